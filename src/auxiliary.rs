@@ -1,0 +1,124 @@
+//! The auxiliary system that compensates saturation, (11), (36), SPEC §8.
+//!
+//! ```text
+//! ‖ζ‖ ≥ μ:  ζ̇ = −Kζ ζ − ((|z2ᵀ Δτ| + ½ Δτᵀ Δτ) / ‖ζ‖²) ζ + Δτ
+//! ‖ζ‖ < μ:  ζ̇ = −Kζ ζ + Δτ   (AuxLaw::Leaky, the SPEC default)
+//!           ζ̇ = 0            (AuxLaw::Printed, as the paper prints it)
+//! ```
+//!
+//! Erratum (SPEC §8): with the printed inner law ζ(0) = 0 never leaves the
+//! origin and the compensator is dead; the default inner law leaves zero when
+//! the actuator saturates and decays when it does not.
+
+use crate::error::{check, Error};
+use crate::Vector;
+
+/// The law inside the ball ‖ζ‖ < μ, SPEC §8.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub enum AuxLaw {
+    /// ζ̇ = −Kζ ζ + Δτ inside the ball (SPEC §8 default; "default" in Python).
+    #[default]
+    Leaky,
+    /// ζ̇ = 0 inside the ball, as printed in (11) ("printed" in Python).
+    Printed,
+}
+
+/// Parameters of the auxiliary system: Kζ (1/s, diagonal), μ (N m) and the inner law.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Auxiliary<const N: usize> {
+    kzeta: Vector<N>,
+    mu: f64,
+    law: AuxLaw,
+}
+
+impl<const N: usize> Auxiliary<N> {
+    /// Validated: Kζ finite (its SPEC §10 condition involves Kp and is checked by
+    /// the controller), μ > 0.
+    pub fn new(kzeta: Vector<N>, mu: f64, law: AuxLaw) -> Result<Self, Error> {
+        check::finite_slice("Kzeta", kzeta.as_slice())?;
+        check::positive("μ > 0", "mu", mu)?;
+        Ok(Self { kzeta, mu, law })
+    }
+
+    /// Kζ (1/s).
+    pub fn kzeta(&self) -> &Vector<N> {
+        &self.kzeta
+    }
+    /// μ (N m).
+    pub fn mu(&self) -> f64 {
+        self.mu
+    }
+    /// The inner law.
+    pub fn law(&self) -> AuxLaw {
+        self.law
+    }
+
+    /// Advance ζ by one period `ts` (s) given z2 (rad/s) and Δτ = sat(τ) − τ (N m).
+    ///
+    /// Semi-implicit, per component (SPEC §11): with β = (|z2ᵀΔτ| + ½ΔτᵀΔτ)/‖ζ‖²
+    /// when ‖ζ‖ ≥ μ and β = 0 otherwise, ζ_i ← (ζ_i + Ts Δτ_i) / (1 + Ts (Kζ_i + β)).
+    /// Unconditionally stable in Ts; with the printed law ζ is left unchanged
+    /// inside the ball.
+    #[inline]
+    pub fn advance(&self, zeta: &mut Vector<N>, z2: &Vector<N>, dtau: &Vector<N>, ts: f64) {
+        let n2 = zeta.norm_squared();
+        let beta = if n2 >= self.mu * self.mu {
+            (z2.dot(dtau).abs() + 0.5 * dtau.norm_squared()) / n2
+        } else if self.law == AuxLaw::Printed {
+            return;
+        } else {
+            0.0
+        };
+        for i in 0..N {
+            zeta[i] = (zeta[i] + ts * dtau[i]) / (1.0 + ts * (self.kzeta[i] + beta));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn aux(law: AuxLaw) -> Auxiliary<2> {
+        Auxiliary::new(Vector::<2>::from_element(60.0), 0.01, law).unwrap()
+    }
+
+    #[test]
+    fn stays_zero_without_saturation() {
+        for law in [AuxLaw::Leaky, AuxLaw::Printed] {
+            let mut z = Vector::<2>::zeros();
+            for _ in 0..1000 {
+                aux(law).advance(&mut z, &Vector::<2>::new(0.3, -0.1), &Vector::zeros(), 1e-3);
+            }
+            assert_eq!(z, Vector::<2>::zeros());
+        }
+    }
+
+    #[test]
+    fn default_law_leaves_zero_under_saturation_printed_does_not() {
+        let dtau = Vector::<2>::new(-3.0, 0.5);
+        let z2 = Vector::<2>::new(0.2, 0.1);
+        let (mut leaky, mut printed) = (Vector::<2>::zeros(), Vector::<2>::zeros());
+        let mut peak = 0.0f64;
+        for _ in 0..2000 {
+            aux(AuxLaw::Leaky).advance(&mut leaky, &z2, &dtau, 50e-6);
+            aux(AuxLaw::Printed).advance(&mut printed, &z2, &dtau, 50e-6);
+            peak = peak.max(leaky.norm());
+        }
+        // It leaves 0 along Δτ; once ‖ζ‖ ≥ μ the −β term pulls it back, so it
+        // stays near the ball's surface (SPEC §11, Finding).
+        assert!((0.01..0.02).contains(&peak), "peak ‖ζ‖ {peak}");
+        assert!(leaky[0] < 0.0 && leaky[1] > 0.0, "ζ follows Δτ: {leaky}");
+        assert_eq!(printed, Vector::<2>::zeros());
+    }
+
+    #[test]
+    fn decays_once_saturation_ends() {
+        let mut z = Vector::<2>::new(0.5, -0.5);
+        for _ in 0..1000 {
+            aux(AuxLaw::Leaky).advance(&mut z, &Vector::zeros(), &Vector::zeros(), 1e-3);
+        }
+        // e^{−60} is far below μ; once inside the ball the leaky law keeps decaying.
+        assert!(z.norm() < 1e-20, "{z}");
+    }
+}

@@ -1,0 +1,126 @@
+//! The environment the robot touches: the contact force τe, SPEC §3.
+//!
+//! τe is the force (N m, in joint space) that the robot exerts on the
+//! environment; the environment pushes back with −τe, (4). A force sensor
+//! measures it and the controller reads it.
+
+use crate::error::{check, Error};
+use crate::Vector;
+
+/// A contact model: τe as a function of time and the robot's state.
+pub trait Environment<const N: usize> {
+    /// τe (N m) at time `t` (s), joint position `x` (rad) and velocity `dx` (rad/s).
+    fn force(&self, t: f64, x: &Vector<N>, dx: &Vector<N>) -> Vector<N>;
+}
+
+/// No contact: τe ≡ 0.
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct FreeSpace;
+
+impl<const N: usize> Environment<N> for FreeSpace {
+    fn force(&self, _t: f64, _x: &Vector<N>, _dx: &Vector<N>) -> Vector<N> {
+        Vector::zeros()
+    }
+}
+
+/// A penalty wall that blocks `x[joint] > position`, SPEC §3.
+///
+/// With δ = x_j − w: `f = max(0, ke δ + be ẋ_j)` if δ > 0, else 0; τe = f e_j.
+/// (The `max` keeps a receding wall from pulling the robot.)
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Wall<const N: usize> {
+    joint: usize,
+    position: f64,
+    ke: f64,
+    be: f64,
+}
+
+impl<const N: usize> Wall<N> {
+    /// A wall on `joint` (0-based) at `position` (rad) with stiffness `ke`
+    /// (N m/rad) and damping `be` (N m s/rad), both ≥ 0.
+    pub fn new(joint: usize, position: f64, ke: f64, be: f64) -> Result<Self, Error> {
+        if joint >= N {
+            return Err(Error::Invalid {
+                what: "wall joint",
+                reason: "must be less than the number of joints",
+            });
+        }
+        check::finite("wall", position)?;
+        check::nonnegative("ke ≥ 0", "ke", ke)?;
+        check::nonnegative("be ≥ 0", "be", be)?;
+        Ok(Self {
+            joint,
+            position,
+            ke,
+            be,
+        })
+    }
+
+    /// The joint the wall acts on (0-based).
+    pub fn joint(&self) -> usize {
+        self.joint
+    }
+    /// The wall position w (rad).
+    pub fn position(&self) -> f64 {
+        self.position
+    }
+    /// Stiffness ke (N m/rad).
+    pub fn ke(&self) -> f64 {
+        self.ke
+    }
+    /// Damping be (N m s/rad).
+    pub fn be(&self) -> f64 {
+        self.be
+    }
+}
+
+impl Wall<2> {
+    /// SPEC §3 defaults: joint 1 (index 0), w = 0.2 rad, ke = 1000 N m/rad, be = 10 N m s/rad.
+    pub fn paper() -> Self {
+        Self {
+            joint: 0,
+            position: 0.2,
+            ke: 1000.0,
+            be: 10.0,
+        }
+    }
+}
+
+impl<const N: usize> Environment<N> for Wall<N> {
+    #[inline]
+    fn force(&self, _t: f64, x: &Vector<N>, dx: &Vector<N>) -> Vector<N> {
+        let mut tau_e = Vector::zeros();
+        let delta = x[self.joint] - self.position;
+        if delta > 0.0 {
+            tau_e[self.joint] = (self.ke * delta + self.be * dx[self.joint]).max(0.0);
+        }
+        tau_e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wall_pushes_only_when_penetrated_and_never_pulls() {
+        let w = Wall::paper();
+        let z = Vector::<2>::zeros();
+        assert_eq!(w.force(0.0, &Vector::<2>::new(0.19, 0.0), &z), z);
+        let f = w.force(0.0, &Vector::<2>::new(0.25, 0.0), &z);
+        assert!((f[0] - 50.0).abs() < 1e-12 && f[1] == 0.0, "{f}");
+        // Leaving the wall fast: ke δ + be ẋ < 0 is clipped to 0 (no adhesion).
+        let f = w.force(
+            0.0,
+            &Vector::<2>::new(0.201, 0.0),
+            &Vector::<2>::new(-1.0, 0.0),
+        );
+        assert_eq!(f, z);
+    }
+
+    #[test]
+    fn rejects_joint_out_of_range() {
+        assert!(Wall::<2>::new(2, 0.2, 1.0, 1.0).is_err());
+        assert!(Wall::<3>::new(2, 0.2, 1.0, 1.0).is_ok());
+    }
+}

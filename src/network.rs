@@ -1,0 +1,258 @@
+//! The three RBF networks D̂, Ĉ, Ĝ: their weights, output and update laws,
+//! (14)–(17), (37)–(39), SPEC §6.
+//!
+//! With the shared basis S(Z) ∈ R^L:
+//!
+//! ```text
+//! (D̂ α̇1)_k = Σ_j Σ_i ŴD[k][j][i] S_i α̇1_j      ≈ (D(q) α̇1)_k
+//! (Ĉ α1)_k  = Σ_j Σ_i ŴC[k][j][i] S_i α1_j       ≈ (C(q, q̇) α1)_k
+//! Ĝ_k       = Σ_i ŴG[k][i] S_i                   ≈ G_k(q)
+//! dŴD[k][j][i]/dt = ΓD (S_i α̇1_j z2_k − σD ŴD[k][j][i])     (15)
+//! dŴC[k][j][i]/dt = ΓC (S_i α1_j  z2_k − σC ŴC[k][j][i])     (16)
+//! dŴG[k][i]/dt    = ΓG (S_i z2_k       − σG ŴG[k][i])        (17)
+//! ```
+//!
+//! Each weight row `Ŵ[k][j]` (a vector over the nodes) appears once in the
+//! output, as a dot product with S, and once in the explicit-Euler update
+//! `Ŵ ← a Ŵ + b S` with `a = 1 − Ts Γ σ`, `b = Ts Γ u_j z2_k`. [`Weights::fused_step`]
+//! does both in one pass over the weights, reading and writing each once.
+
+use crate::error::{check, Error};
+use crate::math::sqrt;
+use crate::Vector;
+use nalgebra::SVector;
+
+/// Index of the three networks in `[f64; 3]` parameter arrays.
+pub const D: usize = 0;
+/// Index of the Ĉ network.
+pub const C: usize = 1;
+/// Index of the Ĝ network.
+pub const G: usize = 2;
+
+/// Weights of the three networks, all zero at t = 0 (SPEC §6).
+///
+/// `d[k][j]` is the row ŴD[k][j][·] over the `L` nodes, `c[k][j]` likewise,
+/// `g[k]` is ŴG[k][·]. Units: D̂ weights in kg m², Ĉ in kg m²/s, Ĝ in N m
+/// (each times the dimensionless basis).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Weights<const N: usize, const L: usize> {
+    /// ŴD[k][j] (kg m²).
+    pub d: [[SVector<f64, L>; N]; N],
+    /// ŴC[k][j] (kg m²/s).
+    pub c: [[SVector<f64, L>; N]; N],
+    /// ŴG[k] (N m).
+    pub g: [SVector<f64, L>; N],
+}
+
+/// Per-step update coefficients of the explicit-Euler learning law.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Rates {
+    /// `a = 1 − Ts Γ σ` per network (D, C, G).
+    pub decay: [f64; 3],
+    /// `Ts Γ` per network (D, C, G) (s times the gain).
+    pub gain: [f64; 3],
+}
+
+impl Rates {
+    /// Coefficients for sampling period `ts` (s), gains Γ and leakages σ, validated > 0.
+    pub fn new(ts: f64, gamma: [f64; 3], sigma: [f64; 3]) -> Result<Self, Error> {
+        check::positive_vec("Γ > 0", "gamma", &Vector::<3>::from(gamma))?;
+        check::positive_vec("σ > 0", "sigma", &Vector::<3>::from(sigma))?;
+        Ok(Self {
+            decay: core::array::from_fn(|n| 1.0 - ts * gamma[n] * sigma[n]),
+            gain: core::array::from_fn(|n| ts * gamma[n]),
+        })
+    }
+}
+
+/// One row: returns `Ŵ·S` and `‖Ŵ‖²` of the old row, and writes `Ŵ ← a Ŵ + b S`.
+#[inline(always)]
+fn dot_update<const L: usize>(
+    w: &mut SVector<f64, L>,
+    s: &SVector<f64, L>,
+    a: f64,
+    b: f64,
+) -> (f64, f64) {
+    const LANES: usize = 4;
+    let (w, s) = (w.as_mut_slice(), s.as_slice());
+    let mut dot = [0.0; LANES];
+    let mut sq = [0.0; LANES];
+    let mut wc = w.chunks_exact_mut(LANES);
+    let mut sc = s.chunks_exact(LANES);
+    for (wv, sv) in (&mut wc).zip(&mut sc) {
+        for l in 0..LANES {
+            let old = wv[l];
+            dot[l] += old * sv[l];
+            sq[l] += old * old;
+            wv[l] = a * old + b * sv[l];
+        }
+    }
+    let (mut dot_t, mut sq_t) = (0.0, 0.0);
+    for (wv, &sv) in wc.into_remainder().iter_mut().zip(sc.remainder()) {
+        let old = *wv;
+        dot_t += old * sv;
+        sq_t += old * old;
+        *wv = a * old + b * sv;
+    }
+    (
+        (dot[0] + dot[1]) + (dot[2] + dot[3]) + dot_t,
+        (sq[0] + sq[1]) + (sq[2] + sq[3]) + sq_t,
+    )
+}
+
+impl<const N: usize, const L: usize> Weights<N, L> {
+    /// All weights zero.
+    pub fn zeros() -> Self {
+        Self {
+            d: [[SVector::zeros(); N]; N],
+            c: [[SVector::zeros(); N]; N],
+            g: [SVector::zeros(); N],
+        }
+    }
+
+    /// Every weight finite.
+    pub fn check_finite(&self) -> Result<(), Error> {
+        for row in self.d.iter().flatten() {
+            check::finite_slice("weights.D", row.as_slice())?;
+        }
+        for row in self.c.iter().flatten() {
+            check::finite_slice("weights.C", row.as_slice())?;
+        }
+        for row in &self.g {
+            check::finite_slice("weights.G", row.as_slice())?;
+        }
+        Ok(())
+    }
+
+    /// Frobenius norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F.
+    pub fn norms(&self) -> [f64; 3] {
+        let sq = |rows: &mut dyn Iterator<Item = &SVector<f64, L>>| {
+            sqrt(rows.map(|r| r.norm_squared()).sum())
+        };
+        [
+            sq(&mut self.d.iter().flatten()),
+            sq(&mut self.c.iter().flatten()),
+            sq(&mut self.g.iter()),
+        ]
+    }
+
+    /// Network output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) for basis `s`, without learning.
+    pub fn output(
+        &self,
+        s: &SVector<f64, L>,
+        dalpha1: &Vector<N>,
+        alpha1: &Vector<N>,
+    ) -> Vector<N> {
+        Vector::from_fn(|k, _| {
+            let mut out = self.g[k].dot(s);
+            for j in 0..N {
+                out += self.d[k][j].dot(s) * dalpha1[j] + self.c[k][j].dot(s) * alpha1[j];
+            }
+            out
+        })
+    }
+
+    /// One step of the networks in a single pass over the weights: returns the
+    /// output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current weights and their
+    /// Frobenius norms, then applies the explicit-Euler update of (15)–(17)
+    /// with error signal `z2` (rad/s; ẑ2 for output feedback, (37)–(39)).
+    #[inline]
+    pub fn fused_step(
+        &mut self,
+        s: &SVector<f64, L>,
+        dalpha1: &Vector<N>,
+        alpha1: &Vector<N>,
+        z2: &Vector<N>,
+        rates: &Rates,
+    ) -> (Vector<N>, [f64; 3]) {
+        let mut out = Vector::<N>::zeros();
+        let mut sq = [0.0; 3];
+        for k in 0..N {
+            let gz = z2[k];
+            for j in 0..N {
+                let (dot, n2) = dot_update(
+                    &mut self.d[k][j],
+                    s,
+                    rates.decay[D],
+                    rates.gain[D] * dalpha1[j] * gz,
+                );
+                out[k] += dot * dalpha1[j];
+                sq[D] += n2;
+                let (dot, n2) = dot_update(
+                    &mut self.c[k][j],
+                    s,
+                    rates.decay[C],
+                    rates.gain[C] * alpha1[j] * gz,
+                );
+                out[k] += dot * alpha1[j];
+                sq[C] += n2;
+            }
+            let (dot, n2) = dot_update(&mut self.g[k], s, rates.decay[G], rates.gain[G] * gz);
+            out[k] += dot;
+            sq[G] += n2;
+        }
+        (out, sq.map(sqrt))
+    }
+}
+
+impl<const N: usize, const L: usize> Default for Weights<N, L> {
+    fn default() -> Self {
+        Self::zeros()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn basis() -> SVector<f64, 16> {
+        SVector::from_fn(|i, _| 0.1 + 0.05 * i as f64)
+    }
+
+    #[test]
+    fn fused_step_equals_output_then_euler_update() {
+        let mut w = Weights::<1, 16>::zeros();
+        // Some non-zero weights.
+        for (i, v) in w.d[0][0].iter_mut().enumerate() {
+            *v = 0.01 * i as f64;
+        }
+        w.c[0][0].fill(-0.2);
+        w.g[0].fill(0.3);
+        let s = basis();
+        let (da, a, z2) = (
+            Vector::<1>::new(2.0),
+            Vector::<1>::new(-0.5),
+            Vector::<1>::new(0.1),
+        );
+        let ts = 1e-3;
+        let (gamma, sigma) = ([100.0; 3], [0.01; 3]);
+        let rates = Rates::new(ts, gamma, sigma).unwrap();
+        let expect_out = w.output(&s, &da, &a);
+        let expect_norms = w.norms();
+        // The SPEC's form: Ŵ ← Ŵ + Ts Γ (S u z2 − σ Ŵ).
+        let mut expect_w = w.clone();
+        for i in 0..16 {
+            expect_w.d[0][0][i] += ts * gamma[D] * (s[i] * da[0] * z2[0] - sigma[D] * w.d[0][0][i]);
+            expect_w.c[0][0][i] += ts * gamma[C] * (s[i] * a[0] * z2[0] - sigma[C] * w.c[0][0][i]);
+            expect_w.g[0][i] += ts * gamma[G] * (s[i] * z2[0] - sigma[G] * w.g[0][i]);
+        }
+        let (out, norms) = w.fused_step(&s, &da, &a, &z2, &rates);
+        assert!((out - expect_out).norm() < 1e-14, "{out} vs {expect_out}");
+        for n in 0..3 {
+            assert!((norms[n] - expect_norms[n]).abs() < 1e-14);
+        }
+        for i in 0..16 {
+            assert!((w.d[0][0][i] - expect_w.d[0][0][i]).abs() < 1e-15);
+            assert!((w.c[0][0][i] - expect_w.c[0][0][i]).abs() < 1e-15);
+            assert!((w.g[0][i] - expect_w.g[0][i]).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn rates_reject_nonpositive_gain_by_name() {
+        let e = Rates::new(1e-3, [100.0, 0.0, 100.0], [0.01; 3]).unwrap_err();
+        assert!(e.to_string().contains("Γ > 0"), "{e}");
+        let e = Rates::new(1e-3, [100.0; 3], [0.01, 0.01, -1.0]).unwrap_err();
+        assert!(e.to_string().contains("σ > 0"), "{e}");
+    }
+}

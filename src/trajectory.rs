@@ -1,0 +1,153 @@
+//! Commanded trajectories xc(t), (64), SPEC §4.
+
+use crate::error::{check, Error};
+use crate::math::{cos, sin};
+use crate::Vector;
+
+/// Position, velocity and acceleration of a trajectory at one instant
+/// (rad, rad/s, rad/s²).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Setpoint<const N: usize> {
+    /// Position (rad).
+    pub x: Vector<N>,
+    /// Velocity (rad/s).
+    pub dx: Vector<N>,
+    /// Acceleration (rad/s²).
+    pub ddx: Vector<N>,
+}
+
+/// A commanded trajectory, twice differentiable: xc(t), ẋc(t), ẍc(t).
+///
+/// Closures `Fn(f64) -> Setpoint<N>` are trajectories too.
+pub trait Trajectory<const N: usize> {
+    /// The setpoint at time `t` (s).
+    fn sample(&self, t: f64) -> Setpoint<N>;
+}
+
+impl<const N: usize, F: Fn(f64) -> Setpoint<N>> Trajectory<N> for F {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        self(t)
+    }
+}
+
+/// Per-joint sinusoid `x_i(t) = o_i + a_i sin(ω_i t) + b_i cos(ω_i t)`.
+///
+/// The paper's circle (64), `xc = [0.2 − 0.2 cos(πt), 0.2 + 0.2 sin(πt)]`,
+/// is [`Sinusoid::paper`].
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Sinusoid<const N: usize> {
+    offset: Vector<N>,
+    sin: Vector<N>,
+    cos: Vector<N>,
+    omega: Vector<N>,
+}
+
+impl<const N: usize> Sinusoid<N> {
+    /// Offset o (rad), sine and cosine amplitudes a, b (rad), angular frequency ω (rad/s).
+    pub fn new(
+        offset: Vector<N>,
+        sin: Vector<N>,
+        cos: Vector<N>,
+        omega: Vector<N>,
+    ) -> Result<Self, Error> {
+        check::finite_slice("xc_offset", offset.as_slice())?;
+        check::finite_slice("xc_sin", sin.as_slice())?;
+        check::finite_slice("xc_cos", cos.as_slice())?;
+        check::finite_slice("xc_omega", omega.as_slice())?;
+        Ok(Self {
+            offset,
+            sin,
+            cos,
+            omega,
+        })
+    }
+
+    /// A constant setpoint at `x` (rad).
+    pub fn constant(x: Vector<N>) -> Result<Self, Error> {
+        Self::new(x, Vector::zeros(), Vector::zeros(), Vector::zeros())
+    }
+
+    /// Offset o (rad).
+    pub fn offset(&self) -> &Vector<N> {
+        &self.offset
+    }
+    /// Sine amplitudes a (rad).
+    pub fn sin_amplitude(&self) -> &Vector<N> {
+        &self.sin
+    }
+    /// Cosine amplitudes b (rad).
+    pub fn cos_amplitude(&self) -> &Vector<N> {
+        &self.cos
+    }
+    /// Angular frequencies ω (rad/s).
+    pub fn omega(&self) -> &Vector<N> {
+        &self.omega
+    }
+}
+
+impl Sinusoid<2> {
+    /// The paper's commanded circle (64): centre [0.2, 0.2] rad, radius 0.2 rad, ω = π rad/s.
+    pub fn paper() -> Self {
+        Self {
+            offset: Vector::<2>::new(0.2, 0.2),
+            sin: Vector::<2>::new(0.0, 0.2),
+            cos: Vector::<2>::new(-0.2, 0.0),
+            omega: Vector::<2>::from_element(core::f64::consts::PI),
+        }
+    }
+}
+
+impl<const N: usize> Trajectory<N> for Sinusoid<N> {
+    #[inline]
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        let mut sp = Setpoint {
+            x: self.offset,
+            dx: Vector::zeros(),
+            ddx: Vector::zeros(),
+        };
+        for i in 0..N {
+            let w = self.omega[i];
+            let (s, c) = (sin(w * t), cos(w * t));
+            let (a, b) = (self.sin[i], self.cos[i]);
+            sp.x[i] += a * s + b * c;
+            sp.dx[i] = w * (a * c - b * s);
+            sp.ddx[i] = -w * w * (a * s + b * c);
+        }
+        sp
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f64::consts::PI;
+
+    #[test]
+    fn paper_circle_matches_64() {
+        let tr = Sinusoid::paper();
+        for &t in &[0.0, 0.3, 1.7, 12.25] {
+            let sp = tr.sample(t);
+            assert!((sp.x[0] - (0.2 - 0.2 * (PI * t).cos())).abs() < 1e-15);
+            assert!((sp.x[1] - (0.2 + 0.2 * (PI * t).sin())).abs() < 1e-15);
+            assert!((sp.dx[0] - 0.2 * PI * (PI * t).sin()).abs() < 1e-14);
+            assert!((sp.dx[1] - 0.2 * PI * (PI * t).cos()).abs() < 1e-14);
+            assert!((sp.ddx[0] - 0.2 * PI * PI * (PI * t).cos()).abs() < 1e-13);
+            assert!((sp.ddx[1] + 0.2 * PI * PI * (PI * t).sin()).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn derivatives_are_consistent_by_finite_differences() {
+        let tr = Sinusoid::<3>::new(
+            Vector::<3>::new(0.1, -0.2, 0.3),
+            Vector::<3>::new(0.5, 0.0, -0.1),
+            Vector::<3>::new(0.0, 0.2, 0.4),
+            Vector::<3>::new(1.0, 2.0, 3.0),
+        )
+        .unwrap();
+        let (t, h) = (0.7, 1e-6);
+        let (a, b, c) = (tr.sample(t - h), tr.sample(t), tr.sample(t + h));
+        assert!(((c.x - a.x) / (2.0 * h) - b.dx).norm() < 1e-8);
+        assert!(((c.dx - a.dx) / (2.0 * h) - b.ddx).norm() < 1e-7);
+    }
+}

@@ -31,6 +31,28 @@
 //! | [`metrics`] | tracking / saturation / impedance figures | §12 |
 //! | [`error`] | validation errors | §10 |
 //!
+//! ## Quick start
+//!
+//! ```
+//! use adaptimp::{simulate, Controller, Law, Measurement, SimConfig, TwoLinkArm, Vector, Wall};
+//!
+//! // The paper's state-feedback controller with every SPEC default (Ts = 50 µs),
+//! // tracking the paper's circle; it keeps its own clock t_k = k·Ts.
+//! let mut ctrl = Box::new(Controller::paper(Law::StateFeedback));
+//! let cmd = ctrl.step(&Measurement {
+//!     x: Vector::<2>::new(0.25, -0.05),   // joint positions (rad)
+//!     dx: Some(Vector::<2>::zeros()),     // joint velocities (rad/s)
+//!     tau_e: Vector::<2>::new(50.0, 0.0), // force on the environment (N m)
+//! })?;
+//! assert_eq!(cmd.tau_sat[0], 17.0); // saturated: the commanded τ is larger
+//!
+//! // Or close the loop with the paper's arm and wall for 0.5 s.
+//! let sim = SimConfig { t_final: 0.5, ..SimConfig::paper() };
+//! let m = simulate(&TwoLinkArm::paper(), &Wall::paper(), ctrl.as_mut(), &sim, &mut ())?;
+//! assert_eq!(m.rows, 10_000);
+//! # Ok::<(), adaptimp::Error>(())
+//! ```
+//!
 //! ## `no_std`
 //!
 //! With `default-features = false` the crate is `no_std` and needs no

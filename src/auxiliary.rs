@@ -21,6 +21,12 @@ pub enum AuxLaw {
     Leaky,
     /// ζ̇ = 0 inside the ball, as printed in (11) ("printed" in Python).
     Printed,
+    /// ζ̇ = −Kζ ζ + Δτ everywhere, without the −β term ("linear" in Python;
+    /// beyond the paper). The −β term of (11) holds ‖ζ‖ near μ whenever the
+    /// actuator saturates, so ζ barely reacts; without it ζ is Δτ low-pass
+    /// filtered at Kζ, the classical anti-windup signal (Åström & Rundqwist,
+    /// "Integrator windup and how to avoid it", ACC 1989).
+    Linear,
 }
 
 /// Parameters of the auxiliary system: Kζ (1/s, diagonal), μ (N m) and the inner law.
@@ -62,7 +68,9 @@ impl<const N: usize> Auxiliary<N> {
     #[inline]
     pub fn advance(&self, zeta: &mut Vector<N>, z2: &Vector<N>, dtau: &Vector<N>, ts: f64) {
         let n2 = zeta.norm_squared();
-        let beta = if n2 >= self.mu * self.mu {
+        let beta = if self.law == AuxLaw::Linear {
+            0.0
+        } else if n2 >= self.mu * self.mu {
             (z2.dot(dtau).abs() + 0.5 * dtau.norm_squared()) / n2
         } else if self.law == AuxLaw::Printed {
             return;

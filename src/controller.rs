@@ -16,7 +16,7 @@ use crate::auxiliary::{AuxLaw, Auxiliary};
 use crate::error::{check, Error};
 use crate::impedance::{Reference, TargetImpedance};
 use crate::math::{sgn, tanh};
-use crate::network::{Rates, Weights};
+use crate::network::{self, Rates, Weights};
 use crate::observer::{HighGainObserver, Hold, ObserverState};
 use crate::rbf::Rbf;
 use crate::saturation::Saturation;
@@ -100,6 +100,42 @@ impl<const N: usize> Robust<N> {
     }
 }
 
+/// How the weights take one learning step (beyond the paper, SPEC §13).
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub enum LearningStep {
+    /// Explicit Euler of (15)–(17), SPEC §11 ("euler" in Python).
+    #[default]
+    Euler,
+    /// Normalised step ("normalized"): the Euler step divided by `1 + g/(κ min Kp)`,
+    /// where `g = Ts ‖S‖² (ΓD ‖α̇1‖² + ΓC ‖α1‖² + ΓG)` (N m per rad/s) is the
+    /// gain one Euler step adds from z2 to the network output. Explicit-Euler
+    /// learning against the plant is stable only for g < Kp (a two-state Jury
+    /// test of z2 and the learned term), so the normalised step keeps the
+    /// per-step gain below κ Kp at any Ts, and is the printed law when g ≪ κ Kp.
+    /// The discrete normalised gradient (projection) algorithm: Goodwin & Sin,
+    /// *Adaptive Filtering, Prediction and Control*, 1984, §3.3; Ioannou & Sun,
+    /// *Robust Adaptive Control*, 1996, §4.5.
+    Normalized {
+        /// κ in (0, 1]: the per-step learning gain's bound as a fraction of Kp.
+        kappa: f64,
+    },
+}
+
+/// What learning does while the actuator saturates (beyond the paper, SPEC §13).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub enum SaturationLearning {
+    /// Learn as if nothing saturated, as printed ("ignore" in Python): the
+    /// weights integrate an error the actuator cannot remove, and wind up.
+    #[default]
+    Ignore,
+    /// Conditional integration ("freeze"): while joint k saturates, its rows do
+    /// not take the learning step that would push τ_k further beyond the limit
+    /// (they still leak by σ, and learn in the unwinding direction). Åström &
+    /// Hägglund, *Advanced PID Control*, 2006, §3.5; for adaptive laws, the
+    /// "stop adaptation under saturation" of Kárason & Annaswamy, IEEE TAC 39(11), 1994.
+    Freeze,
+}
+
 /// How the observer state starts (SPEC §9).
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub enum ObserverInit {
@@ -132,6 +168,14 @@ pub struct Config<const N: usize, const L: usize> {
     pub aux_law: AuxLaw,
     /// Robust term. SPEC §7: `Sign` with kr = 0.5 N m.
     pub robust: Robust<N>,
+    /// The learning step. Paper: explicit Euler.
+    pub learning_step: LearningStep,
+    /// Learning under saturation. Paper: ignore it.
+    pub saturation_learning: SaturationLearning,
+    /// Projection of each network's weights onto the ball ‖Ŵ‖_F ≤ bound
+    /// (D̂, Ĉ, Ĝ). Paper: none. (Ioannou & Sun 1996, §4.5.5, applied after
+    /// each step: the Euler step followed by the projection onto the ball.)
+    pub weight_bound: Option<[f64; 3]>,
     /// Learning gains Γ for D̂, Ĉ, Ĝ. Paper: 100.
     pub gamma: [f64; 3],
     /// Leakages σ for D̂, Ĉ, Ĝ. Paper: 0.01.
@@ -172,6 +216,9 @@ impl<const N: usize, const L: usize> Config<N, L> {
             robust: Robust::Sign {
                 kr: Vector::from_element(0.5),
             },
+            learning_step: LearningStep::Euler,
+            saturation_learning: SaturationLearning::Ignore,
+            weight_bound: None,
             gamma: [100.0; 3],
             sigma: [0.01; 3],
             rbf,
@@ -192,6 +239,51 @@ impl Config<2, 256> {
     pub fn paper(law: Law) -> Self {
         let rbf = Rbf::grid(25.0).unwrap_or_else(|_| unreachable!("256 = 2^(4·2) and η² = 25 > 0"));
         Self::new(law, Vector::<2>::new(17.0, 15.0), rbf)
+    }
+}
+
+impl Config<2, 256> {
+    /// The "robot" scenario (SPEC §13, beyond the paper): the paper's arm,
+    /// gains, Γ, σ, η² and 256 nodes at a robot's Ts = 1 ms, with the
+    /// [hardened](Self::hardened) options as defaults.
+    pub fn robot(law: Law) -> Self {
+        let mut cfg = Self::paper(law).hardened();
+        cfg.ts = 1e-3;
+        cfg
+    }
+
+    /// This configuration with every hardened option of the robot scenario
+    /// (SPEC §13), whatever Ts is:
+    ///
+    /// - [`LearningStep::Normalized`] with κ = 0.5 (the per-step learning gain
+    ///   stays below Kp/2; the printed Euler step exceeds Kp at 1 ms);
+    /// - [`SaturationLearning::Freeze`] (no learning into the limits);
+    /// - `weight_bound` from [`network::weight_bounds`] for this τmax and the
+    ///   paper circle (peak ‖ẋc‖ = 0.2π rad/s, ‖ẍc‖ = 0.2π² rad/s²);
+    ///   ≈ [0.72, 2.26, 1.42] for τmax = [17, 15] N m;
+    /// - [`Robust::Tanh`] with the current kr (or 0.5 N m) and φ = 0.05 rad/s
+    ///   (sgn chatters at 1 kHz);
+    /// - observer: [`Hold::Triangle`] (at Ts ≫ ε it is the backward difference
+    ///   of the samples, where ZOH estimates ≈ 0 at the sample instants),
+    ///   started at the first measurement.
+    pub fn hardened(mut self) -> Self {
+        let pi = core::f64::consts::PI;
+        self.learning_step = LearningStep::Normalized { kappa: 0.5 };
+        self.saturation_learning = SaturationLearning::Freeze;
+        self.weight_bound = Some(network::weight_bounds(
+            &self.tau_max,
+            256,
+            0.2 * pi,
+            0.2 * pi * pi,
+        ));
+        let kr = match self.robust {
+            Robust::Sign { kr } | Robust::Tanh { kr, .. } => kr,
+            Robust::None | Robust::Remark1 { .. } => Vector::from_element(0.5),
+        };
+        self.robust = Robust::Tanh { kr, phi: 0.05 };
+        self.observer_hold = Hold::Triangle;
+        self.observer_init = ObserverInit::FirstMeasurement;
+        self
     }
 }
 
@@ -278,6 +370,8 @@ pub struct Controller<const N: usize, const L: usize, T = Sinusoid<N>> {
     zeta: Vector<N>,
     observer: ObserverState<N>,
     weights: Weights<N, L>,
+    /// ‖Ŵ‖_F of the current weights, kept by the two-pass update.
+    norms: [f64; 3],
     basis: SVector<f64, L>,
     last: Command<N>,
 }
@@ -315,6 +409,24 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
         )?;
         check::positive("η² > 0", "eta2", cfg.rbf.eta2())?;
         cfg.robust.validate()?;
+        if let LearningStep::Normalized { kappa } = cfg.learning_step {
+            check::positive("κ > 0", "kappa", kappa)?;
+            if kappa > 1.0 {
+                return Err(Error::Condition {
+                    condition: "κ ≤ 1",
+                    lhs: "kappa",
+                    index: None,
+                    value: kappa,
+                });
+            }
+        }
+        if let Some(bound) = cfg.weight_bound {
+            check::positive_vec(
+                "weight bound > 0",
+                "weight_bound",
+                &Vector::<3>::from(bound),
+            )?;
+        }
         let parts = Parts {
             sat: Saturation::new(cfg.tau_max)?,
             imp: TargetImpedance::new(cfg.dd, cfg.cd, cfg.gd)?,
@@ -334,6 +446,7 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
             zeta: Vector::zeros(),
             observer: ObserverState::zeros(),
             weights: Weights::zeros(),
+            norms: [0.0; 3],
             basis: SVector::zeros(),
             last: Command::zeros(),
         })
@@ -346,6 +459,7 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
         self.zeta = Vector::zeros();
         self.observer = ObserverState::zeros();
         self.weights = Weights::zeros();
+        self.norms = [0.0; 3];
         self.basis = SVector::zeros();
         self.last = Command::zeros();
     }
@@ -405,24 +519,67 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
         let mut tau = self.cfg.kp.component_mul(&(z2 + self.zeta))
             + self.cfg.robust.eval(&z2, &alpha1, &dalpha1);
         let mut w_norms = [0.0; 3];
+        // The learning step's scale (1 for the printed law), SPEC §13.
+        let mut scale = 1.0;
+        let deferred = self.cfg.saturation_learning == SaturationLearning::Freeze
+            || self.cfg.weight_bound.is_some();
         if law.learns() {
-            // Output and update (15)–(17) / (37)–(39) in one pass; the update
-            // uses only this step's values (SPEC §11, step 5).
             self.cfg
                 .rbf
                 .eval(&[m.x, v, alpha1, dalpha1], &mut self.basis);
-            let (nn, norms) =
-                self.weights
-                    .fused_step(&self.basis, &dalpha1, &alpha1, &z2, &p.rates);
+            if let LearningStep::Normalized { kappa } = self.cfg.learning_step {
+                let g = p.rates.gain;
+                let gain = self.basis.norm_squared()
+                    * (g[network::D] * dalpha1.norm_squared()
+                        + g[network::C] * alpha1.norm_squared()
+                        + g[network::G]);
+                scale = 1.0 / (1.0 + gain / (kappa * self.cfg.kp.min()));
+            }
+            let nn = if deferred {
+                w_norms = self.norms;
+                self.weights.output(&self.basis, &dalpha1, &alpha1)
+            } else {
+                // Output and update (15)–(17) / (37)–(39) in one pass; the update
+                // uses only this step's values (SPEC §11, step 5).
+                let (nn, norms) =
+                    self.weights
+                        .fused_step(&self.basis, &dalpha1, &alpha1, &z2, &p.rates, scale);
+                w_norms = norms;
+                nn
+            };
             // (14), (35) with +z1 (erratum, SPEC §7).
             tau += z1 + nn + m.tau_e;
-            w_norms = norms;
         }
         if tau.iter().any(|t| !t.is_finite()) {
             return Err(Error::Diverged { what: "tau" });
         }
         let tau_sat = p.sat.apply(&tau);
         let dtau = tau_sat - tau;
+        if law.learns() && deferred {
+            // The update needs this step's saturation: after the output.
+            let mut z2_learn = z2;
+            if self.cfg.saturation_learning == SaturationLearning::Freeze {
+                for k in 0..N {
+                    // Learning moves out_k along z2_k; Δτ_k points back inside.
+                    if z2[k] * dtau[k] < 0.0 {
+                        z2_learn[k] = 0.0;
+                    }
+                }
+            }
+            let mut norms =
+                self.weights
+                    .update(&self.basis, &dalpha1, &alpha1, &z2_learn, &p.rates, scale);
+            if let Some(bound) = self.cfg.weight_bound {
+                for net in 0..3 {
+                    if norms[net] > bound[net] {
+                        // Projection onto the ball ‖Ŵ‖_F ≤ bound.
+                        self.weights.scale_network(net, bound[net] / norms[net]);
+                        norms[net] = bound[net];
+                    }
+                }
+            }
+            self.norms = norms;
+        }
 
         let cmd = Command {
             tau_sat,
@@ -488,6 +645,7 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
     /// weight must be finite.
     pub fn set_weights(&mut self, w: Weights<N, L>) -> Result<(), Error> {
         w.check_finite()?;
+        self.norms = w.norms();
         self.weights = w;
         Ok(())
     }
@@ -506,5 +664,149 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
     /// The target impedance.
     pub fn impedance(&self) -> &TargetImpedance<N> {
         &self.parts.imp
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn measurement() -> Measurement<2> {
+        Measurement {
+            x: Vector::<2>::new(0.15, 0.25),
+            dx: Some(Vector::<2>::new(0.4, -0.3)),
+            tau_e: Vector::<2>::zeros(),
+        }
+    }
+
+    /// α1 and α̇1 of the step `c` is about to take with `m` (SPEC §5).
+    fn alphas(c: &Controller<2, 256>, m: &Measurement<2>) -> (Vector<2>, Vector<2>, Vector<2>) {
+        let sp = c.trajectory().sample(c.time());
+        let r = c.reference();
+        let ddxd = c.impedance().accel(&sp, r, &m.tau_e);
+        let v = m.dx.unwrap_or_else(Vector::zeros);
+        let k1 = &c.config().k1;
+        let alpha1 = r.dxd + k1.component_mul(&(r.xd - m.x));
+        let dalpha1 = ddxd + k1.component_mul(&(r.dxd - v));
+        (alpha1, dalpha1, alpha1 - v)
+    }
+
+    /// Change of the network output per unit z2 made by one learning step,
+    /// at that step's basis: the per-step learning gain (N m per rad/s).
+    fn per_step_gain(cfg: Config<2, 256>) -> Vector<2> {
+        let mut c = Controller::new(cfg, Sinusoid::paper()).unwrap();
+        let m = measurement();
+        let (alpha1, dalpha1, z2) = alphas(&c, &m);
+        let before = c.weights().clone();
+        c.step(&m).unwrap();
+        let s = c.basis();
+        let delta = c.weights().output(s, &dalpha1, &alpha1) - before.output(s, &dalpha1, &alpha1);
+        delta.component_div(&z2)
+    }
+
+    #[test]
+    fn printed_euler_gain_exceeds_kp_at_1ms_normalized_stays_below_kappa_kp() {
+        let mut printed = Config::paper(Law::StateFeedback);
+        printed.ts = 1e-3;
+        let g = per_step_gain(printed.clone());
+        // The Jury condition for explicit-Euler learning is g < Kp = 10.
+        assert!(g.min() > 10.0, "printed per-step gain {g}");
+        let mut normalized = printed;
+        normalized.learning_step = LearningStep::Normalized { kappa: 0.5 };
+        let g = per_step_gain(normalized);
+        assert!(
+            g.max() <= 5.0 + 1e-9 && g.min() > 0.0,
+            "normalised per-step gain {g}"
+        );
+    }
+
+    #[test]
+    fn normalized_step_is_the_printed_step_when_the_gain_is_small() {
+        // At Ts = 1 µs the per-step gain is tiny and the scale is ≈ 1.
+        let mut printed = Config::paper(Law::StateFeedback);
+        printed.ts = 1e-6;
+        let g_printed = per_step_gain(printed.clone());
+        let mut normalized = printed;
+        normalized.learning_step = LearningStep::Normalized { kappa: 0.5 };
+        let g = per_step_gain(normalized);
+        assert!(
+            ((g - g_printed).norm() / g_printed.norm()) < 0.01,
+            "{g} vs {g_printed}"
+        );
+    }
+
+    #[test]
+    fn freeze_stops_learning_into_the_limit_only() {
+        let mut cfg = Config::paper(Law::StateFeedback);
+        cfg.saturation_learning = SaturationLearning::Freeze;
+        cfg.tau_max = Vector::<2>::new(0.1, 100.0); // joint 1 saturates
+        let mut c = Controller::new(cfg, Sinusoid::paper()).unwrap();
+        let mut w = Weights::<2, 256>::zeros();
+        w.g[0].fill(0.01);
+        w.g[1].fill(0.01);
+        c.set_weights(w).unwrap();
+        let m = measurement();
+        let cmd = c.step(&m).unwrap();
+        // Joint 1 saturates with learning pushing out: z2 and Δτ of opposite signs.
+        assert!(
+            cmd.dtau[0] != 0.0 && cmd.z2[0] * cmd.dtau[0] < 0.0,
+            "{cmd:?}"
+        );
+        assert_eq!(cmd.dtau[1], 0.0);
+        let decay = 1.0 - c.config().ts * 100.0 * 0.01;
+        // Joint 1's rows only leak; joint 2's rows learn.
+        assert!(c.weights().g[0]
+            .iter()
+            .all(|&v| (v - 0.01 * decay).abs() < 1e-18));
+        assert!(c.weights().d[0][1].iter().all(|&v| v == 0.0));
+        assert!(c.weights().g[1]
+            .iter()
+            .any(|&v| (v - 0.01 * decay).abs() > 1e-12));
+    }
+
+    #[test]
+    fn projection_keeps_each_network_in_its_ball() {
+        let mut cfg = Config::paper(Law::StateFeedback);
+        cfg.ts = 1e-3;
+        cfg.weight_bound = Some([1e-3, 2e-3, 3e-3]);
+        let mut c = Controller::new(cfg, Sinusoid::paper()).unwrap();
+        let m = measurement();
+        let mut hit = [false; 3];
+        for _ in 0..200 {
+            c.step(&m).unwrap();
+            let n = c.weights().norms();
+            for net in 0..3 {
+                let bound = [1e-3, 2e-3, 3e-3][net];
+                assert!(n[net] <= bound * (1.0 + 1e-12), "{n:?}");
+                hit[net] |= n[net] > 0.999 * bound;
+            }
+            // The cached norms reported next step are the weights' norms.
+            assert!(
+                (c.norms[0] - n[0]).abs() <= 1e-12 * n[0],
+                "{:?} vs {n:?}",
+                c.norms
+            );
+        }
+        assert_eq!(hit, [true; 3], "every bound was reached");
+    }
+
+    #[test]
+    fn hardening_options_are_validated() {
+        let mut cfg = Config::paper(Law::StateFeedback);
+        cfg.learning_step = LearningStep::Normalized { kappa: 1.5 };
+        let e = Controller::new(cfg, Sinusoid::paper()).unwrap_err();
+        assert!(e.to_string().contains("κ ≤ 1"), "{e}");
+        let mut cfg = Config::paper(Law::StateFeedback);
+        cfg.weight_bound = Some([1.0, 0.0, 1.0]);
+        let e = Controller::new(cfg, Sinusoid::paper()).unwrap_err();
+        assert!(e.to_string().contains("weight bound > 0"), "{e}");
+    }
+
+    #[test]
+    fn robot_bounds_match_the_documented_values() {
+        let b = Config::robot(Law::StateFeedback).weight_bound.unwrap();
+        for (v, e) in b.iter().zip([0.718, 2.255, 1.417]) {
+            assert!((v - e).abs() < 1e-3, "{b:?}");
+        }
     }
 }

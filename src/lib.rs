@@ -78,7 +78,10 @@ pub mod simulator;
 pub mod trajectory;
 
 pub use auxiliary::AuxLaw;
-pub use controller::{Command, Config, Controller, Law, Measurement, ObserverInit, Robust};
+pub use controller::{
+    Command, Config, Controller, Law, LearningStep, Measurement, ObserverInit, Robust,
+    SaturationLearning,
+};
 pub use environment::{Environment, FreeSpace, Wall};
 pub use error::Error;
 pub use impedance::{Reference, TargetImpedance};

@@ -65,6 +65,25 @@ impl Rates {
     }
 }
 
+/// Bounds on the weight norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F (for
+/// [`Config::weight_bound`](crate::Config::weight_bound)) derived from the
+/// actuator limits: each network may produce at most the actuator's torque
+/// ‖τmax‖ for the commanded trajectory's regressor scale.
+///
+/// Since every S_i ≤ 1, ‖S‖ ≤ √L and `‖Ĝ‖ ≤ ‖ŴG‖_F √L`, `‖D̂ α̇1‖ ≤ ‖ŴD‖_F √L ‖α̇1‖`,
+/// `‖Ĉ α1‖ ≤ ‖ŴC‖_F √L ‖α1‖`. With `speed` and `accel` the peak commanded
+/// ‖ẋc‖ (rad/s) and ‖ẍc‖ (rad/s²) standing in for ‖α1‖ and ‖α̇1‖:
+/// `[‖τmax‖/(√L accel), ‖τmax‖/(√L speed), ‖τmax‖/√L]`.
+pub fn weight_bounds<const N: usize>(
+    tau_max: &Vector<N>,
+    nodes: usize,
+    speed: f64,
+    accel: f64,
+) -> [f64; 3] {
+    let scale = tau_max.norm() / sqrt(nodes as f64);
+    [scale / accel, scale / speed, scale]
+}
+
 /// One row: returns `Ŵ·S` and `‖Ŵ‖²` of the old row, and writes `Ŵ ← a Ŵ + b S`.
 #[inline(always)]
 fn dot_update<const L: usize>(
@@ -98,6 +117,29 @@ fn dot_update<const L: usize>(
         (dot[0] + dot[1]) + (dot[2] + dot[3]) + dot_t,
         (sq[0] + sq[1]) + (sq[2] + sq[3]) + sq_t,
     )
+}
+
+/// One row: `Ŵ ← a Ŵ + b S`; returns `‖Ŵ‖²` of the new row.
+#[inline(always)]
+fn update_row<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
+    const LANES: usize = 4;
+    let (w, s) = (w.as_mut_slice(), s.as_slice());
+    let mut sq = [0.0; LANES];
+    let mut wc = w.chunks_exact_mut(LANES);
+    let mut sc = s.chunks_exact(LANES);
+    for (wv, sv) in (&mut wc).zip(&mut sc) {
+        for l in 0..LANES {
+            let new = a * wv[l] + b * sv[l];
+            sq[l] += new * new;
+            wv[l] = new;
+        }
+    }
+    let mut sq_t = 0.0;
+    for (wv, &sv) in wc.into_remainder().iter_mut().zip(sc.remainder()) {
+        *wv = a * *wv + b * sv;
+        sq_t += *wv * *wv;
+    }
+    (sq[0] + sq[1]) + (sq[2] + sq[3]) + sq_t
 }
 
 impl<const N: usize, const L: usize> Weights<N, L> {
@@ -155,7 +197,8 @@ impl<const N: usize, const L: usize> Weights<N, L> {
     /// One step of the networks in a single pass over the weights: returns the
     /// output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current weights and their
     /// Frobenius norms, then applies the explicit-Euler update of (15)–(17)
-    /// with error signal `z2` (rad/s; ẑ2 for output feedback, (37)–(39)).
+    /// with error signal `z2` (rad/s; ẑ2 for output feedback, (37)–(39)), the
+    /// learning step scaled by `scale` (1 for the printed law).
     #[inline]
     pub fn fused_step(
         &mut self,
@@ -164,9 +207,14 @@ impl<const N: usize, const L: usize> Weights<N, L> {
         alpha1: &Vector<N>,
         z2: &Vector<N>,
         rates: &Rates,
+        scale: f64,
     ) -> (Vector<N>, [f64; 3]) {
         let mut out = Vector::<N>::zeros();
         let mut sq = [0.0; 3];
+        let rates = &Rates {
+            decay: rates.decay,
+            gain: rates.gain.map(|g| g * scale),
+        };
         for k in 0..N {
             let gz = z2[k];
             for j in 0..N {
@@ -192,6 +240,57 @@ impl<const N: usize, const L: usize> Weights<N, L> {
             sq[G] += n2;
         }
         (out, sq.map(sqrt))
+    }
+}
+
+impl<const N: usize, const L: usize> Weights<N, L> {
+    /// The explicit-Euler update of (15)–(17) alone (after [`output`](Self::output)
+    /// has used the old weights), with the learning step of every row scaled by
+    /// `scale` (1 for the printed law). Rows of joint k learn from `z2[k]`; pass
+    /// 0 there to freeze joint k's learning (its weights then only leak).
+    /// Returns the Frobenius norms of the new weights.
+    pub fn update(
+        &mut self,
+        s: &SVector<f64, L>,
+        dalpha1: &Vector<N>,
+        alpha1: &Vector<N>,
+        z2: &Vector<N>,
+        rates: &Rates,
+        scale: f64,
+    ) -> [f64; 3] {
+        let mut sq = [0.0; 3];
+        let gain = rates.gain.map(|g| g * scale);
+        for k in 0..N {
+            let gz = z2[k];
+            for j in 0..N {
+                sq[D] += update_row(
+                    &mut self.d[k][j],
+                    s,
+                    rates.decay[D],
+                    gain[D] * dalpha1[j] * gz,
+                );
+                sq[C] += update_row(
+                    &mut self.c[k][j],
+                    s,
+                    rates.decay[C],
+                    gain[C] * alpha1[j] * gz,
+                );
+            }
+            sq[G] += update_row(&mut self.g[k], s, rates.decay[G], gain[G] * gz);
+        }
+        sq.map(sqrt)
+    }
+
+    /// Multiply every weight of network `net` ([`D`], [`C`] or [`G`]) by `factor`.
+    pub fn scale_network(&mut self, net: usize, factor: f64) {
+        let rows: &mut dyn Iterator<Item = &mut SVector<f64, L>> = match net {
+            D => &mut self.d.iter_mut().flatten(),
+            C => &mut self.c.iter_mut().flatten(),
+            _ => &mut self.g.iter_mut(),
+        };
+        for row in rows {
+            *row *= factor;
+        }
     }
 }
 
@@ -236,7 +335,12 @@ mod tests {
             expect_w.c[0][0][i] += ts * gamma[C] * (s[i] * a[0] * z2[0] - sigma[C] * w.c[0][0][i]);
             expect_w.g[0][i] += ts * gamma[G] * (s[i] * z2[0] - sigma[G] * w.g[0][i]);
         }
-        let (out, norms) = w.fused_step(&s, &da, &a, &z2, &rates);
+        let mut w2 = w.clone();
+        let (out, norms) = w.fused_step(&s, &da, &a, &z2, &rates, 1.0);
+        // The separate update does the same.
+        let new_norms = w2.update(&s, &da, &a, &z2, &rates, 1.0);
+        assert_eq!(w2, w);
+        assert!((new_norms[G] - w.norms()[G]).abs() < 1e-14);
         assert!((out - expect_out).norm() < 1e-14, "{out} vs {expect_out}");
         for n in 0..3 {
             assert!((norms[n] - expect_norms[n]).abs() < 1e-14);

@@ -41,6 +41,17 @@ impl SimConfig<2> {
     }
 }
 
+impl SimConfig<2> {
+    /// The "robot" scenario's run: the paper scenario with M = 10 RK4 substeps
+    /// per 1 ms period (SPEC §13). Use with [`Config::robot`](crate::Config::robot).
+    pub fn robot() -> Self {
+        Self {
+            substeps: 10,
+            ..Self::paper()
+        }
+    }
+}
+
 /// One recorded row at t_k (units as in [`Command`](crate::Command)).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Row<const N: usize> {

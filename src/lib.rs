@@ -72,6 +72,8 @@ pub mod metrics;
 pub mod model;
 pub mod network;
 pub mod observer;
+#[cfg(feature = "python")]
+mod python;
 pub mod rbf;
 pub mod saturation;
 pub mod simulator;

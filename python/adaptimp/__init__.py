@@ -1,0 +1,42 @@
+"""adaptimp: adaptive neural impedance control of a robot arm with input saturation.
+
+A faithful implementation of W. He, Y. Dong, C. Sun, "Adaptive Neural Impedance
+Control of a Robotic Manipulator With Input Saturation", IEEE Trans. SMC: Systems
+46(3), 2016, with a Rust core (``adaptimp._adaptimp``) and this NumPy front.
+Units: rad, rad/s, rad/s², N m, s. The equations, errata and decisions are in
+the project's SPEC (docs/SPEC.md).
+
+- :func:`simulate` runs one of the paper's controllers ("pd", "sf", "of") on the
+  2-link arm against the wall and returns a :class:`SimResult` (arrays, SPEC §12
+  metrics, ``.plot(kind)``, ``.save(path)``).
+- :class:`Controller` is the controller alone, for your own loop.
+- :class:`TwoLinkArm` is the paper's arm: D(q), C(q, q̇), G(q), forward dynamics.
+
+Every SPEC quantity is a keyword parameter with the paper's default
+(:data:`PARAMS`, :data:`SCENARIOS`)::
+
+    import adaptimp
+
+    res = adaptimp.simulate("sf", T=5.0, Kp=10.5)
+    print(res.metrics["rms_z1_after2"])
+    res.plot("tracking").savefig("tracking.png")
+"""
+
+from ._adaptimp import __version__
+from ._api import Controller, TwoLinkArm, simulate
+from ._params import CASES, PARAMS, SCENARIOS, Param
+from ._result import PLOT_KINDS, SimResult, metrics_table
+
+__all__ = [
+    "CASES",
+    "PARAMS",
+    "PLOT_KINDS",
+    "SCENARIOS",
+    "Controller",
+    "Param",
+    "SimResult",
+    "TwoLinkArm",
+    "__version__",
+    "metrics_table",
+    "simulate",
+]

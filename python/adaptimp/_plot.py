@@ -1,0 +1,203 @@
+"""Figures of a run, of the kinds of the paper's Figs. 2–10, and a comparison of runs.
+
+Each function returns a matplotlib ``Figure`` (made through pyplot, so that
+``plt.show()`` and notebooks display it). When there is no display, the Agg
+backend is selected before pyplot is first imported.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ._params import CASE_NAMES
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ._result import SimResult
+
+_JOINTS = ("joint 1", "joint 2")
+_SIZE = (8.0, 5.6)  # inches; 960 × 672 px at the default 120 dpi of savefig below
+_COLORS = {"pd": "#d62728", "sf": "#1f77b4", "of": "#2ca02c"}
+
+
+def _choose_backend() -> None:
+    """Select Agg if pyplot is not imported yet, no backend was chosen and there is
+    no display (call before importing pyplot)."""
+    if "matplotlib.pyplot" not in sys.modules and not os.environ.get("MPLBACKEND"):
+        headless = sys.platform.startswith("linux") and not (
+            os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+        )
+        if headless:
+            import matplotlib
+
+            matplotlib.use("Agg")
+
+
+def _figure(title: str, rows: int = 2) -> tuple[Figure, Sequence[Axes]]:
+    _choose_backend()
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=_SIZE, layout="constrained", dpi=120)
+    fig.suptitle(title, fontsize=12)
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("time t (s)")
+    return fig, list(axes)
+
+
+def _legend(fig: Figure, ax: Axes, ncol: int) -> None:
+    """One legend for the figure, below the axes, where it covers no data."""
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=ncol, fontsize=9, frameon=False)
+
+
+def _title(res: SimResult, what: str) -> str:
+    return f"{CASE_NAMES[res.case]} ({res.case}): {what}"
+
+
+def _settle_band(ax: Axes, res: SimResult) -> None:
+    settle = float(res.params["settle"])
+    if res.t.size and settle > res.t[0]:
+        ax.axvspan(res.t[0], min(settle, res.t[-1]), color="0.85", alpha=0.5, lw=0)
+
+
+def tracking(res: SimResult) -> Figure:
+    """q against the commanded xc and the compliant reference xd, per joint, with
+    the wall (the paper's Figs. 2, 5, 8)."""
+    fig, axes = _figure(_title(res, "joint tracking"))
+    wall = res.params["wall"]
+    for i, ax in enumerate(axes):
+        ax.plot(res.t, res.xc[:, i], color="k", lw=1.0, ls="--", label="xc, commanded")
+        ax.plot(res.t, res.xd[:, i], color="tab:orange", lw=1.2, label="xd, compliant reference")
+        ax.plot(res.t, res.q[:, i], color="tab:blue", lw=1.0, label="q, arm")
+        if i == 0 and wall is not None:
+            ax.axhline(wall, color="tab:red", lw=1.5, label=f"wall at {wall:g} rad")
+            top = max(float(np.max(res.q[:, 0])), float(np.max(res.xc[:, 0])), wall) + 0.05
+            ax.axhspan(wall, top, color="tab:red", alpha=0.08, lw=0)
+            ax.set_ylim(top=top)
+        ax.set_ylabel(f"{_JOINTS[i]}: q{i + 1} (rad)")
+    _legend(fig, axes[0], ncol=4)
+    return fig
+
+
+def errors(res: SimResult) -> Figure:
+    """Tracking error z1 = xd − q per joint (the paper's Figs. 3, 6, 9): the settling
+    transient (t < ``settle``, excluded from the 'after2' metrics) on the left, the
+    rest of the run on its own scale on the right."""
+    _choose_backend()
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(
+        2,
+        2,
+        sharex="col",
+        figsize=_SIZE,
+        layout="constrained",
+        dpi=120,
+        width_ratios=(1, 3),
+    )
+    fig.suptitle(_title(res, "tracking error z1 = xd − q"), fontsize=12)
+    rms = res.metrics["rms_z1_joint_after2"]
+    settle = float(res.params["settle"])
+    early = res.t < settle
+    late = ~early
+    for i in range(2):
+        left, right = axes[i]
+        for ax, rows in ((left, early), (right, late)):
+            ax.grid(True, alpha=0.3)
+            ax.axhline(0.0, color="0.4", lw=0.6)
+            ax.plot(res.t[rows], res.z1[rows, i], color=_COLORS[res.case], lw=0.9)
+        left.set_ylabel(f"{_JOINTS[i]}: z1,{i + 1} (rad)")
+        left.set_title(f"t < {settle:g} s (settling)", fontsize=10, loc="left")
+        right.set_title(f"t ≥ {settle:g} s: RMS = {rms[i]:.3g} rad", fontsize=10, loc="left")
+    for ax in axes[1]:
+        ax.set_xlabel("time t (s)")
+    return fig
+
+
+def torques(res: SimResult) -> Figure:
+    """Commanded torque τ and applied torque sat(τ) per joint, with the limits ±τmax
+    (the paper's Figs. 4, 7, 10). A commanded torque far beyond the limits (windup)
+    is clipped to the view and its peak given in the panel title."""
+    fig, axes = _figure(_title(res, "joint torques"))
+    tau_max = res.params["tau_max"]
+    for i, ax in enumerate(axes):
+        m = float(tau_max[i])
+        ax.plot(res.t, res.tau[:, i], color="tab:orange", lw=0.7, alpha=0.8, label="τ, commanded")
+        ax.plot(res.t, res.tau_sat[:, i], color="tab:blue", lw=0.9, label="sat(τ), applied")
+        ax.axhline(m, color="tab:red", lw=1.0, ls="--", label="±τmax, actuator limit")
+        ax.axhline(-m, color="tab:red", lw=1.0, ls="--")
+        peak = float(np.max(np.abs(res.tau[:, i]))) if res.rows else 0.0
+        title = f"{_JOINTS[i]}: τmax = {m:g} N m"
+        if peak > 1.6 * m:
+            ax.set_ylim(-1.6 * m, 1.6 * m)
+            title += f"; commanded τ clipped to the view, peak |τ| = {peak:.4g} N m"
+        ax.set_title(title, fontsize=10, loc="left")
+        ax.set_ylabel(f"τ{i + 1} (N m)")
+    _legend(fig, axes[0], ncol=3)
+    return fig
+
+
+FIGURES: dict[str, Callable[[SimResult], Figure]] = {
+    "tracking": tracking,
+    "errors": errors,
+    "torques": torques,
+}
+
+
+def _block_rms(t: np.ndarray, x: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray]:
+    """RMS of ``x`` over consecutive windows of ``width`` seconds, at their centres."""
+    if t.size < 2:
+        return t, np.abs(x)
+    per = max(1, round(width / float(t[1] - t[0])))
+    blocks = x.size // per
+    if blocks == 0:
+        return t[:1], np.sqrt(np.mean(x**2, keepdims=True))
+    sq = x[: blocks * per].reshape(blocks, per) ** 2
+    centres = t[: blocks * per].reshape(blocks, per).mean(axis=1)
+    return centres, np.sqrt(sq.mean(axis=1))
+
+
+def compare(
+    results: Sequence[SimResult],
+    title: str = "tracking error of the three cases",
+    window: float = 0.1,
+) -> Figure:
+    """RMS of z1 over ``window``-second windows (s), per joint, for several runs on
+    shared logarithmic axes, so that PD's errors and the adaptive controllers'
+    much smaller ones both show."""
+    fig, axes = _figure(f"{title}: RMS of z1 over {window:g} s windows")
+    for res in results:
+        rms = res.metrics["rms_z1_joint_after2"]
+        for i, ax in enumerate(axes):
+            tc, r = _block_rms(res.t, res.z1[:, i], window)
+            ax.semilogy(
+                tc,
+                r,
+                color=_COLORS.get(res.case),
+                lw=1.3,
+                label=f"{CASE_NAMES[res.case]}: {rms[0]:.2g}, {rms[1]:.2g} rad",
+            )
+    settle = float(results[0].params["settle"]) if results else 0.0
+    for i, ax in enumerate(axes):
+        _settle_band(ax, results[0])
+        ax.set_ylabel(f"{_JOINTS[i]}: RMS z1,{i + 1} (rad)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(
+        handles,
+        labels,
+        loc="outside lower center",
+        ncol=3,
+        fontsize=9,
+        frameon=False,
+        title=f"RMS z1 per joint over t ≥ {settle:g} s",
+        title_fontsize=9,
+    )
+    return fig

@@ -1,0 +1,248 @@
+"""The result of a simulation: recorded arrays, SPEC §12 metrics, plots, saving."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ._params import CASE_NAMES
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+FloatArray = NDArray[np.float64]
+
+ARRAYS = ("t", "q", "dq", "xc", "xd", "dq_hat", "tau", "tau_sat", "tau_e", "zeta", "z1", "w_norms")
+"""Names of the recorded arrays, in the order of :class:`SimResult`."""
+
+PLOT_KINDS = ("tracking", "errors", "torques")
+"""Kinds of :meth:`SimResult.plot` (the kinds of the paper's Figs. 2–10)."""
+
+METRIC_KEYS = (
+    "rms_z1",
+    "rms_z1_after2",
+    "rms_z1_joint_after2",
+    "max_abs_z1_joint_after2",
+    "sat_duty",
+    "steps_in_contact",
+    "peak_contact_after2",
+    "mean_contact",
+    "peak_abs_tau",
+    "imp_err_rms_after2",
+)
+"""Keys of :attr:`SimResult.metrics` (SPEC §12), besides ``rows``."""
+
+
+@dataclass(frozen=True, repr=False, eq=False)
+class SimResult:
+    """One simulated run (SPEC §11): every recorded row k = 0 … K − 1 at t_k = k·Ts.
+
+    Arrays are float64 with one row per controller step; per-joint arrays have
+    shape (K, 2).
+
+    Attributes
+    ----------
+    t : (K,)
+        Time t_k (s).
+    q, dq : (K, 2)
+        Plant joint positions (rad) and velocities (rad/s).
+    xc, xd : (K, 2)
+        Commanded position and compliant reference (rad), SPEC §4.
+    dq_hat : (K, 2)
+        Velocity the controller used (rad/s): measured, or estimated for "of".
+    tau, tau_sat : (K, 2)
+        Commanded torque τ and applied torque sat(τ) (N m).
+    tau_e : (K, 2)
+        Force the arm exerts on the wall (N m).
+    zeta : (K, 2)
+        Auxiliary state ζ used at the step (N m), SPEC §8.
+    z1 : (K, 2)
+        Tracking error z1 = xd − q (rad).
+    w_norms : (K, 3)
+        Frobenius norms of the weights ŴD, ŴC, ŴG before the step's update.
+    metrics : dict
+        SPEC §12 figures: ``rms_z1``, ``rms_z1_after2``, ``rms_z1_joint_after2``,
+        ``max_abs_z1_joint_after2``, ``sat_duty``, ``steps_in_contact``,
+        ``peak_contact_after2``, ``mean_contact``, ``peak_abs_tau``,
+        ``imp_err_rms_after2`` and ``rows`` (per-joint ones as lists). "after2"
+        means t ≥ ``params["settle"]`` (2 s by default); those are NaN if the run
+        is shorter.
+    params : dict
+        Every parameter that ran (JSON-serialisable).
+    case : str
+        "pd", "sf" or "of".
+    scenario : str
+        The scenario whose defaults were used.
+    """
+
+    case: str
+    scenario: str
+    params: dict[str, Any]
+    metrics: dict[str, Any]
+    t: FloatArray
+    q: FloatArray
+    dq: FloatArray
+    xc: FloatArray
+    xd: FloatArray
+    dq_hat: FloatArray
+    tau: FloatArray
+    tau_sat: FloatArray
+    tau_e: FloatArray
+    zeta: FloatArray
+    z1: FloatArray
+    w_norms: FloatArray
+
+    @property
+    def dtau(self) -> FloatArray:
+        """Δτ = sat(τ) − τ (N m), (K, 2)."""
+        return self.tau_sat - self.tau
+
+    @property
+    def rows(self) -> int:
+        """Number of recorded rows K."""
+        return int(self.t.shape[0])
+
+    def plot(self, kind: str = "tracking") -> Figure:
+        """A figure of the run, per joint, returned as a matplotlib ``Figure``.
+
+        Parameters
+        ----------
+        kind : {"tracking", "errors", "torques"}
+            ``"tracking"``: q against xc and xd, with the wall (Figs. 2, 5, 8);
+            ``"errors"``: z1 (Figs. 3, 6, 9); ``"torques"``: commanded and applied
+            torque with the limits ±τmax (Figs. 4, 7, 10).
+        """
+        from . import _plot
+
+        if kind not in PLOT_KINDS:
+            raise ValueError(f"kind must be one of {PLOT_KINDS}, got {kind!r}")
+        return _plot.FIGURES[kind](self)
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the arrays, metrics and parameters to a ``.npz`` file (metrics and
+        parameters as JSON strings, so no pickle is needed to read it back).
+        Returns the path written (``.npz`` is appended if missing)."""
+        path = Path(path)
+        if path.suffix != ".npz":
+            path = path.with_name(path.name + ".npz")
+        arrays = {name: getattr(self, name) for name in ARRAYS}
+        np.savez(
+            path,
+            **arrays,
+            case=np.array(self.case),
+            scenario=np.array(self.scenario),
+            metrics=np.array(json.dumps(self.metrics)),
+            params=np.array(json.dumps(self.params)),
+        )
+        return path
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> SimResult:
+        """Read a result written by :meth:`save`."""
+        with np.load(path, allow_pickle=False) as f:
+            arrays = {name: f[name] for name in ARRAYS}
+            return cls(
+                case=str(f["case"]),
+                scenario=str(f["scenario"]),
+                metrics=json.loads(str(f["metrics"])),
+                params=json.loads(str(f["params"])),
+                **arrays,
+            )
+
+    def __repr__(self) -> str:
+        m = self.metrics
+        p = self.params
+        t_end = self.rows * p["Ts"]
+        wall = "free space" if p["wall"] is None else f"wall at {p['wall']:g} rad"
+        lines = [
+            f"SimResult({self.case!r}: {CASE_NAMES[self.case]}, scenario {self.scenario!r}; "
+            f"{self.rows} steps of Ts = {p['Ts']:g} s, T = {t_end:g} s; {wall})",
+            f"  RMS ‖z1‖ = {m['rms_z1']:.4g} rad, over t ≥ {p['settle']:g} s: "
+            f"{m['rms_z1_after2']:.4g} rad "
+            f"(per joint {_fmt_list(m['rms_z1_joint_after2'], '.4g')})",
+            f"  saturated {100 * m['sat_duty']:.1f}% of steps; "
+            f"peak commanded |τ| = {_fmt_list(m['peak_abs_tau'], '.4g')} N m; "
+            f"{m['steps_in_contact']} steps in contact",
+            "  arrays: " + ", ".join(ARRAYS) + "; .metrics, .params, .plot(kind), .save(path)",
+        ]
+        return "\n".join(lines)
+
+
+def _fmt_list(values: Iterable[float], spec: str) -> str:
+    return "[" + ", ".join(format(v, spec) for v in values) + "]"
+
+
+# ---------------------------------------------------------------------------
+# Tables of metrics.
+# ---------------------------------------------------------------------------
+
+_ROWS: tuple[tuple[str, str, str], ...] = (
+    # (key, label, format); "{after}" is replaced by the settle time.
+    ("rms_z1", "RMS ‖z1‖ (rad)", ".5f"),
+    ("rms_z1_after2", "RMS ‖z1‖, t ≥ {after} s (rad)", ".5f"),
+    ("rms_z1_joint_after2", "RMS z1 per joint, t ≥ {after} s (rad)", ".5f"),
+    ("max_abs_z1_joint_after2", "max \\|z1\\| per joint, t ≥ {after} s (rad)", ".5f"),
+    ("sat_duty", "saturation duty", ".4f"),
+    ("steps_in_contact", "steps in contact", "d"),
+    ("peak_contact_after2", "peak τe, t ≥ {after} s (N m)", ".3f"),
+    ("mean_contact", "mean τe in contact (N m)", ".3f"),
+    ("peak_abs_tau", "peak commanded \\|τ\\| (N m)", ".1f"),
+    ("imp_err_rms_after2", "impedance error RMS, t ≥ {after} s (N m)", ".3f"),
+    ("rows", "rows", "d"),
+)
+
+
+def _cell(value: Any, spec: str) -> str:
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return ", ".join(_cell(v, spec) for v in value)
+    if isinstance(value, float) and math.isnan(value):
+        return "n/a"
+    return format(value, spec)
+
+
+def metrics_table(results: Mapping[str, SimResult] | Iterable[SimResult]) -> str:
+    """The SPEC §12 metrics of several runs as a Markdown table, one column per run.
+
+    ``results`` is a mapping from column title to result, or results (titled by
+    their case).
+    """
+    if isinstance(results, Mapping):
+        cols = list(results.items())
+    else:
+        cols = [(CASE_NAMES[r.case], r) for r in results]
+    after = ", ".join(sorted({f"{r.params['settle']:g}" for _, r in cols}))
+    header = ["metric (SPEC §12)"] + [title for title, _ in cols]
+    body = [
+        [label.replace("{after}", after)] + [_cell(r.metrics[key], spec) for _, r in cols]
+        for key, label, spec in _ROWS
+    ]
+    widths = [max(len(row[i]) for row in [header, *body]) for i in range(len(header))]
+
+    def line(cells: list[str]) -> str:
+        first = cells[0].ljust(widths[0])
+        rest = [c.rjust(w) for c, w in zip(cells[1:], widths[1:])]
+        return "| " + " | ".join([first, *rest]) + " |"
+
+    rule = "|" + "|".join(["-" * (widths[0] + 2)] + ["-" * (w + 1) + ":" for w in widths[1:]])
+    return "\n".join([line(header), rule + "|", *[line(row) for row in body]])
+
+
+def metrics_json(metrics: Mapping[str, Any]) -> dict[str, Any]:
+    """``metrics`` with NaN replaced by None (strict JSON)."""
+
+    def clean(v: Any) -> Any:
+        if isinstance(v, float) and math.isnan(v):
+            return None
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        return v
+
+    return {k: clean(v) for k, v in metrics.items()}

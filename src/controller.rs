@@ -113,8 +113,8 @@ pub enum LearningStep {
     /// test of z2 and the learned term), so the normalised step keeps the
     /// per-step gain below κ Kp at any Ts, and is the printed law when g ≪ κ Kp.
     /// The discrete normalised gradient (projection) algorithm: Goodwin & Sin,
-    /// *Adaptive Filtering, Prediction and Control*, 1984, §3.3; Ioannou & Sun,
-    /// *Robust Adaptive Control*, 1996, §4.5.
+    /// *Adaptive Filtering, Prediction and Control*, 1984, ch. 3; Ioannou & Sun,
+    /// *Robust Adaptive Control*, 1996, ch. 4.
     Normalized {
         /// κ in (0, 1]: the per-step learning gain's bound as a fraction of Kp.
         kappa: f64,
@@ -131,7 +131,7 @@ pub enum SaturationLearning {
     /// Conditional integration ("freeze"): while joint k saturates, its rows do
     /// not take the learning step that would push τ_k further beyond the limit
     /// (they still leak by σ, and learn in the unwinding direction). Åström &
-    /// Hägglund, *Advanced PID Control*, 2006, §3.5; for adaptive laws, the
+    /// Hägglund, *Advanced PID Control*, 2006 (integrator windup); for adaptive laws, the
     /// "stop adaptation under saturation" of Kárason & Annaswamy, IEEE TAC 39(11), 1994.
     Freeze,
 }
@@ -173,7 +173,7 @@ pub struct Config<const N: usize, const L: usize> {
     /// Learning under saturation. Paper: ignore it.
     pub saturation_learning: SaturationLearning,
     /// Projection of each network's weights onto the ball ‖Ŵ‖_F ≤ bound
-    /// (D̂, Ĉ, Ĝ). Paper: none. (Ioannou & Sun 1996, §4.5.5, applied after
+    /// (D̂, Ĉ, Ĝ). Paper: none. (Ioannou & Sun 1996, ch. 4 and 8, applied after
     /// each step: the Euler step followed by the projection onto the ball.)
     pub weight_bound: Option<[f64; 3]>,
     /// Learning gains Γ for D̂, Ĉ, Ĝ. Paper: 100.

@@ -84,6 +84,15 @@ pub fn weight_bounds<const N: usize>(
     [scale / accel, scale / speed, scale]
 }
 
+/// Independent accumulators per row pass: enough to hide the latency of the
+/// additions (Rust never fuses a·b + c, so results are the same on every
+/// target). With 256-bit vectors two registers per accumulator; with 128-bit
+/// SSE2 the 4 of one more register-starved loop measured fastest.
+#[cfg(target_feature = "avx")]
+const LANES: usize = 8;
+#[cfg(not(target_feature = "avx"))]
+const LANES: usize = 4;
+
 /// One row: returns `Ŵ·S` and `‖Ŵ‖²` of the old row, and writes `Ŵ ← a Ŵ + b S`.
 #[inline(always)]
 fn dot_update<const L: usize>(
@@ -92,7 +101,6 @@ fn dot_update<const L: usize>(
     a: f64,
     b: f64,
 ) -> (f64, f64) {
-    const LANES: usize = 4;
     let (w, s) = (w.as_mut_slice(), s.as_slice());
     let mut dot = [0.0; LANES];
     let mut sq = [0.0; LANES];
@@ -113,16 +121,12 @@ fn dot_update<const L: usize>(
         sq_t += old * old;
         *wv = a * old + b * sv;
     }
-    (
-        (dot[0] + dot[1]) + (dot[2] + dot[3]) + dot_t,
-        (sq[0] + sq[1]) + (sq[2] + sq[3]) + sq_t,
-    )
+    (pairwise(&dot) + dot_t, pairwise(&sq) + sq_t)
 }
 
 /// One row: `Ŵ ← a Ŵ + b S`; returns `‖Ŵ‖²` of the new row.
 #[inline(always)]
 fn update_row<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
-    const LANES: usize = 4;
     let (w, s) = (w.as_mut_slice(), s.as_slice());
     let mut sq = [0.0; LANES];
     let mut wc = w.chunks_exact_mut(LANES);
@@ -139,7 +143,21 @@ fn update_row<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f
         *wv = a * *wv + b * sv;
         sq_t += *wv * *wv;
     }
-    (sq[0] + sq[1]) + (sq[2] + sq[3]) + sq_t
+    pairwise(&sq) + sq_t
+}
+
+/// Sum of the lanes, pairwise (the order a SIMD reduction takes).
+#[inline(always)]
+fn pairwise<const M: usize>(v: &[f64; M]) -> f64 {
+    let mut v = *v;
+    let mut n = M;
+    while n > 1 {
+        n /= 2;
+        for i in 0..n {
+            v[i] += v[i + n];
+        }
+    }
+    v[0]
 }
 
 impl<const N: usize, const L: usize> Weights<N, L> {

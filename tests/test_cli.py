@@ -1,0 +1,114 @@
+"""The ``adaptimp`` console script, end to end, in subprocesses."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import sysconfig
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from adaptimp import SimResult
+from adaptimp._result import METRIC_KEYS
+
+
+def adaptimp_exe() -> str:
+    """The installed console script."""
+    name = "adaptimp.exe" if os.name == "nt" else "adaptimp"
+    path = Path(sysconfig.get_path("scripts")) / name
+    assert path.exists(), f"console script not installed at {path}"
+    return str(path)
+
+
+def run(*args: str, check: bool = True) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    proc = subprocess.run(
+        [adaptimp_exe(), *args], capture_output=True, text=True, env=env, timeout=300
+    )
+    if check:
+        assert proc.returncode == 0, proc.stderr
+    return proc
+
+
+def test_reproduce_writes_figures_metrics_and_prints_the_table(tmp_path: Path) -> None:
+    out = tmp_path / "rep"
+    proc = run("reproduce", "--out", str(out), "--T", "2.5")
+    pngs = sorted(p.name for p in out.glob("*.png"))
+    assert pngs == sorted(
+        [f"{c}_{k}.png" for c in ("pd", "sf", "of") for k in ("tracking", "errors", "torques")]
+        + ["comparison.png"]
+    )
+    for png in out.glob("*.png"):
+        assert png.read_bytes().startswith(b"\x89PNG")
+        assert png.stat().st_size > 20_000
+    summary = json.loads((out / "metrics.json").read_text())
+    assert summary["overrides"] == {"T": 2.5}
+    assert set(summary["metrics"]) == {"pd", "sf", "of"}
+    for case, metrics in summary["metrics"].items():
+        assert set(metrics) == {*METRIC_KEYS, "rows"}
+        assert metrics["rows"] == 50_000
+        assert summary["params"][case]["T"] == 2.5
+    # PD tracks far worse than the adaptive controllers (SPEC §12).
+    m = summary["metrics"]
+    assert m["pd"]["rms_z1_after2"] > 5 * m["sf"]["rms_z1_after2"]
+    table = (out / "metrics.md").read_text()
+    assert table.startswith("| metric (SPEC §12)")
+    assert table.strip() in proc.stdout
+    assert f"{m['sf']['rms_z1_after2']:.5f}" in table
+
+
+def test_simulate_takes_parameters_plots_and_saves(tmp_path: Path) -> None:
+    png, npz = tmp_path / "errors.png", tmp_path / "run.npz"
+    proc = run(
+        "simulate", "--case", "pd", "--T", "0.5", "--Kp", "10.5,9", "--wall", "none",
+        "--settle=0.25", "--plot", str(png), "--kind", "errors", "--save", str(npz), "--json",
+    )  # fmt: skip
+    metrics = json.loads(proc.stdout)
+    assert metrics["rows"] == 10_000
+    assert metrics["steps_in_contact"] == 0
+    assert png.read_bytes().startswith(b"\x89PNG")
+    res = SimResult.load(npz)
+    assert res.case == "pd"
+    assert res.params["Kp"] == [10.5, 9.0]
+    assert res.params["wall"] is None
+    assert res.params["settle"] == 0.25
+    assert res.metrics["rms_z1_after2"] == pytest.approx(metrics["rms_z1_after2"])
+    assert np.all(res.tau_e == 0.0)
+
+
+def test_simulate_prints_a_table_by_default() -> None:
+    proc = run("simulate", "--case", "of", "--T", "0.1")
+    assert "output feedback (of): 2000 steps" in proc.stdout
+    assert "| RMS ‖z1‖ (rad)" in proc.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--Kq", "1"], "unknown parameter --Kq"),
+        (["--Kp", "abc"], "--Kp: cannot read 'abc' as a number or comma-separated numbers"),
+        (["--Kp"], "--Kp needs a value"),
+        (["--Kp", "0.25", "--T", "0.01"], "condition 2Kp − I > 0 is violated"),
+        (["--T", "0.01", "--Kp", "1,2,3"], "Kp must be a number or have shape (2,)"),
+        (["extra"], "unexpected argument 'extra'"),
+    ],
+)
+def test_simulate_reports_bad_arguments_with_status_2(args: list[str], message: str) -> None:
+    proc = run("simulate", *args, check=False)
+    assert proc.returncode == 2
+    assert message in proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_params_lists_every_parameter_and_module_entry_point_works() -> None:
+    proc = run("params")
+    for name in ("Kzeta (1/s)", "tau_max (N m)", "wall (rad)", "robust:", "xc_omega (rad/s)"):
+        assert name in proc.stdout
+    version = subprocess.run(
+        [sys.executable, "-m", "adaptimp", "--version"], capture_output=True, text=True, check=True
+    )
+    assert version.stdout.startswith("adaptimp ")

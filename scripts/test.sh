@@ -2,17 +2,41 @@
 # Run every check and test of the project: Rust (format, lints, tests, no_std
 # build) and Python (build and install the package, ruff, stubs, pytest).
 # Works on a fresh machine with Rust and Python 3.9+; installs what it needs.
+#
+# The Python package is installed with its test tools into a virtual
+# environment under target/ (reused by later runs; override with
+# ADAPTIMP_VENV=DIR, the interpreter with PYTHON=...). pip's build of the
+# extension reuses the Rust build cache in target/ (CARGO_TARGET_DIR).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-step() { printf '\n==> %s\n' "$*"; }
+step() { printf '\n==> %s  [%d s]\n' "$*" "$SECONDS"; }
 
 step "Rust: format, lints"
 cargo fmt --check
 cargo clippy --all-targets -- -D warnings
+cargo clippy --all-targets --features python -- -D warnings
 
 step "Rust: no_std build of the core"
 cargo build --no-default-features
 
 step "Rust: tests"
 cargo test
+
+step "Python: build and install the package with its test tools"
+export CARGO_TARGET_DIR="$PWD/target"
+venv="${ADAPTIMP_VENV:-$PWD/target/py-venv}"
+if [ ! -x "$venv/bin/python" ]; then
+    "${PYTHON:-python3}" -m venv "$venv"
+fi
+py="$venv/bin/python"
+"$py" -m pip install --quiet --disable-pip-version-check ".[test]"
+
+step "Python: ruff, type stubs, mypy"
+"$py" -m ruff check python tests
+"$py" -m ruff format --check python tests
+"$py" -m mypy.stubtest adaptimp._adaptimp
+"$py" -m mypy
+
+step "Python: tests"
+"$py" -m pytest

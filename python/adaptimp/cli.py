@@ -13,7 +13,7 @@
 
 Any parameter of :func:`adaptimp.simulate` is given as ``--name value`` (or
 ``--name=value``); per-joint and per-network values as comma-separated lists
-(``--Kp 10,12``), ``none`` for no wall (``--wall none``).
+(``--Kp 10.5,9``), ``none`` for no wall (``--wall none``).
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Adaptive neural impedance control with input saturation "
         "(He, Dong & Sun, IEEE TSMC 2016): simulations of the paper's 2-link arm.",
         epilog="Parameters: any keyword of adaptimp.simulate as --name value "
-        "(lists comma-separated, e.g. --Kp 10,12; --wall none). "
+        "(lists comma-separated, e.g. --Kp 10.5,9; --wall none). "
         "List them with `adaptimp params`.",
         allow_abbrev=False,
     )
@@ -198,14 +198,17 @@ def build_parser() -> argparse.ArgumentParser:
         "simulate",
         help="run one case and print its metrics",
         description="Run one case and print its SPEC §12 metrics. Any parameter "
-        "as --name value (e.g. --T 5 --Kp 12 --wall none).",
+        "as --name value (e.g. --T 5 --Kp 10.5 --wall none).",
         allow_abbrev=False,
     )
     sim.add_argument("--case", default="sf", choices=CASES, help="controller (default: sf)")
     sim.add_argument("--scenario", default="paper", choices=tuple(SCENARIOS))
     sim.add_argument("--plot", metavar="FILE", help="write a figure (PNG, PDF, SVG, …)")
     sim.add_argument(
-        "--kind", default="tracking", choices=PLOT_KINDS, help="figure of --plot (tracking)"
+        "--kind",
+        default="tracking",
+        choices=PLOT_KINDS,
+        help="figure of --plot (default: tracking)",
     )
     sim.add_argument("--save", metavar="FILE", help="write the run to a .npz file")
     sim.add_argument("--json", action="store_true", help="print the metrics as JSON")

@@ -17,7 +17,10 @@
 //!
 //! Nothing here panics on user input and nothing is `unsafe`.
 
-use crate::controller::{Command, Config, Controller, Law, Measurement, ObserverInit, Robust};
+use crate::controller::{
+    Command, Config, Controller, Law, LearningStep, Measurement, ObserverInit, Robust,
+    SaturationLearning,
+};
 use crate::environment::{FreeSpace, Wall};
 use crate::metrics::Metrics;
 use crate::model::{ArmParams, Manipulator, TwoLinkArm};
@@ -29,8 +32,8 @@ use crate::{grid_nodes, AuxLaw, Error, Vector};
 use nalgebra::SVector;
 use numpy::ndarray::{Array, Dimension, IntoDimension};
 use numpy::{
-    IntoPyArray, PyArray, PyArray1, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray,
-    PyUntypedArrayMethods,
+    IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods,
+    PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -96,9 +99,13 @@ struct ControllerParams {
     xc_sin: [f64; N],
     xc_cos: [f64; N],
     xc_omega: [f64; N],
-    // New controller options of the core (e.g. the hardened 1 kHz settings of
-    // SPEC §13) are added here, in `apply_controller_params` below, in
-    // `CONTROLLER_PARAMS` of `python/adaptimp/_params.py` and in the stub.
+    // The hardened options of SPEC §13 (the "robot" scenario). A new option
+    // goes here, in `apply_controller_params`, in `core_defaults`, in `PARAMS`
+    // of `python/adaptimp/_params.py` and in the stub.
+    learning_step: String,
+    kappa: f64,
+    saturation_learning: String,
+    weight_bound: Option<[f64; 3]>,
 }
 
 /// Simulation and environment parameters (SPEC §3, §11).
@@ -167,7 +174,14 @@ fn apply_controller_params(cfg: &mut Config<N, L>, p: &ControllerParams) -> PyRe
     cfg.aux_law = match p.aux_law.as_str() {
         "default" => AuxLaw::Leaky,
         "printed" => AuxLaw::Printed,
-        other => return Err(choice_error("aux_law", "'default', 'printed'", other)),
+        "linear" => AuxLaw::Linear,
+        other => {
+            return Err(choice_error(
+                "aux_law",
+                "'default', 'printed', 'linear'",
+                other,
+            ))
+        }
     };
     let kr = Vector::from(p.kr);
     cfg.robust = match p.robust.as_str() {
@@ -206,6 +220,29 @@ fn apply_controller_params(cfg: &mut Config<N, L>, p: &ControllerParams) -> PyRe
     cfg.dd = Vector::from(p.dd);
     cfg.cd = Vector::from(p.cd);
     cfg.gd = Vector::from(p.gd);
+    cfg.learning_step = match p.learning_step.as_str() {
+        "euler" => LearningStep::Euler,
+        "normalized" => LearningStep::Normalized { kappa: p.kappa },
+        other => {
+            return Err(choice_error(
+                "learning_step",
+                "'euler', 'normalized'",
+                other,
+            ))
+        }
+    };
+    cfg.saturation_learning = match p.saturation_learning.as_str() {
+        "ignore" => SaturationLearning::Ignore,
+        "freeze" => SaturationLearning::Freeze,
+        other => {
+            return Err(choice_error(
+                "saturation_learning",
+                "'ignore', 'freeze'",
+                other,
+            ))
+        }
+    };
+    cfg.weight_bound = p.weight_bound;
     Ok(())
 }
 
@@ -365,6 +402,56 @@ impl PyController {
         };
         let cmd = self.inner.step(&Measurement { x, dx, tau_e })?;
         Ok(array1(py, &cmd.tau_sat))
+    }
+
+    /// `K` steps in one call, replaying logged measurements: `q`, `tau_e` and
+    /// (for "pd", "sf") `dq` of shape (K, 2), float64, C-contiguous. Returns
+    /// the applied torques, shape (K, 2). Runs without the GIL. On an error at
+    /// row k the steps before it have been taken and the error names the row.
+    #[pyo3(signature = (q, tau_e, dq=None))]
+    fn replay<'py>(
+        &mut self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        tau_e: PyReadonlyArray2<'py, f64>,
+        dq: Option<PyReadonlyArray2<'py, f64>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let rows = q.shape()[0];
+        let table = |what: &str, a: &PyReadonlyArray2<'py, f64>| -> PyResult<Vec<f64>> {
+            if a.shape() != [rows, N] {
+                return Err(PyValueError::new_err(format!(
+                    "{what} must have shape ({rows}, {N}) like q, got {}",
+                    python_shape(a.shape())
+                )));
+            }
+            Ok(a.as_array().iter().copied().collect())
+        };
+        let x = table("q", &q)?;
+        let te = table("tau_e", &tau_e)?;
+        let law = self.inner.config().law;
+        let dx = match (law, &dq) {
+            (Law::OutputFeedback, _) | (_, None) => None,
+            (_, Some(dq)) => Some(table("dq", dq)?),
+        };
+        let ctrl = &mut self.inner;
+        let out = py.detach(|| -> Result<Vec<f64>, (usize, Error)> {
+            let mut out = Vec::with_capacity(rows * N);
+            let row = |v: &[f64], k: usize| Vector::<N>::from_column_slice(&v[k * N..(k + 1) * N]);
+            for k in 0..rows {
+                let m = Measurement {
+                    x: row(&x, k),
+                    dx: dx.as_ref().map(|d| row(d, k)),
+                    tau_e: row(&te, k),
+                };
+                let cmd = ctrl.step(&m).map_err(|e| (k, e))?;
+                out.extend_from_slice(cmd.tau_sat.as_slice());
+            }
+            Ok(out)
+        });
+        match out {
+            Ok(out) => array(py, out, (rows, N)),
+            Err((k, e)) => Err(PyValueError::new_err(format!("row {k}: {e}"))),
+        }
     }
 
     /// Back to t = 0: weights, ζ, observer and reference as at construction.
@@ -729,14 +816,19 @@ fn simulate<'py>(
     Ok(out)
 }
 
-/// The core's own defaults for the paper scenario (SPEC §1–§4, §11), keyed
-/// by the Python parameter names: `Config::paper`, `SimConfig::paper`, the
-/// default arm, `Wall::paper` and `Sinusoid::paper`. The Python layer's
-/// scenario table is checked against it in the tests.
+/// The core's own defaults of a scenario, keyed by the Python parameter
+/// names: "paper" (SPEC §1–§4, §11: `Config::paper`, `SimConfig::paper`) or
+/// "robot" (SPEC §13: `Config::robot`, `SimConfig::robot`), with the default
+/// arm, `Wall::paper` and `Sinusoid::paper`. The Python layer's scenario
+/// table is checked against it in the tests.
 #[pyfunction]
-fn core_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    let c = Config::paper(Law::StateFeedback);
-    let s = SimConfig::paper();
+#[pyo3(signature = (scenario="paper"))]
+fn core_defaults<'py>(py: Python<'py>, scenario: &str) -> PyResult<Bound<'py, PyDict>> {
+    let (c, s) = match scenario {
+        "paper" => (Config::paper(Law::StateFeedback), SimConfig::paper()),
+        "robot" => (Config::robot(Law::StateFeedback), SimConfig::robot()),
+        other => return Err(choice_error("scenario", "'paper', 'robot'", other)),
+    };
     let a = ArmParams::default();
     let w = Wall::paper();
     let x = Sinusoid::paper();
@@ -761,14 +853,42 @@ fn core_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         name(&[
             (c.aux_law == AuxLaw::Leaky, "default"),
             (c.aux_law == AuxLaw::Printed, "printed"),
+            (c.aux_law == AuxLaw::Linear, "linear"),
         ]),
     )?;
-    if let Robust::Sign { kr } = c.robust {
-        d.set_item("robust", "sign")?;
-        d.set_item("kr", v(&kr))?;
-    } else {
-        d.set_item("robust", "(not the paper's sign term)")?;
+    match c.robust {
+        Robust::Sign { kr } => {
+            d.set_item("robust", "sign")?;
+            d.set_item("kr", v(&kr))?;
+        }
+        Robust::Tanh { kr, phi } => {
+            d.set_item("robust", "tanh")?;
+            d.set_item("kr", v(&kr))?;
+            d.set_item("phi", phi)?;
+        }
+        Robust::Remark1 { .. } | Robust::None => d.set_item("robust", "(not exposed)")?,
     }
+    match c.learning_step {
+        LearningStep::Euler => d.set_item("learning_step", "euler")?,
+        LearningStep::Normalized { kappa } => {
+            d.set_item("learning_step", "normalized")?;
+            d.set_item("kappa", kappa)?;
+        }
+    }
+    d.set_item(
+        "saturation_learning",
+        name(&[
+            (
+                c.saturation_learning == SaturationLearning::Ignore,
+                "ignore",
+            ),
+            (
+                c.saturation_learning == SaturationLearning::Freeze,
+                "freeze",
+            ),
+        ]),
+    )?;
+    d.set_item("weight_bound", c.weight_bound.map(|b| b.to_vec()))?;
     d.set_item("gamma", c.gamma.to_vec())?;
     d.set_item("sigma", c.sigma.to_vec())?;
     d.set_item("eta2", c.rbf.eta2())?;

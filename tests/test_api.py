@@ -79,7 +79,7 @@ def test_paper_table_agrees_with_the_core_defaults() -> None:
     table = resolve({}, scenario="paper")
     assert set(core) <= set(table)
     for key, value in core.items():
-        if isinstance(value, str):
+        if isinstance(value, str) or value is None:
             assert table[key] == value, key
         else:
             assert table[key] == pytest.approx(value, rel=1e-15), key

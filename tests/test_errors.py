@@ -44,9 +44,9 @@ def test_arm_rejects_controller_keywords() -> None:
         (lambda: adaptimp.simulate(3), TypeError, r"case must be a string"),
         (lambda: adaptimp.Controller("PD"), ValueError, r"case must be one of"),
         (
-            lambda: adaptimp.simulate("sf", "robot"),
+            lambda: adaptimp.simulate("sf", "factory"),
             ValueError,
-            r"scenario must be one of \('paper',\)",
+            r"scenario must be one of \('paper', 'robot'\)",
         ),
         (lambda: adaptimp.simulate(robust="sgn"), ValueError, r"robust must be one of \('sign'"),
         (lambda: adaptimp.simulate(aux_law=1), TypeError, r"aux_law must be a string"),

@@ -93,6 +93,8 @@ class Controller:
 
     def __new__(cls, case: str, params: ControllerParams | dict[str, Any]) -> Controller: ...
     def step(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> _F: ...
+    def replay(self, q: _F, tau_e: _F, dq: _F | None = None) -> _F:
+        """K steps replaying (K, 2) float64 measurement tables; applied torques (K, 2) (N m)."""
     def reset(self) -> None: ...
     @property
     def case(self) -> str: ...
@@ -140,5 +142,5 @@ def simulate(
 ) -> dict[str, Any]:
     """Close the loop with the GIL released; returns the arrays and "metrics"."""
 
-def core_defaults() -> dict[str, Any]:
-    """The core's own paper-scenario defaults, keyed by the Python names."""
+def core_defaults(scenario: str = "paper") -> dict[str, Any]:
+    """The core's own defaults of ``scenario`` ("paper" or "robot"), keyed by the Python names."""

@@ -26,9 +26,13 @@ def simulate(case: str = "sf", scenario: str = "paper", **params: Any) -> SimRes
     ----------
     case : {"pd", "sf", "of"}
         PD (Case 1), adaptive neural state feedback (14) or output feedback (35).
-    scenario : {"paper"}
+    scenario : {"paper", "robot"}
         The table of defaults: ``"paper"`` is SPEC §11 (T = 20 s, Ts = 50 µs,
-        one RK4 substep: 400 000 steps).
+        one RK4 substep: 400 000 steps, the printed laws); ``"robot"`` is the
+        same at a robot's Ts = 1 ms with 10 RK4 substeps and the hardened
+        options of SPEC §13 (normalised learning step, conditional integration,
+        weight projection, tanh robust term, triangle-hold observer started at
+        the first measurement; see ``docs/robot.md``).
     **params
         Any parameter below by name. Per-joint values take a number (for every
         joint) or one value per joint; ``gamma`` and ``sigma`` a number or one
@@ -73,6 +77,16 @@ _PARAMS_DOC = (
 simulate.__doc__ = (simulate.__doc__ or "") + _PARAMS_DOC + describe()
 
 
+def _table(name: str, value: ArrayLike) -> FloatArray:
+    """``value`` as a C-contiguous float64 array of shape (K, 2), or an error naming ``name``."""
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be an array of real numbers, got dtype {arr.dtype}")
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise ValueError(f"{name} must have shape (K, 2), got shape {arr.shape}")
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
 class Controller:
     """One of the paper's controllers, for your own control loop.
 
@@ -84,7 +98,7 @@ class Controller:
     ----------
     case : {"pd", "sf", "of"}
         PD (Case 1), adaptive neural state feedback (14) or output feedback (35).
-    scenario : {"paper"}
+    scenario : {"paper", "robot"}
         The table of defaults (see :func:`simulate`).
     **params
         Controller parameters by name, as for :func:`simulate` (``Ts``, ``Kp``,
@@ -133,6 +147,33 @@ class Controller:
             An input that is not a sequence of numbers.
         """
         return self._core.step(q, tau_e, dq)
+
+    def replay(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> FloatArray:
+        """K steps in one call, e.g. to replay logged measurements; returns the
+        applied torques (N m), shape (K, 2).
+
+        Equivalent to calling :meth:`step` on each row in turn, but the loop runs
+        in the compiled core without the GIL.
+
+        Parameters
+        ----------
+        q : array_like, shape (K, 2)
+            Measured joint positions (rad), one row per step.
+        tau_e : array_like, shape (K, 2)
+            Measured force on the environment (N m).
+        dq : array_like, shape (K, 2), optional
+            Measured joint velocities (rad/s): required by "pd" and "sf".
+
+        Raises
+        ------
+        ValueError
+            A wrong shape, or an error at some row (named in the message; the
+            rows before it have been stepped).
+        TypeError
+            An input that is not an array of real numbers.
+        """
+        dq_table = None if dq is None else _table("dq", dq)
+        return self._core.replay(_table("q", q), _table("tau_e", tau_e), dq_table)
 
     def reset(self) -> None:
         """Back to t = 0: weights, ζ, observer and reference as at construction."""

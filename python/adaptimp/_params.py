@@ -87,8 +87,9 @@ PARAMS: tuple[Param, ...] = (
         "controller",
         "choice",
         "",
-        "auxiliary law inside ‖ζ‖ < μ: ζ̇ = −Kζ ζ + Δτ, or the printed ζ̇ = 0 (SPEC §8)",
-        ("default", "printed"),
+        "auxiliary law: inside ‖ζ‖ < μ ζ̇ = −Kζ ζ + Δτ, or the printed ζ̇ = 0 (SPEC §8);"
+        " 'linear': ζ̇ = −Kζ ζ + Δτ everywhere, without the −β term (SPEC §13)",
+        ("default", "printed", "linear"),
     ),
     _p(
         "robust",
@@ -138,8 +139,34 @@ PARAMS: tuple[Param, ...] = (
     _p("xc_sin", "controller", "joint", "rad", "commanded trajectory: sine amplitude a"),
     _p("xc_cos", "controller", "joint", "rad", "commanded trajectory: cosine amplitude b"),
     _p("xc_omega", "controller", "joint", "rad/s", "commanded trajectory: angular frequency ω"),
-    # Hardened controller options of the core (SPEC §13, the "robot" scenario) are
-    # added here once the core exposes them, with their paper values in SCENARIOS.
+    # Hardened options (SPEC §13, beyond the paper; the "robot" scenario's defaults).
+    _p(
+        "learning_step",
+        "controller",
+        "choice",
+        "",
+        "learning step: explicit Euler of (15)–(17), or normalised so that one step's"
+        " gain from z2 to the network output stays below κ·Kp",
+        ("euler", "normalized"),
+    ),
+    _p("kappa", "controller", "real", "", "κ of the normalised step, 0 < κ ≤ 1"),
+    _p(
+        "saturation_learning",
+        "controller",
+        "choice",
+        "",
+        "learning while a joint saturates: as printed, or conditional integration"
+        " (no step that pushes τ further beyond the limit)",
+        ("ignore", "freeze"),
+    ),
+    _p(
+        "weight_bound",
+        "controller",
+        "bound",
+        "",
+        "projection onto ‖Ŵ‖_F ≤ b for D̂, Ĉ, Ĝ: None (none), 'auto' (derived from"
+        " tau_max and the commanded trajectory's peak speed and acceleration), or b",
+    ),
     # The environment, SPEC §3.
     _p("wall", "env", "optional", "rad", "wall on joint 1 at this position; None: free space"),
     _p("ke", "env", "real", "N m/rad", "wall stiffness"),
@@ -204,6 +231,11 @@ _PAPER: dict[str, Any] = {
     "xc_sin": [0.0, 0.2],
     "xc_cos": [-0.2, 0.0],
     "xc_omega": math.pi,
+    # SPEC §13 options, off in the paper scenario.
+    "learning_step": "euler",
+    "kappa": 0.5,
+    "saturation_learning": "ignore",
+    "weight_bound": None,
     # SPEC §3.
     "wall": 0.2,
     "ke": 1000.0,
@@ -220,11 +252,23 @@ _PAPER: dict[str, Any] = {
     "g": 9.81,
 }
 
-SCENARIOS: dict[str, dict[str, Any]] = {
-    "paper": _PAPER,
-    # A second scenario is one more entry here, e.g. the core's "robot" scenario
-    # (SPEC §13): {**_PAPER, "Ts": 1e-3, "substeps": 10, <hardened options>}.
+_ROBOT: dict[str, Any] = {
+    # SPEC §13: the paper scenario at a robot's Ts = 1 ms with M = 10 substeps,
+    # and the hardened options (Config::robot in the core; docs/robot.md).
+    **_PAPER,
+    "Ts": 1e-3,
+    "substeps": 10,
+    "learning_step": "normalized",
+    "kappa": 0.5,
+    "saturation_learning": "freeze",
+    "weight_bound": "auto",
+    "robust": "tanh",
+    "phi": 0.05,
+    "observer_hold": "triangle",
+    "observer_init": "first",
 }
+
+SCENARIOS: dict[str, dict[str, Any]] = {"paper": _PAPER, "robot": _ROBOT}
 """Default values of every parameter, per scenario."""
 
 
@@ -330,6 +374,12 @@ def validate(name: str, value: object) -> Any:
         return _choice(p, value)
     if p.kind in ("optional", "derived"):
         return None if value is None else _real(p, value)
+    if p.kind == "bound":
+        if value is None or (isinstance(value, str) and value == "auto"):
+            return value
+        if isinstance(value, str):
+            raise ValueError(f"{p.name} must be None, 'auto' or numbers, got {value!r}")
+        return _vector(p, value, 3, "one value per network D, C, G")
     raise AssertionError(f"unknown parameter kind {p.kind!r}")  # pragma: no cover
 
 
@@ -412,4 +462,36 @@ def resolve(
                 out["lc" + i] = length / 2.0
             if out["I" + i] is None:
                 out["I" + i] = m * length * length / 4.0
+    if "controller" in groups and out["weight_bound"] == "auto":
+        out["weight_bound"] = auto_weight_bound(out)
     return out
+
+
+N_NODES = 2 ** (4 * N_JOINTS)
+"""RBF nodes of the paper's vertex grid, 2^(4n) (SPEC §6)."""
+
+
+def peak_rates(p: Mapping[str, Any], samples: int = 4096) -> tuple[float, float]:
+    """Peak ‖ẋc‖ (rad/s) and ‖ẍc‖ (rad/s²) of the commanded trajectory of ``p``,
+    sampled over one period of its slowest non-zero frequency (exact for the
+    paper's circle, whose speed and acceleration are constant)."""
+    a, b, w = (np.asarray(p[k], dtype=float) for k in ("xc_sin", "xc_cos", "xc_omega"))
+    moving = np.abs(w) > 0
+    if not moving.any():
+        return 0.0, 0.0
+    t = np.linspace(0.0, 2 * math.pi / np.min(np.abs(w[moving])), samples)[:, None]
+    c, s = np.cos(w * t), np.sin(w * t)
+    speed = np.linalg.norm(w * (a * c - b * s), axis=1).max()
+    accel = np.linalg.norm(w * w * (a * s + b * c), axis=1).max()
+    return float(speed), float(accel)
+
+
+def auto_weight_bound(p: Mapping[str, Any]) -> list[float]:
+    """The weight bounds of ``weight_bound='auto'`` (``network::weight_bounds`` in
+    the core): ‖τmax‖/(√l · r) with r = peak ‖ẍc‖ for D̂, peak ‖ẋc‖ for Ĉ, 1 for
+    Ĝ (a trajectory that does not move uses r = 1 rad/s, 1 rad/s²). Since every
+    S_i ≤ 1, no network can then produce more than the actuator's torque at the
+    commanded regressor scale. For the paper: ≈ [0.718, 2.255, 1.417]."""
+    speed, accel = peak_rates(p)
+    scale = float(np.linalg.norm(p["tau_max"])) / math.sqrt(N_NODES)
+    return [scale / (accel or 1.0), scale / (speed or 1.0), scale]

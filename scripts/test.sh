@@ -33,8 +33,8 @@ py="$venv/bin/python"
 "$py" -m pip install --quiet --disable-pip-version-check ".[test]"
 
 step "Python: ruff, type stubs, mypy"
-"$py" -m ruff check python tests
-"$py" -m ruff format --check python tests
+"$py" -m ruff check python tests examples benches
+"$py" -m ruff format --check python tests examples benches
 "$py" -m mypy.stubtest adaptimp._adaptimp
 "$py" -m mypy
 

@@ -41,7 +41,9 @@ def _write_rows(path: pathlib.Path, run: dict, rows: np.ndarray) -> None:
         cols.append(run[name][rows])
     header += ["wD", "wC", "wG"]
     cols.append(run["w_norms"][rows])
-    np.savetxt(path, np.hstack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.17e")
+    np.savetxt(
+        path, np.hstack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.17e"
+    )
 
 
 def main() -> None:

@@ -71,18 +71,14 @@ def step_timing(module, case: str, steps: int) -> tuple[float, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "--t-numpy", type=float, default=2.0, help="NumPy PD run length (s)"
-    )
+    parser.add_argument("--t-numpy", type=float, default=2.0, help="NumPy PD run length (s)")
     parser.add_argument(
         "--t-numpy-timing",
         type=float,
         default=0.5,
         help="NumPy sf/of run length for the whole-run timing (s)",
     )
-    parser.add_argument(
-        "--timing-steps", type=int, default=2000, help="steps per step-timing run"
-    )
+    parser.add_argument("--timing-steps", type=int, default=2000, help="steps per step-timing run")
     args = parser.parse_args()
 
     print(
@@ -99,9 +95,7 @@ def main() -> None:
         results[case] = spec_numba.simulate(case)
         wall[case] = time.perf_counter() - t0
     K = len(results["pd"]["t"])
-    print(
-        f"\nPaper scenario, numba: T = 20 s, Ts = 50 µs, substeps = 1, K = {K} rows\n"
-    )
+    print(f"\nPaper scenario, numba: T = 20 s, Ts = 50 µs, substeps = 1, K = {K} rows\n")
     print(metrics_table(results))
 
     t0 = time.perf_counter()
@@ -110,9 +104,7 @@ def main() -> None:
     fast = spec_numba.simulate("pd", T=args.t_numpy)
     print(f"\nPD, NumPy vs numba over T = {args.t_numpy} s ({len(ref['t'])} rows):")
     for key in ("q", "dq", "tau", "z1"):
-        print(
-            f"  max |{key}_numpy - {key}_numba| = {np.max(np.abs(ref[key] - fast[key])):.3e}"
-        )
+        print(f"  max |{key}_numpy - {key}_numba| = {np.max(np.abs(ref[key] - fast[key])):.3e}")
 
     # whole-run NumPy timings of the adaptive cases over a short run
     wall_np = {"pd": (wall_numpy, len(ref["t"]))}

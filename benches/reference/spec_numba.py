@@ -42,13 +42,9 @@ _OUT_ROWS = ("tau", "tau_sat", "dtau", "z1", "dq_hat", "zeta", "xd", "z2")
 
 def _pack(p: dict):
     """Packed (cfg, gains, plant) float arrays for the jitted functions."""
-    cfg = np.array(
-        [p["Ts"], p["mu"], p["eta2"], p["kr"], p["eps"], *p["gamma"], *p["sigma"]]
-    )
+    cfg = np.array([p["Ts"], p["mu"], p["eta2"], p["kr"], p["eps"], *p["gamma"], *p["sigma"]])
     gains = np.stack([p[k] for k in ("Kp", "K1", "Kzeta", "tau_max", "Dd", "Cd", "Gd")])
-    plant = np.array(
-        [*_np_ref.arm_coefficients(p), p["g"], p["wall"], p["ke"], p["be"]]
-    )
+    plant = np.array([*_np_ref.arm_coefficients(p), p["g"], p["wall"], p["ke"], p["be"]])
     return cfg, gains, plant
 
 
@@ -229,13 +225,11 @@ def _step(
     ddxc0, ddxc1 = a * w * w * c, -(a * w * w) * s
     ddxd0 = (
         ddxc0
-        + (gains[5, 0] * (dxc0 - dxd[0]) + gains[6, 0] * (xc0 - xd[0]) - tau_e[0])
-        / gains[4, 0]
+        + (gains[5, 0] * (dxc0 - dxd[0]) + gains[6, 0] * (xc0 - xd[0]) - tau_e[0]) / gains[4, 0]
     )
     ddxd1 = (
         ddxc1
-        + (gains[5, 1] * (dxc1 - dxd[1]) + gains[6, 1] * (xc1 - xd[1]) - tau_e[1])
-        / gains[4, 1]
+        + (gains[5, 1] * (dxc1 - dxd[1]) + gains[6, 1] * (xc1 - xd[1]) - tau_e[1]) / gains[4, 1]
     )
 
     # 2.-3. velocity (measured or observer) and errors (§5)
@@ -305,9 +299,7 @@ def _step(
 
 
 @njit(cache=True)
-def _simulate(
-    case, aux, K, substeps, q0, dq0, cfg, gains, plant, centers, phi, gam, xd0, dxd0
-):
+def _simulate(case, aux, K, substeps, q0, dq0, cfg, gains, plant, centers, phi, gam, xd0, dxd0):
     """Whole closed-loop run of SPEC §11; returns the recorded (K, ·) arrays."""
     n = q0.shape[0]
     nl = centers.shape[0]
@@ -398,9 +390,7 @@ class Controller:
         self.n = N_JOINTS
         self.centers = _np_ref.rbf_centers(self.n)
         self.n_nodes = self.centers.shape[0]
-        self.Phi, self.Gam = _np_ref.observer_zoh(
-            self.p["eps"], self.p["lam1"], self.p["Ts"]
-        )
+        self.Phi, self.Gam = _np_ref.observer_zoh(self.p["eps"], self.p["lam1"], self.p["Ts"])
         self._cfg, self._gains, _ = _pack(self.p)
         self._case = _CASE_CODE[case]
         self._aux = _AUX_CODE[self.p["aux_law"]]

@@ -143,9 +143,7 @@ def _validate(p: dict) -> None:
     ]
     for condition, value in checks:
         if not np.all(np.asarray(value) > 0.0):
-            raise ValueError(
-                f"stability condition violated: {condition} (value {value})"
-            )
+            raise ValueError(f"stability condition violated: {condition} (value {value})")
     if p["substeps"] < 1:
         raise ValueError(f"substeps must be >= 1, got {p['substeps']}")
     if p["aux_law"] not in AUX_LAWS:
@@ -176,9 +174,7 @@ def arm_matrices(q: np.ndarray, dq: np.ndarray, pc: np.ndarray, g: float):
     p1, p2, p3, p4, p5 = pc
     c2, s2 = np.cos(q[1]), np.sin(q[1])
     D = np.array([[p1 + p2 + 2.0 * p3 * c2, p2 + p3 * c2], [p2 + p3 * c2, p2]])
-    C = np.array(
-        [[-p3 * dq[1] * s2, -p3 * (dq[0] + dq[1]) * s2], [p3 * dq[0] * s2, 0.0]]
-    )
+    C = np.array([[-p3 * dq[1] * s2, -p3 * (dq[0] + dq[1]) * s2], [p3 * dq[0] * s2, 0.0]])
     c12 = np.cos(q[0] + q[1])
     G = np.array([p4 * g * np.cos(q[0]) + p5 * g * c12, p5 * g * c12])
     return D, C, G
@@ -373,18 +369,14 @@ class Controller:
         if inside and p["aux_law"] == "printed":
             zeta_new = zeta.copy()  # printed inner law: dzeta/dt = 0
         else:
-            beta = (
-                0.0 if inside else (abs(z2 @ dtau) + 0.5 * (dtau @ dtau)) / zeta_norm2
-            )
+            beta = 0.0 if inside else (abs(z2 @ dtau) + 0.5 * (dtau @ dtau)) / zeta_norm2
             zeta_new = (zeta + Ts * dtau) / (1.0 + Ts * (p["Kzeta"] + beta))
 
         dxd_new = dxd + Ts * ddxd  # reference model, then position with the new ẋd
         xd_new = xd + Ts * dxd_new
 
         if self.case == "of":  # observer, exact ZOH with x_k held
-            self.pi_next = (
-                np.einsum("jab,jb->ja", self.Phi, self.pi_next) + self.Gam * x[:, None]
-            )
+            self.pi_next = np.einsum("jab,jb->ja", self.Phi, self.pi_next) + self.Gam * x[:, None]
 
         # expose the step's values, store the advanced state
         self.tau, self.tau_sat, self.dtau = tau, tau_sat, dtau
@@ -478,8 +470,7 @@ def compute_metrics(rec: dict, p: dict) -> dict:
     D[:, 1, 1] = pc[1]
     Cdq = np.stack(
         [
-            -pc[2] * dq[:, 1] * s2 * dq[:, 0]
-            + -pc[2] * (dq[:, 0] + dq[:, 1]) * s2 * dq[:, 1],
+            -pc[2] * dq[:, 1] * s2 * dq[:, 0] + -pc[2] * (dq[:, 0] + dq[:, 1]) * s2 * dq[:, 1],
             pc[2] * dq[:, 0] * s2 * dq[:, 0],
         ],
         axis=1,

@@ -5,6 +5,7 @@
 //! ```
 //!
 //! - `basis/*`: S(Z) on the paper grid, by the separable fast path and node by node.
+//! - `network/fused_step`: the three networks' output, update and norms, one pass.
 //! - `step/*`: one controller step of each law.
 //! - `plant/rk4`: one RK4 step of the 2-link arm with the wall.
 //! - `bound/sf_step`: the least work any state-feedback step must do: the basis,
@@ -12,6 +13,7 @@
 //!   output and writes it once for the update, from one contiguous array.
 //! - `paper/*`: one whole paper-scenario run (SPEC §11, 400 000 steps).
 
+use adaptimp::network::{Rates, Weights};
 use adaptimp::{
     simulate, Controller, Environment, Law, Manipulator, Measurement, Rbf, SimConfig, TwoLinkArm,
     Vector, Wall,
@@ -47,6 +49,24 @@ fn basis(c: &mut Criterion) {
             direct.eval(black_box(&z), &mut s);
             black_box(&s);
         })
+    });
+}
+
+/// One pass of the three networks (output, update and norms) alone.
+fn network(c: &mut Criterion) {
+    let grid = Rbf::<2, L>::grid(25.0).expect("grid");
+    let mut s = SVector::<f64, L>::zeros();
+    grid.eval(&z_sample(), &mut s);
+    let mut w = Box::new(Weights::<2, L>::zeros());
+    let rates = Rates::new(50e-6, [100.0; 3], [0.01; 3]).expect("rates");
+    let (da, a, z2) = (
+        Vector::<2>::new(-2.0, 3.5),
+        Vector::<2>::new(0.6, 1.1),
+        Vector::<2>::new(0.01, -0.02),
+    );
+    let mut norms = [0.0; 3];
+    c.bench_function("network/fused_step", |b| {
+        b.iter(|| black_box(w.fused_step(black_box(&s), &da, &a, &z2, &rates, &mut norms)))
     });
 }
 
@@ -96,38 +116,51 @@ fn plant(c: &mut Criterion) {
 
 /// Rows of the lower bound: (2n² + n) = 10 rows of l weights.
 const ROWS: usize = 10;
-/// Independent accumulators of the bound's kernel (the fastest measured on
-/// 256-bit vectors; see `src/network.rs`).
+/// Independent accumulators of the bound's kernel (as in `src/network.rs`).
 const LANES: usize = 8;
 
+/// One row of the bound: `Ŵ·S` of the old row, then `Ŵ ← a Ŵ + b S`.
+#[inline(always)]
+fn bound_row(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
+    let mut acc = [0.0; LANES];
+    let rows = w.as_mut_slice().chunks_exact_mut(LANES);
+    for (wv, sv) in rows.zip(s.as_slice().chunks_exact(LANES)) {
+        for l in 0..LANES {
+            let old = wv[l];
+            acc[l] += old * sv[l];
+            wv[l] = a * old + b * sv[l];
+        }
+    }
+    acc.iter().sum()
+}
+
+/// The weight pass of the bound, kept out of line so that it is compiled as
+/// the library's pass is (inlined into a closure it was not vectorised).
+#[inline(never)]
+fn bound_pass(
+    w: &mut [SVector<f64, L>; ROWS],
+    s: &SVector<f64, L>,
+    a: f64,
+    b: &[f64; ROWS],
+) -> [f64; ROWS] {
+    core::array::from_fn(|r| bound_row(&mut w[r], s, a, b[r]))
+}
+
 /// The least work of one state-feedback step: the basis, then one pass that
-/// reads each weight once (for the output) and writes it once (the update),
-/// from one contiguous, aligned block, and nothing else (no norms, no
-/// control law, no reference, no saturation).
+/// reads each of the 2560 weights once (for the output) and writes it once
+/// (the update), and nothing else: no norms, no control law, no reference,
+/// no saturation, no observer.
 fn bound(c: &mut Criterion) {
     let grid = Rbf::<2, L>::grid(25.0).expect("grid");
     let mut s = SVector::<f64, L>::zeros();
-    let mut w = Box::new([[0.001f64; L]; ROWS]);
+    let mut w = Box::new([SVector::<f64, L>::from_element(0.001); ROWS]);
     let z = z_sample();
-    let b: [f64; ROWS] = core::array::from_fn(|r| 1e-6 * (r as f64 + 1.0));
+    let a = black_box(1.0 - 5e-5);
+    let b: [f64; ROWS] = black_box(core::array::from_fn(|r| 1e-6 * (r as f64 + 1.0)));
     c.bench_function("bound/sf_step", |bench| {
         bench.iter(|| {
             grid.eval(black_box(&z), &mut s);
-            let mut out = [0.0; ROWS];
-            for ((row, o), &br) in w.iter_mut().zip(out.iter_mut()).zip(&b) {
-                let mut acc = [0.0; LANES];
-                for (wv, sv) in row
-                    .chunks_exact_mut(LANES)
-                    .zip(s.as_slice().chunks_exact(LANES))
-                {
-                    for l in 0..LANES {
-                        acc[l] += wv[l] * sv[l];
-                        wv[l] = 0.999999 * wv[l] + br * sv[l];
-                    }
-                }
-                *o = acc.iter().sum();
-            }
-            black_box(out);
+            black_box(bound_pass(&mut w, &s, a, &b))
         })
     });
 }
@@ -153,5 +186,5 @@ fn paper(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, basis, steps, plant, bound, paper);
+criterion_group!(benches, basis, network, steps, plant, bound, paper);
 criterion_main!(benches);

@@ -370,7 +370,7 @@ pub struct Controller<const N: usize, const L: usize, T = Sinusoid<N>> {
     zeta: Vector<N>,
     observer: ObserverState<N>,
     weights: Weights<N, L>,
-    /// ‖Ŵ‖_F of the current weights, kept by the two-pass update.
+    /// ‖Ŵ‖_F of the current weights (kept up to date by every update).
     norms: [f64; 3],
     basis: SVector<f64, L>,
     last: Command<N>,
@@ -535,17 +535,21 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
                         + g[network::G]);
                 scale = 1.0 / (1.0 + gain / (kappa * self.cfg.kp.min()));
             }
+            // ‖Ŵ‖ before this step's update.
+            w_norms = self.norms;
             let nn = if deferred {
-                w_norms = self.norms;
                 self.weights.output(&self.basis, &dalpha1, &alpha1)
             } else {
                 // Output and update (15)–(17) / (37)–(39) in one pass; the update
                 // uses only this step's values (SPEC §11, step 5).
-                let (nn, norms) =
-                    self.weights
-                        .fused_step(&self.basis, &dalpha1, &alpha1, &z2, &p.rates, scale);
-                w_norms = norms;
-                nn
+                self.weights.fused_step(
+                    &self.basis,
+                    &dalpha1,
+                    &alpha1,
+                    &z2,
+                    &p.rates.scaled(scale),
+                    &mut self.norms,
+                )
             };
             // (14), (35) with +z1 (erratum, SPEC §7).
             tau += z1 + nn + m.tau_e;
@@ -566,9 +570,13 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
                     }
                 }
             }
-            let mut norms =
-                self.weights
-                    .update(&self.basis, &dalpha1, &alpha1, &z2_learn, &p.rates, scale);
+            let mut norms = self.weights.update(
+                &self.basis,
+                &dalpha1,
+                &alpha1,
+                &z2_learn,
+                &p.rates.scaled(scale),
+            );
             if let Some(bound) = self.cfg.weight_bound {
                 for net in 0..3 {
                     if norms[net] > bound[net] {
@@ -640,6 +648,12 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
     /// The network weights.
     pub fn weights(&self) -> &Weights<N, L> {
         &self.weights
+    }
+    /// Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ of the current weights, as the
+    /// controller tracks them step by step (see [`Weights::fused_step`]);
+    /// [`Weights::norms`] recomputes them from the weights.
+    pub fn weight_norms(&self) -> [f64; 3] {
+        self.norms
     }
     /// Replace the weights (e.g. to warm-start from a previous run). Every
     /// weight must be finite.

@@ -54,6 +54,15 @@ pub struct Rates {
 }
 
 impl Rates {
+    /// The same with the learning step scaled by `scale` (the gains Ts Γ times
+    /// `scale`, the leakage unchanged), as the normalised step does.
+    pub fn scaled(&self, scale: f64) -> Self {
+        Self {
+            decay: self.decay,
+            gain: self.gain.map(|g| g * scale),
+        }
+    }
+
     /// Coefficients for sampling period `ts` (s), gains Γ and leakages σ, validated > 0.
     pub fn new(ts: f64, gamma: [f64; 3], sigma: [f64; 3]) -> Result<Self, Error> {
         check::positive_vec("Γ > 0", "gamma", &Vector::<3>::from(gamma))?;
@@ -93,35 +102,26 @@ const LANES: usize = 8;
 #[cfg(not(target_feature = "avx"))]
 const LANES: usize = 4;
 
-/// One row: returns `Ŵ·S` and `‖Ŵ‖²` of the old row, and writes `Ŵ ← a Ŵ + b S`.
+/// One row: returns `Ŵ·S` of the old row, and writes `Ŵ ← a Ŵ + b S`.
 #[inline(always)]
-fn dot_update<const L: usize>(
-    w: &mut SVector<f64, L>,
-    s: &SVector<f64, L>,
-    a: f64,
-    b: f64,
-) -> (f64, f64) {
+fn dot_update<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
     let (w, s) = (w.as_mut_slice(), s.as_slice());
     let mut dot = [0.0; LANES];
-    let mut sq = [0.0; LANES];
     let mut wc = w.chunks_exact_mut(LANES);
     let mut sc = s.chunks_exact(LANES);
     for (wv, sv) in (&mut wc).zip(&mut sc) {
         for l in 0..LANES {
             let old = wv[l];
             dot[l] += old * sv[l];
-            sq[l] += old * old;
             wv[l] = a * old + b * sv[l];
         }
     }
-    let (mut dot_t, mut sq_t) = (0.0, 0.0);
+    let mut dot_t = 0.0;
     for (wv, &sv) in wc.into_remainder().iter_mut().zip(sc.remainder()) {
-        let old = *wv;
-        dot_t += old * sv;
-        sq_t += old * old;
-        *wv = a * old + b * sv;
+        dot_t += *wv * sv;
+        *wv = a * *wv + b * sv;
     }
-    (pairwise(&dot) + dot_t, pairwise(&sq) + sq_t)
+    pairwise(&dot) + dot_t
 }
 
 /// One row: `Ŵ ← a Ŵ + b S`; returns `‖Ŵ‖²` of the new row.
@@ -213,10 +213,15 @@ impl<const N: usize, const L: usize> Weights<N, L> {
     }
 
     /// One step of the networks in a single pass over the weights: returns the
-    /// output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current weights and their
-    /// Frobenius norms, then applies the explicit-Euler update of (15)–(17)
-    /// with error signal `z2` (rad/s; ẑ2 for output feedback, (37)–(39)), the
-    /// learning step scaled by `scale` (1 for the printed law).
+    /// output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current weights, then applies
+    /// the explicit-Euler update of (15)–(17) with error signal `z2` (rad/s;
+    /// ẑ2 for output feedback, (37)–(39)), the learning step scaled by `scale`
+    /// (1 for the printed law).
+    ///
+    /// `norms` holds the Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ of the weights
+    /// before the step and is brought up to date without a second pass: for
+    /// every row, ‖a Ŵ + b S‖² = a² ‖Ŵ‖² + 2ab (Ŵ·S) + b² ‖S‖², and Ŵ·S is the
+    /// dot product the output needs anyway.
     #[inline]
     pub fn fused_step(
         &mut self,
@@ -225,46 +230,48 @@ impl<const N: usize, const L: usize> Weights<N, L> {
         alpha1: &Vector<N>,
         z2: &Vector<N>,
         rates: &Rates,
-        scale: f64,
-    ) -> (Vector<N>, [f64; 3]) {
+        norms: &mut [f64; 3],
+    ) -> Vector<N> {
         let mut out = Vector::<N>::zeros();
-        let mut sq = [0.0; 3];
-        let rates = &Rates {
-            decay: rates.decay,
-            gain: rates.gain.map(|g| g * scale),
-        };
+        // Per network: Σ_rows b·(Ŵ·S) and Σ_rows b².
+        let mut cross = [0.0; 3];
+        let mut bb = [0.0; 3];
+        let (a, g) = (rates.decay, rates.gain);
         for k in 0..N {
             let gz = z2[k];
             for j in 0..N {
-                let (dot, n2) = dot_update(
-                    &mut self.d[k][j],
-                    s,
-                    rates.decay[D],
-                    rates.gain[D] * dalpha1[j] * gz,
-                );
+                let b = g[D] * dalpha1[j] * gz;
+                let dot = dot_update(&mut self.d[k][j], s, a[D], b);
                 out[k] += dot * dalpha1[j];
-                sq[D] += n2;
-                let (dot, n2) = dot_update(
-                    &mut self.c[k][j],
-                    s,
-                    rates.decay[C],
-                    rates.gain[C] * alpha1[j] * gz,
-                );
+                cross[D] += b * dot;
+                bb[D] += b * b;
+                let b = g[C] * alpha1[j] * gz;
+                let dot = dot_update(&mut self.c[k][j], s, a[C], b);
                 out[k] += dot * alpha1[j];
-                sq[C] += n2;
+                cross[C] += b * dot;
+                bb[C] += b * b;
             }
-            let (dot, n2) = dot_update(&mut self.g[k], s, rates.decay[G], rates.gain[G] * gz);
+            let b = g[G] * gz;
+            let dot = dot_update(&mut self.g[k], s, a[G], b);
             out[k] += dot;
-            sq[G] += n2;
+            cross[G] += b * dot;
+            bb[G] += b * b;
         }
-        (out, sq.map(sqrt))
+        let s2 = s.norm_squared();
+        for net in 0..3 {
+            let n2 = a[net] * a[net] * norms[net] * norms[net]
+                + 2.0 * a[net] * cross[net]
+                + s2 * bb[net];
+            // Rounding can take an exact zero a hair below it.
+            norms[net] = sqrt(n2.max(0.0));
+        }
+        out
     }
 }
 
 impl<const N: usize, const L: usize> Weights<N, L> {
     /// The explicit-Euler update of (15)–(17) alone (after [`output`](Self::output)
-    /// has used the old weights), with the learning step of every row scaled by
-    /// `scale` (1 for the printed law). Rows of joint k learn from `z2[k]`; pass
+    /// has used the old weights). Rows of joint k learn from `z2[k]`; pass
     /// 0 there to freeze joint k's learning (its weights then only leak).
     /// Returns the Frobenius norms of the new weights.
     pub fn update(
@@ -274,10 +281,9 @@ impl<const N: usize, const L: usize> Weights<N, L> {
         alpha1: &Vector<N>,
         z2: &Vector<N>,
         rates: &Rates,
-        scale: f64,
     ) -> [f64; 3] {
         let mut sq = [0.0; 3];
-        let gain = rates.gain.map(|g| g * scale);
+        let gain = rates.gain;
         for k in 0..N {
             let gz = z2[k];
             for j in 0..N {
@@ -354,14 +360,20 @@ mod tests {
             expect_w.g[0][i] += ts * gamma[G] * (s[i] * z2[0] - sigma[G] * w.g[0][i]);
         }
         let mut w2 = w.clone();
-        let (out, norms) = w.fused_step(&s, &da, &a, &z2, &rates, 1.0);
+        let mut norms = expect_norms;
+        let out = w.fused_step(&s, &da, &a, &z2, &rates, &mut norms);
         // The separate update does the same.
-        let new_norms = w2.update(&s, &da, &a, &z2, &rates, 1.0);
+        let new_norms = w2.update(&s, &da, &a, &z2, &rates);
         assert_eq!(w2, w);
-        assert!((new_norms[G] - w.norms()[G]).abs() < 1e-14);
         assert!((out - expect_out).norm() < 1e-14, "{out} vs {expect_out}");
+        // The norms were brought up to date without a second pass.
+        let exact = w.norms();
         for n in 0..3 {
-            assert!((norms[n] - expect_norms[n]).abs() < 1e-14);
+            assert!(
+                (norms[n] - exact[n]).abs() < 1e-13 * exact[n],
+                "{norms:?} vs {exact:?}"
+            );
+            assert!((new_norms[n] - exact[n]).abs() < 1e-13 * exact[n]);
         }
         for i in 0..16 {
             assert!((w.d[0][0][i] - expect_w.d[0][0][i]).abs() < 1e-15);

@@ -153,11 +153,17 @@ where
     for k in 0..steps {
         let t = k as f64 * ts;
         let tau_e = env.force(t, &x, &dx);
-        let cmd = ctrl.step(&Measurement {
-            x,
-            dx: Some(dx),
-            tau_e,
-        })?;
+        // The controller's own trajectory at its own clock (t_k = k·Ts), sampled
+        // once for the step and the impedance residual.
+        let c = ctrl.trajectory().sample(t);
+        let cmd = ctrl.step_with(
+            &Measurement {
+                x,
+                dx: Some(dx),
+                tau_e,
+            },
+            &c,
+        )?;
         // The plant's acceleration at the row: for the impedance residual, and
         // the first RK4 stage of the first substep.
         let a0 = plant.forward_dynamics(&x, &dx, &cmd.tau_sat, &tau_e);
@@ -176,7 +182,6 @@ where
             z1: cmd.z1,
             w_norms: cmd.w_norms,
         };
-        let c = ctrl.trajectory().sample(t);
         acc.push(&row, &imp.residual(&c, &x, &dx, &a0, &tau_e));
         rec.record(&row);
 

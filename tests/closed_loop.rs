@@ -110,6 +110,31 @@ fn paper_scenario_reproduces_the_papers_findings() {
 }
 
 #[test]
+fn tracked_weight_norms_stay_exact_over_a_whole_paper_run() {
+    // The fused pass updates the norms algebraically (no second pass); after
+    // 400 000 steps they still equal a recomputation from the weights.
+    for law in [Law::StateFeedback, Law::OutputFeedback] {
+        let mut ctrl = Box::new(Controller::paper(law));
+        let sim = SimConfig::paper();
+        simulate(
+            &TwoLinkArm::paper(),
+            &Wall::paper(),
+            ctrl.as_mut(),
+            &sim,
+            &mut (),
+        )
+        .expect("simulate");
+        let (tracked, exact) = (ctrl.weight_norms(), ctrl.weights().norms());
+        for (t, e) in tracked.iter().zip(exact) {
+            assert!(
+                e > 1.0 && (t - e).abs() <= 1e-9 * e,
+                "{law:?}: {tracked:?} vs {exact:?}"
+            );
+        }
+    }
+}
+
+#[test]
 fn printed_auxiliary_law_is_dead_the_default_compensates() {
     let mut printed = Config::paper(Law::StateFeedback);
     printed.aux_law = AuxLaw::Printed;

@@ -5,6 +5,9 @@ user would: explicit loops, preallocated arrays, no temporaries in the step,
 and the whole closed-loop scenario inside one ``@njit`` function.  The
 network outputs, the weight update and the weight norms share one pass over
 the weights (outputs use the old weights, as the SPEC requires).
+``Controller.replay`` steps through K logged measurements inside one jitted
+loop, the counterpart of ``adaptimp.Controller.replay`` in
+``benches/compare.py``.
 
 Units: rad, rad/s, rad/s², N m, s.  n = 2 joints.  Conventions (network
 input, centre ordering, weight layouts) are those of ``spec_numpy.py``.
@@ -299,6 +302,69 @@ def _step(
 
 
 @njit(cache=True)
+def _replay(
+    case,
+    aux,
+    k0,
+    q,
+    dq,
+    tau_e,
+    cfg,
+    gains,
+    centers,
+    phi,
+    gam,
+    xd,
+    dxd,
+    zeta,
+    pi,
+    WD,
+    WC,
+    WG,
+    S,
+    Z,
+    out,
+    wnorm,
+    tau_sat,
+):
+    """K controller periods on logged measurements, all inside one jitted loop.
+
+    Row k of q (rad), dq (rad/s; unused for "of") and tau_e (N m), each (K, n),
+    is step k0 + k of ``_step`` (the same maths, no Python per step); the
+    applied torques sat(τ) (N m) go to the rows of ``tau_sat`` (K, n).  The
+    state arrays and ``out``/``wnorm`` end as after the last step.
+    """
+    n = q.shape[1]
+    for k in range(q.shape[0]):
+        _step(
+            case,
+            aux,
+            k0 + k,
+            q[k],
+            dq[k],
+            tau_e[k],
+            cfg,
+            gains,
+            centers,
+            phi,
+            gam,
+            xd,
+            dxd,
+            zeta,
+            pi,
+            WD,
+            WC,
+            WG,
+            S,
+            Z,
+            out,
+            wnorm,
+        )
+        for i in range(n):
+            tau_sat[k, i] = out[1, i]
+
+
+@njit(cache=True)
 def _simulate(case, aux, K, substeps, q0, dq0, cfg, gains, plant, centers, phi, gam, xd0, dxd0):
     """Whole closed-loop run of SPEC §11; returns the recorded (K, ·) arrays."""
     n = q0.shape[0]
@@ -453,6 +519,52 @@ class Controller:
         )
         self.k += 1
         return self._out[1].copy()
+
+    def replay(self, q, tau_e, dq=None) -> np.ndarray:
+        """K periods on logged measurements in one jitted loop (no Python per step).
+
+        q (rad), tau_e (N m) and dq (rad/s, "pd"/"sf" only) have shape (K, n);
+        row k is the measurement of step ``self.k + k``.  Equivalent to calling
+        :meth:`step` on each row in turn; returns sat(τ) (N m), shape (K, n).
+        """
+        q = np.ascontiguousarray(q, dtype=np.float64)
+        tau_e = np.ascontiguousarray(tau_e, dtype=np.float64)
+        if dq is None:
+            if self._case != 2:
+                raise ValueError(f"case {self.case!r} needs the measured velocity dq")
+            dq = np.zeros_like(q)
+        dq = np.ascontiguousarray(dq, dtype=np.float64)
+        shape = (q.shape[0], self.n)
+        if q.shape != shape or tau_e.shape != shape or dq.shape != shape:
+            raise ValueError(f"q, tau_e, dq must have shape (K, {self.n})")
+        tau_sat = np.empty(shape)
+        _replay(
+            self._case,
+            self._aux,
+            self.k,
+            q,
+            dq,
+            tau_e,
+            self._cfg,
+            self._gains,
+            self.centers,
+            self.Phi,
+            self.Gam,
+            self.xd_next,
+            self.dxd_next,
+            self.zeta_next,
+            self.pi_next,
+            self.weights["D"],
+            self.weights["C"],
+            self.weights["G"],
+            self._S,
+            self._Z,
+            self._out,
+            self.w_norms,
+            tau_sat,
+        )
+        self.k += shape[0]
+        return tau_sat
 
     def _row(self, r: int) -> np.ndarray:
         return self._out[r].copy()

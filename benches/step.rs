@@ -21,6 +21,7 @@ use adaptimp::{
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::SVector;
 use std::hint::black_box;
+use wide::f64x4;
 
 const L: usize = 256;
 
@@ -116,22 +117,28 @@ fn plant(c: &mut Criterion) {
 
 /// Rows of the lower bound: (2n² + n) = 10 rows of l weights.
 const ROWS: usize = 10;
-/// Independent accumulators of the bound's kernel (as in `src/network.rs`).
-const LANES: usize = 8;
 
-/// One row of the bound: `Ŵ·S` of the old row, then `Ŵ ← a Ŵ + b S`.
+/// One row of the bound: `Ŵ·S` of the old row, then `Ŵ ← a Ŵ + b S`, with
+/// explicit 4-wide vectors as in `src/network.rs` (two accumulators).
 #[inline(always)]
 fn bound_row(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
-    let mut acc = [0.0; LANES];
-    let rows = w.as_mut_slice().chunks_exact_mut(LANES);
-    for (wv, sv) in rows.zip(s.as_slice().chunks_exact(LANES)) {
-        for l in 0..LANES {
-            let old = wv[l];
-            acc[l] += old * sv[l];
-            wv[l] = a * old + b * sv[l];
-        }
+    let load = |v: &[f64]| f64x4::from(<[f64; 4]>::try_from(v).unwrap_or([0.0; 4]));
+    let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
+    let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
+    let rows = w.as_mut_slice().chunks_exact_mut(8);
+    for (wv, sv) in rows.zip(s.as_slice().chunks_exact(8)) {
+        let (w0, w1, s0, s1) = (
+            load(&wv[..4]),
+            load(&wv[4..]),
+            load(&sv[..4]),
+            load(&sv[4..]),
+        );
+        d0 += w0 * s0;
+        d1 += w1 * s1;
+        wv[..4].copy_from_slice(&(av * w0 + bv * s0).to_array());
+        wv[4..].copy_from_slice(&(av * w1 + bv * s1).to_array());
     }
-    acc.iter().sum()
+    (d0 + d1).reduce_add()
 }
 
 /// The weight pass of the bound, kept out of line so that it is compiled as

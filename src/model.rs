@@ -184,13 +184,14 @@ impl Manipulator<2> for TwoLinkArm {
     ) -> Vector<2> {
         let [p1, p2, p3, p4, p5] = self.p;
         let g = self.params.g;
+        let (s1, c1) = (sin(q[0]), cos(q[0]));
         let (s2, c2) = (sin(q[1]), cos(q[1]));
-        let c12 = cos(q[0] + q[1]);
+        // Two sin/cos pairs (one libm sincos each) instead of three calls: the
+        // plant is evaluated four times per RK4 step.
+        let c12 = c1 * c2 - s1 * s2;
         let h = p3 * s2;
         // rhs = τ − τe − C q̇ − G
-        let r0 = tau[0] - tau_e[0] + h * dq[1] * (2.0 * dq[0] + dq[1])
-            - p4 * g * cos(q[0])
-            - p5 * g * c12;
+        let r0 = tau[0] - tau_e[0] + h * dq[1] * (2.0 * dq[0] + dq[1]) - p4 * g * c1 - p5 * g * c12;
         let r1 = tau[1] - tau_e[1] - h * dq[0] * dq[0] - p5 * g * c12;
         let d11 = p1 + p2 + 2.0 * p3 * c2;
         let d12 = p2 + p3 * c2;

@@ -21,6 +21,7 @@ use crate::error::{check, Error};
 use crate::math::sqrt;
 use crate::Vector;
 use nalgebra::SVector;
+use wide::f64x4;
 
 /// Index of the three networks in `[f64; 3]` parameter arrays.
 pub const D: usize = 0;
@@ -93,71 +94,67 @@ pub fn weight_bounds<const N: usize>(
     [scale / accel, scale / speed, scale]
 }
 
-/// Independent accumulators per row pass: enough to hide the latency of the
-/// additions (Rust never fuses a·b + c, so results are the same on every
-/// target). With 256-bit vectors two registers per accumulator; with 128-bit
-/// SSE2 the 4 of one more register-starved loop measured fastest.
-#[cfg(target_feature = "avx")]
-const LANES: usize = 8;
-#[cfg(not(target_feature = "avx"))]
-const LANES: usize = 4;
-
 /// One row: returns `Ŵ·S` of the old row, and writes `Ŵ ← a Ŵ + b S`.
+///
+/// Explicit 4-wide vectors (`wide::f64x4`: 256-bit AVX when built for it, two
+/// SSE2 registers otherwise) rather than arrays left to the autovectoriser,
+/// which vectorised the ten inlined copies of this loop unevenly (some at
+/// half width). Products and sums stay separate (Rust never fuses a·b + c), so
+/// the results are the same on every target.
 #[inline(always)]
 fn dot_update<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
     let (w, s) = (w.as_mut_slice(), s.as_slice());
-    let mut dot = [0.0; LANES];
-    let mut wc = w.chunks_exact_mut(LANES);
-    let mut sc = s.chunks_exact(LANES);
+    let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
+    // Two independent 4-wide accumulators hide the latency of the additions.
+    let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
+    let mut wc = w.chunks_exact_mut(8);
+    let mut sc = s.chunks_exact(8);
     for (wv, sv) in (&mut wc).zip(&mut sc) {
-        for l in 0..LANES {
-            let old = wv[l];
-            dot[l] += old * sv[l];
-            wv[l] = a * old + b * sv[l];
-        }
+        let (w0, w1) = (load(&wv[..4]), load(&wv[4..]));
+        let (s0, s1) = (load(&sv[..4]), load(&sv[4..]));
+        d0 += w0 * s0;
+        d1 += w1 * s1;
+        wv[..4].copy_from_slice(&(av * w0 + bv * s0).to_array());
+        wv[4..].copy_from_slice(&(av * w1 + bv * s1).to_array());
     }
-    let mut dot_t = 0.0;
+    let mut dot = (d0 + d1).reduce_add();
     for (wv, &sv) in wc.into_remainder().iter_mut().zip(sc.remainder()) {
-        dot_t += *wv * sv;
+        dot += *wv * sv;
         *wv = a * *wv + b * sv;
     }
-    pairwise(&dot) + dot_t
+    dot
+}
+
+/// Four lanes from a slice of exactly four.
+#[inline(always)]
+fn load(v: &[f64]) -> f64x4 {
+    let mut a = [0.0; 4];
+    a.copy_from_slice(v);
+    f64x4::from(a)
 }
 
 /// One row: `Ŵ ← a Ŵ + b S`; returns `‖Ŵ‖²` of the new row.
 #[inline(always)]
 fn update_row<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
     let (w, s) = (w.as_mut_slice(), s.as_slice());
-    let mut sq = [0.0; LANES];
-    let mut wc = w.chunks_exact_mut(LANES);
-    let mut sc = s.chunks_exact(LANES);
+    let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
+    let (mut q0, mut q1) = (f64x4::ZERO, f64x4::ZERO);
+    let mut wc = w.chunks_exact_mut(8);
+    let mut sc = s.chunks_exact(8);
     for (wv, sv) in (&mut wc).zip(&mut sc) {
-        for l in 0..LANES {
-            let new = a * wv[l] + b * sv[l];
-            sq[l] += new * new;
-            wv[l] = new;
-        }
+        let n0 = av * load(&wv[..4]) + bv * load(&sv[..4]);
+        let n1 = av * load(&wv[4..]) + bv * load(&sv[4..]);
+        q0 += n0 * n0;
+        q1 += n1 * n1;
+        wv[..4].copy_from_slice(&n0.to_array());
+        wv[4..].copy_from_slice(&n1.to_array());
     }
-    let mut sq_t = 0.0;
+    let mut sq = (q0 + q1).reduce_add();
     for (wv, &sv) in wc.into_remainder().iter_mut().zip(sc.remainder()) {
         *wv = a * *wv + b * sv;
-        sq_t += *wv * *wv;
+        sq += *wv * *wv;
     }
-    pairwise(&sq) + sq_t
-}
-
-/// Sum of the lanes, pairwise (the order a SIMD reduction takes).
-#[inline(always)]
-fn pairwise<const M: usize>(v: &[f64; M]) -> f64 {
-    let mut v = *v;
-    let mut n = M;
-    while n > 1 {
-        n /= 2;
-        for i in 0..n {
-            v[i] += v[i + n];
-        }
-    }
-    v[0]
+    sq
 }
 
 impl<const N: usize, const L: usize> Weights<N, L> {

@@ -105,9 +105,14 @@ impl<const N: usize> Trajectory<N> for Sinusoid<N> {
             dx: Vector::zeros(),
             ddx: Vector::zeros(),
         };
+        // Joints that share a frequency (the paper's circle) share one sin/cos.
+        let (mut w_prev, mut s, mut c) = (f64::NAN, 0.0, 0.0);
         for i in 0..N {
             let w = self.omega[i];
-            let (s, c) = (sin(w * t), cos(w * t));
+            if w != w_prev {
+                (s, c) = (sin(w * t), cos(w * t));
+                w_prev = w;
+            }
             let (a, b) = (self.sin[i], self.cos[i]);
             sp.x[i] += a * s + b * c;
             sp.dx[i] = w * (a * c - b * s);

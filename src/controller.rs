@@ -16,7 +16,7 @@ use crate::auxiliary::{AuxLaw, Auxiliary};
 use crate::error::{check, Error};
 use crate::impedance::{Reference, TargetImpedance};
 use crate::math::{sgn, tanh};
-use crate::network::{self, Rates, Weights};
+use crate::network::{self, Rates, Weights, Workspace};
 use crate::observer::{HighGainObserver, Hold, ObserverState};
 use crate::rbf::Rbf;
 use crate::saturation::Saturation;
@@ -369,10 +369,10 @@ pub struct Controller<const N: usize, const L: usize, T = Sinusoid<N>> {
     reference: Reference<N>,
     zeta: Vector<N>,
     observer: ObserverState<N>,
-    weights: Weights<N, L>,
+    /// The basis and the weights.
+    net: Workspace<N, L>,
     /// ‖Ŵ‖_F of the current weights (kept up to date by every update).
     norms: [f64; 3],
-    basis: SVector<f64, L>,
     last: Command<N>,
 }
 
@@ -445,9 +445,8 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
             reference: Reference::start(&start),
             zeta: Vector::zeros(),
             observer: ObserverState::zeros(),
-            weights: Weights::zeros(),
+            net: Workspace::zeros(),
             norms: [0.0; 3],
-            basis: SVector::zeros(),
             last: Command::zeros(),
         })
     }
@@ -458,9 +457,8 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
         self.reference = Reference::start(&self.traj.sample(0.0));
         self.zeta = Vector::zeros();
         self.observer = ObserverState::zeros();
-        self.weights = Weights::zeros();
+        self.net = Workspace::zeros();
         self.norms = [0.0; 3];
-        self.basis = SVector::zeros();
         self.last = Command::zeros();
     }
 
@@ -526,10 +524,10 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
         if law.learns() {
             self.cfg
                 .rbf
-                .eval(&[m.x, v, alpha1, dalpha1], &mut self.basis);
+                .eval(&[m.x, v, alpha1, dalpha1], &mut self.net.basis);
             if let LearningStep::Normalized { kappa } = self.cfg.learning_step {
                 let g = p.rates.gain;
-                let gain = self.basis.norm_squared()
+                let gain = self.net.basis.norm_squared()
                     * (g[network::D] * dalpha1.norm_squared()
                         + g[network::C] * alpha1.norm_squared()
                         + g[network::G]);
@@ -538,12 +536,13 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
             // ‖Ŵ‖ before this step's update.
             w_norms = self.norms;
             let nn = if deferred {
-                self.weights.output(&self.basis, &dalpha1, &alpha1)
+                self.net.weights.output(&self.net.basis, &dalpha1, &alpha1)
             } else {
                 // Output and update (15)–(17) / (37)–(39) in one pass; the update
                 // uses only this step's values (SPEC §11, step 5).
-                self.weights.fused_step(
-                    &self.basis,
+                let Workspace { basis, weights, .. } = &mut self.net;
+                weights.fused_step(
+                    basis,
                     &dalpha1,
                     &alpha1,
                     &z2,
@@ -570,18 +569,14 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
                     }
                 }
             }
-            let mut norms = self.weights.update(
-                &self.basis,
-                &dalpha1,
-                &alpha1,
-                &z2_learn,
-                &p.rates.scaled(scale),
-            );
+            let Workspace { basis, weights, .. } = &mut self.net;
+            let mut norms =
+                weights.update(basis, &dalpha1, &alpha1, &z2_learn, &p.rates.scaled(scale));
             if let Some(bound) = self.cfg.weight_bound {
                 for net in 0..3 {
                     if norms[net] > bound[net] {
                         // Projection onto the ball ‖Ŵ‖_F ≤ bound.
-                        self.weights.scale_network(net, bound[net] / norms[net]);
+                        weights.scale_network(net, bound[net] / norms[net]);
                         norms[net] = bound[net];
                     }
                 }
@@ -647,7 +642,7 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
     }
     /// The network weights.
     pub fn weights(&self) -> &Weights<N, L> {
-        &self.weights
+        &self.net.weights
     }
     /// Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ of the current weights, as the
     /// controller tracks them step by step (see [`Weights::fused_step`]);
@@ -660,12 +655,12 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
     pub fn set_weights(&mut self, w: Weights<N, L>) -> Result<(), Error> {
         w.check_finite()?;
         self.norms = w.norms();
-        self.weights = w;
+        self.net.weights = w;
         Ok(())
     }
     /// The basis S(Z) of the last step (zeros before the first, and for PD).
     pub fn basis(&self) -> &SVector<f64, L> {
-        &self.basis
+        &self.net.basis
     }
     /// The last step's command (all zeros before the first step).
     pub fn last(&self) -> &Command<N> {

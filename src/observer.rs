@@ -15,7 +15,7 @@
 
 use crate::error::{check, Error};
 use crate::Vector;
-use nalgebra::{Matrix2, SMatrix, Vector2};
+use nalgebra::{Matrix2, Matrix4, SMatrix, Vector2};
 
 /// How the measured position is modelled between samples.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
@@ -82,7 +82,7 @@ impl<const N: usize> HighGainObserver<N> {
             // has exp = [[Φ, Γ0, Γ1], [0, 1, 1], [0, 0, 1]]; A = (1/ε)[[0, 1], [−1, −λ1]],
             // B = (1/ε)[0, 1]ᵀ.
             let h = ts / eps;
-            let mut m = SMatrix::<f64, 4, 4>::zeros();
+            let mut m = Matrix4::zeros();
             m[(0, 1)] = h;
             m[(1, 0)] = -h;
             m[(1, 1)] = -lam1[i] * h;
@@ -166,10 +166,24 @@ impl<const N: usize> HighGainObserver<N> {
     }
 }
 
-/// Matrix exponential by scaling and squaring with a Taylor series: scale so
-/// that ‖M/2^s‖₁ ≤ 1/2, sum 18 terms (truncation below 1e-22), square s times.
-/// (nalgebra's `exp` needs `std`; this is `no_std` and ample for 4 × 4.)
-fn expm<const D: usize>(m: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
+/// Matrix exponential. With `std`: nalgebra's (Padé approximant with scaling
+/// and squaring, Higham 2005), accurate to ~1e-16 here. Without: a Taylor
+/// series with scaling and squaring (scale to ‖M/2^s‖₁ ≤ 1/2, 18 terms,
+/// square s times), accurate to a few 1e-15 at Ts/ε = 10, because each
+/// squaring doubles the rounding error; nalgebra's `exp` needs `std`.
+#[cfg(feature = "std")]
+fn expm(m: &Matrix4<f64>) -> Matrix4<f64> {
+    m.exp()
+}
+
+#[cfg(not(feature = "std"))]
+fn expm(m: &Matrix4<f64>) -> Matrix4<f64> {
+    expm_taylor(m)
+}
+
+/// The `no_std` matrix exponential (see [`expm`]).
+#[cfg_attr(feature = "std", allow(dead_code))]
+fn expm_taylor<const D: usize>(m: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
     let norm = m.column_iter().map(|c| c.lp_norm(1)).fold(0.0, f64::max);
     let mut squarings = 0;
     let mut scale = 1.0;
@@ -259,7 +273,7 @@ mod tests {
     #[test]
     fn expm_matches_closed_form_of_a_rotation_and_a_decay() {
         let w = 2.5;
-        let e = expm(&Matrix3::new(0.0, w, 0.0, -w, 0.0, 0.0, 0.0, 0.0, -40.0));
+        let e = expm_taylor(&Matrix3::new(0.0, w, 0.0, -w, 0.0, 0.0, 0.0, 0.0, -40.0));
         assert!((e[(0, 0)] - w.cos()).abs() < 1e-14 && (e[(0, 1)] - w.sin()).abs() < 1e-14);
         assert!((e[(1, 0)] + w.sin()).abs() < 1e-14 && (e[(1, 1)] - w.cos()).abs() < 1e-14);
         assert!(
@@ -269,23 +283,65 @@ mod tests {
         );
     }
 
+    /// Ts, then Φ (row-major), Γ0 and Γ1.
+    type Discretisation = (f64, [f64; 4], [f64; 2], [f64; 2]);
+
+    /// Φ, Γ0, Γ1 from scipy.linalg.expm of the scaled 4 × 4 matrix (ε = 1e-4, λ1 = 3).
+    const SCIPY: [Discretisation; 2] = [
+        (
+            50e-6,
+            [
+                0.9211332218348366,
+                0.24867813145602083,
+                -0.24867813145602077,
+                0.1750988274667742,
+            ],
+            [0.07886677816516337, 0.24867813145602077],
+            [0.029443068096977984, 0.15773355633032676],
+        ),
+        (
+            1e-3,
+            [
+                0.02568224405581328,
+                0.009809744320321261,
+                -0.009809744320321246,
+                -0.003746988905150467,
+            ],
+            [0.9743177559441866, 0.0098097443203213],
+            [0.7067236987847116, 0.09743177559441868],
+        ),
+    ];
+
     #[test]
-    fn zoh_discretisation_matches_scipy_expm() {
-        // scipy.linalg.expm([[0, .5, 0], [-.5, -1.5, .5], [0, 0, 0]]) (ε = 1e-4, Ts = 50 µs, λ1 = 3).
-        let obs =
-            HighGainObserver::<1>::new(1e-4, Vector::<1>::new(3.0), 50e-6, Hold::Zero).unwrap();
-        let expect_phi = Matrix2::new(0.92113322, 0.24867813, -0.24867813, 0.17509883);
-        let expect_gam = Vector2::new(0.07886678, 0.24867813);
-        assert!(
-            (obs.phi[0] - expect_phi).abs().max() < 1e-8,
-            "{}",
-            obs.phi[0]
-        );
-        assert!(
-            (obs.gam0[0] - expect_gam).abs().max() < 1e-8,
-            "{}",
-            obs.gam0[0]
-        );
+    fn discretisation_matches_scipy_expm() {
+        for (ts, phi, g0, g1) in SCIPY {
+            let obs = HighGainObserver::<1>::new(1e-4, Vector::<1>::new(3.0), ts, Hold::Triangle)
+                .unwrap();
+            let p = Matrix2::new(phi[0], phi[1], phi[2], phi[3]);
+            let err = [
+                (obs.phi[0] - p).abs().max(),
+                (obs.gam0[0] - Vector2::from(g0)).abs().max(),
+                (obs.gam1[0] - Vector2::from(g1)).abs().max(),
+            ]
+            .into_iter()
+            .fold(0.0, f64::max);
+            // nalgebra's Padé exponential with std; the Taylor fallback without.
+            let tol = if cfg!(feature = "std") { 1e-15 } else { 1e-14 };
+            assert!(err < tol, "Ts = {ts}: error {err:e}");
+        }
+    }
+
+    #[test]
+    fn taylor_fallback_is_within_a_few_ulps_of_the_pade_result() {
+        let h = 10.0; // Ts/ε at Ts = 1 ms
+        let mut m = SMatrix::<f64, 4, 4>::zeros();
+        m[(0, 1)] = h;
+        m[(1, 0)] = -h;
+        m[(1, 1)] = -3.0 * h;
+        m[(1, 2)] = h;
+        m[(2, 3)] = 1.0;
+        let err = (expm_taylor(&m) - expm(&m)).abs().max();
+        assert!(err < 1e-14, "{err:e}");
     }
 
     #[test]

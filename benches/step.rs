@@ -61,15 +61,19 @@ fn net() -> Box<Workspace<2, L>> {
     n
 }
 
+/// Learning rates (paper, 50 µs) and α̇1, α1, z2 for one pass of the networks.
+fn pass_inputs() -> (Rates, Vector<2>, Vector<2>, Vector<2>) {
+    let rates = Rates::new(50e-6, [100.0; 3], [0.01; 3]).expect("rates");
+    let da = Vector::<2>::new(-2.0, 3.5);
+    let a = Vector::<2>::new(0.6, 1.1);
+    let z2 = Vector::<2>::new(0.01, -0.02);
+    (rates, da, a, z2)
+}
+
 /// One pass of the three networks (output, update and norms) alone.
 fn network(c: &mut Criterion) {
     let mut n = net();
-    let rates = Rates::new(50e-6, [100.0; 3], [0.01; 3]).expect("rates");
-    let (da, a, z2) = (
-        Vector::<2>::new(-2.0, 3.5),
-        Vector::<2>::new(0.6, 1.1),
-        Vector::<2>::new(0.01, -0.02),
-    );
+    let (rates, da, a, z2) = pass_inputs();
     let mut norms = [0.0; 3];
     c.bench_function("network/fused_step", |b| {
         b.iter(|| {
@@ -134,12 +138,7 @@ fn plant(c: &mut Criterion) {
 fn bound(c: &mut Criterion) {
     let grid = Rbf::<2, L>::grid(25.0).expect("grid");
     let mut n = net();
-    let rates = Rates::new(50e-6, [100.0; 3], [0.01; 3]).expect("rates");
-    let (da, a, z2) = (
-        Vector::<2>::new(-2.0, 3.5),
-        Vector::<2>::new(0.6, 1.1),
-        Vector::<2>::new(0.01, -0.02),
-    );
+    let (rates, da, a, z2) = pass_inputs();
     let z = z_sample();
     let mut norms = [0.0; 3];
     c.bench_function("bound/sf_step", |b| {

@@ -17,8 +17,9 @@ cargo fmt --check
 cargo clippy --all-targets -- -D warnings
 cargo clippy --all-targets --features python -- -D warnings
 
-step "Rust: no_std build of the core"
+step "Rust: no_std build of the core, docs"
 cargo build --no-default-features
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 
 step "Rust: tests"
 cargo test

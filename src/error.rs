@@ -99,10 +99,15 @@ pub(crate) mod check {
         finite_slice(what, &[v])
     }
 
-    /// A finite scalar with `v > 0`, else the named condition.
-    pub fn positive(condition: &'static str, what: &'static str, v: f64) -> Result<(), Error> {
+    /// A finite scalar with `v > 0` (`strict`) or `v >= 0`, else the named condition.
+    fn sign(
+        condition: &'static str,
+        what: &'static str,
+        v: f64,
+        strict: bool,
+    ) -> Result<(), Error> {
         finite(what, v)?;
-        if v > 0.0 {
+        if (strict && v > 0.0) || (!strict && v >= 0.0) {
             Ok(())
         } else {
             Err(Error::Condition {
@@ -114,19 +119,14 @@ pub(crate) mod check {
         }
     }
 
+    /// A finite scalar with `v > 0`, else the named condition.
+    pub fn positive(condition: &'static str, what: &'static str, v: f64) -> Result<(), Error> {
+        sign(condition, what, v, true)
+    }
+
     /// A finite scalar with `v >= 0`.
     pub fn nonnegative(condition: &'static str, what: &'static str, v: f64) -> Result<(), Error> {
-        finite(what, v)?;
-        if v >= 0.0 {
-            Ok(())
-        } else {
-            Err(Error::Condition {
-                condition,
-                lhs: what,
-                index: None,
-                value: v,
-            })
-        }
+        sign(condition, what, v, false)
     }
 
     /// `f(v_i) > 0` for every element, where `f` is the left-hand side of the condition.

@@ -32,17 +32,17 @@ pub const G: usize = 2;
 
 /// Weights of the three networks, all zero at t = 0 (SPEC §6).
 ///
-/// `d[k][j]` is the row ŴD[k][j][·] over the `L` nodes, `c[k][j]` likewise,
-/// `g[k]` is ŴG[k][·]. Units: D̂ weights in kg m², Ĉ in kg m²/s, Ĝ in N m
+/// `d[k][j]` is the row `ŴD[k][j][·]` over the `L` nodes, `c[k][j]` likewise,
+/// `g[k]` is `ŴG[k][·]`. Units: D̂ weights in kg m², Ĉ in kg m²/s, Ĝ in N m
 /// (each times the dimensionless basis).
 #[repr(C)]
 #[derive(Clone, Debug, PartialEq)]
 pub struct Weights<const N: usize, const L: usize> {
-    /// ŴD[k][j] (kg m²).
+    /// `ŴD[k][j]` (kg m²).
     pub d: [[SVector<f64, L>; N]; N],
-    /// ŴC[k][j] (kg m²/s).
+    /// `ŴC[k][j]` (kg m²/s).
     pub c: [[SVector<f64, L>; N]; N],
-    /// ŴG[k] (N m).
+    /// `ŴG[k]` (N m).
     pub g: [SVector<f64, L>; N],
 }
 

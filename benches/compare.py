@@ -489,26 +489,7 @@ def numba_loop_only(case: str) -> Callable[[], Any]:
     The same arguments ``spec_numba.simulate`` hands its jitted closed loop
     ``_simulate``, prepared once; calling the result runs that loop alone.
     """
-    p = spec_numba.make_params(case)
-    cfg, gains, plant = spec_numba._pack(p)
-    phi, gam = spec_numpy.observer_zoh(p["eps"], p["lam1"], p["Ts"])
-    xc0, dxc0, _ = spec_numpy.commanded(0.0)
-    args = (
-        spec_numba._CASE_CODE[case],
-        spec_numba._AUX_CODE[p["aux_law"]],
-        round(p["T"] / p["Ts"]),
-        p["substeps"],
-        p["q0"],
-        p["dq0"],
-        cfg,
-        gains,
-        plant,
-        spec_numpy.rbf_centers(N),
-        phi,
-        gam,
-        xc0,
-        dxc0,
-    )
+    args = spec_numba.simulate_args(case, spec_numba.make_params(case))
     return lambda: spec_numba._simulate(*args)
 
 

@@ -579,32 +579,36 @@ class Controller:
     z2 = property(lambda self: self._row(7), doc="z2 (ẑ2 for 'of') at t_k (rad/s).")
 
 
-def simulate(case: str = "sf", **params) -> dict:
-    """Closed-loop run of SPEC §11 (jitted); same outputs as ``spec_numpy.simulate``."""
-    p = make_params(case, **params)
+def simulate_args(case: str, p: dict) -> tuple:
+    """The arguments of the jitted closed loop ``_simulate`` for ``case`` and the
+    complete parameters ``p`` (from :func:`make_params`)."""
     cfg, gains, plant = _pack(p)
-    n = N_JOINTS
-    Ts = p["Ts"]
-    K = round(p["T"] / Ts)
-    centers = _np_ref.rbf_centers(n)
-    Phi, Gam = _np_ref.observer_zoh(p["eps"], p["lam1"], Ts)
+    Phi, Gam = _np_ref.observer_zoh(p["eps"], p["lam1"], p["Ts"])
     xc0, dxc0, _ = _np_ref.commanded(0.0)
-    rq, rdq, rxc, rte, rout, rw = _simulate(
+    return (
         _CASE_CODE[case],
         _AUX_CODE[p["aux_law"]],
-        K,
+        round(p["T"] / p["Ts"]),
         p["substeps"],
         p["q0"],
         p["dq0"],
         cfg,
         gains,
         plant,
-        centers,
+        _np_ref.rbf_centers(N_JOINTS),
         Phi,
         Gam,
         xc0,
         dxc0,
     )
+
+
+def simulate(case: str = "sf", **params) -> dict:
+    """Closed-loop run of SPEC §11 (jitted); same outputs as ``spec_numpy.simulate``."""
+    p = make_params(case, **params)
+    Ts = p["Ts"]
+    K = round(p["T"] / Ts)
+    rq, rdq, rxc, rte, rout, rw = _simulate(*simulate_args(case, p))
     rec = {"t": np.arange(K) * Ts, "q": rq, "dq": rdq, "xc": rxc}
     for r, name in enumerate(_OUT_ROWS):
         if name in ("tau", "tau_sat", "z1", "dq_hat", "zeta", "xd"):

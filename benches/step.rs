@@ -15,8 +15,8 @@
 
 use adaptimp::network::{Rates, Workspace};
 use adaptimp::{
-    simulate, Controller, Environment, Law, Manipulator, Measurement, Rbf, SimConfig, TwoLinkArm,
-    Vector, Wall,
+    rk4_step, simulate, Controller, Environment, Law, Manipulator, Measurement, Rbf, SimConfig,
+    TwoLinkArm, Vector, Wall,
 };
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::SVector;
@@ -108,21 +108,12 @@ fn plant(c: &mut Criterion) {
     let tau = Vector::<2>::new(10.0, -4.0);
     let h = 50e-6;
     c.bench_function("plant/rk4", |b| {
-        let (mut x, mut v) = (Vector::<2>::new(0.25, -0.05), Vector::<2>::zeros());
+        let mut state = (Vector::<2>::new(0.25, -0.05), Vector::<2>::zeros());
         b.iter(|| {
-            let f = |x: &Vector<2>, v: &Vector<2>| {
-                arm.forward_dynamics(x, v, &tau, &wall.force(0.0, x, v))
-            };
-            let k1 = f(&x, &v);
-            let (x2, v2) = (x + 0.5 * h * v, v + 0.5 * h * k1);
-            let k2 = f(&x2, &v2);
-            let (x3, v3) = (x + 0.5 * h * v2, v + 0.5 * h * k2);
-            let k3 = f(&x3, &v3);
-            let (x4, v4) = (x + h * v3, v + h * k3);
-            let k4 = f(&x4, &v4);
-            x += h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4);
-            v += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            black_box((&x, &v));
+            let (x, v) = state;
+            let a = arm.forward_dynamics(&x, &v, &tau, &wall.force(0.0, &x, &v));
+            state = rk4_step(&arm, &wall, 0.0, h, &tau, state, &a);
+            black_box(&state);
         })
     });
 }

@@ -13,8 +13,8 @@
 //! for real-time figures pin the process to an isolated core.
 
 use adaptimp::{
-    Config, Controller, Environment, Law, Manipulator, Measurement, Sinusoid, TwoLinkArm, Vector,
-    Wall,
+    rk4_step, Config, Controller, Environment, Law, Manipulator, Measurement, Sinusoid, TwoLinkArm,
+    Vector, Wall,
 };
 use std::time::Instant;
 
@@ -61,18 +61,8 @@ fn main() -> Result<(), adaptimp::Error> {
             let elapsed = start.elapsed();
             times.push(u32::try_from(elapsed.as_nanos()).unwrap_or(u32::MAX));
             // RK4, one substep, torque held.
-            let f = |x: &Vector<2>, v: &Vector<2>| {
-                arm.forward_dynamics(x, v, &cmd.tau_sat, &wall.force(0.0, x, v))
-            };
-            let k1 = f(&x, &dx);
-            let (x2, v2) = (x + 0.5 * ts * dx, dx + 0.5 * ts * k1);
-            let k2 = f(&x2, &v2);
-            let (x3, v3) = (x + 0.5 * ts * v2, dx + 0.5 * ts * k2);
-            let k3 = f(&x3, &v3);
-            let (x4, v4) = (x + ts * v3, dx + ts * k3);
-            let k4 = f(&x4, &v4);
-            x += ts / 6.0 * (dx + 2.0 * v2 + 2.0 * v3 + v4);
-            dx += ts / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+            let a = arm.forward_dynamics(&x, &dx, &cmd.tau_sat, &tau_e);
+            (x, dx) = rk4_step(&arm, &wall, 0.0, ts, &cmd.tau_sat, (x, dx), &a);
         }
         times.sort_unstable();
         println!(

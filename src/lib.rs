@@ -95,7 +95,7 @@ pub use rbf::Rbf;
 pub use saturation::Saturation;
 #[cfg(feature = "std")]
 pub use simulator::Trace;
-pub use simulator::{simulate, Recorder, Row, SimConfig};
+pub use simulator::{rk4_step, simulate, Recorder, Row, SimConfig};
 pub use trajectory::{Setpoint, Sinusoid, Trajectory};
 
 /// A column vector of `N` reals (joint-space quantities: rad, rad/s, N m, …).

@@ -108,6 +108,40 @@ impl<const N: usize> Recorder<N> for Trace<N> {
     }
 }
 
+/// One classical RK4 step of the plant from time `t` (s) over `h` (s), with the
+/// applied torque `tau` (N m) held and τe recomputed from the environment at
+/// every stage. `(x, dx)` is the state (rad, rad/s) at `t` and `a` its
+/// acceleration there (rad/s², as `forward_dynamics` gives it with τe at that
+/// state), which the caller often has already. Returns the state at `t + h`.
+#[inline(always)]
+pub fn rk4_step<const N: usize, M, E>(
+    plant: &M,
+    env: &E,
+    t: f64,
+    h: f64,
+    tau: &Vector<N>,
+    (x, dx): (Vector<N>, Vector<N>),
+    a: &Vector<N>,
+) -> (Vector<N>, Vector<N>)
+where
+    M: Manipulator<N> + ?Sized,
+    E: Environment<N> + ?Sized,
+{
+    let accel = |ts: f64, x: &Vector<N>, dx: &Vector<N>| {
+        plant.forward_dynamics(x, dx, tau, &env.force(ts, x, dx))
+    };
+    let (x2, v2) = (x + 0.5 * h * dx, dx + 0.5 * h * a);
+    let k2 = accel(t + 0.5 * h, &x2, &v2);
+    let (x3, v3) = (x + 0.5 * h * v2, dx + 0.5 * h * k2);
+    let k3 = accel(t + 0.5 * h, &x3, &v3);
+    let (x4, v4) = (x + h * v3, dx + h * k3);
+    let k4 = accel(t + h, &x4, &v4);
+    (
+        x + h / 6.0 * (dx + 2.0 * v2 + 2.0 * v3 + v4),
+        dx + h / 6.0 * (a + 2.0 * k2 + 2.0 * k3 + k4),
+    )
+}
+
 /// Simulate the closed loop of `plant`, `env` and `ctrl` (reset first) and
 /// return the SPEC §12 metrics; every row goes to `rec`. Allocation-free
 /// itself. Errors on an invalid `cfg`, or if the plant state becomes non-finite.
@@ -185,21 +219,14 @@ where
         acc.push(&row, &imp.residual(&c, &x, &dx, &a0, &tau_e));
         rec.record(&row);
 
-        let accel = |ts: f64, x: &Vector<N>, dx: &Vector<N>| {
-            plant.forward_dynamics(x, dx, &cmd.tau_sat, &env.force(ts, x, dx))
-        };
         for m in 0..cfg.substeps {
             let t0 = t + m as f64 * h;
-            let k1a = if m == 0 { a0 } else { accel(t0, &x, &dx) };
-            let k1v = dx;
-            let (x2, v2) = (x + 0.5 * h * k1v, dx + 0.5 * h * k1a);
-            let k2a = accel(t0 + 0.5 * h, &x2, &v2);
-            let (x3, v3) = (x + 0.5 * h * v2, dx + 0.5 * h * k2a);
-            let k3a = accel(t0 + 0.5 * h, &x3, &v3);
-            let (x4, v4) = (x + h * v3, dx + h * k3a);
-            let k4a = accel(t0 + h, &x4, &v4);
-            x += h / 6.0 * (k1v + 2.0 * v2 + 2.0 * v3 + v4);
-            dx += h / 6.0 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a);
+            let a = if m == 0 {
+                a0
+            } else {
+                plant.forward_dynamics(&x, &dx, &cmd.tau_sat, &env.force(t0, &x, &dx))
+            };
+            (x, dx) = rk4_step(plant, env, t0, h, &cmd.tau_sat, (x, dx), &a);
         }
         if x.iter().chain(dx.iter()).any(|v| !v.is_finite()) {
             return Err(Error::Diverged {

@@ -13,13 +13,12 @@
 //!   output and writes it once for the update.
 //! - `paper/*`: one whole paper-scenario run (SPEC §11, 400 000 steps).
 
-use adaptimp::network::{Rates, Workspace};
+use adaptimp::network::Rates;
 use adaptimp::{
-    rk4_step, simulate, Controller, Environment, Law, Manipulator, Measurement, Rbf, SimConfig,
-    TwoLinkArm, Vector, Wall,
+    rk4_step, run, Basis, Controller, Environment, Grid, HeapState, Law, Manipulator, Measurement,
+    SimConfig, Sinusoid, Trajectory, TwoLinkArm, Vector, Wall,
 };
 use criterion::{criterion_group, criterion_main, Criterion};
-use nalgebra::SVector;
 use std::hint::black_box;
 
 const L: usize = 256;
@@ -34,9 +33,9 @@ fn z_sample() -> [Vector<2>; 4] {
 }
 
 fn basis(c: &mut Criterion) {
-    let grid = Rbf::<2, L>::grid(25.0).expect("grid");
-    let direct = grid.to_custom();
-    let mut s = SVector::<f64, L>::zeros();
+    let grid = Grid::<2>::paper();
+    let direct = grid.to_centers();
+    let mut s = [0.0; L];
     let z = z_sample();
     c.bench_function("basis/grid_separable", |b| {
         b.iter(|| {
@@ -52,13 +51,13 @@ fn basis(c: &mut Criterion) {
     });
 }
 
-/// The basis and the weights in the controller's layout (`Workspace`: the
-/// pass's speed depends on it), the basis set at a typical input.
-fn net() -> Box<Workspace<2, L>> {
-    let grid = Rbf::<2, L>::grid(25.0).expect("grid");
-    let mut n = Box::new(Workspace::zeros());
-    grid.eval(&z_sample(), &mut n.basis);
-    n
+/// A state of the paper's controller (basis and weights in the controller's
+/// layout: the pass's speed depends on it), the basis set at a typical input.
+fn net() -> HeapState<2> {
+    let mut st = Controller::paper(Law::StateFeedback).new_state();
+    let (s, _) = st.networks_mut();
+    Grid::<2>::paper().eval(&z_sample(), s);
+    st
 }
 
 /// Learning rates (paper, 50 µs) and α̇1, α1, z2 for one pass of the networks.
@@ -77,7 +76,7 @@ fn network(c: &mut Criterion) {
     let mut norms = [0.0; 3];
     c.bench_function("network/fused_step", |b| {
         b.iter(|| {
-            let Workspace { basis, weights, .. } = n.as_mut();
+            let (basis, mut weights) = n.networks_mut();
             black_box(weights.fused_step(black_box(basis), &da, &a, &z2, &rates, &mut norms))
         })
     });
@@ -89,15 +88,21 @@ fn steps(c: &mut Criterion) {
         ("step/sf", Law::StateFeedback),
         ("step/of", Law::OutputFeedback),
     ] {
-        let mut ctrl = Box::new(Controller::paper(law));
+        let ctrl = Controller::paper(law);
+        let mut state = ctrl.new_state();
+        let circle = Sinusoid::paper();
         let m = Measurement {
             x: Vector::<2>::new(0.25, -0.05),
             dx: Some(Vector::<2>::new(0.3, -0.2)),
             tau_e: Vector::<2>::new(5.0, 0.0),
         };
         c.bench_function(name, |b| {
-            b.iter(|| black_box(ctrl.step(black_box(&m))));
-            ctrl.reset();
+            b.iter(|| {
+                // The trajectory sampled at the state's clock, as in a loop.
+                let sp = circle.sample(ctrl.time(&state));
+                black_box(ctrl.step(&mut state, black_box(&m), &sp))
+            });
+            state.reset();
         });
     }
 }
@@ -127,14 +132,14 @@ fn plant(c: &mut Criterion) {
 /// errors, control law, saturation, auxiliary system), and step ÷ bound is
 /// the cost of everything that is not the networks.
 fn bound(c: &mut Criterion) {
-    let grid = Rbf::<2, L>::grid(25.0).expect("grid");
+    let grid = Grid::<2>::paper();
     let mut n = net();
     let (rates, da, a, z2) = pass_inputs();
     let z = z_sample();
     let mut norms = [0.0; 3];
     c.bench_function("bound/sf_step", |b| {
         b.iter(|| {
-            let Workspace { basis, weights, .. } = n.as_mut();
+            let (basis, mut weights) = n.networks_mut();
             grid.eval(black_box(&z), basis);
             black_box(weights.fused_step(basis, &da, &a, &z2, &rates, &mut norms))
         })
@@ -152,10 +157,19 @@ fn paper(c: &mut Criterion) {
         ("sf", Law::StateFeedback),
         ("of", Law::OutputFeedback),
     ] {
-        let mut ctrl = Box::new(Controller::paper(law));
+        let ctrl = Controller::paper(law);
         g.bench_function(name, |b| {
             b.iter(|| {
-                black_box(simulate(&arm, &wall, ctrl.as_mut(), &sim, &mut ()).expect("simulate"))
+                let mut state = ctrl.new_state();
+                let m = run(
+                    &arm,
+                    &wall,
+                    &mut ctrl.bind(&mut state),
+                    &Sinusoid::paper(),
+                    &sim,
+                    &mut (),
+                );
+                black_box(m.expect("simulate"))
             })
         });
     }

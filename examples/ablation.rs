@@ -9,8 +9,8 @@
 
 use adaptimp::observer::Hold;
 use adaptimp::{
-    simulate, AuxLaw, Config, Controller, Law, LearningStep, ObserverInit, Recorder, Robust, Row,
-    SaturationLearning, SimConfig, Sinusoid, TwoLinkArm, Vector, Wall,
+    run, AuxLaw, Config, Controller, Grid, Law, LearningStep, ObserverInit, Recorder, RobustKind,
+    Row, SaturationLearning, SimConfig, Sinusoid, TwoLinkArm, Wall, WeightBound,
 };
 
 /// Max weight norms over the run.
@@ -24,7 +24,7 @@ impl Recorder<2> for MaxNorms {
     }
 }
 
-type Variant = (&'static str, fn(&mut Config<2, 256>));
+type Variant = (&'static str, fn(&mut Config<2>));
 
 const VARIANTS: [Variant; 9] = [
     ("printed (paper)", |c| {
@@ -37,11 +37,11 @@ const VARIANTS: [Variant; 9] = [
     ("− conditional integration", |c| {
         c.saturation_learning = SaturationLearning::Ignore
     }),
-    ("− weight projection", |c| c.weight_bound = None),
+    ("− weight projection", |c| {
+        c.weight_bound = WeightBound::None
+    }),
     ("− tanh (sgn robust term)", |c| {
-        c.robust = Robust::Sign {
-            kr: Vector::from_element(0.5),
-        }
+        c.robust = RobustKind::Sign
     }),
     ("− triangle hold (ZOH)", |c| c.observer_hold = Hold::Zero),
     ("− observer start at x(0) (π(0) = 0)", |c| {
@@ -53,7 +53,7 @@ const VARIANTS: [Variant; 9] = [
 trait WithTs {
     fn with_ts(self, ts: f64) -> Self;
 }
-impl WithTs for Config<2, 256> {
+impl WithTs for Config<2> {
     fn with_ts(mut self, ts: f64) -> Self {
         self.ts = ts;
         self
@@ -68,12 +68,12 @@ fn main() -> Result<(), adaptimp::Error> {
     for (scenario, base, sim) in [
         (
             "paper 50 µs",
-            Config::paper as fn(Law) -> Config<2, 256>,
+            Config::paper as fn(Law) -> Config<2>,
             SimConfig::paper(),
         ),
         (
             "robot 1 ms",
-            Config::robot as fn(Law) -> Config<2, 256>,
+            Config::robot as fn(Law) -> Config<2>,
             SimConfig::robot(),
         ),
     ] {
@@ -85,9 +85,18 @@ fn main() -> Result<(), adaptimp::Error> {
                 }
                 let mut cfg = base(law).hardened().with_ts(base(law).ts);
                 apply(&mut cfg);
-                let mut ctrl = Box::new(Controller::new(cfg, Sinusoid::paper())?);
+                let circle = Sinusoid::paper();
+                let ctrl = Controller::for_trajectory(cfg, Grid::paper(), &circle)?;
+                let mut state = ctrl.new_state();
                 let mut norms = MaxNorms([0.0; 3]);
-                let m = simulate(&arm, &wall, ctrl.as_mut(), &sim, &mut norms)?;
+                let m = run(
+                    &arm,
+                    &wall,
+                    &mut ctrl.bind(&mut state),
+                    &circle,
+                    &sim,
+                    &mut norms,
+                )?;
                 println!(
                     "| {scenario} | {name} | {variant} | {:.5} | {:.3} | {:.1}, {:.1} | {:.2} | {:.2}, {:.2}, {:.2} |",
                     m.rms_z1_after2,

@@ -5,7 +5,7 @@
 //! cargo run --release --example paper
 //! ```
 
-use adaptimp::{simulate, Controller, Law, Metrics, SimConfig, TwoLinkArm, Wall};
+use adaptimp::{run, Controller, Law, Metrics, SimConfig, Sinusoid, TwoLinkArm, Wall};
 use std::time::Instant;
 
 fn main() -> Result<(), adaptimp::Error> {
@@ -23,10 +23,18 @@ fn main() -> Result<(), adaptimp::Error> {
     );
     let mut results: Vec<(&str, Metrics<2>, f64)> = Vec::new();
     for (name, law) in cases {
-        // Boxed: the controller holds 20 KiB of weights.
-        let mut ctrl = Box::new(Controller::paper(law));
+        // The description, and its state (20 KiB of weights, on the heap).
+        let ctrl = Controller::paper(law);
+        let mut state = ctrl.new_state();
         let start = Instant::now();
-        let m = simulate(&arm, &wall, ctrl.as_mut(), &sim, &mut ())?;
+        let m = run(
+            &arm,
+            &wall,
+            &mut ctrl.bind(&mut state),
+            &Sinusoid::paper(),
+            &sim,
+            &mut (),
+        )?;
         results.push((name, m, start.elapsed().as_secs_f64()));
     }
     print_table(&results);

@@ -1,8 +1,8 @@
 //! Worst-case step time: a 1 kHz loop cares about the slowest step, not the
 //! mean. Runs each controller for 10⁶ steps in closed loop with the paper's arm
 //! and wall (so the inputs are realistic), times every `step` call, and prints
-//! the median, the 99.9th percentile and the maximum, with `size_of` each
-//! controller.
+//! the median, the 99.9th percentile and the maximum, with the size of each
+//! controller's description and state (the state's buffer on the heap).
 //!
 //! ```text
 //! cargo run --release --example worst_case [steps]
@@ -13,8 +13,8 @@
 //! for real-time figures pin the process to an isolated core.
 
 use adaptimp::{
-    rk4_step, Config, Controller, Environment, Law, Manipulator, Measurement, Sinusoid, TwoLinkArm,
-    Vector, Wall,
+    rk4_step, Controller, Environment, Law, Manipulator, Measurement, Sinusoid, Trajectory,
+    TwoLinkArm, Vector, Wall,
 };
 use std::time::Instant;
 
@@ -34,19 +34,28 @@ fn main() -> Result<(), adaptimp::Error> {
         "{steps} steps per controller, closed loop with the paper's arm and wall (RK4, 1 substep)"
     );
     println!(
-        "| controller | Ts | size_of (bytes) | median (ns) | 99.9th percentile (ns) | max (ns) |"
+        "| controller | Ts | description + state (bytes) | median (ns) | 99.9th percentile (ns) | max (ns) |"
     );
     println!("|---|---|---:|---:|---:|---:|");
-    let cases: [(&str, Config<2, 256>); 5] = [
-        ("pd (paper)", Config::paper(Law::Pd)),
-        ("sf (paper)", Config::paper(Law::StateFeedback)),
-        ("of (paper)", Config::paper(Law::OutputFeedback)),
-        ("sf (robot, hardened)", Config::robot(Law::StateFeedback)),
-        ("of (robot, hardened)", Config::robot(Law::OutputFeedback)),
+    let cases: [(&str, Controller<2>); 5] = [
+        ("pd (paper)", Controller::paper(Law::Pd)),
+        ("sf (paper)", Controller::paper(Law::StateFeedback)),
+        ("of (paper)", Controller::paper(Law::OutputFeedback)),
+        (
+            "sf (robot, hardened)",
+            Controller::robot(Law::StateFeedback),
+        ),
+        (
+            "of (robot, hardened)",
+            Controller::robot(Law::OutputFeedback),
+        ),
     ];
-    for (name, cfg) in cases {
-        let ts = cfg.ts;
-        let mut ctrl = Box::new(Controller::new(cfg, Sinusoid::paper())?);
+    let circle = Sinusoid::paper();
+    for (name, ctrl) in cases {
+        let ts = ctrl.period();
+        let mut state = ctrl.new_state();
+        let bytes =
+            std::mem::size_of_val(&ctrl) + std::mem::size_of_val(&state) + 8 * ctrl.buffer_len();
         let (mut x, mut dx) = (Vector::<2>::new(0.25, -0.05), Vector::<2>::zeros());
         let mut times = Vec::with_capacity(steps);
         for _ in 0..steps {
@@ -56,8 +65,9 @@ fn main() -> Result<(), adaptimp::Error> {
                 dx: Some(dx),
                 tau_e,
             };
+            let sp = circle.sample(ctrl.time(&state));
             let start = Instant::now();
-            let cmd = ctrl.step(&m)?;
+            let cmd = ctrl.step(&mut state, &m, &sp)?;
             let elapsed = start.elapsed();
             times.push(u32::try_from(elapsed.as_nanos()).unwrap_or(u32::MAX));
             // RK4, one substep, torque held.
@@ -68,7 +78,7 @@ fn main() -> Result<(), adaptimp::Error> {
         println!(
             "| {name} | {} ms | {} | {} | {} | {} |",
             ts * 1e3,
-            std::mem::size_of::<Controller<2, 256>>(),
+            bytes,
             percentile(&times, 0.5),
             percentile(&times, 0.999),
             times[times.len() - 1]

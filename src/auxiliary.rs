@@ -11,7 +11,7 @@
 //! the actuator saturates and decays when it does not.
 
 use crate::error::{check, Error};
-use crate::Vector;
+use crate::types::{choices, Vector};
 
 /// The law inside the ball ‖ζ‖ < μ, SPEC §8.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
@@ -28,6 +28,12 @@ pub enum AuxLaw {
     /// "Integrator windup and how to avoid it", ACC 1989).
     Linear,
 }
+
+choices!(AuxLaw {
+    "default" => AuxLaw::Leaky,
+    "printed" => AuxLaw::Printed,
+    "linear" => AuxLaw::Linear,
+});
 
 /// Parameters of the auxiliary system: Kζ (1/s, diagonal), μ (N m) and the inner law.
 #[derive(Copy, Clone, Debug, PartialEq)]

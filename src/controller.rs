@@ -6,389 +6,85 @@
 //! - [`Law::OutputFeedback`], Case 3, (35): the same with ẑ2, S(Ẑ) and α̇1
 //!   computed from the high-gain observer's velocity estimate (SPEC §9).
 //!
-//! [`Config`] holds every parameter (public fields, the paper's defaults from
-//! [`Config::paper`]); [`Controller::new`] validates it once (SPEC §10) and
-//! precomputes what the step needs. [`Controller::step`] then takes a
-//! [`Measurement`] and returns a [`Command`], with no heap allocation, no
-//! panic on any finite input, and an error (state untouched) on a non-finite one.
+//! A [`Controller`] is the validated, immutable description (`Send + Sync`:
+//! share it by reference across threads); a [`State`] holds everything a run
+//! changes. [`Controller::step`] takes both, ruckig's shape: description by
+//! `&`, state by `&mut`, measurement and setpoint in, command out. The step
+//! runs as named stages, each a small method below: reference, errors,
+//! velocity source, basis, networks, robust term, saturation, learning,
+//! advance.
 
-use crate::auxiliary::{AuxLaw, Auxiliary};
+use crate::auxiliary::Auxiliary;
+use crate::config::{Config, Law, ObserverInit, WeightBound};
 use crate::error::{check, Error};
 use crate::impedance::{Reference, TargetImpedance};
-use crate::math::{sgn, tanh};
-use crate::network::{self, Rates, Weights, Workspace};
-use crate::observer::{HighGainObserver, Hold, ObserverState};
-use crate::rbf::Rbf;
+use crate::io::{Command, Control, Measurement};
+use crate::learning::{Learning, Signals};
+use crate::observer::HighGainObserver;
+use crate::rbf::{Basis, Grid};
+use crate::robust::Robust;
 use crate::saturation::Saturation;
+use crate::state::State;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
-use crate::Vector;
-use nalgebra::SVector;
+use crate::types::Vector;
 
-/// Which of the paper's controllers, SPEC §7.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum Law {
-    /// Case 1: PD with the auxiliary system, no learning ("pd" in Python).
-    Pd,
-    /// Case 2: adaptive neural state feedback (14) ("sf").
-    StateFeedback,
-    /// Case 3: adaptive neural output feedback with a high-gain observer (35) ("of").
-    OutputFeedback,
-}
-
-impl Law {
-    /// True for the two adaptive (learning) laws.
-    pub fn learns(self) -> bool {
-        !matches!(self, Law::Pd)
-    }
-}
-
-/// The robust term r(z2) (N m), SPEC §7. Each is a choice, not a different controller.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub enum Robust<const N: usize> {
-    /// No robust term.
-    None,
-    /// `Kr sgn(z2)`, the paper's term; `kr` in N m (SPEC default 0.5).
-    Sign {
-        /// Gain kr per joint (N m).
-        kr: Vector<N>,
-    },
-    /// Smooth boundary layer `Kr tanh(z2/φ)`; `kr` in N m, `phi` in rad/s.
-    Tanh {
-        /// Gain kr per joint (N m).
-        kr: Vector<N>,
-        /// Boundary-layer width φ (rad/s), > 0.
-        phi: f64,
-    },
-    /// Remark 1, (30): `kr_i sgn(z2_i)` with `kr_i = kD |α̇1_i| + kC |α1_i| + kG`.
-    Remark1 {
-        /// kD (N m per rad/s², i.e. kg m²).
-        kd: f64,
-        /// kC (N m per rad/s).
-        kc: f64,
-        /// kG (N m).
-        kg: f64,
-    },
-}
-
-impl<const N: usize> Robust<N> {
-    fn validate(&self) -> Result<(), Error> {
-        match self {
-            Robust::None => Ok(()),
-            Robust::Sign { kr } => check::nonnegative_vec("kr ≥ 0", "kr", kr),
-            Robust::Tanh { kr, phi } => {
-                check::nonnegative_vec("kr ≥ 0", "kr", kr)?;
-                check::positive("φ > 0", "phi", *phi)
-            }
-            Robust::Remark1 { kd, kc, kg } => {
-                check::nonnegative("kD ≥ 0", "kD", *kd)?;
-                check::nonnegative("kC ≥ 0", "kC", *kc)?;
-                check::nonnegative("kG ≥ 0", "kG", *kg)
-            }
-        }
-    }
-
-    #[inline]
-    fn eval(&self, z2: &Vector<N>, alpha1: &Vector<N>, dalpha1: &Vector<N>) -> Vector<N> {
-        match self {
-            Robust::None => Vector::zeros(),
-            Robust::Sign { kr } => Vector::from_fn(|i, _| kr[i] * sgn(z2[i])),
-            Robust::Tanh { kr, phi } => Vector::from_fn(|i, _| kr[i] * tanh(z2[i] / phi)),
-            Robust::Remark1 { kd, kc, kg } => Vector::from_fn(|i, _| {
-                (kd * dalpha1[i].abs() + kc * alpha1[i].abs() + kg) * sgn(z2[i])
-            }),
-        }
-    }
-}
-
-/// How the weights take one learning step (beyond the paper, SPEC §13).
-#[derive(Copy, Clone, Debug, Default, PartialEq)]
-pub enum LearningStep {
-    /// Explicit Euler of (15)–(17), SPEC §11 ("euler" in Python).
-    #[default]
-    Euler,
-    /// Normalised step ("normalized"): the Euler step divided by `1 + g/(κ min Kp)`,
-    /// where `g = Ts ‖S‖² (ΓD ‖α̇1‖² + ΓC ‖α1‖² + ΓG)` (N m per rad/s) is the
-    /// gain one Euler step adds from z2 to the network output. Explicit-Euler
-    /// learning against the plant is stable only for g < Kp (a two-state Jury
-    /// test of z2 and the learned term), so the normalised step keeps the
-    /// per-step gain below κ Kp at any Ts, and is the printed law when g ≪ κ Kp.
-    /// The discrete normalised gradient (projection) algorithm: Goodwin & Sin,
-    /// *Adaptive Filtering, Prediction and Control*, 1984, ch. 3; Ioannou & Sun,
-    /// *Robust Adaptive Control*, 1996, ch. 4.
-    Normalized {
-        /// κ in (0, 1]: the per-step learning gain's bound as a fraction of Kp.
-        kappa: f64,
-    },
-}
-
-/// What learning does while the actuator saturates (beyond the paper, SPEC §13).
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub enum SaturationLearning {
-    /// Learn as if nothing saturated, as printed ("ignore" in Python): the
-    /// weights integrate an error the actuator cannot remove, and wind up.
-    #[default]
-    Ignore,
-    /// Conditional integration ("freeze"): while joint k saturates, its rows do
-    /// not take the learning step that would push τ_k further beyond the limit
-    /// (they still leak by σ, and learn in the unwinding direction). Åström &
-    /// Hägglund, *Advanced PID Control*, 2006 (integrator windup); for adaptive laws, the
-    /// "stop adaptation under saturation" of Kárason & Annaswamy, IEEE TAC 39(11), 1994.
-    Freeze,
-}
-
-/// How the observer state starts (SPEC §9).
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub enum ObserverInit {
-    /// π(0) = 0, as in the paper (the estimate peaks at start-up).
-    #[default]
-    Zero,
-    /// π1(0) = the first measured position, π2(0) = 0 (no start-up peak).
-    FirstMeasurement,
-}
-
-/// Every parameter of a controller. Start from [`Config::paper`] (or
-/// [`Config::new`] for other sizes) and change fields; [`Controller::new`]
-/// validates. Gains are diagonal and given by their diagonals.
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub struct Config<const N: usize, const L: usize> {
-    /// Which controller.
-    pub law: Law,
-    /// Sampling period Ts (s).
-    pub ts: f64,
-    /// K1 (1/s), (7): α1 = ẋd + K1 z1. Paper: 6.
-    pub k1: Vector<N>,
-    /// Kp (N m s/rad), (14). Paper: 10.
-    pub kp: Vector<N>,
-    /// Kζ (1/s), (11). SPEC §8: 60 (must exceed (1 + Kp²)/2).
-    pub kzeta: Vector<N>,
-    /// μ (N m), radius of the auxiliary system's inner ball. SPEC §8: 0.01.
-    pub mu: f64,
-    /// Inner law of the auxiliary system. SPEC §8: [`AuxLaw::Leaky`].
-    pub aux_law: AuxLaw,
-    /// Robust term. SPEC §7: `Sign` with kr = 0.5 N m.
-    pub robust: Robust<N>,
-    /// The learning step. Paper: explicit Euler.
-    pub learning_step: LearningStep,
-    /// Learning under saturation. Paper: ignore it.
-    pub saturation_learning: SaturationLearning,
-    /// Projection of each network's weights onto the ball ‖Ŵ‖_F ≤ bound
-    /// (D̂, Ĉ, Ĝ). Paper: none. (Ioannou & Sun 1996, ch. 4 and 8, applied after
-    /// each step: the Euler step followed by the projection onto the ball.)
-    pub weight_bound: Option<[f64; 3]>,
-    /// Learning gains Γ for D̂, Ĉ, Ĝ. Paper: 100.
-    pub gamma: [f64; 3],
-    /// Leakages σ for D̂, Ĉ, Ĝ. Paper: 0.01.
-    pub sigma: [f64; 3],
-    /// The RBF basis (centres and η²). Paper: the 2^{4N} vertex grid, η² = 25.
-    pub rbf: Rbf<N, L>,
-    /// Observer ε (s). SPEC §9: 1e-4.
-    pub eps: f64,
-    /// Observer λ1 per joint. Paper: 3.
-    pub lam1: Vector<N>,
-    /// Observer start. Paper: π(0) = 0.
-    pub observer_init: ObserverInit,
-    /// Observer inter-sample model. SPEC §11: zero-order hold.
-    pub observer_hold: Hold,
-    /// Actuator limits τmax (N m). Paper: [17, 15].
-    pub tau_max: Vector<N>,
-    /// Desired inertia Dd (kg m²). Paper: 1.
-    pub dd: Vector<N>,
-    /// Desired damping Cd (N m s/rad). Paper: 10.
-    pub cd: Vector<N>,
-    /// Desired stiffness Gd (N m/rad). Paper: 60.
-    pub gd: Vector<N>,
-}
-
-impl<const N: usize, const L: usize> Config<N, L> {
-    /// The paper's gains for `N` joints with limits `tau_max` (N m) and basis `rbf`;
-    /// Ts = 50 µs (the paper scenario, SPEC §11).
-    pub fn new(law: Law, tau_max: Vector<N>, rbf: Rbf<N, L>) -> Self {
-        let imp = TargetImpedance::<N>::paper();
-        Self {
-            law,
-            ts: 50e-6,
-            k1: Vector::from_element(6.0),
-            kp: Vector::from_element(10.0),
-            kzeta: Vector::from_element(60.0),
-            mu: 0.01,
-            aux_law: AuxLaw::Leaky,
-            robust: Robust::Sign {
-                kr: Vector::from_element(0.5),
-            },
-            learning_step: LearningStep::Euler,
-            saturation_learning: SaturationLearning::Ignore,
-            weight_bound: None,
-            gamma: [100.0; 3],
-            sigma: [0.01; 3],
-            rbf,
-            eps: 1e-4,
-            lam1: Vector::from_element(3.0),
-            observer_init: ObserverInit::Zero,
-            observer_hold: Hold::Zero,
-            tau_max,
-            dd: *imp.dd(),
-            cd: *imp.cd(),
-            gd: *imp.gd(),
-        }
-    }
-}
-
-impl Config<2, 256> {
-    /// The paper scenario (SPEC §11) for the 2-link arm: every default of the SPEC.
-    pub fn paper(law: Law) -> Self {
-        let rbf = Rbf::grid(25.0).unwrap_or_else(|_| unreachable!("256 = 2^(4·2) and η² = 25 > 0"));
-        Self::new(law, Vector::<2>::new(17.0, 15.0), rbf)
-    }
-}
-
-impl Config<2, 256> {
-    /// The "robot" scenario (SPEC §13, beyond the paper): the paper's arm,
-    /// gains, Γ, σ, η² and 256 nodes at a robot's Ts = 1 ms, with the
-    /// [hardened](Self::hardened) options as defaults.
-    pub fn robot(law: Law) -> Self {
-        let mut cfg = Self::paper(law).hardened();
-        cfg.ts = 1e-3;
-        cfg
-    }
-
-    /// This configuration with every hardened option of the robot scenario
-    /// (SPEC §13), whatever Ts is:
-    ///
-    /// - [`LearningStep::Normalized`] with κ = 0.5 (the per-step learning gain
-    ///   stays below Kp/2; the printed Euler step exceeds Kp at 1 ms);
-    /// - [`SaturationLearning::Freeze`] (no learning into the limits);
-    /// - `weight_bound` from [`network::weight_bounds`] for this τmax and the
-    ///   paper circle (peak ‖ẋc‖ = 0.2π rad/s, ‖ẍc‖ = 0.2π² rad/s²);
-    ///   ≈ [0.72, 2.26, 1.42] for τmax = [17, 15] N m;
-    /// - [`Robust::Tanh`] with the current kr (or 0.5 N m) and φ = 0.05 rad/s
-    ///   (sgn chatters at 1 kHz);
-    /// - observer: [`Hold::Triangle`] (at Ts ≫ ε it is the backward difference
-    ///   of the samples, where ZOH estimates ≈ 0 at the sample instants),
-    ///   started at the first measurement.
-    pub fn hardened(mut self) -> Self {
-        let pi = core::f64::consts::PI;
-        self.learning_step = LearningStep::Normalized { kappa: 0.5 };
-        self.saturation_learning = SaturationLearning::Freeze;
-        self.weight_bound = Some(network::weight_bounds(
-            &self.tau_max,
-            256,
-            0.2 * pi,
-            0.2 * pi * pi,
-        ));
-        let kr = match self.robust {
-            Robust::Sign { kr } | Robust::Tanh { kr, .. } => kr,
-            Robust::None | Robust::Remark1 { .. } => Vector::from_element(0.5),
-        };
-        self.robust = Robust::Tanh { kr, phi: 0.05 };
-        self.observer_hold = Hold::Triangle;
-        self.observer_init = ObserverInit::FirstMeasurement;
-        self
-    }
-}
-
-/// One sample from the sensors at t_k.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct Measurement<const N: usize> {
-    /// Joint position x (rad).
-    pub x: Vector<N>,
-    /// Joint velocity ẋ (rad/s): required by PD and state feedback, ignored by
-    /// output feedback (which estimates it).
-    pub dx: Option<Vector<N>>,
-    /// Force the robot exerts on the environment τe (N m), from a force sensor.
-    pub tau_e: Vector<N>,
-}
-
-/// What one step computed. `tau_sat` goes to the actuators; the rest is for logging.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct Command<const N: usize> {
-    /// Applied torque sat(τ) (N m).
-    pub tau_sat: Vector<N>,
-    /// Commanded torque τ before saturation (N m).
-    pub tau: Vector<N>,
-    /// Δτ = sat(τ) − τ (N m).
-    pub dtau: Vector<N>,
-    /// Tracking error z1 = xd − x (rad), (6).
-    pub z1: Vector<N>,
-    /// z2 = α1 − v (rad/s), (8); ẑ2 for output feedback.
-    pub z2: Vector<N>,
-    /// Commanded position xc(t_k) (rad).
-    pub xc: Vector<N>,
-    /// Compliant reference xd(t_k) (rad).
-    pub xd: Vector<N>,
-    /// Velocity the controller used (rad/s): measured, or the observer's estimate.
-    pub v: Vector<N>,
-    /// Auxiliary state ζ(t_k) (N m) used in this step.
-    pub zeta: Vector<N>,
-    /// Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ before this step's update (zero for PD).
-    pub w_norms: [f64; 3],
-}
-
-impl<const N: usize> Command<N> {
-    /// All zeros (the "last command" before the first step).
-    pub fn zeros() -> Self {
-        let z = Vector::zeros();
-        Self {
-            tau_sat: z,
-            tau: z,
-            dtau: z,
-            z1: z,
-            z2: z,
-            xc: z,
-            xd: z,
-            v: z,
-            zeta: z,
-            w_norms: [0.0; 3],
-        }
-    }
-}
-
-/// Validated parameters and what is precomputed from them.
+/// A validated controller of the paper: its configuration, its basis and
+/// what is precomputed from them. Immutable; see the [module docs](self).
 #[derive(Clone, Debug)]
-struct Parts<const N: usize> {
+pub struct Controller<const N: usize, B = Grid<N>> {
+    cfg: Config<N>,
+    basis: B,
     sat: Saturation<N>,
     imp: TargetImpedance<N>,
     aux: Auxiliary<N>,
     obs: HighGainObserver<N>,
-    rates: Rates,
+    robust: Robust<N>,
+    learning: Learning,
 }
 
-/// A controller of the paper with its state, generic over the number of
-/// joints `N`, the number of RBF nodes `L` and the commanded trajectory `T`.
-///
-/// Size: the weights are `(2N² + N) L` reals (20 KiB for the paper's N = 2,
-/// L = 256), kept in place. Construct once, then call [`step`](Self::step)
-/// every Ts; the controller keeps its clock t_k = k·Ts.
-#[derive(Clone, Debug)]
-pub struct Controller<const N: usize, const L: usize, T = Sinusoid<N>> {
-    cfg: Config<N, L>,
-    parts: Parts<N>,
-    traj: T,
-    // State.
-    k: u64,
-    reference: Reference<N>,
-    zeta: Vector<N>,
-    observer: ObserverState<N>,
-    /// The basis and the weights.
-    net: Workspace<N, L>,
-    /// ‖Ŵ‖_F of the current weights (kept up to date by every update).
-    norms: [f64; 3],
-    last: Command<N>,
+/// The errors of one step at t_k, SPEC §5, from the reference and the velocity used.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Errors<const N: usize> {
+    /// Reference acceleration ẍd (rad/s²), SPEC §4.
+    pub ddxd: Vector<N>,
+    /// z1 = xd − x (rad), (6).
+    pub z1: Vector<N>,
+    /// α1 = ẋd + K1 z1 (rad/s), (7).
+    pub alpha1: Vector<N>,
+    /// z2 = α1 − v (rad/s), (8).
+    pub z2: Vector<N>,
+    /// α̇1 = ẍd + K1 (ẋd − v) (rad/s²).
+    pub dalpha1: Vector<N>,
 }
 
-impl Controller<2, 256, Sinusoid<2>> {
-    /// The paper's controller `law` with every SPEC default, tracking the
-    /// paper's circle (64).
+impl Controller<2, Grid<2>> {
+    /// The paper's controller `law` with every SPEC default (the 256-node grid,
+    /// η² = 25).
     pub fn paper(law: Law) -> Self {
-        Self::new(Config::paper(law), Sinusoid::paper())
+        Self::new(Config::paper(law), Grid::paper())
             .unwrap_or_else(|e| unreachable!("the paper configuration is valid: {e}"))
+    }
+
+    /// The robot scenario's controller `law` (SPEC §13: Ts = 1 ms, the hardened
+    /// options), with its weight bounds for the paper's circle.
+    pub fn robot(law: Law) -> Self {
+        Self::for_trajectory(Config::robot(law), Grid::paper(), &Sinusoid::paper())
+            .unwrap_or_else(|e| unreachable!("the robot configuration is valid: {e}"))
     }
 }
 
-impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
+impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// Validate `cfg` against every condition of SPEC §10 and build the
-    /// controller, tracking `traj`. The error names the condition and the value.
-    pub fn new(cfg: Config<N, L>, traj: T) -> Result<Self, Error> {
+    /// controller with basis `basis`. The error names the condition and the
+    /// value. A [`WeightBound::Auto`] needs the trajectory: use
+    /// [`for_trajectory`](Self::for_trajectory).
+    pub fn new(cfg: Config<N>, basis: B) -> Result<Self, Error> {
+        if N == 0 || basis.nodes() == 0 {
+            return Err(Error::Invalid {
+                what: "controller",
+                reason: "needs at least one joint and one RBF node",
+            });
+        }
         check::positive("Ts > 0", "Ts", cfg.ts)?;
         check::positive_vec("K1 > 0", "K1", &cfg.k1)?;
         check::finite_slice("Kp", cfg.kp.as_slice())?;
@@ -407,278 +103,331 @@ impl<const N: usize, const L: usize, T: Trajectory<N>> Controller<N, L, T> {
             |i, kz| 2.0 * kz - 1.0 - cfg.kp[i] * cfg.kp[i],
             true,
         )?;
-        check::positive("η² > 0", "eta2", cfg.rbf.eta2())?;
-        cfg.robust.validate()?;
-        if let LearningStep::Normalized { kappa } = cfg.learning_step {
-            check::positive("κ > 0", "kappa", kappa)?;
-            if kappa > 1.0 {
-                return Err(Error::Condition {
-                    condition: "κ ≤ 1",
-                    lhs: "kappa",
-                    index: None,
-                    value: kappa,
-                });
+        let robust = Robust::from_config(cfg.robust, cfg.kr, cfg.phi, [cfg.kd, cfg.kc, cfg.kg]);
+        robust.validate()?;
+        let bound = match cfg.weight_bound {
+            WeightBound::None => None,
+            WeightBound::Fixed(b) => Some(b),
+            WeightBound::Auto => {
+                return Err(Error::Invalid {
+                    what: "weight_bound = auto",
+                    reason: "derives from the commanded trajectory: build with Controller::for_trajectory, or give fixed bounds",
+                })
             }
-        }
-        if let Some(bound) = cfg.weight_bound {
-            check::positive_vec(
-                "weight bound > 0",
-                "weight_bound",
-                &Vector::<3>::from(bound),
-            )?;
-        }
-        let parts = Parts {
+        };
+        Ok(Self {
             sat: Saturation::new(cfg.tau_max)?,
             imp: TargetImpedance::new(cfg.dd, cfg.cd, cfg.gd)?,
             aux: Auxiliary::new(cfg.kzeta, cfg.mu, cfg.aux_law)?,
             obs: HighGainObserver::new(cfg.eps, cfg.lam1, cfg.ts, cfg.observer_hold)?,
-            rates: Rates::new(cfg.ts, cfg.gamma, cfg.sigma)?,
-        };
-        let start = traj.sample(0.0);
-        check::finite_slice("xc(0)", start.x.as_slice())?;
-        check::finite_slice("dxc(0)", start.dx.as_slice())?;
-        Ok(Self {
+            learning: Learning::new(
+                cfg.ts,
+                cfg.gamma,
+                cfg.sigma,
+                cfg.learning_step,
+                cfg.kappa,
+                cfg.saturation_learning,
+                bound,
+                cfg.kp.min(),
+            )?,
+            robust,
             cfg,
-            parts,
-            traj,
-            k: 0,
-            reference: Reference::start(&start),
-            zeta: Vector::zeros(),
-            observer: ObserverState::zeros(),
-            net: Workspace::zeros(),
-            norms: [0.0; 3],
-            last: Command::zeros(),
+            basis,
         })
     }
 
-    /// Back to t = 0: weights, ζ, observer and reference as at construction.
-    pub fn reset(&mut self) {
-        self.k = 0;
-        self.reference = Reference::start(&self.traj.sample(0.0));
-        self.zeta = Vector::zeros();
-        self.observer = ObserverState::zeros();
-        self.net = Workspace::zeros();
-        self.norms = [0.0; 3];
-        self.last = Command::zeros();
-    }
-
-    /// One controller step at t_k = k·Ts with the trajectory sampled at t_k
-    /// (SPEC §11, steps 1–5). Returns the command; `tau_sat` goes to the
-    /// actuators. On an error nothing changes, except for
-    /// [`Error::Diverged`] (then call [`reset`](Self::reset)).
-    #[inline]
-    pub fn step(&mut self, m: &Measurement<N>) -> Result<Command<N>, Error> {
-        let c = self.traj.sample(self.time());
-        self.step_with(m, &c)
-    }
-
-    /// One step with an externally supplied commanded setpoint `c` (xc, ẋc, ẍc at
-    /// t_k) instead of the controller's own trajectory; the clock still advances.
-    pub fn step_with(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
-        let law = self.cfg.law;
-        check::finite_slice("x", m.x.as_slice())?;
-        check::finite_slice("tau_e", m.tau_e.as_slice())?;
-        check::finite_slice("xc", c.x.as_slice())?;
-        check::finite_slice("dxc", c.dx.as_slice())?;
-        check::finite_slice("ddxc", c.ddx.as_slice())?;
-        let p = &self.parts;
-        let ts = self.cfg.ts;
-
-        // 2. Velocity: measured, or the observer's estimate at t_k.
-        let v = match law {
-            Law::OutputFeedback => {
-                let first = self.k == 0;
-                if first && self.cfg.observer_init == ObserverInit::FirstMeasurement {
-                    self.observer.pi1 = m.x;
-                    self.observer.pi2 = Vector::zeros();
-                }
-                p.obs.measure(&mut self.observer, &m.x, first);
-                p.obs.estimate(&self.observer)
+    /// As [`new`](Self::new), with a [`WeightBound::Auto`] resolved for the
+    /// trajectory `traj` the controller will track (its
+    /// [`peak_rates`](Trajectory::peak_rates)).
+    pub fn for_trajectory<T: Trajectory<N> + ?Sized>(
+        cfg: Config<N>,
+        basis: B,
+        traj: &T,
+    ) -> Result<Self, Error> {
+        let cfg = match (cfg.weight_bound, traj.peak_rates()) {
+            (WeightBound::Auto, Some(rates)) => cfg.resolve(basis.nodes(), rates),
+            (WeightBound::Auto, None) => {
+                return Err(Error::Invalid {
+                    what: "weight_bound = auto",
+                    reason: "the trajectory does not know its peak speed and acceleration: give fixed bounds",
+                })
             }
-            Law::Pd | Law::StateFeedback => {
-                let dx = m.dx.ok_or(Error::MissingVelocity)?;
-                check::finite_slice("dx", dx.as_slice())?;
-                dx
-            }
+            _ => cfg,
         };
+        Self::new(cfg, basis)
+    }
 
-        // 1. Reference acceleration from the target impedance, SPEC §4.
-        let r = &self.reference;
-        let ddxd = p.imp.accel(c, r, &m.tau_e);
+    /// The validated configuration.
+    pub fn config(&self) -> &Config<N> {
+        &self.cfg
+    }
+    /// The RBF basis.
+    pub fn basis(&self) -> &B {
+        &self.basis
+    }
+    /// The actuator model the controller saturates with.
+    pub fn saturation(&self) -> &Saturation<N> {
+        &self.sat
+    }
+    /// The target impedance.
+    pub fn impedance(&self) -> &TargetImpedance<N> {
+        &self.imp
+    }
+    /// The high-gain observer (output feedback).
+    pub fn observer(&self) -> &HighGainObserver<N> {
+        &self.obs
+    }
+    /// The robust term.
+    pub fn robust(&self) -> &Robust<N> {
+        &self.robust
+    }
+    /// The learning policy.
+    pub fn learning(&self) -> &Learning {
+        &self.learning
+    }
+    /// Sampling period Ts (s).
+    pub fn period(&self) -> f64 {
+        self.cfg.ts
+    }
 
-        // 3. Errors (6)–(8), SPEC §5.
-        let k1 = &self.cfg.k1;
-        let z1 = r.xd - m.x;
-        let alpha1 = r.dxd + k1.component_mul(&z1);
-        let z2 = alpha1 - v;
-        let dalpha1 = ddxd + k1.component_mul(&(r.dxd - v));
+    /// The length (in f64) of the buffer a state of this controller needs.
+    pub fn buffer_len(&self) -> usize {
+        crate::network::Layout::buffer_len(N, self.basis.nodes()).unwrap_or(usize::MAX)
+    }
 
-        // 4. Control law, SPEC §7.
-        let mut tau = self.cfg.kp.component_mul(&(z2 + self.zeta))
-            + self.cfg.robust.eval(&z2, &alpha1, &dalpha1);
-        let mut w_norms = [0.0; 3];
-        // The learning step's scale (1 for the printed law), SPEC §13.
-        let mut scale = 1.0;
-        let deferred = self.cfg.saturation_learning == SaturationLearning::Freeze
-            || self.cfg.weight_bound.is_some();
-        if law.learns() {
-            self.cfg
-                .rbf
-                .eval(&[m.x, v, alpha1, dalpha1], &mut self.net.basis);
-            if let LearningStep::Normalized { kappa } = self.cfg.learning_step {
-                let g = p.rates.gain;
-                let gain = self.net.basis.norm_squared()
-                    * (g[network::D] * dalpha1.norm_squared()
-                        + g[network::C] * alpha1.norm_squared()
-                        + g[network::G]);
-                scale = 1.0 / (1.0 + gain / (kappa * self.cfg.kp.min()));
-            }
-            // ‖Ŵ‖ before this step's update.
-            w_norms = self.norms;
-            let nn = if deferred {
-                self.net.weights.output(&self.net.basis, &dalpha1, &alpha1)
-            } else {
-                // Output and update (15)–(17) / (37)–(39) in one pass; the update
-                // uses only this step's values (SPEC §11, step 5).
-                let Workspace { basis, weights, .. } = &mut self.net;
-                weights.fused_step(
-                    basis,
-                    &dalpha1,
-                    &alpha1,
-                    &z2,
-                    &p.rates.scaled(scale),
-                    &mut self.norms,
-                )
-            };
-            // (14), (35) with +z1 (erratum, SPEC §7).
-            tau += z1 + nn + m.tau_e;
+    /// A state at t = 0 in the caller's buffer `buf` (at least
+    /// [`buffer_len`](Self::buffer_len) reals, zeroed here): for firmware
+    /// without an allocator, or to place the state yourself.
+    pub fn state_in<S: AsRef<[f64]> + AsMut<[f64]>>(&self, buf: S) -> Result<State<N, S>, Error> {
+        State::new_in(self.basis.nodes(), buf)
+    }
+
+    /// A state at t = 0 on the heap (its buffer allocated zeroed, never built
+    /// on the stack).
+    #[cfg(feature = "alloc")]
+    pub fn new_state(&self) -> crate::state::HeapState<N> {
+        // The buffer is allocated zeroed; `new_in` only fails if it is short.
+        State::new_in(self.basis.nodes(), alloc::vec![0.0; self.buffer_len()])
+            .unwrap_or_else(|e| unreachable!("the buffer has buffer_len(): {e}"))
+    }
+
+    /// Time t_k = k·Ts (s) of `state`'s next step.
+    pub fn time<S>(&self, state: &State<N, S>) -> f64 {
+        state.k as f64 * self.cfg.ts
+    }
+
+    /// The observer's current velocity estimate π2/ε (rad/s) in `state`.
+    pub fn velocity_estimate<S>(&self, state: &State<N, S>) -> Vector<N> {
+        self.obs.estimate(&state.observer)
+    }
+
+    /// This controller driving `state`, as a [`Control`] for a closed loop.
+    pub fn bind<'a, S>(&'a self, state: &'a mut State<N, S>) -> Bound<'a, N, B, S> {
+        Bound { ctrl: self, state }
+    }
+
+    /// One controller step at t_k (SPEC §11, steps 1–5): the measurement `m`
+    /// and the commanded setpoint `c` (xc, ẋc, ẍc at t_k; the reference starts
+    /// at the first step's) in, the command out; `tau_sat` goes to the
+    /// actuators. No allocation. On an error nothing changes, except for
+    /// [`Error::Diverged`] (then [`State::reset`]).
+    pub fn step<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> Result<Command<N>, Error> {
+        self.check(st, m, c)?;
+        let v = self.velocity(st, m)?;
+        if st.k == 0 {
+            st.reference = Reference::start(c);
         }
+        let e = self.errors(&st.reference, c, m, &v);
+        let mut tau = self.feedback(&e, &st.zeta);
+        let sig = Signals {
+            dalpha1: e.dalpha1,
+            alpha1: e.alpha1,
+            z2: e.z2,
+        };
+        let w_norms = if self.cfg.law.learns() {
+            let before = st.norms;
+            tau += e.z1 + self.networks(st, &m.x, &v, &sig) + m.tau_e;
+            before
+        } else {
+            [0.0; 3]
+        };
         if tau.iter().any(|t| !t.is_finite()) {
             return Err(Error::Diverged { what: "tau" });
         }
-        let tau_sat = p.sat.apply(&tau);
+        let tau_sat = self.sat.apply(&tau);
         let dtau = tau_sat - tau;
-        if law.learns() && deferred {
-            // The update needs this step's saturation: after the output.
-            let mut z2_learn = z2;
-            if self.cfg.saturation_learning == SaturationLearning::Freeze {
-                for k in 0..N {
-                    // Learning moves out_k along z2_k; Δτ_k points back inside.
-                    if z2[k] * dtau[k] < 0.0 {
-                        z2_learn[k] = 0.0;
-                    }
-                }
-            }
-            let Workspace { basis, weights, .. } = &mut self.net;
-            let mut norms =
-                weights.update(basis, &dalpha1, &alpha1, &z2_learn, &p.rates.scaled(scale));
-            if let Some(bound) = self.cfg.weight_bound {
-                for net in 0..3 {
-                    if norms[net] > bound[net] {
-                        // Projection onto the ball ‖Ŵ‖_F ≤ bound.
-                        weights.scale_network(net, bound[net] / norms[net]);
-                        norms[net] = bound[net];
-                    }
-                }
-            }
-            self.norms = norms;
+        if self.cfg.law.learns() {
+            self.learn(st, &sig, &dtau);
         }
-
         let cmd = Command {
             tau_sat,
             tau,
             dtau,
-            z1,
-            z2,
+            z1: e.z1,
+            z2: e.z2,
             xc: c.x,
-            xd: r.xd,
+            xd: st.reference.xd,
             v,
-            zeta: self.zeta,
+            zeta: st.zeta,
             w_norms,
         };
-
-        // 5. Advance every internal state to t_{k+1}.
-        p.aux.advance(&mut self.zeta, &z2, &dtau, ts);
-        self.reference.advance(&ddxd, ts);
-        if law == Law::OutputFeedback {
-            p.obs.finish(&mut self.observer, &m.x);
-        }
-        self.k += 1;
-        self.last = cmd;
+        self.advance(st, m, &e, &dtau);
+        st.last = cmd;
         Ok(cmd)
     }
 
-    /// The validated configuration.
-    pub fn config(&self) -> &Config<N, L> {
-        &self.cfg
+    /// Inputs finite and the state made for this basis.
+    fn check<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> Result<(), Error> {
+        if st.nodes() != self.basis.nodes() {
+            return Err(Error::Invalid {
+                what: "state",
+                reason: "was made for a basis with another number of nodes",
+            });
+        }
+        check::finite_slice("x", m.x.as_slice())?;
+        check::finite_slice("tau_e", m.tau_e.as_slice())?;
+        check::finite_slice("xc", c.x.as_slice())?;
+        check::finite_slice("dxc", c.dx.as_slice())?;
+        check::finite_slice("ddxc", c.ddx.as_slice())
     }
-    /// The commanded trajectory.
-    pub fn trajectory(&self) -> &T {
-        &self.traj
+
+    /// Stage "velocity source", SPEC §11 step 2: the measured ẋ (PD, state
+    /// feedback) or the observer's estimate at t_k (output feedback).
+    fn velocity<S>(&self, st: &mut State<N, S>, m: &Measurement<N>) -> Result<Vector<N>, Error> {
+        match self.cfg.law {
+            Law::OutputFeedback => {
+                let first = st.k == 0;
+                if first && self.cfg.observer_init == ObserverInit::FirstMeasurement {
+                    st.observer.pi1 = m.x;
+                    st.observer.pi2 = Vector::zeros();
+                }
+                self.obs.measure(&mut st.observer, &m.x, first);
+                Ok(self.obs.estimate(&st.observer))
+            }
+            Law::Pd | Law::StateFeedback => {
+                let dx = m.dx.ok_or(Error::MissingVelocity)?;
+                check::finite_slice("dx", dx.as_slice())?;
+                Ok(dx)
+            }
+        }
     }
-    /// Number of steps taken since construction or reset.
-    pub fn steps(&self) -> u64 {
-        self.k
+
+    /// Stages "reference" and "errors", SPEC §4, §5: ẍd from the target
+    /// impedance, then z1, α1, z2, α̇1 with the velocity `v` (rad/s).
+    pub fn errors(
+        &self,
+        r: &Reference<N>,
+        c: &Setpoint<N>,
+        m: &Measurement<N>,
+        v: &Vector<N>,
+    ) -> Errors<N> {
+        let ddxd = self.imp.accel(c, r, &m.tau_e);
+        let k1 = &self.cfg.k1;
+        let z1 = r.xd - m.x;
+        let alpha1 = r.dxd + k1.component_mul(&z1);
+        Errors {
+            ddxd,
+            z1,
+            alpha1,
+            z2: alpha1 - v,
+            dalpha1: ddxd + k1.component_mul(&(r.dxd - v)),
+        }
     }
-    /// Time t_k = k·Ts (s) of the next step.
-    pub fn time(&self) -> f64 {
-        self.k as f64 * self.cfg.ts
+
+    /// Stage "robust term" with the feedback it adds to: `Kp (z2 + ζ) + r(z2)`
+    /// (N m), SPEC §7.
+    pub fn feedback(&self, e: &Errors<N>, zeta: &Vector<N>) -> Vector<N> {
+        self.cfg.kp.component_mul(&(e.z2 + zeta)) + self.robust.eval(&e.z2, &e.alpha1, &e.dalpha1)
     }
-    /// Auxiliary state ζ (N m), (11).
-    pub fn zeta(&self) -> &Vector<N> {
-        &self.zeta
+
+    /// Stages "basis" and "networks": S(Z) at Z = [x; v; α1; α̇1] into the
+    /// state, then the networks' output (and, for the printed law, their
+    /// update in the same pass; see [`Learning::output`]).
+    fn networks<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        x: &Vector<N>,
+        v: &Vector<N>,
+        sig: &Signals<N>,
+    ) -> Vector<N> {
+        let mut norms = st.norms;
+        let (s, mut w) = st.parts();
+        self.basis.eval(&[*x, *v, sig.alpha1, sig.dalpha1], s);
+        let out = self.learning.output(&mut w, s, sig, &mut norms);
+        st.norms = norms;
+        out
     }
-    /// The compliant reference (xd, ẋd) for the next step.
-    pub fn reference(&self) -> &Reference<N> {
-        &self.reference
+
+    /// Stage "learning", after saturation: the deferred update of the
+    /// hardened policies ([`Learning::learn`]).
+    fn learn<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        sig: &Signals<N>,
+        dtau: &Vector<N>,
+    ) {
+        let mut norms = st.norms;
+        let (s, mut w) = st.parts();
+        self.learning.learn(&mut w, s, sig, dtau, &mut norms);
+        st.norms = norms;
     }
-    /// Observer state π (output feedback only; zeros otherwise).
-    pub fn observer_state(&self) -> &ObserverState<N> {
-        &self.observer
+
+    /// Stage "advance", SPEC §11 step 5: ζ, the reference, the observer and
+    /// the clock to t_{k+1}, from this step's values only.
+    fn advance<S>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        e: &Errors<N>,
+        dtau: &Vector<N>,
+    ) {
+        let ts = self.cfg.ts;
+        self.aux.advance(&mut st.zeta, &e.z2, dtau, ts);
+        st.reference.advance(&e.ddxd, ts);
+        if self.cfg.law == Law::OutputFeedback {
+            self.obs.finish(&mut st.observer, &m.x);
+        }
+        st.k += 1;
     }
-    /// The observer's current velocity estimate π2/ε (rad/s).
-    pub fn velocity_estimate(&self) -> Vector<N> {
-        self.parts.obs.estimate(&self.observer)
+}
+
+/// A [`Controller`] bound to a [`State`]: the [`Control`] a closed loop drives
+/// ([`Controller::bind`]).
+#[derive(Debug)]
+pub struct Bound<'a, const N: usize, B, S> {
+    ctrl: &'a Controller<N, B>,
+    state: &'a mut State<N, S>,
+}
+
+impl<const N: usize, B: Basis<N>, S: AsRef<[f64]> + AsMut<[f64]>> Control<N>
+    for Bound<'_, N, B, S>
+{
+    fn period(&self) -> f64 {
+        self.ctrl.period()
     }
-    /// The network weights.
-    pub fn weights(&self) -> &Weights<N, L> {
-        &self.net.weights
+    fn target(&self) -> &TargetImpedance<N> {
+        self.ctrl.impedance()
     }
-    /// Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ of the current weights, as the
-    /// controller tracks them step by step (see [`Weights::fused_step`]);
-    /// [`Weights::norms`] recomputes them from the weights.
-    pub fn weight_norms(&self) -> [f64; 3] {
-        self.norms
-    }
-    /// Replace the weights (e.g. to warm-start from a previous run). Every
-    /// weight must be finite.
-    pub fn set_weights(&mut self, w: Weights<N, L>) -> Result<(), Error> {
-        w.check_finite()?;
-        self.norms = w.norms();
-        self.net.weights = w;
-        Ok(())
-    }
-    /// The basis S(Z) of the last step (zeros before the first, and for PD).
-    pub fn basis(&self) -> &SVector<f64, L> {
-        &self.net.basis
-    }
-    /// The last step's command (all zeros before the first step).
-    pub fn last(&self) -> &Command<N> {
-        &self.last
-    }
-    /// The actuator model the controller saturates with.
-    pub fn saturation(&self) -> &Saturation<N> {
-        &self.parts.sat
-    }
-    /// The target impedance.
-    pub fn impedance(&self) -> &TargetImpedance<N> {
-        &self.parts.imp
+    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.ctrl.step(self.state, m, c)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::learning::{LearningStep, SaturationLearning};
+    use crate::state::HeapState;
 
     fn measurement() -> Measurement<2> {
         Measurement {
@@ -688,40 +437,51 @@ mod tests {
         }
     }
 
-    /// α1 and α̇1 of the step `c` is about to take with `m` (SPEC §5).
-    fn alphas(c: &Controller<2, 256>, m: &Measurement<2>) -> (Vector<2>, Vector<2>, Vector<2>) {
-        let sp = c.trajectory().sample(c.time());
-        let r = c.reference();
-        let ddxd = c.impedance().accel(&sp, r, &m.tau_e);
-        let v = m.dx.unwrap_or_else(Vector::zeros);
-        let k1 = &c.config().k1;
-        let alpha1 = r.dxd + k1.component_mul(&(r.xd - m.x));
-        let dalpha1 = ddxd + k1.component_mul(&(r.dxd - v));
-        (alpha1, dalpha1, alpha1 - v)
+    /// The circle's setpoint at the state's next step.
+    fn setpoint(c: &Controller<2>, st: &HeapState<2>) -> Setpoint<2> {
+        Sinusoid::paper().sample(c.time(st))
     }
 
     /// Change of the network output per unit z2 made by one learning step,
     /// at that step's basis: the per-step learning gain (N m per rad/s).
-    fn per_step_gain(cfg: Config<2, 256>) -> Vector<2> {
-        let mut c = Controller::new(cfg, Sinusoid::paper()).unwrap();
+    fn per_step_gain(cfg: Config<2>) -> Vector<2> {
+        let c = Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper()).unwrap();
+        let mut st = c.new_state();
         let m = measurement();
-        let (alpha1, dalpha1, z2) = alphas(&c, &m);
-        let before = c.weights().clone();
-        c.step(&m).unwrap();
-        let s = c.basis();
-        let delta = c.weights().output(s, &dalpha1, &alpha1) - before.output(s, &dalpha1, &alpha1);
-        delta.component_div(&z2)
+        let before: Vec<f64> = (0..10).flat_map(|i| row(&st, i)).collect();
+        let sp = setpoint(&c, &st);
+        let cmd = c.step(&mut st, &m, &sp).unwrap();
+        let s = st.basis().to_vec();
+        let e = c.errors(
+            &Reference::start(&Sinusoid::paper().sample(0.0)),
+            &Sinusoid::paper().sample(0.0),
+            &m,
+            &m.dx.unwrap(),
+        );
+        let old = crate::network::Weights::<2>::from_rows(&before, 256).unwrap();
+        let delta =
+            st.weights().output(&s, &e.dalpha1, &e.alpha1) - old.output(&s, &e.dalpha1, &e.alpha1);
+        delta.component_div(&cmd.z2)
+    }
+
+    fn row(st: &HeapState<2>, i: usize) -> Vec<f64> {
+        let w = st.weights();
+        match i {
+            0..=3 => w.d(i / 2, i % 2).to_vec(),
+            4..=7 => w.c((i - 4) / 2, i % 2).to_vec(),
+            _ => w.g(i - 8).to_vec(),
+        }
     }
 
     #[test]
     fn printed_euler_gain_exceeds_kp_at_1ms_normalized_stays_below_kappa_kp() {
         let mut printed = Config::paper(Law::StateFeedback);
         printed.ts = 1e-3;
-        let g = per_step_gain(printed.clone());
+        let g = per_step_gain(printed);
         // The Jury condition for explicit-Euler learning is g < Kp = 10.
         assert!(g.min() > 10.0, "printed per-step gain {g}");
         let mut normalized = printed;
-        normalized.learning_step = LearningStep::Normalized { kappa: 0.5 };
+        normalized.learning_step = LearningStep::Normalized;
         let g = per_step_gain(normalized);
         assert!(
             g.max() <= 5.0 + 1e-9 && g.min() > 0.0,
@@ -734,9 +494,9 @@ mod tests {
         // At Ts = 1 µs the per-step gain is tiny and the scale is ≈ 1.
         let mut printed = Config::paper(Law::StateFeedback);
         printed.ts = 1e-6;
-        let g_printed = per_step_gain(printed.clone());
+        let g_printed = per_step_gain(printed);
         let mut normalized = printed;
-        normalized.learning_step = LearningStep::Normalized { kappa: 0.5 };
+        normalized.learning_step = LearningStep::Normalized;
         let g = per_step_gain(normalized);
         assert!(
             ((g - g_printed).norm() / g_printed.norm()) < 0.01,
@@ -749,13 +509,15 @@ mod tests {
         let mut cfg = Config::paper(Law::StateFeedback);
         cfg.saturation_learning = SaturationLearning::Freeze;
         cfg.tau_max = Vector::<2>::new(0.1, 100.0); // joint 1 saturates
-        let mut c = Controller::new(cfg, Sinusoid::paper()).unwrap();
-        let mut w = Weights::<2, 256>::zeros();
-        w.g[0].fill(0.01);
-        w.g[1].fill(0.01);
-        c.set_weights(w).unwrap();
+        let c = Controller::new(cfg, Grid::paper()).unwrap();
+        let mut st = c.new_state();
+        let mut w = vec![0.0; 10 * 256];
+        w[8 * 256..].fill(0.01); // ŴG
+        st.load_weights(&crate::network::Weights::from_rows(&w, 256).unwrap())
+            .unwrap();
         let m = measurement();
-        let cmd = c.step(&m).unwrap();
+        let sp = setpoint(&c, &st);
+        let cmd = c.step(&mut st, &m, &sp).unwrap();
         // Joint 1 saturates with learning pushing out: z2 and Δτ of opposite signs.
         assert!(
             cmd.dtau[0] != 0.0 && cmd.z2[0] * cmd.dtau[0] < 0.0,
@@ -764,58 +526,88 @@ mod tests {
         assert_eq!(cmd.dtau[1], 0.0);
         let decay = 1.0 - c.config().ts * 100.0 * 0.01;
         // Joint 1's rows only leak; joint 2's rows learn.
-        assert!(c.weights().g[0]
-            .iter()
-            .all(|&v| (v - 0.01 * decay).abs() < 1e-18));
-        assert!(c.weights().d[0][1].iter().all(|&v| v == 0.0));
-        assert!(c.weights().g[1]
-            .iter()
-            .any(|&v| (v - 0.01 * decay).abs() > 1e-12));
+        let w = st.weights();
+        assert!(w.g(0).iter().all(|&v| (v - 0.01 * decay).abs() < 1e-18));
+        assert!(w.d(0, 1).iter().all(|&v| v == 0.0));
+        assert!(w.g(1).iter().any(|&v| (v - 0.01 * decay).abs() > 1e-12));
     }
 
     #[test]
     fn projection_keeps_each_network_in_its_ball() {
         let mut cfg = Config::paper(Law::StateFeedback);
         cfg.ts = 1e-3;
-        cfg.weight_bound = Some([1e-3, 2e-3, 3e-3]);
-        let mut c = Controller::new(cfg, Sinusoid::paper()).unwrap();
+        let bound = [1e-3, 2e-3, 3e-3];
+        cfg.weight_bound = WeightBound::Fixed(bound);
+        let c = Controller::new(cfg, Grid::paper()).unwrap();
+        let mut st = c.new_state();
         let m = measurement();
         let mut hit = [false; 3];
         for _ in 0..200 {
-            c.step(&m).unwrap();
-            let n = c.weights().norms();
+            let sp = setpoint(&c, &st);
+            c.step(&mut st, &m, &sp).unwrap();
+            let n = st.weights().norms();
             for net in 0..3 {
-                let bound = [1e-3, 2e-3, 3e-3][net];
-                assert!(n[net] <= bound * (1.0 + 1e-12), "{n:?}");
-                hit[net] |= n[net] > 0.999 * bound;
+                assert!(n[net] <= bound[net] * (1.0 + 1e-12), "{n:?}");
+                hit[net] |= n[net] > 0.999 * bound[net];
             }
             // The cached norms reported next step are the weights' norms.
+            let cached = st.weight_norms();
             assert!(
-                (c.norms[0] - n[0]).abs() <= 1e-12 * n[0],
-                "{:?} vs {n:?}",
-                c.norms
+                (cached[0] - n[0]).abs() <= 1e-12 * n[0],
+                "{cached:?} vs {n:?}"
             );
         }
         assert_eq!(hit, [true; 3], "every bound was reached");
     }
 
     #[test]
-    fn hardening_options_are_validated() {
-        let mut cfg = Config::paper(Law::StateFeedback);
-        cfg.learning_step = LearningStep::Normalized { kappa: 1.5 };
-        let e = Controller::new(cfg, Sinusoid::paper()).unwrap_err();
-        assert!(e.to_string().contains("κ ≤ 1"), "{e}");
-        let mut cfg = Config::paper(Law::StateFeedback);
-        cfg.weight_bound = Some([1.0, 0.0, 1.0]);
-        let e = Controller::new(cfg, Sinusoid::paper()).unwrap_err();
-        assert!(e.to_string().contains("weight bound > 0"), "{e}");
-    }
-
-    #[test]
-    fn robot_bounds_match_the_documented_values() {
-        let b = Config::robot(Law::StateFeedback).weight_bound.unwrap();
+    fn auto_bounds_need_the_trajectory_and_match_the_documented_values() {
+        let e = Controller::new(Config::robot(Law::StateFeedback), Grid::paper()).unwrap_err();
+        assert!(e.to_string().contains("Controller::for_trajectory"), "{e}");
+        let c = Controller::robot(Law::StateFeedback);
+        let b = c.learning().bound().unwrap();
         for (v, e) in b.iter().zip([0.718, 2.255, 1.417]) {
             assert!((v - e).abs() < 1e-3, "{b:?}");
         }
+    }
+
+    #[test]
+    fn one_description_drives_many_states_and_is_shareable() {
+        fn shareable<T: Send + Sync>(_: &T) {}
+        let c = Controller::paper(Law::StateFeedback);
+        shareable(&c);
+        let (mut a, mut b) = (c.new_state(), c.new_state());
+        let m = measurement();
+        for _ in 0..10 {
+            let sp = setpoint(&c, &a);
+            let ca = c.step(&mut a, &m, &sp).unwrap();
+            let cb = c.step(&mut b, &m, &sp).unwrap();
+            assert_eq!(ca, cb);
+        }
+        // A state of another basis is refused, and left as it was.
+        let small = Controller::new(
+            Config::new(Law::StateFeedback, Vector::<2>::new(1.0, 1.0)),
+            crate::rbf::Centers::uniform(vec![0.0; 8], 1.0).unwrap(),
+        )
+        .unwrap();
+        let sp = setpoint(&c, &a);
+        let e = small.step(&mut a, &m, &sp).unwrap_err();
+        assert!(e.to_string().contains("another number of nodes"), "{e}");
+        assert_eq!(a.steps(), 10);
+    }
+
+    #[test]
+    fn a_state_in_a_caller_buffer_steps_like_a_heap_state() {
+        let c = Controller::paper(Law::OutputFeedback);
+        let mut buf = vec![0.0; c.buffer_len()];
+        let mut st = c.state_in(&mut buf[..]).unwrap();
+        let mut heap = c.new_state();
+        let m = measurement();
+        for k in 0..5 {
+            let sp = Sinusoid::paper().sample(k as f64 * c.period());
+            assert_eq!(c.step(&mut st, &m, &sp), c.step(&mut heap, &m, &sp));
+        }
+        let e = c.state_in(&mut buf[..10]).unwrap_err();
+        assert!(e.to_string().contains("buffer_len"), "{e}");
     }
 }

@@ -5,7 +5,7 @@
 //! measures it and the controller reads it.
 
 use crate::error::{check, Error};
-use crate::Vector;
+use crate::types::Vector;
 
 /// A contact model: τe as a function of time and the robot's state.
 pub trait Environment<const N: usize> {
@@ -71,18 +71,6 @@ impl<const N: usize> Wall<N> {
     /// Damping be (N m s/rad).
     pub fn be(&self) -> f64 {
         self.be
-    }
-}
-
-impl Wall<2> {
-    /// SPEC §3 defaults: joint 1 (index 0), w = 0.2 rad, ke = 1000 N m/rad, be = 10 N m s/rad.
-    pub fn paper() -> Self {
-        Self {
-            joint: 0,
-            position: 0.2,
-            ke: 1000.0,
-            be: 10.0,
-        }
     }
 }
 

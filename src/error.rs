@@ -84,7 +84,7 @@ impl core::error::Error for Error {}
 /// Validation helpers shared by every constructor.
 pub(crate) mod check {
     use super::Error;
-    use crate::Vector;
+    use crate::types::Vector;
 
     /// Every entry finite.
     pub fn finite_slice(what: &'static str, v: &[f64]) -> Result<(), Error> {

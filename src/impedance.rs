@@ -7,7 +7,7 @@
 
 use crate::error::{check, Error};
 use crate::trajectory::Setpoint;
-use crate::Vector;
+use crate::types::Vector;
 
 /// Target impedance: diagonal desired inertia Dd (kg m²), damping Cd
 /// (N m s/rad) and stiffness Gd (N m/rad), (3), (66).
@@ -90,6 +90,14 @@ pub struct Reference<const N: usize> {
 }
 
 impl<const N: usize> Reference<N> {
+    /// All zeros (before the first step).
+    pub fn zeros() -> Self {
+        Self {
+            xd: Vector::zeros(),
+            dxd: Vector::zeros(),
+        }
+    }
+
     /// Start on the commanded trajectory: xd(0) = xc(0), ẋd(0) = ẋc(0), SPEC §4.
     pub fn start(c: &Setpoint<N>) -> Self {
         Self { xd: c.x, dxd: c.dx }

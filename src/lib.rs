@@ -11,44 +11,61 @@
 //!
 //! ## Architecture
 //!
-//! One module per concept. Parameters (validated once, immutable) are kept
-//! apart from state (weights, ζ, observer, reference), and the hot call is
-//! [`Controller::step`]: measurement in, command out, no heap allocation.
+//! One module per concept. A [`Controller`] is the validated, immutable
+//! description (pinocchio's Model, idsp's configuration; `Send + Sync`); a
+//! [`State`] is everything a run changes (pinocchio's Data), owned by the
+//! caller. The hot call takes both, in ruckig's shape:
+//! `ctrl.step(&mut state, &measurement, &setpoint) -> Result<Command>`, with no
+//! heap allocation. One description drives any number of states.
 //!
 //! | module | concept | paper / SPEC |
 //! |---|---|---|
+//! | [`types`] | `Vector`, `Matrix` aliases (a leaf) | |
 //! | [`model`] | manipulator dynamics D, C, G | (4), (55)–(63), §1 |
 //! | [`saturation`] | actuator limits | §2 |
 //! | [`environment`] | contact force τe | §3 |
 //! | [`trajectory`] | commanded trajectory xc | (64), §4 |
 //! | [`impedance`] | target-impedance reference xd | (3), §4 |
-//! | [`rbf`] | Gaussian RBF basis S(Z) | (1), §6 |
-//! | [`network`] | weights ŴD, ŴC, ŴG and update laws | (15)–(17), §6 |
+//! | [`rbf`] | Gaussian RBF bases S(Z): the grid and user centres | (1), §6 |
+//! | [`network`] | weights ŴD, ŴC, ŴG: storage, output, update | (15)–(17), §6 |
+//! | [`learning`] | learning policies (Euler, normalised, freeze, projection) | §11, §13 |
+//! | [`robust`] | robust term r(z2) | §7 |
 //! | [`auxiliary`] | saturation compensator ζ | (11), (36), §8 |
 //! | [`observer`] | high-gain velocity observer | (31)–(34), §9 |
-//! | [`controller`] | PD, state and output feedback | (14), (35), §7, §11 |
-//! | [`simulator`] | closed loop, RK4 plant | §11 |
+//! | [`config`] | every parameter, presets | §4–§11, §13 |
+//! | [`schema`] | the parameter table: names, units, docs, conditions, defaults | §10 |
+//! | [`io`] | measurement, command, the `Control` trait | §11 |
+//! | [`state`] | the caller-owned state | §11 |
+//! | [`controller`] | PD, state and output feedback: the staged step | (14), (35), §7, §11 |
+//! | [`tracker`] | a controller with its trajectory and state | §11 |
+//! | [`plant`] | the `Plant` trait, the rigid-body RK4 plant | §11 |
+//! | [`record`] | recorded rows, the `Recorder` trait | §11 |
 //! | [`metrics`] | tracking / saturation / impedance figures | §12 |
+//! | [`simulator`] | the closed loop | §11 |
 //! | [`error`] | validation errors | §10 |
 //!
 //! ## Quick start
 //!
 //! ```
-//! use adaptimp::{simulate, Controller, Law, Measurement, SimConfig, TwoLinkArm, Vector, Wall};
+//! use adaptimp::{run, Controller, Law, Measurement, SimConfig, Sinusoid, Trajectory, TwoLinkArm, Vector, Wall};
 //!
-//! // The paper's state-feedback controller with every SPEC default (Ts = 50 µs),
-//! // tracking the paper's circle; it keeps its own clock t_k = k·Ts.
-//! let mut ctrl = Box::new(Controller::paper(Law::StateFeedback));
-//! let cmd = ctrl.step(&Measurement {
+//! // The paper's state-feedback controller with every SPEC default (Ts = 50 µs).
+//! let ctrl = Controller::paper(Law::StateFeedback);
+//! let mut state = ctrl.new_state(); // on the heap; one description, many states
+//! let circle = Sinusoid::paper();    // the commanded trajectory (64)
+//! let setpoint = circle.sample(ctrl.time(&state)); // xc, ẋc, ẍc at t_k
+//! let measurement = Measurement {
 //!     x: Vector::<2>::new(0.25, -0.05),   // joint positions (rad)
 //!     dx: Some(Vector::<2>::zeros()),     // joint velocities (rad/s)
 //!     tau_e: Vector::<2>::new(50.0, 0.0), // force on the environment (N m)
-//! })?;
+//! };
+//! let cmd = ctrl.step(&mut state, &measurement, &setpoint)?;
 //! assert_eq!(cmd.tau_sat[0], 17.0); // saturated: the commanded τ is larger
 //!
-//! // Or close the loop with the paper's arm and wall for 0.5 s.
+//! // Or close the loop with the paper's arm and wall for 0.5 s, from a fresh state.
+//! let mut state = ctrl.new_state();
 //! let sim = SimConfig { t_final: 0.5, ..SimConfig::paper() };
-//! let m = simulate(&TwoLinkArm::paper(), &Wall::paper(), ctrl.as_mut(), &sim, &mut ())?;
+//! let m = run(&TwoLinkArm::paper(), &Wall::paper(), &mut ctrl.bind(&mut state), &circle, &sim, &mut ())?;
 //! assert_eq!(m.rows, 10_000);
 //! # Ok::<(), adaptimp::Error>(())
 //! ```
@@ -56,55 +73,70 @@
 //! ## `no_std`
 //!
 //! With `default-features = false` the crate is `no_std` and needs no
-//! allocator; every state lives in fixed-size fields whose sizes are const
-//! generics: `N` joints and `L` RBF nodes.
+//! allocator: a state lives in a buffer of the caller's
+//! ([`Controller::state_in`]). The feature `alloc` adds heap states
+//! ([`Controller::new_state`]), [`Tracker`] and [`Trace`]; `std` (the
+//! default) adds the platform's libm and `std::error::Error`.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+#[cfg(feature = "alloc")]
+extern crate alloc;
+
 pub mod auxiliary;
+pub mod config;
 pub mod controller;
 pub mod environment;
 pub mod error;
 pub mod impedance;
+pub mod io;
+pub mod learning;
 mod math;
 pub mod metrics;
 pub mod model;
 pub mod network;
 pub mod observer;
+pub mod plant;
 #[cfg(feature = "python")]
 mod python;
 pub mod rbf;
+pub mod record;
+pub mod robust;
 pub mod saturation;
+pub mod schema;
 pub mod simulator;
+pub mod state;
+#[cfg(feature = "alloc")]
+pub mod tracker;
 pub mod trajectory;
+pub mod types;
 
 pub use auxiliary::AuxLaw;
-pub use controller::{
-    Command, Config, Controller, Law, LearningStep, Measurement, ObserverInit, Robust,
-    SaturationLearning,
-};
+pub use config::{Config, Law, ObserverInit, WeightBound};
+pub use controller::{Bound, Controller, Errors};
 pub use environment::{Environment, FreeSpace, Wall};
 pub use error::Error;
 pub use impedance::{Reference, TargetImpedance};
+pub use io::{Command, Control, Measurement};
+pub use learning::{Learning, LearningStep, SaturationLearning};
 pub use metrics::{Metrics, MetricsAccumulator};
 pub use model::{Manipulator, PlanarArm, TwoLinkArm};
-pub use network::Weights;
+pub use network::{Weights, WeightsMut};
 pub use observer::{HighGainObserver, Hold};
-pub use rbf::Rbf;
+pub use plant::{rk4_step, Plant, RigidBody};
+pub use rbf::{Basis, Centers, Grid};
+#[cfg(feature = "alloc")]
+pub use record::Trace;
+pub use record::{Recorder, Row};
+pub use robust::{Robust, RobustKind};
 pub use saturation::Saturation;
-#[cfg(feature = "std")]
-pub use simulator::Trace;
-pub use simulator::{rk4_step, simulate, Recorder, Row, SimConfig};
+pub use schema::{Preset, Scenario};
+pub use simulator::{run, simulate, SimConfig};
+#[cfg(feature = "alloc")]
+pub use state::HeapState;
+pub use state::State;
+#[cfg(feature = "alloc")]
+pub use tracker::Tracker;
 pub use trajectory::{Setpoint, Sinusoid, Trajectory};
-
-/// A column vector of `N` reals (joint-space quantities: rad, rad/s, N m, …).
-pub type Vector<const N: usize> = nalgebra::SVector<f64, N>;
-/// An `N × N` real matrix (inertia, Coriolis, …).
-pub type Matrix<const N: usize> = nalgebra::SMatrix<f64, N, N>;
-
-/// Number of RBF nodes of the paper's vertex grid for `n` joints: `2^(4n)`
-/// (256 for the 2-link arm), SPEC §6.
-pub const fn grid_nodes(n: usize) -> usize {
-    1 << (4 * n)
-}
+pub use types::{grid_nodes, Matrix, Vector};

@@ -1,8 +1,11 @@
-//! The figures of SPEC §12, accumulated row by row without allocation.
+//! The figures of SPEC §12, accumulated row by row without allocation: a
+//! [`Recorder`].
 
+use crate::impedance::TargetImpedance;
 use crate::math::sqrt;
-use crate::simulator::Row;
-use crate::Vector;
+use crate::record::{Recorder, Row};
+use crate::trajectory::Setpoint;
+use crate::types::Vector;
 
 /// SPEC §12 metrics of one run. "after" means rows with t_k ≥ `settle`
 /// (2 s by default; a row counts if t_k ≥ settle − 1e-9 s). Means over an
@@ -33,10 +36,12 @@ pub struct Metrics<const N: usize> {
     pub imp_err_rms_after2: f64,
 }
 
-/// Running sums for [`Metrics`]; feed it every row with [`push`](Self::push).
+/// Running sums for [`Metrics`]; feed it every row with [`push`](Self::push)
+/// (or use it as a [`Recorder`]).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct MetricsAccumulator<const N: usize> {
     settle: f64,
+    target: TargetImpedance<N>,
     rows: usize,
     rows_after: usize,
     sum_z1: f64,
@@ -52,10 +57,12 @@ pub struct MetricsAccumulator<const N: usize> {
 }
 
 impl<const N: usize> MetricsAccumulator<N> {
-    /// Start empty; `settle` (s) is where the "after" figures begin (SPEC §12: 2 s).
-    pub fn new(settle: f64) -> Self {
+    /// Start empty; `settle` (s) is where the "after" figures begin (SPEC §12:
+    /// 2 s); `target` is the impedance the residual is measured against.
+    pub fn new(settle: f64, target: TargetImpedance<N>) -> Self {
         Self {
             settle,
+            target,
             rows: 0,
             rows_after: 0,
             sum_z1: 0.0,
@@ -71,9 +78,8 @@ impl<const N: usize> MetricsAccumulator<N> {
         }
     }
 
-    /// Add one row; `imp_residual` is the impedance residual (N m) at the row
-    /// (see [`TargetImpedance::residual`](crate::impedance::TargetImpedance::residual)).
-    pub fn push(&mut self, row: &Row<N>, imp_residual: &Vector<N>) {
+    /// Add one row.
+    pub fn push(&mut self, row: &Row<N>) {
         let after = row.t >= self.settle - 1e-9;
         let z2 = row.z1.norm_squared();
         self.rows += 1;
@@ -93,7 +99,15 @@ impl<const N: usize> MetricsAccumulator<N> {
             self.sum_joint_after += row.z1.component_mul(&row.z1);
             self.max_joint_after = self.max_joint_after.zip_map(&row.z1, |m, z| m.max(z.abs()));
             self.peak_contact_after = self.peak_contact_after.max(contact);
-            self.sum_imp_after += imp_residual.norm_squared();
+            let c = Setpoint {
+                x: row.xc,
+                dx: row.dxc,
+                ddx: row.ddxc,
+            };
+            let residual = self
+                .target
+                .residual(&c, &row.x, &row.dx, &row.ddx, &row.tau_e);
+            self.sum_imp_after += residual.norm_squared();
         }
     }
 
@@ -126,5 +140,11 @@ impl<const N: usize> MetricsAccumulator<N> {
             peak_abs_tau: self.peak_tau,
             imp_err_rms_after2: sqrt(mean(self.sum_imp_after, ka)),
         }
+    }
+}
+
+impl<const N: usize> Recorder<N> for MetricsAccumulator<N> {
+    fn record(&mut self, row: &Row<N>) {
+        self.push(row);
     }
 }

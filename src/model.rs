@@ -7,7 +7,7 @@
 
 use crate::error::{check, Error};
 use crate::math::{cos, sin};
-use crate::{Matrix, Vector};
+use crate::types::{Matrix, Vector};
 use nalgebra::Vector2;
 
 /// Rigid-body dynamics of an `N`-joint manipulator in joint coordinates.
@@ -63,25 +63,6 @@ pub struct ArmParams {
     pub i2: f64,
     /// Gravitational acceleration (m/s²); the arm moves in a vertical plane.
     pub g: f64,
-}
-
-impl Default for ArmParams {
-    /// SPEC §1 defaults: m = [2.00, 0.85] kg, l = [0.35, 0.31] m, lc = l/2,
-    /// I = m l²/4, g = 9.81 m/s².
-    fn default() -> Self {
-        let (m1, m2, l1, l2) = (2.00, 0.85, 0.35, 0.31);
-        Self {
-            m1,
-            m2,
-            l1,
-            l2,
-            lc1: l1 / 2.0,
-            lc2: l2 / 2.0,
-            i1: m1 * l1 * l1 / 4.0,
-            i2: m2 * l2 * l2 / 4.0,
-            g: 9.81,
-        }
-    }
 }
 
 /// The paper's 2-link arm in a vertical plane, (55)–(63), SPEC §1.

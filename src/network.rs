@@ -14,63 +14,115 @@
 //!
 //! Each weight row `Ŵ[k][j]` (a vector over the nodes) appears once in the
 //! output, as a dot product with S, and once in the explicit-Euler update
-//! `Ŵ ← a Ŵ + b S` with `a = 1 − Ts Γ σ`, `b = Ts Γ u_j z2_k`. [`Weights::fused_step`]
-//! does both in one pass over the weights, reading and writing each once.
+//! `Ŵ ← a Ŵ + b S` with `a = 1 − Ts Γ σ`, `b = Ts Γ u_j z2_k`.
+//! [`WeightsMut::fused_step`] does both in one pass over the weights, reading
+//! and writing each once.
+//!
+//! ## Storage
+//!
+//! The basis and the `(2N² + N)` weight rows live in one flat `f64` buffer
+//! owned by the caller's state (heap, or a buffer of the caller's), laid out by
+//! [`Layout`]; [`Weights`] and [`WeightsMut`] are views of it. The number of
+//! nodes L is a run-time value, so any basis fits and nothing large is ever
+//! built on the stack.
 
 use crate::error::{check, Error};
 use crate::math::sqrt;
-use crate::Vector;
-use nalgebra::SVector;
+use crate::types::Vector;
 use wide::f64x4;
 
-/// Index of the three networks in `[f64; 3]` parameter arrays.
+/// Index of the D̂ network in `[f64; 3]` parameter arrays.
 pub const D: usize = 0;
 /// Index of the Ĉ network.
 pub const C: usize = 1;
 /// Index of the Ĝ network.
 pub const G: usize = 2;
 
-/// Weights of the three networks, all zero at t = 0 (SPEC §6).
+/// f64s per 64-byte cache line.
+const LINE: usize = 8;
+/// Space between the basis and the weights (1 KiB): loads of S then never
+/// share their address modulo 4 KiB with the stores to a weight row that
+/// runs beside them (measured for n = 2, l = 256: 315 against 425 ns per pass
+/// when they do, "4K aliasing").
+const GAP: usize = 128;
+
+/// Where the basis and the weight rows lie in a state's buffer.
 ///
-/// `d[k][j]` is the row `ŴD[k][j][·]` over the `L` nodes, `c[k][j]` likewise,
-/// `g[k]` is `ŴG[k][·]`. Units: D̂ weights in kg m², Ĉ in kg m²/s, Ĝ in N m
-/// (each times the dimensionless basis).
-#[repr(C)]
-#[derive(Clone, Debug, PartialEq)]
-pub struct Weights<const N: usize, const L: usize> {
-    /// `ŴD[k][j]` (kg m²).
-    pub d: [[SVector<f64, L>; N]; N],
-    /// `ŴC[k][j]` (kg m²/s).
-    pub c: [[SVector<f64, L>; N]; N],
-    /// `ŴG[k]` (N m).
-    pub g: [SVector<f64, L>; N],
+/// Rows start on 64-byte boundaries (each padded to a multiple of 8 reals), so
+/// no vector load straddles a cache line; the weight rows follow the basis
+/// after a 1 KiB gap. Order of the rows: ŴD[k][j] (N² rows), ŴC[k][j] (N²),
+/// ŴG[k] (N).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct Layout {
+    nodes: usize,
+    stride: usize,
+    rows: usize,
+    basis: usize,
 }
 
-/// The basis and the weights, laid out for the fused pass.
-///
-/// The pass streams every weight row against the basis, so layout decides its
-/// speed (measured: 315 against 425 ns for n = 2, l = 256): rows start on
-/// 64-byte boundaries, so no vector load straddles a cache line, and the basis
-/// lies 1 KiB away from every row modulo 4 KiB (for rows of 2 KiB), so loads of
-/// S do not falsely wait on stores to Ŵ ("4K aliasing").
-#[repr(C, align(64))]
-#[derive(Clone, Debug, PartialEq)]
-pub struct Workspace<const N: usize, const L: usize> {
-    /// The basis S(Z) of the current step.
-    pub basis: SVector<f64, L>,
-    gap: [u64; 128],
-    /// The network weights.
-    pub weights: Weights<N, L>,
-}
+impl Layout {
+    /// Weight rows of `n` joints: `2n² + n`.
+    pub const fn rows(n: usize) -> usize {
+        2 * n * n + n
+    }
 
-impl<const N: usize, const L: usize> Workspace<N, L> {
-    /// Zero basis and weights.
-    pub fn zeros() -> Self {
-        Self {
-            basis: SVector::zeros(),
-            gap: [0; 128],
-            weights: Weights::zeros(),
+    /// The length of a buffer (in f64) that holds the basis and weights of
+    /// `n` joints and `nodes` nodes, wherever it starts in memory; `None` if
+    /// that overflows `usize`.
+    pub const fn buffer_len(n: usize, nodes: usize) -> Option<usize> {
+        let stride = match nodes.checked_next_multiple_of(LINE) {
+            Some(s) => s,
+            None => return None,
+        };
+        match stride.checked_mul(Self::rows(n) + 1) {
+            Some(v) => v.checked_add(LINE + GAP),
+            None => None,
         }
+    }
+
+    /// The layout inside `buf` (whose first element is at `addr` bytes):
+    /// aligned from there; `None` if `buf_len` is too short.
+    pub(crate) fn new(n: usize, nodes: usize, addr: usize, buf_len: usize) -> Option<Self> {
+        let need = Self::buffer_len(n, nodes)?;
+        if buf_len < need {
+            return None;
+        }
+        // Reals to skip to the next 64-byte boundary.
+        let basis = (LINE - (addr / 8) % LINE) % LINE;
+        Some(Self {
+            nodes,
+            stride: nodes.next_multiple_of(LINE),
+            rows: Self::rows(n),
+            basis,
+        })
+    }
+
+    /// The number of nodes L.
+    pub fn nodes(&self) -> usize {
+        self.nodes
+    }
+
+    fn weights(&self) -> usize {
+        self.basis + self.stride + GAP
+    }
+
+    /// The basis (length L) and the weight rows (`rows × stride`) of `buf`.
+    pub(crate) fn split<'a>(&self, buf: &'a [f64]) -> (&'a [f64], &'a [f64]) {
+        let w = self.weights();
+        (
+            &buf[self.basis..self.basis + self.nodes],
+            &buf[w..w + self.rows * self.stride],
+        )
+    }
+
+    /// The same, mutable.
+    pub(crate) fn split_mut<'a>(&self, buf: &'a mut [f64]) -> (&'a mut [f64], &'a mut [f64]) {
+        let w = self.weights();
+        let (head, tail) = buf.split_at_mut(w);
+        (
+            &mut head[self.basis..self.basis + self.nodes],
+            &mut tail[..self.rows * self.stride],
+        )
     }
 }
 
@@ -104,14 +156,15 @@ impl Rates {
     }
 }
 
-/// Bounds on the weight norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F (for
-/// [`Config::weight_bound`](crate::Config::weight_bound)) derived from the
-/// actuator limits: each network may produce at most the actuator's torque
-/// ‖τmax‖ for the commanded trajectory's regressor scale.
+/// Bounds on the weight norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F (for the projection of
+/// [`Learning`](crate::learning::Learning)) derived from the actuator limits:
+/// each network may produce at most the actuator's torque ‖τmax‖ for the
+/// commanded trajectory's regressor scale.
 ///
 /// Since every S_i ≤ 1, ‖S‖ ≤ √L and `‖Ĝ‖ ≤ ‖ŴG‖_F √L`, `‖D̂ α̇1‖ ≤ ‖ŴD‖_F √L ‖α̇1‖`,
 /// `‖Ĉ α1‖ ≤ ‖ŴC‖_F √L ‖α1‖`. With `speed` and `accel` the peak commanded
-/// ‖ẋc‖ (rad/s) and ‖ẍc‖ (rad/s²) standing in for ‖α1‖ and ‖α̇1‖:
+/// ‖ẋc‖ (rad/s) and ‖ẍc‖ (rad/s²) standing in for ‖α1‖ and ‖α̇1‖ (a
+/// trajectory that does not move uses 1 rad/s and 1 rad/s²):
 /// `[‖τmax‖/(√L accel), ‖τmax‖/(√L speed), ‖τmax‖/√L]`.
 pub fn weight_bounds<const N: usize>(
     tau_max: &Vector<N>,
@@ -120,7 +173,8 @@ pub fn weight_bounds<const N: usize>(
     accel: f64,
 ) -> [f64; 3] {
     let scale = tau_max.norm() / sqrt(nodes as f64);
-    [scale / accel, scale / speed, scale]
+    let or_one = |r: f64| if r > 0.0 { r } else { 1.0 };
+    [scale / or_one(accel), scale / or_one(speed), scale]
 }
 
 /// One row: returns `Ŵ·S` of the old row, and writes `Ŵ ← a Ŵ + b S`.
@@ -131,8 +185,7 @@ pub fn weight_bounds<const N: usize>(
 /// half width). Products and sums stay separate (Rust never fuses a·b + c), so
 /// the results are the same on every target.
 #[inline(always)]
-fn dot_update<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
-    let (w, s) = (w.as_mut_slice(), s.as_slice());
+fn dot_update(w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
     let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
     // Two independent 4-wide accumulators hide the latency of the additions.
     let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
@@ -157,14 +210,13 @@ fn dot_update<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f
 /// Two rows sharing the basis, each chunk of S loaded once for both: returns
 /// `Ŵ0·S`, `Ŵ1·S` of the old rows and writes `Ŵr ← ar Ŵr + br S`.
 #[inline(always)]
-fn dot_update_pair<const L: usize>(
-    w0: &mut SVector<f64, L>,
-    w1: &mut SVector<f64, L>,
-    s: &SVector<f64, L>,
+fn dot_update_pair(
+    w0: &mut [f64],
+    w1: &mut [f64],
+    s: &[f64],
     (a0, b0): (f64, f64),
     (a1, b1): (f64, f64),
 ) -> (f64, f64) {
-    let (w0, w1, s) = (w0.as_mut_slice(), w1.as_mut_slice(), s.as_slice());
     let (a0v, b0v, a1v, b1v) = (
         f64x4::splat(a0),
         f64x4::splat(b0),
@@ -206,8 +258,7 @@ fn load(v: &[f64]) -> f64x4 {
 
 /// One row: `Ŵ ← a Ŵ + b S`; returns `‖Ŵ‖²` of the new row.
 #[inline(always)]
-fn update_row<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f64, b: f64) -> f64 {
-    let (w, s) = (w.as_mut_slice(), s.as_slice());
+fn update_row(w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
     let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
     let (mut q0, mut q1) = (f64x4::ZERO, f64x4::ZERO);
     let mut wc = w.chunks_exact_mut(8);
@@ -228,63 +279,176 @@ fn update_row<const L: usize>(w: &mut SVector<f64, L>, s: &SVector<f64, L>, a: f
     sq
 }
 
-impl<const N: usize, const L: usize> Weights<N, L> {
-    /// All weights zero.
-    pub fn zeros() -> Self {
+/// The weights of the three networks, read-only: a view of a state's buffer
+/// (or of a caller's flat array, [`Weights::from_rows`]).
+///
+/// Units: D̂ weights in kg m², Ĉ in kg m²/s, Ĝ in N m (each times the
+/// dimensionless basis).
+#[derive(Copy, Clone, Debug)]
+pub struct Weights<'a, const N: usize> {
+    rows: &'a [f64],
+    nodes: usize,
+    stride: usize,
+}
+
+/// The weights of the three networks, writable (see [`Weights`]).
+#[derive(Debug)]
+pub struct WeightsMut<'a, const N: usize> {
+    rows: &'a mut [f64],
+    nodes: usize,
+    stride: usize,
+}
+
+/// Offset of row `r` of network `net` ([`D`], [`C`]: r = k·N + j; [`G`]: r = k).
+#[inline(always)]
+const fn row_index(n: usize, net: usize, r: usize) -> usize {
+    net * n * n + r
+}
+
+impl<'a, const N: usize> Weights<'a, N> {
+    pub(crate) fn new(rows: &'a [f64], nodes: usize, stride: usize) -> Self {
         Self {
-            d: [[SVector::zeros(); N]; N],
-            c: [[SVector::zeros(); N]; N],
-            g: [SVector::zeros(); N],
+            rows,
+            nodes,
+            stride,
         }
+    }
+
+    /// A view of `data`: the `2N² + N` rows of `nodes` reals each, back to back,
+    /// in the order ŴD[k][j], ŴC[k][j], ŴG[k] (row-major over k, j). Errors if
+    /// the length is not `(2N² + N)·nodes`.
+    pub fn from_rows(data: &'a [f64], nodes: usize) -> Result<Self, Error> {
+        if nodes == 0 || data.len() != Layout::rows(N) * nodes {
+            return Err(Error::Invalid {
+                what: "weights",
+                reason: "need (2n² + n)·L values: ŴD[k][j], ŴC[k][j], ŴG[k], each over the L nodes",
+            });
+        }
+        Ok(Self::new(data, nodes, nodes))
+    }
+
+    /// The number of nodes L.
+    pub fn nodes(&self) -> usize {
+        self.nodes
+    }
+
+    fn row(&self, i: usize) -> &'a [f64] {
+        &self.rows[i * self.stride..i * self.stride + self.nodes]
+    }
+
+    /// Row `ŴD[k][j]` over the nodes (kg m²).
+    pub fn d(&self, k: usize, j: usize) -> &'a [f64] {
+        self.row(row_index(N, D, k * N + j))
+    }
+    /// Row `ŴC[k][j]` over the nodes (kg m²/s).
+    pub fn c(&self, k: usize, j: usize) -> &'a [f64] {
+        self.row(row_index(N, C, k * N + j))
+    }
+    /// Row `ŴG[k]` over the nodes (N m).
+    pub fn g(&self, k: usize) -> &'a [f64] {
+        self.row(row_index(N, G, k))
+    }
+
+    /// Every row of network `net` ([`D`], [`C`] or [`G`]).
+    pub fn network(&self, net: usize) -> impl Iterator<Item = &'a [f64]> + '_ {
+        let (first, count) = match net {
+            D => (row_index(N, D, 0), N * N),
+            C => (row_index(N, C, 0), N * N),
+            _ => (row_index(N, G, 0), N),
+        };
+        (first..first + count).map(|i| self.row(i))
     }
 
     /// Every weight finite.
     pub fn check_finite(&self) -> Result<(), Error> {
-        for row in self.d.iter().flatten() {
-            check::finite_slice("weights.D", row.as_slice())?;
-        }
-        for row in self.c.iter().flatten() {
-            check::finite_slice("weights.C", row.as_slice())?;
-        }
-        for row in &self.g {
-            check::finite_slice("weights.G", row.as_slice())?;
+        for (net, what) in [(D, "weights.D"), (C, "weights.C"), (G, "weights.G")] {
+            for row in self.network(net) {
+                check::finite_slice(what, row)?;
+            }
         }
         Ok(())
     }
 
     /// Frobenius norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F.
     pub fn norms(&self) -> [f64; 3] {
-        let sq = |rows: &mut dyn Iterator<Item = &SVector<f64, L>>| {
-            sqrt(rows.map(|r| r.norm_squared()).sum())
-        };
-        [
-            sq(&mut self.d.iter().flatten()),
-            sq(&mut self.c.iter().flatten()),
-            sq(&mut self.g.iter()),
-        ]
+        [D, C, G].map(|net| sqrt(self.network(net).map(|r| dot(r, r)).sum()))
     }
 
     /// Network output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) for basis `s`, without learning.
-    pub fn output(
-        &self,
-        s: &SVector<f64, L>,
-        dalpha1: &Vector<N>,
-        alpha1: &Vector<N>,
-    ) -> Vector<N> {
+    pub fn output(&self, s: &[f64], dalpha1: &Vector<N>, alpha1: &Vector<N>) -> Vector<N> {
         Vector::from_fn(|k, _| {
-            let mut out = self.g[k].dot(s);
+            let mut out = dot(self.g(k), s);
             for j in 0..N {
-                out += self.d[k][j].dot(s) * dalpha1[j] + self.c[k][j].dot(s) * alpha1[j];
+                out += dot(self.d(k, j), s) * dalpha1[j] + dot(self.c(k, j), s) * alpha1[j];
             }
             out
         })
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+impl<'a, const N: usize> WeightsMut<'a, N> {
+    pub(crate) fn new(rows: &'a mut [f64], nodes: usize, stride: usize) -> Self {
+        Self {
+            rows,
+            nodes,
+            stride,
+        }
+    }
+
+    /// A read-only view.
+    pub fn as_ref(&self) -> Weights<'_, N> {
+        Weights::new(self.rows, self.nodes, self.stride)
+    }
+
+    fn row_mut(&mut self, i: usize) -> &mut [f64] {
+        &mut self.rows[i * self.stride..i * self.stride + self.nodes]
+    }
+
+    /// Row `ŴD[k][j]`, writable.
+    pub fn d_mut(&mut self, k: usize, j: usize) -> &mut [f64] {
+        self.row_mut(row_index(N, D, k * N + j))
+    }
+    /// Row `ŴC[k][j]`, writable.
+    pub fn c_mut(&mut self, k: usize, j: usize) -> &mut [f64] {
+        self.row_mut(row_index(N, C, k * N + j))
+    }
+    /// Row `ŴG[k]`, writable.
+    pub fn g_mut(&mut self, k: usize) -> &mut [f64] {
+        self.row_mut(row_index(N, G, k))
+    }
+
+    /// Copy every weight from `src` (same N and L; the caller checks L).
+    pub(crate) fn copy_from(&mut self, src: &Weights<'_, N>) {
+        for i in 0..Layout::rows(N) {
+            self.row_mut(i).copy_from_slice(src.row(i));
+        }
+    }
+
+    /// All weights zero.
+    pub fn fill_zero(&mut self) {
+        self.rows.fill(0.0);
+    }
+
+    /// Multiply every weight of network `net` ([`D`], [`C`] or [`G`]) by `factor`.
+    pub fn scale_network(&mut self, net: usize, factor: f64) {
+        let (first, count) = match net {
+            D => (row_index(N, D, 0), N * N),
+            C => (row_index(N, C, 0), N * N),
+            _ => (row_index(N, G, 0), N),
+        };
+        for i in first..first + count {
+            self.row_mut(i).iter_mut().for_each(|w| *w *= factor);
+        }
     }
 
     /// One step of the networks in a single pass over the weights: returns the
     /// output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current weights, then applies
     /// the explicit-Euler update of (15)–(17) with error signal `z2` (rad/s;
-    /// ẑ2 for output feedback, (37)–(39)), the learning step scaled by `scale`
-    /// (1 for the printed law).
+    /// ẑ2 for output feedback, (37)–(39)) at `rates`.
     ///
     /// `norms` holds the Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ of the weights
     /// before the step and is brought up to date without a second pass: for
@@ -293,26 +457,31 @@ impl<const N: usize, const L: usize> Weights<N, L> {
     #[inline]
     pub fn fused_step(
         &mut self,
-        s: &SVector<f64, L>,
+        s: &[f64],
         dalpha1: &Vector<N>,
         alpha1: &Vector<N>,
         z2: &Vector<N>,
         rates: &Rates,
         norms: &mut [f64; 3],
     ) -> Vector<N> {
+        let (l, stride) = (self.nodes, self.stride);
+        let s = &s[..l];
+        let (d, rest) = self.rows.split_at_mut(N * N * stride);
+        let (c, g) = rest.split_at_mut(N * N * stride);
         let mut out = Vector::<N>::zeros();
         // Per network: Σ_rows b·(Ŵ·S) and Σ_rows b².
         let mut cross = [0.0; 3];
         let mut bb = [0.0; 3];
-        let (a, g) = (rates.decay, rates.gain);
+        let (a, gain) = (rates.decay, rates.gain);
         for k in 0..N {
             let gz = z2[k];
             for j in 0..N {
+                let r = (k * N + j) * stride;
                 // ŴD[k][j] and ŴC[k][j] share one pass over S.
-                let (bd, bc) = (g[D] * dalpha1[j] * gz, g[C] * alpha1[j] * gz);
+                let (bd, bc) = (gain[D] * dalpha1[j] * gz, gain[C] * alpha1[j] * gz);
                 let (dd, dc) = dot_update_pair(
-                    &mut self.d[k][j],
-                    &mut self.c[k][j],
+                    &mut d[r..r + l],
+                    &mut c[r..r + l],
                     s,
                     (a[D], bd),
                     (a[C], bc),
@@ -323,13 +492,13 @@ impl<const N: usize, const L: usize> Weights<N, L> {
                 bb[D] += bd * bd;
                 bb[C] += bc * bc;
             }
-            let b = g[G] * gz;
-            let dot = dot_update(&mut self.g[k], s, a[G], b);
+            let b = gain[G] * gz;
+            let dot = dot_update(&mut g[k * stride..k * stride + l], s, a[G], b);
             out[k] += dot;
             cross[G] += b * dot;
             bb[G] += b * b;
         }
-        let s2 = s.norm_squared();
+        let s2 = dot(s, s);
         for net in 0..3 {
             let n2 = a[net] * a[net] * norms[net] * norms[net]
                 + 2.0 * a[net] * cross[net]
@@ -339,60 +508,31 @@ impl<const N: usize, const L: usize> Weights<N, L> {
         }
         out
     }
-}
 
-impl<const N: usize, const L: usize> Weights<N, L> {
-    /// The explicit-Euler update of (15)–(17) alone (after [`output`](Self::output)
-    /// has used the old weights). Rows of joint k learn from `z2[k]`; pass
-    /// 0 there to freeze joint k's learning (its weights then only leak).
-    /// Returns the Frobenius norms of the new weights.
+    /// The explicit-Euler update of (15)–(17) alone (after
+    /// [`Weights::output`] has used the old weights). Rows of joint k learn
+    /// from `z2[k]`; pass 0 there to freeze joint k's learning (its weights
+    /// then only leak). Returns the Frobenius norms of the new weights.
     pub fn update(
         &mut self,
-        s: &SVector<f64, L>,
+        s: &[f64],
         dalpha1: &Vector<N>,
         alpha1: &Vector<N>,
         z2: &Vector<N>,
         rates: &Rates,
     ) -> [f64; 3] {
+        let s = &s[..self.nodes];
         let mut sq = [0.0; 3];
-        let gain = rates.gain;
+        let (a, gain) = (rates.decay, rates.gain);
         for k in 0..N {
             let gz = z2[k];
             for j in 0..N {
-                sq[D] += update_row(
-                    &mut self.d[k][j],
-                    s,
-                    rates.decay[D],
-                    gain[D] * dalpha1[j] * gz,
-                );
-                sq[C] += update_row(
-                    &mut self.c[k][j],
-                    s,
-                    rates.decay[C],
-                    gain[C] * alpha1[j] * gz,
-                );
+                sq[D] += update_row(self.d_mut(k, j), s, a[D], gain[D] * dalpha1[j] * gz);
+                sq[C] += update_row(self.c_mut(k, j), s, a[C], gain[C] * alpha1[j] * gz);
             }
-            sq[G] += update_row(&mut self.g[k], s, rates.decay[G], gain[G] * gz);
+            sq[G] += update_row(self.g_mut(k), s, a[G], gain[G] * gz);
         }
         sq.map(sqrt)
-    }
-
-    /// Multiply every weight of network `net` ([`D`], [`C`] or [`G`]) by `factor`.
-    pub fn scale_network(&mut self, net: usize, factor: f64) {
-        let rows: &mut dyn Iterator<Item = &mut SVector<f64, L>> = match net {
-            D => &mut self.d.iter_mut().flatten(),
-            C => &mut self.c.iter_mut().flatten(),
-            _ => &mut self.g.iter_mut(),
-        };
-        for row in rows {
-            *row *= factor;
-        }
-    }
-}
-
-impl<const N: usize, const L: usize> Default for Weights<N, L> {
-    fn default() -> Self {
-        Self::zeros()
     }
 }
 
@@ -400,19 +540,44 @@ impl<const N: usize, const L: usize> Default for Weights<N, L> {
 mod tests {
     use super::*;
 
-    fn basis() -> SVector<f64, 16> {
-        SVector::from_fn(|i, _| 0.1 + 0.05 * i as f64)
+    const L: usize = 16;
+
+    fn basis() -> [f64; L] {
+        core::array::from_fn(|i| 0.1 + 0.05 * i as f64)
+    }
+
+    /// A buffer and its layout for N = 1, L = 16.
+    fn buffer() -> (Vec<f64>, Layout) {
+        let len = Layout::buffer_len(1, L).unwrap();
+        let buf = vec![0.0; len];
+        let layout = Layout::new(1, L, buf.as_ptr() as usize, len).unwrap();
+        (buf, layout)
+    }
+
+    #[test]
+    fn layout_aligns_rows_and_keeps_the_gap() {
+        let (buf, layout) = buffer();
+        let (s, w) = layout.split(&buf);
+        assert_eq!(s.len(), L);
+        assert_eq!(w.len(), 3 * 16);
+        assert_eq!(s.as_ptr() as usize % 64, 0);
+        assert_eq!(w.as_ptr() as usize % 64, 0);
+        assert_eq!(w.as_ptr() as usize - s.as_ptr() as usize, 8 * (16 + GAP));
+        assert!(Layout::new(1, L, 0, Layout::buffer_len(1, L).unwrap() - 1).is_none());
+        assert_eq!(Layout::buffer_len(7, usize::MAX), None);
     }
 
     #[test]
     fn fused_step_equals_output_then_euler_update() {
-        let mut w = Weights::<1, 16>::zeros();
+        let (mut buf, layout) = buffer();
+        let (_, rows) = layout.split_mut(&mut buf);
+        let mut w = WeightsMut::<1>::new(rows, L, layout.stride);
         // Some non-zero weights.
-        for (i, v) in w.d[0][0].iter_mut().enumerate() {
+        for (i, v) in w.d_mut(0, 0).iter_mut().enumerate() {
             *v = 0.01 * i as f64;
         }
-        w.c[0][0].fill(-0.2);
-        w.g[0].fill(0.3);
+        w.c_mut(0, 0).fill(-0.2);
+        w.g_mut(0).fill(0.3);
         let s = basis();
         let (da, a, z2) = (
             Vector::<1>::new(2.0),
@@ -422,24 +587,28 @@ mod tests {
         let ts = 1e-3;
         let (gamma, sigma) = ([100.0; 3], [0.01; 3]);
         let rates = Rates::new(ts, gamma, sigma).unwrap();
-        let expect_out = w.output(&s, &da, &a);
-        let expect_norms = w.norms();
+        let expect_out = w.as_ref().output(&s, &da, &a);
+        let expect_norms = w.as_ref().norms();
         // The SPEC's form: Ŵ ← Ŵ + Ts Γ (S u z2 − σ Ŵ).
-        let mut expect_w = w.clone();
-        for i in 0..16 {
-            expect_w.d[0][0][i] += ts * gamma[D] * (s[i] * da[0] * z2[0] - sigma[D] * w.d[0][0][i]);
-            expect_w.c[0][0][i] += ts * gamma[C] * (s[i] * a[0] * z2[0] - sigma[C] * w.c[0][0][i]);
-            expect_w.g[0][i] += ts * gamma[G] * (s[i] * z2[0] - sigma[G] * w.g[0][i]);
-        }
-        let mut w2 = w.clone();
+        let old: Vec<Vec<f64>> = (0..3).map(|i| w.as_ref().row(i).to_vec()).collect();
+        let u = [da[0], a[0], 1.0];
+        let mut copy: Vec<f64> = (0..3).flat_map(|i| w.as_ref().row(i).to_vec()).collect();
+        let mut w2 = WeightsMut::<1>::new(&mut copy, L, L);
         let mut norms = expect_norms;
         let out = w.fused_step(&s, &da, &a, &z2, &rates, &mut norms);
         // The separate update does the same.
         let new_norms = w2.update(&s, &da, &a, &z2, &rates);
-        assert_eq!(w2, w);
+        for i in 0..3 {
+            assert_eq!(w2.as_ref().row(i), w.as_ref().row(i));
+            for n in 0..L {
+                let expect =
+                    old[i][n] + ts * gamma[i] * (s[n] * u[i] * z2[0] - sigma[i] * old[i][n]);
+                assert!((w.as_ref().row(i)[n] - expect).abs() < 1e-15);
+            }
+        }
         assert!((out - expect_out).norm() < 1e-14, "{out} vs {expect_out}");
         // The norms were brought up to date without a second pass.
-        let exact = w.norms();
+        let exact = w.as_ref().norms();
         for n in 0..3 {
             assert!(
                 (norms[n] - exact[n]).abs() < 1e-13 * exact[n],
@@ -447,11 +616,14 @@ mod tests {
             );
             assert!((new_norms[n] - exact[n]).abs() < 1e-13 * exact[n]);
         }
-        for i in 0..16 {
-            assert!((w.d[0][0][i] - expect_w.d[0][0][i]).abs() < 1e-15);
-            assert!((w.c[0][0][i] - expect_w.c[0][0][i]).abs() < 1e-15);
-            assert!((w.g[0][i] - expect_w.g[0][i]).abs() < 1e-15);
-        }
+    }
+
+    #[test]
+    fn from_rows_checks_the_length() {
+        let data = [0.0; 3 * L];
+        assert!(Weights::<1>::from_rows(&data, L).is_ok());
+        let e = Weights::<1>::from_rows(&data[1..], L).unwrap_err();
+        assert!(e.to_string().contains("(2n² + n)·L"), "{e}");
     }
 
     #[test]

@@ -14,7 +14,7 @@
 //! satisfies exactly, and has no such deficit.
 
 use crate::error::{check, Error};
-use crate::Vector;
+use crate::types::{choices, Vector};
 use nalgebra::{Matrix2, Matrix4, SMatrix, Vector2};
 
 /// How the measured position is modelled between samples.
@@ -29,6 +29,11 @@ pub enum Hold {
     /// of step k, once y_k is measured, so the estimate at t_k uses y_k.
     Triangle,
 }
+
+choices!(Hold {
+    "zoh" => Hold::Zero,
+    "triangle" => Hold::Triangle,
+});
 
 /// Observer parameters and their precomputed discretisation.
 #[derive(Copy, Clone, Debug, PartialEq)]

@@ -1,15 +1,22 @@
-//! Gaussian RBF basis S(Z), (1), SPEC §6.
+//! Gaussian RBF bases S(Z), (1), SPEC §6, as two types behind one trait.
 //!
-//! `S_j(Z) = exp(−‖Z − μ_j‖² / η²)`, j = 1..L, with the network input
-//! `Z = [x; v; α1; α̇1] ∈ R^{4N}` passed as four blocks of `N`. One basis is
-//! shared by the three networks D̂, Ĉ, Ĝ (ZD = ZC = ZG).
+//! The network input is `Z = [x; v; α1; α̇1] ∈ R^{4N}`, passed as four blocks
+//! of `N`. One basis is shared by the three networks D̂, Ĉ, Ĝ (ZD = ZC = ZG).
+//!
+//! - [`Grid`]: the paper's `L = 2^{4N}` centres at the vertices of
+//!   `[−1, 1]^{4N}`, one width η², evaluated by a separable fast path. It
+//!   exists for N ≤ 3 (4096 nodes); beyond, 2^{4N} nodes are not a basis one
+//!   can store (2^28 at N = 7).
+//! - [`Centers`]: user-chosen centres, held in any `AsRef<[f64]>` (a `Vec` or
+//!   `Box<[f64]>` on the heap, or a borrowed slice), with one width per input
+//!   dimension, since x, ẋ, α1 and α̇1 have different units:
+//!   `S_j(Z) = exp(−Σ_d (Z_d − μ_jd)² / η_d²)`.
 //!
 //! ## Node order of the vertex grid
 //!
-//! The paper's grid puts the `L = 2^{4N}` centres at the vertices of
-//! `[−1, 1]^{4N}`. Node `j` has `μ_j[d] = +1` if bit `d` of `j` is set and
-//! `−1` otherwise, where `d = b·N + i` indexes component `i` of block `b`
-//! (b = 0: x, 1: v, 2: α1, 3: α̇1).
+//! Node `j` has `μ_j[d] = +1` if bit `d` of `j` is set and `−1` otherwise,
+//! where `d = b·N + i` indexes component `i` of block `b` (b = 0: x, 1: v,
+//! 2: α1, 3: α̇1).
 //!
 //! ## The separable fast path
 //!
@@ -22,61 +29,41 @@
 
 use crate::error::{check, Error};
 use crate::math::exp;
-use crate::{grid_nodes, Vector};
-use nalgebra::{SMatrix, SVector};
+use crate::types::{grid_nodes, Vector};
 
-/// Where the centres are.
-#[derive(Clone, Debug, PartialEq)]
-enum Centers<const N: usize, const L: usize> {
-    /// The paper's vertex grid (see the module docs for the node order).
-    Grid,
-    /// User-chosen centres, one `N × L` matrix per input block (x, v, α1, α̇1).
-    Custom([SMatrix<f64, N, L>; 4]),
+/// A basis S(Z) ∈ R^L over the network input Z = [x; v; α1; α̇1].
+pub trait Basis<const N: usize> {
+    /// The number of nodes L.
+    fn nodes(&self) -> usize;
+    /// Evaluate S(Z) into `s` (length [`nodes`](Self::nodes)); `z` = [x, v, α1, α̇1].
+    /// Allocation-free; every S_j in [0, 1] for finite `z`.
+    fn eval(&self, z: &[Vector<N>; 4], s: &mut [f64]);
 }
 
-/// A Gaussian RBF basis of `L` nodes over the `4N`-dimensional input, SPEC §6.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Rbf<const N: usize, const L: usize> {
+/// The largest N for which the vertex grid exists here (2^{4·3} = 4096 nodes).
+pub const GRID_MAX_JOINTS: usize = 3;
+
+/// The paper's vertex grid of `L = 2^{4N}` nodes with width η², SPEC §6.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Grid<const N: usize> {
     eta2: f64,
     inv_eta2: f64,
-    centers: Centers<N, L>,
 }
 
-impl<const N: usize, const L: usize> Rbf<N, L> {
-    /// The paper's vertex grid of `L = 2^{4N}` nodes with width η² (the paper's
-    /// "variance 25" is η² = 25). Errors if `L ≠ 2^{4N}` or η² is not > 0.
-    pub fn grid(eta2: f64) -> Result<Self, Error> {
-        if 4 * N >= usize::BITS as usize || L != grid_nodes(N) {
+impl<const N: usize> Grid<N> {
+    /// The grid with width η² (the paper's "variance 25" is η² = 25). Errors if
+    /// η² is not > 0, or for N > [`GRID_MAX_JOINTS`] (use [`Centers`]).
+    pub fn new(eta2: f64) -> Result<Self, Error> {
+        if N == 0 || N > GRID_MAX_JOINTS {
             return Err(Error::Invalid {
                 what: "RBF vertex grid",
-                reason: "the number of nodes L must be 2^(4n)",
+                reason: "the grid has 2^(4n) nodes and exists for 1 ≤ n ≤ 3; use user centres",
             });
         }
         check::positive("η² > 0", "eta2", eta2)?;
         Ok(Self {
             eta2,
             inv_eta2: 1.0 / eta2,
-            centers: Centers::Grid,
-        })
-    }
-
-    /// User-chosen centres: `centers[b]` column `j` is block `b` of μ_j
-    /// (blocks x, v, α1, α̇1 in rad, rad/s, rad/s, rad/s²), width η².
-    pub fn custom(centers: [SMatrix<f64, N, L>; 4], eta2: f64) -> Result<Self, Error> {
-        if L == 0 {
-            return Err(Error::Invalid {
-                what: "RBF centres",
-                reason: "at least one node is needed",
-            });
-        }
-        for block in &centers {
-            check::finite_slice("centers", block.as_slice())?;
-        }
-        check::positive("η² > 0", "eta2", eta2)?;
-        Ok(Self {
-            eta2,
-            inv_eta2: 1.0 / eta2,
-            centers: Centers::Custom(centers),
         })
     }
 
@@ -85,73 +72,48 @@ impl<const N: usize, const L: usize> Rbf<N, L> {
         self.eta2
     }
 
-    /// True for the paper's vertex grid (evaluated by the separable fast path).
-    pub fn is_grid(&self) -> bool {
-        matches!(self.centers, Centers::Grid)
-    }
-
     /// Centre μ_j as four blocks (x, v, α1, α̇1). Panics if `j >= L`.
     pub fn center(&self, j: usize) -> [Vector<N>; 4] {
-        assert!(j < L, "node index {j} out of range (L = {L})");
-        match &self.centers {
-            Centers::Grid => core::array::from_fn(|b| {
-                Vector::from_fn(|i, _| {
-                    if (j >> (b * N + i)) & 1 == 1 {
-                        1.0
-                    } else {
-                        -1.0
-                    }
-                })
-            }),
-            Centers::Custom(c) => core::array::from_fn(|b| c[b].column(j).into_owned()),
-        }
+        assert!(j < grid_nodes(N), "node index {j} out of range");
+        core::array::from_fn(|b| {
+            Vector::from_fn(|i, _| {
+                if (j >> (b * N + i)) & 1 == 1 {
+                    1.0
+                } else {
+                    -1.0
+                }
+            })
+        })
     }
 
     /// The same basis with its centres stored explicitly (evaluated node by
-    /// node): the reference the grid's fast path is tested against.
-    pub fn to_custom(&self) -> Self {
-        let centers =
-            core::array::from_fn(|b| SMatrix::<f64, N, L>::from_fn(|i, j| self.center(j)[b][i]));
-        Self {
-            eta2: self.eta2,
-            inv_eta2: self.inv_eta2,
-            centers: Centers::Custom(centers),
-        }
-    }
-
-    /// Evaluate S(Z) into `s`. `z` = [x, v, α1, α̇1]. Allocation-free.
-    #[inline]
-    pub fn eval(&self, z: &[Vector<N>; 4], s: &mut SVector<f64, L>) {
-        match &self.centers {
-            Centers::Grid => self.eval_grid(z, s),
-            Centers::Custom(c) => self.eval_direct(c, z, s),
-        }
-    }
-
-    fn eval_direct(
-        &self,
-        c: &[SMatrix<f64, N, L>; 4],
-        z: &[Vector<N>; 4],
-        s: &mut SVector<f64, L>,
-    ) {
-        for (j, sj) in s.iter_mut().enumerate() {
-            let mut d2 = 0.0;
-            for (block, zb) in c.iter().zip(z) {
-                for i in 0..N {
-                    let e = zb[i] - block[(i, j)];
-                    d2 += e * e;
-                }
+    /// node): the reference the fast path is tested against.
+    #[cfg(feature = "alloc")]
+    pub fn to_centers(&self) -> Centers<N, alloc::vec::Vec<f64>> {
+        let mut c = alloc::vec::Vec::with_capacity(grid_nodes(N) * 4 * N);
+        for j in 0..grid_nodes(N) {
+            for block in self.center(j) {
+                c.extend_from_slice(block.as_slice());
             }
-            *sj = exp(-d2 * self.inv_eta2);
+        }
+        Centers {
+            centers: c,
+            nodes: grid_nodes(N),
+            inv_w2: [Vector::from_element(self.inv_eta2); 4],
         }
     }
+}
 
-    fn eval_grid(&self, z: &[Vector<N>; 4], s: &mut SVector<f64, L>) {
+impl<const N: usize> Basis<N> for Grid<N> {
+    fn nodes(&self) -> usize {
+        grid_nodes(N)
+    }
+
+    fn eval(&self, z: &[Vector<N>; 4], s: &mut [f64]) {
         let inv = self.inv_eta2;
         let comps = || z.iter().flat_map(|b| b.iter().copied());
         // Distance to the nearest vertex: Σ_d (|Z_d| − 1)².
         let near: f64 = comps().map(|zd| (zd.abs() - 1.0) * (zd.abs() - 1.0)).sum();
-        let s = s.as_mut_slice();
         s[0] = exp(-near * inv);
         // Doubling over dimensions d: nodes with bit d clear take the factor for
         // μ_d = −1, nodes with it set the factor for μ_d = +1; the far one is r_d.
@@ -171,6 +133,79 @@ impl<const N: usize, const L: usize> Rbf<N, L> {
     }
 }
 
+/// User-chosen centres with a width per input dimension.
+///
+/// `centers` holds L rows of 4N coordinates, node j's at
+/// `[j·4N, (j+1)·4N)`, in the order x (rad), v (rad/s), α1 (rad/s), α̇1
+/// (rad/s²), N each. `S_j(Z) = exp(−Σ_d (Z_d − μ_jd)² / η_d²)` with η_d² the
+/// width of dimension d in that dimension's squared unit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Centers<const N: usize, C> {
+    centers: C,
+    nodes: usize,
+    inv_w2: [Vector<N>; 4],
+}
+
+impl<const N: usize, C: AsRef<[f64]>> Centers<N, C> {
+    /// Centres `centers` (length L·4N, L ≥ 1, finite) with widths η_d² per
+    /// input dimension, `widths2[b][i]` for block b (x, v, α1, α̇1) and joint i,
+    /// each finite and > 0.
+    pub fn new(centers: C, widths2: [Vector<N>; 4]) -> Result<Self, Error> {
+        let len = centers.as_ref().len();
+        if N == 0 || len == 0 || len % (4 * N) != 0 {
+            return Err(Error::Invalid {
+                what: "RBF centres",
+                reason: "need L ≥ 1 rows of 4n coordinates (x, v, α1, α̇1)",
+            });
+        }
+        check::finite_slice("centers", centers.as_ref())?;
+        for w in &widths2 {
+            check::positive_vec("η² > 0", "widths", w)?;
+        }
+        Ok(Self {
+            nodes: len / (4 * N),
+            centers,
+            inv_w2: widths2.map(|w| w.map(|v| 1.0 / v)),
+        })
+    }
+
+    /// Centres with one width η² for every dimension (as the paper's grid).
+    pub fn uniform(centers: C, eta2: f64) -> Result<Self, Error> {
+        check::positive("η² > 0", "eta2", eta2)?;
+        Self::new(centers, [Vector::from_element(eta2); 4])
+    }
+
+    /// The centres, L rows of 4N coordinates.
+    pub fn centers(&self) -> &[f64] {
+        self.centers.as_ref()
+    }
+
+    /// The widths η_d² per block and joint.
+    pub fn widths2(&self) -> [Vector<N>; 4] {
+        self.inv_w2.map(|w| w.map(|v| 1.0 / v))
+    }
+}
+
+impl<const N: usize, C: AsRef<[f64]>> Basis<N> for Centers<N, C> {
+    fn nodes(&self) -> usize {
+        self.nodes
+    }
+
+    fn eval(&self, z: &[Vector<N>; 4], s: &mut [f64]) {
+        let c = self.centers.as_ref();
+        for (sj, mu) in s.iter_mut().zip(c.chunks_exact(4 * N)) {
+            let mut d2 = 0.0;
+            for (b, (zb, wb)) in z.iter().zip(&self.inv_w2).enumerate() {
+                for i in 0..N {
+                    let e = zb[i] - mu[b * N + i];
+                    d2 += e * e * wb[i];
+                }
+            }
+            *sj = exp(-d2);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,8 +216,8 @@ mod tests {
 
     #[test]
     fn zero_input_gives_exp_minus_8_over_25_everywhere() {
-        let rbf = Rbf::<2, 256>::grid(25.0).unwrap();
-        let mut s = SVector::<f64, 256>::zeros();
+        let rbf = Grid::<2>::new(25.0).unwrap();
+        let mut s = [0.0; 256];
         rbf.eval(&z_of([0.0; 8]), &mut s);
         let expect = (-8.0f64 / 25.0).exp();
         for &v in s.iter() {
@@ -192,8 +227,8 @@ mod tests {
 
     #[test]
     fn input_on_a_vertex_gives_one_there() {
-        let rbf = Rbf::<2, 256>::grid(25.0).unwrap();
-        let mut s = SVector::<f64, 256>::zeros();
+        let rbf = Grid::<2>::new(25.0).unwrap();
+        let mut s = [0.0; 256];
         // Z = μ_j for j = 0b1010_0110.
         let j = 0b1010_0110usize;
         let mu = rbf.center(j);
@@ -205,15 +240,15 @@ mod tests {
 
     #[test]
     fn fast_grid_path_equals_direct_evaluation() {
-        let grid = Rbf::<2, 256>::grid(25.0).unwrap();
-        let direct = grid.to_custom();
-        assert!(grid.is_grid() && !direct.is_grid());
+        let grid = Grid::<2>::new(25.0).unwrap();
+        let direct = grid.to_centers();
+        assert_eq!(direct.nodes(), 256);
         let inputs = [
             [0.3, -0.2, 1.5, -4.0, 0.0, 2.5, -0.7, 11.0],
             [-1.0, 1.0, 0.0, -0.0, 3.0, -3.0, 0.5, -0.5],
             [40.0, -60.0, 0.1, 0.2, -90.0, 5.0, 7.0, -1e3],
         ];
-        let (mut a, mut b) = (SVector::<f64, 256>::zeros(), SVector::<f64, 256>::zeros());
+        let (mut a, mut b) = ([0.0; 256], [0.0; 256]);
         for v in inputs {
             grid.eval(&z_of(v), &mut a);
             direct.eval(&z_of(v), &mut b);
@@ -225,9 +260,23 @@ mod tests {
     }
 
     #[test]
+    fn widths_per_dimension_scale_each_dimension() {
+        // One node at the origin of R^4 (N = 1); widths 1, 4, 9, 16.
+        let w = [1.0, 4.0, 9.0, 16.0].map(Vector::<1>::new);
+        let c = Centers::<1, _>::new([0.0; 4], w).unwrap();
+        let mut s = [0.0];
+        c.eval(&[1.0, 2.0, 3.0, 4.0].map(Vector::<1>::new), &mut s);
+        assert!((s[0] - (-4.0f64).exp()).abs() < 1e-15, "{}", s[0]);
+        // Borrowed centres work as well as owned ones.
+        let owned = [0.5; 8];
+        let b = Centers::<1, &[f64]>::uniform(&owned[..], 2.0).unwrap();
+        assert_eq!(b.nodes(), 2);
+    }
+
+    #[test]
     fn huge_inputs_underflow_to_zero_without_nan() {
-        let rbf = Rbf::<2, 256>::grid(25.0).unwrap();
-        let mut s = SVector::<f64, 256>::zeros();
+        let rbf = Grid::<2>::new(25.0).unwrap();
+        let mut s = [0.0; 256];
         rbf.eval(
             &z_of([1e200, -1e200, 1e300, 0.0, 0.0, 0.0, 0.0, 0.0]),
             &mut s,
@@ -236,10 +285,14 @@ mod tests {
     }
 
     #[test]
-    fn grid_requires_two_to_the_four_n_nodes() {
-        assert!(Rbf::<2, 255>::grid(25.0).is_err());
-        assert!(Rbf::<1, 16>::grid(25.0).is_ok());
-        let e = Rbf::<2, 256>::grid(0.0).unwrap_err();
+    fn bad_grids_and_centres_are_rejected_by_name() {
+        assert!(Grid::<4>::new(25.0).is_err());
+        assert!(Grid::<1>::new(25.0).is_ok());
+        let e = Grid::<2>::new(0.0).unwrap_err();
         assert!(e.to_string().contains("η² > 0"), "{e}");
+        let e = Centers::<2, _>::uniform([0.0; 7], 1.0).unwrap_err();
+        assert!(e.to_string().contains("rows of 4n"), "{e}");
+        let e = Centers::<1, _>::uniform([0.0, f64::NAN, 0.0, 0.0], 1.0).unwrap_err();
+        assert!(e.to_string().starts_with("centers[1]"), "{e}");
     }
 }

@@ -1,7 +1,7 @@
 //! Actuator saturation `sat_i(τ_i) = clamp(τ_i, −τmax_i, τmax_i)`, SPEC §2.
 
 use crate::error::{check, Error};
-use crate::Vector;
+use crate::types::Vector;
 
 /// Symmetric per-joint torque limits τmax (N m), SPEC §2.
 #[derive(Copy, Clone, Debug, PartialEq)]

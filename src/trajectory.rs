@@ -2,7 +2,7 @@
 
 use crate::error::{check, Error};
 use crate::math::{cos, sin};
-use crate::Vector;
+use crate::types::Vector;
 
 /// Position, velocity and acceleration of a trajectory at one instant
 /// (rad, rad/s, rad/s²).
@@ -22,6 +22,13 @@ pub struct Setpoint<const N: usize> {
 pub trait Trajectory<const N: usize> {
     /// The setpoint at time `t` (s).
     fn sample(&self, t: f64) -> Setpoint<N>;
+
+    /// The peak commanded speed ‖ẋc‖ (rad/s) and acceleration ‖ẍc‖ (rad/s²)
+    /// over the trajectory, if known: `weight_bound = auto` derives the weight
+    /// bounds from them ([`WeightBound::Auto`](crate::config::WeightBound::Auto)).
+    fn peak_rates(&self) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 impl<const N: usize, F: Fn(f64) -> Setpoint<N>> Trajectory<N> for F {
@@ -85,19 +92,33 @@ impl<const N: usize> Sinusoid<N> {
     }
 }
 
-impl Sinusoid<2> {
-    /// The paper's commanded circle (64): centre [0.2, 0.2] rad, radius 0.2 rad, ω = π rad/s.
-    pub fn paper() -> Self {
-        Self {
-            offset: Vector::<2>::new(0.2, 0.2),
-            sin: Vector::<2>::new(0.0, 0.2),
-            cos: Vector::<2>::new(-0.2, 0.0),
-            omega: Vector::<2>::from_element(core::f64::consts::PI),
-        }
-    }
-}
+/// Samples per period for [`Sinusoid`]'s peak rates.
+const PEAK_SAMPLES: usize = 4096;
 
 impl<const N: usize> Trajectory<N> for Sinusoid<N> {
+    /// Peak ‖ẋc‖ and ‖ẍc‖ from 4096 samples over one period of the slowest
+    /// non-zero frequency (exact for the paper's circle, whose speed and
+    /// acceleration are constant); (0, 0) if nothing moves.
+    fn peak_rates(&self) -> Option<(f64, f64)> {
+        let slowest = self
+            .omega
+            .iter()
+            .map(|w| w.abs())
+            .filter(|w| *w > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        if !slowest.is_finite() {
+            return Some((0.0, 0.0));
+        }
+        let period = 2.0 * core::f64::consts::PI / slowest;
+        let (mut speed, mut accel) = (0.0f64, 0.0f64);
+        for k in 0..PEAK_SAMPLES {
+            let sp = self.sample(period * k as f64 / (PEAK_SAMPLES - 1) as f64);
+            speed = speed.max(sp.dx.norm());
+            accel = accel.max(sp.ddx.norm());
+        }
+        Some((speed, accel))
+    }
+
     #[inline]
     fn sample(&self, t: f64) -> Setpoint<N> {
         let mut sp = Setpoint {

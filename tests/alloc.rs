@@ -1,55 +1,133 @@
-//! Zero heap allocations in the hot path, counted by a global allocator
-//! (dhat in testing mode) in this test binary.
-//!
-//! One test function only: dhat allows one profiler per process.
+//! Zero heap allocations in the hot path, counted exactly: a global allocator
+//! that counts the allocations of the calling thread only (a thread-local
+//! counter), so the test harness's own threads, or any other test running
+//! beside this one, cannot change the count.
 
-use adaptimp::{simulate, Controller, Law, Measurement, SimConfig, TwoLinkArm, Vector, Wall};
+use adaptimp::{
+    run, Controller, Environment, Law, Manipulator, Measurement, SimConfig, Sinusoid, Trajectory,
+    TwoLinkArm, Vector, Wall,
+};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+/// The system allocator, counting every allocation (and reallocation) made
+/// by the current thread.
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+fn count() {
+    // `try_with`: allocations during thread teardown (after the counter is
+    // destroyed) are not this test's.
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
+
+// SAFETY: every call is forwarded unchanged to `System`, which upholds the
+// `GlobalAlloc` contract; the counter is a thread-local `Cell` that never
+// allocates (a `const` initialiser).
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        count();
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        count();
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        count();
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
 
 #[global_allocator]
-static ALLOC: dhat::Alloc = dhat::Alloc;
+static ALLOC: Counting = Counting;
 
-fn blocks() -> u64 {
-    dhat::HeapStats::get().total_blocks
+/// The allocations this thread makes while running `f`.
+fn allocations_in<T>(f: impl FnOnce() -> T) -> (u64, T) {
+    let before = ALLOCATIONS.with(Cell::get);
+    let out = f();
+    (ALLOCATIONS.with(Cell::get) - before, out)
 }
 
 #[test]
-fn no_heap_allocation_in_steps_and_simulation() {
-    let _profiler = dhat::Profiler::builder().testing().build();
+fn the_counter_counts_this_threads_allocations_only() {
+    let (n, v) = allocations_in(|| Vec::<u8>::with_capacity(16));
+    assert_eq!(n, 1);
+    drop(v);
+    // Another thread's allocations are not ours.
+    let (n, _) = allocations_in(|| {
+        std::thread::scope(|s| {
+            s.spawn(|| (0..100).map(|i| vec![i; 8]).collect::<Vec<_>>().len());
+        })
+    });
+    // Spawning itself allocates here (the thread's handle), but not the
+    // other thread's hundred vectors.
+    assert!(n < 100, "{n}");
+}
+
+#[test]
+fn no_heap_allocation_in_steps() {
     let arm = TwoLinkArm::paper();
     let wall = Wall::paper();
-    for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
-        // Construction is allowed to allocate (here: one Box); the step is not.
-        let mut ctrl = Box::new(Controller::paper(law));
+    let circle = Sinusoid::paper();
+    let laws = [Law::Pd, Law::StateFeedback, Law::OutputFeedback];
+    // The printed laws (fused pass) and the hardened ones (deferred update).
+    for ctrl in laws
+        .map(Controller::paper)
+        .into_iter()
+        .chain(laws.map(Controller::robot))
+    {
+        let law = ctrl.config().law;
+        // Construction may allocate (the state's buffer); the step may not.
+        let mut state = ctrl.new_state();
         let (mut x, mut dx) = (Vector::<2>::new(0.25, -0.05), Vector::<2>::zeros());
-        let before = blocks();
-        for _ in 0..10_000 {
-            let tau_e = adaptimp::Environment::force(&wall, 0.0, &x, &dx);
-            let cmd = ctrl
-                .step(&Measurement {
+        let (n, ()) = allocations_in(|| {
+            for _ in 0..10_000 {
+                let tau_e = wall.force(0.0, &x, &dx);
+                let sp = circle.sample(ctrl.time(&state));
+                let m = Measurement {
                     x,
                     dx: Some(dx),
                     tau_e,
-                })
-                .expect("step");
-            // A crude plant update, just to vary the inputs.
-            let a = adaptimp::Manipulator::forward_dynamics(&arm, &x, &dx, &cmd.tau_sat, &tau_e);
-            dx += 5e-5 * a;
-            x += 5e-5 * dx;
-        }
-        assert_eq!(blocks(), before, "{law:?}: the step allocated");
+                };
+                let cmd = ctrl.step(&mut state, &m, &sp).expect("step");
+                // A crude plant update, just to vary the inputs.
+                let a = arm.forward_dynamics(&x, &dx, &cmd.tau_sat, &tau_e);
+                dx += 5e-5 * a;
+                x += 5e-5 * dx;
+            }
+        });
+        assert_eq!(n, 0, "{law:?}: the step allocated");
+    }
+}
 
+#[test]
+fn no_heap_allocation_in_a_simulation() {
+    for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
+        let ctrl = Controller::robot(law);
+        let mut state = ctrl.new_state();
         let sim = SimConfig {
             t_final: 0.5,
-            ..SimConfig::paper()
+            ..SimConfig::robot()
         };
-        let before = blocks();
-        let m = simulate(&arm, &wall, ctrl.as_mut(), &sim, &mut ()).expect("simulate");
-        assert_eq!(blocks(), before, "{law:?}: simulate allocated");
-        assert_eq!(m.rows, 10_000);
+        let (n, m) = allocations_in(|| {
+            run(
+                &TwoLinkArm::paper(),
+                &Wall::paper(),
+                &mut ctrl.bind(&mut state),
+                &Sinusoid::paper(),
+                &sim,
+                &mut (),
+            )
+            .expect("simulate")
+        });
+        assert_eq!(n, 0, "{law:?}: simulate allocated");
+        assert_eq!(m.rows, 500);
     }
-    // The counter does count: a Vec allocates one block.
-    let before = blocks();
-    let v: Vec<u8> = Vec::with_capacity(16);
-    assert_eq!(blocks(), before + 1);
-    drop(v);
 }

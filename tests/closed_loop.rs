@@ -3,10 +3,10 @@
 
 use adaptimp::model::{Link, PlanarArm};
 use adaptimp::{
-    simulate, AuxLaw, Config, Controller, FreeSpace, Law, Measurement, Metrics, ObserverInit, Rbf,
-    Recorder, Robust, Row, SimConfig, Sinusoid, TwoLinkArm, Vector, Wall,
+    run, AuxLaw, Centers, Config, Controller, FreeSpace, Grid, Law, Measurement, Metrics,
+    ObserverInit, Recorder, RobustKind, Row, SimConfig, Sinusoid, Tracker, Trajectory, TwoLinkArm,
+    Vector, Wall,
 };
-use nalgebra::SMatrix;
 use proptest::prelude::*;
 
 /// Tracks the worst |sat(τ)_i| / τmax_i and whether anything was non-finite.
@@ -53,18 +53,20 @@ impl<const N: usize> Recorder<N> for Guard<N> {
     }
 }
 
-fn paper_run(cfg: Config<2, 256>, t_final: f64) -> (Metrics<2>, Guard<2>) {
+fn paper_run(cfg: Config<2>, t_final: f64) -> (Metrics<2>, Guard<2>) {
     let tau_max = cfg.tau_max;
-    let mut ctrl = Box::new(Controller::new(cfg, Sinusoid::paper()).expect("valid"));
+    let ctrl = Controller::new(cfg, Grid::paper()).expect("valid");
+    let mut state = ctrl.new_state();
     let mut guard = Guard::new(tau_max);
     let sim = SimConfig {
         t_final,
         ..SimConfig::paper()
     };
-    let m = simulate(
+    let m = run(
         &TwoLinkArm::paper(),
         &Wall::paper(),
-        ctrl.as_mut(),
+        &mut ctrl.bind(&mut state),
+        &Sinusoid::paper(),
         &sim,
         &mut guard,
     )
@@ -114,17 +116,19 @@ fn tracked_weight_norms_stay_exact_over_a_whole_paper_run() {
     // The fused pass updates the norms algebraically (no second pass); after
     // 400 000 steps they still equal a recomputation from the weights.
     for law in [Law::StateFeedback, Law::OutputFeedback] {
-        let mut ctrl = Box::new(Controller::paper(law));
+        let ctrl = Controller::paper(law);
+        let mut state = ctrl.new_state();
         let sim = SimConfig::paper();
-        simulate(
+        run(
             &TwoLinkArm::paper(),
             &Wall::paper(),
-            ctrl.as_mut(),
+            &mut ctrl.bind(&mut state),
+            &Sinusoid::paper(),
             &sim,
             &mut (),
         )
         .expect("simulate");
-        let (tracked, exact) = (ctrl.weight_norms(), ctrl.weights().norms());
+        let (tracked, exact) = (state.weight_norms(), state.weights().norms());
         for (t, e) in tracked.iter().zip(exact) {
             assert!(
                 e > 1.0 && (t - e).abs() <= 1e-9 * e,
@@ -168,19 +172,11 @@ fn starting_the_observer_at_the_first_measurement_removes_the_startup_peak() {
 
 #[test]
 fn every_robust_term_runs_and_tracks() {
-    let kr = Vector::<2>::from_element(0.5);
-    for robust in [
-        Robust::None,
-        Robust::Sign { kr },
-        Robust::Tanh { kr, phi: 0.01 },
-        Robust::Remark1 {
-            kd: 0.01,
-            kc: 0.05,
-            kg: 0.5,
-        },
-    ] {
+    for robust in RobustKind::ALL {
+        // kr = 0.5 N m; Remark 1: kD = 0.01, kC = 0.05, kG = 0.5 (the defaults).
         let mut cfg = Config::paper(Law::StateFeedback);
         cfg.robust = robust;
+        cfg.phi = 0.01;
         let (m, g) = paper_run(cfg, 5.0);
         assert!(g.finite, "{robust:?}");
         assert!(m.rms_z1_after2 < 0.03, "{robust:?}: {}", m.rms_z1_after2);
@@ -213,9 +209,21 @@ fn three_link_arm_with_custom_centres_learns() {
     const L: usize = 64;
     let arm = PlanarArm::new([link(2.0, 0.4), link(1.2, 0.3), link(0.5, 0.2)], 9.81).expect("arm");
     let mut seed = 7;
-    let centers: [SMatrix<f64, N, L>; 4] =
-        core::array::from_fn(|_| SMatrix::from_fn(|_, _| lcg(&mut seed)));
-    let rbf = Rbf::custom(centers, 25.0).expect("rbf");
+    // The same centres as the earlier block-major layout: block b of node j
+    // was drawn at position (b, j) in column order.
+    let mut blocks = [[[0.0; L]; N]; 4];
+    for block in &mut blocks {
+        for j in 0..L {
+            for row in block.iter_mut() {
+                row[j] = lcg(&mut seed);
+            }
+        }
+    }
+    let centers: Vec<f64> = (0..L)
+        .flat_map(|j| (0..4).flat_map(move |b| (0..N).map(move |i| (b, i, j))))
+        .map(|(b, i, j)| blocks[b][i][j])
+        .collect();
+    let rbf = Centers::uniform(centers, 25.0).expect("rbf");
     let traj = Sinusoid::new(
         Vector::<N>::new(0.3, -0.4, 0.2),
         Vector::<N>::new(0.2, 0.15, 0.1),
@@ -230,12 +238,12 @@ fn three_link_arm_with_custom_centres_learns() {
         dq0: Vector::zeros(),
         settle: 2.0,
     };
-    let run = |law: Law| {
-        let cfg = Config::<N, L>::new(law, Vector::<N>::new(100.0, 60.0, 30.0), rbf.clone());
-        let mut ctrl = Box::new(Controller::new(cfg, traj).expect("controller"));
-        simulate(&arm, &FreeSpace, ctrl.as_mut(), &sim, &mut ()).expect("simulate")
+    let go = |law: Law| {
+        let cfg = Config::<N>::new(law, Vector::<N>::new(100.0, 60.0, 30.0));
+        let mut ctrl = Tracker::new(Controller::new(cfg, rbf.clone()).expect("controller"), traj);
+        run(&arm, &FreeSpace, &mut ctrl, &traj, &sim, &mut ()).expect("simulate")
     };
-    let (pd, sf) = (run(Law::Pd), run(Law::StateFeedback));
+    let (pd, sf) = (go(Law::Pd), go(Law::StateFeedback));
     assert!(sf.rms_z1_after2.is_finite());
     assert!(
         sf.rms_z1_after2 < 0.05 * pd.rms_z1_after2,
@@ -248,7 +256,7 @@ fn three_link_arm_with_custom_centres_learns() {
 #[test]
 fn one_link_pendulum_on_the_sixteen_node_grid_learns() {
     let arm = PlanarArm::new([link(1.0, 0.5)], 9.81).expect("arm");
-    let rbf = Rbf::<1, 16>::grid(25.0).expect("grid");
+    let rbf = Grid::<1>::new(25.0).expect("grid");
     let traj = Sinusoid::new(
         Vector::<1>::new(0.2),
         Vector::<1>::new(0.3),
@@ -263,13 +271,13 @@ fn one_link_pendulum_on_the_sixteen_node_grid_learns() {
         dq0: Vector::zeros(),
         settle: 2.0,
     };
-    let run = |law: Law| {
-        let mut cfg = Config::<1, 16>::new(law, Vector::<1>::new(20.0), rbf.clone());
+    let go = |law: Law| {
+        let mut cfg = Config::<1>::new(law, Vector::<1>::new(20.0));
         cfg.ts = 1e-4;
-        let mut ctrl = Box::new(Controller::new(cfg, traj).expect("controller"));
-        simulate(&arm, &FreeSpace, ctrl.as_mut(), &sim, &mut ()).expect("simulate")
+        let mut ctrl = Tracker::new(Controller::new(cfg, rbf).expect("controller"), traj);
+        run(&arm, &FreeSpace, &mut ctrl, &traj, &sim, &mut ()).expect("simulate")
     };
-    let (pd, sf) = (run(Law::Pd), run(Law::StateFeedback));
+    let (pd, sf) = (go(Law::Pd), go(Law::StateFeedback));
     assert!(
         sf.rms_z1_after2 < 0.25 * pd.rms_z1_after2,
         "sf {} vs pd {}",
@@ -283,7 +291,7 @@ trait AtZero<const N: usize> {
 }
 impl<const N: usize> AtZero<N> for Sinusoid<N> {
     fn sample_at_zero(&self) -> Vector<N> {
-        adaptimp::Trajectory::sample(self, 0.0).x
+        Trajectory::sample(self, 0.0).x
     }
 }
 
@@ -297,7 +305,7 @@ proptest! {
         law in prop::sample::select(vec![Law::Pd, Law::StateFeedback, Law::OutputFeedback]),
         values in prop::collection::vec(prop_oneof![-1e3..1e3f64, -1e300..1e300f64], 6 * 20),
     ) {
-        let mut c = Box::new(Controller::paper(law));
+        let mut c = Tracker::paper(law);
         for v in values.chunks(6) {
             let m = Measurement {
                 x: Vector::<2>::new(v[0], v[1]),

@@ -7,20 +7,21 @@
 
 mod common;
 
-use adaptimp::{simulate, Controller, Law, Row, SimConfig, Trace, TwoLinkArm, Wall};
+use adaptimp::{run as run_loop, Law, Row, SimConfig, Sinusoid, Trace, Tracker, TwoLinkArm, Wall};
 use common::{reference_metrics, Fixture};
 
 fn run(law: Law, t_final: f64) -> Vec<Row<2>> {
-    let mut ctrl = Box::new(Controller::paper(law));
+    let mut ctrl = Tracker::paper(law);
     let mut trace = Trace::default();
     let sim = SimConfig {
         t_final,
         ..SimConfig::paper()
     };
-    simulate(
+    run_loop(
         &TwoLinkArm::paper(),
         &Wall::paper(),
-        ctrl.as_mut(),
+        &mut ctrl,
+        &Sinusoid::paper(),
         &sim,
         &mut trace,
     )
@@ -101,11 +102,12 @@ fn paper_scenario_metrics_match_the_reference() {
         ("sf", Law::StateFeedback),
         ("of", Law::OutputFeedback),
     ] {
-        let mut ctrl = Box::new(Controller::paper(law));
-        let m = simulate(
+        let mut ctrl = Tracker::paper(law);
+        let m = run_loop(
             &arm,
             &Wall::paper(),
-            ctrl.as_mut(),
+            &mut ctrl,
+            &Sinusoid::paper(),
             &SimConfig::paper(),
             &mut (),
         )

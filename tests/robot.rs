@@ -2,8 +2,8 @@
 //! hardened options, against the targets of the 1 kHz issue. Metrics, never timings.
 
 use adaptimp::{
-    simulate, Config, Controller, Law, Metrics, Recorder, Row, SimConfig, Sinusoid, TwoLinkArm,
-    Vector, Wall,
+    run as run_loop, Config, Controller, Grid, Law, Metrics, Recorder, Row, SimConfig, Sinusoid,
+    TwoLinkArm, Vector, Wall, WeightBound,
 };
 
 /// Per-row facts the metrics do not keep.
@@ -40,8 +40,9 @@ impl Recorder<2> for Watch {
     }
 }
 
-fn run(cfg: Config<2, 256>, sim: SimConfig<2>) -> (Metrics<2>, Watch) {
-    let mut ctrl = Box::new(Controller::new(cfg, Sinusoid::paper()).expect("valid"));
+fn run(cfg: Config<2>, sim: SimConfig<2>) -> (Metrics<2>, Watch) {
+    let ctrl = Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper()).expect("valid");
+    let mut state = ctrl.new_state();
     let mut watch = Watch {
         peak_after_first: Vector::zeros(),
         first_tau: Vector::zeros(),
@@ -50,10 +51,11 @@ fn run(cfg: Config<2, 256>, sim: SimConfig<2>) -> (Metrics<2>, Watch) {
         half: sim.t_final / 2.0,
         rows: 0,
     };
-    let m = simulate(
+    let m = run_loop(
         &TwoLinkArm::paper(),
         &Wall::paper(),
-        ctrl.as_mut(),
+        &mut ctrl.bind(&mut state),
+        &Sinusoid::paper(),
         &sim,
         &mut watch,
     )
@@ -106,12 +108,15 @@ fn robot_scenario_meets_its_targets() {
 fn weights_stay_bounded_over_600_s() {
     for law in [Law::StateFeedback, Law::OutputFeedback] {
         let cfg = Config::robot(law);
-        let bound = cfg.weight_bound.expect("robot bounds");
+        let bound = Controller::robot(law)
+            .learning()
+            .bound()
+            .expect("robot bounds");
         let sim = SimConfig {
             t_final: 600.0,
             ..SimConfig::robot()
         };
-        let (m, w) = run(cfg.clone(), sim);
+        let (m, w) = run(cfg, sim);
         assert!(m.rms_z1_after2 <= 0.010, "{law:?}: {}", m.rms_z1_after2);
         for ((second, first), b) in w.w_second_half.iter().zip(w.w_first_half).zip(bound) {
             assert!(*second <= b * (1.0 + 1e-12));
@@ -126,7 +131,7 @@ fn weights_stay_bounded_over_600_s() {
         // Without the projection, normalisation, conditional integration and
         // σ-leakage alone keep them bounded too.
         let mut free = cfg;
-        free.weight_bound = None;
+        free.weight_bound = WeightBound::None;
         let (_, w) = run(free, sim);
         for net in 0..3 {
             assert!(

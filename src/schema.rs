@@ -1,0 +1,922 @@
+//! The parameter schema: every parameter's name (as Python and the command
+//! line spell it), group, kind, unit, one-line doc, validity condition and
+//! per-scenario default, declared once, in [`PARAMS`].
+//!
+//! Everything else derives from this table: the presets ([`Config::new`],
+//! [`Config::paper`], [`Config::robot`], [`SimConfig::paper`],
+//! [`Sinusoid::paper`], [`Wall::paper`], the default [`ArmParams`],
+//! [`Grid::paper`]), the setter by name ([`Scenario::set`]) through which the
+//! Python bindings and the C ABI build configurations, and, in Python, the
+//! keyword table, `help(adaptimp.simulate)`, the command line and the stubs.
+//! [`Scenario::visit`] destructures every configuration struct exhaustively, so
+//! a field added without a schema name does not compile, and a test checks
+//! that the names it visits are exactly those of [`PARAMS`].
+
+use crate::auxiliary::AuxLaw;
+use crate::config::{Config, Law, ObserverInit, WeightBound};
+use crate::environment::Wall;
+use crate::error::Error;
+use crate::learning::{LearningStep, SaturationLearning};
+use crate::model::ArmParams;
+use crate::observer::Hold;
+use crate::rbf::Grid;
+use crate::robust::RobustKind;
+use crate::simulator::SimConfig;
+use crate::trajectory::Sinusoid;
+use crate::types::Vector;
+
+/// The group a parameter belongs to (the Python keyword sets).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Group {
+    /// The run: duration, integration, initial state, metrics window.
+    Sim,
+    /// The controller, its basis and its commanded trajectory.
+    Controller,
+    /// The environment (the wall).
+    Env,
+    /// The paper's 2-link arm (the plant).
+    Arm,
+}
+
+impl Group {
+    /// The group's name in Python ("sim", "controller", "env", "arm").
+    pub fn name(self) -> &'static str {
+        match self {
+            Group::Sim => "sim",
+            Group::Controller => "controller",
+            Group::Env => "env",
+            Group::Arm => "arm",
+        }
+    }
+}
+
+/// The kind of value a parameter takes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A finite number.
+    Real,
+    /// An integer.
+    Int,
+    /// One number per joint (a scalar is broadcast).
+    Joint,
+    /// One number per network D̂, Ĉ, Ĝ (a scalar is broadcast).
+    Network,
+    /// One of the listed names.
+    Choice(&'static [&'static str]),
+    /// A number, or none.
+    Optional,
+    /// A number, or none for the value derived from other parameters.
+    Derived,
+    /// None, "auto", or one number per network.
+    Bound,
+}
+
+impl Kind {
+    /// The kind's name in Python ("real", "int", "joint", "network",
+    /// "choice", "optional", "derived", "bound").
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Real => "real",
+            Kind::Int => "int",
+            Kind::Joint => "joint",
+            Kind::Network => "network",
+            Kind::Choice(_) => "choice",
+            Kind::Optional => "optional",
+            Kind::Derived => "derived",
+            Kind::Bound => "bound",
+        }
+    }
+}
+
+/// A parameter value. Per-joint and per-network values are slices; a
+/// [`Value::Real`] given for them is broadcast.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Value<'a> {
+    /// A number.
+    Real(f64),
+    /// An integer.
+    Int(i64),
+    /// One number per joint or per network.
+    Vec(&'a [f64]),
+    /// A choice's name, or "auto".
+    Str(&'a str),
+    /// No value (free space, a derived default, no bound).
+    None,
+}
+
+/// The scenarios with their own defaults.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Preset {
+    /// The paper scenario, SPEC §1–§12 (Ts = 50 µs).
+    Paper,
+    /// The robot scenario, SPEC §13 (Ts = 1 ms, the hardened options).
+    Robot,
+}
+
+impl Preset {
+    /// Every preset.
+    pub const ALL: [Preset; 2] = [Preset::Paper, Preset::Robot];
+
+    /// Its name in Python ("paper", "robot").
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Paper => "paper",
+            Preset::Robot => "robot",
+        }
+    }
+
+    /// The preset called `name`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+}
+
+/// One parameter: see the [module docs](self).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Param {
+    /// Its name in Python and on the command line, e.g. `"Kzeta"`.
+    pub name: &'static str,
+    /// Its group.
+    pub group: Group,
+    /// Its kind of value.
+    pub kind: Kind,
+    /// Its unit (empty if dimensionless).
+    pub unit: &'static str,
+    /// What it means, in one line.
+    pub doc: &'static str,
+    /// The condition a valid value meets (SPEC §10 style), or "" if any
+    /// finite value is valid.
+    pub condition: &'static str,
+    /// Its default in the paper scenario.
+    pub paper: Value<'static>,
+    /// Its default in the robot scenario, if it differs.
+    pub robot: Option<Value<'static>>,
+}
+
+impl Param {
+    /// Its default in `preset`.
+    pub fn default_in(&self, preset: Preset) -> Value<'static> {
+        match (preset, self.robot) {
+            (Preset::Robot, Some(v)) => v,
+            _ => self.paper,
+        }
+    }
+}
+
+const fn p(
+    name: &'static str,
+    group: Group,
+    kind: Kind,
+    unit: &'static str,
+    doc: &'static str,
+    condition: &'static str,
+    paper: Value<'static>,
+) -> Param {
+    Param {
+        name,
+        group,
+        kind,
+        unit,
+        doc,
+        condition,
+        paper,
+        robot: None,
+    }
+}
+
+/// The same parameter with a robot-scenario default of its own.
+const fn robot(param: Param, value: Value<'static>) -> Param {
+    Param {
+        robot: Some(value),
+        ..param
+    }
+}
+
+use Group::{Arm, Controller as Ctrl, Env, Sim};
+use Kind::{Bound, Derived, Int, Joint, Network, Optional, Real};
+use Value::{Int as I, None as Nil, Real as R, Str as S, Vec as V};
+
+const PI: f64 = core::f64::consts::PI;
+
+/// Every parameter, in the order of the documentation.
+pub const PARAMS: &[Param] = &[
+    // The run, SPEC §11 (the robot scenario: SPEC §13).
+    p("T", Sim, Real, "s", "duration; rows k = 0 … round(T/Ts) − 1 are recorded", "T > 0", R(20.0)),
+    robot(
+        p("substeps", Sim, Int, "", "RK4 substeps M of the plant per controller period", "substeps ≥ 1", I(1)),
+        I(10),
+    ),
+    p("q0", Sim, Joint, "rad", "initial joint position q(0), (65)", "", V(&[0.25, -0.05])),
+    p("dq0", Sim, Joint, "rad/s", "initial joint velocity q̇(0)", "", R(0.0)),
+    p("settle", Sim, Real, "s", "start of the 'after2' window of the metrics (SPEC §12)", "", R(2.0)),
+    // The controller, SPEC §4–§9, §11.
+    robot(p("Ts", Ctrl, Real, "s", "sampling period of the controller", "Ts > 0", R(50e-6)), R(1e-3)),
+    p("K1", Ctrl, Joint, "1/s", "K1 of α1 = ẋd + K1 z1, (7)", "K1 > 0", R(6.0)),
+    p("Kp", Ctrl, Joint, "N m s/rad", "feedback gain Kp, (14)", "2Kp − I > 0", R(10.0)),
+    p("Kzeta", Ctrl, Joint, "1/s", "auxiliary-system gain Kζ, (11)", "2Kζ − I − KpᵀKp > 0", R(60.0)),
+    p("mu", Ctrl, Real, "N m", "radius μ of the auxiliary system's inner ball, (11)", "μ > 0", R(0.01)),
+    p(
+        "aux_law",
+        Ctrl,
+        Kind::Choice(&AuxLaw::NAMES),
+        "",
+        "auxiliary law: inside ‖ζ‖ < μ ζ̇ = −Kζ ζ + Δτ, or the printed ζ̇ = 0 (SPEC §8); 'linear': ζ̇ = −Kζ ζ + Δτ everywhere, without the −β term (SPEC §13)",
+        "",
+        S("default"),
+    ),
+    robot(
+        p(
+            "robust",
+            Ctrl,
+            Kind::Choice(&RobustKind::NAMES),
+            "",
+            "robust term r(z2): kr sgn z2, kr tanh(z2/φ), Remark 1's gain, none (SPEC §7)",
+            "",
+            S("sign"),
+        ),
+        S("tanh"),
+    ),
+    p("kr", Ctrl, Joint, "N m", "gain of the 'sign' and 'tanh' robust terms (SPEC §7)", "kr ≥ 0", R(0.5)),
+    // φ is of the order of the adaptive loops' |z2| after settling (measured on
+    // joint 1: median 0.015, RMS 0.09 rad/s), so tanh is smooth near the target.
+    p("phi", Ctrl, Real, "rad/s", "boundary layer φ of the 'tanh' robust term", "φ > 0", R(0.05)),
+    // The Remark 1 gains make kr ≈ 0.55 N m on the paper's circle, close to the sign term's.
+    p("kD", Ctrl, Real, "kg m²", "Remark 1 (30): kr_i = kD |α̇1_i| + kC |α1_i| + kG", "kD ≥ 0", R(0.01)),
+    p("kC", Ctrl, Real, "N m s/rad", "Remark 1 (30): gain on |α1_i|", "kC ≥ 0", R(0.05)),
+    p("kG", Ctrl, Real, "N m", "Remark 1 (30): constant part", "kG ≥ 0", R(0.5)),
+    p("gamma", Ctrl, Network, "", "learning gains Γ of D̂, Ĉ, Ĝ, (15)–(17)", "Γ > 0", R(100.0)),
+    p("sigma", Ctrl, Network, "", "leakages σ of D̂, Ĉ, Ĝ, (15)–(17)", "σ > 0", R(0.01)),
+    p("eta2", Ctrl, Real, "", "RBF width η² of the vertex grid (the paper's 'variance 25'), SPEC §6", "η² > 0", R(25.0)),
+    // SPEC §9: ε = 1e-4 s, not the paper's 1e-3.
+    p("eps", Ctrl, Real, "s", "high-gain observer ε, (31)", "ε > 0", R(1e-4)),
+    p("lam1", Ctrl, Joint, "", "high-gain observer λ1, (31)", "λ1 > 0", R(3.0)),
+    robot(
+        p(
+            "observer_init",
+            Ctrl,
+            Kind::Choice(&ObserverInit::NAMES),
+            "",
+            "observer start: π(0) = 0 (paper), or π1(0) = the first measurement",
+            "",
+            S("zero"),
+        ),
+        S("first"),
+    ),
+    robot(
+        p(
+            "observer_hold",
+            Ctrl,
+            Kind::Choice(&Hold::NAMES),
+            "",
+            "observer discretisation: zero-order hold (SPEC §11) or triangle hold",
+            "",
+            S("zoh"),
+        ),
+        S("triangle"),
+    ),
+    p("tau_max", Ctrl, Joint, "N m", "actuator limits τmax (SPEC §2)", "τmax > 0", V(&[17.0, 15.0])),
+    p("Dd", Ctrl, Joint, "kg m²", "target inertia Dd, (3)", "Dd > 0", R(1.0)),
+    p("Cd", Ctrl, Joint, "N m s/rad", "target damping Cd, (3)", "Cd ≥ 0", R(10.0)),
+    p("Gd", Ctrl, Joint, "N m/rad", "target stiffness Gd, (3)", "Gd ≥ 0", R(60.0)),
+    // (64): xc = [0.2 − 0.2 cos(πt), 0.2 + 0.2 sin(πt)].
+    p(
+        "xc_offset",
+        Ctrl,
+        Joint,
+        "rad",
+        "commanded trajectory xc_i = o_i + a_i sin(ω_i t) + b_i cos(ω_i t): offset o",
+        "",
+        V(&[0.2, 0.2]),
+    ),
+    p("xc_sin", Ctrl, Joint, "rad", "commanded trajectory: sine amplitude a", "", V(&[0.0, 0.2])),
+    p("xc_cos", Ctrl, Joint, "rad", "commanded trajectory: cosine amplitude b", "", V(&[-0.2, 0.0])),
+    p("xc_omega", Ctrl, Joint, "rad/s", "commanded trajectory: angular frequency ω", "", R(PI)),
+    // Hardened options (SPEC §13, beyond the paper; the robot scenario's defaults).
+    robot(
+        p(
+            "learning_step",
+            Ctrl,
+            Kind::Choice(&LearningStep::NAMES),
+            "",
+            "learning step: explicit Euler of (15)–(17), or normalised so that one step's gain from z2 to the network output stays below κ·Kp",
+            "",
+            S("euler"),
+        ),
+        S("normalized"),
+    ),
+    p("kappa", Ctrl, Real, "", "κ of the normalised step", "0 < κ ≤ 1", R(0.5)),
+    robot(
+        p(
+            "saturation_learning",
+            Ctrl,
+            Kind::Choice(&SaturationLearning::NAMES),
+            "",
+            "learning while a joint saturates: as printed, or conditional integration (no step that pushes τ further beyond the limit)",
+            "",
+            S("ignore"),
+        ),
+        S("freeze"),
+    ),
+    robot(
+        p(
+            "weight_bound",
+            Ctrl,
+            Bound,
+            "",
+            "projection onto ‖Ŵ‖_F ≤ b for D̂, Ĉ, Ĝ: None (none), 'auto' (derived from tau_max, the number of nodes and the commanded trajectory's peak speed and acceleration), or b",
+            "weight bound > 0",
+            Nil,
+        ),
+        S("auto"),
+    ),
+    // The environment, SPEC §3.
+    p("wall", Env, Optional, "rad", "wall on joint 1 at this position; None: free space", "", R(0.2)),
+    p("ke", Env, Real, "N m/rad", "wall stiffness", "ke ≥ 0", R(1000.0)),
+    p("be", Env, Real, "N m s/rad", "wall damping", "be ≥ 0", R(10.0)),
+    // The arm, SPEC §1 (the plant only: the controller is model-free). Table I
+    // is missing; the same group's arm.
+    p("m1", Arm, Real, "kg", "mass of link 1", "m1 > 0", R(2.0)),
+    p("m2", Arm, Real, "kg", "mass of link 2", "m2 > 0", R(0.85)),
+    p("l1", Arm, Real, "m", "length of link 1", "l1 > 0", R(0.35)),
+    p("l2", Arm, Real, "m", "length of link 2", "l2 > 0", R(0.31)),
+    p("lc1", Arm, Derived, "m", "joint 1 to the centre of mass of link 1 (None: l1/2)", "lc1 ≥ 0", Nil),
+    p("lc2", Arm, Derived, "m", "joint 2 to the centre of mass of link 2 (None: l2/2)", "lc2 ≥ 0", Nil),
+    p("I1", Arm, Derived, "kg m²", "inertia of link 1 about its centre (None: m1 l1²/4)", "I1 ≥ 0", Nil),
+    p("I2", Arm, Derived, "kg m²", "inertia of link 2 about its centre (None: m2 l2²/4)", "I2 ≥ 0", Nil),
+    p("g", Arm, Real, "m/s²", "gravitational acceleration (vertical plane)", "", R(9.81)),
+];
+
+/// The parameter called `name`.
+pub fn param(name: &str) -> Option<&'static Param> {
+    PARAMS.iter().find(|p| p.name == name)
+}
+
+/// The arm's parameters with the derived ones (centres of mass, inertias)
+/// left open: `None` takes the default derived from mass and length.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct ArmValues {
+    /// m1, m2 (kg), l1, l2 (m), g (m/s²).
+    pub m: [f64; 2],
+    /// Link lengths (m).
+    pub l: [f64; 2],
+    /// Centres of mass (m); `None`: l/2.
+    pub lc: [Option<f64>; 2],
+    /// Inertias about the centres (kg m²); `None`: m l²/4.
+    pub inertia: [Option<f64>; 2],
+    /// Gravitational acceleration (m/s²).
+    pub g: f64,
+}
+
+impl ArmValues {
+    /// The arm's parameters, with the derived ones filled in (SPEC §1).
+    pub fn resolve(&self) -> ArmParams {
+        let lc = |i: usize| self.lc[i].unwrap_or(self.l[i] / 2.0);
+        let inertia = |i: usize| self.inertia[i].unwrap_or(self.m[i] * self.l[i] * self.l[i] / 4.0);
+        ArmParams {
+            m1: self.m[0],
+            m2: self.m[1],
+            l1: self.l[0],
+            l2: self.l[1],
+            lc1: lc(0),
+            lc2: lc(1),
+            i1: inertia(0),
+            i2: inertia(1),
+            g: self.g,
+        }
+    }
+}
+
+/// Every parameter of a scenario at once: the controller's configuration,
+/// its basis width and trajectory, the run, the wall and the arm. Built from
+/// a [`Preset`] and changed by name with [`set`](Self::set); validated by the
+/// constructors it feeds.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Scenario<const N: usize> {
+    /// The controller's configuration.
+    pub config: Config<N>,
+    /// The run.
+    pub sim: SimConfig<N>,
+    /// η² of the vertex grid.
+    pub eta2: f64,
+    /// The commanded sinusoid: offset, sine and cosine amplitudes (rad), ω (rad/s).
+    pub xc: [Vector<N>; 4],
+    /// The wall position (rad), or free space.
+    pub wall: Option<f64>,
+    /// Wall stiffness (N m/rad) and damping (N m s/rad).
+    pub ke_be: [f64; 2],
+    /// The 2-link arm.
+    pub arm: ArmValues,
+}
+
+/// A lookup that cannot fail: `name` is in [`PARAMS`] and its default suits
+/// `N` (tested for N = 1 … 7).
+fn preset_error(name: &str, e: Error) -> ! {
+    unreachable!("the schema's default of {name} applies: {e}")
+}
+
+impl<const N: usize> Scenario<N> {
+    /// Every default of `preset` for the controller `law`. Per-joint defaults
+    /// given as one value per joint of the 2-link arm (q0, τmax, the paper's
+    /// circle) apply to N = 2; for other N, give them yourself (they start at
+    /// the first value, broadcast).
+    pub fn preset(preset: Preset, law: Law) -> Self {
+        let zero = Vector::<N>::zeros();
+        let mut s = Self {
+            config: Config::zeroed(law),
+            sim: SimConfig {
+                t_final: 0.0,
+                substeps: 0,
+                q0: zero,
+                dq0: zero,
+                settle: 0.0,
+            },
+            eta2: 0.0,
+            xc: [zero; 4],
+            wall: None,
+            ke_be: [0.0; 2],
+            arm: ArmValues {
+                m: [0.0; 2],
+                l: [0.0; 2],
+                lc: [None; 2],
+                inertia: [None; 2],
+                g: 0.0,
+            },
+        };
+        for p in PARAMS {
+            let v = match p.default_in(preset) {
+                // A per-joint default for another number of joints: broadcast its first value.
+                Value::Vec(v) if p.kind == Kind::Joint && v.len() != N => Value::Real(v[0]),
+                v => v,
+            };
+            if let Err(e) = s.set(p.name, v) {
+                preset_error(p.name, e)
+            }
+        }
+        s
+    }
+
+    /// Set parameter `name` to `value`. Errors (naming the parameter) for an
+    /// unknown name, a value of the wrong kind or length, or an unknown
+    /// choice; the conditions of SPEC §10 are checked by the constructors.
+    pub fn set(&mut self, name: &str, value: Value<'_>) -> Result<(), Error> {
+        let p = param(name).ok_or(Error::Invalid {
+            what: "parameter",
+            reason: "unknown name (see adaptimp::schema::PARAMS)",
+        })?;
+        let n = p.name;
+        let c = &mut self.config;
+        match n {
+            "T" => self.sim.t_final = real(n, value)?,
+            "substeps" => {
+                let v = int(n, value)?;
+                self.sim.substeps = usize::try_from(v).map_err(|_| Error::Condition {
+                    condition: "substeps ≥ 1",
+                    lhs: "substeps",
+                    index: None,
+                    value: v as f64,
+                })?
+            }
+            "q0" => self.sim.q0 = joint(n, value)?,
+            "dq0" => self.sim.dq0 = joint(n, value)?,
+            "settle" => self.sim.settle = real(n, value)?,
+            "Ts" => c.ts = real(n, value)?,
+            "K1" => c.k1 = joint(n, value)?,
+            "Kp" => c.kp = joint(n, value)?,
+            "Kzeta" => c.kzeta = joint(n, value)?,
+            "mu" => c.mu = real(n, value)?,
+            "aux_law" => c.aux_law = choice(p, value, &AuxLaw::ALL)?,
+            "robust" => c.robust = choice(p, value, &RobustKind::ALL)?,
+            "kr" => c.kr = joint(n, value)?,
+            "phi" => c.phi = real(n, value)?,
+            "kD" => c.kd = real(n, value)?,
+            "kC" => c.kc = real(n, value)?,
+            "kG" => c.kg = real(n, value)?,
+            "gamma" => c.gamma = network(n, value)?,
+            "sigma" => c.sigma = network(n, value)?,
+            "eta2" => self.eta2 = real(n, value)?,
+            "eps" => c.eps = real(n, value)?,
+            "lam1" => c.lam1 = joint(n, value)?,
+            "observer_init" => c.observer_init = choice(p, value, &ObserverInit::ALL)?,
+            "observer_hold" => c.observer_hold = choice(p, value, &Hold::ALL)?,
+            "tau_max" => c.tau_max = joint(n, value)?,
+            "Dd" => c.dd = joint(n, value)?,
+            "Cd" => c.cd = joint(n, value)?,
+            "Gd" => c.gd = joint(n, value)?,
+            "xc_offset" => self.xc[0] = joint(n, value)?,
+            "xc_sin" => self.xc[1] = joint(n, value)?,
+            "xc_cos" => self.xc[2] = joint(n, value)?,
+            "xc_omega" => self.xc[3] = joint(n, value)?,
+            "learning_step" => c.learning_step = choice(p, value, &LearningStep::ALL)?,
+            "kappa" => c.kappa = real(n, value)?,
+            "saturation_learning" => {
+                c.saturation_learning = choice(p, value, &SaturationLearning::ALL)?
+            }
+            "weight_bound" => {
+                c.weight_bound = match value {
+                    Value::None => WeightBound::None,
+                    Value::Str("auto") => WeightBound::Auto,
+                    v => WeightBound::Fixed(network(n, v)?),
+                }
+            }
+            "wall" => self.wall = optional(n, value)?,
+            "ke" => self.ke_be[0] = real(n, value)?,
+            "be" => self.ke_be[1] = real(n, value)?,
+            "m1" => self.arm.m[0] = real(n, value)?,
+            "m2" => self.arm.m[1] = real(n, value)?,
+            "l1" => self.arm.l[0] = real(n, value)?,
+            "l2" => self.arm.l[1] = real(n, value)?,
+            "lc1" => self.arm.lc[0] = optional(n, value)?,
+            "lc2" => self.arm.lc[1] = optional(n, value)?,
+            "I1" => self.arm.inertia[0] = optional(n, value)?,
+            "I2" => self.arm.inertia[1] = optional(n, value)?,
+            "g" => self.arm.g = real(n, value)?,
+            _ => unreachable!("{n} is in PARAMS but has no setter"),
+        }
+        Ok(())
+    }
+
+    /// Call `f` with every parameter's name and current value. Every field of
+    /// every struct is destructured without `..`: a field added without a
+    /// schema name is a compile error here.
+    pub fn visit(&self, mut f: impl FnMut(&'static str, Value<'_>)) {
+        let Config {
+            law: _,
+            ts,
+            k1,
+            kp,
+            kzeta,
+            mu,
+            aux_law,
+            robust,
+            kr,
+            phi,
+            kd,
+            kc,
+            kg,
+            learning_step,
+            kappa,
+            saturation_learning,
+            weight_bound,
+            gamma,
+            sigma,
+            eps,
+            lam1,
+            observer_init,
+            observer_hold,
+            tau_max,
+            dd,
+            cd,
+            gd,
+        } = &self.config;
+        let SimConfig {
+            t_final,
+            substeps,
+            q0,
+            dq0,
+            settle,
+        } = &self.sim;
+        let Self {
+            config: _,
+            sim: _,
+            eta2,
+            xc: [xc_offset, xc_sin, xc_cos, xc_omega],
+            wall,
+            ke_be: [ke, be],
+            arm:
+                ArmValues {
+                    m: [m1, m2],
+                    l: [l1, l2],
+                    lc: [lc1, lc2],
+                    inertia: [i1, i2],
+                    g,
+                },
+        } = self;
+        let opt = |v: &Option<f64>| v.map_or(Value::None, Value::Real);
+        f("T", R(*t_final));
+        f("substeps", I(*substeps as i64));
+        f("q0", V(q0.as_slice()));
+        f("dq0", V(dq0.as_slice()));
+        f("settle", R(*settle));
+        f("Ts", R(*ts));
+        f("K1", V(k1.as_slice()));
+        f("Kp", V(kp.as_slice()));
+        f("Kzeta", V(kzeta.as_slice()));
+        f("mu", R(*mu));
+        f("aux_law", S(aux_law.name()));
+        f("robust", S(robust.name()));
+        f("kr", V(kr.as_slice()));
+        f("phi", R(*phi));
+        f("kD", R(*kd));
+        f("kC", R(*kc));
+        f("kG", R(*kg));
+        f("gamma", V(gamma));
+        f("sigma", V(sigma));
+        f("eta2", R(*eta2));
+        f("eps", R(*eps));
+        f("lam1", V(lam1.as_slice()));
+        f("observer_init", S(observer_init.name()));
+        f("observer_hold", S(observer_hold.name()));
+        f("tau_max", V(tau_max.as_slice()));
+        f("Dd", V(dd.as_slice()));
+        f("Cd", V(cd.as_slice()));
+        f("Gd", V(gd.as_slice()));
+        f("xc_offset", V(xc_offset.as_slice()));
+        f("xc_sin", V(xc_sin.as_slice()));
+        f("xc_cos", V(xc_cos.as_slice()));
+        f("xc_omega", V(xc_omega.as_slice()));
+        f("learning_step", S(learning_step.name()));
+        f("kappa", R(*kappa));
+        f("saturation_learning", S(saturation_learning.name()));
+        match weight_bound {
+            WeightBound::None => f("weight_bound", Nil),
+            WeightBound::Auto => f("weight_bound", S("auto")),
+            WeightBound::Fixed(b) => f("weight_bound", V(b)),
+        }
+        f("wall", opt(wall));
+        f("ke", R(*ke));
+        f("be", R(*be));
+        f("m1", R(*m1));
+        f("m2", R(*m2));
+        f("l1", R(*l1));
+        f("l2", R(*l2));
+        f("lc1", opt(lc1));
+        f("lc2", opt(lc2));
+        f("I1", opt(i1));
+        f("I2", opt(i2));
+        f("g", R(*g));
+    }
+
+    /// The commanded sinusoid (validated: finite).
+    pub fn trajectory(&self) -> Result<Sinusoid<N>, Error> {
+        let [o, a, b, w] = self.xc;
+        Sinusoid::new(o, a, b, w)
+    }
+
+    /// The vertex grid of width η² (validated).
+    pub fn grid(&self) -> Result<Grid<N>, Error> {
+        Grid::new(self.eta2)
+    }
+}
+
+fn kind_error(name: &'static str) -> Error {
+    Error::Invalid {
+        what: name,
+        reason: "a value of another kind is expected (see its schema entry)",
+    }
+}
+
+fn real(name: &'static str, v: Value<'_>) -> Result<f64, Error> {
+    match v {
+        Value::Real(x) => Ok(x),
+        Value::Int(i) => Ok(i as f64),
+        _ => Err(kind_error(name)),
+    }
+}
+
+fn int(name: &'static str, v: Value<'_>) -> Result<i64, Error> {
+    match v {
+        Value::Int(i) => Ok(i),
+        _ => Err(kind_error(name)),
+    }
+}
+
+fn optional(name: &'static str, v: Value<'_>) -> Result<Option<f64>, Error> {
+    match v {
+        Value::None => Ok(None),
+        v => real(name, v).map(Some),
+    }
+}
+
+fn array<const M: usize>(name: &'static str, v: Value<'_>) -> Result<[f64; M], Error> {
+    match v {
+        Value::Vec(s) => s.try_into().map_err(|_| Error::Invalid {
+            what: name,
+            reason: "wrong length: one value per joint, or per network D, C, G",
+        }),
+        v => real(name, v).map(|x| [x; M]),
+    }
+}
+
+fn joint<const N: usize>(name: &'static str, v: Value<'_>) -> Result<Vector<N>, Error> {
+    array::<N>(name, v).map(Vector::from)
+}
+
+fn network(name: &'static str, v: Value<'_>) -> Result<[f64; 3], Error> {
+    array::<3>(name, v)
+}
+
+fn choice<T: Copy>(p: &Param, v: Value<'_>, all: &[T]) -> Result<T, Error> {
+    let (Kind::Choice(names), Value::Str(s)) = (p.kind, v) else {
+        return Err(kind_error(p.name));
+    };
+    names
+        .iter()
+        .position(|n| *n == s)
+        .and_then(|i| all.get(i).copied())
+        .ok_or(Error::Invalid {
+            what: p.name,
+            reason: "not one of its choices (see its schema entry)",
+        })
+}
+
+// ---------------------------------------------------------------------------
+// The presets, from the table.
+// ---------------------------------------------------------------------------
+
+impl<const N: usize> Config<N> {
+    /// The paper's gains for `N` joints with limits `tau_max` (N m); Ts = 50 µs
+    /// (the paper scenario, SPEC §11): the schema's paper defaults.
+    pub fn new(law: Law, tau_max: Vector<N>) -> Self {
+        let mut cfg = Scenario::<N>::preset(Preset::Paper, law).config;
+        cfg.tau_max = tau_max;
+        cfg
+    }
+
+    /// This configuration with every hardened option of the robot scenario
+    /// (SPEC §13), whatever Ts is: each controller parameter whose robot
+    /// default differs from the paper's, except Ts. That is:
+    ///
+    /// - [`LearningStep::Normalized`] with κ = 0.5 (the per-step learning gain
+    ///   stays below Kp/2; the printed Euler step exceeds Kp at 1 ms);
+    /// - [`SaturationLearning::Freeze`] (no learning into the limits);
+    /// - [`WeightBound::Auto`] (bounds from τmax and the commanded trajectory);
+    /// - the tanh robust term (sgn chatters at 1 kHz) with φ = 0.05 rad/s;
+    /// - observer: [`Hold::Triangle`] (at Ts ≫ ε it is the backward difference
+    ///   of the samples, where ZOH estimates ≈ 0 at the sample instants),
+    ///   started at the first measurement.
+    pub fn hardened(self) -> Self {
+        let mut s = Scenario::<N>::preset(Preset::Paper, self.law);
+        s.config = self;
+        for p in PARAMS {
+            if let (Group::Controller, Some(v), false) = (p.group, p.robot, p.name == "Ts") {
+                if let Err(e) = s.set(p.name, v) {
+                    preset_error(p.name, e)
+                }
+            }
+        }
+        s.config
+    }
+}
+
+impl Config<2> {
+    /// The paper scenario (SPEC §11) for the 2-link arm: every default of the SPEC.
+    pub fn paper(law: Law) -> Self {
+        Scenario::<2>::preset(Preset::Paper, law).config
+    }
+
+    /// The "robot" scenario (SPEC §13, beyond the paper): the paper's arm,
+    /// gains, Γ, σ, η² and 256 nodes at a robot's Ts = 1 ms, with the
+    /// [hardened](Self::hardened) options as defaults.
+    pub fn robot(law: Law) -> Self {
+        Scenario::<2>::preset(Preset::Robot, law).config
+    }
+}
+
+impl SimConfig<2> {
+    /// The paper scenario: T = 20 s, M = 1, q(0) = [0.25, −0.05], q̇(0) = 0 (SPEC §11, (65)).
+    pub fn paper() -> Self {
+        Scenario::<2>::preset(Preset::Paper, Law::Pd).sim
+    }
+
+    /// The "robot" scenario's run: the paper scenario with M = 10 RK4 substeps
+    /// per 1 ms period (SPEC §13). Use with [`Config::robot`].
+    pub fn robot() -> Self {
+        Scenario::<2>::preset(Preset::Robot, Law::Pd).sim
+    }
+}
+
+impl Sinusoid<2> {
+    /// The paper's commanded circle (64): centre [0.2, 0.2] rad, radius 0.2 rad, ω = π rad/s.
+    pub fn paper() -> Self {
+        Scenario::<2>::preset(Preset::Paper, Law::Pd)
+            .trajectory()
+            .unwrap_or_else(|e| preset_error("xc", e))
+    }
+}
+
+impl Wall<2> {
+    /// SPEC §3 defaults: joint 1 (index 0), w = 0.2 rad, ke = 1000 N m/rad, be = 10 N m s/rad.
+    pub fn paper() -> Self {
+        let s = Scenario::<2>::preset(Preset::Paper, Law::Pd);
+        let w = s
+            .wall
+            .unwrap_or_else(|| unreachable!("the paper has a wall"));
+        Wall::new(0, w, s.ke_be[0], s.ke_be[1]).unwrap_or_else(|e| preset_error("wall", e))
+    }
+}
+
+impl Default for ArmParams {
+    /// SPEC §1 defaults: m = [2.00, 0.85] kg, l = [0.35, 0.31] m, lc = l/2,
+    /// I = m l²/4, g = 9.81 m/s².
+    fn default() -> Self {
+        Scenario::<2>::preset(Preset::Paper, Law::Pd).arm.resolve()
+    }
+}
+
+impl Grid<2> {
+    /// The paper's grid for the 2-link arm: 256 nodes, η² = 25 (SPEC §6).
+    pub fn paper() -> Self {
+        Scenario::<2>::preset(Preset::Paper, Law::Pd)
+            .grid()
+            .unwrap_or_else(|e| preset_error("eta2", e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn visit_names_exactly_the_schema_in_its_order() {
+        let s = Scenario::<2>::preset(Preset::Robot, Law::StateFeedback);
+        let mut seen = alloc::vec::Vec::new();
+        s.visit(|name, _| seen.push(name));
+        let table: alloc::vec::Vec<_> = PARAMS.iter().map(|p| p.name).collect();
+        assert_eq!(seen, table);
+    }
+
+    #[test]
+    fn every_value_round_trips_through_set_and_visit() {
+        for preset in Preset::ALL {
+            let s = Scenario::<2>::preset(preset, Law::OutputFeedback);
+            let mut copy = Scenario::<2>::preset(Preset::Paper, Law::OutputFeedback);
+            s.visit(|name, v| copy.set(name, v).unwrap());
+            assert_eq!(copy, s, "{preset:?}");
+            // The defaults the table declares are the values visited.
+            s.visit(|name, v| {
+                let d = param(name).unwrap().default_in(preset);
+                match (d, v) {
+                    (Value::Real(x), Value::Vec(y)) => assert!(y.iter().all(|y| *y == x), "{name}"),
+                    (d, v) => assert_eq!(d, v, "{name}"),
+                }
+            });
+        }
+    }
+
+    #[test]
+    fn presets_apply_for_every_size() {
+        fn check<const N: usize>() {
+            for preset in Preset::ALL {
+                let s = Scenario::<N>::preset(preset, Law::StateFeedback);
+                assert_eq!(s.config.kp, Vector::<N>::from_element(10.0));
+            }
+        }
+        check::<1>();
+        check::<2>();
+        check::<3>();
+        check::<5>();
+        check::<7>();
+    }
+
+    #[test]
+    fn every_choice_name_maps_to_a_distinct_variant() {
+        let mut s = Scenario::<2>::preset(Preset::Paper, Law::Pd);
+        for p in PARAMS {
+            if let Kind::Choice(names) = p.kind {
+                for name in names {
+                    s.set(p.name, Value::Str(name)).unwrap();
+                    s.visit(|n, v| {
+                        if n == p.name {
+                            assert_eq!(v, Value::Str(name));
+                        }
+                    });
+                }
+                let e = s.set(p.name, Value::Str("nonsense")).unwrap_err();
+                assert!(e.to_string().contains("not one of its choices"), "{e}");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_names_and_kinds_are_errors() {
+        let mut s = Scenario::<2>::preset(Preset::Paper, Law::Pd);
+        assert!(s.set("Kpp", Value::Real(1.0)).is_err());
+        assert!(s.set("Kp", Value::Str("x")).is_err());
+        assert!(s.set("Kp", Value::Vec(&[1.0, 2.0, 3.0])).is_err());
+        let e = s.set("substeps", Value::Int(-1)).unwrap_err();
+        assert!(e.to_string().contains("substeps ≥ 1"), "{e}");
+        s.set("weight_bound", Value::Vec(&[1.0, 2.0, 3.0])).unwrap();
+        assert_eq!(s.config.weight_bound, WeightBound::Fixed([1.0, 2.0, 3.0]));
+        s.set("weight_bound", Value::Real(2.0)).unwrap();
+        assert_eq!(s.config.weight_bound, WeightBound::Fixed([2.0; 3]));
+    }
+
+    #[test]
+    fn presets_are_the_documented_values() {
+        let c = Config::paper(Law::StateFeedback);
+        assert_eq!(c.ts, 50e-6);
+        assert_eq!(c.tau_max, Vector::<2>::new(17.0, 15.0));
+        let r = Config::robot(Law::StateFeedback);
+        assert_eq!(r.ts, 1e-3);
+        assert_eq!(r.weight_bound, WeightBound::Auto);
+        assert_eq!(Config::paper(Law::StateFeedback).hardened().ts, 50e-6);
+        let mut h = Config::robot(Law::StateFeedback);
+        h.ts = 50e-6;
+        assert_eq!(Config::paper(Law::StateFeedback).hardened(), h);
+        assert_eq!(SimConfig::robot().substeps, 10);
+        let a = ArmParams::default();
+        assert!((a.i2 - 0.85 * 0.31 * 0.31 / 4.0).abs() < 1e-15);
+        assert_eq!(Wall::paper().position(), 0.2);
+        assert_eq!(Grid::paper().eta2(), 25.0);
+    }
+}

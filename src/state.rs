@@ -1,0 +1,158 @@
+//! A controller's state, owned by the caller (pinocchio's Data, idsp's
+//! state): the clock, the compliant reference, ζ, the observer, the basis
+//! values, the weights and their norms, and the last command.
+//!
+//! One [`Controller`](crate::Controller) (the validated description) drives
+//! any number of states. The large part, the basis and the `(2N² + N) L`
+//! weights, lives in one flat `f64` buffer `S`: a `Vec<f64>` on the heap
+//! (feature `alloc`, [`Controller::new_state`](crate::Controller::new_state)),
+//! or any buffer of the caller's, e.g. a `static mut` array in firmware
+//! ([`Controller::state_in`](crate::Controller::state_in)). Either way it is
+//! zeroed in place: no large value is ever built on the stack.
+
+use crate::error::Error;
+use crate::impedance::Reference;
+use crate::io::Command;
+use crate::network::{Layout, Weights, WeightsMut};
+use crate::observer::ObserverState;
+use crate::types::Vector;
+
+/// The state of one controller run. See the [module docs](self).
+#[derive(Clone, Debug)]
+pub struct State<const N: usize, S> {
+    /// Steps taken since the start (k of t_k = k·Ts for the next step).
+    pub(crate) k: u64,
+    pub(crate) reference: Reference<N>,
+    pub(crate) zeta: Vector<N>,
+    pub(crate) observer: ObserverState<N>,
+    /// ‖Ŵ‖_F of the current weights (kept up to date by every update).
+    pub(crate) norms: [f64; 3],
+    pub(crate) last: Command<N>,
+    layout: Layout,
+    buf: S,
+}
+
+/// A state whose buffer is on the heap.
+#[cfg(feature = "alloc")]
+pub type HeapState<const N: usize> = State<N, alloc::vec::Vec<f64>>;
+
+impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
+    /// A state at t = 0 (weights zero) for a basis of `nodes` nodes in `buf`,
+    /// which must hold at least [`Layout::buffer_len`]`(N, nodes)` reals; it is
+    /// zeroed. Errors if it is too short.
+    pub fn new_in(nodes: usize, mut buf: S) -> Result<Self, Error> {
+        if N == 0 || nodes == 0 {
+            return Err(Error::Invalid {
+                what: "state",
+                reason: "needs at least one joint and one node",
+            });
+        }
+        let slice = buf.as_mut();
+        let layout =
+            Layout::new(N, nodes, slice.as_ptr() as usize, slice.len()).ok_or(Error::Invalid {
+                what: "state buffer",
+                reason: "too short for the basis and weights: see Controller::buffer_len",
+            })?;
+        slice.fill(0.0);
+        Ok(Self {
+            k: 0,
+            reference: Reference::zeros(),
+            zeta: Vector::zeros(),
+            observer: ObserverState::zeros(),
+            norms: [0.0; 3],
+            last: Command::zeros(),
+            layout,
+            buf,
+        })
+    }
+
+    /// Back to t = 0: weights, ζ, observer and reference as at creation.
+    pub fn reset(&mut self) {
+        self.k = 0;
+        self.reference = Reference::zeros();
+        self.zeta = Vector::zeros();
+        self.observer = ObserverState::zeros();
+        self.norms = [0.0; 3];
+        self.last = Command::zeros();
+        self.buf.as_mut().fill(0.0);
+    }
+
+    /// Number of steps taken since creation or reset.
+    pub fn steps(&self) -> u64 {
+        self.k
+    }
+    /// Auxiliary state ζ (N m), (11), for the next step.
+    pub fn zeta(&self) -> &Vector<N> {
+        &self.zeta
+    }
+    /// The compliant reference (xd, ẋd) for the next step (it starts at the
+    /// first step's setpoint, SPEC §4).
+    pub fn reference(&self) -> &Reference<N> {
+        &self.reference
+    }
+    /// Observer state π (output feedback only; zeros otherwise).
+    pub fn observer(&self) -> &ObserverState<N> {
+        &self.observer
+    }
+    /// The last step's command (all zeros before the first step).
+    pub fn last(&self) -> &Command<N> {
+        &self.last
+    }
+    /// The number of basis nodes L this state was made for.
+    pub fn nodes(&self) -> usize {
+        self.layout.nodes()
+    }
+    /// The basis S(Z) of the last step (zeros before the first, and for PD).
+    pub fn basis(&self) -> &[f64] {
+        self.layout.split(self.buf.as_ref()).0
+    }
+    /// The network weights (after the last step's update).
+    pub fn weights(&self) -> Weights<'_, N> {
+        let (_, rows) = self.layout.split(self.buf.as_ref());
+        Weights::new(rows, self.layout.nodes(), rows.len() / Layout::rows(N))
+    }
+    /// Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ of the current weights, as the
+    /// controller tracks them step by step (see
+    /// [`WeightsMut::fused_step`]); [`Weights::norms`] recomputes them.
+    pub fn weight_norms(&self) -> [f64; 3] {
+        self.norms
+    }
+
+    /// Replace the weights (e.g. to warm-start from a previous run, or from a
+    /// file through [`Weights::from_rows`]). They must have this state's
+    /// number of nodes and be finite; on an error nothing changes.
+    pub fn load_weights(&mut self, w: &Weights<'_, N>) -> Result<(), Error> {
+        if w.nodes() != self.nodes() {
+            return Err(Error::Invalid {
+                what: "weights",
+                reason: "their number of nodes differs from the state's",
+            });
+        }
+        w.check_finite()?;
+        let mut dst = self.parts().1;
+        dst.copy_from(w);
+        self.norms = dst.as_ref().norms();
+        Ok(())
+    }
+
+    /// The basis buffer and the weights, writable: for benchmarks and for
+    /// learning laws of your own. The tracked norms
+    /// ([`weight_norms`](Self::weight_norms)) are not updated by edits made
+    /// here: call [`refresh_norms`](Self::refresh_norms) after them.
+    pub fn networks_mut(&mut self) -> (&mut [f64], WeightsMut<'_, N>) {
+        self.parts()
+    }
+
+    /// Recompute the tracked norms from the weights.
+    pub fn refresh_norms(&mut self) {
+        self.norms = self.weights().norms();
+    }
+
+    /// The basis buffer and the weights, writable.
+    pub(crate) fn parts(&mut self) -> (&mut [f64], WeightsMut<'_, N>) {
+        let nodes = self.layout.nodes();
+        let (basis, rows) = self.layout.split_mut(self.buf.as_mut());
+        let stride = rows.len() / Layout::rows(N);
+        (basis, WeightsMut::new(rows, nodes, stride))
+    }
+}

@@ -1,0 +1,95 @@
+//! The convenience of one controller that tracks its own trajectory: a
+//! [`Controller`], a [`Trajectory`] and a heap [`State`] in one value, with
+//! the clock t_k = k·Ts (feature `alloc`).
+
+use crate::config::Law;
+use crate::controller::Controller;
+use crate::error::Error;
+use crate::impedance::TargetImpedance;
+use crate::io::{Command, Control, Measurement};
+use crate::rbf::{Basis, Grid};
+use crate::state::HeapState;
+use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
+
+/// A controller with its trajectory and its state: `step(&measurement)` samples
+/// the trajectory at t_k = k·Ts and takes the step.
+#[derive(Clone, Debug)]
+pub struct Tracker<const N: usize, B = Grid<N>, T = Sinusoid<N>> {
+    ctrl: Controller<N, B>,
+    traj: T,
+    state: HeapState<N>,
+}
+
+impl Tracker<2, Grid<2>, Sinusoid<2>> {
+    /// The paper's controller `law` (every SPEC default) on the paper's circle (64).
+    pub fn paper(law: Law) -> Self {
+        Self::new(Controller::paper(law), Sinusoid::paper())
+    }
+
+    /// The robot scenario's controller `law` on the paper's circle (SPEC §13).
+    pub fn robot(law: Law) -> Self {
+        Self::new(Controller::robot(law), Sinusoid::paper())
+    }
+}
+
+impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Tracker<N, B, T> {
+    /// `ctrl` tracking `traj`, from t = 0 (a new heap state).
+    pub fn new(ctrl: Controller<N, B>, traj: T) -> Self {
+        let state = ctrl.new_state();
+        Self { ctrl, traj, state }
+    }
+
+    /// One step at t_k = k·Ts with the trajectory sampled there (SPEC §11).
+    #[inline]
+    pub fn step(&mut self, m: &Measurement<N>) -> Result<Command<N>, Error> {
+        let c = self.traj.sample(self.time());
+        self.ctrl.step(&mut self.state, m, &c)
+    }
+
+    /// One step with an external setpoint `c` instead of the trajectory's
+    /// (the clock still advances).
+    #[inline]
+    pub fn step_with(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.ctrl.step(&mut self.state, m, c)
+    }
+
+    /// Back to t = 0 (weights, ζ, observer and reference as at construction).
+    pub fn reset(&mut self) {
+        self.state.reset();
+    }
+
+    /// Time t_k = k·Ts (s) of the next step.
+    pub fn time(&self) -> f64 {
+        self.ctrl.time(&self.state)
+    }
+    /// The controller (description).
+    pub fn controller(&self) -> &Controller<N, B> {
+        &self.ctrl
+    }
+    /// The commanded trajectory.
+    pub fn trajectory(&self) -> &T {
+        &self.traj
+    }
+    /// The state.
+    pub fn state(&self) -> &HeapState<N> {
+        &self.state
+    }
+    /// The state, writable (e.g. to load weights).
+    pub fn state_mut(&mut self) -> &mut HeapState<N> {
+        &mut self.state
+    }
+}
+
+/// The tracker as a closed loop's [`Control`]: the loop supplies the setpoint
+/// (normally from the same trajectory).
+impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Control<N> for Tracker<N, B, T> {
+    fn period(&self) -> f64 {
+        self.ctrl.period()
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        self.ctrl.impedance()
+    }
+    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.step_with(m, c)
+    }
+}

@@ -1,7 +1,7 @@
 //! Every parameter of a controller, with the paper's defaults and the robot
 //! scenario's presets, SPEC §4–§11, §13. Validated by
-//! [`Controller::new`](crate::Controller::new); the parameter schema
-//! ([`schema`](crate::schema)) documents each field.
+//! `Controller::new`; the parameter schema
+//! (`src/schema.rs`, re-exported as `adaptimp::schema`) documents each field.
 
 use crate::auxiliary::AuxLaw;
 use crate::learning::{LearningStep, SaturationLearning};
@@ -61,9 +61,9 @@ pub enum WeightBound {
 
 /// Every parameter of a controller. Start from [`Config::paper`] (or
 /// [`Config::new`] for other sizes) and change fields;
-/// [`Controller::new`](crate::Controller::new) validates. Gains are diagonal
+/// `Controller::new` validates. Gains are diagonal
 /// and given by their diagonals. Each field is a parameter of the schema
-/// ([`schema::PARAMS`](crate::schema::PARAMS)), where its default is declared.
+/// (`schema::PARAMS`), where its default is declared.
 #[derive(Copy, Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct Config<const N: usize> {
@@ -160,7 +160,7 @@ impl<const N: usize> Config<N> {
 
     /// The same with [`WeightBound::Auto`] replaced by its bounds for `nodes`
     /// RBF nodes and a trajectory of peak speed and acceleration `rates`
-    /// (rad/s, rad/s²; see [`Trajectory::peak_rates`](crate::Trajectory::peak_rates)).
+    /// (rad/s, rad/s²; see `Trajectory::peak_rates`).
     pub fn resolve(mut self, nodes: usize, rates: (f64, f64)) -> Self {
         if self.weight_bound == WeightBound::Auto {
             self.weight_bound = WeightBound::Fixed(crate::network::weight_bounds(

@@ -65,9 +65,9 @@ impl<const N: usize> Command<N> {
 /// A controller as a closed loop sees it: a period, the target impedance it
 /// realises, and a step from measurement and commanded setpoint to command.
 ///
-/// Implemented by a [`Controller`](crate::Controller) bound to a state
-/// ([`Controller::bind`](crate::Controller::bind)) and by
-/// [`Tracker`](crate::Tracker); implement it to drive the simulator with a
+/// Implemented by a `Controller` bound to a state
+/// (`Controller::bind`) and by
+/// `Tracker`; implement it to drive the simulator with a
 /// controller of your own.
 pub trait Control<const N: usize> {
     /// Sampling period Ts (s).

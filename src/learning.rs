@@ -150,7 +150,7 @@ impl Learning {
             LearningStep::Euler => self.rates,
             LearningStep::Normalized => {
                 let g = self.rates.gain;
-                let s2: f64 = s.iter().map(|v| v * v).sum();
+                let s2 = crate::network::dot(s, s);
                 let gain = s2
                     * (g[D] * sig.dalpha1.norm_squared() + g[C] * sig.alpha1.norm_squared() + g[G]);
                 self.rates.scaled(1.0 / (1.0 + gain / self.gain_cap))

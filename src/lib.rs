@@ -140,3 +140,14 @@ pub use state::State;
 pub use tracker::Tracker;
 pub use trajectory::{Setpoint, Sinusoid, Trajectory};
 pub use types::{grid_nodes, Matrix, Vector};
+
+/// The README's Rust quick start, compiled and run as a doctest inside
+/// `fn main() -> Result<(), Box<dyn std::error::Error>>` (`tests/readme.rs`
+/// keeps the README's copy identical).
+#[cfg(doctest)]
+#[doc = concat!(
+    "```\nfn main() -> Result<(), Box<dyn std::error::Error>> {\n",
+    include_str!("../tests/snippets/readme_quickstart.rs"),
+    "Ok(())\n}\n```"
+)]
+pub struct ReadmeQuickStart;

@@ -50,8 +50,8 @@ const GAP: usize = 128;
 ///
 /// Rows start on 64-byte boundaries (each padded to a multiple of 8 reals), so
 /// no vector load straddles a cache line; the weight rows follow the basis
-/// after a 1 KiB gap. Order of the rows: ŴD[k][j] (N² rows), ŴC[k][j] (N²),
-/// ŴG[k] (N).
+/// after a 1 KiB gap. Order of the rows: ŴD\[k\]\[j\] (N² rows), ŴC\[k\]\[j\] (N²),
+/// ŴG\[k\] (N).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct Layout {
     nodes: usize,
@@ -157,7 +157,7 @@ impl Rates {
 }
 
 /// Bounds on the weight norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F (for the projection of
-/// [`Learning`](crate::learning::Learning)) derived from the actuator limits:
+/// `Learning`) derived from the actuator limits:
 /// each network may produce at most the actuator's torque ‖τmax‖ for the
 /// commanded trajectory's regressor scale.
 ///
@@ -182,25 +182,26 @@ pub fn weight_bounds<const N: usize>(
 /// Explicit 4-wide vectors (`wide::f64x4`: 256-bit AVX when built for it, two
 /// SSE2 registers otherwise) rather than arrays left to the autovectoriser,
 /// which vectorised the ten inlined copies of this loop unevenly (some at
-/// half width). Products and sums stay separate (Rust never fuses a·b + c), so
-/// the results are the same on every target.
+/// half width). The rows are viewed as arrays of 8 (`as_chunks`), so every
+/// load and store has a length known at compile time whatever the number of
+/// nodes. Products and sums stay separate (Rust never fuses a·b + c), so the
+/// results are the same on every target.
 #[inline(always)]
 fn dot_update(w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
     let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
     // Two independent 4-wide accumulators hide the latency of the additions.
     let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
-    let mut wc = w.chunks_exact_mut(8);
-    let mut sc = s.chunks_exact(8);
-    for (wv, sv) in (&mut wc).zip(&mut sc) {
-        let (w0, w1) = (load(&wv[..4]), load(&wv[4..]));
-        let (s0, s1) = (load(&sv[..4]), load(&sv[4..]));
+    let (wc, wr) = w.as_chunks_mut::<8>();
+    let (sc, sr) = s.as_chunks::<8>();
+    for (wv, sv) in wc.iter_mut().zip(sc) {
+        let [w0, w1] = halves(wv);
+        let [s0, s1] = halves(sv);
         d0 += w0 * s0;
         d1 += w1 * s1;
-        wv[..4].copy_from_slice(&(av * w0 + bv * s0).to_array());
-        wv[4..].copy_from_slice(&(av * w1 + bv * s1).to_array());
+        *wv = join(av * w0 + bv * s0, av * w1 + bv * s1);
     }
     let mut dot = (d0 + d1).reduce_add();
-    for (wv, &sv) in wc.into_remainder().iter_mut().zip(sc.remainder()) {
+    for (wv, &sv) in wr.iter_mut().zip(sr) {
         dot += *wv * sv;
         *wv = a * *wv + b * sv;
     }
@@ -224,36 +225,40 @@ fn dot_update_pair(
         f64x4::splat(b1),
     );
     let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
-    let mut c0 = w0.chunks_exact_mut(4);
-    let mut c1 = w1.chunks_exact_mut(4);
-    let mut cs = s.chunks_exact(4);
-    for ((v0, v1), sv) in (&mut c0).zip(&mut c1).zip(&mut cs) {
-        let (x0, x1, sx) = (load(v0), load(v1), load(sv));
+    let (c0, r0) = w0.as_chunks_mut::<4>();
+    let (c1, r1) = w1.as_chunks_mut::<4>();
+    let (cs, rs) = s.as_chunks::<4>();
+    for ((v0, v1), sv) in c0.iter_mut().zip(c1.iter_mut()).zip(cs) {
+        let (x0, x1, sx) = (f64x4::from(*v0), f64x4::from(*v1), f64x4::from(*sv));
         d0 += x0 * sx;
         d1 += x1 * sx;
-        v0.copy_from_slice(&(a0v * x0 + b0v * sx).to_array());
-        v1.copy_from_slice(&(a1v * x1 + b1v * sx).to_array());
+        *v0 = (a0v * x0 + b0v * sx).to_array();
+        *v1 = (a1v * x1 + b1v * sx).to_array();
     }
-    let (mut r0, mut r1) = (d0.reduce_add(), d1.reduce_add());
-    let rest = c0
-        .into_remainder()
-        .iter_mut()
-        .zip(c1.into_remainder().iter_mut());
-    for ((v0, v1), &sx) in rest.zip(cs.remainder()) {
-        r0 += *v0 * sx;
-        r1 += *v1 * sx;
+    let (mut e0, mut e1) = (d0.reduce_add(), d1.reduce_add());
+    for ((v0, v1), &sx) in r0.iter_mut().zip(r1.iter_mut()).zip(rs) {
+        e0 += *v0 * sx;
+        e1 += *v1 * sx;
         *v0 = a0 * *v0 + b0 * sx;
         *v1 = a1 * *v1 + b1 * sx;
     }
-    (r0, r1)
+    (e0, e1)
 }
 
-/// Four lanes from a slice of exactly four.
+/// The two 4-lane halves of eight reals.
 #[inline(always)]
-fn load(v: &[f64]) -> f64x4 {
-    let mut a = [0.0; 4];
-    a.copy_from_slice(v);
-    f64x4::from(a)
+fn halves(v: &[f64; 8]) -> [f64x4; 2] {
+    [
+        f64x4::from([v[0], v[1], v[2], v[3]]),
+        f64x4::from([v[4], v[5], v[6], v[7]]),
+    ]
+}
+
+/// Eight reals from two 4-lane halves.
+#[inline(always)]
+fn join(lo: f64x4, hi: f64x4) -> [f64; 8] {
+    let (l, h) = (lo.to_array(), hi.to_array());
+    [l[0], l[1], l[2], l[3], h[0], h[1], h[2], h[3]]
 }
 
 /// One row: `Ŵ ← a Ŵ + b S`; returns `‖Ŵ‖²` of the new row.
@@ -261,18 +266,18 @@ fn load(v: &[f64]) -> f64x4 {
 fn update_row(w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
     let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
     let (mut q0, mut q1) = (f64x4::ZERO, f64x4::ZERO);
-    let mut wc = w.chunks_exact_mut(8);
-    let mut sc = s.chunks_exact(8);
-    for (wv, sv) in (&mut wc).zip(&mut sc) {
-        let n0 = av * load(&wv[..4]) + bv * load(&sv[..4]);
-        let n1 = av * load(&wv[4..]) + bv * load(&sv[4..]);
+    let (wc, wr) = w.as_chunks_mut::<8>();
+    let (sc, sr) = s.as_chunks::<8>();
+    for (wv, sv) in wc.iter_mut().zip(sc) {
+        let [w0, w1] = halves(wv);
+        let [s0, s1] = halves(sv);
+        let (n0, n1) = (av * w0 + bv * s0, av * w1 + bv * s1);
         q0 += n0 * n0;
         q1 += n1 * n1;
-        wv[..4].copy_from_slice(&n0.to_array());
-        wv[4..].copy_from_slice(&n1.to_array());
+        *wv = join(n0, n1);
     }
     let mut sq = (q0 + q1).reduce_add();
-    for (wv, &sv) in wc.into_remainder().iter_mut().zip(sc.remainder()) {
+    for (wv, &sv) in wr.iter_mut().zip(sr) {
         *wv = a * *wv + b * sv;
         sq += *wv * *wv;
     }
@@ -315,7 +320,7 @@ impl<'a, const N: usize> Weights<'a, N> {
     }
 
     /// A view of `data`: the `2N² + N` rows of `nodes` reals each, back to back,
-    /// in the order ŴD[k][j], ŴC[k][j], ŴG[k] (row-major over k, j). Errors if
+    /// in the order ŴD\[k\]\[j\], ŴC\[k\]\[j\], ŴG\[k\] (row-major over k, j). Errors if
     /// the length is not `(2N² + N)·nodes`.
     pub fn from_rows(data: &'a [f64], nodes: usize) -> Result<Self, Error> {
         if nodes == 0 || data.len() != Layout::rows(N) * nodes {
@@ -386,8 +391,22 @@ impl<'a, const N: usize> Weights<'a, N> {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+/// `a · b` over the shorter length, on 4-wide vectors with two accumulators
+/// (a scalar sum is a chain of dependent additions, four times slower).
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
+    let (ac, ar) = a.as_chunks::<8>();
+    let (bc, br) = b.as_chunks::<8>();
+    for (av, bv) in ac.iter().zip(bc) {
+        let ([a0, a1], [b0, b1]) = (halves(av), halves(bv));
+        d0 += a0 * b0;
+        d1 += a1 * b1;
+    }
+    let mut sum = (d0 + d1).reduce_add();
+    for (x, y) in ar.iter().zip(br) {
+        sum += x * y;
+    }
+    sum
 }
 
 impl<'a, const N: usize> WeightsMut<'a, N> {

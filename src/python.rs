@@ -17,19 +17,20 @@
 //!
 //! Nothing here panics on user input and nothing is `unsafe`.
 
-use crate::controller::{
-    Command, Config, Controller, Law, LearningStep, Measurement, ObserverInit, Robust,
-    SaturationLearning,
-};
+use crate::config::Law;
+use crate::controller::Controller;
 use crate::environment::{FreeSpace, Wall};
+use crate::error::Error;
+use crate::io::{Command, Measurement};
 use crate::metrics::Metrics;
-use crate::model::{ArmParams, Manipulator, TwoLinkArm};
-use crate::observer::Hold;
-use crate::rbf::Rbf;
-use crate::simulator::{simulate as simulate_core, Recorder, Row, SimConfig};
+use crate::model::{Manipulator, TwoLinkArm};
+use crate::rbf::Grid;
+use crate::record::{Recorder, Row};
+use crate::schema::{Kind, Preset, Scenario, Value, PARAMS};
+use crate::simulator::run;
+use crate::tracker::Tracker;
 use crate::trajectory::Sinusoid;
-use crate::{grid_nodes, AuxLaw, Error, Vector};
-use nalgebra::SVector;
+use crate::types::{grid_nodes, Vector};
 use numpy::ndarray::{Array, Dimension, IntoDimension};
 use numpy::{
     IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods,
@@ -37,14 +38,14 @@ use numpy::{
 };
 use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict, PyString};
+use pyo3::types::{PyBytes, PyDict, PyList, PyString};
 
 /// Joints of the paper's arm.
 const N: usize = 2;
 /// RBF nodes of the paper's vertex grid, 2^(4N).
 const L: usize = grid_nodes(N);
 
-type Ctrl = Controller<N, L, Sinusoid<N>>;
+type Ctrl = Tracker<N, Grid<N>, Sinusoid<N>>;
 
 /// The one place where core errors become Python exceptions: `ValueError`
 /// with the core's message (condition, quantity and value for SPEC §10).
@@ -55,90 +56,11 @@ impl From<Error> for PyErr {
 }
 
 // ---------------------------------------------------------------------------
-// Parameters: extracted from the dicts the Python layer builds (`_params.py`).
+// Parameters: the schema (src/schema.rs) is the one source. The Python layer
+// (`_params.py`) builds its keyword table from `schema()` and its defaults
+// from `defaults()`, and hands complete dicts back; they are applied here by
+// name through `Scenario::set`.
 // ---------------------------------------------------------------------------
-
-/// Controller parameters (SPEC §4–§11), keyed by their Python names.
-#[derive(FromPyObject)]
-#[pyo3(from_item_all)]
-struct ControllerParams {
-    #[pyo3(item("Ts"))]
-    ts: f64,
-    #[pyo3(item("K1"))]
-    k1: [f64; N],
-    #[pyo3(item("Kp"))]
-    kp: [f64; N],
-    #[pyo3(item("Kzeta"))]
-    kzeta: [f64; N],
-    mu: f64,
-    aux_law: String,
-    robust: String,
-    kr: [f64; N],
-    phi: f64,
-    #[pyo3(item("kD"))]
-    kd: f64,
-    #[pyo3(item("kC"))]
-    kc: f64,
-    #[pyo3(item("kG"))]
-    kg: f64,
-    gamma: [f64; 3],
-    sigma: [f64; 3],
-    eta2: f64,
-    eps: f64,
-    lam1: [f64; N],
-    observer_init: String,
-    observer_hold: String,
-    tau_max: [f64; N],
-    #[pyo3(item("Dd"))]
-    dd: [f64; N],
-    #[pyo3(item("Cd"))]
-    cd: [f64; N],
-    #[pyo3(item("Gd"))]
-    gd: [f64; N],
-    xc_offset: [f64; N],
-    xc_sin: [f64; N],
-    xc_cos: [f64; N],
-    xc_omega: [f64; N],
-    // The hardened options of SPEC §13 (the "robot" scenario). A new option
-    // goes here, in `apply_controller_params`, in `core_defaults`, in `PARAMS`
-    // of `python/adaptimp/_params.py` and in the stub.
-    learning_step: String,
-    kappa: f64,
-    saturation_learning: String,
-    weight_bound: Option<[f64; 3]>,
-}
-
-/// Simulation and environment parameters (SPEC §3, §11).
-#[derive(FromPyObject)]
-#[pyo3(from_item_all)]
-struct SimParams {
-    #[pyo3(item("T"))]
-    t_final: f64,
-    substeps: i64,
-    q0: [f64; N],
-    dq0: [f64; N],
-    settle: f64,
-    wall: Option<f64>,
-    ke: f64,
-    be: f64,
-}
-
-/// Arm parameters (SPEC §1).
-#[derive(FromPyObject)]
-#[pyo3(from_item_all)]
-struct ArmParamsPy {
-    m1: f64,
-    m2: f64,
-    l1: f64,
-    l2: f64,
-    lc1: f64,
-    lc2: f64,
-    #[pyo3(item("I1"))]
-    i1: f64,
-    #[pyo3(item("I2"))]
-    i2: f64,
-    g: f64,
-}
 
 fn law_of(case: &str) -> PyResult<Law> {
     match case {
@@ -159,103 +81,77 @@ fn case_of(law: Law) -> &'static str {
     }
 }
 
-fn choice_error(name: &str, valid: &str, got: &str) -> PyErr {
-    PyValueError::new_err(format!("{name} must be one of {valid}, got {got:?}"))
+/// A Python value in the schema's terms, owned.
+enum Owned {
+    Real(f64),
+    Int(i64),
+    Vec(Vec<f64>),
+    Str(String),
+    None,
 }
 
-/// Fill `cfg` (which starts from the paper's defaults, so fields the Python
-/// layer does not know yet keep the core's values) from `p`.
-fn apply_controller_params(cfg: &mut Config<N, L>, p: &ControllerParams) -> PyResult<()> {
-    cfg.ts = p.ts;
-    cfg.k1 = Vector::from(p.k1);
-    cfg.kp = Vector::from(p.kp);
-    cfg.kzeta = Vector::from(p.kzeta);
-    cfg.mu = p.mu;
-    cfg.aux_law = match p.aux_law.as_str() {
-        "default" => AuxLaw::Leaky,
-        "printed" => AuxLaw::Printed,
-        "linear" => AuxLaw::Linear,
-        other => {
-            return Err(choice_error(
-                "aux_law",
-                "'default', 'printed', 'linear'",
-                other,
-            ))
+impl Owned {
+    fn extract(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if obj.is_none() {
+            return Ok(Owned::None);
         }
-    };
-    let kr = Vector::from(p.kr);
-    cfg.robust = match p.robust.as_str() {
-        "sign" => Robust::Sign { kr },
-        "tanh" => Robust::Tanh { kr, phi: p.phi },
-        "remark1" => Robust::Remark1 {
-            kd: p.kd,
-            kc: p.kc,
-            kg: p.kg,
-        },
-        "none" => Robust::None,
-        other => {
-            return Err(choice_error(
-                "robust",
-                "'sign', 'tanh', 'remark1', 'none'",
-                other,
-            ))
+        if obj.is_instance_of::<PyString>() {
+            return Ok(Owned::Str(obj.extract()?));
         }
-    };
-    cfg.gamma = p.gamma;
-    cfg.sigma = p.sigma;
-    cfg.rbf = Rbf::grid(p.eta2)?;
-    cfg.eps = p.eps;
-    cfg.lam1 = Vector::from(p.lam1);
-    cfg.observer_init = match p.observer_init.as_str() {
-        "zero" => ObserverInit::Zero,
-        "first" => ObserverInit::FirstMeasurement,
-        other => return Err(choice_error("observer_init", "'zero', 'first'", other)),
-    };
-    cfg.observer_hold = match p.observer_hold.as_str() {
-        "zoh" => Hold::Zero,
-        "triangle" => Hold::Triangle,
-        other => return Err(choice_error("observer_hold", "'zoh', 'triangle'", other)),
-    };
-    cfg.tau_max = Vector::from(p.tau_max);
-    cfg.dd = Vector::from(p.dd);
-    cfg.cd = Vector::from(p.cd);
-    cfg.gd = Vector::from(p.gd);
-    cfg.learning_step = match p.learning_step.as_str() {
-        "euler" => LearningStep::Euler,
-        "normalized" => LearningStep::Normalized { kappa: p.kappa },
-        other => {
-            return Err(choice_error(
-                "learning_step",
-                "'euler', 'normalized'",
-                other,
-            ))
+        if obj.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(PyTypeError::new_err(format!(
+                "{name} must be a number, got bool"
+            )));
         }
-    };
-    cfg.saturation_learning = match p.saturation_learning.as_str() {
-        "ignore" => SaturationLearning::Ignore,
-        "freeze" => SaturationLearning::Freeze,
-        other => {
-            return Err(choice_error(
-                "saturation_learning",
-                "'ignore', 'freeze'",
-                other,
-            ))
+        if obj.is_instance_of::<pyo3::types::PyInt>() {
+            return match obj.extract::<i64>() {
+                Ok(i) => Ok(Owned::Int(i)),
+                Err(_) => Err(PyValueError::new_err(format!(
+                    "{name} is out of range: {}",
+                    obj.str().map(|s| s.to_string()).unwrap_or_default()
+                ))),
+            };
         }
-    };
-    cfg.weight_bound = p.weight_bound;
-    Ok(())
+        if let Ok(x) = obj.extract::<f64>() {
+            return Ok(Owned::Real(x));
+        }
+        match obj.extract::<Vec<f64>>() {
+            Ok(v) => Ok(Owned::Vec(v)),
+            Err(_) => Err(PyTypeError::new_err(format!(
+                "{name} must be a number, a sequence of numbers, a string or None"
+            ))),
+        }
+    }
+
+    fn value(&self) -> Value<'_> {
+        match self {
+            Owned::Real(x) => Value::Real(*x),
+            Owned::Int(i) => Value::Int(*i),
+            Owned::Vec(v) => Value::Vec(v),
+            Owned::Str(s) => Value::Str(s),
+            Owned::None => Value::None,
+        }
+    }
 }
 
-fn build_controller(case: &str, p: &ControllerParams) -> PyResult<Box<Ctrl>> {
-    let mut cfg = Config::paper(law_of(case)?);
-    apply_controller_params(&mut cfg, p)?;
-    let traj = Sinusoid::new(
-        Vector::from(p.xc_offset),
-        Vector::from(p.xc_sin),
-        Vector::from(p.xc_cos),
-        Vector::from(p.xc_omega),
-    )?;
-    Ok(Box::new(Ctrl::new(cfg, traj)?))
+/// The paper scenario's defaults for `case` updated by every item of `params`
+/// (keys are schema names). The error names the key.
+fn scenario(case: &str, params: &Bound<'_, PyDict>) -> PyResult<Scenario<N>> {
+    let mut s = Scenario::<N>::preset(Preset::Paper, law_of(case)?);
+    for (key, value) in params.iter() {
+        let name: String = key.extract()?;
+        let v = Owned::extract(&name, &value)?;
+        s.set(&name, v.value())
+            .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+    }
+    Ok(s)
+}
+
+fn build_controller(case: &str, params: &Bound<'_, PyDict>) -> PyResult<Ctrl> {
+    let s = scenario(case, params)?;
+    let traj = s.trajectory()?;
+    let ctrl = Controller::for_trajectory(s.config, s.grid()?, &traj)?;
+    Ok(Tracker::new(ctrl, traj))
 }
 
 // ---------------------------------------------------------------------------
@@ -350,10 +246,10 @@ fn array<'py, D: Dimension>(
 }
 
 /// The rows of a weight table, concatenated (row-major over [k][j][i]).
-fn flatten<'a>(rows: impl Iterator<Item = &'a SVector<f64, L>>) -> Vec<f64> {
+fn flatten<'a>(rows: impl Iterator<Item = &'a [f64]>) -> Vec<f64> {
     let mut v = Vec::with_capacity(N * N * L);
     for row in rows {
-        v.extend_from_slice(row.as_slice());
+        v.extend_from_slice(row);
     }
     v
 }
@@ -376,9 +272,9 @@ struct PyController {
 impl PyController {
     #[new]
     #[pyo3(signature = (case, params))]
-    fn new(case: &str, params: ControllerParams) -> PyResult<Self> {
+    fn new(case: &str, params: &Bound<'_, PyDict>) -> PyResult<Self> {
         Ok(Self {
-            inner: build_controller(case, &params)?,
+            inner: Box::new(build_controller(case, params)?),
         })
     }
 
@@ -396,7 +292,7 @@ impl PyController {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let x = vector("q", q)?;
         let tau_e = vector("tau_e", tau_e)?;
-        let dx = match (self.inner.config().law, dq) {
+        let dx = match (self.inner.controller().config().law, dq) {
             (Law::OutputFeedback, _) | (_, None) => None,
             (_, Some(dq)) => Some(vector("dq", dq)?),
         };
@@ -428,7 +324,7 @@ impl PyController {
         };
         let x = table("q", &q)?;
         let te = table("tau_e", &tau_e)?;
-        let law = self.inner.config().law;
+        let law = self.inner.controller().config().law;
         let dx = match (law, &dq) {
             (Law::OutputFeedback, _) | (_, None) => None,
             (_, Some(dq)) => Some(table("dq", dq)?),
@@ -462,7 +358,7 @@ impl PyController {
     /// "pd", "sf" or "of".
     #[getter]
     fn case(&self) -> &'static str {
-        case_of(self.inner.config().law)
+        case_of(self.inner.controller().config().law)
     }
 
     /// Time of the next step t_k = k·Ts (s).
@@ -474,19 +370,19 @@ impl PyController {
     /// Steps taken since construction or reset.
     #[getter]
     fn steps(&self) -> u64 {
-        self.inner.steps()
+        self.inner.state().steps()
     }
 
     /// Sampling period Ts (s).
     #[getter]
     fn ts(&self) -> f64 {
-        self.inner.config().ts
+        self.inner.controller().period()
     }
 
     /// Auxiliary state ζ (N m) now, i.e. what the next step uses, (11).
     #[getter]
     fn zeta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.inner.zeta())
+        array1(py, self.inner.state().zeta())
     }
 
     /// Velocity the last step used (rad/s): dq, or the observer's estimate for "of".
@@ -536,12 +432,24 @@ impl PyController {
     /// indexed [k][j][i] (output row, column, node).
     #[getter]
     fn weights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let w = self.inner.weights();
+        let w = self.inner.state().weights();
         let out = PyDict::new(py);
-        out.set_item("D", array(py, flatten(w.d.iter().flatten()), (N, N, L))?)?;
-        out.set_item("C", array(py, flatten(w.c.iter().flatten()), (N, N, L))?)?;
-        out.set_item("G", array(py, flatten(w.g.iter()), (N, L))?)?;
+        for (name, net) in [("D", crate::network::D), ("C", crate::network::C)] {
+            out.set_item(name, array(py, flatten(w.network(net)), (N, N, L))?)?;
+        }
+        out.set_item(
+            "G",
+            array(py, flatten(w.network(crate::network::G)), (N, L))?,
+        )?;
         Ok(out)
+    }
+
+    /// The projection's weight bounds on ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F as resolved
+    /// (kg m², kg m²/s, N m; "auto" derived from τmax and the trajectory),
+    /// or None.
+    #[getter]
+    fn weight_bound(&self) -> Option<[f64; 3]> {
+        self.inner.controller().learning().bound()
     }
 
     fn __repr__(&self) -> String {
@@ -557,7 +465,7 @@ impl PyController {
 
 impl PyController {
     fn last(&self) -> &Command<N> {
-        self.inner.last()
+        self.inner.state().last()
     }
 }
 
@@ -578,20 +486,11 @@ struct PyArm {
 impl PyArm {
     #[new]
     #[pyo3(signature = (params))]
-    fn new(params: ArmParamsPy) -> PyResult<Self> {
-        let p = params;
-        let inner = TwoLinkArm::new(ArmParams {
-            m1: p.m1,
-            m2: p.m2,
-            l1: p.l1,
-            l2: p.l2,
-            lc1: p.lc1,
-            lc2: p.lc2,
-            i1: p.i1,
-            i2: p.i2,
-            g: p.g,
-        })?;
-        Ok(Self { inner })
+    fn new(params: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let s = scenario("pd", params)?;
+        Ok(Self {
+            inner: TwoLinkArm::new(s.arm.resolve())?,
+        })
     }
 
     /// Inertia matrix D(q) (kg m²), shape (2, 2), (56).
@@ -645,6 +544,28 @@ impl PyArm {
             &vector("tau_e", tau_e)?,
         );
         Ok(array1(py, &a))
+    }
+
+    /// The arm's parameters, derived ones included: "m1", "m2" (kg), "l1",
+    /// "l2", "lc1", "lc2" (m), "I1", "I2" (kg m²), "g" (m/s²).
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = self.inner.params();
+        let d = PyDict::new(py);
+        for (name, v) in [
+            ("m1", p.m1),
+            ("m2", p.m2),
+            ("l1", p.l1),
+            ("l2", p.l2),
+            ("lc1", p.lc1),
+            ("lc2", p.lc2),
+            ("I1", p.i1),
+            ("I2", p.i2),
+            ("g", p.g),
+        ] {
+            d.set_item(name, v)?;
+        }
+        Ok(d)
     }
 
     /// The lumped parameters p1..p5 of (59)–(63) (kg m², kg m², kg m², kg m, kg m).
@@ -757,40 +678,30 @@ fn simulate<'py>(
     py: Python<'py>,
     controller: &Bound<'py, PyController>,
     arm: &Bound<'py, PyArm>,
-    params: SimParams,
+    params: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let p = params;
-    let substeps = usize::try_from(p.substeps).map_err(|_| Error::Condition {
-        condition: "substeps ≥ 1",
-        lhs: "substeps",
-        index: None,
-        value: p.substeps as f64,
-    })?;
-    let cfg = SimConfig {
-        t_final: p.t_final,
-        substeps,
-        q0: Vector::from(p.q0),
-        dq0: Vector::from(p.dq0),
-        settle: p.settle,
-    };
-    let wall = match p.wall {
-        Some(w) => Some(Wall::<N>::new(0, w, p.ke, p.be)?),
+    let s = scenario("pd", params)?;
+    let wall = match s.wall {
+        Some(w) => Some(Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?),
         None => None,
     };
     let plant = arm.get().inner;
     let mut guard = controller.try_borrow_mut()?;
     let ctrl: &mut Ctrl = &mut guard.inner;
     // Room for every row (the core re-checks T and Ts and reports bad ones).
-    let rows = (p.t_final / ctrl.config().ts).round();
-    let rows = if rows.is_finite() && (1.0..=1e15).contains(&rows) {
-        rows as usize
-    } else {
-        0
-    };
+    let rows = crate::simulator::steps(s.sim.t_final, ctrl.controller().period())
+        .ok()
+        .and_then(|r| usize::try_from(r).ok())
+        .unwrap_or(0);
     let mut rec = Buffers::with_rows(rows)?;
-    let metrics = py.detach(|| match wall {
-        Some(w) => simulate_core(&plant, &w, ctrl, &cfg, &mut rec),
-        None => simulate_core(&plant, &FreeSpace, ctrl, &cfg, &mut rec),
+    let cfg = s.sim;
+    let metrics = py.detach(|| {
+        ctrl.reset();
+        let traj = *ctrl.trajectory();
+        match wall {
+            Some(w) => run(&plant, &w, ctrl, &traj, &cfg, &mut rec),
+            None => run(&plant, &FreeSpace, ctrl, &traj, &cfg, &mut rec),
+        }
     })?;
     drop(guard);
 
@@ -816,123 +727,66 @@ fn simulate<'py>(
     Ok(out)
 }
 
-/// The core's own defaults of a scenario, keyed by the Python parameter
-/// names: "paper" (SPEC §1–§4, §11: `Config::paper`, `SimConfig::paper`) or
-/// "robot" (SPEC §13: `Config::robot`, `SimConfig::robot`), with the default
-/// arm, `Wall::paper` and `Sinusoid::paper`. The Python layer's scenario
-/// table is checked against it in the tests.
+/// A schema value as Python sees it: float, int, list of floats, str or None.
+fn py_value<'py>(py: Python<'py>, v: Value<'_>) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        Value::Real(x) => x.into_pyobject(py)?.into_any(),
+        Value::Int(i) => i.into_pyobject(py)?.into_any(),
+        Value::Vec(v) => PyList::new(py, v)?.into_any(),
+        Value::Str(s) => PyString::new(py, s).into_any(),
+        Value::None => py.None().into_bound(py),
+    })
+}
+
+/// The parameter schema (src/schema.rs), the one source of every parameter:
+/// a list of dicts with "name", "group", "kind", "unit", "doc", "condition",
+/// "choices" (for a choice) and "defaults" (per scenario, as the schema
+/// declares them: a number may stand for every joint).
+#[pyfunction]
+fn schema_table(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let out = PyList::empty(py);
+    for p in PARAMS {
+        let d = PyDict::new(py);
+        d.set_item("name", p.name)?;
+        d.set_item("group", p.group.name())?;
+        d.set_item("kind", p.kind.name())?;
+        d.set_item("unit", p.unit)?;
+        d.set_item("doc", p.doc)?;
+        d.set_item("condition", p.condition)?;
+        let choices: &[&str] = match p.kind {
+            Kind::Choice(c) => c,
+            _ => &[],
+        };
+        d.set_item("choices", PyList::new(py, choices)?)?;
+        let defaults = PyDict::new(py);
+        for preset in Preset::ALL {
+            defaults.set_item(preset.name(), py_value(py, p.default_in(preset))?)?;
+        }
+        d.set_item("defaults", defaults)?;
+        out.append(d)?;
+    }
+    Ok(out)
+}
+
+/// Every parameter's default in `scenario` ("paper" or "robot") for the
+/// paper's 2-link arm, keyed by name: per-joint values as lists of 2, derived
+/// arm values as None.
 #[pyfunction]
 #[pyo3(signature = (scenario="paper"))]
-fn core_defaults<'py>(py: Python<'py>, scenario: &str) -> PyResult<Bound<'py, PyDict>> {
-    let (c, s) = match scenario {
-        "paper" => (Config::paper(Law::StateFeedback), SimConfig::paper()),
-        "robot" => (Config::robot(Law::StateFeedback), SimConfig::robot()),
-        other => return Err(choice_error("scenario", "'paper', 'robot'", other)),
-    };
-    let a = ArmParams::default();
-    let w = Wall::paper();
-    let x = Sinusoid::paper();
-    let v = |v: &Vector<N>| v.as_slice().to_vec();
+fn defaults<'py>(py: Python<'py>, scenario: &str) -> PyResult<Bound<'py, PyDict>> {
+    let preset = Preset::from_name(scenario).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "scenario must be one of 'paper', 'robot', got {scenario:?}"
+        ))
+    })?;
     let d = PyDict::new(py);
-    d.set_item("Ts", c.ts)?;
-    d.set_item("K1", v(&c.k1))?;
-    d.set_item("Kp", v(&c.kp))?;
-    d.set_item("Kzeta", v(&c.kzeta))?;
-    d.set_item("mu", c.mu)?;
-    // Compared with `==`, not matched, so that a new option of the core does
-    // not break this build: it shows up as "(not exposed)" and fails the test
-    // that compares this with the Python table until it is exposed.
-    let name = |known: &[(bool, &'static str)]| {
-        known
-            .iter()
-            .find(|(is, _)| *is)
-            .map_or("(not exposed)", |(_, n)| *n)
-    };
-    d.set_item(
-        "aux_law",
-        name(&[
-            (c.aux_law == AuxLaw::Leaky, "default"),
-            (c.aux_law == AuxLaw::Printed, "printed"),
-            (c.aux_law == AuxLaw::Linear, "linear"),
-        ]),
-    )?;
-    match c.robust {
-        Robust::Sign { kr } => {
-            d.set_item("robust", "sign")?;
-            d.set_item("kr", v(&kr))?;
+    let mut err = Ok(());
+    Scenario::<N>::preset(preset, Law::StateFeedback).visit(|name, v| {
+        if err.is_ok() {
+            err = py_value(py, v).and_then(|v| d.set_item(name, v));
         }
-        Robust::Tanh { kr, phi } => {
-            d.set_item("robust", "tanh")?;
-            d.set_item("kr", v(&kr))?;
-            d.set_item("phi", phi)?;
-        }
-        Robust::Remark1 { .. } | Robust::None => d.set_item("robust", "(not exposed)")?,
-    }
-    match c.learning_step {
-        LearningStep::Euler => d.set_item("learning_step", "euler")?,
-        LearningStep::Normalized { kappa } => {
-            d.set_item("learning_step", "normalized")?;
-            d.set_item("kappa", kappa)?;
-        }
-    }
-    d.set_item(
-        "saturation_learning",
-        name(&[
-            (
-                c.saturation_learning == SaturationLearning::Ignore,
-                "ignore",
-            ),
-            (
-                c.saturation_learning == SaturationLearning::Freeze,
-                "freeze",
-            ),
-        ]),
-    )?;
-    d.set_item("weight_bound", c.weight_bound.map(|b| b.to_vec()))?;
-    d.set_item("gamma", c.gamma.to_vec())?;
-    d.set_item("sigma", c.sigma.to_vec())?;
-    d.set_item("eta2", c.rbf.eta2())?;
-    d.set_item("eps", c.eps)?;
-    d.set_item("lam1", v(&c.lam1))?;
-    d.set_item(
-        "observer_init",
-        name(&[
-            (c.observer_init == ObserverInit::Zero, "zero"),
-            (c.observer_init == ObserverInit::FirstMeasurement, "first"),
-        ]),
-    )?;
-    d.set_item(
-        "observer_hold",
-        name(&[
-            (c.observer_hold == Hold::Zero, "zoh"),
-            (c.observer_hold == Hold::Triangle, "triangle"),
-        ]),
-    )?;
-    d.set_item("tau_max", v(&c.tau_max))?;
-    d.set_item("Dd", v(&c.dd))?;
-    d.set_item("Cd", v(&c.cd))?;
-    d.set_item("Gd", v(&c.gd))?;
-    d.set_item("T", s.t_final)?;
-    d.set_item("substeps", s.substeps)?;
-    d.set_item("q0", v(&s.q0))?;
-    d.set_item("dq0", v(&s.dq0))?;
-    d.set_item("settle", s.settle)?;
-    d.set_item("wall", w.position())?;
-    d.set_item("ke", w.ke())?;
-    d.set_item("be", w.be())?;
-    d.set_item("m1", a.m1)?;
-    d.set_item("m2", a.m2)?;
-    d.set_item("l1", a.l1)?;
-    d.set_item("l2", a.l2)?;
-    d.set_item("lc1", a.lc1)?;
-    d.set_item("lc2", a.lc2)?;
-    d.set_item("I1", a.i1)?;
-    d.set_item("I2", a.i2)?;
-    d.set_item("g", a.g)?;
-    d.set_item("xc_offset", v(x.offset()))?;
-    d.set_item("xc_sin", v(x.sin_amplitude()))?;
-    d.set_item("xc_cos", v(x.cos_amplitude()))?;
-    d.set_item("xc_omega", v(x.omega()))?;
+    });
+    err?;
     Ok(d)
 }
 
@@ -945,7 +799,7 @@ mod adaptimp_module {
     use pyo3::prelude::*;
 
     #[pymodule_export]
-    use super::{core_defaults, simulate, PyArm, PyController};
+    use super::{defaults, schema_table, simulate, PyArm, PyController};
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -3,7 +3,7 @@
 
 use crate::types::Vector;
 
-/// One recorded row at t_k (units as in [`Command`](crate::Command)).
+/// One recorded row at t_k (units as in `Command`).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Row<const N: usize> {
     /// t_k (s).

@@ -2,12 +2,12 @@
 //! state): the clock, the compliant reference, ζ, the observer, the basis
 //! values, the weights and their norms, and the last command.
 //!
-//! One [`Controller`](crate::Controller) (the validated description) drives
+//! One `Controller` (the validated description) drives
 //! any number of states. The large part, the basis and the `(2N² + N) L`
 //! weights, lives in one flat `f64` buffer `S`: a `Vec<f64>` on the heap
-//! (feature `alloc`, [`Controller::new_state`](crate::Controller::new_state)),
+//! (feature `alloc`, `Controller::new_state`),
 //! or any buffer of the caller's, e.g. a `static mut` array in firmware
-//! ([`Controller::state_in`](crate::Controller::state_in)). Either way it is
+//! (`Controller::state_in`). Either way it is
 //! zeroed in place: no large value is ever built on the stack.
 
 use crate::error::Error;

@@ -1,5 +1,5 @@
 //! The convenience of one controller that tracks its own trajectory: a
-//! [`Controller`], a [`Trajectory`] and a heap [`State`] in one value, with
+//! [`Controller`], a [`Trajectory`] and a heap [`State`](crate::state::State) in one value, with
 //! the clock t_k = k·Ts (feature `alloc`).
 
 use crate::config::Law;

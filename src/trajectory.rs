@@ -25,7 +25,7 @@ pub trait Trajectory<const N: usize> {
 
     /// The peak commanded speed ‖ẋc‖ (rad/s) and acceleration ‖ẍc‖ (rad/s²)
     /// over the trajectory, if known: `weight_bound = auto` derives the weight
-    /// bounds from them ([`WeightBound::Auto`](crate::config::WeightBound::Auto)).
+    /// bounds from them (`WeightBound::Auto`).
     fn peak_rates(&self) -> Option<(f64, f64)> {
         None
     }

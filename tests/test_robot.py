@@ -7,7 +7,7 @@ import pytest
 
 import adaptimp
 from adaptimp import _adaptimp
-from adaptimp._params import auto_weight_bound, resolve
+from adaptimp._params import resolve
 
 
 @pytest.fixture(scope="module")
@@ -15,16 +15,13 @@ def robot() -> dict[str, adaptimp.SimResult]:
     return {case: adaptimp.simulate(case, scenario="robot") for case in ("sf", "of")}
 
 
-def test_robot_table_agrees_with_the_core() -> None:
-    core = _adaptimp.core_defaults("robot")
+def test_robot_table_is_the_core_schema() -> None:
+    core = _adaptimp.defaults("robot")
     table = resolve({}, scenario="robot")
-    for key, value in core.items():
-        if isinstance(value, str) or value is None:
-            assert table[key] == value, key
-        else:
-            assert table[key] == pytest.approx(value, rel=1e-12), key
+    assert table == core
     assert table["Ts"] == 1e-3
     assert table["substeps"] == 10
+    assert table["weight_bound"] == "auto"
 
 
 @pytest.mark.parametrize(("case", "target"), [("sf", 0.010), ("of", 0.030)])
@@ -51,17 +48,23 @@ def test_printed_laws_at_1khz_wind_up() -> None:
     assert np.max(np.abs(r.tau)) > 1e3
 
 
+def _bound(**params: object) -> np.ndarray:
+    """The weight bound the core resolved for a robot controller with ``params``."""
+    return np.array(adaptimp.Controller("sf", scenario="robot", **params).params["weight_bound"])
+
+
 def test_auto_weight_bound_follows_the_limits_and_the_trajectory() -> None:
-    p = resolve({}, scenario="robot")
-    assert p["weight_bound"] == pytest.approx([0.71785, 2.25518, 1.41697], rel=1e-5)
-    double = resolve({"tau_max": [34.0, 30.0]}, scenario="robot")["weight_bound"]
-    assert double == pytest.approx(2 * np.array(p["weight_bound"]))
+    paper = _bound()
+    assert paper == pytest.approx([0.71785, 2.25518, 1.41697], rel=1e-5)
+    assert _bound(tau_max=[34.0, 30.0]) == pytest.approx(2 * paper)
     # Twice the speed: Ĉ's bound halves, D̂'s (acceleration, ω²) quarters.
-    fast = resolve({"xc_omega": 2 * np.pi}, scenario="robot")["weight_bound"]
-    assert fast == pytest.approx(np.array(p["weight_bound"]) / [4, 2, 1])
+    assert _bound(xc_omega=2 * np.pi) == pytest.approx(paper / [4, 2, 1])
     # A trajectory that does not move uses unit rates.
-    still = dict(p, xc_omega=[0.0, 0.0])
-    assert auto_weight_bound(still)[:2] == pytest.approx([p["weight_bound"][2]] * 2)
+    assert _bound(xc_omega=0.0)[:2] == pytest.approx([paper[2]] * 2)
+    # simulate() resolves "auto" the same way, and records the numbers.
+    r = adaptimp.simulate("sf", scenario="robot", T=0.01, xc_omega=6.0)
+    assert r.params["weight_bound"] == pytest.approx(_bound(xc_omega=6.0))
+    assert r.params["weight_bound"][0] == pytest.approx(paper[0] * (np.pi / 6) ** 2)
 
 
 def test_hardened_options_are_validated() -> None:

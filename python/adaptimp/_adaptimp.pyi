@@ -6,7 +6,7 @@ them from keywords with the paper's defaults.
 """
 
 from collections.abc import Sequence
-from typing import Any, TypedDict, final, type_check_only
+from typing import Any, Literal, TypedDict, final, type_check_only
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,7 +17,8 @@ __all__ = [
     "Controller",
     "TwoLinkArm",
     "__version__",
-    "core_defaults",
+    "defaults",
+    "schema_table",
     "simulate",
 ]
 
@@ -28,64 +29,124 @@ N_NODES: int
 _F = NDArray[np.float64]
 _Joint = Sequence[float]
 
+# BEGIN GENERATED from src/schema.rs by scripts/gen_stubs.py: do not edit
+
 @type_check_only
-class ControllerParams(TypedDict):
-    """Controller parameters (SPEC §4–§11); per-joint values have 2 entries."""
+class ControllerParams(TypedDict, total=False):
+    """Controller parameters (SPEC §4–§11, §13)."""
 
     Ts: float
-    K1: _Joint
-    Kp: _Joint
-    Kzeta: _Joint
+    """sampling period of the controller (s)."""
+    K1: float | _Joint
+    """K1 of α1 = ẋd + K1 z1, (7) (1/s)."""
+    Kp: float | _Joint
+    """feedback gain Kp, (14) (N m s/rad)."""
+    Kzeta: float | _Joint
+    """auxiliary-system gain Kζ, (11) (1/s)."""
     mu: float
-    aux_law: str
-    robust: str
-    kr: _Joint
+    """radius μ of the auxiliary system's inner ball, (11) (N m)."""
+    aux_law: Literal["default", "printed", "linear"]
+    """auxiliary law: inside ‖ζ‖ < μ ζ̇ = −Kζ ζ + Δτ, or the printed ζ̇ = 0 (SPEC §8);
+    'linear': ζ̇ = −Kζ ζ + Δτ everywhere, without the −β term (SPEC §13)."""
+    robust: Literal["sign", "tanh", "remark1", "none"]
+    """robust term r(z2): kr sgn z2, kr tanh(z2/φ), Remark 1's gain, none (SPEC §7)."""
+    kr: float | _Joint
+    """gain of the 'sign' and 'tanh' robust terms (SPEC §7) (N m)."""
     phi: float
+    """boundary layer φ of the 'tanh' robust term (rad/s)."""
     kD: float
+    """Remark 1 (30): kr_i = kD |α̇1_i| + kC |α1_i| + kG (kg m²)."""
     kC: float
+    """Remark 1 (30): gain on |α1_i| (N m s/rad)."""
     kG: float
-    gamma: Sequence[float]
-    sigma: Sequence[float]
+    """Remark 1 (30): constant part (N m)."""
+    gamma: float | Sequence[float]
+    """learning gains Γ of D̂, Ĉ, Ĝ, (15)–(17)."""
+    sigma: float | Sequence[float]
+    """leakages σ of D̂, Ĉ, Ĝ, (15)–(17)."""
     eta2: float
+    """RBF width η² of the vertex grid (the paper's 'variance 25'), SPEC §6."""
     eps: float
-    lam1: _Joint
-    observer_init: str
-    observer_hold: str
-    tau_max: _Joint
-    Dd: _Joint
-    Cd: _Joint
-    Gd: _Joint
-    xc_offset: _Joint
-    xc_sin: _Joint
-    xc_cos: _Joint
-    xc_omega: _Joint
+    """high-gain observer ε, (31) (s)."""
+    lam1: float | _Joint
+    """high-gain observer λ1, (31)."""
+    observer_init: Literal["zero", "first"]
+    """observer start: π(0) = 0 (paper), or π1(0) = the first measurement."""
+    observer_hold: Literal["zoh", "triangle"]
+    """observer discretisation: zero-order hold (SPEC §11) or triangle hold."""
+    tau_max: float | _Joint
+    """actuator limits τmax (SPEC §2) (N m)."""
+    Dd: float | _Joint
+    """target inertia Dd, (3) (kg m²)."""
+    Cd: float | _Joint
+    """target damping Cd, (3) (N m s/rad)."""
+    Gd: float | _Joint
+    """target stiffness Gd, (3) (N m/rad)."""
+    xc_offset: float | _Joint
+    """commanded trajectory xc_i = o_i + a_i sin(ω_i t) + b_i cos(ω_i t): offset o (rad)."""
+    xc_sin: float | _Joint
+    """commanded trajectory: sine amplitude a (rad)."""
+    xc_cos: float | _Joint
+    """commanded trajectory: cosine amplitude b (rad)."""
+    xc_omega: float | _Joint
+    """commanded trajectory: angular frequency ω (rad/s)."""
+    learning_step: Literal["euler", "normalized"]
+    """learning step: explicit Euler of (15)–(17), or normalised so that one step's gain from
+    z2 to the network output stays below κ·Kp."""
+    kappa: float
+    """κ of the normalised step."""
+    saturation_learning: Literal["ignore", "freeze"]
+    """learning while a joint saturates: as printed, or conditional integration (no step that
+    pushes τ further beyond the limit)."""
+    weight_bound: float | Sequence[float] | Literal["auto"] | None
+    """projection onto ‖Ŵ‖_F ≤ b for D̂, Ĉ, Ĝ: None (none), 'auto' (derived from tau_max, the
+    number of nodes and the commanded trajectory's peak speed and acceleration), or b."""
 
 @type_check_only
-class ArmParams(TypedDict):
-    """Arm parameters (SPEC §1), all given."""
-
-    m1: float
-    m2: float
-    l1: float
-    l2: float
-    lc1: float
-    lc2: float
-    I1: float
-    I2: float
-    g: float
-
-@type_check_only
-class SimParams(TypedDict):
+class SimParams(TypedDict, total=False):
     """Run and environment parameters (SPEC §3, §11)."""
 
     T: float
+    """duration; rows k = 0 … round(T/Ts) − 1 are recorded (s)."""
     substeps: int
-    q0: _Joint
-    dq0: _Joint
+    """RK4 substeps M of the plant per controller period."""
+    q0: float | _Joint
+    """initial joint position q(0), (65) (rad)."""
+    dq0: float | _Joint
+    """initial joint velocity q̇(0) (rad/s)."""
     settle: float
+    """start of the 'after2' window of the metrics (SPEC §12) (s)."""
     wall: float | None
+    """wall on joint 1 at this position; None: free space (rad)."""
     ke: float
+    """wall stiffness (N m/rad)."""
     be: float
+    """wall damping (N m s/rad)."""
+
+@type_check_only
+class ArmParams(TypedDict, total=False):
+    """Arm parameters (SPEC §1)."""
+
+    m1: float
+    """mass of link 1 (kg)."""
+    m2: float
+    """mass of link 2 (kg)."""
+    l1: float
+    """length of link 1 (m)."""
+    l2: float
+    """length of link 2 (m)."""
+    lc1: float | None
+    """joint 1 to the centre of mass of link 1 (None: l1/2) (m)."""
+    lc2: float | None
+    """joint 2 to the centre of mass of link 2 (None: l2/2) (m)."""
+    I1: float | None
+    """inertia of link 1 about its centre (None: m1 l1²/4) (kg m²)."""
+    I2: float | None
+    """inertia of link 2 about its centre (None: m2 l2²/4) (kg m²)."""
+    g: float
+    """gravitational acceleration (vertical plane) (m/s²)."""
+
+# END GENERATED
 
 @final
 class Controller:
@@ -122,6 +183,8 @@ class Controller:
     def xd(self) -> _F: ...
     @property
     def weights(self) -> dict[str, _F]: ...
+    @property
+    def weight_bound(self) -> list[float] | None: ...
 
 @final
 class TwoLinkArm:
@@ -135,6 +198,8 @@ class TwoLinkArm:
         self, q: ArrayLike, dq: ArrayLike, tau: ArrayLike, tau_e: ArrayLike
     ) -> _F: ...
     @property
+    def params(self) -> dict[str, float]: ...
+    @property
     def lumped(self) -> tuple[float, float, float, float, float]: ...
 
 def simulate(
@@ -142,5 +207,8 @@ def simulate(
 ) -> dict[str, Any]:
     """Close the loop with the GIL released; returns the arrays and "metrics"."""
 
-def core_defaults(scenario: str = "paper") -> dict[str, Any]:
-    """The core's own defaults of ``scenario`` ("paper" or "robot"), keyed by the Python names."""
+def schema_table() -> list[dict[str, Any]]:
+    """The parameter schema: name, group, kind, unit, doc, condition, choices, defaults."""
+
+def defaults(scenario: str = "paper") -> dict[str, Any]:
+    """Every parameter's default in ``scenario`` ("paper" or "robot"), keyed by name."""

@@ -66,6 +66,10 @@ def simulate(case: str = "sf", scenario: str = "paper", **params: Any) -> SimRes
     p = resolve(params, scenario=scenario, caller="simulate()")
     ctrl = _adaptimp.Controller(case, p)
     arm = _adaptimp.TwoLinkArm(p)
+    # What the core derived: the arm's centres of mass and inertias, the
+    # weight bounds of "auto".
+    p.update(arm.params)
+    p["weight_bound"] = ctrl.weight_bound
     out = _adaptimp.simulate(ctrl, arm, p)
     metrics = out.pop("metrics")
     return SimResult(case=case, scenario=scenario, params=p, metrics=metrics, **out)
@@ -124,6 +128,7 @@ class Controller:
         )
         self._scenario = scenario
         self._core = _adaptimp.Controller(case, self._params)
+        self._params["weight_bound"] = self._core.weight_bound
 
     def step(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> FloatArray:
         """One controller step at t_k = k·Ts; returns the applied torque sat(τ) (N m), (2,).
@@ -289,6 +294,7 @@ class TwoLinkArm:
     def __init__(self, **params: Any) -> None:
         self._params = resolve(params, groups=("arm",), caller="TwoLinkArm()")
         self._core = _adaptimp.TwoLinkArm(self._params)
+        self._params.update(self._core.params)
 
     @property
     def params(self) -> dict[str, Any]:

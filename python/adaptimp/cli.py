@@ -8,12 +8,14 @@
 ``adaptimp simulate [--case sf] [--PARAM VALUE ...] [--plot FILE [--kind KIND]] [--save FILE]``
     Run one case and print its SPEC §12 metrics.
 
-``adaptimp params``
-    List every parameter with its unit, meaning and paper default.
+``adaptimp params [--scenario paper|robot]``
+    List every parameter with its unit, meaning, validity condition and the
+    scenario's default.
 
 Any parameter of :func:`adaptimp.simulate` is given as ``--name value`` (or
 ``--name=value``); per-joint and per-network values as comma-separated lists
-(``--Kp 10.5,9``), ``none`` for no wall (``--wall none``).
+(``--Kp 10.5,9``), ``none`` for no wall (``--wall none``) or no weight bound
+(``--weight_bound none``; ``auto`` or ``1,2,3`` otherwise).
 """
 
 from __future__ import annotations
@@ -39,8 +41,13 @@ class CliError(Exception):
 def _parse_value(name: str, text: str) -> Any:
     p = BY_NAME[name]
     try:
-        if p.kind in ("optional", "derived") and text.lower() == "none":
+        if p.kind in ("optional", "derived", "bound") and text.lower() == "none":
             return None
+        if p.kind == "bound":
+            if text.lower() == "auto":
+                return "auto"
+            parts = [float(x) for x in text.split(",")]
+            return parts[0] if len(parts) == 1 else parts
         if p.kind == "int":
             return int(text)
         if p.kind in ("real", "optional", "derived"):
@@ -61,6 +68,7 @@ def _expected(kind: str) -> str:
         "derived": "a number or 'none'",
         "joint": "a number or comma-separated numbers, one per joint",
         "network": "a number or comma-separated numbers, one per network (D, C, G)",
+        "bound": "'none', 'auto', or comma-separated numbers, one per network (D, C, G)",
     }.get(kind, "a value")
 
 
@@ -160,11 +168,14 @@ def cmd_simulate(args: argparse.Namespace, params: dict[str, Any]) -> int:
 
 
 def cmd_params(args: argparse.Namespace, params: dict[str, Any]) -> int:
-    """Print every parameter with its unit, meaning and paper default."""
+    """Print every parameter with its unit, meaning, condition and the scenario's default."""
     if params:
         raise CliError("`adaptimp params` takes no parameters")
-    print("Parameters of adaptimp.simulate (units; paper defaults, SPEC §11):")
-    print(describe())
+    print(
+        f"Parameters of adaptimp.simulate (units; validity; defaults of the "
+        f"{args.scenario!r} scenario):"
+    )
+    print(describe(scenario=args.scenario))
     return 0
 
 
@@ -214,7 +225,14 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--json", action="store_true", help="print the metrics as JSON")
     sim.set_defaults(func=cmd_simulate)
 
-    par = sub.add_parser("params", help="list the parameters, units and defaults")
+    par = sub.add_parser(
+        "params",
+        help="list the parameters, units and defaults",
+        description="List every parameter with its unit, meaning, validity condition "
+        "and the default of --scenario.",
+        allow_abbrev=False,
+    )
+    par.add_argument("--scenario", default="paper", choices=tuple(SCENARIOS))
     par.set_defaults(func=cmd_params)
     return parser
 

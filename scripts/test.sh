@@ -17,8 +17,9 @@ cargo fmt --check
 cargo clippy --all-targets -- -D warnings
 cargo clippy --all-targets --features python -- -D warnings
 
-step "Rust: no_std build of the core, docs"
+step "Rust: no_std build of the core (without and with alloc), docs"
 cargo build --no-default-features
+cargo build --no-default-features --features alloc
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 
 step "Rust: tests"
@@ -34,8 +35,8 @@ py="$venv/bin/python"
 "$py" -m pip install --quiet --disable-pip-version-check ".[test]"
 
 step "Python: ruff, type stubs, mypy"
-"$py" -m ruff check python tests examples benches
-"$py" -m ruff format --check python tests examples benches
+"$py" -m ruff check python tests examples benches scripts
+"$py" -m ruff format --check python tests examples benches scripts
 "$py" -m mypy.stubtest adaptimp._adaptimp
 "$py" -m mypy
 

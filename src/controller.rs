@@ -597,6 +597,43 @@ mod tests {
     }
 
     #[test]
+    fn a_snapshot_restores_a_state_that_continues_bit_identically() {
+        for c in [
+            Controller::paper(Law::OutputFeedback),
+            Controller::robot(Law::StateFeedback),
+        ] {
+            let m = measurement();
+            let circle = Sinusoid::paper();
+            let mut a = c.new_state();
+            for _ in 0..100 {
+                let sp = circle.sample(c.time(&a));
+                c.step(&mut a, &m, &sp).unwrap();
+            }
+            let mut snap = vec![0.0; a.snapshot_len()];
+            assert_eq!(a.save(&mut snap).unwrap(), snap.len());
+            let mut b = c.new_state();
+            b.load(&snap).unwrap();
+            for k in 0..50 {
+                let x = m.x + Vector::<2>::from_element(1e-3 * k as f64);
+                let mk = Measurement { x, ..m };
+                let sp = circle.sample(c.time(&a));
+                assert_eq!(c.step(&mut a, &mk, &sp), c.step(&mut b, &mk, &sp));
+            }
+            assert_eq!(a.weight_norms(), b.weight_norms());
+            // A corrupt snapshot is refused and changes nothing.
+            let before = format!("{:?}", b.weights());
+            let last = snap.len() - 1;
+            snap[last] = f64::NAN;
+            assert!(b.load(&snap).is_err());
+            snap[4] = 0.5;
+            let e = b.load(&snap).unwrap_err();
+            assert!(e.to_string().contains("whole number"), "{e}");
+            assert!(b.load(&snap[1..]).is_err());
+            assert_eq!(format!("{:?}", b.weights()), before);
+        }
+    }
+
+    #[test]
     fn a_state_in_a_caller_buffer_steps_like_a_heap_state() {
         let c = Controller::paper(Law::OutputFeedback);
         let mut buf = vec![0.0; c.buffer_len()];

@@ -125,6 +125,8 @@ pub use model::{Manipulator, PlanarArm, TwoLinkArm};
 pub use network::{Weights, WeightsMut};
 pub use observer::{HighGainObserver, Hold};
 pub use plant::{rk4_step, Plant, RigidBody};
+#[cfg(feature = "alloc")]
+pub use rbf::AnyBasis;
 pub use rbf::{Basis, Centers, Grid};
 #[cfg(feature = "alloc")]
 pub use record::Trace;

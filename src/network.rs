@@ -423,7 +423,7 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
         Weights::new(self.rows, self.nodes, self.stride)
     }
 
-    fn row_mut(&mut self, i: usize) -> &mut [f64] {
+    pub(crate) fn row_mut(&mut self, i: usize) -> &mut [f64] {
         &mut self.rows[i * self.stride..i * self.stride + self.nodes]
     }
 

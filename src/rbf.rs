@@ -206,6 +206,35 @@ impl<const N: usize, C: AsRef<[f64]>> Basis<N> for Centers<N, C> {
     }
 }
 
+/// Either basis, chosen at run time (feature `alloc`): for bindings that
+/// take the paper's grid or user centres from their caller.
+#[cfg(feature = "alloc")]
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyBasis<const N: usize> {
+    /// The paper's vertex grid.
+    Grid(Grid<N>),
+    /// User centres on the heap.
+    Centers(Centers<N, alloc::vec::Vec<f64>>),
+}
+
+#[cfg(feature = "alloc")]
+impl<const N: usize> Basis<N> for AnyBasis<N> {
+    fn nodes(&self) -> usize {
+        match self {
+            AnyBasis::Grid(g) => g.nodes(),
+            AnyBasis::Centers(c) => c.nodes(),
+        }
+    }
+
+    #[inline]
+    fn eval(&self, z: &[Vector<N>; 4], s: &mut [f64]) {
+        match self {
+            AnyBasis::Grid(g) => g.eval(z, s),
+            AnyBasis::Centers(c) => c.eval(z, s),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -32,6 +32,11 @@ pub struct State<const N: usize, S> {
     buf: S,
 }
 
+/// First two values of a snapshot: a marker and the format's version.
+const SNAPSHOT_HEADER: [f64; 2] = [4_151_076.0, 1.0];
+/// Values of a snapshot before its per-joint part: header, N, L, k.
+const SNAPSHOT_PREFIX: usize = 5;
+
 /// A state whose buffer is on the heap.
 #[cfg(feature = "alloc")]
 pub type HeapState<const N: usize> = State<N, alloc::vec::Vec<f64>>;
@@ -135,6 +140,117 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
         Ok(())
     }
 
+    /// The number of reals [`save`](Self::save) writes:
+    /// `11 + 15 N + L (2N² + N + 1)`.
+    pub fn snapshot_len(&self) -> usize {
+        SNAPSHOT_PREFIX + 15 * N + 6 + self.nodes() * (Layout::rows(N) + 1)
+    }
+
+    /// Write everything this state holds into `out` (at least
+    /// [`snapshot_len`](Self::snapshot_len) reals) as a flat array of reals:
+    /// a header, N, L, the step count, the reference, ζ, the observer, the
+    /// norms, the last command, the basis and the weights. Returns the number
+    /// written. [`load`](Self::load) restores it exactly, so a run continues
+    /// bit-identically. No allocation.
+    pub fn save(&self, out: &mut [f64]) -> Result<usize, Error> {
+        let len = self.snapshot_len();
+        let out = out.get_mut(..len).ok_or(Error::Invalid {
+            what: "snapshot buffer",
+            reason: "too short: see State::snapshot_len",
+        })?;
+        let mut w = Writer { out, at: 0 };
+        w.put(&SNAPSHOT_HEADER);
+        w.put(&[N as f64, self.nodes() as f64, self.k as f64]);
+        let c = &self.last;
+        for v in [
+            &self.reference.xd,
+            &self.reference.dxd,
+            &self.zeta,
+            &self.observer.pi1,
+            &self.observer.pi2,
+            &self.observer.y_prev,
+            &c.tau_sat,
+            &c.tau,
+            &c.dtau,
+            &c.z1,
+            &c.z2,
+            &c.xc,
+            &c.xd,
+            &c.v,
+            &c.zeta,
+        ] {
+            w.put(v.as_slice());
+        }
+        w.put(&self.norms);
+        w.put(&c.w_norms);
+        w.put(self.basis());
+        let weights = self.weights();
+        for net in [crate::network::D, crate::network::C, crate::network::G] {
+            for row in weights.network(net) {
+                w.put(row);
+            }
+        }
+        Ok(w.at)
+    }
+
+    /// Restore a snapshot written by [`save`](Self::save) for the same N and L.
+    /// Every value is checked (header, sizes, a whole step count, finite
+    /// numbers) before anything changes: on an error the state is as before.
+    pub fn load(&mut self, data: &[f64]) -> Result<(), Error> {
+        let bad = |reason| Error::Invalid {
+            what: "snapshot",
+            reason,
+        };
+        if data.len() != self.snapshot_len() {
+            return Err(bad("its length is not State::snapshot_len() of this state"));
+        }
+        if data[..2] != SNAPSHOT_HEADER {
+            return Err(bad("not a snapshot of this version (header)"));
+        }
+        if data[2] != N as f64 || data[3] != self.nodes() as f64 {
+            return Err(bad("made for another number of joints or nodes"));
+        }
+        let k = data[4];
+        if !(0.0..=9.007_199_254_740_992e15).contains(&k) || k.fract() != 0.0 {
+            return Err(bad("the step count is not a whole number in [0, 2^53]"));
+        }
+        crate::error::check::finite_slice("snapshot", data)?;
+        let mut r = Reader {
+            data,
+            at: SNAPSHOT_PREFIX,
+        };
+        self.k = k as u64;
+        self.reference.xd = r.vector();
+        self.reference.dxd = r.vector();
+        self.zeta = r.vector();
+        self.observer.pi1 = r.vector();
+        self.observer.pi2 = r.vector();
+        self.observer.y_prev = r.vector();
+        let c = &mut self.last;
+        for v in [
+            &mut c.tau_sat,
+            &mut c.tau,
+            &mut c.dtau,
+            &mut c.z1,
+            &mut c.z2,
+            &mut c.xc,
+            &mut c.xd,
+            &mut c.v,
+            &mut c.zeta,
+        ] {
+            *v = r.vector();
+        }
+        self.norms = r.array();
+        c.w_norms = r.array();
+        let (basis, mut weights) = self.parts();
+        basis.copy_from_slice(r.take(basis.len()));
+        let nodes = basis.len();
+        for i in 0..Layout::rows(N) {
+            weights.row_mut(i).copy_from_slice(r.take(nodes));
+        }
+        Ok(())
+    }
+
     /// The basis buffer and the weights, writable: for benchmarks and for
     /// learning laws of your own. The tracked norms
     /// ([`weight_norms`](Self::weight_norms)) are not updated by edits made
@@ -154,5 +270,40 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
         let (basis, rows) = self.layout.split_mut(self.buf.as_mut());
         let stride = rows.len() / Layout::rows(N);
         (basis, WeightsMut::new(rows, nodes, stride))
+    }
+}
+
+/// Sequential writes into a snapshot.
+struct Writer<'a> {
+    out: &'a mut [f64],
+    at: usize,
+}
+
+impl Writer<'_> {
+    fn put(&mut self, v: &[f64]) {
+        self.out[self.at..self.at + v.len()].copy_from_slice(v);
+        self.at += v.len();
+    }
+}
+
+/// Sequential reads from a snapshot whose length was checked.
+struct Reader<'a> {
+    data: &'a [f64],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> &'a [f64] {
+        let v = &self.data[self.at..self.at + n];
+        self.at += n;
+        v
+    }
+    fn vector<const N: usize>(&mut self) -> Vector<N> {
+        Vector::from_column_slice(self.take(N))
+    }
+    fn array(&mut self) -> [f64; 3] {
+        let mut a = [0.0; 3];
+        a.copy_from_slice(self.take(3));
+        a
     }
 }

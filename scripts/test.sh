@@ -12,18 +12,31 @@ cd "$(dirname "$0")/.."
 
 step() { printf '\n==> %s  [%d s]\n' "$*" "$SECONDS"; }
 
+step "System tools: CMake and valgrind for the C ABI's examples"
+need=()
+command -v cmake >/dev/null || need+=(cmake)
+command -v valgrind >/dev/null || need+=(valgrind)
+if [ ${#need[@]} -gt 0 ]; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+        apt-get update -qq && apt-get install -y -qq "${need[@]}" >/dev/null
+    else
+        echo "please install: ${need[*]}" >&2
+        exit 1
+    fi
+fi
+
 step "Rust: format, lints"
-cargo fmt --check
-cargo clippy --all-targets -- -D warnings
+cargo fmt --all --check
+cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy --all-targets --features python -- -D warnings
 
 step "Rust: no_std build of the core (without and with alloc), docs"
 cargo build --no-default-features
 cargo build --no-default-features --features alloc
-RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 
-step "Rust: tests"
-cargo test
+step "Rust: tests (the core, and the C ABI with its header check)"
+cargo test --workspace
 
 step "Python: build and install the package with its test tools"
 export CARGO_TARGET_DIR="$PWD/target"

@@ -1,0 +1,278 @@
+//! The C ABI against the Rust API: the same torques (bit for bit) for the
+//! same inputs, user centres for n = 3, snapshots, and misuse by status.
+
+use adaptimp::{Controller, Law, Measurement, Sinusoid, Tracker, Trajectory, Vector};
+use adaptimp_ffi::*;
+use std::ffi::CStr;
+use std::ptr;
+
+fn last_error() -> String {
+    // SAFETY: the library returns a NUL-terminated thread-local buffer.
+    unsafe { CStr::from_ptr(adaptimp_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+struct Handles {
+    ctrl: *mut AdaptimpController,
+    state: *mut AdaptimpState,
+}
+
+impl Handles {
+    fn new(params: &AdaptimpParams) -> Result<Self, (AdaptimpStatus, String)> {
+        let mut ctrl = ptr::null_mut();
+        // SAFETY: valid pointers.
+        let s = unsafe { adaptimp_controller_new(params, &mut ctrl) };
+        if s != AdaptimpStatus::Ok {
+            return Err((s, last_error()));
+        }
+        let mut state = ptr::null_mut();
+        // SAFETY: a valid controller and out pointer.
+        assert_eq!(
+            unsafe { adaptimp_state_new(ctrl, &mut state) },
+            AdaptimpStatus::Ok
+        );
+        Ok(Self { ctrl, state })
+    }
+
+    fn step(
+        &self,
+        q: &[f64],
+        dq: Option<&[f64]>,
+        te: &[f64],
+    ) -> Result<AdaptimpCommand, AdaptimpStatus> {
+        // SAFETY: zeroed is a valid AdaptimpCommand (numbers only).
+        let mut out: AdaptimpCommand = unsafe { std::mem::zeroed() };
+        // SAFETY: valid handles; slices of n reals.
+        let s = unsafe {
+            adaptimp_step(
+                self.ctrl,
+                self.state,
+                q.len(),
+                q.as_ptr(),
+                dq.map_or(ptr::null(), |d| d.as_ptr()),
+                te.as_ptr(),
+                ptr::null(),
+                &mut out,
+            )
+        };
+        if s == AdaptimpStatus::Ok {
+            Ok(out)
+        } else {
+            Err(s)
+        }
+    }
+}
+
+impl Drop for Handles {
+    fn drop(&mut self) {
+        // SAFETY: created by the library, freed once.
+        unsafe {
+            adaptimp_state_free(self.state);
+            adaptimp_controller_free(self.ctrl);
+        }
+    }
+}
+
+fn defaults(n: usize, law: AdaptimpLaw, preset: AdaptimpPreset) -> AdaptimpParams {
+    let mut p = std::mem::MaybeUninit::uninit();
+    // SAFETY: a valid place; Ok means it was written whole.
+    unsafe {
+        assert_eq!(
+            adaptimp_params_default(p.as_mut_ptr(), n, law, preset),
+            AdaptimpStatus::Ok
+        );
+        p.assume_init()
+    }
+}
+
+/// The fixed input sequence of ffi/examples/paper.c at step k.
+fn inputs(k: usize) -> ([f64; 2], [f64; 2], [f64; 2]) {
+    let s = k as f64;
+    (
+        [
+            0.25 + 0.01 * (0.1 * s).sin(),
+            -0.05 + 0.01 * (0.07 * s).cos(),
+        ],
+        [0.1 * (0.1 * s).cos(), -0.1 * (0.07 * s).sin()],
+        [(5.0 * (0.05 * s).sin()).max(0.0), 0.0],
+    )
+}
+
+#[test]
+fn torques_through_the_abi_equal_the_rust_api_bit_for_bit() {
+    for (law, claw) in [
+        (Law::Pd, AdaptimpLaw::Pd),
+        (Law::StateFeedback, AdaptimpLaw::StateFeedback),
+        (Law::OutputFeedback, AdaptimpLaw::OutputFeedback),
+    ] {
+        for (preset, rust) in [
+            (AdaptimpPreset::Paper, Tracker::paper(law)),
+            (AdaptimpPreset::Robot, Tracker::robot(law)),
+        ] {
+            let mut rust = rust;
+            let c = Handles::new(&defaults(2, claw, preset)).expect("controller");
+            for k in 0..500 {
+                let (q, dq, te) = inputs(k);
+                let ours = c.step(&q, Some(&dq), &te).expect("step");
+                let theirs = rust
+                    .step(&Measurement {
+                        x: Vector::<2>::from(q),
+                        dx: Some(Vector::<2>::from(dq)),
+                        tau_e: Vector::<2>::from(te),
+                    })
+                    .expect("step");
+                assert_eq!(ours.n, 2);
+                assert_eq!(
+                    &ours.tau_sat[..2],
+                    theirs.tau_sat.as_slice(),
+                    "{law:?} {preset:?} k={k}"
+                );
+                assert_eq!(&ours.tau[..2], theirs.tau.as_slice());
+                assert_eq!(ours.w_norms, theirs.w_norms);
+                assert!(ours.tau_sat[2..].iter().all(|v| *v == 0.0));
+            }
+        }
+    }
+}
+
+#[test]
+fn three_joints_with_user_centres_and_widths() {
+    const N: usize = 3;
+    let mut p = defaults(N, AdaptimpLaw::StateFeedback, AdaptimpPreset::Robot);
+    p.tau_max[..N].copy_from_slice(&[40.0, 30.0, 20.0]);
+    let nodes = 50;
+    let centers: Vec<f64> = (0..nodes * 4 * N)
+        .map(|i| ((i * 7919) % 200) as f64 / 100.0 - 1.0)
+        .collect();
+    let widths2: Vec<f64> = (0..4 * N).map(|i| 1.0 + i as f64).collect();
+    p.centers = centers.as_ptr();
+    p.nodes = nodes;
+    p.widths2 = widths2.as_ptr();
+    let c = Handles::new(&p).expect("controller");
+    // SAFETY: valid handle.
+    assert_eq!(unsafe { adaptimp_controller_joints(c.ctrl) }, N);
+    // The same controller built in Rust.
+    let widths: [Vector<N>; 4] =
+        core::array::from_fn(|b| Vector::<N>::from_column_slice(&widths2[b * N..(b + 1) * N]));
+    let basis =
+        adaptimp::AnyBasis::Centers(adaptimp::Centers::new(centers.clone(), widths).unwrap());
+    let s = adaptimp::Scenario::<N>::preset(adaptimp::Preset::Robot, Law::StateFeedback);
+    let mut cfg = s.config;
+    cfg.tau_max = Vector::<N>::new(40.0, 30.0, 20.0);
+    let traj = s.trajectory().unwrap();
+    let ctrl = Controller::for_trajectory(cfg, basis, &traj).unwrap();
+    let mut st = ctrl.new_state();
+    for k in 0..300 {
+        let q = [0.1 * (k as f64 * 0.01).sin(), 0.2, -0.1];
+        let dq = [0.01, 0.0, -0.02];
+        let ours = c.step(&q, Some(&dq), &[0.0; 3]).expect("step");
+        let sp = traj.sample(ctrl.time(&st));
+        let theirs = ctrl
+            .step(
+                &mut st,
+                &Measurement {
+                    x: Vector::from(q),
+                    dx: Some(Vector::from(dq)),
+                    tau_e: Vector::zeros(),
+                },
+                &sp,
+            )
+            .unwrap();
+        assert_eq!(&ours.tau_sat[..N], theirs.tau_sat.as_slice(), "k={k}");
+    }
+    // Mis-sized inputs are refused by status.
+    assert_eq!(
+        c.step(&[0.0; 2], Some(&[0.0; 2]), &[0.0; 2]).unwrap_err(),
+        AdaptimpStatus::BadSize
+    );
+    assert!(
+        last_error().contains("the controller has 3 joints"),
+        "{}",
+        last_error()
+    );
+    // NULL centres with n > 3: the grid does not exist.
+    p.centers = ptr::null();
+    p.n = 4;
+    let (status, msg) = Handles::new(&p).err().expect("refused");
+    assert_eq!(status, AdaptimpStatus::InvalidConfig);
+    assert!(msg.contains("1 ≤ n ≤ 3"), "{msg}");
+}
+
+#[test]
+fn a_snapshot_restored_continues_bit_identically_and_a_bad_one_changes_nothing() {
+    let p = defaults(2, AdaptimpLaw::OutputFeedback, AdaptimpPreset::Robot);
+    let (a, b) = (Handles::new(&p).unwrap(), Handles::new(&p).unwrap());
+    for k in 0..100 {
+        let (q, _, te) = inputs(k);
+        a.step(&q, None, &te).unwrap();
+    }
+    // SAFETY: valid handles and buffers of the stated lengths.
+    unsafe {
+        let len = adaptimp_state_snapshot_len(a.state);
+        let mut buf = vec![0.0; len];
+        let mut written = 0;
+        assert_eq!(
+            adaptimp_state_save(a.state, buf.as_mut_ptr(), len, &mut written),
+            AdaptimpStatus::Ok
+        );
+        assert_eq!(written, len);
+        assert_eq!(
+            adaptimp_state_restore(b.state, buf.as_ptr(), len),
+            AdaptimpStatus::Ok
+        );
+        assert_eq!(adaptimp_state_steps(b.state), 100);
+        for k in 100..200 {
+            let (q, _, te) = inputs(k);
+            assert_eq!(
+                a.step(&q, None, &te).unwrap(),
+                b.step(&q, None, &te).unwrap()
+            );
+        }
+        buf[3] += 1.0; // another number of nodes
+        assert_eq!(
+            adaptimp_state_restore(b.state, buf.as_ptr(), len),
+            AdaptimpStatus::WrongState
+        );
+        assert_eq!(adaptimp_state_steps(b.state), 200);
+        assert_eq!(
+            adaptimp_state_restore(b.state, ptr::null(), len),
+            AdaptimpStatus::NullPointer
+        );
+        // A state of another size is refused by the step.
+        let three = Handles::new(&{
+            let mut p3 = defaults(3, AdaptimpLaw::Pd, AdaptimpPreset::Paper);
+            p3.eta2 = 25.0;
+            p3
+        })
+        .unwrap();
+        let mut out: AdaptimpCommand = std::mem::zeroed();
+        let q = [0.0; 2];
+        let s = adaptimp_step(
+            a.ctrl,
+            three.state,
+            2,
+            q.as_ptr(),
+            q.as_ptr(),
+            q.as_ptr(),
+            ptr::null(),
+            &mut out,
+        );
+        assert_eq!(s, AdaptimpStatus::WrongState);
+    }
+}
+
+#[test]
+fn the_circle_of_the_preset_is_the_default_setpoint() {
+    // A NULL setpoint tracks the controller's own trajectory, as Tracker does.
+    let c = Handles::new(&defaults(
+        2,
+        AdaptimpLaw::StateFeedback,
+        AdaptimpPreset::Paper,
+    ))
+    .unwrap();
+    let out = c
+        .step(&[0.25, -0.05], Some(&[0.0, 0.0]), &[0.0, 0.0])
+        .unwrap();
+    assert_eq!(&out.xc[..2], Sinusoid::paper().sample(0.0).x.as_slice());
+}

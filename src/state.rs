@@ -211,7 +211,7 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
             return Err(bad("made for another number of joints or nodes"));
         }
         let k = data[4];
-        if !(0.0..=9.007_199_254_740_992e15).contains(&k) || k.fract() != 0.0 {
+        if !(0.0..=9.007_199_254_740_992e15).contains(&k) || (k as u64) as f64 != k {
             return Err(bad("the step count is not a whole number in [0, 2^53]"));
         }
         crate::error::check::finite_slice("snapshot", data)?;

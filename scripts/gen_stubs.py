@@ -29,6 +29,7 @@ TYPES = {
     "optional": "float | None",
     "derived": "float | None",
     "bound": 'float | Sequence[float] | Literal["auto"] | None',
+    "limit": "float | _Joint | None",
 }
 
 CLASSES = (

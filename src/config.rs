@@ -7,6 +7,7 @@ use crate::auxiliary::AuxLaw;
 use crate::learning::{LearningStep, SaturationLearning};
 use crate::observer::Hold;
 use crate::robust::RobustKind;
+use crate::safety::{Fallback, FaultPolicy, Limits};
 use crate::types::{choices, Vector};
 
 /// Which of the paper's controllers, SPEC §7.
@@ -121,6 +122,15 @@ pub struct Config<const N: usize> {
     pub cd: Vector<N>,
     /// Desired stiffness Gd (N m/rad). Paper: 60.
     pub gd: Vector<N>,
+    /// The torque to apply when a step fails (beyond the paper).
+    pub fallback: Fallback,
+    /// Kd (N m s/rad) of the damping fallback −Kd q̇.
+    pub fallback_damping: Vector<N>,
+    /// What a failed step does to the following ones.
+    pub fault_policy: FaultPolicy,
+    /// Plausibility limits on the measurements and the torque rate limit
+    /// (infinity: none).
+    pub limits: Limits<N>,
 }
 
 impl<const N: usize> Config<N> {
@@ -155,6 +165,10 @@ impl<const N: usize> Config<N> {
             dd: z,
             cd: z,
             gd: z,
+            fallback: Fallback::Hold,
+            fallback_damping: z,
+            fault_policy: FaultPolicy::Report,
+            limits: Limits::none(),
         }
     }
 

@@ -16,13 +16,14 @@
 
 use crate::auxiliary::Auxiliary;
 use crate::config::{Config, Law, ObserverInit, WeightBound};
-use crate::error::{check, Error};
+use crate::error::{check, Error, BOUND, PARAM_BOUND};
 use crate::impedance::{Reference, TargetImpedance};
 use crate::io::{Command, Control, Measurement};
 use crate::learning::{Learning, Signals};
-use crate::observer::HighGainObserver;
+use crate::observer::{HighGainObserver, ObserverState};
 use crate::rbf::{Basis, Grid};
 use crate::robust::Robust;
+use crate::safety::{Fallback, Fault, FaultPolicy};
 use crate::saturation::Saturation;
 use crate::state::State;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
@@ -103,6 +104,9 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             |i, kz| 2.0 * kz - 1.0 - cfg.kp[i] * cfg.kp[i],
             true,
         )?;
+        Self::check_magnitudes(&cfg)?;
+        check::nonnegative_vec("Kd ≥ 0", "fallback_damping", &cfg.fallback_damping)?;
+        cfg.limits.validate()?;
         let robust = Robust::from_config(cfg.robust, cfg.kr, cfg.phi, [cfg.kd, cfg.kc, cfg.kg]);
         robust.validate()?;
         let bound = match cfg.weight_bound {
@@ -134,6 +138,53 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             cfg,
             basis,
         })
+    }
+
+    /// Every gain and physical parameter at most [`PARAM_BOUND`] (1e9) in
+    /// magnitude: the stability conditions of SPEC §10 accept, e.g., K1 = 1e300,
+    /// which then overflows within two steps.
+    fn check_magnitudes(cfg: &Config<N>) -> Result<(), Error> {
+        let vectors = [
+            ("K1", &cfg.k1),
+            ("Kp", &cfg.kp),
+            ("Kzeta", &cfg.kzeta),
+            ("kr", &cfg.kr),
+            ("lam1", &cfg.lam1),
+            ("tau_max", &cfg.tau_max),
+            ("Dd", &cfg.dd),
+            ("Cd", &cfg.cd),
+            ("Gd", &cfg.gd),
+            ("fallback_damping", &cfg.fallback_damping),
+        ];
+        for (what, v) in vectors {
+            check::finite_slice(what, v.as_slice())?;
+            check::each(
+                "|value| ≤ 1e9",
+                what,
+                v,
+                |_, x| PARAM_BOUND - x.abs(),
+                false,
+            )?;
+        }
+        let scalars = [
+            ("mu", cfg.mu),
+            ("phi", cfg.phi),
+            ("kD", cfg.kd),
+            ("kC", cfg.kc),
+            ("kG", cfg.kg),
+            ("kappa", cfg.kappa),
+            ("eps", cfg.eps),
+            ("gamma", cfg.gamma[0]),
+            ("gamma", cfg.gamma[1]),
+            ("gamma", cfg.gamma[2]),
+            ("sigma", cfg.sigma[0]),
+            ("sigma", cfg.sigma[1]),
+            ("sigma", cfg.sigma[2]),
+        ];
+        for (what, x) in scalars {
+            check::at_most("|value| ≤ 1e9", what, x, PARAM_BOUND)?;
+        }
+        check::at_most("Ts ≤ 1 s", "Ts", cfg.ts, 1.0)
     }
 
     /// As [`new`](Self::new), with a [`WeightBound::Auto`] resolved for the
@@ -229,39 +280,123 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// One controller step at t_k (SPEC §11, steps 1–5): the measurement `m`
     /// and the commanded setpoint `c` (xc, ẋc, ẍc at t_k; the reference starts
     /// at the first step's) in, the command out; `tau_sat` goes to the
-    /// actuators. No allocation. On an error nothing changes, except for
-    /// [`Error::Diverged`] (then [`State::reset`]).
+    /// actuators. No allocation.
+    ///
+    /// **Transactional**: the step first checks its inputs (finite, within the
+    /// plausibility limits, every signal within [`BOUND`](crate::error::BOUND))
+    /// and that the weights' update keeps them within the bound; only then
+    /// does it change the state. On an error the state is exactly as before,
+    /// except that the fault is recorded ([`State::fault`]); with
+    /// [`FaultPolicy::Latch`] later steps are refused until
+    /// [`State::clear_fault`]. [`step_or_fallback`](Self::step_or_fallback)
+    /// also gives the torque to apply then.
     pub fn step<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
         st: &mut State<N, S>,
         m: &Measurement<N>,
         c: &Setpoint<N>,
     ) -> Result<Command<N>, Error> {
-        self.check(st, m, c)?;
-        let v = self.velocity(st, m)?;
-        if st.k == 0 {
-            st.reference = Reference::start(c);
+        let out = self.try_step(st, m, c);
+        if let Err(error) = out {
+            st.fault = Some(Fault { error, step: st.k });
         }
-        let e = self.errors(&st.reference, c, m, &v);
-        let mut tau = self.feedback(&e, &st.zeta);
+        out
+    }
+
+    /// [`step`](Self::step), and the torque to apply whatever happened: the
+    /// step's `tau_sat`, or on an error the configured [`Fallback`] (the last
+    /// applied torque held, zero, or joint damping −Kd q̇, saturated).
+    pub fn step_or_fallback<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        match self.step(st, m, c) {
+            Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
+            Err(e) => (self.fallback(st, m), Err(e)),
+        }
+    }
+
+    /// The configured fallback torque (N m, saturated) for `state` given the
+    /// measurement `m`: for damping, its velocity if finite and within
+    /// `dq_max`, else the last velocity the controller used.
+    pub fn fallback<S>(&self, st: &State<N, S>, m: &Measurement<N>) -> Vector<N> {
+        let tau = match self.cfg.fallback {
+            Fallback::Hold => st.last.tau_sat,
+            Fallback::Zero => Vector::zeros(),
+            Fallback::Damping => {
+                let usable = |v: &Vector<N>| {
+                    v.iter()
+                        .zip(self.cfg.limits.dq.iter())
+                        .all(|(x, l)| x.is_finite() && x.abs() <= *l)
+                };
+                let v = match m.dx {
+                    Some(dx) if usable(&dx) => dx,
+                    _ => st.last.v,
+                };
+                -self.cfg.fallback_damping.component_mul(&v)
+            }
+        };
+        self.sat.apply(&tau)
+    }
+
+    /// The step itself: checks, then stages on local copies, then the commit.
+    fn try_step<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> Result<Command<N>, Error> {
+        if let (FaultPolicy::Latch, Some(f)) = (self.cfg.fault_policy, st.fault) {
+            return Err(Error::Faulted {
+                reason: f.error.kind(),
+            });
+        }
+        self.check(st, m, c)?;
+        let mut observer = st.observer;
+        let v = self.velocity(st.k, &mut observer, m)?;
+        let mut reference = if st.k == 0 {
+            Reference::start(c)
+        } else {
+            st.reference
+        };
+        let e = self.errors(&reference, c, m, &v);
+        for (what, x) in [
+            ("v", &v),
+            ("z1", &e.z1),
+            ("alpha1", &e.alpha1),
+            ("z2", &e.z2),
+            ("dalpha1", &e.dalpha1),
+            ("zeta", &st.zeta),
+        ] {
+            check::within(what, x.as_slice(), BOUND)?;
+        }
         let sig = Signals {
             dalpha1: e.dalpha1,
             alpha1: e.alpha1,
             z2: e.z2,
         };
-        let w_norms = if self.cfg.law.learns() {
+        let learns = self.cfg.law.learns();
+        if learns {
+            self.learning
+                .check_bounded(&st.norms, &sig, self.basis.nodes())?;
+        }
+        // Every check has passed: from here on the state changes, and with
+        // every signal and weight within BOUND nothing below can overflow.
+        let mut tau = self.feedback(&e, &st.zeta);
+        let w_norms = if learns {
             let before = st.norms;
             tau += e.z1 + self.networks(st, &m.x, &v, &sig) + m.tau_e;
             before
         } else {
             [0.0; 3]
         };
-        if tau.iter().any(|t| !t.is_finite()) {
-            return Err(Error::Diverged { what: "tau" });
-        }
-        let tau_sat = self.sat.apply(&tau);
+        let tau_sat = self
+            .sat
+            .apply(&self.cfg.limits.rate_limit(&tau, &st.last.tau_sat));
         let dtau = tau_sat - tau;
-        if self.cfg.law.learns() {
+        if learns {
             self.learn(st, &sig, &dtau);
         }
         let cmd = Command {
@@ -271,17 +406,29 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             z1: e.z1,
             z2: e.z2,
             xc: c.x,
-            xd: st.reference.xd,
+            xd: reference.xd,
             v,
             zeta: st.zeta,
             w_norms,
         };
-        self.advance(st, m, &e, &dtau);
+        // Stage "advance", SPEC §11 step 5: ζ, the reference, the observer and
+        // the clock to t_{k+1}, from this step's values only.
+        let ts = self.cfg.ts;
+        self.aux.advance(&mut st.zeta, &e.z2, &dtau, ts);
+        reference.advance(&e.ddxd, ts);
+        if self.cfg.law == Law::OutputFeedback {
+            self.obs.finish(&mut observer, &m.x);
+        }
+        st.reference = reference;
+        st.observer = observer;
+        st.q_prev = m.x;
+        st.k += 1;
         st.last = cmd;
         Ok(cmd)
     }
 
-    /// Inputs finite and the state made for this basis.
+    /// Inputs finite, within the plausibility limits and [`BOUND`], and the
+    /// state made for this basis.
     fn check<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
         st: &State<N, S>,
@@ -294,31 +441,49 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
                 reason: "was made for a basis with another number of nodes",
             });
         }
-        check::finite_slice("x", m.x.as_slice())?;
-        check::finite_slice("tau_e", m.tau_e.as_slice())?;
-        check::finite_slice("xc", c.x.as_slice())?;
-        check::finite_slice("dxc", c.dx.as_slice())?;
-        check::finite_slice("ddxc", c.ddx.as_slice())
+        for (what, v) in [
+            ("x", &m.x),
+            ("tau_e", &m.tau_e),
+            ("xc", &c.x),
+            ("dxc", &c.dx),
+            ("ddxc", &c.ddx),
+        ] {
+            check::finite_slice(what, v.as_slice())?;
+            check::within(what, v.as_slice(), BOUND)?;
+        }
+        if let (Some(dx), Law::Pd | Law::StateFeedback) = (&m.dx, self.cfg.law) {
+            check::finite_slice("dx", dx.as_slice())?;
+            check::within("dx", dx.as_slice(), BOUND)?;
+        }
+        let prev = (st.k > 0).then_some(&st.q_prev);
+        let m = match self.cfg.law {
+            // Output feedback ignores a measured velocity: so do its limits.
+            Law::OutputFeedback => &Measurement { dx: None, ..*m },
+            Law::Pd | Law::StateFeedback => m,
+        };
+        self.cfg.limits.check(m, prev)
     }
 
     /// Stage "velocity source", SPEC §11 step 2: the measured ẋ (PD, state
-    /// feedback) or the observer's estimate at t_k (output feedback).
-    fn velocity<S>(&self, st: &mut State<N, S>, m: &Measurement<N>) -> Result<Vector<N>, Error> {
+    /// feedback) or the observer's estimate at t_k (output feedback), which
+    /// takes in the measurement (on the caller's copy of the observer state).
+    fn velocity(
+        &self,
+        k: u64,
+        observer: &mut ObserverState<N>,
+        m: &Measurement<N>,
+    ) -> Result<Vector<N>, Error> {
         match self.cfg.law {
             Law::OutputFeedback => {
-                let first = st.k == 0;
+                let first = k == 0;
                 if first && self.cfg.observer_init == ObserverInit::FirstMeasurement {
-                    st.observer.pi1 = m.x;
-                    st.observer.pi2 = Vector::zeros();
+                    observer.pi1 = m.x;
+                    observer.pi2 = Vector::zeros();
                 }
-                self.obs.measure(&mut st.observer, &m.x, first);
-                Ok(self.obs.estimate(&st.observer))
+                self.obs.measure(observer, &m.x, first);
+                Ok(self.obs.estimate(observer))
             }
-            Law::Pd | Law::StateFeedback => {
-                let dx = m.dx.ok_or(Error::MissingVelocity)?;
-                check::finite_slice("dx", dx.as_slice())?;
-                Ok(dx)
-            }
+            Law::Pd | Law::StateFeedback => m.dx.ok_or(Error::MissingVelocity),
         }
     }
 
@@ -380,24 +545,6 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         let (s, mut w) = st.parts();
         self.learning.learn(&mut w, s, sig, dtau, &mut norms);
         st.norms = norms;
-    }
-
-    /// Stage "advance", SPEC §11 step 5: ζ, the reference, the observer and
-    /// the clock to t_{k+1}, from this step's values only.
-    fn advance<S>(
-        &self,
-        st: &mut State<N, S>,
-        m: &Measurement<N>,
-        e: &Errors<N>,
-        dtau: &Vector<N>,
-    ) {
-        let ts = self.cfg.ts;
-        self.aux.advance(&mut st.zeta, &e.z2, dtau, ts);
-        st.reference.advance(&e.ddxd, ts);
-        if self.cfg.law == Law::OutputFeedback {
-            self.obs.finish(&mut st.observer, &m.x);
-        }
-        st.k += 1;
     }
 }
 

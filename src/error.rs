@@ -40,6 +40,27 @@ pub enum Error {
         /// Which quantity became non-finite.
         what: &'static str,
     },
+    /// An input, or the state a step would reach, is beyond a limit: a
+    /// plausibility limit of the configuration (`q_max`, `dq_max`,
+    /// `tau_e_max`, `q_jump_max`) or the bound every signal and state value
+    /// of a step must respect ([`BOUND`], so nothing overflows). The step
+    /// changed nothing.
+    OutOfRange {
+        /// Which quantity, e.g. `"q"` or `"z2"`.
+        what: &'static str,
+        /// Element index (joint), if a vector.
+        index: Option<usize>,
+        /// Its value.
+        value: f64,
+        /// The limit it exceeds (in magnitude).
+        limit: f64,
+    },
+    /// A fault is latched (fault policy "latch"): the step is refused until
+    /// `clear_fault`; `reason` is the error that latched it.
+    Faulted {
+        /// The error that latched the fault.
+        reason: &'static str,
+    },
     /// A structural mismatch, e.g. an RBF grid whose node count is not 2^(4n).
     Invalid {
         /// Which quantity.
@@ -74,12 +95,53 @@ impl fmt::Display for Error {
                 f,
                 "{what} became non-finite from finite inputs: the controller state diverged; call reset()"
             ),
+            Error::OutOfRange {
+                what,
+                index,
+                value,
+                limit,
+            } => {
+                write!(f, "{what}")?;
+                if let Some(i) = index {
+                    write!(f, "[{i}]")?;
+                }
+                write!(f, " = {value:e} is beyond its limit ±{limit:e}; the state was left unchanged")
+            }
+            Error::Faulted { reason } => write!(
+                f,
+                "a fault is latched ({reason}): the step is refused until clear_fault()"
+            ),
             Error::Invalid { what, reason } => write!(f, "{what}: {reason}"),
         }
     }
 }
 
 impl core::error::Error for Error {}
+
+/// The magnitude no signal or state value of a step may exceed (far from
+/// f64's 1.8e308, so products of a few of them cannot overflow): a step that
+/// would go beyond it returns [`Error::OutOfRange`] and changes nothing.
+pub const BOUND: f64 = 1e100;
+
+/// The magnitude no gain or physical parameter may exceed (SPEC §10,
+/// extended): beyond it a configuration is accepted by the stability
+/// conditions but overflows in use.
+pub const PARAM_BOUND: f64 = 1e9;
+
+impl Error {
+    /// A short name of the error's kind, for a latched fault's reason.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Error::Condition { .. } => "condition",
+            Error::NonFinite { .. } => "non-finite input",
+            Error::MissingVelocity => "missing velocity",
+            Error::Diverged { .. } => "diverged",
+            Error::OutOfRange { .. } => "out of range",
+            Error::Faulted { .. } => "latched fault",
+            Error::Invalid { .. } => "invalid",
+        }
+    }
+}
 
 /// Validation helpers shared by every constructor.
 pub(crate) mod check {
@@ -160,6 +222,52 @@ pub(crate) mod check {
     ) -> Result<(), Error> {
         finite_slice(what, v.as_slice())?;
         each(condition, what, v, |_, x| x, true)
+    }
+
+    /// A finite scalar with `|v| ≤ bound`, else the named condition.
+    pub fn at_most(
+        condition: &'static str,
+        what: &'static str,
+        v: f64,
+        bound: f64,
+    ) -> Result<(), Error> {
+        finite(what, v)?;
+        if v.abs() <= bound {
+            Ok(())
+        } else {
+            Err(Error::Condition {
+                condition,
+                lhs: what,
+                index: None,
+                value: v,
+            })
+        }
+    }
+
+    /// Every element with `|v_i| ≤ bound`, else `Error::OutOfRange` (inputs of a step).
+    pub fn within(what: &'static str, v: &[f64], bound: f64) -> Result<(), Error> {
+        match v.iter().position(|x| x.abs() > bound) {
+            Some(i) => Err(Error::OutOfRange {
+                what,
+                index: Some(i),
+                value: v[i],
+                limit: bound,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Every element with `|v_i| ≤ limits_i` (NaN limits never hold).
+    pub fn within_each(what: &'static str, v: &[f64], limits: &[f64]) -> Result<(), Error> {
+        match v.iter().zip(limits).position(|(x, l)| x.abs() > *l) {
+            Some(i) => Err(Error::OutOfRange {
+                what,
+                index: Some(i),
+                value: v[i],
+                limit: limits[i],
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Every element finite and `>= 0`.

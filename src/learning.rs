@@ -10,7 +10,8 @@
 //! under saturation, the projection). Adding a learning law touches this
 //! module and the parameter schema, nothing else.
 
-use crate::error::{check, Error};
+use crate::error::{check, Error, BOUND};
+use crate::math::sqrt;
 use crate::network::{Rates, WeightsMut, C, D, G};
 use crate::types::{choices, Vector};
 
@@ -136,6 +137,38 @@ impl Learning {
     /// The projection's bounds on ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F, if any.
     pub fn bound(&self) -> Option<[f64; 3]> {
         self.bound
+    }
+
+    /// The weights after this step's update stay within [`BOUND`]: with the
+    /// current norms ‖Ŵ‖ (`norms`) the new ones are at most
+    /// `|a| ‖Ŵ‖ + Ts Γ ‖u‖ ‖z2‖ ‖S‖`, ‖S‖ ≤ √L (u = α̇1 for D̂, α1 for Ĉ, 1
+    /// for Ĝ; normalisation and freezing only shrink the step). Checked
+    /// before the pass that writes them, so a failed check changes nothing.
+    pub fn check_bounded<const N: usize>(
+        &self,
+        norms: &[f64; 3],
+        sig: &Signals<N>,
+        nodes: usize,
+    ) -> Result<(), Error> {
+        let (a, g) = (self.rates.decay, self.rates.gain);
+        let step = sig.z2.norm() * sqrt(nodes as f64);
+        let u = [sig.dalpha1.norm(), sig.alpha1.norm(), 1.0];
+        for (net, what) in ["weights.D", "weights.C", "weights.G"]
+            .into_iter()
+            .enumerate()
+        {
+            let bound = a[net].abs() * norms[net] + g[net] * u[net] * step;
+            // NaN (from an infinite norm times zero) is out of range too.
+            if bound.is_nan() || bound > BOUND {
+                return Err(Error::OutOfRange {
+                    what,
+                    index: None,
+                    value: bound,
+                    limit: BOUND,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// True if the update needs this step's saturation, so it follows the output.

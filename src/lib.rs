@@ -31,6 +31,7 @@
 //! | [`learning`] | learning policies (Euler, normalised, freeze, projection) | §11, §13 |
 //! | [`robust`] | robust term r(z2) | §7 |
 //! | [`auxiliary`] | saturation compensator ζ | (11), (36), §8 |
+//! | [`safety`] | fallback command, fault policy, plausibility and rate limits | beyond the paper |
 //! | [`observer`] | high-gain velocity observer | (31)–(34), §9 |
 //! | [`config`] | every parameter, presets | §4–§11, §13 |
 //! | [`schema`] | the parameter table: names, units, docs, conditions, defaults | §10 |
@@ -103,6 +104,7 @@ mod python;
 pub mod rbf;
 pub mod record;
 pub mod robust;
+pub mod safety;
 pub mod saturation;
 pub mod schema;
 pub mod simulator;
@@ -132,6 +134,7 @@ pub use rbf::{Basis, Centers, Grid};
 pub use record::Trace;
 pub use record::{Recorder, Row};
 pub use robust::{Robust, RobustKind};
+pub use safety::{Fallback, Fault, FaultPolicy, Limits};
 pub use saturation::Saturation;
 pub use schema::{Preset, Scenario};
 pub use simulator::{run, simulate, SimConfig};

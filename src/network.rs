@@ -145,10 +145,21 @@ impl Rates {
         }
     }
 
-    /// Coefficients for sampling period `ts` (s), gains Γ and leakages σ, validated > 0.
+    /// Coefficients for sampling period `ts` (s), gains Γ and leakages σ,
+    /// validated > 0, with `Ts Γ σ < 1` (the leakage of one explicit-Euler
+    /// step, `a = 1 − Ts Γ σ`, must keep the sign of the weights: a ≤ 0
+    /// flips or zeroes them every step).
     pub fn new(ts: f64, gamma: [f64; 3], sigma: [f64; 3]) -> Result<Self, Error> {
         check::positive_vec("Γ > 0", "gamma", &Vector::<3>::from(gamma))?;
         check::positive_vec("σ > 0", "sigma", &Vector::<3>::from(sigma))?;
+        let leak = Vector::<3>::from_fn(|n, _| ts * gamma[n] * sigma[n]);
+        check::each(
+            "Ts Γ σ < 1",
+            "1 − Ts·gamma·sigma",
+            &leak,
+            |_, l| 1.0 - l,
+            true,
+        )?;
         Ok(Self {
             decay: core::array::from_fn(|n| 1.0 - ts * gamma[n] * sigma[n]),
             gain: core::array::from_fn(|n| ts * gamma[n]),

@@ -78,6 +78,11 @@ impl<const N: usize> HighGainObserver<N> {
         check::positive("ε > 0", "eps", eps)?;
         check::positive_vec("λ1 > 0", "lam1", &lam1)?;
         check::positive("Ts > 0", "Ts", ts)?;
+        // Beyond this the observer is a steady state at every sample anyway,
+        // and the matrix exponential's scaling would overflow (its squaring
+        // count saturates: a construction that never returns).
+        check::at_most("Ts/ε ≤ 1e6", "Ts/eps", ts / eps, 1e6)?;
+        check::each("λ1 ≤ 1e6", "lam1", &lam1, |_, l| 1e6 - l, false)?;
         let mut phi = [Matrix2::zeros(); N];
         let mut gam0 = [Vector2::zeros(); N];
         let mut gam1 = [Vector2::zeros(); N];

@@ -70,7 +70,7 @@ pub struct RigidBody<const N: usize, M, E> {
 
 impl<const N: usize, M: Manipulator<N>, E: Environment<N>> RigidBody<N, M, E> {
     /// At t = 0 with position `q0` (rad) and velocity `dq0` (rad/s), finite;
-    /// `substeps` ≥ 1.
+    /// 1 ≤ `substeps` ≤ 10 000.
     pub fn new(
         arm: M,
         env: E,
@@ -78,12 +78,12 @@ impl<const N: usize, M: Manipulator<N>, E: Environment<N>> RigidBody<N, M, E> {
         dq0: Vector<N>,
         substeps: usize,
     ) -> Result<Self, Error> {
-        if substeps == 0 {
+        if substeps == 0 || substeps > 10_000 {
             return Err(Error::Condition {
-                condition: "substeps ≥ 1",
+                condition: "1 ≤ substeps ≤ 10 000",
                 lhs: "substeps",
                 index: None,
-                value: 0.0,
+                value: substeps as f64,
             });
         }
         check::finite_slice("q0", q0.as_slice())?;

@@ -187,8 +187,8 @@ fn type_error(what: &str, obj: &Bound<'_, PyAny>) -> PyErr {
 }
 
 /// A joint-space vector from Python: an array of shape (N,) of a real dtype,
-/// or a sequence of N real numbers; finite. Errors name `what`.
-fn vector(what: &'static str, obj: &Bound<'_, PyAny>) -> PyResult<Vector<N>> {
+/// or a sequence of N real numbers (any values). Errors name `what`.
+fn vector_any(what: &'static str, obj: &Bound<'_, PyAny>) -> PyResult<Vector<N>> {
     let mut out = [0.0; N];
     if let Ok(arr) = obj.cast::<PyUntypedArray>() {
         if arr.ndim() != 1 || arr.len() != N {
@@ -224,10 +224,16 @@ fn vector(what: &'static str, obj: &Bound<'_, PyAny>) -> PyResult<Vector<N>> {
     } else {
         return Err(type_error(what, obj));
     }
+    Ok(Vector::from(out))
+}
+
+/// As `vector_any`, every entry finite.
+fn vector(what: &'static str, obj: &Bound<'_, PyAny>) -> PyResult<Vector<N>> {
+    let out = vector_any(what, obj)?;
     if let Some(index) = out.iter().position(|x| !x.is_finite()) {
         return Err(Error::NonFinite { what, index }.into());
     }
-    Ok(Vector::from(out))
+    Ok(out)
 }
 
 fn array1<'py>(py: Python<'py>, v: &Vector<N>) -> Bound<'py, PyArray1<f64>> {
@@ -298,6 +304,45 @@ impl PyController {
         };
         let cmd = self.inner.step(&Measurement { x, dx, tau_e })?;
         Ok(array1(py, &cmd.tau_sat))
+    }
+
+    /// One step as `step`, but never raising for a failed step: returns the
+    /// torque to apply (N m, shape (2,)): the step's sat(τ), or on a failed
+    /// step the configured fallback ("hold", "zero" or "damping", saturated),
+    /// and the error message (None on success). Shapes and types are still
+    /// checked (TypeError/ValueError).
+    #[pyo3(signature = (q, tau_e, dq=None))]
+    fn step_or_fallback<'py>(
+        &mut self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        tau_e: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Option<String>)> {
+        // Shapes are checked; values are the controller's to judge.
+        let x = vector_any("q", q)?;
+        let tau_e = vector_any("tau_e", tau_e)?;
+        let dx = match (self.inner.controller().config().law, dq) {
+            (Law::OutputFeedback, _) | (_, None) => None,
+            (_, Some(dq)) => Some(vector_any("dq", dq)?),
+        };
+        let (tau, result) = self.inner.step_or_fallback(&Measurement { x, dx, tau_e });
+        Ok((array1(py, &tau), result.err().map(|e| e.to_string())))
+    }
+
+    /// The fault recorded by the last failed step: (message, step k), or None.
+    #[getter]
+    fn fault(&self) -> Option<(String, u64)> {
+        self.inner
+            .state()
+            .fault()
+            .map(|f| (f.error.to_string(), f.step))
+    }
+
+    /// Clear the recorded fault (with fault_policy="latch", steps are refused
+    /// until this is called).
+    fn clear_fault(&mut self) {
+        self.inner.state_mut().clear_fault();
     }
 
     /// `K` steps in one call, replaying logged measurements: `q`, `tau_e` and

@@ -21,6 +21,7 @@ use crate::model::ArmParams;
 use crate::observer::Hold;
 use crate::rbf::Grid;
 use crate::robust::RobustKind;
+use crate::safety::{Fallback, FaultPolicy, Limits};
 use crate::simulator::SimConfig;
 use crate::trajectory::Sinusoid;
 use crate::types::Vector;
@@ -69,6 +70,8 @@ pub enum Kind {
     Derived,
     /// None, "auto", or one number per network.
     Bound,
+    /// None (no limit), or a number > 0 per joint (a scalar is broadcast).
+    Limit,
 }
 
 impl Kind {
@@ -84,6 +87,7 @@ impl Kind {
             Kind::Optional => "optional",
             Kind::Derived => "derived",
             Kind::Bound => "bound",
+            Kind::Limit => "limit",
         }
     }
 }
@@ -193,7 +197,7 @@ const fn robot(param: Param, value: Value<'static>) -> Param {
 }
 
 use Group::{Arm, Controller as Ctrl, Env, Sim};
-use Kind::{Bound, Derived, Int, Joint, Network, Optional, Real};
+use Kind::{Bound, Derived, Int, Joint, Limit, Network, Optional, Real};
 use Value::{Int as I, None as Nil, Real as R, Str as S, Vec as V};
 
 const PI: f64 = core::f64::consts::PI;
@@ -203,7 +207,7 @@ pub const PARAMS: &[Param] = &[
     // The run, SPEC §11 (the robot scenario: SPEC §13).
     p("T", Sim, Real, "s", "duration; rows k = 0 … round(T/Ts) − 1 are recorded", "T > 0", R(20.0)),
     robot(
-        p("substeps", Sim, Int, "", "RK4 substeps M of the plant per controller period", "substeps ≥ 1", I(1)),
+        p("substeps", Sim, Int, "", "RK4 substeps M of the plant per controller period", "1 ≤ substeps ≤ 10 000", I(1)),
         I(10),
     ),
     p("q0", Sim, Joint, "rad", "initial joint position q(0), (65)", "", V(&[0.25, -0.05])),
@@ -328,6 +332,47 @@ pub const PARAMS: &[Param] = &[
             Nil,
         ),
         S("auto"),
+    ),
+    // Safety around the control law (beyond the paper; src/safety.rs).
+    p(
+        "fallback",
+        Ctrl,
+        Kind::Choice(&Fallback::NAMES),
+        "",
+        "the torque returned when a step fails: the last applied one held, zero, or joint damping −Kd q̇ (each saturated)",
+        "",
+        S("hold"),
+    ),
+    p("fallback_damping", Ctrl, Joint, "N m s/rad", "Kd of the damping fallback", "Kd ≥ 0", R(1.0)),
+    p(
+        "fault_policy",
+        Ctrl,
+        Kind::Choice(&FaultPolicy::NAMES),
+        "",
+        "after a failed step: record the fault and go on, or latch it and refuse every step until clear_fault()",
+        "",
+        S("report"),
+    ),
+    p("q_max", Ctrl, Limit, "rad", "plausibility limit |q_i| ≤ q_max (None: none)", "limit > 0", Nil),
+    p("dq_max", Ctrl, Limit, "rad/s", "plausibility limit |q̇_i| ≤ dq_max (None: none)", "limit > 0", Nil),
+    p("tau_e_max", Ctrl, Limit, "N m", "plausibility limit |τe_i| ≤ tau_e_max (None: none)", "limit > 0", Nil),
+    p(
+        "q_jump_max",
+        Ctrl,
+        Limit,
+        "rad",
+        "plausibility limit on the change of q_i between two samples (None: none)",
+        "limit > 0",
+        Nil,
+    ),
+    p(
+        "tau_rate_max",
+        Ctrl,
+        Limit,
+        "N m",
+        "torque rate limit per step, applied before saturation and visible in Δτ (None: none)",
+        "limit > 0",
+        Nil,
     ),
     // The environment, SPEC §3.
     p("wall", Env, Optional, "rad", "wall on joint 1 at this position; None: free space", "", R(0.2)),
@@ -470,7 +515,7 @@ impl<const N: usize> Scenario<N> {
             "substeps" => {
                 let v = int(n, value)?;
                 self.sim.substeps = usize::try_from(v).map_err(|_| Error::Condition {
-                    condition: "substeps ≥ 1",
+                    condition: "1 ≤ substeps ≤ 10 000",
                     lhs: "substeps",
                     index: None,
                     value: v as f64,
@@ -518,6 +563,14 @@ impl<const N: usize> Scenario<N> {
                     v => WeightBound::Fixed(network(n, v)?),
                 }
             }
+            "fallback" => c.fallback = choice(p, value, &Fallback::ALL)?,
+            "fallback_damping" => c.fallback_damping = joint(n, value)?,
+            "fault_policy" => c.fault_policy = choice(p, value, &FaultPolicy::ALL)?,
+            "q_max" => c.limits.q = limit(n, value)?,
+            "dq_max" => c.limits.dq = limit(n, value)?,
+            "tau_e_max" => c.limits.tau_e = limit(n, value)?,
+            "q_jump_max" => c.limits.q_jump = limit(n, value)?,
+            "tau_rate_max" => c.limits.tau_rate = limit(n, value)?,
             "wall" => self.wall = optional(n, value)?,
             "ke" => self.ke_be[0] = real(n, value)?,
             "be" => self.ke_be[1] = real(n, value)?,
@@ -567,6 +620,17 @@ impl<const N: usize> Scenario<N> {
             dd,
             cd,
             gd,
+            fallback,
+            fallback_damping,
+            fault_policy,
+            limits:
+                Limits {
+                    q: q_max,
+                    dq: dq_max,
+                    tau_e: tau_e_max,
+                    q_jump: q_jump_max,
+                    tau_rate: tau_rate_max,
+                },
         } = &self.config;
         let SimConfig {
             t_final,
@@ -632,6 +696,21 @@ impl<const N: usize> Scenario<N> {
             WeightBound::Auto => f("weight_bound", S("auto")),
             WeightBound::Fixed(b) => f("weight_bound", V(b)),
         }
+        f("fallback", S(fallback.name()));
+        f("fallback_damping", V(fallback_damping.as_slice()));
+        f("fault_policy", S(fault_policy.name()));
+        fn lim<const N: usize>(v: &Vector<N>) -> Value<'_> {
+            if v.iter().all(|x| *x == f64::INFINITY) {
+                Value::None
+            } else {
+                Value::Vec(v.as_slice())
+            }
+        }
+        f("q_max", lim(q_max));
+        f("dq_max", lim(dq_max));
+        f("tau_e_max", lim(tau_e_max));
+        f("q_jump_max", lim(q_jump_max));
+        f("tau_rate_max", lim(tau_rate_max));
         f("wall", opt(wall));
         f("ke", R(*ke));
         f("be", R(*be));
@@ -699,6 +778,13 @@ fn array<const M: usize>(name: &'static str, v: Value<'_>) -> Result<[f64; M], E
 
 fn joint<const N: usize>(name: &'static str, v: Value<'_>) -> Result<Vector<N>, Error> {
     array::<N>(name, v).map(Vector::from)
+}
+
+fn limit<const N: usize>(name: &'static str, v: Value<'_>) -> Result<Vector<N>, Error> {
+    match v {
+        Value::None => Ok(Vector::from_element(f64::INFINITY)),
+        v => joint(name, v),
+    }
 }
 
 fn network(name: &'static str, v: Value<'_>) -> Result<[f64; 3], Error> {
@@ -894,7 +980,7 @@ mod tests {
         assert!(s.set("Kp", Value::Str("x")).is_err());
         assert!(s.set("Kp", Value::Vec(&[1.0, 2.0, 3.0])).is_err());
         let e = s.set("substeps", Value::Int(-1)).unwrap_err();
-        assert!(e.to_string().contains("substeps ≥ 1"), "{e}");
+        assert!(e.to_string().contains("1 ≤ substeps ≤ 10 000"), "{e}");
         s.set("weight_bound", Value::Vec(&[1.0, 2.0, 3.0])).unwrap();
         assert_eq!(s.config.weight_bound, WeightBound::Fixed([1.0, 2.0, 3.0]));
         s.set("weight_bound", Value::Real(2.0)).unwrap();

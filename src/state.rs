@@ -15,6 +15,7 @@ use crate::impedance::Reference;
 use crate::io::Command;
 use crate::network::{Layout, Weights, WeightsMut};
 use crate::observer::ObserverState;
+use crate::safety::Fault;
 use crate::types::Vector;
 
 /// The state of one controller run. See the [module docs](self).
@@ -28,12 +29,16 @@ pub struct State<const N: usize, S> {
     /// ‖Ŵ‖_F of the current weights (kept up to date by every update).
     pub(crate) norms: [f64; 3],
     pub(crate) last: Command<N>,
+    /// The last measured position (for the jump limit).
+    pub(crate) q_prev: Vector<N>,
+    /// The last failed step's error, until cleared.
+    pub(crate) fault: Option<Fault>,
     layout: Layout,
     buf: S,
 }
 
 /// First two values of a snapshot: a marker and the format's version.
-const SNAPSHOT_HEADER: [f64; 2] = [4_151_076.0, 1.0];
+const SNAPSHOT_HEADER: [f64; 2] = [4_151_076.0, 2.0];
 /// Values of a snapshot before its per-joint part: header, N, L, k.
 const SNAPSHOT_PREFIX: usize = 5;
 
@@ -66,6 +71,8 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
             observer: ObserverState::zeros(),
             norms: [0.0; 3],
             last: Command::zeros(),
+            q_prev: Vector::zeros(),
+            fault: None,
             layout,
             buf,
         })
@@ -79,6 +86,8 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
         self.observer = ObserverState::zeros();
         self.norms = [0.0; 3];
         self.last = Command::zeros();
+        self.q_prev = Vector::zeros();
+        self.fault = None;
         self.buf.as_mut().fill(0.0);
     }
 
@@ -102,6 +111,17 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
     /// The last step's command (all zeros before the first step).
     pub fn last(&self) -> &Command<N> {
         &self.last
+    }
+    /// The fault recorded by the last failed step (its error and step), if
+    /// not cleared. With the "latch" fault policy, steps are refused while
+    /// it is set.
+    pub fn fault(&self) -> Option<Fault> {
+        self.fault
+    }
+    /// Clear the recorded fault (the documented recovery after a latched
+    /// fault): the next step runs from the state as it was before the fault.
+    pub fn clear_fault(&mut self) {
+        self.fault = None;
     }
     /// The number of basis nodes L this state was made for.
     pub fn nodes(&self) -> usize {
@@ -141,17 +161,18 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
     }
 
     /// The number of reals [`save`](Self::save) writes:
-    /// `11 + 15 N + L (2N² + N + 1)`.
+    /// `11 + 16 N + L (2N² + N + 1)`.
     pub fn snapshot_len(&self) -> usize {
-        SNAPSHOT_PREFIX + 15 * N + 6 + self.nodes() * (Layout::rows(N) + 1)
+        SNAPSHOT_PREFIX + 16 * N + 6 + self.nodes() * (Layout::rows(N) + 1)
     }
 
     /// Write everything this state holds into `out` (at least
     /// [`snapshot_len`](Self::snapshot_len) reals) as a flat array of reals:
     /// a header, N, L, the step count, the reference, ζ, the observer, the
-    /// norms, the last command, the basis and the weights. Returns the number
-    /// written. [`load`](Self::load) restores it exactly, so a run continues
-    /// bit-identically. No allocation.
+    /// last position, the norms, the last command, the basis and the weights.
+    /// Returns the number written. [`load`](Self::load) restores it exactly,
+    /// so a run continues bit-identically (a recorded fault is not part of a
+    /// snapshot, and loading clears it). No allocation.
     pub fn save(&self, out: &mut [f64]) -> Result<usize, Error> {
         let len = self.snapshot_len();
         let out = out.get_mut(..len).ok_or(Error::Invalid {
@@ -169,6 +190,7 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
             &self.observer.pi1,
             &self.observer.pi2,
             &self.observer.y_prev,
+            &self.q_prev,
             &c.tau_sat,
             &c.tau,
             &c.dtau,
@@ -226,6 +248,8 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
         self.observer.pi1 = r.vector();
         self.observer.pi2 = r.vector();
         self.observer.y_prev = r.vector();
+        self.q_prev = r.vector();
+        self.fault = None;
         let c = &mut self.last;
         for v in [
             &mut c.tau_sat,

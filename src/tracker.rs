@@ -53,6 +53,16 @@ impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Tracker<N, B, T> {
         self.ctrl.step(&mut self.state, m, c)
     }
 
+    /// [`step`](Self::step), and the torque to apply whatever happened (the
+    /// step's, or the configured fallback): see [`Controller::step_or_fallback`].
+    pub fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+    ) -> (crate::types::Vector<N>, Result<Command<N>, Error>) {
+        let c = self.traj.sample(self.time());
+        self.ctrl.step_or_fallback(&mut self.state, m, &c)
+    }
+
     /// Back to t = 0 (weights, ζ, observer and reference as at construction).
     pub fn reset(&mut self) {
         self.state.reset();

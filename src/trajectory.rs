@@ -1,7 +1,7 @@
 //! Commanded trajectories xc(t), (64), SPEC §4.
 
 use crate::error::{check, Error};
-use crate::math::{cos, sin};
+use crate::math::{cos, sin, sqrt};
 use crate::types::Vector;
 
 /// Position, velocity and acceleration of a trajectory at one instant
@@ -51,6 +51,9 @@ pub struct Sinusoid<const N: usize> {
 
 impl<const N: usize> Sinusoid<N> {
     /// Offset o (rad), sine and cosine amplitudes a, b (rad), angular frequency ω (rad/s).
+    /// Every entry finite, and per joint, with r = √(a² + b²): |o| + r ≤ 1e6 rad,
+    /// |ω| r ≤ 1e6 rad/s and ω² r ≤ 1e6 rad/s² (a trajectory beyond them
+    /// overflows the controller's signals; the error names the bound).
     pub fn new(
         offset: Vector<N>,
         sin: Vector<N>,
@@ -61,6 +64,20 @@ impl<const N: usize> Sinusoid<N> {
         check::finite_slice("xc_sin", sin.as_slice())?;
         check::finite_slice("xc_cos", cos.as_slice())?;
         check::finite_slice("xc_omega", omega.as_slice())?;
+        for i in 0..N {
+            let r = sqrt(sin[i] * sin[i] + cos[i] * cos[i]);
+            let w = omega[i].abs();
+            check::at_most(
+                "|xc| ≤ 1e6 rad",
+                "xc_offset + amplitude",
+                offset[i].abs() + r,
+                1e6,
+            )?;
+            if r > 0.0 {
+                check::at_most("|ẋc| ≤ 1e6 rad/s", "xc_omega · amplitude", w * r, 1e6)?;
+                check::at_most("|ẍc| ≤ 1e6 rad/s²", "xc_omega² · amplitude", w * w * r, 1e6)?;
+            }
+        }
         Ok(Self {
             offset,
             sin,

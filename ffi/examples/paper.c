@@ -443,6 +443,21 @@ static int abi_checks(void) {
            "too short");
     EXPECT(adaptimp_state_restore(state, snapshot, 8), ADAPTIMP_STATUS_WRONG_STATE,
            "snapshot");
+    /* A refused step returns the fallback torque (here: the last one, held). */
+    const double held0 = cmd.tau_sat[0];
+    q[0] = NAN;
+    EXPECT(adaptimp_step(ctrl, state, 2, q, dq, te, NULL, &cmd), ADAPTIMP_STATUS_NON_FINITE,
+           "not finite");
+    q[0] = 0.1;
+    if (cmd.tau_sat[0] != held0 || !adaptimp_state_fault(state, NULL)) {
+        fprintf(stderr, "FAILED: no fallback torque or no fault recorded\n");
+        failures++;
+    }
+    EXPECT(adaptimp_state_clear_fault(state), ADAPTIMP_STATUS_OK, "");
+    if (adaptimp_state_fault(state, NULL)) {
+        fprintf(stderr, "FAILED: the fault was not cleared\n");
+        failures++;
+    }
     EXPECT(adaptimp_state_reset(NULL), ADAPTIMP_STATUS_NULL_POINTER, "state is NULL");
     adaptimp_state_free(state);
     adaptimp_controller_free(ctrl);

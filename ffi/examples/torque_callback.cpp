@@ -30,8 +30,9 @@ class AdaptiveImpedance {
 
     // One step of the 1 kHz loop: measured joint positions (rad), velocities
     // (rad/s) and external torque (N m) in, the torque to apply (N m) out.
-    // On an error the last applied torque is held and the error is counted:
-    // the real-time loop keeps running, a supervisor reads error().
+    // When the controller refuses a step, cmd.tau_sat holds its configured
+    // fallback (by default the last applied torque, held): the real-time
+    // loop keeps running, the error is counted, and a supervisor reads error().
     Joints update(const Joints& q, const Joints& dq, const Joints& tau_ext) {
         AdaptimpCommand cmd;
         const AdaptimpStatus s = adaptimp_step(ctrl_.get(), state_.get(), kJoints, q.data(),
@@ -39,10 +40,10 @@ class AdaptiveImpedance {
         if (s != ADAPTIMP_STATUS_OK) {
             ++errors_;
             error_ = adaptimp_last_error();
-            return last_;
         }
-        for (std::size_t i = 0; i < kJoints; ++i) last_[i] = cmd.tau_sat[i];
-        return last_;
+        Joints tau{};
+        for (std::size_t i = 0; i < kJoints; ++i) tau[i] = cmd.tau_sat[i];
+        return tau;
     }
 
     double period() const { return adaptimp_controller_period(ctrl_.get()); }
@@ -62,7 +63,6 @@ class AdaptiveImpedance {
     };
     std::unique_ptr<AdaptimpController, FreeController> ctrl_;
     std::unique_ptr<AdaptimpState, FreeState> state_;
-    Joints last_{};
     unsigned errors_ = 0;
     std::string error_;
 };
@@ -86,7 +86,8 @@ int main() {
     }
     std::printf("after 2 s: q = [%.4f, %.4f] rad, tau = [%.3f, %.3f] N m, errors %u\n", q[0],
                 q[1], tau[0], tau[1], controller.errors());
-    // The error path: a NaN from a broken sensor is refused, the last torque held.
+    // The error path: a NaN from a broken sensor is refused, the fallback (the
+    // last applied torque, held) returned.
     const Joints broken{std::nan(""), -0.05};
     const Joints held = controller.update(broken, dq, no_contact);
     std::printf("with a NaN position: tau = [%.3f, %.3f] N m held, error: %s\n", held[0], held[1],

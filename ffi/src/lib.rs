@@ -18,9 +18,9 @@
 
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
-    AnyBasis, AuxLaw, Centers, Command, Controller, Error, Grid, HeapState, Hold, Law,
-    LearningStep, Measurement, ObserverInit, RobustKind, SaturationLearning, Setpoint, Sinusoid,
-    Trajectory, Vector,
+    AnyBasis, AuxLaw, Centers, Command, Controller, Error, Fallback, FaultPolicy, Grid, HeapState,
+    Hold, Law, LearningStep, Measurement, ObserverInit, RobustKind, SaturationLearning, Setpoint,
+    Sinusoid, Trajectory, Vector,
 };
 use core::ffi::c_char;
 use std::cell::RefCell;
@@ -52,6 +52,11 @@ pub enum AdaptimpStatus {
     WrongState = 7,
     /// An internal error (a Rust panic, caught at the boundary).
     Internal = 8,
+    /// A measurement beyond a plausibility limit, or a step whose signals
+    /// would go beyond the bound that keeps them finite.
+    OutOfRange = 9,
+    /// A fault is latched: clear it with `adaptimp_state_clear_fault`.
+    Faulted = 10,
 }
 
 /// Which controller (SPEC §7).
@@ -154,6 +159,28 @@ pub enum AdaptimpWeightBound {
     Auto = 2,
 }
 
+/// The torque a failed step returns, in the order of `Fallback::NAMES`.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpFallback {
+    /// The last applied torque held.
+    Hold = 0,
+    /// Zero torque.
+    Zero = 1,
+    /// Joint damping −Kd q̇ (`fallback_damping`).
+    Damping = 2,
+}
+
+/// What a failed step does to the following ones, in the order of `FaultPolicy::NAMES`.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpFaultPolicy {
+    /// Record the fault; the next step runs as usual.
+    Report = 0,
+    /// Refuse every step until `adaptimp_state_clear_fault`.
+    Latch = 1,
+}
+
 /// Every parameter of a controller for `n` joints (1…7): the fields of the
 /// parameter schema (`adaptimp::schema::PARAMS`, group "controller"), named as
 /// there, with per-joint arrays of which the first `n` entries are read.
@@ -234,6 +261,22 @@ pub struct AdaptimpParams {
     pub xc_cos: [f64; ADAPTIMP_MAX_JOINTS],
     /// Angular frequency ω (rad/s).
     pub xc_omega: [f64; ADAPTIMP_MAX_JOINTS],
+    /// The torque a failed step returns in `AdaptimpCommand.tau_sat`.
+    pub fallback: AdaptimpFallback,
+    /// Kd (N m s/rad) of the damping fallback.
+    pub fallback_damping: [f64; ADAPTIMP_MAX_JOINTS],
+    /// After a failed step: go on, or latch the fault.
+    pub fault_policy: AdaptimpFaultPolicy,
+    /// Plausibility limit |q_i| ≤ q_max (rad; INFINITY: none).
+    pub q_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Plausibility limit |q̇_i| ≤ dq_max (rad/s; INFINITY: none).
+    pub dq_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Plausibility limit |τe_i| ≤ tau_e_max (N m; INFINITY: none).
+    pub tau_e_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Plausibility limit on the change of q_i between samples (rad; INFINITY: none).
+    pub q_jump_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Torque rate limit per step (N m; INFINITY: none), before saturation.
+    pub tau_rate_max: [f64; ADAPTIMP_MAX_JOINTS],
 }
 
 /// A commanded setpoint at t_k: position (rad), velocity (rad/s) and
@@ -394,6 +437,8 @@ fn core_error(e: Error) -> AdaptimpStatus {
         Error::Invalid { what, .. } if what == "state" || what == "snapshot" => {
             AdaptimpStatus::WrongState
         }
+        Error::OutOfRange { .. } => AdaptimpStatus::OutOfRange,
+        Error::Faulted { .. } => AdaptimpStatus::Faulted,
         _ => AdaptimpStatus::InvalidConfig,
     };
     fail(status, &e)
@@ -507,6 +552,12 @@ const SATURATION: [AdaptimpSaturationLearning; 2] = [
 ];
 const INIT: [AdaptimpObserverInit; 2] = [AdaptimpObserverInit::Zero, AdaptimpObserverInit::First];
 const HOLD: [AdaptimpObserverHold; 2] = [AdaptimpObserverHold::Zoh, AdaptimpObserverHold::Triangle];
+const FALLBACK: [AdaptimpFallback; 3] = [
+    AdaptimpFallback::Hold,
+    AdaptimpFallback::Zero,
+    AdaptimpFallback::Damping,
+];
+const POLICY: [AdaptimpFaultPolicy; 2] = [AdaptimpFaultPolicy::Report, AdaptimpFaultPolicy::Latch];
 
 /// The schema's name of C choice `v`, by position.
 fn name_of<T: PartialEq>(all: &[T], v: &T, names: &[&'static str]) -> &'static str {
@@ -560,6 +611,14 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         xc_sin,
         xc_cos,
         xc_omega,
+        fallback,
+        fallback_damping,
+        fault_policy,
+        q_max,
+        dq_max,
+        tau_e_max,
+        q_jump_max,
+        tau_rate_max,
     } = p;
     let mut s = Scenario::<N>::preset(Preset::Paper, law_of(*law));
     fn joint<const N: usize>(v: &[f64; ADAPTIMP_MAX_JOINTS]) -> Value<'_> {
@@ -571,7 +630,7 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
         AdaptimpWeightBound::Auto => Value::Str("auto"),
     };
-    let values: [(&str, Value<'_>); 31] = [
+    let values: [(&str, Value<'_>); 39] = [
         ("Ts", Value::Real(*ts)),
         ("K1", joint(k1)),
         ("Kp", joint(kp)),
@@ -625,6 +684,20 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
             )),
         ),
         ("weight_bound", bound),
+        (
+            "fallback",
+            Value::Str(name_of(&FALLBACK, fallback, &Fallback::NAMES)),
+        ),
+        ("fallback_damping", joint(fallback_damping)),
+        (
+            "fault_policy",
+            Value::Str(name_of(&POLICY, fault_policy, &FaultPolicy::NAMES)),
+        ),
+        ("q_max", joint(q_max)),
+        ("dq_max", joint(dq_max)),
+        ("tau_e_max", joint(tau_e_max)),
+        ("q_jump_max", joint(q_jump_max)),
+        ("tau_rate_max", joint(tau_rate_max)),
     ];
     debug_assert!(values.iter().map(|(n, _)| *n).eq(controller_names()));
     for (name, v) in values {
@@ -708,6 +781,14 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
         xc_sin: [0.0; ADAPTIMP_MAX_JOINTS],
         xc_cos: [0.0; ADAPTIMP_MAX_JOINTS],
         xc_omega: [0.0; ADAPTIMP_MAX_JOINTS],
+        fallback: AdaptimpFallback::Hold,
+        fallback_damping: [0.0; ADAPTIMP_MAX_JOINTS],
+        fault_policy: AdaptimpFaultPolicy::Report,
+        q_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        dq_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        tau_e_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        q_jump_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        tau_rate_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
     };
     s.visit(|name, v| {
         let joint = |dst: &mut [f64; ADAPTIMP_MAX_JOINTS]| {
@@ -770,6 +851,14 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
                     three(&mut p.weight_bound);
                 }
             },
+            "fallback" => p.fallback = from_name(&FALLBACK, &Fallback::NAMES, choice),
+            "fallback_damping" => joint(&mut p.fallback_damping),
+            "fault_policy" => p.fault_policy = from_name(&POLICY, &FaultPolicy::NAMES, choice),
+            "q_max" => joint(&mut p.q_max),
+            "dq_max" => joint(&mut p.dq_max),
+            "tau_e_max" => joint(&mut p.tau_e_max),
+            "q_jump_max" => joint(&mut p.q_jump_max),
+            "tau_rate_max" => joint(&mut p.tau_rate_max),
             _ => {} // the run, the environment and the arm are not the controller's
         }
     });
@@ -970,6 +1059,44 @@ pub unsafe extern "C" fn adaptimp_state_reset(state: *mut AdaptimpState) -> Adap
     })
 }
 
+/// True if a failed step recorded a fault (with fault policy "latch", steps
+/// are refused until it is cleared); `*step` (if not NULL) gets the step at
+/// which it happened. False for NULL.
+///
+/// # Safety
+/// `state` is NULL or valid; `step` is NULL or valid.
+#[no_mangle]
+pub unsafe extern "C" fn adaptimp_state_fault(state: *const AdaptimpState, step: *mut u64) -> bool {
+    // SAFETY (in `read`): checked for NULL.
+    let Ok(s) = (unsafe { read(state, "state") }) else {
+        return false;
+    };
+    match with_state!(&s.0, s => s.fault()) {
+        Some(f) => {
+            if !step.is_null() {
+                // SAFETY: non-NULL; the caller's contract.
+                unsafe { *step = f.step };
+            }
+            true
+        }
+        None => false,
+    }
+}
+
+/// Clear the recorded fault: the documented recovery after a latched fault.
+///
+/// # Safety
+/// `state` is NULL or valid.
+#[no_mangle]
+pub unsafe extern "C" fn adaptimp_state_clear_fault(state: *mut AdaptimpState) -> AdaptimpStatus {
+    guard(|| {
+        // SAFETY (in `out`): checked for NULL.
+        let s = unsafe { out(state, "state") }?;
+        with_state!(&mut s.0, s => s.clear_fault());
+        Ok(())
+    })
+}
+
 /// Steps taken since creation or reset, or 0 for NULL.
 ///
 /// # Safety
@@ -1048,8 +1175,10 @@ pub unsafe extern "C" fn adaptimp_state_restore(
 /// feedback) hold `n` reals, the controller's number of joints. `setpoint` is
 /// the commanded xc, ẋc, ẍc at t_k, or NULL for the controller's own
 /// trajectory at t_k. On success `*out` holds the command (`tau_sat` goes to
-/// the actuators). On an error the state is unchanged (except
-/// `ADAPTIMP_STATUS_DIVERGED`: reset it). No allocation.
+/// the actuators). If the controller refuses the step (a non-finite or
+/// implausible input, a latched fault), the state is unchanged but for the
+/// recorded fault, and `out->tau_sat` holds the configured fallback torque
+/// (the other fields zero): apply it. No allocation.
 ///
 /// # Safety
 /// Each pointer is NULL or valid for `n` reals (`setpoint`, `out`: one struct).
@@ -1115,9 +1244,19 @@ fn step_sized<const N: usize>(
         },
         None => c.traj.sample(c.ctrl.time(s)),
     };
-    let cmd = c.ctrl.step(s, &m, &setpoint).map_err(core_error)?;
-    write_command(&cmd, out);
-    Ok(())
+    match c.ctrl.step_or_fallback(s, &m, &setpoint) {
+        (_, Ok(cmd)) => {
+            write_command(&cmd, out);
+            Ok(())
+        }
+        (fallback, Err(e)) => {
+            // The torque to apply after a failed step; nothing else is valid.
+            let mut cmd = Command::<N>::zeros();
+            cmd.tau_sat = fallback;
+            write_command(&cmd, out);
+            Err(core_error(e))
+        }
+    }
 }
 
 fn write_command<const N: usize>(cmd: &Command<N>, out: &mut AdaptimpCommand) {
@@ -1170,6 +1309,12 @@ mod tests {
         for (c, name) in AUX.iter().zip(AuxLaw::NAMES) {
             assert_eq!(debug(c), name);
         }
+        for (c, name) in FALLBACK.iter().zip(Fallback::NAMES) {
+            assert_eq!(debug(c), name);
+        }
+        for (c, name) in POLICY.iter().zip(FaultPolicy::NAMES) {
+            assert_eq!(debug(c), name);
+        }
     }
 
     #[test]
@@ -1198,6 +1343,6 @@ mod tests {
         check::<7>();
         // scenario_of sets exactly the controller group's names, in order (its
         // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 31);
+        assert_eq!(controller_names().count(), 39);
     }
 }

@@ -101,6 +101,25 @@ class ControllerParams(TypedDict, total=False):
     weight_bound: float | Sequence[float] | Literal["auto"] | None
     """projection onto ‖Ŵ‖_F ≤ b for D̂, Ĉ, Ĝ: None (none), 'auto' (derived from tau_max, the
     number of nodes and the commanded trajectory's peak speed and acceleration), or b."""
+    fallback: Literal["hold", "zero", "damping"]
+    """the torque returned when a step fails: the last applied one held, zero, or joint damping
+    −Kd q̇ (each saturated)."""
+    fallback_damping: float | _Joint
+    """Kd of the damping fallback (N m s/rad)."""
+    fault_policy: Literal["report", "latch"]
+    """after a failed step: record the fault and go on, or latch it and refuse every step until
+    clear_fault()."""
+    q_max: float | _Joint | None
+    """plausibility limit |q_i| ≤ q_max (None: none) (rad)."""
+    dq_max: float | _Joint | None
+    """plausibility limit |q̇_i| ≤ dq_max (None: none) (rad/s)."""
+    tau_e_max: float | _Joint | None
+    """plausibility limit |τe_i| ≤ tau_e_max (None: none) (N m)."""
+    q_jump_max: float | _Joint | None
+    """plausibility limit on the change of q_i between two samples (None: none) (rad)."""
+    tau_rate_max: float | _Joint | None
+    """torque rate limit per step, applied before saturation and visible in Δτ (None: none) (N
+    m)."""
 
 @type_check_only
 class SimParams(TypedDict, total=False):
@@ -154,6 +173,12 @@ class Controller:
 
     def __new__(cls, case: str, params: ControllerParams | dict[str, Any]) -> Controller: ...
     def step(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> _F: ...
+    def step_or_fallback(
+        self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None
+    ) -> tuple[_F, str | None]: ...
+    @property
+    def fault(self) -> tuple[str, int] | None: ...
+    def clear_fault(self) -> None: ...
     def replay(self, q: _F, tau_e: _F, dq: _F | None = None) -> _F:
         """K steps replaying (K, 2) float64 measurement tables; applied torques (K, 2) (N m)."""
     def reset(self) -> None: ...

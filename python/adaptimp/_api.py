@@ -153,6 +153,39 @@ class Controller:
         """
         return self._core.step(q, tau_e, dq)
 
+    def step_or_fallback(
+        self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None
+    ) -> tuple[FloatArray, str | None]:
+        """One step that never raises for a refused measurement: for a real loop.
+
+        Returns the torque to apply (N m), (2,), and None, or, when the
+        controller refuses the step (a non-finite or implausible measurement,
+        a latched fault), the configured fallback torque (``fallback``:
+        "hold" the last applied torque, "zero", or "damping" −Kd q̇; saturated)
+        and the error message. A refused step changes nothing but the
+        recorded :attr:`fault`. Inputs of the wrong shape or type still raise.
+
+        Examples
+        --------
+        >>> import adaptimp
+        >>> ctrl = adaptimp.Controller("sf", scenario="robot", fallback="zero")
+        >>> tau, error = ctrl.step_or_fallback([float("nan"), 0.0], [0.0, 0.0], [0.0, 0.0])
+        >>> tau.tolist(), error
+        ([0.0, 0.0], 'x[0] is not finite (NaN or infinite)')
+        """
+        return self._core.step_or_fallback(q, tau_e, dq)
+
+    @property
+    def fault(self) -> tuple[str, int] | None:
+        """The fault recorded by the last refused step: (message, step k), or None."""
+        return self._core.fault
+
+    def clear_fault(self) -> None:
+        """Clear the recorded fault. With ``fault_policy="latch"`` every step is
+        refused until this is called; the controller then continues from the
+        state it had before the fault (nothing learned is lost)."""
+        self._core.clear_fault()
+
     def replay(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> FloatArray:
         """K steps in one call, e.g. to replay logged measurements; returns the
         applied torques (N m), shape (K, 2).

@@ -53,7 +53,8 @@ class Param:
     (a number, or one value per network D̂, Ĉ, Ĝ), ``"choice"`` (one of
     ``choices``), ``"optional"`` (a number or ``None``), ``"derived"`` (a
     number, or ``None`` for the value derived from other parameters),
-    ``"bound"`` (``None``, ``"auto"`` or one number per network).
+    ``"bound"`` (``None``, ``"auto"`` or one number per network), ``"limit"``
+    (``None`` for no limit, or a number > 0 per joint).
     ``condition`` is the validity condition the core checks (SPEC §10 style).
     """
 
@@ -199,6 +200,8 @@ def validate(name: str, value: object) -> Any:
         return _choice(p, value)
     if p.kind in ("optional", "derived"):
         return None if value is None else _real(p, value)
+    if p.kind == "limit":
+        return None if value is None else _vector(p, value, N_JOINTS, "one value per joint")
     if p.kind == "bound":
         if value is None or (isinstance(value, str) and value == "auto"):
             return value

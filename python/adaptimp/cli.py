@@ -41,7 +41,7 @@ class CliError(Exception):
 def _parse_value(name: str, text: str) -> Any:
     p = BY_NAME[name]
     try:
-        if p.kind in ("optional", "derived", "bound") and text.lower() == "none":
+        if p.kind in ("optional", "derived", "bound", "limit") and text.lower() == "none":
             return None
         if p.kind == "bound":
             if text.lower() == "auto":
@@ -52,7 +52,7 @@ def _parse_value(name: str, text: str) -> Any:
             return int(text)
         if p.kind in ("real", "optional", "derived"):
             return float(text)
-        if p.kind in ("joint", "network"):
+        if p.kind in ("joint", "network", "limit"):
             parts = [float(x) for x in text.split(",")]
             return parts[0] if len(parts) == 1 else parts
     except ValueError:
@@ -69,6 +69,7 @@ def _expected(kind: str) -> str:
         "joint": "a number or comma-separated numbers, one per joint",
         "network": "a number or comma-separated numbers, one per network (D, C, G)",
         "bound": "'none', 'auto', or comma-separated numbers, one per network (D, C, G)",
+        "limit": "'none', or a number or comma-separated numbers, one per joint",
     }.get(kind, "a value")
 
 

@@ -1,0 +1,312 @@
+//! Reliability: configurations that would hang or overflow are refused at
+//! construction by named conditions; the step is transactional (a spike is
+//! refused and changes nothing); the fail-safe step, the fault policy, the
+//! plausibility limits and the torque rate limit.
+
+use adaptimp::{
+    Config, Controller, Error, Fallback, FaultPolicy, Grid, HeapState, Law, Measurement, SimConfig,
+    Sinusoid, Trajectory, Vector,
+};
+
+fn robot(law: Law) -> Config<2> {
+    Config::robot(law)
+}
+
+fn build(cfg: Config<2>) -> Result<Controller<2>, Error> {
+    Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper())
+}
+
+fn condition(e: Error) -> &'static str {
+    match e {
+        Error::Condition { condition, .. } => condition,
+        other => panic!("not a condition: {other:?}"),
+    }
+}
+
+/// A change to a configuration.
+type Mutation = Box<dyn Fn(&mut Config<2>)>;
+
+#[test]
+fn configurations_that_hung_or_overflowed_are_refused_by_name() {
+    let cases: [(&str, Mutation); 6] = [
+        // nalgebra's matrix exponential never returned for these (issue 13).
+        ("Ts/ε ≤ 1e6", Box::new(|c| c.eps = 1e-80)),
+        ("Ts ≤ 1 s", Box::new(|c| c.ts = 1e45)),
+        ("|value| ≤ 1e9", Box::new(|c| c.k1[0] = 1e300)),
+        ("|value| ≤ 1e9", Box::new(|c| c.gamma[1] = 1e20)),
+        ("Ts Γ σ < 1", Box::new(|c| c.sigma = [10.0; 3])),
+        ("λ1 ≤ 1e6", Box::new(|c| c.lam1[1] = 1e8)),
+    ];
+    for (expect, mutate) in cases {
+        let mut cfg = robot(Law::OutputFeedback);
+        mutate(&mut cfg);
+        assert_eq!(condition(build(cfg).unwrap_err()), expect);
+    }
+    // The trajectory's magnitudes are bounded where it is built.
+    let big = |o: f64, a: f64, w: f64| {
+        Sinusoid::new(
+            Vector::<2>::from_element(o),
+            Vector::<2>::from_element(a),
+            Vector::zeros(),
+            Vector::from_element(w),
+        )
+    };
+    assert_eq!(
+        condition(big(1e300, 0.0, 1.0).unwrap_err()),
+        "|xc| ≤ 1e6 rad"
+    );
+    assert_eq!(
+        condition(big(0.0, 0.2, 1e300).unwrap_err()),
+        "|ẋc| ≤ 1e6 rad/s"
+    );
+    assert_eq!(
+        condition(big(0.0, 0.2, 1e4).unwrap_err()),
+        "|ẍc| ≤ 1e6 rad/s²"
+    );
+    assert!(
+        big(0.0, 0.0, 1e300).is_ok(),
+        "a frequency without amplitude moves nothing"
+    );
+    // substeps has an upper bound (2^31 would run for days).
+    let sim = SimConfig {
+        substeps: 1 << 31,
+        ..SimConfig::paper()
+    };
+    let e = adaptimp::RigidBody::new(
+        adaptimp::TwoLinkArm::paper(),
+        adaptimp::Wall::paper(),
+        sim.q0,
+        sim.dq0,
+        sim.substeps,
+    )
+    .unwrap_err();
+    assert_eq!(condition(e), "1 ≤ substeps ≤ 10 000");
+}
+
+fn measurement(k: usize) -> Measurement<2> {
+    let s = k as f64 * 1e-3;
+    Measurement {
+        x: Vector::<2>::new(0.2 + 0.1 * s.sin(), 0.2 + 0.1 * s.cos()),
+        dx: Some(Vector::<2>::new(0.1 * s.cos(), -0.1 * s.sin())),
+        tau_e: Vector::<2>::new((10.0 * s.sin()).max(0.0), 0.0),
+    }
+}
+
+fn snapshot(st: &HeapState<2>) -> Vec<f64> {
+    let mut v = vec![0.0; st.snapshot_len()];
+    st.save(&mut v).expect("save");
+    v
+}
+
+fn step(
+    c: &Controller<2>,
+    st: &mut HeapState<2>,
+    m: &Measurement<2>,
+) -> Result<adaptimp::Command<2>, Error> {
+    let sp = Sinusoid::paper().sample(c.time(st));
+    c.step(st, m, &sp)
+}
+
+#[test]
+fn a_finite_spike_is_refused_and_poisons_nothing() {
+    for cfg in [
+        Config::paper(Law::StateFeedback),
+        robot(Law::StateFeedback),
+        robot(Law::OutputFeedback),
+        robot(Law::Pd),
+    ] {
+        let c = build(cfg).unwrap();
+        let (mut st, mut twin) = (c.new_state(), c.new_state());
+        for k in 0..1000 {
+            step(&c, &mut st, &measurement(k)).unwrap();
+            step(&c, &mut twin, &measurement(k)).unwrap();
+        }
+        let before = snapshot(&st);
+        let m = measurement(1000);
+        let spikes = [
+            Measurement {
+                x: Vector::<2>::new(1e151, 0.2),
+                ..m
+            },
+            Measurement {
+                dx: Some(Vector::<2>::new(0.0, -1e151)),
+                ..m
+            },
+            Measurement {
+                tau_e: Vector::<2>::new(1e155, 0.0),
+                ..m
+            },
+            Measurement {
+                x: Vector::<2>::new(1e300, -1e300),
+                ..m
+            },
+        ];
+        for (i, spike) in spikes.into_iter().enumerate() {
+            if i == 1 && c.config().law == Law::OutputFeedback {
+                continue; // output feedback ignores a measured velocity
+            }
+            let e = step(&c, &mut st, &spike).unwrap_err();
+            assert!(matches!(e, Error::OutOfRange { .. }), "{e:?}");
+            assert_eq!(snapshot(&st), before, "{e}");
+            assert_eq!(st.fault().map(|f| f.step), Some(1000));
+        }
+        // Nothing learned was lost: the run continues exactly as its twin's.
+        for k in 1000..1500 {
+            assert_eq!(
+                step(&c, &mut st, &measurement(k)),
+                step(&c, &mut twin, &measurement(k))
+            );
+        }
+    }
+}
+
+#[test]
+fn the_fallback_is_returned_with_the_error() {
+    let nan = Measurement {
+        x: Vector::<2>::new(f64::NAN, 0.0),
+        ..measurement(0)
+    };
+    for (fallback, expect) in [
+        (Fallback::Hold, None),
+        (Fallback::Zero, Some(Vector::<2>::zeros())),
+        (Fallback::Damping, Some(Vector::<2>::new(-2.0 * 0.1, 0.0))),
+    ] {
+        let mut cfg = robot(Law::StateFeedback);
+        cfg.fallback = fallback;
+        cfg.fallback_damping = Vector::from_element(2.0);
+        let c = build(cfg).unwrap();
+        let mut st = c.new_state();
+        let mut last = Vector::zeros();
+        for k in 0..100 {
+            last = step(&c, &mut st, &measurement(k)).unwrap().tau_sat;
+        }
+        let m = Measurement {
+            dx: Some(Vector::<2>::new(0.1, 0.0)),
+            ..nan
+        };
+        let sp = Sinusoid::paper().sample(c.time(&st));
+        let (tau, result) = c.step_or_fallback(&mut st, &m, &sp);
+        assert!(
+            matches!(result, Err(Error::NonFinite { what: "x", .. })),
+            "{result:?}"
+        );
+        assert_eq!(tau, expect.unwrap_or(last), "{fallback:?}");
+        assert_eq!(st.fault().unwrap().error, result.unwrap_err());
+    }
+    // Damping is saturated like every command.
+    let mut cfg = robot(Law::Pd);
+    cfg.fallback = Fallback::Damping;
+    cfg.fallback_damping = Vector::from_element(1e6);
+    let c = build(cfg).unwrap();
+    let mut st = c.new_state();
+    let m = Measurement {
+        dx: Some(Vector::<2>::new(1.0, -1.0)),
+        ..nan
+    };
+    let (tau, _) = c.step_or_fallback(&mut st, &m, &Sinusoid::paper().sample(0.0));
+    assert_eq!(tau, Vector::<2>::new(-17.0, 15.0));
+}
+
+#[test]
+fn a_latched_fault_refuses_steps_until_cleared() {
+    let mut cfg = robot(Law::StateFeedback);
+    cfg.fault_policy = FaultPolicy::Latch;
+    let c = build(cfg).unwrap();
+    let (mut st, mut twin) = (c.new_state(), c.new_state());
+    for k in 0..200 {
+        step(&c, &mut st, &measurement(k)).unwrap();
+        step(&c, &mut twin, &measurement(k)).unwrap();
+    }
+    let bad = Measurement {
+        tau_e: Vector::<2>::new(f64::INFINITY, 0.0),
+        ..measurement(200)
+    };
+    assert!(step(&c, &mut st, &bad).is_err());
+    let e = step(&c, &mut st, &measurement(200)).unwrap_err();
+    assert_eq!(
+        e,
+        Error::Faulted {
+            reason: "non-finite input"
+        }
+    );
+    assert!(e.to_string().contains("until clear_fault()"), "{e}");
+    assert_eq!(st.steps(), 200);
+    st.clear_fault();
+    for k in 200..300 {
+        assert_eq!(
+            step(&c, &mut st, &measurement(k)),
+            step(&c, &mut twin, &measurement(k))
+        );
+    }
+}
+
+#[test]
+fn plausibility_limits_refuse_a_measurement_and_change_nothing() {
+    let mut cfg = robot(Law::StateFeedback);
+    cfg.limits.q = Vector::from_element(1.0);
+    cfg.limits.dq = Vector::from_element(2.0);
+    cfg.limits.tau_e = Vector::from_element(100.0);
+    cfg.limits.q_jump = Vector::from_element(0.05);
+    let c = build(cfg).unwrap();
+    let mut st = c.new_state();
+    for k in 0..10 {
+        step(&c, &mut st, &measurement(k)).unwrap();
+    }
+    let before = snapshot(&st);
+    let m = measurement(10);
+    for (bad, what) in [
+        (
+            Measurement {
+                x: Vector::<2>::new(1.5, 0.2),
+                ..m
+            },
+            "q",
+        ),
+        (
+            Measurement {
+                dx: Some(Vector::<2>::new(0.0, 3.0)),
+                ..m
+            },
+            "dq",
+        ),
+        (
+            Measurement {
+                tau_e: Vector::<2>::new(150.0, 0.0),
+                ..m
+            },
+            "tau_e",
+        ),
+        (
+            Measurement {
+                x: m.x + Vector::<2>::new(0.0, 0.1),
+                ..m
+            },
+            "q jump",
+        ),
+    ] {
+        match step(&c, &mut st, &bad).unwrap_err() {
+            Error::OutOfRange { what: w, .. } => assert_eq!(w, what),
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(snapshot(&st), before);
+    }
+    assert!(step(&c, &mut st, &m).is_ok());
+}
+
+#[test]
+fn the_rate_limit_bounds_the_change_of_torque_and_shows_in_dtau() {
+    let mut cfg = robot(Law::StateFeedback);
+    cfg.limits.tau_rate = Vector::from_element(0.5);
+    let c = build(cfg).unwrap();
+    let mut st = c.new_state();
+    let mut last = Vector::<2>::zeros();
+    let mut limited = false;
+    for k in 0..500 {
+        let cmd = step(&c, &mut st, &measurement(k)).unwrap();
+        assert!((cmd.tau_sat - last).amax() <= 0.5 + 1e-12, "k={k}");
+        assert_eq!(cmd.dtau, cmd.tau_sat - cmd.tau);
+        limited |= cmd.dtau.amax() > 0.0 && cmd.tau.amax() < 15.0;
+        last = cmd.tau_sat;
+    }
+    assert!(limited, "the rate limit acted below the saturation limits");
+}

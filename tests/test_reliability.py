@@ -1,0 +1,110 @@
+"""Reliability from Python: configurations that hung are refused at once by
+named conditions, a spike poisons nothing, and the fail-safe step."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import adaptimp
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"eps": 1e-80}, "Ts/ε ≤ 1e6"),
+        ({"Ts": 1e45}, "Ts ≤ 1 s"),
+        ({"K1": 1e300}, "|value| ≤ 1e9"),
+        ({"xc_offset": 1e300}, "|xc| ≤ 1e6 rad"),
+        ({"xc_omega": 1e300}, "|ẋc| ≤ 1e6 rad/s"),
+        ({"sigma": 50.0, "Ts": 1e-3}, "Ts Γ σ < 1"),
+    ],
+)
+def test_configurations_that_hung_or_overflowed_are_refused(
+    kwargs: dict[str, float], message: str
+) -> None:
+    with pytest.raises(ValueError, match=message.replace("|", r"\|")):
+        adaptimp.Controller("sf", **kwargs)
+
+
+def test_simulate_refuses_a_hanging_observer_and_huge_substeps() -> None:
+    with pytest.raises(ValueError, match="Ts/ε ≤ 1e6"):
+        adaptimp.simulate("sf", T=0.05, eps=1e-50)
+    with pytest.raises(ValueError, match="1 ≤ substeps ≤ 10 000"):
+        adaptimp.simulate("pd", T=0.05, substeps=2**31)
+    with pytest.raises(ValueError, match="substeps is out of range"):
+        adaptimp.simulate("pd", T=0.05, substeps=2**63)
+
+
+def _inputs(k: int) -> tuple[list[float], list[float], list[float]]:
+    s = k * 1e-3
+    return (
+        [0.2 + 0.1 * np.sin(s), 0.2 + 0.1 * np.cos(s)],
+        [max(0.0, 10 * np.sin(s)), 0.0],
+        [0.1 * np.cos(s), -0.1 * np.sin(s)],
+    )
+
+
+@pytest.mark.parametrize(
+    "spike",
+    [
+        {"q": [1e151, 0.2]},
+        {"dq": [0.0, -1e151]},
+        {"tau_e": [1e155, 0.0]},
+    ],
+)
+def test_a_spike_is_refused_and_nothing_learned_is_lost(spike: dict[str, list[float]]) -> None:
+    ctrl, twin = (adaptimp.Controller("sf", scenario="robot") for _ in range(2))
+    for k in range(300):
+        q, te, dq = _inputs(k)
+        ctrl.step(q, te, dq)
+        twin.step(q, te, dq)
+    before = ctrl.weights
+    q, te, dq = _inputs(300)
+    args = {"q": q, "tau_e": te, "dq": dq, **spike}
+    with pytest.raises(ValueError, match="beyond its limit"):
+        ctrl.step(**args)
+    for name, w in ctrl.weights.items():
+        np.testing.assert_array_equal(w, before[name])
+    assert ctrl.fault is not None
+    assert ctrl.fault[1] == 300
+    for k in range(300, 400):
+        q, te, dq = _inputs(k)
+        np.testing.assert_array_equal(ctrl.step(q, te, dq), twin.step(q, te, dq))
+
+
+def test_the_fail_safe_step_returns_the_fallback_and_latches() -> None:
+    ctrl = adaptimp.Controller(
+        "sf", scenario="robot", fallback="damping", fallback_damping=2.0, fault_policy="latch"
+    )
+    for k in range(100):
+        q, te, dq = _inputs(k)
+        tau, error = ctrl.step_or_fallback(q, te, dq)
+        assert error is None
+    q, te, dq = _inputs(100)
+    tau, error = ctrl.step_or_fallback([np.nan, q[1]], te, [0.5, -0.5])
+    assert error == "x[0] is not finite (NaN or infinite)"
+    np.testing.assert_array_equal(tau, [-1.0, 1.0])
+    # Latched: refused until cleared, then the run goes on.
+    tau, error = ctrl.step_or_fallback(q, te, dq)
+    assert error is not None
+    assert "clear_fault()" in error
+    assert ctrl.steps == 100
+    ctrl.clear_fault()
+    assert ctrl.fault is None
+    tau, error = ctrl.step_or_fallback(q, te, dq)
+    assert error is None
+    assert ctrl.steps == 101
+
+
+def test_plausibility_and_rate_limits_from_python() -> None:
+    ctrl = adaptimp.Controller("sf", scenario="robot", q_max=1.0, tau_rate_max=[0.5, 0.5])
+    with pytest.raises(ValueError, match=r"q\[0\] = 1.5e0 is beyond its limit"):
+        ctrl.step([1.5, 0.0], [0.0, 0.0], [0.0, 0.0])
+    last = np.zeros(2)
+    for k in range(50):
+        q, te, dq = _inputs(k)
+        tau = ctrl.step(q, te, dq)
+        assert np.max(np.abs(tau - last)) <= 0.5 + 1e-12
+        last = tau
+    assert adaptimp.Controller("sf", q_max=None).params["q_max"] is None

@@ -568,6 +568,13 @@ impl<const N: usize, B: Basis<N>, S: AsRef<[f64]> + AsMut<[f64]>> Control<N>
     fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
         self.ctrl.step(self.state, m, c)
     }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        self.ctrl.step_or_fallback(self.state, m, c)
+    }
 }
 
 #[cfg(test)]

@@ -78,4 +78,16 @@ pub trait Control<const N: usize> {
     /// One step at t_k: the measurement and the commanded setpoint (xc, ẋc, ẍc) in,
     /// the command out.
     fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error>;
+    /// The step, and the torque to apply whatever happened: the command's,
+    /// or a fallback on an error (zero unless the controller says otherwise).
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        match self.step(m, c) {
+            Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
+            Err(e) => (Vector::zeros(), Err(e)),
+        }
+    }
 }

@@ -43,6 +43,7 @@
 //! | [`record`] | recorded rows, the `Recorder` trait | §11 |
 //! | [`metrics`] | tracking / saturation / impedance figures | §12 |
 //! | [`simulator`] | the closed loop | §11 |
+//! | [`inject`] | faults injected into a closed loop | beyond the paper |
 //! | [`error`] | validation errors | §10 |
 //!
 //! ## Quick start
@@ -91,6 +92,7 @@ pub mod controller;
 pub mod environment;
 pub mod error;
 pub mod impedance;
+pub mod inject;
 pub mod io;
 pub mod learning;
 mod math;
@@ -120,6 +122,7 @@ pub use controller::{Bound, Controller, Errors};
 pub use environment::{Environment, FreeSpace, Wall};
 pub use error::Error;
 pub use impedance::{Reference, TargetImpedance};
+pub use inject::{Injected, Injection};
 pub use io::{Command, Control, Measurement};
 pub use learning::{Learning, LearningStep, SaturationLearning};
 pub use metrics::{Metrics, MetricsAccumulator};
@@ -137,7 +140,7 @@ pub use robust::{Robust, RobustKind};
 pub use safety::{Fallback, Fault, FaultPolicy, Limits};
 pub use saturation::Saturation;
 pub use schema::{Preset, Scenario};
-pub use simulator::{run, simulate, SimConfig};
+pub use simulator::{run, simulate, simulate_with, SimConfig};
 #[cfg(feature = "alloc")]
 pub use state::HeapState;
 pub use state::State;

@@ -38,6 +38,10 @@ pub struct Row<const N: usize> {
     pub z1: Vector<N>,
     /// ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F before the step's update.
     pub w_norms: [f64; 3],
+    /// True if no command was computed at this row (the step was refused or
+    /// skipped): `tau_sat` is then the fallback or held torque, the other
+    /// controller fields those of the last computed command.
+    pub refused: bool,
 }
 
 /// Receives every row of a simulation. `()` discards them; a pair records

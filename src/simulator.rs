@@ -6,7 +6,8 @@
 
 use crate::environment::Environment;
 use crate::error::{check, Error};
-use crate::io::{Control, Measurement};
+use crate::inject::Injection;
+use crate::io::{Command, Control, Measurement};
 use crate::metrics::{Metrics, MetricsAccumulator};
 use crate::model::Manipulator;
 use crate::plant::{Plant, RigidBody};
@@ -59,22 +60,66 @@ where
     T: Trajectory<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
+    simulate_with(plant, ctrl, traj, t_final, None, rec)
+}
+
+/// [`simulate`] with a fault injected ([`Injection`]): the sensors, the
+/// actuators or the control period misbehave during its window. A step the
+/// controller refuses does not end the run: its fallback torque is applied
+/// (as a real loop would) and the row is marked `refused`. Without an
+/// injection a refused step ends the run with its error.
+pub fn simulate_with<const N: usize, P, C, T, R>(
+    plant: &mut P,
+    ctrl: &mut C,
+    traj: &T,
+    t_final: f64,
+    injection: Option<&Injection<N>>,
+    rec: &mut R,
+) -> Result<u64, Error>
+where
+    P: Plant<N> + ?Sized,
+    C: Control<N> + ?Sized,
+    T: Trajectory<N> + ?Sized,
+    R: Recorder<N> + ?Sized,
+{
     let ts = ctrl.period();
     let steps = steps(t_final, ts)?;
+    let (x0, dx0) = plant.state();
+    let mut sensed = (x0, dx0, plant.contact());
+    let mut applied = Vector::<N>::zeros();
+    let mut last = Command::<N>::zeros();
     for k in 0..steps {
         let t = k as f64 * ts;
         let (x, dx) = plant.state();
         let tau_e = plant.contact();
+        let truth = (x, dx, tau_e);
+        if let Some(inj) = injection {
+            sensed = inj.measure(t, truth, sensed);
+        } else {
+            sensed = truth;
+        }
         let c = traj.sample(t);
-        let cmd = ctrl.step(
-            &Measurement {
-                x,
-                dx: Some(dx),
-                tau_e,
-            },
-            &c,
-        )?;
-        let ddx = plant.advance(&cmd.tau_sat, ts)?;
+        let refused = if injection.is_some_and(|i| i.skips(t)) {
+            true
+        } else {
+            let m = Measurement {
+                x: sensed.0,
+                dx: Some(sensed.1),
+                tau_e: sensed.2,
+            };
+            let (tau, result) = ctrl.step_or_fallback(&m, &c);
+            applied = tau;
+            match result {
+                Ok(cmd) => {
+                    last = cmd;
+                    false
+                }
+                Err(e) if injection.is_none() => return Err(e),
+                Err(_) => true,
+            }
+        };
+        let delivered = injection.map_or(applied, |i| i.actuate(t, &applied));
+        let ddx = plant.advance(&delivered, ts)?;
         rec.record(&Row {
             t,
             x,
@@ -83,15 +128,16 @@ where
             xc: c.x,
             dxc: c.dx,
             ddxc: c.ddx,
-            xd: cmd.xd,
-            dx_hat: cmd.v,
-            tau: cmd.tau,
-            tau_sat: cmd.tau_sat,
-            dtau: cmd.dtau,
+            xd: last.xd,
+            dx_hat: last.v,
+            tau: if refused { delivered } else { last.tau },
+            tau_sat: delivered,
+            dtau: if refused { Vector::zeros() } else { last.dtau },
             tau_e,
-            zeta: cmd.zeta,
-            z1: cmd.z1,
-            w_norms: cmd.w_norms,
+            zeta: last.zeta,
+            z1: if refused { last.xd - x } else { last.z1 },
+            w_norms: last.w_norms,
+            refused,
         });
     }
     Ok(steps)
@@ -127,4 +173,43 @@ where
         &mut (&mut metrics, rec),
     )?;
     Ok(metrics.finish())
+}
+
+/// [`run`] with a fault injected (feature `alloc`): the rigid-body scenario of
+/// `cfg`, `injection` acting in its window, and the figures of
+/// [`FaultFigures`](crate::inject::FaultFigures) for actuator limits `tau_max` (N m).
+#[cfg(feature = "alloc")]
+pub fn run_with_injection<const N: usize, M, E, C, T>(
+    arm: &M,
+    env: &E,
+    ctrl: &mut C,
+    traj: &T,
+    cfg: &SimConfig<N>,
+    injection: &Injection<N>,
+    tau_max: &Vector<N>,
+) -> Result<crate::inject::FaultFigures, Error>
+where
+    M: Manipulator<N> + Clone,
+    E: Environment<N> + Clone,
+    C: Control<N> + ?Sized,
+    T: Trajectory<N> + ?Sized,
+{
+    struct Report<'a, const N: usize>(crate::inject::FaultReport, &'a Vector<N>);
+    impl<const N: usize> Recorder<N> for Report<'_, N> {
+        fn record(&mut self, row: &Row<N>) {
+            self.0.push(row, self.1);
+        }
+    }
+    let mut plant = RigidBody::new(arm.clone(), env.clone(), cfg.q0, cfg.dq0, cfg.substeps)?;
+    let ts = ctrl.period();
+    let mut report = Report(crate::inject::FaultReport::default(), tau_max);
+    simulate_with(
+        &mut plant,
+        ctrl,
+        traj,
+        cfg.t_final,
+        Some(injection),
+        &mut report,
+    )?;
+    Ok(report.0.finish(injection, ts))
 }

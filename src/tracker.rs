@@ -102,4 +102,11 @@ impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Control<N> for Tracker<N, B,
     fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
         self.step_with(m, c)
     }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (crate::types::Vector<N>, Result<Command<N>, Error>) {
+        self.ctrl.step_or_fallback(&mut self.state, m, c)
+    }
 }

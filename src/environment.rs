@@ -4,7 +4,7 @@
 //! environment; the environment pushes back with −τe, (4). A force sensor
 //! measures it and the controller reads it.
 
-use crate::error::{check, Error};
+use crate::error::{check, Error, PARAM_BOUND};
 use crate::types::Vector;
 
 /// A contact model: τe as a function of time and the robot's state.
@@ -45,9 +45,11 @@ impl<const N: usize> Wall<N> {
                 reason: "must be less than the number of joints",
             });
         }
-        check::finite("wall", position)?;
+        check::at_most("|wall| ≤ 1e6 rad", "wall", position, 1e6)?;
         check::nonnegative("ke ≥ 0", "ke", ke)?;
         check::nonnegative("be ≥ 0", "be", be)?;
+        check::at_most("|value| ≤ 1e9", "ke", ke, PARAM_BOUND)?;
+        check::at_most("|value| ≤ 1e9", "be", be, PARAM_BOUND)?;
         Ok(Self {
             joint,
             position,

@@ -5,7 +5,7 @@
 //! n-link planar arm in a vertical plane for any `N` (it reduces to
 //! [`TwoLinkArm`] for `N = 2`).
 
-use crate::error::{check, Error};
+use crate::error::{check, Error, PARAM_BOUND};
 use crate::math::{cos, sin};
 use crate::types::{Matrix, Vector};
 use nalgebra::Vector2;
@@ -94,6 +94,19 @@ impl TwoLinkArm {
         check::nonnegative("I1 ≥ 0", "I1", a.i1)?;
         check::nonnegative("I2 ≥ 0", "I2", a.i2)?;
         check::finite("g", a.g)?;
+        for (what, v) in [
+            ("m1", a.m1),
+            ("m2", a.m2),
+            ("l1", a.l1),
+            ("l2", a.l2),
+            ("lc1", a.lc1),
+            ("lc2", a.lc2),
+            ("I1", a.i1),
+            ("I2", a.i2),
+            ("g", a.g),
+        ] {
+            check::at_most("|value| ≤ 1e9", what, v, PARAM_BOUND)?;
+        }
         let arm = Self::from_valid(params);
         let [p1, p2, p3, _, _] = arm.p;
         let det = p1 * p2 - p3 * p3;
@@ -219,8 +232,16 @@ impl<const N: usize> PlanarArm<N> {
             check::positive("length > 0", "length", link.length)?;
             check::nonnegative("com ≥ 0", "com", link.com)?;
             check::nonnegative("inertia ≥ 0", "inertia", link.inertia)?;
+            for (what, v) in [
+                ("mass", link.mass),
+                ("length", link.length),
+                ("com", link.com),
+                ("inertia", link.inertia),
+            ] {
+                check::at_most("|value| ≤ 1e9", what, v, PARAM_BOUND)?;
+            }
         }
-        check::finite("g", g)?;
+        check::at_most("|value| ≤ 1e9", "g", g, PARAM_BOUND)?;
         Ok(Self { links, g })
     }
 

@@ -47,7 +47,7 @@ impl Recorder<2> for Soak {
         let values = [row.x, row.dx, row.tau, row.tau_sat, row.z1, row.zeta];
         self.non_finite |= values.iter().any(|v| v.iter().any(|x| !x.is_finite()))
             || row.w_norms.iter().any(|x| !x.is_finite());
-        if self.k % self.every == 0 {
+        if self.k.is_multiple_of(self.every) {
             self.kept.push((row.t, row.z1.norm(), row.w_norms));
         }
         self.k += 1;

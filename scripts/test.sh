@@ -38,6 +38,18 @@ RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 step "Rust: tests (the core, and the C ABI with its header check)"
 cargo test --workspace
 
+step "Fuzzing: a short run of each cargo-fuzz target (nightly)"
+if ! cargo +nightly --version >/dev/null 2>&1; then
+    echo "the nightly toolchain is needed for cargo-fuzz (rustup toolchain install nightly)" >&2
+    exit 1
+fi
+command -v cargo-fuzz >/dev/null || cargo install --locked cargo-fuzz
+for target in config steps abi; do
+    (cd fuzz && cargo +nightly fuzz run -O "$target" -- \
+        -max_total_time="${ADAPTIMP_FUZZ_SECONDS:-15}" -timeout=5 -rss_limit_mb=2048 2>&1 |
+        grep -E "^Done|ERROR|panicked|SUMMARY")
+done
+
 step "Python: build and install the package with its test tools"
 export CARGO_TARGET_DIR="$PWD/target"
 venv="${ADAPTIMP_VENV:-$PWD/target/py-venv}"

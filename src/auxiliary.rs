@@ -76,7 +76,9 @@ impl<const N: usize> Auxiliary<N> {
         let n2 = zeta.norm_squared();
         let beta = if self.law == AuxLaw::Linear {
             0.0
-        } else if n2 >= self.mu * self.mu {
+        } else if n2 >= self.mu * self.mu && n2 > 0.0 {
+            // (n2 > 0: for μ below ~1e-154, μ² underflows to 0 and ‖ζ‖ = 0
+            // would divide by zero; found by fuzzing.)
             (z2.dot(dtau).abs() + 0.5 * dtau.norm_squared()) / n2
         } else if self.law == AuxLaw::Printed {
             return;

@@ -392,6 +392,11 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         } else {
             [0.0; 3]
         };
+        if tau.iter().any(|t| !t.is_finite()) {
+            // Unreachable when the checks above hold (SPEC §14); kept so that
+            // a non-finite torque is never returned, whatever the cause.
+            return Err(Error::Diverged { what: "tau" });
+        }
         let tau_sat = self
             .sat
             .apply(&self.cfg.limits.rate_limit(&tau, &st.last.tau_sat));

@@ -244,9 +244,10 @@ pub(crate) mod check {
         }
     }
 
-    /// Every element with `|v_i| ≤ bound`, else `Error::OutOfRange` (inputs of a step).
+    /// Every element with `|v_i| ≤ bound` (NaN never is), else
+    /// `Error::OutOfRange` (inputs and signals of a step).
     pub fn within(what: &'static str, v: &[f64], bound: f64) -> Result<(), Error> {
-        match v.iter().position(|x| x.abs() > bound) {
+        match v.iter().position(|x| x.is_nan() || x.abs() > bound) {
             Some(i) => Err(Error::OutOfRange {
                 what,
                 index: Some(i),

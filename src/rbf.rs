@@ -40,6 +40,21 @@ pub trait Basis<const N: usize> {
     fn eval(&self, z: &[Vector<N>; 4], s: &mut [f64]);
 }
 
+/// A width η² ≥ 1e-12 (in the squared unit of its dimension): below, 1/η²
+/// overflows and S_j = exp(−0 · ∞) is NaN at a centre (found by fuzzing).
+fn check_width(what: &'static str, eta2: f64) -> Result<(), Error> {
+    if eta2 >= 1e-12 {
+        Ok(())
+    } else {
+        Err(Error::Condition {
+            condition: "η² ≥ 1e-12",
+            lhs: what,
+            index: None,
+            value: eta2,
+        })
+    }
+}
+
 /// The largest N for which the vertex grid exists here (2^{4·3} = 4096 nodes).
 pub const GRID_MAX_JOINTS: usize = 3;
 
@@ -61,6 +76,7 @@ impl<const N: usize> Grid<N> {
             });
         }
         check::positive("η² > 0", "eta2", eta2)?;
+        check_width("eta2", eta2)?;
         Ok(Self {
             eta2,
             inv_eta2: 1.0 / eta2,
@@ -161,6 +177,9 @@ impl<const N: usize, C: AsRef<[f64]>> Centers<N, C> {
         check::finite_slice("centers", centers.as_ref())?;
         for w in &widths2 {
             check::positive_vec("η² > 0", "widths", w)?;
+            for &x in w.iter() {
+                check_width("widths", x)?;
+            }
         }
         Ok(Self {
             nodes: len / (4 * N),

@@ -161,6 +161,36 @@ fn a_finite_spike_is_refused_and_poisons_nothing() {
 }
 
 #[test]
+fn a_subnormal_mu_does_not_divide_by_zero() {
+    // Found by fuzzing (fuzz/fuzz_targets/config.rs): μ = 9.7e-309 passed
+    // μ > 0, μ² underflowed to 0, and ‖ζ‖ = 0 counted as outside the ball.
+    let mut cfg = robot(Law::Pd);
+    cfg.mu = 9.734889110590228e-309;
+    let c = build(cfg).unwrap();
+    let mut st = c.new_state();
+    let m = Measurement {
+        x: Vector::<2>::zeros(),
+        dx: Some(Vector::zeros()),
+        tau_e: Vector::zeros(),
+    };
+    for _ in 0..3 {
+        let cmd = step(&c, &mut st, &m).unwrap();
+        assert!(cmd.tau_sat.iter().all(|t| t.is_finite()), "{cmd:?}");
+        assert!(st.zeta().iter().all(|z| z.is_finite()));
+    }
+}
+
+#[test]
+fn a_subnormal_width_is_refused() {
+    // Found by fuzzing: η² = 9.1e-316 passed η² > 0, 1/η² overflowed, and the
+    // basis at a centre was exp(−0·∞) = NaN.
+    let e = Grid::<2>::new(9.1155762e-316).unwrap_err();
+    assert_eq!(condition(e), "η² ≥ 1e-12");
+    let e = adaptimp::Centers::<1, _>::new([0.0; 4], [Vector::<1>::new(1e-300); 4]).unwrap_err();
+    assert_eq!(condition(e), "η² ≥ 1e-12");
+}
+
+#[test]
 fn the_fallback_is_returned_with_the_error() {
     let nan = Measurement {
         x: Vector::<2>::new(f64::NAN, 0.0),

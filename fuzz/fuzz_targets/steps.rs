@@ -1,0 +1,75 @@
+//! Fuzzed step sequences: the paper's and the robot scenario's controllers fed
+//! arbitrary measurements and setpoints (NaN, infinities, spikes). Every step
+//! returns a finite torque within the limits, or an error that leaves the
+//! state exactly as it was; the weights never become non-finite.
+#![no_main]
+
+use adaptimp::{Controller, Error, Law, Measurement, Setpoint, Sinusoid, Trajectory, Vector};
+use arbitrary::Arbitrary;
+use libfuzzer_sys::fuzz_target;
+
+#[derive(Arbitrary, Debug)]
+struct Step {
+    q: [f64; 2],
+    dq: Option<[f64; 2]>,
+    tau_e: [f64; 2],
+    setpoint: Option<[f64; 6]>,
+    repeat: u8,
+}
+
+#[derive(Arbitrary, Debug)]
+struct Input {
+    robot: bool,
+    law: u8,
+    steps: Vec<Step>,
+}
+
+fuzz_target!(|input: Input| {
+    let law = [Law::Pd, Law::StateFeedback, Law::OutputFeedback][usize::from(input.law % 3)];
+    let ctrl = if input.robot {
+        Controller::robot(law)
+    } else {
+        Controller::paper(law)
+    };
+    let limits = *ctrl.saturation().limits();
+    let mut state = ctrl.new_state();
+    let mut before = vec![0.0; state.snapshot_len()];
+    let mut after = vec![0.0; state.snapshot_len()];
+    for s in input.steps.iter().take(64) {
+        let m = Measurement {
+            x: Vector::from(s.q),
+            dx: s.dq.map(Vector::from),
+            tau_e: Vector::from(s.tau_e),
+        };
+        let sp = match s.setpoint {
+            Some(v) => Setpoint {
+                x: Vector::<2>::new(v[0], v[1]),
+                dx: Vector::<2>::new(v[2], v[3]),
+                ddx: Vector::<2>::new(v[4], v[5]),
+            },
+            None => Sinusoid::paper().sample(ctrl.time(&state)),
+        };
+        for _ in 0..=(s.repeat % 8) {
+            state.save(&mut before).expect("save");
+            match ctrl.step(&mut state, &m, &sp) {
+                Ok(cmd) => {
+                    for i in 0..2 {
+                        assert!(cmd.tau_sat[i].is_finite() && cmd.tau_sat[i].abs() <= limits[i]);
+                    }
+                }
+                Err(e) => {
+                    assert!(!matches!(e, Error::Diverged { .. }), "{e}");
+                    state.save(&mut after).expect("save");
+                    assert!(
+                        before
+                            .iter()
+                            .zip(&after)
+                            .all(|(a, b)| a.to_bits() == b.to_bits()),
+                        "{e}"
+                    );
+                }
+            }
+            assert!(state.weights().norms().iter().all(|n| n.is_finite()));
+        }
+    }
+});

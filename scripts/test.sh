@@ -27,6 +27,7 @@ fi
 
 step "Rust: format, lints"
 cargo fmt --all --check
+cargo fmt --manifest-path fuzz/Cargo.toml --check
 cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy --all-targets --features python -- -D warnings
 

@@ -35,7 +35,7 @@ fuzz_target!(|input: Input| {
     let mut state = ctrl.new_state();
     let mut before = vec![0.0; state.snapshot_len()];
     let mut after = vec![0.0; state.snapshot_len()];
-    for s in input.steps.iter().take(64) {
+    for s in input.steps.iter().take(16) {
         let m = Measurement {
             x: Vector::from(s.q),
             dx: s.dq.map(Vector::from),
@@ -49,7 +49,7 @@ fuzz_target!(|input: Input| {
             },
             None => Sinusoid::paper().sample(ctrl.time(&state)),
         };
-        for _ in 0..=(s.repeat % 8) {
+        for _ in 0..=(s.repeat % 4) {
             state.save(&mut before).expect("save");
             match ctrl.step(&mut state, &m, &sp) {
                 Ok(cmd) => {

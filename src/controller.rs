@@ -58,6 +58,24 @@ pub struct Errors<const N: usize> {
     pub dalpha1: Vector<N>,
 }
 
+impl<const N: usize> Errors<N> {
+    /// The signals the learning laws use.
+    pub fn signals(&self) -> Signals<N> {
+        Signals {
+            dalpha1: self.dalpha1,
+            alpha1: self.alpha1,
+            z2: self.z2,
+        }
+    }
+}
+
+/// The small state a step changes, staged until its commit.
+#[derive(Copy, Clone, Debug)]
+struct Staged<const N: usize> {
+    observer: ObserverState<N>,
+    reference: Reference<N>,
+}
+
 impl Controller<2, Grid<2>> {
     /// The paper's controller `law` with every SPEC default (the 256-node grid,
     /// η² = 25).
@@ -354,16 +372,36 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             });
         }
         self.check(st, m, c)?;
-        let mut observer = st.observer;
-        let v = self.velocity(st.k, &mut observer, m)?;
-        let mut reference = if st.k == 0 {
-            Reference::start(c)
-        } else {
-            st.reference
+        // Staged on copies: the observer takes in the measurement, the
+        // reference starts at the first step's setpoint.
+        let mut staged = Staged {
+            observer: st.observer,
+            reference: if st.k == 0 {
+                Reference::start(c)
+            } else {
+                st.reference
+            },
         };
-        let e = self.errors(&reference, c, m, &v);
+        let v = self.velocity(st.k, &mut staged.observer, m)?;
+        let e = self.errors(&staged.reference, c, m, &v);
+        self.check_bounded(st, &e, &v)?;
+        // Every check has passed: from here on the state changes, and with
+        // every signal and weight within BOUND nothing below can overflow.
+        let cmd = self.command(st, m, c, &e, &v, &staged.reference)?;
+        self.advance(st, staged, m, &e, &cmd);
+        Ok(cmd)
+    }
+
+    /// Every signal of the step and ζ within [`BOUND`], and the weights
+    /// within it after this step's update ([`Learning::check_bounded`]).
+    fn check_bounded<S>(
+        &self,
+        st: &State<N, S>,
+        e: &Errors<N>,
+        v: &Vector<N>,
+    ) -> Result<(), Error> {
         for (what, x) in [
-            ("v", &v),
+            ("v", v),
             ("z1", &e.z1),
             ("alpha1", &e.alpha1),
             ("z2", &e.z2),
@@ -372,39 +410,48 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         ] {
             check::within(what, x.as_slice(), BOUND)?;
         }
-        let sig = Signals {
-            dalpha1: e.dalpha1,
-            alpha1: e.alpha1,
-            z2: e.z2,
-        };
-        let learns = self.cfg.law.learns();
-        if learns {
+        if self.cfg.law.learns() {
             self.learning
-                .check_bounded(&st.norms, &sig, self.basis.nodes())?;
+                .check_bounded(&st.norms, &e.signals(), self.basis.nodes())?;
         }
-        // Every check has passed: from here on the state changes, and with
-        // every signal and weight within BOUND nothing below can overflow.
-        let mut tau = self.feedback(&e, &st.zeta);
+        Ok(())
+    }
+
+    /// Stages "robust term", "networks", "saturation" and "learning": the
+    /// command of the step (SPEC §7), the rate limit and the saturation, and
+    /// the weights' update.
+    fn command<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+        e: &Errors<N>,
+        v: &Vector<N>,
+        reference: &Reference<N>,
+    ) -> Result<Command<N>, Error> {
+        let learns = self.cfg.law.learns();
+        let sig = e.signals();
+        let mut tau = self.feedback(e, &st.zeta);
         let w_norms = if learns {
             let before = st.norms;
-            tau += e.z1 + self.networks(st, &m.x, &v, &sig) + m.tau_e;
+            // (14), (35) with +z1 (erratum, SPEC §7).
+            tau += e.z1 + self.networks(st, &m.x, v, &sig) + m.tau_e;
             before
         } else {
             [0.0; 3]
         };
         if tau.iter().any(|t| !t.is_finite()) {
-            // Unreachable when the checks above hold (SPEC §14); kept so that
-            // a non-finite torque is never returned, whatever the cause.
+            // Unreachable when the checks hold (SPEC §14); kept so that a
+            // non-finite torque is never returned, whatever the cause.
             return Err(Error::Diverged { what: "tau" });
         }
-        let tau_sat = self
-            .sat
-            .apply(&self.cfg.limits.rate_limit(&tau, &st.last.tau_sat));
+        let limited = self.cfg.limits.rate_limit(&tau, &st.last.tau_sat);
+        let tau_sat = self.sat.apply(&limited);
         let dtau = tau_sat - tau;
         if learns {
             self.learn(st, &sig, &dtau);
         }
-        let cmd = Command {
+        Ok(Command {
             tau_sat,
             tau,
             dtau,
@@ -412,24 +459,33 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             z2: e.z2,
             xc: c.x,
             xd: reference.xd,
-            v,
+            v: *v,
             zeta: st.zeta,
             w_norms,
-        };
-        // Stage "advance", SPEC §11 step 5: ζ, the reference, the observer and
-        // the clock to t_{k+1}, from this step's values only.
+        })
+    }
+
+    /// Stage "advance", SPEC §11 step 5: ζ, the reference, the observer and
+    /// the clock to t_{k+1}, from this step's values only; the commit.
+    fn advance<S>(
+        &self,
+        st: &mut State<N, S>,
+        mut staged: Staged<N>,
+        m: &Measurement<N>,
+        e: &Errors<N>,
+        cmd: &Command<N>,
+    ) {
         let ts = self.cfg.ts;
-        self.aux.advance(&mut st.zeta, &e.z2, &dtau, ts);
-        reference.advance(&e.ddxd, ts);
+        self.aux.advance(&mut st.zeta, &e.z2, &cmd.dtau, ts);
+        staged.reference.advance(&e.ddxd, ts);
         if self.cfg.law == Law::OutputFeedback {
-            self.obs.finish(&mut observer, &m.x);
+            self.obs.finish(&mut staged.observer, &m.x);
         }
-        st.reference = reference;
-        st.observer = observer;
+        st.reference = staged.reference;
+        st.observer = staged.observer;
         st.q_prev = m.x;
         st.k += 1;
-        st.last = cmd;
-        Ok(cmd)
+        st.last = *cmd;
     }
 
     /// Inputs finite, within the plausibility limits and [`BOUND`], and the

@@ -301,7 +301,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// actuators. No allocation.
     ///
     /// **Transactional**: the step first checks its inputs (finite, within the
-    /// plausibility limits, every signal within [`BOUND`](crate::error::BOUND))
+    /// plausibility limits, every signal within [`BOUND`])
     /// and that the weights' update keeps them within the bound; only then
     /// does it change the state. On an error the state is exactly as before,
     /// except that the fault is recorded ([`State::fault`]); with

@@ -81,6 +81,34 @@ fn case_of(law: Law) -> &'static str {
     }
 }
 
+/// A step's error with the measurement named as in Python (`q`, `dq`, not
+/// the core's `x`, `dx`).
+fn python_names(e: Error) -> Error {
+    let rename = |what: &'static str| match what {
+        "x" => "q",
+        "dx" => "dq",
+        other => other,
+    };
+    match e {
+        Error::NonFinite { what, index } => Error::NonFinite {
+            what: rename(what),
+            index,
+        },
+        Error::OutOfRange {
+            what,
+            index,
+            value,
+            limit,
+        } => Error::OutOfRange {
+            what: rename(what),
+            index,
+            value,
+            limit,
+        },
+        other => other,
+    }
+}
+
 /// A Python value in the schema's terms, owned.
 enum Owned {
     Real(f64),
@@ -302,7 +330,10 @@ impl PyController {
             (Law::OutputFeedback, _) | (_, None) => None,
             (_, Some(dq)) => Some(vector("dq", dq)?),
         };
-        let cmd = self.inner.step(&Measurement { x, dx, tau_e })?;
+        let cmd = self
+            .inner
+            .step(&Measurement { x, dx, tau_e })
+            .map_err(python_names)?;
         Ok(array1(py, &cmd.tau_sat))
     }
 
@@ -327,7 +358,10 @@ impl PyController {
             (_, Some(dq)) => Some(vector_any("dq", dq)?),
         };
         let (tau, result) = self.inner.step_or_fallback(&Measurement { x, dx, tau_e });
-        Ok((array1(py, &tau), result.err().map(|e| e.to_string())))
+        Ok((
+            array1(py, &tau),
+            result.err().map(|e| python_names(e).to_string()),
+        ))
     }
 
     /// The fault recorded by the last failed step: (message, step k), or None.

@@ -83,7 +83,7 @@ def test_the_fail_safe_step_returns_the_fallback_and_latches() -> None:
         assert error is None
     q, te, dq = _inputs(100)
     tau, error = ctrl.step_or_fallback([np.nan, q[1]], te, [0.5, -0.5])
-    assert error == "x[0] is not finite (NaN or infinite)"
+    assert error == "q[0] is not finite (NaN or infinite)"
     np.testing.assert_array_equal(tau, [-1.0, 1.0])
     # Latched: refused until cleared, then the run goes on.
     tau, error = ctrl.step_or_fallback(q, te, dq)

@@ -171,7 +171,7 @@ class Controller:
         >>> ctrl = adaptimp.Controller("sf", scenario="robot", fallback="zero")
         >>> tau, error = ctrl.step_or_fallback([float("nan"), 0.0], [0.0, 0.0], [0.0, 0.0])
         >>> tau.tolist(), error
-        ([0.0, 0.0], 'x[0] is not finite (NaN or infinite)')
+        ([0.0, 0.0], 'q[0] is not finite (NaN or infinite)')
         """
         return self._core.step_or_fallback(q, tau_e, dq)
 

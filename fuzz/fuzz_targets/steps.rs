@@ -7,6 +7,23 @@
 use adaptimp::{Controller, Error, Law, Measurement, Setpoint, Sinusoid, Trajectory, Vector};
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
+use std::sync::OnceLock;
+
+/// The six controllers (paper and robot, each law), built once: building
+/// one resolves "auto" weight bounds from 4096 samples of the circle.
+fn controllers() -> &'static [Controller<2>; 6] {
+    static CTRL: OnceLock<[Controller<2>; 6]> = OnceLock::new();
+    CTRL.get_or_init(|| {
+        let laws = [Law::Pd, Law::StateFeedback, Law::OutputFeedback];
+        core::array::from_fn(|i| {
+            if i < 3 {
+                Controller::paper(laws[i])
+            } else {
+                Controller::robot(laws[i - 3])
+            }
+        })
+    })
+}
 
 #[derive(Arbitrary, Debug)]
 struct Step {
@@ -25,12 +42,7 @@ struct Input {
 }
 
 fuzz_target!(|input: Input| {
-    let law = [Law::Pd, Law::StateFeedback, Law::OutputFeedback][usize::from(input.law % 3)];
-    let ctrl = if input.robot {
-        Controller::robot(law)
-    } else {
-        Controller::paper(law)
-    };
+    let ctrl = &controllers()[usize::from(input.law % 3) + if input.robot { 3 } else { 0 }];
     let limits = *ctrl.saturation().limits();
     let mut state = ctrl.new_state();
     let mut before = vec![0.0; state.snapshot_len()];

@@ -29,6 +29,7 @@
 //! | [`rbf`] | Gaussian RBF bases S(Z): the grid and user centres | (1), §6 |
 //! | [`network`] | weights ŴD, ŴC, ŴG: storage, output, update | (15)–(17), §6 |
 //! | [`learning`] | learning policies (Euler, normalised, freeze, projection) | §11, §13 |
+//! | [`simd`] | the weight pass's instruction set, chosen at run time | |
 //! | [`robust`] | robust term r(z2) | §7 |
 //! | [`auxiliary`] | saturation compensator ζ | (11), (36), §8 |
 //! | [`observer`] | high-gain velocity observer | (31)–(34), §9 |
@@ -105,6 +106,7 @@ pub mod record;
 pub mod robust;
 pub mod saturation;
 pub mod schema;
+pub mod simd;
 pub mod simulator;
 pub mod state;
 #[cfg(feature = "alloc")]
@@ -132,6 +134,7 @@ pub use record::{Recorder, Row};
 pub use robust::{Robust, RobustKind};
 pub use saturation::Saturation;
 pub use schema::{Preset, Scenario};
+pub use simd::SimdPath;
 pub use simulator::{run, simulate, SimConfig};
 #[cfg(feature = "alloc")]
 pub use state::HeapState;

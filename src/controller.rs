@@ -387,7 +387,8 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     ) -> Vector<N> {
         let mut norms = st.norms;
         let (s, mut w) = st.parts();
-        self.basis.eval(&[*x, *v, sig.alpha1, sig.dalpha1], s);
+        self.simd
+            .eval_basis(&self.basis, &[*x, *v, sig.alpha1, sig.dalpha1], s);
         let out = self.learning.output(self.simd, &mut w, s, sig, &mut norms);
         st.norms = norms;
         out

@@ -23,6 +23,8 @@
 //! whether the environment saves the 256-bit registers. On other
 //! architectures the pass is portable.
 
+use crate::rbf::Basis;
+use crate::types::Vector;
 use pulp::{Scalar256b, Simd, WithSimd};
 
 #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
@@ -87,6 +89,32 @@ impl SimdPath {
     /// True on the portable path.
     pub const fn is_portable(&self) -> bool {
         matches!(self.0, Path::Portable)
+    }
+
+    /// Evaluate `basis` at `z` into `s` ([`Basis::eval`]) inside this path's
+    /// function, as the controller's step does: a basis whose `eval` is
+    /// inlined there (the paper's [`Grid`](crate::Grid)) is compiled for AVX2
+    /// too when the path is the fast one. The same operations, so the same
+    /// values.
+    pub fn eval_basis<const N: usize, B: Basis<N> + ?Sized>(
+        self,
+        basis: &B,
+        z: &[Vector<N>; 4],
+        s: &mut [f64],
+    ) {
+        struct Eval<'a, const N: usize, B: ?Sized> {
+            basis: &'a B,
+            z: &'a [Vector<N>; 4],
+            s: &'a mut [f64],
+        }
+        impl<const N: usize, B: Basis<N> + ?Sized> WithSimd for Eval<'_, N, B> {
+            type Output = ();
+            #[inline(always)]
+            fn with_simd<S: Simd>(self, _: S) {
+                self.basis.eval(self.z, self.s);
+            }
+        }
+        self.run(Eval { basis, z, s });
     }
 
     /// Run `op` on this path: inside a function compiled for AVX2 and FMA, or

@@ -77,7 +77,9 @@
 //! allocator: a state lives in a buffer of the caller's
 //! ([`Controller::state_in`]). The feature `alloc` adds heap states
 //! ([`Controller::new_state`]), [`Tracker`] and [`Trace`]; `std` (the
-//! default) adds the platform's libm and `std::error::Error`.
+//! default) adds the platform's libm, `std::error::Error` and the run-time
+//! check of the operating system's AVX support: without it the weight pass
+//! takes AVX2/FMA only in a build for them ([`SimdPath`]).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

@@ -14,7 +14,9 @@
 //! Both paths do the same operations in the same order (two accumulators,
 //! products and sums never fused, the same lane reduction), so they give the
 //! same results. A [`Controller`](crate::Controller) picks its path once, when
-//! it is built ([`SimdPath::detect`]), and passes it down to every pass.
+//! it is built ([`SimdPath::detect`]), and passes it down to every pass
+//! (through [`Learning`](crate::Learning) to [`WeightsMut`](crate::WeightsMut))
+//! and to the evaluation of its basis ([`SimdPath::eval_basis`]).
 //!
 //! Detection: with `std`, the standard library's CPU feature detection (CPUID,
 //! and XGETBV for the operating system's support of the 256-bit registers).
@@ -39,10 +41,10 @@ pub const ENV_VAR: &str = "ADAPTIMP_SIMD";
 /// runs: `"avx2-fma"` or `"portable"` ([`name`](Self::name)); see the
 /// [module docs](self). A value is proof that the CPU supports its path: the
 /// fast one can only be had from detection.
-#[derive(Copy, Clone, Debug)]
+#[derive(Copy, Clone)]
 pub struct SimdPath(Path);
 
-#[derive(Copy, Clone, Debug)]
+#[derive(Copy, Clone)]
 enum Path {
     /// 256-bit AVX2 vectors; the token proves the CPU has them.
     #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
@@ -145,6 +147,12 @@ impl PartialEq for SimdPath {
 
 impl Eq for SimdPath {}
 
+impl core::fmt::Debug for SimdPath {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_tuple("SimdPath").field(&self.name()).finish()
+    }
+}
+
 impl core::fmt::Display for SimdPath {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(self.name())
@@ -178,5 +186,9 @@ mod tests {
         assert!(fast.is_portable());
         assert!(SimdPath::portable().is_portable());
         assert_eq!(SimdPath::portable().to_string(), "portable");
+        assert_eq!(
+            format!("{:?}", SimdPath::portable()),
+            r#"SimdPath("portable")"#
+        );
     }
 }

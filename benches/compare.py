@@ -849,7 +849,8 @@ def main(argv: list[str] | None = None) -> int:
     for key, value in info.items():
         print(f"- {key}: {value}")
     print(
-        "- builds: adaptimp's extension for x86-64-v3 (AVX2, FMA: .cargo/config.toml); "
+        "- builds: adaptimp's extension built plainly (its weight pass takes AVX2/FMA at run "
+        "time when the CPU has them; ADAPTIMP_SIMD=portable forces the portable path); "
         "numba compiles for the host CPU\n"
     )
 

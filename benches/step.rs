@@ -16,7 +16,7 @@
 use adaptimp::network::Rates;
 use adaptimp::{
     rk4_step, run, Basis, Controller, Environment, Grid, HeapState, Law, Manipulator, Measurement,
-    SimConfig, Sinusoid, Trajectory, TwoLinkArm, Vector, Wall,
+    SimConfig, SimdPath, Sinusoid, Trajectory, TwoLinkArm, Vector, Wall,
 };
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -37,9 +37,11 @@ fn basis(c: &mut Criterion) {
     let direct = grid.to_centers();
     let mut s = [0.0; L];
     let z = z_sample();
+    let simd = Controller::paper(Law::StateFeedback).simd();
     c.bench_function("basis/grid_separable", |b| {
         b.iter(|| {
-            grid.eval(black_box(&z), &mut s);
+            // On the controller's instruction set, as its step evaluates it.
+            simd.eval_basis(&grid, black_box(&z), &mut s);
             black_box(&s);
         })
     });
@@ -52,12 +54,15 @@ fn basis(c: &mut Criterion) {
 }
 
 /// A state of the paper's controller (basis and weights in the controller's
-/// layout: the pass's speed depends on it), the basis set at a typical input.
-fn net() -> HeapState<2> {
-    let mut st = Controller::paper(Law::StateFeedback).new_state();
+/// layout: the pass's speed depends on it), the basis set at a typical input,
+/// and the controller's instruction set for the pass (`ADAPTIMP_SIMD=portable`
+/// forces the portable one).
+fn net() -> (HeapState<2>, SimdPath) {
+    let ctrl = Controller::paper(Law::StateFeedback);
+    let mut st = ctrl.new_state();
     let (s, _) = st.networks_mut();
     Grid::<2>::paper().eval(&z_sample(), s);
-    st
+    (st, ctrl.simd())
 }
 
 /// Learning rates (paper, 50 µs) and α̇1, α1, z2 for one pass of the networks.
@@ -71,13 +76,14 @@ fn pass_inputs() -> (Rates, Vector<2>, Vector<2>, Vector<2>) {
 
 /// One pass of the three networks (output, update and norms) alone.
 fn network(c: &mut Criterion) {
-    let mut n = net();
+    let (mut n, simd) = net();
     let (rates, da, a, z2) = pass_inputs();
     let mut norms = [0.0; 3];
     c.bench_function("network/fused_step", |b| {
         b.iter(|| {
             let (basis, mut weights) = n.networks_mut();
-            black_box(weights.fused_step(black_box(basis), &da, &a, &z2, &rates, &mut norms))
+            let s = black_box(basis);
+            black_box(weights.fused_step(simd, s, &da, &a, &z2, &rates, &mut norms))
         })
     });
 }
@@ -133,15 +139,15 @@ fn plant(c: &mut Criterion) {
 /// the cost of everything that is not the networks.
 fn bound(c: &mut Criterion) {
     let grid = Grid::<2>::paper();
-    let mut n = net();
+    let (mut n, simd) = net();
     let (rates, da, a, z2) = pass_inputs();
     let z = z_sample();
     let mut norms = [0.0; 3];
     c.bench_function("bound/sf_step", |b| {
         b.iter(|| {
             let (basis, mut weights) = n.networks_mut();
-            grid.eval(black_box(&z), basis);
-            black_box(weights.fused_step(basis, &da, &a, &z2, &rates, &mut norms))
+            simd.eval_basis(&grid, black_box(&z), basis);
+            black_box(weights.fused_step(simd, basis, &da, &a, &z2, &rates, &mut norms))
         })
     });
 }

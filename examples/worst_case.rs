@@ -34,6 +34,10 @@ fn main() -> Result<(), adaptimp::Error> {
         "{steps} steps per controller, closed loop with the paper's arm and wall (RK4, 1 substep)"
     );
     println!(
+        "weight pass: {} (chosen at run time; ADAPTIMP_SIMD=portable forces the portable one)",
+        Controller::paper(Law::Pd).simd()
+    );
+    println!(
         "| controller | Ts | description + state (bytes) | median (ns) | 99.9th percentile (ns) | max (ns) |"
     );
     println!("|---|---|---:|---:|---:|---:|");

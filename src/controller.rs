@@ -25,6 +25,7 @@ use crate::rbf::{Basis, Grid};
 use crate::robust::Robust;
 use crate::safety::{Fallback, Fault, FaultPolicy};
 use crate::saturation::Saturation;
+use crate::simd::SimdPath;
 use crate::state::State;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
@@ -41,6 +42,8 @@ pub struct Controller<const N: usize, B = Grid<N>> {
     obs: HighGainObserver<N>,
     robust: Robust<N>,
     learning: Learning,
+    /// The weight pass's instruction set, chosen once in [`Controller::new`].
+    simd: SimdPath,
 }
 
 /// The errors of one step at t_k, SPEC §5, from the reference and the velocity used.
@@ -97,6 +100,14 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// controller with basis `basis`. The error names the condition and the
     /// value. A [`WeightBound::Auto`] needs the trajectory: use
     /// [`for_trajectory`](Self::for_trajectory).
+    ///
+    /// The weight pass's instruction set is chosen here, once
+    /// ([`SimdPath::detect`]): AVX2 and FMA if the CPU has them (x86-64-v3,
+    /// no build flag needed), the portable path otherwise. With `std`, the
+    /// environment variable `ADAPTIMP_SIMD=portable` forces the portable path
+    /// (e.g. to compare the two); [`simd`](Self::simd) tells which was taken
+    /// and [`with_simd`](Self::with_simd) changes it. Both give the same
+    /// results.
     pub fn new(cfg: Config<N>, basis: B) -> Result<Self, Error> {
         if N == 0 || basis.nodes() == 0 {
             return Err(Error::Invalid {
@@ -155,6 +166,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             robust,
             cfg,
             basis,
+            simd: SimdPath::detect(),
         })
     }
 
@@ -253,6 +265,19 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// The learning policy.
     pub fn learning(&self) -> &Learning {
         &self.learning
+    }
+    /// The instruction set of the weight pass: `simd().name()` is
+    /// `"avx2-fma"` or `"portable"` (see [`new`](Self::new)).
+    pub fn simd(&self) -> SimdPath {
+        self.simd
+    }
+    /// The same controller with the weight pass on `path`, e.g.
+    /// [`SimdPath::portable`]. A fast path can only come from detection
+    /// ([`SimdPath::fastest`]), so this never asks for instructions the CPU
+    /// lacks.
+    pub fn with_simd(mut self, path: SimdPath) -> Self {
+        self.simd = path;
+        self
     }
     /// Sampling period Ts (s).
     pub fn period(&self) -> f64 {
@@ -588,8 +613,9 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     ) -> Vector<N> {
         let mut norms = st.norms;
         let (s, mut w) = st.parts();
-        self.basis.eval(&[*x, *v, sig.alpha1, sig.dalpha1], s);
-        let out = self.learning.output(&mut w, s, sig, &mut norms);
+        self.simd
+            .eval_basis(&self.basis, &[*x, *v, sig.alpha1, sig.dalpha1], s);
+        let out = self.learning.output(self.simd, &mut w, s, sig, &mut norms);
         st.norms = norms;
         out
     }
@@ -604,7 +630,8 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     ) {
         let mut norms = st.norms;
         let (s, mut w) = st.parts();
-        self.learning.learn(&mut w, s, sig, dtau, &mut norms);
+        self.learning
+            .learn(self.simd, &mut w, s, sig, dtau, &mut norms);
         st.norms = norms;
     }
 }
@@ -674,8 +701,9 @@ mod tests {
             &m.dx.unwrap(),
         );
         let old = crate::network::Weights::<2>::from_rows(&before, 256).unwrap();
-        let delta =
-            st.weights().output(&s, &e.dalpha1, &e.alpha1) - old.output(&s, &e.dalpha1, &e.alpha1);
+        let out =
+            |w: &crate::network::Weights<'_, 2>| w.output(c.simd(), &s, &e.dalpha1, &e.alpha1);
+        let delta = out(&st.weights()) - out(&old);
         delta.component_div(&cmd.z2)
     }
 

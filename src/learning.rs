@@ -13,6 +13,7 @@
 use crate::error::{check, Error, BOUND};
 use crate::math::sqrt;
 use crate::network::{Rates, WeightsMut, C, D, G};
+use crate::simd::SimdPath;
 use crate::types::{choices, Vector};
 
 /// How the weights take one learning step (beyond the paper, SPEC §13).
@@ -177,13 +178,14 @@ impl Learning {
     }
 
     /// This step's rates: the normalised step scales the gains by
-    /// `1/(1 + g/(κ min Kp))` (see [`LearningStep::Normalized`]).
-    pub fn step_rates<const N: usize>(&self, s: &[f64], sig: &Signals<N>) -> Rates {
+    /// `1/(1 + g/(κ min Kp))` (see [`LearningStep::Normalized`]); ‖S‖² is
+    /// summed on the instruction set `path`.
+    pub fn step_rates<const N: usize>(&self, path: SimdPath, s: &[f64], sig: &Signals<N>) -> Rates {
         match self.step {
             LearningStep::Euler => self.rates,
             LearningStep::Normalized => {
                 let g = self.rates.gain;
-                let s2 = crate::network::dot(s, s);
+                let s2 = crate::network::dot_on(path, s, s);
                 let gain = s2
                     * (g[D] * sig.dalpha1.norm_squared() + g[C] * sig.alpha1.norm_squared() + g[G]);
                 self.rates.scaled(1.0 / (1.0 + gain / self.gain_cap))
@@ -194,29 +196,34 @@ impl Learning {
     /// Stage "networks": the output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current
     /// weights; for a policy that is not [`deferred`](Self::deferred), the
     /// update (15)–(17) in the same pass (it uses only this step's values,
-    /// SPEC §11, step 5). `norms` (‖Ŵ‖_F) is kept up to date.
+    /// SPEC §11, step 5). `norms` (‖Ŵ‖_F) is kept up to date. The passes
+    /// run on the instruction set `path` (the controller's,
+    /// [`Controller::simd`](crate::Controller::simd)).
     #[inline]
     pub fn output<const N: usize>(
         &self,
+        path: SimdPath,
         w: &mut WeightsMut<'_, N>,
         s: &[f64],
         sig: &Signals<N>,
         norms: &mut [f64; 3],
     ) -> Vector<N> {
         if self.deferred() {
-            w.as_ref().output(s, &sig.dalpha1, &sig.alpha1)
+            w.as_ref().output(path, s, &sig.dalpha1, &sig.alpha1)
         } else {
-            let rates = self.step_rates(s, sig);
-            w.fused_step(s, &sig.dalpha1, &sig.alpha1, &sig.z2, &rates, norms)
+            let rates = self.step_rates(path, s, sig);
+            w.fused_step(path, s, &sig.dalpha1, &sig.alpha1, &sig.z2, &rates, norms)
         }
     }
 
     /// Stage "learning", after saturation (Δτ = sat(τ) − τ, N m): for a
     /// [`deferred`](Self::deferred) policy, the update with the freeze under
     /// saturation and the projection onto the weight bounds. No-op otherwise.
+    /// The pass runs on the instruction set `path`.
     #[inline]
     pub fn learn<const N: usize>(
         &self,
+        path: SimdPath,
         w: &mut WeightsMut<'_, N>,
         s: &[f64],
         sig: &Signals<N>,
@@ -226,9 +233,9 @@ impl Learning {
         if !self.deferred() {
             return;
         }
-        let rates = self.step_rates(s, sig);
+        let rates = self.step_rates(path, s, sig);
         let z2 = self.learning_error(&sig.z2, dtau);
-        let mut new = w.update(s, &sig.dalpha1, &sig.alpha1, &z2, &rates);
+        let mut new = w.update(path, s, &sig.dalpha1, &sig.alpha1, &z2, &rates);
         if let Some(bound) = self.bound {
             project(w, &mut new, &bound);
         }

@@ -29,6 +29,7 @@
 //! | [`rbf`] | Gaussian RBF bases S(Z): the grid and user centres | (1), §6 |
 //! | [`network`] | weights ŴD, ŴC, ŴG: storage, output, update | (15)–(17), §6 |
 //! | [`learning`] | learning policies (Euler, normalised, freeze, projection) | §11, §13 |
+//! | [`simd`] | the weight pass's instruction set, chosen at run time | |
 //! | [`robust`] | robust term r(z2) | §7 |
 //! | [`auxiliary`] | saturation compensator ζ | (11), (36), §8 |
 //! | [`safety`] | fallback command, fault policy, plausibility and rate limits | beyond the paper |
@@ -78,7 +79,9 @@
 //! allocator: a state lives in a buffer of the caller's
 //! ([`Controller::state_in`]). The feature `alloc` adds heap states
 //! ([`Controller::new_state`]), [`Tracker`] and [`Trace`]; `std` (the
-//! default) adds the platform's libm and `std::error::Error`.
+//! default) adds the platform's libm, `std::error::Error` and the run-time
+//! check of the operating system's AVX support: without it the weight pass
+//! takes AVX2/FMA only in a build for them ([`SimdPath`]).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -109,6 +112,7 @@ pub mod robust;
 pub mod safety;
 pub mod saturation;
 pub mod schema;
+pub mod simd;
 pub mod simulator;
 pub mod state;
 #[cfg(feature = "alloc")]
@@ -140,6 +144,7 @@ pub use robust::{Robust, RobustKind};
 pub use safety::{Fallback, Fault, FaultPolicy, Limits};
 pub use saturation::Saturation;
 pub use schema::{Preset, Scenario};
+pub use simd::SimdPath;
 pub use simulator::{run, simulate, simulate_with, SimConfig};
 #[cfg(feature = "alloc")]
 pub use state::HeapState;

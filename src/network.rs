@@ -28,8 +28,9 @@
 
 use crate::error::{check, Error};
 use crate::math::sqrt;
+use crate::simd::SimdPath;
 use crate::types::Vector;
-use wide::f64x4;
+use pulp::{Simd, WithSimd};
 
 /// Index of the D̂ network in `[f64; 3]` parameter arrays.
 pub const D: usize = 0;
@@ -188,30 +189,62 @@ pub fn weight_bounds<const N: usize>(
     [scale / or_one(accel), scale / or_one(speed), scale]
 }
 
+/// The vectors of `w` and `s` (equal lengths) in groups of `2 · G` reals
+/// (`G = S::F64_LANES`, 4 on both paths), and the rest, which the kernels sum
+/// and update real by real, on every path alike.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn groups_mut<'w, 's, S: Simd>(
+    w: &'w mut [f64],
+    s: &'s [f64],
+) -> (
+    (&'w mut [[S::f64s; 2]], &'s [[S::f64s; 2]]),
+    (&'w mut [f64], &'s [f64]),
+) {
+    let n = w.len().min(s.len());
+    let n = n - n % (2 * S::F64_LANES);
+    let (wh, wr) = w.split_at_mut(n);
+    let (sh, sr) = s.split_at(n);
+    let (wv, _) = pulp::as_arrays_mut::<2, _>(S::as_mut_simd_f64s(wh).0);
+    let (sv, _) = pulp::as_arrays::<2, _>(S::as_simd_f64s(sh).0);
+    ((wv, sv), (wr, sr))
+}
+
 /// One row: returns `Ŵ·S` of the old row, and writes `Ŵ ← a Ŵ + b S`.
 ///
-/// Explicit 4-wide vectors (`wide::f64x4`: 256-bit AVX when built for it, two
-/// SSE2 registers otherwise) rather than arrays left to the autovectoriser,
-/// which vectorised the ten inlined copies of this loop unevenly (some at
-/// half width). The rows are viewed as arrays of 8 (`as_chunks`), so every
-/// load and store has a length known at compile time whatever the number of
-/// nodes. Products and sums stay separate (Rust never fuses a·b + c), so the
-/// results are the same on every target.
+/// Explicit vectors of pulp's [`Simd`] (4 lanes on both paths, see
+/// [`crate::simd`]) rather than arrays left to the autovectoriser, which
+/// vectorised the ten inlined copies of this loop unevenly (some at half
+/// width). Each group of two vectors feeds two independent accumulators.
+/// Products and sums stay separate (never fused into an FMA), so the results
+/// are the same on every path and target.
+///
+/// The loops over the vectors take two steps (`unit`) per iteration: what
+/// `-C target-cpu=x86-64-v3` made of them. The function pulp compiles for
+/// AVX2 keeps the generic tuning, which does not unroll, so it is spelt out
+/// (callgrind: 5% fewer instructions per pass). The steps, and so every sum,
+/// keep their order.
 #[inline(always)]
-fn dot_update(w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
-    let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
-    // Two independent 4-wide accumulators hide the latency of the additions.
-    let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
-    let (wc, wr) = w.as_chunks_mut::<8>();
-    let (sc, sr) = s.as_chunks::<8>();
-    for (wv, sv) in wc.iter_mut().zip(sc) {
-        let [w0, w1] = halves(wv);
-        let [s0, s1] = halves(sv);
-        d0 += w0 * s0;
-        d1 += w1 * s1;
-        *wv = join(av * w0 + bv * s0, av * w1 + bv * s1);
+fn dot_update<S: Simd>(simd: S, w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
+    let (av, bv) = (simd.splat_f64s(a), simd.splat_f64s(b));
+    // Two independent accumulators hide the latency of the additions.
+    let mut d = [simd.splat_f64s(0.0); 2];
+    let mut unit = |w: &mut [S::f64s; 2], s: &[S::f64s; 2]| {
+        for i in 0..2 {
+            d[i] = simd.add_f64s(d[i], simd.mul_f64s(w[i], s[i]));
+            w[i] = simd.add_f64s(simd.mul_f64s(av, w[i]), simd.mul_f64s(bv, s[i]));
+        }
+    };
+    let ((wv, sv), (wr, sr)) = groups_mut::<S>(w, s);
+    let ((w2, w1), (s2, s1)) = (pulp::as_arrays_mut::<2, _>(wv), pulp::as_arrays::<2, _>(sv));
+    for ([x0, x1], [y0, y1]) in w2.iter_mut().zip(s2) {
+        unit(x0, y0);
+        unit(x1, y1);
     }
-    let mut dot = (d0 + d1).reduce_add();
+    for (x, y) in w1.iter_mut().zip(s1) {
+        unit(x, y);
+    }
+    let mut dot = simd.reduce_sum_f64s(simd.add_f64s(d[0], d[1]));
     for (wv, &sv) in wr.iter_mut().zip(sr) {
         dot += *wv * sv;
         *wv = a * *wv + b * sv;
@@ -219,10 +252,12 @@ fn dot_update(w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
     dot
 }
 
-/// Two rows sharing the basis, each chunk of S loaded once for both: returns
-/// `Ŵ0·S`, `Ŵ1·S` of the old rows and writes `Ŵr ← ar Ŵr + br S`.
+/// Two rows sharing the basis, each vector of S loaded once for both: returns
+/// `Ŵ0·S`, `Ŵ1·S` of the old rows and writes `Ŵr ← ar Ŵr + br S`. One
+/// accumulator per row.
 #[inline(always)]
-fn dot_update_pair(
+fn dot_update_pair<S: Simd>(
+    simd: S,
     w0: &mut [f64],
     w1: &mut [f64],
     s: &[f64],
@@ -230,23 +265,34 @@ fn dot_update_pair(
     (a1, b1): (f64, f64),
 ) -> (f64, f64) {
     let (a0v, b0v, a1v, b1v) = (
-        f64x4::splat(a0),
-        f64x4::splat(b0),
-        f64x4::splat(a1),
-        f64x4::splat(b1),
+        simd.splat_f64s(a0),
+        simd.splat_f64s(b0),
+        simd.splat_f64s(a1),
+        simd.splat_f64s(b1),
     );
-    let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
-    let (c0, r0) = w0.as_chunks_mut::<4>();
-    let (c1, r1) = w1.as_chunks_mut::<4>();
-    let (cs, rs) = s.as_chunks::<4>();
-    for ((v0, v1), sv) in c0.iter_mut().zip(c1.iter_mut()).zip(cs) {
-        let (x0, x1, sx) = (f64x4::from(*v0), f64x4::from(*v1), f64x4::from(*sv));
-        d0 += x0 * sx;
-        d1 += x1 * sx;
-        *v0 = (a0v * x0 + b0v * sx).to_array();
-        *v1 = (a1v * x1 + b1v * sx).to_array();
+    let (mut d0, mut d1) = (simd.splat_f64s(0.0), simd.splat_f64s(0.0));
+    let (c0, r0) = S::as_mut_simd_f64s(w0);
+    let (c1, r1) = S::as_mut_simd_f64s(w1);
+    let (cs, rs) = S::as_simd_f64s(s);
+    let mut unit = |v0: &mut S::f64s, v1: &mut S::f64s, sx: S::f64s| {
+        let (x0, x1) = (*v0, *v1);
+        d0 = simd.add_f64s(d0, simd.mul_f64s(x0, sx));
+        d1 = simd.add_f64s(d1, simd.mul_f64s(x1, sx));
+        *v0 = simd.add_f64s(simd.mul_f64s(a0v, x0), simd.mul_f64s(b0v, sx));
+        *v1 = simd.add_f64s(simd.mul_f64s(a1v, x1), simd.mul_f64s(b1v, sx));
+    };
+    // Two steps per iteration, as in `dot_update`.
+    let (p0, o0) = pulp::as_arrays_mut::<2, _>(c0);
+    let (p1, o1) = pulp::as_arrays_mut::<2, _>(c1);
+    let (ps, os) = pulp::as_arrays::<2, _>(cs);
+    for ((x0, x1), sx) in p0.iter_mut().zip(p1.iter_mut()).zip(ps) {
+        unit(&mut x0[0], &mut x1[0], sx[0]);
+        unit(&mut x0[1], &mut x1[1], sx[1]);
     }
-    let (mut e0, mut e1) = (d0.reduce_add(), d1.reduce_add());
+    for ((v0, v1), &sx) in o0.iter_mut().zip(o1.iter_mut()).zip(os) {
+        unit(v0, v1, sx);
+    }
+    let (mut e0, mut e1) = (simd.reduce_sum_f64s(d0), simd.reduce_sum_f64s(d1));
     for ((v0, v1), &sx) in r0.iter_mut().zip(r1.iter_mut()).zip(rs) {
         e0 += *v0 * sx;
         e1 += *v1 * sx;
@@ -256,43 +302,80 @@ fn dot_update_pair(
     (e0, e1)
 }
 
-/// The two 4-lane halves of eight reals.
-#[inline(always)]
-fn halves(v: &[f64; 8]) -> [f64x4; 2] {
-    [
-        f64x4::from([v[0], v[1], v[2], v[3]]),
-        f64x4::from([v[4], v[5], v[6], v[7]]),
-    ]
-}
-
-/// Eight reals from two 4-lane halves.
-#[inline(always)]
-fn join(lo: f64x4, hi: f64x4) -> [f64; 8] {
-    let (l, h) = (lo.to_array(), hi.to_array());
-    [l[0], l[1], l[2], l[3], h[0], h[1], h[2], h[3]]
-}
-
 /// One row: `Ŵ ← a Ŵ + b S`; returns `‖Ŵ‖²` of the new row.
 #[inline(always)]
-fn update_row(w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
-    let (av, bv) = (f64x4::splat(a), f64x4::splat(b));
-    let (mut q0, mut q1) = (f64x4::ZERO, f64x4::ZERO);
-    let (wc, wr) = w.as_chunks_mut::<8>();
-    let (sc, sr) = s.as_chunks::<8>();
-    for (wv, sv) in wc.iter_mut().zip(sc) {
-        let [w0, w1] = halves(wv);
-        let [s0, s1] = halves(sv);
-        let (n0, n1) = (av * w0 + bv * s0, av * w1 + bv * s1);
-        q0 += n0 * n0;
-        q1 += n1 * n1;
-        *wv = join(n0, n1);
+fn update_row<S: Simd>(simd: S, w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
+    let (av, bv) = (simd.splat_f64s(a), simd.splat_f64s(b));
+    let mut q = [simd.splat_f64s(0.0); 2];
+    let mut unit = |w: &mut [S::f64s; 2], s: &[S::f64s; 2]| {
+        for i in 0..2 {
+            let n = simd.add_f64s(simd.mul_f64s(av, w[i]), simd.mul_f64s(bv, s[i]));
+            q[i] = simd.add_f64s(q[i], simd.mul_f64s(n, n));
+            w[i] = n;
+        }
+    };
+    // Two steps per iteration, as in `dot_update`.
+    let ((wv, sv), (wr, sr)) = groups_mut::<S>(w, s);
+    let ((w2, w1), (s2, s1)) = (pulp::as_arrays_mut::<2, _>(wv), pulp::as_arrays::<2, _>(sv));
+    for ([x0, x1], [y0, y1]) in w2.iter_mut().zip(s2) {
+        unit(x0, y0);
+        unit(x1, y1);
     }
-    let mut sq = (q0 + q1).reduce_add();
+    for (x, y) in w1.iter_mut().zip(s1) {
+        unit(x, y);
+    }
+    let mut sq = simd.reduce_sum_f64s(simd.add_f64s(q[0], q[1]));
     for (wv, &sv) in wr.iter_mut().zip(sr) {
         *wv = a * *wv + b * sv;
         sq += *wv * *wv;
     }
     sq
+}
+
+/// `a · b` over the shorter length, on vectors with two accumulators (a
+/// scalar sum is a chain of dependent additions, four times slower).
+#[inline(always)]
+pub(crate) fn dot<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let n = n - n % (2 * S::F64_LANES);
+    let (ah, ar) = a.split_at(n);
+    let (bh, br) = b.split_at(n);
+    let (av, _) = pulp::as_arrays::<2, _>(S::as_simd_f64s(ah).0);
+    let (bv, _) = pulp::as_arrays::<2, _>(S::as_simd_f64s(bh).0);
+    let mut d = [simd.splat_f64s(0.0); 2];
+    let mut unit = |x: &[S::f64s; 2], y: &[S::f64s; 2]| {
+        for i in 0..2 {
+            d[i] = simd.add_f64s(d[i], simd.mul_f64s(x[i], y[i]));
+        }
+    };
+    // Two steps per iteration, as in `dot_update`.
+    let (a2, a1) = pulp::as_arrays::<2, _>(av);
+    let (b2, b1) = pulp::as_arrays::<2, _>(bv);
+    for ([x0, x1], [y0, y1]) in a2.iter().zip(b2) {
+        unit(x0, y0);
+        unit(x1, y1);
+    }
+    for (x, y) in a1.iter().zip(b1) {
+        unit(x, y);
+    }
+    let mut sum = simd.reduce_sum_f64s(simd.add_f64s(d[0], d[1]));
+    for (x, y) in ar.iter().zip(br) {
+        sum += x * y;
+    }
+    sum
+}
+
+/// `a · b` on `path` (see [`dot`]).
+pub(crate) fn dot_on(path: SimdPath, a: &[f64], b: &[f64]) -> f64 {
+    struct Dot<'a>(&'a [f64], &'a [f64]);
+    impl WithSimd for Dot<'_> {
+        type Output = f64;
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, simd: S) -> f64 {
+            dot(simd, self.0, self.1)
+        }
+    }
+    path.run(Dot(a, b))
 }
 
 /// The weights of the three networks, read-only: a view of a state's buffer
@@ -385,39 +468,57 @@ impl<'a, const N: usize> Weights<'a, N> {
         Ok(())
     }
 
-    /// Frobenius norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F.
+    /// Frobenius norms ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F, recomputed from the weights
+    /// on the portable path (off the step: a controller tracks the norms from
+    /// its passes, [`WeightsMut::fused_step`]; both paths give the same sums).
     pub fn norms(&self) -> [f64; 3] {
-        [D, C, G].map(|net| sqrt(self.network(net).map(|r| dot(r, r)).sum()))
+        let simd = pulp::Scalar256b;
+        [D, C, G].map(|net| sqrt(self.network(net).map(|r| dot(simd, r, r)).sum()))
     }
 
-    /// Network output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) for basis `s`, without learning.
-    pub fn output(&self, s: &[f64], dalpha1: &Vector<N>, alpha1: &Vector<N>) -> Vector<N> {
-        Vector::from_fn(|k, _| {
-            let mut out = dot(self.g(k), s);
-            for j in 0..N {
-                out += dot(self.d(k, j), s) * dalpha1[j] + dot(self.c(k, j), s) * alpha1[j];
+    /// Network output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) for basis `s`, without
+    /// learning, on the instruction set `path` (a controller passes its own,
+    /// [`Controller::simd`](crate::Controller::simd)).
+    pub fn output(
+        &self,
+        path: SimdPath,
+        s: &[f64],
+        dalpha1: &Vector<N>,
+        alpha1: &Vector<N>,
+    ) -> Vector<N> {
+        struct Output<'w, 'v, const N: usize> {
+            w: &'v Weights<'w, N>,
+            s: &'v [f64],
+            dalpha1: &'v Vector<N>,
+            alpha1: &'v Vector<N>,
+        }
+        impl<const N: usize> WithSimd for Output<'_, '_, N> {
+            type Output = Vector<N>;
+            #[inline(always)]
+            fn with_simd<S: Simd>(self, simd: S) -> Vector<N> {
+                let Self {
+                    w,
+                    s,
+                    dalpha1,
+                    alpha1,
+                } = self;
+                Vector::from_fn(|k, _| {
+                    let mut out = dot(simd, w.g(k), s);
+                    for j in 0..N {
+                        out += dot(simd, w.d(k, j), s) * dalpha1[j]
+                            + dot(simd, w.c(k, j), s) * alpha1[j];
+                    }
+                    out
+                })
             }
-            out
+        }
+        path.run(Output {
+            w: self,
+            s,
+            dalpha1,
+            alpha1,
         })
     }
-}
-
-/// `a · b` over the shorter length, on 4-wide vectors with two accumulators
-/// (a scalar sum is a chain of dependent additions, four times slower).
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let (mut d0, mut d1) = (f64x4::ZERO, f64x4::ZERO);
-    let (ac, ar) = a.as_chunks::<8>();
-    let (bc, br) = b.as_chunks::<8>();
-    for (av, bv) in ac.iter().zip(bc) {
-        let ([a0, a1], [b0, b1]) = (halves(av), halves(bv));
-        d0 += a0 * b0;
-        d1 += a1 * b1;
-    }
-    let mut sum = (d0 + d1).reduce_add();
-    for (x, y) in ar.iter().zip(br) {
-        sum += x * y;
-    }
-    sum
 }
 
 impl<'a, const N: usize> WeightsMut<'a, N> {
@@ -475,18 +576,71 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
         }
     }
 
-    /// One step of the networks in a single pass over the weights: returns the
-    /// output `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current weights, then applies
-    /// the explicit-Euler update of (15)–(17) with error signal `z2` (rad/s;
-    /// ẑ2 for output feedback, (37)–(39)) at `rates`.
+    /// One step of the networks in a single pass over the weights, on the
+    /// instruction set `path` (a controller passes its own,
+    /// [`Controller::simd`](crate::Controller::simd)): returns the output
+    /// `D̂ α̇1 + Ĉ α1 + Ĝ` (N m) with the current weights, then applies the
+    /// explicit-Euler update of (15)–(17) with error signal `z2` (rad/s; ẑ2
+    /// for output feedback, (37)–(39)) at `rates`.
     ///
     /// `norms` holds the Frobenius norms ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ of the weights
     /// before the step and is brought up to date without a second pass: for
     /// every row, ‖a Ŵ + b S‖² = a² ‖Ŵ‖² + 2ab (Ŵ·S) + b² ‖S‖², and Ŵ·S is the
     /// dot product the output needs anyway.
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn fused_step(
         &mut self,
+        path: SimdPath,
+        s: &[f64],
+        dalpha1: &Vector<N>,
+        alpha1: &Vector<N>,
+        z2: &Vector<N>,
+        rates: &Rates,
+        norms: &mut [f64; 3],
+    ) -> Vector<N> {
+        struct Fused<'w, 'v, const N: usize> {
+            w: &'v mut WeightsMut<'w, N>,
+            s: &'v [f64],
+            dalpha1: &'v Vector<N>,
+            alpha1: &'v Vector<N>,
+            z2: &'v Vector<N>,
+            rates: &'v Rates,
+            norms: &'v mut [f64; 3],
+        }
+        impl<const N: usize> WithSimd for Fused<'_, '_, N> {
+            type Output = Vector<N>;
+            #[inline(always)]
+            fn with_simd<S: Simd>(self, simd: S) -> Vector<N> {
+                let Self {
+                    w,
+                    s,
+                    dalpha1,
+                    alpha1,
+                    z2,
+                    rates,
+                    norms,
+                } = self;
+                w.fused_step_on(simd, s, dalpha1, alpha1, z2, rates, norms)
+            }
+        }
+        path.run(Fused {
+            w: self,
+            s,
+            dalpha1,
+            alpha1,
+            z2,
+            rates,
+            norms,
+        })
+    }
+
+    /// [`fused_step`](Self::fused_step) on the vectors of `simd`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn fused_step_on<S: Simd>(
+        &mut self,
+        simd: S,
         s: &[f64],
         dalpha1: &Vector<N>,
         alpha1: &Vector<N>,
@@ -510,6 +664,7 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
                 // ŴD[k][j] and ŴC[k][j] share one pass over S.
                 let (bd, bc) = (gain[D] * dalpha1[j] * gz, gain[C] * alpha1[j] * gz);
                 let (dd, dc) = dot_update_pair(
+                    simd,
                     &mut d[r..r + l],
                     &mut c[r..r + l],
                     s,
@@ -523,12 +678,12 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
                 bb[C] += bc * bc;
             }
             let b = gain[G] * gz;
-            let dot = dot_update(&mut g[k * stride..k * stride + l], s, a[G], b);
+            let dot = dot_update(simd, &mut g[k * stride..k * stride + l], s, a[G], b);
             out[k] += dot;
             cross[G] += b * dot;
             bb[G] += b * b;
         }
-        let s2 = dot(s, s);
+        let s2 = dot(simd, s, s);
         for net in 0..3 {
             let n2 = a[net] * a[net] * norms[net] * norms[net]
                 + 2.0 * a[net] * cross[net]
@@ -540,29 +695,62 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
     }
 
     /// The explicit-Euler update of (15)–(17) alone (after
-    /// [`Weights::output`] has used the old weights). Rows of joint k learn
-    /// from `z2[k]`; pass 0 there to freeze joint k's learning (its weights
-    /// then only leak). Returns the Frobenius norms of the new weights.
+    /// [`Weights::output`] has used the old weights), on the instruction set
+    /// `path`. Rows of joint k learn from `z2[k]`; pass 0 there to freeze
+    /// joint k's learning (its weights then only leak). Returns the Frobenius
+    /// norms of the new weights.
     pub fn update(
         &mut self,
+        path: SimdPath,
         s: &[f64],
         dalpha1: &Vector<N>,
         alpha1: &Vector<N>,
         z2: &Vector<N>,
         rates: &Rates,
     ) -> [f64; 3] {
-        let s = &s[..self.nodes];
-        let mut sq = [0.0; 3];
-        let (a, gain) = (rates.decay, rates.gain);
-        for k in 0..N {
-            let gz = z2[k];
-            for j in 0..N {
-                sq[D] += update_row(self.d_mut(k, j), s, a[D], gain[D] * dalpha1[j] * gz);
-                sq[C] += update_row(self.c_mut(k, j), s, a[C], gain[C] * alpha1[j] * gz);
-            }
-            sq[G] += update_row(self.g_mut(k), s, a[G], gain[G] * gz);
+        struct Update<'w, 'v, const N: usize> {
+            w: &'v mut WeightsMut<'w, N>,
+            s: &'v [f64],
+            dalpha1: &'v Vector<N>,
+            alpha1: &'v Vector<N>,
+            z2: &'v Vector<N>,
+            rates: &'v Rates,
         }
-        sq.map(sqrt)
+        impl<const N: usize> WithSimd for Update<'_, '_, N> {
+            type Output = [f64; 3];
+            #[inline(always)]
+            fn with_simd<S: Simd>(self, simd: S) -> [f64; 3] {
+                let Self {
+                    w,
+                    s,
+                    dalpha1,
+                    alpha1,
+                    z2,
+                    rates,
+                } = self;
+                let s = &s[..w.nodes];
+                let mut sq = [0.0; 3];
+                let (a, gain) = (rates.decay, rates.gain);
+                for k in 0..N {
+                    let gz = z2[k];
+                    for j in 0..N {
+                        let (bd, bc) = (gain[D] * dalpha1[j] * gz, gain[C] * alpha1[j] * gz);
+                        sq[D] += update_row(simd, w.d_mut(k, j), s, a[D], bd);
+                        sq[C] += update_row(simd, w.c_mut(k, j), s, a[C], bc);
+                    }
+                    sq[G] += update_row(simd, w.g_mut(k), s, a[G], gain[G] * gz);
+                }
+                sq.map(sqrt)
+            }
+        }
+        path.run(Update {
+            w: self,
+            s,
+            dalpha1,
+            alpha1,
+            z2,
+            rates,
+        })
     }
 }
 
@@ -617,7 +805,7 @@ mod tests {
         let ts = 1e-3;
         let (gamma, sigma) = ([100.0; 3], [0.01; 3]);
         let rates = Rates::new(ts, gamma, sigma).unwrap();
-        let expect_out = w.as_ref().output(&s, &da, &a);
+        let expect_out = w.as_ref().output(SimdPath::portable(), &s, &da, &a);
         let expect_norms = w.as_ref().norms();
         // The SPEC's form: Ŵ ← Ŵ + Ts Γ (S u z2 − σ Ŵ).
         let old: Vec<Vec<f64>> = (0..3).map(|i| w.as_ref().row(i).to_vec()).collect();
@@ -625,9 +813,9 @@ mod tests {
         let mut copy: Vec<f64> = (0..3).flat_map(|i| w.as_ref().row(i).to_vec()).collect();
         let mut w2 = WeightsMut::<1>::new(&mut copy, L, L);
         let mut norms = expect_norms;
-        let out = w.fused_step(&s, &da, &a, &z2, &rates, &mut norms);
+        let out = w.fused_step(SimdPath::fastest(), &s, &da, &a, &z2, &rates, &mut norms);
         // The separate update does the same.
-        let new_norms = w2.update(&s, &da, &a, &z2, &rates);
+        let new_norms = w2.update(SimdPath::fastest(), &s, &da, &a, &z2, &rates);
         for i in 0..3 {
             assert_eq!(w2.as_ref().row(i), w.as_ref().row(i));
             for n in 0..L {

@@ -1,6 +1,6 @@
 //! Which instruction set the weight pass runs on, chosen at run time.
 //!
-//! The pass over the (2N² + N)·L weights ([`crate::network`]) is written once,
+//! The pass over the (2N² + N)·L weights (the `network` module) is written once,
 //! generic over [`pulp::Simd`] on 4-lane f64 vectors, and compiled twice:
 //!
 //! - **avx2-fma**: pulp's `x86::V3` (x86-64-v3: AVX2, FMA, every x86-64 CPU

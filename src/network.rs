@@ -210,6 +210,26 @@ fn groups_mut<'w, 's, S: Simd>(
     ((wv, sv), (wr, sr))
 }
 
+/// `unit` on each group of two vectors of `w` and `s`, in order, two groups
+/// per loop iteration (see [`dot_update`]); returns the scalar tails.
+#[inline(always)]
+fn for_groups<'w, 's, S: Simd>(
+    w: &'w mut [f64],
+    s: &'s [f64],
+    mut unit: impl FnMut(&mut [S::f64s; 2], &[S::f64s; 2]),
+) -> (&'w mut [f64], &'s [f64]) {
+    let ((wv, sv), tails) = groups_mut::<S>(w, s);
+    let ((w2, w1), (s2, s1)) = (pulp::as_arrays_mut::<2, _>(wv), pulp::as_arrays::<2, _>(sv));
+    for ([x0, x1], [y0, y1]) in w2.iter_mut().zip(s2) {
+        unit(x0, y0);
+        unit(x1, y1);
+    }
+    for (x, y) in w1.iter_mut().zip(s1) {
+        unit(x, y);
+    }
+    tails
+}
+
 /// One row: returns `Ŵ·S` of the old row, and writes `Ŵ ← a Ŵ + b S`.
 ///
 /// Explicit vectors of pulp's [`Simd`] (4 lanes on both paths, see
@@ -229,21 +249,13 @@ fn dot_update<S: Simd>(simd: S, w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64
     let (av, bv) = (simd.splat_f64s(a), simd.splat_f64s(b));
     // Two independent accumulators hide the latency of the additions.
     let mut d = [simd.splat_f64s(0.0); 2];
-    let mut unit = |w: &mut [S::f64s; 2], s: &[S::f64s; 2]| {
+    let unit = |w: &mut [S::f64s; 2], s: &[S::f64s; 2]| {
         for i in 0..2 {
             d[i] = simd.add_f64s(d[i], simd.mul_f64s(w[i], s[i]));
             w[i] = simd.add_f64s(simd.mul_f64s(av, w[i]), simd.mul_f64s(bv, s[i]));
         }
     };
-    let ((wv, sv), (wr, sr)) = groups_mut::<S>(w, s);
-    let ((w2, w1), (s2, s1)) = (pulp::as_arrays_mut::<2, _>(wv), pulp::as_arrays::<2, _>(sv));
-    for ([x0, x1], [y0, y1]) in w2.iter_mut().zip(s2) {
-        unit(x0, y0);
-        unit(x1, y1);
-    }
-    for (x, y) in w1.iter_mut().zip(s1) {
-        unit(x, y);
-    }
+    let (wr, sr) = for_groups::<S>(w, s, unit);
     let mut dot = simd.reduce_sum_f64s(simd.add_f64s(d[0], d[1]));
     for (wv, &sv) in wr.iter_mut().zip(sr) {
         dot += *wv * sv;
@@ -307,23 +319,14 @@ fn dot_update_pair<S: Simd>(
 fn update_row<S: Simd>(simd: S, w: &mut [f64], s: &[f64], a: f64, b: f64) -> f64 {
     let (av, bv) = (simd.splat_f64s(a), simd.splat_f64s(b));
     let mut q = [simd.splat_f64s(0.0); 2];
-    let mut unit = |w: &mut [S::f64s; 2], s: &[S::f64s; 2]| {
+    let unit = |w: &mut [S::f64s; 2], s: &[S::f64s; 2]| {
         for i in 0..2 {
             let n = simd.add_f64s(simd.mul_f64s(av, w[i]), simd.mul_f64s(bv, s[i]));
             q[i] = simd.add_f64s(q[i], simd.mul_f64s(n, n));
             w[i] = n;
         }
     };
-    // Two steps per iteration, as in `dot_update`.
-    let ((wv, sv), (wr, sr)) = groups_mut::<S>(w, s);
-    let ((w2, w1), (s2, s1)) = (pulp::as_arrays_mut::<2, _>(wv), pulp::as_arrays::<2, _>(sv));
-    for ([x0, x1], [y0, y1]) in w2.iter_mut().zip(s2) {
-        unit(x0, y0);
-        unit(x1, y1);
-    }
-    for (x, y) in w1.iter_mut().zip(s1) {
-        unit(x, y);
-    }
+    let (wr, sr) = for_groups::<S>(w, s, unit);
     let mut sq = simd.reduce_sum_f64s(simd.add_f64s(q[0], q[1]));
     for (wv, &sv) in wr.iter_mut().zip(sr) {
         *wv = a * *wv + b * sv;

@@ -136,7 +136,7 @@ def test_arm_matches_the_spec_formulas() -> None:
 
 
 def test_controller_keeps_its_clock_and_resets() -> None:
-    ctrl = adaptimp.Controller("sf", Ts=1e-3)
+    ctrl = adaptimp.Controller("sf", Ts=1e-3, learning_step="normalized")
     assert (ctrl.t, ctrl.steps, ctrl.Ts, ctrl.case) == (0.0, 0, 1e-3, "sf")
     for _ in range(3):
         tau = ctrl.step([0.25, -0.05], [5.0, 0.0], dq=[0.0, 0.0])

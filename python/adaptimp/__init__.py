@@ -6,11 +6,15 @@ Control of a Robotic Manipulator With Input Saturation", IEEE Trans. SMC: System
 Units: rad, rad/s, rad/s², N m, s. The equations, errata and decisions are in
 the project's SPEC (docs/SPEC.md).
 
-- :func:`simulate` runs one of the paper's controllers ("pd", "sf", "of") on the
-  2-link arm against the wall and returns a :class:`SimResult` (arrays, SPEC §12
-  metrics, ``.plot(kind)``, ``.save(path)``).
-- :class:`Controller` is the controller alone, for your own loop.
-- :class:`TwoLinkArm` is the paper's arm: D(q), C(q, q̇), G(q), forward dynamics.
+- :func:`simulate` runs one of the paper's controllers ("pd", "sf", "of") on an
+  arm of 1–7 joints (the paper's 2-link arm by default) against the wall and
+  returns a :class:`SimResult` (arrays, SPEC §12 metrics, ``.plot(kind)``,
+  ``.save(path)``, ``.to_pandas()``).
+- :class:`Controller` is the controller alone, for your own loop; it pickles.
+- :class:`TwoLinkArm` is the paper's arm, :class:`PlanarArm` an arm of n links:
+  D(q), C(q, q̇), G(q), forward dynamics.
+- Errors by kind: :class:`ConfigError`, :class:`MeasurementError`,
+  :class:`DivergedError`, :class:`FaultError`; :class:`StabilityWarning`.
 
 Every SPEC quantity is a keyword parameter with the paper's default
 (:data:`PARAMS`, :data:`SCENARIOS`)::
@@ -23,20 +27,39 @@ Every SPEC quantity is a keyword parameter with the paper's default
 """
 
 from ._adaptimp import __version__
-from ._api import Controller, TwoLinkArm, simulate
-from ._params import CASES, PARAMS, SCENARIOS, Param
+from ._api import Controller, PlanarArm, TwoLinkArm, simulate
+from ._errors import (
+    AdaptimpError,
+    ConfigError,
+    DivergedError,
+    FaultError,
+    MeasurementError,
+    StabilityWarning,
+)
+from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
+from ._plot import compare as plot_compare
 from ._result import PLOT_KINDS, SimResult, metrics_table
 
 __all__ = [
     "CASES",
+    "MAX_JOINTS",
     "PARAMS",
     "PLOT_KINDS",
     "SCENARIOS",
+    "AdaptimpError",
+    "ConfigError",
     "Controller",
+    "DivergedError",
+    "FaultError",
+    "MeasurementError",
     "Param",
+    "PlanarArm",
     "SimResult",
+    "StabilityWarning",
     "TwoLinkArm",
     "__version__",
+    "defaults",
     "metrics_table",
+    "plot_compare",
     "simulate",
 ]

@@ -1,26 +1,209 @@
-"""The public entry points: :func:`simulate`, :class:`Controller`, :class:`TwoLinkArm`."""
+"""The public entry points: :func:`simulate`, :class:`Controller`, :class:`TwoLinkArm`,
+:class:`PlanarArm`."""
 
 from __future__ import annotations
 
-from typing import Any
+import math
+import sys
+import time
+import warnings
+from collections.abc import Callable, Mapping
+from typing import Any, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
-from ._params import check_case, describe, resolve
+from ._errors import ConfigError, StabilityWarning
+from ._params import (
+    BY_NAME,
+    N_JOINTS,
+    check_case,
+    check_n,
+    check_scenario,
+    describe,
+    names,
+    resolve,
+    with_hint,
+)
 from ._result import SimResult
 
 FloatArray = NDArray[np.float64]
+Progress = Union[bool, Callable[[int, int], object], None]
+
+STATE_FORMAT = "adaptimp.state/1"
+"""The ``format`` entry of :meth:`Controller.state_dict`."""
 
 
-def simulate(case: str = "sf", scenario: str = "paper", **params: Any) -> SimResult:
-    """Simulate one of the paper's controllers on the 2-link arm against the wall.
+# ---------------------------------------------------------------------------
+# Helpers shared by Controller and simulate.
+# ---------------------------------------------------------------------------
+
+
+def _basis(
+    n: int, centers: ArrayLike | None, widths: ArrayLike | None, params: Mapping[str, Any]
+) -> tuple[FloatArray | None, FloatArray | None]:
+    """User centres as a (L, 4n) float64 array and the squared widths (4n,), or
+    (None, None) for the vertex grid."""
+    if centers is None:
+        if widths is not None:
+            raise TypeError("widths needs centers (the vertex grid's width is eta2)")
+        if n > 3:
+            raise ConfigError(
+                f"n = {n} needs RBF centres: the paper's vertex grid has 2^(4n) nodes "
+                f"(2^{4 * n} here) and exists for n ≤ 3; pass centers= (an (L, {4 * n}) array "
+                "of x, v, α1, α̇1 coordinates) and widths="
+            )
+        return None, None
+    c = np.asarray(centers)
+    if c.dtype.kind not in "iuf":
+        raise TypeError(f"centers must be an array of real numbers, got dtype {c.dtype}")
+    c = np.ascontiguousarray(c, dtype=np.float64)
+    if c.ndim != 2 or c.shape[1] != 4 * n or c.shape[0] == 0:
+        raise ConfigError(
+            f"centers must have shape (L, {4 * n}) (L ≥ 1 rows of x, v, α1, α̇1 for "
+            f"{n} joints), got shape {c.shape}"
+        )
+    if not np.all(np.isfinite(c)):
+        raise ConfigError("centers must be finite")
+    w = np.sqrt(params["eta2"]) if widths is None else widths
+    wa = np.asarray(w, dtype=np.float64)
+    if wa.shape not in ((), (4 * n,)):
+        raise ConfigError(
+            f"widths must be a number or have shape ({4 * n},) (one per input dimension), "
+            f"got shape {wa.shape}"
+        )
+    wa = np.broadcast_to(wa, (4 * n,))
+    if not np.all(np.isfinite(wa)) or np.any(wa <= 0):
+        raise ConfigError("widths must be finite and > 0")
+    return c, np.ascontiguousarray(wa**2)
+
+
+def _core_controller(
+    case: str,
+    p: dict[str, Any],
+    n: int,
+    centers: FloatArray | None,
+    widths2: FloatArray | None,
+    cls: type[_adaptimp.Controller] = _adaptimp.Controller,
+) -> _adaptimp.Controller:
+    try:
+        # The compiled constructor, also for the Python subclass Controller.
+        return _adaptimp.Controller.__new__(cls, case, p, n, centers, widths2)
+    except ConfigError as e:
+        raise with_hint(e, p) from None
+
+
+def _check_stability(core: _adaptimp.Controller, p: Mapping[str, Any], stacklevel: int) -> None:
+    """:class:`StabilityWarning` when explicit-Euler learning is unstable at this Ts."""
+    if core.case == "pd" or p["learning_step"] != "euler":
+        return
+    gain, kp = core.learning_gain
+    if gain >= kp:
+        warnings.warn(
+            StabilityWarning(
+                f"explicit-Euler learning is unstable at Ts = {p['Ts']:g} s: its per-step "
+                f"gain Ts‖S‖²(ΓD‖ẍc‖² + ΓC‖ẋc‖² + ΓG) = {gain:.3g} N m s/rad exceeds "
+                f"Kp = {kp:g} (the Jury condition of docs/robot.md); use scenario='robot', "
+                "or learning_step='normalized', or a smaller Ts or gamma"
+            ),
+            stacklevel=stacklevel + 1,
+        )
+
+
+class _Progress:
+    """Progress of a long call: silent for its first ``delay`` seconds, then a tqdm
+    bar if tqdm is installed, else a line on stderr rewritten in place."""
+
+    def __init__(self, desc: str, delay: float = 2.0) -> None:
+        self.desc = desc
+        self.start = time.perf_counter()
+        self.delay = delay
+        self.bar: Any = None
+        self.shown = False
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.shown and time.perf_counter() - self.start < self.delay:
+            return
+        self.shown = True
+        if self.bar is None:
+            try:
+                from tqdm.auto import tqdm
+            except ImportError:
+                self.bar = False
+            else:
+                self.bar = tqdm(total=total, desc=self.desc, unit="step", unit_scale=True)
+        if self.bar:
+            self.bar.update(done - self.bar.n)
+        else:
+            print(f"\r{self.desc}: {100 * done / total:5.1f}% ({done}/{total} steps)", end="",
+                  file=sys.stderr, flush=True)
+
+    def close(self, total: int | None = None) -> None:
+        if self.bar:
+            if total is not None:
+                self.bar.update(total - self.bar.n)
+            self.bar.close()
+        elif self.shown:
+            print(file=sys.stderr)
+
+
+def _progress(progress: Progress, desc: str) -> tuple[Callable[[int, int], object] | None, Any]:
+    if progress is None or progress is False:
+        return None, None
+    if progress is True:
+        p = _Progress(desc)
+        return p, p
+    if callable(progress):
+        return progress, None
+    raise TypeError(f"progress must be a bool or a callable(done, total), got {progress!r}")
+
+
+def _record_every(k: object) -> int:
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+        raise TypeError(f"record_every must be an integer ≥ 1, got {type(k).__name__}")
+    if not 1 <= int(k) < 2**63:
+        raise ConfigError(f"record_every must be an integer ≥ 1, got {k}")
+    return int(k)
+
+
+def _table(name: str, value: ArrayLike, n: int) -> FloatArray:
+    """``value`` as a C-contiguous float64 array of shape (K, n), or an error naming ``name``."""
+    from ._errors import MeasurementError
+
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be an array of real numbers, got dtype {arr.dtype}")
+    if arr.ndim != 2 or arr.shape[1] != n:
+        raise MeasurementError(f"{name} must have shape (K, {n}), got shape {arr.shape}")
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
+# ---------------------------------------------------------------------------
+# simulate.
+# ---------------------------------------------------------------------------
+
+
+def simulate(
+    case: str = "sf",
+    scenario: str = "paper",
+    *,
+    n: int = N_JOINTS,
+    arm: TwoLinkArm | PlanarArm | None = None,
+    centers: ArrayLike | None = None,
+    widths: ArrayLike | None = None,
+    weights: Mapping[str, ArrayLike] | None = None,
+    record_every: int = 1,
+    progress: Progress = False,
+    **params: Any,
+) -> SimResult:
+    """Simulate one of the paper's controllers on an arm against the wall.
 
     The controller runs at the period ``Ts``; the plant is integrated by RK4 with
     the applied torque held for the period (``substeps`` RK4 steps), and the wall
     force recomputed at every stage (SPEC §11). The compiled core runs with the
-    GIL released.
+    GIL released, checks for Ctrl-C every 50 ms (``KeyboardInterrupt``) and can
+    report progress.
 
     Parameters
     ----------
@@ -30,14 +213,33 @@ def simulate(case: str = "sf", scenario: str = "paper", **params: Any) -> SimRes
         The table of defaults: ``"paper"`` is SPEC §11 (T = 20 s, Ts = 50 µs,
         one RK4 substep: 400 000 steps, the printed laws); ``"robot"`` is the
         same at a robot's Ts = 1 ms with 10 RK4 substeps and the hardened
-        options of SPEC §13 (normalised learning step, conditional integration,
-        weight projection, tanh robust term, triangle-hold observer started at
-        the first measurement; see ``docs/robot.md``).
+        options of SPEC §13 (see ``docs/robot.md``).
+    n : int
+        Joints, 1 … 7 (default 2, the paper's arm). Per-joint defaults are the
+        paper's first joint's value for every joint.
+    arm : TwoLinkArm or PlanarArm, optional
+        The plant. Default: the paper's arm for n = 2 (from the arm keywords),
+        else ``PlanarArm(n)``. The controller is model-free and never reads it.
+    centers : array_like, shape (L, 4n), optional
+        RBF centres (rows of x, v, α1, α̇1; rad, rad/s, rad/s, rad/s²) instead
+        of the paper's vertex grid (which exists for n ≤ 3).
+    widths : float or array_like, shape (4n,), optional
+        The centres' widths η_d per input dimension (units of that input):
+        S_i = exp(−Σ_d (Z_d − μ_id)² / η_d²). Default √eta2.
+    weights : dict, optional
+        Initial network weights ("D" (n, n, L), "C" (n, n, L), "G" (n, L)),
+        e.g. ``Controller.state_dict()`` or ``SimResult`` of a previous run's
+        controller: a warm start. Default zero, as in the paper.
+    record_every : int
+        Keep every k-th row (k ≥ 1); the metrics still see every step.
+    progress : bool or callable
+        ``True``: a progress bar (tqdm if installed, else a line on stderr)
+        for runs longer than 2 s; a callable is called as ``progress(done,
+        total)`` about every 50 ms.
     **params
         Any parameter below by name. Per-joint values take a number (for every
         joint) or one value per joint; ``gamma`` and ``sigma`` a number or one
-        value per network (D̂, Ĉ, Ĝ). The arm parameters define the plant only:
-        the controller is model-free and never reads them.
+        value per network (D̂, Ĉ, Ĝ).
 
     Returns
     -------
@@ -49,11 +251,19 @@ def simulate(case: str = "sf", scenario: str = "paper", **params: Any) -> SimRes
     TypeError
         An unknown keyword (the message lists the valid names) or a value of the
         wrong type.
-    ValueError
-        A wrong shape, a non-finite number, an unknown case or choice, or a
-        violated condition of SPEC §10 (the message names the condition and the
-        value, e.g. ``condition 2Kζ − I − KpᵀKp > 0 is violated: 2·Kzeta − 1 −
-        Kp²[0] = -1 (SPEC §10)``).
+    ConfigError
+        (a ``ValueError``) a wrong shape, a non-finite number, an unknown case or
+        choice, or a violated condition of SPEC §10 (the message names the
+        condition, the value and what to change).
+    DivergedError
+        The closed loop left the finite range.
+    KeyboardInterrupt
+        Ctrl-C during the run (within 0.1 s).
+
+    Warns
+    -----
+    StabilityWarning
+        Explicit-Euler learning unstable at this Ts (per-step gain ≥ Kp).
 
     Examples
     --------
@@ -63,16 +273,65 @@ def simulate(case: str = "sf", scenario: str = "paper", **params: Any) -> SimRes
     (10000, 2)
     """
     check_case(case)
-    p = resolve(params, scenario=scenario, caller="simulate()")
-    ctrl = _adaptimp.Controller(case, p)
-    arm = _adaptimp.TwoLinkArm(p)
-    # What the core derived: the arm's centres of mass and inertias, the
-    # weight bounds of "auto".
-    p.update(arm.params)
-    p["weight_bound"] = ctrl.weight_bound
-    out = _adaptimp.simulate(ctrl, arm, p)
+    n = check_n(n)
+    every = _record_every(record_every)
+    if arm is not None and arm.n != n:
+        raise ConfigError(f"arm has {arm.n} joints but n = {n}")
+    if isinstance(arm, (TwoLinkArm, PlanarArm)) and any(
+        BY_NAME[k].group == "arm" for k in params if k in BY_NAME
+    ):
+        raise TypeError("give the arm's parameters to the arm, not to simulate(), with arm=")
+    p = resolve(params, scenario=scenario, caller="simulate()", n=n)
+    c, w2 = _basis(n, centers, widths, p)
+    core = _core_controller(case, p, n, c, w2)
+    _check_stability(core, p, stacklevel=2)
+    if arm is None:
+        arm = TwoLinkArm(**{k: p[k] for k in names("arm")}) if n == N_JOINTS else PlanarArm(n)
+    # What the core derived: the arm's parameters, the weight bounds of "auto".
+    if isinstance(arm, TwoLinkArm):
+        p.update(arm.params)
+    else:
+        p["arm"] = arm.params
+    p["weight_bound"] = core.weight_bound
+    if c is not None:
+        p["nodes"] = int(c.shape[0])
+    callback, bar = _progress(progress, f"simulate({case!r})")
+    try:
+        core_params = {k: v for k, v in p.items() if k in BY_NAME}
+        out = _adaptimp.simulate(
+            core, arm._core, core_params, every, callback, _weights_or_none(weights)
+        )
+    finally:
+        if bar is not None:
+            bar.close()
     metrics = out.pop("metrics")
-    return SimResult(case=case, scenario=scenario, params=p, metrics=metrics, **out)
+    return SimResult(
+        case=case,
+        scenario=scenario,
+        params=p,
+        metrics=metrics,
+        record_every=every,
+        centers=c,
+        widths=None if w2 is None else np.sqrt(w2),
+        **out,
+    )
+
+
+def _weights_dict(weights: Mapping[str, ArrayLike]) -> dict[str, FloatArray]:
+    """The "D", "C", "G" arrays of a weights dict or a state dict."""
+    if not isinstance(weights, Mapping):
+        raise TypeError(f"weights must be a dict of arrays, got {type(weights).__name__}")
+    keys = ("W_D", "W_C", "W_G") if "W_D" in weights else ("D", "C", "G")
+    out = {}
+    for name, key in zip(("D", "C", "G"), keys):
+        if key not in weights:
+            raise ConfigError(f"weights has no {key!r} (need D, C and G)")
+        out[name] = np.ascontiguousarray(weights[key], dtype=np.float64)
+    return out
+
+
+def _weights_or_none(weights: Mapping[str, ArrayLike] | None) -> dict[str, FloatArray] | None:
+    return None if weights is None else _weights_dict(weights)
 
 
 _PARAMS_DOC = (
@@ -81,22 +340,34 @@ _PARAMS_DOC = (
 simulate.__doc__ = (simulate.__doc__ or "") + _PARAMS_DOC + describe()
 
 
-def _table(name: str, value: ArrayLike) -> FloatArray:
-    """``value`` as a C-contiguous float64 array of shape (K, 2), or an error naming ``name``."""
-    arr = np.asarray(value)
-    if arr.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be an array of real numbers, got dtype {arr.dtype}")
-    if arr.ndim != 2 or arr.shape[1] != 2:
-        raise ValueError(f"{name} must have shape (K, 2), got shape {arr.shape}")
-    return np.ascontiguousarray(arr, dtype=np.float64)
+# ---------------------------------------------------------------------------
+# Controller.
+# ---------------------------------------------------------------------------
 
 
-class Controller:
-    """One of the paper's controllers, for your own control loop.
+def _rebuild_controller(state: dict[str, Any]) -> Controller:
+    """Unpickle: a controller from the state :meth:`Controller.__reduce__` wrote."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", StabilityWarning)
+        ctrl = Controller._make(
+            state["case"],
+            state["scenario"],
+            state["n"],
+            state["params"],
+            state["centers"],
+            state["widths"],
+        )
+    ctrl.restore(np.asarray(state["snapshot"], dtype=np.float64))
+    return ctrl
+
+
+class Controller(_adaptimp.Controller):
+    """One of the paper's controllers for an arm of n joints, for your own loop.
 
     The controller keeps its own clock: step k happens at t_k = k·Ts, counted
     from construction or :meth:`reset`, and tracks the commanded trajectory
-    ``xc`` of its parameters. It never reads a model of the arm.
+    ``xc`` of its parameters, or a setpoint you give at each step (``xc=``).
+    It never reads a model of the arm.
 
     Parameters
     ----------
@@ -104,123 +375,221 @@ class Controller:
         PD (Case 1), adaptive neural state feedback (14) or output feedback (35).
     scenario : {"paper", "robot"}
         The table of defaults (see :func:`simulate`).
+    n : int
+        Joints, 1 … 7 (default 2).
+    centers, widths : array_like, optional
+        RBF centres (L, 4n) and widths (4n,) instead of the vertex grid (see
+        :func:`simulate`); required for n > 3.
     **params
         Controller parameters by name, as for :func:`simulate` (``Ts``, ``Kp``,
         ``K1``, ``Kzeta``, ``gamma``, ``tau_max``, ``xc_offset``, …). The run's,
         the wall's and the arm's parameters (``T``, ``q0``, ``wall``, ``m1``, …)
         are rejected with ``TypeError``.
 
+    Notes
+    -----
+    **Methods from the compiled core.** ``step(q, tau_e, dq=None, *, xc=None,
+    dxc=None, ddxc=None)`` takes positions q (rad), the measured force on the
+    environment τe (N m) and, for "pd"/"sf", velocities dq (rad/s), each of shape
+    (n,), and returns the applied torque sat(τ) (N m), (n,); ``xc``, ``dxc``,
+    ``ddxc`` (rad, rad/s, rad/s²; the last two zero if omitted) replace the
+    trajectory's setpoint. ``step_or_fallback`` never raises for a refused
+    measurement and returns (torque, error message or None). ``replay`` runs K
+    steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
+    ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
+    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``dtau``, ``z1``,
+    ``xc``, ``xd``, ``dq_hat``, ``weights``, ``weight_bound``, ``fault``.
+
+    **Threads.** Each call is atomic: a controller is guarded by a lock, and a
+    thread that finds it in use waits (with the GIL released) until the other
+    call ends; steps from several threads are applied one after another in
+    the order the threads get the lock. Give each thread its own controller
+    (``copy.deepcopy``) unless that is what you want. Distinct controllers run
+    in parallel: ``simulate`` and ``replay`` release the GIL.
+
+    **Copies and pickles.** ``copy.copy``, ``copy.deepcopy`` and ``pickle``
+    make independent controllers that continue bit-identically (a recorded
+    fault is not carried over).
+
     Examples
     --------
     >>> import adaptimp
-    >>> ctrl = adaptimp.Controller("sf", Ts=1e-3)
+    >>> ctrl = adaptimp.Controller("sf", scenario="robot")
     >>> tau = ctrl.step(q=[0.25, -0.05], tau_e=[0.0, 0.0], dq=[0.0, 0.0])
     >>> tau.shape, ctrl.t
     ((2,), 0.001)
     """
 
-    __slots__ = ("_core", "_params", "_scenario")
+    _params: dict[str, Any]
+    _scenario: str
+    _centers: FloatArray | None
+    _widths: FloatArray | None
 
-    def __init__(self, case: str, scenario: str = "paper", **params: Any) -> None:
+    def __new__(
+        cls,
+        case: str,
+        scenario: str = "paper",
+        *,
+        n: int = N_JOINTS,
+        centers: ArrayLike | None = None,
+        widths: ArrayLike | None = None,
+        **params: Any,
+    ) -> Controller:
         check_case(case)
-        self._params = resolve(
-            params, scenario=scenario, groups=("controller",), caller="Controller()"
+        check_scenario(scenario)
+        n = check_n(n)
+        p = resolve(
+            params, scenario=scenario, groups=("controller",), caller="Controller()", n=n
         )
+        c, w2 = _basis(n, centers, widths, p)
+        self = cls._make(case, scenario, n, p, c, None if w2 is None else np.sqrt(w2))
+        _check_stability(self, p, stacklevel=2)
+        return self
+
+    @classmethod
+    def _make(
+        cls,
+        case: str,
+        scenario: str,
+        n: int,
+        p: dict[str, Any],
+        centers: FloatArray | None,
+        widths: FloatArray | None,
+    ) -> Controller:
+        w2 = None if widths is None else np.ascontiguousarray(np.asarray(widths) ** 2)
+        self = _core_controller(case, p, n, centers, w2, cls)
+        assert isinstance(self, Controller)
+        self._params = dict(p)
+        self._params["weight_bound"] = self.weight_bound
         self._scenario = scenario
-        self._core = _adaptimp.Controller(case, self._params)
-        self._params["weight_bound"] = self._core.weight_bound
+        self._centers = centers
+        self._widths = widths
+        return self
 
-    def step(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> FloatArray:
-        """One controller step at t_k = k·Ts; returns the applied torque sat(τ) (N m), (2,).
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        """Everything happens in ``__new__`` (the compiled core is immutable)."""
 
-        Parameters
-        ----------
-        q : array_like, shape (2,)
-            Measured joint positions (rad).
-        tau_e : array_like, shape (2,)
-            Measured force the robot exerts on the environment (N m).
-        dq : array_like, shape (2,), optional
-            Measured joint velocities (rad/s): required by "pd" and "sf",
-            ignored by "of" (which estimates them with its observer).
+    # -- state that travels -------------------------------------------------
 
-        Raises
-        ------
-        ValueError
-            A wrong shape, a non-finite input (the state is left untouched), a
-            missing ``dq`` for "pd"/"sf", or a diverged state (then :meth:`reset`).
-        TypeError
-            An input that is not a sequence of numbers.
+    def __reduce__(self) -> tuple[Any, ...]:
+        state = {
+            "case": self.case,
+            "scenario": self._scenario,
+            "n": self.n,
+            "params": self._params,
+            "centers": self._centers,
+            "widths": self._widths,
+            "snapshot": self.snapshot(),
+        }
+        return (_rebuild_controller, (state,))
+
+    def __copy__(self) -> Controller:
+        """An independent copy: stepping it never changes this controller."""
+        return _rebuild_controller(self.__reduce__()[1][0])
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> Controller:
+        return self.__copy__()
+
+    def state_dict(self) -> dict[str, Any]:
+        """Everything learned and the whole state, as plain NumPy arrays and numbers.
+
+        Keys: ``format`` (``"adaptimp.state/1"``), ``case``, ``n``, ``nodes``,
+        ``steps``, ``t`` (s), ``zeta`` (N m, (n,)), ``W_D`` (n, n, L) kg m²,
+        ``W_C`` (n, n, L) kg m²/s, ``W_G`` (n, L) N m, and ``snapshot`` (the
+        flat state of :meth:`restore`). Save it with ``np.savez``.
         """
-        return self._core.step(q, tau_e, dq)
+        w = self.weights
+        return {
+            "format": STATE_FORMAT,
+            "case": self.case,
+            "n": self.n,
+            "nodes": self.nodes,
+            "steps": self.steps,
+            "t": self.t,
+            "zeta": self.zeta,
+            "W_D": w["D"],
+            "W_C": w["C"],
+            "W_G": w["G"],
+            "snapshot": self.snapshot(),
+        }
 
-    def step_or_fallback(
-        self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None
-    ) -> tuple[FloatArray, str | None]:
-        """One step that never raises for a refused measurement: for a real loop.
+    def load_state_dict(self, state: Mapping[str, Any], *, weights_only: bool = False) -> None:
+        """Load a :meth:`state_dict` of a controller with the same n and L.
 
-        Returns the torque to apply (N m), (2,), and None, or, when the
-        controller refuses the step (a non-finite or implausible measurement,
-        a latched fault), the configured fallback torque (``fallback``:
-        "hold" the last applied torque, "zero", or "damping" −Kd q̇; saturated)
-        and the error message. A refused step changes nothing but the
-        recorded :attr:`fault`. Inputs of the wrong shape or type still raise.
-
-        Examples
-        --------
-        >>> import adaptimp
-        >>> ctrl = adaptimp.Controller("sf", scenario="robot", fallback="zero")
-        >>> tau, error = ctrl.step_or_fallback([float("nan"), 0.0], [0.0, 0.0], [0.0, 0.0])
-        >>> tau.tolist(), error
-        ([0.0, 0.0], 'q[0] is not finite (NaN or infinite)')
+        With ``weights_only=False`` (default) the whole state is restored and the
+        controller continues exactly where the saved one stopped. With
+        ``weights_only=True`` only the weights are loaded, into the current
+        state (call :meth:`reset` first to start a new run from t = 0 with
+        them: a warm start). Checked before anything changes.
         """
-        return self._core.step_or_fallback(q, tau_e, dq)
+        if not isinstance(state, Mapping):
+            raise TypeError(f"state must be a dict, got {type(state).__name__}")
+        fmt = state.get("format")
+        if fmt is not None and str(fmt) != STATE_FORMAT:
+            raise ConfigError(f"state has format {fmt!r}, expected {STATE_FORMAT!r}")
+        for key, mine in (("n", self.n), ("nodes", self.nodes)):
+            if key in state and int(state[key]) != mine:
+                raise ConfigError(f"state has {key} = {int(state[key])}, this controller {mine}")
+        if weights_only or "snapshot" not in state:
+            self.load_weights(_weights_dict(state))
+        else:
+            self.restore(np.ascontiguousarray(state["snapshot"], dtype=np.float64))
 
-    @property
-    def fault(self) -> tuple[str, int] | None:
-        """The fault recorded by the last refused step: (message, step k), or None."""
-        return self._core.fault
+    # -- conveniences -------------------------------------------------------
 
-    def clear_fault(self) -> None:
-        """Clear the recorded fault. With ``fault_policy="latch"`` every step is
-        refused until this is called; the controller then continues from the
-        state it had before the fault (nothing learned is lost)."""
-        self._core.clear_fault()
-
-    def replay(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> FloatArray:
+    def replay(  # type: ignore[override]
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None = None,
+        *,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+        progress: Progress = False,
+    ) -> FloatArray:
         """K steps in one call, e.g. to replay logged measurements; returns the
-        applied torques (N m), shape (K, 2).
+        applied torques (N m), shape (K, n).
 
         Equivalent to calling :meth:`step` on each row in turn, but the loop runs
-        in the compiled core without the GIL.
+        in the compiled core without the GIL (Ctrl-C is honoured within 0.1 s).
 
         Parameters
         ----------
-        q : array_like, shape (K, 2)
+        q : array_like, shape (K, n)
             Measured joint positions (rad), one row per step.
-        tau_e : array_like, shape (K, 2)
+        tau_e : array_like, shape (K, n)
             Measured force on the environment (N m).
-        dq : array_like, shape (K, 2), optional
+        dq : array_like, shape (K, n), optional
             Measured joint velocities (rad/s): required by "pd" and "sf".
+        xc, dxc, ddxc : array_like, shape (K, n), optional
+            External setpoints (rad, rad/s, rad/s²) instead of the trajectory.
+        progress : bool or callable
+            As for :func:`simulate`.
 
         Raises
         ------
-        ValueError
+        MeasurementError
             A wrong shape, or an error at some row (named in the message; the
             rows before it have been stepped).
-        TypeError
-            An input that is not an array of real numbers.
         """
-        dq_table = None if dq is None else _table("dq", dq)
-        return self._core.replay(_table("q", q), _table("tau_e", tau_e), dq_table)
-
-    def reset(self) -> None:
-        """Back to t = 0: weights, ζ, observer and reference as at construction."""
-        self._core.reset()
-
-    @property
-    def case(self) -> str:
-        """The controller: "pd", "sf" or "of"."""
-        return self._core.case
+        n = self.n
+        tables = [None if a is None else _table(name, a, n)
+                  for name, a in (("dq", dq), ("xc", xc), ("dxc", dxc), ("ddxc", ddxc))]
+        callback, bar = _progress(progress, "replay")
+        try:
+            return super().replay(
+                _table("q", q, n),
+                _table("tau_e", tau_e, n),
+                tables[0],
+                xc=tables[1],
+                dxc=tables[2],
+                ddxc=tables[3],
+                progress=callback,
+            )
+        finally:
+            if bar is not None:
+                bar.close()
 
     @property
     def scenario(self) -> str:
@@ -235,70 +604,20 @@ class Controller:
     @property
     def Ts(self) -> float:
         """Sampling period Ts (s)."""
-        return self._core.ts
-
-    @property
-    def t(self) -> float:
-        """Time of the next step t_k = k·Ts (s)."""
-        return self._core.t
-
-    @property
-    def steps(self) -> int:
-        """Steps taken since construction or :meth:`reset`."""
-        return self._core.steps
-
-    @property
-    def zeta(self) -> FloatArray:
-        """Auxiliary state ζ (N m), (2,), now: the value the next step uses, (11)."""
-        return self._core.zeta
-
-    @property
-    def weights(self) -> dict[str, FloatArray]:
-        """Network weights now (a copy), SPEC §6, indexed [k][j][i] (output row,
-        column, node): "D" (2, 2, 256) kg m², "C" (2, 2, 256) kg m²/s, "G" (2, 256) N m."""
-        return self._core.weights
-
-    @property
-    def dq_hat(self) -> FloatArray:
-        """Velocity the last step used (rad/s), (2,): the measured dq, or the
-        observer's estimate for "of"."""
-        return self._core.dq_hat
-
-    @property
-    def tau(self) -> FloatArray:
-        """The last step's commanded torque τ before saturation (N m), (2,)."""
-        return self._core.tau
-
-    @property
-    def tau_sat(self) -> FloatArray:
-        """The last step's applied torque sat(τ) (N m), (2,)."""
-        return self._core.tau_sat
-
-    @property
-    def dtau(self) -> FloatArray:
-        """The last step's Δτ = sat(τ) − τ (N m), (2,)."""
-        return self._core.dtau
-
-    @property
-    def z1(self) -> FloatArray:
-        """The last step's tracking error z1 = xd − q (rad), (2,)."""
-        return self._core.z1
-
-    @property
-    def xc(self) -> FloatArray:
-        """The last step's commanded position xc (rad), (2,)."""
-        return self._core.xc
-
-    @property
-    def xd(self) -> FloatArray:
-        """The last step's compliant reference xd (rad), (2,)."""
-        return self._core.xd
+        return self.ts
 
     def __repr__(self) -> str:
+        basis = "vertex grid" if self._centers is None else "user centres"
         return (
-            f"adaptimp.Controller({self.case!r}, scenario={self._scenario!r}): "
-            f"Ts = {self.Ts:g} s, t = {self.t:g} s after {self.steps} steps"
+            f"adaptimp.Controller({self.case!r}, scenario={self._scenario!r}, n={self.n}): "
+            f"{self.nodes} RBF nodes ({basis}), Ts = {self.Ts:g} s, "
+            f"t = {self.t:g} s after {self.steps} steps"
         )
+
+
+# ---------------------------------------------------------------------------
+# Arms.
+# ---------------------------------------------------------------------------
 
 
 class TwoLinkArm:
@@ -324,10 +643,16 @@ class TwoLinkArm:
 
     __slots__ = ("_core", "_params")
 
+    n = 2
+    """Joints."""
+
     def __init__(self, **params: Any) -> None:
         self._params = resolve(params, groups=("arm",), caller="TwoLinkArm()")
         self._core = _adaptimp.TwoLinkArm(self._params)
         self._params.update(self._core.params)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_two_link_arm, (self._params,))
 
     @property
     def params(self) -> dict[str, Any]:
@@ -374,4 +699,125 @@ class TwoLinkArm:
             f"adaptimp.TwoLinkArm(m1={p['m1']:g}, m2={p['m2']:g}, l1={p['l1']:g}, "
             f"l2={p['l2']:g}, lc1={p['lc1']:g}, lc2={p['lc2']:g}, I1={p['I1']:g}, "
             f"I2={p['I2']:g}, g={p['g']:g})"
+        )
+
+
+def _two_link_arm(params: dict[str, Any]) -> TwoLinkArm:
+    return TwoLinkArm(**params)
+
+
+def _per_link(name: str, value: ArrayLike, n: int, positive: bool) -> list[float]:
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be a number or {n} numbers, got {type(value).__name__}")
+    if arr.shape not in ((), (n,)):
+        raise ConfigError(f"{name} must be a number or have shape ({n},), got shape {arr.shape}")
+    out = np.broadcast_to(arr.astype(np.float64), (n,))
+    for i, x in enumerate(out):
+        if not math.isfinite(x) or (x <= 0 if positive else x < 0):
+            rel = "> 0" if positive else "≥ 0"
+            raise ConfigError(f"{name}[{i}] must be finite and {rel}, got {x}")
+    return [float(x) for x in out]
+
+
+class PlanarArm:
+    """An arm of n revolute joints (1 ≤ n ≤ 7) in a vertical plane.
+
+    Joint angles are relative (q_i is link i's angle to link i−1); link 1's
+    angle is measured from the horizontal, and gravity acts along −y. D is
+    assembled from the centre-of-mass Jacobians and C from the Christoffel
+    symbols of D, so Ḋ − 2C is skew-symmetric. For n = 2 it equals
+    :class:`TwoLinkArm` with the same links to rounding.
+
+    Parameters
+    ----------
+    n : int
+        Links (joints), 1 … 7.
+    masses : float or array_like, shape (n,)
+        Link masses (kg), > 0. Default 1 kg each.
+    lengths : float or array_like, shape (n,)
+        Joint-to-joint lengths (m), > 0. Default 0.3 m each.
+    coms : float or array_like, shape (n,), optional
+        Distances from each link's proximal joint to its centre of mass (m).
+        Default half the lengths.
+    inertias : float or array_like, shape (n,), optional
+        Moments of inertia about the centres of mass, normal to the plane
+        (kg m²). Default m l²/12 (uniform rods).
+    g : float
+        Gravity (m/s²).
+
+    Examples
+    --------
+    >>> import adaptimp
+    >>> arm = adaptimp.PlanarArm(3, masses=[2.0, 1.5, 1.0], lengths=0.4)
+    >>> arm.D([0.0, 0.1, 0.2]).shape
+    (3, 3)
+    """
+
+    __slots__ = ("_core", "_params")
+
+    def __init__(
+        self,
+        n: int,
+        masses: ArrayLike = 1.0,
+        lengths: ArrayLike = 0.3,
+        coms: ArrayLike | None = None,
+        inertias: ArrayLike | None = None,
+        g: float = 9.81,
+    ) -> None:
+        n = check_n(n)
+        m = _per_link("masses", masses, n, positive=True)
+        length = _per_link("lengths", lengths, n, positive=True)
+        c = [x / 2 for x in length] if coms is None else _per_link("coms", coms, n, False)
+        if inertias is None:
+            inertia = [mi * li * li / 12 for mi, li in zip(m, length)]
+        else:
+            inertia = _per_link("inertias", inertias, n, positive=False)
+        if isinstance(g, bool) or not isinstance(g, (int, float, np.floating, np.integer)):
+            raise TypeError(f"g must be a number (m/s²), got {type(g).__name__}")
+        if not math.isfinite(float(g)):
+            raise ConfigError(f"g must be finite, got {g}")
+        self._params = {
+            "n": n, "masses": m, "lengths": length, "coms": c, "inertias": inertia, "g": float(g)
+        }
+        self._core = _adaptimp.PlanarArm(m, length, c, inertia, float(g))
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        p = self._params
+        return (PlanarArm, (p["n"], p["masses"], p["lengths"], p["coms"], p["inertias"], p["g"]))
+
+    @property
+    def n(self) -> int:
+        """Joints."""
+        return int(self._params["n"])
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """The arm's parameters (a copy): n, masses, lengths, coms, inertias, g."""
+        return {k: list(v) if isinstance(v, list) else v for k, v in self._params.items()}
+
+    def D(self, q: ArrayLike) -> FloatArray:
+        """Inertia matrix D(q) (kg m²), (n, n), at joint positions ``q`` (rad)."""
+        return self._core.D(q)
+
+    def C(self, q: ArrayLike, dq: ArrayLike) -> FloatArray:
+        """Coriolis and centripetal matrix C(q, q̇) (kg m²/s), (n, n)."""
+        return self._core.C(q, dq)
+
+    def G(self, q: ArrayLike) -> FloatArray:
+        """Gravity torque G(q) (N m), (n,)."""
+        return self._core.G(q)
+
+    def forward_dynamics(
+        self, q: ArrayLike, dq: ArrayLike, tau: ArrayLike, tau_e: ArrayLike
+    ) -> FloatArray:
+        """Joint acceleration q̈ (rad/s²), (n,): D q̈ = τ − τe − C q̇ − G, with τ the
+        applied torque and τe the force on the environment (N m)."""
+        return self._core.forward_dynamics(q, dq, tau, tau_e)
+
+    def __repr__(self) -> str:
+        p = self._params
+        return (
+            f"adaptimp.PlanarArm({p['n']}, masses={p['masses']}, lengths={p['lengths']}, "
+            f"coms={p['coms']}, inertias={p['inertias']}, g={p['g']:g})"
         )

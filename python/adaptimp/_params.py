@@ -27,12 +27,16 @@ from typing import Any
 import numpy as np
 
 from . import _adaptimp
+from ._errors import ConfigError
 
-N_JOINTS: int = _adaptimp.N_JOINTS
-"""Joints of the paper's arm (the compiled core is built for n = 2, l = 256 nodes)."""
+N_JOINTS: int = 2
+"""Joints of the paper's arm (the default ``n``)."""
+
+MAX_JOINTS: int = _adaptimp.MAX_JOINTS
+"""The most joints a controller may have (7)."""
 
 N_NODES: int = _adaptimp.N_NODES
-"""RBF nodes of the paper's vertex grid, 2^(4n) (SPEC §6)."""
+"""RBF nodes of the paper's vertex grid for n = 2, 2^(4n) = 256 (SPEC §6)."""
 
 CASES = ("pd", "sf", "of")
 """The paper's three controllers: PD (Case 1), state feedback (14), output feedback (35)."""
@@ -93,7 +97,33 @@ BY_NAME: dict[str, Param] = {p.name: p for p in PARAMS}
 SCENARIOS: dict[str, dict[str, Any]] = {
     name: _adaptimp.defaults(name) for name in ("paper", "robot")
 }
-"""Default values of every parameter, per scenario (from the core's schema)."""
+"""Default values of every parameter, per scenario (from the core's schema), for
+the paper's n = 2 joints; :func:`defaults` gives them for any n."""
+
+_DEFAULTS: dict[tuple[str, int], dict[str, Any]] = {
+    (name, 2): values for name, values in SCENARIOS.items()
+}
+
+
+def defaults(scenario: str = "paper", n: int = 2) -> dict[str, Any]:
+    """Every parameter's default in ``scenario`` for ``n`` joints (a copy): per-joint
+    values have n entries (the paper's first joint's value for every joint, when
+    the paper gives two)."""
+    check_scenario(scenario)
+    n = check_n(n)
+    key = (scenario, n)
+    if key not in _DEFAULTS:
+        _DEFAULTS[key] = _adaptimp.defaults(scenario, n)
+    return dict(_DEFAULTS[key])
+
+
+def check_n(n: object) -> int:
+    """``n`` if it is a whole number of joints in 1 … :data:`MAX_JOINTS`, else an error."""
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral):
+        raise TypeError(f"n must be an integer number of joints, got {_type_name(n)}")
+    if not 1 <= int(n) <= MAX_JOINTS:
+        raise ConfigError(f"n must be between 1 and {MAX_JOINTS} joints, got {n}")
+    return int(n)
 
 
 def names(*groups: str) -> list[str]:
@@ -132,13 +162,16 @@ def _real(p: Param, value: object) -> float:
         value = value.item()
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         if isinstance(value, (np.ndarray, list, tuple)):
-            raise ValueError(
+            raise ConfigError(
                 f"{p.name} must be a single number{_unit(p)}, got shape {np.shape(value)}"
             )
         raise TypeError(f"{p.name} must be a real number{_unit(p)}, got {_type_name(value)}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        raise ConfigError(f"{p.name} is too large for a float: {value}") from None
     if not math.isfinite(x):
-        raise ValueError(f"{p.name} must be finite, got {x}")
+        raise ConfigError(f"{p.name} must be finite, got {x}")
     return x
 
 
@@ -150,8 +183,10 @@ def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
         )
     try:
         arr = np.asarray(value)
+    except OverflowError:
+        raise ConfigError(f"{p.name} holds a number too large for a float") from None
     except ValueError as e:  # ragged nested sequences
-        raise ValueError(
+        raise ConfigError(
             f"{p.name} must be a number or have shape ({size},) ({per}), got {value!r}"
         ) from e
     if arr.dtype.kind not in "iuf":
@@ -160,19 +195,26 @@ def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
             f"got {_type_name(value)}" + (f" of dtype {arr.dtype}" if arr.ndim else "")
         )
     if arr.shape not in ((), (size,)):
-        raise ValueError(
+        raise ConfigError(
             f"{p.name} must be a number or have shape ({size},) ({per}), got shape {arr.shape}"
         )
-    out = np.broadcast_to(arr.astype(np.float64), (size,))
+    if arr.dtype == object:  # pragma: no cover - caught by the dtype check above
+        raise TypeError(f"{p.name} must hold numbers")
+    try:
+        out = np.broadcast_to(arr.astype(np.float64), (size,))
+    except OverflowError:
+        raise ConfigError(f"{p.name} holds a number too large for a float") from None
     bad = np.flatnonzero(~np.isfinite(out))
     if bad.size:
-        raise ValueError(f"{p.name}[{bad[0]}] must be finite, got {out[bad[0]]}")
+        raise ConfigError(f"{p.name}[{bad[0]}] must be finite, got {out[bad[0]]}")
     return [float(x) for x in out]
 
 
 def _integer(p: Param, value: object) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{p.name} must be an integer, got {_type_name(value)}")
+    if not -(2**63) <= int(value) < 2**63:
+        raise ConfigError(f"{p.name} is out of range: {value}")
     return int(value)
 
 
@@ -180,20 +222,21 @@ def _choice(p: Param, value: object) -> str:
     if not isinstance(value, str):
         raise TypeError(f"{p.name} must be a string, one of {p.choices}, got {_type_name(value)}")
     if value not in p.choices:
-        raise ValueError(f"{p.name} must be one of {p.choices}, got {value!r}")
+        raise ConfigError(f"{p.name} must be one of {p.choices}, got {value!r}")
     return value
 
 
-def validate(name: str, value: object) -> Any:
+def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
     """``value`` of parameter ``name`` in its normal form (float, int, str, list of
-    floats or None); raises ``TypeError``/``ValueError`` naming the parameter."""
+    floats or None) for ``n`` joints; raises ``TypeError``/``ValueError`` naming
+    the parameter."""
     p = BY_NAME[name]
     if p.kind == "real":
         return _real(p, value)
     if p.kind == "int":
         return _integer(p, value)
     if p.kind == "joint":
-        return _vector(p, value, N_JOINTS, "one value per joint")
+        return _vector(p, value, n, "one value per joint")
     if p.kind == "network":
         return _vector(p, value, 3, "one value per network D, C, G")
     if p.kind == "choice":
@@ -201,12 +244,12 @@ def validate(name: str, value: object) -> Any:
     if p.kind in ("optional", "derived"):
         return None if value is None else _real(p, value)
     if p.kind == "limit":
-        return None if value is None else _vector(p, value, N_JOINTS, "one value per joint")
+        return None if value is None else _vector(p, value, n, "one value per joint")
     if p.kind == "bound":
         if value is None or (isinstance(value, str) and value == "auto"):
             return value
         if isinstance(value, str):
-            raise ValueError(f"{p.name} must be None, 'auto' or numbers, got {value!r}")
+            raise ConfigError(f"{p.name} must be None, 'auto' or numbers, got {value!r}")
         return _vector(p, value, 3, "one value per network D, C, G")
     raise AssertionError(f"unknown parameter kind {p.kind!r}")  # pragma: no cover
 
@@ -221,7 +264,7 @@ def check_case(case: object) -> str:
     if not isinstance(case, str):
         raise TypeError(f"case must be a string, one of {CASES}, got {_type_name(case)}")
     if case not in CASES:
-        raise ValueError(f"case must be one of {CASES}, got {case!r}")
+        raise ConfigError(f"case must be one of {CASES}, got {case!r}")
     return case
 
 
@@ -232,14 +275,21 @@ def check_scenario(scenario: object) -> str:
             f"scenario must be a string, one of {tuple(SCENARIOS)}, got {_type_name(scenario)}"
         )
     if scenario not in SCENARIOS:
-        raise ValueError(f"scenario must be one of {tuple(SCENARIOS)}, got {scenario!r}")
+        raise ConfigError(f"scenario must be one of {tuple(SCENARIOS)}, got {scenario!r}")
     return scenario
 
 
-def _reject_unknown(given: Mapping[str, object], groups: tuple[str, ...], caller: str) -> None:
+def _reject_unknown(
+    given: Mapping[str, object], groups: tuple[str, ...], caller: str, n: int = N_JOINTS
+) -> None:
     valid = names(*groups)
     for key in given:
         if key in valid:
+            if n != N_JOINTS and BY_NAME[key].group == "arm":
+                raise TypeError(
+                    f"{caller} got {key!r}, a parameter of the paper's 2-link arm, with "
+                    f"n = {n}: pass arm=adaptimp.PlanarArm(...) for an arm of {n} joints"
+                )
             continue
         if key in BY_NAME:
             where = {
@@ -267,6 +317,7 @@ def resolve(
     scenario: str = "paper",
     groups: tuple[str, ...] = GROUPS,
     caller: str = "simulate()",
+    n: int = N_JOINTS,
 ) -> dict[str, Any]:
     """The complete parameter dict of ``groups``: the scenario's defaults updated
     with ``given``, validated and normalised (per-joint values as lists of floats;
@@ -278,9 +329,56 @@ def resolve(
     a non-finite number or an unknown choice.
     """
     check_scenario(scenario)
-    _reject_unknown(given, groups, caller)
-    defaults = SCENARIOS[scenario]
+    n = check_n(n)
+    _reject_unknown(given, groups, caller, n)
+    table = defaults(scenario, n)
     out: dict[str, Any] = {}
     for name in names(*groups):
-        out[name] = validate(name, given.get(name, defaults[name]))
+        if n != N_JOINTS and BY_NAME[name].group == "arm":
+            continue
+        out[name] = validate(name, given.get(name, table[name]), n)
     return out
+
+
+# ---------------------------------------------------------------------------
+# What to change when a condition of SPEC §10 fails.
+# ---------------------------------------------------------------------------
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.6g}"
+
+
+def config_hint(message: str, params: Mapping[str, Any]) -> str:
+    """A sentence saying what to change for the violated condition in ``message``
+    (the core's text), from the parameters ``params``; empty if none applies."""
+    kp = params.get("Kp")
+    if "2Kζ − I − KpᵀKp" in message and kp is not None:
+        kz = params["Kzeta"]
+        for i, (k, z) in enumerate(zip(kp, kz)):
+            need = (1.0 + k * k) / 2.0
+            if 2.0 * z - 1.0 - k * k <= 0.0:
+                top = math.sqrt(max(2.0 * z - 1.0, 0.0))
+                return (
+                    f"raise Kzeta above {_fmt(need)} for Kp = {_fmt(k)} (joint {i}), "
+                    f"or lower Kp below {_fmt(top)} for Kzeta = {_fmt(z)}"
+                )
+    if "2Kp − I" in message:
+        return "raise Kp above 0.5 on every joint"
+    if "Ts Γ σ < 1" in message:
+        ts = params["Ts"]
+        return (
+            f"lower Ts, gamma or sigma: gamma·sigma must stay below 1/Ts = {_fmt(1.0 / ts)} "
+            f"at Ts = {_fmt(ts)} s"
+        )
+    if "Ts/ε ≤ 1e6" in message:
+        return f"raise eps above Ts/1e6 = {_fmt(params['Ts'] / 1e6)} s, or lower Ts"
+    if "λ1 ≤ 1e6" in message:
+        return "lower lam1 to at most 1e6"
+    return ""
+
+
+def with_hint(error: ConfigError, params: Mapping[str, Any]) -> ConfigError:
+    """``error`` with the :func:`config_hint` for ``params`` appended."""
+    hint = config_hint(str(error), params)
+    return ConfigError(f"{error}; {hint}") if hint else error

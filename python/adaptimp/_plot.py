@@ -22,7 +22,6 @@ if TYPE_CHECKING:
 
     from ._result import SimResult
 
-_JOINTS = ("joint 1", "joint 2")
 _SIZE = (8.0, 5.6)  # inches; 960 × 672 px at the default 120 dpi of savefig below
 _COLORS = {"pd": "#d62728", "sf": "#1f77b4", "of": "#2ca02c"}
 
@@ -40,11 +39,19 @@ def _choose_backend() -> None:
             matplotlib.use("Agg")
 
 
+def _joint(i: int) -> str:
+    return f"joint {i + 1}"
+
+
 def _figure(title: str, rows: int = 2) -> tuple[Figure, Sequence[Axes]]:
     _choose_backend()
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=_SIZE, layout="constrained", dpi=120)
+    size = (_SIZE[0], max(_SIZE[1], 2.2 * rows + 1.2))
+    fig, axes = plt.subplots(
+        rows, 1, sharex=True, figsize=size, layout="constrained", dpi=120, squeeze=False
+    )
+    axes = axes[:, 0]
     fig.suptitle(title, fontsize=12)
     for ax in axes:
         ax.grid(True, alpha=0.3)
@@ -71,7 +78,7 @@ def _settle_band(ax: Axes, res: SimResult) -> None:
 def tracking(res: SimResult) -> Figure:
     """q against the commanded xc and the compliant reference xd, per joint, with
     the wall (the paper's Figs. 2, 5, 8)."""
-    fig, axes = _figure(_title(res, "joint tracking"))
+    fig, axes = _figure(_title(res, "joint tracking"), res.n)
     wall = res.params["wall"]
     for i, ax in enumerate(axes):
         ax.plot(res.t, res.xc[:, i], color="k", lw=1.0, ls="--", label="xc, commanded")
@@ -82,7 +89,7 @@ def tracking(res: SimResult) -> Figure:
             top = max(float(np.max(res.q[:, 0])), float(np.max(res.xc[:, 0])), wall) + 0.05
             ax.axhspan(wall, top, color="tab:red", alpha=0.08, lw=0)
             ax.set_ylim(top=top)
-        ax.set_ylabel(f"{_JOINTS[i]}: q{i + 1} (rad)")
+        ax.set_ylabel(f"{_joint(i)}: q{i + 1} (rad)")
     _legend(fig, axes[0], ncol=4)
     return fig
 
@@ -95,10 +102,11 @@ def errors(res: SimResult) -> Figure:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(
-        2,
+        res.n,
         2,
         sharex="col",
-        figsize=_SIZE,
+        squeeze=False,
+        figsize=(_SIZE[0], max(_SIZE[1], 2.2 * res.n + 1.2)),
         layout="constrained",
         dpi=120,
         width_ratios=(1, 3),
@@ -108,16 +116,16 @@ def errors(res: SimResult) -> Figure:
     settle = float(res.params["settle"])
     early = res.t < settle
     late = ~early
-    for i in range(2):
+    for i in range(res.n):
         left, right = axes[i]
         for ax, rows in ((left, early), (right, late)):
             ax.grid(True, alpha=0.3)
             ax.axhline(0.0, color="0.4", lw=0.6)
             ax.plot(res.t[rows], res.z1[rows, i], color=_COLORS[res.case], lw=0.9)
-        left.set_ylabel(f"{_JOINTS[i]}: z1,{i + 1} (rad)")
+        left.set_ylabel(f"{_joint(i)}: z1,{i + 1} (rad)")
         left.set_title(f"t < {settle:g} s (settling)", fontsize=10, loc="left")
         right.set_title(f"t ≥ {settle:g} s: RMS = {rms[i]:.3g} rad", fontsize=10, loc="left")
-    for ax in axes[1]:
+    for ax in axes[-1]:
         ax.set_xlabel("time t (s)")
     return fig
 
@@ -126,7 +134,7 @@ def torques(res: SimResult) -> Figure:
     """Commanded torque τ and applied torque sat(τ) per joint, with the limits ±τmax
     (the paper's Figs. 4, 7, 10). A commanded torque far beyond the limits (windup)
     is clipped to the view and its peak given in the panel title."""
-    fig, axes = _figure(_title(res, "joint torques"))
+    fig, axes = _figure(_title(res, "joint torques"), res.n)
     tau_max = res.params["tau_max"]
     for i, ax in enumerate(axes):
         m = float(tau_max[i])
@@ -135,7 +143,7 @@ def torques(res: SimResult) -> Figure:
         ax.axhline(m, color="tab:red", lw=1.0, ls="--", label="±τmax, actuator limit")
         ax.axhline(-m, color="tab:red", lw=1.0, ls="--")
         peak = float(np.max(np.abs(res.tau[:, i]))) if res.rows else 0.0
-        title = f"{_JOINTS[i]}: τmax = {m:g} N m"
+        title = f"{_joint(i)}: τmax = {m:g} N m"
         if peak > 1.6 * m:
             ax.set_ylim(-1.6 * m, 1.6 * m)
             title += f"; commanded τ clipped to the view, peak |τ| = {peak:.4g} N m"
@@ -173,7 +181,8 @@ def compare(
     """RMS of z1 over ``window``-second windows (s), per joint, for several runs on
     shared logarithmic axes, so that PD's errors and the adaptive controllers'
     much smaller ones both show."""
-    fig, axes = _figure(f"{title}: RMS of z1 over {window:g} s windows")
+    n = results[0].n if results else 2
+    fig, axes = _figure(f"{title}: RMS of z1 over {window:g} s windows", n)
     for res in results:
         rms = res.metrics["rms_z1_joint_after2"]
         for i, ax in enumerate(axes):
@@ -183,12 +192,12 @@ def compare(
                 r,
                 color=_COLORS.get(res.case),
                 lw=1.3,
-                label=f"{CASE_NAMES[res.case]}: {rms[0]:.2g}, {rms[1]:.2g} rad",
+                label=f"{CASE_NAMES[res.case]}: " + ", ".join(f"{r:.2g}" for r in rms) + " rad",
             )
     settle = float(results[0].params["settle"]) if results else 0.0
     for i, ax in enumerate(axes):
         _settle_band(ax, results[0])
-        ax.set_ylabel(f"{_JOINTS[i]}: RMS z1,{i + 1} (rad)")
+        ax.set_ylabel(f"{_joint(i)}: RMS z1,{i + 1} (rad)")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(
         handles,
@@ -201,3 +210,30 @@ def compare(
         title_fontsize=9,
     )
     return fig
+
+
+_QUANTITY = {"tracking": ("q", "rad"), "errors": ("z1", "rad"), "torques": ("tau_sat", "N m")}
+
+
+def into(res: SimResult, kind: str, ax: Axes | Sequence[Axes]) -> Figure:
+    """Draw ``kind`` of ``res`` into ``ax`` (one Axes per joint, or one for all),
+    labelled with the case, so that several runs overlay; returns the figure."""
+    from matplotlib.axes import Axes as _Axes
+
+    name, unit = _QUANTITY[kind]
+    data = getattr(res, name)
+    axes = [ax] * res.n if isinstance(ax, _Axes) else list(ax)
+    if len(axes) != res.n:
+        raise ValueError(f"ax must be one Axes or {res.n} (one per joint), got {len(axes)}")
+    single = isinstance(ax, _Axes)
+    for i, a in enumerate(axes):
+        joint = f", joint {i + 1}" if single and res.n > 1 else ""
+        a.plot(res.t, data[:, i], lw=1.0, color=None if single else _COLORS.get(res.case),
+               label=f"{CASE_NAMES[res.case]}: {name}{joint}")
+        if kind == "tracking" and not single:
+            a.plot(res.t, res.xc[:, i], color="k", lw=0.8, ls="--")
+        a.set_ylabel(f"{name} ({unit})")
+        a.set_xlabel("time t (s)")
+    fig = axes[0].get_figure()
+    assert fig is not None
+    return fig  # type: ignore[return-value]

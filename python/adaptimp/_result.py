@@ -16,12 +16,38 @@ from numpy.typing import NDArray
 from ._params import CASE_NAMES
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import pandas as pd
+    import xarray as xr
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 FloatArray = NDArray[np.float64]
 
 ARRAYS = ("t", "q", "dq", "xc", "xd", "dq_hat", "tau", "tau_sat", "tau_e", "zeta", "z1", "w_norms")
-"""Names of the recorded arrays, in the order of :class:`SimResult`."""
+"""Names of the recorded arrays every result has, in the order of :class:`SimResult`."""
+
+EXTRA_ARRAYS = ("ddq", "dxc", "ddxc", "refused")
+"""Recorded arrays of results made by this version (None in older saved files)."""
+
+UNITS = {
+    "t": "s",
+    "q": "rad",
+    "dq": "rad/s",
+    "ddq": "rad/s^2",
+    "xc": "rad",
+    "dxc": "rad/s",
+    "ddxc": "rad/s^2",
+    "xd": "rad",
+    "dq_hat": "rad/s",
+    "tau": "N m",
+    "tau_sat": "N m",
+    "tau_e": "N m",
+    "zeta": "N m",
+    "z1": "rad",
+}
+"""Units of the per-joint arrays (``w_norms``: kg m², kg m²/s, N m per network)."""
 
 PLOT_KINDS = ("tracking", "errors", "torques")
 """Kinds of :meth:`SimResult.plot` (the kinds of the paper's Figs. 2–10)."""
@@ -45,8 +71,8 @@ METRIC_KEYS = (
 class SimResult:
     """One simulated run (SPEC §11): every recorded row k = 0 … K − 1 at t_k = k·Ts.
 
-    Arrays are float64 with one row per controller step; per-joint arrays have
-    shape (K, 2).
+    Arrays are float64 with one row per recorded step; per-joint arrays have
+    shape (K, n).
 
     Attributes
     ----------
@@ -99,6 +125,18 @@ class SimResult:
     zeta: FloatArray
     z1: FloatArray
     w_norms: FloatArray
+    ddq: FloatArray | None = None
+    dxc: FloatArray | None = None
+    ddxc: FloatArray | None = None
+    refused: NDArray[np.bool_] | None = None
+    record_every: int = 1
+    centers: FloatArray | None = None
+    widths: FloatArray | None = None
+
+    @property
+    def n(self) -> int:
+        """Joints n."""
+        return int(self.q.shape[1])
 
     @property
     def dtau(self) -> FloatArray:
@@ -110,7 +148,7 @@ class SimResult:
         """Number of recorded rows K."""
         return int(self.t.shape[0])
 
-    def plot(self, kind: str = "tracking") -> Figure:
+    def plot(self, kind: str = "tracking", ax: Axes | Sequence[Axes] | None = None) -> Figure:
         """A figure of the run, per joint, returned as a matplotlib ``Figure``.
 
         Parameters
@@ -119,28 +157,96 @@ class SimResult:
             ``"tracking"``: q against xc and xd, with the wall (Figs. 2, 5, 8);
             ``"errors"``: z1 (Figs. 3, 6, 9); ``"torques"``: commanded and applied
             torque with the limits ±τmax (Figs. 4, 7, 10).
+        ax : Axes or sequence of n Axes, optional
+            Draw into these axes (one per joint, or one for every joint) instead
+            of a new figure, so that several runs overlay; the returned figure is
+            theirs. Lines are labelled with the case.
         """
         from . import _plot
 
         if kind not in PLOT_KINDS:
             raise ValueError(f"kind must be one of {PLOT_KINDS}, got {kind!r}")
+        if ax is not None:
+            return _plot.into(self, kind, ax)
         return _plot.FIGURES[kind](self)
 
+    def to_pandas(self) -> pd.DataFrame:
+        """The run as a tidy pandas ``DataFrame``: one row per recorded step, indexed
+        by ``t [s]``, one column per joint quantity named with its unit
+        (``"q1 [rad]"``, ``"tau_sat2 [N m]"``, ``"w_norm_G"``); ``attrs`` holds
+        the case, scenario, metrics, parameters and the units by column."""
+        import pandas as pd
+
+        columns: dict[str, Any] = {}
+        units: dict[str, str] = {}
+        for name in (*ARRAYS[1:-1], *EXTRA_ARRAYS[:-1]):
+            arr = getattr(self, name)
+            if arr is None:
+                continue
+            for i in range(arr.shape[1]):
+                col = f"{name}{i + 1} [{UNITS[name]}]"
+                columns[col] = arr[:, i]
+                units[col] = UNITS[name]
+        for j, net in enumerate(("D", "C", "G")):
+            columns[f"w_norm_{net}"] = self.w_norms[:, j]
+        if self.refused is not None:
+            columns["refused"] = self.refused
+        df = pd.DataFrame(columns, index=pd.Index(self.t, name="t [s]"))
+        df.attrs.update(
+            case=self.case,
+            scenario=self.scenario,
+            metrics=dict(self.metrics),
+            params=dict(self.params),
+            units=units,
+            record_every=self.record_every,
+        )
+        return df
+
+    def to_xarray(self) -> xr.Dataset:
+        """The run as an xarray ``Dataset`` with dimensions ``t`` (s) and ``joint``
+        (1 … n), one variable per quantity with its ``units`` attribute; needs
+        xarray (``pip install xarray``)."""
+        try:
+            import xarray as xr
+        except ImportError:
+            raise ImportError("to_xarray() needs xarray: pip install xarray") from None
+        joints = np.arange(1, self.n + 1)
+        data: dict[str, Any] = {}
+        for name in (*ARRAYS[1:-1], *EXTRA_ARRAYS[:-1]):
+            arr = getattr(self, name)
+            if arr is not None:
+                data[name] = (("t", "joint"), arr, {"units": UNITS[name]})
+        data["w_norms"] = (("t", "network"), self.w_norms, {})
+        if self.refused is not None:
+            data["refused"] = (("t",), self.refused, {})
+        coords = {"t": ("t", self.t, {"units": "s"}), "joint": joints, "network": ["D", "C", "G"]}
+        attrs = {
+            "case": self.case,
+            "scenario": self.scenario,
+            "metrics": json.dumps(metrics_json(self.metrics)),
+            "params": json.dumps(self.params),
+        }
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
     def save(self, path: str | os.PathLike[str]) -> Path:
-        """Write the arrays, metrics and parameters to a ``.npz`` file (metrics and
-        parameters as JSON strings, so no pickle is needed to read it back).
-        Returns the path written (``.npz`` is appended if missing)."""
+        """Write the arrays, metrics and parameters to a compressed ``.npz`` file
+        (metrics and parameters as JSON strings, so no pickle is needed to read it
+        back). Returns the path written (``.npz`` is appended if missing)."""
         path = Path(path)
         if path.suffix != ".npz":
             path = path.with_name(path.name + ".npz")
         arrays = {name: getattr(self, name) for name in ARRAYS}
-        np.savez(
+        for name in EXTRA_ARRAYS:
+            if getattr(self, name) is not None:
+                arrays[name] = getattr(self, name)
+        np.savez_compressed(
             path,
             **arrays,
             case=np.array(self.case),
             scenario=np.array(self.scenario),
             metrics=np.array(json.dumps(self.metrics)),
             params=np.array(json.dumps(self.params)),
+            record_every=np.array(self.record_every),
         )
         return path
 
@@ -149,6 +255,11 @@ class SimResult:
         """Read a result written by :meth:`save`."""
         with np.load(path, allow_pickle=False) as f:
             arrays = {name: f[name] for name in ARRAYS}
+            for name in EXTRA_ARRAYS:
+                if name in f:
+                    arrays[name] = f[name]
+            if "record_every" in f:
+                arrays["record_every"] = int(f["record_every"])
             return cls(
                 case=str(f["case"]),
                 scenario=str(f["scenario"]),
@@ -160,18 +271,24 @@ class SimResult:
     def __repr__(self) -> str:
         m = self.metrics
         p = self.params
-        t_end = self.rows * p["Ts"]
+        t_end = self.rows * self.record_every * p["Ts"]
+        rows = (
+            f"{self.rows} steps"
+            if self.record_every == 1
+            else f"{self.rows} rows (every {self.record_every}th step)"
+        )
         wall = "free space" if p["wall"] is None else f"wall at {p['wall']:g} rad"
         lines = [
             f"SimResult({self.case!r}: {CASE_NAMES[self.case]}, scenario {self.scenario!r}; "
-            f"{self.rows} steps of Ts = {p['Ts']:g} s, T = {t_end:g} s; {wall})",
+            f"{rows}, n = {self.n}, Ts = {p['Ts']:g} s, T = {t_end:g} s; {wall})",
             f"  RMS ‖z1‖ = {m['rms_z1']:.4g} rad, over t ≥ {p['settle']:g} s: "
             f"{m['rms_z1_after2']:.4g} rad "
             f"(per joint {_fmt_list(m['rms_z1_joint_after2'], '.4g')})",
             f"  saturated {100 * m['sat_duty']:.1f}% of steps; "
             f"peak commanded |τ| = {_fmt_list(m['peak_abs_tau'], '.4g')} N m; "
             f"{m['steps_in_contact']} steps in contact",
-            "  arrays: " + ", ".join(ARRAYS) + "; .metrics, .params, .plot(kind), .save(path)",
+            "  arrays: " + ", ".join(ARRAYS) + "; .metrics, .params, .plot(kind), .save(path), "
+            ".to_pandas()",
         ]
         return "\n".join(lines)
 

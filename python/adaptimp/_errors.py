@@ -1,0 +1,51 @@
+"""The exceptions and warnings of adaptimp, catchable by kind.
+
+The compiled core raises these classes directly (``adaptimp._adaptimp`` imports
+them from here), so the same error is the same class whether it came from
+Python's checks or from Rust's.
+"""
+
+from __future__ import annotations
+
+
+class AdaptimpError(Exception):
+    """Base class of every adaptimp error."""
+
+
+class ConfigError(AdaptimpError, ValueError):
+    """A parameter set that cannot make a controller or a run: a violated
+    condition of SPEC §10 (the message says what to change), a wrong shape or
+    an impossible value. A ``ValueError``."""
+
+
+class MeasurementError(AdaptimpError, ValueError):
+    """A step's input that is not a measurement: non-finite, of the wrong shape,
+    beyond a plausibility limit, or missing (``dq`` for "pd"/"sf"). Named as you
+    named it (``q``, ``dq``, ``tau_e``, ``xc``). The controller's state is
+    unchanged. A ``ValueError``."""
+
+
+class DivergedError(AdaptimpError, ArithmeticError):
+    """The controller's state or a signal left the finite range (|x| > 1e100):
+    call ``reset()`` or restore a saved state. An ``ArithmeticError``."""
+
+
+class FaultError(AdaptimpError, RuntimeError):
+    """A step refused because a fault is latched (``fault_policy="latch"``):
+    call ``clear_fault()`` once the cause is gone. A ``RuntimeError``."""
+
+
+class StabilityWarning(UserWarning):
+    """The chosen parameters are valid but known to be unstable in discrete
+    time, e.g. explicit-Euler learning whose per-step gain exceeds Kp (the Jury
+    condition of docs/robot.md)."""
+
+
+__all__ = [
+    "AdaptimpError",
+    "ConfigError",
+    "DivergedError",
+    "FaultError",
+    "MeasurementError",
+    "StabilityWarning",
+]

@@ -1,0 +1,1209 @@
+//! Python bindings: the extension module `adaptimp._adaptimp` (cargo feature
+//! `python`, built by maturin; see `pyproject.toml`).
+//!
+//! Thin wrappers over the core for arms of n = 1 … 7 joints with the paper's
+//! vertex grid (n ≤ 3) or user RBF centres. The friendly layer (keyword
+//! parameters with the paper's defaults, result objects, plots, the CLI) is
+//! pure Python in `python/adaptimp/`; it hands this module complete parameter
+//! dicts whose keys are the schema's names (`Ts`, `Kp`, `Kzeta`, …).
+//!
+//! - The controller of n joints is a [`dynamic::DynTracker`] (one
+//!   monomorphised core per n behind one object-safe face), the arms are
+//!   [`arm::DynArm`]s.
+//! - Errors become the exception classes of `adaptimp._errors` in one place
+//!   each: [`config_error`] (construction: `ConfigError`) and [`step_error`]
+//!   (a step: `MeasurementError`, `DivergedError`, `FaultError`), with the
+//!   measurement named as in Python (`q`, not the core's `x`).
+//! - Long calls ([`simulate`], `Controller.replay`) run with the GIL released,
+//!   check for signals (Ctrl-C) every 50 ms of work and report progress to an
+//!   optional callback; records are moved into NumPy without copying.
+//! - A controller is behind a mutex: each call is atomic; a thread that finds
+//!   it in use by another waits with the GIL released (never "Already
+//!   borrowed").
+//!
+//! Nothing here panics on user input and nothing is `unsafe`.
+
+mod arm;
+mod dynamic;
+
+use crate::config::Law;
+use crate::error::Error;
+use crate::model::{Link, TwoLinkArm};
+use crate::schema::{Kind, Preset, Scenario, Value, PARAMS};
+use arm::DynArm;
+use dynamic::{
+    ArmSpec, CentersSpec, DynTracker, Hooks, Inputs, Last, Owned, ParamError, RunError, Tables,
+    JOINT_RECORDS, MAX_JOINTS,
+};
+use numpy::ndarray::{Array, Dimension, IntoDimension};
+use numpy::{
+    IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods,
+    PyReadonlyArray1, PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyMemoryError, PyOverflowError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList, PyString};
+use std::sync::{Mutex, MutexGuard, TryLockError};
+use std::time::{Duration, Instant};
+
+pyo3::import_exception!(adaptimp._errors, ConfigError);
+pyo3::import_exception!(adaptimp._errors, MeasurementError);
+pyo3::import_exception!(adaptimp._errors, DivergedError);
+pyo3::import_exception!(adaptimp._errors, FaultError);
+
+// ---------------------------------------------------------------------------
+// Errors: the one place each where core errors become exceptions.
+// ---------------------------------------------------------------------------
+
+/// A construction error: `ConfigError` (a `ValueError`) naming the parameter.
+fn config_error(e: ParamError) -> PyErr {
+    match e.name {
+        Some(name) => ConfigError::new_err(format!("{name}: {}", e.error)),
+        None => ConfigError::new_err(e.error.to_string()),
+    }
+}
+
+/// A step's error: `DivergedError` for a diverged state, `FaultError` for a
+/// latched fault, `MeasurementError` for an input (named as in Python).
+fn step_error(e: Error) -> PyErr {
+    let e = python_names(e);
+    match e {
+        Error::Diverged { .. } => DivergedError::new_err(e.to_string()),
+        Error::Faulted { .. } => FaultError::new_err(e.to_string()),
+        Error::Condition { .. } | Error::Invalid { .. } => ConfigError::new_err(e.to_string()),
+        _ => MeasurementError::new_err(e.to_string()),
+    }
+}
+
+/// A run's error: as [`step_error`] with the row, or the hook's exception.
+fn run_error(e: RunError, hooks: &mut PyHooks) -> PyErr {
+    match e {
+        RunError::Stopped => hooks
+            .error
+            .take()
+            .unwrap_or_else(|| PyRuntimeError::new_err("the run was stopped")),
+        RunError::Memory(rows) => {
+            PyMemoryError::new_err(format!("cannot allocate the records of {rows} rows"))
+        }
+        RunError::Core(e, None) => step_error(e),
+        RunError::Core(e, Some(k)) => {
+            let err = step_error(e);
+            Python::attach(|py| {
+                let msg = format!("row {k}: {}", err.value(py));
+                let ty = err.get_type(py);
+                PyErr::from_type(ty, msg)
+            })
+        }
+    }
+}
+
+/// The core's names of the measurement as Python names them.
+fn python_names(e: Error) -> Error {
+    let rename = |what: &'static str| match what {
+        "x" => "q",
+        "dx" => "dq",
+        other => other,
+    };
+    match e {
+        Error::NonFinite { what, index } => Error::NonFinite {
+            what: rename(what),
+            index,
+        },
+        Error::OutOfRange {
+            what,
+            index,
+            value,
+            limit,
+        } => Error::OutOfRange {
+            what: rename(what),
+            index,
+            value,
+            limit,
+        },
+        other => other,
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Parameters: the schema (src/schema.rs) is the one source.
+// ---------------------------------------------------------------------------
+
+fn law_of(case: &str) -> PyResult<Law> {
+    match case {
+        "pd" => Ok(Law::Pd),
+        "sf" => Ok(Law::StateFeedback),
+        "of" => Ok(Law::OutputFeedback),
+        other => Err(PyValueError::new_err(format!(
+            "case must be 'pd', 'sf' or 'of', got {other:?}"
+        ))),
+    }
+}
+
+fn case_of(law: Law) -> &'static str {
+    match law {
+        Law::Pd => "pd",
+        Law::StateFeedback => "sf",
+        Law::OutputFeedback => "of",
+    }
+}
+
+fn preset_of(scenario: &str) -> PyResult<Preset> {
+    Preset::from_name(scenario).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "scenario must be one of 'paper', 'robot', got {scenario:?}"
+        ))
+    })
+}
+
+fn check_n(n: usize) -> PyResult<usize> {
+    if (1..=MAX_JOINTS).contains(&n) {
+        Ok(n)
+    } else {
+        Err(ConfigError::new_err(format!(
+            "n must be between 1 and {MAX_JOINTS} joints, got {n}"
+        )))
+    }
+}
+
+/// A Python value in the schema's terms.
+fn owned(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<Owned> {
+    if obj.is_none() {
+        return Ok(Owned::None);
+    }
+    if obj.is_instance_of::<PyString>() {
+        return Ok(Owned::Str(obj.extract()?));
+    }
+    if obj.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name} must be a number, got bool"
+        )));
+    }
+    if obj.is_instance_of::<pyo3::types::PyInt>() {
+        return match obj.extract::<i64>() {
+            Ok(i) => Ok(Owned::Int(i)),
+            Err(_) => Err(ConfigError::new_err(format!(
+                "{name} is out of range: {}",
+                obj.str().map(|s| s.to_string()).unwrap_or_default()
+            ))),
+        };
+    }
+    if let Ok(x) = obj.extract::<f64>() {
+        return Ok(Owned::Real(x));
+    }
+    match obj.extract::<Vec<f64>>() {
+        Ok(v) => Ok(Owned::Vec(v)),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{name} must be a number, a sequence of numbers, a string or None"
+        ))),
+    }
+}
+
+fn items(params: &Bound<'_, PyDict>) -> PyResult<Vec<(String, Owned)>> {
+    params
+        .iter()
+        .map(|(k, v)| {
+            let name: String = k.extract()?;
+            let o = owned(&name, &v)?;
+            Ok((name, o))
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------
+// Vectors in and out.
+// ---------------------------------------------------------------------------
+
+/// Up to [`MAX_JOINTS`] values on the stack.
+type Buf = [f64; MAX_JOINTS];
+
+/// A shape as Python prints it: `shape (3,)`, `shape (2, 1)`.
+fn python_shape(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("shape ({n},)"),
+        _ => {
+            let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+            format!("shape ({})", dims.join(", "))
+        }
+    }
+}
+
+fn shape_error(what: &str, n: usize, got: &str) -> PyErr {
+    MeasurementError::new_err(format!(
+        "{what} must have shape ({n},) (one value per joint), got {got}"
+    ))
+}
+
+fn type_error(what: &str, n: usize, obj: &Bound<'_, PyAny>) -> PyErr {
+    let ty = obj
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".to_owned());
+    PyTypeError::new_err(format!(
+        "{what} must be a sequence or array of {n} real numbers (shape ({n},)), got {ty}"
+    ))
+}
+
+/// A joint-space vector of n values from Python: an array of shape (n,) of a
+/// real dtype, or a sequence of n real numbers (any values). Errors name `what`.
+fn vector_any(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<Buf> {
+    let mut out = [0.0; MAX_JOINTS];
+    if let Ok(f) = obj.cast::<PyArray1<f64>>() {
+        if f.len() != n {
+            return Err(shape_error(what, n, &python_shape(f.shape())));
+        }
+        // A copy without the borrow tracker (the hot path of `step`).
+        match f.to_vec() {
+            Ok(v) => out[..n].copy_from_slice(&v),
+            Err(_) => {
+                for (i, o) in out[..n].iter_mut().enumerate() {
+                    *o = f.get_owned(i).unwrap_or(f64::NAN);
+                }
+            }
+        }
+    } else if let Ok(arr) = obj.cast::<PyUntypedArray>() {
+        if arr.ndim() != 1 || arr.len() != n {
+            return Err(shape_error(what, n, &python_shape(arr.shape())));
+        }
+        if !matches!(arr.dtype().kind(), b'f' | b'i' | b'u') {
+            return Err(PyTypeError::new_err(format!(
+                "{what} must hold real numbers, got an array of dtype {}",
+                arr.dtype()
+            )));
+        }
+        let converted = obj.call_method1("astype", ("float64",))?;
+        let f = converted.cast::<PyArray1<f64>>()?;
+        let ro = f.try_readonly()?;
+        for (o, x) in out.iter_mut().zip(ro.as_array().iter()) {
+            *o = *x;
+        }
+    } else if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() {
+        return Err(type_error(what, n, obj));
+    } else if let Ok(v) = obj.extract::<Vec<f64>>() {
+        if v.len() != n {
+            return Err(shape_error(what, n, &format!("length {}", v.len())));
+        }
+        out[..n].copy_from_slice(&v);
+    } else if obj.extract::<f64>().is_ok() {
+        return Err(shape_error(what, n, "a scalar"));
+    } else {
+        let e = obj.extract::<Vec<f64>>().err();
+        let overflow = Python::attach(|py| e.is_some_and(|e| e.is_instance_of::<PyOverflowError>(py)));
+        if overflow {
+            return Err(MeasurementError::new_err(format!(
+                "{what} holds a number too large for a float"
+            )));
+        }
+        return Err(type_error(what, n, obj));
+    }
+    Ok(out)
+}
+
+/// As [`vector_any`], every entry finite.
+fn vector(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<Buf> {
+    let out = vector_any(what, n, obj)?;
+    if let Some(index) = out[..n].iter().position(|x| !x.is_finite()) {
+        return Err(step_error(Error::NonFinite { what, index }));
+    }
+    Ok(out)
+}
+
+fn array1<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, v)
+}
+
+/// Move `data` (row-major) into a NumPy array of shape `shape`, without copying.
+fn array<'py, D: Dimension>(
+    py: Python<'py>,
+    data: Vec<f64>,
+    shape: impl IntoDimension<Dim = D>,
+) -> PyResult<Bound<'py, PyArray<f64, D>>> {
+    let a = Array::from_shape_vec(shape.into_dimension(), data)
+        .map_err(|e| PyValueError::new_err(format!("internal shape mismatch: {e}")))?;
+    Ok(a.into_pyarray(py))
+}
+
+/// A (K, n) float64 table, flattened row-major; the error names it.
+fn table(what: &str, a: &PyReadonlyArray2<'_, f64>, rows: usize, n: usize) -> PyResult<Vec<f64>> {
+    if a.shape() != [rows, n] {
+        return Err(MeasurementError::new_err(format!(
+            "{what} must have shape ({rows}, {n}) like q, got {}",
+            python_shape(a.shape())
+        )));
+    }
+    Ok(a.as_array().iter().copied().collect())
+}
+
+/// Network weights from a dict of "D" (n, n, L), "C" (n, n, L), "G" (n, L)
+/// arrays, as rows ŴD[k][j], ŴC[k][j], ŴG[k]; errors name the key.
+fn weight_rows(n: usize, l: usize, weights: &Bound<'_, PyDict>) -> PyResult<Vec<f64>> {
+    let mut rows = Vec::with_capacity((2 * n * n + n) * l);
+    for (name, shape) in [("D", vec![n, n, l]), ("C", vec![n, n, l]), ("G", vec![n, l])] {
+        let item = weights.get_item(name)?.ok_or_else(|| {
+            ConfigError::new_err(format!("weights has no {name:?} (need D, C and G)"))
+        })?;
+        let arr = item.cast::<PyUntypedArray>().map_err(|_| {
+            PyTypeError::new_err(format!("weights[{name:?}] must be a NumPy array"))
+        })?;
+        if arr.shape() != shape.as_slice() {
+            return Err(ConfigError::new_err(format!(
+                "weights[{name:?}] must have {}, got {}",
+                python_shape(&shape),
+                python_shape(arr.shape())
+            )));
+        }
+        let f = item.call_method1("astype", ("float64",))?;
+        let f = f.cast::<PyArray<f64, numpy::IxDyn>>()?.try_readonly()?;
+        rows.extend(f.as_array().iter().copied());
+    }
+    Ok(rows)
+}
+
+// ---------------------------------------------------------------------------
+// Long calls: signals and progress.
+// ---------------------------------------------------------------------------
+
+/// Checks for signals (and reports progress) at most every [`CHECK_EVERY`]
+/// of work, taking the GIL only then.
+struct PyHooks {
+    last: Instant,
+    progress: Option<Py<PyAny>>,
+    error: Option<PyErr>,
+}
+
+/// Time between two checks for signals.
+const CHECK_EVERY: Duration = Duration::from_millis(50);
+
+impl PyHooks {
+    fn new(progress: Option<Py<PyAny>>) -> Self {
+        Self {
+            last: Instant::now(),
+            progress,
+            error: None,
+        }
+    }
+}
+
+impl Hooks for PyHooks {
+    fn tick(&mut self, done: u64, total: u64) -> bool {
+        if self.last.elapsed() < CHECK_EVERY {
+            return true;
+        }
+        self.last = Instant::now();
+        Python::attach(|py| {
+            let result = py.check_signals().and_then(|()| match &self.progress {
+                Some(cb) => cb.call1(py, (done, total)).map(|_| ()),
+                None => Ok(()),
+            });
+            match result {
+                Ok(()) => true,
+                Err(e) => {
+                    self.error = Some(e);
+                    false
+                }
+            }
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Controller.
+// ---------------------------------------------------------------------------
+
+/// One of the paper's controllers (SPEC §7) for an arm of n joints, with its
+/// commanded trajectory and its state, stepped by the caller at the period
+/// Ts (SPEC §11).
+///
+/// Built from a complete parameter dict; use `adaptimp.Controller`, which
+/// fills in the defaults and checks the keywords.
+#[pyclass(name = "Controller", module = "adaptimp._adaptimp", frozen, subclass)]
+struct PyController {
+    inner: Mutex<Box<dyn DynTracker>>,
+    n: usize,
+    law: Law,
+}
+
+impl PyController {
+    /// The controller, waiting (with the GIL released) while another thread
+    /// uses it.
+    fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynTracker>> {
+        loop {
+            match self.inner.try_lock() {
+                Ok(g) => return g,
+                Err(TryLockError::Poisoned(p)) => return p.into_inner(),
+                // Wait for the other thread's call to end without the GIL
+                // (it may need the GIL to finish), then try again with it.
+                Err(TryLockError::WouldBlock) => py.detach(|| {
+                    drop(self.inner.lock());
+                }),
+            }
+        }
+    }
+
+    fn wrap(inner: Box<dyn DynTracker>) -> Self {
+        Self {
+            n: inner.n(),
+            law: inner.law(),
+            inner: Mutex::new(inner),
+        }
+    }
+
+    fn last<'py>(&self, py: Python<'py>, what: Last) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.lock(py).last(what))
+    }
+
+    /// The optional velocity and setpoint of a step, converted.
+    fn optional(
+        &self,
+        dq: Option<&Bound<'_, PyAny>>,
+        setpoint: [Option<&Bound<'_, PyAny>>; 3],
+        finite: bool,
+    ) -> PyResult<(Option<Buf>, Option<[Buf; 3]>)> {
+        let n = self.n;
+        let conv = |what, o| {
+            if finite {
+                vector(what, n, o)
+            } else {
+                vector_any(what, n, o)
+            }
+        };
+        let dx = match (self.law, dq) {
+            (Law::OutputFeedback, _) | (_, None) => None,
+            (_, Some(dq)) => Some(conv("dq", dq)?),
+        };
+        let sp = match setpoint {
+            [None, None, None] => None,
+            [Some(x), dx, ddx] => {
+                let zero = [0.0; MAX_JOINTS];
+                Some([
+                    conv("xc", x)?,
+                    dx.map(|d| conv("dxc", d)).transpose()?.unwrap_or(zero),
+                    ddx.map(|d| conv("ddxc", d)).transpose()?.unwrap_or(zero),
+                ])
+            }
+            [None, ..] => {
+                return Err(PyTypeError::new_err(
+                    "dxc and ddxc need xc (the commanded position)",
+                ))
+            }
+        };
+        Ok((dx, sp))
+    }
+}
+
+#[pymethods]
+impl PyController {
+    /// The controller `case` ("pd", "sf", "of") for `n` joints from the
+    /// complete parameter dict `params`, with the paper's vertex grid (n ≤ 3)
+    /// or the RBF `centers` (L, 4n) with squared widths `widths2` (4n,).
+    #[new]
+    #[pyo3(signature = (case, params, n=2, centers=None, widths2=None))]
+    fn new(
+        case: &str,
+        params: &Bound<'_, PyDict>,
+        n: usize,
+        centers: Option<PyReadonlyArray2<'_, f64>>,
+        widths2: Option<PyReadonlyArray1<'_, f64>>,
+    ) -> PyResult<Self> {
+        let n = check_n(n)?;
+        let law = law_of(case)?;
+        let items = items(params)?;
+        let centers = match (centers, widths2) {
+            (None, None) => None,
+            (Some(c), Some(w)) => {
+                if c.shape()[1] != 4 * n || c.shape()[0] == 0 {
+                    return Err(ConfigError::new_err(format!(
+                        "centers must have shape (L, {}) (L ≥ 1 rows of x, v, α1, α̇1 for {n} joints), got {}",
+                        4 * n,
+                        python_shape(c.shape())
+                    )));
+                }
+                Some(CentersSpec {
+                    centers: c.as_array().iter().copied().collect(),
+                    widths2: w.as_array().iter().copied().collect(),
+                })
+            }
+            _ => {
+                return Err(PyTypeError::new_err(
+                    "centers and widths2 go together (or neither, for the vertex grid)",
+                ))
+            }
+        };
+        let inner = dynamic::build(n, Preset::Paper, law, &items, centers.as_ref())
+            .map_err(config_error)?;
+        Ok(Self::wrap(inner))
+    }
+
+    /// One controller step at t_k = k·Ts: joint positions `q` (rad), the
+    /// measured force on the environment `tau_e` (N m) and, for "pd" and
+    /// "sf", joint velocities `dq` (rad/s; ignored by "of"); with `xc` (and
+    /// optionally `dxc`, `ddxc`, zero if not given) the controller tracks
+    /// that setpoint instead of its trajectory. Returns sat(τ) (N m), (n,).
+    #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        tau_e: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+        xc: Option<&Bound<'py, PyAny>>,
+        dxc: Option<&Bound<'py, PyAny>>,
+        ddxc: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.n;
+        let x = vector("q", n, q)?;
+        let te = vector("tau_e", n, tau_e)?;
+        let (dx, sp) = self.optional(dq, [xc, dxc, ddxc], true)?;
+        let mut out = [0.0; MAX_JOINTS];
+        let inputs = Inputs {
+            x: &x[..n],
+            dx: dx.as_ref().map(|d| &d[..n]),
+            tau_e: &te[..n],
+            setpoint: sp.as_ref().map(|s| [&s[0][..n], &s[1][..n], &s[2][..n]]),
+        };
+        self.lock(py)
+            .step(&inputs, &mut out[..n])
+            .map_err(step_error)?;
+        Ok(array1(py, &out[..n]))
+    }
+
+    /// One step as `step`, but never raising for a refused step: returns the
+    /// torque to apply (N m, (n,)) and the error message (None on success).
+    /// Shapes and types are still checked.
+    #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn step_or_fallback<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        tau_e: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+        xc: Option<&Bound<'py, PyAny>>,
+        dxc: Option<&Bound<'py, PyAny>>,
+        ddxc: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Option<String>)> {
+        let n = self.n;
+        let x = vector_any("q", n, q)?;
+        let te = vector_any("tau_e", n, tau_e)?;
+        let (dx, sp) = self.optional(dq, [xc, dxc, ddxc], false)?;
+        let mut out = [0.0; MAX_JOINTS];
+        let inputs = Inputs {
+            x: &x[..n],
+            dx: dx.as_ref().map(|d| &d[..n]),
+            tau_e: &te[..n],
+            setpoint: sp.as_ref().map(|s| [&s[0][..n], &s[1][..n], &s[2][..n]]),
+        };
+        let result = self.lock(py).step_or_fallback(&inputs, &mut out[..n]);
+        Ok((
+            array1(py, &out[..n]),
+            result.err().map(|e| python_names(e).to_string()),
+        ))
+    }
+
+    /// The fault recorded by the last failed step: (message, step k), or None.
+    #[getter]
+    fn fault(&self, py: Python<'_>) -> Option<(String, u64)> {
+        self.lock(py)
+            .fault()
+            .map(|(e, k)| (python_names(e).to_string(), k))
+    }
+
+    /// Clear the recorded fault.
+    fn clear_fault(&self, py: Python<'_>) {
+        self.lock(py).clear_fault();
+    }
+
+    /// `K` steps in one call from (K, n) float64 tables, without the GIL;
+    /// returns sat(τ), (K, n). Signals are checked every 50 ms of work and
+    /// `progress(done, total)` is called as often. On an error at row k the
+    /// steps before it have been taken and the error names the row.
+    #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None, progress=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn replay<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        tau_e: PyReadonlyArray2<'py, f64>,
+        dq: Option<PyReadonlyArray2<'py, f64>>,
+        xc: Option<PyReadonlyArray2<'py, f64>>,
+        dxc: Option<PyReadonlyArray2<'py, f64>>,
+        ddxc: Option<PyReadonlyArray2<'py, f64>>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.n;
+        let rows = q.shape()[0];
+        let x = table("q", &q, rows, n)?;
+        let te = table("tau_e", &tau_e, rows, n)?;
+        let dx = match (self.law, &dq) {
+            (Law::OutputFeedback, _) | (_, None) => None,
+            (_, Some(dq)) => Some(table("dq", dq, rows, n)?),
+        };
+        let zeros = || vec![0.0; rows * n];
+        let sp = match (&xc, &dxc, &ddxc) {
+            (None, None, None) => None,
+            (Some(x), dx, ddx) => Some([
+                table("xc", x, rows, n)?,
+                dx.as_ref().map(|d| table("dxc", d, rows, n)).transpose()?.unwrap_or_else(zeros),
+                ddx.as_ref().map(|d| table("ddxc", d, rows, n)).transpose()?.unwrap_or_else(zeros),
+            ]),
+            _ => {
+                return Err(PyTypeError::new_err(
+                    "dxc and ddxc need xc (the commanded position)",
+                ))
+            }
+        };
+        let mut out = Vec::new();
+        if out.try_reserve_exact(rows * n).is_err() {
+            return Err(PyMemoryError::new_err(format!(
+                "cannot allocate the torques of {rows} rows"
+            )));
+        }
+        let mut hooks = PyHooks::new(progress);
+        let mut guard = self.lock(py);
+        let tables = Tables {
+            x: &x,
+            dx: dx.as_deref(),
+            tau_e: &te,
+            setpoint: sp.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
+        };
+        let tracker: &mut dyn DynTracker = &mut **guard;
+        let result = py.detach(|| tracker.replay(rows, &tables, &mut out, &mut hooks));
+        drop(guard);
+        result.map_err(|e| run_error(e, &mut hooks))?;
+        array(py, out, (rows, n))
+    }
+
+    /// Back to t = 0: weights, ζ, observer and reference as at construction.
+    fn reset(&self, py: Python<'_>) {
+        self.lock(py).reset();
+    }
+
+    /// The whole state as a flat float64 array (header, n, L, step count,
+    /// reference, ζ, observer, last command, basis, weights); `restore` puts
+    /// it back exactly, so a run continues bit-identically.
+    fn snapshot<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let data = self.lock(py).snapshot();
+        data.into_pyarray(py)
+    }
+
+    /// Restore a `snapshot` of a controller with the same n and L (checked;
+    /// on an error nothing changes). Clears a recorded fault.
+    fn restore(&self, py: Python<'_>, data: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let data: Vec<f64> = data.as_array().iter().copied().collect();
+        self.lock(py).restore(&data).map_err(step_error)
+    }
+
+    /// Replace the network weights: "D" (n, n, L), "C" (n, n, L), "G" (n, L)
+    /// float64 arrays (checked: shape, finite; on an error nothing changes).
+    fn load_weights(&self, py: Python<'_>, weights: &Bound<'_, PyDict>) -> PyResult<()> {
+        let l = self.lock(py).nodes();
+        let rows = weight_rows(self.n, l, weights)?;
+        self.lock(py).load_weights(&rows).map_err(step_error)
+    }
+
+    /// "pd", "sf" or "of".
+    #[getter]
+    fn case(&self) -> &'static str {
+        case_of(self.law)
+    }
+
+    /// Joints n.
+    #[getter]
+    fn n(&self) -> usize {
+        self.n
+    }
+
+    /// RBF nodes L.
+    #[getter]
+    fn nodes(&self, py: Python<'_>) -> usize {
+        self.lock(py).nodes()
+    }
+
+    /// Time of the next step t_k = k·Ts (s).
+    #[getter]
+    fn t(&self, py: Python<'_>) -> f64 {
+        self.lock(py).time()
+    }
+
+    /// Steps taken since construction or reset.
+    #[getter]
+    fn steps(&self, py: Python<'_>) -> u64 {
+        self.lock(py).steps()
+    }
+
+    /// Sampling period Ts (s).
+    #[getter]
+    fn ts(&self, py: Python<'_>) -> f64 {
+        self.lock(py).ts()
+    }
+
+    /// Auxiliary state ζ (N m) now, i.e. what the next step uses, (11).
+    #[getter]
+    fn zeta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.lock(py).zeta())
+    }
+
+    /// Velocity the last step used (rad/s): dq, or the observer's estimate for "of".
+    #[getter]
+    fn dq_hat<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::V)
+    }
+
+    /// The last step's commanded torque τ (N m), before saturation.
+    #[getter]
+    fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::Tau)
+    }
+
+    /// The last step's applied torque sat(τ) (N m).
+    #[getter]
+    fn tau_sat<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::TauSat)
+    }
+
+    /// The last step's Δτ = sat(τ) − τ (N m).
+    #[getter]
+    fn dtau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::Dtau)
+    }
+
+    /// The last step's tracking error z1 = xd − q (rad).
+    #[getter]
+    fn z1<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::Z1)
+    }
+
+    /// The last step's commanded position xc (rad).
+    #[getter]
+    fn xc<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::Xc)
+    }
+
+    /// The last step's compliant reference xd (rad).
+    #[getter]
+    fn xd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::Xd)
+    }
+
+    /// Network weights now (after the last step's update), SPEC §6:
+    /// "D" (n, n, L) kg m², "C" (n, n, L) kg m²/s, "G" (n, L) N m,
+    /// indexed [k][j][i] (output row, column, node).
+    #[getter]
+    fn weights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (mut w, l) = {
+            let g = self.lock(py);
+            (g.weights(), g.nodes())
+        };
+        let n = self.n;
+        let g = w.split_off(2 * n * n * l);
+        let c = w.split_off(n * n * l);
+        let out = PyDict::new(py);
+        out.set_item("D", array(py, w, (n, n, l))?)?;
+        out.set_item("C", array(py, c, (n, n, l))?)?;
+        out.set_item("G", array(py, g, (n, l))?)?;
+        Ok(out)
+    }
+
+    /// The projection's weight bounds on ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F as resolved,
+    /// or None.
+    #[getter]
+    fn weight_bound(&self, py: Python<'_>) -> Option<[f64; 3]> {
+        self.lock(py).weight_bound()
+    }
+
+    /// (g, min Kp): the per-step gain of the explicit-Euler learning step at
+    /// the start of the trajectory (N m per rad/s) and the smallest Kp; the
+    /// learning loop is stable for g < Kp (docs/robot.md).
+    #[getter]
+    fn learning_gain(&self, py: Python<'_>) -> (f64, f64) {
+        self.lock(py).learning_gain()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let g = self.lock(py);
+        format!(
+            "<adaptimp._adaptimp.Controller case={:?} n={} L={} Ts={} s, t={} s, steps={}>",
+            case_of(self.law),
+            self.n,
+            g.nodes(),
+            g.ts(),
+            g.time(),
+            g.steps()
+        )
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Arms.
+// ---------------------------------------------------------------------------
+
+/// D(q), C(q, q̇), G(q) and q̈ of `arm`, for both arm classes.
+fn arm_matrix<'py>(py: Python<'py>, n: usize, data: Vec<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    array(py, data, (n, n))
+}
+
+macro_rules! arm_class {
+    ($ty:ty, { $($extra:tt)* }) => {
+        #[pymethods]
+        impl $ty {
+            $($extra)*
+
+            /// Inertia matrix D(q) (kg m²), (n, n).
+            #[pyo3(name = "D")]
+            fn inertia<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                arm_matrix(py, n, a.inertia(&vector("q", n, q)?[..n]))
+            }
+
+            /// Coriolis and centripetal matrix C(q, dq) (kg m²/s), (n, n).
+            #[pyo3(name = "C")]
+            fn coriolis<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+                dq: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                let m = a.coriolis(&vector("q", n, q)?[..n], &vector("dq", n, dq)?[..n]);
+                arm_matrix(py, n, m)
+            }
+
+            /// Gravity torque G(q) (N m), (n,).
+            #[pyo3(name = "G")]
+            fn gravity<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                Ok(array1(py, &a.gravity(&vector("q", n, q)?[..n])))
+            }
+
+            /// Joint acceleration (rad/s²), (n,), from (4):
+            /// D(q) q̈ = tau − tau_e − C(q, dq) dq − G(q).
+            fn forward_dynamics<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+                dq: &Bound<'py, PyAny>,
+                tau: &Bound<'py, PyAny>,
+                tau_e: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                let acc = a.forward_dynamics(
+                    &vector("q", n, q)?[..n],
+                    &vector("dq", n, dq)?[..n],
+                    &vector("tau", n, tau)?[..n],
+                    &vector("tau_e", n, tau_e)?[..n],
+                );
+                Ok(array1(py, &acc))
+            }
+
+            /// Joints n.
+            #[getter]
+            fn n(&self) -> usize {
+                self.dyn_arm().n()
+            }
+        }
+    };
+}
+
+/// The paper's 2-link arm in a vertical plane, (55)–(63), SPEC §1.
+///
+/// Built from a complete parameter dict; use `adaptimp.TwoLinkArm`.
+#[pyclass(name = "TwoLinkArm", module = "adaptimp._adaptimp", frozen)]
+struct PyArm {
+    inner: TwoLinkArm,
+}
+
+impl PyArm {
+    fn dyn_arm(&self) -> &dyn DynArm {
+        &self.inner
+    }
+}
+
+arm_class!(PyArm, {
+    #[new]
+    #[pyo3(signature = (params))]
+    fn new(params: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let items = items(params)?;
+        let s = dynamic::scenario::<2>(Preset::Paper, Law::Pd, &items).map_err(config_error)?;
+        let inner = TwoLinkArm::new(s.arm.resolve()).map_err(|e| config_error(e.into()))?;
+        Ok(Self { inner })
+    }
+
+    /// The arm's parameters, derived ones included: "m1", "m2" (kg), "l1",
+    /// "l2", "lc1", "lc2" (m), "I1", "I2" (kg m²), "g" (m/s²).
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = self.inner.params();
+        let d = PyDict::new(py);
+        for (name, v) in [
+            ("m1", p.m1),
+            ("m2", p.m2),
+            ("l1", p.l1),
+            ("l2", p.l2),
+            ("lc1", p.lc1),
+            ("lc2", p.lc2),
+            ("I1", p.i1),
+            ("I2", p.i2),
+            ("g", p.g),
+        ] {
+            d.set_item(name, v)?;
+        }
+        Ok(d)
+    }
+
+    /// The lumped parameters p1..p5 of (59)–(63) (kg m², kg m², kg m², kg m, kg m).
+    #[getter]
+    fn lumped(&self) -> (f64, f64, f64, f64, f64) {
+        let [p1, p2, p3, p4, p5] = self.inner.lumped();
+        (p1, p2, p3, p4, p5)
+    }
+
+    fn __repr__(&self) -> String {
+        let p = self.inner.params();
+        format!(
+            "<adaptimp._adaptimp.TwoLinkArm m=[{}, {}] kg, l=[{}, {}] m, lc=[{}, {}] m, I=[{}, {}] kg m², g={} m/s²>",
+            p.m1, p.m2, p.l1, p.l2, p.lc1, p.lc2, p.i1, p.i2, p.g
+        )
+    }
+});
+
+/// An n-link planar arm (1 ≤ n ≤ 7) of revolute joints in a vertical plane:
+/// relative joint angles, link 1's angle from the horizontal, gravity along −y.
+#[pyclass(name = "PlanarArm", module = "adaptimp._adaptimp", frozen)]
+struct PyPlanarArm {
+    inner: Box<dyn DynArm>,
+    links: Vec<Link>,
+    g: f64,
+}
+
+impl PyPlanarArm {
+    fn dyn_arm(&self) -> &dyn DynArm {
+        self.inner.as_ref()
+    }
+}
+
+arm_class!(PyPlanarArm, {
+    /// Links from per-link `masses` (kg), `lengths` (m), `coms` (m, joint to
+    /// centre of mass) and `inertias` (kg m², about the centre of mass), and
+    /// gravity `g` (m/s²).
+    #[new]
+    #[pyo3(signature = (masses, lengths, coms, inertias, g))]
+    fn new(
+        masses: Vec<f64>,
+        lengths: Vec<f64>,
+        coms: Vec<f64>,
+        inertias: Vec<f64>,
+        g: f64,
+    ) -> PyResult<Self> {
+        let n = masses.len();
+        if lengths.len() != n || coms.len() != n || inertias.len() != n {
+            return Err(ConfigError::new_err(
+                "masses, lengths, coms and inertias need one value per link each",
+            ));
+        }
+        let links: Vec<Link> = (0..n)
+            .map(|i| Link {
+                mass: masses[i],
+                length: lengths[i],
+                com: coms[i],
+                inertia: inertias[i],
+            })
+            .collect();
+        let inner = arm::planar(&links, g).map_err(|e| config_error(e.into()))?;
+        Ok(Self { inner, links, g })
+    }
+
+    /// Gravity (m/s²).
+    #[getter]
+    fn g(&self) -> f64 {
+        self.g
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<adaptimp._adaptimp.PlanarArm n={} g={} m/s²>",
+            self.links.len(),
+            self.g
+        )
+    }
+});
+
+// ---------------------------------------------------------------------------
+// simulate.
+// ---------------------------------------------------------------------------
+
+/// Close the loop of `controller` (reset first) with `arm` (a `TwoLinkArm` or
+/// a `PlanarArm` of the controller's n joints) and the wall (or free space)
+/// of `params`, integrating the plant with RK4 (SPEC §11), with the GIL
+/// released, from the initial `weights` (a dict as for
+/// `Controller.load_weights`; zero if None). Keeps every `record_every`-th row (the metrics see every step);
+/// checks for signals every 50 ms and calls `progress(done, total)` as often.
+/// Returns a dict of the arrays ("t" (K,), per-joint (K, n): "q", "dq",
+/// "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e",
+/// "zeta", "z1"; "w_norms" (K, 3); "refused" (K,) bool) and "metrics"
+/// (SPEC §12). `controller` is left in its state at the end of the run.
+#[pyfunction]
+#[pyo3(signature = (controller, arm, params, record_every=1, progress=None, weights=None))]
+fn simulate<'py>(
+    py: Python<'py>,
+    controller: &Bound<'py, PyController>,
+    arm: &Bound<'py, PyAny>,
+    params: &Bound<'py, PyDict>,
+    record_every: u64,
+    progress: Option<Py<PyAny>>,
+    weights: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if record_every == 0 {
+        return Err(ConfigError::new_err("record_every must be ≥ 1"));
+    }
+    let spec = if let Ok(a) = arm.cast::<PyArm>() {
+        ArmSpec::Paper(a.get().inner)
+    } else if let Ok(a) = arm.cast::<PyPlanarArm>() {
+        ArmSpec::Planar {
+            links: a.get().links.clone(),
+            g: a.get().g,
+        }
+    } else {
+        return Err(PyTypeError::new_err(
+            "arm must be an adaptimp TwoLinkArm or PlanarArm",
+        ));
+    };
+    let items = items(params)?;
+    let ctrl = controller.get();
+    let weights = match weights {
+        Some(w) => Some(weight_rows(ctrl.n, ctrl.lock(py).nodes(), w)?),
+        None => None,
+    };
+    let mut hooks = PyHooks::new(progress);
+    let mut guard = ctrl.lock(py);
+    let tracker: &mut dyn DynTracker = &mut **guard;
+    let result =
+        py.detach(|| {
+        tracker.simulate(&spec, &items, weights.as_deref(), record_every, &mut hooks)
+    });
+    drop(guard);
+    let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
+    let k = rec.rows();
+    let n = rec.n;
+    let out = PyDict::new(py);
+    out.set_item("t", rec.t.into_pyarray(py))?;
+    for (name, data) in JOINT_RECORDS.iter().zip(rec.joint) {
+        out.set_item(*name, array(py, data, (k, n))?)?;
+    }
+    out.set_item("w_norms", array(py, rec.w_norms, (k, 3))?)?;
+    out.set_item("refused", PyArray1::from_vec(py, rec.refused))?;
+    let m = PyDict::new(py);
+    for (name, v) in metrics.counts {
+        m.set_item(name, v)?;
+    }
+    for (name, v) in metrics.scalars {
+        m.set_item(name, v)?;
+    }
+    for (name, v) in metrics.joint {
+        m.set_item(name, v)?;
+    }
+    out.set_item("metrics", m)?;
+    Ok(out)
+}
+
+/// A schema value as Python sees it: float, int, list of floats, str or None.
+fn py_value<'py>(py: Python<'py>, v: Value<'_>) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        Value::Real(x) => x.into_pyobject(py)?.into_any(),
+        Value::Int(i) => i.into_pyobject(py)?.into_any(),
+        Value::Vec(v) => PyList::new(py, v)?.into_any(),
+        Value::Str(s) => PyString::new(py, s).into_any(),
+        Value::None => py.None().into_bound(py),
+    })
+}
+
+/// The parameter schema (src/schema.rs), the one source of every parameter:
+/// a list of dicts with "name", "group", "kind", "unit", "doc", "condition",
+/// "choices" (for a choice) and "defaults" (per scenario, as the schema
+/// declares them: a number may stand for every joint).
+#[pyfunction]
+fn schema_table(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let out = PyList::empty(py);
+    for p in PARAMS {
+        let d = PyDict::new(py);
+        d.set_item("name", p.name)?;
+        d.set_item("group", p.group.name())?;
+        d.set_item("kind", p.kind.name())?;
+        d.set_item("unit", p.unit)?;
+        d.set_item("doc", p.doc)?;
+        d.set_item("condition", p.condition)?;
+        let choices: &[&str] = match p.kind {
+            Kind::Choice(c) => c,
+            _ => &[],
+        };
+        d.set_item("choices", PyList::new(py, choices)?)?;
+        let defaults = PyDict::new(py);
+        for preset in Preset::ALL {
+            defaults.set_item(preset.name(), py_value(py, p.default_in(preset))?)?;
+        }
+        d.set_item("defaults", defaults)?;
+        out.append(d)?;
+    }
+    Ok(out)
+}
+
+/// Every parameter's default in `scenario` ("paper" or "robot") for `n`
+/// joints, keyed by name: per-joint values as lists of n, derived arm values
+/// as None.
+#[pyfunction]
+#[pyo3(signature = (scenario="paper", n=2))]
+fn defaults<'py>(py: Python<'py>, scenario: &str, n: usize) -> PyResult<Bound<'py, PyDict>> {
+    let preset = preset_of(scenario)?;
+    let d = PyDict::new(py);
+    let mut err = Ok(());
+    macro_rules! visit {
+        ($($k:literal)*) => {
+            match check_n(n)? {
+                $($k => Scenario::<$k>::preset(preset, Law::StateFeedback).visit(|name, v| {
+                    if err.is_ok() {
+                        err = py_value(py, v).and_then(|v| d.set_item(name, v));
+                    }
+                }),)*
+                _ => {}
+            }
+        };
+    }
+    visit!(1 2 3 4 5 6 7);
+    err?;
+    Ok(d)
+}
+
+/// Adaptive neural impedance control with input saturation (He, Dong & Sun,
+/// IEEE TSMC 2016): the compiled core for arms of 1 to 7 joints. Use the
+/// `adaptimp` package, which wraps this module.
+#[pymodule]
+#[pyo3(name = "_adaptimp")]
+mod adaptimp_module {
+    use pyo3::prelude::*;
+
+    #[pymodule_export]
+    use super::{defaults, schema_table, simulate, PyArm, PyController, PyPlanarArm};
+
+    #[pymodule_init]
+    fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
+        m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+        m.add("MAX_JOINTS", super::MAX_JOINTS)?;
+        m.add("N_NODES", crate::types::grid_nodes(2))?;
+        // Load NumPy's C API now, at import: loading it lazily inside a call
+        // can meet a pending KeyboardInterrupt and fail with a panic.
+        let _ = numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
+        Ok(())
+    }
+}

@@ -1,20 +1,22 @@
-"""Type stubs of the compiled core ``adaptimp._adaptimp`` (src/python.rs).
+"""Type stubs of the compiled core ``adaptimp._adaptimp`` (src/python/).
 
 The classes take complete parameter dicts keyed by the Python parameter names;
 ``adaptimp.Controller``, ``adaptimp.TwoLinkArm`` and ``adaptimp.simulate`` build
 them from keywords with the paper's defaults.
 """
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, Literal, TypedDict, final, type_check_only
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from typing_extensions import disjoint_base
 
 __all__ = [
-    "N_JOINTS",
+    "MAX_JOINTS",
     "N_NODES",
     "Controller",
+    "PlanarArm",
     "TwoLinkArm",
     "__version__",
     "defaults",
@@ -23,7 +25,7 @@ __all__ = [
 ]
 
 __version__: str
-N_JOINTS: int
+MAX_JOINTS: int
 N_NODES: int
 
 _F = NDArray[np.float64]
@@ -167,23 +169,63 @@ class ArmParams(TypedDict, total=False):
 
 # END GENERATED
 
-@final
+@disjoint_base
 class Controller:
-    """One of the paper's controllers for the 2-link arm, with its state."""
+    """One of the paper's controllers for an arm of n joints, with its state."""
 
-    def __new__(cls, case: str, params: ControllerParams | dict[str, Any]) -> Controller: ...
-    def step(self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None) -> _F: ...
+    def __new__(
+        cls,
+        case: str,
+        params: ControllerParams | dict[str, Any],
+        n: int = 2,
+        centers: _F | None = None,
+        widths2: _F | None = None,
+    ) -> Controller: ...
+    def step(
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None = None,
+        *,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> _F: ...
     def step_or_fallback(
-        self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None = None,
+        *,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
     ) -> tuple[_F, str | None]: ...
     @property
     def fault(self) -> tuple[str, int] | None: ...
     def clear_fault(self) -> None: ...
-    def replay(self, q: _F, tau_e: _F, dq: _F | None = None) -> _F:
-        """K steps replaying (K, 2) float64 measurement tables; applied torques (K, 2) (N m)."""
+    def replay(
+        self,
+        q: _F,
+        tau_e: _F,
+        dq: _F | None = None,
+        *,
+        xc: _F | None = None,
+        dxc: _F | None = None,
+        ddxc: _F | None = None,
+        progress: Callable[[int, int], object] | None = None,
+    ) -> _F:
+        """K steps from (K, n) float64 tables; applied torques (K, n) (N m)."""
     def reset(self) -> None: ...
+    def snapshot(self) -> _F: ...
+    def restore(self, data: _F) -> None: ...
+    def load_weights(self, weights: dict[str, _F]) -> None: ...
     @property
     def case(self) -> str: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def nodes(self) -> int: ...
     @property
     def t(self) -> float: ...
     @property
@@ -210,6 +252,8 @@ class Controller:
     def weights(self) -> dict[str, _F]: ...
     @property
     def weight_bound(self) -> list[float] | None: ...
+    @property
+    def learning_gain(self) -> tuple[float, float]: ...
 
 @final
 class TwoLinkArm:
@@ -223,17 +267,47 @@ class TwoLinkArm:
         self, q: ArrayLike, dq: ArrayLike, tau: ArrayLike, tau_e: ArrayLike
     ) -> _F: ...
     @property
+    def n(self) -> int: ...
+    @property
     def params(self) -> dict[str, float]: ...
     @property
     def lumped(self) -> tuple[float, float, float, float, float]: ...
 
+@final
+class PlanarArm:
+    """An n-link planar arm (1 ≤ n ≤ 7)."""
+
+    def __new__(
+        cls,
+        masses: Sequence[float],
+        lengths: Sequence[float],
+        coms: Sequence[float],
+        inertias: Sequence[float],
+        g: float,
+    ) -> PlanarArm: ...
+    def D(self, q: ArrayLike) -> _F: ...
+    def C(self, q: ArrayLike, dq: ArrayLike) -> _F: ...
+    def G(self, q: ArrayLike) -> _F: ...
+    def forward_dynamics(
+        self, q: ArrayLike, dq: ArrayLike, tau: ArrayLike, tau_e: ArrayLike
+    ) -> _F: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def g(self) -> float: ...
+
 def simulate(
-    controller: Controller, arm: TwoLinkArm, params: SimParams | dict[str, Any]
+    controller: Controller,
+    arm: TwoLinkArm | PlanarArm,
+    params: SimParams | dict[str, Any],
+    record_every: int = 1,
+    progress: Callable[[int, int], object] | None = None,
+    weights: dict[str, _F] | None = None,
 ) -> dict[str, Any]:
     """Close the loop with the GIL released; returns the arrays and "metrics"."""
 
 def schema_table() -> list[dict[str, Any]]:
     """The parameter schema: name, group, kind, unit, doc, condition, choices, defaults."""
 
-def defaults(scenario: str = "paper") -> dict[str, Any]:
-    """Every parameter's default in ``scenario`` ("paper" or "robot"), keyed by name."""
+def defaults(scenario: str = "paper", n: int = 2) -> dict[str, Any]:
+    """Every parameter's default in ``scenario`` ("paper" or "robot") for n joints."""

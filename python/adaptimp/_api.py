@@ -136,8 +136,12 @@ class _Progress:
         if self.bar:
             self.bar.update(done - self.bar.n)
         else:
-            print(f"\r{self.desc}: {100 * done / total:5.1f}% ({done}/{total} steps)", end="",
-                  file=sys.stderr, flush=True)
+            print(
+                f"\r{self.desc}: {100 * done / total:5.1f}% ({done}/{total} steps)",
+                end="",
+                file=sys.stderr,
+                flush=True,
+            )
 
     def close(self, total: int | None = None) -> None:
         if self.bar:
@@ -438,9 +442,7 @@ class Controller(_adaptimp.Controller):
         check_case(case)
         check_scenario(scenario)
         n = check_n(n)
-        p = resolve(
-            params, scenario=scenario, groups=("controller",), caller="Controller()", n=n
-        )
+        p = resolve(params, scenario=scenario, groups=("controller",), caller="Controller()", n=n)
         c, w2 = _basis(n, centers, widths, p)
         self = cls._make(case, scenario, n, p, c, None if w2 is None else np.sqrt(w2))
         _check_stability(self, p, stacklevel=2)
@@ -537,7 +539,7 @@ class Controller(_adaptimp.Controller):
 
     # -- conveniences -------------------------------------------------------
 
-    def replay(  # type: ignore[override]
+    def replay(
         self,
         q: ArrayLike,
         tau_e: ArrayLike,
@@ -574,8 +576,10 @@ class Controller(_adaptimp.Controller):
             rows before it have been stepped).
         """
         n = self.n
-        tables = [None if a is None else _table(name, a, n)
-                  for name, a in (("dq", dq), ("xc", xc), ("dxc", dxc), ("ddxc", ddxc))]
+        tables = [
+            None if a is None else _table(name, a, n)
+            for name, a in (("dq", dq), ("xc", xc), ("dxc", dxc), ("ddxc", ddxc))
+        ]
         callback, bar = _progress(progress, "replay")
         try:
             return super().replay(
@@ -777,8 +781,13 @@ class PlanarArm:
             raise TypeError(f"g must be a number (m/s²), got {type(g).__name__}")
         if not math.isfinite(float(g)):
             raise ConfigError(f"g must be finite, got {g}")
-        self._params = {
-            "n": n, "masses": m, "lengths": length, "coms": c, "inertias": inertia, "g": float(g)
+        self._params: dict[str, Any] = {
+            "n": n,
+            "masses": m,
+            "lengths": length,
+            "coms": c,
+            "inertias": inertia,
+            "g": float(g),
         }
         self._core = _adaptimp.PlanarArm(m, length, c, inertia, float(g))
 

@@ -189,6 +189,13 @@ def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
         raise ConfigError(
             f"{p.name} must be a number or have shape ({size},) ({per}), got {value!r}"
         ) from e
+    if arr.dtype == object:
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except OverflowError:
+            raise ConfigError(f"{p.name} holds a number too large for a float") from None
+        except (TypeError, ValueError):
+            pass
     if arr.dtype.kind not in "iuf":
         raise TypeError(
             f"{p.name} must be a number or a sequence of {size} numbers ({per}){_unit(p)}, "
@@ -198,8 +205,6 @@ def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
         raise ConfigError(
             f"{p.name} must be a number or have shape ({size},) ({per}), got shape {arr.shape}"
         )
-    if arr.dtype == object:  # pragma: no cover - caught by the dtype check above
-        raise TypeError(f"{p.name} must hold numbers")
     try:
         out = np.broadcast_to(arr.astype(np.float64), (size,))
     except OverflowError:

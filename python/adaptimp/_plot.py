@@ -228,8 +228,13 @@ def into(res: SimResult, kind: str, ax: Axes | Sequence[Axes]) -> Figure:
     single = isinstance(ax, _Axes)
     for i, a in enumerate(axes):
         joint = f", joint {i + 1}" if single and res.n > 1 else ""
-        a.plot(res.t, data[:, i], lw=1.0, color=None if single else _COLORS.get(res.case),
-               label=f"{CASE_NAMES[res.case]}: {name}{joint}")
+        a.plot(
+            res.t,
+            data[:, i],
+            lw=1.0,
+            color=None if single else _COLORS.get(res.case),
+            label=f"{CASE_NAMES[res.case]}: {name}{joint}",
+        )
         if kind == "tracking" and not single:
             a.plot(res.t, res.xc[:, i], color="k", lw=0.8, ls="--")
         a.set_ylabel(f"{name} ({unit})")

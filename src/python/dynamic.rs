@@ -143,8 +143,7 @@ pub struct Records {
 
 /// The names of [`Records::joint`], in order.
 pub const JOINT_RECORDS: [&str; 13] = [
-    "q", "dq", "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e", "zeta",
-    "z1",
+    "q", "dq", "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e", "zeta", "z1",
 ];
 
 impl Records {
@@ -172,7 +171,7 @@ impl Records {
 
 impl<const N: usize> Recorder<N> for Records {
     fn record(&mut self, r: &Row<N>) {
-        let keep = self.seen % self.every == 0;
+        let keep = self.seen.is_multiple_of(self.every);
         self.seen += 1;
         if !keep {
             return;
@@ -442,7 +441,7 @@ impl<const N: usize, P: Plant<N>> Plant<N> for Watched<'_, P> {
     fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
         let a = self.plant.advance(tau, h)?;
         self.done += 1;
-        if self.done % HOOK_EVERY == 0 && !self.hooks.tick(self.done, self.total) {
+        if self.done.is_multiple_of(HOOK_EVERY) && !self.hooks.tick(self.done, self.total) {
             self.stopped = true;
             return Err(Error::Invalid {
                 what: "run",
@@ -477,11 +476,27 @@ fn run_arm<const N: usize, M: Manipulator<N> + Clone>(
         Some(w) => {
             let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
             let plant = RigidBody::new(arm.clone(), wall, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(plant, t, &traj, cfg.t_final, total, &mut (&mut metrics, &mut rec), hooks)
+            watched(
+                plant,
+                t,
+                &traj,
+                cfg.t_final,
+                total,
+                &mut (&mut metrics, &mut rec),
+                hooks,
+            )
         }
         None => {
             let plant = RigidBody::new(arm.clone(), FreeSpace, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(plant, t, &traj, cfg.t_final, total, &mut (&mut metrics, &mut rec), hooks)
+            watched(
+                plant,
+                t,
+                &traj,
+                cfg.t_final,
+                total,
+                &mut (&mut metrics, &mut rec),
+                hooks,
+            )
         }
     };
     result?;
@@ -633,7 +648,7 @@ impl<const N: usize> DynTracker for Typed<N> {
     ) -> Result<(), RunError> {
         let row = |v: &[f64], k: usize| Vector::<N>::from_column_slice(&v[k * N..(k + 1) * N]);
         for k in 0..rows {
-            if k > 0 && (k as u64) % HOOK_EVERY == 0 && !hooks.tick(k as u64, rows as u64) {
+            if k > 0 && (k as u64).is_multiple_of(HOOK_EVERY) && !hooks.tick(k as u64, rows as u64) {
                 return Err(RunError::Stopped);
             }
             let m = Measurement {
@@ -667,18 +682,20 @@ impl<const N: usize> DynTracker for Typed<N> {
         hooks: &mut dyn Hooks,
     ) -> Result<(Records, MetricsOut), RunError> {
         let preset = Preset::Paper;
-        let s = scenario::<N>(preset, self.law(), items).map_err(|e| RunError::Core(e.error, None))?;
+        let s =
+            scenario::<N>(preset, self.law(), items).map_err(|e| RunError::Core(e.error, None))?;
         match arm {
             ArmSpec::Paper(two) => {
-                let typed = self.as_any_mut().downcast_mut::<Typed<2>>().ok_or(
-                    RunError::Core(
+                let typed = self
+                    .as_any_mut()
+                    .downcast_mut::<Typed<2>>()
+                    .ok_or(RunError::Core(
                         Error::Invalid {
                             what: "arm",
                             reason: "TwoLinkArm has 2 joints: the controller has another number",
                         },
                         None,
-                    ),
-                )?;
+                    ))?;
                 let s2 = scenario::<2>(preset, typed.law(), items)
                     .map_err(|e| RunError::Core(e.error, None))?;
                 run_arm(typed, two, &s2, weights, every, hooks)

@@ -67,8 +67,13 @@ fn config_error(e: ParamError) -> PyErr {
 /// latched fault, `MeasurementError` for an input (named as in Python).
 fn step_error(e: Error) -> PyErr {
     let e = python_names(e);
+    const INPUTS: [&str; 6] = ["q", "dq", "tau_e", "xc", "dxc", "ddxc"];
     match e {
         Error::Diverged { .. } => DivergedError::new_err(e.to_string()),
+        // An internal signal (ζ, z1, α1, the weights, …) beyond the finite range.
+        Error::OutOfRange { what, .. } if !INPUTS.contains(&what) => {
+            DivergedError::new_err(e.to_string())
+        }
         Error::Faulted { .. } => FaultError::new_err(e.to_string()),
         Error::Condition { .. } | Error::Invalid { .. } => ConfigError::new_err(e.to_string()),
         _ => MeasurementError::new_err(e.to_string()),
@@ -288,7 +293,8 @@ fn vector_any(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<
         return Err(shape_error(what, n, "a scalar"));
     } else {
         let e = obj.extract::<Vec<f64>>().err();
-        let overflow = Python::attach(|py| e.is_some_and(|e| e.is_instance_of::<PyOverflowError>(py)));
+        let overflow =
+            Python::attach(|py| e.is_some_and(|e| e.is_instance_of::<PyOverflowError>(py)));
         if overflow {
             return Err(MeasurementError::new_err(format!(
                 "{what} holds a number too large for a float"
@@ -338,7 +344,11 @@ fn table(what: &str, a: &PyReadonlyArray2<'_, f64>, rows: usize, n: usize) -> Py
 /// arrays, as rows ŴD[k][j], ŴC[k][j], ŴG[k]; errors name the key.
 fn weight_rows(n: usize, l: usize, weights: &Bound<'_, PyDict>) -> PyResult<Vec<f64>> {
     let mut rows = Vec::with_capacity((2 * n * n + n) * l);
-    for (name, shape) in [("D", vec![n, n, l]), ("C", vec![n, n, l]), ("G", vec![n, l])] {
+    for (name, shape) in [
+        ("D", vec![n, n, l]),
+        ("C", vec![n, n, l]),
+        ("G", vec![n, l]),
+    ] {
         let item = weights.get_item(name)?.ok_or_else(|| {
             ConfigError::new_err(format!("weights has no {name:?} (need D, C and G)"))
         })?;
@@ -644,8 +654,14 @@ impl PyController {
             (None, None, None) => None,
             (Some(x), dx, ddx) => Some([
                 table("xc", x, rows, n)?,
-                dx.as_ref().map(|d| table("dxc", d, rows, n)).transpose()?.unwrap_or_else(zeros),
-                ddx.as_ref().map(|d| table("ddxc", d, rows, n)).transpose()?.unwrap_or_else(zeros),
+                dx.as_ref()
+                    .map(|d| table("dxc", d, rows, n))
+                    .transpose()?
+                    .unwrap_or_else(zeros),
+                ddx.as_ref()
+                    .map(|d| table("ddxc", d, rows, n))
+                    .transpose()?
+                    .unwrap_or_else(zeros),
             ]),
             _ => {
                 return Err(PyTypeError::new_err(
@@ -839,7 +855,11 @@ impl PyController {
 // ---------------------------------------------------------------------------
 
 /// D(q), C(q, q̇), G(q) and q̈ of `arm`, for both arm classes.
-fn arm_matrix<'py>(py: Python<'py>, n: usize, data: Vec<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn arm_matrix<'py>(
+    py: Python<'py>,
+    n: usize,
+    data: Vec<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
     array(py, data, (n, n))
 }
 
@@ -1090,9 +1110,7 @@ fn simulate<'py>(
     let mut guard = ctrl.lock(py);
     let tracker: &mut dyn DynTracker = &mut **guard;
     let result =
-        py.detach(|| {
-        tracker.simulate(&spec, &items, weights.as_deref(), record_every, &mut hooks)
-    });
+        py.detach(|| tracker.simulate(&spec, &items, weights.as_deref(), record_every, &mut hooks));
     drop(guard);
     let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
     let k = rec.rows();

@@ -66,5 +66,8 @@ step "Python: ruff, type stubs, mypy"
 "$py" -m mypy.stubtest adaptimp._adaptimp
 "$py" -m mypy
 
+step "Docs: the site, warnings as errors (MkDocs + mkdocstrings)"
+NO_MKDOCS_2_WARNING=1 "$py" -m mkdocs build --strict --quiet
+
 step "Python: tests"
 "$py" -m pytest

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import adaptimp
 from adaptimp import SimResult
 from adaptimp._result import METRIC_KEYS
 
@@ -47,6 +48,7 @@ def test_reproduce_writes_figures_metrics_and_prints_the_table(tmp_path: Path) -
         assert png.stat().st_size > 20_000
     summary = json.loads((out / "metrics.json").read_text())
     assert summary["overrides"] == {"T": 2.5}
+    assert summary["adaptimp_version"] == adaptimp.__version__
     assert set(summary["metrics"]) == {"pd", "sf", "of"}
     for case, metrics in summary["metrics"].items():
         assert set(metrics) == {*METRIC_KEYS, "rows"}

@@ -138,6 +138,7 @@ def cmd_reproduce(args: argparse.Namespace, params: dict[str, Any]) -> int:
 
     table = metrics_table({CASE_NAMES[c]: r for c, r in results.items()})
     summary = {
+        "adaptimp_version": __version__,
         "scenario": args.scenario,
         "overrides": params,
         "metrics": {c: metrics_json(r.metrics) for c, r in results.items()},

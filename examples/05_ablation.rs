@@ -60,6 +60,18 @@ impl WithTs for Config<2> {
     }
 }
 
+/// The run, 2.5 s under `cargo test`.
+fn short(sim: SimConfig<2>) -> SimConfig<2> {
+    if cfg!(test) {
+        SimConfig {
+            t_final: 2.5,
+            ..sim
+        }
+    } else {
+        sim
+    }
+}
+
 fn main() -> Result<(), adaptimp::Error> {
     let arm = TwoLinkArm::paper();
     let wall = Wall::paper();
@@ -69,12 +81,12 @@ fn main() -> Result<(), adaptimp::Error> {
         (
             "paper 50 µs",
             Config::paper as fn(Law) -> Config<2>,
-            SimConfig::paper(),
+            short(SimConfig::paper()),
         ),
         (
             "robot 1 ms",
             Config::robot as fn(Law) -> Config<2>,
-            SimConfig::robot(),
+            short(SimConfig::robot()),
         ),
     ] {
         for (law, name) in [(Law::StateFeedback, "sf"), (Law::OutputFeedback, "of")] {
@@ -112,4 +124,13 @@ fn main() -> Result<(), adaptimp::Error> {
         }
     }
     Ok(())
+}
+
+/// `cargo test` runs this example, shortened (`cfg!(test)`).
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn runs() {
+        super::main().unwrap();
+    }
 }

@@ -49,7 +49,7 @@ fn faults(tau_max: Vector<2>) -> [(&'static str, Injection<2>); 5] {
 
 fn main() -> Result<(), adaptimp::Error> {
     let sim = SimConfig {
-        t_final: 10.0,
+        t_final: if cfg!(test) { 3.0 } else { 10.0 },
         ..SimConfig::robot()
     };
     println!("| controller | fault | peak applied \\|τ\\|/τmax | peak commanded \\|τ\\| (N m) | refused rows | recovery (s) | NaN | ‖Ŵ‖ D, C, G before → end |");
@@ -85,4 +85,13 @@ fn main() -> Result<(), adaptimp::Error> {
         }
     }
     Ok(())
+}
+
+/// `cargo test` runs this example, shortened (`cfg!(test)`).
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn runs() {
+        super::main().unwrap();
+    }
 }

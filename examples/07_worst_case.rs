@@ -27,7 +27,7 @@ fn main() -> Result<(), adaptimp::Error> {
     let steps: usize = std::env::args()
         .nth(1)
         .and_then(|s| s.parse().ok())
-        .unwrap_or(1_000_000);
+        .unwrap_or(if cfg!(test) { 2_000 } else { 1_000_000 });
     let arm = TwoLinkArm::paper();
     let wall = Wall::paper();
     println!(
@@ -89,4 +89,13 @@ fn main() -> Result<(), adaptimp::Error> {
         );
     }
     Ok(())
+}
+
+/// `cargo test` runs this example, shortened (`cfg!(test)`).
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn runs() {
+        super::main().unwrap();
+    }
 }

@@ -66,7 +66,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .map(|s| s.parse())
         .transpose()?
-        .unwrap_or(24.0);
+        .unwrap_or(if cfg!(test) { 0.0005 } else { 24.0 });
     let ctrl = Controller::robot(Law::StateFeedback);
     let bounds = ctrl
         .learning()
@@ -159,5 +159,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Ok(())
     } else {
         Err(failures.join("; ").into())
+    }
+}
+
+/// `cargo test` runs this example, shortened (`cfg!(test)`).
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn runs() {
+        super::main().unwrap();
     }
 }

@@ -299,3 +299,9 @@ def test_result_plots(close_figures: None) -> None:
     with pytest.raises(ValueError, match="kind must be one of"):
         res.plot("bode")
     assert "MujocoResult" in repr(res)
+
+
+def test_module_examples_run() -> None:
+    import doctest
+
+    assert doctest.testmod(amj, raise_on_error=False).failed == 0

@@ -1,0 +1,112 @@
+"""Robot descriptions shipped with, or found by, adaptimp (standard library only).
+
+- ``two_link.xml`` (packaged): the paper's 2-link arm as MJCF, SPEC §1.
+- The Franka Emika Panda of the ``example-robot-data`` package (installed data,
+  no download): its URDF path, and the arm-only URDF that
+  :func:`adaptimp.mujoco.panda` compiles (finger joints fixed, joint dynamics
+  and meshes removed).
+
+Nothing here imports MuJoCo or Pinocchio; :mod:`adaptimp.mujoco` and
+:mod:`adaptimp.baselines` build their models from these.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+MODELS_DIR = Path(__file__).resolve().parent / "models"
+"""The packaged model files."""
+
+TWO_LINK_XML = MODELS_DIR / "two_link.xml"
+"""MJCF of the paper's 2-link arm in a vertical plane (SPEC §1), with a ceiling wall."""
+
+PANDA_JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
+"""The Panda's seven arm joints, base to flange."""
+
+PANDA_FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+"""The Panda's two prismatic finger joints (locked closed, at 0 m, in every adaptimp model)."""
+
+PANDA_EFFORT = (87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0)
+"""The Panda's joint torque limits (N m), the URDF's ``<limit effort>``."""
+
+PANDA_HOME = (0.0, -0.785398, 0.0, -2.35619, 0.0, 1.5707, 0.785398)
+"""The Panda's reference posture (rad): the ``default`` state of example-robot-data's SRDF."""
+
+PANDA_EE = "panda_hand_tcp"
+"""The Panda's end-effector frame: the tool centre point, 0.1034 m beyond the hand
+along its z axis (the SRDF's ``end_effector``)."""
+
+_ERD = "example-robot-data"
+_PANDA_URDF = "cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf"
+
+
+def panda_urdf_path() -> Path:
+    """Path of the Panda's URDF in the installed ``example-robot-data`` package.
+
+    The package (data only since its version 4.4; the Python loaders are the
+    separate ``example-robot-data-loaders``) installs its robots under its
+    ``cmeel.prefix``. ``$ADAPTIMP_PANDA_URDF`` overrides the lookup.
+
+    Raises
+    ------
+    ImportError
+        ``example-robot-data`` is not installed (``pip install adaptimp[pinocchio]``).
+    """
+    override = os.environ.get("ADAPTIMP_PANDA_URDF")
+    if override:
+        return Path(override)
+    try:
+        dist = importlib.metadata.distribution(_ERD)
+    except importlib.metadata.PackageNotFoundError as e:
+        raise ImportError(
+            "the Panda model comes from the package example-robot-data: "
+            "pip install adaptimp[pinocchio]"
+        ) from e
+    path = Path(str(dist.locate_file(_PANDA_URDF)))
+    if not path.is_file():
+        raise ImportError(f"example-robot-data {dist.version} has no Panda URDF at {path}")
+    return path
+
+
+def adapt_urdf(text: str, fix: tuple[str, ...] = ()) -> tuple[str, dict[str, float]]:
+    """A URDF reduced to its kinematics and inertias, and its joints' effort limits.
+
+    Removes every ``<visual>`` and ``<collision>`` (so no mesh file is needed),
+    every joint's ``<dynamics>`` (damping, friction: the plant adds nothing to
+    the rigid-body dynamics), ``<safety_controller>`` and ``<mimic>``, and makes
+    the joints named in ``fix`` fixed at their zero position.
+
+    Returns the new URDF text and ``{joint name: effort limit (N m)}`` for the
+    remaining revolute, continuous and prismatic joints that declare one.
+    """
+    root = ET.fromstring(text)
+    for link in root.findall("link"):
+        for tag in ("visual", "collision"):
+            for e in link.findall(tag):
+                link.remove(e)
+    effort: dict[str, float] = {}
+    for joint in root.findall("joint"):
+        for tag in ("dynamics", "safety_controller", "mimic"):
+            for e in joint.findall(tag):
+                joint.remove(e)
+        name = joint.get("name", "")
+        if name in fix:
+            joint.set("type", "fixed")
+            for tag in ("axis", "limit"):
+                for e in joint.findall(tag):
+                    joint.remove(e)
+        elif joint.get("type") in ("revolute", "continuous", "prismatic"):
+            limit = joint.find("limit")
+            if limit is not None and limit.get("effort") is not None:
+                effort[name] = float(limit.get("effort", "nan"))
+    return ET.tostring(root, encoding="unicode"), effort
+
+
+def panda_arm_urdf() -> str:
+    """The Panda's URDF as adaptimp uses it: :func:`adapt_urdf` with both finger
+    joints fixed (closed, the fingers' masses then ride on the hand)."""
+    text, _ = adapt_urdf(panda_urdf_path().read_text(), fix=PANDA_FINGERS)
+    return text

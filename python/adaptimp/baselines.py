@@ -1,0 +1,302 @@
+"""Model-based baselines to compare the paper's model-free controllers against.
+
+Needs the optional dependency Pinocchio (``pip install adaptimp[pinocchio]``);
+the rest of adaptimp never imports it.
+
+:class:`ComputedTorque` is the textbook computed-torque (inverse-dynamics)
+impedance controller, in joint space: with the compliant reference xd of SPEC §4
+(the same target impedance Dd, Cd, Gd as the paper's controllers, driven by the
+measured τe),
+
+    τ = M̂(q) (ẍd + K_D (ẋd − q̇) + K_P (xd − q)) + ĥ(q, q̇) + τe,   sat(τ) applied,
+
+with M̂ from Pinocchio's CRBA and ĥ = Ĉ q̇ + Ĝ from its RNEA at zero
+acceleration. With the exact model and no saturation, the error obeys
+ë + K_D ė + K_P e = 0. ``mass_scale`` multiplies every link's mass and inertia
+(e.g. 1.3 for a +30 % model error).
+
+:func:`pinocchio_model` gives the Pinocchio models of the packaged arms:
+``"two_link"`` (the paper's arm, SPEC §1, as in ``models/two_link.xml``) and
+``"panda"`` (example-robot-data's URDF, fingers locked closed), or loads a URDF.
+
+Units: rad, rad/s, rad/s², N m, kg, s.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+try:
+    import pinocchio as pin
+except ImportError as e:  # pragma: no cover - depends on the environment
+    raise ImportError(
+        "adaptimp.baselines needs Pinocchio, an optional dependency: "
+        "pip install adaptimp[pinocchio]"
+    ) from e
+
+from . import _models
+from ._trajectory import Reference, paper_circle
+
+__all__ = ["ComputedTorque", "pinocchio_model"]
+
+FloatArray = NDArray[np.float64]
+
+
+def _two_link(params: dict[str, float]) -> Any:
+    """The paper's arm (SPEC §1) as a Pinocchio model: hinges about −y, links
+    along x, gravity −z (the plane and axes of ``models/two_link.xml``)."""
+    model = pin.Model()
+    model.gravity.linear = np.array([0.0, 0.0, -params["g"]])
+    axis = np.array([0.0, -1.0, 0.0])
+    parent, offset = 0, 0.0
+    for i in (1, 2):
+        placement = pin.SE3(np.eye(3), np.array([offset, 0.0, 0.0]))
+        joint = model.addJoint(
+            parent, pin.JointModelRevoluteUnaligned(axis), placement, f"joint{i}"
+        )
+        inertia = pin.Inertia(
+            params[f"m{i}"],
+            np.array([params[f"lc{i}"], 0.0, 0.0]),
+            np.eye(3) * params[f"I{i}"],
+        )
+        model.appendBodyToJoint(joint, inertia, pin.SE3.Identity())
+        parent, offset = joint, params[f"l{i}"]
+    model.addFrame(
+        pin.Frame(
+            "ee", parent, pin.SE3(np.eye(3), np.array([offset, 0.0, 0.0])), pin.FrameType.OP_FRAME
+        )
+    )
+    return model
+
+
+def pinocchio_model(source: Any = "two_link", **arm: float) -> Any:
+    """A Pinocchio ``Model`` of an arm.
+
+    Parameters
+    ----------
+    source : {"two_link", "panda"}, path or pinocchio.Model
+        ``"two_link"``: the paper's arm (SPEC §1; ``arm`` keywords override its
+        parameters, as for :class:`adaptimp.TwoLinkArm`), with frame ``"ee"``
+        at the tip of link 2. ``"panda"``: the Franka Emika Panda from
+        example-robot-data's URDF with both finger joints locked closed
+        (``buildReducedModel``), 7 joints, frame ``"panda_hand_tcp"``.
+        A path: a URDF. A ``pinocchio.Model`` is returned as it is.
+    """
+    if isinstance(source, pin.Model):
+        return source
+    if isinstance(source, str) and source == "two_link":
+        from ._api import TwoLinkArm
+
+        return _two_link(TwoLinkArm(**arm).params)
+    if arm:
+        raise TypeError(f"arm parameters {sorted(arm)} apply to 'two_link' only")
+    if isinstance(source, str) and source == "panda":
+        full = pin.buildModelFromUrdf(str(_models.panda_urdf_path()))
+        lock = [full.getJointId(name) for name in _models.PANDA_FINGERS]
+        return pin.buildReducedModel(full, lock, pin.neutral(full))
+    if isinstance(source, (str, os.PathLike)) and Path(source).is_file():
+        return pin.buildModelFromUrdf(str(source))
+    raise ValueError(
+        f"source must be 'two_link', 'panda', a URDF path or a pinocchio.Model, got {source!r}"
+    )
+
+
+def scale_masses(model: Any, factor: float) -> Any:
+    """A copy of ``model`` with every body's mass and rotational inertia times
+    ``factor`` (centres of mass unchanged: a uniform change of density)."""
+    if not (factor > 0 and math.isfinite(factor)):
+        raise ValueError(f"mass_scale must be > 0, got {factor}")
+    out = model.copy()
+    for i in range(1, out.njoints):
+        inertia = out.inertias[i]
+        out.inertias[i] = pin.Inertia(
+            factor * inertia.mass, inertia.lever.copy(), factor * inertia.inertia
+        )
+    return out
+
+
+def _joint(name: str, value: ArrayLike, n: int) -> FloatArray:
+    v = np.asarray(value, dtype=np.float64)
+    if v.shape == ():
+        v = np.full(n, float(v))
+    if v.shape != (n,):
+        raise ValueError(f"{name} must be a number or have shape ({n},), got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} must be finite, got {v}")
+    return v
+
+
+class ComputedTorque:
+    """Computed-torque impedance control from a Pinocchio model (module doc).
+
+    The controller protocol of :func:`adaptimp.mujoco.simulate`: ``step(q,
+    tau_e, dq, xc=, dxc=, ddxc=)`` at t_k = k·Ts returns the applied torque
+    sat(τ) (N m); without a setpoint it follows ``trajectory`` (by default,
+    for two joints, the paper's circle (64)).
+
+    Parameters
+    ----------
+    model : str, path or pinocchio.Model
+        What :func:`pinocchio_model` takes (default the paper's arm).
+    Ts : float
+        Period (s).
+    Kp : float or (n,)
+        Stiffness K_P of the error dynamics (1/s²); default 400 (ω = 20 rad/s).
+    Kd : float or (n,)
+        Damping K_D (1/s); default 40 (critical damping at ω = 20 rad/s).
+    tau_max : float or (n,), optional
+        Actuator limits (N m); default the model's ``effortLimit`` (the URDF's),
+        or the paper's [17, 15] for the paper's arm.
+    mass_scale : float
+        Every link mass and inertia of the controller's model times this
+        (1: the exact model; 1.3: +30 %).
+    Dd, Cd, Gd : float or (n,)
+        Target impedance (3) (kg m², N m s/rad, N m/rad); default the paper's
+        1, 10, 60.
+    trajectory : callable, optional
+        ``trajectory(t) -> (xc, dxc, ddxc)`` for steps given no setpoint.
+    """
+
+    def __init__(
+        self,
+        model: Any = "two_link",
+        *,
+        Ts: float = 1e-3,
+        Kp: ArrayLike = 400.0,
+        Kd: ArrayLike = 40.0,
+        tau_max: ArrayLike | None = None,
+        mass_scale: float = 1.0,
+        Dd: ArrayLike = 1.0,
+        Cd: ArrayLike = 10.0,
+        Gd: ArrayLike = 60.0,
+        trajectory: Reference | None = None,
+    ) -> None:
+        exact = pinocchio_model(model)
+        self.model = scale_masses(exact, mass_scale)
+        self.data = self.model.createData()
+        n = self.n = int(self.model.nv)
+        if self.model.nq != n:
+            raise ValueError("ComputedTorque needs revolute joints only (nq = nv)")
+        if not (Ts > 0 and math.isfinite(Ts)):
+            raise ValueError(f"Ts must be > 0, got {Ts}")
+        self._ts = float(Ts)
+        self.Kp, self.Kd = _joint("Kp", Kp, n), _joint("Kd", Kd, n)
+        self.Dd, self.Cd, self.Gd = _joint("Dd", Dd, n), _joint("Cd", Cd, n), _joint("Gd", Gd, n)
+        if np.any(self.Dd <= 0):
+            raise ValueError(f"Dd must be > 0, got {self.Dd}")
+        if tau_max is None:
+            limits = np.asarray(self.model.effortLimit, dtype=np.float64)
+            usable = limits.shape == (n,) and np.all((limits > 0) & (limits < 1e300))
+            tau_max = limits if usable else [17.0, 15.0] if n == 2 else None
+            if tau_max is None:
+                raise ValueError("the model has no effort limits: give tau_max")
+        self.tau_max = _joint("tau_max", tau_max, n)
+        self.mass_scale = float(mass_scale)
+        self._params: dict[str, Any] = {
+            "Ts": self._ts,
+            "Kp": self.Kp.tolist(),
+            "Kd": self.Kd.tolist(),
+            "tau_max": self.tau_max.tolist(),
+            "mass_scale": self.mass_scale,
+            "Dd": self.Dd.tolist(),
+            "Cd": self.Cd.tolist(),
+            "Gd": self.Gd.tolist(),
+        }
+        if trajectory is None and n == 2:
+            trajectory = paper_circle()
+            self._params.update(
+                xc_offset=[0.2, 0.2], xc_sin=[0.0, 0.2], xc_cos=[-0.2, 0.0], xc_omega=[math.pi] * 2
+            )
+        self._trajectory = trajectory
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to t = 0; the reference starts at the first setpoint."""
+        self._k = 0
+        self._xd: FloatArray | None = None
+        self._dxd = np.zeros(self.n)
+        nan = np.full(self.n, math.nan)
+        self.tau, self.tau_sat, self.xc, self.xd, self.z1 = nan, nan, nan, nan, nan
+
+    @property
+    def ts(self) -> float:
+        """Period Ts (s)."""
+        return self._ts
+
+    Ts = ts
+
+    @property
+    def t(self) -> float:
+        """Time of the next step t_k = k·Ts (s)."""
+        return self._k * self._ts
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """The gains, limits, target impedance and (if built in) the trajectory."""
+        return dict(self._params)
+
+    def mass_matrix(self, q: ArrayLike) -> FloatArray:
+        """The controller's model M̂(q) (kg m²), (n, n), from CRBA."""
+        m = pin.crba(self.model, self.data, _joint("q", q, self.n))
+        return np.array(np.triu(m) + np.triu(m, 1).T, dtype=np.float64)
+
+    def bias(self, q: ArrayLike, dq: ArrayLike) -> FloatArray:
+        """The controller's model ĥ = Ĉ(q, q̇) q̇ + Ĝ(q) (N m), (n,), RNEA with q̈ = 0."""
+        q, dq = _joint("q", q, self.n), _joint("dq", dq, self.n)
+        return np.array(pin.rnea(self.model, self.data, q, dq, np.zeros(self.n)), dtype=np.float64)
+
+    def step(
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None = None,
+        *,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> FloatArray:
+        """One step at t_k = k·Ts; returns the applied torque sat(τ) (N m), (n,).
+
+        q (rad), tau_e (N m), dq (rad/s; required), each (n,); the setpoint
+        xc (rad), dxc (rad/s), ddxc (rad/s²), (n,), or none of them (then the
+        built-in ``trajectory``).
+        """
+        n = self.n
+        if dq is None:
+            raise ValueError("ComputedTorque needs the measured joint velocity dq")
+        q, dq, tau_e = _joint("q", q, n), _joint("dq", dq, n), _joint("tau_e", tau_e, n)
+        if xc is None:
+            if dxc is not None or ddxc is not None:
+                raise ValueError("give xc with dxc and ddxc")
+            if self._trajectory is None:
+                raise ValueError("no setpoint given and no trajectory to follow")
+            xc, dxc, ddxc = self._trajectory(self.t)
+        xc = _joint("xc", xc, n)
+        dxc = _joint("dxc", np.zeros(n) if dxc is None else dxc, n)
+        ddxc = _joint("ddxc", np.zeros(n) if ddxc is None else ddxc, n)
+        if self._xd is None:  # xd(0) = xc(0), ẋd(0) = ẋc(0), SPEC §4
+            self._xd, self._dxd = xc.copy(), dxc.copy()
+        xd, dxd = self._xd, self._dxd
+        # The compliant reference (SPEC §4) and the computed torque.
+        ddxd = ddxc + (self.Cd * (dxc - dxd) + self.Gd * (xc - xd) - tau_e) / self.Dd
+        a = ddxd + self.Kd * (dxd - dq) + self.Kp * (xd - q)
+        tau = self.mass_matrix(q) @ a + self.bias(q, dq) + tau_e
+        tau_sat = np.clip(tau, -self.tau_max, self.tau_max)
+        self.tau, self.tau_sat, self.xc, self.xd, self.z1 = tau, tau_sat, xc, xd.copy(), xd - q
+        # Advance the reference to t_{k+1} (SPEC §11: ẋd first, then xd with it).
+        self._dxd = dxd + self._ts * ddxd
+        self._xd = xd + self._ts * self._dxd
+        self._k += 1
+        return tau_sat
+
+    def __repr__(self) -> str:
+        return (
+            f"adaptimp.baselines.ComputedTorque({self.n} joints, Ts = {self._ts:g} s, "
+            f"mass_scale = {self.mass_scale:g})"
+        )

@@ -1,0 +1,1044 @@
+"""MuJoCo as the plant: real arms, contact from a physics engine (SPEC §13).
+
+Needs the optional dependency MuJoCo (``pip install adaptimp[mujoco]``); the
+rest of adaptimp never imports it.
+
+- :class:`Plant` wraps a MuJoCo model of a serial arm with n ≤ 7 hinge joints,
+  one torque actuator (``motor``) per joint: it reads τmax from the actuators'
+  ``ctrlrange``, lets MuJoCo's constraint solver compute contact, and measures
+  the force the arm exerts on its environment, mapped to joint space as
+  τe = Jᵀ F_e.
+- :func:`simulate` closes the loop: any controller with
+  ``.step(q, tau_e, dq=None, **setpoint)`` and a period (``.ts`` or ``.Ts``),
+  or one of the paper's cases by name, runs at Ts with the torque held over
+  ``substeps`` MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12
+  metrics.
+- Models: :func:`two_link` (the paper's arm, packaged as ``models/two_link.xml``),
+  :func:`panda` (the Franka Emika Panda of ``example-robot-data``, arm only, on a
+  table), :func:`from_urdf` (any URDF arm, with motors from its effort limits).
+
+The measured wrench. If the model has a ``force`` sensor, its site is the end
+effector and F_e is read from it (with the ``torque`` sensor on the same site,
+if any, for the moment; without one the moment is taken as zero). MuJoCo's
+force/torque sensors measure the wrench between the site's body and its parent,
+so the site should sit on a massless body welded to the last link, holding the
+contact geometry: then the reading is exactly the contact wrench (the packaged
+models do this). Without a force sensor, F_e is the sum over the active
+contacts of the end-effector body's subtree of ``mj_contactForce``, with the
+moment about the end-effector point (the first site on the last joint's body,
+or that body's origin). :attr:`Plant.wrench_source` says which is used.
+
+Units: rad, rad/s, rad/s², N, N m, m, s. Vectors in the world frame.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+try:
+    import mujoco
+except ImportError as e:  # pragma: no cover - depends on the environment
+    raise ImportError(
+        "adaptimp.mujoco needs MuJoCo, an optional dependency: pip install adaptimp[mujoco]"
+    ) from e
+
+from . import _models
+from ._result import METRIC_KEYS
+from ._trajectory import Reference, paper_circle, sinusoid
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = [
+    "MAX_JOINTS",
+    "ControllerLike",
+    "MujocoResult",
+    "Plant",
+    "Reference",
+    "from_urdf",
+    "panda",
+    "paper_circle",
+    "simulate",
+    "sinusoid",
+    "two_link",
+]
+
+FloatArray = NDArray[np.float64]
+
+MAX_JOINTS = 7
+"""The most joints a :class:`Plant` accepts."""
+
+
+ModelSource = Union["mujoco.MjModel", str, "os.PathLike[str]"]
+
+
+class ControllerLike(Protocol):
+    """What :func:`simulate` needs of a controller: a step and a period.
+
+    ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,);
+    ``setpoint`` is ``xc=, dxc=, ddxc=`` when :func:`simulate` is given a
+    ``reference``, nothing otherwise (the controller then follows its own
+    trajectory). The period is ``.ts`` or ``.Ts`` (s). Optional attributes
+    that :func:`simulate` records when present: ``tau`` (commanded torque
+    before saturation), ``xc``, ``xd``, ``z1``, ``dq_hat``, ``zeta``, and
+    ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``,
+    ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
+    """
+
+    def step(
+        self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None, **setpoint: Any
+    ) -> ArrayLike: ...
+
+
+# ---------------------------------------------------------------------------
+# Commanded trajectories.
+# ---------------------------------------------------------------------------
+
+
+# ---------------------------------------------------------------------------
+# Models.
+# ---------------------------------------------------------------------------
+
+
+def two_link() -> mujoco.MjModel:
+    """The paper's 2-link arm in a vertical plane (SPEC §1), ``models/two_link.xml``.
+
+    The plane is MuJoCo's x-z plane (gravity −z), both hinges about −y, so q is
+    the paper's (q1 from the horizontal, q2 relative). Motors with ctrlrange
+    ±[17, 15] N m; a ceiling wall 0.20 m above the base that only the
+    end-effector sphere touches; force/torque sensors at the site ``ee``;
+    keyframe ``paper`` = the paper's q(0) = [0.25, −0.05]; RK4 at 50 µs.
+    """
+    return mujoco.MjModel.from_xml_path(str(_models.TWO_LINK_XML))
+
+
+def _add_motors(spec: Any, effort: Mapping[str, float]) -> None:
+    """A motor (gear 1, ctrlrange ±effort) for every joint of ``effort``."""
+    for name, limit in effort.items():
+        spec.add_actuator(
+            name=name,
+            target=name,
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            gear=[1.0, 0, 0, 0, 0, 0],
+            ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
+            ctrlrange=[-limit, limit],
+        )
+
+
+def _urdf_spec(text: str, fix: tuple[str, ...] = ()) -> tuple[Any, dict[str, float]]:
+    urdf, effort = _models.adapt_urdf(text, fix)
+    spec = mujoco.MjSpec.from_string(urdf)
+    # Keep the URDF's fixed links as bodies: a force sensor needs its own body.
+    spec.compiler.fusestatic = False
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    return spec, effort
+
+
+def from_urdf(path: str | os.PathLike[str], timestep: float = 1e-3) -> mujoco.MjModel:
+    """A URDF arm as a MuJoCo model :class:`Plant` accepts.
+
+    Visual and collision elements, joint ``<dynamics>`` (damping, friction)
+    and mimic tags are dropped (the rigid-body dynamics only, no mesh files);
+    each moving joint gets a motor with ctrlrange ± its ``<limit effort>``
+    (N m). RK4 at ``timestep`` (s). Without contact geometry and without a
+    sensor: add them for contact (see :func:`panda`).
+
+    Raises
+    ------
+    ValueError
+        A moving joint without an effort limit.
+    """
+    text = Path(path).read_text()
+    spec, effort = _urdf_spec(text)
+    spec.option.timestep = timestep
+    joints = [j.name for j in spec.joints]
+    missing = [j for j in joints if j not in effort]
+    if missing:
+        raise ValueError(f"URDF joints without <limit effort=...>: {missing}")
+    _add_motors(spec, effort)
+    return spec.compile()
+
+
+def panda(
+    table_height: float | None = 0.45,
+    *,
+    tool_radius: float = 0.01,
+    timestep: float = 5e-4,
+) -> mujoco.MjModel:
+    """The Franka Emika Panda (example-robot-data's URDF, no download), arm only.
+
+    The URDF's kinematics and inertias as they are; both finger joints fixed
+    closed (their 15 g each ride on the hand); no joint damping or friction;
+    one motor per joint with ctrlrange ±[87, 87, 87, 87, 12, 12, 12] N m (the
+    URDF's effort limits). The end effector is the tool centre point
+    ``panda_hand_tcp`` (0.1034 m beyond the flange-mounted hand): a massless
+    body with the site ``ee``, force/torque sensors ``ee_force``/``ee_torque``
+    and the only collision geometry of the arm, a sphere of ``tool_radius`` (m)
+    at the TCP. Keyframe ``home`` is the SRDF's default posture, joint limits
+    from the URDF, RK4 at ``timestep`` (s).
+
+    Parameters
+    ----------
+    table_height : float or None
+        Height (m) above the robot's base of the top of a table box in front of
+        the arm (x from 0.2 to 0.9 m, y within ±0.5 m); None: no table. At the
+        home posture the TCP is at (0.307, 0, 0.487) m, the bottom of the tool
+        sphere 0.477 m above the base (for the default radius): 27 mm above the
+        default table.
+    tool_radius : float
+        Radius of the tool sphere (m).
+    timestep : float
+        MuJoCo's timestep (s); :func:`simulate` resets it to Ts / substeps.
+    """
+    spec, effort = _urdf_spec(_models.panda_urdf_path().read_text(), fix=_models.PANDA_FINGERS)
+    spec.modelname = "panda"
+    spec.option.timestep = timestep
+    _add_motors(spec, effort)
+    tcp = spec.body(_models.PANDA_EE)
+    tcp.add_site(name="ee", size=[0.01, 0, 0])
+    tcp.add_geom(
+        name="tool",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[tool_radius, 0, 0],
+        contype=1,
+        conaffinity=1,
+        mass=0.0,
+        density=0.0,
+    )
+    spec.add_sensor(
+        name="ee_force",
+        type=mujoco.mjtSensor.mjSENS_FORCE,
+        objtype=mujoco.mjtObj.mjOBJ_SITE,
+        objname="ee",
+    )
+    spec.add_sensor(
+        name="ee_torque",
+        type=mujoco.mjtSensor.mjSENS_TORQUE,
+        objtype=mujoco.mjtObj.mjOBJ_SITE,
+        objname="ee",
+    )
+    if table_height is not None:
+        thickness = 0.05
+        table = spec.worldbody.add_body(name="table", pos=[0.55, 0.0, table_height - thickness / 2])
+        table.add_geom(
+            name="table",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[0.35, 0.5, thickness / 2],
+            contype=1,
+            conaffinity=1,
+            rgba=[0.6, 0.5, 0.4, 1.0],
+        )
+    spec.add_key(name="home", qpos=list(_models.PANDA_HOME))
+    return spec.compile()
+
+
+def _load(source: ModelSource) -> mujoco.MjModel:
+    if isinstance(source, mujoco.MjModel):
+        return copy.deepcopy(source)
+    if isinstance(source, str) and source in _BUILTIN:
+        return _BUILTIN[source]()
+    path = Path(source)
+    if not path.is_file():
+        raise ValueError(
+            f"model must be an MjModel, one of {sorted(_BUILTIN)} or a path to an MJCF or URDF "
+            f"file; no file {str(path)!r}"
+        )
+    if path.suffix.lower() == ".urdf":
+        return from_urdf(path)
+    return mujoco.MjModel.from_xml_path(str(path))
+
+
+_BUILTIN: dict[str, Callable[[], mujoco.MjModel]] = {"two_link": two_link, "panda": panda}
+
+
+# ---------------------------------------------------------------------------
+# The plant.
+# ---------------------------------------------------------------------------
+
+
+def _name(m: mujoco.MjModel, objtype: Any, i: int) -> str:
+    return mujoco.mj_id2name(m, objtype, i) or f"#{i}"
+
+
+class Plant:
+    """A MuJoCo model of a serial arm as the plant of a control loop.
+
+    ``D(q) q̈ + C(q, q̇) q̇ + G(q) = sat(τ) − τe`` with everything MuJoCo adds
+    (contact, joint limits, whatever the model declares). The plant owns a copy
+    of the model (``model``) and its ``data``.
+
+    Parameters
+    ----------
+    model : MjModel, str or path
+        An ``MjModel``; ``"two_link"`` or ``"panda"`` (the packaged models, see
+        :func:`two_link`, :func:`panda`); or a path to an MJCF file, or to a
+        URDF (compiled by :func:`from_urdf`).
+    contact : bool
+        False disables every contact (MuJoCo's ``mjDSBL_CONTACT``): free space.
+    site : str, optional
+        The end-effector site; by default the site of the model's force sensor,
+        or the first site of the last joint's body, or that body's origin.
+
+    Raises
+    ------
+    ValueError
+        The model is not an arm this class can drive; the message names the
+        offending joint or actuator (joints must all be hinges, at most
+        :data:`MAX_JOINTS`, along one kinematic chain; every joint needs exactly
+        one torque actuator: a ``motor``, ``ctrllimited`` with a symmetric
+        ``ctrlrange``).
+
+    Attributes
+    ----------
+    n : int
+        Number of joints.
+    tau_max : ndarray, (n,)
+        Actuator limits τmax (N m): gear × ctrlrange.
+    wrench_source : str
+        ``"sensor"`` (force/torque sensor) or ``"contact"`` (``mj_contactForce``).
+    """
+
+    def __init__(
+        self, model: ModelSource = "two_link", *, contact: bool = True, site: str | None = None
+    ) -> None:
+        self.model = _load(model)
+        m = self.model
+        if not contact:
+            m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        self.contact = contact
+        self._check_joints()
+        self._check_actuators()
+        self._find_end_effector(site)
+        self.data = mujoco.MjData(m)
+        self._jac = np.zeros((6, m.nv))
+        self._jacp, self._jacr = self._jac[:3], self._jac[3:]
+        self._mass = np.zeros((m.nv, m.nv))
+        self.reset()
+
+    # -- construction checks ------------------------------------------------
+
+    def _check_joints(self) -> None:
+        m = self.model
+        hinge = int(mujoco.mjtJoint.mjJNT_HINGE)
+        bad = [
+            f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)} ({mujoco.mjtJoint(m.jnt_type[j]).name})"
+            for j in range(m.njnt)
+            if m.jnt_type[j] != hinge
+        ]
+        if bad:
+            raise ValueError(f"Plant needs hinge joints only; not hinges: {', '.join(bad)}")
+        if not 1 <= m.njnt <= MAX_JOINTS:
+            raise ValueError(f"Plant needs 1 to {MAX_JOINTS} joints, the model has {m.njnt}")
+        self.n = int(m.njnt)
+        # Joints in kinematic order (hinges: one qpos and one dof each).
+        self._joints = sorted(range(self.n), key=lambda j: int(m.jnt_dofadr[j]))
+        self._qadr = np.array([m.jnt_qposadr[j] for j in self._joints])
+        self._dofs = np.array([m.jnt_dofadr[j] for j in self._joints])
+        bodies = [int(m.jnt_bodyid[j]) for j in self._joints]
+        for prev, (j, body) in zip(bodies, list(zip(self._joints, bodies))[1:]):
+            if body == prev or prev not in self._ancestors(body):
+                raise ValueError(
+                    "Plant needs a serial chain, one joint per body: joint "
+                    f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} is not on a descendant "
+                    f"of body {_name(m, mujoco.mjtObj.mjOBJ_BODY, prev)!r}"
+                )
+        self._last_body = bodies[-1]
+
+    def _ancestors(self, body: int) -> list[int]:
+        out = []
+        while body > 0:
+            body = int(self.model.body_parentid[body])
+            out.append(body)
+        return out
+
+    def _check_actuators(self) -> None:
+        m = self.model
+        joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
+        act_of: dict[int, list[int]] = {j: [] for j in range(self.n)}
+        for a in range(m.nu):
+            name = _name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)
+            if m.actuator_trntype[a] != joint_trn:
+                raise ValueError(f"actuator {name!r} does not act on a joint")
+            motor = (
+                m.actuator_dyntype[a] == int(mujoco.mjtDyn.mjDYN_NONE)
+                and m.actuator_gaintype[a] == int(mujoco.mjtGain.mjGAIN_FIXED)
+                and m.actuator_biastype[a] == int(mujoco.mjtBias.mjBIAS_NONE)
+                and m.actuator_gainprm[a, 0] == 1.0
+            )
+            if not motor:
+                raise ValueError(
+                    f"actuator {name!r} is not a torque actuator: use <motor> (no dynamics, "
+                    "gain 1, no bias)"
+                )
+            act_of[int(m.actuator_trnid[a, 0])].append(a)
+        self._act = np.zeros(self.n, dtype=int)
+        self._gear = np.zeros(self.n)
+        self.tau_max = np.zeros(self.n)
+        for i, j in enumerate(self._joints):
+            jname = _name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+            acts = act_of[j]
+            if len(acts) != 1:
+                raise ValueError(
+                    f"Plant needs exactly one torque actuator per joint; joint {jname!r} has "
+                    f"{len(acts)}"
+                )
+            a = acts[0]
+            lo, hi = (float(v) for v in m.actuator_ctrlrange[a])
+            gear = float(m.actuator_gear[a, 0])
+            if not (m.actuator_ctrllimited[a] and gear > 0 and hi > 0 and lo == -hi):
+                raise ValueError(
+                    f"the motor of joint {jname!r} needs ctrllimited with a symmetric ctrlrange "
+                    f"and gear > 0 (its τmax); got ctrlrange [{lo:g}, {hi:g}], gear {gear:g}"
+                )
+            self._act[i] = a
+            self._gear[i] = gear
+            self.tau_max[i] = gear * hi
+
+    def _find_end_effector(self, site: str | None) -> None:
+        m = self.model
+        force = int(mujoco.mjtSensor.mjSENS_FORCE)
+        torque = int(mujoco.mjtSensor.mjSENS_TORQUE)
+        on_site = int(mujoco.mjtObj.mjOBJ_SITE)
+        sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
+        if site is not None:
+            sid = mujoco.mj_name2id(m, on_site, site)
+            if sid < 0:
+                raise ValueError(f"the model has no site {site!r}")
+            sensors = [s for s in sensors if m.sensor_objid[s] == sid]
+        elif sensors:
+            sid = int(m.sensor_objid[sensors[0]])
+        else:
+            on_last = [s for s in range(m.nsite) if m.site_bodyid[s] == self._last_body]
+            sid = on_last[0] if on_last else -1
+        self._site = sid
+        self._ee_body = int(m.site_bodyid[sid]) if sid >= 0 else self._last_body
+        self._force_adr = int(m.sensor_adr[sensors[0]]) if sensors else -1
+        torques = [
+            s
+            for s in range(m.nsensor)
+            if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sid >= 0
+        ]
+        self._torque_adr = int(m.sensor_adr[torques[0]]) if torques else -1
+        self.wrench_source = "sensor" if self._force_adr >= 0 else "contact"
+        subtree = [
+            b for b in range(m.nbody) if b == self._ee_body or self._ee_body in self._ancestors(b)
+        ]
+        self._ee_subtree = frozenset(subtree)
+
+    # -- state ----------------------------------------------------------------
+
+    def reset(self, q0: ArrayLike | None = None, dq0: ArrayLike | None = None) -> None:
+        """Back to the first keyframe (or ``qpos0`` without one), then q = ``q0``
+        (rad) and q̇ = ``dq0`` (rad/s) where given; zero torque."""
+        m, d = self.model, self.data
+        if m.nkey > 0:
+            mujoco.mj_resetDataKeyframe(m, d, 0)
+        else:
+            mujoco.mj_resetData(m, d)
+        d.ctrl[:] = 0.0
+        if q0 is not None:
+            d.qpos[self._qadr] = self._vector("q0", q0)
+        if dq0 is not None:
+            d.qvel[self._dofs] = self._vector("dq0", dq0)
+        mujoco.mj_forward(m, d)
+
+    def _vector(self, name: str, value: ArrayLike) -> FloatArray:
+        v = np.asarray(value, dtype=np.float64)
+        if v.shape == ():
+            v = np.full(self.n, float(v))
+        if v.shape != (self.n,):
+            raise ValueError(f"{name} must have shape ({self.n},), got {v.shape}")
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"{name} must be finite, got {v}")
+        return v
+
+    @property
+    def q(self) -> FloatArray:
+        """Joint positions (rad), (n,)."""
+        return np.array(self.data.qpos[self._qadr], dtype=np.float64)
+
+    @property
+    def dq(self) -> FloatArray:
+        """Joint velocities (rad/s), (n,)."""
+        return np.array(self.data.qvel[self._dofs], dtype=np.float64)
+
+    @property
+    def ddq(self) -> FloatArray:
+        """Joint accelerations (rad/s²), (n,), of the last :meth:`forward`."""
+        return np.array(self.data.qacc[self._dofs], dtype=np.float64)
+
+    @property
+    def timestep(self) -> float:
+        """MuJoCo's timestep (s)."""
+        return float(self.model.opt.timestep)
+
+    @timestep.setter
+    def timestep(self, value: float) -> None:
+        if not (value > 0 and math.isfinite(value)):
+            raise ValueError(f"timestep must be > 0, got {value}")
+        self.model.opt.timestep = value
+
+    # -- dynamics ------------------------------------------------------------
+
+    def forward(self) -> None:
+        """``mj_forward``: kinematics, contact, sensors and q̈ at the current
+        state and applied torque."""
+        mujoco.mj_forward(self.model, self.data)
+
+    def apply(self, tau: ArrayLike) -> FloatArray:
+        """Hold the torque sat(τ) (N m), (n,), from now on; returns sat(τ)."""
+        tau = np.asarray(tau, dtype=np.float64)
+        if tau.shape != (self.n,) or not math.isfinite(float(tau.sum())):
+            tau = self._vector("tau", tau)  # raises the precise error
+        tau_sat = np.minimum(np.maximum(tau, -self.tau_max), self.tau_max)
+        self.data.ctrl[self._act] = tau_sat / self._gear
+        return tau_sat
+
+    def step(self, substeps: int = 1) -> None:
+        """Advance ``substeps`` MuJoCo steps with the applied torque held.
+
+        Raises
+        ------
+        RuntimeError
+            The state became non-finite (MuJoCo's warnings say why).
+        """
+        m, d = self.model, self.data
+        for _ in range(substeps):
+            mujoco.mj_step(m, d)
+        if not math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum())):
+            raise RuntimeError(f"the MuJoCo state diverged at t = {d.time:g} s")
+
+    def mass_matrix(self) -> FloatArray:
+        """Joint-space inertia D(q) (kg m²), (n, n), of the last :meth:`forward`."""
+        _full_inertia(self.model, self.data, self._mass)
+        return np.array(self._mass[np.ix_(self._dofs, self._dofs)], dtype=np.float64)
+
+    def bias(self) -> FloatArray:
+        """C(q, q̇) q̇ + G(q) (N m), (n,), of the last :meth:`forward`."""
+        return np.array(self.data.qfrc_bias[self._dofs], dtype=np.float64)
+
+    # -- end effector ----------------------------------------------------------
+
+    def ee_position(self) -> FloatArray:
+        """End-effector point (m), (3,), in the world frame."""
+        d = self.data
+        point = d.site_xpos[self._site] if self._site >= 0 else d.xpos[self._ee_body]
+        return np.array(point, dtype=np.float64)
+
+    def jacobian(self) -> FloatArray:
+        """End-effector Jacobian (6, n): linear velocity of the end-effector point
+        (m/s) over angular velocity (rad/s), world frame, per joint velocity."""
+        m, d = self.model, self.data
+        if self._site >= 0:
+            mujoco.mj_jacSite(m, d, self._jacp, self._jacr, self._site)
+        else:
+            mujoco.mj_jacBody(m, d, self._jacp, self._jacr, self._ee_body)
+        return self._jac[:, self._dofs]
+
+    def wrench(self) -> FloatArray:
+        """F_e = [f; m], (6,): the force (N) and the moment about the end-effector
+        point (N m) that the arm exerts on its environment, world frame, of the
+        last :meth:`forward` (from the sensor or the contacts, see the module doc)."""
+        return self.sensor_wrench() if self._force_adr >= 0 else self.contact_wrench()
+
+    def sensor_wrench(self) -> FloatArray:
+        """F_e (6,) from the force/torque sensors (world frame; see :meth:`wrench`).
+
+        MuJoCo's force sensor gives the force of the site's body on its parent,
+        in the site frame: for a massless end-effector body, the force it exerts
+        on the environment.
+
+        Raises
+        ------
+        ValueError
+            The model has no force sensor at the end effector.
+        """
+        d = self.data
+        if self._force_adr < 0:
+            raise ValueError("the model has no force sensor at the end effector")
+        out = np.zeros(6)
+        rot = d.site_xmat[self._site].reshape(3, 3)
+        out[:3] = rot @ d.sensordata[self._force_adr : self._force_adr + 3]
+        if self._torque_adr >= 0:
+            out[3:] = rot @ d.sensordata[self._torque_adr : self._torque_adr + 3]
+        return out
+
+    def contact_wrench(self) -> FloatArray:
+        """F_e (6,) summed over the active contacts of the end-effector body's
+        subtree with anything else, by ``mj_contactForce`` (world frame; the
+        moment about the end-effector point)."""
+        m, d = self.model, self.data
+        out = np.zeros(6)
+        point = self.ee_position()
+        local = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if c.efc_address < 0:
+                continue
+            b1 = int(m.geom_bodyid[c.geom1]) in self._ee_subtree
+            b2 = int(m.geom_bodyid[c.geom2]) in self._ee_subtree
+            if b1 == b2:
+                continue
+            mujoco.mj_contactForce(m, d, i, local)
+            frame = c.frame.reshape(3, 3)
+            # The force geom1 exerts on geom2, rotated from the contact frame.
+            f = frame.T @ local[:3]
+            t = frame.T @ local[3:]
+            sign = 1.0 if b1 else -1.0
+            out[:3] += sign * f
+            out[3:] += sign * (np.cross(c.pos - point, f) + t)
+        return out
+
+    def tau_e(self, wrench: FloatArray | None = None) -> FloatArray:
+        """τe = Jᵀ F_e (N m), (n,): the wrench on the environment in joint space
+        (of :meth:`wrench`, or of ``wrench`` if given)."""
+        return self.jacobian().T @ (self.wrench() if wrench is None else wrench)
+
+    def __repr__(self) -> str:
+        name = self.model.names[: self.model.names.find(b"\0")].decode() or "model"
+        return (
+            f"adaptimp.mujoco.Plant({name!r}: {self.n} joints, τmax = {self.tau_max.tolist()} N m,"
+            f" wrench from {self.wrench_source}, timestep {self.timestep:g} s)"
+        )
+
+
+def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
+    """The dense joint-space inertia into ``out`` (mj_fullM's signature changed in MuJoCo 4)."""
+    try:
+        mujoco.mj_fullM(m, d, out)
+    except TypeError:  # MuJoCo 3: mj_fullM(m, dst, qM)
+        mujoco.mj_fullM(m, out, d.qM)
+
+
+# ---------------------------------------------------------------------------
+# The result of a run.
+# ---------------------------------------------------------------------------
+
+PLOT_KINDS = ("tracking", "errors", "torques", "contact")
+"""Kinds of :meth:`MujocoResult.plot`."""
+
+ARRAYS = (
+    "t", "q", "dq", "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e",
+    "zeta", "z1", "x_ee", "wrench_ee",
+)  # fmt: skip
+"""Names of the recorded arrays of :class:`MujocoResult`."""
+
+
+@dataclass(frozen=True, repr=False, eq=False)
+class MujocoResult:
+    """A closed-loop run on a MuJoCo plant: one row k = 0 … K − 1 per controller
+    step at t_k = k·Ts.
+
+    Per-joint arrays have shape (K, n); the reference arrays (K, m), m the
+    dimension of the controller's xc (n in joint space).
+
+    Attributes
+    ----------
+    t : (K,)
+        Time t_k (s).
+    q, dq, ddq : (K, n)
+        Joint positions (rad), velocities (rad/s), and accelerations (rad/s²)
+        at the row's state and applied torque (MuJoCo's q̈, contact included).
+    xc, dxc, ddxc : (K, m)
+        Commanded trajectory and its derivatives (NaN where unknown).
+    xd : (K, m)
+        Compliant reference (the controller's ``xd``; xc if it has none).
+    dq_hat : (K, n)
+        Velocity the controller used (its ``dq_hat``; dq if it has none).
+    tau, tau_sat : (K, n)
+        Commanded torque τ and the torque applied to the plant (N m).
+    tau_e : (K, n)
+        τe = Jᵀ F_e given to the controller (N m).
+    zeta : (K, n)
+        Auxiliary state ζ (N m; zero for controllers without one).
+    z1 : (K, m)
+        Tracking error xd − x (the controller's ``z1``, else xd − q).
+    x_ee : (K, 3)
+        End-effector position (m), world frame.
+    wrench_ee : (K, 6)
+        F_e: force (N) and moment (N m) the end effector exerts, world frame.
+    metrics : dict
+        The SPEC §12 metrics, with the keys of :attr:`adaptimp.SimResult.metrics`
+        (NaN where they do not apply: ``imp_err_rms_after2`` needs a joint-space
+        reference).
+    params : dict
+        The run: ``Ts``, ``substeps``, ``timestep``, ``T``, ``settle``,
+        ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``controller``.
+    """
+
+    params: dict[str, Any]
+    metrics: dict[str, Any]
+    t: FloatArray
+    q: FloatArray
+    dq: FloatArray
+    ddq: FloatArray
+    xc: FloatArray
+    dxc: FloatArray
+    ddxc: FloatArray
+    xd: FloatArray
+    dq_hat: FloatArray
+    tau: FloatArray
+    tau_sat: FloatArray
+    tau_e: FloatArray
+    zeta: FloatArray
+    z1: FloatArray
+    x_ee: FloatArray
+    wrench_ee: FloatArray
+
+    @property
+    def rows(self) -> int:
+        """Number of recorded rows K."""
+        return int(self.t.shape[0])
+
+    @property
+    def dtau(self) -> FloatArray:
+        """sat(τ) − τ (N m), (K, n)."""
+        return self.tau_sat - self.tau
+
+    def plot(self, kind: str = "tracking") -> Figure:
+        """A matplotlib figure of the run, one panel per joint (or per force axis).
+
+        kind : {"tracking", "errors", "torques", "contact"}
+            q against xc and xd; z1; τ and sat(τ) with ±τmax; the end-effector
+            force F_e (N) and ‖τe‖ (N m).
+        """
+        if kind not in PLOT_KINDS:
+            raise ValueError(f"kind must be one of {PLOT_KINDS}, got {kind!r}")
+        return _plot(self, kind)
+
+    def __repr__(self) -> str:
+        m, p = self.metrics, self.params
+        return (
+            f"MujocoResult({p['controller']} on {p['model']}: {self.rows} steps of Ts = "
+            f"{p['Ts']:g} s, {p['substeps']} MuJoCo steps each; contact "
+            f"{'on' if p['contact'] else 'off'})\n"
+            f"  RMS ‖z1‖ = {m['rms_z1']:.4g}, over t ≥ {p['settle']:g} s: "
+            f"{m['rms_z1_after2']:.4g}; saturated {100 * m['sat_duty']:.1f}% of steps; "
+            f"{m['steps_in_contact']} steps in contact"
+        )
+
+
+def _plot(res: MujocoResult, kind: str) -> Figure:
+    from ._plot import _figure, _legend
+
+    t = res.t
+    if kind == "contact":
+        fig, axes = _figure("end-effector force F_e (world frame) and ‖τe‖", rows=2)
+        for i, axis in enumerate("xyz"):
+            axes[0].plot(t, res.wrench_ee[:, i], lw=1.0, label=f"F_e,{axis}")
+        axes[0].set_ylabel("force (N)")
+        axes[1].plot(t, np.linalg.norm(res.tau_e, axis=1), color="k", lw=1.0, label="‖τe‖")
+        axes[1].set_ylabel("‖τe‖ (N m)")
+        _legend(fig, axes[0], ncol=3)
+        return fig
+    n = res.q.shape[1] if kind == "torques" else res.z1.shape[1]
+    fig, axes = _figure(f"{res.params['controller']} on {res.params['model']}: {kind}", rows=n)
+    for i, ax in enumerate(axes):
+        if kind == "tracking":
+            ax.plot(t, res.xc[:, i], color="k", lw=1.0, ls="--", label="xc, commanded")
+            ax.plot(t, res.xd[:, i], color="tab:orange", lw=1.2, label="xd, compliant reference")
+            if res.q.shape[1] == n:
+                ax.plot(t, res.q[:, i], color="tab:blue", lw=1.0, label="q, arm")
+            ax.set_ylabel(f"x{i + 1}")
+        elif kind == "errors":
+            ax.plot(t, res.z1[:, i], color="tab:blue", lw=0.9, label="z1 = xd − x")
+            ax.set_ylabel(f"z1,{i + 1}")
+        else:
+            m = float(res.params["tau_max"][i])
+            ax.plot(t, res.tau[:, i], color="tab:orange", lw=0.7, label="τ, commanded")
+            ax.plot(t, res.tau_sat[:, i], color="tab:blue", lw=0.9, label="sat(τ), applied")
+            ax.axhline(m, color="tab:red", lw=1.0, ls="--", label="±τmax")
+            ax.axhline(-m, color="tab:red", lw=1.0, ls="--")
+            ax.set_ylim(-1.6 * m, 1.6 * m)
+            ax.set_ylabel(f"τ{i + 1} (N m)")
+    _legend(fig, axes[0], ncol=3)
+    return fig
+
+
+def metrics(
+    *,
+    t: FloatArray,
+    q: FloatArray,
+    dq: FloatArray,
+    ddq: FloatArray,
+    xc: FloatArray,
+    dxc: FloatArray,
+    ddxc: FloatArray,
+    z1: FloatArray,
+    tau: FloatArray,
+    dtau: FloatArray,
+    tau_e: FloatArray,
+    settle: float,
+    target: tuple[ArrayLike, ArrayLike, ArrayLike] = (1.0, 10.0, 60.0),
+) -> dict[str, Any]:
+    """The SPEC §12 metrics of recorded rows, as ``adaptimp.simulate`` computes them.
+
+    ``target`` is the impedance (Dd, Cd, Gd) of the residual; the impedance
+    error is NaN unless the reference is in joint space (same width as q).
+    """
+    after = t >= settle - 1e-9
+    nan_after = not np.any(after)
+
+    def rms(x: FloatArray) -> float:
+        return float(np.sqrt(np.mean(x))) if x.size else math.nan
+
+    z2 = np.sum(z1**2, axis=1)
+    contact_rows = np.any(tau_e != 0.0, axis=1)
+    contact = np.linalg.norm(tau_e, axis=1)
+    k = len(t)
+    if xc.shape == q.shape:
+        dd, cd, gd = (np.asarray(v, dtype=np.float64) for v in target)
+        res = dd * (ddxc - ddq) + cd * (dxc - dq) + gd * (xc - q) - tau_e
+        imp = rms(np.sum(res[after] ** 2, axis=1))
+    else:
+        imp = math.nan
+    out: dict[str, Any] = {
+        "rms_z1": rms(z2),
+        "rms_z1_after2": rms(z2[after]),
+        "rms_z1_joint_after2": [rms(z1[after, i] ** 2) for i in range(z1.shape[1])],
+        "max_abs_z1_joint_after2": (
+            [math.nan] * z1.shape[1] if nan_after else np.max(np.abs(z1[after]), axis=0).tolist()
+        ),
+        "sat_duty": float(np.mean(np.any(dtau != 0.0, axis=1))) if k else math.nan,
+        "steps_in_contact": int(np.sum(contact_rows)),
+        "peak_contact_after2": math.nan if nan_after else float(np.max(contact[after])),
+        "mean_contact": float(np.mean(contact[contact_rows])) if np.any(contact_rows) else 0.0,
+        "peak_abs_tau": (np.max(np.abs(tau), axis=0).tolist() if k else [0.0] * tau.shape[1]),
+        "imp_err_rms_after2": imp,
+        "rows": k,
+    }
+    assert set(out) == {*METRIC_KEYS, "rows"}
+    return out
+
+
+# ---------------------------------------------------------------------------
+# The closed loop.
+# ---------------------------------------------------------------------------
+
+
+def _period(ctrl: Any) -> float:
+    for attr in ("ts", "Ts"):
+        value = getattr(ctrl, attr, None)
+        if value is not None:
+            return float(value)
+    raise TypeError(f"the controller {ctrl!r} has no period: give it a .ts or .Ts (s)")
+
+
+def _builtin_reference(ctrl: Any) -> Reference | None:
+    """The controller's own sinusoid (SPEC §4), if its params declare one."""
+    params = getattr(ctrl, "params", None)
+    keys = ("xc_offset", "xc_sin", "xc_cos", "xc_omega")
+    if isinstance(params, Mapping) and all(k in params for k in keys):
+        return sinusoid(*(params[k] for k in keys))
+    return None
+
+
+def simulate(
+    controller: str | ControllerLike = "sf",
+    model: Plant | ModelSource = "two_link",
+    *,
+    T: float | None = None,
+    Ts: float | None = None,
+    substeps: int | None = None,
+    q0: ArrayLike | None = None,
+    dq0: ArrayLike | None = None,
+    reference: Reference | None = None,
+    contact: bool = True,
+    settle: float | None = None,
+    scenario: str = "robot",
+    **params: Any,
+) -> MujocoResult:
+    """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
+
+    At every t_k = k·Ts: MuJoCo computes contact and sensors at the state
+    (with the torque applied over the last period), the controller is given
+    ``(q, tau_e, dq[, xc=, dxc=, ddxc=])`` and returns a torque; it is
+    saturated to the actuators' τmax and held for ``substeps`` MuJoCo steps of
+    Ts / substeps each.
+
+    Parameters
+    ----------
+    controller : str or controller
+        ``"pd"``, ``"sf"`` or ``"of"`` builds ``adaptimp.Controller(case,
+        scenario=scenario, Ts=Ts, tau_max=<the plant's>, **params)``; or any
+        object of the :class:`ControllerLike` protocol (e.g. an
+        ``adaptimp.Controller`` or :class:`adaptimp.baselines.ComputedTorque`),
+        used as it is (reset it first if it has run before).
+    model : Plant, MjModel, str or path
+        The plant, or what :class:`Plant` takes (default the paper's arm).
+    T : float, optional
+        Duration (s); rows k = 0 … round(T/Ts) − 1. Default: the scenario's T.
+    Ts : float, optional
+        Controller period (s). Default: the controller's; for a case name the
+        scenario's (``"robot"``: 1 ms, ``"paper"``: 50 µs). Must equal the
+        period of a given controller.
+    substeps : int, optional
+        MuJoCo steps per period; MuJoCo's timestep becomes Ts / substeps.
+        Default: round(Ts / the model's timestep), at least 1.
+    q0, dq0 : array_like, optional
+        Initial joint positions (rad) and velocities (rad/s); default the
+        model's first keyframe (the paper's q(0) for ``two_link``), else qpos0.
+    reference : callable, optional
+        ``reference(t) -> (xc, dxc, ddxc)``: passed to every step as
+        ``xc=, dxc=, ddxc=``. None: the controller follows its own trajectory.
+    contact : bool
+        False: free space (MuJoCo's contact disabled). Ignored for a Plant.
+    settle : float, optional
+        Start of the "after2" metrics (s); default the scenario's (2 s).
+    scenario : {"robot", "paper"}
+        Defaults for a case name (see :func:`adaptimp.simulate`).
+    **params
+        Controller parameters for a case name (``Kp``, ``gamma``, …).
+
+    Returns
+    -------
+    MujocoResult
+        Arrays, the SPEC §12 metrics, ``.plot(kind)``.
+
+    Examples
+    --------
+    >>> from adaptimp import mujoco as amj
+    >>> res = amj.simulate("sf", "two_link", T=0.05, contact=False)
+    >>> res.q.shape, res.params["substeps"]
+    ((50, 2), 20)
+    """
+    from . import Controller
+    from ._params import SCENARIOS
+
+    defaults = SCENARIOS.get(scenario)
+    if defaults is None:
+        raise ValueError(f"scenario must be one of {sorted(SCENARIOS)}, got {scenario!r}")
+    plant = model if isinstance(model, Plant) else Plant(model, contact=contact)
+    if isinstance(controller, str):
+        kwargs = dict(params)
+        kwargs.setdefault("tau_max", plant.tau_max.tolist())
+        if Ts is not None:
+            kwargs["Ts"] = Ts
+        if plant.n != 2:
+            kwargs["n"] = plant.n
+        ctrl: Any = Controller(controller, scenario=scenario, **kwargs)
+        label = f"adaptimp.Controller({controller!r}, scenario={scenario!r})"
+    else:
+        if params:
+            raise TypeError(
+                f"controller parameters {sorted(params)} apply to a case name only; "
+                "configure the controller object itself"
+            )
+        ctrl = controller
+        label = type(controller).__name__
+    period = _period(ctrl)
+    if Ts is not None and not math.isclose(Ts, period, rel_tol=1e-12):
+        raise ValueError(f"Ts = {Ts:g} s differs from the controller's period {period:g} s")
+    Ts = period
+    T = float(defaults["T"]) if T is None else float(T)
+    settle = float(defaults["settle"]) if settle is None else float(settle)
+    steps = round(T / Ts)
+    if steps < 0 or not math.isfinite(T):
+        raise ValueError(f"T must be finite and ≥ 0, got {T}")
+    if substeps is None:
+        substeps = max(1, round(Ts / plant.timestep))
+    if substeps < 1:
+        raise ValueError(f"substeps must be ≥ 1, got {substeps}")
+    plant.timestep = Ts / substeps
+    plant.reset(q0, dq0)
+    has = {name: hasattr(ctrl, name) for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta")}
+    n = plant.n
+    rows: dict[str, list[Any]] = {name: [] for name in ARRAYS if name != "t"}
+    # The rows' own lists, bound once: this loop runs a Python step per period.
+    (r_q, r_dq, r_ddq, r_xc, r_dxc, r_ddxc, r_xd, r_dq_hat, r_tau, r_tau_sat, r_tau_e, r_zeta,
+     r_z1, r_x_ee, r_wrench) = rows.values()  # fmt: skip
+    zeros = np.zeros(n)
+    for k in range(steps):
+        q, dq = plant.q, plant.dq
+        wrench = plant.wrench()
+        tau_e = plant.tau_e(wrench)
+        r_x_ee.append(plant.ee_position())
+        if reference is not None:
+            xc, dxc, ddxc = (np.asarray(v, dtype=np.float64) for v in reference(k * Ts))
+            tau_cmd = ctrl.step(q, tau_e, dq, xc=xc, dxc=dxc, ddxc=ddxc)
+            r_xc.append(xc)
+            r_dxc.append(dxc)
+            r_ddxc.append(ddxc)
+        else:
+            tau_cmd = ctrl.step(q, tau_e, dq)
+            xc = ctrl.xc if has["xc"] else q
+            r_xc.append(xc)
+        tau_sat = plant.apply(tau_cmd)
+        plant.forward()  # q̈ at the row's state and applied torque (SPEC §12)
+        xd = ctrl.xd if has["xd"] else xc
+        r_q.append(q)
+        r_dq.append(dq)
+        r_ddq.append(plant.ddq)
+        r_xd.append(xd)
+        r_z1.append(ctrl.z1 if has["z1"] else np.asarray(xd) - q)
+        r_dq_hat.append(ctrl.dq_hat if has["dq_hat"] else dq)
+        r_zeta.append(ctrl.zeta if has["zeta"] else zeros)
+        r_tau.append(ctrl.tau if has["tau"] else tau_cmd)
+        r_tau_sat.append(tau_sat)
+        r_tau_e.append(tau_e)
+        r_wrench.append(wrench)
+        plant.step(substeps)
+        plant.forward()  # contact and sensors at the new state, torque held
+
+    t: FloatArray = np.arange(steps, dtype=np.float64) * Ts
+    if reference is None:
+        # The controller's own trajectory, if its params declare one (for the
+        # impedance metric), evaluated for every row at once.
+        builtin = _builtin_reference(ctrl)
+        if builtin is not None:
+            # (sinusoid's reference broadcasts: one row per time.)
+            _, dxc_all, ddxc_all = builtin(t[:, None])  # type: ignore[arg-type]
+            rows["dxc"] = list(np.asarray(dxc_all, dtype=np.float64))
+            rows["ddxc"] = list(np.asarray(ddxc_all, dtype=np.float64))
+        else:
+            nan = np.full(len(r_xc[0]) if steps else n, math.nan)
+            rows["dxc"] = rows["ddxc"] = [nan] * steps
+    ref_width = len(rows["xc"][0]) if steps else n
+    width = {"x_ee": 3, "wrench_ee": 6}
+    width.update(dict.fromkeys(("xc", "dxc", "ddxc", "xd", "z1"), ref_width))
+    arrays = {
+        name: np.array(values, dtype=np.float64).reshape(steps, width.get(name, n))
+        for name, values in rows.items()
+    }
+    arrays["t"] = t
+    cparams = getattr(ctrl, "params", None)
+    cparams = cparams if isinstance(cparams, Mapping) else {}
+    target = tuple(cparams.get(k, v) for k, v in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0)))
+    m = metrics(
+        t=arrays["t"],
+        q=arrays["q"],
+        dq=arrays["dq"],
+        ddq=arrays["ddq"],
+        xc=arrays["xc"],
+        dxc=arrays["dxc"],
+        ddxc=arrays["ddxc"],
+        z1=arrays["z1"],
+        tau=arrays["tau"],
+        dtau=arrays["tau_sat"] - arrays["tau"],
+        tau_e=arrays["tau_e"],
+        settle=settle,
+        target=(target[0], target[1], target[2]),
+    )
+    name = plant.model.names[: plant.model.names.find(b"\0")].decode()
+    run = {
+        "Ts": Ts,
+        "substeps": substeps,
+        "timestep": plant.timestep,
+        "T": T,
+        "settle": settle,
+        "contact": plant.contact,
+        "tau_max": plant.tau_max.tolist(),
+        "wrench_source": plant.wrench_source,
+        "model": name,
+        "controller": label,
+    }
+    return MujocoResult(params=run, metrics=m, **arrays)

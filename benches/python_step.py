@@ -23,8 +23,6 @@ import statistics
 import time
 from collections.abc import Callable
 
-import numpy as np
-
 import adaptimp
 
 

@@ -13,6 +13,8 @@ the project's SPEC (docs/SPEC.md).
 - :class:`Controller` is the controller alone, for your own loop; it pickles.
 - :class:`TwoLinkArm` is the paper's arm, :class:`PlanarArm` an arm of n links:
   D(q), C(q, q̇), G(q), forward dynamics.
+- :func:`sweep` runs many simulations (a grid or random samples) on every core
+  or on a Dask cluster and returns a pandas DataFrame.
 - Errors by kind: :class:`ConfigError`, :class:`MeasurementError`,
   :class:`DivergedError`, :class:`FaultError`; :class:`StabilityWarning`.
 
@@ -39,6 +41,7 @@ from ._errors import (
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
 from ._plot import compare as plot_compare
 from ._result import PLOT_KINDS, SimResult, metrics_table
+from ._sweep import Choice, LogUniform, Normal, Uniform, sweep
 
 __all__ = [
     "CASES",
@@ -47,19 +50,24 @@ __all__ = [
     "PLOT_KINDS",
     "SCENARIOS",
     "AdaptimpError",
+    "Choice",
     "ConfigError",
     "Controller",
     "DivergedError",
     "FaultError",
+    "LogUniform",
     "MeasurementError",
+    "Normal",
     "Param",
     "PlanarArm",
     "SimResult",
     "StabilityWarning",
     "TwoLinkArm",
+    "Uniform",
     "__version__",
     "defaults",
     "metrics_table",
     "plot_compare",
     "simulate",
+    "sweep",
 ]

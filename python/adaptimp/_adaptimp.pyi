@@ -22,6 +22,7 @@ __all__ = [
     "defaults",
     "schema_table",
     "simulate",
+    "simulate_many",
 ]
 
 __version__: str
@@ -305,6 +306,13 @@ def simulate(
     weights: dict[str, _F] | None = None,
 ) -> dict[str, Any]:
     """Close the loop with the GIL released; returns the arrays and "metrics"."""
+
+def simulate_many(
+    jobs: Sequence[tuple[str, dict[str, Any], TwoLinkArm | None]],
+    threads: int | None = None,
+    progress: Callable[[int, int], object] | None = None,
+) -> list[dict[str, Any] | str]:
+    """Run independent jobs (case, params, arm) on every core; metrics or error texts."""
 
 def schema_table() -> list[dict[str, Any]]:
     """The parameter schema: name, group, kind, unit, doc, condition, choices, defaults."""

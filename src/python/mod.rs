@@ -1122,6 +1122,50 @@ fn simulate<'py>(
     }
     out.set_item("w_norms", array(py, rec.w_norms, (k, 3))?)?;
     out.set_item("refused", PyArray1::from_vec(py, rec.refused))?;
+    out.set_item("metrics", metrics_to_dict(py, metrics)?)?;
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------
+// Many runs at once: sweeps.
+// ---------------------------------------------------------------------------
+
+/// One run of a sweep, parsed while the GIL is held.
+struct Job {
+    law: Law,
+    items: Vec<(String, Owned)>,
+    arm: ArmSpec,
+}
+
+/// Stops a run when asked (from the thread that watches for signals).
+struct StopHooks<'a>(&'a std::sync::atomic::AtomicBool);
+
+impl Hooks for StopHooks<'_> {
+    fn tick(&mut self, _done: u64, _total: u64) -> bool {
+        !self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
+/// One job, start to end, on the calling thread: its SPEC §12 metrics or the
+/// error's message.
+fn run_job(job: &Job, stop: &std::sync::atomic::AtomicBool) -> Result<dynamic::MetricsOut, String> {
+    let mut tracker = dynamic::build(2, Preset::Paper, job.law, &job.items, None).map_err(|e| {
+        match e.name {
+            Some(name) => format!("{name}: {}", e.error),
+            None => e.error.to_string(),
+        }
+    })?;
+    let mut hooks = StopHooks(stop);
+    match tracker.simulate(&job.arm, &job.items, None, u64::MAX, &mut hooks) {
+        Ok((_, m)) => Ok(m),
+        Err(RunError::Stopped) => Err("stopped".to_owned()),
+        Err(RunError::Memory(rows)) => Err(format!("cannot allocate the records of {rows} rows")),
+        Err(RunError::Core(e, None)) => Err(python_names(e).to_string()),
+        Err(RunError::Core(e, Some(k))) => Err(format!("row {k}: {}", python_names(e))),
+    }
+}
+
+fn metrics_to_dict<'py>(py: Python<'py>, metrics: dynamic::MetricsOut) -> PyResult<Bound<'py, PyDict>> {
     let m = PyDict::new(py);
     for (name, v) in metrics.counts {
         m.set_item(name, v)?;
@@ -1132,7 +1176,103 @@ fn simulate<'py>(
     for (name, v) in metrics.joint {
         m.set_item(name, v)?;
     }
-    out.set_item("metrics", m)?;
+    Ok(m)
+}
+
+/// Run every job of `jobs` — tuples (case, params, arm) of the paper's 2-joint
+/// arm (`arm` a `TwoLinkArm`, or None for the arm of `params`) — on `threads`
+/// threads (all cores if None), each run single-threaded, with the GIL
+/// released. Returns, in order, each run's SPEC §12 metrics (a dict) or its
+/// error message (a str): one failing run never stops the others. Results
+/// equal those of running the jobs one by one, bit for bit. Ctrl-C stops the
+/// batch (`KeyboardInterrupt`) within 50 ms; `progress(done, total)` is called
+/// as runs finish, at most every 50 ms.
+#[pyfunction]
+#[pyo3(signature = (jobs, threads=None, progress=None))]
+fn simulate_many<'py>(
+    py: Python<'py>,
+    jobs: &Bound<'py, PyList>,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyList>> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let mut parsed = Vec::with_capacity(jobs.len());
+    for job in jobs.iter() {
+        let (case, params, arm): (String, Bound<'py, PyDict>, Bound<'py, PyAny>) = job.extract()?;
+        let law = law_of(&case)?;
+        let items = items(&params)?;
+        let arm = if arm.is_none() {
+            let s = dynamic::scenario::<2>(Preset::Paper, law, &items).map_err(config_error)?;
+            ArmSpec::Paper(TwoLinkArm::new(s.arm.resolve()).map_err(|e| config_error(e.into()))?)
+        } else if let Ok(a) = arm.cast::<PyArm>() {
+            ArmSpec::Paper(a.get().inner)
+        } else {
+            return Err(PyTypeError::new_err("a sweep's arm must be a TwoLinkArm or None"));
+        };
+        parsed.push(Job { law, items, arm });
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start the thread pool: {e}")))?;
+    let stop = AtomicBool::new(false);
+    let done = AtomicUsize::new(0);
+    let total = parsed.len();
+    let mut interrupted: Option<PyErr> = None;
+    let results = py.detach(|| {
+        std::thread::scope(|scope| {
+            let worker = scope.spawn(|| {
+                pool.install(|| {
+                    parsed
+                        .par_iter()
+                        .map(|job| {
+                            let r = run_job(job, &stop);
+                            done.fetch_add(1, Ordering::Relaxed);
+                            r
+                        })
+                        .collect::<Vec<_>>()
+                })
+            });
+            // This thread watches for signals and reports progress, every
+            // 50 ms, and notices the end within 10 ms.
+            let mut last = Instant::now();
+            while !worker.is_finished() {
+                std::thread::sleep(Duration::from_millis(10));
+                if last.elapsed() < CHECK_EVERY {
+                    continue;
+                }
+                last = Instant::now();
+                let stopped = Python::attach(|py| {
+                    let r = py.check_signals().and_then(|()| match &progress {
+                        Some(cb) => cb
+                            .call1(py, (done.load(Ordering::Relaxed), total))
+                            .map(|_| ()),
+                        None => Ok(()),
+                    });
+                    r.err()
+                });
+                if let Some(e) = stopped {
+                    interrupted = Some(e);
+                    stop.store(true, Ordering::Relaxed);
+                    break;
+                }
+            }
+            worker.join()
+        })
+    });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let results =
+        results.map_err(|_| PyRuntimeError::new_err("a sweep's worker thread panicked"))?;
+    let out = PyList::empty(py);
+    for r in results {
+        match r {
+            Ok(m) => out.append(metrics_to_dict(py, m)?)?,
+            Err(msg) => out.append(msg)?,
+        }
+    }
     Ok(out)
 }
 
@@ -1212,7 +1352,9 @@ mod adaptimp_module {
     use pyo3::prelude::*;
 
     #[pymodule_export]
-    use super::{defaults, schema_table, simulate, PyArm, PyController, PyPlanarArm};
+    use super::{
+        defaults, schema_table, simulate, simulate_many, PyArm, PyController, PyPlanarArm,
+    };
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

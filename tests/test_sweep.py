@@ -1,0 +1,121 @@
+"""Sweeps: grids and random samples, every core, any executor (a real Dask
+LocalCluster), failing runs, the cache and resumption."""
+
+from __future__ import annotations
+
+import json
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import adaptimp
+
+FIXED = {"T": 0.4, "substeps": 2}
+
+
+def _serial(df: pd.DataFrame, scenario: str = "robot") -> list[float]:
+    """rms_z1 of every row, each run alone through adaptimp.simulate."""
+    out = []
+    for _, row in df.iterrows():
+        kw = {k: row[k] for k in ("Kp", "m2") if k in row}
+        out.append(adaptimp.simulate(row["case"], scenario, **FIXED, **kw).metrics["rms_z1"])
+    return out
+
+
+def test_grid_runs_the_product_on_every_core_equal_to_serial_runs() -> None:
+    df = adaptimp.sweep(
+        "sf", vary={"case": ["pd", "sf", "of"], "m2": [0.85, 1.5]}, scenario="robot", **FIXED
+    )
+    assert len(df) == 6
+    assert list(df["case"]) == ["pd", "pd", "sf", "sf", "of", "of"]
+    assert list(df["m2"]) == [0.85, 1.5] * 3
+    assert df["error"].isna().all()
+    # Bit for bit the runs made one by one.
+    assert list(df["rms_z1"]) == _serial(df)
+    for col in ("rms_z1_after2", "sat_duty", "peak_abs_tau_1", "peak_abs_tau_2", "rows"):
+        assert col in df.columns
+
+
+def test_random_samples_are_reproducible_from_the_seed() -> None:
+    vary = {"Kp": adaptimp.Uniform(8.0, 10.0), "m2": adaptimp.Choice([0.85, 1.2])}
+    a = adaptimp.sweep("pd", vary=vary, samples=5, seed=7, scenario="robot", **FIXED)
+    b = adaptimp.sweep("pd", vary=vary, samples=5, seed=7, scenario="robot", **FIXED)
+    c = adaptimp.sweep("pd", vary=vary, samples=5, seed=8, scenario="robot", **FIXED)
+    pd.testing.assert_frame_equal(a, b)
+    assert not a["Kp"].equals(c["Kp"])
+    assert a["Kp"].between(8.0, 10.0).all()
+    assert set(a["m2"]) <= {0.85, 1.2}
+
+
+def test_a_failing_run_never_sinks_the_sweep() -> None:
+    df = adaptimp.sweep("sf", vary={"Kp": [10.0, 12.0, "x"]}, scenario="robot", **FIXED)
+    assert df["error"].isna().tolist() == [True, False, False]
+    assert "raise Kzeta above 72.5 for Kp = 12" in df["error"][1]
+    assert df["error"][2].startswith("TypeError: Kp must be")
+    assert np.isnan(df["rms_z1"][1])
+
+
+def test_any_executor_gives_the_serial_results() -> None:
+    vary = {"case": ["pd", "sf"], "Kp": [9.0, 10.0, 11.0]}
+    local = adaptimp.sweep("sf", vary=vary, scenario="robot", **FIXED)
+    with ThreadPoolExecutor(2) as ex:
+        pooled = adaptimp.sweep(
+            "sf", vary=vary, scenario="robot", executor=ex, batch_size=2, **FIXED
+        )
+    pd.testing.assert_frame_equal(local, pooled)
+
+
+def test_a_dask_local_cluster_gives_the_serial_results() -> None:
+    distributed = pytest.importorskip("distributed")
+    vary = {"case": ["pd", "sf", "of"], "m2": [0.85, 1.2, 1.5]}
+    local = adaptimp.sweep("sf", vary=vary, scenario="robot", **FIXED)
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        remote = adaptimp.sweep(
+            "sf", vary=vary, scenario="robot", executor=client.get_executor(), batch_size=2, **FIXED
+        )
+    pd.testing.assert_frame_equal(local, remote)
+
+
+def test_cache_resumes_an_interrupted_sweep(tmp_path: Path) -> None:
+    vary = {"Kp": [7.0, 8.0, 9.0, 10.0]}
+    first = adaptimp.sweep("pd", vary={"Kp": [7.0, 8.0]}, scenario="robot", cache=tmp_path, **FIXED)
+    assert first["error"].isna().all()
+    assert len(list(tmp_path.glob("*.json"))) == 2
+    # Poison one cached result: a resumed sweep must read it, not rerun it.
+    path = sorted(tmp_path.glob("*.json"))[0]
+    data = json.loads(path.read_text())
+    data["result"]["rms_z1"] = 123.0
+    path.write_text(json.dumps(data))
+    seen: list[tuple[int, int]] = []
+    full = adaptimp.sweep(
+        "pd",
+        vary=vary,
+        scenario="robot",
+        cache=tmp_path,
+        progress=lambda d, t: seen.append((d, t)),
+        **FIXED,
+    )
+    assert len(list(tmp_path.glob("*.json"))) == 4
+    assert 123.0 in set(full["rms_z1"])
+    assert seen[-1] == (4, 4)
+    fresh = adaptimp.sweep("pd", vary=vary, scenario="robot", **FIXED)
+    changed = full["rms_z1"] != fresh["rms_z1"]
+    assert changed.sum() == 1
+    assert first["rms_z1"].tolist()[1] == fresh["rms_z1"].tolist()[1]
+
+
+def test_sweep_arguments_are_checked() -> None:
+    with pytest.raises(TypeError, match="cannot vary 'Kq'"):
+        adaptimp.sweep("pd", vary={"Kq": [1.0]})
+    with pytest.raises(TypeError, match="must be a sequence of values for a grid"):
+        adaptimp.sweep("pd", vary={"Kp": adaptimp.Uniform(1.0, 2.0)})
+    with pytest.raises(ValueError, match="samples must be an integer ≥ 1"):
+        adaptimp.sweep("pd", vary={"Kp": adaptimp.Uniform(1.0, 2.0)}, samples=0)

@@ -119,3 +119,16 @@ def test_sweep_arguments_are_checked() -> None:
         adaptimp.sweep("pd", vary={"Kp": adaptimp.Uniform(1.0, 2.0)})
     with pytest.raises(ValueError, match="samples must be an integer ≥ 1"):
         adaptimp.sweep("pd", vary={"Kp": adaptimp.Uniform(1.0, 2.0)}, samples=0)
+
+
+def test_sweep_on_the_mujoco_plant() -> None:
+    pytest.importorskip("mujoco")
+    df = adaptimp.sweep(
+        "pd", vary={"Kp": [8.0, 10.0]}, plant="mujoco", T=0.3, contact=False, scenario="robot"
+    )
+    assert df["error"].isna().all()
+    from adaptimp import mujoco as amj
+
+    alone = amj.simulate("pd", "two_link", T=0.3, contact=False, scenario="robot", Kp=10.0)
+    assert df["rms_z1"][1] == alone.metrics["rms_z1"]
+    assert df["rms_z1"][0] != df["rms_z1"][1]

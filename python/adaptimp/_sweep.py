@@ -149,9 +149,19 @@ class _Run:
     key: str
 
 
-def _prepare(case: str, scenario: str, fixed: Mapping[str, Any], varied: Mapping[str, Any]) -> _Run:
+def _prepare(
+    case: str,
+    scenario: str,
+    fixed: Mapping[str, Any],
+    varied: Mapping[str, Any],
+    model: str | None = None,
+) -> _Run:
     run_case = str(varied.get("case", case))
     given = {**fixed, **{k: v for k, v in varied.items() if k != "case"}}
+    if model is not None:
+        # The MuJoCo plant takes the keywords as they are (adaptimp.mujoco.simulate).
+        key = _key(run_case, scenario, {"mujoco": model, **given})
+        return _Run(dict(varied), run_case, dict(given), None, key)
     try:
         check_case(run_case)
         p = resolve(given, scenario=scenario, caller="sweep()")
@@ -166,6 +176,21 @@ def _run_batch(
     """Run ``jobs`` (case, params, arm) in this process: the task an executor runs."""
     core_jobs = [(c, p, None if a is None else a._core) for c, p, a in jobs]
     return list(_adaptimp.simulate_many(core_jobs, threads))
+
+
+def _run_mujoco_batch(
+    jobs: list[tuple[str, str, str, dict[str, Any]]],
+) -> list[dict[str, Any] | str]:
+    """Run ``jobs`` (case, scenario, model, keywords) on the MuJoCo plant, one by one."""
+    from . import mujoco as amj
+
+    def one(case: str, scenario: str, model: str, kw: dict[str, Any]) -> dict[str, Any] | str:
+        try:
+            return dict(amj.simulate(case, model, scenario=scenario, **kw).metrics)
+        except (TypeError, ValueError, ArithmeticError, RuntimeError) as e:
+            return f"{type(e).__name__}: {e}"
+
+    return [one(*job) for job in jobs]
 
 
 def _batches(items: list[Any], size: int) -> Iterator[list[Any]]:
@@ -241,6 +266,8 @@ def sweep(
     progress: bool | Callable[[int, int], object] = False,
     batch_size: int | None = None,
     threads: int | None = None,
+    plant: str = "rigid",
+    model: str = "two_link",
     **params: Any,
 ) -> pd.DataFrame:
     """Many runs of :func:`adaptimp.simulate`: one row per run, with its varied
@@ -285,6 +312,13 @@ def sweep(
         threads when caching) or 8 per task (an executor).
     threads : int, optional
         Threads of ``executor=None`` (default: every core).
+    plant : {"rigid", "mujoco"}
+        The plant: the RK4 rigid body of :func:`adaptimp.simulate`, or MuJoCo
+        (``adaptimp.mujoco.simulate`` with ``model``; needs ``adaptimp[mujoco]``).
+        MuJoCo runs step in Python: with ``executor=None`` they run one after the
+        other in this process; give a process pool or a Dask executor to spread them.
+    model : str
+        The MuJoCo model of ``plant="mujoco"`` (``"two_link"``, ``"panda"``, a path).
     **params
         Fixed parameters of every run, as for :func:`adaptimp.simulate`.
 
@@ -307,7 +341,10 @@ def sweep(
 
     check_scenario(scenario)
     check_case(case)
-    runs = [_prepare(case, scenario, params, v) for v in _runs(vary or {}, samples, seed)]
+    if plant not in ("rigid", "mujoco"):
+        raise ValueError(f"plant must be 'rigid' or 'mujoco', got {plant!r}")
+    mj_model = model if plant == "mujoco" else None
+    runs = [_prepare(case, scenario, params, v, mj_model) for v in _runs(vary or {}, samples, seed)]
     store = _Cache(cache)
     results: list[dict[str, Any] | str | None] = [
         run.error if run.error is not None else store.get(run.key) for run in runs
@@ -332,7 +369,7 @@ def sweep(
         nonlocal finished
         for i, result in zip(batch, out):
             p = runs[i].params
-            if isinstance(result, str) and p is not None:
+            if isinstance(result, str) and p is not None and mj_model is None:
                 hint = config_hint(result, p)
                 result = f"{result}; {hint}" if hint else result
             results[i] = result
@@ -341,8 +378,28 @@ def sweep(
         if report is not None:
             report(finished, total)
 
+    def mj_job(i: int) -> tuple[str, str, str, dict[str, Any]]:
+        p = runs[i].params
+        assert p is not None
+        return (runs[i].case, scenario, model, p)
+
     try:
-        if executor is None:
+        if mj_model is not None and executor is None:
+            for batch in _batches(todo, batch_size or 1):
+                record(batch, _run_mujoco_batch([mj_job(i) for i in batch]))
+        elif mj_model is not None:
+            assert executor is not None
+            mj_pending = {
+                executor.submit(_run_mujoco_batch, [mj_job(i) for i in batch]): batch
+                for batch in _batches(todo, batch_size or 1)
+            }
+            try:
+                for future in as_completed(mj_pending):
+                    record(mj_pending[future], future.result())
+            finally:
+                for future in mj_pending:
+                    future.cancel()
+        elif executor is None:
             cores = threads or os.cpu_count() or 1
             size = batch_size or (8 * cores if cache is not None else max(len(todo), 1))
             for batch in _batches(todo, size):

@@ -648,7 +648,8 @@ impl<const N: usize> DynTracker for Typed<N> {
     ) -> Result<(), RunError> {
         let row = |v: &[f64], k: usize| Vector::<N>::from_column_slice(&v[k * N..(k + 1) * N]);
         for k in 0..rows {
-            if k > 0 && (k as u64).is_multiple_of(HOOK_EVERY) && !hooks.tick(k as u64, rows as u64) {
+            if k > 0 && (k as u64).is_multiple_of(HOOK_EVERY) && !hooks.tick(k as u64, rows as u64)
+            {
                 return Err(RunError::Stopped);
             }
             let m = Measurement {

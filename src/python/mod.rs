@@ -1149,12 +1149,11 @@ impl Hooks for StopHooks<'_> {
 /// One job, start to end, on the calling thread: its SPEC §12 metrics or the
 /// error's message.
 fn run_job(job: &Job, stop: &std::sync::atomic::AtomicBool) -> Result<dynamic::MetricsOut, String> {
-    let mut tracker = dynamic::build(2, Preset::Paper, job.law, &job.items, None).map_err(|e| {
-        match e.name {
+    let mut tracker =
+        dynamic::build(2, Preset::Paper, job.law, &job.items, None).map_err(|e| match e.name {
             Some(name) => format!("{name}: {}", e.error),
             None => e.error.to_string(),
-        }
-    })?;
+        })?;
     let mut hooks = StopHooks(stop);
     match tracker.simulate(&job.arm, &job.items, None, u64::MAX, &mut hooks) {
         Ok((_, m)) => Ok(m),
@@ -1165,7 +1164,10 @@ fn run_job(job: &Job, stop: &std::sync::atomic::AtomicBool) -> Result<dynamic::M
     }
 }
 
-fn metrics_to_dict<'py>(py: Python<'py>, metrics: dynamic::MetricsOut) -> PyResult<Bound<'py, PyDict>> {
+fn metrics_to_dict<'py>(
+    py: Python<'py>,
+    metrics: dynamic::MetricsOut,
+) -> PyResult<Bound<'py, PyDict>> {
     let m = PyDict::new(py);
     for (name, v) in metrics.counts {
         m.set_item(name, v)?;
@@ -1208,7 +1210,9 @@ fn simulate_many<'py>(
         } else if let Ok(a) = arm.cast::<PyArm>() {
             ArmSpec::Paper(a.get().inner)
         } else {
-            return Err(PyTypeError::new_err("a sweep's arm must be a TwoLinkArm or None"));
+            return Err(PyTypeError::new_err(
+                "a sweep's arm must be a TwoLinkArm or None",
+            ));
         };
         parsed.push(Job { law, items, arm });
     }

@@ -606,6 +606,16 @@ fn a_weak_actuator_never_delivers_more_than_rho_tau_max() {
 }
 
 #[test]
+fn the_schema_defaults_are_no_disturbance() {
+    for preset in Preset::ALL {
+        for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
+            let s = Scenario::<2>::preset(preset, law);
+            assert_eq!(s.disturb, DisturbanceParams::default(), "{preset:?}");
+        }
+    }
+}
+
+#[test]
 fn the_schema_builds_the_disturbances_and_names_bad_values() {
     let mut s = Scenario::<2>::preset(Preset::Paper, Law::Pd);
     let e = s.set("seed", Value::Int(-1)).unwrap_err();

@@ -45,6 +45,7 @@
 //! | [`metrics`] | tracking / saturation / impedance figures | §12 |
 //! | [`simulator`] | the closed loop | §11 |
 //! | [`inject`] | faults injected into a closed loop | beyond the paper |
+//! | [`disturb`] | payload, sensor noise and delay, jitter, friction, weak actuators | beyond the paper, §15 |
 //! | [`error`] | validation errors | §10 |
 //!
 //! ## Quick start
@@ -92,6 +93,7 @@ extern crate alloc;
 pub mod auxiliary;
 pub mod config;
 pub mod controller;
+pub mod disturb;
 pub mod environment;
 pub mod error;
 pub mod impedance;
@@ -123,6 +125,7 @@ pub mod types;
 pub use auxiliary::AuxLaw;
 pub use config::{Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};
+pub use disturb::{DisturbanceParams, Disturbances, Friction, TipPayload, WithFriction};
 pub use environment::{Environment, FreeSpace, Wall};
 pub use error::Error;
 pub use impedance::{Reference, TargetImpedance};
@@ -145,7 +148,7 @@ pub use safety::{Fallback, Fault, FaultPolicy, Limits};
 pub use saturation::Saturation;
 pub use schema::{Preset, Scenario};
 pub use simd::SimdPath;
-pub use simulator::{run, simulate, simulate_with, SimConfig};
+pub use simulator::{run, run_disturbed, simulate, simulate_disturbed, simulate_with, SimConfig};
 #[cfg(feature = "alloc")]
 pub use state::HeapState;
 pub use state::State;

@@ -250,6 +250,11 @@ impl<const N: usize> PlanarArm<N> {
         &self.links
     }
 
+    /// Gravitational acceleration g (m/s²).
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+
     /// Absolute link angles θ (rad) with their sines and cosines.
     fn angles(q: &Vector<N>) -> [(f64, f64); N] {
         let mut out = [(0.0, 0.0); N];

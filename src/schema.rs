@@ -14,10 +14,11 @@
 
 use crate::auxiliary::AuxLaw;
 use crate::config::{Config, Law, ObserverInit, WeightBound};
+use crate::disturb::{DisturbanceParams, Disturbances, MAX_DELAY};
 use crate::environment::Wall;
 use crate::error::Error;
 use crate::learning::{LearningStep, SaturationLearning};
-use crate::model::ArmParams;
+use crate::model::{ArmParams, TwoLinkArm};
 use crate::observer::Hold;
 use crate::rbf::Grid;
 use crate::robust::RobustKind;
@@ -213,6 +214,43 @@ pub const PARAMS: &[Param] = &[
     p("q0", Sim, Joint, "rad", "initial joint position q(0), (65)", "", V(&[0.25, -0.05])),
     p("dq0", Sim, Joint, "rad/s", "initial joint velocity q̇(0)", "", R(0.0)),
     p("settle", Sim, Real, "s", "start of the 'after2' window of the metrics (SPEC §12)", "", R(2.0)),
+    // Disturbances a real robot has (SPEC §15, src/disturb.rs); the defaults
+    // disturb nothing. The controller is told none of them.
+    p("payload", Sim, Real, "kg", "point mass at the tip of the last link (the plant's only)", "payload ≥ 0", R(0.0)),
+    p("noise_q", Sim, Joint, "rad", "standard deviation of the Gaussian noise on each measured q_i", "noise ≥ 0", R(0.0)),
+    p("noise_dq", Sim, Joint, "rad/s", "standard deviation of the Gaussian noise on each measured q̇_i", "noise ≥ 0", R(0.0)),
+    p(
+        "noise_tau_e",
+        Sim,
+        Joint,
+        "N m",
+        "standard deviation of the Gaussian noise on each measured τe_i",
+        "noise ≥ 0",
+        R(0.0),
+    ),
+    p("seed", Sim, Int, "", "seed of the noise and jitter generators (xoshiro256++): same seed, same run", "seed ≥ 0", I(0)),
+    p("delay", Sim, Int, "steps", "measurement delay d: the controller sees the sample of step k − d", "0 ≤ delay ≤ 64", I(0)),
+    p(
+        "jitter",
+        Sim,
+        Real,
+        "",
+        "sampling-time jitter j: the plant advances Ts (1 + u), u uniform on [−j, j), the controller assumes Ts",
+        "0 ≤ jitter < 1",
+        R(0.0),
+    ),
+    p("friction_viscous", Sim, Joint, "N m s/rad", "viscous joint friction b of τf = −b q̇ − fc tanh(q̇/v_s)", "b ≥ 0", R(0.0)),
+    p("friction_coulomb", Sim, Joint, "N m", "Coulomb joint friction level fc of τf", "fc ≥ 0", R(0.0)),
+    p("friction_vs", Sim, Real, "rad/s", "velocity scale v_s of the smooth Coulomb term fc tanh(q̇/v_s)", "v_s > 0", R(0.01)),
+    p(
+        "actuator_fraction",
+        Sim,
+        Joint,
+        "",
+        "fraction ρ of its limit τmax each actuator delivers: the applied torque is clamped to ±ρ τmax",
+        "0 < ρ ≤ 1",
+        R(1.0),
+    ),
     // The controller, SPEC §4–§9, §11.
     robot(p("Ts", Ctrl, Real, "s", "sampling period of the controller", "Ts > 0", R(50e-6)), R(1e-3)),
     p("K1", Ctrl, Joint, "1/s", "K1 of α1 = ẋd + K1 z1, (7)", "K1 > 0", R(6.0)),
@@ -441,6 +479,8 @@ pub struct Scenario<const N: usize> {
     pub config: Config<N>,
     /// The run.
     pub sim: SimConfig<N>,
+    /// The disturbances of the run (SPEC §15).
+    pub disturb: DisturbanceParams<N>,
     /// η² of the vertex grid.
     pub eta2: f64,
     /// The commanded sinusoid: offset, sine and cosine amplitudes (rad), ω (rad/s).
@@ -475,6 +515,7 @@ impl<const N: usize> Scenario<N> {
                 dq0: zero,
                 settle: 0.0,
             },
+            disturb: DisturbanceParams::default(),
             eta2: 0.0,
             xc: [zero; 4],
             wall: None,
@@ -524,6 +565,37 @@ impl<const N: usize> Scenario<N> {
             "q0" => self.sim.q0 = joint(n, value)?,
             "dq0" => self.sim.dq0 = joint(n, value)?,
             "settle" => self.sim.settle = real(n, value)?,
+            "payload" => self.disturb.payload = real(n, value)?,
+            "noise_q" => self.disturb.noise_q = joint(n, value)?,
+            "noise_dq" => self.disturb.noise_dq = joint(n, value)?,
+            "noise_tau_e" => self.disturb.noise_tau_e = joint(n, value)?,
+            "seed" => {
+                let v = int(n, value)?;
+                self.disturb.seed = u64::try_from(v).map_err(|_| Error::Condition {
+                    condition: "seed ≥ 0",
+                    lhs: "seed",
+                    index: None,
+                    value: v as f64,
+                })?
+            }
+            "delay" => {
+                let v = int(n, value)?;
+                self.disturb.delay =
+                    usize::try_from(v)
+                        .ok()
+                        .filter(|d| *d <= MAX_DELAY)
+                        .ok_or(Error::Condition {
+                            condition: "0 ≤ delay ≤ 64",
+                            lhs: "delay",
+                            index: None,
+                            value: v as f64,
+                        })?
+            }
+            "jitter" => self.disturb.jitter = real(n, value)?,
+            "friction_viscous" => self.disturb.friction_viscous = joint(n, value)?,
+            "friction_coulomb" => self.disturb.friction_coulomb = joint(n, value)?,
+            "friction_vs" => self.disturb.friction_vs = real(n, value)?,
+            "actuator_fraction" => self.disturb.actuator_fraction = joint(n, value)?,
             "Ts" => c.ts = real(n, value)?,
             "K1" => c.k1 = joint(n, value)?,
             "Kp" => c.kp = joint(n, value)?,
@@ -639,9 +711,23 @@ impl<const N: usize> Scenario<N> {
             dq0,
             settle,
         } = &self.sim;
+        let DisturbanceParams {
+            payload,
+            noise_q,
+            noise_dq,
+            noise_tau_e,
+            seed,
+            delay,
+            jitter,
+            friction_viscous,
+            friction_coulomb,
+            friction_vs,
+            actuator_fraction,
+        } = &self.disturb;
         let Self {
             config: _,
             sim: _,
+            disturb: _,
             eta2,
             xc: [xc_offset, xc_sin, xc_cos, xc_omega],
             wall,
@@ -661,6 +747,18 @@ impl<const N: usize> Scenario<N> {
         f("q0", V(q0.as_slice()));
         f("dq0", V(dq0.as_slice()));
         f("settle", R(*settle));
+        f("payload", R(*payload));
+        f("noise_q", V(noise_q.as_slice()));
+        f("noise_dq", V(noise_dq.as_slice()));
+        f("noise_tau_e", V(noise_tau_e.as_slice()));
+        // The setter admits 0 ≤ seed ≤ i64::MAX only.
+        f("seed", I(i64::try_from(*seed).unwrap_or(i64::MAX)));
+        f("delay", I(*delay as i64));
+        f("jitter", R(*jitter));
+        f("friction_viscous", V(friction_viscous.as_slice()));
+        f("friction_coulomb", V(friction_coulomb.as_slice()));
+        f("friction_vs", R(*friction_vs));
+        f("actuator_fraction", V(actuator_fraction.as_slice()));
         f("Ts", R(*ts));
         f("K1", V(k1.as_slice()));
         f("Kp", V(kp.as_slice()));
@@ -734,6 +832,22 @@ impl<const N: usize> Scenario<N> {
     /// The vertex grid of width η² (validated).
     pub fn grid(&self) -> Result<Grid<N>, Error> {
         Grid::new(self.eta2)
+    }
+
+    /// The disturbances of the run (validated; SPEC §15), the actuator
+    /// fraction taken of the controller's `tau_max`. For
+    /// [`run_disturbed`](crate::simulator::run_disturbed).
+    pub fn disturbances(&self) -> Result<Disturbances<N>, Error> {
+        Disturbances::new(self.disturb, self.config.tau_max)
+    }
+}
+
+impl Scenario<2> {
+    /// The plant's 2-link arm (validated; SPEC §1): the arm parameters m1,
+    /// m2, l1, l2, lc1, lc2, I1, I2 and g, the derived ones filled in. Only
+    /// the plant reads them: the controller is model-free.
+    pub fn arm(&self) -> Result<TwoLinkArm, Error> {
+        TwoLinkArm::new(self.arm.resolve())
     }
 }
 

@@ -4,6 +4,7 @@
 //! step with the trajectory's setpoint at t_k, the plant advanced to t_{k+1}
 //! with the applied torque held, and the row recorded.
 
+use crate::disturb::{Disturbances, TipPayload, WithFriction};
 use crate::environment::Environment;
 use crate::error::{check, Error};
 use crate::inject::Injection;
@@ -82,8 +83,47 @@ where
     T: Trajectory<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
+    let none = Disturbances::none();
+    simulate_disturbed(plant, ctrl, traj, t_final, injection, &none, rec)
+}
+
+/// [`simulate_with`] in a disturbed loop (SPEC §15): the loop's own
+/// disturbances of `disturbances` act at every step, the plant's (payload,
+/// friction) are `plant`'s to have ([`run_disturbed`] builds them in).
+///
+/// At step k, with t_k = k·Ts on the controller's clock:
+///
+/// 1. the sensors sample the plant; noise is added and the controller sees
+///    the noisy sample of step k − d ([`Disturbances::measure`]), then the
+///    injected fault, if any, acts on what it sees;
+/// 2. the controller steps with the trajectory at t_k (it assumes Ts);
+/// 3. the actuators deliver the applied torque (the injected fault, then the
+///    fraction ρ: [`Disturbances::actuate`]), recorded as `tau_sat`;
+/// 4. the plant advances by the true interval h_k = Ts (1 + u_k)
+///    ([`Disturbances::interval`]).
+///
+/// Rows carry t_k, the controller's time, and the plant's true state. With
+/// [`Disturbances::none`] it is [`simulate_with`], bit for bit. The
+/// generators start from the seed at every call: the same arguments give the
+/// same rows. Allocation-free itself.
+pub fn simulate_disturbed<const N: usize, P, C, T, R>(
+    plant: &mut P,
+    ctrl: &mut C,
+    traj: &T,
+    t_final: f64,
+    injection: Option<&Injection<N>>,
+    disturbances: &Disturbances<N>,
+    rec: &mut R,
+) -> Result<u64, Error>
+where
+    P: Plant<N> + ?Sized,
+    C: Control<N> + ?Sized,
+    T: Trajectory<N> + ?Sized,
+    R: Recorder<N> + ?Sized,
+{
     let ts = ctrl.period();
     let steps = steps(t_final, ts)?;
+    let mut noise = disturbances.new_state();
     let (x0, dx0) = plant.state();
     let mut sensed = (x0, dx0, plant.contact());
     let mut applied = Vector::<N>::zeros();
@@ -92,11 +132,11 @@ where
         let t = k as f64 * ts;
         let (x, dx) = plant.state();
         let tau_e = plant.contact();
-        let truth = (x, dx, tau_e);
+        let seen = disturbances.measure(&mut noise, (x, dx, tau_e));
         if let Some(inj) = injection {
-            sensed = inj.measure(t, truth, sensed);
+            sensed = inj.measure(t, seen, sensed);
         } else {
-            sensed = truth;
+            sensed = seen;
         }
         let c = traj.sample(t);
         let refused = if injection.is_some_and(|i| i.skips(t)) {
@@ -119,7 +159,9 @@ where
             }
         };
         let delivered = injection.map_or(applied, |i| i.actuate(t, &applied));
-        let ddx = plant.advance(&delivered, ts)?;
+        let delivered = disturbances.actuate(&delivered);
+        let h = disturbances.interval(&mut noise, ts);
+        let ddx = plant.advance(&delivered, h)?;
         rec.record(&Row {
             t,
             x,
@@ -170,6 +212,49 @@ where
         ctrl,
         traj,
         cfg.t_final,
+        &mut (&mut metrics, rec),
+    )?;
+    Ok(metrics.finish())
+}
+
+/// [`run`] with the disturbances a real robot has (SPEC §15): the arm of
+/// the plant carries `disturbances`' payload and joint friction, and the
+/// loop has its sensor noise, measurement delay, sampling jitter and weak
+/// actuators ([`simulate_disturbed`]). The controller is told none of them.
+/// With [`Disturbances::none`] it is [`run`], bit for bit. The entry point
+/// of the bindings: with a `schema::Scenario` `s` (for the 2-link arm),
+/// `run_disturbed(&s.arm()?, &wall, ctrl, &traj, &s.sim, &s.disturbances()?, rec)`.
+/// Allocation-free itself.
+pub fn run_disturbed<const N: usize, M, E, C, T, R>(
+    arm: &M,
+    env: &E,
+    ctrl: &mut C,
+    traj: &T,
+    cfg: &SimConfig<N>,
+    disturbances: &Disturbances<N>,
+    rec: &mut R,
+) -> Result<Metrics<N>, Error>
+where
+    M: TipPayload<N> + Clone,
+    E: Environment<N> + Clone,
+    C: Control<N> + ?Sized,
+    T: Trajectory<N> + ?Sized,
+    R: Recorder<N> + ?Sized,
+{
+    check::finite("settle", cfg.settle)?;
+    let arm = WithFriction::new(
+        arm.with_payload(disturbances.payload())?,
+        *disturbances.friction(),
+    );
+    let mut plant = RigidBody::new(arm, env.clone(), cfg.q0, cfg.dq0, cfg.substeps)?;
+    let mut metrics = MetricsAccumulator::new(cfg.settle, *ctrl.target());
+    simulate_disturbed(
+        &mut plant,
+        ctrl,
+        traj,
+        cfg.t_final,
+        None,
+        disturbances,
         &mut (&mut metrics, rec),
     )?;
     Ok(metrics.finish())

@@ -131,3 +131,48 @@ fn no_heap_allocation_in_a_simulation() {
         assert_eq!(m.rows, 500);
     }
 }
+
+#[test]
+fn no_heap_allocation_in_a_disturbed_simulation() {
+    // Every disturbance of SPEC §15 on: the generators and the delay line
+    // live in a fixed state on the stack.
+    let d = adaptimp::Disturbances::new(
+        adaptimp::DisturbanceParams {
+            payload: 0.3,
+            noise_q: Vector::from_element(1e-4),
+            noise_dq: Vector::from_element(1e-2),
+            noise_tau_e: Vector::from_element(0.2),
+            seed: 1,
+            delay: 64,
+            jitter: 0.1,
+            friction_viscous: Vector::from_element(0.05),
+            friction_coulomb: Vector::from_element(0.2),
+            friction_vs: 0.01,
+            actuator_fraction: Vector::from_element(0.8),
+        },
+        Vector::<2>::new(17.0, 15.0),
+    )
+    .expect("valid");
+    for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
+        let ctrl = Controller::robot(law);
+        let mut state = ctrl.new_state();
+        let sim = SimConfig {
+            t_final: 0.5,
+            ..SimConfig::robot()
+        };
+        let (n, m) = allocations_in(|| {
+            adaptimp::run_disturbed(
+                &TwoLinkArm::paper(),
+                &Wall::paper(),
+                &mut ctrl.bind(&mut state),
+                &Sinusoid::paper(),
+                &sim,
+                &d,
+                &mut (),
+            )
+            .expect("simulate")
+        });
+        assert_eq!(n, 0, "{law:?}: run_disturbed allocated");
+        assert_eq!(m.rows, 500);
+    }
+}

@@ -16,6 +16,7 @@ use crate::auxiliary::AuxLaw;
 use crate::config::{Config, Law, ObserverInit, WeightBound};
 use crate::environment::Wall;
 use crate::error::Error;
+use crate::impedance::ImpedanceMode;
 use crate::learning::{LearningStep, SaturationLearning};
 use crate::model::ArmParams;
 use crate::observer::Hold;
@@ -282,6 +283,15 @@ pub const PARAMS: &[Param] = &[
     p("Dd", Ctrl, Joint, "kg m²", "target inertia Dd, (3)", "Dd > 0", R(1.0)),
     p("Cd", Ctrl, Joint, "N m s/rad", "target damping Cd, (3)", "Cd ≥ 0", R(10.0)),
     p("Gd", Ctrl, Joint, "N m/rad", "target stiffness Gd, (3)", "Gd ≥ 0", R(60.0)),
+    p(
+        "impedance",
+        Ctrl,
+        Kind::Choice(&ImpedanceMode::NAMES),
+        "",
+        "where the target impedance acts: 'joint', the reference model of SPEC §4 (Dd, Cd, Gd); 'external', the setpoint is already the compliant reference (xd = xc, e.g. a Cartesian impedance, SPEC §16)",
+        "",
+        S("joint"),
+    ),
     // (64): xc = [0.2 − 0.2 cos(πt), 0.2 + 0.2 sin(πt)].
     p(
         "xc_offset",
@@ -547,6 +557,7 @@ impl<const N: usize> Scenario<N> {
             "Dd" => c.dd = joint(n, value)?,
             "Cd" => c.cd = joint(n, value)?,
             "Gd" => c.gd = joint(n, value)?,
+            "impedance" => c.impedance = choice(p, value, &ImpedanceMode::ALL)?,
             "xc_offset" => self.xc[0] = joint(n, value)?,
             "xc_sin" => self.xc[1] = joint(n, value)?,
             "xc_cos" => self.xc[2] = joint(n, value)?,
@@ -620,6 +631,7 @@ impl<const N: usize> Scenario<N> {
             dd,
             cd,
             gd,
+            impedance,
             fallback,
             fallback_damping,
             fault_policy,
@@ -684,6 +696,7 @@ impl<const N: usize> Scenario<N> {
         f("Dd", V(dd.as_slice()));
         f("Cd", V(cd.as_slice()));
         f("Gd", V(gd.as_slice()));
+        f("impedance", S(impedance.name()));
         f("xc_offset", V(xc_offset.as_slice()));
         f("xc_sin", V(xc_sin.as_slice()));
         f("xc_cos", V(xc_cos.as_slice()));

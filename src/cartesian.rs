@@ -393,3 +393,75 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{Config, Law};
+    use crate::model::TwoLinkArm;
+    use crate::rbf::Grid;
+
+    fn outer() -> CartesianImpedance<2, TwoLinkArm> {
+        let q0 = Vector::<2>::new(0.5, 1.0);
+        CartesianImpedance::new(CartesianConfig::new(1e-3, q0), TwoLinkArm::paper()).unwrap()
+    }
+
+    #[test]
+    fn bad_gains_are_rejected_by_name() {
+        let q0 = Vector::<2>::new(0.5, 1.0);
+        let arm = TwoLinkArm::paper();
+        let mut cfg = CartesianConfig::new(1e-3, q0);
+        cfg.md[1] = 0.0;
+        let e = CartesianImpedance::new(cfg, arm).unwrap_err();
+        assert!(e.to_string().contains("Md > 0"), "{e}");
+        let mut cfg = CartesianConfig::new(1e-3, q0);
+        cfg.lambda = 0.0;
+        let e = CartesianImpedance::new(cfg, arm).unwrap_err();
+        assert!(e.to_string().contains("λ > 0"), "{e}");
+        let mut cfg = CartesianConfig::new(1e-3, q0);
+        cfg.clik_kd = 2000.0;
+        let e = CartesianImpedance::new(cfg, arm).unwrap_err();
+        assert!(e.to_string().contains("Ts·K_D < 1"), "{e}");
+    }
+
+    #[test]
+    fn the_joint_controller_must_leave_the_impedance_to_the_outer_loop() {
+        let mut cfg = Config::paper(Law::StateFeedback);
+        cfg.ts = 1e-3;
+        let joint = Controller::new(cfg, Grid::paper()).unwrap();
+        let e = CartesianController::new(outer(), joint).unwrap_err();
+        assert!(e.to_string().contains("external"), "{e}");
+        cfg.impedance = ImpedanceMode::External;
+        let joint = Controller::new(cfg, Grid::paper()).unwrap();
+        assert!(CartesianController::new(outer(), joint).is_ok());
+    }
+
+    #[test]
+    fn a_static_force_deflects_the_reference_by_f_over_kd_and_ik_follows() {
+        let o = outer();
+        let mut st = o.start(Vector::<2>::new(0.5, 1.0));
+        let pc = o.kinematics().fk(&st.qd);
+        let c = Setpoint {
+            x: pc,
+            dx: Vector::zeros(),
+            ddx: Vector::zeros(),
+        };
+        let f = Vector::<3>::new(5.0, -2.0, 0.0);
+        for _ in 0..20_000 {
+            o.step(&mut st, &c, &f).unwrap();
+        }
+        // K_d (p_c − p_d) = F_e at rest, (C1); fk(q_d) = p_d, (C2), up to
+        // the posture term the damped inverse lets into the task,
+        // O(λ²/σ²)·k0‖q_posture − q_d‖/K_P (measured 9.5e-8 m).
+        let kd = o.config().kd[0];
+        assert!((kd * (pc - st.pd) - f).norm() < 1e-9, "{}", st.pd);
+        let e = (o.kinematics().fk(&st.qd) - st.pd).norm();
+        assert!(e < 1e-6, "{e}");
+        // A non-finite force is refused and changes nothing.
+        let before = st;
+        assert!(o
+            .step(&mut st, &c, &Vector::from_element(f64::NAN))
+            .is_err());
+        assert_eq!(st, before);
+    }
+}

@@ -880,6 +880,30 @@ mod tests {
     }
 
     #[test]
+    fn external_impedance_tracks_the_setpoint_itself_under_contact() {
+        // Joint: the reference yields to τe; external: xd = xc whatever τe.
+        let mut cfg = Config::paper(Law::StateFeedback);
+        let joint = Controller::new(cfg, Grid::paper()).unwrap();
+        cfg.impedance = crate::impedance::ImpedanceMode::External;
+        let external = Controller::new(cfg, Grid::paper()).unwrap();
+        let m = Measurement {
+            tau_e: Vector::<2>::new(30.0, -5.0),
+            ..measurement()
+        };
+        let (mut a, mut b) = (joint.new_state(), external.new_state());
+        let (mut ca, mut cb) = (Command::zeros(), Command::zeros());
+        for _ in 0..100 {
+            let sp = setpoint(&joint, &a);
+            ca = joint.step(&mut a, &m, &sp).unwrap();
+            cb = external.step(&mut b, &m, &sp).unwrap();
+            assert_eq!(cb.xd, sp.x);
+            assert_eq!(cb.z1, sp.x - m.x);
+        }
+        assert!((ca.xd - ca.xc).norm() > 1e-4, "{ca:?}");
+        assert_ne!(ca.tau, cb.tau);
+    }
+
+    #[test]
     fn a_state_in_a_caller_buffer_steps_like_a_heap_state() {
         let c = Controller::paper(Law::OutputFeedback);
         let mut buf = vec![0.0; c.buffer_len()];

@@ -491,6 +491,72 @@ mod tests {
     }
 
     #[test]
+    fn lattice_and_orbit_bases_follow_their_rules() {
+        let lo = Vector::<2>::new(-1.0, 0.0);
+        let hi = Vector::<2>::new(1.0, 0.5);
+        let l = Centers::<2, _>::lattice(&lo, &hi, 3).unwrap();
+        assert_eq!(l.nodes(), 9);
+        // Node 5 = level 2 of joint 1, level 1 of joint 2.
+        assert_eq!(&l.centers()[5 * 8..5 * 8 + 2], &[1.0, 0.25]);
+        let w = l.widths2();
+        assert_eq!((w[0][0], w[0][1]), (1.0, 0.0625));
+        assert!(w[1..].iter().all(|b| b.iter().all(|x| *x == f64::INFINITY)));
+        // Only q enters: v, α1, α̇1 change nothing.
+        let (mut a, mut b) = ([0.0; 9], [0.0; 9]);
+        let q = Vector::<2>::new(0.3, 0.1);
+        l.eval(
+            &[q, Vector::zeros(), Vector::zeros(), Vector::zeros()],
+            &mut a,
+        );
+        l.eval(
+            &[
+                q,
+                Vector::from_element(9.0),
+                Vector::from_element(-7.0),
+                Vector::from_element(1e3),
+            ],
+            &mut b,
+        );
+        assert_eq!(a, b);
+        let e =
+            Centers::<7, _>::lattice(&Vector::zeros(), &Vector::from_element(1.0), 4).unwrap_err();
+        assert!(e.to_string().contains("4096"), "{e}");
+        let e = Centers::<2, _>::lattice(&hi, &lo, 2).unwrap_err();
+        assert!(e.to_string().contains("hi > lo"), "{e}");
+
+        // Along an orbit: the widths are ρ times the largest spacing, or the tube.
+        let samples: alloc::vec::Vec<_> = (0..4)
+            .map(|j| Setpoint {
+                x: Vector::<2>::new(0.1 * j as f64, 0.0),
+                dx: Vector::<2>::new(0.0, 1.0),
+                ddx: Vector::zeros(),
+            })
+            .collect();
+        let c = Centers::along(&samples, [0.05, 0.5]).unwrap();
+        let w = c.widths2();
+        assert!((w[0][0] - 0.04).abs() < 1e-15, "{w:?}"); // (2 · 0.1)²
+        assert_eq!(w[1][1], 0.25); // the tube: no spacing in v
+        assert_eq!(w[3][0], f64::INFINITY);
+        let mut s = [0.0; 4];
+        c.eval(
+            &[
+                samples[2].x,
+                samples[2].dx,
+                Vector::zeros(),
+                Vector::from_element(5.0),
+            ],
+            &mut s,
+        );
+        assert_eq!(s[2], 1.0);
+        assert!((s[1] - (-0.25f64).exp()).abs() < 1e-15, "{s:?}");
+        let e = Centers::<2, _>::along(&samples, [0.0, 1.0]).unwrap_err();
+        assert!(e.to_string().contains("tube > 0"), "{e}");
+        let e =
+            Centers::<1, _>::new([0.0; 4], [Vector::from_element(f64::INFINITY); 4]).unwrap_err();
+        assert!(e.to_string().contains("every width is infinite"), "{e}");
+    }
+
+    #[test]
     fn bad_grids_and_centres_are_rejected_by_name() {
         assert!(Grid::<4>::new(25.0).is_err());
         assert!(Grid::<1>::new(25.0).is_ok());

@@ -14,7 +14,7 @@
 //!    damped-least-squares inverse (Nakamura & Hanafusa 1986; Wampler 1986)
 //!    and a null-space posture task for redundant arms (Ott 2008, ch. 3)
 //!    turns p_d into a joint reference q_d, q̇_d, q̈_d (C2)–(C4);
-//! 3. the joint controller, with [`ImpedanceMode::External`](crate::ImpedanceMode::External)
+//! 3. the joint controller, with [`ImpedanceMode::External`]
 //!    (no joint impedance on top), tracks that reference, with τe = Jᵀ(q) F_e
 //!    in its feedforward (C5); saturation stays per joint.
 //!

@@ -8,7 +8,7 @@ use adaptimp::network::weight_bounds;
 use adaptimp::{
     rk4_step, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
     CartesianWall, Centers, Config, Controller, Environment, ImpedanceMode, Kinematics, Law, Link,
-    Manipulator, PlanarArm, Setpoint, Trajectory, Vector, WeightBound,
+    Manipulator, PlanarArm, Setpoint, Vector, WeightBound,
 };
 use core::f64::consts::PI;
 

@@ -12,11 +12,15 @@
 //!   then one pass that reads each of the (2n² + n) l = 2560 weights once for the
 //!   output and writes it once for the update.
 //! - `paper/*`: one whole paper-scenario run (SPEC §11, 400 000 steps).
+//! - `step/sf7`, `bound/sf7_step`: n = 7 at 1 kHz with L = 64 centres along
+//!   the orbit (SPEC §15): the hardened state-feedback step, and its lower
+//!   bound as above, (2·49 + 7)·64 = 6720 weights.
 
 use adaptimp::network::Rates;
 use adaptimp::{
-    rk4_step, run, Basis, Controller, Environment, Grid, HeapState, Law, Manipulator, Measurement,
-    SimConfig, SimdPath, Sinusoid, Trajectory, TwoLinkArm, Vector, Wall,
+    rk4_step, run, Basis, Centers, Config, Controller, Environment, Grid, HeapState, Law, Link,
+    Manipulator, Measurement, PlanarArm, SimConfig, SimdPath, Sinusoid, Trajectory, TwoLinkArm,
+    Vector, Wall,
 };
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -182,5 +186,90 @@ fn paper(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, basis, network, steps, plant, bound, paper);
+/// The n = 7 controller of `examples/11_worst_case_7.rs` (SPEC §15): a 7-link
+/// planar arm's gains, 64 centres along the commanded orbit, Ts = 1 ms.
+fn seven() -> (Controller<7, Centers<7, Vec<f64>>>, Sinusoid<7>) {
+    let masses = [4.0, 3.5, 3.0, 2.5, 2.0, 1.5, 1.0];
+    let arm = PlanarArm::new(
+        masses.map(|m| Link {
+            mass: m,
+            length: 0.2,
+            com: 0.1,
+            inertia: m * 0.04 / 12.0,
+        }),
+        0.0,
+    )
+    .expect("arm");
+    let traj = Sinusoid::<7>::new(
+        Vector::from_column_slice(&[0.6, -0.3, -0.3, 0.2, -0.2, 0.3, -0.2]),
+        Vector::from_element(0.15),
+        Vector::from_column_slice(&[0.0, 0.1, -0.1, 0.1, 0.0, -0.1, 0.1]),
+        Vector::from_element(1.0),
+    )
+    .expect("trajectory");
+    let nodes = 64;
+    let period = 2.0 * std::f64::consts::PI;
+    let samples: Vec<_> = (0..nodes)
+        .map(|j| traj.sample(period * j as f64 / nodes as f64))
+        .collect();
+    let basis = Centers::along(&samples, [0.3, 1.0]).expect("basis");
+    let tau_max = Vector::<7>::from_column_slice(&[200.0, 150.0, 100.0, 60.0, 35.0, 15.0, 5.0]);
+    let mut cfg = Config::<7>::new(Law::StateFeedback, tau_max).hardened();
+    cfg.ts = 1e-3;
+    let dinv = arm
+        .inertia(&traj.sample(0.0).x)
+        .try_inverse()
+        .expect("D > 0")
+        .diagonal();
+    cfg.kp = dinv.map(|x| 0.25 / (cfg.ts * x));
+    cfg.kzeta = cfg.kp.map(|k| (1.0 + k * k) / 2.0 + 10.0);
+    cfg.k1 = Vector::from_element(20.0);
+    cfg.gamma = [1.0; 3];
+    let ctrl = Controller::for_trajectory(cfg, basis, &traj).expect("controller");
+    (ctrl, traj)
+}
+
+fn seven_joints(c: &mut Criterion) {
+    let (ctrl, traj) = seven();
+    let mut state = ctrl.new_state();
+    let sp0 = traj.sample(0.3);
+    let m = Measurement {
+        x: sp0.x + Vector::<7>::from_element(0.01),
+        dx: Some(sp0.dx),
+        tau_e: Vector::<7>::zeros(),
+    };
+    c.bench_function("step/sf7", |b| {
+        b.iter(|| {
+            let sp = traj.sample(ctrl.time(&state));
+            black_box(ctrl.step(&mut state, black_box(&m), &sp))
+        });
+        state.reset();
+    });
+    // The bound: the basis, then one fused pass over the 105 × 64 weights.
+    let simd = ctrl.simd();
+    let rates = Rates::new(1e-3, [1.0; 3], [0.01; 3]).expect("rates");
+    let z = [sp0.x, sp0.dx, sp0.dx, sp0.ddx];
+    let (da, a) = (sp0.ddx, sp0.dx);
+    let z2 = Vector::<7>::from_element(0.01);
+    let mut norms = [0.0; 3];
+    let mut st = ctrl.new_state();
+    c.bench_function("bound/sf7_step", |b| {
+        b.iter(|| {
+            let (basis, mut weights) = st.networks_mut();
+            simd.eval_basis(ctrl.basis(), black_box(&z), basis);
+            black_box(weights.fused_step(simd, basis, &da, &a, &z2, &rates, &mut norms))
+        })
+    });
+}
+
+criterion_group!(
+    benches,
+    basis,
+    network,
+    steps,
+    plant,
+    bound,
+    paper,
+    seven_joints
+);
 criterion_main!(benches);

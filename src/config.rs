@@ -4,6 +4,7 @@
 //! (`src/schema.rs`, re-exported as `adaptimp::schema`) documents each field.
 
 use crate::auxiliary::AuxLaw;
+use crate::impedance::ImpedanceMode;
 use crate::learning::{LearningStep, SaturationLearning};
 use crate::observer::Hold;
 use crate::robust::RobustKind;
@@ -122,6 +123,8 @@ pub struct Config<const N: usize> {
     pub cd: Vector<N>,
     /// Desired stiffness Gd (N m/rad). Paper: 60.
     pub gd: Vector<N>,
+    /// Where the target impedance is realised. Paper: in joint space.
+    pub impedance: ImpedanceMode,
     /// The torque to apply when a step fails (beyond the paper).
     pub fallback: Fallback,
     /// Kd (N m s/rad) of the damping fallback −Kd q̇.
@@ -165,6 +168,7 @@ impl<const N: usize> Config<N> {
             dd: z,
             cd: z,
             gd: z,
+            impedance: ImpedanceMode::Joint,
             fallback: Fallback::Hold,
             fallback_damping: z,
             fault_policy: FaultPolicy::Report,

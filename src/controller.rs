@@ -17,7 +17,7 @@
 use crate::auxiliary::Auxiliary;
 use crate::config::{Config, Law, ObserverInit, WeightBound};
 use crate::error::{check, Error, BOUND, PARAM_BOUND};
-use crate::impedance::{Reference, TargetImpedance};
+use crate::impedance::{ImpedanceMode, Reference, TargetImpedance};
 use crate::io::{Command, Control, Measurement};
 use crate::learning::{Learning, Signals};
 use crate::observer::{HighGainObserver, ObserverState};
@@ -401,10 +401,9 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         // reference starts at the first step's setpoint.
         let mut staged = Staged {
             observer: st.observer,
-            reference: if st.k == 0 {
-                Reference::start(c)
-            } else {
-                st.reference
+            reference: match (st.k, self.cfg.impedance) {
+                (0, _) | (_, ImpedanceMode::External) => Reference::start(c),
+                (_, ImpedanceMode::Joint) => st.reference,
             },
         };
         let v = self.velocity(st.k, &mut staged.observer, m)?;
@@ -574,7 +573,8 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     }
 
     /// Stages "reference" and "errors", SPEC §4, §5: ẍd from the target
-    /// impedance, then z1, α1, z2, α̇1 with the velocity `v` (rad/s).
+    /// impedance (ẍc with [`ImpedanceMode::External`], SPEC §16), then z1,
+    /// α1, z2, α̇1 with the velocity `v` (rad/s).
     pub fn errors(
         &self,
         r: &Reference<N>,
@@ -582,7 +582,10 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         m: &Measurement<N>,
         v: &Vector<N>,
     ) -> Errors<N> {
-        let ddxd = self.imp.accel(c, r, &m.tau_e);
+        let ddxd = match self.cfg.impedance {
+            ImpedanceMode::Joint => self.imp.accel(c, r, &m.tau_e),
+            ImpedanceMode::External => c.ddx,
+        };
         let k1 = &self.cfg.k1;
         let z1 = r.xd - m.x;
         let alpha1 = r.dxd + k1.component_mul(&z1);
@@ -874,6 +877,30 @@ mod tests {
             assert!(b.load(&snap[1..]).is_err());
             assert_eq!(format!("{:?}", b.weights()), before);
         }
+    }
+
+    #[test]
+    fn external_impedance_tracks_the_setpoint_itself_under_contact() {
+        // Joint: the reference yields to τe; external: xd = xc whatever τe.
+        let mut cfg = Config::paper(Law::StateFeedback);
+        let joint = Controller::new(cfg, Grid::paper()).unwrap();
+        cfg.impedance = crate::impedance::ImpedanceMode::External;
+        let external = Controller::new(cfg, Grid::paper()).unwrap();
+        let m = Measurement {
+            tau_e: Vector::<2>::new(30.0, -5.0),
+            ..measurement()
+        };
+        let (mut a, mut b) = (joint.new_state(), external.new_state());
+        let (mut ca, mut cb) = (Command::zeros(), Command::zeros());
+        for _ in 0..100 {
+            let sp = setpoint(&joint, &a);
+            ca = joint.step(&mut a, &m, &sp).unwrap();
+            cb = external.step(&mut b, &m, &sp).unwrap();
+            assert_eq!(cb.xd, sp.x);
+            assert_eq!(cb.z1, sp.x - m.x);
+        }
+        assert!((ca.xd - ca.xc).norm() > 1e-4, "{ca:?}");
+        assert_ne!(ca.tau, cb.tau);
     }
 
     #[test]

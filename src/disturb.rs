@@ -1,5 +1,5 @@
 //! Disturbances a real robot has, as simulator options (beyond the paper,
-//! SPEC §15): the plant differs from the nominal one, the sensors are noisy
+//! SPEC §17): the plant differs from the nominal one, the sensors are noisy
 //! and late, the sampling instants jitter, the joints have friction and the
 //! actuators are weaker than rated. The controller knows none of them.
 //!
@@ -95,7 +95,7 @@ impl<const N: usize> Default for DisturbanceParams<N> {
     }
 }
 
-/// Joint friction, SPEC §15: τf(q̇) = −b∘q̇ − fc∘tanh(q̇/v_s) (N m), the
+/// Joint friction, SPEC §17: τf(q̇) = −b∘q̇ − fc∘tanh(q̇/v_s) (N m), the
 /// viscous plus Coulomb model of Olsson et al. (1998) with the sign function
 /// smoothed by tanh so that RK4 integrates a smooth right-hand side.
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -158,7 +158,7 @@ impl<const N: usize> Friction<N> {
 
 /// An arm with joint friction: the same D, C, G, and a forward dynamics in
 /// which the joints also receive the friction torque,
-/// `D q̈ + C q̇ + G = τ + τf(q̇) − τe` (SPEC §15). RK4 evaluates it at every
+/// `D q̈ + C q̇ + G = τ + τf(q̇) − τe` (SPEC §17). RK4 evaluates it at every
 /// stage with that stage's velocity.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct WithFriction<const N: usize, M> {
@@ -219,7 +219,7 @@ pub trait TipPayload<const N: usize>: Manipulator<N> + Sized {
 /// A link of mass `m` (kg), centre of mass at `c` (m) from its proximal
 /// joint and inertia `i` (kg m²) about it, with a point mass `mp` (kg) added
 /// at distance `l` (m) on its axis: the combined mass, centre of mass and
-/// inertia about that centre (parallel-axis theorem, SPEC §15).
+/// inertia about that centre (parallel-axis theorem, SPEC §17).
 fn add_point_mass(m: f64, c: f64, i: f64, mp: f64, l: f64) -> (f64, f64, f64) {
     let mass = m + mp;
     let com = (m * c + mp * l) / mass;

@@ -5,6 +5,7 @@
 //! measures it and the controller reads it.
 
 use crate::error::{check, Error, PARAM_BOUND};
+use crate::kinematics::Kinematics;
 use crate::types::Vector;
 
 /// A contact model: τe as a function of time and the robot's state.
@@ -85,6 +86,83 @@ impl<const N: usize> Environment<N> for Wall<N> {
             tau_e[self.joint] = (self.ke * delta + self.be * dx[self.joint]).max(0.0);
         }
         tau_e
+    }
+}
+
+/// A penalty wall in task space, SPEC §16: the half-space `n·p > w` of
+/// end-effector positions p (m) is solid, with the unit normal n pointing
+/// into it. With δ = n·p − w (m) and the kinematics of the arm:
+///
+/// `F_e = max(0, ke δ + be n·ṗ) n` if δ > 0, else 0 (N, the force the end
+/// effector exerts on the wall), and `τe = Jᵀ(q) F_e` (N m).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct CartesianWall<K> {
+    kin: K,
+    normal: Vector<3>,
+    position: f64,
+    ke: f64,
+    be: f64,
+}
+
+impl<K> CartesianWall<K> {
+    /// A wall with normal `normal` (normalised here; non-zero and finite), at
+    /// `position` w (m) along it, stiffness `ke` (N/m) and damping `be`
+    /// (N s/m), both ≥ 0, for the arm of kinematics `kin`.
+    pub fn new(kin: K, normal: Vector<3>, position: f64, ke: f64, be: f64) -> Result<Self, Error> {
+        check::finite_slice("normal", normal.as_slice())?;
+        let len = normal.norm();
+        check::positive("‖normal‖ > 0", "‖normal‖", len)?;
+        check::at_most("|wall| ≤ 1e6 m", "wall", position, 1e6)?;
+        check::nonnegative("ke ≥ 0", "ke", ke)?;
+        check::nonnegative("be ≥ 0", "be", be)?;
+        check::at_most("|value| ≤ 1e9", "ke", ke, PARAM_BOUND)?;
+        check::at_most("|value| ≤ 1e9", "be", be, PARAM_BOUND)?;
+        Ok(Self {
+            kin,
+            normal: normal / len,
+            position,
+            ke,
+            be,
+        })
+    }
+
+    /// The unit normal n, pointing into the wall.
+    pub fn normal(&self) -> &Vector<3> {
+        &self.normal
+    }
+    /// The wall's position w (m) along n.
+    pub fn position(&self) -> f64 {
+        self.position
+    }
+    /// Stiffness ke (N/m).
+    pub fn ke(&self) -> f64 {
+        self.ke
+    }
+
+    /// The contact force F_e (N) at end-effector position `p` (m) and velocity `dp` (m/s).
+    pub fn force_at(&self, p: &Vector<3>, dp: &Vector<3>) -> Vector<3> {
+        let delta = self.normal.dot(p) - self.position;
+        if delta > 0.0 {
+            (self.ke * delta + self.be * self.normal.dot(dp)).max(0.0) * self.normal
+        } else {
+            Vector::zeros()
+        }
+    }
+
+    /// The contact force F_e (N) at joint position `q` (rad) and velocity `dq` (rad/s).
+    pub fn wrench<const N: usize>(&self, q: &Vector<N>, dq: &Vector<N>) -> Vector<3>
+    where
+        K: Kinematics<N>,
+    {
+        self.force_at(&self.kin.fk(q), &(self.kin.jacobian(q) * dq))
+    }
+}
+
+impl<const N: usize, K: Kinematics<N>> Environment<N> for CartesianWall<K> {
+    fn force(&self, _t: f64, x: &Vector<N>, dx: &Vector<N>) -> Vector<N> {
+        let j = self.kin.jacobian(x);
+        let f = self.force_at(&self.kin.fk(x), &(j * dx));
+        j.transpose() * f
     }
 }
 

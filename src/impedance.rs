@@ -7,7 +7,24 @@
 
 use crate::error::{check, Error};
 use crate::trajectory::Setpoint;
-use crate::types::Vector;
+use crate::types::{choices, Vector};
+
+/// Where the target impedance is realised (schema keyword `impedance`).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub enum ImpedanceMode {
+    /// In joint space by the reference model of SPEC §4 ("joint", the paper).
+    #[default]
+    Joint,
+    /// Outside the controller ("external"): the setpoint already is the
+    /// compliant reference, xd = xc, ẋd = ẋc, ẍd = ẍc, and τe only enters the
+    /// control law's feedforward (SPEC §16; e.g. from a Cartesian impedance).
+    External,
+}
+
+choices!(ImpedanceMode {
+    "joint" => ImpedanceMode::Joint,
+    "external" => ImpedanceMode::External,
+});
 
 /// Target impedance: diagonal desired inertia Dd (kg m²), damping Cd
 /// (N m s/rad) and stiffness Gd (N m/rad), (3), (66).

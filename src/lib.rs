@@ -23,10 +23,12 @@
 //! | [`types`] | `Vector`, `Matrix` aliases (a leaf) | |
 //! | [`model`] | manipulator dynamics D, C, G | (4), (55)–(63), §1 |
 //! | [`saturation`] | actuator limits | §2 |
-//! | [`environment`] | contact force τe | §3 |
+//! | [`environment`] | contact force τe; a Cartesian wall (τe = Jᵀ F_e) | §3, §16 |
 //! | [`trajectory`] | commanded trajectory xc | (64), §4 |
-//! | [`impedance`] | target-impedance reference xd | (3), §4 |
-//! | [`rbf`] | Gaussian RBF bases S(Z): the grid and user centres | (1), §6 |
+//! | [`impedance`] | target-impedance reference xd; where it acts | (3), §4 |
+//! | [`kinematics`] | end-effector position and Jacobian | §16 |
+//! | [`cartesian`] | Cartesian impedance, inverse kinematics, the pair with a joint controller | (3), §16 |
+//! | [`rbf`] | Gaussian RBF bases S(Z): the grid, user centres, lattices, centres along an orbit | (1), §6, §15 |
 //! | [`network`] | weights ŴD, ŴC, ŴG: storage, output, update | (15)–(17), §6 |
 //! | [`learning`] | learning policies (Euler, normalised, freeze, projection) | §11, §13 |
 //! | [`simd`] | the weight pass's instruction set, chosen at run time | |
@@ -91,6 +93,7 @@
 extern crate alloc;
 
 pub mod auxiliary;
+pub mod cartesian;
 pub mod config;
 pub mod controller;
 pub mod disturb;
@@ -99,6 +102,7 @@ pub mod error;
 pub mod impedance;
 pub mod inject;
 pub mod io;
+pub mod kinematics;
 pub mod learning;
 mod math;
 pub mod metrics;
@@ -123,17 +127,22 @@ pub mod trajectory;
 pub mod types;
 
 pub use auxiliary::AuxLaw;
+pub use cartesian::{
+    CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
+    CartesianMeasurement, CartesianState, OuterStep,
+};
 pub use config::{Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};
 pub use disturb::{DisturbanceParams, Disturbances, Friction, TipPayload, WithFriction};
-pub use environment::{Environment, FreeSpace, Wall};
+pub use environment::{CartesianWall, Environment, FreeSpace, Wall};
 pub use error::Error;
-pub use impedance::{Reference, TargetImpedance};
+pub use impedance::{ImpedanceMode, Reference, TargetImpedance};
 pub use inject::{Injected, Injection};
 pub use io::{Command, Control, Measurement};
+pub use kinematics::Kinematics;
 pub use learning::{Learning, LearningStep, SaturationLearning};
 pub use metrics::{Metrics, MetricsAccumulator};
-pub use model::{Manipulator, PlanarArm, TwoLinkArm};
+pub use model::{Link, Manipulator, PlanarArm, TwoLinkArm};
 pub use network::{Weights, WeightsMut};
 pub use observer::{HighGainObserver, Hold};
 pub use plant::{rk4_step, Plant, RigidBody};
@@ -155,7 +164,7 @@ pub use state::State;
 #[cfg(feature = "alloc")]
 pub use tracker::Tracker;
 pub use trajectory::{Setpoint, Sinusoid, Trajectory};
-pub use types::{grid_nodes, Matrix, Vector};
+pub use types::{grid_nodes, Jacobian, Matrix, Vector};
 
 /// The README's Rust quick start, compiled and run as a doctest inside
 /// `fn main() -> Result<(), Box<dyn std::error::Error>>` (`tests/readme.rs`

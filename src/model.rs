@@ -141,6 +141,11 @@ impl TwoLinkArm {
     pub fn lumped(&self) -> [f64; 5] {
         self.p
     }
+
+    /// The link lengths [l1, l2] (m).
+    pub fn lengths(&self) -> [f64; 2] {
+        [self.params.l1, self.params.l2]
+    }
 }
 
 impl Default for TwoLinkArm {

@@ -29,6 +29,7 @@
 
 use crate::error::{check, Error};
 use crate::math::exp;
+use crate::trajectory::Setpoint;
 use crate::types::{grid_nodes, Vector};
 
 /// A basis S(Z) ∈ R^L over the network input Z = [x; v; α1; α̇1].
@@ -116,6 +117,7 @@ impl<const N: usize> Grid<N> {
             centers: c,
             nodes: grid_nodes(N),
             inv_w2: [Vector::from_element(self.inv_eta2); 4],
+            active: [true; 4],
         }
     }
 }
@@ -159,17 +161,25 @@ impl<const N: usize> Basis<N> for Grid<N> {
 /// `[j·4N, (j+1)·4N)`, in the order x (rad), v (rad/s), α1 (rad/s), α̇1
 /// (rad/s²), N each. `S_j(Z) = exp(−Σ_d (Z_d − μ_jd)² / η_d²)` with η_d² the
 /// width of dimension d in that dimension's squared unit.
+///
+/// A width η_d² = +∞ leaves dimension d out of the distance (1/η_d² = 0):
+/// the basis then does not depend on that input, as in the per-network
+/// inputs of Ge, Lee & Harris (ZD = ZG = q, ZC = [q; q̇]; SPEC §15). A block
+/// whose widths are all infinite is skipped by [`eval`](Basis::eval).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Centers<const N: usize, C> {
     centers: C,
     nodes: usize,
     inv_w2: [Vector<N>; 4],
+    /// The blocks with at least one finite width (the others add nothing).
+    active: [bool; 4],
 }
 
 impl<const N: usize, C: AsRef<[f64]>> Centers<N, C> {
     /// Centres `centers` (length L·4N, L ≥ 1, finite) with widths η_d² per
     /// input dimension, `widths2[b][i]` for block b (x, v, α1, α̇1) and joint i,
-    /// each finite and > 0.
+    /// each > 0 and either finite (≥ 1e-12) or +∞ (the dimension is left
+    /// out; at least one width must be finite).
     pub fn new(centers: C, widths2: [Vector<N>; 4]) -> Result<Self, Error> {
         let len = centers.as_ref().len();
         if N == 0 || len == 0 || len % (4 * N) != 0 {
@@ -180,15 +190,26 @@ impl<const N: usize, C: AsRef<[f64]>> Centers<N, C> {
         }
         check::finite_slice("centers", centers.as_ref())?;
         for w in &widths2 {
-            check::positive_vec("η² > 0", "widths", w)?;
-            for &x in w.iter() {
+            // +∞ is the one non-finite width allowed: check the rest.
+            let finite = w.map(|x| if x == f64::INFINITY { 1.0 } else { x });
+            check::positive_vec("η² > 0", "widths", &finite)?;
+            for &x in finite.iter() {
                 check_width("widths", x)?;
             }
+        }
+        let inv_w2 = widths2.map(|w| w.map(|v| 1.0 / v));
+        let active = inv_w2.map(|w| w.iter().any(|v| *v > 0.0));
+        if !active.iter().any(|a| *a) {
+            return Err(Error::Invalid {
+                what: "RBF widths",
+                reason: "every width is infinite: the basis would be constant",
+            });
         }
         Ok(Self {
             nodes: len / (4 * N),
             centers,
-            inv_w2: widths2.map(|w| w.map(|v| 1.0 / v)),
+            inv_w2,
+            active,
         })
     }
 
@@ -214,11 +235,16 @@ impl<const N: usize, C: AsRef<[f64]>> Basis<N> for Centers<N, C> {
         self.nodes
     }
 
+    // Inlined into the controller's instruction-set dispatch, as the grid's.
+    #[inline(always)]
     fn eval(&self, z: &[Vector<N>; 4], s: &mut [f64]) {
         let c = self.centers.as_ref();
         for (sj, mu) in s.iter_mut().zip(c.chunks_exact(4 * N)) {
             let mut d2 = 0.0;
             for (b, (zb, wb)) in z.iter().zip(&self.inv_w2).enumerate() {
+                if !self.active[b] {
+                    continue;
+                }
                 for i in 0..N {
                     let e = zb[i] - mu[b * N + i];
                     d2 += e * e * wb[i];
@@ -226,6 +252,134 @@ impl<const N: usize, C: AsRef<[f64]>> Basis<N> for Centers<N, C> {
             }
             *sj = exp(-d2);
         }
+    }
+}
+
+/// The most nodes [`Centers::lattice`] builds (as many as the grid at n = 3).
+pub const LATTICE_MAX_NODES: usize = 4096;
+
+/// The overlap factor ρ of [`Centers::along`]: each width is at least ρ times
+/// the largest spacing of neighbouring centres, so that S_j of a neighbour is
+/// ≥ exp(−1/ρ²) at a centre and the sum of the basis along the orbit varies
+/// by under 12 % (ρ = 2: exp(−1/4) = 0.78 at the neighbour, 0.88 halfway).
+pub const ALONG_OVERLAP: f64 = 2.0;
+
+impl<const N: usize, C: AsRef<[f64]> + AsMut<[f64]>> Centers<N, C> {
+    /// Centres along an orbit, in the caller's buffer `buf` (length L·4N for
+    /// L = `samples.len()`), SPEC §15: deterministic learning (Wang & Hill,
+    /// *Deterministic Learning Theory for Identification, Recognition, and
+    /// Control*, CRC 2009, ch. 3) places the centres where the network input
+    /// goes, along the periodic orbit, and only those neurons learn.
+    ///
+    /// Node j is centred at `[q_j; q̇_j]` of sample j (the joint reference's
+    /// xc, ẋc); the network inputs α1, α̇1 are left out (width +∞), since
+    /// the networks multiply them outside (D̂ α̇1, Ĉ α1) and D, C, G depend
+    /// on q and q̇ only (Ge, Lee & Harris 1998, ch. 3: ZD = ZG = q, ZC = [q; q̇]).
+    /// Widths, per block b (x: rad, v: rad/s), with the largest spacing
+    /// `h_b = max_j ‖μ_{j+1,b} − μ_{j,b}‖` of consecutive samples:
+    /// `η_b = max(ρ h_b, tube_b)` ([`ALONG_OVERLAP`] ρ = 2), the same for
+    /// each joint: `tube` = [rad, rad/s] is how far from the orbit the
+    /// networks should still act (compliant deflection, transients), finite
+    /// and > 0.
+    pub fn along_in(buf: C, samples: &[Setpoint<N>], tube: [f64; 2]) -> Result<Self, Error> {
+        let mut buf = buf;
+        check::positive("tube > 0", "tube", tube[0])?;
+        check::positive("tube > 0", "tube", tube[1])?;
+        let rows = buf.as_mut();
+        if N == 0 || samples.is_empty() || rows.len() != samples.len() * 4 * N {
+            return Err(Error::Invalid {
+                what: "RBF centres along an orbit",
+                reason: "need L ≥ 1 samples and a buffer of L·4n reals",
+            });
+        }
+        let mut h = [0.0f64; 2];
+        for (j, sp) in samples.iter().enumerate() {
+            check::finite_slice("samples", sp.x.as_slice())?;
+            check::finite_slice("samples", sp.dx.as_slice())?;
+            let row = &mut rows[j * 4 * N..(j + 1) * 4 * N];
+            row[..N].copy_from_slice(sp.x.as_slice());
+            row[N..2 * N].copy_from_slice(sp.dx.as_slice());
+            row[2 * N..].fill(0.0);
+            if let Some(next) = samples.get(j + 1) {
+                h[0] = h[0].max((next.x - sp.x).norm());
+                h[1] = h[1].max((next.dx - sp.dx).norm());
+            }
+        }
+        let eta = |b: usize| {
+            let w = (ALONG_OVERLAP * h[b]).max(tube[b]);
+            Vector::<N>::from_element(w * w)
+        };
+        let inf = Vector::<N>::from_element(f64::INFINITY);
+        Self::new(buf, [eta(0), eta(1), inf, inf])
+    }
+
+    /// A lattice over the joint positions, in the caller's buffer `buf`
+    /// (length `points^N · 4N`), SPEC §15: `points` ≥ 2 nodes per joint,
+    /// evenly from `lo` to `hi` (rad, lo < hi), `L = points^N ≤ 4096`, each
+    /// width the mesh spacing, η_i = (hi_i − lo_i)/(points − 1) (Sanner &
+    /// Slotine, "Gaussian networks for direct adaptive control", IEEE TNN
+    /// 3(6), 1992: a regular lattice with widths of the order of the mesh).
+    /// Only q enters (ZD = ZG = q, Ge, Lee & Harris 1998): the other blocks
+    /// have width +∞, so Ĉ is a function of q alone, which suits slow motions.
+    /// Node j's joint i takes level `(j / points^i) % points`.
+    pub fn lattice_in(
+        buf: C,
+        lo: &Vector<N>,
+        hi: &Vector<N>,
+        points: usize,
+    ) -> Result<Self, Error> {
+        let mut buf = buf;
+        check::finite_slice("lo", lo.as_slice())?;
+        check::finite_slice("hi", hi.as_slice())?;
+        check::each("hi > lo", "hi − lo", &(hi - lo), |_, d| d, true)?;
+        let nodes = lattice_nodes(N, points).ok_or(Error::Invalid {
+            what: "RBF lattice",
+            reason: "needs points ≥ 2 and L = points^n ≤ 4096 (use centres along the orbit)",
+        })?;
+        let rows = buf.as_mut();
+        if rows.len() != nodes * 4 * N {
+            return Err(Error::Invalid {
+                what: "RBF lattice",
+                reason: "needs a buffer of points^n · 4n reals",
+            });
+        }
+        let step = (hi - lo) / (points - 1) as f64;
+        for (j, row) in rows.chunks_exact_mut(4 * N).enumerate() {
+            let mut rest = j;
+            for i in 0..N {
+                row[i] = lo[i] + (rest % points) as f64 * step[i];
+                rest /= points;
+            }
+            row[N..].fill(0.0);
+        }
+        let inf = Vector::<N>::from_element(f64::INFINITY);
+        Self::new(buf, [step.component_mul(&step), inf, inf, inf])
+    }
+}
+
+/// `points^n` if points ≥ 2 and it is at most [`LATTICE_MAX_NODES`].
+pub fn lattice_nodes(n: usize, points: usize) -> Option<usize> {
+    if points < 2 {
+        return None;
+    }
+    let mut l = 1usize;
+    for _ in 0..n {
+        l = l.checked_mul(points).filter(|l| *l <= LATTICE_MAX_NODES)?;
+    }
+    Some(l)
+}
+
+#[cfg(feature = "alloc")]
+impl<const N: usize> Centers<N, alloc::vec::Vec<f64>> {
+    /// [`along_in`](Centers::along_in) on the heap: one node per sample.
+    pub fn along(samples: &[Setpoint<N>], tube: [f64; 2]) -> Result<Self, Error> {
+        Self::along_in(alloc::vec![0.0; samples.len() * 4 * N], samples, tube)
+    }
+
+    /// [`lattice_in`](Centers::lattice_in) on the heap.
+    pub fn lattice(lo: &Vector<N>, hi: &Vector<N>, points: usize) -> Result<Self, Error> {
+        let nodes = lattice_nodes(N, points).unwrap_or(0);
+        Self::lattice_in(alloc::vec![0.0; nodes * 4 * N], lo, hi, points)
     }
 }
 
@@ -334,6 +488,72 @@ mod tests {
             &mut s,
         );
         assert!(s.iter().all(|v| *v == 0.0));
+    }
+
+    #[test]
+    fn lattice_and_orbit_bases_follow_their_rules() {
+        let lo = Vector::<2>::new(-1.0, 0.0);
+        let hi = Vector::<2>::new(1.0, 0.5);
+        let l = Centers::<2, _>::lattice(&lo, &hi, 3).unwrap();
+        assert_eq!(l.nodes(), 9);
+        // Node 5 = level 2 of joint 1, level 1 of joint 2.
+        assert_eq!(&l.centers()[5 * 8..5 * 8 + 2], &[1.0, 0.25]);
+        let w = l.widths2();
+        assert_eq!((w[0][0], w[0][1]), (1.0, 0.0625));
+        assert!(w[1..].iter().all(|b| b.iter().all(|x| *x == f64::INFINITY)));
+        // Only q enters: v, α1, α̇1 change nothing.
+        let (mut a, mut b) = ([0.0; 9], [0.0; 9]);
+        let q = Vector::<2>::new(0.3, 0.1);
+        l.eval(
+            &[q, Vector::zeros(), Vector::zeros(), Vector::zeros()],
+            &mut a,
+        );
+        l.eval(
+            &[
+                q,
+                Vector::from_element(9.0),
+                Vector::from_element(-7.0),
+                Vector::from_element(1e3),
+            ],
+            &mut b,
+        );
+        assert_eq!(a, b);
+        let e =
+            Centers::<7, _>::lattice(&Vector::zeros(), &Vector::from_element(1.0), 4).unwrap_err();
+        assert!(e.to_string().contains("4096"), "{e}");
+        let e = Centers::<2, _>::lattice(&hi, &lo, 2).unwrap_err();
+        assert!(e.to_string().contains("hi > lo"), "{e}");
+
+        // Along an orbit: the widths are ρ times the largest spacing, or the tube.
+        let samples: alloc::vec::Vec<_> = (0..4)
+            .map(|j| Setpoint {
+                x: Vector::<2>::new(0.1 * j as f64, 0.0),
+                dx: Vector::<2>::new(0.0, 1.0),
+                ddx: Vector::zeros(),
+            })
+            .collect();
+        let c = Centers::along(&samples, [0.05, 0.5]).unwrap();
+        let w = c.widths2();
+        assert!((w[0][0] - 0.04).abs() < 1e-15, "{w:?}"); // (2 · 0.1)²
+        assert_eq!(w[1][1], 0.25); // the tube: no spacing in v
+        assert_eq!(w[3][0], f64::INFINITY);
+        let mut s = [0.0; 4];
+        c.eval(
+            &[
+                samples[2].x,
+                samples[2].dx,
+                Vector::zeros(),
+                Vector::from_element(5.0),
+            ],
+            &mut s,
+        );
+        assert_eq!(s[2], 1.0);
+        assert!((s[1] - (-0.25f64).exp()).abs() < 1e-15, "{s:?}");
+        let e = Centers::<2, _>::along(&samples, [0.0, 1.0]).unwrap_err();
+        assert!(e.to_string().contains("tube > 0"), "{e}");
+        let e =
+            Centers::<1, _>::new([0.0; 4], [Vector::from_element(f64::INFINITY); 4]).unwrap_err();
+        assert!(e.to_string().contains("every width is infinite"), "{e}");
     }
 
     #[test]

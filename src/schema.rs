@@ -17,6 +17,7 @@ use crate::config::{Config, Law, ObserverInit, WeightBound};
 use crate::disturb::{DisturbanceParams, Disturbances, MAX_DELAY};
 use crate::environment::Wall;
 use crate::error::Error;
+use crate::impedance::ImpedanceMode;
 use crate::learning::{LearningStep, SaturationLearning};
 use crate::model::{ArmParams, TwoLinkArm};
 use crate::observer::Hold;
@@ -214,7 +215,7 @@ pub const PARAMS: &[Param] = &[
     p("q0", Sim, Joint, "rad", "initial joint position q(0), (65)", "", V(&[0.25, -0.05])),
     p("dq0", Sim, Joint, "rad/s", "initial joint velocity q̇(0)", "", R(0.0)),
     p("settle", Sim, Real, "s", "start of the 'after2' window of the metrics (SPEC §12)", "", R(2.0)),
-    // Disturbances a real robot has (SPEC §15, src/disturb.rs); the defaults
+    // Disturbances a real robot has (SPEC §17, src/disturb.rs); the defaults
     // disturb nothing. The controller is told none of them.
     p("payload", Sim, Real, "kg", "point mass at the tip of the last link (the plant's only)", "payload ≥ 0", R(0.0)),
     p("noise_q", Sim, Joint, "rad", "standard deviation of the Gaussian noise on each measured q_i", "noise ≥ 0", R(0.0)),
@@ -320,6 +321,15 @@ pub const PARAMS: &[Param] = &[
     p("Dd", Ctrl, Joint, "kg m²", "target inertia Dd, (3)", "Dd > 0", R(1.0)),
     p("Cd", Ctrl, Joint, "N m s/rad", "target damping Cd, (3)", "Cd ≥ 0", R(10.0)),
     p("Gd", Ctrl, Joint, "N m/rad", "target stiffness Gd, (3)", "Gd ≥ 0", R(60.0)),
+    p(
+        "impedance",
+        Ctrl,
+        Kind::Choice(&ImpedanceMode::NAMES),
+        "",
+        "where the target impedance acts: 'joint', the reference model of SPEC §4 (Dd, Cd, Gd); 'external', the setpoint is already the compliant reference (xd = xc, e.g. a Cartesian impedance, SPEC §16)",
+        "",
+        S("joint"),
+    ),
     // (64): xc = [0.2 − 0.2 cos(πt), 0.2 + 0.2 sin(πt)].
     p(
         "xc_offset",
@@ -479,7 +489,7 @@ pub struct Scenario<const N: usize> {
     pub config: Config<N>,
     /// The run.
     pub sim: SimConfig<N>,
-    /// The disturbances of the run (SPEC §15).
+    /// The disturbances of the run (SPEC §17).
     pub disturb: DisturbanceParams<N>,
     /// η² of the vertex grid.
     pub eta2: f64,
@@ -619,6 +629,7 @@ impl<const N: usize> Scenario<N> {
             "Dd" => c.dd = joint(n, value)?,
             "Cd" => c.cd = joint(n, value)?,
             "Gd" => c.gd = joint(n, value)?,
+            "impedance" => c.impedance = choice(p, value, &ImpedanceMode::ALL)?,
             "xc_offset" => self.xc[0] = joint(n, value)?,
             "xc_sin" => self.xc[1] = joint(n, value)?,
             "xc_cos" => self.xc[2] = joint(n, value)?,
@@ -692,6 +703,7 @@ impl<const N: usize> Scenario<N> {
             dd,
             cd,
             gd,
+            impedance,
             fallback,
             fallback_damping,
             fault_policy,
@@ -782,6 +794,7 @@ impl<const N: usize> Scenario<N> {
         f("Dd", V(dd.as_slice()));
         f("Cd", V(cd.as_slice()));
         f("Gd", V(gd.as_slice()));
+        f("impedance", S(impedance.name()));
         f("xc_offset", V(xc_offset.as_slice()));
         f("xc_sin", V(xc_sin.as_slice()));
         f("xc_cos", V(xc_cos.as_slice()));
@@ -834,7 +847,7 @@ impl<const N: usize> Scenario<N> {
         Grid::new(self.eta2)
     }
 
-    /// The disturbances of the run (validated; SPEC §15), the actuator
+    /// The disturbances of the run (validated; SPEC §17), the actuator
     /// fraction taken of the controller's `tau_max`. For
     /// [`run_disturbed`](crate::simulator::run_disturbed).
     pub fn disturbances(&self) -> Result<Disturbances<N>, Error> {

@@ -87,7 +87,7 @@ where
     simulate_disturbed(plant, ctrl, traj, t_final, injection, &none, rec)
 }
 
-/// [`simulate_with`] in a disturbed loop (SPEC §15): the loop's own
+/// [`simulate_with`] in a disturbed loop (SPEC §17): the loop's own
 /// disturbances of `disturbances` act at every step, the plant's (payload,
 /// friction) are `plant`'s to have ([`run_disturbed`] builds them in).
 ///
@@ -217,7 +217,7 @@ where
     Ok(metrics.finish())
 }
 
-/// [`run`] with the disturbances a real robot has (SPEC §15): the arm of
+/// [`run`] with the disturbances a real robot has (SPEC §17): the arm of
 /// the plant carries `disturbances`' payload and joint friction, and the
 /// loop has its sensor noise, measurement delay, sampling jitter and weak
 /// actuators ([`simulate_disturbed`]). The controller is told none of them.

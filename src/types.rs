@@ -5,6 +5,8 @@
 pub type Vector<const N: usize> = nalgebra::SVector<f64, N>;
 /// An `N × N` real matrix (inertia, Coriolis, …).
 pub type Matrix<const N: usize> = nalgebra::SMatrix<f64, N, N>;
+/// The `3 × N` Jacobian ∂p/∂q of an end-effector position p ∈ R³ (m/rad).
+pub type Jacobian<const N: usize> = nalgebra::SMatrix<f64, 3, N>;
 
 /// Number of RBF nodes of the paper's vertex grid for `n` joints: `2^(4n)`
 /// (256 for the 2-link arm), SPEC §6.

@@ -134,7 +134,7 @@ fn no_heap_allocation_in_a_simulation() {
 
 #[test]
 fn no_heap_allocation_in_a_disturbed_simulation() {
-    // Every disturbance of SPEC §15 on: the generators and the delay line
+    // Every disturbance of SPEC §17 on: the generators and the delay line
     // live in a fixed state on the stack.
     let d = adaptimp::Disturbances::new(
         adaptimp::DisturbanceParams {
@@ -175,4 +175,64 @@ fn no_heap_allocation_in_a_disturbed_simulation() {
         assert_eq!(n, 0, "{law:?}: run_disturbed allocated");
         assert_eq!(m.rows, 500);
     }
+}
+
+#[test]
+fn no_heap_allocation_in_seven_joint_and_cartesian_steps() {
+    use adaptimp::{
+        CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement, Centers,
+        Config, Grid, ImpedanceMode, Kinematics, Setpoint,
+    };
+    // n = 7 with centres along an orbit (SPEC §15).
+    let traj = Sinusoid::<7>::new(
+        Vector::from_element(0.1),
+        Vector::from_element(0.15),
+        Vector::zeros(),
+        Vector::from_element(1.0),
+    )
+    .expect("trajectory");
+    let samples: Vec<_> = (0..64).map(|j| traj.sample(0.1 * j as f64)).collect();
+    let mut cfg = Config::<7>::new(Law::StateFeedback, Vector::from_element(50.0)).hardened();
+    cfg.ts = 1e-3;
+    let basis = Centers::along(&samples, [0.3, 1.0]).expect("basis");
+    let ctrl = Controller::for_trajectory(cfg, basis, &traj).expect("controller");
+    let mut state = ctrl.new_state();
+    let (n, ()) = allocations_in(|| {
+        for _ in 0..1000 {
+            let sp = traj.sample(ctrl.time(&state));
+            let m = Measurement {
+                x: sp.x,
+                dx: Some(sp.dx),
+                tau_e: Vector::zeros(),
+            };
+            ctrl.step(&mut state, &m, &sp).expect("step");
+        }
+    });
+    assert_eq!(n, 0, "the n = 7 step allocated");
+    // The Cartesian pair (SPEC §16) on the paper's arm.
+    let arm = TwoLinkArm::paper();
+    let q0 = Vector::<2>::new(0.5, 1.0);
+    let outer = CartesianImpedance::new(CartesianConfig::new(1e-3, q0), arm).expect("outer");
+    let mut cfg = Config::robot(Law::StateFeedback);
+    cfg.impedance = ImpedanceMode::External;
+    let inner = Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper()).expect("inner");
+    let pair = CartesianController::new(outer, inner).expect("pair");
+    let (mut ost, mut ist) = (pair.outer().start(q0), pair.inner().new_state());
+    let p0 = arm.fk(&q0);
+    let (n, ()) = allocations_in(|| {
+        for k in 0..1000 {
+            let c = Setpoint {
+                x: p0 + Vector::<3>::new(0.01 * (k as f64 * 1e-3).sin(), 0.0, 0.0),
+                dx: Vector::zeros(),
+                ddx: Vector::zeros(),
+            };
+            let m = CartesianMeasurement {
+                q: q0,
+                dq: Some(Vector::zeros()),
+                f_e: Vector::<3>::new(1.0, 0.0, 0.0),
+            };
+            pair.step(&mut ost, &mut ist, &m, &c).expect("step");
+        }
+    });
+    assert_eq!(n, 0, "the Cartesian step allocated");
 }

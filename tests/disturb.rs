@@ -1,4 +1,4 @@
-//! The disturbances of SPEC §15 in closed loops: each one has the physical
+//! The disturbances of SPEC §17 in closed loops: each one has the physical
 //! effect it should, none of them changes a bit when it is off, and a seed
 //! fixes a run bit for bit, in any thread. Every assertion is exact or has a
 //! tolerance fixed by a fixed seed.

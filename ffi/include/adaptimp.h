@@ -116,6 +116,15 @@ typedef enum AdaptimpObserverHold {
   ADAPTIMP_OBSERVER_HOLD_TRIANGLE = 1,
 } AdaptimpObserverHold;
 
+// Where the target impedance acts, in the order of `ImpedanceMode::NAMES`.
+typedef enum AdaptimpImpedance {
+  // The joint-space reference model of Dd, Cd, Gd (the paper).
+  ADAPTIMP_IMPEDANCE_JOINT = 0,
+  // The setpoint is already the compliant reference (e.g. a Cartesian
+  // impedance outside): xd = xc.
+  ADAPTIMP_IMPEDANCE_EXTERNAL = 1,
+} AdaptimpImpedance;
+
 // The torque a failed step returns, in the order of `Fallback::NAMES`.
 typedef enum AdaptimpFallback {
   // The last applied torque held.
@@ -207,6 +216,8 @@ typedef struct AdaptimpParams {
   double cd[ADAPTIMP_MAX_JOINTS];
   // Target stiffness Gd (N m/rad), (3).
   double gd[ADAPTIMP_MAX_JOINTS];
+  // Where the target impedance acts.
+  enum AdaptimpImpedance impedance;
   // Width η² of the vertex grid (used when `centers` is NULL; n ≤ 3).
   double eta2;
   // User centres: `nodes` rows of 4n reals (x, v, α1, α̇1 blocks of n), or

@@ -19,8 +19,8 @@
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
     AnyBasis, AuxLaw, Centers, Command, Controller, Error, Fallback, FaultPolicy, Grid, HeapState,
-    Hold, Law, LearningStep, Measurement, ObserverInit, RobustKind, SaturationLearning, Setpoint,
-    Sinusoid, Trajectory, Vector,
+    Hold, ImpedanceMode, Law, LearningStep, Measurement, ObserverInit, RobustKind,
+    SaturationLearning, Setpoint, Sinusoid, Trajectory, Vector,
 };
 use core::ffi::c_char;
 use std::cell::RefCell;
@@ -147,6 +147,17 @@ pub enum AdaptimpObserverHold {
     Triangle = 1,
 }
 
+/// Where the target impedance acts, in the order of `ImpedanceMode::NAMES`.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpImpedance {
+    /// The joint-space reference model of Dd, Cd, Gd (the paper).
+    Joint = 0,
+    /// The setpoint is already the compliant reference (e.g. a Cartesian
+    /// impedance outside): xd = xc.
+    External = 1,
+}
+
 /// The projection of the weights.
 #[repr(C)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -242,6 +253,8 @@ pub struct AdaptimpParams {
     pub cd: [f64; ADAPTIMP_MAX_JOINTS],
     /// Target stiffness Gd (N m/rad), (3).
     pub gd: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Where the target impedance acts.
+    pub impedance: AdaptimpImpedance,
     /// Width η² of the vertex grid (used when `centers` is NULL; n ≤ 3).
     pub eta2: f64,
     /// User centres: `nodes` rows of 4n reals (x, v, α1, α̇1 blocks of n), or
@@ -552,6 +565,7 @@ const SATURATION: [AdaptimpSaturationLearning; 2] = [
 ];
 const INIT: [AdaptimpObserverInit; 2] = [AdaptimpObserverInit::Zero, AdaptimpObserverInit::First];
 const HOLD: [AdaptimpObserverHold; 2] = [AdaptimpObserverHold::Zoh, AdaptimpObserverHold::Triangle];
+const IMPEDANCE: [AdaptimpImpedance; 2] = [AdaptimpImpedance::Joint, AdaptimpImpedance::External];
 const FALLBACK: [AdaptimpFallback; 3] = [
     AdaptimpFallback::Hold,
     AdaptimpFallback::Zero,
@@ -603,6 +617,7 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         dd,
         cd,
         gd,
+        impedance,
         eta2,
         centers: _,
         nodes: _,
@@ -630,7 +645,7 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
         AdaptimpWeightBound::Auto => Value::Str("auto"),
     };
-    let values: [(&str, Value<'_>); 39] = [
+    let values: [(&str, Value<'_>); 40] = [
         ("Ts", Value::Real(*ts)),
         ("K1", joint(k1)),
         ("Kp", joint(kp)),
@@ -666,6 +681,10 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         ("Dd", joint(dd)),
         ("Cd", joint(cd)),
         ("Gd", joint(gd)),
+        (
+            "impedance",
+            Value::Str(name_of(&IMPEDANCE, impedance, &ImpedanceMode::NAMES)),
+        ),
         ("xc_offset", joint(xc_offset)),
         ("xc_sin", joint(xc_sin)),
         ("xc_cos", joint(xc_cos)),
@@ -773,6 +792,7 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
         dd: [0.0; ADAPTIMP_MAX_JOINTS],
         cd: [0.0; ADAPTIMP_MAX_JOINTS],
         gd: [0.0; ADAPTIMP_MAX_JOINTS],
+        impedance: AdaptimpImpedance::Joint,
         eta2: 0.0,
         centers: std::ptr::null(),
         nodes: 0,
@@ -834,6 +854,7 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
             "Dd" => joint(&mut p.dd),
             "Cd" => joint(&mut p.cd),
             "Gd" => joint(&mut p.gd),
+            "impedance" => p.impedance = from_name(&IMPEDANCE, &ImpedanceMode::NAMES, choice),
             "xc_offset" => joint(&mut p.xc_offset),
             "xc_sin" => joint(&mut p.xc_sin),
             "xc_cos" => joint(&mut p.xc_cos),
@@ -1290,6 +1311,7 @@ mod tests {
         assert_eq!(SATURATION.len(), SaturationLearning::NAMES.len());
         assert_eq!(INIT.len(), ObserverInit::NAMES.len());
         assert_eq!(HOLD.len(), Hold::NAMES.len());
+        assert_eq!(IMPEDANCE.len(), ImpedanceMode::NAMES.len());
         let debug = |v: &dyn std::fmt::Debug| format!("{v:?}").to_lowercase();
         for (c, name) in ROBUST.iter().zip(RobustKind::NAMES) {
             assert_eq!(debug(c), name);
@@ -1304,6 +1326,9 @@ mod tests {
             assert_eq!(debug(c), name);
         }
         for (c, name) in HOLD.iter().zip(Hold::NAMES) {
+            assert_eq!(debug(c), name);
+        }
+        for (c, name) in IMPEDANCE.iter().zip(ImpedanceMode::NAMES) {
             assert_eq!(debug(c), name);
         }
         for (c, name) in AUX.iter().zip(AuxLaw::NAMES) {
@@ -1343,6 +1368,6 @@ mod tests {
         check::<7>();
         // scenario_of sets exactly the controller group's names, in order (its
         // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 39);
+        assert_eq!(controller_names().count(), 40);
     }
 }

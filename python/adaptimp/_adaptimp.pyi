@@ -85,6 +85,10 @@ class ControllerParams(TypedDict, total=False):
     """target damping Cd, (3) (N m s/rad)."""
     Gd: float | _Joint
     """target stiffness Gd, (3) (N m/rad)."""
+    impedance: Literal["joint", "external"]
+    """where the target impedance acts: 'joint', the reference model of SPEC §4 (Dd, Cd, Gd);
+    'external', the setpoint is already the compliant reference (xd = xc, e.g. a Cartesian
+    impedance, SPEC §16)."""
     xc_offset: float | _Joint
     """commanded trajectory xc_i = o_i + a_i sin(ω_i t) + b_i cos(ω_i t): offset o (rad)."""
     xc_sin: float | _Joint
@@ -138,6 +142,30 @@ class SimParams(TypedDict, total=False):
     """initial joint velocity q̇(0) (rad/s)."""
     settle: float
     """start of the 'after2' window of the metrics (SPEC §12) (s)."""
+    payload: float
+    """point mass at the tip of the last link (the plant's only) (kg)."""
+    noise_q: float | _Joint
+    """standard deviation of the Gaussian noise on each measured q_i (rad)."""
+    noise_dq: float | _Joint
+    """standard deviation of the Gaussian noise on each measured q̇_i (rad/s)."""
+    noise_tau_e: float | _Joint
+    """standard deviation of the Gaussian noise on each measured τe_i (N m)."""
+    seed: int
+    """seed of the noise and jitter generators (xoshiro256++): same seed, same run."""
+    delay: int
+    """measurement delay d: the controller sees the sample of step k − d (steps)."""
+    jitter: float
+    """sampling-time jitter j: the plant advances Ts (1 + u), u uniform on [−j, j), the
+    controller assumes Ts."""
+    friction_viscous: float | _Joint
+    """viscous joint friction b of τf = −b q̇ − fc tanh(q̇/v_s) (N m s/rad)."""
+    friction_coulomb: float | _Joint
+    """Coulomb joint friction level fc of τf (N m)."""
+    friction_vs: float
+    """velocity scale v_s of the smooth Coulomb term fc tanh(q̇/v_s) (rad/s)."""
+    actuator_fraction: float | _Joint
+    """fraction ρ of its limit τmax each actuator delivers: the applied torque is clamped to ±ρ
+    τmax."""
     wall: float | None
     """wall on joint 1 at this position; None: free space (rad)."""
     ke: float

@@ -13,13 +13,14 @@ use crate::environment::{FreeSpace, Wall};
 use crate::error::Error;
 use crate::io::{Command, Measurement};
 use crate::metrics::MetricsAccumulator;
-use crate::model::{Link, Manipulator, PlanarArm, TwoLinkArm};
+use crate::model::{Link, PlanarArm, TwoLinkArm};
 use crate::network::{Weights, C, D, G};
 use crate::plant::{Plant, RigidBody};
 use crate::rbf::{AnyBasis, Basis, Centers};
 use crate::record::{Recorder, Row};
 use crate::schema::{Preset, Scenario, Value};
-use crate::simulator::simulate;
+use crate::disturb::{Disturbances, TipPayload, WithFriction};
+use crate::simulator::simulate_disturbed;
 use crate::tracker::Tracker;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
@@ -452,7 +453,7 @@ impl<const N: usize, P: Plant<N>> Plant<N> for Watched<'_, P> {
     }
 }
 
-fn run_arm<const N: usize, M: Manipulator<N> + Clone>(
+fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     t: &mut Typed<N>,
     arm: &M,
     s: &Scenario<N>,
@@ -472,43 +473,33 @@ fn run_arm<const N: usize, M: Manipulator<N> + Clone>(
         DynTracker::load_weights(t, w)?;
     }
     let traj = *t.trajectory();
+    // The plant the controller does not know (SPEC §17): payload and friction.
+    let dist = s.disturbances()?;
+    let arm = WithFriction::new(arm.with_payload(dist.payload())?, *dist.friction());
+    let rec2 = &mut (&mut metrics, &mut rec);
     let result = match s.wall {
         Some(w) => {
             let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
-            let plant = RigidBody::new(arm.clone(), wall, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(
-                plant,
-                t,
-                &traj,
-                cfg.t_final,
-                total,
-                &mut (&mut metrics, &mut rec),
-                hooks,
-            )
+            let plant = RigidBody::new(arm, wall, cfg.q0, cfg.dq0, cfg.substeps)?;
+            watched(plant, t, &traj, cfg.t_final, total, &dist, rec2, hooks)
         }
         None => {
-            let plant = RigidBody::new(arm.clone(), FreeSpace, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(
-                plant,
-                t,
-                &traj,
-                cfg.t_final,
-                total,
-                &mut (&mut metrics, &mut rec),
-                hooks,
-            )
+            let plant = RigidBody::new(arm, FreeSpace, cfg.q0, cfg.dq0, cfg.substeps)?;
+            watched(plant, t, &traj, cfg.t_final, total, &dist, rec2, hooks)
         }
     };
     result?;
     Ok((rec, metrics_out(&metrics.finish())))
 }
 
+#[allow(clippy::too_many_arguments)]
 fn watched<const N: usize, P: Plant<N>>(
     plant: P,
     t: &mut Typed<N>,
     traj: &Sinusoid<N>,
     t_final: f64,
     total: u64,
+    dist: &Disturbances<N>,
     rec: &mut impl Recorder<N>,
     hooks: &mut dyn Hooks,
 ) -> Result<(), RunError> {
@@ -519,7 +510,7 @@ fn watched<const N: usize, P: Plant<N>>(
         total,
         stopped: false,
     };
-    match simulate(&mut p, t, traj, t_final, rec) {
+    match simulate_disturbed(&mut p, t, traj, t_final, None, dist, rec) {
         Ok(_) => Ok(()),
         Err(_) if p.stopped => Err(RunError::Stopped),
         Err(e) => Err(RunError::Core(e, Some(p.done))),

@@ -28,6 +28,8 @@ def test_python_example_runs(path: Path, tmp_path: Path) -> None:
     args = [sys.executable, str(path)]
     if path.stem == "02_robot_1khz":
         args.append(str(tmp_path / "figure.png"))
+    if path.stem == "12_robustness":
+        args.append(str(tmp_path))
     out = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600, check=False)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip()

@@ -1,6 +1,7 @@
-"""PlanarArm against Pinocchio (an independent rigid-body library): the same arm
-built as a Pinocchio model of revolute-z joints, D by CRBA, C by Pinocchio's
-Coriolis matrix, G by its generalized gravity, for N = 2 … 5 at random states."""
+"""PlanarArm and TwoLinkArm against Pinocchio (an independent rigid-body library):
+the same arm built as a Pinocchio model of revolute-z joints; D by CRBA, C by
+Pinocchio's Coriolis matrix, G by its generalized gravity, q̈ by ABA, the tip's
+position and Jacobian by its frame kinematics, for N = 2 … 5 at random states."""
 
 from __future__ import annotations
 
@@ -49,3 +50,37 @@ def test_planar_arm_dynamics_equal_pinocchio(n: int) -> None:
         tau = rng.normal(size=n)
         a = pin.aba(model, data, q, v, tau)
         np.testing.assert_allclose(arm.forward_dynamics(q, v, tau, np.zeros(n)), a, atol=1e-10)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5])
+def test_planar_arm_kinematics_equal_pinocchio(n: int) -> None:
+    rng = np.random.default_rng(200 + n)
+    length = rng.uniform(0.2, 0.5, n)
+    arm = adaptimp.PlanarArm(n, 1.0, length)
+    model = planar_model(np.ones(n), length, length / 2, np.full(n, 0.01), 9.81)
+    data = model.createData()
+    tip = model.getFrameId("tip")
+    for _ in range(20):
+        q = rng.uniform(-np.pi, np.pi, n)
+        pin.forwardKinematics(model, data, q)
+        pin.updateFramePlacements(model, data)
+        np.testing.assert_allclose(arm.fk(q), data.oMf[tip].translation, rtol=0, atol=1e-12)
+        j = pin.computeFrameJacobian(model, data, q, tip, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        np.testing.assert_allclose(arm.jacobian(q), j[:3], rtol=0, atol=1e-12)
+
+
+def test_two_link_arm_kinematics_equal_pinocchio() -> None:
+    two = adaptimp.TwoLinkArm()
+    p = two.params
+    model = planar_model(
+        [p["m1"], p["m2"]], [p["l1"], p["l2"]], [p["lc1"], p["lc2"]], [p["I1"], p["I2"]], p["g"]
+    )
+    data = model.createData()
+    tip = model.getFrameId("tip")
+    q = np.array([0.3, -1.1])
+    pin.forwardKinematics(model, data, q)
+    pin.updateFramePlacements(model, data)
+    np.testing.assert_allclose(two.fk(q), data.oMf[tip].translation, rtol=0, atol=1e-12)
+    j = pin.computeFrameJacobian(model, data, q, tip, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    np.testing.assert_allclose(two.jacobian(q), j[:3], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(two.D(q), pin.crba(model, data, q), rtol=0, atol=1e-12)

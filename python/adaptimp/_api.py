@@ -697,6 +697,14 @@ class TwoLinkArm:
         """
         return self._core.forward_dynamics(q, dq, tau, tau_e)
 
+    def fk(self, q: ArrayLike) -> FloatArray:
+        """End-effector position (m), (3,), in the arm's plane (z = 0), SPEC §16."""
+        return self._core.fk(q)
+
+    def jacobian(self, q: ArrayLike) -> FloatArray:
+        """Position Jacobian J(q) = ∂fk/∂q (m/rad), (3, 2), SPEC §16."""
+        return self._core.jacobian(q)
+
     def __repr__(self) -> str:
         p = self._params
         return (
@@ -823,6 +831,15 @@ class PlanarArm:
         """Joint acceleration q̈ (rad/s²), (n,): D q̈ = τ − τe − C q̇ − G, with τ the
         applied torque and τe the force on the environment (N m)."""
         return self._core.forward_dynamics(q, dq, tau, tau_e)
+
+    def fk(self, q: ArrayLike) -> FloatArray:
+        """End-effector position (m), (3,): the tip of the last link, in the arm's
+        x–y plane (z = 0; x horizontal, y up), SPEC §16."""
+        return self._core.fk(q)
+
+    def jacobian(self, q: ArrayLike) -> FloatArray:
+        """Position Jacobian J(q) = ∂fk/∂q (m/rad), (3, n): ṗ = J q̇ (the z row is zero)."""
+        return self._core.jacobian(q)
 
     def __repr__(self) -> str:
         p = self._params

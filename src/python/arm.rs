@@ -3,6 +3,7 @@
 //! [`PlanarArm<N>`] with N = 1 … 7.
 
 use crate::error::Error;
+use crate::kinematics::Kinematics;
 use crate::model::{Link, Manipulator, PlanarArm, TwoLinkArm};
 use crate::types::Vector;
 use std::vec::Vec;
@@ -20,6 +21,10 @@ pub trait DynArm: Send + Sync {
     fn gravity(&self, q: &[f64]) -> Vec<f64>;
     /// q̈ (rad/s²) from (4).
     fn forward_dynamics(&self, q: &[f64], dq: &[f64], tau: &[f64], tau_e: &[f64]) -> Vec<f64>;
+    /// End-effector position p = fk(q) (m), 3 values (SPEC §16).
+    fn fk(&self, q: &[f64]) -> Vec<f64>;
+    /// Position Jacobian ∂p/∂q (m/rad), 3 × n row-major (SPEC §16).
+    fn jacobian(&self, q: &[f64]) -> Vec<f64>;
 }
 
 fn v<const N: usize>(x: &[f64]) -> Vector<N> {
@@ -46,6 +51,15 @@ macro_rules! dyn_arm {
         }
         fn forward_dynamics(&self, q: &[f64], dq: &[f64], tau: &[f64], tau_e: &[f64]) -> Vec<f64> {
             Manipulator::forward_dynamics(self, &v(q), &v(dq), &v(tau), &v(tau_e))
+                .as_slice()
+                .to_vec()
+        }
+        fn fk(&self, q: &[f64]) -> Vec<f64> {
+            Kinematics::fk(self, &v(q)).as_slice().to_vec()
+        }
+        fn jacobian(&self, q: &[f64]) -> Vec<f64> {
+            Kinematics::jacobian(self, &v(q))
+                .transpose()
                 .as_slice()
                 .to_vec()
         }

@@ -9,6 +9,7 @@
 
 use crate::config::Law;
 use crate::controller::Controller;
+use crate::disturb::{Disturbances, TipPayload, WithFriction};
 use crate::environment::{FreeSpace, Wall};
 use crate::error::Error;
 use crate::io::{Command, Measurement};
@@ -19,7 +20,6 @@ use crate::plant::{Plant, RigidBody};
 use crate::rbf::{AnyBasis, Basis, Centers};
 use crate::record::{Recorder, Row};
 use crate::schema::{Preset, Scenario, Value};
-use crate::disturb::{Disturbances, TipPayload, WithFriction};
 use crate::simulator::simulate_disturbed;
 use crate::tracker::Tracker;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};

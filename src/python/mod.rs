@@ -928,6 +928,29 @@ macro_rules! arm_class {
                 Ok(array1(py, &acc))
             }
 
+            /// End-effector position fk(q) (m), (3,): the tip of the last link in
+            /// the arm's x–y plane (z = 0), SPEC §16.
+            fn fk<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                Ok(array1(py, &a.fk(&vector("q", n, q)?[..n])))
+            }
+
+            /// Position Jacobian J(q) = ∂fk/∂q (m/rad), (3, n): ṗ = J q̇, SPEC §16.
+            fn jacobian<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                array(py, a.jacobian(&vector("q", n, q)?[..n]), (3, n))
+            }
+
             /// Joints n.
             #[getter]
             fn n(&self) -> usize {

@@ -8,7 +8,8 @@ shape (2,), one call per row of the same log, and the same with lists. Both
 run K = 20 000 rows of a recorded run of the robot scenario (state feedback,
 n = 2, Ts = 1 ms), interleaved round-robin (7 repeats, garbage collector off)
 so that load falls on all alike. Reports medians and the overhead of a Python
-call over the Rust step (the target of issue 9: at most 0.5 µs).
+call over the Rust step (the target of issue 9: at most 0.5 µs), and then
+the speed-up of two ``simulate`` runs in two threads over one after the other.
 
     target/py-venv/bin/python benches/python_step.py [--repeats 7] [--rows 20000]
 
@@ -85,12 +86,41 @@ def report(medians: dict[str, float]) -> str:
     return "\n".join(lines)
 
 
+def threads(repeats: int = 3, T: float = 10.0) -> tuple[float, float]:
+    """Median wall time (s) of two robot-scenario runs one after the other, and in
+    two threads (distinct controllers, the GIL released by ``simulate``)."""
+    import threading
+
+    def run() -> None:
+        adaptimp.simulate("sf", "robot", T=T, record_every=1000)
+
+    serial, parallel = [], []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        run()
+        run()
+        serial.append(time.perf_counter() - start)
+        ts = [threading.Thread(target=run) for _ in range(2)]
+        start = time.perf_counter()
+        for t in ts:
+            t.start()
+        for t in ts:
+            t.join()
+        parallel.append(time.perf_counter() - start)
+    return statistics.median(serial), statistics.median(parallel)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rows", type=int, default=20_000)
     ap.add_argument("--repeats", type=int, default=7)
     args = ap.parse_args()
     print(report(measure(args.rows, args.repeats)))
+    serial, parallel = threads()
+    print(
+        f"\ntwo simulate() runs (robot scenario, 10 s): one after the other {serial:.3f} s, "
+        f"in two threads {parallel:.3f} s: {serial / parallel:.2f}x"
+    )
 
 
 if __name__ == "__main__":

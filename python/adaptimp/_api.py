@@ -74,8 +74,9 @@ def _basis(
             f"got shape {wa.shape}"
         )
     wa = np.broadcast_to(wa, (4 * n,))
-    if np.any(np.isnan(wa)) or np.any(wa <= 0):
-        raise ConfigError("widths must be > 0 (np.inf leaves an input dimension out)")
+    # +inf leaves an input out of the distance (SPEC §15.1); at least one finite.
+    if np.any(np.isnan(wa)) or np.any(wa <= 0) or not np.any(np.isfinite(wa)):
+        raise ConfigError("widths must be > 0, finite or +inf (that input left out), not all inf")
     return c, np.ascontiguousarray(wa**2)
 
 
@@ -229,7 +230,7 @@ def simulate(
         of the paper's vertex grid (which exists for n ≤ 3).
     widths : float or array_like, shape (4n,), optional
         The centres' widths η_d per input dimension (units of that input):
-        S_i = exp(−Σ_d (Z_d − μ_id)² / η_d²); ``np.inf`` leaves dimension d out
+        S_i = exp(−Σ_d (Z_d − μ_id)² / η_d²); ``np.inf`` leaves input d out
         (SPEC §15). Default √eta2.
     weights : dict, optional
         Initial network weights ("D" (n, n, L), "C" (n, n, L), "G" (n, L)),

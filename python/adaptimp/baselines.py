@@ -161,6 +161,11 @@ class ComputedTorque:
         1, 10, 60.
     trajectory : callable, optional
         ``trajectory(t) -> (xc, dxc, ddxc)`` for steps given no setpoint.
+    impedance : {"joint", "external"}
+        ``"joint"`` (default): the compliant reference of SPEC §4 as above.
+        ``"external"``: the setpoint is already compliant (an outer loop such
+        as :class:`adaptimp.cartesian.CartesianImpedance` made it, SPEC §16):
+        xd = xc, ẋd = ẋc, ẍd = ẍc, and τe enters only as the feedforward +τe.
     """
 
     def __init__(
@@ -176,7 +181,11 @@ class ComputedTorque:
         Cd: ArrayLike = 10.0,
         Gd: ArrayLike = 60.0,
         trajectory: Reference | None = None,
+        impedance: str = "joint",
     ) -> None:
+        if impedance not in ("joint", "external"):
+            raise ValueError(f"impedance must be 'joint' or 'external', got {impedance!r}")
+        self.impedance = impedance
         exact = pinocchio_model(model)
         self.model = scale_masses(exact, mass_scale)
         self.data = self.model.createData()
@@ -207,6 +216,7 @@ class ComputedTorque:
             "Dd": self.Dd.tolist(),
             "Cd": self.Cd.tolist(),
             "Gd": self.Gd.tolist(),
+            "impedance": impedance,
         }
         if trajectory is None and n == 2:
             trajectory = paper_circle()
@@ -280,11 +290,15 @@ class ComputedTorque:
         xc = _joint("xc", xc, n)
         dxc = _joint("dxc", np.zeros(n) if dxc is None else dxc, n)
         ddxc = _joint("ddxc", np.zeros(n) if ddxc is None else ddxc, n)
-        if self._xd is None:  # xd(0) = xc(0), ẋd(0) = ẋc(0), SPEC §4
+        if self._xd is None or self.impedance == "external":
+            # xd(0) = xc(0), ẋd(0) = ẋc(0), SPEC §4; "external": xd ≡ xc.
             self._xd, self._dxd = xc.copy(), dxc.copy()
         xd, dxd = self._xd, self._dxd
         # The compliant reference (SPEC §4) and the computed torque.
-        ddxd = ddxc + (self.Cd * (dxc - dxd) + self.Gd * (xc - xd) - tau_e) / self.Dd
+        if self.impedance == "external":
+            ddxd = ddxc
+        else:
+            ddxd = ddxc + (self.Cd * (dxc - dxd) + self.Gd * (xc - xd) - tau_e) / self.Dd
         a = ddxd + self.Kd * (dxd - dq) + self.Kp * (xd - q)
         tau = self.mass_matrix(q) @ a + self.bias(q, dq) + tau_e
         tau_sat = np.clip(tau, -self.tau_max, self.tau_max)

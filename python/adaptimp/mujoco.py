@@ -92,6 +92,11 @@ class ControllerLike(Protocol):
     before saturation), ``xc``, ``xd``, ``z1``, ``dq_hat``, ``zeta``, and
     ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``,
     ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
+
+    Cartesian hook: a controller with ``wants_wrench = True`` is also given
+    ``wrench=`` F_e = [f; m] (6,), N and N m, world frame (the plant's
+    measurement of the row, the one τe is computed from), e.g.
+    :class:`adaptimp.cartesian.CartesianImpedance`.
     """
 
     def step(
@@ -951,6 +956,9 @@ def simulate(
     plant.timestep = Ts / substeps
     plant.reset(q0, dq0)
     has = {name: hasattr(ctrl, name) for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta")}
+    # The Cartesian hook (ControllerLike): the measured wrench as well as τe.
+    extra: dict[str, Any] = {}
+    wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
     n = plant.n
     rows: dict[str, list[Any]] = {name: [] for name in ARRAYS if name != "t"}
     # The rows' own lists, bound once: this loop runs a Python step per period.
@@ -962,14 +970,16 @@ def simulate(
         wrench = plant.wrench()
         tau_e = plant.tau_e(wrench)
         r_x_ee.append(plant.ee_position())
+        if wants_wrench:
+            extra["wrench"] = wrench
         if reference is not None:
             xc, dxc, ddxc = (np.asarray(v, dtype=np.float64) for v in reference(k * Ts))
-            tau_cmd = ctrl.step(q, tau_e, dq, xc=xc, dxc=dxc, ddxc=ddxc)
+            tau_cmd = ctrl.step(q, tau_e, dq, xc=xc, dxc=dxc, ddxc=ddxc, **extra)
             r_xc.append(xc)
             r_dxc.append(dxc)
             r_ddxc.append(ddxc)
         else:
-            tau_cmd = ctrl.step(q, tau_e, dq)
+            tau_cmd = ctrl.step(q, tau_e, dq, **extra)
             xc = ctrl.xc if has["xc"] else q
             r_xc.append(xc)
         tau_sat = plant.apply(tau_cmd)

@@ -1,0 +1,85 @@
+"""The Python outer loop of SPEC §16 (adaptimp.cartesian) and the panda-table scenario."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+pytest.importorskip("pinocchio")
+
+from adaptimp import cartesian as ac
+from adaptimp import mujoco as amj
+
+
+@pytest.fixture(scope="module")
+def sc() -> ac.PandaTable:
+    return ac.panda_table()
+
+
+def test_free_space_clik_follows_the_command(sc: ac.PandaTable) -> None:
+    """F_e = 0: p_d ≡ p_c (Euler), and the CLIK drives fk(q_d) to p_d."""
+    outer = sc.outer()
+    err, gap = [], []
+    for k in range(3000):
+        p, dp, ddp = sc.path(k * sc.ts, depth=0.0)
+        q, _, _ = outer.step(p, dp, ddp, np.zeros(3))
+        if k * sc.ts >= 1.5:
+            err.append(np.linalg.norm(sc.fk(q) - outer.pd_k))
+            gap.append(np.linalg.norm(outer.pd_k - p))
+    assert max(gap) < 1e-5
+    assert max(err) < 1e-4
+
+
+def test_steady_contact_force_is_kd_times_depth(sc: ac.PandaTable) -> None:
+    """A plane z ≤ w of stiffness k_e with a perfect inner loop (p = fk(q_d)):
+    F = K_d k_e/(K_d + k_e) δ_c (16.1), → K_d δ_c as k_e ≫ K_d."""
+    outer = sc.outer()
+    ke, w = 5000.0, 0.46
+    p0 = sc.fk(sc.q0)
+    pc = np.array([p0[0], p0[1], w - 0.01])  # commanded 1 cm into the plane
+    f = np.zeros(3)
+    for k in range(4000):
+        s = min(k * sc.ts / 1.0, 1.0)
+        q, _, _ = outer.step(p0 + s * (pc - p0), np.zeros(3), np.zeros(3), f)
+        z = sc.fk(q)[2]
+        f = np.array([0.0, 0.0, -ke * max(0.0, w - z)])  # the force the tool exerts: down
+    fn = -f[2]
+    expected = 500.0 * ke / (500.0 + ke) * 0.01
+    assert fn == pytest.approx(expected, rel=2e-3)
+    assert fn == pytest.approx(500.0 * 0.01, rel=0.1)
+
+
+def test_outer_loop_validates() -> None:
+    fk = lambda q: np.zeros(3)  # noqa: E731
+    jac = lambda q: np.zeros((3, 2))  # noqa: E731
+    with pytest.raises(ValueError, match="Ts·K_D"):
+        ac.OuterLoop(fk, jac, 0.02, np.zeros(2))
+    with pytest.raises(ValueError, match="M_d > 0"):
+        ac.OuterLoop(fk, jac, 1e-3, np.zeros(2), config=ac.OuterLoopConfig(Md=0.0))
+
+
+@pytest.mark.parametrize("kind", ["pd", "sf"])
+def test_short_run_within_limits(sc: ac.PandaTable, kind: str) -> None:
+    ctrl = ac.panda_controller(kind, sc)
+    res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.6, q0=sc.q0)
+    m = ac.cartesian_metrics(res, ctrl, sc, settle=0.3)
+    assert all(np.isfinite(v) for v in m.values())
+    assert m["applied_ratio"] <= 1.0 + 1e-12
+    assert np.all(np.abs(res.tau_sat) <= np.asarray(res.params["tau_max"]) + 1e-12)
+
+
+def test_computed_torque_tracks_the_circle(sc: ac.PandaTable) -> None:
+    ctrl = ac.panda_controller("ct", sc)
+    res = amj.simulate(ctrl, amj.Plant(sc.model), T=3.0, q0=sc.q0)
+    m = ac.cartesian_metrics(res, ctrl, sc)
+    assert m["rms_track"] < 1e-3  # m
+    assert m["rms_path_xy"] < 3e-3  # m: the circle on the table
+    assert res.metrics["steps_in_contact"] > 500
+
+
+def test_cartesian_impedance_needs_external_inner(sc: ac.PandaTable) -> None:
+    from adaptimp.baselines import ComputedTorque
+
+    with pytest.raises(ValueError, match="external"):
+        ac.CartesianImpedance(ComputedTorque(sc.pin_model, tau_max=sc.tau_max), sc.outer())

@@ -303,11 +303,25 @@ class CartesianImpedance:
     outer : OuterLoop
     path : callable, optional
         path(t) -> (p_c, ṗ_c, p̈_c), used when a step has no setpoint.
+    force_feedforward : bool
+        True (SPEC (C5)): the joint controller gets τe = Jᵀ F_e, which its law
+        adds to the torque (+τe in (14), (35)). False: it gets zero, and the
+        contact force acts through the outer loop only. Against a stiff
+        surface sampled at 1 kHz the feedforward closes a one-step loop from
+        the measured force to the torque whose gain (the arm's apparent mass
+        over M_d) exceeds 1, and the contact chatters (docs/panda.md).
     """
 
     wants_wrench = True
 
-    def __init__(self, inner: Any, outer: OuterLoop, path: Path | None = None) -> None:
+    def __init__(
+        self,
+        inner: Any,
+        outer: OuterLoop,
+        path: Path | None = None,
+        *,
+        force_feedforward: bool = True,
+    ) -> None:
         ts = getattr(inner, "ts", None) or getattr(inner, "Ts", None)
         if ts is None or not math.isclose(float(ts), outer.ts, rel_tol=1e-12):
             raise ValueError(f"inner period {ts} differs from the outer loop's {outer.ts} s")
@@ -320,6 +334,7 @@ class CartesianImpedance:
                 f"the joint controller must have impedance='external' (SPEC §16), got {mode!r}"
             )
         self.inner, self.outer, self.path = inner, outer, path
+        self.force_feedforward = force_feedforward
         self.ts = outer.ts
         self._k = 0
         self.log: dict[str, list[FloatArray]] = {
@@ -375,7 +390,8 @@ class CartesianImpedance:
             dpc = np.zeros(3) if dxc is None else np.asarray(dxc, dtype=np.float64)
             ddpc = np.zeros(3) if ddxc is None else np.asarray(ddxc, dtype=np.float64)
         q_d, dq_d, ddq_d = self.outer.step(pc, dpc, ddpc, f)
-        out = np.asarray(self.inner.step(q, tau_e, dq, xc=q_d, dxc=dq_d, ddxc=ddq_d))
+        te = tau_e if self.force_feedforward else np.zeros(self.outer.n)
+        out = np.asarray(self.inner.step(q, te, dq, xc=q_d, dxc=dq_d, ddxc=ddq_d))
         qm = np.asarray(q, dtype=np.float64)
         pd = self.outer.pd_k
         self.xc, self.xd, self.force, self.q_d = np.asarray(pc, dtype=np.float64), pd, f, q_d
@@ -648,6 +664,7 @@ def panda_controller(
     gains: dict[str, list[float]] | None = None,
     gamma: float = 1.0,
     ct_gains: tuple[float, float] = (400.0, 40.0),
+    force_feedforward: bool = True,
     **params: Any,
 ) -> CartesianImpedance:
     """One of the five controllers of the comparison, with the outer loop in front.
@@ -659,6 +676,8 @@ def panda_controller(
         networks and the centres ``basis`` (default :func:`orbit_basis`); or
         computed torque with Pinocchio's exact model ("ct") or every link's mass
         and inertia +30 % ("ct+30"), K_P, K_D = ``ct_gains`` (1/s², 1/s).
+    force_feedforward : bool
+        Whether the joint controller gets τe (see :class:`CartesianImpedance`).
     **params
         Further parameters of ``adaptimp.Controller``.
     """
@@ -694,7 +713,9 @@ def panda_controller(
         )
     else:
         raise ValueError(f"kind must be one of pd, sf, of, ct, ct+30; got {kind!r}")
-    return CartesianImpedance(inner, sc.outer(), lambda t: sc.path(t))
+    return CartesianImpedance(
+        inner, sc.outer(), lambda t: sc.path(t), force_feedforward=force_feedforward
+    )
 
 
 def cartesian_metrics(

@@ -139,7 +139,13 @@ fn main() -> Result<(), Error> {
     );
 
     let far = CartesianWall::new(arm, n, 10.0, 5000.0, 50.0)?;
-    let (rms, _, _, _, peak) = simulate(&ctrl, &circle, &far, q0, 12.0)?;
+    let (rms, _, _, _, peak) = simulate(
+        &ctrl,
+        &circle,
+        &far,
+        q0,
+        if cfg!(test) { 5.0 } else { 12.0 },
+    )?;
     println!(
         "circle r = 5 cm, free space: RMS ‖p − p_c‖ (t ≥ 4 s) = {:.2} mm, peak |τ| = {peak:.1} N m",
         rms * 1e3
@@ -182,4 +188,13 @@ fn main() -> Result<(), Error> {
         n.dot(&(cmd.p - cmd.pd)) * 1e3
     );
     Ok(())
+}
+
+/// `cargo test` runs this example, shortened (`cfg!(test)`).
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn runs() {
+        super::main().unwrap();
+    }
 }

@@ -41,7 +41,10 @@ fn arm() -> Result<PlanarArm<N>, adaptimp::Error> {
 
 fn main() -> Result<(), adaptimp::Error> {
     let mut args = std::env::args().skip(1);
-    let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(200_000);
+    let steps: usize = args
+        .next()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(if cfg!(test) { 2_000 } else { 200_000 });
     let nodes: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(64);
     let arm = arm()?;
     let traj = Sinusoid::<N>::new(
@@ -106,3 +109,12 @@ fn main() -> Result<(), adaptimp::Error> {
 }
 
 type Matrix7 = adaptimp::Matrix<N>;
+
+/// `cargo test` runs this example, shortened (`cfg!(test)`).
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn runs() {
+        super::main().unwrap();
+    }
+}

@@ -257,14 +257,10 @@ fn vector_any(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<
         if f.len() != n {
             return Err(shape_error(what, n, &python_shape(f.shape())));
         }
-        // A copy without the borrow tracker (the hot path of `step`).
-        match f.to_vec() {
-            Ok(v) => out[..n].copy_from_slice(&v),
-            Err(_) => {
-                for (i, o) in out[..n].iter_mut().enumerate() {
-                    *o = f.get_owned(i).unwrap_or(f64::NAN);
-                }
-            }
+        // Element by element: no borrow tracking, no allocation (the hot path
+        // of `step`); any stride.
+        for (i, o) in out[..n].iter_mut().enumerate() {
+            *o = f.get_owned(i).unwrap_or(f64::NAN);
         }
     } else if let Ok(arr) = obj.cast::<PyUntypedArray>() {
         if arr.ndim() != 1 || arr.len() != n {

@@ -416,6 +416,28 @@ impl Hooks for PyHooks {
 // Controller.
 // ---------------------------------------------------------------------------
 
+/// A step's arguments, converted: n values each in fixed buffers.
+struct Given {
+    x: Buf,
+    tau_e: Buf,
+    dx: Option<Buf>,
+    setpoint: Option<[Buf; 3]>,
+}
+
+impl Given {
+    fn inputs(&self, n: usize) -> Inputs<'_> {
+        Inputs {
+            x: &self.x[..n],
+            dx: self.dx.as_ref().map(|d| &d[..n]),
+            tau_e: &self.tau_e[..n],
+            setpoint: self
+                .setpoint
+                .as_ref()
+                .map(|s| [&s[0][..n], &s[1][..n], &s[2][..n]]),
+        }
+    }
+}
+
 /// One of the paper's controllers (SPEC §7) for an arm of n joints, with its
 /// commanded trajectory and its state, stepped by the caller at the period
 /// Ts (SPEC §11).
@@ -458,13 +480,15 @@ impl PyController {
         array1(py, self.lock(py).last(what))
     }
 
-    /// The optional velocity and setpoint of a step, converted.
-    fn optional(
+    /// A step's arguments, converted (and, with `finite`, checked finite).
+    fn convert(
         &self,
+        q: &Bound<'_, PyAny>,
+        tau_e: &Bound<'_, PyAny>,
         dq: Option<&Bound<'_, PyAny>>,
         setpoint: [Option<&Bound<'_, PyAny>>; 3],
         finite: bool,
-    ) -> PyResult<(Option<Buf>, Option<[Buf; 3]>)> {
+    ) -> PyResult<Given> {
         let n = self.n;
         let conv = |what, o| {
             if finite {
@@ -473,6 +497,8 @@ impl PyController {
                 vector_any(what, n, o)
             }
         };
+        let x = conv("q", q)?;
+        let te = conv("tau_e", tau_e)?;
         let dx = match (self.law, dq) {
             (Law::OutputFeedback, _) | (_, None) => None,
             (_, Some(dq)) => Some(conv("dq", dq)?),
@@ -493,7 +519,12 @@ impl PyController {
                 ))
             }
         };
-        Ok((dx, sp))
+        Ok(Given {
+            x,
+            tau_e: te,
+            dx,
+            setpoint: sp,
+        })
     }
 }
 
@@ -558,18 +589,10 @@ impl PyController {
         ddxc: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
-        let x = vector("q", n, q)?;
-        let te = vector("tau_e", n, tau_e)?;
-        let (dx, sp) = self.optional(dq, [xc, dxc, ddxc], true)?;
+        let given = self.convert(q, tau_e, dq, [xc, dxc, ddxc], true)?;
         let mut out = [0.0; MAX_JOINTS];
-        let inputs = Inputs {
-            x: &x[..n],
-            dx: dx.as_ref().map(|d| &d[..n]),
-            tau_e: &te[..n],
-            setpoint: sp.as_ref().map(|s| [&s[0][..n], &s[1][..n], &s[2][..n]]),
-        };
         self.lock(py)
-            .step(&inputs, &mut out[..n])
+            .step(&given.inputs(n), &mut out[..n])
             .map_err(step_error)?;
         Ok(array1(py, &out[..n]))
     }
@@ -590,17 +613,12 @@ impl PyController {
         ddxc: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Option<String>)> {
         let n = self.n;
-        let x = vector_any("q", n, q)?;
-        let te = vector_any("tau_e", n, tau_e)?;
-        let (dx, sp) = self.optional(dq, [xc, dxc, ddxc], false)?;
+        // Shapes and types are checked; values are the controller's to judge.
+        let given = self.convert(q, tau_e, dq, [xc, dxc, ddxc], false)?;
         let mut out = [0.0; MAX_JOINTS];
-        let inputs = Inputs {
-            x: &x[..n],
-            dx: dx.as_ref().map(|d| &d[..n]),
-            tau_e: &te[..n],
-            setpoint: sp.as_ref().map(|s| [&s[0][..n], &s[1][..n], &s[2][..n]]),
-        };
-        let result = self.lock(py).step_or_fallback(&inputs, &mut out[..n]);
+        let result = self
+            .lock(py)
+            .step_or_fallback(&given.inputs(n), &mut out[..n]);
         Ok((
             array1(py, &out[..n]),
             result.err().map(|e| python_names(e).to_string()),

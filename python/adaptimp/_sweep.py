@@ -383,22 +383,28 @@ def sweep(
         assert p is not None
         return (runs[i].case, scenario, model, p)
 
+    def on_executor(
+        run_batch: Callable[[list[Any]], Any], make: Callable[[int], Any], size: int
+    ) -> None:
+        """Every batch of ``todo`` to ``executor``, recorded as it finishes."""
+        assert executor is not None
+        pending: dict[Future[list[dict[str, Any] | str]], list[int]] = {
+            executor.submit(run_batch, [make(i) for i in batch]): batch
+            for batch in _batches(todo, size)
+        }
+        try:
+            for future in as_completed(pending):
+                record(pending[future], future.result())
+        finally:
+            for future in pending:
+                future.cancel()
+
     try:
         if mj_model is not None and executor is None:
             for batch in _batches(todo, batch_size or 1):
                 record(batch, _run_mujoco_batch([mj_job(i) for i in batch]))
         elif mj_model is not None:
-            assert executor is not None
-            mj_pending = {
-                executor.submit(_run_mujoco_batch, [mj_job(i) for i in batch]): batch
-                for batch in _batches(todo, batch_size or 1)
-            }
-            try:
-                for future in as_completed(mj_pending):
-                    record(mj_pending[future], future.result())
-            finally:
-                for future in mj_pending:
-                    future.cancel()
+            on_executor(_run_mujoco_batch, mj_job, batch_size or 1)
         elif executor is None:
             cores = threads or os.cpu_count() or 1
             size = batch_size or (8 * cores if cache is not None else max(len(todo), 1))
@@ -413,17 +419,7 @@ def sweep(
                 out = _adaptimp.simulate_many(core_jobs, threads, inner)
                 record(batch, out)
         else:
-            size = batch_size or 8
-            pending: dict[Future[list[dict[str, Any] | str]], list[int]] = {
-                executor.submit(_run_batch, [job(i) for i in batch]): batch
-                for batch in _batches(todo, size)
-            }
-            try:
-                for future in as_completed(pending):
-                    record(pending[future], future.result())
-            finally:
-                for future in pending:
-                    future.cancel()
+            on_executor(_run_batch, job, batch_size or 8)
     finally:
         if bar is not None:
             bar.close(total)

@@ -43,7 +43,7 @@ STATE_FORMAT = "adaptimp.state/1"
 def _basis(
     n: int, centers: ArrayLike | None, widths: ArrayLike | None, params: Mapping[str, Any]
 ) -> tuple[FloatArray | None, FloatArray | None]:
-    """User centres as a (L, 4n) float64 array and the squared widths (4n,), or
+    """User centres as a (L, 4n) float64 array and the widths η (4n,), or
     (None, None) for the vertex grid."""
     if centers is None:
         if widths is not None:
@@ -77,7 +77,7 @@ def _basis(
     # +inf leaves an input out of the distance (SPEC §15.1); at least one finite.
     if np.any(np.isnan(wa)) or np.any(wa <= 0) or not np.any(np.isfinite(wa)):
         raise ConfigError("widths must be > 0, finite or +inf (that input left out), not all inf")
-    return c, np.ascontiguousarray(wa**2)
+    return c, np.ascontiguousarray(wa)
 
 
 def _core_controller(
@@ -288,8 +288,8 @@ def simulate(
     ):
         raise TypeError("give the arm's parameters to the arm, not to simulate(), with arm=")
     p = resolve(params, scenario=scenario, caller="simulate()", n=n)
-    c, w2 = _basis(n, centers, widths, p)
-    core = _core_controller(case, p, n, c, w2)
+    c, eta = _basis(n, centers, widths, p)
+    core = _core_controller(case, p, n, c, None if eta is None else eta**2)
     _check_stability(core, p, stacklevel=2)
     if arm is None:
         arm = TwoLinkArm(**{k: p[k] for k in names("arm")}) if n == N_JOINTS else PlanarArm(n)
@@ -318,7 +318,7 @@ def simulate(
         metrics=metrics,
         record_every=every,
         centers=c,
-        widths=None if w2 is None else np.sqrt(w2),
+        widths=eta,
         **out,
     )
 
@@ -445,8 +445,8 @@ class Controller(_adaptimp.Controller):
         check_scenario(scenario)
         n = check_n(n)
         p = resolve(params, scenario=scenario, groups=("controller",), caller="Controller()", n=n)
-        c, w2 = _basis(n, centers, widths, p)
-        self = cls._make(case, scenario, n, p, c, None if w2 is None else np.sqrt(w2))
+        c, eta = _basis(n, centers, widths, p)
+        self = cls._make(case, scenario, n, p, c, eta)
         _check_stability(self, p, stacklevel=2)
         return self
 

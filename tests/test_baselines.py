@@ -3,14 +3,10 @@
 
 from __future__ import annotations
 
-import numpy as np
-import pytest
-
-pytest.importorskip("mujoco")
-pytest.importorskip("pinocchio")
-
 import mujoco
+import numpy as np
 import pinocchio as pin
+import pytest
 
 import adaptimp
 from adaptimp import _models

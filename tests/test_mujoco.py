@@ -8,12 +8,9 @@ import importlib
 import importlib.resources
 import sys
 
+import mujoco
 import numpy as np
 import pytest
-
-pytest.importorskip("mujoco")
-
-import mujoco
 
 import adaptimp
 from adaptimp import _models

@@ -5,9 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-pytest.importorskip("mujoco")
-pytest.importorskip("pinocchio")
-
 from adaptimp import cartesian as ac
 from adaptimp import mujoco as amj
 

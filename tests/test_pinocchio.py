@@ -6,11 +6,10 @@ position and Jacobian by its frame kinematics, for N = 2 … 5 at random states.
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import adaptimp
-
-pin = pytest.importorskip("pinocchio")
 
 
 def planar_model(masses, lengths, coms, inertias, g: float):  # type: ignore[no-untyped-def]

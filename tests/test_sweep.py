@@ -69,7 +69,8 @@ def test_any_executor_gives_the_serial_results() -> None:
 
 
 def test_a_dask_local_cluster_gives_the_serial_results() -> None:
-    distributed = pytest.importorskip("distributed")
+    import distributed
+
     vary = {"case": ["pd", "sf", "of"], "m2": [0.85, 1.2, 1.5]}
     local = adaptimp.sweep("sf", vary=vary, scenario="robot", **FIXED)
     with (
@@ -122,7 +123,7 @@ def test_sweep_arguments_are_checked() -> None:
 
 
 def test_sweep_on_the_mujoco_plant() -> None:
-    pytest.importorskip("mujoco")
+
     df = adaptimp.sweep(
         "pd", vary={"Kp": [8.0, 10.0]}, plant="mujoco", T=0.3, contact=False, scenario="robot"
     )

@@ -25,9 +25,11 @@ class MeasurementError(AdaptimpError, ValueError):
     unchanged. A ``ValueError``."""
 
 
-class DivergedError(AdaptimpError, ArithmeticError):
-    """The controller's state or a signal left the finite range (|x| > 1e100):
-    call ``reset()`` or restore a saved state. An ``ArithmeticError``."""
+class DivergedError(AdaptimpError, ValueError, ArithmeticError):
+    """The controller's state, a signal or the plant left the finite range
+    (|x| > 1e100): call ``reset()`` or restore a saved state. An
+    ``ArithmeticError``, and a ``ValueError`` (what every run-time error of
+    adaptimp is, so ``except ValueError`` keeps catching it)."""
 
 
 class FaultError(AdaptimpError, RuntimeError):

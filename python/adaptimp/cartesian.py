@@ -662,7 +662,7 @@ def panda_controller(
     *,
     basis: tuple[FloatArray, FloatArray] | None = None,
     gains: dict[str, list[float]] | None = None,
-    gamma: float = 1.0,
+    gamma: float | Sequence[float] = 1.0,
     ct_gains: tuple[float, float] = (400.0, 40.0),
     force_feedforward: bool = True,
     **params: Any,
@@ -707,7 +707,7 @@ def panda_controller(
             impedance="external",
             Ts=sc.ts,
             tau_max=sc.tau_max.tolist(),
-            gamma=[gamma] * 3,
+            gamma=[float(gamma)] * 3 if isinstance(gamma, (int, float)) else list(gamma),
             **g,
             **params,
         )

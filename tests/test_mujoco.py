@@ -302,3 +302,15 @@ def test_module_examples_run() -> None:
     import doctest
 
     assert doctest.testmod(amj, raise_on_error=False).failed == 0
+
+
+def test_mujoco_result_is_a_sim_result() -> None:
+    """adaptimp.mujoco.simulate returns a SimResult: the same metrics, pandas, plots."""
+    res = amj.simulate("pd", "two_link", T=0.05, contact=False)
+    assert isinstance(res, adaptimp.SimResult)
+    assert res.case == "pd"
+    assert set(adaptimp._result.METRIC_KEYS) <= set(res.metrics)
+    df = res.to_pandas()
+    assert "q1 [rad]" in df.columns
+    assert res.x_ee is not None
+    assert res.x_ee.shape == (50, 3)

@@ -66,7 +66,7 @@ def _legend(fig: Figure, ax: Axes, ncol: int) -> None:
 
 
 def _title(res: SimResult, what: str) -> str:
-    return f"{CASE_NAMES[res.case]} ({res.case}): {what}"
+    return f"{CASE_NAMES.get(res.case, res.case)} ({res.case}): {what}"
 
 
 def _settle_band(ax: Axes, res: SimResult) -> None:
@@ -192,7 +192,9 @@ def compare(
                 r,
                 color=_COLORS.get(res.case),
                 lw=1.3,
-                label=f"{CASE_NAMES[res.case]}: " + ", ".join(f"{r:.2g}" for r in rms) + " rad",
+                label=f"{CASE_NAMES.get(res.case, res.case)}: "
+                + ", ".join(f"{r:.2g}" for r in rms)
+                + " rad",
             )
     settle = float(results[0].params["settle"]) if results else 0.0
     for i, ax in enumerate(axes):
@@ -233,7 +235,7 @@ def into(res: SimResult, kind: str, ax: Axes | Sequence[Axes]) -> Figure:
             data[:, i],
             lw=1.0,
             color=None if single else _COLORS.get(res.case),
-            label=f"{CASE_NAMES[res.case]}: {name}{joint}",
+            label=f"{CASE_NAMES.get(res.case, res.case)}: {name}{joint}",
         )
         if kind == "tracking" and not single:
             a.plot(res.t, res.xc[:, i], color="k", lw=0.8, ls="--")

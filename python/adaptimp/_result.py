@@ -279,7 +279,8 @@ class SimResult:
         )
         wall = "free space" if p["wall"] is None else f"wall at {p['wall']:g} rad"
         lines = [
-            f"SimResult({self.case!r}: {CASE_NAMES[self.case]}, scenario {self.scenario!r}; "
+            f"SimResult({self.case!r}: {CASE_NAMES.get(self.case, self.case)}, "
+            f"scenario {self.scenario!r}; "
             f"{rows}, n = {self.n}, Ts = {p['Ts']:g} s, T = {t_end:g} s; {wall})",
             f"  RMS ‖z1‖ = {m['rms_z1']:.4g} rad, over t ≥ {p['settle']:g} s: "
             f"{m['rms_z1_after2']:.4g} rad "
@@ -334,7 +335,7 @@ def metrics_table(results: Mapping[str, SimResult] | Iterable[SimResult]) -> str
     if isinstance(results, Mapping):
         cols = list(results.items())
     else:
-        cols = [(CASE_NAMES[r.case], r) for r in results]
+        cols = [(CASE_NAMES.get(r.case, r.case), r) for r in results]
     after = ", ".join(sorted({f"{r.params['settle']:g}" for _, r in cols}))
     header = ["metric (SPEC §12)"] + [title for title, _ in cols]
     body = [

@@ -36,7 +36,7 @@ from __future__ import annotations
 import copy
 import math
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, Union
@@ -52,10 +52,11 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     ) from e
 
 from . import _models
-from ._result import METRIC_KEYS
+from ._result import METRIC_KEYS, SimResult
 from ._trajectory import Reference, paper_circle, sinusoid
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 __all__ = [
@@ -639,9 +640,13 @@ ARRAYS = (
 
 
 @dataclass(frozen=True, repr=False, eq=False)
-class MujocoResult:
+class MujocoResult(SimResult):
     """A closed-loop run on a MuJoCo plant: one row k = 0 … K − 1 per controller
-    step at t_k = k·Ts.
+    step at t_k = k·Ts. A :class:`adaptimp.SimResult` (the same metrics,
+    ``to_pandas``, ``save``), with the end effector's position and wrench, and
+    the plot kinds of a MuJoCo run ("contact" besides SimResult's); ``w_norms``
+    is NaN (the plant does not see the weights) and ``case`` is the
+    controller's, or "custom".
 
     Per-joint arrays have shape (K, n); the reference arrays (K, m), m the
     dimension of the controller's xc (n in joint space).
@@ -680,24 +685,8 @@ class MujocoResult:
         ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``controller``.
     """
 
-    params: dict[str, Any]
-    metrics: dict[str, Any]
-    t: FloatArray
-    q: FloatArray
-    dq: FloatArray
-    ddq: FloatArray
-    xc: FloatArray
-    dxc: FloatArray
-    ddxc: FloatArray
-    xd: FloatArray
-    dq_hat: FloatArray
-    tau: FloatArray
-    tau_sat: FloatArray
-    tau_e: FloatArray
-    zeta: FloatArray
-    z1: FloatArray
-    x_ee: FloatArray
-    wrench_ee: FloatArray
+    x_ee: FloatArray | None = None
+    wrench_ee: FloatArray | None = None
 
     @property
     def rows(self) -> int:
@@ -709,13 +698,18 @@ class MujocoResult:
         """sat(τ) − τ (N m), (K, n)."""
         return self.tau_sat - self.tau
 
-    def plot(self, kind: str = "tracking") -> Figure:
+    def plot(self, kind: str = "tracking", ax: Axes | Sequence[Axes] | None = None) -> Figure:
         """A matplotlib figure of the run, one panel per joint (or per force axis).
 
         kind : {"tracking", "errors", "torques", "contact"}
             q against xc and xd; z1; τ and sat(τ) with ±τmax; the end-effector
             force F_e (N) and ‖τe‖ (N m).
+        ax : Axes or sequence of Axes, optional
+            Draw "tracking", "errors" or "torques" into these axes, as
+            :meth:`adaptimp.SimResult.plot` does.
         """
+        if ax is not None:
+            return super().plot(kind, ax)
         if kind not in PLOT_KINDS:
             raise ValueError(f"kind must be one of {PLOT_KINDS}, got {kind!r}")
         return _plot(self, kind)
@@ -737,6 +731,7 @@ def _plot(res: MujocoResult, kind: str) -> Figure:
 
     t = res.t
     if kind == "contact":
+        assert res.wrench_ee is not None
         fig, axes = _figure("end-effector force F_e (world frame) and ‖τe‖", rows=2)
         for i, axis in enumerate("xyz"):
             axes[0].plot(t, res.wrench_ee[:, i], lw=1.0, label=f"F_e,{axis}")
@@ -1051,4 +1046,14 @@ def simulate(
         "model": name,
         "controller": label,
     }
-    return MujocoResult(params=run, metrics=m, **arrays)
+    case = getattr(ctrl, "case", None)
+    case = case if isinstance(case, str) else getattr(getattr(ctrl, "inner", None), "case", None)
+    fields: dict[str, Any] = dict(arrays)
+    return MujocoResult(
+        case=case if isinstance(case, str) else "custom",
+        scenario=scenario,
+        params=run,
+        metrics=m,
+        w_norms=np.full((steps, 3), math.nan),
+        **fields,
+    )

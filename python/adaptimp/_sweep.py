@@ -171,11 +171,14 @@ def _prepare(
 
 
 def _run_batch(
-    jobs: list[tuple[str, dict[str, Any], TwoLinkArm | None]], threads: int | None = 1
+    jobs: list[tuple[str, dict[str, Any], TwoLinkArm | None]],
+    threads: int | None = 1,
+    progress: Callable[[int, int], object] | None = None,
 ) -> list[dict[str, Any] | str]:
-    """Run ``jobs`` (case, params, arm) in this process: the task an executor runs."""
+    """Run ``jobs`` (case, params, arm) in this process on ``threads`` threads: the
+    task an executor runs, and the batches of ``executor=None``."""
     core_jobs = [(c, p, None if a is None else a._core) for c, p, a in jobs]
-    return list(_adaptimp.simulate_many(core_jobs, threads))
+    return list(_adaptimp.simulate_many(core_jobs, threads, progress))
 
 
 def _run_mujoco_batch(
@@ -415,9 +418,7 @@ def sweep(
                     if report is not None:
                         report(base + done, total)
 
-                core_jobs = [(c, p, None if a is None else a._core) for c, p, a in map(job, batch)]
-                out = _adaptimp.simulate_many(core_jobs, threads, inner)
-                record(batch, out)
+                record(batch, _run_batch([job(i) for i in batch], threads, inner))
         else:
             on_executor(_run_batch, job, batch_size or 8)
     finally:

@@ -270,7 +270,7 @@ SENSITIVITY_NOTE = (
     "reference against itself with every entry of Φ and Γ moved up one unit in the last "
     "place: the deviation that rounding alone causes. adaptimp computes Φ, Γ with "
     "nalgebra's Padé exponential and the references with scipy's; the two agree to "
-    "1e-15 (tested in src/observer.rs), a few ulps on the smallest entries, which at "
+    "1e-15 (tested in src/control/observer.rs), a few ulps on the smallest entries, which at "
     "Ts = 1 ms (Ts/ε = 10), on a sequence whose weights stay ~1e-7, is ~1e-12 relative. "
     "At the paper's Ts = 50 µs the checks gate the run."
 )

@@ -31,9 +31,10 @@ cargo fmt --manifest-path fuzz/Cargo.toml --check
 cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy --all-targets --features python -- -D warnings
 
-step "Rust: no_std build of the core (without and with alloc), docs"
+step "Rust: no_std builds of the core (firmware: without and with alloc; the simulator), docs"
 cargo build --no-default-features
 cargo build --no-default-features --features alloc
+cargo build --no-default-features --features sim
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 
 step "Rust: tests (the core, and the C ABI with its header check)"

@@ -20,35 +20,12 @@
 //!
 //! | module | concept | paper / SPEC |
 //! |---|---|---|
-//! | [`types`] | `Vector`, `Matrix` aliases (a leaf) | |
-//! | [`model`] | manipulator dynamics D, C, G | (4), (55)–(63), §1 |
-//! | [`saturation`] | actuator limits | §2 |
-//! | [`environment`] | contact force τe; a Cartesian wall (τe = Jᵀ F_e) | §3, §16 |
-//! | [`trajectory`] | commanded trajectory xc | (64), §4 |
-//! | [`impedance`] | target-impedance reference xd; where it acts | (3), §4 |
-//! | [`kinematics`] | end-effector position and Jacobian | §16 |
-//! | [`cartesian`] | Cartesian impedance, inverse kinematics, the pair with a joint controller | (3), §16 |
-//! | [`rbf`] | Gaussian RBF bases S(Z): the grid, user centres, lattices, centres along an orbit | (1), §6, §15 |
-//! | [`network`] | weights ŴD, ŴC, ŴG: storage, output, update | (15)–(17), §6 |
-//! | [`learning`] | learning policies (Euler, normalised, freeze, projection) | §11, §13 |
-//! | [`simd`] | the weight pass's instruction set, chosen at run time | |
-//! | [`robust`] | robust term r(z2) | §7 |
-//! | [`auxiliary`] | saturation compensator ζ | (11), (36), §8 |
-//! | [`safety`] | fallback command, fault policy, plausibility and rate limits | beyond the paper |
-//! | [`observer`] | high-gain velocity observer | (31)–(34), §9 |
-//! | [`config`] | every parameter, presets | §4–§11, §13 |
+//! | [`types`], [`error`], [`trajectory`] | leaves: `Vector`/`Matrix` aliases, validation errors, the commanded trajectory xc | §10, (64), §4 |
+//! | [`control`] | the controller: [`config`], [`controller`] (PD, state and output feedback: the staged step), [`state`], [`io`], [`impedance`] (target-impedance reference xd), [`auxiliary`] (saturation compensator ζ), [`observer`] (high-gain observer), [`robust`], [`saturation`], [`safety`] (fallback, faults, limits), [`tracker`] | (3), (11), (14), (31)–(36), §4–§11, §14 |
+//! | [`networks`] | learning: [`rbf`] (bases S(Z): the grid, user centres, lattices, orbits), [`network`] (ŴD, ŴC, ŴG), [`learning`] (Euler, normalised, freeze, projection), [`simd`] | (1), (15)–(17), §6, §13, §15 |
+//! | [`cartesian`] | task space: [`kinematics`], the Cartesian impedance outer loop and its pair with a joint controller | (3), §16 |
 //! | [`schema`] | the parameter table: names, units, docs, conditions, defaults | §10 |
-//! | [`io`] | measurement, command, the `Control` trait | §11 |
-//! | [`state`] | the caller-owned state | §11 |
-//! | [`controller`] | PD, state and output feedback: the staged step | (14), (35), §7, §11 |
-//! | [`tracker`] | a controller with its trajectory and state | §11 |
-//! | [`plant`] | the `Plant` trait, the rigid-body RK4 plant | §11 |
-//! | [`record`] | recorded rows, the `Recorder` trait | §11 |
-//! | [`metrics`] | tracking / saturation / impedance figures | §12 |
-//! | [`simulator`] | the closed loop | §11 |
-//! | [`inject`] | faults injected into a closed loop | beyond the paper |
-//! | [`disturb`] | payload, sensor noise and delay, jitter, friction, weak actuators | beyond the paper, §15 |
-//! | [`error`] | validation errors | §10 |
+//! | `sim` (feature `sim`) | simulation only: `model` (D, C, G of the paper's and planar arms), `environment` (walls), `plant` (the `Plant` trait, RK4), `simulator` (the closed loop), `record`, `metrics`, `disturb`, `inject` | (4), (55)–(63), §1–§3, §11, §12, §17 |
 //!
 //! ## Quick start
 //!
@@ -92,39 +69,33 @@
 #[cfg(feature = "alloc")]
 extern crate alloc;
 
-pub mod auxiliary;
+// The tree shows the architecture: leaves (`types`, `math`, `error`,
+// `trajectory`), then the controller (`control`), what it learns with
+// (`networks`), task space (`cartesian`), the parameter table (`schema`) and,
+// behind the feature `sim`, simulation only (`sim`). Every module keeps its
+// short public path (`adaptimp::controller`, …) through the re-exports below.
 pub mod cartesian;
-pub mod config;
-pub mod controller;
-pub mod disturb;
-pub mod environment;
+pub mod control;
 pub mod error;
-pub mod impedance;
-pub mod inject;
-pub mod io;
-pub mod kinematics;
-pub mod learning;
 mod math;
-pub mod metrics;
-pub mod model;
-pub mod network;
-pub mod observer;
-pub mod plant;
+pub mod networks;
 #[cfg(feature = "python")]
 mod python;
-pub mod rbf;
-pub mod record;
-pub mod robust;
-pub mod safety;
-pub mod saturation;
 pub mod schema;
-pub mod simd;
-pub mod simulator;
-pub mod state;
-#[cfg(feature = "alloc")]
-pub mod tracker;
+#[cfg(feature = "sim")]
+pub mod sim;
 pub mod trajectory;
 pub mod types;
+
+pub use cartesian::kinematics;
+#[cfg(feature = "alloc")]
+pub use control::tracker;
+pub use control::{
+    auxiliary, config, controller, impedance, io, observer, robust, safety, saturation, state,
+};
+pub use networks::{learning, network, rbf, simd};
+#[cfg(feature = "sim")]
+pub use sim::{disturb, environment, inject, metrics, model, plant, record, simulator};
 
 pub use auxiliary::AuxLaw;
 pub use cartesian::{
@@ -133,30 +104,38 @@ pub use cartesian::{
 };
 pub use config::{Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};
+#[cfg(feature = "sim")]
 pub use disturb::{DisturbanceParams, Disturbances, Friction, TipPayload, WithFriction};
+#[cfg(feature = "sim")]
 pub use environment::{CartesianWall, Environment, FreeSpace, Wall};
 pub use error::Error;
 pub use impedance::{ImpedanceMode, Reference, TargetImpedance};
+#[cfg(feature = "sim")]
 pub use inject::{Injected, Injection};
 pub use io::{Command, Control, Measurement};
 pub use kinematics::Kinematics;
 pub use learning::{Learning, LearningStep, SaturationLearning};
+#[cfg(feature = "sim")]
 pub use metrics::{Metrics, MetricsAccumulator};
+#[cfg(feature = "sim")]
 pub use model::{Link, Manipulator, PlanarArm, TwoLinkArm};
 pub use network::{Weights, WeightsMut};
 pub use observer::{HighGainObserver, Hold};
+#[cfg(feature = "sim")]
 pub use plant::{rk4_step, Plant, RigidBody};
 #[cfg(feature = "alloc")]
 pub use rbf::AnyBasis;
 pub use rbf::{Basis, Centers, Grid};
-#[cfg(feature = "alloc")]
+#[cfg(all(feature = "sim", feature = "alloc"))]
 pub use record::Trace;
+#[cfg(feature = "sim")]
 pub use record::{Recorder, Row};
 pub use robust::{Robust, RobustKind};
 pub use safety::{Fallback, Fault, FaultPolicy, Limits};
 pub use saturation::Saturation;
 pub use schema::{Preset, Scenario};
 pub use simd::SimdPath;
+#[cfg(feature = "sim")]
 pub use simulator::{run, run_disturbed, simulate, simulate_disturbed, simulate_with, SimConfig};
 #[cfg(feature = "alloc")]
 pub use state::HeapState;

@@ -12,19 +12,23 @@
 //! a field added without a schema name does not compile, and a test checks
 //! that the names it visits are exactly those of [`PARAMS`].
 
-use crate::auxiliary::AuxLaw;
-use crate::config::{Config, Law, ObserverInit, WeightBound};
-use crate::disturb::{DisturbanceParams, Disturbances, MAX_DELAY};
-use crate::environment::Wall;
+use crate::control::auxiliary::AuxLaw;
+use crate::control::config::{Config, Law, ObserverInit, WeightBound};
+use crate::control::impedance::ImpedanceMode;
+use crate::control::observer::Hold;
+use crate::control::robust::RobustKind;
+use crate::control::safety::{Fallback, FaultPolicy, Limits};
 use crate::error::Error;
-use crate::impedance::ImpedanceMode;
-use crate::learning::{LearningStep, SaturationLearning};
-use crate::model::{ArmParams, TwoLinkArm};
-use crate::observer::Hold;
-use crate::rbf::Grid;
-use crate::robust::RobustKind;
-use crate::safety::{Fallback, FaultPolicy, Limits};
-use crate::simulator::SimConfig;
+use crate::networks::learning::{LearningStep, SaturationLearning};
+use crate::networks::rbf::Grid;
+#[cfg(feature = "sim")]
+use crate::sim::disturb::{DisturbanceParams, Disturbances, MAX_DELAY};
+#[cfg(feature = "sim")]
+use crate::sim::environment::Wall;
+#[cfg(feature = "sim")]
+use crate::sim::model::{ArmParams, TwoLinkArm};
+#[cfg(feature = "sim")]
+use crate::sim::simulator::SimConfig;
 use crate::trajectory::Sinusoid;
 use crate::types::Vector;
 
@@ -215,7 +219,7 @@ pub const PARAMS: &[Param] = &[
     p("q0", Sim, Joint, "rad", "initial joint position q(0), (65)", "", V(&[0.25, -0.05])),
     p("dq0", Sim, Joint, "rad/s", "initial joint velocity q̇(0)", "", R(0.0)),
     p("settle", Sim, Real, "s", "start of the 'after2' window of the metrics (SPEC §12)", "", R(2.0)),
-    // Disturbances a real robot has (SPEC §17, src/disturb.rs); the defaults
+    // Disturbances a real robot has (SPEC §17, src/sim/disturb.rs); the defaults
     // disturb nothing. The controller is told none of them.
     p("payload", Sim, Real, "kg", "point mass at the tip of the last link (the plant's only)", "payload ≥ 0", R(0.0)),
     p("noise_q", Sim, Joint, "rad", "standard deviation of the Gaussian noise on each measured q_i", "noise ≥ 0", R(0.0)),
@@ -381,7 +385,7 @@ pub const PARAMS: &[Param] = &[
         ),
         S("auto"),
     ),
-    // Safety around the control law (beyond the paper; src/safety.rs).
+    // Safety around the control law (beyond the paper; src/control/safety.rs).
     p(
         "fallback",
         Ctrl,
@@ -462,6 +466,7 @@ pub struct ArmValues {
 
 impl ArmValues {
     /// The arm's parameters, with the derived ones filled in (SPEC §1).
+    #[cfg(feature = "sim")]
     pub fn resolve(&self) -> ArmParams {
         let lc = |i: usize| self.lc[i].unwrap_or(self.l[i] / 2.0);
         let inertia = |i: usize| self.inertia[i].unwrap_or(self.m[i] * self.l[i] * self.l[i] / 4.0);
@@ -487,9 +492,11 @@ impl ArmValues {
 pub struct Scenario<const N: usize> {
     /// The controller's configuration.
     pub config: Config<N>,
-    /// The run.
+    /// The run (feature `sim`).
+    #[cfg(feature = "sim")]
     pub sim: SimConfig<N>,
-    /// The disturbances of the run (SPEC §17).
+    /// The disturbances of the run (SPEC §17; feature `sim`).
+    #[cfg(feature = "sim")]
     pub disturb: DisturbanceParams<N>,
     /// η² of the vertex grid.
     pub eta2: f64,
@@ -518,6 +525,7 @@ impl<const N: usize> Scenario<N> {
         let zero = Vector::<N>::zeros();
         let mut s = Self {
             config: Config::zeroed(law),
+            #[cfg(feature = "sim")]
             sim: SimConfig {
                 t_final: 0.0,
                 substeps: 0,
@@ -525,6 +533,7 @@ impl<const N: usize> Scenario<N> {
                 dq0: zero,
                 settle: 0.0,
             },
+            #[cfg(feature = "sim")]
             disturb: DisturbanceParams::default(),
             eta2: 0.0,
             xc: [zero; 4],
@@ -539,6 +548,9 @@ impl<const N: usize> Scenario<N> {
             },
         };
         for p in PARAMS {
+            if !cfg!(feature = "sim") && p.group == Group::Sim {
+                continue; // the run's parameters need the feature `sim`
+            }
             let v = match p.default_in(preset) {
                 // A per-joint default for another number of joints: broadcast its first value.
                 Value::Vec(v) if p.kind == Kind::Joint && v.len() != N => Value::Real(v[0]),
@@ -562,50 +574,7 @@ impl<const N: usize> Scenario<N> {
         let n = p.name;
         let c = &mut self.config;
         match n {
-            "T" => self.sim.t_final = real(n, value)?,
-            "substeps" => {
-                let v = int(n, value)?;
-                self.sim.substeps = usize::try_from(v).map_err(|_| Error::Condition {
-                    condition: "1 ≤ substeps ≤ 10 000",
-                    lhs: "substeps",
-                    index: None,
-                    value: v as f64,
-                })?
-            }
-            "q0" => self.sim.q0 = joint(n, value)?,
-            "dq0" => self.sim.dq0 = joint(n, value)?,
-            "settle" => self.sim.settle = real(n, value)?,
-            "payload" => self.disturb.payload = real(n, value)?,
-            "noise_q" => self.disturb.noise_q = joint(n, value)?,
-            "noise_dq" => self.disturb.noise_dq = joint(n, value)?,
-            "noise_tau_e" => self.disturb.noise_tau_e = joint(n, value)?,
-            "seed" => {
-                let v = int(n, value)?;
-                self.disturb.seed = u64::try_from(v).map_err(|_| Error::Condition {
-                    condition: "seed ≥ 0",
-                    lhs: "seed",
-                    index: None,
-                    value: v as f64,
-                })?
-            }
-            "delay" => {
-                let v = int(n, value)?;
-                self.disturb.delay =
-                    usize::try_from(v)
-                        .ok()
-                        .filter(|d| *d <= MAX_DELAY)
-                        .ok_or(Error::Condition {
-                            condition: "0 ≤ delay ≤ 64",
-                            lhs: "delay",
-                            index: None,
-                            value: v as f64,
-                        })?
-            }
-            "jitter" => self.disturb.jitter = real(n, value)?,
-            "friction_viscous" => self.disturb.friction_viscous = joint(n, value)?,
-            "friction_coulomb" => self.disturb.friction_coulomb = joint(n, value)?,
-            "friction_vs" => self.disturb.friction_vs = real(n, value)?,
-            "actuator_fraction" => self.disturb.actuator_fraction = joint(n, value)?,
+            _ if p.group == Group::Sim => return self.set_run(n, value),
             "Ts" => c.ts = real(n, value)?,
             "K1" => c.k1 = joint(n, value)?,
             "Kp" => c.kp = joint(n, value)?,
@@ -671,6 +640,68 @@ impl<const N: usize> Scenario<N> {
         Ok(())
     }
 
+    /// [`set`](Self::set) for a parameter of the run (group "sim").
+    #[cfg(feature = "sim")]
+    fn set_run(&mut self, n: &'static str, value: Value<'_>) -> Result<(), Error> {
+        match n {
+            "T" => self.sim.t_final = real(n, value)?,
+            "substeps" => {
+                let v = int(n, value)?;
+                self.sim.substeps = usize::try_from(v).map_err(|_| Error::Condition {
+                    condition: "1 ≤ substeps ≤ 10 000",
+                    lhs: "substeps",
+                    index: None,
+                    value: v as f64,
+                })?
+            }
+            "q0" => self.sim.q0 = joint(n, value)?,
+            "dq0" => self.sim.dq0 = joint(n, value)?,
+            "settle" => self.sim.settle = real(n, value)?,
+            "payload" => self.disturb.payload = real(n, value)?,
+            "noise_q" => self.disturb.noise_q = joint(n, value)?,
+            "noise_dq" => self.disturb.noise_dq = joint(n, value)?,
+            "noise_tau_e" => self.disturb.noise_tau_e = joint(n, value)?,
+            "seed" => {
+                let v = int(n, value)?;
+                self.disturb.seed = u64::try_from(v).map_err(|_| Error::Condition {
+                    condition: "seed ≥ 0",
+                    lhs: "seed",
+                    index: None,
+                    value: v as f64,
+                })?
+            }
+            "delay" => {
+                let v = int(n, value)?;
+                self.disturb.delay =
+                    usize::try_from(v)
+                        .ok()
+                        .filter(|d| *d <= MAX_DELAY)
+                        .ok_or(Error::Condition {
+                            condition: "0 ≤ delay ≤ 64",
+                            lhs: "delay",
+                            index: None,
+                            value: v as f64,
+                        })?
+            }
+            "jitter" => self.disturb.jitter = real(n, value)?,
+            "friction_viscous" => self.disturb.friction_viscous = joint(n, value)?,
+            "friction_coulomb" => self.disturb.friction_coulomb = joint(n, value)?,
+            "friction_vs" => self.disturb.friction_vs = real(n, value)?,
+            "actuator_fraction" => self.disturb.actuator_fraction = joint(n, value)?,
+            _ => unreachable!("{n} is in PARAMS but has no setter"),
+        }
+        Ok(())
+    }
+
+    /// Without the feature `sim` the run's parameters do not exist.
+    #[cfg(not(feature = "sim"))]
+    fn set_run(&mut self, n: &'static str, _value: Value<'_>) -> Result<(), Error> {
+        Err(Error::Invalid {
+            what: n,
+            reason: "a parameter of the run: needs the feature `sim`",
+        })
+    }
+
     /// Call `f` with every parameter's name and current value. Every field of
     /// every struct is destructured without `..`: a field added without a
     /// schema name is a compile error here.
@@ -716,30 +747,12 @@ impl<const N: usize> Scenario<N> {
                     tau_rate: tau_rate_max,
                 },
         } = &self.config;
-        let SimConfig {
-            t_final,
-            substeps,
-            q0,
-            dq0,
-            settle,
-        } = &self.sim;
-        let DisturbanceParams {
-            payload,
-            noise_q,
-            noise_dq,
-            noise_tau_e,
-            seed,
-            delay,
-            jitter,
-            friction_viscous,
-            friction_coulomb,
-            friction_vs,
-            actuator_fraction,
-        } = &self.disturb;
         let Self {
             config: _,
-            sim: _,
-            disturb: _,
+            #[cfg(feature = "sim")]
+                sim: _,
+            #[cfg(feature = "sim")]
+                disturb: _,
             eta2,
             xc: [xc_offset, xc_sin, xc_cos, xc_omega],
             wall,
@@ -754,23 +767,8 @@ impl<const N: usize> Scenario<N> {
                 },
         } = self;
         let opt = |v: &Option<f64>| v.map_or(Value::None, Value::Real);
-        f("T", R(*t_final));
-        f("substeps", I(*substeps as i64));
-        f("q0", V(q0.as_slice()));
-        f("dq0", V(dq0.as_slice()));
-        f("settle", R(*settle));
-        f("payload", R(*payload));
-        f("noise_q", V(noise_q.as_slice()));
-        f("noise_dq", V(noise_dq.as_slice()));
-        f("noise_tau_e", V(noise_tau_e.as_slice()));
-        // The setter admits 0 ≤ seed ≤ i64::MAX only.
-        f("seed", I(i64::try_from(*seed).unwrap_or(i64::MAX)));
-        f("delay", I(*delay as i64));
-        f("jitter", R(*jitter));
-        f("friction_viscous", V(friction_viscous.as_slice()));
-        f("friction_coulomb", V(friction_coulomb.as_slice()));
-        f("friction_vs", R(*friction_vs));
-        f("actuator_fraction", V(actuator_fraction.as_slice()));
+        #[cfg(feature = "sim")]
+        self.visit_run(&mut f);
         f("Ts", R(*ts));
         f("K1", V(k1.as_slice()));
         f("Kp", V(kp.as_slice()));
@@ -836,6 +834,49 @@ impl<const N: usize> Scenario<N> {
         f("g", R(*g));
     }
 
+    /// [`visit`](Self::visit) for the parameters of the run (group "sim"),
+    /// the first in [`PARAMS`].
+    #[cfg(feature = "sim")]
+    fn visit_run(&self, f: &mut impl FnMut(&'static str, Value<'_>)) {
+        let SimConfig {
+            t_final,
+            substeps,
+            q0,
+            dq0,
+            settle,
+        } = &self.sim;
+        let DisturbanceParams {
+            payload,
+            noise_q,
+            noise_dq,
+            noise_tau_e,
+            seed,
+            delay,
+            jitter,
+            friction_viscous,
+            friction_coulomb,
+            friction_vs,
+            actuator_fraction,
+        } = &self.disturb;
+        f("T", R(*t_final));
+        f("substeps", I(*substeps as i64));
+        f("q0", V(q0.as_slice()));
+        f("dq0", V(dq0.as_slice()));
+        f("settle", R(*settle));
+        f("payload", R(*payload));
+        f("noise_q", V(noise_q.as_slice()));
+        f("noise_dq", V(noise_dq.as_slice()));
+        f("noise_tau_e", V(noise_tau_e.as_slice()));
+        // The setter admits 0 ≤ seed ≤ i64::MAX only.
+        f("seed", I(i64::try_from(*seed).unwrap_or(i64::MAX)));
+        f("delay", I(*delay as i64));
+        f("jitter", R(*jitter));
+        f("friction_viscous", V(friction_viscous.as_slice()));
+        f("friction_coulomb", V(friction_coulomb.as_slice()));
+        f("friction_vs", R(*friction_vs));
+        f("actuator_fraction", V(actuator_fraction.as_slice()));
+    }
+
     /// The commanded sinusoid (validated: finite).
     pub fn trajectory(&self) -> Result<Sinusoid<N>, Error> {
         let [o, a, b, w] = self.xc;
@@ -849,12 +890,14 @@ impl<const N: usize> Scenario<N> {
 
     /// The disturbances of the run (validated; SPEC §17), the actuator
     /// fraction taken of the controller's `tau_max`. For
-    /// [`run_disturbed`](crate::simulator::run_disturbed).
+    /// [`run_disturbed`](crate::sim::simulator::run_disturbed).
+    #[cfg(feature = "sim")]
     pub fn disturbances(&self) -> Result<Disturbances<N>, Error> {
         Disturbances::new(self.disturb, self.config.tau_max)
     }
 }
 
+#[cfg(feature = "sim")]
 impl Scenario<2> {
     /// The plant's 2-link arm (validated; SPEC §1): the arm parameters m1,
     /// m2, l1, l2, lc1, lc2, I1, I2 and g, the derived ones filled in. Only
@@ -879,6 +922,7 @@ fn real(name: &'static str, v: Value<'_>) -> Result<f64, Error> {
     }
 }
 
+#[cfg(feature = "sim")]
 fn int(name: &'static str, v: Value<'_>) -> Result<i64, Error> {
     match v {
         Value::Int(i) => Ok(i),
@@ -985,6 +1029,7 @@ impl Config<2> {
     }
 }
 
+#[cfg(feature = "sim")]
 impl SimConfig<2> {
     /// The paper scenario: T = 20 s, M = 1, q(0) = [0.25, −0.05], q̇(0) = 0 (SPEC §11, (65)).
     pub fn paper() -> Self {
@@ -1007,6 +1052,7 @@ impl Sinusoid<2> {
     }
 }
 
+#[cfg(feature = "sim")]
 impl Wall<2> {
     /// SPEC §3 defaults: joint 1 (index 0), w = 0.2 rad, ke = 1000 N m/rad, be = 10 N m s/rad.
     pub fn paper() -> Self {
@@ -1018,6 +1064,7 @@ impl Wall<2> {
     }
 }
 
+#[cfg(feature = "sim")]
 impl Default for ArmParams {
     /// SPEC §1 defaults: m = [2.00, 0.85] kg, l = [0.35, 0.31] m, lc = l/2,
     /// I = m l²/4, g = 9.81 m/s².

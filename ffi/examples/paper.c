@@ -1,7 +1,7 @@
 /* The paper scenario (SPEC §11) from C: adaptimp's controllers through the C
  * ABI, closing the loop with the paper's 2-link arm and wall written here in
- * C (RK4, the arithmetic of src/model.rs, src/environment.rs and
- * src/plant.rs, so the trajectories are those of `cargo run --example
+ * C (RK4, the arithmetic of src/sim/model.rs, src/sim/environment.rs and
+ * src/sim/plant.rs, so the trajectories are those of `cargo run --example
  * paper`). Prints the same SPEC §12 metrics table.
  *
  *   paper [--T seconds]   the three cases (default T = 20 s)
@@ -131,7 +131,7 @@ static int check(AdaptimpStatus status, const char *what) {
     return 1;
 }
 
-/* ---- SPEC §12 metrics, accumulated as src/metrics.rs does. ---- */
+/* ---- SPEC §12 metrics, accumulated as src/sim/metrics.rs does. ---- */
 
 typedef struct {
     size_t rows, rows_after, sat_rows, contact_rows;

@@ -1,6 +1,6 @@
 """Cartesian impedance in Python: the outer admittance loop of SPEC §16 (C1–C5).
 
-The Rust core has the outer loop (``src/cartesian.rs``) for its own kinematics
+The Rust core has the outer loop (``src/cartesian/outer.rs``) for its own kinematics
 (planar arms); this module is the same loop in NumPy for kinematics given as
 callables, so that a real arm (the Panda, through Pinocchio) can run it with
 MuJoCo as the plant:

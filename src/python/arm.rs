@@ -2,9 +2,9 @@
 //! face of [`Manipulator<N>`] over slices, for the paper's [`TwoLinkArm`] and
 //! [`PlanarArm<N>`] with N = 1 … 7.
 
+use crate::cartesian::kinematics::Kinematics;
 use crate::error::Error;
-use crate::kinematics::Kinematics;
-use crate::model::{Link, Manipulator, PlanarArm, TwoLinkArm};
+use crate::sim::model::{Link, Manipulator, PlanarArm, TwoLinkArm};
 use crate::types::Vector;
 use std::vec::Vec;
 

@@ -7,21 +7,21 @@
 //! Nothing here knows Python: the bindings (`mod.rs`) convert arrays to
 //! slices and errors to exceptions.
 
-use crate::config::Law;
-use crate::controller::Controller;
-use crate::disturb::{Disturbances, TipPayload, WithFriction};
-use crate::environment::{FreeSpace, Wall};
+use crate::control::config::Law;
+use crate::control::controller::Controller;
+use crate::control::io::{Command, Measurement};
+use crate::control::tracker::Tracker;
 use crate::error::Error;
-use crate::io::{Command, Measurement};
-use crate::metrics::MetricsAccumulator;
-use crate::model::{Link, PlanarArm, TwoLinkArm};
-use crate::network::{Weights, C, D, G};
-use crate::plant::{Plant, RigidBody};
-use crate::rbf::{AnyBasis, Basis, Centers};
-use crate::record::{Recorder, Row};
+use crate::networks::network::{Weights, C, D, G};
+use crate::networks::rbf::{AnyBasis, Basis, Centers};
 use crate::schema::{Preset, Scenario, Value};
-use crate::simulator::simulate_disturbed;
-use crate::tracker::Tracker;
+use crate::sim::disturb::{Disturbances, TipPayload, WithFriction};
+use crate::sim::environment::{FreeSpace, Wall};
+use crate::sim::metrics::MetricsAccumulator;
+use crate::sim::model::{Link, PlanarArm, TwoLinkArm};
+use crate::sim::plant::{Plant, RigidBody};
+use crate::sim::record::{Recorder, Row};
+use crate::sim::simulator::simulate_disturbed;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 use std::any::Any;
@@ -283,7 +283,7 @@ pub trait DynTracker: Send + Sync {
     fn weights(&self) -> Vec<f64>;
     /// Replace the weights (same layout as [`weights`](Self::weights)).
     fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error>;
-    /// The whole state as reals ([`State::save`](crate::state::State::save)).
+    /// The whole state as reals ([`State::save`](crate::control::state::State::save)).
     fn snapshot(&self) -> Vec<f64>;
     /// Restore a [`snapshot`](Self::snapshot).
     fn restore(&mut self, data: &[f64]) -> Result<(), Error>;
@@ -400,7 +400,7 @@ fn setpoint<const N: usize>(s: [&[f64]; 3]) -> Setpoint<N> {
     }
 }
 
-fn metrics_out<const N: usize>(m: &crate::metrics::Metrics<N>) -> MetricsOut {
+fn metrics_out<const N: usize>(m: &crate::sim::metrics::Metrics<N>) -> MetricsOut {
     let v = |x: &Vector<N>| x.as_slice().to_vec();
     MetricsOut {
         scalars: Vec::from([
@@ -464,7 +464,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     let cfg = &s.sim;
     crate::error::check::finite("settle", cfg.settle)?;
     let ts = t.controller().period();
-    let total = crate::simulator::steps(cfg.t_final, ts)?;
+    let total = crate::sim::simulator::steps(cfg.t_final, ts)?;
     let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
     let mut rec = Records::with_rows(N, kept, every).ok_or(RunError::Memory(kept))?;
     let mut metrics = MetricsAccumulator::new(cfg.settle, *t.controller().impedance());
@@ -556,7 +556,7 @@ impl<const N: usize> DynTracker for Typed<N> {
             Some(s) => setpoint(s),
             None => self.trajectory().sample(Tracker::time(self)),
         };
-        let (tau, result) = crate::io::Control::step_or_fallback(self, &meas, &c);
+        let (tau, result) = crate::control::io::Control::step_or_fallback(self, &meas, &c);
         out.copy_from_slice(tau.as_slice());
         result.map(|_| ())
     }

@@ -26,10 +26,10 @@
 mod arm;
 mod dynamic;
 
-use crate::config::Law;
+use crate::control::config::Law;
 use crate::error::Error;
-use crate::model::{Link, TwoLinkArm};
 use crate::schema::{Kind, Preset, Scenario, Value, PARAMS};
+use crate::sim::model::{Link, TwoLinkArm};
 use arm::DynArm;
 use dynamic::{
     ArmSpec, CentersSpec, DynTracker, Hooks, Inputs, Last, Owned, ParamError, RunError, Tables,

@@ -3,9 +3,9 @@
 //! rigid-body arm against an environment integrated by classical RK4 (SPEC §11).
 //! A physics engine that advances itself implements the same trait.
 
-use crate::environment::Environment;
 use crate::error::{check, Error};
-use crate::model::Manipulator;
+use crate::sim::environment::Environment;
+use crate::sim::model::Manipulator;
 use crate::types::Vector;
 
 /// A plant with `N` actuated joints.

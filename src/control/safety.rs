@@ -20,8 +20,8 @@
 //!   difference shows in Δτ = sat(τ) − τ, so the auxiliary system and the
 //!   learning see it as they see saturation.
 
+use crate::control::io::Measurement;
 use crate::error::{check, Error};
-use crate::io::Measurement;
 use crate::types::{choices, Vector};
 
 /// The torque to apply when a step fails.

@@ -12,8 +12,8 @@
 
 use crate::error::{check, Error, BOUND};
 use crate::math::sqrt;
-use crate::network::{Rates, WeightsMut, C, D, G};
-use crate::simd::SimdPath;
+use crate::networks::network::{Rates, WeightsMut, C, D, G};
+use crate::networks::simd::SimdPath;
 use crate::types::{choices, Vector};
 
 /// How the weights take one learning step (beyond the paper, SPEC §13).
@@ -185,7 +185,7 @@ impl Learning {
             LearningStep::Euler => self.rates,
             LearningStep::Normalized => {
                 let g = self.rates.gain;
-                let s2 = crate::network::dot_on(path, s, s);
+                let s2 = crate::networks::network::dot_on(path, s, s);
                 let gain = s2
                     * (g[D] * sig.dalpha1.norm_squared() + g[C] * sig.alpha1.norm_squared() + g[G]);
                 self.rates.scaled(1.0 / (1.0 + gain / self.gain_cap))

@@ -1,8 +1,8 @@
 //! What goes into a controller step and what comes out (ruckig's input /
 //! output), and the [`Control`] trait a closed loop drives.
 
+use crate::control::impedance::TargetImpedance;
 use crate::error::Error;
-use crate::impedance::TargetImpedance;
 use crate::trajectory::Setpoint;
 use crate::types::Vector;
 

@@ -28,7 +28,7 @@
 
 use crate::error::{check, Error};
 use crate::math::sqrt;
-use crate::simd::SimdPath;
+use crate::networks::simd::SimdPath;
 use crate::types::Vector;
 use pulp::{Simd, WithSimd};
 
@@ -233,7 +233,7 @@ fn for_groups<'w, 's, S: Simd>(
 /// One row: returns `Ŵ·S` of the old row, and writes `Ŵ ← a Ŵ + b S`.
 ///
 /// Explicit vectors of pulp's [`Simd`] (4 lanes on both paths, see
-/// [`crate::simd`]) rather than arrays left to the autovectoriser, which
+/// [`crate::networks::simd`]) rather than arrays left to the autovectoriser, which
 /// vectorised the ten inlined copies of this loop unevenly (some at half
 /// width). Each group of two vectors feeds two independent accumulators.
 /// Products and sums stay separate (never fused into an FMA), so the results

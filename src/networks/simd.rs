@@ -25,7 +25,7 @@
 //! whether the environment saves the 256-bit registers. On other
 //! architectures the pass is portable.
 
-use crate::rbf::Basis;
+use crate::networks::rbf::Basis;
 use crate::types::Vector;
 use pulp::{Scalar256b, Simd, WithSimd};
 

@@ -14,19 +14,19 @@
 //! velocity source, basis, networks, robust term, saturation, learning,
 //! advance.
 
-use crate::auxiliary::Auxiliary;
-use crate::config::{Config, Law, ObserverInit, WeightBound};
+use crate::control::auxiliary::Auxiliary;
+use crate::control::config::{Config, Law, ObserverInit, WeightBound};
+use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
+use crate::control::io::{Command, Control, Measurement};
+use crate::control::observer::{HighGainObserver, ObserverState};
+use crate::control::robust::Robust;
+use crate::control::safety::{Fallback, Fault, FaultPolicy};
+use crate::control::saturation::Saturation;
+use crate::control::state::State;
 use crate::error::{check, Error, BOUND, PARAM_BOUND};
-use crate::impedance::{ImpedanceMode, Reference, TargetImpedance};
-use crate::io::{Command, Control, Measurement};
-use crate::learning::{Learning, Signals};
-use crate::observer::{HighGainObserver, ObserverState};
-use crate::rbf::{Basis, Grid};
-use crate::robust::Robust;
-use crate::safety::{Fallback, Fault, FaultPolicy};
-use crate::saturation::Saturation;
-use crate::simd::SimdPath;
-use crate::state::State;
+use crate::networks::learning::{Learning, Signals};
+use crate::networks::rbf::{Basis, Grid};
+use crate::networks::simd::SimdPath;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 
@@ -286,7 +286,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
 
     /// The length (in f64) of the buffer a state of this controller needs.
     pub fn buffer_len(&self) -> usize {
-        crate::network::Layout::buffer_len(N, self.basis.nodes()).unwrap_or(usize::MAX)
+        crate::networks::network::Layout::buffer_len(N, self.basis.nodes()).unwrap_or(usize::MAX)
     }
 
     /// A state at t = 0 in the caller's buffer `buf` (at least
@@ -299,7 +299,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// A state at t = 0 on the heap (its buffer allocated zeroed, never built
     /// on the stack).
     #[cfg(feature = "alloc")]
-    pub fn new_state(&self) -> crate::state::HeapState<N> {
+    pub fn new_state(&self) -> crate::control::state::HeapState<N> {
         // The buffer is allocated zeroed; `new_in` only fails if it is short.
         State::new_in(self.basis.nodes(), alloc::vec![0.0; self.buffer_len()])
             .unwrap_or_else(|e| unreachable!("the buffer has buffer_len(): {e}"))
@@ -671,8 +671,8 @@ impl<const N: usize, B: Basis<N>, S: AsRef<[f64]> + AsMut<[f64]>> Control<N>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::learning::{LearningStep, SaturationLearning};
-    use crate::state::HeapState;
+    use crate::control::state::HeapState;
+    use crate::networks::learning::{LearningStep, SaturationLearning};
 
     fn measurement() -> Measurement<2> {
         Measurement {
@@ -703,9 +703,10 @@ mod tests {
             &m,
             &m.dx.unwrap(),
         );
-        let old = crate::network::Weights::<2>::from_rows(&before, 256).unwrap();
-        let out =
-            |w: &crate::network::Weights<'_, 2>| w.output(c.simd(), &s, &e.dalpha1, &e.alpha1);
+        let old = crate::networks::network::Weights::<2>::from_rows(&before, 256).unwrap();
+        let out = |w: &crate::networks::network::Weights<'_, 2>| {
+            w.output(c.simd(), &s, &e.dalpha1, &e.alpha1)
+        };
         let delta = out(&st.weights()) - out(&old);
         delta.component_div(&cmd.z2)
     }
@@ -759,7 +760,7 @@ mod tests {
         let mut st = c.new_state();
         let mut w = vec![0.0; 10 * 256];
         w[8 * 256..].fill(0.01); // ŴG
-        st.load_weights(&crate::network::Weights::from_rows(&w, 256).unwrap())
+        st.load_weights(&crate::networks::network::Weights::from_rows(&w, 256).unwrap())
             .unwrap();
         let m = measurement();
         let sp = setpoint(&c, &st);
@@ -833,7 +834,7 @@ mod tests {
         // A state of another basis is refused, and left as it was.
         let small = Controller::new(
             Config::new(Law::StateFeedback, Vector::<2>::new(1.0, 1.0)),
-            crate::rbf::Centers::uniform(vec![0.0; 8], 1.0).unwrap(),
+            crate::networks::rbf::Centers::uniform(vec![0.0; 8], 1.0).unwrap(),
         )
         .unwrap();
         let sp = setpoint(&c, &a);
@@ -884,7 +885,7 @@ mod tests {
         // Joint: the reference yields to τe; external: xd = xc whatever τe.
         let mut cfg = Config::paper(Law::StateFeedback);
         let joint = Controller::new(cfg, Grid::paper()).unwrap();
-        cfg.impedance = crate::impedance::ImpedanceMode::External;
+        cfg.impedance = crate::control::impedance::ImpedanceMode::External;
         let external = Controller::new(cfg, Grid::paper()).unwrap();
         let m = Measurement {
             tau_e: Vector::<2>::new(30.0, -5.0),

@@ -10,12 +10,12 @@
 //! (`Controller::state_in`). Either way it is
 //! zeroed in place: no large value is ever built on the stack.
 
+use crate::control::impedance::Reference;
+use crate::control::io::Command;
+use crate::control::observer::ObserverState;
+use crate::control::safety::Fault;
 use crate::error::Error;
-use crate::impedance::Reference;
-use crate::io::Command;
-use crate::network::{Layout, Weights, WeightsMut};
-use crate::observer::ObserverState;
-use crate::safety::Fault;
+use crate::networks::network::{Layout, Weights, WeightsMut};
 use crate::types::Vector;
 
 /// The state of one controller run. See the [module docs](self).
@@ -207,7 +207,11 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
         w.put(&c.w_norms);
         w.put(self.basis());
         let weights = self.weights();
-        for net in [crate::network::D, crate::network::C, crate::network::G] {
+        for net in [
+            crate::networks::network::D,
+            crate::networks::network::C,
+            crate::networks::network::G,
+        ] {
             for row in weights.network(net) {
                 w.put(row);
             }

@@ -31,7 +31,7 @@
 
 use crate::error::{check, Error, PARAM_BOUND};
 use crate::math::tanh;
-use crate::model::{ArmParams, Link, Manipulator, PlanarArm, TwoLinkArm};
+use crate::sim::model::{ArmParams, Link, Manipulator, PlanarArm, TwoLinkArm};
 use crate::types::{Matrix, Vector};
 use rand_distr::{Distribution, StandardNormal, StandardUniform};
 use rand_xoshiro::rand_core::SeedableRng;

@@ -3,12 +3,12 @@
 //! `Controller::new`; the parameter schema
 //! (`src/schema.rs`, re-exported as `adaptimp::schema`) documents each field.
 
-use crate::auxiliary::AuxLaw;
-use crate::impedance::ImpedanceMode;
-use crate::learning::{LearningStep, SaturationLearning};
-use crate::observer::Hold;
-use crate::robust::RobustKind;
-use crate::safety::{Fallback, FaultPolicy, Limits};
+use crate::control::auxiliary::AuxLaw;
+use crate::control::impedance::ImpedanceMode;
+use crate::control::observer::Hold;
+use crate::control::robust::RobustKind;
+use crate::control::safety::{Fallback, FaultPolicy, Limits};
+use crate::networks::learning::{LearningStep, SaturationLearning};
 use crate::types::{choices, Vector};
 
 /// Which of the paper's controllers, SPEC §7.
@@ -54,7 +54,7 @@ pub enum WeightBound {
     /// The bounds b for D̂ (kg m²), Ĉ (kg m²/s), Ĝ (N m).
     Fixed([f64; 3]),
     /// Derived from τmax, the number of nodes and the commanded trajectory's
-    /// peak speed and acceleration by [`network::weight_bounds`](crate::network::weight_bounds)
+    /// peak speed and acceleration by [`network::weight_bounds`](crate::networks::network::weight_bounds)
     /// ("auto"): no network can then produce more than the actuator's torque
     /// at the commanded regressor scale. Resolved when the trajectory is known
     /// ([`Config::resolve`]); ≈ [0.718, 2.255, 1.417] for the paper.
@@ -181,7 +181,7 @@ impl<const N: usize> Config<N> {
     /// (rad/s, rad/s²; see `Trajectory::peak_rates`).
     pub fn resolve(mut self, nodes: usize, rates: (f64, f64)) -> Self {
         if self.weight_bound == WeightBound::Auto {
-            self.weight_bound = WeightBound::Fixed(crate::network::weight_bounds(
+            self.weight_bound = WeightBound::Fixed(crate::networks::network::weight_bounds(
                 &self.tau_max,
                 nodes,
                 rates.0,

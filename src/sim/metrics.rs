@@ -1,9 +1,9 @@
 //! The figures of SPEC §12, accumulated row by row without allocation: a
 //! [`Recorder`].
 
-use crate::impedance::TargetImpedance;
+use crate::control::impedance::TargetImpedance;
 use crate::math::sqrt;
-use crate::record::{Recorder, Row};
+use crate::sim::record::{Recorder, Row};
 use crate::trajectory::Setpoint;
 use crate::types::Vector;
 

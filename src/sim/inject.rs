@@ -126,7 +126,7 @@ pub struct FaultReport {
 #[cfg(feature = "alloc")]
 impl FaultReport {
     /// Record `row` (with the actuators' limits `tau_max`, N m).
-    pub fn push<const N: usize>(&mut self, row: &crate::record::Row<N>, tau_max: &Vector<N>) {
+    pub fn push<const N: usize>(&mut self, row: &crate::sim::record::Row<N>, tau_max: &Vector<N>) {
         let z = row.z1.norm_squared();
         let last = self.cumulative.last().copied().unwrap_or(0.0);
         self.t.push(row.t);

@@ -4,8 +4,8 @@
 //! environment; the environment pushes back with −τe, (4). A force sensor
 //! measures it and the controller reads it.
 
+use crate::cartesian::kinematics::Kinematics;
 use crate::error::{check, Error, PARAM_BOUND};
-use crate::kinematics::Kinematics;
 use crate::types::Vector;
 
 /// A contact model: τe as a function of time and the robot's state.

@@ -4,15 +4,15 @@
 //! step with the trajectory's setpoint at t_k, the plant advanced to t_{k+1}
 //! with the applied torque held, and the row recorded.
 
-use crate::disturb::{Disturbances, TipPayload, WithFriction};
-use crate::environment::Environment;
+use crate::control::io::{Command, Control, Measurement};
 use crate::error::{check, Error};
-use crate::inject::Injection;
-use crate::io::{Command, Control, Measurement};
-use crate::metrics::{Metrics, MetricsAccumulator};
-use crate::model::Manipulator;
-use crate::plant::{Plant, RigidBody};
-use crate::record::{Recorder, Row};
+use crate::sim::disturb::{Disturbances, TipPayload, WithFriction};
+use crate::sim::environment::Environment;
+use crate::sim::inject::Injection;
+use crate::sim::metrics::{Metrics, MetricsAccumulator};
+use crate::sim::model::Manipulator;
+use crate::sim::plant::{Plant, RigidBody};
+use crate::sim::record::{Recorder, Row};
 use crate::trajectory::Trajectory;
 use crate::types::Vector;
 
@@ -262,7 +262,7 @@ where
 
 /// [`run`] with a fault injected (feature `alloc`): the rigid-body scenario of
 /// `cfg`, `injection` acting in its window, and the figures of
-/// [`FaultFigures`](crate::inject::FaultFigures) for actuator limits `tau_max` (N m).
+/// [`FaultFigures`](crate::sim::inject::FaultFigures) for actuator limits `tau_max` (N m).
 #[cfg(feature = "alloc")]
 pub fn run_with_injection<const N: usize, M, E, C, T>(
     arm: &M,
@@ -272,14 +272,14 @@ pub fn run_with_injection<const N: usize, M, E, C, T>(
     cfg: &SimConfig<N>,
     injection: &Injection<N>,
     tau_max: &Vector<N>,
-) -> Result<crate::inject::FaultFigures, Error>
+) -> Result<crate::sim::inject::FaultFigures, Error>
 where
     M: Manipulator<N> + Clone,
     E: Environment<N> + Clone,
     C: Control<N> + ?Sized,
     T: Trajectory<N> + ?Sized,
 {
-    struct Report<'a, const N: usize>(crate::inject::FaultReport, &'a Vector<N>);
+    struct Report<'a, const N: usize>(crate::sim::inject::FaultReport, &'a Vector<N>);
     impl<const N: usize> Recorder<N> for Report<'_, N> {
         fn record(&mut self, row: &Row<N>) {
             self.0.push(row, self.1);
@@ -287,7 +287,7 @@ where
     }
     let mut plant = RigidBody::new(arm.clone(), env.clone(), cfg.q0, cfg.dq0, cfg.substeps)?;
     let ts = ctrl.period();
-    let mut report = Report(crate::inject::FaultReport::default(), tau_max);
+    let mut report = Report(crate::sim::inject::FaultReport::default(), tau_max);
     simulate_with(
         &mut plant,
         ctrl,

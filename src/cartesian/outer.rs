@@ -24,13 +24,13 @@
 //! its step takes both states, transactionally: if the joint step refuses a
 //! measurement, the outer state is left as it was too.
 
-use crate::controller::Controller;
+use crate::cartesian::kinematics::Kinematics;
+use crate::control::controller::Controller;
+use crate::control::impedance::ImpedanceMode;
+use crate::control::io::{Command, Measurement};
+use crate::control::state::State;
 use crate::error::{check, Error, BOUND, PARAM_BOUND};
-use crate::impedance::ImpedanceMode;
-use crate::io::{Command, Measurement};
-use crate::kinematics::Kinematics;
-use crate::rbf::Basis;
-use crate::state::State;
+use crate::networks::rbf::Basis;
 use crate::trajectory::Setpoint;
 use crate::types::{Jacobian, Vector};
 
@@ -397,9 +397,9 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{Config, Law};
-    use crate::model::TwoLinkArm;
-    use crate::rbf::Grid;
+    use crate::control::config::{Config, Law};
+    use crate::networks::rbf::Grid;
+    use crate::sim::model::TwoLinkArm;
 
     fn outer() -> CartesianImpedance<2, TwoLinkArm> {
         let q0 = Vector::<2>::new(0.5, 1.0);

@@ -1,14 +1,14 @@
 //! The convenience of one controller that tracks its own trajectory: a
-//! [`Controller`], a [`Trajectory`] and a heap [`State`](crate::state::State) in one value, with
+//! [`Controller`], a [`Trajectory`] and a heap [`State`](crate::control::state::State) in one value, with
 //! the clock t_k = k·Ts (feature `alloc`).
 
-use crate::config::Law;
-use crate::controller::Controller;
+use crate::control::config::Law;
+use crate::control::controller::Controller;
+use crate::control::impedance::TargetImpedance;
+use crate::control::io::{Command, Control, Measurement};
+use crate::control::state::HeapState;
 use crate::error::Error;
-use crate::impedance::TargetImpedance;
-use crate::io::{Command, Control, Measurement};
-use crate::rbf::{Basis, Grid};
-use crate::state::HeapState;
+use crate::networks::rbf::{Basis, Grid};
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 
 /// A controller with its trajectory and its state: `step(&measurement)` samples

@@ -12,7 +12,7 @@ use adaptimp::network::weight_bounds;
 use adaptimp::{
     rk4_step, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
     CartesianWall, Centers, Config, Controller, Environment, Error, ImpedanceMode, Kinematics, Law,
-    Link, Manipulator, PlanarArm, Setpoint, Vector, WeightBound,
+    Link, Manipulator, PlanarArm, PoseTarget, Setpoint, Vector, WeightBound,
 };
 use std::f64::consts::PI;
 
@@ -29,23 +29,24 @@ fn arm() -> Result<PlanarArm<N>, Error> {
     PlanarArm::new([link(2.0, 0.4), link(1.5, 0.35), link(1.0, 0.25)], 9.81)
 }
 
-/// The outer loop (SPEC §16 defaults) and the hardened adaptive joint
-/// controller with centres along the joint path of the circle.
+/// The outer loop (SPEC §16 defaults, position-only: a planar arm's
+/// orientation is no task) and the hardened adaptive joint controller with
+/// centres along the joint path of the circle (SPEC §15's orbit rule).
 fn controller(
     arm: PlanarArm<N>,
     q0: Vector<N>,
     circle: &dyn Fn(f64) -> Setpoint<3>,
 ) -> Result<CartesianController<N, PlanarArm<N>, Centers<N, Vec<f64>>>, Error> {
-    let outer = CartesianImpedance::new(CartesianConfig::new(TS, q0), arm)?;
-    let mut st = outer.start(q0);
-    let mut samples = Vec::new();
-    for k in 0..4000 {
-        let sp = outer.step(&mut st, &circle(k as f64 * TS), &Vector::zeros())?;
-        if k % 125 == 0 {
-            samples.push(sp);
-        }
-    }
-    let basis = Centers::along(&samples, [0.2, 0.5])?;
+    let outer = CartesianImpedance::new(CartesianConfig::default().position_only(), arm, TS)?;
+    let zero = Setpoint {
+        x: Vector::<N>::zeros(),
+        dx: Vector::zeros(),
+        ddx: Vector::zeros(),
+    };
+    let mut samples = vec![zero; 32];
+    let path = |k: usize| PoseTarget::from_position(&circle(k as f64 * TS));
+    let written = outer.orbit(q0, 4000, path, &mut samples)?;
+    let basis = Centers::along(&samples[..written], [0.2, 0.5])?;
     let tau_max = Vector::<N>::new(60.0, 30.0, 15.0);
     let mut cfg = Config::<N>::new(Law::StateFeedback, tau_max).hardened();
     cfg.ts = TS;
@@ -91,12 +92,14 @@ fn simulate(
         let t = k as f64 * TS;
         let f_e = wall.wrench(&q, &dq);
         let c = traj(t);
+        let mut wrench = Vector::<6>::zeros();
+        wrench.fixed_rows_mut::<3>(0).copy_from(&f_e);
         let m = CartesianMeasurement {
             q,
             dq: Some(dq),
-            f_e,
+            wrench,
         };
-        let cmd = ctrl.step(&mut ost, &mut ist, &m, &c)?;
+        let cmd = ctrl.step(&mut ost, &mut ist, &m, Some(&PoseTarget::from_position(&c)))?;
         if t >= 4.0 {
             sum += (cmd.p - c.x).norm_squared();
             rows += 1;
@@ -176,7 +179,7 @@ fn main() -> Result<(), Error> {
     println!("  contact force F_e·n            = {:.3} N", n.dot(&f));
     println!(
         "  target impedance K_d (p_c − p_d) = {:.3} N",
-        kd * n.dot(&(c.x - cmd.pd))
+        kd * n.dot(&(c.x - cmd.compliant.p))
     );
     println!(
         "  K_d ke/(K_d + ke) · depth        = {:.3} N (stiff-wall limit K_d · depth = {:.1} N)",
@@ -185,7 +188,7 @@ fn main() -> Result<(), Error> {
     );
     println!(
         "  tracking n·(p − p_d)             = {:.3} mm; peak |τ| = {peak:.1} N m",
-        n.dot(&(cmd.p - cmd.pd)) * 1e3
+        n.dot(&(cmd.p - cmd.compliant.p)) * 1e3
     );
     Ok(())
 }

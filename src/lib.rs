@@ -23,7 +23,7 @@
 //! | [`types`], [`error`], [`trajectory`] | leaves: `Vector`/`Matrix` aliases, validation errors, the commanded trajectory xc | §10, (64), §4 |
 //! | [`control`] | the controller: [`config`], [`controller`] (PD, state and output feedback: the staged step), [`state`], [`io`], [`impedance`] (target-impedance reference xd), [`auxiliary`] (saturation compensator ζ), [`observer`] (high-gain observer), [`robust`], [`saturation`], [`safety`] (fallback, faults, limits), [`tracker`] | (3), (11), (14), (31)–(36), §4–§11, §14 |
 //! | [`networks`] | learning: [`rbf`] (bases S(Z): the grid, user centres, lattices, orbits), [`network`] (ŴD, ŴC, ŴG), [`learning`] (Euler, normalised, freeze, projection), [`simd`] | (1), (15)–(17), §6, §13, §15 |
-//! | [`cartesian`] | task space: [`kinematics`], the Cartesian impedance outer loop and its pair with a joint controller | (3), §16 |
+//! | [`cartesian`] | task space: [`kinematics`] (pose, 6 × N Jacobian, J̇ q̇), serial [`chain`](cartesian::chain)s from joint data, the [`rotation`](cartesian::rotation) error, the 6-D Cartesian impedance outer loop and its pair with a joint controller | (3), §16 |
 //! | [`schema`] | the parameter table: names, units, docs, conditions, defaults | §10 |
 //! | `sim` (feature `sim`) | simulation only: `model` (D, C, G of the paper's and planar arms), `environment` (walls), `plant` (the `Plant` trait, RK4), `simulator` (the closed loop), `record`, `metrics`, `disturb`, `inject` | (4), (55)–(63), §1–§3, §11, §12, §17 |
 //!
@@ -100,7 +100,8 @@ pub use sim::{disturb, environment, inject, metrics, model, plant, record, simul
 pub use auxiliary::AuxLaw;
 pub use cartesian::{
     CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
-    CartesianMeasurement, CartesianState, OuterStep,
+    CartesianMeasurement, CartesianState, Chain, CompliantPose, Joint, JointKind, OuterStep,
+    PoseTarget, Transform,
 };
 pub use config::{Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};
@@ -113,7 +114,7 @@ pub use impedance::{ImpedanceMode, Reference, TargetImpedance};
 #[cfg(feature = "sim")]
 pub use inject::{Injected, Injection};
 pub use io::{Command, Control, Measurement};
-pub use kinematics::Kinematics;
+pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use learning::{Learning, LearningStep, SaturationLearning};
 #[cfg(feature = "sim")]
 pub use metrics::{Metrics, MetricsAccumulator};

@@ -25,6 +25,10 @@ mod imp {
     pub fn sqrt(x: f64) -> f64 {
         x.sqrt()
     }
+    #[inline(always)]
+    pub fn atan2(y: f64, x: f64) -> f64 {
+        y.atan2(x)
+    }
 }
 
 #[cfg(not(feature = "std"))]
@@ -48,6 +52,10 @@ mod imp {
     #[inline(always)]
     pub fn sqrt(x: f64) -> f64 {
         libm::sqrt(x)
+    }
+    #[inline(always)]
+    pub fn atan2(y: f64, x: f64) -> f64 {
+        libm::atan2(y, x)
     }
 }
 

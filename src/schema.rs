@@ -12,6 +12,7 @@
 //! a field added without a schema name does not compile, and a test checks
 //! that the names it visits are exactly those of [`PARAMS`].
 
+use crate::cartesian::CartesianConfig;
 use crate::control::auxiliary::AuxLaw;
 use crate::control::config::{Config, Law, ObserverInit, WeightBound};
 use crate::control::impedance::ImpedanceMode;
@@ -43,16 +44,19 @@ pub enum Group {
     Env,
     /// The paper's 2-link arm (the plant).
     Arm,
+    /// The 6-D Cartesian impedance (SPEC §16).
+    Cartesian,
 }
 
 impl Group {
-    /// The group's name in Python ("sim", "controller", "env", "arm").
+    /// The group's name in Python ("sim", "controller", "env", "arm", "cartesian").
     pub fn name(self) -> &'static str {
         match self {
             Group::Sim => "sim",
             Group::Controller => "controller",
             Group::Env => "env",
             Group::Arm => "arm",
+            Group::Cartesian => "cartesian",
         }
     }
 }
@@ -78,11 +82,18 @@ pub enum Kind {
     Bound,
     /// None (no limit), or a number > 0 per joint (a scalar is broadcast).
     Limit,
+    /// One number per task axis x, y, z (a scalar is broadcast).
+    Axes,
+    /// One number per task axis, or none for the value derived from other parameters.
+    DerivedAxes,
+    /// True or false.
+    Flag,
 }
 
 impl Kind {
     /// The kind's name in Python ("real", "int", "joint", "network",
-    /// "choice", "optional", "derived", "bound").
+    /// "choice", "optional", "derived", "bound", "limit", "axes",
+    /// "derived_axes", "flag").
     pub fn name(self) -> &'static str {
         match self {
             Kind::Real => "real",
@@ -94,6 +105,9 @@ impl Kind {
             Kind::Derived => "derived",
             Kind::Bound => "bound",
             Kind::Limit => "limit",
+            Kind::Axes => "axes",
+            Kind::DerivedAxes => "derived_axes",
+            Kind::Flag => "flag",
         }
     }
 }
@@ -110,6 +124,8 @@ pub enum Value<'a> {
     Vec(&'a [f64]),
     /// A choice's name, or "auto".
     Str(&'a str),
+    /// A flag.
+    Bool(bool),
     /// No value (free space, a derived default, no bound).
     None,
 }
@@ -202,9 +218,9 @@ const fn robot(param: Param, value: Value<'static>) -> Param {
     }
 }
 
-use Group::{Arm, Controller as Ctrl, Env, Sim};
-use Kind::{Bound, Derived, Int, Joint, Limit, Network, Optional, Real};
-use Value::{Int as I, None as Nil, Real as R, Str as S, Vec as V};
+use Group::{Arm, Cartesian as Cart, Controller as Ctrl, Env, Sim};
+use Kind::{Axes, Bound, Derived, DerivedAxes, Flag, Int, Joint, Limit, Network, Optional, Real};
+use Value::{Bool as B, Int as I, None as Nil, Real as R, Str as S, Vec as V};
 
 const PI: f64 = core::f64::consts::PI;
 
@@ -441,6 +457,65 @@ pub const PARAMS: &[Param] = &[
     p("I1", Arm, Derived, "kg m²", "inertia of link 1 about its centre (None: m1 l1²/4)", "I1 ≥ 0", Nil),
     p("I2", Arm, Derived, "kg m²", "inertia of link 2 about its centre (None: m2 l2²/4)", "I2 ≥ 0", Nil),
     p("g", Arm, Real, "m/s²", "gravitational acceleration (vertical plane)", "", R(9.81)),
+    // The 6-D Cartesian impedance, SPEC §16 (src/cartesian/outer.rs): world-frame
+    // axes; the translation at ω = √(K/M) = 15.8 rad/s, the rotation at the same.
+    p("Md", Cart, Axes, "kg", "target inertia M_d of the translation, (C1)", "Md > 0", R(2.0)),
+    p(
+        "Bd",
+        Cart,
+        DerivedAxes,
+        "N s/m",
+        "target damping B_d of the translation, (C1) (None: critical, 2√(K_d M_d), following the filtered K_d)",
+        "Bd ≥ 0",
+        Nil,
+    ),
+    p("Kd", Cart, Axes, "N/m", "target stiffness K_d of the translation, (C1)", "Kd ≥ 0", R(500.0)),
+    p("Md_rot", Cart, Axes, "kg m²", "target inertia of the rotation, (C1)", "Md_rot > 0", R(0.08)),
+    p(
+        "Bd_rot",
+        Cart,
+        DerivedAxes,
+        "N m s/rad",
+        "target damping of the rotation, (C1) (None: critical, 2√(K_d,rot M_d,rot))",
+        "Bd_rot ≥ 0",
+        Nil,
+    ),
+    p(
+        "Kd_rot",
+        Cart,
+        Axes,
+        "N m/rad",
+        "target stiffness of the rotation, (C1); 0 on every axis: position-only (the orientation is no task)",
+        "Kd_rot ≥ 0",
+        R(20.0),
+    ),
+    p("clik_kp", Cart, Real, "1/s²", "CLIK gain K_P: the pose error of fk(q_d) obeys ë + K_D ė + K_P e = 0, (C2)", "clik_kp > 0", R(1600.0)),
+    p("clik_kd", Cart, Real, "1/s", "CLIK gain K_D, (C2)", "clik_kd > 0", R(80.0)),
+    p("clik_lambda", Cart, Real, "m", "damping λ_p of the least-squares inverse in the translation rows, (C3)", "clik_lambda > 0", R(0.01)),
+    p("clik_lambda_rot", Cart, Real, "", "damping λ_o of the least-squares inverse in the rotation rows, (C3)", "clik_lambda_rot > 0", R(0.01)),
+    p("null_k", Cart, Real, "1/s²", "null-space posture stiffness k_0, (C2)", "null_k ≥ 0", R(25.0)),
+    p("null_d", Cart, Real, "1/s", "null-space damping d_0, (C2)", "null_d ≥ 0", R(10.0)),
+    p("pos_error_max", Cart, Optional, "m", "largest translation error fed to the impedance, (16.5) (None: no clipping)", "pos_error_max > 0", Nil),
+    p("rot_error_max", Cart, Optional, "rad", "largest rotation error fed to the impedance, (16.5) (None: no clipping)", "rot_error_max > 0", Nil),
+    p(
+        "target_filter",
+        Cart,
+        Real,
+        "s",
+        "time constant of the first-order filter on jumps of the commanded pose and on stiffness changes, (16.6) (0: none)",
+        "target_filter ≥ 0",
+        R(0.05),
+    ),
+    p("force_filter", Cart, Real, "s", "time constant of the first-order filter on the measured wrench, (16.6) (0: none)", "force_filter ≥ 0", R(0.0)),
+    p(
+        "force_feedforward",
+        Cart,
+        Flag,
+        "",
+        "the joint controller gets τe = Jᵀ F_e for its +τe feedforward (C5); False: τe = 0, the contact acts through (C1) only",
+        "",
+        B(true),
+    ),
 ];
 
 /// The parameter called `name`.
@@ -508,6 +583,8 @@ pub struct Scenario<const N: usize> {
     pub ke_be: [f64; 2],
     /// The 2-link arm.
     pub arm: ArmValues,
+    /// The 6-D Cartesian impedance (SPEC §16).
+    pub cartesian: CartesianConfig,
 }
 
 /// A lookup that cannot fail: `name` is in [`PARAMS`] and its default suits
@@ -546,6 +623,25 @@ impl<const N: usize> Scenario<N> {
                 inertia: [None; 2],
                 g: 0.0,
             },
+            cartesian: CartesianConfig {
+                md: Vector::zeros(),
+                bd: None,
+                kd: Vector::zeros(),
+                md_rot: Vector::zeros(),
+                bd_rot: None,
+                kd_rot: Vector::zeros(),
+                clik_kp: 0.0,
+                clik_kd: 0.0,
+                clik_lambda: 0.0,
+                clik_lambda_rot: 0.0,
+                null_k: 0.0,
+                null_d: 0.0,
+                pos_error_max: None,
+                rot_error_max: None,
+                target_filter: 0.0,
+                force_filter: 0.0,
+                force_feedforward: false,
+            },
         };
         for p in PARAMS {
             if !cfg!(feature = "sim") && p.group == Group::Sim {
@@ -575,6 +671,7 @@ impl<const N: usize> Scenario<N> {
         let c = &mut self.config;
         match n {
             _ if p.group == Group::Sim => return self.set_run(n, value),
+            _ if p.group == Group::Cartesian => return self.set_cartesian(n, value),
             "Ts" => c.ts = real(n, value)?,
             "K1" => c.k1 = joint(n, value)?,
             "Kp" => c.kp = joint(n, value)?,
@@ -693,6 +790,32 @@ impl<const N: usize> Scenario<N> {
         Ok(())
     }
 
+    /// [`set`](Self::set) for a parameter of the Cartesian impedance (group "cartesian").
+    fn set_cartesian(&mut self, n: &'static str, value: Value<'_>) -> Result<(), Error> {
+        let c = &mut self.cartesian;
+        match n {
+            "Md" => c.md = joint(n, value)?,
+            "Bd" => c.bd = derived_axes(n, value)?,
+            "Kd" => c.kd = joint(n, value)?,
+            "Md_rot" => c.md_rot = joint(n, value)?,
+            "Bd_rot" => c.bd_rot = derived_axes(n, value)?,
+            "Kd_rot" => c.kd_rot = joint(n, value)?,
+            "clik_kp" => c.clik_kp = real(n, value)?,
+            "clik_kd" => c.clik_kd = real(n, value)?,
+            "clik_lambda" => c.clik_lambda = real(n, value)?,
+            "clik_lambda_rot" => c.clik_lambda_rot = real(n, value)?,
+            "null_k" => c.null_k = real(n, value)?,
+            "null_d" => c.null_d = real(n, value)?,
+            "pos_error_max" => c.pos_error_max = optional(n, value)?,
+            "rot_error_max" => c.rot_error_max = optional(n, value)?,
+            "target_filter" => c.target_filter = real(n, value)?,
+            "force_filter" => c.force_filter = real(n, value)?,
+            "force_feedforward" => c.force_feedforward = flag(n, value)?,
+            _ => unreachable!("{n} is in PARAMS but has no setter"),
+        }
+        Ok(())
+    }
+
     /// Without the feature `sim` the run's parameters do not exist.
     #[cfg(not(feature = "sim"))]
     fn set_run(&mut self, n: &'static str, _value: Value<'_>) -> Result<(), Error> {
@@ -765,6 +888,7 @@ impl<const N: usize> Scenario<N> {
                     inertia: [i1, i2],
                     g,
                 },
+            cartesian: _,
         } = self;
         let opt = |v: &Option<f64>| v.map_or(Value::None, Value::Real);
         #[cfg(feature = "sim")]
@@ -832,6 +956,49 @@ impl<const N: usize> Scenario<N> {
         f("I1", opt(i1));
         f("I2", opt(i2));
         f("g", R(*g));
+        self.visit_cartesian(&mut f);
+    }
+
+    /// [`visit`](Self::visit) for the parameters of the Cartesian impedance
+    /// (group "cartesian"), the last in [`PARAMS`].
+    fn visit_cartesian(&self, f: &mut impl FnMut(&'static str, Value<'_>)) {
+        let CartesianConfig {
+            md,
+            bd,
+            kd,
+            md_rot,
+            bd_rot,
+            kd_rot,
+            clik_kp,
+            clik_kd,
+            clik_lambda,
+            clik_lambda_rot,
+            null_k,
+            null_d,
+            pos_error_max,
+            rot_error_max,
+            target_filter,
+            force_filter,
+            force_feedforward,
+        } = &self.cartesian;
+        let opt = |v: &Option<f64>| v.map_or(Value::None, Value::Real);
+        f("Md", V(md.as_slice()));
+        f("Bd", bd.as_ref().map_or(Nil, |b| V(b.as_slice())));
+        f("Kd", V(kd.as_slice()));
+        f("Md_rot", V(md_rot.as_slice()));
+        f("Bd_rot", bd_rot.as_ref().map_or(Nil, |b| V(b.as_slice())));
+        f("Kd_rot", V(kd_rot.as_slice()));
+        f("clik_kp", R(*clik_kp));
+        f("clik_kd", R(*clik_kd));
+        f("clik_lambda", R(*clik_lambda));
+        f("clik_lambda_rot", R(*clik_lambda_rot));
+        f("null_k", R(*null_k));
+        f("null_d", R(*null_d));
+        f("pos_error_max", opt(pos_error_max));
+        f("rot_error_max", opt(rot_error_max));
+        f("target_filter", R(*target_filter));
+        f("force_filter", R(*force_filter));
+        f("force_feedforward", B(*force_feedforward));
     }
 
     /// [`visit`](Self::visit) for the parameters of the run (group "sim"),
@@ -930,6 +1097,21 @@ fn int(name: &'static str, v: Value<'_>) -> Result<i64, Error> {
     }
 }
 
+fn flag(name: &'static str, v: Value<'_>) -> Result<bool, Error> {
+    match v {
+        Value::Bool(b) => Ok(b),
+        _ => Err(kind_error(name)),
+    }
+}
+
+/// Three values (x, y, z), or none for the derived default.
+fn derived_axes(name: &'static str, v: Value<'_>) -> Result<Option<Vector<3>>, Error> {
+    match v {
+        Value::None => Ok(None),
+        v => joint::<3>(name, v).map(Some),
+    }
+}
+
 fn optional(name: &'static str, v: Value<'_>) -> Result<Option<f64>, Error> {
     match v {
         Value::None => Ok(None),
@@ -941,7 +1123,7 @@ fn array<const M: usize>(name: &'static str, v: Value<'_>) -> Result<[f64; M], E
     match v {
         Value::Vec(s) => s.try_into().map_err(|_| Error::Invalid {
             what: name,
-            reason: "wrong length: one value per joint, or per network D, C, G",
+            reason: "wrong length: one value per joint, per network D, C, G, or per axis x, y, z",
         }),
         v => real(name, v).map(|x| [x; M]),
     }

@@ -181,7 +181,7 @@ fn no_heap_allocation_in_a_disturbed_simulation() {
 fn no_heap_allocation_in_seven_joint_and_cartesian_steps() {
     use adaptimp::{
         CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement, Centers,
-        Config, Grid, ImpedanceMode, Kinematics, Setpoint,
+        Config, Grid, ImpedanceMode, Kinematics, PoseTarget, Setpoint,
     };
     // n = 7 with centres along an orbit (SPEC §15).
     let traj = Sinusoid::<7>::new(
@@ -209,10 +209,11 @@ fn no_heap_allocation_in_seven_joint_and_cartesian_steps() {
         }
     });
     assert_eq!(n, 0, "the n = 7 step allocated");
-    // The Cartesian pair (SPEC §16) on the paper's arm.
+    // The Cartesian pair (SPEC §16) on the paper's arm, position-only.
     let arm = TwoLinkArm::paper();
     let q0 = Vector::<2>::new(0.5, 1.0);
-    let outer = CartesianImpedance::new(CartesianConfig::new(1e-3, q0), arm).expect("outer");
+    let cfg = CartesianConfig::default().position_only();
+    let outer = CartesianImpedance::new(cfg, arm, 1e-3).expect("outer");
     let mut cfg = Config::robot(Law::StateFeedback);
     cfg.impedance = ImpedanceMode::External;
     let inner = Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper()).expect("inner");
@@ -229,9 +230,11 @@ fn no_heap_allocation_in_seven_joint_and_cartesian_steps() {
             let m = CartesianMeasurement {
                 q: q0,
                 dq: Some(Vector::zeros()),
-                f_e: Vector::<3>::new(1.0, 0.0, 0.0),
+                wrench: Vector::<6>::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0),
             };
-            pair.step(&mut ost, &mut ist, &m, &c).expect("step");
+            let target = PoseTarget::from_position(&c);
+            pair.step(&mut ost, &mut ist, &m, Some(&target))
+                .expect("step");
         }
     });
     assert_eq!(n, 0, "the Cartesian step allocated");

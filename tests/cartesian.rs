@@ -8,7 +8,7 @@ use adaptimp::network::weight_bounds;
 use adaptimp::{
     rk4_step, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
     CartesianWall, Centers, Config, Controller, Environment, ImpedanceMode, Kinematics, Law, Link,
-    Manipulator, PlanarArm, Setpoint, Vector, WeightBound,
+    Manipulator, PlanarArm, PoseTarget, Setpoint, Vector, WeightBound,
 };
 use core::f64::consts::PI;
 
@@ -45,9 +45,11 @@ fn circle(t: f64) -> Setpoint<3> {
     }
 }
 
-/// The outer loop with the test's gains (SPEC §16 defaults, posture q0).
+/// The outer loop with the test's gains (SPEC §16 defaults, position-only:
+/// the planar arm's orientation is no task; posture q0).
 fn outer() -> CartesianImpedance<N, PlanarArm<N>> {
-    CartesianImpedance::new(CartesianConfig::new(TS, q0()), arm()).expect("outer loop")
+    CartesianImpedance::new(CartesianConfig::default().position_only(), arm(), TS)
+        .expect("outer loop")
 }
 
 /// The joint controller: hardened state feedback at 1 kHz, impedance
@@ -62,7 +64,11 @@ fn controller(
     let mut samples = Vec::new();
     for k in 0..4000 {
         let sp = outer
-            .step(&mut st, &circle(k as f64 * TS), &Vector::zeros())
+            .step(
+                &mut st,
+                Some(&PoseTarget::from_position(&circle(k as f64 * TS))),
+                &Vector::zeros(),
+            )
             .expect("outer");
         if k % (4000 / nodes) == 0 {
             samples.push(sp);
@@ -126,17 +132,22 @@ fn simulate(
         let t = k as f64 * TS;
         let f_e = wall.wrench(&q, &dq);
         let c = traj(t);
+        let mut wrench = Vector::<6>::zeros();
+        wrench.fixed_rows_mut::<3>(0).copy_from(&f_e);
         let m = CartesianMeasurement {
             q,
             dq: Some(dq),
-            f_e,
+            wrench,
         };
-        let cmd = ctrl.step(&mut ost, &mut ist, &m, &c).expect("step");
+        let target = PoseTarget::from_position(&c);
+        let cmd = ctrl
+            .step(&mut ost, &mut ist, &m, Some(&target))
+            .expect("step");
         let tau = cmd.joint.tau_sat;
         run.tau_ok &= tau.iter().zip(tau_max.iter()).all(|(t, l)| t.abs() <= *l);
         run.p.push(cmd.p);
         run.pc.push(c.x);
-        run.pd.push(cmd.pd);
+        run.pd.push(cmd.compliant.p);
         run.f.push(f_e);
         // The plant: 10 RK4 substeps per period, τ held, contact recomputed.
         let h = TS / 10.0;
@@ -211,7 +222,7 @@ fn pressing_on_a_wall_gives_the_force_the_target_impedance_prescribes() {
     let last = r.f.len() - 1;
     let n = Vector::<3>::new(1.0, 0.0, 0.0);
     let f = n.dot(&r.f[last]);
-    let kd = CartesianConfig::<N>::new(TS, q0()).kd[0];
+    let kd = CartesianConfig::default().kd[0];
     // At rest the target impedance (C1) is K_d (p_c − p_d) = F_e.
     let model = kd * n.dot(&(r.pc[last] - r.pd[last]));
     // With the wall a spring ke in series with K_d, and p = p_d + e:

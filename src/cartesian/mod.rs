@@ -1,10 +1,16 @@
-//! Task space: an arm's kinematics and the Cartesian impedance that drives a
-//! joint controller, SPEC §16. No allocation.
+//! Task space: an arm's kinematics (pose, 6 × N Jacobian, J̇ q̇), serial
+//! chains from joint data, the rotation error on SO(3), and the 6-D Cartesian
+//! impedance that drives a joint controller, SPEC §16. No allocation.
 
+pub mod chain;
 pub mod kinematics;
 mod outer;
+mod pair;
+pub mod rotation;
 
+pub use chain::{Chain, Joint, JointKind, Transform, MAX_CHAIN_JOINTS};
+pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{
-    CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
-    CartesianMeasurement, CartesianState, OuterStep,
+    CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, OuterStep, PoseTarget,
 };
+pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement};

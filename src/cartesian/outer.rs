@@ -1,127 +1,317 @@
-//! Cartesian impedance for an `N`-joint arm, SPEC §16: the target impedance
-//! (3) on the end-effector position, as an outer loop that hands the
+//! The 6-D Cartesian impedance for an `N`-joint arm, SPEC §16: the target
+//! impedance (3) on the tip's pose, as an outer loop that hands the
 //! joint-space controller its reference.
 //!
 //! Position-based impedance (admittance; Siciliano & Villani, *Robot Force
 //! Control*, 1999, ch. 3; the paper's own structure, where the impedance model
 //! produces the compliant reference that the adaptive loop tracks):
 //!
-//! 1. the impedance model, driven by the measured contact force F_e (N, the
-//!    force the robot exerts), integrates the compliant reference p_d (C1);
-//! 2. second-order closed-loop inverse kinematics (Siciliano, "A closed-loop
-//!    inverse kinematic scheme for on-line joint-based robot control",
-//!    Robotica 8, 1990; Siciliano et al., *Robotics*, 2009, §3.7) with a
-//!    damped-least-squares inverse (Nakamura & Hanafusa 1986; Wampler 1986)
-//!    and a null-space posture task for redundant arms (Ott 2008, ch. 3)
-//!    turns p_d into a joint reference q_d, q̇_d, q̈_d (C2)–(C4);
-//! 3. the joint controller, with [`ImpedanceMode::External`]
+//! 1. the measured wrench F_e = [f; m] (N, N m; what the tip exerts on the
+//!    environment) and the commanded pose, both through first-order filters
+//!    (16.6), drive the compliant reference pose (p_d, R_d) through the target
+//!    impedance in translation and rotation (C1), with a hemisphere-safe
+//!    rotation error ([`rotation`](crate::cartesian::rotation)) and error
+//!    clipping (16.5);
+//! 2. second-order closed-loop inverse kinematics on the pose (Siciliano,
+//!    "A closed-loop inverse kinematic scheme for on-line joint-based robot
+//!    control", Robotica 8, 1990; Siciliano et al., *Robotics*, 2009, §3.7)
+//!    with a damped-least-squares inverse weighted per task direction
+//!    (Nakamura & Hanafusa 1986; Wampler 1986) and a null-space posture task
+//!    (Ott 2008, ch. 3) turns it into a joint reference q_d, q̇_d, q̈_d
+//!    (C2)–(C4);
+//! 3. the joint controller, with [`ImpedanceMode::External`](crate::ImpedanceMode)
 //!    (no joint impedance on top), tracks that reference, with τe = Jᵀ(q) F_e
-//!    in its feedforward (C5); saturation stays per joint.
+//!    in its feedforward or not (`force_feedforward`, C5); saturation stays
+//!    per joint ([`CartesianController`](crate::cartesian::CartesianController)).
+//!
+//! Orientation stiffness 0 on every axis at construction makes the loop
+//! position-only: the orientation is then no task of the inverse kinematics
+//! (SPEC §16's 3-D loop).
 //!
 //! A [`CartesianImpedance`] is the validated description (with the arm's
-//! [`Kinematics`]); a [`CartesianState`] is what a run changes. A
-//! [`CartesianController`] holds the outer loop and a joint [`Controller`];
-//! its step takes both states, transactionally: if the joint step refuses a
-//! measurement, the outer state is left as it was too.
+//! [`Kinematics`] and the period); a [`CartesianState`] is what a run
+//! changes. A step is staged on a copy ([`CartesianImpedance::stage`]) and
+//! committed by the caller, so a refused input changes nothing.
 
-use crate::cartesian::kinematics::Kinematics;
-use crate::control::controller::Controller;
-use crate::control::impedance::ImpedanceMode;
-use crate::control::io::{Command, Measurement};
-use crate::control::state::State;
+use crate::cartesian::kinematics::{Jacobian6, Kinematics};
+use crate::cartesian::rotation::{self, clip, exp, rotation_error};
 use crate::error::{check, Error, BOUND, PARAM_BOUND};
-use crate::networks::rbf::Basis;
+use crate::math::sqrt;
+use crate::schema::{Preset, Scenario};
 use crate::trajectory::Setpoint;
-use crate::types::{Jacobian, Vector};
+use crate::types::Vector;
+use nalgebra::{Matrix3, SMatrix, UnitQuaternion};
 
-/// Parameters of the Cartesian impedance and of the inverse kinematics; every
-/// diagonal gain by its diagonal (x, y, z). Start from [`CartesianConfig::new`].
+/// Parameters of the 6-D target impedance and of the inverse kinematics,
+/// every diagonal one by its diagonal (x, y, z of the world frame); the
+/// schema's group "cartesian" (SPEC §16). Start from [`Default`] (the
+/// schema's defaults).
 #[derive(Copy, Clone, Debug, PartialEq)]
-pub struct CartesianConfig<const N: usize> {
-    /// Sampling period Ts (s), the joint controller's.
-    pub ts: f64,
-    /// Target inertia M_d (kg), > 0.
+pub struct CartesianConfig {
+    /// Target inertia M_d of the translation (kg), > 0.
     pub md: Vector<3>,
-    /// Target damping B_d (N s/m), ≥ 0.
-    pub bd: Vector<3>,
-    /// Target stiffness K_d (N/m), ≥ 0.
+    /// Target damping B_d of the translation (N s/m), ≥ 0; `None`: critically
+    /// damped, 2√(K_d M_d), following the filtered K_d.
+    pub bd: Option<Vector<3>>,
+    /// Target stiffness K_d of the translation (N/m), ≥ 0.
     pub kd: Vector<3>,
-    /// CLIK position gain K_P (1/s²), > 0: e = p_d − fk(q_d) obeys ë + K_D ė + K_P e = 0.
+    /// Target inertia of the rotation (kg m²), > 0.
+    pub md_rot: Vector<3>,
+    /// Target damping of the rotation (N m s/rad), ≥ 0; `None`: critical.
+    pub bd_rot: Option<Vector<3>>,
+    /// Target stiffness of the rotation (N m/rad), ≥ 0; 0 on every axis at
+    /// construction: position-only (the orientation is no task).
+    pub kd_rot: Vector<3>,
+    /// CLIK gain K_P (1/s²), > 0: the pose error e of fk(q_d) obeys ë + K_D ė + K_P e = 0.
     pub clik_kp: f64,
-    /// CLIK velocity gain K_D (1/s), > 0.
+    /// CLIK gain K_D (1/s), > 0.
     pub clik_kd: f64,
-    /// Damping λ (m) of the least-squares inverse J⁺ = Jᵀ(J Jᵀ + λ² I)⁻¹, > 0.
-    pub lambda: f64,
+    /// Damping λ_p of the least-squares inverse in the translation rows (m/rad), > 0.
+    pub clik_lambda: f64,
+    /// Damping λ_o of the least-squares inverse in the rotation rows (rad/rad), > 0.
+    pub clik_lambda_rot: f64,
     /// Null-space posture stiffness k_0 (1/s²), ≥ 0.
     pub null_k: f64,
     /// Null-space damping d_0 (1/s), ≥ 0.
     pub null_d: f64,
-    /// Posture q_posture (rad) the null-space task pulls toward.
-    pub posture: Vector<N>,
+    /// Largest translation error fed to the impedance (m), > 0; `None`: no clipping.
+    pub pos_error_max: Option<f64>,
+    /// Largest rotation error fed to the impedance (rad), > 0; `None`: no clipping.
+    pub rot_error_max: Option<f64>,
+    /// Time constant τ_t (s) of the first-order filter on jumps of the
+    /// commanded pose and on changes of the stiffness, ≥ 0 (0: none).
+    pub target_filter: f64,
+    /// Time constant τ_f (s) of the first-order filter on the measured wrench, ≥ 0 (0: none).
+    pub force_filter: f64,
+    /// Whether the joint controller gets τe = Jᵀ(q) F_e (C5, its law's +τe
+    /// feedforward), or zero (the contact acts through (C1) only).
+    pub force_feedforward: bool,
 }
 
-impl<const N: usize> CartesianConfig<N> {
-    /// The defaults of SPEC §16 at period `ts` (s) with `posture` (rad):
-    /// M_d = 2 kg, K_d = 500 N/m, B_d = 2√(K_d M_d) ≈ 63.2 N s/m (critically
-    /// damped, ω = 15.8 rad/s), CLIK at ω = 40 rad/s (K_P = 1600 1/s²,
-    /// K_D = 80 1/s), λ = 0.01 m, k_0 = 25 1/s², d_0 = 10 1/s.
-    pub fn new(ts: f64, posture: Vector<N>) -> Self {
-        let (md, kd) = (2.0, 500.0);
+impl Default for CartesianConfig {
+    /// The schema's defaults (SPEC §16).
+    fn default() -> Self {
+        Scenario::<1>::preset(Preset::Robot, crate::Law::Pd).cartesian
+    }
+}
+
+impl CartesianConfig {
+    /// This configuration with the orientation left free: rotational stiffness 0
+    /// (position-only, SPEC §16's 3-D loop).
+    pub fn position_only(self) -> Self {
         Self {
-            ts,
-            md: Vector::from_element(md),
-            bd: Vector::from_element(2.0 * crate::math::sqrt(kd * md)),
-            kd: Vector::from_element(kd),
-            clik_kp: 1600.0,
-            clik_kd: 80.0,
-            lambda: 0.01,
-            null_k: 25.0,
-            null_d: 10.0,
-            posture,
+            kd_rot: Vector::zeros(),
+            ..self
+        }
+    }
+
+    /// Whether the orientation is a task (some rotational stiffness > 0).
+    pub fn orients(&self) -> bool {
+        self.kd_rot.iter().any(|k| *k > 0.0)
+    }
+
+    /// Validated (each condition named, as SPEC §10).
+    fn check(&self) -> Result<(), Error> {
+        check::positive_vec("Md > 0", "Md", &self.md)?;
+        check::positive_vec("Md_rot > 0", "Md_rot", &self.md_rot)?;
+        check::nonnegative_vec("Kd ≥ 0", "Kd", &self.kd)?;
+        check::nonnegative_vec("Kd_rot ≥ 0", "Kd_rot", &self.kd_rot)?;
+        if let Some(b) = &self.bd {
+            check::nonnegative_vec("Bd ≥ 0", "Bd", b)?;
+            bounded("Bd", b)?;
+        }
+        if let Some(b) = &self.bd_rot {
+            check::nonnegative_vec("Bd_rot ≥ 0", "Bd_rot", b)?;
+            bounded("Bd_rot", b)?;
+        }
+        for (what, v) in [
+            ("Md", &self.md),
+            ("Kd", &self.kd),
+            ("Md_rot", &self.md_rot),
+            ("Kd_rot", &self.kd_rot),
+        ] {
+            bounded(what, v)?;
+        }
+        check::positive("clik_kp > 0", "clik_kp", self.clik_kp)?;
+        check::positive("clik_kd > 0", "clik_kd", self.clik_kd)?;
+        check::positive("clik_lambda > 0", "clik_lambda", self.clik_lambda)?;
+        check::positive(
+            "clik_lambda_rot > 0",
+            "clik_lambda_rot",
+            self.clik_lambda_rot,
+        )?;
+        check::nonnegative("null_k ≥ 0", "null_k", self.null_k)?;
+        check::nonnegative("null_d ≥ 0", "null_d", self.null_d)?;
+        check::nonnegative("target_filter ≥ 0", "target_filter", self.target_filter)?;
+        check::nonnegative("force_filter ≥ 0", "force_filter", self.force_filter)?;
+        if let Some(e) = self.pos_error_max {
+            check::positive("pos_error_max > 0", "pos_error_max", e)?;
+        }
+        if let Some(e) = self.rot_error_max {
+            check::positive("rot_error_max > 0", "rot_error_max", e)?;
+        }
+        for (what, v) in [
+            ("clik_kp", self.clik_kp),
+            ("clik_kd", self.clik_kd),
+            ("clik_lambda", self.clik_lambda),
+            ("clik_lambda_rot", self.clik_lambda_rot),
+            ("null_k", self.null_k),
+            ("null_d", self.null_d),
+            ("target_filter", self.target_filter),
+            ("force_filter", self.force_filter),
+        ] {
+            check::at_most("|value| ≤ 1e9", what, v, PARAM_BOUND)?;
+        }
+        Ok(())
+    }
+}
+
+fn bounded(what: &'static str, v: &Vector<3>) -> Result<(), Error> {
+    check::each("|value| ≤ 1e9", what, v, |_, x| PARAM_BOUND - x, false)
+}
+
+/// A commanded pose and its rates at t_k, world frame; plain data (a C
+/// caller fills it). The rotation is validated at every step (orthonormal to
+/// 1e-6, det +1).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct PoseTarget {
+    /// Position p_c (m).
+    pub p: Vector<3>,
+    /// Velocity ṗ_c (m/s).
+    pub dp: Vector<3>,
+    /// Acceleration p̈_c (m/s²).
+    pub ddp: Vector<3>,
+    /// Rotation R_c (world ← tip); ignored by a position-only loop.
+    pub r: Matrix3<f64>,
+    /// Angular velocity ω_c (rad/s), world frame.
+    pub w: Vector<3>,
+    /// Angular acceleration ω̇_c (rad/s²), world frame.
+    pub dw: Vector<3>,
+}
+
+impl PoseTarget {
+    /// The pose (p, R) at rest.
+    pub fn at(p: Vector<3>, r: Matrix3<f64>) -> Self {
+        Self {
+            p,
+            dp: Vector::zeros(),
+            ddp: Vector::zeros(),
+            r,
+            w: Vector::zeros(),
+            dw: Vector::zeros(),
+        }
+    }
+
+    /// A position setpoint (p_c, ṗ_c, p̈_c) with the identity rotation at
+    /// rest (for a position-only loop, which ignores the rotation).
+    pub fn from_position(c: &Setpoint<3>) -> Self {
+        Self {
+            p: c.x,
+            dp: c.dx,
+            ddp: c.ddx,
+            ..Self::at(c.x, Matrix3::identity())
         }
     }
 }
 
-/// The state of the outer loop: the compliant reference and the joint reference.
+/// A validated target: the rotation as a unit quaternion.
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct Target {
+    p: Vector<3>,
+    dp: Vector<3>,
+    ddp: Vector<3>,
+    q: UnitQuaternion<f64>,
+    w: Vector<3>,
+    dw: Vector<3>,
+}
+
+impl Target {
+    fn check(t: &PoseTarget, orients: bool) -> Result<Self, Error> {
+        for (what, v) in [
+            ("p_c", &t.p),
+            ("dp_c", &t.dp),
+            ("ddp_c", &t.ddp),
+            ("w_c", &t.w),
+            ("dw_c", &t.dw),
+        ] {
+            check::finite_slice(what, v.as_slice())?;
+            check::within(what, v.as_slice(), BOUND)?;
+        }
+        let q = if orients {
+            rotation::rotation("R_c", &t.r)?
+        } else {
+            UnitQuaternion::identity()
+        };
+        Ok(Self {
+            p: t.p,
+            dp: t.dp,
+            ddp: t.ddp,
+            q,
+            w: t.w,
+            dw: t.dw,
+        })
+    }
+
+    /// The same pose at rest (a step without a target holds the last one).
+    fn held(&self) -> Self {
+        Self {
+            dp: Vector::zeros(),
+            ddp: Vector::zeros(),
+            w: Vector::zeros(),
+            dw: Vector::zeros(),
+            ..*self
+        }
+    }
+}
+
+/// The state of the outer loop: the compliant reference, the joint
+/// reference and the filters. Plain data; a step replaces it as a whole.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct CartesianState<const N: usize> {
     /// Compliant reference position p_d (m).
     pub pd: Vector<3>,
     /// Compliant reference velocity ṗ_d (m/s).
     pub dpd: Vector<3>,
+    /// Compliant reference rotation R_d (world ← tip); a position-only loop
+    /// keeps R(q_d) here.
+    pub rd: UnitQuaternion<f64>,
+    /// Compliant reference angular velocity ω_d (rad/s).
+    pub wd: Vector<3>,
     /// Joint reference q_d (rad).
     pub qd: Vector<N>,
     /// Joint reference velocity q̇_d (rad/s).
     pub dqd: Vector<N>,
+    /// Posture q_posture (rad) the null-space task pulls toward.
+    pub posture: Vector<N>,
+    /// The stiffness asked for, [K_d; K_d,rot] (N/m, N m/rad).
+    pub stiffness: Vector<6>,
+    /// The filtered stiffness the impedance uses (16.6).
+    pub stiffness_filtered: Vector<6>,
+    /// The target filter's offset [o_p (m); o_r (rad)] (16.6).
+    pub offset: Vector<6>,
+    /// The filtered wrench [f (N); m (N m)] (16.6).
+    pub wrench: Vector<6>,
+    /// The commanded target of the last step (held when a step has none).
+    last: Target,
     /// Steps taken.
     pub k: u64,
 }
 
-/// One sample from the sensors at t_k.
+/// The compliant reference pose and its rates at t_k, world frame.
 #[derive(Copy, Clone, Debug, PartialEq)]
-pub struct CartesianMeasurement<const N: usize> {
-    /// Joint position q (rad).
-    pub q: Vector<N>,
-    /// Joint velocity q̇ (rad/s), as [`Measurement::dx`].
-    pub dq: Option<Vector<N>>,
-    /// Force the end effector exerts on the environment F_e (N), from a
-    /// force sensor (the environment pushes back with −F_e).
-    pub f_e: Vector<3>,
-}
-
-/// What a Cartesian step computed; `joint.tau_sat` goes to the actuators.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct CartesianCommand<const N: usize> {
-    /// The joint controller's command (τ, sat(τ), z1 = q_d − q, …).
-    pub joint: Command<N>,
-    /// The joint reference q_d, q̇_d, q̈_d (rad, rad/s, rad/s²) at t_k.
-    pub reference: Setpoint<N>,
-    /// The compliant reference p_d(t_k) (m).
-    pub pd: Vector<3>,
-    /// The measured end-effector position fk(q) (m).
+pub struct CompliantPose {
+    /// p_d (m).
     pub p: Vector<3>,
-    /// τe = Jᵀ(q) F_e (N m), the contact torque the joint controller got.
-    pub tau_e: Vector<N>,
+    /// ṗ_d (m/s).
+    pub dp: Vector<3>,
+    /// p̈_d (m/s²).
+    pub ddp: Vector<3>,
+    /// R_d.
+    pub r: UnitQuaternion<f64>,
+    /// ω_d (rad/s).
+    pub w: Vector<3>,
+    /// ω̇_d (rad/s²).
+    pub dw: Vector<3>,
 }
 
 /// One staged step of the outer loop ([`CartesianImpedance::stage`]).
@@ -129,171 +319,310 @@ pub struct CartesianCommand<const N: usize> {
 pub struct OuterStep<const N: usize> {
     /// The joint reference q_d, q̇_d, q̈_d at t_k (rad, rad/s, rad/s²).
     pub reference: Setpoint<N>,
-    /// The compliant reference p_d, ṗ_d, p̈_d at t_k (m, m/s, m/s²).
-    pub compliant: Setpoint<3>,
+    /// The compliant reference at t_k.
+    pub compliant: CompliantPose,
+    /// The commanded pose at t_k after the target filter (p_t (m), R_t).
+    pub target: (Vector<3>, UnitQuaternion<f64>),
+    /// The error [e_p (m); e_o (rad)] the impedance acted on (after clipping).
+    pub error: Vector<6>,
     /// The state at t_{k+1}, to commit.
     pub next: CartesianState<N>,
 }
 
-/// The validated outer loop: a [`CartesianConfig`] and the arm's kinematics.
+/// The validated outer loop: a [`CartesianConfig`], the arm's kinematics
+/// and the period.
 #[derive(Copy, Clone, Debug)]
 pub struct CartesianImpedance<const N: usize, K> {
-    cfg: CartesianConfig<N>,
+    cfg: CartesianConfig,
     kin: K,
-}
-
-/// The damped-least-squares solve `J⁺ v = Jᵀ (J Jᵀ + λ² I)⁻¹ v`: 3 × 3,
-/// positive definite for λ > 0 (zero if a non-finite J makes it indefinite;
-/// the step's checks then refuse the result).
-fn dls<const N: usize>(j: &Jacobian<N>, lambda2: f64, v: &Vector<3>) -> Vector<N> {
-    let a = j * j.transpose() + nalgebra::Matrix3::identity() * lambda2;
-    match a.cholesky() {
-        Some(ch) => j.transpose() * ch.solve(v),
-        None => Vector::zeros(),
-    }
+    ts: f64,
+    orients: bool,
+    /// Λ² of (C3): λ_p² on the translation rows, λ_o² on the rotation rows.
+    lambda2: Vector<6>,
 }
 
 impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
-    /// Validate `cfg` (each condition named, as SPEC §10): Ts > 0 and ≤ 1 s,
-    /// M_d > 0, B_d ≥ 0, K_d ≥ 0, K_P > 0, K_D > 0, λ > 0, k_0 ≥ 0, d_0 ≥ 0,
-    /// every value finite and at most 1e9 in magnitude, and `Ts·K_D < 1`,
-    /// `Ts²·K_P < 1` (the CLIK's explicit step stays far inside its stability
-    /// region: ω Ts < 1).
-    pub fn new(cfg: CartesianConfig<N>, kin: K) -> Result<Self, Error> {
+    /// Validate `cfg` (each condition named, as SPEC §10): M > 0, B ≥ 0,
+    /// K ≥ 0, K_P, K_D, λ_p, λ_o > 0, k_0, d_0 ≥ 0, clipping limits > 0,
+    /// filter time constants ≥ 0, every value finite and at most 1e9; the
+    /// period `ts` (s) > 0 and ≤ 1 s, with `Ts·K_D < 1`, `Ts²·K_P < 1` (the
+    /// CLIK's explicit step stays far inside its stability region: ω Ts < 1).
+    pub fn new(cfg: CartesianConfig, kin: K, ts: f64) -> Result<Self, Error> {
         if N == 0 {
             return Err(Error::Invalid {
                 what: "Cartesian impedance",
                 reason: "needs at least one joint",
             });
         }
-        check::positive("Ts > 0", "Ts", cfg.ts)?;
-        check::at_most("Ts ≤ 1 s", "Ts", cfg.ts, 1.0)?;
-        check::positive_vec("Md > 0", "Md", &cfg.md)?;
-        check::nonnegative_vec("Bd ≥ 0", "Bd", &cfg.bd)?;
-        check::nonnegative_vec("Kd ≥ 0", "Kd", &cfg.kd)?;
-        check::positive("K_P > 0", "clik_kp", cfg.clik_kp)?;
-        check::positive("K_D > 0", "clik_kd", cfg.clik_kd)?;
-        check::positive("λ > 0", "lambda", cfg.lambda)?;
-        check::nonnegative("k0 ≥ 0", "null_k", cfg.null_k)?;
-        check::nonnegative("d0 ≥ 0", "null_d", cfg.null_d)?;
-        check::finite_slice("posture", cfg.posture.as_slice())?;
-        for (what, v) in [("Md", &cfg.md), ("Bd", &cfg.bd), ("Kd", &cfg.kd)] {
-            check::each("|value| ≤ 1e9", what, v, |_, x| PARAM_BOUND - x, false)?;
-        }
-        for (what, v) in [
-            ("clik_kp", cfg.clik_kp),
-            ("clik_kd", cfg.clik_kd),
-            ("lambda", cfg.lambda),
-            ("null_k", cfg.null_k),
-            ("null_d", cfg.null_d),
-        ] {
-            check::at_most("|value| ≤ 1e9", what, v, PARAM_BOUND)?;
-        }
-        check::at_most("|posture| ≤ 1e6 rad", "posture", cfg.posture.amax(), 1e6)?;
+        check::positive("Ts > 0", "Ts", ts)?;
+        check::at_most("Ts ≤ 1 s", "Ts", ts, 1.0)?;
+        cfg.check()?;
         check::at_most(
-            "Ts·K_D < 1",
+            "Ts·clik_kd < 1",
             "Ts·clik_kd",
-            cfg.ts * cfg.clik_kd,
+            ts * cfg.clik_kd,
             1.0 - 1e-12,
         )?;
-        let kp = cfg.ts * cfg.ts * cfg.clik_kp;
-        check::at_most("Ts²·K_P < 1", "Ts²·clik_kp", kp, 1.0 - 1e-12)?;
-        Ok(Self { cfg, kin })
+        let kp = ts * ts * cfg.clik_kp;
+        check::at_most("Ts²·clik_kp < 1", "Ts²·clik_kp", kp, 1.0 - 1e-12)?;
+        let (lp, lo) = (
+            cfg.clik_lambda * cfg.clik_lambda,
+            cfg.clik_lambda_rot * cfg.clik_lambda_rot,
+        );
+        Ok(Self {
+            cfg,
+            kin,
+            ts,
+            orients: cfg.orients(),
+            lambda2: Vector::<6>::new(lp, lp, lp, lo, lo, lo),
+        })
     }
 
     /// The validated configuration.
-    pub fn config(&self) -> &CartesianConfig<N> {
+    pub fn config(&self) -> &CartesianConfig {
         &self.cfg
     }
     /// The arm's kinematics.
     pub fn kinematics(&self) -> &K {
         &self.kin
     }
+    /// The period Ts (s).
+    pub fn period(&self) -> f64 {
+        self.ts
+    }
+    /// Whether the orientation is a task (not position-only).
+    pub fn orients(&self) -> bool {
+        self.orients
+    }
 
-    /// A state at t = 0 with the joint reference at `q0` (rad; e.g. the
-    /// measured start). p_d starts on the commanded p_c at the first step,
-    /// and q̇_d at J⁺(q0) ṗ_c; the inverse kinematics then pulls fk(q_d) onto
-    /// p_d, so q0 should be near an inverse-kinematics solution of p_c(0).
+    /// A state at t = 0 with the joint reference and the posture at `q0`
+    /// (rad; e.g. the measured start). The compliant pose starts on the
+    /// commanded one at the first step (on fk(q0) if that step has none),
+    /// and q̇_d at J⁺(q0) [ṗ_c; ω_c]; the inverse kinematics then pulls
+    /// fk(q_d) onto it, so q0 should be near an inverse-kinematics solution
+    /// of the first target.
     pub fn start(&self, q0: Vector<N>) -> CartesianState<N> {
+        let mut k = Vector::<6>::zeros();
+        k.fixed_rows_mut::<3>(0).copy_from(&self.cfg.kd);
+        k.fixed_rows_mut::<3>(3).copy_from(&self.cfg.kd_rot);
+        let zero = Target {
+            p: Vector::zeros(),
+            dp: Vector::zeros(),
+            ddp: Vector::zeros(),
+            q: UnitQuaternion::identity(),
+            w: Vector::zeros(),
+            dw: Vector::zeros(),
+        };
         CartesianState {
             pd: Vector::zeros(),
             dpd: Vector::zeros(),
+            rd: UnitQuaternion::identity(),
+            wd: Vector::zeros(),
             qd: q0,
             dqd: Vector::zeros(),
+            posture: q0,
+            stiffness: k,
+            stiffness_filtered: k,
+            offset: Vector::zeros(),
+            wrench: Vector::zeros(),
+            last: zero,
             k: 0,
         }
     }
 
-    /// The target impedance (C1): `p̈_d = p̈_c + M_d⁻¹ (−B_d (ṗ_d − ṗ_c) −
-    /// K_d (p_d − p_c) − F_e)` (m/s²).
-    pub fn accel(&self, c: &Setpoint<3>, st: &CartesianState<N>, f_e: &Vector<3>) -> Vector<3> {
-        let cfg = &self.cfg;
-        let mut a = c.ddx;
-        for i in 0..3 {
-            a[i] += (-cfg.bd[i] * (st.dpd[i] - c.dx[i]) - cfg.kd[i] * (st.pd[i] - c.x[i]) - f_e[i])
-                / cfg.md[i];
+    /// Ask for the stiffness K_d (N/m) and K_d,rot (N m/rad): the impedance
+    /// moves to it through the target filter (16.6), so the torque does not
+    /// jump. Errors, changing nothing, for a negative, non-finite or larger
+    /// than 1e9 value, or a rotational stiffness > 0 for a position-only loop.
+    pub fn set_stiffness(
+        &self,
+        st: &mut CartesianState<N>,
+        kd: &Vector<3>,
+        kd_rot: &Vector<3>,
+    ) -> Result<(), Error> {
+        check::nonnegative_vec("Kd ≥ 0", "Kd", kd)?;
+        check::nonnegative_vec("Kd_rot ≥ 0", "Kd_rot", kd_rot)?;
+        bounded("Kd", kd)?;
+        bounded("Kd_rot", kd_rot)?;
+        if !self.orients && kd_rot.iter().any(|k| *k > 0.0) {
+            return Err(Error::Invalid {
+                what: "Kd_rot",
+                reason: "a position-only loop (Kd_rot = 0 at construction) has no orientation task: build it with Kd_rot > 0",
+            });
         }
-        a
+        st.stiffness.fixed_rows_mut::<3>(0).copy_from(kd);
+        st.stiffness.fixed_rows_mut::<3>(3).copy_from(kd_rot);
+        Ok(())
     }
 
-    /// The joint reference acceleration (C2), second-order CLIK with the
-    /// posture task in the null space (rad/s²):
-    /// `q̈_d = w + J⁺ (r − J w)`, with J = J(q_d), J⁺ damped least squares,
-    /// `r = p̈_d − J̇ q̇_d + K_D (ṗ_d − J q̇_d) + K_P (p_d − fk(q_d))` and
-    /// `w = k_0 (q_posture − q_d) − d_0 q̇_d`; i.e. `J⁺ r + (I − J⁺ J) w`.
-    pub fn joint_accel(&self, st: &CartesianState<N>, ddpd: &Vector<3>) -> Vector<N> {
-        let cfg = &self.cfg;
-        let j = self.kin.jacobian(&st.qd);
-        let e = st.pd - self.kin.fk(&st.qd);
-        let de = st.dpd - j * st.dqd;
-        let r =
-            ddpd - self.kin.jacobian_dot_qdot(&st.qd, &st.dqd) + cfg.clik_kd * de + cfg.clik_kp * e;
-        let w = cfg.null_k * (cfg.posture - st.qd) - cfg.null_d * st.dqd;
-        w + dls(&j, cfg.lambda * cfg.lambda, &(r - j * w))
+    /// The damped-least-squares solve `J⁺ v = Jᵀ (J Jᵀ + Λ²)⁻¹ v` (C3): 6 × 6,
+    /// positive definite for λ > 0 (zero if a non-finite J makes it
+    /// indefinite; the step's checks then refuse the result).
+    fn dls(&self, j: &Jacobian6<N>, v: &Vector<6>) -> Vector<N> {
+        let a = j * j.transpose() + SMatrix::<f64, 6, 6>::from_diagonal(&self.lambda2);
+        match a.cholesky() {
+            Some(ch) => j.transpose() * ch.solve(v),
+            None => Vector::zeros(),
+        }
     }
 
-    /// τe = Jᵀ(q) F_e (N m): the contact force as the joint controller sees it (C5).
-    pub fn contact_torque(&self, q: &Vector<N>, f_e: &Vector<3>) -> Vector<N> {
-        self.kin.jacobian(q).transpose() * f_e
+    /// The orientation rows zeroed for a position-only loop (the selection of (C2)).
+    fn select(&self, mut v: Vector<6>) -> Vector<6> {
+        if !self.orients {
+            v.fixed_rows_mut::<3>(3).fill(0.0);
+        }
+        v
+    }
+
+    fn select_jacobian(&self, mut j: Jacobian6<N>) -> Jacobian6<N> {
+        if !self.orients {
+            j.fixed_rows_mut::<3>(3).fill(0.0);
+        }
+        j
     }
 
     /// One step of the outer loop on a copy of the state: the joint reference
-    /// at t_k and the state at t_{k+1} (semi-implicit Euler, as SPEC §11's
-    /// reference: ṗ_d ← ṗ_d + Ts p̈_d, p_d ← p_d + Ts ṗ_d, then the same for
-    /// q̇_d, q_d). Errors, changing nothing, if an input is not finite or
-    /// beyond [`BOUND`], or a result would be (`OutOfRange`).
+    /// at t_k and the state at t_{k+1}, SPEC §16 (C0)–(C4). `target`: the
+    /// commanded pose at t_k (`None`: hold the last one at rest; at the first
+    /// step, fk(q_d)); `wrench`: the measured F_e = [f (N); m (N m)], world
+    /// frame, about the tip. Errors, changing nothing, if an input is not
+    /// finite or beyond [`BOUND`], the target's rotation is not one, or a
+    /// result would be beyond [`BOUND`] (`OutOfRange`).
     pub fn stage(
         &self,
         st: &CartesianState<N>,
-        c: &Setpoint<3>,
-        f_e: &Vector<3>,
+        target: Option<&PoseTarget>,
+        wrench: &Vector<6>,
     ) -> Result<OuterStep<N>, Error> {
-        for (what, v) in [("pc", &c.x), ("dpc", &c.dx), ("ddpc", &c.ddx), ("f_e", f_e)] {
-            check::finite_slice(what, v.as_slice())?;
-            check::within(what, v.as_slice(), BOUND)?;
-        }
+        check::finite_slice("wrench", wrench.as_slice())?;
+        check::within("wrench", wrench.as_slice(), BOUND)?;
+        let cfg = &self.cfg;
+        let ts = self.ts;
         let mut s = *st;
-        if s.k == 0 {
-            s.pd = c.x;
-            s.dpd = c.dx;
-            let j = self.kin.jacobian(&s.qd);
-            s.dqd = dls(&j, self.cfg.lambda * self.cfg.lambda, &c.dx);
+        let first = s.k == 0;
+        let c = match target {
+            Some(t) => Target::check(t, self.orients)?,
+            None if first => {
+                let tip = self.kin.tip(&s.qd, &Vector::zeros());
+                Target {
+                    p: tip.position,
+                    dp: Vector::zeros(),
+                    ddp: Vector::zeros(),
+                    q: UnitQuaternion::from_rotation_matrix(&tip.rotation),
+                    w: Vector::zeros(),
+                    dw: Vector::zeros(),
+                }
+            }
+            None => s.last.held(),
+        };
+        // (C0) the filters (16.6).
+        if first {
+            s.pd = c.p;
+            s.dpd = c.dp;
+            s.rd = c.q;
+            s.wd = c.w;
+            s.wrench = *wrench;
+            s.stiffness_filtered = s.stiffness;
+            s.offset = Vector::zeros();
+            let j = self.select_jacobian(self.kin.jacobian(&s.qd));
+            let mut v = Vector::<6>::zeros();
+            v.fixed_rows_mut::<3>(0).copy_from(&c.dp);
+            v.fixed_rows_mut::<3>(3).copy_from(&c.w);
+            s.dqd = self.dls(&j, &self.select(v));
+        } else {
+            let at = ts / (cfg.target_filter + ts);
+            let af = ts / (cfg.force_filter + ts);
+            let last = &s.last;
+            // The part of the target's change its rates do not explain (trapezoid).
+            let dp = c.p - last.p - 0.5 * ts * (c.dp + last.dp);
+            let dr = rotation_error(&c.q, &last.q) - 0.5 * ts * (c.w + last.w);
+            let mut jump = Vector::<6>::zeros();
+            jump.fixed_rows_mut::<3>(0).copy_from(&dp);
+            jump.fixed_rows_mut::<3>(3).copy_from(&dr);
+            s.offset = (1.0 - at) * (s.offset - jump);
+            s.stiffness_filtered += at * (s.stiffness - s.stiffness_filtered);
+            s.wrench += af * (wrench - s.wrench);
         }
-        let ddpd = self.accel(c, &s, f_e);
-        let ddqd = self.joint_accel(&s, &ddpd);
+        s.last = c;
+        let pt = c.p + s.offset.fixed_rows::<3>(0);
+        let qt = exp(&s.offset.fixed_rows::<3>(3).into_owned()) * c.q;
+        // Damping: given, or critical for the filtered stiffness.
+        let k = s.stiffness_filtered;
+        let damping = |given: &Option<Vector<3>>, m: &Vector<3>, row: usize| match given {
+            Some(b) => *b,
+            None => Vector::<3>::from_fn(|i, _| 2.0 * sqrt(k[row + i] * m[i])),
+        };
+        let (f, mom) = (s.wrench.fixed_rows::<3>(0), s.wrench.fixed_rows::<3>(3));
+        // (C1) the target impedance, with the clipped errors (16.5).
+        let ep = clip(&(pt - s.pd), cfg.pos_error_max.unwrap_or(f64::INFINITY));
+        let b = damping(&cfg.bd, &cfg.md, 0);
+        let kp = k.fixed_rows::<3>(0);
+        let ddpd = c.ddp
+            + (-b.component_mul(&(s.dpd - c.dp)) + kp.component_mul(&ep) - f)
+                .component_div(&cfg.md);
+        let (eo, dwd) = if self.orients {
+            let eo = clip(
+                &rotation_error(&qt, &s.rd),
+                cfg.rot_error_max.unwrap_or(f64::INFINITY),
+            );
+            let b = damping(&cfg.bd_rot, &cfg.md_rot, 3);
+            let ko = k.fixed_rows::<3>(3);
+            let dwd = c.dw
+                + (-b.component_mul(&(s.wd - c.w)) + ko.component_mul(&eo) - mom)
+                    .component_div(&cfg.md_rot);
+            (eo, dwd)
+        } else {
+            (Vector::zeros(), Vector::zeros())
+        };
+        // (C2) second-order CLIK on the pose at q_d, posture in the null space.
+        let tip = self.kin.tip(&s.qd, &s.dqd);
+        let j = self.select_jacobian(tip.jacobian);
+        if !self.orients {
+            // Position-only: the compliant orientation is the reference's own.
+            s.rd = UnitQuaternion::from_rotation_matrix(&tip.rotation);
+            s.wd = tip.jacobian.fixed_rows::<3>(3) * s.dqd;
+        }
+        let twist = j * s.dqd;
+        let mut r = Vector::<6>::zeros();
+        let ep_ik = s.pd - tip.position;
+        r.fixed_rows_mut::<3>(0).copy_from(
+            &(ddpd - tip.bias.fixed_rows::<3>(0)
+                + cfg.clik_kd * (s.dpd - twist.fixed_rows::<3>(0))
+                + cfg.clik_kp * ep_ik),
+        );
+        if self.orients {
+            let eo_ik = rotation_error(&s.rd, &UnitQuaternion::from_rotation_matrix(&tip.rotation));
+            r.fixed_rows_mut::<3>(3).copy_from(
+                &(dwd - tip.bias.fixed_rows::<3>(3)
+                    + cfg.clik_kd * (s.wd - twist.fixed_rows::<3>(3))
+                    + cfg.clik_kp * eo_ik),
+            );
+        }
+        let w = cfg.null_k * (s.posture - s.qd) - cfg.null_d * s.dqd;
+        let ddqd = w + self.dls(&j, &(r - j * w));
         let reference = Setpoint {
             x: s.qd,
             dx: s.dqd,
             ddx: ddqd,
         };
-        let compliant = Setpoint {
-            x: s.pd,
-            dx: s.dpd,
-            ddx: ddpd,
+        let compliant = CompliantPose {
+            p: s.pd,
+            dp: s.dpd,
+            ddp: ddpd,
+            r: s.rd,
+            w: s.wd,
+            dw: dwd,
         };
-        let ts = self.cfg.ts;
+        let mut error = Vector::<6>::zeros();
+        error.fixed_rows_mut::<3>(0).copy_from(&ep);
+        error.fixed_rows_mut::<3>(3).copy_from(&eo);
+        // (C4) semi-implicit Euler, the velocity first; R_d on SO(3).
         s.dpd += ts * ddpd;
         s.pd += ts * s.dpd;
+        if self.orients {
+            s.wd += ts * dwd;
+            s.rd = exp(&(ts * s.wd)) * s.rd;
+        }
         s.dqd += ts * ddqd;
         s.qd += ts * s.dqd;
         s.k += 1;
@@ -303,9 +632,14 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         for (what, v) in [("pd", &s.pd), ("dpd", &s.dpd), ("ddpd", &ddpd)] {
             check::within(what, v.as_slice(), BOUND)?;
         }
+        for (what, v) in [("wd", &s.wd), ("dwd", &dwd)] {
+            check::within(what, v.as_slice(), BOUND)?;
+        }
         Ok(OuterStep {
             reference,
             compliant,
+            target: (pt, qt),
+            error,
             next: s,
         })
     }
@@ -315,153 +649,135 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
     pub fn step(
         &self,
         st: &mut CartesianState<N>,
-        c: &Setpoint<3>,
-        f_e: &Vector<3>,
+        target: Option<&PoseTarget>,
+        wrench: &Vector<6>,
     ) -> Result<Setpoint<N>, Error> {
-        let staged = self.stage(st, c, f_e)?;
+        let staged = self.stage(st, target, wrench)?;
         *st = staged.next;
         Ok(staged.reference)
     }
-}
 
-/// The outer Cartesian impedance and the joint controller it drives.
-#[derive(Clone, Debug)]
-pub struct CartesianController<const N: usize, K, B> {
-    outer: CartesianImpedance<N, K>,
-    inner: Controller<N, B>,
-}
-
-impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B> {
-    /// The pair, validated: the joint controller must have
-    /// `impedance = "external"` (the Cartesian impedance is the only one:
-    /// a joint impedance would answer τe a second time) and the same Ts.
-    pub fn new(outer: CartesianImpedance<N, K>, inner: Controller<N, B>) -> Result<Self, Error> {
-        if inner.config().impedance != ImpedanceMode::External {
-            return Err(Error::Invalid {
-                what: "joint controller of a Cartesian impedance",
-                reason: "needs impedance = \"external\" (ImpedanceMode::External): the joint impedance would act on τe a second time",
-            });
-        }
-        if inner.period() != outer.config().ts {
-            return Err(Error::Invalid {
-                what: "joint controller of a Cartesian impedance",
-                reason: "needs the same Ts as the Cartesian impedance",
-            });
-        }
-        Ok(Self { outer, inner })
-    }
-
-    /// The outer loop.
-    pub fn outer(&self) -> &CartesianImpedance<N, K> {
-        &self.outer
-    }
-    /// The joint controller.
-    pub fn inner(&self) -> &Controller<N, B> {
-        &self.inner
-    }
-
-    /// One step at t_k: the measurement `m` and the commanded position
-    /// `c` (p_c, ṗ_c, p̈_c at t_k; m, m/s, m/s²) in, the command out; no
-    /// allocation. The outer loop is staged, the joint step runs with the
-    /// joint reference and τe = Jᵀ(q) F_e, and only if it succeeds is the
-    /// outer state committed (on an error both states are as before, except
-    /// the joint state's recorded fault).
-    pub fn step<S: AsRef<[f64]> + AsMut<[f64]>>(
+    /// The orbit-centre rule of SPEC §15 (15.2) for a Cartesian task: run the
+    /// outer loop kinematically (F_e = 0) from `q0` for `steps` steps along
+    /// the commanded `path(k)` (the target at t_k = k·Ts), and write the joint
+    /// reference (q_d, q̇_d) of every `every`-th step, `every` = max(1, ⌊steps /
+    /// L⌋) for L = `out.len()`, into `out` until it is full or the steps run
+    /// out; returns how many were written. [`Centers::along`](crate::Centers)
+    /// makes them RBF centres.
+    pub fn orbit<F: FnMut(usize) -> PoseTarget>(
         &self,
-        outer: &mut CartesianState<N>,
-        inner: &mut State<N, S>,
-        m: &CartesianMeasurement<N>,
-        c: &Setpoint<3>,
-    ) -> Result<CartesianCommand<N>, Error> {
-        let staged = self.outer.stage(outer, c, &m.f_e)?;
-        check::finite_slice("q", m.q.as_slice())?;
-        check::within("q", m.q.as_slice(), BOUND)?;
-        let tau_e = self.outer.contact_torque(&m.q, &m.f_e);
-        let meas = Measurement {
-            x: m.q,
-            dx: m.dq,
-            tau_e,
-        };
-        let joint = self.inner.step(inner, &meas, &staged.reference)?;
-        *outer = staged.next;
-        Ok(CartesianCommand {
-            joint,
-            reference: staged.reference,
-            pd: staged.compliant.x,
-            p: self.outer.kin.fk(&m.q),
-            tau_e,
-        })
+        q0: Vector<N>,
+        steps: usize,
+        mut path: F,
+        out: &mut [Setpoint<N>],
+    ) -> Result<usize, Error> {
+        let every = (steps / out.len().max(1)).max(1);
+        let mut st = self.start(q0);
+        let mut written = 0;
+        for k in 0..steps {
+            let sp = self.step(&mut st, Some(&path(k)), &Vector::zeros())?;
+            if k % every == 0 && written < out.len() {
+                out[written] = sp;
+                written += 1;
+            }
+        }
+        Ok(written)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::control::config::{Config, Law};
-    use crate::networks::rbf::Grid;
     use crate::sim::model::TwoLinkArm;
 
-    fn outer() -> CartesianImpedance<2, TwoLinkArm> {
-        let q0 = Vector::<2>::new(0.5, 1.0);
-        CartesianImpedance::new(CartesianConfig::new(1e-3, q0), TwoLinkArm::paper()).unwrap()
+    fn outer(cfg: CartesianConfig) -> CartesianImpedance<2, TwoLinkArm> {
+        CartesianImpedance::new(cfg, TwoLinkArm::paper(), 1e-3).unwrap()
     }
 
     #[test]
     fn bad_gains_are_rejected_by_name() {
-        let q0 = Vector::<2>::new(0.5, 1.0);
         let arm = TwoLinkArm::paper();
-        let mut cfg = CartesianConfig::new(1e-3, q0);
+        let base = CartesianConfig::default();
+        let mut cfg = base;
         cfg.md[1] = 0.0;
-        let e = CartesianImpedance::new(cfg, arm).unwrap_err();
+        let e = CartesianImpedance::new(cfg, arm, 1e-3).unwrap_err();
         assert!(e.to_string().contains("Md > 0"), "{e}");
-        let mut cfg = CartesianConfig::new(1e-3, q0);
-        cfg.lambda = 0.0;
-        let e = CartesianImpedance::new(cfg, arm).unwrap_err();
-        assert!(e.to_string().contains("λ > 0"), "{e}");
-        let mut cfg = CartesianConfig::new(1e-3, q0);
-        cfg.clik_kd = 2000.0;
-        let e = CartesianImpedance::new(cfg, arm).unwrap_err();
-        assert!(e.to_string().contains("Ts·K_D < 1"), "{e}");
-    }
-
-    #[test]
-    fn the_joint_controller_must_leave_the_impedance_to_the_outer_loop() {
-        let mut cfg = Config::paper(Law::StateFeedback);
-        cfg.ts = 1e-3;
-        let joint = Controller::new(cfg, Grid::paper()).unwrap();
-        let e = CartesianController::new(outer(), joint).unwrap_err();
-        assert!(e.to_string().contains("external"), "{e}");
-        cfg.impedance = ImpedanceMode::External;
-        let joint = Controller::new(cfg, Grid::paper()).unwrap();
-        assert!(CartesianController::new(outer(), joint).is_ok());
+        let cfg = CartesianConfig {
+            clik_lambda: 0.0,
+            ..base
+        };
+        let e = CartesianImpedance::new(cfg, arm, 1e-3).unwrap_err();
+        assert!(e.to_string().contains("clik_lambda > 0"), "{e}");
+        let cfg = CartesianConfig {
+            clik_kd: 2000.0,
+            ..base
+        };
+        let e = CartesianImpedance::new(cfg, arm, 1e-3).unwrap_err();
+        assert!(e.to_string().contains("Ts·clik_kd < 1"), "{e}");
+        let cfg = CartesianConfig {
+            rot_error_max: Some(0.0),
+            ..base
+        };
+        let e = CartesianImpedance::new(cfg, arm, 1e-3).unwrap_err();
+        assert!(e.to_string().contains("rot_error_max > 0"), "{e}");
     }
 
     #[test]
     fn a_static_force_deflects_the_reference_by_f_over_kd_and_ik_follows() {
-        let o = outer();
+        let o = outer(CartesianConfig::default().position_only());
         let mut st = o.start(Vector::<2>::new(0.5, 1.0));
         let pc = o.kinematics().fk(&st.qd);
-        let c = Setpoint {
-            x: pc,
-            dx: Vector::zeros(),
-            ddx: Vector::zeros(),
-        };
-        let f = Vector::<3>::new(5.0, -2.0, 0.0);
+        let c = PoseTarget::at(pc, Matrix3::identity());
+        let mut f = Vector::<6>::zeros();
+        f[0] = 5.0;
+        f[1] = -2.0;
         for _ in 0..20_000 {
-            o.step(&mut st, &c, &f).unwrap();
+            o.step(&mut st, Some(&c), &f).unwrap();
         }
         // K_d (p_c − p_d) = F_e at rest, (C1); fk(q_d) = p_d, (C2), up to
         // the posture term the damped inverse lets into the task,
-        // O(λ²/σ²)·k0‖q_posture − q_d‖/K_P (measured 9.5e-8 m).
+        // O(λ²/σ²)·k0‖q_posture − q_d‖/K_P.
         let kd = o.config().kd[0];
-        assert!((kd * (pc - st.pd) - f).norm() < 1e-9, "{}", st.pd);
+        let f3 = f.fixed_rows::<3>(0);
+        assert!((kd * (pc - st.pd) - f3).norm() < 1e-9, "{}", st.pd);
         let e = (o.kinematics().fk(&st.qd) - st.pd).norm();
         assert!(e < 1e-6, "{e}");
-        // A non-finite force is refused and changes nothing.
+        // A non-finite force or a reflection as target is refused and changes nothing.
         let before = st;
         assert!(o
-            .step(&mut st, &c, &Vector::from_element(f64::NAN))
+            .step(&mut st, Some(&c), &Vector::from_element(f64::NAN))
             .is_err());
+        assert_eq!(st, before);
+        let o6 = outer(CartesianConfig::default());
+        let mut st6 = o6.start(Vector::<2>::new(0.5, 1.0));
+        let mirror = PoseTarget::at(
+            pc,
+            Matrix3::from_diagonal(&Vector::<3>::new(1.0, 1.0, -1.0)),
+        );
+        let before = st6;
+        let e = o6.step(&mut st6, Some(&mirror), &f).unwrap_err();
+        assert!(e.to_string().contains("det R = +1"), "{e}");
+        assert_eq!(st6, before);
+    }
+
+    #[test]
+    fn position_only_refuses_a_rotational_stiffness_at_run_time() {
+        let o = outer(CartesianConfig::default().position_only());
+        let mut st = o.start(Vector::<2>::new(0.5, 1.0));
+        let before = st;
+        let e = o
+            .set_stiffness(
+                &mut st,
+                &Vector::from_element(100.0),
+                &Vector::from_element(1.0),
+            )
+            .unwrap_err();
+        assert!(e.to_string().contains("position-only"), "{e}");
+        assert_eq!(st, before);
+        let e = o
+            .set_stiffness(&mut st, &Vector::from_element(-1.0), &Vector::zeros())
+            .unwrap_err();
+        assert!(e.to_string().contains("Kd ≥ 0"), "{e}");
         assert_eq!(st, before);
     }
 }

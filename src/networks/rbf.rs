@@ -282,6 +282,26 @@ impl<const N: usize, C: AsRef<[f64]> + AsMut<[f64]>> Centers<N, C> {
     /// networks should still act (compliant deflection, transients), finite
     /// and > 0.
     pub fn along_in(buf: C, samples: &[Setpoint<N>], tube: [f64; 2]) -> Result<Self, Error> {
+        Self::along_spaced(buf, samples, tube, false)
+    }
+
+    /// [`along_in`](Self::along_in) for the samples of one period of a
+    /// periodic orbit: the spacing h_b also counts the step from the last
+    /// sample back to the first (the orbit closes on itself).
+    pub fn along_periodic_in(
+        buf: C,
+        samples: &[Setpoint<N>],
+        tube: [f64; 2],
+    ) -> Result<Self, Error> {
+        Self::along_spaced(buf, samples, tube, true)
+    }
+
+    fn along_spaced(
+        buf: C,
+        samples: &[Setpoint<N>],
+        tube: [f64; 2],
+        closed: bool,
+    ) -> Result<Self, Error> {
         let mut buf = buf;
         check::positive("tube > 0", "tube", tube[0])?;
         check::positive("tube > 0", "tube", tube[1])?;
@@ -300,7 +320,12 @@ impl<const N: usize, C: AsRef<[f64]> + AsMut<[f64]>> Centers<N, C> {
             row[..N].copy_from_slice(sp.x.as_slice());
             row[N..2 * N].copy_from_slice(sp.dx.as_slice());
             row[2 * N..].fill(0.0);
-            if let Some(next) = samples.get(j + 1) {
+            let next = match samples.get(j + 1) {
+                Some(next) => Some(next),
+                None if closed => samples.first(),
+                None => None,
+            };
+            if let Some(next) = next {
                 h[0] = h[0].max((next.x - sp.x).norm());
                 h[1] = h[1].max((next.dx - sp.dx).norm());
             }
@@ -374,6 +399,11 @@ impl<const N: usize> Centers<N, alloc::vec::Vec<f64>> {
     /// [`along_in`](Centers::along_in) on the heap: one node per sample.
     pub fn along(samples: &[Setpoint<N>], tube: [f64; 2]) -> Result<Self, Error> {
         Self::along_in(alloc::vec![0.0; samples.len() * 4 * N], samples, tube)
+    }
+
+    /// [`along_periodic_in`](Centers::along_periodic_in) on the heap.
+    pub fn along_periodic(samples: &[Setpoint<N>], tube: [f64; 2]) -> Result<Self, Error> {
+        Self::along_periodic_in(alloc::vec![0.0; samples.len() * 4 * N], samples, tube)
     }
 
     /// [`lattice_in`](Centers::lattice_in) on the heap.
@@ -537,6 +567,13 @@ mod tests {
         assert!((w[0][0] - 0.04).abs() < 1e-15, "{w:?}"); // (2 · 0.1)²
         assert_eq!(w[1][1], 0.25); // the tube: no spacing in v
         assert_eq!(w[3][0], f64::INFINITY);
+        // A periodic orbit also counts the way back from the last sample to the first.
+        let p = Centers::along_periodic(&samples, [0.05, 0.5]).unwrap();
+        assert!(
+            (p.widths2()[0][0] - 0.36).abs() < 1e-15,
+            "{:?}",
+            p.widths2()
+        ); // (2 · 0.3)²
         let mut s = [0.0; 4];
         c.eval(
             &[

@@ -41,6 +41,8 @@ pub enum Owned {
     Vec(Vec<f64>),
     /// A name.
     Str(String),
+    /// A flag.
+    Bool(bool),
     /// None.
     None,
 }
@@ -52,6 +54,7 @@ impl Owned {
             Owned::Int(i) => Value::Int(*i),
             Owned::Vec(v) => Value::Vec(v),
             Owned::Str(s) => Value::Str(s),
+            Owned::Bool(b) => Value::Bool(*b),
             Owned::None => Value::None,
         }
     }
@@ -327,7 +330,9 @@ pub struct Tables<'a> {
     pub setpoint: Option<[&'a [f64]; 3]>,
 }
 
-type Typed<const N: usize> = Tracker<N, AnyBasis<N>, Sinusoid<N>>;
+/// The typed controller behind a [`DynTracker`] of N joints (the Cartesian
+/// bindings step it directly, `src/python/cartesian.rs`).
+pub(crate) type Typed<const N: usize> = Tracker<N, AnyBasis<N>, Sinusoid<N>>;
 
 /// Build the controller `law` for n joints from `preset` and `items`, with the
 /// paper's grid (n ≤ 3) or `centers`.

@@ -24,6 +24,7 @@
 //! Nothing here panics on user input and nothing is `unsafe`.
 
 mod arm;
+mod cartesian;
 mod dynamic;
 
 use crate::control::config::Law;
@@ -179,9 +180,8 @@ fn owned(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<Owned> {
         return Ok(Owned::Str(obj.extract()?));
     }
     if obj.is_instance_of::<pyo3::types::PyBool>() {
-        return Err(PyTypeError::new_err(format!(
-            "{name} must be a number, got bool"
-        )));
+        // A flag's value; the schema refuses it for any other kind.
+        return Ok(Owned::Bool(obj.extract()?));
     }
     if obj.is_instance_of::<pyo3::types::PyInt>() {
         return match obj.extract::<i64>() {
@@ -1317,13 +1317,14 @@ fn simulate_many<'py>(
     Ok(out)
 }
 
-/// A schema value as Python sees it: float, int, list of floats, str or None.
+/// A schema value as Python sees it: float, int, list of floats, str, bool or None.
 fn py_value<'py>(py: Python<'py>, v: Value<'_>) -> PyResult<Bound<'py, PyAny>> {
     Ok(match v {
         Value::Real(x) => x.into_pyobject(py)?.into_any(),
         Value::Int(i) => i.into_pyobject(py)?.into_any(),
         Value::Vec(v) => PyList::new(py, v)?.into_any(),
         Value::Str(s) => PyString::new(py, s).into_any(),
+        Value::Bool(b) => pyo3::types::PyBool::new(py, b).to_owned().into_any(),
         Value::None => py.None().into_bound(py),
     })
 }
@@ -1396,6 +1397,9 @@ mod adaptimp_module {
     use super::{
         defaults, schema_table, simulate, simulate_many, PyArm, PyController, PyPlanarArm,
     };
+
+    #[pymodule_export]
+    use super::cartesian::{centres_along, PyCartesian, PyChain};
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

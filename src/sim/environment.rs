@@ -154,14 +154,17 @@ impl<K> CartesianWall<K> {
     where
         K: Kinematics<N>,
     {
-        self.force_at(&self.kin.fk(q), &(self.kin.jacobian(q) * dq))
+        let tip = self.kin.tip(q, dq);
+        let j = tip.jacobian.fixed_rows::<3>(0);
+        self.force_at(&tip.position, &(j * dq))
     }
 }
 
 impl<const N: usize, K: Kinematics<N>> Environment<N> for CartesianWall<K> {
     fn force(&self, _t: f64, x: &Vector<N>, dx: &Vector<N>) -> Vector<N> {
-        let j = self.kin.jacobian(x);
-        let f = self.force_at(&self.kin.fk(x), &(j * dx));
+        let tip = self.kin.tip(x, dx);
+        let j = tip.jacobian.fixed_rows::<3>(0);
+        let f = self.force_at(&tip.position, &(j * dx));
         j.transpose() * f
     }
 }

@@ -5,11 +5,11 @@
 //! n-link planar arm in a vertical plane for any `N` (it reduces to
 //! [`TwoLinkArm`] for `N = 2`).
 
-use crate::cartesian::kinematics::Kinematics;
+use crate::cartesian::kinematics::{Jacobian6, Kinematics, Tip};
 use crate::error::{check, Error, PARAM_BOUND};
 use crate::math::{cos, sin};
-use crate::types::{Jacobian, Matrix, Vector};
-use nalgebra::Vector2;
+use crate::types::{Matrix, Vector};
+use nalgebra::{Rotation3, Vector2, Vector3};
 
 /// Rigid-body dynamics of an `N`-joint manipulator in joint coordinates.
 ///
@@ -355,19 +355,16 @@ impl<const N: usize> Manipulator<N> for PlanarArm<N> {
 
 // The planar arms' kinematics, SPEC (16.0) (the trait's module docs).
 
-/// Link lengths and the absolute angles' sines, cosines and rates, then the
-/// three sums of the module docs.
-fn planar<const N: usize>(
-    lengths: &[f64; N],
-    q: &Vector<N>,
-    dq: Option<&Vector<N>>,
-) -> (Vector<3>, Jacobian<N>, Vector<3>) {
+/// The tip of a planar arm with link `lengths` at (q, q̇): the sums of the
+/// module docs of `Kinematics`, in one pass.
+fn planar<const N: usize>(lengths: &[f64; N], q: &Vector<N>, dq: &Vector<N>) -> Tip<N> {
     let mut p = Vector::<3>::zeros();
-    let mut jac = Jacobian::<N>::zeros();
-    let mut jdq = Vector::<3>::zeros();
+    let mut jac = Jacobian6::<N>::zeros();
+    let mut bias = Vector::<6>::zeros();
     let (mut theta, mut rate) = (0.0, 0.0);
     for a in 0..N {
         theta += q[a];
+        rate += dq[a];
         let (s, c) = (sin(theta), cos(theta));
         let l = lengths[a];
         p[0] += l * c;
@@ -377,36 +374,27 @@ fn planar<const N: usize>(
             jac[(0, i)] -= l * s;
             jac[(1, i)] += l * c;
         }
-        if let Some(dq) = dq {
-            rate += dq[a];
-            jdq[0] -= l * rate * rate * c;
-            jdq[1] -= l * rate * rate * s;
-        }
+        jac[(5, a)] = 1.0;
+        bias[0] -= l * rate * rate * c;
+        bias[1] -= l * rate * rate * s;
     }
-    (p, jac, jdq)
+    Tip {
+        position: p,
+        rotation: Rotation3::from_axis_angle(&Vector3::z_axis(), theta),
+        jacobian: jac,
+        bias,
+    }
 }
 
 impl<const N: usize> Kinematics<N> for PlanarArm<N> {
-    fn fk(&self, q: &Vector<N>) -> Vector<3> {
-        planar(&self.links().map(|l| l.length), q, None).0
-    }
-    fn jacobian(&self, q: &Vector<N>) -> Jacobian<N> {
-        planar(&self.links().map(|l| l.length), q, None).1
-    }
-    fn jacobian_dot_qdot(&self, q: &Vector<N>, dq: &Vector<N>) -> Vector<3> {
-        planar(&self.links().map(|l| l.length), q, Some(dq)).2
+    fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> Tip<N> {
+        planar(&self.links().map(|l| l.length), q, dq)
     }
 }
 
 impl Kinematics<2> for TwoLinkArm {
-    fn fk(&self, q: &Vector<2>) -> Vector<3> {
-        planar(&self.lengths(), q, None).0
-    }
-    fn jacobian(&self, q: &Vector<2>) -> Jacobian<2> {
-        planar(&self.lengths(), q, None).1
-    }
-    fn jacobian_dot_qdot(&self, q: &Vector<2>, dq: &Vector<2>) -> Vector<3> {
-        planar(&self.lengths(), q, Some(dq)).2
+    fn tip(&self, q: &Vector<2>, dq: &Vector<2>) -> Tip<2> {
+        planar(&self.lengths(), q, dq)
     }
 }
 
@@ -491,17 +479,6 @@ mod kinematics_tests {
         PlanarArm::new([link(2.0, 0.4), link(1.5, 0.35), link(1.0, 0.25)], 9.81).unwrap()
     }
 
-    /// The numerical default of J̇ q̇, for comparison with the closed forms.
-    struct Numeric<'a>(&'a PlanarArm<3>);
-    impl Kinematics<3> for Numeric<'_> {
-        fn fk(&self, q: &Vector<3>) -> Vector<3> {
-            self.0.fk(q)
-        }
-        fn jacobian(&self, q: &Vector<3>) -> Jacobian<3> {
-            self.0.jacobian(q)
-        }
-    }
-
     #[test]
     fn jacobian_and_its_derivative_match_finite_differences() {
         let arm = arm3();
@@ -513,10 +490,20 @@ mod kinematics_tests {
             let mut e = Vector::<3>::zeros();
             e[i] = h;
             let col = (arm.fk(&(q + e)) - arm.fk(&(q - e))) / (2.0 * h);
-            assert!((col - j.column(i)).norm() < 1e-8, "column {i}");
+            assert!(
+                (col - j.fixed_view::<3, 1>(0, i)).norm() < 1e-8,
+                "column {i}"
+            );
+            // ω = J_ω q̇: the tip turns with every joint about z.
+            let dr = arm.rotation(&(q + e)) * arm.rotation(&(q - e)).inverse();
+            let w = crate::cartesian::rotation::log_quaternion(
+                &nalgebra::UnitQuaternion::from_rotation_matrix(&dr),
+            ) / (2.0 * h);
+            assert!((w - j.fixed_view::<3, 1>(3, i)).norm() < 1e-8, "column {i}");
         }
-        let closed = arm.jacobian_dot_qdot(&q, &dq);
-        let numeric = Numeric(&arm).jacobian_dot_qdot(&q, &dq);
+        // J̇ q̇ = d/dt (J(q + t q̇)) q̇ at t = 0, by a central difference.
+        let numeric = (arm.jacobian(&(q + h * dq)) - arm.jacobian(&(q - h * dq))) / (2.0 * h) * dq;
+        let closed = arm.jdot_qdot(&q, &dq);
         assert!((closed - numeric).norm() < 1e-7, "{closed} vs {numeric}");
         assert_eq!(arm.fk(&q)[2], 0.0);
     }

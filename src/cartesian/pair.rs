@@ -1,0 +1,178 @@
+//! The Cartesian controller: the 6-D outer loop of SPEC §16 and the joint
+//! controller it drives (C5), one step over plain data (q, q̇, the measured
+//! wrench, an optional pose target), transactional, allocation-free.
+
+use crate::cartesian::kinematics::Kinematics;
+use crate::cartesian::outer::{CartesianImpedance, CartesianState, CompliantPose, PoseTarget};
+use crate::control::controller::Controller;
+use crate::control::impedance::ImpedanceMode;
+use crate::control::io::{Command, Measurement};
+use crate::control::state::State;
+use crate::error::{check, Error, BOUND};
+use crate::networks::rbf::Basis;
+use crate::trajectory::Setpoint;
+use crate::types::Vector;
+use nalgebra::{Rotation3, UnitQuaternion};
+
+/// One sample from the sensors at t_k.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct CartesianMeasurement<const N: usize> {
+    /// Joint position q (rad).
+    pub q: Vector<N>,
+    /// Joint velocity q̇ (rad/s), as [`Measurement::dx`].
+    pub dq: Option<Vector<N>>,
+    /// The wrench the tip exerts on the environment, F_e = [f (N); m (N m)],
+    /// world frame, the moment about the tip (the environment pushes back
+    /// with −F_e); from a force/torque sensor.
+    pub wrench: Vector<6>,
+}
+
+/// What a Cartesian step computed; `joint.tau_sat` goes to the actuators.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct CartesianCommand<const N: usize> {
+    /// The joint controller's command (τ, sat(τ), z1 = q_d − q, …).
+    pub joint: Command<N>,
+    /// The joint reference q_d, q̇_d, q̈_d (rad, rad/s, rad/s²) at t_k.
+    pub reference: Setpoint<N>,
+    /// The compliant reference pose at t_k.
+    pub compliant: CompliantPose,
+    /// The commanded pose at t_k after the target filter (p_t (m), R_t).
+    pub target: (Vector<3>, UnitQuaternion<f64>),
+    /// The error [e_p (m); e_o (rad)] the impedance acted on (after clipping).
+    pub error: Vector<6>,
+    /// The measured tip position fk(q) (m).
+    pub p: Vector<3>,
+    /// The measured tip rotation R(q).
+    pub r: Rotation3<f64>,
+    /// τe = Jᵀ(q) F_e (N m), or zero without `force_feedforward`: what the
+    /// joint controller got.
+    pub tau_e: Vector<N>,
+}
+
+/// The outer Cartesian impedance and the joint controller it drives.
+#[derive(Clone, Debug)]
+pub struct CartesianController<const N: usize, K, B> {
+    outer: CartesianImpedance<N, K>,
+    inner: Controller<N, B>,
+}
+
+impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B> {
+    /// The pair, validated: the joint controller must have
+    /// `impedance = "external"` (the Cartesian impedance is the only one:
+    /// a joint impedance would answer τe a second time) and the same Ts.
+    pub fn new(outer: CartesianImpedance<N, K>, inner: Controller<N, B>) -> Result<Self, Error> {
+        if inner.config().impedance != ImpedanceMode::External {
+            return Err(Error::Invalid {
+                what: "joint controller of a Cartesian impedance",
+                reason: "needs impedance = \"external\" (ImpedanceMode::External): the joint impedance would act on τe a second time",
+            });
+        }
+        if inner.period() != outer.period() {
+            return Err(Error::Invalid {
+                what: "joint controller of a Cartesian impedance",
+                reason: "needs the same Ts as the Cartesian impedance",
+            });
+        }
+        Ok(Self { outer, inner })
+    }
+
+    /// The outer loop.
+    pub fn outer(&self) -> &CartesianImpedance<N, K> {
+        &self.outer
+    }
+    /// The joint controller.
+    pub fn inner(&self) -> &Controller<N, B> {
+        &self.inner
+    }
+
+    /// One step at t_k: the measurement `m` and the commanded pose `target`
+    /// (`None`: hold the last one) in, the command out; no allocation. The
+    /// outer loop is staged, the joint step runs with the joint reference and
+    /// τe = Jᵀ(q) F_e (or zero without `force_feedforward`), and only if it
+    /// succeeds is the outer state committed (on an error both states are as
+    /// before, except the joint state's recorded fault).
+    pub fn step<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        outer: &mut CartesianState<N>,
+        inner: &mut State<N, S>,
+        m: &CartesianMeasurement<N>,
+        target: Option<&PoseTarget>,
+    ) -> Result<CartesianCommand<N>, Error> {
+        self.outer
+            .step_with(outer, m, target, |meas, r| self.inner.step(inner, meas, r))
+    }
+}
+
+impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
+    /// The Cartesian step with any joint controller `joint` (C5): stage the
+    /// outer loop, call `joint(measurement, reference)` with the joint
+    /// reference (q_d, q̇_d, q̈_d) and τe = Jᵀ(q) F_e (zero without
+    /// `force_feedforward`), and commit the outer state only if it succeeds.
+    /// [`CartesianController::step`] is this with the core's joint
+    /// controller; a binding passes its own.
+    pub fn step_with<F>(
+        &self,
+        outer: &mut CartesianState<N>,
+        m: &CartesianMeasurement<N>,
+        target: Option<&PoseTarget>,
+        joint: F,
+    ) -> Result<CartesianCommand<N>, Error>
+    where
+        F: FnOnce(&Measurement<N>, &Setpoint<N>) -> Result<Command<N>, Error>,
+    {
+        check::finite_slice("q", m.q.as_slice())?;
+        check::within("q", m.q.as_slice(), BOUND)?;
+        let staged = self.stage(outer, target, &m.wrench)?;
+        let tip = self.kinematics().tip(&m.q, &Vector::zeros());
+        let tau_e = if self.config().force_feedforward {
+            tip.jacobian.transpose() * m.wrench
+        } else {
+            Vector::zeros()
+        };
+        let meas = Measurement {
+            x: m.q,
+            dx: m.dq,
+            tau_e,
+        };
+        let joint = joint(&meas, &staged.reference)?;
+        *outer = staged.next;
+        Ok(CartesianCommand {
+            joint,
+            reference: staged.reference,
+            compliant: staged.compliant,
+            target: staged.target,
+            error: staged.error,
+            p: tip.position,
+            r: tip.rotation,
+            tau_e,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cartesian::outer::CartesianConfig;
+    use crate::control::config::{Config, Law};
+    use crate::networks::rbf::Grid;
+    use crate::sim::model::TwoLinkArm;
+
+    #[test]
+    fn the_joint_controller_must_leave_the_impedance_to_the_outer_loop() {
+        let outer = || {
+            CartesianImpedance::new(CartesianConfig::default(), TwoLinkArm::paper(), 1e-3).unwrap()
+        };
+        let mut cfg = Config::paper(Law::StateFeedback);
+        cfg.ts = 1e-3;
+        let joint = Controller::new(cfg, Grid::paper()).unwrap();
+        let e = CartesianController::new(outer(), joint).unwrap_err();
+        assert!(e.to_string().contains("external"), "{e}");
+        cfg.impedance = ImpedanceMode::External;
+        let joint = Controller::new(cfg, Grid::paper()).unwrap();
+        assert!(CartesianController::new(outer(), joint).is_ok());
+        cfg.ts = 2e-3;
+        let joint = Controller::new(cfg, Grid::paper()).unwrap();
+        let e = CartesianController::new(outer(), joint).unwrap_err();
+        assert!(e.to_string().contains("same Ts"), "{e}");
+    }
+}

@@ -1,0 +1,1030 @@
+//! Python bindings of task space (SPEC §16): `Chain` (serial-chain
+//! kinematics from joint data, n = 1 … 7) and `CartesianImpedance` (the core's
+//! 6-D outer loop over a chain, stepped alone, with an `adaptimp.Controller`
+//! — the core's joint step, no Python in between — or with a joint
+//! controller written in Python), and `centres_along` (SPEC §15's rule).
+//!
+//! As for the controller: one monomorphised core per n behind an object-safe
+//! face ([`DynChain`], [`DynOuter`]), slices in and out; errors become the
+//! exceptions of `adaptimp._errors`.
+
+use super::dynamic::{scenario, DynTracker, Owned, Typed, MAX_JOINTS};
+use super::{array, array1, config_error, items, python_shape, vector, ConfigError, PyController};
+use super::{DivergedError, MeasurementError};
+use crate::cartesian::chain::MAX_CHAIN_JOINTS;
+use crate::cartesian::{
+    CartesianCommand, CartesianConfig, CartesianImpedance, CartesianMeasurement, CartesianState,
+    Chain, Joint, JointKind, Kinematics, PoseTarget, Transform,
+};
+use crate::control::config::Law;
+use crate::control::io::Command;
+use crate::error::Error;
+use crate::networks::rbf::Centers;
+use crate::schema::Preset;
+use crate::trajectory::Setpoint;
+use crate::types::Vector;
+use nalgebra::Matrix3;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::{Mutex, MutexGuard, TryLockError};
+use std::vec::Vec;
+
+/// Length of a flat pose target: p, ṗ, p̈ (3 each), R row-major (9), ω, ω̇ (3 each).
+pub const TARGET_LEN: usize = 24;
+
+// ---------------------------------------------------------------------------
+// The object-safe faces.
+// ---------------------------------------------------------------------------
+
+/// The tip at (q, q̇): position (3), rotation (3 × 3 row-major), Jacobian
+/// (6 × n row-major), J̇ q̇ (6).
+pub struct TipOut {
+    /// p (m).
+    pub position: [f64; 3],
+    /// R, row-major.
+    pub rotation: [f64; 9],
+    /// [J_v; J_ω], 6 × n row-major.
+    pub jacobian: Vec<f64>,
+    /// J̇ q̇.
+    pub bias: [f64; 6],
+}
+
+/// A [`Chain`] of any n ≤ 7, over slices.
+pub trait DynChain: Send + Sync {
+    /// Movable joints n.
+    fn n(&self) -> usize;
+    /// Which joints are prismatic.
+    fn prismatic(&self) -> Vec<bool>;
+    /// The tip at (q, q̇) (n values each).
+    fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut;
+    /// The outer loop of `cfg` over this chain at period `ts`, started at `q0`.
+    fn outer(
+        &self,
+        cfg: CartesianConfig,
+        ts: f64,
+        q0: &[f64],
+        posture: Option<&[f64]>,
+    ) -> Result<Box<dyn DynOuter>, Error>;
+}
+
+fn vector_of<const N: usize>(v: &[f64]) -> Vector<N> {
+    Vector::from_column_slice(&v[..N])
+}
+
+impl<const N: usize> DynChain for Chain<N> {
+    fn n(&self) -> usize {
+        N
+    }
+    fn prismatic(&self) -> Vec<bool> {
+        (0..N).map(|i| self.is_prismatic(i)).collect()
+    }
+    fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut {
+        let t = Kinematics::tip(self, &vector_of(q), &vector_of(dq));
+        let r = t.rotation.matrix();
+        TipOut {
+            position: t.position.into(),
+            rotation: core::array::from_fn(|k| r[(k / 3, k % 3)]),
+            jacobian: t.jacobian.transpose().as_slice().to_vec(),
+            bias: t.bias.into(),
+        }
+    }
+    fn outer(
+        &self,
+        cfg: CartesianConfig,
+        ts: f64,
+        q0: &[f64],
+        posture: Option<&[f64]>,
+    ) -> Result<Box<dyn DynOuter>, Error> {
+        let outer = CartesianImpedance::new(cfg, *self, ts)?;
+        let q0 = vector_of::<N>(q0);
+        let posture = posture.map_or(q0, vector_of::<N>);
+        crate::error::check::finite_slice("q0", q0.as_slice())?;
+        crate::error::check::finite_slice("posture", posture.as_slice())?;
+        let mut state = outer.start(q0);
+        state.posture = posture;
+        Ok(Box::new(Outer {
+            outer,
+            state,
+            q0,
+            posture,
+            last: None,
+        }))
+    }
+}
+
+/// A chain of `joints` (base to tip, fixed ones included) and `tip`, with as
+/// many joints as it has movable ones (1 … 7).
+pub fn chain(joints: &[Joint], tip: &Transform) -> Result<Box<dyn DynChain>, Error> {
+    let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
+    macro_rules! arms {
+        ($($k:literal)*) => {
+            match n {
+                $($k => Ok(Box::new(Chain::<$k>::new(joints, tip)?)),)*
+                _ => Err(Error::Condition {
+                    condition: "1 ≤ n ≤ 7 movable joints",
+                    lhs: "movable joints",
+                    index: None,
+                    value: n as f64,
+                }),
+            }
+        };
+    }
+    arms!(1 2 3 4 5 6 7)
+}
+
+/// The quantities of the last Cartesian step, by name.
+const LAST: [&str; 18] = [
+    "q_d", "dq_d", "ddq_d", "p_d", "dp_d", "ddp_d", "R_d", "w_d", "dw_d", "p_t", "R_t", "error",
+    "p", "R", "tau_e", "tau", "tau_sat", "z1",
+];
+
+/// The quantities of the outer state, by name.
+const STATE: [&str; 9] = [
+    "p_d",
+    "R_d",
+    "q_d",
+    "dq_d",
+    "posture",
+    "stiffness",
+    "stiffness_filtered",
+    "offset",
+    "wrench",
+];
+
+/// A step's measurement and target, n ≤ 7 values each.
+pub struct StepIn<'a> {
+    /// q (rad).
+    pub q: &'a [f64],
+    /// q̇ (rad/s), if measured.
+    pub dq: Option<&'a [f64]>,
+    /// F_e = [f; m] (N, N m).
+    pub wrench: [f64; 6],
+    /// The commanded pose, or none (hold).
+    pub target: Option<PoseTarget>,
+}
+
+/// A joint controller written in the caller's language: given q, q̇, τe and
+/// the joint reference (q_d, q̇_d, q̈_d), write the torque to apply into the
+/// last slice.
+pub type JointFn<'a> =
+    dyn FnMut(&[f64], Option<&[f64]>, &[f64], [&[f64]; 3], &mut [f64]) -> Result<(), Error> + 'a;
+
+/// The outer loop over a chain, for any n ≤ 7, with its state.
+pub trait DynOuter: Send + Sync {
+    /// Ts (s).
+    fn ts(&self) -> f64;
+    /// Steps taken.
+    fn steps(&self) -> u64;
+    /// Whether the orientation is a task.
+    fn orients(&self) -> bool;
+    /// Back to t = 0 at `q0` (the start's, if none), the posture kept.
+    fn reset(&mut self, q0: Option<&[f64]>) -> Result<(), Error>;
+    /// The null-space posture (rad).
+    fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error>;
+    /// The stiffness asked for (N/m, N m/rad).
+    fn set_stiffness(&mut self, kd: [f64; 3], kd_rot: [f64; 3]) -> Result<(), Error>;
+    /// The outer loop alone: one committed step.
+    fn reference(&mut self, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Result<(), Error>;
+    /// One step with the core's joint controller behind `tracker`.
+    fn step_tracker(&mut self, tracker: &mut dyn DynTracker, m: &StepIn<'_>) -> Result<(), Error>;
+    /// One step with a joint controller of the caller's.
+    fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error>;
+    /// A quantity of the last step (see [`LAST`]).
+    fn last(&self, what: usize) -> Vec<f64>;
+    /// A quantity of the state (see [`STATE`]).
+    fn state(&self, what: usize) -> Vec<f64>;
+    /// The orbit rule: (q_d rows, q̇_d rows) of `nodes` samples along `targets`.
+    fn orbit(
+        &self,
+        q0: &[f64],
+        targets: &[PoseTarget],
+        nodes: usize,
+    ) -> Result<(Vec<f64>, Vec<f64>), Error>;
+}
+
+struct Outer<const N: usize> {
+    outer: CartesianImpedance<N, Chain<N>>,
+    state: CartesianState<N>,
+    q0: Vector<N>,
+    posture: Vector<N>,
+    last: Option<CartesianCommand<N>>,
+}
+
+impl<const N: usize> Outer<N> {
+    fn measurement(m: &StepIn<'_>) -> CartesianMeasurement<N> {
+        CartesianMeasurement {
+            q: vector_of(m.q),
+            dq: m.dq.map(vector_of),
+            wrench: Vector::<6>::from(m.wrench),
+        }
+    }
+}
+
+fn quaternion_rows(q: &nalgebra::UnitQuaternion<f64>) -> Vec<f64> {
+    let r = q.to_rotation_matrix();
+    (0..9).map(|k| r[(k / 3, k % 3)]).collect()
+}
+
+impl<const N: usize> DynOuter for Outer<N> {
+    fn ts(&self) -> f64 {
+        self.outer.period()
+    }
+    fn steps(&self) -> u64 {
+        self.state.k
+    }
+    fn orients(&self) -> bool {
+        self.outer.orients()
+    }
+    fn reset(&mut self, q0: Option<&[f64]>) -> Result<(), Error> {
+        if let Some(q0) = q0 {
+            let q0 = vector_of::<N>(q0);
+            crate::error::check::finite_slice("q0", q0.as_slice())?;
+            self.q0 = q0;
+        }
+        self.state = self.outer.start(self.q0);
+        self.state.posture = self.posture;
+        self.last = None;
+        Ok(())
+    }
+    fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error> {
+        let p = vector_of::<N>(posture);
+        crate::error::check::finite_slice("posture", p.as_slice())?;
+        self.posture = p;
+        self.state.posture = p;
+        Ok(())
+    }
+    fn set_stiffness(&mut self, kd: [f64; 3], kd_rot: [f64; 3]) -> Result<(), Error> {
+        self.outer
+            .set_stiffness(&mut self.state, &kd.into(), &kd_rot.into())
+    }
+    fn reference(&mut self, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Result<(), Error> {
+        let staged = self.outer.stage(&self.state, target, &wrench.into())?;
+        let tip = Kinematics::tip(
+            self.outer.kinematics(),
+            &staged.reference.x,
+            &Vector::zeros(),
+        );
+        self.state = staged.next;
+        self.last = Some(CartesianCommand {
+            joint: Command::zeros(),
+            reference: staged.reference,
+            compliant: staged.compliant,
+            target: staged.target,
+            error: staged.error,
+            p: tip.position,
+            r: tip.rotation,
+            tau_e: Vector::zeros(),
+        });
+        Ok(())
+    }
+    fn step_tracker(&mut self, tracker: &mut dyn DynTracker, m: &StepIn<'_>) -> Result<(), Error> {
+        let typed = tracker
+            .as_any_mut()
+            .downcast_mut::<Typed<N>>()
+            .ok_or(Error::Invalid {
+                what: "controller",
+                reason: "has another number of joints than the chain",
+            })?;
+        let meas = Self::measurement(m);
+        let cmd = self
+            .outer
+            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r| {
+                typed.step_with(jm, r)
+            })?;
+        self.last = Some(cmd);
+        Ok(())
+    }
+    fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error> {
+        let meas = Self::measurement(m);
+        let cmd = self
+            .outer
+            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r| {
+                let mut tau = [0.0; MAX_JOINTS];
+                joint(
+                    jm.x.as_slice(),
+                    jm.dx.as_ref().map(|d| d.as_slice()),
+                    jm.tau_e.as_slice(),
+                    [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
+                    &mut tau[..N],
+                )?;
+                let t = vector_of::<N>(&tau);
+                Ok(Command {
+                    tau_sat: t,
+                    tau: t,
+                    z1: r.x - jm.x,
+                    xc: r.x,
+                    xd: r.x,
+                    ..Command::zeros()
+                })
+            })?;
+        self.last = Some(cmd);
+        Ok(())
+    }
+    fn last(&self, what: usize) -> Vec<f64> {
+        let Some(c) = &self.last else {
+            let width = match LAST[what] {
+                "R_d" | "R_t" | "R" => 9,
+                "q_d" | "dq_d" | "ddq_d" | "tau_e" | "tau" | "tau_sat" | "z1" => N,
+                "error" => 6,
+                _ => 3,
+            };
+            return std::vec![f64::NAN; width];
+        };
+        let v3 = |v: &Vector<3>| v.as_slice().to_vec();
+        let vn = |v: &Vector<N>| v.as_slice().to_vec();
+        match LAST[what] {
+            "q_d" => vn(&c.reference.x),
+            "dq_d" => vn(&c.reference.dx),
+            "ddq_d" => vn(&c.reference.ddx),
+            "p_d" => v3(&c.compliant.p),
+            "dp_d" => v3(&c.compliant.dp),
+            "ddp_d" => v3(&c.compliant.ddp),
+            "R_d" => quaternion_rows(&c.compliant.r),
+            "w_d" => v3(&c.compliant.w),
+            "dw_d" => v3(&c.compliant.dw),
+            "p_t" => v3(&c.target.0),
+            "R_t" => quaternion_rows(&c.target.1),
+            "error" => c.error.as_slice().to_vec(),
+            "p" => v3(&c.p),
+            "R" => (0..9).map(|k| c.r[(k / 3, k % 3)]).collect(),
+            "tau_e" => vn(&c.tau_e),
+            "tau" => vn(&c.joint.tau),
+            "tau_sat" => vn(&c.joint.tau_sat),
+            _ => vn(&c.joint.z1),
+        }
+    }
+    fn state(&self, what: usize) -> Vec<f64> {
+        let s = &self.state;
+        match STATE[what] {
+            "p_d" => s.pd.as_slice().to_vec(),
+            "R_d" => quaternion_rows(&s.rd),
+            "q_d" => s.qd.as_slice().to_vec(),
+            "dq_d" => s.dqd.as_slice().to_vec(),
+            "posture" => s.posture.as_slice().to_vec(),
+            "stiffness" => s.stiffness.as_slice().to_vec(),
+            "stiffness_filtered" => s.stiffness_filtered.as_slice().to_vec(),
+            "offset" => s.offset.as_slice().to_vec(),
+            _ => s.wrench.as_slice().to_vec(),
+        }
+    }
+    fn orbit(
+        &self,
+        q0: &[f64],
+        targets: &[PoseTarget],
+        nodes: usize,
+    ) -> Result<(Vec<f64>, Vec<f64>), Error> {
+        let q0 = vector_of::<N>(q0);
+        crate::error::check::finite_slice("q0", q0.as_slice())?;
+        let zero = Setpoint {
+            x: Vector::<N>::zeros(),
+            dx: Vector::zeros(),
+            ddx: Vector::zeros(),
+        };
+        let mut out = std::vec![zero; nodes];
+        let k = self
+            .outer
+            .orbit(q0, targets.len(), |k| targets[k], &mut out)?;
+        let q = out[..k].iter().flat_map(|s| s.x.iter().copied()).collect();
+        let dq = out[..k].iter().flat_map(|s| s.dx.iter().copied()).collect();
+        Ok((q, dq))
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Conversions.
+// ---------------------------------------------------------------------------
+
+/// A step's error, named as in Python: the measurement and the target are
+/// inputs (`MeasurementError`), a signal beyond the finite range is
+/// `DivergedError`, a parameter `ConfigError`.
+fn cartesian_error(e: Error) -> PyErr {
+    const INPUTS: [&str; 11] = [
+        "q", "x", "dq", "dx", "wrench", "p_c", "dp_c", "ddp_c", "R_c", "w_c", "dw_c",
+    ];
+    let input = match e {
+        Error::NonFinite { what, .. } | Error::OutOfRange { what, .. } => INPUTS.contains(&what),
+        Error::Condition { lhs, .. } => INPUTS.contains(&lhs),
+        Error::MissingVelocity => true,
+        _ => false,
+    };
+    match e {
+        _ if input => MeasurementError::new_err(super::python_names(e).to_string()),
+        Error::OutOfRange { .. } | Error::Diverged { .. } => DivergedError::new_err(e.to_string()),
+        _ => super::step_error(e),
+    }
+}
+
+/// A flat vector of exactly `len` finite reals (a sequence or an array).
+fn flat(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let v: Vec<f64> = match obj.cast::<PyArray1<f64>>() {
+        Ok(a) => a.try_readonly()?.as_array().iter().copied().collect(),
+        Err(_) => obj
+            .call_method1("__array__", ())
+            .ok()
+            .and_then(|a| a.call_method1("astype", ("float64",)).ok())
+            .and_then(|a| a.call_method0("ravel").ok())
+            .and_then(|a| a.extract::<Vec<f64>>().ok())
+            .or_else(|| obj.extract::<Vec<f64>>().ok())
+            .ok_or_else(|| {
+                PyTypeError::new_err(format!("{what} must be a sequence or array of {len} reals"))
+            })?,
+    };
+    if v.len() != len {
+        return Err(MeasurementError::new_err(format!(
+            "{what} must have {len} values, got {}",
+            v.len()
+        )));
+    }
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(MeasurementError::new_err(format!(
+            "{what}[{i}] is not finite (NaN or infinite)"
+        )));
+    }
+    Ok(v)
+}
+
+/// A pose target from its flat layout (see [`TARGET_LEN`]).
+fn pose_target(v: &[f64]) -> PoseTarget {
+    let v3 = |i: usize| Vector::<3>::new(v[i], v[i + 1], v[i + 2]);
+    PoseTarget {
+        p: v3(0),
+        dp: v3(3),
+        ddp: v3(6),
+        r: Matrix3::from_fn(|i, j| v[9 + 3 * i + j]),
+        w: v3(18),
+        dw: v3(21),
+    }
+}
+
+fn target_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PoseTarget>> {
+    obj.map(|o| flat("target", TARGET_LEN, o).map(|v| pose_target(&v)))
+        .transpose()
+}
+
+fn wrench_of(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
+    let v = flat("wrench", 6, obj)?;
+    Ok(core::array::from_fn(|i| v[i]))
+}
+
+/// A transform from a dict: {"xyz", "rpy"} (URDF), {"pos", "quat"} (MuJoCo,
+/// [w, x, y, z]) or {"translation", "rotation"} (3 × 3, row-major); empty:
+/// the identity.
+fn transform(d: &Bound<'_, PyDict>) -> PyResult<Transform> {
+    let get = |key: &str, len: usize| -> PyResult<Option<Vec<f64>>> {
+        match d.get_item(key)? {
+            None => Ok(None),
+            Some(v) => {
+                let v: Vec<f64> = v
+                    .call_method0("__iter__")
+                    .ok()
+                    .and_then(|_| {
+                        v.extract::<Vec<Vec<f64>>>()
+                            .ok()
+                            .map(|rows| rows.concat())
+                            .or_else(|| v.extract::<Vec<f64>>().ok())
+                    })
+                    .ok_or_else(|| {
+                        PyTypeError::new_err(format!("{key} must be a sequence of {len} reals"))
+                    })?;
+                if v.len() != len {
+                    return Err(ConfigError::new_err(format!(
+                        "{key} must have {len} values, got {}",
+                        v.len()
+                    )));
+                }
+                Ok(Some(v))
+            }
+        }
+    };
+    let a3 = |v: Vec<f64>| -> [f64; 3] { core::array::from_fn(|i| v[i]) };
+    let err = |e: Error| ConfigError::new_err(e.to_string());
+    if let Some(q) = get("quat", 4)? {
+        let pos = get("pos", 3)?.map_or([0.0; 3], a3);
+        return Transform::from_pos_quat(pos, core::array::from_fn(|i| q[i])).map_err(err);
+    }
+    if let Some(r) = get("rotation", 9)? {
+        let t = get("translation", 3)?.map_or([0.0; 3], a3);
+        return Ok(Transform {
+            translation: t,
+            rotation: core::array::from_fn(|i| core::array::from_fn(|j| r[3 * i + j])),
+        });
+    }
+    let xyz = get("xyz", 3)?
+        .or(get("pos", 3)?)
+        .or(get("translation", 3)?)
+        .map_or([0.0; 3], a3);
+    let rpy = get("rpy", 3)?.map_or([0.0; 3], a3);
+    Ok(Transform::from_xyz_rpy(xyz, rpy))
+}
+
+fn joint(d: &Bound<'_, PyDict>) -> PyResult<Joint> {
+    let kind: String = match d.get_item("kind")? {
+        Some(k) => k.extract()?,
+        None => return Err(PyTypeError::new_err("a joint needs its kind")),
+    };
+    let kind = match kind.as_str() {
+        "fixed" => JointKind::Fixed,
+        "revolute" => JointKind::Revolute,
+        "prismatic" => JointKind::Prismatic,
+        other => {
+            return Err(ConfigError::new_err(format!(
+                "joint kind must be 'fixed', 'revolute' or 'prismatic', got {other:?}"
+            )))
+        }
+    };
+    let axis: [f64; 3] = match d.get_item("axis")? {
+        Some(a) => {
+            let v: Vec<f64> = a.extract()?;
+            if v.len() != 3 {
+                return Err(ConfigError::new_err(format!(
+                    "axis must have 3 values, got {}",
+                    v.len()
+                )));
+            }
+            [v[0], v[1], v[2]]
+        }
+        None if kind == JointKind::Fixed => [0.0; 3],
+        None => return Err(PyTypeError::new_err("a movable joint needs its axis")),
+    };
+    let offset: f64 = match d.get_item("offset")? {
+        Some(o) => o.extract()?,
+        None => 0.0,
+    };
+    Ok(Joint {
+        kind,
+        origin: transform(d)?,
+        axis,
+        offset,
+    })
+}
+
+fn rows(n: usize, what: &str, a: &PyReadonlyArray2<'_, f64>, width: usize) -> PyResult<Vec<f64>> {
+    if a.shape()[1] != width || a.shape()[0] != n {
+        return Err(MeasurementError::new_err(format!(
+            "{what} must have shape ({n}, {width}), got {}",
+            python_shape(a.shape())
+        )));
+    }
+    Ok(a.as_array().iter().copied().collect())
+}
+
+// ---------------------------------------------------------------------------
+// Chain.
+// ---------------------------------------------------------------------------
+
+/// A serial chain of n = 1 … 7 movable (revolute or prismatic) joints and a
+/// tip, from joint data (SPEC §16): pose, 6 × n Jacobian and J̇ q̇ of the tip.
+/// Use `adaptimp.Chain`, which reads URDF files and MuJoCo models.
+#[pyclass(name = "Chain", module = "adaptimp._adaptimp", frozen, subclass)]
+pub struct PyChain {
+    inner: Box<dyn DynChain>,
+}
+
+impl PyChain {
+    fn qv(&self, what: &'static str, obj: &Bound<'_, PyAny>) -> PyResult<[f64; MAX_JOINTS]> {
+        vector(what, self.inner.n(), obj)
+    }
+}
+
+#[pymethods]
+impl PyChain {
+    /// The chain of `joints` (dicts, base to tip: "kind" ("fixed",
+    /// "revolute", "prismatic"), the origin as "xyz" and "rpy" (m, rad),
+    /// "pos" and "quat" ([w, x, y, z]) or "translation" and "rotation" (3 × 3),
+    /// "axis" (3) and "offset" (rad or m, default 0)) and the `tip` transform
+    /// (a dict of the same origin keys).
+    #[new]
+    #[pyo3(signature = (joints, tip=None))]
+    fn new(joints: Vec<Bound<'_, PyDict>>, tip: Option<Bound<'_, PyDict>>) -> PyResult<Self> {
+        let js = joints.iter().map(joint).collect::<PyResult<Vec<_>>>()?;
+        let tip = match tip {
+            Some(t) => transform(&t)?,
+            None => Transform::IDENTITY,
+        };
+        let inner = chain(&js, &tip).map_err(|e| ConfigError::new_err(e.to_string()))?;
+        Ok(Self { inner })
+    }
+
+    /// Movable joints n.
+    #[getter]
+    fn n(&self) -> usize {
+        self.inner.n()
+    }
+
+    /// Whether each joint is prismatic (else revolute), (n,).
+    #[getter]
+    fn prismatic(&self) -> Vec<bool> {
+        self.inner.prismatic()
+    }
+
+    /// The tip's pose at q: the homogeneous transform (4, 4), world ← tip (m).
+    fn fk<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.inner.n();
+        let q = self.qv("q", q)?;
+        let t = self.inner.tip(&q[..n], &[0.0; MAX_JOINTS][..n]);
+        let mut m = std::vec![0.0; 16];
+        for i in 0..3 {
+            m[4 * i..4 * i + 3].copy_from_slice(&t.rotation[3 * i..3 * i + 3]);
+            m[4 * i + 3] = t.position[i];
+        }
+        m[15] = 1.0;
+        array(py, m, (4, 4))
+    }
+
+    /// The geometric Jacobian [J_v; J_ω] at q, (6, n), world-aligned, at the
+    /// tip origin: ṗ = J_v q̇ (m/s), ω = J_ω q̇ (rad/s).
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.inner.n();
+        let q = self.qv("q", q)?;
+        let t = self.inner.tip(&q[..n], &[0.0; MAX_JOINTS][..n]);
+        array(py, t.jacobian, (6, n))
+    }
+
+    /// J̇ q̇ at (q, q̇), (6,): the tip's classical acceleration at q̈ = 0,
+    /// [m/s²; rad/s²] (p̈ = J_v q̈ + (J̇ q̇)_v, ω̇ = J_ω q̈ + (J̇ q̇)_ω).
+    fn jdot_qdot<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        dq: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.inner.n();
+        let (q, dq) = (self.qv("q", q)?, self.qv("dq", dq)?);
+        let t = self.inner.tip(&q[..n], &dq[..n]);
+        Ok(array1(py, &t.bias))
+    }
+}
+
+// ---------------------------------------------------------------------------
+// CartesianImpedance.
+// ---------------------------------------------------------------------------
+
+/// The 6-D Cartesian impedance outer loop of SPEC §16 over a `Chain`, with its
+/// state; stepped alone (`reference`), with an `adaptimp.Controller`
+/// (`step_controller`: the core's joint step) or with a joint controller
+/// written in Python (`step_python`). Use `adaptimp.CartesianController`.
+#[pyclass(name = "CartesianImpedance", module = "adaptimp._adaptimp", frozen)]
+pub struct PyCartesian {
+    inner: Mutex<Box<dyn DynOuter>>,
+    n: usize,
+}
+
+impl PyCartesian {
+    fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynOuter>> {
+        loop {
+            match self.inner.try_lock() {
+                Ok(g) => return g,
+                Err(TryLockError::Poisoned(p)) => return p.into_inner(),
+                Err(TryLockError::WouldBlock) => py.detach(|| {
+                    drop(self.inner.lock());
+                }),
+            }
+        }
+    }
+
+    fn measurement<'a>(
+        &self,
+        q: &'a [f64; MAX_JOINTS],
+        dq: Option<&'a [f64; MAX_JOINTS]>,
+        wrench: [f64; 6],
+        target: Option<PoseTarget>,
+    ) -> StepIn<'a> {
+        StepIn {
+            q: &q[..self.n],
+            dq: dq.map(|d| &d[..self.n]),
+            wrench,
+            target,
+        }
+    }
+}
+
+#[pymethods]
+impl PyCartesian {
+    /// The outer loop with the complete Cartesian parameter dict `params`
+    /// (the schema's group "cartesian") over `chain`, at period `ts` (s),
+    /// started at `q0` (rad), with the null-space `posture` (default q0).
+    #[new]
+    #[pyo3(signature = (chain, params, ts, q0, posture=None))]
+    fn new(
+        chain: &PyChain,
+        params: &Bound<'_, PyDict>,
+        ts: f64,
+        q0: &Bound<'_, PyAny>,
+        posture: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let n = chain.inner.n();
+        let items: Vec<(String, Owned)> = items(params)?;
+        let cfg = scenario::<1>(Preset::Robot, Law::Pd, &items)
+            .map_err(config_error)?
+            .cartesian;
+        let q0 = vector("q0", n, q0)?;
+        let posture = posture.map(|p| vector("posture", n, p)).transpose()?;
+        let inner = chain
+            .inner
+            .outer(cfg, ts, &q0[..n], posture.as_ref().map(|p| &p[..n]))
+            .map_err(|e| ConfigError::new_err(e.to_string()))?;
+        Ok(Self {
+            inner: Mutex::new(inner),
+            n,
+        })
+    }
+
+    /// Joints n.
+    #[getter]
+    fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Period Ts (s).
+    #[getter]
+    fn ts(&self, py: Python<'_>) -> f64 {
+        self.lock(py).ts()
+    }
+
+    /// Steps taken.
+    #[getter]
+    fn steps(&self, py: Python<'_>) -> u64 {
+        self.lock(py).steps()
+    }
+
+    /// Whether the orientation is a task (False: position-only, Kd_rot = 0).
+    #[getter]
+    fn orients(&self, py: Python<'_>) -> bool {
+        self.lock(py).orients()
+    }
+
+    /// Back to t = 0 at `q0` (rad; default the start's); the posture is kept.
+    #[pyo3(signature = (q0=None))]
+    fn reset(&self, py: Python<'_>, q0: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+        let q0 = q0.map(|q| vector("q0", self.n, q)).transpose()?;
+        self.lock(py)
+            .reset(q0.as_ref().map(|q| &q[..self.n]))
+            .map_err(cartesian_error)
+    }
+
+    /// The null-space posture q_posture (rad), (n,).
+    fn set_posture(&self, py: Python<'_>, posture: &Bound<'_, PyAny>) -> PyResult<()> {
+        let p = vector("posture", self.n, posture)?;
+        self.lock(py)
+            .set_posture(&p[..self.n])
+            .map_err(cartesian_error)
+    }
+
+    /// Ask for the stiffness `Kd` (N/m, (3,)) and `Kd_rot` (N m/rad, (3,)): the
+    /// impedance moves to it through the target filter (SPEC (16.6)).
+    #[allow(non_snake_case)]
+    #[pyo3(name = "set_stiffness", signature = (Kd, Kd_rot))]
+    fn set_stiffness(
+        &self,
+        py: Python<'_>,
+        Kd: &Bound<'_, PyAny>,
+        Kd_rot: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let (a, b) = (flat("Kd", 3, Kd)?, flat("Kd_rot", 3, Kd_rot)?);
+        self.lock(py)
+            .set_stiffness([a[0], a[1], a[2]], [b[0], b[1], b[2]])
+            .map_err(|e| ConfigError::new_err(e.to_string()))
+    }
+
+    /// The outer loop alone, one committed step: `target` the commanded pose
+    /// flat (24,: p, ṗ, p̈, R row-major, ω, ω̇; None: hold the last one),
+    /// `wrench` F_e = [f; m] (N, N m). Returns (q_d, q̇_d, q̈_d) of t_k.
+    #[pyo3(signature = (target, wrench))]
+    #[allow(clippy::type_complexity)]
+    fn reference<'py>(
+        &self,
+        py: Python<'py>,
+        target: Option<&Bound<'py, PyAny>>,
+        wrench: &Bound<'py, PyAny>,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+    )> {
+        let target = target_of(target)?;
+        let wrench = wrench_of(wrench)?;
+        let mut g = self.lock(py);
+        g.reference(target.as_ref(), wrench)
+            .map_err(cartesian_error)?;
+        Ok((
+            array1(py, &g.last(0)),
+            array1(py, &g.last(1)),
+            array1(py, &g.last(2)),
+        ))
+    }
+
+    /// One Cartesian step with `controller` (an `adaptimp.Controller` with
+    /// impedance "external", the same n and Ts): the core's outer loop and
+    /// joint step, no Python in between. Returns sat(τ) (N m), (n,).
+    #[pyo3(signature = (controller, q, dq, wrench, target=None))]
+    fn step_controller<'py>(
+        &self,
+        py: Python<'py>,
+        controller: &PyController,
+        q: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+        wrench: &Bound<'py, PyAny>,
+        target: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.n;
+        let q = vector("q", n, q)?;
+        let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
+        let m = self.measurement(&q, dq.as_ref(), wrench_of(wrench)?, target_of(target)?);
+        let mut tracker = controller.lock(py);
+        let mut g = self.lock(py);
+        g.step_tracker(tracker.as_mut(), &m)
+            .map_err(cartesian_error)?;
+        Ok(array1(py, &g.last(16)))
+    }
+
+    /// One Cartesian step with a joint controller written in Python:
+    /// `inner.step(q, tau_e, dq, xc=q_d, dxc=q̇_d, ddxc=q̈_d)` is called with
+    /// the core's joint reference and τe, and the outer state is committed
+    /// only if it returns. Returns its torque (N m), (n,).
+    #[pyo3(signature = (inner, q, dq, wrench, target=None))]
+    fn step_python<'py>(
+        &self,
+        py: Python<'py>,
+        inner: &Bound<'py, PyAny>,
+        q: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+        wrench: &Bound<'py, PyAny>,
+        target: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.n;
+        let q = vector("q", n, q)?;
+        let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
+        let m = self.measurement(&q, dq.as_ref(), wrench_of(wrench)?, target_of(target)?);
+        let mut raised: Option<PyErr> = None;
+        let mut g = self.lock(py);
+        let mut call = |q: &[f64],
+                        dq: Option<&[f64]>,
+                        tau_e: &[f64],
+                        r: [&[f64]; 3],
+                        out: &mut [f64]|
+         -> Result<(), Error> {
+            let result = (|| -> PyResult<Vec<f64>> {
+                let kw = PyDict::new(py);
+                kw.set_item("xc", array1(py, r[0]))?;
+                kw.set_item("dxc", array1(py, r[1]))?;
+                kw.set_item("ddxc", array1(py, r[2]))?;
+                let dq = dq.map(|d| array1(py, d));
+                let tau =
+                    inner.call_method("step", (array1(py, q), array1(py, tau_e), dq), Some(&kw))?;
+                let v = flat("the joint controller's torque", out.len(), &tau)?;
+                Ok(v)
+            })();
+            match result {
+                Ok(v) => {
+                    out.copy_from_slice(&v);
+                    Ok(())
+                }
+                Err(e) => {
+                    raised = Some(e);
+                    Err(Error::Invalid {
+                        what: "joint controller",
+                        reason: "raised",
+                    })
+                }
+            }
+        };
+        let r = g.step_joint(&m, &mut call);
+        if let Some(e) = raised {
+            return Err(e);
+        }
+        r.map_err(cartesian_error)?;
+        Ok(array1(py, &g.last(16)))
+    }
+
+    /// A quantity of the last step by name: "q_d", "dq_d", "ddq_d" (n,);
+    /// "p_d", "dp_d", "ddp_d", "w_d", "dw_d" (3,) and "R_d" (3, 3), the
+    /// compliant reference; "p_t" (3,), "R_t" (3, 3), the filtered target;
+    /// "error" (6,) [e_p; e_o] after clipping; "p" (3,), "R" (3, 3), the
+    /// measured tip; "tau_e", "tau", "tau_sat", "z1" (n,) (NaN before a step).
+    fn last<'py>(&self, py: Python<'py>, what: &str) -> PyResult<Bound<'py, PyAny>> {
+        let i = LAST
+            .iter()
+            .position(|n| *n == what)
+            .ok_or_else(|| PyValueError::new_err(format!("last: one of {LAST:?}, got {what:?}")))?;
+        let v = self.lock(py).last(i);
+        if v.len() == 9 && what.starts_with('R') {
+            Ok(array(py, v, (3, 3))?.into_any())
+        } else {
+            Ok(array1(py, &v).into_any())
+        }
+    }
+
+    /// A quantity of the state by name: "p_d" (3,), "R_d" (3, 3), "q_d",
+    /// "dq_d", "posture" (n,), "stiffness", "stiffness_filtered" (6,)
+    /// [K_d; K_d,rot], "offset" (6,) of the target filter, "wrench" (6,)
+    /// filtered.
+    fn state<'py>(&self, py: Python<'py>, what: &str) -> PyResult<Bound<'py, PyAny>> {
+        let i = STATE.iter().position(|n| *n == what).ok_or_else(|| {
+            PyValueError::new_err(format!("state: one of {STATE:?}, got {what:?}"))
+        })?;
+        let v = self.lock(py).state(i);
+        if what == "R_d" {
+            Ok(array(py, v, (3, 3))?.into_any())
+        } else {
+            Ok(array1(py, &v).into_any())
+        }
+    }
+
+    /// The orbit rule (SPEC §15, §16): run this outer loop kinematically
+    /// (F_e = 0) from `q0` along `targets` (K, 24) (one flat pose target per
+    /// step) and return the joint reference (q_d (L, n), q̇_d (L, n)) of every
+    /// max(1, K // nodes)-th step, L ≤ `nodes`. This loop's state is unchanged.
+    #[allow(clippy::type_complexity)]
+    fn orbit<'py>(
+        &self,
+        py: Python<'py>,
+        q0: &Bound<'py, PyAny>,
+        targets: PyReadonlyArray2<'py, f64>,
+        nodes: usize,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+        let n = self.n;
+        let q0 = vector("q0", n, q0)?;
+        if nodes == 0 {
+            return Err(ConfigError::new_err("nodes must be ≥ 1"));
+        }
+        let k = targets.shape()[0];
+        let flat_rows = rows(k, "targets", &targets, TARGET_LEN)?;
+        let ts: Vec<PoseTarget> = flat_rows.chunks(TARGET_LEN).map(pose_target).collect();
+        let g = self.lock(py);
+        let (q, dq) = py
+            .detach(|| g.orbit(&q0[..n], &ts, nodes))
+            .map_err(cartesian_error)?;
+        let l = q.len() / n;
+        Ok((array(py, q, (l, n))?, array(py, dq, (l, n))?))
+    }
+}
+
+/// RBF centres along an orbit, SPEC §15 (15.2) (`Centers::along`, or
+/// `along_periodic` for one period of a periodic orbit): the samples q (L, n)
+/// (rad) and q̇ (L, n) (rad/s), the tube (rad, rad/s). Returns the centres
+/// (L, 4n) and the squared widths (4n,) (infinite for α1, α̇1).
+#[pyfunction]
+#[pyo3(signature = (q, dq, tube, periodic=false))]
+#[allow(clippy::type_complexity)]
+pub fn centres_along<'py>(
+    py: Python<'py>,
+    q: PyReadonlyArray2<'py, f64>,
+    dq: PyReadonlyArray2<'py, f64>,
+    tube: (f64, f64),
+    periodic: bool,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let (l, n) = (q.shape()[0], q.shape()[1]);
+    if !(1..=MAX_CHAIN_JOINTS).contains(&n) || l == 0 {
+        return Err(ConfigError::new_err(format!(
+            "q must have shape (L, n) with L ≥ 1 and 1 ≤ n ≤ 7, got {}",
+            python_shape(q.shape())
+        )));
+    }
+    let qs = rows(l, "q", &q, n)?;
+    let dqs = rows(l, "dq", &dq, n)?;
+    fn along<const N: usize>(
+        qs: &[f64],
+        dqs: &[f64],
+        tube: [f64; 2],
+        periodic: bool,
+    ) -> Result<(Vec<f64>, Vec<f64>), Error> {
+        let samples: Vec<Setpoint<N>> = qs
+            .chunks(N)
+            .zip(dqs.chunks(N))
+            .map(|(x, dx)| Setpoint {
+                x: vector_of(x),
+                dx: vector_of(dx),
+                ddx: Vector::zeros(),
+            })
+            .collect();
+        let c = if periodic {
+            Centers::along_periodic(&samples, tube)?
+        } else {
+            Centers::along(&samples, tube)?
+        };
+        let w = c.widths2();
+        let widths = w.iter().flat_map(|b| b.iter().copied()).collect();
+        Ok((c.centers().to_vec(), widths))
+    }
+    let tube = [tube.0, tube.1];
+    macro_rules! arms {
+        ($($k:literal)*) => {
+            match n {
+                $($k => along::<$k>(&qs, &dqs, tube, periodic),)*
+                _ => unreachable!("n is checked above"),
+            }
+        };
+    }
+    let (c, w) = arms!(1 2 3 4 5 6 7).map_err(|e| ConfigError::new_err(e.to_string()))?;
+    Ok((array(py, c, (l, 4 * n))?, array1(py, &w)))
+}

@@ -30,12 +30,16 @@ TYPES = {
     "derived": "float | None",
     "bound": 'float | Sequence[float] | Literal["auto"] | None',
     "limit": "float | _Joint | None",
+    "axes": "float | Sequence[float]",
+    "derived_axes": "float | Sequence[float] | None",
+    "flag": "bool",
 }
 
 CLASSES = (
     ("ControllerParams", ("controller",), "Controller parameters (SPEC §4–§11, §13)."),
     ("SimParams", ("sim", "env"), "Run and environment parameters (SPEC §3, §11)."),
     ("ArmParams", ("arm",), "Arm parameters (SPEC §1)."),
+    ("CartesianParams", ("cartesian",), "Cartesian impedance parameters (SPEC §16)."),
 )
 
 

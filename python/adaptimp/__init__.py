@@ -13,6 +13,8 @@ the project's SPEC (docs/SPEC.md).
 - :class:`Controller` is the controller alone, for your own loop; it pickles.
 - :class:`TwoLinkArm` is the paper's arm, :class:`PlanarArm` an arm of n links:
   D(q), C(q, q̇), G(q), forward dynamics.
+- :class:`Chain` is any arm's kinematics (from a URDF or a MuJoCo model), and
+  :class:`CartesianController` the 6-D Cartesian impedance over it (SPEC §16).
 - :func:`sweep` runs many simulations (a grid or random samples) on every core
   or on a Dask cluster and returns a pandas DataFrame.
 - Errors by kind: :class:`ConfigError`, :class:`MeasurementError`,
@@ -30,6 +32,8 @@ Every SPEC quantity is a keyword parameter with the paper's default
 
 from ._adaptimp import __version__
 from ._api import Controller, PlanarArm, TwoLinkArm, simulate
+from .cartesian import CartesianController
+from .chain import Chain
 from ._errors import (
     AdaptimpError,
     ConfigError,
@@ -50,6 +54,8 @@ __all__ = [
     "PLOT_KINDS",
     "SCENARIOS",
     "AdaptimpError",
+    "CartesianController",
+    "Chain",
     "Choice",
     "ConfigError",
     "Controller",

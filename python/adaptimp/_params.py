@@ -45,7 +45,12 @@ CASE_NAMES = {"pd": "PD", "sf": "state feedback", "of": "output feedback"}
 """Readable names of the cases, for tables and figure titles."""
 
 GROUPS = ("sim", "controller", "env", "arm")
-"""Parameter groups: the run, the controller, the environment (wall), the arm."""
+"""Parameter groups of :func:`adaptimp.simulate`: the run, the controller, the
+environment (wall), the arm."""
+
+ALL_GROUPS = (*GROUPS, "cartesian")
+"""Every parameter group: those of :data:`GROUPS` and the 6-D Cartesian impedance
+of :class:`adaptimp.CartesianController` (SPEC §16)."""
 
 
 @dataclass(frozen=True)
@@ -58,7 +63,10 @@ class Param:
     ``choices``), ``"optional"`` (a number or ``None``), ``"derived"`` (a
     number, or ``None`` for the value derived from other parameters),
     ``"bound"`` (``None``, ``"auto"`` or one number per network), ``"limit"``
-    (``None`` for no limit, or a number > 0 per joint).
+    (``None`` for no limit, or a number > 0 per joint), ``"axes"`` (a number
+    broadcast to the task axes x, y, z, or one value per axis),
+    ``"derived_axes"`` (the same, or ``None`` for the value derived from other
+    parameters), ``"flag"`` (``True`` or ``False``).
     ``condition`` is the validity condition the core checks (SPEC §10 style).
     """
 
@@ -127,7 +135,8 @@ def check_n(n: object) -> int:
 
 
 def names(*groups: str) -> list[str]:
-    """Parameter names of the given groups (all groups if none), in documentation order."""
+    """Parameter names of the given groups (those of :func:`adaptimp.simulate`,
+    :data:`GROUPS`, if none), in documentation order."""
     wanted = groups or GROUPS
     return [p.name for p in PARAMS if p.group in wanted]
 
@@ -250,6 +259,14 @@ def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
         return None if value is None else _real(p, value)
     if p.kind == "limit":
         return None if value is None else _vector(p, value, n, "one value per joint")
+    if p.kind == "axes":
+        return _vector(p, value, 3, "one value per axis x, y, z")
+    if p.kind == "derived_axes":
+        return None if value is None else _vector(p, value, 3, "one value per axis x, y, z")
+    if p.kind == "flag":
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        raise TypeError(f"{p.name} must be True or False, got {_type_name(value)}")
     if p.kind == "bound":
         if value is None or (isinstance(value, str) and value == "auto"):
             return value
@@ -302,6 +319,7 @@ def _reject_unknown(
                 "env": "an environment parameter (adaptimp.simulate)",
                 "arm": "an arm parameter (adaptimp.TwoLinkArm, adaptimp.simulate)",
                 "controller": "a controller parameter (adaptimp.Controller, adaptimp.simulate)",
+                "cartesian": "a Cartesian impedance parameter (adaptimp.CartesianController)",
             }[BY_NAME[key].group]
             raise TypeError(
                 f"{caller} got an unexpected keyword argument {key!r}: it is {where}. "

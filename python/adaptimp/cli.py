@@ -41,7 +41,9 @@ class CliError(Exception):
 def _parse_value(name: str, text: str) -> Any:
     p = BY_NAME[name]
     try:
-        if p.kind in ("optional", "derived", "bound", "limit") and text.lower() == "none":
+        if p.kind in ("optional", "derived", "bound", "limit", "derived_axes") and (
+            text.lower() == "none"
+        ):
             return None
         if p.kind == "bound":
             if text.lower() == "auto":
@@ -52,9 +54,13 @@ def _parse_value(name: str, text: str) -> Any:
             return int(text)
         if p.kind in ("real", "optional", "derived"):
             return float(text)
-        if p.kind in ("joint", "network", "limit"):
+        if p.kind in ("joint", "network", "limit", "axes", "derived_axes"):
             parts = [float(x) for x in text.split(",")]
             return parts[0] if len(parts) == 1 else parts
+        if p.kind == "flag":
+            if text.lower() in ("true", "false"):
+                return text.lower() == "true"
+            raise ValueError(text)
     except ValueError:
         raise CliError(f"--{name}: cannot read {text!r} as {_expected(p.kind)}") from None
     return text  # a choice
@@ -70,6 +76,9 @@ def _expected(kind: str) -> str:
         "network": "a number or comma-separated numbers, one per network (D, C, G)",
         "bound": "'none', 'auto', or comma-separated numbers, one per network (D, C, G)",
         "limit": "'none', or a number or comma-separated numbers, one per joint",
+        "axes": "a number or comma-separated numbers, one per axis (x, y, z)",
+        "derived_axes": "'none', or a number or comma-separated numbers, one per axis (x, y, z)",
+        "flag": "'true' or 'false'",
     }.get(kind, "a value")
 
 
@@ -178,6 +187,8 @@ def cmd_params(args: argparse.Namespace, params: dict[str, Any]) -> int:
         f"{args.scenario!r} scenario):"
     )
     print(describe(scenario=args.scenario))
+    print("\nParameters of adaptimp.CartesianController, the 6-D Cartesian impedance (SPEC §16):")
+    print(describe("cartesian", scenario=args.scenario))
     return 0
 
 

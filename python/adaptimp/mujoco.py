@@ -94,10 +94,11 @@ class ControllerLike(Protocol):
     ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``,
     ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
 
-    Cartesian hook: a controller with ``wants_wrench = True`` is also given
-    ``wrench=`` F_e = [f; m] (6,), N and N m, world frame (the plant's
-    measurement of the row, the one τe is computed from), e.g.
-    :class:`adaptimp.cartesian.CartesianImpedance`.
+    Cartesian hook: a controller with ``wants_wrench = True`` is called as
+    ``step(q, dq, wrench, **setpoint)`` instead, with the measured wrench
+    F_e = [f; m] (6,), N and N m, world frame (the plant's measurement of the
+    row, the one τe is computed from) in place of τe, e.g.
+    :class:`adaptimp.CartesianController` (which maps it to the joints itself).
     """
 
     def step(
@@ -951,8 +952,7 @@ def simulate(
     plant.timestep = Ts / substeps
     plant.reset(q0, dq0)
     has = {name: hasattr(ctrl, name) for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta")}
-    # The Cartesian hook (ControllerLike): the measured wrench as well as τe.
-    extra: dict[str, Any] = {}
+    # The Cartesian hook (ControllerLike): the measured wrench instead of τe.
     wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
     n = plant.n
     rows: dict[str, list[Any]] = {name: [] for name in ARRAYS if name != "t"}
@@ -965,16 +965,15 @@ def simulate(
         wrench = plant.wrench()
         tau_e = plant.tau_e(wrench)
         r_x_ee.append(plant.ee_position())
-        if wants_wrench:
-            extra["wrench"] = wrench
+        args = (q, dq, wrench) if wants_wrench else (q, tau_e, dq)
         if reference is not None:
             xc, dxc, ddxc = (np.asarray(v, dtype=np.float64) for v in reference(k * Ts))
-            tau_cmd = ctrl.step(q, tau_e, dq, xc=xc, dxc=dxc, ddxc=ddxc, **extra)
+            tau_cmd = ctrl.step(*args, xc=xc, dxc=dxc, ddxc=ddxc)
             r_xc.append(xc)
             r_dxc.append(dxc)
             r_ddxc.append(ddxc)
         else:
-            tau_cmd = ctrl.step(q, tau_e, dq, **extra)
+            tau_cmd = ctrl.step(*args)
             xc = ctrl.xc if has["xc"] else q
             r_xc.append(xc)
         tau_sat = plant.apply(tau_cmd)

@@ -56,3 +56,33 @@ pub fn reference_metrics() -> HashMap<(String, String), f64> {
         })
         .collect()
 }
+
+/// The Franka Emika Panda to its tool centre point, from the joint data of
+/// example-robot-data's `panda.urdf` (`<origin xyz rpy>`, `<axis>`; the fixed
+/// joints `panda_joint8`, `panda_hand_joint`, `panda_hand_tcp_joint`).
+pub fn panda() -> adaptimp::Chain<7> {
+    use adaptimp::{Chain, Joint, Transform};
+    let h = std::f64::consts::FRAC_PI_2;
+    let rev = |xyz: [f64; 3], roll: f64| {
+        Joint::revolute(Transform::from_xyz_rpy(xyz, [roll, 0.0, 0.0]), [0.0, 0.0, 1.0])
+    };
+    let joints = [
+        rev([0.0, 0.0, 0.333], 0.0),
+        rev([0.0, 0.0, 0.0], -h),
+        rev([0.0, -0.316, 0.0], h),
+        rev([0.0825, 0.0, 0.0], h),
+        rev([-0.0825, 0.384, 0.0], -h),
+        rev([0.0, 0.0, 0.0], h),
+        rev([0.088, 0.0, 0.0], h),
+        Joint::fixed(Transform::from_xyz_rpy([0.0, 0.0, 0.107], [0.0; 3])),
+        Joint::fixed(Transform::from_xyz_rpy(
+            [0.0; 3],
+            [0.0, 0.0, -std::f64::consts::FRAC_PI_4],
+        )),
+    ];
+    let tcp = Transform::from_xyz_rpy([0.0, 0.0, 0.1034], [0.0; 3]);
+    Chain::new(&joints, &tcp).expect("the Panda's joint data")
+}
+
+/// The Panda's reference posture (rad), the SRDF's `default`.
+pub const PANDA_HOME: [f64; 7] = [0.0, -0.785398, 0.0, -2.35619, 0.0, 1.5707, 0.785398];

@@ -3,8 +3,10 @@
 The Franka Emika Panda (example-robot-data's URDF, effort limits 87/12 N m) in
 MuJoCo draws a 5 cm circle at 0.25 Hz on a table with its tool while pressing
 δ_c = 15 mm into it through the target impedance (SPEC §16: M_d = 2 kg,
-K_d = 500 N/m, B_d critically damped). Every controller has the same outer
-loop (``adaptimp.cartesian``); the joint controller differs:
+K_d = 500 N/m, B_d critically damped, position-only). Every controller has the
+same outer loop, the core's (``adaptimp.CartesianController`` over the Panda's
+``adaptimp.Chain``, scenario in ``adaptimp.panda_table``); the joint controller
+differs:
 
 - PD, adaptive state feedback (SF), adaptive output feedback (OF):
   ``adaptimp.Controller(case, "robot", n=7, impedance="external")`` at 1 kHz,
@@ -130,7 +132,7 @@ def long_run(sc: ac.PandaTable, basis: Any, T: float) -> None:
     peak = 0.0
     for k in range(round(T / sc.ts)):
         wrench = plant.wrench()
-        tau = ctrl.step(plant.q, plant.tau_e(wrench), plant.dq, wrench=wrench)
+        tau = ctrl.step(plant.q, plant.dq, wrench)
         peak = max(peak, float(np.max(np.abs(plant.apply(tau)) / plant.tau_max)))
         plant.step(substeps)
         plant.forward()

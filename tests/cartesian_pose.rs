@@ -7,9 +7,9 @@ mod common;
 
 use adaptimp::cartesian::rotation::{exp, log_quaternion, rotation_error};
 use adaptimp::{
-    CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
-    CartesianState, Centers, Chain, Config, Controller, ImpedanceMode, Kinematics, Law,
-    PoseTarget, Setpoint, Vector,
+    CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement, CartesianState,
+    Centers, Chain, Config, Controller, ImpedanceMode, Kinematics, Law, PoseTarget, Setpoint,
+    Vector,
 };
 use nalgebra::{Matrix3, SMatrix, UnitQuaternion, Vector3};
 use proptest::prelude::*;
@@ -131,7 +131,10 @@ fn the_restoring_moment_is_continuous_except_at_exactly_180_degrees() {
     }
     // Across 180°: from +K(π − 1°)u to −K(π − 1°)u.
     let across = moments[181] - moments[179];
-    assert!((across + 2.0 * k * (PI - step) * u).norm() < 1e-9, "{across}");
+    assert!(
+        (across + 2.0 * k * (PI - step) * u).norm() < 1e-9,
+        "{across}"
+    );
 }
 
 /// J⁺ = Jᵀ (J Jᵀ + Λ²)⁻¹ of (C3), explicitly, and its largest singular value.
@@ -140,7 +143,9 @@ fn pinv_norm(o: &CartesianImpedance<7, Chain<7>>, q: &Vector<7>) -> f64 {
     let cfg = o.config();
     let (lp, lo) = (cfg.clik_lambda.powi(2), cfg.clik_lambda_rot.powi(2));
     let lam = SMatrix::<f64, 6, 6>::from_diagonal(&Vector::<6>::new(lp, lp, lp, lo, lo, lo));
-    let a = (j * j.transpose() + lam).try_inverse().expect("positive definite");
+    let a = (j * j.transpose() + lam)
+        .try_inverse()
+        .expect("positive definite");
     let pinv = j.transpose() * a;
     pinv.svd(false, false).singular_values.max()
 }
@@ -180,12 +185,22 @@ fn a_change_of_stiffness_or_target_moves_the_reference_by_a_t_of_a_jump() {
         assert!(norm <= 1.0 / (2.0 * cfg.clik_lambda.min(cfg.clik_lambda_rot)));
 
         // (a) K doubled on every axis.
-        let base_f = filtered.stage(&sf, Some(&c), &wrench).expect("stage").reference.ddx;
-        let base_b = bare.stage(&sb, Some(&c), &wrench).expect("stage").reference.ddx;
+        let base_f = filtered
+            .stage(&sf, Some(&c), &wrench)
+            .expect("stage")
+            .reference
+            .ddx;
+        let base_b = bare
+            .stage(&sb, Some(&c), &wrench)
+            .expect("stage")
+            .reference
+            .ddx;
         let (mut f2, mut b2) = (sf, sb);
         let kd2 = 2.0 * cfg.kd;
         let kr2 = 2.0 * cfg.kd_rot;
-        filtered.set_stiffness(&mut f2, &kd2, &kr2).expect("stiffness");
+        filtered
+            .set_stiffness(&mut f2, &kd2, &kr2)
+            .expect("stiffness");
         bare.set_stiffness(&mut b2, &kd2, &kr2).expect("stiffness");
         let step_f = filtered.stage(&f2, Some(&c), &wrench).expect("stage");
         let step_b = bare.stage(&b2, Some(&c), &wrench).expect("stage");
@@ -193,10 +208,19 @@ fn a_change_of_stiffness_or_target_moves_the_reference_by_a_t_of_a_jump() {
         assert!(db.norm() > 1.0, "a jump to filter: {}", db.norm());
         // Linear in the filtered stiffness up to the damping 2√(K M), which moves
         // with √K on a compliant velocity that has settled to ~0.
-        assert!((df - at * db).norm() <= 1e-6 * db.norm(), "{df} vs {}", at * db);
+        assert!(
+            (df - at * db).norm() <= 1e-6 * db.norm(),
+            "{df} vs {}",
+            at * db
+        );
         let e = step_f.error;
         let dr = (at * k.component_mul(&e)).component_div(&m); // ΔK = K
-        assert!(df.norm() <= norm * dr.norm() * (1.0 + 1e-9), "{} > {}", df.norm(), norm * dr.norm());
+        assert!(
+            df.norm() <= norm * dr.norm() * (1.0 + 1e-9),
+            "{} > {}",
+            df.norm(),
+            norm * dr.norm()
+        );
 
         // (b) the target jumps 5 cm along x and 10° about z (from rest, no wrench).
         let (c0, rest_f) = at_rest(&filtered);
@@ -204,14 +228,28 @@ fn a_change_of_stiffness_or_target_moves_the_reference_by_a_t_of_a_jump() {
         let mut jumped = c0;
         jumped.p[0] += 0.05;
         let turn = exp(&Vector::<3>::new(0.0, 0.0, 10f64.to_radians()));
-        jumped.r = *(turn * UnitQuaternion::from_matrix(&c0.r)).to_rotation_matrix().matrix();
-        let base_f = filtered.stage(&rest_f, Some(&c0), &Vector::zeros()).expect("stage");
-        let base_b = bare.stage(&rest_b, Some(&c0), &Vector::zeros()).expect("stage");
-        let step_f = filtered.stage(&rest_f, Some(&jumped), &Vector::zeros()).expect("stage");
-        let step_b = bare.stage(&rest_b, Some(&jumped), &Vector::zeros()).expect("stage");
+        jumped.r = *(turn * UnitQuaternion::from_matrix(&c0.r))
+            .to_rotation_matrix()
+            .matrix();
+        let base_f = filtered
+            .stage(&rest_f, Some(&c0), &Vector::zeros())
+            .expect("stage");
+        let base_b = bare
+            .stage(&rest_b, Some(&c0), &Vector::zeros())
+            .expect("stage");
+        let step_f = filtered
+            .stage(&rest_f, Some(&jumped), &Vector::zeros())
+            .expect("stage");
+        let step_b = bare
+            .stage(&rest_b, Some(&jumped), &Vector::zeros())
+            .expect("stage");
         let df = step_f.reference.ddx - base_f.reference.ddx;
         let db = step_b.reference.ddx - base_b.reference.ddx;
-        assert!((df - at * db).norm() <= 1e-9 * db.norm(), "{df} vs {}", at * db);
+        assert!(
+            (df - at * db).norm() <= 1e-9 * db.norm(),
+            "{df} vs {}",
+            at * db
+        );
         let delta = Vector::<6>::new(0.05, 0.0, 0.0, 0.0, 0.0, 10f64.to_radians());
         let dr = (at * k.component_mul(&delta)).component_div(&m);
         let norm = pinv_norm(&filtered, &rest_f.qd);
@@ -257,7 +295,9 @@ fn a_target_jump_changes_the_torque_by_at_most_a_t_times_its_variation_per_step(
         let mut jumped = c0;
         jumped.p[0] += 0.05;
         let turn = exp(&Vector::<3>::new(0.0, 0.0, 10f64.to_radians()));
-        jumped.r = *(turn * UnitQuaternion::from_matrix(&c0.r)).to_rotation_matrix().matrix();
+        jumped.r = *(turn * UnitQuaternion::from_matrix(&c0.r))
+            .to_rotation_matrix()
+            .matrix();
         (0..1500)
             .map(|k| {
                 let c = if jump && k >= 500 { jumped } else { c0 };
@@ -275,9 +315,8 @@ fn a_target_jump_changes_the_torque_by_at_most_a_t_times_its_variation_per_step(
         a.iter().zip(&b).map(|(x, y)| x - y).collect()
     };
     let (filtered, bare) = (response(tau_t), response(0.0));
-    let steps = |r: &[Vector<7>]| -> Vec<f64> {
-        r.windows(2).map(|w| (w[1] - w[0]).amax()).collect()
-    };
+    let steps =
+        |r: &[Vector<7>]| -> Vec<f64> { r.windows(2).map(|w| (w[1] - w[0]).amax()).collect() };
     let variation: f64 = steps(&bare).iter().sum();
     let worst = steps(&filtered).into_iter().fold(0.0, f64::max);
     let first = steps(&bare).into_iter().fold(0.0, f64::max);
@@ -293,7 +332,11 @@ fn a_target_jump_changes_the_torque_by_at_most_a_t_times_its_variation_per_step(
     assert_eq!(bare[500], Vector::<7>::zeros());
     let (f1, b1) = (filtered[501], bare[501]);
     assert!(b1.amax() > 0.1, "{b1}");
-    assert!((f1 - at * b1).amax() <= 1e-9 * b1.amax(), "{f1} vs {}", at * b1);
+    assert!(
+        (f1 - at * b1).amax() <= 1e-9 * b1.amax(),
+        "{f1} vs {}",
+        at * b1
+    );
 }
 
 /// Free space, the outer loop alone: a pose path (a 5 cm circle while turning
@@ -303,7 +346,10 @@ fn a_target_jump_changes_the_torque_by_at_most_a_t_times_its_variation_per_step(
 fn the_six_d_inverse_kinematics_follows_a_pose_path() {
     let o = outer(CartesianConfig::default());
     let tip = o.kinematics().tip(&home(), &Vector::zeros());
-    let (p0, r0) = (tip.position, UnitQuaternion::from_rotation_matrix(&tip.rotation));
+    let (p0, r0) = (
+        tip.position,
+        UnitQuaternion::from_rotation_matrix(&tip.rotation),
+    );
     let w = PI / 2.0;
     let path = |t: f64| {
         let (s, c) = ((w * t).sin(), (w * t).cos());
@@ -323,7 +369,9 @@ fn the_six_d_inverse_kinematics_follows_a_pose_path() {
     let (mut worst_p, mut worst_r, mut worst_c) = (0.0f64, 0.0f64, 0.0f64);
     for k in 0..4000 {
         let target = path(k as f64 * TS);
-        let s = o.stage(&st, Some(&target), &Vector::zeros()).expect("stage");
+        let s = o
+            .stage(&st, Some(&target), &Vector::zeros())
+            .expect("stage");
         if k >= 500 {
             let at = o.kinematics().tip(&s.reference.x, &Vector::zeros());
             let rq = UnitQuaternion::from_rotation_matrix(&at.rotation);

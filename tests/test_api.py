@@ -13,7 +13,7 @@ import pytest
 
 import adaptimp
 from adaptimp import SimResult, _adaptimp
-from adaptimp._params import names, resolve
+from adaptimp._params import ALL_GROUPS, names, resolve
 from adaptimp._result import ARRAYS, METRIC_KEYS
 
 PER_JOINT = ("q", "dq", "xc", "xd", "dq_hat", "tau", "tau_sat", "tau_e", "zeta", "z1")
@@ -76,8 +76,8 @@ def test_params_are_complete_and_json_serialisable(runs: dict[str, SimResult]) -
 def test_paper_table_is_the_core_schema() -> None:
     """The Python keyword table and defaults are the core's schema, read at import."""
     core = _adaptimp.defaults("paper")
-    assert list(core) == names()
-    table = resolve({}, scenario="paper")
+    assert list(core) == names(*ALL_GROUPS)
+    table = resolve({}, scenario="paper", groups=ALL_GROUPS)
     for key, value in core.items():
         assert table[key] == value, key
 

@@ -1,4 +1,4 @@
-"""The Python outer loop of SPEC §16 (adaptimp.cartesian) and the panda-table scenario."""
+"""The core's outer loop of SPEC §16 through adaptimp.cartesian, and the panda-table scenario."""
 
 from __future__ import annotations
 
@@ -20,10 +20,11 @@ def test_free_space_clik_follows_the_command(sc: ac.PandaTable) -> None:
     err, gap = [], []
     for k in range(3000):
         p, dp, ddp = sc.path(k * sc.ts, depth=0.0)
-        q, _, _ = outer.step(p, dp, ddp, np.zeros(3))
+        q, _, _ = outer.step(p, dp, ddp)
         if k * sc.ts >= 1.5:
-            err.append(np.linalg.norm(sc.fk(q) - outer.pd_k))
-            gap.append(np.linalg.norm(outer.pd_k - p))
+            pd = outer.last("p_d")
+            err.append(np.linalg.norm(sc.fk(q) - pd))
+            gap.append(np.linalg.norm(pd - p))
     assert max(gap) < 1e-5
     assert max(err) < 1e-4
 
@@ -38,22 +39,20 @@ def test_steady_contact_force_is_kd_times_depth(sc: ac.PandaTable) -> None:
     f = np.zeros(3)
     for k in range(4000):
         s = min(k * sc.ts / 1.0, 1.0)
-        q, _, _ = outer.step(p0 + s * (pc - p0), np.zeros(3), np.zeros(3), f)
+        q, _, _ = outer.step(p0 + s * (pc - p0), wrench=f)
         z = sc.fk(q)[2]
-        f = np.array([0.0, 0.0, -ke * max(0.0, w - z)])  # the force the tool exerts: down
+        f = np.array([0.0, 0.0, -ke * max(0.0, w - z), 0.0, 0.0, 0.0])  # the tool presses down
     fn = -f[2]
     expected = 500.0 * ke / (500.0 + ke) * 0.01
     assert fn == pytest.approx(expected, rel=2e-3)
     assert fn == pytest.approx(500.0 * 0.01, rel=0.1)
 
 
-def test_outer_loop_validates() -> None:
-    fk = lambda q: np.zeros(3)  # noqa: E731
-    jac = lambda q: np.zeros((3, 2))  # noqa: E731
-    with pytest.raises(ValueError, match="Ts·K_D"):
-        ac.OuterLoop(fk, jac, 0.02, np.zeros(2))
-    with pytest.raises(ValueError, match="M_d > 0"):
-        ac.OuterLoop(fk, jac, 1e-3, np.zeros(2), config=ac.OuterLoopConfig(Md=0.0))
+def test_outer_loop_validates(sc: ac.PandaTable) -> None:
+    with pytest.raises(ValueError, match="Ts·clik_kd < 1"):
+        ac.CartesianImpedance(sc.chain, Ts=0.02, q0=sc.q0)
+    with pytest.raises(ValueError, match=r"Md > 0"):
+        ac.CartesianImpedance(sc.chain, Ts=1e-3, q0=sc.q0, Md=0.0)
 
 
 @pytest.mark.parametrize("kind", ["pd", "sf"])
@@ -79,7 +78,9 @@ def test_cartesian_impedance_needs_external_inner(sc: ac.PandaTable) -> None:
     from adaptimp.baselines import ComputedTorque
 
     with pytest.raises(ValueError, match="external"):
-        ac.CartesianImpedance(ComputedTorque(sc.pin_model, tau_max=sc.tau_max), sc.outer())
+        ac.CartesianController(sc.chain, ComputedTorque(sc.pin_model, tau_max=sc.tau_max), q0=sc.q0)
+    with pytest.raises(ValueError, match="external"):
+        ac.CartesianController(sc.chain, "pd", q0=sc.q0, impedance="joint")
 
 
 def test_gravity_learning_without_feedforward_beats_pd(sc: ac.PandaTable) -> None:

@@ -14,7 +14,7 @@ import pytest
 
 import adaptimp
 from adaptimp import _adaptimp
-from adaptimp._params import BY_NAME, PARAMS, SCENARIOS, names
+from adaptimp._params import ALL_GROUPS, BY_NAME, GROUPS, PARAMS, SCENARIOS, names
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -31,7 +31,8 @@ def test_every_core_parameter_has_a_python_keyword_and_back() -> None:
     """A Rust option without a Python name fails here (the core's own test checks
     that every configuration field has a schema entry)."""
     core = _adaptimp.defaults("paper")
-    assert names() == list(core)
+    assert names(*ALL_GROUPS) == list(core)
+    assert {p.group for p in PARAMS} == set(ALL_GROUPS)
     assert [p["name"] for p in _adaptimp.schema_table()] == [p.name for p in PARAMS]
     for scenario in ("paper", "robot"):
         assert set(SCENARIOS[scenario]) == set(BY_NAME)
@@ -52,8 +53,9 @@ def test_the_table_carries_units_docs_conditions_and_choices() -> None:
 
 def test_help_lists_every_parameter_with_unit_and_condition() -> None:
     doc = adaptimp.simulate.__doc__ or ""
+    cart = adaptimp.CartesianController.__doc__ or ""
     for p in PARAMS:
-        assert f"{p.name}" in doc
+        assert f"{p.name}" in (doc if p.group in GROUPS else cart), p.name
     assert "Kzeta (1/s)" in doc
     assert "valid: 2Kζ − I − KpᵀKp > 0" in doc
 

@@ -32,8 +32,6 @@ Every SPEC quantity is a keyword parameter with the paper's default
 
 from ._adaptimp import __version__
 from ._api import Controller, PlanarArm, TwoLinkArm, simulate
-from .cartesian import CartesianController
-from .chain import Chain
 from ._errors import (
     AdaptimpError,
     ConfigError,
@@ -46,6 +44,8 @@ from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
 from ._plot import compare as plot_compare
 from ._result import PLOT_KINDS, SimResult, metrics_table
 from ._sweep import Choice, LogUniform, Normal, Uniform, sweep
+from .cartesian import CartesianController
+from .chain import Chain
 
 __all__ = [
     "CASES",

@@ -15,10 +15,13 @@ from typing_extensions import disjoint_base
 __all__ = [
     "MAX_JOINTS",
     "N_NODES",
+    "CartesianImpedance",
+    "Chain",
     "Controller",
     "PlanarArm",
     "TwoLinkArm",
     "__version__",
+    "centres_along",
     "defaults",
     "schema_table",
     "simulate",
@@ -196,6 +199,49 @@ class ArmParams(TypedDict, total=False):
     g: float
     """gravitational acceleration (vertical plane) (m/s²)."""
 
+@type_check_only
+class CartesianParams(TypedDict, total=False):
+    """Cartesian impedance parameters (SPEC §16)."""
+
+    Md: float | Sequence[float]
+    """target inertia M_d of the translation, (C1) (kg)."""
+    Bd: float | Sequence[float] | None
+    """target damping B_d of the translation, (C1) (None: critical, 2√(K_d M_d), following the
+    filtered K_d) (N s/m)."""
+    Kd: float | Sequence[float]
+    """target stiffness K_d of the translation, (C1) (N/m)."""
+    Md_rot: float | Sequence[float]
+    """target inertia of the rotation, (C1) (kg m²)."""
+    Bd_rot: float | Sequence[float] | None
+    """target damping of the rotation, (C1) (None: critical, 2√(K_d,rot M_d,rot)) (N m s/rad)."""
+    Kd_rot: float | Sequence[float]
+    """target stiffness of the rotation, (C1); 0 on every axis: position-only (the orientation
+    is no task) (N m/rad)."""
+    clik_kp: float
+    """CLIK gain K_P: the pose error of fk(q_d) obeys ë + K_D ė + K_P e = 0, (C2) (1/s²)."""
+    clik_kd: float
+    """CLIK gain K_D, (C2) (1/s)."""
+    clik_lambda: float
+    """damping λ_p of the least-squares inverse in the translation rows, (C3) (m)."""
+    clik_lambda_rot: float
+    """damping λ_o of the least-squares inverse in the rotation rows, (C3)."""
+    null_k: float
+    """null-space posture stiffness k_0, (C2) (1/s²)."""
+    null_d: float
+    """null-space damping d_0, (C2) (1/s)."""
+    pos_error_max: float | None
+    """largest translation error fed to the impedance, (16.5) (None: no clipping) (m)."""
+    rot_error_max: float | None
+    """largest rotation error fed to the impedance, (16.5) (None: no clipping) (rad)."""
+    target_filter: float
+    """time constant of the first-order filter on jumps of the commanded pose and on stiffness
+    changes, (16.6) (0: none) (s)."""
+    force_filter: float
+    """time constant of the first-order filter on the measured wrench, (16.6) (0: none) (s)."""
+    force_feedforward: bool
+    """the joint controller gets τe = Jᵀ F_e for its +τe feedforward (C5); False: τe = 0, the
+    contact acts through (C1) only."""
+
 # END GENERATED
 
 @disjoint_base
@@ -351,3 +397,67 @@ def schema_table() -> list[dict[str, Any]]:
 
 def defaults(scenario: str = "paper", n: int = 2) -> dict[str, Any]:
     """Every parameter's default in ``scenario`` ("paper" or "robot") for n joints."""
+
+@disjoint_base
+class Chain:
+    """A serial chain of 1 … 7 revolute or prismatic joints and a tip (SPEC §16)."""
+
+    def __new__(
+        cls, joints: Sequence[dict[str, Any]], tip: dict[str, Any] | None = None
+    ) -> Chain: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def prismatic(self) -> list[bool]: ...
+    def fk(self, q: ArrayLike) -> _F: ...
+    def jacobian(self, q: ArrayLike) -> _F: ...
+    def jdot_qdot(self, q: ArrayLike, dq: ArrayLike) -> _F: ...
+
+@final
+class CartesianImpedance:
+    """The 6-D Cartesian impedance outer loop over a Chain, with its state (SPEC §16)."""
+
+    def __new__(
+        cls,
+        chain: Chain,
+        params: CartesianParams | dict[str, Any],
+        ts: float,
+        q0: ArrayLike,
+        posture: ArrayLike | None = None,
+    ) -> CartesianImpedance: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def ts(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def orients(self) -> bool: ...
+    def reset(self, q0: ArrayLike | None = None) -> None: ...
+    def set_posture(self, posture: ArrayLike) -> None: ...
+    def set_stiffness(self, Kd: ArrayLike, Kd_rot: ArrayLike) -> None: ...
+    def reference(self, target: ArrayLike | None, wrench: ArrayLike) -> tuple[_F, _F, _F]: ...
+    def step_controller(
+        self,
+        controller: Controller,
+        q: ArrayLike,
+        dq: ArrayLike | None,
+        wrench: ArrayLike,
+        target: ArrayLike | None = None,
+    ) -> _F: ...
+    def step_python(
+        self,
+        inner: Any,
+        q: ArrayLike,
+        dq: ArrayLike | None,
+        wrench: ArrayLike,
+        target: ArrayLike | None = None,
+    ) -> _F: ...
+    def last(self, what: str) -> _F: ...
+    def state(self, what: str) -> _F: ...
+    def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F]: ...
+
+def centres_along(
+    q: _F, dq: _F, tube: tuple[float, float], periodic: bool = False
+) -> tuple[_F, _F]:
+    """RBF centres (L, 4n) along an orbit and their squared widths (4n,), SPEC (15.2)."""

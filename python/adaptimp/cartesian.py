@@ -42,7 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
 from ._errors import ConfigError
-from ._params import BY_NAME, check_scenario, resolve
+from ._params import BY_NAME, check_scenario, describe, resolve
 from .chain import Chain
 from .panda_table import (
     PandaTable,
@@ -97,6 +97,17 @@ def pose_target(
         if v is not None:
             out[18 + 3 * i : 21 + 3 * i] = np.asarray(v, dtype=np.float64).reshape(3)
     return out
+
+
+def _wrench(wrench: ArrayLike | None) -> FloatArray:
+    """F_e = [f; m] (6,) from (6,), f (3,) alone (no moment) or None (no contact)."""
+    f = np.zeros(6)
+    if wrench is not None:
+        w = np.asarray(wrench, dtype=np.float64).reshape(-1)
+        if w.shape not in ((3,), (6,)):
+            raise ValueError(f"wrench must have shape (6,) or (3,), got {w.shape}")
+        f[: w.shape[0]] = w
+    return f
 
 
 def _sample(path: Path, t: float, R: FloatArray) -> FloatArray:
@@ -197,11 +208,10 @@ class CartesianImpedance:
         wrench: ArrayLike | None = None,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """One committed step: the commanded pose (p_c (m); ṗ_c, p̈_c, R_c, ω_c,
-        ω̇_c; None: hold the last) and F_e = [f; m] (default 0) in; (q_d, q̇_d, q̈_d)
-        of t_k out (rad, rad/s, rad/s²)."""
+        ω̇_c; None: hold the last) and F_e = [f; m] ((6,), or f (3,) alone;
+        default 0) in; (q_d, q̇_d, q̈_d) of t_k out (rad, rad/s, rad/s²)."""
         target = None if p is None else self.target(p, dp, ddp, R, w, dw)
-        f = np.zeros(6) if wrench is None else wrench
-        q, dq, ddq = self._core.reference(target, f)
+        q, dq, ddq = self._core.reference(target, _wrench(wrench))
         return q, dq, ddq
 
     def last(self, what: str) -> FloatArray:
@@ -301,12 +311,16 @@ class CartesianController:
     Examples
     --------
     >>> import adaptimp
-    >>> arm = adaptimp.Chain([
-    ...     {"kind": "revolute", "axis": [0, 0, 1]},
-    ...     {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [0, 0, 1]},
-    ... ], tip={"xyz": [0.2, 0, 0]})
-    >>> ctrl = adaptimp.CartesianController(arm, "pd", q0=[0.3, 0.6], Kd_rot=0.0,
-    ...                                     tau_max=20.0, Kp=5.0, Kzeta=25.0)
+    >>> arm = adaptimp.Chain(
+    ...     [
+    ...         {"kind": "revolute", "axis": [0, 0, 1]},
+    ...         {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [0, 0, 1]},
+    ...     ],
+    ...     tip={"xyz": [0.2, 0, 0]},
+    ... )
+    >>> ctrl = adaptimp.CartesianController(
+    ...     arm, "pd", q0=[0.3, 0.6], Kd_rot=0.0, tau_max=20.0, Kp=5.0, Kzeta=25.0
+    ... )
     >>> tau = ctrl.step([0.3, 0.6], [0.0, 0.0], [0.0] * 6)
     >>> tau.shape
     (2,)
@@ -427,12 +441,7 @@ class CartesianController:
         rad/s²), each optional (R: the last commanded rotation); without
         ``xc`` the ``path`` at t_k, or the last target held.
         """
-        f = np.zeros(6)
-        if wrench is not None:
-            wv = np.asarray(wrench, dtype=np.float64).reshape(-1)
-            if wv.shape not in ((3,), (6,)):
-                raise ValueError(f"wrench must have shape (6,) or (3,), got {wv.shape}")
-            f[: wv.shape[0]] = wv
+        f = _wrench(wrench)
         if xc is not None:
             target: FloatArray | None = self.outer.target(xc, dxc, ddxc, R, w, dw)
         elif self.path is not None:
@@ -487,6 +496,14 @@ class CartesianController:
 
 
 _LOG = ("pc", "dpc", "ddpc", "pd", "dpd", "ddpd", "qd", "wrench", "error")
+
+_PARAMS_DOC = (
+    "\n    Cartesian parameters by name (unit; default)\n"
+    "    --------------------------------------------\n"
+)
+CartesianController.__doc__ = (
+    (CartesianController.__doc__ or "") + _PARAMS_DOC + describe("cartesian", scenario="robot")
+)
 
 
 def inner_params(inner: Any) -> dict[str, Any]:

@@ -21,7 +21,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -93,9 +93,15 @@ def _read_urdf(source: str | os.PathLike[str]) -> tuple[set[str], dict[str, _Urd
             kind=j.get("type", ""),
             parent=p,
             child=c,
-            xyz=_triple(None if origin is None else origin.get("xyz"), f"{name} origin xyz", (0.0,) * 3),
-            rpy=_triple(None if origin is None else origin.get("rpy"), f"{name} origin rpy", (0.0,) * 3),
-            axis=_triple(None if axis is None else axis.get("xyz"), f"{name} axis", (1.0, 0.0, 0.0)),
+            xyz=_triple(
+                None if origin is None else origin.get("xyz"), f"{name} origin xyz", (0.0,) * 3
+            ),
+            rpy=_triple(
+                None if origin is None else origin.get("rpy"), f"{name} origin rpy", (0.0,) * 3
+            ),
+            axis=_triple(
+                None if axis is None else axis.get("xyz"), f"{name} axis", (1.0, 0.0, 0.0)
+            ),
         )
     # Every link's way up must end at a root, not run in a circle.
     for start in by_child:
@@ -179,10 +185,13 @@ class Chain(_adaptimp.Chain):
     Examples
     --------
     >>> import adaptimp
-    >>> arm = adaptimp.Chain([
-    ...     {"kind": "revolute", "axis": [0, 0, 1]},
-    ...     {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [0, 0, 1]},
-    ... ], tip={"xyz": [0.2, 0, 0]})
+    >>> arm = adaptimp.Chain(
+    ...     [
+    ...         {"kind": "revolute", "axis": [0, 0, 1]},
+    ...         {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [0, 0, 1]},
+    ...     ],
+    ...     tip={"xyz": [0.2, 0, 0]},
+    ... )
     >>> arm.fk([0.0, 0.0])[:3, 3].tolist()
     [0.5, 0.0, 0.0]
     """
@@ -200,7 +209,7 @@ class Chain(_adaptimp.Chain):
     ) -> Chain:
         data = [dict(j) for j in joints]
         try:
-            self = super().__new__(cls, data, None if tip is None else dict(tip))
+            self = cast(Chain, super().__new__(cls, data, None if tip is None else dict(tip)))
         except ValueError as e:
             raise ConfigError(f"{source}: {e}") from None
         movable = [j for j in data if j.get("kind") != "fixed"]
@@ -280,11 +289,20 @@ class Chain(_adaptimp.Chain):
             bodies.append(b)
             b = int(model.body_parentid[b])
         bodies.reverse()
-        kinds = {int(mujoco.mjtJoint.mjJNT_HINGE): "revolute", int(mujoco.mjtJoint.mjJNT_SLIDE): "prismatic"}
+        kinds = {
+            int(mujoco.mjtJoint.mjJNT_HINGE): "revolute",
+            int(mujoco.mjtJoint.mjJNT_SLIDE): "prismatic",
+        }
         joints: list[dict[str, Any]] = []
         names: list[str] = []
         for b in bodies:
-            joints.append({"kind": "fixed", "pos": model.body_pos[b].tolist(), "quat": model.body_quat[b].tolist()})
+            joints.append(
+                {
+                    "kind": "fixed",
+                    "pos": model.body_pos[b].tolist(),
+                    "quat": model.body_quat[b].tolist(),
+                }
+            )
             first = int(model.body_jntadr[b])
             for j in range(first, first + int(model.body_jntnum[b])):
                 kind = kinds.get(int(model.jnt_type[j]))

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from .chain import Chain
 
 if TYPE_CHECKING:
-    from .cartesian import CartesianController
+    from .cartesian import CartesianController, CartesianImpedance
 
 __all__ = [
     "PandaTable",
@@ -182,7 +182,7 @@ class PandaTable:
         ddp = np.array([-r * sn * ddphi - r * c * dphi**2, r * c * ddphi - r * sn * dphi**2, 0.0])
         return p, dp, ddp
 
-    def outer(self, **params: Any) -> Any:
+    def outer(self, **params: Any) -> CartesianImpedance:
         """A fresh outer loop for this scenario (the core's
         :class:`~adaptimp.cartesian.CartesianImpedance`, position-only, posture
         q0), with ``params`` of the group "cartesian"."""
@@ -257,9 +257,7 @@ def orbit_basis(
     become the centres. Returns (centres (L, 4n), widths (4n,)).
     """
     t_end = sc.t_approach + sc.t_ramp + 1.0 / sc.freq
-    return sc.outer().orbit_centres(
-        lambda t: sc.path(t, depth=0.0), t_end, nodes=nodes, tube=tube
-    )
+    return sc.outer().orbit_centres(lambda t: sc.path(t, depth=0.0), t_end, nodes=nodes, tube=tube)
 
 
 def joint_gains(sc: PandaTable, k1: float = 20.0, scale: float = 0.25) -> dict[str, list[float]]:
@@ -329,7 +327,7 @@ def panda_controller(
         return CartesianController(sc.chain, inner, **common, **params)
     if kind in ("pd", "sf", "of"):
         centres, widths = orbit_basis(sc) if basis is None else basis
-        g = joint_gains(sc) if gains is None else gains
+        g: dict[str, Any] = dict(joint_gains(sc) if gains is None else gains)
         return CartesianController(
             sc.chain,
             kind,

@@ -66,22 +66,16 @@ def orbit_centres(
 ) -> tuple[FloatArray, FloatArray]:
     """Centres at the samples [q; q̇] of one period of a joint path (rows) and their
     widths (4n,), SPEC (15.2): η_b = max(2 h_b, tube_b) for b = q (rad), q̇ (rad/s),
-    infinite for α1, α̇1."""
-    q = np.atleast_2d(np.asarray(samples_q, dtype=np.float64))
-    dq = np.atleast_2d(np.asarray(samples_dq, dtype=np.float64))
-    n = q.shape[1]
+    infinite for α1, α̇1; the period closes on itself (the core's
+    ``Centers::along_periodic``)."""
+    from . import _adaptimp
 
-    def closed(a: FloatArray) -> FloatArray:
-        """The samples with the first appended: the period closes on itself."""
-        return np.vstack([a, a[:1]])
-
-    h_q = float(np.max(np.linalg.norm(np.diff(closed(q), axis=0), axis=1)))
-    h_v = float(np.max(np.linalg.norm(np.diff(closed(dq), axis=0), axis=1)))
-    eta_q = max(2 * h_q, tube[0])
-    eta_v = max(2 * h_v, tube[1])
-    centres = np.hstack([q, dq, np.zeros_like(q), np.zeros_like(q)])
-    widths = np.concatenate([np.full(n, eta_q), np.full(n, eta_v), np.full(2 * n, np.inf)])
-    return centres, widths
+    q = np.ascontiguousarray(np.atleast_2d(np.asarray(samples_q, dtype=np.float64)))
+    dq = np.ascontiguousarray(np.atleast_2d(np.asarray(samples_dq, dtype=np.float64)))
+    centres, widths2 = _adaptimp.centres_along(
+        q, dq, (float(tube[0]), float(tube[1])), periodic=True
+    )
+    return np.asarray(centres, dtype=np.float64), np.sqrt(widths2)
 
 
 def suggest(

@@ -58,7 +58,7 @@ macro_rules! dyn_arm {
             Kinematics::fk(self, &v(q)).as_slice().to_vec()
         }
         fn jacobian(&self, q: &[f64]) -> Vec<f64> {
-            Kinematics::jacobian(self, &v(q))
+            Kinematics::position_jacobian(self, &v(q))
                 .transpose()
                 .as_slice()
                 .to_vec()

@@ -64,7 +64,10 @@ pub fn panda() -> adaptimp::Chain<7> {
     use adaptimp::{Chain, Joint, Transform};
     let h = std::f64::consts::FRAC_PI_2;
     let rev = |xyz: [f64; 3], roll: f64| {
-        Joint::revolute(Transform::from_xyz_rpy(xyz, [roll, 0.0, 0.0]), [0.0, 0.0, 1.0])
+        Joint::revolute(
+            Transform::from_xyz_rpy(xyz, [roll, 0.0, 0.0]),
+            [0.0, 0.0, 1.0],
+        )
     };
     let joints = [
         rev([0.0, 0.0, 0.333], 0.0),

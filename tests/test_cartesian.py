@@ -87,7 +87,7 @@ def test_a_rotation_that_is_not_one_changes_nothing(stiff: CartesianImpedance) -
     p0, r0 = PANDA.pose(HOME)
     stiff.step(p0, R=r0)
     before = stiff.core.state("q_d"), stiff.core.steps
-    with pytest.raises(adaptimp.MeasurementError, match="orthonormal.*R_c"):
+    with pytest.raises(adaptimp.MeasurementError, match=r"orthonormal.*R_c"):
         stiff.step(p0, R=r0 * 1.001)
     with pytest.raises(adaptimp.MeasurementError, match=r"det R = \+1"):
         stiff.step(p0, R=np.diag([1.0, 1.0, -1.0]))

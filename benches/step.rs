@@ -15,6 +15,9 @@
 //! - `step/sf7`, `bound/sf7_step`: n = 7 at 1 kHz with L = 64 centres along
 //!   the orbit (SPEC §15): the hardened state-feedback step, and its lower
 //!   bound as above, (2·49 + 7)·64 = 6720 weights.
+//! - `step/cart7`: the n = 7 Cartesian step (SPEC §16) beside it: the Panda's
+//!   chain (kinematics at q_d and at q), the 6-D outer loop, and the same
+//!   kind of hardened state-feedback joint step (L = 64), in free motion.
 
 use adaptimp::network::Rates;
 use adaptimp::{
@@ -23,6 +26,9 @@ use adaptimp::{
     Vector, Wall,
 };
 use criterion::{criterion_group, criterion_main, Criterion};
+
+#[path = "../tests/common/mod.rs"]
+mod common;
 use std::hint::black_box;
 
 const L: usize = 256;
@@ -262,6 +268,29 @@ fn seven_joints(c: &mut Criterion) {
     });
 }
 
+/// The n = 7 Cartesian step, free motion: a 4 cm circle commanded, the arm
+/// 0.01 rad off the joint reference on every joint (as `step/sf7`), no contact.
+fn cartesian_seven(c: &mut Criterion) {
+    use adaptimp::{CartesianMeasurement, Kinematics};
+    let pair = common::cart7(100.0, None, common::PANDA_EFFORT);
+    let q0 = Vector::<7>::from_column_slice(&common::PANDA_HOME);
+    let tip = pair.outer().kinematics().tip(&q0, &Vector::zeros());
+    let (mut ost, mut ist) = (pair.outer().start(q0), pair.inner().new_state());
+    c.bench_function("step/cart7", |b| {
+        b.iter(|| {
+            let target = common::circle(&tip, ost.k as f64 * 1e-3);
+            let m = CartesianMeasurement {
+                q: ost.qd + Vector::<7>::from_element(0.01),
+                dq: Some(ost.dqd),
+                wrench: Vector::<6>::zeros(),
+            };
+            black_box(pair.step(&mut ost, &mut ist, black_box(&m), Some(&target)))
+        });
+        ost = pair.outer().start(q0);
+        ist.reset();
+    });
+}
+
 criterion_group!(
     benches,
     basis,
@@ -270,6 +299,7 @@ criterion_group!(
     plant,
     bound,
     paper,
-    seven_joints
+    seven_joints,
+    cartesian_seven
 );
 criterion_main!(benches);

@@ -8,6 +8,8 @@ use adaptimp::{
     TwoLinkArm, Vector, Wall,
 };
 use std::alloc::{GlobalAlloc, Layout, System};
+
+mod common;
 use std::cell::Cell;
 
 /// The system allocator, counting every allocation (and reallocation) made
@@ -238,4 +240,34 @@ fn no_heap_allocation_in_seven_joint_and_cartesian_steps() {
         }
     });
     assert_eq!(n, 0, "the Cartesian step allocated");
+}
+
+/// The n = 7 Cartesian step (the Panda's chain: kinematics at q_d and at q,
+/// the 6-D outer loop with its filters, the hardened state-feedback joint
+/// step): in free motion, and saturated, projecting, clipping, in contact.
+#[test]
+fn no_heap_allocation_in_the_seven_joint_cartesian_step() {
+    use adaptimp::{CartesianMeasurement, Kinematics, Vector};
+    let low = [1.0, 1.0, 1.0, 1.0, 12.0, 12.0, 12.0];
+    for (bound, clip, tau_max, offset, wrench) in [
+        (100.0, None, common::PANDA_EFFORT, 0.0, 0.0),
+        (1e-3, Some(1e-3), low, 0.02, 20.0),
+    ] {
+        let pair = common::cart7(bound, clip, tau_max);
+        let q0 = Vector::<7>::from_column_slice(&common::PANDA_HOME);
+        let tip = pair.outer().kinematics().tip(&q0, &Vector::zeros());
+        let (mut ost, mut ist) = (pair.outer().start(q0), pair.inner().new_state());
+        let m = CartesianMeasurement {
+            q: q0 + Vector::<7>::from_element(offset),
+            dq: Some(Vector::zeros()),
+            wrench: Vector::<6>::new(0.0, 0.0, -wrench, 0.1 * wrench, 0.0, 0.0),
+        };
+        let (n, ()) = allocations_in(|| {
+            for k in 0..1000 {
+                let c = common::circle(&tip, k as f64 * 1e-3);
+                pair.step(&mut ost, &mut ist, &m, Some(&c)).expect("step");
+            }
+        });
+        assert_eq!(n, 0, "the n = 7 Cartesian step allocated (bound {bound})");
+    }
 }

@@ -17,7 +17,13 @@ PYTHON = sorted(EXAMPLES.glob("[0-9][0-9]_*.py"))
 def test_examples_are_numbered_and_mirrored_where_both_apply() -> None:
     names = {p.stem for p in EXAMPLES.iterdir() if p.suffix in (".py", ".rs")}
     assert all(n[:2].isdigit() and n[2] == "_" for n in names), sorted(names)
-    for stem in ("01_paper", "02_robot_1khz", "03_your_loop", "04_custom_basis"):
+    for stem in (
+        "01_paper",
+        "02_robot_1khz",
+        "03_your_loop",
+        "04_custom_basis",
+        "14_cartesian_pose",
+    ):
         assert (EXAMPLES / f"{stem}.py").exists()
         assert (EXAMPLES / f"{stem}.rs").exists()
 

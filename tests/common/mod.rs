@@ -87,5 +87,71 @@ pub fn panda() -> adaptimp::Chain<7> {
     Chain::new(&joints, &tcp).expect("the Panda's joint data")
 }
 
+/// The Panda's torque limits (N m), the URDF's `<limit effort>`.
+pub const PANDA_EFFORT: [f64; 7] = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0];
+
 /// The Panda's reference posture (rad), the SRDF's `default`.
 pub const PANDA_HOME: [f64; 7] = [0.0, -0.785398, 0.0, -2.35619, 0.0, 1.5707, 0.785398];
+
+/// The n = 7 Cartesian controller of the allocation test, the benchmark
+/// `step/cart7` and the instruction counts: the Panda's chain, the 6-D outer
+/// loop with SPEC §16's defaults, and the hardened state-feedback joint
+/// controller at 1 kHz (L = 64 centres along the joint orbit of a 4 cm
+/// circle, by the core's orbit rule; the Panda's effort limits; Kp of
+/// docs/panda.md). `bound`: the weight bound of every network (the
+/// projection acts when a norm exceeds it); `clip`: pos/rot error limits;
+/// `tau_max`: the actuator limits (N m).
+pub fn cart7(
+    bound: f64,
+    clip: Option<f64>,
+    tau_max: [f64; 7],
+) -> adaptimp::CartesianController<7, adaptimp::Chain<7>, adaptimp::Centers<7, Vec<f64>>> {
+    use adaptimp::{
+        CartesianConfig, CartesianController, CartesianImpedance, Centers, Config, Controller,
+        ImpedanceMode, Kinematics, Law, Setpoint, Vector, WeightBound,
+    };
+    let chain = panda();
+    let q0 = Vector::<7>::from_column_slice(&PANDA_HOME);
+    let cfg = CartesianConfig {
+        pos_error_max: clip,
+        rot_error_max: clip,
+        ..CartesianConfig::default()
+    };
+    let outer = CartesianImpedance::new(cfg, chain, 1e-3).expect("outer loop");
+    let tip = chain.tip(&q0, &Vector::zeros());
+    let zero = Setpoint {
+        x: Vector::<7>::zeros(),
+        dx: Vector::zeros(),
+        ddx: Vector::zeros(),
+    };
+    let mut samples = vec![zero; 64];
+    let written = outer
+        .orbit(q0, 2000, |k| circle(&tip, k as f64 * 1e-3), &mut samples)
+        .expect("orbit");
+    let basis = Centers::along(&samples[..written], [0.05, 0.2]).expect("basis");
+    let tau_max = Vector::<7>::from(tau_max);
+    let mut joint = Config::<7>::new(Law::StateFeedback, tau_max).hardened();
+    joint.ts = 1e-3;
+    joint.impedance = ImpedanceMode::External;
+    joint.kp = Vector::from_column_slice(&[66.6, 242.0, 136.0, 101.0, 9.24, 8.44, 1.63]);
+    joint.kzeta = joint.kp.map(|k| (1.0 + k * k) / 2.0 + 10.0);
+    joint.k1 = Vector::from_element(20.0);
+    joint.gamma = [1.0; 3];
+    joint.weight_bound = WeightBound::Fixed([bound; 3]);
+    let inner = Controller::new(joint, basis).expect("joint controller");
+    CartesianController::new(outer, inner).expect("pair")
+}
+
+/// A 4 cm circle at 0.5 Hz in the horizontal plane through the tip of `tip`,
+/// the orientation held: the commanded pose at `t` (s).
+pub fn circle(tip: &adaptimp::Tip<7>, t: f64) -> adaptimp::PoseTarget {
+    use adaptimp::{PoseTarget, Vector};
+    let w = std::f64::consts::PI;
+    let (s, c) = ((w * t).sin(), (w * t).cos());
+    PoseTarget {
+        p: tip.position + Vector::<3>::new(0.04 * (c - 1.0), 0.04 * s, 0.0),
+        dp: Vector::<3>::new(-0.04 * w * s, 0.04 * w * c, 0.0),
+        ddp: Vector::<3>::new(-0.04 * w * w * c, -0.04 * w * w * s, 0.0),
+        ..PoseTarget::at(tip.position, *tip.rotation.matrix())
+    }
+}

@@ -31,6 +31,8 @@ const INERTIA: [f64; 7] = [0.27, 0.97, 0.54, 0.40, 0.037, 0.034, 0.0065];
 /// The Panda's torque limits (N m).
 const TAU_MAX: [f64; 7] = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0];
 /// The Panda's home posture (rad).
+// The SRDF's numbers as written (close to, not exactly, π/4 and π/2).
+#[allow(clippy::approx_constant)]
 const HOME: [f64; 7] = [0.0, -0.785398, 0.0, -2.35619, 0.0, 1.5707, 0.785398];
 /// The table: stiffness (N/m), damping (N s/m), how far below the home TCP (m).
 const TABLE: (f64, f64, f64) = (5000.0, 50.0, 0.03);

@@ -470,8 +470,18 @@ class Controller(_adaptimp.Controller):
         self._widths = widths
         return self
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        """Everything happens in ``__new__`` (the compiled core is immutable)."""
+    def __init__(
+        self,
+        case: str,
+        scenario: str = "paper",
+        *,
+        n: int = N_JOINTS,
+        centers: ArrayLike | None = None,
+        widths: ArrayLike | None = None,
+        **params: Any,
+    ) -> None:
+        """Everything happens in ``__new__`` (the compiled core is immutable); the
+        signature is ``__new__``'s, for help() and the documentation."""
 
     # -- state that travels -------------------------------------------------
 

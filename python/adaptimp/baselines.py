@@ -164,7 +164,7 @@ class ComputedTorque:
     impedance : {"joint", "external"}
         ``"joint"`` (default): the compliant reference of SPEC §4 as above.
         ``"external"``: the setpoint is already compliant (an outer loop such
-        as :class:`adaptimp.cartesian.CartesianImpedance` made it, SPEC §16):
+        as that of :class:`adaptimp.CartesianController` made it, SPEC §16):
         xd = xc, ẋd = ẋc, ẍd = ẍc, and τe enters only as the feedforward +τe.
     """
 

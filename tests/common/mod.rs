@@ -91,6 +91,8 @@ pub fn panda() -> adaptimp::Chain<7> {
 pub const PANDA_EFFORT: [f64; 7] = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0];
 
 /// The Panda's reference posture (rad), the SRDF's `default`.
+// The SRDF's numbers as written (close to, not exactly, π/4 and π/2).
+#[allow(clippy::approx_constant)]
 pub const PANDA_HOME: [f64; 7] = [0.0, -0.785398, 0.0, -2.35619, 0.0, 1.5707, 0.785398];
 
 /// The n = 7 Cartesian controller of the allocation test, the benchmark

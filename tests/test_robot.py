@@ -7,7 +7,7 @@ import pytest
 
 import adaptimp
 from adaptimp import _adaptimp
-from adaptimp._params import resolve
+from adaptimp._params import ALL_GROUPS, resolve
 
 
 @pytest.fixture(scope="module")
@@ -17,7 +17,7 @@ def robot() -> dict[str, adaptimp.SimResult]:
 
 def test_robot_table_is_the_core_schema() -> None:
     core = _adaptimp.defaults("robot")
-    table = resolve({}, scenario="robot")
+    table = resolve({}, scenario="robot", groups=ALL_GROUPS)
     assert table == core
     assert table["Ts"] == 1e-3
     assert table["substeps"] == 10

@@ -235,6 +235,10 @@ class CartesianImpedance:
         kr = np.broadcast_to(np.asarray(rot, dtype=np.float64), (3,))
         self._core.set_stiffness(kd, kr)
 
+    def set_posture(self, posture: ArrayLike) -> None:
+        """The null-space posture q_posture (rad), (n,), from the next step on."""
+        self._core.set_posture(np.asarray(posture, dtype=np.float64))
+
     def orbit_centres(
         self,
         path: Path,

@@ -23,6 +23,11 @@
 //!
 //! The run prints what the branch did (saturated joints, weight norms against
 //! the bound, the error's norm) so that the branch is checked, not assumed.
+//!
+//! `cargo bench --bench cartesian_cost -- time [STEPS]` (without valgrind)
+//! times every step of the free branch and of the joint step alone with the
+//! wall clock and prints their percentiles: reported, not a target, on a
+//! shared machine (SPEC §15).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -61,8 +66,77 @@ fn measured_joint(
         .expect("joint step")
 }
 
+/// The percentiles 50, 99, 99.9 of `t` (ns), sorted in place.
+fn percentiles(t: &mut [u128]) -> [u128; 3] {
+    t.sort_unstable();
+    let at = |p: f64| t[((t.len() as f64 - 1.0) * p).round() as usize];
+    [at(0.5), at(0.99), at(0.999)]
+}
+
+/// Wall-clock percentiles of the free Cartesian step and of the joint step alone.
+fn time(steps: usize) {
+    use std::time::Instant;
+    let pair = common::cart7(100.0, None, common::PANDA_EFFORT);
+    let q0 = Vector::<7>::from_column_slice(&common::PANDA_HOME);
+    let tip = pair.outer().kinematics().tip(&q0, &Vector::zeros());
+    for joint in [false, true] {
+        let (mut ost, mut ist) = (pair.outer().start(q0), pair.inner().new_state());
+        let mut t = Vec::with_capacity(steps);
+        for k in 0..steps {
+            let c = common::circle(&tip, k as f64 * 1e-3);
+            let m = CartesianMeasurement {
+                q: ost.qd + Vector::<7>::from_element(0.01),
+                dq: Some(ost.dqd),
+                wrench: Vector::zeros(),
+            };
+            if joint {
+                let s = pair
+                    .outer()
+                    .stage(&ost, Some(&c), &m.wrench)
+                    .expect("stage");
+                let jm = Measurement {
+                    x: m.q,
+                    dx: m.dq,
+                    tau_e: Vector::zeros(),
+                };
+                let start = Instant::now();
+                black_box(measured_joint(&pair, &mut ist, &jm, &s.reference));
+                t.push(start.elapsed().as_nanos());
+                ost = s.next;
+            } else {
+                let start = Instant::now();
+                black_box(measured(&pair, &mut ost, &mut ist, &m, &c));
+                t.push(start.elapsed().as_nanos());
+            }
+        }
+        // Steps beyond 100 µs: a preemption of the process (a scheduler
+        // quantum is milliseconds), not the step's work.
+        let slow = t.iter().filter(|x| **x > 100_000).count();
+        let [p50, p99, p999] = percentiles(&mut t);
+        let what = if joint {
+            "joint step"
+        } else {
+            "Cartesian step"
+        };
+        println!(
+            "{what}: {steps} steps, median {:.2} µs, 99th percentile {:.2} µs, 99.9th {:.2} µs; {slow} steps beyond 100 µs",
+            p50 as f64 / 1e3,
+            p99 as f64 / 1e3,
+            p999 as f64 / 1e3
+        );
+    }
+}
+
 fn main() {
     let branch = std::env::args().nth(1).unwrap_or_else(|| "free".into());
+    if branch == "time" {
+        let steps = std::env::args()
+            .nth(2)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(100_000);
+        time(steps);
+        return;
+    }
     let costly = branch == "costly";
     let pair = if costly {
         common::cart7(1e-3, Some(1e-3), [1.0, 1.0, 1.0, 1.0, 12.0, 12.0, 12.0])

@@ -15,13 +15,12 @@ use crate::error::Error;
 use crate::networks::network::{Weights, C, D, G};
 use crate::networks::rbf::{AnyBasis, Basis, Centers};
 use crate::schema::{Preset, Scenario, Value};
-use crate::sim::disturb::{Disturbances, TipPayload, WithFriction};
+use crate::sim::disturb::TipPayload;
 use crate::sim::environment::{FreeSpace, Wall};
-use crate::sim::metrics::MetricsAccumulator;
 use crate::sim::model::{Link, PlanarArm, TwoLinkArm};
 use crate::sim::plant::{Plant, RigidBody};
 use crate::sim::record::{Recorder, Row};
-use crate::sim::simulator::simulate_disturbed;
+use crate::sim::simulator::{run_disturbed_with, Adapter};
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 use std::any::Any;
@@ -140,6 +139,12 @@ pub struct Records {
     pub w_norms: Vec<f64>,
     /// The rows the controller refused (fallback applied).
     pub refused: Vec<bool>,
+    /// Whether the end effector is recorded (`x_ee`, `wrench`).
+    pub ee: bool,
+    /// End-effector position (m), 3 per row (if `ee`).
+    pub x_ee: Vec<f64>,
+    /// End-effector wrench [f; m] (N, N m), 6 per row (if `ee`).
+    pub wrench: Vec<f64>,
 }
 
 /// The names of [`Records::joint`], in order.
@@ -148,13 +153,19 @@ pub const JOINT_RECORDS: [&str; 13] = [
 ];
 
 impl Records {
-    /// Room for `rows` kept rows of `n` joints; `None` if it cannot be had.
-    pub fn with_rows(n: usize, rows: usize, every: u64) -> Option<Self> {
+    /// Room for `rows` kept rows of `n` joints (and of the end effector, with
+    /// `ee`); `None` if it cannot be had.
+    pub fn with_rows(n: usize, rows: usize, every: u64, ee: bool) -> Option<Self> {
         let mut r = Self {
             n,
             every: every.max(1),
+            ee,
             ..Self::default()
         };
+        if ee {
+            r.x_ee.try_reserve_exact(rows.checked_mul(3)?).ok()?;
+            r.wrench.try_reserve_exact(rows.checked_mul(6)?).ok()?;
+        }
         r.t.try_reserve_exact(rows).ok()?;
         r.refused.try_reserve_exact(rows).ok()?;
         for v in &mut r.joint {
@@ -187,6 +198,10 @@ impl<const N: usize> Recorder<N> for Records {
         }
         self.w_norms.extend_from_slice(&r.w_norms);
         self.refused.push(r.refused);
+        if self.ee {
+            self.x_ee.extend_from_slice(&r.x_ee);
+            self.wrench.extend_from_slice(&r.wrench);
+        }
     }
 }
 
@@ -420,9 +435,8 @@ fn metrics_out<const N: usize>(m: &crate::sim::metrics::Metrics<N>) -> MetricsOu
     }
 }
 
-/// A plant that asks the hook every [`HOOK_EVERY`] steps whether to go on.
-struct Watched<'a, P> {
-    plant: P,
+/// The adapter that asks the hook every [`HOOK_EVERY`] periods whether to go on.
+pub(crate) struct Watch<'a> {
     hooks: &'a mut dyn Hooks,
     done: u64,
     total: u64,
@@ -432,15 +446,34 @@ struct Watched<'a, P> {
 /// Steps between two calls of [`Hooks::tick`].
 const HOOK_EVERY: u64 = 64;
 
-impl<const N: usize, P: Plant<N>> Plant<N> for Watched<'_, P> {
-    fn state(&self) -> (Vector<N>, Vector<N>) {
-        self.plant.state()
+impl<'a> Watch<'a> {
+    pub(crate) fn new(hooks: &'a mut dyn Hooks, total: u64) -> Self {
+        Self {
+            hooks,
+            done: 0,
+            total,
+            stopped: false,
+        }
     }
-    fn contact(&self) -> Vector<N> {
-        self.plant.contact()
+
+    /// The run's error, with the period it happened in.
+    pub(crate) fn error(&self, e: Error) -> RunError {
+        if self.stopped {
+            RunError::Stopped
+        } else {
+            RunError::Core(e, Some(self.done))
+        }
     }
-    fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
-        let a = self.plant.advance(tau, h)?;
+}
+
+impl<const N: usize> Adapter<N> for Watch<'_> {
+    fn advance<P: Plant<N> + ?Sized>(
+        &mut self,
+        plant: &mut P,
+        tau: &Vector<N>,
+        h: f64,
+    ) -> Result<Vector<N>, Error> {
+        let a = plant.advance(tau, h)?;
         self.done += 1;
         if self.done.is_multiple_of(HOOK_EVERY) && !self.hooks.tick(self.done, self.total) {
             self.stopped = true;
@@ -462,12 +495,10 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     hooks: &mut dyn Hooks,
 ) -> Result<(Records, MetricsOut), RunError> {
     let cfg = &s.sim;
-    crate::error::check::finite("settle", cfg.settle)?;
     let ts = t.controller().period();
     let total = crate::sim::simulator::steps(cfg.t_final, ts)?;
     let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
-    let mut rec = Records::with_rows(N, kept, every).ok_or(RunError::Memory(kept))?;
-    let mut metrics = MetricsAccumulator::new(cfg.settle, *t.controller().impedance());
+    let mut rec = Records::with_rows(N, kept, every, false).ok_or(RunError::Memory(kept))?;
     t.reset();
     if let Some(w) = weights {
         DynTracker::load_weights(t, w)?;
@@ -475,46 +506,25 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     let traj = *t.trajectory();
     // The plant the controller does not know (SPEC §17): payload and friction.
     let dist = s.disturbances()?;
-    let arm = WithFriction::new(arm.with_payload(dist.payload())?, *dist.friction());
-    let rec2 = &mut (&mut metrics, &mut rec);
-    let result = match s.wall {
+    // The set-up's errors name no row: check what the run builds first.
+    crate::error::check::finite("settle", cfg.settle)?;
+    RigidBody::new(
+        arm.with_payload(dist.payload())?,
+        FreeSpace,
+        cfg.q0,
+        cfg.dq0,
+        cfg.substeps,
+    )?;
+    let mut watch = Watch::new(hooks, total);
+    let metrics = match s.wall {
         Some(w) => {
             let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
-            let plant = RigidBody::new(arm, wall, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(plant, t, &traj, cfg.t_final, total, &dist, rec2, hooks)
+            run_disturbed_with(arm, &wall, t, &traj, cfg, &dist, &mut watch, &mut rec)
         }
-        None => {
-            let plant = RigidBody::new(arm, FreeSpace, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(plant, t, &traj, cfg.t_final, total, &dist, rec2, hooks)
-        }
-    };
-    result?;
-    Ok((rec, metrics_out(&metrics.finish())))
-}
-
-#[allow(clippy::too_many_arguments)]
-fn watched<const N: usize, P: Plant<N>>(
-    plant: P,
-    t: &mut Typed<N>,
-    traj: &Sinusoid<N>,
-    t_final: f64,
-    total: u64,
-    dist: &Disturbances<N>,
-    rec: &mut impl Recorder<N>,
-    hooks: &mut dyn Hooks,
-) -> Result<(), RunError> {
-    let mut p = Watched {
-        plant,
-        hooks,
-        done: 0,
-        total,
-        stopped: false,
-    };
-    match simulate_disturbed(&mut p, t, traj, t_final, None, dist, rec) {
-        Ok(_) => Ok(()),
-        Err(_) if p.stopped => Err(RunError::Stopped),
-        Err(e) => Err(RunError::Core(e, Some(p.done))),
+        None => run_disturbed_with(arm, &FreeSpace, t, &traj, cfg, &dist, &mut watch, &mut rec),
     }
+    .map_err(|e| watch.error(e))?;
+    Ok((rec, metrics_out(&metrics)))
 }
 
 impl<const N: usize> DynTracker for Typed<N> {

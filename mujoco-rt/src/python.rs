@@ -60,6 +60,13 @@ fn span(
     if size != len {
         return Err(bad(&format!("{size} values, the model needs {len}")));
     }
+    if len == 0 {
+        // Nothing to read or write (NumPy may hand out a fresh empty array).
+        return Ok(Span {
+            ptr: std::ptr::NonNull::<f64>::dangling().as_ptr(),
+            len,
+        });
+    }
     if arr.getattr("base")?.is_none() {
         return Err(bad("a copy, not a view of MuJoCo's memory"));
     }
@@ -68,7 +75,7 @@ fn span(
         .get_item("data")?
         .get_item(0)?
         .extract()?;
-    if len > 0 && (addr == 0 || addr % std::mem::align_of::<f64>() != 0) {
+    if addr == 0 || !addr.is_multiple_of(std::mem::align_of::<f64>()) {
         return Err(bad("misaligned"));
     }
     keep.push(arr.unbind());
@@ -98,7 +105,7 @@ fn warnings(data: &Bound<'_, PyAny>, keep: &mut Vec<Py<PyAny>>) -> PyResult<Warn
             .get_item(0)?
             .extract()?;
         let stride = usize::try_from(stride).map_err(|_| bad("negative stride"))?;
-        if addr == 0 || addr % 4 != 0 || stride % 4 != 0 || stride < 8 {
+        if addr == 0 || !addr.is_multiple_of(4) || !stride.is_multiple_of(4) || stride < 8 {
             return Err(bad("unexpected layout"));
         }
         keep.push(arr.unbind());

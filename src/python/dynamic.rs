@@ -7,8 +7,10 @@
 //! Nothing here knows Python: the bindings (`mod.rs`) convert arrays to
 //! slices and errors to exceptions.
 
+use super::mujoco::{Continued, Failure, MjPlant, MujocoSpec, Table};
 use crate::control::config::Law;
 use crate::control::controller::Controller;
+use crate::control::impedance::TargetImpedance;
 use crate::control::io::{Command, Measurement};
 use crate::control::tracker::Tracker;
 use crate::error::Error;
@@ -17,12 +19,14 @@ use crate::networks::rbf::{AnyBasis, Basis, Centers};
 use crate::schema::{Preset, Scenario, Value};
 use crate::sim::disturb::TipPayload;
 use crate::sim::environment::{FreeSpace, Wall};
+use crate::sim::metrics::MetricsAccumulator;
 use crate::sim::model::{Link, PlanarArm, TwoLinkArm};
 use crate::sim::plant::{Plant, RigidBody};
 use crate::sim::record::{Recorder, Row};
-use crate::sim::simulator::{run_disturbed_with, Adapter};
+use crate::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapted, Adapter};
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
+use adaptimp_mujoco::Sim;
 use std::any::Any;
 use std::vec::Vec;
 
@@ -219,6 +223,9 @@ pub struct MetricsOut {
 /// How a run ended when it did not finish.
 #[derive(Clone, Debug)]
 pub enum RunError {
+    /// The plant ended it (a MuJoCo run that diverged, or MuJoCo's fatal
+    /// error): how, with the row and the time.
+    Plant(Failure),
     /// The core's error (at step `k`, when the run had started).
     Core(Error, Option<u64>),
     /// The hook asked to stop.
@@ -326,8 +333,118 @@ pub trait DynTracker: Send + Sync {
         every: u64,
         hooks: &mut dyn Hooks,
     ) -> Result<(Records, MetricsOut), RunError>;
+    /// The closed loop on MuJoCo (`sim` as `spec` describes it) from the
+    /// controller's current state (not reset: a used controller goes on),
+    /// with the disturbances of `run.items` (SPEC §17; payload and jitter are
+    /// refused: the first is a change of the model, the second of its
+    /// timestep). Records every `run.every`-th row with the end effector.
+    fn simulate_mujoco(
+        &mut self,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &MujocoRun<'_>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(Records, MetricsOut), RunError>;
     /// As [`Any`], for the typed paths.
     fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// A run of [`DynTracker::simulate_mujoco`].
+pub struct MujocoRun<'a> {
+    /// Duration T (s).
+    pub t_final: f64,
+    /// Start of the "after" window of the metrics (s).
+    pub settle: f64,
+    /// Keep every `every`-th row.
+    pub every: u64,
+    /// The disturbance parameters (SPEC §17) by schema name.
+    pub items: &'a Items,
+    /// The commanded setpoints xc, ẋc, ẍc of every row (K × n each,
+    /// row-major), or none: the controller's own trajectory.
+    pub reference: Option<[&'a [f64]; 3]>,
+}
+
+fn run_mujoco<const N: usize>(
+    t: &mut Typed<N>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &MujocoRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> Result<(Records, MetricsOut), RunError> {
+    let ts = t.controller().period();
+    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    crate::error::check::finite("settle", run.settle)?;
+    let s = scenario::<N>(Preset::Robot, t.law(), run.items)
+        .map_err(|e| RunError::Core(e.error, None))?;
+    let dist = s.disturbances()?;
+    if dist.payload() != 0.0 {
+        return Err(RunError::Core(
+            Error::Invalid {
+                what: "payload",
+                reason: "on MuJoCo the payload is a change of the model, not of the loop",
+            },
+            None,
+        ));
+    }
+    if dist.params().jitter != 0.0 {
+        return Err(RunError::Core(
+            Error::Invalid {
+                what: "jitter",
+                reason: "the MuJoCo plant advances by Ts exactly (its timestep is fixed for a run)",
+            },
+            None,
+        ));
+    }
+    if let Some(rows) = run.reference {
+        let need = usize::try_from(total)
+            .unwrap_or(usize::MAX)
+            .saturating_mul(N);
+        if rows.iter().any(|r| r.len() < need) {
+            return Err(RunError::Core(
+                Error::Invalid {
+                    what: "reference",
+                    reason: "needs one row per step",
+                },
+                None,
+            ));
+        }
+    }
+    let every = run.every.max(1);
+    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let mut rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let mut metrics = MetricsAccumulator::new(run.settle, *t.controller().impedance());
+    let k0 = t.steps();
+    let own = Continued {
+        traj: *t.trajectory(),
+        k0,
+        ts,
+    };
+    let mut plant = MjPlant::<N>::new(sim, spec, ts, *dist.friction())?;
+    if let Err(e) = plant.start() {
+        return Err(match plant.failure() {
+            Some(f) => RunError::Plant(f.clone()),
+            None => RunError::Core(e, None),
+        });
+    }
+    let mut watch = Watch::new(hooks, total);
+    let rec2 = &mut (&mut metrics, &mut rec);
+    let result = {
+        let mut p = Adapted::new(&mut plant, &mut watch);
+        match run.reference {
+            Some(rows) => {
+                let table = Table::<N> { rows, ts };
+                simulate_disturbed(&mut p, t, &table, run.t_final, None, &dist, rec2)
+            }
+            None => simulate_disturbed(&mut p, t, &own, run.t_final, None, &dist, rec2),
+        }
+    };
+    match result {
+        Ok(_) => Ok((rec, metrics_out(&metrics.finish()))),
+        Err(e) => Err(match plant.failure() {
+            Some(f) => RunError::Plant(f.clone()),
+            None => watch.error(e),
+        }),
+    }
 }
 
 /// Row-major tables of a replay: K × n each.
@@ -718,7 +835,140 @@ impl<const N: usize> DynTracker for Typed<N> {
         }
     }
 
+    fn simulate_mujoco(
+        &mut self,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &MujocoRun<'_>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(Records, MetricsOut), RunError> {
+        run_mujoco(self, sim, spec, run, hooks)
+    }
+
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
     }
+}
+
+/// Recorded rows of a run whose loop ran elsewhere (a Python controller's):
+/// row-major tables of K rows, `n` values per row for the plant's
+/// quantities, `m` for the reference's (xc, ẋc, ẍc, z1: m = n in joint
+/// space, m ≠ n in task space).
+pub struct RowTables<'a> {
+    /// Joints n.
+    pub n: usize,
+    /// Width m of the reference and of z1.
+    pub m: usize,
+    /// t (K).
+    pub t: &'a [f64],
+    /// q, q̇, q̈ (K × n each).
+    pub x: [&'a [f64]; 3],
+    /// xc, ẋc, ẍc (K × m each).
+    pub c: [&'a [f64]; 3],
+    /// z1 (K × m).
+    pub z1: &'a [f64],
+    /// τ, sat(τ), τe (K × n each).
+    pub tau: [&'a [f64]; 3],
+}
+
+/// The SPEC §12 metrics of recorded rows by the core's [`MetricsAccumulator`]
+/// (the one implementation of the metrics): the rows are fed to an
+/// accumulator of max(n, m) joints with the narrower quantities padded with
+/// zeros (which change no norm, peak or count), and the per-joint figures cut
+/// back to z1's m or τ's n; the impedance residual needs m = n (NaN
+/// otherwise). `target` is (Dd, Cd, Gd), n values each.
+pub fn metrics_of(
+    rows: &RowTables<'_>,
+    settle: f64,
+    target: [&[f64]; 3],
+) -> Result<MetricsOut, Error> {
+    macro_rules! arms {
+        ($($k:literal)*) => {
+            match rows.n.max(rows.m) {
+                $($k => metrics_n::<$k>(rows, settle, target),)*
+                _ => Err(Error::Invalid {
+                    what: "rows",
+                    reason: "the joints and the reference's width must be between 1 and 7",
+                }),
+            }
+        };
+    }
+    arms!(1 2 3 4 5 6 7)
+}
+
+fn metrics_n<const N: usize>(
+    r: &RowTables<'_>,
+    settle: f64,
+    target: [&[f64]; 3],
+) -> Result<MetricsOut, Error> {
+    let (n, m, k) = (r.n, r.m, r.t.len());
+    let bad = |reason| Error::Invalid {
+        what: "rows",
+        reason,
+    };
+    if n == 0 || m == 0 {
+        return Err(bad("need at least one joint and one reference coordinate"));
+    }
+    if r.x.iter().chain(r.tau.iter()).any(|v| v.len() != k * n)
+        || r.c.iter().chain([&r.z1]).any(|v| v.len() != k * m)
+        || target.iter().any(|v| v.len() != n)
+    {
+        return Err(bad("every table needs K rows of its width"));
+    }
+    let pad = |v: &[f64], w: usize, i: usize| {
+        let mut out = Vector::<N>::zeros();
+        out.as_mut_slice()[..w].copy_from_slice(&v[i * w..(i + 1) * w]);
+        out
+    };
+    let joint = m == n;
+    let ones = Vector::<N>::from_element(1.0);
+    let tgt = if joint {
+        let t = |v: &[f64]| {
+            let mut o = ones;
+            o.as_mut_slice()[..n].copy_from_slice(v);
+            o
+        };
+        TargetImpedance::new(t(target[0]), t(target[1]), t(target[2]))?
+    } else {
+        TargetImpedance::new(ones, ones, ones)?
+    };
+    let mut acc = MetricsAccumulator::new(settle, tgt);
+    let zero = Vector::<N>::zeros();
+    for i in 0..k {
+        let (tau, tau_sat) = (pad(r.tau[0], n, i), pad(r.tau[1], n, i));
+        let x = pad(r.x[0], n, i);
+        acc.push(&Row {
+            t: r.t[i],
+            x,
+            dx: pad(r.x[1], n, i),
+            ddx: pad(r.x[2], n, i),
+            xc: if joint { pad(r.c[0], m, i) } else { zero },
+            dxc: if joint { pad(r.c[1], m, i) } else { zero },
+            ddxc: if joint { pad(r.c[2], m, i) } else { zero },
+            xd: zero,
+            dx_hat: zero,
+            tau,
+            tau_sat,
+            dtau: tau_sat - tau,
+            tau_e: pad(r.tau[2], n, i),
+            zeta: zero,
+            z1: pad(r.z1, m, i),
+            w_norms: [0.0; 3],
+            x_ee: [f64::NAN; 3],
+            wrench: [f64::NAN; 6],
+            refused: false,
+        });
+    }
+    let mut out = metrics_out(&acc.finish());
+    for (name, v) in &mut out.joint {
+        v.truncate(if *name == "peak_abs_tau" { n } else { m });
+    }
+    if !joint {
+        for (name, v) in &mut out.scalars {
+            if *name == "imp_err_rms_after2" {
+                *v = f64::NAN;
+            }
+        }
+    }
+    Ok(out)
 }

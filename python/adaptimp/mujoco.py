@@ -1192,6 +1192,9 @@ def _python_loop(
     (r_q, r_dq, r_ddq, r_xc, r_dxc, r_ddxc, r_xd, r_dq_hat, r_tau, r_tau_sat, r_tau_e, r_zeta,
      r_z1, r_x_ee, r_wrench) = rows.values()  # fmt: skip
     zeros = np.zeros(n)
+    # Steps the controller took before (its own trajectory goes on from there).
+    k0 = getattr(ctrl, "steps", 0)
+    k0 = k0 if isinstance(k0, int) else 0
     last = time.perf_counter()
     for k in range(steps):
         q, dq = plant.q, plant.dq
@@ -1238,7 +1241,8 @@ def _python_loop(
         builtin = _builtin_reference(ctrl)
         if builtin is not None:
             # (sinusoid's reference broadcasts: one row per time.)
-            _, dxc_all, ddxc_all = builtin(t[:, None])  # type: ignore[arg-type]
+            own = (k0 + np.arange(steps, dtype=np.float64)) * Ts
+            _, dxc_all, ddxc_all = builtin(own[:, None])  # type: ignore[arg-type]
             rows["dxc"] = list(np.asarray(dxc_all, dtype=np.float64))
             rows["ddxc"] = list(np.asarray(ddxc_all, dtype=np.float64))
         else:

@@ -920,13 +920,14 @@ def _native(ctrl: Any) -> bool:
     return isinstance(ctrl, _adaptimp.Controller) and type(ctrl).step is _adaptimp.Controller.step
 
 
-def _tabulate(reference: Reference, steps: int, Ts: float) -> tuple[FloatArray, ...]:
+def _tabulate(
+    reference: Reference, steps: int, Ts: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """``reference(k·Ts)`` for every row k, as three (K, m) arrays (called in
     order, once per row, as the loop would)."""
     rows = [tuple(np.asarray(v, dtype=np.float64) for v in reference(k * Ts)) for k in range(steps)]
-    if not rows:
-        return (np.zeros((0, 0)),) * 3
-    return tuple(np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
+    xc, dxc, ddxc = (np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
+    return xc, dxc, ddxc
 
 
 def simulate(
@@ -1033,6 +1034,7 @@ def simulate(
     callback, bar = _progress(progress, "mujoco.simulate")
     try:
         if run.native:
+            assert run.spec is not None
             refs = None if reference is None else _tabulate(reference, run.steps, run.Ts)
             out = _adaptimp.simulate_mujoco(
                 run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
@@ -1120,6 +1122,8 @@ def _setup(
     if not (math.isfinite(T) and T > 0):
         raise ValueError(f"T must be finite and > 0, got {T}")
     steps = round(T / Ts)
+    if steps < 1:
+        raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
     if substeps is None:
         substeps = max(1, round(Ts / plant.timestep))
     if substeps < 1:
@@ -1306,7 +1310,7 @@ def _run_many(
     if native:
         results = _adaptimp.simulate_mujoco_many(
             [
-                (r.ctrl, r.plant.model, r.plant.data, r.spec, r.dist, r.T, r.settle)
+                (r.ctrl, r.plant.model, r.plant.data, r.spec or {}, r.dist, r.T, r.settle)
                 for _, r in native
             ],
             threads,

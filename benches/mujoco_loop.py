@@ -22,9 +22,14 @@ gains and centres along a sinusoid of 0.15 rad at 1 rad/s about the posture:
 - for reference, the Python loop (``simulate`` with the same controller behind a
   Python object: the fallback, the loop every controller took before).
 
+Then a sweep on MuJoCo: ``adaptimp.sweep(..., plant="mujoco")`` of 16 runs (the
+paper's arm with its ceiling, state feedback in the robot scenario, T =
+``--sweep-T``, a 4 × 4 grid of Kp and K1) on every core (``executor=None``)
+against one thread (``threads=1``); target ≥ 1.7× on 2 cores.
+
 Each measurement is repeated ``--repeats`` times, interleaved; medians.
 
-    target/py-venv/bin/python benches/mujoco_loop.py [--T 10] [--repeats 5]
+    target/py-venv/bin/python benches/mujoco_loop.py [--T 10] [--repeats 5] [--sweep-T 2]
 """
 
 from __future__ import annotations
@@ -150,6 +155,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--T", type=float, default=10.0, help="run length (s)")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--sweep-T", type=float, default=2.0, help="sweep run length (s)")
     args = parser.parse_args()
     print(
         f"machine: {platform.processor() or platform.machine()}, "
@@ -179,6 +185,26 @@ def main() -> None:
             f"{med['hold']:.1f} | {med['step']:.2f} | {ratio:.2f} | {med['python']:.1f} | "
             f"{med['python'] / med['native']:.1f}× |"
         )
+    sweep_table(args.sweep_T, args.repeats)
+
+
+def sweep_table(T: float, repeats: int) -> None:
+    import os
+
+    vary = {"Kp": [7.0, 8.0, 9.0, 10.0], "K1": [4.0, 5.0, 6.0, 7.0]}
+    times: dict[str, list[float]] = {"every core": [], "one thread": []}
+    for _ in range(repeats):
+        for label, threads in (("every core", None), ("one thread", 1)):
+            start = time.perf_counter()
+            df = adaptimp.sweep("sf", vary=vary, plant="mujoco", T=T, threads=threads)
+            times[label].append(time.perf_counter() - start)
+            assert df["error"].isna().all(), df["error"].dropna().head()
+    med = {k: statistics.median(v) for k, v in times.items()}
+    print(
+        f"\nsweep(plant='mujoco'), 16 runs of T = {T:g} s on {os.cpu_count()} cores: "
+        f"one thread {med['one thread']:.2f} s, every core {med['every core']:.2f} s, "
+        f"speed-up {med['one thread'] / med['every core']:.2f}× (medians of {repeats})"
+    )
 
 
 if __name__ == "__main__":

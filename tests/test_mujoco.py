@@ -317,7 +317,7 @@ def test_mujoco_result_is_a_sim_result() -> None:
 
 
 # ---------------------------------------------------------------------------
-# The native loop (SPEC §13.2): the core's loop, recorder and metrics.
+# The native loop (SPEC §13.1): the core's loop, recorder and metrics.
 # ---------------------------------------------------------------------------
 
 

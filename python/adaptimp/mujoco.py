@@ -584,7 +584,7 @@ class Plant:
         return any((ct[a] & ca[b]) or (ct[b] & ca[a]) for a in inside for b in outside)
 
     def _native(self, substeps: int) -> dict[str, Any] | None:
-        """The plant as the core's native loop takes it (SPEC §13.2), or None
+        """The plant as the core's native loop takes it (SPEC §13.1), or None
         if the core cannot measure its wrench (no force sensor and contacts
         possible: the contact path reads MuJoCo's contact list, which only
         the Python loop does)."""
@@ -953,7 +953,7 @@ def simulate(
     (with the torque applied over the last period), the controller is given
     ``(q, tau_e, dq[, xc=, dxc=, ddxc=])`` and returns a torque; it is
     saturated to the actuators' τmax and held for ``substeps`` MuJoCo steps of
-    Ts / substeps each (SPEC §13.2).
+    Ts / substeps each (SPEC §13.1).
 
     An ``adaptimp.Controller`` (or a case name) runs in the compiled core: the
     loop, the recording and the metrics are the core's, MuJoCo is driven

@@ -1271,7 +1271,7 @@ fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
 /// Close the loop of `controller` (from its current state) with the MuJoCo
 /// `model` and its `data` (`mujoco.MjModel`, `mujoco.MjData`) as `spec`
 /// describes the plant, for `t_final` (s), with the GIL released and MuJoCo
-/// driven through its C library (SPEC §13.2): the disturbances of `params`
+/// driven through its C library (SPEC §13.1): the disturbances of `params`
 /// (SPEC §17), the setpoints `reference` = (xc, dxc, ddxc), each (K, n) with
 /// K ≥ the steps (None: the controller's own trajectory), the metrics after
 /// `settle` (s). Keeps every `record_every`-th row; checks for signals every

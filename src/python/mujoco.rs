@@ -1,6 +1,6 @@
 //! MuJoCo as a [`Plant`] of the core's closed loop: [`MjPlant`] drives a
 //! model through [`adaptimp_mujoco::Sim`] (the engine's C library, no Python
-//! in the loop) with the semantics of `adaptimp.mujoco` (SPEC §13.2):
+//! in the loop) with the semantics of `adaptimp.mujoco` (SPEC §13.1):
 //!
 //! - at t_k, the state, the end-effector position, the wrench F_e and
 //!   τe = Jᵀ F_e are those of MuJoCo's forward computation at x_k with the

@@ -14,7 +14,7 @@
 //! changes between MuJoCo versions.
 //!
 //! Everything `unsafe` of adaptimp's MuJoCo support is in this crate, each
-//! block with its invariant. The API is safe: [`Sim::from_python`] (feature
+//! block with its invariant. The API is safe: `Sim::from_python` (feature
 //! `python`) checks the objects it is given and keeps them alive; a `Sim` is
 //! the only user of its `mjData` while it exists (a process-wide lease), so
 //! runs on distinct data go in parallel threads (MuJoCo's functions are

@@ -339,6 +339,7 @@ def simulate(
     record_every: int = 1,
     progress: Callable[[int, int], object] | None = None,
     weights: dict[str, _F] | None = None,
+    fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
 ) -> dict[str, Any]:
     """Close the loop with the GIL released; returns the arrays and "metrics"."""
 
@@ -360,6 +361,7 @@ def simulate_mujoco(
     record_every: int = 1,
     progress: Callable[[int, int], object] | None = None,
     reference: tuple[_F, _F, _F] | None = None,
+    fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
 ) -> dict[str, Any]:
     """The closed loop on a MuJoCo MjModel/MjData with the GIL released (SPEC §13.2)."""
 

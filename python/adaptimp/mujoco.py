@@ -53,6 +53,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     ) from e
 
 from . import _adaptimp, _models
+from ._faults import Fault
 from ._result import SimResult
 from ._trajectory import Reference, paper_circle, sinusoid
 
@@ -945,6 +946,7 @@ def simulate(
     scenario: str = "robot",
     record_every: int = 1,
     progress: bool | Callable[[int, int], object] = False,
+    fault: Fault | None = None,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1000,6 +1002,9 @@ def simulate(
     progress : bool or callable
         ``True``: a progress bar for runs longer than 2 s; a callable is called
         as ``progress(done, total)`` about every 50 ms.
+    fault : adaptimp.Fault, optional
+        A fault injected over a window, as for :func:`adaptimp.simulate` (the
+        actuators' τmax for ``"actuator_drop"``); needs the native loop.
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
@@ -1036,12 +1041,19 @@ def simulate(
         if run.native:
             assert run.spec is not None
             refs = None if reference is None else _tabulate(reference, run.steps, run.Ts)
+            core_fault = None if fault is None else fault._core(run.plant.n)
             out = _adaptimp.simulate_mujoco(
                 run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
-                run.settle, run.every, callback, refs,
+                run.settle, run.every, callback, refs, core_fault,
             )  # fmt: skip
             m = out.pop("metrics")
         else:
+            if fault is not None:
+                raise TypeError(
+                    "fault= needs a controller the core steps (an adaptimp.Controller or a "
+                    "case name) and a plant with a force sensor or no possible contact; this "
+                    "run steps its controller from Python"
+                )
             out, m = _python_loop(run, reference, callback)
     finally:
         if bar is not None:

@@ -91,7 +91,7 @@ pub trait Control<const N: usize> {
         }
     }
     /// [`step_or_fallback`](Self::step_or_fallback) with the measured
-    /// end-effector wrench F_e = [f; m] (N, N m, world frame; NaN where the
+    /// end-effector wrench F_e = [f; m] (N, N m, world frame; zeros where the
     /// plant measures none), which the closed loop passes at every step: a
     /// controller in task space (a Cartesian impedance) uses it; the default
     /// ignores it, as a joint-space controller does.

@@ -19,6 +19,7 @@ use crate::networks::rbf::{AnyBasis, Basis, Centers};
 use crate::schema::{Preset, Scenario, Value};
 use crate::sim::disturb::TipPayload;
 use crate::sim::environment::{FreeSpace, Wall};
+use crate::sim::inject::{Injected, Injection};
 use crate::sim::metrics::MetricsAccumulator;
 use crate::sim::model::{Link, PlanarArm, TwoLinkArm};
 use crate::sim::plant::{Plant, RigidBody};
@@ -116,6 +117,74 @@ pub enum ArmSpec {
         /// Gravity (m/s²).
         g: f64,
     },
+}
+
+/// A fault to inject into a run (`src/sim/inject.rs`), for any number of joints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaultSpec {
+    /// What goes wrong.
+    pub kind: FaultKind,
+    /// Start of the window (s).
+    pub start: f64,
+    /// Length of the window (s).
+    pub duration: f64,
+}
+
+/// The kinds of [`Injected`] faults.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FaultKind {
+    /// The sensors repeat their last sample.
+    Stale,
+    /// The position sensor reads NaN.
+    NanBurst,
+    /// The force sensor reads τe + bias (N m, one per joint).
+    ForceBias(Vec<f64>),
+    /// The actuators deliver at most this fraction of τmax.
+    ActuatorDrop(f64),
+    /// No control step runs: the last applied torque is held.
+    Skipped,
+}
+
+/// The core's injection of `f`, with the actuators' limits `tau_max` (N m).
+fn injection<const N: usize>(f: &FaultSpec, tau_max: &Vector<N>) -> Result<Injection<N>, Error> {
+    crate::error::check::nonnegative("fault start ≥ 0", "start", f.start)?;
+    crate::error::check::positive("fault duration > 0", "duration", f.duration)?;
+    let fault = match &f.kind {
+        FaultKind::Stale => Injected::Stale,
+        FaultKind::NanBurst => Injected::NanBurst,
+        FaultKind::Skipped => Injected::Skipped,
+        FaultKind::ForceBias(b) => {
+            if b.len() != N {
+                return Err(Error::Invalid {
+                    what: "bias",
+                    reason: "needs one value per joint (N m)",
+                });
+            }
+            crate::error::check::finite_slice("bias", b)?;
+            Injected::ForceBias {
+                bias: Vector::from_column_slice(b),
+            }
+        }
+        FaultKind::ActuatorDrop(fraction) => {
+            if !(0.0..=1.0).contains(fraction) {
+                return Err(Error::Condition {
+                    condition: "0 ≤ fraction ≤ 1",
+                    lhs: "fraction",
+                    index: None,
+                    value: *fraction,
+                });
+            }
+            Injected::ActuatorDrop {
+                tau_max: *tau_max,
+                fraction: *fraction,
+            }
+        }
+    };
+    Ok(Injection {
+        fault,
+        start: f.start,
+        duration: f.duration,
+    })
 }
 
 /// The run-time hook of long calls: asked every few steps whether to go on
@@ -330,6 +399,7 @@ pub trait DynTracker: Send + Sync {
         arm: &ArmSpec,
         items: &Items,
         weights: Option<&[f64]>,
+        fault: Option<&FaultSpec>,
         every: u64,
         hooks: &mut dyn Hooks,
     ) -> Result<(Records, MetricsOut), RunError>;
@@ -362,6 +432,15 @@ pub struct MujocoRun<'a> {
     /// The commanded setpoints xc, ẋc, ẍc of every row (K × n each,
     /// row-major), or none: the controller's own trajectory.
     pub reference: Option<[&'a [f64]; 3]>,
+    /// A fault to inject (τmax: the plant's actuators').
+    pub fault: Option<&'a FaultSpec>,
+}
+
+fn invalid_tau_max() -> Error {
+    Error::Invalid {
+        what: "tau_max",
+        reason: "the plant needs one limit per joint",
+    }
 }
 
 fn run_mujoco<const N: usize>(
@@ -419,6 +498,18 @@ fn run_mujoco<const N: usize>(
         k0,
         ts,
     };
+    let inj = match run.fault {
+        Some(f) => {
+            if spec.tau_max.len() != N {
+                return Err(RunError::Core(invalid_tau_max(), None));
+            }
+            Some(injection::<N>(
+                f,
+                &Vector::from_column_slice(&spec.tau_max),
+            )?)
+        }
+        None => None,
+    };
     let mut plant = MjPlant::<N>::new(sim, spec, ts, *dist.friction())?;
     if let Err(e) = plant.start() {
         return Err(match plant.failure() {
@@ -433,9 +524,9 @@ fn run_mujoco<const N: usize>(
         match run.reference {
             Some(rows) => {
                 let table = Table::<N> { rows, ts };
-                simulate_disturbed(&mut p, t, &table, run.t_final, None, &dist, rec2)
+                simulate_disturbed(&mut p, t, &table, run.t_final, inj.as_ref(), &dist, rec2)
             }
-            None => simulate_disturbed(&mut p, t, &own, run.t_final, None, &dist, rec2),
+            None => simulate_disturbed(&mut p, t, &own, run.t_final, inj.as_ref(), &dist, rec2),
         }
     };
     match result {
@@ -608,10 +699,14 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     arm: &M,
     s: &Scenario<N>,
     weights: Option<&[f64]>,
+    fault: Option<&FaultSpec>,
     every: u64,
     hooks: &mut dyn Hooks,
 ) -> Result<(Records, MetricsOut), RunError> {
     let cfg = &s.sim;
+    let inj = fault
+        .map(|f| injection::<N>(f, &t.controller().config().tau_max))
+        .transpose()?;
     let ts = t.controller().period();
     let total = crate::sim::simulator::steps(cfg.t_final, ts)?;
     let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
@@ -636,9 +731,32 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     let metrics = match s.wall {
         Some(w) => {
             let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
-            run_disturbed_with(arm, &wall, t, &traj, cfg, &dist, &mut watch, &mut rec)
+            run_disturbed_with(
+                arm,
+                &wall,
+                t,
+                &traj,
+                cfg,
+                &dist,
+                inj.as_ref(),
+                &mut watch,
+                &mut rec,
+            )
         }
-        None => run_disturbed_with(arm, &FreeSpace, t, &traj, cfg, &dist, &mut watch, &mut rec),
+        None => {
+            let env = FreeSpace;
+            run_disturbed_with(
+                arm,
+                &env,
+                t,
+                &traj,
+                cfg,
+                &dist,
+                inj.as_ref(),
+                &mut watch,
+                &mut rec,
+            )
+        }
     }
     .map_err(|e| watch.error(e))?;
     Ok((rec, metrics_out(&metrics)))
@@ -797,6 +915,7 @@ impl<const N: usize> DynTracker for Typed<N> {
         arm: &ArmSpec,
         items: &Items,
         weights: Option<&[f64]>,
+        fault: Option<&FaultSpec>,
         every: u64,
         hooks: &mut dyn Hooks,
     ) -> Result<(Records, MetricsOut), RunError> {
@@ -817,7 +936,7 @@ impl<const N: usize> DynTracker for Typed<N> {
                     ))?;
                 let s2 = scenario::<2>(preset, typed.law(), items)
                     .map_err(|e| RunError::Core(e.error, None))?;
-                run_arm(typed, two, &s2, weights, every, hooks)
+                run_arm(typed, two, &s2, weights, fault, every, hooks)
             }
             ArmSpec::Planar { links, g } => {
                 let links: [Link; N] = links.as_slice().try_into().map_err(|_| {
@@ -830,7 +949,7 @@ impl<const N: usize> DynTracker for Typed<N> {
                     )
                 })?;
                 let arm = PlanarArm::new(links, *g)?;
-                run_arm(self, &arm, &s, weights, every, hooks)
+                run_arm(self, &arm, &s, weights, fault, every, hooks)
             }
         }
     }
@@ -954,8 +1073,8 @@ fn metrics_n<const N: usize>(
             zeta: zero,
             z1: pad(r.z1, m, i),
             w_norms: [0.0; 3],
-            x_ee: [f64::NAN; 3],
-            wrench: [f64::NAN; 6],
+            x_ee: [0.0; 3],
+            wrench: [0.0; 6],
             refused: false,
         });
     }

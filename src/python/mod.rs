@@ -1114,8 +1114,12 @@ arm_class!(PyPlanarArm, {
 /// "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e",
 /// "zeta", "z1"; "w_norms" (K, 3); "refused" (K,) bool) and "metrics"
 /// (SPEC §12). `controller` is left in its state at the end of the run.
+/// With `fault` = (kind, start, duration, bias, fraction), that fault is
+/// injected (`src/sim/inject.rs`): a refused step applies the fallback and
+/// the run goes on, the row marked "refused".
 #[pyfunction]
-#[pyo3(signature = (controller, arm, params, record_every=1, progress=None, weights=None))]
+#[pyo3(signature = (controller, arm, params, record_every=1, progress=None, weights=None, fault=None))]
+#[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
     controller: &Bound<'py, PyController>,
@@ -1124,7 +1128,9 @@ fn simulate<'py>(
     record_every: u64,
     progress: Option<Py<PyAny>>,
     weights: Option<&Bound<'py, PyDict>>,
+    fault: Option<PyFault>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let fault = fault_spec(fault)?;
     if record_every == 0 {
         return Err(ConfigError::new_err("record_every must be ≥ 1"));
     }
@@ -1149,8 +1155,10 @@ fn simulate<'py>(
     let mut hooks = PyHooks::new(progress);
     let mut guard = ctrl.lock(py);
     let tracker: &mut dyn DynTracker = &mut **guard;
-    let result =
-        py.detach(|| tracker.simulate(&spec, &items, weights.as_deref(), record_every, &mut hooks));
+    let result = py.detach(|| {
+        let w = weights.as_deref();
+        tracker.simulate(&spec, &items, w, fault.as_ref(), record_every, &mut hooks)
+    });
     drop(guard);
     let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
     records_dict(py, rec, metrics)
@@ -1238,6 +1246,38 @@ fn metrics<'py>(
     metrics_to_dict(py, out)
 }
 
+/// A fault as `adaptimp.Fault` hands it to the core: (kind, start (s),
+/// duration (s), bias (N m, per joint) or None, fraction or None).
+type PyFault = (String, f64, f64, Option<Vec<f64>>, Option<f64>);
+
+/// A fault to inject from its Python form ([`PyFault`]).
+fn fault_spec(
+    f: Option<PyFault>,
+) -> PyResult<Option<dynamic::FaultSpec>> {
+    let Some((kind, start, duration, bias, fraction)) = f else {
+        return Ok(None);
+    };
+    use dynamic::FaultKind as K;
+    let kind = match (kind.as_str(), bias, fraction) {
+        ("stale", None, None) => K::Stale,
+        ("nan_burst", None, None) => K::NanBurst,
+        ("skipped", None, None) => K::Skipped,
+        ("force_bias", Some(b), None) => K::ForceBias(b),
+        ("actuator_drop", None, Some(x)) => K::ActuatorDrop(x),
+        (other, b, x) => {
+            return Err(ConfigError::new_err(format!(
+                "fault {other:?} with bias {b:?} and fraction {x:?}: the kinds are 'stale', \
+                 'nan_burst', 'skipped', 'force_bias' (with bias) and 'actuator_drop' (with fraction)"
+            )))
+        }
+    };
+    Ok(Some(dynamic::FaultSpec {
+        kind,
+        start,
+        duration,
+    }))
+}
+
 // ---------------------------------------------------------------------------
 // The closed loop on MuJoCo.
 // ---------------------------------------------------------------------------
@@ -1280,7 +1320,7 @@ fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
 /// which MuJoCo warned (it resets a diverged state) raises `DivergedError`
 /// naming the row, the time and MuJoCo's message.
 #[pyfunction]
-#[pyo3(signature = (controller, model, data, spec, params, t_final, settle, record_every=1, progress=None, reference=None))]
+#[pyo3(signature = (controller, model, data, spec, params, t_final, settle, record_every=1, progress=None, reference=None, fault=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_mujoco<'py>(
     py: Python<'py>,
@@ -1298,7 +1338,9 @@ fn simulate_mujoco<'py>(
         PyReadonlyArray2<'py, f64>,
         PyReadonlyArray2<'py, f64>,
     )>,
+    fault: Option<PyFault>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let fault = fault_spec(fault)?;
     if record_every == 0 {
         return Err(ConfigError::new_err("record_every must be ≥ 1"));
     }
@@ -1324,6 +1366,7 @@ fn simulate_mujoco<'py>(
         every: record_every,
         items: &items,
         reference: tables.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
+        fault: fault.as_ref(),
     };
     let mut hooks = PyHooks::new(progress);
     let mut guard = ctrl.lock(py);
@@ -1365,7 +1408,7 @@ fn run_job(job: &Job, stop: &std::sync::atomic::AtomicBool) -> Result<dynamic::M
         })?;
     let mut hooks = StopHooks(stop);
     tracker
-        .simulate(&job.arm, &job.items, None, u64::MAX, &mut hooks)
+        .simulate(&job.arm, &job.items, None, None, u64::MAX, &mut hooks)
         .map(|(_, m)| m)
         .map_err(run_message)
 }
@@ -1563,6 +1606,7 @@ fn simulate_mujoco_many<'py>(
             every: u64::MAX,
             items: &job.items,
             reference: None,
+            fault: None,
         };
         let mut hooks = StopHooks(stop);
         let mut sim = job.sim.lock().unwrap_or_else(|p| p.into_inner());

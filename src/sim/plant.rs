@@ -28,14 +28,16 @@ pub trait Plant<const N: usize> {
     }
     /// The wrench F_e = [f; m] the end effector exerts on the environment
     /// now, force (N) and moment (N m) in the world frame, as a force/torque
-    /// sensor measures it (τe = Jᵀ F_e). Default: NaN (a plant without an
-    /// end effector in Cartesian space: the joint-space rigid bodies).
+    /// sensor measures it (τe = Jᵀ F_e). Default: zeros (a plant that
+    /// measures no Cartesian quantity: the joint-space rigid bodies, whose
+    /// contact is τe; zeros rather than NaN keep rows comparable).
     fn wrench(&self) -> [f64; 6] {
-        [f64::NAN; 6]
+        [0.0; 6]
     }
-    /// The end-effector position (m), world frame, now. Default: NaN.
+    /// The end-effector position (m), world frame, now. Default: zeros (as
+    /// [`wrench`](Self::wrench)).
     fn end_effector(&self) -> [f64; 3] {
-        [f64::NAN; 3]
+        [0.0; 3]
     }
 }
 

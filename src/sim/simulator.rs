@@ -247,12 +247,14 @@ where
     T: Trajectory<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
-    run_disturbed_with(arm, env, ctrl, traj, cfg, disturbances, &mut (), rec)
+    run_disturbed_with(arm, env, ctrl, traj, cfg, disturbances, None, &mut (), rec)
 }
 
-/// [`run_disturbed`] with the plant seen through `adapter` (e.g. one that
-/// checks for a stop request after every period: [`Adapter`]). With `()` it
-/// is [`run_disturbed`], bit for bit.
+/// [`run_disturbed`] with a fault injected (`injection`, as
+/// [`simulate_with`]: a refused step applies the fallback and the run goes
+/// on) and the plant seen through `adapter` (e.g. one that checks for a stop
+/// request after every period: [`Adapter`]). With `None` and `()` it is
+/// [`run_disturbed`], bit for bit.
 #[allow(clippy::too_many_arguments)]
 pub fn run_disturbed_with<const N: usize, M, E, C, T, A, R>(
     arm: &M,
@@ -261,6 +263,7 @@ pub fn run_disturbed_with<const N: usize, M, E, C, T, A, R>(
     traj: &T,
     cfg: &SimConfig<N>,
     disturbances: &Disturbances<N>,
+    injection: Option<&Injection<N>>,
     adapter: &mut A,
     rec: &mut R,
 ) -> Result<Metrics<N>, Error>
@@ -284,7 +287,7 @@ where
         ctrl,
         traj,
         cfg.t_final,
-        None,
+        injection,
         disturbances,
         &mut (&mut metrics, rec),
     )?;

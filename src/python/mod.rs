@@ -1251,9 +1251,7 @@ fn metrics<'py>(
 type PyFault = (String, f64, f64, Option<Vec<f64>>, Option<f64>);
 
 /// A fault to inject from its Python form ([`PyFault`]).
-fn fault_spec(
-    f: Option<PyFault>,
-) -> PyResult<Option<dynamic::FaultSpec>> {
+fn fault_spec(f: Option<PyFault>) -> PyResult<Option<dynamic::FaultSpec>> {
     let Some((kind, start, duration, bias, fraction)) = f else {
         return Ok(None);
     };
@@ -1543,6 +1541,17 @@ fn in_parallel<J: Sync>(
     results.map_err(|_| PyRuntimeError::new_err("a sweep's worker thread panicked"))
 }
 
+/// A MuJoCo job as Python gives it: (controller, model, data, spec, params, T, settle).
+type PyMujocoJob<'py> = (
+    Bound<'py, PyController>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyDict>,
+    Bound<'py, PyDict>,
+    f64,
+    f64,
+);
+
 /// One MuJoCo run of a sweep: its controller, plant and settings.
 struct MujocoJob {
     ctrl: Py<PyController>,
@@ -1581,15 +1590,7 @@ fn simulate_mujoco_many<'py>(
 ) -> PyResult<Bound<'py, PyList>> {
     let mut parsed = Vec::with_capacity(jobs.len());
     for job in jobs.iter() {
-        let (ctrl, model, data, spec, params, t_final, settle): (
-            Bound<'py, PyController>,
-            Bound<'py, PyAny>,
-            Bound<'py, PyAny>,
-            Bound<'py, PyDict>,
-            Bound<'py, PyDict>,
-            f64,
-            f64,
-        ) = job.extract()?;
+        let (ctrl, model, data, spec, params, t_final, settle): PyMujocoJob<'py> = job.extract()?;
         parsed.push(MujocoJob {
             ctrl: ctrl.unbind(),
             sim: Mutex::new(adaptimp_mujoco::Sim::from_python(&model, &data)?),

@@ -7,6 +7,7 @@ from __future__ import annotations
 import importlib
 import importlib.resources
 import sys
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -478,10 +479,13 @@ def _step_at(k: int) -> object:
     return lambda t: ([0.0 if t < (k - 0.5) * 1e-3 else 10.0], [0.0], [0.0])
 
 
-def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause() -> None:
+def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Issue 20, item 6: MuJoCo resets a diverged state and only warns, so the
     run used to end at data.time = 0.001 s with a normal-looking result. Both
     loops now raise DivergedError with the row, the time and MuJoCo's words."""
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warnings to MUJOCO_LOG.TXT here
     model = mujoco.MjModel.from_xml_string(_FEATHER)
     want = (
         "the MuJoCo plant diverged in the period of row 5 (t = 0.005 s to 0.006 s): "
@@ -500,7 +504,10 @@ def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause() -> N
         amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0))
 
 
-def test_plant_step_raises_when_mujoco_resets() -> None:
+def test_plant_step_raises_when_mujoco_resets(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warnings to MUJOCO_LOG.TXT here
     plant = amj.Plant(mujoco.MjModel.from_xml_string(_FEATHER))
     plant.step(3)
     plant.apply([1e6])

@@ -542,3 +542,37 @@ impl Sim {
         Ok((&self.jacp, &self.jacr))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_lease_per_data_until_it_is_given_back() {
+        let mut a = 0u8;
+        let data = (&mut a as *mut u8).cast::<c_void>();
+        let first = Lease::take(data).expect("free");
+        assert_eq!(Lease::take(data).unwrap_err(), Error::Busy);
+        drop(first);
+        let again = Lease::take(data).expect("given back");
+        drop(again);
+    }
+
+    #[test]
+    fn a_fatal_error_returns_and_other_panics_go_on() {
+        // What `on_error` does inside a guarded call.
+        let r: Result<(), Error> = guarded(|| resume_unwind(Box::new(FatalPayload("boom".into()))));
+        assert_eq!(r, Err(Error::Fatal("boom".into())));
+        assert!(!GUARDED.with(Cell::get));
+        assert_eq!(guarded(|| 7), Ok(7));
+        let other = catch_unwind(|| guarded(|| resume_unwind(Box::new(3_i32))));
+        assert_eq!(
+            *other
+                .unwrap_err()
+                .downcast::<i32>()
+                .expect("the same payload"),
+            3
+        );
+        assert!(!GUARDED.with(Cell::get));
+    }
+}

@@ -137,7 +137,10 @@ pub use saturation::Saturation;
 pub use schema::{Preset, Scenario};
 pub use simd::SimdPath;
 #[cfg(feature = "sim")]
-pub use simulator::{run, run_disturbed, simulate, simulate_disturbed, simulate_with, SimConfig};
+pub use simulator::{
+    run, run_disturbed, run_disturbed_with, simulate, simulate_disturbed, simulate_with, Adapted,
+    Adapter, SimConfig,
+};
 #[cfg(feature = "alloc")]
 pub use state::HeapState;
 pub use state::State;

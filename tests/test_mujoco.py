@@ -7,6 +7,7 @@ from __future__ import annotations
 import importlib
 import importlib.resources
 import sys
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -314,3 +315,250 @@ def test_mujoco_result_is_a_sim_result() -> None:
     assert "q1 [rad]" in df.columns
     assert res.x_ee is not None
     assert res.x_ee.shape == (50, 3)
+
+
+# ---------------------------------------------------------------------------
+# The native loop (SPEC §13.1): the core's loop, recorder and metrics.
+# ---------------------------------------------------------------------------
+
+
+class _InPython:
+    """An adaptimp.Controller behind a Python object: simulate's Python loop
+    steps it through its Python ``step``."""
+
+    def __init__(self, inner: adaptimp.Controller) -> None:
+        self.inner = inner
+        self.ts = inner.ts
+        self.params = inner.params
+
+    def step(self, q: object, tau_e: object, dq: object = None, **sp: object) -> np.ndarray:
+        return self.inner.step(q, tau_e, dq, **sp)
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self.inner, name)
+
+
+_ARRAYS = (
+    "t", "q", "dq", "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e",
+    "zeta", "z1", "x_ee", "wrench_ee",
+)  # fmt: skip
+
+
+def _assert_same_run(got: amj.MujocoResult, want: amj.MujocoResult) -> None:
+    for name in _ARRAYS:
+        np.testing.assert_array_equal(getattr(got, name), getattr(want, name), err_msg=name)
+    assert set(got.metrics) == set(want.metrics)
+    for key, value in want.metrics.items():
+        np.testing.assert_array_equal(got.metrics[key], value, err_msg=key)
+
+
+@pytest.mark.parametrize("contact", [False, True])
+@pytest.mark.parametrize("case", ["pd", "sf", "of"])
+def test_the_native_loop_equals_the_python_loop(case: str, contact: bool) -> None:
+    """The core's loop (MuJoCo through its C library) and the Python loop
+    stepping the same controller through its Python ``step`` give the same
+    bits, row by row and metric by metric, in contact too."""
+    T = 2.5
+    native = amj.simulate(adaptimp.Controller(case, "robot"), "two_link", T=T, contact=contact)
+    python = amj.simulate(
+        _InPython(adaptimp.Controller(case, "robot")), "two_link", T=T, contact=contact
+    )
+    assert native.params["loop"] == "native"
+    assert python.params["loop"] == "python"
+    _assert_same_run(native, python)
+    if contact:
+        assert native.metrics["steps_in_contact"] > 100
+    # The native run records what the Python loop cannot see: the weights.
+    assert case == "pd" or native.w_norms[-1, 2] > 0
+    assert np.all(np.isnan(python.w_norms))
+
+
+def test_the_native_loop_with_a_reference_and_seven_joints_in_contact() -> None:
+    """The Panda on its table, a reference callable: native and Python loops agree."""
+    q0 = np.array(_models.PANDA_HOME)
+
+    def down(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        # The shoulder leans towards the table: the tool meets it within 0.3 s.
+        xc = q0.copy()
+        xc[1] += 0.6 * t
+        v = np.zeros(7)
+        v[1] = 0.6
+        return xc, v, np.zeros(7)
+
+    def ctrl() -> adaptimp.Controller:
+        return adaptimp.Controller(
+            "pd", "robot", n=7, tau_max=list(_models.PANDA_EFFORT), impedance="external",
+            Kp=[40.0, 40.0, 40.0, 40.0, 4.0, 4.0, 4.0], K1=20.0, Kzeta=1000.0,
+            centers=np.zeros((1, 28)), widths=1.0,
+        )  # fmt: skip
+
+    plant = amj.Plant("panda")
+    native = amj.simulate(ctrl(), plant, T=0.6, q0=q0, reference=down)
+    python = amj.simulate(_InPython(ctrl()), plant, T=0.6, q0=q0, reference=down)
+    assert native.params["loop"] == "native"
+    _assert_same_run(native, python)
+    assert native.metrics["steps_in_contact"] > 50
+    # The wrench is the sensor's, and τe = Jᵀ F_e row by row.
+    assert np.max(np.abs(native.wrench_ee[:, 2])) > 1.0
+
+
+def test_a_used_controller_goes_on_along_its_trajectory() -> None:
+    """A controller that has run before is used as it is: its clock goes on."""
+    a = adaptimp.Controller("sf", "robot")
+    amj.simulate(a, "two_link", T=0.5, contact=False)
+    b = adaptimp.Controller("sf", "robot")
+    amj.simulate(_InPython(b), "two_link", T=0.5, contact=False)
+    assert a.steps == b.steps == 500
+    _assert_same_run(
+        amj.simulate(a, "two_link", T=0.5, contact=False),
+        amj.simulate(_InPython(b), "two_link", T=0.5, contact=False),
+    )
+
+
+def test_the_core_metrics_serve_both_loops() -> None:
+    """_adaptimp.metrics (the core's accumulator over recorded rows) gives
+    adaptimp.simulate's own metrics for its rows: one implementation."""
+    res = adaptimp.simulate("sf", "robot", T=3.0)
+    p = res.params
+    assert res.ddq is not None
+    assert res.dxc is not None
+    assert res.ddxc is not None
+    m = adaptimp._adaptimp.metrics(
+        res.t, res.q, res.dq, res.ddq, res.xc, res.dxc, res.ddxc, res.z1, res.tau,
+        res.tau_sat, res.tau_e, p["settle"], (p["Dd"], p["Cd"], p["Gd"]),
+    )  # fmt: skip
+    assert m == res.metrics
+    # Task-space rows (z1 of width 3 on 2 joints): the per-joint z1 figures
+    # have z1's width, τ's have n; no impedance residual.
+    k = res.rows
+    z3 = np.column_stack([res.z1, np.zeros(k)])
+    x3 = np.zeros((k, 3))
+    m3 = adaptimp._adaptimp.metrics(
+        res.t, res.q, res.dq, res.ddq, x3, x3, x3, z3, res.tau, res.tau_sat, res.tau_e,
+        p["settle"], (p["Dd"], p["Cd"], p["Gd"]),
+    )  # fmt: skip
+    assert m3["rms_z1"] == res.metrics["rms_z1"]
+    assert m3["rms_z1_joint_after2"] == [*res.metrics["rms_z1_joint_after2"], 0.0]
+    assert m3["peak_abs_tau"] == res.metrics["peak_abs_tau"]
+    assert np.isnan(m3["imp_err_rms_after2"])
+
+
+# ---------------------------------------------------------------------------
+# A run that explodes (MuJoCo resets the state and only warns).
+# ---------------------------------------------------------------------------
+
+_FEATHER = """<mujoco><option integrator="RK4" timestep="0.001"/><worldbody>
+<body><joint name="j" type="hinge" axis="0 1 0"/><geom type="sphere" size=".01" mass="1e-6"/>
+<site name="ee"/></body></worldbody>
+<actuator><motor joint="j" ctrlrange="-1e6 1e6" ctrllimited="true"/></actuator></mujoco>"""
+"""A 1 mg arm with a 1 MN m motor: full torque is q̈ ~ 1e12 rad/s², beyond MuJoCo's bound."""
+
+
+class _Kick:
+    """Zero torque, then full torque from row ``at`` on."""
+
+    ts = 1e-3
+
+    def __init__(self, at: int) -> None:
+        self.at, self.k = at, 0
+
+    def step(self, q: object, tau_e: object, dq: object = None, **sp: object) -> np.ndarray:
+        self.k += 1
+        return np.array([0.0 if self.k <= self.at else 1e6])
+
+
+def _kicking_controller() -> adaptimp.Controller:
+    return adaptimp.Controller(
+        "pd", "robot", n=1, tau_max=1e6, xc_offset=0.0, xc_sin=0.0, xc_cos=0.0, Kp=1e4,
+        Kzeta=6e7, impedance="external",
+    )  # fmt: skip
+
+
+def _step_at(k: int) -> object:
+    """A reference that jumps by 10 rad at row k (the PD then saturates)."""
+    return lambda t: ([0.0 if t < (k - 0.5) * 1e-3 else 10.0], [0.0], [0.0])
+
+
+def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 20, item 6: MuJoCo resets a diverged state and only warns, so the
+    run used to end at data.time = 0.001 s with a normal-looking result. Both
+    loops now raise DivergedError with the row, the time and MuJoCo's words."""
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warnings to MUJOCO_LOG.TXT here
+    model = mujoco.MjModel.from_xml_string(_FEATHER)
+    want = (
+        "the MuJoCo plant diverged in the period of row 5 (t = 0.005 s to 0.006 s): "
+        "MuJoCo warned mjWARN_BADQACC: Nan, Inf or huge value in QACC at DOF 0. "
+        'The simulation is unstable. (joint "j"); MuJoCo reset its state '
+        "(its time is 0.001 s, not 0.006 s)"
+    )
+    with pytest.raises(adaptimp.DivergedError) as python:
+        amj.simulate(_Kick(5), model, T=1.0)
+    assert str(python.value) == want
+    with pytest.raises(adaptimp.DivergedError) as native:
+        amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(5))
+    assert str(native.value) == want
+    # From the first row: the reset is at t = 0, the warning still tells.
+    with pytest.raises(adaptimp.DivergedError, match=r"row 0 \(t = 0 s to 0.001 s\): MuJoCo"):
+        amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0))
+
+
+def test_plant_step_raises_when_mujoco_resets(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warnings to MUJOCO_LOG.TXT here
+    plant = amj.Plant(mujoco.MjModel.from_xml_string(_FEATHER))
+    plant.step(3)
+    plant.apply([1e6])
+    with pytest.raises(adaptimp.DivergedError, match=r"from t = 0.003 s: MuJoCo warned mjWARN"):
+        plant.step(2)
+
+
+def test_after_an_error_the_plant_and_controller_run_again() -> None:
+    """The native run gives its MuJoCo data back on every exit, Ctrl-C included."""
+    plant = amj.Plant("two_link")
+    ctrl = adaptimp.Controller("sf", "robot")
+
+    def interrupt(done: int, total: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        amj.simulate(ctrl, plant, T=30.0, progress=interrupt)
+    assert 0 < ctrl.steps < 30_000
+    ctrl.reset()
+    again = amj.simulate(ctrl, plant, T=0.2)
+    fresh = amj.simulate(adaptimp.Controller("sf", "robot"), "two_link", T=0.2)
+    _assert_same_run(again, fresh)
+
+
+# ---------------------------------------------------------------------------
+# Disturbances (SPEC §17) on MuJoCo.
+# ---------------------------------------------------------------------------
+
+
+def test_disturbances_act_on_the_mujoco_plant() -> None:
+    base = amj.simulate("sf", "two_link", T=1.0, contact=False)
+    assert base.params["noise_q"] == [0.0, 0.0]
+    a = amj.simulate("sf", "two_link", T=1.0, contact=False, noise_q=1e-3, seed=1)
+    b = amj.simulate("sf", "two_link", T=1.0, contact=False, noise_q=1e-3, seed=1)
+    c = amj.simulate("sf", "two_link", T=1.0, contact=False, noise_q=1e-3, seed=2)
+    _assert_same_run(a, b)
+    assert not np.array_equal(a.tau, c.tau)
+    assert not np.array_equal(a.tau, base.tau)
+    # The rows hold the true state: the first row is the plant's q0.
+    np.testing.assert_array_equal(a.q[0], base.q[0])
+    weak = amj.simulate("sf", "two_link", T=1.0, actuator_fraction=0.25)
+    assert np.all(np.abs(weak.tau_sat) <= 0.25 * np.array([17.0, 15.0]) + 1e-12)
+    assert weak.metrics["sat_duty"] > base.metrics["sat_duty"]
+    late = amj.simulate("sf", "two_link", T=1.0, contact=False, delay=3)
+    assert not np.array_equal(late.tau, base.tau)
+    slow = amj.simulate("pd", "two_link", T=1.0, contact=False, friction_viscous=2.0)
+    free = amj.simulate("pd", "two_link", T=1.0, contact=False)
+    assert slow.metrics["rms_z1"] > free.metrics["rms_z1"]
+    with pytest.raises(adaptimp.ConfigError, match="jitter"):
+        amj.simulate("sf", "two_link", T=0.1, jitter=0.1)
+    with pytest.raises(ValueError, match="0 ≤ delay ≤ 64"):
+        amj.simulate("sf", "two_link", T=0.1, delay=65)
+    with pytest.raises(TypeError, match=r"disturbances \['noise_q'\] need a controller the core"):
+        amj.simulate(_Hold([0.0, 0.0]), "two_link", T=0.01, noise_q=1e-3)

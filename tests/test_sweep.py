@@ -163,3 +163,43 @@ def test_disturbances_reach_simulate_and_sweeps() -> None:
         assert row["rms_z1"] == alone.metrics["rms_z1"]
     with pytest.raises(ValueError, match="0 ≤ delay ≤ 64"):
         adaptimp.simulate("sf", delay=65)
+
+
+def test_mujoco_sweeps_run_in_the_core_on_every_core_and_on_dask() -> None:
+    """plant="mujoco": every core from the core's loop (each run with its own
+    MuJoCo data), on a Dask cluster in batches; the results of each run alone."""
+    import distributed
+
+    from adaptimp import mujoco as amj
+
+    vary = {"case": ["pd", "sf", "of"], "Kp": [8.0, 10.0]}
+    fixed = {"T": 0.5, "scenario": "robot", "plant": "mujoco", "noise_q": 1e-4}
+    local = adaptimp.sweep("sf", vary=vary, **fixed)
+    serial = adaptimp.sweep("sf", vary=vary, threads=1, **fixed)
+    assert local["error"].isna().all()
+    pd.testing.assert_frame_equal(local, serial)
+    for _, row in local.iterrows():
+        alone = amj.simulate(row["case"], "two_link", T=0.5, Kp=row["Kp"], noise_q=1e-4).metrics
+        assert row["rms_z1"] == alone["rms_z1"]
+        assert row["imp_err_rms_after2"] == alone["imp_err_rms_after2"] or np.isnan(
+            alone["imp_err_rms_after2"]
+        )
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        remote = adaptimp.sweep(
+            "sf", vary=vary, executor=client.get_executor(), batch_size=2, **fixed
+        )
+    pd.testing.assert_frame_equal(local, remote)
+
+
+def test_a_failing_mujoco_run_never_sinks_the_sweep() -> None:
+    df = adaptimp.sweep(
+        "pd", vary={"Kp": [10.0, -1.0], "jitter": [0.0, 0.1]}, plant="mujoco", T=0.2
+    )
+    assert df["error"].isna().tolist() == [True, False, False, False]
+    assert "jitter" in df["error"][1]
+    assert "Kp" in df["error"][2]

@@ -40,6 +40,7 @@ from ._errors import (
     MeasurementError,
     StabilityWarning,
 )
+from ._faults import Fault
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
 from ._plot import compare as plot_compare
 from ._result import PLOT_KINDS, SimResult, metrics_table
@@ -60,6 +61,7 @@ __all__ = [
     "ConfigError",
     "Controller",
     "DivergedError",
+    "Fault",
     "FaultError",
     "LogUniform",
     "MeasurementError",

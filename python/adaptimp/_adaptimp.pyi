@@ -23,9 +23,12 @@ __all__ = [
     "__version__",
     "centres_along",
     "defaults",
+    "metrics",
     "schema_table",
     "simulate",
     "simulate_many",
+    "simulate_mujoco",
+    "simulate_mujoco_many",
 ]
 
 __version__: str
@@ -382,6 +385,7 @@ def simulate(
     record_every: int = 1,
     progress: Callable[[int, int], object] | None = None,
     weights: dict[str, _F] | None = None,
+    fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
 ) -> dict[str, Any]:
     """Close the loop with the GIL released; returns the arrays and "metrics"."""
 
@@ -391,6 +395,45 @@ def simulate_many(
     progress: Callable[[int, int], object] | None = None,
 ) -> list[dict[str, Any] | str]:
     """Run independent jobs (case, params, arm) on every core; metrics or error texts."""
+
+def simulate_mujoco(
+    controller: Controller,
+    model: Any,
+    data: Any,
+    spec: dict[str, Any],
+    params: dict[str, Any],
+    t_final: float,
+    settle: float,
+    record_every: int = 1,
+    progress: Callable[[int, int], object] | None = None,
+    reference: tuple[_F, _F, _F] | None = None,
+    fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
+) -> dict[str, Any]:
+    """The closed loop on a MuJoCo MjModel/MjData with the GIL released (SPEC §13.2)."""
+
+def simulate_mujoco_many(
+    jobs: Sequence[tuple[Controller, Any, Any, dict[str, Any], dict[str, Any], float, float]],
+    threads: int | None = None,
+    progress: Callable[[int, int], object] | None = None,
+) -> list[dict[str, Any] | str]:
+    """Run independent MuJoCo jobs on every core; metrics or error texts."""
+
+def metrics(
+    t: _F,
+    q: _F,
+    dq: _F,
+    ddq: _F,
+    xc: _F,
+    dxc: _F,
+    ddxc: _F,
+    z1: _F,
+    tau: _F,
+    tau_sat: _F,
+    tau_e: _F,
+    settle: float,
+    target: tuple[Sequence[float], Sequence[float], Sequence[float]],
+) -> dict[str, Any]:
+    """The SPEC §12 metrics of recorded rows, by the core's accumulator."""
 
 def schema_table() -> list[dict[str, Any]]:
     """The parameter schema: name, group, kind, unit, doc, condition, choices, defaults."""

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
 from ._errors import ConfigError, StabilityWarning
+from ._faults import Fault
 from ._params import (
     BY_NAME,
     N_JOINTS,
@@ -200,6 +201,7 @@ def simulate(
     weights: Mapping[str, ArrayLike] | None = None,
     record_every: int = 1,
     progress: Progress = False,
+    fault: Fault | None = None,
     **params: Any,
 ) -> SimResult:
     """Simulate one of the paper's controllers on an arm against the wall.
@@ -242,6 +244,10 @@ def simulate(
         ``True``: a progress bar (tqdm if installed, else a line on stderr)
         for runs longer than 2 s; a callable is called as ``progress(done,
         total)`` about every 50 ms.
+    fault : Fault, optional
+        A fault injected over a window (:class:`adaptimp.Fault`: stale or NaN
+        sensors, a force bias, weak actuators, skipped steps); refused steps
+        apply the fallback and are marked in ``refused``.
     **params
         Any parameter below by name. Per-joint values take a number (for every
         joint) or one value per joint; ``gamma`` and ``sigma`` a number or one
@@ -305,7 +311,13 @@ def simulate(
     try:
         core_params = {k: v for k, v in p.items() if k in BY_NAME}
         out = _adaptimp.simulate(
-            core, arm._core, core_params, every, callback, _weights_or_none(weights)
+            core,
+            arm._core,
+            core_params,
+            every,
+            callback,
+            _weights_or_none(weights),
+            None if fault is None else fault._core(n),
         )
     finally:
         if bar is not None:

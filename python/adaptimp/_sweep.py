@@ -183,17 +183,15 @@ def _run_batch(
 
 def _run_mujoco_batch(
     jobs: list[tuple[str, str, str, dict[str, Any]]],
+    threads: int | None = 1,
+    progress: Callable[[int, int], object] | None = None,
 ) -> list[dict[str, Any] | str]:
-    """Run ``jobs`` (case, scenario, model, keywords) on the MuJoCo plant, one by one."""
+    """Run ``jobs`` (case, scenario, model, keywords) on the MuJoCo plant in this
+    process on ``threads`` threads (the core's loop, the GIL released): the task
+    an executor runs, and the batches of ``executor=None``."""
     from . import mujoco as amj
 
-    def one(case: str, scenario: str, model: str, kw: dict[str, Any]) -> dict[str, Any] | str:
-        try:
-            return dict(amj.simulate(case, model, scenario=scenario, **kw).metrics)
-        except (TypeError, ValueError, ArithmeticError, RuntimeError) as e:
-            return f"{type(e).__name__}: {e}"
-
-    return [one(*job) for job in jobs]
+    return amj._run_many(jobs, threads, progress)
 
 
 def _batches(items: list[Any], size: int) -> Iterator[list[Any]]:
@@ -318,8 +316,9 @@ def sweep(
     plant : {"rigid", "mujoco"}
         The plant: the RK4 rigid body of :func:`adaptimp.simulate`, or MuJoCo
         (``adaptimp.mujoco.simulate`` with ``model``; needs ``adaptimp[mujoco]``).
-        MuJoCo runs step in Python: with ``executor=None`` they run one after the
-        other in this process; give a process pool or a Dask executor to spread them.
+        MuJoCo runs go through the core's loop like rigid ones: on every core
+        with ``executor=None`` (each run with its own MuJoCo data), in batches
+        on an executor.
     model : str
         The MuJoCo model of ``plant="mujoco"`` (``"two_link"``, ``"panda"``, a path).
     **params
@@ -403,12 +402,7 @@ def sweep(
                 future.cancel()
 
     try:
-        if mj_model is not None and executor is None:
-            for batch in _batches(todo, batch_size or 1):
-                record(batch, _run_mujoco_batch([mj_job(i) for i in batch]))
-        elif mj_model is not None:
-            on_executor(_run_mujoco_batch, mj_job, batch_size or 1)
-        elif executor is None:
+        if executor is None:
             cores = threads or os.cpu_count() or 1
             size = batch_size or (8 * cores if cache is not None else max(len(todo), 1))
             for batch in _batches(todo, size):
@@ -418,7 +412,12 @@ def sweep(
                     if report is not None:
                         report(base + done, total)
 
-                record(batch, _run_batch([job(i) for i in batch], threads, inner))
+                if mj_model is not None:
+                    record(batch, _run_mujoco_batch([mj_job(i) for i in batch], threads, inner))
+                else:
+                    record(batch, _run_batch([job(i) for i in batch], threads, inner))
+        elif mj_model is not None:
+            on_executor(_run_mujoco_batch, mj_job, batch_size or 8)
         else:
             on_executor(_run_batch, job, batch_size or 8)
     finally:

@@ -36,6 +36,7 @@ from __future__ import annotations
 import copy
 import math
 import os
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,8 +52,9 @@ except ImportError as e:  # pragma: no cover - depends on the environment
         "adaptimp.mujoco needs MuJoCo, an optional dependency: pip install adaptimp[mujoco]"
     ) from e
 
-from . import _models
-from ._result import METRIC_KEYS, SimResult
+from . import _adaptimp, _models
+from ._faults import Fault
+from ._result import SimResult
 from ._trajectory import Reference, paper_circle, sinusoid
 
 if TYPE_CHECKING:
@@ -510,19 +512,104 @@ class Plant:
         self.data.ctrl[self._act] = tau_sat / self._gear
         return tau_sat
 
-    def step(self, substeps: int = 1) -> None:
+    def step(self, substeps: int = 1, *, row: int | None = None, Ts: float | None = None) -> None:
         """Advance ``substeps`` MuJoCo steps with the applied torque held.
+
+        MuJoCo resets its state on a bad position, velocity or acceleration
+        and only counts a warning (``data.warning``); a step after which
+        MuJoCo warned, whose time did not advance by ``substeps`` timesteps,
+        or whose state is not finite raises.
+
+        Parameters
+        ----------
+        substeps : int
+            MuJoCo steps.
+        row, Ts : int and float, optional
+            The loop's row k and period (s), named in the error.
 
         Raises
         ------
-        RuntimeError
-            The state became non-finite (MuJoCo's warnings say why).
+        DivergedError
+            Naming the row (if given), the time and MuJoCo's warning with its
+            joint (e.g. "Nan, Inf or huge value in QACC at DOF 1 … (joint
+            'j1')").
         """
         m, d = self.model, self.data
+        before = d.warning.number.copy()
+        t0 = expected = float(d.time)
         for _ in range(substeps):
             mujoco.mj_step(m, d)
-        if not math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum())):
-            raise RuntimeError(f"the MuJoCo state diverged at t = {d.time:g} s")
+            expected += m.opt.timestep
+        warned = np.flatnonzero(d.warning.number != before)
+        reset = abs(float(d.time) - expected) > 0.5 * m.opt.timestep
+        finite = math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum()))
+        if warned.size == 0 and not reset and finite:
+            return
+        from ._errors import DivergedError
+
+        if warned.size:
+            i = int(warned[0])
+            info = int(d.warning.lastinfo[i])
+            name = mujoco.mjtWarning(i).name
+            text = mujoco.mju_warningText(i, max(info, 0))
+            joint = ""
+            if name in _DOF_WARNINGS and 0 <= info < m.nv:
+                joint = f' (joint "{_name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[info]))}")'
+            now, want = _num(d.time), _num(expected)
+            note = f"; MuJoCo reset its state (its time is {now} s, not {want} s)" if reset else ""
+            cause = f"MuJoCo warned {name}: {text}{joint}{note}"
+        elif not finite:
+            cause = "the state is not finite"
+        else:
+            now, want = _num(d.time), _num(expected)
+            cause = f"MuJoCo's time is {now} s, not {want} s (its state was reset)"
+        if row is None or Ts is None:
+            where = f"from t = {_num(t0)} s"
+        else:
+            where = (
+                f"in the period of row {row} (t = {_num(row * Ts)} s to {_num((row + 1) * Ts)} s)"
+            )
+        raise DivergedError(f"the MuJoCo plant diverged {where}: {cause}")
+
+    def _contact_possible(self) -> bool:
+        """Whether a contact can involve the end effector's subtree (contact
+        enabled, and a geom of the subtree whose contype/conaffinity meets a
+        geom outside it, or explicit contact pairs)."""
+        m = self.model
+        if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
+            return False
+        if m.npair > 0:
+            return True
+        inside = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in self._ee_subtree]
+        outside = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) not in self._ee_subtree]
+        ct, ca = m.geom_contype, m.geom_conaffinity
+        return any((ct[a] & ca[b]) or (ct[b] & ca[a]) for a in inside for b in outside)
+
+    def _native(self, substeps: int) -> dict[str, Any] | None:
+        """The plant as the core's native loop takes it (SPEC §13.1), or None
+        if the core cannot measure its wrench (no force sensor and contacts
+        possible: the contact path reads MuJoCo's contact list, which only
+        the Python loop does)."""
+        m = self.model
+        if self._force_adr < 0 and self._contact_possible():
+            return None
+        return {
+            "qadr": [int(a) for a in self._qadr],
+            "dofs": [int(a) for a in self._dofs],
+            "act": [int(a) for a in self._act],
+            "gear": [float(g) for g in self._gear],
+            "tau_max": [float(t) for t in self.tau_max],
+            "site": int(self._site) if self._site >= 0 else None,
+            "ee_body": int(self._ee_body),
+            "force_adr": int(self._force_adr) if self._force_adr >= 0 else None,
+            "torque_adr": int(self._torque_adr) if self._torque_adr >= 0 else None,
+            "substeps": int(substeps),
+            "timestep": float(m.opt.timestep),
+            "dof_names": [
+                _name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)
+            ],
+            "warning_names": _warning_names(),
+        }
 
     def mass_matrix(self) -> FloatArray:
         """Joint-space inertia D(q) (kg m²), (n, n), of the last :meth:`forward`."""
@@ -574,9 +661,9 @@ class Plant:
             raise ValueError("the model has no force sensor at the end effector")
         out = np.zeros(6)
         rot = d.site_xmat[self._site].reshape(3, 3)
-        out[:3] = rot @ d.sensordata[self._force_adr : self._force_adr + 3]
+        out[:3] = _rotate(rot, d.sensordata[self._force_adr : self._force_adr + 3])
         if self._torque_adr >= 0:
-            out[3:] = rot @ d.sensordata[self._torque_adr : self._torque_adr + 3]
+            out[3:] = _rotate(rot, d.sensordata[self._torque_adr : self._torque_adr + 3])
         return out
 
     def contact_wrench(self) -> FloatArray:
@@ -608,7 +695,13 @@ class Plant:
     def tau_e(self, wrench: FloatArray | None = None) -> FloatArray:
         """τe = Jᵀ F_e (N m), (n,): the wrench on the environment in joint space
         (of :meth:`wrench`, or of ``wrench`` if given)."""
-        return self.jacobian().T @ (self.wrench() if wrench is None else wrench)
+        w = self.wrench() if wrench is None else np.asarray(wrench, dtype=np.float64)
+        jac = self.jacobian()
+        # Σ_r J[r, i] F[r] in the order of the core's native loop (the same bits).
+        out = jac[0] * w[0]
+        for r in range(1, 6):
+            out = out + jac[r] * w[r]
+        return np.asarray(out, dtype=np.float64)
 
     def __repr__(self) -> str:
         name = self.model.names[: self.model.names.find(b"\0")].decode() or "model"
@@ -616,6 +709,26 @@ class Plant:
             f"adaptimp.mujoco.Plant({name!r}: {self.n} joints, τmax = {self.tau_max.tolist()} N m,"
             f" wrench from {self.wrench_source}, timestep {self.timestep:g} s)"
         )
+
+
+def _warning_names() -> list[str]:
+    """MuJoCo's warning kinds by index (``mjtWarning``, without ``mjNWARNING``)."""
+    return [mujoco.mjtWarning(i).name for i in range(int(mujoco.mjtWarning.mjNWARNING))]
+
+
+def _num(x: float) -> str:
+    """A float as the core's messages print it (Rust's shortest form: 0, 0.001)."""
+    text = repr(float(x))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def _rotate(rot: FloatArray, v: FloatArray) -> FloatArray:
+    """R v for a 3 × 3 R, summed in the order of the core's native loop (the same bits)."""
+    return np.asarray(rot[:, 0] * v[0] + rot[:, 1] * v[1] + rot[:, 2] * v[2], dtype=np.float64)
+
+
+_DOF_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC", "mjWARN_INERTIA")
+"""MuJoCo's warnings whose info is a DOF (hinges: the joint's qpos and DOF index agree)."""
 
 
 def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
@@ -765,62 +878,6 @@ def _plot(res: MujocoResult, kind: str) -> Figure:
     return fig
 
 
-def metrics(
-    *,
-    t: FloatArray,
-    q: FloatArray,
-    dq: FloatArray,
-    ddq: FloatArray,
-    xc: FloatArray,
-    dxc: FloatArray,
-    ddxc: FloatArray,
-    z1: FloatArray,
-    tau: FloatArray,
-    dtau: FloatArray,
-    tau_e: FloatArray,
-    settle: float,
-    target: tuple[ArrayLike, ArrayLike, ArrayLike] = (1.0, 10.0, 60.0),
-) -> dict[str, Any]:
-    """The SPEC §12 metrics of recorded rows, as ``adaptimp.simulate`` computes them.
-
-    ``target`` is the impedance (Dd, Cd, Gd) of the residual; the impedance
-    error is NaN unless the reference is in joint space (same width as q).
-    """
-    after = t >= settle - 1e-9
-    nan_after = not np.any(after)
-
-    def rms(x: FloatArray) -> float:
-        return float(np.sqrt(np.mean(x))) if x.size else math.nan
-
-    z2 = np.sum(z1**2, axis=1)
-    contact_rows = np.any(tau_e != 0.0, axis=1)
-    contact = np.linalg.norm(tau_e, axis=1)
-    k = len(t)
-    if xc.shape == q.shape:
-        dd, cd, gd = (np.asarray(v, dtype=np.float64) for v in target)
-        res = dd * (ddxc - ddq) + cd * (dxc - dq) + gd * (xc - q) - tau_e
-        imp = rms(np.sum(res[after] ** 2, axis=1))
-    else:
-        imp = math.nan
-    out: dict[str, Any] = {
-        "rms_z1": rms(z2),
-        "rms_z1_after2": rms(z2[after]),
-        "rms_z1_joint_after2": [rms(z1[after, i] ** 2) for i in range(z1.shape[1])],
-        "max_abs_z1_joint_after2": (
-            [math.nan] * z1.shape[1] if nan_after else np.max(np.abs(z1[after]), axis=0).tolist()
-        ),
-        "sat_duty": float(np.mean(np.any(dtau != 0.0, axis=1))) if k else math.nan,
-        "steps_in_contact": int(np.sum(contact_rows)),
-        "peak_contact_after2": math.nan if nan_after else float(np.max(contact[after])),
-        "mean_contact": float(np.mean(contact[contact_rows])) if np.any(contact_rows) else 0.0,
-        "peak_abs_tau": (np.max(np.abs(tau), axis=0).tolist() if k else [0.0] * tau.shape[1]),
-        "imp_err_rms_after2": imp,
-        "rows": k,
-    }
-    assert set(out) == {*METRIC_KEYS, "rows"}
-    return out
-
-
 # ---------------------------------------------------------------------------
 # The closed loop.
 # ---------------------------------------------------------------------------
@@ -843,6 +900,38 @@ def _builtin_reference(ctrl: Any) -> Reference | None:
     return None
 
 
+DISTURBANCES = (
+    "noise_q",
+    "noise_dq",
+    "noise_tau_e",
+    "seed",
+    "delay",
+    "jitter",
+    "friction_viscous",
+    "friction_coulomb",
+    "friction_vs",
+    "actuator_fraction",
+)
+"""The disturbances of SPEC §17 that :func:`simulate` takes by name (the
+schema's; ``jitter`` must stay 0 on MuJoCo, whose timestep is fixed for a run)."""
+
+
+def _native(ctrl: Any) -> bool:
+    """Whether the core can step ``ctrl`` itself: an ``adaptimp.Controller``
+    whose ``step`` is the compiled one."""
+    return isinstance(ctrl, _adaptimp.Controller) and type(ctrl).step is _adaptimp.Controller.step
+
+
+def _tabulate(
+    reference: Reference, steps: int, Ts: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``reference(k·Ts)`` for every row k, as three (K, m) arrays (called in
+    order, once per row, as the loop would)."""
+    rows = [tuple(np.asarray(v, dtype=np.float64) for v in reference(k * Ts)) for k in range(steps)]
+    xc, dxc, ddxc = (np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
+    return xc, dxc, ddxc
+
+
 def simulate(
     controller: str | ControllerLike = "sf",
     model: Plant | ModelSource = "two_link",
@@ -856,6 +945,9 @@ def simulate(
     contact: bool = True,
     settle: float | None = None,
     scenario: str = "robot",
+    record_every: int = 1,
+    progress: bool | Callable[[int, int], object] = False,
+    fault: Fault | None = None,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -864,7 +956,16 @@ def simulate(
     (with the torque applied over the last period), the controller is given
     ``(q, tau_e, dq[, xc=, dxc=, ddxc=])`` and returns a torque; it is
     saturated to the actuators' τmax and held for ``substeps`` MuJoCo steps of
-    Ts / substeps each.
+    Ts / substeps each (SPEC §13.1).
+
+    An ``adaptimp.Controller`` (or a case name) runs in the compiled core: the
+    loop, the recording and the metrics are the core's, MuJoCo is driven
+    through its C library, the GIL is released (Ctrl-C is honoured within
+    0.1 s). Any other controller (:class:`ControllerLike`, e.g.
+    :class:`adaptimp.baselines.ComputedTorque`) is stepped from a Python loop
+    with the same semantics and the core's metrics, as is a model without a
+    force sensor whose end effector can touch something (its wrench comes
+    from MuJoCo's contact list, which only the Python loop reads).
 
     Parameters
     ----------
@@ -897,13 +998,31 @@ def simulate(
         Start of the "after2" metrics (s); default the scenario's (2 s).
     scenario : {"robot", "paper"}
         Defaults for a case name (see :func:`adaptimp.simulate`).
+    record_every : int
+        Keep every k-th row (k ≥ 1); the metrics still see every step.
+    progress : bool or callable
+        ``True``: a progress bar for runs longer than 2 s; a callable is called
+        as ``progress(done, total)`` about every 50 ms.
+    fault : adaptimp.Fault, optional
+        A fault injected over a window, as for :func:`adaptimp.simulate` (the
+        actuators' τmax for ``"actuator_drop"``); needs the native loop.
     **params
-        Controller parameters for a case name (``Kp``, ``gamma``, …).
+        The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
+        delay, joint friction, weak actuators; the controller is told none of
+        them), for any controller; and, for a case name, controller parameters
+        (``Kp``, ``gamma``, …).
 
     Returns
     -------
     MujocoResult
         Arrays, the SPEC §12 metrics, ``.plot(kind)``.
+
+    Raises
+    ------
+    DivergedError
+        MuJoCo warned during a period (it resets a diverged state and only
+        counts a warning), its time did not advance, or the state is not
+        finite: the message names the row, the time and MuJoCo's warning.
 
     Examples
     --------
@@ -912,13 +1031,84 @@ def simulate(
     >>> res.q.shape, res.params["substeps"]
     ((50, 2), 20)
     """
+    run = _setup(
+        controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
+        settle=settle, scenario=scenario, record_every=record_every, params=params,
+    )  # fmt: skip
+    from ._api import _progress
+
+    callback, bar = _progress(progress, "mujoco.simulate")
+    try:
+        if run.native:
+            assert run.spec is not None
+            refs = None if reference is None else _tabulate(reference, run.steps, run.Ts)
+            core_fault = None if fault is None else fault._core(run.plant.n)
+            out = _adaptimp.simulate_mujoco(
+                run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
+                run.settle, run.every, callback, refs, core_fault,
+            )  # fmt: skip
+            m = out.pop("metrics")
+        else:
+            if fault is not None:
+                raise TypeError(
+                    "fault= needs a controller the core steps (an adaptimp.Controller or a "
+                    "case name) and a plant with a force sensor or no possible contact; this "
+                    "run steps its controller from Python"
+                )
+            out, m = _python_loop(run, reference, callback)
+    finally:
+        if bar is not None:
+            bar.close()
+    return _result(run, out, m)
+
+
+@dataclass
+class _Run:
+    """A run of :func:`simulate`, set up: its controller, plant and settings."""
+
+    ctrl: Any
+    plant: Plant
+    label: str
+    scenario: str
+    Ts: float
+    T: float
+    settle: float
+    substeps: int
+    steps: int
+    every: int
+    dist: dict[str, Any]
+    spec: dict[str, Any] | None
+    native: bool
+
+
+def _setup(
+    controller: str | ControllerLike,
+    model: Plant | ModelSource,
+    *,
+    T: float | None = None,
+    Ts: float | None = None,
+    substeps: int | None = None,
+    q0: ArrayLike | None = None,
+    dq0: ArrayLike | None = None,
+    contact: bool = True,
+    settle: float | None = None,
+    scenario: str = "robot",
+    record_every: int = 1,
+    params: Mapping[str, Any],
+) -> _Run:
+    """Everything :func:`simulate` does before the loop: the controller, the
+    plant at its initial state, the settings and the choice of loop."""
     from . import Controller
-    from ._params import SCENARIOS
+    from ._api import _record_every
+    from ._params import SCENARIOS, resolve
 
     defaults = SCENARIOS.get(scenario)
     if defaults is None:
         raise ValueError(f"scenario must be one of {sorted(SCENARIOS)}, got {scenario!r}")
+    every = _record_every(record_every)
     plant = model if isinstance(model, Plant) else Plant(model, contact=contact)
+    params = dict(params)
+    disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
     if isinstance(controller, str):
         kwargs = dict(params)
         kwargs.setdefault("tau_max", plant.tau_max.tolist())
@@ -942,15 +1132,73 @@ def simulate(
     Ts = period
     T = float(defaults["T"]) if T is None else float(T)
     settle = float(defaults["settle"]) if settle is None else float(settle)
+    if not (math.isfinite(T) and T > 0):
+        raise ValueError(f"T must be finite and > 0, got {T}")
     steps = round(T / Ts)
-    if steps < 0 or not math.isfinite(T):
-        raise ValueError(f"T must be finite and ≥ 0, got {T}")
+    if steps < 1:
+        raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
     if substeps is None:
         substeps = max(1, round(Ts / plant.timestep))
     if substeps < 1:
         raise ValueError(f"substeps must be ≥ 1, got {substeps}")
+    resolved = resolve(disturb, scenario="robot", groups=("sim",), caller="simulate()", n=plant.n)
+    dist = {k: resolved[k] for k in DISTURBANCES}
     plant.timestep = Ts / substeps
     plant.reset(q0, dq0)
+    spec = plant._native(substeps)
+    native = _native(ctrl) and spec is not None and not bool(getattr(ctrl, "wants_wrench", False))
+    return _Run(
+        ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native
+    )
+
+
+def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
+    plant, ctrl = run.plant, run.ctrl
+    name = plant.model.names[: plant.model.names.find(b"\0")].decode()
+    params = {
+        "Ts": run.Ts,
+        "substeps": run.substeps,
+        "timestep": plant.timestep,
+        "T": run.T,
+        "settle": run.settle,
+        "contact": plant.contact,
+        "tau_max": plant.tau_max.tolist(),
+        "wrench_source": plant.wrench_source,
+        "model": name,
+        "controller": run.label,
+        "loop": "native" if run.native else "python",
+        **run.dist,
+    }
+    case = getattr(ctrl, "case", None)
+    case = case if isinstance(case, str) else getattr(getattr(ctrl, "inner", None), "case", None)
+    return MujocoResult(
+        case=case if isinstance(case, str) else "custom",
+        scenario=run.scenario,
+        params=params,
+        metrics=m,
+        record_every=run.every,
+        **out,
+    )
+
+
+def _python_loop(
+    run: _Run, reference: Reference | None, progress: Callable[[int, int], object] | None
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The loop of :func:`simulate` for a controller the core cannot step: the
+    same order of operations, the core's metrics. Returns the arrays and the
+    metrics."""
+    from ._params import defaults as scenario_defaults
+
+    ctrl, plant, steps, Ts, substeps = run.ctrl, run.plant, run.steps, run.Ts, run.substeps
+    dist, every, settle = run.dist, run.every, run.settle
+    clean = scenario_defaults("robot", plant.n)
+    changed = sorted(k for k, v in dist.items() if v != clean[k])
+    if changed:
+        raise TypeError(
+            f"the disturbances {changed} need a controller the core steps (an "
+            "adaptimp.Controller or a case name) and a plant with a force sensor or "
+            "no possible contact; this run steps its controller from Python"
+        )
     has = {name: hasattr(ctrl, name) for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta")}
     # The Cartesian hook (ControllerLike): the measured wrench instead of τe.
     wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
@@ -960,12 +1208,18 @@ def simulate(
     (r_q, r_dq, r_ddq, r_xc, r_dxc, r_ddxc, r_xd, r_dq_hat, r_tau, r_tau_sat, r_tau_e, r_zeta,
      r_z1, r_x_ee, r_wrench) = rows.values()  # fmt: skip
     zeros = np.zeros(n)
+    # Steps the controller took before (its own trajectory goes on from there).
+    k0 = getattr(ctrl, "steps", 0)
+    k0 = k0 if isinstance(k0, int) else 0
+    last = time.perf_counter()
     for k in range(steps):
         q, dq = plant.q, plant.dq
         wrench = plant.wrench()
         tau_e = plant.tau_e(wrench)
         r_x_ee.append(plant.ee_position())
         args = (q, dq, wrench) if wants_wrench else (q, tau_e, dq)
+        # ζ(t_k), what this step uses (SimResult's zeta), read before the step.
+        r_zeta.append(np.array(ctrl.zeta, dtype=np.float64) if has["zeta"] else zeros)
         if reference is not None:
             xc, dxc, ddxc = (np.asarray(v, dtype=np.float64) for v in reference(k * Ts))
             tau_cmd = ctrl.step(*args, xc=xc, dxc=dxc, ddxc=ddxc)
@@ -985,13 +1239,15 @@ def simulate(
         r_xd.append(xd)
         r_z1.append(ctrl.z1 if has["z1"] else np.asarray(xd) - q)
         r_dq_hat.append(ctrl.dq_hat if has["dq_hat"] else dq)
-        r_zeta.append(ctrl.zeta if has["zeta"] else zeros)
         r_tau.append(ctrl.tau if has["tau"] else tau_cmd)
         r_tau_sat.append(tau_sat)
         r_tau_e.append(tau_e)
         r_wrench.append(wrench)
-        plant.step(substeps)
+        plant.step(substeps, row=k, Ts=Ts)
         plant.forward()  # contact and sensors at the new state, torque held
+        if progress is not None and time.perf_counter() - last > 0.05:
+            last = time.perf_counter()
+            progress(k + 1, steps)
 
     t: FloatArray = np.arange(steps, dtype=np.float64) * Ts
     if reference is None:
@@ -1000,7 +1256,8 @@ def simulate(
         builtin = _builtin_reference(ctrl)
         if builtin is not None:
             # (sinusoid's reference broadcasts: one row per time.)
-            _, dxc_all, ddxc_all = builtin(t[:, None])  # type: ignore[arg-type]
+            own = (k0 + np.arange(steps, dtype=np.float64)) * Ts
+            _, dxc_all, ddxc_all = builtin(own[:, None])  # type: ignore[arg-type]
             rows["dxc"] = list(np.asarray(dxc_all, dtype=np.float64))
             rows["ddxc"] = list(np.asarray(ddxc_all, dtype=np.float64))
         else:
@@ -1016,43 +1273,60 @@ def simulate(
     arrays["t"] = t
     cparams = getattr(ctrl, "params", None)
     cparams = cparams if isinstance(cparams, Mapping) else {}
-    target = tuple(cparams.get(k, v) for k, v in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0)))
-    m = metrics(
-        t=arrays["t"],
-        q=arrays["q"],
-        dq=arrays["dq"],
-        ddq=arrays["ddq"],
-        xc=arrays["xc"],
-        dxc=arrays["dxc"],
-        ddxc=arrays["ddxc"],
-        z1=arrays["z1"],
-        tau=arrays["tau"],
-        dtau=arrays["tau_sat"] - arrays["tau"],
-        tau_e=arrays["tau_e"],
-        settle=settle,
-        target=(target[0], target[1], target[2]),
-    )
-    name = plant.model.names[: plant.model.names.find(b"\0")].decode()
-    run = {
-        "Ts": Ts,
-        "substeps": substeps,
-        "timestep": plant.timestep,
-        "T": T,
-        "settle": settle,
-        "contact": plant.contact,
-        "tau_max": plant.tau_max.tolist(),
-        "wrench_source": plant.wrench_source,
-        "model": name,
-        "controller": label,
-    }
-    case = getattr(ctrl, "case", None)
-    case = case if isinstance(case, str) else getattr(getattr(ctrl, "inner", None), "case", None)
-    fields: dict[str, Any] = dict(arrays)
-    return MujocoResult(
-        case=case if isinstance(case, str) else "custom",
-        scenario=scenario,
-        params=run,
-        metrics=m,
-        w_norms=np.full((steps, 3), math.nan),
-        **fields,
-    )
+    target = [
+        np.broadcast_to(np.asarray(cparams.get(k, v), dtype=np.float64), (n,)).tolist()
+        for k, v in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0))
+    ]
+    a = arrays
+    m = _adaptimp.metrics(
+        a["t"], a["q"], a["dq"], a["ddq"], a["xc"], a["dxc"], a["ddxc"], a["z1"],
+        a["tau"], a["tau_sat"], a["tau_e"], settle, tuple(target),
+    )  # fmt: skip
+    kept = {name: v[::every] for name, v in arrays.items()}
+    kept["w_norms"] = np.full((kept["t"].shape[0], 3), math.nan)
+    return kept, m
+
+
+def _run_many(
+    jobs: Sequence[tuple[str, str, str, Mapping[str, Any]]],
+    threads: int | None = None,
+    progress: Callable[[int, int], object] | None = None,
+) -> list[dict[str, Any] | str]:
+    """Runs ``(case, scenario, model, keywords)`` of :func:`simulate`, their
+    SPEC §12 metrics or their errors as text: in the core, on ``threads``
+    threads (every core if None) with the GIL released, each run with its own
+    controller and MuJoCo data; a run the core cannot take alone (a Python
+    loop, a reference callable) runs here. Results are those of
+    :func:`simulate`, bit for bit."""
+    errors = (TypeError, ValueError, ArithmeticError, RuntimeError)
+    out: list[dict[str, Any] | str | None] = [None] * len(jobs)
+    native: list[tuple[int, _Run]] = []
+    for i, (case, scenario, model, kw) in enumerate(jobs):
+        kw = dict(kw)
+        try:
+            if kw.get("reference") is not None or kw.get("progress"):
+                out[i] = dict(simulate(case, model, scenario=scenario, **kw).metrics)
+                continue
+            names = ("T", "Ts", "substeps", "q0", "dq0", "contact", "settle", "record_every")
+            run = _setup(
+                case, model, scenario=scenario, params=kw,
+                **{k: kw.pop(k) for k in names if k in kw},
+            )  # fmt: skip
+            if run.native:
+                native.append((i, run))
+            else:
+                out[i] = dict(_python_loop(run, None, None)[1])
+        except errors as e:
+            out[i] = f"{type(e).__name__}: {e}"
+    if native:
+        results = _adaptimp.simulate_mujoco_many(
+            [
+                (r.ctrl, r.plant.model, r.plant.data, r.spec or {}, r.dist, r.T, r.settle)
+                for _, r in native
+            ],
+            threads,
+            progress,
+        )
+        for (i, _), result in zip(native, results):
+            out[i] = result
+    return [r if r is not None else "no result" for r in out]

@@ -90,4 +90,18 @@ pub trait Control<const N: usize> {
             Err(e) => (Vector::zeros(), Err(e)),
         }
     }
+    /// [`step_or_fallback`](Self::step_or_fallback) with the measured
+    /// end-effector wrench F_e = [f; m] (N, N m, world frame; zeros where the
+    /// plant measures none), which the closed loop passes at every step: a
+    /// controller in task space (a Cartesian impedance) uses it; the default
+    /// ignores it, as a joint-space controller does.
+    fn step_with_wrench(
+        &mut self,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        let _ = wrench;
+        self.step_or_fallback(m, c)
+    }
 }

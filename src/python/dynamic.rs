@@ -7,23 +7,27 @@
 //! Nothing here knows Python: the bindings (`mod.rs`) convert arrays to
 //! slices and errors to exceptions.
 
+use super::mujoco::{Continued, Failure, MjPlant, MujocoSpec, Table};
 use crate::control::config::Law;
 use crate::control::controller::Controller;
+use crate::control::impedance::TargetImpedance;
 use crate::control::io::{Command, Measurement};
 use crate::control::tracker::Tracker;
 use crate::error::Error;
 use crate::networks::network::{Weights, C, D, G};
 use crate::networks::rbf::{AnyBasis, Basis, Centers};
 use crate::schema::{Preset, Scenario, Value};
-use crate::sim::disturb::{Disturbances, TipPayload, WithFriction};
+use crate::sim::disturb::TipPayload;
 use crate::sim::environment::{FreeSpace, Wall};
+use crate::sim::inject::{Injected, Injection};
 use crate::sim::metrics::MetricsAccumulator;
 use crate::sim::model::{Link, PlanarArm, TwoLinkArm};
 use crate::sim::plant::{Plant, RigidBody};
 use crate::sim::record::{Recorder, Row};
-use crate::sim::simulator::simulate_disturbed;
+use crate::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapted, Adapter};
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
+use adaptimp_mujoco::Sim;
 use std::any::Any;
 use std::vec::Vec;
 
@@ -118,6 +122,74 @@ pub enum ArmSpec {
     },
 }
 
+/// A fault to inject into a run (`src/sim/inject.rs`), for any number of joints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaultSpec {
+    /// What goes wrong.
+    pub kind: FaultKind,
+    /// Start of the window (s).
+    pub start: f64,
+    /// Length of the window (s).
+    pub duration: f64,
+}
+
+/// The kinds of [`Injected`] faults.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FaultKind {
+    /// The sensors repeat their last sample.
+    Stale,
+    /// The position sensor reads NaN.
+    NanBurst,
+    /// The force sensor reads τe + bias (N m, one per joint).
+    ForceBias(Vec<f64>),
+    /// The actuators deliver at most this fraction of τmax.
+    ActuatorDrop(f64),
+    /// No control step runs: the last applied torque is held.
+    Skipped,
+}
+
+/// The core's injection of `f`, with the actuators' limits `tau_max` (N m).
+fn injection<const N: usize>(f: &FaultSpec, tau_max: &Vector<N>) -> Result<Injection<N>, Error> {
+    crate::error::check::nonnegative("fault start ≥ 0", "start", f.start)?;
+    crate::error::check::positive("fault duration > 0", "duration", f.duration)?;
+    let fault = match &f.kind {
+        FaultKind::Stale => Injected::Stale,
+        FaultKind::NanBurst => Injected::NanBurst,
+        FaultKind::Skipped => Injected::Skipped,
+        FaultKind::ForceBias(b) => {
+            if b.len() != N {
+                return Err(Error::Invalid {
+                    what: "bias",
+                    reason: "needs one value per joint (N m)",
+                });
+            }
+            crate::error::check::finite_slice("bias", b)?;
+            Injected::ForceBias {
+                bias: Vector::from_column_slice(b),
+            }
+        }
+        FaultKind::ActuatorDrop(fraction) => {
+            if !(0.0..=1.0).contains(fraction) {
+                return Err(Error::Condition {
+                    condition: "0 ≤ fraction ≤ 1",
+                    lhs: "fraction",
+                    index: None,
+                    value: *fraction,
+                });
+            }
+            Injected::ActuatorDrop {
+                tau_max: *tau_max,
+                fraction: *fraction,
+            }
+        }
+    };
+    Ok(Injection {
+        fault,
+        start: f.start,
+        duration: f.duration,
+    })
+}
+
 /// The run-time hook of long calls: asked every few steps whether to go on
 /// (signals) and told the progress.
 pub trait Hooks {
@@ -143,6 +215,12 @@ pub struct Records {
     pub w_norms: Vec<f64>,
     /// The rows the controller refused (fallback applied).
     pub refused: Vec<bool>,
+    /// Whether the end effector is recorded (`x_ee`, `wrench`).
+    pub ee: bool,
+    /// End-effector position (m), 3 per row (if `ee`).
+    pub x_ee: Vec<f64>,
+    /// End-effector wrench [f; m] (N, N m), 6 per row (if `ee`).
+    pub wrench: Vec<f64>,
 }
 
 /// The names of [`Records::joint`], in order.
@@ -151,13 +229,19 @@ pub const JOINT_RECORDS: [&str; 13] = [
 ];
 
 impl Records {
-    /// Room for `rows` kept rows of `n` joints; `None` if it cannot be had.
-    pub fn with_rows(n: usize, rows: usize, every: u64) -> Option<Self> {
+    /// Room for `rows` kept rows of `n` joints (and of the end effector, with
+    /// `ee`); `None` if it cannot be had.
+    pub fn with_rows(n: usize, rows: usize, every: u64, ee: bool) -> Option<Self> {
         let mut r = Self {
             n,
             every: every.max(1),
+            ee,
             ..Self::default()
         };
+        if ee {
+            r.x_ee.try_reserve_exact(rows.checked_mul(3)?).ok()?;
+            r.wrench.try_reserve_exact(rows.checked_mul(6)?).ok()?;
+        }
         r.t.try_reserve_exact(rows).ok()?;
         r.refused.try_reserve_exact(rows).ok()?;
         for v in &mut r.joint {
@@ -190,6 +274,10 @@ impl<const N: usize> Recorder<N> for Records {
         }
         self.w_norms.extend_from_slice(&r.w_norms);
         self.refused.push(r.refused);
+        if self.ee {
+            self.x_ee.extend_from_slice(&r.x_ee);
+            self.wrench.extend_from_slice(&r.wrench);
+        }
     }
 }
 
@@ -207,6 +295,9 @@ pub struct MetricsOut {
 /// How a run ended when it did not finish.
 #[derive(Clone, Debug)]
 pub enum RunError {
+    /// The plant ended it (a MuJoCo run that diverged, or MuJoCo's fatal
+    /// error): how, with the row and the time.
+    Plant(Failure),
     /// The core's error (at step `k`, when the run had started).
     Core(Error, Option<u64>),
     /// The hook asked to stop.
@@ -311,11 +402,143 @@ pub trait DynTracker: Send + Sync {
         arm: &ArmSpec,
         items: &Items,
         weights: Option<&[f64]>,
+        fault: Option<&FaultSpec>,
         every: u64,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(Records, MetricsOut), RunError>;
+    /// The closed loop on MuJoCo (`sim` as `spec` describes it) from the
+    /// controller's current state (not reset: a used controller goes on),
+    /// with the disturbances of `run.items` (SPEC §17; payload and jitter are
+    /// refused: the first is a change of the model, the second of its
+    /// timestep). Records every `run.every`-th row with the end effector.
+    fn simulate_mujoco(
+        &mut self,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &MujocoRun<'_>,
         hooks: &mut dyn Hooks,
     ) -> Result<(Records, MetricsOut), RunError>;
     /// As [`Any`], for the typed paths.
     fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// A run of [`DynTracker::simulate_mujoco`].
+pub struct MujocoRun<'a> {
+    /// Duration T (s).
+    pub t_final: f64,
+    /// Start of the "after" window of the metrics (s).
+    pub settle: f64,
+    /// Keep every `every`-th row.
+    pub every: u64,
+    /// The disturbance parameters (SPEC §17) by schema name.
+    pub items: &'a Items,
+    /// The commanded setpoints xc, ẋc, ẍc of every row (K × n each,
+    /// row-major), or none: the controller's own trajectory.
+    pub reference: Option<[&'a [f64]; 3]>,
+    /// A fault to inject (τmax: the plant's actuators').
+    pub fault: Option<&'a FaultSpec>,
+}
+
+fn invalid_tau_max() -> Error {
+    Error::Invalid {
+        what: "tau_max",
+        reason: "the plant needs one limit per joint",
+    }
+}
+
+fn run_mujoco<const N: usize>(
+    t: &mut Typed<N>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &MujocoRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> Result<(Records, MetricsOut), RunError> {
+    let ts = t.controller().period();
+    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    crate::error::check::finite("settle", run.settle)?;
+    let s = scenario::<N>(Preset::Robot, t.law(), run.items)
+        .map_err(|e| RunError::Core(e.error, None))?;
+    let dist = s.disturbances()?;
+    if dist.payload() != 0.0 {
+        return Err(RunError::Core(
+            Error::Invalid {
+                what: "payload",
+                reason: "on MuJoCo the payload is a change of the model, not of the loop",
+            },
+            None,
+        ));
+    }
+    if dist.params().jitter != 0.0 {
+        return Err(RunError::Core(
+            Error::Invalid {
+                what: "jitter",
+                reason: "the MuJoCo plant advances by Ts exactly (its timestep is fixed for a run)",
+            },
+            None,
+        ));
+    }
+    if let Some(rows) = run.reference {
+        let need = usize::try_from(total)
+            .unwrap_or(usize::MAX)
+            .saturating_mul(N);
+        if rows.iter().any(|r| r.len() < need) {
+            return Err(RunError::Core(
+                Error::Invalid {
+                    what: "reference",
+                    reason: "needs one row per step",
+                },
+                None,
+            ));
+        }
+    }
+    let every = run.every.max(1);
+    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let mut rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let mut metrics = MetricsAccumulator::new(run.settle, *t.controller().impedance());
+    let k0 = t.steps();
+    let own = Continued {
+        traj: *t.trajectory(),
+        k0,
+        ts,
+    };
+    let inj = match run.fault {
+        Some(f) => {
+            if spec.tau_max.len() != N {
+                return Err(RunError::Core(invalid_tau_max(), None));
+            }
+            Some(injection::<N>(
+                f,
+                &Vector::from_column_slice(&spec.tau_max),
+            )?)
+        }
+        None => None,
+    };
+    let mut plant = MjPlant::<N>::new(sim, spec, ts, *dist.friction())?;
+    if let Err(e) = plant.start() {
+        return Err(match plant.failure() {
+            Some(f) => RunError::Plant(f.clone()),
+            None => RunError::Core(e, None),
+        });
+    }
+    let mut watch = Watch::new(hooks, total);
+    let rec2 = &mut (&mut metrics, &mut rec);
+    let result = {
+        let mut p = Adapted::new(&mut plant, &mut watch);
+        match run.reference {
+            Some(rows) => {
+                let table = Table::<N> { rows, ts };
+                simulate_disturbed(&mut p, t, &table, run.t_final, inj.as_ref(), &dist, rec2)
+            }
+            None => simulate_disturbed(&mut p, t, &own, run.t_final, inj.as_ref(), &dist, rec2),
+        }
+    };
+    match result {
+        Ok(_) => Ok((rec, metrics_out(&metrics.finish()))),
+        Err(e) => Err(match plant.failure() {
+            Some(f) => RunError::Plant(f.clone()),
+            None => watch.error(e),
+        }),
+    }
 }
 
 /// Row-major tables of a replay: K × n each.
@@ -425,9 +648,8 @@ fn metrics_out<const N: usize>(m: &crate::sim::metrics::Metrics<N>) -> MetricsOu
     }
 }
 
-/// A plant that asks the hook every [`HOOK_EVERY`] steps whether to go on.
-struct Watched<'a, P> {
-    plant: P,
+/// The adapter that asks the hook every [`HOOK_EVERY`] periods whether to go on.
+pub(crate) struct Watch<'a> {
     hooks: &'a mut dyn Hooks,
     done: u64,
     total: u64,
@@ -437,15 +659,34 @@ struct Watched<'a, P> {
 /// Steps between two calls of [`Hooks::tick`].
 const HOOK_EVERY: u64 = 64;
 
-impl<const N: usize, P: Plant<N>> Plant<N> for Watched<'_, P> {
-    fn state(&self) -> (Vector<N>, Vector<N>) {
-        self.plant.state()
+impl<'a> Watch<'a> {
+    pub(crate) fn new(hooks: &'a mut dyn Hooks, total: u64) -> Self {
+        Self {
+            hooks,
+            done: 0,
+            total,
+            stopped: false,
+        }
     }
-    fn contact(&self) -> Vector<N> {
-        self.plant.contact()
+
+    /// The run's error, with the period it happened in.
+    pub(crate) fn error(&self, e: Error) -> RunError {
+        if self.stopped {
+            RunError::Stopped
+        } else {
+            RunError::Core(e, Some(self.done))
+        }
     }
-    fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
-        let a = self.plant.advance(tau, h)?;
+}
+
+impl<const N: usize> Adapter<N> for Watch<'_> {
+    fn advance<P: Plant<N> + ?Sized>(
+        &mut self,
+        plant: &mut P,
+        tau: &Vector<N>,
+        h: f64,
+    ) -> Result<Vector<N>, Error> {
+        let a = plant.advance(tau, h)?;
         self.done += 1;
         if self.done.is_multiple_of(HOOK_EVERY) && !self.hooks.tick(self.done, self.total) {
             self.stopped = true;
@@ -463,16 +704,18 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     arm: &M,
     s: &Scenario<N>,
     weights: Option<&[f64]>,
+    fault: Option<&FaultSpec>,
     every: u64,
     hooks: &mut dyn Hooks,
 ) -> Result<(Records, MetricsOut), RunError> {
     let cfg = &s.sim;
-    crate::error::check::finite("settle", cfg.settle)?;
+    let inj = fault
+        .map(|f| injection::<N>(f, &t.controller().config().tau_max))
+        .transpose()?;
     let ts = t.controller().period();
     let total = crate::sim::simulator::steps(cfg.t_final, ts)?;
     let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
-    let mut rec = Records::with_rows(N, kept, every).ok_or(RunError::Memory(kept))?;
-    let mut metrics = MetricsAccumulator::new(cfg.settle, *t.controller().impedance());
+    let mut rec = Records::with_rows(N, kept, every, false).ok_or(RunError::Memory(kept))?;
     t.reset();
     if let Some(w) = weights {
         DynTracker::load_weights(t, w)?;
@@ -480,46 +723,48 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     let traj = *t.trajectory();
     // The plant the controller does not know (SPEC §17): payload and friction.
     let dist = s.disturbances()?;
-    let arm = WithFriction::new(arm.with_payload(dist.payload())?, *dist.friction());
-    let rec2 = &mut (&mut metrics, &mut rec);
-    let result = match s.wall {
+    // The set-up's errors name no row: check what the run builds first.
+    crate::error::check::finite("settle", cfg.settle)?;
+    RigidBody::new(
+        arm.with_payload(dist.payload())?,
+        FreeSpace,
+        cfg.q0,
+        cfg.dq0,
+        cfg.substeps,
+    )?;
+    let mut watch = Watch::new(hooks, total);
+    let metrics = match s.wall {
         Some(w) => {
             let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
-            let plant = RigidBody::new(arm, wall, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(plant, t, &traj, cfg.t_final, total, &dist, rec2, hooks)
+            run_disturbed_with(
+                arm,
+                &wall,
+                t,
+                &traj,
+                cfg,
+                &dist,
+                inj.as_ref(),
+                &mut watch,
+                &mut rec,
+            )
         }
         None => {
-            let plant = RigidBody::new(arm, FreeSpace, cfg.q0, cfg.dq0, cfg.substeps)?;
-            watched(plant, t, &traj, cfg.t_final, total, &dist, rec2, hooks)
+            let env = FreeSpace;
+            run_disturbed_with(
+                arm,
+                &env,
+                t,
+                &traj,
+                cfg,
+                &dist,
+                inj.as_ref(),
+                &mut watch,
+                &mut rec,
+            )
         }
-    };
-    result?;
-    Ok((rec, metrics_out(&metrics.finish())))
-}
-
-#[allow(clippy::too_many_arguments)]
-fn watched<const N: usize, P: Plant<N>>(
-    plant: P,
-    t: &mut Typed<N>,
-    traj: &Sinusoid<N>,
-    t_final: f64,
-    total: u64,
-    dist: &Disturbances<N>,
-    rec: &mut impl Recorder<N>,
-    hooks: &mut dyn Hooks,
-) -> Result<(), RunError> {
-    let mut p = Watched {
-        plant,
-        hooks,
-        done: 0,
-        total,
-        stopped: false,
-    };
-    match simulate_disturbed(&mut p, t, traj, t_final, None, dist, rec) {
-        Ok(_) => Ok(()),
-        Err(_) if p.stopped => Err(RunError::Stopped),
-        Err(e) => Err(RunError::Core(e, Some(p.done))),
     }
+    .map_err(|e| watch.error(e))?;
+    Ok((rec, metrics_out(&metrics)))
 }
 
 impl<const N: usize> DynTracker for Typed<N> {
@@ -675,6 +920,7 @@ impl<const N: usize> DynTracker for Typed<N> {
         arm: &ArmSpec,
         items: &Items,
         weights: Option<&[f64]>,
+        fault: Option<&FaultSpec>,
         every: u64,
         hooks: &mut dyn Hooks,
     ) -> Result<(Records, MetricsOut), RunError> {
@@ -695,7 +941,7 @@ impl<const N: usize> DynTracker for Typed<N> {
                     ))?;
                 let s2 = scenario::<2>(preset, typed.law(), items)
                     .map_err(|e| RunError::Core(e.error, None))?;
-                run_arm(typed, two, &s2, weights, every, hooks)
+                run_arm(typed, two, &s2, weights, fault, every, hooks)
             }
             ArmSpec::Planar { links, g } => {
                 let links: [Link; N] = links.as_slice().try_into().map_err(|_| {
@@ -708,12 +954,145 @@ impl<const N: usize> DynTracker for Typed<N> {
                     )
                 })?;
                 let arm = PlanarArm::new(links, *g)?;
-                run_arm(self, &arm, &s, weights, every, hooks)
+                run_arm(self, &arm, &s, weights, fault, every, hooks)
             }
         }
+    }
+
+    fn simulate_mujoco(
+        &mut self,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &MujocoRun<'_>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(Records, MetricsOut), RunError> {
+        run_mujoco(self, sim, spec, run, hooks)
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
     }
+}
+
+/// Recorded rows of a run whose loop ran elsewhere (a Python controller's):
+/// row-major tables of K rows, `n` values per row for the plant's
+/// quantities, `m` for the reference's (xc, ẋc, ẍc, z1: m = n in joint
+/// space, m ≠ n in task space).
+pub struct RowTables<'a> {
+    /// Joints n.
+    pub n: usize,
+    /// Width m of the reference and of z1.
+    pub m: usize,
+    /// t (K).
+    pub t: &'a [f64],
+    /// q, q̇, q̈ (K × n each).
+    pub x: [&'a [f64]; 3],
+    /// xc, ẋc, ẍc (K × m each).
+    pub c: [&'a [f64]; 3],
+    /// z1 (K × m).
+    pub z1: &'a [f64],
+    /// τ, sat(τ), τe (K × n each).
+    pub tau: [&'a [f64]; 3],
+}
+
+/// The SPEC §12 metrics of recorded rows by the core's [`MetricsAccumulator`]
+/// (the one implementation of the metrics): the rows are fed to an
+/// accumulator of max(n, m) joints with the narrower quantities padded with
+/// zeros (which change no norm, peak or count), and the per-joint figures cut
+/// back to z1's m or τ's n; the impedance residual needs m = n (NaN
+/// otherwise). `target` is (Dd, Cd, Gd), n values each.
+pub fn metrics_of(
+    rows: &RowTables<'_>,
+    settle: f64,
+    target: [&[f64]; 3],
+) -> Result<MetricsOut, Error> {
+    macro_rules! arms {
+        ($($k:literal)*) => {
+            match rows.n.max(rows.m) {
+                $($k => metrics_n::<$k>(rows, settle, target),)*
+                _ => Err(Error::Invalid {
+                    what: "rows",
+                    reason: "the joints and the reference's width must be between 1 and 7",
+                }),
+            }
+        };
+    }
+    arms!(1 2 3 4 5 6 7)
+}
+
+fn metrics_n<const N: usize>(
+    r: &RowTables<'_>,
+    settle: f64,
+    target: [&[f64]; 3],
+) -> Result<MetricsOut, Error> {
+    let (n, m, k) = (r.n, r.m, r.t.len());
+    let bad = |reason| Error::Invalid {
+        what: "rows",
+        reason,
+    };
+    if n == 0 || m == 0 {
+        return Err(bad("need at least one joint and one reference coordinate"));
+    }
+    if r.x.iter().chain(r.tau.iter()).any(|v| v.len() != k * n)
+        || r.c.iter().chain([&r.z1]).any(|v| v.len() != k * m)
+        || target.iter().any(|v| v.len() != n)
+    {
+        return Err(bad("every table needs K rows of its width"));
+    }
+    let pad = |v: &[f64], w: usize, i: usize| {
+        let mut out = Vector::<N>::zeros();
+        out.as_mut_slice()[..w].copy_from_slice(&v[i * w..(i + 1) * w]);
+        out
+    };
+    let joint = m == n;
+    let ones = Vector::<N>::from_element(1.0);
+    let tgt = if joint {
+        let t = |v: &[f64]| {
+            let mut o = ones;
+            o.as_mut_slice()[..n].copy_from_slice(v);
+            o
+        };
+        TargetImpedance::new(t(target[0]), t(target[1]), t(target[2]))?
+    } else {
+        TargetImpedance::new(ones, ones, ones)?
+    };
+    let mut acc = MetricsAccumulator::new(settle, tgt);
+    let zero = Vector::<N>::zeros();
+    for i in 0..k {
+        let (tau, tau_sat) = (pad(r.tau[0], n, i), pad(r.tau[1], n, i));
+        let x = pad(r.x[0], n, i);
+        acc.push(&Row {
+            t: r.t[i],
+            x,
+            dx: pad(r.x[1], n, i),
+            ddx: pad(r.x[2], n, i),
+            xc: if joint { pad(r.c[0], m, i) } else { zero },
+            dxc: if joint { pad(r.c[1], m, i) } else { zero },
+            ddxc: if joint { pad(r.c[2], m, i) } else { zero },
+            xd: zero,
+            dx_hat: zero,
+            tau,
+            tau_sat,
+            dtau: tau_sat - tau,
+            tau_e: pad(r.tau[2], n, i),
+            zeta: zero,
+            z1: pad(r.z1, m, i),
+            w_norms: [0.0; 3],
+            x_ee: [0.0; 3],
+            wrench: [0.0; 6],
+            refused: false,
+        });
+    }
+    let mut out = metrics_out(&acc.finish());
+    for (name, v) in &mut out.joint {
+        v.truncate(if *name == "peak_abs_tau" { n } else { m });
+    }
+    if !joint {
+        for (name, v) in &mut out.scalars {
+            if *name == "imp_err_rms_after2" {
+                *v = f64::NAN;
+            }
+        }
+    }
+    Ok(out)
 }

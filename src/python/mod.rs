@@ -26,6 +26,7 @@
 mod arm;
 mod cartesian;
 mod dynamic;
+mod mujoco;
 
 use crate::control::config::Law;
 use crate::error::Error;
@@ -88,6 +89,8 @@ fn run_error(e: RunError, hooks: &mut PyHooks) -> PyErr {
             .error
             .take()
             .unwrap_or_else(|| PyRuntimeError::new_err("the run was stopped")),
+        RunError::Plant(f) if f.fatal => PyRuntimeError::new_err(f.message),
+        RunError::Plant(f) => DivergedError::new_err(f.message),
         RunError::Memory(rows) => {
             PyMemoryError::new_err(format!("cannot allocate the records of {rows} rows"))
         }
@@ -1111,8 +1114,12 @@ arm_class!(PyPlanarArm, {
 /// "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e",
 /// "zeta", "z1"; "w_norms" (K, 3); "refused" (K,) bool) and "metrics"
 /// (SPEC §12). `controller` is left in its state at the end of the run.
+/// With `fault` = (kind, start, duration, bias, fraction), that fault is
+/// injected (`src/sim/inject.rs`): a refused step applies the fallback and
+/// the run goes on, the row marked "refused".
 #[pyfunction]
-#[pyo3(signature = (controller, arm, params, record_every=1, progress=None, weights=None))]
+#[pyo3(signature = (controller, arm, params, record_every=1, progress=None, weights=None, fault=None))]
+#[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
     controller: &Bound<'py, PyController>,
@@ -1121,7 +1128,9 @@ fn simulate<'py>(
     record_every: u64,
     progress: Option<Py<PyAny>>,
     weights: Option<&Bound<'py, PyDict>>,
+    fault: Option<PyFault>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let fault = fault_spec(fault)?;
     if record_every == 0 {
         return Err(ConfigError::new_err("record_every must be ≥ 1"));
     }
@@ -1146,10 +1155,24 @@ fn simulate<'py>(
     let mut hooks = PyHooks::new(progress);
     let mut guard = ctrl.lock(py);
     let tracker: &mut dyn DynTracker = &mut **guard;
-    let result =
-        py.detach(|| tracker.simulate(&spec, &items, weights.as_deref(), record_every, &mut hooks));
+    let result = py.detach(|| {
+        let w = weights.as_deref();
+        tracker.simulate(&spec, &items, w, fault.as_ref(), record_every, &mut hooks)
+    });
     drop(guard);
     let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
+    records_dict(py, rec, metrics)
+}
+
+/// A run's records and metrics as the dict `simulate` returns: "t" (K,),
+/// the per-joint arrays (K, n), "w_norms" (K, 3), "refused" (K,), with the
+/// end effector "x_ee" (K, 3) and "wrench_ee" (K, 6) if recorded, and
+/// "metrics".
+fn records_dict<'py>(
+    py: Python<'py>,
+    rec: dynamic::Records,
+    metrics: dynamic::MetricsOut,
+) -> PyResult<Bound<'py, PyDict>> {
     let k = rec.rows();
     let n = rec.n;
     let out = PyDict::new(py);
@@ -1159,8 +1182,198 @@ fn simulate<'py>(
     }
     out.set_item("w_norms", array(py, rec.w_norms, (k, 3))?)?;
     out.set_item("refused", PyArray1::from_vec(py, rec.refused))?;
+    if rec.ee {
+        out.set_item("x_ee", array(py, rec.x_ee, (k, 3))?)?;
+        out.set_item("wrench_ee", array(py, rec.wrench, (k, 6))?)?;
+    }
     out.set_item("metrics", metrics_to_dict(py, metrics)?)?;
     Ok(out)
+}
+
+/// The SPEC §12 metrics of recorded rows, by the core's accumulator (the
+/// metrics of a loop that ran in Python: `adaptimp.mujoco.simulate` with a
+/// Python controller): `t` (K,), `q`, `dq`, `ddq`, `tau`, `tau_sat`, `tau_e`
+/// (K, n), `xc`, `dxc`, `ddxc`, `z1` (K, m) (m = n in joint space; the
+/// impedance residual is NaN otherwise), the window after `settle` (s) and
+/// the target impedance (Dd, Cd, Gd), n values each. Returns the dict of
+/// `SimResult.metrics`.
+#[pyfunction]
+#[pyo3(signature = (t, q, dq, ddq, xc, dxc, ddxc, z1, tau, tau_sat, tau_e, settle, target))]
+#[allow(clippy::too_many_arguments)]
+fn metrics<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    q: PyReadonlyArray2<'py, f64>,
+    dq: PyReadonlyArray2<'py, f64>,
+    ddq: PyReadonlyArray2<'py, f64>,
+    xc: PyReadonlyArray2<'py, f64>,
+    dxc: PyReadonlyArray2<'py, f64>,
+    ddxc: PyReadonlyArray2<'py, f64>,
+    z1: PyReadonlyArray2<'py, f64>,
+    tau: PyReadonlyArray2<'py, f64>,
+    tau_sat: PyReadonlyArray2<'py, f64>,
+    tau_e: PyReadonlyArray2<'py, f64>,
+    settle: f64,
+    target: (Vec<f64>, Vec<f64>, Vec<f64>),
+) -> PyResult<Bound<'py, PyDict>> {
+    let k = t.len();
+    let (n, m) = (q.shape()[1], xc.shape()[1]);
+    let tab = |name: &str, a: &PyReadonlyArray2<'py, f64>, w: usize| table(name, a, k, w);
+    let x = [tab("q", &q, n)?, tab("dq", &dq, n)?, tab("ddq", &ddq, n)?];
+    let c = [
+        tab("xc", &xc, m)?,
+        tab("dxc", &dxc, m)?,
+        tab("ddxc", &ddxc, m)?,
+    ];
+    let z = tab("z1", &z1, m)?;
+    let tq = [
+        tab("tau", &tau, n)?,
+        tab("tau_sat", &tau_sat, n)?,
+        tab("tau_e", &tau_e, n)?,
+    ];
+    let ts: Vec<f64> = t.as_array().iter().copied().collect();
+    let rows = dynamic::RowTables {
+        n,
+        m,
+        t: &ts,
+        x: [&x[0], &x[1], &x[2]],
+        c: [&c[0], &c[1], &c[2]],
+        z1: &z,
+        tau: [&tq[0], &tq[1], &tq[2]],
+    };
+    let out = dynamic::metrics_of(&rows, settle, [&target.0, &target.1, &target.2])
+        .map_err(step_error)?;
+    metrics_to_dict(py, out)
+}
+
+/// A fault as `adaptimp.Fault` hands it to the core: (kind, start (s),
+/// duration (s), bias (N m, per joint) or None, fraction or None).
+type PyFault = (String, f64, f64, Option<Vec<f64>>, Option<f64>);
+
+/// A fault to inject from its Python form ([`PyFault`]).
+fn fault_spec(f: Option<PyFault>) -> PyResult<Option<dynamic::FaultSpec>> {
+    let Some((kind, start, duration, bias, fraction)) = f else {
+        return Ok(None);
+    };
+    use dynamic::FaultKind as K;
+    let kind = match (kind.as_str(), bias, fraction) {
+        ("stale", None, None) => K::Stale,
+        ("nan_burst", None, None) => K::NanBurst,
+        ("skipped", None, None) => K::Skipped,
+        ("force_bias", Some(b), None) => K::ForceBias(b),
+        ("actuator_drop", None, Some(x)) => K::ActuatorDrop(x),
+        (other, b, x) => {
+            return Err(ConfigError::new_err(format!(
+                "fault {other:?} with bias {b:?} and fraction {x:?}: the kinds are 'stale', \
+                 'nan_burst', 'skipped', 'force_bias' (with bias) and 'actuator_drop' (with fraction)"
+            )))
+        }
+    };
+    Ok(Some(dynamic::FaultSpec {
+        kind,
+        start,
+        duration,
+    }))
+}
+
+// ---------------------------------------------------------------------------
+// The closed loop on MuJoCo.
+// ---------------------------------------------------------------------------
+
+/// A plant description from the dict `adaptimp.mujoco.Plant` makes (see
+/// [`mujoco::MujocoSpec`]).
+fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
+    fn get<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
+        d.get_item(key)?
+            .ok_or_else(|| PyTypeError::new_err(format!("the plant description has no {key:?}")))?
+            .extract()
+            .map_err(Into::into)
+    }
+    Ok(mujoco::MujocoSpec {
+        qadr: get(d, "qadr")?,
+        dofs: get(d, "dofs")?,
+        act: get(d, "act")?,
+        gear: get(d, "gear")?,
+        tau_max: get(d, "tau_max")?,
+        site: get(d, "site")?,
+        ee_body: get(d, "ee_body")?,
+        force_adr: get(d, "force_adr")?,
+        torque_adr: get(d, "torque_adr")?,
+        substeps: get(d, "substeps")?,
+        timestep: get(d, "timestep")?,
+        dof_names: get(d, "dof_names")?,
+        warning_names: get(d, "warning_names")?,
+    })
+}
+
+/// Close the loop of `controller` (from its current state) with the MuJoCo
+/// `model` and its `data` (`mujoco.MjModel`, `mujoco.MjData`) as `spec`
+/// describes the plant, for `t_final` (s), with the GIL released and MuJoCo
+/// driven through its C library (SPEC §13.1): the disturbances of `params`
+/// (SPEC §17), the setpoints `reference` = (xc, dxc, ddxc), each (K, n) with
+/// K ≥ the steps (None: the controller's own trajectory), the metrics after
+/// `settle` (s). Keeps every `record_every`-th row; checks for signals every
+/// 50 ms and calls `progress(done, total)` as often. Returns the dict of
+/// `simulate` with "x_ee" (K, 3) and "wrench_ee" (K, 6). A period after
+/// which MuJoCo warned (it resets a diverged state) raises `DivergedError`
+/// naming the row, the time and MuJoCo's message.
+#[pyfunction]
+#[pyo3(signature = (controller, model, data, spec, params, t_final, settle, record_every=1, progress=None, reference=None, fault=None))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_mujoco<'py>(
+    py: Python<'py>,
+    controller: &Bound<'py, PyController>,
+    model: &Bound<'py, PyAny>,
+    data: &Bound<'py, PyAny>,
+    spec: &Bound<'py, PyDict>,
+    params: &Bound<'py, PyDict>,
+    t_final: f64,
+    settle: f64,
+    record_every: u64,
+    progress: Option<Py<PyAny>>,
+    reference: Option<(
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+    )>,
+    fault: Option<PyFault>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let fault = fault_spec(fault)?;
+    if record_every == 0 {
+        return Err(ConfigError::new_err("record_every must be ≥ 1"));
+    }
+    let spec = mujoco_spec(spec)?;
+    let items = items(params)?;
+    let ctrl = controller.get();
+    let n = ctrl.n;
+    let tables = match &reference {
+        None => None,
+        Some((x, dx, ddx)) => {
+            let rows = x.shape()[0];
+            Some([
+                table("xc", x, rows, n)?,
+                table("dxc", dx, rows, n)?,
+                table("ddxc", ddx, rows, n)?,
+            ])
+        }
+    };
+    let mut sim = adaptimp_mujoco::Sim::from_python(model, data)?;
+    let run = dynamic::MujocoRun {
+        t_final,
+        settle,
+        every: record_every,
+        items: &items,
+        reference: tables.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
+        fault: fault.as_ref(),
+    };
+    let mut hooks = PyHooks::new(progress);
+    let mut guard = ctrl.lock(py);
+    let tracker: &mut dyn DynTracker = &mut **guard;
+    let result = py.detach(|| tracker.simulate_mujoco(&mut sim, &spec, &run, &mut hooks));
+    drop(guard);
+    drop(sim);
+    let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
+    records_dict(py, rec, metrics)
 }
 
 // ---------------------------------------------------------------------------
@@ -1192,13 +1405,10 @@ fn run_job(job: &Job, stop: &std::sync::atomic::AtomicBool) -> Result<dynamic::M
             None => e.error.to_string(),
         })?;
     let mut hooks = StopHooks(stop);
-    match tracker.simulate(&job.arm, &job.items, None, u64::MAX, &mut hooks) {
-        Ok((_, m)) => Ok(m),
-        Err(RunError::Stopped) => Err("stopped".to_owned()),
-        Err(RunError::Memory(rows)) => Err(format!("cannot allocate the records of {rows} rows")),
-        Err(RunError::Core(e, None)) => Err(python_names(e).to_string()),
-        Err(RunError::Core(e, Some(k))) => Err(format!("row {k}: {}", python_names(e))),
-    }
+    tracker
+        .simulate(&job.arm, &job.items, None, None, u64::MAX, &mut hooks)
+        .map(|(_, m)| m)
+        .map_err(run_message)
 }
 
 fn metrics_to_dict<'py>(
@@ -1234,8 +1444,6 @@ fn simulate_many<'py>(
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
-    use rayon::prelude::*;
-    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let mut parsed = Vec::with_capacity(jobs.len());
     for job in jobs.iter() {
         let (case, params, arm): (String, Bound<'py, PyDict>, Bound<'py, PyAny>) = job.extract()?;
@@ -1253,22 +1461,47 @@ fn simulate_many<'py>(
         };
         parsed.push(Job { law, items, arm });
     }
+    let results = in_parallel(py, &parsed, threads, progress, |job, stop| {
+        run_job(job, stop)
+    })?;
+    let out = PyList::empty(py);
+    for r in results {
+        match r {
+            Ok(m) => out.append(metrics_to_dict(py, m)?)?,
+            Err(msg) => out.append(msg)?,
+        }
+    }
+    Ok(out)
+}
+
+/// Run `run` on every job on `threads` threads (all cores if None) with the
+/// GIL released, in order of the results; this thread watches for signals
+/// and reports progress every 50 ms (Ctrl-C stops the remaining runs and
+/// raises `KeyboardInterrupt`).
+fn in_parallel<J: Sync>(
+    py: Python<'_>,
+    jobs: &[J],
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+    run: impl Fn(&J, &std::sync::atomic::AtomicBool) -> Result<dynamic::MetricsOut, String> + Sync,
+) -> PyResult<Vec<Result<dynamic::MetricsOut, String>>> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start the thread pool: {e}")))?;
     let stop = AtomicBool::new(false);
     let done = AtomicUsize::new(0);
-    let total = parsed.len();
+    let total = jobs.len();
     let mut interrupted: Option<PyErr> = None;
     let results = py.detach(|| {
         std::thread::scope(|scope| {
             let worker = scope.spawn(|| {
                 pool.install(|| {
-                    parsed
-                        .par_iter()
+                    jobs.par_iter()
                         .map(|job| {
-                            let r = run_job(job, &stop);
+                            let r = run(job, &stop);
                             done.fetch_add(1, Ordering::Relaxed);
                             r
                         })
@@ -1305,8 +1538,91 @@ fn simulate_many<'py>(
     if let Some(e) = interrupted {
         return Err(e);
     }
-    let results =
-        results.map_err(|_| PyRuntimeError::new_err("a sweep's worker thread panicked"))?;
+    results.map_err(|_| PyRuntimeError::new_err("a sweep's worker thread panicked"))
+}
+
+/// A MuJoCo job as Python gives it: (controller, model, data, spec, params, T, settle).
+type PyMujocoJob<'py> = (
+    Bound<'py, PyController>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyDict>,
+    Bound<'py, PyDict>,
+    f64,
+    f64,
+);
+
+/// One MuJoCo run of a sweep: its controller, plant and settings.
+struct MujocoJob {
+    ctrl: Py<PyController>,
+    sim: Mutex<adaptimp_mujoco::Sim>,
+    spec: mujoco::MujocoSpec,
+    items: Vec<(String, Owned)>,
+    t_final: f64,
+    settle: f64,
+}
+
+/// The error of a run as a sweep reports it.
+fn run_message(e: RunError) -> String {
+    match e {
+        RunError::Stopped => "stopped".to_owned(),
+        RunError::Plant(f) => f.message,
+        RunError::Memory(rows) => format!("cannot allocate the records of {rows} rows"),
+        RunError::Core(e, None) => python_names(e).to_string(),
+        RunError::Core(e, Some(k)) => format!("row {k}: {}", python_names(e)),
+    }
+}
+
+/// Run every job of `jobs` — tuples (controller, model, data, spec, params,
+/// T, settle) as for `simulate_mujoco`, each with its own controller and
+/// `MjData` — on `threads` threads (all cores if None), with the GIL
+/// released, MuJoCo driven through its C library. Returns, in order, each
+/// run's SPEC §12 metrics (a dict) or its error message (a str); results
+/// equal those of running each alone. Ctrl-C stops the batch within 50 ms;
+/// `progress(done, total)` is called as runs finish.
+#[pyfunction]
+#[pyo3(signature = (jobs, threads=None, progress=None))]
+fn simulate_mujoco_many<'py>(
+    py: Python<'py>,
+    jobs: &Bound<'py, PyList>,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyList>> {
+    let mut parsed = Vec::with_capacity(jobs.len());
+    for job in jobs.iter() {
+        let (ctrl, model, data, spec, params, t_final, settle): PyMujocoJob<'py> = job.extract()?;
+        parsed.push(MujocoJob {
+            ctrl: ctrl.unbind(),
+            sim: Mutex::new(adaptimp_mujoco::Sim::from_python(&model, &data)?),
+            spec: mujoco_spec(&spec)?,
+            items: items(&params)?,
+            t_final,
+            settle,
+        });
+    }
+    let results = in_parallel(py, &parsed, threads, progress, |job, stop| {
+        let run = dynamic::MujocoRun {
+            t_final: job.t_final,
+            settle: job.settle,
+            every: u64::MAX,
+            items: &job.items,
+            reference: None,
+            fault: None,
+        };
+        let mut hooks = StopHooks(stop);
+        let mut sim = job.sim.lock().unwrap_or_else(|p| p.into_inner());
+        let mut tracker = job
+            .ctrl
+            .get()
+            .inner
+            .lock()
+            .unwrap_or_else(|p| p.into_inner());
+        tracker
+            .simulate_mujoco(&mut sim, &job.spec, &run, &mut hooks)
+            .map(|(_, m)| m)
+            .map_err(run_message)
+    })?;
+    drop(parsed);
     let out = PyList::empty(py);
     for r in results {
         match r {
@@ -1395,7 +1711,8 @@ mod adaptimp_module {
 
     #[pymodule_export]
     use super::{
-        defaults, schema_table, simulate, simulate_many, PyArm, PyController, PyPlanarArm,
+        defaults, metrics, schema_table, simulate, simulate_many, simulate_mujoco,
+        simulate_mujoco_many, PyArm, PyController, PyPlanarArm,
     };
 
     #[pymodule_export]

@@ -19,6 +19,26 @@ pub trait Plant<const N: usize> {
     /// the acceleration ẍ (rad/s²) at the start of the interval (for the
     /// impedance residual, SPEC §12). Errors if the state becomes non-finite.
     fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error>;
+    /// The torque (N m) the actuators deliver for the command `tau`: the
+    /// plant's own limits (a physics engine's actuator range). The loop
+    /// records it as the applied torque and advances with it. Default: `tau`
+    /// itself (the rigid-body plants have no limits of their own).
+    fn actuate(&self, tau: &Vector<N>) -> Vector<N> {
+        *tau
+    }
+    /// The wrench F_e = [f; m] the end effector exerts on the environment
+    /// now, force (N) and moment (N m) in the world frame, as a force/torque
+    /// sensor measures it (τe = Jᵀ F_e). Default: zeros (a plant that
+    /// measures no Cartesian quantity: the joint-space rigid bodies, whose
+    /// contact is τe; zeros rather than NaN keep rows comparable).
+    fn wrench(&self) -> [f64; 6] {
+        [0.0; 6]
+    }
+    /// The end-effector position (m), world frame, now. Default: zeros (as
+    /// [`wrench`](Self::wrench)).
+    fn end_effector(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
 }
 
 /// One classical RK4 step of the arm from time `t` (s) over `h` (s), with the

@@ -38,6 +38,11 @@ pub struct Row<const N: usize> {
     pub z1: Vector<N>,
     /// ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F before the step's update.
     pub w_norms: [f64; 3],
+    /// End-effector position (m), world frame, at x_k ([`Plant::end_effector`](crate::sim::plant::Plant::end_effector); zeros for the joint-space plants).
+    pub x_ee: [f64; 3],
+    /// End-effector wrench F_e = [f; m] (N, N m), world frame, measured at
+    /// x_k ([`Plant::wrench`](crate::sim::plant::Plant::wrench); zeros for the joint-space plants).
+    pub wrench: [f64; 6],
     /// True if no command was computed at this row (the step was refused or
     /// skipped): `tau_sat` is then the fallback or held torque, the other
     /// controller fields those of the last computed command.

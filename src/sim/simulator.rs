@@ -98,11 +98,14 @@ where
 ///    injected fault, if any, acts on what it sees;
 /// 2. the controller steps with the trajectory at t_k (it assumes Ts);
 /// 3. the actuators deliver the applied torque (the injected fault, then the
-///    fraction ρ: [`Disturbances::actuate`]), recorded as `tau_sat`;
+///    fraction ρ: [`Disturbances::actuate`], then the plant's own limits:
+///    [`Plant::actuate`]), recorded as `tau_sat`;
 /// 4. the plant advances by the true interval h_k = Ts (1 + u_k)
 ///    ([`Disturbances::interval`]).
 ///
-/// Rows carry t_k, the controller's time, and the plant's true state. With
+/// The controller also gets the plant's end-effector wrench
+/// ([`Control::step_with_wrench`]). Rows carry t_k, the controller's time,
+/// and the plant's true state, end-effector position and wrench. With
 /// [`Disturbances::none`] it is [`simulate_with`], bit for bit. The
 /// generators start from the seed at every call: the same arguments give the
 /// same rows. Allocation-free itself.
@@ -132,6 +135,7 @@ where
         let t = k as f64 * ts;
         let (x, dx) = plant.state();
         let tau_e = plant.contact();
+        let (wrench, x_ee) = (plant.wrench(), plant.end_effector());
         let seen = disturbances.measure(&mut noise, (x, dx, tau_e));
         if let Some(inj) = injection {
             sensed = inj.measure(t, seen, sensed);
@@ -147,7 +151,7 @@ where
                 dx: Some(sensed.1),
                 tau_e: sensed.2,
             };
-            let (tau, result) = ctrl.step_or_fallback(&m, &c);
+            let (tau, result) = ctrl.step_with_wrench(&m, &wrench, &c);
             applied = tau;
             match result {
                 Ok(cmd) => {
@@ -159,7 +163,7 @@ where
             }
         };
         let delivered = injection.map_or(applied, |i| i.actuate(t, &applied));
-        let delivered = disturbances.actuate(&delivered);
+        let delivered = plant.actuate(&disturbances.actuate(&delivered));
         let h = disturbances.interval(&mut noise, ts);
         let ddx = plant.advance(&delivered, h)?;
         rec.record(&Row {
@@ -179,6 +183,8 @@ where
             zeta: last.zeta,
             z1: if refused { last.xd - x } else { last.z1 },
             w_norms: last.w_norms,
+            x_ee,
+            wrench,
             refused,
         });
     }
@@ -241,6 +247,34 @@ where
     T: Trajectory<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
+    run_disturbed_with(arm, env, ctrl, traj, cfg, disturbances, None, &mut (), rec)
+}
+
+/// [`run_disturbed`] with a fault injected (`injection`, as
+/// [`simulate_with`]: a refused step applies the fallback and the run goes
+/// on) and the plant seen through `adapter` (e.g. one that checks for a stop
+/// request after every period: [`Adapter`]). With `None` and `()` it is
+/// [`run_disturbed`], bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn run_disturbed_with<const N: usize, M, E, C, T, A, R>(
+    arm: &M,
+    env: &E,
+    ctrl: &mut C,
+    traj: &T,
+    cfg: &SimConfig<N>,
+    disturbances: &Disturbances<N>,
+    injection: Option<&Injection<N>>,
+    adapter: &mut A,
+    rec: &mut R,
+) -> Result<Metrics<N>, Error>
+where
+    M: TipPayload<N> + Clone,
+    E: Environment<N> + Clone,
+    C: Control<N> + ?Sized,
+    T: Trajectory<N> + ?Sized,
+    A: Adapter<N> + ?Sized,
+    R: Recorder<N> + ?Sized,
+{
     check::finite("settle", cfg.settle)?;
     let arm = WithFriction::new(
         arm.with_payload(disturbances.payload())?,
@@ -249,15 +283,68 @@ where
     let mut plant = RigidBody::new(arm, env.clone(), cfg.q0, cfg.dq0, cfg.substeps)?;
     let mut metrics = MetricsAccumulator::new(cfg.settle, *ctrl.target());
     simulate_disturbed(
-        &mut plant,
+        &mut Adapted::new(&mut plant, adapter),
         ctrl,
         traj,
         cfg.t_final,
-        None,
+        injection,
         disturbances,
         &mut (&mut metrics, rec),
     )?;
     Ok(metrics.finish())
+}
+
+/// What a closed loop's caller adds to a plant without changing it: a hook
+/// around every [`Plant::advance`] (a stop request, progress, a watchdog).
+/// `()` adds nothing.
+pub trait Adapter<const N: usize> {
+    /// Advance `plant` by `h` (s) with `tau` (N m) held: by default exactly
+    /// `plant.advance(tau, h)`. An error ends the run.
+    fn advance<P: Plant<N> + ?Sized>(
+        &mut self,
+        plant: &mut P,
+        tau: &Vector<N>,
+        h: f64,
+    ) -> Result<Vector<N>, Error> {
+        plant.advance(tau, h)
+    }
+}
+
+impl<const N: usize> Adapter<N> for () {}
+
+/// A plant seen through an [`Adapter`]: everything is the plant's, its
+/// advance goes through the adapter.
+pub struct Adapted<'a, P: ?Sized, A: ?Sized> {
+    plant: &'a mut P,
+    adapter: &'a mut A,
+}
+
+impl<'a, P: ?Sized, A: ?Sized> Adapted<'a, P, A> {
+    /// `plant` through `adapter`.
+    pub fn new(plant: &'a mut P, adapter: &'a mut A) -> Self {
+        Self { plant, adapter }
+    }
+}
+
+impl<const N: usize, P: Plant<N> + ?Sized, A: Adapter<N> + ?Sized> Plant<N> for Adapted<'_, P, A> {
+    fn state(&self) -> (Vector<N>, Vector<N>) {
+        self.plant.state()
+    }
+    fn contact(&self) -> Vector<N> {
+        self.plant.contact()
+    }
+    fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
+        self.adapter.advance(&mut *self.plant, tau, h)
+    }
+    fn actuate(&self, tau: &Vector<N>) -> Vector<N> {
+        self.plant.actuate(tau)
+    }
+    fn wrench(&self) -> [f64; 6] {
+        self.plant.wrench()
+    }
+    fn end_effector(&self) -> [f64; 3] {
+        self.plant.end_effector()
+    }
 }
 
 /// [`run`] with a fault injected (feature `alloc`): the rigid-body scenario of

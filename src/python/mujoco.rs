@@ -1,0 +1,426 @@
+//! MuJoCo as a [`Plant`] of the core's closed loop: [`MjPlant`] drives a
+//! model through [`adaptimp_mujoco::Sim`] (the engine's C library, no Python
+//! in the loop) with the semantics of `adaptimp.mujoco` (SPEC §13.1):
+//!
+//! - at t_k, the state, the end-effector position, the wrench F_e and
+//!   τe = Jᵀ F_e are those of MuJoCo's forward computation at x_k with the
+//!   previous torque held (sensors and contact as a real sensor reads them
+//!   just before the new command);
+//! - the command is saturated to the actuators' τmax (gear × ctrlrange) and
+//!   held for `substeps` MuJoCo steps of Ts/substeps; ẍ_k is MuJoCo's q̈ at
+//!   x_k with that torque (`mj_forwardSkip` from the velocity stage: the
+//!   acceleration of `mj_forward`, without recomputing positions and
+//!   velocities); after the steps, `mj_forward` at x_{k+1};
+//! - a period after which MuJoCo has warned (it resets the state on a bad
+//!   position, velocity or acceleration and only counts a warning), whose
+//!   time did not advance by Ts, or whose state is not finite, ends the run
+//!   with the row, the time and MuJoCo's own message ([`MjPlant::failure`]).
+//!
+//! Nothing here is `unsafe`: the FFI lives in the `adaptimp-mujoco` crate.
+
+use crate::error::Error;
+use crate::sim::disturb::Friction;
+use crate::sim::plant::Plant;
+use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
+use crate::types::Vector;
+use adaptimp_mujoco::{Sim, MAX_WARNINGS};
+use std::string::String;
+use std::vec::Vec;
+
+/// Where a plant's joints, actuators and end effector are in the model.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MujocoSpec {
+    /// `qpos` address of each joint, in kinematic order.
+    pub qadr: Vec<usize>,
+    /// DOF address of each joint.
+    pub dofs: Vec<usize>,
+    /// The motor of each joint.
+    pub act: Vec<usize>,
+    /// Each motor's gear (τ = gear · ctrl).
+    pub gear: Vec<f64>,
+    /// τmax (N m) of each joint: gear × ctrlrange.
+    pub tau_max: Vec<f64>,
+    /// The end-effector site, or none (then the body's origin).
+    pub site: Option<usize>,
+    /// The end-effector body.
+    pub ee_body: usize,
+    /// `sensordata` address of the force sensor at the site; none: the model
+    /// measures no wrench (no contact can reach the end effector).
+    pub force_adr: Option<usize>,
+    /// `sensordata` address of the torque sensor at the site, if any.
+    pub torque_adr: Option<usize>,
+    /// MuJoCo steps per period.
+    pub substeps: usize,
+    /// MuJoCo's timestep (s): Ts / substeps.
+    pub timestep: f64,
+    /// The joint name of each DOF of the model (for messages).
+    pub dof_names: Vec<String>,
+    /// The names of MuJoCo's warning kinds, by index (`mjtWarning`).
+    pub warning_names: Vec<String>,
+}
+
+/// MuJoCo as a [`Plant`] of N joints.
+pub struct MjPlant<'a, const N: usize> {
+    sim: &'a mut Sim,
+    spec: &'a MujocoSpec,
+    qadr: [usize; N],
+    dofs: [usize; N],
+    act: [usize; N],
+    gear: Vector<N>,
+    tau_max: Vector<N>,
+    friction: Friction<N>,
+    ts: f64,
+    rows: u64,
+    tau_e: Vector<N>,
+    wrench: [f64; 6],
+    x_ee: [f64; 3],
+    failure: Option<Failure>,
+}
+
+/// How the plant ended a run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Failure {
+    /// MuJoCo raised a fatal error (`mju_error`), rather than a warning or a
+    /// non-finite state.
+    pub fatal: bool,
+    /// The message: the row, the time and MuJoCo's words.
+    pub message: String,
+}
+
+fn invalid(what: &'static str, reason: &'static str) -> Error {
+    Error::Invalid { what, reason }
+}
+
+fn indices<const N: usize>(
+    v: &[usize],
+    bound: usize,
+    what: &'static str,
+) -> Result<[usize; N], Error> {
+    let a: [usize; N] = v
+        .try_into()
+        .map_err(|_| invalid(what, "need one per joint"))?;
+    if a.iter().any(|&i| i >= bound) {
+        return Err(invalid(what, "out of the model's range"));
+    }
+    Ok(a)
+}
+
+impl<'a, const N: usize> MjPlant<'a, N> {
+    /// The plant of `sim` as `spec` describes it, at the period `ts` (s),
+    /// with the joint `friction` of SPEC §17 applied through `qfrc_applied`
+    /// (held over each MuJoCo step). Reads the state MuJoCo's last forward
+    /// computation left (the caller has run one, e.g. a reset).
+    pub fn new(
+        sim: &'a mut Sim,
+        spec: &'a MujocoSpec,
+        ts: f64,
+        friction: Friction<N>,
+    ) -> Result<Self, Error> {
+        let nv = sim.nv();
+        let qadr = indices::<N>(&spec.qadr, sim.qpos().len(), "qadr")?;
+        let dofs = indices::<N>(&spec.dofs, nv, "dofs")?;
+        let act = indices::<N>(&spec.act, sim.ctrl_mut().len(), "act")?;
+        let vec = |v: &[f64], what| -> Result<Vector<N>, Error> {
+            if v.len() != N || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+                return Err(invalid(what, "need one finite value > 0 per joint"));
+            }
+            Ok(Vector::from_column_slice(v))
+        };
+        let gear = vec(&spec.gear, "gear")?;
+        let tau_max = vec(&spec.tau_max, "tau_max")?;
+        let sensors = sim.sensordata().len();
+        for adr in [spec.force_adr, spec.torque_adr].into_iter().flatten() {
+            if adr + 3 > sensors {
+                return Err(invalid("sensor", "address out of sensordata"));
+            }
+        }
+        if spec.force_adr.is_none() && spec.torque_adr.is_some() {
+            return Err(invalid("sensor", "a torque sensor needs a force sensor"));
+        }
+        match spec.site {
+            Some(s) if s >= sim.site_xpos().len() / 3 => {
+                return Err(invalid("site", "out of the model's range"))
+            }
+            None if spec.ee_body >= sim.xpos().len() / 3 => {
+                return Err(invalid("ee_body", "out of the model's range"))
+            }
+            _ => {}
+        }
+        if spec.force_adr.is_some() && spec.site.is_none() {
+            return Err(invalid("sensor", "a force sensor needs its site"));
+        }
+        if spec.substeps == 0 || !(spec.timestep > 0.0 && spec.timestep.is_finite()) {
+            return Err(invalid("substeps", "need substeps ≥ 1 and a timestep > 0"));
+        }
+        Ok(Self {
+            sim,
+            spec,
+            qadr,
+            dofs,
+            act,
+            gear,
+            tau_max,
+            friction,
+            ts,
+            rows: 0,
+            tau_e: Vector::zeros(),
+            wrench: [0.0; 6],
+            x_ee: [0.0; 3],
+            failure: None,
+        })
+    }
+
+    /// Read the end effector at the state MuJoCo's last forward computation
+    /// left: call once before the run.
+    pub fn start(&mut self) -> Result<(), Error> {
+        self.sense()
+    }
+
+    /// Why the run ended, if the plant ended it.
+    pub fn failure(&self) -> Option<&Failure> {
+        self.failure.as_ref()
+    }
+
+    /// A MuJoCo call's fatal error, recorded as the failure of the period.
+    fn fatal(&mut self, e: adaptimp_mujoco::Error) -> Error {
+        let t0 = self.rows as f64 * self.ts;
+        self.failure = Some(Failure {
+            fatal: true,
+            message: std::format!(
+                "the MuJoCo plant failed in the period of row {} (t = {t0} s): {e}",
+                self.rows
+            ),
+        });
+        Error::Diverged { what: "MuJoCo" }
+    }
+
+    /// The end effector's position, wrench and τe at the current forward
+    /// computation.
+    fn sense(&mut self) -> Result<(), Error> {
+        let spec = self.spec;
+        let (point, sid) = match spec.site {
+            Some(s) => (&self.sim.site_xpos()[3 * s..3 * s + 3], s),
+            None => (&self.sim.xpos()[3 * spec.ee_body..3 * spec.ee_body + 3], 0),
+        };
+        self.x_ee.copy_from_slice(point);
+        let mut w = [0.0; 6];
+        if let Some(fa) = spec.force_adr {
+            // The sensors measure in the site frame: F_world = R F_site.
+            let r = &self.sim.site_xmat()[9 * sid..9 * sid + 9];
+            let data = self.sim.sensordata();
+            for (block, adr) in [(0, Some(fa)), (3, spec.torque_adr)] {
+                if let Some(a) = adr {
+                    for i in 0..3 {
+                        w[block + i] = r[3 * i] * data[a]
+                            + r[3 * i + 1] * data[a + 1]
+                            + r[3 * i + 2] * data[a + 2];
+                    }
+                }
+            }
+        }
+        self.wrench = w;
+        self.tau_e = Vector::zeros();
+        if w.iter().any(|x| *x != 0.0) {
+            let nv = self.sim.nv();
+            let dofs = self.dofs;
+            let (by_site, id) = match spec.site {
+                Some(s) => (true, s),
+                None => (false, spec.ee_body),
+            };
+            let e = self.sim.jacobian(by_site, id);
+            let (jp, jr) = match e {
+                Ok(j) => j,
+                Err(e) => return Err(self.fatal(e)),
+            };
+            // τe = Jᵀ F_e, J = [Jp; Jr] (6 × n).
+            let mut te = Vector::<N>::zeros();
+            for (i, &d) in dofs.iter().enumerate() {
+                let mut acc = 0.0;
+                for r in 0..3 {
+                    acc += jp[r * nv + d] * w[r];
+                }
+                for r in 0..3 {
+                    acc += jr[r * nv + d] * w[3 + r];
+                }
+                te[i] = acc;
+            }
+            self.tau_e = te;
+        }
+        Ok(())
+    }
+
+    /// The period's end: MuJoCo's warnings, the time, the state.
+    fn check(&mut self, before: &[(i32, i32); MAX_WARNINGS], t0: f64) -> Result<(), Error> {
+        let (after, count) = self.sim.warnings();
+        let k = self.rows;
+        let start = k as f64 * self.ts;
+        let mut expected = t0;
+        for _ in 0..self.spec.substeps {
+            expected += self.spec.timestep; // as mj_step advances d->time
+        }
+        let time = self.sim.time();
+        let warned = (0..count).find(|&i| after[i].0 != before[i].0);
+        let nonfinite = {
+            let (x, dx) = self.state();
+            x.iter().chain(dx.iter()).any(|v| !v.is_finite())
+        };
+        // A reset puts the time back to 0: half a timestep tells it from rounding.
+        let reset = (time - expected).abs() > 0.5 * self.spec.timestep;
+        if warned.is_none() && !reset && !nonfinite {
+            return Ok(());
+        }
+        let cause = match warned {
+            Some(i) => {
+                let info = after[i].1;
+                let text = self.sim.library().warning_text(i, info);
+                let name = self.spec.warning_names.get(i).map_or("", String::as_str);
+                let joint = match (name, usize::try_from(info)) {
+                    (
+                        "mjWARN_BADQPOS" | "mjWARN_BADQVEL" | "mjWARN_BADQACC" | "mjWARN_INERTIA",
+                        Ok(d),
+                    ) => self
+                        .spec
+                        .dof_names
+                        .get(d)
+                        .map(|j| std::format!(" (joint {j:?})"))
+                        .unwrap_or_default(),
+                    _ => String::new(),
+                };
+                let reset = if reset {
+                    std::format!(
+                        "; MuJoCo reset its state (its time is {time} s, not {expected} s)"
+                    )
+                } else {
+                    String::new()
+                };
+                std::format!("MuJoCo warned {name}: {text}{joint}{reset}")
+            }
+            None if nonfinite => String::from("the state is not finite"),
+            None => {
+                std::format!("MuJoCo's time is {time} s, not {expected} s (its state was reset)")
+            }
+        };
+        self.failure = Some(Failure {
+            fatal: false,
+            message: std::format!(
+                "the MuJoCo plant diverged in the period of row {k} (t = {start} s to {} s): {cause}",
+                (k + 1) as f64 * self.ts
+            ),
+        });
+        Err(Error::Diverged {
+            what: "MuJoCo state",
+        })
+    }
+}
+
+impl<const N: usize> Plant<N> for MjPlant<'_, N> {
+    fn state(&self) -> (Vector<N>, Vector<N>) {
+        let (qpos, qvel) = (self.sim.qpos(), self.sim.qvel());
+        (
+            Vector::from_fn(|i, _| qpos[self.qadr[i]]),
+            Vector::from_fn(|i, _| qvel[self.dofs[i]]),
+        )
+    }
+
+    fn contact(&self) -> Vector<N> {
+        self.tau_e
+    }
+
+    fn actuate(&self, tau: &Vector<N>) -> Vector<N> {
+        tau.zip_map(&self.tau_max, |t, m| t.max(-m).min(m))
+    }
+
+    fn wrench(&self) -> [f64; 6] {
+        self.wrench
+    }
+
+    fn end_effector(&self) -> [f64; 3] {
+        self.x_ee
+    }
+
+    fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
+        if h != self.ts {
+            return Err(invalid(
+                "jitter",
+                "the MuJoCo plant advances by Ts exactly (its timestep is fixed for a run)",
+            ));
+        }
+        let tau = self.actuate(tau);
+        let (act, gear) = (self.act, self.gear);
+        let ctrl = self.sim.ctrl_mut();
+        for i in 0..N {
+            ctrl[act[i]] = tau[i] / gear[i];
+        }
+        if let Err(e) = self.sim.forward_acceleration() {
+            return Err(self.fatal(e));
+        }
+        let qacc = self.sim.qacc();
+        let ddq = Vector::from_fn(|i, _| qacc[self.dofs[i]]);
+        let (before, _) = self.sim.warnings();
+        let t0 = self.sim.time();
+        for _ in 0..self.spec.substeps {
+            if !self.friction.is_none() {
+                let (_, dq) = self.state();
+                let f = self.friction.torque(&dq);
+                let dofs = self.dofs;
+                let applied = self.sim.qfrc_applied_mut();
+                for i in 0..N {
+                    applied[dofs[i]] = f[i];
+                }
+            }
+            if let Err(e) = self.sim.step() {
+                return Err(self.fatal(e));
+            }
+        }
+        if let Err(e) = self.sim.forward() {
+            return Err(self.fatal(e));
+        }
+        self.check(&before, t0)?;
+        self.sense()?;
+        self.rows += 1;
+        Ok(ddq)
+    }
+}
+
+/// A commanded trajectory tabulated at t_k = k·Ts (K rows of N values each
+/// for xc, ẋc, ẍc): the setpoint of row k.
+pub struct Table<'a, const N: usize> {
+    /// xc, ẋc, ẍc, row-major K × N.
+    pub rows: [&'a [f64]; 3],
+    /// Ts (s).
+    pub ts: f64,
+}
+
+impl<const N: usize> Trajectory<N> for Table<'_, N> {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        let k = libm::round(t / self.ts) as usize;
+        let row = |v: &[f64]| match v.get(k * N..(k + 1) * N) {
+            Some(r) => Vector::from_column_slice(r),
+            None => Vector::from_element(f64::NAN),
+        };
+        Setpoint {
+            x: row(self.rows[0]),
+            dx: row(self.rows[1]),
+            ddx: row(self.rows[2]),
+        }
+    }
+}
+
+/// A controller's own sinusoid on its own clock: at the loop's t = k·Ts, the
+/// trajectory at (k0 + k)·Ts, k0 the steps the controller had taken before
+/// the run (exactly its `time()`).
+pub struct Continued<const N: usize> {
+    /// The trajectory.
+    pub traj: Sinusoid<N>,
+    /// Steps taken before the run.
+    pub k0: u64,
+    /// Ts (s).
+    pub ts: f64,
+}
+
+impl<const N: usize> Trajectory<N> for Continued<N> {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        let k = libm::round(t / self.ts) as u64;
+        self.traj.sample((self.k0 + k) as f64 * self.ts)
+    }
+}

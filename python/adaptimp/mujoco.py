@@ -941,9 +941,12 @@ def simulate(
     Ts = period
     T = float(defaults["T"]) if T is None else float(T)
     settle = float(defaults["settle"]) if settle is None else float(settle)
-    steps = round(T / Ts)
-    if steps < 0 or not math.isfinite(T):
+    # Checked before it is used: round(inf) overflows, round(nan) raises.
+    if not (math.isfinite(T) and T >= 0):
         raise ValueError(f"T must be finite and ≥ 0, got {T}")
+    if T / Ts > 1e15:
+        raise ValueError("T / Ts: the run must have at most 1e15 steps")
+    steps = round(T / Ts)
     if substeps is None:
         substeps = max(1, round(Ts / plant.timestep))
     if substeps < 1:

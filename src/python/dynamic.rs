@@ -269,6 +269,9 @@ pub trait DynTracker: Send + Sync {
     fn step(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
     /// One step that always writes a torque to apply into `out`.
     fn step_or_fallback(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
+    /// A step call refused by the front (its arguments' shapes or types):
+    /// recorded as a refused step ([`Controller::refuse`](crate::Controller::refuse)).
+    fn refuse(&mut self, error: Error);
     /// A quantity of the last step.
     fn last(&self, what: Last) -> &[f64];
     /// ζ now.
@@ -561,6 +564,10 @@ impl<const N: usize> DynTracker for Typed<N> {
         result.map(|_| ())
     }
 
+    fn refuse(&mut self, error: Error) {
+        Tracker::refuse(self, error);
+    }
+
     fn last(&self, what: Last) -> &[f64] {
         let c: &Command<N> = self.state().last();
         match what {
@@ -603,7 +610,7 @@ impl<const N: usize> DynTracker for Typed<N> {
 
     fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error> {
         let w = Weights::<N>::from_rows(rows, self.nodes())?;
-        self.state_mut().load_weights(&w)
+        Tracker::load_weights(self, &w)
     }
 
     fn snapshot(&self) -> Vec<f64> {
@@ -615,7 +622,7 @@ impl<const N: usize> DynTracker for Typed<N> {
     }
 
     fn restore(&mut self, data: &[f64]) -> Result<(), Error> {
-        self.state_mut().load(data)
+        Tracker::restore(self, data)
     }
 
     fn learning_gain(&self) -> (f64, f64) {

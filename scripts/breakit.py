@@ -402,10 +402,12 @@ def faults(t: Tally, quick: bool) -> None:
                         check(bool(np.all(np.asarray(tau) == 0.0)), f"{kind}: zero fallback {tau}")
                     if tau is not None and fallback == "hold":
                         check(bool(np.array_equal(tau, applied)), f"{kind}: hold gave {tau}")
-                    if tau is not None:
-                        applied = np.asarray(tau)
-                    elif fallback == "zero":
-                        applied = np.zeros(2)
+                    if tau is None:  # raised: the torque to apply is ctrl.applied
+                        tau = ctrl.applied
+                        _torque_ok(ctrl, tau)
+                        if fallback == "zero":
+                            check(bool(np.all(tau == 0.0)), f"{kind}: zero fallback {tau}")
+                    applied = np.asarray(tau)
                     if policy == "latch":
                         tau2, err2 = ctrl.step_or_fallback(*_inputs(k))
                         check(err2 is not None and "latched" in err2, f"{kind}: latch did not hold")

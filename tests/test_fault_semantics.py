@@ -73,6 +73,8 @@ def test_a_step_refused_for_its_arguments_latches_too(
             getattr(ctrl, call)(**args)
         assert ctrl.fault is not None
         assert "wrong shape or type" in ctrl.fault[0]
+        # The torque to apply: the fallback (hold: the torque before).
+        np.testing.assert_array_equal(ctrl.applied, ctrl.tau_sat)
         with pytest.raises(FaultError):
             ctrl.step(*_inputs(5))
 
@@ -89,6 +91,9 @@ def test_the_rate_limit_starts_from_the_fallback_after_a_refusal_and_clear_fault
         for _ in range(200):
             tau, error = ctrl.step_or_fallback(zero, zero, zero, xc=far)
         np.testing.assert_array_equal(tau, [17.0, 15.0])
+        with pytest.raises(MeasurementError):
+            ctrl.step([np.nan, 0.0], zero, zero, xc=far)
+        np.testing.assert_array_equal(ctrl.applied, [0.0, 0.0])
         tau, error = ctrl.step_or_fallback([np.nan, 0.0], zero, zero, xc=far)
         assert error is not None
         np.testing.assert_array_equal(tau, [0.0, 0.0])

@@ -403,7 +403,8 @@ class Controller(_adaptimp.Controller):
     measurement and returns (torque, error message or None). ``replay`` runs K
     steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
     ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
-    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``dtau``, ``z1``,
+    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``applied`` (the
+    torque to apply now: after a refused step, the fallback), ``dtau``, ``z1``,
     ``xc``, ``xd``, ``dq_hat``, ``weights``, ``weight_bound``, ``fault``.
 
     **Faults.** Every refused step, whichever method refused it, records the

@@ -247,6 +247,8 @@ pub enum Last {
     Xd,
     /// The velocity used.
     V,
+    /// The torque last given to apply: the step's sat(τ), or a fallback.
+    Applied,
 }
 
 /// A controller with its trajectory and state, for any N ≤ [`MAX_JOINTS`].
@@ -578,6 +580,7 @@ impl<const N: usize> DynTracker for Typed<N> {
             Last::Xc => c.xc.as_slice(),
             Last::Xd => c.xd.as_slice(),
             Last::V => c.v.as_slice(),
+            Last::Applied => self.state().applied().as_slice(),
         }
     }
 

@@ -819,6 +819,14 @@ impl PyController {
         self.last(py, Last::TauSat)
     }
 
+    /// The torque to apply now (N m): the last accepted step's sat(τ), or,
+    /// after a refused call (also one that raised), the configured fallback;
+    /// the next step's rate limit is measured from it.
+    #[getter]
+    fn applied<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::Applied)
+    }
+
     /// The last step's Δτ = sat(τ) − τ (N m).
     #[getter]
     fn dtau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {

@@ -167,6 +167,19 @@ def _trained(case_: str, scenario: str, n: int = 2, steps: int = 200, **kw: Any)
     return ctrl
 
 
+def _refused(dst: Any, data: Any, unchanged: Callable[[], None]) -> None:
+    """``dst.restore(data)`` must raise and change nothing; if it accepts,
+    ``dst`` is put back (for the next case) and the case is wrong."""
+    before = dst.snapshot()
+    try:
+        dst.restore(data)
+    except BaseException:
+        unchanged()
+        raise
+    dst.restore(before)
+    raise Wrong("a corrupt or edited snapshot was accepted")
+
+
 def _tau_max(ctrl: Any) -> np.ndarray:
     return np.asarray(ctrl.params["tau_max"], dtype=float)
 
@@ -210,10 +223,7 @@ def restore(t: Tally, quick: bool) -> None:
             def flip(
                 bad: np.ndarray = bad, dst: Any = dst, unchanged: Callable[[], None] = unchanged
             ) -> None:
-                try:
-                    dst.restore(bad)
-                finally:
-                    unchanged()
+                _refused(dst, bad, unchanged)
 
             case(t, f"{case_}/{scenario}/n={n}: flip bit {bit} of value {i}", flip, "refuse")
         edits: list[tuple[str, Any]] = [
@@ -235,10 +245,7 @@ def restore(t: Tally, quick: bool) -> None:
             def edit(
                 data: Any = data, dst: Any = dst, unchanged: Callable[[], None] = unchanged
             ) -> None:
-                try:
-                    dst.restore(data)
-                finally:
-                    unchanged()
+                _refused(dst, data, unchanged)
 
             case(t, f"{case_}/n={n}: restore {what}", edit, "refuse")
 
@@ -403,7 +410,8 @@ def faults(t: Tally, quick: bool) -> None:
                     if tau is not None and fallback == "hold":
                         check(bool(np.array_equal(tau, applied)), f"{kind}: hold gave {tau}")
                     if tau is None:  # raised: the torque to apply is ctrl.applied
-                        tau = ctrl.applied
+                        tau = getattr(ctrl, "applied", None)
+                        check(tau is not None, f"{kind}: no torque to apply after a refusal")
                         _torque_ok(ctrl, tau)
                         if fallback == "zero":
                             check(bool(np.all(tau == 0.0)), f"{kind}: zero fallback {tau}")

@@ -733,8 +733,9 @@ impl PyController {
     }
 
     /// The whole state as a flat float64 array (header, n, L, step count,
-    /// reference, ζ, observer, last command, basis, weights); `restore` puts
-    /// it back exactly, so a run continues bit-identically.
+    /// reference, ζ, observer, last command, norms, basis, weights, the
+    /// torque applied, the last measured position, a checksum); `restore`
+    /// puts it back exactly, so a run continues bit-identically.
     fn snapshot<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         let data = self.lock(py).snapshot();
         data.into_pyarray(py)

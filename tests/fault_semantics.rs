@@ -497,3 +497,45 @@ fn load_weights_refuses_weights_a_step_could_never_use() {
         .unwrap();
     assert_eq!(st.weight_norms(), st.weights().norms());
 }
+
+#[test]
+fn the_tracked_norms_stay_far_within_restores_tolerance() {
+    // Restore refuses stored norms more than 1e-6 (relative) from the
+    // weights' norms; the norms a step tracks by its recurrence drift by
+    // rounding only. Measured here (`-- --nocapture` prints it).
+    for (name, c, steps) in [
+        (
+            "paper sf",
+            build(Config::paper(Law::StateFeedback)),
+            400_000,
+        ),
+        (
+            "robot sf",
+            build(Config::robot(Law::StateFeedback)),
+            2_000_000,
+        ),
+    ] {
+        let mut st = c.new_state();
+        let traj = Sinusoid::paper();
+        for k in 0..steps {
+            let t = k as f64 * 1e-3;
+            let m = Measurement {
+                x: Vector::<2>::new(0.2 + 0.1 * (2.0 * t).sin(), 0.2 + 0.1 * (3.0 * t).cos()),
+                dx: Some(Vector::<2>::new(
+                    0.2 * (2.0 * t).cos(),
+                    -0.3 * (3.0 * t).sin(),
+                )),
+                tau_e: Vector::<2>::new((5.0 * t.sin()).max(0.0), 0.0),
+            };
+            let sp = traj.sample(c.time(&st));
+            c.step(&mut st, &m, &sp).unwrap();
+        }
+        let (tracked, exact) = (st.weight_norms(), st.weights().norms());
+        let drift = Vector::<3>::from_fn(|i, _| (tracked[i] - exact[i]).abs() / exact[i]);
+        println!(
+            "{name}, {steps} steps: relative drift of the tracked norms D, C, G: {:.1e}, {:.1e}, {:.1e}",
+            drift[0], drift[1], drift[2]
+        );
+        assert!(drift.iter().all(|d| *d < 1e-12), "{name}: {drift:?}");
+    }
+}

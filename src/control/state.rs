@@ -49,9 +49,9 @@ const SNAPSHOT_HEADER: [f64; 2] = [4_151_076.0, 3.0];
 const SNAPSHOT_PREFIX: usize = 5;
 /// How far a stored weight norm may be from the one recomputed from the
 /// stored weights (relative): the step tracks the norms by a recurrence whose
-/// rounding was measured at 4.5e-14 after 400 000 steps (the paper's state
-/// feedback) and 2e-16 after 2 M (the robot scenario); a larger gap is a
-/// corrupt or edited snapshot.
+/// rounding was measured at 6.8e-14 after 400 000 steps (the paper's state
+/// feedback) and 0 after 2 M (the robot scenario; `tests/fault_semantics.rs`);
+/// a larger gap is a corrupt or edited snapshot.
 const NORM_TOLERANCE: f64 = 1e-6;
 
 /// A 53-bit FNV-1a hash of the bit patterns of `data`, exact as an f64: the

@@ -62,8 +62,10 @@ fn peak_rss_kb() -> Option<u64> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let hours: f64 = std::env::args()
-        .nth(1)
+    // Under `cargo test` the arguments are the test harness's: not ours.
+    let hours: f64 = (!cfg!(test))
+        .then(|| std::env::args().nth(1))
+        .flatten()
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(if cfg!(test) { 0.0005 } else { 24.0 });

@@ -39,6 +39,8 @@ RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 
 step "Rust: tests (the core, and the C ABI with its header check)"
 cargo test --workspace
+# The examples under the harness's own arguments (-q, a filter): they must not read them.
+cargo test -q --examples runs
 
 step "Fuzzing: a short run of each cargo-fuzz target (nightly)"
 if ! cargo +nightly --version >/dev/null 2>&1; then

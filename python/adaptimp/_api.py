@@ -415,8 +415,16 @@ class Controller(_adaptimp.Controller):
     measurement and returns (torque, error message or None). ``replay`` runs K
     steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
     ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
-    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``dtau``, ``z1``,
+    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``applied`` (the
+    torque to apply now: after a refused step, the fallback), ``dtau``, ``z1``,
     ``xc``, ``xd``, ``dq_hat``, ``weights``, ``weight_bound``, ``fault``.
+
+    **Faults.** Every refused step, whichever method refused it, records the
+    fault (``fault``; with ``fault_policy="latch"`` later steps raise
+    ``FaultError`` until ``clear_fault()``) and takes the fallback as the
+    torque applied, from which the next step's ``tau_rate_max`` is measured.
+    ``restore``, ``load_state_dict`` and ``load_weights`` refuse a state this
+    controller could never step. The table is in docs/reliability.md.
 
     **Threads.** Each call is atomic: a controller is guarded by a lock, and a
     thread that finds it in use waits (with the GIL released) until the other
@@ -546,7 +554,11 @@ class Controller(_adaptimp.Controller):
         controller continues exactly where the saved one stopped. With
         ``weights_only=True`` only the weights are loaded, into the current
         state (call :meth:`reset` first to start a new run from t = 0 with
-        them: a warm start). Checked before anything changes.
+        them: a warm start). Checked before anything changes: a state this
+        controller could never step is refused (see :meth:`restore`), and so
+        are keys that disagree with the ``snapshot`` they travel with (edited
+        ``W_D``, ``steps``, …: load edited weights with ``weights_only=True``),
+        and a snapshot of another case.
         """
         if not isinstance(state, Mapping):
             raise TypeError(f"state must be a dict, got {type(state).__name__}")
@@ -558,8 +570,25 @@ class Controller(_adaptimp.Controller):
                 raise ConfigError(f"state has {key} = {int(state[key])}, this controller {mine}")
         if weights_only or "snapshot" not in state:
             self.load_weights(_weights_dict(state))
-        else:
-            self.restore(np.ascontiguousarray(state["snapshot"], dtype=np.float64))
+            return
+        if "case" in state and str(state["case"]) != self.case:
+            raise ConfigError(
+                f"state is of case {str(state['case'])!r}, this controller {self.case!r} "
+                "(load its weights with weights_only=True)"
+            )
+        snapshot = np.ascontiguousarray(state["snapshot"], dtype=np.float64)
+        # What the snapshot holds, read by the core on a scratch copy: every
+        # other key given must agree with it.
+        scratch = self.__copy__()
+        scratch.restore(snapshot)
+        restored = scratch.state_dict()
+        for key in ("W_D", "W_C", "W_G", "zeta", "steps", "t"):
+            if key in state and not np.array_equal(np.asarray(state[key]), restored[key]):
+                raise ConfigError(
+                    f"state[{key!r}] disagrees with state['snapshot']: drop the snapshot "
+                    "to load edited weights (load_state_dict(state, weights_only=True))"
+                )
+        self.restore(snapshot)
 
     # -- conveniences -------------------------------------------------------
 

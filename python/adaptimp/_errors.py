@@ -21,8 +21,9 @@ class ConfigError(AdaptimpError, ValueError):
 class MeasurementError(AdaptimpError, ValueError):
     """A step's input that is not a measurement: non-finite, of the wrong shape,
     beyond a plausibility limit, or missing (``dq`` for "pd"/"sf"). Named as you
-    named it (``q``, ``dq``, ``tau_e``, ``xc``). The controller's state is
-    unchanged. A ``ValueError``."""
+    named it (``q``, ``dq``, ``tau_e``, ``xc``). What the control law uses is
+    unchanged; the refusal is recorded (the fault, the fallback as the torque
+    applied: the fault semantics of docs/reliability.md). A ``ValueError``."""
 
 
 class DivergedError(AdaptimpError, ValueError, ArithmeticError):

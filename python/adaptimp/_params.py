@@ -184,7 +184,7 @@ def _real(p: Param, value: object) -> float:
     return x
 
 
-def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
+def _vector(p: Param, value: object, size: int, per: str, inf_ok: bool = False) -> list[float]:
     if isinstance(value, (str, bytes, bool)):
         raise TypeError(
             f"{p.name} must be a number or a sequence of {size} numbers ({per}){_unit(p)}, "
@@ -218,9 +218,11 @@ def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
         out = np.broadcast_to(arr.astype(np.float64), (size,))
     except OverflowError:
         raise ConfigError(f"{p.name} holds a number too large for a float") from None
-    bad = np.flatnonzero(~np.isfinite(out))
+    # A limit may be +inf (none on that joint), as in C.
+    bad = np.flatnonzero(np.isnan(out) if inf_ok else ~np.isfinite(out))
     if bad.size:
-        raise ConfigError(f"{p.name}[{bad[0]}] must be finite, got {out[bad[0]]}")
+        need = "a number (inf: no limit)" if inf_ok else "finite"
+        raise ConfigError(f"{p.name}[{bad[0]}] must be {need}, got {out[bad[0]]}")
     return [float(x) for x in out]
 
 
@@ -258,7 +260,11 @@ def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
     if p.kind in ("optional", "derived"):
         return None if value is None else _real(p, value)
     if p.kind == "limit":
-        return None if value is None else _vector(p, value, n, "one value per joint")
+        if value is None:
+            return None
+        v = _vector(p, value, n, "one value per joint", inf_ok=True)
+        # Infinity is "no limit": on every joint, that is None.
+        return None if all(x == math.inf for x in v) else v
     if p.kind == "axes":
         return _vector(p, value, 3, "one value per axis x, y, z")
     if p.kind == "derived_axes":

@@ -1132,8 +1132,11 @@ def _setup(
     Ts = period
     T = float(defaults["T"]) if T is None else float(T)
     settle = float(defaults["settle"]) if settle is None else float(settle)
+    # Checked before it is used: round(inf) overflows, round(nan) raises.
     if not (math.isfinite(T) and T > 0):
         raise ValueError(f"T must be finite and > 0, got {T}")
+    if T / Ts > 1e15:
+        raise ValueError("T / Ts: the run must have at most 1e15 steps")
     steps = round(T / Ts)
     if steps < 1:
         raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
@@ -1298,7 +1301,6 @@ def _run_many(
     controller and MuJoCo data; a run the core cannot take alone (a Python
     loop, a reference callable) runs here. Results are those of
     :func:`simulate`, bit for bit."""
-    errors = (TypeError, ValueError, ArithmeticError, RuntimeError)
     out: list[dict[str, Any] | str | None] = [None] * len(jobs)
     native: list[tuple[int, _Run]] = []
     for i, (case, scenario, model, kw) in enumerate(jobs):
@@ -1316,7 +1318,7 @@ def _run_many(
                 native.append((i, run))
             else:
                 out[i] = dict(_python_loop(run, None, None)[1])
-        except errors as e:
+        except Exception as e:  # a run's failure, whatever it is (a model's ParseError)
             out[i] = f"{type(e).__name__}: {e}"
     if native:
         results = _adaptimp.simulate_mujoco_many(

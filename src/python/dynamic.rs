@@ -341,6 +341,8 @@ pub enum Last {
     Xd,
     /// The velocity used.
     V,
+    /// The torque last given to apply: the step's sat(τ), or a fallback.
+    Applied,
 }
 
 /// A controller with its trajectory and state, for any N ≤ [`MAX_JOINTS`].
@@ -363,6 +365,9 @@ pub trait DynTracker: Send + Sync {
     fn step(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
     /// One step that always writes a torque to apply into `out`.
     fn step_or_fallback(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
+    /// A step call refused by the front (its arguments' shapes or types):
+    /// recorded as a refused step ([`Controller::refuse`](crate::Controller::refuse)).
+    fn refuse(&mut self, error: Error);
     /// A quantity of the last step.
     fn last(&self, what: Last) -> &[f64];
     /// ζ now.
@@ -811,6 +816,10 @@ impl<const N: usize> DynTracker for Typed<N> {
         result.map(|_| ())
     }
 
+    fn refuse(&mut self, error: Error) {
+        Tracker::refuse(self, error);
+    }
+
     fn last(&self, what: Last) -> &[f64] {
         let c: &Command<N> = self.state().last();
         match what {
@@ -821,6 +830,7 @@ impl<const N: usize> DynTracker for Typed<N> {
             Last::Xc => c.xc.as_slice(),
             Last::Xd => c.xd.as_slice(),
             Last::V => c.v.as_slice(),
+            Last::Applied => self.state().applied().as_slice(),
         }
     }
 
@@ -853,7 +863,7 @@ impl<const N: usize> DynTracker for Typed<N> {
 
     fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error> {
         let w = Weights::<N>::from_rows(rows, self.nodes())?;
-        self.state_mut().load_weights(&w)
+        Tracker::load_weights(self, &w)
     }
 
     fn snapshot(&self) -> Vec<f64> {
@@ -865,7 +875,7 @@ impl<const N: usize> DynTracker for Typed<N> {
     }
 
     fn restore(&mut self, data: &[f64]) -> Result<(), Error> {
-        self.state_mut().load(data)
+        Tracker::restore(self, data)
     }
 
     fn learning_gain(&self) -> (f64, f64) {

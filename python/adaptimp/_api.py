@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
-from ._errors import ConfigError, StabilityWarning
+from ._errors import ConfigError, StabilityWarning, period_alias
 from ._params import (
     BY_NAME,
     N_JOINTS,
@@ -112,7 +112,7 @@ def _check_stability(core: _adaptimp.Controller, p: Mapping[str, Any], stackleve
         )
 
 
-class _Progress:
+class ProgressReport:
     """Progress of a long call: silent for its first ``delay`` seconds, then a tqdm
     bar if tqdm is installed, else a line on stderr rewritten in place."""
 
@@ -157,7 +157,7 @@ def _progress(progress: Progress, desc: str) -> tuple[Callable[[int, int], objec
     if progress is None or progress is False:
         return None, None
     if progress is True:
-        p = _Progress(desc)
+        p = ProgressReport(desc)
         return p, p
     if callable(progress):
         return progress, None
@@ -608,9 +608,9 @@ class Controller(_adaptimp.Controller):
         return dict(self._params)
 
     @property
-    def Ts(self) -> float:
-        """Sampling period Ts (s)."""
-        return self.ts
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     def __repr__(self) -> str:
         basis = "vertex grid" if self._centers is None else "user centres"

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ._params import CASE_NAMES
+from ._plot import FIGURES, PLOT_KINDS, into
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -46,9 +47,6 @@ UNITS = {
     "z1": "rad",
 }
 """Units of the per-joint arrays (``w_norms``: kg m², kg m²/s, N m per network)."""
-
-PLOT_KINDS = ("tracking", "errors", "torques")
-"""Kinds of :meth:`SimResult.plot` (the kinds of the paper's Figs. 2–10)."""
 
 METRIC_KEYS = (
     "rms_z1",
@@ -160,13 +158,11 @@ class SimResult:
             of a new figure, so that several runs overlay; the returned figure is
             theirs. Lines are labelled with the case.
         """
-        from . import _plot
-
         if kind not in PLOT_KINDS:
             raise ValueError(f"kind must be one of {PLOT_KINDS}, got {kind!r}")
         if ax is not None:
-            return _plot.into(self, kind, ax)
-        return _plot.FIGURES[kind](self)
+            return into(self, kind, ax)
+        return FIGURES[kind](self)
 
     def to_pandas(self) -> pd.DataFrame:
         """The run as a tidy pandas ``DataFrame``: one row per recorded step, indexed

@@ -340,7 +340,7 @@ def sweep(
     >>> df[["Kp", "rms_z1"]].shape
     (2, 2)
     """
-    from ._api import _Progress
+    from ._api import ProgressReport
 
     check_scenario(scenario)
     check_case(case)
@@ -357,7 +357,7 @@ def sweep(
     bar: Any = None
     report: Callable[[int, int], object] | None = None
     if progress is True:
-        bar = _Progress("sweep")
+        bar = ProgressReport("sweep")
         report = bar
     elif callable(progress):
         report = progress

@@ -41,6 +41,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     ) from e
 
 from . import _models
+from ._errors import period_alias
 from ._trajectory import Reference, paper_circle
 
 __all__ = ["ComputedTorque", "pinocchio_model"]
@@ -235,11 +236,14 @@ class ComputedTorque:
         self.tau, self.tau_sat, self.xc, self.xd, self.z1 = nan, nan, nan, nan, nan
 
     @property
-    def ts(self) -> float:
+    def Ts(self) -> float:
         """Period Ts (s)."""
         return self._ts
 
-    Ts = ts
+    @property
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     @property
     def t(self) -> float:

@@ -14,7 +14,7 @@ MuJoCo as the plant:
   (C5): an ``adaptimp.Controller(..., impedance="external")`` or
   :class:`adaptimp.baselines.ComputedTorque` ``(impedance="external")``. It
   follows the controller protocol of :func:`adaptimp.mujoco.simulate`
-  (``.step(q, tau_e, dq, **kw)``, ``.ts``), takes the measured wrench through
+  (``.step(q, tau_e, dq, **kw)``, ``.Ts``), takes the measured wrench through
   its ``wants_wrench`` hook and records what :func:`cartesian_metrics` needs.
 - The scenario "panda-table" (:func:`panda_table`): the Panda's tool follows a
   circle on a table while pressing on it through the target impedance;
@@ -39,6 +39,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from ._errors import period_alias
 
 __all__ = [
     "CartesianImpedance",
@@ -151,7 +153,7 @@ class OuterLoop:
     ----------
     fk, jacobian : callable
         fk(q) -> (3,) (m); jacobian(q) -> (3, n) (m/rad).
-    ts : float
+    Ts : float
         Period Ts (s).
     q0 : (n,)
         Initial joint setpoint q_d(0) (rad).
@@ -167,20 +169,20 @@ class OuterLoop:
         self,
         fk: Fk,
         jacobian: Jacobian,
-        ts: float,
+        Ts: float,
         q0: ArrayLike,
         *,
         posture: ArrayLike | None = None,
         config: OuterLoopConfig | None = None,
         jdot_qdot: Callable[[FloatArray, FloatArray], FloatArray] | None = None,
     ) -> None:
-        if not (ts > 0 and math.isfinite(ts)):
-            raise ValueError(f"ts must be > 0, got {ts}")
-        self.fk, self.jacobian, self.ts = fk, jacobian, float(ts)
+        if not (Ts > 0 and math.isfinite(Ts)):
+            raise ValueError(f"Ts must be > 0, got {Ts}")
+        self.fk, self.jacobian, self.Ts = fk, jacobian, float(Ts)
         self.config = config or OuterLoopConfig()
         c = self.config
-        if ts * c.KD >= 1 or ts**2 * c.KP >= 1:
-            raise ValueError(f"need Ts·K_D < 1 and Ts²·K_P < 1 (SPEC §16), Ts = {ts:g} s")
+        if Ts * c.KD >= 1 or Ts**2 * c.KP >= 1:
+            raise ValueError(f"need Ts·K_D < 1 and Ts²·K_P < 1 (SPEC §16), Ts = {Ts:g} s")
         if not c.force_filter >= 0:
             raise ValueError(f"force_filter must be ≥ 0 s, got {c.force_filter}")
         if c.lam <= 0 or c.KP <= 0 or c.KD <= 0 or c.k0 < 0 or c.d0 < 0:
@@ -193,6 +195,11 @@ class OuterLoop:
         self.posture = _vec("posture", self.q0 if posture is None else posture, self.n)
         self._jdot = jdot_qdot
         self.reset()
+
+    @property
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     def reset(self) -> None:
         """Back to t = 0 (the Cartesian state is set by the next step's p_c)."""
@@ -232,7 +239,7 @@ class OuterLoop:
             if self.f_filt is None:
                 self.f_filt = f.copy()
             else:
-                self.f_filt = self.f_filt + self.ts / (c.force_filter + self.ts) * (f - self.f_filt)
+                self.f_filt = self.f_filt + self.Ts / (c.force_filter + self.Ts) * (f - self.f_filt)
             f = self.f_filt
         q, dq = self.q_d, self.dq_d
         if self.p_d is None:  # p_d(0) = p_c(0), ṗ_d(0) = ṗ_c(0), q̇_d(0) = J⁺(q0) ṗ_c(0)
@@ -253,10 +260,10 @@ class OuterLoop:
         self.ddp_d = ddp_d
         self._pd_k, self._dpd_k = p_d.copy(), dp_d.copy()
         # (C4): semi-implicit Euler, the velocity first.
-        self.dp_d = dp_d + self.ts * ddp_d
-        self.p_d = p_d + self.ts * self.dp_d
-        self.dq_d = dq + self.ts * ddq
-        self.q_d = q + self.ts * self.dq_d
+        self.dp_d = dp_d + self.Ts * ddp_d
+        self.p_d = p_d + self.Ts * self.dp_d
+        self.dq_d = dq + self.Ts * ddq
+        self.q_d = q + self.Ts * self.dq_d
         return out
 
     @property
@@ -280,7 +287,7 @@ class CartesianImpedance:
 
     The protocol of :func:`adaptimp.mujoco.simulate`: ``step(q, tau_e, dq, *,
     wrench=, xc=, dxc=, ddxc=)`` returns the joint controller's output (its
-    sat(τ), N m), ``.ts`` is the period. ``wants_wrench = True`` makes
+    sat(τ), N m), ``.Ts`` is the period. ``wants_wrench = True`` makes
     :func:`~adaptimp.mujoco.simulate` pass the measured wrench [f; m] (N, N m);
     the outer loop uses its force f = F_e. The joint controller gets the
     setpoint ``xc=q_d, dxc=q̇_d, ddxc=q̈_d`` and τe = Jᵀ F_e: the plant's τe
@@ -322,9 +329,9 @@ class CartesianImpedance:
         *,
         force_feedforward: bool = True,
     ) -> None:
-        ts = getattr(inner, "ts", None) or getattr(inner, "Ts", None)
-        if ts is None or not math.isclose(float(ts), outer.ts, rel_tol=1e-12):
-            raise ValueError(f"inner period {ts} differs from the outer loop's {outer.ts} s")
+        Ts = getattr(inner, "Ts", None)
+        if Ts is None or not math.isclose(float(Ts), outer.Ts, rel_tol=1e-12):
+            raise ValueError(f"inner period {Ts} differs from the outer loop's {outer.Ts} s")
         mode = getattr(inner, "impedance", None)
         if mode is None:
             params = getattr(inner, "params", {})
@@ -335,7 +342,7 @@ class CartesianImpedance:
             )
         self.inner, self.outer, self.path = inner, outer, path
         self.force_feedforward = force_feedforward
-        self.ts = outer.ts
+        self.Ts = outer.Ts
         self._k = 0
         self.log: dict[str, list[FloatArray]] = {
             k: [] for k in ("pc", "dpc", "ddpc", "pd", "dpd", "ddpd", "qd", "force")
@@ -346,9 +353,9 @@ class CartesianImpedance:
         self.q_d = outer.q0.copy()
 
     @property
-    def Ts(self) -> float:
-        """Period Ts (s)."""
-        return self.ts
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     @property
     def params(self) -> dict[str, Any]:
@@ -384,7 +391,7 @@ class CartesianImpedance:
         if xc is None:
             if self.path is None:
                 raise ValueError("no Cartesian setpoint given and no path to follow")
-            pc, dpc, ddpc = self.path(self._k * self.ts)
+            pc, dpc, ddpc = self.path(self._k * self.Ts)
         else:
             pc = np.asarray(xc, dtype=np.float64)
             dpc = np.zeros(3) if dxc is None else np.asarray(dxc, dtype=np.float64)
@@ -471,7 +478,7 @@ class PandaTable:
         The TCP's kinematics from Pinocchio (:func:`pinocchio_kinematics`).
     pin_model : pinocchio.Model
         The exact model (for D(q0) and :class:`~adaptimp.baselines.ComputedTorque`).
-    ts : float
+    Ts : float
         Controller period (s), 1 ms.
     radius, freq : float
         The circle's radius (m) and frequency (Hz).
@@ -495,7 +502,7 @@ class PandaTable:
     fk: Fk
     jacobian: Jacobian
     pin_model: Any
-    ts: float
+    Ts: float
     radius: float
     freq: float
     centre: FloatArray
@@ -508,6 +515,11 @@ class PandaTable:
 
     def __post_init__(self) -> None:
         self.p0 = self.fk(self.q0)
+
+    @property
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     @property
     def n(self) -> int:
@@ -543,7 +555,7 @@ class PandaTable:
 
     def outer(self, config: OuterLoopConfig | None = None) -> OuterLoop:
         """A fresh :class:`OuterLoop` for this scenario (posture = q0)."""
-        return OuterLoop(self.fk, self.jacobian, self.ts, self.q0, config=config)
+        return OuterLoop(self.fk, self.jacobian, self.Ts, self.q0, config=config)
 
     def target_force(self, config: OuterLoopConfig | None = None) -> float:
         """The normal force (N) the target impedance prescribes against a rigid
@@ -561,7 +573,7 @@ def panda_table(
     friction: float = 0.1,
     table_height: float = 0.45,
     tool_radius: float = 0.01,
-    ts: float = 1e-3,
+    Ts: float = 1e-3,
     t_approach: float = 1.0,
     t_ramp: float = 1.0,
 ) -> PandaTable:
@@ -589,7 +601,7 @@ def panda_table(
         fk=fk,
         jacobian=jac,
         pin_model=pin_model,
-        ts=ts,
+        Ts=Ts,
         radius=radius,
         freq=freq,
         centre=np.array(centre, dtype=np.float64),
@@ -617,12 +629,12 @@ def orbit_basis(
     """
     outer = sc.outer()
     t_end = sc.t_approach + sc.t_ramp + 1.0 / sc.freq
-    steps = round(t_end / sc.ts)
+    steps = round(t_end / sc.Ts)
     every = max(1, steps // nodes)
     qs: list[FloatArray] = []
     dqs: list[FloatArray] = []
     for k in range(steps):
-        p, dp, ddp = sc.path(k * sc.ts, depth=0.0)
+        p, dp, ddp = sc.path(k * sc.Ts, depth=0.0)
         q, dq, _ = outer.step(p, dp, ddp, np.zeros(3))
         if k % every == 0 and len(qs) < nodes:
             qs.append(q)
@@ -648,7 +660,7 @@ def joint_gains(sc: PandaTable, k1: float = 20.0, scale: float = 0.25) -> dict[s
     data = sc.pin_model.createData()
     m = pin.crba(sc.pin_model, data, sc.q0)
     m = np.triu(m) + np.triu(m, 1).T
-    kp = scale / (sc.ts * np.diag(np.linalg.inv(m)))
+    kp = scale / (sc.Ts * np.diag(np.linalg.inv(m)))
     return {
         "Kp": kp.tolist(),
         "Kzeta": ((1 + kp**2) / 2 + 10).tolist(),
@@ -686,7 +698,7 @@ def panda_controller(
 
         inner: Any = ComputedTorque(
             sc.pin_model,
-            Ts=sc.ts,
+            Ts=sc.Ts,
             Kp=ct_gains[0],
             Kd=ct_gains[1],
             tau_max=sc.tau_max,
@@ -705,7 +717,7 @@ def panda_controller(
             centers=centres,
             widths=widths,
             impedance="external",
-            Ts=sc.ts,
+            Ts=sc.Ts,
             tau_max=sc.tau_max.tolist(),
             gamma=[float(gamma)] * 3 if isinstance(gamma, (int, float)) else list(gamma),
             **g,

@@ -67,3 +67,13 @@ def period_alias(owner: object) -> float:
         stacklevel=3,
     )
     return float(owner.Ts)  # type: ignore[attr-defined]
+
+
+def needs_extra(what: str, package: str, extra: str) -> ImportError:
+    """The ImportError of an optional dependency: what needs it, and the pip
+    commands that install it, as they install (quoted, for zsh too)."""
+    return ImportError(
+        f"{what} needs {package}, an optional dependency (adaptimp's extra {extra!r}): "
+        f'pip install "{package}"; or adaptimp with the extra: pip install ".[{extra}]" '
+        f'from a checkout, pip install "adaptimp-<version>-<tags>.whl[{extra}]" from a wheel'
+    )

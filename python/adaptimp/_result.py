@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ._errors import needs_extra
 from ._params import CASE_NAMES
 from ._plot import FIGURES, PLOT_KINDS, into
 
@@ -168,8 +169,12 @@ class SimResult:
         """The run as a tidy pandas ``DataFrame``: one row per recorded step, indexed
         by ``t [s]``, one column per joint quantity named with its unit
         (``"q1 [rad]"``, ``"tau_sat2 [N m]"``, ``"w_norm_G"``); ``attrs`` holds
-        the case, scenario, metrics, parameters and the units by column."""
-        import pandas as pd
+        the case, scenario, metrics, parameters and the units by column; needs
+        pandas (the extra ``pandas``)."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise needs_extra("SimResult.to_pandas()", "pandas>=1.5", "pandas") from None
 
         columns: dict[str, Any] = {}
         units: dict[str, str] = {}
@@ -199,11 +204,11 @@ class SimResult:
     def to_xarray(self) -> xr.Dataset:
         """The run as an xarray ``Dataset`` with dimensions ``t`` (s) and ``joint``
         (1 … n), one variable per quantity with its ``units`` attribute; needs
-        xarray (``pip install xarray``)."""
+        xarray (the extra ``xarray``)."""
         try:
             import xarray as xr
         except ImportError:
-            raise ImportError("to_xarray() needs xarray: pip install xarray") from None
+            raise needs_extra("SimResult.to_xarray()", "xarray>=2022.6", "xarray") from None
         joints = np.arange(1, self.n + 1)
         data: dict[str, Any] = {}
         for name in (*ARRAYS[1:-1], *EXTRA_ARRAYS[:-1]):

@@ -20,6 +20,7 @@ import numpy as np
 
 from . import _adaptimp
 from ._adaptimp import __version__
+from ._errors import needs_extra
 from ._params import BY_NAME, check_case, check_scenario, config_hint, resolve
 
 if TYPE_CHECKING:
@@ -342,6 +343,10 @@ def sweep(
     """
     from ._api import ProgressReport
 
+    try:  # before any run: the result is a DataFrame
+        import pandas  # noqa: F401
+    except ImportError:
+        raise needs_extra("adaptimp.sweep()", "pandas>=1.5", "sweep") from None
     check_scenario(scenario)
     check_case(case)
     if plant not in ("rigid", "mujoco"):

@@ -1,6 +1,6 @@
 """Model-based baselines to compare the paper's model-free controllers against.
 
-Needs the optional dependency Pinocchio (``pip install adaptimp[pinocchio]``);
+Needs the optional dependency Pinocchio (the extra ``pinocchio``: ``pip install ".[pinocchio]"``);
 the rest of adaptimp never imports it.
 
 :class:`ComputedTorque` is the textbook computed-torque (inverse-dynamics)
@@ -32,16 +32,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._errors import needs_extra, period_alias
+
 try:
     import pinocchio as pin
 except ImportError as e:  # pragma: no cover - depends on the environment
-    raise ImportError(
-        "adaptimp.baselines needs Pinocchio, an optional dependency: "
-        "pip install adaptimp[pinocchio]"
-    ) from e
+    raise needs_extra("adaptimp.baselines", "pin>=3", "pinocchio") from e
 
 from . import _models
-from ._errors import period_alias
 from ._trajectory import Reference, paper_circle
 
 __all__ = ["ComputedTorque", "pinocchio_model"]

@@ -1,6 +1,6 @@
 """MuJoCo as the plant: real arms, contact from a physics engine (SPEC §13).
 
-Needs the optional dependency MuJoCo (``pip install adaptimp[mujoco]``); the
+Needs the optional dependency MuJoCo (the extra ``mujoco``: ``pip install ".[mujoco]"``); the
 rest of adaptimp never imports it.
 
 - :class:`Plant` wraps a MuJoCo model of a serial arm with n ≤ 7 hinge joints,
@@ -45,12 +45,12 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._errors import needs_extra
+
 try:
     import mujoco
 except ImportError as e:  # pragma: no cover - depends on the environment
-    raise ImportError(
-        "adaptimp.mujoco needs MuJoCo, an optional dependency: pip install adaptimp[mujoco]"
-    ) from e
+    raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _models
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS

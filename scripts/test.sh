@@ -75,10 +75,12 @@ done
 step "Python: the wheel and the sdist (scripts/wheel.sh: maturin, zig for manylinux_2_17)"
 bash scripts/wheel.sh
 wheel=$(ls dist/adaptimp-*-cp39-abi3-*.whl)
-# The sdist holds what a build needs: its crate resolves and compiles (check) offline.
-rm -rf target/sdist-check && mkdir -p target/sdist-check
-tar xzf dist/adaptimp-*.tar.gz -C target/sdist-check
-(cd target/sdist-check/adaptimp-* && cargo check --quiet --offline --features python)
+# The sdist holds what a build needs: its crate, unpacked outside this workspace,
+# resolves and compiles (check) offline.
+sdist_dir=$(mktemp -d)
+tar xzf dist/adaptimp-*.tar.gz -C "$sdist_dir"
+(cd "$sdist_dir"/adaptimp-* && cargo check --quiet --offline --features python)
+rm -rf "$sdist_dir"
 
 step "Python: the test environment (the wheel with its test extra)"
 venv="${ADAPTIMP_VENV:-$PWD/target/py-venv}"

@@ -403,7 +403,7 @@ class Controller(_adaptimp.Controller):
     measurement and returns (torque, error message or None). ``replay`` runs K
     steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
     ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
-    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``dtau``, ``z1``,
+    ``Ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``dtau``, ``z1``,
     ``xc``, ``xd``, ``dq_hat``, ``weights``, ``weight_bound``, ``fault``.
 
     **Threads.** Each call is atomic: a controller is guarded by a lock, and a

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
-from ._errors import ConfigError, StabilityWarning
+from ._errors import ConfigError, StabilityWarning, period_alias
 from ._faults import Fault
 from ._params import (
     BY_NAME,
@@ -113,7 +113,7 @@ def _check_stability(core: _adaptimp.Controller, p: Mapping[str, Any], stackleve
         )
 
 
-class _Progress:
+class ProgressReport:
     """Progress of a long call: silent for its first ``delay`` seconds, then a tqdm
     bar if tqdm is installed, else a line on stderr rewritten in place."""
 
@@ -158,7 +158,7 @@ def _progress(progress: Progress, desc: str) -> tuple[Callable[[int, int], objec
     if progress is None or progress is False:
         return None, None
     if progress is True:
-        p = _Progress(desc)
+        p = ProgressReport(desc)
         return p, p
     if callable(progress):
         return progress, None
@@ -415,7 +415,7 @@ class Controller(_adaptimp.Controller):
     measurement and returns (torque, error message or None). ``replay`` runs K
     steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
     ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
-    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``applied`` (the
+    ``Ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``applied`` (the
     torque to apply now: after a refused step, the fallback), ``dtau``, ``z1``,
     ``xc``, ``xd``, ``dq_hat``, ``weights``, ``weight_bound``, ``fault``.
 
@@ -659,9 +659,9 @@ class Controller(_adaptimp.Controller):
         return dict(self._params)
 
     @property
-    def Ts(self) -> float:
-        """Sampling period Ts (s)."""
-        return self.ts
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     def __repr__(self) -> str:
         basis = "vertex grid" if self._centers is None else "user centres"

@@ -17,6 +17,8 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from ._errors import needs_extra
+
 MODELS_DIR = Path(__file__).resolve().parent / "models"
 """The packaged model files."""
 
@@ -53,7 +55,7 @@ def panda_urdf_path() -> Path:
     Raises
     ------
     ImportError
-        ``example-robot-data`` is not installed (``pip install adaptimp[pinocchio]``).
+        ``example-robot-data`` is not installed (the extra ``pinocchio``).
     """
     override = os.environ.get("ADAPTIMP_PANDA_URDF")
     if override:
@@ -61,10 +63,7 @@ def panda_urdf_path() -> Path:
     try:
         dist = importlib.metadata.distribution(_ERD)
     except importlib.metadata.PackageNotFoundError as e:
-        raise ImportError(
-            "the Panda model comes from the package example-robot-data: "
-            "pip install adaptimp[pinocchio]"
-        ) from e
+        raise needs_extra("the Panda model", "example-robot-data>=4", "pinocchio") from e
     path = Path(str(dist.locate_file(_PANDA_URDF)))
     if not path.is_file():
         raise ImportError(f"example-robot-data {dist.version} has no Panda URDF at {path}")

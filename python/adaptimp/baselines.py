@@ -1,6 +1,6 @@
 """Model-based baselines to compare the paper's model-free controllers against.
 
-Needs the optional dependency Pinocchio (``pip install adaptimp[pinocchio]``);
+Needs the optional dependency Pinocchio (the extra ``pinocchio``: ``pip install ".[pinocchio]"``);
 the rest of adaptimp never imports it.
 
 :class:`ComputedTorque` is the textbook computed-torque (inverse-dynamics)
@@ -32,13 +32,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._errors import needs_extra, period_alias
+
 try:
     import pinocchio as pin
 except ImportError as e:  # pragma: no cover - depends on the environment
-    raise ImportError(
-        "adaptimp.baselines needs Pinocchio, an optional dependency: "
-        "pip install adaptimp[pinocchio]"
-    ) from e
+    raise needs_extra("adaptimp.baselines", "pin>=3", "pinocchio") from e
 
 from . import _models
 from ._trajectory import Reference, paper_circle
@@ -235,11 +234,14 @@ class ComputedTorque:
         self.tau, self.tau_sat, self.xc, self.xd, self.z1 = nan, nan, nan, nan, nan
 
     @property
-    def ts(self) -> float:
+    def Ts(self) -> float:
         """Period Ts (s)."""
         return self._ts
 
-    Ts = ts
+    @property
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     @property
     def t(self) -> float:

@@ -1,6 +1,6 @@
 """MuJoCo as the plant: real arms, contact from a physics engine (SPEC §13).
 
-Needs the optional dependency MuJoCo (``pip install adaptimp[mujoco]``); the
+Needs the optional dependency MuJoCo (the extra ``mujoco``: ``pip install ".[mujoco]"``); the
 rest of adaptimp never imports it.
 
 - :class:`Plant` wraps a MuJoCo model of a serial arm with n ≤ 7 hinge joints,
@@ -9,7 +9,7 @@ rest of adaptimp never imports it.
   the force the arm exerts on its environment, mapped to joint space as
   τe = Jᵀ F_e.
 - :func:`simulate` closes the loop: any controller with
-  ``.step(q, tau_e, dq=None, **setpoint)`` and a period (``.ts`` or ``.Ts``),
+  ``.step(q, tau_e, dq=None, **setpoint)`` and a period ``.Ts`` (s),
   or one of the paper's cases by name, runs at Ts with the torque held over
   ``substeps`` MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12
   metrics.
@@ -37,6 +37,7 @@ import copy
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,15 +46,16 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._errors import needs_extra
+
 try:
     import mujoco
 except ImportError as e:  # pragma: no cover - depends on the environment
-    raise ImportError(
-        "adaptimp.mujoco needs MuJoCo, an optional dependency: pip install adaptimp[mujoco]"
-    ) from e
+    raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _adaptimp, _models
 from ._faults import Fault
+from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
 from ._trajectory import Reference, paper_circle, sinusoid
 
@@ -90,7 +92,7 @@ class ControllerLike(Protocol):
     ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,);
     ``setpoint`` is ``xc=, dxc=, ddxc=`` when :func:`simulate` is given a
     ``reference``, nothing otherwise (the controller then follows its own
-    trajectory). The period is ``.ts`` or ``.Ts`` (s). Optional attributes
+    trajectory). The period is ``.Ts`` (s; ``.ts`` is read, deprecated). Optional attributes
     that :func:`simulate` records when present: ``tau`` (commanded torque
     before saturation), ``xc``, ``xd``, ``z1``, ``dq_hat``, ``zeta``, and
     ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``,
@@ -743,7 +745,7 @@ def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
 # The result of a run.
 # ---------------------------------------------------------------------------
 
-PLOT_KINDS = ("tracking", "errors", "torques", "contact")
+PLOT_KINDS = MUJOCO_PLOT_KINDS
 """Kinds of :meth:`MujocoResult.plot`."""
 
 ARRAYS = (
@@ -826,7 +828,7 @@ class MujocoResult(SimResult):
             return super().plot(kind, ax)
         if kind not in PLOT_KINDS:
             raise ValueError(f"kind must be one of {PLOT_KINDS}, got {kind!r}")
-        return _plot(self, kind)
+        return MUJOCO_FIGURES[kind](self)
 
     def __repr__(self) -> str:
         m, p = self.metrics, self.params
@@ -840,42 +842,6 @@ class MujocoResult(SimResult):
         )
 
 
-def _plot(res: MujocoResult, kind: str) -> Figure:
-    from ._plot import _figure, _legend
-
-    t = res.t
-    if kind == "contact":
-        assert res.wrench_ee is not None
-        fig, axes = _figure("end-effector force F_e (world frame) and ‖τe‖", rows=2)
-        for i, axis in enumerate("xyz"):
-            axes[0].plot(t, res.wrench_ee[:, i], lw=1.0, label=f"F_e,{axis}")
-        axes[0].set_ylabel("force (N)")
-        axes[1].plot(t, np.linalg.norm(res.tau_e, axis=1), color="k", lw=1.0, label="‖τe‖")
-        axes[1].set_ylabel("‖τe‖ (N m)")
-        _legend(fig, axes[0], ncol=3)
-        return fig
-    n = res.q.shape[1] if kind == "torques" else res.z1.shape[1]
-    fig, axes = _figure(f"{res.params['controller']} on {res.params['model']}: {kind}", rows=n)
-    for i, ax in enumerate(axes):
-        if kind == "tracking":
-            ax.plot(t, res.xc[:, i], color="k", lw=1.0, ls="--", label="xc, commanded")
-            ax.plot(t, res.xd[:, i], color="tab:orange", lw=1.2, label="xd, compliant reference")
-            if res.q.shape[1] == n:
-                ax.plot(t, res.q[:, i], color="tab:blue", lw=1.0, label="q, arm")
-            ax.set_ylabel(f"x{i + 1}")
-        elif kind == "errors":
-            ax.plot(t, res.z1[:, i], color="tab:blue", lw=0.9, label="z1 = xd − x")
-            ax.set_ylabel(f"z1,{i + 1}")
-        else:
-            m = float(res.params["tau_max"][i])
-            ax.plot(t, res.tau[:, i], color="tab:orange", lw=0.7, label="τ, commanded")
-            ax.plot(t, res.tau_sat[:, i], color="tab:blue", lw=0.9, label="sat(τ), applied")
-            ax.axhline(m, color="tab:red", lw=1.0, ls="--", label="±τmax")
-            ax.axhline(-m, color="tab:red", lw=1.0, ls="--")
-            ax.set_ylim(-1.6 * m, 1.6 * m)
-            ax.set_ylabel(f"τ{i + 1} (N m)")
-    _legend(fig, axes[0], ncol=3)
-    return fig
 
 
 # ---------------------------------------------------------------------------
@@ -884,11 +850,17 @@ def _plot(res: MujocoResult, kind: str) -> Figure:
 
 
 def _period(ctrl: Any) -> float:
-    for attr in ("ts", "Ts"):
-        value = getattr(ctrl, attr, None)
-        if value is not None:
-            return float(value)
-    raise TypeError(f"the controller {ctrl!r} has no period: give it a .ts or .Ts (s)")
+    value = getattr(ctrl, "Ts", None)
+    if value is not None:
+        return float(value)
+    if getattr(ctrl, "ts", None) is not None:  # the earlier name, deprecated
+        warnings.warn(
+            f"the controller's period .ts is deprecated: name it .Ts ({type(ctrl).__name__})",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        return float(ctrl.ts)
+    raise TypeError(f"the controller {ctrl!r} has no period: give it a .Ts (s)")
 
 
 def _builtin_reference(ctrl: Any) -> Reference | None:

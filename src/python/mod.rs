@@ -794,7 +794,7 @@ impl PyController {
     }
 
     /// Sampling period Ts (s).
-    #[getter]
+    #[getter(Ts)]
     fn ts(&self, py: Python<'_>) -> f64 {
         self.lock(py).ts()
     }

@@ -457,7 +457,7 @@ _FEATHER = """<mujoco><option integrator="RK4" timestep="0.001"/><worldbody>
 class _Kick:
     """Zero torque, then full torque from row ``at`` on."""
 
-    ts = 1e-3
+    Ts = 1e-3
 
     def __init__(self, at: int) -> None:
         self.at, self.k = at, 0

@@ -52,6 +52,15 @@ typedef enum AdaptimpLaw {
   ADAPTIMP_LAW_OUTPUT_FEEDBACK = 2,
 } AdaptimpLaw;
 
+// The stability conditions construction checks (SPEC §10), in the order of
+// `Conditions::NAMES`.
+typedef enum AdaptimpConditions {
+  // The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 (needs inertia = 1, rho = 1).
+  ADAPTIMP_CONDITIONS_PAPER = 0,
+  // SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0.
+  ADAPTIMP_CONDITIONS_SCALED = 1,
+} AdaptimpConditions;
+
 // Inner law of the auxiliary system (SPEC §8), in the order of `AuxLaw::NAMES`.
 typedef enum AdaptimpAuxLaw {
   // ζ̇ = −Kζ ζ + Δτ inside the ball ("default").
@@ -174,6 +183,12 @@ typedef struct AdaptimpParams {
   double kp[ADAPTIMP_MAX_JOINTS];
   // Kζ (1/s), (11).
   double kzeta[ADAPTIMP_MAX_JOINTS];
+  // Inertia scale d of each joint (kg m²), SPEC §10.
+  double inertia[ADAPTIMP_MAX_JOINTS];
+  // Young weight ρ (1/s) of the auxiliary system, SPEC §10.
+  double rho;
+  // The stability conditions checked.
+  enum AdaptimpConditions conditions;
   // μ (N m), (11).
   double mu;
   // Inner law of the auxiliary system.

@@ -18,8 +18,8 @@
 
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
-    AnyBasis, AuxLaw, Centers, Command, Controller, Error, Fallback, FaultPolicy, Grid, HeapState,
-    Hold, ImpedanceMode, Law, LearningStep, Measurement, ObserverInit, RobustKind,
+    AnyBasis, AuxLaw, Centers, Command, Conditions, Controller, Error, Fallback, FaultPolicy, Grid,
+    HeapState, Hold, ImpedanceMode, Law, LearningStep, Measurement, ObserverInit, RobustKind,
     SaturationLearning, Setpoint, Sinusoid, Trajectory, Vector,
 };
 use core::ffi::c_char;
@@ -91,6 +91,17 @@ pub enum AdaptimpAuxLaw {
     Printed = 1,
     /// No −β term anywhere ("linear").
     Linear = 2,
+}
+
+/// The stability conditions construction checks (SPEC §10), in the order of
+/// `Conditions::NAMES`.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpConditions {
+    /// The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 (needs inertia = 1, rho = 1).
+    Paper = 0,
+    /// SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0.
+    Scaled = 1,
 }
 
 /// The robust term r(z2) (SPEC §7), in the order of `RobustKind::NAMES`.
@@ -211,6 +222,12 @@ pub struct AdaptimpParams {
     pub kp: [f64; ADAPTIMP_MAX_JOINTS],
     /// Kζ (1/s), (11).
     pub kzeta: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Inertia scale d of each joint (kg m²), SPEC §10.
+    pub inertia: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Young weight ρ (1/s) of the auxiliary system, SPEC §10.
+    pub rho: f64,
+    /// The stability conditions checked.
+    pub conditions: AdaptimpConditions,
     /// μ (N m), (11).
     pub mu: f64,
     /// Inner law of the auxiliary system.
@@ -544,6 +561,7 @@ fn preset_of(p: AdaptimpPreset) -> Preset {
 }
 
 /// The C enums follow the order of the schema's choice names.
+const CONDITIONS: [AdaptimpConditions; 2] = [AdaptimpConditions::Paper, AdaptimpConditions::Scaled];
 const AUX: [AdaptimpAuxLaw; 3] = [
     AdaptimpAuxLaw::Default,
     AdaptimpAuxLaw::Printed,
@@ -596,6 +614,9 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         k1,
         kp,
         kzeta,
+        inertia,
+        rho,
+        conditions,
         mu,
         aux_law,
         robust,
@@ -645,11 +666,17 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
         AdaptimpWeightBound::Auto => Value::Str("auto"),
     };
-    let values: [(&str, Value<'_>); 40] = [
+    let values: [(&str, Value<'_>); 43] = [
         ("Ts", Value::Real(*ts)),
         ("K1", joint(k1)),
         ("Kp", joint(kp)),
         ("Kzeta", joint(kzeta)),
+        ("inertia", joint(inertia)),
+        ("rho", Value::Real(*rho)),
+        (
+            "conditions",
+            Value::Str(name_of(&CONDITIONS, conditions, &Conditions::NAMES)),
+        ),
         ("mu", Value::Real(*mu)),
         (
             "aux_law",
@@ -771,6 +798,9 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
         k1: [0.0; ADAPTIMP_MAX_JOINTS],
         kp: [0.0; ADAPTIMP_MAX_JOINTS],
         kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
+        inertia: [0.0; ADAPTIMP_MAX_JOINTS],
+        rho: 0.0,
+        conditions: AdaptimpConditions::Paper,
         mu: 0.0,
         aux_law: AdaptimpAuxLaw::Default,
         robust: AdaptimpRobust::Sign,
@@ -835,6 +865,9 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
             "K1" => joint(&mut p.k1),
             "Kp" => joint(&mut p.kp),
             "Kzeta" => joint(&mut p.kzeta),
+            "inertia" => joint(&mut p.inertia),
+            "rho" => real(&mut p.rho),
+            "conditions" => p.conditions = from_name(&CONDITIONS, &Conditions::NAMES, choice),
             "mu" => real(&mut p.mu),
             "aux_law" => p.aux_law = from_name(&AUX, &AuxLaw::NAMES, choice),
             "robust" => p.robust = from_name(&ROBUST, &RobustKind::NAMES, choice),
@@ -1306,6 +1339,7 @@ mod tests {
     #[test]
     fn the_c_enums_follow_the_schemas_choice_order() {
         assert_eq!(AUX.len(), AuxLaw::NAMES.len());
+        assert_eq!(CONDITIONS.len(), Conditions::NAMES.len());
         assert_eq!(ROBUST.len(), RobustKind::NAMES.len());
         assert_eq!(STEP.len(), LearningStep::NAMES.len());
         assert_eq!(SATURATION.len(), SaturationLearning::NAMES.len());
@@ -1314,6 +1348,9 @@ mod tests {
         assert_eq!(IMPEDANCE.len(), ImpedanceMode::NAMES.len());
         let debug = |v: &dyn std::fmt::Debug| format!("{v:?}").to_lowercase();
         for (c, name) in ROBUST.iter().zip(RobustKind::NAMES) {
+            assert_eq!(debug(c), name);
+        }
+        for (c, name) in CONDITIONS.iter().zip(Conditions::NAMES) {
             assert_eq!(debug(c), name);
         }
         for (c, name) in STEP.iter().zip(LearningStep::NAMES) {

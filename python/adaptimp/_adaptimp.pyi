@@ -19,10 +19,12 @@ __all__ = [
     "PlanarArm",
     "TwoLinkArm",
     "__version__",
+    "default_task",
     "defaults",
     "schema_table",
     "simulate",
     "simulate_many",
+    "suggest",
 ]
 
 __version__: str
@@ -46,6 +48,14 @@ class ControllerParams(TypedDict, total=False):
     """feedback gain Kp, (14) (N m s/rad)."""
     Kzeta: float | _Joint
     """auxiliary-system gain Kζ, (11) (1/s)."""
+    inertia: float | _Joint
+    """inertia scale d of each joint: the auxiliary system takes Δτ/d, the z1 term d·z1, the
+    learning error d·z2 (SPEC §10) (kg m²)."""
+    rho: float
+    """Young weight ρ of ζᵀΔτ in the auxiliary system's β (SPEC §10) (1/s)."""
+    conditions: Literal["paper", "scaled"]
+    """stability conditions checked: the paper's (13) (unit weights: inertia = 1, rho = 1), or
+    'scaled' (SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0)."""
     mu: float
     """radius μ of the auxiliary system's inner ball, (11) (N m)."""
     aux_law: Literal["default", "printed", "linear"]
@@ -351,3 +361,19 @@ def schema_table() -> list[dict[str, Any]]:
 
 def defaults(scenario: str = "paper", n: int = 2) -> dict[str, Any]:
     """Every parameter's default in ``scenario`` ("paper" or "robot") for n joints."""
+
+def suggest(
+    case: str,
+    inertia: NDArray[np.float64],
+    tau_max: NDArray[np.float64],
+    ts: float,
+    path: NDArray[np.float64] | None = None,
+    period: float | None = None,
+) -> dict[str, Any]:
+    """The gain and basis rule of SPEC §18: "params" (every controller keyword),
+    with a path also "centers" (L, 4n) and "widths" (4n,)."""
+
+def default_task(
+    home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
+) -> tuple[list[float], list[float], list[float], list[float]]:
+    """The default task of SPEC §18: (xc_offset, xc_sin, xc_cos, xc_omega)."""

@@ -11,9 +11,10 @@ use crate::control::config::Law;
 use crate::control::controller::Controller;
 use crate::control::io::{Command, Measurement};
 use crate::control::tracker::Tracker;
+use crate::control::tuning::Rule;
 use crate::error::Error;
 use crate::networks::network::{Weights, C, D, G};
-use crate::networks::rbf::{AnyBasis, Basis, Centers};
+use crate::networks::rbf::{AnyBasis, Basis, Centers, GRID_MAX_JOINTS};
 use crate::schema::{Preset, Scenario, Value};
 use crate::sim::disturb::{Disturbances, TipPayload, WithFriction};
 use crate::sim::environment::{FreeSpace, Wall};
@@ -362,6 +363,8 @@ fn build_n<const N: usize>(
     let s = scenario::<N>(preset, law, items)?;
     let traj = s.trajectory()?;
     let basis = match centers {
+        // Beyond the vertex grid: the rule's default basis, SPEC §18.
+        None if N > GRID_MAX_JOINTS => AnyBasis::Centers(Rule::default().default_basis(&traj)?),
         None => AnyBasis::Grid(s.grid()?),
         Some(c) => {
             if c.widths2.len() != 4 * N {

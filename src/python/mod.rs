@@ -25,6 +25,7 @@
 
 mod arm;
 mod dynamic;
+mod tuning;
 
 use crate::control::config::Law;
 use crate::error::Error;
@@ -1392,6 +1393,8 @@ fn defaults<'py>(py: Python<'py>, scenario: &str, n: usize) -> PyResult<Bound<'p
 mod adaptimp_module {
     use pyo3::prelude::*;
 
+    #[pymodule_export]
+    use super::tuning::{default_task, suggest};
     #[pymodule_export]
     use super::{
         defaults, schema_table, simulate, simulate_many, PyArm, PyController, PyPlanarArm,

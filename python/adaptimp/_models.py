@@ -13,8 +13,10 @@ Nothing here imports MuJoCo or Pinocchio; :mod:`adaptimp.mujoco` and
 from __future__ import annotations
 
 import importlib.metadata
+import math
 import os
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
 from pathlib import Path
 
 MODELS_DIR = Path(__file__).resolve().parent / "models"
@@ -110,3 +112,160 @@ def panda_arm_urdf() -> str:
     joints fixed (closed, the fingers' masses then ride on the hand)."""
     text, _ = adapt_urdf(panda_urdf_path().read_text(), fix=PANDA_FINGERS)
     return text
+
+
+GRIPPER_WORDS = ("gripper", "finger", "jaw", "claw")
+"""Joint names containing one of these (any case) belong to a gripper, which
+:func:`arm_urdf` fixes."""
+
+
+@dataclass(frozen=True)
+class ArmURDF:
+    """A URDF reduced to the serial arm adaptimp drives (:func:`arm_urdf`).
+
+    Attributes
+    ----------
+    text : str
+        The reduced URDF (kinematics and inertias only; every joint not in
+        ``joints`` made fixed at its zero position).
+    joints : tuple of str
+        The arm's joints, base to tip: the revolute and continuous joints of
+        the longest serial chain from the root.
+    lower, upper : tuple of float
+        Their position limits (rad); ∓inf for a continuous joint.
+    effort : tuple of float
+        Their ``<limit effort>`` (N m); NaN where the URDF gives none or zero.
+    tip : str
+        The child link of the last joint: the end-effector body.
+    fixed : dict
+        Every other movable joint of the URDF and why it was fixed.
+    """
+
+    text: str
+    joints: tuple[str, ...]
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    effort: tuple[float, ...]
+    tip: str
+    fixed: dict[str, str] = field(default_factory=dict)
+
+
+def _float(e: ET.Element | None, name: str, default: float) -> float:
+    if e is None or e.get(name) is None:
+        return default
+    try:
+        return float(e.get(name, "nan"))
+    except ValueError:
+        return default
+
+
+def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
+    """The serial arm of a URDF, as :func:`adaptimp.mujoco.from_urdf` and
+    :func:`adaptimp.baselines.pinocchio_model` load it (one reduction for both).
+
+    :func:`adapt_urdf`'s clean-up (no meshes, no joint dynamics), then:
+
+    - joints named in ``fix``, prismatic joints (a linear axis or a finger),
+      mimic joints, joints whose name contains a word of :data:`GRIPPER_WORDS`
+      and revolute joints whose limits leave no motion (lower ≥ upper) are
+      fixed;
+    - of the rest (revolute and continuous), the arm is the longest serial
+      chain from the root (the most movable joints on one path; the first in
+      document order on a tie); movable joints off it (a branch: another arm,
+      a head, a hand's fingers) are fixed too.
+
+    Every fixed joint is fixed at its zero position. Raises ``ValueError`` if
+    no movable joint is left.
+    """
+    root = ET.fromstring(text)
+    mimic = {j.get("name", "") for j in root.findall("joint") if j.find("mimic") is not None}
+    base, _ = adapt_urdf(text)
+    root = ET.fromstring(base)
+    fixed: dict[str, str] = {}
+    children: dict[str, list[ET.Element]] = {}
+    parents: set[str] = set()
+    for joint in root.findall("joint"):
+        name = joint.get("name", "")
+        kind = joint.get("type", "")
+        parent = joint.find("parent")
+        child = joint.find("child")
+        if parent is None or child is None:
+            raise ValueError(f"URDF joint {name!r} has no parent or child link")
+        children.setdefault(parent.get("link", ""), []).append(joint)
+        parents.add(child.get("link", ""))
+        if kind in ("fixed", "floating", "planar"):
+            continue
+        limit = joint.find("limit")
+        lo, hi = _float(limit, "lower", -math.inf), _float(limit, "upper", math.inf)
+        words = [w for w in GRIPPER_WORDS if w in name.lower()]
+        if name in fix:
+            fixed[name] = "asked"
+        elif kind == "prismatic":
+            fixed[name] = "prismatic (the arm's joints are revolute)"
+        elif name in mimic:
+            fixed[name] = "mimic joint"
+        elif words:
+            fixed[name] = f"a gripper joint (its name contains {words[0]!r})"
+        elif kind == "revolute" and limit is not None and not lo < hi:
+            fixed[name] = f"no motion within its limits [{lo:g}, {hi:g}]"
+    roots = [
+        link.get("name", "") for link in root.findall("link") if link.get("name") not in parents
+    ]
+    if len(roots) != 1:
+        raise ValueError(f"the URDF must have one root link, found {roots}")
+
+    def movable(j: ET.Element) -> bool:
+        return j.get("type") in ("revolute", "continuous") and j.get("name") not in fixed
+
+    def longest(link: str) -> list[ET.Element]:
+        """The movable joints of the longest chain below ``link``."""
+        best: list[ET.Element] = []
+        for j in children.get(link, []):
+            child = j.find("child")
+            assert child is not None
+            chain = ([j] if movable(j) else []) + longest(child.get("link", ""))
+            if len(chain) > len(best):
+                best = chain
+        return best
+
+    chain = longest(roots[0])
+    on_chain = {j.get("name", "") for j in chain}
+    for j in root.findall("joint"):
+        name = j.get("name", "")
+        if movable(j) and name not in on_chain:
+            fixed[name] = "off the arm's chain (a branch)"
+    if not chain:
+        raise ValueError(
+            "the URDF has no revolute or continuous joint to drive"
+            + (f" (fixed: {fixed})" if fixed else "")
+        )
+    for j in root.findall("joint"):
+        if j.get("name", "") in fixed:
+            j.set("type", "fixed")
+            for tag in ("axis", "limit"):
+                for e in j.findall(tag):
+                    j.remove(e)
+    lower: list[float] = []
+    upper: list[float] = []
+    effort: list[float] = []
+    for j in chain:
+        lim = j.find("limit")
+        if j.get("type") == "continuous":
+            lower.append(-math.inf)
+            upper.append(math.inf)
+        else:
+            lower.append(_float(lim, "lower", -math.inf))
+            upper.append(_float(lim, "upper", math.inf))
+        given = _float(lim, "effort", math.nan)
+        effort.append(given if given > 0 and math.isfinite(given) else math.nan)
+    tip = chain[-1].find("child")
+    assert tip is not None
+    return ArmURDF(
+        text=ET.tostring(root, encoding="unicode"),
+        joints=tuple(j.get("name", "") for j in chain),
+        lower=tuple(lower),
+        upper=tuple(upper),
+        effort=tuple(effort),
+        tip=tip.get("link", ""),
+        fixed=fixed,
+    )

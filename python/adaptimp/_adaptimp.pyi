@@ -369,6 +369,7 @@ def suggest(
     ts: float,
     path: NDArray[np.float64] | None = None,
     period: float | None = None,
+    gravity: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18: "params" (every controller keyword),
     with a path also "centers" (L, 4n) and "widths" (4n,)."""

@@ -208,8 +208,9 @@ class ComputedTorque:
         self.model = with_payload(scale_masses(exact, mass_scale), float(payload))
         self.data = self.model.createData()
         n = self.n = int(self.model.nv)
-        if self.model.nq != n:
-            raise ValueError("ComputedTorque needs revolute joints only (nq = nv)")
+        # Continuous joints (nq = 2 each: cos, sin) take q as the angle from
+        # the neutral configuration.
+        self._angles = self.model.nq != n
         if not (Ts > 0 and math.isfinite(Ts)):
             raise ValueError(f"Ts must be > 0, got {Ts}")
         self._ts = float(Ts)
@@ -270,14 +271,21 @@ class ComputedTorque:
         """The gains, limits, target impedance and (if built in) the trajectory."""
         return dict(self._params)
 
+    def _config(self, q: FloatArray) -> FloatArray:
+        """Pinocchio's configuration of joint angles q (rad)."""
+        if self._angles:
+            return np.asarray(pin.integrate(self.model, pin.neutral(self.model), q))
+        return q
+
     def mass_matrix(self, q: ArrayLike) -> FloatArray:
         """The controller's model M̂(q) (kg m²), (n, n), from CRBA."""
-        m = pin.crba(self.model, self.data, _joint("q", q, self.n))
+        m = pin.crba(self.model, self.data, self._config(_joint("q", q, self.n)))
         return np.array(np.triu(m) + np.triu(m, 1).T, dtype=np.float64)
 
     def bias(self, q: ArrayLike, dq: ArrayLike) -> FloatArray:
         """The controller's model ĥ = Ĉ(q, q̇) q̇ + Ĝ(q) (N m), (n,), RNEA with q̈ = 0."""
         q, dq = _joint("q", q, self.n), _joint("dq", dq, self.n)
+        q = self._config(q)
         return np.array(pin.rnea(self.model, self.data, q, dq, np.zeros(self.n)), dtype=np.float64)
 
     def step(

@@ -160,7 +160,7 @@ def _spec_of(urdf: str) -> Any:
     return spec
 
 
-EFFORT_ACCEL = 5.0
+EFFORT_ACCEL = 10.0
 """The acceleration (rad/s²) an estimated effort limit leaves beyond gravity
 (:func:`from_urdf`)."""
 
@@ -180,9 +180,9 @@ def from_urdf(
     only, no mesh files; no contact geometry). Continuous joints are
     unlimited hinges. Each arm joint gets a motor with ctrlrange ± its
     ``<limit effort>`` (N m); where the URDF gives none (or zero) the limit is
-    estimated from the arm itself, 2 (max |G_i| + 5 rad/s² · max D_ii) over
-    256 postures within the joint limits (:func:`estimate_effort`), with a
-    warning. RK4 at ``timestep`` (s).
+    estimated from the arm itself, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|)
+    over 256 postures within the joint limits (:func:`estimate_effort`), with
+    a warning. RK4 at ``timestep`` (s).
 
     Raises
     ------
@@ -212,7 +212,7 @@ def from_urdf(
         warnings.warn(
             f"the URDF gives no effort limit for {missing}: estimated "
             f"{[round(float(estimate[arm.joints.index(j)]), 3) for j in missing]} N m "
-            "(2 (max |G| + 5 rad/s² · max D_ii) within the joint limits)",
+            "(2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within the joint limits)",
             stacklevel=2,
         )
     return model
@@ -245,8 +245,9 @@ def _postures(lo: FloatArray, hi: FloatArray, count: int, margin: ArrayLike = 0.
 
 def estimate_effort(model: mujoco.MjModel, postures: int = 256) -> FloatArray:
     """Effort limits (N m, per joint of ``model``'s arm) for an arm whose URDF
-    gives none: 2 (max |G_i(q)| + 5 rad/s² · max D_ii(q)) over ``postures``
-    postures within the joint limits (:func:`from_urdf`)."""
+    gives none: 2 (max |G_i(q)| + 10 rad/s² · max Σ_j |D_ij(q)|) over
+    ``postures`` postures within the joint limits (:func:`from_urdf`): gravity
+    and an acceleration of 10 rad/s² of every joint at once, twice over."""
     joints = sorted(range(model.njnt), key=lambda j: int(model.jnt_dofadr[j]))
     qadr = [int(model.jnt_qposadr[j]) for j in joints]
     dofs = [int(model.jnt_dofadr[j]) for j in joints]
@@ -262,7 +263,7 @@ def estimate_effort(model: mujoco.MjModel, postures: int = 256) -> FloatArray:
         mujoco.mj_forward(model, data)
         _full_inertia(model, data, full)
         g = np.maximum(g, np.abs(data.qfrc_bias[dofs]))
-        d = np.maximum(d, np.diag(full)[dofs])
+        d = np.maximum(d, np.sum(np.abs(full[np.ix_(dofs, dofs)]), axis=1))
     return np.asarray(2.0 * (g + EFFORT_ACCEL * d), dtype=np.float64)
 
 

@@ -9,11 +9,13 @@ and :func:`adaptimp.simulate` in the robot scenario. Every rate is in the
 joint's own units (each joint's inertia scale d_i = 1/(D⁻¹)_ii, SPEC §10):
 
 - **Kp_i = 0.25 d_i / Ts**: the sampled velocity loop of every joint keeps its
-  pole at 0.75, whatever the joint's size; **K1 = min(20 s⁻¹, 0.05/Ts)**;
+  pole at 0.75, whatever the joint's size; **K1 = min(50 s⁻¹, 0.05/Ts)**;
   **Kζ_i = Kp_i/d_i + ρ/2** with the conditions ``"scaled"`` of SPEC §10
   (met by construction, for any arm, τmax and Ts); kr_i = φ Kp_i/2.
-- **Centres along the path** (SPEC §15): L = clip(⌈2·(path length in q)/0.2
-  rad⌉, 16, 256) samples of one period, widths max(2 h, tube).
+- **Centres along the path** (SPEC §15): L = clip(⌈2·(path length in q)/tube⌉,
+  16, 256) samples of one period, widths max(2 h, tube), tube = (0.2 rad,
+  0.5 rad/s), widened to twice the sag G/(Kp K1) the arm has before the
+  networks learn (with a model that gives G).
 - **Learning** (with a path): Ĝ at the bandwidth ω_G² = ½ (Kp/d) K1 per
   unit inertia (Γ_G = ω_G²/⟨‖S‖²⟩), D̂ and Ĉ five times slower, a leak
   time of 25 periods, and weight bounds from τmax and the basis the path
@@ -68,6 +70,8 @@ def inertia(model: Any, q: ArrayLike) -> FloatArray:
     if type(model).__name__ == "Model" and hasattr(model, "nq"):
         import pinocchio as pin
 
+        if model.nq != model.nv:  # continuous joints: angles from the neutral configuration
+            q = pin.integrate(model, pin.neutral(model), q)
         d = pin.crba(model, model.createData(), q)
         return np.asarray(np.triu(d) + np.triu(d, 1).T, dtype=np.float64)
     try:
@@ -80,6 +84,25 @@ def inertia(model: Any, q: ArrayLike) -> FloatArray:
             f"or be an (n, n) inertia matrix; got {type(model).__name__}"
         )
     return arr
+
+
+def gravity(model: Any, q: ArrayLike) -> FloatArray | None:
+    """The gravity torque G(q) (N m, (n,)) of ``model`` if it can tell: an object
+    with ``G(q)``, a Pinocchio ``Model`` or an ``adaptimp.mujoco.Plant``; None
+    for a bare inertia matrix."""
+    q = np.asarray(q, dtype=np.float64)
+    if hasattr(model, "G"):
+        return np.asarray(model.G(q), dtype=np.float64)
+    if hasattr(model, "bias") and hasattr(model, "reset"):
+        model.reset(q)
+        return np.asarray(model.bias(), dtype=np.float64)
+    if type(model).__name__ == "Model" and hasattr(model, "nq"):
+        import pinocchio as pin
+
+        if model.nq != model.nv:
+            q = pin.integrate(model, pin.neutral(model), q)
+        return np.asarray(pin.computeGeneralizedGravity(model, model.createData(), q))
+    return None
 
 
 def sample_path(path: Path, period: float, n: int) -> FloatArray:
@@ -149,7 +172,8 @@ def suggest(
         if period is None:
             raise ConfigError("a path needs its period (s)")
         rows = sample_path(path, period, n)
-    out = _adaptimp.suggest(case, np.ascontiguousarray(d), tau, float(Ts), rows, period)
+    g = gravity(model, q0) if rows is not None else None
+    out = _adaptimp.suggest(case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g)
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})
     if "centers" in out:

@@ -8,7 +8,7 @@
 //!
 //! ```text
 //! Kp_i = m d_i / Ts,   m = 0.25                          (18.1)
-//! K1   = min(20 s⁻¹, 0.05 / Ts)                          (18.2)
+//! K1   = min(50 s⁻¹, 0.05 / Ts)                          (18.2)
 //! Kζ_i = Kp_i/d_i + ρ/2,  ρ = 1 s⁻¹  (conditions "scaled") (18.3)
 //! kr_i = φ Kp_i / 2,  Kd_i (fallback) = Kp_i             (18.4)
 //! ```
@@ -46,7 +46,7 @@ pub struct Rule {
     /// m of Kp_i = m d_i/Ts: each joint's sampled velocity loop keeps its
     /// pole at 1 − m (0.25).
     pub margin: f64,
-    /// The largest K1 (1/s) (20).
+    /// The largest K1 (1/s) (50).
     pub k1_max: f64,
     /// K1 ≤ this/Ts: the position loop inside the velocity loop (0.05).
     pub k1_per_step: f64,
@@ -66,7 +66,7 @@ impl Default for Rule {
     fn default() -> Self {
         Self {
             margin: 0.25,
-            k1_max: 20.0,
+            k1_max: 50.0,
             k1_per_step: 0.05,
             learn: 0.5,
             learn_dc: 0.2,
@@ -103,6 +103,22 @@ pub fn inertia_scales<const N: usize>(d: &Matrix<N>) -> Result<Vector<N>, Error>
 }
 
 impl Rule {
+    /// The rule with its tube widened to hold the sag of the arm under the
+    /// feedback alone, SPEC (18.5): the weights start at zero, so at first the
+    /// arm hangs G_i/(Kp_i K1_i) (rad) below the path, and the networks must
+    /// still act there: tube_q ≥ 2 max_i |G_i|/(Kp_i K1_i). `gravity` (N m) is
+    /// G at the path's start; `cfg` the [`gains`](Self::gains).
+    pub fn holding<const N: usize>(&self, cfg: &Config<N>, gravity: &Vector<N>) -> Self {
+        let sag = (0..N)
+            .map(|i| gravity[i].abs() / (cfg.kp[i] * cfg.k1[i]))
+            .fold(0.0, f64::max);
+        let mut rule = *self;
+        if sag.is_finite() {
+            rule.tube[0] = rule.tube[0].max(2.0 * sag);
+        }
+        rule
+    }
+
     /// K1 (1/s) at period `ts` (s), (18.2).
     pub fn k1(&self, ts: f64) -> f64 {
         self.k1_max.min(self.k1_per_step / ts)
@@ -277,7 +293,9 @@ impl Rule {
 
     /// Everything at once: [`gains`](Self::gains), [`centres`](Self::centres)
     /// and [`learning`](Self::learning) for `path` (one period of `period`
-    /// s, evenly spaced in time, e.g. [`Rule::sample`]).
+    /// s, evenly spaced in time, e.g. [`Rule::sample`]); with `gravity` (G
+    /// at the path's start, N m) the tube [`holding`](Self::holding) the sag.
+    #[allow(clippy::too_many_arguments)]
     pub fn suggest<const N: usize>(
         &self,
         law: Law,
@@ -286,11 +304,16 @@ impl Rule {
         ts: f64,
         path: &[Setpoint<N>],
         period: f64,
+        gravity: Option<&Vector<N>>,
     ) -> Result<Suggestion<N>, Error> {
         let mut config = self.gains(law, d, tau_max, ts)?;
-        let centers = self.centres(path)?;
+        if let Some(g) = gravity {
+            check::finite_slice("gravity", g.as_slice())?;
+        }
+        let rule = gravity.map_or(*self, |g| self.holding(&config, g));
+        let centers = rule.centres(path)?;
         let mut scratch = alloc::vec![0.0; centers.nodes()];
-        self.learning(&mut config, &centers, path, period, &mut scratch)?;
+        rule.learning(&mut config, &centers, path, period, &mut scratch)?;
         Ok(Suggestion { config, centers })
     }
 
@@ -384,7 +407,7 @@ mod tests {
         .unwrap();
         let path = Rule::sample(&traj, 2.0);
         let s = Rule::default()
-            .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0)
+            .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, None)
             .unwrap();
         Controller::new(s.config, s.centers).unwrap();
     }

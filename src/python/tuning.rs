@@ -19,9 +19,11 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// by name), the centres (L, 4n) and their widths η (4n,) for `case`, an arm
 /// of inertia matrix `inertia` (n, n; kg m²), limits `tau_max` (n,; N m),
 /// period `ts` (s) and, if given, the task's `path` (K, 3n: q, q̇, q̈ per
-/// row, one period of `period` s, evenly spaced in time).
+/// row, one period of `period` s, evenly spaced in time) with the gravity
+/// torque `gravity` (n,; N m) at its start, if known.
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
     case: &str,
@@ -30,6 +32,7 @@ pub fn suggest<'py>(
     ts: f64,
     path: Option<PyReadonlyArray2<'py, f64>>,
     period: Option<f64>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -42,6 +45,11 @@ pub fn suggest<'py>(
     }
     let d: Vec<f64> = inertia.as_array().iter().copied().collect();
     let tau: Vec<f64> = tau_max.as_array().iter().copied().collect();
+    let gravity: Option<Vec<f64>> = match gravity {
+        None => None,
+        Some(g) if g.shape() == [n] => Some(g.as_array().iter().copied().collect()),
+        Some(g) => return Err(shape_error("gravity", format!("({n},)"), g.shape())),
+    };
     let path: Option<(Vec<f64>, f64)> = match (path, period) {
         (None, _) => None,
         (Some(p), Some(period)) => {
@@ -58,7 +66,7 @@ pub fn suggest<'py>(
     macro_rules! arms {
         ($($k:literal)*) => {
             match n {
-                $($k => fill::<$k>(py, &out, law, &d, &tau, ts, path.as_ref()),)*
+                $($k => fill::<$k>(py, &out, law, &d, &tau, ts, path.as_ref(), gravity.as_deref()),)*
                 _ => unreachable!("n checked above"),
             }
         };
@@ -67,6 +75,7 @@ pub fn suggest<'py>(
     Ok(out)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fill<'py, const N: usize>(
     py: Python<'py>,
     out: &Bound<'py, PyDict>,
@@ -75,6 +84,7 @@ fn fill<'py, const N: usize>(
     tau: &[f64],
     ts: f64,
     path: Option<&(Vec<f64>, f64)>,
+    gravity: Option<&[f64]>,
 ) -> PyResult<()> {
     let err = |e: Error| config_error(e.into());
     let rule = Rule::default();
@@ -97,8 +107,9 @@ fn fill<'py, const N: usize>(
                     ddx: Vector::from_column_slice(&r[2 * N..]),
                 })
                 .collect();
+            let g = gravity.map(Vector::<N>::from_column_slice);
             let sug = rule
-                .suggest(law, &d, &tau, ts, &samples, *period)
+                .suggest(law, &d, &tau, ts, &samples, *period, g.as_ref())
                 .map_err(err)?;
             s.config = sug.config;
             Some(sug.centers)

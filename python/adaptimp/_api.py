@@ -97,12 +97,15 @@ def _check_stability(core: _adaptimp.Controller, p: Mapping[str, Any], stackleve
         return
     gain, kp = core.learning_gain
     if gain >= kp:
+        scaled = any(d != 1.0 for d in p["inertia"])
+        against = "Kp/inertia" if scaled else "Kp"
         warnings.warn(
             StabilityWarning(
                 f"explicit-Euler learning is unstable at Ts = {p['Ts']:g} s: its per-step "
-                f"gain Ts‖S‖²(ΓD‖ẍc‖² + ΓC‖ẋc‖² + ΓG) = {gain:.3g} N m s/rad exceeds "
-                f"Kp = {kp:g} (the Jury condition of docs/robot.md); use scenario='robot', "
-                "or learning_step='normalized', or a smaller Ts or gamma"
+                f"gain Ts‖S‖²(ΓD‖ẍc‖² + ΓC‖ẋc‖² + ΓG) = {gain:.3g} exceeds "
+                f"{against} = {kp:g} (the Jury condition of docs/robot.md, per unit inertia "
+                "scale); use scenario='robot', or learning_step='normalized', or a smaller Ts "
+                "or gamma"
             ),
             stacklevel=stacklevel + 1,
         )

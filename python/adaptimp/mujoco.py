@@ -178,7 +178,11 @@ def from_urdf(
     named in ``fix``. Visual and collision elements, joint ``<dynamics>``
     (damping, friction) and mimic tags are dropped (the rigid-body dynamics
     only, no mesh files; no contact geometry). Continuous joints are
-    unlimited hinges. Each arm joint gets a motor with ctrlrange ± its
+    unlimited hinges. If the inertias do not compile as they are (a massless
+    moving link, an inertia that violates the triangle inequality), every
+    body gets at least 1e-6 kg and 1e-10 kg m² and inertias are balanced
+    (MuJoCo's ``boundmass``, ``boundinertia``, ``balanceinertia``), with a
+    warning. Each arm joint gets a motor with ctrlrange ± its
     ``<limit effort>`` (N m); where the URDF gives none (or zero) the limit is
     estimated from the arm itself, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|)
     over 256 postures within the joint limits (:func:`estimate_effort`), with
@@ -200,7 +204,23 @@ def from_urdf(
     spec.option.timestep = timestep
     missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
     _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
-    model = spec.compile()
+    try:
+        model = spec.compile()
+    except ValueError as e:
+        # A massless moving link or an inertia that violates the triangle
+        # inequality: bound and balance them (1e-6 kg, 1e-10 kg m², far below
+        # any real link), and say so.
+        spec.compiler.boundmass = 1e-6
+        spec.compiler.boundinertia = 1e-10
+        spec.compiler.balanceinertia = True
+        model = spec.compile()
+        import warnings
+
+        warnings.warn(
+            f"the URDF's inertias do not compile as they are ({e}); every body now has "
+            "at least 1e-6 kg and 1e-10 kg m², and inertias are balanced",
+            stacklevel=2,
+        )
     if missing:
         estimate = estimate_effort(model)
         for j, name in enumerate(arm.joints):

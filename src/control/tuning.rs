@@ -23,12 +23,14 @@
 //! b_G = 2 ‖τmax‖ √L / min ΣS_j,  b_D = b_G / max‖ẍc‖,  b_C = b_G / max‖ẋc‖  (18.8)
 //! ```
 //!
-//! (⟨·⟩ the mean, min and max over the path). The reasons are in SPEC §18.
+//! (⟨·⟩ the mean, min and max over the path; ‖ẍc‖ and ‖ẋc‖ floored at 1
+//! rad/s² and 1 rad/s). The reasons are in SPEC §18.
 //! [`default_task`] is the joint-space motion `adaptimp.mujoco.simulate` runs
 //! when given only a model.
 
 use crate::control::config::{Conditions, Config, Law, WeightBound};
-use crate::error::{check, Error};
+use crate::control::controller::MIN_SCALE;
+use crate::error::{check, Error, PARAM_BOUND};
 use crate::math::sqrt;
 use crate::networks::rbf::{Basis, Centers};
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
@@ -145,6 +147,21 @@ impl Rule {
         check::at_most("Ts ≤ 1 s", "Ts", ts, 1.0)?;
         check::positive_vec("τmax > 0", "tau_max", tau_max)?;
         let scales = inertia_scales(d)?;
+        if let Some(i) = scales
+            .iter()
+            .position(|d| !(*d >= MIN_SCALE && *d <= PARAM_BOUND))
+        {
+            return Err(Error::Condition {
+                condition: if scales[i] < MIN_SCALE {
+                    "d ≥ 1e-9"
+                } else {
+                    "|value| ≤ 1e9"
+                },
+                lhs: "inertia",
+                index: Some(i),
+                value: scales[i],
+            });
+        }
         let mut cfg = Config::<N>::new(law, *tau_max).hardened();
         cfg.ts = ts;
         cfg.conditions = Conditions::Scaled;
@@ -235,7 +252,10 @@ impl Rule {
             v_max = v_max.max(sp.dx.norm());
         }
         let k = path.len() as f64;
-        let (s2, a2, v2) = (s2 / k, a2 / k, v2 / k);
+        // Regressor scales floored at 1 rad/s² and 1 rad/s: a path that barely
+        // moves must not make Γ_D, Γ_C (or the bounds b_D, b_C) unbounded.
+        let (s2, a2, v2) = (s2 / k, (a2 / k).max(1.0), (v2 / k).max(1.0));
+        let (a_max, v_max) = (a_max.max(1.0), v_max.max(1.0));
         if !(s2 > 0.0 && sum_min > 0.0) {
             return Err(Error::Invalid {
                 what: "basis",
@@ -251,7 +271,7 @@ impl Rule {
         let leak = self.leak_periods * period;
         cfg.sigma = cfg.gamma.map(|g| 1.0 / (g * leak));
         let b_g = self.bound_margin * cfg.tau_max.norm() * sqrt(l as f64) / sum_min;
-        cfg.weight_bound = WeightBound::Fixed([b_g / or_one(a_max), b_g / or_one(v_max), b_g]);
+        cfg.weight_bound = WeightBound::Fixed([b_g / a_max, b_g / v_max, b_g]);
         Ok(())
     }
 }
@@ -357,11 +377,12 @@ pub fn default_task<const N: usize>(
     check::finite_slice("home", home.as_slice())?;
     check::each("hi > lo", "hi − lo", &(hi - lo), |_, d| d, true)?;
     let amp = Vector::<N>::from_fn(|i, _| (0.25 * (hi[i] - lo[i])).min(TASK_AMPLITUDE));
+    // (1e-9 rad of rounding allowed: a home clipped onto lo + A is inside.)
     check::each(
         "lo + A ≤ home ≤ hi − A",
         "distance from home to the nearest limit − A",
         home,
-        |i, h| (h - lo[i]).min(hi[i] - h) - amp[i],
+        |i, h| (h - lo[i]).min(hi[i] - h) - amp[i] + 1e-9,
         false,
     )?;
     Sinusoid::new(

@@ -630,7 +630,9 @@ impl<const N: usize> DynTracker for Typed<N> {
         let s2: f64 = s.iter().map(|x| x * x).sum();
         let [gd, gc, gg] = cfg.gamma;
         let gain = cfg.ts * s2 * (gd * c.ddx.norm_squared() + gc * c.dx.norm_squared() + gg);
-        (gain, cfg.kp.min())
+        // Per unit inertia scale, SPEC (10.2): joint k's rows learn at Γ d_k
+        // against Kp_k (Kp for the paper's d = 1).
+        (gain, cfg.kp.component_div(&cfg.inertia).min())
     }
 
     fn replay(

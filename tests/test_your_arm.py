@@ -176,3 +176,64 @@ def test_references_as_arrays_must_cover_the_run() -> None:
         amj.simulate(ct, UR5, T=0.06, reference=res)
     with pytest.raises(TypeError, match="reference must be a callable"):
         amj.simulate(ct, UR5, T=0.05, reference=3.0)
+
+
+def _urdf(joints: list[tuple[str, str, str, str, str]]) -> str:
+    """A URDF of unit boxes: (name, type, parent, child, limits) per joint."""
+    links = {"root"} | {j[3] for j in joints}
+    inertial = (
+        '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" '
+        'iyz="0" izz="0.01"/></inertial>'
+    )
+    out = ['<robot name="t">']
+    out += [f'<link name="{name}">{inertial}</link>' for name in sorted(links)]
+    for name, kind, parent, child, limits in joints:
+        out.append(
+            f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>{limits}</joint>'
+        )
+    return "".join([*out, "</robot>"])
+
+
+LIM = '<limit lower="-2" upper="2" effort="10" velocity="1"/>'
+
+
+def test_the_arm_of_a_urdf_is_its_serial_chain() -> None:
+    # An arm of three joints holding a hand of two 2-joint fingers: the arm
+    # ends at the hand (each finger is shorter than the arm).
+    arm = [("a1", "revolute", "root", "l1", LIM), ("a2", "revolute", "l1", "l2", LIM)]
+    arm.append(("a3", "revolute", "l2", "palm", LIM))
+    hand = [
+        ("f1a", "revolute", "palm", "f1", LIM),
+        ("f1b", "revolute", "f1", "f1t", LIM),
+        ("f2a", "revolute", "palm", "f2", LIM),
+        ("f2b", "revolute", "f2", "f2t", LIM),
+    ]
+    a = _models.arm_urdf(_urdf(arm + hand))
+    assert a.joints == ("a1", "a2", "a3")
+    assert a.tip == "palm"
+    assert set(a.fixed) == {"f1a", "f1b", "f2a", "f2b"}
+    # A torso of one joint with two arms of three: the chain goes on along
+    # the first arm (the arms are longer than the torso); the other is fixed.
+    body = [("t", "revolute", "root", "torso", LIM)]
+    for side in ("l", "r"):
+        parent = "torso"
+        for k in range(3):
+            body.append((f"{side}{k}", "revolute", parent, f"{side}{k}link", LIM))
+            parent = f"{side}{k}link"
+    a = _models.arm_urdf(_urdf(body))
+    assert a.joints == ("t", "l0", "l1", "l2")
+    assert a.fixed == dict.fromkeys(("r0", "r1", "r2"), "off the arm's chain (a branch)")
+    # A robot that is itself a finger keeps its joints; limits of "0 0" mean
+    # none (a continuous joint); no effort limit is NaN.
+    finger = [
+        ("finger_1", "revolute", "root", "l1", '<limit lower="0" upper="0" effort="1"/>'),
+        ("finger_2", "revolute", "l1", "l2", '<limit lower="-1" upper="1"/>'),
+    ]
+    a = _models.arm_urdf(_urdf(finger))
+    assert a.joints == ("finger_1", "finger_2")
+    assert a.lower[0] == -np.inf
+    assert a.upper[0] == np.inf
+    assert np.isnan(a.effort[1])
+    with pytest.raises(ValueError, match="no revolute or continuous joint to drive"):
+        _models.arm_urdf(_urdf([("s", "prismatic", "root", "l1", LIM)]))

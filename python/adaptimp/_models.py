@@ -165,15 +165,22 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
 
     :func:`adapt_urdf`'s clean-up (no meshes, no joint dynamics), then:
 
-    - joints named in ``fix``, prismatic joints (a linear axis or a finger),
-      mimic joints, joints whose name contains a word of :data:`GRIPPER_WORDS`
-      and revolute joints whose limits leave no motion (lower ≥ upper) are
-      fixed;
-    - of the rest (revolute and continuous), the arm is the longest serial
-      chain from the root (the most movable joints on one path; the first in
-      document order on a tie); movable joints off it (a branch: another arm,
-      a head, a hand's fingers) are fixed too.
+    - joints named in ``fix``, prismatic joints (a linear axis or a finger)
+      and mimic joints are fixed;
+    - the arm is the longest serial chain of the remaining revolute and
+      continuous joints from the root (the most of them on one path; the
+      first in document order on a tie), and it ends where the tree branches
+      into two or more subtrees with movable joints that are each shorter
+      than the chain so far (a hand: fingers are shorter than the arm that
+      holds them; a humanoid's arms are longer than its torso, so the chain
+      goes on along one of them);
+    - a joint whose name contains a word of :data:`GRIPPER_WORDS` is fixed
+      when it comes after a joint of the arm whose name does not (a gripper
+      on the arm; a robot that is itself a finger keeps its joints);
+    - movable joints off the arm (another arm, a head, a hand) are fixed.
 
+    A revolute joint whose limits leave no range (lower ≥ upper, often
+    "0 0" in exported files) is taken as unlimited: a continuous joint.
     Every fixed joint is fixed at its zero position. Raises ``ValueError`` if
     no movable joint is left.
     """
@@ -193,21 +200,21 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
             raise ValueError(f"URDF joint {name!r} has no parent or child link")
         children.setdefault(parent.get("link", ""), []).append(joint)
         parents.add(child.get("link", ""))
-        if kind in ("fixed", "floating", "planar"):
-            continue
         limit = joint.find("limit")
         lo, hi = _float(limit, "lower", -math.inf), _float(limit, "upper", math.inf)
-        words = [w for w in GRIPPER_WORDS if w in name.lower()]
+        if kind == "revolute" and not lo < hi:
+            joint.set("type", "continuous")  # no range given: unlimited
+            if limit is not None:
+                for attr in ("lower", "upper"):
+                    limit.attrib.pop(attr, None)
+        if kind in ("fixed", "floating", "planar"):
+            continue
         if name in fix:
             fixed[name] = "asked"
         elif kind == "prismatic":
             fixed[name] = "prismatic (the arm's joints are revolute)"
         elif name in mimic:
             fixed[name] = "mimic joint"
-        elif words:
-            fixed[name] = f"a gripper joint (its name contains {words[0]!r})"
-        elif kind == "revolute" and limit is not None and not lo < hi:
-            fixed[name] = f"no motion within its limits [{lo:g}, {hi:g}]"
     roots = [
         link.get("name", "") for link in root.findall("link") if link.get("name") not in parents
     ]
@@ -217,18 +224,31 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
     def movable(j: ET.Element) -> bool:
         return j.get("type") in ("revolute", "continuous") and j.get("name") not in fixed
 
-    def longest(link: str) -> list[ET.Element]:
-        """The movable joints of the longest chain below ``link``."""
-        best: list[ET.Element] = []
+    def gripper(j: ET.Element) -> str | None:
+        words = [w for w in GRIPPER_WORDS if w in j.get("name", "").lower()]
+        return words[0] if words else None
+
+    def longest(link: str, held: int, arm: bool) -> list[ET.Element]:
+        """The movable joints of the arm's chain below ``link``, with ``held``
+        joints above it, ``arm`` if one of them is not a gripper's."""
+        options = []
         for j in children.get(link, []):
             child = j.find("child")
             assert child is not None
-            chain = ([j] if movable(j) else []) + longest(child.get("link", ""))
-            if len(chain) > len(best):
-                best = chain
-        return best
+            word = gripper(j)
+            if word is not None and arm and movable(j):
+                fixed[j.get("name", "")] = f"a gripper joint (its name contains {word!r})"
+            own = [j] if movable(j) else []
+            below = longest(
+                child.get("link", ""), held + len(own), arm or (bool(own) and word is None)
+            )
+            options.append(own + below)
+        carrying = [c for c in options if c]
+        if held > 0 and len(carrying) >= 2 and all(len(c) < held for c in carrying):
+            return []  # a hand: the arm ends here
+        return max(options, key=len, default=[])
 
-    chain = longest(roots[0])
+    chain = longest(roots[0], 0, False)
     on_chain = {j.get("name", "") for j in chain}
     for j in root.findall("joint"):
         name = j.get("name", "")

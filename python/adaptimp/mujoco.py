@@ -172,11 +172,13 @@ def from_urdf(
 
     The arm is the URDF's serial chain of revolute and continuous joints
     (:func:`adaptimp._models.arm_urdf`, one reduction for MuJoCo and
-    Pinocchio): grippers (prismatic joints, mimic joints, joints named
-    gripper/finger/jaw/claw), joints without motion and branches off the
-    longest chain are fixed at their zero position, and so are the joints
-    named in ``fix``. Visual and collision elements, joint ``<dynamics>``
-    (damping, friction) and mimic tags are dropped (the rigid-body dynamics
+    Pinocchio): the longest chain from the root, ending at a hand (a branch
+    into shorter chains); prismatic and mimic joints, a gripper's joints
+    (named gripper/finger/jaw/claw, after the arm's) and every joint off the
+    chain are fixed at their zero position, and so are the joints named in
+    ``fix``. A revolute joint with no range (lower ≥ upper) is continuous.
+    Visual and collision elements, joint ``<dynamics>`` (damping, friction)
+    and mimic tags are dropped (the rigid-body dynamics
     only, no mesh files; no contact geometry). Continuous joints are
     unlimited hinges. If the inertias do not compile as they are (a massless
     moving link, an inertia that violates the triangle inequality), every

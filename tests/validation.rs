@@ -197,7 +197,7 @@ fn the_scaled_conditions_name_themselves_and_their_boundary() {
         c
     };
     assert!(build(scaled()).is_ok());
-    let cases: Vec<(&str, Box<dyn Fn(&mut Cfg)>)> = vec![
+    let cases: Vec<Violation> = vec![
         ("Kp > 0", Box::new(|c: &mut Cfg| c.kp[1] = 0.0)),
         (
             "2Kζ − ρ − Kp/d > 0",

@@ -177,7 +177,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         check::finite_slice("Kp", cfg.kp.as_slice())?;
         check::finite_slice("Kzeta", cfg.kzeta.as_slice())?;
         check::finite_slice("inertia", cfg.inertia.as_slice())?;
-        if let Some(i) = cfg.inertia.iter().position(|d| !(*d >= MIN_SCALE)) {
+        if let Some(i) = cfg.inertia.iter().position(|d| *d < MIN_SCALE) {
             return Err(Error::Condition {
                 condition: "d ≥ 1e-9",
                 lhs: "inertia",
@@ -186,7 +186,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             });
         }
         check::finite("rho", cfg.rho)?;
-        if !(cfg.rho >= MIN_SCALE) {
+        if cfg.rho < MIN_SCALE {
             return Err(Error::Condition {
                 condition: "ρ ≥ 1e-9",
                 lhs: "rho",

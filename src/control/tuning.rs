@@ -33,7 +33,9 @@ use crate::control::controller::MIN_SCALE;
 use crate::error::{check, Error, PARAM_BOUND};
 use crate::math::sqrt;
 use crate::networks::rbf::{Basis, Centers};
-use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
+#[cfg(feature = "alloc")]
+use crate::trajectory::Trajectory;
+use crate::trajectory::{Setpoint, Sinusoid};
 use crate::types::{Matrix, Vector};
 
 /// The smallest and largest number of centres [`Rule::nodes`] gives.
@@ -149,7 +151,7 @@ impl Rule {
         let scales = inertia_scales(d)?;
         if let Some(i) = scales
             .iter()
-            .position(|d| !(*d >= MIN_SCALE && *d <= PARAM_BOUND))
+            .position(|d| *d < MIN_SCALE || *d > PARAM_BOUND)
         {
             return Err(Error::Condition {
                 condition: if scales[i] < MIN_SCALE {
@@ -418,7 +420,7 @@ mod tests {
             assert!((cfg.inertia[i] - di).abs() < 1e-12 * di);
             assert!((cfg.kp[i] - 250.0 * di).abs() < 1e-9 * cfg.kp[i]);
         }
-        assert_eq!(cfg.k1, Vector::<3>::from_element(20.0));
+        assert_eq!(cfg.k1, Vector::<3>::from_element(50.0));
         assert_eq!(cfg.conditions, Conditions::Scaled);
         let traj = default_task(
             &Vector::<3>::zeros(),

@@ -169,13 +169,22 @@ def test_plant_rejects_models_it_cannot_drive() -> None:
         amj.Plant("nowhere.xml")
 
 
-def test_a_urdf_with_finger_joints_is_rejected_by_name() -> None:
-    try:
-        path = _models.panda_urdf_path()
-    except ImportError:
-        pytest.skip("example-robot-data is not installed")
+def test_a_urdf_arm_is_its_chain_with_the_gripper_fixed() -> None:
+    path = _models.panda_urdf_path()
+    arm = _models.arm_urdf(path.read_text())
+    assert arm.joints == _models.PANDA_JOINTS
+    assert arm.effort == _models.PANDA_EFFORT
+    assert arm.tip == "panda_link7"
+    prismatic = "prismatic (the arm's joints are revolute)"
+    assert arm.fixed == dict.fromkeys(_models.PANDA_FINGERS, prismatic)
+    plant = amj.Plant(path)
+    assert plant.n == 7
+    assert plant.tau_max.tolist() == list(_models.PANDA_EFFORT)
+    # The plant itself still refuses a slide joint, by name.
+    spec, effort = amj._urdf_spec(path.read_text())
+    amj._add_motors(spec, effort)
     with pytest.raises(ValueError, match=r"panda_finger_joint1 \(mjJNT_SLIDE\)"):
-        amj.Plant(path)
+        amj.Plant(spec.compile())
 
 
 def test_import_error_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:

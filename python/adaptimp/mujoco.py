@@ -1754,7 +1754,7 @@ def _run_many(
                     r.T,
                     r.settle,
                     None if r.reference is None else _tabulate(r.reference, r.steps, r.Ts),
-                )  # fmt: skip
+                )
                 for _, r in native
             ],
             threads,

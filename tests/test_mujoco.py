@@ -510,7 +510,8 @@ def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause(
     assert str(native.value) == want
     # From the first row: the reset is at t = 0, the warning still tells.
     with pytest.raises(adaptimp.DivergedError, match=r"row 0 \(t = 0 s to 0.001 s\): MuJoCo"):
-        amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0))
+        # (q0 given: with a reference and no keyframe the arm would start on it.)
+        amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0), q0=[0.0])
 
 
 def test_plant_step_raises_when_mujoco_resets(

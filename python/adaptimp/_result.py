@@ -288,9 +288,11 @@ class SimResult:
         if not compress:
             np.savez(path, **{**arrays, **meta})
             return path
+        # Only a SimResult of simulate() can be a run of the native loop; a
+        # subclass (a MuJoCo run) comes from another engine and keeps its arrays.
         rerun = (
             _rerun(self.case, self.scenario, self.params, self.n, record_every)
-            if recompute
+            if recompute and type(self) is SimResult
             else None
         )
         stored, manifest = _encode(arrays, self.params, record_every, rerun)

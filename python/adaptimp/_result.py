@@ -467,7 +467,7 @@ def _rerun(
             arm = _api.PlanarArm(n)
             if params.get("arm") != arm.params:
                 return None
-        if "nodes" in params and n <= 3:  # user centres (not recorded)
+        if "nodes" in params:  # user centres (not recorded)
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

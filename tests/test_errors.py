@@ -199,6 +199,8 @@ def test_missing_dq_is_an_error_for_state_feedback_and_pd(case: str) -> None:
         (("ab", TE, DQ), TypeError, r"q must be a sequence or array of 2 real numbers .*got str"),
         ((Q, TE, {"a": 1}), TypeError, r"dq must be a sequence or array of 2 real numbers"),
         ((Q, TE, [1.0, "x"]), TypeError, r"dq must be a sequence or array"),
+        ((Q, TE, [10**400, 0.0]), ValueError, r"dq holds a number too large for a float"),
+        (([0.1, 0.2, 0.3, 0.4], TE, DQ), ValueError, r"q must have shape \(2,\) .*got length 4"),
         (
             (np.array([1 + 1j, 0]), TE, DQ),
             TypeError,
@@ -218,6 +220,24 @@ def test_bad_step_inputs_raise_and_leave_the_state_untouched(args, error, patter
     assert ctrl.steps == 1
     np.testing.assert_array_equal(ctrl.zeta, zeta)
     np.testing.assert_array_equal(ctrl.weights["G"], weights["G"])
+
+
+def test_lists_tuples_and_arrays_step_alike() -> None:
+    """A list (of floats, ints or NumPy scalars), a tuple and an array of the same
+    numbers give the same torque, bit for bit."""
+    forms = [
+        (np.array([0.1, 0.2]), np.array([0.0, 1.0]), np.array([0.5, -0.5])),
+        ([0.1, 0.2], [0, 1], [0.5, -0.5]),
+        ((0.1, 0.2), (0.0, 1.0), (0.5, -0.5)),
+        ([np.float64(0.1), np.float32(0.2).item()], [0.0, 1.0], [np.float64(0.5), -0.5]),
+    ]
+    torques = []
+    for q, te, dq in forms:
+        ctrl = adaptimp.Controller("sf")
+        torques.append(ctrl.step(q, te, dq))
+    for tau in torques[1:3]:
+        assert np.array_equal(tau, torques[0])
+    assert not np.array_equal(torques[3], torques[0])  # 0.2 as a float32 is another number
 
 
 def test_arm_methods_check_their_inputs() -> None:

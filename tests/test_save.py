@@ -109,6 +109,81 @@ def test_a_file_of_the_first_format_still_loads() -> None:
     assert res.params["Ts"] == 50e-6
 
 
+def test_a_file_of_the_second_format_still_loads() -> None:
+    """tests/data/simresult_v2.npz was written by SimResult.save in format 2 (every
+    array stored or derived from stored ones); simresult_v2_plain.npz is the same
+    run with compress=False."""
+    res = SimResult.load(DATA / "simresult_v2.npz")
+    with np.load(DATA / "simresult_v2.npz", allow_pickle=False) as f:
+        assert json.loads(str(f["format"]))["version"] == 2
+    plain = SimResult.load(DATA / "simresult_v2_plain.npz")
+    assert_same_bits(plain, res)
+    assert (res.case, res.scenario, res.rows, res.record_every) == ("sf", "paper", 200, 1)
+    assert res.params == plain.params
+
+
+def manifest(path: Path) -> dict:
+    with np.load(path, allow_pickle=False) as f:
+        return dict(json.loads(str(f["format"])))
+
+
+def test_the_paper_run_saves_under_10_mb_and_loads_bit_identically(tmp_path: Path) -> None:
+    """The default paper run (400 000 rows) is repeated by the core at save: every
+    array comes out bit-identical, so none is stored; the load runs it again."""
+    res = adaptimp.simulate("sf")
+    path = res.save(tmp_path / "paper")
+    assert path.stat().st_size < 10_000_000
+    m = manifest(path)
+    assert m["version"] == 3
+    assert sorted(m["simulated"]) == sorted(NAMES)
+    back = SimResult.load(path)
+    assert_same_bits(res, back)
+    assert (back.case, back.scenario, back.record_every) == ("sf", "paper", 1)
+    kept = res.save(tmp_path / "kept", every=10, recompute=False)  # every array stored
+    assert manifest(kept)["simulated"] == {}
+    assert_same_bits(res, SimResult.load(kept), every=10)
+    assert back.params == res.params
+    assert json.dumps(back.metrics) == json.dumps(res.metrics)
+
+
+def test_arrays_the_core_does_not_repeat_are_stored(tmp_path: Path) -> None:
+    """A warm start, a fault and an edited array are not what the recorded
+    parameters give: those arrays are stored (and still load bit for bit)."""
+    cold = adaptimp.simulate("sf", T=0.05)
+    weights = {"D": np.full((2, 2, 256), 0.01), "C": np.zeros((2, 2, 256)), "G": np.zeros((2, 256))}
+    warm = adaptimp.simulate("sf", T=0.05, weights=weights)
+    faulty = adaptimp.simulate("sf", T=0.05, fault=adaptimp.Fault("nan_burst", 0.01, 0.01))
+    tau = cold.tau.copy()
+    tau[3, 0] = np.nextafter(tau[3, 0], np.inf)
+    edited = dataclasses.replace(cold, tau=tau)
+    for name, res in (("warm", warm), ("faulty", faulty), ("edited", edited)):
+        path = res.save(tmp_path / name)
+        assert_same_bits(res, SimResult.load(path))
+        simulated = manifest(path)["simulated"]
+        assert "tau" not in simulated, name
+        if name == "edited":  # the rest still comes from the core
+            assert "q" in simulated
+        else:
+            assert "q" not in simulated, name
+
+
+def test_a_rerun_that_differs_from_the_save_is_refused(tmp_path: Path) -> None:
+    """The load checks each recomputed array against the SHA-256 the save recorded
+    (another version of the core or another platform could give other bits)."""
+    path = adaptimp.simulate("pd", T=0.05).save(tmp_path / "run")
+    with np.load(path) as f:
+        content = dict(f)
+    m = manifest(path)
+    m["simulated"]["zeta"]["sha256"] = "0" * 64
+    content["format"] = np.array(json.dumps(m))
+    np.savez(tmp_path / "other.npz", **content)
+    with pytest.raises(
+        ValueError,
+        match=r"zeta was left to the simulation to recompute .* does not give the same bits",
+    ):
+        SimResult.load(tmp_path / "other.npz")
+
+
 def test_an_unknown_format_is_refused(runs: dict[str, SimResult], tmp_path: Path) -> None:
     path = runs["pd"].save(tmp_path / "run")
     with np.load(path) as f:

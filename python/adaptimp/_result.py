@@ -227,7 +227,14 @@ class SimResult:
         }
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def save(self, path: str | os.PathLike[str], *, every: int = 1, compress: bool = True) -> Path:
+    def save(
+        self,
+        path: str | os.PathLike[str],
+        *,
+        every: int = 1,
+        compress: bool = True,
+        recompute: bool = True,
+    ) -> Path:
         """Write the arrays, metrics and parameters to an ``.npz`` file (metrics and
         parameters as JSON strings, so no pickle is needed to read it back); returns
         the path written (``.npz`` is appended if missing). :meth:`load` reads it back
@@ -240,12 +247,24 @@ class SimResult:
             loaded result has ``record_every`` multiplied by k); the metrics stay
             those of the whole run.
         compress : bool
-            True (default): arrays that are exactly t_k = k·Ts, ``xd − q``,
-            ``sat(τ)`` or ``dq`` are not stored (they are recomputed on load, the
-            check is bit for bit), the others are stored as integer differences
-            of their bit patterns (lossless), deflated. The paper scenario's
-            400 000 rows take about a third of ``np.savez_compressed``'s size.
+            True (default): arrays that the core recomputes exactly are not
+            stored: a run of :func:`adaptimp.simulate` is deterministic, so the
+            save runs it again from the recorded case, scenario and parameters
+            and drops every array that comes out bit-identical (with its SHA-256,
+            which the load checks after running it again); arrays that are
+            exactly t_k = k·Ts, ``xd − q``, ``sat(τ)`` or ``dq`` are recomputed
+            on load (checked bit for bit); the others (a warm start, a fault, an
+            edited result, another arm, a MuJoCo run) are stored as integer
+            differences of their bit patterns (lossless), deflated. The paper
+            scenario's 400 000 rows take under 1 MB (a save and a load then
+            each cost one run of the simulation).
             False: plain float64 arrays (``np.savez``), readable by NumPy alone.
+        recompute : bool
+            True (default): leave to the core what it repeats bit for bit (with
+            ``compress``). Such a file loads only where the simulation gives the
+            same bits (the load checks, and names the version that saved it);
+            False: store every array, for a file that any later version loads on
+            any platform.
         """
         if isinstance(every, bool) or not isinstance(every, int) or every < 1:
             raise ValueError(f"every must be an integer ≥ 1, got {every!r}")
@@ -269,8 +288,15 @@ class SimResult:
         if not compress:
             np.savez(path, **{**arrays, **meta})
             return path
-        stored, manifest = _encode(arrays, self.params, record_every)
-        meta["format"] = np.array(json.dumps({"version": 2, **manifest}))
+        # Only a SimResult of simulate() can be a run of the native loop; a
+        # subclass (a MuJoCo run) comes from another engine and keeps its arrays.
+        rerun = (
+            _rerun(self.case, self.scenario, self.params, self.n, record_every)
+            if recompute and type(self) is SimResult
+            else None
+        )
+        stored, manifest = _encode(arrays, self.params, record_every, rerun)
+        meta["format"] = np.array(json.dumps({"version": 3, **manifest}))
         np.savez_compressed(path, **{**stored, **meta})
         return path
 
@@ -283,12 +309,19 @@ class SimResult:
             names = [*ARRAYS, *EXTRA_ARRAYS]
             if "format" in f:
                 manifest = json.loads(str(f["format"]))
-                if manifest.get("version") != 2:
+                if manifest.get("version") not in (2, 3):
                     raise ValueError(
                         f"{path}: saved in format {manifest.get('version')!r}, which this "
-                        "version of adaptimp cannot read (it reads 1 and 2)"
+                        "version of adaptimp cannot read (it reads 1, 2 and 3)"
                     )
-                arrays = _decode(f, manifest, params, record_every)
+                simulated = (
+                    _resimulated(
+                        path, str(f["case"]), str(f["scenario"]), params, record_every, manifest
+                    )
+                    if manifest.get("simulated")
+                    else {}
+                )
+                arrays = _decode(f, manifest, params, record_every, simulated)
             else:  # format 1: plain float64 arrays
                 arrays = {name: f[name] for name in names if name in f}
             return cls(
@@ -350,11 +383,11 @@ def _derivations(
 
 
 def _same_bits(a: NDArray[Any], b: NDArray[Any]) -> bool:
-    return (
-        a.shape == b.shape
-        and a.dtype == b.dtype
-        and bool(np.array_equal(a.view(_U64), b.view(_U64)))
-    )
+    if a.shape != b.shape or a.dtype != b.dtype:
+        return False
+    if a.dtype == np.float64:
+        return bool(np.array_equal(a.view(_U64), b.view(_U64)))
+    return bool(np.array_equal(a, b))
 
 
 def _ordered_bits(a: NDArray[np.float64]) -> NDArray[np.uint64]:
@@ -411,13 +444,95 @@ def _best_order(a: NDArray[np.float64]) -> int:
     return int(np.argmin(sizes))
 
 
+def _rerun(
+    case: str, scenario: str, params: Mapping[str, Any], n: int, record_every: int
+) -> dict[str, NDArray[Any]] | None:
+    """The arrays of :func:`adaptimp.simulate` run again from the recorded case,
+    scenario and parameters alone (the default arm for n, the vertex grid or the
+    rule's centres, zero initial weights, no fault), keeping every
+    ``record_every``-th step; None where those do not describe a run the core
+    can repeat (another arm, user centres, an unknown parameter)."""
+    import warnings
+
+    from . import _adaptimp, _api
+    from ._params import BY_NAME, N_JOINTS, names
+
+    try:
+        p = {k: v for k, v in params.items() if k in BY_NAME}
+        if n == N_JOINTS and "arm" not in params:
+            arm: _api.TwoLinkArm | _api.PlanarArm = _api.TwoLinkArm(
+                **{k: p[k] for k in names("arm")}
+            )
+        else:
+            arm = _api.PlanarArm(n)
+            if params.get("arm") != arm.params:
+                return None
+        if "nodes" in params:  # user centres (not recorded)
+            return None
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            core = _api._core_controller(case, p, n, None, None)
+            out = _adaptimp.simulate(core, arm._core, p, record_every, None, None, None)
+    except (TypeError, ValueError, KeyError, ArithmeticError):
+        return None  # not a run the core can repeat from what was recorded
+    out.pop("metrics")
+    return {k: v for k, v in out.items() if isinstance(v, np.ndarray)}
+
+
+def _digest(a: NDArray[Any]) -> str:
+    import hashlib
+
+    return hashlib.sha256(np.ascontiguousarray(a).tobytes()).hexdigest()
+
+
+def _resimulated(
+    path: str | os.PathLike[str],
+    case: str,
+    scenario: str,
+    params: Mapping[str, Any],
+    record_every: int,
+    manifest: Mapping[str, Any],
+) -> dict[str, NDArray[Any]]:
+    """The arrays a format-3 file left to the core, run again and checked against
+    the SHA-256 the save recorded."""
+    simulated: Mapping[str, Any] = manifest["simulated"]
+    rerun = _rerun(case, scenario, params, int(manifest["n"]), record_every)
+    out: dict[str, NDArray[Any]] = {}
+    for name, spec in simulated.items():
+        a = None if rerun is None else rerun.get(name)
+        if a is None or list(a.shape) != spec["shape"] or _digest(a) != spec["sha256"]:
+            raise ValueError(
+                f"{path}: {name} was left to the simulation to recompute (saved by "
+                f"adaptimp {manifest.get('adaptimp')}), but running it again here does not "
+                "give the same bits (another version of the core, or another platform's "
+                "floating point): load it with the version that saved it"
+            )
+        out[name] = a
+    return out
+
+
 def _encode(
-    arrays: Mapping[str, NDArray[Any]], params: Mapping[str, Any], record_every: int
+    arrays: Mapping[str, NDArray[Any]],
+    params: Mapping[str, Any],
+    record_every: int,
+    rerun: Mapping[str, NDArray[Any]] | None = None,
 ) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
+    from . import __version__
+
     stored: dict[str, NDArray[Any]] = {}
-    manifest: dict[str, Any] = {"derived": [], "differences": {}}
+    manifest: dict[str, Any] = {
+        "derived": [],
+        "differences": {},
+        "simulated": {},
+        "n": int(arrays["q"].shape[1]),
+        "adaptimp": __version__,
+    }
     derive = _derivations(arrays["t"].shape[0], params, record_every)
     for name, a in arrays.items():
+        again = None if rerun is None else rerun.get(name)
+        if again is not None and _same_bits(again, a):
+            manifest["simulated"][name] = {"shape": list(a.shape), "sha256": _digest(a)}
+            continue
         rule = derive.get(name)
         if rule is not None and a.dtype == np.float64:
             try:
@@ -441,15 +556,17 @@ def _decode(
     manifest: Mapping[str, Any],
     params: Mapping[str, Any],
     record_every: int,
+    simulated: Mapping[str, NDArray[Any]],
 ) -> dict[str, NDArray[Any]]:
-    arrays: dict[str, NDArray[Any]] = {}
+    arrays: dict[str, NDArray[Any]] = dict(simulated)
     for name in f:
         if name in manifest["differences"]:
             spec = manifest["differences"][name]
             arrays[name] = _undifferences(f[name], spec["order"], spec["shape"])
         else:
             arrays[name] = f[name]
-    # Each rule reads only arrays that are stored (q, xd, tau, dq), never derived.
+    # Each rule reads only arrays that are stored or simulated (q, xd, tau, dq),
+    # never derived.
     derive = _derivations(arrays["q"].shape[0], params, record_every)
     for name in manifest["derived"]:
         arrays[name] = derive[name](arrays)

@@ -273,6 +273,37 @@ fn type_error(what: &str, n: usize, obj: &Bound<'_, PyAny>) -> PyErr {
 /// real dtype, or a sequence of n real numbers (any values). Errors name `what`.
 fn vector_any(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<Buf> {
     let mut out = [0.0; MAX_JOINTS];
+    vector_into(what, n, obj, &mut out)?;
+    Ok(out)
+}
+
+/// A list of exactly `out.len()` real numbers into `out`, without allocating
+/// (the hot path of `step` with lists); false for anything else (then `out`
+/// may be partly written, and the general path reads or refuses it).
+fn list_into(obj: &Bound<'_, PyAny>, out: &mut [f64]) -> bool {
+    let Ok(list) = obj.cast::<PyList>() else {
+        return false;
+    };
+    if list.len() != out.len() {
+        return false;
+    }
+    for (o, item) in out.iter_mut().zip(list.iter()) {
+        match item.extract::<f64>() {
+            Ok(x) => *o = x,
+            Err(_) => return false,
+        }
+    }
+    true
+}
+
+/// As [`vector_any`], into `out` (the entries past n untouched): a step's
+/// arguments go straight into their buffers.
+fn vector_into(
+    what: &'static str,
+    n: usize,
+    obj: &Bound<'_, PyAny>,
+    out: &mut Buf,
+) -> PyResult<()> {
     if let Ok(f) = obj.cast::<PyArray1<f64>>() {
         if f.len() != n {
             return Err(shape_error(what, n, &python_shape(f.shape())));
@@ -298,6 +329,7 @@ fn vector_any(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<
         for (o, x) in out.iter_mut().zip(ro.as_array().iter()) {
             *o = *x;
         }
+    } else if list_into(obj, &mut out[..n]) {
     } else if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() {
         return Err(type_error(what, n, obj));
     } else if let Ok(v) = obj.extract::<Vec<f64>>() {
@@ -318,7 +350,7 @@ fn vector_any(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<
         }
         return Err(type_error(what, n, obj));
     }
-    Ok(out)
+    Ok(())
 }
 
 /// As [`vector_any`], every entry finite.
@@ -461,6 +493,13 @@ struct Given {
 }
 
 impl Given {
+    const EMPTY: Self = Self {
+        x: [0.0; MAX_JOINTS],
+        tau_e: [0.0; MAX_JOINTS],
+        dx: None,
+        setpoint: None,
+    };
+
     fn inputs(&self, n: usize) -> Inputs<'_> {
         Inputs {
             x: &self.x[..n],
@@ -516,26 +555,28 @@ impl PyController {
         array1(py, self.lock(py).last(what))
     }
 
-    /// A step's arguments, converted (shapes and types checked; any values).
+    /// A step's arguments, converted into `given` (shapes and types checked;
+    /// any values). In place: the buffers are not moved about per call.
     fn convert(
         &self,
         q: &Bound<'_, PyAny>,
         tau_e: &Bound<'_, PyAny>,
         dq: Option<&Bound<'_, PyAny>>,
         setpoint: [Option<&Bound<'_, PyAny>>; 3],
-    ) -> PyResult<Given> {
+        given: &mut Given,
+    ) -> PyResult<()> {
         let n = self.n;
-        let conv = |what, o| vector_any(what, n, o);
-        let x = conv("q", q)?;
-        let te = conv("tau_e", tau_e)?;
-        let dx = match (self.law, dq) {
+        vector_into("q", n, q, &mut given.x)?;
+        vector_into("tau_e", n, tau_e, &mut given.tau_e)?;
+        given.dx = match (self.law, dq) {
             (Law::OutputFeedback, _) | (_, None) => None,
-            (_, Some(dq)) => Some(conv("dq", dq)?),
+            (_, Some(dq)) => Some(vector_any("dq", n, dq)?),
         };
-        let sp = match setpoint {
+        given.setpoint = match setpoint {
             [None, None, None] => None,
             [Some(x), dx, ddx] => {
                 let zero = [0.0; MAX_JOINTS];
+                let conv = |what, o| vector_any(what, n, o);
                 Some([
                     conv("xc", x)?,
                     dx.map(|d| conv("dxc", d)).transpose()?.unwrap_or(zero),
@@ -548,12 +589,7 @@ impl PyController {
                 ))
             }
         };
-        Ok(Given {
-            x,
-            tau_e: te,
-            dx,
-            setpoint: sp,
-        })
+        Ok(())
     }
 }
 
@@ -623,8 +659,8 @@ impl PyController {
         let n = self.n;
         // Values are the core's to judge (a non-finite one is a refused step
         // that records its fault); shapes and types are checked here.
-        let given = self
-            .convert(q, tau_e, dq, [xc, dxc, ddxc])
+        let mut given = Given::EMPTY;
+        self.convert(q, tau_e, dq, [xc, dxc, ddxc], &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)
@@ -653,8 +689,8 @@ impl PyController {
         let n = self.n;
         // Shapes and types are checked (a refusal, recorded, then raised);
         // values are the controller's to judge.
-        let given = self
-            .convert(q, tau_e, dq, [xc, dxc, ddxc])
+        let mut given = Given::EMPTY;
+        self.convert(q, tau_e, dq, [xc, dxc, ddxc], &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         let result = self

@@ -505,7 +505,8 @@ def _resimulated(
                 f"{path}: {name} was left to the simulation to recompute (saved by "
                 f"adaptimp {manifest.get('adaptimp')}), but running it again here does not "
                 "give the same bits (another version of the core, or another platform's "
-                "floating point): load it with the version that saved it"
+                "floating point): load it with the version that saved it, and save it there "
+                "with recompute=False for a file that any version reads"
             )
         out[name] = a
     return out

@@ -327,8 +327,8 @@ fn the_wrench_goes_through_the_sensor_path_delayed_and_frozen_with_the_joints() 
     let (noisy, wrench, _) = spy_run(2, 1e-3, None);
     let (quiet, _, _) = spy_run(2, 0.0, None);
     assert!(noisy != quiet, "the noise reached the joint sample");
-    for k in 0..wrench.len() {
-        assert_eq!(wrench[k], truth.rows[k.saturating_sub(2)].wrench, "k = {k}");
+    for (k, w) in wrench.iter().enumerate() {
+        assert_eq!(*w, truth.rows[k.saturating_sub(2)].wrench, "k = {k}");
     }
     // A stale sensor freezes the wrench with q, q̇, τe; other faults leave it be.
     let stale = Injection {

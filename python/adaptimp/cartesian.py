@@ -308,9 +308,15 @@ class CartesianController:
     -----
     The :func:`adaptimp.mujoco.simulate` protocol: ``wants_wrench = True``, so it
     calls ``step(q, dq, wrench, xc=, dxc=, ddxc=)``; ``.ts``; after a step
-    ``xc`` = p_c, ``xd`` = p_d (the compliant reference), ``z1`` = p_d − p(q)
-    (m, (3,)), ``tau`` (the joint controller's commanded τ, N m), ``q_d``,
-    ``force`` (f, N).
+    ``xc``, ``dxc``, ``ddxc`` = p_c, ṗ_c, p̈_c (the commanded position and its
+    rates; when no target is given, the held target after its filter, p_t, at
+    rest), ``xd`` = p_d (the compliant reference), ``z1`` = p_d − p(q) (m,
+    (3,)), ``tau`` (the joint controller's commanded τ, N m), ``q_d``,
+    ``force`` (f, N); ``zeta`` and ``dq_hat`` are the joint controller's (if it
+    has them). With a case name's joint controller, :func:`adaptimp.mujoco.simulate`
+    runs the whole loop in the core (the path or the reference tabulated
+    first, at the loop's t_k); afterwards the controller is as after the same
+    steps taken one by one (its log holds the run's kept rows).
 
     Examples
     --------
@@ -393,6 +399,7 @@ class CartesianController:
         n = chain.n
         nan3 = np.full(3, math.nan)
         self.xc, self.xd, self.z1, self.force = nan3, nan3, nan3, nan3
+        self.dxc, self.ddxc = nan3, nan3
         self.tau = np.full(n, math.nan)
         self.q_d = self.outer.q0.copy()
         self.log: dict[str, list[FloatArray]] = {k: [] for k in _LOG}
@@ -401,6 +408,18 @@ class CartesianController:
     def Ts(self) -> float:
         """Period Ts (s)."""
         return self.ts
+
+    @property
+    def zeta(self) -> FloatArray:
+        """The joint controller's auxiliary state ζ now (N m), (n,) (AttributeError
+        if it has none)."""
+        return np.asarray(self.inner.zeta, dtype=np.float64)
+
+    @property
+    def dq_hat(self) -> FloatArray:
+        """The velocity the joint controller used in the last step (rad/s), (n,)
+        (AttributeError if it does not say)."""
+        return np.asarray(self.inner.dq_hat, dtype=np.float64)
 
     @property
     def n(self) -> int:
@@ -460,18 +479,15 @@ class CartesianController:
         else:
             out = core.step_python(self.inner, q, dq, f, target)
             self.tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
-        pd = core.last("p_d")
-        self.xc = core.last("p_t") if target is None else target[:3].copy()
-        self.xd, self.force, self.q_d = pd, f[:3].copy(), core.last("q_d")
-        self.z1 = pd - core.last("p")
+        self._last_step()
+        pd = self.xd
         if self.record:
-            t = np.zeros(24) if target is None else target
             for key, v in zip(
                 _LOG,
                 (
-                    t[0:3],
-                    t[3:6],
-                    t[6:9],
+                    self.xc,
+                    self.dxc,
+                    self.ddxc,
                     pd,
                     core.last("dp_d"),
                     core.last("ddp_d"),
@@ -486,9 +502,61 @@ class CartesianController:
         return np.asarray(out)
 
     def arrays(self) -> dict[str, FloatArray]:
-        """The log as (K, ·) arrays: pc, dpc, ddpc, pd, dpd, ddpd (K, 3); qd (K, n);
+        """The log as (K, ·) arrays: pc, dpc, ddpc (the commanded position and its
+        rates, as ``xc``, ``dxc``, ``ddxc``), pd, dpd, ddpd (K, 3); qd (K, n);
         wrench, error (K, 6)."""
-        return {k: np.array(v, dtype=np.float64) for k, v in self.log.items()}
+        n = self.chain.n
+        width = {"qd": n, "wrench": 6, "error": 6}
+        return {
+            k: np.array(v, dtype=np.float64).reshape(len(v), width.get(k, 3))
+            for k, v in self.log.items()
+        }
+
+    def _targets(
+        self, steps: int, reference: Callable[[float], Sequence[ArrayLike]] | None
+    ) -> FloatArray | None:
+        """The commanded pose of the next ``steps`` steps at t_k = k·Ts of a loop,
+        (steps, 24), as :meth:`step` would take them one by one: ``reference(t_k)``
+        (position, rates; the rotation held), else the path on this controller's
+        clock, else None (the last target held). Leaves the held rotation as
+        those steps would."""
+        R = self.outer._R
+        if reference is not None:
+            out = np.empty((steps, 24))
+            for k in range(steps):
+                xc, dxc, ddxc = reference(k * self.ts)
+                out[k] = pose_target(xc, dxc, ddxc, R)
+            return out
+        if self.path is None:
+            return None
+        out = np.empty((steps, 24))
+        for k in range(steps):
+            out[k] = _sample(self.path, (self._k + k) * self.ts, R)
+            R = out[k, 9:18].reshape(3, 3)
+        return out
+
+    def _last_step(self) -> None:
+        """The attributes of the last step taken, from the core's outer loop."""
+        last = self.outer.core.last
+        self.xc, self.dxc, self.ddxc = last("p_c"), last("dp_c"), last("ddp_c")
+        self.xd, self.force, self.q_d = last("p_d"), last("wrench")[:3], last("q_d")
+        self.z1 = self.xd - last("p")
+
+    def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None) -> None:
+        """After a run of the core's loop (:func:`adaptimp.mujoco.simulate`) along
+        ``targets`` (of :meth:`_targets`), whole or stopped by an error: the clock,
+        the held rotation and the attributes as after the steps it took; the log
+        extended by the run's kept rows ``task`` (None: none)."""
+        core = self.outer.core
+        k0, self._k = self._k, int(core.steps)
+        if self._k > k0:
+            if targets is not None and self.path is not None:
+                self.outer._R = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
+            self._last_step()
+            self.tau = core.last("tau")
+        if self.record and task is not None:
+            for key in _LOG:
+                self.log[key].extend(np.array(row) for row in task[key])
 
     def __repr__(self) -> str:
         kind = "position-only" if not self.outer.orients else "6-D"

@@ -790,6 +790,14 @@ class MujocoResult(SimResult):
         End-effector position (m), world frame.
     wrench_ee : (K, 6)
         F_e: force (N) and moment (N m) the end effector exerts, world frame.
+    task : dict or None
+        A Cartesian controller's task-space rows (:class:`adaptimp.CartesianController`,
+        the keys of its ``arrays()``): "pc", "dpc", "ddpc" (the commanded position
+        and rates, = ``xc``, ``dxc``, ``ddxc``), "pd", "dpd", "ddpd" (the compliant
+        reference, ``xd`` = pd), "qd" (the joint reference, (K, n)), "wrench" (the
+        F_e it was given, (K, 6)), "error" (the impedance's [e_p; e_o], (K, 6)).
+        None for a joint-space controller (and in the Python loop for a Cartesian
+        one with ``record=False``).
     metrics : dict
         The SPEC §12 metrics, with the keys of :attr:`adaptimp.SimResult.metrics`
         (NaN where they do not apply: ``imp_err_rms_after2`` needs a joint-space
@@ -801,6 +809,7 @@ class MujocoResult(SimResult):
 
     x_ee: FloatArray | None = None
     wrench_ee: FloatArray | None = None
+    task: dict[str, FloatArray] | None = None
 
     @property
     def rows(self) -> int:
@@ -922,6 +931,20 @@ def _native(ctrl: Any) -> bool:
     return isinstance(ctrl, _adaptimp.Controller) and type(ctrl).step is _adaptimp.Controller.step
 
 
+def _native_cartesian(ctrl: Any) -> bool:
+    """Whether the core can step ``ctrl`` as a whole: an
+    :class:`adaptimp.CartesianController` (its own ``step``) in front of a
+    joint controller the core steps (a case name's)."""
+    from .cartesian import CartesianController
+
+    return (
+        isinstance(ctrl, CartesianController)
+        and type(ctrl).step is CartesianController.step
+        and ctrl._core_inner
+        and _native(ctrl.inner)
+    )
+
+
 def _tabulate(
     reference: Reference, steps: int, Ts: float
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -1039,7 +1062,10 @@ def simulate(
 
     callback, bar = _progress(progress, "mujoco.simulate")
     try:
-        if run.native:
+        if run.native and run.cartesian:
+            out = _cartesian_loop(run, reference, callback, fault)
+            m = out.pop("metrics")
+        elif run.native:
             assert run.spec is not None
             refs = None if reference is None else _tabulate(reference, run.steps, run.Ts)
             core_fault = None if fault is None else fault._core(run.plant.n)
@@ -1062,6 +1088,31 @@ def simulate(
     return _result(run, out, m)
 
 
+def _cartesian_loop(
+    run: _Run,
+    reference: Reference | None,
+    progress: Callable[[int, int], object] | None,
+    fault: Fault | None,
+) -> dict[str, Any]:
+    """The native loop of an :class:`adaptimp.CartesianController` whose joint
+    controller the core steps: its commanded pose tabulated for every row
+    (the reference at t_k, else its path on its own clock), then the core's
+    loop; the controller's Python side brought up to date, whatever happens."""
+    assert run.spec is not None
+    ctrl = run.ctrl
+    targets = ctrl._targets(run.steps, reference)
+    core_fault = None if fault is None else fault._core(run.plant.n)
+    out: dict[str, Any] | None = None
+    try:
+        out = ctrl.outer.core.simulate_mujoco(
+            ctrl.inner, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
+            run.settle, run.every, progress, targets, core_fault,
+        )  # fmt: skip
+    finally:
+        ctrl._ran(targets, None if out is None else out["task"])
+    return out
+
+
 @dataclass
 class _Run:
     """A run of :func:`simulate`, set up: its controller, plant and settings."""
@@ -1079,6 +1130,7 @@ class _Run:
     dist: dict[str, Any]
     spec: dict[str, Any] | None
     native: bool
+    cartesian: bool = False
 
 
 def _setup(
@@ -1146,10 +1198,12 @@ def _setup(
     plant.timestep = Ts / substeps
     plant.reset(q0, dq0)
     spec = plant._native(substeps)
-    native = _native(ctrl) and spec is not None and not bool(getattr(ctrl, "wants_wrench", False))
+    cartesian = _native_cartesian(ctrl)
+    native = spec is not None and (cartesian or _native(ctrl))
     return _Run(
-        ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native
-    )
+        ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native,
+        cartesian,
+    )  # fmt: skip
 
 
 def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
@@ -1199,7 +1253,12 @@ def _python_loop(
             "adaptimp.Controller or a case name) and a plant with a force sensor or "
             "no possible contact; this run steps its controller from Python"
         )
-    has = {name: hasattr(ctrl, name) for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta")}
+    has = {
+        name: hasattr(ctrl, name)
+        for name in ("tau", "xc", "dxc", "ddxc", "xd", "z1", "dq_hat", "zeta")
+    }
+    # Its own commanded rates (a Cartesian controller's ṗ_c, p̈_c), if it says.
+    own_rates = reference is None and has["dxc"] and has["ddxc"]
     # The Cartesian hook (ControllerLike): the measured wrench instead of τe.
     wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
     n = plant.n
@@ -1230,6 +1289,9 @@ def _python_loop(
             tau_cmd = ctrl.step(*args)
             xc = ctrl.xc if has["xc"] else q
             r_xc.append(xc)
+            if own_rates:
+                r_dxc.append(ctrl.dxc)
+                r_ddxc.append(ctrl.ddxc)
         tau_sat = plant.apply(tau_cmd)
         plant.forward()  # q̈ at the row's state and applied torque (SPEC §12)
         xd = ctrl.xd if has["xd"] else xc
@@ -1250,7 +1312,7 @@ def _python_loop(
             progress(k + 1, steps)
 
     t: FloatArray = np.arange(steps, dtype=np.float64) * Ts
-    if reference is None:
+    if reference is None and not own_rates:
         # The controller's own trajectory, if its params declare one (for the
         # impedance metric), evaluated for every row at once.
         builtin = _builtin_reference(ctrl)
@@ -1281,9 +1343,14 @@ def _python_loop(
     m = _adaptimp.metrics(
         a["t"], a["q"], a["dq"], a["ddq"], a["xc"], a["dxc"], a["ddxc"], a["z1"],
         a["tau"], a["tau_sat"], a["tau_e"], settle, tuple(target),
+        False if wants_wrench else None,
     )  # fmt: skip
-    kept = {name: v[::every] for name, v in arrays.items()}
+    kept: dict[str, Any] = {name: v[::every] for name, v in arrays.items()}
     kept["w_norms"] = np.full((kept["t"].shape[0], 3), math.nan)
+    # A Cartesian controller's log of this run (adaptimp.CartesianController.arrays).
+    log = getattr(ctrl, "arrays", None) if wants_wrench and getattr(ctrl, "record", False) else None
+    if callable(log) and steps:
+        kept["task"] = {k: v[len(v) - steps :: every] for k, v in log().items()}
     return kept, m
 
 

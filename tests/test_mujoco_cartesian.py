@@ -303,3 +303,50 @@ def test_an_exploding_cartesian_run_raises_and_names_the_row(
     assert a._k == b._k == 7
     for name in _ATTRS:
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_a_reference_given_as_arrays(sc: ac.PandaTable, basis: Any) -> None:
+    """simulate(reference=(xc, dxc, ddxc)) tabulated at k·Ts: the run of the same
+    reference as a callable, in both loops, joint space and task space."""
+    steps = 300
+    rows = [sc.path(k * sc.ts) for k in range(steps + 5)]
+    table = tuple(np.array([r[i] for r in rows]) for i in range(3))
+
+    def reference(t: float) -> Any:
+        return sc.path(t)
+
+    def make() -> adaptimp.CartesianController:
+        ctrl = ac.panda_controller("sf", sc, basis=basis)
+        ctrl.path = None  # the reference of simulate instead
+        return ctrl
+
+    plant = amj.Plant(sc.model)
+    runs = []
+    for ref in (table, reference):
+        for native in (True, False):
+            ctrl = make()
+            res = amj.simulate(
+                ctrl if native else _InPython(ctrl), plant, T=0.3, q0=sc.q0, reference=ref
+            )
+            assert res.params["loop"] == ("native" if native else "python")
+            runs.append((ctrl, res))
+    for ctrl, res in runs[1:]:
+        _assert_same_run(res, runs[0][1], ctrl, runs[0][0])
+    # Joint space: the native loop with a table is the one with the callable.
+    q0 = np.array([0.25, -0.05])
+    joint = tuple(np.tile(v, (steps, 1)) for v in (q0, np.zeros(2), np.zeros(2)))
+    a = amj.simulate(adaptimp.Controller("pd", "robot"), "two_link", T=0.3, reference=joint)
+    b = amj.simulate(
+        adaptimp.Controller("pd", "robot"), "two_link", T=0.3,
+        reference=lambda t: (q0, np.zeros(2), np.zeros(2)),
+    )  # fmt: skip
+    for name in _ARRAYS:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    with pytest.raises(ValueError, match=r"reference dxc must have shape \(K, m\) with K ≥ 300"):
+        amj.simulate("pd", "two_link", T=0.3, reference=(joint[0], joint[1][:10], joint[2]))
+    with pytest.raises(ValueError, match="reference must be a callable or three arrays"):
+        amj.simulate("pd", "two_link", T=0.3, reference=joint[:2])
+    bad = joint[0].copy()
+    bad[7, 1] = math.nan
+    with pytest.raises(ValueError, match="reference xc must be finite"):
+        amj.simulate("pd", "two_link", T=0.3, reference=(bad, joint[1], joint[2]))

@@ -507,32 +507,53 @@ class CartesianController:
         wrench, error (K, 6)."""
         n = self.chain.n
         width = {"qd": n, "wrench": 6, "error": 6}
+        # Each entry of the log is a step's row, or a block of rows (a run of the core's loop).
         return {
-            k: np.array(v, dtype=np.float64).reshape(len(v), width.get(k, 3))
+            k: np.vstack(v) if v else np.zeros((0, width.get(k, 3)))
             for k, v in self.log.items()
         }
 
     def _targets(
-        self, steps: int, reference: Callable[[float], Sequence[ArrayLike]] | None
+        self,
+        steps: int,
+        reference: Callable[[float], Sequence[ArrayLike]] | Sequence[FloatArray] | None,
     ) -> FloatArray | None:
         """The commanded pose of the next ``steps`` steps at t_k = k·Ts of a loop,
         (steps, 24), as :meth:`step` would take them one by one: ``reference(t_k)``
-        (position, rates; the rotation held), else the path on this controller's
-        clock, else None (the last target held). Leaves the held rotation as
-        those steps would."""
-        R = self.outer._R
-        if reference is not None:
-            out = np.empty((steps, 24))
-            for k in range(steps):
-                xc, dxc, ddxc = reference(k * self.ts)
-                out[k] = pose_target(xc, dxc, ddxc, R)
-            return out
-        if self.path is None:
+        or the row k of a tabulated reference (xc, dxc, ddxc) (position, rates;
+        the rotation held), else the path on this controller's clock, else None
+        (the last target held)."""
+        path = self.path
+        if reference is None and path is None:
             return None
-        out = np.empty((steps, 24))
+        # The rows of pose_target, filled in place (a path is called once a period).
+        out = np.zeros((steps, 24))
+        out[:, 9:18] = self.outer._R.ravel()
+        if reference is not None and not callable(reference):
+            for i in range(3):
+                out[:, 3 * i : 3 * i + 3] = reference[i][:steps]
+            return out
+        if reference is not None:
+            for k in range(steps):
+                out[k, 0:3], out[k, 3:6], out[k, 6:9] = reference(k * self.ts)
+            return out
+        assert path is not None
+        k0, ts = self._k, self.ts
+        turned = False  # a 3-tuple keeps the rotation a 6-tuple set
         for k in range(steps):
-            out[k] = _sample(self.path, (self._k + k) * self.ts, R)
-            R = out[k, 9:18].reshape(3, 3)
+            s = tuple(path((k0 + k) * ts))
+            if len(s) == 3:
+                out[k, 0:3], out[k, 3:6], out[k, 6:9] = s
+                if turned:
+                    out[k, 9:18] = out[k - 1, 9:18]
+            elif len(s) == 6:
+                out[k] = pose_target(*s)
+                turned = True
+            else:
+                raise ValueError(
+                    "path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), "
+                    f"got {len(s)}"
+                )
         return out
 
     def _last_step(self) -> None:
@@ -554,9 +575,9 @@ class CartesianController:
                 self.outer._R = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
             self._last_step()
             self.tau = core.last("tau")
-        if self.record and task is not None:
+        if self.record and task is not None and len(task["pc"]):
             for key in _LOG:
-                self.log[key].extend(np.array(row) for row in task[key])
+                self.log[key].append(task[key])
 
     def __repr__(self) -> str:
         kind = "position-only" if not self.outer.orients else "6-D"

@@ -945,14 +945,47 @@ def _native_cartesian(ctrl: Any) -> bool:
     )
 
 
-def _tabulate(
-    reference: Reference, steps: int, Ts: float
-) -> tuple[FloatArray, FloatArray, FloatArray]:
+Table = tuple[FloatArray, FloatArray, FloatArray]
+"""A reference tabulated at t_k = k·Ts: (xc, dxc, ddxc), (K, m) each."""
+
+
+def _tabulate(reference: Reference | Table, steps: int, Ts: float) -> Table:
     """``reference(k·Ts)`` for every row k, as three (K, m) arrays (called in
-    order, once per row, as the loop would)."""
+    order, once per row, as the loop would); a table as it is."""
+    if isinstance(reference, tuple):
+        return reference
     rows = [tuple(np.asarray(v, dtype=np.float64) for v in reference(k * Ts)) for k in range(steps)]
     xc, dxc, ddxc = (np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
     return xc, dxc, ddxc
+
+
+def _reference_table(reference: Sequence[ArrayLike], steps: int) -> Table:
+    """A reference given as arrays, validated: its first ``steps`` rows."""
+    if len(reference) != 3:
+        raise ValueError(
+            f"reference must be a callable or three arrays (xc, dxc, ddxc), got {len(reference)}"
+        )
+    arrays = [np.asarray(v, dtype=np.float64) for v in reference]
+    for name, a in zip(("xc", "dxc", "ddxc"), arrays):
+        if a.ndim != 2 or a.shape[0] < steps or a.shape[1] != arrays[0].shape[1]:
+            raise ValueError(
+                f"reference {name} must have shape (K, m) with K ≥ {steps} rows (one per step) "
+                f"and the width m of xc, got {a.shape}"
+            )
+        if not np.all(np.isfinite(a[:steps])):
+            raise ValueError(f"reference {name} must be finite")
+    xc, dxc, ddxc = (np.ascontiguousarray(a[:steps]) for a in arrays)
+    return xc, dxc, ddxc
+
+
+def _table_reference(table: Table, Ts: float) -> Reference:
+    """A tabulated reference as a callable: the row of t_k = k·Ts."""
+
+    def reference(t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        k = round(t / Ts)
+        return table[0][k], table[1][k], table[2][k]
+
+    return reference
 
 
 def simulate(
@@ -964,7 +997,7 @@ def simulate(
     substeps: int | None = None,
     q0: ArrayLike | None = None,
     dq0: ArrayLike | None = None,
-    reference: Reference | None = None,
+    reference: Reference | Sequence[ArrayLike] | None = None,
     contact: bool = True,
     settle: float | None = None,
     scenario: str = "robot",
@@ -1012,9 +1045,11 @@ def simulate(
     q0, dq0 : array_like, optional
         Initial joint positions (rad) and velocities (rad/s); default the
         model's first keyframe (the paper's q(0) for ``two_link``), else qpos0.
-    reference : callable, optional
+    reference : callable or (xc, dxc, ddxc), optional
         ``reference(t) -> (xc, dxc, ddxc)``: passed to every step as
-        ``xc=, dxc=, ddxc=``. None: the controller follows its own trajectory.
+        ``xc=, dxc=, ddxc=``; or three arrays (K, m) tabulated at t_k = k·Ts,
+        K ≥ the steps (computed with NumPy in advance, no Python call in the
+        loop). None: the controller follows its own trajectory.
     contact : bool
         False: free space (MuJoCo's contact disabled). Ignored for a Plant.
     settle : float, optional
@@ -1060,14 +1095,17 @@ def simulate(
     )  # fmt: skip
     from ._api import _progress
 
+    ref: Reference | Table | None = None
+    if reference is not None:
+        ref = reference if callable(reference) else _reference_table(reference, run.steps)
     callback, bar = _progress(progress, "mujoco.simulate")
     try:
         if run.native and run.cartesian:
-            out = _cartesian_loop(run, reference, callback, fault)
+            out = _cartesian_loop(run, ref, callback, fault)
             m = out.pop("metrics")
         elif run.native:
             assert run.spec is not None
-            refs = None if reference is None else _tabulate(reference, run.steps, run.Ts)
+            refs = None if ref is None else _tabulate(ref, run.steps, run.Ts)
             core_fault = None if fault is None else fault._core(run.plant.n)
             out = _adaptimp.simulate_mujoco(
                 run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
@@ -1081,7 +1119,9 @@ def simulate(
                     "case name) and a plant with a force sensor or no possible contact; this "
                     "run steps its controller from Python"
                 )
-            out, m = _python_loop(run, reference, callback)
+            if isinstance(ref, tuple):
+                ref = _table_reference(ref, run.Ts)
+            out, m = _python_loop(run, ref, callback)
     finally:
         if bar is not None:
             bar.close()
@@ -1090,7 +1130,7 @@ def simulate(
 
 def _cartesian_loop(
     run: _Run,
-    reference: Reference | None,
+    reference: Reference | Table | None,
     progress: Callable[[int, int], object] | None,
     fault: Fault | None,
 ) -> dict[str, Any]:

@@ -36,7 +36,9 @@ dxc, ddxc)``, tabulated before the clock starts). (c) is ``CartesianImpedance.re
 The Panda table: ``examples/13_panda_table.py``'s controllers (T = ``--table-T``)
 each run natively and through the Python loop (the controller behind a Python
 object: what every Cartesian controller took before), side by side; computed
-torque (Pinocchio, Python) takes the Python loop in both.
+torque (Pinocchio, Python) takes the Python loop in both. Beside them, MuJoCo
+alone on the same motion (``mujoco.rollout`` of the native run's torques): the
+floor of any loop.
 
 Then a sweep on MuJoCo: ``adaptimp.sweep(..., plant="mujoco")`` of 16 runs (the
 paper's arm with its ceiling, state feedback in the robot scenario, T =
@@ -54,6 +56,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import os
 import platform
 import statistics
 import time
@@ -344,9 +347,12 @@ def panda_table_times(T: float, repeats: int) -> None:
     basis = ac.orbit_basis(sc)
     plant = amj.Plant(sc.model)
     times: dict[str, dict[str, list[float]]] = {
-        k: {"native": [], "python": []} for k in example.KINDS
+        k: {"native": [], "python": [], "engine": []} for k in example.KINDS
     }
     loops: dict[str, str] = {}
+    m, d = plant.model, plant.data
+    substeps = max(1, round(sc.ts / plant.timestep))
+    full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
     for _ in range(repeats):
         for kind in example.KINDS:
             base, _, variant = kind.partition("-")
@@ -363,24 +369,37 @@ def panda_table_times(T: float, repeats: int) -> None:
                 times[kind][how].append(time.perf_counter() - start)
                 if how == "native":
                     loops[kind] = res.params["loop"]
+            # MuJoCo alone on the same motion: the run's torques through mujoco.rollout.
+            plant.reset(sc.q0)
+            initial = np.zeros(mujoco.mj_stateSize(m, full))
+            mujoco.mj_getState(m, d, initial, full)
+            controls = np.repeat(res.tau_sat / plant._gear, substeps, axis=0)
+            start = time.perf_counter()
+            rollout.rollout(m, d, initial, controls)
+            times[kind]["engine"].append(time.perf_counter() - start)
     print(
         f"\nthe Panda table (examples/13_panda_table.py's controllers, T = {T:g} s; "
         f"medians of {repeats}, s per controller: simulate and cartesian_metrics)"
     )
-    print("\n| controller | loop | native (s) | Python loop (s) | Python/native |")
-    print("|---|---|---:|---:|---:|")
-    total = {"native": 0.0, "python": 0.0}
+    print(
+        "\n| controller | loop | native (s) | Python loop (s) | native/Python | "
+        "MuJoCo alone (s) | MuJoCo alone/Python |"
+    )
+    print("|---|---|---:|---:|---:|---:|---:|")
+    total = {"native": 0.0, "python": 0.0, "engine": 0.0}
     for kind, label in example.KINDS.items():
         med = {how: statistics.median(v) for how, v in times[kind].items()}
         for how in total:
             total[how] += med[how]
         print(
             f"| {label} | {loops[kind]} | {med['native']:.2f} | {med['python']:.2f} | "
-            f"{med['python'] / med['native']:.2f}× |"
+            f"{med['native'] / med['python']:.2f} | {med['engine']:.2f} | "
+            f"{med['engine'] / med['python']:.2f} |"
         )
     print(
         f"| all | | {total['native']:.2f} | {total['python']:.2f} | "
-        f"{total['python'] / total['native']:.2f}× |"
+        f"{total['native'] / total['python']:.2f} | {total['engine']:.2f} | "
+        f"{total['engine'] / total['python']:.2f} |"
     )
 
 
@@ -395,8 +414,10 @@ def main() -> None:
     )
     args = parser.parse_args()
     only = set(args.only.split(","))
+    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
     print(
-        f"machine: {platform.processor() or platform.machine()}, "
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores "
+        f"(load average {load}), "
         f"{platform.python_implementation()} {platform.python_version()}, "
         f"MuJoCo {mujoco.__version__}; T = {args.T:g} s at Ts = 1 ms; "
         f"medians of {args.repeats}, µs per control period"
@@ -418,35 +439,57 @@ def _half(vary: dict[str, list[float]], T: float, part: int) -> None:
     adaptimp.sweep("sf", vary=share, plant="mujoco", T=T, threads=1)
 
 
+def _cpu(who: int) -> float:
+    """CPU seconds (user + system) used so far by this process or its children."""
+    import resource
+
+    r = resource.getrusage(who)
+    return r.ru_utime + r.ru_stime
+
+
 def sweep_table(T: float, repeats: int) -> None:
+    """Wall time and CPU time of the sweep: the CPU seconds tell whether the
+    threads do more work than one thread (contention) independently of how
+    much of the machine the other users leave (the wall time)."""
     import multiprocessing
-    import os
+    import resource
 
     vary = {"Kp": [7.0, 8.0, 9.0, 10.0], "K1": [4.0, 5.0, 6.0, 7.0]}
-    times: dict[str, list[float]] = {"every core": [], "one thread": [], "two processes": []}
+    labels = ("every core", "one thread", "two processes")
+    times: dict[str, list[float]] = {k: [] for k in labels}
+    cpu: dict[str, list[float]] = {k: [] for k in labels}
+    loads: list[float] = []
     ctx = multiprocessing.get_context("fork")
     for _ in range(repeats):
         for label, threads in (("every core", None), ("one thread", 1)):
-            start = time.perf_counter()
+            c0, start = _cpu(resource.RUSAGE_SELF), time.perf_counter()
             df = adaptimp.sweep("sf", vary=vary, plant="mujoco", T=T, threads=threads)
             times[label].append(time.perf_counter() - start)
+            cpu[label].append(_cpu(resource.RUSAGE_SELF) - c0)
             assert df["error"].isna().all(), df["error"].dropna().head()
         # The ceiling on this machine: two independent processes, half each.
         procs = [ctx.Process(target=_half, args=(vary, T, part)) for part in (0, 1)]
-        start = time.perf_counter()
+        c0, start = _cpu(resource.RUSAGE_CHILDREN), time.perf_counter()
         for p in procs:
             p.start()
         for p in procs:
             p.join()
         times["two processes"].append(time.perf_counter() - start)
+        cpu["two processes"].append(_cpu(resource.RUSAGE_CHILDREN) - c0)
+        loads.append(os.getloadavg()[0])
     med = {k: statistics.median(v) for k, v in times.items()}
+    mcpu = {k: statistics.median(v) for k, v in cpu.items()}
     print(
-        f"\nsweep(plant='mujoco'), 16 runs of T = {T:g} s on {os.cpu_count()} cores "
-        f"(medians of {repeats}): one thread {med['one thread']:.2f} s, every core "
-        f"{med['every core']:.2f} s (speed-up {med['one thread'] / med['every core']:.2f}×); "
-        f"two independent processes, 8 runs each: {med['two processes']:.2f} s "
-        f"(speed-up {med['one thread'] / med['two processes']:.2f}×, this machine's ceiling)"
+        f"\nsweep(plant='mujoco'), 16 runs of T = {T:g} s on {os.cpu_count()} cores, "
+        f"medians of {repeats} (load average over the repeats {min(loads):.1f}–{max(loads):.1f}):"
     )
+    print("\n| how | wall (s) | speed-up | CPU (s) | CPU / wall (cores busy) |")
+    print("|---|---:|---:|---:|---:|")
+    for k in labels:
+        print(
+            f"| {k} | {med[k]:.2f} | {med['one thread'] / med[k]:.2f}× | {mcpu[k]:.2f} | "
+            f"{mcpu[k] / med[k]:.2f} |"
+        )
 
 
 if __name__ == "__main__":

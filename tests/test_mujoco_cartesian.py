@@ -350,3 +350,23 @@ def test_a_reference_given_as_arrays(sc: ac.PandaTable, basis: Any) -> None:
     bad[7, 1] = math.nan
     with pytest.raises(ValueError, match="reference xc must be finite"):
         amj.simulate("pd", "two_link", T=0.3, reference=(bad, joint[1], joint[2]))
+
+
+def test_a_long_run_in_parts_is_the_whole_run(sc: ac.PandaTable, basis: Any) -> None:
+    """reset=False: the plant goes on from where the last part left it, the used
+    controller along its path: two parts give the rows of one run, bit for bit."""
+    plant = amj.Plant(sc.model)
+    whole_ctrl = ac.panda_controller("sf", sc, basis=basis)
+    whole = amj.simulate(whole_ctrl, plant, T=1.4, q0=sc.q0)
+    ctrl = ac.panda_controller("sf", sc, basis=basis)
+    first = amj.simulate(ctrl, plant, T=0.7, q0=sc.q0)
+    second = amj.simulate(ctrl, plant, T=0.7, reset=False)
+    for name in _ARRAYS[1:]:
+        got = np.concatenate([getattr(first, name), getattr(second, name)])
+        np.testing.assert_array_equal(got, getattr(whole, name), err_msg=name)
+    np.testing.assert_array_equal(second.t, first.t)
+    assert whole.metrics["steps_in_contact"] > 0
+    for name, value in whole_ctrl.arrays().items():
+        np.testing.assert_array_equal(ctrl.arrays()[name], value, err_msg=name)
+    with pytest.raises(ValueError, match="q0 and dq0 start a run afresh"):
+        amj.simulate(ctrl, plant, T=0.1, q0=sc.q0, reset=False)

@@ -1004,6 +1004,7 @@ def simulate(
     record_every: int = 1,
     progress: bool | Callable[[int, int], object] = False,
     fault: Fault | None = None,
+    reset: bool = True,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1064,6 +1065,11 @@ def simulate(
     fault : adaptimp.Fault, optional
         A fault injected over a window, as for :func:`adaptimp.simulate` (the
         actuators' τmax for ``"actuator_drop"``); needs the native loop.
+    reset : bool
+        True: the plant starts at ``q0``, ``dq0``. False: a :class:`Plant` goes
+        on from where its last run left it (a long run in parts: with a used
+        controller, the parts are the whole run's rows; each part's t starts
+        at 0 and its disturbances afresh); ``q0``, ``dq0`` must then be None.
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
@@ -1091,7 +1097,7 @@ def simulate(
     """
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
-        settle=settle, scenario=scenario, record_every=record_every, params=params,
+        settle=settle, scenario=scenario, record_every=record_every, params=params, reset=reset,
     )  # fmt: skip
     from ._api import _progress
 
@@ -1187,6 +1193,7 @@ def _setup(
     scenario: str = "robot",
     record_every: int = 1,
     params: Mapping[str, Any],
+    reset: bool = True,
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
     plant at its initial state, the settings and the choice of loop."""
@@ -1235,8 +1242,11 @@ def _setup(
         raise ValueError(f"substeps must be ≥ 1, got {substeps}")
     resolved = resolve(disturb, scenario="robot", groups=("sim",), caller="simulate()", n=plant.n)
     dist = {k: resolved[k] for k in DISTURBANCES}
+    if not reset and (q0 is not None or dq0 is not None):
+        raise ValueError("q0 and dq0 start a run afresh: give them with reset=True (the default)")
     plant.timestep = Ts / substeps
-    plant.reset(q0, dq0)
+    if reset:
+        plant.reset(q0, dq0)
     spec = plant._native(substeps)
     cartesian = _native_cartesian(ctrl)
     native = spec is not None and (cartesian or _native(ctrl))

@@ -509,8 +509,7 @@ class CartesianController:
         width = {"qd": n, "wrench": 6, "error": 6}
         # Each entry of the log is a step's row, or a block of rows (a run of the core's loop).
         return {
-            k: np.vstack(v) if v else np.zeros((0, width.get(k, 3)))
-            for k, v in self.log.items()
+            k: np.vstack(v) if v else np.zeros((0, width.get(k, 3))) for k, v in self.log.items()
         }
 
     def _targets(
@@ -551,8 +550,7 @@ class CartesianController:
                 turned = True
             else:
                 raise ValueError(
-                    "path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), "
-                    f"got {len(s)}"
+                    f"path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}"
                 )
         return out
 

@@ -24,9 +24,13 @@ force/torque sensors measure the wrench between the site's body and its parent,
 so the site should sit on a massless body welded to the last link, holding the
 contact geometry: then the reading is exactly the contact wrench (the packaged
 models do this). Without a force sensor, F_e is the sum over the active
-contacts of the end-effector body's subtree of ``mj_contactForce``, with the
-moment about the end-effector point (the first site on the last joint's body,
-or that body's origin). :attr:`Plant.wrench_source` says which is used.
+contacts of the end-effector body's subtree with anything outside it of
+``mj_contactForce``, with the moment about the end-effector point (the first
+site on the last joint's body, or that body's origin): read from MuJoCo's
+contact list, or, for a model :class:`Plant` loads from a file and in which no
+contact can arise inside that subtree, from a contact sensor it adds (the net
+contact wrench on the subtree, ``reduce="netforce"``; it changes no dynamics),
+which the core's loop reads. :attr:`Plant.wrench_source` says which is used.
 
 Units: rad, rad/s, rad/s², N, N m, m, s. Vectors in the world frame.
 """
@@ -166,6 +170,11 @@ def from_urdf(path: str | os.PathLike[str], timestep: float = 1e-3) -> mujoco.Mj
     ValueError
         A moving joint without an effort limit.
     """
+    return _from_urdf_spec(path, timestep).compile()
+
+
+def _from_urdf_spec(path: str | os.PathLike[str], timestep: float = 1e-3) -> Any:
+    """The ``MjSpec`` :func:`from_urdf` compiles."""
     text = Path(path).read_text()
     spec, effort = _urdf_spec(text)
     spec.option.timestep = timestep
@@ -174,7 +183,7 @@ def from_urdf(path: str | os.PathLike[str], timestep: float = 1e-3) -> mujoco.Mj
     if missing:
         raise ValueError(f"URDF joints without <limit effort=...>: {missing}")
     _add_motors(spec, effort)
-    return spec.compile()
+    return spec
 
 
 def panda(
@@ -255,6 +264,11 @@ def _load(source: ModelSource) -> mujoco.MjModel:
         return copy.deepcopy(source)
     if isinstance(source, str) and source in _BUILTIN:
         return _BUILTIN[source]()
+    return _load_spec(source).compile()
+
+
+def _load_spec(source: str | os.PathLike[str]) -> Any:
+    """The ``MjSpec`` of an MJCF or URDF file."""
     path = Path(source)
     if not path.is_file():
         raise ValueError(
@@ -262,8 +276,8 @@ def _load(source: ModelSource) -> mujoco.MjModel:
             f"file; no file {str(path)!r}"
         )
     if path.suffix.lower() == ".urdf":
-        return from_urdf(path)
-    return mujoco.MjModel.from_xml_path(str(path))
+        return _from_urdf_spec(path)
+    return mujoco.MjSpec.from_file(str(path))
 
 
 _BUILTIN: dict[str, Callable[[], mujoco.MjModel]] = {"two_link": two_link, "panda": panda}
@@ -313,20 +327,31 @@ class Plant:
     tau_max : ndarray, (n,)
         Actuator limits τmax (N m): gear × ctrlrange.
     wrench_source : str
-        ``"sensor"`` (force/torque sensor) or ``"contact"`` (``mj_contactForce``).
+        ``"sensor"`` (force/torque sensor), ``"contact sensor"`` (the net contact
+        wrench on the end effector's subtree, a MuJoCo contact sensor) or
+        ``"contact"`` (MuJoCo's contact list, ``mj_contactForce``).
     """
 
     def __init__(
         self, model: ModelSource = "two_link", *, contact: bool = True, site: str | None = None
     ) -> None:
-        self.model = _load(model)
-        m = self.model
-        if not contact:
-            m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         self.contact = contact
-        self._check_joints()
-        self._check_actuators()
-        self._find_end_effector(site)
+        self._setup_model(_load(model), site)
+        if self.wrench_source == "contact" and self._contact_sensor_fits(model):
+            # A file's model: measure the contacts with a sensor of its own (the
+            # net contact wrench on the end effector's subtree), which the core's
+            # loop reads like the force sensor. A sensor changes no dynamics.
+            assert isinstance(model, (str, os.PathLike))
+            spec = _load_spec(model)
+            spec.add_sensor(
+                name=_CONTACT_SENSOR,
+                type=mujoco.mjtSensor.mjSENS_CONTACT,
+                objtype=mujoco.mjtObj.mjOBJ_XBODY,
+                objname=_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
+                intprm=[_NETFORCE_DATA, _NETFORCE, 1],
+            )
+            self._setup_model(spec.compile(), site)
+        m = self.model
         self.data = mujoco.MjData(m)
         self._jac = np.zeros((6, m.nv))
         self._jacp, self._jacr = self._jac[:3], self._jac[3:]
@@ -334,6 +359,36 @@ class Plant:
         self.reset()
 
     # -- construction checks ------------------------------------------------
+
+    def _setup_model(self, model: mujoco.MjModel, site: str | None) -> None:
+        self.model = model
+        if not self.contact:
+            model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        self._check_joints()
+        self._check_actuators()
+        self._find_end_effector(site)
+
+    def _contact_sensor_fits(self, source: ModelSource) -> bool:
+        """Whether a contact sensor can measure this plant's wrench exactly as
+        :meth:`contact_wrench` defines it: the model comes from a file (so it can
+        be rebuilt with the sensor), a contact can reach the end effector, and no
+        contact can arise inside its subtree (the sensor would count it; the
+        contact list skips it). Conservative: no explicit contact pairs, and no
+        two geoms of the subtree on different weld bodies whose contype and
+        conaffinity meet."""
+        if isinstance(source, mujoco.MjModel) or (isinstance(source, str) and source in _BUILTIN):
+            return False
+        m = self.model
+        if m.npair > 0 or not self._contact_possible():
+            return False
+        inside = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in self._ee_subtree]
+        ct, ca, weld = m.geom_contype, m.geom_conaffinity, m.body_weldid
+        return not any(
+            ((ct[a] & ca[b]) or (ct[b] & ca[a]))
+            and weld[m.geom_bodyid[a]] != weld[m.geom_bodyid[b]]
+            for i, a in enumerate(inside)
+            for b in inside[i + 1 :]
+        )
 
     def _check_joints(self) -> None:
         m = self.model
@@ -437,11 +492,28 @@ class Plant:
             if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sid >= 0
         ]
         self._torque_adr = int(m.sensor_adr[torques[0]]) if torques else -1
-        self.wrench_source = "sensor" if self._force_adr >= 0 else "contact"
         subtree = [
             b for b in range(m.nbody) if b == self._ee_body or self._ee_body in self._ancestors(b)
         ]
         self._ee_subtree = frozenset(subtree)
+        # A contact sensor of the net contact wrench on the end effector's subtree.
+        nets = [
+            s
+            for s in range(m.nsensor)
+            if m.sensor_type[s] == int(mujoco.mjtSensor.mjSENS_CONTACT)
+            and m.sensor_objtype[s] == int(mujoco.mjtObj.mjOBJ_XBODY)
+            and m.sensor_objid[s] == self._ee_body
+            and m.sensor_reftype[s] == int(mujoco.mjtObj.mjOBJ_UNKNOWN)
+            and list(m.sensor_intprm[s]) == [_NETFORCE_DATA, _NETFORCE, 1]
+        ]
+        self._contact_adr = int(m.sensor_adr[nets[0]]) if nets and self._force_adr < 0 else -1
+        self.wrench_source = (
+            "sensor"
+            if self._force_adr >= 0
+            else "contact sensor"
+            if self._contact_adr >= 0
+            else "contact"
+        )
 
     # -- state ----------------------------------------------------------------
 
@@ -591,7 +663,7 @@ class Plant:
         possible: the contact path reads MuJoCo's contact list, which only
         the Python loop does)."""
         m = self.model
-        if self._force_adr < 0 and self._contact_possible():
+        if self.wrench_source == "contact" and self._contact_possible():
             return None
         return {
             "qadr": [int(a) for a in self._qadr],
@@ -603,6 +675,7 @@ class Plant:
             "ee_body": int(self._ee_body),
             "force_adr": int(self._force_adr) if self._force_adr >= 0 else None,
             "torque_adr": int(self._torque_adr) if self._torque_adr >= 0 else None,
+            "contact_adr": int(self._contact_adr) if self._contact_adr >= 0 else None,
             "substeps": int(substeps),
             "timestep": float(m.opt.timestep),
             "dof_names": [
@@ -642,7 +715,34 @@ class Plant:
         """F_e = [f; m], (6,): the force (N) and the moment about the end-effector
         point (N m) that the arm exerts on its environment, world frame, of the
         last :meth:`forward` (from the sensor or the contacts, see the module doc)."""
-        return self.sensor_wrench() if self._force_adr >= 0 else self.contact_wrench()
+        if self._force_adr >= 0:
+            return self.sensor_wrench()
+        if self._contact_adr >= 0:
+            return self.contact_sensor_wrench()
+        return self.contact_wrench()
+
+    def contact_sensor_wrench(self) -> FloatArray:
+        """F_e (6,) from the model's contact sensor of the net contact wrench on the
+        end effector's subtree (force f and torque t about the force-weighted
+        centroid c of the contacts, world frame): [f; t + (c − p) × f], p the
+        end-effector point (summed in the order of the core's native loop).
+
+        Raises
+        ------
+        ValueError
+            The model has no such sensor.
+        """
+        if self._contact_adr < 0:
+            raise ValueError("the model has no contact sensor at the end effector")
+        a = self._contact_adr
+        f, t, c = (self.data.sensordata[a + 3 * i : a + 3 * i + 3] for i in range(3))
+        d = c - self.ee_position()
+        out = np.zeros(6)
+        out[:3] = f
+        out[3] = t[0] + (d[1] * f[2] - d[2] * f[1])
+        out[4] = t[1] + (d[2] * f[0] - d[0] * f[2])
+        out[5] = t[2] + (d[0] * f[1] - d[1] * f[0])
+        return out
 
     def sensor_wrench(self) -> FloatArray:
         """F_e (6,) from the force/torque sensors (world frame; see :meth:`wrench`).
@@ -709,6 +809,23 @@ class Plant:
             f"adaptimp.mujoco.Plant({name!r}: {self.n} joints, τmax = {self.tau_max.tolist()} N m,"
             f" wrench from {self.wrench_source}, timestep {self.timestep:g} s)"
         )
+
+
+_CONTACT_SENSOR = "adaptimp_ee_contact"
+"""The name of the contact sensor :class:`Plant` adds to a file's model."""
+
+_NETFORCE = 3
+"""The contact sensor's ``reduce="netforce"`` (MuJoCo's sensor_intprm[1])."""
+
+_NETFORCE_DATA = sum(
+    1 << int(f)
+    for f in (
+        mujoco.mjtConDataField.mjCONDATA_FORCE,
+        mujoco.mjtConDataField.mjCONDATA_TORQUE,
+        mujoco.mjtConDataField.mjCONDATA_POS,
+    )
+)
+"""The contact sensor's ``data="force torque pos"`` (sensor_intprm[0])."""
 
 
 def _warning_names() -> list[str]:

@@ -1307,6 +1307,7 @@ fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
         ee_body: get(d, "ee_body")?,
         force_adr: get(d, "force_adr")?,
         torque_adr: get(d, "torque_adr")?,
+        contact_adr: get(d, "contact_adr")?,
         substeps: get(d, "substeps")?,
         timestep: get(d, "timestep")?,
         dof_names: get(d, "dof_names")?,

@@ -96,9 +96,10 @@ class ControllerLike(Protocol):
     ``reference``, nothing otherwise (the controller then follows its own
     trajectory). The period is ``.ts`` or ``.Ts`` (s). Optional attributes
     that :func:`simulate` records when present: ``tau`` (commanded torque
-    before saturation), ``xc``, ``xd``, ``z1``, ``dq_hat``, ``zeta``, and
-    ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``,
-    ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
+    before saturation), ``xc`` and, without a ``reference``, ``dxc``, ``ddxc``
+    (the controller's own commanded rates), ``xd``, ``z1``, ``dq_hat``,
+    ``zeta``, and ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``,
+    ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
 
     Cartesian hook: a controller with ``wants_wrench = True`` is called as
     ``step(q, dq, wrench, **setpoint)`` instead, with the measured wrench

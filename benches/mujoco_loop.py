@@ -100,7 +100,7 @@ class PythonSide:
 
     def __init__(self, inner: adaptimp.Controller) -> None:
         self.inner = inner
-        self.ts = inner.ts
+        self.Ts = inner.Ts
         self.params = inner.params
 
     def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> Any:
@@ -114,8 +114,8 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
     model, q0 = arm(name)
     plant = amj.Plant(model)
     ctrl = controller(plant, q0)
-    steps = round(T / ctrl.ts)
-    substeps = max(1, round(ctrl.ts / plant.timestep))
+    steps = round(T / ctrl.Ts)
+    substeps = max(1, round(ctrl.Ts / plant.timestep))
     log = amj.simulate(ctrl, plant, T=T, q0=q0)
     assert log.params["loop"] == "native"
 
@@ -149,7 +149,7 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
         start = time.perf_counter()
         mujoco.mj_step(m, d, nstep=substeps * steps)
         seconds = time.perf_counter() - start
-        assert abs(d.time - steps * ctrl.ts) < 1e-6, "MuJoCo reset its state"
+        assert abs(d.time - steps * ctrl.Ts) < 1e-6, "MuJoCo reset its state"
         return seconds / steps
 
     def step() -> float:
@@ -221,7 +221,7 @@ def cartesian(name: str) -> tuple[Any, Any, np.ndarray]:
 
 def tabulated(ctrl: Any, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The controller's path at t_k = k·Ts as arrays (K, 3) (before any clock starts)."""
-    rows = [ctrl.path(k * ctrl.ts) for k in range(steps)]
+    rows = [ctrl.path(k * ctrl.Ts) for k in range(steps)]
     p, dp, ddp = (np.array([r[i] for r in rows]) for i in range(3))
     return p, dp, ddp
 
@@ -230,8 +230,8 @@ def cartesian_timers(
     name: str, T: float, table: bool = False
 ) -> tuple[dict[str, Callable[[], float]], int, int]:
     plant, ctrl, q0 = cartesian(name)
-    steps = round(T / ctrl.ts)
-    substeps = max(1, round(ctrl.ts / plant.timestep))
+    steps = round(T / ctrl.Ts)
+    substeps = max(1, round(ctrl.Ts / plant.timestep))
     reference = tabulated(ctrl, steps) if table else None
     if table:
         ctrl.path = None  # simulate's reference instead, tabulated before the clock starts
@@ -267,7 +267,7 @@ def cartesian_timers(
         start = time.perf_counter()
         mujoco.mj_step(m, d, nstep=substeps * steps)
         seconds = time.perf_counter() - start
-        assert abs(d.time - steps * ctrl.ts) < 1e-6, "MuJoCo reset its state"
+        assert abs(d.time - steps * ctrl.Ts) < 1e-6, "MuJoCo reset its state"
         return seconds / steps
 
     def step() -> float:
@@ -351,7 +351,7 @@ def panda_table_times(T: float, repeats: int) -> None:
     }
     loops: dict[str, str] = {}
     m, d = plant.model, plant.data
-    substeps = max(1, round(sc.ts / plant.timestep))
+    substeps = max(1, round(sc.Ts / plant.timestep))
     full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
     for _ in range(repeats):
         for kind in example.KINDS:

@@ -26,8 +26,10 @@ Metrics over t ≥ 2 s (p the TCP, p_d the compliant reference, F_n = −F_e,z):
 - sat: fraction of all steps with some sat(τ_i) ≠ τ_i.
 - peak: max_i max_{t ≥ 0.1 s} |τ_i| / τmax_i of the commanded τ (≤ 2: no windup).
 
-Run ``python examples/13_panda_table.py`` (T = 20 s; ``--long 120`` adds a
-long SF run reporting the weight norms every 10 s); ``ADAPTIMP_QUICK=1``: T = 1 s, no figure.
+Needs the extras ``mujoco`` and ``pinocchio`` (from a checkout:
+``pip install ".[mujoco,pinocchio]"``). Run ``python examples/13_panda_table.py``
+(T = 20 s; ``--long 120`` adds a long SF run reporting the weight norms every 10 s);
+``ADAPTIMP_QUICK=1``: T = 1 s, no figure.
 Writes ``docs/figures/panda_table.png``.
 """
 

@@ -309,7 +309,7 @@ def test_a_reference_given_as_arrays(sc: ac.PandaTable, basis: Any) -> None:
     """simulate(reference=(xc, dxc, ddxc)) tabulated at k·Ts: the run of the same
     reference as a callable, in both loops, joint space and task space."""
     steps = 300
-    rows = [sc.path(k * sc.ts) for k in range(steps + 5)]
+    rows = [sc.path(k * sc.Ts) for k in range(steps + 5)]
     table = tuple(np.array([r[i] for r in rows]) for i in range(3))
 
     def reference(t: float) -> Any:
@@ -342,10 +342,13 @@ def test_a_reference_given_as_arrays(sc: ac.PandaTable, basis: Any) -> None:
     )  # fmt: skip
     for name in _ARRAYS:
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
-    with pytest.raises(ValueError, match=r"reference dxc must have shape \(K, m\) with K ≥ 300"):
+    with pytest.raises(ValueError, match=r"reference dxc must have shape \(K, 2\) with K ≥ 300"):
         amj.simulate("pd", "two_link", T=0.3, reference=(joint[0], joint[1][:10], joint[2]))
-    with pytest.raises(ValueError, match="reference must be a callable or three arrays"):
+    with pytest.raises(TypeError, match="reference must be a callable t -> "):
         amj.simulate("pd", "two_link", T=0.3, reference=joint[:2])
+    # A Cartesian controller's reference is its p_c: three columns.
+    with pytest.raises(ValueError, match=r"reference xc must have shape \(K, 3\)"):
+        amj.simulate(make(), plant, T=0.3, q0=sc.q0, reference=joint)
     bad = joint[0].copy()
     bad[7, 1] = math.nan
     with pytest.raises(ValueError, match="reference xc must be finite"):
@@ -368,5 +371,5 @@ def test_a_long_run_in_parts_is_the_whole_run(sc: ac.PandaTable, basis: Any) -> 
     assert whole.metrics["steps_in_contact"] > 0
     for name, value in whole_ctrl.arrays().items():
         np.testing.assert_array_equal(ctrl.arrays()[name], value, err_msg=name)
-    with pytest.raises(ValueError, match="q0 and dq0 start a run afresh"):
+    with pytest.raises(ValueError, match="q0, dq0 and a payload start a run afresh"):
         amj.simulate(ctrl, plant, T=0.1, q0=sc.q0, reset=False)

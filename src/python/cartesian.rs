@@ -317,11 +317,13 @@ impl<const N: usize> DynOuter for Outer<N> {
     fn step_tracker(&mut self, tracker: &mut dyn DynTracker, m: &StepIn<'_>) -> Result<(), Error> {
         let typed = typed::<N>(tracker)?;
         let meas = Self::measurement(m);
-        let cmd = self
-            .outer
-            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r| {
-                typed.step_with(jm, r)
-            })?;
+        let cmd = cartesian_loop::cartesian_step(
+            &self.outer,
+            &mut self.state,
+            typed,
+            &meas,
+            m.target.as_ref(),
+        )?;
         self.last = Some(LastStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
     }

@@ -195,6 +195,32 @@ impl<const N: usize> LastStep<N> {
     }
 }
 
+/// One Cartesian step of `outer` (its state `state`) with the core's joint
+/// controller `joint` (SPEC §16, (C0)–(C5)), under the fault semantics of
+/// every step: a step the joint controller refuses is recorded there (the
+/// fault, its fallback as the applied torque); so is one the outer loop
+/// refuses before the joint step runs (a non-finite q, wrench or target), as
+/// a front's refused call is ([`Tracker::refuse`](crate::control::tracker::Tracker::refuse)).
+pub(crate) fn cartesian_step<const N: usize>(
+    outer: &CartesianImpedance<N, Chain<N>>,
+    state: &mut CartesianState<N>,
+    joint: &mut Typed<N>,
+    m: &CartesianMeasurement<N>,
+    target: Option<&PoseTarget>,
+) -> Result<CartesianCommand<N>, Error> {
+    let mut ran = false;
+    let result = outer.step_with(state, m, target, |jm, r| {
+        ran = true;
+        joint.step_with(jm, r)
+    });
+    if let Err(e) = result {
+        if !ran {
+            joint.refuse(e);
+        }
+    }
+    result
+}
+
 /// A pose target from its flat layout (see [`TARGET_LEN`]).
 pub(crate) fn pose_target(v: &[f64]) -> PoseTarget {
     let v3 = |i: usize| Vector::<3>::new(v[i], v[i + 1], v[i + 2]);
@@ -237,12 +263,7 @@ impl<const N: usize> Cartesian<'_, N> {
             dq: m.dx,
             wrench: Vector::<6>::from(*wrench),
         };
-        let joint = &mut *self.joint;
-        let cmd = self
-            .outer
-            .step_with(self.state, &meas, target.as_ref(), |jm, r| {
-                joint.step_with(jm, r)
-            })?;
+        let cmd = cartesian_step(self.outer, self.state, self.joint, &meas, target.as_ref())?;
         let last = LastStep::new(cmd, target.as_ref(), *wrench);
         let c = &cmd.compliant;
         self.row.set(TaskRow {
@@ -277,7 +298,8 @@ impl<const N: usize> Control<N> for Cartesian<'_, N> {
         self.step_with_wrench(m, &[0.0; 6], c)
     }
     /// The Cartesian step; on an error (of the outer loop or of the joint
-    /// step) the joint controller's configured fallback torque.
+    /// step, recorded in the joint controller: [`cartesian_step`]) its
+    /// fallback, the torque it now applies.
     fn step_with_wrench(
         &mut self,
         m: &Measurement<N>,
@@ -286,10 +308,7 @@ impl<const N: usize> Control<N> for Cartesian<'_, N> {
     ) -> (Vector<N>, Result<Command<N>, Error>) {
         match self.step_cartesian(m, wrench) {
             Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
-            Err(e) => {
-                let ctrl = self.joint.controller();
-                (ctrl.fallback(self.joint.state(), m), Err(e))
-            }
+            Err(e) => (*self.joint.state().applied(), Err(e)),
         }
     }
 }
@@ -482,8 +501,7 @@ pub(crate) fn replay<const N: usize>(
             wrench: Vector::<6>::from_column_slice(&wrench[k * 6..(k + 1) * 6]),
         };
         let target = targets.map(|t| pose_target(&t[k * TARGET_LEN..(k + 1) * TARGET_LEN]));
-        let cmd = outer
-            .step_with(state, &m, target.as_ref(), |jm, r| joint.step_with(jm, r))
+        let cmd = cartesian_step(outer, state, joint, &m, target.as_ref())
             .map_err(|e| RunError::Core(e, Some(k as u64)))?;
         out.extend_from_slice(cmd.joint.tau_sat.as_slice());
         *last = Some(LastStep::new(cmd, target.as_ref(), m.wrench.into()));

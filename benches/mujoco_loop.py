@@ -22,6 +22,24 @@ gains and centres along a sinusoid of 0.15 rad at 1 rad/s about the posture:
 - for reference, the Python loop (``simulate`` with the same controller behind a
   Python object: the fallback, the loop every controller took before).
 
+Cartesian rows: ``adaptimp.CartesianController`` (the core's outer loop of SPEC
+§16, position-only, in front of state feedback with the same rule's gains and
+centres along the joint orbit of its path): the UR5's tool on a 5 cm circle at
+0.5 Hz about its start (free space), and the Panda of the scenario
+"panda-table" (``adaptimp.panda_table``: the tool pressing on the table along
+its circle, contact on). Twice: with the controller's path, a Python callable,
+whose tabulation (one ``path(t)`` call per period, as the Python loop makes) is
+in (a); and with the path given to ``simulate`` as arrays (``reference=(xc,
+dxc, ddxc)``, tabulated before the clock starts). (c) is ``CartesianImpedance.replay``
+(outer loop and joint step in a Rust loop) over (a)'s rows.
+
+The Panda table: ``examples/13_panda_table.py``'s controllers (T = ``--table-T``)
+each run natively and through the Python loop (the controller behind a Python
+object: what every Cartesian controller took before), side by side; computed
+torque (Pinocchio, Python) takes the Python loop in both. Beside them, MuJoCo
+alone on the same motion (``mujoco.rollout`` of the native run's torques): the
+floor of any loop.
+
 Then a sweep on MuJoCo: ``adaptimp.sweep(..., plant="mujoco")`` of 16 runs (the
 paper's arm with its ceiling, state feedback in the robot scenario, T =
 ``--sweep-T``, a 4 × 4 grid of Kp and K1) on every core (``executor=None``)
@@ -31,12 +49,14 @@ independent processes running 8 runs each; target ≥ 1.7× on 2 cores.
 Each measurement is repeated ``--repeats`` times, interleaved; medians.
 
     target/py-venv/bin/python benches/mujoco_loop.py [--T 10] [--repeats 5] [--sweep-T 2]
+        [--table-T 20] [--only loop,cartesian,table,sweep]
 """
 
 from __future__ import annotations
 
 import argparse
 import gc
+import os
 import platform
 import statistics
 import time
@@ -152,41 +172,265 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
     )
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--T", type=float, default=10.0, help="run length (s)")
-    parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--sweep-T", type=float, default=2.0, help="sweep run length (s)")
-    args = parser.parse_args()
-    print(
-        f"machine: {platform.processor() or platform.machine()}, "
-        f"{platform.python_implementation()} {platform.python_version()}, "
-        f"MuJoCo {mujoco.__version__}; T = {args.T:g} s at Ts = 1 ms; "
-        f"medians of {args.repeats}, µs per control period"
+class InPython:
+    """A controller behind a Python object: simulate's Python loop steps it."""
+
+    def __init__(self, inner: Any) -> None:
+        self.inner = inner
+
+    def step(self, *args: Any, **kwargs: Any) -> Any:
+        return self.inner.step(*args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.inner, name)
+
+
+def cartesian(name: str) -> tuple[Any, Any, np.ndarray]:
+    """The arm's plant, Cartesian controller and start."""
+    from adaptimp import cartesian as ac
+
+    if name == "Panda":
+        sc = ac.panda_table()
+        return amj.Plant(sc.model), ac.panda_controller("sf", sc), sc.q0
+    from adaptimp._models import panda_urdf_path
+
+    urdf = panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
+    model, q0 = arm(name)
+    plant = amj.Plant(model)
+    chain = adaptimp.Chain.from_urdf(urdf)
+    p0 = chain.pose(q0)[0]
+    r, w = 0.05, np.pi  # m, rad/s: 0.5 Hz
+
+    def path(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        c, s = np.cos(w * t), np.sin(w * t)
+        return (
+            p0 + r * np.array([c - 1.0, s, 0.0]),
+            r * w * np.array([-s, c, 0.0]),
+            -r * w * w * np.array([c, s, 0.0]),
+        )
+
+    outer = adaptimp.cartesian.CartesianImpedance(chain, Ts=1e-3, q0=q0, Kd_rot=0.0)
+    centres, widths = outer.orbit_centres(path, 2.0, nodes=64)
+    kw = tuning.suggest(plant, q0, plant.tau_max, Ts=1e-3)
+    kw.pop("n")
+    ctrl = adaptimp.CartesianController(
+        chain, "sf", q0=q0, path=path, Kd_rot=0.0, centers=centres, widths=widths, **kw
     )
+    return plant, ctrl, q0
+
+
+def tabulated(ctrl: Any, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The controller's path at t_k = k·Ts as arrays (K, 3) (before any clock starts)."""
+    rows = [ctrl.path(k * ctrl.Ts) for k in range(steps)]
+    p, dp, ddp = (np.array([r[i] for r in rows]) for i in range(3))
+    return p, dp, ddp
+
+
+def cartesian_timers(
+    name: str, T: float, table: bool = False
+) -> tuple[dict[str, Callable[[], float]], int, int]:
+    plant, ctrl, q0 = cartesian(name)
+    steps = round(T / ctrl.Ts)
+    substeps = max(1, round(ctrl.Ts / plant.timestep))
+    reference = tabulated(ctrl, steps) if table else None
+    if table:
+        ctrl.path = None  # simulate's reference instead, tabulated before the clock starts
+    log = amj.simulate(ctrl, plant, T=T, q0=q0, reference=reference)
+    assert log.params["loop"] == "native"
+    assert log.task is not None
+    ctrl.reset()
+    targets = ctrl._targets(steps, reference)
+    controls = np.repeat(log.tau_sat / plant._gear, substeps, axis=0)
+    m, d = plant.model, plant.data
+    plant.reset(q0)
+    spec = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    initial = np.zeros(mujoco.mj_stateSize(m, spec))
+    mujoco.mj_getState(m, d, initial, spec)
+
+    def native() -> float:
+        ctrl.reset()
+        start = time.perf_counter()
+        amj.simulate(ctrl, plant, T=T, q0=q0, reference=reference)
+        return (time.perf_counter() - start) / steps
+
+    def engine() -> float:
+        start = time.perf_counter()
+        states, _ = rollout.rollout(m, d, initial, controls)
+        seconds = time.perf_counter() - start
+        q_end = states[0, -1, 1 : 1 + m.nq][plant._qadr]
+        assert np.allclose(q_end, log.q[-1], atol=1e-3), (q_end, log.q[-1])
+        return seconds / steps
+
+    def hold() -> float:
+        plant.reset(q0)
+        plant.apply(plant.bias())
+        start = time.perf_counter()
+        mujoco.mj_step(m, d, nstep=substeps * steps)
+        seconds = time.perf_counter() - start
+        assert abs(d.time - steps * ctrl.Ts) < 1e-6, "MuJoCo reset its state"
+        return seconds / steps
+
+    def step() -> float:
+        ctrl.reset()
+        core = ctrl.outer.core
+        assert log.task is not None
+        start = time.perf_counter()
+        tau = core.replay(ctrl.inner, log.q, log.dq, log.task["wrench"], targets)
+        seconds = time.perf_counter() - start
+        assert np.array_equal(tau, log.tau_sat)
+        return seconds / steps
+
+    def python_loop() -> float:
+        ctrl.reset()
+        start = time.perf_counter()
+        res = amj.simulate(InPython(ctrl), plant, T=T, q0=q0, reference=reference)
+        assert res.params["loop"] == "python"
+        return (time.perf_counter() - start) / steps
+
+    return (
+        {"native": native, "engine": engine, "hold": hold, "step": step, "python": python_loop},
+        plant.n,
+        substeps,
+    )
+
+
+LABELS = {
+    "joint": "SF, joint space (own sinusoid)",
+    "cartesian": "SF behind the Cartesian impedance, path in Python",
+    "table": "SF behind the Cartesian impedance, path as arrays",
+}
+
+
+def loop_table(rows: list[tuple[str, str]], T: float, repeats: int) -> None:
     print(
-        "\n| arm | n | substeps | (a) simulate, native | (b) MuJoCo, same motion | "
+        "\n| arm | controller | n | substeps | (a) simulate, native | (b) MuJoCo, same motion | "
         "(b') MuJoCo at rest | (c) Rust step | (a)/((b)+(c)) | Python loop | Python/(a) |"
     )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for name in ("UR5", "Panda"):
-        fns, n, substeps = timers(name, args.T)
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, kind in rows:
+        if kind == "joint":
+            fns, n, substeps = timers(name, T)
+        else:
+            fns, n, substeps = cartesian_timers(name, T, table=kind == "table")
         times: dict[str, list[float]] = {k: [] for k in fns}
         gc.disable()
         try:
-            for _ in range(args.repeats):
+            for _ in range(repeats):
                 for k, f in fns.items():
                     times[k].append(f())
         finally:
             gc.enable()
         med = {k: statistics.median(v) * 1e6 for k, v in times.items()}
         ratio = med["native"] / (med["engine"] + med["step"])
+        label = LABELS[kind]
         print(
-            f"| {name} | {n} | {substeps} | {med['native']:.1f} | {med['engine']:.1f} | "
+            f"| {name} | {label} | {n} | {substeps} | {med['native']:.1f} | {med['engine']:.1f} | "
             f"{med['hold']:.1f} | {med['step']:.2f} | {ratio:.2f} | {med['python']:.1f} | "
             f"{med['python'] / med['native']:.1f}× |"
         )
-    sweep_table(args.sweep_T, args.repeats)
+
+
+def panda_table_times(T: float, repeats: int) -> None:
+    """examples/13's table: each controller natively and through the Python loop."""
+    import importlib.util
+    from pathlib import Path
+
+    from adaptimp import cartesian as ac
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "13_panda_table.py"
+    spec = importlib.util.spec_from_file_location("panda_table_example", path)
+    assert spec is not None
+    assert spec.loader is not None
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    sc = ac.panda_table()
+    basis = ac.orbit_basis(sc)
+    plant = amj.Plant(sc.model)
+    times: dict[str, dict[str, list[float]]] = {
+        k: {"native": [], "python": [], "engine": []} for k in example.KINDS
+    }
+    loops: dict[str, str] = {}
+    m, d = plant.model, plant.data
+    substeps = max(1, round(sc.Ts / plant.timestep))
+    full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    for _ in range(repeats):
+        for kind in example.KINDS:
+            base, _, variant = kind.partition("-")
+            extra = example.LEARN if variant == "learn" else {}
+            for how in ("native", "python"):
+                ctrl = ac.panda_controller(
+                    base, sc, basis=basis, force_feedforward=variant == "", **extra
+                )
+                start = time.perf_counter()
+                res = amj.simulate(
+                    ctrl if how == "native" else InPython(ctrl), plant, T=T, q0=sc.q0
+                )
+                ac.cartesian_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
+                times[kind][how].append(time.perf_counter() - start)
+                if how == "native":
+                    loops[kind] = res.params["loop"]
+            # MuJoCo alone on the same motion: the run's torques through mujoco.rollout.
+            plant.reset(sc.q0)
+            initial = np.zeros(mujoco.mj_stateSize(m, full))
+            mujoco.mj_getState(m, d, initial, full)
+            controls = np.repeat(res.tau_sat / plant._gear, substeps, axis=0)
+            start = time.perf_counter()
+            rollout.rollout(m, d, initial, controls)
+            times[kind]["engine"].append(time.perf_counter() - start)
+    print(
+        f"\nthe Panda table (examples/13_panda_table.py's controllers, T = {T:g} s; "
+        f"medians of {repeats}, s per controller: simulate and cartesian_metrics)"
+    )
+    print(
+        "\n| controller | loop | native (s) | Python loop (s) | native/Python | "
+        "MuJoCo alone (s) | MuJoCo alone/Python |"
+    )
+    print("|---|---|---:|---:|---:|---:|---:|")
+    total = {"native": 0.0, "python": 0.0, "engine": 0.0}
+    for kind, label in example.KINDS.items():
+        med = {how: statistics.median(v) for how, v in times[kind].items()}
+        for how in total:
+            total[how] += med[how]
+        print(
+            f"| {label} | {loops[kind]} | {med['native']:.2f} | {med['python']:.2f} | "
+            f"{med['native'] / med['python']:.2f} | {med['engine']:.2f} | "
+            f"{med['engine'] / med['python']:.2f} |"
+        )
+    print(
+        f"| all | | {total['native']:.2f} | {total['python']:.2f} | "
+        f"{total['native'] / total['python']:.2f} | {total['engine']:.2f} | "
+        f"{total['engine'] / total['python']:.2f} |"
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--T", type=float, default=10.0, help="run length (s)")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--sweep-T", type=float, default=2.0, help="sweep run length (s)")
+    parser.add_argument("--table-T", type=float, default=20.0, help="Panda table run length (s)")
+    parser.add_argument(
+        "--only", default="loop,cartesian,table,sweep", help="which tables, comma-separated"
+    )
+    args = parser.parse_args()
+    only = set(args.only.split(","))
+    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores "
+        f"(load average {load}), "
+        f"{platform.python_implementation()} {platform.python_version()}, "
+        f"MuJoCo {mujoco.__version__}; T = {args.T:g} s at Ts = 1 ms; "
+        f"medians of {args.repeats}, µs per control period"
+    )
+    rows = [(name, "joint") for name in ("UR5", "Panda") if "loop" in only]
+    rows += [(name, kind) for kind in ("cartesian", "table") for name in ("UR5", "Panda")]
+    rows = [(name, kind) for name, kind in rows if kind == "joint" or "cartesian" in only]
+    if rows:
+        loop_table(rows, args.T, args.repeats)
+    if "table" in only:
+        panda_table_times(args.table_T, max(1, args.repeats // 2))
+    if "sweep" in only:
+        sweep_table(args.sweep_T, args.repeats)
 
 
 def _half(vary: dict[str, list[float]], T: float, part: int) -> None:
@@ -195,35 +439,57 @@ def _half(vary: dict[str, list[float]], T: float, part: int) -> None:
     adaptimp.sweep("sf", vary=share, plant="mujoco", T=T, threads=1)
 
 
+def _cpu(who: int) -> float:
+    """CPU seconds (user + system) used so far by this process or its children."""
+    import resource
+
+    r = resource.getrusage(who)
+    return r.ru_utime + r.ru_stime
+
+
 def sweep_table(T: float, repeats: int) -> None:
+    """Wall time and CPU time of the sweep: the CPU seconds tell whether the
+    threads do more work than one thread (contention) independently of how
+    much of the machine the other users leave (the wall time)."""
     import multiprocessing
-    import os
+    import resource
 
     vary = {"Kp": [7.0, 8.0, 9.0, 10.0], "K1": [4.0, 5.0, 6.0, 7.0]}
-    times: dict[str, list[float]] = {"every core": [], "one thread": [], "two processes": []}
+    labels = ("every core", "one thread", "two processes")
+    times: dict[str, list[float]] = {k: [] for k in labels}
+    cpu: dict[str, list[float]] = {k: [] for k in labels}
+    loads: list[float] = []
     ctx = multiprocessing.get_context("fork")
     for _ in range(repeats):
         for label, threads in (("every core", None), ("one thread", 1)):
-            start = time.perf_counter()
+            c0, start = _cpu(resource.RUSAGE_SELF), time.perf_counter()
             df = adaptimp.sweep("sf", vary=vary, plant="mujoco", T=T, threads=threads)
             times[label].append(time.perf_counter() - start)
+            cpu[label].append(_cpu(resource.RUSAGE_SELF) - c0)
             assert df["error"].isna().all(), df["error"].dropna().head()
         # The ceiling on this machine: two independent processes, half each.
         procs = [ctx.Process(target=_half, args=(vary, T, part)) for part in (0, 1)]
-        start = time.perf_counter()
+        c0, start = _cpu(resource.RUSAGE_CHILDREN), time.perf_counter()
         for p in procs:
             p.start()
         for p in procs:
             p.join()
         times["two processes"].append(time.perf_counter() - start)
+        cpu["two processes"].append(_cpu(resource.RUSAGE_CHILDREN) - c0)
+        loads.append(os.getloadavg()[0])
     med = {k: statistics.median(v) for k, v in times.items()}
+    mcpu = {k: statistics.median(v) for k, v in cpu.items()}
     print(
-        f"\nsweep(plant='mujoco'), 16 runs of T = {T:g} s on {os.cpu_count()} cores "
-        f"(medians of {repeats}): one thread {med['one thread']:.2f} s, every core "
-        f"{med['every core']:.2f} s (speed-up {med['one thread'] / med['every core']:.2f}×); "
-        f"two independent processes, 8 runs each: {med['two processes']:.2f} s "
-        f"(speed-up {med['one thread'] / med['two processes']:.2f}×, this machine's ceiling)"
+        f"\nsweep(plant='mujoco'), 16 runs of T = {T:g} s on {os.cpu_count()} cores, "
+        f"medians of {repeats} (load average over the repeats {min(loads):.1f}–{max(loads):.1f}):"
     )
+    print("\n| how | wall (s) | speed-up | CPU (s) | CPU / wall (cores busy) |")
+    print("|---|---:|---:|---:|---:|")
+    for k in labels:
+        print(
+            f"| {k} | {med[k]:.2f} | {med['one thread'] / med[k]:.2f}× | {mcpu[k]:.2f} | "
+            f"{mcpu[k] / med[k]:.2f} |"
+        )
 
 
 if __name__ == "__main__":

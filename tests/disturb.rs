@@ -7,8 +7,8 @@ use adaptimp::impedance::TargetImpedance;
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
     run, run_disturbed, simulate_disturbed, Command, Control, Controller, DisturbanceParams,
-    Disturbances, Error, FreeSpace, Friction, Law, Manipulator, Measurement, Plant, RigidBody,
-    SimConfig, Sinusoid, Trace, TwoLinkArm, Vector, Wall, WithFriction,
+    Disturbances, Error, FreeSpace, Friction, Injected, Injection, Law, Manipulator, Measurement,
+    Plant, RigidBody, SimConfig, Sinusoid, Trace, TwoLinkArm, Vector, Wall, WithFriction,
 };
 use adaptimp::{Setpoint, TipPayload};
 
@@ -222,6 +222,136 @@ fn delay_shows_the_controller_the_sample_of_k_minus_d() {
     for (m, r) in now.iter().zip(&truth.rows) {
         assert_eq!((m.x, m.dx, m.tau_e), (r.x, Some(r.dx), r.tau_e));
     }
+}
+
+/// A plant whose end effector measures a different wrench at every sample
+/// (its sample count in f_x, the joint position in f_y, f_z): the wrench a
+/// controller is given tells which sample it is.
+struct Sensing<P> {
+    plant: P,
+    k: f64,
+}
+
+impl<P: Plant<2>> Plant<2> for Sensing<P> {
+    fn state(&self) -> (V2, V2) {
+        self.plant.state()
+    }
+    fn contact(&self) -> V2 {
+        self.plant.contact()
+    }
+    fn advance(&mut self, tau: &V2, h: f64) -> Result<V2, Error> {
+        self.k += 1.0;
+        self.plant.advance(tau, h)
+    }
+    fn wrench(&self) -> [f64; 6] {
+        let (x, _) = self.plant.state();
+        [self.k, x[0], x[1], 0.5, -0.5, self.k * 0.25]
+    }
+}
+
+/// A [`Spy`] that also remembers the wrenches it was given.
+struct WrenchSpy(Spy, Vec<[f64; 6]>);
+
+impl Control<2> for WrenchSpy {
+    fn period(&self) -> f64 {
+        self.0.period()
+    }
+    fn target(&self) -> &TargetImpedance<2> {
+        self.0.target()
+    }
+    fn step(&mut self, m: &Measurement<2>, c: &Setpoint<2>) -> Result<Command<2>, Error> {
+        self.0.step(m, c)
+    }
+    fn step_with_wrench(
+        &mut self,
+        m: &Measurement<2>,
+        wrench: &[f64; 6],
+        c: &Setpoint<2>,
+    ) -> (V2, Result<Command<2>, Error>) {
+        self.1.push(*wrench);
+        self.step_or_fallback(m, c)
+    }
+}
+
+#[test]
+fn the_wrench_goes_through_the_sensor_path_delayed_and_frozen_with_the_joints() {
+    let ts = 1e-3;
+    let spy_run = |delay: usize, noise: f64, injection: Option<&Injection<2>>| {
+        let mut plant = Sensing {
+            plant: RigidBody::new(
+                TwoLinkArm::paper(),
+                FreeSpace,
+                V2::new(0.1, 0.0),
+                V2::zeros(),
+                2,
+            )
+            .unwrap(),
+            k: 0.0,
+        };
+        let mut spy = WrenchSpy(Spy::new(ts, V2::new(3.0, 1.0)), Vec::new());
+        let d = disturbances(DisturbanceParams {
+            delay,
+            noise_q: V2::from_element(noise),
+            noise_tau_e: V2::from_element(noise),
+            ..DisturbanceParams::default()
+        });
+        let mut trace = Trace::default();
+        simulate_disturbed(
+            &mut plant,
+            &mut spy,
+            &Sinusoid::paper(),
+            0.2,
+            injection,
+            &d,
+            &mut trace,
+        )
+        .unwrap();
+        (spy.0.seen, spy.1, trace)
+    };
+    let (now, wrench_now, truth) = spy_run(0, 0.0, None);
+    // Undisturbed: the controller is given the row's wrench, exactly.
+    assert_eq!(wrench_now.len(), truth.rows.len());
+    for (w, r) in wrench_now.iter().zip(&truth.rows) {
+        assert_eq!(*w, r.wrench);
+    }
+    for delay in [1, 5, 64] {
+        let (seen, wrench, rows) = spy_run(delay, 0.0, None);
+        assert!(rows == truth, "the delay changed the plant's motion");
+        for k in 0..rows.rows.len() {
+            let then = k.saturating_sub(delay);
+            assert_eq!(wrench[k], truth.rows[then].wrench, "d = {delay}, k = {k}");
+            assert_eq!(seen[k], now[then], "d = {delay}, k = {k}");
+        }
+    }
+    // Noise is on τe (N m per joint), not on the wrench, and draws nothing for it.
+    let (noisy, wrench, _) = spy_run(2, 1e-3, None);
+    let (quiet, _, _) = spy_run(2, 0.0, None);
+    assert!(noisy != quiet, "the noise reached the joint sample");
+    for (k, w) in wrench.iter().enumerate() {
+        assert_eq!(*w, truth.rows[k.saturating_sub(2)].wrench, "k = {k}");
+    }
+    // A stale sensor freezes the wrench with q, q̇, τe; other faults leave it be.
+    let stale = Injection {
+        fault: Injected::Stale,
+        start: 0.05,
+        duration: 0.02,
+    };
+    let (seen, wrench, rows) = spy_run(0, 0.0, Some(&stale));
+    let first = 50;
+    for (k, r) in rows.rows.iter().enumerate() {
+        let want = if stale.active(r.t) { first - 1 } else { k };
+        assert_eq!(wrench[k], truth.rows[want].wrench, "k = {k}");
+        assert_eq!(seen[k].x, now[want].x, "k = {k}");
+    }
+    assert!(rows.rows.iter().filter(|r| stale.active(r.t)).count() >= 19);
+    let bias = Injection {
+        fault: Injected::ForceBias {
+            bias: V2::new(1.0, -1.0),
+        },
+        ..stale
+    };
+    let (_, wrench, _) = spy_run(0, 0.0, Some(&bias));
+    assert_eq!(wrench, wrench_now);
 }
 
 #[test]

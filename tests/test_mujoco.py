@@ -130,6 +130,50 @@ def test_sensor_and_contact_forces_agree(two_link: mujoco.MjModel) -> None:
         bare.sensor_wrench()
 
 
+def test_a_files_model_without_force_sensor_gets_a_contact_sensor(
+    tmp_path: Path, two_link: mujoco.MjModel
+) -> None:
+    """An MJCF file without a force sensor whose end effector can touch something:
+    Plant adds a contact sensor (the net contact wrench on the end effector's
+    subtree), whose wrench is the contact list's to rounding, so the core's loop
+    runs it, and both loops give the same bits; the same model as an MjModel
+    keeps the contact list and the Python loop."""
+    spec = mujoco.MjSpec.from_file(str(_models.TWO_LINK_XML))
+    for sensor in list(spec.sensors):
+        spec.delete(sensor)
+    path = tmp_path / "bare.xml"
+    path.write_text(spec.to_xml())
+    plant = amj.Plant(path)
+    assert plant.wrench_source == "contact sensor"
+    assert plant.model.nsensor == 1
+    _push_into_wall(plant, [0.5, 0.0])
+    np.testing.assert_allclose(
+        plant.contact_sensor_wrench(), plant.contact_wrench(), rtol=0, atol=1e-12
+    )
+    assert plant.wrench()[2] > 1.0
+    native = amj.simulate(adaptimp.Controller("sf", "robot"), path, T=2.0)
+    python = amj.simulate(_InPython(adaptimp.Controller("sf", "robot")), path, T=2.0)
+    assert native.params["loop"] == "native"
+    assert python.params["loop"] == "python"
+    _assert_same_run(native, python)
+    assert native.metrics["steps_in_contact"] > 100
+    same = mujoco.MjModel.from_xml_path(str(path))
+    listed = amj.simulate(adaptimp.Controller("sf", "robot"), same, T=2.0)
+    assert listed.params["wrench_source"] == "contact"
+    assert listed.params["loop"] == "python"
+    # The contact list and the sensor sum the same contact forces in another order.
+    np.testing.assert_allclose(listed.q, native.q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(listed.wrench_ee, native.wrench_ee, rtol=0, atol=1e-9)
+    assert listed.metrics["steps_in_contact"] == native.metrics["steps_in_contact"]
+    # Explicit contact pairs could collide geoms of the subtree with each other,
+    # which the sensor would count and the contact list skips: the list stays.
+    spec.add_pair(geomname1="ee", geomname2="wall")
+    paired = tmp_path / "paired.xml"
+    paired.write_text(spec.to_xml())
+    assert amj.Plant(paired).wrench_source == "contact"
+    assert amj.Plant(two_link).wrench_source == "sensor"
+
+
 def _mjcf(body: str, actuators: str = "") -> mujoco.MjModel:
     xml = f"""<mujoco><worldbody>{body}</worldbody><actuator>{actuators}</actuator></mujoco>"""
     return mujoco.MjModel.from_xml_string(xml)
@@ -509,8 +553,8 @@ def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause(
         amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(5))
     assert str(native.value) == want
     # From the first row: the reset is at t = 0, the warning still tells.
+    # (q0 given: without it the run starts on the reference, xc(0) = 10 rad.)
     with pytest.raises(adaptimp.DivergedError, match=r"row 0 \(t = 0 s to 0.001 s\): MuJoCo"):
-        # (q0 given: with a reference and no keyframe the arm would start on it.)
         amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0), q0=[0.0])
 
 

@@ -455,6 +455,7 @@ def metrics(
     tau_e: _F,
     settle: float,
     target: tuple[Sequence[float], Sequence[float], Sequence[float]],
+    joint_space: bool | None = None,
 ) -> dict[str, Any]:
     """The SPEC §12 metrics of recorded rows, by the core's accumulator."""
 
@@ -522,6 +523,31 @@ class CartesianImpedance:
     def last(self, what: str) -> _F: ...
     def state(self, what: str) -> _F: ...
     def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F]: ...
+    def simulate_mujoco(
+        self,
+        controller: Controller,
+        model: Any,
+        data: Any,
+        spec: dict[str, Any],
+        params: dict[str, Any],
+        t_final: float,
+        settle: float,
+        record_every: int = 1,
+        progress: Callable[[int, int], object] | None = None,
+        targets: _F | None = None,
+        fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
+    ) -> dict[str, Any]:
+        """The closed loop on MuJoCo with this outer loop in front of ``controller``."""
+    def replay(
+        self,
+        controller: Controller,
+        q: _F,
+        dq: _F,
+        wrench: _F,
+        targets: _F | None = None,
+        progress: Callable[[int, int], object] | None = None,
+    ) -> _F:
+        """The core's Cartesian steps over recorded rows; sat(τ) (K, n)."""
 
 def centres_along(
     q: _F, dq: _F, tube: tuple[float, float], periodic: bool = False

@@ -313,9 +313,15 @@ class CartesianController:
     -----
     The :func:`adaptimp.mujoco.simulate` protocol: ``wants_wrench = True``, so it
     calls ``step(q, dq, wrench, xc=, dxc=, ddxc=)``; ``.Ts``; after a step
-    ``xc`` = p_c, ``xd`` = p_d (the compliant reference), ``z1`` = p_d − p(q)
-    (m, (3,)), ``tau`` (the joint controller's commanded τ, N m), ``q_d``,
-    ``force`` (f, N).
+    ``xc``, ``dxc``, ``ddxc`` = p_c, ṗ_c, p̈_c (the commanded position and its
+    rates; when no target is given, the held target after its filter, p_t, at
+    rest), ``xd`` = p_d (the compliant reference), ``z1`` = p_d − p(q) (m,
+    (3,)), ``tau`` (the joint controller's commanded τ, N m), ``q_d``,
+    ``force`` (f, N); ``zeta`` and ``dq_hat`` are the joint controller's (if it
+    has them). With a case name's joint controller, :func:`adaptimp.mujoco.simulate`
+    runs the whole loop in the core (the path or the reference tabulated
+    first, at the loop's t_k); afterwards the controller is as after the same
+    steps taken one by one (its log holds the run's kept rows).
 
     Examples
     --------
@@ -398,6 +404,7 @@ class CartesianController:
         n = chain.n
         nan3 = np.full(3, math.nan)
         self.xc, self.xd, self.z1, self.force = nan3, nan3, nan3, nan3
+        self.dxc, self.ddxc = nan3, nan3
         self.tau = np.full(n, math.nan)
         self.q_d = self.outer.q0.copy()
         self.log: dict[str, list[FloatArray]] = {k: [] for k in _LOG}
@@ -411,6 +418,18 @@ class CartesianController:
     def ts(self) -> float:
         """Deprecated name of :attr:`Ts`."""
         return period_alias(self)
+
+    @property
+    def zeta(self) -> FloatArray:
+        """The joint controller's auxiliary state ζ now (N m), (n,) (AttributeError
+        if it has none)."""
+        return np.asarray(self.inner.zeta, dtype=np.float64)
+
+    @property
+    def dq_hat(self) -> FloatArray:
+        """The velocity the joint controller used in the last step (rad/s), (n,)
+        (AttributeError if it does not say)."""
+        return np.asarray(self.inner.dq_hat, dtype=np.float64)
 
     @property
     def n(self) -> int:
@@ -470,18 +489,15 @@ class CartesianController:
         else:
             out = core.step_python(self.inner, q, dq, f, target)
             self.tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
-        pd = core.last("p_d")
-        self.xc = core.last("p_t") if target is None else target[:3].copy()
-        self.xd, self.force, self.q_d = pd, f[:3].copy(), core.last("q_d")
-        self.z1 = pd - core.last("p")
+        self._last_step()
+        pd = self.xd
         if self.record:
-            t = np.zeros(24) if target is None else target
             for key, v in zip(
                 _LOG,
                 (
-                    t[0:3],
-                    t[3:6],
-                    t[6:9],
+                    self.xc,
+                    self.dxc,
+                    self.ddxc,
                     pd,
                     core.last("dp_d"),
                     core.last("ddp_d"),
@@ -496,9 +512,80 @@ class CartesianController:
         return np.asarray(out)
 
     def arrays(self) -> dict[str, FloatArray]:
-        """The log as (K, ·) arrays: pc, dpc, ddpc, pd, dpd, ddpd (K, 3); qd (K, n);
+        """The log as (K, ·) arrays: pc, dpc, ddpc (the commanded position and its
+        rates, as ``xc``, ``dxc``, ``ddxc``), pd, dpd, ddpd (K, 3); qd (K, n);
         wrench, error (K, 6)."""
-        return {k: np.array(v, dtype=np.float64) for k, v in self.log.items()}
+        n = self.chain.n
+        width = {"qd": n, "wrench": 6, "error": 6}
+        # Each entry of the log is a step's row, or a block of rows (a run of the core's loop).
+        return {
+            k: np.vstack(v) if v else np.zeros((0, width.get(k, 3))) for k, v in self.log.items()
+        }
+
+    def _targets(
+        self,
+        steps: int,
+        reference: Callable[[float], Sequence[ArrayLike]] | Sequence[FloatArray] | None,
+    ) -> FloatArray | None:
+        """The commanded pose of the next ``steps`` steps at t_k = k·Ts of a loop,
+        (steps, 24), as :meth:`step` would take them one by one: ``reference(t_k)``
+        or the row k of a tabulated reference (xc, dxc, ddxc) (position, rates;
+        the rotation held), else the path on this controller's clock, else None
+        (the last target held)."""
+        path = self.path
+        if reference is None and path is None:
+            return None
+        # The rows of pose_target, filled in place (a path is called once a period).
+        out = np.zeros((steps, 24))
+        out[:, 9:18] = self.outer._R.ravel()
+        if reference is not None and not callable(reference):
+            for i in range(3):
+                out[:, 3 * i : 3 * i + 3] = reference[i][:steps]
+            return out
+        if reference is not None:
+            for k in range(steps):
+                out[k, 0:3], out[k, 3:6], out[k, 6:9] = reference(k * self.Ts)
+            return out
+        assert path is not None
+        k0, ts = self._k, self.Ts
+        turned = False  # a 3-tuple keeps the rotation a 6-tuple set
+        for k in range(steps):
+            s = tuple(path((k0 + k) * ts))
+            if len(s) == 3:
+                out[k, 0:3], out[k, 3:6], out[k, 6:9] = s
+                if turned:
+                    out[k, 9:18] = out[k - 1, 9:18]
+            elif len(s) == 6:
+                out[k] = pose_target(*s)
+                turned = True
+            else:
+                raise ValueError(
+                    f"path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}"
+                )
+        return out
+
+    def _last_step(self) -> None:
+        """The attributes of the last step taken, from the core's outer loop."""
+        last = self.outer.core.last
+        self.xc, self.dxc, self.ddxc = last("p_c"), last("dp_c"), last("ddp_c")
+        self.xd, self.force, self.q_d = last("p_d"), last("wrench")[:3], last("q_d")
+        self.z1 = self.xd - last("p")
+
+    def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None) -> None:
+        """After a run of the core's loop (:func:`adaptimp.mujoco.simulate`) along
+        ``targets`` (of :meth:`_targets`), whole or stopped by an error: the clock,
+        the held rotation and the attributes as after the steps it took; the log
+        extended by the run's kept rows ``task`` (None: none)."""
+        core = self.outer.core
+        k0, self._k = self._k, int(core.steps)
+        if self._k > k0:
+            if targets is not None and self.path is not None:
+                self.outer._R = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
+            self._last_step()
+            self.tau = core.last("tau")
+        if self.record and task is not None and len(task["pc"]):
+            for key in _LOG:
+                self.log[key].append(task[key])
 
     def __repr__(self) -> str:
         kind = "position-only" if not self.outer.orients else "6-D"

@@ -24,9 +24,13 @@ force/torque sensors measure the wrench between the site's body and its parent,
 so the site should sit on a massless body welded to the last link, holding the
 contact geometry: then the reading is exactly the contact wrench (the packaged
 models do this). Without a force sensor, F_e is the sum over the active
-contacts of the end-effector body's subtree of ``mj_contactForce``, with the
-moment about the end-effector point (the first site on the last joint's body,
-or that body's origin). :attr:`Plant.wrench_source` says which is used.
+contacts of the end-effector body's subtree with anything outside it of
+``mj_contactForce``, with the moment about the end-effector point (the first
+site on the last joint's body, or that body's origin): read from MuJoCo's
+contact list, or, for a model :class:`Plant` loads from a file and in which no
+contact can arise inside that subtree, from a contact sensor it adds (the net
+contact wrench on the subtree, ``reduce="netforce"``; it changes no dynamics),
+which the core's loop reads. :attr:`Plant.wrench_source` says which is used.
 
 Units: rad, rad/s, rad/s², N, N m, m, s. Vectors in the world frame.
 """
@@ -101,9 +105,10 @@ class ControllerLike(Protocol):
     ``reference``, nothing otherwise (the controller then follows its own
     trajectory). The period is ``.Ts`` (s; ``.ts`` is read, deprecated). Optional attributes
     that :func:`simulate` records when present: ``tau`` (commanded torque
-    before saturation), ``xc``, ``xd``, ``z1``, ``dq_hat``, ``zeta``, and
-    ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``,
-    ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
+    before saturation), ``xc`` and, without a ``reference``, ``dxc``, ``ddxc``
+    (the controller's own commanded rates), ``xd``, ``z1``, ``dq_hat``,
+    ``zeta``, and ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``,
+    ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
 
     Cartesian hook: a controller with ``wants_wrench = True`` is called as
     ``step(q, dq, wrench, **setpoint)`` instead, with the measured wrench
@@ -372,15 +377,20 @@ def _load(source: ModelSource) -> mujoco.MjModel:
         return copy.deepcopy(source)
     if isinstance(source, str) and source in _BUILTIN:
         return _BUILTIN[source]()
+    path = _model_path(source)
+    if path.suffix.lower() == ".urdf":
+        return from_urdf(path)
+    return mujoco.MjModel.from_xml_path(str(path))
+
+
+def _model_path(source: str | os.PathLike[str]) -> Path:
     path = Path(source)
     if not path.is_file():
         raise ValueError(
             f"model must be an MjModel, one of {sorted(_BUILTIN)} or a path to an MJCF or URDF "
             f"file; no file {str(path)!r}"
         )
-    if path.suffix.lower() == ".urdf":
-        return from_urdf(path)
-    return mujoco.MjModel.from_xml_path(str(path))
+    return path
 
 
 _BUILTIN: dict[str, Callable[[], mujoco.MjModel]] = {"two_link": two_link, "panda": panda}
@@ -430,7 +440,9 @@ class Plant:
     tau_max : ndarray, (n,)
         Actuator limits τmax (N m): gear × ctrlrange.
     wrench_source : str
-        ``"sensor"`` (force/torque sensor) or ``"contact"`` (``mj_contactForce``).
+        ``"sensor"`` (force/torque sensor), ``"contact sensor"`` (the net contact
+        wrench on the end effector's subtree, a MuJoCo contact sensor) or
+        ``"contact"`` (MuJoCo's contact list, ``mj_contactForce``).
     site : str or None
         The end-effector site asked for (None: found as above).
     """
@@ -438,15 +450,24 @@ class Plant:
     def __init__(
         self, model: ModelSource = "two_link", *, contact: bool = True, site: str | None = None
     ) -> None:
-        self.model = _load(model)
-        m = self.model
-        if not contact:
-            m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         self.contact = contact
         self.site = site
-        self._check_joints()
-        self._check_actuators()
-        self._find_end_effector(site)
+        self._setup_model(_load(model), site)
+        if self.wrench_source == "contact" and self._contact_sensor_fits(model):
+            # An MJCF file's model: measure the contacts with a sensor of its own
+            # (the net contact wrench on the end effector's subtree), which the
+            # core's loop reads like the force sensor. A sensor changes no dynamics.
+            assert isinstance(model, (str, os.PathLike))
+            spec = mujoco.MjSpec.from_file(str(model))
+            spec.add_sensor(
+                name=_CONTACT_SENSOR,
+                type=mujoco.mjtSensor.mjSENS_CONTACT,
+                objtype=mujoco.mjtObj.mjOBJ_XBODY,
+                objname=_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
+                intprm=[_NETFORCE_DATA, _NETFORCE, 1],
+            )
+            self._setup_model(spec.compile(), site)
+        m = self.model
         self.data = mujoco.MjData(m)
         self._jac = np.zeros((6, m.nv))
         self._jacp, self._jacr = self._jac[:3], self._jac[3:]
@@ -454,6 +475,38 @@ class Plant:
         self.reset()
 
     # -- construction checks ------------------------------------------------
+
+    def _setup_model(self, model: mujoco.MjModel, site: str | None) -> None:
+        self.model = model
+        if not self.contact:
+            model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        self._check_joints()
+        self._check_actuators()
+        self._find_end_effector(site)
+
+    def _contact_sensor_fits(self, source: ModelSource) -> bool:
+        """Whether a contact sensor can measure this plant's wrench exactly as
+        :meth:`contact_wrench` defines it: the model comes from an MJCF file (so
+        it can be rebuilt with the sensor; :func:`from_urdf` gives no contact
+        geometry), a contact can reach the end effector, and no contact can
+        arise inside its subtree (the sensor would count it; the contact list
+        skips it). Conservative: no explicit contact pairs, and no two geoms of
+        the subtree on different weld bodies whose contype and conaffinity meet."""
+        if isinstance(source, mujoco.MjModel) or (isinstance(source, str) and source in _BUILTIN):
+            return False
+        if Path(source).suffix.lower() == ".urdf":
+            return False
+        m = self.model
+        if m.npair > 0 or not self._contact_possible():
+            return False
+        inside = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in self._ee_subtree]
+        ct, ca, weld = m.geom_contype, m.geom_conaffinity, m.body_weldid
+        return not any(
+            ((ct[a] & ca[b]) or (ct[b] & ca[a]))
+            and weld[m.geom_bodyid[a]] != weld[m.geom_bodyid[b]]
+            for i, a in enumerate(inside)
+            for b in inside[i + 1 :]
+        )
 
     def _check_joints(self) -> None:
         m = self.model
@@ -557,11 +610,28 @@ class Plant:
             if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sid >= 0
         ]
         self._torque_adr = int(m.sensor_adr[torques[0]]) if torques else -1
-        self.wrench_source = "sensor" if self._force_adr >= 0 else "contact"
         subtree = [
             b for b in range(m.nbody) if b == self._ee_body or self._ee_body in self._ancestors(b)
         ]
         self._ee_subtree = frozenset(subtree)
+        # A contact sensor of the net contact wrench on the end effector's subtree.
+        nets = [
+            s
+            for s in range(m.nsensor)
+            if m.sensor_type[s] == int(mujoco.mjtSensor.mjSENS_CONTACT)
+            and m.sensor_objtype[s] == int(mujoco.mjtObj.mjOBJ_XBODY)
+            and m.sensor_objid[s] == self._ee_body
+            and m.sensor_reftype[s] == int(mujoco.mjtObj.mjOBJ_UNKNOWN)
+            and list(m.sensor_intprm[s]) == [_NETFORCE_DATA, _NETFORCE, 1]
+        ]
+        self._contact_adr = int(m.sensor_adr[nets[0]]) if nets and self._force_adr < 0 else -1
+        self.wrench_source = (
+            "sensor"
+            if self._force_adr >= 0
+            else "contact sensor"
+            if self._contact_adr >= 0
+            else "contact"
+        )
 
     # -- state ----------------------------------------------------------------
 
@@ -711,7 +781,7 @@ class Plant:
         possible: the contact path reads MuJoCo's contact list, which only
         the Python loop does)."""
         m = self.model
-        if self._force_adr < 0 and self._contact_possible():
+        if self.wrench_source == "contact" and self._contact_possible():
             return None
         return {
             "qadr": [int(a) for a in self._qadr],
@@ -723,6 +793,7 @@ class Plant:
             "ee_body": int(self._ee_body),
             "force_adr": int(self._force_adr) if self._force_adr >= 0 else None,
             "torque_adr": int(self._torque_adr) if self._torque_adr >= 0 else None,
+            "contact_adr": int(self._contact_adr) if self._contact_adr >= 0 else None,
             "substeps": int(substeps),
             "timestep": float(m.opt.timestep),
             "dof_names": [
@@ -762,7 +833,34 @@ class Plant:
         """F_e = [f; m], (6,): the force (N) and the moment about the end-effector
         point (N m) that the arm exerts on its environment, world frame, of the
         last :meth:`forward` (from the sensor or the contacts, see the module doc)."""
-        return self.sensor_wrench() if self._force_adr >= 0 else self.contact_wrench()
+        if self._force_adr >= 0:
+            return self.sensor_wrench()
+        if self._contact_adr >= 0:
+            return self.contact_sensor_wrench()
+        return self.contact_wrench()
+
+    def contact_sensor_wrench(self) -> FloatArray:
+        """F_e (6,) from the model's contact sensor of the net contact wrench on the
+        end effector's subtree (force f and torque t about the force-weighted
+        centroid c of the contacts, world frame): [f; t + (c − p) × f], p the
+        end-effector point (summed in the order of the core's native loop).
+
+        Raises
+        ------
+        ValueError
+            The model has no such sensor.
+        """
+        if self._contact_adr < 0:
+            raise ValueError("the model has no contact sensor at the end effector")
+        a = self._contact_adr
+        f, t, c = (self.data.sensordata[a + 3 * i : a + 3 * i + 3] for i in range(3))
+        d = c - self.ee_position()
+        out = np.zeros(6)
+        out[:3] = f
+        out[3] = t[0] + (d[1] * f[2] - d[2] * f[1])
+        out[4] = t[1] + (d[2] * f[0] - d[0] * f[2])
+        out[5] = t[2] + (d[0] * f[1] - d[1] * f[0])
+        return out
 
     def sensor_wrench(self) -> FloatArray:
         """F_e (6,) from the force/torque sensors (world frame; see :meth:`wrench`).
@@ -829,6 +927,23 @@ class Plant:
             f"adaptimp.mujoco.Plant({name!r}: {self.n} joints, τmax = {self.tau_max.tolist()} N m,"
             f" wrench from {self.wrench_source}, timestep {self.timestep:g} s)"
         )
+
+
+_CONTACT_SENSOR = "adaptimp_ee_contact"
+"""The name of the contact sensor :class:`Plant` adds to a file's model."""
+
+_NETFORCE = 3
+"""The contact sensor's ``reduce="netforce"`` (MuJoCo's sensor_intprm[1])."""
+
+_NETFORCE_DATA = sum(
+    1 << int(f)
+    for f in (
+        mujoco.mjtConDataField.mjCONDATA_FORCE,
+        mujoco.mjtConDataField.mjCONDATA_TORQUE,
+        mujoco.mjtConDataField.mjCONDATA_POS,
+    )
+)
+"""The contact sensor's ``data="force torque pos"`` (sensor_intprm[0])."""
 
 
 def _warning_names() -> list[str]:
@@ -1047,10 +1162,24 @@ def rule_keywords(
     return kw
 
 
+class _Table:
+    """A reference tabulated at t_k = k·Ts, as a callable of t (the row of t),
+    with its arrays (xc, dxc, ddxc), one row per step."""
+
+    def __init__(self, arrays: tuple[FloatArray, FloatArray, FloatArray], Ts: float) -> None:
+        self.arrays, self.Ts = arrays, Ts
+
+    def __call__(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        xc, dxc, ddxc = self.arrays
+        k = min(max(round(t / self.Ts), 0), xc.shape[0] - 1)
+        return xc[k], dxc[k], ddxc[k]
+
+
 def _table_reference(reference: Any, n: int, Ts: float, steps: int) -> Reference:
     """``reference`` as a callable of t: a callable as it is; (xc, dxc, ddxc)
     arrays of shape (K, n), K ≥ ``steps`` (or an object with those attributes,
-    e.g. a :class:`MujocoResult`), row k at t_k = k·Ts."""
+    e.g. a :class:`MujocoResult`), row k at t_k = k·Ts (n: the width of the
+    controller's reference, 3 for a Cartesian controller's p_c)."""
     if callable(reference):
         return reference  # type: ignore[no-any-return]
     if all(hasattr(reference, a) for a in ("xc", "dxc", "ddxc")):
@@ -1070,12 +1199,7 @@ def _table_reference(reference: Any, n: int, Ts: float, steps: int) -> Reference
             )
         if not np.all(np.isfinite(a[:steps])):
             raise ValueError(f"reference {name} must be finite")
-
-    def table(t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-        k = min(max(round(t / Ts), 0), xc.shape[0] - 1)
-        return xc[k], dxc[k], ddxc[k]
-
-    return table
+    return _Table((xc, dxc, ddxc), Ts)
 
 
 # ---------------------------------------------------------------------------
@@ -1129,6 +1253,14 @@ class MujocoResult(SimResult):
         End-effector position (m), world frame.
     wrench_ee : (K, 6)
         F_e: force (N) and moment (N m) the end effector exerts, world frame.
+    task : dict or None
+        A Cartesian controller's task-space rows (:class:`adaptimp.CartesianController`,
+        the keys of its ``arrays()``): "pc", "dpc", "ddpc" (the commanded position
+        and rates, = ``xc``, ``dxc``, ``ddxc``), "pd", "dpd", "ddpd" (the compliant
+        reference, ``xd`` = pd), "qd" (the joint reference, (K, n)), "wrench" (the
+        F_e it was given, (K, 6)), "error" (the impedance's [e_p; e_o], (K, 6)).
+        None for a joint-space controller (and in the Python loop for a Cartesian
+        one with ``record=False``).
     metrics : dict
         The SPEC §12 metrics, with the keys of :attr:`adaptimp.SimResult.metrics`
         (NaN where they do not apply: ``imp_err_rms_after2`` needs a joint-space
@@ -1140,6 +1272,7 @@ class MujocoResult(SimResult):
 
     x_ee: FloatArray | None = None
     wrench_ee: FloatArray | None = None
+    task: dict[str, FloatArray] | None = None
 
     @property
     def rows(self) -> int:
@@ -1229,11 +1362,28 @@ def _native(ctrl: Any) -> bool:
     return isinstance(ctrl, _adaptimp.Controller) and type(ctrl).step is _adaptimp.Controller.step
 
 
+def _native_cartesian(ctrl: Any) -> bool:
+    """Whether the core can step ``ctrl`` as a whole: an
+    :class:`adaptimp.CartesianController` (its own ``step``) in front of a
+    joint controller the core steps (a case name's)."""
+    from .cartesian import CartesianController
+
+    return (
+        isinstance(ctrl, CartesianController)
+        and type(ctrl).step is CartesianController.step
+        and ctrl._core_inner
+        and _native(ctrl.inner)
+    )
+
+
 def _tabulate(
     reference: Reference, steps: int, Ts: float
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """``reference(k·Ts)`` for every row k, as three (K, m) arrays (called in
-    order, once per row, as the loop would)."""
+    order, once per row, as the loop would; a table's own rows)."""
+    if isinstance(reference, _Table) and math.isclose(reference.Ts, Ts, rel_tol=1e-12):
+        xc, dxc, ddxc = (np.ascontiguousarray(a[:steps]) for a in reference.arrays)
+        return xc, dxc, ddxc
     rows = [tuple(np.asarray(v, dtype=np.float64) for v in reference(k * Ts)) for k in range(steps)]
     xc, dxc, ddxc = (np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
     return xc, dxc, ddxc
@@ -1317,6 +1467,7 @@ def simulate(
     progress: bool | Callable[[int, int], object] = False,
     fault: Fault | None = None,
     payload: float = 0.0,
+    reset: bool = True,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1384,6 +1535,12 @@ def simulate(
         A point mass (kg, ≥ 0) at the end effector's link of the plant only
         (:func:`with_payload`); the controller's gains come from the arm
         without it, and no model the controller is given has it.
+    reset : bool
+        True: the plant starts at ``q0``, ``dq0``. False: a :class:`Plant` goes
+        on from where its last run left it (a long run in parts: with a used
+        controller, the parts are the whole run's rows; each part's t starts
+        at 0 and its disturbances afresh); ``q0``, ``dq0`` must then be None
+        and ``payload`` 0.
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
@@ -1426,13 +1583,16 @@ def simulate(
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
         settle=settle, scenario=scenario, record_every=record_every, reference=reference,
-        payload=payload, params=params,
+        payload=payload, params=params, reset=reset,
     )  # fmt: skip
     from ._api import _progress
 
     callback, bar = _progress(progress, "mujoco.simulate")
     try:
-        if run.native:
+        if run.native and run.cartesian:
+            out = _cartesian_loop(run, run.reference, callback, fault)
+            m = out.pop("metrics")
+        elif run.native:
             assert run.spec is not None
             refs = None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts)
             core_fault = None if fault is None else fault._core(run.plant.n)
@@ -1453,6 +1613,32 @@ def simulate(
         if bar is not None:
             bar.close()
     return _result(run, out, m)
+
+
+def _cartesian_loop(
+    run: _Run,
+    reference: Reference | None,
+    progress: Callable[[int, int], object] | None,
+    fault: Fault | None,
+) -> dict[str, Any]:
+    """The native loop of an :class:`adaptimp.CartesianController` whose joint
+    controller the core steps: its commanded pose tabulated for every row
+    (the reference at t_k, else its path on its own clock), then the core's
+    loop; the controller's Python side brought up to date, whatever happens."""
+    assert run.spec is not None
+    ctrl = run.ctrl
+    table = reference.arrays if isinstance(reference, _Table) else reference
+    targets = ctrl._targets(run.steps, table)
+    core_fault = None if fault is None else fault._core(run.plant.n)
+    out: dict[str, Any] | None = None
+    try:
+        out = ctrl.outer.core.simulate_mujoco(
+            ctrl.inner, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
+            run.settle, run.every, progress, targets, core_fault,
+        )  # fmt: skip
+    finally:
+        ctrl._ran(targets, None if out is None else out["task"])
+    return out
 
 
 @dataclass
@@ -1476,6 +1662,7 @@ class _Run:
     task: Task | None
     payload: float
     q0: FloatArray
+    cartesian: bool = False
 
 
 def _setup(
@@ -1494,6 +1681,7 @@ def _setup(
     reference: Any = None,
     payload: float = 0.0,
     params: Mapping[str, Any],
+    reset: bool = True,
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
     plant at its initial state, the settings and the choice of loop."""
@@ -1505,6 +1693,10 @@ def _setup(
     if defaults is None:
         raise ValueError(f"scenario must be one of {sorted(SCENARIOS)}, got {scenario!r}")
     every = _record_every(record_every)
+    if not reset and (q0 is not None or dq0 is not None or payload != 0):
+        raise ValueError(
+            "q0, dq0 and a payload start a run afresh: give them with reset=True (the default)"
+        )
     nominal = model if isinstance(model, Plant) else Plant(model, contact=contact)
     plant = _payload_plant(nominal, payload)
     task: Task | None = None
@@ -1555,19 +1747,23 @@ def _setup(
         raise ValueError(f"substeps must be ≥ 1, got {substeps}")
     resolved = resolve(disturb, scenario="robot", groups=("sim",), caller="simulate()", n=plant.n)
     dist = {k: resolved[k] for k in DISTURBANCES}
+    # A Cartesian controller's reference is its commanded position p_c (3,).
+    task_space = bool(getattr(ctrl, "wants_wrench", False))
     if reference is not None:
-        reference = _table_reference(reference, plant.n, Ts, steps)
-        if q0 is None and plant.model.nkey == 0:
+        reference = _table_reference(reference, 3 if task_space else plant.n, Ts, steps)
+        if q0 is None and plant.model.nkey == 0 and not task_space and reset:
             start = reference(0.0)
             q0 = np.asarray(start[0], dtype=np.float64)
             dq0 = np.asarray(start[1], dtype=np.float64) if dq0 is None else dq0
     plant.timestep = Ts / substeps
-    plant.reset(q0, dq0)
+    if reset:
+        plant.reset(q0, dq0)
     spec = plant._native(substeps)
-    native = _native(ctrl) and spec is not None and not bool(getattr(ctrl, "wants_wrench", False))
+    cartesian = _native_cartesian(ctrl)
+    native = spec is not None and (cartesian or (_native(ctrl) and not task_space))
     return _Run(
         ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native,
-        reference, task, float(payload), plant.q,
+        reference, task, float(payload), plant.q, cartesian,
     )  # fmt: skip
 
 
@@ -1622,7 +1818,12 @@ def _python_loop(
             "adaptimp.Controller or a case name) and a plant with a force sensor or "
             "no possible contact; this run steps its controller from Python"
         )
-    has = {name: hasattr(ctrl, name) for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta")}
+    has = {
+        name: hasattr(ctrl, name)
+        for name in ("tau", "xc", "dxc", "ddxc", "xd", "z1", "dq_hat", "zeta")
+    }
+    # Its own commanded rates (a Cartesian controller's ṗ_c, p̈_c), if it says.
+    own_rates = reference is None and has["dxc"] and has["ddxc"]
     # The Cartesian hook (ControllerLike): the measured wrench instead of τe.
     wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
     n = plant.n
@@ -1653,6 +1854,9 @@ def _python_loop(
             tau_cmd = ctrl.step(*args)
             xc = ctrl.xc if has["xc"] else q
             r_xc.append(xc)
+            if own_rates:
+                r_dxc.append(ctrl.dxc)
+                r_ddxc.append(ctrl.ddxc)
         tau_sat = plant.apply(tau_cmd)
         plant.forward()  # q̈ at the row's state and applied torque (SPEC §12)
         xd = ctrl.xd if has["xd"] else xc
@@ -1673,7 +1877,7 @@ def _python_loop(
             progress(k + 1, steps)
 
     t: FloatArray = np.arange(steps, dtype=np.float64) * Ts
-    if reference is None:
+    if reference is None and not own_rates:
         # The controller's own trajectory, if its params declare one (for the
         # impedance metric), evaluated for every row at once.
         builtin = _builtin_reference(ctrl)
@@ -1704,9 +1908,14 @@ def _python_loop(
     m = _adaptimp.metrics(
         a["t"], a["q"], a["dq"], a["ddq"], a["xc"], a["dxc"], a["ddxc"], a["z1"],
         a["tau"], a["tau_sat"], a["tau_e"], settle, tuple(target),
+        False if wants_wrench else None,
     )  # fmt: skip
-    kept = {name: v[::every] for name, v in arrays.items()}
+    kept: dict[str, Any] = {name: v[::every] for name, v in arrays.items()}
     kept["w_norms"] = np.full((kept["t"].shape[0], 3), math.nan)
+    # A Cartesian controller's log of this run (adaptimp.CartesianController.arrays).
+    log = getattr(ctrl, "arrays", None) if wants_wrench and getattr(ctrl, "record", False) else None
+    if callable(log) and steps:
+        kept["task"] = {k: v[len(v) - steps :: every] for k, v in log().items()}
     return kept, m
 
 

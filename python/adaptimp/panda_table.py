@@ -357,7 +357,8 @@ def cartesian_metrics(
     Over the rows with t ≥ ``settle`` (s), with p = the TCP (MuJoCo's site),
     ṗ = J(q) q̇, p̈ = J(q) q̈ + J̇ q̇ (q̈ MuJoCo's at the row's state and torque;
     J and J̇ q̇ the core's chain), p_d the controller's compliant reference and
-    F_e its measured force:
+    F_e its measured force (the run's task-space rows, ``res.task``; the
+    controller's log ``ctrl.arrays()`` if the run has none):
 
     - ``rms_track`` (m): sqrt(mean ‖p_d − p‖²), the Cartesian tracking error.
     - ``rms_path_xy`` (m): sqrt(mean ‖(p_c − p)_xy‖²), the path on the table
@@ -371,7 +372,7 @@ def cartesian_metrics(
       |τ_i| / τmax_i for the commanded τ (target ≤ 2: no windup).
     - ``applied_ratio``: the same for the applied sat(τ) over all rows (≤ 1).
     """
-    log = ctrl.arrays()
+    log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
     t = res.t
     after = t >= settle - 1e-9
     p = res.x_ee

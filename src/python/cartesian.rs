@@ -8,7 +8,9 @@
 //! face ([`DynChain`], [`DynOuter`]), slices in and out; errors become the
 //! exceptions of `adaptimp._errors`.
 
-use super::dynamic::{scenario, DynTracker, Owned, Typed, MAX_JOINTS};
+use super::cartesian_loop::{self, pose_target, CartesianOut, CartesianRun, LastStep};
+use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JOINTS};
+use super::mujoco::MujocoSpec;
 use super::{array, array1, config_error, items, python_shape, vector, ConfigError, PyController};
 use super::{DivergedError, MeasurementError};
 use crate::cartesian::chain::MAX_CHAIN_JOINTS;
@@ -23,7 +25,7 @@ use crate::networks::rbf::Centers;
 use crate::schema::Preset;
 use crate::trajectory::Setpoint;
 use crate::types::Vector;
-use nalgebra::Matrix3;
+use adaptimp_mujoco::Sim;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -135,9 +137,9 @@ pub fn chain(joints: &[Joint], tip: &Transform) -> Result<Box<dyn DynChain>, Err
 }
 
 /// The quantities of the last Cartesian step, by name.
-const LAST: [&str; 18] = [
+const LAST: [&str; 22] = [
     "q_d", "dq_d", "ddq_d", "p_d", "dp_d", "ddp_d", "R_d", "w_d", "dw_d", "p_t", "R_t", "error",
-    "p", "R", "tau_e", "tau", "tau_sat", "z1",
+    "p", "R", "tau_e", "tau", "tau_sat", "z1", "p_c", "dp_c", "ddp_c", "wrench",
 ];
 
 /// The quantities of the outer state, by name.
@@ -202,6 +204,38 @@ pub trait DynOuter: Send + Sync {
         targets: &[PoseTarget],
         nodes: usize,
     ) -> Result<(Vec<f64>, Vec<f64>), Error>;
+    /// The closed loop on MuJoCo of this outer loop in front of the core's
+    /// joint controller behind `tracker`, from both states
+    /// ([`cartesian_loop::simulate_mujoco`]).
+    fn simulate_mujoco(
+        &mut self,
+        tracker: &mut dyn DynTracker,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &CartesianRun<'_>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<CartesianOut, RunError>;
+    /// Steps over recorded rows, the core's alone ([`cartesian_loop::replay`]).
+    fn replay(
+        &mut self,
+        tracker: &mut dyn DynTracker,
+        rows: usize,
+        tables: [&[f64]; 3],
+        targets: Option<&[f64]>,
+        out: &mut Vec<f64>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(), RunError>;
+}
+
+/// The typed joint controller of N joints behind `tracker`.
+fn typed<const N: usize>(tracker: &mut dyn DynTracker) -> Result<&mut Typed<N>, Error> {
+    tracker
+        .as_any_mut()
+        .downcast_mut::<Typed<N>>()
+        .ok_or(Error::Invalid {
+            what: "controller",
+            reason: "has another number of joints than the chain",
+        })
 }
 
 struct Outer<const N: usize> {
@@ -209,7 +243,7 @@ struct Outer<const N: usize> {
     state: CartesianState<N>,
     q0: Vector<N>,
     posture: Vector<N>,
-    last: Option<CartesianCommand<N>>,
+    last: Option<LastStep<N>>,
 }
 
 impl<const N: usize> Outer<N> {
@@ -267,7 +301,7 @@ impl<const N: usize> DynOuter for Outer<N> {
             &Vector::zeros(),
         );
         self.state = staged.next;
-        self.last = Some(CartesianCommand {
+        let cmd = CartesianCommand {
             joint: Command::zeros(),
             reference: staged.reference,
             compliant: staged.compliant,
@@ -276,24 +310,21 @@ impl<const N: usize> DynOuter for Outer<N> {
             p: tip.position,
             r: tip.rotation,
             tau_e: Vector::zeros(),
-        });
+        };
+        self.last = Some(LastStep::new(cmd, target, wrench));
         Ok(())
     }
     fn step_tracker(&mut self, tracker: &mut dyn DynTracker, m: &StepIn<'_>) -> Result<(), Error> {
-        let typed = tracker
-            .as_any_mut()
-            .downcast_mut::<Typed<N>>()
-            .ok_or(Error::Invalid {
-                what: "controller",
-                reason: "has another number of joints than the chain",
-            })?;
+        let typed = typed::<N>(tracker)?;
         let meas = Self::measurement(m);
-        let cmd = self
-            .outer
-            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r| {
-                typed.step_with(jm, r)
-            })?;
-        self.last = Some(cmd);
+        let cmd = cartesian_loop::cartesian_step(
+            &self.outer,
+            &mut self.state,
+            typed,
+            &meas,
+            m.target.as_ref(),
+        )?;
+        self.last = Some(LastStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
     }
     fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error> {
@@ -319,19 +350,20 @@ impl<const N: usize> DynOuter for Outer<N> {
                     ..Command::zeros()
                 })
             })?;
-        self.last = Some(cmd);
+        self.last = Some(LastStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
     }
     fn last(&self, what: usize) -> Vec<f64> {
-        let Some(c) = &self.last else {
+        let Some(last) = &self.last else {
             let width = match LAST[what] {
                 "R_d" | "R_t" | "R" => 9,
                 "q_d" | "dq_d" | "ddq_d" | "tau_e" | "tau" | "tau_sat" | "z1" => N,
-                "error" => 6,
+                "error" | "wrench" => 6,
                 _ => 3,
             };
             return std::vec![f64::NAN; width];
         };
+        let c = &last.cmd;
         let v3 = |v: &Vector<3>| v.as_slice().to_vec();
         let vn = |v: &Vector<N>| v.as_slice().to_vec();
         match LAST[what] {
@@ -352,6 +384,10 @@ impl<const N: usize> DynOuter for Outer<N> {
             "tau_e" => vn(&c.tau_e),
             "tau" => vn(&c.joint.tau),
             "tau_sat" => vn(&c.joint.tau_sat),
+            "p_c" => v3(&last.commanded[0]),
+            "dp_c" => v3(&last.commanded[1]),
+            "ddp_c" => v3(&last.commanded[2]),
+            "wrench" => last.wrench.to_vec(),
             _ => vn(&c.joint.z1),
         }
     }
@@ -389,6 +425,48 @@ impl<const N: usize> DynOuter for Outer<N> {
         let q = out[..k].iter().flat_map(|s| s.x.iter().copied()).collect();
         let dq = out[..k].iter().flat_map(|s| s.dx.iter().copied()).collect();
         Ok((q, dq))
+    }
+    fn simulate_mujoco(
+        &mut self,
+        tracker: &mut dyn DynTracker,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &CartesianRun<'_>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<CartesianOut, RunError> {
+        let joint = typed::<N>(tracker)?;
+        cartesian_loop::simulate_mujoco(
+            &self.outer,
+            &mut self.state,
+            joint,
+            &mut self.last,
+            sim,
+            spec,
+            run,
+            hooks,
+        )
+    }
+    fn replay(
+        &mut self,
+        tracker: &mut dyn DynTracker,
+        rows: usize,
+        tables: [&[f64]; 3],
+        targets: Option<&[f64]>,
+        out: &mut Vec<f64>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(), RunError> {
+        let joint = typed::<N>(tracker)?;
+        cartesian_loop::replay(
+            &self.outer,
+            &mut self.state,
+            joint,
+            &mut self.last,
+            rows,
+            tables,
+            targets,
+            out,
+            hooks,
+        )
     }
 }
 
@@ -443,19 +521,6 @@ fn flat(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<
         )));
     }
     Ok(v)
-}
-
-/// A pose target from its flat layout (see [`TARGET_LEN`]).
-fn pose_target(v: &[f64]) -> PoseTarget {
-    let v3 = |i: usize| Vector::<3>::new(v[i], v[i + 1], v[i + 2]);
-    PoseTarget {
-        p: v3(0),
-        dp: v3(3),
-        ddp: v3(6),
-        r: Matrix3::from_fn(|i, j| v[9 + 3 * i + j]),
-        w: v3(18),
-        dw: v3(21),
-    }
 }
 
 fn target_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PoseTarget>> {
@@ -910,7 +975,10 @@ impl PyCartesian {
     /// "p_d", "dp_d", "ddp_d", "w_d", "dw_d" (3,) and "R_d" (3, 3), the
     /// compliant reference; "p_t" (3,), "R_t" (3, 3), the filtered target;
     /// "error" (6,) [e_p; e_o] after clipping; "p" (3,), "R" (3, 3), the
-    /// measured tip; "tau_e", "tau", "tau_sat", "z1" (n,) (NaN before a step).
+    /// measured tip; "tau_e", "tau", "tau_sat", "z1" (n,); "p_c", "dp_c",
+    /// "ddp_c" (3,), the commanded position and rates (the filtered target
+    /// p_t at rest when the step had none); "wrench" (6,), the F_e it was
+    /// given (NaN before a step).
     fn last<'py>(&self, py: Python<'py>, what: &str) -> PyResult<Bound<'py, PyAny>> {
         let i = LAST
             .iter()
@@ -938,6 +1006,155 @@ impl PyCartesian {
         } else {
             Ok(array1(py, &v).into_any())
         }
+    }
+
+    /// The closed loop on MuJoCo of this outer loop in front of `controller`
+    /// (an `adaptimp.Controller` with impedance "external", the same n and
+    /// Ts), from both states (not reset), with the GIL released: the core's
+    /// loop (`adaptimp.mujoco.simulate`'s native loop, SPEC §13.1) with the
+    /// measured wrench. `model`, `data`, `spec`, `params` (the disturbances
+    /// of SPEC §17), `t_final`, `settle`, `record_every`, `progress`,
+    /// `fault` as for `simulate_mujoco`; `targets` the commanded pose of
+    /// every row (K, 24) (None: the last target held). Returns the dict of
+    /// `simulate_mujoco` with the reference in task space ("xc", "dxc",
+    /// "ddxc" = p_c, ṗ_c, p̈_c; "xd" = p_d; "z1" = p_d − p(q); (K, 3)), the
+    /// metrics of task space, and "task": a dict of "pc", "dpc", "ddpc",
+    /// "pd", "dpd", "ddpd" (K, 3), "qd" (K, n), "wrench", "error" (K, 6).
+    /// Afterwards `last` gives the last step taken, also after an error.
+    #[pyo3(signature = (controller, model, data, spec, params, t_final, settle, record_every=1, progress=None, targets=None, fault=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate_mujoco<'py>(
+        &self,
+        py: Python<'py>,
+        controller: &PyController,
+        model: &Bound<'py, PyAny>,
+        data: &Bound<'py, PyAny>,
+        spec: &Bound<'py, PyDict>,
+        params: &Bound<'py, PyDict>,
+        t_final: f64,
+        settle: f64,
+        record_every: u64,
+        progress: Option<Py<PyAny>>,
+        targets: Option<PyReadonlyArray2<'py, f64>>,
+        fault: Option<super::PyFault>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let fault = super::fault_spec(fault)?;
+        if record_every == 0 {
+            return Err(ConfigError::new_err("record_every must be ≥ 1"));
+        }
+        if controller.n != self.n {
+            return Err(ConfigError::new_err(format!(
+                "the joint controller has {} joints, the chain {}",
+                controller.n, self.n
+            )));
+        }
+        let spec = super::mujoco_spec(spec)?;
+        let items = items(params)?;
+        let targets = match &targets {
+            None => None,
+            Some(t) => Some(rows(t.shape()[0], "targets", t, TARGET_LEN)?),
+        };
+        let mut sim = Sim::from_python(model, data)?;
+        let run = CartesianRun {
+            t_final,
+            settle,
+            every: record_every,
+            items: &items,
+            targets: targets.as_deref(),
+            fault: fault.as_ref(),
+        };
+        let mut hooks = super::PyHooks::new(progress);
+        let mut tracker = controller.lock(py);
+        let mut outer = self.lock(py);
+        let result = {
+            let (t, o): (&mut dyn DynTracker, &mut dyn DynOuter) = (&mut **tracker, &mut **outer);
+            py.detach(|| o.simulate_mujoco(t, &mut sim, &spec, &run, &mut hooks))
+        };
+        drop(outer);
+        drop(tracker);
+        drop(sim);
+        let (rec, task, metrics) = result.map_err(|e| super::run_error(e, &mut hooks))?;
+        let k = rec.rows();
+        let out = super::records_dict(py, rec, metrics)?;
+        let n = task.n;
+        let [pc, dpc, ddpc] = task.pc;
+        let [pd, dpd, ddpd] = task.pd;
+        for (name, v) in [("xc", &pc), ("dxc", &dpc), ("ddxc", &ddpc), ("xd", &pd)] {
+            out.set_item(name, array(py, v.clone(), (k, 3))?)?;
+        }
+        out.set_item("z1", array(py, task.z1, (k, 3))?)?;
+        let d = PyDict::new(py);
+        for (name, v, w) in [
+            ("pc", pc, 3),
+            ("dpc", dpc, 3),
+            ("ddpc", ddpc, 3),
+            ("pd", pd, 3),
+            ("dpd", dpd, 3),
+            ("ddpd", ddpd, 3),
+            ("qd", task.qd, n),
+            ("wrench", task.wrench, 6),
+            ("error", task.error, 6),
+        ] {
+            d.set_item(name, array(py, v, (k, w))?)?;
+        }
+        out.set_item("task", d)?;
+        Ok(out)
+    }
+
+    /// Steps of this outer loop in front of `controller` (as for
+    /// `step_controller`) over recorded rows, the core's alone with the GIL
+    /// released: q, dq (K, n) (rad, rad/s), wrench (K, 6) (N, N m),
+    /// `targets` (K, 24) (None: the last target held). Returns sat(τ) (K, n)
+    /// (N m); errors name the row. For the cost of the controller without a
+    /// plant.
+    #[pyo3(signature = (controller, q, dq, wrench, targets=None, progress=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn replay<'py>(
+        &self,
+        py: Python<'py>,
+        controller: &PyController,
+        q: PyReadonlyArray2<'py, f64>,
+        dq: PyReadonlyArray2<'py, f64>,
+        wrench: PyReadonlyArray2<'py, f64>,
+        targets: Option<PyReadonlyArray2<'py, f64>>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.n;
+        if controller.n != n {
+            return Err(ConfigError::new_err(format!(
+                "the joint controller has {} joints, the chain {}",
+                controller.n, n
+            )));
+        }
+        let k = q.shape()[0];
+        let q = super::table("q", &q, k, n)?;
+        let dq = super::table("dq", &dq, k, n)?;
+        let wrench = super::table("wrench", &wrench, k, 6)?;
+        let targets = match &targets {
+            None => None,
+            Some(t) => Some(super::table("targets", t, k, TARGET_LEN)?),
+        };
+        let mut out = Vec::with_capacity(k * n);
+        let mut hooks = super::PyHooks::new(progress);
+        let mut tracker = controller.lock(py);
+        let mut outer = self.lock(py);
+        let result = {
+            let (t, o): (&mut dyn DynTracker, &mut dyn DynOuter) = (&mut **tracker, &mut **outer);
+            py.detach(|| {
+                o.replay(
+                    t,
+                    k,
+                    [&q, &dq, &wrench],
+                    targets.as_deref(),
+                    &mut out,
+                    &mut hooks,
+                )
+            })
+        };
+        drop(outer);
+        drop(tracker);
+        result.map_err(|e| super::run_error(e, &mut hooks))?;
+        array(py, out, (k, n))
     }
 
     /// The orbit rule (SPEC §15, §16): run this outer loop kinematically

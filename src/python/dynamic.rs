@@ -461,28 +461,6 @@ fn run_mujoco<const N: usize>(
 ) -> Result<(Records, MetricsOut), RunError> {
     let ts = t.controller().period();
     let total = crate::sim::simulator::steps(run.t_final, ts)?;
-    crate::error::check::finite("settle", run.settle)?;
-    let s = scenario::<N>(Preset::Robot, t.law(), run.items)
-        .map_err(|e| RunError::Core(e.error, None))?;
-    let dist = s.disturbances()?;
-    if dist.payload() != 0.0 {
-        return Err(RunError::Core(
-            Error::Invalid {
-                what: "payload",
-                reason: "on MuJoCo the payload is a change of the model, not of the loop",
-            },
-            None,
-        ));
-    }
-    if dist.params().jitter != 0.0 {
-        return Err(RunError::Core(
-            Error::Invalid {
-                what: "jitter",
-                reason: "the MuJoCo plant advances by Ts exactly (its timestep is fixed for a run)",
-            },
-            None,
-        ));
-    }
     if let Some(rows) = run.reference {
         let need = usize::try_from(total)
             .unwrap_or(usize::MAX)
@@ -507,7 +485,86 @@ fn run_mujoco<const N: usize>(
         k0,
         ts,
     };
-    let inj = match run.fault {
+    let law = t.law();
+    let on = OnMujoco {
+        sim,
+        spec,
+        t_final: run.t_final,
+        settle: run.settle,
+        items: run.items,
+        law,
+        fault: run.fault,
+    };
+    let rec2 = &mut (&mut metrics, &mut rec);
+    match run.reference {
+        Some(rows) => drive_mujoco(t, &Table::<N> { rows, ts }, on, hooks, rec2),
+        None => drive_mujoco(t, &own, on, hooks, rec2),
+    }?;
+    Ok((rec, metrics_out(&metrics.finish())))
+}
+
+/// A run's plant on MuJoCo and the settings of its loop ([`drive_mujoco`]).
+pub(crate) struct OnMujoco<'a> {
+    /// The model and its data.
+    pub sim: &'a mut Sim,
+    /// Where the plant's joints, actuators and end effector are.
+    pub spec: &'a MujocoSpec,
+    /// Duration T (s).
+    pub t_final: f64,
+    /// Start of the metrics' "after" window (s) (checked here).
+    pub settle: f64,
+    /// The disturbance parameters (SPEC §17) by schema name.
+    pub items: &'a Items,
+    /// The controller's law (whose scenario reads the items).
+    pub law: Law,
+    /// A fault to inject (τmax: the plant's actuators').
+    pub fault: Option<&'a FaultSpec>,
+}
+
+/// The core's loop ([`simulate_disturbed`]) of `ctrl` along `traj` on MuJoCo,
+/// every row to `rec`: the disturbances of `on.items` (payload and jitter
+/// refused: the first is a change of the model, the second of its
+/// timestep), the fault, the hook every few periods; the plant's own failure
+/// (a diverged or fatal MuJoCo) as [`RunError::Plant`]. One loop for the
+/// joint controllers and the Cartesian ones.
+pub(crate) fn drive_mujoco<const N: usize, C, T, R>(
+    ctrl: &mut C,
+    traj: &T,
+    on: OnMujoco<'_>,
+    hooks: &mut dyn Hooks,
+    rec: &mut R,
+) -> Result<(), RunError>
+where
+    C: crate::control::io::Control<N> + ?Sized,
+    T: Trajectory<N> + ?Sized,
+    R: Recorder<N> + ?Sized,
+{
+    let ts = ctrl.period();
+    let total = crate::sim::simulator::steps(on.t_final, ts)?;
+    crate::error::check::finite("settle", on.settle)?;
+    let s = scenario::<N>(Preset::Robot, on.law, on.items)
+        .map_err(|e| RunError::Core(e.error, None))?;
+    let dist = s.disturbances()?;
+    if dist.payload() != 0.0 {
+        return Err(RunError::Core(
+            Error::Invalid {
+                what: "payload",
+                reason: "on MuJoCo the payload is a change of the model, not of the loop",
+            },
+            None,
+        ));
+    }
+    if dist.params().jitter != 0.0 {
+        return Err(RunError::Core(
+            Error::Invalid {
+                what: "jitter",
+                reason: "the MuJoCo plant advances by Ts exactly (its timestep is fixed for a run)",
+            },
+            None,
+        ));
+    }
+    let spec = on.spec;
+    let inj = match on.fault {
         Some(f) => {
             if spec.tau_max.len() != N {
                 return Err(RunError::Core(invalid_tau_max(), None));
@@ -519,7 +576,7 @@ fn run_mujoco<const N: usize>(
         }
         None => None,
     };
-    let mut plant = MjPlant::<N>::new(sim, spec, ts, *dist.friction())?;
+    let mut plant = MjPlant::<N>::new(on.sim, spec, ts, *dist.friction())?;
     if let Err(e) = plant.start() {
         return Err(match plant.failure() {
             Some(f) => RunError::Plant(f.clone()),
@@ -527,19 +584,12 @@ fn run_mujoco<const N: usize>(
         });
     }
     let mut watch = Watch::new(hooks, total);
-    let rec2 = &mut (&mut metrics, &mut rec);
     let result = {
         let mut p = Adapted::new(&mut plant, &mut watch);
-        match run.reference {
-            Some(rows) => {
-                let table = Table::<N> { rows, ts };
-                simulate_disturbed(&mut p, t, &table, run.t_final, inj.as_ref(), &dist, rec2)
-            }
-            None => simulate_disturbed(&mut p, t, &own, run.t_final, inj.as_ref(), &dist, rec2),
-        }
+        simulate_disturbed(&mut p, ctrl, traj, on.t_final, inj.as_ref(), &dist, rec)
     };
     match result {
-        Ok(_) => Ok((rec, metrics_out(&metrics.finish()))),
+        Ok(_) => Ok(()),
         Err(e) => Err(match plant.failure() {
             Some(f) => RunError::Plant(f.clone()),
             None => watch.error(e),
@@ -1014,17 +1064,20 @@ pub struct RowTables<'a> {
 /// (the one implementation of the metrics): the rows are fed to an
 /// accumulator of max(n, m) joints with the narrower quantities padded with
 /// zeros (which change no norm, peak or count), and the per-joint figures cut
-/// back to z1's m or τ's n; the impedance residual needs m = n (NaN
-/// otherwise). `target` is (Dd, Cd, Gd), n values each.
+/// back to z1's m or τ's n ([`TaskMetrics`]). `joint_space`: whether the
+/// reference and z1 are in joint space (then m = n, and the impedance
+/// residual is computed with the target (Dd, Cd, Gd), n values each); none:
+/// whether m = n. In task space the impedance residual is NaN.
 pub fn metrics_of(
     rows: &RowTables<'_>,
     settle: f64,
     target: [&[f64]; 3],
+    joint_space: Option<bool>,
 ) -> Result<MetricsOut, Error> {
     macro_rules! arms {
         ($($k:literal)*) => {
             match rows.n.max(rows.m) {
-                $($k => metrics_n::<$k>(rows, settle, target),)*
+                $($k => metrics_n::<$k>(rows, settle, target, joint_space),)*
                 _ => Err(Error::Invalid {
                     what: "rows",
                     reason: "the joints and the reference's width must be between 1 and 7",
@@ -1035,79 +1088,154 @@ pub fn metrics_of(
     arms!(1 2 3 4 5 6 7)
 }
 
-fn metrics_n<const N: usize>(
-    r: &RowTables<'_>,
-    settle: f64,
-    target: [&[f64]; 3],
-) -> Result<MetricsOut, Error> {
-    let (n, m, k) = (r.n, r.m, r.t.len());
-    let bad = |reason| Error::Invalid {
-        what: "rows",
-        reason,
-    };
-    if n == 0 || m == 0 {
-        return Err(bad("need at least one joint and one reference coordinate"));
-    }
-    if r.x.iter().chain(r.tau.iter()).any(|v| v.len() != k * n)
-        || r.c.iter().chain([&r.z1]).any(|v| v.len() != k * m)
-        || target.iter().any(|v| v.len() != n)
-    {
-        return Err(bad("every table needs K rows of its width"));
-    }
-    let pad = |v: &[f64], w: usize, i: usize| {
-        let mut out = Vector::<N>::zeros();
-        out.as_mut_slice()[..w].copy_from_slice(&v[i * w..(i + 1) * w]);
-        out
-    };
-    let joint = m == n;
-    let ones = Vector::<N>::from_element(1.0);
-    let tgt = if joint {
-        let t = |v: &[f64]| {
-            let mut o = ones;
-            o.as_mut_slice()[..n].copy_from_slice(v);
-            o
+/// The SPEC §12 metrics of a run's rows given one at a time as slices: n
+/// joints (q, q̇, q̈, τ, sat(τ), τe) and a reference of width m (xc, ẋc, ẍc,
+/// z1), in an accumulator of M ≥ max(n, m) slots with the narrower
+/// quantities padded with zeros. [`metrics_of`] (rows recorded elsewhere)
+/// and the Cartesian loop on MuJoCo (rows as they come) both go through it:
+/// the same rows give the same bits.
+pub struct TaskMetrics<const M: usize> {
+    acc: MetricsAccumulator<M>,
+    n: usize,
+    m: usize,
+    joint: bool,
+}
+
+impl<const M: usize> TaskMetrics<M> {
+    /// For n joints and a reference of width m (1 ≤ n, m ≤ M), with the
+    /// window after `settle` (s); `joint`: the reference is in joint space
+    /// (needs m = n; the impedance residual with `target` = (Dd, Cd, Gd), n
+    /// values each).
+    pub fn new(
+        n: usize,
+        m: usize,
+        joint: bool,
+        settle: f64,
+        target: [&[f64]; 3],
+    ) -> Result<Self, Error> {
+        let bad = |reason| Error::Invalid {
+            what: "rows",
+            reason,
         };
-        TargetImpedance::new(t(target[0]), t(target[1]), t(target[2]))?
-    } else {
-        TargetImpedance::new(ones, ones, ones)?
-    };
-    let mut acc = MetricsAccumulator::new(settle, tgt);
-    let zero = Vector::<N>::zeros();
-    for i in 0..k {
-        let (tau, tau_sat) = (pad(r.tau[0], n, i), pad(r.tau[1], n, i));
-        let x = pad(r.x[0], n, i);
-        acc.push(&Row {
-            t: r.t[i],
-            x,
-            dx: pad(r.x[1], n, i),
-            ddx: pad(r.x[2], n, i),
-            xc: if joint { pad(r.c[0], m, i) } else { zero },
-            dxc: if joint { pad(r.c[1], m, i) } else { zero },
-            ddxc: if joint { pad(r.c[2], m, i) } else { zero },
+        if n == 0 || m == 0 || n > M || m > M {
+            return Err(bad("need at least one joint and one reference coordinate"));
+        }
+        if joint && m != n {
+            return Err(bad(
+                "a joint-space reference needs one coordinate per joint (m = n)",
+            ));
+        }
+        if target.iter().any(|v| v.len() != n) {
+            return Err(bad("the target impedance needs n values per matrix"));
+        }
+        let ones = Vector::<M>::from_element(1.0);
+        let tgt = if joint {
+            let t = |v: &[f64]| {
+                let mut o = ones;
+                o.as_mut_slice()[..n].copy_from_slice(v);
+                o
+            };
+            TargetImpedance::new(t(target[0]), t(target[1]), t(target[2]))?
+        } else {
+            TargetImpedance::new(ones, ones, ones)?
+        };
+        Ok(Self {
+            acc: MetricsAccumulator::new(settle, tgt),
+            n,
+            m,
+            joint,
+        })
+    }
+
+    /// One row: t (s); q, q̇, q̈ (n each); xc, ẋc, ẍc (m each); z1 (m); τ,
+    /// sat(τ), τe (n each).
+    pub fn push(&mut self, t: f64, x: [&[f64]; 3], c: [&[f64]; 3], z1: &[f64], tau: [&[f64]; 3]) {
+        let (n, m) = (self.n, self.m);
+        let pad = |v: &[f64], w: usize| {
+            let mut out = Vector::<M>::zeros();
+            out.as_mut_slice()[..w].copy_from_slice(&v[..w]);
+            out
+        };
+        let zero = Vector::<M>::zeros();
+        let (tau_m, tau_sat) = (pad(tau[0], n), pad(tau[1], n));
+        let joint = self.joint;
+        self.acc.push(&Row {
+            t,
+            x: pad(x[0], n),
+            dx: pad(x[1], n),
+            ddx: pad(x[2], n),
+            xc: if joint { pad(c[0], m) } else { zero },
+            dxc: if joint { pad(c[1], m) } else { zero },
+            ddxc: if joint { pad(c[2], m) } else { zero },
             xd: zero,
             dx_hat: zero,
-            tau,
+            tau: tau_m,
             tau_sat,
-            dtau: tau_sat - tau,
-            tau_e: pad(r.tau[2], n, i),
+            dtau: tau_sat - tau_m,
+            tau_e: pad(tau[2], n),
             zeta: zero,
-            z1: pad(r.z1, m, i),
+            z1: pad(z1, m),
             w_norms: [0.0; 3],
             x_ee: [0.0; 3],
             wrench: [0.0; 6],
             refused: false,
         });
     }
-    let mut out = metrics_out(&acc.finish());
-    for (name, v) in &mut out.joint {
-        v.truncate(if *name == "peak_abs_tau" { n } else { m });
-    }
-    if !joint {
-        for (name, v) in &mut out.scalars {
-            if *name == "imp_err_rms_after2" {
-                *v = f64::NAN;
+
+    /// The metrics: per-joint figures of z1 cut to m, of τ to n; the
+    /// impedance residual NaN in task space.
+    pub fn finish(&self) -> MetricsOut {
+        let mut out = metrics_out(&self.acc.finish());
+        for (name, v) in &mut out.joint {
+            v.truncate(if *name == "peak_abs_tau" {
+                self.n
+            } else {
+                self.m
+            });
+        }
+        if !self.joint {
+            for (name, v) in &mut out.scalars {
+                if *name == "imp_err_rms_after2" {
+                    *v = f64::NAN;
+                }
             }
         }
+        out
     }
-    Ok(out)
+}
+
+fn metrics_n<const N: usize>(
+    r: &RowTables<'_>,
+    settle: f64,
+    target: [&[f64]; 3],
+    joint_space: Option<bool>,
+) -> Result<MetricsOut, Error> {
+    let (n, m, k) = (r.n, r.m, r.t.len());
+    if r.x.iter().chain(r.tau.iter()).any(|v| v.len() != k * n)
+        || r.c.iter().chain([&r.z1]).any(|v| v.len() != k * m)
+    {
+        return Err(Error::Invalid {
+            what: "rows",
+            reason: "every table needs K rows of its width",
+        });
+    }
+    let joint = joint_space.unwrap_or(m == n);
+    let mut acc = TaskMetrics::<N>::new(n, m, joint, settle, target)?;
+    fn row(v: &[f64], w: usize, i: usize) -> &[f64] {
+        &v[i * w..(i + 1) * w]
+    }
+    for i in 0..k {
+        acc.push(
+            r.t[i],
+            [row(r.x[0], n, i), row(r.x[1], n, i), row(r.x[2], n, i)],
+            [row(r.c[0], m, i), row(r.c[1], m, i), row(r.c[2], m, i)],
+            row(r.z1, m, i),
+            [
+                row(r.tau[0], n, i),
+                row(r.tau[1], n, i),
+                row(r.tau[2], n, i),
+            ],
+        );
+    }
+    Ok(acc.finish())
 }

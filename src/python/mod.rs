@@ -25,6 +25,7 @@
 
 mod arm;
 mod cartesian;
+mod cartesian_loop;
 mod dynamic;
 mod mujoco;
 mod tuning;
@@ -1282,12 +1283,13 @@ fn records_dict<'py>(
 /// The SPEC §12 metrics of recorded rows, by the core's accumulator (the
 /// metrics of a loop that ran in Python: `adaptimp.mujoco.simulate` with a
 /// Python controller): `t` (K,), `q`, `dq`, `ddq`, `tau`, `tau_sat`, `tau_e`
-/// (K, n), `xc`, `dxc`, `ddxc`, `z1` (K, m) (m = n in joint space; the
-/// impedance residual is NaN otherwise), the window after `settle` (s) and
-/// the target impedance (Dd, Cd, Gd), n values each. Returns the dict of
+/// (K, n), `xc`, `dxc`, `ddxc`, `z1` (K, m), the window after `settle` (s)
+/// and the target impedance (Dd, Cd, Gd), n values each. `joint_space`:
+/// whether the reference is in joint space (m = n; None: whether m = n); in
+/// task space the impedance residual is NaN. Returns the dict of
 /// `SimResult.metrics`.
 #[pyfunction]
-#[pyo3(signature = (t, q, dq, ddq, xc, dxc, ddxc, z1, tau, tau_sat, tau_e, settle, target))]
+#[pyo3(signature = (t, q, dq, ddq, xc, dxc, ddxc, z1, tau, tau_sat, tau_e, settle, target, joint_space=None))]
 #[allow(clippy::too_many_arguments)]
 fn metrics<'py>(
     py: Python<'py>,
@@ -1304,6 +1306,7 @@ fn metrics<'py>(
     tau_e: PyReadonlyArray2<'py, f64>,
     settle: f64,
     target: (Vec<f64>, Vec<f64>, Vec<f64>),
+    joint_space: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let k = t.len();
     let (n, m) = (q.shape()[1], xc.shape()[1]);
@@ -1330,8 +1333,13 @@ fn metrics<'py>(
         z1: &z,
         tau: [&tq[0], &tq[1], &tq[2]],
     };
-    let out = dynamic::metrics_of(&rows, settle, [&target.0, &target.1, &target.2])
-        .map_err(step_error)?;
+    let out = dynamic::metrics_of(
+        &rows,
+        settle,
+        [&target.0, &target.1, &target.2],
+        joint_space,
+    )
+    .map_err(step_error)?;
     metrics_to_dict(py, out)
 }
 
@@ -1388,6 +1396,7 @@ fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
         ee_body: get(d, "ee_body")?,
         force_adr: get(d, "force_adr")?,
         torque_adr: get(d, "torque_adr")?,
+        contact_adr: get(d, "contact_adr")?,
         substeps: get(d, "substeps")?,
         timestep: get(d, "timestep")?,
         dof_names: get(d, "dof_names")?,

@@ -2,10 +2,11 @@
 //! model through [`adaptimp_mujoco::Sim`] (the engine's C library, no Python
 //! in the loop) with the semantics of `adaptimp.mujoco` (SPEC §13.1):
 //!
-//! - at t_k, the state, the end-effector position, the wrench F_e and
-//!   τe = Jᵀ F_e are those of MuJoCo's forward computation at x_k with the
-//!   previous torque held (sensors and contact as a real sensor reads them
-//!   just before the new command);
+//! - at t_k, the state, the end-effector position, the wrench F_e (from the
+//!   force/torque sensors, or a contact sensor of the net contact wrench on
+//!   the end effector's subtree) and τe = Jᵀ F_e are those of MuJoCo's
+//!   forward computation at x_k with the previous torque held (sensors and
+//!   contact as a real sensor reads them just before the new command);
 //! - the command is saturated to the actuators' τmax (gear × ctrlrange) and
 //!   held for `substeps` MuJoCo steps of Ts/substeps; ẍ_k is MuJoCo's q̈ at
 //!   x_k with that torque (`mj_forwardSkip` from the velocity stage: the
@@ -49,6 +50,11 @@ pub struct MujocoSpec {
     pub force_adr: Option<usize>,
     /// `sensordata` address of the torque sensor at the site, if any.
     pub torque_adr: Option<usize>,
+    /// `sensordata` address of a contact sensor of the net contact wrench on
+    /// the end effector's subtree (`reduce="netforce"`, `data="force torque
+    /// pos"`: f, t about the centroid c, c; world frame), used without a
+    /// force sensor.
+    pub contact_adr: Option<usize>,
     /// MuJoCo steps per period.
     pub substeps: usize,
     /// MuJoCo's timestep (s): Ts / substeps.
@@ -134,6 +140,17 @@ impl<'a, const N: usize> MjPlant<'a, N> {
                 return Err(invalid("sensor", "address out of sensordata"));
             }
         }
+        if let Some(adr) = spec.contact_adr {
+            if adr + 9 > sensors {
+                return Err(invalid("contact sensor", "address out of sensordata"));
+            }
+            if spec.force_adr.is_some() {
+                return Err(invalid(
+                    "contact sensor",
+                    "the wrench comes from the force sensor, or the contact sensor, not both",
+                ));
+            }
+        }
         if spec.force_adr.is_none() && spec.torque_adr.is_some() {
             return Err(invalid("sensor", "a torque sensor needs a force sensor"));
         }
@@ -204,6 +221,22 @@ impl<'a, const N: usize> MjPlant<'a, N> {
         };
         self.x_ee.copy_from_slice(point);
         let mut w = [0.0; 6];
+        if let Some(a) = spec.contact_adr {
+            // The net contact wrench about the contacts' centroid c, moved to the
+            // end-effector point p: [f; t + (c − p) × f] (world frame).
+            let data = self.sim.sensordata();
+            let (f, t, c) = (&data[a..a + 3], &data[a + 3..a + 6], &data[a + 6..a + 9]);
+            let p = self.x_ee;
+            let d = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+            w = [
+                f[0],
+                f[1],
+                f[2],
+                t[0] + (d[1] * f[2] - d[2] * f[1]),
+                t[1] + (d[2] * f[0] - d[0] * f[2]),
+                t[2] + (d[0] * f[1] - d[1] * f[0]),
+            ];
+        }
         if let Some(fa) = spec.force_adr {
             // The sensors measure in the site frame: F_world = R F_site.
             let r = &self.sim.site_xmat()[9 * sid..9 * sid + 9];

@@ -8,7 +8,7 @@
 //! | `payload` | kg | point mass at the tip of the last link | the plant's arm ([`TipPayload`]) |
 //! | `noise_q`, `noise_dq`, `noise_tau_e` | rad, rad/s, N m | Gaussian noise on each sample, seeded | the measurement |
 //! | `seed` | | the generator of the noise and the jitter | |
-//! | `delay` | steps | the controller sees the sample of step k − d | the measurement |
+//! | `delay` | steps | the controller sees the sample of step k − d (the end-effector wrench too) | the measurement |
 //! | `jitter` | | the true interval is Ts (1 + u), u ~ U[−j, j) | the plant's integration |
 //! | `friction_viscous`, `friction_coulomb`, `friction_vs` | N m s/rad, N m, rad/s | τf = −b q̇ − fc tanh(q̇/v_s) | the plant's arm ([`WithFriction`]) |
 //! | `actuator_fraction` | | the delivered torque is clamped to ±ρ τmax | the actuators |
@@ -385,6 +385,7 @@ impl<const N: usize> Disturbances<N> {
             noise,
             jitter,
             line: [(zero, zero, zero); MAX_DELAY + 1],
+            wrenches: [[0.0; 6]; MAX_DELAY + 1],
             k: 0,
         }
     }
@@ -395,8 +396,24 @@ impl<const N: usize> Disturbances<N> {
     /// k < d: the first sample is held until the line fills). Call once per
     /// step, in order.
     pub fn measure(&self, state: &mut DisturbanceState<N>, sample: Sample<N>) -> Sample<N> {
+        self.measure_with_wrench(state, sample, [0.0; 6]).0
+    }
+
+    /// [`measure`](Self::measure) with the end effector's wrench F_e = [f; m]
+    /// (N, N m) as a force/torque sensor delivers it (what a Cartesian
+    /// controller reads instead of τe): it goes through the same delay line,
+    /// so the controller sees the wrench of step k − d with the joint sample
+    /// of step k − d. No noise is added to it (the noise of SPEC §17 is on
+    /// τe, N m per joint) and no draw is taken for it: the joint sample is
+    /// exactly [`measure`](Self::measure)'s.
+    pub fn measure_with_wrench(
+        &self,
+        state: &mut DisturbanceState<N>,
+        sample: Sample<N>,
+        wrench: [f64; 6],
+    ) -> (Sample<N>, [f64; 6]) {
         if !self.noisy && self.params.delay == 0 {
-            return sample;
+            return (sample, wrench);
         }
         let (mut q, mut dq, mut tau_e) = sample;
         if self.noisy {
@@ -415,9 +432,10 @@ impl<const N: usize> Disturbances<N> {
         let slots = (MAX_DELAY + 1) as u64;
         let k = state.k;
         state.line[(k % slots) as usize] = (q, dq, tau_e);
-        let seen = state.line[(k.saturating_sub(self.params.delay as u64) % slots) as usize];
+        state.wrenches[(k % slots) as usize] = wrench;
+        let then = (k.saturating_sub(self.params.delay as u64) % slots) as usize;
         state.k = k + 1;
-        seen
+        (state.line[then], state.wrenches[then])
     }
 
     /// The true interval (s) between this sample and the next, for the
@@ -444,12 +462,14 @@ impl<const N: usize> Disturbances<N> {
 }
 
 /// What a run with [`Disturbances`] changes: the noise and jitter generators
-/// and the delay line (a fixed array; `(MAX_DELAY + 1)·3N` reals).
+/// and the delay line (a fixed array; `(MAX_DELAY + 1)·(3N + 6)` reals).
 #[derive(Clone, Debug)]
 pub struct DisturbanceState<const N: usize> {
     noise: Xoshiro256PlusPlus,
     jitter: Xoshiro256PlusPlus,
     line: [Sample<N>; MAX_DELAY + 1],
+    /// The wrenches of the same samples ([`Disturbances::measure_with_wrench`]).
+    wrenches: [[f64; 6]; MAX_DELAY + 1],
     /// Samples taken.
     k: u64,
 }

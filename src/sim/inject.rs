@@ -72,6 +72,18 @@ impl<const N: usize> Injection<N> {
         }
     }
 
+    /// The end-effector wrench F_e (N, N m) the controller sees at `t`, from
+    /// the true one and the last the sensor delivered: the last during a
+    /// [`Injected::Stale`] window (the force/torque sensor freezes with the
+    /// others), the true one otherwise ([`Injected::ForceBias`] acts on τe,
+    /// N m per joint, and [`Injected::NanBurst`] on the position sensor).
+    pub fn measure_wrench(&self, t: f64, truth: [f64; 6], last: [f64; 6]) -> [f64; 6] {
+        match self.fault {
+            Injected::Stale if self.active(t) => last,
+            _ => truth,
+        }
+    }
+
     /// The torque the actuators deliver at `t` for the applied command `tau` (N m).
     pub fn actuate(&self, t: f64, tau: &Vector<N>) -> Vector<N> {
         match self.fault {

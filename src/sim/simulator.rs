@@ -104,7 +104,10 @@ where
 ///    ([`Disturbances::interval`]).
 ///
 /// The controller also gets the plant's end-effector wrench
-/// ([`Control::step_with_wrench`]). Rows carry t_k, the controller's time,
+/// ([`Control::step_with_wrench`]) through the same sensor path: delayed
+/// with the joint sample, frozen with it by a stale-sensor fault, without
+/// noise ([`Disturbances::measure_with_wrench`],
+/// [`Injection::measure_wrench`]). Rows carry t_k, the controller's time,
 /// and the plant's true state, end-effector position and wrench. With
 /// [`Disturbances::none`] it is [`simulate_with`], bit for bit. The
 /// generators start from the seed at every call: the same arguments give the
@@ -129,6 +132,7 @@ where
     let mut noise = disturbances.new_state();
     let (x0, dx0) = plant.state();
     let mut sensed = (x0, dx0, plant.contact());
+    let mut sensed_wrench = plant.wrench();
     let mut applied = Vector::<N>::zeros();
     let mut last = Command::<N>::zeros();
     for k in 0..steps {
@@ -136,11 +140,14 @@ where
         let (x, dx) = plant.state();
         let tau_e = plant.contact();
         let (wrench, x_ee) = (plant.wrench(), plant.end_effector());
-        let seen = disturbances.measure(&mut noise, (x, dx, tau_e));
+        let (seen, seen_wrench) =
+            disturbances.measure_with_wrench(&mut noise, (x, dx, tau_e), wrench);
         if let Some(inj) = injection {
             sensed = inj.measure(t, seen, sensed);
+            sensed_wrench = inj.measure_wrench(t, seen_wrench, sensed_wrench);
         } else {
             sensed = seen;
+            sensed_wrench = seen_wrench;
         }
         let c = traj.sample(t);
         let refused = if injection.is_some_and(|i| i.skips(t)) {
@@ -151,7 +158,7 @@ where
                 dx: Some(sensed.1),
                 tau_e: sensed.2,
             };
-            let (tau, result) = ctrl.step_with_wrench(&m, &wrench, &c);
+            let (tau, result) = ctrl.step_with_wrench(&m, &sensed_wrench, &c);
             applied = tau;
             match result {
                 Ok(cmd) => {

@@ -1,0 +1,510 @@
+//! The Cartesian controller in the core's closed loop on MuJoCo (SPEC §13.1,
+//! §16): the core's outer loop over a [`Chain`] and the joint controller
+//! behind it ([`Typed`]) as one [`Control`], stepped by the core's loop
+//! ([`drive_mujoco`]) with the measured end-effector wrench
+//! ([`Control::step_with_wrench`]), recorded in task space and measured by
+//! the one implementation of the SPEC §12 metrics ([`TaskMetrics`]).
+//!
+//! The commanded pose of row k is the k-th of a table (tabulated by the
+//! caller from a path or a reference at t_k = k·Ts), or none: the last
+//! target held. The loop's clock reaches the controller through the
+//! trajectory it samples at every row ([`Clock`]): a fault that skips rows
+//! does not shift the path.
+//!
+//! What each row records, as the Python loop records it for
+//! `adaptimp.CartesianController`: xc = p_c (the commanded position; the
+//! filtered target p_t when held), ẋc, ẍc (ṗ_c, p̈_c; zero when held), xd =
+//! p_d (the compliant reference), z1 = p_d − p(q) (m, with p(q) the chain's
+//! tip at the measured q), and beside them ṗ_d, p̈_d, q_d, the impedance's
+//! error and the wrench the controller was given ([`TaskRecords`]). The
+//! joint quantities (q, τ, sat(τ), τe, ζ, the velocity used) are the joint
+//! controller's, as for a joint-space run.
+
+use super::cartesian::TARGET_LEN;
+use super::dynamic::{
+    drive_mujoco, FaultKind, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError,
+    TaskMetrics, Typed,
+};
+use super::mujoco::MujocoSpec;
+use crate::cartesian::{
+    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, PoseTarget,
+};
+use crate::control::impedance::TargetImpedance;
+use crate::control::io::{Command, Control, Measurement};
+use crate::error::Error;
+use crate::sim::record::{Recorder, Row};
+use crate::trajectory::{Setpoint, Trajectory};
+use crate::types::Vector;
+use adaptimp_mujoco::Sim;
+use core::cell::Cell;
+use nalgebra::Matrix3;
+use std::vec::Vec;
+
+/// A Cartesian run on MuJoCo ([`simulate_mujoco`]).
+pub struct CartesianRun<'a> {
+    /// Duration T (s).
+    pub t_final: f64,
+    /// Start of the "after" window of the metrics (s).
+    pub settle: f64,
+    /// Keep every `every`-th row.
+    pub every: u64,
+    /// The disturbance parameters (SPEC §17) by schema name.
+    pub items: &'a Items,
+    /// The commanded pose of every row, [`TARGET_LEN`] values each (p, ṗ,
+    /// p̈, R row-major, ω, ω̇), row-major; none: the last target held.
+    pub targets: Option<&'a [f64]>,
+    /// A fault to inject (τmax: the plant's actuators').
+    pub fault: Option<&'a FaultSpec>,
+}
+
+/// The task-space quantities of one row.
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct TaskRow<const N: usize> {
+    /// p_c, ṗ_c, p̈_c (m, m/s, m/s²).
+    pc: [Vector<3>; 3],
+    /// p_d, ṗ_d, p̈_d (m, m/s, m/s²).
+    pd: [Vector<3>; 3],
+    /// q_d (rad).
+    qd: Vector<N>,
+    /// [e_p; e_o] (m, rad) after clipping.
+    error: Vector<6>,
+    /// F_e the controller was given (N, N m).
+    wrench: [f64; 6],
+    /// p_d − p(q) (m).
+    z1: Vector<3>,
+}
+
+impl<const N: usize> TaskRow<N> {
+    fn nan() -> Self {
+        let v3 = Vector::<3>::from_element(f64::NAN);
+        Self {
+            pc: [v3; 3],
+            pd: [v3; 3],
+            qd: Vector::from_element(f64::NAN),
+            error: Vector::from_element(f64::NAN),
+            wrench: [f64::NAN; 6],
+            z1: v3,
+        }
+    }
+}
+
+/// Every kept row's task-space quantities, one flat row-major buffer each.
+#[derive(Clone, Debug, Default)]
+pub struct TaskRecords {
+    /// Joints n (the width of `qd`).
+    pub n: usize,
+    every: u64,
+    seen: u64,
+    /// p_c, ṗ_c, p̈_c (m, m/s, m/s²), 3 per row each.
+    pub pc: [Vec<f64>; 3],
+    /// p_d, ṗ_d, p̈_d (m, m/s, m/s²), 3 per row each.
+    pub pd: [Vec<f64>; 3],
+    /// q_d (rad), n per row.
+    pub qd: Vec<f64>,
+    /// The impedance's error [e_p; e_o] (m, rad), 6 per row.
+    pub error: Vec<f64>,
+    /// The wrench the controller was given (N, N m), 6 per row.
+    pub wrench: Vec<f64>,
+    /// z1 = p_d − p(q) (m), 3 per row.
+    pub z1: Vec<f64>,
+}
+
+impl TaskRecords {
+    fn with_rows(n: usize, rows: usize, every: u64) -> Option<Self> {
+        let mut r = Self {
+            n,
+            every: every.max(1),
+            ..Self::default()
+        };
+        for v in r.pc.iter_mut().chain(r.pd.iter_mut()).chain([&mut r.z1]) {
+            v.try_reserve_exact(rows.checked_mul(3)?).ok()?;
+        }
+        r.qd.try_reserve_exact(rows.checked_mul(n)?).ok()?;
+        r.error.try_reserve_exact(rows.checked_mul(6)?).ok()?;
+        r.wrench.try_reserve_exact(rows.checked_mul(6)?).ok()?;
+        Some(r)
+    }
+
+    fn record<const N: usize>(&mut self, r: &TaskRow<N>) {
+        let keep = self.seen.is_multiple_of(self.every);
+        self.seen += 1;
+        if !keep {
+            return;
+        }
+        for (out, v) in self.pc.iter_mut().zip(&r.pc) {
+            out.extend_from_slice(v.as_slice());
+        }
+        for (out, v) in self.pd.iter_mut().zip(&r.pd) {
+            out.extend_from_slice(v.as_slice());
+        }
+        self.qd.extend_from_slice(r.qd.as_slice());
+        self.error.extend_from_slice(r.error.as_slice());
+        self.wrench.extend_from_slice(&r.wrench);
+        self.z1.extend_from_slice(r.z1.as_slice());
+    }
+}
+
+/// The loop's clock: the trajectory the loop samples at every row, t_k in,
+/// nothing out (the Cartesian controller's commanded pose is its own table,
+/// read at the row of t_k). Its joint setpoint is NaN: a Cartesian run has
+/// no joint-space reference.
+struct Clock<'a>(&'a Cell<f64>);
+
+impl<const N: usize> Trajectory<N> for Clock<'_> {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        self.0.set(t);
+        let nan = Vector::from_element(f64::NAN);
+        Setpoint {
+            x: nan,
+            dx: nan,
+            ddx: nan,
+        }
+    }
+}
+
+/// The row of a table for t_k = k·Ts.
+fn row_of(t: f64, ts: f64) -> usize {
+    libm::round(t / ts) as usize
+}
+
+/// The last step of an outer loop, with what it was given: the command,
+/// the commanded position and rates p_c, ṗ_c, p̈_c (the target's; without
+/// one, the held target after its filter, p_t, at rest) and the wrench.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(crate) struct LastStep<const N: usize> {
+    /// The step's command.
+    pub cmd: CartesianCommand<N>,
+    /// p_c, ṗ_c, p̈_c (m, m/s, m/s²).
+    pub commanded: [Vector<3>; 3],
+    /// F_e (N, N m).
+    pub wrench: [f64; 6],
+}
+
+impl<const N: usize> LastStep<N> {
+    /// The step of `cmd` with its `target` and `wrench`.
+    pub fn new(cmd: CartesianCommand<N>, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Self {
+        let commanded = match target {
+            Some(t) => [t.p, t.dp, t.ddp],
+            None => [cmd.target.0, Vector::zeros(), Vector::zeros()],
+        };
+        Self {
+            cmd,
+            commanded,
+            wrench,
+        }
+    }
+}
+
+/// One Cartesian step of `outer` (its state `state`) with the core's joint
+/// controller `joint` (SPEC §16, (C0)–(C5)), under the fault semantics of
+/// every step: a step the joint controller refuses is recorded there (the
+/// fault, its fallback as the applied torque); so is one the outer loop
+/// refuses before the joint step runs (a non-finite q, wrench or target), as
+/// a front's refused call is ([`Tracker::refuse`](crate::control::tracker::Tracker::refuse)).
+pub(crate) fn cartesian_step<const N: usize>(
+    outer: &CartesianImpedance<N, Chain<N>>,
+    state: &mut CartesianState<N>,
+    joint: &mut Typed<N>,
+    m: &CartesianMeasurement<N>,
+    target: Option<&PoseTarget>,
+) -> Result<CartesianCommand<N>, Error> {
+    let mut ran = false;
+    let result = outer.step_with(state, m, target, |jm, r| {
+        ran = true;
+        joint.step_with(jm, r)
+    });
+    if let Err(e) = result {
+        if !ran {
+            joint.refuse(e);
+        }
+    }
+    result
+}
+
+/// A pose target from its flat layout (see [`TARGET_LEN`]).
+pub(crate) fn pose_target(v: &[f64]) -> PoseTarget {
+    let v3 = |i: usize| Vector::<3>::new(v[i], v[i + 1], v[i + 2]);
+    PoseTarget {
+        p: v3(0),
+        dp: v3(3),
+        ddp: v3(6),
+        r: Matrix3::from_fn(|i, j| v[9 + 3 * i + j]),
+        w: v3(18),
+        dw: v3(21),
+    }
+}
+
+/// The outer loop and the joint controller behind it as the loop's
+/// [`Control`]: [`Control::step_with_wrench`] runs
+/// [`CartesianImpedance::step_with`] with the measured wrench and the
+/// joint controller's step, the commanded pose of the row from the table.
+struct Cartesian<'a, const N: usize> {
+    outer: &'a CartesianImpedance<N, Chain<N>>,
+    state: &'a mut CartesianState<N>,
+    joint: &'a mut Typed<N>,
+    targets: Option<&'a [f64]>,
+    clock: &'a Cell<f64>,
+    row: &'a Cell<TaskRow<N>>,
+    last: Option<LastStep<N>>,
+}
+
+impl<const N: usize> Cartesian<'_, N> {
+    fn step_cartesian(
+        &mut self,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+    ) -> Result<Command<N>, Error> {
+        let target = self.targets.map(|tab| {
+            let k = row_of(self.clock.get(), self.outer.period());
+            pose_target(&tab[k * TARGET_LEN..(k + 1) * TARGET_LEN])
+        });
+        let meas = CartesianMeasurement {
+            q: m.x,
+            dq: m.dx,
+            wrench: Vector::<6>::from(*wrench),
+        };
+        let cmd = cartesian_step(self.outer, self.state, self.joint, &meas, target.as_ref())?;
+        let last = LastStep::new(cmd, target.as_ref(), *wrench);
+        let c = &cmd.compliant;
+        self.row.set(TaskRow {
+            pc: last.commanded,
+            pd: [c.p, c.dp, c.ddp],
+            qd: cmd.reference.x,
+            error: cmd.error,
+            wrench: *wrench,
+            z1: c.p - cmd.p,
+        });
+        self.last = Some(last);
+        Ok(cmd.joint)
+    }
+}
+
+impl<const N: usize> Control<N> for Cartesian<'_, N> {
+    fn period(&self) -> f64 {
+        self.outer.period()
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        self.joint.controller().impedance()
+    }
+    /// The Cartesian step with no wrench measured.
+    fn step(&mut self, m: &Measurement<N>, _c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.step_cartesian(m, &[0.0; 6])
+    }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        self.step_with_wrench(m, &[0.0; 6], c)
+    }
+    /// The Cartesian step; on an error (of the outer loop or of the joint
+    /// step, recorded in the joint controller: [`cartesian_step`]) its
+    /// fallback, the torque it now applies.
+    fn step_with_wrench(
+        &mut self,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+        _c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        match self.step_cartesian(m, wrench) {
+            Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
+            Err(e) => (*self.joint.state().applied(), Err(e)),
+        }
+    }
+}
+
+/// The joint rows, the task rows and the task-space metrics of every row.
+struct TaskRecorder<'a, const N: usize, const M: usize> {
+    joint: &'a mut Records,
+    task: &'a mut TaskRecords,
+    metrics: &'a mut TaskMetrics<M>,
+    row: &'a Cell<TaskRow<N>>,
+}
+
+impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
+    fn record(&mut self, r: &Row<N>) {
+        let tr = self.row.get();
+        self.joint.record(r);
+        self.task.record(&tr);
+        self.metrics.push(
+            r.t,
+            [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
+            [
+                tr.pc[0].as_slice(),
+                tr.pc[1].as_slice(),
+                tr.pc[2].as_slice(),
+            ],
+            tr.z1.as_slice(),
+            [r.tau.as_slice(), r.tau_sat.as_slice(), r.tau_e.as_slice()],
+        );
+    }
+}
+
+/// What a Cartesian run gives back: the joint rows, the task rows and the
+/// SPEC §12 metrics of task space (z1 = p_d − p, m = 3).
+pub type CartesianOut = (Records, TaskRecords, MetricsOut);
+
+fn invalid(what: &'static str, reason: &'static str) -> RunError {
+    RunError::Core(Error::Invalid { what, reason }, None)
+}
+
+/// The closed loop of the outer loop `outer` (its state `state`) in front of
+/// the joint controller `joint` on MuJoCo (`sim` as `spec` describes it),
+/// from both controllers' current states (not reset: a used controller goes
+/// on). Returns the records and the task-space metrics, and leaves the last
+/// step taken in `last` (also when the run ends with an error).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn simulate_mujoco<const N: usize>(
+    outer: &CartesianImpedance<N, Chain<N>>,
+    state: &mut CartesianState<N>,
+    joint: &mut Typed<N>,
+    last: &mut Option<LastStep<N>>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &CartesianRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> Result<CartesianOut, RunError> {
+    if N <= 3 {
+        run_m::<N, 3>(outer, state, joint, last, sim, spec, run, hooks)
+    } else {
+        run_m::<N, N>(outer, state, joint, last, sim, spec, run, hooks)
+    }
+}
+
+/// [`simulate_mujoco`] with the metrics' accumulator of M = max(N, 3) slots
+/// (as [`metrics_of`](super::dynamic::metrics_of) takes for the same rows).
+#[allow(clippy::too_many_arguments)]
+fn run_m<const N: usize, const M: usize>(
+    outer: &CartesianImpedance<N, Chain<N>>,
+    state: &mut CartesianState<N>,
+    joint: &mut Typed<N>,
+    last: &mut Option<LastStep<N>>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &CartesianRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> Result<CartesianOut, RunError> {
+    let ts = outer.period();
+    if joint.controller().period() != ts {
+        return Err(invalid(
+            "joint controller of a Cartesian impedance",
+            "needs the same Ts as the Cartesian impedance",
+        ));
+    }
+    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    if let Some(tab) = run.targets {
+        let need = usize::try_from(total)
+            .unwrap_or(usize::MAX)
+            .saturating_mul(TARGET_LEN);
+        if tab.len() < need {
+            return Err(invalid("targets", "needs one pose target per step"));
+        }
+    }
+    // A Cartesian controller reads the wrench, not τe: what acts on τe alone
+    // would act on nothing.
+    let s = super::dynamic::scenario::<N>(
+        crate::schema::Preset::Robot,
+        joint.controller().config().law,
+        run.items,
+    )
+    .map_err(|e| RunError::Core(e.error, None))?;
+    if s.disturbances()?
+        .params()
+        .noise_tau_e
+        .iter()
+        .any(|v| *v != 0.0)
+    {
+        return Err(invalid(
+            "noise_tau_e",
+            "a Cartesian controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
+        ));
+    }
+    if let Some(FaultSpec {
+        kind: FaultKind::ForceBias(_),
+        ..
+    }) = run.fault
+    {
+        return Err(invalid(
+            "force_bias",
+            "a Cartesian controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
+        ));
+    }
+    let every = run.every.max(1);
+    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let mut rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let mut task = TaskRecords::with_rows(N, kept, every).ok_or(RunError::Memory(kept))?;
+    let ones = [1.0; N];
+    let mut metrics = TaskMetrics::<M>::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
+    let clock = Cell::new(0.0);
+    let row = Cell::new(TaskRow::<N>::nan());
+    let mut ctrl = Cartesian {
+        outer,
+        state,
+        joint,
+        targets: run.targets,
+        clock: &clock,
+        row: &row,
+        last: *last,
+    };
+    let law = ctrl.joint.controller().config().law;
+    let on = OnMujoco {
+        sim,
+        spec,
+        t_final: run.t_final,
+        settle: run.settle,
+        items: run.items,
+        law,
+        fault: run.fault,
+    };
+    let mut recorder = TaskRecorder {
+        joint: &mut rec,
+        task: &mut task,
+        metrics: &mut metrics,
+        row: &row,
+    };
+    let result = drive_mujoco(&mut ctrl, &Clock(&clock), on, hooks, &mut recorder);
+    *last = ctrl.last;
+    result?;
+    Ok((rec, task, metrics.finish()))
+}
+
+/// A Cartesian step per row of recorded tables, the core's alone (for the
+/// cost of the controller without a plant): q, q̇ (K × n), the wrench (K ×
+/// 6), the pose targets (K × [`TARGET_LEN`], or none: held). Writes sat(τ)
+/// rows into `out`. Errors name the row.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn replay<const N: usize>(
+    outer: &CartesianImpedance<N, Chain<N>>,
+    state: &mut CartesianState<N>,
+    joint: &mut Typed<N>,
+    last: &mut Option<LastStep<N>>,
+    rows: usize,
+    tables: [&[f64]; 3],
+    targets: Option<&[f64]>,
+    out: &mut Vec<f64>,
+    hooks: &mut dyn Hooks,
+) -> Result<(), RunError> {
+    let [q, dq, wrench] = tables;
+    if q.len() < rows * N || dq.len() < rows * N || wrench.len() < rows * 6 {
+        return Err(invalid("rows", "every table needs K rows of its width"));
+    }
+    if targets.is_some_and(|t| t.len() < rows * TARGET_LEN) {
+        return Err(invalid("targets", "needs one pose target per row"));
+    }
+    for k in 0..rows {
+        if k > 0 && k % 64 == 0 && !hooks.tick(k as u64, rows as u64) {
+            return Err(RunError::Stopped);
+        }
+        let m = CartesianMeasurement {
+            q: Vector::<N>::from_column_slice(&q[k * N..(k + 1) * N]),
+            dq: Some(Vector::<N>::from_column_slice(&dq[k * N..(k + 1) * N])),
+            wrench: Vector::<6>::from_column_slice(&wrench[k * 6..(k + 1) * 6]),
+        };
+        let target = targets.map(|t| pose_target(&t[k * TARGET_LEN..(k + 1) * TARGET_LEN]));
+        let cmd = cartesian_step(outer, state, joint, &m, target.as_ref())
+            .map_err(|e| RunError::Core(e, Some(k as u64)))?;
+        out.extend_from_slice(cmd.joint.tau_sat.as_slice());
+        *last = Some(LastStep::new(cmd, target.as_ref(), m.wrench.into()));
+    }
+    Ok(())
+}

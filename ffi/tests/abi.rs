@@ -79,7 +79,7 @@ fn defaults(n: usize, law: AdaptimpLaw, preset: AdaptimpPreset) -> AdaptimpParam
     // SAFETY: a valid place; Ok means it was written whole.
     unsafe {
         assert_eq!(
-            adaptimp_params_default(p.as_mut_ptr(), n, law, preset),
+            adaptimp_params_default(p.as_mut_ptr(), n, law.into(), preset.into()),
             AdaptimpStatus::Ok
         );
         p.assume_init()
@@ -218,7 +218,7 @@ fn a_snapshot_restored_continues_bit_identically_and_a_bad_one_changes_nothing()
         );
         assert_eq!(written, len);
         assert_eq!(
-            adaptimp_state_restore(b.state, buf.as_ptr(), len),
+            adaptimp_state_restore(b.ctrl, b.state, buf.as_ptr(), len),
             AdaptimpStatus::Ok
         );
         assert_eq!(adaptimp_state_steps(b.state), 100);
@@ -231,12 +231,13 @@ fn a_snapshot_restored_continues_bit_identically_and_a_bad_one_changes_nothing()
         }
         buf[3] += 1.0; // another number of nodes
         assert_eq!(
-            adaptimp_state_restore(b.state, buf.as_ptr(), len),
-            AdaptimpStatus::WrongState
+            adaptimp_state_restore(b.ctrl, b.state, buf.as_ptr(), len),
+            AdaptimpStatus::BadSnapshot
         );
+        assert!(last_error().contains("another number of joints or nodes"));
         assert_eq!(adaptimp_state_steps(b.state), 200);
         assert_eq!(
-            adaptimp_state_restore(b.state, ptr::null(), len),
+            adaptimp_state_restore(b.ctrl, b.state, ptr::null(), len),
             AdaptimpStatus::NullPointer
         );
         // A state of another size is refused by the step.

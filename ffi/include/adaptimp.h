@@ -193,6 +193,95 @@ typedef struct AdaptimpController AdaptimpController;
 // a buffer of the caller's ([`adaptimp_state_init`]).
 typedef struct AdaptimpState AdaptimpState;
 
+// A rigid transform as plain data: `x_parent = rotation · x + translation`.
+typedef struct AdaptimpTransform {
+  // Translation (m).
+  double translation[3];
+  // Rotation matrix, row-major (`rotation[i][j]` = R_ij); orthonormal to
+  // 1e-6 with det +1 (the chain checks it).
+  double rotation[3][3];
+} AdaptimpTransform;
+
+// One joint of a chain description, base to tip (SPEC §16, (16.0)): a fixed
+// `origin` (the parent joint's frame → this joint's frame, URDF's
+// `<origin xyz rpy>`), a `kind`, and for a movable joint a non-zero `axis`
+// in its own frame (normalised by the chain) and an `offset`.
+typedef struct AdaptimpJoint {
+  // Fixed, revolute or prismatic (an `AdaptimpJointKind`, read as an integer).
+  AdaptimpJointKind kind;
+  // The parent joint's frame → this joint's frame (at joint value `offset`).
+  struct AdaptimpTransform origin;
+  // The axis in this joint's frame (ignored for a fixed joint).
+  double axis[3];
+  // The joint value (rad or m) at which the frame is `origin` (URDF: 0;
+  // MuJoCo: `qpos0`).
+  double offset;
+} AdaptimpJoint;
+
+// The tip of a chain at (q, q̇): the pose, the 6 × n geometric Jacobian
+// (world-aligned, at the tip) and J̇ q̇.
+typedef struct AdaptimpTip {
+  // Number of joints n.
+  size_t n;
+  // Tip position p (m), world frame.
+  double position[3];
+  // Tip rotation R (world ← tip), row-major.
+  double rotation[3][3];
+  // [J_v; J_ω], row i the task direction (x, y, z (m/rad or m/m), then
+  // rotation about x, y, z), column j the joint; the first n columns set.
+  double jacobian[6][ADAPTIMP_MAX_JOINTS];
+  // J̇ q̇ = [p̈; ω̇] at q̈ = 0 (m/s², rad/s²).
+  double bias[6];
+} AdaptimpTip;
+
+// The 6-D Cartesian impedance's parameters: the schema's group "cartesian"
+// (SPEC §16), named as there, per axis of the world frame (x, y, z). Fill it
+// with [`adaptimp_cartesian_params_default`], then change fields.
+typedef struct AdaptimpCartesianParams {
+  // Target inertia M_d of the translation (kg), > 0.
+  double md[3];
+  // Target damping B_d of the translation (N s/m), ≥ 0 (read if not `bd_critical`).
+  double bd[3];
+  // True: B_d = 2√(K_d M_d) per axis, critical, following the filtered K_d (Python's `Bd=None`).
+  bool bd_critical;
+  // Target stiffness K_d of the translation (N/m), ≥ 0.
+  double kd[3];
+  // Target inertia of the rotation (kg m²), > 0.
+  double md_rot[3];
+  // Target damping of the rotation (N m s/rad), ≥ 0 (read if not `bd_rot_critical`).
+  double bd_rot[3];
+  // True: critical damping of the rotation (Python's `Bd_rot=None`).
+  bool bd_rot_critical;
+  // Target stiffness of the rotation (N m/rad), ≥ 0; 0 on every axis:
+  // position-only (the orientation is no task).
+  double kd_rot[3];
+  // CLIK gain K_P (1/s²), > 0, Ts²·K_P < 1, (C2).
+  double clik_kp;
+  // CLIK gain K_D (1/s), > 0, Ts·K_D < 1, (C2).
+  double clik_kd;
+  // Damping λ_p of the least-squares inverse in the translation rows (m), > 0, (C3).
+  double clik_lambda;
+  // Damping λ_o of the least-squares inverse in the rotation rows, > 0, (C3).
+  double clik_lambda_rot;
+  // Null-space posture stiffness k_0 (1/s²), ≥ 0.
+  double null_k;
+  // Null-space damping d_0 (1/s), ≥ 0.
+  double null_d;
+  // Largest translation error fed to the impedance (m), > 0, (16.5);
+  // INFINITY: no clipping (Python's None).
+  double pos_error_max;
+  // Largest rotation error fed to the impedance (rad), > 0; INFINITY: no clipping.
+  double rot_error_max;
+  // Time constant (s) of the filter on jumps of the commanded pose and on
+  // stiffness changes, (16.6), ≥ 0 (0: none).
+  double target_filter;
+  // Time constant (s) of the filter on the measured wrench, ≥ 0 (0: none).
+  double force_filter;
+  // True: the joint controller gets τe = Jᵀ F_e for its +τe feedforward
+  // (C5); false: τe = 0.
+  bool force_feedforward;
+} AdaptimpCartesianParams;
+
 // Every parameter of a controller for `n` joints (1…7): the fields of the
 // parameter schema (`adaptimp::schema::PARAMS`, group "controller"), named as
 // there, with per-joint arrays of which the first `n` entries are read.
@@ -299,136 +388,6 @@ typedef struct AdaptimpParams {
   double tau_rate_max[ADAPTIMP_MAX_JOINTS];
 } AdaptimpParams;
 
-// A commanded setpoint at t_k: position (rad), velocity (rad/s) and
-// acceleration (rad/s²); the first n entries are read.
-typedef struct AdaptimpSetpoint {
-  // xc (rad).
-  double x[ADAPTIMP_MAX_JOINTS];
-  // ẋc (rad/s).
-  double dx[ADAPTIMP_MAX_JOINTS];
-  // ẍc (rad/s²).
-  double ddx[ADAPTIMP_MAX_JOINTS];
-} AdaptimpSetpoint;
-
-// What one step computed; the first `n` entries of each array are set, the
-// others zero. Written on every status (see [`adaptimp_step`]): `tau_sat`
-// is what goes to the actuators.
-typedef struct AdaptimpCommand {
-  // Number of joints; 0 when no controller could be asked (then every
-  // field is zero).
-  size_t n;
-  // The torque to apply (N m): sat(τ) of an accepted step, the configured
-  // fallback of a refused one.
-  double tau_sat[ADAPTIMP_MAX_JOINTS];
-  // Commanded torque τ (N m).
-  double tau[ADAPTIMP_MAX_JOINTS];
-  // Δτ = sat(τ) − τ (N m).
-  double dtau[ADAPTIMP_MAX_JOINTS];
-  // z1 = xd − x (rad).
-  double z1[ADAPTIMP_MAX_JOINTS];
-  // z2 (rad/s).
-  double z2[ADAPTIMP_MAX_JOINTS];
-  // xc (rad).
-  double xc[ADAPTIMP_MAX_JOINTS];
-  // xd (rad).
-  double xd[ADAPTIMP_MAX_JOINTS];
-  // The velocity used (rad/s): measured, or the observer's estimate.
-  double v[ADAPTIMP_MAX_JOINTS];
-  // ζ (N m).
-  double zeta[ADAPTIMP_MAX_JOINTS];
-  // ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ before the step's update.
-  double w_norms[3];
-} AdaptimpCommand;
-
-// A rigid transform as plain data: `x_parent = rotation · x + translation`.
-typedef struct AdaptimpTransform {
-  // Translation (m).
-  double translation[3];
-  // Rotation matrix, row-major (`rotation[i][j]` = R_ij); orthonormal to
-  // 1e-6 with det +1 (the chain checks it).
-  double rotation[3][3];
-} AdaptimpTransform;
-
-// One joint of a chain description, base to tip (SPEC §16, (16.0)): a fixed
-// `origin` (the parent joint's frame → this joint's frame, URDF's
-// `<origin xyz rpy>`), a `kind`, and for a movable joint a non-zero `axis`
-// in its own frame (normalised by the chain) and an `offset`.
-typedef struct AdaptimpJoint {
-  // Fixed, revolute or prismatic (an `AdaptimpJointKind`, read as an integer).
-  AdaptimpJointKind kind;
-  // The parent joint's frame → this joint's frame (at joint value `offset`).
-  struct AdaptimpTransform origin;
-  // The axis in this joint's frame (ignored for a fixed joint).
-  double axis[3];
-  // The joint value (rad or m) at which the frame is `origin` (URDF: 0;
-  // MuJoCo: `qpos0`).
-  double offset;
-} AdaptimpJoint;
-
-// The tip of a chain at (q, q̇): the pose, the 6 × n geometric Jacobian
-// (world-aligned, at the tip) and J̇ q̇.
-typedef struct AdaptimpTip {
-  // Number of joints n.
-  size_t n;
-  // Tip position p (m), world frame.
-  double position[3];
-  // Tip rotation R (world ← tip), row-major.
-  double rotation[3][3];
-  // [J_v; J_ω], row i the task direction (x, y, z (m/rad or m/m), then
-  // rotation about x, y, z), column j the joint; the first n columns set.
-  double jacobian[6][ADAPTIMP_MAX_JOINTS];
-  // J̇ q̇ = [p̈; ω̇] at q̈ = 0 (m/s², rad/s²).
-  double bias[6];
-} AdaptimpTip;
-
-// The 6-D Cartesian impedance's parameters: the schema's group "cartesian"
-// (SPEC §16), named as there, per axis of the world frame (x, y, z). Fill it
-// with [`adaptimp_cartesian_params_default`], then change fields.
-typedef struct AdaptimpCartesianParams {
-  // Target inertia M_d of the translation (kg), > 0.
-  double md[3];
-  // Target damping B_d of the translation (N s/m), ≥ 0 (read if not `bd_critical`).
-  double bd[3];
-  // True: B_d = 2√(K_d M_d) per axis, critical, following the filtered K_d (Python's `Bd=None`).
-  bool bd_critical;
-  // Target stiffness K_d of the translation (N/m), ≥ 0.
-  double kd[3];
-  // Target inertia of the rotation (kg m²), > 0.
-  double md_rot[3];
-  // Target damping of the rotation (N m s/rad), ≥ 0 (read if not `bd_rot_critical`).
-  double bd_rot[3];
-  // True: critical damping of the rotation (Python's `Bd_rot=None`).
-  bool bd_rot_critical;
-  // Target stiffness of the rotation (N m/rad), ≥ 0; 0 on every axis:
-  // position-only (the orientation is no task).
-  double kd_rot[3];
-  // CLIK gain K_P (1/s²), > 0, Ts²·K_P < 1, (C2).
-  double clik_kp;
-  // CLIK gain K_D (1/s), > 0, Ts·K_D < 1, (C2).
-  double clik_kd;
-  // Damping λ_p of the least-squares inverse in the translation rows (m), > 0, (C3).
-  double clik_lambda;
-  // Damping λ_o of the least-squares inverse in the rotation rows, > 0, (C3).
-  double clik_lambda_rot;
-  // Null-space posture stiffness k_0 (1/s²), ≥ 0.
-  double null_k;
-  // Null-space damping d_0 (1/s), ≥ 0.
-  double null_d;
-  // Largest translation error fed to the impedance (m), > 0, (16.5);
-  // INFINITY: no clipping (Python's None).
-  double pos_error_max;
-  // Largest rotation error fed to the impedance (rad), > 0; INFINITY: no clipping.
-  double rot_error_max;
-  // Time constant (s) of the filter on jumps of the commanded pose and on
-  // stiffness changes, (16.6), ≥ 0 (0: none).
-  double target_filter;
-  // Time constant (s) of the filter on the measured wrench, ≥ 0 (0: none).
-  double force_filter;
-  // True: the joint controller gets τe = Jᵀ F_e for its +τe feedforward
-  // (C5); false: τe = 0.
-  bool force_feedforward;
-} AdaptimpCartesianParams;
-
 // A commanded pose and its rates at t_k, world frame (SPEC §16). The
 // rotation is checked at every step (orthonormal to 1e-6, det +1; else
 // INVALID_INPUT and nothing changes); fill it from a unit quaternion with
@@ -492,6 +451,47 @@ typedef struct AdaptimpCartesianCommand {
   double error[6];
 } AdaptimpCartesianCommand;
 
+// A commanded setpoint at t_k: position (rad), velocity (rad/s) and
+// acceleration (rad/s²); the first n entries are read.
+typedef struct AdaptimpSetpoint {
+  // xc (rad).
+  double x[ADAPTIMP_MAX_JOINTS];
+  // ẋc (rad/s).
+  double dx[ADAPTIMP_MAX_JOINTS];
+  // ẍc (rad/s²).
+  double ddx[ADAPTIMP_MAX_JOINTS];
+} AdaptimpSetpoint;
+
+// What one step computed; the first `n` entries of each array are set, the
+// others zero. Written on every status (see [`adaptimp_step`]): `tau_sat`
+// is what goes to the actuators.
+typedef struct AdaptimpCommand {
+  // Number of joints; 0 when no controller could be asked (then every
+  // field is zero).
+  size_t n;
+  // The torque to apply (N m): sat(τ) of an accepted step, the configured
+  // fallback of a refused one.
+  double tau_sat[ADAPTIMP_MAX_JOINTS];
+  // Commanded torque τ (N m).
+  double tau[ADAPTIMP_MAX_JOINTS];
+  // Δτ = sat(τ) − τ (N m).
+  double dtau[ADAPTIMP_MAX_JOINTS];
+  // z1 = xd − x (rad).
+  double z1[ADAPTIMP_MAX_JOINTS];
+  // z2 (rad/s).
+  double z2[ADAPTIMP_MAX_JOINTS];
+  // xc (rad).
+  double xc[ADAPTIMP_MAX_JOINTS];
+  // xd (rad).
+  double xd[ADAPTIMP_MAX_JOINTS];
+  // The velocity used (rad/s): measured, or the observer's estimate.
+  double v[ADAPTIMP_MAX_JOINTS];
+  // ζ (N m).
+  double zeta[ADAPTIMP_MAX_JOINTS];
+  // ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ before the step's update.
+  double w_norms[3];
+} AdaptimpCommand;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -503,218 +503,6 @@ const char *adaptimp_last_error(void);
 
 // The library's version, e.g. "0.1.0" (NUL-terminated, static).
 const char *adaptimp_version(void);
-
-// Fill `out` with the defaults of `preset` for controller `law` and `n`
-// joints (1 … 7). Per-joint defaults declared for the paper's 2 joints (τmax,
-// the commanded circle) are broadcast from their first entry for other n.
-// BAD_SIZE for n outside 1 … 7, INVALID_CONFIG for a `law` or `preset` that
-// is not a value of its enum (two arguments swapped, say); on an error
-// `*out` is unchanged.
-//
-// # Safety
-// `out` is NULL or points to an `AdaptimpParams`.
-enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
-                                            size_t n,
-                                            AdaptimpLaw law,
-                                            AdaptimpPreset preset);
-
-// Validate `params` (SPEC §10 and every other condition) and build a
-// controller into `*out` (free it with [`adaptimp_controller_free`]). On an
-// error `*out` is left unchanged: INVALID_CONFIG (a condition, a NaN, an
-// enum value), BAD_SIZE (n), NULL_POINTER.
-//
-// # Safety
-// `params` and `out` are NULL or valid; `params.centers` and
-// `params.widths2` are NULL or hold `nodes × 4n` and `4n` reals.
-enum AdaptimpStatus adaptimp_controller_new(const struct AdaptimpParams *params,
-                                            struct AdaptimpController **out);
-
-// The controller of `preset` for the paper's 2-link arm (the 256-node grid,
-// the paper's circle as the default trajectory). A `preset` or `law` that
-// is not a value of its enum (the two swapped, say) is refused
-// (INVALID_CONFIG).
-//
-// # Safety
-// `out` is NULL or valid.
-enum AdaptimpStatus adaptimp_controller_new_preset(AdaptimpPreset preset,
-                                                   AdaptimpLaw law,
-                                                   struct AdaptimpController **out);
-
-// Free a controller (NULL is ignored, and so is a pointer that is not a
-// live controller: freeing twice is the caller's bug, made unlikely to do
-// harm). Free its states first: a state does not keep its controller alive.
-//
-// # Safety
-// `ctrl` is NULL or came from `adaptimp_controller_new*`.
-void adaptimp_controller_free(struct AdaptimpController *ctrl);
-
-// The controller's number of joints, or 0 for NULL or a dead handle.
-//
-// # Safety
-// `ctrl` is NULL or valid.
-size_t adaptimp_controller_joints(const struct AdaptimpController *ctrl);
-
-// The controller's sampling period Ts (s), or NaN for NULL or a dead handle.
-//
-// # Safety
-// `ctrl` is NULL or valid.
-double adaptimp_controller_period(const struct AdaptimpController *ctrl);
-
-// A state at t = 0 for `ctrl` into `*out`, on the heap (free it with
-// [`adaptimp_state_free`]). This allocates; the step does not. For a state
-// in memory of your own (firmware), see [`adaptimp_state_init`].
-//
-// # Safety
-// `ctrl` and `out` are NULL or valid.
-enum AdaptimpStatus adaptimp_state_new(const struct AdaptimpController *ctrl,
-                                       struct AdaptimpState **out);
-
-// The size (bytes) and alignment a caller buffer for a state of `ctrl`
-// needs ([`adaptimp_state_init`]): fixed for a controller and a build of
-// the library.
-//
-// # Safety
-// `ctrl` is NULL or valid; `size` and `align` are NULL or valid.
-enum AdaptimpStatus adaptimp_state_buffer_size(const struct AdaptimpController *ctrl,
-                                               size_t *size,
-                                               size_t *align);
-
-// A state at t = 0 for `ctrl` in the caller's buffer `buf` of `size` bytes
-// (at least what [`adaptimp_state_buffer_size`] says, aligned as it says),
-// no allocation: for firmware without a heap, or to place the state
-// yourself. `*out` gets the handle (it points into `buf`); use it as any
-// state. The buffer must stay where it is and must not be used otherwise
-// while the state lives (a state cannot be moved or copied bytewise: save
-// and restore it); [`adaptimp_state_free`] ends its life and gives the
-// buffer back (it frees nothing). BAD_SIZE for a buffer too small or
-// misaligned.
-//
-// # Safety
-// `ctrl` and `out` are NULL or valid; `buf` is NULL or `size` writable
-// bytes that nothing else uses while the state lives.
-enum AdaptimpStatus adaptimp_state_init(const struct AdaptimpController *ctrl,
-                                        void *buf,
-                                        size_t size,
-                                        struct AdaptimpState **out);
-
-// Free a state (NULL is ignored, and so is a pointer that is not a live
-// state): a heap state's memory is freed; a state in a caller buffer
-// ([`adaptimp_state_init`]) ends its life and its buffer is the caller's
-// again. Using a state after this is refused (BAD_HANDLE) as long as its
-// memory was not reused.
-//
-// # Safety
-// `state` is NULL or came from `adaptimp_state_new` or `adaptimp_state_init`.
-void adaptimp_state_free(struct AdaptimpState *state);
-
-// Back to t = 0: weights, ζ, observer, reference and applied torque as at
-// creation, the fault cleared.
-//
-// # Safety
-// `state` is NULL or valid.
-enum AdaptimpStatus adaptimp_state_reset(struct AdaptimpState *state);
-
-// True if a refused step recorded a fault (with fault policy "latch", steps
-// are refused until it is cleared); `*step` (if not NULL) gets the step at
-// which it happened. False for NULL or a dead handle.
-//
-// # Safety
-// `state` is NULL or valid; `step` is NULL or valid.
-bool adaptimp_state_fault(const struct AdaptimpState *state, uint64_t *step);
-
-// Clear the recorded fault: the documented recovery after a latched fault
-// (the next step's torque climbs from the fallback at the rate limit).
-//
-// # Safety
-// `state` is NULL or valid.
-enum AdaptimpStatus adaptimp_state_clear_fault(struct AdaptimpState *state);
-
-// Steps taken since creation or reset, or 0 for NULL or a dead handle.
-//
-// # Safety
-// `state` is NULL or valid.
-uint64_t adaptimp_state_steps(const struct AdaptimpState *state);
-
-// The torque to apply now (N m) into `tau` (`n` reals, the state's number
-// of joints): the last accepted step's sat(τ), or the fallback of a refused
-// call after it (the origin of the next step's rate limit); zero after
-// creation and reset.
-//
-// # Safety
-// `state` is NULL or valid; `tau` is NULL or holds `n` reals.
-enum AdaptimpStatus adaptimp_state_applied(const struct AdaptimpState *state,
-                                           size_t n,
-                                           double *tau);
-
-// The number of reals [`adaptimp_state_save`] writes for this state,
-// `12 + 18 n + L (2n² + n + 1)` (L the nodes), or 0 for NULL or a dead handle.
-//
-// # Safety
-// `state` is NULL or valid.
-size_t adaptimp_state_snapshot_len(const struct AdaptimpState *state);
-
-// Save the whole state into the caller's buffer `buf` of `len` reals (at
-// least [`adaptimp_state_snapshot_len`]); `*written` (if not NULL) gets the
-// number written. No allocation. The format (3): a header, n, L, the step
-// count, the reference, ζ, the observer, the last accepted position, the
-// last command, the norms, the basis, the weights, the applied torque, the
-// last measured position and a checksum; a recorded fault is not part of
-// it.
-//
-// # Safety
-// `state` is NULL or valid; `buf` is NULL or holds `len` reals.
-enum AdaptimpStatus adaptimp_state_save(const struct AdaptimpState *state,
-                                        double *buf,
-                                        size_t len,
-                                        size_t *written);
-
-// Restore into `state` a snapshot of `len` reals written by
-// [`adaptimp_state_save`], checked as Rust's `Controller::restore` and
-// Python's `Controller.restore` check it: its format, sizes and checksum,
-// and that `ctrl`'s step could have left it (the reference and ζ within
-// their ceilings, the weights' norms as stored and within the projection
-// bounds, the applied and last torques within τmax). On an error the state
-// is unchanged: BAD_SNAPSHOT (the snapshot), WRONG_STATE (a state of
-// another controller). The recorded fault is cleared.
-//
-// # Safety
-// `ctrl` and `state` are NULL or valid; `buf` is NULL or holds `len` reals.
-enum AdaptimpStatus adaptimp_state_restore(const struct AdaptimpController *ctrl,
-                                           struct AdaptimpState *state,
-                                           const double *buf,
-                                           size_t len);
-
-// One controller step at t_k = k·Ts. `q` (rad), `tau_e` (N m) and `dq`
-// (rad/s; required by PD and state feedback, may be NULL for output
-// feedback) hold `n` reals, the controller's number of joints. `setpoint` is
-// the commanded xc, ẋc, ẍc at t_k, or NULL for the controller's own
-// trajectory at t_k. No allocation.
-//
-// `*out` is written on every status, and `out->tau_sat` is the torque to
-// apply (docs/reliability.md, "The fault semantics"):
-//
-// | status | `out` | recorded in the state |
-// |---|---|---|
-// | OK | the command, `tau_sat` = sat(τ) | the step |
-// | refused by the controller: NON_FINITE, OUT_OF_RANGE, MISSING_VELOCITY, DIVERGED, FAULTED, INVALID_INPUT, WRONG_STATE (another basis) | `tau_sat` = the configured fallback, n set, the rest zero | the fault (a latched one kept), the fallback as applied torque |
-// | refused here, with a live controller and a state of its size: NULL_POINTER (`q`, `tau_e`, `out`), BAD_SIZE (`n`) | as above (nothing if `out` is NULL) | as above |
-// | no controller to ask: NULL_POINTER or BAD_HANDLE (`ctrl`, `state`), WRONG_STATE (a state of another size), INTERNAL | every field zero, n = 0 | nothing |
-//
-// So a loop applies `out->tau_sat` after any status with `out->n` equal to
-// its joints; `out->n == 0` is a programming error (stop the arm by your
-// own means). The applied torque stays readable with
-// [`adaptimp_state_applied`].
-//
-// # Safety
-// Each pointer is NULL or valid for `n` reals (`setpoint`, `out`: one struct).
-enum AdaptimpStatus adaptimp_step(const struct AdaptimpController *ctrl,
-                                  struct AdaptimpState *state,
-                                  size_t n,
-                                  const double *q,
-                                  const double *dq,
-                                  const double *tau_e,
-                                  const struct AdaptimpSetpoint *setpoint,
-                                  struct AdaptimpCommand *out);
 
 // URDF's `<origin xyz="…" rpy="…">`: translation `xyz` (3 reals, m) and the
 // fixed-axis roll, pitch, yaw `rpy` (3 reals, rad), R = Rot_z(yaw)
@@ -997,6 +785,218 @@ enum AdaptimpStatus adaptimp_cartesian_orbit_centres(const struct AdaptimpChain 
                                                      double *centers,
                                                      double *widths2,
                                                      size_t *written);
+
+// Validate `params` (SPEC §10 and every other condition) and build a
+// controller into `*out` (free it with [`adaptimp_controller_free`]). On an
+// error `*out` is left unchanged: INVALID_CONFIG (a condition, a NaN, an
+// enum value), BAD_SIZE (n), NULL_POINTER.
+//
+// # Safety
+// `params` and `out` are NULL or valid; `params.centers` and
+// `params.widths2` are NULL or hold `nodes × 4n` and `4n` reals.
+enum AdaptimpStatus adaptimp_controller_new(const struct AdaptimpParams *params,
+                                            struct AdaptimpController **out);
+
+// The controller of `preset` for the paper's 2-link arm (the 256-node grid,
+// the paper's circle as the default trajectory). A `preset` or `law` that
+// is not a value of its enum (the two swapped, say) is refused
+// (INVALID_CONFIG).
+//
+// # Safety
+// `out` is NULL or valid.
+enum AdaptimpStatus adaptimp_controller_new_preset(AdaptimpPreset preset,
+                                                   AdaptimpLaw law,
+                                                   struct AdaptimpController **out);
+
+// Free a controller (NULL is ignored, and so is a pointer that is not a
+// live controller: freeing twice is the caller's bug, made unlikely to do
+// harm). Free its states first: a state does not keep its controller alive.
+//
+// # Safety
+// `ctrl` is NULL or came from `adaptimp_controller_new*`.
+void adaptimp_controller_free(struct AdaptimpController *ctrl);
+
+// The controller's number of joints, or 0 for NULL or a dead handle.
+//
+// # Safety
+// `ctrl` is NULL or valid.
+size_t adaptimp_controller_joints(const struct AdaptimpController *ctrl);
+
+// The controller's sampling period Ts (s), or NaN for NULL or a dead handle.
+//
+// # Safety
+// `ctrl` is NULL or valid.
+double adaptimp_controller_period(const struct AdaptimpController *ctrl);
+
+// A state at t = 0 for `ctrl` into `*out`, on the heap (free it with
+// [`adaptimp_state_free`]). This allocates; the step does not. For a state
+// in memory of your own (firmware), see [`adaptimp_state_init`].
+//
+// # Safety
+// `ctrl` and `out` are NULL or valid.
+enum AdaptimpStatus adaptimp_state_new(const struct AdaptimpController *ctrl,
+                                       struct AdaptimpState **out);
+
+// The size (bytes) and alignment a caller buffer for a state of `ctrl`
+// needs ([`adaptimp_state_init`]): fixed for a controller and a build of
+// the library.
+//
+// # Safety
+// `ctrl` is NULL or valid; `size` and `align` are NULL or valid.
+enum AdaptimpStatus adaptimp_state_buffer_size(const struct AdaptimpController *ctrl,
+                                               size_t *size,
+                                               size_t *align);
+
+// A state at t = 0 for `ctrl` in the caller's buffer `buf` of `size` bytes
+// (at least what [`adaptimp_state_buffer_size`] says, aligned as it says),
+// no allocation: for firmware without a heap, or to place the state
+// yourself. `*out` gets the handle (it points into `buf`); use it as any
+// state. The buffer must stay where it is and must not be used otherwise
+// while the state lives (a state cannot be moved or copied bytewise: save
+// and restore it); [`adaptimp_state_free`] ends its life and gives the
+// buffer back (it frees nothing). BAD_SIZE for a buffer too small or
+// misaligned.
+//
+// # Safety
+// `ctrl` and `out` are NULL or valid; `buf` is NULL or `size` writable
+// bytes that nothing else uses while the state lives.
+enum AdaptimpStatus adaptimp_state_init(const struct AdaptimpController *ctrl,
+                                        void *buf,
+                                        size_t size,
+                                        struct AdaptimpState **out);
+
+// Free a state (NULL is ignored, and so is a pointer that is not a live
+// state): a heap state's memory is freed; a state in a caller buffer
+// ([`adaptimp_state_init`]) ends its life and its buffer is the caller's
+// again. Using a state after this is refused (BAD_HANDLE) as long as its
+// memory was not reused.
+//
+// # Safety
+// `state` is NULL or came from `adaptimp_state_new` or `adaptimp_state_init`.
+void adaptimp_state_free(struct AdaptimpState *state);
+
+// Back to t = 0: weights, ζ, observer, reference and applied torque as at
+// creation, the fault cleared.
+//
+// # Safety
+// `state` is NULL or valid.
+enum AdaptimpStatus adaptimp_state_reset(struct AdaptimpState *state);
+
+// True if a refused step recorded a fault (with fault policy "latch", steps
+// are refused until it is cleared); `*step` (if not NULL) gets the step at
+// which it happened. False for NULL or a dead handle.
+//
+// # Safety
+// `state` is NULL or valid; `step` is NULL or valid.
+bool adaptimp_state_fault(const struct AdaptimpState *state, uint64_t *step);
+
+// Clear the recorded fault: the documented recovery after a latched fault
+// (the next step's torque climbs from the fallback at the rate limit).
+//
+// # Safety
+// `state` is NULL or valid.
+enum AdaptimpStatus adaptimp_state_clear_fault(struct AdaptimpState *state);
+
+// Steps taken since creation or reset, or 0 for NULL or a dead handle.
+//
+// # Safety
+// `state` is NULL or valid.
+uint64_t adaptimp_state_steps(const struct AdaptimpState *state);
+
+// The torque to apply now (N m) into `tau` (`n` reals, the state's number
+// of joints): the last accepted step's sat(τ), or the fallback of a refused
+// call after it (the origin of the next step's rate limit); zero after
+// creation and reset.
+//
+// # Safety
+// `state` is NULL or valid; `tau` is NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_state_applied(const struct AdaptimpState *state,
+                                           size_t n,
+                                           double *tau);
+
+// The number of reals [`adaptimp_state_save`] writes for this state,
+// `12 + 18 n + L (2n² + n + 1)` (L the nodes), or 0 for NULL or a dead handle.
+//
+// # Safety
+// `state` is NULL or valid.
+size_t adaptimp_state_snapshot_len(const struct AdaptimpState *state);
+
+// Save the whole state into the caller's buffer `buf` of `len` reals (at
+// least [`adaptimp_state_snapshot_len`]); `*written` (if not NULL) gets the
+// number written. No allocation. The format (3): a header, n, L, the step
+// count, the reference, ζ, the observer, the last accepted position, the
+// last command, the norms, the basis, the weights, the applied torque, the
+// last measured position and a checksum; a recorded fault is not part of
+// it.
+//
+// # Safety
+// `state` is NULL or valid; `buf` is NULL or holds `len` reals.
+enum AdaptimpStatus adaptimp_state_save(const struct AdaptimpState *state,
+                                        double *buf,
+                                        size_t len,
+                                        size_t *written);
+
+// Restore into `state` a snapshot of `len` reals written by
+// [`adaptimp_state_save`], checked as Rust's `Controller::restore` and
+// Python's `Controller.restore` check it: its format, sizes and checksum,
+// and that `ctrl`'s step could have left it (the reference and ζ within
+// their ceilings, the weights' norms as stored and within the projection
+// bounds, the applied and last torques within τmax). On an error the state
+// is unchanged: BAD_SNAPSHOT (the snapshot), WRONG_STATE (a state of
+// another controller). The recorded fault is cleared.
+//
+// # Safety
+// `ctrl` and `state` are NULL or valid; `buf` is NULL or holds `len` reals.
+enum AdaptimpStatus adaptimp_state_restore(const struct AdaptimpController *ctrl,
+                                           struct AdaptimpState *state,
+                                           const double *buf,
+                                           size_t len);
+
+// One controller step at t_k = k·Ts. `q` (rad), `tau_e` (N m) and `dq`
+// (rad/s; required by PD and state feedback, may be NULL for output
+// feedback) hold `n` reals, the controller's number of joints. `setpoint` is
+// the commanded xc, ẋc, ẍc at t_k, or NULL for the controller's own
+// trajectory at t_k. No allocation.
+//
+// `*out` is written on every status, and `out->tau_sat` is the torque to
+// apply (docs/reliability.md, "The fault semantics"):
+//
+// | status | `out` | recorded in the state |
+// |---|---|---|
+// | OK | the command, `tau_sat` = sat(τ) | the step |
+// | refused by the controller: NON_FINITE, OUT_OF_RANGE, MISSING_VELOCITY, DIVERGED, FAULTED, INVALID_INPUT, WRONG_STATE (another basis) | `tau_sat` = the configured fallback, n set, the rest zero | the fault (a latched one kept), the fallback as applied torque |
+// | refused here, with a live controller and a state of its size: NULL_POINTER (`q`, `tau_e`, `out`), BAD_SIZE (`n`) | as above (nothing if `out` is NULL) | as above |
+// | no controller to ask: NULL_POINTER or BAD_HANDLE (`ctrl`, `state`), WRONG_STATE (a state of another size), INTERNAL | every field zero, n = 0 | nothing |
+//
+// So a loop applies `out->tau_sat` after any status with `out->n` equal to
+// its joints; `out->n == 0` is a programming error (stop the arm by your
+// own means). The applied torque stays readable with
+// [`adaptimp_state_applied`].
+//
+// # Safety
+// Each pointer is NULL or valid for `n` reals (`setpoint`, `out`: one struct).
+enum AdaptimpStatus adaptimp_step(const struct AdaptimpController *ctrl,
+                                  struct AdaptimpState *state,
+                                  size_t n,
+                                  const double *q,
+                                  const double *dq,
+                                  const double *tau_e,
+                                  const struct AdaptimpSetpoint *setpoint,
+                                  struct AdaptimpCommand *out);
+
+// Fill `out` with the defaults of `preset` for controller `law` and `n`
+// joints (1 … 7). Per-joint defaults declared for the paper's 2 joints (τmax,
+// the commanded circle) are broadcast from their first entry for other n.
+// BAD_SIZE for n outside 1 … 7, INVALID_CONFIG for a `law` or `preset` that
+// is not a value of its enum (two arguments swapped, say); on an error
+// `*out` is unchanged.
+//
+// # Safety
+// `out` is NULL or points to an `AdaptimpParams`.
+enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
+                                            size_t n,
+                                            AdaptimpLaw law,
+                                            AdaptimpPreset preset);
 
 #ifdef __cplusplus
 }  // extern "C"

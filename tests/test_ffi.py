@@ -7,6 +7,7 @@ import math
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -71,6 +72,72 @@ def test_the_c_paper_example_prints_the_rust_examples_metrics(examples: Path) ->
     rust = table(sh("cargo", "run", "--quiet", "--release", "--example", "paper").stdout)
     assert len(c) == 13
     assert c == rust
+
+
+def test_the_c_cartesian_example_prints_the_rust_and_python_examples_figures(
+    examples: Path,
+) -> None:
+    """examples/14_cartesian_pose in C (the Panda's joint data written in C, the
+    plant in C, the controller through the ABI), Rust and Python: the same
+    printed figures."""
+    c = sh(examples / "cartesian_pose").stdout
+    rust = sh("cargo", "run", "--quiet", "--release", "--example", "cartesian_pose").stdout
+    py = sh(sys.executable, ROOT / "examples" / "14_cartesian_pose.py").stdout
+    assert c.count("\n") == 6
+    assert "normal force on the table       = 4.545 N" in c
+    assert c == rust
+    assert c == py
+
+
+def test_the_c_examples_build_as_iso_c11_and_cxx17(examples: Path) -> None:
+    """Each example compiles alone with -std=c11 (-std=c++17) -Wall -Wextra
+    -Werror: no GNU extension (paper.c's clock_gettime needs its POSIX feature
+    macro), whatever CMake would add."""
+    for src, compiler, std in (
+        ("paper.c", "cc", "-std=c11"),
+        ("14_cartesian_pose.c", "cc", "-std=c11"),
+        ("torque_callback.cpp", "c++", "-std=c++17"),
+    ):
+        sh(
+            compiler,
+            std,
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-pedantic",
+            "-fsyntax-only",
+            "-I",
+            ROOT / "ffi" / "include",
+            ROOT / "ffi" / "examples" / src,
+        )
+
+
+def valgrind(*args: str | Path) -> str:
+    """Run under valgrind's memcheck: no error, no leak; its stderr."""
+    proc = subprocess.run(
+        [
+            "valgrind",
+            "--leak-check=full",
+            "--errors-for-leak-kinds=all",
+            "--error-exitcode=3",
+            *[str(a) for a in args],
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "ERROR SUMMARY: 0 errors" in proc.stderr
+    assert "All heap blocks were freed -- no leaks are possible" in proc.stderr
+    return proc.stderr
+
+
+def test_valgrind_finds_no_error_and_no_leak_in_the_cartesian_example(examples: Path) -> None:
+    assert shutil.which("valgrind"), "valgrind is needed (scripts/test.sh installs it)"
+    valgrind(examples / "cartesian_pose")
+    valgrind(examples / "cartesian_pose", "--abi-checks")
+    valgrind(examples / "paper", "--abi-checks")
 
 
 def test_valgrind_finds_no_error_no_leak_and_allocations_do_not_grow(examples: Path) -> None:

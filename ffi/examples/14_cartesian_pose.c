@@ -76,7 +76,7 @@ static AdaptimpStatus panda(AdaptimpChain **out) {
 
 /* The commanded pose at t (s): from (p0, R0), 5 cm along x, 4 cm down and 20
  * degrees about z in 1 s (10 s^3 - 15 s^4 + 6 s^5), then held. */
-static void target(const double p0[3], const double r0[3][3], double t, AdaptimpPoseTarget *c) {
+static void target(const double p0[3], double r0[3][3], double t, AdaptimpPoseTarget *c) {
     const double s = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
     const double f = s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
     const double df = 30.0 * s * s * (1.0 - s) * (1.0 - s);
@@ -119,7 +119,7 @@ static void tip_velocity(const AdaptimpTip *t, const double dq[N], double dp[3])
 }
 
 /* The rotation angle of a b^T (rad). */
-static double angle_between(const double a[3][3], const double b[3][3]) {
+static double angle_between(double a[3][3], double b[3][3]) {
     double r[3][3];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) r[i][j] = a[i][0] * b[j][0] + a[i][1] * b[j][1] + a[i][2] * b[j][2];
@@ -130,7 +130,7 @@ static double angle_between(const double a[3][3], const double b[3][3]) {
 /* The Cartesian controller: the outer loop with the schema's defaults (6-D),
  * the robot scenario's state feedback (hardened) with centres along the joint
  * orbit of the commanded motion, and gains matched to the inertias. */
-static int controller(const AdaptimpChain *chain, const double p0[3], const double r0[3][3],
+static int controller(const AdaptimpChain *chain, const double p0[3], double r0[3][3],
                       AdaptimpCartesian **out) {
     enum { STEPS = 1500, NODES = 32 };
     AdaptimpCartesianParams cart;

@@ -411,7 +411,7 @@ static int abi_checks(void) {
     AdaptimpCommand cmd;
     AdaptimpParams p;
     double q[3] = {0.1, 0.2, 0.3}, dq[3] = {0, 0, 0}, te[3] = {0, 0, 0};
-    double snapshot[8];
+    double snapshot[8] = {0};
     EXPECT(adaptimp_controller_new(NULL, &ctrl), ADAPTIMP_STATUS_NULL_POINTER, "params is NULL");
     EXPECT(adaptimp_params_default(&p, 8, ADAPTIMP_LAW_PD, ADAPTIMP_PRESET_PAPER),
            ADAPTIMP_STATUS_BAD_SIZE, "1 … 7");

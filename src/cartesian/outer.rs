@@ -782,7 +782,8 @@ mod tests {
         o.step(&mut st, Some(&PoseTarget::at(p, r)), &Vector::zeros())
             .unwrap();
         let before = st;
-        let cases: [(&str, fn(&mut PoseTarget)); 5] = [
+        type Edit = fn(&mut PoseTarget);
+        let cases: [(&str, Edit); 5] = [
             ("p_c[0] = 1e50", |t| t.p[0] = 1e50),
             ("p_c[1] = 2e6", |t| t.p[1] = 2e6),
             ("dp_c[2] = 2e6", |t| t.dp[2] = 2e6),

@@ -26,8 +26,10 @@ Metrics over t ≥ 2 s (p the TCP, p_d the compliant reference, F_n = −F_e,z):
 - sat: fraction of all steps with some sat(τ_i) ≠ τ_i.
 - peak: max_i max_{t ≥ 0.1 s} |τ_i| / τmax_i of the commanded τ (≤ 2: no windup).
 
-Run ``python examples/13_panda_table.py`` (T = 20 s; ``--long 120`` adds a
-long SF run reporting the weight norms); ``ADAPTIMP_QUICK=1``: T = 1 s, no figure.
+Needs the extras ``mujoco`` and ``pinocchio`` (from a checkout:
+``pip install ".[mujoco,pinocchio]"``). Run ``python examples/13_panda_table.py``
+(T = 20 s; ``--long 120`` adds a long SF run reporting the weight norms);
+``ADAPTIMP_QUICK=1``: T = 1 s, no figure.
 Writes ``docs/figures/panda_table.png``.
 """
 
@@ -124,23 +126,23 @@ def long_run(sc: ac.PandaTable, basis: Any, T: float) -> None:
     ctrl = ac.panda_controller("sf", sc, basis=basis, force_feedforward=False, **LEARN)
     plant = amj.Plant(sc.model)
     plant.reset(sc.q0)
-    substeps = max(1, round(sc.ts / plant.timestep))
-    plant.timestep = sc.ts / substeps
+    substeps = max(1, round(sc.Ts / plant.timestep))
+    plant.timestep = sc.Ts / substeps
     print(f"\nlong run, SF without τe feedforward, gravity learning, T = {T:g} s: weight norms")
     print("| t (s) | ‖W_D‖ | ‖W_C‖ | ‖W_G‖ | max |τ_i|/τmax_i applied |")
     print("|---:|---:|---:|---:|---:|")
     peak = 0.0
-    for k in range(round(T / sc.ts)):
+    for k in range(round(T / sc.Ts)):
         wrench = plant.wrench()
         tau = ctrl.step(plant.q, plant.dq, wrench)
         peak = max(peak, float(np.max(np.abs(plant.apply(tau)) / plant.tau_max)))
         plant.step(substeps)
         plant.forward()
-        if (k + 1) % round(10.0 / sc.ts) == 0:
+        if (k + 1) % round(10.0 / sc.Ts) == 0:
             sd = ctrl.inner.state_dict()
             norms = [float(np.linalg.norm(sd[w])) for w in ("W_D", "W_C", "W_G")]
             print(
-                f"| {(k + 1) * sc.ts:.0f} | "
+                f"| {(k + 1) * sc.Ts:.0f} | "
                 + " | ".join(f"{v:.3g}" for v in norms)
                 + f" | {peak:.3f} |"
             )

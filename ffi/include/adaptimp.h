@@ -282,6 +282,9 @@ typedef struct AdaptimpCartesianParams {
   bool force_feedforward;
 } AdaptimpCartesianParams;
 
+// An [`AdaptimpConditions`] as the caller passed it.
+typedef uint32_t AdaptimpConditionsRaw;
+
 // Every parameter of a controller for `n` joints (1…7): the fields of the
 // parameter schema (`adaptimp::schema::PARAMS`, group "controller"), named as
 // there, with per-joint arrays of which the first `n` entries are read.
@@ -302,6 +305,12 @@ typedef struct AdaptimpParams {
   double kp[ADAPTIMP_MAX_JOINTS];
   // Kζ (1/s), (11).
   double kzeta[ADAPTIMP_MAX_JOINTS];
+  // Inertia scale d of each joint (kg m²), SPEC §10.
+  double inertia[ADAPTIMP_MAX_JOINTS];
+  // Young weight ρ (1/s) of the auxiliary system, SPEC §10.
+  double rho;
+  // The stability conditions checked.
+  AdaptimpConditionsRaw conditions;
   // μ (N m), (11).
   double mu;
   // Inner law of the auxiliary system.
@@ -997,6 +1006,36 @@ enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
                                             size_t n,
                                             AdaptimpLaw law,
                                             AdaptimpPreset preset);
+
+// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
+// the robot scenario's parameters for `law` with the rule's gains from the
+// inertia matrix `inertia` (n × n, row-major, kg m², at the task's start),
+// the limits `tau_max` (n, N m) and the period `ts` (s), and the conditions
+// "scaled" (SPEC §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
+// one period of `period` s, evenly spaced in time) also the centres along
+// it, the learning rates and the weight bounds: the centres are written to
+// `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
+// squared widths to `widths2` (4n), and `out->centers`, `out->nodes`,
+// `out->widths2` point at them. `gravity` (n, N m, G at the path's start)
+// may be NULL. `adaptimp_controller_new(out, …)` then builds the
+// controller. `law` outside its enum is INVALID_CONFIG; a NaN or a bad
+// value is INVALID_CONFIG naming it. On an error `*out` is left unchanged.
+//
+// # Safety
+// Every pointer is NULL or valid for the lengths above; `centers` and
+// `widths2` are only read with a path.
+enum AdaptimpStatus adaptimp_params_suggest(struct AdaptimpParams *out,
+                                            size_t n,
+                                            AdaptimpLaw law,
+                                            const double *inertia,
+                                            const double *tau_max,
+                                            double ts,
+                                            const double *path,
+                                            size_t rows,
+                                            double period,
+                                            const double *gravity,
+                                            double *centers,
+                                            double *widths2);
 
 #ifdef __cplusplus
 }  // extern "C"

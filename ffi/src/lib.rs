@@ -119,6 +119,17 @@ pub enum AdaptimpAuxLaw {
     Linear = 302,
 }
 
+/// The stability conditions construction checks (SPEC §10), in the order of
+/// `Conditions::NAMES`.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpConditions {
+    /// The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 (needs inertia = 1, rho = 1).
+    Paper = 1400,
+    /// SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0.
+    Scaled = 1401,
+}
+
 /// The robust term r(z2) (SPEC §7), in the order of `RobustKind::NAMES`.
 #[repr(C)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -243,6 +254,10 @@ pub struct AdaptimpPresetRaw(pub u32);
 #[repr(transparent)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct AdaptimpAuxLawRaw(pub u32);
+/// An [`AdaptimpConditions`] as the caller passed it.
+#[repr(transparent)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct AdaptimpConditionsRaw(pub u32);
 /// An [`AdaptimpRobust`] as the caller passed it.
 #[repr(transparent)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -349,6 +364,7 @@ c_enums! {
     AdaptimpLaw / AdaptimpLawRaw: Pd, StateFeedback, OutputFeedback;
     AdaptimpPreset / AdaptimpPresetRaw: Paper, Robot;
     AdaptimpAuxLaw / AdaptimpAuxLawRaw: Default, Printed, Linear;
+    AdaptimpConditions / AdaptimpConditionsRaw: Paper, Scaled;
     AdaptimpRobust / AdaptimpRobustRaw: Sign, Tanh, Remark1, None;
     AdaptimpLearningStep / AdaptimpLearningStepRaw: Euler, Normalized;
     AdaptimpSaturationLearning / AdaptimpSaturationLearningRaw: Ignore, Freeze;
@@ -722,6 +738,7 @@ mod tests {
         values::<AdaptimpLaw>(&mut seen);
         values::<AdaptimpPreset>(&mut seen);
         values::<AdaptimpAuxLaw>(&mut seen);
+        values::<AdaptimpConditions>(&mut seen);
         values::<AdaptimpRobust>(&mut seen);
         values::<AdaptimpLearningStep>(&mut seen);
         values::<AdaptimpSaturationLearning>(&mut seen);

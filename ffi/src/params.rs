@@ -4,8 +4,8 @@
 use crate::*;
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
-    AuxLaw, Fallback, FaultPolicy, Hold, ImpedanceMode, Law, LearningStep, ObserverInit,
-    RobustKind, SaturationLearning,
+    AuxLaw, Conditions, Fallback, FaultPolicy, Hold, ImpedanceMode, Law, LearningStep,
+    ObserverInit, RobustKind, SaturationLearning,
 };
 
 /// Every parameter of a controller for `n` joints (1…7): the fields of the
@@ -30,6 +30,12 @@ pub struct AdaptimpParams {
     pub kp: [f64; ADAPTIMP_MAX_JOINTS],
     /// Kζ (1/s), (11).
     pub kzeta: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Inertia scale d of each joint (kg m²), SPEC §10.
+    pub inertia: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Young weight ρ (1/s) of the auxiliary system, SPEC §10.
+    pub rho: f64,
+    /// The stability conditions checked.
+    pub conditions: AdaptimpConditionsRaw,
     /// μ (N m), (11).
     pub mu: f64,
     /// Inner law of the auxiliary system.
@@ -155,6 +161,9 @@ pub(crate) fn scenario_of<const N: usize>(
         k1,
         kp,
         kzeta,
+        inertia,
+        rho,
+        conditions,
         mu,
         aux_law,
         robust,
@@ -196,6 +205,7 @@ pub(crate) fn scenario_of<const N: usize>(
     } = p;
     let law = decode::<AdaptimpLaw>(*law, "params.law")?;
     let aux_law = decode::<AdaptimpAuxLaw>(*aux_law, "params.aux_law")?;
+    let conditions = decode::<AdaptimpConditions>(*conditions, "params.conditions")?;
     let robust = decode::<AdaptimpRobust>(*robust, "params.robust")?;
     let learning_step = decode::<AdaptimpLearningStep>(*learning_step, "params.learning_step")?;
     let saturation_learning =
@@ -218,11 +228,17 @@ pub(crate) fn scenario_of<const N: usize>(
         AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
         AdaptimpWeightBound::Auto => Value::Str("auto"),
     };
-    let values: [(&str, Value<'_>); 40] = [
+    let values: [(&str, Value<'_>); 43] = [
         ("Ts", Value::Real(*ts)),
         ("K1", joint(k1)),
         ("Kp", joint(kp)),
         ("Kzeta", joint(kzeta)),
+        ("inertia", joint(inertia)),
+        ("rho", Value::Real(*rho)),
+        (
+            "conditions",
+            Value::Str(name_of(conditions, &Conditions::NAMES)),
+        ),
         ("mu", Value::Real(*mu)),
         ("aux_law", Value::Str(name_of(aux_law, &AuxLaw::NAMES))),
         ("robust", Value::Str(name_of(robust, &RobustKind::NAMES))),
@@ -295,7 +311,11 @@ pub(crate) fn controller_names() -> impl Iterator<Item = &'static str> {
 
 /// `out` filled with the defaults of `preset` for `law` and N joints.
 pub(crate) fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpParams) {
-    let s = Scenario::<N>::preset(preset, law);
+    fill_from(&Scenario::<N>::preset(preset, law), law, out);
+}
+
+/// `out` from the controller parameters of scenario `s` (centres: none).
+pub(crate) fn fill_from<const N: usize>(s: &Scenario<N>, law: Law, out: &mut AdaptimpParams) {
     let mut p = AdaptimpParams {
         n: N,
         law: match law {
@@ -308,6 +328,9 @@ pub(crate) fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut 
         k1: [0.0; ADAPTIMP_MAX_JOINTS],
         kp: [0.0; ADAPTIMP_MAX_JOINTS],
         kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
+        inertia: [0.0; ADAPTIMP_MAX_JOINTS],
+        rho: 0.0,
+        conditions: AdaptimpConditions::Paper.raw(),
         mu: 0.0,
         aux_law: AdaptimpAuxLaw::Default.raw(),
         robust: AdaptimpRobust::Sign.raw(),
@@ -372,6 +395,11 @@ pub(crate) fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut 
             "K1" => joint(&mut p.k1),
             "Kp" => joint(&mut p.kp),
             "Kzeta" => joint(&mut p.kzeta),
+            "inertia" => joint(&mut p.inertia),
+            "rho" => real(&mut p.rho),
+            "conditions" => {
+                p.conditions = from_name::<AdaptimpConditions>(&Conditions::NAMES, choice)
+            }
             "mu" => real(&mut p.mu),
             "aux_law" => p.aux_law = from_name::<AdaptimpAuxLaw>(&AuxLaw::NAMES, choice),
             "robust" => p.robust = from_name::<AdaptimpRobust>(&RobustKind::NAMES, choice),
@@ -469,6 +497,150 @@ pub unsafe extern "C" fn adaptimp_params_default(
     })
 }
 
+/// The inputs of [`adaptimp_params_suggest`], checked for NULL and length.
+struct Suggest<'a> {
+    law: Law,
+    inertia: &'a [f64],
+    tau_max: &'a [f64],
+    ts: f64,
+    /// Rows of 3n (q, q̇, q̈) and the period (s), or none.
+    path: Option<(&'a [f64], f64)>,
+    gravity: Option<&'a [f64]>,
+    /// Where the centres (ADAPTIMP_SUGGEST_MAX_NODES × 4n) and widths² (4n) go.
+    centers: *mut f64,
+    widths2: *mut f64,
+}
+
+fn suggest_sized<const N: usize>(
+    a: &Suggest<'_>,
+    out: &mut AdaptimpParams,
+) -> Result<(), AdaptimpStatus> {
+    use adaptimp::tuning::Rule;
+    use adaptimp::{Setpoint, Vector};
+    let rule = Rule::default();
+    let d = adaptimp::Matrix::<N>::from_row_slice(a.inertia);
+    let tau = Vector::<N>::from_column_slice(a.tau_max);
+    let mut s = Scenario::<N>::preset(Preset::Robot, a.law);
+    let config = |e| core_error(e, Context::Config);
+    let centers = match a.path {
+        None => {
+            s.config = rule.gains(a.law, &d, &tau, a.ts).map_err(config)?;
+            None
+        }
+        Some((rows, period)) => {
+            let samples: Vec<Setpoint<N>> = rows
+                .chunks_exact(3 * N)
+                .map(|r| Setpoint {
+                    x: Vector::from_column_slice(&r[..N]),
+                    dx: Vector::from_column_slice(&r[N..2 * N]),
+                    ddx: Vector::from_column_slice(&r[2 * N..]),
+                })
+                .collect();
+            let g = a.gravity.map(Vector::<N>::from_column_slice);
+            let sug = rule
+                .suggest(a.law, &d, &tau, a.ts, &samples, period, g.as_ref())
+                .map_err(config)?;
+            s.config = sug.config;
+            Some(sug.centers)
+        }
+    };
+    fill_from(&s, a.law, out);
+    if let Some(c) = centers {
+        let l = c.centers().len() / (4 * N);
+        // SAFETY (in `slice_mut`): the caller gives ADAPTIMP_SUGGEST_MAX_NODES
+        // rows of 4n reals and 4n reals, L ≤ that.
+        let dst = unsafe { slice_mut(a.centers, l * 4 * N, "centers") }?;
+        dst.copy_from_slice(c.centers());
+        let w = unsafe { slice_mut(a.widths2, 4 * N, "widths2") }?;
+        for (b, block) in c.widths2().iter().enumerate() {
+            w[b * N..(b + 1) * N].copy_from_slice(block.as_slice());
+        }
+        out.centers = a.centers;
+        out.nodes = l;
+        out.widths2 = a.widths2;
+    }
+    Ok(())
+}
+
+/// The most centres [`adaptimp_params_suggest`] places (its `centers`
+/// buffer holds this many rows of 4n reals).
+pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = adaptimp::tuning::NODES.1;
+
+/// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
+/// the robot scenario's parameters for `law` with the rule's gains from the
+/// inertia matrix `inertia` (n × n, row-major, kg m², at the task's start),
+/// the limits `tau_max` (n, N m) and the period `ts` (s), and the conditions
+/// "scaled" (SPEC §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
+/// one period of `period` s, evenly spaced in time) also the centres along
+/// it, the learning rates and the weight bounds: the centres are written to
+/// `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
+/// squared widths to `widths2` (4n), and `out->centers`, `out->nodes`,
+/// `out->widths2` point at them. `gravity` (n, N m, G at the path's start)
+/// may be NULL. `adaptimp_controller_new(out, …)` then builds the
+/// controller. `law` outside its enum is INVALID_CONFIG; a NaN or a bad
+/// value is INVALID_CONFIG naming it. On an error `*out` is left unchanged.
+///
+/// # Safety
+/// Every pointer is NULL or valid for the lengths above; `centers` and
+/// `widths2` are only read with a path.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn adaptimp_params_suggest(
+    out: *mut AdaptimpParams,
+    n: usize,
+    law: AdaptimpLawRaw,
+    inertia: *const f64,
+    tau_max: *const f64,
+    ts: f64,
+    path: *const f64,
+    rows: usize,
+    period: f64,
+    gravity: *const f64,
+    centers: *mut f64,
+    widths2: *mut f64,
+) -> AdaptimpStatus {
+    guard(|| {
+        if !(1..=ADAPTIMP_MAX_JOINTS).contains(&n) {
+            return Err(bad_n(n));
+        }
+        // SAFETY (in `out`, `slice`): checked for NULL; the caller's contract.
+        let out = unsafe { crate::out(out, "out") }?;
+        let args = Suggest {
+            law: law_of(decode::<AdaptimpLaw>(law, "law")?),
+            inertia: unsafe { slice(inertia, n * n, "inertia") }?,
+            tau_max: unsafe { slice(tau_max, n, "tau_max") }?,
+            ts,
+            path: if path.is_null() {
+                None
+            } else {
+                let len = rows
+                    .checked_mul(3 * n)
+                    .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"rows × 3n overflows"))?;
+                Some((unsafe { slice(path, len, "path") }?, period))
+            },
+            gravity: if gravity.is_null() {
+                None
+            } else {
+                Some(unsafe { slice(gravity, n, "gravity") }?)
+            },
+            centers,
+            widths2,
+        };
+        let mut filled = *out;
+        match n {
+            1 => suggest_sized::<1>(&args, &mut filled),
+            2 => suggest_sized::<2>(&args, &mut filled),
+            3 => suggest_sized::<3>(&args, &mut filled),
+            4 => suggest_sized::<4>(&args, &mut filled),
+            5 => suggest_sized::<5>(&args, &mut filled),
+            6 => suggest_sized::<6>(&args, &mut filled),
+            _ => suggest_sized::<7>(&args, &mut filled),
+        }?;
+        *out = filled;
+        Ok(())
+    })
+}
+
 /// BadSize for a number of joints outside 1 … 7.
 pub(crate) fn bad_n(n: usize) -> AdaptimpStatus {
     fail(
@@ -490,6 +662,7 @@ mod tests {
             }
         }
         check::<AdaptimpAuxLaw>(&AuxLaw::NAMES);
+        check::<AdaptimpConditions>(&Conditions::NAMES);
         check::<AdaptimpRobust>(&RobustKind::NAMES);
         check::<AdaptimpLearningStep>(&LearningStep::NAMES);
         check::<AdaptimpSaturationLearning>(&SaturationLearning::NAMES);
@@ -526,6 +699,6 @@ mod tests {
         check::<7>();
         // scenario_of sets exactly the controller group's names, in order (its
         // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 40);
+        assert_eq!(controller_names().count(), 43);
     }
 }

@@ -392,8 +392,20 @@ def config_hint(message: str, params: Mapping[str, Any]) -> str:
                     f"raise Kzeta above {_fmt(need)} for Kp = {_fmt(k)} (joint {i}), "
                     f"or lower Kp below {_fmt(top)} for Kzeta = {_fmt(z)}"
                 )
+    if "2Kζ − ρ − Kp/d" in message and kp is not None:
+        kz, d, rho = params["Kzeta"], params["inertia"], params["rho"]
+        for i, (k, z, di) in enumerate(zip(kp, kz, d)):
+            if 2.0 * z - rho - k / di <= 0.0:
+                return (
+                    f"raise Kzeta above {_fmt((rho + k / di) / 2.0)} for Kp = {_fmt(k)} and "
+                    f"inertia = {_fmt(di)} (joint {i}), or lower Kp below "
+                    f"{_fmt(max(2.0 * z - rho, 0.0) * di)}"
+                )
     if "2Kp − I" in message:
-        return "raise Kp above 0.5 on every joint"
+        return (
+            "raise Kp above 0.5 on every joint, or use conditions='scaled' (SPEC §10: "
+            "Kp > 0 with inertia scales)"
+        )
     if "Ts Γ σ < 1" in message:
         ts = params["Ts"]
         return (

@@ -23,6 +23,7 @@ import numpy as np
 
 from . import _adaptimp
 from ._adaptimp import __version__
+from ._errors import needs_extra
 from ._params import BY_NAME, check_case, check_scenario, config_hint, resolve
 
 if TYPE_CHECKING:
@@ -465,8 +466,12 @@ def sweep(
     >>> df[["Kp", "rms_z1"]].shape
     (2, 2)
     """
-    from ._api import TwoLinkArm, _Progress
+    from ._api import ProgressReport, TwoLinkArm
 
+    try:  # before any run: the result is a DataFrame
+        import pandas  # noqa: F401
+    except ImportError:
+        raise needs_extra("adaptimp.sweep()", "pandas>=1.5", "sweep") from None
     check_scenario(scenario)
     check_case(case)
     if plant not in ("rigid", "mujoco"):
@@ -487,7 +492,7 @@ def sweep(
     bar: Any = None
     report: Callable[[int, int], object] | None = None
     if progress is True:
-        bar = _Progress("sweep")
+        bar = ProgressReport("sweep")
         report = bar
     elif callable(progress):
         report = progress

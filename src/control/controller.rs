@@ -15,7 +15,7 @@
 //! advance.
 
 use crate::control::auxiliary::Auxiliary;
-use crate::control::config::{Config, Law, ObserverInit, WeightBound};
+use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound};
 use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
 use crate::control::io::{Command, Control, Measurement};
 use crate::control::observer::{HighGainObserver, ObserverState};
@@ -29,6 +29,10 @@ use crate::networks::rbf::{Basis, Grid};
 use crate::networks::simd::SimdPath;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
+
+/// The smallest inertia scale d (kg m²) and Young weight ρ (1/s), SPEC §10:
+/// 1/d and 1/ρ multiply Δτ, so a smaller one could take ζ beyond [`BOUND`].
+pub const MIN_SCALE: f64 = 1e-9;
 
 /// A validated controller of the paper: its configuration, its basis and
 /// what is precomputed from them. Immutable; see the [module docs](self).
@@ -62,12 +66,23 @@ pub struct Errors<const N: usize> {
 }
 
 impl<const N: usize> Errors<N> {
-    /// The signals the learning laws use.
+    /// The signals the learning laws use, with the learning error z2 (the
+    /// paper's, for unit inertia scales).
     pub fn signals(&self) -> Signals<N> {
         Signals {
             dalpha1: self.dalpha1,
             alpha1: self.alpha1,
             z2: self.z2,
+        }
+    }
+
+    /// The signals the learning laws use, with the learning error d∘z2 (N m s)
+    /// weighted by the inertia scales d (kg m²), SPEC (10.2): joint k's rows
+    /// learn at Γ d_k and leak at Γσ.
+    pub fn signals_scaled(&self, inertia: &Vector<N>) -> Signals<N> {
+        Signals {
+            z2: self.z2.component_mul(inertia),
+            ..self.signals()
         }
     }
 }
@@ -117,22 +132,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         }
         check::positive("Ts > 0", "Ts", cfg.ts)?;
         check::positive_vec("K1 > 0", "K1", &cfg.k1)?;
-        check::finite_slice("Kp", cfg.kp.as_slice())?;
-        check::each(
-            "2Kp − I > 0",
-            "2·Kp − 1",
-            &cfg.kp,
-            |_, kp| 2.0 * kp - 1.0,
-            true,
-        )?;
-        check::finite_slice("Kzeta", cfg.kzeta.as_slice())?;
-        check::each(
-            "2Kζ − I − KpᵀKp > 0",
-            "2·Kzeta − 1 − Kp²",
-            &cfg.kzeta,
-            |i, kz| 2.0 * kz - 1.0 - cfg.kp[i] * cfg.kp[i],
-            true,
-        )?;
+        Self::check_stability(&cfg)?;
         Self::check_magnitudes(&cfg)?;
         check::nonnegative_vec("Kd ≥ 0", "fallback_damping", &cfg.fallback_damping)?;
         cfg.limits.validate()?;
@@ -151,7 +151,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         Ok(Self {
             sat: Saturation::new(cfg.tau_max)?,
             imp: TargetImpedance::new(cfg.dd, cfg.cd, cfg.gd)?,
-            aux: Auxiliary::new(cfg.kzeta, cfg.mu, cfg.aux_law)?,
+            aux: Auxiliary::weighted(cfg.kzeta, cfg.mu, cfg.aux_law, cfg.inertia, cfg.rho)?,
             obs: HighGainObserver::new(cfg.eps, cfg.lam1, cfg.ts, cfg.observer_hold)?,
             learning: Learning::new(
                 cfg.ts,
@@ -161,13 +161,74 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
                 cfg.kappa,
                 cfg.saturation_learning,
                 bound,
-                cfg.kp.min(),
+                // min_k Kp_k/d_k (1/s; min Kp for d = 1, exactly).
+                cfg.kp.component_div(&cfg.inertia).min(),
             )?,
             robust,
             cfg,
             basis,
             simd: SimdPath::detect(),
         })
+    }
+
+    /// The stability conditions of SPEC §10 that [`Config::conditions`]
+    /// names: the paper's (13), or the inertia-scaled (10.3).
+    fn check_stability(cfg: &Config<N>) -> Result<(), Error> {
+        check::finite_slice("Kp", cfg.kp.as_slice())?;
+        check::finite_slice("Kzeta", cfg.kzeta.as_slice())?;
+        check::finite_slice("inertia", cfg.inertia.as_slice())?;
+        if let Some(i) = cfg.inertia.iter().position(|d| *d < MIN_SCALE) {
+            return Err(Error::Condition {
+                condition: "d ≥ 1e-9",
+                lhs: "inertia",
+                index: Some(i),
+                value: cfg.inertia[i],
+            });
+        }
+        check::finite("rho", cfg.rho)?;
+        if cfg.rho < MIN_SCALE {
+            return Err(Error::Condition {
+                condition: "ρ ≥ 1e-9",
+                lhs: "rho",
+                index: None,
+                value: cfg.rho,
+            });
+        }
+        match cfg.conditions {
+            Conditions::Paper => {
+                // (13) is proved with the paper's unit weights only (SPEC §10).
+                if cfg.inertia.iter().any(|d| *d != 1.0) || cfg.rho != 1.0 {
+                    return Err(Error::Invalid {
+                        what: "conditions = paper",
+                        reason: "(13) is proved for the paper's unit weights (inertia = 1, rho = 1): use conditions = scaled",
+                    });
+                }
+                check::each(
+                    "2Kp − I > 0",
+                    "2·Kp − 1",
+                    &cfg.kp,
+                    |_, kp| 2.0 * kp - 1.0,
+                    true,
+                )?;
+                check::each(
+                    "2Kζ − I − KpᵀKp > 0",
+                    "2·Kzeta − 1 − Kp²",
+                    &cfg.kzeta,
+                    |i, kz| 2.0 * kz - 1.0 - cfg.kp[i] * cfg.kp[i],
+                    true,
+                )
+            }
+            Conditions::Scaled => {
+                check::each("Kp > 0", "Kp", &cfg.kp, |_, kp| kp, true)?;
+                check::each(
+                    "2Kζ − ρ − Kp/d > 0",
+                    "2·Kzeta − rho − Kp/inertia",
+                    &cfg.kzeta,
+                    |i, kz| 2.0 * kz - cfg.rho - cfg.kp[i] / cfg.inertia[i],
+                    true,
+                )
+            }
+        }
     }
 
     /// Every gain and physical parameter at most [`PARAM_BOUND`] (1e9) in
@@ -178,6 +239,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             ("K1", &cfg.k1),
             ("Kp", &cfg.kp),
             ("Kzeta", &cfg.kzeta),
+            ("inertia", &cfg.inertia),
             ("kr", &cfg.kr),
             ("lam1", &cfg.lam1),
             ("tau_max", &cfg.tau_max),
@@ -198,6 +260,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         }
         let scalars = [
             ("mu", cfg.mu),
+            ("rho", cfg.rho),
             ("phi", cfg.phi),
             ("kD", cfg.kd),
             ("kC", cfg.kc),
@@ -564,8 +627,11 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             check::within(what, x.as_slice(), BOUND)?;
         }
         if self.cfg.law.learns() {
-            self.learning
-                .check_bounded(&st.norms, &e.signals(), self.basis.nodes())?;
+            self.learning.check_bounded(
+                &st.norms,
+                &e.signals_scaled(&self.cfg.inertia),
+                self.basis.nodes(),
+            )?;
         }
         Ok(())
     }
@@ -583,12 +649,13 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         reference: &Reference<N>,
     ) -> Result<Command<N>, Error> {
         let learns = self.cfg.law.learns();
-        let sig = e.signals();
+        let sig = e.signals_scaled(&self.cfg.inertia);
         let mut tau = self.feedback(e, &st.zeta);
         let w_norms = if learns {
             let before = st.norms;
-            // (14), (35) with +z1 (erratum, SPEC §7).
-            tau += e.z1 + self.networks(st, &m.x, v, &sig) + m.tau_e;
+            // (14), (35) with +z1 (erratum, SPEC §7), weighted d∘z1 (SPEC (10.2)).
+            tau +=
+                e.z1.component_mul(&self.cfg.inertia) + self.networks(st, &m.x, v, &sig) + m.tau_e;
             before
         } else {
             [0.0; 3]

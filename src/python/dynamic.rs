@@ -13,9 +13,10 @@ use crate::control::controller::Controller;
 use crate::control::impedance::TargetImpedance;
 use crate::control::io::{Command, Measurement};
 use crate::control::tracker::Tracker;
+use crate::control::tuning::Rule;
 use crate::error::Error;
 use crate::networks::network::{Weights, C, D, G};
-use crate::networks::rbf::{AnyBasis, Basis, Centers};
+use crate::networks::rbf::{AnyBasis, Basis, Centers, GRID_MAX_JOINTS};
 use crate::schema::{Preset, Scenario, Value};
 use crate::sim::disturb::TipPayload;
 use crate::sim::environment::{FreeSpace, Wall};
@@ -595,6 +596,8 @@ fn build_n<const N: usize>(
     let s = scenario::<N>(preset, law, items)?;
     let traj = s.trajectory()?;
     let basis = match centers {
+        // Beyond the vertex grid: the rule's default basis, SPEC §18.
+        None if N > GRID_MAX_JOINTS => AnyBasis::Centers(Rule::default().default_basis(&traj)?),
         None => AnyBasis::Grid(s.grid()?),
         Some(c) => {
             if c.widths2.len() != 4 * N {
@@ -887,7 +890,9 @@ impl<const N: usize> DynTracker for Typed<N> {
         let s2: f64 = s.iter().map(|x| x * x).sum();
         let [gd, gc, gg] = cfg.gamma;
         let gain = cfg.ts * s2 * (gd * c.ddx.norm_squared() + gc * c.dx.norm_squared() + gg);
-        (gain, cfg.kp.min())
+        // Per unit inertia scale, SPEC (10.2): joint k's rows learn at Γ d_k
+        // against Kp_k (Kp for the paper's d = 1).
+        (gain, cfg.kp.component_div(&cfg.inertia).min())
     }
 
     fn replay(

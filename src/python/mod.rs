@@ -27,6 +27,7 @@ mod arm;
 mod cartesian;
 mod dynamic;
 mod mujoco;
+mod tuning;
 
 use crate::control::config::Law;
 use crate::error::Error;
@@ -353,6 +354,22 @@ fn table(what: &str, a: &PyReadonlyArray2<'_, f64>, rows: usize, n: usize) -> Py
         )));
     }
     Ok(a.as_array().iter().copied().collect())
+}
+
+/// The rows of a reference table (xc, ẋc, ẍc, (K, n) each), checked.
+fn reference_tables(
+    n: usize,
+    reference: Option<&PyReference<'_>>,
+) -> PyResult<Option<[Vec<f64>; 3]>> {
+    let Some((x, dx, ddx)) = reference else {
+        return Ok(None);
+    };
+    let rows = x.shape()[0];
+    Ok(Some([
+        table("xc", x, rows, n)?,
+        table("dxc", dx, rows, n)?,
+        table("ddxc", ddx, rows, n)?,
+    ]))
 }
 
 /// Network weights from a dict of "D" (n, n, L), "C" (n, n, L), "G" (n, L)
@@ -794,7 +811,7 @@ impl PyController {
     }
 
     /// Sampling period Ts (s).
-    #[getter]
+    #[getter(Ts)]
     fn ts(&self, py: Python<'_>) -> f64 {
         self.lock(py).ts()
     }
@@ -1367,11 +1384,7 @@ fn simulate_mujoco<'py>(
     settle: f64,
     record_every: u64,
     progress: Option<Py<PyAny>>,
-    reference: Option<(
-        PyReadonlyArray2<'py, f64>,
-        PyReadonlyArray2<'py, f64>,
-        PyReadonlyArray2<'py, f64>,
-    )>,
+    reference: Option<PyReference<'py>>,
     fault: Option<PyFault>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let fault = fault_spec(fault)?;
@@ -1382,17 +1395,7 @@ fn simulate_mujoco<'py>(
     let items = items(params)?;
     let ctrl = controller.get();
     let n = ctrl.n;
-    let tables = match &reference {
-        None => None,
-        Some((x, dx, ddx)) => {
-            let rows = x.shape()[0];
-            Some([
-                table("xc", x, rows, n)?,
-                table("dxc", dx, rows, n)?,
-                table("ddxc", ddx, rows, n)?,
-            ])
-        }
-    };
+    let tables = reference_tables(n, reference.as_ref())?;
     let mut sim = adaptimp_mujoco::Sim::from_python(model, data)?;
     let run = dynamic::MujocoRun {
         t_final,
@@ -1616,6 +1619,14 @@ type PyMujocoJob<'py> = (
     Bound<'py, PyDict>,
     f64,
     f64,
+    Option<PyReference<'py>>,
+);
+
+/// A reference table: xc, ẋc, ẍc of every row, (K, n) each.
+type PyReference<'py> = (
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, f64>,
 );
 
 /// One MuJoCo run of a sweep: its controller, plant and settings.
@@ -1626,6 +1637,8 @@ struct MujocoJob {
     items: Vec<(String, Owned)>,
     t_final: f64,
     settle: f64,
+    /// The commanded setpoints of every row (K × n each), or the controller's own trajectory.
+    reference: Option<[Vec<f64>; 3]>,
 }
 
 /// The error of a run as a sweep reports it.
@@ -1656,7 +1669,9 @@ fn simulate_mujoco_many<'py>(
 ) -> PyResult<Bound<'py, PyList>> {
     let mut parsed = Vec::with_capacity(jobs.len());
     for job in jobs.iter() {
-        let (ctrl, model, data, spec, params, t_final, settle): PyMujocoJob<'py> = job.extract()?;
+        let (ctrl, model, data, spec, params, t_final, settle, reference): PyMujocoJob<'py> =
+            job.extract()?;
+        let reference = reference_tables(ctrl.get().n, reference.as_ref())?;
         parsed.push(MujocoJob {
             ctrl: ctrl.unbind(),
             sim: Mutex::new(adaptimp_mujoco::Sim::from_python(&model, &data)?),
@@ -1664,6 +1679,7 @@ fn simulate_mujoco_many<'py>(
             items: items(&params)?,
             t_final,
             settle,
+            reference,
         });
     }
     let results = in_parallel(py, &parsed, threads, progress, |job, stop| {
@@ -1672,7 +1688,10 @@ fn simulate_mujoco_many<'py>(
             settle: job.settle,
             every: u64::MAX,
             items: &job.items,
-            reference: None,
+            reference: job
+                .reference
+                .as_ref()
+                .map(|[x, dx, ddx]| [x.as_slice(), dx.as_slice(), ddx.as_slice()]),
             fault: None,
         };
         let mut hooks = StopHooks(stop);
@@ -1775,6 +1794,8 @@ fn defaults<'py>(py: Python<'py>, scenario: &str, n: usize) -> PyResult<Bound<'p
 mod adaptimp_module {
     use pyo3::prelude::*;
 
+    #[pymodule_export]
+    use super::tuning::{default_task, suggest};
     #[pymodule_export]
     use super::{
         defaults, metrics, schema_table, simulate, simulate_many, simulate_mujoco,

@@ -168,3 +168,38 @@ def test_valgrind_finds_no_error_no_leak_and_allocations_do_not_grow(examples: P
         assert allocs == frees
         counts.append(allocs)
     assert counts[0] == counts[1], counts
+
+
+def test_the_c_break_it_probe_finds_no_crash_hang_or_wrong_result_under_valgrind(
+    examples: Path,
+) -> None:
+    """ffi/tests/breakit.c: NULLs, sizes, enum integers, NaN/inf/huge values,
+    bit flips and truncations of snapshots, dead and foreign handles, caller
+    buffers, bad chains and rotations through the C ABI; each case is a clear
+    refusal or an accepted call whose invariants hold, and memcheck finds no
+    error and no leak in any of its processes."""
+    assert shutil.which("valgrind"), "valgrind is needed (scripts/test.sh installs it)"
+    proc = subprocess.run(
+        [
+            "valgrind",
+            "--leak-check=full",
+            "--errors-for-leak-kinds=all",
+            "--error-exitcode=3",
+            str(examples / "breakit"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    summaries = re.findall(r"ERROR SUMMARY: (\d+) errors", proc.stderr)
+    assert summaries, proc.stderr
+    assert set(summaries) == {"0"}, proc.stderr
+    m = re.search(r"^\| \*\*all\*\* \|(.*)\|$", proc.stdout, re.MULTILINE)
+    assert m, proc.stdout
+    cases, accepted, clear, crash, hang, wrong, false_refusal = (
+        int(c.strip().strip("*")) for c in m.group(1).split("|")
+    )
+    assert cases == accepted + clear > 10_000, proc.stdout
+    assert (crash, hang, wrong, false_refusal) == (0, 0, 0, 0), proc.stdout

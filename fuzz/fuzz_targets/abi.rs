@@ -71,12 +71,13 @@ fn params(input: &Input) -> Option<AdaptimpParams> {
         }
     }
     for (field, raw) in input.enums.iter().take(4) {
-        match field % 6 {
+        match field % 7 {
             0 => p.fallback = AdaptimpFallbackRaw(pick(*raw, 1100, 3)),
             1 => p.fault_policy = AdaptimpFaultPolicyRaw(pick(*raw, 1200, 2)),
             2 => p.robust = AdaptimpRobustRaw(pick(*raw, 400, 4)),
             3 => p.impedance = AdaptimpImpedanceRaw(pick(*raw, 1000, 2)),
             4 => p.weight_bound_mode = AdaptimpWeightBoundRaw(pick(*raw, 700, 3)),
+            5 => p.conditions = AdaptimpConditionsRaw(pick(*raw, 1400, 2)),
             _ => p.law = AdaptimpLawRaw(pick(*raw, 100, 3)),
         }
     }

@@ -772,8 +772,8 @@ enum AdaptimpStatus adaptimp_cartesian_step(const struct AdaptimpCartesian *cart
 // `ts` kinematically (F_e = 0) from `q0` (`n` reals, rad) along `targets`
 // (`steps` poses, one per step), keeps the joint reference (q_d, q̇_d) of
 // every max(1, ⌊steps/nodes⌋)-th step (L ≤ `nodes` samples), and makes them
-// centres with widths per block η_q = max(2 h_q, tube[0]) (rad), η_v =
-// max(2 h_v, tube[1]) (rad/s) (α1, α̇1 left out: width INFINITY). Writes
+// centres with widths per block η_q = max(2 h_q, `tube[0]`) (rad), η_v =
+// max(2 h_v, `tube[1]`) (rad/s) (α1, α̇1 left out: width INFINITY). Writes
 // the centres into `centers` (room for `nodes` rows of 4n reals; L rows
 // written), the squared widths into `widths2` (4n reals) and L into
 // `*written`: what `AdaptimpParams.centers`, `.nodes` and `.widths2` take.

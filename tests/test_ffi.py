@@ -7,6 +7,7 @@ import math
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -74,6 +75,72 @@ def test_the_c_paper_example_prints_the_rust_examples_metrics(examples: Path) ->
     assert c == rust
 
 
+def test_the_c_cartesian_example_prints_the_rust_and_python_examples_figures(
+    examples: Path,
+) -> None:
+    """examples/14_cartesian_pose in C (the Panda's joint data written in C, the
+    plant in C, the controller through the ABI), Rust and Python: the same
+    printed figures."""
+    c = sh(examples / "cartesian_pose").stdout
+    rust = sh("cargo", "run", "--quiet", "--release", "--example", "cartesian_pose").stdout
+    py = sh(sys.executable, ROOT / "examples" / "14_cartesian_pose.py").stdout
+    assert c.count("\n") == 6
+    assert "normal force on the table       = 4.545 N" in c
+    assert c == rust
+    assert c == py
+
+
+def test_the_c_examples_build_as_iso_c11_and_cxx17(examples: Path) -> None:
+    """Each example compiles alone with -std=c11 (-std=c++17) -Wall -Wextra
+    -Werror: no GNU extension (paper.c's clock_gettime needs its POSIX feature
+    macro), whatever CMake would add."""
+    for src, compiler, std in (
+        ("paper.c", "cc", "-std=c11"),
+        ("14_cartesian_pose.c", "cc", "-std=c11"),
+        ("torque_callback.cpp", "c++", "-std=c++17"),
+    ):
+        sh(
+            compiler,
+            std,
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-pedantic",
+            "-fsyntax-only",
+            "-I",
+            ROOT / "ffi" / "include",
+            ROOT / "ffi" / "examples" / src,
+        )
+
+
+def valgrind(*args: str | Path) -> str:
+    """Run under valgrind's memcheck: no error, no leak; its stderr."""
+    proc = subprocess.run(
+        [
+            "valgrind",
+            "--leak-check=full",
+            "--errors-for-leak-kinds=all",
+            "--error-exitcode=3",
+            *[str(a) for a in args],
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "ERROR SUMMARY: 0 errors" in proc.stderr
+    assert "All heap blocks were freed -- no leaks are possible" in proc.stderr
+    return proc.stderr
+
+
+def test_valgrind_finds_no_error_and_no_leak_in_the_cartesian_example(examples: Path) -> None:
+    assert shutil.which("valgrind"), "valgrind is needed (scripts/test.sh installs it)"
+    valgrind(examples / "cartesian_pose")
+    valgrind(examples / "cartesian_pose", "--abi-checks")
+    valgrind(examples / "paper", "--abi-checks")
+
+
 def test_valgrind_finds_no_error_no_leak_and_allocations_do_not_grow(examples: Path) -> None:
     assert shutil.which("valgrind"), "valgrind is needed (scripts/test.sh installs it)"
     counts = []
@@ -101,3 +168,38 @@ def test_valgrind_finds_no_error_no_leak_and_allocations_do_not_grow(examples: P
         assert allocs == frees
         counts.append(allocs)
     assert counts[0] == counts[1], counts
+
+
+def test_the_c_break_it_probe_finds_no_crash_hang_or_wrong_result_under_valgrind(
+    examples: Path,
+) -> None:
+    """ffi/tests/breakit.c: NULLs, sizes, enum integers, NaN/inf/huge values,
+    bit flips and truncations of snapshots, dead and foreign handles, caller
+    buffers, bad chains and rotations through the C ABI; each case is a clear
+    refusal or an accepted call whose invariants hold, and memcheck finds no
+    error and no leak in any of its processes."""
+    assert shutil.which("valgrind"), "valgrind is needed (scripts/test.sh installs it)"
+    proc = subprocess.run(
+        [
+            "valgrind",
+            "--leak-check=full",
+            "--errors-for-leak-kinds=all",
+            "--error-exitcode=3",
+            str(examples / "breakit"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    summaries = re.findall(r"ERROR SUMMARY: (\d+) errors", proc.stderr)
+    assert summaries, proc.stderr
+    assert set(summaries) == {"0"}, proc.stderr
+    m = re.search(r"^\| \*\*all\*\* \|(.*)\|$", proc.stdout, re.MULTILINE)
+    assert m, proc.stdout
+    cases, accepted, clear, crash, hang, wrong, false_refusal = (
+        int(c.strip().strip("*")) for c in m.group(1).split("|")
+    )
+    assert cases == accepted + clear > 10_000, proc.stdout
+    assert (crash, hang, wrong, false_refusal) == (0, 0, 0, 0), proc.stdout

@@ -16,6 +16,10 @@
  *                         median and 99.9th percentile, as the Rust
  *                         example worst_case does
  */
+/* clock_gettime and CLOCK_MONOTONIC are POSIX, not ISO C: declared by
+   <time.h> under -std=c11 only with this. */
+#define _POSIX_C_SOURCE 199309L
+
 #include "adaptimp.h"
 
 #include <math.h>
@@ -364,11 +368,12 @@ static int torques(void) {
     const AdaptimpLaw laws[3] = {ADAPTIMP_LAW_PD, ADAPTIMP_LAW_STATE_FEEDBACK,
                                  ADAPTIMP_LAW_OUTPUT_FEEDBACK};
     const char *names[3] = {"pd", "sf", "of"};
+    const AdaptimpPreset presets[2] = {ADAPTIMP_PRESET_PAPER, ADAPTIMP_PRESET_ROBOT};
     for (int l = 0; l < 3; l++) {
         for (int preset = 0; preset < 2; preset++) {
             AdaptimpController *ctrl = NULL;
             AdaptimpState *state = NULL;
-            if (!check(adaptimp_controller_new_preset((AdaptimpPreset)preset, laws[l], &ctrl),
+            if (!check(adaptimp_controller_new_preset(presets[preset], laws[l], &ctrl),
                        "controller") ||
                 !check(adaptimp_state_new(ctrl, &state), "state"))
                 return 1;
@@ -406,7 +411,7 @@ static int abi_checks(void) {
     AdaptimpCommand cmd;
     AdaptimpParams p;
     double q[3] = {0.1, 0.2, 0.3}, dq[3] = {0, 0, 0}, te[3] = {0, 0, 0};
-    double snapshot[8];
+    double snapshot[8] = {0};
     EXPECT(adaptimp_controller_new(NULL, &ctrl), ADAPTIMP_STATUS_NULL_POINTER, "params is NULL");
     EXPECT(adaptimp_params_default(&p, 8, ADAPTIMP_LAW_PD, ADAPTIMP_PRESET_PAPER),
            ADAPTIMP_STATUS_BAD_SIZE, "1 … 7");
@@ -441,7 +446,7 @@ static int abi_checks(void) {
     }
     EXPECT(adaptimp_state_save(state, snapshot, 8, NULL), ADAPTIMP_STATUS_BAD_SIZE,
            "too short");
-    EXPECT(adaptimp_state_restore(state, snapshot, 8), ADAPTIMP_STATUS_WRONG_STATE,
+    EXPECT(adaptimp_state_restore(ctrl, state, snapshot, 8), ADAPTIMP_STATUS_BAD_SNAPSHOT,
            "snapshot");
     /* A refused step returns the fallback torque (here: the last one, held). */
     const double held0 = cmd.tau_sat[0];

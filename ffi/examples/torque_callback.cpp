@@ -30,9 +30,15 @@ class AdaptiveImpedance {
 
     // One step of the 1 kHz loop: measured joint positions (rad), velocities
     // (rad/s) and external torque (N m) in, the torque to apply (N m) out.
-    // When the controller refuses a step, cmd.tau_sat holds its configured
-    // fallback (by default the last applied torque, held): the real-time
-    // loop keeps running, the error is counted, and a supervisor reads error().
+    // adaptimp_step writes cmd on every status (the table at adaptimp_step in
+    // adaptimp.h): with cmd.n == kJoints a controller answered, and
+    // cmd.tau_sat is the torque to apply: the step's, or after a refused step
+    // its configured fallback (by default the last applied torque, held), so
+    // the real-time loop keeps running, the error is counted, and a
+    // supervisor reads error(). cmd.n == 0 means no controller could be
+    // asked (a NULL or freed handle: a programming error): there is no
+    // torque to apply, and the loop is stopped (libfranka stops the robot
+    // when its control callback throws).
     Joints update(const Joints& q, const Joints& dq, const Joints& tau_ext) {
         AdaptimpCommand cmd;
         const AdaptimpStatus s = adaptimp_step(ctrl_.get(), state_.get(), kJoints, q.data(),
@@ -41,6 +47,8 @@ class AdaptiveImpedance {
             ++errors_;
             error_ = adaptimp_last_error();
         }
+        if (cmd.n != kJoints)
+            throw std::logic_error("adaptimp: no controller to ask (" + error_ + ")");
         Joints tau{};
         for (std::size_t i = 0; i < kJoints; ++i) tau[i] = cmd.tau_sat[i];
         return tau;

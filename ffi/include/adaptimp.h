@@ -21,17 +21,19 @@ typedef enum AdaptimpStatus {
   ADAPTIMP_STATUS_OK = 0,
   // A required pointer was NULL.
   ADAPTIMP_STATUS_NULL_POINTER = 1,
-  // A length or a number of joints does not match (or is out of 1…7).
+  // A length or a number of joints does not match (or is out of 1…7), or
+  // a caller buffer is too small or misaligned.
   ADAPTIMP_STATUS_BAD_SIZE = 2,
-  // The parameters violate a condition (SPEC §10) or are inconsistent.
+  // A parameter violates a condition (SPEC §10), is not finite, is not a
+  // value of its enum, or the parameters are inconsistent.
   ADAPTIMP_STATUS_INVALID_CONFIG = 3,
-  // A measurement or setpoint is not finite.
+  // A measurement or setpoint given to a step is not finite.
   ADAPTIMP_STATUS_NON_FINITE = 4,
   // PD and state feedback need the measured velocity (dq was NULL).
   ADAPTIMP_STATUS_MISSING_VELOCITY = 5,
   // The state diverged from finite inputs; reset it.
   ADAPTIMP_STATUS_DIVERGED = 6,
-  // The state or snapshot was made for another controller (joints or nodes).
+  // The state was made for another controller (joints or nodes).
   ADAPTIMP_STATUS_WRONG_STATE = 7,
   // An internal error (a Rust panic, caught at the boundary).
   ADAPTIMP_STATUS_INTERNAL = 8,
@@ -40,141 +42,261 @@ typedef enum AdaptimpStatus {
   ADAPTIMP_STATUS_OUT_OF_RANGE = 9,
   // A fault is latched: clear it with `adaptimp_state_clear_fault`.
   ADAPTIMP_STATUS_FAULTED = 10,
+  // A pointer that is not a live handle of its kind: freed, never made,
+  // or another object.
+  ADAPTIMP_STATUS_BAD_HANDLE = 11,
+  // A snapshot refused by restore: not one of this format, of another
+  // size, corrupt (its checksum), or a state this controller's step could
+  // never have left (docs/reliability.md); the state is unchanged.
+  ADAPTIMP_STATUS_BAD_SNAPSHOT = 12,
+  // A step input that is finite and within its limits but not what it
+  // must be: a rotation setpoint that is not a rotation (orthonormal to
+  // 1e-6, det +1), a quaternion that is not a unit one.
+  ADAPTIMP_STATUS_INVALID_INPUT = 13,
 } AdaptimpStatus;
 
 // Which controller (SPEC §7).
 typedef enum AdaptimpLaw {
   // Case 1: PD with the auxiliary system.
-  ADAPTIMP_LAW_PD = 0,
+  ADAPTIMP_LAW_PD = 100,
   // Case 2: adaptive neural state feedback (14).
-  ADAPTIMP_LAW_STATE_FEEDBACK = 1,
+  ADAPTIMP_LAW_STATE_FEEDBACK = 101,
   // Case 3: adaptive neural output feedback with a high-gain observer (35).
-  ADAPTIMP_LAW_OUTPUT_FEEDBACK = 2,
+  ADAPTIMP_LAW_OUTPUT_FEEDBACK = 102,
 } AdaptimpLaw;
 
-// The stability conditions construction checks (SPEC §10), in the order of
-// `Conditions::NAMES`.
-typedef enum AdaptimpConditions {
-  // The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 (needs inertia = 1, rho = 1).
-  ADAPTIMP_CONDITIONS_PAPER = 0,
-  // SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0.
-  ADAPTIMP_CONDITIONS_SCALED = 1,
-} AdaptimpConditions;
+// A scenario's defaults.
+typedef enum AdaptimpPreset {
+  // The paper scenario (Ts = 50 µs, the printed laws).
+  ADAPTIMP_PRESET_PAPER = 200,
+  // The robot scenario (Ts = 1 ms, the hardened options, SPEC §13).
+  ADAPTIMP_PRESET_ROBOT = 201,
+} AdaptimpPreset;
 
 // Inner law of the auxiliary system (SPEC §8), in the order of `AuxLaw::NAMES`.
 typedef enum AdaptimpAuxLaw {
   // ζ̇ = −Kζ ζ + Δτ inside the ball ("default").
-  ADAPTIMP_AUX_LAW_DEFAULT = 0,
+  ADAPTIMP_AUX_LAW_DEFAULT = 300,
   // ζ̇ = 0 inside the ball, as printed ("printed").
-  ADAPTIMP_AUX_LAW_PRINTED = 1,
+  ADAPTIMP_AUX_LAW_PRINTED = 301,
   // No −β term anywhere ("linear").
-  ADAPTIMP_AUX_LAW_LINEAR = 2,
+  ADAPTIMP_AUX_LAW_LINEAR = 302,
 } AdaptimpAuxLaw;
 
 // The robust term r(z2) (SPEC §7), in the order of `RobustKind::NAMES`.
 typedef enum AdaptimpRobust {
   // kr sgn(z2).
-  ADAPTIMP_ROBUST_SIGN = 0,
+  ADAPTIMP_ROBUST_SIGN = 400,
   // kr tanh(z2/φ).
-  ADAPTIMP_ROBUST_TANH = 1,
+  ADAPTIMP_ROBUST_TANH = 401,
   // Remark 1's gain, (30).
-  ADAPTIMP_ROBUST_REMARK1 = 2,
+  ADAPTIMP_ROBUST_REMARK1 = 402,
   // None.
-  ADAPTIMP_ROBUST_NONE = 3,
+  ADAPTIMP_ROBUST_NONE = 403,
 } AdaptimpRobust;
 
 // The learning step, in the order of `LearningStep::NAMES`.
 typedef enum AdaptimpLearningStep {
   // Explicit Euler of (15)–(17).
-  ADAPTIMP_LEARNING_STEP_EULER = 0,
+  ADAPTIMP_LEARNING_STEP_EULER = 500,
   // Normalised (per-step gain below κ Kp).
-  ADAPTIMP_LEARNING_STEP_NORMALIZED = 1,
+  ADAPTIMP_LEARNING_STEP_NORMALIZED = 501,
 } AdaptimpLearningStep;
 
 // Learning under saturation, in the order of `SaturationLearning::NAMES`.
 typedef enum AdaptimpSaturationLearning {
   // As printed.
-  ADAPTIMP_SATURATION_LEARNING_IGNORE = 0,
+  ADAPTIMP_SATURATION_LEARNING_IGNORE = 600,
   // Conditional integration.
-  ADAPTIMP_SATURATION_LEARNING_FREEZE = 1,
+  ADAPTIMP_SATURATION_LEARNING_FREEZE = 601,
 } AdaptimpSaturationLearning;
 
 // The projection of the weights.
 typedef enum AdaptimpWeightBound {
   // No projection.
-  ADAPTIMP_WEIGHT_BOUND_NONE = 0,
+  ADAPTIMP_WEIGHT_BOUND_NONE = 700,
   // The bounds in `weight_bound`.
-  ADAPTIMP_WEIGHT_BOUND_FIXED = 1,
+  ADAPTIMP_WEIGHT_BOUND_FIXED = 701,
   // Derived from τmax, the nodes and the trajectory's peak rates.
-  ADAPTIMP_WEIGHT_BOUND_AUTO = 2,
+  ADAPTIMP_WEIGHT_BOUND_AUTO = 702,
 } AdaptimpWeightBound;
 
 // Observer start, in the order of `ObserverInit::NAMES`.
 typedef enum AdaptimpObserverInit {
   // π(0) = 0.
-  ADAPTIMP_OBSERVER_INIT_ZERO = 0,
+  ADAPTIMP_OBSERVER_INIT_ZERO = 800,
   // π1(0) = the first measurement.
-  ADAPTIMP_OBSERVER_INIT_FIRST = 1,
+  ADAPTIMP_OBSERVER_INIT_FIRST = 801,
 } AdaptimpObserverInit;
 
 // Observer discretisation, in the order of `Hold::NAMES`.
 typedef enum AdaptimpObserverHold {
   // Zero-order hold.
-  ADAPTIMP_OBSERVER_HOLD_ZOH = 0,
+  ADAPTIMP_OBSERVER_HOLD_ZOH = 900,
   // Triangle hold.
-  ADAPTIMP_OBSERVER_HOLD_TRIANGLE = 1,
+  ADAPTIMP_OBSERVER_HOLD_TRIANGLE = 901,
 } AdaptimpObserverHold;
 
 // Where the target impedance acts, in the order of `ImpedanceMode::NAMES`.
 typedef enum AdaptimpImpedance {
   // The joint-space reference model of Dd, Cd, Gd (the paper).
-  ADAPTIMP_IMPEDANCE_JOINT = 0,
+  ADAPTIMP_IMPEDANCE_JOINT = 1000,
   // The setpoint is already the compliant reference (e.g. a Cartesian
-  // impedance outside): xd = xc.
-  ADAPTIMP_IMPEDANCE_EXTERNAL = 1,
+  // impedance outside; the joint controller of an `AdaptimpCartesian`):
+  // xd = xc.
+  ADAPTIMP_IMPEDANCE_EXTERNAL = 1001,
 } AdaptimpImpedance;
 
 // The torque a failed step returns, in the order of `Fallback::NAMES`.
 typedef enum AdaptimpFallback {
   // The last applied torque held.
-  ADAPTIMP_FALLBACK_HOLD = 0,
+  ADAPTIMP_FALLBACK_HOLD = 1100,
   // Zero torque.
-  ADAPTIMP_FALLBACK_ZERO = 1,
+  ADAPTIMP_FALLBACK_ZERO = 1101,
   // Joint damping −Kd q̇ (`fallback_damping`).
-  ADAPTIMP_FALLBACK_DAMPING = 2,
+  ADAPTIMP_FALLBACK_DAMPING = 1102,
 } AdaptimpFallback;
 
 // What a failed step does to the following ones, in the order of `FaultPolicy::NAMES`.
 typedef enum AdaptimpFaultPolicy {
   // Record the fault; the next step runs as usual.
-  ADAPTIMP_FAULT_POLICY_REPORT = 0,
+  ADAPTIMP_FAULT_POLICY_REPORT = 1200,
   // Refuse every step until `adaptimp_state_clear_fault`.
-  ADAPTIMP_FAULT_POLICY_LATCH = 1,
+  ADAPTIMP_FAULT_POLICY_LATCH = 1201,
 } AdaptimpFaultPolicy;
 
-// A scenario's defaults.
-typedef enum AdaptimpPreset {
-  // The paper scenario (Ts = 50 µs, the printed laws).
-  ADAPTIMP_PRESET_PAPER = 0,
-  // The robot scenario (Ts = 1 ms, the hardened options, SPEC §13).
-  ADAPTIMP_PRESET_ROBOT = 1,
-} AdaptimpPreset;
+// What a joint of a chain does (SPEC §16, (16.0)).
+typedef enum AdaptimpJointKind {
+  // Rigid: folded into the next origin (URDF `fixed`).
+  ADAPTIMP_JOINT_KIND_FIXED = 1300,
+  // Rotation about its axis by q (rad) (URDF `revolute`, `continuous`; MuJoCo `hinge`).
+  ADAPTIMP_JOINT_KIND_REVOLUTE = 1301,
+  // Translation along its axis by q (m) (URDF `prismatic`; MuJoCo `slide`).
+  ADAPTIMP_JOINT_KIND_PRISMATIC = 1302,
+} AdaptimpJointKind;
+
+// The 6-D Cartesian impedance over a chain and the joint controller it
+// drives (opaque; immutable: share it between threads).
+typedef struct AdaptimpCartesian AdaptimpCartesian;
+
+// The state of a Cartesian run (opaque): the outer loop's and the joint
+// controller's.
+typedef struct AdaptimpCartesianState AdaptimpCartesianState;
+
+// An arm's kinematics: a serial chain of 1 … 7 movable joints (opaque).
+typedef struct AdaptimpChain AdaptimpChain;
 
 // A validated controller description (opaque).
 typedef struct AdaptimpController AdaptimpController;
 
-// A controller's state (opaque).
+// A controller's state (opaque): on the heap ([`adaptimp_state_new`]) or in
+// a buffer of the caller's ([`adaptimp_state_init`]).
 typedef struct AdaptimpState AdaptimpState;
+
+// A rigid transform as plain data: `x_parent = rotation · x + translation`.
+typedef struct AdaptimpTransform {
+  // Translation (m).
+  double translation[3];
+  // Rotation matrix, row-major (`rotation[i][j]` = R_ij); orthonormal to
+  // 1e-6 with det +1 (the chain checks it).
+  double rotation[3][3];
+} AdaptimpTransform;
+
+// One joint of a chain description, base to tip (SPEC §16, (16.0)): a fixed
+// `origin` (the parent joint's frame → this joint's frame, URDF's
+// `<origin xyz rpy>`), a `kind`, and for a movable joint a non-zero `axis`
+// in its own frame (normalised by the chain) and an `offset`.
+typedef struct AdaptimpJoint {
+  // Fixed, revolute or prismatic (an `AdaptimpJointKind`, read as an integer).
+  AdaptimpJointKind kind;
+  // The parent joint's frame → this joint's frame (at joint value `offset`).
+  struct AdaptimpTransform origin;
+  // The axis in this joint's frame (ignored for a fixed joint).
+  double axis[3];
+  // The joint value (rad or m) at which the frame is `origin` (URDF: 0;
+  // MuJoCo: `qpos0`).
+  double offset;
+} AdaptimpJoint;
+
+// The tip of a chain at (q, q̇): the pose, the 6 × n geometric Jacobian
+// (world-aligned, at the tip) and J̇ q̇.
+typedef struct AdaptimpTip {
+  // Number of joints n.
+  size_t n;
+  // Tip position p (m), world frame.
+  double position[3];
+  // Tip rotation R (world ← tip), row-major.
+  double rotation[3][3];
+  // [J_v; J_ω], row i the task direction (x, y, z (m/rad or m/m), then
+  // rotation about x, y, z), column j the joint; the first n columns set.
+  double jacobian[6][ADAPTIMP_MAX_JOINTS];
+  // J̇ q̇ = [p̈; ω̇] at q̈ = 0 (m/s², rad/s²).
+  double bias[6];
+} AdaptimpTip;
+
+// The 6-D Cartesian impedance's parameters: the schema's group "cartesian"
+// (SPEC §16), named as there, per axis of the world frame (x, y, z). Fill it
+// with [`adaptimp_cartesian_params_default`], then change fields.
+typedef struct AdaptimpCartesianParams {
+  // Target inertia M_d of the translation (kg), > 0.
+  double md[3];
+  // Target damping B_d of the translation (N s/m), ≥ 0 (read if not `bd_critical`).
+  double bd[3];
+  // True: B_d = 2√(K_d M_d) per axis, critical, following the filtered K_d (Python's `Bd=None`).
+  bool bd_critical;
+  // Target stiffness K_d of the translation (N/m), ≥ 0.
+  double kd[3];
+  // Target inertia of the rotation (kg m²), > 0.
+  double md_rot[3];
+  // Target damping of the rotation (N m s/rad), ≥ 0 (read if not `bd_rot_critical`).
+  double bd_rot[3];
+  // True: critical damping of the rotation (Python's `Bd_rot=None`).
+  bool bd_rot_critical;
+  // Target stiffness of the rotation (N m/rad), ≥ 0; 0 on every axis:
+  // position-only (the orientation is no task).
+  double kd_rot[3];
+  // CLIK gain K_P (1/s²), > 0, Ts²·K_P < 1, (C2).
+  double clik_kp;
+  // CLIK gain K_D (1/s), > 0, Ts·K_D < 1, (C2).
+  double clik_kd;
+  // Damping λ_p of the least-squares inverse in the translation rows (m), > 0, (C3).
+  double clik_lambda;
+  // Damping λ_o of the least-squares inverse in the rotation rows, > 0, (C3).
+  double clik_lambda_rot;
+  // Null-space posture stiffness k_0 (1/s²), ≥ 0.
+  double null_k;
+  // Null-space damping d_0 (1/s), ≥ 0.
+  double null_d;
+  // Largest translation error fed to the impedance (m), > 0, (16.5);
+  // INFINITY: no clipping (Python's None).
+  double pos_error_max;
+  // Largest rotation error fed to the impedance (rad), > 0; INFINITY: no clipping.
+  double rot_error_max;
+  // Time constant (s) of the filter on jumps of the commanded pose and on
+  // stiffness changes, (16.6), ≥ 0 (0: none).
+  double target_filter;
+  // Time constant (s) of the filter on the measured wrench, ≥ 0 (0: none).
+  double force_filter;
+  // True: the joint controller gets τe = Jᵀ F_e for its +τe feedforward
+  // (C5); false: τe = 0.
+  bool force_feedforward;
+} AdaptimpCartesianParams;
+
+// An [`AdaptimpConditions`] as the caller passed it.
+typedef uint32_t AdaptimpConditionsRaw;
 
 // Every parameter of a controller for `n` joints (1…7): the fields of the
 // parameter schema (`adaptimp::schema::PARAMS`, group "controller"), named as
 // there, with per-joint arrays of which the first `n` entries are read.
-// Fill it with [`adaptimp_params_default`], then change fields.
+// Fill it with [`adaptimp_params_default`], then change fields. Every enum
+// field is read as an integer and refused (INVALID_CONFIG, naming the
+// field) if it is not a value of its enum; a NaN anywhere is a parameter
+// error (INVALID_CONFIG), as in Python.
 typedef struct AdaptimpParams {
   // Number of joints, 1…7.
   size_t n;
   // Which controller.
-  enum AdaptimpLaw law;
+  AdaptimpLaw law;
   // Sampling period Ts (s).
   double ts;
   // K1 (1/s), (7).
@@ -188,13 +310,13 @@ typedef struct AdaptimpParams {
   // Young weight ρ (1/s) of the auxiliary system, SPEC §10.
   double rho;
   // The stability conditions checked.
-  enum AdaptimpConditions conditions;
+  AdaptimpConditionsRaw conditions;
   // μ (N m), (11).
   double mu;
   // Inner law of the auxiliary system.
-  enum AdaptimpAuxLaw aux_law;
+  AdaptimpAuxLaw aux_law;
   // The robust term.
-  enum AdaptimpRobust robust;
+  AdaptimpRobust robust;
   // kr (N m) of the sign and tanh terms.
   double kr[ADAPTIMP_MAX_JOINTS];
   // φ (rad/s) of the tanh term.
@@ -202,13 +324,13 @@ typedef struct AdaptimpParams {
   // kD (kg m²), kC (N m s/rad), kG (N m) of Remark 1, (30).
   double k_remark1[3];
   // The learning step.
-  enum AdaptimpLearningStep learning_step;
+  AdaptimpLearningStep learning_step;
   // κ of the normalised step, in (0, 1].
   double kappa;
   // Learning under saturation.
-  enum AdaptimpSaturationLearning saturation_learning;
+  AdaptimpSaturationLearning saturation_learning;
   // The projection of the weights.
-  enum AdaptimpWeightBound weight_bound_mode;
+  AdaptimpWeightBound weight_bound_mode;
   // Bounds on ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ for `ADAPTIMP_WEIGHT_BOUND_FIXED`.
   double weight_bound[3];
   // Γ of D̂, Ĉ, Ĝ, (15)–(17).
@@ -220,9 +342,9 @@ typedef struct AdaptimpParams {
   // Observer λ1, (31).
   double lam1[ADAPTIMP_MAX_JOINTS];
   // Observer start.
-  enum AdaptimpObserverInit observer_init;
+  AdaptimpObserverInit observer_init;
   // Observer discretisation.
-  enum AdaptimpObserverHold observer_hold;
+  AdaptimpObserverHold observer_hold;
   // Actuator limits τmax (N m).
   double tau_max[ADAPTIMP_MAX_JOINTS];
   // Target inertia Dd (kg m²), (3).
@@ -231,8 +353,9 @@ typedef struct AdaptimpParams {
   double cd[ADAPTIMP_MAX_JOINTS];
   // Target stiffness Gd (N m/rad), (3).
   double gd[ADAPTIMP_MAX_JOINTS];
-  // Where the target impedance acts.
-  enum AdaptimpImpedance impedance;
+  // Where the target impedance acts (`ADAPTIMP_IMPEDANCE_EXTERNAL` for the
+  // joint controller of an `AdaptimpCartesian`).
+  AdaptimpImpedance impedance;
   // Width η² of the vertex grid (used when `centers` is NULL; n ≤ 3).
   double eta2;
   // User centres: `nodes` rows of 4n reals (x, v, α1, α̇1 blocks of n), or
@@ -240,8 +363,9 @@ typedef struct AdaptimpParams {
   const double *centers;
   // The number of user centres L.
   size_t nodes;
-  // Widths η_d² per input dimension (4n reals, blocks as the centres), or
-  // NULL for `eta2` in every dimension. Copied at construction.
+  // Widths η_d² per input dimension (4n reals, blocks as the centres;
+  // INFINITY: the dimension is left out), or NULL for `eta2` in every
+  // dimension. Copied at construction.
   const double *widths2;
   // The commanded trajectory, xc_i = o_i + a_i sin(ω_i t) + b_i cos(ω_i t):
   // offset o (rad), used when a step gets no setpoint.
@@ -252,23 +376,89 @@ typedef struct AdaptimpParams {
   double xc_cos[ADAPTIMP_MAX_JOINTS];
   // Angular frequency ω (rad/s).
   double xc_omega[ADAPTIMP_MAX_JOINTS];
-  // The torque a failed step returns in `AdaptimpCommand.tau_sat`.
-  enum AdaptimpFallback fallback;
+  // The torque a refused step returns in `AdaptimpCommand.tau_sat`.
+  AdaptimpFallback fallback;
   // Kd (N m s/rad) of the damping fallback.
   double fallback_damping[ADAPTIMP_MAX_JOINTS];
-  // After a failed step: go on, or latch the fault.
-  enum AdaptimpFaultPolicy fault_policy;
-  // Plausibility limit |q_i| ≤ q_max (rad; INFINITY: none).
+  // After a refused step: go on, or latch the fault.
+  AdaptimpFaultPolicy fault_policy;
+  // Plausibility limit |q_i| ≤ q_max (rad; INFINITY: none, the ceiling
+  // 1e6 rad still holds). As Python's None.
   double q_max[ADAPTIMP_MAX_JOINTS];
-  // Plausibility limit |q̇_i| ≤ dq_max (rad/s; INFINITY: none).
+  // Plausibility limit |q̇_i| ≤ dq_max (rad/s; INFINITY: none, the ceiling
+  // 1e6 rad/s still holds).
   double dq_max[ADAPTIMP_MAX_JOINTS];
-  // Plausibility limit |τe_i| ≤ tau_e_max (N m; INFINITY: none).
+  // Plausibility limit |τe_i| ≤ tau_e_max (N m; INFINITY: none, the
+  // ceiling 1e9 N m still holds).
   double tau_e_max[ADAPTIMP_MAX_JOINTS];
   // Plausibility limit on the change of q_i between samples (rad; INFINITY: none).
   double q_jump_max[ADAPTIMP_MAX_JOINTS];
   // Torque rate limit per step (N m; INFINITY: none), before saturation.
   double tau_rate_max[ADAPTIMP_MAX_JOINTS];
 } AdaptimpParams;
+
+// A commanded pose and its rates at t_k, world frame (SPEC §16). The
+// rotation is checked at every step (orthonormal to 1e-6, det +1; else
+// INVALID_INPUT and nothing changes); fill it from a unit quaternion with
+// [`adaptimp_pose_target_set_quaternion`].
+typedef struct AdaptimpPoseTarget {
+  // Position p_c (m).
+  double p[3];
+  // Velocity ṗ_c (m/s).
+  double dp[3];
+  // Acceleration p̈_c (m/s²).
+  double ddp[3];
+  // Rotation R_c (world ← tip), row-major; ignored by a position-only loop.
+  double rotation[3][3];
+  // Angular velocity ω_c (rad/s).
+  double w[3];
+  // Angular acceleration ω̇_c (rad/s²).
+  double dw[3];
+} AdaptimpPoseTarget;
+
+// What one Cartesian step computed; written on every status as
+// `AdaptimpCommand` is (see [`adaptimp_cartesian_step`]): `tau_sat` is
+// what goes to the actuators.
+typedef struct AdaptimpCartesianCommand {
+  // Number of joints; 0 when no controller could be asked (every field zero).
+  size_t n;
+  // The torque to apply (N m): sat(τ), or the joint controller's fallback.
+  double tau_sat[ADAPTIMP_MAX_JOINTS];
+  // The joint controller's commanded τ (N m).
+  double tau[ADAPTIMP_MAX_JOINTS];
+  // z1 = q_d − q (rad).
+  double z1[ADAPTIMP_MAX_JOINTS];
+  // The joint reference q_d (rad) at t_k.
+  double q_d[ADAPTIMP_MAX_JOINTS];
+  // q̇_d (rad/s).
+  double dq_d[ADAPTIMP_MAX_JOINTS];
+  // q̈_d (rad/s²).
+  double ddq_d[ADAPTIMP_MAX_JOINTS];
+  // τe = Jᵀ(q) F_e (N m) the joint controller got (zero without force feedforward).
+  double tau_e[ADAPTIMP_MAX_JOINTS];
+  // The measured tip position fk(q) (m).
+  double p[3];
+  // The measured tip rotation R(q), row-major.
+  double rotation[3][3];
+  // The compliant reference p_d (m).
+  double p_d[3];
+  // ṗ_d (m/s).
+  double dp_d[3];
+  // p̈_d (m/s²).
+  double ddp_d[3];
+  // R_d, row-major.
+  double rotation_d[3][3];
+  // ω_d (rad/s).
+  double w_d[3];
+  // ω̇_d (rad/s²).
+  double dw_d[3];
+  // The commanded position after the target filter p_t (m).
+  double p_t[3];
+  // The commanded rotation after the target filter R_t, row-major.
+  double rotation_t[3][3];
+  // The error [e_p (m); e_o (rad)] the impedance acted on (after clipping).
+  double error[6];
+} AdaptimpCartesianCommand;
 
 // A commanded setpoint at t_k: position (rad), velocity (rad/s) and
 // acceleration (rad/s²); the first n entries are read.
@@ -281,12 +471,15 @@ typedef struct AdaptimpSetpoint {
   double ddx[ADAPTIMP_MAX_JOINTS];
 } AdaptimpSetpoint;
 
-// What one step computed; the first `n` entries of each array are set.
-// `tau_sat` goes to the actuators.
+// What one step computed; the first `n` entries of each array are set, the
+// others zero. Written on every status (see [`adaptimp_step`]): `tau_sat`
+// is what goes to the actuators.
 typedef struct AdaptimpCommand {
-  // Number of joints.
+  // Number of joints; 0 when no controller could be asked (then every
+  // field is zero).
   size_t n;
-  // Applied torque sat(τ) (N m).
+  // The torque to apply (N m): sat(τ) of an accepted step, the configured
+  // fallback of a refused one.
   double tau_sat[ADAPTIMP_MAX_JOINTS];
   // Commanded torque τ (N m).
   double tau[ADAPTIMP_MAX_JOINTS];
@@ -320,16 +513,499 @@ const char *adaptimp_last_error(void);
 // The library's version, e.g. "0.1.0" (NUL-terminated, static).
 const char *adaptimp_version(void);
 
+// URDF's `<origin xyz="…" rpy="…">`: translation `xyz` (3 reals, m) and the
+// fixed-axis roll, pitch, yaw `rpy` (3 reals, rad), R = Rot_z(yaw)
+// Rot_y(pitch) Rot_x(roll). Values are checked by the chain.
+//
+// # Safety
+// `xyz` and `rpy` are NULL or hold 3 reals; `out` is NULL or valid.
+enum AdaptimpStatus adaptimp_transform_xyz_rpy(const double *xyz,
+                                               const double *rpy,
+                                               struct AdaptimpTransform *out);
+
+// A position `pos` (3 reals, m) and a quaternion `quat` = [w, x, y, z]
+// (MuJoCo's `body_pos`, `body_quat`; normalised as MuJoCo does, finite and
+// non-zero, else INVALID_CONFIG).
+//
+// # Safety
+// `pos` holds 3 reals, `quat` 4, or is NULL; `out` is NULL or valid.
+enum AdaptimpStatus adaptimp_transform_pos_quat(const double *pos,
+                                                const double *quat,
+                                                struct AdaptimpTransform *out);
+
+// A 4 × 4 homogeneous transform `m` (16 reals, row-major: [R p; 0 0 0 1]).
+// Its last row must be 0 0 0 1 (to 1e-6; else INVALID_CONFIG); R is checked
+// by the chain.
+//
+// # Safety
+// `m` is NULL or holds 16 reals; `out` is NULL or valid.
+enum AdaptimpStatus adaptimp_transform_matrix(const double *m, struct AdaptimpTransform *out);
+
+// The chain of `count` joints `joints` (base to tip, fixed ones included;
+// 1 … 7 movable) and the `tip` transform (the last joint's frame → the
+// tip; NULL: the identity) into `*out` (free it with
+// [`adaptimp_chain_free`]). Checked by the core, each error naming the
+// condition and the joint's index: a zero or non-finite axis, a rotation
+// that is not orthonormal or is a reflection, an origin beyond 1e6 m
+// (INVALID_CONFIG); a `kind` that is not an `AdaptimpJointKind`
+// (INVALID_CONFIG); no or more than 7 movable joints (BAD_SIZE).
+//
+// # Safety
+// `joints` is NULL or holds `count` joints; `tip` and `out` are NULL or valid.
+enum AdaptimpStatus adaptimp_chain_new(const struct AdaptimpJoint *joints,
+                                       size_t count,
+                                       const struct AdaptimpTransform *tip,
+                                       struct AdaptimpChain **out);
+
+// Free a chain (NULL and dead handles are ignored). A Cartesian controller
+// keeps its own copy: the chain can be freed after `adaptimp_cartesian_new`.
+//
+// # Safety
+// `chain` is NULL or came from `adaptimp_chain_new`.
+void adaptimp_chain_free(struct AdaptimpChain *chain);
+
+// The chain's number of movable joints, or 0 for NULL or a dead handle.
+//
+// # Safety
+// `chain` is NULL or valid.
+size_t adaptimp_chain_joints(const struct AdaptimpChain *chain);
+
+// The tip at q (rad or m, `n` reals) and q̇ (`n` reals; NULL: zero) into
+// `*out`: pose, Jacobian, J̇ q̇ (the core's one pass, (16.0)). NON_FINITE
+// for a q or q̇ that is not finite; BAD_SIZE for n ≠ the chain's.
+//
+// # Safety
+// `chain` and `out` are NULL or valid; `q`, `dq` NULL or hold `n` reals.
+enum AdaptimpStatus adaptimp_chain_tip(const struct AdaptimpChain *chain,
+                                       size_t n,
+                                       const double *q,
+                                       const double *dq,
+                                       struct AdaptimpTip *out);
+
+// Fill `out` with the schema's defaults of the group "cartesian" (SPEC
+// §16: M_d = 2 kg, K_d = 500 N/m, critical damping, M_d,rot = 0.08 kg m²,
+// K_d,rot = 20 N m/rad, …; no clipping).
+//
+// # Safety
+// `out` is NULL or points to an `AdaptimpCartesianParams`.
+enum AdaptimpStatus adaptimp_cartesian_params_default(struct AdaptimpCartesianParams *out);
+
+// The 6-D Cartesian impedance of `cart` over `chain` (copied), driving the
+// joint controller of `joint` (its `n` the chain's, `impedance` =
+// `ADAPTIMP_IMPEDANCE_EXTERNAL`: the Cartesian impedance is the only one),
+// at the joint controller's period Ts, into `*out` (free it with
+// [`adaptimp_cartesian_free`]). Every condition is the core's
+// (INVALID_CONFIG naming it); BAD_SIZE if `joint.n` is not the chain's.
+//
+// # Safety
+// `chain`, `cart`, `joint` and `out` are NULL or valid (and `joint`'s
+// pointers as `adaptimp_controller_new` says).
+enum AdaptimpStatus adaptimp_cartesian_new(const struct AdaptimpChain *chain,
+                                           const struct AdaptimpCartesianParams *cart,
+                                           const struct AdaptimpParams *joint,
+                                           struct AdaptimpCartesian **out);
+
+// Free a Cartesian controller (NULL and dead handles are ignored). Free its
+// states first.
+//
+// # Safety
+// `cart` is NULL or came from `adaptimp_cartesian_new`.
+void adaptimp_cartesian_free(struct AdaptimpCartesian *cart);
+
+// The number of joints, or 0 for NULL or a dead handle.
+//
+// # Safety
+// `cart` is NULL or valid.
+size_t adaptimp_cartesian_joints(const struct AdaptimpCartesian *cart);
+
+// The period Ts (s), or NaN for NULL or a dead handle.
+//
+// # Safety
+// `cart` is NULL or valid.
+double adaptimp_cartesian_period(const struct AdaptimpCartesian *cart);
+
+// A state at t = 0 of `cart` into `*out`, on the heap (free it with
+// [`adaptimp_cartesian_state_free`]), started at `q0` (`n` reals, rad: the
+// measured start; the joint reference q_d(0) and the null-space posture).
+// The first step's target should be near fk(q0) (the inverse kinematics
+// pulls fk(q_d) onto it). For a state in memory of your own, see
+// [`adaptimp_cartesian_state_init`].
+//
+// # Safety
+// `cart` and `out` are NULL or valid; `q0` is NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_cartesian_state_new(const struct AdaptimpCartesian *cart,
+                                                 size_t n,
+                                                 const double *q0,
+                                                 struct AdaptimpCartesianState **out);
+
+// The size (bytes) and alignment a caller buffer for a state of `cart`
+// needs ([`adaptimp_cartesian_state_init`]).
+//
+// # Safety
+// `cart` is NULL or valid; `size` and `align` are NULL or valid.
+enum AdaptimpStatus adaptimp_cartesian_state_buffer_size(const struct AdaptimpCartesian *cart,
+                                                         size_t *size,
+                                                         size_t *align);
+
+// A state of `cart` started at `q0` in the caller's buffer `buf` of `size`
+// bytes, no allocation: as [`adaptimp_state_init`] for a joint state (the
+// buffer stays put and unused otherwise while the state lives;
+// [`adaptimp_cartesian_state_free`] ends its life and frees nothing).
+//
+// # Safety
+// `cart` and `out` are NULL or valid; `q0` NULL or `n` reals; `buf` NULL or
+// `size` writable bytes that nothing else uses while the state lives.
+enum AdaptimpStatus adaptimp_cartesian_state_init(const struct AdaptimpCartesian *cart,
+                                                  size_t n,
+                                                  const double *q0,
+                                                  void *buf,
+                                                  size_t size,
+                                                  struct AdaptimpCartesianState **out);
+
+// Free a Cartesian state (NULL and dead handles ignored); for one in a
+// caller buffer, end its life (nothing is freed).
+//
+// # Safety
+// `state` is NULL or came from `adaptimp_cartesian_state_new` or `_init`.
+void adaptimp_cartesian_state_free(struct AdaptimpCartesianState *state);
+
+// Back to t = 0: the outer loop started at `q0` (`n` reals; NULL: the
+// start's), the null-space posture kept, the joint state as at creation.
+//
+// # Safety
+// `cart` and `state` are NULL or valid; `q0` NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_cartesian_state_reset(const struct AdaptimpCartesian *cart,
+                                                   struct AdaptimpCartesianState *state,
+                                                   size_t n,
+                                                   const double *q0);
+
+// The null-space posture (rad, `n` reals, finite) from the next step on.
+//
+// # Safety
+// `state` is NULL or valid; `posture` NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_cartesian_set_posture(struct AdaptimpCartesianState *state,
+                                                   size_t n,
+                                                   const double *posture);
+
+// Ask for the stiffness `kd` (3 reals, N/m) and `kd_rot` (3 reals, N m/rad):
+// the impedance moves to it through the target filter, (16.6). The core
+// checks it (≥ 0, finite, ≤ 1e9, none > 0 for a position-only loop:
+// INVALID_CONFIG, nothing changed).
+//
+// # Safety
+// `cart`, `state` NULL or valid; `kd`, `kd_rot` NULL or hold 3 reals.
+enum AdaptimpStatus adaptimp_cartesian_set_stiffness(const struct AdaptimpCartesian *cart,
+                                                     struct AdaptimpCartesianState *state,
+                                                     const double *kd,
+                                                     const double *kd_rot);
+
+// True if a refused step recorded a fault in the joint controller's state
+// (as [`adaptimp_state_fault`]); `*step` gets its step. False for NULL.
+//
+// # Safety
+// `state` is NULL or valid; `step` is NULL or valid.
+bool adaptimp_cartesian_state_fault(const struct AdaptimpCartesianState *state, uint64_t *step);
+
+// Clear the recorded fault (as [`adaptimp_state_clear_fault`]).
+//
+// # Safety
+// `state` is NULL or valid.
+enum AdaptimpStatus adaptimp_cartesian_state_clear_fault(struct AdaptimpCartesianState *state);
+
+// Steps taken since creation or reset, or 0 for NULL or a dead handle.
+//
+// # Safety
+// `state` is NULL or valid.
+uint64_t adaptimp_cartesian_state_steps(const struct AdaptimpCartesianState *state);
+
+// The torque to apply now (N m, `n` reals), as [`adaptimp_state_applied`].
+//
+// # Safety
+// `state` is NULL or valid; `tau` NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_cartesian_state_applied(const struct AdaptimpCartesianState *state,
+                                                     size_t n,
+                                                     double *tau);
+
+// The unit quaternion `quat` = [w, x, y, z] as `target`'s rotation matrix
+// (the core's conversion: a quaternion whose norm is not 1 to 1e-6, or not
+// finite, is refused with INVALID_INPUT and `target` is unchanged).
+//
+// # Safety
+// `target` is NULL or valid; `quat` NULL or holds 4 reals.
+enum AdaptimpStatus adaptimp_pose_target_set_quaternion(struct AdaptimpPoseTarget *target,
+                                                        const double *quat);
+
+// One Cartesian step at t_k = k·Ts (SPEC §16, (C0)–(C5)): the measured q
+// (rad, `n` reals), q̇ (rad/s, `n` reals; NULL for output feedback), the
+// measured wrench F_e = [f (N); m (N m)] (6 reals, world frame, what the
+// tip exerts on the environment, the moment about the tip) and the
+// commanded pose `target` (NULL: hold the last one; at the first step the
+// start pose fk(q0)) in; the command out. The outer loop is staged, the
+// joint step runs, and only if it succeeds is anything committed: on a
+// refusal both states are as before but for the refusal, recorded in the
+// joint state as a refused joint step (the fault semantics of
+// docs/reliability.md). No allocation.
+//
+// `*out` is written on every status, as [`adaptimp_step`]'s table says:
+// the command on OK; the joint controller's fallback in `tau_sat` (n set,
+// the rest zero) on a refusal by the core (NON_FINITE, OUT_OF_RANGE,
+// INVALID_INPUT for a target rotation that is not one, MISSING_VELOCITY,
+// FAULTED, …) or by this front with live handles of one size
+// (NULL_POINTER for `q`, `wrench`, `out`; BAD_SIZE for `n`), the refusal
+// recorded; every field zero with n = 0 when there is no controller to ask
+// (NULL or dead `cart` or `state`, WRONG_STATE, INTERNAL).
+//
+// # Safety
+// Each pointer is NULL or valid for what it holds (`q`, `dq`: `n` reals;
+// `wrench`: 6; `target`, `out`: one struct).
+enum AdaptimpStatus adaptimp_cartesian_step(const struct AdaptimpCartesian *cart,
+                                            struct AdaptimpCartesianState *state,
+                                            size_t n,
+                                            const double *q,
+                                            const double *dq,
+                                            const double *wrench,
+                                            const struct AdaptimpPoseTarget *target,
+                                            struct AdaptimpCartesianCommand *out);
+
+// RBF centres along the joint orbit of a Cartesian path (SPEC §15, (15.2),
+// and §16): the core runs the outer loop of `cart` over `chain` at period
+// `ts` kinematically (F_e = 0) from `q0` (`n` reals, rad) along `targets`
+// (`steps` poses, one per step), keeps the joint reference (q_d, q̇_d) of
+// every max(1, ⌊steps/nodes⌋)-th step (L ≤ `nodes` samples), and makes them
+// centres with widths per block η_q = max(2 h_q, `tube[0]`) (rad), η_v =
+// max(2 h_v, `tube[1]`) (rad/s) (α1, α̇1 left out: width INFINITY). Writes
+// the centres into `centers` (room for `nodes` rows of 4n reals; L rows
+// written), the squared widths into `widths2` (4n reals) and L into
+// `*written`: what `AdaptimpParams.centers`, `.nodes` and `.widths2` take.
+//
+// # Safety
+// `chain`, `cart` NULL or valid; `q0` NULL or `n` reals; `targets` NULL or
+// `steps` poses; `tube` NULL or 2 reals; `centers` NULL or `nodes × 4n`
+// reals; `widths2` NULL or `4n` reals; `written` NULL or valid.
+enum AdaptimpStatus adaptimp_cartesian_orbit_centres(const struct AdaptimpChain *chain,
+                                                     const struct AdaptimpCartesianParams *cart,
+                                                     double ts,
+                                                     size_t n,
+                                                     const double *q0,
+                                                     const struct AdaptimpPoseTarget *targets,
+                                                     size_t steps,
+                                                     size_t nodes,
+                                                     const double *tube,
+                                                     double *centers,
+                                                     double *widths2,
+                                                     size_t *written);
+
+// Validate `params` (SPEC §10 and every other condition) and build a
+// controller into `*out` (free it with [`adaptimp_controller_free`]). On an
+// error `*out` is left unchanged: INVALID_CONFIG (a condition, a NaN, an
+// enum value), BAD_SIZE (n), NULL_POINTER.
+//
+// # Safety
+// `params` and `out` are NULL or valid; `params.centers` and
+// `params.widths2` are NULL or hold `nodes × 4n` and `4n` reals.
+enum AdaptimpStatus adaptimp_controller_new(const struct AdaptimpParams *params,
+                                            struct AdaptimpController **out);
+
+// The controller of `preset` for the paper's 2-link arm (the 256-node grid,
+// the paper's circle as the default trajectory). A `preset` or `law` that
+// is not a value of its enum (the two swapped, say) is refused
+// (INVALID_CONFIG).
+//
+// # Safety
+// `out` is NULL or valid.
+enum AdaptimpStatus adaptimp_controller_new_preset(AdaptimpPreset preset,
+                                                   AdaptimpLaw law,
+                                                   struct AdaptimpController **out);
+
+// Free a controller (NULL is ignored, and so is a pointer that is not a
+// live controller: freeing twice is the caller's bug, made unlikely to do
+// harm). Free its states first: a state does not keep its controller alive.
+//
+// # Safety
+// `ctrl` is NULL or came from `adaptimp_controller_new*`.
+void adaptimp_controller_free(struct AdaptimpController *ctrl);
+
+// The controller's number of joints, or 0 for NULL or a dead handle.
+//
+// # Safety
+// `ctrl` is NULL or valid.
+size_t adaptimp_controller_joints(const struct AdaptimpController *ctrl);
+
+// The controller's sampling period Ts (s), or NaN for NULL or a dead handle.
+//
+// # Safety
+// `ctrl` is NULL or valid.
+double adaptimp_controller_period(const struct AdaptimpController *ctrl);
+
+// A state at t = 0 for `ctrl` into `*out`, on the heap (free it with
+// [`adaptimp_state_free`]). This allocates; the step does not. For a state
+// in memory of your own (firmware), see [`adaptimp_state_init`].
+//
+// # Safety
+// `ctrl` and `out` are NULL or valid.
+enum AdaptimpStatus adaptimp_state_new(const struct AdaptimpController *ctrl,
+                                       struct AdaptimpState **out);
+
+// The size (bytes) and alignment a caller buffer for a state of `ctrl`
+// needs ([`adaptimp_state_init`]): fixed for a controller and a build of
+// the library.
+//
+// # Safety
+// `ctrl` is NULL or valid; `size` and `align` are NULL or valid.
+enum AdaptimpStatus adaptimp_state_buffer_size(const struct AdaptimpController *ctrl,
+                                               size_t *size,
+                                               size_t *align);
+
+// A state at t = 0 for `ctrl` in the caller's buffer `buf` of `size` bytes
+// (at least what [`adaptimp_state_buffer_size`] says, aligned as it says),
+// no allocation: for firmware without a heap, or to place the state
+// yourself. `*out` gets the handle (it points into `buf`); use it as any
+// state. The buffer must stay where it is and must not be used otherwise
+// while the state lives (a state cannot be moved or copied bytewise: save
+// and restore it); [`adaptimp_state_free`] ends its life and gives the
+// buffer back (it frees nothing). BAD_SIZE for a buffer too small or
+// misaligned.
+//
+// # Safety
+// `ctrl` and `out` are NULL or valid; `buf` is NULL or `size` writable
+// bytes that nothing else uses while the state lives.
+enum AdaptimpStatus adaptimp_state_init(const struct AdaptimpController *ctrl,
+                                        void *buf,
+                                        size_t size,
+                                        struct AdaptimpState **out);
+
+// Free a state (NULL is ignored, and so is a pointer that is not a live
+// state): a heap state's memory is freed; a state in a caller buffer
+// ([`adaptimp_state_init`]) ends its life and its buffer is the caller's
+// again. Using a state after this is refused (BAD_HANDLE) as long as its
+// memory was not reused.
+//
+// # Safety
+// `state` is NULL or came from `adaptimp_state_new` or `adaptimp_state_init`.
+void adaptimp_state_free(struct AdaptimpState *state);
+
+// Back to t = 0: weights, ζ, observer, reference and applied torque as at
+// creation, the fault cleared.
+//
+// # Safety
+// `state` is NULL or valid.
+enum AdaptimpStatus adaptimp_state_reset(struct AdaptimpState *state);
+
+// True if a refused step recorded a fault (with fault policy "latch", steps
+// are refused until it is cleared); `*step` (if not NULL) gets the step at
+// which it happened. False for NULL or a dead handle.
+//
+// # Safety
+// `state` is NULL or valid; `step` is NULL or valid.
+bool adaptimp_state_fault(const struct AdaptimpState *state, uint64_t *step);
+
+// Clear the recorded fault: the documented recovery after a latched fault
+// (the next step's torque climbs from the fallback at the rate limit).
+//
+// # Safety
+// `state` is NULL or valid.
+enum AdaptimpStatus adaptimp_state_clear_fault(struct AdaptimpState *state);
+
+// Steps taken since creation or reset, or 0 for NULL or a dead handle.
+//
+// # Safety
+// `state` is NULL or valid.
+uint64_t adaptimp_state_steps(const struct AdaptimpState *state);
+
+// The torque to apply now (N m) into `tau` (`n` reals, the state's number
+// of joints): the last accepted step's sat(τ), or the fallback of a refused
+// call after it (the origin of the next step's rate limit); zero after
+// creation and reset.
+//
+// # Safety
+// `state` is NULL or valid; `tau` is NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_state_applied(const struct AdaptimpState *state,
+                                           size_t n,
+                                           double *tau);
+
+// The number of reals [`adaptimp_state_save`] writes for this state,
+// `12 + 18 n + L (2n² + n + 1)` (L the nodes), or 0 for NULL or a dead handle.
+//
+// # Safety
+// `state` is NULL or valid.
+size_t adaptimp_state_snapshot_len(const struct AdaptimpState *state);
+
+// Save the whole state into the caller's buffer `buf` of `len` reals (at
+// least [`adaptimp_state_snapshot_len`]); `*written` (if not NULL) gets the
+// number written. No allocation. The format (3): a header, n, L, the step
+// count, the reference, ζ, the observer, the last accepted position, the
+// last command, the norms, the basis, the weights, the applied torque, the
+// last measured position and a checksum; a recorded fault is not part of
+// it.
+//
+// # Safety
+// `state` is NULL or valid; `buf` is NULL or holds `len` reals.
+enum AdaptimpStatus adaptimp_state_save(const struct AdaptimpState *state,
+                                        double *buf,
+                                        size_t len,
+                                        size_t *written);
+
+// Restore into `state` a snapshot of `len` reals written by
+// [`adaptimp_state_save`], checked as Rust's `Controller::restore` and
+// Python's `Controller.restore` check it: its format, sizes and checksum,
+// and that `ctrl`'s step could have left it (the reference and ζ within
+// their ceilings, the weights' norms as stored and within the projection
+// bounds, the applied and last torques within τmax). On an error the state
+// is unchanged: BAD_SNAPSHOT (the snapshot), WRONG_STATE (a state of
+// another controller). The recorded fault is cleared.
+//
+// # Safety
+// `ctrl` and `state` are NULL or valid; `buf` is NULL or holds `len` reals.
+enum AdaptimpStatus adaptimp_state_restore(const struct AdaptimpController *ctrl,
+                                           struct AdaptimpState *state,
+                                           const double *buf,
+                                           size_t len);
+
+// One controller step at t_k = k·Ts. `q` (rad), `tau_e` (N m) and `dq`
+// (rad/s; required by PD and state feedback, may be NULL for output
+// feedback) hold `n` reals, the controller's number of joints. `setpoint` is
+// the commanded xc, ẋc, ẍc at t_k, or NULL for the controller's own
+// trajectory at t_k. No allocation.
+//
+// `*out` is written on every status, and `out->tau_sat` is the torque to
+// apply (docs/reliability.md, "The fault semantics"):
+//
+// | status | `out` | recorded in the state |
+// |---|---|---|
+// | OK | the command, `tau_sat` = sat(τ) | the step |
+// | refused by the controller: NON_FINITE, OUT_OF_RANGE, MISSING_VELOCITY, DIVERGED, FAULTED, INVALID_INPUT, WRONG_STATE (another basis) | `tau_sat` = the configured fallback, n set, the rest zero | the fault (a latched one kept), the fallback as applied torque |
+// | refused here, with a live controller and a state of its size: NULL_POINTER (`q`, `tau_e`, `out`), BAD_SIZE (`n`) | as above (nothing if `out` is NULL) | as above |
+// | no controller to ask: NULL_POINTER or BAD_HANDLE (`ctrl`, `state`), WRONG_STATE (a state of another size), INTERNAL | every field zero, n = 0 | nothing |
+//
+// So a loop applies `out->tau_sat` after any status with `out->n` equal to
+// its joints; `out->n == 0` is a programming error (stop the arm by your
+// own means). The applied torque stays readable with
+// [`adaptimp_state_applied`].
+//
+// # Safety
+// Each pointer is NULL or valid for `n` reals (`setpoint`, `out`: one struct).
+enum AdaptimpStatus adaptimp_step(const struct AdaptimpController *ctrl,
+                                  struct AdaptimpState *state,
+                                  size_t n,
+                                  const double *q,
+                                  const double *dq,
+                                  const double *tau_e,
+                                  const struct AdaptimpSetpoint *setpoint,
+                                  struct AdaptimpCommand *out);
+
 // Fill `out` with the defaults of `preset` for controller `law` and `n`
 // joints (1 … 7). Per-joint defaults declared for the paper's 2 joints (τmax,
 // the commanded circle) are broadcast from their first entry for other n.
+// BAD_SIZE for n outside 1 … 7, INVALID_CONFIG for a `law` or `preset` that
+// is not a value of its enum (two arguments swapped, say); on an error
+// `*out` is unchanged.
 //
 // # Safety
 // `out` is NULL or points to an `AdaptimpParams`.
 enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
                                             size_t n,
-                                            enum AdaptimpLaw law,
-                                            enum AdaptimpPreset preset);
+                                            AdaptimpLaw law,
+                                            AdaptimpPreset preset);
 
 // The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
 // the robot scenario's parameters for `law` with the rule's gains from the
@@ -342,14 +1018,15 @@ enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
 // squared widths to `widths2` (4n), and `out->centers`, `out->nodes`,
 // `out->widths2` point at them. `gravity` (n, N m, G at the path's start)
 // may be NULL. `adaptimp_controller_new(out, …)` then builds the
-// controller. On an error `*out` is left unchanged.
+// controller. `law` outside its enum is INVALID_CONFIG; a NaN or a bad
+// value is INVALID_CONFIG naming it. On an error `*out` is left unchanged.
 //
 // # Safety
 // Every pointer is NULL or valid for the lengths above; `centers` and
 // `widths2` are only read with a path.
 enum AdaptimpStatus adaptimp_params_suggest(struct AdaptimpParams *out,
                                             size_t n,
-                                            enum AdaptimpLaw law,
+                                            AdaptimpLaw law,
                                             const double *inertia,
                                             const double *tau_max,
                                             double ts,
@@ -359,131 +1036,6 @@ enum AdaptimpStatus adaptimp_params_suggest(struct AdaptimpParams *out,
                                             const double *gravity,
                                             double *centers,
                                             double *widths2);
-
-// Validate `params` (SPEC §10 and every other condition) and build a
-// controller into `*out` (free it with [`adaptimp_controller_free`]). On an
-// error `*out` is left unchanged.
-//
-// # Safety
-// `params` and `out` are NULL or valid; `params.centers` and
-// `params.widths2` are NULL or hold `nodes × 4n` and `4n` reals.
-enum AdaptimpStatus adaptimp_controller_new(const struct AdaptimpParams *params,
-                                            struct AdaptimpController **out);
-
-// The controller of `preset` for the paper's 2-link arm (the 256-node grid,
-// the paper's circle as the default trajectory).
-//
-// # Safety
-// `out` is NULL or valid.
-enum AdaptimpStatus adaptimp_controller_new_preset(enum AdaptimpPreset preset,
-                                                   enum AdaptimpLaw law,
-                                                   struct AdaptimpController **out);
-
-// Free a controller (NULL is ignored). Its states must be freed too.
-//
-// # Safety
-// `ctrl` is NULL or came from `adaptimp_controller_new*` and is not used again.
-void adaptimp_controller_free(struct AdaptimpController *ctrl);
-
-// The controller's number of joints, or 0 for NULL.
-//
-// # Safety
-// `ctrl` is NULL or valid.
-size_t adaptimp_controller_joints(const struct AdaptimpController *ctrl);
-
-// The controller's sampling period Ts (s), or NaN for NULL.
-//
-// # Safety
-// `ctrl` is NULL or valid.
-double adaptimp_controller_period(const struct AdaptimpController *ctrl);
-
-// A state at t = 0 for `ctrl` into `*out` (free it with
-// [`adaptimp_state_free`]). This allocates; the step does not.
-//
-// # Safety
-// `ctrl` and `out` are NULL or valid.
-enum AdaptimpStatus adaptimp_state_new(const struct AdaptimpController *ctrl,
-                                       struct AdaptimpState **out);
-
-// Free a state (NULL is ignored).
-//
-// # Safety
-// `state` is NULL or came from `adaptimp_state_new` and is not used again.
-void adaptimp_state_free(struct AdaptimpState *state);
-
-// Back to t = 0: weights, ζ, observer and reference as at creation.
-//
-// # Safety
-// `state` is NULL or valid.
-enum AdaptimpStatus adaptimp_state_reset(struct AdaptimpState *state);
-
-// True if a failed step recorded a fault (with fault policy "latch", steps
-// are refused until it is cleared); `*step` (if not NULL) gets the step at
-// which it happened. False for NULL.
-//
-// # Safety
-// `state` is NULL or valid; `step` is NULL or valid.
-bool adaptimp_state_fault(const struct AdaptimpState *state, uint64_t *step);
-
-// Clear the recorded fault: the documented recovery after a latched fault.
-//
-// # Safety
-// `state` is NULL or valid.
-enum AdaptimpStatus adaptimp_state_clear_fault(struct AdaptimpState *state);
-
-// Steps taken since creation or reset, or 0 for NULL.
-//
-// # Safety
-// `state` is NULL or valid.
-uint64_t adaptimp_state_steps(const struct AdaptimpState *state);
-
-// The number of reals [`adaptimp_state_save`] writes for this state, or 0 for NULL.
-//
-// # Safety
-// `state` is NULL or valid.
-size_t adaptimp_state_snapshot_len(const struct AdaptimpState *state);
-
-// Save the whole state into the caller's buffer `buf` of `len` reals (at
-// least [`adaptimp_state_snapshot_len`]); `*written` (if not NULL) gets the
-// number written. No allocation.
-//
-// # Safety
-// `state` is NULL or valid; `buf` is NULL or holds `len` reals.
-enum AdaptimpStatus adaptimp_state_save(const struct AdaptimpState *state,
-                                        double *buf,
-                                        size_t len,
-                                        size_t *written);
-
-// Restore a snapshot of `len` reals written by [`adaptimp_state_save`] for a
-// state of the same controller. Everything is checked first: on an error the
-// state is unchanged.
-//
-// # Safety
-// `state` is NULL or valid; `buf` is NULL or holds `len` reals.
-enum AdaptimpStatus adaptimp_state_restore(struct AdaptimpState *state,
-                                           const double *buf,
-                                           size_t len);
-
-// One controller step at t_k = k·Ts. `q` (rad), `tau_e` (N m) and `dq`
-// (rad/s; required by PD and state feedback, may be NULL for output
-// feedback) hold `n` reals, the controller's number of joints. `setpoint` is
-// the commanded xc, ẋc, ẍc at t_k, or NULL for the controller's own
-// trajectory at t_k. On success `*out` holds the command (`tau_sat` goes to
-// the actuators). If the controller refuses the step (a non-finite or
-// implausible input, a latched fault), the state is unchanged but for the
-// recorded fault, and `out->tau_sat` holds the configured fallback torque
-// (the other fields zero): apply it. No allocation.
-//
-// # Safety
-// Each pointer is NULL or valid for `n` reals (`setpoint`, `out`: one struct).
-enum AdaptimpStatus adaptimp_step(const struct AdaptimpController *ctrl,
-                                  struct AdaptimpState *state,
-                                  size_t n,
-                                  const double *q,
-                                  const double *dq,
-                                  const double *tau_e,
-                                  const struct AdaptimpSetpoint *setpoint,
-                                  struct AdaptimpCommand *out);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -79,7 +79,7 @@ fn defaults(n: usize, law: AdaptimpLaw, preset: AdaptimpPreset) -> AdaptimpParam
     // SAFETY: a valid place; Ok means it was written whole.
     unsafe {
         assert_eq!(
-            adaptimp_params_default(p.as_mut_ptr(), n, law, preset),
+            adaptimp_params_default(p.as_mut_ptr(), n, law.into(), preset.into()),
             AdaptimpStatus::Ok
         );
         p.assume_init()
@@ -218,7 +218,7 @@ fn a_snapshot_restored_continues_bit_identically_and_a_bad_one_changes_nothing()
         );
         assert_eq!(written, len);
         assert_eq!(
-            adaptimp_state_restore(b.state, buf.as_ptr(), len),
+            adaptimp_state_restore(b.ctrl, b.state, buf.as_ptr(), len),
             AdaptimpStatus::Ok
         );
         assert_eq!(adaptimp_state_steps(b.state), 100);
@@ -231,12 +231,13 @@ fn a_snapshot_restored_continues_bit_identically_and_a_bad_one_changes_nothing()
         }
         buf[3] += 1.0; // another number of nodes
         assert_eq!(
-            adaptimp_state_restore(b.state, buf.as_ptr(), len),
-            AdaptimpStatus::WrongState
+            adaptimp_state_restore(b.ctrl, b.state, buf.as_ptr(), len),
+            AdaptimpStatus::BadSnapshot
         );
+        assert!(last_error().contains("another number of joints or nodes"));
         assert_eq!(adaptimp_state_steps(b.state), 200);
         assert_eq!(
-            adaptimp_state_restore(b.state, ptr::null(), len),
+            adaptimp_state_restore(b.ctrl, b.state, ptr::null(), len),
             AdaptimpStatus::NullPointer
         );
         // A state of another size is refused by the step.
@@ -307,7 +308,7 @@ fn the_rule_through_the_abi_is_the_cores() {
         adaptimp_params_suggest(
             &mut p,
             3,
-            AdaptimpLaw::StateFeedback,
+            AdaptimpLaw::StateFeedback.into(),
             d.as_ptr(),
             tau.as_ptr(),
             1e-3,
@@ -333,7 +334,7 @@ fn the_rule_through_the_abi_is_the_cores() {
         .expect("rule");
     assert_eq!(&p.kp[..3], sug.config.kp.as_slice());
     assert_eq!(&p.inertia[..3], sug.config.inertia.as_slice());
-    assert_eq!(p.conditions, AdaptimpConditions::Scaled);
+    assert_eq!(p.conditions, AdaptimpConditions::Scaled.into());
     assert_eq!(p.gamma, sug.config.gamma);
     assert_eq!(p.nodes * 12, sug.centers.centers().len());
     assert_eq!(p.centers, centers.as_ptr());
@@ -370,7 +371,7 @@ fn the_rule_through_the_abi_is_the_cores() {
         adaptimp_params_suggest(
             &mut p,
             3,
-            AdaptimpLaw::Pd,
+            AdaptimpLaw::Pd.into(),
             bad.as_ptr(),
             tau.as_ptr(),
             1e-3,

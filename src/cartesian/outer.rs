@@ -35,6 +35,9 @@
 
 use crate::cartesian::kinematics::{Jacobian6, Kinematics};
 use crate::cartesian::rotation::{self, clip, exp, rotation_error};
+use crate::control::safety::{
+    CEILING_ACCELERATION, CEILING_POSITION, CEILING_TORQUE, CEILING_VELOCITY,
+};
 use crate::error::{check, Error, BOUND, PARAM_BOUND};
 use crate::math::sqrt;
 use crate::schema::{Preset, Scenario};
@@ -227,15 +230,18 @@ struct Target {
 
 impl Target {
     fn check(t: &PoseTarget, orients: bool) -> Result<Self, Error> {
-        for (what, v) in [
-            ("p_c", &t.p),
-            ("dp_c", &t.dp),
-            ("ddp_c", &t.ddp),
-            ("w_c", &t.w),
-            ("dw_c", &t.dw),
+        // The ceilings of a joint setpoint (docs/reliability.md), in m and rad:
+        // no plan gives more, and beyond them one sample throws the reference
+        // so far that the arm is driven at saturation.
+        for (what, v, ceiling) in [
+            ("p_c", &t.p, CEILING_POSITION),
+            ("dp_c", &t.dp, CEILING_VELOCITY),
+            ("ddp_c", &t.ddp, CEILING_ACCELERATION),
+            ("w_c", &t.w, CEILING_VELOCITY),
+            ("dw_c", &t.dw, CEILING_ACCELERATION),
         ] {
             check::finite_slice(what, v.as_slice())?;
-            check::within(what, v.as_slice(), BOUND)?;
+            check::within(what, v.as_slice(), ceiling)?;
         }
         let q = if orients {
             rotation::rotation("R_c", &t.r)?
@@ -486,8 +492,11 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
     /// commanded pose at t_k (`None`: hold the last one at rest; at the first
     /// step, fk(q_d)); `wrench`: the measured F_e = [f (N); m (N m)], world
     /// frame, about the tip. Errors, changing nothing, if an input is not
-    /// finite or beyond [`BOUND`], the target's rotation is not one, or a
-    /// result would be beyond [`BOUND`] (`OutOfRange`).
+    /// finite or beyond its ceiling (p_c 1e6 m, ṗ_c and ω_c 1e6 m/s and
+    /// rad/s, p̈_c and ω̇_c 1e6 m/s² and rad/s², the wrench 1e9 N and N m: those
+    /// of a joint setpoint and τe, docs/reliability.md), the target's
+    /// rotation is not one, or a result would be beyond [`BOUND`]
+    /// (`OutOfRange`).
     pub fn stage(
         &self,
         st: &CartesianState<N>,
@@ -495,7 +504,8 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         wrench: &Vector<6>,
     ) -> Result<OuterStep<N>, Error> {
         check::finite_slice("wrench", wrench.as_slice())?;
-        check::within("wrench", wrench.as_slice(), BOUND)?;
+        // The ceiling of a measured τe (N m), here in N and N m.
+        check::within("wrench", wrench.as_slice(), CEILING_TORQUE)?;
         let cfg = &self.cfg;
         let ts = self.ts;
         let mut s = *st;
@@ -758,6 +768,50 @@ mod tests {
         let e = o6.step(&mut st6, Some(&mirror), &f).unwrap_err();
         assert!(e.to_string().contains("det R = +1"), "{e}");
         assert_eq!(st6, before);
+    }
+
+    #[test]
+    fn a_target_or_wrench_beyond_its_ceiling_is_refused_and_changes_nothing() {
+        // The joint setpoint's ceilings (docs/reliability.md) hold for a pose
+        // target too: 1e50 m used to be accepted (only 1e100 was refused) and
+        // drove the arm at saturation.
+        let o = outer(CartesianConfig::default());
+        let mut st = o.start(Vector::<2>::new(0.5, 1.0));
+        let p = o.kinematics().fk(&st.qd);
+        let r = *o.kinematics().rotation(&st.qd).matrix();
+        o.step(&mut st, Some(&PoseTarget::at(p, r)), &Vector::zeros())
+            .unwrap();
+        let before = st;
+        type Edit = fn(&mut PoseTarget);
+        let cases: [(&str, Edit); 5] = [
+            ("p_c[0] = 1e50", |t| t.p[0] = 1e50),
+            ("p_c[1] = 2e6", |t| t.p[1] = 2e6),
+            ("dp_c[2] = 2e6", |t| t.dp[2] = 2e6),
+            ("ddp_c[0] = -2e6", |t| t.ddp[0] = -2e6),
+            ("w_c[1] = 1e7", |t| t.w[1] = 1e7),
+        ];
+        for (what, set) in cases {
+            let mut t = PoseTarget::at(p, r);
+            set(&mut t);
+            let e = o.step(&mut st, Some(&t), &Vector::zeros()).unwrap_err();
+            assert!(e.to_string().starts_with(what), "{e}");
+            assert!(e.to_string().contains("beyond its limit ±1e6"), "{e}");
+            assert_eq!(st, before);
+        }
+        let mut t = PoseTarget::at(p, r);
+        t.dw[2] = 1e6;
+        o.step(&mut st.clone(), Some(&t), &Vector::zeros()).unwrap();
+        let mut f = Vector::<6>::zeros();
+        f[4] = 2e9;
+        let e = o
+            .step(&mut st, Some(&PoseTarget::at(p, r)), &f)
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("wrench[4] = 2e9 is beyond its limit ±1e9"),
+            "{e}"
+        );
+        assert_eq!(st, before);
     }
 
     #[test]

@@ -89,8 +89,12 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
     /// (`None`: hold the last one) in, the command out; no allocation. The
     /// outer loop is staged, the joint step runs with the joint reference and
     /// τe = Jᵀ(q) F_e (or zero without `force_feedforward`), and only if it
-    /// succeeds is the outer state committed (on an error both states are as
-    /// before, except the joint state's recorded fault).
+    /// succeeds is the outer state committed. On an error both states are as
+    /// before but for the refusal, recorded in the joint state as a refused
+    /// joint step records it (the fault semantics of `docs/reliability.md`),
+    /// whether the joint step refused or the outer loop did before it (a
+    /// target that is not a rotation, a wrench not finite, a result beyond
+    /// the bound).
     pub fn step<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
         outer: &mut CartesianState<N>,
@@ -98,8 +102,37 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
         m: &CartesianMeasurement<N>,
         target: Option<&PoseTarget>,
     ) -> Result<CartesianCommand<N>, Error> {
-        self.outer
-            .step_with(outer, m, target, |meas, r| self.inner.step(inner, meas, r))
+        let mut reached = false;
+        let result = self.outer.step_with(outer, m, target, |meas, r| {
+            reached = true;
+            self.inner.step(inner, meas, r)
+        });
+        if let (Err(e), false) = (&result, reached) {
+            let meas = Measurement {
+                x: m.q,
+                dx: m.dq,
+                tau_e: Vector::zeros(),
+            };
+            self.inner.refuse_measured(inner, &meas, *e);
+        }
+        result
+    }
+
+    /// [`step`](Self::step), and the torque to apply whatever happened: the
+    /// step's `joint.tau_sat`, or on an error the joint controller's
+    /// configured fallback (then the applied torque the next step's rate
+    /// limit starts from), as [`Controller::step_or_fallback`].
+    pub fn step_or_fallback<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        outer: &mut CartesianState<N>,
+        inner: &mut State<N, S>,
+        m: &CartesianMeasurement<N>,
+        target: Option<&PoseTarget>,
+    ) -> (Vector<N>, Result<CartesianCommand<N>, Error>) {
+        match self.step(outer, inner, m, target) {
+            Ok(cmd) => (cmd.joint.tau_sat, Ok(cmd)),
+            Err(e) => (*inner.applied(), Err(e)),
+        }
     }
 }
 
@@ -156,6 +189,42 @@ mod tests {
     use crate::control::config::{Config, Law};
     use crate::networks::rbf::Grid;
     use crate::sim::model::TwoLinkArm;
+
+    #[test]
+    fn a_refusal_of_the_outer_loop_is_recorded_as_a_refused_joint_step() {
+        let outer =
+            CartesianImpedance::new(CartesianConfig::default(), TwoLinkArm::paper(), 1e-3).unwrap();
+        let mut cfg = Config::paper(Law::Pd);
+        cfg.ts = 1e-3;
+        cfg.impedance = ImpedanceMode::External;
+        cfg.fallback = crate::control::safety::Fallback::Zero;
+        let pair =
+            CartesianController::new(outer, Controller::new(cfg, Grid::paper()).unwrap()).unwrap();
+        let q = Vector::<2>::new(0.5, 1.0);
+        let (mut ost, mut ist) = (pair.outer().start(q), pair.inner().new_state());
+        let m = CartesianMeasurement {
+            q: q + Vector::<2>::new(0.01, 0.0),
+            dq: Some(Vector::zeros()),
+            wrench: Vector::zeros(),
+        };
+        let (tau, r) = pair.step_or_fallback(&mut ost, &mut ist, &m, None);
+        assert_eq!(tau, r.unwrap().joint.tau_sat);
+        assert!(tau.norm() > 0.0);
+        let before = ost;
+        let p = pair.outer().kinematics().fk(&q);
+        let mirror = PoseTarget::at(
+            p,
+            nalgebra::Matrix3::from_diagonal(&Vector::<3>::new(1.0, 1.0, -1.0)),
+        );
+        let (tau, r) = pair.step_or_fallback(&mut ost, &mut ist, &m, Some(&mirror));
+        let e = r.unwrap_err();
+        assert!(e.to_string().contains("det R = +1"), "{e}");
+        assert_eq!(ost, before);
+        assert_eq!(ist.fault().map(|f| f.error), Some(e));
+        assert_eq!(tau, Vector::<2>::zeros());
+        assert_eq!(*ist.applied(), Vector::<2>::zeros());
+        assert_eq!(ist.steps(), 1);
+    }
 
     #[test]
     fn the_joint_controller_must_leave_the_impedance_to_the_outer_loop() {

@@ -114,6 +114,38 @@ pub fn rotation(what: &'static str, m: &Matrix3<f64>) -> Result<UnitQuaternion<f
     ))
 }
 
+/// The rotation matrix of the unit quaternion `q = [w, x, y, z]` (world ←
+/// tip; MuJoCo's and Eigen's order of the coefficients), for a rotation
+/// target given as a quaternion. Every coefficient finite and |‖q‖ − 1| ≤
+/// [`ROTATION_TOLERANCE`], else an error naming `what` and the value: a
+/// quaternion that is not a rotation is refused as a matrix that is not one
+/// is, never normalised behind the caller's back. q and −q give the same
+/// matrix.
+pub fn quaternion_matrix(what: &'static str, q: &[f64; 4]) -> Result<Matrix3<f64>, Error> {
+    crate::error::check::finite_slice(what, q)?;
+    let norm = sqrt(q.iter().map(|c| c * c).sum::<f64>());
+    if (norm - 1.0).abs() > ROTATION_TOLERANCE {
+        return Err(Error::Condition {
+            condition: "‖q‖ = 1 (a unit quaternion, to 1e-6)",
+            lhs: what,
+            index: None,
+            value: norm,
+        });
+    }
+    let [w, x, y, z] = *q;
+    Ok(Matrix3::new(
+        1.0 - 2.0 * (y * y + z * z),
+        2.0 * (x * y - w * z),
+        2.0 * (x * z + w * y),
+        2.0 * (x * y + w * z),
+        1.0 - 2.0 * (x * x + z * z),
+        2.0 * (y * z - w * x),
+        2.0 * (x * z - w * y),
+        2.0 * (y * z + w * x),
+        1.0 - 2.0 * (x * x + y * y),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,6 +168,21 @@ mod tests {
             1.5 * core::f64::consts::PI,
         )));
         assert!((e - Vector::<3>::new(0.0, 0.0, -0.5 * core::f64::consts::PI)).norm() < 1e-14);
+    }
+
+    #[test]
+    fn a_unit_quaternion_gives_its_rotation_and_any_other_is_refused() {
+        let q = UnitQuaternion::from_euler_angles(0.3, -0.7, 1.9);
+        let c = [q.w, q.i, q.j, q.k];
+        let m = quaternion_matrix("R_c", &c).unwrap();
+        assert!((m - q.to_rotation_matrix().matrix()).amax() < 1e-15);
+        let neg = quaternion_matrix("R_c", &c.map(|v| -v)).unwrap();
+        assert_eq!(m, neg);
+        let e = quaternion_matrix("R_c", &[0.0, 0.0, 2.0, 0.0]).unwrap_err();
+        assert!(e.to_string().contains("‖q‖ = 1"), "{e}");
+        assert!(e.to_string().contains("R_c = 2 "), "{e}");
+        assert!(quaternion_matrix("R_c", &[f64::NAN, 0.0, 0.0, 1.0]).is_err());
+        assert!(quaternion_matrix("R_c", &[0.0; 4]).is_err());
     }
 
     #[test]

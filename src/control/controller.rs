@@ -410,10 +410,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         match self.try_step(st, m, c) {
             Ok(cmd) => Ok(cmd),
             Err(error) => {
-                if self.cfg.limits.plausible_position(&m.x) {
-                    st.q_seen = m.x;
-                }
-                self.record(st, m.dx.as_ref(), error);
+                self.refuse_measured(st, m, error);
                 Err(error)
             }
         }
@@ -442,6 +439,25 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// So every refusal latches, whichever front saw it first.
     pub fn refuse<S>(&self, st: &mut State<N, S>, error: Error) -> Vector<N> {
         self.record(st, None, error);
+        st.applied
+    }
+
+    /// A step refused before it reached [`step`](Self::step) by a caller
+    /// that has its measurement `m` (a Cartesian outer loop that refused its
+    /// target or wrench, SPEC §16): recorded exactly as a refused step is
+    /// (the fault, the fallback as the applied torque, with damping from the
+    /// measured q̇ if usable, and q as the last measured position if
+    /// plausible), and the fallback returned.
+    pub fn refuse_measured<S>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        error: Error,
+    ) -> Vector<N> {
+        if self.cfg.limits.plausible_position(&m.x) {
+            st.q_seen = m.x;
+        }
+        self.record(st, m.dx.as_ref(), error);
         st.applied
     }
 

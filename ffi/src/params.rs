@@ -1,0 +1,704 @@
+//! The joint controller's parameters as a C struct: every field of the
+//! schema's group "controller", converted by name to the core's scenario.
+
+use crate::*;
+use adaptimp::schema::{Preset, Scenario, Value};
+use adaptimp::{
+    AuxLaw, Conditions, Fallback, FaultPolicy, Hold, ImpedanceMode, Law, LearningStep,
+    ObserverInit, RobustKind, SaturationLearning,
+};
+
+/// Every parameter of a controller for `n` joints (1…7): the fields of the
+/// parameter schema (`adaptimp::schema::PARAMS`, group "controller"), named as
+/// there, with per-joint arrays of which the first `n` entries are read.
+/// Fill it with [`adaptimp_params_default`], then change fields. Every enum
+/// field is read as an integer and refused (INVALID_CONFIG, naming the
+/// field) if it is not a value of its enum; a NaN anywhere is a parameter
+/// error (INVALID_CONFIG), as in Python.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct AdaptimpParams {
+    /// Number of joints, 1…7.
+    pub n: usize,
+    /// Which controller.
+    pub law: AdaptimpLawRaw,
+    /// Sampling period Ts (s).
+    pub ts: f64,
+    /// K1 (1/s), (7).
+    pub k1: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Kp (N m s/rad), (14).
+    pub kp: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Kζ (1/s), (11).
+    pub kzeta: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Inertia scale d of each joint (kg m²), SPEC §10.
+    pub inertia: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Young weight ρ (1/s) of the auxiliary system, SPEC §10.
+    pub rho: f64,
+    /// The stability conditions checked.
+    pub conditions: AdaptimpConditionsRaw,
+    /// μ (N m), (11).
+    pub mu: f64,
+    /// Inner law of the auxiliary system.
+    pub aux_law: AdaptimpAuxLawRaw,
+    /// The robust term.
+    pub robust: AdaptimpRobustRaw,
+    /// kr (N m) of the sign and tanh terms.
+    pub kr: [f64; ADAPTIMP_MAX_JOINTS],
+    /// φ (rad/s) of the tanh term.
+    pub phi: f64,
+    /// kD (kg m²), kC (N m s/rad), kG (N m) of Remark 1, (30).
+    pub k_remark1: [f64; 3],
+    /// The learning step.
+    pub learning_step: AdaptimpLearningStepRaw,
+    /// κ of the normalised step, in (0, 1].
+    pub kappa: f64,
+    /// Learning under saturation.
+    pub saturation_learning: AdaptimpSaturationLearningRaw,
+    /// The projection of the weights.
+    pub weight_bound_mode: AdaptimpWeightBoundRaw,
+    /// Bounds on ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ for `ADAPTIMP_WEIGHT_BOUND_FIXED`.
+    pub weight_bound: [f64; 3],
+    /// Γ of D̂, Ĉ, Ĝ, (15)–(17).
+    pub gamma: [f64; 3],
+    /// σ of D̂, Ĉ, Ĝ, (15)–(17).
+    pub sigma: [f64; 3],
+    /// Observer ε (s), (31).
+    pub eps: f64,
+    /// Observer λ1, (31).
+    pub lam1: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Observer start.
+    pub observer_init: AdaptimpObserverInitRaw,
+    /// Observer discretisation.
+    pub observer_hold: AdaptimpObserverHoldRaw,
+    /// Actuator limits τmax (N m).
+    pub tau_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Target inertia Dd (kg m²), (3).
+    pub dd: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Target damping Cd (N m s/rad), (3).
+    pub cd: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Target stiffness Gd (N m/rad), (3).
+    pub gd: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Where the target impedance acts (`ADAPTIMP_IMPEDANCE_EXTERNAL` for the
+    /// joint controller of an `AdaptimpCartesian`).
+    pub impedance: AdaptimpImpedanceRaw,
+    /// Width η² of the vertex grid (used when `centers` is NULL; n ≤ 3).
+    pub eta2: f64,
+    /// User centres: `nodes` rows of 4n reals (x, v, α1, α̇1 blocks of n), or
+    /// NULL for the paper's vertex grid. Copied at construction.
+    pub centers: *const f64,
+    /// The number of user centres L.
+    pub nodes: usize,
+    /// Widths η_d² per input dimension (4n reals, blocks as the centres;
+    /// INFINITY: the dimension is left out), or NULL for `eta2` in every
+    /// dimension. Copied at construction.
+    pub widths2: *const f64,
+    /// The commanded trajectory, xc_i = o_i + a_i sin(ω_i t) + b_i cos(ω_i t):
+    /// offset o (rad), used when a step gets no setpoint.
+    pub xc_offset: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Sine amplitude a (rad).
+    pub xc_sin: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Cosine amplitude b (rad).
+    pub xc_cos: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Angular frequency ω (rad/s).
+    pub xc_omega: [f64; ADAPTIMP_MAX_JOINTS],
+    /// The torque a refused step returns in `AdaptimpCommand.tau_sat`.
+    pub fallback: AdaptimpFallbackRaw,
+    /// Kd (N m s/rad) of the damping fallback.
+    pub fallback_damping: [f64; ADAPTIMP_MAX_JOINTS],
+    /// After a refused step: go on, or latch the fault.
+    pub fault_policy: AdaptimpFaultPolicyRaw,
+    /// Plausibility limit |q_i| ≤ q_max (rad; INFINITY: none, the ceiling
+    /// 1e6 rad still holds). As Python's None.
+    pub q_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Plausibility limit |q̇_i| ≤ dq_max (rad/s; INFINITY: none, the ceiling
+    /// 1e6 rad/s still holds).
+    pub dq_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Plausibility limit |τe_i| ≤ tau_e_max (N m; INFINITY: none, the
+    /// ceiling 1e9 N m still holds).
+    pub tau_e_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Plausibility limit on the change of q_i between samples (rad; INFINITY: none).
+    pub q_jump_max: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Torque rate limit per step (N m; INFINITY: none), before saturation.
+    pub tau_rate_max: [f64; ADAPTIMP_MAX_JOINTS],
+}
+
+/// The name the schema gives to C choice `v` of enum `E`, by position.
+fn name_of<E: CEnum>(v: E, names: &[&'static str]) -> &'static str {
+    names[v.index()]
+}
+
+/// The C choice of schema name `name`, by position.
+fn from_name<E: CEnum>(names: &[&str], name: &str) -> E::Raw {
+    let i = names.iter().position(|n| *n == name).unwrap_or(0);
+    E::ALL[i].raw()
+}
+
+pub(crate) fn law_of(law: AdaptimpLaw) -> Law {
+    match law {
+        AdaptimpLaw::Pd => Law::Pd,
+        AdaptimpLaw::StateFeedback => Law::StateFeedback,
+        AdaptimpLaw::OutputFeedback => Law::OutputFeedback,
+    }
+}
+
+pub(crate) fn preset_of(p: AdaptimpPreset) -> Preset {
+    match p {
+        AdaptimpPreset::Paper => Preset::Paper,
+        AdaptimpPreset::Robot => Preset::Robot,
+    }
+}
+
+/// The parameters as a schema scenario of N joints (every controller field
+/// set by its schema name: the destructuring fails to compile if a field is
+/// added without being mapped). Every error is a parameter's: InvalidConfig.
+pub(crate) fn scenario_of<const N: usize>(
+    p: &AdaptimpParams,
+) -> Result<Scenario<N>, AdaptimpStatus> {
+    let AdaptimpParams {
+        n: _,
+        law,
+        ts,
+        k1,
+        kp,
+        kzeta,
+        inertia,
+        rho,
+        conditions,
+        mu,
+        aux_law,
+        robust,
+        kr,
+        phi,
+        k_remark1,
+        learning_step,
+        kappa,
+        saturation_learning,
+        weight_bound_mode,
+        weight_bound,
+        gamma,
+        sigma,
+        eps,
+        lam1,
+        observer_init,
+        observer_hold,
+        tau_max,
+        dd,
+        cd,
+        gd,
+        impedance,
+        eta2,
+        centers: _,
+        nodes: _,
+        widths2: _,
+        xc_offset,
+        xc_sin,
+        xc_cos,
+        xc_omega,
+        fallback,
+        fallback_damping,
+        fault_policy,
+        q_max,
+        dq_max,
+        tau_e_max,
+        q_jump_max,
+        tau_rate_max,
+    } = p;
+    let law = decode::<AdaptimpLaw>(*law, "params.law")?;
+    let aux_law = decode::<AdaptimpAuxLaw>(*aux_law, "params.aux_law")?;
+    let conditions = decode::<AdaptimpConditions>(*conditions, "params.conditions")?;
+    let robust = decode::<AdaptimpRobust>(*robust, "params.robust")?;
+    let learning_step = decode::<AdaptimpLearningStep>(*learning_step, "params.learning_step")?;
+    let saturation_learning =
+        decode::<AdaptimpSaturationLearning>(*saturation_learning, "params.saturation_learning")?;
+    let weight_bound_mode =
+        decode::<AdaptimpWeightBound>(*weight_bound_mode, "params.weight_bound_mode")?;
+    let observer_init = decode::<AdaptimpObserverInit>(*observer_init, "params.observer_init")?;
+    let observer_hold = decode::<AdaptimpObserverHold>(*observer_hold, "params.observer_hold")?;
+    let impedance = decode::<AdaptimpImpedance>(*impedance, "params.impedance")?;
+    let fallback = decode::<AdaptimpFallback>(*fallback, "params.fallback")?;
+    let fault_policy = decode::<AdaptimpFaultPolicy>(*fault_policy, "params.fault_policy")?;
+    let mut s = Scenario::<N>::preset(Preset::Paper, law_of(law));
+    // INFINITY in a limit is "none" (the core's, as Python's None).
+    fn joint<const N: usize>(v: &[f64; ADAPTIMP_MAX_JOINTS]) -> Value<'_> {
+        Value::Vec(&v[..N])
+    }
+    let joint = joint::<N>;
+    let bound = match weight_bound_mode {
+        AdaptimpWeightBound::None => Value::None,
+        AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
+        AdaptimpWeightBound::Auto => Value::Str("auto"),
+    };
+    let values: [(&str, Value<'_>); 43] = [
+        ("Ts", Value::Real(*ts)),
+        ("K1", joint(k1)),
+        ("Kp", joint(kp)),
+        ("Kzeta", joint(kzeta)),
+        ("inertia", joint(inertia)),
+        ("rho", Value::Real(*rho)),
+        (
+            "conditions",
+            Value::Str(name_of(conditions, &Conditions::NAMES)),
+        ),
+        ("mu", Value::Real(*mu)),
+        ("aux_law", Value::Str(name_of(aux_law, &AuxLaw::NAMES))),
+        ("robust", Value::Str(name_of(robust, &RobustKind::NAMES))),
+        ("kr", joint(kr)),
+        ("phi", Value::Real(*phi)),
+        ("kD", Value::Real(k_remark1[0])),
+        ("kC", Value::Real(k_remark1[1])),
+        ("kG", Value::Real(k_remark1[2])),
+        ("gamma", Value::Vec(gamma)),
+        ("sigma", Value::Vec(sigma)),
+        ("eta2", Value::Real(*eta2)),
+        ("eps", Value::Real(*eps)),
+        ("lam1", joint(lam1)),
+        (
+            "observer_init",
+            Value::Str(name_of(observer_init, &ObserverInit::NAMES)),
+        ),
+        (
+            "observer_hold",
+            Value::Str(name_of(observer_hold, &Hold::NAMES)),
+        ),
+        ("tau_max", joint(tau_max)),
+        ("Dd", joint(dd)),
+        ("Cd", joint(cd)),
+        ("Gd", joint(gd)),
+        (
+            "impedance",
+            Value::Str(name_of(impedance, &ImpedanceMode::NAMES)),
+        ),
+        ("xc_offset", joint(xc_offset)),
+        ("xc_sin", joint(xc_sin)),
+        ("xc_cos", joint(xc_cos)),
+        ("xc_omega", joint(xc_omega)),
+        (
+            "learning_step",
+            Value::Str(name_of(learning_step, &LearningStep::NAMES)),
+        ),
+        ("kappa", Value::Real(*kappa)),
+        (
+            "saturation_learning",
+            Value::Str(name_of(saturation_learning, &SaturationLearning::NAMES)),
+        ),
+        ("weight_bound", bound),
+        ("fallback", Value::Str(name_of(fallback, &Fallback::NAMES))),
+        ("fallback_damping", joint(fallback_damping)),
+        (
+            "fault_policy",
+            Value::Str(name_of(fault_policy, &FaultPolicy::NAMES)),
+        ),
+        ("q_max", joint(q_max)),
+        ("dq_max", joint(dq_max)),
+        ("tau_e_max", joint(tau_e_max)),
+        ("q_jump_max", joint(q_jump_max)),
+        ("tau_rate_max", joint(tau_rate_max)),
+    ];
+    debug_assert!(values.iter().map(|(n, _)| *n).eq(controller_names()));
+    for (name, v) in values {
+        s.set(name, v).map_err(|e| core_error(e, Context::Config))?;
+    }
+    Ok(s)
+}
+
+/// The schema's controller parameters, in its order.
+pub(crate) fn controller_names() -> impl Iterator<Item = &'static str> {
+    adaptimp::schema::PARAMS
+        .iter()
+        .filter(|p| p.group == adaptimp::schema::Group::Controller)
+        .map(|p| p.name)
+}
+
+/// `out` filled with the defaults of `preset` for `law` and N joints.
+pub(crate) fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpParams) {
+    fill_from(&Scenario::<N>::preset(preset, law), law, out);
+}
+
+/// `out` from the controller parameters of scenario `s` (centres: none).
+pub(crate) fn fill_from<const N: usize>(s: &Scenario<N>, law: Law, out: &mut AdaptimpParams) {
+    let mut p = AdaptimpParams {
+        n: N,
+        law: match law {
+            Law::Pd => AdaptimpLaw::Pd,
+            Law::StateFeedback => AdaptimpLaw::StateFeedback,
+            Law::OutputFeedback => AdaptimpLaw::OutputFeedback,
+        }
+        .raw(),
+        ts: 0.0,
+        k1: [0.0; ADAPTIMP_MAX_JOINTS],
+        kp: [0.0; ADAPTIMP_MAX_JOINTS],
+        kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
+        inertia: [0.0; ADAPTIMP_MAX_JOINTS],
+        rho: 0.0,
+        conditions: AdaptimpConditions::Paper.raw(),
+        mu: 0.0,
+        aux_law: AdaptimpAuxLaw::Default.raw(),
+        robust: AdaptimpRobust::Sign.raw(),
+        kr: [0.0; ADAPTIMP_MAX_JOINTS],
+        phi: 0.0,
+        k_remark1: [0.0; 3],
+        learning_step: AdaptimpLearningStep::Euler.raw(),
+        kappa: 0.0,
+        saturation_learning: AdaptimpSaturationLearning::Ignore.raw(),
+        weight_bound_mode: AdaptimpWeightBound::None.raw(),
+        weight_bound: [0.0; 3],
+        gamma: [0.0; 3],
+        sigma: [0.0; 3],
+        eps: 0.0,
+        lam1: [0.0; ADAPTIMP_MAX_JOINTS],
+        observer_init: AdaptimpObserverInit::Zero.raw(),
+        observer_hold: AdaptimpObserverHold::Zoh.raw(),
+        tau_max: [0.0; ADAPTIMP_MAX_JOINTS],
+        dd: [0.0; ADAPTIMP_MAX_JOINTS],
+        cd: [0.0; ADAPTIMP_MAX_JOINTS],
+        gd: [0.0; ADAPTIMP_MAX_JOINTS],
+        impedance: AdaptimpImpedance::Joint.raw(),
+        eta2: 0.0,
+        centers: std::ptr::null(),
+        nodes: 0,
+        widths2: std::ptr::null(),
+        xc_offset: [0.0; ADAPTIMP_MAX_JOINTS],
+        xc_sin: [0.0; ADAPTIMP_MAX_JOINTS],
+        xc_cos: [0.0; ADAPTIMP_MAX_JOINTS],
+        xc_omega: [0.0; ADAPTIMP_MAX_JOINTS],
+        fallback: AdaptimpFallback::Hold.raw(),
+        fallback_damping: [0.0; ADAPTIMP_MAX_JOINTS],
+        fault_policy: AdaptimpFaultPolicy::Report.raw(),
+        q_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        dq_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        tau_e_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        q_jump_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        tau_rate_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+    };
+    s.visit(|name, v| {
+        let joint = |dst: &mut [f64; ADAPTIMP_MAX_JOINTS]| {
+            if let Value::Vec(v) = v {
+                dst[..v.len()].copy_from_slice(v);
+            }
+        };
+        let real = |dst: &mut f64| {
+            if let Value::Real(x) = v {
+                *dst = x;
+            }
+        };
+        let three = |dst: &mut [f64; 3]| {
+            if let Value::Vec(v) = v {
+                dst.copy_from_slice(v);
+            }
+        };
+        let choice = match v {
+            Value::Str(s) => s,
+            _ => "",
+        };
+        match name {
+            "Ts" => real(&mut p.ts),
+            "K1" => joint(&mut p.k1),
+            "Kp" => joint(&mut p.kp),
+            "Kzeta" => joint(&mut p.kzeta),
+            "inertia" => joint(&mut p.inertia),
+            "rho" => real(&mut p.rho),
+            "conditions" => {
+                p.conditions = from_name::<AdaptimpConditions>(&Conditions::NAMES, choice)
+            }
+            "mu" => real(&mut p.mu),
+            "aux_law" => p.aux_law = from_name::<AdaptimpAuxLaw>(&AuxLaw::NAMES, choice),
+            "robust" => p.robust = from_name::<AdaptimpRobust>(&RobustKind::NAMES, choice),
+            "kr" => joint(&mut p.kr),
+            "phi" => real(&mut p.phi),
+            "kD" => real(&mut p.k_remark1[0]),
+            "kC" => real(&mut p.k_remark1[1]),
+            "kG" => real(&mut p.k_remark1[2]),
+            "gamma" => three(&mut p.gamma),
+            "sigma" => three(&mut p.sigma),
+            "eta2" => real(&mut p.eta2),
+            "eps" => real(&mut p.eps),
+            "lam1" => joint(&mut p.lam1),
+            "observer_init" => {
+                p.observer_init = from_name::<AdaptimpObserverInit>(&ObserverInit::NAMES, choice)
+            }
+            "observer_hold" => {
+                p.observer_hold = from_name::<AdaptimpObserverHold>(&Hold::NAMES, choice)
+            }
+            "tau_max" => joint(&mut p.tau_max),
+            "Dd" => joint(&mut p.dd),
+            "Cd" => joint(&mut p.cd),
+            "Gd" => joint(&mut p.gd),
+            "impedance" => {
+                p.impedance = from_name::<AdaptimpImpedance>(&ImpedanceMode::NAMES, choice)
+            }
+            "xc_offset" => joint(&mut p.xc_offset),
+            "xc_sin" => joint(&mut p.xc_sin),
+            "xc_cos" => joint(&mut p.xc_cos),
+            "xc_omega" => joint(&mut p.xc_omega),
+            "learning_step" => {
+                p.learning_step = from_name::<AdaptimpLearningStep>(&LearningStep::NAMES, choice)
+            }
+            "kappa" => real(&mut p.kappa),
+            "saturation_learning" => {
+                p.saturation_learning =
+                    from_name::<AdaptimpSaturationLearning>(&SaturationLearning::NAMES, choice)
+            }
+            "weight_bound" => match v {
+                Value::None => p.weight_bound_mode = AdaptimpWeightBound::None.raw(),
+                Value::Str(_) => p.weight_bound_mode = AdaptimpWeightBound::Auto.raw(),
+                _ => {
+                    p.weight_bound_mode = AdaptimpWeightBound::Fixed.raw();
+                    three(&mut p.weight_bound);
+                }
+            },
+            "fallback" => p.fallback = from_name::<AdaptimpFallback>(&Fallback::NAMES, choice),
+            "fallback_damping" => joint(&mut p.fallback_damping),
+            "fault_policy" => {
+                p.fault_policy = from_name::<AdaptimpFaultPolicy>(&FaultPolicy::NAMES, choice)
+            }
+            "q_max" => joint(&mut p.q_max),
+            "dq_max" => joint(&mut p.dq_max),
+            "tau_e_max" => joint(&mut p.tau_e_max),
+            "q_jump_max" => joint(&mut p.q_jump_max),
+            "tau_rate_max" => joint(&mut p.tau_rate_max),
+            _ => {} // the run, the environment, the arm and the Cartesian group are not the controller's
+        }
+    });
+    *out = p;
+}
+
+/// Fill `out` with the defaults of `preset` for controller `law` and `n`
+/// joints (1 … 7). Per-joint defaults declared for the paper's 2 joints (τmax,
+/// the commanded circle) are broadcast from their first entry for other n.
+/// BAD_SIZE for n outside 1 … 7, INVALID_CONFIG for a `law` or `preset` that
+/// is not a value of its enum (two arguments swapped, say); on an error
+/// `*out` is unchanged.
+///
+/// # Safety
+/// `out` is NULL or points to an `AdaptimpParams`.
+#[no_mangle]
+pub unsafe extern "C" fn adaptimp_params_default(
+    out: *mut AdaptimpParams,
+    n: usize,
+    law: AdaptimpLawRaw,
+    preset: AdaptimpPresetRaw,
+) -> AdaptimpStatus {
+    guard(|| {
+        // SAFETY (in `out`): checked for NULL; the caller's contract.
+        let out = unsafe { crate::out(out, "out") }?;
+        let law = law_of(decode::<AdaptimpLaw>(law, "law")?);
+        let preset = preset_of(decode::<AdaptimpPreset>(preset, "preset")?);
+        match n {
+            1 => fill_defaults::<1>(law, preset, out),
+            2 => fill_defaults::<2>(law, preset, out),
+            3 => fill_defaults::<3>(law, preset, out),
+            4 => fill_defaults::<4>(law, preset, out),
+            5 => fill_defaults::<5>(law, preset, out),
+            6 => fill_defaults::<6>(law, preset, out),
+            7 => fill_defaults::<7>(law, preset, out),
+            _ => return Err(bad_n(n)),
+        }
+        Ok(())
+    })
+}
+
+/// The inputs of [`adaptimp_params_suggest`], checked for NULL and length.
+struct Suggest<'a> {
+    law: Law,
+    inertia: &'a [f64],
+    tau_max: &'a [f64],
+    ts: f64,
+    /// Rows of 3n (q, q̇, q̈) and the period (s), or none.
+    path: Option<(&'a [f64], f64)>,
+    gravity: Option<&'a [f64]>,
+    /// Where the centres (ADAPTIMP_SUGGEST_MAX_NODES × 4n) and widths² (4n) go.
+    centers: *mut f64,
+    widths2: *mut f64,
+}
+
+fn suggest_sized<const N: usize>(
+    a: &Suggest<'_>,
+    out: &mut AdaptimpParams,
+) -> Result<(), AdaptimpStatus> {
+    use adaptimp::tuning::Rule;
+    use adaptimp::{Setpoint, Vector};
+    let rule = Rule::default();
+    let d = adaptimp::Matrix::<N>::from_row_slice(a.inertia);
+    let tau = Vector::<N>::from_column_slice(a.tau_max);
+    let mut s = Scenario::<N>::preset(Preset::Robot, a.law);
+    let config = |e| core_error(e, Context::Config);
+    let centers = match a.path {
+        None => {
+            s.config = rule.gains(a.law, &d, &tau, a.ts).map_err(config)?;
+            None
+        }
+        Some((rows, period)) => {
+            let samples: Vec<Setpoint<N>> = rows
+                .chunks_exact(3 * N)
+                .map(|r| Setpoint {
+                    x: Vector::from_column_slice(&r[..N]),
+                    dx: Vector::from_column_slice(&r[N..2 * N]),
+                    ddx: Vector::from_column_slice(&r[2 * N..]),
+                })
+                .collect();
+            let g = a.gravity.map(Vector::<N>::from_column_slice);
+            let sug = rule
+                .suggest(a.law, &d, &tau, a.ts, &samples, period, g.as_ref())
+                .map_err(config)?;
+            s.config = sug.config;
+            Some(sug.centers)
+        }
+    };
+    fill_from(&s, a.law, out);
+    if let Some(c) = centers {
+        let l = c.centers().len() / (4 * N);
+        // SAFETY (in `slice_mut`): the caller gives ADAPTIMP_SUGGEST_MAX_NODES
+        // rows of 4n reals and 4n reals, L ≤ that.
+        let dst = unsafe { slice_mut(a.centers, l * 4 * N, "centers") }?;
+        dst.copy_from_slice(c.centers());
+        let w = unsafe { slice_mut(a.widths2, 4 * N, "widths2") }?;
+        for (b, block) in c.widths2().iter().enumerate() {
+            w[b * N..(b + 1) * N].copy_from_slice(block.as_slice());
+        }
+        out.centers = a.centers;
+        out.nodes = l;
+        out.widths2 = a.widths2;
+    }
+    Ok(())
+}
+
+/// The most centres [`adaptimp_params_suggest`] places (its `centers`
+/// buffer holds this many rows of 4n reals).
+pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = adaptimp::tuning::NODES.1;
+
+/// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
+/// the robot scenario's parameters for `law` with the rule's gains from the
+/// inertia matrix `inertia` (n × n, row-major, kg m², at the task's start),
+/// the limits `tau_max` (n, N m) and the period `ts` (s), and the conditions
+/// "scaled" (SPEC §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
+/// one period of `period` s, evenly spaced in time) also the centres along
+/// it, the learning rates and the weight bounds: the centres are written to
+/// `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
+/// squared widths to `widths2` (4n), and `out->centers`, `out->nodes`,
+/// `out->widths2` point at them. `gravity` (n, N m, G at the path's start)
+/// may be NULL. `adaptimp_controller_new(out, …)` then builds the
+/// controller. `law` outside its enum is INVALID_CONFIG; a NaN or a bad
+/// value is INVALID_CONFIG naming it. On an error `*out` is left unchanged.
+///
+/// # Safety
+/// Every pointer is NULL or valid for the lengths above; `centers` and
+/// `widths2` are only read with a path.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn adaptimp_params_suggest(
+    out: *mut AdaptimpParams,
+    n: usize,
+    law: AdaptimpLawRaw,
+    inertia: *const f64,
+    tau_max: *const f64,
+    ts: f64,
+    path: *const f64,
+    rows: usize,
+    period: f64,
+    gravity: *const f64,
+    centers: *mut f64,
+    widths2: *mut f64,
+) -> AdaptimpStatus {
+    guard(|| {
+        if !(1..=ADAPTIMP_MAX_JOINTS).contains(&n) {
+            return Err(bad_n(n));
+        }
+        // SAFETY (in `out`, `slice`): checked for NULL; the caller's contract.
+        let out = unsafe { crate::out(out, "out") }?;
+        let args = Suggest {
+            law: law_of(decode::<AdaptimpLaw>(law, "law")?),
+            inertia: unsafe { slice(inertia, n * n, "inertia") }?,
+            tau_max: unsafe { slice(tau_max, n, "tau_max") }?,
+            ts,
+            path: if path.is_null() {
+                None
+            } else {
+                let len = rows
+                    .checked_mul(3 * n)
+                    .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"rows × 3n overflows"))?;
+                Some((unsafe { slice(path, len, "path") }?, period))
+            },
+            gravity: if gravity.is_null() {
+                None
+            } else {
+                Some(unsafe { slice(gravity, n, "gravity") }?)
+            },
+            centers,
+            widths2,
+        };
+        let mut filled = *out;
+        match n {
+            1 => suggest_sized::<1>(&args, &mut filled),
+            2 => suggest_sized::<2>(&args, &mut filled),
+            3 => suggest_sized::<3>(&args, &mut filled),
+            4 => suggest_sized::<4>(&args, &mut filled),
+            5 => suggest_sized::<5>(&args, &mut filled),
+            6 => suggest_sized::<6>(&args, &mut filled),
+            _ => suggest_sized::<7>(&args, &mut filled),
+        }?;
+        *out = filled;
+        Ok(())
+    })
+}
+
+/// BadSize for a number of joints outside 1 … 7.
+pub(crate) fn bad_n(n: usize) -> AdaptimpStatus {
+    fail(
+        AdaptimpStatus::BadSize,
+        &format_args!("n = {n}: the number of joints must be 1 … 7"),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_c_enums_follow_the_schemas_choice_order() {
+        fn check<E: CEnum>(names: &[&str]) {
+            assert_eq!(E::ALL.len(), names.len(), "{}", E::NAME);
+            for (c, name) in E::ALL.iter().zip(names) {
+                assert_eq!(format!("{c:?}").to_lowercase(), *name, "{}", E::NAME);
+            }
+        }
+        check::<AdaptimpAuxLaw>(&AuxLaw::NAMES);
+        check::<AdaptimpConditions>(&Conditions::NAMES);
+        check::<AdaptimpRobust>(&RobustKind::NAMES);
+        check::<AdaptimpLearningStep>(&LearningStep::NAMES);
+        check::<AdaptimpSaturationLearning>(&SaturationLearning::NAMES);
+        check::<AdaptimpObserverInit>(&ObserverInit::NAMES);
+        check::<AdaptimpObserverHold>(&Hold::NAMES);
+        check::<AdaptimpImpedance>(&ImpedanceMode::NAMES);
+        check::<AdaptimpFallback>(&Fallback::NAMES);
+        check::<AdaptimpFaultPolicy>(&FaultPolicy::NAMES);
+    }
+
+    #[test]
+    fn every_controller_parameter_of_the_schema_is_a_field() {
+        // scenario_of sets each controller parameter by name: the defaults
+        // round-trip exactly for every size and preset.
+        fn check<const N: usize>() {
+            for preset in Preset::ALL {
+                for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
+                    let mut p = std::mem::MaybeUninit::<AdaptimpParams>::uninit();
+                    // SAFETY: a valid place to write.
+                    let p = unsafe {
+                        fill_defaults::<N>(law, preset, &mut *p.as_mut_ptr());
+                        p.assume_init()
+                    };
+                    let s = scenario_of::<N>(&p).unwrap();
+                    let expect = Scenario::<N>::preset(preset, law);
+                    assert_eq!(s.config, expect.config, "{preset:?} {law:?}");
+                    assert_eq!(s.eta2, expect.eta2);
+                    assert_eq!(s.xc, expect.xc);
+                }
+            }
+        }
+        check::<1>();
+        check::<2>();
+        check::<7>();
+        // scenario_of sets exactly the controller group's names, in order (its
+        // debug assertion); the array's length is the group's size.
+        assert_eq!(controller_names().count(), 43);
+    }
+}

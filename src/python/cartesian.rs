@@ -270,6 +270,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         self.last = Some(CartesianCommand {
             joint: Command::zeros(),
             reference: staged.reference,
+            commanded: staged.commanded,
             compliant: staged.compliant,
             target: staged.target,
             error: staged.error,
@@ -290,8 +291,11 @@ impl<const N: usize> DynOuter for Outer<N> {
         let meas = Self::measurement(m);
         let cmd = self
             .outer
-            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r| {
-                typed.step_with(jm, r)
+            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r, task| {
+                match task {
+                    Some(t) => typed.step_task(jm, r, t),
+                    None => typed.step_with(jm, r),
+                }
             })?;
         self.last = Some(cmd);
         Ok(())
@@ -300,7 +304,13 @@ impl<const N: usize> DynOuter for Outer<N> {
         let meas = Self::measurement(m);
         let cmd = self
             .outer
-            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r| {
+            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r, task| {
+                if task.is_some() {
+                    return Err(Error::Invalid {
+                        what: "formulation",
+                        reason: "'impedance' and 'unified' need the core's joint controller (a case name): a joint controller written in Python gets the compliant reference only ('admittance')",
+                    });
+                }
                 let mut tau = [0.0; MAX_JOINTS];
                 joint(
                     jm.x.as_slice(),

@@ -34,8 +34,8 @@
 //! committed by the caller, so a refused input changes nothing.
 
 use crate::cartesian::kinematics::{Jacobian6, Kinematics, Tip};
-use crate::control::io::TaskTorque;
 use crate::cartesian::rotation::{self, clip, exp, rotation_error};
+use crate::control::io::TaskTorque;
 use crate::error::{check, Error, BOUND, PARAM_BOUND};
 use crate::math::sqrt;
 use crate::schema::{Preset, Scenario};
@@ -718,7 +718,11 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
                 (qt, c.w, c.dw)
             } else {
                 let r = UnitQuaternion::from_rotation_matrix(&tip_c.rotation);
-                (r, tip_c.jacobian.fixed_rows::<3>(3) * s.dqc, Vector::zeros())
+                (
+                    r,
+                    tip_c.jacobian.fixed_rows::<3>(3) * s.dqc,
+                    Vector::zeros(),
+                )
             };
             let ddqc = self.clik(
                 &tip_c,
@@ -825,7 +829,6 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             commanded: staged.commanded,
             jacobian: j,
             spring: self.select(k.component_mul(&e)),
-            stiffness: self.select(k),
             damping: self.select(staged.damping),
             twist: self.select(staged.twist),
             lambda2: self.lambda2,

@@ -3,10 +3,10 @@
 //! wrench, an optional pose target), transactional, allocation-free.
 
 use crate::cartesian::kinematics::Kinematics;
+use crate::cartesian::outer::Formulation;
 use crate::cartesian::outer::{CartesianImpedance, CartesianState, CompliantPose, PoseTarget};
 use crate::control::controller::Controller;
 use crate::control::impedance::ImpedanceMode;
-use crate::cartesian::outer::Formulation;
 use crate::control::io::{Command, Measurement, TaskTorque};
 use crate::control::state::State;
 use crate::error::{check, Error, BOUND};
@@ -126,7 +126,11 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         joint: F,
     ) -> Result<CartesianCommand<N>, Error>
     where
-        F: FnOnce(&Measurement<N>, &Setpoint<N>, Option<&TaskTorque<N>>) -> Result<Command<N>, Error>,
+        F: FnOnce(
+            &Measurement<N>,
+            &Setpoint<N>,
+            Option<&TaskTorque<N>>,
+        ) -> Result<Command<N>, Error>,
     {
         check::finite_slice("q", m.q.as_slice())?;
         check::within("q", m.q.as_slice(), BOUND)?;

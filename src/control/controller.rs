@@ -80,8 +80,6 @@ struct Task<const N: usize> {
     errors: Errors<N>,
     /// Jᵀ(K̃e + B ė) + Π (z1_c + Kp z2_c + r(z2_c)) (N m), (19.3).
     torque: Vector<N>,
-    /// The learning error of the torque-level part (rad/s), (19.4).
-    learning: Vector<N>,
     /// The admittance's share n.
     share: f64,
     /// The commanded joint reference (q_c, q̇_c, q̈_c).
@@ -90,13 +88,15 @@ struct Task<const N: usize> {
 
 impl<const N: usize> Task<N> {
     /// The learning signals of (19.2): the regressors n α̇1 + (1 − n) q̈_c,
-    /// n α1 + (1 − n) q̇_c and the compliant z2 of `e`.
+    /// n α1 + (1 − n) q̇_c and the paper's z2 of `e` (on the compliant
+    /// reference: the networks learn what the impedance leaves undone, never
+    /// the contact force it prescribes).
     fn signals(&self, e: &Errors<N>) -> Signals<N> {
         let n = self.share;
         Signals {
             dalpha1: n * e.dalpha1 + (1.0 - n) * self.commanded.ddx,
             alpha1: n * e.alpha1 + (1.0 - n) * self.commanded.dx,
-            z2: n * e.z2 + (1.0 - n) * self.learning,
+            z2: e.z2,
         }
     }
 
@@ -479,7 +479,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         self.check_bounded(st, &e, &v)?;
         let task = match task {
             // n = 1 is the admittance law itself, bit for bit.
-            Some(t) if t.share < 1.0 => Some(self.task_terms(t, m, &v, &e)?),
+            Some(t) if t.share < 1.0 => Some(self.task_terms(t, m, &v)?),
             Some(t) => {
                 Self::check_share(t.share)?;
                 None
@@ -727,7 +727,6 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         t: &TaskTorque<N>,
         m: &Measurement<N>,
         v: &Vector<N>,
-        e: &Errors<N>,
     ) -> Result<Task<N>, Error> {
         Self::check_share(t.share)?;
         for (what, x) in [
@@ -739,7 +738,6 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             ("damping", t.damping.as_slice()),
             ("twist", t.twist.as_slice()),
             ("lambda2", t.lambda2.as_slice()),
-            ("stiffness", t.stiffness.as_slice()),
         ] {
             check::finite_slice(what, x)?;
             check::within(what, x, BOUND)?;
@@ -766,19 +764,10 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             None => Vector::zeros(),
         };
         let torque = j.transpose() * force + null(&inner);
-        // (19.4) the learning error: the same feedback on the compliant
-        // errors, per unit Kp: Kp⁻¹ [Jᵀ(K̃ J z1 + B J (q̇_d − v)) + Π Kp z2].
-        let dz = e.z2 - self.cfg.k1.component_mul(&e.z1);
-        let f_d = t.stiffness.component_mul(&(j * e.z1)) + t.damping.component_mul(&(j * dz));
-        let learning = (j.transpose() * f_d + null(&self.cfg.kp.component_mul(&e.z2)))
-            .component_mul(&kinv);
-        for (what, x) in [("tau_task", &torque), ("z2_task", &learning)] {
-            check::within(what, x.as_slice(), BOUND)?;
-        }
+        check::within("tau_task", torque.as_slice(), BOUND)?;
         Ok(Task {
             errors,
             torque,
-            learning,
             share: t.share,
             commanded: t.commanded,
         })

@@ -33,8 +33,6 @@ pub struct TaskTorque<const N: usize> {
     /// The spring K̃ e (N, N m) at the measured pose, e = [p_t − p; Log(R_t Rᵀ)]
     /// (clipped as (16.5)).
     pub spring: Vector<6>,
-    /// The stiffness K̃ (N/m, N m/rad) per task axis (after the filter (16.6)).
-    pub stiffness: Vector<6>,
     /// The damping B (N s/m, N m s/rad) per task axis.
     pub damping: Vector<6>,
     /// The commanded twist [ṗ_c; ω_c] (m/s, rad/s).

@@ -289,14 +289,17 @@ impl<const N: usize> DynOuter for Outer<N> {
                 reason: "has another number of joints than the chain",
             })?;
         let meas = Self::measurement(m);
-        let cmd = self
-            .outer
-            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r, task| {
-                match task {
-                    Some(t) => typed.step_task(jm, r, t),
-                    None => typed.step_with(jm, r),
-                }
-            })?;
+        let cmd =
+            self.outer
+                .step_with(
+                    &mut self.state,
+                    &meas,
+                    m.target.as_ref(),
+                    |jm, r, task| match task {
+                        Some(t) => typed.step_task(jm, r, t),
+                        None => typed.step_with(jm, r),
+                    },
+                )?;
         self.last = Some(cmd);
         Ok(())
     }

@@ -56,7 +56,8 @@ REACH_SHARE = 0.7
 from the base's vertical axis."""
 
 TABLE_MASS = 1.0
-"""Mass (kg) of a spring-mounted table top (``spring=``); critically damped."""
+"""Mass (kg) of a spring-mounted table top (``spring=``); critically damped, its
+weight carried by the spring's preload (the top at rest where the rigid one is)."""
 
 
 def _tool_and_table(
@@ -109,6 +110,9 @@ def _tool_and_table(
             axis=[0, 0, 1],
             stiffness=spring,
             damping=2.0 * math.sqrt(spring * TABLE_MASS),
+            # At rest under its weight the top is at table_top: the spring
+            # carries the table (g = 9.81 m/s², MuJoCo's default).
+            springref=TABLE_MASS * 9.81 / spring,
         )
     table.add_geom(
         name="table",
@@ -336,7 +340,7 @@ def contact_metrics(
     - ``force_rms_err_N``: RMS (F_n − target) (N), F_n = −F_e,z;
     - ``force_chatter_N``: RMS (F_n,k+1 − F_n,k) (N), the sample-to-sample change;
     - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
-      after the end of the approach;
+      after the end of the approach (all the time after it, if none);
     - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
     - ``sat_duty``: fraction of all rows with sat(τ_i) ≠ τ_i on some joint.
     """
@@ -347,10 +351,11 @@ def contact_metrics(
     fn = -np.asarray(res.wrench_ee)[:, 2]
     t = np.asarray(res.t)
     after = t >= settle - 1e-9
-    contact = np.flatnonzero((t >= sc.t_approach - 1e-9) & (fn > 0))
-    lost = 0.0
-    if contact.size:
-        lost = float(np.sum(fn[contact[0] :] <= 0) * sc.ts)
+    approach = t >= sc.t_approach - 1e-9
+    contact = np.flatnonzero(approach & (fn > 0))
+    # Never touched after the approach: all of that time is without contact.
+    start = contact[0] if contact.size else int(np.argmax(approach))
+    lost = float(np.sum(fn[start:] <= 0) * sc.ts) if approach.any() else 0.0
     return {
         "track_mm": m["rms_track"] * 1e3,
         "force_rms_err_N": float(np.sqrt(np.mean((fn[after] - target) ** 2))),

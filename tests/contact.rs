@@ -227,8 +227,9 @@ fn the_torque_level_step_does_not_carry_this_samples_wrench() {
     let mut taus = Vec::new();
     for f in [0.0, 7.5, -40.0] {
         let (mut o, mut i) = (st, ist.clone());
-        // The wrench of step 1 moves p̈_d at once, q̇_d at step 2 and, through
-        // the learning error of step 2, the weights and torque of step 3.
+        // The wrench of step 1 moves p̈_d at once, q̇_d at step 2 (not the
+        // torque: n = 0) and, through the learning error of step 2, the
+        // weights and the torque of step 3.
         let first = ctrl
             .step(&mut o, &mut i, &m(f), Some(&target))
             .expect("step");
@@ -238,13 +239,19 @@ fn the_torque_level_step_does_not_carry_this_samples_wrench() {
         let third = ctrl
             .step(&mut o, &mut i, &m(0.0), Some(&target))
             .expect("step");
-        taus.push((first.joint.tau, first.compliant.ddp, third.joint.tau));
+        taus.push((
+            first.joint.tau,
+            first.compliant.ddp,
+            third.joint.tau,
+            second.joint.tau,
+        ));
     }
     for k in 1..3 {
         assert_eq!(
             taus[k].0, taus[0].0,
             "the same sample's torque moved with the wrench"
         );
+        assert_eq!(taus[k].3, taus[0].3, "the next sample's torque moved");
         assert_ne!(
             taus[k].1, taus[0].1,
             "the wrench did not reach the compliant reference"

@@ -87,9 +87,7 @@ def test_the_scenario_on_the_ur5_is_placed_from_its_reach() -> None:
     sc = act.arm_table(_ur5())
     plant = amj.Plant(sc.model)
     assert plant.n == 6
-    centre, top, reach = act.placement(
-        sc.chain, sc.q0, (np.full(6, -np.pi), np.full(6, np.pi))
-    )
+    centre, top, reach = act.placement(sc.chain, sc.q0, (np.full(6, -np.pi), np.full(6, np.pi)))
     np.testing.assert_allclose(sc.centre, centre)
     p_home = sc.chain.fk(sc.q0)[:3, 3]
     # OUTWARD beyond the home tip, within REACH_SHARE of the reach.

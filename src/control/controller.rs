@@ -537,6 +537,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// Stages "robust term", "networks", "saturation" and "learning": the
     /// command of the step (SPEC §7), the rate limit and the saturation, and
     /// the weights' update.
+    #[allow(clippy::too_many_arguments)]
     fn command<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
         st: &mut State<N, S>,

@@ -70,14 +70,18 @@ def _tool_and_table(
     friction: float,
     spring: float | None,
 ) -> None:
-    """Add the tool sphere (the arm's only collision geometry), the site ``ee``
-    with force/torque sensors at the tip body, and the table (static, or on a
-    vertical slide joint with stiffness ``spring`` N/m)."""
+    """Add the tool: a massless body ``tool`` at the origin of the tip body with
+    the sphere (the arm's only collision geometry) and the site ``ee`` with
+    force/torque sensors; and the table (static, or on a vertical slide joint
+    with stiffness ``spring`` N/m)."""
     import mujoco
 
-    body = spec.body(tip)
-    if body is None:
+    parent = spec.body(tip)
+    if parent is None:
         raise ValueError(f"the model has no body {tip!r} for the tool")
+    # A massless body of its own at the tip's origin: its force sensor reads
+    # the contact alone (on a body with mass it would add its weight).
+    body = parent.add_body(name="tool")
     body.add_site(name="ee", size=[0.01, 0, 0])
     body.add_geom(
         name="tool",
@@ -339,6 +343,7 @@ def contact_metrics(
       K_d k_e/(K_d + k_e) δ_c (N);
     - ``force_rms_err_N``: RMS (F_n − target) (N), F_n = −F_e,z;
     - ``force_chatter_N``: RMS (F_n,k+1 − F_n,k) (N), the sample-to-sample change;
+    - ``force_mean_N``: the mean of F_n (N);
     - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
       after the end of the approach (all the time after it, if none);
     - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
@@ -361,6 +366,7 @@ def contact_metrics(
         "force_rms_err_N": float(np.sqrt(np.mean((fn[after] - target) ** 2))),
         "force_target_N": float(target),
         "force_chatter_N": float(np.sqrt(np.mean(np.diff(fn[after]) ** 2))),
+        "force_mean_N": float(np.mean(fn[after])),
         "contact_lost_s": lost,
         "peak_tau_ratio": m["peak_tau_ratio"],
         "sat_duty": m["sat_duty"],

@@ -344,6 +344,9 @@ def contact_metrics(
     - ``force_rms_err_N``: RMS (F_n − target) (N), F_n = −F_e,z;
     - ``force_chatter_N``: RMS (F_n,k+1 − F_n,k) (N), the sample-to-sample change;
     - ``force_mean_N``: the mean of F_n (N);
+    - ``force_16_1_N``: what (16.1) prescribes with the measured mean n·e,
+      K_d k_e/(K_d + k_e)(δ_c + n·e) (K_d (δ_c + n·e) for a rigid table), n = −z,
+      e = p − p_d (N);
     - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
       after the end of the approach (all the time after it, if none);
     - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
@@ -356,6 +359,9 @@ def contact_metrics(
     fn = -np.asarray(res.wrench_ee)[:, 2]
     t = np.asarray(res.t)
     after = t >= settle - 1e-9
+    # (16.1) with the measured n·e, n = −z (into the table), e = p − p_d.
+    series = kd if spring is None else kd * spring / (kd + spring)
+    ne = ctrl.arrays()["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
     approach = t >= sc.t_approach - 1e-9
     contact = np.flatnonzero(approach & (fn > 0))
     # Never touched after the approach: all of that time is without contact.
@@ -367,6 +373,7 @@ def contact_metrics(
         "force_target_N": float(target),
         "force_chatter_N": float(np.sqrt(np.mean(np.diff(fn[after]) ** 2))),
         "force_mean_N": float(np.mean(fn[after])),
+        "force_16_1_N": float(series * (sc.depth + np.mean(ne))),
         "contact_lost_s": lost,
         "peak_tau_ratio": m["peak_tau_ratio"],
         "sat_duty": m["sat_duty"],

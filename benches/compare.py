@@ -901,10 +901,11 @@ def main(argv: list[str] | None = None) -> int:
     # A Python call against the Rust step (issue 9: at most 0.5 µs above it).
     import python_step
 
-    print("\n## One Controller.step from Python against the Rust step (n = 2)\n")
-    python_call = python_step.measure(repeats=3 if args.quick else 7)
-    print(python_step.report(python_call))
-    result["python_step_s"] = python_call
+    print("\n## One Controller.step from Python against the Rust step (n = 2 and 7)\n")
+    for n in (2, 7):
+        python_call = python_step.measure(repeats=3 if args.quick else 7, n=n)
+        print(python_step.report(python_call, n), end="\n\n")
+        result["python_step_s" if n == 2 else f"python_step_s_n{n}"] = python_call
 
     info["load_average_1min_at_end"] = round(os.getloadavg()[0], 2)
     elapsed = time.perf_counter() - started

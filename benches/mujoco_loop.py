@@ -80,7 +80,7 @@ class PythonSide:
 
     def __init__(self, inner: adaptimp.Controller) -> None:
         self.inner = inner
-        self.ts = inner.ts
+        self.Ts = inner.Ts
         self.params = inner.params
 
     def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> Any:
@@ -94,8 +94,8 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
     model, q0 = arm(name)
     plant = amj.Plant(model)
     ctrl = controller(plant, q0)
-    steps = round(T / ctrl.ts)
-    substeps = max(1, round(ctrl.ts / plant.timestep))
+    steps = round(T / ctrl.Ts)
+    substeps = max(1, round(ctrl.Ts / plant.timestep))
     log = amj.simulate(ctrl, plant, T=T, q0=q0)
     assert log.params["loop"] == "native"
 
@@ -129,7 +129,7 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
         start = time.perf_counter()
         mujoco.mj_step(m, d, nstep=substeps * steps)
         seconds = time.perf_counter() - start
-        assert abs(d.time - steps * ctrl.ts) < 1e-6, "MuJoCo reset its state"
+        assert abs(d.time - steps * ctrl.Ts) < 1e-6, "MuJoCo reset its state"
         return seconds / steps
 
     def step() -> float:

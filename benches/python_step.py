@@ -4,14 +4,16 @@ The Rust step is timed by ``Controller.replay`` over logged measurements: the
 loop runs in Rust (GIL released) and calls exactly the step a Python call
 reaches, so replay's time per row is the Rust step (plus a row copy of a few
 ns). The Python call is ``Controller.step(q, tau_e, dq)`` with NumPy arrays of
-shape (2,), one call per row of the same log, and the same with lists. Both
+shape (n,), one call per row of the same log, and the same with lists. Both
 run K = 20 000 rows of a recorded run of the robot scenario (state feedback,
-n = 2, Ts = 1 ms), interleaved round-robin (7 repeats, garbage collector off)
-so that load falls on all alike. Reports medians and the overhead of a Python
-call over the Rust step (the target of issue 9: at most 0.5 µs), and then
-the speed-up of two ``simulate`` runs in two threads over one after the other.
+Ts = 1 ms), interleaved round-robin (7 repeats, garbage collector off) so
+that load falls on all alike: n = 2 (the paper's arm, the 256-node grid) and
+n = 7 (a 7-link planar arm, gains and 64 centres along the orbit from
+``adaptimp.tuning.suggest``, SPEC §18). Reports medians and the overhead of a
+Python call over the Rust step (target: at most 0.5 µs), and then the speed-up
+of two ``simulate`` runs in two threads over one after the other.
 
-    target/py-venv/bin/python benches/python_step.py [--repeats 7] [--rows 20000]
+    target/py-venv/bin/python benches/python_step.py [--repeats 7] [--rows 20000] [--n 2 7]
 
 Also run by ``benches/compare.py``, whose report includes this table.
 """
@@ -23,16 +25,42 @@ import gc
 import statistics
 import time
 from collections.abc import Callable
+from typing import Any
+
+import numpy as np
 
 import adaptimp
 
 
-def timers(rows: int) -> dict[str, Callable[[], float]]:
-    log = adaptimp.simulate("sf", "robot", T=rows * 1e-3)
+def setup(rows: int, n: int) -> tuple[adaptimp.SimResult, dict[str, Any]]:
+    """A logged run of ``rows`` steps (robot scenario, state feedback) and the
+    controller's keywords: the paper's arm for n = 2; for other n a planar arm
+    of 1 kg, 0.25 m links tracking a sinusoid of 0.15 rad about 0.3 rad, with
+    the gains and centres of ``tuning.suggest``."""
+    if n == 2:
+        return adaptimp.simulate("sf", "robot", T=rows * 1e-3), {}
+    from adaptimp import tuning
+
+    arm = adaptimp.PlanarArm(n, masses=1.0, lengths=0.25)
+    q0 = np.full(n, 0.3)
+    ones = np.ones(n)
+
+    def path(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return q0 + 0.15 * np.sin(t) * ones, 0.15 * np.cos(t) * ones, -0.15 * np.sin(t) * ones
+
+    kw = tuning.suggest(arm, q0, np.full(n, 20.0), Ts=1e-3, path=path, period=2 * np.pi)
+    kw.update(q0=q0.tolist(), xc_offset=0.3, xc_sin=0.15, xc_cos=0.0, xc_omega=1.0)
+    log = adaptimp.simulate("sf", "robot", arm=arm, T=rows * 1e-3, wall=None, **kw)
+    kw.pop("q0")
+    return log, kw
+
+
+def timers(rows: int, n: int = 2) -> dict[str, Callable[[], float]]:
+    log, kw = setup(rows, n)
     q, tau_e, dq = log.q[:rows], log.tau_e[:rows], log.dq[:rows]
     arrays = list(zip(q, tau_e, dq))
     lists = [(a.tolist(), b.tolist(), c.tolist()) for a, b, c in arrays]
-    ctrl = adaptimp.Controller("sf", "robot")
+    ctrl = adaptimp.Controller("sf", "robot", **kw)
 
     def replay() -> float:
         ctrl.reset()
@@ -58,9 +86,9 @@ def timers(rows: int) -> dict[str, Callable[[], float]]:
     }
 
 
-def measure(rows: int = 20_000, repeats: int = 7) -> dict[str, float]:
+def measure(rows: int = 20_000, repeats: int = 7, n: int = 2) -> dict[str, float]:
     """Median seconds per step of each timer, interleaved round-robin."""
-    ts = timers(rows)
+    ts = timers(rows, n)
     for run in ts.values():  # warm-up
         run()
     samples: dict[str, list[float]] = {k: [] for k in ts}
@@ -74,10 +102,10 @@ def measure(rows: int = 20_000, repeats: int = 7) -> dict[str, float]:
     return {k: statistics.median(v) for k, v in samples.items()}
 
 
-def report(medians: dict[str, float]) -> str:
+def report(medians: dict[str, float], n: int = 2) -> str:
     rust = medians["Rust step (Controller.replay, per row)"]
     lines = [
-        "| n = 2, state feedback, robot scenario | median (µs) | over the Rust step (µs) |",
+        f"| n = {n}, state feedback, robot scenario | median (µs) | over the Rust step (µs) |",
         "|---|---:|---:|",
     ]
     for key, s in medians.items():
@@ -114,11 +142,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rows", type=int, default=20_000)
     ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--n", type=int, nargs="+", default=[2, 7], help="joints (default: 2 7)")
+    ap.add_argument("--no-threads", action="store_true", help="skip the two-thread run")
     args = ap.parse_args()
-    print(report(measure(args.rows, args.repeats)))
+    for n in args.n:
+        print(report(measure(args.rows, args.repeats, n), n), end="\n\n")
+    if args.no_threads:
+        return
     serial, parallel = threads()
     print(
-        f"\ntwo simulate() runs (robot scenario, 10 s): one after the other {serial:.3f} s, "
+        f"two simulate() runs (robot scenario, 10 s): one after the other {serial:.3f} s, "
         f"in two threads {parallel:.3f} s: {serial / parallel:.2f}x"
     )
 

@@ -24,8 +24,10 @@ fn percentile(sorted: &[u32], p: f64) -> u32 {
 }
 
 fn main() -> Result<(), adaptimp::Error> {
-    let steps: usize = std::env::args()
-        .nth(1)
+    // Under `cargo test` the arguments are the test harness's: not ours.
+    let steps: usize = (!cfg!(test))
+        .then(|| std::env::args().nth(1))
+        .flatten()
         .and_then(|s| s.parse().ok())
         .unwrap_or(if cfg!(test) { 2_000 } else { 1_000_000 });
     let arm = TwoLinkArm::paper();

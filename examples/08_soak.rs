@@ -62,8 +62,13 @@ fn peak_rss_kb() -> Option<u64> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let hours: f64 = std::env::args()
-        .nth(1)
+    // Under the test harness the arguments are the harness's (filters, flags).
+    let arg = if cfg!(test) {
+        None
+    } else {
+        std::env::args().nth(1)
+    };
+    let hours: f64 = arg
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(if cfg!(test) { 0.0005 } else { 24.0 });

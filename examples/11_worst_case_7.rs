@@ -40,7 +40,8 @@ fn arm() -> Result<PlanarArm<N>, adaptimp::Error> {
 }
 
 fn main() -> Result<(), adaptimp::Error> {
-    let mut args = std::env::args().skip(1);
+    // Under `cargo test` the arguments are the test harness's: not ours.
+    let mut args = std::env::args().skip(1).filter(|_| !cfg!(test));
     let steps: usize = args
         .next()
         .and_then(|s| s.parse().ok())

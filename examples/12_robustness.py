@@ -11,6 +11,8 @@ the RMS tracking error (t ≥ 2 s) and the saturation duty, written to
 
     python examples/12_robustness.py [output_dir]
 
+Needs the extra ``sweep`` (pandas; from a checkout: ``pip install ".[sweep]"``).
+
 ``ADAPTIMP_QUICK=1`` runs a small, short grid.
 """
 

@@ -40,7 +40,8 @@ share of steps that saturate.
     python examples/13_panda_table.py --figure             # docs/figures/contact_force.png
     python examples/13_panda_table.py --long 120           # and a long SF run, weight norms
 
-``ADAPTIMP_QUICK=1``: T = 1 s.
+Needs the extras ``mujoco`` and ``pinocchio`` (from a checkout:
+``pip install ".[mujoco,pinocchio]"``). ``ADAPTIMP_QUICK=1``: T = 1 s.
 """
 
 from __future__ import annotations
@@ -158,25 +159,25 @@ def long_run(sc: ac.PandaTable, basis: Any, T: float) -> None:
     )
     plant = amj.Plant(sc.model)
     plant.reset(sc.q0)
-    substeps = max(1, round(sc.ts / plant.timestep))
-    plant.timestep = sc.ts / substeps
+    substeps = max(1, round(sc.Ts / plant.timestep))
+    plant.timestep = sc.Ts / substeps
     print(f"\nlong run, {ROWS['sf'][0]}, T = {T:g} s: weight norms, mean normal force")
     print("| t (s) | ‖W_D‖ | ‖W_C‖ | ‖W_G‖ | mean F_n over the last 10 s (N) |")
     print("|---:|---:|---:|---:|---:|")
     forces: list[float] = []
-    for k in range(round(T / sc.ts)):
+    for k in range(round(T / sc.Ts)):
         wrench = plant.wrench()
         forces.append(-float(wrench[2]))
         tau = ctrl.step(plant.q, plant.dq, wrench)
         plant.apply(tau)
         plant.step(substeps)
         plant.forward()
-        if (k + 1) % round(10.0 / sc.ts) == 0:
+        if (k + 1) % round(10.0 / sc.Ts) == 0:
             sd = ctrl.inner.state_dict()
             norms = [float(np.linalg.norm(sd[w])) for w in ("W_D", "W_C", "W_G")]
-            mean = float(np.mean(forces[-round(10.0 / sc.ts) :]))
+            mean = float(np.mean(forces[-round(10.0 / sc.Ts) :]))
             print(
-                f"| {(k + 1) * sc.ts:.0f} | "
+                f"| {(k + 1) * sc.Ts:.0f} | "
                 + " | ".join(f"{v:.3g}" for v in norms)
                 + f" | {mean:.3f} |"
             )

@@ -1,16 +1,30 @@
 #!/usr/bin/env bash
-# Run every check and test of the project: Rust (format, lints, tests, no_std
-# build) and Python (build and install the package, ruff, stubs, pytest).
-# Works on a fresh machine with Rust and Python 3.9+; installs what it needs.
+# Run every check and test of the project: Rust (format, lints, no_std builds,
+# docs, tests, fuzzing), the wheel (built once, tested in a Rust-free
+# environment) and Python (ruff, stubs, mypy, the docs site, pytest).
+# Works on a fresh machine with Rust (stable and nightly) and Python 3.9+.
 #
-# The Python package is installed with its test tools into a virtual
-# environment under target/ (reused by later runs; override with
-# ADAPTIMP_VENV=DIR, the interpreter with PYTHON=...). pip's build of the
-# extension reuses the Rust build cache in target/ (CARGO_TARGET_DIR).
+# What it installs, and where (README "Tests"):
+#   apt     cmake, valgrind                      (if missing; as root)
+#   cargo   cargo-fuzz into ~/.cargo/bin         (if missing)
+#   pip     target/build-venv: maturin, ziglang (zig, the wheel's linker), auditwheel
+#           target/py-venv:    the wheel with its `test` extra (pytest, hypothesis, ruff,
+#                              mypy, pandas, xarray, tqdm, MkDocs, MuJoCo, Pinocchio,
+#                              example-robot-data, Dask)
+#           target/wheel-test: the wheel with its `mujoco` extra, without Rust on PATH
+# Disk it leaves: target/ (Rust builds and the venvs), fuzz/target/, dist/.
+#
+# ADAPTIMP_VENV=DIR overrides the test environment, PYTHON=... the interpreter,
+# ADAPTIMP_FUZZ_SECONDS the time of each fuzz target (default 10).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 step() { printf '\n==> %s  [%d s]\n' "$*" "$SECONDS"; }
+
+# One build cache for everything, no incremental compilation (a test run
+# builds once; incremental state only costs time and disk here).
+export CARGO_TARGET_DIR="$PWD/target"
+export CARGO_INCREMENTAL=0
 
 step "System tools: CMake and valgrind for the C ABI's examples"
 need=()
@@ -24,42 +38,60 @@ if [ ${#need[@]} -gt 0 ]; then
         exit 1
     fi
 fi
-
-step "Rust: format, lints"
-cargo fmt --all --check
-cargo fmt --manifest-path fuzz/Cargo.toml --check
-cargo clippy --workspace --all-targets -- -D warnings
-cargo clippy --all-targets --features python -- -D warnings
-
-step "Rust: no_std builds of the core (firmware: without and with alloc; the simulator), docs"
-cargo build --no-default-features
-cargo build --no-default-features --features alloc
-cargo build --no-default-features --features sim
-RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
-
-step "Rust: tests (the core, and the C ABI with its header check)"
-cargo test --workspace
-
-step "Fuzzing: a short run of each cargo-fuzz target (nightly)"
 if ! cargo +nightly --version >/dev/null 2>&1; then
     echo "the nightly toolchain is needed for cargo-fuzz (rustup toolchain install nightly)" >&2
     exit 1
 fi
-command -v cargo-fuzz >/dev/null || cargo install --locked cargo-fuzz
+
+step "Rust: format, lints"
+cargo fmt --all --check
+cargo fmt --manifest-path fuzz/Cargo.toml --check
+cargo clippy --quiet --workspace --all-targets -- -D warnings
+cargo clippy --quiet --all-targets --features python -- -D warnings
+
+step "Rust: no_std builds of the core (firmware: without and with alloc; the simulator), docs"
+cargo build --quiet --no-default-features
+cargo build --quiet --no-default-features --features alloc
+cargo build --quiet --no-default-features --features sim
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
+
+step "Rust: tests (the core, and the C ABI with its header check)"
+if command -v cargo-nextest >/dev/null; then
+    # Every test in its own process, the binaries in parallel; then the doctests.
+    cargo nextest run --workspace --no-fail-fast --status-level fail --final-status-level slow
+    cargo test --workspace --doc --quiet
+else
+    cargo test --workspace --quiet
+fi
+# The examples under the harness's own arguments (-q, a filter): they must not read them.
+cargo test --quiet --examples runs
+
+step "Fuzzing: a short run of each cargo-fuzz target (nightly)"
+command -v cargo-fuzz >/dev/null || cargo install --locked --quiet cargo-fuzz
 for target in config steps abi; do
-    (cd fuzz && cargo +nightly fuzz run -O "$target" -- \
-        -max_total_time="${ADAPTIMP_FUZZ_SECONDS:-15}" -timeout=5 -rss_limit_mb=2048 2>&1 |
+    (cd fuzz && CARGO_TARGET_DIR="$PWD/target" cargo +nightly fuzz run -O "$target" -- \
+        -max_total_time="${ADAPTIMP_FUZZ_SECONDS:-10}" -timeout=5 -rss_limit_mb=2048 2>&1 |
         grep -E "^Done|ERROR|panicked|SUMMARY")
 done
 
-step "Python: build and install the package with its test tools"
-export CARGO_TARGET_DIR="$PWD/target"
+step "Python: the wheel and the sdist (scripts/wheel.sh: maturin, zig for manylinux_2_17)"
+bash scripts/wheel.sh
+wheel=$(ls dist/adaptimp-*-cp39-abi3-*.whl)
+# The sdist holds what a build needs: its crate, unpacked outside this workspace,
+# resolves and compiles (check) offline.
+sdist_dir=$(mktemp -d)
+tar xzf dist/adaptimp-*.tar.gz -C "$sdist_dir"
+(cd "$sdist_dir"/adaptimp-* && cargo check --quiet --offline --features python)
+rm -rf "$sdist_dir"
+
+step "Python: the test environment (the wheel with its test extra)"
 venv="${ADAPTIMP_VENV:-$PWD/target/py-venv}"
 if [ ! -x "$venv/bin/python" ]; then
     "${PYTHON:-python3}" -m venv "$venv"
 fi
 py="$venv/bin/python"
-"$py" -m pip install --quiet --disable-pip-version-check ".[test]"
+"$py" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$wheel"
+"$py" -m pip install --quiet --disable-pip-version-check "$wheel[test]"
 
 step "Python: ruff, type stubs, mypy"
 "$py" -m ruff check python tests examples benches scripts
@@ -70,5 +102,9 @@ step "Python: ruff, type stubs, mypy"
 step "Docs: the site, warnings as errors (MkDocs + mkdocstrings)"
 NO_MKDOCS_2_WARNING=1 "$py" -m mkdocs build --strict --quiet
 
+step "The wheel without Rust: installed with its mujoco extra, reproduce and a MuJoCo run"
+bash scripts/test_wheel.sh
+
 step "Python: tests"
 "$py" -m pytest
+step "done"

@@ -92,6 +92,7 @@ pub use cartesian::kinematics;
 pub use control::tracker;
 pub use control::{
     auxiliary, config, controller, impedance, io, observer, robust, safety, saturation, state,
+    tuning,
 };
 pub use networks::{learning, network, rbf, simd};
 #[cfg(feature = "sim")]
@@ -103,7 +104,7 @@ pub use cartesian::{
     CartesianMeasurement, CartesianState, Chain, CompliantPose, Formulation, Joint, JointKind,
     OuterStep, PoseTarget, Transform,
 };
-pub use config::{Config, Law, ObserverInit, WeightBound};
+pub use config::{Conditions, Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};
 #[cfg(feature = "sim")]
 pub use disturb::{DisturbanceParams, Disturbances, Friction, TipPayload, WithFriction};

@@ -14,7 +14,7 @@
 
 use crate::cartesian::{CartesianConfig, Formulation};
 use crate::control::auxiliary::AuxLaw;
-use crate::control::config::{Config, Law, ObserverInit, WeightBound};
+use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound};
 use crate::control::impedance::ImpedanceMode;
 use crate::control::observer::Hold;
 use crate::control::robust::RobustKind;
@@ -275,8 +275,47 @@ pub const PARAMS: &[Param] = &[
     // The controller, SPEC §4–§9, §11.
     robot(p("Ts", Ctrl, Real, "s", "sampling period of the controller", "Ts > 0", R(50e-6)), R(1e-3)),
     p("K1", Ctrl, Joint, "1/s", "K1 of α1 = ẋd + K1 z1, (7)", "K1 > 0", R(6.0)),
-    p("Kp", Ctrl, Joint, "N m s/rad", "feedback gain Kp, (14)", "2Kp − I > 0", R(10.0)),
-    p("Kzeta", Ctrl, Joint, "1/s", "auxiliary-system gain Kζ, (11)", "2Kζ − I − KpᵀKp > 0", R(60.0)),
+    p(
+        "Kp",
+        Ctrl,
+        Joint,
+        "N m s/rad",
+        "feedback gain Kp, (14)",
+        "2Kp − I > 0 (conditions 'paper'); Kp > 0 ('scaled')",
+        R(10.0),
+    ),
+    p(
+        "Kzeta",
+        Ctrl,
+        Joint,
+        "1/s",
+        "auxiliary-system gain Kζ, (11)",
+        "2Kζ − I − KpᵀKp > 0 (conditions 'paper'); 2Kζ − ρ − Kp/d > 0 ('scaled')",
+        R(60.0),
+    ),
+    // SPEC §10: the Lyapunov function weighted by each joint's inertia scale.
+    p(
+        "inertia",
+        Ctrl,
+        Joint,
+        "kg m²",
+        "inertia scale d of each joint: the auxiliary system takes Δτ/d, the z1 term d·z1, the learning error d·z2 (SPEC §10)",
+        "1e-9 ≤ d ≤ 1e9",
+        R(1.0),
+    ),
+    p("rho", Ctrl, Real, "1/s", "Young weight ρ of ζᵀΔτ in the auxiliary system's β (SPEC §10)", "1e-9 ≤ ρ ≤ 1e9", R(1.0)),
+    robot(
+        p(
+            "conditions",
+            Ctrl,
+            Kind::Choice(&Conditions::NAMES),
+            "",
+            "stability conditions checked: the paper's (13) (unit weights: inertia = 1, rho = 1), or 'scaled' (SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0)",
+            "",
+            S("paper"),
+        ),
+        S("scaled"),
+    ),
     p("mu", Ctrl, Real, "N m", "radius μ of the auxiliary system's inner ball, (11)", "μ > 0", R(0.01)),
     p(
         "aux_law",
@@ -697,6 +736,9 @@ impl<const N: usize> Scenario<N> {
             "K1" => c.k1 = joint(n, value)?,
             "Kp" => c.kp = joint(n, value)?,
             "Kzeta" => c.kzeta = joint(n, value)?,
+            "inertia" => c.inertia = joint(n, value)?,
+            "rho" => c.rho = real(n, value)?,
+            "conditions" => c.conditions = choice(p, value, &Conditions::ALL)?,
             "mu" => c.mu = real(n, value)?,
             "aux_law" => c.aux_law = choice(p, value, &AuxLaw::ALL)?,
             "robust" => c.robust = choice(p, value, &RobustKind::ALL)?,
@@ -863,6 +905,9 @@ impl<const N: usize> Scenario<N> {
             kp,
             kzeta,
             mu,
+            inertia,
+            rho,
+            conditions,
             aux_law,
             robust,
             kr,
@@ -924,6 +969,9 @@ impl<const N: usize> Scenario<N> {
         f("K1", V(k1.as_slice()));
         f("Kp", V(kp.as_slice()));
         f("Kzeta", V(kzeta.as_slice()));
+        f("inertia", V(inertia.as_slice()));
+        f("rho", R(*rho));
+        f("conditions", S(conditions.name()));
         f("mu", R(*mu));
         f("aux_law", S(aux_law.name()));
         f("robust", S(robust.name()));

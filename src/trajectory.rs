@@ -107,6 +107,18 @@ impl<const N: usize> Sinusoid<N> {
     pub fn omega(&self) -> &Vector<N> {
         &self.omega
     }
+
+    /// The period 2π/ω (s) of the slowest joint that moves (a ≠ 0 or b ≠ 0,
+    /// ω ≠ 0), or `None` if none does.
+    pub fn period(&self) -> Option<f64> {
+        let slowest = (0..N)
+            .filter(|&i| (self.sin[i] != 0.0 || self.cos[i] != 0.0) && self.omega[i] != 0.0)
+            .map(|i| self.omega[i].abs())
+            .fold(f64::INFINITY, f64::min);
+        slowest
+            .is_finite()
+            .then(|| 2.0 * core::f64::consts::PI / slowest)
+    }
 }
 
 /// Samples per period for [`Sinusoid`]'s peak rates.

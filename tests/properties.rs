@@ -120,3 +120,62 @@ fn planar_gravity_is_the_gradient_of_potential_energy() {
         assert!((arm.gravity(&q)[i] - fd).abs() < 1e-7, "joint {i}");
     }
 }
+
+/// An inertia matrix (kg m²) with joint scales λ_i = 10^e_i over four
+/// decades and random coupling: S (A Aᵀ/N + I) S, S = diag(√λ), A random.
+fn inertia_matrix<const N: usize>(entries: &[f64], exps: &[f64]) -> Matrix<N> {
+    let a = Matrix::<N>::from_iterator(entries.iter().copied());
+    let s = Matrix::<N>::from_diagonal(&Vector::<N>::from_iterator(
+        exps.iter().map(|e| 10f64.powf(*e).sqrt()),
+    ));
+    let d = s * (a * a.transpose() / N as f64 + Matrix::<N>::identity()) * s;
+    (d + d.transpose()) / 2.0
+}
+
+/// SPEC §18: construction accepts the rule's configuration for any arm
+/// (inertias over four decades, any coupling), τmax and Ts, for each law.
+fn rule_builds<const N: usize>(entries: &[f64], exps: &[f64], tau: &[f64], ts: f64, amp: f64) {
+    use adaptimp::tuning::{default_task, Rule};
+    use adaptimp::{Controller, Law};
+    let d = inertia_matrix::<N>(entries, exps);
+    let tau_max = Vector::<N>::from_iterator(tau.iter().map(|e| 10f64.powf(*e)));
+    let lim = Vector::<N>::from_element(amp.max(1e-3) * 4.0);
+    let task = default_task(&Vector::zeros(), &-lim, &lim).expect("task");
+    let path = Rule::sample(&task, 2.0);
+    for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
+        let s = Rule::default()
+            .suggest(law, &d, &tau_max, ts, &path, 2.0, None)
+            .expect("the rule applies");
+        Controller::new(s.config, s.centers).expect("construction accepts the rule");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 200,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(18),
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn the_rule_always_builds_for_three_joints(
+        entries in prop::collection::vec(-1.0..1.0f64, 9),
+        exps in prop::collection::vec(-2.0..2.0f64, 3),
+        tau in prop::collection::vec(-2.0..3.0f64, 3),
+        ts in 1e-4..1e-2f64,
+        amp in 0.0..0.5f64,
+    ) {
+        rule_builds::<3>(&entries, &exps, &tau, ts, amp);
+    }
+
+    #[test]
+    fn the_rule_always_builds_for_seven_joints(
+        entries in prop::collection::vec(-1.0..1.0f64, 49),
+        exps in prop::collection::vec(-2.0..2.0f64, 7),
+        tau in prop::collection::vec(-2.0..3.0f64, 7),
+        ts in 1e-4..1e-2f64,
+        amp in 0.0..0.5f64,
+    ) {
+        rule_builds::<7>(&entries, &exps, &tau, ts, amp);
+    }
+}

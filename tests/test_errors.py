@@ -105,6 +105,15 @@ CONDITIONS = [
     ({"K1": [6.0, 0.0]}, "K1 > 0", "K1[1] = 0"),
     ({"Kp": 0.25}, "2Kp − I > 0", "2·Kp − 1[0] = -0.5"),
     ({"Kzeta": 50.0}, "2Kζ − I − KpᵀKp > 0", "2·Kzeta − 1 − Kp²[0] = -1"),
+    # SPEC §10's conditions with inertia scales (conditions "scaled").
+    ({"conditions": "scaled", "Kp": [10.0, -1.0]}, "Kp > 0", "Kp[1] = -1"),
+    (
+        {"conditions": "scaled", "Kzeta": 5.0},
+        "2Kζ − ρ − Kp/d > 0",
+        "2·Kzeta − rho − Kp/inertia[0] = -1",
+    ),
+    ({"conditions": "scaled", "inertia": [1.0, 1e-12]}, "d ≥ 1e-9", "inertia[1] = 0.000000000001"),
+    ({"conditions": "scaled", "rho": 0.0}, "ρ ≥ 1e-9", "rho = 0"),
     ({"gamma": [100.0, 0.0, 100.0]}, "Γ > 0", "gamma[1] = 0"),
     ({"sigma": -0.01}, "σ > 0", "sigma[0] = -0.01"),
     ({"eta2": 0.0}, "η² > 0", "eta2 = 0"),
@@ -135,6 +144,24 @@ def test_each_violated_condition_reaches_python_as_value_error(params, condition
     message = str(info.value)
     assert f"condition {condition} is violated" in message
     assert value in message
+
+
+def test_the_papers_conditions_need_the_papers_weights() -> None:
+    with pytest.raises(ValueError, match=r"conditions = paper: \(13\) is proved for the paper's"):
+        adaptimp.Controller("sf", inertia=[1.0, 2.0])
+    with pytest.raises(ValueError, match="use conditions = scaled"):
+        adaptimp.Controller("sf", rho=2.0)
+    # A light joint is not refused for being light: Kp = 0.03 N m s/rad on
+    # an inertia scale of 0.001 kg m² (Kp/d = 30 s⁻¹).
+    with pytest.raises(ValueError, match=r"2Kp − I > 0.*raise Kp above 0\.5"):
+        adaptimp.Controller("sf", Kp=[10.0, 0.03])
+    adaptimp.Controller(
+        "sf", conditions="scaled", Kp=[10.0, 0.03], inertia=[1.0, 0.001], Kzeta=[60.0, 20.0]
+    )
+    with pytest.raises(ValueError, match=r"raise Kzeta above 15\.5 for Kp = 0\.03 and inertia"):
+        adaptimp.Controller(
+            "sf", conditions="scaled", Kp=[10.0, 0.03], inertia=[1.0, 0.001], Kzeta=[60.0, 15.0]
+        )
 
 
 def test_controller_and_arm_report_conditions_too() -> None:

@@ -169,19 +169,28 @@ def test_plant_rejects_models_it_cannot_drive() -> None:
         amj.Plant("nowhere.xml")
 
 
-def test_a_urdf_with_finger_joints_is_rejected_by_name() -> None:
-    try:
-        path = _models.panda_urdf_path()
-    except ImportError:
-        pytest.skip("example-robot-data is not installed")
+def test_a_urdf_arm_is_its_chain_with_the_gripper_fixed() -> None:
+    path = _models.panda_urdf_path()
+    arm = _models.arm_urdf(path.read_text())
+    assert arm.joints == _models.PANDA_JOINTS
+    assert arm.effort == _models.PANDA_EFFORT
+    assert arm.tip == "panda_link7"
+    prismatic = "prismatic (the arm's joints are revolute)"
+    assert arm.fixed == dict.fromkeys(_models.PANDA_FINGERS, prismatic)
+    plant = amj.Plant(path)
+    assert plant.n == 7
+    assert plant.tau_max.tolist() == list(_models.PANDA_EFFORT)
+    # The plant itself still refuses a slide joint, by name.
+    spec, effort = amj._urdf_spec(path.read_text())
+    amj._add_motors(spec, effort)
     with pytest.raises(ValueError, match=r"panda_finger_joint1 \(mjJNT_SLIDE\)"):
-        amj.Plant(path)
+        amj.Plant(spec.compile())
 
 
 def test_import_error_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "mujoco", None)
     monkeypatch.delitem(sys.modules, "adaptimp.mujoco")
-    with pytest.raises(ImportError, match=r"pip install adaptimp\[mujoco\]"):
+    with pytest.raises(ImportError, match=r'pip install "\.\[mujoco\]" from a checkout, pip inst'):
         importlib.import_module("adaptimp.mujoco")
 
 
@@ -257,7 +266,7 @@ def test_the_wall_is_felt_through_the_sensor() -> None:
 class _Hold:
     """The smallest controller: a constant torque, a period, nothing else."""
 
-    ts = 1e-3
+    Ts = 1e-3
 
     def __init__(self, tau: list[float]) -> None:
         self.tau_cmd = np.array(tau)
@@ -328,7 +337,7 @@ class _InPython:
 
     def __init__(self, inner: adaptimp.Controller) -> None:
         self.inner = inner
-        self.ts = inner.ts
+        self.Ts = inner.Ts
         self.params = inner.params
 
     def step(self, q: object, tau_e: object, dq: object = None, **sp: object) -> np.ndarray:
@@ -457,7 +466,7 @@ _FEATHER = """<mujoco><option integrator="RK4" timestep="0.001"/><worldbody>
 class _Kick:
     """Zero torque, then full torque from row ``at`` on."""
 
-    ts = 1e-3
+    Ts = 1e-3
 
     def __init__(self, at: int) -> None:
         self.at, self.k = at, 0
@@ -501,7 +510,8 @@ def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause(
     assert str(native.value) == want
     # From the first row: the reset is at t = 0, the warning still tells.
     with pytest.raises(adaptimp.DivergedError, match=r"row 0 \(t = 0 s to 0.001 s\): MuJoCo"):
-        amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0))
+        # (q0 given: with a reference and no keyframe the arm would start on it.)
+        amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0), q0=[0.0])
 
 
 def test_plant_step_raises_when_mujoco_resets(

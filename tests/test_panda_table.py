@@ -19,9 +19,9 @@ def test_free_space_clik_follows_the_command(sc: ac.PandaTable) -> None:
     outer = sc.outer()
     err, gap = [], []
     for k in range(3000):
-        p, dp, ddp = sc.path(k * sc.ts, depth=0.0)
+        p, dp, ddp = sc.path(k * sc.Ts, depth=0.0)
         q, _, _ = outer.step(p, dp, ddp)
-        if k * sc.ts >= 1.5:
+        if k * sc.Ts >= 1.5:
             pd = outer.last("p_d")
             err.append(np.linalg.norm(sc.fk(q) - pd))
             gap.append(np.linalg.norm(pd - p))
@@ -38,7 +38,7 @@ def test_steady_contact_force_is_kd_times_depth(sc: ac.PandaTable) -> None:
     pc = np.array([p0[0], p0[1], w - 0.01])  # commanded 1 cm into the plane
     f = np.zeros(3)
     for k in range(4000):
-        s = min(k * sc.ts / 1.0, 1.0)
+        s = min(k * sc.Ts / 1.0, 1.0)
         q, _, _ = outer.step(p0 + s * (pc - p0), wrench=f)
         z = sc.fk(q)[2]
         f = np.array([0.0, 0.0, -ke * max(0.0, w - z), 0.0, 0.0, 0.0])  # the tool presses down

@@ -126,9 +126,14 @@ def test_simulate_runs_n_joints_with_a_planar_arm() -> None:
     assert len(res.metrics["peak_abs_tau"]) == 3
 
 
-def test_n_beyond_the_grid_needs_centres() -> None:
-    with pytest.raises(adaptimp.ConfigError, match=r"n = 4 needs RBF centres.*2\^16"):
-        adaptimp.Controller("sf", n=4)
+def test_n_beyond_the_grid_gets_centres_along_its_trajectory() -> None:
+    # SPEC §18: the default trajectory (0.2 − 0.2 cos πt on each joint) is
+    # 1.6 rad long per period in q for n = 4: L = ⌈2 · 1.6 / 0.2⌉ = 16.
+    ctrl = adaptimp.Controller("sf", n=4)
+    assert ctrl.nodes == 16
+    assert "centres along the trajectory" in repr(ctrl)
+    # A trajectory that does not move: 2n + 1 centres about its offset.
+    assert adaptimp.Controller("sf", n=5, xc_sin=0.0, xc_cos=0.0).nodes == 11
     with pytest.raises(adaptimp.ConfigError, match="n must be between 1 and 7"):
         adaptimp.Controller("sf", n=8)
     with pytest.raises(adaptimp.ConfigError, match=r"centers must have shape \(L, 12\)"):
@@ -516,7 +521,9 @@ def test_huge_integers_are_value_errors_not_overflow_errors() -> None:
 
 
 def test_diverged_error() -> None:
-    with pytest.raises(adaptimp.DivergedError, match="non-finite"):
+    # The unstable loop's plant leaves the ceilings of SPEC §14 (1e6 rad) at
+    # once: the run stops there, naming it, rather than at an overflow.
+    with pytest.raises(adaptimp.DivergedError, match=r"plant state q\[0\] = .* beyond .*±1e6"):
         adaptimp.simulate("pd", Ts=1e-2, Kp=1e4, Kzeta=1e9, tau_max=1e9, T=5.0)
 
 

@@ -41,7 +41,10 @@ def test_every_core_parameter_has_a_python_keyword_and_back() -> None:
 def test_the_table_carries_units_docs_conditions_and_choices() -> None:
     kzeta = BY_NAME["Kzeta"]
     assert (kzeta.group, kzeta.kind, kzeta.unit) == ("controller", "joint", "1/s")
-    assert kzeta.condition == "2Kζ − I − KpᵀKp > 0"
+    assert kzeta.condition == (
+        "2Kζ − I − KpᵀKp > 0 (conditions 'paper'); 2Kζ − ρ − Kp/d > 0 ('scaled')"
+    )
+    assert BY_NAME["conditions"].choices == ("paper", "scaled")
     assert BY_NAME["learning_step"].choices == ("euler", "normalized")
     assert BY_NAME["weight_bound"].kind == "bound"
     assert all(p.doc for p in PARAMS)
@@ -67,7 +70,7 @@ def test_help_lists_every_parameter_with_unit_and_condition() -> None:
     for p in PARAMS:
         assert f"{p.name}" in (doc if p.group in GROUPS else cart), p.name
     assert "Kzeta (1/s)" in doc
-    assert "valid: 2Kζ − I − KpᵀKp > 0" in doc
+    assert "valid: 2Kζ − I − KpᵀKp > 0 (conditions 'paper')" in doc
 
 
 def test_stubs_are_generated_from_the_schema() -> None:

@@ -1,94 +1,154 @@
-"""The gain and basis rule of SPEC §18 on arms nobody tuned for: the same code
-on a 3-joint planar arm under gravity, the UR5 and the Panda (MuJoCo, from the
-URDFs of example-robot-data): stable, within the torque limits, and the
-adaptive controllers no worse than PD with the same gains."""
+"""The gain and basis rule of SPEC §18 (the core's ``control::tuning``, through
+``adaptimp.tuning``): it follows its equations, and construction accepts what
+it returns for any serial arm of 1 to 7 joints, any τmax and any Ts."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import adaptimp
 from adaptimp import tuning
 
-W = 1.0  # rad/s
-A = 0.15  # rad
 
-
-def _path(q0: np.ndarray) -> Any:
-    """A sinusoid of amplitude A (rad) about q0 on every joint: (q, q̇, q̈) at t (s)."""
+def _swing(q0: np.ndarray, amp: float = 0.2, w: float = math.pi) -> Any:
+    """xc = q0 − A cos(ωt) on every joint (the default task's shape)."""
     ones = np.ones_like(q0)
     return lambda t: (
-        q0 + A * np.sin(W * t),
-        A * W * np.cos(W * t) * ones,
-        -A * W * W * np.sin(W * t) * ones,
+        q0 - amp * np.cos(w * t),
+        amp * w * np.sin(w * t) * ones,
+        amp * w * w * np.cos(w * t) * ones,
     )
 
 
 def test_suggest_follows_the_rule() -> None:
     arm = adaptimp.PlanarArm(3, masses=[2.0, 1.5, 1.0], lengths=[0.4, 0.35, 0.25])
     q0 = np.array([0.3, 0.3, 0.3])
-    kw = tuning.suggest(arm, q0, [60.0, 30.0, 15.0], Ts=1e-3, path=_path(q0), period=2 * np.pi)
-    dinv = np.diag(np.linalg.inv(arm.D(q0)))
-    np.testing.assert_allclose(kw["Kp"], 0.25 / (1e-3 * dinv), rtol=1e-12)
-    kp = np.array(kw["Kp"])
-    assert np.all(2 * np.array(kw["Kzeta"]) - 1 - kp**2 > 0)  # SPEC §10
-    assert kw["centers"].shape[1] == 12
-    assert 16 <= kw["centers"].shape[0] <= 256
+    kw = tuning.suggest(arm, q0, [60.0, 30.0, 15.0], Ts=1e-3, path=_swing(q0), period=2.0)
+    d = 1.0 / np.diag(np.linalg.inv(arm.D(q0)))
+    np.testing.assert_allclose(kw["inertia"], d, rtol=1e-12)
+    np.testing.assert_allclose(kw["Kp"], 0.25 * d / 1e-3, rtol=1e-12)  # (18.1)
+    assert kw["K1"] == [50.0] * 3  # (18.2): min(50, 0.05/Ts)
+    assert kw["Kzeta"] == [250.5] * 3  # (18.3): Kp/d + ρ/2
+    assert kw["conditions"] == "scaled"
+    # SPEC (10.3), with the margin Kp/d of the rule.
+    kp, kz = np.array(kw["Kp"]), np.array(kw["Kzeta"])
+    np.testing.assert_allclose(2 * kz - 1.0 - kp / d, 250.0, rtol=1e-12)
+    # Centres along the path: L = ⌈2 · 4 · 0.2 · √3 / 0.2⌉ = 14 → 16, on q, q̇ only.
+    assert kw["centers"].shape == (16, 12)
     assert np.all(np.isinf(kw["widths"][6:]))
+    # Learning (18.6): Ĝ's bandwidth ω² = ½ (Kp/d) K1 = 6250 s⁻², D̂ and Ĉ
+    # 25 times less in ω²; the leak after 25 periods.
+    gamma, sigma = np.array(kw["gamma"]), np.array(kw["sigma"])
+    np.testing.assert_allclose(gamma * sigma * 25 * 2.0, 1.0, rtol=1e-12)
+    assert gamma[2] > 0
+    assert np.all(np.array(kw["weight_bound"]) > 0)
+    for case in adaptimp.CASES:
+        adaptimp.Controller(case, "robot", **kw)
 
 
-def test_a_3_joint_planar_arm_under_gravity() -> None:
-    arm = adaptimp.PlanarArm(3, masses=[2.0, 1.5, 1.0], lengths=[0.4, 0.35, 0.25])
-    q0 = np.full(3, 0.3)
-    kw = tuning.suggest(arm, q0, [60.0, 30.0, 15.0], Ts=1e-3, path=_path(q0), period=2 * np.pi)
+def test_gains_alone_without_a_path() -> None:
+    kw = tuning.suggest(np.diag([2.0, 0.5]), [0.0, 0.0], 10.0, Ts=2e-3)
+    np.testing.assert_allclose(kw["Kp"], [250.0, 62.5], rtol=1e-15)
+    assert kw["K1"] == [25.0, 25.0]
+    assert "centers" not in kw
+    adaptimp.Controller("sf", "robot", **kw)
+
+
+def test_bad_arms_are_errors_naming_the_condition() -> None:
+    with pytest.raises(adaptimp.ConfigError, match="positive definite"):
+        tuning.suggest(np.diag([1.0, -1.0]), [0.0, 0.0], 10.0)
+    with pytest.raises(adaptimp.ConfigError, match="symmetric"):
+        tuning.suggest(np.array([[1.0, 0.5], [0.0, 1.0]]), [0.0, 0.0], 10.0)
+    with pytest.raises(adaptimp.ConfigError, match=r"τmax > 0.*tau_max\[1\] = 0"):
+        tuning.suggest(np.eye(2), [0.0, 0.0], [1.0, 0.0])
+    with pytest.raises(adaptimp.ConfigError, match=r"condition Ts ≤ 1 s"):
+        tuning.suggest(np.eye(2), [0.0, 0.0], 1.0, Ts=2.0)
+    with pytest.raises(adaptimp.ConfigError, match=r"d ≥ 1e-9"):
+        tuning.suggest(np.eye(2) * 1e-12, [0.0, 0.0], 1.0)
+    with pytest.raises(adaptimp.ConfigError, match="a path needs its period"):
+        tuning.suggest(np.eye(2), [0.0, 0.0], 1.0, path=_swing(np.zeros(2)))
+
+
+# -- A rule that always builds (property test over random arms) -------------
+
+decade = st.floats(min_value=-2.0, max_value=2.0)
+
+
+@st.composite
+def arms(draw: st.DrawFn) -> tuple[adaptimp.PlanarArm, np.ndarray]:
+    """A serial arm of 1 … 7 links, masses and inertias each over four decades
+    (1e-2 … 1e2 kg; 1e-2 … 1e2 times a rod's), lengths 0.05 … 1 m, in a random
+    posture."""
+    n = draw(st.integers(min_value=1, max_value=7))
+    masses = [10 ** draw(decade) for _ in range(n)]
+    lengths = [draw(st.floats(min_value=0.05, max_value=1.0)) for _ in range(n)]
+    inertias = [m * x * x / 12 * 10 ** draw(decade) for m, x in zip(masses, lengths)]
+    arm = adaptimp.PlanarArm(n, masses=masses, lengths=lengths, inertias=inertias)
+    q0 = np.array([draw(st.floats(min_value=-math.pi, max_value=math.pi)) for _ in range(n)])
+    return arm, q0
+
+
+@settings(
+    max_examples=40,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(
+    arm=arms(),
+    tau_exp=st.lists(st.floats(min_value=-2.0, max_value=3.0), min_size=7, max_size=7),
+    ts=st.sampled_from([1e-4, 2.5e-4, 5e-4, 1e-3, 2e-3, 4e-3, 1e-2]),
+    amp=st.floats(min_value=0.0, max_value=1.0),
+    w=st.floats(min_value=0.1, max_value=20.0),
+)
+def test_the_rule_always_builds(
+    arm: tuple[adaptimp.PlanarArm, np.ndarray],
+    tau_exp: list[float],
+    ts: float,
+    amp: float,
+    w: float,
+) -> None:
+    model, q0 = arm
+    tau_max = [10**e for e in tau_exp[: model.n]]
+    kw = tuning.suggest(model, q0, tau_max, Ts=ts, path=_swing(q0, amp, w), period=2 * math.pi / w)
+    for case in adaptimp.CASES:
+        ctrl = adaptimp.Controller(case, "robot", **kw)
+        # It also steps: the first step of an arm at rest on its path.
+        tau = ctrl.step(q0 - amp, np.zeros(model.n), np.zeros(model.n))
+        assert np.all(np.isfinite(tau))
+        assert np.all(np.abs(tau) <= np.array(tau_max))
+    # And the gains alone, for the vertex grid (n ≤ 3) or the default basis.
+    kw = tuning.suggest(model, q0, tau_max, Ts=ts)
     kw.pop("n")
-    common = {"n": 3, "arm": arm, "T": 8.0, "wall": None, "q0": q0.tolist()}
-    traj = {"xc_offset": 0.3, "xc_sin": A, "xc_cos": 0.0, "xc_omega": W}
-    rms = {}
-    for case in ("pd", "sf", "of"):
-        r = adaptimp.simulate(case, "robot", **common, **traj, **kw)
-        assert np.all(np.abs(r.tau_sat) <= np.array(kw["tau_max"]) + 1e-12)
-        rms[case] = r.metrics["rms_z1_after2"]
-    assert rms["sf"] < rms["pd"]
-    assert rms["of"] < rms["pd"]
+    adaptimp.Controller("sf", "robot", n=model.n, **kw)
 
 
-@pytest.mark.parametrize("robot", ["ur5", "panda"])
-def test_real_arms_in_mujoco(robot: str) -> None:
-    from adaptimp import mujoco as amj
-
-    if robot == "ur5":
-        from adaptimp._models import panda_urdf_path
-
-        root = panda_urdf_path().parents[2]
-        model = amj.from_urdf(root / "ur_description" / "urdf" / "ur5_robot.urdf")
-        q0 = np.array([0.0, -1.2, 1.2, -1.5, -1.5, 0.0])
-    else:
-        model = amj.panda()
-        q0 = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
-    plant = amj.Plant(model, contact=False)
-    kw = tuning.suggest(plant, q0, plant.tau_max, Ts=1e-3, path=_path(q0), period=2 * np.pi)
-    n = kw.pop("n")
-    rms = {}
-    for case in ("pd", "sf"):
-        ctrl = adaptimp.Controller(case, "robot", n=n, impedance="external", **kw)
-        r = amj.simulate(ctrl, amj.Plant(model, contact=False), T=5.0, q0=q0, reference=_path(q0))
-        assert np.all(np.isfinite(r.q))
-        assert np.all(np.abs(r.tau_sat) <= plant.tau_max + 1e-9)
-        assert r.metrics["sat_duty"] < 0.01
-        rms[case] = r.metrics["rms_z1_after2"]
-    assert rms["sf"] <= rms["pd"]
-    assert rms["pd"] < 0.05
+# -- The default task and the pieces a model gives ---------------------------
 
 
-def test_inertia_from_every_kind_of_model(tmp_path: Path) -> None:
+def test_the_default_task_swings_from_rest_within_the_limits() -> None:
+    kw = tuning.default_task([0.0, 1.0, 0.0], [-1.0, 0.9, -math.inf], [1.0, 1.3, math.inf])
+    assert kw["xc_offset"] == [0.0, 1.0, 0.0]
+    # A = min(0.2, range/4): the second joint's range is 0.4 rad.
+    np.testing.assert_allclose(kw["xc_cos"], [-0.2, -0.1, -0.2])
+    assert kw["xc_sin"] == [0.0, 0.0, 0.0]
+    assert kw["xc_omega"] == [math.pi] * 3
+    with pytest.raises(adaptimp.ConfigError, match="lo \\+ A ≤ home ≤ hi − A"):
+        tuning.default_task([0.95], [-1.0], [1.0])
+
+
+def test_inertia_and_gravity_from_every_kind_of_model(tmp_path: Path) -> None:
     arm = adaptimp.PlanarArm(2)
     q = [0.1, 0.2]
     np.testing.assert_array_equal(tuning.inertia(arm, q), arm.D(q))
     np.testing.assert_array_equal(tuning.inertia(arm.D(q), q), arm.D(q))
+    np.testing.assert_array_equal(tuning.gravity(arm, q), arm.G(q))
+    assert tuning.gravity(arm.D(q), q) is None
     with pytest.raises(TypeError, match="must have D"):
         tuning.inertia("not a model", q)

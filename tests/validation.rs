@@ -180,3 +180,48 @@ fn non_finite_measurement_is_an_error_and_changes_no_state() {
         }
     }
 }
+
+/// SPEC §10 (10.3): the conditions with inertia scales, each violated alone,
+/// its boundary rejected and just inside accepted; the paper's (13) kept for
+/// its unit weights only.
+#[test]
+fn the_scaled_conditions_name_themselves_and_their_boundary() {
+    use adaptimp::Conditions;
+    let scaled = || {
+        let mut c = Cfg::paper(Law::StateFeedback);
+        c.conditions = Conditions::Scaled;
+        // A light second joint: Kp/d = 0.03/0.001 = 30 s⁻¹.
+        c.kp = Vector::<2>::new(10.0, 0.03);
+        c.inertia = Vector::<2>::new(1.0, 0.001);
+        c.kzeta = Vector::<2>::new(60.0, 20.0);
+        c
+    };
+    assert!(build(scaled()).is_ok());
+    let cases: Vec<Violation> = vec![
+        ("Kp > 0", Box::new(|c: &mut Cfg| c.kp[1] = 0.0)),
+        (
+            "2Kζ − ρ − Kp/d > 0",
+            Box::new(|c: &mut Cfg| c.kzeta[1] = 15.5),
+        ),
+        ("d ≥ 1e-9", Box::new(|c: &mut Cfg| c.inertia[0] = 1e-10)),
+        ("ρ ≥ 1e-9", Box::new(|c: &mut Cfg| c.rho = -1.0)),
+    ];
+    for (condition, mutate) in cases {
+        let mut cfg = scaled();
+        mutate(&mut cfg);
+        let e = build(cfg).expect_err(condition);
+        assert!(
+            matches!(e, Error::Condition { condition: c, .. } if c == condition),
+            "{condition}: {e}"
+        );
+    }
+    // (2·15.5 − 1 − 30 = 0 is the boundary; just inside passes.)
+    let mut cfg = scaled();
+    cfg.kzeta[1] = 15.5 + 1e-9;
+    assert!(build(cfg).is_ok());
+    // The paper's conditions with other weights are refused, by name.
+    let mut cfg = Cfg::paper(Law::StateFeedback);
+    cfg.inertia[1] = 0.5;
+    let e = build(cfg).unwrap_err().to_string();
+    assert!(e.contains("use conditions = scaled"), "{e}");
+}

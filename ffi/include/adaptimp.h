@@ -52,6 +52,15 @@ typedef enum AdaptimpLaw {
   ADAPTIMP_LAW_OUTPUT_FEEDBACK = 2,
 } AdaptimpLaw;
 
+// The stability conditions construction checks (SPEC §10), in the order of
+// `Conditions::NAMES`.
+typedef enum AdaptimpConditions {
+  // The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 (needs inertia = 1, rho = 1).
+  ADAPTIMP_CONDITIONS_PAPER = 0,
+  // SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0.
+  ADAPTIMP_CONDITIONS_SCALED = 1,
+} AdaptimpConditions;
+
 // Inner law of the auxiliary system (SPEC §8), in the order of `AuxLaw::NAMES`.
 typedef enum AdaptimpAuxLaw {
   // ζ̇ = −Kζ ζ + Δτ inside the ball ("default").
@@ -174,6 +183,12 @@ typedef struct AdaptimpParams {
   double kp[ADAPTIMP_MAX_JOINTS];
   // Kζ (1/s), (11).
   double kzeta[ADAPTIMP_MAX_JOINTS];
+  // Inertia scale d of each joint (kg m²), SPEC §10.
+  double inertia[ADAPTIMP_MAX_JOINTS];
+  // Young weight ρ (1/s) of the auxiliary system, SPEC §10.
+  double rho;
+  // The stability conditions checked.
+  enum AdaptimpConditions conditions;
   // μ (N m), (11).
   double mu;
   // Inner law of the auxiliary system.
@@ -315,6 +330,35 @@ enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
                                             size_t n,
                                             enum AdaptimpLaw law,
                                             enum AdaptimpPreset preset);
+
+// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
+// the robot scenario's parameters for `law` with the rule's gains from the
+// inertia matrix `inertia` (n × n, row-major, kg m², at the task's start),
+// the limits `tau_max` (n, N m) and the period `ts` (s), and the conditions
+// "scaled" (SPEC §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
+// one period of `period` s, evenly spaced in time) also the centres along
+// it, the learning rates and the weight bounds: the centres are written to
+// `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
+// squared widths to `widths2` (4n), and `out->centers`, `out->nodes`,
+// `out->widths2` point at them. `gravity` (n, N m, G at the path's start)
+// may be NULL. `adaptimp_controller_new(out, …)` then builds the
+// controller. On an error `*out` is left unchanged.
+//
+// # Safety
+// Every pointer is NULL or valid for the lengths above; `centers` and
+// `widths2` are only read with a path.
+enum AdaptimpStatus adaptimp_params_suggest(struct AdaptimpParams *out,
+                                            size_t n,
+                                            enum AdaptimpLaw law,
+                                            const double *inertia,
+                                            const double *tau_max,
+                                            double ts,
+                                            const double *path,
+                                            size_t rows,
+                                            double period,
+                                            const double *gravity,
+                                            double *centers,
+                                            double *widths2);
 
 // Validate `params` (SPEC §10 and every other condition) and build a
 // controller into `*out` (free it with [`adaptimp_controller_free`]). On an

@@ -18,8 +18,8 @@
 
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
-    AnyBasis, AuxLaw, Centers, Command, Controller, Error, Fallback, FaultPolicy, Grid, HeapState,
-    Hold, ImpedanceMode, Law, LearningStep, Measurement, ObserverInit, RobustKind,
+    AnyBasis, AuxLaw, Centers, Command, Conditions, Controller, Error, Fallback, FaultPolicy, Grid,
+    HeapState, Hold, ImpedanceMode, Law, LearningStep, Measurement, ObserverInit, RobustKind,
     SaturationLearning, Setpoint, Sinusoid, Trajectory, Vector,
 };
 use core::ffi::c_char;
@@ -91,6 +91,17 @@ pub enum AdaptimpAuxLaw {
     Printed = 1,
     /// No −β term anywhere ("linear").
     Linear = 2,
+}
+
+/// The stability conditions construction checks (SPEC §10), in the order of
+/// `Conditions::NAMES`.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpConditions {
+    /// The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 (needs inertia = 1, rho = 1).
+    Paper = 0,
+    /// SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0.
+    Scaled = 1,
 }
 
 /// The robust term r(z2) (SPEC §7), in the order of `RobustKind::NAMES`.
@@ -211,6 +222,12 @@ pub struct AdaptimpParams {
     pub kp: [f64; ADAPTIMP_MAX_JOINTS],
     /// Kζ (1/s), (11).
     pub kzeta: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Inertia scale d of each joint (kg m²), SPEC §10.
+    pub inertia: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Young weight ρ (1/s) of the auxiliary system, SPEC §10.
+    pub rho: f64,
+    /// The stability conditions checked.
+    pub conditions: AdaptimpConditions,
     /// μ (N m), (11).
     pub mu: f64,
     /// Inner law of the auxiliary system.
@@ -389,6 +406,12 @@ macro_rules! sized {
                 _ => Err(fail(AdaptimpStatus::BadSize, &"n (the number of joints) must be 1 … 7")),
             }
         }
+        fn suggest(n: usize, args: &Suggest<'_>, out: &mut AdaptimpParams) -> Result<(), AdaptimpStatus> {
+            match n {
+                $($n => suggest_sized::<$n>(args, out),)+
+                _ => Err(fail(AdaptimpStatus::BadSize, &"n (the number of joints) must be 1 … 7")),
+            }
+        }
     };
 }
 
@@ -544,6 +567,7 @@ fn preset_of(p: AdaptimpPreset) -> Preset {
 }
 
 /// The C enums follow the order of the schema's choice names.
+const CONDITIONS: [AdaptimpConditions; 2] = [AdaptimpConditions::Paper, AdaptimpConditions::Scaled];
 const AUX: [AdaptimpAuxLaw; 3] = [
     AdaptimpAuxLaw::Default,
     AdaptimpAuxLaw::Printed,
@@ -596,6 +620,9 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         k1,
         kp,
         kzeta,
+        inertia,
+        rho,
+        conditions,
         mu,
         aux_law,
         robust,
@@ -645,11 +672,17 @@ fn scenario_of<const N: usize>(p: &AdaptimpParams) -> Result<Scenario<N>, Adapti
         AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
         AdaptimpWeightBound::Auto => Value::Str("auto"),
     };
-    let values: [(&str, Value<'_>); 40] = [
+    let values: [(&str, Value<'_>); 43] = [
         ("Ts", Value::Real(*ts)),
         ("K1", joint(k1)),
         ("Kp", joint(kp)),
         ("Kzeta", joint(kzeta)),
+        ("inertia", joint(inertia)),
+        ("rho", Value::Real(*rho)),
+        (
+            "conditions",
+            Value::Str(name_of(&CONDITIONS, conditions, &Conditions::NAMES)),
+        ),
         ("mu", Value::Real(*mu)),
         (
             "aux_law",
@@ -759,7 +792,11 @@ fn build_sized<const N: usize>(p: &AdaptimpParams) -> Result<Ctl<N>, AdaptimpSta
 }
 
 fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpParams) {
-    let s = Scenario::<N>::preset(preset, law);
+    fill_from(&Scenario::<N>::preset(preset, law), law, out);
+}
+
+/// `out` from the controller parameters of scenario `s` (centres: none).
+fn fill_from<const N: usize>(s: &Scenario<N>, law: Law, out: &mut AdaptimpParams) {
     let mut p = AdaptimpParams {
         n: N,
         law: match law {
@@ -771,6 +808,9 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
         k1: [0.0; ADAPTIMP_MAX_JOINTS],
         kp: [0.0; ADAPTIMP_MAX_JOINTS],
         kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
+        inertia: [0.0; ADAPTIMP_MAX_JOINTS],
+        rho: 0.0,
+        conditions: AdaptimpConditions::Paper,
         mu: 0.0,
         aux_law: AdaptimpAuxLaw::Default,
         robust: AdaptimpRobust::Sign,
@@ -835,6 +875,9 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
             "K1" => joint(&mut p.k1),
             "Kp" => joint(&mut p.kp),
             "Kzeta" => joint(&mut p.kzeta),
+            "inertia" => joint(&mut p.inertia),
+            "rho" => real(&mut p.rho),
+            "conditions" => p.conditions = from_name(&CONDITIONS, &Conditions::NAMES, choice),
             "mu" => real(&mut p.mu),
             "aux_law" => p.aux_law = from_name(&AUX, &AuxLaw::NAMES, choice),
             "robust" => p.robust = from_name(&ROBUST, &RobustKind::NAMES, choice),
@@ -886,6 +929,69 @@ fn fill_defaults<const N: usize>(law: Law, preset: Preset, out: &mut AdaptimpPar
     *out = p;
 }
 
+/// The inputs of [`adaptimp_params_suggest`], checked for NULL and length.
+struct Suggest<'a> {
+    law: Law,
+    inertia: &'a [f64],
+    tau_max: &'a [f64],
+    ts: f64,
+    /// Rows of 3n (q, q̇, q̈) and the period (s), or none.
+    path: Option<(&'a [f64], f64)>,
+    gravity: Option<&'a [f64]>,
+    /// Where the centres (ADAPTIMP_SUGGEST_MAX_NODES × 4n) and widths² (4n) go.
+    centers: *mut f64,
+    widths2: *mut f64,
+}
+
+fn suggest_sized<const N: usize>(
+    a: &Suggest<'_>,
+    out: &mut AdaptimpParams,
+) -> Result<(), AdaptimpStatus> {
+    use adaptimp::tuning::Rule;
+    let rule = Rule::default();
+    let d = adaptimp::Matrix::<N>::from_row_slice(a.inertia);
+    let tau = Vector::<N>::from_column_slice(a.tau_max);
+    let mut s = Scenario::<N>::preset(Preset::Robot, a.law);
+    let centers = match a.path {
+        None => {
+            s.config = rule.gains(a.law, &d, &tau, a.ts).map_err(core_error)?;
+            None
+        }
+        Some((rows, period)) => {
+            let samples: Vec<Setpoint<N>> = rows
+                .chunks_exact(3 * N)
+                .map(|r| Setpoint {
+                    x: Vector::from_column_slice(&r[..N]),
+                    dx: Vector::from_column_slice(&r[N..2 * N]),
+                    ddx: Vector::from_column_slice(&r[2 * N..]),
+                })
+                .collect();
+            let g = a.gravity.map(Vector::<N>::from_column_slice);
+            let sug = rule
+                .suggest(a.law, &d, &tau, a.ts, &samples, period, g.as_ref())
+                .map_err(core_error)?;
+            s.config = sug.config;
+            Some(sug.centers)
+        }
+    };
+    fill_from(&s, a.law, out);
+    if let Some(c) = centers {
+        let l = c.centers().len() / (4 * N);
+        // SAFETY (in `slice_mut`): the caller gives ADAPTIMP_SUGGEST_MAX_NODES
+        // rows of 4n reals and 4n reals, L ≤ that.
+        let dst = unsafe { slice_mut(a.centers, l * 4 * N, "centers") }?;
+        dst.copy_from_slice(c.centers());
+        let w = unsafe { slice_mut(a.widths2, 4 * N, "widths2") }?;
+        for (b, block) in c.widths2().iter().enumerate() {
+            w[b * N..(b + 1) * N].copy_from_slice(block.as_slice());
+        }
+        out.centers = a.centers;
+        out.nodes = l;
+        out.widths2 = a.widths2;
+    }
+    Ok(())
+}
+
 // ---------------------------------------------------------------------------
 // The API.
 // ---------------------------------------------------------------------------
@@ -921,6 +1027,79 @@ pub unsafe extern "C" fn adaptimp_params_default(
         // SAFETY (in `out`): checked for NULL; the caller's contract.
         let out = unsafe { self::out(out, "out") }?;
         defaults(n, law_of(law), preset_of(preset), out)
+    })
+}
+
+/// The most centres [`adaptimp_params_suggest`] places (its `centers`
+/// buffer holds this many rows of 4n reals).
+pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = adaptimp::tuning::NODES.1;
+
+/// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
+/// the robot scenario's parameters for `law` with the rule's gains from the
+/// inertia matrix `inertia` (n × n, row-major, kg m², at the task's start),
+/// the limits `tau_max` (n, N m) and the period `ts` (s), and the conditions
+/// "scaled" (SPEC §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
+/// one period of `period` s, evenly spaced in time) also the centres along
+/// it, the learning rates and the weight bounds: the centres are written to
+/// `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
+/// squared widths to `widths2` (4n), and `out->centers`, `out->nodes`,
+/// `out->widths2` point at them. `gravity` (n, N m, G at the path's start)
+/// may be NULL. `adaptimp_controller_new(out, …)` then builds the
+/// controller. On an error `*out` is left unchanged.
+///
+/// # Safety
+/// Every pointer is NULL or valid for the lengths above; `centers` and
+/// `widths2` are only read with a path.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn adaptimp_params_suggest(
+    out: *mut AdaptimpParams,
+    n: usize,
+    law: AdaptimpLaw,
+    inertia: *const f64,
+    tau_max: *const f64,
+    ts: f64,
+    path: *const f64,
+    rows: usize,
+    period: f64,
+    gravity: *const f64,
+    centers: *mut f64,
+    widths2: *mut f64,
+) -> AdaptimpStatus {
+    guard(|| {
+        if !(1..=ADAPTIMP_MAX_JOINTS).contains(&n) {
+            return Err(fail(
+                AdaptimpStatus::BadSize,
+                &"n (the number of joints) must be 1 … 7",
+            ));
+        }
+        // SAFETY (in `out`, `slice`): checked for NULL; the caller's contract.
+        let out = unsafe { self::out(out, "out") }?;
+        let args = Suggest {
+            law: law_of(law),
+            inertia: unsafe { slice(inertia, n * n, "inertia") }?,
+            tau_max: unsafe { slice(tau_max, n, "tau_max") }?,
+            ts,
+            path: if path.is_null() {
+                None
+            } else {
+                let len = rows
+                    .checked_mul(3 * n)
+                    .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"rows × 3n overflows"))?;
+                Some((unsafe { slice(path, len, "path") }?, period))
+            },
+            gravity: if gravity.is_null() {
+                None
+            } else {
+                Some(unsafe { slice(gravity, n, "gravity") }?)
+            },
+            centers,
+            widths2,
+        };
+        let mut filled = *out;
+        suggest(n, &args, &mut filled)?;
+        *out = filled;
+        Ok(())
     })
 }
 
@@ -1306,6 +1485,7 @@ mod tests {
     #[test]
     fn the_c_enums_follow_the_schemas_choice_order() {
         assert_eq!(AUX.len(), AuxLaw::NAMES.len());
+        assert_eq!(CONDITIONS.len(), Conditions::NAMES.len());
         assert_eq!(ROBUST.len(), RobustKind::NAMES.len());
         assert_eq!(STEP.len(), LearningStep::NAMES.len());
         assert_eq!(SATURATION.len(), SaturationLearning::NAMES.len());
@@ -1314,6 +1494,9 @@ mod tests {
         assert_eq!(IMPEDANCE.len(), ImpedanceMode::NAMES.len());
         let debug = |v: &dyn std::fmt::Debug| format!("{v:?}").to_lowercase();
         for (c, name) in ROBUST.iter().zip(RobustKind::NAMES) {
+            assert_eq!(debug(c), name);
+        }
+        for (c, name) in CONDITIONS.iter().zip(Conditions::NAMES) {
             assert_eq!(debug(c), name);
         }
         for (c, name) in STEP.iter().zip(LearningStep::NAMES) {
@@ -1368,6 +1551,6 @@ mod tests {
         check::<7>();
         // scenario_of sets exactly the controller group's names, in order (its
         // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 40);
+        assert_eq!(controller_names().count(), 43);
     }
 }

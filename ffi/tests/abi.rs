@@ -276,3 +276,116 @@ fn the_circle_of_the_preset_is_the_default_setpoint() {
         .unwrap();
     assert_eq!(&out.xc[..2], Sinusoid::paper().sample(0.0).x.as_slice());
 }
+
+/// SPEC §18 through the C ABI: `adaptimp_params_suggest` fills the rule's
+/// gains, centres and learning, and the controller it builds steps bit for
+/// bit as the Rust rule's.
+#[test]
+fn the_rule_through_the_abi_is_the_cores() {
+    use adaptimp::schema::{Preset, Scenario};
+    use adaptimp::tuning::{default_task, Rule};
+    use adaptimp::{Centers, Matrix};
+    let d = [2.0, 0.5, 0.1, 0.5, 1.0, 0.2, 0.1, 0.2, 0.05];
+    let tau = [50.0, 20.0, 5.0];
+    let gravity = [0.0, -3.0, -0.4];
+    let task = default_task(
+        &Vector::<3>::zeros(),
+        &Vector::from_element(-1.0),
+        &Vector::from_element(1.0),
+    )
+    .expect("task");
+    let path = Rule::sample(&task, 2.0);
+    let rows: Vec<f64> = path
+        .iter()
+        .flat_map(|s| s.x.iter().chain(s.dx.iter()).chain(s.ddx.iter()).copied())
+        .collect();
+    let mut centers = vec![0.0; ADAPTIMP_SUGGEST_MAX_NODES * 12];
+    let mut widths2 = [0.0; 12];
+    let mut p = defaults(3, AdaptimpLaw::StateFeedback, AdaptimpPreset::Paper);
+    // SAFETY: valid pointers with the documented lengths.
+    let s = unsafe {
+        adaptimp_params_suggest(
+            &mut p,
+            3,
+            AdaptimpLaw::StateFeedback,
+            d.as_ptr(),
+            tau.as_ptr(),
+            1e-3,
+            rows.as_ptr(),
+            path.len(),
+            2.0,
+            gravity.as_ptr(),
+            centers.as_mut_ptr(),
+            widths2.as_mut_ptr(),
+        )
+    };
+    assert_eq!(s, AdaptimpStatus::Ok, "{}", last_error());
+    let sug = Rule::default()
+        .suggest(
+            Law::StateFeedback,
+            &Matrix::<3>::from_row_slice(&d),
+            &Vector::from(tau),
+            1e-3,
+            &path,
+            2.0,
+            Some(&Vector::from(gravity)),
+        )
+        .expect("rule");
+    assert_eq!(&p.kp[..3], sug.config.kp.as_slice());
+    assert_eq!(&p.inertia[..3], sug.config.inertia.as_slice());
+    assert_eq!(p.conditions, AdaptimpConditions::Scaled);
+    assert_eq!(p.gamma, sug.config.gamma);
+    assert_eq!(p.nodes * 12, sug.centers.centers().len());
+    assert_eq!(p.centers, centers.as_ptr());
+    assert_eq!(&centers[..p.nodes * 12], sug.centers.centers());
+    let traj = Scenario::<3>::preset(Preset::Robot, Law::StateFeedback)
+        .trajectory()
+        .expect("trajectory");
+    let ctrl = Controller::for_trajectory(
+        sug.config,
+        Centers::new(sug.centers.centers().to_vec(), sug.centers.widths2()).expect("centres"),
+        &traj,
+    )
+    .expect("the rule builds");
+    let mut rust = Tracker::new(ctrl, traj);
+    let c = Handles::new(&p).expect("the rule builds through the ABI");
+    for k in 0..300 {
+        let t = k as f64 * 1e-3;
+        let q = [0.1 * t.sin(), -0.2 * t, 0.05];
+        let dq = [0.1 * t.cos(), -0.2, 0.0];
+        let ours = c.step(&q, Some(&dq), &[0.0; 3]).expect("step");
+        let theirs = rust
+            .step(&Measurement {
+                x: Vector::from(q),
+                dx: Some(Vector::from(dq)),
+                tau_e: Vector::zeros(),
+            })
+            .expect("step");
+        assert_eq!(&ours.tau_sat[..3], theirs.tau_sat.as_slice(), "k = {k}");
+    }
+    // Misuse is a status: a matrix that is not positive definite.
+    let bad = [1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0];
+    // SAFETY: valid pointers; no path.
+    let s = unsafe {
+        adaptimp_params_suggest(
+            &mut p,
+            3,
+            AdaptimpLaw::Pd,
+            bad.as_ptr(),
+            tau.as_ptr(),
+            1e-3,
+            ptr::null(),
+            0,
+            0.0,
+            ptr::null(),
+            ptr::null_mut(),
+            ptr::null_mut(),
+        )
+    };
+    assert_eq!(s, AdaptimpStatus::InvalidConfig);
+    assert!(
+        last_error().contains("positive definite"),
+        "{}",
+        last_error()
+    );
+}

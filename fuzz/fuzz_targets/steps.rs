@@ -1,7 +1,9 @@
 //! Fuzzed step sequences: the paper's and the robot scenario's controllers fed
 //! arbitrary measurements and setpoints (NaN, infinities, spikes). Every step
-//! returns a finite torque within the limits, or an error that leaves the
-//! state exactly as it was; the weights never become non-finite.
+//! returns a finite torque within the limits, or an error that leaves what
+//! the control law uses exactly as it was (and records a fallback within the
+//! limits); the weights never become non-finite; every state a step leaves
+//! is one `Controller::restore` accepts.
 #![no_main]
 
 use adaptimp::{Controller, Error, Law, Measurement, Setpoint, Sinusoid, Trajectory, Vector};
@@ -72,16 +74,29 @@ fuzz_target!(|input: Input| {
                 Err(e) => {
                     assert!(!matches!(e, Error::Diverged { .. }), "{e}");
                     state.save(&mut after).expect("save");
+                    // What the control law uses is unchanged: all but the
+                    // refusal record (the applied torque, the last measured
+                    // position) and the checksum, the last 2N + 1 values.
+                    let control = before.len() - 2 * 2 - 1;
                     assert!(
-                        before
+                        before[..control]
                             .iter()
-                            .zip(&after)
+                            .zip(&after[..control])
                             .all(|(a, b)| a.to_bits() == b.to_bits()),
                         "{e}"
                     );
+                    let applied = state.applied();
+                    for i in 0..2 {
+                        assert!(applied[i].is_finite() && applied[i].abs() <= limits[i]);
+                    }
                 }
             }
             assert!(state.weights().norms().iter().all(|n| n.is_finite()));
+            // Every state a step leaves, the controller restores.
+            state.save(&mut after).expect("save");
+            let mut copy = ctrl.new_state();
+            ctrl.restore(&mut copy, &after)
+                .expect("a stepped state restores");
         }
     }
 });

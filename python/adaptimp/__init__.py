@@ -42,8 +42,9 @@ from ._errors import (
 )
 from ._faults import Fault
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
+from ._plot import PLOT_KINDS
 from ._plot import compare as plot_compare
-from ._result import PLOT_KINDS, SimResult, metrics_table
+from ._result import SimResult, metrics_table
 from ._sweep import Choice, LogUniform, Normal, Uniform, sweep
 from .cartesian import CartesianController
 from .chain import Chain

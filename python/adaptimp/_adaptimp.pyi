@@ -22,6 +22,7 @@ __all__ = [
     "TwoLinkArm",
     "__version__",
     "centres_along",
+    "default_task",
     "defaults",
     "metrics",
     "schema_table",
@@ -29,6 +30,7 @@ __all__ = [
     "simulate_many",
     "simulate_mujoco",
     "simulate_mujoco_many",
+    "suggest",
 ]
 
 __version__: str
@@ -52,6 +54,14 @@ class ControllerParams(TypedDict, total=False):
     """feedback gain Kp, (14) (N m s/rad)."""
     Kzeta: float | _Joint
     """auxiliary-system gain Kζ, (11) (1/s)."""
+    inertia: float | _Joint
+    """inertia scale d of each joint: the auxiliary system takes Δτ/d, the z1 term d·z1, the
+    learning error d·z2 (SPEC §10) (kg m²)."""
+    rho: float
+    """Young weight ρ of ζᵀΔτ in the auxiliary system's β (SPEC §10) (1/s)."""
+    conditions: Literal["paper", "scaled"]
+    """stability conditions checked: the paper's (13) (unit weights: inertia = 1, rho = 1), or
+    'scaled' (SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0)."""
     mu: float
     """radius μ of the auxiliary system's inner ball, (11) (N m)."""
     aux_law: Literal["default", "printed", "linear"]
@@ -317,7 +327,7 @@ class Controller:
     @property
     def steps(self) -> int: ...
     @property
-    def ts(self) -> float: ...
+    def Ts(self) -> float: ...
     @property
     def zeta(self) -> _F: ...
     @property
@@ -326,6 +336,8 @@ class Controller:
     def tau(self) -> _F: ...
     @property
     def tau_sat(self) -> _F: ...
+    @property
+    def applied(self) -> _F: ...
     @property
     def dtau(self) -> _F: ...
     @property
@@ -420,7 +432,18 @@ def simulate_mujoco(
     """The closed loop on a MuJoCo MjModel/MjData with the GIL released (SPEC §13.2)."""
 
 def simulate_mujoco_many(
-    jobs: Sequence[tuple[Controller, Any, Any, dict[str, Any], dict[str, Any], float, float]],
+    jobs: Sequence[
+        tuple[
+            Controller,
+            Any,
+            Any,
+            dict[str, Any],
+            dict[str, Any],
+            float,
+            float,
+            tuple[_F, _F, _F] | None,
+        ]
+    ],
     threads: int | None = None,
     progress: Callable[[int, int], object] | None = None,
 ) -> list[dict[str, Any] | str]:
@@ -512,3 +535,20 @@ def centres_along(
     q: _F, dq: _F, tube: tuple[float, float], periodic: bool = False
 ) -> tuple[_F, _F]:
     """RBF centres (L, 4n) along an orbit and their squared widths (4n,), SPEC (15.2)."""
+
+def suggest(
+    case: str,
+    inertia: NDArray[np.float64],
+    tau_max: NDArray[np.float64],
+    ts: float,
+    path: NDArray[np.float64] | None = None,
+    period: float | None = None,
+    gravity: NDArray[np.float64] | None = None,
+) -> dict[str, Any]:
+    """The gain and basis rule of SPEC §18: "params" (every controller keyword),
+    with a path also "centers" (L, 4n) and "widths" (4n,)."""
+
+def default_task(
+    home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
+) -> tuple[list[float], list[float], list[float], list[float]]:
+    """The default task of SPEC §18: (xc_offset, xc_sin, xc_cos, xc_omega)."""

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
-from ._errors import ConfigError, StabilityWarning
+from ._errors import ConfigError, StabilityWarning, period_alias
 from ._faults import Fault
 from ._params import (
     BY_NAME,
@@ -49,12 +49,8 @@ def _basis(
     if centers is None:
         if widths is not None:
             raise TypeError("widths needs centers (the vertex grid's width is eta2)")
-        if n > 3:
-            raise ConfigError(
-                f"n = {n} needs RBF centres: the paper's vertex grid has 2^(4n) nodes "
-                f"(2^{4 * n} here) and exists for n ≤ 3; pass centers= (an (L, {4 * n}) array "
-                "of x, v, α1, α̇1 coordinates) and widths="
-            )
+        # n ≤ 3: the paper's vertex grid; beyond, the core places the rule's
+        # centres along the controller's own trajectory (SPEC §18).
         return None, None
     c = np.asarray(centers)
     if c.dtype.kind not in "iuf":
@@ -102,18 +98,21 @@ def _check_stability(core: _adaptimp.Controller, p: Mapping[str, Any], stackleve
         return
     gain, kp = core.learning_gain
     if gain >= kp:
+        scaled = any(d != 1.0 for d in p["inertia"])
+        against = "Kp/inertia" if scaled else "Kp"
         warnings.warn(
             StabilityWarning(
                 f"explicit-Euler learning is unstable at Ts = {p['Ts']:g} s: its per-step "
-                f"gain Ts‖S‖²(ΓD‖ẍc‖² + ΓC‖ẋc‖² + ΓG) = {gain:.3g} N m s/rad exceeds "
-                f"Kp = {kp:g} (the Jury condition of docs/robot.md); use scenario='robot', "
-                "or learning_step='normalized', or a smaller Ts or gamma"
+                f"gain Ts‖S‖²(ΓD‖ẍc‖² + ΓC‖ẋc‖² + ΓG) = {gain:.3g} exceeds "
+                f"{against} = {kp:g} (the Jury condition of docs/robot.md, per unit inertia "
+                "scale); use scenario='robot', or learning_step='normalized', or a smaller Ts "
+                "or gamma"
             ),
             stacklevel=stacklevel + 1,
         )
 
 
-class _Progress:
+class ProgressReport:
     """Progress of a long call: silent for its first ``delay`` seconds, then a tqdm
     bar if tqdm is installed, else a line on stderr rewritten in place."""
 
@@ -158,7 +157,7 @@ def _progress(progress: Progress, desc: str) -> tuple[Callable[[int, int], objec
     if progress is None or progress is False:
         return None, None
     if progress is True:
-        p = _Progress(desc)
+        p = ProgressReport(desc)
         return p, p
     if callable(progress):
         return progress, None
@@ -229,7 +228,10 @@ def simulate(
         else ``PlanarArm(n)``. The controller is model-free and never reads it.
     centers : array_like, shape (L, 4n), optional
         RBF centres (rows of x, v, α1, α̇1; rad, rad/s, rad/s, rad/s²) instead
-        of the paper's vertex grid (which exists for n ≤ 3).
+        of the paper's vertex grid (which exists for n ≤ 3). Without them for
+        n > 3: the rule's centres along one period of the commanded trajectory
+        (``xc_*``), or, if it does not move, 2n + 1 centres about its offset
+        (SPEC §18).
     widths : float or array_like, shape (4n,), optional
         The centres' widths η_d per input dimension (units of that input):
         S_i = exp(−Σ_d (Z_d − μ_id)² / η_d²); ``np.inf`` leaves input d out
@@ -397,7 +399,8 @@ class Controller(_adaptimp.Controller):
         Joints, 1 … 7 (default 2).
     centers, widths : array_like, optional
         RBF centres (L, 4n) and widths (4n,) instead of the vertex grid (see
-        :func:`simulate`); required for n > 3.
+        :func:`simulate`); for n > 3 without them, the rule's default basis
+        along the commanded trajectory (SPEC §18).
     **params
         Controller parameters by name, as for :func:`simulate` (``Ts``, ``Kp``,
         ``K1``, ``Kzeta``, ``gamma``, ``tau_max``, ``xc_offset``, …). The run's,
@@ -415,8 +418,16 @@ class Controller(_adaptimp.Controller):
     measurement and returns (torque, error message or None). ``replay`` runs K
     steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
     ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
-    ``ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``dtau``, ``z1``,
+    ``Ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``applied`` (the
+    torque to apply now: after a refused step, the fallback), ``dtau``, ``z1``,
     ``xc``, ``xd``, ``dq_hat``, ``weights``, ``weight_bound``, ``fault``.
+
+    **Faults.** Every refused step, whichever method refused it, records the
+    fault (``fault``; with ``fault_policy="latch"`` later steps raise
+    ``FaultError`` until ``clear_fault()``) and takes the fallback as the
+    torque applied, from which the next step's ``tau_rate_max`` is measured.
+    ``restore``, ``load_state_dict`` and ``load_weights`` refuse a state this
+    controller could never step. The table is in docs/reliability.md.
 
     **Threads.** Each call is atomic: a controller is guarded by a lock, and a
     thread that finds it in use waits (with the GIL released) until the other
@@ -546,7 +557,11 @@ class Controller(_adaptimp.Controller):
         controller continues exactly where the saved one stopped. With
         ``weights_only=True`` only the weights are loaded, into the current
         state (call :meth:`reset` first to start a new run from t = 0 with
-        them: a warm start). Checked before anything changes.
+        them: a warm start). Checked before anything changes: a state this
+        controller could never step is refused (see :meth:`restore`), and so
+        are keys that disagree with the ``snapshot`` they travel with (edited
+        ``W_D``, ``steps``, …: load edited weights with ``weights_only=True``),
+        and a snapshot of another case.
         """
         if not isinstance(state, Mapping):
             raise TypeError(f"state must be a dict, got {type(state).__name__}")
@@ -558,8 +573,25 @@ class Controller(_adaptimp.Controller):
                 raise ConfigError(f"state has {key} = {int(state[key])}, this controller {mine}")
         if weights_only or "snapshot" not in state:
             self.load_weights(_weights_dict(state))
-        else:
-            self.restore(np.ascontiguousarray(state["snapshot"], dtype=np.float64))
+            return
+        if "case" in state and str(state["case"]) != self.case:
+            raise ConfigError(
+                f"state is of case {str(state['case'])!r}, this controller {self.case!r} "
+                "(load its weights with weights_only=True)"
+            )
+        snapshot = np.ascontiguousarray(state["snapshot"], dtype=np.float64)
+        # What the snapshot holds, read by the core on a scratch copy: every
+        # other key given must agree with it.
+        scratch = self.__copy__()
+        scratch.restore(snapshot)
+        restored = scratch.state_dict()
+        for key in ("W_D", "W_C", "W_G", "zeta", "steps", "t"):
+            if key in state and not np.array_equal(np.asarray(state[key]), restored[key]):
+                raise ConfigError(
+                    f"state[{key!r}] disagrees with state['snapshot']: drop the snapshot "
+                    "to load edited weights (load_state_dict(state, weights_only=True))"
+                )
+        self.restore(snapshot)
 
     # -- conveniences -------------------------------------------------------
 
@@ -630,12 +662,15 @@ class Controller(_adaptimp.Controller):
         return dict(self._params)
 
     @property
-    def Ts(self) -> float:
-        """Sampling period Ts (s)."""
-        return self.ts
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     def __repr__(self) -> str:
-        basis = "vertex grid" if self._centers is None else "user centres"
+        if self._centers is not None:
+            basis = "user centres"
+        else:
+            basis = "vertex grid" if self.n <= 3 else "centres along the trajectory"
         return (
             f"adaptimp.Controller({self.case!r}, scenario={self._scenario!r}, n={self.n}): "
             f"{self.nodes} RBF nodes ({basis}), Ts = {self.Ts:g} s, "

@@ -21,8 +21,9 @@ class ConfigError(AdaptimpError, ValueError):
 class MeasurementError(AdaptimpError, ValueError):
     """A step's input that is not a measurement: non-finite, of the wrong shape,
     beyond a plausibility limit, or missing (``dq`` for "pd"/"sf"). Named as you
-    named it (``q``, ``dq``, ``tau_e``, ``xc``). The controller's state is
-    unchanged. A ``ValueError``."""
+    named it (``q``, ``dq``, ``tau_e``, ``xc``). What the control law uses is
+    unchanged; the refusal is recorded (the fault, the fallback as the torque
+    applied: the fault semantics of docs/reliability.md). A ``ValueError``."""
 
 
 class DivergedError(AdaptimpError, ValueError, ArithmeticError):
@@ -51,3 +52,29 @@ __all__ = [
     "MeasurementError",
     "StabilityWarning",
 ]
+
+
+def period_alias(owner: object) -> float:
+    """The deprecated ``.ts`` of adaptimp's objects: warns, then returns ``.Ts`` (s).
+
+    ``Ts`` is the one name of the sampling period (the schema's, ``simulate(Ts=…)``);
+    ``.ts`` stays readable, for code written before, with a ``DeprecationWarning``.
+    """
+    import warnings
+
+    warnings.warn(
+        f"{type(owner).__name__}.ts is deprecated: the period is .Ts (s)",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    return float(owner.Ts)  # type: ignore[attr-defined]
+
+
+def needs_extra(what: str, package: str, extra: str) -> ImportError:
+    """The ImportError of an optional dependency: what needs it, and the pip
+    commands that install it, as they install (quoted, for zsh too)."""
+    return ImportError(
+        f"{what} needs {package}, an optional dependency (adaptimp's extra {extra!r}): "
+        f'pip install "{package}"; or adaptimp with the extra: pip install ".[{extra}]" '
+        f'from a checkout, pip install "adaptimp-<version>-<tags>.whl[{extra}]" from a wheel'
+    )

@@ -13,9 +13,13 @@ Nothing here imports MuJoCo or Pinocchio; :mod:`adaptimp.mujoco` and
 from __future__ import annotations
 
 import importlib.metadata
+import math
 import os
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
 from pathlib import Path
+
+from ._errors import needs_extra
 
 MODELS_DIR = Path(__file__).resolve().parent / "models"
 """The packaged model files."""
@@ -53,7 +57,7 @@ def panda_urdf_path() -> Path:
     Raises
     ------
     ImportError
-        ``example-robot-data`` is not installed (``pip install adaptimp[pinocchio]``).
+        ``example-robot-data`` is not installed (the extra ``pinocchio``).
     """
     override = os.environ.get("ADAPTIMP_PANDA_URDF")
     if override:
@@ -61,10 +65,7 @@ def panda_urdf_path() -> Path:
     try:
         dist = importlib.metadata.distribution(_ERD)
     except importlib.metadata.PackageNotFoundError as e:
-        raise ImportError(
-            "the Panda model comes from the package example-robot-data: "
-            "pip install adaptimp[pinocchio]"
-        ) from e
+        raise needs_extra("the Panda model", "example-robot-data>=4", "pinocchio") from e
     path = Path(str(dist.locate_file(_PANDA_URDF)))
     if not path.is_file():
         raise ImportError(f"example-robot-data {dist.version} has no Panda URDF at {path}")
@@ -110,3 +111,180 @@ def panda_arm_urdf() -> str:
     joints fixed (closed, the fingers' masses then ride on the hand)."""
     text, _ = adapt_urdf(panda_urdf_path().read_text(), fix=PANDA_FINGERS)
     return text
+
+
+GRIPPER_WORDS = ("gripper", "finger", "jaw", "claw")
+"""Joint names containing one of these (any case) belong to a gripper, which
+:func:`arm_urdf` fixes."""
+
+
+@dataclass(frozen=True)
+class ArmURDF:
+    """A URDF reduced to the serial arm adaptimp drives (:func:`arm_urdf`).
+
+    Attributes
+    ----------
+    text : str
+        The reduced URDF (kinematics and inertias only; every joint not in
+        ``joints`` made fixed at its zero position).
+    joints : tuple of str
+        The arm's joints, base to tip: the revolute and continuous joints of
+        the longest serial chain from the root.
+    lower, upper : tuple of float
+        Their position limits (rad); ∓inf for a continuous joint.
+    effort : tuple of float
+        Their ``<limit effort>`` (N m); NaN where the URDF gives none or zero.
+    tip : str
+        The child link of the last joint: the end-effector body.
+    fixed : dict
+        Every other movable joint of the URDF and why it was fixed.
+    """
+
+    text: str
+    joints: tuple[str, ...]
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    effort: tuple[float, ...]
+    tip: str
+    fixed: dict[str, str] = field(default_factory=dict)
+
+
+def _float(e: ET.Element | None, name: str, default: float) -> float:
+    if e is None or e.get(name) is None:
+        return default
+    try:
+        return float(e.get(name, "nan"))
+    except ValueError:
+        return default
+
+
+def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
+    """The serial arm of a URDF, as :func:`adaptimp.mujoco.from_urdf` and
+    :func:`adaptimp.baselines.pinocchio_model` load it (one reduction for both).
+
+    :func:`adapt_urdf`'s clean-up (no meshes, no joint dynamics), then:
+
+    - joints named in ``fix``, prismatic joints (a linear axis or a finger)
+      and mimic joints are fixed;
+    - the arm is the longest serial chain of the remaining revolute and
+      continuous joints from the root (the most of them on one path; the
+      first in document order on a tie), and it ends where the tree branches
+      into two or more subtrees with movable joints that are each shorter
+      than the chain so far (a hand: fingers are shorter than the arm that
+      holds them; a humanoid's arms are longer than its torso, so the chain
+      goes on along one of them);
+    - a joint whose name contains a word of :data:`GRIPPER_WORDS` is fixed
+      when it comes after a joint of the arm whose name does not (a gripper
+      on the arm; a robot that is itself a finger keeps its joints);
+    - movable joints off the arm (another arm, a head, a hand) are fixed.
+
+    A revolute joint whose limits leave no range (lower ≥ upper, often
+    "0 0" in exported files) is taken as unlimited: a continuous joint.
+    Every fixed joint is fixed at its zero position. Raises ``ValueError`` if
+    no movable joint is left.
+    """
+    root = ET.fromstring(text)
+    mimic = {j.get("name", "") for j in root.findall("joint") if j.find("mimic") is not None}
+    base, _ = adapt_urdf(text)
+    root = ET.fromstring(base)
+    fixed: dict[str, str] = {}
+    children: dict[str, list[ET.Element]] = {}
+    parents: set[str] = set()
+    for joint in root.findall("joint"):
+        name = joint.get("name", "")
+        kind = joint.get("type", "")
+        parent = joint.find("parent")
+        child = joint.find("child")
+        if parent is None or child is None:
+            raise ValueError(f"URDF joint {name!r} has no parent or child link")
+        children.setdefault(parent.get("link", ""), []).append(joint)
+        parents.add(child.get("link", ""))
+        limit = joint.find("limit")
+        lo, hi = _float(limit, "lower", -math.inf), _float(limit, "upper", math.inf)
+        if kind == "revolute" and not lo < hi:
+            joint.set("type", "continuous")  # no range given: unlimited
+            if limit is not None:
+                for attr in ("lower", "upper"):
+                    limit.attrib.pop(attr, None)
+        if kind in ("fixed", "floating", "planar"):
+            continue
+        if name in fix:
+            fixed[name] = "asked"
+        elif kind == "prismatic":
+            fixed[name] = "prismatic (the arm's joints are revolute)"
+        elif name in mimic:
+            fixed[name] = "mimic joint"
+    roots = [
+        link.get("name", "") for link in root.findall("link") if link.get("name") not in parents
+    ]
+    if len(roots) != 1:
+        raise ValueError(f"the URDF must have one root link, found {roots}")
+
+    def movable(j: ET.Element) -> bool:
+        return j.get("type") in ("revolute", "continuous") and j.get("name") not in fixed
+
+    def gripper(j: ET.Element) -> str | None:
+        words = [w for w in GRIPPER_WORDS if w in j.get("name", "").lower()]
+        return words[0] if words else None
+
+    def longest(link: str, held: int, arm: bool) -> list[ET.Element]:
+        """The movable joints of the arm's chain below ``link``, with ``held``
+        joints above it, ``arm`` if one of them is not a gripper's."""
+        options = []
+        for j in children.get(link, []):
+            child = j.find("child")
+            assert child is not None
+            word = gripper(j)
+            if word is not None and arm and movable(j):
+                fixed[j.get("name", "")] = f"a gripper joint (its name contains {word!r})"
+            own = [j] if movable(j) else []
+            below = longest(
+                child.get("link", ""), held + len(own), arm or (bool(own) and word is None)
+            )
+            options.append(own + below)
+        carrying = [c for c in options if c]
+        if held > 0 and len(carrying) >= 2 and all(len(c) < held for c in carrying):
+            return []  # a hand: the arm ends here
+        return max(options, key=len, default=[])
+
+    chain = longest(roots[0], 0, False)
+    on_chain = {j.get("name", "") for j in chain}
+    for j in root.findall("joint"):
+        name = j.get("name", "")
+        if movable(j) and name not in on_chain:
+            fixed[name] = "off the arm's chain (a branch)"
+    if not chain:
+        raise ValueError(
+            "the URDF has no revolute or continuous joint to drive"
+            + (f" (fixed: {fixed})" if fixed else "")
+        )
+    for j in root.findall("joint"):
+        if j.get("name", "") in fixed:
+            j.set("type", "fixed")
+            for tag in ("axis", "limit"):
+                for e in j.findall(tag):
+                    j.remove(e)
+    lower: list[float] = []
+    upper: list[float] = []
+    effort: list[float] = []
+    for j in chain:
+        lim = j.find("limit")
+        if j.get("type") == "continuous":
+            lower.append(-math.inf)
+            upper.append(math.inf)
+        else:
+            lower.append(_float(lim, "lower", -math.inf))
+            upper.append(_float(lim, "upper", math.inf))
+        given = _float(lim, "effort", math.nan)
+        effort.append(given if given > 0 and math.isfinite(given) else math.nan)
+    tip = chain[-1].find("child")
+    assert tip is not None
+    return ArmURDF(
+        text=ET.tostring(root, encoding="unicode"),
+        joints=tuple(j.get("name", "") for j in chain),
+        lower=tuple(lower),
+        upper=tuple(upper),
+        effort=tuple(effort),
+        tip=tip.get("link", ""),
+        fixed=fixed,
+    )

@@ -184,7 +184,7 @@ def _real(p: Param, value: object) -> float:
     return x
 
 
-def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
+def _vector(p: Param, value: object, size: int, per: str, inf_ok: bool = False) -> list[float]:
     if isinstance(value, (str, bytes, bool)):
         raise TypeError(
             f"{p.name} must be a number or a sequence of {size} numbers ({per}){_unit(p)}, "
@@ -218,9 +218,11 @@ def _vector(p: Param, value: object, size: int, per: str) -> list[float]:
         out = np.broadcast_to(arr.astype(np.float64), (size,))
     except OverflowError:
         raise ConfigError(f"{p.name} holds a number too large for a float") from None
-    bad = np.flatnonzero(~np.isfinite(out))
+    # A limit may be +inf (none on that joint), as in C.
+    bad = np.flatnonzero(np.isnan(out) if inf_ok else ~np.isfinite(out))
     if bad.size:
-        raise ConfigError(f"{p.name}[{bad[0]}] must be finite, got {out[bad[0]]}")
+        need = "a number (inf: no limit)" if inf_ok else "finite"
+        raise ConfigError(f"{p.name}[{bad[0]}] must be {need}, got {out[bad[0]]}")
     return [float(x) for x in out]
 
 
@@ -258,7 +260,11 @@ def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
     if p.kind in ("optional", "derived"):
         return None if value is None else _real(p, value)
     if p.kind == "limit":
-        return None if value is None else _vector(p, value, n, "one value per joint")
+        if value is None:
+            return None
+        v = _vector(p, value, n, "one value per joint", inf_ok=True)
+        # Infinity is "no limit": on every joint, that is None.
+        return None if all(x == math.inf for x in v) else v
     if p.kind == "axes":
         return _vector(p, value, 3, "one value per axis x, y, z")
     if p.kind == "derived_axes":
@@ -386,8 +392,20 @@ def config_hint(message: str, params: Mapping[str, Any]) -> str:
                     f"raise Kzeta above {_fmt(need)} for Kp = {_fmt(k)} (joint {i}), "
                     f"or lower Kp below {_fmt(top)} for Kzeta = {_fmt(z)}"
                 )
+    if "2Kζ − ρ − Kp/d" in message and kp is not None:
+        kz, d, rho = params["Kzeta"], params["inertia"], params["rho"]
+        for i, (k, z, di) in enumerate(zip(kp, kz, d)):
+            if 2.0 * z - rho - k / di <= 0.0:
+                return (
+                    f"raise Kzeta above {_fmt((rho + k / di) / 2.0)} for Kp = {_fmt(k)} and "
+                    f"inertia = {_fmt(di)} (joint {i}), or lower Kp below "
+                    f"{_fmt(max(2.0 * z - rho, 0.0) * di)}"
+                )
     if "2Kp − I" in message:
-        return "raise Kp above 0.5 on every joint"
+        return (
+            "raise Kp above 0.5 on every joint, or use conditions='scaled' (SPEC §10: "
+            "Kp > 0 with inertia scales)"
+        )
     if "Ts Γ σ < 1" in message:
         ts = params["Ts"]
         return (

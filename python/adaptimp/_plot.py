@@ -3,6 +3,11 @@
 Each function returns a matplotlib ``Figure`` (made through pyplot, so that
 ``plt.show()`` and notebooks display it). When there is no display, the Agg
 backend is selected before pyplot is first imported.
+
+This module owns the registry of plot kinds: :data:`FIGURES` for
+:meth:`adaptimp.Run.plot`, :data:`MUJOCO_FIGURES` for
+``adaptimp.mujoco.MujocoResult.plot`` (with "contact"). It reads runs through
+the :class:`Run` protocol and imports nothing of the result classes.
 """
 
 from __future__ import annotations
@@ -10,9 +15,10 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ._params import CASE_NAMES
 
@@ -20,7 +26,45 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from ._result import SimResult
+
+class Run(Protocol):
+    """What the figures read of a run (:class:`adaptimp.Run` and its
+    subclasses): arrays with one row per recorded step."""
+
+    @property
+    def case(self) -> str: ...
+    @property
+    def params(self) -> dict[str, Any]: ...
+    @property
+    def metrics(self) -> dict[str, Any]: ...
+    @property
+    def t(self) -> NDArray[np.float64]: ...
+    @property
+    def q(self) -> NDArray[np.float64]: ...
+    @property
+    def xc(self) -> NDArray[np.float64]: ...
+    @property
+    def xd(self) -> NDArray[np.float64]: ...
+    @property
+    def z1(self) -> NDArray[np.float64]: ...
+    @property
+    def tau(self) -> NDArray[np.float64]: ...
+    @property
+    def tau_sat(self) -> NDArray[np.float64]: ...
+    @property
+    def tau_e(self) -> NDArray[np.float64]: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def rows(self) -> int: ...
+
+
+class MujocoRun(Run, Protocol):
+    """A run on a MuJoCo plant (``adaptimp.mujoco.MujocoResult``)."""
+
+    @property
+    def wrench_ee(self) -> NDArray[np.float64] | None: ...
+
 
 _SIZE = (8.0, 5.6)  # inches; 960 × 672 px at the default 120 dpi of savefig below
 _COLORS = {"pd": "#d62728", "sf": "#1f77b4", "of": "#2ca02c"}
@@ -65,17 +109,17 @@ def _legend(fig: Figure, ax: Axes, ncol: int) -> None:
     fig.legend(handles, labels, loc="outside lower center", ncol=ncol, fontsize=9, frameon=False)
 
 
-def _title(res: SimResult, what: str) -> str:
+def _title(res: Run, what: str) -> str:
     return f"{CASE_NAMES.get(res.case, res.case)} ({res.case}): {what}"
 
 
-def _settle_band(ax: Axes, res: SimResult) -> None:
+def _settle_band(ax: Axes, res: Run) -> None:
     settle = float(res.params["settle"])
     if res.t.size and settle > res.t[0]:
         ax.axvspan(res.t[0], min(settle, res.t[-1]), color="0.85", alpha=0.5, lw=0)
 
 
-def tracking(res: SimResult) -> Figure:
+def tracking(res: Run) -> Figure:
     """q against the commanded xc and the compliant reference xd, per joint, with
     the wall (the paper's Figs. 2, 5, 8)."""
     fig, axes = _figure(_title(res, "joint tracking"), res.n)
@@ -94,7 +138,7 @@ def tracking(res: SimResult) -> Figure:
     return fig
 
 
-def errors(res: SimResult) -> Figure:
+def errors(res: Run) -> Figure:
     """Tracking error z1 = xd − q per joint (the paper's Figs. 3, 6, 9): the settling
     transient (t < ``settle``, excluded from the 'after2' metrics) on the left, the
     rest of the run on its own scale on the right."""
@@ -130,7 +174,7 @@ def errors(res: SimResult) -> Figure:
     return fig
 
 
-def torques(res: SimResult) -> Figure:
+def torques(res: Run) -> Figure:
     """Commanded torque τ and applied torque sat(τ) per joint, with the limits ±τmax
     (the paper's Figs. 4, 7, 10). A commanded torque far beyond the limits (windup)
     is clipped to the view and its peak given in the panel title."""
@@ -153,11 +197,14 @@ def torques(res: SimResult) -> Figure:
     return fig
 
 
-FIGURES: dict[str, Callable[[SimResult], Figure]] = {
+FIGURES: dict[str, Callable[[Run], Figure]] = {
     "tracking": tracking,
     "errors": errors,
     "torques": torques,
 }
+"""The kinds of :meth:`adaptimp.SimResult.plot` (the kinds of the paper's Figs. 2–10)."""
+
+PLOT_KINDS = tuple(FIGURES)
 
 
 def _block_rms(t: np.ndarray, x: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray]:
@@ -174,7 +221,7 @@ def _block_rms(t: np.ndarray, x: np.ndarray, width: float) -> tuple[np.ndarray, 
 
 
 def compare(
-    results: Sequence[SimResult],
+    results: Sequence[Run],
     title: str = "tracking error of the three cases",
     window: float = 0.1,
 ) -> Figure:
@@ -214,10 +261,78 @@ def compare(
     return fig
 
 
+def _mujoco_title(res: Run, kind: str) -> str:
+    return f"{res.params['controller']} on {res.params['model']}: {kind}"
+
+
+def contact(res: MujocoRun) -> Figure:
+    """The end-effector force F_e (N, world frame) and ‖τe‖ (N m) of a MuJoCo run."""
+    if res.wrench_ee is None:
+        raise ValueError("the run has no end-effector wrench (wrench_ee) to plot")
+    fig, axes = _figure("end-effector force F_e (world frame) and ‖τe‖", rows=2)
+    for i, axis in enumerate("xyz"):
+        axes[0].plot(res.t, res.wrench_ee[:, i], lw=1.0, label=f"F_e,{axis}")
+    axes[0].set_ylabel("force (N)")
+    axes[1].plot(res.t, np.linalg.norm(res.tau_e, axis=1), color="k", lw=1.0, label="‖τe‖")
+    axes[1].set_ylabel("‖τe‖ (N m)")
+    _legend(fig, axes[0], ncol=3)
+    return fig
+
+
+def mujoco_tracking(res: MujocoRun) -> Figure:
+    """xc and xd, and q where the reference is in joint space, per coordinate."""
+    n = res.z1.shape[1]
+    fig, axes = _figure(_mujoco_title(res, "tracking"), rows=n)
+    for i, ax in enumerate(axes):
+        ax.plot(res.t, res.xc[:, i], color="k", lw=1.0, ls="--", label="xc, commanded")
+        ax.plot(res.t, res.xd[:, i], color="tab:orange", lw=1.2, label="xd, compliant reference")
+        if res.q.shape[1] == n:
+            ax.plot(res.t, res.q[:, i], color="tab:blue", lw=1.0, label="q, arm")
+        ax.set_ylabel(f"x{i + 1}")
+    _legend(fig, axes[0], ncol=3)
+    return fig
+
+
+def mujoco_errors(res: MujocoRun) -> Figure:
+    """The tracking error z1 = xd − x per coordinate."""
+    fig, axes = _figure(_mujoco_title(res, "errors"), rows=res.z1.shape[1])
+    for i, ax in enumerate(axes):
+        ax.plot(res.t, res.z1[:, i], color="tab:blue", lw=0.9, label="z1 = xd − x")
+        ax.set_ylabel(f"z1,{i + 1}")
+    _legend(fig, axes[0], ncol=3)
+    return fig
+
+
+def mujoco_torques(res: MujocoRun) -> Figure:
+    """Commanded and applied torque per joint, with ±τmax."""
+    fig, axes = _figure(_mujoco_title(res, "torques"), rows=res.q.shape[1])
+    for i, ax in enumerate(axes):
+        m = float(res.params["tau_max"][i])
+        ax.plot(res.t, res.tau[:, i], color="tab:orange", lw=0.7, label="τ, commanded")
+        ax.plot(res.t, res.tau_sat[:, i], color="tab:blue", lw=0.9, label="sat(τ), applied")
+        ax.axhline(m, color="tab:red", lw=1.0, ls="--", label="±τmax")
+        ax.axhline(-m, color="tab:red", lw=1.0, ls="--")
+        ax.set_ylim(-1.6 * m, 1.6 * m)
+        ax.set_ylabel(f"τ{i + 1} (N m)")
+    _legend(fig, axes[0], ncol=3)
+    return fig
+
+
+MUJOCO_FIGURES: dict[str, Callable[[MujocoRun], Figure]] = {
+    "tracking": mujoco_tracking,
+    "errors": mujoco_errors,
+    "torques": mujoco_torques,
+    "contact": contact,
+}
+"""The kinds of ``adaptimp.mujoco.MujocoResult.plot``."""
+
+MUJOCO_PLOT_KINDS = tuple(MUJOCO_FIGURES)
+
+
 _QUANTITY = {"tracking": ("q", "rad"), "errors": ("z1", "rad"), "torques": ("tau_sat", "N m")}
 
 
-def into(res: SimResult, kind: str, ax: Axes | Sequence[Axes]) -> Figure:
+def into(res: Run, kind: str, ax: Axes | Sequence[Axes]) -> Figure:
     """Draw ``kind`` of ``res`` into ``ax`` (one Axes per joint, or one for all),
     labelled with the case, so that several runs overlay; returns the figure."""
     from matplotlib.axes import Axes as _Axes

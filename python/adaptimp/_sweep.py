@@ -5,11 +5,14 @@ progress bar and a cache that lets an interrupted sweep resume."""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import itertools
 import json
 import math
 import os
+import tempfile
+import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import Executor, Future, as_completed
 from dataclasses import dataclass
@@ -20,6 +23,7 @@ import numpy as np
 
 from . import _adaptimp
 from ._adaptimp import __version__
+from ._errors import needs_extra
 from ._params import BY_NAME, check_case, check_scenario, config_hint, resolve
 
 if TYPE_CHECKING:
@@ -130,12 +134,38 @@ def _runs(vary: Mapping[str, Any], samples: int | None, seed: int) -> list[dict[
     return runs
 
 
-def _key(case: str, scenario: str, params: Mapping[str, Any]) -> str:
-    text = json.dumps(
-        {"case": case, "scenario": scenario, "params": params, "version": __version__},
-        sort_keys=True,
+def _plain(value: Any) -> Any:
+    """A JSON-able form of a NumPy value (``json.dumps``'s ``default``); any
+    other object cannot be keyed or stored: ``TypeError``."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"a value of type {type(value).__name__} has no stable key")
+
+
+def _json(value: Any) -> str:
+    return json.dumps(value, sort_keys=True, default=_plain)
+
+
+def _key(case: str, scenario: str, params: Mapping[str, Any], **more: Any) -> str:
+    """The hash of every input that changes a run's result: the case, the
+    scenario, the complete parameters, what else is given (``more``: the arm,
+    the MuJoCo model) and the adaptimp version. ``TypeError`` for a value
+    that has no stable key."""
+    text = _json(
+        {"case": case, "scenario": scenario, "params": params, "version": __version__, **more}
     )
     return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def _model_key(model: str) -> dict[str, Any]:
+    """The MuJoCo model as a key: its name, and the content of its file if it
+    is one (an edited file is another model)."""
+    path = Path(model)
+    if path.is_file():
+        return {"model": model, "model_sha256": hashlib.sha256(path.read_bytes()).hexdigest()}
+    return {"model": model}
 
 
 @dataclass
@@ -155,19 +185,32 @@ def _prepare(
     fixed: Mapping[str, Any],
     varied: Mapping[str, Any],
     model: str | None = None,
+    arm: TwoLinkArm | None = None,
+    keyed: bool = True,
 ) -> _Run:
+    """One run's complete parameters and, if ``keyed`` (a cache), its key; a
+    run whose parameters are refused, or that cannot be keyed, is an error row."""
     run_case = str(varied.get("case", case))
     given = {**fixed, **{k: v for k, v in varied.items() if k != "case"}}
     if model is not None:
         # The MuJoCo plant takes the keywords as they are (adaptimp.mujoco.simulate).
-        key = _key(run_case, scenario, {"mujoco": model, **given})
+        try:
+            key = (
+                _key(run_case, scenario, given, plant="mujoco", **_model_key(model))
+                if keyed
+                else ""
+            )
+        except (TypeError, ValueError, OSError) as e:
+            return _Run(dict(varied), run_case, None, f"cannot be cached: {e}", "")
         return _Run(dict(varied), run_case, dict(given), None, key)
     try:
         check_case(run_case)
         p = resolve(given, scenario=scenario, caller="sweep()")
+        more = {"arm": None if arm is None else arm.params}
+        key = _key(run_case, scenario, p, **more) if keyed else ""
     except (TypeError, ValueError) as e:
         return _Run(dict(varied), run_case, None, f"{type(e).__name__}: {e}", "")
-    return _Run(dict(varied), run_case, p, None, _key(run_case, scenario, p))
+    return _Run(dict(varied), run_case, p, None, key)
 
 
 def _run_batch(
@@ -200,12 +243,32 @@ def _batches(items: list[Any], size: int) -> Iterator[list[Any]]:
 
 
 class _Cache:
-    """One JSON file per finished run in ``root``, named by its parameters' hash."""
+    """One JSON file per finished run in ``root``, named by its key (the hash of
+    everything that changes its result).
+
+    The directory is checked writable before any run starts. Each file is
+    written under a name of its own and renamed into place (atomic: a reader
+    never sees half a file, concurrent writers never share a temporary). An
+    entry that cannot be read back whole (truncated, empty, not UTF-8, not
+    JSON, a missing metric, another key) is recomputed, with a warning. A
+    result that cannot be written is kept in the sweep's table, with a warning.
+    """
 
     def __init__(self, root: str | os.PathLike[str] | None) -> None:
         self.root = None if root is None else Path(root)
-        if self.root is not None:
+        if self.root is None:
+            return
+        try:
             self.root.mkdir(parents=True, exist_ok=True)
+            fd, probe = tempfile.mkstemp(dir=self.root, prefix=".probe.", suffix=".tmp")
+            os.close(fd)
+            os.unlink(probe)
+        except OSError as e:
+            raise OSError(
+                e.errno,
+                f"sweep(cache={str(root)!r}): the cache directory cannot be written "
+                f"({e.strerror or e}); no run was started",
+            ) from e
 
     def get(self, key: str) -> dict[str, Any] | str | None:
         if self.root is None or not key:
@@ -213,25 +276,85 @@ class _Cache:
         path = self.root / f"{key}.json"
         if not path.exists():
             return None
-        data = json.loads(path.read_text(encoding="utf-8"))
-        result: dict[str, Any] | str = data["result"]
-        if isinstance(result, dict):
-            result = {k: (math.nan if v is None else v) for k, v in result.items()}
-            for k in JOINT_METRICS:
-                if k in result:
-                    result[k] = [math.nan if v is None else v for v in result[k]]
-        return result
+        try:
+            data = json.loads(path.read_bytes().decode("utf-8"))
+            return self._result(data, key)
+        except (OSError, ValueError, TypeError, KeyError) as e:
+            warnings.warn(
+                f"sweep(): the cache entry {path} is unreadable ({type(e).__name__}: {e}); "
+                "recomputing that run",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+            return None
+
+    @staticmethod
+    def _result(data: Any, key: str) -> dict[str, Any] | str:
+        """The result of a cache entry, checked whole: ``ValueError`` if not."""
+        if not isinstance(data, dict):
+            raise ValueError("not a JSON object")
+        if data.get("key", key) != key:
+            raise ValueError(f"it holds the run {data.get('key')!r}")
+        result = data["result"]
+        if isinstance(result, str):
+            return result
+        if not isinstance(result, dict):
+            raise ValueError("its result is neither metrics nor an error")
+        out: dict[str, Any] = {}
+        for k in METRIC_COLUMNS:
+            v = result[k]
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+                raise ValueError(f"metric {k!r} is not a number")
+            out[k] = math.nan if v is None else v
+        for k in JOINT_METRICS:
+            v = result[k]
+            if not isinstance(v, list) or not all(
+                x is None or (isinstance(x, (int, float)) and not isinstance(x, bool)) for x in v
+            ):
+                raise ValueError(f"metric {k!r} is not a list of numbers")
+            out[k] = [math.nan if x is None else x for x in v]
+        return out
 
     def put(self, run: _Run, result: dict[str, Any] | str) -> None:
-        if self.root is None:
+        if self.root is None or not run.key or _transient(result):
             return
         from ._result import metrics_json
 
         clean = metrics_json(result) if isinstance(result, dict) else result
-        body = {"case": run.case, "params": run.params, "result": clean, "version": __version__}
-        tmp = self.root / f".{run.key}.tmp"
-        tmp.write_text(json.dumps(body), encoding="utf-8")
-        tmp.replace(self.root / f"{run.key}.json")
+        body = {
+            "key": run.key,
+            "case": run.case,
+            "params": run.params,
+            "result": clean,
+            "version": __version__,
+        }
+        tmp = None
+        try:
+            text = _json(body)
+            fd, tmp = tempfile.mkstemp(dir=self.root, prefix=f".{run.key}.", suffix=".tmp")
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(text)
+            os.replace(tmp, self.root / f"{run.key}.json")
+            tmp = None
+        except (OSError, TypeError, ValueError) as e:
+            warnings.warn(
+                f"sweep(): the result of run {run.key} could not be cached "
+                f"({type(e).__name__}: {e}); it is in the returned table",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+        finally:
+            if tmp is not None:
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+
+
+def _transient(result: dict[str, Any] | str) -> bool:
+    """A failure that says nothing about the run's parameters (an interrupted
+    run, memory): not cached, so a rerun tries again."""
+    return isinstance(result, str) and (
+        result == "stopped" or result.startswith(("cannot allocate", "MemoryError"))
+    )
 
 
 def _frame(runs: list[_Run], results: list[dict[str, Any] | str | None]) -> pd.DataFrame:
@@ -302,9 +425,13 @@ def sweep(
         ``m1``, ``m2``, … can be varied).
     cache : path, optional
         A directory where each finished run is written (one JSON file named by
-        a hash of its parameters and the adaptimp version). A sweep started
-        again with the same cache runs only what is missing: an interrupted
-        sweep resumes where it stopped.
+        a hash of everything that changes its result: the case, the scenario,
+        the complete parameters, the arm, the MuJoCo model and its file, the
+        adaptimp version). A sweep started again with the same cache runs only
+        what is missing: an interrupted sweep resumes where it stopped. The
+        directory must be writable (checked before any run starts); an entry
+        that cannot be read back whole is recomputed, with a warning; a run
+        with a value that has no stable key (e.g. a function) is an error row.
     progress : bool or callable
         ``True``: a progress bar over the runs (tqdm if installed, else a line on
         stderr) for sweeps longer than 2 s; a callable gets ``(done, total)``.
@@ -339,15 +466,24 @@ def sweep(
     >>> df[["Kp", "rms_z1"]].shape
     (2, 2)
     """
-    from ._api import _Progress
+    from ._api import ProgressReport, TwoLinkArm
 
+    try:  # before any run: the result is a DataFrame
+        import pandas  # noqa: F401
+    except ImportError:
+        raise needs_extra("adaptimp.sweep()", "pandas>=1.5", "sweep") from None
     check_scenario(scenario)
     check_case(case)
     if plant not in ("rigid", "mujoco"):
         raise ValueError(f"plant must be 'rigid' or 'mujoco', got {plant!r}")
+    if arm is not None and not isinstance(arm, TwoLinkArm):
+        raise TypeError(f"a sweep's arm must be a TwoLinkArm or None, got {type(arm).__name__}")
+    if arm is not None and plant == "mujoco":
+        raise TypeError("arm= is the rigid plant's arm: the MuJoCo plant's arm is its model=")
     mj_model = model if plant == "mujoco" else None
-    runs = [_prepare(case, scenario, params, v, mj_model) for v in _runs(vary or {}, samples, seed)]
+    grid = _runs(vary or {}, samples, seed)
     store = _Cache(cache)
+    runs = [_prepare(case, scenario, params, v, mj_model, arm, cache is not None) for v in grid]
     results: list[dict[str, Any] | str | None] = [
         run.error if run.error is not None else store.get(run.key) for run in runs
     ]
@@ -356,7 +492,7 @@ def sweep(
     bar: Any = None
     report: Callable[[int, int], object] | None = None
     if progress is True:
-        bar = _Progress("sweep")
+        bar = ProgressReport("sweep")
         report = bar
     elif callable(progress):
         report = progress

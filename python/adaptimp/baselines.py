@@ -1,6 +1,6 @@
 """Model-based baselines to compare the paper's model-free controllers against.
 
-Needs the optional dependency Pinocchio (``pip install adaptimp[pinocchio]``);
+Needs the optional dependency Pinocchio (the extra ``pinocchio``: ``pip install ".[pinocchio]"``);
 the rest of adaptimp never imports it.
 
 :class:`ComputedTorque` is the textbook computed-torque (inverse-dynamics)
@@ -32,18 +32,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._errors import needs_extra, period_alias
+
 try:
     import pinocchio as pin
 except ImportError as e:  # pragma: no cover - depends on the environment
-    raise ImportError(
-        "adaptimp.baselines needs Pinocchio, an optional dependency: "
-        "pip install adaptimp[pinocchio]"
-    ) from e
+    raise needs_extra("adaptimp.baselines", "pin>=3", "pinocchio") from e
 
 from . import _models
 from ._trajectory import Reference, paper_circle
 
-__all__ = ["ComputedTorque", "pinocchio_model"]
+__all__ = ["ComputedTorque", "pinocchio_model", "with_payload"]
 
 FloatArray = NDArray[np.float64]
 
@@ -101,7 +100,7 @@ def pinocchio_model(source: Any = "two_link", **arm: float) -> Any:
         lock = [full.getJointId(name) for name in _models.PANDA_FINGERS]
         return pin.buildReducedModel(full, lock, pin.neutral(full))
     if isinstance(source, (str, os.PathLike)) and Path(source).is_file():
-        return pin.buildModelFromUrdf(str(source))
+        return pin.buildModelFromXML(_models.arm_urdf(Path(source).read_text()).text)
     raise ValueError(
         f"source must be 'two_link', 'panda', a URDF path or a pinocchio.Model, got {source!r}"
     )
@@ -118,6 +117,19 @@ def scale_masses(model: Any, factor: float) -> Any:
         out.inertias[i] = pin.Inertia(
             factor * inertia.mass, inertia.lever.copy(), factor * inertia.inertia
         )
+    return out
+
+
+def with_payload(model: Any, mass: float) -> Any:
+    """A copy of ``model`` with a point mass ``mass`` (kg, ≥ 0) at the origin
+    of its last joint's frame: the payload of
+    :func:`adaptimp.mujoco.with_payload` (the body of the last joint), for a
+    computed torque with the exact model of a loaded plant."""
+    if not (math.isfinite(mass) and mass >= 0):
+        raise ValueError(f"payload must be ≥ 0 kg, got {mass}")
+    out = model.copy()
+    j = out.njoints - 1
+    out.inertias[j] = out.inertias[j] + pin.Inertia(mass, np.zeros(3), np.zeros((3, 3)))
     return out
 
 
@@ -156,6 +168,10 @@ class ComputedTorque:
     mass_scale : float
         Every link mass and inertia of the controller's model times this
         (1: the exact model; 1.3: +30 %).
+    payload : float
+        A point mass (kg) at the last joint's frame of the controller's model
+        (:func:`with_payload`): the exact model of a plant simulated with
+        ``adaptimp.mujoco.simulate(..., payload=...)``; 0: the nominal model.
     Dd, Cd, Gd : float or (n,)
         Target impedance (3) (kg m², N m s/rad, N m/rad); default the paper's
         1, 10, 60.
@@ -177,6 +193,7 @@ class ComputedTorque:
         Kd: ArrayLike = 40.0,
         tau_max: ArrayLike | None = None,
         mass_scale: float = 1.0,
+        payload: float = 0.0,
         Dd: ArrayLike = 1.0,
         Cd: ArrayLike = 10.0,
         Gd: ArrayLike = 60.0,
@@ -187,11 +204,12 @@ class ComputedTorque:
             raise ValueError(f"impedance must be 'joint' or 'external', got {impedance!r}")
         self.impedance = impedance
         exact = pinocchio_model(model)
-        self.model = scale_masses(exact, mass_scale)
+        self.model = with_payload(scale_masses(exact, mass_scale), float(payload))
         self.data = self.model.createData()
         n = self.n = int(self.model.nv)
-        if self.model.nq != n:
-            raise ValueError("ComputedTorque needs revolute joints only (nq = nv)")
+        # Continuous joints (nq = 2 each: cos, sin) take q as the angle from
+        # the neutral configuration.
+        self._angles = self.model.nq != n
         if not (Ts > 0 and math.isfinite(Ts)):
             raise ValueError(f"Ts must be > 0, got {Ts}")
         self._ts = float(Ts)
@@ -213,6 +231,7 @@ class ComputedTorque:
             "Kd": self.Kd.tolist(),
             "tau_max": self.tau_max.tolist(),
             "mass_scale": self.mass_scale,
+            "payload": float(payload),
             "Dd": self.Dd.tolist(),
             "Cd": self.Cd.tolist(),
             "Gd": self.Gd.tolist(),
@@ -235,11 +254,14 @@ class ComputedTorque:
         self.tau, self.tau_sat, self.xc, self.xd, self.z1 = nan, nan, nan, nan, nan
 
     @property
-    def ts(self) -> float:
+    def Ts(self) -> float:
         """Period Ts (s)."""
         return self._ts
 
-    Ts = ts
+    @property
+    def ts(self) -> float:
+        """Deprecated: the period is :attr:`Ts` (s)."""
+        return period_alias(self)
 
     @property
     def t(self) -> float:
@@ -251,14 +273,21 @@ class ComputedTorque:
         """The gains, limits, target impedance and (if built in) the trajectory."""
         return dict(self._params)
 
+    def _config(self, q: FloatArray) -> FloatArray:
+        """Pinocchio's configuration of joint angles q (rad)."""
+        if self._angles:
+            return np.asarray(pin.integrate(self.model, pin.neutral(self.model), q))
+        return q
+
     def mass_matrix(self, q: ArrayLike) -> FloatArray:
         """The controller's model M̂(q) (kg m²), (n, n), from CRBA."""
-        m = pin.crba(self.model, self.data, _joint("q", q, self.n))
+        m = pin.crba(self.model, self.data, self._config(_joint("q", q, self.n)))
         return np.array(np.triu(m) + np.triu(m, 1).T, dtype=np.float64)
 
     def bias(self, q: ArrayLike, dq: ArrayLike) -> FloatArray:
         """The controller's model ĥ = Ĉ(q, q̇) q̇ + Ĝ(q) (N m), (n,), RNEA with q̈ = 0."""
         q, dq = _joint("q", q, self.n), _joint("dq", dq, self.n)
+        q = self._config(q)
         return np.array(pin.rnea(self.model, self.data, q, dq, np.zeros(self.n)), dtype=np.float64)
 
     def step(

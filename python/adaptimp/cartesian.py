@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
-from ._errors import ConfigError
+from ._errors import ConfigError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
 from .chain import Chain
 from .panda_table import (
@@ -163,8 +163,13 @@ class CartesianImpedance:
         )
         self.q0 = np.array(q0, dtype=np.float64)
         self._core = _adaptimp.CartesianImpedance(chain, self.params, float(Ts), self.q0, posture)
-        self.ts = float(Ts)
+        self.Ts = float(Ts)
         self._R = chain.fk(self.q0)[:3, :3].copy()
+
+    @property
+    def ts(self) -> float:
+        """Deprecated name of :attr:`Ts`."""
+        return period_alias(self)
 
     @property
     def n(self) -> int:
@@ -259,11 +264,11 @@ class CartesianImpedance:
         (centres (L, 4n), widths (4n,)) for ``adaptimp.Controller(centers=,
         widths=)``.
         """
-        steps = round(T / self.ts)
+        steps = round(T / self.Ts)
         if steps < 1:
-            raise ConfigError(f"T must cover at least one step of {self.ts:g} s, got {T}")
+            raise ConfigError(f"T must cover at least one step of {self.Ts:g} s, got {T}")
         R = self.chain.fk(self.q0 if q0 is None else q0)[:3, :3]
-        table = np.array([_sample(path, k * self.ts, R) for k in range(steps)])
+        table = np.array([_sample(path, k * self.Ts, R) for k in range(steps)])
         start = self.q0 if q0 is None else np.asarray(q0, dtype=np.float64)
         q, dq = self._core.orbit(start, table, int(nodes))
         centres, widths2 = _adaptimp.centres_along(q, dq, (float(tube[0]), float(tube[1])))
@@ -307,7 +312,7 @@ class CartesianController:
     Notes
     -----
     The :func:`adaptimp.mujoco.simulate` protocol: ``wants_wrench = True``, so it
-    calls ``step(q, dq, wrench, xc=, dxc=, ddxc=)``; ``.ts``; after a step
+    calls ``step(q, dq, wrench, xc=, dxc=, ddxc=)``; ``.Ts``; after a step
     ``xc`` = p_c, ``xd`` = p_d (the compliant reference), ``z1`` = p_d − p(q)
     (m, (3,)), ``tau`` (the joint controller's commanded τ, N m), ``q_d``,
     ``force`` (f, N).
@@ -382,13 +387,13 @@ class CartesianController:
                 )
             inner = controller
             self._core_inner = False
-        ts = getattr(inner, "ts", None) or getattr(inner, "Ts", None)
-        if ts is None:
-            raise TypeError(f"the joint controller {inner!r} has no period .ts or .Ts")
+        Ts = getattr(inner, "Ts", None)
+        if Ts is None:
+            raise TypeError(f"the joint controller {inner!r} has no period .Ts (s)")
         self.inner = inner
-        self.outer = CartesianImpedance(chain, Ts=float(ts), q0=q0, posture=posture, **cart)
+        self.outer = CartesianImpedance(chain, Ts=float(Ts), q0=q0, posture=posture, **cart)
         self.chain, self.path, self.record = chain, path, record
-        self.ts = float(ts)
+        self._Ts = float(Ts)
         self._k = 0
         n = chain.n
         nan3 = np.full(3, math.nan)
@@ -400,7 +405,12 @@ class CartesianController:
     @property
     def Ts(self) -> float:
         """Period Ts (s)."""
-        return self.ts
+        return self._Ts
+
+    @property
+    def ts(self) -> float:
+        """Deprecated name of :attr:`Ts`."""
+        return period_alias(self)
 
     @property
     def n(self) -> int:
@@ -449,7 +459,7 @@ class CartesianController:
         if xc is not None:
             target: FloatArray | None = self.outer.target(xc, dxc, ddxc, R, w, dw)
         elif self.path is not None:
-            target = _sample(self.path, self._k * self.ts, self.outer._R)
+            target = _sample(self.path, self._k * self.Ts, self.outer._R)
             self.outer._R = target[9:18].reshape(3, 3).copy()
         else:
             target = None
@@ -495,7 +505,7 @@ class CartesianController:
         inner = getattr(self.inner, "case", type(self.inner).__name__)
         return (
             f"adaptimp.CartesianController({self.chain.source}, {inner!r}): {kind}, "
-            f"Ts = {self.ts:g} s, {self._k} steps"
+            f"Ts = {self.Ts:g} s, {self._k} steps"
         )
 
 

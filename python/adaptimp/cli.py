@@ -31,7 +31,8 @@ from typing import Any
 from . import __version__
 from ._api import simulate
 from ._params import BY_NAME, CASE_NAMES, CASES, SCENARIOS, describe
-from ._result import PLOT_KINDS, SimResult, metrics_json, metrics_table
+from ._plot import PLOT_KINDS, compare
+from ._result import SimResult, metrics_json, metrics_table
 
 
 class CliError(Exception):
@@ -138,8 +139,6 @@ def cmd_reproduce(args: argparse.Namespace, params: dict[str, Any]) -> int:
             _save_figure(res, kind, out / f"{case}_{kind}.png")
 
     import matplotlib.pyplot as plt
-
-    from ._plot import compare
 
     fig = compare(list(results.values()))
     fig.savefig(out / "comparison.png", dpi=120)

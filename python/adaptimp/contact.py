@@ -249,7 +249,7 @@ def arm_table(
     freq: float = 0.25,
     depth: float = 0.015,
     tool_radius: float = 0.01,
-    ts: float = 1e-3,
+    Ts: float = 1e-3,
     t_approach: float = 1.0,
     t_ramp: float = 1.0,
 ) -> PandaTable:
@@ -275,7 +275,7 @@ def arm_table(
             depth=depth,
             friction=friction,
             tool_radius=tool_radius,
-            ts=ts,
+            Ts=Ts,
             t_approach=t_approach,
             t_ramp=t_ramp,
         )
@@ -320,7 +320,7 @@ def arm_table(
         chain=chain,
         q0=q0,
         pin_model=pinocchio_model(path),
-        ts=ts,
+        Ts=Ts,
         radius=radius,
         freq=freq,
         centre=np.asarray(centre, dtype=np.float64),
@@ -366,7 +366,7 @@ def contact_metrics(
     contact = np.flatnonzero(approach & (fn > 0))
     # Never touched after the approach: all of that time is without contact.
     start = contact[0] if contact.size else int(np.argmax(approach))
-    lost = float(np.sum(fn[start:] <= 0) * sc.ts) if approach.any() else 0.0
+    lost = float(np.sum(fn[start:] <= 0) * sc.Ts) if approach.any() else 0.0
     return {
         "track_mm": m["rms_track"] * 1e3,
         "force_rms_err_N": float(np.sqrt(np.mean((fn[after] - target) ** 2))),

@@ -1,6 +1,6 @@
 """MuJoCo as the plant: real arms, contact from a physics engine (SPEC §13).
 
-Needs the optional dependency MuJoCo (``pip install adaptimp[mujoco]``); the
+Needs the optional dependency MuJoCo (the extra ``mujoco``: ``pip install ".[mujoco]"``); the
 rest of adaptimp never imports it.
 
 - :class:`Plant` wraps a MuJoCo model of a serial arm with n ≤ 7 hinge joints,
@@ -9,7 +9,7 @@ rest of adaptimp never imports it.
   the force the arm exerts on its environment, mapped to joint space as
   τe = Jᵀ F_e.
 - :func:`simulate` closes the loop: any controller with
-  ``.step(q, tau_e, dq=None, **setpoint)`` and a period (``.ts`` or ``.Ts``),
+  ``.step(q, tau_e, dq=None, **setpoint)`` and a period ``.Ts`` (s),
   or one of the paper's cases by name, runs at Ts with the torque held over
   ``substeps`` MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12
   metrics.
@@ -37,6 +37,7 @@ import copy
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,15 +46,16 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._errors import needs_extra
+
 try:
     import mujoco
 except ImportError as e:  # pragma: no cover - depends on the environment
-    raise ImportError(
-        "adaptimp.mujoco needs MuJoCo, an optional dependency: pip install adaptimp[mujoco]"
-    ) from e
+    raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _adaptimp, _models
 from ._faults import Fault
+from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
 from ._trajectory import Reference, paper_circle, sinusoid
 
@@ -67,12 +69,19 @@ __all__ = [
     "MujocoResult",
     "Plant",
     "Reference",
+    "Task",
+    "default_task",
+    "estimate_effort",
     "from_urdf",
+    "home_posture",
+    "moving_mass",
     "panda",
     "paper_circle",
+    "rule_keywords",
     "simulate",
     "sinusoid",
     "two_link",
+    "with_payload",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -90,7 +99,7 @@ class ControllerLike(Protocol):
     ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,);
     ``setpoint`` is ``xc=, dxc=, ddxc=`` when :func:`simulate` is given a
     ``reference``, nothing otherwise (the controller then follows its own
-    trajectory). The period is ``.ts`` or ``.Ts`` (s). Optional attributes
+    trajectory). The period is ``.Ts`` (s; ``.ts`` is read, deprecated). Optional attributes
     that :func:`simulate` records when present: ``tau`` (commanded torque
     before saturation), ``xc``, ``xd``, ``z1``, ``dq_hat``, ``zeta``, and
     ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``,
@@ -145,36 +154,144 @@ def _add_motors(spec: Any, effort: Mapping[str, float]) -> None:
 
 def _urdf_spec(text: str, fix: tuple[str, ...] = ()) -> tuple[Any, dict[str, float]]:
     urdf, effort = _models.adapt_urdf(text, fix)
+    return _spec_of(urdf), effort
+
+
+def _spec_of(urdf: str) -> Any:
     spec = mujoco.MjSpec.from_string(urdf)
     # Keep the URDF's fixed links as bodies: a force sensor needs its own body.
     spec.compiler.fusestatic = False
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
-    return spec, effort
+    return spec
 
 
-def from_urdf(path: str | os.PathLike[str], timestep: float = 1e-3) -> mujoco.MjModel:
+EFFORT_ACCEL = 10.0
+"""The acceleration (rad/s²) an estimated effort limit leaves beyond gravity
+(:func:`from_urdf`)."""
+
+
+def from_urdf(
+    path: str | os.PathLike[str], timestep: float = 1e-3, *, fix: tuple[str, ...] = ()
+) -> mujoco.MjModel:
     """A URDF arm as a MuJoCo model :class:`Plant` accepts.
 
+    The arm is the URDF's serial chain of revolute and continuous joints
+    (:func:`adaptimp._models.arm_urdf`, one reduction for MuJoCo and
+    Pinocchio): the longest chain from the root, ending at a hand (a branch
+    into shorter chains); prismatic and mimic joints, a gripper's joints
+    (named gripper/finger/jaw/claw, after the arm's) and every joint off the
+    chain are fixed at their zero position, and so are the joints named in
+    ``fix``. A revolute joint with no range (lower ≥ upper) is continuous.
     Visual and collision elements, joint ``<dynamics>`` (damping, friction)
-    and mimic tags are dropped (the rigid-body dynamics only, no mesh files);
-    each moving joint gets a motor with ctrlrange ± its ``<limit effort>``
-    (N m). RK4 at ``timestep`` (s). Without contact geometry and without a
-    sensor: add them for contact (see :func:`panda`).
+    and mimic tags are dropped (the rigid-body dynamics
+    only, no mesh files; no contact geometry). Continuous joints are
+    unlimited hinges. If the inertias do not compile as they are (a massless
+    moving link, an inertia that violates the triangle inequality), every
+    body gets at least 1e-6 kg and 1e-10 kg m² and inertias are balanced
+    (MuJoCo's ``boundmass``, ``boundinertia``, ``balanceinertia``), with a
+    warning. Each arm joint gets a motor with ctrlrange ± its
+    ``<limit effort>`` (N m); where the URDF gives none (or zero) the limit is
+    estimated from the arm itself, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|)
+    over 256 postures within the joint limits (:func:`estimate_effort`), with
+    a warning. RK4 at ``timestep`` (s).
 
     Raises
     ------
     ValueError
-        A moving joint without an effort limit.
+        The URDF has no revolute or continuous joint to drive, or more than
+        :data:`MAX_JOINTS` on its longest chain.
     """
-    text = Path(path).read_text()
-    spec, effort = _urdf_spec(text)
+    arm = _models.arm_urdf(Path(path).read_text(), fix)
+    if len(arm.joints) > MAX_JOINTS:
+        raise ValueError(
+            f"the URDF's arm has {len(arm.joints)} joints ({', '.join(arm.joints)}); "
+            f"adaptimp drives at most {MAX_JOINTS}: fix some with fix=(...)"
+        )
+    spec = _spec_of(arm.text)
     spec.option.timestep = timestep
-    joints = [j.name for j in spec.joints]
-    missing = [j for j in joints if j not in effort]
+    missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
+    _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
+    try:
+        model = spec.compile()
+    except ValueError as e:
+        # A massless moving link or an inertia that violates the triangle
+        # inequality: bound and balance them (1e-6 kg, 1e-10 kg m², far below
+        # any real link), and say so.
+        spec.compiler.boundmass = 1e-6
+        spec.compiler.boundinertia = 1e-10
+        spec.compiler.balanceinertia = True
+        model = spec.compile()
+        import warnings
+
+        warnings.warn(
+            f"the URDF's inertias do not compile as they are ({e}); every body now has "
+            "at least 1e-6 kg and 1e-10 kg m², and inertias are balanced",
+            stacklevel=2,
+        )
     if missing:
-        raise ValueError(f"URDF joints without <limit effort=...>: {missing}")
-    _add_motors(spec, effort)
-    return spec.compile()
+        estimate = estimate_effort(model)
+        for j, name in enumerate(arm.joints):
+            if name in missing:
+                a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+                model.actuator_ctrlrange[a] = [-estimate[j], estimate[j]]
+        import warnings
+
+        warnings.warn(
+            f"the URDF gives no effort limit for {missing}: estimated "
+            f"{[round(float(estimate[arm.joints.index(j)]), 3) for j in missing]} N m "
+            "(2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within the joint limits)",
+            stacklevel=2,
+        )
+    return model
+
+
+def _limits(model: mujoco.MjModel, joints: Sequence[int]) -> tuple[FloatArray, FloatArray]:
+    """Position limits (rad) of ``joints``; ∓inf where a hinge is unlimited."""
+    lo = np.full(len(joints), -math.inf)
+    hi = np.full(len(joints), math.inf)
+    for i, j in enumerate(joints):
+        if model.jnt_limited[j]:
+            lo[i], hi[i] = model.jnt_range[j]
+    return lo, hi
+
+
+def _postures(lo: FloatArray, hi: FloatArray, count: int, margin: ArrayLike = 0.0) -> FloatArray:
+    """``count`` postures (rad), deterministic, uniform in the box [lo + margin,
+    hi − margin] (±π for an unlimited joint): the zero posture clipped into the
+    box first, then the box's middle, then samples of a fixed-seed generator."""
+    m = np.asarray(margin, dtype=np.float64)
+    a: FloatArray = np.where(np.isfinite(lo), lo, -math.pi) + m
+    b: FloatArray = np.where(np.isfinite(hi), hi, math.pi) - m
+    rng = np.random.default_rng(0)
+    out = rng.uniform(a, b, size=(count, len(lo)))
+    out[0] = np.clip(0.0, a, b)
+    if count > 1:
+        out[1] = (a + b) / 2
+    return np.asarray(out, dtype=np.float64)
+
+
+def estimate_effort(model: mujoco.MjModel, postures: int = 256) -> FloatArray:
+    """Effort limits (N m, per joint of ``model``'s arm) for an arm whose URDF
+    gives none: 2 (max |G_i(q)| + 10 rad/s² · max Σ_j |D_ij(q)|) over
+    ``postures`` postures within the joint limits (:func:`from_urdf`): gravity
+    and an acceleration of 10 rad/s² of every joint at once, twice over."""
+    joints = sorted(range(model.njnt), key=lambda j: int(model.jnt_dofadr[j]))
+    qadr = [int(model.jnt_qposadr[j]) for j in joints]
+    dofs = [int(model.jnt_dofadr[j]) for j in joints]
+    lo, hi = _limits(model, joints)
+    data = mujoco.MjData(model)
+    full = np.zeros((model.nv, model.nv))
+    g = np.zeros(len(joints))
+    d = np.zeros(len(joints))
+    for q in _postures(lo, hi, postures):
+        data.qpos[:] = model.qpos0
+        data.qpos[qadr] = q
+        data.qvel[:] = 0.0
+        mujoco.mj_forward(model, data)
+        _full_inertia(model, data, full)
+        g = np.maximum(g, np.abs(data.qfrc_bias[dofs]))
+        d = np.maximum(d, np.sum(np.abs(full[np.ix_(dofs, dofs)]), axis=1))
+    return np.asarray(2.0 * (g + EFFORT_ACCEL * d), dtype=np.float64)
 
 
 def panda(
@@ -314,6 +431,8 @@ class Plant:
         Actuator limits τmax (N m): gear × ctrlrange.
     wrench_source : str
         ``"sensor"`` (force/torque sensor) or ``"contact"`` (``mj_contactForce``).
+    site : str or None
+        The end-effector site asked for (None: found as above).
     """
 
     def __init__(
@@ -324,6 +443,7 @@ class Plant:
         if not contact:
             m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         self.contact = contact
+        self.site = site
         self._check_joints()
         self._check_actuators()
         self._find_end_effector(site)
@@ -764,10 +884,229 @@ def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
 
 
 # ---------------------------------------------------------------------------
+# An arm nobody configured: payload, home posture, default task, the rule
+# (SPEC §18). Each a function of its own that simulate calls before its loop.
+# ---------------------------------------------------------------------------
+
+
+def moving_mass(model: mujoco.MjModel) -> float:
+    """The arm's moving mass (kg): every body below the first joint."""
+    plant_bodies = [int(model.jnt_bodyid[j]) for j in range(model.njnt)]
+    if not plant_bodies:
+        return 0.0
+    first = min(plant_bodies)
+
+    def below(b: int) -> bool:
+        while b > 0:
+            if b == first:
+                return True
+            b = int(model.body_parentid[b])
+        return False
+
+    return float(sum(model.body_mass[b] for b in range(model.nbody) if below(b)))
+
+
+def with_payload(model: mujoco.MjModel, mass: float, body: int | None = None) -> mujoco.MjModel:
+    """A copy of ``model`` with a point mass ``mass`` (kg, ≥ 0) at the origin of
+    ``body`` (default: the body of the last joint, the end effector's link;
+    SPEC §17's payload for a MuJoCo arm). The body's mass, centre of mass and
+    inertia change by the parallel-axis theorem; nothing else does. Give it
+    to the plant only: the controller is not told."""
+    if not (math.isfinite(mass) and mass >= 0):
+        raise ValueError(f"payload must be ≥ 0 kg, got {mass}")
+    m = copy.deepcopy(model)
+    if mass == 0:
+        return m
+    if body is None:
+        last = max(range(m.njnt), key=lambda j: int(m.jnt_dofadr[j]))
+        body = int(m.jnt_bodyid[last])
+    mb, c = float(m.body_mass[body]), np.array(m.body_ipos[body], dtype=np.float64)
+    rot = np.zeros(9)
+    mujoco.mju_quat2Mat(rot, m.body_iquat[body])
+    r = rot.reshape(3, 3)
+    inertia = r @ np.diag(m.body_inertia[body]) @ r.T
+    total = mb + mass
+    com = mb * c / total
+
+    def steiner(k: float, x: FloatArray) -> FloatArray:
+        return np.asarray(k * (x @ x * np.eye(3) - np.outer(x, x)), dtype=np.float64)
+
+    inertia = inertia + steiner(mb, c - com) + steiner(mass, -com)
+    w, v = np.linalg.eigh(inertia)
+    if np.linalg.det(v) < 0:
+        v[:, 0] = -v[:, 0]
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, v.flatten())
+    m.body_mass[body] = total
+    m.body_ipos[body] = com
+    m.body_iquat[body] = quat
+    m.body_inertia[body] = np.maximum(w, 0.0)
+    mujoco.mj_setConst(m, mujoco.MjData(m))
+    return m
+
+
+@dataclass(frozen=True)
+class Task:
+    """The default task of a plant (:func:`default_task`, SPEC §18).
+
+    Attributes
+    ----------
+    home : ndarray, (n,)
+        The posture the task swings about (rad).
+    q0 : ndarray, (n,)
+        Its start, at rest (rad): home − A.
+    keywords : dict
+        ``xc_offset``, ``xc_sin``, ``xc_cos``, ``xc_omega``: the controller's
+        sinusoid (SPEC §4).
+    period : float
+        2 s.
+    """
+
+    home: FloatArray
+    q0: FloatArray
+    keywords: dict[str, list[float]]
+    period: float
+
+    @property
+    def reference(self) -> Reference:
+        """``reference(t) -> (xc, dxc, ddxc)``."""
+        k = self.keywords
+        return sinusoid(k["xc_offset"], k["xc_sin"], k["xc_cos"], k["xc_omega"])
+
+
+HOME_SAMPLES = 256
+"""Postures :func:`home_posture` compares."""
+
+HOME_LOAD = 0.5
+"""The zero posture is the home posture if gravity takes at most this share of
+every effort limit over the task's swing (:func:`home_posture`)."""
+
+
+def home_posture(plant: Plant) -> FloatArray:
+    """A posture inside the joint limits where gravity is well within the
+    effort limits (SPEC §18). The gravity load of a posture q is the largest
+    max_i |G_i|/τmax_i over the task's swing (q − A, q, q + A). Every posture
+    is kept A = min(0.2 rad, range/4) inside each limit (a continuous joint
+    ranges over [−π, π]). The zero posture (the URDF's reference, clipped
+    into that box) if its load is at most :data:`HOME_LOAD`; else, of it, the
+    box's middle and 254 fixed-seed samples, the one of least load.
+
+    Raises
+    ------
+    ValueError
+        Gravity exceeds an effort limit at every posture compared: the arm
+        cannot hold itself anywhere (the message gives the best load).
+    """
+    m = plant.model
+    lo, hi = _limits(m, plant._joints)
+    width = np.where(np.isfinite(hi - lo), hi - lo, 2 * math.pi)
+    amp = np.minimum(0.25 * width, TASK_AMPLITUDE)
+    saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
+    best, best_load = None, math.inf
+    for k, q in enumerate(_postures(lo, hi, HOME_SAMPLES, amp)):
+        load = max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0))
+        if load < best_load:
+            best, best_load = q, load
+        if k == 0 and load <= HOME_LOAD:
+            break
+    plant.data.qpos[:], plant.data.qvel[:] = saved
+    mujoco.mj_forward(m, plant.data)
+    if best is None or best_load >= 1.0:
+        raise ValueError(
+            f"gravity exceeds the effort limits at every posture compared: the least "
+            f"max_i |G_i|/τmax_i found is {best_load:.3g} (τmax = {plant.tau_max.tolist()} N m)"
+        )
+    return np.asarray(best, dtype=np.float64)
+
+
+def _gravity_load(plant: Plant, q: FloatArray) -> float:
+    """max_i |G_i(q)|/τmax_i at rest."""
+    d = plant.data
+    d.qpos[plant._qadr] = q
+    d.qvel[:] = 0.0
+    mujoco.mj_forward(plant.model, d)
+    return float(np.max(np.abs(d.qfrc_bias[plant._dofs]) / plant.tau_max))
+
+
+TASK_AMPLITUDE = 0.2
+"""The largest swing A (rad) of the default task."""
+
+
+def default_task(plant: Plant, home: ArrayLike | None = None) -> Task:
+    """The default task of ``plant`` (SPEC §18): about ``home`` (default
+    :func:`home_posture`), every joint swings xc_i = home_i − A_i cos(π t)
+    (period 2 s, from rest at home − A, through home, to home + A), A_i =
+    min(0.2 rad, range/4), in free space. (The swing of every joint moves the
+    arm's gravity and inertia, which learning must then learn; the metrics'
+    windows of 2 s hold whole periods.)"""
+    from . import tuning
+
+    m = plant.model
+    lo, hi = _limits(m, plant._joints)
+    h = home_posture(plant) if home is None else plant._vector("home", home)
+    kw = tuning.default_task(h, lo, hi)
+    q0 = np.asarray(kw["xc_offset"]) + np.asarray(kw["xc_cos"])
+    return Task(home=h, q0=q0, keywords=kw, period=2 * math.pi / kw["xc_omega"][0])
+
+
+def rule_keywords(
+    plant: Plant, task: Task | None = None, *, Ts: float = 1e-3, case: str = "sf"
+) -> dict[str, Any]:
+    """The rule's controller keywords for ``plant`` on ``task`` (default
+    :func:`default_task`) at period ``Ts`` (s), SPEC §18
+    (:func:`adaptimp.tuning.suggest` with D at the task's home, the plant's
+    τmax and the task's path), with ``impedance="external"`` (in free space
+    the controller tracks the reference as given). The plant's own model:
+    give it the nominal plant (no payload)."""
+    from . import tuning
+
+    task = default_task(plant) if task is None else task
+    saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
+    kw = tuning.suggest(
+        plant, task.home, plant.tau_max, Ts=Ts, path=task.reference, period=task.period, case=case
+    )
+    plant.data.qpos[:], plant.data.qvel[:] = saved
+    mujoco.mj_forward(plant.model, plant.data)
+    kw["impedance"] = "external"
+    return kw
+
+
+def _table_reference(reference: Any, n: int, Ts: float, steps: int) -> Reference:
+    """``reference`` as a callable of t: a callable as it is; (xc, dxc, ddxc)
+    arrays of shape (K, n), K ≥ ``steps`` (or an object with those attributes,
+    e.g. a :class:`MujocoResult`), row k at t_k = k·Ts."""
+    if callable(reference):
+        return reference  # type: ignore[no-any-return]
+    if all(hasattr(reference, a) for a in ("xc", "dxc", "ddxc")):
+        reference = (reference.xc, reference.dxc, reference.ddxc)
+    try:
+        xc, dxc, ddxc = (np.asarray(a, dtype=np.float64) for a in reference)
+    except (TypeError, ValueError) as e:
+        raise TypeError(
+            "reference must be a callable t -> (xc, dxc, ddxc), the arrays (xc, dxc, ddxc) "
+            "of shape (K, n), or a result that has them"
+        ) from e
+    for name, a in (("xc", xc), ("dxc", dxc), ("ddxc", ddxc)):
+        if a.ndim != 2 or a.shape[1] != n or a.shape[0] < steps:
+            raise ValueError(
+                f"reference {name} must have shape (K, {n}) with K ≥ {steps} rows (one per "
+                f"step), got {a.shape}"
+            )
+        if not np.all(np.isfinite(a[:steps])):
+            raise ValueError(f"reference {name} must be finite")
+
+    def table(t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        k = min(max(round(t / Ts), 0), xc.shape[0] - 1)
+        return xc[k], dxc[k], ddxc[k]
+
+    return table
+
+
+# ---------------------------------------------------------------------------
 # The result of a run.
 # ---------------------------------------------------------------------------
 
-PLOT_KINDS = ("tracking", "errors", "torques", "contact")
+PLOT_KINDS = MUJOCO_PLOT_KINDS
 """Kinds of :meth:`MujocoResult.plot`."""
 
 ARRAYS = (
@@ -850,7 +1189,7 @@ class MujocoResult(SimResult):
             return super().plot(kind, ax)
         if kind not in PLOT_KINDS:
             raise ValueError(f"kind must be one of {PLOT_KINDS}, got {kind!r}")
-        return _plot(self, kind)
+        return MUJOCO_FIGURES[kind](self)
 
     def __repr__(self) -> str:
         m, p = self.metrics, self.params
@@ -864,55 +1203,23 @@ class MujocoResult(SimResult):
         )
 
 
-def _plot(res: MujocoResult, kind: str) -> Figure:
-    from ._plot import _figure, _legend
-
-    t = res.t
-    if kind == "contact":
-        assert res.wrench_ee is not None
-        fig, axes = _figure("end-effector force F_e (world frame) and ‖τe‖", rows=2)
-        for i, axis in enumerate("xyz"):
-            axes[0].plot(t, res.wrench_ee[:, i], lw=1.0, label=f"F_e,{axis}")
-        axes[0].set_ylabel("force (N)")
-        axes[1].plot(t, np.linalg.norm(res.tau_e, axis=1), color="k", lw=1.0, label="‖τe‖")
-        axes[1].set_ylabel("‖τe‖ (N m)")
-        _legend(fig, axes[0], ncol=3)
-        return fig
-    n = res.q.shape[1] if kind == "torques" else res.z1.shape[1]
-    fig, axes = _figure(f"{res.params['controller']} on {res.params['model']}: {kind}", rows=n)
-    for i, ax in enumerate(axes):
-        if kind == "tracking":
-            ax.plot(t, res.xc[:, i], color="k", lw=1.0, ls="--", label="xc, commanded")
-            ax.plot(t, res.xd[:, i], color="tab:orange", lw=1.2, label="xd, compliant reference")
-            if res.q.shape[1] == n:
-                ax.plot(t, res.q[:, i], color="tab:blue", lw=1.0, label="q, arm")
-            ax.set_ylabel(f"x{i + 1}")
-        elif kind == "errors":
-            ax.plot(t, res.z1[:, i], color="tab:blue", lw=0.9, label="z1 = xd − x")
-            ax.set_ylabel(f"z1,{i + 1}")
-        else:
-            m = float(res.params["tau_max"][i])
-            ax.plot(t, res.tau[:, i], color="tab:orange", lw=0.7, label="τ, commanded")
-            ax.plot(t, res.tau_sat[:, i], color="tab:blue", lw=0.9, label="sat(τ), applied")
-            ax.axhline(m, color="tab:red", lw=1.0, ls="--", label="±τmax")
-            ax.axhline(-m, color="tab:red", lw=1.0, ls="--")
-            ax.set_ylim(-1.6 * m, 1.6 * m)
-            ax.set_ylabel(f"τ{i + 1} (N m)")
-    _legend(fig, axes[0], ncol=3)
-    return fig
-
-
 # ---------------------------------------------------------------------------
 # The closed loop.
 # ---------------------------------------------------------------------------
 
 
 def _period(ctrl: Any) -> float:
-    for attr in ("ts", "Ts"):
-        value = getattr(ctrl, attr, None)
-        if value is not None:
-            return float(value)
-    raise TypeError(f"the controller {ctrl!r} has no period: give it a .ts or .Ts (s)")
+    value = getattr(ctrl, "Ts", None)
+    if value is not None:
+        return float(value)
+    if getattr(ctrl, "ts", None) is not None:  # the earlier name, deprecated
+        warnings.warn(
+            f"the controller's period .ts is deprecated: name it .Ts ({type(ctrl).__name__})",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        return float(ctrl.ts)
+    raise TypeError(f"the controller {ctrl!r} has no period: give it a .Ts (s)")
 
 
 def _builtin_reference(ctrl: Any) -> Reference | None:
@@ -956,6 +1263,67 @@ def _tabulate(
     return xc, dxc, ddxc
 
 
+def _uses_rule(plant: Plant) -> bool:
+    """True unless ``plant`` is the paper's arm, whose scenario has its own defaults."""
+    return _model_name(plant.model) != "adaptimp_two_link"
+
+
+def _model_name(model: mujoco.MjModel) -> str:
+    return str(model.names[: model.names.find(b"\0")].decode())
+
+
+def _payload_plant(nominal: Plant, payload: float) -> Plant:
+    """The plant with ``payload`` kg at its end effector's link (the nominal
+    plant itself for 0)."""
+    if isinstance(payload, bool) or not isinstance(payload, (int, float, np.floating, np.integer)):
+        raise TypeError(f"payload must be a number (kg), got {type(payload).__name__}")
+    if payload == 0:
+        return nominal
+    return Plant(
+        with_payload(nominal.model, float(payload)), contact=nominal.contact, site=nominal.site
+    )
+
+
+def _rule_setup(
+    plant: Plant,
+    case: str,
+    params: Mapping[str, Any],
+    reference: Any,
+    Ts: float,
+    T: float,
+) -> tuple[Task | None, Any, dict[str, Any]]:
+    """The task and the rule's keywords for a case name on ``plant`` (SPEC §18):
+    the default task unless a reference or the controller's own trajectory
+    (``xc_*``) is given, which is then the path."""
+    own = [k for k in ("xc_offset", "xc_sin", "xc_cos", "xc_omega") if k in params]
+    if reference is None and not own:
+        task = default_task(plant)
+        kw = rule_keywords(plant, task, Ts=Ts, case=case)
+        kw.pop("n")
+        return task, task.reference, kw
+    from . import tuning
+
+    if reference is None:
+        from ._params import defaults as scenario_defaults
+
+        base = scenario_defaults("robot", plant.n)
+        xc = {k: params.get(k, base[k]) for k in ("xc_offset", "xc_sin", "xc_cos", "xc_omega")}
+        path = sinusoid(xc["xc_offset"], xc["xc_sin"], xc["xc_cos"], xc["xc_omega"])
+        w = np.abs(np.broadcast_to(np.asarray(xc["xc_omega"], dtype=np.float64), (plant.n,)))
+        period = 2 * math.pi / float(np.min(w[w > 0])) if np.any(w > 0) else T
+    else:
+        path = _table_reference(reference, plant.n, Ts, round(T / Ts))
+        period = T
+    home = np.asarray(path(0.0)[0], dtype=np.float64)
+    saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
+    kw = tuning.suggest(plant, home, plant.tau_max, Ts=Ts, path=path, period=period, case=case)
+    plant.data.qpos[:], plant.data.qvel[:] = saved
+    mujoco.mj_forward(plant.model, plant.data)
+    kw.pop("n")
+    kw["impedance"] = "external"
+    return None, reference, kw
+
+
 def simulate(
     controller: str | ControllerLike = "sf",
     model: Plant | ModelSource = "two_link",
@@ -965,13 +1333,14 @@ def simulate(
     substeps: int | None = None,
     q0: ArrayLike | None = None,
     dq0: ArrayLike | None = None,
-    reference: Reference | None = None,
+    reference: Reference | Any | None = None,
     contact: bool = True,
     settle: float | None = None,
     scenario: str = "robot",
     record_every: int = 1,
     progress: bool | Callable[[int, int], object] = False,
     fault: Fault | None = None,
+    payload: float = 0.0,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1012,10 +1381,15 @@ def simulate(
         Default: round(Ts / the model's timestep), at least 1.
     q0, dq0 : array_like, optional
         Initial joint positions (rad) and velocities (rad/s); default the
-        model's first keyframe (the paper's q(0) for ``two_link``), else qpos0.
-    reference : callable, optional
-        ``reference(t) -> (xc, dxc, ddxc)``: passed to every step as
-        ``xc=, dxc=, ddxc=``. None: the controller follows its own trajectory.
+        default task's start (below), else the model's first keyframe (the
+        paper's q(0) for ``two_link``), else the reference's start xc(0),
+        ẋc(0), else qpos0.
+    reference : callable or arrays, optional
+        ``reference(t) -> (xc, dxc, ddxc)``, or the arrays (xc, dxc, ddxc) of
+        shape (K, n) with a row per step (K ≥ round(T/Ts)), or a result that
+        has them (e.g. a :class:`MujocoResult`: the same task again): passed
+        to every step as ``xc=, dxc=, ddxc=``. None: the default task (below),
+        or the controller's own trajectory.
     contact : bool
         False: free space (MuJoCo's contact disabled). Ignored for a Plant.
     settle : float, optional
@@ -1030,11 +1404,29 @@ def simulate(
     fault : adaptimp.Fault, optional
         A fault injected over a window, as for :func:`adaptimp.simulate` (the
         actuators' τmax for ``"actuator_drop"``); needs the native loop.
+    payload : float
+        A point mass (kg, ≥ 0) at the end effector's link of the plant only
+        (:func:`with_payload`); the controller's gains come from the arm
+        without it, and no model the controller is given has it.
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
         them), for any controller; and, for a case name, controller parameters
         (``Kp``, ``gamma``, …).
+
+    Notes
+    -----
+    **Any arm, out of the box** (SPEC §18, ``docs/your_arm.md``). A case name
+    on any model but the paper's ``two_link`` is built by the rule of
+    :func:`rule_keywords` (gains from the arm's inertia, the centres and
+    learning along the task's path, ``impedance="external"``): with no
+    ``reference`` and no ``xc_*`` keyword the task is :func:`default_task`
+    (a joint-space swing of ±0.2 rad at 0.5 Hz about :func:`home_posture`,
+    from rest); a given ``reference`` is the path instead. Keywords given in
+    ``params`` replace the rule's. The result's ``xc``, ``dxc``, ``ddxc``
+    (K, n) are the reference tracked, so that any other controller can run
+    the same task: ``simulate(ct, model, reference=res, q0=res.q[0],
+    payload=...)``.
 
     Returns
     -------
@@ -1057,7 +1449,8 @@ def simulate(
     """
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
-        settle=settle, scenario=scenario, record_every=record_every, params=params,
+        settle=settle, scenario=scenario, record_every=record_every, reference=reference,
+        payload=payload, params=params,
     )  # fmt: skip
     from ._api import _progress
 
@@ -1065,7 +1458,7 @@ def simulate(
     try:
         if run.native:
             assert run.spec is not None
-            refs = None if reference is None else _tabulate(reference, run.steps, run.Ts)
+            refs = None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts)
             core_fault = None if fault is None else fault._core(run.plant.n)
             out = _adaptimp.simulate_mujoco(
                 run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
@@ -1079,7 +1472,7 @@ def simulate(
                     "case name) and a plant with a force sensor or no possible contact; this "
                     "run steps its controller from Python"
                 )
-            out, m = _python_loop(run, reference, callback)
+            out, m = _python_loop(run, run.reference, callback)
     finally:
         if bar is not None:
             bar.close()
@@ -1103,6 +1496,10 @@ class _Run:
     dist: dict[str, Any]
     spec: dict[str, Any] | None
     native: bool
+    reference: Reference | None
+    task: Task | None
+    payload: float
+    q0: FloatArray
 
 
 def _setup(
@@ -1118,6 +1515,8 @@ def _setup(
     settle: float | None = None,
     scenario: str = "robot",
     record_every: int = 1,
+    reference: Any = None,
+    payload: float = 0.0,
     params: Mapping[str, Any],
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
@@ -1130,11 +1529,21 @@ def _setup(
     if defaults is None:
         raise ValueError(f"scenario must be one of {sorted(SCENARIOS)}, got {scenario!r}")
     every = _record_every(record_every)
-    plant = model if isinstance(model, Plant) else Plant(model, contact=contact)
+    nominal = model if isinstance(model, Plant) else Plant(model, contact=contact)
+    plant = _payload_plant(nominal, payload)
+    task: Task | None = None
     params = dict(params)
     disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
     if isinstance(controller, str):
         kwargs = dict(params)
+        if _uses_rule(nominal):
+            task, reference, rule = _rule_setup(
+                nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
+                float(defaults["T"]) if T is None else float(T),
+            )  # fmt: skip
+            kwargs = {**rule, **kwargs}
+            if q0 is None and task is not None:
+                q0 = task.q0
         kwargs.setdefault("tau_max", plant.tau_max.tolist())
         if Ts is not None:
             kwargs["Ts"] = Ts
@@ -1156,8 +1565,11 @@ def _setup(
     Ts = period
     T = float(defaults["T"]) if T is None else float(T)
     settle = float(defaults["settle"]) if settle is None else float(settle)
+    # Checked before it is used: round(inf) overflows, round(nan) raises.
     if not (math.isfinite(T) and T > 0):
         raise ValueError(f"T must be finite and > 0, got {T}")
+    if T / Ts > 1e15:
+        raise ValueError("T / Ts: the run must have at most 1e15 steps")
     steps = round(T / Ts)
     if steps < 1:
         raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
@@ -1167,13 +1579,20 @@ def _setup(
         raise ValueError(f"substeps must be ≥ 1, got {substeps}")
     resolved = resolve(disturb, scenario="robot", groups=("sim",), caller="simulate()", n=plant.n)
     dist = {k: resolved[k] for k in DISTURBANCES}
+    if reference is not None:
+        reference = _table_reference(reference, plant.n, Ts, steps)
+        if q0 is None and plant.model.nkey == 0:
+            start = reference(0.0)
+            q0 = np.asarray(start[0], dtype=np.float64)
+            dq0 = np.asarray(start[1], dtype=np.float64) if dq0 is None else dq0
     plant.timestep = Ts / substeps
     plant.reset(q0, dq0)
     spec = plant._native(substeps)
     native = _native(ctrl) and spec is not None and not bool(getattr(ctrl, "wants_wrench", False))
     return _Run(
-        ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native
-    )
+        ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native,
+        reference, task, float(payload), plant.q,
+    )  # fmt: skip
 
 
 def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
@@ -1191,8 +1610,12 @@ def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
         "model": name,
         "controller": run.label,
         "loop": "native" if run.native else "python",
+        "payload": run.payload,
+        "q0": run.q0.tolist(),
         **run.dist,
     }
+    if run.task is not None:
+        params["task"] = {"home": run.task.home.tolist(), **run.task.keywords}
     case = getattr(ctrl, "case", None)
     case = case if isinstance(case, str) else getattr(getattr(ctrl, "inner", None), "case", None)
     return MujocoResult(
@@ -1322,7 +1745,6 @@ def _run_many(
     controller and MuJoCo data; a run the core cannot take alone (a Python
     loop, a reference callable) runs here. Results are those of
     :func:`simulate`, bit for bit."""
-    errors = (TypeError, ValueError, ArithmeticError, RuntimeError)
     out: list[dict[str, Any] | str | None] = [None] * len(jobs)
     native: list[tuple[int, _Run]] = []
     for i, (case, scenario, model, kw) in enumerate(jobs):
@@ -1331,7 +1753,9 @@ def _run_many(
             if kw.get("reference") is not None or kw.get("progress"):
                 out[i] = dict(simulate(case, model, scenario=scenario, **kw).metrics)
                 continue
-            names = ("T", "Ts", "substeps", "q0", "dq0", "contact", "settle", "record_every")
+            names = (
+                "T", "Ts", "substeps", "q0", "dq0", "contact", "settle", "record_every", "payload",
+            )  # fmt: skip
             run = _setup(
                 case, model, scenario=scenario, params=kw,
                 **{k: kw.pop(k) for k in names if k in kw},
@@ -1339,13 +1763,22 @@ def _run_many(
             if run.native:
                 native.append((i, run))
             else:
-                out[i] = dict(_python_loop(run, None, None)[1])
-        except errors as e:
+                out[i] = dict(_python_loop(run, run.reference, None)[1])
+        except Exception as e:  # a run's failure, whatever it is (a model's ParseError)
             out[i] = f"{type(e).__name__}: {e}"
     if native:
         results = _adaptimp.simulate_mujoco_many(
             [
-                (r.ctrl, r.plant.model, r.plant.data, r.spec or {}, r.dist, r.T, r.settle)
+                (
+                    r.ctrl,
+                    r.plant.model,
+                    r.plant.data,
+                    r.spec or {},
+                    r.dist,
+                    r.T,
+                    r.settle,
+                    None if r.reference is None else _tabulate(r.reference, r.steps, r.Ts),
+                )
                 for _, r in native
             ],
             threads,

@@ -105,7 +105,7 @@ class PandaTable:
         Start posture (rad): the SRDF's ``home``.
     pin_model : pinocchio.Model
         The exact model (for D(q0) and :class:`~adaptimp.baselines.ComputedTorque`).
-    ts : float
+    Ts : float
         Controller period (s), 1 ms.
     radius, freq : float
         The circle's radius (m) and frequency (Hz).
@@ -128,7 +128,7 @@ class PandaTable:
     chain: Chain
     q0: FloatArray
     pin_model: Any
-    ts: float
+    Ts: float
     radius: float
     freq: float
     centre: FloatArray
@@ -188,7 +188,7 @@ class PandaTable:
         q0), with ``params`` of the group "cartesian"."""
         from .cartesian import CartesianImpedance
 
-        return CartesianImpedance(self.chain, Ts=self.ts, q0=self.q0, **{**POSITION_ONLY, **params})
+        return CartesianImpedance(self.chain, Ts=self.Ts, q0=self.q0, **{**POSITION_ONLY, **params})
 
     def target_force(self, Kd: float = 500.0) -> float:
         """The normal force (N) the target impedance prescribes against a rigid
@@ -205,7 +205,7 @@ def panda_table(
     friction: float = 0.1,
     table_height: float = 0.45,
     tool_radius: float = 0.01,
-    ts: float = 1e-3,
+    Ts: float = 1e-3,
     t_approach: float = 1.0,
     t_ramp: float = 1.0,
 ) -> PandaTable:
@@ -232,7 +232,7 @@ def panda_table(
         chain=Chain.from_urdf(_models.panda_urdf_path(), tip=_models.PANDA_EE),
         q0=np.array(_models.PANDA_HOME, dtype=np.float64),
         pin_model=pinocchio_model("panda"),
-        ts=ts,
+        Ts=Ts,
         radius=radius,
         freq=freq,
         centre=np.array(centre, dtype=np.float64),
@@ -270,7 +270,7 @@ def joint_gains(sc: PandaTable, k1: float = 20.0, scale: float = 0.25) -> dict[s
     data = sc.pin_model.createData()
     m = pin.crba(sc.pin_model, data, sc.q0)
     m = np.triu(m) + np.triu(m, 1).T
-    kp = scale / (sc.ts * np.diag(np.linalg.inv(m)))
+    kp = scale / (sc.Ts * np.diag(np.linalg.inv(m)))
     return {
         "Kp": kp.tolist(),
         "Kzeta": ((1 + kp**2) / 2 + 10).tolist(),
@@ -317,7 +317,7 @@ def panda_controller(
 
         inner = ComputedTorque(
             sc.pin_model,
-            Ts=sc.ts,
+            Ts=sc.Ts,
             Kp=ct_gains[0],
             Kd=ct_gains[1],
             tau_max=sc.tau_max,
@@ -334,7 +334,7 @@ def panda_controller(
             "robot",
             centers=centres,
             widths=widths,
-            Ts=sc.ts,
+            Ts=sc.Ts,
             tau_max=sc.tau_max.tolist(),
             gamma=[float(gamma)] * 3 if isinstance(gamma, (int, float)) else list(gamma),
             **g,

@@ -1,37 +1,60 @@
-"""Gains and a basis for an arm nobody tuned for (SPEC §18).
+"""Gains, a basis and learning rates for an arm nobody tuned for (SPEC §18).
 
-:func:`suggest` turns what a user knows about a new arm (its inertia at a
-posture, from any model: a URDF through Pinocchio or MuJoCo, or an
-:class:`adaptimp.PlanarArm`; the actuator limits; the period Ts; the task's
-joint path) into keyword parameters for :class:`adaptimp.Controller` and
-:func:`adaptimp.simulate` in the robot scenario:
+A thin front of the compiled core's rule (``src/control/tuning.rs``; C users
+have the same rule). :func:`suggest` turns what a user knows about a new arm
+(its inertia at the task's start, from any model: a URDF through Pinocchio or
+MuJoCo, or an :class:`adaptimp.PlanarArm`; the actuator limits; the period Ts;
+the task's joint path) into keyword parameters for :class:`adaptimp.Controller`
+and :func:`adaptimp.simulate` in the robot scenario. Every rate is in the
+joint's own units (each joint's inertia scale d_i = 1/(D⁻¹)_ii, SPEC §10):
 
-- **Kp_i = m / (Ts (D⁻¹)_ii)** with the margin m = 0.25: the velocity loop
-  z2⁺ ≈ (1 − Ts Kp (D⁻¹)_ii) z2 of one sampled joint keeps its pole at 0.75
-  (stable for m < 2, not ringing for m < 1), whatever the arm's size; the
-  paper's Kp = 10 is this rule for its arm's heavy first joint.
-- **K1 = min(20 s⁻¹, 0.05 / Ts)**: the position loop 5× slower than the
-  velocity loop at most.
-- **Kζ_i = (1 + Kp_i²)/2 + 10**: SPEC §10's 2Kζ − 1 − Kp² > 0 with a margin.
-- **Γ = 1** for the three networks, the normalised learning step and the rest
-  of the robot scenario's hardening (SPEC §13).
-- **Centres along the task's joint path** (SPEC §15): L = 2·(path length in
-  q)/tube_q samples over one period, clipped to [16, 256], at [q; q̇] of the
-  samples, widths η_b = max(2 h_b, tube_b) (h_b the largest spacing of
-  consecutive samples), α1 and α̇1 left out (infinite widths).
+- **Kp_i = 0.25 d_i / Ts**: the sampled velocity loop of every joint keeps its
+  pole at 0.75, whatever the joint's size; **K1 = min(50 s⁻¹, 0.05/Ts)**;
+  **Kζ_i = Kp_i/d_i + ρ/2** with the conditions ``"scaled"`` of SPEC §10
+  (met by construction, for any arm, τmax and Ts); kr_i = φ Kp_i/2.
+- **Centres along the path** (SPEC §15): L = clip(⌈2·(path length in q)/tube⌉,
+  16, 256) samples of one period, widths max(2 h, tube), tube = (0.2 rad,
+  0.5 rad/s), widened to twice the sag G/(Kp K1) the arm has before the
+  networks learn (with a model that gives G).
+- **Learning** (with a path): Ĝ at the bandwidth ω_G² = ½ (Kp/d) K1 per
+  unit inertia (Γ_G = ω_G²/⟨‖S‖²⟩), D̂ and Ĉ five times slower, a leak
+  time of 25 periods, and weight bounds from τmax and the basis the path
+  actually excites.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _adaptimp
+from ._errors import ConfigError
+
 FloatArray = NDArray[np.float64]
 Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]
+
+PATH_SAMPLES = 1000
+"""Samples of one period of a path that :func:`suggest` hands the core."""
+
+RULE_KEYS = (
+    "Ts",
+    "Kp",
+    "K1",
+    "Kzeta",
+    "inertia",
+    "rho",
+    "conditions",
+    "kr",
+    "fallback_damping",
+    "gamma",
+    "sigma",
+    "weight_bound",
+    "tau_max",
+)
+"""The keywords :func:`suggest` returns (the rest are the robot scenario's)."""
 
 
 def inertia(model: Any, q: ArrayLike) -> FloatArray:
@@ -47,6 +70,8 @@ def inertia(model: Any, q: ArrayLike) -> FloatArray:
     if type(model).__name__ == "Model" and hasattr(model, "nq"):
         import pinocchio as pin
 
+        if model.nq != model.nv:  # continuous joints: angles from the neutral configuration
+            q = pin.integrate(model, pin.neutral(model), q)
         d = pin.crba(model, model.createData(), q)
         return np.asarray(np.triu(d) + np.triu(d, 1).T, dtype=np.float64)
     try:
@@ -61,21 +86,37 @@ def inertia(model: Any, q: ArrayLike) -> FloatArray:
     return arr
 
 
-def orbit_centres(
-    samples_q: ArrayLike, samples_dq: ArrayLike, tube: tuple[float, float] = (0.2, 0.5)
-) -> tuple[FloatArray, FloatArray]:
-    """Centres at the samples [q; q̇] of one period of a joint path (rows) and their
-    widths (4n,), SPEC (15.2): η_b = max(2 h_b, tube_b) for b = q (rad), q̇ (rad/s),
-    infinite for α1, α̇1; the period closes on itself (the core's
-    ``Centers::along_periodic``)."""
-    from . import _adaptimp
+def gravity(model: Any, q: ArrayLike) -> FloatArray | None:
+    """The gravity torque G(q) (N m, (n,)) of ``model`` if it can tell: an object
+    with ``G(q)``, a Pinocchio ``Model`` or an ``adaptimp.mujoco.Plant``; None
+    for a bare inertia matrix."""
+    q = np.asarray(q, dtype=np.float64)
+    if hasattr(model, "G"):
+        return np.asarray(model.G(q), dtype=np.float64)
+    if hasattr(model, "bias") and hasattr(model, "reset"):
+        model.reset(q)
+        return np.asarray(model.bias(), dtype=np.float64)
+    if type(model).__name__ == "Model" and hasattr(model, "nq"):
+        import pinocchio as pin
 
-    q = np.ascontiguousarray(np.atleast_2d(np.asarray(samples_q, dtype=np.float64)))
-    dq = np.ascontiguousarray(np.atleast_2d(np.asarray(samples_dq, dtype=np.float64)))
-    centres, widths2 = _adaptimp.centres_along(
-        q, dq, (float(tube[0]), float(tube[1])), periodic=True
-    )
-    return np.asarray(centres, dtype=np.float64), np.sqrt(widths2)
+        if model.nq != model.nv:
+            q = pin.integrate(model, pin.neutral(model), q)
+        return np.asarray(pin.computeGeneralizedGravity(model, model.createData(), q))
+    return None
+
+
+def sample_path(path: Path, period: float, n: int) -> FloatArray:
+    """One period of ``path(t) -> (q, dq, ddq)`` as a (K, 3n) array, K =
+    :data:`PATH_SAMPLES` instants evenly spaced from t = 0 (the first not
+    repeated)."""
+    if not (period > 0 and np.isfinite(period)):
+        raise ConfigError(f"a path needs its period (s) > 0, got {period}")
+    rows = np.empty((PATH_SAMPLES, 3 * n))
+    for k in range(PATH_SAMPLES):
+        q, dq, ddq = path(period * k / PATH_SAMPLES)
+        for j, v in enumerate((q, dq, ddq)):
+            rows[k, j * n : (j + 1) * n] = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+    return rows
 
 
 def suggest(
@@ -86,8 +127,7 @@ def suggest(
     Ts: float = 1e-3,
     path: Path | None = None,
     period: float | None = None,
-    tube: tuple[float, float] = (0.2, 0.5),
-    margin: float = 0.25,
+    case: str = "sf",
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia at ``q0`` (rad), its actuator
     limits ``tau_max`` (N m) and the task's joint path (SPEC §18, module docs).
@@ -104,48 +144,55 @@ def suggest(
         Control period (s).
     path : callable, optional
         ``path(t) -> (q, dq, ddq)``, the task's joint path (rad, rad/s, rad/s²),
-        periodic with ``period`` (s): the RBF centres go along it. Without it
-        the result has no ``centers`` (the vertex grid, n ≤ 3).
-    tube : (float, float)
-        How far from the path (rad, rad/s) the networks should act.
-    margin : float
-        m of Kp_i = m/(Ts (D⁻¹)_ii), in (0, 1).
+        periodic with ``period`` (s): the RBF centres go along it and the
+        learning rates follow from the basis it excites. Without it: the gains
+        only (a controller for n ≤ 3 then uses the vertex grid, beyond it the
+        default basis along its own trajectory, SPEC §18).
+    case : {"pd", "sf", "of"}
+        The controller (the keywords are the same for all three).
 
     Returns
     -------
     dict
-        ``n``, ``Kp``, ``K1``, ``Kzeta``, ``gamma``, ``tau_max`` and, with a
-        path, ``centers`` (L, 4n) and ``widths`` (4n,): keywords of
-        ``adaptimp.Controller(case, "robot", **kw)``.
+        ``n`` and the keywords of :data:`RULE_KEYS` and, with a path,
+        ``centers`` (L, 4n) and ``widths`` (4n,): keywords of
+        ``adaptimp.Controller(case, "robot", **kw)``, which construction accepts.
+
+    Raises
+    ------
+    ConfigError
+        D(q0) not symmetric positive definite, τmax ≤ 0, Ts outside (0, 1] s,
+        a shape that does not match (each named).
     """
-    if not 0 < margin < 1:
-        raise ValueError(f"margin must be in (0, 1), got {margin}")
     d = inertia(model, q0)
     n = d.shape[0]
-    dinv = np.diag(np.linalg.inv(d))
-    if np.any(dinv <= 0) or not np.all(np.isfinite(dinv)):
-        raise ValueError("the inertia matrix at q0 is not positive definite")
-    kp = margin / (Ts * dinv)
-    out: dict[str, Any] = {
-        "n": n,
-        "Kp": [float(x) for x in kp],
-        "K1": float(min(20.0, 0.05 / Ts)),
-        "Kzeta": [float((1 + x * x) / 2 + 10) for x in kp],
-        "gamma": 1.0,
-        "tau_max": [float(x) for x in np.broadcast_to(np.asarray(tau_max, float), (n,))],
-    }
+    tau = np.ascontiguousarray(np.broadcast_to(np.asarray(tau_max, dtype=np.float64), (n,)))
+    rows = None
     if path is not None:
-        if period is None or not period > 0:
-            raise ValueError("a path needs its period (s) > 0")
+        if period is None:
+            raise ConfigError("a path needs its period (s)")
+        rows = sample_path(path, period, n)
+    g = gravity(model, q0) if rows is not None else None
+    out = _adaptimp.suggest(case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g)
+    kw: dict[str, Any] = {"n": n}
+    kw.update({k: out["params"][k] for k in RULE_KEYS})
+    if "centers" in out:
+        kw["centers"], kw["widths"] = out["centers"], out["widths"]
+    return kw
 
-        def at(t: float, k: int) -> FloatArray:
-            return np.broadcast_to(np.asarray(path(t)[k], dtype=np.float64), (n,))
 
-        fine = np.array([at(t, 0) for t in np.linspace(0, period, 1001)])
-        length = float(np.sum(np.linalg.norm(np.diff(fine, axis=0), axis=1)))
-        nodes = int(min(256, max(16, math.ceil(2 * length / tube[0]))))
-        times = np.arange(nodes) * period / nodes
-        q = np.array([at(t, 0) for t in times])
-        dq = np.array([at(t, 1) for t in times])
-        out["centers"], out["widths"] = orbit_centres(q, dq, tube)
-    return out
+def default_task(home: ArrayLike, lo: ArrayLike, hi: ArrayLike) -> dict[str, list[float]]:
+    """The default task of SPEC §18 about the posture ``home`` (rad) for joints
+    limited to [``lo``, ``hi``] (rad; ±inf for a continuous joint): every joint
+    swings xc_i = home_i − A_i cos(π t) (period 2 s, from rest), A_i =
+    min(0.2 rad, range/4). Returns the keywords ``xc_offset``, ``xc_sin``,
+    ``xc_cos``, ``xc_omega``.
+
+    Raises
+    ------
+    ConfigError
+        lo ≥ hi on some joint, or ``home`` closer than A to a limit.
+    """
+    arrays = [np.ascontiguousarray(np.asarray(v, dtype=np.float64)) for v in (home, lo, hi)]
+    o, a, b, w = _adaptimp.default_task(*arrays)
+    return {"xc_offset": o, "xc_sin": a, "xc_cos": b, "xc_omega": w}

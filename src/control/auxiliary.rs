@@ -9,6 +9,15 @@
 //! Erratum (SPEC §8): with the printed inner law ζ(0) = 0 never leaves the
 //! origin and the compensator is dead; the default inner law leaves zero when
 //! the actuator saturates and decays when it does not.
+//!
+//! Weighted by each joint's inertia scale d_i (kg m²) and the Young weight ρ
+//! (1/s), SPEC (10.1): with Dₛ = diag(d),
+//!
+//! ```text
+//! ζ̇ = −Kζ ζ − ((|z2ᵀ Δτ| + Δτᵀ Dₛ⁻¹ Δτ / (2ρ)) / (ζᵀ Dₛ ζ)) ζ + Dₛ⁻¹ Δτ
+//! ```
+//!
+//! which is (11) for d = 1, ρ = 1 (the paper).
 
 use crate::error::{check, Error};
 use crate::types::{choices, Vector};
@@ -35,21 +44,53 @@ choices!(AuxLaw {
     "linear" => AuxLaw::Linear,
 });
 
-/// Parameters of the auxiliary system: Kζ (1/s, diagonal), μ (N m) and the inner law.
+/// Parameters of the auxiliary system: Kζ (1/s, diagonal), μ (N m), the inner
+/// law, the inertia scales d (kg m²) and the Young weight ρ (1/s).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Auxiliary<const N: usize> {
     kzeta: Vector<N>,
     mu: f64,
     law: AuxLaw,
+    inertia: Vector<N>,
+    /// 1/d_i (1/(kg m²)).
+    inv_inertia: Vector<N>,
+    /// 1/(2ρ) (s).
+    half_inv_rho: f64,
 }
 
 impl<const N: usize> Auxiliary<N> {
     /// Validated: Kζ finite (its SPEC §10 condition involves Kp and is checked by
-    /// the controller), μ > 0.
+    /// the controller), μ > 0; the paper's weights d = 1, ρ = 1.
     pub fn new(kzeta: Vector<N>, mu: f64, law: AuxLaw) -> Result<Self, Error> {
+        Self::weighted(kzeta, mu, law, Vector::from_element(1.0), 1.0)
+    }
+
+    /// As [`new`](Self::new), weighted by the inertia scales `inertia` (kg m²,
+    /// each > 0) and the Young weight `rho` (1/s, > 0), SPEC (10.1).
+    pub fn weighted(
+        kzeta: Vector<N>,
+        mu: f64,
+        law: AuxLaw,
+        inertia: Vector<N>,
+        rho: f64,
+    ) -> Result<Self, Error> {
         check::finite_slice("Kzeta", kzeta.as_slice())?;
         check::positive("μ > 0", "mu", mu)?;
-        Ok(Self { kzeta, mu, law })
+        check::positive_vec("d > 0", "inertia", &inertia)?;
+        check::positive("ρ > 0", "rho", rho)?;
+        Ok(Self {
+            kzeta,
+            mu,
+            law,
+            inertia,
+            inv_inertia: inertia.map(|d| 1.0 / d),
+            half_inv_rho: 0.5 / rho,
+        })
+    }
+
+    /// The inertia scales d (kg m²).
+    pub fn inertia(&self) -> &Vector<N> {
+        &self.inertia
     }
 
     /// Kζ (1/s).
@@ -67,26 +108,32 @@ impl<const N: usize> Auxiliary<N> {
 
     /// Advance ζ by one period `ts` (s) given z2 (rad/s) and Δτ = sat(τ) − τ (N m).
     ///
-    /// Semi-implicit, per component (SPEC §11): with β = (|z2ᵀΔτ| + ½ΔτᵀΔτ)/‖ζ‖²
-    /// when ‖ζ‖ ≥ μ and β = 0 otherwise, ζ_i ← (ζ_i + Ts Δτ_i) / (1 + Ts (Kζ_i + β)).
-    /// Unconditionally stable in Ts; with the printed law ζ is left unchanged
-    /// inside the ball.
+    /// Semi-implicit, per component (SPEC §11): with
+    /// β = (|z2ᵀΔτ| + ΔτᵀDₛ⁻¹Δτ/(2ρ))/(ζᵀDₛζ) when ‖ζ‖ ≥ μ and β = 0
+    /// otherwise, ζ_i ← (ζ_i + Ts Δτ_i/d_i) / (1 + Ts (Kζ_i + β)) (for d = 1,
+    /// ρ = 1: β = (|z2ᵀΔτ| + ½ΔτᵀΔτ)/‖ζ‖², the paper's). Unconditionally
+    /// stable in Ts; with the printed law ζ is left unchanged inside the ball.
     #[inline]
     pub fn advance(&self, zeta: &mut Vector<N>, z2: &Vector<N>, dtau: &Vector<N>, ts: f64) {
         let n2 = zeta.norm_squared();
+        // ζᵀDₛζ (with d = 1, ρ = 1 every product by d_i, 1/d_i below is
+        // exact: the paper's β to the last bit).
+        let energy = zeta.component_mul(&self.inertia).dot(zeta);
         let beta = if self.law == AuxLaw::Linear {
             0.0
-        } else if n2 >= self.mu * self.mu && n2 > 0.0 {
-            // (n2 > 0: for μ below ~1e-154, μ² underflows to 0 and ‖ζ‖ = 0
+        } else if n2 >= self.mu * self.mu && energy > 0.0 {
+            // (energy > 0: for μ below ~1e-154, μ² underflows to 0 and ‖ζ‖ = 0
             // would divide by zero; found by fuzzing.)
-            (z2.dot(dtau).abs() + 0.5 * dtau.norm_squared()) / n2
+            let weighted = dtau.component_mul(&self.inv_inertia).dot(dtau);
+            (z2.dot(dtau).abs() + weighted * self.half_inv_rho) / energy
         } else if self.law == AuxLaw::Printed {
             return;
         } else {
             0.0
         };
         for i in 0..N {
-            zeta[i] = (zeta[i] + ts * dtau[i]) / (1.0 + ts * (self.kzeta[i] + beta));
+            zeta[i] = (zeta[i] + ts * (dtau[i] * self.inv_inertia[i]))
+                / (1.0 + ts * (self.kzeta[i] + beta));
         }
     }
 }

@@ -22,6 +22,25 @@ pub enum Law {
     OutputFeedback,
 }
 
+/// Which stability conditions construction checks, SPEC §10.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub enum Conditions {
+    /// The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 ("paper"). Proved
+    /// for the unit weights of the paper's Lyapunov function only: it needs
+    /// `inertia` = 1 and ρ = 1.
+    #[default]
+    Paper,
+    /// SPEC (10.3), from the Lyapunov function weighted by each joint's inertia
+    /// scale d_i with the cross term split at Kp ("scaled"): Kp_i > 0 and
+    /// 2Kζ_i − ρ − Kp_i/d_i > 0, every term in 1/s.
+    Scaled,
+}
+
+choices!(Conditions {
+    "paper" => Conditions::Paper,
+    "scaled" => Conditions::Scaled,
+});
+
 impl Law {
     /// True for the two adaptive (learning) laws.
     pub fn learns(self) -> bool {
@@ -81,6 +100,14 @@ pub struct Config<const N: usize> {
     pub kzeta: Vector<N>,
     /// μ (N m), radius of the auxiliary system's inner ball. SPEC §8: 0.01.
     pub mu: f64,
+    /// Inertia scale d_i of each joint (kg m²), SPEC §10: weights the
+    /// auxiliary system (Δτ_i/d_i), the z1 term (d_i z1_i) and the learning
+    /// error (d_i z2_i). Paper: 1.
+    pub inertia: Vector<N>,
+    /// Young weight ρ (1/s) of ζᵀΔτ in the auxiliary system's β, SPEC §10. Paper: 1.
+    pub rho: f64,
+    /// Which stability conditions construction checks, SPEC §10.
+    pub conditions: Conditions,
     /// Inner law of the auxiliary system. SPEC §8: [`AuxLaw::Leaky`].
     pub aux_law: AuxLaw,
     /// Robust term. SPEC §7: `Sign` with kr = 0.5 N m.
@@ -147,6 +174,9 @@ impl<const N: usize> Config<N> {
             kp: z,
             kzeta: z,
             mu: 0.0,
+            inertia: z,
+            rho: 0.0,
+            conditions: Conditions::Paper,
             aux_law: AuxLaw::Leaky,
             robust: RobustKind::Sign,
             kr: z,

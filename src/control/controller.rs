@@ -15,7 +15,7 @@
 //! advance.
 
 use crate::control::auxiliary::Auxiliary;
-use crate::control::config::{Config, Law, ObserverInit, WeightBound};
+use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound};
 use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
 use crate::control::io::{Command, Control, Measurement, TaskTorque};
 use crate::control::observer::{HighGainObserver, ObserverState};
@@ -30,6 +30,10 @@ use crate::networks::simd::SimdPath;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 use nalgebra::SMatrix;
+
+/// The smallest inertia scale d (kg m²) and Young weight ρ (1/s), SPEC §10:
+/// 1/d and 1/ρ multiply Δτ, so a smaller one could take ζ beyond [`BOUND`].
+pub const MIN_SCALE: f64 = 1e-9;
 
 /// A validated controller of the paper: its configuration, its basis and
 /// what is precomputed from them. Immutable; see the [module docs](self).
@@ -63,12 +67,23 @@ pub struct Errors<const N: usize> {
 }
 
 impl<const N: usize> Errors<N> {
-    /// The signals the learning laws use.
+    /// The signals the learning laws use, with the learning error z2 (the
+    /// paper's, for unit inertia scales).
     pub fn signals(&self) -> Signals<N> {
         Signals {
             dalpha1: self.dalpha1,
             alpha1: self.alpha1,
             z2: self.z2,
+        }
+    }
+
+    /// The signals the learning laws use, with the learning error d∘z2 (N m s)
+    /// weighted by the inertia scales d (kg m²), SPEC (10.2): joint k's rows
+    /// learn at Γ d_k and leak at Γσ.
+    pub fn signals_scaled(&self, inertia: &Vector<N>) -> Signals<N> {
+        Signals {
+            z2: self.z2.component_mul(inertia),
+            ..self.signals()
         }
     }
 }
@@ -90,13 +105,14 @@ impl<const N: usize> Task<N> {
     /// The learning signals of (19.2): the regressors n α̇1 + (1 − n) q̈_c,
     /// n α1 + (1 − n) q̇_c and the paper's z2 of `e` (on the compliant
     /// reference: the networks learn what the impedance leaves undone, never
-    /// the contact force it prescribes).
-    fn signals(&self, e: &Errors<N>) -> Signals<N> {
+    /// the contact force it prescribes), weighted d∘z2 by the inertia scales
+    /// as (10.2).
+    fn signals(&self, e: &Errors<N>, inertia: &Vector<N>) -> Signals<N> {
         let n = self.share;
         Signals {
             dalpha1: n * e.dalpha1 + (1.0 - n) * self.commanded.ddx,
             alpha1: n * e.alpha1 + (1.0 - n) * self.commanded.dx,
-            z2: e.z2,
+            z2: e.z2.component_mul(inertia),
         }
     }
 
@@ -155,22 +171,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         }
         check::positive("Ts > 0", "Ts", cfg.ts)?;
         check::positive_vec("K1 > 0", "K1", &cfg.k1)?;
-        check::finite_slice("Kp", cfg.kp.as_slice())?;
-        check::each(
-            "2Kp − I > 0",
-            "2·Kp − 1",
-            &cfg.kp,
-            |_, kp| 2.0 * kp - 1.0,
-            true,
-        )?;
-        check::finite_slice("Kzeta", cfg.kzeta.as_slice())?;
-        check::each(
-            "2Kζ − I − KpᵀKp > 0",
-            "2·Kzeta − 1 − Kp²",
-            &cfg.kzeta,
-            |i, kz| 2.0 * kz - 1.0 - cfg.kp[i] * cfg.kp[i],
-            true,
-        )?;
+        Self::check_stability(&cfg)?;
         Self::check_magnitudes(&cfg)?;
         check::nonnegative_vec("Kd ≥ 0", "fallback_damping", &cfg.fallback_damping)?;
         cfg.limits.validate()?;
@@ -189,7 +190,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         Ok(Self {
             sat: Saturation::new(cfg.tau_max)?,
             imp: TargetImpedance::new(cfg.dd, cfg.cd, cfg.gd)?,
-            aux: Auxiliary::new(cfg.kzeta, cfg.mu, cfg.aux_law)?,
+            aux: Auxiliary::weighted(cfg.kzeta, cfg.mu, cfg.aux_law, cfg.inertia, cfg.rho)?,
             obs: HighGainObserver::new(cfg.eps, cfg.lam1, cfg.ts, cfg.observer_hold)?,
             learning: Learning::new(
                 cfg.ts,
@@ -199,13 +200,74 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
                 cfg.kappa,
                 cfg.saturation_learning,
                 bound,
-                cfg.kp.min(),
+                // min_k Kp_k/d_k (1/s; min Kp for d = 1, exactly).
+                cfg.kp.component_div(&cfg.inertia).min(),
             )?,
             robust,
             cfg,
             basis,
             simd: SimdPath::detect(),
         })
+    }
+
+    /// The stability conditions of SPEC §10 that [`Config::conditions`]
+    /// names: the paper's (13), or the inertia-scaled (10.3).
+    fn check_stability(cfg: &Config<N>) -> Result<(), Error> {
+        check::finite_slice("Kp", cfg.kp.as_slice())?;
+        check::finite_slice("Kzeta", cfg.kzeta.as_slice())?;
+        check::finite_slice("inertia", cfg.inertia.as_slice())?;
+        if let Some(i) = cfg.inertia.iter().position(|d| *d < MIN_SCALE) {
+            return Err(Error::Condition {
+                condition: "d ≥ 1e-9",
+                lhs: "inertia",
+                index: Some(i),
+                value: cfg.inertia[i],
+            });
+        }
+        check::finite("rho", cfg.rho)?;
+        if cfg.rho < MIN_SCALE {
+            return Err(Error::Condition {
+                condition: "ρ ≥ 1e-9",
+                lhs: "rho",
+                index: None,
+                value: cfg.rho,
+            });
+        }
+        match cfg.conditions {
+            Conditions::Paper => {
+                // (13) is proved with the paper's unit weights only (SPEC §10).
+                if cfg.inertia.iter().any(|d| *d != 1.0) || cfg.rho != 1.0 {
+                    return Err(Error::Invalid {
+                        what: "conditions = paper",
+                        reason: "(13) is proved for the paper's unit weights (inertia = 1, rho = 1): use conditions = scaled",
+                    });
+                }
+                check::each(
+                    "2Kp − I > 0",
+                    "2·Kp − 1",
+                    &cfg.kp,
+                    |_, kp| 2.0 * kp - 1.0,
+                    true,
+                )?;
+                check::each(
+                    "2Kζ − I − KpᵀKp > 0",
+                    "2·Kzeta − 1 − Kp²",
+                    &cfg.kzeta,
+                    |i, kz| 2.0 * kz - 1.0 - cfg.kp[i] * cfg.kp[i],
+                    true,
+                )
+            }
+            Conditions::Scaled => {
+                check::each("Kp > 0", "Kp", &cfg.kp, |_, kp| kp, true)?;
+                check::each(
+                    "2Kζ − ρ − Kp/d > 0",
+                    "2·Kzeta − rho − Kp/inertia",
+                    &cfg.kzeta,
+                    |i, kz| 2.0 * kz - cfg.rho - cfg.kp[i] / cfg.inertia[i],
+                    true,
+                )
+            }
+        }
     }
 
     /// Every gain and physical parameter at most [`PARAM_BOUND`] (1e9) in
@@ -216,6 +278,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             ("K1", &cfg.k1),
             ("Kp", &cfg.kp),
             ("Kzeta", &cfg.kzeta),
+            ("inertia", &cfg.inertia),
             ("kr", &cfg.kr),
             ("lam1", &cfg.lam1),
             ("tau_max", &cfg.tau_max),
@@ -236,6 +299,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         }
         let scalars = [
             ("mu", cfg.mu),
+            ("rho", cfg.rho),
             ("phi", cfg.phi),
             ("kD", cfg.kd),
             ("kC", cfg.kc),
@@ -364,12 +428,17 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// actuators. No allocation.
     ///
     /// **Transactional**: the step first checks its inputs (finite, within the
-    /// plausibility limits, every signal within [`BOUND`])
+    /// plausibility limits and their ceilings, the setpoint too), every signal
+    /// within [`BOUND`], the reference it would commit within the ceilings,
     /// and that the weights' update keeps them within the bound; only then
-    /// does it change the state. On an error the state is exactly as before,
-    /// except that the fault is recorded ([`State::fault`]); with
-    /// [`FaultPolicy::Latch`] later steps are refused until
-    /// [`State::clear_fault`]. [`step_or_fallback`](Self::step_or_fallback)
+    /// does it change the state. A refused step changes nothing the control
+    /// law uses (clock, reference, ζ, observer, weights, last command, last
+    /// accepted position); it records the refusal: the fault
+    /// ([`State::fault`]; with [`FaultPolicy::Latch`] later steps are refused
+    /// until [`State::clear_fault`], and the fault that latched is kept), the
+    /// fallback as the applied torque ([`State::applied`]) and the measured
+    /// position if plausible (a jump anchor). The table is in
+    /// `docs/reliability.md`. [`step_or_fallback`](Self::step_or_fallback)
     /// also gives the torque to apply then.
     pub fn step<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
@@ -377,11 +446,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         m: &Measurement<N>,
         c: &Setpoint<N>,
     ) -> Result<Command<N>, Error> {
-        let out = self.try_step(st, m, c, None);
-        if let Err(error) = out {
-            st.fault = Some(Fault { error, step: st.k });
-        }
-        out
+        self.step_inner(st, m, c, None)
     }
 
     /// One step of the torque-level formulations of a Cartesian impedance
@@ -390,14 +455,16 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// part. With n = `task.share`,
     ///
     /// ```text
-    /// τ = n [Kp z2 + r(z2) + z1 + τe] + (1 − n) [Jᵀ(K̃e + B(ṗ_c − J v)) + N (z1_c + Kp N z2_c + r(N z2_c))]
+    /// τ = n [Kp z2 + r(z2) + d∘z1 + τe] + (1 − n) [Jᵀ(K̃e + B(ṗ_c − J v)) + Π (d∘z1_c + Kp z2_c + r(z2_c))]
     ///     + Kp ζ + ŴD S α̇ + ŴC S α + ŴG S
     /// ```
     ///
-    /// (z1, τe and the networks for the learning laws only), with the
-    /// regressors α = n α1 + (1 − n) α1_c, α̇ likewise, where α1_c, z2_c are
-    /// (7), (8) on the commanded reference; the networks learn from the
-    /// compliant z2. With n = 1 it is [`step`](Self::step) (the same
+    /// (the z1 terms, τe and the networks for the learning laws only; d the
+    /// inertia scales of SPEC (10.2)), with the regressors α = n α1 + (1 −
+    /// n) q̇_c, α̇ = n α̇1 + (1 − n) q̈_c and the input n [q; v] + (1 − n)
+    /// [q_c; q̇_c], where z1_c, z2_c are (6), (8) on the commanded reference
+    /// and Π is (19.3); the networks learn from the paper's z2 on the
+    /// compliant reference. With n = 1 it is [`step`](Self::step) (the same
     /// result); transactional as [`step`](Self::step).
     pub fn step_task<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
@@ -406,16 +473,34 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         c: &Setpoint<N>,
         task: &TaskTorque<N>,
     ) -> Result<Command<N>, Error> {
-        let out = self.try_step(st, m, c, Some(task));
-        if let Err(error) = out {
-            st.fault = Some(Fault { error, step: st.k });
+        self.step_inner(st, m, c, Some(task))
+    }
+
+    /// [`step`](Self::step) or [`step_task`](Self::step_task): the step, and
+    /// on a refusal its record.
+    fn step_inner<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+        task: Option<&TaskTorque<N>>,
+    ) -> Result<Command<N>, Error> {
+        match self.try_step(st, m, c, task) {
+            Ok(cmd) => Ok(cmd),
+            Err(error) => {
+                if self.cfg.limits.plausible_position(&m.x) {
+                    st.q_seen = m.x;
+                }
+                self.record(st, m.dx.as_ref(), error);
+                Err(error)
+            }
         }
-        out
     }
 
     /// [`step`](Self::step), and the torque to apply whatever happened: the
     /// step's `tau_sat`, or on an error the configured [`Fallback`] (the last
-    /// applied torque held, zero, or joint damping −Kd q̇, saturated).
+    /// applied torque held, zero, or joint damping −Kd q̇, saturated), which
+    /// is then the applied torque the next step's rate limit starts from.
     pub fn step_or_fallback<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
         st: &mut State<N, S>,
@@ -424,31 +509,128 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     ) -> (Vector<N>, Result<Command<N>, Error>) {
         match self.step(st, m, c) {
             Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
-            Err(e) => (self.fallback(st, m), Err(e)),
+            Err(e) => (st.applied, Err(e)),
         }
     }
 
+    /// A step call a front refused before it reached [`step`](Self::step)
+    /// (an argument of the wrong shape or type, a missing measurement):
+    /// recorded as a refused step is, with `error` as its fault, and the
+    /// fallback returned (damping uses the last velocity the controller used).
+    /// So every refusal latches, whichever front saw it first.
+    pub fn refuse<S>(&self, st: &mut State<N, S>, error: Error) -> Vector<N> {
+        self.record(st, None, error);
+        st.applied
+    }
+
+    /// Record a refused step: the fault (a latched one is kept), and the
+    /// fallback as the applied torque.
+    fn record<S>(&self, st: &mut State<N, S>, dx: Option<&Vector<N>>, error: Error) {
+        let latched = self.cfg.fault_policy == FaultPolicy::Latch && st.fault.is_some();
+        if !latched {
+            st.fault = Some(Fault { error, step: st.k });
+        }
+        st.applied = self.fallback_with(st, dx);
+    }
+
     /// The configured fallback torque (N m, saturated) for `state` given the
-    /// measurement `m`: for damping, its velocity if finite and within
-    /// `dq_max`, else the last velocity the controller used.
+    /// measurement `m`: for hold, the torque last applied; for damping, its
+    /// velocity if finite and within `dq_max`, else the last velocity the
+    /// controller used.
     pub fn fallback<S>(&self, st: &State<N, S>, m: &Measurement<N>) -> Vector<N> {
+        self.fallback_with(st, m.dx.as_ref())
+    }
+
+    /// [`fallback`](Self::fallback) with the measured velocity `dx`, if any.
+    fn fallback_with<S>(&self, st: &State<N, S>, dx: Option<&Vector<N>>) -> Vector<N> {
         let tau = match self.cfg.fallback {
-            Fallback::Hold => st.last.tau_sat,
+            Fallback::Hold => st.applied,
             Fallback::Zero => Vector::zeros(),
             Fallback::Damping => {
+                let bound = self.cfg.limits.velocity();
                 let usable = |v: &Vector<N>| {
                     v.iter()
-                        .zip(self.cfg.limits.dq.iter())
+                        .zip(bound.iter())
                         .all(|(x, l)| x.is_finite() && x.abs() <= *l)
                 };
-                let v = match m.dx {
-                    Some(dx) if usable(&dx) => dx,
+                let v = match dx {
+                    Some(dx) if usable(dx) => *dx,
                     _ => st.last.v,
                 };
                 -self.cfg.fallback_damping.component_mul(&v)
             }
         };
         self.sat.apply(&tau)
+    }
+
+    /// Restore into `st` a snapshot written by [`State::save`], checked as
+    /// [`State::load`] checks it and against this controller: its basis, the
+    /// applied and last torques within τmax, the weight norms within the
+    /// projection bounds. A state this controller's step could never have
+    /// left is refused; on an error `st` is as before.
+    pub fn restore<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        data: &[f64],
+    ) -> Result<(), Error> {
+        self.check_nodes(st)?;
+        let snap = st.check_snapshot(data)?;
+        let tau_max = self.sat.limits();
+        check::within_each(
+            "applied torque",
+            snap.applied.as_slice(),
+            tau_max.as_slice(),
+        )?;
+        check::within_each("tau_sat", snap.last.tau_sat.as_slice(), tau_max.as_slice())?;
+        self.check_projection(&snap.exact)?;
+        st.commit(&snap);
+        Ok(())
+    }
+
+    /// Replace the weights of `st` (a warm start), checked as
+    /// [`State::load_weights`] checks them and against the projection bounds.
+    pub fn load_weights<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        w: &crate::networks::network::Weights<'_, N>,
+    ) -> Result<(), Error> {
+        self.check_nodes(st)?;
+        w.check_finite()?;
+        self.check_projection(&w.norms())?;
+        st.load_weights(w)
+    }
+
+    /// Weight norms within the projection bounds (to rounding), if any.
+    fn check_projection(&self, norms: &[f64; 3]) -> Result<(), Error> {
+        if let Some(bound) = self.learning.bound() {
+            for ((n, b), what) in
+                norms
+                    .iter()
+                    .zip(bound)
+                    .zip(["‖weights.D‖", "‖weights.C‖", "‖weights.G‖"])
+            {
+                if n.is_nan() || *n > b * (1.0 + 1e-9) {
+                    return Err(Error::OutOfRange {
+                        what,
+                        index: None,
+                        value: *n,
+                        limit: b,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The state made for this basis.
+    fn check_nodes<S: AsRef<[f64]> + AsMut<[f64]>>(&self, st: &State<N, S>) -> Result<(), Error> {
+        if st.nodes() != self.basis.nodes() {
+            return Err(Error::Invalid {
+                what: "state",
+                reason: "was made for a basis with another number of nodes",
+            });
+        }
+        Ok(())
     }
 
     /// The step itself: checks, then stages on local copies, then the commit.
@@ -498,13 +680,21 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
                 check::within(what, x.as_slice(), BOUND)?;
             }
             if self.cfg.law.learns() {
-                self.learning
-                    .check_bounded(&st.norms, &t.signals(&e), self.basis.nodes())?;
+                self.learning.check_bounded(
+                    &st.norms,
+                    &t.signals(&e, &self.cfg.inertia),
+                    self.basis.nodes(),
+                )?;
             }
         }
+        // The reference this step would commit, within the ceilings.
+        let mut next = staged.reference;
+        next.advance(&e.ddxd, self.cfg.ts);
+        self.cfg.limits.check_reference(&next)?;
         // Every check has passed: from here on the state changes, and with
         // every signal and weight within BOUND nothing below can overflow.
         let cmd = self.command(st, m, c, &e, &v, &staged.reference, task.as_ref())?;
+        staged.reference = next;
         self.advance(st, staged, m, &e, &cmd);
         Ok(cmd)
     }
@@ -528,8 +718,11 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             check::within(what, x.as_slice(), BOUND)?;
         }
         if self.cfg.law.learns() {
-            self.learning
-                .check_bounded(&st.norms, &e.signals(), self.basis.nodes())?;
+            self.learning.check_bounded(
+                &st.norms,
+                &e.signals_scaled(&self.cfg.inertia),
+                self.basis.nodes(),
+            )?;
         }
         Ok(())
     }
@@ -549,26 +742,26 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         task: Option<&Task<N>>,
     ) -> Result<Command<N>, Error> {
         let learns = self.cfg.law.learns();
+        let d = &self.cfg.inertia;
         let (sig, mut tau) = match task {
-            None => (e.signals(), self.feedback(e, &st.zeta)),
+            None => (e.signals_scaled(d), self.feedback(e, &st.zeta)),
             Some(t) => {
                 // (19.2): the admittance's share and the torque-level part.
                 let n = t.share;
                 let mut adm = self.cfg.kp.component_mul(&e.z2)
                     + self.robust.eval(&e.z2, &e.alpha1, &e.dalpha1);
                 if learns {
-                    adm += e.z1 + m.tau_e;
+                    adm += e.z1.component_mul(d) + m.tau_e;
                 }
-                let sig = t.signals(e);
                 let tau = n * adm + (1.0 - n) * t.torque + self.cfg.kp.component_mul(&st.zeta);
-                (sig, tau)
+                (t.signals(e, d), tau)
             }
         };
         let w_norms = if learns {
             let before = st.norms;
             if task.is_none() {
-                // (14), (35) with +z1 (erratum, SPEC §7).
-                tau += e.z1 + self.networks(st, &m.x, v, &sig) + m.tau_e;
+                // (14), (35) with +z1 (erratum, SPEC §7), weighted d∘z1 (SPEC (10.2)).
+                tau += e.z1.component_mul(d) + self.networks(st, &m.x, v, &sig) + m.tau_e;
             } else {
                 let (x, v) = task.map_or((m.x, *v), |t| t.input(&m.x, v));
                 tau += self.networks(st, &x, &v, &sig);
@@ -582,7 +775,8 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             // non-finite torque is never returned, whatever the cause.
             return Err(Error::Diverged { what: "tau" });
         }
-        let limited = self.cfg.limits.rate_limit(&tau, &st.last.tau_sat);
+        // The rate limit starts from the torque last applied (a fallback too).
+        let limited = self.cfg.limits.rate_limit(&tau, &st.applied);
         let tau_sat = self.sat.apply(&limited);
         let dtau = tau_sat - tau;
         if learns {
@@ -602,8 +796,9 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         })
     }
 
-    /// Stage "advance", SPEC §11 step 5: ζ, the reference, the observer and
-    /// the clock to t_{k+1}, from this step's values only; the commit.
+    /// Stage "advance", SPEC §11 step 5: ζ, the reference (`staged` holds it
+    /// advanced already), the observer and the clock to t_{k+1}, from this
+    /// step's values only; the commit.
     fn advance<S>(
         &self,
         st: &mut State<N, S>,
@@ -614,31 +809,27 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     ) {
         let ts = self.cfg.ts;
         self.aux.advance(&mut st.zeta, &e.z2, &cmd.dtau, ts);
-        staged.reference.advance(&e.ddxd, ts);
         if self.cfg.law == Law::OutputFeedback {
             self.obs.finish(&mut staged.observer, &m.x);
         }
         st.reference = staged.reference;
         st.observer = staged.observer;
         st.q_prev = m.x;
+        st.q_seen = m.x;
+        st.applied = cmd.tau_sat;
         st.k += 1;
         st.last = *cmd;
     }
 
-    /// Inputs finite, within the plausibility limits and [`BOUND`], and the
-    /// state made for this basis.
+    /// Inputs finite and within the plausibility limits and their ceilings
+    /// (the setpoint too), and the state made for this basis.
     fn check<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
         st: &State<N, S>,
         m: &Measurement<N>,
         c: &Setpoint<N>,
     ) -> Result<(), Error> {
-        if st.nodes() != self.basis.nodes() {
-            return Err(Error::Invalid {
-                what: "state",
-                reason: "was made for a basis with another number of nodes",
-            });
-        }
+        self.check_nodes(st)?;
         for (what, v) in [
             ("x", &m.x),
             ("tau_e", &m.tau_e),
@@ -647,19 +838,18 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             ("ddxc", &c.ddx),
         ] {
             check::finite_slice(what, v.as_slice())?;
-            check::within(what, v.as_slice(), BOUND)?;
         }
         if let (Some(dx), Law::Pd | Law::StateFeedback) = (&m.dx, self.cfg.law) {
             check::finite_slice("dx", dx.as_slice())?;
-            check::within("dx", dx.as_slice(), BOUND)?;
         }
-        let prev = (st.k > 0).then_some(&st.q_prev);
+        let anchors = (st.k > 0).then_some([&st.q_prev, &st.q_seen]);
         let m = match self.cfg.law {
             // Output feedback ignores a measured velocity: so do its limits.
             Law::OutputFeedback => &Measurement { dx: None, ..*m },
             Law::Pd | Law::StateFeedback => m,
         };
-        self.cfg.limits.check(m, prev)
+        self.cfg.limits.check(m, anchors)?;
+        self.cfg.limits.check_setpoint(c)
     }
 
     /// Stage "velocity source", SPEC §11 step 2: the measured ẋ (PD, state
@@ -757,7 +947,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
                 .robust
                 .eval(&errors.z2, &errors.alpha1, &errors.dalpha1);
         if self.cfg.law.learns() {
-            inner += errors.z1;
+            inner += errors.z1.component_mul(&self.cfg.inertia);
         }
         let ch = a.cholesky();
         let null = |tau: &Vector<N>| match &ch {

@@ -16,3 +16,4 @@ pub mod saturation;
 pub mod state;
 #[cfg(feature = "alloc")]
 pub mod tracker;
+pub mod tuning;

@@ -76,9 +76,30 @@ impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Tracker<N, B, T> {
         self.ctrl.step_or_fallback(&mut self.state, m, &c)
     }
 
+    /// A step call refused before it reached the controller (see
+    /// [`Controller::refuse`]): recorded as a refused step, the fallback returned.
+    pub fn refuse(&mut self, error: Error) -> crate::types::Vector<N> {
+        self.ctrl.refuse(&mut self.state, error)
+    }
+
     /// Back to t = 0 (weights, ζ, observer and reference as at construction).
     pub fn reset(&mut self) {
         self.state.reset();
+    }
+
+    /// Restore a snapshot, checked against the controller
+    /// ([`Controller::restore`]); on an error nothing changes.
+    pub fn restore(&mut self, data: &[f64]) -> Result<(), Error> {
+        self.ctrl.restore(&mut self.state, data)
+    }
+
+    /// Replace the weights, checked against the controller
+    /// ([`Controller::load_weights`]); on an error nothing changes.
+    pub fn load_weights(
+        &mut self,
+        w: &crate::networks::network::Weights<'_, N>,
+    ) -> Result<(), Error> {
+        self.ctrl.load_weights(&mut self.state, w)
     }
 
     /// Time t_k = k·Ts (s) of the next step.

@@ -13,9 +13,10 @@ use crate::control::controller::Controller;
 use crate::control::impedance::TargetImpedance;
 use crate::control::io::{Command, Measurement};
 use crate::control::tracker::Tracker;
+use crate::control::tuning::Rule;
 use crate::error::Error;
 use crate::networks::network::{Weights, C, D, G};
-use crate::networks::rbf::{AnyBasis, Basis, Centers};
+use crate::networks::rbf::{AnyBasis, Basis, Centers, GRID_MAX_JOINTS};
 use crate::schema::{Preset, Scenario, Value};
 use crate::sim::disturb::TipPayload;
 use crate::sim::environment::{FreeSpace, Wall};
@@ -341,6 +342,8 @@ pub enum Last {
     Xd,
     /// The velocity used.
     V,
+    /// The torque last given to apply: the step's sat(τ), or a fallback.
+    Applied,
 }
 
 /// A controller with its trajectory and state, for any N ≤ [`MAX_JOINTS`].
@@ -363,6 +366,9 @@ pub trait DynTracker: Send + Sync {
     fn step(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
     /// One step that always writes a torque to apply into `out`.
     fn step_or_fallback(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
+    /// A step call refused by the front (its arguments' shapes or types):
+    /// recorded as a refused step ([`Controller::refuse`](crate::Controller::refuse)).
+    fn refuse(&mut self, error: Error);
     /// A quantity of the last step.
     fn last(&self, what: Last) -> &[f64];
     /// ζ now.
@@ -590,6 +596,8 @@ fn build_n<const N: usize>(
     let s = scenario::<N>(preset, law, items)?;
     let traj = s.trajectory()?;
     let basis = match centers {
+        // Beyond the vertex grid: the rule's default basis, SPEC §18.
+        None if N > GRID_MAX_JOINTS => AnyBasis::Centers(Rule::default().default_basis(&traj)?),
         None => AnyBasis::Grid(s.grid()?),
         Some(c) => {
             if c.widths2.len() != 4 * N {
@@ -811,6 +819,10 @@ impl<const N: usize> DynTracker for Typed<N> {
         result.map(|_| ())
     }
 
+    fn refuse(&mut self, error: Error) {
+        Tracker::refuse(self, error);
+    }
+
     fn last(&self, what: Last) -> &[f64] {
         let c: &Command<N> = self.state().last();
         match what {
@@ -821,6 +833,7 @@ impl<const N: usize> DynTracker for Typed<N> {
             Last::Xc => c.xc.as_slice(),
             Last::Xd => c.xd.as_slice(),
             Last::V => c.v.as_slice(),
+            Last::Applied => self.state().applied().as_slice(),
         }
     }
 
@@ -853,7 +866,7 @@ impl<const N: usize> DynTracker for Typed<N> {
 
     fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error> {
         let w = Weights::<N>::from_rows(rows, self.nodes())?;
-        self.state_mut().load_weights(&w)
+        Tracker::load_weights(self, &w)
     }
 
     fn snapshot(&self) -> Vec<f64> {
@@ -865,7 +878,7 @@ impl<const N: usize> DynTracker for Typed<N> {
     }
 
     fn restore(&mut self, data: &[f64]) -> Result<(), Error> {
-        self.state_mut().load(data)
+        Tracker::restore(self, data)
     }
 
     fn learning_gain(&self) -> (f64, f64) {
@@ -877,7 +890,9 @@ impl<const N: usize> DynTracker for Typed<N> {
         let s2: f64 = s.iter().map(|x| x * x).sum();
         let [gd, gc, gg] = cfg.gamma;
         let gain = cfg.ts * s2 * (gd * c.ddx.norm_squared() + gc * c.dx.norm_squared() + gg);
-        (gain, cfg.kp.min())
+        // Per unit inertia scale, SPEC (10.2): joint k's rows learn at Γ d_k
+        // against Kp_k (Kp for the paper's d = 1).
+        (gain, cfg.kp.component_div(&cfg.inertia).min())
     }
 
     fn replay(

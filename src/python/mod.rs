@@ -27,6 +27,7 @@ mod arm;
 mod cartesian;
 mod dynamic;
 mod mujoco;
+mod tuning;
 
 use crate::control::config::Law;
 use crate::error::Error;
@@ -69,7 +70,11 @@ fn config_error(e: ParamError) -> PyErr {
 /// latched fault, `MeasurementError` for an input (named as in Python).
 fn step_error(e: Error) -> PyErr {
     let e = python_names(e);
-    const INPUTS: [&str; 6] = ["q", "dq", "tau_e", "xc", "dxc", "ddxc"];
+    // The inputs, and what the inputs would drive beyond a limit (the jump,
+    // the reference a step would commit): the state is sound, the input is not.
+    const INPUTS: [&str; 9] = [
+        "q", "dq", "tau_e", "xc", "dxc", "ddxc", "q jump", "xd", "dxd",
+    ];
     match e {
         Error::Diverged { .. } => DivergedError::new_err(e.to_string()),
         // An internal signal (ζ, z1, α1, the weights, …) beyond the finite range.
@@ -81,6 +86,18 @@ fn step_error(e: Error) -> PyErr {
         _ => MeasurementError::new_err(e.to_string()),
     }
 }
+
+/// A state that cannot be restored or loaded: `ConfigError` with the core's
+/// message (it names the value and the limit).
+fn state_error(e: Error) -> PyErr {
+    ConfigError::new_err(python_names(e).to_string())
+}
+
+/// The fault a step call refused by its arguments' shapes or types records.
+const BAD_ARGUMENTS: Error = Error::Invalid {
+    what: "step",
+    reason: "an argument had the wrong shape or type (the exception raised said which)",
+};
 
 /// A run's error: as [`step_error`] with the row, or the hook's exception.
 fn run_error(e: RunError, hooks: &mut PyHooks) -> PyErr {
@@ -339,6 +356,22 @@ fn table(what: &str, a: &PyReadonlyArray2<'_, f64>, rows: usize, n: usize) -> Py
     Ok(a.as_array().iter().copied().collect())
 }
 
+/// The rows of a reference table (xc, ẋc, ẍc, (K, n) each), checked.
+fn reference_tables(
+    n: usize,
+    reference: Option<&PyReference<'_>>,
+) -> PyResult<Option<[Vec<f64>; 3]>> {
+    let Some((x, dx, ddx)) = reference else {
+        return Ok(None);
+    };
+    let rows = x.shape()[0];
+    Ok(Some([
+        table("xc", x, rows, n)?,
+        table("dxc", dx, rows, n)?,
+        table("ddxc", ddx, rows, n)?,
+    ]))
+}
+
 /// Network weights from a dict of "D" (n, n, L), "C" (n, n, L), "G" (n, L)
 /// arrays, as rows ŴD[k][j], ŴC[k][j], ŴG[k]; errors name the key.
 fn weight_rows(n: usize, l: usize, weights: &Bound<'_, PyDict>) -> PyResult<Vec<f64>> {
@@ -483,23 +516,16 @@ impl PyController {
         array1(py, self.lock(py).last(what))
     }
 
-    /// A step's arguments, converted (and, with `finite`, checked finite).
+    /// A step's arguments, converted (shapes and types checked; any values).
     fn convert(
         &self,
         q: &Bound<'_, PyAny>,
         tau_e: &Bound<'_, PyAny>,
         dq: Option<&Bound<'_, PyAny>>,
         setpoint: [Option<&Bound<'_, PyAny>>; 3],
-        finite: bool,
     ) -> PyResult<Given> {
         let n = self.n;
-        let conv = |what, o| {
-            if finite {
-                vector(what, n, o)
-            } else {
-                vector_any(what, n, o)
-            }
-        };
+        let conv = |what, o| vector_any(what, n, o);
         let x = conv("q", q)?;
         let te = conv("tau_e", tau_e)?;
         let dx = match (self.law, dq) {
@@ -579,6 +605,9 @@ impl PyController {
     /// "sf", joint velocities `dq` (rad/s; ignored by "of"); with `xc` (and
     /// optionally `dxc`, `ddxc`, zero if not given) the controller tracks
     /// that setpoint instead of its trajectory. Returns sat(τ) (N m), (n,).
+    /// A refused step raises, and records the refusal as `step_or_fallback`
+    /// does (the fault, the fallback as the torque applied, the measured
+    /// position): the fault semantics of docs/reliability.md.
     #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
     #[allow(clippy::too_many_arguments)]
     fn step<'py>(
@@ -592,7 +621,11 @@ impl PyController {
         ddxc: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
-        let given = self.convert(q, tau_e, dq, [xc, dxc, ddxc], true)?;
+        // Values are the core's to judge (a non-finite one is a refused step
+        // that records its fault); shapes and types are checked here.
+        let given = self
+            .convert(q, tau_e, dq, [xc, dxc, ddxc])
+            .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)
             .step(&given.inputs(n), &mut out[..n])
@@ -601,8 +634,10 @@ impl PyController {
     }
 
     /// One step as `step`, but never raising for a refused step: returns the
-    /// torque to apply (N m, (n,)) and the error message (None on success).
-    /// Shapes and types are still checked.
+    /// torque to apply (N m, (n,)) and the error message (None on success);
+    /// after a refusal the torque is the configured fallback, and the next
+    /// step's rate limit starts from it. Shapes and types are still checked
+    /// (a wrong one raises, and is recorded as a refused step).
     #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
     #[allow(clippy::too_many_arguments)]
     fn step_or_fallback<'py>(
@@ -616,8 +651,11 @@ impl PyController {
         ddxc: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Option<String>)> {
         let n = self.n;
-        // Shapes and types are checked; values are the controller's to judge.
-        let given = self.convert(q, tau_e, dq, [xc, dxc, ddxc], false)?;
+        // Shapes and types are checked (a refusal, recorded, then raised);
+        // values are the controller's to judge.
+        let given = self
+            .convert(q, tau_e, dq, [xc, dxc, ddxc])
+            .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         let result = self
             .lock(py)
@@ -636,7 +674,8 @@ impl PyController {
             .map(|(e, k)| (python_names(e).to_string(), k))
     }
 
-    /// Clear the recorded fault.
+    /// Clear the recorded fault; nothing else changes (the learned state,
+    /// the torque last applied and the jump anchors are kept).
     fn clear_fault(&self, py: Python<'_>) {
         self.lock(py).clear_fault();
     }
@@ -707,32 +746,38 @@ impl PyController {
         array(py, out, (rows, n))
     }
 
-    /// Back to t = 0: weights, ζ, observer and reference as at construction.
+    /// Back to t = 0, everything as at construction: weights, ζ, observer,
+    /// reference, the torque last applied (zero), the jump anchors, the fault.
     fn reset(&self, py: Python<'_>) {
         self.lock(py).reset();
     }
 
     /// The whole state as a flat float64 array (header, n, L, step count,
-    /// reference, ζ, observer, last command, basis, weights); `restore` puts
-    /// it back exactly, so a run continues bit-identically.
+    /// reference, ζ, observer, last command, norms, basis, weights, the
+    /// torque applied, the last measured position, a checksum); `restore`
+    /// puts it back exactly, so a run continues bit-identically.
     fn snapshot<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         let data = self.lock(py).snapshot();
         data.into_pyarray(py)
     }
 
-    /// Restore a `snapshot` of a controller with the same n and L (checked;
-    /// on an error nothing changes). Clears a recorded fault.
+    /// Restore a `snapshot` of a controller with the same n and L. Checked
+    /// before anything changes (`ConfigError` naming the value): its format,
+    /// its checksum, and that this controller could step it (the reference,
+    /// the torques and the weights within their limits, the stored weight
+    /// norms those of the weights). Clears a recorded fault.
     fn restore(&self, py: Python<'_>, data: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let data: Vec<f64> = data.as_array().iter().copied().collect();
-        self.lock(py).restore(&data).map_err(step_error)
+        self.lock(py).restore(&data).map_err(state_error)
     }
 
     /// Replace the network weights: "D" (n, n, L), "C" (n, n, L), "G" (n, L)
-    /// float64 arrays (checked: shape, finite; on an error nothing changes).
+    /// float64 arrays (checked: shape, finite, norms within the projection
+    /// bounds and 1e100; on an error nothing changes).
     fn load_weights(&self, py: Python<'_>, weights: &Bound<'_, PyDict>) -> PyResult<()> {
         let l = self.lock(py).nodes();
         let rows = weight_rows(self.n, l, weights)?;
-        self.lock(py).load_weights(&rows).map_err(step_error)
+        self.lock(py).load_weights(&rows).map_err(state_error)
     }
 
     /// "pd", "sf" or "of".
@@ -766,7 +811,7 @@ impl PyController {
     }
 
     /// Sampling period Ts (s).
-    #[getter]
+    #[getter(Ts)]
     fn ts(&self, py: Python<'_>) -> f64 {
         self.lock(py).ts()
     }
@@ -793,6 +838,14 @@ impl PyController {
     #[getter]
     fn tau_sat<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.last(py, Last::TauSat)
+    }
+
+    /// The torque to apply now (N m): the last accepted step's sat(τ), or,
+    /// after a refused call (also one that raised), the configured fallback;
+    /// the next step's rate limit is measured from it.
+    #[getter]
+    fn applied<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.last(py, Last::Applied)
     }
 
     /// The last step's Δτ = sat(τ) − τ (N m).
@@ -1331,11 +1384,7 @@ fn simulate_mujoco<'py>(
     settle: f64,
     record_every: u64,
     progress: Option<Py<PyAny>>,
-    reference: Option<(
-        PyReadonlyArray2<'py, f64>,
-        PyReadonlyArray2<'py, f64>,
-        PyReadonlyArray2<'py, f64>,
-    )>,
+    reference: Option<PyReference<'py>>,
     fault: Option<PyFault>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let fault = fault_spec(fault)?;
@@ -1346,17 +1395,7 @@ fn simulate_mujoco<'py>(
     let items = items(params)?;
     let ctrl = controller.get();
     let n = ctrl.n;
-    let tables = match &reference {
-        None => None,
-        Some((x, dx, ddx)) => {
-            let rows = x.shape()[0];
-            Some([
-                table("xc", x, rows, n)?,
-                table("dxc", dx, rows, n)?,
-                table("ddxc", ddx, rows, n)?,
-            ])
-        }
-    };
+    let tables = reference_tables(n, reference.as_ref())?;
     let mut sim = adaptimp_mujoco::Sim::from_python(model, data)?;
     let run = dynamic::MujocoRun {
         t_final,
@@ -1380,11 +1419,20 @@ fn simulate_mujoco<'py>(
 // Many runs at once: sweeps.
 // ---------------------------------------------------------------------------
 
-/// One run of a sweep, parsed while the GIL is held.
+/// One run of a sweep, parsed while the GIL is held; a run whose parameters
+/// cannot make a controller or an arm is its error message.
 struct Job {
     law: Law,
     items: Vec<(String, Owned)>,
     arm: ArmSpec,
+}
+
+/// A [`ParamError`]'s message, as `config_error` words it.
+fn param_message(e: ParamError) -> String {
+    match e.name {
+        Some(name) => format!("{name}: {}", e.error),
+        None => e.error.to_string(),
+    }
 }
 
 /// Stops a run when asked (from the thread that watches for signals).
@@ -1398,12 +1446,13 @@ impl Hooks for StopHooks<'_> {
 
 /// One job, start to end, on the calling thread: its SPEC §12 metrics or the
 /// error's message.
-fn run_job(job: &Job, stop: &std::sync::atomic::AtomicBool) -> Result<dynamic::MetricsOut, String> {
+fn run_job(
+    job: &Result<Job, String>,
+    stop: &std::sync::atomic::AtomicBool,
+) -> Result<dynamic::MetricsOut, String> {
+    let job = job.as_ref().map_err(Clone::clone)?;
     let mut tracker =
-        dynamic::build(2, Preset::Paper, job.law, &job.items, None).map_err(|e| match e.name {
-            Some(name) => format!("{name}: {}", e.error),
-            None => e.error.to_string(),
-        })?;
+        dynamic::build(2, Preset::Paper, job.law, &job.items, None).map_err(param_message)?;
     let mut hooks = StopHooks(stop);
     tracker
         .simulate(&job.arm, &job.items, None, None, u64::MAX, &mut hooks)
@@ -1432,7 +1481,8 @@ fn metrics_to_dict<'py>(
 /// arm (`arm` a `TwoLinkArm`, or None for the arm of `params`) — on `threads`
 /// threads (all cores if None), each run single-threaded, with the GIL
 /// released. Returns, in order, each run's SPEC §12 metrics (a dict) or its
-/// error message (a str): one failing run never stops the others. Results
+/// error message (a str; also for parameters that make no controller or no
+/// arm): one failing run never stops the others. Results
 /// equal those of running the jobs one by one, bit for bit. Ctrl-C stops the
 /// batch (`KeyboardInterrupt`) within 50 ms; `progress(done, total)` is called
 /// as runs finish, at most every 50 ms.
@@ -1447,19 +1497,38 @@ fn simulate_many<'py>(
     let mut parsed = Vec::with_capacity(jobs.len());
     for job in jobs.iter() {
         let (case, params, arm): (String, Bound<'py, PyDict>, Bound<'py, PyAny>) = job.extract()?;
-        let law = law_of(&case)?;
-        let items = items(&params)?;
-        let arm = if arm.is_none() {
-            let s = dynamic::scenario::<2>(Preset::Paper, law, &items).map_err(config_error)?;
-            ArmSpec::Paper(TwoLinkArm::new(s.arm.resolve()).map_err(|e| config_error(e.into()))?)
+        let given = if arm.is_none() {
+            None
         } else if let Ok(a) = arm.cast::<PyArm>() {
-            ArmSpec::Paper(a.get().inner)
+            Some(ArmSpec::Paper(a.get().inner))
         } else {
             return Err(PyTypeError::new_err(
                 "a sweep's arm must be a TwoLinkArm or None",
             ));
         };
-        parsed.push(Job { law, items, arm });
+        // The values are the run's: an error here is that run's error row.
+        let job = (|| -> PyResult<Result<Job, String>> {
+            let law = match law_of(&case) {
+                Ok(law) => law,
+                Err(e) => return Ok(Err(Python::attach(|py| e.value(py).to_string()))),
+            };
+            let items = items(&params)?;
+            let arm = match given {
+                Some(arm) => arm,
+                None => {
+                    let s = match dynamic::scenario::<2>(Preset::Paper, law, &items) {
+                        Ok(s) => s,
+                        Err(e) => return Ok(Err(param_message(e))),
+                    };
+                    match TwoLinkArm::new(s.arm.resolve()) {
+                        Ok(a) => ArmSpec::Paper(a),
+                        Err(e) => return Ok(Err(param_message(e.into()))),
+                    }
+                }
+            };
+            Ok(Ok(Job { law, items, arm }))
+        })()?;
+        parsed.push(job);
     }
     let results = in_parallel(py, &parsed, threads, progress, |job, stop| {
         run_job(job, stop)
@@ -1550,6 +1619,14 @@ type PyMujocoJob<'py> = (
     Bound<'py, PyDict>,
     f64,
     f64,
+    Option<PyReference<'py>>,
+);
+
+/// A reference table: xc, ẋc, ẍc of every row, (K, n) each.
+type PyReference<'py> = (
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, f64>,
 );
 
 /// One MuJoCo run of a sweep: its controller, plant and settings.
@@ -1560,6 +1637,8 @@ struct MujocoJob {
     items: Vec<(String, Owned)>,
     t_final: f64,
     settle: f64,
+    /// The commanded setpoints of every row (K × n each), or the controller's own trajectory.
+    reference: Option<[Vec<f64>; 3]>,
 }
 
 /// The error of a run as a sweep reports it.
@@ -1590,7 +1669,9 @@ fn simulate_mujoco_many<'py>(
 ) -> PyResult<Bound<'py, PyList>> {
     let mut parsed = Vec::with_capacity(jobs.len());
     for job in jobs.iter() {
-        let (ctrl, model, data, spec, params, t_final, settle): PyMujocoJob<'py> = job.extract()?;
+        let (ctrl, model, data, spec, params, t_final, settle, reference): PyMujocoJob<'py> =
+            job.extract()?;
+        let reference = reference_tables(ctrl.get().n, reference.as_ref())?;
         parsed.push(MujocoJob {
             ctrl: ctrl.unbind(),
             sim: Mutex::new(adaptimp_mujoco::Sim::from_python(&model, &data)?),
@@ -1598,6 +1679,7 @@ fn simulate_mujoco_many<'py>(
             items: items(&params)?,
             t_final,
             settle,
+            reference,
         });
     }
     let results = in_parallel(py, &parsed, threads, progress, |job, stop| {
@@ -1606,7 +1688,10 @@ fn simulate_mujoco_many<'py>(
             settle: job.settle,
             every: u64::MAX,
             items: &job.items,
-            reference: None,
+            reference: job
+                .reference
+                .as_ref()
+                .map(|[x, dx, ddx]| [x.as_slice(), dx.as_slice(), ddx.as_slice()]),
             fault: None,
         };
         let mut hooks = StopHooks(stop);
@@ -1709,6 +1794,8 @@ fn defaults<'py>(py: Python<'py>, scenario: &str, n: usize) -> PyResult<Bound<'p
 mod adaptimp_module {
     use pyo3::prelude::*;
 
+    #[pymodule_export]
+    use super::tuning::{default_task, suggest};
     #[pymodule_export]
     use super::{
         defaults, metrics, schema_table, simulate, simulate_many, simulate_mujoco,

@@ -17,7 +17,8 @@ pub trait Plant<const N: usize> {
     fn contact(&self) -> Vector<N>;
     /// Advance by `h` (s) with the applied torque `tau` (N m) held. Returns
     /// the acceleration ẍ (rad/s²) at the start of the interval (for the
-    /// impedance residual, SPEC §12). Errors if the state becomes non-finite.
+    /// impedance residual, SPEC §12). Errors if the state becomes non-finite
+    /// (or, for [`RigidBody`], leaves the ceilings of SPEC §14).
     fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error>;
     /// The torque (N m) the actuators deliver for the command `tau`: the
     /// plant's own limits (a physics engine's actuator range). The loop
@@ -161,6 +162,11 @@ impl<const N: usize, M: Manipulator<N>, E: Environment<N>> Plant<N> for RigidBod
                 what: "plant state",
             });
         }
+        // Beyond the ceilings no controller step accepts the state: the run
+        // has diverged (SPEC §14), say so here rather than as a refused step.
+        use crate::control::safety::{CEILING_POSITION, CEILING_VELOCITY};
+        check::within("plant state q", x.as_slice(), CEILING_POSITION)?;
+        check::within("plant state dq", dx.as_slice(), CEILING_VELOCITY)?;
         (self.t, self.x, self.dx) = (t + h, x, dx);
         Ok(a0)
     }

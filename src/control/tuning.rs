@@ -1,0 +1,471 @@
+//! Gains, a basis and learning rates for an arm nobody tuned for, SPEC §18.
+//!
+//! What a user knows about a new arm: its inertia matrix D(q0) at a posture
+//! (any URDF through Pinocchio or MuJoCo gives it), the actuator limits τmax,
+//! the period Ts and the task's joint path. [`Rule`] turns these into a
+//! [`Config`] that construction accepts, in each joint's own units (SPEC §10:
+//! d_i = 1/(D⁻¹(q0))_ii, every rate in 1/s):
+//!
+//! ```text
+//! Kp_i = m d_i / Ts,   m = 0.25                          (18.1)
+//! K1   = min(50 s⁻¹, 0.05 / Ts)                          (18.2)
+//! Kζ_i = Kp_i/d_i + ρ/2,  ρ = 1 s⁻¹  (conditions "scaled") (18.3)
+//! kr_i = φ Kp_i / 2,  Kd_i (fallback) = Kp_i             (18.4)
+//! ```
+//!
+//! and, for a basis along the path ([`Rule::centres`], SPEC §15), the
+//! learning of [`Rule::learning`]:
+//!
+//! ```text
+//! Γ_G = ω_G² / ⟨‖S‖²⟩,  ω_G² = ½ (m/Ts) K1               (18.6)
+//! Γ_D = (ω_G/5)² / (⟨‖S‖²⟩ ⟨‖ẍc‖²⟩),  Γ_C = (ω_G/5)² / (⟨‖S‖²⟩ ⟨‖ẋc‖²⟩)
+//! σ = 1 / (Γ τ_leak),  τ_leak = 25 periods                (18.7)
+//! b_G = 2 ‖τmax‖ √L / min ΣS_j,  b_D = b_G / max‖ẍc‖,  b_C = b_G / max‖ẋc‖  (18.8)
+//! ```
+//!
+//! (⟨·⟩ the mean, min and max over the path; ‖ẍc‖ and ‖ẋc‖ floored at 1
+//! rad/s² and 1 rad/s). The reasons are in SPEC §18.
+//! [`default_task`] is the joint-space motion `adaptimp.mujoco.simulate` runs
+//! when given only a model.
+
+use crate::control::config::{Conditions, Config, Law, WeightBound};
+use crate::control::controller::MIN_SCALE;
+use crate::error::{check, Error, PARAM_BOUND};
+use crate::math::sqrt;
+use crate::networks::rbf::{Basis, Centers};
+#[cfg(feature = "alloc")]
+use crate::trajectory::Trajectory;
+use crate::trajectory::{Setpoint, Sinusoid};
+use crate::types::{Matrix, Vector};
+
+/// The smallest and largest number of centres [`Rule::nodes`] gives.
+pub const NODES: (usize, usize) = (16, 256);
+
+/// Samples of one period of a [`Trajectory`] the alloc conveniences take.
+pub const PATH_SAMPLES: usize = 1000;
+
+/// The constants of the rule, SPEC §18 ([`Rule::default`] is the SPEC's).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Rule {
+    /// m of Kp_i = m d_i/Ts: each joint's sampled velocity loop keeps its
+    /// pole at 1 − m (0.25).
+    pub margin: f64,
+    /// The largest K1 (1/s) (50).
+    pub k1_max: f64,
+    /// K1 ≤ this/Ts: the position loop inside the velocity loop (0.05).
+    pub k1_per_step: f64,
+    /// ω_G² = this · (m/Ts) · K1: the Ĝ loop's slow pole near K1/3 (0.5).
+    pub learn: f64,
+    /// ω_D = ω_C = this · ω_G: D̂ and Ĉ learn slower than Ĝ (0.2).
+    pub learn_dc: f64,
+    /// The leak time τ_leak in periods of the path (25).
+    pub leak_periods: f64,
+    /// How far from the path the networks act, (rad, rad/s) ((0.2, 0.5)).
+    pub tube: [f64; 2],
+    /// The factor on the smallest bound that realises τmax (2).
+    pub bound_margin: f64,
+}
+
+impl Default for Rule {
+    fn default() -> Self {
+        Self {
+            margin: 0.25,
+            k1_max: 50.0,
+            k1_per_step: 0.05,
+            learn: 0.5,
+            learn_dc: 0.2,
+            leak_periods: 25.0,
+            tube: [0.2, 0.5],
+            bound_margin: 2.0,
+        }
+    }
+}
+
+/// The inertia scales d_i = 1/(D⁻¹)_ii (kg m²) of an inertia matrix `d`
+/// (kg m², symmetric positive definite), SPEC §10: joint i's inertia with
+/// the other joints free. Errors if `d` is not finite, not symmetric (to
+/// 1e-9 relative) or not positive definite.
+pub fn inertia_scales<const N: usize>(d: &Matrix<N>) -> Result<Vector<N>, Error> {
+    check::finite_slice("inertia matrix", d.as_slice())?;
+    let scale = d.amax();
+    if (d - d.transpose()).amax() > 1e-9 * scale {
+        return Err(Error::Invalid {
+            what: "inertia matrix",
+            reason: "must be symmetric",
+        });
+    }
+    let inv = d
+        .cholesky()
+        .ok_or(Error::Invalid {
+            what: "inertia matrix",
+            reason: "must be positive definite",
+        })?
+        .inverse();
+    let scales = inv.diagonal().map(|x| 1.0 / x);
+    check::finite_slice("inertia scale", scales.as_slice())?;
+    Ok(scales)
+}
+
+impl Rule {
+    /// The rule with its tube widened to hold the sag of the arm under the
+    /// feedback alone, SPEC (18.5): the weights start at zero, so at first the
+    /// arm hangs G_i/(Kp_i K1_i) (rad) below the path, and the networks must
+    /// still act there: tube_q ≥ 2 max_i |G_i|/(Kp_i K1_i). `gravity` (N m) is
+    /// G at the path's start; `cfg` the [`gains`](Self::gains).
+    pub fn holding<const N: usize>(&self, cfg: &Config<N>, gravity: &Vector<N>) -> Self {
+        let sag = (0..N)
+            .map(|i| gravity[i].abs() / (cfg.kp[i] * cfg.k1[i]))
+            .fold(0.0, f64::max);
+        let mut rule = *self;
+        if sag.is_finite() {
+            rule.tube[0] = rule.tube[0].max(2.0 * sag);
+        }
+        rule
+    }
+
+    /// K1 (1/s) at period `ts` (s), (18.2).
+    pub fn k1(&self, ts: f64) -> f64 {
+        self.k1_max.min(self.k1_per_step / ts)
+    }
+
+    /// The robot-scenario configuration of `law` for an arm of inertia matrix
+    /// `d` (kg m², at the task's start), limits `tau_max` (N m) and period
+    /// `ts` (s): (18.1)–(18.4), the hardened options of SPEC §13 and the
+    /// conditions "scaled" (SPEC §10), which it meets by construction.
+    /// Learning keeps the schema's Γ, σ and "auto" bound until
+    /// [`learning`](Self::learning) sets them for a basis.
+    ///
+    /// Errors name the condition: `d` symmetric positive definite, τmax > 0,
+    /// 0 < Ts ≤ 1 s, every inertia scale in [1e-9, 1e9] kg m², every gain
+    /// within 1e9.
+    pub fn gains<const N: usize>(
+        &self,
+        law: Law,
+        d: &Matrix<N>,
+        tau_max: &Vector<N>,
+        ts: f64,
+    ) -> Result<Config<N>, Error> {
+        check::positive("Ts > 0", "Ts", ts)?;
+        check::at_most("Ts ≤ 1 s", "Ts", ts, 1.0)?;
+        check::positive_vec("τmax > 0", "tau_max", tau_max)?;
+        let scales = inertia_scales(d)?;
+        if let Some(i) = scales
+            .iter()
+            .position(|d| *d < MIN_SCALE || *d > PARAM_BOUND)
+        {
+            return Err(Error::Condition {
+                condition: if scales[i] < MIN_SCALE {
+                    "d ≥ 1e-9"
+                } else {
+                    "|value| ≤ 1e9"
+                },
+                lhs: "inertia",
+                index: Some(i),
+                value: scales[i],
+            });
+        }
+        let mut cfg = Config::<N>::new(law, *tau_max).hardened();
+        cfg.ts = ts;
+        cfg.conditions = Conditions::Scaled;
+        cfg.inertia = scales;
+        cfg.rho = 1.0;
+        let rate = self.margin / ts; // Kp/d (1/s)
+        cfg.kp = scales * rate;
+        cfg.k1 = Vector::from_element(self.k1(ts));
+        cfg.kzeta = Vector::from_element(rate + 0.5 * cfg.rho);
+        cfg.kr = cfg.kp * (0.5 * cfg.phi);
+        cfg.fallback_damping = cfg.kp;
+        Ok(cfg)
+    }
+
+    /// The number of centres L for a path given by `path`, samples evenly
+    /// spaced in time over one period (the first not repeated), SPEC (18.5):
+    /// L = clip(⌈2 ℓ / tube_q⌉, 16, 256), ℓ the length of the closed path
+    /// in q (rad).
+    pub fn nodes<const N: usize>(&self, path: &[Setpoint<N>]) -> usize {
+        let mut length = 0.0;
+        for (j, sp) in path.iter().enumerate() {
+            let next = &path[(j + 1) % path.len()];
+            length += (next.x - sp.x).norm();
+        }
+        let l = libm::ceil(2.0 * length / self.tube[0]);
+        if l.is_finite() && l > NODES.0 as f64 {
+            (l as usize).min(NODES.1)
+        } else {
+            NODES.0
+        }
+    }
+
+    /// Centres along `path` (one period, evenly spaced in time; see
+    /// [`nodes`](Self::nodes)) in the caller's buffer `buf` (length
+    /// [`nodes`](Self::nodes) · 4N): sample `⌊j·K/L⌋` for node j, widths
+    /// (15.2) with the rule's tube ([`Centers::along_in`], SPEC §15).
+    /// `scratch` holds L setpoints.
+    pub fn centres_in<const N: usize, C: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        path: &[Setpoint<N>],
+        buf: C,
+        scratch: &mut [Setpoint<N>],
+    ) -> Result<Centers<N, C>, Error> {
+        let l = scratch.len();
+        if path.len() < l || l == 0 {
+            return Err(Error::Invalid {
+                what: "path",
+                reason: "needs at least as many samples as centres (and one)",
+            });
+        }
+        for (j, s) in scratch.iter_mut().enumerate() {
+            *s = path[j * path.len() / l];
+        }
+        Centers::along_in(buf, scratch, self.tube)
+    }
+
+    /// The learning of SPEC (18.6)–(18.8) into `cfg` for `basis` along `path`
+    /// (one period of `period` s, evenly spaced in time): Γ, σ and fixed
+    /// weight bounds. `scratch` holds the basis (length L). The rates are in
+    /// the inertia-scaled units of `cfg.inertia` (SPEC (10.2)), so they need
+    /// the [`gains`](Self::gains) of the same rule.
+    pub fn learning<const N: usize, B: Basis<N>>(
+        &self,
+        cfg: &mut Config<N>,
+        basis: &B,
+        path: &[Setpoint<N>],
+        period: f64,
+        scratch: &mut [f64],
+    ) -> Result<(), Error> {
+        let l = basis.nodes();
+        if path.is_empty() || scratch.len() != l {
+            return Err(Error::Invalid {
+                what: "path",
+                reason: "needs one sample or more, and a scratch buffer of L reals",
+            });
+        }
+        check::positive("period > 0", "period", period)?;
+        let (mut s2, mut sum_min) = (0.0, f64::INFINITY);
+        let (mut a2, mut v2, mut a_max, mut v_max) = (0.0, 0.0, 0.0f64, 0.0f64);
+        for sp in path {
+            // On the path z1 = 0: α1 = ẋc, α̇1 = ẍc.
+            basis.eval(&[sp.x, sp.dx, sp.dx, sp.ddx], scratch);
+            s2 += scratch.iter().map(|s| s * s).sum::<f64>();
+            sum_min = sum_min.min(scratch.iter().sum::<f64>());
+            a2 += sp.ddx.norm_squared();
+            v2 += sp.dx.norm_squared();
+            a_max = a_max.max(sp.ddx.norm());
+            v_max = v_max.max(sp.dx.norm());
+        }
+        let k = path.len() as f64;
+        // Regressor scales floored at 1 rad/s² and 1 rad/s: a path that barely
+        // moves must not make Γ_D, Γ_C (or the bounds b_D, b_C) unbounded.
+        let (s2, a2, v2) = (s2 / k, (a2 / k).max(1.0), (v2 / k).max(1.0));
+        let (a_max, v_max) = (a_max.max(1.0), v_max.max(1.0));
+        if !(s2 > 0.0 && sum_min > 0.0) {
+            return Err(Error::Invalid {
+                what: "basis",
+                reason: "does not reach the path (every S_j ≈ 0 somewhere on it)",
+            });
+        }
+        let rate = cfg.kp.component_div(&cfg.inertia).min();
+        let omega2 = self.learn * rate * cfg.k1.min();
+        let dc2 = self.learn_dc * self.learn_dc * omega2;
+        let or_one = |x: f64| if x > 0.0 { x } else { 1.0 };
+        let gamma_g = omega2 / s2;
+        cfg.gamma = [dc2 / (s2 * or_one(a2)), dc2 / (s2 * or_one(v2)), gamma_g];
+        let leak = self.leak_periods * period;
+        cfg.sigma = cfg.gamma.map(|g| 1.0 / (g * leak));
+        let b_g = self.bound_margin * cfg.tau_max.norm() * sqrt(l as f64) / sum_min;
+        cfg.weight_bound = WeightBound::Fixed([b_g / a_max, b_g / v_max, b_g]);
+        Ok(())
+    }
+}
+
+/// The rule's centres and configuration together (feature `alloc`).
+#[cfg(feature = "alloc")]
+#[derive(Clone, Debug, PartialEq)]
+pub struct Suggestion<const N: usize> {
+    /// The controller's configuration.
+    pub config: Config<N>,
+    /// The centres along the path.
+    pub centers: Centers<N, alloc::vec::Vec<f64>>,
+}
+
+#[cfg(feature = "alloc")]
+impl Rule {
+    /// One period of `traj` from t = 0 as [`PATH_SAMPLES`] setpoints.
+    pub fn sample<const N: usize, T: Trajectory<N> + ?Sized>(
+        traj: &T,
+        period: f64,
+    ) -> alloc::vec::Vec<Setpoint<N>> {
+        (0..PATH_SAMPLES)
+            .map(|k| traj.sample(period * k as f64 / PATH_SAMPLES as f64))
+            .collect()
+    }
+
+    /// [`centres_in`](Self::centres_in) on the heap, [`nodes`](Self::nodes) centres.
+    pub fn centres<const N: usize>(
+        &self,
+        path: &[Setpoint<N>],
+    ) -> Result<Centers<N, alloc::vec::Vec<f64>>, Error> {
+        let l = self.nodes(path);
+        let mut scratch = alloc::vec![path.first().copied().ok_or(Error::Invalid {
+            what: "path",
+            reason: "needs at least one sample",
+        })?; l];
+        self.centres_in(path, alloc::vec![0.0; l * 4 * N], &mut scratch)
+    }
+
+    /// Everything at once: [`gains`](Self::gains), [`centres`](Self::centres)
+    /// and [`learning`](Self::learning) for `path` (one period of `period`
+    /// s, evenly spaced in time, e.g. [`Rule::sample`]); with `gravity` (G
+    /// at the path's start, N m) the tube [`holding`](Self::holding) the sag.
+    #[allow(clippy::too_many_arguments)]
+    pub fn suggest<const N: usize>(
+        &self,
+        law: Law,
+        d: &Matrix<N>,
+        tau_max: &Vector<N>,
+        ts: f64,
+        path: &[Setpoint<N>],
+        period: f64,
+        gravity: Option<&Vector<N>>,
+    ) -> Result<Suggestion<N>, Error> {
+        let mut config = self.gains(law, d, tau_max, ts)?;
+        if let Some(g) = gravity {
+            check::finite_slice("gravity", g.as_slice())?;
+        }
+        let rule = gravity.map_or(*self, |g| self.holding(&config, g));
+        let centers = rule.centres(path)?;
+        let mut scratch = alloc::vec![0.0; centers.nodes()];
+        rule.learning(&mut config, &centers, path, period, &mut scratch)?;
+        Ok(Suggestion { config, centers })
+    }
+
+    /// A basis for a controller given none, beyond the vertex grid (n > 3),
+    /// SPEC §18: centres along one period of `traj` (the slowest frequency,
+    /// [`Sinusoid::period`]) if it moves; else the "star" of 2N + 1 centres
+    /// at its offset and ±tube_q along each joint, widths tube (a posture to
+    /// hold).
+    pub fn default_basis<const N: usize>(
+        &self,
+        traj: &Sinusoid<N>,
+    ) -> Result<Centers<N, alloc::vec::Vec<f64>>, Error> {
+        if let Some(period) = traj.period() {
+            return self.centres(&Self::sample(traj, period));
+        }
+        let mut c = alloc::vec![0.0; (2 * N + 1) * 4 * N];
+        for (j, row) in c.chunks_exact_mut(4 * N).enumerate() {
+            row[..N].copy_from_slice(traj.offset().as_slice());
+            if j > 0 {
+                let sign = if j % 2 == 1 { 1.0 } else { -1.0 };
+                row[(j - 1) / 2] += sign * self.tube[0];
+            }
+        }
+        let w = |t: f64| Vector::<N>::from_element(t * t);
+        let inf = Vector::<N>::from_element(f64::INFINITY);
+        Centers::new(c, [w(self.tube[0]), w(self.tube[1]), inf, inf])
+    }
+}
+
+/// The default task about the posture `home` (rad) for joints limited to
+/// [`lo`, `hi`] (rad; ±∞ for a continuous joint), SPEC §18: every joint
+/// swings `xc_i = home_i − A_i cos(π t)` (period 2 s, from rest at home − A,
+/// through home, to home + A), with A_i = min(0.2 rad, (hi_i − lo_i)/4)
+/// (the swing covers at most half the range). Errors unless lo < hi per
+/// joint and `home` is inside [lo + A, hi − A].
+pub fn default_task<const N: usize>(
+    home: &Vector<N>,
+    lo: &Vector<N>,
+    hi: &Vector<N>,
+) -> Result<Sinusoid<N>, Error> {
+    check::finite_slice("home", home.as_slice())?;
+    check::each("hi > lo", "hi − lo", &(hi - lo), |_, d| d, true)?;
+    let amp = Vector::<N>::from_fn(|i, _| (0.25 * (hi[i] - lo[i])).min(TASK_AMPLITUDE));
+    // (1e-9 rad of rounding allowed: a home clipped onto lo + A is inside.)
+    check::each(
+        "lo + A ≤ home ≤ hi − A",
+        "distance from home to the nearest limit − A",
+        home,
+        |i, h| (h - lo[i]).min(hi[i] - h) - amp[i] + 1e-9,
+        false,
+    )?;
+    Sinusoid::new(
+        *home,
+        Vector::zeros(),
+        -amp,
+        Vector::from_element(core::f64::consts::PI),
+    )
+}
+
+/// The largest swing A (rad) of [`default_task`].
+pub const TASK_AMPLITUDE: f64 = 0.2;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::controller::Controller;
+
+    fn arm_matrix() -> Matrix<3> {
+        Matrix::<3>::new(2.0, 0.5, 0.1, 0.5, 1.0, 0.2, 0.1, 0.2, 0.05)
+    }
+
+    #[test]
+    fn gains_follow_the_rule_and_build() {
+        let d = arm_matrix();
+        let tau = Vector::<3>::new(50.0, 20.0, 5.0);
+        let cfg = Rule::default()
+            .gains(Law::StateFeedback, &d, &tau, 1e-3)
+            .unwrap();
+        let inv = d.try_inverse().unwrap();
+        for i in 0..3 {
+            let di = 1.0 / inv[(i, i)];
+            assert!((cfg.inertia[i] - di).abs() < 1e-12 * di);
+            assert!((cfg.kp[i] - 250.0 * di).abs() < 1e-9 * cfg.kp[i]);
+        }
+        assert_eq!(cfg.k1, Vector::<3>::from_element(50.0));
+        assert_eq!(cfg.conditions, Conditions::Scaled);
+        let traj = default_task(
+            &Vector::<3>::zeros(),
+            &Vector::from_element(-1.0),
+            &Vector::from_element(1.0),
+        )
+        .unwrap();
+        let path = Rule::sample(&traj, 2.0);
+        let s = Rule::default()
+            .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, None)
+            .unwrap();
+        Controller::new(s.config, s.centers).unwrap();
+    }
+
+    #[test]
+    fn bad_inertia_matrices_are_named() {
+        let mut d = arm_matrix();
+        d[(0, 1)] = 0.7;
+        let e = inertia_scales(&d).unwrap_err();
+        assert!(e.to_string().contains("symmetric"), "{e}");
+        let e = inertia_scales(&-arm_matrix()).unwrap_err();
+        assert!(e.to_string().contains("positive definite"), "{e}");
+    }
+
+    #[test]
+    fn the_default_task_starts_at_rest_inside_the_limits() {
+        let lo = Vector::<2>::new(-1.0, 0.0);
+        let hi = Vector::<2>::new(1.0, 0.4);
+        let home = Vector::<2>::new(0.3, 0.2);
+        let t = default_task(&home, &lo, &hi).unwrap();
+        let s0 = t.sample(0.0);
+        assert_eq!(s0.dx, Vector::<2>::zeros());
+        assert!((s0.x - Vector::<2>::new(0.1, 0.1)).norm() < 1e-15);
+        assert!((t.sample(1.0).x - Vector::<2>::new(0.5, 0.3)).norm() < 1e-15);
+        let e = default_task(&Vector::<2>::new(0.9, 0.2), &lo, &hi).unwrap_err();
+        assert!(e.to_string().contains("lo + A ≤ home ≤ hi − A"), "{e}");
+    }
+
+    #[test]
+    fn a_posture_to_hold_gets_the_star() {
+        let c = Rule::default()
+            .default_basis(&Sinusoid::<4>::constant(Vector::from_element(0.5)).unwrap())
+            .unwrap();
+        assert_eq!(c.nodes(), 9);
+        assert_eq!(c.centers()[4 * 4], 0.7);
+        assert_eq!(c.centers()[2 * 4 * 4], 0.3);
+    }
+}

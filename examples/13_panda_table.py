@@ -1,41 +1,53 @@
-"""The Panda on a table (scenario "panda-table", docs/panda.md): one command, one table.
+"""The Panda (or any arm) pressing on a table (scenario "panda-table", docs/panda.md,
+docs/contact.md): one command, one table.
 
 The Franka Emika Panda (example-robot-data's URDF, effort limits 87/12 N m) in
 MuJoCo draws a 5 cm circle at 0.25 Hz on a table with its tool while pressing
 δ_c = 15 mm into it through the target impedance (SPEC §16: M_d = 2 kg,
-K_d = 500 N/m, B_d critically damped, position-only). Every controller has the
-same outer loop, the core's (``adaptimp.CartesianController`` over the Panda's
-``adaptimp.Chain``, scenario in ``adaptimp.panda_table``); the joint controller
-differs:
+K_d = 500 N/m, B_d critically damped, position-only): K_d δ_c = 7.5 N. Every
+controller has the same outer loop, the core's (``adaptimp.CartesianController``
+over the arm's ``adaptimp.Chain``); the rows differ in the joint controller and
+in the formulation of the impedance (SPEC §19, schema keyword ``formulation``):
 
-- PD, adaptive state feedback (SF), adaptive output feedback (OF):
-  ``adaptimp.Controller(case, "robot", n=7, impedance="external")`` at 1 kHz,
-  the same gains Kp_i = 0.25/(Ts (D⁻¹)_ii) (D = D(q0) from Pinocchio),
-  Kζ_i = (1 + Kp_i²)/2 + 10, K1 = 20; SF and OF learn with Γ = 1 on 64 RBF
-  centres along the joint orbit of the circle (SPEC §15).
-- CT, CT+30%: computed torque with Pinocchio's RNEA/CRBA, the exact model and
-  every link's mass and inertia +30 %, K_P = 400 s⁻², K_D = 40 s⁻¹.
+- ``admittance``: the measured wrench drives the compliant reference that the
+  joint law tracks (SPEC §16); "as printed": with the law's +τe feedforward.
+- ``unified``: the convex combination of the admittance's torque (share n =
+  ``admittance_share``) and the torque-level one; the networks learn from the
+  paper's z2 on the compliant reference.
+- ``impedance``: the torque-level impedance τ = Jᵀ(K e + B ė) at the measured
+  pose, the model terms along the commanded motion; the wrench never reaches
+  the torque.
 
-Metrics over t ≥ 2 s (p the TCP, p_d the compliant reference, F_n = −F_e,z):
+Joint controllers: PD, adaptive state feedback (SF) and output feedback (OF),
+``adaptimp.Controller(case, "robot", n, impedance="external")`` at 1 kHz with
+the gains of SPEC §18's rule (Kp_i = 0.25/(Ts (D⁻¹)_ii) from D(q0), Kζ, K1 =
+20) and gravity learning (Γ = (1, 1, 5000), σ = (0.01, 0.01, 1e-5), ‖ŴG‖ ≤
+100) on 64 RBF centres along the joint orbit; computed torque with the exact
+model (CT) and with +30 % mass (CT +30 %), Pinocchio.
 
-- track: RMS ‖p_d − p‖ (mm), the Cartesian tracking error.
-- force: RMS (F_n − K_d δ_c) (N), the normal force against the target's
-  steady value against a rigid table (SPEC (16.1)), 7.5 N.
-- imp: RMS ‖M_d (p̈ − p̈_c) + B_d (ṗ − ṗ_c) + K_d (p − p_c) + F_e‖ (N), the
-  residual of the target impedance at the arm's motion.
-- sat: fraction of all steps with some sat(τ_i) ≠ τ_i.
-- peak: max_i max_{t ≥ 0.1 s} |τ_i| / τmax_i of the commanded τ (≤ 2: no windup).
+Metrics over t ≥ 2 s (p the tool, p_d the compliant reference, F_n = −F_e,z),
+the keys of ``--json``: ``track_mm`` RMS ‖p_d − p‖; ``force_target_N`` K_d δ_c
+(a spring table: SPEC (16.1)); ``force_rms_err_N`` RMS (F_n − target);
+``force_chatter_N`` RMS of F_n's sample-to-sample change; ``contact_lost_s``
+time with F_n ≤ 0 after the first contact at the end of the approach;
+``peak_tau_ratio`` max |τ_i|/τmax_i commanded after 0.1 s; ``sat_duty`` the
+share of steps that saturate.
+
+    python examples/13_panda_table.py                      # the Panda, T = 20 s, the table
+    python examples/13_panda_table.py --friction 0         # a frictionless table
+    python examples/13_panda_table.py --spring 5000        # a table on a 5 kN/m spring
+    python examples/13_panda_table.py --arm ur5_robot.urdf --json ur5.json
+    python examples/13_panda_table.py --figure             # docs/figures/contact_force.png
+    python examples/13_panda_table.py --long 120           # and a long SF run, weight norms
 
 Needs the extras ``mujoco`` and ``pinocchio`` (from a checkout:
-``pip install ".[mujoco,pinocchio]"``). Run ``python examples/13_panda_table.py``
-(T = 20 s; ``--long 120`` adds a long SF run reporting the weight norms every 10 s);
-``ADAPTIMP_QUICK=1``: T = 1 s, no figure.
-Writes ``docs/figures/panda_table.png``.
+``pip install ".[mujoco,pinocchio]"``). ``ADAPTIMP_QUICK=1``: T = 1 s.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import time
 from pathlib import Path
@@ -43,134 +55,176 @@ from typing import Any
 
 import numpy as np
 
+import adaptimp
 from adaptimp import cartesian as ac
+from adaptimp import contact as act
 from adaptimp import mujoco as amj
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
-KINDS = {
-    "pd": "PD",
-    "sf": "SF as printed (+τe, Γ = 1)",
-    "of": "OF as printed (+τe, Γ = 1)",
-    "sf-noff": "SF, no τe feedforward, Γ = 1",
-    "sf-learn": "SF, no τe feedforward, gravity learning",
-    "of-learn": "OF, no τe feedforward, gravity learning",
-    "ct": "CT exact",
-    "ct+30": "CT +30% mass",
-}
 # "Gravity learning": the Ĝ network learns fast and forgets slowly (ΓG = 5000,
-# σG = 1e-5; the normalised step keeps it stable), with a bound of 100 N m on
-# ‖ŴG‖ (the "auto" bound, 21.9, is binding: gravity along the orbit needs 27.8).
+# σG = 1e-5; the normalised step keeps it stable), ‖ŴG‖ ≤ 100.
 LEARN = {
     "gamma": [1.0, 1.0, 5000.0],
     "sigma": [0.01, 0.01, 1e-5],
     "weight_bound": [4.19, 13.2, 100.0],
 }
-FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "panda_table.png"
+SHARE = 0.3
+"""The admittance's share n of the unified rows (docs/contact.md)."""
+# name: (label, joint controller, formulation, +τe feedforward, learning)
+ROWS: dict[str, tuple[str, str, str, bool, bool]] = {
+    "pd": ("PD, admittance", "pd", "admittance", False, False),
+    "sf-printed": ("SF as printed (+τe, Γ = 1), admittance", "sf", "admittance", True, False),
+    "sf-admittance": ("SF, admittance, no τe feedforward", "sf", "admittance", False, True),
+    "sf": (f"SF, unified n = {SHARE}", "sf", "unified", False, True),
+    "of": (f"OF, unified n = {SHARE}", "of", "unified", False, True),
+    "sf-ff": (f"SF with +τe, unified n = {SHARE}", "sf", "unified", True, True),
+    "sf-impedance": ("SF, impedance", "sf", "impedance", False, True),
+    "ct-admittance": ("CT exact, admittance (+τe)", "ct", "admittance", True, False),
+    "ct": ("CT exact, impedance", "ct", "impedance", False, False),
+    "ct+30": ("CT +30 % mass, impedance", "ct+30", "impedance", False, False),
+}
+KEYS = (
+    "track_mm",
+    "force_rms_err_N",
+    "force_target_N",
+    "force_chatter_N",
+    "contact_lost_s",
+    "peak_tau_ratio",
+    "sat_duty",
+)
+FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "contact_force.png"
 
 
-def run(kind: str, sc: ac.PandaTable, basis: Any, T: float) -> tuple[Any, Any, dict[str, float]]:
-    """One controller on the panda-table scenario: (result, controller, metrics)."""
-    base, _, variant = kind.partition("-")
-    extra: dict[str, Any] = LEARN if variant == "learn" else {}
-    ctrl = ac.panda_controller(base, sc, basis=basis, force_feedforward=variant == "", **extra)
+def run(name: str, sc: ac.PandaTable, basis: Any, T: float) -> tuple[Any, Any, dict[str, float]]:
+    """One row on the scenario: (result, controller, metrics)."""
+    _, kind, formulation, ff, learn = ROWS[name]
+    extra: dict[str, Any] = dict(LEARN) if learn else {}
+    if formulation == "unified":
+        extra["admittance_share"] = SHARE
+    ctrl = ac.panda_controller(
+        kind, sc, basis=basis, force_feedforward=ff, formulation=formulation, **extra
+    )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=T, q0=sc.q0)
-    return res, ctrl, ac.cartesian_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
+    return res, ctrl, act.contact_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
 
 
-def figure(res: Any, ctrl: Any, sc: ac.PandaTable, path: Path) -> None:
-    """Path on the table, normal force against the target, torques against limits."""
+def figure(path: Path, T: float) -> None:
+    """Normal force against time, old (admittance) and new formulations, on the
+    Panda's table without and with friction."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    log = ctrl.arrays()
-    fig = plt.figure(figsize=(12, 7.5), layout="constrained")
-    grid = fig.add_gridspec(2, 2)
-    ax = fig.add_subplot(grid[:, 0])
-    a = res.t >= 2.0
-    ax.plot(log["pc"][a, 0], log["pc"][a, 1], "k--", lw=1, label="p_c, commanded")
-    ax.plot(res.x_ee[:, 0], res.x_ee[:, 1], color="tab:blue", lw=0.8, label="p, TCP (all t)")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title("SF: the path on the table")
-    ax.legend(loc="upper right", fontsize=8)
-    ax = fig.add_subplot(grid[0, 1])
-    fn = -res.wrench_ee[:, 2]
-    ax.plot(res.t, fn, color="tab:blue", lw=0.4, label="F_n, measured")
-    kernel = np.ones(50) / 50
-    ax.plot(res.t, np.convolve(fn, kernel, "same"), color="tab:green", lw=1.2, label="50 ms mean")
-    ax.axhline(sc.target_force(), color="k", ls="--", lw=1, label="K_d δ_c (target)")
-    ax.set_ylabel("normal force (N)")
-    ax.set_xlabel("t (s)")
-    ax.legend(loc="upper right", fontsize=8, ncol=3)
-    ax = fig.add_subplot(grid[1, 1])
-    ratio = res.tau / np.asarray(res.params["tau_max"])
-    for i in range(sc.n):
-        ax.plot(res.t, ratio[:, i], lw=0.6, label=f"τ{i + 1}")
-    ax.axhline(1, color="tab:red", ls="--", lw=1)
-    ax.axhline(-1, color="tab:red", ls="--", lw=1, label="±τmax")
-    ax.set_ylabel("τ_i / τmax_i (commanded)")
-    ax.set_xlabel("t (s)")
-    ax.legend(loc="upper right", fontsize=7, ncol=4)
-    fig.suptitle("Panda on a table, adaptive state feedback (examples/13_panda_table.py)")
+    fig, axes = plt.subplots(2, 1, figsize=(11, 7), sharex=True, layout="constrained")
+    for ax, friction in zip(axes, (0.0, 0.1), strict=True):
+        sc = act.arm_table(friction=friction)
+        basis = ac.orbit_basis(sc)
+        for name, color, lw in (
+            ("sf-printed", "tab:red", 0.5),
+            ("ct-admittance", "tab:orange", 0.5),
+            ("sf", "tab:blue", 0.9),
+            ("ct", "tab:green", 0.9),
+        ):
+            res, _, m = run(name, sc, basis, T)
+            ax.plot(
+                res.t,
+                -res.wrench_ee[:, 2],
+                color=color,
+                lw=lw,
+                label=f"{ROWS[name][0]}: chatter {m['force_chatter_N']:.2f} N",
+            )
+        ax.axhline(sc.target_force(), color="k", ls="--", lw=1, label="K_d δ_c")
+        ax.set_ylim(-2, 30)
+        ax.set_ylabel("normal force F_n (N)")
+        ax.set_title(f"Panda on a rigid table, sliding friction {friction:g}")
+        ax.legend(loc="upper right", fontsize=7)
+    axes[-1].set_xlabel("t (s)")
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
 def long_run(sc: ac.PandaTable, basis: Any, T: float) -> None:
-    """SF (without the τe feedforward) for T seconds, in parts of 10 s (the plant
-    and the controller go on from one part to the next: the rows of one run);
-    prints ‖Ŵ‖_F every 10 s."""
-    ctrl = ac.panda_controller("sf", sc, basis=basis, force_feedforward=False, **LEARN)
+    """SF (unified, n = SHARE) for T seconds, in parts of 10 s in the core's loop
+    (the plant and the controller go on from one part to the next: the rows of
+    one run); prints ‖Ŵ‖_F and the mean normal force every 10 s."""
+    ctrl = ac.panda_controller(
+        "sf",
+        sc,
+        basis=basis,
+        force_feedforward=False,
+        formulation="unified",
+        admittance_share=SHARE,
+        **LEARN,
+    )
     plant = amj.Plant(sc.model)
-    print(f"\nlong run, SF without τe feedforward, gravity learning, T = {T:g} s: weight norms")
-    print("| t (s) | ‖W_D‖ | ‖W_C‖ | ‖W_G‖ | max |τ_i|/τmax_i applied |")
+    print(f"\nlong run, {ROWS['sf'][0]}, T = {T:g} s: weight norms, mean normal force")
+    print("| t (s) | ‖W_D‖ | ‖W_C‖ | ‖W_G‖ | mean F_n over the last 10 s (N) |")
     print("|---:|---:|---:|---:|---:|")
-    peak, part = 0.0, 10.0
+    part = 10.0
     for i in range(round(T / part)):
         first = i == 0
         res = amj.simulate(
             ctrl, plant, T=part, q0=sc.q0 if first else None, reset=first, record_every=1
         )
-        peak = max(peak, float(np.max(np.abs(res.tau_sat) / plant.tau_max)))
         sd = ctrl.inner.state_dict()
         norms = [float(np.linalg.norm(sd[w])) for w in ("W_D", "W_C", "W_G")]
+        mean = -float(np.mean(res.task["wrench"][:, 2]))
         print(
             f"| {(i + 1) * part:.0f} | "
             + " | ".join(f"{v:.3g}" for v in norms)
-            + f" | {peak:.3f} |"
+            + f" | {mean:.3f} |"
         )
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--arm", type=str, default=None, help="URDF of the arm (default: Panda)")
     parser.add_argument("--T", type=float, default=1.0 if QUICK else 20.0, help="duration (s)")
+    parser.add_argument("--json", type=str, default=None, help="write the table as JSON here")
+    parser.add_argument("--friction", type=float, default=0.1, help="sliding friction")
+    parser.add_argument("--spring", type=float, default=None, help="table spring k_e (N/m)")
+    parser.add_argument("--rows", type=str, default=",".join(ROWS), help="rows to run")
+    parser.add_argument("--figure", action="store_true", help=f"write {FIGURE.name}")
     parser.add_argument("--long", type=float, default=0.0, help="also a long SF run (s)")
     args = parser.parse_args()
-    sc = ac.panda_table()
+    sc = act.arm_table(args.arm, spring=args.spring, friction=args.friction)
     basis = ac.orbit_basis(sc)
     print(
-        f"panda-table: {sc.radius * 100:g} cm circle at {sc.freq:g} Hz, δ_c = "
-        f"{sc.depth * 1e3:g} mm (target {sc.target_force():g} N), T = {args.T:g} s, "
-        f"{basis[0].shape[0]} centres, η_q = {basis[1][0]:.3g} rad, η_v = {basis[1][7]:.3g} rad/s"
+        f"{args.arm or 'Panda'}: {sc.radius * 100:g} cm circle at {sc.freq:g} Hz about "
+        f"({sc.centre[0]:.3f}, {sc.centre[1]:.3f}) m, table top {sc.surface_z - 0.01:.4f} m, "
+        f"δ_c = {sc.depth * 1e3:g} mm, friction {args.friction:g}, "
+        f"{'rigid' if args.spring is None else f'spring {args.spring:g} N/m'}, T = {args.T:g} s, "
+        f"home {np.round(sc.q0, 3).tolist()}, {basis[0].shape[0]} centres"
     )
-    print("\n| controller | track (mm) | force (N) | imp (N) | sat | peak τ/τmax | time (s) |")
-    print("|---|---:|---:|---:|---:|---:|---:|")
-    keep: dict[str, Any] = {}
-    for kind, label in KINDS.items():
+    print(
+        "\n| controller | track (mm) | force RMS err (N) | target (N) | mean (N) | (16.1) (N) "
+        "| chatter (N) | contact lost (s) | peak τ/τmax | sat | time (s) |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    table: dict[str, dict[str, float]] = {}
+    for name in args.rows.split(","):
         t0 = time.perf_counter()
-        res, ctrl, m = run(kind, sc, basis, args.T)
-        keep[kind] = (res, ctrl)
+        try:
+            _, _, m = run(name, sc, basis, args.T)
+        except adaptimp.DivergedError as e:
+            print(f"| {ROWS[name][0]} | diverged: {str(e).splitlines()[0]} |")
+            continue
+        table[name] = {k: m[k] for k in KEYS}
         print(
-            f"| {label} | {m['rms_track'] * 1e3:.3f} | {m['rms_force']:.2f} | {m['rms_imp']:.2f} "
-            f"| {m['sat_duty']:.3f} | {m['peak_tau_ratio']:.3f} | {time.perf_counter() - t0:.1f} |"
+            f"| {ROWS[name][0]} | {m['track_mm']:.3f} | {m['force_rms_err_N']:.3f} "
+            f"| {m['force_target_N']:.3f} | {m['force_mean_N']:.3f} | {m['force_16_1_N']:.3f} "
+            f"| {m['force_chatter_N']:.3f} "
+            f"| {m['contact_lost_s']:.3f} | {m['peak_tau_ratio']:.3f} | {m['sat_duty']:.3f} "
+            f"| {time.perf_counter() - t0:.1f} |"
         )
         assert m["applied_ratio"] <= 1.0 + 1e-12, "applied torque beyond its limit"
-    if not QUICK:
-        figure(*keep["sf-learn"], sc, FIGURE)
+    if args.json:
+        Path(args.json).write_text(json.dumps(table, indent=2) + "\n")
+        print(f"\nwrote {args.json}")
+    if args.figure and not QUICK:
+        figure(FIGURE, args.T)
         print(f"\nwrote {FIGURE}")
     if args.long > 0:
         long_run(sc, basis, args.long)

@@ -101,8 +101,8 @@ pub use sim::{disturb, environment, inject, metrics, model, plant, record, simul
 pub use auxiliary::AuxLaw;
 pub use cartesian::{
     CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
-    CartesianMeasurement, CartesianState, Chain, CompliantPose, Joint, JointKind, OuterStep,
-    PoseTarget, Transform,
+    CartesianMeasurement, CartesianState, Chain, CompliantPose, Formulation, Joint, JointKind,
+    OuterStep, PoseTarget, Transform,
 };
 pub use config::{Conditions, Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};
@@ -114,7 +114,7 @@ pub use error::Error;
 pub use impedance::{ImpedanceMode, Reference, TargetImpedance};
 #[cfg(feature = "sim")]
 pub use inject::{Injected, Injection};
-pub use io::{Command, Control, Measurement};
+pub use io::{Command, Control, Measurement, TaskTorque};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use learning::{Learning, LearningStep, SaturationLearning};
 #[cfg(feature = "sim")]

@@ -12,7 +12,7 @@
 //! a field added without a schema name does not compile, and a test checks
 //! that the names it visits are exactly those of [`PARAMS`].
 
-use crate::cartesian::CartesianConfig;
+use crate::cartesian::{CartesianConfig, Formulation};
 use crate::control::auxiliary::AuxLaw;
 use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound};
 use crate::control::impedance::ImpedanceMode;
@@ -555,6 +555,25 @@ pub const PARAMS: &[Param] = &[
         "",
         B(true),
     ),
+    // How the impedance reaches the torque, SPEC §19.
+    p(
+        "formulation",
+        Cart,
+        Kind::Choice(&Formulation::NAMES),
+        "",
+        "how the impedance reaches the torque: 'admittance', the joint law tracks the compliant reference (C1)–(C5); 'impedance', τ = Jᵀ(K e + B ė) at the measured pose with the learned terms along the commanded motion, the wrench only in the learning error (holds a rigid contact); 'unified', their convex combination (SPEC §19)",
+        "",
+        S("admittance"),
+    ),
+    p(
+        "admittance_share",
+        Cart,
+        Real,
+        "",
+        "the admittance's share n of the torque for formulation 'unified' (0: impedance, 1: admittance), SPEC §19",
+        "0 ≤ admittance_share ≤ 1",
+        R(0.3),
+    ),
 ];
 
 /// The parameter called `name`.
@@ -680,6 +699,8 @@ impl<const N: usize> Scenario<N> {
                 target_filter: 0.0,
                 force_filter: 0.0,
                 force_feedforward: false,
+                formulation: Formulation::Admittance,
+                admittance_share: 0.0,
             },
         };
         for p in PARAMS {
@@ -835,6 +856,10 @@ impl<const N: usize> Scenario<N> {
     /// [`set`](Self::set) for a parameter of the Cartesian impedance (group "cartesian").
     fn set_cartesian(&mut self, n: &'static str, value: Value<'_>) -> Result<(), Error> {
         let c = &mut self.cartesian;
+        let p = param(n).ok_or(Error::Invalid {
+            what: "parameter",
+            reason: "unknown name (see adaptimp::schema::PARAMS)",
+        })?;
         match n {
             "Md" => c.md = joint(n, value)?,
             "Bd" => c.bd = derived_axes(n, value)?,
@@ -853,6 +878,8 @@ impl<const N: usize> Scenario<N> {
             "target_filter" => c.target_filter = real(n, value)?,
             "force_filter" => c.force_filter = real(n, value)?,
             "force_feedforward" => c.force_feedforward = flag(n, value)?,
+            "formulation" => c.formulation = choice(p, value, &Formulation::ALL)?,
+            "admittance_share" => c.admittance_share = real(n, value)?,
             _ => unreachable!("{n} is in PARAMS but has no setter"),
         }
         Ok(())
@@ -1028,6 +1055,8 @@ impl<const N: usize> Scenario<N> {
             target_filter,
             force_filter,
             force_feedforward,
+            formulation,
+            admittance_share,
         } = &self.cartesian;
         let opt = |v: &Option<f64>| v.map_or(Value::None, Value::Real);
         f("Md", V(md.as_slice()));
@@ -1047,6 +1076,8 @@ impl<const N: usize> Scenario<N> {
         f("target_filter", R(*target_filter));
         f("force_filter", R(*force_filter));
         f("force_feedforward", B(*force_feedforward));
+        f("formulation", S(formulation.name()));
+        f("admittance_share", R(*admittance_share));
     }
 
     /// [`visit`](Self::visit) for the parameters of the run (group "sim"),

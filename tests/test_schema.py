@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _adaptimp
+from adaptimp import _adaptimp, cartesian
 from adaptimp._params import ALL_GROUPS, BY_NAME, GROUPS, PARAMS, SCENARIOS, names
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -49,9 +49,19 @@ def test_the_table_carries_units_docs_conditions_and_choices() -> None:
     assert BY_NAME["weight_bound"].kind == "bound"
     assert all(p.doc for p in PARAMS)
     # Every choice a user can name is accepted by the core.
+    arm = adaptimp.Chain(
+        [
+            {"kind": "revolute", "axis": [0, 0, 1]},
+            {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [0, 0, 1]},
+        ],
+        tip={"xyz": [0.2, 0, 0]},
+    )
     for p in PARAMS:
         for choice in p.choices:
-            adaptimp.Controller("sf", **{p.name: choice})
+            if p.group == "cartesian":
+                cartesian.CartesianImpedance(arm, Ts=1e-3, q0=[0.3, 0.6], **{p.name: choice})
+            else:
+                adaptimp.Controller("sf", **{p.name: choice})
 
 
 def test_help_lists_every_parameter_with_unit_and_condition() -> None:

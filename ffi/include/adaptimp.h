@@ -175,6 +175,26 @@ typedef enum AdaptimpJointKind {
   ADAPTIMP_JOINT_KIND_PRISMATIC = 1302,
 } AdaptimpJointKind;
 
+// The stability conditions construction checks (SPEC §10), in the order of
+// `Conditions::NAMES`.
+typedef enum AdaptimpConditions {
+  // The paper's (13): 2Kp − I > 0, 2Kζ − I − KpᵀKp > 0 (needs inertia = 1, rho = 1).
+  ADAPTIMP_CONDITIONS_PAPER = 1400,
+  // SPEC (10.3): Kp > 0, 2Kζ − ρ − Kp/d > 0.
+  ADAPTIMP_CONDITIONS_SCALED = 1401,
+} AdaptimpConditions;
+
+// How the Cartesian target impedance reaches the torque (SPEC §19), in the
+// order of `Formulation::NAMES`.
+typedef enum AdaptimpFormulation {
+  // The joint law tracks the compliant reference driven by the measured wrench (SPEC §16).
+  ADAPTIMP_FORMULATION_ADMITTANCE = 1500,
+  // τ = Jᵀ(K e + B ė) at the measured pose; the wrench never reaches the torque.
+  ADAPTIMP_FORMULATION_IMPEDANCE = 1501,
+  // The convex combination, the admittance's share `admittance_share`.
+  ADAPTIMP_FORMULATION_UNIFIED = 1502,
+} AdaptimpFormulation;
+
 // The 6-D Cartesian impedance over a chain and the joint controller it
 // drives (opaque; immutable: share it between threads).
 typedef struct AdaptimpCartesian AdaptimpCartesian;
@@ -280,10 +300,12 @@ typedef struct AdaptimpCartesianParams {
   // True: the joint controller gets τe = Jᵀ F_e for its +τe feedforward
   // (C5); false: τe = 0.
   bool force_feedforward;
+  // How the impedance reaches the torque (an `AdaptimpFormulation`, read as
+  // an integer; SPEC §19): ADMITTANCE (the default), IMPEDANCE or UNIFIED.
+  AdaptimpFormulation formulation;
+  // The admittance's share n ∈ [0, 1] of the torque for UNIFIED (ignored otherwise).
+  double admittance_share;
 } AdaptimpCartesianParams;
-
-// An [`AdaptimpConditions`] as the caller passed it.
-typedef uint32_t AdaptimpConditionsRaw;
 
 // Every parameter of a controller for `n` joints (1…7): the fields of the
 // parameter schema (`adaptimp::schema::PARAMS`, group "controller"), named as
@@ -310,7 +332,7 @@ typedef struct AdaptimpParams {
   // Young weight ρ (1/s) of the auxiliary system, SPEC §10.
   double rho;
   // The stability conditions checked.
-  AdaptimpConditionsRaw conditions;
+  AdaptimpConditions conditions;
   // μ (N m), (11).
   double mu;
   // Inner law of the auxiliary system.

@@ -10,8 +10,8 @@ use adaptimp::cartesian::rotation::quaternion_matrix;
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
     AnyBasis, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
-    CartesianState, Centers, Chain, Joint, JointKind, Kinematics, Law, PoseTarget, Setpoint,
-    Transform, Vector,
+    CartesianState, Centers, Chain, Formulation, Joint, JointKind, Kinematics, Law, PoseTarget,
+    Setpoint, Transform, Vector,
 };
 use core::ffi::c_void;
 use nalgebra::{Matrix3, UnitQuaternion};
@@ -111,6 +111,11 @@ pub struct AdaptimpCartesianParams {
     /// True: the joint controller gets τe = Jᵀ F_e for its +τe feedforward
     /// (C5); false: τe = 0.
     pub force_feedforward: AdaptimpBoolRaw,
+    /// How the impedance reaches the torque (an `AdaptimpFormulation`, read as
+    /// an integer; SPEC §19): ADMITTANCE (the default), IMPEDANCE or UNIFIED.
+    pub formulation: AdaptimpFormulationRaw,
+    /// The admittance's share n ∈ [0, 1] of the torque for UNIFIED (ignored otherwise).
+    pub admittance_share: f64,
 }
 
 /// A commanded pose and its rates at t_k, world frame (SPEC §16). The
@@ -674,6 +679,8 @@ fn cartesian_of(p: &AdaptimpCartesianParams) -> Result<CartesianConfig, Adaptimp
         target_filter,
         force_filter,
         force_feedforward,
+        formulation,
+        admittance_share,
     } = p;
     // INFINITY: no clipping (the schema's None).
     let clipping = |v: f64| {
@@ -695,7 +702,8 @@ fn cartesian_of(p: &AdaptimpCartesianParams) -> Result<CartesianConfig, Adaptimp
             Value::Vec(v)
         })
     }
-    let values: [(&str, Value<'_>); 17] = [
+    let formulation = decode::<AdaptimpFormulation>(*formulation, "cart.formulation")?;
+    let values: [(&str, Value<'_>); 19] = [
         ("Md", Value::Vec(md)),
         ("Bd", derived(*bd_critical, "cart.bd_critical", bd)?),
         ("Kd", Value::Vec(kd)),
@@ -719,6 +727,11 @@ fn cartesian_of(p: &AdaptimpCartesianParams) -> Result<CartesianConfig, Adaptimp
             "force_feedforward",
             Value::Bool(decode_bool(*force_feedforward, "cart.force_feedforward")?),
         ),
+        (
+            "formulation",
+            Value::Str(Formulation::NAMES[formulation.index()]),
+        ),
+        ("admittance_share", Value::Real(*admittance_share)),
     ];
     debug_assert!(values.iter().map(|(n, _)| *n).eq(cartesian_names()));
     let mut s = Scenario::<1>::preset(Preset::Robot, Law::Pd);
@@ -768,6 +781,8 @@ pub unsafe extern "C" fn adaptimp_cartesian_params_default(
             target_filter,
             force_filter,
             force_feedforward,
+            formulation,
+            admittance_share,
         } = c;
         *out = AdaptimpCartesianParams {
             md: a3(&md),
@@ -789,6 +804,12 @@ pub unsafe extern "C" fn adaptimp_cartesian_params_default(
             target_filter,
             force_filter,
             force_feedforward: force_feedforward.into(),
+            formulation: AdaptimpFormulation::ALL[Formulation::ALL
+                .iter()
+                .position(|f| *f == formulation)
+                .unwrap_or(0)]
+            .raw(),
+            admittance_share,
         };
         Ok(())
     })

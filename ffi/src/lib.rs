@@ -130,6 +130,19 @@ pub enum AdaptimpConditions {
     Scaled = 1401,
 }
 
+/// How the Cartesian target impedance reaches the torque (SPEC §19), in the
+/// order of `Formulation::NAMES`.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpFormulation {
+    /// The joint law tracks the compliant reference driven by the measured wrench (SPEC §16).
+    Admittance = 1500,
+    /// τ = Jᵀ(K e + B ė) at the measured pose; the wrench never reaches the torque.
+    Impedance = 1501,
+    /// The convex combination, the admittance's share `admittance_share`.
+    Unified = 1502,
+}
+
 /// The robust term r(z2) (SPEC §7), in the order of `RobustKind::NAMES`.
 #[repr(C)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -258,6 +271,10 @@ pub struct AdaptimpAuxLawRaw(pub u32);
 #[repr(transparent)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct AdaptimpConditionsRaw(pub u32);
+/// An [`AdaptimpFormulation`] as the caller passed it.
+#[repr(transparent)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct AdaptimpFormulationRaw(pub u32);
 /// An [`AdaptimpRobust`] as the caller passed it.
 #[repr(transparent)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -375,6 +392,7 @@ c_enums! {
     AdaptimpFallback / AdaptimpFallbackRaw: Hold, Zero, Damping;
     AdaptimpFaultPolicy / AdaptimpFaultPolicyRaw: Report, Latch;
     AdaptimpJointKind / AdaptimpJointKindRaw: Fixed, Revolute, Prismatic;
+    AdaptimpFormulation / AdaptimpFormulationRaw: Admittance, Impedance, Unified;
 }
 
 /// The C name of a value: "AdaptimpLaw", "StateFeedback" → "ADAPTIMP_LAW_STATE_FEEDBACK".
@@ -748,6 +766,7 @@ mod tests {
         values::<AdaptimpImpedance>(&mut seen);
         values::<AdaptimpFallback>(&mut seen);
         values::<AdaptimpFaultPolicy>(&mut seen);
+        values::<AdaptimpFormulation>(&mut seen);
         values::<AdaptimpJointKind>(&mut seen);
         assert_eq!(
             decode::<AdaptimpLaw>(AdaptimpLawRaw(101), "law"),

@@ -663,6 +663,7 @@ mod tests {
         }
         check::<AdaptimpAuxLaw>(&AuxLaw::NAMES);
         check::<AdaptimpConditions>(&Conditions::NAMES);
+        check::<AdaptimpFormulation>(&adaptimp::Formulation::NAMES);
         check::<AdaptimpRobust>(&RobustKind::NAMES);
         check::<AdaptimpLearningStep>(&LearningStep::NAMES);
         check::<AdaptimpSaturationLearning>(&SaturationLearning::NAMES);

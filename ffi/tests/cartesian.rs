@@ -8,8 +8,8 @@ use adaptimp::cartesian::rotation::rotation_error;
 use adaptimp::schema::Value;
 use adaptimp::{
     AnyBasis, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
-    Centers, Chain, Controller, Joint, Kinematics, Law, PoseTarget, Preset, Scenario, Setpoint,
-    Transform, Vector,
+    Centers, Chain, Controller, Formulation, Joint, Kinematics, Law, PoseTarget, Preset, Scenario,
+    Setpoint, Transform, Vector,
 };
 use adaptimp_ffi::*;
 use nalgebra::{Matrix3, UnitQuaternion};
@@ -287,8 +287,23 @@ impl Drop for Pair {
 }
 
 fn pair(law: AdaptimpLaw, core_law: Law) -> Pair {
+    pair_formulated(law, core_law, AdaptimpFormulation::Admittance)
+}
+
+/// [`pair`] with the impedance reaching the torque as `form` says (SPEC §19),
+/// the unified formulation at the admittance share 0.3.
+fn pair_formulated(law: AdaptimpLaw, core_law: Law, form: AdaptimpFormulation) -> Pair {
     let chain = c_chain();
-    let cart = cart_defaults();
+    let mut cart = cart_defaults();
+    cart.formulation = form.into();
+    cart.admittance_share = 0.3;
+    let mut config = CartesianConfig::default();
+    config.formulation = match form {
+        AdaptimpFormulation::Admittance => Formulation::Admittance,
+        AdaptimpFormulation::Impedance => Formulation::Impedance,
+        AdaptimpFormulation::Unified => Formulation::Unified,
+    };
+    config.admittance_share = 0.3;
     let core = core_chain();
     let tip0 = core.tip(&Vector::from(Q0), &Vector::zeros());
     let (p0, r0) = (tip0.position, *tip0.rotation.matrix());
@@ -315,7 +330,7 @@ fn pair(law: AdaptimpLaw, core_law: Law) -> Pair {
     };
     assert_eq!(s, AdaptimpStatus::Ok, "{}", last_error());
     assert_eq!(l, 16);
-    let outer = CartesianImpedance::new(CartesianConfig::default(), core, 1e-3).unwrap();
+    let outer = CartesianImpedance::new(config, core, 1e-3).unwrap();
     let zero = Setpoint {
         x: Vector::<N>::zeros(),
         dx: Vector::zeros(),
@@ -389,12 +404,42 @@ fn step(
 
 #[test]
 fn the_cartesian_step_is_the_cores_bit_for_bit() {
+    for form in [
+        AdaptimpFormulation::Admittance,
+        AdaptimpFormulation::Impedance,
+        AdaptimpFormulation::Unified,
+    ] {
+        cartesian_steps_are_the_cores(form);
+    }
+}
+
+#[test]
+fn a_formulation_outside_its_enum_is_refused_by_name() {
+    let chain = c_chain();
+    let mut cart = cart_defaults();
+    cart.formulation = AdaptimpFormulationRaw(1503);
+    let joint = defaults(N, AdaptimpLaw::Pd, AdaptimpPreset::Robot);
+    let mut c = ptr::null_mut();
+    // SAFETY: valid handles and structs.
+    let s = unsafe { adaptimp_cartesian_new(chain, &cart, &joint, &mut c) };
+    assert_eq!(s, AdaptimpStatus::InvalidConfig);
+    assert!(c.is_null());
+    assert!(
+        last_error().contains("cart.formulation"),
+        "{}",
+        last_error()
+    );
+    // SAFETY: a live chain.
+    unsafe { adaptimp_chain_free(chain) };
+}
+
+fn cartesian_steps_are_the_cores(form: AdaptimpFormulation) {
     for (law, core_law) in [
         (AdaptimpLaw::Pd, Law::Pd),
         (AdaptimpLaw::StateFeedback, Law::StateFeedback),
         (AdaptimpLaw::OutputFeedback, Law::OutputFeedback),
     ] {
-        let p = pair(law, core_law);
+        let p = pair_formulated(law, core_law, form);
         let chain = core_chain();
         let tip0 = chain.tip(&Vector::from(Q0), &Vector::zeros());
         let (p0, r0) = (tip0.position, *tip0.rotation.matrix());
@@ -419,7 +464,7 @@ fn the_cartesian_step_is_the_cores_bit_for_bit() {
             assert_eq!(
                 status,
                 AdaptimpStatus::Ok,
-                "{law:?} k = {k}: {}",
+                "{form:?} {law:?} k = {k}: {}",
                 last_error()
             );
             let m = CartesianMeasurement {
@@ -435,7 +480,7 @@ fn the_cartesian_step_is_the_cores_bit_for_bit() {
             assert_eq!(
                 &out.tau_sat[..N],
                 want.joint.tau_sat.as_slice(),
-                "{law:?} k = {k}"
+                "{form:?} {law:?} k = {k}"
             );
             assert_eq!(&out.tau[..N], want.joint.tau.as_slice());
             assert_eq!(&out.z1[..N], want.joint.z1.as_slice());

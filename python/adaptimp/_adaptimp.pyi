@@ -254,6 +254,14 @@ class CartesianParams(TypedDict, total=False):
     force_feedforward: bool
     """the joint controller gets τe = Jᵀ F_e for its +τe feedforward (C5); False: τe = 0, the
     contact acts through (C1) only."""
+    formulation: Literal["admittance", "impedance", "unified"]
+    """how the impedance reaches the torque: 'admittance', the joint law tracks the compliant
+    reference (C1)–(C5); 'impedance', τ = Jᵀ(K e + B ė) at the measured pose with the
+    learned terms along the commanded motion, the wrench only in the learning error (holds a
+    rigid contact); 'unified', their convex combination (SPEC §19)."""
+    admittance_share: float
+    """the admittance's share n of the torque for formulation 'unified' (0: impedance, 1:
+    admittance), SPEC §19."""
 
 # END GENERATED
 

@@ -299,13 +299,26 @@ class ComputedTorque:
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
+        task_torque: ArrayLike | None = None,
+        jacobian: ArrayLike | None = None,
     ) -> FloatArray:
         """One step at t_k = k·Ts; returns the applied torque sat(τ) (N m), (n,).
 
         q (rad), tau_e (N m), dq (rad/s; required), each (n,); the setpoint
         xc (rad), dxc (rad/s), ddxc (rad/s²), (n,), or none of them (then the
         built-in ``trajectory``).
+
+        ``task_torque`` (N m, (n,)) and ``jacobian`` ((6, n)): what a
+        Cartesian impedance in a torque-level formulation hands its joint
+        controller (SPEC §19): the setpoint is then the commanded joint
+        reference q_c and the law the torque-level impedance with the model
+        as feedforward, τ = M̂ q̈_c + ĥ + τ_task + (I − Jᵀ J⁺ᵀ) M̂ (K_P (q_c − q)
+        + K_D (q̇_c − q̇)), J⁺ the pseudo-inverse (Paden & Panja's PD+, 1988;
+        the null-space term of Albu-Schäffer, Ott & Hirzinger, 2007). τe is
+        not used.
         """
+        if task_torque is not None:
+            return self._task_step(q, dq, xc, dxc, ddxc, task_torque, jacobian)
         n = self.n
         if dq is None:
             raise ValueError("ComputedTorque needs the measured joint velocity dq")
@@ -335,6 +348,33 @@ class ComputedTorque:
         # Advance the reference to t_{k+1} (SPEC §11: ẋd first, then xd with it).
         self._dxd = dxd + self._ts * ddxd
         self._xd = xd + self._ts * self._dxd
+        self._k += 1
+        return tau_sat
+
+    def _task_step(
+        self,
+        q: ArrayLike,
+        dq: ArrayLike | None,
+        xc: ArrayLike | None,
+        dxc: ArrayLike | None,
+        ddxc: ArrayLike | None,
+        task_torque: ArrayLike,
+        jacobian: ArrayLike | None,
+    ) -> FloatArray:
+        """The torque-level law of :meth:`step` (``task_torque`` given)."""
+        n = self.n
+        if dq is None or xc is None or dxc is None or ddxc is None or jacobian is None:
+            raise ValueError("a task step needs dq, xc, dxc, ddxc, task_torque and jacobian")
+        q, dq = _joint("q", q, n), _joint("dq", dq, n)
+        xc, dxc, ddxc = _joint("xc", xc, n), _joint("dxc", dxc, n), _joint("ddxc", ddxc, n)
+        tt = _joint("task_torque", task_torque, n)
+        jac = np.asarray(jacobian, dtype=np.float64).reshape(6, n)
+        m = self.mass_matrix(q)
+        null = np.eye(n) - jac.T @ np.linalg.pinv(jac).T
+        pd = m @ (self.Kp * (xc - q) + self.Kd * (dxc - dq))
+        tau = m @ ddxc + self.bias(q, dq) + tt + null @ pd
+        tau_sat = np.clip(tau, -self.tau_max, self.tau_max)
+        self.tau, self.tau_sat, self.xc, self.xd, self.z1 = tau, tau_sat, xc, xc.copy(), xc - q
         self._k += 1
         return tau_sat
 

@@ -508,21 +508,45 @@ class Plant:
             for b in inside[i + 1 :]
         )
 
+    def _environment_joints(self) -> set[int]:
+        """Joints of the environment, not of the arm: unactuated, on a body tree
+        hanging from the world that holds no actuated joint (e.g. a table on a
+        spring, ``adaptimp.contact``)."""
+        m = self.model
+        joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
+        actuated = {
+            int(m.actuator_trnid[a, 0]) for a in range(m.nu) if m.actuator_trntype[a] == joint_trn
+        }
+
+        def root(body: int) -> int:
+            while int(m.body_parentid[body]) > 0:
+                body = int(m.body_parentid[body])
+            return body
+
+        arm_roots = {root(int(m.jnt_bodyid[j])) for j in actuated}
+        return {
+            j
+            for j in range(m.njnt)
+            if j not in actuated and root(int(m.jnt_bodyid[j])) not in arm_roots
+        }
+
     def _check_joints(self) -> None:
         m = self.model
         hinge = int(mujoco.mjtJoint.mjJNT_HINGE)
+        env = self._environment_joints()
+        arm = [j for j in range(m.njnt) if j not in env]
         bad = [
             f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)} ({mujoco.mjtJoint(m.jnt_type[j]).name})"
-            for j in range(m.njnt)
+            for j in arm
             if m.jnt_type[j] != hinge
         ]
         if bad:
             raise ValueError(f"Plant needs hinge joints only; not hinges: {', '.join(bad)}")
-        if not 1 <= m.njnt <= MAX_JOINTS:
-            raise ValueError(f"Plant needs 1 to {MAX_JOINTS} joints, the model has {m.njnt}")
-        self.n = int(m.njnt)
+        if not 1 <= len(arm) <= MAX_JOINTS:
+            raise ValueError(f"Plant needs 1 to {MAX_JOINTS} joints, the model has {len(arm)}")
+        self.n = len(arm)
         # Joints in kinematic order (hinges: one qpos and one dof each).
-        self._joints = sorted(range(self.n), key=lambda j: int(m.jnt_dofadr[j]))
+        self._joints = sorted(arm, key=lambda j: int(m.jnt_dofadr[j]))
         self._qadr = np.array([m.jnt_qposadr[j] for j in self._joints])
         self._dofs = np.array([m.jnt_dofadr[j] for j in self._joints])
         bodies = [int(m.jnt_bodyid[j]) for j in self._joints]
@@ -545,7 +569,7 @@ class Plant:
     def _check_actuators(self) -> None:
         m = self.model
         joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
-        act_of: dict[int, list[int]] = {j: [] for j in range(self.n)}
+        act_of: dict[int, list[int]] = {j: [] for j in self._joints}
         for a in range(m.nu):
             name = _name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)
             if m.actuator_trntype[a] != joint_trn:

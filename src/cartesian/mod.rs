@@ -11,6 +11,7 @@ pub mod rotation;
 pub use chain::{Chain, Joint, JointKind, Transform, MAX_CHAIN_JOINTS};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{
-    CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, OuterStep, PoseTarget,
+    CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation, OuterStep,
+    PoseTarget,
 };
 pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement};

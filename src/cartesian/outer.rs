@@ -33,8 +33,9 @@
 //! changes. A step is staged on a copy ([`CartesianImpedance::stage`]) and
 //! committed by the caller, so a refused input changes nothing.
 
-use crate::cartesian::kinematics::{Jacobian6, Kinematics};
+use crate::cartesian::kinematics::{Jacobian6, Kinematics, Tip};
 use crate::cartesian::rotation::{self, clip, exp, rotation_error};
+use crate::control::io::TaskTorque;
 use crate::control::safety::{
     CEILING_ACCELERATION, CEILING_POSITION, CEILING_TORQUE, CEILING_VELOCITY,
 };
@@ -42,8 +43,52 @@ use crate::error::{check, Error, BOUND, PARAM_BOUND};
 use crate::math::sqrt;
 use crate::schema::{Preset, Scenario};
 use crate::trajectory::Setpoint;
-use crate::types::Vector;
+use crate::types::{choices, Vector};
 use nalgebra::{Matrix3, SMatrix, UnitQuaternion};
+
+/// How the target impedance reaches the torque (schema keyword `formulation`,
+/// SPEC §19).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub enum Formulation {
+    /// Position-based impedance ("admittance", SPEC §16): the measured wrench
+    /// drives the compliant reference (C1), which the joint law tracks. Exact
+    /// in free space and against compliant environments; against a rigid one
+    /// the loop wrench → p̈_d → q̈_d → τ → wrench is algebraic and chatters
+    /// when the arm's apparent mass exceeds M_d (docs/panda.md).
+    #[default]
+    Admittance,
+    /// Torque-level impedance ("impedance", SPEC §19): τ = Jᵀ(q)[K̃ e + B ė]
+    /// at the measured pose, the joint law's feedback in the null space of
+    /// the task, the networks compensating D, C, G along the *commanded*
+    /// motion; the measured wrench never reaches the torque, only the
+    /// learning error (against the compliant reference). Passive against
+    /// any environment (Hogan 1985; Albu-Schäffer, Ott & Hirzinger 2007).
+    Impedance,
+    /// The family between the two ("unified", SPEC §19): the convex
+    /// combination of the admittance and the impedance torques with the
+    /// admittance's share `admittance_share` (Ott, Mukherjee & Nakamura 2010,
+    /// whose switched law averages to it).
+    Unified,
+}
+
+choices!(Formulation {
+    "admittance" => Formulation::Admittance,
+    "impedance" => Formulation::Impedance,
+    "unified" => Formulation::Unified,
+});
+
+impl Formulation {
+    /// The admittance's share n ∈ [0, 1] of the torque: 1 for
+    /// [`Admittance`](Self::Admittance), 0 for [`Impedance`](Self::Impedance),
+    /// `share` for [`Unified`](Self::Unified).
+    pub fn share(self, share: f64) -> f64 {
+        match self {
+            Formulation::Admittance => 1.0,
+            Formulation::Impedance => 0.0,
+            Formulation::Unified => share,
+        }
+    }
+}
 
 /// Parameters of the 6-D target impedance and of the inverse kinematics,
 /// every diagonal one by its diagonal (x, y, z of the world frame); the
@@ -89,6 +134,11 @@ pub struct CartesianConfig {
     /// Whether the joint controller gets τe = Jᵀ(q) F_e (C5, its law's +τe
     /// feedforward), or zero (the contact acts through (C1) only).
     pub force_feedforward: bool,
+    /// How the impedance reaches the torque (SPEC §19).
+    pub formulation: Formulation,
+    /// The admittance's share n ∈ [0, 1] of the torque for
+    /// [`Formulation::Unified`] (ignored otherwise).
+    pub admittance_share: f64,
 }
 
 impl Default for CartesianConfig {
@@ -147,6 +197,17 @@ impl CartesianConfig {
         check::nonnegative("null_d ≥ 0", "null_d", self.null_d)?;
         check::nonnegative("target_filter ≥ 0", "target_filter", self.target_filter)?;
         check::nonnegative("force_filter ≥ 0", "force_filter", self.force_filter)?;
+        check::nonnegative(
+            "0 ≤ admittance_share ≤ 1",
+            "admittance_share",
+            self.admittance_share,
+        )?;
+        check::at_most(
+            "0 ≤ admittance_share ≤ 1",
+            "admittance_share",
+            self.admittance_share,
+            1.0,
+        )?;
         if let Some(e) = self.pos_error_max {
             check::positive("pos_error_max > 0", "pos_error_max", e)?;
         }
@@ -287,6 +348,12 @@ pub struct CartesianState<const N: usize> {
     pub qd: Vector<N>,
     /// Joint reference velocity q̇_d (rad/s).
     pub dqd: Vector<N>,
+    /// Commanded joint reference q_c (rad): the inverse kinematics of the
+    /// commanded pose alone, F_e = 0 (formulations other than admittance,
+    /// SPEC §19; q0 otherwise).
+    pub qc: Vector<N>,
+    /// Commanded joint reference velocity q̇_c (rad/s).
+    pub dqc: Vector<N>,
     /// Posture q_posture (rad) the null-space task pulls toward.
     pub posture: Vector<N>,
     /// The stiffness asked for, [K_d; K_d,rot] (N/m, N m/rad).
@@ -325,6 +392,14 @@ pub struct CompliantPose {
 pub struct OuterStep<const N: usize> {
     /// The joint reference q_d, q̇_d, q̈_d at t_k (rad, rad/s, rad/s²).
     pub reference: Setpoint<N>,
+    /// The commanded joint reference q_c, q̇_c, q̈_c at t_k (the inverse
+    /// kinematics of the commanded pose alone, SPEC §19; the reference
+    /// itself for the admittance formulation).
+    pub commanded: Setpoint<N>,
+    /// The commanded twist [ṗ_c (m/s); ω_c (rad/s)] at t_k.
+    pub twist: Vector<6>,
+    /// The damping [B (N s/m); B_o (N m s/rad)] the impedance used at t_k.
+    pub damping: Vector<6>,
     /// The compliant reference at t_k.
     pub compliant: CompliantPose,
     /// The commanded pose at t_k after the target filter (p_t (m), R_t).
@@ -426,6 +501,8 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             wd: Vector::zeros(),
             qd: q0,
             dqd: Vector::zeros(),
+            qc: q0,
+            dqc: Vector::zeros(),
             posture: q0,
             stiffness: k,
             stiffness_filtered: k,
@@ -487,6 +564,38 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         j
     }
 
+    /// (C2): the second-order CLIK acceleration q̈ at (q, q̇) toward the pose
+    /// (p, ṗ, p̈) and (R, ω, ω̇) (the rotation rows only when orienting),
+    /// the posture in the null space; `tip` is the kinematics at (q, q̇).
+    fn clik(
+        &self,
+        tip: &crate::cartesian::kinematics::Tip<N>,
+        (q, dq, posture): (&Vector<N>, &Vector<N>, &Vector<N>),
+        (p, dp, ddp): (&Vector<3>, &Vector<3>, &Vector<3>),
+        (rq, w, dw): (&UnitQuaternion<f64>, &Vector<3>, &Vector<3>),
+    ) -> Vector<N> {
+        let cfg = &self.cfg;
+        let j = self.select_jacobian(tip.jacobian);
+        let twist = j * dq;
+        let mut r = Vector::<6>::zeros();
+        let ep_ik = p - tip.position;
+        r.fixed_rows_mut::<3>(0).copy_from(
+            &(ddp - tip.bias.fixed_rows::<3>(0)
+                + cfg.clik_kd * (dp - twist.fixed_rows::<3>(0))
+                + cfg.clik_kp * ep_ik),
+        );
+        if self.orients {
+            let eo_ik = rotation_error(rq, &UnitQuaternion::from_rotation_matrix(&tip.rotation));
+            r.fixed_rows_mut::<3>(3).copy_from(
+                &(dw - tip.bias.fixed_rows::<3>(3)
+                    + cfg.clik_kd * (w - twist.fixed_rows::<3>(3))
+                    + cfg.clik_kp * eo_ik),
+            );
+        }
+        let wn = cfg.null_k * (posture - q) - cfg.null_d * dq;
+        wn + self.dls(&j, &(r - j * wn))
+    }
+
     /// One step of the outer loop on a copy of the state: the joint reference
     /// at t_k and the state at t_{k+1}, SPEC §16 (C0)–(C4). `target`: the
     /// commanded pose at t_k (`None`: hold the last one at rest; at the first
@@ -539,6 +648,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             v.fixed_rows_mut::<3>(0).copy_from(&c.dp);
             v.fixed_rows_mut::<3>(3).copy_from(&c.w);
             s.dqd = self.dls(&j, &self.select(v));
+            s.dqc = s.dqd;
         } else {
             let at = ts / (cfg.target_filter + ts);
             let af = ts / (cfg.force_filter + ts);
@@ -566,6 +676,8 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         // (C1) the target impedance, with the clipped errors (16.5).
         let ep = clip(&(pt - s.pd), cfg.pos_error_max.unwrap_or(f64::INFINITY));
         let b = damping(&cfg.bd, &cfg.md, 0);
+        let mut damping_used = Vector::<6>::zeros();
+        damping_used.fixed_rows_mut::<3>(0).copy_from(&b);
         let kp = k.fixed_rows::<3>(0);
         let ddpd = c.ddp
             + (-b.component_mul(&(s.dpd - c.dp)) + kp.component_mul(&ep) - f)
@@ -576,6 +688,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
                 cfg.rot_error_max.unwrap_or(f64::INFINITY),
             );
             let b = damping(&cfg.bd_rot, &cfg.md_rot, 3);
+            damping_used.fixed_rows_mut::<3>(3).copy_from(&b);
             let ko = k.fixed_rows::<3>(3);
             let dwd = c.dw
                 + (-b.component_mul(&(s.wd - c.w)) + ko.component_mul(&eo) - mom)
@@ -586,30 +699,61 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         };
         // (C2) second-order CLIK on the pose at q_d, posture in the null space.
         let tip = self.kin.tip(&s.qd, &s.dqd);
-        let j = self.select_jacobian(tip.jacobian);
         if !self.orients {
             // Position-only: the compliant orientation is the reference's own.
             s.rd = UnitQuaternion::from_rotation_matrix(&tip.rotation);
             s.wd = tip.jacobian.fixed_rows::<3>(3) * s.dqd;
         }
-        let twist = j * s.dqd;
-        let mut r = Vector::<6>::zeros();
-        let ep_ik = s.pd - tip.position;
-        r.fixed_rows_mut::<3>(0).copy_from(
-            &(ddpd - tip.bias.fixed_rows::<3>(0)
-                + cfg.clik_kd * (s.dpd - twist.fixed_rows::<3>(0))
-                + cfg.clik_kp * ep_ik),
+        let ddqd = self.clik(
+            &tip,
+            (&s.qd, &s.dqd, &s.posture),
+            (&s.pd, &s.dpd, &ddpd),
+            (&s.rd, &s.wd, &dwd),
         );
-        if self.orients {
-            let eo_ik = rotation_error(&s.rd, &UnitQuaternion::from_rotation_matrix(&tip.rotation));
-            r.fixed_rows_mut::<3>(3).copy_from(
-                &(dwd - tip.bias.fixed_rows::<3>(3)
-                    + cfg.clik_kd * (s.wd - twist.fixed_rows::<3>(3))
-                    + cfg.clik_kp * eo_ik),
+        // (19.1) the commanded joint reference: the same CLIK on the filtered
+        // commanded pose alone (F_e = 0), for the formulations whose torque
+        // must not carry the measured wrench.
+        let (commanded, twist_c) = if cfg.formulation == Formulation::Admittance {
+            (
+                Setpoint {
+                    x: s.qd,
+                    dx: s.dqd,
+                    ddx: ddqd,
+                },
+                Vector::<6>::zeros(),
+            )
+        } else {
+            let tip_c = self.kin.tip(&s.qc, &s.dqc);
+            let (rc, wc, dwc) = if self.orients {
+                (qt, c.w, c.dw)
+            } else {
+                let r = UnitQuaternion::from_rotation_matrix(&tip_c.rotation);
+                (
+                    r,
+                    tip_c.jacobian.fixed_rows::<3>(3) * s.dqc,
+                    Vector::zeros(),
+                )
+            };
+            let ddqc = self.clik(
+                &tip_c,
+                (&s.qc, &s.dqc, &s.posture),
+                (&pt, &c.dp, &c.ddp),
+                (&rc, &wc, &dwc),
             );
-        }
-        let w = cfg.null_k * (s.posture - s.qd) - cfg.null_d * s.dqd;
-        let ddqd = w + self.dls(&j, &(r - j * w));
+            let mut tw = Vector::<6>::zeros();
+            tw.fixed_rows_mut::<3>(0).copy_from(&c.dp);
+            if self.orients {
+                tw.fixed_rows_mut::<3>(3).copy_from(&c.w);
+            }
+            (
+                Setpoint {
+                    x: s.qc,
+                    dx: s.dqc,
+                    ddx: ddqc,
+                },
+                tw,
+            )
+        };
         let reference = Setpoint {
             x: s.qd,
             dx: s.dqd,
@@ -635,8 +779,19 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         }
         s.dqd += ts * ddqd;
         s.qd += ts * s.dqd;
+        if cfg.formulation != Formulation::Admittance {
+            s.dqc += ts * commanded.ddx;
+            s.qc += ts * s.dqc;
+        }
         s.k += 1;
-        for (what, v) in [("ddqd", &ddqd), ("qd", &s.qd), ("dqd", &s.dqd)] {
+        for (what, v) in [
+            ("ddqd", &ddqd),
+            ("qd", &s.qd),
+            ("dqd", &s.dqd),
+            ("ddqc", &commanded.ddx),
+            ("qc", &s.qc),
+            ("dqc", &s.dqc),
+        ] {
             check::within(what, v.as_slice(), BOUND)?;
         }
         for (what, v) in [("pd", &s.pd), ("dpd", &s.dpd), ("ddpd", &ddpd)] {
@@ -647,11 +802,48 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         }
         Ok(OuterStep {
             reference,
+            commanded,
+            twist: twist_c,
+            damping: damping_used,
             compliant,
             target: (pt, qt),
             error,
             next: s,
         })
+    }
+
+    /// The torque-level part of (19.2) for a staged step at the measured
+    /// tip `tip` (pose and Jacobian at the measured q): the spring K̃ e with
+    /// e = [clip(p_t − p); clip(Log(R_t Rᵀ))] (16.5), the damping and the
+    /// commanded twist, the task Jacobian and (C3)'s damping, the
+    /// admittance's share.
+    pub fn task_torque(&self, staged: &OuterStep<N>, tip: &Tip<N>) -> TaskTorque<N> {
+        let cfg = &self.cfg;
+        let j = self.select_jacobian(tip.jacobian);
+        let k = staged.next.stiffness_filtered;
+        let mut e = Vector::<6>::zeros();
+        let ep = clip(
+            &(staged.target.0 - tip.position),
+            cfg.pos_error_max.unwrap_or(f64::INFINITY),
+        );
+        e.fixed_rows_mut::<3>(0).copy_from(&ep);
+        if self.orients {
+            let r = UnitQuaternion::from_rotation_matrix(&tip.rotation);
+            let eo = clip(
+                &rotation_error(&staged.target.1, &r),
+                cfg.rot_error_max.unwrap_or(f64::INFINITY),
+            );
+            e.fixed_rows_mut::<3>(3).copy_from(&eo);
+        }
+        TaskTorque {
+            commanded: staged.commanded,
+            jacobian: j,
+            spring: self.select(k.component_mul(&e)),
+            damping: self.select(staged.damping),
+            twist: self.select(staged.twist),
+            lambda2: self.lambda2,
+            share: cfg.formulation.share(cfg.admittance_share),
+        }
     }
 
     /// [`stage`](Self::stage) and commit: the joint reference at t_k, for a

@@ -3,10 +3,11 @@
 //! wrench, an optional pose target), transactional, allocation-free.
 
 use crate::cartesian::kinematics::Kinematics;
+use crate::cartesian::outer::Formulation;
 use crate::cartesian::outer::{CartesianImpedance, CartesianState, CompliantPose, PoseTarget};
 use crate::control::controller::Controller;
 use crate::control::impedance::ImpedanceMode;
-use crate::control::io::{Command, Measurement};
+use crate::control::io::{Command, Measurement, TaskTorque};
 use crate::control::state::State;
 use crate::error::{check, Error, BOUND};
 use crate::networks::rbf::Basis;
@@ -34,6 +35,9 @@ pub struct CartesianCommand<const N: usize> {
     pub joint: Command<N>,
     /// The joint reference q_d, q̇_d, q̈_d (rad, rad/s, rad/s²) at t_k.
     pub reference: Setpoint<N>,
+    /// The commanded joint reference q_c, q̇_c, q̈_c at t_k (SPEC §19; the
+    /// reference itself for the admittance formulation).
+    pub commanded: Setpoint<N>,
     /// The compliant reference pose at t_k.
     pub compliant: CompliantPose,
     /// The commanded pose at t_k after the target filter (p_t (m), R_t).
@@ -103,9 +107,12 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
         target: Option<&PoseTarget>,
     ) -> Result<CartesianCommand<N>, Error> {
         let mut reached = false;
-        let result = self.outer.step_with(outer, m, target, |meas, r| {
+        let result = self.outer.step_with(outer, m, target, |meas, r, task| {
             reached = true;
-            self.inner.step(inner, meas, r)
+            match task {
+                Some(t) => self.inner.step_task(inner, meas, r, t),
+                None => self.inner.step(inner, meas, r),
+            }
         });
         if let (Err(e), false) = (&result, reached) {
             let meas = Measurement {
@@ -138,11 +145,12 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
 
 impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
     /// The Cartesian step with any joint controller `joint` (C5): stage the
-    /// outer loop, call `joint(measurement, reference)` with the joint
-    /// reference (q_d, q̇_d, q̈_d) and τe = Jᵀ(q) F_e (zero without
-    /// `force_feedforward`), and commit the outer state only if it succeeds.
-    /// [`CartesianController::step`] is this with the core's joint
-    /// controller; a binding passes its own.
+    /// outer loop, call `joint(measurement, reference, task)` with the joint
+    /// reference (q_d, q̇_d, q̈_d), τe = Jᵀ(q) F_e (zero without
+    /// `force_feedforward`) and, for the formulations other than admittance,
+    /// the torque-level part (SPEC §19, [`TaskTorque`]), and commit the
+    /// outer state only if it succeeds. [`CartesianController::step`] is
+    /// this with the core's joint controller; a binding passes its own.
     pub fn step_with<F>(
         &self,
         outer: &mut CartesianState<N>,
@@ -151,7 +159,11 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         joint: F,
     ) -> Result<CartesianCommand<N>, Error>
     where
-        F: FnOnce(&Measurement<N>, &Setpoint<N>) -> Result<Command<N>, Error>,
+        F: FnOnce(
+            &Measurement<N>,
+            &Setpoint<N>,
+            Option<&TaskTorque<N>>,
+        ) -> Result<Command<N>, Error>,
     {
         check::finite_slice("q", m.q.as_slice())?;
         check::within("q", m.q.as_slice(), BOUND)?;
@@ -167,11 +179,14 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             dx: m.dq,
             tau_e,
         };
-        let joint = joint(&meas, &staged.reference)?;
+        let task = (self.config().formulation != Formulation::Admittance)
+            .then(|| self.task_torque(&staged, &tip));
+        let joint = joint(&meas, &staged.reference, task.as_ref())?;
         *outer = staged.next;
         Ok(CartesianCommand {
             joint,
             reference: staged.reference,
+            commanded: staged.commanded,
             compliant: staged.compliant,
             target: staged.target,
             error: staged.error,

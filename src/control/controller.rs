@@ -17,7 +17,7 @@
 use crate::control::auxiliary::Auxiliary;
 use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound};
 use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
-use crate::control::io::{Command, Control, Measurement};
+use crate::control::io::{Command, Control, Measurement, TaskTorque};
 use crate::control::observer::{HighGainObserver, ObserverState};
 use crate::control::robust::Robust;
 use crate::control::safety::{Fallback, Fault, FaultPolicy};
@@ -29,6 +29,7 @@ use crate::networks::rbf::{Basis, Grid};
 use crate::networks::simd::SimdPath;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
+use nalgebra::SMatrix;
 
 /// The smallest inertia scale d (kg m²) and Young weight ρ (1/s), SPEC §10:
 /// 1/d and 1/ρ multiply Δτ, so a smaller one could take ζ beyond [`BOUND`].
@@ -84,6 +85,44 @@ impl<const N: usize> Errors<N> {
             z2: self.z2.component_mul(inertia),
             ..self.signals()
         }
+    }
+}
+
+/// The torque-level terms of a step of (19.2).
+#[derive(Copy, Clone, Debug)]
+struct Task<const N: usize> {
+    /// (7), (8) on the commanded reference.
+    errors: Errors<N>,
+    /// Jᵀ(K̃e + B ė) + Π (z1_c + Kp z2_c + r(z2_c)) (N m), (19.3).
+    torque: Vector<N>,
+    /// The admittance's share n.
+    share: f64,
+    /// The commanded joint reference (q_c, q̇_c, q̈_c).
+    commanded: Setpoint<N>,
+}
+
+impl<const N: usize> Task<N> {
+    /// The learning signals of (19.2): the regressors n α̇1 + (1 − n) q̈_c,
+    /// n α1 + (1 − n) q̇_c and the paper's z2 of `e` (on the compliant
+    /// reference: the networks learn what the impedance leaves undone, never
+    /// the contact force it prescribes), weighted d∘z2 by the inertia scales
+    /// as (10.2).
+    fn signals(&self, e: &Errors<N>, inertia: &Vector<N>) -> Signals<N> {
+        let n = self.share;
+        Signals {
+            dalpha1: n * e.dalpha1 + (1.0 - n) * self.commanded.ddx,
+            alpha1: n * e.alpha1 + (1.0 - n) * self.commanded.dx,
+            z2: e.z2.component_mul(inertia),
+        }
+    }
+
+    /// The networks' input [x; v] of (19.2): n [q; v] + (1 − n) [q_c; q̇_c].
+    fn input(&self, x: &Vector<N>, v: &Vector<N>) -> (Vector<N>, Vector<N>) {
+        let n = self.share;
+        (
+            n * x + (1.0 - n) * self.commanded.x,
+            n * v + (1.0 - n) * self.commanded.dx,
+        )
     }
 }
 
@@ -407,7 +446,46 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         m: &Measurement<N>,
         c: &Setpoint<N>,
     ) -> Result<Command<N>, Error> {
-        match self.try_step(st, m, c) {
+        self.step_inner(st, m, c, None)
+    }
+
+    /// One step of the torque-level formulations of a Cartesian impedance
+    /// (SPEC §19, (19.2)), with `impedance = "external"`: `c` is the
+    /// compliant joint reference (q_d, q̇_d, q̈_d), `task` the torque-level
+    /// part. With n = `task.share`,
+    ///
+    /// ```text
+    /// τ = n [Kp z2 + r(z2) + d∘z1 + τe] + (1 − n) [Jᵀ(K̃e + B(ṗ_c − J v)) + Π (d∘z1_c + Kp z2_c + r(z2_c))]
+    ///     + Kp ζ + ŴD S α̇ + ŴC S α + ŴG S
+    /// ```
+    ///
+    /// (the z1 terms, τe and the networks for the learning laws only; d the
+    /// inertia scales of SPEC (10.2)), with the regressors α = n α1 + (1 −
+    /// n) q̇_c, α̇ = n α̇1 + (1 − n) q̈_c and the input n [q; v] + (1 − n)
+    /// [q_c; q̇_c], where z1_c, z2_c are (6), (8) on the commanded reference
+    /// and Π is (19.3); the networks learn from the paper's z2 on the
+    /// compliant reference. With n = 1 it is [`step`](Self::step) (the same
+    /// result); transactional as [`step`](Self::step).
+    pub fn step_task<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+        task: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error> {
+        self.step_inner(st, m, c, Some(task))
+    }
+
+    /// [`step`](Self::step) or [`step_task`](Self::step_task): the step, and
+    /// on a refusal its record.
+    fn step_inner<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+        task: Option<&TaskTorque<N>>,
+    ) -> Result<Command<N>, Error> {
+        match self.try_step(st, m, c, task) {
             Ok(cmd) => Ok(cmd),
             Err(error) => {
                 self.refuse_measured(st, m, error);
@@ -577,6 +655,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         st: &mut State<N, S>,
         m: &Measurement<N>,
         c: &Setpoint<N>,
+        task: Option<&TaskTorque<N>>,
     ) -> Result<Command<N>, Error> {
         if let (FaultPolicy::Latch, Some(f)) = (self.cfg.fault_policy, st.fault) {
             return Err(Error::Faulted {
@@ -596,13 +675,41 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         let v = self.velocity(st.k, &mut staged.observer, m)?;
         let e = self.errors(&staged.reference, c, m, &v);
         self.check_bounded(st, &e, &v)?;
+        let task = match task {
+            // n = 1 is the admittance law itself, bit for bit.
+            Some(t) if t.share < 1.0 => Some(self.task_terms(t, m, &v)?),
+            Some(t) => {
+                Self::check_share(t.share)?;
+                None
+            }
+            None => None,
+        };
+        if let Some(t) = &task {
+            // The commanded errors within BOUND, and the weights within it
+            // after the update with the blended regressors (19.2).
+            for (what, x) in [
+                ("z1_c", &t.errors.z1),
+                ("alpha1_c", &t.errors.alpha1),
+                ("z2_c", &t.errors.z2),
+                ("dalpha1_c", &t.errors.dalpha1),
+            ] {
+                check::within(what, x.as_slice(), BOUND)?;
+            }
+            if self.cfg.law.learns() {
+                self.learning.check_bounded(
+                    &st.norms,
+                    &t.signals(&e, &self.cfg.inertia),
+                    self.basis.nodes(),
+                )?;
+            }
+        }
         // The reference this step would commit, within the ceilings.
         let mut next = staged.reference;
         next.advance(&e.ddxd, self.cfg.ts);
         self.cfg.limits.check_reference(&next)?;
         // Every check has passed: from here on the state changes, and with
         // every signal and weight within BOUND nothing below can overflow.
-        let cmd = self.command(st, m, c, &e, &v, &staged.reference)?;
+        let cmd = self.command(st, m, c, &e, &v, &staged.reference, task.as_ref())?;
         staged.reference = next;
         self.advance(st, staged, m, &e, &cmd);
         Ok(cmd)
@@ -639,6 +746,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// Stages "robust term", "networks", "saturation" and "learning": the
     /// command of the step (SPEC §7), the rate limit and the saturation, and
     /// the weights' update.
+    #[allow(clippy::too_many_arguments)]
     fn command<S: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
         st: &mut State<N, S>,
@@ -647,15 +755,33 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         e: &Errors<N>,
         v: &Vector<N>,
         reference: &Reference<N>,
+        task: Option<&Task<N>>,
     ) -> Result<Command<N>, Error> {
         let learns = self.cfg.law.learns();
-        let sig = e.signals_scaled(&self.cfg.inertia);
-        let mut tau = self.feedback(e, &st.zeta);
+        let d = &self.cfg.inertia;
+        let (sig, mut tau) = match task {
+            None => (e.signals_scaled(d), self.feedback(e, &st.zeta)),
+            Some(t) => {
+                // (19.2): the admittance's share and the torque-level part.
+                let n = t.share;
+                let mut adm = self.cfg.kp.component_mul(&e.z2)
+                    + self.robust.eval(&e.z2, &e.alpha1, &e.dalpha1);
+                if learns {
+                    adm += e.z1.component_mul(d) + m.tau_e;
+                }
+                let tau = n * adm + (1.0 - n) * t.torque + self.cfg.kp.component_mul(&st.zeta);
+                (t.signals(e, d), tau)
+            }
+        };
         let w_norms = if learns {
             let before = st.norms;
-            // (14), (35) with +z1 (erratum, SPEC §7), weighted d∘z1 (SPEC (10.2)).
-            tau +=
-                e.z1.component_mul(&self.cfg.inertia) + self.networks(st, &m.x, v, &sig) + m.tau_e;
+            if task.is_none() {
+                // (14), (35) with +z1 (erratum, SPEC §7), weighted d∘z1 (SPEC (10.2)).
+                tau += e.z1.component_mul(d) + self.networks(st, &m.x, v, &sig) + m.tau_e;
+            } else {
+                let (x, v) = task.map_or((m.x, *v), |t| t.input(&m.x, v));
+                tau += self.networks(st, &x, &v, &sig);
+            }
             before
         } else {
             [0.0; 3]
@@ -678,7 +804,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             dtau,
             z1: e.z1,
             z2: e.z2,
-            xc: c.x,
+            xc: task.map_or(c.x, |t| t.commanded.x),
             xd: reference.xd,
             v: *v,
             zeta: st.zeta,
@@ -789,6 +915,69 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             z2: alpha1 - v,
             dalpha1: ddxd + k1.component_mul(&(r.dxd - v)),
         }
+    }
+
+    /// 0 ≤ n ≤ 1.
+    fn check_share(share: f64) -> Result<(), Error> {
+        check::finite_slice("share", &[share])?;
+        check::nonnegative("0 ≤ admittance_share ≤ 1", "admittance_share", share)?;
+        check::at_most("0 ≤ admittance_share ≤ 1", "admittance_share", share, 1.0)
+    }
+
+    /// The torque-level part of (19.2) at the velocity `v` (rad/s): the
+    /// errors (7), (8) on the commanded reference and
+    /// `Jᵀ(K̃e + B(ṗ_c − J v)) + N (z1_c + Kp N z2_c + r(N z2_c))` (N m;
+    /// z1_c for the learning laws only). Checks its inputs (finite, within
+    /// [`BOUND`], 0 ≤ n ≤ 1).
+    fn task_terms(
+        &self,
+        t: &TaskTorque<N>,
+        m: &Measurement<N>,
+        v: &Vector<N>,
+    ) -> Result<Task<N>, Error> {
+        Self::check_share(t.share)?;
+        for (what, x) in [
+            ("xc", t.commanded.x.as_slice()),
+            ("dxc", t.commanded.dx.as_slice()),
+            ("ddxc", t.commanded.ddx.as_slice()),
+            ("jacobian", t.jacobian.as_slice()),
+            ("spring", t.spring.as_slice()),
+            ("damping", t.damping.as_slice()),
+            ("twist", t.twist.as_slice()),
+            ("lambda2", t.lambda2.as_slice()),
+        ] {
+            check::finite_slice(what, x)?;
+            check::within(what, x, BOUND)?;
+        }
+        let errors = self.errors(&Reference::start(&t.commanded), &t.commanded, m, v);
+        let j = &t.jacobian;
+        let force = t.spring + t.damping.component_mul(&(t.twist - j * v));
+        // (19.3) the joint law's feedback without its task part:
+        // Π τ = τ − Jᵀ (J Kp⁻¹ Jᵀ + Λ² k̄⁻¹)⁻¹ J Kp⁻¹ τ, so Π Kp = Kp − Jᵀ Λ_K J ≼ Kp.
+        let kinv = self.cfg.kp.map(|k| 1.0 / k);
+        let kbar = kinv.sum() / N as f64;
+        let jk = SMatrix::<f64, 6, N>::from_fn(|r, c| j[(r, c)] * kinv[c]);
+        let a = jk * j.transpose() + SMatrix::<f64, 6, 6>::from_diagonal(&(kbar * t.lambda2));
+        let mut inner = self.cfg.kp.component_mul(&errors.z2)
+            + self
+                .robust
+                .eval(&errors.z2, &errors.alpha1, &errors.dalpha1);
+        if self.cfg.law.learns() {
+            inner += errors.z1.component_mul(&self.cfg.inertia);
+        }
+        let ch = a.cholesky();
+        let null = |tau: &Vector<N>| match &ch {
+            Some(ch) => tau - j.transpose() * ch.solve(&(jk * tau)),
+            None => Vector::zeros(),
+        };
+        let torque = j.transpose() * force + null(&inner);
+        check::within("tau_task", torque.as_slice(), BOUND)?;
+        Ok(Task {
+            errors,
+            torque,
+            share: t.share,
+            commanded: t.commanded,
+        })
     }
 
     /// Stage "robust term" with the feedback it adds to: `Kp (z2 + ζ) + r(z2)`

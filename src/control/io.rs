@@ -18,6 +18,33 @@ pub struct Measurement<const N: usize> {
     pub tau_e: Vector<N>,
 }
 
+/// The torque-level part of a Cartesian impedance, for the joint step of the
+/// formulations "impedance" and "unified" (SPEC §19, (19.2)): everything the
+/// joint law needs besides the compliant reference, none of it carrying the
+/// measured wrench.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct TaskTorque<const N: usize> {
+    /// The commanded joint reference q_c, q̇_c, q̈_c (rad, rad/s, rad/s²): the
+    /// inverse kinematics of the commanded pose alone (19.1).
+    pub commanded: Setpoint<N>,
+    /// The task Jacobian J(q) at the measured q (6 × N; the rotation rows zero
+    /// for a position-only task).
+    pub jacobian: nalgebra::SMatrix<f64, 6, N>,
+    /// The spring K̃ e (N, N m) at the measured pose, e = [p_t − p; Log(R_t Rᵀ)]
+    /// (clipped as (16.5)).
+    pub spring: Vector<6>,
+    /// The damping B (N s/m, N m s/rad) per task axis.
+    pub damping: Vector<6>,
+    /// The commanded twist [ṗ_c; ω_c] (m/s, rad/s).
+    pub twist: Vector<6>,
+    /// The damping Λ² of the least-squares inverse per task row, (C3)
+    /// (m², 1): the joint law regularises its task projection with it.
+    pub lambda2: Vector<6>,
+    /// The admittance's share n ∈ [0, 1] of the torque (0: torque-level
+    /// impedance, 1: the admittance law alone).
+    pub share: f64,
+}
+
 /// What one step computed. `tau_sat` goes to the actuators; the rest is for logging.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Command<const N: usize> {

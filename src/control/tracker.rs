@@ -5,7 +5,7 @@
 use crate::control::config::Law;
 use crate::control::controller::Controller;
 use crate::control::impedance::TargetImpedance;
-use crate::control::io::{Command, Control, Measurement};
+use crate::control::io::{Command, Control, Measurement, TaskTorque};
 use crate::control::state::HeapState;
 use crate::error::Error;
 use crate::networks::rbf::{Basis, Grid};
@@ -51,6 +51,19 @@ impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Tracker<N, B, T> {
     #[inline]
     pub fn step_with(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
         self.ctrl.step(&mut self.state, m, c)
+    }
+
+    /// One step of the torque-level formulations of a Cartesian impedance
+    /// with the compliant reference `c` and the torque-level part `task`
+    /// ([`Controller::step_task`], SPEC §19; the clock still advances).
+    #[inline]
+    pub fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+        task: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error> {
+        self.ctrl.step_task(&mut self.state, m, c, task)
     }
 
     /// [`step`](Self::step), and the torque to apply whatever happened (the

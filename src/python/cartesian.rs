@@ -167,11 +167,20 @@ pub struct StepIn<'a> {
     pub target: Option<PoseTarget>,
 }
 
-/// A joint controller written in the caller's language: given q, q̇, τe and
-/// the joint reference (q_d, q̇_d, q̈_d), write the torque to apply into the
-/// last slice.
-pub type JointFn<'a> =
-    dyn FnMut(&[f64], Option<&[f64]>, &[f64], [&[f64]; 3], &mut [f64]) -> Result<(), Error> + 'a;
+/// A joint controller written in the caller's language: given q, q̇, τe, the
+/// joint reference (q_d, q̇_d, q̈_d; for the torque-level formulations the
+/// commanded q_c, q̇_c, q̈_c) and, for those, the task torque
+/// Jᵀ(K̃e + B(ṗ_c − J q̇)) (n) with the task Jacobian (6 × n, row-major),
+/// write the torque to apply into the last slice.
+pub type JointFn<'a> = dyn FnMut(
+        &[f64],
+        Option<&[f64]>,
+        &[f64],
+        [&[f64]; 3],
+        Option<(&[f64], &[f64])>,
+        &mut [f64],
+    ) -> Result<(), Error>
+    + 'a;
 
 /// The outer loop over a chain, for any n ≤ 7, with its state.
 pub trait DynOuter: Send + Sync {
@@ -304,6 +313,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         let cmd = CartesianCommand {
             joint: Command::zeros(),
             reference: staged.reference,
+            commanded: staged.commanded,
             compliant: staged.compliant,
             target: staged.target,
             error: staged.error,
@@ -329,27 +339,45 @@ impl<const N: usize> DynOuter for Outer<N> {
     }
     fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error> {
         let meas = Self::measurement(m);
-        let cmd = self
-            .outer
-            .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r| {
-                let mut tau = [0.0; MAX_JOINTS];
-                joint(
-                    jm.x.as_slice(),
-                    jm.dx.as_ref().map(|d| d.as_slice()),
-                    jm.tau_e.as_slice(),
-                    [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
-                    &mut tau[..N],
-                )?;
-                let t = vector_of::<N>(&tau);
-                Ok(Command {
-                    tau_sat: t,
-                    tau: t,
-                    z1: r.x - jm.x,
-                    xc: r.x,
-                    xd: r.x,
-                    ..Command::zeros()
-                })
-            })?;
+        let cmd =
+            self.outer
+                .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r, task| {
+                    let mut tau = [0.0; MAX_JOINTS];
+                    let (reference, extra) = match task {
+                        // The torque-level formulations (SPEC §19): the commanded
+                        // reference and the task torque at the measured q̇.
+                        Some(t) if t.share < 1.0 => {
+                            let dq = jm.dx.ok_or(Error::MissingVelocity)?;
+                            let force =
+                                t.spring + t.damping.component_mul(&(t.twist - t.jacobian * dq));
+                            let torque = t.jacobian.transpose() * force;
+                            let rows = t.jacobian.transpose();
+                            (t.commanded, Some((torque, rows)))
+                        }
+                        _ => (*r, None),
+                    };
+                    joint(
+                        jm.x.as_slice(),
+                        jm.dx.as_ref().map(|d| d.as_slice()),
+                        jm.tau_e.as_slice(),
+                        [
+                            reference.x.as_slice(),
+                            reference.dx.as_slice(),
+                            reference.ddx.as_slice(),
+                        ],
+                        extra.as_ref().map(|(t, j)| (t.as_slice(), j.as_slice())),
+                        &mut tau[..N],
+                    )?;
+                    let t = vector_of::<N>(&tau);
+                    Ok(Command {
+                        tau_sat: t,
+                        tau: t,
+                        z1: r.x - jm.x,
+                        xc: r.x,
+                        xd: r.x,
+                        ..Command::zeros()
+                    })
+                })?;
         self.last = Some(LastStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
     }
@@ -936,6 +964,7 @@ impl PyCartesian {
                         dq: Option<&[f64]>,
                         tau_e: &[f64],
                         r: [&[f64]; 3],
+                        task: Option<(&[f64], &[f64])>,
                         out: &mut [f64]|
          -> Result<(), Error> {
             let result = (|| -> PyResult<Vec<f64>> {
@@ -943,6 +972,12 @@ impl PyCartesian {
                 kw.set_item("xc", array1(py, r[0]))?;
                 kw.set_item("dxc", array1(py, r[1]))?;
                 kw.set_item("ddxc", array1(py, r[2]))?;
+                if let Some((torque, jt)) = task {
+                    // Jᵀ is n × 6 column-major: J (6 × n) row-major.
+                    kw.set_item("task_torque", array1(py, torque))?;
+                    let j = numpy::PyArray1::from_slice(py, jt).reshape([6, torque.len()])?;
+                    kw.set_item("jacobian", j)?;
+                }
                 let dq = dq.map(|d| array1(py, d));
                 let tau =
                     inner.call_method("step", (array1(py, q), array1(py, tau_e), dq), Some(&kw))?;

@@ -209,9 +209,12 @@ pub(crate) fn cartesian_step<const N: usize>(
     target: Option<&PoseTarget>,
 ) -> Result<CartesianCommand<N>, Error> {
     let mut ran = false;
-    let result = outer.step_with(state, m, target, |jm, r| {
+    let result = outer.step_with(state, m, target, |jm, r, task| {
         ran = true;
-        joint.step_with(jm, r)
+        match task {
+            Some(t) => joint.step_task(jm, r, t),
+            None => joint.step_with(jm, r),
+        }
     });
     if let Err(e) = result {
         if !ran {

@@ -1,0 +1,389 @@
+"""Contact that holds (SPEC §19, ``docs/contact.md``): the table scenario on any arm.
+
+:func:`arm_table` builds the scenario "panda-table" (:mod:`adaptimp.panda_table`)
+for any serial arm given as a URDF: the arm in MuJoCo with a tool sphere and a
+force/torque sensor at its tip, a table in front of it, the path (an approach
+from the home posture to a point δ_c below the table's surface, then a 5 cm
+circle at 0.25 Hz on it), placed from the arm's reach at its home posture. The
+table is rigid (MuJoCo's contact) or, with ``spring=k_e``, mounted on a
+vertical spring of stiffness k_e (N/m): a compliant environment where SPEC
+(16.1) prescribes the force.
+
+:func:`contact_metrics` gives a run's metrics under the names of the
+scenario's JSON table: ``track_mm``, ``force_rms_err_N``, ``force_target_N``,
+``force_chatter_N``, ``contact_lost_s``, ``peak_tau_ratio``, ``sat_duty``.
+
+MuJoCo and Pinocchio are imported when a function needs them. Units: m, s,
+rad, N, N m, kg.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .chain import Chain
+from .panda_table import PandaTable, cartesian_metrics
+
+__all__ = [
+    "CLEARANCE",
+    "OUTWARD",
+    "REACH_SHARE",
+    "TABLE_MASS",
+    "arm_model",
+    "arm_table",
+    "contact_metrics",
+    "placement",
+]
+
+FloatArray = NDArray[np.float64]
+
+CLEARANCE = 0.027
+"""Gap (m) between the tool sphere at the home posture and the table top (the
+Panda scenario's)."""
+
+OUTWARD = 0.10
+"""How far (m) beyond the home TCP, away from the base's vertical axis, the
+circle's centre lies (horizontally)."""
+
+REACH_SHARE = 0.7
+"""The circle's centre lies at most this share of the arm's horizontal reach
+from the base's vertical axis."""
+
+TABLE_MASS = 1.0
+"""Mass (kg) of a spring-mounted table top (``spring=``); critically damped, its
+weight carried by the spring's preload (the top at rest where the rigid one is)."""
+
+
+def _tool_and_table(
+    spec: Any,
+    tip: str,
+    *,
+    tool_radius: float,
+    table_top: float | None,
+    centre: ArrayLike,
+    friction: float,
+    spring: float | None,
+) -> None:
+    """Add the tool: a massless body ``tool`` at the origin of the tip body with
+    the sphere (the arm's only collision geometry) and the site ``ee`` with
+    force/torque sensors; and the table (static, or on a vertical slide joint
+    with stiffness ``spring`` N/m)."""
+    import mujoco
+
+    parent = spec.body(tip)
+    if parent is None:
+        raise ValueError(f"the model has no body {tip!r} for the tool")
+    # A massless body of its own at the tip's origin: its force sensor reads
+    # the contact alone (on a body with mass it would add its weight).
+    body = parent.add_body(name="tool")
+    body.add_site(name="ee", size=[0.01, 0, 0])
+    body.add_geom(
+        name="tool",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[tool_radius, 0, 0],
+        contype=1,
+        conaffinity=1,
+        mass=0.0,
+        density=0.0,
+        friction=[friction, 0.005, 0.0001],
+    )
+    for name, kind in (("ee_force", "mjSENS_FORCE"), ("ee_torque", "mjSENS_TORQUE")):
+        spec.add_sensor(
+            name=name,
+            type=getattr(mujoco.mjtSensor, kind),
+            objtype=mujoco.mjtObj.mjOBJ_SITE,
+            objname="ee",
+        )
+    if table_top is None:
+        return
+    thickness = 0.05
+    c = np.asarray(centre, dtype=np.float64)
+    table = spec.worldbody.add_body(
+        name="table", pos=[float(c[0]), float(c[1]), table_top - thickness / 2]
+    )
+    if spring is not None:
+        table.add_joint(
+            name="table_spring",
+            type=mujoco.mjtJoint.mjJNT_SLIDE,
+            axis=[0, 0, 1],
+            stiffness=spring,
+            damping=2.0 * math.sqrt(spring * TABLE_MASS),
+            # At rest under its weight the top is at table_top: the spring
+            # carries the table (g = 9.81 m/s², MuJoCo's default).
+            springref=TABLE_MASS * 9.81 / spring,
+        )
+    table.add_geom(
+        name="table",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[0.35, 0.5, thickness / 2],
+        contype=1,
+        conaffinity=1,
+        friction=[friction, 0.005, 0.0001],
+        rgba=[0.6, 0.5, 0.4, 1.0],
+        mass=TABLE_MASS,
+    )
+
+
+def arm_model(
+    urdf: str | os.PathLike[str],
+    tip: str,
+    *,
+    fix: tuple[str, ...] = (),
+    tool_radius: float = 0.01,
+    table_top: float | None = None,
+    centre: ArrayLike = (0.0, 0.0),
+    friction: float = 0.1,
+    spring: float | None = None,
+    home: ArrayLike | None = None,
+    timestep: float = 5e-4,
+) -> Any:
+    """A URDF arm in MuJoCo with a tool and a table (see the module doc).
+
+    The arm as :func:`adaptimp.mujoco.from_urdf` makes it (rigid-body dynamics
+    only, a motor per joint with ctrlrange ± its effort limit, RK4), joints in
+    ``fix`` fixed at zero; the tool sphere of ``tool_radius`` (m) at the origin
+    of body ``tip`` with the site ``ee`` and its force/torque sensors; a 0.7 ×
+    1.0 m table whose top is at height ``table_top`` (m; None: no table),
+    centred at ``centre`` (x, y), sliding friction ``friction`` for the table
+    and the tool, rigid or on a vertical spring of ``spring`` N/m (a slide
+    joint, mass :data:`TABLE_MASS`, critically damped). Keyframe ``home``.
+    """
+    import mujoco
+
+    from . import mujoco as amj
+
+    spec, effort = amj._urdf_spec(Path(urdf).read_text(), fix)
+    spec.option.timestep = timestep
+    missing = [j.name for j in spec.joints if j.name not in effort]
+    if missing:
+        raise ValueError(f"URDF joints without <limit effort=...>: {missing}")
+    amj._add_motors(spec, effort)
+    _tool_and_table(
+        spec,
+        tip,
+        tool_radius=tool_radius,
+        table_top=table_top,
+        centre=centre,
+        friction=friction,
+        spring=spring,
+    )
+    if home is not None:
+        qpos = list(np.asarray(home, dtype=np.float64))
+        if spring is not None:
+            qpos.append(0.0)
+        spec.add_key(name="home", qpos=qpos)
+    model = spec.compile()
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    return model
+
+
+def placement(
+    chain: Chain,
+    home: ArrayLike,
+    limits: tuple[ArrayLike, ArrayLike],
+    *,
+    tool_radius: float = 0.01,
+    seed: int = 0,
+) -> tuple[FloatArray, float, float]:
+    """Where the table and the circle go for an arm at ``home`` (rad), from its
+    reach (SPEC §19, "the scenario on any arm").
+
+    With p_h the tip at home and u the horizontal unit vector from the base's
+    vertical axis to p_h: the circle's centre lies :data:`OUTWARD` beyond p_h
+    along u, but at most :data:`REACH_SHARE` of the horizontal reach R (the
+    largest horizontal distance of the tip over 1024 postures drawn uniformly
+    within ``limits`` = (lo, hi) (rad), each clipped to ±π, seed ``seed``); the
+    table top lies :data:`CLEARANCE` below the tool sphere at home.
+
+    Returns (centre (2,) m, table top m, R m).
+    """
+    q = np.asarray(home, dtype=np.float64)
+    p = np.asarray(chain.fk(q)[:3, 3], dtype=np.float64)
+    lo = np.clip(np.asarray(limits[0], dtype=np.float64), -math.pi, math.pi)
+    hi = np.clip(np.asarray(limits[1], dtype=np.float64), -math.pi, math.pi)
+    samples = np.random.default_rng(seed).uniform(lo, hi, size=(1024, q.shape[0]))
+    reach = max(float(np.linalg.norm(chain.fk(s)[:2, 3])) for s in samples)
+    radial = float(np.linalg.norm(p[:2]))
+    u = p[:2] / radial if radial > 1e-9 else np.array([1.0, 0.0])
+    dist = min(radial + OUTWARD, REACH_SHARE * reach)
+    return dist * u, float(p[2] - tool_radius - CLEARANCE), reach
+
+
+def _limits(plant: Any) -> tuple[FloatArray, FloatArray]:
+    """The arm's joint ranges (rad) from the MuJoCo model (±π where unlimited)."""
+    m = plant.model
+    lo = np.full(plant.n, -math.pi)
+    hi = np.full(plant.n, math.pi)
+    for i, j in enumerate(plant._joints):
+        if m.jnt_limited[j]:
+            lo[i], hi[i] = m.jnt_range[j]
+    return lo, hi
+
+
+def _home(urdf: Path, chain: Chain, plant: Any) -> FloatArray:
+    """The rule's home posture (SPEC §18) if this version has it
+    (``adaptimp.mujoco.home_posture``), else the zero posture."""
+    from . import mujoco as amj
+
+    rule = getattr(amj, "home_posture", None)
+    if rule is not None:
+        return np.asarray(rule(plant), dtype=np.float64)
+    return np.zeros(chain.n)
+
+
+def arm_table(
+    urdf: str | os.PathLike[str] | None = None,
+    *,
+    tip: str | None = None,
+    fix: tuple[str, ...] = (),
+    home: ArrayLike | None = None,
+    spring: float | None = None,
+    friction: float = 0.1,
+    radius: float = 0.05,
+    freq: float = 0.25,
+    depth: float = 0.015,
+    tool_radius: float = 0.01,
+    Ts: float = 1e-3,
+    t_approach: float = 1.0,
+    t_ramp: float = 1.0,
+) -> PandaTable:
+    """The table scenario for the arm of ``urdf`` (None: the Panda of
+    :func:`adaptimp.panda_table.panda_table`, whose table and circle are kept).
+
+    ``tip``: the tool's body (default: :meth:`Chain.from_urdf`'s tip, the child
+    link of the last movable joint); ``home`` (rad): default the rule's home
+    posture; ``spring``: the table's spring stiffness k_e (N/m), None: rigid;
+    ``friction``: sliding friction of table and tool. The rest as
+    :func:`~adaptimp.panda_table.panda_table`. The table and the circle are
+    placed by :func:`placement`.
+    """
+    from . import _models
+    from . import mujoco as amj
+    from .baselines import pinocchio_model
+    from .panda_table import panda_table
+
+    if urdf is None:
+        sc = panda_table(
+            radius=radius,
+            freq=freq,
+            depth=depth,
+            friction=friction,
+            tool_radius=tool_radius,
+            Ts=Ts,
+            t_approach=t_approach,
+            t_ramp=t_ramp,
+        )
+        if spring is None:
+            return sc
+        model = arm_model(
+            _models.panda_urdf_path(),
+            _models.PANDA_EE,
+            fix=_models.PANDA_FINGERS,
+            tool_radius=tool_radius,
+            table_top=sc.surface_z - tool_radius,
+            centre=(0.55, 0.0),
+            friction=friction,
+            spring=spring,
+            home=sc.q0,
+        )
+        sc.model = model
+        return sc
+    from .chain import _default_tip, _read_urdf
+
+    path = Path(urdf)
+    if tip is None:
+        tip = _default_tip(*_read_urdf(path))
+    chain = Chain.from_urdf(path, tip=tip)
+    bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
+    q0 = _home(path, chain, bare) if home is None else np.asarray(home, dtype=np.float64)
+    centre, top, _ = placement(chain, q0, _limits(bare), tool_radius=tool_radius)
+    table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)
+    model = arm_model(
+        path,
+        tip,
+        fix=fix,
+        tool_radius=tool_radius,
+        table_top=top,
+        centre=table_centre,
+        friction=friction,
+        spring=spring,
+        home=q0,
+    )
+    return PandaTable(
+        model=model,
+        chain=chain,
+        q0=q0,
+        pin_model=pinocchio_model(path),
+        Ts=Ts,
+        radius=radius,
+        freq=freq,
+        centre=np.asarray(centre, dtype=np.float64),
+        depth=depth,
+        surface_z=top + tool_radius,
+        t_approach=t_approach,
+        t_ramp=t_ramp,
+        tau_max=np.asarray(bare.tau_max, dtype=np.float64),
+    )
+
+
+def contact_metrics(
+    res: Any, ctrl: Any, sc: PandaTable, *, settle: float = 2.0
+) -> dict[str, float]:
+    """The scenario's table of a run (``res`` from :func:`adaptimp.mujoco.simulate`),
+    over t ≥ ``settle`` (s) unless said:
+
+    - ``track_mm``: RMS ‖p_d − p‖ (mm), the compliant reference against the tip;
+    - ``force_target_N``: K_d,z δ_c, or for a spring table of k_e (16.1)'s
+      K_d k_e/(K_d + k_e) δ_c (N);
+    - ``force_rms_err_N``: RMS (F_n − target) (N), F_n = −F_e,z;
+    - ``force_chatter_N``: RMS (F_n,k+1 − F_n,k) (N), the sample-to-sample change;
+    - ``force_mean_N``: the mean of F_n (N);
+    - ``force_16_1_N``: what (16.1) prescribes with the measured mean n·e,
+      K_d k_e/(K_d + k_e)(δ_c + n·e) (K_d (δ_c + n·e) for a rigid table), n = −z,
+      e = p − p_d (N);
+    - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
+      after the end of the approach (all the time after it, if none);
+    - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
+    - ``sat_duty``: fraction of all rows with sat(τ_i) ≠ τ_i on some joint.
+    """
+    m = cartesian_metrics(res, ctrl, sc, settle=settle)
+    kd = float(np.asarray(ctrl.params["Kd"])[2])
+    spring = _spring(sc)
+    target = kd * sc.depth if spring is None else kd * spring / (kd + spring) * sc.depth
+    fn = -np.asarray(res.wrench_ee)[:, 2]
+    t = np.asarray(res.t)
+    after = t >= settle - 1e-9
+    # (16.1) with the measured n·e, n = −z (into the table), e = p − p_d.
+    series = kd if spring is None else kd * spring / (kd + spring)
+    ne = ctrl.arrays()["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
+    approach = t >= sc.t_approach - 1e-9
+    contact = np.flatnonzero(approach & (fn > 0))
+    # Never touched after the approach: all of that time is without contact.
+    start = contact[0] if contact.size else int(np.argmax(approach))
+    lost = float(np.sum(fn[start:] <= 0) * sc.Ts) if approach.any() else 0.0
+    return {
+        "track_mm": m["rms_track"] * 1e3,
+        "force_rms_err_N": float(np.sqrt(np.mean((fn[after] - target) ** 2))),
+        "force_target_N": float(target),
+        "force_chatter_N": float(np.sqrt(np.mean(np.diff(fn[after]) ** 2))),
+        "force_mean_N": float(np.mean(fn[after])),
+        "force_16_1_N": float(series * (sc.depth + np.mean(ne))),
+        "contact_lost_s": lost,
+        "peak_tau_ratio": m["peak_tau_ratio"],
+        "sat_duty": m["sat_duty"],
+        "applied_ratio": m["applied_ratio"],
+    }
+
+
+def _spring(sc: PandaTable) -> float | None:
+    """The table's spring stiffness (N/m), None for a rigid table."""
+    import mujoco
+
+    j = mujoco.mj_name2id(sc.model, mujoco.mjtObj.mjOBJ_JOINT, "table_spring")
+    return None if j < 0 else float(sc.model.jnt_stiffness[j])

@@ -297,13 +297,15 @@ fn pair_formulated(law: AdaptimpLaw, core_law: Law, form: AdaptimpFormulation) -
     let mut cart = cart_defaults();
     cart.formulation = form.into();
     cart.admittance_share = 0.3;
-    let mut config = CartesianConfig::default();
-    config.formulation = match form {
-        AdaptimpFormulation::Admittance => Formulation::Admittance,
-        AdaptimpFormulation::Impedance => Formulation::Impedance,
-        AdaptimpFormulation::Unified => Formulation::Unified,
+    let config = CartesianConfig {
+        formulation: match form {
+            AdaptimpFormulation::Admittance => Formulation::Admittance,
+            AdaptimpFormulation::Impedance => Formulation::Impedance,
+            AdaptimpFormulation::Unified => Formulation::Unified,
+        },
+        admittance_share: 0.3,
+        ..CartesianConfig::default()
     };
-    config.admittance_share = 0.3;
     let core = core_chain();
     let tip0 = core.tip(&Vector::from(Q0), &Vector::zeros());
     let (p0, r0) = (tip0.position, *tip0.rotation.matrix());

@@ -525,9 +525,9 @@ impl<'a> Reader<'a> {
 mod tests {
     use super::*;
     use crate::control::config::Law;
+    use crate::control::controller::Controller;
     use crate::control::io::Measurement;
     use crate::trajectory::{Sinusoid, Trajectory};
-    use crate::Controller;
 
     /// A snapshot after 200 steps of `c` on a slow motion.
     fn stepped(c: &Controller<2>) -> alloc::vec::Vec<f64> {

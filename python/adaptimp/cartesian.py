@@ -369,6 +369,10 @@ class CartesianController:
                     "(the Cartesian impedance is the only one, SPEC §16)"
                 )
             joint["impedance"] = "external"
+            # The chain fixes n; an n given too (e.g. in tuning.suggest's keywords) must agree.
+            n = joint.pop("n", chain.n)
+            if n != chain.n:
+                raise ConfigError(f"n = {n!r}, but the chain has {chain.n} joints")
             inner: Any = Controller(
                 controller,
                 scenario,

@@ -373,3 +373,24 @@ def test_a_long_run_in_parts_is_the_whole_run(sc: ac.PandaTable, basis: Any) -> 
         np.testing.assert_array_equal(ctrl.arrays()[name], value, err_msg=name)
     with pytest.raises(ValueError, match="q0, dq0 and a payload start a run afresh"):
         amj.simulate(ctrl, plant, T=0.1, q0=sc.q0, reset=False)
+
+
+@pytest.mark.parametrize("options", [{}, {"every": 3}, {"compress": False}])
+def test_a_cartesian_run_saves_its_task_rows(
+    sc: ac.PandaTable, basis: Any, tmp_path: Path, options: dict[str, Any]
+) -> None:
+    """A MuJoCo result keeps, through save and load, the end effector's position
+    and wrench and the task-space rows (the Cartesian metrics read them)."""
+    ctrl = ac.panda_controller("sf", sc, basis=basis)
+    res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.2, q0=sc.q0)
+    assert res.task is not None
+    assert res.x_ee is not None
+    assert res.wrench_ee is not None
+    back = amj.MujocoResult.load(res.save(tmp_path / "run", **options))
+    k = options.get("every", 1)
+    np.testing.assert_array_equal(back.x_ee, res.x_ee[::k])
+    np.testing.assert_array_equal(back.wrench_ee, res.wrench_ee[::k])
+    assert back.task is not None
+    assert sorted(back.task) == sorted(res.task)
+    for name, rows in res.task.items():
+        np.testing.assert_array_equal(back.task[name], rows[::k], err_msg=name)

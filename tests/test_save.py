@@ -192,3 +192,16 @@ def test_an_unknown_format_is_refused(runs: dict[str, SimResult], tmp_path: Path
     np.savez(tmp_path / "future.npz", **content)
     with pytest.raises(ValueError, match="saved in format 99, which this version of adaptimp"):
         SimResult.load(tmp_path / "future.npz")
+
+
+def test_a_stored_copy_of_a_recomputed_array_is_refused(tmp_path: Path) -> None:
+    """An array the manifest leaves to the core, stored in the file too (the file
+    edited after the save), would replace the checked one unseen: refused."""
+    path = adaptimp.simulate("pd", T=0.05).save(tmp_path / "run")
+    assert "q" in manifest(path)["simulated"]
+    with np.load(path) as f:
+        content = dict(f)
+    content["q"] = np.zeros((50, 2))
+    np.savez(tmp_path / "edited.npz", **content)
+    with pytest.raises(ValueError, match=r"^q is both stored and left to the core to recompute"):
+        SimResult.load(tmp_path / "edited.npz")

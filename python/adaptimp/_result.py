@@ -31,6 +31,9 @@ ARRAYS = ("t", "q", "dq", "xc", "xd", "dq_hat", "tau", "tau_sat", "tau_e", "zeta
 EXTRA_ARRAYS = ("ddq", "dxc", "ddxc", "refused")
 """Recorded arrays of results made by this version (None in older saved files)."""
 
+_META = frozenset({"case", "scenario", "metrics", "params", "record_every", "format"})
+"""The entries of a saved file that are not arrays of rows."""
+
 UNITS = {
     "t": "s",
     "q": "rad",
@@ -275,6 +278,7 @@ class SimResult:
         for name in EXTRA_ARRAYS:
             if getattr(self, name) is not None:
                 arrays[name] = getattr(self, name)
+        arrays.update(self._own_arrays())
         if every > 1:
             arrays = {name: a[::every] for name, a in arrays.items()}
         record_every = self.record_every * every
@@ -323,7 +327,7 @@ class SimResult:
                 )
                 arrays = _decode(f, manifest, params, record_every, simulated)
             else:  # format 1: plain float64 arrays
-                arrays = {name: f[name] for name in names if name in f}
+                arrays = {name: f[name] for name in f if name not in _META}
             return cls(
                 case=str(f["case"]),
                 scenario=str(f["scenario"]),
@@ -331,7 +335,18 @@ class SimResult:
                 params=params,
                 record_every=record_every,
                 **{name: arrays[name] for name in names if name in arrays},
+                **cls._own_fields(arrays),
             )
+
+    def _own_arrays(self) -> dict[str, NDArray[Any]]:
+        """A subclass's own recorded arrays (one row per recorded step), by the
+        names :meth:`save` stores them under; :meth:`_own_fields` reads them back."""
+        return {}
+
+    @classmethod
+    def _own_fields(cls, arrays: Mapping[str, NDArray[Any]]) -> dict[str, Any]:
+        """The constructor's keywords of a subclass's own arrays (see :meth:`_own_arrays`)."""
+        return {}
 
     def __repr__(self) -> str:
         m = self.metrics
@@ -561,6 +576,15 @@ def _decode(
 ) -> dict[str, NDArray[Any]]:
     arrays: dict[str, NDArray[Any]] = dict(simulated)
     for name in f:
+        if name in _META:
+            continue
+        if name in simulated or name in manifest["derived"]:
+            # The manifest leaves it to the core; a stored copy would replace the
+            # checked one unseen.
+            raise ValueError(
+                f"{name} is both stored and left to the core to recompute: the file was "
+                "edited after it was saved"
+            )
         if name in manifest["differences"]:
             spec = manifest["differences"][name]
             arrays[name] = _undifferences(f[name], spec["order"], spec["shape"])

@@ -1298,6 +1298,19 @@ class MujocoResult(SimResult):
     wrench_ee: FloatArray | None = None
     task: dict[str, FloatArray] | None = None
 
+    def _own_arrays(self) -> dict[str, FloatArray]:
+        out = {n: a for n in ("x_ee", "wrench_ee") if (a := getattr(self, n)) is not None}
+        out.update({f"task.{k}": v for k, v in (self.task or {}).items()})
+        return out
+
+    @classmethod
+    def _own_fields(cls, arrays: Mapping[str, Any]) -> dict[str, Any]:
+        fields: dict[str, Any] = {n: arrays[n] for n in ("x_ee", "wrench_ee") if n in arrays}
+        task = {k[len("task.") :]: v for k, v in arrays.items() if k.startswith("task.")}
+        if task:
+            fields["task"] = task
+        return fields
+
     @property
     def rows(self) -> int:
         """Number of recorded rows K."""

@@ -14,6 +14,7 @@ import mujoco
 import numpy as np
 import pytest
 
+import adaptimp
 from adaptimp import cartesian as ac
 from adaptimp import contact as act
 from adaptimp import mujoco as amj
@@ -164,3 +165,30 @@ def test_mujoco_alternates_a_sliding_contact_s_normal_force() -> None:
     mean0, std0 = _sliding_point(0.0, 0.0)
     assert mean0 == pytest.approx(7.5 + 4 * 9.81, rel=1e-4)
     assert std > 10.0 * std0
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "what"),
+    [
+        ("friction", float("nan"), "≥ 0"),
+        ("friction", -0.1, "≥ 0"),
+        ("radius", -0.05, r"> 0 \(m\)"),
+        ("freq", float("inf"), r"> 0 \(Hz\)"),
+        ("depth", float("nan"), r"≥ 0 \(m\)"),
+        ("tool_radius", -0.01, r"> 0 \(m\)"),
+        ("Ts", 0.0, r"> 0 \(s\)"),
+        ("t_approach", -1.0, r"≥ 0 \(s\)"),
+        ("spring", 0.0, r"> 0 \(N/m\), or None for a rigid table"),
+        ("spring", "stiff", r"> 0 \(N/m\), or None for a rigid table"),
+    ],
+)
+def test_a_scenario_quantity_out_of_range_is_refused_by_name(
+    name: str, value: object, what: str
+) -> None:
+    """arm_table refuses, before building anything, a quantity that is not a
+    finite number in its range, naming it and the value (both the Panda's
+    default table and a URDF's)."""
+    for urdf in (None, _ur5()):
+        message = rf"^{name} must be a finite number {what}, got "
+        with pytest.raises(adaptimp.ConfigError, match=message):
+            act.arm_table(urdf, **{name: value})

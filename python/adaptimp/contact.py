@@ -21,12 +21,14 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._errors import ConfigError
 from .chain import Chain
 from .panda_table import PandaTable, cartesian_metrics
 
@@ -237,6 +239,32 @@ def _home(urdf: Path, chain: Chain, plant: Any) -> FloatArray:
     return np.zeros(chain.n)
 
 
+def _check_scenario(**values: float | None) -> None:
+    """Refuse, by name, a scenario quantity that is not a finite number in its
+    range (before any model is built)."""
+    ranges: dict[str, tuple[str, Callable[[float], bool]]] = {
+        "spring": ("> 0 (N/m), or None for a rigid table", lambda v: v > 0),
+        "friction": ("≥ 0", lambda v: v >= 0),
+        "radius": ("> 0 (m)", lambda v: v > 0),
+        "freq": ("> 0 (Hz)", lambda v: v > 0),
+        "depth": ("≥ 0 (m)", lambda v: v >= 0),
+        "tool_radius": ("> 0 (m)", lambda v: v > 0),
+        "Ts": ("> 0 (s)", lambda v: v > 0),
+        "t_approach": ("≥ 0 (s)", lambda v: v >= 0),
+        "t_ramp": ("≥ 0 (s)", lambda v: v >= 0),
+    }
+    for name, value in values.items():
+        if value is None and name == "spring":
+            continue
+        what, ok = ranges[name]
+        try:
+            v = float(value)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            v = math.nan
+        if not (math.isfinite(v) and ok(v)):
+            raise ConfigError(f"{name} must be a finite number {what}, got {value!r}")
+
+
 def arm_table(
     urdf: str | os.PathLike[str] | None = None,
     *,
@@ -268,6 +296,10 @@ def arm_table(
     from .baselines import pinocchio_model
     from .panda_table import panda_table
 
+    _check_scenario(
+        spring=spring, friction=friction, radius=radius, freq=freq, depth=depth,
+        tool_radius=tool_radius, Ts=Ts, t_approach=t_approach, t_ramp=t_ramp,
+    )  # fmt: skip
     if urdf is None:
         sc = panda_table(
             radius=radius,

@@ -951,7 +951,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         }
         let errors = self.errors(&Reference::start(&t.commanded), &t.commanded, m, v);
         let j = &t.jacobian;
-        let force = t.spring + t.damping.component_mul(&(t.twist - j * v));
+        let force = t.force(v);
         // (19.3) the joint law's feedback without its task part:
         // Π τ = τ − Jᵀ (J Kp⁻¹ Jᵀ + Λ² k̄⁻¹)⁻¹ J Kp⁻¹ τ, so Π Kp = Kp − Jᵀ Λ_K J ≼ Kp.
         let kinv = self.cfg.kp.map(|k| 1.0 / k);

@@ -45,6 +45,18 @@ pub struct TaskTorque<const N: usize> {
     pub share: f64,
 }
 
+impl<const N: usize> TaskTorque<N> {
+    /// The task force F = K̃ e + B (ẋ_c − J q̇) at the joint velocity `dq`
+    /// (rad/s): the wrench of τ_I that the torque-level impedance applies (N,
+    /// N m), SPEC §19.
+    pub fn force(&self, dq: &Vector<N>) -> Vector<6> {
+        self.spring
+            + self
+                .damping
+                .component_mul(&(self.twist - self.jacobian * dq))
+    }
+}
+
 /// What one step computed. `tau_sat` goes to the actuators; the rest is for logging.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Command<const N: usize> {

@@ -348,9 +348,7 @@ impl<const N: usize> DynOuter for Outer<N> {
                         // reference and the task torque at the measured q̇.
                         Some(t) if t.share < 1.0 => {
                             let dq = jm.dx.ok_or(Error::MissingVelocity)?;
-                            let force =
-                                t.spring + t.damping.component_mul(&(t.twist - t.jacobian * dq));
-                            let torque = t.jacobian.transpose() * force;
+                            let torque = t.jacobian.transpose() * t.force(&dq);
                             let rows = t.jacobian.transpose();
                             (t.commanded, Some((torque, rows)))
                         }

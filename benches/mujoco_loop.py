@@ -19,6 +19,9 @@ gains and centres along a sinusoid of 0.15 rad at 1 rad/s about the posture:
 - (c) the controller alone: ``Controller.replay`` over (a)'s K recorded rows
   (the Rust step in a Rust loop), divided by K;
 - the ratio (a) / ((b) + (c)) (target ≤ 1.5);
+- for a path given as a Python callable: (d) the path's own calls at t_k
+  (``path(k·Ts)`` K times in a Python loop, nothing else), divided by K, and
+  ((a) − (d)) / ((b) + (c)): the loop's cost without the user's function;
 - for reference, the Python loop (``simulate`` with the same controller behind a
   Python object: the fallback, the loop every controller took before).
 
@@ -166,7 +169,13 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
         return (time.perf_counter() - start) / steps
 
     return (
-        {"native": native, "engine": engine, "hold": hold, "step": step, "python": python_loop},
+        {
+            "native": native,
+            "engine": engine,
+            "hold": hold,
+            "step": step,
+            "python": python_loop,
+        },
         plant.n,
         substeps,
     )
@@ -280,6 +289,16 @@ def cartesian_timers(
         assert np.array_equal(tau, log.tau_sat)
         return seconds / steps
 
+    def path_alone() -> float:
+        # The path's own cost: its calls at t_k, as (a) makes them, with nothing else.
+        if table:
+            return 0.0
+        path, ts = ctrl.path, ctrl.Ts
+        start = time.perf_counter()
+        for k in range(steps):
+            path(k * ts)
+        return (time.perf_counter() - start) / steps
+
     def python_loop() -> float:
         ctrl.reset()
         start = time.perf_counter()
@@ -288,7 +307,14 @@ def cartesian_timers(
         return (time.perf_counter() - start) / steps
 
     return (
-        {"native": native, "engine": engine, "hold": hold, "step": step, "python": python_loop},
+        {
+            "native": native,
+            "engine": engine,
+            "hold": hold,
+            "step": step,
+            "path": path_alone,
+            "python": python_loop,
+        },
         plant.n,
         substeps,
     )
@@ -304,9 +330,10 @@ LABELS = {
 def loop_table(rows: list[tuple[str, str]], T: float, repeats: int) -> None:
     print(
         "\n| arm | controller | n | substeps | (a) simulate, native | (b) MuJoCo, same motion | "
-        "(b') MuJoCo at rest | (c) Rust step | (a)/((b)+(c)) | Python loop | Python/(a) |"
+        "(b') MuJoCo at rest | (c) Rust step | (a)/((b)+(c)) | (d) the path's calls | "
+        "((a)−(d))/((b)+(c)) | Python loop | Python/(a) |"
     )
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, kind in rows:
         if kind == "joint":
             fns, n, substeps = timers(name, T)
@@ -321,12 +348,14 @@ def loop_table(rows: list[tuple[str, str]], T: float, repeats: int) -> None:
         finally:
             gc.enable()
         med = {k: statistics.median(v) * 1e6 for k, v in times.items()}
+        med.setdefault("path", 0.0)
         ratio = med["native"] / (med["engine"] + med["step"])
+        own = (med["native"] - med["path"]) / (med["engine"] + med["step"])
         label = LABELS[kind]
         print(
             f"| {name} | {label} | {n} | {substeps} | {med['native']:.1f} | {med['engine']:.1f} | "
-            f"{med['hold']:.1f} | {med['step']:.2f} | {ratio:.2f} | {med['python']:.1f} | "
-            f"{med['python'] / med['native']:.1f}× |"
+            f"{med['hold']:.1f} | {med['step']:.2f} | {ratio:.2f} | {med['path']:.1f} | "
+            f"{own:.2f} | {med['python']:.1f} | {med['python'] / med['native']:.1f}× |"
         )
 
 

@@ -203,18 +203,53 @@ def placement(
     within ``limits`` = (lo, hi) (rad), each clipped to ±π, seed ``seed``); the
     table top lies :data:`CLEARANCE` below the tool sphere at home.
 
-    Returns (centre (2,) m, table top m, R m).
+    Returns (centre (2,) m, table top m, R m). ``ConfigError`` (naming it and
+    the value) for a ``tool_radius`` that is not a finite number > 0, a
+    ``home`` or a limit that is not n finite numbers, and lo > hi.
     """
-    q = np.asarray(home, dtype=np.float64)
+    _check_scenario(tool_radius=tool_radius)
+    q = _joint_vector("home", home, chain)
+    unlimited = " (±π for an unlimited joint)"
+    lo_given = _joint_vector("limits[0] (lo)", limits[0], chain, unlimited)
+    hi_given = _joint_vector("limits[1] (hi)", limits[1], chain, unlimited)
+    inverted = np.flatnonzero(lo_given > hi_given)
+    if inverted.size:
+        i = int(inverted[0])
+        raise ConfigError(
+            f"limits must have lo ≤ hi for every joint; joint {i} ({chain.joint_names[i]!r}) "
+            f"has lo = {float(lo_given[i])!r} > hi = {float(hi_given[i])!r}"
+        )
     p = np.asarray(chain.fk(q)[:3, 3], dtype=np.float64)
-    lo = np.clip(np.asarray(limits[0], dtype=np.float64), -math.pi, math.pi)
-    hi = np.clip(np.asarray(limits[1], dtype=np.float64), -math.pi, math.pi)
+    lo = np.clip(lo_given, -math.pi, math.pi)
+    hi = np.clip(hi_given, -math.pi, math.pi)
     samples = np.random.default_rng(seed).uniform(lo, hi, size=(1024, q.shape[0]))
     reach = max(float(np.linalg.norm(chain.fk(s)[:2, 3])) for s in samples)
     radial = float(np.linalg.norm(p[:2]))
     u = p[:2] / radial if radial > 1e-9 else np.array([1.0, 0.0])
     dist = min(radial + OUTWARD, REACH_SHARE * reach)
     return dist * u, float(p[2] - tool_radius - CLEARANCE), reach
+
+
+def _joint_vector(name: str, value: ArrayLike, chain: Chain, hint: str = "") -> FloatArray:
+    """``value`` as n finite numbers (rad), one per joint of ``chain``, or a
+    ``ConfigError`` naming ``name``, the joint and the value."""
+    n = chain.n
+    try:
+        v = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be {n} finite numbers (rad){hint}, got {value!r}") from None
+    if v.shape != (n,):
+        raise ConfigError(
+            f"{name} must be {n} finite numbers (rad){hint}, one per joint; got shape {v.shape}"
+        )
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        i = int(bad[0])
+        raise ConfigError(
+            f"{name} must be {n} finite numbers (rad){hint}; joint {i} "
+            f"({chain.joint_names[i]!r}) is {float(v[i])!r}"
+        )
+    return v
 
 
 def _limits(plant: Any) -> tuple[FloatArray, FloatArray]:
@@ -333,7 +368,7 @@ def arm_table(
         tip = _default_tip(*_read_urdf(path))
     chain = Chain.from_urdf(path, tip=tip)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
-    q0 = _home(path, chain, bare) if home is None else np.asarray(home, dtype=np.float64)
+    q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
     centre, top, _ = placement(chain, q0, _limits(bare), tool_radius=tool_radius)
     table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)
     model = arm_model(

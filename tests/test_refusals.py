@@ -86,3 +86,37 @@ def test_arm_table_refuses_a_home_that_is_not_finite_by_name() -> None:
     message = "home must be 6 finite numbers (rad); joint 1 ('shoulder_lift_joint') is nan"
     with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
         act.arm_table(ur5, home=home)
+
+
+def test_contact_metrics_of_a_run_without_rows_in_its_windows_is_refused() -> None:
+    """A 0.05 s run: no row at t ≥ settle (default 2 s), and none at t ≥ 0.1 s
+    (peak_tau_ratio's window): each is named with the run's last row."""
+    from adaptimp import cartesian as ac
+    from adaptimp import mujoco as amj
+
+    sc = act.arm_table(friction=0.0)
+    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.05, q0=sc.q0)
+    message = (
+        "the metrics' window t ≥ settle = 2 s holds no row of the run (50 rows, its last "
+        "row at t = 0.049 s): run for longer than 2 s (or give a smaller settle)"
+    )
+    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
+        act.contact_metrics(res, ctrl, sc)
+    message = (
+        "the metrics' window t ≥ windup_after = 0.1 s holds no row of the run (50 rows, its "
+        "last row at t = 0.049 s): run for longer than 0.1 s (peak_tau_ratio leaves out the "
+        "start-up transient)"
+    )
+    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
+        act.contact_metrics(res, ctrl, sc, settle=0.0)
+    for settle in (math.nan, -1.0):
+        with pytest.raises(
+            adaptimp.ConfigError,
+            match=f"^{re.escape(f'settle must be a finite number ≥ 0 (s), got {settle!r}')}$",
+        ):
+            act.contact_metrics(res, ctrl, sc, settle=settle)
+    # Long enough for both windows: every metric is a number.
+    longer = amj.simulate(ctrl, amj.Plant(sc.model), T=0.2, q0=sc.q0)
+    m = act.contact_metrics(longer, ctrl, sc, settle=0.1)
+    assert all(math.isfinite(v) for v in m.values()), m

@@ -428,7 +428,9 @@ def contact_metrics(
     after = t >= settle - 1e-9
     # (16.1) with the measured n·e, n = −z (into the table), e = p − p_d.
     series = kd if spring is None else kd * spring / (kd + spring)
-    ne = ctrl.arrays()["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
+    # The run's own task-space rows (the controller's log may hold earlier runs).
+    log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
+    ne = log["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
     approach = t >= sc.t_approach - 1e-9
     contact = np.flatnonzero(approach & (fn > 0))
     # Never touched after the approach: all of that time is without contact.

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -120,3 +121,50 @@ def test_contact_metrics_of_a_run_without_rows_in_its_windows_is_refused() -> No
     longer = amj.simulate(ctrl, amj.Plant(sc.model), T=0.2, q0=sc.q0)
     m = act.contact_metrics(longer, ctrl, sc, settle=0.1)
     assert all(math.isfinite(v) for v in m.values()), m
+
+
+def _erd(*parts: str) -> str:
+    return str(_models.panda_urdf_path().parent.parent.parent.joinpath(*parts))
+
+
+SOLO = _erd("solo_description", "robots", "solo12.urdf")
+LEGS = "'FL_LOWER_LEG', 'FR_LOWER_LEG', 'HL_LOWER_LEG', 'HR_LOWER_LEG'"
+
+
+def test_a_quadruped_is_refused_unless_the_leg_is_named() -> None:
+    """Solo's four legs tie for the longest chain: the arm loaders (MuJoCo's,
+    Pinocchio's, the contact scenario's) and the kinematic chain each refuse to
+    pick one, listing the candidates; tip= picks it."""
+    from adaptimp import mujoco as amj
+    from adaptimp.baselines import pinocchio_model
+
+    message = (
+        f"the URDF has 4 serial chains of 3 joints from the root that tie for the arm (legs, "
+        f"or two arms), ending at the links {LEGS}: name one with tip= "
+        "(adaptimp.mujoco.from_urdf(path, tip=...), adaptimp.contact.arm_table(path, "
+        "tip=...)) or fix the others' joints with fix="
+    )
+    for load in (amj.from_urdf, amj.Plant, pinocchio_model):
+        with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+            load(SOLO)
+    with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+        amj.simulate("sf", SOLO, T=0.01)
+    branch = (
+        "the movable joints branch at the link 'base_link' ('FL_HAA', 'FR_HAA', 'HL_HAA', "
+        "'HR_HAA'): give tip= (the link that ends the chain)"
+    )
+    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(branch)}$"):
+        adaptimp.Chain.from_urdf(SOLO)
+    # Named: that leg, the others fixed, the same in every loader.
+    leg = ("HR_HAA", "HR_HFE", "HR_KFE")
+    arm = _models.arm_urdf(Path(SOLO).read_text(), tip="HR_LOWER_LEG")
+    assert arm.joints == leg
+    assert sorted(arm.fixed) == sorted(
+        f"{side}_{j}" for side in ("FL", "FR", "HL") for j in ("HAA", "HFE", "KFE")
+    )
+    plant = amj.Plant(amj.from_urdf(SOLO, tip="HR_LOWER_LEG"))
+    joint = amj.mujoco.mjtObj.mjOBJ_JOINT
+    assert tuple(amj._name(plant.model, joint, j) for j in plant._joints) == leg
+    assert adaptimp.Chain.from_urdf(SOLO, tip="HR_LOWER_LEG").joint_names == list(leg)
+    with pytest.raises(ValueError, match=re.escape("the URDF has no link named 'paw' (tip=)")):
+        _models.arm_urdf(Path(SOLO).read_text(), tip="paw")

@@ -176,7 +176,11 @@ EFFORT_ACCEL = 10.0
 
 
 def from_urdf(
-    path: str | os.PathLike[str], timestep: float = 1e-3, *, fix: tuple[str, ...] = ()
+    path: str | os.PathLike[str],
+    timestep: float = 1e-3,
+    *,
+    fix: tuple[str, ...] = (),
+    tip: str | None = None,
 ) -> mujoco.MjModel:
     """A URDF arm as a MuJoCo model :class:`Plant` accepts.
 
@@ -186,7 +190,10 @@ def from_urdf(
     into shorter chains); prismatic and mimic joints, a gripper's joints
     (named gripper/finger/jaw/claw, after the arm's) and every joint off the
     chain are fixed at their zero position, and so are the joints named in
-    ``fix``. A revolute joint with no range (lower ≥ upper) is continuous.
+    ``fix``. Chains that tie for the longest (a quadruped's legs, two arms)
+    are an error listing the link each ends at: ``tip`` names the link that
+    ends the arm (the movable joints on the way to it are the arm's). A
+    revolute joint with no range (lower ≥ upper) is continuous.
     Visual and collision elements, joint ``<dynamics>`` (damping, friction)
     and mimic tags are dropped (the rigid-body dynamics
     only, no mesh files; no contact geometry). Continuous joints are
@@ -203,10 +210,11 @@ def from_urdf(
     Raises
     ------
     ValueError
-        The URDF has no revolute or continuous joint to drive, or more than
-        :data:`MAX_JOINTS` on its longest chain.
+        The URDF has no revolute or continuous joint to drive, more than
+        :data:`MAX_JOINTS` on its longest chain, or several chains that tie
+        for the longest and no ``tip``.
     """
-    arm = _models.arm_urdf(Path(path).read_text(), fix)
+    arm = _models.arm_urdf(Path(path).read_text(), fix, tip=tip)
     if len(arm.joints) > MAX_JOINTS:
         raise ValueError(
             f"the URDF's arm has {len(arm.joints)} joints ({', '.join(arm.joints)}); "

@@ -144,7 +144,7 @@ def test_a_quadruped_is_refused_unless_the_leg_is_named() -> None:
         "(adaptimp.mujoco.from_urdf(path, tip=...), adaptimp.contact.arm_table(path, "
         "tip=...)) or fix the others' joints with fix="
     )
-    for load in (amj.from_urdf, amj.Plant, pinocchio_model):
+    for load in (amj.from_urdf, amj.Plant, pinocchio_model, act.arm_table):
         with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
             load(SOLO)
     with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
@@ -168,3 +168,40 @@ def test_a_quadruped_is_refused_unless_the_leg_is_named() -> None:
     assert adaptimp.Chain.from_urdf(SOLO, tip="HR_LOWER_LEG").joint_names == list(leg)
     with pytest.raises(ValueError, match=re.escape("the URDF has no link named 'paw' (tip=)")):
         _models.arm_urdf(Path(SOLO).read_text(), tip="paw")
+
+
+def test_the_contact_scenario_drives_the_joints_simulate_drives() -> None:
+    """The so100 arm ends in a gripper joint (named "gripper"): the contact
+    scenario and adaptimp.mujoco.simulate take the same arm, by the one rule of
+    _models.arm_urdf (the gripper's joint fixed, the tool on the wrist's link)."""
+    from adaptimp import mujoco as amj
+
+    so100 = _erd("so_arm_description", "urdf", "so100.urdf")
+    arm = ("shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll")
+    rule = _models.arm_urdf(Path(so100).read_text())
+    assert rule.joints == arm
+    assert rule.fixed == {"gripper": "a gripper joint (its name contains 'gripper')"}
+    sc = act.arm_table(so100)
+    assert sc.n == len(arm)
+    assert tuple(sc.chain.joint_names) == arm
+    plant = amj.Plant(sc.model)
+    joint = amj.mujoco.mjtObj.mjOBJ_JOINT
+    assert tuple(amj._name(plant.model, joint, j) for j in plant._joints) == arm
+    res = amj.simulate("sf", so100, T=0.01)
+    assert res.q.shape == (10, len(arm))
+    alone = amj.Plant(so100)
+    assert tuple(amj._name(alone.model, joint, j) for j in alone._joints) == arm
+
+
+def test_a_tip_whose_chain_is_not_the_driven_arm_is_refused() -> None:
+    """Given tip= and fix= that leave a fixed joint on the chain, the chain and
+    the model would differ in n: refused, naming both joint lists."""
+    so100 = _erd("so_arm_description", "urdf", "so100.urdf")
+    message = (
+        "the chain to 'jaw' has the joints ['shoulder_pan', 'shoulder_lift', 'elbow_flex', "
+        "'wrist_flex', 'wrist_roll', 'gripper'], but the arm's model drives ['shoulder_pan', "
+        "'shoulder_lift', 'elbow_flex', 'wrist_flex', 'wrist_roll'] (fix=('gripper',)): give "
+        "a tip whose path holds exactly the driven joints, or fix the others"
+    )
+    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
+        act.arm_table(so100, tip="jaw", fix=("gripper",))

@@ -319,8 +319,11 @@ def arm_table(
     """The table scenario for the arm of ``urdf`` (None: the Panda of
     :func:`adaptimp.panda_table.panda_table`, whose table and circle are kept).
 
-    ``tip``: the tool's body (default: :meth:`Chain.from_urdf`'s tip, the child
-    link of the last movable joint); ``home`` (rad): default the rule's home
+    ``tip``: the tool's body (default: the child link of the arm's last joint).
+    The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
+    the rule of :func:`adaptimp.mujoco.from_urdf` (``_models.arm_urdf``, with
+    ``tip``): a gripper's, prismatic, mimic and off-chain joints are fixed,
+    and chains that tie (legs, two arms) need ``tip``; ``home`` (rad): default the rule's home
     posture; ``spring``: the table's spring stiffness k_e (N/m), None: rigid;
     ``friction``: sliding friction of table and tool. The rest as
     :func:`~adaptimp.panda_table.panda_table`. The table and the circle are
@@ -361,13 +364,26 @@ def arm_table(
         )
         sc.model = model
         return sc
-    from .chain import _default_tip, _read_urdf
-
     path = Path(urdf)
-    if tip is None:
-        tip = _default_tip(*_read_urdf(path))
+    # The arm's joints by the one rule of adaptimp.mujoco.simulate and the
+    # Pinocchio model (_models.arm_urdf): a gripper's, prismatic, mimic and
+    # off-chain joints are fixed; by default the tool goes on the last arm
+    # joint's link.
+    arm = _models.arm_urdf(path.read_text(), fix, tip=tip)
+    tip = arm.tip if tip is None else tip
+    fix = (*fix, *(j for j in arm.fixed if j not in fix))
     chain = Chain.from_urdf(path, tip=tip)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
+    import mujoco
+
+    joint = mujoco.mjtObj.mjOBJ_JOINT
+    driven = [amj._name(bare.model, joint, j) for j in bare._joints]
+    if driven != chain.joint_names:
+        raise ConfigError(
+            f"the chain to {tip!r} has the joints {chain.joint_names}, but the arm's model "
+            f"drives {driven} (fix={fix!r}): give a tip whose path holds exactly the "
+            "driven joints, or fix the others"
+        )
     q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
     centre, top, _ = placement(chain, q0, _limits(bare), tool_radius=tool_radius)
     table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)

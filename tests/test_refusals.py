@@ -205,3 +205,32 @@ def test_a_tip_whose_chain_is_not_the_driven_arm_is_refused() -> None:
     )
     with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
         act.arm_table(so100, tip="jaw", fix=("gripper",))
+
+
+@pytest.mark.parametrize("formulation", [None, "admittance", "impedance"])
+def test_an_admittance_share_without_the_unified_formulation_is_refused(
+    formulation: str | None,
+) -> None:
+    """admittance_share acts in formulation='unified' only; given with another
+    (or the default, 'admittance') it would be ignored: refused, naming both."""
+    from adaptimp import cartesian as ac
+
+    chosen = {} if formulation is None else {"formulation": formulation}
+    message = (
+        f"admittance_share = 0.5 has no effect with formulation={formulation or 'admittance'!r}: "
+        "it is the admittance's share of the torque for formulation='unified' only (give "
+        "formulation='unified', or leave admittance_share out)"
+    )
+    for make in (
+        lambda: ac.CartesianImpedance(PANDA, Ts=1e-3, q0=HOME, admittance_share=0.5, **chosen),
+        lambda: ac.CartesianController(PANDA, "sf", q0=HOME, admittance_share=0.5, **chosen),
+    ):
+        with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
+            make()
+    # Unified takes it; the other formulations take their defaults' dict.
+    unified = ac.CartesianImpedance(
+        PANDA, Ts=1e-3, q0=HOME, formulation="unified", admittance_share=0.5
+    )
+    assert unified.params["admittance_share"] == 0.5
+    other = ac.CartesianImpedance(PANDA, Ts=1e-3, q0=HOME, **chosen)
+    assert other.params["formulation"] == (formulation or "admittance")

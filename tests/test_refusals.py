@@ -234,3 +234,90 @@ def test_an_admittance_share_without_the_unified_formulation_is_refused(
     assert unified.params["admittance_share"] == 0.5
     other = ac.CartesianImpedance(PANDA, Ts=1e-3, q0=HOME, **chosen)
     assert other.params["formulation"] == (formulation or "admittance")
+
+
+def _edited(src: Path, dst: Path, **edits: object) -> Path:
+    """A copy of the saved file ``src`` with entries replaced: a callable edits
+    the entry's JSON, anything else replaces the entry."""
+    import json
+
+    with np.load(src, allow_pickle=False) as f:
+        content = {k: f[k] for k in f}
+    for key, edit in edits.items():
+        if callable(edit):
+            content[key] = np.array(json.dumps(edit(json.loads(str(content[key])))))
+        else:
+            content[key] = np.array(edit)
+    np.savez_compressed(dst, **content)
+    return dst
+
+
+def _set(key: str, value: object) -> object:
+    def edit(d: dict[str, object]) -> dict[str, object]:
+        d[key] = value
+        return d
+
+    return edit
+
+
+def _without_inputs(m: dict[str, object]) -> dict[str, object]:
+    del m["inputs"]
+    return m
+
+
+def test_a_load_names_the_parameters_edited_after_the_save(tmp_path: Path) -> None:
+    """The save records the SHA-256 of the case, scenario, rows kept and each
+    parameter; a load names each that differs, instead of blaming the platform."""
+    path = adaptimp.simulate("sf", T=0.05).save(tmp_path / "run")
+    edited = _edited(path, tmp_path / "k1.npz", params=_set("K1", [7.0, 6.0]))
+    message = (
+        f"{edited}: the file was edited after it was saved: the parameter 'K1' (now [7.0, "
+        "6.0]) is not what the save recorded (its SHA-256 differs), so its arrays and metrics "
+        "are not those of a run with it"
+    )
+    with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+        adaptimp.SimResult.load(edited)
+    both = _edited(path, tmp_path / "both.npz", case="pd", params=_set("T", 0.06))
+    message = (
+        f"{both}: the file was edited after it was saved: the case ('pd'), the parameter 'T' "
+        "(now 0.06) are not what the save recorded"
+    )
+    with pytest.raises(ValueError, match=f"^{re.escape(message)}"):
+        adaptimp.SimResult.load(both)
+    # A MuJoCo run keeps its arrays: an edited Ts would re-derive t unseen.
+    from adaptimp import mujoco as amj
+
+    saved = amj.simulate("sf", "two_link", T=0.02).save(tmp_path / "mj")
+    ts = _edited(saved, tmp_path / "ts.npz", params=_set("Ts", 2e-3))
+    with pytest.raises(ValueError, match=re.escape("the parameter 'Ts' (now 0.002) is not")):
+        amj.MujocoResult.load(ts)
+
+
+def test_a_file_without_recorded_inputs_names_what_differs_and_both_causes(
+    tmp_path: Path,
+) -> None:
+    """A file saved before the inputs were recorded: the rerun's bits differ; the
+    message names the array, both digests, the versions and both causes."""
+    path = adaptimp.simulate("sf", T=0.05).save(tmp_path / "run")
+    old = _edited(path, tmp_path / "old.npz", format=_without_inputs)
+    assert adaptimp.SimResult.load(old).metrics == adaptimp.SimResult.load(path).metrics
+    edited = _edited(old, tmp_path / "edited.npz", params=_set("K1", [7.0, 6.0]))
+    message = (
+        r"^.*edited\.npz: \w+ was left to the simulation to recompute, but running the file's "
+        r"case 'sf', scenario 'paper' and parameters again does not give the same bits "
+        r"\(SHA-256 [0-9a-f]{12}…, the save recorded [0-9a-f]{12}…; saved by adaptimp "
+        + re.escape(adaptimp.__version__)
+        + r", which this is\): the file's case, scenario or parameters were edited after it "
+        r"was saved, or this platform's floating point differs from the one that saved it$"
+    )
+    with pytest.raises(ValueError, match=message):
+        adaptimp.SimResult.load(edited)
+    broken = _edited(old, tmp_path / "broken.npz", params=_set("K1", [-1.0, 6.0]))
+    message = (
+        "t was left to the simulation to recompute, but the file's case 'sf', scenario "
+        "'paper' and parameters do not describe a run the core can repeat (ConfigError: "
+        "condition K1 > 0 is violated: K1[0] = -1 (SPEC §10)); saved by adaptimp "
+        f"{adaptimp.__version__}, which this is"
+    )
+    with pytest.raises(ValueError, match=f"{re.escape(message)}$"):
+        adaptimp.SimResult.load(broken)

@@ -300,6 +300,7 @@ class SimResult:
             else None
         )
         stored, manifest = _encode(arrays, self.params, record_every, rerun)
+        manifest["inputs"] = _input_digests(self.case, self.scenario, self.params, record_every)
         meta["format"] = np.array(json.dumps({"version": 3, **manifest}))
         np.savez_compressed(path, **{**stored, **meta})
         return path
@@ -318,6 +319,9 @@ class SimResult:
                         f"{path}: saved in format {manifest.get('version')!r}, which this "
                         "version of adaptimp cannot read (it reads 1, 2 and 3)"
                     )
+                _check_inputs(
+                    path, str(f["case"]), str(f["scenario"]), params, record_every, manifest
+                )
                 simulated = (
                     _resimulated(
                         path, str(f["case"]), str(f["scenario"]), params, record_every, manifest
@@ -460,13 +464,19 @@ def _best_order(a: NDArray[np.float64]) -> int:
 
 
 def _rerun(
-    case: str, scenario: str, params: Mapping[str, Any], n: int, record_every: int
+    case: str,
+    scenario: str,
+    params: Mapping[str, Any],
+    n: int,
+    record_every: int,
+    why: list[str] | None = None,
 ) -> dict[str, NDArray[Any]] | None:
     """The arrays of :func:`adaptimp.simulate` run again from the recorded case,
     scenario and parameters alone (the default arm for n, the vertex grid or the
     rule's centres, zero initial weights, no fault), keeping every
     ``record_every``-th step; None where those do not describe a run the core
-    can repeat (another arm, user centres, an unknown parameter)."""
+    can repeat (another arm, user centres, an unknown parameter), the reason
+    appended to ``why``."""
     import warnings
 
     from . import _adaptimp, _api
@@ -481,14 +491,20 @@ def _rerun(
         else:
             arm = _api.PlanarArm(n)
             if params.get("arm") != arm.params:
+                if why is not None:
+                    why.append("its arm is not the default arm of its n")
                 return None
         if "nodes" in params:  # user centres (not recorded)
+            if why is not None:
+                why.append("it used centres of the user's (not recorded)")
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             core = _api._core_controller(case, p, n, None, None)
             out = _adaptimp.simulate(core, arm._core, p, record_every, None, None, None)
-    except (TypeError, ValueError, KeyError, ArithmeticError):
+    except (TypeError, ValueError, KeyError, ArithmeticError) as e:
+        if why is not None:
+            why.append(f"{type(e).__name__}: {e}")
         return None  # not a run the core can repeat from what was recorded
     out.pop("metrics")
     return {k: v for k, v in out.items() if isinstance(v, np.ndarray)}
@@ -510,21 +526,102 @@ def _resimulated(
 ) -> dict[str, NDArray[Any]]:
     """The arrays a format-3 file left to the core, run again and checked against
     the SHA-256 the save recorded."""
+    from . import __version__
+
     simulated: Mapping[str, Any] = manifest["simulated"]
-    rerun = _rerun(case, scenario, params, int(manifest["n"]), record_every)
+    why: list[str] = []
+    rerun = _rerun(case, scenario, params, int(manifest["n"]), record_every, why)
+    saved_by = manifest.get("adaptimp")
+    version = (
+        f"saved by adaptimp {saved_by}, which this is"
+        if saved_by == __version__
+        else f"saved by adaptimp {saved_by}, this is {__version__}"
+    )
     out: dict[str, NDArray[Any]] = {}
     for name, spec in simulated.items():
-        a = None if rerun is None else rerun.get(name)
-        if a is None or list(a.shape) != spec["shape"] or _digest(a) != spec["sha256"]:
+        if rerun is None:
             raise ValueError(
-                f"{path}: {name} was left to the simulation to recompute (saved by "
-                f"adaptimp {manifest.get('adaptimp')}), but running it again here does not "
-                "give the same bits (another version of the core, or another platform's "
-                "floating point): load it with the version that saved it, and save it there "
-                "with recompute=False for a file that any version reads"
+                f"{path}: {name} was left to the simulation to recompute, but the file's "
+                f"case {case!r}, scenario {scenario!r} and parameters do not describe a run "
+                f"the core can repeat ({'; '.join(why)}); {version}"
+            )
+        a = rerun.get(name)
+        if a is None or list(a.shape) != spec["shape"]:
+            got = "no such array" if a is None else f"shape {list(a.shape)}"
+            raise ValueError(
+                f"{path}: {name} was left to the simulation to recompute with shape "
+                f"{spec['shape']}, but running the file's case {case!r}, scenario "
+                f"{scenario!r} and parameters again gives {got}; {version}"
+            )
+        if _digest(a) != spec["sha256"]:
+            cause = (
+                "the file's case, scenario or parameters were edited after it was saved, "
+                "or this platform's floating point differs from the one that saved it"
+                if saved_by == __version__
+                else "the file's case, scenario or parameters were edited after it was "
+                "saved, or another version of the core or another platform's floating point "
+                "gives other bits: load it with the version that saved it, and save it "
+                "there with recompute=False for a file that any version reads"
+            )
+            raise ValueError(
+                f"{path}: {name} was left to the simulation to recompute, but running the "
+                f"file's case {case!r}, scenario {scenario!r} and parameters again does not "
+                f"give the same bits (SHA-256 {_digest(a)[:12]}…, the save recorded "
+                f"{spec['sha256'][:12]}…; {version}): {cause}"
             )
         out[name] = a
     return out
+
+
+def _input_digests(
+    case: str, scenario: str, params: Mapping[str, Any], record_every: int
+) -> dict[str, Any]:
+    """SHA-256 of what a saved file's arrays and metrics are a function of: the
+    case, the scenario, the rows kept and each parameter (its JSON, keys sorted)."""
+    import hashlib
+
+    def sha(value: Any) -> str:
+        text = json.dumps(value, sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    return {
+        "case": sha(case),
+        "scenario": sha(scenario),
+        "record_every": sha(record_every),
+        "params": {name: sha(value) for name, value in params.items()},
+    }
+
+
+def _check_inputs(
+    path: str | os.PathLike[str],
+    case: str,
+    scenario: str,
+    params: Mapping[str, Any],
+    record_every: int,
+    manifest: Mapping[str, Any],
+) -> None:
+    """Refuse a file whose case, scenario or parameters are not those its save
+    recorded (the file edited after it was saved), naming each that differs."""
+    recorded = manifest.get("inputs")
+    if recorded is None:  # saved before the inputs were recorded
+        return
+    now = _input_digests(case, scenario, params, record_every)
+    given = {"case": case, "scenario": scenario, "record_every": record_every}
+    changed = [f"the {k} ({v!r})" for k, v in given.items() if now[k] != recorded.get(k)]
+    saved, found = recorded.get("params", {}), now["params"]
+    changed += [
+        f"the parameter {k!r} (now {params[k]!r})"
+        for k in found
+        if k in saved and found[k] != saved[k]
+    ]
+    changed += [f"the parameter {k!r} (added)" for k in found if k not in saved]
+    changed += [f"the parameter {k!r} (removed)" for k in saved if k not in found]
+    if changed:
+        raise ValueError(
+            f"{path}: the file was edited after it was saved: {', '.join(changed)} "
+            f"{'is' if len(changed) == 1 else 'are'} not what the save recorded (its SHA-256 "
+            "differs), so its arrays and metrics are not those of a run with it"
+        )
 
 
 def _encode(

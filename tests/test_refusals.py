@@ -5,6 +5,7 @@ result whose metrics or parameters were edited, a URDF with several legs."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from pathlib import Path
@@ -321,3 +322,41 @@ def test_a_file_without_recorded_inputs_names_what_differs_and_both_causes(
     )
     with pytest.raises(ValueError, match=f"{re.escape(message)}$"):
         adaptimp.SimResult.load(broken)
+
+
+def test_metrics_edited_after_the_save_are_refused_or_recomputed(tmp_path: Path) -> None:
+    """A compressed save records each metric's SHA-256: an edited one is refused by
+    name. A file without that record (compress=False, an earlier version) has its
+    metrics recomputed from its rows by the core's accumulator (bit for bit the
+    run's), with a warning naming each that differed."""
+    res = adaptimp.simulate("sf", T=2.05)
+    path = res.save(tmp_path / "run")
+    edited = _edited(path, tmp_path / "m.npz", metrics=_set("rms_z1", 0.001))
+    message = (
+        f"{edited}: the file was edited after it was saved: the metric 'rms_z1' (now 0.001) "
+        "is not what the save recorded (its SHA-256 differs)"
+    )
+    with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+        adaptimp.SimResult.load(edited)
+    true = res.metrics["rms_z1_after2"]
+    for name, source in (
+        ("plain", res.save(tmp_path / "plain", compress=False)),
+        ("old", _edited(path, tmp_path / "old.npz", format=_without_metrics)),
+    ):
+        bad = _edited(source, tmp_path / f"{name}_m.npz", metrics=_set("rms_z1_after2", 0.5))
+        warning = (
+            f"{bad}: the stored metrics disagree with what its rows give (rms_z1_after2 = 0.5 "
+            f"stored, {true!r} from the rows); the file records no digest of them (saved with "
+            "compress=False, or by an earlier version): the metrics are recomputed from the rows"
+        )
+        with pytest.warns(UserWarning, match=f"^{re.escape(warning)}$"):
+            back = adaptimp.SimResult.load(bad)
+        assert back.metrics == res.metrics
+    # An edited result, saved: the file is faithful to it and loads as saved.
+    odd = dataclasses.replace(res, metrics={**res.metrics, "rms_z1": 1.0})
+    assert adaptimp.SimResult.load(odd.save(tmp_path / "odd")).metrics["rms_z1"] == 1.0
+
+
+def _without_metrics(m: dict[str, object]) -> dict[str, object]:
+    del m["metrics"]
+    return m

@@ -301,17 +301,29 @@ class SimResult:
         )
         stored, manifest = _encode(arrays, self.params, record_every, rerun)
         manifest["inputs"] = _input_digests(self.case, self.scenario, self.params, record_every)
+        manifest["metrics"] = {k: _sha_json(v) for k, v in self.metrics.items()}
         meta["format"] = np.array(json.dumps({"version": 3, **manifest}))
         np.savez_compressed(path, **{**stored, **meta})
         return path
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> SimResult:
-        """Read a result written by :meth:`save` (by this or an earlier version)."""
+        """Read a result written by :meth:`save` (by this or an earlier version).
+
+        The file's metrics are checked: against the SHA-256 of each that the
+        save recorded (a metric edited after the save is a ``ValueError``
+        naming it); in a file without that record (``compress=False``, an
+        earlier version) against its rows, where it holds every step: the
+        core's accumulator (the one the run used, bit for bit) recomputes them,
+        and a metric that differs is replaced, with a warning naming it and
+        both values (the impedance residual only where the parameters give the
+        target impedance, ``Dd``, ``Cd``, ``Gd``; not a MuJoCo run's).
+        """
         with np.load(path, allow_pickle=False) as f:
             params = json.loads(str(f["params"]))
             record_every = int(f["record_every"]) if "record_every" in f else 1
             names = [*ARRAYS, *EXTRA_ARRAYS]
+            manifest = None
             if "format" in f:
                 manifest = json.loads(str(f["format"]))
                 if manifest.get("version") not in (2, 3):
@@ -332,7 +344,7 @@ class SimResult:
                 arrays = _decode(f, manifest, params, record_every, simulated)
             else:  # format 1: plain float64 arrays
                 arrays = {name: f[name] for name in f if name not in _META}
-            return cls(
+            res = cls(
                 case=str(f["case"]),
                 scenario=str(f["scenario"]),
                 metrics=json.loads(str(f["metrics"])),
@@ -341,6 +353,8 @@ class SimResult:
                 **{name: arrays[name] for name in names if name in arrays},
                 **cls._own_fields(arrays),
             )
+        _check_metrics(path, res, manifest)
+        return res
 
     def _own_arrays(self) -> dict[str, NDArray[Any]]:
         """A subclass's own recorded arrays (one row per recorded step), by the
@@ -573,17 +587,101 @@ def _resimulated(
     return out
 
 
+def _same_metric(a: Any, b: Any) -> bool:
+    """Equal, NaN equal to NaN, element by element for lists."""
+    if isinstance(a, list) or isinstance(b, list):
+        return (
+            isinstance(a, list)
+            and isinstance(b, list)
+            and len(a) == len(b)
+            and all(_same_metric(x, y) for x, y in zip(a, b))
+        )
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return bool(a == b)
+
+
+def _metrics_of_rows(res: SimResult) -> dict[str, Any] | None:
+    """The metrics the core's accumulator gives for the rows of ``res`` (bit for
+    bit those of the run), or None where the rows cannot give them (every k-th
+    row kept, rates missing, no rows). Without ``Dd``, ``Cd``, ``Gd`` in the
+    parameters (a MuJoCo run) the impedance residual is left out."""
+    from . import _adaptimp
+
+    ddq, dxc, ddxc = res.ddq, res.dxc, res.ddxc
+    p = res.params
+    if res.record_every != 1 or res.rows == 0 or ddq is None or dxc is None or ddxc is None:
+        return None
+    if not isinstance(p.get("settle"), (int, float)):
+        return None
+    target = tuple(
+        np.broadcast_to(np.asarray(p.get(k, default), dtype=np.float64), (res.n,)).tolist()
+        for k, default in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0))
+    )
+    try:
+        again = dict(
+            _adaptimp.metrics(
+                res.t, res.q, res.dq, ddq, res.xc, dxc, ddxc, res.z1,
+                res.tau, res.tau_sat, res.tau_e, float(p["settle"]), target, None,
+            )
+        )  # fmt: skip
+    except ValueError:
+        return None
+    if not {"Dd", "Cd", "Gd"} <= set(p):
+        again.pop("imp_err_rms_after2", None)
+    return {k: v for k, v in again.items() if k in res.metrics}
+
+
+def _check_metrics(
+    path: str | os.PathLike[str], res: SimResult, manifest: Mapping[str, Any] | None
+) -> None:
+    """The stored metrics of a loaded result against the save's record, or its
+    rows (see :meth:`SimResult.load`)."""
+    recorded = None if manifest is None else manifest.get("metrics")
+    if recorded is not None:
+        now = {k: _sha_json(v) for k, v in res.metrics.items()}
+        changed = [f"{k!r} (now {res.metrics[k]!r})" for k in now if now[k] != recorded.get(k)]
+        changed += [f"{k!r} (removed)" for k in recorded if k not in now]
+        if changed:
+            raise ValueError(
+                f"{path}: the file was edited after it was saved: the "
+                f"{'metric' if len(changed) == 1 else 'metrics'} {', '.join(changed)} "
+                f"{'is' if len(changed) == 1 else 'are'} not what the save recorded (its "
+                "SHA-256 differs)"
+            )
+        return
+    again = _metrics_of_rows(res)
+    if again is None:
+        return
+    differ = [k for k in again if not _same_metric(res.metrics[k], again[k])]
+    if differ:
+        import warnings
+
+        values = "; ".join(
+            f"{k} = {res.metrics[k]!r} stored, {again[k]!r} from the rows" for k in differ
+        )
+        warnings.warn(
+            f"{path}: the stored metrics disagree with what its rows give ({values}); "
+            "the file records no digest of them (saved with compress=False, or by an "
+            "earlier version): the metrics are recomputed from the rows",
+            stacklevel=3,
+        )
+        res.metrics.update({k: again[k] for k in differ})
+
+
+def _sha_json(value: Any) -> str:
+    """SHA-256 of ``value``'s JSON (keys sorted)."""
+    import hashlib
+
+    return hashlib.sha256(json.dumps(value, sort_keys=True).encode()).hexdigest()
+
+
 def _input_digests(
     case: str, scenario: str, params: Mapping[str, Any], record_every: int
 ) -> dict[str, Any]:
     """SHA-256 of what a saved file's arrays and metrics are a function of: the
     case, the scenario, the rows kept and each parameter (its JSON, keys sorted)."""
-    import hashlib
-
-    def sha(value: Any) -> str:
-        text = json.dumps(value, sort_keys=True)
-        return hashlib.sha256(text.encode()).hexdigest()
-
+    sha = _sha_json
     return {
         "case": sha(case),
         "scenario": sha(scenario),

@@ -360,3 +360,41 @@ def test_metrics_edited_after_the_save_are_refused_or_recomputed(tmp_path: Path)
 def _without_metrics(m: dict[str, object]) -> dict[str, object]:
     del m["metrics"]
     return m
+
+
+def test_a_settle_below_zero_or_beyond_the_run_is_refused_by_both_plants() -> None:
+    """settle ≥ 0 is the core's condition, on the rigid plant and on MuJoCo (either
+    loop); a settle given beyond the run's last step would leave the 'after'
+    metrics NaN: refused, naming the last step. The last step itself is fine."""
+    from adaptimp import mujoco as amj
+    from adaptimp.baselines import ComputedTorque
+
+    below = "condition settle ≥ 0 is violated: settle = -1 (SPEC §10)"
+    beyond = (
+        "settle = {s:g} s starts the metrics' window t ≥ settle after the run's last step "
+        "(t = {last:g} s; T = 0.2 s at Ts = {Ts:g} s), so its metrics would be NaN: give "
+        "settle ≤ {last:g} s, or a longer T"
+    )
+    runs = (
+        (lambda s: adaptimp.simulate("sf", T=0.2, settle=s), 5e-5),
+        (lambda s: amj.simulate("sf", "panda", T=0.2, settle=s), 1e-3),  # the core's loop
+        (  # a loop in Python (a Python controller)
+            lambda s: amj.simulate(
+                ComputedTorque(Ts=1e-3), "two_link",
+                T=0.2, settle=s,
+            ),
+            1e-3,
+        ),
+    )  # fmt: skip
+    for run, ts in runs:
+        with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(below)}$"):
+            run(-1.0)
+        last = 0.2 - ts
+        for s in (5.0, 0.2):
+            message = beyond.format(s=s, last=last, Ts=ts)
+            with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
+                run(s)
+        res = run(last)
+        assert math.isfinite(res.metrics["rms_z1_after2"])
+    # The default settle (2 s) on a shorter run keeps its documented NaN.
+    assert math.isnan(adaptimp.simulate("sf", T=0.2).metrics["rms_z1_after2"])

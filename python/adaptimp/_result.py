@@ -100,7 +100,8 @@ class SimResult:
         ``peak_contact_after2``, ``mean_contact``, ``peak_abs_tau``,
         ``imp_err_rms_after2`` and ``rows`` (per-joint ones as lists). "after2"
         means t ≥ ``params["settle"]`` (2 s by default); those are NaN if the run
-        is shorter.
+        is shorter than the default (a ``settle`` given beyond the run's last
+        step is refused before the run, SPEC §12).
     params : dict
         Every parameter that ran (JSON-serialisable).
     case : str

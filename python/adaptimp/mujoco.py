@@ -50,7 +50,7 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._errors import needs_extra
+from ._errors import ConfigError, needs_extra
 
 try:
     import mujoco
@@ -1565,7 +1565,10 @@ def simulate(
     contact : bool
         False: free space (MuJoCo's contact disabled). Ignored for a Plant.
     settle : float, optional
-        Start of the "after2" metrics (s); default the scenario's (2 s).
+        Start of the "after2" metrics (s), ≥ 0; default the scenario's (2 s),
+        whose metrics are NaN for a shorter run. One given must leave a
+        recorded step in the window (settle ≤ (round(T/Ts) − 1) Ts), as in
+        :func:`adaptimp.simulate`.
     scenario : {"robot", "paper"}
         Defaults for a case name (see :func:`adaptimp.simulate`).
     record_every : int
@@ -1732,7 +1735,7 @@ def _setup(
     plant at its initial state, the settings and the choice of loop."""
     from . import Controller
     from ._api import _record_every
-    from ._params import SCENARIOS, resolve
+    from ._params import SCENARIOS, check_settle, resolve
 
     defaults = SCENARIOS.get(scenario)
     if defaults is None:
@@ -1777,6 +1780,7 @@ def _setup(
         raise ValueError(f"Ts = {Ts:g} s differs from the controller's period {period:g} s")
     Ts = period
     T = float(defaults["T"]) if T is None else float(T)
+    given_settle = settle is not None
     settle = float(defaults["settle"]) if settle is None else float(settle)
     # Checked before it is used: round(inf) overflows, round(nan) raises.
     if not (math.isfinite(T) and T > 0):
@@ -1786,6 +1790,13 @@ def _setup(
     steps = round(T / Ts)
     if steps < 1:
         raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
+    # As the rigid plant's simulate (the core's condition, for either loop).
+    if not math.isfinite(settle):
+        raise ConfigError(f"settle must be finite, got {settle!r}")
+    if settle < 0:
+        raise ConfigError(f"condition settle ≥ 0 is violated: settle = {settle:g} (SPEC §10)")
+    if given_settle:
+        check_settle(settle, T, Ts)
     if substeps is None:
         substeps = max(1, round(Ts / plant.timestep))
     if substeps < 1:

@@ -398,3 +398,16 @@ def test_a_settle_below_zero_or_beyond_the_run_is_refused_by_both_plants() -> No
         assert math.isfinite(res.metrics["rms_z1_after2"])
     # The default settle (2 s) on a shorter run keeps its documented NaN.
     assert math.isnan(adaptimp.simulate("sf", T=0.2).metrics["rms_z1_after2"])
+
+
+def test_the_panda_s_scenario_refuses_a_urdf_s_keywords() -> None:
+    """arm_table(urdf=None) is the Panda's own scenario: tip, fix and home would
+    be ignored; refused, naming them."""
+    message = (
+        "tip, home apply to the arm of a URDF; the Panda's scenario (urdf=None) has its own "
+        "tool body, fixed fingers and home posture: give the Panda's URDF path to set them"
+    )
+    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
+        act.arm_table(tip="panda_link8", home=HOME)
+    with pytest.raises(adaptimp.ConfigError, match=r"^fix applies to the arm of a URDF"):
+        act.arm_table(fix=("panda_joint7",))

@@ -317,7 +317,8 @@ def arm_table(
     t_ramp: float = 1.0,
 ) -> PandaTable:
     """The table scenario for the arm of ``urdf`` (None: the Panda of
-    :func:`adaptimp.panda_table.panda_table`, whose table and circle are kept).
+    :func:`adaptimp.panda_table.panda_table`, whose table and circle are kept,
+    and which refuses ``tip``, ``fix`` and ``home``: it has its own).
 
     ``tip``: the tool's body (default: the child link of the arm's last joint).
     The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
@@ -339,6 +340,15 @@ def arm_table(
         tool_radius=tool_radius, Ts=Ts, t_approach=t_approach, t_ramp=t_ramp,
     )  # fmt: skip
     if urdf is None:
+        # The Panda's scenario has its own tool body, fixed fingers and home.
+        given = {"tip": tip, "fix": fix or None, "home": home}
+        ignored = [k for k, v in given.items() if v is not None]
+        if ignored:
+            raise ConfigError(
+                f"{', '.join(ignored)} {'applies' if len(ignored) == 1 else 'apply'} to the arm "
+                "of a URDF; the Panda's scenario (urdf=None) has its own tool body, fixed "
+                "fingers and home posture: give the Panda's URDF path to set them"
+            )
         sc = panda_table(
             radius=radius,
             freq=freq,

@@ -234,7 +234,7 @@ pub const PARAMS: &[Param] = &[
     ),
     p("q0", Sim, Joint, "rad", "initial joint position q(0), (65)", "", V(&[0.25, -0.05])),
     p("dq0", Sim, Joint, "rad/s", "initial joint velocity q̇(0)", "", R(0.0)),
-    p("settle", Sim, Real, "s", "start of the 'after2' window of the metrics (SPEC §12)", "", R(2.0)),
+    p("settle", Sim, Real, "s", "start of the 'after2' window of the metrics (SPEC §12)", "settle ≥ 0", R(2.0)),
     // Disturbances a real robot has (SPEC §17, src/sim/disturb.rs); the defaults
     // disturb nothing. The controller is told none of them.
     p("payload", Sim, Real, "kg", "point mass at the tip of the last link (the plant's only)", "payload ≥ 0", R(0.0)),

@@ -286,6 +286,41 @@ fn one_link_pendulum_on_the_sixteen_node_grid_learns() {
     );
 }
 
+#[test]
+fn a_metrics_window_before_the_start_is_refused_by_name() {
+    let arm = PlanarArm::new([link(1.0, 0.5)], 9.81).expect("arm");
+    let traj = Sinusoid::new(
+        Vector::<1>::new(0.2),
+        Vector::<1>::new(0.3),
+        Vector::<1>::new(0.0),
+        Vector::<1>::new(2.0),
+    )
+    .expect("trajectory");
+    let go = |settle: f64| {
+        let sim = SimConfig {
+            t_final: 0.01,
+            substeps: 1,
+            q0: Vector::<1>::new(0.2),
+            dq0: Vector::zeros(),
+            settle,
+        };
+        let cfg = Config::<1>::new(Law::Pd, Vector::<1>::new(20.0));
+        let rbf = Grid::<1>::new(25.0).expect("grid");
+        let mut ctrl = Tracker::new(Controller::new(cfg, rbf).expect("controller"), traj);
+        run(&arm, &FreeSpace, &mut ctrl, &traj, &sim, &mut ())
+    };
+    let e = go(-1.0).expect_err("settle < 0");
+    assert_eq!(
+        e.to_string(),
+        "condition settle ≥ 0 is violated: settle = -1 (SPEC §10)"
+    );
+    assert!(go(f64::NAN)
+        .expect_err("NaN")
+        .to_string()
+        .contains("settle"));
+    assert!(go(0.0).expect("settle = 0").rms_z1_after2.is_finite());
+}
+
 trait AtZero<const N: usize> {
     fn sample_at_zero(&self) -> Vector<N>;
 }

@@ -179,7 +179,7 @@ def test_a_rerun_that_differs_from_the_save_is_refused(tmp_path: Path) -> None:
     np.savez(tmp_path / "other.npz", **content)
     with pytest.raises(
         ValueError,
-        match=r"zeta was left to the simulation to recompute .* does not give the same bits",
+        match=r"zeta was left to the simulation to recompute, .* does not give the same bits",
     ):
         SimResult.load(tmp_path / "other.npz")
 

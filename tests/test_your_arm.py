@@ -213,15 +213,18 @@ def test_the_arm_of_a_urdf_is_its_serial_chain() -> None:
     assert a.joints == ("a1", "a2", "a3")
     assert a.tip == "palm"
     assert set(a.fixed) == {"f1a", "f1b", "f2a", "f2b"}
-    # A torso of one joint with two arms of three: the chain goes on along
-    # the first arm (the arms are longer than the torso); the other is fixed.
+    # A torso of one joint with two arms of three: the chain goes on along an
+    # arm (the arms are longer than the torso), but the two tie: which one is
+    # the user's to say (tip=); the other is then fixed.
     body = [("t", "revolute", "root", "torso", LIM)]
     for side in ("l", "r"):
         parent = "torso"
         for k in range(3):
             body.append((f"{side}{k}", "revolute", parent, f"{side}{k}link", LIM))
             parent = f"{side}{k}link"
-    a = _models.arm_urdf(_urdf(body))
+    with pytest.raises(ValueError, match=r"2 serial chains of 4 joints .* 'l2link', 'r2link'"):
+        _models.arm_urdf(_urdf(body))
+    a = _models.arm_urdf(_urdf(body), tip="l2link")
     assert a.joints == ("t", "l0", "l1", "l2")
     assert a.fixed == dict.fromkeys(("r0", "r1", "r2"), "off the arm's chain (a branch)")
     # A robot that is itself a finger keeps its joints; limits of "0 0" mean

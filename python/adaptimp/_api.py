@@ -22,6 +22,7 @@ from ._params import (
     check_case,
     check_n,
     check_scenario,
+    check_settle,
     describe,
     names,
     resolve,
@@ -296,6 +297,8 @@ def simulate(
     ):
         raise TypeError("give the arm's parameters to the arm, not to simulate(), with arm=")
     p = resolve(params, scenario=scenario, caller="simulate()", n=n)
+    if "settle" in params:
+        check_settle(p["settle"], p["T"], p["Ts"])
     c, eta = _basis(n, centers, widths, p)
     core = _core_controller(case, p, n, c, None if eta is None else eta**2)
     _check_stability(core, p, stacklevel=2)

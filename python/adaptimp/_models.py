@@ -158,7 +158,7 @@ def _float(e: ET.Element | None, name: str, default: float) -> float:
         return default
 
 
-def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
+def arm_urdf(text: str, fix: tuple[str, ...] = (), *, tip: str | None = None) -> ArmURDF:
     """The serial arm of a URDF, as :func:`adaptimp.mujoco.from_urdf` and
     :func:`adaptimp.baselines.pinocchio_model` load it (one reduction for both).
 
@@ -167,8 +167,10 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
     - joints named in ``fix``, prismatic joints (a linear axis or a finger)
       and mimic joints are fixed;
     - the arm is the longest serial chain of the remaining revolute and
-      continuous joints from the root (the most of them on one path; the
-      first in document order on a tie), and it ends where the tree branches
+      continuous joints from the root (the most of them on one path; chains
+      that tie, such as a quadruped's legs or a robot's two arms, are an
+      error that lists where each ends, unless ``tip`` names the link that
+      ends the arm), and it ends where the tree branches
       into two or more subtrees with movable joints that are each shorter
       than the chain so far (a hand: fingers are shorter than the arm that
       holds them; a humanoid's arms are longer than its torso, so the chain
@@ -176,7 +178,9 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
     - a joint whose name contains a word of :data:`GRIPPER_WORDS` is fixed
       when it comes after a joint of the arm whose name does not (a gripper
       on the arm; a robot that is itself a finger keeps its joints);
-    - movable joints off the arm (another arm, a head, a hand) are fixed.
+    - movable joints off the arm (another arm, a head, a hand) are fixed;
+    - with ``tip`` (a link), the arm is the movable joints on the path from
+      the root to it, the rules above fixing the rest.
 
     A revolute joint whose limits leave no range (lower ≥ upper, often
     "0 0" in exported files) is taken as unlimited: a continuous joint.
@@ -227,10 +231,11 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
         words = [w for w in GRIPPER_WORDS if w in j.get("name", "").lower()]
         return words[0] if words else None
 
-    def longest(link: str, held: int, arm: bool) -> list[ET.Element]:
+    def longest(link: str, held: int, arm: bool) -> list[list[ET.Element]]:
         """The movable joints of the arm's chain below ``link``, with ``held``
-        joints above it, ``arm`` if one of them is not a gripper's."""
-        options = []
+        joints above it, ``arm`` if one of them is not a gripper's: every chain
+        of the greatest length (several if they tie)."""
+        per_child: list[list[list[ET.Element]]] = []
         for j in children.get(link, []):
             child = j.find("child")
             assert child is not None
@@ -241,13 +246,44 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
             below = longest(
                 child.get("link", ""), held + len(own), arm or (bool(own) and word is None)
             )
-            options.append(own + below)
-        carrying = [c for c in options if c]
+            per_child.append([own + b for b in below])
+        carrying = [c[0] for c in per_child if c[0]]
         if held > 0 and len(carrying) >= 2 and all(len(c) < held for c in carrying):
-            return []  # a hand: the arm ends here
-        return max(options, key=len, default=[])
+            return [[]]  # a hand: the arm ends here
+        every = [c for options in per_child for c in options]
+        best = max((len(c) for c in every), default=0)
+        return [c for c in every if len(c) == best] if best > 0 else [[]]
 
-    chain = longest(roots[0], 0, False)
+    def link_of(j: ET.Element) -> str:
+        child = j.find("child")
+        return "" if child is None else child.get("link", "")
+
+    longest_chains = longest(roots[0], 0, False)
+    if tip is not None:
+        by_child = {link_of(j): j for j in root.findall("joint")}
+        if tip not in by_child and tip != roots[0]:
+            raise ValueError(f"the URDF has no link named {tip!r} (tip=)")
+        path: list[ET.Element] = []
+        link = tip
+        while link in by_child:
+            path.append(by_child[link])
+            parent = by_child[link].find("parent")
+            link = "" if parent is None else parent.get("link", "")
+        chain = [j for j in reversed(path) if movable(j)]
+        if not chain:
+            raise ValueError(
+                f"the URDF has no revolute or continuous joint to drive on the way to {tip!r}"
+            )
+    else:
+        chain = longest_chains[0]
+        if len(longest_chains) > 1:
+            tips = ", ".join(repr(link_of(c[-1])) for c in longest_chains)
+            raise ValueError(
+                f"the URDF has {len(longest_chains)} serial chains of {len(chain)} joints "
+                f"from the root that tie for the arm (legs, or two arms), ending at the "
+                f"links {tips}: name one with tip= (adaptimp.mujoco.from_urdf(path, tip=...), "
+                "adaptimp.contact.arm_table(path, tip=...)) or fix the others' joints with fix="
+            )
     on_chain = {j.get("name", "") for j in chain}
     for j in root.findall("joint"):
         name = j.get("name", "")
@@ -277,14 +313,14 @@ def arm_urdf(text: str, fix: tuple[str, ...] = ()) -> ArmURDF:
             upper.append(_float(lim, "upper", math.inf))
         given = _float(lim, "effort", math.nan)
         effort.append(given if given > 0 and math.isfinite(given) else math.nan)
-    tip = chain[-1].find("child")
-    assert tip is not None
+    end = chain[-1].find("child")
+    assert end is not None
     return ArmURDF(
         text=ET.tostring(root, encoding="unicode"),
         joints=tuple(j.get("name", "") for j in chain),
         lower=tuple(lower),
         upper=tuple(upper),
         effort=tuple(effort),
-        tip=tip.get("link", ""),
+        tip=end.get("link", ""),
         fixed=fixed,
     )

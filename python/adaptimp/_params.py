@@ -287,6 +287,25 @@ def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
 # ---------------------------------------------------------------------------
 
 
+def check_settle(settle: float, T: float, Ts: float) -> None:
+    """Refuse a ``settle`` (s) the caller gave that starts the metrics' window
+    t ≥ settle after the run's last recorded step, t = (round(T/Ts) − 1) Ts:
+    the window's metrics would be NaN. (The default settle keeps its
+    documented NaN for a shorter run; settle ≥ 0 is the core's check.)"""
+    if not (math.isfinite(T) and math.isfinite(Ts) and T > 0 and Ts > 0):
+        return  # the core names these
+    steps = round(T / Ts)
+    if steps < 1 or not math.isfinite(settle):
+        return
+    last = (steps - 1) * Ts
+    if settle > last + 1e-9:
+        raise ConfigError(
+            f"settle = {settle:g} s starts the metrics' window t ≥ settle after the run's "
+            f"last step (t = {last:g} s; T = {T:g} s at Ts = {Ts:g} s), so its metrics would "
+            f"be NaN: give settle ≤ {last:g} s, or a longer T"
+        )
+
+
 def check_case(case: object) -> str:
     """``case`` if it is one of :data:`CASES`, else ``ValueError``/``TypeError``."""
     if not isinstance(case, str):

@@ -100,7 +100,8 @@ class SimResult:
         ``peak_contact_after2``, ``mean_contact``, ``peak_abs_tau``,
         ``imp_err_rms_after2`` and ``rows`` (per-joint ones as lists). "after2"
         means t ≥ ``params["settle"]`` (2 s by default); those are NaN if the run
-        is shorter.
+        is shorter than the default (a ``settle`` given beyond the run's last
+        step is refused before the run, SPEC §12).
     params : dict
         Every parameter that ran (JSON-serialisable).
     case : str
@@ -300,17 +301,30 @@ class SimResult:
             else None
         )
         stored, manifest = _encode(arrays, self.params, record_every, rerun)
+        manifest["inputs"] = _input_digests(self.case, self.scenario, self.params, record_every)
+        manifest["metrics"] = {k: _sha_json(v) for k, v in self.metrics.items()}
         meta["format"] = np.array(json.dumps({"version": 3, **manifest}))
         np.savez_compressed(path, **{**stored, **meta})
         return path
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> SimResult:
-        """Read a result written by :meth:`save` (by this or an earlier version)."""
+        """Read a result written by :meth:`save` (by this or an earlier version).
+
+        The file's metrics are checked: against the SHA-256 of each that the
+        save recorded (a metric edited after the save is a ``ValueError``
+        naming it); in a file without that record (``compress=False``, an
+        earlier version) against its rows, where it holds every step: the
+        core's accumulator (the one the run used, bit for bit) recomputes them,
+        and a metric that differs is replaced, with a warning naming it and
+        both values (the impedance residual only where the parameters give the
+        target impedance, ``Dd``, ``Cd``, ``Gd``; not a MuJoCo run's).
+        """
         with np.load(path, allow_pickle=False) as f:
             params = json.loads(str(f["params"]))
             record_every = int(f["record_every"]) if "record_every" in f else 1
             names = [*ARRAYS, *EXTRA_ARRAYS]
+            manifest = None
             if "format" in f:
                 manifest = json.loads(str(f["format"]))
                 if manifest.get("version") not in (2, 3):
@@ -318,6 +332,9 @@ class SimResult:
                         f"{path}: saved in format {manifest.get('version')!r}, which this "
                         "version of adaptimp cannot read (it reads 1, 2 and 3)"
                     )
+                _check_inputs(
+                    path, str(f["case"]), str(f["scenario"]), params, record_every, manifest
+                )
                 simulated = (
                     _resimulated(
                         path, str(f["case"]), str(f["scenario"]), params, record_every, manifest
@@ -328,7 +345,7 @@ class SimResult:
                 arrays = _decode(f, manifest, params, record_every, simulated)
             else:  # format 1: plain float64 arrays
                 arrays = {name: f[name] for name in f if name not in _META}
-            return cls(
+            res = cls(
                 case=str(f["case"]),
                 scenario=str(f["scenario"]),
                 metrics=json.loads(str(f["metrics"])),
@@ -337,6 +354,8 @@ class SimResult:
                 **{name: arrays[name] for name in names if name in arrays},
                 **cls._own_fields(arrays),
             )
+        _check_metrics(path, res, manifest)
+        return res
 
     def _own_arrays(self) -> dict[str, NDArray[Any]]:
         """A subclass's own recorded arrays (one row per recorded step), by the
@@ -460,13 +479,19 @@ def _best_order(a: NDArray[np.float64]) -> int:
 
 
 def _rerun(
-    case: str, scenario: str, params: Mapping[str, Any], n: int, record_every: int
+    case: str,
+    scenario: str,
+    params: Mapping[str, Any],
+    n: int,
+    record_every: int,
+    why: list[str] | None = None,
 ) -> dict[str, NDArray[Any]] | None:
     """The arrays of :func:`adaptimp.simulate` run again from the recorded case,
     scenario and parameters alone (the default arm for n, the vertex grid or the
     rule's centres, zero initial weights, no fault), keeping every
     ``record_every``-th step; None where those do not describe a run the core
-    can repeat (another arm, user centres, an unknown parameter)."""
+    can repeat (another arm, user centres, an unknown parameter), the reason
+    appended to ``why``."""
     import warnings
 
     from . import _adaptimp, _api
@@ -481,14 +506,20 @@ def _rerun(
         else:
             arm = _api.PlanarArm(n)
             if params.get("arm") != arm.params:
+                if why is not None:
+                    why.append("its arm is not the default arm of its n")
                 return None
         if "nodes" in params:  # user centres (not recorded)
+            if why is not None:
+                why.append("it used centres of the user's (not recorded)")
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             core = _api._core_controller(case, p, n, None, None)
             out = _adaptimp.simulate(core, arm._core, p, record_every, None, None, None)
-    except (TypeError, ValueError, KeyError, ArithmeticError):
+    except (TypeError, ValueError, KeyError, ArithmeticError) as e:
+        if why is not None:
+            why.append(f"{type(e).__name__}: {e}")
         return None  # not a run the core can repeat from what was recorded
     out.pop("metrics")
     return {k: v for k, v in out.items() if isinstance(v, np.ndarray)}
@@ -510,21 +541,186 @@ def _resimulated(
 ) -> dict[str, NDArray[Any]]:
     """The arrays a format-3 file left to the core, run again and checked against
     the SHA-256 the save recorded."""
+    from . import __version__
+
     simulated: Mapping[str, Any] = manifest["simulated"]
-    rerun = _rerun(case, scenario, params, int(manifest["n"]), record_every)
+    why: list[str] = []
+    rerun = _rerun(case, scenario, params, int(manifest["n"]), record_every, why)
+    saved_by = manifest.get("adaptimp")
+    version = (
+        f"saved by adaptimp {saved_by}, which this is"
+        if saved_by == __version__
+        else f"saved by adaptimp {saved_by}, this is {__version__}"
+    )
     out: dict[str, NDArray[Any]] = {}
     for name, spec in simulated.items():
-        a = None if rerun is None else rerun.get(name)
-        if a is None or list(a.shape) != spec["shape"] or _digest(a) != spec["sha256"]:
+        if rerun is None:
             raise ValueError(
-                f"{path}: {name} was left to the simulation to recompute (saved by "
-                f"adaptimp {manifest.get('adaptimp')}), but running it again here does not "
-                "give the same bits (another version of the core, or another platform's "
-                "floating point): load it with the version that saved it, and save it there "
-                "with recompute=False for a file that any version reads"
+                f"{path}: {name} was left to the simulation to recompute, but the file's "
+                f"case {case!r}, scenario {scenario!r} and parameters do not describe a run "
+                f"the core can repeat ({'; '.join(why)}); {version}"
+            )
+        a = rerun.get(name)
+        if a is None or list(a.shape) != spec["shape"]:
+            got = "no such array" if a is None else f"shape {list(a.shape)}"
+            raise ValueError(
+                f"{path}: {name} was left to the simulation to recompute with shape "
+                f"{spec['shape']}, but running the file's case {case!r}, scenario "
+                f"{scenario!r} and parameters again gives {got}; {version}"
+            )
+        if _digest(a) != spec["sha256"]:
+            cause = (
+                "the file's case, scenario or parameters were edited after it was saved, "
+                "or this platform's floating point differs from the one that saved it"
+                if saved_by == __version__
+                else "the file's case, scenario or parameters were edited after it was "
+                "saved, or another version of the core or another platform's floating point "
+                "gives other bits: load it with the version that saved it, and save it "
+                "there with recompute=False for a file that any version reads"
+            )
+            raise ValueError(
+                f"{path}: {name} was left to the simulation to recompute, but running the "
+                f"file's case {case!r}, scenario {scenario!r} and parameters again does not "
+                f"give the same bits (SHA-256 {_digest(a)[:12]}…, the save recorded "
+                f"{spec['sha256'][:12]}…; {version}): {cause}"
             )
         out[name] = a
     return out
+
+
+def _same_metric(a: Any, b: Any) -> bool:
+    """Equal, NaN equal to NaN, element by element for lists."""
+    if isinstance(a, list) or isinstance(b, list):
+        return (
+            isinstance(a, list)
+            and isinstance(b, list)
+            and len(a) == len(b)
+            and all(_same_metric(x, y) for x, y in zip(a, b))
+        )
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return bool(a == b)
+
+
+def _metrics_of_rows(res: SimResult) -> dict[str, Any] | None:
+    """The metrics the core's accumulator gives for the rows of ``res`` (bit for
+    bit those of the run), or None where the rows cannot give them (every k-th
+    row kept, rates missing, no rows). Without ``Dd``, ``Cd``, ``Gd`` in the
+    parameters (a MuJoCo run) the impedance residual is left out."""
+    from . import _adaptimp
+
+    ddq, dxc, ddxc = res.ddq, res.dxc, res.ddxc
+    p = res.params
+    if res.record_every != 1 or res.rows == 0 or ddq is None or dxc is None or ddxc is None:
+        return None
+    if not isinstance(p.get("settle"), (int, float)):
+        return None
+    target = tuple(
+        np.broadcast_to(np.asarray(p.get(k, default), dtype=np.float64), (res.n,)).tolist()
+        for k, default in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0))
+    )
+    try:
+        again = dict(
+            _adaptimp.metrics(
+                res.t, res.q, res.dq, ddq, res.xc, dxc, ddxc, res.z1,
+                res.tau, res.tau_sat, res.tau_e, float(p["settle"]), target, None,
+            )
+        )  # fmt: skip
+    except ValueError:
+        return None
+    if not {"Dd", "Cd", "Gd"} <= set(p):
+        again.pop("imp_err_rms_after2", None)
+    return {k: v for k, v in again.items() if k in res.metrics}
+
+
+def _check_metrics(
+    path: str | os.PathLike[str], res: SimResult, manifest: Mapping[str, Any] | None
+) -> None:
+    """The stored metrics of a loaded result against the save's record, or its
+    rows (see :meth:`SimResult.load`)."""
+    recorded = None if manifest is None else manifest.get("metrics")
+    if recorded is not None:
+        now = {k: _sha_json(v) for k, v in res.metrics.items()}
+        changed = [f"{k!r} (now {res.metrics[k]!r})" for k in now if now[k] != recorded.get(k)]
+        changed += [f"{k!r} (removed)" for k in recorded if k not in now]
+        if changed:
+            raise ValueError(
+                f"{path}: the file was edited after it was saved: the "
+                f"{'metric' if len(changed) == 1 else 'metrics'} {', '.join(changed)} "
+                f"{'is' if len(changed) == 1 else 'are'} not what the save recorded (its "
+                "SHA-256 differs)"
+            )
+        return
+    again = _metrics_of_rows(res)
+    if again is None:
+        return
+    differ = [k for k in again if not _same_metric(res.metrics[k], again[k])]
+    if differ:
+        import warnings
+
+        values = "; ".join(
+            f"{k} = {res.metrics[k]!r} stored, {again[k]!r} from the rows" for k in differ
+        )
+        warnings.warn(
+            f"{path}: the stored metrics disagree with what its rows give ({values}); "
+            "the file records no digest of them (saved with compress=False, or by an "
+            "earlier version): the metrics are recomputed from the rows",
+            stacklevel=3,
+        )
+        res.metrics.update({k: again[k] for k in differ})
+
+
+def _sha_json(value: Any) -> str:
+    """SHA-256 of ``value``'s JSON (keys sorted)."""
+    import hashlib
+
+    return hashlib.sha256(json.dumps(value, sort_keys=True).encode()).hexdigest()
+
+
+def _input_digests(
+    case: str, scenario: str, params: Mapping[str, Any], record_every: int
+) -> dict[str, Any]:
+    """SHA-256 of what a saved file's arrays and metrics are a function of: the
+    case, the scenario, the rows kept and each parameter (its JSON, keys sorted)."""
+    sha = _sha_json
+    return {
+        "case": sha(case),
+        "scenario": sha(scenario),
+        "record_every": sha(record_every),
+        "params": {name: sha(value) for name, value in params.items()},
+    }
+
+
+def _check_inputs(
+    path: str | os.PathLike[str],
+    case: str,
+    scenario: str,
+    params: Mapping[str, Any],
+    record_every: int,
+    manifest: Mapping[str, Any],
+) -> None:
+    """Refuse a file whose case, scenario or parameters are not those its save
+    recorded (the file edited after it was saved), naming each that differs."""
+    recorded = manifest.get("inputs")
+    if recorded is None:  # saved before the inputs were recorded
+        return
+    now = _input_digests(case, scenario, params, record_every)
+    given = {"case": case, "scenario": scenario, "record_every": record_every}
+    changed = [f"the {k} ({v!r})" for k, v in given.items() if now[k] != recorded.get(k)]
+    saved, found = recorded.get("params", {}), now["params"]
+    changed += [
+        f"the parameter {k!r} (now {params[k]!r})"
+        for k in found
+        if k in saved and found[k] != saved[k]
+    ]
+    changed += [f"the parameter {k!r} (added)" for k in found if k not in saved]
+    changed += [f"the parameter {k!r} (removed)" for k in saved if k not in found]
+    if changed:
+        raise ValueError(
+            f"{path}: the file was edited after it was saved: {', '.join(changed)} "
+            f"{'is' if len(changed) == 1 else 'are'} not what the save recorded (its SHA-256 "
+            "differs), so its arrays and metrics are not those of a run with it"
+        )
 
 
 def _encode(

@@ -144,6 +144,8 @@ class CartesianImpedance:
         Whose defaults (the Cartesian ones are the same in every scenario).
     **params
         The group "cartesian" of the schema (``Kd``, ``Kd_rot``, …).
+        ``admittance_share`` applies to ``formulation="unified"`` only: given
+        with another formulation it is a ``ConfigError`` naming both.
     """
 
     def __init__(
@@ -161,6 +163,15 @@ class CartesianImpedance:
         self.params = resolve(
             params, scenario=scenario, groups=("cartesian",), caller="CartesianImpedance()"
         )
+        if "admittance_share" in params and self.params["formulation"] != "unified":
+            # The schema keeps a default share in every parameter set; one the
+            # caller gives with another formulation would be ignored unseen.
+            raise ConfigError(
+                f"admittance_share = {params['admittance_share']!r} has no effect with "
+                f"formulation={self.params['formulation']!r}: it is the admittance's share "
+                "of the torque for formulation='unified' only (give formulation='unified', "
+                "or leave admittance_share out)"
+            )
         self.q0 = np.array(q0, dtype=np.float64)
         self._core = _adaptimp.CartesianImpedance(chain, self.params, float(Ts), self.q0, posture)
         self.Ts = float(Ts)

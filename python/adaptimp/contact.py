@@ -203,18 +203,53 @@ def placement(
     within ``limits`` = (lo, hi) (rad), each clipped to ±π, seed ``seed``); the
     table top lies :data:`CLEARANCE` below the tool sphere at home.
 
-    Returns (centre (2,) m, table top m, R m).
+    Returns (centre (2,) m, table top m, R m). ``ConfigError`` (naming it and
+    the value) for a ``tool_radius`` that is not a finite number > 0, a
+    ``home`` or a limit that is not n finite numbers, and lo > hi.
     """
-    q = np.asarray(home, dtype=np.float64)
+    _check_scenario(tool_radius=tool_radius)
+    q = _joint_vector("home", home, chain)
+    unlimited = " (±π for an unlimited joint)"
+    lo_given = _joint_vector("limits[0] (lo)", limits[0], chain, unlimited)
+    hi_given = _joint_vector("limits[1] (hi)", limits[1], chain, unlimited)
+    inverted = np.flatnonzero(lo_given > hi_given)
+    if inverted.size:
+        i = int(inverted[0])
+        raise ConfigError(
+            f"limits must have lo ≤ hi for every joint; joint {i} ({chain.joint_names[i]!r}) "
+            f"has lo = {float(lo_given[i])!r} > hi = {float(hi_given[i])!r}"
+        )
     p = np.asarray(chain.fk(q)[:3, 3], dtype=np.float64)
-    lo = np.clip(np.asarray(limits[0], dtype=np.float64), -math.pi, math.pi)
-    hi = np.clip(np.asarray(limits[1], dtype=np.float64), -math.pi, math.pi)
+    lo = np.clip(lo_given, -math.pi, math.pi)
+    hi = np.clip(hi_given, -math.pi, math.pi)
     samples = np.random.default_rng(seed).uniform(lo, hi, size=(1024, q.shape[0]))
     reach = max(float(np.linalg.norm(chain.fk(s)[:2, 3])) for s in samples)
     radial = float(np.linalg.norm(p[:2]))
     u = p[:2] / radial if radial > 1e-9 else np.array([1.0, 0.0])
     dist = min(radial + OUTWARD, REACH_SHARE * reach)
     return dist * u, float(p[2] - tool_radius - CLEARANCE), reach
+
+
+def _joint_vector(name: str, value: ArrayLike, chain: Chain, hint: str = "") -> FloatArray:
+    """``value`` as n finite numbers (rad), one per joint of ``chain``, or a
+    ``ConfigError`` naming ``name``, the joint and the value."""
+    n = chain.n
+    try:
+        v = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be {n} finite numbers (rad){hint}, got {value!r}") from None
+    if v.shape != (n,):
+        raise ConfigError(
+            f"{name} must be {n} finite numbers (rad){hint}, one per joint; got shape {v.shape}"
+        )
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        i = int(bad[0])
+        raise ConfigError(
+            f"{name} must be {n} finite numbers (rad){hint}; joint {i} "
+            f"({chain.joint_names[i]!r}) is {float(v[i])!r}"
+        )
+    return v
 
 
 def _limits(plant: Any) -> tuple[FloatArray, FloatArray]:
@@ -282,10 +317,14 @@ def arm_table(
     t_ramp: float = 1.0,
 ) -> PandaTable:
     """The table scenario for the arm of ``urdf`` (None: the Panda of
-    :func:`adaptimp.panda_table.panda_table`, whose table and circle are kept).
+    :func:`adaptimp.panda_table.panda_table`, whose table and circle are kept,
+    and which refuses ``tip``, ``fix`` and ``home``: it has its own).
 
-    ``tip``: the tool's body (default: :meth:`Chain.from_urdf`'s tip, the child
-    link of the last movable joint); ``home`` (rad): default the rule's home
+    ``tip``: the tool's body (default: the child link of the arm's last joint).
+    The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
+    the rule of :func:`adaptimp.mujoco.from_urdf` (``_models.arm_urdf``, with
+    ``tip``): a gripper's, prismatic, mimic and off-chain joints are fixed,
+    and chains that tie (legs, two arms) need ``tip``; ``home`` (rad): default the rule's home
     posture; ``spring``: the table's spring stiffness k_e (N/m), None: rigid;
     ``friction``: sliding friction of table and tool. The rest as
     :func:`~adaptimp.panda_table.panda_table`. The table and the circle are
@@ -301,6 +340,15 @@ def arm_table(
         tool_radius=tool_radius, Ts=Ts, t_approach=t_approach, t_ramp=t_ramp,
     )  # fmt: skip
     if urdf is None:
+        # The Panda's scenario has its own tool body, fixed fingers and home.
+        given = {"tip": tip, "fix": fix or None, "home": home}
+        ignored = [k for k, v in given.items() if v is not None]
+        if ignored:
+            raise ConfigError(
+                f"{', '.join(ignored)} {'applies' if len(ignored) == 1 else 'apply'} to the arm "
+                "of a URDF; the Panda's scenario (urdf=None) has its own tool body, fixed "
+                "fingers and home posture: give the Panda's URDF path to set them"
+            )
         sc = panda_table(
             radius=radius,
             freq=freq,
@@ -326,14 +374,27 @@ def arm_table(
         )
         sc.model = model
         return sc
-    from .chain import _default_tip, _read_urdf
-
     path = Path(urdf)
-    if tip is None:
-        tip = _default_tip(*_read_urdf(path))
+    # The arm's joints by the one rule of adaptimp.mujoco.simulate and the
+    # Pinocchio model (_models.arm_urdf): a gripper's, prismatic, mimic and
+    # off-chain joints are fixed; by default the tool goes on the last arm
+    # joint's link.
+    arm = _models.arm_urdf(path.read_text(), fix, tip=tip)
+    tip = arm.tip if tip is None else tip
+    fix = (*fix, *(j for j in arm.fixed if j not in fix))
     chain = Chain.from_urdf(path, tip=tip)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
-    q0 = _home(path, chain, bare) if home is None else np.asarray(home, dtype=np.float64)
+    import mujoco
+
+    joint = mujoco.mjtObj.mjOBJ_JOINT
+    driven = [amj._name(bare.model, joint, j) for j in bare._joints]
+    if driven != chain.joint_names:
+        raise ConfigError(
+            f"the chain to {tip!r} has the joints {chain.joint_names}, but the arm's model "
+            f"drives {driven} (fix={fix!r}): give a tip whose path holds exactly the "
+            "driven joints, or fix the others"
+        )
+    q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
     centre, top, _ = placement(chain, q0, _limits(bare), tool_radius=tool_radius)
     table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)
     model = arm_model(
@@ -393,7 +454,9 @@ def contact_metrics(
     after = t >= settle - 1e-9
     # (16.1) with the measured n·e, n = −z (into the table), e = p − p_d.
     series = kd if spring is None else kd * spring / (kd + spring)
-    ne = ctrl.arrays()["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
+    # The run's own task-space rows (the controller's log may hold earlier runs).
+    log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
+    ne = log["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
     approach = t >= sc.t_approach - 1e-9
     contact = np.flatnonzero(approach & (fn > 0))
     # Never touched after the approach: all of that time is without contact.

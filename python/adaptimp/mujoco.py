@@ -50,7 +50,7 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._errors import needs_extra
+from ._errors import ConfigError, needs_extra
 
 try:
     import mujoco
@@ -176,7 +176,11 @@ EFFORT_ACCEL = 10.0
 
 
 def from_urdf(
-    path: str | os.PathLike[str], timestep: float = 1e-3, *, fix: tuple[str, ...] = ()
+    path: str | os.PathLike[str],
+    timestep: float = 1e-3,
+    *,
+    fix: tuple[str, ...] = (),
+    tip: str | None = None,
 ) -> mujoco.MjModel:
     """A URDF arm as a MuJoCo model :class:`Plant` accepts.
 
@@ -186,7 +190,10 @@ def from_urdf(
     into shorter chains); prismatic and mimic joints, a gripper's joints
     (named gripper/finger/jaw/claw, after the arm's) and every joint off the
     chain are fixed at their zero position, and so are the joints named in
-    ``fix``. A revolute joint with no range (lower ≥ upper) is continuous.
+    ``fix``. Chains that tie for the longest (a quadruped's legs, two arms)
+    are an error listing the link each ends at: ``tip`` names the link that
+    ends the arm (the movable joints on the way to it are the arm's). A
+    revolute joint with no range (lower ≥ upper) is continuous.
     Visual and collision elements, joint ``<dynamics>`` (damping, friction)
     and mimic tags are dropped (the rigid-body dynamics
     only, no mesh files; no contact geometry). Continuous joints are
@@ -203,10 +210,11 @@ def from_urdf(
     Raises
     ------
     ValueError
-        The URDF has no revolute or continuous joint to drive, or more than
-        :data:`MAX_JOINTS` on its longest chain.
+        The URDF has no revolute or continuous joint to drive, more than
+        :data:`MAX_JOINTS` on its longest chain, or several chains that tie
+        for the longest and no ``tip``.
     """
-    arm = _models.arm_urdf(Path(path).read_text(), fix)
+    arm = _models.arm_urdf(Path(path).read_text(), fix, tip=tip)
     if len(arm.joints) > MAX_JOINTS:
         raise ValueError(
             f"the URDF's arm has {len(arm.joints)} joints ({', '.join(arm.joints)}); "
@@ -1557,7 +1565,10 @@ def simulate(
     contact : bool
         False: free space (MuJoCo's contact disabled). Ignored for a Plant.
     settle : float, optional
-        Start of the "after2" metrics (s); default the scenario's (2 s).
+        Start of the "after2" metrics (s), ≥ 0; default the scenario's (2 s),
+        whose metrics are NaN for a shorter run. One given must leave a
+        recorded step in the window (settle ≤ (round(T/Ts) − 1) Ts), as in
+        :func:`adaptimp.simulate`.
     scenario : {"robot", "paper"}
         Defaults for a case name (see :func:`adaptimp.simulate`).
     record_every : int
@@ -1724,7 +1735,7 @@ def _setup(
     plant at its initial state, the settings and the choice of loop."""
     from . import Controller
     from ._api import _record_every
-    from ._params import SCENARIOS, resolve
+    from ._params import SCENARIOS, check_settle, resolve
 
     defaults = SCENARIOS.get(scenario)
     if defaults is None:
@@ -1769,6 +1780,7 @@ def _setup(
         raise ValueError(f"Ts = {Ts:g} s differs from the controller's period {period:g} s")
     Ts = period
     T = float(defaults["T"]) if T is None else float(T)
+    given_settle = settle is not None
     settle = float(defaults["settle"]) if settle is None else float(settle)
     # Checked before it is used: round(inf) overflows, round(nan) raises.
     if not (math.isfinite(T) and T > 0):
@@ -1778,6 +1790,13 @@ def _setup(
     steps = round(T / Ts)
     if steps < 1:
         raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
+    # As the rigid plant's simulate (the core's condition, for either loop).
+    if not math.isfinite(settle):
+        raise ConfigError(f"settle must be finite, got {settle!r}")
+    if settle < 0:
+        raise ConfigError(f"condition settle ≥ 0 is violated: settle = {settle:g} (SPEC §10)")
+    if given_settle:
+        check_settle(settle, T, Ts)
     if substeps is None:
         substeps = max(1, round(Ts / plant.timestep))
     if substeps < 1:

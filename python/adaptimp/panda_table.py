@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ._errors import ConfigError
 from .chain import Chain
 
 if TYPE_CHECKING:
@@ -344,6 +345,29 @@ def panda_controller(
     raise ValueError(f"kind must be one of pd, sf, of, ct, ct+30; got {kind!r}")
 
 
+def _check_windows(t: FloatArray, **windows: float) -> None:
+    """Refuse a window start (s) that is not a finite number ≥ 0, or that no
+    row of the run reaches (its metrics would be means over no rows)."""
+    for name, start in windows.items():
+        if isinstance(start, bool) or not (
+            isinstance(start, (int, float)) and math.isfinite(start) and start >= 0
+        ):
+            raise ConfigError(f"{name} must be a finite number ≥ 0 (s), got {start!r}")
+    last = float(t[-1]) if t.size else math.nan
+    for name, start in windows.items():
+        if not (t.size and last >= start - 1e-9):
+            span = f"its last row at t = {last:g} s" if t.size else "no rows"
+            hint = (
+                "or give a smaller settle"
+                if name == "settle"
+                else "peak_tau_ratio leaves out the start-up transient"
+            )
+            raise ConfigError(
+                f"the metrics' window t ≥ {name} = {start:g} s holds no row of the run "
+                f"({t.size} rows, {span}): run for longer than {start:g} s ({hint})"
+            )
+
+
 def cartesian_metrics(
     res: Any,
     ctrl: CartesianController,
@@ -371,9 +395,14 @@ def cartesian_metrics(
     - ``peak_tau_ratio``: max over joints and rows with t ≥ ``windup_after`` of
       |τ_i| / τmax_i for the commanded τ (target ≤ 2: no windup).
     - ``applied_ratio``: the same for the applied sat(τ) over all rows (≤ 1).
+
+    A ``ConfigError`` if ``settle`` or ``windup_after`` is not a finite number
+    ≥ 0, or if the run has no row in one of the windows (a run that ends
+    before ``settle`` or ``windup_after``): its metrics would be empty.
     """
+    t = np.asarray(res.t, dtype=np.float64)
+    _check_windows(t, settle=settle, windup_after=windup_after)
     log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
-    t = res.t
     after = t >= settle - 1e-9
     p = res.x_ee
     rows = np.flatnonzero(after)

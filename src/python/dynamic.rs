@@ -541,7 +541,7 @@ where
 {
     let ts = ctrl.period();
     let total = crate::sim::simulator::steps(on.t_final, ts)?;
-    crate::error::check::finite("settle", on.settle)?;
+    crate::error::check::nonnegative("settle ≥ 0", "settle", on.settle)?;
     let s = scenario::<N>(Preset::Robot, on.law, on.items)
         .map_err(|e| RunError::Core(e.error, None))?;
     let dist = s.disturbances()?;
@@ -782,7 +782,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     // The plant the controller does not know (SPEC §17): payload and friction.
     let dist = s.disturbances()?;
     // The set-up's errors name no row: check what the run builds first.
-    crate::error::check::finite("settle", cfg.settle)?;
+    crate::error::check::nonnegative("settle ≥ 0", "settle", cfg.settle)?;
     RigidBody::new(
         arm.with_payload(dist.payload())?,
         FreeSpace,

@@ -217,7 +217,7 @@ where
     T: Trajectory<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
-    check::finite("settle", cfg.settle)?;
+    check::nonnegative("settle ≥ 0", "settle", cfg.settle)?;
     let mut plant = RigidBody::new(arm.clone(), env.clone(), cfg.q0, cfg.dq0, cfg.substeps)?;
     let mut metrics = MetricsAccumulator::new(cfg.settle, *ctrl.target());
     simulate(
@@ -282,7 +282,7 @@ where
     A: Adapter<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
-    check::finite("settle", cfg.settle)?;
+    check::nonnegative("settle ≥ 0", "settle", cfg.settle)?;
     let arm = WithFriction::new(
         arm.with_payload(disturbances.payload())?,
         *disturbances.friction(),

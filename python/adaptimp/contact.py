@@ -38,6 +38,7 @@ __all__ = [
     "REACH_SHARE",
     "SLIP_SHARE",
     "TABLE_MASS",
+    "TABLE_TIMECONST",
     "arm_model",
     "arm_table",
     "contact_metrics",
@@ -66,12 +67,17 @@ weight carried by the spring's preload (the top at rest where the rigid one is).
 
 SLIP_SHARE = 0.5
 """Share of the prescribed normal force that MuJoCo's friction-to-normal coupling
-may reach while the tool slides (SPEC (19.7)): the friction rows' time constant
+may reach while the tool slides (SPEC (19.5)): the friction rows' time constant
 is set so that μ D_t B_t v ≤ SLIP_SHARE · F_n."""
 
-MUJOCO_TIMECONST = 0.02
-"""MuJoCo's default ``solref`` time constant (s): the friction rows are never
-made stiffer than the normal row."""
+TABLE_TIMECONST = 0.01
+"""Time constant (s) of the tool–table contact's normal row (``solref``, damping
+ratio 1; MuJoCo's default is 0.02 s): a rigid table whose own compliance is
+small against K_d and k_e (SPEC §19: at 0.02 s the Panda's tool sinks 0.13 mm
+under 7.5 N, a 58 kN/m spring in series that takes 2.4 % off (16.1)'s force
+on the 5 kN/m table; at 0.01 s, 4 times stiffer, 0.7 %), within MuJoCo's
+stability advice (time constant ≥ 2 timesteps) for steps up to 5 ms. The
+friction rows are never made stiffer than this."""
 
 
 _NOMINAL_KD = 500.0
@@ -79,13 +85,11 @@ _NOMINAL_KD = 500.0
 K_d,z δ_c (:meth:`PandaTable.target_force`)."""
 
 
-def sliding_timeconst(
-    model: Any, *, force: float, speed: float, friction: float
-) -> float:
+def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float) -> float:
     """The time constant (s) of the tool–table contact's friction rows (MuJoCo's
     ``pair/solreffriction``, damping ratio 1) under which the tool, sliding at
     ``speed`` (m/s) with sliding friction ``friction`` while it presses with
-    ``force`` (N), stays on the table (SPEC §19, (19.7)).
+    ``force`` (N), stays on the table (SPEC §19, (19.5)).
 
     MuJoCo's convex contact is one cost over the normal and the friction rows:
     while the contact slides, the friction rows' reference −B_t v (B_t =
@@ -94,10 +98,11 @@ def sliding_timeconst(
     MuJoCo's inverse-mass approximation of the contact (``body_invweight0`` of
     the tool and the table at qpos0) and d the impedance (``solimp``). When it
     exceeds the pressing force the tool lifts off for a step, falls back, and
-    the force alternates. (19.7) keeps it at :data:`SLIP_SHARE` of ``force``
+    the force alternates. (19.5) keeps it at :data:`SLIP_SHARE` of ``force``
     with d = d_max: B_t = SLIP_SHARE · F (1 − d_max) A/(d_max μ v), τ_t =
-    2/(d_max B_t), at least :data:`MUJOCO_TIMECONST`. ``friction``, ``speed``
-    or ``force`` zero: :data:`MUJOCO_TIMECONST` (nothing slides under load).
+    2/(d_max B_t), at least :data:`TABLE_TIMECONST`. ``friction``, ``speed``
+    or ``force`` zero: :data:`TABLE_TIMECONST` (nothing slides under load).
+    The normal row keeps its own time constant (:data:`TABLE_TIMECONST`).
     """
     import mujoco
 
@@ -106,14 +111,14 @@ def sliding_timeconst(
     if tool < 0 or table < 0:
         raise ValueError("the model has no geoms 'tool' and 'table'")
     if friction <= 0 or speed <= 0 or force <= 0:
-        return MUJOCO_TIMECONST
+        return TABLE_TIMECONST
     inv_mass = float(
         model.body_invweight0[model.geom_bodyid[tool], 0]
         + model.body_invweight0[model.geom_bodyid[table], 0]
     )
     dmax = float(max(model.geom_solimp[tool, 1], model.geom_solimp[table, 1]))
     damping = SLIP_SHARE * force * (1.0 - dmax) * inv_mass / (dmax * friction * speed)
-    return max(MUJOCO_TIMECONST, 2.0 / (dmax * damping))
+    return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
 
 
 def _tool_and_table(
@@ -148,6 +153,7 @@ def _tool_and_table(
         mass=0.0,
         density=0.0,
         friction=[friction, 0.005, 0.0001],
+        solref=[TABLE_TIMECONST, 1.0],
     )
     for name, kind in (("ee_force", "mjSENS_FORCE"), ("ee_torque", "mjSENS_TORQUE")):
         spec.add_sensor(
@@ -181,6 +187,7 @@ def _tool_and_table(
         contype=1,
         conaffinity=1,
         friction=[friction, 0.005, 0.0001],
+        solref=[TABLE_TIMECONST, 1.0],
         rgba=[0.6, 0.5, 0.4, 1.0],
         mass=TABLE_MASS,
     )
@@ -197,7 +204,8 @@ def _tool_and_table(
             geomname2="table",
             condim=3,
             friction=[friction, friction, 0.005, 0.0001, 0.0001],
-            solreffriction=[MUJOCO_TIMECONST, 1.0],
+            solref=[TABLE_TIMECONST, 1.0],
+            solreffriction=[TABLE_TIMECONST, 1.0],
         )
 
 
@@ -228,10 +236,11 @@ def arm_model(
     joint, mass :data:`TABLE_MASS`, critically damped). Keyframe ``home``.
 
     The contact (SPEC §19): MuJoCo's elliptic (Coulomb) cone, its default
-    ``solref``/``solimp``; with friction, the tool–table contact is the explicit
-    pair ``tool_table`` whose friction rows have the time constant
-    :func:`sliding_timeconst` for a tool pressing with ``force`` (N) while it
-    slides at ``speed`` (m/s) (zero: MuJoCo's default).
+    ``solimp``, ``solref`` with the time constant :data:`TABLE_TIMECONST`; with
+    friction, the tool–table contact is the explicit pair ``tool_table`` whose
+    friction rows have the time constant :func:`sliding_timeconst` for a tool
+    pressing with ``force`` (N) while it slides at ``speed`` (m/s) (zero:
+    :data:`TABLE_TIMECONST`).
     """
     import mujoco
 

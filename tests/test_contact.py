@@ -216,7 +216,7 @@ def test_the_panda_s_tool_slides_on_the_friction_table_without_chatter() -> None
 def test_the_ur5_s_tool_stays_on_the_frictionless_table() -> None:
     """The UR5 on the frictionless table, computed torque with the exact model
     (impedance): no single-step lift-offs (with the pyramid: 0.67 N of chatter
-    and 0.019 s without contact over t ∈ [2, 4] s)."""
+    and 0.019 s without contact over t ∈ [2, 6] s)."""
     sc = act.arm_table(_ur5(), friction=0.0)
     ctrl = ac.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)

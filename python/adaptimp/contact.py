@@ -36,11 +36,14 @@ __all__ = [
     "CLEARANCE",
     "OUTWARD",
     "REACH_SHARE",
+    "SLIP_SHARE",
     "TABLE_MASS",
+    "TABLE_TIMECONST",
     "arm_model",
     "arm_table",
     "contact_metrics",
     "placement",
+    "sliding_timeconst",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -60,6 +63,62 @@ from the base's vertical axis."""
 TABLE_MASS = 1.0
 """Mass (kg) of a spring-mounted table top (``spring=``); critically damped, its
 weight carried by the spring's preload (the top at rest where the rigid one is)."""
+
+
+SLIP_SHARE = 0.5
+"""Share of the prescribed normal force that MuJoCo's friction-to-normal coupling
+may reach while the tool slides (SPEC (19.5)): the friction rows' time constant
+is set so that μ D_t B_t v ≤ SLIP_SHARE · F_n."""
+
+TABLE_TIMECONST = 0.01
+"""Time constant (s) of the tool–table contact's normal row (``solref``, damping
+ratio 1; MuJoCo's default is 0.02 s): a rigid table whose own compliance is
+small against K_d and k_e (SPEC §19: at 0.02 s the Panda's tool sinks 0.13 mm
+under 7.5 N, a 58 kN/m spring in series that takes 2.4 % off (16.1)'s force
+on the 5 kN/m table; at 0.01 s, 4 times stiffer, 0.7 %), within MuJoCo's
+stability advice (time constant ≥ 2 timesteps) for steps up to 5 ms. The
+friction rows are never made stiffer than this."""
+
+
+_NOMINAL_KD = 500.0
+"""K_d,z (N/m) of SPEC §16's default impedance: the scenario's prescribed force is
+K_d,z δ_c (:meth:`PandaTable.target_force`)."""
+
+
+def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float) -> float:
+    """The time constant (s) of the tool–table contact's friction rows (MuJoCo's
+    ``pair/solreffriction``, damping ratio 1) under which the tool, sliding at
+    ``speed`` (m/s) with sliding friction ``friction`` while it presses with
+    ``force`` (N), stays on the table (SPEC §19, (19.5)).
+
+    MuJoCo's convex contact is one cost over the normal and the friction rows:
+    while the contact slides, the friction rows' reference −B_t v (B_t =
+    2/(d_max τ_t)) cannot be met and the solver moves the unmet part into the
+    normal row, as an upward force of about μ D B_t v, D = d/((1 − d) A) with A
+    MuJoCo's inverse-mass approximation of the contact (``body_invweight0`` of
+    the tool and the table at qpos0) and d the impedance (``solimp``). When it
+    exceeds the pressing force the tool lifts off for a step, falls back, and
+    the force alternates. (19.5) keeps it at :data:`SLIP_SHARE` of ``force``
+    with d = d_max: B_t = SLIP_SHARE · F (1 − d_max) A/(d_max μ v), τ_t =
+    2/(d_max B_t), at least :data:`TABLE_TIMECONST`. ``friction``, ``speed``
+    or ``force`` zero: :data:`TABLE_TIMECONST` (nothing slides under load).
+    The normal row keeps its own time constant (:data:`TABLE_TIMECONST`).
+    """
+    import mujoco
+
+    tool = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "tool")
+    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "table")
+    if tool < 0 or table < 0:
+        raise ValueError("the model has no geoms 'tool' and 'table'")
+    if friction <= 0 or speed <= 0 or force <= 0:
+        return TABLE_TIMECONST
+    inv_mass = float(
+        model.body_invweight0[model.geom_bodyid[tool], 0]
+        + model.body_invweight0[model.geom_bodyid[table], 0]
+    )
+    dmax = float(max(model.geom_solimp[tool, 1], model.geom_solimp[table, 1]))
+    damping = SLIP_SHARE * force * (1.0 - dmax) * inv_mass / (dmax * friction * speed)
+    return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
 
 
 def _tool_and_table(
@@ -94,6 +153,7 @@ def _tool_and_table(
         mass=0.0,
         density=0.0,
         friction=[friction, 0.005, 0.0001],
+        solref=[TABLE_TIMECONST, 1.0],
     )
     for name, kind in (("ee_force", "mjSENS_FORCE"), ("ee_torque", "mjSENS_TORQUE")):
         spec.add_sensor(
@@ -127,9 +187,26 @@ def _tool_and_table(
         contype=1,
         conaffinity=1,
         friction=[friction, 0.005, 0.0001],
+        solref=[TABLE_TIMECONST, 1.0],
         rgba=[0.6, 0.5, 0.4, 1.0],
         mass=TABLE_MASS,
     )
+    # The Coulomb cone itself, not its pyramid: a pyramid's edges mix the
+    # normal into every row and scale their regulariser by 2μ² (at μ = 0,
+    # MuJoCo's floor 1e-5: a contact so stiff that it lifts off for single
+    # steps; SPEC §19). The tool–table contact as an explicit pair, so that its
+    # friction rows get their own time constant (sliding_timeconst).
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    if friction > 0:
+        spec.add_pair(
+            name="tool_table",
+            geomname1="tool",
+            geomname2="table",
+            condim=3,
+            friction=[friction, friction, 0.005, 0.0001, 0.0001],
+            solref=[TABLE_TIMECONST, 1.0],
+            solreffriction=[TABLE_TIMECONST, 1.0],
+        )
 
 
 def arm_model(
@@ -144,6 +221,8 @@ def arm_model(
     spring: float | None = None,
     home: ArrayLike | None = None,
     timestep: float = 5e-4,
+    force: float = 0.0,
+    speed: float = 0.0,
 ) -> Any:
     """A URDF arm in MuJoCo with a tool and a table (see the module doc).
 
@@ -155,6 +234,13 @@ def arm_model(
     centred at ``centre`` (x, y), sliding friction ``friction`` for the table
     and the tool, rigid or on a vertical spring of ``spring`` N/m (a slide
     joint, mass :data:`TABLE_MASS`, critically damped). Keyframe ``home``.
+
+    The contact (SPEC §19): MuJoCo's elliptic (Coulomb) cone, its default
+    ``solimp``, ``solref`` with the time constant :data:`TABLE_TIMECONST`; with
+    friction, the tool–table contact is the explicit pair ``tool_table`` whose
+    friction rows have the time constant :func:`sliding_timeconst` for a tool
+    pressing with ``force`` (N) while it slides at ``speed`` (m/s) (zero:
+    :data:`TABLE_TIMECONST`).
     """
     import mujoco
 
@@ -182,6 +268,11 @@ def arm_model(
         spec.add_key(name="home", qpos=qpos)
     model = spec.compile()
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    if model.npair:
+        model.pair_solreffriction[0] = [
+            sliding_timeconst(model, force=force, speed=speed, friction=friction),
+            1.0,
+        ]
     return model
 
 
@@ -339,6 +430,7 @@ def arm_table(
         spring=spring, friction=friction, radius=radius, freq=freq, depth=depth,
         tool_radius=tool_radius, Ts=Ts, t_approach=t_approach, t_ramp=t_ramp,
     )  # fmt: skip
+    speed = 2.0 * math.pi * freq * radius
     if urdf is None:
         # The Panda's scenario has its own tool body, fixed fingers and home.
         given = {"tip": tip, "fix": fix or None, "home": home}
@@ -359,9 +451,10 @@ def arm_table(
             t_approach=t_approach,
             t_ramp=t_ramp,
         )
-        if spring is None:
-            return sc
-        model = arm_model(
+        # The Panda of adaptimp.mujoco.panda (the same URDF, inertias, motors
+        # and table), with the tool on a body of its own and this module's
+        # contact (arm_model).
+        sc.model = arm_model(
             _models.panda_urdf_path(),
             _models.PANDA_EE,
             fix=_models.PANDA_FINGERS,
@@ -371,8 +464,9 @@ def arm_table(
             friction=friction,
             spring=spring,
             home=sc.q0,
+            force=sc.target_force(),
+            speed=speed,
         )
-        sc.model = model
         return sc
     path = Path(urdf)
     # The arm's joints by the one rule of adaptimp.mujoco.simulate and the
@@ -407,6 +501,8 @@ def arm_table(
         friction=friction,
         spring=spring,
         home=q0,
+        force=_NOMINAL_KD * depth,
+        speed=speed,
     )
     return PandaTable(
         model=model,

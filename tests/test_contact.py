@@ -251,3 +251,23 @@ def test_a_scenario_quantity_out_of_range_is_refused_by_name(
         message = rf"^{name} must be a finite number {what}, got "
         with pytest.raises(adaptimp.ConfigError, match=message):
             act.arm_table(urdf, **{name: value})
+
+
+def test_the_scenario_s_joint_gains_take_continuous_joints_as_angles() -> None:
+    """Kinova's arm joints are continuous (Pinocchio: nq = 9 for nv = 6). The
+    scenario's joint gains read D(q0) through tuning.inertia, which takes the
+    chain's angles; they equal the rule (18.1) computed from MuJoCo's mass matrix
+    of the same arm, an independent engine, to 1e-9 (Pinocchio's CRBA on the
+    6 angles failed with "expected 9, got 6")."""
+    from adaptimp import panda_table as apt
+
+    urdf = _ur5().parent.parent.parent / "kinova_description" / "robots" / "kinova.urdf"
+    sc = act.arm_table(urdf)
+    assert sc.pin_model.nq == 9
+    assert sc.n == 6
+    gains = apt.joint_gains(sc)
+    plant = amj.Plant(sc.model)
+    d = adaptimp.tuning.inertia(plant, sc.q0)
+    kp = 0.25 / (sc.Ts * np.diag(np.linalg.inv(d)))
+    np.testing.assert_allclose(gains["Kp"], kp, rtol=1e-9)
+    assert gains["K1"] == [20.0] * 6

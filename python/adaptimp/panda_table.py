@@ -264,13 +264,12 @@ def orbit_basis(
 def joint_gains(sc: PandaTable, k1: float = 20.0, scale: float = 0.25) -> dict[str, list[float]]:
     """The joint gains shared by PD, state and output feedback (SPEC §15's rule):
     Kp_i = scale/(Ts (D⁻¹)_ii) (N m s/rad) with D the exact D(q0) from
-    Pinocchio's CRBA, Kζ_i = (1 + Kp_i²)/2 + 10 (so 2Kζ − 1 − Kp² = 20 > 0),
-    K1 = k1 (1/s)."""
-    import pinocchio as pin
+    Pinocchio's CRBA (:func:`adaptimp.tuning.inertia`, which takes continuous
+    joints' angles as the chain does), Kζ_i = (1 + Kp_i²)/2 + 10 (so
+    2Kζ − 1 − Kp² = 20 > 0), K1 = k1 (1/s)."""
+    from .tuning import inertia
 
-    data = sc.pin_model.createData()
-    m = pin.crba(sc.pin_model, data, sc.q0)
-    m = np.triu(m) + np.triu(m, 1).T
+    m = inertia(sc.pin_model, sc.q0)
     kp = scale / (sc.Ts * np.diag(np.linalg.inv(m)))
     return {
         "Kp": kp.tolist(),

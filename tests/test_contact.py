@@ -271,3 +271,33 @@ def test_the_scenario_s_joint_gains_take_continuous_joints_as_angles() -> None:
     kp = 0.25 / (sc.Ts * np.diag(np.linalg.inv(d)))
     np.testing.assert_allclose(gains["Kp"], kp, rtol=1e-9)
     assert gains["K1"] == [20.0] * 6
+
+
+def test_a_light_wrist_does_not_ring_against_the_table() -> None:
+    """The UR10's last joint (d = 5e-4 kg m²) with the robot preset's fixed
+    kr = 0.5 N m ran its sampled velocity loop at Ts (Kp + kr/φ)/d = 20 > 2: it
+    rang at half the sampling rate and the tool chattered on the table (SF
+    unified: 183 N). The scenario's gains carry SPEC (18.4)'s kr = φ Kp/2."""
+    from adaptimp import panda_table as apt
+
+    urdf = _ur5().parent / "ur10_robot.urdf"
+    sc = act.arm_table(urdf)
+    gains = apt.joint_gains(sc)
+    np.testing.assert_allclose(gains["kr"], 0.025 * np.asarray(gains["Kp"]), rtol=1e-15)
+    ctrl = ac.panda_controller(
+        "sf",
+        sc,
+        force_feedforward=False,
+        formulation="unified",
+        admittance_share=0.3,
+        gamma=[1.0, 1.0, 5000.0],  # examples/13's LEARN
+        sigma=[0.01, 0.01, 1e-5],
+        weight_bound=[4.19, 13.2, 100.0],
+    )
+    res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
+    m = act.contact_metrics(res, ctrl, sc)
+    after = res.t >= 2.0
+    ring = np.abs(np.diff(res.dq[after, 5])).max()
+    assert ring < 0.01  # rad/s from one sample to the next (1 rad/s with the fixed kr)
+    assert m["force_chatter_N"] < 0.05 * m["force_target_N"]
+    assert m["contact_lost_s"] == 0.0

@@ -262,11 +262,18 @@ def orbit_basis(
 
 
 def joint_gains(sc: PandaTable, k1: float = 20.0, scale: float = 0.25) -> dict[str, list[float]]:
-    """The joint gains shared by PD, state and output feedback (SPEC §15's rule):
-    Kp_i = scale/(Ts (D⁻¹)_ii) (N m s/rad) with D the exact D(q0) from
-    Pinocchio's CRBA (:func:`adaptimp.tuning.inertia`, which takes continuous
-    joints' angles as the chain does), Kζ_i = (1 + Kp_i²)/2 + 10 (so
-    2Kζ − 1 − Kp² = 20 > 0), K1 = k1 (1/s)."""
+    """The joint gains shared by PD, state and output feedback (SPEC §15's rule,
+    with SPEC (18.4)'s robust term): Kp_i = scale/(Ts (D⁻¹)_ii) (N m s/rad)
+    with D the exact D(q0) from Pinocchio's CRBA (:func:`adaptimp.tuning.inertia`,
+    which takes continuous joints' angles as the chain does), Kζ_i = (1 +
+    Kp_i²)/2 + 10 (so 2Kζ − 1 − Kp² = 20 > 0), K1 = k1 (1/s), kr_i = φ Kp_i/2
+    (N m, φ = 0.05 rad/s, the robot preset's) and the fallback's damping Kp_i.
+
+    kr scales with Kp as in the gain rule: the robot preset's fixed kr = 0.5 N m
+    (slope kr/φ = 10 N m s/rad) put the sampled velocity loop of a light wrist
+    joint beyond its limit, Ts (Kp_i + kr_i/φ)/d_i < 2 (the UR10's last joint,
+    d = 5e-4 kg m²: 20), and the wrist rang at half the sampling rate, which
+    the tool passed on to the table as force chatter."""
     from .tuning import inertia
 
     m = inertia(sc.pin_model, sc.q0)
@@ -275,6 +282,8 @@ def joint_gains(sc: PandaTable, k1: float = 20.0, scale: float = 0.25) -> dict[s
         "Kp": kp.tolist(),
         "Kzeta": ((1 + kp**2) / 2 + 10).tolist(),
         "K1": [k1] * sc.n,
+        "kr": (0.05 / 2 * kp).tolist(),
+        "fallback_damping": kp.tolist(),
     }
 
 

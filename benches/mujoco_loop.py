@@ -360,11 +360,13 @@ def loop_table(rows: list[tuple[str, str]], T: float, repeats: int) -> None:
 
 
 def panda_table_times(T: float, repeats: int) -> None:
-    """examples/13's table: each controller natively and through the Python loop."""
+    """examples/13's table, the issue's five controllers (its rows pd, sf, of, ct,
+    ct+30 on the default table): each natively and through the Python loop."""
     import importlib.util
     from pathlib import Path
 
     from adaptimp import cartesian as ac
+    from adaptimp import contact as act
 
     path = Path(__file__).resolve().parent.parent / "examples" / "13_panda_table.py"
     spec = importlib.util.spec_from_file_location("panda_table_example", path)
@@ -372,24 +374,21 @@ def panda_table_times(T: float, repeats: int) -> None:
     assert spec.loader is not None
     example = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(example)
-    sc = ac.panda_table()
+    sc = act.arm_table()
     basis = ac.orbit_basis(sc)
     plant = amj.Plant(sc.model)
+    rows = {name: example.ROWS[name][0] for name in ("pd", "sf", "of", "ct", "ct+30")}
     times: dict[str, dict[str, list[float]]] = {
-        k: {"native": [], "python": [], "engine": []} for k in example.KINDS
+        k: {"native": [], "python": [], "engine": []} for k in rows
     }
     loops: dict[str, str] = {}
     m, d = plant.model, plant.data
     substeps = max(1, round(sc.Ts / plant.timestep))
     full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
     for _ in range(repeats):
-        for kind in example.KINDS:
-            base, _, variant = kind.partition("-")
-            extra = example.LEARN if variant == "learn" else {}
+        for kind in rows:
             for how in ("native", "python"):
-                ctrl = ac.panda_controller(
-                    base, sc, basis=basis, force_feedforward=variant == "", **extra
-                )
+                ctrl = example.controller(kind, sc, basis)
                 start = time.perf_counter()
                 res = amj.simulate(
                     ctrl if how == "native" else InPython(ctrl), plant, T=T, q0=sc.q0
@@ -416,7 +415,7 @@ def panda_table_times(T: float, repeats: int) -> None:
     )
     print("|---|---|---:|---:|---:|---:|---:|")
     total = {"native": 0.0, "python": 0.0, "engine": 0.0}
-    for kind, label in example.KINDS.items():
+    for kind, label in rows.items():
         med = {how: statistics.median(v) for how, v in times[kind].items()}
         for how in total:
             total[how] += med[how]

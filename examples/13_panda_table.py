@@ -95,15 +95,20 @@ KEYS = (
 FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "contact_force.png"
 
 
-def run(name: str, sc: ac.PandaTable, basis: Any, T: float) -> tuple[Any, Any, dict[str, float]]:
-    """One row on the scenario: (result, controller, metrics)."""
+def controller(name: str, sc: ac.PandaTable, basis: Any) -> Any:
+    """The controller of one row on the scenario."""
     _, kind, formulation, ff, learn = ROWS[name]
     extra: dict[str, Any] = dict(LEARN) if learn else {}
     if formulation == "unified":
         extra["admittance_share"] = SHARE
-    ctrl = ac.panda_controller(
+    return ac.panda_controller(
         kind, sc, basis=basis, force_feedforward=ff, formulation=formulation, **extra
     )
+
+
+def run(name: str, sc: ac.PandaTable, basis: Any, T: float) -> tuple[Any, Any, dict[str, float]]:
+    """One row on the scenario: (result, controller, metrics)."""
+    ctrl = controller(name, sc, basis)
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=T, q0=sc.q0)
     return res, ctrl, act.contact_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
 

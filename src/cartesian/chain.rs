@@ -110,7 +110,7 @@ impl Transform {
 
     /// Validated: every value finite, |translation| ≤ 1e6 m, the rotation
     /// orthonormal (|RᵀR − I| ≤ 1e-6) with det R = +1.
-    fn check(&self, index: usize) -> Result<Frame, Error> {
+    pub(crate) fn check(&self, index: usize) -> Result<Frame, Error> {
         let (p, r) = (self.vector(), self.matrix());
         check::finite_slice("joint origin translation", p.as_slice())?;
         check::finite_slice("joint origin rotation", r.as_slice())?;
@@ -192,19 +192,19 @@ impl Joint {
 
 /// A rigid transform: x_parent = r x + p.
 #[derive(Copy, Clone, Debug, PartialEq)]
-struct Frame {
-    p: Vector3<f64>,
-    r: Matrix3<f64>,
+pub(crate) struct Frame {
+    pub(crate) p: Vector3<f64>,
+    pub(crate) r: Matrix3<f64>,
 }
 
 impl Frame {
-    const IDENTITY: Self = Self {
+    pub(crate) const IDENTITY: Self = Self {
         p: Vector3::new(0.0, 0.0, 0.0),
         r: Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
     };
 
     /// `self ∘ other`.
-    fn then(&self, other: &Frame) -> Frame {
+    pub(crate) fn then(&self, other: &Frame) -> Frame {
         Frame {
             p: self.p + self.r * other.p,
             r: self.r * other.r,
@@ -326,39 +326,91 @@ impl<const N: usize> Chain<N> {
     }
 }
 
-impl<const N: usize> Kinematics<N> for Chain<N> {
-    fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> Tip<N> {
+/// The motion of one movable joint's frame in the world, from
+/// [`Chain::walk`]: its rotation `r` and origin `c` (on the axis of a
+/// revolute joint), the angular velocity `w` and acceleration `al` of its
+/// link, the classical acceleration `a` of `c`, the joint's world axis `z`
+/// and origin `o` (before a prismatic joint's travel).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(crate) struct LinkMotion {
+    pub r: Matrix3<f64>,
+    pub c: Vector3<f64>,
+    pub w: Vector3<f64>,
+    pub al: Vector3<f64>,
+    pub a: Vector3<f64>,
+    pub z: Vector3<f64>,
+    pub o: Vector3<f64>,
+}
+
+impl<const N: usize> Chain<N> {
+    /// The forward recursion of (16.0), base to tip, with the joint
+    /// accelerations `ddq` (none: q̈ = 0) and the base's acceleration `a0`
+    /// (m/s²; −g for the dynamics, SPEC (20.2)): calls `visit(i, motion)`
+    /// for every movable joint i, and returns the last one's motion.
+    #[inline]
+    pub(crate) fn walk<F: FnMut(usize, &LinkMotion)>(
+        &self,
+        q: &Vector<N>,
+        dq: &Vector<N>,
+        ddq: Option<&Vector<N>>,
+        a0: Vector3<f64>,
+        mut visit: F,
+    ) -> LinkMotion {
         // The frame of the link before joint i: rotation r, origin c, the
         // angular velocity w and acceleration al, and the acceleration a of
-        // c (q̈ = 0; no velocity of a point enters an acceleration).
-        let mut r = Matrix3::identity();
-        let (mut c, mut a) = (Vector3::zeros(), Vector3::zeros());
-        let (mut w, mut al) = (Vector3::zeros(), Vector3::zeros());
-        let mut z = [Vector3::zeros(); N];
-        let mut o = [Vector3::zeros(); N];
+        // c (no velocity of a point enters an acceleration).
+        let mut m = LinkMotion {
+            r: Matrix3::identity(),
+            c: Vector3::zeros(),
+            w: Vector3::zeros(),
+            al: Vector3::zeros(),
+            a: a0,
+            z: Vector3::zeros(),
+            o: Vector3::zeros(),
+        };
         for (i, link) in self.links.iter().enumerate() {
-            let d = r * link.origin.p;
-            let wxd = w.cross(&d);
-            let (oi, ao) = (c + d, a + al.cross(&d) + w.cross(&wxd));
-            let r0 = r * link.origin.r;
+            let d = m.r * link.origin.p;
+            let wxd = m.w.cross(&d);
+            let (oi, ao) = (m.c + d, m.a + m.al.cross(&d) + m.w.cross(&wxd));
+            let r0 = m.r * link.origin.r;
             let zi = r0 * link.axis;
             let zdq = zi * dq[i];
             if link.prismatic {
                 let s = zi * q[i];
-                let wxs = w.cross(&s);
-                r = r0;
-                c = oi + s;
-                a = ao + al.cross(&s) + w.cross(&wxs) + 2.0 * w.cross(&zdq);
+                let wxs = m.w.cross(&s);
+                m.r = r0;
+                m.c = oi + s;
+                m.a = ao + m.al.cross(&s) + m.w.cross(&wxs) + 2.0 * m.w.cross(&zdq);
+                if let Some(dd) = ddq {
+                    m.a += zi * dd[i];
+                }
             } else {
-                r = r0 * axis_rotation(&link.axis, q[i]);
-                al += w.cross(&zdq);
-                w += zdq;
-                c = oi;
-                a = ao;
+                m.r = r0 * axis_rotation(&link.axis, q[i]);
+                m.al += m.w.cross(&zdq);
+                if let Some(dd) = ddq {
+                    m.al += zi * dd[i];
+                }
+                m.w += zdq;
+                m.c = oi;
+                m.a = ao;
             }
-            z[i] = zi;
-            o[i] = oi;
+            m.z = zi;
+            m.o = oi;
+            visit(i, &m);
         }
+        m
+    }
+}
+
+impl<const N: usize> Kinematics<N> for Chain<N> {
+    fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> Tip<N> {
+        let mut z = [Vector3::zeros(); N];
+        let mut o = [Vector3::zeros(); N];
+        let last = self.walk(q, dq, None, Vector3::zeros(), |i, m| {
+            z[i] = m.z;
+            o[i] = m.o;
+        });
+        let LinkMotion { r, c, w, al, a, .. } = last;
         let d = r * self.tip.p;
         let p = c + d;
         let wxd = w.cross(&d);

@@ -3,12 +3,16 @@
 //! impedance that drives a joint controller, SPEC §16. No allocation.
 
 pub mod chain;
+pub mod computed;
+pub mod dynamics;
 pub mod kinematics;
 mod outer;
 mod pair;
 pub mod rotation;
 
 pub use chain::{Chain, Joint, JointKind, Transform, MAX_CHAIN_JOINTS};
+pub use computed::{ComputedState, ComputedTorque, ComputedTorqueConfig};
+pub use dynamics::{Dynamics, Inertial, GRAVITY};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{
     CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation, OuterStep,

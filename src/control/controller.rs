@@ -29,7 +29,6 @@ use crate::networks::rbf::{Basis, Grid};
 use crate::networks::simd::SimdPath;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
-use nalgebra::SMatrix;
 
 /// The smallest inertia scale d (kg m²) and Young weight ρ (1/s), SPEC §10:
 /// 1/d and 1/ρ multiply Δτ, so a smaller one could take ζ beyond [`BOUND`].
@@ -953,11 +952,8 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         let j = &t.jacobian;
         let force = t.force(v);
         // (19.3) the joint law's feedback without its task part:
-        // Π τ = τ − Jᵀ (J Kp⁻¹ Jᵀ + Λ² k̄⁻¹)⁻¹ J Kp⁻¹ τ, so Π Kp = Kp − Jᵀ Λ_K J ≼ Kp.
-        let kinv = self.cfg.kp.map(|k| 1.0 / k);
-        let kbar = kinv.sum() / N as f64;
-        let jk = SMatrix::<f64, 6, N>::from_fn(|r, c| j[(r, c)] * kinv[c]);
-        let a = jk * j.transpose() + SMatrix::<f64, 6, 6>::from_diagonal(&(kbar * t.lambda2));
+        // Π τ = τ − Jᵀ (J Kp⁻¹ Jᵀ + k̄ Λ²)⁻¹ J Kp⁻¹ τ, so Π Kp = Kp − Jᵀ Λ_K J ≼ Kp.
+        let null = t.null_space(&self.cfg.kp);
         let mut inner = self.cfg.kp.component_mul(&errors.z2)
             + self
                 .robust
@@ -965,12 +961,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         if self.cfg.law.learns() {
             inner += errors.z1.component_mul(&self.cfg.inertia);
         }
-        let ch = a.cholesky();
-        let null = |tau: &Vector<N>| match &ch {
-            Some(ch) => tau - j.transpose() * ch.solve(&(jk * tau)),
-            None => Vector::zeros(),
-        };
-        let torque = j.transpose() * force + null(&inner);
+        let torque = j.transpose() * force + null.apply(&inner);
         check::within("tau_task", torque.as_slice(), BOUND)?;
         Ok(Task {
             errors,

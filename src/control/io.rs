@@ -55,6 +55,44 @@ impl<const N: usize> TaskTorque<N> {
                 .damping
                 .component_mul(&(self.twist - self.jacobian * dq))
     }
+
+    /// Π of (19.3) for a joint law of stiffness `kp` (> 0 each): its
+    /// feedback acts in the null space of this task.
+    pub fn null_space(&self, kp: &Vector<N>) -> NullSpace<N> {
+        let j = self.jacobian;
+        let kinv = kp.map(|k| 1.0 / k);
+        let kbar = kinv.sum() / N as f64;
+        let jk = nalgebra::SMatrix::<f64, 6, N>::from_fn(|r, c| j[(r, c)] * kinv[c]);
+        let a = jk * j.transpose()
+            + nalgebra::SMatrix::<f64, 6, 6>::from_diagonal(&(kbar * self.lambda2));
+        NullSpace {
+            j,
+            jk,
+            ch: a.cholesky(),
+        }
+    }
+}
+
+/// The projection Π of (19.3) onto the null space of a task Jacobian J,
+/// weighted by a joint law's stiffness Kp (SPEC §19, §20):
+/// Π τ = τ − Jᵀ (J Kp⁻¹ Jᵀ + k̄ Λ²)⁻¹ J Kp⁻¹ τ, k̄ = (1/N) Σ_i 1/Kp_i.
+#[derive(Copy, Clone, Debug)]
+pub struct NullSpace<const N: usize> {
+    j: nalgebra::SMatrix<f64, 6, N>,
+    jk: nalgebra::SMatrix<f64, 6, N>,
+    ch: Option<nalgebra::Cholesky<f64, nalgebra::Const<6>>>,
+}
+
+impl<const N: usize> NullSpace<N> {
+    /// Π τ (N m); zero if J Kp⁻¹ Jᵀ + k̄ Λ² is not positive definite (a
+    /// non-finite input the caller's checks refuse first).
+    #[inline]
+    pub fn apply(&self, tau: &Vector<N>) -> Vector<N> {
+        match &self.ch {
+            Some(ch) => tau - self.j.transpose() * ch.solve(&(self.jk * tau)),
+            None => Vector::zeros(),
+        }
+    }
 }
 
 /// What one step computed. `tau_sat` goes to the actuators; the rest is for logging.

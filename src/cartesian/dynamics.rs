@@ -1,0 +1,430 @@
+//! Rigid-body dynamics of a serial chain, SPEC §20: the inertials of its
+//! links (20.1) and the recursive Newton–Euler algorithm (20.2),
+//! τ = M(q) q̈ + C(q, q̇) q̇ + G(q), with the mass matrix and the gravity
+//! torque from it. No allocation; validation at construction returns errors
+//! naming the condition and the entry, never panics.
+//!
+//! Units: kg, m, kg m², rad (m for a prismatic joint), N m (N).
+
+use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
+use crate::error::{check, Error};
+use crate::types::{Matrix, Vector};
+use nalgebra::{Matrix3, Vector3};
+
+/// Standard gravity (m/s²), along −z of the chain's base frame: the default
+/// of [`Dynamics::new`]'s `gravity`.
+pub const GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+/// The inertial of one link as a URDF or a MuJoCo model states it: the
+/// mass, and the rotational inertia about the centre of mass in the frame
+/// `origin` (the centre of mass and the inertia's axes in the link's frame).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Inertial {
+    /// Mass m (kg), ≥ 0.
+    pub mass: f64,
+    /// The centre of mass (translation, m) and the axes of `inertia`
+    /// (rotation) in the link's frame (URDF's `<inertial><origin>`).
+    pub origin: Transform,
+    /// Rotational inertia about the centre of mass in `origin`'s axes (kg
+    /// m², row-major), symmetric with a non-negative diagonal.
+    pub inertia: [[f64; 3]; 3],
+}
+
+impl Inertial {
+    /// No mass (a link whose inertial is not given).
+    pub const NONE: Self = Self {
+        mass: 0.0,
+        origin: Transform::IDENTITY,
+        inertia: [[0.0; 3]; 3],
+    };
+
+    /// A point mass `mass` (kg) at `com` (m) of the link's frame.
+    pub fn point(mass: f64, com: [f64; 3]) -> Self {
+        Self {
+            mass,
+            origin: Transform {
+                translation: com,
+                ..Transform::IDENTITY
+            },
+            inertia: [[0.0; 3]; 3],
+        }
+    }
+
+    /// Validated: finite, mass ≥ 0, the inertia symmetric (to 1e-9 of its
+    /// largest entry) with a non-negative diagonal.
+    fn check(&self, index: usize) -> Result<(Frame, Matrix3<f64>), Error> {
+        let frame = self.origin.check(index)?;
+        check::finite("link mass", self.mass)?;
+        if self.mass < 0.0 {
+            return Err(Error::Condition {
+                condition: "mass ≥ 0",
+                lhs: "link mass",
+                index: Some(index),
+                value: self.mass,
+            });
+        }
+        let i = Matrix3::from_fn(|r, c| self.inertia[r][c]);
+        check::finite_slice("link inertia", i.as_slice())?;
+        let scale = i.amax();
+        let asym = (i - i.transpose()).amax();
+        if asym > 1e-9 * scale {
+            return Err(Error::Condition {
+                condition: "the inertia is symmetric (|I − Iᵀ| ≤ 1e-9 |I|)",
+                lhs: "link inertia asymmetry",
+                index: Some(index),
+                value: asym,
+            });
+        }
+        for k in 0..3 {
+            if i[(k, k)] < 0.0 {
+                return Err(Error::Condition {
+                    condition: "the inertia's diagonal ≥ 0",
+                    lhs: "link inertia diagonal",
+                    index: Some(index),
+                    value: i[(k, k)],
+                });
+            }
+        }
+        Ok((frame, i))
+    }
+}
+
+/// The rigid body of one movable joint, in its frame, (20.1): the mass m
+/// (kg), the first moment h = m c (kg m) and the inertia about the frame's
+/// origin (kg m²).
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct Body {
+    m: f64,
+    h: Vector3<f64>,
+    i: Matrix3<f64>,
+}
+
+impl Body {
+    const EMPTY: Self = Self {
+        m: 0.0,
+        h: Vector3::new(0.0, 0.0, 0.0),
+        i: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    };
+
+    /// Add a mass `m` at `c` with the inertia `ic` about `c` (the body's
+    /// axes): the parallel-axis theorem.
+    fn add(&mut self, m: f64, c: Vector3<f64>, ic: Matrix3<f64>) {
+        self.m += m;
+        self.h += m * c;
+        self.i += ic + m * (Matrix3::identity() * c.norm_squared() - c * c.transpose());
+    }
+}
+
+/// A chain with the inertials of its links and gravity: inverse dynamics by
+/// the recursive Newton–Euler algorithm, SPEC §20. Cheap to copy (N ≤ 7
+/// bodies of 13 reals and the chain).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Dynamics<const N: usize> {
+    chain: Chain<N>,
+    bodies: [Body; N],
+    gravity: Vector3<f64>,
+}
+
+impl<const N: usize> Dynamics<N> {
+    /// The dynamics of the chain of `joints` (as [`Chain::new`] takes them)
+    /// with `inertials[k]` the inertial of joint k's child link in that
+    /// link's frame (one per entry of `joints`, fixed ones too;
+    /// [`Inertial::NONE`] for none), under `gravity` (m/s², in the base frame;
+    /// [`GRAVITY`] on Earth). Each inertial belongs to the last movable
+    /// joint at or before its entry (the fixed joints fold); those before the
+    /// first movable joint are the base's and take no part (20.1).
+    ///
+    /// Errors, naming the condition and the entry: those of [`Chain::new`],
+    /// another number of inertials than joints, a negative or non-finite
+    /// mass, an inertia that is not finite or symmetric or has a negative
+    /// diagonal, a non-finite gravity.
+    pub fn new(joints: &[Joint], inertials: &[Inertial], gravity: [f64; 3]) -> Result<Self, Error> {
+        let chain = Chain::<N>::new(joints, &Transform::IDENTITY)?;
+        if inertials.len() != joints.len() {
+            return Err(Error::Condition {
+                condition: "one inertial per joint of the list (fixed ones too)",
+                lhs: "inertials",
+                index: None,
+                value: inertials.len() as f64,
+            });
+        }
+        check::finite_slice("gravity", &gravity)?;
+        let mut bodies = [Body::EMPTY; N];
+        // The body the entries belong to, and the frame of the current
+        // entry's child link in that body's frame.
+        let mut body: Option<usize> = None;
+        let mut pending = Frame::IDENTITY;
+        for (index, (j, inertial)) in joints.iter().zip(inertials).enumerate() {
+            let (origin, ic) = inertial.check(index)?;
+            if j.kind == JointKind::Fixed {
+                pending = pending.then(&j.origin.check(index)?);
+            } else {
+                body = Some(body.map_or(0, |b| b + 1));
+                pending = Frame::IDENTITY;
+            }
+            if let Some(b) = body {
+                let f = pending.then(&origin);
+                bodies[b].add(inertial.mass, f.p, f.r * ic * f.r.transpose());
+            }
+        }
+        Ok(Self {
+            chain,
+            bodies,
+            gravity: Vector3::from(gravity),
+        })
+    }
+
+    /// The chain (for its kinematics; its tip is the last joint's frame).
+    pub fn chain(&self) -> &Chain<N> {
+        &self.chain
+    }
+
+    /// Gravity (m/s², base frame).
+    pub fn gravity(&self) -> [f64; 3] {
+        self.gravity.into()
+    }
+
+    /// Total mass of the moving links (kg).
+    pub fn mass(&self) -> f64 {
+        self.bodies.iter().map(|b| b.m).sum()
+    }
+
+    /// Every mass and inertia times `factor` (> 0, finite), the centres of
+    /// mass kept: a uniform change of density (20.1).
+    pub fn scaled(mut self, factor: f64) -> Result<Self, Error> {
+        check::positive("mass_scale > 0", "mass_scale", factor)?;
+        for b in &mut self.bodies {
+            b.m *= factor;
+            b.h *= factor;
+            b.i *= factor;
+        }
+        Ok(self)
+    }
+
+    /// A point mass `mass` (kg, ≥ 0, finite) at the origin of the last
+    /// joint's frame added (a payload, 20.1).
+    pub fn with_payload(mut self, mass: f64) -> Result<Self, Error> {
+        check::nonnegative("payload ≥ 0", "payload", mass)?;
+        if let Some(b) = self.bodies.last_mut() {
+            b.m += mass;
+        }
+        Ok(self)
+    }
+
+    /// RNEA(q, q̇, q̈) = M(q) q̈ + C(q, q̇) q̇ + G(q) (N m, N), (20.2).
+    #[inline]
+    pub fn inverse_dynamics(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>) -> Vector<N> {
+        self.rnea(q, dq, ddq, -self.gravity)
+    }
+
+    /// G(q) = RNEA(q, 0, 0) (N m, N).
+    pub fn gravity_torque(&self, q: &Vector<N>) -> Vector<N> {
+        let z = Vector::<N>::zeros();
+        self.rnea(q, &z, &z, -self.gravity)
+    }
+
+    /// M(q) v = RNEA₀(q, 0, v), without gravity (N m, N).
+    #[inline]
+    pub fn mass_times(&self, q: &Vector<N>, v: &Vector<N>) -> Vector<N> {
+        self.rnea(q, &Vector::zeros(), v, Vector3::zeros())
+    }
+
+    /// M(q) (kg m², kg), column j = M e_j, symmetrised.
+    pub fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
+        let mut m = Matrix::<N>::zeros();
+        for j in 0..N {
+            let mut e = Vector::<N>::zeros();
+            e[j] = 1.0;
+            m.set_column(j, &self.mass_times(q, &e));
+        }
+        (m + m.transpose()) * 0.5
+    }
+
+    /// The recursion of (20.2) with the base accelerating at `a0`.
+    fn rnea(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>, a0: Vector3<f64>) -> Vector<N> {
+        // Forward: each body's force F_i and moment N_i about its origin O_i.
+        let mut f = [Vector3::zeros(); N];
+        let mut n = [Vector3::zeros(); N];
+        let mut o = [Vector3::zeros(); N];
+        let mut z = [Vector3::zeros(); N];
+        self.chain.walk(q, dq, Some(ddq), a0, |i, m| {
+            let b = &self.bodies[i];
+            let h = m.r * b.h;
+            let inertia = m.r * b.i * m.r.transpose();
+            f[i] = b.m * m.a + m.al.cross(&h) + m.w.cross(&m.w.cross(&h));
+            n[i] = inertia * m.al + m.w.cross(&(inertia * m.w)) + h.cross(&m.a);
+            o[i] = m.c;
+            z[i] = m.z;
+        });
+        // Backward: what each joint transmits, tip to base.
+        let mut tau = Vector::<N>::zeros();
+        for i in (0..N).rev() {
+            if i + 1 < N {
+                let (fi, ni) = (f[i + 1], n[i + 1]);
+                f[i] += fi;
+                n[i] += ni + (o[i + 1] - o[i]).cross(&fi);
+            }
+            tau[i] = if self.chain.is_prismatic(i) {
+                z[i].dot(&f[i])
+            } else {
+                z[i].dot(&n[i])
+            };
+        }
+        tau
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cartesian::chain::Transform;
+
+    /// Every kind of element: a fixed base, a tilted revolute joint, a
+    /// prismatic joint, a fixed elbow carrying a second inertial, an oblique
+    /// revolute joint with an offset; inertials with rotated axes.
+    fn arm() -> Dynamics<3> {
+        let joints = [
+            Joint::fixed(Transform::from_xyz_rpy([0.0, 0.0, 0.1], [0.0, 0.0, 0.3])),
+            Joint::revolute(
+                Transform::from_xyz_rpy([0.0, 0.05, 0.2], [0.2, -0.1, 0.0]),
+                [0.0, 0.0, 1.0],
+            ),
+            Joint::prismatic(
+                Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0, 0.5, 0.0]),
+                [1.0, 0.0, 0.0],
+            ),
+            Joint::fixed(Transform::from_xyz_rpy([0.1, 0.0, 0.0], [0.0, 0.0, 1.0])),
+            Joint {
+                offset: 0.25,
+                ..Joint::revolute(
+                    Transform::from_xyz_rpy([0.0, 0.2, 0.0], [0.0, 0.0, 0.0]),
+                    [1.0, 2.0, 2.0],
+                )
+            },
+        ];
+        let inertial = |m: f64, xyz: [f64; 3], rpy: [f64; 3], d: [f64; 3]| Inertial {
+            mass: m,
+            origin: Transform::from_xyz_rpy(xyz, rpy),
+            inertia: [[d[0], 0.01, 0.0], [0.01, d[1], 0.002], [0.0, 0.002, d[2]]],
+        };
+        let inertials = [
+            inertial(5.0, [0.0; 3], [0.0; 3], [1.0; 3]),
+            inertial(2.0, [0.1, 0.02, 0.05], [0.3, 0.1, -0.2], [0.05, 0.04, 0.03]),
+            inertial(
+                1.5,
+                [0.15, 0.0, -0.01],
+                [0.0, 0.2, 0.0],
+                [0.02, 0.03, 0.025],
+            ),
+            inertial(
+                0.7,
+                [0.05, 0.01, 0.0],
+                [0.1, 0.0, 0.4],
+                [0.01, 0.012, 0.011],
+            ),
+            inertial(0.9, [0.0, 0.1, 0.03], [-0.2, 0.3, 0.1], [0.015, 0.01, 0.02]),
+        ];
+        Dynamics::new(&joints, &inertials, [0.3, -0.2, -9.81]).unwrap()
+    }
+
+    fn state() -> (Vector<3>, Vector<3>, Vector<3>) {
+        (
+            Vector::<3>::new(0.4, 0.12, -0.7),
+            Vector::<3>::new(0.9, -0.3, 1.4),
+            Vector::<3>::new(-1.1, 0.6, 2.0),
+        )
+    }
+
+    #[test]
+    fn the_mass_matrix_is_symmetric_positive_definite() {
+        let d = arm();
+        let (q, _, _) = state();
+        let m = d.mass_matrix(&q);
+        let mut raw = Matrix::<3>::zeros();
+        for j in 0..3 {
+            let mut e = Vector::<3>::zeros();
+            e[j] = 1.0;
+            raw.set_column(j, &d.mass_times(&q, &e));
+        }
+        assert!((raw - raw.transpose()).amax() < 1e-12, "{raw}");
+        assert!(m.cholesky().is_some(), "{m}");
+        // Affine in q̈ with the mass matrix as its slope.
+        let (q, dq, ddq) = state();
+        let lhs = d.inverse_dynamics(&q, &dq, &ddq) - d.inverse_dynamics(&q, &dq, &Vector::zeros());
+        assert!((lhs - m * ddq).amax() < 1e-12, "{lhs} vs {}", m * ddq);
+    }
+
+    /// The potential energy −Σ m_i gᵀ p_ci from the bodies' centres of mass.
+    fn potential(d: &Dynamics<3>, q: &Vector<3>) -> f64 {
+        let mut v = 0.0;
+        d.chain
+            .walk(q, &Vector::zeros(), None, Vector3::zeros(), |i, m| {
+                let b = &d.bodies[i];
+                v -= d.gravity.dot(&(b.m * m.c + m.r * b.h));
+            });
+        v
+    }
+
+    #[test]
+    fn gravity_is_the_gradient_of_the_potential_energy() {
+        let d = arm();
+        let (q, _, _) = state();
+        let g = d.gravity_torque(&q);
+        let h = 1e-6;
+        for i in 0..3 {
+            let mut e = Vector::<3>::zeros();
+            e[i] = h;
+            let num = (potential(&d, &(q + e)) - potential(&d, &(q - e))) / (2.0 * h);
+            assert!((num - g[i]).abs() < 1e-7, "joint {i}: {num} vs {}", g[i]);
+        }
+    }
+
+    #[test]
+    fn the_power_of_the_torque_is_the_rate_of_the_kinetic_energy() {
+        // q̇ᵀ(τ − G) = d/dt (½ q̇ᵀ M q̇) along q(t) = q0 + t q̇0 + t²/2 q̈0.
+        let d = arm();
+        let (q0, dq0, ddq) = state();
+        let at = |t: f64| (q0 + t * dq0 + 0.5 * t * t * ddq, dq0 + t * ddq);
+        let kinetic = |t: f64| {
+            let (q, dq) = at(t);
+            0.5 * dq.dot(&(d.mass_matrix(&q) * dq))
+        };
+        let h = 1e-5;
+        let rate = (kinetic(h) - kinetic(-h)) / (2.0 * h);
+        let power = dq0.dot(&(d.inverse_dynamics(&q0, &dq0, &ddq) - d.gravity_torque(&q0)));
+        assert!((rate - power).abs() < 1e-7, "{rate} vs {power}");
+    }
+
+    #[test]
+    fn scale_and_payload_change_the_model_as_stated() {
+        let d = arm();
+        let (q, dq, ddq) = state();
+        let tau = d.inverse_dynamics(&q, &dq, &ddq);
+        let scaled = d.scaled(1.3).unwrap().inverse_dynamics(&q, &dq, &ddq);
+        assert!((scaled - 1.3 * tau).amax() < 1e-12);
+        // A payload at the last origin weighs on every joint by its gravity.
+        let loaded = d.with_payload(2.0).unwrap();
+        assert!((loaded.mass() - d.mass() - 2.0).abs() < 1e-15);
+        assert!(d.scaled(0.0).is_err() && d.with_payload(-1.0).is_err());
+    }
+
+    #[test]
+    fn bad_inertials_are_refused_by_name() {
+        let joints = [Joint::revolute(Transform::IDENTITY, [0.0, 0.0, 1.0])];
+        let e =
+            Dynamics::<1>::new(&joints, &[Inertial::point(-1.0, [0.0; 3])], GRAVITY).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("mass ≥ 0 is violated: link mass[0] = -1"),
+            "{e}"
+        );
+        let mut skew = Inertial::point(1.0, [0.0; 3]);
+        skew.inertia = [[1.0, 0.1, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let e = Dynamics::<1>::new(&joints, &[skew], GRAVITY).unwrap_err();
+        assert!(e.to_string().contains("symmetric"), "{e}");
+        let e = Dynamics::<1>::new(&joints, &[], GRAVITY).unwrap_err();
+        assert!(e.to_string().contains("one inertial per joint"), "{e}");
+        let e = Dynamics::<1>::new(&joints, &[Inertial::NONE], [0.0, f64::NAN, 0.0]).unwrap_err();
+        assert!(e.to_string().contains("gravity"), "{e}");
+    }
+}

@@ -107,10 +107,24 @@ def test_the_panda_table_runs_natively_and_equals_the_python_loop(
 
 
 def test_a_python_joint_controller_keeps_the_python_loop(sc: ac.PandaTable) -> None:
-    """Computed torque (Pinocchio's dynamics, in Python) behind the core's outer loop."""
-    ctrl = ac.panda_controller("ct", sc)
+    """A joint controller with a ``step`` of its own (here computed torque's,
+    wrapped in Python) behind the core's outer loop: the Python loop steps it,
+    and it gives computed torque's run; the core's own is native."""
+    from adaptimp.baselines import ComputedTorque
+
+    class Own(ComputedTorque):
+        def step(self, *args: Any, **kwargs: Any) -> Any:
+            return super().step(*args, **kwargs)
+
+    inner = Own(sc.pin_model, Ts=sc.Ts, tau_max=sc.tau_max, impedance="external")
+    ctrl = adaptimp.CartesianController(
+        sc.chain, inner, q0=sc.q0, path=sc.path, Kd_rot=0.0, force_feedforward=True
+    )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.05, q0=sc.q0)
     assert res.params["loop"] == "python"
+    core = amj.simulate(ac.panda_controller("ct", sc), amj.Plant(sc.model), T=0.05, q0=sc.q0)
+    assert core.params["loop"] == "native"
+    np.testing.assert_array_equal(res.tau_sat, core.tau_sat)
     assert res.task is not None
     np.testing.assert_array_equal(res.xc, res.task["pc"])
 

@@ -17,6 +17,7 @@ __all__ = [
     "N_NODES",
     "CartesianImpedance",
     "Chain",
+    "ComputedTorque",
     "Controller",
     "PlanarArm",
     "TwoLinkArm",
@@ -514,7 +515,7 @@ class CartesianImpedance:
     def reference(self, target: ArrayLike | None, wrench: ArrayLike) -> tuple[_F, _F, _F]: ...
     def step_controller(
         self,
-        controller: Controller,
+        controller: Controller | ComputedTorque,
         q: ArrayLike,
         dq: ArrayLike | None,
         wrench: ArrayLike,
@@ -533,7 +534,7 @@ class CartesianImpedance:
     def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F]: ...
     def simulate_mujoco(
         self,
-        controller: Controller,
+        controller: Controller | ComputedTorque,
         model: Any,
         data: Any,
         spec: dict[str, Any],
@@ -548,7 +549,7 @@ class CartesianImpedance:
         """The closed loop on MuJoCo with this outer loop in front of ``controller``."""
     def replay(
         self,
-        controller: Controller,
+        controller: Controller | ComputedTorque,
         q: _F,
         dq: _F,
         wrench: _F,
@@ -578,3 +579,51 @@ def default_task(
     home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """The default task of SPEC §18: (xc_offset, xc_sin, xc_cos, xc_omega)."""
+
+@disjoint_base
+class ComputedTorque:
+    """Computed-torque impedance control on the core's rigid-body model (SPEC §20)."""
+
+    def __new__(
+        cls,
+        joints: list[dict[str, Any]],
+        inertials: list[dict[str, Any]],
+        gravity: Sequence[float],
+        *,
+        Ts: float,
+        Kp: float | Sequence[float],
+        Kd: float | Sequence[float],
+        tau_max: float | Sequence[float],
+        Dd: float | Sequence[float],
+        Cd: float | Sequence[float],
+        Gd: float | Sequence[float],
+        impedance: str,
+        mass_scale: float,
+        payload: float,
+    ) -> ComputedTorque: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def Ts(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def mass(self) -> float: ...
+    @property
+    def fault(self) -> tuple[str, int] | None: ...
+    def reset(self) -> None: ...
+    def step(
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None,
+        xc: ArrayLike,
+        dxc: ArrayLike,
+        ddxc: ArrayLike,
+    ) -> _F:
+        """One step (SPEC (20.3)); sat(τ) (N m), (n,)."""
+    def inverse_dynamics(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> _F:
+        """RNEA(q, q̇, q̈) = M q̈ + C q̇ + G (N m), (n,)."""
+    def mass_matrix(self, q: ArrayLike) -> _F:
+        """M(q) (kg m²), (n, n)."""
+    def last(self, what: str) -> _F: ...

@@ -42,7 +42,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 from . import _models
 from ._trajectory import Reference, paper_circle
 
-__all__ = ["ComputedTorque", "pinocchio_model", "with_payload"]
+__all__ = ["ComputedTorque", "core_description", "pinocchio_model", "with_payload"]
 
 FloatArray = NDArray[np.float64]
 
@@ -144,18 +144,83 @@ def _joint(name: str, value: ArrayLike, n: int) -> FloatArray:
     return v
 
 
+_AXES = {"X": [1.0, 0.0, 0.0], "Y": [0.0, 1.0, 0.0], "Z": [0.0, 0.0, 1.0]}
+
+
+def core_description(model: Any) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[float]]:
+    """A serial Pinocchio ``Model`` as the core's joint data (as
+    :class:`adaptimp.Chain` takes it), one inertial per joint (mass, centre
+    of mass and inertia about it in the joint's frame: Pinocchio's, its
+    fixed links already merged) and gravity (m/s²): what
+    ``adaptimp._adaptimp.ComputedTorque`` takes (SPEC §20).
+
+    Revolute (bounded or continuous, about a frame axis or any axis) and
+    prismatic joints, each the child of the one before; anything else is a
+    ``ValueError`` naming the joint.
+    """
+    joints: list[dict[str, Any]] = []
+    inertials: list[dict[str, Any]] = []
+    for j in range(1, model.njoints):
+        name = model.names[j]
+        if model.parents[j] != j - 1:
+            raise ValueError(
+                f"joint {name!r} is not the child of the joint before it: "
+                "the core's dynamics takes a serial chain"
+            )
+        jm = model.joints[j]
+        short = jm.shortname()
+        kind: str | None = None
+        axis: list[float] | None = None
+        if short.startswith("JointModelR"):
+            kind = "revolute"
+        elif short.startswith("JointModelP"):
+            kind = "prismatic"
+        if short[-1] in _AXES and short[-2:-1] in ("R", "P", "B"):
+            axis = _AXES[short[-1]]
+        elif short.endswith("Unaligned"):
+            axis = [float(x) for x in np.asarray(jm.extract().axis).ravel()]
+        if kind is None or axis is None:
+            raise ValueError(
+                f"joint {name!r} is a {short}: the core's dynamics takes revolute and "
+                "prismatic joints only"
+            )
+        placement = model.jointPlacements[j]
+        joints.append(
+            {
+                "kind": kind,
+                "translation": placement.translation.tolist(),
+                "rotation": placement.rotation.tolist(),
+                "axis": axis,
+            }
+        )
+        inertia = model.inertias[j]
+        inertials.append(
+            {
+                "mass": float(inertia.mass),
+                "translation": inertia.lever.tolist(),
+                "inertia": np.asarray(inertia.inertia).tolist(),
+            }
+        )
+    return joints, inertials, [float(x) for x in model.gravity.linear]
+
+
 class ComputedTorque:
-    """Computed-torque impedance control from a Pinocchio model (module doc).
+    """Computed-torque impedance control (module doc), stepped by the core
+    (SPEC §20) with the inertials of a Pinocchio model.
 
     The controller protocol of :func:`adaptimp.mujoco.simulate`: ``step(q,
     tau_e, dq, xc=, dxc=, ddxc=)`` at t_k = k·Ts returns the applied torque
     sat(τ) (N m); without a setpoint it follows ``trajectory`` (by default,
-    for two joints, the paper's circle (64)).
+    for two joints, the paper's circle (64)). Behind an
+    :class:`adaptimp.CartesianController` the core steps it in its own
+    Cartesian step and native MuJoCo loop, in every formulation (SPEC (20.4)).
 
     Parameters
     ----------
     model : str, path or pinocchio.Model
-        What :func:`pinocchio_model` takes (default the paper's arm).
+        What :func:`pinocchio_model` takes (default the paper's arm): a serial
+        chain of revolute and prismatic joints. Pinocchio only reads it; the
+        dynamics are the core's.
     Ts : float
         Period (s).
     Kp : float or (n,)
@@ -169,8 +234,8 @@ class ComputedTorque:
         Every link mass and inertia of the controller's model times this
         (1: the exact model; 1.3: +30 %).
     payload : float
-        A point mass (kg) at the last joint's frame of the controller's model
-        (:func:`with_payload`): the exact model of a plant simulated with
+        A point mass (kg) at the last joint's frame of the controller's model:
+        the exact model of a plant simulated with
         ``adaptimp.mujoco.simulate(..., payload=...)``; 0: the nominal model.
     Dd, Cd, Gd : float or (n,)
         Target impedance (3) (kg m², N m s/rad, N m/rad); default the paper's
@@ -200,16 +265,17 @@ class ComputedTorque:
         trajectory: Reference | None = None,
         impedance: str = "joint",
     ) -> None:
+        from . import _adaptimp
+
         if impedance not in ("joint", "external"):
             raise ValueError(f"impedance must be 'joint' or 'external', got {impedance!r}")
         self.impedance = impedance
         exact = pinocchio_model(model)
-        self.model = with_payload(scale_masses(exact, mass_scale), float(payload))
-        self.data = self.model.createData()
-        n = self.n = int(self.model.nv)
-        # Continuous joints (nq = 2 each: cos, sin) take q as the angle from
-        # the neutral configuration.
-        self._angles = self.model.nq != n
+        if not (mass_scale > 0 and math.isfinite(mass_scale)):
+            raise ValueError(f"mass_scale must be > 0, got {mass_scale}")
+        if not (math.isfinite(payload) and payload >= 0):
+            raise ValueError(f"payload must be ≥ 0 kg, got {payload}")
+        n = self.n = int(exact.nv)
         if not (Ts > 0 and math.isfinite(Ts)):
             raise ValueError(f"Ts must be > 0, got {Ts}")
         self._ts = float(Ts)
@@ -218,13 +284,29 @@ class ComputedTorque:
         if np.any(self.Dd <= 0):
             raise ValueError(f"Dd must be > 0, got {self.Dd}")
         if tau_max is None:
-            limits = np.asarray(self.model.effortLimit, dtype=np.float64)
+            limits = np.asarray(exact.effortLimit, dtype=np.float64)
             usable = limits.shape == (n,) and np.all((limits > 0) & (limits < 1e300))
             tau_max = limits if usable else [17.0, 15.0] if n == 2 else None
             if tau_max is None:
                 raise ValueError("the model has no effort limits: give tau_max")
         self.tau_max = _joint("tau_max", tau_max, n)
         self.mass_scale = float(mass_scale)
+        joints, inertials, gravity = core_description(exact)
+        self._core = _adaptimp.ComputedTorque(
+            joints,
+            inertials,
+            gravity,
+            Ts=self._ts,
+            Kp=self.Kp.tolist(),
+            Kd=self.Kd.tolist(),
+            tau_max=self.tau_max.tolist(),
+            Dd=self.Dd.tolist(),
+            Cd=self.Cd.tolist(),
+            Gd=self.Gd.tolist(),
+            impedance=impedance,
+            mass_scale=self.mass_scale,
+            payload=float(payload),
+        )
         self._params: dict[str, Any] = {
             "Ts": self._ts,
             "Kp": self.Kp.tolist(),
@@ -243,15 +325,16 @@ class ComputedTorque:
                 xc_offset=[0.2, 0.2], xc_sin=[0.0, 0.2], xc_cos=[-0.2, 0.0], xc_omega=[math.pi] * 2
             )
         self._trajectory = trajectory
-        self.reset()
 
     def reset(self) -> None:
-        """Back to t = 0; the reference starts at the first setpoint."""
-        self._k = 0
-        self._xd: FloatArray | None = None
-        self._dxd = np.zeros(self.n)
-        nan = np.full(self.n, math.nan)
-        self.tau, self.tau_sat, self.xc, self.xd, self.z1 = nan, nan, nan, nan, nan
+        """Back to t = 0; the reference starts at the next setpoint."""
+        self._core.reset()
+
+    @property
+    def _core_joint(self) -> Any:
+        """The core's controller, which a Cartesian controller steps itself
+        (None for a subclass with a ``step`` of its own)."""
+        return self._core if type(self).step is ComputedTorque.step else None
 
     @property
     def Ts(self) -> float:
@@ -266,29 +349,56 @@ class ComputedTorque:
     @property
     def t(self) -> float:
         """Time of the next step t_k = k·Ts (s)."""
-        return self._k * self._ts
+        return int(self._core.steps) * self._ts
 
     @property
     def params(self) -> dict[str, Any]:
         """The gains, limits, target impedance and (if built in) the trajectory."""
         return dict(self._params)
 
-    def _config(self, q: FloatArray) -> FloatArray:
-        """Pinocchio's configuration of joint angles q (rad)."""
-        if self._angles:
-            return np.asarray(pin.integrate(self.model, pin.neutral(self.model), q))
-        return q
+    def _last(self, what: str) -> FloatArray:
+        if self._core.steps == 0:
+            return np.full(self.n, math.nan)
+        return np.asarray(self._core.last(what), dtype=np.float64)
+
+    @property
+    def tau(self) -> FloatArray:
+        """The last step's commanded torque τ before saturation (N m), (n,)."""
+        return self._last("tau")
+
+    @property
+    def tau_sat(self) -> FloatArray:
+        """The last step's applied torque sat(τ) (N m), (n,)."""
+        return self._last("tau_sat")
+
+    @property
+    def xc(self) -> FloatArray:
+        """The last step's setpoint (rad), (n,)."""
+        return self._last("xc")
+
+    @property
+    def xd(self) -> FloatArray:
+        """The last step's reference x_d (rad), (n,)."""
+        return self._last("xd")
+
+    @property
+    def z1(self) -> FloatArray:
+        """The last step's error x_d − q (rad), (n,)."""
+        return self._last("z1")
 
     def mass_matrix(self, q: ArrayLike) -> FloatArray:
-        """The controller's model M̂(q) (kg m²), (n, n), from CRBA."""
-        m = pin.crba(self.model, self.data, self._config(_joint("q", q, self.n)))
-        return np.array(np.triu(m) + np.triu(m, 1).T, dtype=np.float64)
+        """The controller's model M̂(q) (kg m²), (n, n) (the core's, SPEC (20.2))."""
+        return np.asarray(self._core.mass_matrix(_joint("q", q, self.n)), dtype=np.float64)
 
     def bias(self, q: ArrayLike, dq: ArrayLike) -> FloatArray:
-        """The controller's model ĥ = Ĉ(q, q̇) q̇ + Ĝ(q) (N m), (n,), RNEA with q̈ = 0."""
+        """The controller's model ĥ = Ĉ(q, q̇) q̇ + Ĝ(q) (N m), (n,): RNEA with q̈ = 0."""
         q, dq = _joint("q", q, self.n), _joint("dq", dq, self.n)
-        q = self._config(q)
-        return np.array(pin.rnea(self.model, self.data, q, dq, np.zeros(self.n)), dtype=np.float64)
+        return np.asarray(self._core.inverse_dynamics(q, dq, np.zeros(self.n)), dtype=np.float64)
+
+    def inverse_dynamics(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> FloatArray:
+        """The controller's model M̂ q̈ + Ĉ q̇ + Ĝ (N m), (n,) (RNEA, SPEC (20.2))."""
+        q, dq, ddq = _joint("q", q, self.n), _joint("dq", dq, self.n), _joint("ddq", ddq, self.n)
+        return np.asarray(self._core.inverse_dynamics(q, dq, ddq), dtype=np.float64)
 
     def step(
         self,
@@ -299,84 +409,30 @@ class ComputedTorque:
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
-        task_torque: ArrayLike | None = None,
-        jacobian: ArrayLike | None = None,
     ) -> FloatArray:
-        """One step at t_k = k·Ts; returns the applied torque sat(τ) (N m), (n,).
+        """One step at t_k = k·Ts (SPEC (20.3)); returns the applied torque
+        sat(τ) (N m), (n,).
 
         q (rad), tau_e (N m), dq (rad/s; required), each (n,); the setpoint
-        xc (rad), dxc (rad/s), ddxc (rad/s²), (n,), or none of them (then the
-        built-in ``trajectory``).
-
-        ``task_torque`` (N m, (n,)) and ``jacobian`` ((6, n)): what a
-        Cartesian impedance in a torque-level formulation hands its joint
-        controller (SPEC §19): the setpoint is then the commanded joint
-        reference q_c and the law the torque-level impedance with the model
-        as feedforward, τ = M̂ q̈_c + ĥ + τ_task + (I − Jᵀ J⁺ᵀ) M̂ (K_P (q_c − q)
-        + K_D (q̇_c − q̇)), J⁺ the pseudo-inverse (Paden & Panja's PD+, 1988;
-        the null-space term of Albu-Schäffer, Ott & Hirzinger, 2007). τe is
-        not used.
+        xc (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0), or
+        none of them (then the built-in ``trajectory``).
         """
-        if task_torque is not None:
-            return self._task_step(q, dq, xc, dxc, ddxc, task_torque, jacobian)
         n = self.n
         if dq is None:
             raise ValueError("ComputedTorque needs the measured joint velocity dq")
-        q, dq, tau_e = _joint("q", q, n), _joint("dq", dq, n), _joint("tau_e", tau_e, n)
         if xc is None:
             if dxc is not None or ddxc is not None:
                 raise ValueError("give xc with dxc and ddxc")
             if self._trajectory is None:
                 raise ValueError("no setpoint given and no trajectory to follow")
             xc, dxc, ddxc = self._trajectory(self.t)
-        xc = _joint("xc", xc, n)
-        dxc = _joint("dxc", np.zeros(n) if dxc is None else dxc, n)
-        ddxc = _joint("ddxc", np.zeros(n) if ddxc is None else ddxc, n)
-        if self._xd is None or self.impedance == "external":
-            # xd(0) = xc(0), ẋd(0) = ẋc(0), SPEC §4; "external": xd ≡ xc.
-            self._xd, self._dxd = xc.copy(), dxc.copy()
-        xd, dxd = self._xd, self._dxd
-        # The compliant reference (SPEC §4) and the computed torque.
-        if self.impedance == "external":
-            ddxd = ddxc
-        else:
-            ddxd = ddxc + (self.Cd * (dxc - dxd) + self.Gd * (xc - xd) - tau_e) / self.Dd
-        a = ddxd + self.Kd * (dxd - dq) + self.Kp * (xd - q)
-        tau = self.mass_matrix(q) @ a + self.bias(q, dq) + tau_e
-        tau_sat = np.clip(tau, -self.tau_max, self.tau_max)
-        self.tau, self.tau_sat, self.xc, self.xd, self.z1 = tau, tau_sat, xc, xd.copy(), xd - q
-        # Advance the reference to t_{k+1} (SPEC §11: ẋd first, then xd with it).
-        self._dxd = dxd + self._ts * ddxd
-        self._xd = xd + self._ts * self._dxd
-        self._k += 1
-        return tau_sat
-
-    def _task_step(
-        self,
-        q: ArrayLike,
-        dq: ArrayLike | None,
-        xc: ArrayLike | None,
-        dxc: ArrayLike | None,
-        ddxc: ArrayLike | None,
-        task_torque: ArrayLike,
-        jacobian: ArrayLike | None,
-    ) -> FloatArray:
-        """The torque-level law of :meth:`step` (``task_torque`` given)."""
-        n = self.n
-        if dq is None or xc is None or dxc is None or ddxc is None or jacobian is None:
-            raise ValueError("a task step needs dq, xc, dxc, ddxc, task_torque and jacobian")
-        q, dq = _joint("q", q, n), _joint("dq", dq, n)
-        xc, dxc, ddxc = _joint("xc", xc, n), _joint("dxc", dxc, n), _joint("ddxc", ddxc, n)
-        tt = _joint("task_torque", task_torque, n)
-        jac = np.asarray(jacobian, dtype=np.float64).reshape(6, n)
-        m = self.mass_matrix(q)
-        null = np.eye(n) - jac.T @ np.linalg.pinv(jac).T
-        pd = m @ (self.Kp * (xc - q) + self.Kd * (dxc - dq))
-        tau = m @ ddxc + self.bias(q, dq) + tt + null @ pd
-        tau_sat = np.clip(tau, -self.tau_max, self.tau_max)
-        self.tau, self.tau_sat, self.xc, self.xd, self.z1 = tau, tau_sat, xc, xc.copy(), xc - q
-        self._k += 1
-        return tau_sat
+        zero = np.zeros(n)
+        return np.asarray(
+            self._core.step(
+                q, tau_e, dq, xc, zero if dxc is None else dxc, zero if ddxc is None else ddxc
+            ),
+            dtype=np.float64,
+        )
 
     def __repr__(self) -> str:
         return (

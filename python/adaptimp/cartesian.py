@@ -393,6 +393,7 @@ class CartesianController:
                 **joint,
             )
             self._core_inner = True
+            self._joint: Any = inner
         else:
             if joint or centers is not None or widths is not None:
                 raise TypeError(
@@ -407,7 +408,10 @@ class CartesianController:
                     f"the joint controller must have impedance='external' (SPEC §16), got {mode!r}"
                 )
             inner = controller
-            self._core_inner = False
+            # A joint controller the core steps (computed torque, SPEC §20).
+            core_joint = getattr(controller, "_core_joint", None)
+            self._core_inner = isinstance(core_joint, _adaptimp.ComputedTorque)
+            self._joint = core_joint if self._core_inner else controller
         Ts = getattr(inner, "Ts", None)
         if Ts is None:
             raise TypeError(f"the joint controller {inner!r} has no period .Ts (s)")
@@ -499,7 +503,7 @@ class CartesianController:
             target = None
         core = self.outer.core
         if self._core_inner:
-            out = core.step_controller(self.inner, q, dq, f, target)
+            out = core.step_controller(self._joint, q, dq, f, target)
             self.tau = core.last("tau")
         else:
             out = core.step_python(self.inner, q, dq, f, target)

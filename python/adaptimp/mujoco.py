@@ -1417,7 +1417,7 @@ def _native_cartesian(ctrl: Any) -> bool:
         isinstance(ctrl, CartesianController)
         and type(ctrl).step is CartesianController.step
         and ctrl._core_inner
-        and _native(ctrl.inner)
+        and (_native(ctrl.inner) or isinstance(ctrl._joint, _adaptimp.ComputedTorque))
     )
 
 
@@ -1681,7 +1681,7 @@ def _cartesian_loop(
     out: dict[str, Any] | None = None
     try:
         out = ctrl.outer.core.simulate_mujoco(
-            ctrl.inner, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
+            ctrl._joint, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
             run.settle, run.every, progress, targets, core_fault,
         )  # fmt: skip
     finally:

@@ -8,7 +8,10 @@
 //! face ([`DynChain`], [`DynOuter`]), slices in and out; errors become the
 //! exceptions of `adaptimp._errors`.
 
-use super::cartesian_loop::{self, pose_target, CartesianOut, CartesianRun, LastStep};
+use super::cartesian_loop::{
+    self, pose_target, CartesianOut, CartesianRun, Computed, JointStep, LastStep,
+};
+use super::computed::{DynComputed, PyComputedTorque};
 use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JOINTS};
 use super::mujoco::MujocoSpec;
 use super::{array, array1, config_error, items, python_shape, vector, ConfigError, PyController};
@@ -198,8 +201,8 @@ pub trait DynOuter: Send + Sync {
     fn set_stiffness(&mut self, kd: [f64; 3], kd_rot: [f64; 3]) -> Result<(), Error>;
     /// The outer loop alone: one committed step.
     fn reference(&mut self, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Result<(), Error>;
-    /// One step with the core's joint controller behind `tracker`.
-    fn step_tracker(&mut self, tracker: &mut dyn DynTracker, m: &StepIn<'_>) -> Result<(), Error>;
+    /// One step with the core's joint controller `joint`.
+    fn step_tracker(&mut self, joint: JointRef<'_>, m: &StepIn<'_>) -> Result<(), Error>;
     /// One step with a joint controller of the caller's.
     fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error>;
     /// A quantity of the last step (see [`LAST`]).
@@ -218,7 +221,7 @@ pub trait DynOuter: Send + Sync {
     /// ([`cartesian_loop::simulate_mujoco`]).
     fn simulate_mujoco(
         &mut self,
-        tracker: &mut dyn DynTracker,
+        joint: JointRef<'_>,
         sim: &mut Sim,
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
@@ -227,7 +230,7 @@ pub trait DynOuter: Send + Sync {
     /// Steps over recorded rows, the core's alone ([`cartesian_loop::replay`]).
     fn replay(
         &mut self,
-        tracker: &mut dyn DynTracker,
+        joint: JointRef<'_>,
         rows: usize,
         tables: [&[f64]; 3],
         targets: Option<&[f64]>,
@@ -236,15 +239,33 @@ pub trait DynOuter: Send + Sync {
     ) -> Result<(), RunError>;
 }
 
-/// The typed joint controller of N joints behind `tracker`.
-fn typed<const N: usize>(tracker: &mut dyn DynTracker) -> Result<&mut Typed<N>, Error> {
-    tracker
-        .as_any_mut()
-        .downcast_mut::<Typed<N>>()
-        .ok_or(Error::Invalid {
-            what: "controller",
-            reason: "has another number of joints than the chain",
-        })
+/// A joint controller of the core, of any n: the paper's laws or computed
+/// torque (SPEC §20).
+pub enum JointRef<'a> {
+    /// An `adaptimp.Controller`.
+    Adaptive(&'a mut dyn DynTracker),
+    /// An `adaptimp.baselines.ComputedTorque`.
+    Computed(&'a mut dyn DynComputed),
+}
+
+/// The typed joint controller of N joints behind `joint`.
+fn typed<'a, const N: usize>(joint: JointRef<'a>) -> Result<&'a mut dyn JointStep<N>, Error> {
+    let other = Error::Invalid {
+        what: "controller",
+        reason: "has another number of joints than the chain",
+    };
+    match joint {
+        JointRef::Adaptive(t) => t
+            .as_any_mut()
+            .downcast_mut::<Typed<N>>()
+            .map(|t| t as &mut dyn JointStep<N>)
+            .ok_or(other),
+        JointRef::Computed(c) => c
+            .as_any_mut()
+            .downcast_mut::<Computed<N>>()
+            .map(|c| c as &mut dyn JointStep<N>)
+            .ok_or(other),
+    }
 }
 
 struct Outer<const N: usize> {
@@ -324,8 +345,8 @@ impl<const N: usize> DynOuter for Outer<N> {
         self.last = Some(LastStep::new(cmd, target, wrench));
         Ok(())
     }
-    fn step_tracker(&mut self, tracker: &mut dyn DynTracker, m: &StepIn<'_>) -> Result<(), Error> {
-        let typed = typed::<N>(tracker)?;
+    fn step_tracker(&mut self, joint: JointRef<'_>, m: &StepIn<'_>) -> Result<(), Error> {
+        let typed = typed::<N>(joint)?;
         let meas = Self::measurement(m);
         let cmd = cartesian_loop::cartesian_step(
             &self.outer,
@@ -454,13 +475,13 @@ impl<const N: usize> DynOuter for Outer<N> {
     }
     fn simulate_mujoco(
         &mut self,
-        tracker: &mut dyn DynTracker,
+        joint: JointRef<'_>,
         sim: &mut Sim,
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
         hooks: &mut dyn Hooks,
     ) -> Result<CartesianOut, RunError> {
-        let joint = typed::<N>(tracker)?;
+        let joint = typed::<N>(joint)?;
         cartesian_loop::simulate_mujoco(
             &self.outer,
             &mut self.state,
@@ -474,14 +495,14 @@ impl<const N: usize> DynOuter for Outer<N> {
     }
     fn replay(
         &mut self,
-        tracker: &mut dyn DynTracker,
+        joint: JointRef<'_>,
         rows: usize,
         tables: [&[f64]; 3],
         targets: Option<&[f64]>,
         out: &mut Vec<f64>,
         hooks: &mut dyn Hooks,
     ) -> Result<(), RunError> {
-        let joint = typed::<N>(tracker)?;
+        let joint = typed::<N>(joint)?;
         cartesian_loop::replay(
             &self.outer,
             &mut self.state,
@@ -494,6 +515,46 @@ impl<const N: usize> DynOuter for Outer<N> {
             hooks,
         )
     }
+}
+
+/// The core's joint controller behind a Python object, locked: an
+/// `adaptimp.Controller` or a `ComputedTorque` (SPEC §20) of n joints.
+enum Locked<'a> {
+    Adaptive(MutexGuard<'a, Box<dyn DynTracker>>),
+    Computed(MutexGuard<'a, Box<dyn DynComputed>>),
+}
+
+impl Locked<'_> {
+    fn joint(&mut self) -> JointRef<'_> {
+        match self {
+            Locked::Adaptive(g) => JointRef::Adaptive(&mut ***g),
+            Locked::Computed(g) => JointRef::Computed(&mut ***g),
+        }
+    }
+}
+
+fn lock_joint<'a>(
+    py: Python<'_>,
+    controller: &'a Bound<'_, PyAny>,
+    n: usize,
+) -> PyResult<Locked<'a>> {
+    let (got, locked) = if let Ok(c) = controller.cast::<PyController>() {
+        let c = c.get();
+        (c.n, Locked::Adaptive(c.lock(py)))
+    } else if let Ok(c) = controller.cast::<PyComputedTorque>() {
+        let c = c.get();
+        (c.n, Locked::Computed(c.lock(py)))
+    } else {
+        return Err(PyTypeError::new_err(
+            "the joint controller must be an adaptimp.Controller or a core ComputedTorque",
+        ));
+    };
+    if got != n {
+        return Err(ConfigError::new_err(format!(
+            "the joint controller has {got} joints, the chain {n}"
+        )));
+    }
+    Ok(locked)
 }
 
 // ---------------------------------------------------------------------------
@@ -562,7 +623,7 @@ fn wrench_of(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
 /// A transform from a dict: {"xyz", "rpy"} (URDF), {"pos", "quat"} (MuJoCo,
 /// [w, x, y, z]) or {"translation", "rotation"} (3 × 3, row-major); empty:
 /// the identity.
-fn transform(d: &Bound<'_, PyDict>) -> PyResult<Transform> {
+pub(super) fn transform(d: &Bound<'_, PyDict>) -> PyResult<Transform> {
     let get = |key: &str, len: usize| -> PyResult<Option<Vec<f64>>> {
         match d.get_item(key)? {
             None => Ok(None),
@@ -610,7 +671,7 @@ fn transform(d: &Bound<'_, PyDict>) -> PyResult<Transform> {
     Ok(Transform::from_xyz_rpy(xyz, rpy))
 }
 
-fn joint(d: &Bound<'_, PyDict>) -> PyResult<Joint> {
+pub(super) fn joint(d: &Bound<'_, PyDict>) -> PyResult<Joint> {
     let kind: String = match d.get_item("kind")? {
         Some(k) => k.extract()?,
         None => return Err(PyTypeError::new_err("a joint needs its kind")),
@@ -921,7 +982,7 @@ impl PyCartesian {
     fn step_controller<'py>(
         &self,
         py: Python<'py>,
-        controller: &PyController,
+        controller: &Bound<'py, PyAny>,
         q: &Bound<'py, PyAny>,
         dq: Option<&Bound<'py, PyAny>>,
         wrench: &Bound<'py, PyAny>,
@@ -931,10 +992,9 @@ impl PyCartesian {
         let q = vector("q", n, q)?;
         let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
         let m = self.measurement(&q, dq.as_ref(), wrench_of(wrench)?, target_of(target)?);
-        let mut tracker = controller.lock(py);
+        let mut joint = lock_joint(py, controller, n)?;
         let mut g = self.lock(py);
-        g.step_tracker(tracker.as_mut(), &m)
-            .map_err(cartesian_error)?;
+        g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
         Ok(array1(py, &g.last(16)))
     }
 
@@ -1059,7 +1119,7 @@ impl PyCartesian {
     fn simulate_mujoco<'py>(
         &self,
         py: Python<'py>,
-        controller: &PyController,
+        controller: &Bound<'py, PyAny>,
         model: &Bound<'py, PyAny>,
         data: &Bound<'py, PyAny>,
         spec: &Bound<'py, PyDict>,
@@ -1075,12 +1135,7 @@ impl PyCartesian {
         if record_every == 0 {
             return Err(ConfigError::new_err("record_every must be ≥ 1"));
         }
-        if controller.n != self.n {
-            return Err(ConfigError::new_err(format!(
-                "the joint controller has {} joints, the chain {}",
-                controller.n, self.n
-            )));
-        }
+        let mut joint = lock_joint(py, controller, self.n)?;
         let spec = super::mujoco_spec(spec)?;
         let items = items(params)?;
         let targets = match &targets {
@@ -1097,14 +1152,13 @@ impl PyCartesian {
             fault: fault.as_ref(),
         };
         let mut hooks = super::PyHooks::new(progress);
-        let mut tracker = controller.lock(py);
         let mut outer = self.lock(py);
         let result = {
-            let (t, o): (&mut dyn DynTracker, &mut dyn DynOuter) = (&mut **tracker, &mut **outer);
+            let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
             py.detach(|| o.simulate_mujoco(t, &mut sim, &spec, &run, &mut hooks))
         };
         drop(outer);
-        drop(tracker);
+        drop(joint);
         drop(sim);
         let (rec, task, metrics) = result.map_err(|e| super::run_error(e, &mut hooks))?;
         let k = rec.rows();
@@ -1145,7 +1199,7 @@ impl PyCartesian {
     fn replay<'py>(
         &self,
         py: Python<'py>,
-        controller: &PyController,
+        controller: &Bound<'py, PyAny>,
         q: PyReadonlyArray2<'py, f64>,
         dq: PyReadonlyArray2<'py, f64>,
         wrench: PyReadonlyArray2<'py, f64>,
@@ -1153,12 +1207,6 @@ impl PyCartesian {
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.n;
-        if controller.n != n {
-            return Err(ConfigError::new_err(format!(
-                "the joint controller has {} joints, the chain {}",
-                controller.n, n
-            )));
-        }
         let k = q.shape()[0];
         let q = super::table("q", &q, k, n)?;
         let dq = super::table("dq", &dq, k, n)?;
@@ -1169,10 +1217,10 @@ impl PyCartesian {
         };
         let mut out = Vec::with_capacity(k * n);
         let mut hooks = super::PyHooks::new(progress);
-        let mut tracker = controller.lock(py);
+        let mut joint = lock_joint(py, controller, n)?;
         let mut outer = self.lock(py);
         let result = {
-            let (t, o): (&mut dyn DynTracker, &mut dyn DynOuter) = (&mut **tracker, &mut **outer);
+            let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
             py.detach(|| {
                 o.replay(
                     t,
@@ -1185,7 +1233,7 @@ impl PyCartesian {
             })
         };
         drop(outer);
-        drop(tracker);
+        drop(joint);
         result.map_err(|e| super::run_error(e, &mut hooks))?;
         array(py, out, (k, n))
     }

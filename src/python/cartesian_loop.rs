@@ -27,9 +27,12 @@ use super::dynamic::{
 };
 use super::mujoco::MujocoSpec;
 use crate::cartesian::{
-    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, PoseTarget,
+    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain,
+    ComputedState, ComputedTorque, PoseTarget,
 };
+use crate::control::config::Law;
 use crate::control::impedance::TargetImpedance;
+use crate::control::io::TaskTorque;
 use crate::control::io::{Command, Control, Measurement};
 use crate::error::Error;
 use crate::sim::record::{Recorder, Row};
@@ -55,6 +58,99 @@ pub struct CartesianRun<'a> {
     pub targets: Option<&'a [f64]>,
     /// A fault to inject (τmax: the plant's actuators').
     pub fault: Option<&'a FaultSpec>,
+}
+
+/// A joint controller of the core behind a Cartesian impedance: the
+/// paper's laws ([`Typed`]) or computed torque ([`Computed`]), as the
+/// Cartesian step and the native loop drive it.
+pub(crate) trait JointStep<const N: usize> {
+    /// Ts (s).
+    fn period(&self) -> f64;
+    /// The target impedance (3) (for the impedance residual of SPEC §12).
+    fn impedance(&self) -> &TargetImpedance<N>;
+    /// The law whose preset the run's scenario takes (SPEC §17).
+    fn law(&self) -> Law;
+    /// One step on the compliant reference `r`.
+    fn step_with(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error>;
+    /// One step of the torque-level formulations (SPEC §19).
+    fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        r: &Setpoint<N>,
+        t: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error>;
+    /// A step refused before it reached the controller, recorded.
+    fn refuse(&mut self, e: Error);
+    /// The torque it applies now (N m): the last step's, or its fallback.
+    fn applied(&self) -> Vector<N>;
+}
+
+impl<const N: usize> JointStep<N> for Typed<N> {
+    fn period(&self) -> f64 {
+        self.controller().period()
+    }
+    fn impedance(&self) -> &TargetImpedance<N> {
+        self.controller().impedance()
+    }
+    fn law(&self) -> Law {
+        self.controller().config().law
+    }
+    fn step_with(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error> {
+        Typed::step_with(self, m, r)
+    }
+    fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        r: &Setpoint<N>,
+        t: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error> {
+        Typed::step_task(self, m, r, t)
+    }
+    fn refuse(&mut self, e: Error) {
+        Typed::refuse(self, e);
+    }
+    fn applied(&self) -> Vector<N> {
+        *self.state().applied()
+    }
+}
+
+/// Computed torque (SPEC §20) with its state.
+#[derive(Clone, Debug)]
+pub struct Computed<const N: usize> {
+    /// The controller.
+    pub ctrl: ComputedTorque<N>,
+    /// Its state.
+    pub state: ComputedState<N>,
+}
+
+impl<const N: usize> JointStep<N> for Computed<N> {
+    fn period(&self) -> f64 {
+        self.ctrl.period()
+    }
+    fn impedance(&self) -> &TargetImpedance<N> {
+        self.ctrl.impedance()
+    }
+    /// PD's preset: a model-based law has no network or observer.
+    fn law(&self) -> Law {
+        Law::Pd
+    }
+    fn step_with(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.ctrl.step(&mut self.state, m, r)
+    }
+    fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        r: &Setpoint<N>,
+        t: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error> {
+        self.ctrl.step_task(&mut self.state, m, r, t)
+    }
+    fn refuse(&mut self, e: Error) {
+        self.ctrl.refuse(&mut self.state, e);
+    }
+    fn applied(&self) -> Vector<N> {
+        self.state.applied
+    }
 }
 
 /// The task-space quantities of one row.
@@ -201,10 +297,10 @@ impl<const N: usize> LastStep<N> {
 /// fault, its fallback as the applied torque); so is one the outer loop
 /// refuses before the joint step runs (a non-finite q, wrench or target), as
 /// a front's refused call is ([`Tracker::refuse`](crate::control::tracker::Tracker::refuse)).
-pub(crate) fn cartesian_step<const N: usize>(
+pub(crate) fn cartesian_step<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
-    joint: &mut Typed<N>,
+    joint: &mut J,
     m: &CartesianMeasurement<N>,
     target: Option<&PoseTarget>,
 ) -> Result<CartesianCommand<N>, Error> {
@@ -241,17 +337,17 @@ pub(crate) fn pose_target(v: &[f64]) -> PoseTarget {
 /// [`Control`]: [`Control::step_with_wrench`] runs
 /// [`CartesianImpedance::step_with`] with the measured wrench and the
 /// joint controller's step, the commanded pose of the row from the table.
-struct Cartesian<'a, const N: usize> {
+struct Cartesian<'a, const N: usize, J: ?Sized> {
     outer: &'a CartesianImpedance<N, Chain<N>>,
     state: &'a mut CartesianState<N>,
-    joint: &'a mut Typed<N>,
+    joint: &'a mut J,
     targets: Option<&'a [f64]>,
     clock: &'a Cell<f64>,
     row: &'a Cell<TaskRow<N>>,
     last: Option<LastStep<N>>,
 }
 
-impl<const N: usize> Cartesian<'_, N> {
+impl<const N: usize, J: JointStep<N> + ?Sized> Cartesian<'_, N, J> {
     fn step_cartesian(
         &mut self,
         m: &Measurement<N>,
@@ -282,12 +378,12 @@ impl<const N: usize> Cartesian<'_, N> {
     }
 }
 
-impl<const N: usize> Control<N> for Cartesian<'_, N> {
+impl<const N: usize, J: JointStep<N> + ?Sized> Control<N> for Cartesian<'_, N, J> {
     fn period(&self) -> f64 {
         self.outer.period()
     }
     fn target(&self) -> &TargetImpedance<N> {
-        self.joint.controller().impedance()
+        self.joint.impedance()
     }
     /// The Cartesian step with no wrench measured.
     fn step(&mut self, m: &Measurement<N>, _c: &Setpoint<N>) -> Result<Command<N>, Error> {
@@ -311,7 +407,7 @@ impl<const N: usize> Control<N> for Cartesian<'_, N> {
     ) -> (Vector<N>, Result<Command<N>, Error>) {
         match self.step_cartesian(m, wrench) {
             Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
-            Err(e) => (*self.joint.state().applied(), Err(e)),
+            Err(e) => (self.joint.applied(), Err(e)),
         }
     }
 }
@@ -357,10 +453,10 @@ fn invalid(what: &'static str, reason: &'static str) -> RunError {
 /// on). Returns the records and the task-space metrics, and leaves the last
 /// step taken in `last` (also when the run ends with an error).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn simulate_mujoco<const N: usize>(
+pub(crate) fn simulate_mujoco<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
-    joint: &mut Typed<N>,
+    joint: &mut J,
     last: &mut Option<LastStep<N>>,
     sim: &mut Sim,
     spec: &MujocoSpec,
@@ -368,19 +464,19 @@ pub(crate) fn simulate_mujoco<const N: usize>(
     hooks: &mut dyn Hooks,
 ) -> Result<CartesianOut, RunError> {
     if N <= 3 {
-        run_m::<N, 3>(outer, state, joint, last, sim, spec, run, hooks)
+        run_m::<N, 3, J>(outer, state, joint, last, sim, spec, run, hooks)
     } else {
-        run_m::<N, N>(outer, state, joint, last, sim, spec, run, hooks)
+        run_m::<N, N, J>(outer, state, joint, last, sim, spec, run, hooks)
     }
 }
 
 /// [`simulate_mujoco`] with the metrics' accumulator of M = max(N, 3) slots
 /// (as [`metrics_of`](super::dynamic::metrics_of) takes for the same rows).
 #[allow(clippy::too_many_arguments)]
-fn run_m<const N: usize, const M: usize>(
+fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
-    joint: &mut Typed<N>,
+    joint: &mut J,
     last: &mut Option<LastStep<N>>,
     sim: &mut Sim,
     spec: &MujocoSpec,
@@ -388,7 +484,7 @@ fn run_m<const N: usize, const M: usize>(
     hooks: &mut dyn Hooks,
 ) -> Result<CartesianOut, RunError> {
     let ts = outer.period();
-    if joint.controller().period() != ts {
+    if joint.period() != ts {
         return Err(invalid(
             "joint controller of a Cartesian impedance",
             "needs the same Ts as the Cartesian impedance",
@@ -405,12 +501,8 @@ fn run_m<const N: usize, const M: usize>(
     }
     // A Cartesian controller reads the wrench, not τe: what acts on τe alone
     // would act on nothing.
-    let s = super::dynamic::scenario::<N>(
-        crate::schema::Preset::Robot,
-        joint.controller().config().law,
-        run.items,
-    )
-    .map_err(|e| RunError::Core(e.error, None))?;
+    let s = super::dynamic::scenario::<N>(crate::schema::Preset::Robot, joint.law(), run.items)
+        .map_err(|e| RunError::Core(e.error, None))?;
     if s.disturbances()?
         .params()
         .noise_tau_e
@@ -449,7 +541,7 @@ fn run_m<const N: usize, const M: usize>(
         row: &row,
         last: *last,
     };
-    let law = ctrl.joint.controller().config().law;
+    let law = ctrl.joint.law();
     let on = OnMujoco {
         sim,
         spec,
@@ -476,10 +568,10 @@ fn run_m<const N: usize, const M: usize>(
 /// 6), the pose targets (K × [`TARGET_LEN`], or none: held). Writes sat(τ)
 /// rows into `out`. Errors name the row.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn replay<const N: usize>(
+pub(crate) fn replay<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
-    joint: &mut Typed<N>,
+    joint: &mut J,
     last: &mut Option<LastStep<N>>,
     rows: usize,
     tables: [&[f64]; 3],

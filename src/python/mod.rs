@@ -26,6 +26,7 @@
 mod arm;
 mod cartesian;
 mod cartesian_loop;
+mod computed;
 mod dynamic;
 mod mujoco;
 mod tuning;
@@ -1849,6 +1850,8 @@ mod adaptimp_module {
 
     #[pymodule_export]
     use super::cartesian::{centres_along, PyCartesian, PyChain};
+    #[pymodule_export]
+    use super::computed::PyComputedTorque;
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

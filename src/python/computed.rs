@@ -1,0 +1,467 @@
+//! Python bindings of the core's rigid-body dynamics and computed torque
+//! (SPEC §20): `ComputedTorque`, one monomorphised core per n behind an
+//! object-safe face ([`DynComputed`]); `adaptimp.baselines.ComputedTorque`
+//! is its front. As a joint controller behind `CartesianImpedance` it steps
+//! in the core's Cartesian step and native loop like `Controller`.
+
+use super::cartesian::transform;
+use super::cartesian_loop::Computed;
+use super::dynamic::MAX_JOINTS;
+use super::{array, array1, vector, ConfigError};
+use crate::cartesian::chain::JointKind;
+use crate::cartesian::{
+    ComputedState, ComputedTorque, ComputedTorqueConfig, Dynamics, Inertial, Joint,
+};
+use crate::control::impedance::{ImpedanceMode, TargetImpedance};
+use crate::control::io::Measurement;
+use crate::error::Error;
+use crate::trajectory::Setpoint;
+use crate::types::Vector;
+use numpy::PyArray1;
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::any::Any;
+use std::sync::{Mutex, MutexGuard, TryLockError};
+use std::vec::Vec;
+
+/// A computed-torque controller of any n ≤ 7 with its state, over slices.
+pub trait DynComputed: Send + Sync {
+    /// Joints n.
+    fn n(&self) -> usize;
+    /// Ts (s).
+    fn ts(&self) -> f64;
+    /// Steps taken.
+    fn steps(&self) -> u64;
+    /// Back to t = 0.
+    fn reset(&mut self);
+    /// One step (20.3) on the setpoint `c` (xc, ẋc, ẍc); writes sat(τ).
+    fn step(
+        &mut self,
+        q: &[f64],
+        dq: Option<&[f64]>,
+        tau_e: &[f64],
+        c: [&[f64]; 3],
+        out: &mut [f64],
+    ) -> Result<(), Error>;
+    /// RNEA(q, q̇, q̈) of the controller's model.
+    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Vec<f64>;
+    /// M(q), row-major.
+    fn mass_matrix(&self, q: &[f64]) -> Vec<f64>;
+    /// The last step's τ, sat(τ), xc, xd, z1 (by index).
+    fn last(&self, what: usize) -> Vec<f64>;
+    /// The last refused step: (error, step).
+    fn fault(&self) -> Option<(Error, u64)>;
+    /// The controller's total moving mass (kg).
+    fn mass(&self) -> f64;
+    /// As [`Any`], for the typed paths.
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+fn vector_of<const N: usize>(v: &[f64]) -> Vector<N> {
+    Vector::from_column_slice(&v[..N])
+}
+
+impl<const N: usize> DynComputed for Computed<N> {
+    fn n(&self) -> usize {
+        N
+    }
+    fn ts(&self) -> f64 {
+        self.ctrl.period()
+    }
+    fn steps(&self) -> u64 {
+        self.state.k
+    }
+    fn reset(&mut self) {
+        self.state = ComputedState::default();
+    }
+    fn step(
+        &mut self,
+        q: &[f64],
+        dq: Option<&[f64]>,
+        tau_e: &[f64],
+        c: [&[f64]; 3],
+        out: &mut [f64],
+    ) -> Result<(), Error> {
+        let m = Measurement {
+            x: vector_of(q),
+            dx: dq.map(vector_of),
+            tau_e: vector_of(tau_e),
+        };
+        let s = Setpoint {
+            x: vector_of(c[0]),
+            dx: vector_of(c[1]),
+            ddx: vector_of(c[2]),
+        };
+        let cmd = self.ctrl.step(&mut self.state, &m, &s)?;
+        out[..N].copy_from_slice(cmd.tau_sat.as_slice());
+        Ok(())
+    }
+    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Vec<f64> {
+        let tau =
+            self.ctrl
+                .model()
+                .inverse_dynamics(&vector_of(q), &vector_of(dq), &vector_of(ddq));
+        tau.as_slice().to_vec()
+    }
+    fn mass_matrix(&self, q: &[f64]) -> Vec<f64> {
+        let m = self.ctrl.model().mass_matrix(&vector_of(q));
+        // Column-major storage of a symmetric matrix: its rows.
+        m.as_slice().to_vec()
+    }
+    fn last(&self, what: usize) -> Vec<f64> {
+        let c = &self.state.last;
+        let v = match what {
+            0 => c.tau,
+            1 => c.tau_sat,
+            2 => c.xc,
+            3 => c.xd,
+            _ => c.z1,
+        };
+        v.as_slice().to_vec()
+    }
+    fn fault(&self) -> Option<(Error, u64)> {
+        self.state.fault.map(|f| (f.error, f.step))
+    }
+    fn mass(&self) -> f64 {
+        self.ctrl.model().mass()
+    }
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// The parameters of a [`DynComputed`], as reals per joint.
+struct Params<'a> {
+    ts: f64,
+    kp: &'a [f64],
+    kd: &'a [f64],
+    tau_max: &'a [f64],
+    dd: &'a [f64],
+    cd: &'a [f64],
+    gd: &'a [f64],
+    mode: ImpedanceMode,
+    mass_scale: f64,
+    payload: f64,
+}
+
+fn build<const N: usize>(
+    joints: &[Joint],
+    inertials: &[Inertial],
+    gravity: [f64; 3],
+    p: &Params<'_>,
+) -> Result<Box<dyn DynComputed>, Error> {
+    let model = Dynamics::<N>::new(joints, inertials, gravity)?
+        .scaled(p.mass_scale)?
+        .with_payload(p.payload)?;
+    let cfg = ComputedTorqueConfig {
+        ts: p.ts,
+        kp: vector_of(p.kp),
+        kd: vector_of(p.kd),
+        tau_max: vector_of(p.tau_max),
+        impedance: TargetImpedance::new(vector_of(p.dd), vector_of(p.cd), vector_of(p.gd))?,
+        mode: p.mode,
+    };
+    Ok(Box::new(Computed {
+        ctrl: ComputedTorque::new(cfg, model)?,
+        state: ComputedState::default(),
+    }))
+}
+
+fn computed(
+    joints: &[Joint],
+    inertials: &[Inertial],
+    gravity: [f64; 3],
+    p: &Params<'_>,
+) -> Result<Box<dyn DynComputed>, Error> {
+    let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
+    macro_rules! arms {
+        ($($k:literal)*) => {
+            match n {
+                $($k => build::<$k>(joints, inertials, gravity, p),)*
+                _ => Err(Error::Condition {
+                    condition: "1 ≤ n ≤ 7 movable joints",
+                    lhs: "movable joints",
+                    index: None,
+                    value: n as f64,
+                }),
+            }
+        };
+    }
+    arms!(1 2 3 4 5 6 7)
+}
+
+/// A 3 × 3 matrix from a nested or a flat sequence of 9 reals.
+fn matrix3(key: &str, v: &Bound<'_, PyAny>) -> PyResult<[[f64; 3]; 3]> {
+    let flat = v
+        .extract::<Vec<Vec<f64>>>()
+        .map(|rows| rows.concat())
+        .or_else(|_| v.extract::<Vec<f64>>())
+        .map_err(|_| PyTypeError::new_err(format!("{key} must be 3 × 3 reals")))?;
+    if flat.len() != 9 {
+        return Err(ConfigError::new_err(format!(
+            "{key} must have 3 × 3 values, got {}",
+            flat.len()
+        )));
+    }
+    Ok(core::array::from_fn(|i| {
+        core::array::from_fn(|j| flat[3 * i + j])
+    }))
+}
+
+fn inertial(d: &Bound<'_, PyDict>) -> PyResult<Inertial> {
+    let mass: f64 = match d.get_item("mass")? {
+        Some(m) => m.extract()?,
+        None => return Err(PyTypeError::new_err("an inertial needs its mass (kg)")),
+    };
+    let inertia = match d.get_item("inertia")? {
+        Some(i) => matrix3("inertia", &i)?,
+        None => [[0.0; 3]; 3],
+    };
+    Ok(Inertial {
+        mass,
+        origin: transform(d)?,
+        inertia,
+    })
+}
+
+fn per_joint(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let v = match obj.extract::<f64>() {
+        Ok(x) => std::vec![x; n],
+        Err(_) => obj
+            .extract::<Vec<f64>>()
+            .map_err(|_| PyTypeError::new_err(format!("{what} must be a number or {n} numbers")))?,
+    };
+    if v.len() != n {
+        return Err(ConfigError::new_err(format!(
+            "{what} must be a number or have {n} values, got {}",
+            v.len()
+        )));
+    }
+    Ok(v)
+}
+
+const LAST: [&str; 5] = ["tau", "tau_sat", "xc", "xd", "z1"];
+
+/// Computed-torque impedance control on the core's rigid-body model (SPEC
+/// §20). Use `adaptimp.baselines.ComputedTorque`, which builds it from a
+/// Pinocchio model.
+#[pyclass(
+    name = "ComputedTorque",
+    module = "adaptimp._adaptimp",
+    frozen,
+    subclass
+)]
+pub struct PyComputedTorque {
+    inner: Mutex<Box<dyn DynComputed>>,
+    /// Joints n.
+    pub n: usize,
+}
+
+impl PyComputedTorque {
+    /// The controller, waiting (with the GIL released) while another thread
+    /// uses it.
+    pub fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynComputed>> {
+        loop {
+            match self.inner.try_lock() {
+                Ok(g) => return g,
+                Err(TryLockError::Poisoned(p)) => return p.into_inner(),
+                Err(TryLockError::WouldBlock) => py.detach(|| {
+                    drop(self.inner.lock());
+                }),
+            }
+        }
+    }
+}
+
+fn config_err(e: Error) -> PyErr {
+    ConfigError::new_err(e.to_string())
+}
+
+#[pymethods]
+impl PyComputedTorque {
+    /// The controller of the chain `joints` (dicts as `Chain` takes them)
+    /// with `inertials[k]` the inertial of joint k's child link (dicts:
+    /// "mass" (kg), the centre of mass and the inertia's axes as origin keys,
+    /// "inertia" 3 × 3 (kg m²) about the centre of mass), `gravity` (m/s²),
+    /// period `Ts` (s), K_P (1/s²), K_D (1/s), τmax (N m), the target
+    /// impedance Dd, Cd, Gd, `impedance` ("joint" or "external"), the model's
+    /// masses times `mass_scale` and a `payload` (kg) at the last joint.
+    #[new]
+    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload))]
+    #[allow(clippy::too_many_arguments, non_snake_case)]
+    fn new(
+        joints: Vec<Bound<'_, PyDict>>,
+        inertials: Vec<Bound<'_, PyDict>>,
+        gravity: [f64; 3],
+        Ts: f64,
+        Kp: &Bound<'_, PyAny>,
+        Kd: &Bound<'_, PyAny>,
+        tau_max: &Bound<'_, PyAny>,
+        Dd: &Bound<'_, PyAny>,
+        Cd: &Bound<'_, PyAny>,
+        Gd: &Bound<'_, PyAny>,
+        impedance: &str,
+        mass_scale: f64,
+        payload: f64,
+    ) -> PyResult<Self> {
+        let js = joints
+            .iter()
+            .map(super::cartesian::joint)
+            .collect::<PyResult<Vec<_>>>()?;
+        let ins = inertials
+            .iter()
+            .map(inertial)
+            .collect::<PyResult<Vec<_>>>()?;
+        let n = js.iter().filter(|j| j.kind != JointKind::Fixed).count();
+        let mode = match impedance {
+            "joint" => ImpedanceMode::Joint,
+            "external" => ImpedanceMode::External,
+            other => {
+                return Err(ConfigError::new_err(format!(
+                    "impedance must be 'joint' or 'external', got {other:?}"
+                )))
+            }
+        };
+        let (kp, kd, tm) = (
+            per_joint("Kp", n, Kp)?,
+            per_joint("Kd", n, Kd)?,
+            per_joint("tau_max", n, tau_max)?,
+        );
+        let (dd, cd, gd) = (
+            per_joint("Dd", n, Dd)?,
+            per_joint("Cd", n, Cd)?,
+            per_joint("Gd", n, Gd)?,
+        );
+        let p = Params {
+            ts: Ts,
+            kp: &kp,
+            kd: &kd,
+            tau_max: &tm,
+            dd: &dd,
+            cd: &cd,
+            gd: &gd,
+            mode,
+            mass_scale,
+            payload,
+        };
+        let inner = computed(&js, &ins, gravity, &p).map_err(config_err)?;
+        Ok(Self {
+            n: inner.n(),
+            inner: Mutex::new(inner),
+        })
+    }
+
+    /// Joints n.
+    #[getter]
+    fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Period Ts (s).
+    #[getter]
+    #[allow(non_snake_case)]
+    fn Ts(&self, py: Python<'_>) -> f64 {
+        self.lock(py).ts()
+    }
+
+    /// Steps taken k (the next step is at t_k = k·Ts).
+    #[getter]
+    fn steps(&self, py: Python<'_>) -> u64 {
+        self.lock(py).steps()
+    }
+
+    /// Total mass of the model's moving links (kg).
+    #[getter]
+    fn mass(&self, py: Python<'_>) -> f64 {
+        self.lock(py).mass()
+    }
+
+    /// Back to t = 0 (the reference starts at the next setpoint).
+    fn reset(&self, py: Python<'_>) {
+        self.lock(py).reset();
+    }
+
+    /// One step (SPEC (20.3)): q (rad), tau_e (N m), dq (rad/s), the
+    /// setpoint xc (rad), dxc (rad/s), ddxc (rad/s²), each (n,). Returns
+    /// sat(τ) (N m), (n,).
+    #[allow(clippy::too_many_arguments)]
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        tau_e: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+        xc: &Bound<'py, PyAny>,
+        dxc: &Bound<'py, PyAny>,
+        ddxc: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.n;
+        let q = vector("q", n, q)?;
+        let tau_e = vector("tau_e", n, tau_e)?;
+        let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
+        let c = [
+            vector("xc", n, xc)?,
+            vector("dxc", n, dxc)?,
+            vector("ddxc", n, ddxc)?,
+        ];
+        let mut out = [0.0; MAX_JOINTS];
+        self.lock(py)
+            .step(
+                &q[..n],
+                dq.as_ref().map(|d| &d[..n]),
+                &tau_e[..n],
+                [&c[0][..n], &c[1][..n], &c[2][..n]],
+                &mut out[..n],
+            )
+            .map_err(super::step_error)?;
+        Ok(array1(py, &out[..n]))
+    }
+
+    /// RNEA(q, q̇, q̈) = M q̈ + C q̇ + G of the controller's model (N m), (n,).
+    fn inverse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        dq: &Bound<'py, PyAny>,
+        ddq: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.n;
+        let (q, dq, ddq) = (
+            vector("q", n, q)?,
+            vector("dq", n, dq)?,
+            vector("ddq", n, ddq)?,
+        );
+        Ok(array1(
+            py,
+            &self.lock(py).inverse_dynamics(&q[..n], &dq[..n], &ddq[..n]),
+        ))
+    }
+
+    /// M(q) of the controller's model (kg m²), (n, n).
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+        let n = self.n;
+        let q = vector("q", n, q)?;
+        array(py, self.lock(py).mass_matrix(&q[..n]), (n, n))
+    }
+
+    /// A quantity of the last step by name: "tau", "tau_sat", "xc", "xd",
+    /// "z1" (n,) (zeros before the first step).
+    fn last<'py>(&self, py: Python<'py>, what: &str) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let i = LAST
+            .iter()
+            .position(|w| *w == what)
+            .ok_or_else(|| ConfigError::new_err(format!("last() knows {LAST:?}, got {what:?}")))?;
+        Ok(array1(py, &self.lock(py).last(i)))
+    }
+
+    /// The last refused step as (message, step), or None.
+    #[getter]
+    fn fault(&self, py: Python<'_>) -> Option<(String, u64)> {
+        self.lock(py).fault().map(|(e, k)| (e.to_string(), k))
+    }
+}

@@ -1,0 +1,217 @@
+"""The core's rigid-body dynamics and computed torque (SPEC §20) against
+Pinocchio: RNEA and the mass matrix on the arms of example-robot-data, the
+computed-torque law against the same law written here with Pinocchio's
+algorithms, and its native MuJoCo run against the Python loop, bit for bit."""
+
+from __future__ import annotations
+
+import importlib.metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import adaptimp
+from adaptimp import cartesian as ac
+from adaptimp import mujoco as amj
+from adaptimp.baselines import ComputedTorque, core_description, pinocchio_model
+from adaptimp.panda_table import POSITION_ONLY
+
+ROBOTS = Path(
+    str(
+        importlib.metadata.distribution("example-robot-data").locate_file(
+            "cmeel.prefix/share/example-robot-data/robots"
+        )
+    )
+)
+
+# Two recursions of the same model (the core's in the world frame, Pinocchio's
+# in the joints' frames) agree to rounding; a wrong axis, frame, lever or
+# inertia shows as O(1e-2) and more.
+RTOL = 1e-9
+
+ARMS = {
+    "panda": "panda",
+    "ur3": ROBOTS / "ur_description/urdf/ur3_robot.urdf",
+    "ur5": ROBOTS / "ur_description/urdf/ur5_robot.urdf",
+    "ur10": ROBOTS / "ur_description/urdf/ur10_robot.urdf",
+    "xarm7": ROBOTS / "xarm_description/urdf/xarm7.urdf",
+    "kinova": ROBOTS / "kinova_description/robots/kinova.urdf",
+    "z1": ROBOTS / "z1_description/urdf/z1.urdf",
+    "two_link": "two_link",
+}
+
+
+def _config(model: Any, q: np.ndarray) -> np.ndarray:
+    """Pinocchio's configuration of the joint angles q (continuous joints are
+    (cos, sin) pairs there)."""
+    if model.nq == model.nv:
+        return q
+    return np.asarray(pin.integrate(model, pin.neutral(model), q))
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_rnea_and_the_mass_matrix_equal_pinocchio(arm: str) -> None:
+    model = pinocchio_model(ARMS[arm])
+    data = model.createData()
+    n = model.nv
+    ct = ComputedTorque(model, tau_max=np.full(n, 100.0))
+    rng = np.random.default_rng(20161116)
+    for _ in range(20):
+        q, dq, ddq = rng.uniform(-3, 3, n), rng.uniform(-4, 4, n), rng.uniform(-10, 10, n)
+        want = pin.rnea(model, data, _config(model, q), dq, ddq)
+        got = ct.inverse_dynamics(q, dq, ddq)
+        np.testing.assert_allclose(got, want, rtol=0, atol=RTOL * np.abs(want).max())
+        m = pin.crba(model, data, _config(model, q))
+        m = np.triu(m) + np.triu(m, 1).T
+        np.testing.assert_allclose(ct.mass_matrix(q), m, rtol=0, atol=RTOL * np.abs(m).max())
+        g = pin.computeGeneralizedGravity(model, data, _config(model, q))
+        np.testing.assert_allclose(
+            ct.bias(q, np.zeros(n)), g, rtol=0, atol=RTOL * max(1, np.abs(g).max())
+        )
+
+
+def test_the_models_description_keeps_pinocchios_parameters() -> None:
+    model = pinocchio_model("panda")
+    joints, inertials, gravity = core_description(model)
+    assert len(joints) == len(inertials) == 7
+    assert gravity == [0.0, 0.0, -9.81]
+    masses = [i["mass"] for i in inertials]
+    assert masses == [float(model.inertias[j].mass) for j in range(1, 8)]
+    core = adaptimp._adaptimp.ComputedTorque(
+        joints, inertials, gravity, Ts=1e-3, Kp=400.0, Kd=40.0, tau_max=87.0,
+        Dd=1.0, Cd=10.0, Gd=60.0, impedance="joint", mass_scale=1.0, payload=0.5,
+    )  # fmt: skip
+    assert core.mass == pytest.approx(sum(masses) + 0.5, rel=1e-15)
+    bad = [dict(i) for i in inertials]
+    bad[3]["mass"] = -1.0
+    with pytest.raises(ValueError, match=r"mass ≥ 0 is violated: link mass\[3\] = -1"):
+        adaptimp._adaptimp.ComputedTorque(
+            joints, bad, gravity, Ts=1e-3, Kp=400.0, Kd=40.0, tau_max=87.0,
+            Dd=1.0, Cd=10.0, Gd=60.0, impedance="joint", mass_scale=1.0, payload=0.0,
+        )  # fmt: skip
+
+
+def _law(model: Any, data: Any, q: np.ndarray, dq: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """M(q) a + C(q, q̇) q̇ + G(q) from Pinocchio's CRBA and RNEA at q̈ = 0."""
+    m = pin.crba(model, data, q)
+    m = np.triu(m) + np.triu(m, 1).T
+    return np.asarray(m @ a + pin.rnea(model, data, q, dq, np.zeros(len(q))))
+
+
+def test_the_joint_law_is_computed_torque_with_pinocchios_dynamics() -> None:
+    """(20.3) in the joint mode along a run of setpoints: the compliant reference
+    of SPEC §4 and τ = M (ẍd + K_D ė + K_P e) + C q̇ + G + τe, clipped at τmax."""
+    model = pinocchio_model("panda")
+    data = model.createData()
+    n = 7
+    kp, kd = np.linspace(300, 500, n), np.linspace(30, 50, n)
+    tau_max = np.array([87.0] * 4 + [12.0] * 3)
+    ct = ComputedTorque(model, Kp=kp, Kd=kd, tau_max=tau_max, Gd=80.0, Cd=12.0, Dd=1.5)
+    rng = np.random.default_rng(7)
+    xd = dxd = None
+    for k in range(200):
+        q, dq = rng.uniform(-2, 2, n), rng.uniform(-1, 1, n)
+        tau_e = rng.uniform(-5, 5, n)
+        xc, dxc, ddxc = np.sin(0.01 * k + np.arange(n)), np.cos(0.01 * k) * np.ones(n), np.zeros(n)
+        if xd is None:
+            xd, dxd = xc.copy(), dxc.copy()
+        ddxd = ddxc + (12.0 * (dxc - dxd) + 80.0 * (xc - xd) - tau_e) / 1.5
+        a = ddxd + kd * (dxd - dq) + kp * (xd - q)
+        want = np.clip(_law(model, data, q, dq, a) + tau_e, -tau_max, tau_max)
+        got = ct.step(q, tau_e, dq, xc=xc, dxc=dxc, ddxc=ddxc)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.abs(want).max())
+        dxd = dxd + 1e-3 * ddxd
+        xd = xd + 1e-3 * dxd
+    assert ct.t == pytest.approx(0.2)
+
+
+@pytest.fixture(scope="module")
+def sc() -> ac.PandaTable:
+    return ac.panda_table()
+
+
+class _PinocchioLaw(ComputedTorque):
+    """The PD+ law of SPEC (20.4) at n = 0 written with Pinocchio's algorithms
+    (its own ``step``: the Cartesian controller calls it from Python with the
+    commanded reference, the task torque and the task Jacobian)."""
+
+    def step(  # type: ignore[override]
+        self,
+        q: Any,
+        tau_e: Any,
+        dq: Any = None,
+        *,
+        xc: Any = None,
+        dxc: Any = None,
+        ddxc: Any = None,
+        task_torque: Any = None,
+        jacobian: Any = None,
+    ) -> np.ndarray:
+        model = self.pin
+        data = model.createData()
+        j = np.asarray(jacobian).reshape(6, self.n)
+        # Π of (19.3) for a uniform K_P: I − Jᵀ (J Jᵀ + Λ²)⁻¹ J, Λ² of (C3).
+        null = np.eye(self.n) - j.T @ np.linalg.solve(j @ j.T + 1e-4 * np.eye(6), j)
+        m = pin.crba(model, data, q)
+        m = np.triu(m) + np.triu(m, 1).T
+        pd = self.Kp * (xc - q) + self.Kd * (dxc - dq)
+        tau = _law(model, data, q, dq, ddxc) + task_torque + null @ (m @ pd)
+        self.out = np.clip(tau, -self.tau_max, self.tau_max)
+        return self.out
+
+
+def test_the_torque_level_law_is_pinocchios_pd_plus(sc: ac.PandaTable) -> None:
+    """(20.4) with n = 0 behind the Cartesian impedance on the Panda table: the
+    core's step and the law written with Pinocchio, row by row on the rows of a
+    native run pressing on the table."""
+    res = amj.simulate(
+        ac.panda_controller("ct", sc, formulation="impedance", force_feedforward=False),
+        amj.Plant(sc.model),
+        T=1.0,
+        q0=sc.q0,
+    )
+    assert res.params["loop"] == "native"
+    assert res.metrics["steps_in_contact"] > 300
+    assert res.task is not None
+    core = ac.panda_controller("ct", sc, formulation="impedance", force_feedforward=False)
+    law = _PinocchioLaw(sc.pin_model, Ts=sc.Ts, tau_max=sc.tau_max, impedance="external")
+    law.pin = sc.pin_model
+    written = adaptimp.CartesianController(
+        sc.chain, law, q0=sc.q0, path=sc.path, force_feedforward=False,
+        formulation="impedance", **POSITION_ONLY,
+    )  # fmt: skip
+    for k in range(len(res.t)):
+        q, dq, f = res.q[k], res.dq[k], res.task["wrench"][k]
+        got = core.step(q, dq, f)
+        want = written.step(q, dq, f)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.abs(want).max(), err_msg=k)
+    np.testing.assert_array_equal(got, res.tau_sat[-1])
+
+
+def test_the_native_run_equals_the_python_loop_in_every_formulation(sc: ac.PandaTable) -> None:
+    """Computed torque behind the Cartesian impedance steps in the core's native
+    loop, bit for bit the Python loop's run (the five controllers' table, issue
+    of engine speed)."""
+    from test_mujoco_cartesian import _InPython
+
+    for kind, formulation, share in (
+        ("ct", "impedance", None),
+        ("ct", "admittance", None),
+        ("ct+30", "unified", 0.3),
+    ):
+        kw: dict[str, Any] = {"formulation": formulation, "force_feedforward": share is None}
+        if share is not None:
+            kw["admittance_share"] = share
+        a, b = ac.panda_controller(kind, sc, **kw), ac.panda_controller(kind, sc, **kw)
+        native = amj.simulate(a, amj.Plant(sc.model), T=1.0, q0=sc.q0)
+        python = amj.simulate(_InPython(b), amj.Plant(sc.model), T=1.0, q0=sc.q0)
+        assert (native.params["loop"], python.params["loop"]) == ("native", "python")
+        for name in ("q", "dq", "tau", "tau_sat", "z1", "xd", "x_ee", "wrench_ee"):
+            np.testing.assert_array_equal(getattr(native, name), getattr(python, name), name)
+        assert set(native.metrics) == set(python.metrics)
+        for key, value in python.metrics.items():
+            np.testing.assert_array_equal(native.metrics[key], value, err_msg=key)
+        assert native.metrics["steps_in_contact"] > 150

@@ -39,9 +39,12 @@ dxc, ddxc)``, tabulated before the clock starts). (c) is ``CartesianImpedance.re
 The Panda table: ``examples/13_panda_table.py``'s controllers (T = ``--table-T``)
 each run natively and through the Python loop (the controller behind a Python
 object: what every Cartesian controller took before), side by side; computed
-torque (Pinocchio, Python) takes the Python loop in both. Beside them, MuJoCo
-alone on the same motion (``mujoco.rollout`` of the native run's torques): the
-floor of any loop.
+torque steps in the core (SPEC §20) in both. A third column, "before", is the
+table as it ran before computed torque was in the core: the Python loop, with
+the computed-torque rows' joint law written with Pinocchio in Python
+(``PinocchioPDPlus`` below, the law of SPEC (20.4) at n = 0 that
+``adaptimp.baselines`` stepped then). Beside them, MuJoCo alone on the same
+motion (``mujoco.rollout`` of the native run's torques): the floor of any loop.
 
 Then a sweep on MuJoCo: ``adaptimp.sweep(..., plant="mujoco")`` of 16 runs (the
 paper's arm with its ceiling, state feedback in the robot scenario, T =
@@ -359,6 +362,36 @@ def loop_table(rows: list[tuple[str, str]], T: float, repeats: int) -> None:
         )
 
 
+class PinocchioPDPlus:
+    """The computed-torque rows' joint law as it stepped before SPEC §20, in
+    Python with Pinocchio's CRBA and RNEA: τ = M q̈_c + C q̇ + G + τ_task +
+    Π M (K_P (q_c − q) + K_D (q̇_c − q̇)), Π = I − Jᵀ (J Jᵀ + Λ²)⁻¹ J (the
+    "before" column of the Panda table; the library's law is the core's)."""
+
+    def __init__(self, model: Any, tau_max: np.ndarray, mass_scale: float) -> None:
+        import pinocchio as pin
+
+        from adaptimp.baselines import scale_masses
+
+        self.pin = pin
+        self.model = scale_masses(model, mass_scale)
+        self.data = self.model.createData()
+        self.tau_max, self.Ts, self.impedance = tau_max, 1e-3, "external"
+        self.n = self.model.nv
+
+    def step(self, q: Any, tau_e: Any, dq: Any = None, **kw: Any) -> np.ndarray:
+        pin, m_, d_ = self.pin, self.model, self.data
+        xc, dxc, ddxc = kw["xc"], kw["dxc"], kw["ddxc"]
+        j = np.asarray(kw["jacobian"]).reshape(6, self.n)
+        null = np.eye(self.n) - j.T @ np.linalg.solve(j @ j.T + 1e-4 * np.eye(6), j)
+        m = pin.crba(m_, d_, q)
+        m = np.triu(m) + np.triu(m, 1).T
+        pd = 400.0 * (xc - q) + 40.0 * (dxc - dq)
+        h = pin.rnea(m_, d_, q, dq, np.zeros(self.n))
+        tau = m @ ddxc + h + kw["task_torque"] + null @ (m @ pd)
+        return np.clip(tau, -self.tau_max, self.tau_max)
+
+
 def panda_table_times(T: float, repeats: int) -> None:
     """examples/13's table, the issue's five controllers (its rows pd, sf, of, ct,
     ct+30 on the default table): each natively and through the Python loop."""
@@ -379,7 +412,7 @@ def panda_table_times(T: float, repeats: int) -> None:
     plant = amj.Plant(sc.model)
     rows = {name: example.ROWS[name][0] for name in ("pd", "sf", "of", "ct", "ct+30")}
     times: dict[str, dict[str, list[float]]] = {
-        k: {"native": [], "python": [], "engine": []} for k in rows
+        k: {"native": [], "python": [], "before": [], "engine": []} for k in rows
     }
     loops: dict[str, str] = {}
     m, d = plant.model, plant.data
@@ -387,8 +420,18 @@ def panda_table_times(T: float, repeats: int) -> None:
     full = int(mujoco.mjtState.mjSTATE_FULLPHYSICS)
     for _ in range(repeats):
         for kind in rows:
-            for how in ("native", "python"):
+            for how in ("native", "python", "before"):
+                if how == "before" and not kind.startswith("ct"):
+                    # The rows the core stepped already: as the Python loop.
+                    times[kind]["before"].append(times[kind]["python"][-1])
+                    continue
                 ctrl = example.controller(kind, sc, basis)
+                if how == "before" and kind.startswith("ct"):
+                    law = PinocchioPDPlus(sc.pin_model, sc.tau_max, 1.3 if kind == "ct+30" else 1.0)
+                    ctrl = adaptimp.CartesianController(
+                        sc.chain, law, q0=sc.q0, path=sc.path, Kd_rot=0.0,
+                        force_feedforward=False, formulation="impedance",
+                    )  # fmt: skip
                 start = time.perf_counter()
                 res = amj.simulate(
                     ctrl if how == "native" else InPython(ctrl), plant, T=T, q0=sc.q0
@@ -410,24 +453,24 @@ def panda_table_times(T: float, repeats: int) -> None:
         f"medians of {repeats}, s per controller: simulate and cartesian_metrics)"
     )
     print(
-        "\n| controller | loop | native (s) | Python loop (s) | native/Python | "
-        "MuJoCo alone (s) | MuJoCo alone/Python |"
+        "\n| controller | loop | native (s) | Python loop (s) | before (s) | native/Python | "
+        "native/before | MuJoCo alone (s) |"
     )
-    print("|---|---|---:|---:|---:|---:|---:|")
-    total = {"native": 0.0, "python": 0.0, "engine": 0.0}
+    print("|---|---|---:|---:|---:|---:|---:|---:|")
+    total = {"native": 0.0, "python": 0.0, "before": 0.0, "engine": 0.0}
     for kind, label in rows.items():
         med = {how: statistics.median(v) for how, v in times[kind].items()}
         for how in total:
             total[how] += med[how]
         print(
             f"| {label} | {loops[kind]} | {med['native']:.2f} | {med['python']:.2f} | "
-            f"{med['native'] / med['python']:.2f} | {med['engine']:.2f} | "
-            f"{med['engine'] / med['python']:.2f} |"
+            f"{med['before']:.2f} | {med['native'] / med['python']:.2f} | "
+            f"{med['native'] / med['before']:.2f} | {med['engine']:.2f} |"
         )
     print(
-        f"| all | | {total['native']:.2f} | {total['python']:.2f} | "
-        f"{total['native'] / total['python']:.2f} | {total['engine']:.2f} | "
-        f"{total['engine'] / total['python']:.2f} |"
+        f"| all | | {total['native']:.2f} | {total['python']:.2f} | {total['before']:.2f} | "
+        f"{total['native'] / total['python']:.2f} | {total['native'] / total['before']:.2f} | "
+        f"{total['engine']:.2f} |"
     )
 
 

@@ -101,8 +101,9 @@ pub use sim::{disturb, environment, inject, metrics, model, plant, record, simul
 pub use auxiliary::AuxLaw;
 pub use cartesian::{
     CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
-    CartesianMeasurement, CartesianState, Chain, CompliantPose, Formulation, Joint, JointKind,
-    OuterStep, PoseTarget, Transform,
+    CartesianMeasurement, CartesianState, Chain, CompliantPose, ComputedState, ComputedTorque,
+    ComputedTorqueConfig, Dynamics, Formulation, Inertial, Joint, JointKind, OuterStep, PoseTarget,
+    Transform, GRAVITY,
 };
 pub use config::{Conditions, Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};

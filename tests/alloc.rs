@@ -271,3 +271,58 @@ fn no_heap_allocation_in_the_seven_joint_cartesian_step() {
         assert_eq!(n, 0, "the n = 7 Cartesian step allocated (bound {bound})");
     }
 }
+
+#[test]
+fn no_heap_allocation_in_computed_torque_steps() {
+    // SPEC §20: RNEA and both forms of the law on seven joints.
+    use adaptimp::control::io::TaskTorque;
+    use adaptimp::{
+        ComputedState, ComputedTorque, ComputedTorqueConfig, Dynamics, ImpedanceMode, Inertial,
+        Joint, Kinematics, Setpoint, Transform, Vector,
+    };
+    let joints: Vec<Joint> = (0..7)
+        .map(|i| {
+            let axis = if i % 2 == 0 {
+                [0.0, 0.0, 1.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            Joint::revolute(Transform::from_xyz_rpy([0.0, 0.0, 0.12], [0.0; 3]), axis)
+        })
+        .collect();
+    let inertials = [Inertial::point(1.5, [0.02, 0.01, 0.06]); 7];
+    let model = Dynamics::<7>::new(&joints, &inertials, adaptimp::GRAVITY).expect("model");
+    let mut cfg = ComputedTorqueConfig::new(1e-3, Vector::<7>::from(common::PANDA_EFFORT));
+    cfg.mode = ImpedanceMode::External;
+    let ct = ComputedTorque::new(cfg, model).expect("controller");
+    let mut st = ComputedState::default();
+    let q = Vector::<7>::from_column_slice(&common::PANDA_HOME);
+    let tip = model.chain().tip(&q, &Vector::zeros());
+    let c = Setpoint {
+        x: q,
+        dx: Vector::from_element(0.1),
+        ddx: Vector::zeros(),
+    };
+    let task = TaskTorque {
+        commanded: c,
+        jacobian: tip.jacobian,
+        spring: Vector::<6>::from_element(1.0),
+        damping: Vector::<6>::from_element(20.0),
+        twist: Vector::zeros(),
+        lambda2: Vector::<6>::from_element(1e-4),
+        share: 0.3,
+    };
+    let m = adaptimp::Measurement {
+        x: q,
+        dx: Some(Vector::zeros()),
+        tau_e: Vector::zeros(),
+    };
+    let (n, ()) = allocations_in(|| {
+        for _ in 0..1000 {
+            ct.step(&mut st, &m, &c).expect("step");
+            ct.step_task(&mut st, &m, &c, &task).expect("task step");
+        }
+    });
+    assert_eq!(n, 0, "a computed-torque step allocated");
+    assert_eq!(st.k, 2000);
+}

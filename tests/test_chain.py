@@ -291,3 +291,20 @@ def test_default_tip_is_the_end_of_the_single_chain_of_movable_joints(tmp_path: 
     np.testing.assert_allclose(chain.fk([0.0, 0.0])[:3, 3], [0.3, 0.0, 0.1], atol=1e-15)
     tool = adaptimp.Chain.from_urdf(_urdf(tmp_path, text), tip="tool")
     np.testing.assert_allclose(tool.fk([0.0, 0.0])[:3, 3], [0.3, 0.0, 0.2], atol=1e-15)
+
+
+def test_motion_along_rows_is_the_jacobian_and_its_derivative() -> None:
+    """Chain.motion: [ṗ; ω] = J q̇ and [p̈; ω̇] = J q̈ + J̇ q̇ per row, as the
+    single-row methods give them; a table of the wrong width is refused."""
+    chain = adaptimp.Chain.from_urdf(_models.panda_urdf_path(), tip=_models.PANDA_EE)
+    rng = np.random.default_rng(3)
+    q, dq, ddq = (rng.uniform(-2, 2, (50, 7)) for _ in range(3))
+    v, a = chain.motion(q, dq, ddq)
+    assert v.shape == a.shape == (50, 6)
+    for k in range(50):
+        jac = chain.jacobian(q[k])
+        np.testing.assert_allclose(v[k], jac @ dq[k], rtol=0, atol=1e-12)
+        want = jac @ ddq[k] + chain.jdot_qdot(q[k], dq[k])
+        np.testing.assert_allclose(a[k], want, rtol=0, atol=1e-11)
+    with pytest.raises(ValueError, match="dq"):
+        chain.motion(q, dq[:, :6], ddq)

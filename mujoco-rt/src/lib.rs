@@ -5,7 +5,8 @@
 //! Python package installed it — the library that package has already
 //! loaded, so the same code and the same global state — and resolves the few
 //! functions a closed loop needs (`mj_step`, `mj_forward`, `mj_forwardSkip`,
-//! `mj_getState`, `mj_jacSite`, `mj_jacBody`, `mju_warningText`,
+//! `mj_checkPos`, `mj_checkVel`, `mj_checkAcc`, `mj_Euler`, `mj_RungeKutta`,
+//! `mj_implicit`, `mj_getState`, `mj_jacSite`, `mj_jacBody`, `mju_warningText`,
 //! `mj_version`). [`Sim`] is a handle on one `mjModel` and its `mjData`
 //! whose arrays (`qpos`, `qvel`, `qacc`, `ctrl`, `qfrc_applied`,
 //! `sensordata`, `site_xpos`, `site_xmat`, `xpos`, the warning counters) are
@@ -74,6 +75,7 @@ type DataP = *mut c_void;
 // "C-unwind": MuJoCo's fatal errors unwind through these calls (see the crate doc).
 type StepFn = unsafe extern "C-unwind" fn(ModelP, DataP);
 type SkipFn = unsafe extern "C-unwind" fn(ModelP, DataP, c_int, c_int);
+type RkFn = unsafe extern "C-unwind" fn(ModelP, DataP, c_int);
 type StateFn = unsafe extern "C-unwind" fn(ModelP, *const c_void, *mut f64, c_int);
 type JacFn = unsafe extern "C-unwind" fn(ModelP, *const c_void, *mut f64, *mut f64, c_int);
 type TextFn = unsafe extern "C-unwind" fn(c_int, usize) -> *const c_char;
@@ -92,6 +94,12 @@ pub struct Library {
     step: StepFn,
     forward: StepFn,
     forward_skip: SkipFn,
+    check_pos: StepFn,
+    check_vel: StepFn,
+    check_acc: StepFn,
+    euler: StepFn,
+    runge_kutta: RkFn,
+    implicit: StepFn,
     get_state: StateFn,
     jac_site: JacFn,
     jac_body: JacFn,
@@ -146,6 +154,12 @@ impl Library {
         let step = sym!(b"mj_step\0", StepFn);
         let forward = sym!(b"mj_forward\0", StepFn);
         let forward_skip = sym!(b"mj_forwardSkip\0", SkipFn);
+        let check_pos = sym!(b"mj_checkPos\0", StepFn);
+        let check_vel = sym!(b"mj_checkVel\0", StepFn);
+        let check_acc = sym!(b"mj_checkAcc\0", StepFn);
+        let euler = sym!(b"mj_Euler\0", StepFn);
+        let runge_kutta = sym!(b"mj_RungeKutta\0", RkFn);
+        let implicit = sym!(b"mj_implicit\0", StepFn);
         let get_state = sym!(b"mj_getState\0", StateFn);
         let jac_site = sym!(b"mj_jacSite\0", JacFn);
         let jac_body = sym!(b"mj_jacBody\0", JacFn);
@@ -169,6 +183,12 @@ impl Library {
             step,
             forward,
             forward_skip,
+            check_pos,
+            check_vel,
+            check_acc,
+            euler,
+            runge_kutta,
+            implicit,
             get_state,
             jac_site,
             jac_body,
@@ -475,6 +495,37 @@ impl Sim {
         let (f, m, d) = (self.lib.step, self.p.model, self.p.data);
         // SAFETY: model and data are a live pair (from_raw), used by us only.
         guarded(|| unsafe { f(m, d) })
+    }
+
+    /// `mj_step` whose forward computation at the current state and
+    /// controls is already done (`mj_forward`, or `mj_forwardSkip` after a
+    /// change of the controls only): `mj_checkPos`, `mj_checkVel` (if they
+    /// warn, a full `mj_forward` as `mj_step` would then compute),
+    /// `mj_checkAcc` and the model's `integrator` (`mjtIntegrator`: 0 Euler,
+    /// 1 RK4, 2 implicit, 3 implicitfast). The same state as `mj_step`, one
+    /// forward computation fewer.
+    pub fn step_computed(&mut self, integrator: i32) -> Result<(), Error> {
+        let (before, _) = self.warnings();
+        let l = &self.lib;
+        let (m, d) = (self.p.model, self.p.data);
+        // SAFETY: model and data are a live pair (from_raw), used by us only.
+        guarded(|| unsafe {
+            (l.check_pos)(m, d);
+            (l.check_vel)(m, d);
+        })?;
+        if self.warnings().0 != before {
+            self.forward()?;
+        }
+        let l = &self.lib;
+        // SAFETY: as above; the integrator functions take the computed data.
+        guarded(|| unsafe {
+            (l.check_acc)(m, d);
+            match integrator {
+                0 => (l.euler)(m, d),
+                1 => (l.runge_kutta)(m, d, 4),
+                _ => (l.implicit)(m, d),
+            }
+        })
     }
 
     /// `mj_forward`: everything at the current state and controls.

@@ -828,6 +828,7 @@ class Plant:
             "contact_adr": int(self._contact_adr) if self._contact_adr >= 0 else None,
             "substeps": int(substeps),
             "timestep": float(m.opt.timestep),
+            "integrator": int(m.opt.integrator),
             "dof_names": [
                 _name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)
             ],

@@ -413,13 +413,12 @@ def cartesian_metrics(
     log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
     after = t >= settle - 1e-9
     p = res.x_ee
-    rows = np.flatnonzero(after)
-    dp = np.empty((len(rows), 3))
-    ddp = np.empty((len(rows), 3))
-    for j, k in enumerate(rows):
-        jac = sc.chain.jacobian(res.q[k])[:3]
-        dp[j] = jac @ res.dq[k]
-        ddp[j] = jac @ res.ddq[k] + sc.chain.jdot_qdot(res.q[k], res.dq[k])[:3]
+    twist, accel = sc.chain.motion(
+        np.ascontiguousarray(res.q[after]),
+        np.ascontiguousarray(res.dq[after]),
+        np.ascontiguousarray(res.ddq[after]),
+    )
+    dp, ddp = twist[:, :3], accel[:, :3]
     prm = ctrl.params
     md, kd = np.asarray(prm["Md"]), np.asarray(prm["Kd"])
     bd = 2.0 * np.sqrt(kd * md) if prm["Bd"] is None else np.asarray(prm["Bd"])

@@ -789,6 +789,51 @@ impl PyChain {
         array(py, m, (4, 4))
     }
 
+    /// The tip's twist and acceleration along recorded rows q, q̇, q̈ (K, n)
+    /// (rad, rad/s, rad/s²): (V (K, 6), A (K, 6)) with V = J(q) q̇ = [ṗ; ω]
+    /// (m/s, rad/s) and A = J(q) q̈ + J̇ q̇ = [p̈; ω̇] (m/s², rad/s²), one pass
+    /// of the chain per row, the GIL released.
+    #[allow(clippy::type_complexity)]
+    fn motion<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        dq: PyReadonlyArray2<'py, f64>,
+        ddq: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+        let n = self.inner.n();
+        let k = q.shape()[0];
+        let q = super::table("q", &q, k, n)?;
+        let dq = super::table("dq", &dq, k, n)?;
+        let ddq = super::table("ddq", &ddq, k, n)?;
+        for (what, t) in [("q", &q), ("dq", &dq), ("ddq", &ddq)] {
+            if let Some(i) = t.iter().position(|x| !x.is_finite()) {
+                return Err(MeasurementError::new_err(format!(
+                    "{what}[{}, {}] is not finite (NaN or infinite)",
+                    i / n,
+                    i % n
+                )));
+            }
+        }
+        let inner = &self.inner;
+        let (v, a) = py.detach(|| {
+            let (mut v, mut a) = (std::vec![0.0; 6 * k], std::vec![0.0; 6 * k]);
+            for r in 0..k {
+                let rows = r * n..(r + 1) * n;
+                let t = inner.tip(&q[rows.clone()], &dq[rows.clone()]);
+                // TipOut's Jacobian is row-major 6 × n.
+                for i in 0..6 {
+                    let row = &t.jacobian[i * n..(i + 1) * n];
+                    let dot = |x: &[f64]| row.iter().zip(x).map(|(j, x)| j * x).sum::<f64>();
+                    v[6 * r + i] = dot(&dq[rows.clone()]);
+                    a[6 * r + i] = dot(&ddq[rows.clone()]) + t.bias[i];
+                }
+            }
+            (v, a)
+        });
+        Ok((array(py, v, (k, 6))?, array(py, a, (k, 6))?))
+    }
+
     /// The geometric Jacobian [J_v; J_ω] at q, (6, n), world-aligned, at the
     /// tip origin: ṗ = J_v q̇ (m/s), ω = J_ω q̇ (rad/s).
     fn jacobian<'py>(

@@ -1400,6 +1400,15 @@ fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
         contact_adr: get(d, "contact_adr")?,
         substeps: get(d, "substeps")?,
         timestep: get(d, "timestep")?,
+        integrator: match get::<i32>(d, "integrator")? {
+            i @ 0..=3 => i,
+            other => {
+                return Err(ConfigError::new_err(format!(
+                    "the model's integrator must be 0 (Euler), 1 (RK4), 2 (implicit) or 3 \
+                     (implicitfast), got {other}"
+                )))
+            }
+        },
         dof_names: get(d, "dof_names")?,
         warning_names: get(d, "warning_names")?,
     })

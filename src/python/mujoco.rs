@@ -59,6 +59,9 @@ pub struct MujocoSpec {
     pub substeps: usize,
     /// MuJoCo's timestep (s): Ts / substeps.
     pub timestep: f64,
+    /// The model's integrator (`mjtIntegrator`: 0 Euler, 1 RK4, 2 implicit,
+    /// 3 implicitfast).
+    pub integrator: i32,
     /// The joint name of each DOF of the model (for messages).
     pub dof_names: Vec<String>,
     /// The names of MuJoCo's warning kinds, by index (`mjtWarning`).
@@ -391,7 +394,15 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
         let ddq = Vector::from_fn(|i, _| qacc[self.dofs[i]]);
         let (before, _) = self.sim.warnings();
         let t0 = self.sim.time();
-        for _ in 0..self.spec.substeps {
+        for sub in 0..self.spec.substeps {
+            if sub == 0 && self.friction.is_none() {
+                // The forward computation at x_k with these controls is the
+                // one just done for the row's q̈: `mj_step` without it.
+                if let Err(e) = self.sim.step_computed(self.spec.integrator) {
+                    return Err(self.fatal(e));
+                }
+                continue;
+            }
             if !self.friction.is_none() {
                 let (_, dq) = self.state();
                 let f = self.friction.torque(&dq);

@@ -439,35 +439,40 @@ impl<const N: usize> Kinematics<N> for Chain<N> {
     }
 }
 
+/// Three movable joints with every kind of element, for tests: a fixed base
+/// offset, a revolute joint with a tilted origin, a prismatic joint, a fixed
+/// elbow, a revolute joint about an oblique axis with an offset.
+#[cfg(test)]
+pub(crate) fn sample_joints() -> [Joint; 5] {
+    [
+        Joint::fixed(Transform::from_xyz_rpy([0.0, 0.0, 0.1], [0.0, 0.0, 0.3])),
+        Joint::revolute(
+            Transform::from_xyz_rpy([0.0, 0.05, 0.2], [0.2, -0.1, 0.0]),
+            [0.0, 0.0, 1.0],
+        ),
+        Joint::prismatic(
+            Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0, 0.5, 0.0]),
+            [1.0, 0.0, 0.0],
+        ),
+        Joint::fixed(Transform::from_xyz_rpy([0.1, 0.0, 0.0], [0.0, 0.0, 1.0])),
+        Joint {
+            offset: 0.25,
+            ..Joint::revolute(
+                Transform::from_xyz_rpy([0.0, 0.2, 0.0], [0.0, 0.0, 0.0]),
+                [1.0, 2.0, 2.0],
+            )
+        },
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A 3-joint arm with every kind of element: a fixed base offset, a
-    /// revolute joint with a tilted origin, a prismatic joint, a fixed
-    /// elbow, a revolute joint about an oblique axis with an offset.
+    /// A 3-joint arm with every kind of element ([`sample_joints`]).
     fn arm() -> Chain<3> {
-        let joints = [
-            Joint::fixed(Transform::from_xyz_rpy([0.0, 0.0, 0.1], [0.0, 0.0, 0.3])),
-            Joint::revolute(
-                Transform::from_xyz_rpy([0.0, 0.05, 0.2], [0.2, -0.1, 0.0]),
-                [0.0, 0.0, 1.0],
-            ),
-            Joint::prismatic(
-                Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0, 0.5, 0.0]),
-                [1.0, 0.0, 0.0],
-            ),
-            Joint::fixed(Transform::from_xyz_rpy([0.1, 0.0, 0.0], [0.0, 0.0, 1.0])),
-            Joint {
-                offset: 0.25,
-                ..Joint::revolute(
-                    Transform::from_xyz_rpy([0.0, 0.2, 0.0], [0.0, 0.0, 0.0]),
-                    [1.0, 2.0, 2.0],
-                )
-            },
-        ];
         Chain::new(
-            &joints,
+            &sample_joints(),
             &Transform::from_xyz_rpy([0.0, 0.0, 0.15], [0.1, 0.2, 0.3]),
         )
         .unwrap()

@@ -279,29 +279,10 @@ mod tests {
     use super::*;
     use crate::cartesian::chain::Transform;
 
-    /// Every kind of element: a fixed base, a tilted revolute joint, a
-    /// prismatic joint, a fixed elbow carrying a second inertial, an oblique
-    /// revolute joint with an offset; inertials with rotated axes.
+    /// The chain tests' joints (every kind of element; the fixed elbow
+    /// carries a second inertial), inertials with rotated axes.
     fn arm() -> Dynamics<3> {
-        let joints = [
-            Joint::fixed(Transform::from_xyz_rpy([0.0, 0.0, 0.1], [0.0, 0.0, 0.3])),
-            Joint::revolute(
-                Transform::from_xyz_rpy([0.0, 0.05, 0.2], [0.2, -0.1, 0.0]),
-                [0.0, 0.0, 1.0],
-            ),
-            Joint::prismatic(
-                Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0, 0.5, 0.0]),
-                [1.0, 0.0, 0.0],
-            ),
-            Joint::fixed(Transform::from_xyz_rpy([0.1, 0.0, 0.0], [0.0, 0.0, 1.0])),
-            Joint {
-                offset: 0.25,
-                ..Joint::revolute(
-                    Transform::from_xyz_rpy([0.0, 0.2, 0.0], [0.0, 0.0, 0.0]),
-                    [1.0, 2.0, 2.0],
-                )
-            },
-        ];
+        let joints = crate::cartesian::chain::sample_joints();
         let inertial = |m: f64, xyz: [f64; 3], rpy: [f64; 3], d: [f64; 3]| Inertial {
             mass: m,
             origin: Transform::from_xyz_rpy(xyz, rpy),

@@ -33,7 +33,7 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArray
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::sync::{Mutex, MutexGuard, TryLockError};
+use std::sync::{Mutex, MutexGuard};
 use std::vec::Vec;
 
 /// Length of a flat pose target: p, ṗ, p̈ (3 each), R row-major (9), ω, ω̇ (3 each).
@@ -878,15 +878,7 @@ pub struct PyCartesian {
 
 impl PyCartesian {
     fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynOuter>> {
-        loop {
-            match self.inner.try_lock() {
-                Ok(g) => return g,
-                Err(TryLockError::Poisoned(p)) => return p.into_inner(),
-                Err(TryLockError::WouldBlock) => py.detach(|| {
-                    drop(self.inner.lock());
-                }),
-            }
-        }
+        super::wait_lock(py, &self.inner)
     }
 
     fn measurement<'a>(

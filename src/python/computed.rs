@@ -22,7 +22,7 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::any::Any;
-use std::sync::{Mutex, MutexGuard, TryLockError};
+use std::sync::{Mutex, MutexGuard};
 use std::vec::Vec;
 
 /// A computed-torque controller of any n ≤ 7 with its state, over slices.
@@ -262,15 +262,7 @@ impl PyComputedTorque {
     /// The controller, waiting (with the GIL released) while another thread
     /// uses it.
     pub fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynComputed>> {
-        loop {
-            match self.inner.try_lock() {
-                Ok(g) => return g,
-                Err(TryLockError::Poisoned(p)) => return p.into_inner(),
-                Err(TryLockError::WouldBlock) => py.detach(|| {
-                    drop(self.inner.lock());
-                }),
-            }
-        }
+        super::wait_lock(py, &self.inner)
     }
 }
 

@@ -364,6 +364,20 @@ fn vector(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<Buf>
     Ok(out)
 }
 
+/// `m` locked; while another thread's call holds it, wait with the GIL
+/// released (that call may need the GIL to finish), then try again with it.
+fn wait_lock<'a, T: ?Sized + Send>(py: Python<'_>, m: &'a Mutex<T>) -> MutexGuard<'a, T> {
+    loop {
+        match m.try_lock() {
+            Ok(g) => return g,
+            Err(TryLockError::Poisoned(p)) => return p.into_inner(),
+            Err(TryLockError::WouldBlock) => py.detach(|| {
+                drop(m.lock());
+            }),
+        }
+    }
+}
+
 fn array1<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_slice(py, v)
 }
@@ -532,17 +546,7 @@ impl PyController {
     /// The controller, waiting (with the GIL released) while another thread
     /// uses it.
     fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynTracker>> {
-        loop {
-            match self.inner.try_lock() {
-                Ok(g) => return g,
-                Err(TryLockError::Poisoned(p)) => return p.into_inner(),
-                // Wait for the other thread's call to end without the GIL
-                // (it may need the GIL to finish), then try again with it.
-                Err(TryLockError::WouldBlock) => py.detach(|| {
-                    drop(self.inner.lock());
-                }),
-            }
-        }
+        wait_lock(py, &self.inner)
     }
 
     fn wrap(inner: Box<dyn DynTracker>) -> Self {

@@ -26,10 +26,12 @@ the gains of SPEC §18's rule (Kp_i = 0.25/(Ts (D⁻¹)_ii) from D(q0), Kζ, K1 
 model (CT) and with +30 % mass (CT +30 %), Pinocchio.
 
 Metrics over t ≥ 2 s (p the tool, p_d the compliant reference, F_n = −F_e,z),
-the keys of ``--json``: ``track_mm`` RMS ‖p_d − p‖; ``force_target_N`` K_d δ_c
+the keys of ``--json``: ``track_mm`` RMS ‖p_d − p‖; ``track_along_mm`` its part
+along the table, RMS ‖(p_d − p)_xy‖; ``force_target_N`` K_d δ_c
 (a spring table: SPEC (16.1)); ``force_rms_err_N`` RMS (F_n − target);
 ``force_chatter_N`` RMS of F_n's sample-to-sample change; ``contact_lost_s``
 time with F_n ≤ 0 after the first contact at the end of the approach;
+``peak_force_N`` max F_n over the run (the approach's impact included);
 ``peak_tau_ratio`` max |τ_i|/τmax_i commanded after 0.1 s; ``sat_duty`` the
 share of steps that saturate.
 
@@ -85,10 +87,12 @@ ROWS: dict[str, tuple[str, str, str, bool, bool]] = {
 }
 KEYS = (
     "track_mm",
+    "track_along_mm",
     "force_rms_err_N",
     "force_target_N",
     "force_chatter_N",
     "contact_lost_s",
+    "peak_force_N",
     "peak_tau_ratio",
     "sat_duty",
 )
@@ -204,10 +208,11 @@ def main() -> None:
         f"home {np.round(sc.q0, 3).tolist()}, {basis[0].shape[0]} centres"
     )
     print(
-        "\n| controller | track (mm) | force RMS err (N) | target (N) | mean (N) | (16.1) (N) "
-        "| chatter (N) | contact lost (s) | peak τ/τmax | sat | time (s) |"
+        "\n| controller | track (mm) | along (mm) | force RMS err (N) | target (N) | mean (N) "
+        "| (16.1) (N) | chatter (N) | contact lost (s) | peak F_n (N) | peak τ/τmax | sat "
+        "| time (s) |"
     )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     table: dict[str, dict[str, float]] = {}
     for name in args.rows.split(","):
         t0 = time.perf_counter()
@@ -218,10 +223,11 @@ def main() -> None:
             continue
         table[name] = {k: m[k] for k in KEYS}
         print(
-            f"| {ROWS[name][0]} | {m['track_mm']:.3f} | {m['force_rms_err_N']:.3f} "
+            f"| {ROWS[name][0]} | {m['track_mm']:.3f} | {m['track_along_mm']:.3f} "
+            f"| {m['force_rms_err_N']:.3f} "
             f"| {m['force_target_N']:.3f} | {m['force_mean_N']:.3f} | {m['force_16_1_N']:.3f} "
-            f"| {m['force_chatter_N']:.3f} "
-            f"| {m['contact_lost_s']:.3f} | {m['peak_tau_ratio']:.3f} | {m['sat_duty']:.3f} "
+            f"| {m['force_chatter_N']:.3f} | {m['contact_lost_s']:.3f} | {m['peak_force_N']:.1f} "
+            f"| {m['peak_tau_ratio']:.3f} | {m['sat_duty']:.3f} "
             f"| {time.perf_counter() - t0:.1f} |"
         )
         assert m["applied_ratio"] <= 1.0 + 1e-12, "applied torque beyond its limit"

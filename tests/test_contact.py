@@ -45,6 +45,14 @@ def test_the_torque_level_formulation_holds_a_rigid_frictionless_table() -> None
     assert m["force_chatter_N"] < 1e-3
     assert m["contact_lost_s"] == 0.0
     assert m["track_mm"] < 0.1
+    # The tracking splits into its part along the table and the normal part.
+    assert res.task is not None
+    after = res.t >= 2.0 - 1e-9
+    normal = (res.task["pd"][after, 2] - res.x_ee[after, 2]) * 1e3
+    split = m["track_along_mm"] ** 2 + float(np.mean(normal**2))
+    assert m["track_mm"] ** 2 == pytest.approx(split, rel=1e-12)
+    assert m["peak_force_N"] == float(np.max(-res.wrench_ee[:, 2]))
+    assert m["peak_force_N"] >= m["force_mean_N"]
 
 
 def test_the_unified_formulation_holds_the_table_with_the_paper_s_feedforward() -> None:
@@ -118,10 +126,12 @@ def test_example_13_writes_the_table_as_json(tmp_path: Path) -> None:
         assert sorted(row) == sorted(
             [
                 "track_mm",
+                "track_along_mm",
                 "force_rms_err_N",
                 "force_target_N",
                 "force_chatter_N",
                 "contact_lost_s",
+                "peak_force_N",
                 "peak_tau_ratio",
                 "sat_duty",
             ]

@@ -528,6 +528,8 @@ def contact_metrics(
     over t ≥ ``settle`` (s) unless said:
 
     - ``track_mm``: RMS ‖p_d − p‖ (mm), the compliant reference against the tip;
+    - ``track_along_mm``: RMS ‖(p_d − p)_xy‖ (mm), its part along the table
+      (the table's plane; the normal part is the force error over K_d,z);
     - ``force_target_N``: K_d,z δ_c, or for a spring table of k_e (16.1)'s
       K_d k_e/(K_d + k_e) δ_c (N);
     - ``force_rms_err_N``: RMS (F_n − target) (N), F_n = −F_e,z;
@@ -538,6 +540,8 @@ def contact_metrics(
       e = p − p_d (N);
     - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
       after the end of the approach (all the time after it, if none);
+    - ``peak_force_N``: max F_n over the whole run (N), the approach's impact
+      included;
     - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
     - ``sat_duty``: fraction of all rows with sat(τ_i) ≠ τ_i on some joint.
     """
@@ -553,6 +557,7 @@ def contact_metrics(
     # The run's own task-space rows (the controller's log may hold earlier runs).
     log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
     ne = log["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
+    along = (log["pd"][after, :2] - np.asarray(res.x_ee)[after, :2]) * 1e3
     approach = t >= sc.t_approach - 1e-9
     contact = np.flatnonzero(approach & (fn > 0))
     # Never touched after the approach: all of that time is without contact.
@@ -560,6 +565,8 @@ def contact_metrics(
     lost = float(np.sum(fn[start:] <= 0) * sc.Ts) if approach.any() else 0.0
     return {
         "track_mm": m["rms_track"] * 1e3,
+        "track_along_mm": float(np.sqrt(np.mean(np.sum(along**2, axis=1)))),
+        "peak_force_N": float(np.max(fn)),
         "force_rms_err_N": float(np.sqrt(np.mean((fn[after] - target) ** 2))),
         "force_target_N": float(target),
         "force_chatter_N": float(np.sqrt(np.mean(np.diff(fn[after]) ** 2))),

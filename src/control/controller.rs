@@ -101,15 +101,19 @@ struct Task<const N: usize> {
 }
 
 impl<const N: usize> Task<N> {
-    /// The learning signals of (19.2): the regressors n α̇1 + (1 − n) q̈_c,
+    /// The learning signals of (19.2): the regressors q̈_c + n (α̇1 − ẍd),
     /// n α1 + (1 − n) q̇_c and the paper's z2 of `e` (on the compliant
     /// reference: the networks learn what the impedance leaves undone, never
     /// the contact force it prescribes), weighted d∘z2 by the inertia scales
-    /// as (10.2).
+    /// as (10.2). The acceleration regressor takes the commanded q̈_c in place
+    /// of the compliant ẍd, which carries this sample's wrench (ẍd ∋ J⁺F_e/M_d):
+    /// through D̂ that closed the admittance's algebraic loop with the learnt
+    /// inertia's gain, and the unified step rang on a rigid table once D̂ had
+    /// learnt (SPEC (19.2)).
     fn signals(&self, e: &Errors<N>, inertia: &Vector<N>) -> Signals<N> {
         let n = self.share;
         Signals {
-            dalpha1: n * e.dalpha1 + (1.0 - n) * self.commanded.ddx,
+            dalpha1: self.commanded.ddx + n * (e.dalpha1 - e.ddxd),
             alpha1: n * e.alpha1 + (1.0 - n) * self.commanded.dx,
             z2: e.z2.component_mul(inertia),
         }
@@ -1091,6 +1095,45 @@ mod tests {
             4..=7 => w.c((i - 4) / 2, i % 2).to_vec(),
             _ => w.g(i - 8).to_vec(),
         }
+    }
+
+    #[test]
+    fn the_unified_regressors_do_not_carry_the_compliant_acceleration() {
+        // (19.2): ẍd of the compliant reference holds this sample's wrench
+        // (J⁺F_e/M_d); the regressor D̂ multiplies must not, or the learnt
+        // inertia closes the admittance's algebraic loop through the contact.
+        let commanded = Setpoint {
+            x: Vector::<2>::new(0.1, 0.2),
+            dx: Vector::<2>::new(0.3, -0.1),
+            ddx: Vector::<2>::new(-2.0, 1.5),
+        };
+        let task = Task {
+            errors: Errors {
+                ddxd: Vector::zeros(),
+                z1: Vector::zeros(),
+                alpha1: Vector::zeros(),
+                z2: Vector::zeros(),
+                dalpha1: Vector::zeros(),
+            },
+            torque: Vector::zeros(),
+            share: 0.3,
+            commanded,
+        };
+        let errors = |ddxd: Vector<2>| Errors {
+            ddxd,
+            z1: Vector::<2>::new(1e-3, -2e-3),
+            alpha1: Vector::<2>::new(0.25, -0.05),
+            z2: Vector::<2>::new(0.01, 0.02),
+            dalpha1: ddxd + Vector::<2>::new(0.5, -0.25), // ẍd + K1 (ẋd − v)
+        };
+        let d = Vector::<2>::new(2.0, 0.5);
+        let quiet = task.signals(&errors(Vector::<2>::new(0.1, -0.2)), &d);
+        let pushed = task.signals(&errors(Vector::<2>::new(50.0, -80.0)), &d);
+        assert_eq!(quiet.dalpha1, pushed.dalpha1);
+        // q̈_c + n K1 (ẋd − v): the commanded acceleration and the share's feedback.
+        let expected = commanded.ddx + 0.3 * Vector::<2>::new(0.5, -0.25);
+        assert!((quiet.dalpha1 - expected).amax() < 1e-15, "{quiet:?}");
+        assert_eq!(quiet.z2, Vector::<2>::new(0.02, 0.01));
     }
 
     #[test]

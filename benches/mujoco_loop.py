@@ -408,7 +408,7 @@ def panda_table_times(T: float, repeats: int) -> None:
     example = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(example)
     sc = act.arm_table()
-    basis = ac.orbit_basis(sc)
+    rule = act.rule_keywords(sc)
     plant = amj.Plant(sc.model)
     rows = {name: example.ROWS[name][0] for name in ("pd", "sf", "of", "ct", "ct+30")}
     times: dict[str, dict[str, list[float]]] = {
@@ -425,7 +425,7 @@ def panda_table_times(T: float, repeats: int) -> None:
                     # The rows the core stepped already: as the Python loop.
                     times[kind]["before"].append(times[kind]["python"][-1])
                     continue
-                ctrl = example.controller(kind, sc, basis)
+                ctrl = example.controller(kind, sc, rule)
                 if how == "before" and kind.startswith("ct"):
                     law = PinocchioPDPlus(sc.pin_model, sc.tau_max, 1.3 if kind == "ct+30" else 1.0)
                     ctrl = adaptimp.CartesianController(

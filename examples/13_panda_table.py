@@ -20,10 +20,16 @@ in the formulation of the impedance (SPEC §19, schema keyword ``formulation``):
 
 Joint controllers: PD, adaptive state feedback (SF) and output feedback (OF),
 ``adaptimp.Controller(case, "robot", n, impedance="external")`` at 1 kHz with
-the gains of SPEC §18's rule (Kp_i = 0.25/(Ts (D⁻¹)_ii) from D(q0), Kζ, K1 =
-20) and gravity learning (Γ = (1, 1, 5000), σ = (0.01, 0.01, 1e-5), ‖ŴG‖ ≤
-100) on 64 RBF centres along the joint orbit; computed torque with the exact
-model (CT) and with +30 % mass (CT +30 %), Pinocchio.
+the core's rule (SPEC §18, ``adaptimp.contact.rule_keywords``): gains from
+D(q0), RBF centres and learning rates along the scenario's whole joint path,
+K1 = 20 s⁻¹ (SPEC (19.6)); nothing per arm. Computed torque with the exact
+model (CT) and with +30 % mass (CT +30 %), the core's RNEA on the URDF.
+
+The path (SPEC (19.6)): the home posture held 0.5 s (the networks learn the
+arm's gravity in free space), the approach to the table's surface arriving at
+rest at t = 1.3 s, the depth pressed in over 0.5 s while the circle's speed
+ramps up over 1 s. For a URDF arm the table lies at least twice the arm's sag
+before learning below the tool at home.
 
 Metrics over t ≥ 2 s (p the tool, p_d the compliant reference, F_n = −F_e,z),
 the keys of ``--json``: ``track_mm`` RMS ‖p_d − p‖; ``track_along_mm`` its part
@@ -63,13 +69,9 @@ from adaptimp import contact as act
 from adaptimp import mujoco as amj
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
-# "Gravity learning": the Ĝ network learns fast and forgets slowly (ΓG = 5000,
-# σG = 1e-5; the normalised step keeps it stable), ‖ŴG‖ ≤ 100.
-LEARN = {
-    "gamma": [1.0, 1.0, 5000.0],
-    "sigma": [0.01, 0.01, 1e-5],
-    "weight_bound": [4.19, 13.2, 100.0],
-}
+LEARN_KEYS = ("gamma", "sigma", "weight_bound")
+"""The rule's learning keywords; the rows without learning (PD, SF as printed)
+leave them out."""
 SHARE = 0.3
 """The admittance's share n of the unified rows (docs/contact.md)."""
 # name: (label, joint controller, formulation, +τe feedforward, learning)
@@ -99,20 +101,23 @@ KEYS = (
 FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "contact_force.png"
 
 
-def controller(name: str, sc: ac.PandaTable, basis: Any) -> Any:
-    """The controller of one row on the scenario."""
+def controller(name: str, sc: ac.PandaTable, rule: dict[str, Any]) -> Any:
+    """The controller of one row on the scenario; ``rule``: the scenario's
+    :func:`adaptimp.contact.rule_keywords`."""
     _, kind, formulation, ff, learn = ROWS[name]
-    extra: dict[str, Any] = dict(LEARN) if learn else {}
+    extra: dict[str, Any] = {}
     if formulation == "unified":
         extra["admittance_share"] = SHARE
-    return ac.panda_controller(
-        kind, sc, basis=basis, force_feedforward=ff, formulation=formulation, **extra
-    )
+    if kind in ("pd", "sf", "of"):
+        extra.update({k: v for k, v in rule.items() if learn or k not in LEARN_KEYS})
+    return ac.panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
 
 
-def run(name: str, sc: ac.PandaTable, basis: Any, T: float) -> tuple[Any, Any, dict[str, float]]:
+def run(
+    name: str, sc: ac.PandaTable, rule: dict[str, Any], T: float
+) -> tuple[Any, Any, dict[str, float]]:
     """One row on the scenario: (result, controller, metrics)."""
-    ctrl = controller(name, sc, basis)
+    ctrl = controller(name, sc, rule)
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=T, q0=sc.q0)
     return res, ctrl, act.contact_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
 
@@ -128,14 +133,14 @@ def figure(path: Path, T: float) -> None:
     fig, axes = plt.subplots(2, 1, figsize=(11, 7), sharex=True, layout="constrained")
     for ax, friction in zip(axes, (0.0, 0.1), strict=True):
         sc = act.arm_table(friction=friction)
-        basis = ac.orbit_basis(sc)
+        rule = act.rule_keywords(sc)
         for name, color, lw in (
             ("sf-printed", "tab:red", 0.5),
             ("ct-admittance", "tab:orange", 0.5),
             ("sf", "tab:blue", 0.9),
             ("ct", "tab:green", 0.9),
         ):
-            res, _, m = run(name, sc, basis, T)
+            res, _, m = run(name, sc, rule, T)
             ax.plot(
                 res.t,
                 -res.wrench_ee[:, 2],
@@ -154,19 +159,11 @@ def figure(path: Path, T: float) -> None:
     plt.close(fig)
 
 
-def long_run(sc: ac.PandaTable, basis: Any, T: float) -> None:
+def long_run(sc: ac.PandaTable, rule: dict[str, Any], T: float) -> None:
     """SF (unified, n = SHARE) for T seconds, in parts of 10 s in the core's loop
     (the plant and the controller go on from one part to the next: the rows of
     one run); prints ‖Ŵ‖_F and the mean normal force every 10 s."""
-    ctrl = ac.panda_controller(
-        "sf",
-        sc,
-        basis=basis,
-        force_feedforward=False,
-        formulation="unified",
-        admittance_share=SHARE,
-        **LEARN,
-    )
+    ctrl = controller("sf", sc, rule)
     plant = amj.Plant(sc.model)
     print(f"\nlong run, {ROWS['sf'][0]}, T = {T:g} s: weight norms, mean normal force")
     print("| t (s) | ‖W_D‖ | ‖W_C‖ | ‖W_G‖ | mean F_n over the last 10 s (N) |")
@@ -199,13 +196,13 @@ def main() -> None:
     parser.add_argument("--long", type=float, default=0.0, help="also a long SF run (s)")
     args = parser.parse_args()
     sc = act.arm_table(args.arm, spring=args.spring, friction=args.friction)
-    basis = ac.orbit_basis(sc)
+    rule = act.rule_keywords(sc)
     print(
         f"{args.arm or 'Panda'}: {sc.radius * 100:g} cm circle at {sc.freq:g} Hz about "
         f"({sc.centre[0]:.3f}, {sc.centre[1]:.3f}) m, table top {sc.surface_z - 0.01:.4f} m, "
         f"δ_c = {sc.depth * 1e3:g} mm, friction {args.friction:g}, "
         f"{'rigid' if args.spring is None else f'spring {args.spring:g} N/m'}, T = {args.T:g} s, "
-        f"home {np.round(sc.q0, 3).tolist()}, {basis[0].shape[0]} centres"
+        f"home {np.round(sc.q0, 3).tolist()}, {rule['basis'][0].shape[0]} centres"
     )
     print(
         "\n| controller | track (mm) | along (mm) | force RMS err (N) | target (N) | mean (N) "
@@ -217,7 +214,7 @@ def main() -> None:
     for name in args.rows.split(","):
         t0 = time.perf_counter()
         try:
-            _, _, m = run(name, sc, basis, args.T)
+            _, _, m = run(name, sc, rule, args.T)
         except adaptimp.DivergedError as e:
             print(f"| {ROWS[name][0]} | diverged: {str(e).splitlines()[0]} |")
             continue
@@ -238,7 +235,7 @@ def main() -> None:
         figure(FIGURE, args.T)
         print(f"\nwrote {FIGURE}")
     if args.long > 0:
-        long_run(sc, basis, args.long)
+        long_run(sc, rule, args.long)
 
 
 if __name__ == "__main__":

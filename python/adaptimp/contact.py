@@ -34,23 +34,57 @@ from .panda_table import PandaTable, cartesian_metrics
 
 __all__ = [
     "CLEARANCE",
+    "CONTACT_K1",
     "OUTWARD",
     "REACH_SHARE",
+    "SAG_MARGIN",
     "SLIP_SHARE",
     "TABLE_MASS",
     "TABLE_TIMECONST",
+    "T_APPROACH",
+    "T_HOLD",
+    "T_PRESS",
     "arm_model",
     "arm_table",
     "contact_metrics",
     "placement",
+    "rule_keywords",
+    "sag",
     "sliding_timeconst",
 ]
 
 FloatArray = NDArray[np.float64]
 
 CLEARANCE = 0.027
-"""Gap (m) between the tool sphere at the home posture and the table top (the
-Panda scenario's)."""
+"""The smallest gap (m) between the tool sphere at the home posture and the table
+top (the Panda scenario's); :func:`arm_table` makes it at least :data:`SAG_MARGIN`
+times the arm's :func:`sag`."""
+
+SAG_MARGIN = 2.0
+"""The table top lies at least this many times the arm's :func:`sag` below the
+tool at home: the networks start at zero, and until Ĝ has learnt gravity (the
+hold, :data:`T_HOLD`) the arm hangs below its path; it must not reach the table
+then (SPEC (19.6))."""
+
+CONTACT_K1 = 20.0
+"""K1 (1/s) of the table's joint controllers, in place of the rule's (18.2)
+min(50, 0.05/Ts): the position loop that pulls the arm onto the compliant
+reference, which the contact wrench moves. At 50 s⁻¹ it follows the landing's
+force spike and the tool bounced off the table (87–240 N, 0.3–0.5 s off on
+the Panda, the UR5 and the UR10); at 20 s⁻¹ (SPEC §15's) it lands within
+12 N. The learning keeps the rule's bandwidth (18.6) (SPEC (19.6))."""
+
+T_HOLD = 0.5
+"""The path holds the home posture this long (s) before the approach: the
+networks learn the arm's gravity in free space, where they will then act."""
+
+T_APPROACH = 1.3
+"""The approach (from home to the table's surface, arriving at rest) ends at
+this time (s)."""
+
+T_PRESS = 0.5
+"""After the approach the commanded depth grows from 0 to δ_c over this long
+(s): the force rises from zero instead of an impact."""
 
 OUTWARD = 0.10
 """How far (m) beyond the home TCP, away from the base's vertical axis, the
@@ -283,6 +317,7 @@ def placement(
     *,
     tool_radius: float = 0.01,
     seed: int = 0,
+    clearance: float = CLEARANCE,
 ) -> tuple[FloatArray, float, float]:
     """Where the table and the circle go for an arm at ``home`` (rad), from its
     reach (SPEC §19, "the scenario on any arm").
@@ -292,13 +327,14 @@ def placement(
     along u, but at most :data:`REACH_SHARE` of the horizontal reach R (the
     largest horizontal distance of the tip over 1024 postures drawn uniformly
     within ``limits`` = (lo, hi) (rad), each clipped to ±π, seed ``seed``); the
-    table top lies :data:`CLEARANCE` below the tool sphere at home.
+    table top lies ``clearance`` (m, default :data:`CLEARANCE`) below the tool
+    sphere at home.
 
     Returns (centre (2,) m, table top m, R m). ``ConfigError`` (naming it and
     the value) for a ``tool_radius`` that is not a finite number > 0, a
     ``home`` or a limit that is not n finite numbers, and lo > hi.
     """
-    _check_scenario(tool_radius=tool_radius)
+    _check_scenario(tool_radius=tool_radius, clearance=clearance)
     q = _joint_vector("home", home, chain)
     unlimited = " (±π for an unlimited joint)"
     lo_given = _joint_vector("limits[0] (lo)", limits[0], chain, unlimited)
@@ -318,7 +354,7 @@ def placement(
     radial = float(np.linalg.norm(p[:2]))
     u = p[:2] / radial if radial > 1e-9 else np.array([1.0, 0.0])
     dist = min(radial + OUTWARD, REACH_SHARE * reach)
-    return dist * u, float(p[2] - tool_radius - CLEARANCE), reach
+    return dist * u, float(p[2] - tool_radius - clearance), reach
 
 
 def _joint_vector(name: str, value: ArrayLike, chain: Chain, hint: str = "") -> FloatArray:
@@ -378,6 +414,9 @@ def _check_scenario(**values: float | None) -> None:
         "Ts": ("> 0 (s)", lambda v: v > 0),
         "t_approach": ("≥ 0 (s)", lambda v: v >= 0),
         "t_ramp": ("≥ 0 (s)", lambda v: v >= 0),
+        "t_hold": ("≥ 0 (s)", lambda v: v >= 0),
+        "t_press": ("≥ 0 (s)", lambda v: v >= 0),
+        "clearance": ("≥ 0 (m)", lambda v: v >= 0),
     }
     for name, value in values.items():
         if value is None and name == "spring":
@@ -404,12 +443,23 @@ def arm_table(
     depth: float = 0.015,
     tool_radius: float = 0.01,
     Ts: float = 1e-3,
-    t_approach: float = 1.0,
+    t_approach: float = T_APPROACH,
     t_ramp: float = 1.0,
+    t_hold: float = T_HOLD,
+    t_press: float = T_PRESS,
 ) -> PandaTable:
     """The table scenario for the arm of ``urdf`` (None: the Panda of
     :func:`adaptimp.panda_table.panda_table`, whose table and circle are kept,
     and which refuses ``tip``, ``fix`` and ``home``: it has its own).
+
+    The path (SPEC (19.6)): the home posture held over [0, ``t_hold``) s, the
+    approach to the circle's start on the table's surface, arriving at rest at
+    ``t_approach`` s, then the commanded depth δ_c pressed in over ``t_press``
+    s while the circle's speed ramps up over ``t_ramp`` s (``t_hold`` =
+    ``t_press`` = 0: the earlier path, straight from home to δ_c into the
+    table by ``t_approach``). For a URDF arm the table top lies
+    max(:data:`CLEARANCE`, :data:`SAG_MARGIN` · :func:`sag`) below the tool
+    at home.
 
     ``tip``: the tool's body (default: the child link of the arm's last joint).
     The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
@@ -429,7 +479,13 @@ def arm_table(
     _check_scenario(
         spring=spring, friction=friction, radius=radius, freq=freq, depth=depth,
         tool_radius=tool_radius, Ts=Ts, t_approach=t_approach, t_ramp=t_ramp,
+        t_hold=t_hold, t_press=t_press,
     )  # fmt: skip
+    if t_hold > 0 and t_hold >= t_approach:
+        raise ConfigError(
+            f"t_hold must end before the approach does (t_hold < t_approach), got "
+            f"t_hold = {t_hold!r} and t_approach = {t_approach!r}"
+        )
     speed = 2.0 * math.pi * freq * radius
     if urdf is None:
         # The Panda's scenario has its own tool body, fixed fingers and home.
@@ -467,6 +523,7 @@ def arm_table(
             force=sc.target_force(),
             speed=speed,
         )
+        sc.t_hold, sc.t_press = float(t_hold), float(t_press)
         return sc
     path = Path(urdf)
     # The arm's joints by the one rule of adaptimp.mujoco.simulate and the
@@ -489,7 +546,11 @@ def arm_table(
             "driven joints, or fix the others"
         )
     q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
-    centre, top, _ = placement(chain, q0, _limits(bare), tool_radius=tool_radius)
+    tau_max = np.asarray(bare.tau_max, dtype=np.float64)
+    clearance = max(CLEARANCE, SAG_MARGIN * sag(chain, bare, q0, tau_max, Ts=Ts))
+    centre, top, _ = placement(
+        chain, q0, _limits(bare), tool_radius=tool_radius, clearance=clearance
+    )
     table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)
     model = arm_model(
         path,
@@ -517,8 +578,71 @@ def arm_table(
         surface_z=top + tool_radius,
         t_approach=t_approach,
         t_ramp=t_ramp,
-        tau_max=np.asarray(bare.tau_max, dtype=np.float64),
+        tau_max=tau_max,
+        t_hold=float(t_hold),
+        t_press=float(t_press),
     )
+
+
+def sag(chain: Chain, model: Any, q0: ArrayLike, tau_max: ArrayLike, *, Ts: float = 1e-3) -> float:
+    """How far (m) the tip hangs below its path at ``q0`` (rad) under the joint
+    feedback alone, before the networks have learnt gravity: |(J Δq)_z| with
+    Δq_i = G_i/(Kp_i K1) (SPEC (18.5)'s sag, in the task), Kp from the rule
+    (:func:`adaptimp.tuning.suggest` with ``model``'s D(q0), ``tau_max`` (N m),
+    ``Ts`` (s)), K1 = min(:data:`CONTACT_K1`, the rule's), G(q0) and J the tip's position
+    Jacobian from ``chain``. ``model``: what :func:`adaptimp.tuning.gravity`
+    takes (here the arm's ``adaptimp.mujoco.Plant``)."""
+    from . import tuning
+
+    q = _joint_vector("q0", q0, chain)
+    g = tuning.gravity(model, q)
+    if g is None:
+        raise ConfigError(f"sag needs a model that gives G(q); got {type(model).__name__}")
+    kw = tuning.suggest(model, q, tau_max, Ts=Ts)
+    kp = np.asarray(kw["Kp"], dtype=np.float64)
+    dq = g / (kp * min(CONTACT_K1, float(kw["K1"][0])))
+    return float(abs(np.asarray(chain.jacobian(q))[2] @ dq))
+
+
+def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
+    """Keywords of :func:`adaptimp.cartesian.panda_controller` for the joint
+    controller ``case`` on the scenario ``sc``, from the core's rule (SPEC §18,
+    :func:`adaptimp.tuning.suggest`): gains (18.1)–(18.4) from D(q0), the RBF
+    centres (18.5) and the learning (18.6)–(18.8) along the scenario's whole
+    joint path (the hold, the approach, the press and one period of the circle,
+    as the outer loop maps the path on the table's surface into the joints,
+    F_e = 0, taken as one period of that length), and K1 = min(:data:`CONTACT_K1`,
+    the rule's (18.2)) (SPEC (19.6)). Returns ``gains`` (Kp, Kzeta, K1), ``basis`` (centres,
+    widths) and the rest (gamma, sigma, weight_bound, kr, …) as keywords."""
+    from . import cartesian as ac
+    from . import mujoco as amj
+    from . import tuning
+
+    start = sc.t_approach + max(sc.t_ramp, sc.t_press)
+    steps = round((start + 1.0 / sc.freq) / sc.Ts)
+    rot = sc.chain.fk(sc.q0)[:3, :3]
+    table = np.array(
+        [ac._sample(lambda t: sc.path(t, depth=0.0), k * sc.Ts, rot) for k in range(steps)]
+    )
+    q, dq = sc.outer()._core.orbit(sc.q0, table, steps)
+    ddq = np.gradient(dq, sc.Ts, axis=0)
+
+    def path(t: float) -> tuple[Any, Any, Any]:
+        k = min(round(t / sc.Ts), steps - 1)
+        return q[k], dq[k], ddq[k]
+
+    kw = tuning.suggest(
+        amj.Plant(sc.model), sc.q0, sc.tau_max, Ts=sc.Ts, path=path, period=steps * sc.Ts,
+        case=case,
+    )  # fmt: skip
+    kw["K1"] = [min(CONTACT_K1, float(kw["K1"][0]))] * sc.n  # never above (18.2)
+    out: dict[str, Any] = {
+        "gains": {k: kw[k] for k in ("Kp", "Kzeta", "K1")},
+        "basis": (kw["centers"], kw["widths"]),
+    }
+    skip = {"n", "Kp", "Kzeta", "K1", "centers", "widths", "Ts", "tau_max"}
+    out.update({k: v for k, v in kw.items() if k not in skip})
+    return out
 
 
 def contact_metrics(
@@ -539,7 +663,9 @@ def contact_metrics(
       K_d k_e/(K_d + k_e)(δ_c + n·e) (K_d (δ_c + n·e) for a rigid table), n = −z,
       e = p − p_d (N);
     - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
-      after the end of the approach (all the time after it, if none);
+      after the end of the approach, when the commanded point has reached δ_c
+      into the table (``t_approach + t_press``; all the time after it, if
+      none);
     - ``peak_force_N``: max F_n over the whole run (N), the approach's impact
       included;
     - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
@@ -558,7 +684,9 @@ def contact_metrics(
     log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
     ne = log["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
     along = (log["pd"][after, :2] - np.asarray(res.x_ee)[after, :2]) * 1e3
-    approach = t >= sc.t_approach - 1e-9
+    # The approach ends when the commanded point has reached δ_c (with a
+    # soft landing, the press's end).
+    approach = t >= sc.t_approach + sc.t_press - 1e-9
     contact = np.flatnonzero(approach & (fn > 0))
     # Never touched after the approach: all of that time is without contact.
     start = contact[0] if contact.size else int(np.argmax(approach))

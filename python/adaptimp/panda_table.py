@@ -119,10 +119,20 @@ class PandaTable:
         TCP height (m) with the tool sphere resting on the table.
     t_approach, t_ramp : float
         The approach (quintic, from the home TCP to the circle's start point
-        δ_c into the table) takes [0, t_approach) s; the circle's angular speed
-        ramps from 0 to 2π·freq over [t_approach, t_approach + t_ramp) s.
+        δ_c into the table, or on its surface with ``t_press`` > 0) ends at
+        t_approach s; the circle's angular speed ramps from 0 to 2π·freq over
+        [t_approach, t_approach + t_ramp) s.
     tau_max : (7,)
         Actuator limits (N m).
+    t_hold : float
+        The path holds the home TCP over [0, t_hold) s, then approaches over
+        [t_hold, t_approach) (default 0: the approach starts at once).
+    t_press : float
+        0 (default): the approach ends δ_c into the table, and the tool lands
+        with the quintic's speed. > 0: the approach ends on the table's
+        surface (the tool arrives at rest, touching), and the commanded depth
+        then grows from 0 to δ_c over [t_approach, t_approach + t_press) s
+        (a quintic): the force rises from zero instead of an impact.
     """
 
     model: Any
@@ -138,6 +148,8 @@ class PandaTable:
     t_approach: float
     t_ramp: float
     tau_max: FloatArray
+    t_hold: float = 0.0
+    t_press: float = 0.0
     p0: FloatArray = field(init=False)
 
     def __post_init__(self) -> None:
@@ -163,12 +175,24 @@ class PandaTable:
         (m) overrides δ_c (0: the path on the table's surface)."""
         depth = self.depth if depth is None else depth
         r, w = self.radius, 2 * math.pi * self.freq
+        soft = self.t_press > 0
         start = np.array([self.centre[0] - r, self.centre[1], self.surface_z - depth])
         if t < self.t_approach:
-            s, ds, dds = _quintic(t / self.t_approach)
+            if t < self.t_hold:
+                return self.p0.copy(), np.zeros(3), np.zeros(3)
+            span = self.t_approach - self.t_hold
+            s, ds, dds = _quintic((t - self.t_hold) / span)
             d = start - self.p0
-            return self.p0 + s * d, ds * d / self.t_approach, dds * d / self.t_approach**2
+            if soft:  # to the surface: the depth comes after the approach
+                d[2] += depth
+            return self.p0 + s * d, ds * d / span, dds * d / span**2
         u = t - self.t_approach
+        # The commanded depth: all of it at once, or pressed in over t_press.
+        z, dz, ddz = start[2], 0.0, 0.0
+        if soft:
+            s, ds, dds = _quintic(u / self.t_press)
+            z = self.surface_z - s * depth
+            dz, ddz = -ds * depth / self.t_press, -dds * depth / self.t_press**2
         if u < self.t_ramp:
             v = u / self.t_ramp  # φ̇ = ω·quintic(v): φ = π + ω T_r (2.5v⁴ − 3v⁵ + v⁶)
             phi = math.pi + w * self.t_ramp * (2.5 * v**4 - 3 * v**5 + v**6)
@@ -178,9 +202,9 @@ class PandaTable:
             phi = math.pi + w * (0.5 * self.t_ramp + u - self.t_ramp)
             dphi, ddphi = w, 0.0
         c, sn = math.cos(phi), math.sin(phi)
-        p = np.array([self.centre[0] + r * c, self.centre[1] + r * sn, start[2]])
-        dp = np.array([-r * sn * dphi, r * c * dphi, 0.0])
-        ddp = np.array([-r * sn * ddphi - r * c * dphi**2, r * c * ddphi - r * sn * dphi**2, 0.0])
+        p = np.array([self.centre[0] + r * c, self.centre[1] + r * sn, z])
+        dp = np.array([-r * sn * dphi, r * c * dphi, dz])
+        ddp = np.array([-r * sn * ddphi - r * c * dphi**2, r * c * ddphi - r * sn * dphi**2, ddz])
         return p, dp, ddp
 
     def outer(self, **params: Any) -> CartesianImpedance:

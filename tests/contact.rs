@@ -335,17 +335,18 @@ fn a_stiff_wall_is_held_by_the_torque_level_formulation_and_not_by_the_admittanc
         );
         rows.push((rms, c, lost, r.tau_ok));
     }
-    // Admittance, with and without +τe, and the unified law with half the
-    // admittance: the force jumps by more than twice K_d δ_c per sample
-    // (measured 30–34 N) and the tool leaves the wall.
-    for r in [&rows[0], &rows[1], &rows[4]] {
+    // Admittance, with and without +τe: the force jumps by more than twice
+    // K_d δ_c per sample (measured 30–34 N) and the tool leaves the wall.
+    for r in [&rows[0], &rows[1]] {
         assert!(r.1 > 2.0 * kd_depth && r.2 > 0, "{r:?}");
     }
-    // Torque-level, and unified with n = 0.3 and the paper's +τe: chatter
-    // under 0.1 % of K_d δ_c (measured 0.0004 N), contact never lost, the
-    // force within 10 % and 15 % RMS of K_d δ_c while the networks still
-    // learn (6 s; measured 8.7 % and 12.1 %).
-    for (r, within) in [(&rows[2], 0.10), (&rows[3], 0.15)] {
+    // Torque-level, and unified with n = 0.3 and 0.5 and the paper's +τe:
+    // chatter under 0.1 % of K_d δ_c (measured 0.0002–0.0004 N), contact
+    // never lost, the force within 10 % and 15 % RMS of K_d δ_c while the
+    // networks still learn (6 s; measured 8.7 %, 11.1 % and 10.2 %). Unified
+    // n = 0.5 chattered (30 N per sample) while D̂'s regressor carried the
+    // compliant acceleration, i.e. this sample's wrench (SPEC (19.2)).
+    for (r, within) in [(&rows[2], 0.10), (&rows[3], 0.15), (&rows[4], 0.15)] {
         assert!(
             r.0 < within * kd_depth && r.1 < 1e-3 * kd_depth && r.2 == 0 && r.3,
             "{r:?}"

@@ -33,8 +33,10 @@ from .chain import Chain
 from .panda_table import PandaTable, cartesian_metrics
 
 __all__ = [
+    "AXIS_SHARE",
     "CLEARANCE",
     "CONTACT_K1",
+    "MIN_REACH_SHARE",
     "OUTWARD",
     "REACH_SHARE",
     "SAG_MARGIN",
@@ -93,6 +95,16 @@ circle's centre lies (horizontally)."""
 REACH_SHARE = 0.7
 """The circle's centre lies at most this share of the arm's horizontal reach
 from the base's vertical axis."""
+
+MIN_REACH_SHARE = 0.4
+"""… and at least this share of it: a folded home posture (the tip above the
+base, the Unitree Z1's rest) does not put the circle where the arm cannot
+press on the table."""
+
+AXIS_SHARE = 0.1
+"""A home tip closer than this share of the reach to the base's vertical axis
+has no outward direction of its own; the circle then lies along the base's x
+axis."""
 
 TABLE_MASS = 1.0
 """Mass (kg) of a spring-mounted table top (``spring=``); critically damped, its
@@ -155,6 +167,18 @@ def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float
     return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
 
 
+def _unused_body(spec: Any, name: str) -> str:
+    """``name``, or ``name_1``, ``name_2``, … if the arm already has a body of
+    that name (a URDF link called "tool" or "table"). Only the bodies are
+    renamed: the URDF's geoms are dropped, so the geoms, the site and the
+    sensors keep their names."""
+    i, candidate = 0, name
+    while spec.body(candidate) is not None:
+        i += 1
+        candidate = f"{name}_{i}"
+    return candidate
+
+
 def _tool_and_table(
     spec: Any,
     tip: str,
@@ -176,7 +200,7 @@ def _tool_and_table(
         raise ValueError(f"the model has no body {tip!r} for the tool")
     # A massless body of its own at the tip's origin: its force sensor reads
     # the contact alone (on a body with mass it would add its weight).
-    body = parent.add_body(name="tool")
+    body = parent.add_body(name=_unused_body(spec, "tool"))
     body.add_site(name="ee", size=[0.01, 0, 0])
     body.add_geom(
         name="tool",
@@ -201,7 +225,7 @@ def _tool_and_table(
     thickness = 0.05
     c = np.asarray(centre, dtype=np.float64)
     table = spec.worldbody.add_body(
-        name="table", pos=[float(c[0]), float(c[1]), table_top - thickness / 2]
+        name=_unused_body(spec, "table"), pos=[float(c[0]), float(c[1]), table_top - thickness / 2]
     )
     if spring is not None:
         table.add_joint(
@@ -282,9 +306,14 @@ def arm_model(
 
     spec, effort = amj._urdf_spec(Path(urdf).read_text(), fix)
     spec.option.timestep = timestep
-    missing = [j.name for j in spec.joints if j.name not in effort]
+    missing = [j.name for j in spec.joints if not 0 < effort.get(j.name, math.nan) < math.inf]
     if missing:
-        raise ValueError(f"URDF joints without <limit effort=...>: {missing}")
+        # The arm's own estimate, as adaptimp.mujoco.from_urdf makes it (and
+        # says so): 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|).
+        arm = amj.from_urdf(urdf, fix=fix, tip=tip)
+        for name in missing:
+            a = mujoco.mj_name2id(arm, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+            effort[name] = float(arm.actuator_ctrlrange[a][1])
     amj._add_motors(spec, effort)
     _tool_and_table(
         spec,
@@ -300,7 +329,16 @@ def arm_model(
         if spring is not None:
             qpos.append(0.0)
         spec.add_key(name="home", qpos=qpos)
-    model = spec.compile()
+    try:
+        model = spec.compile()
+    except ValueError:
+        # Inertias that do not compile as they are: bounded and balanced as
+        # adaptimp.mujoco.from_urdf does (which has warned of it above or in
+        # the arm's own model).
+        spec.compiler.boundmass = 1e-6
+        spec.compiler.boundinertia = 1e-10
+        spec.compiler.balanceinertia = True
+        model = spec.compile()
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
         model.pair_solreffriction[0] = [
@@ -323,8 +361,10 @@ def placement(
     reach (SPEC §19, "the scenario on any arm").
 
     With p_h the tip at home and u the horizontal unit vector from the base's
-    vertical axis to p_h: the circle's centre lies :data:`OUTWARD` beyond p_h
-    along u, but at most :data:`REACH_SHARE` of the horizontal reach R (the
+    vertical axis to p_h (the base's x axis if p_h is within :data:`AXIS_SHARE`
+    of R of that axis): the circle's centre lies :data:`OUTWARD` beyond p_h
+    along u, but at least :data:`MIN_REACH_SHARE` and at most
+    :data:`REACH_SHARE` of the horizontal reach R (the
     largest horizontal distance of the tip over 1024 postures drawn uniformly
     within ``limits`` = (lo, hi) (rad), each clipped to ±π, seed ``seed``); the
     table top lies ``clearance`` (m, default :data:`CLEARANCE`) below the tool
@@ -352,8 +392,10 @@ def placement(
     samples = np.random.default_rng(seed).uniform(lo, hi, size=(1024, q.shape[0]))
     reach = max(float(np.linalg.norm(chain.fk(s)[:2, 3])) for s in samples)
     radial = float(np.linalg.norm(p[:2]))
-    u = p[:2] / radial if radial > 1e-9 else np.array([1.0, 0.0])
-    dist = min(radial + OUTWARD, REACH_SHARE * reach)
+    # A tip near the base's axis (a folded arm at rest) has no direction of
+    # its own: the base's forward axis x.
+    u = p[:2] / radial if radial > AXIS_SHARE * reach else np.array([1.0, 0.0])
+    dist = min(max(radial + OUTWARD, MIN_REACH_SHARE * reach), REACH_SHARE * reach)
     return dist * u, float(p[2] - tool_radius - clearance), reach
 
 
@@ -547,6 +589,7 @@ def arm_table(
         )
     q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
     tau_max = np.asarray(bare.tau_max, dtype=np.float64)
+    _check_press(chain, bare, q0, tau_max, _NOMINAL_KD * depth, friction, tool_radius)
     clearance = max(CLEARANCE, SAG_MARGIN * sag(chain, bare, q0, tau_max, Ts=Ts))
     centre, top, _ = placement(
         chain, q0, _limits(bare), tool_radius=tool_radius, clearance=clearance
@@ -582,6 +625,43 @@ def arm_table(
         t_hold=float(t_hold),
         t_press=float(t_press),
     )
+
+
+def _check_press(
+    chain: Chain,
+    plant: Any,
+    q0: FloatArray,
+    tau_max: FloatArray,
+    force: float,
+    friction: float,
+    tool_radius: float,
+) -> None:
+    """Refuse an arm that cannot hold the press at its home posture: joint i
+    takes |G_i(q0)| + F (|J_c,z,i| + μ ‖J_c,xy,i‖) (N m), gravity and the
+    prescribed normal force F (N) with its sliding friction μF in the worst
+    horizontal direction, acting at the contact point (the tool's centre less
+    ``tool_radius`` along z, J_c its position Jacobian); beyond τmax_i no
+    controller can press (an estimated effort limit of a light wrist, say)."""
+    from . import tuning
+
+    j = np.asarray(chain.jacobian(q0), dtype=np.float64)
+    o = np.array([0.0, 0.0, -tool_radius])
+    skew = np.array([[0.0, -o[2], o[1]], [o[2], 0.0, -o[0]], [-o[1], o[0], 0.0]])
+    jc = j[:3] - skew @ j[3:]  # v + ω × o
+    g = tuning.gravity(plant, q0)
+    load = np.abs(g if g is not None else 0.0) + force * (
+        np.abs(jc[2]) + friction * np.linalg.norm(jc[:2], axis=0)
+    )
+    over = np.flatnonzero(load > tau_max)
+    if over.size:
+        i = int(over[0])
+        raise ConfigError(
+            f"the arm cannot press on the table: at its home posture joint {i} "
+            f"({chain.joint_names[i]!r}) takes {load[i]:.4g} N m (gravity and the "
+            f"prescribed {force:.4g} N with friction {friction:g}) but its effort limit is "
+            f"{tau_max[i]:.4g} N m; give the URDF a larger <limit effort> for it, or a "
+            "smaller depth or friction"
+        )
 
 
 def sag(chain: Chain, model: Any, q0: ArrayLike, tau_max: ArrayLike, *, Ts: float = 1e-3) -> float:

@@ -10,7 +10,8 @@ over the arm's ``adaptimp.Chain``); the rows differ in the joint controller and
 in the formulation of the impedance (SPEC §19, schema keyword ``formulation``):
 
 - ``admittance``: the measured wrench drives the compliant reference that the
-  joint law tracks (SPEC §16); "as printed": with the law's +τe feedforward.
+  joint law tracks (SPEC §16); "with +τe": the paper's law with its +τe
+  feedforward (and Γ = 1: no learning rates of the rule).
 - ``unified``: the convex combination of the admittance's torque (share n =
   ``admittance_share``) and the torque-level one; the networks learn from the
   paper's z2 on the compliant reference.
@@ -22,7 +23,7 @@ Joint controllers: PD, adaptive state feedback (SF) and output feedback (OF),
 ``adaptimp.Controller(case, "robot", n, impedance="external")`` at 1 kHz with
 the core's rule (SPEC §18, ``adaptimp.contact.rule_keywords``): gains from
 D(q0), RBF centres and learning rates along the scenario's whole joint path,
-K1 = 20 s⁻¹ (SPEC (19.6)); nothing per arm. Computed torque with the exact
+K1 = 10 s⁻¹ (SPEC (19.6)); nothing per arm. Computed torque with the exact
 model (CT) and with +30 % mass (CT +30 %), the core's RNEA on the URDF.
 
 The path (SPEC (19.6)): the home posture held 0.5 s (the networks learn the
@@ -49,7 +50,7 @@ share of steps that saturate.
     python examples/13_panda_table.py --long 120           # and a long SF run, weight norms
 
 Needs the extras ``mujoco`` and ``pinocchio`` (from a checkout:
-``pip install ".[mujoco,pinocchio]"``). ``ADAPTIMP_QUICK=1``: T = 1 s.
+``pip install ".[mujoco,pinocchio]"``). ``ADAPTIMP_QUICK=1``: T = 2.5 s.
 """
 
 from __future__ import annotations
@@ -69,15 +70,16 @@ from adaptimp import contact as act
 from adaptimp import mujoco as amj
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
+"""``ADAPTIMP_QUICK=1``: T = 2.5 s (the tool is pressed in at 1.8 s)."""
 LEARN_KEYS = ("gamma", "sigma", "weight_bound")
-"""The rule's learning keywords; the rows without learning (PD, SF as printed)
+"""The rule's learning keywords; the rows without learning (PD, SF with +τe and Γ = 1)
 leave them out."""
 SHARE = 0.3
 """The admittance's share n of the unified rows (docs/contact.md)."""
 # name: (label, joint controller, formulation, +τe feedforward, learning)
 ROWS: dict[str, tuple[str, str, str, bool, bool]] = {
     "pd": ("PD, admittance", "pd", "admittance", False, False),
-    "sf-printed": ("SF as printed (+τe, Γ = 1), admittance", "sf", "admittance", True, False),
+    "sf-printed": ("SF with +τe, Γ = 1, admittance", "sf", "admittance", True, False),
     "sf-admittance": ("SF, admittance, no τe feedforward", "sf", "admittance", False, True),
     "sf": (f"SF, unified n = {SHARE}", "sf", "unified", False, True),
     "of": (f"OF, unified n = {SHARE}", "of", "unified", False, True),
@@ -187,7 +189,7 @@ def long_run(sc: ac.PandaTable, rule: dict[str, Any], T: float) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--arm", type=str, default=None, help="URDF of the arm (default: Panda)")
-    parser.add_argument("--T", type=float, default=1.0 if QUICK else 20.0, help="duration (s)")
+    parser.add_argument("--T", type=float, default=2.5 if QUICK else 20.0, help="duration (s)")
     parser.add_argument("--json", type=str, default=None, help="write the table as JSON here")
     parser.add_argument("--friction", type=float, default=0.1, help="sliding friction")
     parser.add_argument("--spring", type=float, default=None, help="table spring k_e (N/m)")

@@ -524,7 +524,6 @@ class CartesianController:
                     f,
                     core.last("error"),
                 ),
-                strict=True,
             ):
                 self.log[key].append(np.array(v, dtype=np.float64))
         self._k += 1

@@ -153,6 +153,15 @@ class PandaTable:
     p0: FloatArray = field(init=False)
 
     def __post_init__(self) -> None:
+        for name in ("t_hold", "t_press"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise ConfigError(f"{name} must be a finite number ≥ 0 (s), got {v!r}")
+        if self.t_hold > 0 and self.t_hold >= self.t_approach:
+            raise ConfigError(
+                f"t_hold must end before the approach does (t_hold < t_approach), got "
+                f"t_hold = {self.t_hold!r} and t_approach = {self.t_approach!r}"
+            )
         self.p0 = self.fk(self.q0)
 
     @property

@@ -464,7 +464,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     ///
     /// (the z1 terms, τe and the networks for the learning laws only; d the
     /// inertia scales of SPEC (10.2)), with the regressors α = n α1 + (1 −
-    /// n) q̇_c, α̇ = n α̇1 + (1 − n) q̈_c and the input n [q; v] + (1 − n)
+    /// n) q̇_c, α̇ = q̈_c + n (α̇1 − ẍd) and the input n [q; v] + (1 − n)
     /// [q_c; q̇_c], where z1_c, z2_c are (6), (8) on the commanded reference
     /// and Π is (19.3); the networks learn from the paper's z2 on the
     /// compliant reference. With n = 1 it is [`step`](Self::step) (the same

@@ -480,3 +480,24 @@ def test_an_arm_three_times_the_ur10_holds_the_table(tmp_path: Path) -> None:
     assert m["force_chatter_N"] < 0.05 * m["force_target_N"]
     assert m["track_mm"] < 1.0
     assert m["peak_tau_ratio"] <= 2.0
+
+
+def test_example_13_s_table_does_not_depend_on_its_threads(tmp_path: Path) -> None:
+    """The rows run at once on threads (--jobs); the table is the same to the bit
+    on one thread, and --jobs 0 is refused by name."""
+    env = dict(os.environ, MPLBACKEND="Agg")
+    tables = []
+    for jobs in ("1", "3"):
+        out = tmp_path / f"table{jobs}.json"
+        args = [sys.executable, str(EXAMPLE), "--T", "2.5", "--rows", "pd,sf,ct"]
+        args += ["--jobs", jobs, "--json", str(out)]
+        run = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600)
+        assert run.returncode == 0, run.stderr
+        assert "3 rows in " in run.stdout
+        tables.append(out.read_text())
+    assert tables[0] == tables[1]
+    assert json.loads(tables[0])["sf"]["contact_lost_s"] == 0.0
+    args = [sys.executable, str(EXAMPLE), "--jobs", "0"]
+    run = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600)
+    assert run.returncode == 2
+    assert "--jobs must be ≥ 1, got 0" in run.stderr

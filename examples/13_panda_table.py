@@ -46,7 +46,7 @@ share of steps that saturate.
     python examples/13_panda_table.py                      # the Panda, T = 20 s, the table
     python examples/13_panda_table.py --friction 0         # a frictionless table
     python examples/13_panda_table.py --spring 5000        # a table on a 5 kN/m spring
-    python examples/13_panda_table.py --arm ur5_robot.urdf --json ur5.json
+    python examples/13_panda_table.py --arm path/to/ur5_robot.urdf --json ur5.json
     python examples/13_panda_table.py --figure             # docs/figures/contact_force.png
     python examples/13_panda_table.py --long 120           # and a long SF run, weight norms
     python examples/13_panda_table.py --jobs 1             # the rows one after another
@@ -64,6 +64,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -213,7 +214,27 @@ def main() -> None:
     args = parser.parse_args()
     if args.jobs < 1:
         parser.error(f"--jobs must be ≥ 1, got {args.jobs}")
-    sc = act.arm_table(args.arm, spring=args.spring, friction=args.friction)
+    if not (math.isfinite(args.T) and args.T > 0):
+        parser.error(f"--T must be a finite number > 0 (s), got {args.T}")
+    if not (math.isfinite(args.long) and args.long >= 0 and args.long % 10 == 0):
+        parser.error(
+            f"--long must be 0 or a multiple of 10 s (it runs in parts of 10 s), got {args.long}"
+        )
+    names = args.rows.split(",")
+    unknown = [n for n in names if n not in ROWS]
+    if unknown:
+        parser.error(f"--rows: unknown {unknown}; the rows are {list(ROWS)}")
+    if args.json and not Path(args.json).resolve().parent.is_dir():
+        parser.error(f"--json: no directory {Path(args.json).resolve().parent}")
+    try:
+        sc = act.arm_table(args.arm, spring=args.spring, friction=args.friction)
+    except (adaptimp.ConfigError, ValueError, OSError) as e:
+        parser.error(str(e))
+    if sc.t_approach + sc.t_press >= args.T:
+        parser.error(
+            f"--T must be longer than the approach, which ends with the tool pressed in at "
+            f"t = {sc.t_approach + sc.t_press:g} s; got {args.T:g}"
+        )
     rule = act.rule_keywords(sc)
     print(
         f"{args.arm or 'Panda'}: {sc.radius * 100:g} cm circle at {sc.freq:g} Hz about "
@@ -229,10 +250,6 @@ def main() -> None:
     )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     table: dict[str, dict[str, float]] = {}
-    names = args.rows.split(",")
-    unknown = [n for n in names if n not in ROWS]
-    if unknown:
-        parser.error(f"--rows: unknown {unknown}; the rows are {list(ROWS)}")
 
     def timed(name: str) -> tuple[dict[str, float] | None, float, str]:
         """One row: its metrics (None if it diverged), its own time (s), the error."""

@@ -128,7 +128,7 @@ def test_the_scenario_on_the_ur5_is_placed_from_its_reach() -> None:
 def test_example_13_writes_the_table_as_json(tmp_path: Path) -> None:
     out = tmp_path / "table.json"
     env = dict(os.environ, MPLBACKEND="Agg")
-    args = [sys.executable, str(EXAMPLE), "--T", "0.4", "--rows", "pd,ct", "--json", str(out)]
+    args = [sys.executable, str(EXAMPLE), "--T", "2", "--rows", "pd,ct", "--json", str(out)]
     run = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600, check=False)
     assert run.returncode == 0, run.stderr
     table = json.loads(out.read_text())
@@ -501,3 +501,56 @@ def test_example_13_s_table_does_not_depend_on_its_threads(tmp_path: Path) -> No
     run = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600)
     assert run.returncode == 2
     assert "--jobs must be ≥ 1, got 0" in run.stderr
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"radius": True}, r"^radius must be a finite number > 0 \(m\), got True$"),
+        ({"fix": "shoulder_pan_joint"}, r"^fix must be a tuple of joint names, got "),
+        ({"fix": ("nope",)}, r"^fix names joints the URDF does not have: \['nope'\]$"),
+        (
+            {"home": [1.0, -1.5, 10.0, 0.0, 0.0, 0.0]},
+            r"^home must lie within the joint limits; joint 2 \('elbow_joint'\) has home = 10\.0",
+        ),
+    ],
+)
+def test_the_ur5_scenario_refuses_by_name(kwargs: dict[str, Any], message: str) -> None:
+    with pytest.raises(adaptimp.ConfigError, match=message):
+        act.arm_table(_ur5(), **kwargs)
+
+
+def test_scenario_quantities_given_as_strings_are_numbers() -> None:
+    sc = act.arm_table(_ur5(), radius="0.05", Ts="1e-3", friction="0.1")
+    assert sc.radius == 0.05
+    assert sc.Ts == 1e-3
+    assert isinstance(sc.Ts, float)
+
+
+def test_example_13_refuses_a_run_shorter_than_its_approach() -> None:
+    args = [sys.executable, str(EXAMPLE), "--T", "1.5", "--rows", "ct"]
+    run = subprocess.run(args, capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 2
+    assert (
+        "--T must be longer than the approach, which ends with the tool pressed in at t = 1.8 s"
+        in run.stderr
+    )
+    for bad, what in (
+        (["--rows", "nope"], "--rows: unknown ['nope']"),
+        (["--long", "5"], "--long must be 0 or a multiple of 10 s"),
+    ):
+        run = subprocess.run(
+            [sys.executable, str(EXAMPLE), *bad],
+            capture_output=True,
+            text=True,
+            timeout=600,
+            check=False,
+        )
+        assert run.returncode == 2
+        assert what in run.stderr
+
+
+def test_the_rule_refuses_a_path_too_long_to_sample() -> None:
+    sc = act.arm_table(_ur5(), t_press=1e9)
+    with pytest.raises(adaptimp.ConfigError, match=r"beyond 1000000: give a shorter t_press"):
+        act.rule_keywords(sc)

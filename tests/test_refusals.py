@@ -118,10 +118,16 @@ def test_contact_metrics_of_a_run_without_rows_in_its_windows_is_refused() -> No
             match=f"^{re.escape(f'settle must be a finite number ≥ 0 (s), got {settle!r}')}$",
         ):
             act.contact_metrics(res, ctrl, sc, settle=settle)
-    # Long enough for both windows: every metric is a number.
+    # Long enough for both windows: every metric is a number, but for the time
+    # off the table after the approach, which this run never reaches: NaN.
     longer = amj.simulate(ctrl, amj.Plant(sc.model), T=0.2, q0=sc.q0)
     m = act.contact_metrics(longer, ctrl, sc, settle=0.1)
+    assert math.isnan(m.pop("contact_lost_s"))
     assert all(math.isfinite(v) for v in m.values()), m
+    # A run recorded every other period: the chatter is per sample, so refused.
+    sparse = amj.simulate(ctrl, amj.Plant(sc.model), T=0.4, q0=sc.q0, record_every=2)
+    with pytest.raises(adaptimp.ConfigError, match=r"record_every=1$"):
+        act.contact_metrics(sparse, ctrl, sc, settle=0.1)
 
 
 def _erd(*parts: str) -> str:

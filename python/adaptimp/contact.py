@@ -37,6 +37,7 @@ __all__ = [
     "AXIS_SHARE",
     "CLEARANCE",
     "CONTACT_K1",
+    "MAX_PATH_STEPS",
     "MIN_REACH_SHARE",
     "OUTWARD",
     "REACH_SHARE",
@@ -392,6 +393,7 @@ def placement(
     ``home`` or a limit that is not n finite numbers, and lo > hi.
     """
     _check_scenario(tool_radius=tool_radius, clearance=clearance)
+    tool_radius, clearance = float(tool_radius), float(clearance)
     q = _joint_vector("home", home, chain)
     unlimited = " (±π for an unlimited joint)"
     lo_given = _joint_vector("limits[0] (lo)", limits[0], chain, unlimited)
@@ -460,6 +462,26 @@ def _home(urdf: Path, chain: Chain, plant: Any) -> FloatArray:
     return np.zeros(chain.n)
 
 
+MAX_PATH_STEPS = 1_000_000
+"""The longest scenario path (periods) :func:`rule_keywords` samples: the hold,
+the approach, the press or ramp and one period of the circle (1000 s at 1 kHz);
+a longer one (a huge ``t_press`` or ``t_ramp``, a tiny ``freq``) is refused
+there, not by :func:`arm_table` (a press without a circle needs no rule)."""
+
+
+def _check_path_length(duration: float, Ts: float) -> None:
+    """Refuse a path whose one circle after the approach lasts beyond
+    :data:`MAX_PATH_STEPS` periods (a huge ``t_press`` or ``t_ramp``, a tiny
+    ``freq``): the rule samples it once, period by period."""
+    steps = duration / Ts
+    if not steps <= MAX_PATH_STEPS:
+        raise ConfigError(
+            f"the scenario's path (the approach, the press or ramp and one circle: "
+            f"{duration:.6g} s) is {steps:.3g} periods of Ts = {Ts:g} s, beyond "
+            f"{MAX_PATH_STEPS}: give a shorter t_press or t_ramp, or a higher freq"
+        )
+
+
 def _check_scenario(**values: float | None) -> None:
     """Refuse, by name, a scenario quantity that is not a finite number in its
     range (before any model is built)."""
@@ -482,7 +504,8 @@ def _check_scenario(**values: float | None) -> None:
             continue
         what, ok = ranges[name]
         try:
-            v = float(value)  # type: ignore[arg-type]
+            # A bool is not a quantity (True would be 1 m, 1 s, 1 N/m).
+            v = math.nan if isinstance(value, bool) else float(value)  # type: ignore[arg-type]
         except (TypeError, ValueError):
             v = math.nan
         if not (math.isfinite(v) and ok(v)):
@@ -540,7 +563,14 @@ def arm_table(
         tool_radius=tool_radius, Ts=Ts, t_approach=t_approach, t_ramp=t_ramp,
         t_hold=t_hold, t_press=t_press,
     )  # fmt: skip
+    # The checked values as numbers (a string that reads as one, a NumPy scalar).
+    friction, radius, freq, depth = float(friction), float(radius), float(freq), float(depth)
+    tool_radius, Ts, t_ramp = float(tool_radius), float(Ts), float(t_ramp)
+    spring = None if spring is None else float(spring)
     t_hold, t_press, t_approach = float(t_hold), float(t_press), float(t_approach)
+    given: object = fix  # typed a tuple; a caller may still pass a bare string
+    if not isinstance(given, (tuple, list)) or not all(isinstance(j, str) for j in given):
+        raise ConfigError(f"fix must be a tuple of joint names, got {fix!r}")
     if t_hold > 0 and t_hold >= t_approach:
         raise ConfigError(
             f"t_hold must end before the approach does (t_hold < t_approach), got "
@@ -591,7 +621,14 @@ def arm_table(
     # Pinocchio model (_models.arm_urdf): a gripper's, prismatic, mimic and
     # off-chain joints are fixed; by default the tool goes on the last arm
     # joint's link.
-    arm = _models.arm_urdf(path.read_text(), fix, tip=tip)
+    text = path.read_text()
+    import xml.etree.ElementTree as ET
+
+    names = {j.get("name") for j in ET.fromstring(text).iter("joint")}
+    unknown = [j for j in fix if j not in names]
+    if unknown:
+        raise ConfigError(f"fix names joints the URDF does not have: {unknown}")
+    arm = _models.arm_urdf(text, fix, tip=tip)
     tip = arm.tip if tip is None else tip
     fix = (*fix, *(j for j in arm.fixed if j not in fix))
     chain = Chain.from_urdf(path, tip=tip)
@@ -607,6 +644,14 @@ def arm_table(
             "driven joints, or fix the others"
         )
     q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
+    lo, hi = _limits(bare)
+    outside = np.flatnonzero((q0 < lo - 1e-12) | (q0 > hi + 1e-12))
+    if outside.size:
+        i = int(outside[0])
+        raise ConfigError(
+            f"home must lie within the joint limits; joint {i} ({chain.joint_names[i]!r}) "
+            f"has home = {float(q0[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
+        )
     tau_max = np.asarray(bare.tau_max, dtype=np.float64)
     _check_press(chain, bare, q0, tau_max, _NOMINAL_KD * depth, friction, tool_radius)
     clearance = max(CLEARANCE, SAG_MARGIN * sag(chain, bare, q0, tau_max, Ts=Ts))
@@ -734,6 +779,7 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
     from . import tuning
 
     start = sc.t_approach + max(sc.t_ramp, sc.t_press)
+    _check_path_length(start + 1.0 / sc.freq, sc.Ts)
     steps = round((start + 1.0 / sc.freq) / sc.Ts)
     rot = sc.chain.fk(sc.q0)[:3, :3]
     table = np.array(
@@ -780,7 +826,7 @@ def contact_metrics(
     - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
       after the end of the approach, when the commanded point has reached δ_c
       into the table (``t_approach + t_press``; all the time after it, if
-      none);
+      none; NaN for a run that ends before it);
     - ``peak_force_N``: max F_n over the whole run (N), the approach's impact
       included;
     - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
@@ -801,11 +847,17 @@ def contact_metrics(
     along = (log["pd"][after, :2] - np.asarray(res.x_ee)[after, :2]) * 1e3
     # The approach ends when the commanded point has reached δ_c (with a
     # soft landing, the press's end).
+    if t.size > 1 and not np.allclose(np.diff(t), sc.Ts, rtol=1e-9, atol=0.0):
+        raise ConfigError(
+            f"contact_metrics needs every period's row (Ts = {sc.Ts:g} s; the chatter is "
+            "sample to sample): run simulate with record_every=1"
+        )
     approach = t >= sc.t_approach + sc.t_press - 1e-9
     contact = np.flatnonzero(approach & (fn > 0))
-    # Never touched after the approach: all of that time is without contact.
+    # Never touched after the approach: all of that time is without contact. A
+    # run that ends before the approach does has no such time: NaN.
     start = contact[0] if contact.size else int(np.argmax(approach))
-    lost = float(np.sum(fn[start:] <= 0) * sc.Ts) if approach.any() else 0.0
+    lost = float(np.sum(fn[start:] <= 0) * sc.Ts) if approach.any() else math.nan
     return {
         "track_mm": m["rms_track"] * 1e3,
         "track_along_mm": float(np.sqrt(np.mean(np.sum(along**2, axis=1)))),

@@ -19,6 +19,7 @@ Units: m, m/s, m/s², rad, rad/s, rad/s², N, N m, kg, s.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -155,7 +156,8 @@ class PandaTable:
     def __post_init__(self) -> None:
         for name in ("t_hold", "t_press"):
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+            real = isinstance(v, numbers.Real) and not isinstance(v, bool)
+            if not (real and math.isfinite(v) and v >= 0):
                 raise ConfigError(f"{name} must be a finite number ≥ 0 (s), got {v!r}")
         if self.t_hold > 0 and self.t_hold >= self.t_approach:
             raise ConfigError(

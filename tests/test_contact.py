@@ -507,6 +507,8 @@ def test_example_13_s_table_does_not_depend_on_its_threads(tmp_path: Path) -> No
     ("kwargs", "message"),
     [
         ({"radius": True}, r"^radius must be a finite number > 0 \(m\), got True$"),
+        ({"radius": 0.25}, r"^radius must keep the circle and the tool on the table"),
+        ({"freq": 500.0}, r"^freq must lie below the sampling's 1/\(2 Ts\) = 500 Hz, got 500\.0$"),
         ({"fix": "shoulder_pan_joint"}, r"^fix must be a tuple of joint names, got "),
         ({"fix": ("nope",)}, r"^fix names joints the URDF does not have: \['nope'\]$"),
         (
@@ -554,3 +556,10 @@ def test_the_rule_refuses_a_path_too_long_to_sample() -> None:
     sc = act.arm_table(_ur5(), t_press=1e9)
     with pytest.raises(adaptimp.ConfigError, match=r"beyond 1000000: give a shorter t_press"):
         act.rule_keywords(sc)
+
+
+def test_the_panda_s_scenario_checks_the_press_too() -> None:
+    """The Panda's own table gets the check a URDF arm gets: a 1 m depth is a
+    500 N press that its wrist cannot hold."""
+    with pytest.raises(adaptimp.ConfigError, match=r"^the arm cannot press on the table: "):
+        act.arm_table(depth=1.0)

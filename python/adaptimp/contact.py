@@ -462,6 +462,10 @@ def _home(urdf: Path, chain: Chain, plant: Any) -> FloatArray:
     return np.zeros(chain.n)
 
 
+TABLE_OFFSET_MARGIN = 0.2
+"""The table (0.7 m deep) is centred 0.15 m beyond the circle's centre: the
+circle and the tool stay on it for radius + tool_radius ≤ 0.35 − 0.15 m."""
+
 MAX_PATH_STEPS = 1_000_000
 """The longest scenario path (periods) :func:`rule_keywords` samples: the hold,
 the approach, the press or ramp and one period of the circle (1000 s at 1 kHz);
@@ -568,6 +572,15 @@ def arm_table(
     tool_radius, Ts, t_ramp = float(tool_radius), float(Ts), float(t_ramp)
     spring = None if spring is None else float(spring)
     t_hold, t_press, t_approach = float(t_hold), float(t_press), float(t_approach)
+    if freq >= 0.5 / Ts:
+        raise ConfigError(
+            f"freq must lie below the sampling's 1/(2 Ts) = {0.5 / Ts:g} Hz, got {freq!r}"
+        )
+    if radius + tool_radius > TABLE_OFFSET_MARGIN:
+        raise ConfigError(
+            f"radius must keep the circle and the tool on the table (radius + tool_radius ≤ "
+            f"{TABLE_OFFSET_MARGIN:g} m), got radius = {radius!r}"
+        )
     given: object = fix  # typed a tuple; a caller may still pass a bare string
     if not isinstance(given, (tuple, list)) or not all(isinstance(j, str) for j in given):
         raise ConfigError(f"fix must be a tuple of joint names, got {fix!r}")
@@ -615,6 +628,8 @@ def arm_table(
         )
         sc.t_hold, sc.t_press = float(t_hold), float(t_press)
         sc.__post_init__()
+        plant = amj.Plant(sc.model)
+        _check_press(sc.chain, plant, sc.q0, sc.tau_max, _NOMINAL_KD * depth, friction, tool_radius)
         return sc
     path = Path(urdf)
     # The arm's joints by the one rule of adaptimp.mujoco.simulate and the

@@ -547,6 +547,15 @@ def arm_table(
     max(:data:`CLEARANCE`, :data:`SAG_MARGIN` · :func:`sag`) below the tool
     at home.
 
+    Refused with a ``ConfigError`` naming the argument (before anything is
+    built where it can be): a quantity that is not a finite number in its
+    range (a bool is not one; a string or NumPy number that reads as one is
+    taken as that number), ``t_hold`` ≥ ``t_approach``, ``freq`` ≥ 1/(2 Ts),
+    a circle that leaves the table (``radius`` + ``tool_radius`` > 0.2 m),
+    ``fix`` that is not a tuple of the URDF's joint names, a ``home``
+    outside the joint limits, and an arm that cannot hold gravity and the
+    press with its friction at home (the joint and both torques named).
+
     ``tip``: the tool's body (default: the child link of the arm's last joint).
     The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
     the rule of :func:`adaptimp.mujoco.from_urdf` (``_models.arm_urdf``, with

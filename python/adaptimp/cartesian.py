@@ -275,15 +275,26 @@ class CartesianImpedance:
         (centres (L, 4n), widths (4n,)) for ``adaptimp.Controller(centers=,
         widths=)``.
         """
+        q, dq = self.joint_orbit(path, T, samples=int(nodes), q0=q0)
+        centres, widths2 = _adaptimp.centres_along(q, dq, (float(tube[0]), float(tube[1])))
+        return centres, np.sqrt(widths2)
+
+    def joint_orbit(
+        self, path: Path, T: float, *, samples: int, q0: ArrayLike | None = None
+    ) -> tuple[FloatArray, FloatArray]:
+        """The joint reference (q_d, q̇_d) (rad, rad/s), each (``samples``, n), at
+        ``samples`` steps evenly in time of this outer loop run kinematically
+        (F_e = 0; its state unchanged) from ``q0`` (default the start's) along
+        ``path`` sampled at k·Ts for t < ``T`` (the core's orbit; ``samples`` =
+        round(T/Ts): every step)."""
         steps = round(T / self.Ts)
         if steps < 1:
             raise ConfigError(f"T must cover at least one step of {self.Ts:g} s, got {T}")
         R = self.chain.fk(self.q0 if q0 is None else q0)[:3, :3]
         table = np.array([_sample(path, k * self.Ts, R) for k in range(steps)])
         start = self.q0 if q0 is None else np.asarray(q0, dtype=np.float64)
-        q, dq = self._core.orbit(start, table, int(nodes))
-        centres, widths2 = _adaptimp.centres_along(q, dq, (float(tube[0]), float(tube[1])))
-        return centres, np.sqrt(widths2)
+        q, dq = self._core.orbit(start, table, samples)
+        return np.asarray(q, dtype=np.float64), np.asarray(dq, dtype=np.float64)
 
 
 class CartesianController:

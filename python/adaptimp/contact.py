@@ -339,23 +339,9 @@ def arm_model(
         if spring is not None:
             qpos.append(0.0)
         spec.add_key(name="home", qpos=qpos)
-    try:
-        model = spec.compile()
-    except ValueError as e:
-        # Inertias that do not compile as they are: bounded and balanced as
-        # adaptimp.mujoco.from_urdf does, and said as it says it.
-        spec.compiler.boundmass = 1e-6
-        spec.compiler.boundinertia = 1e-10
-        spec.compiler.balanceinertia = True
-        model = spec.compile()
-        import warnings
-
-        warnings.warn(
-            f"the URDF's inertias do not compile as they are ({e}); every body now has "
-            "at least 1e-6 kg and 1e-10 kg m², and inertias are balanced (the chain and "
-            "Pinocchio's model keep the URDF's)",
-            stacklevel=2,
-        )
+    # Inertias that do not compile as they are: bounded and balanced as
+    # adaptimp.mujoco.from_urdf does, and said as it says it.
+    model = amj._compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
         model.pair_solreffriction[0] = [
@@ -798,18 +784,13 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
     F_e = 0, taken as one period of that length), and K1 = min(:data:`CONTACT_K1`,
     the rule's (18.2)) (SPEC (19.6)). Returns ``gains`` (Kp, Kzeta, K1), ``basis`` (centres,
     widths) and the rest (gamma, sigma, weight_bound, kr, …) as keywords."""
-    from . import cartesian as ac
     from . import mujoco as amj
     from . import tuning
 
     start = sc.t_approach + max(sc.t_ramp, sc.t_press)
     _check_path_length(start + 1.0 / sc.freq, sc.Ts)
     steps = round((start + 1.0 / sc.freq) / sc.Ts)
-    rot = sc.chain.fk(sc.q0)[:3, :3]
-    table = np.array(
-        [ac._sample(lambda t: sc.path(t, depth=0.0), k * sc.Ts, rot) for k in range(steps)]
-    )
-    q, dq = sc.outer()._core.orbit(sc.q0, table, steps)
+    q, dq = sc.outer().joint_orbit(lambda t: sc.path(t, depth=0.0), steps * sc.Ts, samples=steps)
     ddq = np.gradient(dq, sc.Ts, axis=0)
 
     def path(t: float) -> tuple[Any, Any, Any]:

@@ -170,6 +170,29 @@ def _spec_of(urdf: str) -> Any:
     return spec
 
 
+def _compile_arm(spec: Any, note: str = "") -> mujoco.MjModel:
+    """``spec`` compiled; if a URDF's inertias do not compile as they are (a
+    massless moving link, an inertia that violates the triangle inequality),
+    compiled again with every body bounded and balanced (1e-6 kg, 1e-10 kg m²,
+    far below any real link), with a warning (``note`` added to it) pointing at
+    the caller of the function that called this one."""
+    try:
+        return spec.compile()
+    except ValueError as e:
+        spec.compiler.boundmass = 1e-6
+        spec.compiler.boundinertia = 1e-10
+        spec.compiler.balanceinertia = True
+        model = spec.compile()
+        import warnings
+
+        warnings.warn(
+            f"the URDF's inertias do not compile as they are ({e}); every body now has "
+            f"at least 1e-6 kg and 1e-10 kg m², and inertias are balanced{note}",
+            stacklevel=3,
+        )
+        return model
+
+
 EFFORT_ACCEL = 10.0
 """The acceleration (rad/s²) an estimated effort limit leaves beyond gravity
 (:func:`from_urdf`)."""
@@ -224,23 +247,7 @@ def from_urdf(
     spec.option.timestep = timestep
     missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
     _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
-    try:
-        model = spec.compile()
-    except ValueError as e:
-        # A massless moving link or an inertia that violates the triangle
-        # inequality: bound and balance them (1e-6 kg, 1e-10 kg m², far below
-        # any real link), and say so.
-        spec.compiler.boundmass = 1e-6
-        spec.compiler.boundinertia = 1e-10
-        spec.compiler.balanceinertia = True
-        model = spec.compile()
-        import warnings
-
-        warnings.warn(
-            f"the URDF's inertias do not compile as they are ({e}); every body now has "
-            "at least 1e-6 kg and 1e-10 kg m², and inertias are balanced",
-            stacklevel=2,
-        )
+    model = _compile_arm(spec)
     if missing:
         estimate = estimate_effort(model)
         for j, name in enumerate(arm.joints):

@@ -246,7 +246,8 @@ def simulate(
     progress : bool or callable
         ``True``: a progress bar (tqdm if installed, else a line on stderr)
         for runs longer than 2 s; a callable is called as ``progress(done,
-        total)`` about every 50 ms.
+        total)`` about every 50 ms, and once with ``done == total`` when
+        the run ends.
     fault : Fault, optional
         A fault injected over a window (:class:`adaptimp.Fault`: stale or NaN
         sensors, a force bias, weak actuators, skipped steps); refused steps

@@ -1583,7 +1583,7 @@ def simulate(
         Keep every k-th row (k ≥ 1); the metrics still see every step.
     progress : bool or callable
         ``True``: a progress bar for runs longer than 2 s; a callable is called
-        as ``progress(done, total)`` about every 50 ms.
+        as ``progress(done, total)`` about every 50 ms, and once when the run ends.
     fault : adaptimp.Fault, optional
         A fault injected over a window, as for :func:`adaptimp.simulate` (the
         actuators' τmax for ``"actuator_drop"``); needs the native loop.

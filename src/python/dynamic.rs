@@ -746,7 +746,8 @@ impl<const N: usize> Adapter<N> for Watch<'_> {
     ) -> Result<Vector<N>, Error> {
         let a = plant.advance(tau, h)?;
         self.done += 1;
-        if self.done.is_multiple_of(HOOK_EVERY) && !self.hooks.tick(self.done, self.total) {
+        let due = self.done.is_multiple_of(HOOK_EVERY) || self.done == self.total;
+        if due && !self.hooks.tick(self.done, self.total) {
             self.stopped = true;
             return Err(Error::Invalid {
                 what: "run",

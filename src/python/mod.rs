@@ -476,7 +476,9 @@ impl PyHooks {
 
 impl Hooks for PyHooks {
     fn tick(&mut self, done: u64, total: u64) -> bool {
-        if self.last.elapsed() < CHECK_EVERY {
+        // The last step is always reported (a progress bar ends at 100 %,
+        // however fast the run); the others at most every CHECK_EVERY.
+        if done < total && self.last.elapsed() < CHECK_EVERY {
             return true;
         }
         self.last = Instant::now();

@@ -4,6 +4,7 @@
 //! core's (`adaptimp::cartesian`); this converts and checks pointers, sizes
 //! and enum values.
 
+use crate::handles::{free, handle, handle_mut, publish, publish_at, release, Header};
 use crate::joint::{build_sized, copy_sized, fault_of, Buf, Place, St};
 use crate::*;
 use adaptimp::cartesian::rotation::quaternion_matrix;
@@ -210,32 +211,50 @@ impl AdaptimpCartesianCommand {
     };
 }
 
-/// An arm's kinematics: a serial chain of 1 … 7 movable joints (opaque).
-#[derive(Debug)]
+/// An arm's kinematics: a serial chain of 1 … 7 movable joints (opaque: a handle).
 pub struct AdaptimpChain {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpChain`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct ChainObject {
+    head: Header,
     inner: Chains,
 }
-handle!(AdaptimpChain, b"adpCHAIN");
+handle_kind!(AdaptimpChain => ChainObject, b"adpCHAIN");
 
 /// The 6-D Cartesian impedance over a chain and the joint controller it
-/// drives (opaque; immutable: share it between threads).
-#[derive(Debug)]
+/// drives (opaque: a handle; immutable: share it between threads).
 pub struct AdaptimpCartesian {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpCartesian`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct CartesianObject {
+    head: Header,
     inner: Carts,
 }
-handle!(AdaptimpCartesian, b"adpCARTE");
+handle_kind!(AdaptimpCartesian => CartesianObject, b"adpCARTE");
 
-/// The state of a Cartesian run (opaque): the outer loop's and the joint
-/// controller's.
-#[derive(Debug)]
+/// The state of a Cartesian run (opaque: a handle): the outer loop's and
+/// the joint controller's.
 pub struct AdaptimpCartesianState {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpCartesianState`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct CartesianStateObject {
+    head: Header,
     place: Place,
     states: CStates,
 }
-handle!(AdaptimpCartesianState, b"adpCSTAT");
+handle_kind!(AdaptimpCartesianState => CartesianStateObject, b"adpCSTAT");
 
 /// One Cartesian controller of N joints.
 #[derive(Debug)]
@@ -561,10 +580,10 @@ pub unsafe extern "C" fn adaptimp_chain_new(
             });
         }
         let inner = chain_of(&js, &tip)?;
-        *out = Box::into_raw(Box::new(AdaptimpChain {
-            tag: <AdaptimpChain as Handle>::TAG,
+        *out = publish(Box::new(ChainObject {
+            head: Header::unpublished(),
             inner,
-        }));
+        }))?;
         Ok(())
     })
 }
@@ -577,7 +596,7 @@ pub unsafe extern "C" fn adaptimp_chain_new(
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_chain_free(chain: *mut AdaptimpChain) {
     // SAFETY: the caller's contract.
-    unsafe { free_boxed(chain, "chain", |c| c.tag = 0) }
+    unsafe { free(chain, "chain") }
 }
 
 /// The chain's number of movable joints, or 0 for NULL or a dead handle.
@@ -844,10 +863,10 @@ pub unsafe extern "C" fn adaptimp_cartesian_new(
         let out = unsafe { crate::out(out, "out") }?;
         let cfg = cartesian_of(cart)?;
         let inner = cart_of(&chain.inner, cfg, joint)?;
-        *out = Box::into_raw(Box::new(AdaptimpCartesian {
-            tag: <AdaptimpCartesian as Handle>::TAG,
+        *out = publish(Box::new(CartesianObject {
+            head: Header::unpublished(),
             inner,
-        }));
+        }))?;
         Ok(())
     })
 }
@@ -860,7 +879,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_new(
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_cartesian_free(cart: *mut AdaptimpCartesian) {
     // SAFETY: the caller's contract.
-    unsafe { free_boxed(cart, "cart", |c| c.tag = 0) }
+    unsafe { free(cart, "cart") }
 }
 
 /// The number of joints, or 0 for NULL or a dead handle.
@@ -941,20 +960,20 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_new(
         let states = with_cart!(&c.inner, c => unsafe {
             cstate_over(c, n, q0, Buf::Heap(vec![0.0; c.pair.inner().buffer_len()]))
         })?;
-        *out = Box::into_raw(Box::new(AdaptimpCartesianState {
-            tag: <AdaptimpCartesianState as Handle>::TAG,
+        *out = publish(Box::new(CartesianStateObject {
+            head: Header::unpublished(),
             place: Place::Heap,
             states,
-        }));
+        }))?;
         Ok(())
     })
 }
 
 /// The header of a Cartesian state in a caller buffer, in bytes.
-const CSTATE_HEADER: usize = std::mem::size_of::<AdaptimpCartesianState>().next_multiple_of(8);
+const CSTATE_HEADER: usize = std::mem::size_of::<CartesianStateObject>().next_multiple_of(8);
 /// The alignment a caller buffer for a Cartesian state needs.
-const CSTATE_ALIGN: usize = if std::mem::align_of::<AdaptimpCartesianState>() > 8 {
-    std::mem::align_of::<AdaptimpCartesianState>()
+const CSTATE_ALIGN: usize = if std::mem::align_of::<CartesianStateObject>() > 8 {
+    std::mem::align_of::<CartesianStateObject>()
 } else {
     8
 };
@@ -1034,13 +1053,19 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_init(
             std::ptr::write_bytes(data, 0, reals);
             let data: &'static mut [f64] = std::slice::from_raw_parts_mut(data, reals);
             let states = with_cart!(&c.inner, c => cstate_over(c, n, q0, Buf::Caller(data)))?;
-            let p = buf.cast::<AdaptimpCartesianState>();
-            p.write(AdaptimpCartesianState {
-                tag: <AdaptimpCartesianState as Handle>::TAG,
+            let p = buf.cast::<CartesianStateObject>();
+            p.write(CartesianStateObject {
+                head: Header::unpublished(),
                 place: Place::Caller,
                 states,
             });
-            *out = p;
+            match publish_at::<AdaptimpCartesianState>(p) {
+                Ok(h) => *out = h,
+                Err(status) => {
+                    p.drop_in_place();
+                    return Err(status);
+                }
+            }
         }
         Ok(())
     })
@@ -1053,14 +1078,17 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_init(
 /// `state` is NULL or came from `adaptimp_cartesian_state_new` or `_init`.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_cartesian_state_free(state: *mut AdaptimpCartesianState) {
-    // SAFETY (in `handle_mut`): checked for NULL and a live handle.
-    let Ok(s) = (unsafe { handle_mut(state, "state") }) else {
+    let Some(o) = release(state, "state") else {
         return;
     };
-    s.tag = 0;
-    if s.place == Place::Heap {
-        // SAFETY: a live heap state came from Box::into_raw; freed once.
-        drop(unsafe { Box::from_raw(state) });
+    // SAFETY: as in `adaptimp_state_free`: a heap one came from `publish`,
+    // one in a caller's buffer is dropped in place.
+    unsafe {
+        if (*o).place == Place::Heap {
+            drop(Box::from_raw(o));
+        } else {
+            o.drop_in_place();
+        }
     }
 }
 

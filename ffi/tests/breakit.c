@@ -35,6 +35,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -942,6 +944,355 @@ static void cartesian(void) {
     }
 }
 
+/* ---- Forged handles at every entry point. ---- */
+
+/* The live handles of one world; every entry point is called with one of its
+   handle arguments replaced by a bad one, the others live. */
+typedef struct {
+    AdaptimpController *ctrl;
+    AdaptimpState *state;
+    AdaptimpChain *chain;
+    AdaptimpCartesian *cart;
+    AdaptimpCartesianState *cstate;
+} World;
+
+enum { KIND_CTRL, KIND_STATE, KIND_CHAIN, KIND_CART, KIND_CSTATE, NKINDS };
+static const char *KIND_NAMES[NKINDS] = {"controller", "state", "chain", "Cartesian",
+                                         "Cartesian state"};
+
+static void open_world(World *w) {
+    AdaptimpParams p = robot(ADAPTIMP_LAW_STATE_FEEDBACK);
+    if (adaptimp_controller_new(&p, &w->ctrl) != ADAPTIMP_STATUS_OK ||
+        adaptimp_state_new(w->ctrl, &w->state) != ADAPTIMP_STATUS_OK)
+        abort();
+    AdaptimpJoint j[4];
+    AdaptimpTransform tip;
+    arm(j, &tip);
+    if (adaptimp_chain_new(j, 4, &tip, &w->chain) != ADAPTIMP_STATUS_OK) abort();
+    AdaptimpCartesianParams cp;
+    if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+    Cart c;
+    if (open_cart(&cp, &c) != ADAPTIMP_STATUS_OK) abort();
+    w->cart = c.cart;
+    w->cstate = c.state;
+}
+
+static void close_world(World *w) {
+    adaptimp_cartesian_state_free(w->cstate);
+    adaptimp_cartesian_free(w->cart);
+    adaptimp_chain_free(w->chain);
+    adaptimp_state_free(w->state);
+    adaptimp_controller_free(w->ctrl);
+}
+
+/* The live handle of `kind` in `w`. */
+static void *live_of(const World *w, int kind) {
+    switch (kind) {
+    case KIND_CTRL: return w->ctrl;
+    case KIND_STATE: return w->state;
+    case KIND_CHAIN: return w->chain;
+    case KIND_CART: return w->cart;
+    default: return w->cstate;
+    }
+}
+
+/* Each entry point and the kinds of its handle arguments (-1: none). */
+typedef struct {
+    const char *name;
+    int kinds[2];
+} Entry;
+
+static const Entry ENTRIES[] = {
+    {"adaptimp_controller_joints", {KIND_CTRL, -1}},
+    {"adaptimp_controller_period", {KIND_CTRL, -1}},
+    {"adaptimp_state_new", {KIND_CTRL, -1}},
+    {"adaptimp_state_buffer_size", {KIND_CTRL, -1}},
+    {"adaptimp_state_init", {KIND_CTRL, -1}},
+    {"adaptimp_state_reset", {KIND_STATE, -1}},
+    {"adaptimp_state_fault", {KIND_STATE, -1}},
+    {"adaptimp_state_clear_fault", {KIND_STATE, -1}},
+    {"adaptimp_state_steps", {KIND_STATE, -1}},
+    {"adaptimp_state_applied", {KIND_STATE, -1}},
+    {"adaptimp_state_snapshot_len", {KIND_STATE, -1}},
+    {"adaptimp_state_save", {KIND_STATE, -1}},
+    {"adaptimp_state_restore", {KIND_CTRL, KIND_STATE}},
+    {"adaptimp_step", {KIND_CTRL, KIND_STATE}},
+    {"adaptimp_chain_joints", {KIND_CHAIN, -1}},
+    {"adaptimp_chain_tip", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_new", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_orbit_centres", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_joints", {KIND_CART, -1}},
+    {"adaptimp_cartesian_period", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_new", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_buffer_size", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_init", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_reset", {KIND_CART, KIND_CSTATE}},
+    {"adaptimp_cartesian_set_stiffness", {KIND_CART, KIND_CSTATE}},
+    {"adaptimp_cartesian_step", {KIND_CART, KIND_CSTATE}},
+    {"adaptimp_cartesian_set_posture", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_state_fault", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_state_clear_fault", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_state_steps", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_state_applied", {KIND_CSTATE, -1}},
+    /* The frees last: a bad handle is ignored, the live ones stay live. */
+    {"adaptimp_controller_free", {KIND_CTRL, -1}},
+    {"adaptimp_state_free", {KIND_STATE, -1}},
+    {"adaptimp_chain_free", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_free", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_free", {KIND_CSTATE, -1}},
+};
+enum { NENTRIES = sizeof ENTRIES / sizeof ENTRIES[0] };
+
+/* Call entry `e` with the handle of `kind` h[kind] (the others as given):
+   1 if it refused as it must (BAD_HANDLE or NULL_POINTER, a getter's "none"
+   value, outputs untouched or zeroed as documented), 0 otherwise; *status the
+   status (OK for the void and value-returning ones that refused). */
+static int call_entry(int e, void *h[NKINDS], AdaptimpStatus *status) {
+    AdaptimpController *ctrl = h[KIND_CTRL];
+    AdaptimpState *state = h[KIND_STATE];
+    AdaptimpChain *chain = h[KIND_CHAIN];
+    AdaptimpCartesian *cart = h[KIND_CART];
+    AdaptimpCartesianState *cstate = h[KIND_CSTATE];
+    static const double q3[3] = {0.1, 0.05, -0.2}, zero6[6] = {0}, kd[3] = {100, 100, 100};
+    double q2[2], dq2[2], te2[2];
+    inputs(0, q2, dq2, te2);
+    double buf[16] = {0};
+    static uint64_t mem[1 << 14];
+    size_t size = 7, align = 7, written = 7;
+    uint64_t step = 77;
+    const char *name = ENTRIES[e].name;
+    AdaptimpStatus s = ADAPTIMP_STATUS_OK;
+    int ok = 1;
+    /* A refusal of a handle: BAD_HANDLE, or NULL_POINTER for NULL. */
+#define REFUSED(st) ((st) == ADAPTIMP_STATUS_BAD_HANDLE || (st) == ADAPTIMP_STATUS_NULL_POINTER)
+    if (!strcmp(name, "adaptimp_controller_joints")) {
+        ok = adaptimp_controller_joints(ctrl) == 0;
+    } else if (!strcmp(name, "adaptimp_controller_period")) {
+        ok = isnan(adaptimp_controller_period(ctrl));
+    } else if (!strcmp(name, "adaptimp_state_new")) {
+        AdaptimpState *o = NULL;
+        s = adaptimp_state_new(ctrl, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_state_buffer_size")) {
+        s = adaptimp_state_buffer_size(ctrl, &size, &align);
+        ok = REFUSED(s) && size == 7 && align == 7;
+    } else if (!strcmp(name, "adaptimp_state_init")) {
+        AdaptimpState *o = NULL;
+        s = adaptimp_state_init(ctrl, mem, sizeof mem, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_state_reset")) {
+        s = adaptimp_state_reset(state);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_state_fault")) {
+        ok = !adaptimp_state_fault(state, &step) && step == 77;
+    } else if (!strcmp(name, "adaptimp_state_clear_fault")) {
+        s = adaptimp_state_clear_fault(state);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_state_steps")) {
+        ok = adaptimp_state_steps(state) == 0;
+    } else if (!strcmp(name, "adaptimp_state_applied")) {
+        double tau[2] = {7, 7};
+        s = adaptimp_state_applied(state, 2, tau);
+        ok = REFUSED(s) && tau[0] == 7 && tau[1] == 7;
+    } else if (!strcmp(name, "adaptimp_state_snapshot_len")) {
+        ok = adaptimp_state_snapshot_len(state) == 0;
+    } else if (!strcmp(name, "adaptimp_state_save")) {
+        s = adaptimp_state_save(state, buf, 16, &written);
+        ok = REFUSED(s) && written == 7 && buf[0] == 0;
+    } else if (!strcmp(name, "adaptimp_state_restore")) {
+        s = adaptimp_state_restore(ctrl, state, buf, 16);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_step")) {
+        AdaptimpCommand c;
+        memset(&c, 0xAB, sizeof c);
+        s = adaptimp_step(ctrl, state, 2, q2, dq2, te2, NULL, &c);
+        ok = REFUSED(s) && c.n == 0 && c.tau_sat[0] == 0.0;
+    } else if (!strcmp(name, "adaptimp_chain_joints")) {
+        ok = adaptimp_chain_joints(chain) == 0;
+    } else if (!strcmp(name, "adaptimp_chain_tip")) {
+        AdaptimpTip t;
+        memset(&t, 0xAB, sizeof t);
+        s = adaptimp_chain_tip(chain, 3, q3, NULL, &t);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_new")) {
+        AdaptimpCartesianParams cp;
+        if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+        AdaptimpParams p;
+        if (adaptimp_params_default(&p, 3, ADAPTIMP_LAW_PD, ADAPTIMP_PRESET_ROBOT) !=
+            ADAPTIMP_STATUS_OK)
+            abort();
+        p.impedance = ADAPTIMP_IMPEDANCE_EXTERNAL;
+        AdaptimpCartesian *o = NULL;
+        s = adaptimp_cartesian_new(chain, &cp, &p, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_cartesian_orbit_centres")) {
+        AdaptimpCartesianParams cp;
+        if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+        AdaptimpPoseTarget t = start_target();
+        const double tube[2] = {0.05, 0.2};
+        double centres[4 * 12], w2[12];
+        s = adaptimp_cartesian_orbit_centres(chain, &cp, 1e-3, 3, q3, &t, 1, 4, tube, centres, w2,
+                                             &written);
+        ok = REFUSED(s) && written == 7;
+    } else if (!strcmp(name, "adaptimp_cartesian_joints")) {
+        ok = adaptimp_cartesian_joints(cart) == 0;
+    } else if (!strcmp(name, "adaptimp_cartesian_period")) {
+        ok = isnan(adaptimp_cartesian_period(cart));
+    } else if (!strcmp(name, "adaptimp_cartesian_state_new")) {
+        AdaptimpCartesianState *o = NULL;
+        s = adaptimp_cartesian_state_new(cart, 3, q3, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_buffer_size")) {
+        s = adaptimp_cartesian_state_buffer_size(cart, &size, &align);
+        ok = REFUSED(s) && size == 7 && align == 7;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_init")) {
+        AdaptimpCartesianState *o = NULL;
+        s = adaptimp_cartesian_state_init(cart, 3, q3, mem, sizeof mem, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_reset")) {
+        s = adaptimp_cartesian_state_reset(cart, cstate, 3, NULL);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_set_stiffness")) {
+        s = adaptimp_cartesian_set_stiffness(cart, cstate, kd, kd);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_step")) {
+        AdaptimpCartesianCommand c;
+        memset(&c, 0xAB, sizeof c);
+        s = adaptimp_cartesian_step(cart, cstate, 3, q3, q3, zero6, NULL, &c);
+        ok = REFUSED(s) && c.n == 0 && c.tau_sat[0] == 0.0;
+    } else if (!strcmp(name, "adaptimp_cartesian_set_posture")) {
+        s = adaptimp_cartesian_set_posture(cstate, 3, q3);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_state_fault")) {
+        ok = !adaptimp_cartesian_state_fault(cstate, &step) && step == 77;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_clear_fault")) {
+        s = adaptimp_cartesian_state_clear_fault(cstate);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_state_steps")) {
+        ok = adaptimp_cartesian_state_steps(cstate) == 0;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_applied")) {
+        double tau[3] = {7, 7, 7};
+        s = adaptimp_cartesian_state_applied(cstate, 3, tau);
+        ok = REFUSED(s) && tau[0] == 7;
+    } else if (!strcmp(name, "adaptimp_controller_free")) {
+        adaptimp_controller_free(ctrl);
+    } else if (!strcmp(name, "adaptimp_state_free")) {
+        adaptimp_state_free(state);
+    } else if (!strcmp(name, "adaptimp_chain_free")) {
+        adaptimp_chain_free(chain);
+    } else if (!strcmp(name, "adaptimp_cartesian_free")) {
+        adaptimp_cartesian_free(cart);
+    } else if (!strcmp(name, "adaptimp_cartesian_state_free")) {
+        adaptimp_cartesian_state_free(cstate);
+    } else {
+        abort();
+    }
+#undef REFUSED
+    /* A status-returning call names the bad argument in its message. */
+    if (s != ADAPTIMP_STATUS_OK) {
+        const char *msg = adaptimp_last_error();
+        ok = ok && (strstr(msg, "not a live") || strstr(msg, "is a live") || strstr(msg, "is NULL"));
+    }
+    *status = s;
+    return ok;
+}
+
+/* The world still works: each live handle answers, and the two states were
+   not stepped by anything but this check. */
+static int world_intact(const World *w, uint64_t steps, uint64_t csteps) {
+    return adaptimp_controller_joints(w->ctrl) == 2 && adaptimp_state_steps(w->state) == steps &&
+           adaptimp_chain_joints(w->chain) == 3 && adaptimp_cartesian_joints(w->cart) == 3 &&
+           adaptimp_cartesian_state_steps(w->cstate) == csteps;
+}
+
+static void forged(void) {
+    World w;
+    open_world(&w);
+    /* Freed handles of each kind: made, freed (the next handles may reuse
+       their memory: a stale one must not reach the new object). */
+    World dead;
+    open_world(&dead);
+    close_world(&dead);
+    World after; /* made after the frees: the memory of the dead ones */
+    open_world(&after);
+    /* Memory a foreign pointer may point to: 8 readable bytes before an
+       unmapped page, zeroed memory, memory that looks like a handle's tag,
+       small integers and unmapped addresses, a live handle's number + 1. */
+    const long page = sysconf(_SC_PAGESIZE);
+    const int zero_fd = open("/dev/zero", O_RDWR); /* POSIX: no MAP_ANONYMOUS in 2008 */
+    unsigned char *pages =
+        mmap(NULL, 2 * (size_t)page, PROT_READ | PROT_WRITE, MAP_PRIVATE, zero_fd, 0);
+    if (pages == MAP_FAILED || munmap(pages + page, (size_t)page) != 0) abort();
+    close(zero_fd);
+    memset(pages, 0, (size_t)page);
+    static uint64_t zeros[512];
+    static uint64_t looks[4];
+    memcpy(&looks[0], "adpSTATE", 8);
+    enum { NFORGED = 8 };
+    void *foreign[NFORGED] = {pages + page - 8, pages + page - 64, zeros, looks,
+                              (void *)(uintptr_t)0x1000, (void *)(uintptr_t)1,
+                              (void *)(uintptr_t)(UINTPTR_MAX - 7), NULL};
+    static const char *foreign_names[NFORGED] = {
+        "8 bytes before an unmapped page", "64 bytes before an unmapped page", "zeroed memory",
+        "memory that looks like a state",  "address 0x1000", "address 1", "the top address",
+        "a live handle's number + 1"};
+    char what[200];
+    for (int e = 0; e < NENTRIES; e++) {
+        for (int a = 0; a < 2; a++) {
+            const int kind = ENTRIES[e].kinds[a];
+            if (kind < 0) continue;
+            /* The bad values for this argument: NULL, the freed handle of its
+               kind, a live handle of each other kind, each foreign pointer. */
+            void *bad[2 + NKINDS + NFORGED];
+            const char *bad_names[2 + NKINDS + NFORGED];
+            char other_names[NKINDS][64];
+            int nbad = 0;
+            bad[nbad] = NULL;
+            bad_names[nbad++] = "NULL";
+            bad[nbad] = live_of(&dead, kind);
+            bad_names[nbad++] = "freed (its memory reused)";
+            for (int k = 0; k < NKINDS; k++) {
+                if (k == kind) continue;
+                snprintf(other_names[k], sizeof other_names[k], "a live %s", KIND_NAMES[k]);
+                bad[nbad] = live_of(&w, k);
+                bad_names[nbad++] = other_names[k];
+            }
+            foreign[NFORGED - 1] = (void *)((uintptr_t)live_of(&w, kind) + 1);
+            for (int f = 0; f < NFORGED; f++) {
+                bad[nbad] = foreign[f];
+                bad_names[nbad++] = foreign_names[f];
+            }
+            for (int b = 0; b < nbad; b++) {
+                void *h[NKINDS];
+                for (int k = 0; k < NKINDS; k++) h[k] = live_of(&w, k);
+                h[kind] = bad[b];
+                AdaptimpStatus s;
+                int ok = call_entry(e, h, &s);
+                ok = ok && world_intact(&w, 0, 0) && world_intact(&after, 0, 0);
+                snprintf(what, sizeof what, "%s, %s argument: %s", ENTRIES[e].name,
+                         KIND_NAMES[kind], bad_names[b]);
+                T.cases++;
+                if (!ok) {
+                    T.wrong++;
+                    note("%s: not refused as it must be (%s)", what, adaptimp_last_error());
+                } else {
+                    T.clear++;
+                }
+            }
+        }
+    }
+    /* The live ones still step. */
+    double q[2], dq[2], te[2];
+    inputs(0, q, dq, te);
+    AdaptimpCommand c;
+    const AdaptimpStatus s = adaptimp_step(w.ctrl, w.state, 2, q, dq, te, NULL, &c);
+    outcome("the live world steps after every forged call", ACCEPT, s,
+            c.n == 2 && world_intact(&w, 1, 0));
+    munmap(pages, (size_t)page);
+    close_world(&after);
+    close_world(&w);
+}
+
 /* ---- The driver. ---- */
 
 typedef struct {
@@ -952,6 +1303,7 @@ typedef struct {
 static const Category CATEGORIES[] = {
     {"parameters", construction}, {"steps and fallbacks", steps}, {"snapshots", snapshots},
     {"handles and buffers", handles}, {"chains", chains},        {"Cartesian", cartesian},
+    {"forged handles", forged},
 };
 
 int main(void) {

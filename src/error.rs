@@ -244,6 +244,26 @@ pub(crate) mod check {
         }
     }
 
+    /// Every element finite with `|v_i| ≤ bound`, else the named condition
+    /// naming the element and its value (not the margin).
+    pub fn at_most_each(
+        condition: &'static str,
+        what: &'static str,
+        v: &[f64],
+        bound: f64,
+    ) -> Result<(), Error> {
+        finite_slice(what, v)?;
+        match v.iter().position(|x| x.abs() > bound) {
+            Some(i) => Err(Error::Condition {
+                condition,
+                lhs: what,
+                index: Some(i),
+                value: v[i],
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// Every element with `|v_i| ≤ bound` (NaN never is), else
     /// `Error::OutOfRange` (inputs and signals of a step).
     pub fn within(what: &'static str, v: &[f64], bound: f64) -> Result<(), Error> {
@@ -299,6 +319,17 @@ mod tests {
         assert!(s.contains("Kzeta"), "{s}");
         assert!(s.contains("[1]"), "{s}");
         assert!(s.contains("= -1"), "{s}");
+    }
+
+    #[test]
+    fn a_bound_names_the_value_not_the_margin() {
+        let e = check::at_most_each("|value| ≤ 1e9", "Kd", &[1.0, 1e10], PARAM_BOUND).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "condition |value| ≤ 1e9 is violated: Kd[1] = 10000000000 (SPEC §10)"
+        );
+        assert!(check::at_most_each("|value| ≤ 1e9", "Kd", &[-1e9, 1e9], PARAM_BOUND).is_ok());
+        assert!(check::at_most_each("|value| ≤ 1e9", "Kd", &[f64::NAN], PARAM_BOUND).is_err());
     }
 
     #[test]

@@ -709,11 +709,16 @@ enum AdaptimpStatus adaptimp_cartesian_state_reset(const struct AdaptimpCartesia
                                                    size_t n,
                                                    const double *q0);
 
-// The null-space posture (rad, `n` reals, finite) from the next step on.
+// The null-space posture (rad, `n` reals) of `state` under `cart` from
+// the next step on. The core checks it, as the step would need it:
+// finite, within the joint controller's `q_max` (at most 1e6 rad), and
+// null_k·|posture − q_d| ≤ 1e6 rad/s² (the ceiling of q̈_d) per joint;
+// else INVALID_CONFIG naming `posture` and the joint, nothing changed.
 //
 // # Safety
-// `state` is NULL or valid; `posture` NULL or holds `n` reals.
-enum AdaptimpStatus adaptimp_cartesian_set_posture(struct AdaptimpCartesianState *state,
+// `cart`, `state` NULL or valid; `posture` NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_cartesian_set_posture(const struct AdaptimpCartesian *cart,
+                                                   struct AdaptimpCartesianState *state,
                                                    size_t n,
                                                    const double *posture);
 

@@ -11,8 +11,8 @@ use adaptimp::cartesian::rotation::quaternion_matrix;
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
     AnyBasis, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
-    CartesianState, Centers, Chain, Formulation, Joint, JointKind, Kinematics, Law, PoseTarget,
-    Setpoint, Transform, Vector,
+    CartesianState, Centers, Chain, Formulation, Joint, JointKind, Law, PoseTarget, Setpoint,
+    Transform, Vector,
 };
 use core::ffi::c_void;
 use nalgebra::{Matrix3, UnitQuaternion};
@@ -656,7 +656,9 @@ unsafe fn tip_sized<const N: usize>(
         // SAFETY: the caller's contract.
         unsafe { joint_values::<N>(dq, "dq", Context::Step) }?
     };
-    let t = c.tip(&q, &dq);
+    let t = c
+        .tip_checked(&q, &dq)
+        .map_err(|e| core_error(e, Context::Step))?;
     out.n = N;
     out.position = a3(&t.position);
     out.rotation = rows3(t.rotation.matrix());
@@ -924,17 +926,10 @@ where
     check_n::<N>(n, "Cartesian controller")?;
     // SAFETY: the caller's contract.
     let q0 = unsafe { joint_values::<N>(q0, "q0", Context::Config) }?;
-    let inner = c
-        .pair
-        .inner()
-        .state_in(buf)
-        .map_err(|e| core_error(e, Context::Config))?;
-    Ok(CSt {
-        outer: c.pair.outer().start(q0),
-        inner,
-        q0,
-    }
-    .into_cstates())
+    let config = |e| core_error(e, Context::Config);
+    let outer = c.pair.start(&q0).map_err(config)?;
+    let inner = c.pair.inner().state_in(buf).map_err(config)?;
+    Ok(CSt { outer, inner, q0 }.into_cstates())
 }
 
 /// A state at t = 0 of `cart` into `*out`, on the heap (free it with
@@ -1128,41 +1123,54 @@ unsafe fn reset_sized<const N: usize>(
         unsafe { joint_values::<N>(q0, "q0", Context::Config) }?
     };
     let posture = s.outer.posture;
+    let outer = c
+        .pair
+        .start(&q0)
+        .map_err(|e| core_error(e, Context::Config))?;
     s.q0 = q0;
-    s.outer = c.pair.outer().start(q0);
+    s.outer = outer;
     s.outer.posture = posture;
     s.inner.reset();
     Ok(())
 }
 
-/// The null-space posture (rad, `n` reals, finite) from the next step on.
+/// The null-space posture (rad, `n` reals) of `state` under `cart` from
+/// the next step on. The core checks it, as the step would need it:
+/// finite, within the joint controller's `q_max` (at most 1e6 rad), and
+/// null_k·|posture − q_d| ≤ 1e6 rad/s² (the ceiling of q̈_d) per joint;
+/// else INVALID_CONFIG naming `posture` and the joint, nothing changed.
 ///
 /// # Safety
-/// `state` is NULL or valid; `posture` NULL or holds `n` reals.
+/// `cart`, `state` NULL or valid; `posture` NULL or holds `n` reals.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_cartesian_set_posture(
+    cart: *const AdaptimpCartesian,
     state: *mut AdaptimpCartesianState,
     n: usize,
     posture: *const f64,
 ) -> AdaptimpStatus {
     guard(|| {
         // SAFETY (in the helpers): checked; the caller's contract.
+        let c = unsafe { handle(cart, "cart") }?;
         let s = unsafe { handle_mut(state, "state") }?;
-        with_cstate!(&mut s.states, s => unsafe { posture_sized(s, n, posture) })
+        with_cpair!(&c.inner, &mut s.states, c, s => unsafe { posture_sized(c, s, n, posture) })
     })
 }
 
 /// # Safety
 /// `posture` NULL or holds `n` reals.
 unsafe fn posture_sized<const N: usize>(
+    c: &Cart<N>,
     s: &mut CSt<N>,
     n: usize,
     posture: *const f64,
 ) -> Result<(), AdaptimpStatus> {
     check_n::<N>(n, "state")?;
     // SAFETY: the caller's contract.
-    s.outer.posture = unsafe { joint_values::<N>(posture, "posture", Context::Config) }?;
-    Ok(())
+    let p = unsafe { joint_values::<N>(posture, "posture", Context::Config) }?;
+    c.pair
+        .set_posture(&mut s.outer, &p)
+        .map_err(|e| core_error(e, Context::Config))
 }
 
 /// Ask for the stiffness `kd` (3 reals, N/m) and `kd_rot` (3 reals, N m/rad):
@@ -1545,7 +1553,8 @@ unsafe fn orbit_sized<const N: usize>(
         dx: Vector::zeros(),
         ddx: Vector::zeros(),
     };
-    let mut samples = vec![zero; a.nodes];
+    // At most one sample a step (a huge `nodes` allocates no more).
+    let mut samples = vec![zero; a.nodes.min(a.targets.len()).max(1)];
     let l = outer
         .orbit(
             q0,

@@ -595,6 +595,7 @@ unsafe fn slice<'a, T>(p: *const T, len: usize, what: &str) -> Result<&'a [T], A
     if p.is_null() {
         return Err(null(what));
     }
+    addressable::<T>(len, what)?;
     // SAFETY: non-NULL; `len` valid elements is the caller's contract.
     Ok(unsafe { std::slice::from_raw_parts(p, len) })
 }
@@ -611,8 +612,21 @@ unsafe fn slice_mut<'a>(
     if p.is_null() {
         return Err(null(what));
     }
+    addressable::<f64>(len, what)?;
     // SAFETY: non-NULL; `len` valid, exclusive elements is the caller's contract.
     Ok(unsafe { std::slice::from_raw_parts_mut(p, len) })
+}
+
+/// `len` values of `T` fit in an address space (a slice of more is
+/// undefined behaviour even to make), else BadSize naming `what`.
+fn addressable<T>(len: usize, what: &str) -> Result<(), AdaptimpStatus> {
+    match len.checked_mul(std::mem::size_of::<T>()) {
+        Some(bytes) if bytes <= isize::MAX as usize => Ok(()),
+        _ => Err(fail(
+            AdaptimpStatus::BadSize,
+            &format_args!("{what}: {len} values are more than an address space holds"),
+        )),
+    }
 }
 
 fn null(what: &str) -> AdaptimpStatus {

@@ -944,6 +944,148 @@ static void cartesian(void) {
     }
 }
 
+/* ---- Issue 33: postures, starts, axes, rates, orbits. ---- */
+
+/* A Cartesian state steps (OK) k times from Q0 toward the start pose. */
+static int cart_steps_ok(const Cart *c, int k) {
+    const double dq[3] = {0}, w[6] = {0};
+    AdaptimpPoseTarget g = start_target();
+    AdaptimpCartesianCommand o;
+    for (int i = 0; i < k; i++)
+        if (adaptimp_cartesian_step(c->cart, c->state, 3, Q0, dq, w, &g, &o) != ADAPTIMP_STATUS_OK ||
+            !finite_all(o.tau_sat, 3))
+            return 0;
+    return 1;
+}
+
+static void postures(void) {
+    char what[160];
+    AdaptimpCartesianParams cp;
+    if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+    /* A posture: refused when given if far out of range (then every step
+       used to be refused), accepted otherwise; either way the loop steps. */
+    const double far[] = {1e7, -1e7, 2e6, 1e6 + 1, 1e5, 4.1e4, 1e4, 10.0, 0.0};
+    for (size_t f = 0; f < sizeof far / sizeof far[0]; f++) {
+        for (int j = 0; j < 3; j++) {
+            Cart c;
+            if (open_cart(&cp, &c) != ADAPTIMP_STATUS_OK) abort();
+            double p[3] = {Q0[0], Q0[1], Q0[2]};
+            p[j] = far[f];
+            const AdaptimpStatus s = adaptimp_cartesian_set_posture(c.cart, c.state, 3, p);
+            /* null_k = 25: a pull beyond 1e6 rad/s² is refused. */
+            const int bad = 25.0 * fabs(far[f] - Q0[j]) > 1e6;
+            snprintf(what, sizeof what, "set_posture[%d] = %g", j, far[f]);
+            outcome(what, bad ? REFUSE : ACCEPT, s,
+                    (s == ADAPTIMP_STATUS_OK || s == ADAPTIMP_STATUS_INVALID_CONFIG) &&
+                        cart_steps_ok(&c, 10));
+            close_cart(&c);
+        }
+    }
+    /* A start: within 1e6 rad accepted (the step decides), beyond refused. */
+    for (int b = 0; b < NBAD; b++) {
+        Cart c;
+        if (open_cart(&cp, &c) != ADAPTIMP_STATUS_OK) abort();
+        double q0[3] = {Q0[0], BAD[b], Q0[2]};
+        AdaptimpCartesianState *st = NULL;
+        AdaptimpStatus s = adaptimp_cartesian_state_new(c.cart, 3, q0, &st);
+        snprintf(what, sizeof what, "cartesian_state_new q0[1] = %g", BAD[b]);
+        const int bad = !isfinite(BAD[b]) || fabs(BAD[b]) > 1e6;
+        outcome(what, bad ? REFUSE : ACCEPT, s, (s == ADAPTIMP_STATUS_OK) == (st != NULL));
+        adaptimp_cartesian_state_free(st);
+        s = adaptimp_cartesian_state_reset(c.cart, c.state, 3, q0);
+        snprintf(what, sizeof what, "cartesian_state_reset q0[1] = %g", BAD[b]);
+        outcome(what, bad ? REFUSE : ACCEPT, s, 1);
+        /* A refused reset changed nothing: the state still steps. */
+        if (s != ADAPTIMP_STATUS_OK) {
+            snprintf(what, sizeof what, "steps after a refused reset to %g", BAD[b]);
+            outcome(what, ACCEPT, ADAPTIMP_STATUS_OK, cart_steps_ok(&c, 5));
+        }
+        close_cart(&c);
+    }
+    /* Axes of every magnitude: an axis whose norm overflows is an axis. */
+    const double scales[] = {1e-11, 1e-3, 1.0, 1e100, 1e200, 1e300, DBL_MAX, 1e-13, 0.0};
+    AdaptimpTip ref;
+    {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        AdaptimpChain *ch = NULL;
+        if (adaptimp_chain_new(j, 4, &tip, &ch) != ADAPTIMP_STATUS_OK ||
+            adaptimp_chain_tip(ch, 3, Q0, Q0, &ref) != ADAPTIMP_STATUS_OK)
+            abort();
+        adaptimp_chain_free(ch);
+    }
+    for (size_t k = 0; k < sizeof scales / sizeof scales[0]; k++) {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        for (int i = 0; i < 3; i++) j[0].axis[i] *= scales[k];
+        AdaptimpChain *ch = NULL;
+        const AdaptimpStatus s = adaptimp_chain_new(j, 4, &tip, &ch);
+        AdaptimpTip t;
+        int ok = (s == ADAPTIMP_STATUS_OK) == (ch != NULL);
+        if (ch) {
+            /* The same chain as the unit axis's, to rounding. */
+            ok = ok && adaptimp_chain_tip(ch, 3, Q0, Q0, &t) == ADAPTIMP_STATUS_OK;
+            for (int r = 0; ok && r < 6; r++)
+                for (int i = 0; i < 3; i++)
+                    ok = ok && fabs(t.jacobian[r][i] - ref.jacobian[r][i]) < 1e-12;
+            adaptimp_chain_free(ch);
+        }
+        snprintf(what, sizeof what, "joint axis × %g", scales[k]);
+        outcome(what, scales[k] >= 1e-11 ? ACCEPT : REFUSE, s, ok);
+    }
+    /* Rates: the tip's J̇ q̇ finite or refused, never NaN with OK. */
+    for (int b = 0; b < NBAD; b++) {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        AdaptimpChain *ch = NULL;
+        if (adaptimp_chain_new(j, 4, &tip, &ch) != ADAPTIMP_STATUS_OK) abort();
+        double dq[3] = {BAD[b], 0.1, 0.0};
+        AdaptimpTip t;
+        const AdaptimpStatus s = adaptimp_chain_tip(ch, 3, Q0, dq, &t);
+        snprintf(what, sizeof what, "chain_tip dq[0] = %g", BAD[b]);
+        const int bad = !isfinite(BAD[b]) || fabs(BAD[b]) > 1e6;
+        outcome(what, bad ? REFUSE : ACCEPT, s,
+                s != ADAPTIMP_STATUS_OK || (finite_all(t.bias, 6) && finite_all(t.position, 3)));
+        double q[3] = {Q0[0], BAD[b], Q0[2]};
+        const AdaptimpStatus s2 = adaptimp_chain_tip(ch, 3, q, NULL, &t);
+        snprintf(what, sizeof what, "chain_tip q[1] = %g", BAD[b]);
+        outcome(what, bad ? REFUSE : ACCEPT, s2,
+                s2 != ADAPTIMP_STATUS_OK || (finite_all(t.bias, 6) && finite_all(t.position, 3)));
+        adaptimp_chain_free(ch);
+    }
+    /* Orbits: a huge `nodes` allocates no more than one sample a step; a
+       zero one is refused; the number of steps is bounded. */
+    {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        AdaptimpChain *ch = NULL;
+        if (adaptimp_chain_new(j, 4, &tip, &ch) != ADAPTIMP_STATUS_OK) abort();
+        AdaptimpPoseTarget path[8];
+        for (int k = 0; k < 8; k++) path[k] = start_target();
+        const double tube[2] = {0.05, 0.2};
+        static double centres[8 * 12];
+        double w2[12];
+        const size_t nodes[] = {1, 8, 9, (size_t)1 << 40, SIZE_MAX / 96, 0};
+        for (size_t k = 0; k < sizeof nodes / sizeof nodes[0]; k++) {
+            size_t written = 99;
+            /* The contract is room for `nodes` rows: the huge ones get NULL
+               (refused before anything is allocated or written). */
+            double *out = nodes[k] <= 9 ? centres : NULL;
+            const AdaptimpStatus s = adaptimp_cartesian_orbit_centres(
+                ch, &cp, 1e-3, 3, Q0, path, 8, nodes[k], tube, out, w2, &written);
+            snprintf(what, sizeof what, "orbit_centres nodes = %zu", nodes[k]);
+            const int good = nodes[k] >= 1 && nodes[k] <= 9;
+            outcome(what, good ? ACCEPT : REFUSE, s,
+                    s != ADAPTIMP_STATUS_OK || written == (nodes[k] < 8 ? nodes[k] : 8));
+        }
+        adaptimp_chain_free(ch);
+    }
+}
+
 /* ---- Forged handles at every entry point. ---- */
 
 /* The live handles of one world; every entry point is called with one of its
@@ -1029,7 +1171,7 @@ static const Entry ENTRIES[] = {
     {"adaptimp_cartesian_state_reset", {KIND_CART, KIND_CSTATE}},
     {"adaptimp_cartesian_set_stiffness", {KIND_CART, KIND_CSTATE}},
     {"adaptimp_cartesian_step", {KIND_CART, KIND_CSTATE}},
-    {"adaptimp_cartesian_set_posture", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_set_posture", {KIND_CART, KIND_CSTATE}},
     {"adaptimp_cartesian_state_fault", {KIND_CSTATE, -1}},
     {"adaptimp_cartesian_state_clear_fault", {KIND_CSTATE, -1}},
     {"adaptimp_cartesian_state_steps", {KIND_CSTATE, -1}},
@@ -1161,7 +1303,7 @@ static int call_entry(int e, void *h[NKINDS], AdaptimpStatus *status) {
         s = adaptimp_cartesian_step(cart, cstate, 3, q3, q3, zero6, NULL, &c);
         ok = REFUSED(s) && c.n == 0 && c.tau_sat[0] == 0.0;
     } else if (!strcmp(name, "adaptimp_cartesian_set_posture")) {
-        s = adaptimp_cartesian_set_posture(cstate, 3, q3);
+        s = adaptimp_cartesian_set_posture(cart, cstate, 3, q3);
         ok = REFUSED(s);
     } else if (!strcmp(name, "adaptimp_cartesian_state_fault")) {
         ok = !adaptimp_cartesian_state_fault(cstate, &step) && step == 77;
@@ -1303,7 +1445,7 @@ typedef struct {
 static const Category CATEGORIES[] = {
     {"parameters", construction}, {"steps and fallbacks", steps}, {"snapshots", snapshots},
     {"handles and buffers", handles}, {"chains", chains},        {"Cartesian", cartesian},
-    {"forged handles", forged},
+    {"forged handles", forged},       {"postures, axes, orbits", postures},
 };
 
 int main(void) {

@@ -15,7 +15,7 @@ pub use computed::{ComputedState, ComputedTorque, ComputedTorqueConfig};
 pub use dynamics::{Dynamics, Inertial, GRAVITY};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{
-    CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation, OuterStep,
-    PoseTarget,
+    orbit_steps, CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation,
+    OuterStep, PoseTarget, ORBIT_MAX_STEPS,
 };
 pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement};

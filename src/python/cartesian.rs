@@ -62,8 +62,9 @@ pub trait DynChain: Send + Sync {
     fn n(&self) -> usize;
     /// Which joints are prismatic.
     fn prismatic(&self) -> Vec<bool>;
-    /// The tip at (q, q̇) (n values each).
-    fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut;
+    /// The tip at (q, q̇) (n values each), both finite and within their
+    /// ceilings (`Chain::tip_checked`).
+    fn tip(&self, q: &[f64], dq: &[f64]) -> Result<TipOut, Error>;
     /// The outer loop of `cfg` over this chain at period `ts`, started at `q0`.
     fn outer(
         &self,
@@ -85,15 +86,15 @@ impl<const N: usize> DynChain for Chain<N> {
     fn prismatic(&self) -> Vec<bool> {
         (0..N).map(|i| self.is_prismatic(i)).collect()
     }
-    fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut {
-        let t = Kinematics::tip(self, &vector_of(q), &vector_of(dq));
+    fn tip(&self, q: &[f64], dq: &[f64]) -> Result<TipOut, Error> {
+        let t = self.tip_checked(&vector_of(q), &vector_of(dq))?;
         let r = t.rotation.matrix();
-        TipOut {
+        Ok(TipOut {
             position: t.position.into(),
             rotation: core::array::from_fn(|k| r[(k / 3, k % 3)]),
             jacobian: t.jacobian.transpose().as_slice().to_vec(),
             bias: t.bias.into(),
-        }
+        })
     }
     fn outer(
         &self,
@@ -105,10 +106,8 @@ impl<const N: usize> DynChain for Chain<N> {
         let outer = CartesianImpedance::new(cfg, *self, ts)?;
         let q0 = vector_of::<N>(q0);
         let posture = posture.map_or(q0, vector_of::<N>);
-        crate::error::check::finite_slice("q0", q0.as_slice())?;
-        crate::error::check::finite_slice("posture", posture.as_slice())?;
-        let mut state = outer.start(q0);
-        state.posture = posture;
+        let mut state = outer.start_checked(&q0)?;
+        outer.set_posture(&mut state, &posture)?;
         Ok(Box::new(Outer {
             outer,
             state,
@@ -197,6 +196,8 @@ pub trait DynOuter: Send + Sync {
     fn reset(&mut self, q0: Option<&[f64]>) -> Result<(), Error>;
     /// The null-space posture (rad).
     fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error>;
+    /// Check a commanded pose as a step would, changing nothing.
+    fn check_target(&self, target: &PoseTarget) -> Result<(), Error>;
     /// The stiffness asked for (N/m, N m/rad).
     fn set_stiffness(&mut self, kd: [f64; 3], kd_rot: [f64; 3]) -> Result<(), Error>;
     /// The outer loop alone: one committed step.
@@ -302,26 +303,26 @@ impl<const N: usize> DynOuter for Outer<N> {
         self.outer.orients()
     }
     fn reset(&mut self, q0: Option<&[f64]>) -> Result<(), Error> {
-        if let Some(q0) = q0 {
-            let q0 = vector_of::<N>(q0);
-            crate::error::check::finite_slice("q0", q0.as_slice())?;
-            self.q0 = q0;
-        }
-        self.state = self.outer.start(self.q0);
+        let q0 = q0.map_or(self.q0, vector_of::<N>);
+        let state = self.outer.start_checked(&q0)?;
+        self.q0 = q0;
+        self.state = state;
         self.state.posture = self.posture;
         self.last = None;
         Ok(())
     }
     fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error> {
         let p = vector_of::<N>(posture);
-        crate::error::check::finite_slice("posture", p.as_slice())?;
+        self.outer.set_posture(&mut self.state, &p)?;
         self.posture = p;
-        self.state.posture = p;
         Ok(())
     }
     fn set_stiffness(&mut self, kd: [f64; 3], kd_rot: [f64; 3]) -> Result<(), Error> {
         self.outer
             .set_stiffness(&mut self.state, &kd.into(), &kd_rot.into())
+    }
+    fn check_target(&self, target: &PoseTarget) -> Result<(), Error> {
+        self.outer.check_target(target)
     }
     fn reference(&mut self, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Result<(), Error> {
         let staged = self.outer.stage(&self.state, target, &wrench.into())?;
@@ -465,7 +466,8 @@ impl<const N: usize> DynOuter for Outer<N> {
             dx: Vector::zeros(),
             ddx: Vector::zeros(),
         };
-        let mut out = std::vec![zero; nodes];
+        // At most one sample a step: a huge `nodes` allocates no more.
+        let mut out = std::vec![zero; nodes.min(targets.len()).max(1)];
         let k = self
             .outer
             .orbit(q0, targets.len(), |k| targets[k], &mut out)?;
@@ -583,6 +585,26 @@ fn cartesian_error(e: Error) -> PyErr {
 
 /// A flat vector of exactly `len` finite reals (a sequence or an array).
 fn flat(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let v = flat_values(what, len, obj)?;
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(MeasurementError::new_err(format!(
+            "{what}[{i}] is not finite (NaN or infinite)"
+        )));
+    }
+    Ok(v)
+}
+
+/// `len` reals from a 1-D sequence or array (another shape, e.g. a (2, 3)
+/// wrench, is refused naming `what`), finite or not.
+fn flat_values(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    if let Ok(shape) = obj.getattr("shape").and_then(|s| s.extract::<Vec<usize>>()) {
+        if shape.len() != 1 {
+            return Err(MeasurementError::new_err(format!(
+                "{what} must have shape ({len},), got {}",
+                python_shape(&shape)
+            )));
+        }
+    }
     let v: Vec<f64> = match obj.cast::<PyArray1<f64>>() {
         Ok(a) => a.try_readonly()?.as_array().iter().copied().collect(),
         Err(_) => obj
@@ -602,16 +624,13 @@ fn flat(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<
             v.len()
         )));
     }
-    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-        return Err(MeasurementError::new_err(format!(
-            "{what}[{i}] is not finite (NaN or infinite)"
-        )));
-    }
     Ok(v)
 }
 
+/// A flat target (24,); a value that is not finite is refused by the
+/// core's check of the target, naming its part (p_c, R_c, w_c, …).
 fn target_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PoseTarget>> {
-    obj.map(|o| flat("target", TARGET_LEN, o).map(|v| pose_target(&v)))
+    obj.map(|o| flat_values("target", TARGET_LEN, o).map(|v| pose_target(&v)))
         .transpose()
 }
 
@@ -712,6 +731,67 @@ pub(super) fn joint(d: &Bound<'_, PyDict>) -> PyResult<Joint> {
     })
 }
 
+/// The rows of a table (K, n) of reals from any array or nested sequence
+/// (K given: of that many rows), else a MeasurementError (TypeError for
+/// values that are not reals) naming `what` and the shape it had.
+fn rows_of(
+    what: &str,
+    obj: &Bound<'_, PyAny>,
+    k: Option<usize>,
+    n: usize,
+) -> PyResult<(usize, Vec<f64>)> {
+    let np = obj.py().import("numpy")?;
+    let a = np
+        .call_method1("asarray", (obj, "float64"))
+        .map_err(|_| PyTypeError::new_err(format!("{what} must be an array of reals")))?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    let rows = k.unwrap_or(shape.first().copied().unwrap_or(0));
+    if shape != [rows, n] {
+        let like = if k.is_some() { " like q" } else { "" };
+        return Err(MeasurementError::new_err(format!(
+            "{what} must have shape ({}, {n}){like}, got {}",
+            k.map_or("K".to_string(), |k| k.to_string()),
+            python_shape(&shape)
+        )));
+    }
+    let v: Vec<f64> = a.call_method0("ravel")?.extract()?;
+    Ok((rows, v))
+}
+
+/// A count given as a Python integer (not a bool, not a float): ≥ 1, else
+/// a ConfigError (TypeError for another type) naming `what`.
+fn count(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    use pyo3::types::{PyBool, PyInt};
+    if obj.is_instance_of::<PyBool>() || !obj.is_instance_of::<PyInt>() {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must be an integer ≥ 1, got {}",
+            obj.repr()?
+        )));
+    }
+    match obj.extract::<i128>() {
+        Ok(v) if v >= 1 => Ok(usize::try_from(v).unwrap_or(usize::MAX)),
+        _ => Err(ConfigError::new_err(format!(
+            "{what} must be an integer ≥ 1, got {}",
+            obj.repr()?
+        ))),
+    }
+}
+
+/// A real number (a Python or NumPy int or float; not a bool, not a
+/// string), else a TypeError naming `what`.
+fn real(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    use pyo3::types::PyBool;
+    let v = if obj.is_instance_of::<PyBool>() {
+        None
+    } else {
+        obj.extract::<f64>().ok()
+    };
+    v.ok_or_else(|| {
+        let shown = obj.repr().map_or_else(|_| "?".into(), |r| r.to_string());
+        PyTypeError::new_err(format!("{what} must be a real number, got {shown}"))
+    })
+}
+
 fn rows(n: usize, what: &str, a: &PyReadonlyArray2<'_, f64>, width: usize) -> PyResult<Vec<f64>> {
     if a.shape()[1] != width || a.shape()[0] != n {
         return Err(MeasurementError::new_err(format!(
@@ -779,7 +859,10 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        let t = self.inner.tip(&q[..n], &[0.0; MAX_JOINTS][..n]);
+        let t = self
+            .inner
+            .tip(&q[..n], &[0.0; MAX_JOINTS][..n])
+            .map_err(cartesian_error)?;
         let mut m = std::vec![0.0; 16];
         for i in 0..3 {
             m[4 * i..4 * i + 3].copy_from_slice(&t.rotation[3 * i..3 * i + 3]);
@@ -797,15 +880,14 @@ impl PyChain {
     fn motion<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray2<'py, f64>,
-        dq: PyReadonlyArray2<'py, f64>,
-        ddq: PyReadonlyArray2<'py, f64>,
+        q: &Bound<'py, PyAny>,
+        dq: &Bound<'py, PyAny>,
+        ddq: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
         let n = self.inner.n();
-        let k = q.shape()[0];
-        let q = super::table("q", &q, k, n)?;
-        let dq = super::table("dq", &dq, k, n)?;
-        let ddq = super::table("ddq", &ddq, k, n)?;
+        let (k, q) = rows_of("q", q, None, n)?;
+        let (_, dq) = rows_of("dq", dq, Some(k), n)?;
+        let (_, ddq) = rows_of("ddq", ddq, Some(k), n)?;
         for (what, t) in [("q", &q), ("dq", &dq), ("ddq", &ddq)] {
             if let Some(i) = t.iter().position(|x| !x.is_finite()) {
                 return Err(MeasurementError::new_err(format!(
@@ -816,21 +898,27 @@ impl PyChain {
             }
         }
         let inner = &self.inner;
-        let (v, a) = py.detach(|| {
-            let (mut v, mut a) = (std::vec![0.0; 6 * k], std::vec![0.0; 6 * k]);
-            for r in 0..k {
-                let rows = r * n..(r + 1) * n;
-                let t = inner.tip(&q[rows.clone()], &dq[rows.clone()]);
-                // TipOut's Jacobian is row-major 6 × n.
-                for i in 0..6 {
-                    let row = &t.jacobian[i * n..(i + 1) * n];
-                    let dot = |x: &[f64]| row.iter().zip(x).map(|(j, x)| j * x).sum::<f64>();
-                    v[6 * r + i] = dot(&dq[rows.clone()]);
-                    a[6 * r + i] = dot(&ddq[rows.clone()]) + t.bias[i];
+        let (v, a) = py
+            .detach(|| {
+                let (mut v, mut a) = (std::vec![0.0; 6 * k], std::vec![0.0; 6 * k]);
+                for r in 0..k {
+                    let rows = r * n..(r + 1) * n;
+                    let t = inner
+                        .tip(&q[rows.clone()], &dq[rows.clone()])
+                        .map_err(|e| (r, e))?;
+                    // TipOut's Jacobian is row-major 6 × n.
+                    for i in 0..6 {
+                        let row = &t.jacobian[i * n..(i + 1) * n];
+                        let dot = |x: &[f64]| row.iter().zip(x).map(|(j, x)| j * x).sum::<f64>();
+                        v[6 * r + i] = dot(&dq[rows.clone()]);
+                        a[6 * r + i] = dot(&ddq[rows.clone()]) + t.bias[i];
+                    }
                 }
-            }
-            (v, a)
-        });
+                Ok((v, a))
+            })
+            .map_err(|(r, e): (usize, Error)| {
+                MeasurementError::new_err(format!("row {r}: {}", super::python_names(e)))
+            })?;
         Ok((array(py, v, (k, 6))?, array(py, a, (k, 6))?))
     }
 
@@ -843,7 +931,10 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        let t = self.inner.tip(&q[..n], &[0.0; MAX_JOINTS][..n]);
+        let t = self
+            .inner
+            .tip(&q[..n], &[0.0; MAX_JOINTS][..n])
+            .map_err(cartesian_error)?;
         array(py, t.jacobian, (6, n))
     }
 
@@ -857,7 +948,7 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.inner.n();
         let (q, dq) = (self.qv("q", q)?, self.qv("dq", dq)?);
-        let t = self.inner.tip(&q[..n], &dq[..n]);
+        let t = self.inner.tip(&q[..n], &dq[..n]).map_err(cartesian_error)?;
         Ok(array1(py, &t.bias))
     }
 }
@@ -958,7 +1049,7 @@ impl PyCartesian {
         let q0 = q0.map(|q| vector("q0", self.n, q)).transpose()?;
         self.lock(py)
             .reset(q0.as_ref().map(|q| &q[..self.n]))
-            .map_err(cartesian_error)
+            .map_err(|e| ConfigError::new_err(e.to_string()))
     }
 
     /// The null-space posture q_posture (rad), (n,).
@@ -966,7 +1057,18 @@ impl PyCartesian {
         let p = vector("posture", self.n, posture)?;
         self.lock(py)
             .set_posture(&p[..self.n])
-            .map_err(cartesian_error)
+            .map_err(|e| ConfigError::new_err(e.to_string()))
+    }
+
+    /// Check a flat pose target (24,) as a step would (its parts finite and
+    /// within their ceilings, R_c a rotation), changing nothing:
+    /// MeasurementError naming the part.
+    fn check_target(&self, py: Python<'_>, target: &Bound<'_, PyAny>) -> PyResult<()> {
+        let t = target_of(Some(target))?;
+        match t {
+            Some(t) => self.lock(py).check_target(&t).map_err(cartesian_error),
+            None => Ok(()),
+        }
     }
 
     /// Ask for the stiffness `Kd` (N/m, (3,)) and `Kd_rot` (N m/rad, (3,)): the
@@ -1275,6 +1377,25 @@ impl PyCartesian {
         array(py, out, (k, n))
     }
 
+    /// The steps round(T/Ts) of an orbit of `T` (s) at this loop's period
+    /// (1 … 1e6) and the number of samples `nodes` (an integer ≥ 1), checked
+    /// by name before a path is tabulated.
+    #[pyo3(name = "orbit_size", signature = (T, nodes))]
+    #[allow(non_snake_case)]
+    fn orbit_size(
+        &self,
+        py: Python<'_>,
+        T: &Bound<'_, PyAny>,
+        nodes: &Bound<'_, PyAny>,
+    ) -> PyResult<(usize, usize)> {
+        let t = real("T", T)?;
+        let nodes = count("nodes", nodes)?;
+        let ts = self.lock(py).ts();
+        let steps = crate::cartesian::orbit_steps(t, ts)
+            .map_err(|e| ConfigError::new_err(e.to_string()))?;
+        Ok((steps, nodes))
+    }
+
     /// The orbit rule (SPEC §15, §16): run this outer loop kinematically
     /// (F_e = 0) from `q0` along `targets` (K, 24) (one flat pose target per
     /// step) and return the joint reference (q_d (L, n), q̇_d (L, n)) of every
@@ -1285,13 +1406,11 @@ impl PyCartesian {
         py: Python<'py>,
         q0: &Bound<'py, PyAny>,
         targets: PyReadonlyArray2<'py, f64>,
-        nodes: usize,
+        nodes: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
         let n = self.n;
         let q0 = vector("q0", n, q0)?;
-        if nodes == 0 {
-            return Err(ConfigError::new_err("nodes must be ≥ 1"));
-        }
+        let nodes = count("nodes", nodes)?;
         let k = targets.shape()[0];
         let flat_rows = rows(k, "targets", &targets, TARGET_LEN)?;
         let ts: Vec<PoseTarget> = flat_rows.chunks(TARGET_LEN).map(pose_target).collect();

@@ -319,3 +319,43 @@ def test_the_chain_refuses_rates_whose_outputs_would_not_be_finite() -> None:
     )
     v, a = ARM.motion([[0.1, 0.2, 0.3]], [[0.0, 0.0, 1.0]], [[0, 0, 0]])  # lists, ints
     assert v.shape == a.shape == (1, 6)
+
+
+@pytest.mark.parametrize(
+    ("origin", "got"),
+    [
+        ({"quat": [1, 0, 0, 0], "rpy": [0, 0, 1]}, "rpy and quat"),
+        ({"xyz": [0, 0, 1], "pos": [0, 0, 1]}, "xyz and pos"),
+        ({"rotation": np.eye(3).tolist(), "rpy": [0, 0, 1]}, "rpy and rotation"),
+        ({"translation": [0, 0, 1], "quat": [1, 0, 0, 0]}, "quat and translation"),
+    ],
+)
+def test_an_origin_in_two_conventions_is_refused(origin: dict[str, Any], got: str) -> None:
+    # quat together with rpy: the rpy was ignored.
+    with pytest.raises(adaptimp.ConfigError) as e:
+        adaptimp.Chain([{"kind": "revolute", "axis": [0, 0, 1], **origin}])
+    assert str(e.value) == (
+        "joints: an origin is given by xyz and rpy (URDF), pos and quat (MuJoCo) or "
+        f"translation and rotation, one convention at a time; got {got}"
+    )
+
+
+def test_names_of_another_length_and_a_site_that_is_no_id_are_refused() -> None:
+    with pytest.raises(adaptimp.ConfigError) as e:
+        adaptimp.Chain([{"kind": "revolute", "axis": [0, 0, 1]}], names=["a", "b"])
+    assert str(e.value) == (
+        "joints: names must give one name per movable joint (1), got ['a', 'b']"
+    )
+    with pytest.raises(adaptimp.ConfigError):
+        adaptimp.Chain([{"kind": "revolute", "axis": [0, 0, 1]}], names="ab")
+    import mujoco
+
+    m = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><joint type="hinge"/><geom size=".1"/>'
+        '<site name="s"/><site name="t"/></body></worldbody></mujoco>'
+    )
+    for site in (1.5, True):  # taken as site 1
+        with pytest.raises(TypeError) as e:
+            adaptimp.Chain.from_mujoco(m, site)  # type: ignore[arg-type]
+        assert str(e.value) == f"site must be a site's name or its id (an int), got {site!r}"
+    assert adaptimp.Chain.from_mujoco(m, np.int64(1)).source == "MuJoCo model to site 't'"

@@ -213,6 +213,11 @@ class Chain(_adaptimp.Chain):
         except ValueError as e:
             raise ConfigError(f"{source}: {e}") from None
         movable = [j for j in data if j.get("kind") != "fixed"]
+        if names is not None and (isinstance(names, str) or len(names) != len(movable)):
+            raise ConfigError(
+                f"{source}: names must give one name per movable joint ({len(movable)}), "
+                f"got {names!r}"
+            )
         self.joint_names = (
             list(names) if names is not None else [f"joint{i}" for i in range(len(movable))]
         )
@@ -280,6 +285,8 @@ class Chain(_adaptimp.Chain):
             if sid < 0:
                 raise ConfigError(f"the MuJoCo model has no site named {site!r}")
         else:
+            if isinstance(site, bool) or not isinstance(site, (int, np.integer)):
+                raise TypeError(f"site must be a site's name or its id (an int), got {site!r}")
             sid = int(site)
             if not 0 <= sid < model.nsite:
                 raise ConfigError(f"the MuJoCo model has no site {sid} ({model.nsite} sites)")

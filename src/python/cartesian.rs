@@ -682,9 +682,13 @@ pub(super) fn transform(d: &Bound<'_, PyDict>) -> PyResult<Transform> {
         .filter(|k| d.contains(*k).unwrap_or(false))
         .collect();
     let fits = |set: &[&str]| given.iter().all(|k| set.contains(k));
-    if !(fits(&["xyz", "rpy"]) || fits(&["pos", "rpy"]) || fits(&["pos", "quat"]))
-        && !fits(&["translation", "rotation"])
-    {
+    let conventions: [&[&str]; 4] = [
+        &["xyz", "rpy"],
+        &["pos", "rpy"],
+        &["pos", "quat"],
+        &["translation", "rotation"],
+    ];
+    if !conventions.iter().any(|set| fits(set)) {
         return Err(ConfigError::new_err(format!(
             "an origin is given by xyz and rpy (URDF), pos and quat (MuJoCo) or translation \
              and rotation, one convention at a time; got {}",

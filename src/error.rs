@@ -83,7 +83,12 @@ impl fmt::Display for Error {
                 if let Some(i) = index {
                     write!(f, "[{i}]")?;
                 }
-                write!(f, " = {value} (SPEC §10)")
+                // Beyond 1e15 in scientific notation (1e300, not 301 digits).
+                if value.abs() >= 1e15 {
+                    write!(f, " = {value:e} (SPEC §10)")
+                } else {
+                    write!(f, " = {value} (SPEC §10)")
+                }
             }
             Error::NonFinite { what, index } => {
                 write!(f, "{what}[{index}] is not finite (NaN or infinite)")
@@ -319,6 +324,20 @@ mod tests {
         assert!(s.contains("Kzeta"), "{s}");
         assert!(s.contains("[1]"), "{s}");
         assert!(s.contains("= -1"), "{s}");
+    }
+
+    #[test]
+    fn a_huge_value_is_written_in_scientific_notation() {
+        let e = Error::Condition {
+            condition: "|value| ≤ 1e9",
+            lhs: "payload",
+            index: None,
+            value: 1e300,
+        };
+        assert_eq!(
+            e.to_string(),
+            "condition |value| ≤ 1e9 is violated: payload = 1e300 (SPEC §10)"
+        );
     }
 
     #[test]

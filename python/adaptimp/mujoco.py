@@ -1038,13 +1038,15 @@ def moving_mass(model: mujoco.MjModel) -> float:
 
 
 def with_payload(model: mujoco.MjModel, mass: float, body: int | None = None) -> mujoco.MjModel:
-    """A copy of ``model`` with a point mass ``mass`` (kg, ≥ 0) at the origin of
+    """A copy of ``model`` with a point mass ``mass`` (kg, 0 … 1e9, the bound of
+    every physical parameter) at the origin of
     ``body`` (default: the body of the last joint, the end effector's link;
     SPEC §17's payload for a MuJoCo arm). The body's mass, centre of mass and
     inertia change by the parallel-axis theorem; nothing else does. Give it
     to the plant only: the controller is not told."""
-    if not (math.isfinite(mass) and mass >= 0):
-        raise ValueError(f"payload must be ≥ 0 kg, got {mass}")
+    if not (math.isfinite(mass) and 0 <= mass <= 1e9):
+        # (1e300 kg was accepted, and the run ended in a DivergedError of MuJoCo's.)
+        raise ConfigError(f"payload must be ≥ 0 and ≤ 1e9 kg, got {mass}")
     m = copy.deepcopy(model)
     if mass == 0:
         return m

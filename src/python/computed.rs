@@ -45,9 +45,9 @@ pub trait DynComputed: Send + Sync {
         out: &mut [f64],
     ) -> Result<(), Error>;
     /// RNEA(q, q̇, q̈) of the controller's model.
-    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Vec<f64>;
+    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Result<Vec<f64>, Error>;
     /// M(q), row-major.
-    fn mass_matrix(&self, q: &[f64]) -> Vec<f64>;
+    fn mass_matrix(&self, q: &[f64]) -> Result<Vec<f64>, Error>;
     /// The last step's τ, sat(τ), xc, xd, z1 (by index).
     fn last(&self, what: usize) -> Vec<f64>;
     /// The last refused step: (error, step).
@@ -56,6 +56,15 @@ pub trait DynComputed: Send + Sync {
     fn mass(&self) -> f64;
     /// As [`Any`], for the typed paths.
     fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// An input of a model query refused (MeasurementError, named), or a result
+/// that is not finite (DivergedError).
+fn input_error(e: Error) -> pyo3::PyErr {
+    match e {
+        Error::Diverged { .. } => super::DivergedError::new_err(e.to_string()),
+        _ => super::MeasurementError::new_err(e.to_string()),
+    }
 }
 
 fn vector_of<const N: usize>(v: &[f64]) -> Vector<N> {
@@ -97,17 +106,18 @@ impl<const N: usize> DynComputed for Computed<N> {
         out[..N].copy_from_slice(cmd.tau_sat.as_slice());
         Ok(())
     }
-    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Vec<f64> {
-        let tau =
-            self.ctrl
-                .model()
-                .inverse_dynamics(&vector_of(q), &vector_of(dq), &vector_of(ddq));
-        tau.as_slice().to_vec()
+    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Result<Vec<f64>, Error> {
+        let tau = self.ctrl.model().inverse_dynamics_checked(
+            &vector_of(q),
+            &vector_of(dq),
+            &vector_of(ddq),
+        )?;
+        Ok(tau.as_slice().to_vec())
     }
-    fn mass_matrix(&self, q: &[f64]) -> Vec<f64> {
-        let m = self.ctrl.model().mass_matrix(&vector_of(q));
+    fn mass_matrix(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
+        let m = self.ctrl.model().mass_matrix_checked(&vector_of(q))?;
         // Column-major storage of a symmetric matrix: its rows.
-        m.as_slice().to_vec()
+        Ok(m.as_slice().to_vec())
     }
     fn last(&self, what: usize) -> Vec<f64> {
         let c = &self.state.last;
@@ -433,7 +443,7 @@ impl PyComputedTorque {
                 [&c[0][..n], &c[1][..n], &c[2][..n]],
                 &mut out[..n],
             )
-            .map_err(super::step_error)?;
+            .map_err(input_error)?;
         Ok(array1(py, &out[..n]))
     }
 
@@ -451,10 +461,11 @@ impl PyComputedTorque {
             vector("dq", n, dq)?,
             vector("ddq", n, ddq)?,
         );
-        Ok(array1(
-            py,
-            &self.lock(py).inverse_dynamics(&q[..n], &dq[..n], &ddq[..n]),
-        ))
+        let tau = self
+            .lock(py)
+            .inverse_dynamics(&q[..n], &dq[..n], &ddq[..n])
+            .map_err(input_error)?;
+        Ok(array1(py, &tau))
     }
 
     /// M(q) of the controller's model (kg m²), (n, n).
@@ -465,7 +476,8 @@ impl PyComputedTorque {
     ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
         let n = self.n;
         let q = vector("q", n, q)?;
-        array(py, self.lock(py).mass_matrix(&q[..n]), (n, n))
+        let m = self.lock(py).mass_matrix(&q[..n]).map_err(input_error)?;
+        array(py, m, (n, n))
     }
 
     /// A quantity of the last step by name: "tau", "tau_sat", "xc", "xd",

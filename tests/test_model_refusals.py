@@ -62,3 +62,44 @@ def test_a_payload_beyond_any_arm_is_refused_as_a_payload() -> None:
     with pytest.raises(adaptimp.ConfigError) as e:
         amj.simulate("pd", "two_link", T=0.01, payload=1e300)
     assert str(e.value) == "payload must be ≥ 0 and ≤ 1e9 kg, got 1e+300"
+
+
+def test_a_model_without_actuators_is_refused_as_such(tmp_path: Any) -> None:
+    from adaptimp import mujoco as amj
+
+    path = tmp_path / "no_motors.xml"
+    path.write_text(
+        '<mujoco><worldbody><body><joint type="hinge"/><geom size=".1" mass="1"/>'
+        '<body pos="0 0 .3"><joint type="hinge" axis="0 1 0"/><geom size=".1" mass="1"/>'
+        "</body></body></worldbody></mujoco>"
+    )
+    # It said "Plant needs 1 to 7 joints, the model has 0".
+    with pytest.raises(ValueError, match=r"^Plant drives an arm's joints by actuators") as e:
+        amj.Plant(str(path))
+    assert str(e.value) == (
+        "Plant drives an arm's joints by actuators, and the model has none (2 joints, 0 "
+        "actuators): add a motor on each arm joint (<motor joint=...>)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("reference", "error", "message"),
+    [
+        (lambda t: (np.zeros(2), np.zeros(2)), ValueError,
+         "reference(t) must return 3 arrays (xc, dxc, ddxc), got 2 values at t = 0"),
+        (lambda t: np.zeros(2), ValueError,
+         "reference(t) must return 3 arrays (xc, dxc, ddxc), got not a tuple at t = 0"),
+        (lambda t: (np.zeros(3), np.zeros(2), np.zeros(2)), ValueError,
+         "reference(t)'s xc must have shape (2,), got (3,) at t = 0"),
+        (lambda t: (np.zeros(2), ["a", 0], np.zeros(2)), TypeError,
+         "reference(t)'s dxc must be reals, got ['a', 0] at t = 0"),
+    ],
+)  # fmt: skip
+def test_a_reference_of_the_wrong_shape_is_refused_by_name(
+    reference: Any, error: type[Exception], message: str
+) -> None:
+    from adaptimp import mujoco as amj
+
+    with pytest.raises(error) as e:  # a 2-tuple was an IndexError
+        amj.simulate("pd", "two_link", T=0.01, reference=reference)
+    assert str(e.value) == message

@@ -557,6 +557,13 @@ class Plant:
         ]
         if bad:
             raise ValueError(f"Plant needs hinge joints only; not hinges: {', '.join(bad)}")
+        if not arm and m.njnt > 0:
+            # Every joint counted as the environment's: none is actuated.
+            raise ValueError(
+                f"Plant drives an arm's joints by actuators, and the model has "
+                f"{'none' if m.nu == 0 else 'none on a joint'} ({m.njnt} joints, {m.nu} "
+                "actuators): add a motor on each arm joint (<motor joint=...>)"
+            )
         if not 1 <= len(arm) <= MAX_JOINTS:
             raise ValueError(f"Plant needs 1 to {MAX_JOINTS} joints, the model has {len(arm)}")
         self.n = len(arm)
@@ -1217,13 +1224,46 @@ class _Table:
         return xc[k], dxc[k], ddxc[k]
 
 
+def _checked_reference(reference: Reference, n: int) -> Reference:
+    """``reference`` whose every value is checked: three arrays (xc, dxc, ddxc)
+    of shape (n,), else an error naming the reference, t and what it gave (a
+    2-tuple was an IndexError, a wrong length a broadcast error)."""
+
+    def checked(t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        got = reference(t)
+        values = tuple(got) if isinstance(got, (tuple, list)) else None
+        if values is None or len(values) != 3:
+            size = "not a tuple" if values is None else f"{len(values)} values"
+            raise ValueError(
+                f"reference(t) must return 3 arrays (xc, dxc, ddxc), got {size} at t = {t:g}"
+            )
+        out = []
+        for name, v in zip(("xc", "dxc", "ddxc"), values):
+            try:
+                a = np.asarray(v, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise TypeError(
+                    f"reference(t)'s {name} must be reals, got {v!r} at t = {t:g}"
+                ) from None
+            if a.shape != (n,):
+                raise ValueError(
+                    f"reference(t)'s {name} must have shape ({n},), got {a.shape} at t = {t:g}"
+                )
+            out.append(a)
+        return out[0], out[1], out[2]
+
+    return checked
+
+
 def _table_reference(reference: Any, n: int, Ts: float, steps: int) -> Reference:
     """``reference`` as a callable of t: a callable as it is; (xc, dxc, ddxc)
     arrays of shape (K, n), K ≥ ``steps`` (or an object with those attributes,
     e.g. a :class:`MujocoResult`), row k at t_k = k·Ts (n: the width of the
     controller's reference, 3 for a Cartesian controller's p_c)."""
+    if isinstance(reference, _Table):
+        return reference
     if callable(reference):
-        return reference  # type: ignore[no-any-return]
+        return _checked_reference(reference, n)
     if all(hasattr(reference, a) for a in ("xc", "dxc", "ddxc")):
         reference = (reference.xc, reference.dxc, reference.ddxc)
     try:

@@ -634,7 +634,10 @@ def arm_table(
     text = path.read_text()
     import xml.etree.ElementTree as ET
 
-    names = {j.get("name") for j in ET.fromstring(text).iter("joint")}
+    try:
+        names = {j.get("name") for j in ET.fromstring(text).iter("joint")}
+    except ET.ParseError as e:  # a traceback of examples/13 for a broken --arm
+        raise ConfigError(f"cannot read the URDF {str(urdf)!r}: {e}") from None
     unknown = [j for j in fix if j not in names]
     if unknown:
         raise ConfigError(f"fix names joints the URDF does not have: {unknown}")

@@ -41,7 +41,12 @@ from adaptimp import _models
 from adaptimp import mujoco as amj
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
-UR5 = _models.panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
+
+
+def ur5() -> Path:
+    """The UR5 of example-robot-data (the extra ``pinocchio``): the default arm,
+    looked up only when no URDF is given (a given URDF needs only ``mujoco``)."""
+    return _models.panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
 
 
 def targets(res: Any) -> dict[str, float]:
@@ -145,15 +150,25 @@ def long_run(urdf: Path, seconds: float, case: str = "sf") -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("urdf", nargs="?", type=Path, default=UR5)
+    parser.add_argument(
+        "urdf", nargs="?", type=Path, default=None, help="default: the UR5 of example-robot-data"
+    )
     parser.add_argument("--payload", type=float, default=None, help="fraction of the arm's mass")
     parser.add_argument("--figure", type=Path, default=None, help="write SF's tracking figure")
     parser.add_argument("--long", type=float, default=None, help="seconds of a long SF run")
     args = parser.parse_args()
+    if args.urdf is None:
+        try:
+            args.urdf = ur5()
+        except ImportError as e:
+            parser.error(f"no URDF given, and the default UR5 needs the extra pinocchio: {e}")
     if args.long is not None:
         long_run(args.urdf, 1.0 if QUICK else args.long)
         return
-    runs = table(args.urdf, 2.5 if QUICK else 10.0, args.payload)
+    try:
+        runs = table(args.urdf, 2.5 if QUICK else 10.0, args.payload)
+    except ImportError as e:  # --payload's computed torque needs the extra pinocchio
+        parser.error(str(e))
     if args.figure is not None:
         fig = runs["sf"].plot("errors")
         fig.savefig(args.figure, dpi=110)

@@ -53,3 +53,46 @@ def test_a_duration_whose_records_would_not_fit_is_refused() -> None:
     assert _usage_error("--T", "2e5") == (
         "13_panda_table.py: error: --T must be at most 3600 s (every step is kept), got 200000"
     )
+
+
+_WITHOUT_PINOCCHIO = """
+import importlib.metadata as md, runpy, sys
+real = md.distribution
+def distribution(name):
+    if name == "example-robot-data":
+        raise md.PackageNotFoundError(name)
+    return real(name)
+md.distribution = distribution
+sys.modules["pinocchio"] = None  # `import pinocchio` fails, as without the extra
+sys.argv = [sys.argv[1], *sys.argv[2:]]
+runpy.run_path(sys.argv[0], run_name="__main__")
+"""
+
+
+def _without_pinocchio(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", _WITHOUT_PINOCCHIO, str(EXAMPLE.with_name("15_your_arm.py")), *args],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+        env={**os.environ, "ADAPTIMP_QUICK": "1"},
+    )
+
+
+def test_your_arm_with_a_urdf_needs_only_mujoco() -> None:
+    """examples/15 given a URDF looked the default UR5 up at import and died
+    without the extra pinocchio, which the README does not name for it."""
+    hobby = Path(__file__).resolve().parent / "data" / "hobby_arm.urdf"
+    proc = _without_pinocchio(str(hobby))
+    assert proc.returncode == 0, proc.stderr
+    assert "hobby_arm.urdf: 5 joints" in proc.stdout
+    assert "| sf |" in proc.stdout
+    # The default arm and --payload's computed torque need the extra: said so.
+    proc = _without_pinocchio()
+    assert proc.returncode == 2
+    assert "no URDF given, and the default UR5 needs the extra pinocchio" in proc.stderr
+    proc = _without_pinocchio(str(hobby), "--payload", "0.1")
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert "pinocchio" in proc.stderr.strip().splitlines()[-1]

@@ -1,6 +1,7 @@
 """A break-it probe of the public Python API: state restore (bit flips,
 edits, truncations), the fault semantics, the n-joint API, sweeps and their
-cache. Every case is classified:
+cache, chains, the Cartesian front, formulations, the dynamics and computed
+torque, saved results, MuJoCo runs. Every case is classified:
 
 - accepted: it succeeded and every invariant checked held;
 - clear error: it was refused by an adaptimp error (or a TypeError,
@@ -668,11 +669,590 @@ def _rekey(p: Path) -> str:
     return json.dumps(data)
 
 
+# ---------------------------------------------------------------------------
+# The surfaces of issue 33: chains, the Cartesian front, formulations, the
+# dynamics and computed torque, saves, MuJoCo runs.
+# ---------------------------------------------------------------------------
+
+BAD = (math.nan, math.inf, -math.inf, 1e300, -1e300, 1e200, 1e151, 1e50, 1e7, 1e-320, 0.0, -1.0)
+
+
+def _arm3() -> Any:
+    import adaptimp
+
+    return adaptimp.Chain(
+        [
+            {"kind": "revolute", "axis": [0, 0, 1]},
+            {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [0, 1, 0]},
+            {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [1, 0, 0]},
+        ],
+        tip={"xyz": [0.2, 0, 0]},
+    )
+
+
+def _finite(*arrays: Any) -> None:
+    for a in arrays:
+        check(bool(np.all(np.isfinite(np.asarray(a, dtype=float)))), f"not finite: {a}")
+
+
+def chains(t: Tally, quick: bool) -> None:
+    """Chains from joint data: every field of a joint with every bad value, the
+    origin conventions, names, sites; fk, Jacobian, J̇q̇ and motion with bad
+    rates and shapes. Accepted: finite outputs, and a movable joint that moves
+    the tip (no zero axis)."""
+    import adaptimp
+
+    base = [
+        {"kind": "revolute", "axis": [0, 0, 1]},
+        {"kind": "prismatic", "xyz": [0.3, 0, 0], "rpy": [0.1, 0.2, 0.3], "axis": [1, 0, 0]},
+        {"kind": "revolute", "pos": [0.1, 0, 0], "quat": [1, 0, 0, 0], "axis": [0, 1, 0]},
+    ]
+    fields = [("axis", 3), ("xyz", 3), ("rpy", 3), ("quat", 4), ("offset", 1)]
+    values = BAD if not quick else BAD[::2]
+    for j in range(3):
+        for key, size in fields:
+            if key not in base[j] and key != "offset":
+                continue
+            for i in range(size):
+                for v in values:
+
+                    def one(j: int = j, field: str = key, i: int = i, v: float = v) -> None:
+                        joints = [dict(x) for x in base]
+                        if field == "offset":
+                            joints[j]["offset"] = v
+                        else:
+                            joints[j][field] = list(joints[j][field])
+                            joints[j][field][i] = v
+                        arm = adaptimp.Chain(joints, tip={"xyz": [0.2, 0, 0]})
+                        q = [0.1, 0.05, -0.2]
+                        _finite(arm.fk(q), arm.jacobian(q), arm.jdot_qdot(q, [0.1] * 3))
+                        # Every movable joint moves the tip or turns it.
+                        col = np.abs(arm.jacobian(q)).max(axis=0)
+                        check(bool(np.all(col > 0)), f"a joint that moves nothing: {col}")
+
+                    axis = list(base[j]["axis"])
+                    if field == "axis":
+                        axis[i] = v
+                    zero_axis = field == "axis" and float(np.linalg.norm(axis)) <= 1e-12
+                    bad_value = not math.isfinite(v) or zero_axis
+                    case(
+                        t,
+                        f"joint {j} {field}[{i}] = {v:g}",
+                        one,
+                        "refuse" if bad_value else "either",
+                    )
+    extra: list[tuple[str, dict[str, Any], str]] = [
+        ("quat with rpy", {"quat": [1, 0, 0, 0], "rpy": [0, 0, 1]}, "refuse"),
+        ("xyz with pos", {"xyz": [0, 0, 1], "pos": [0, 0, 1]}, "refuse"),
+        ("rotation with rpy", {"rotation": np.eye(3).tolist(), "rpy": [0, 0, 1]}, "refuse"),
+        ("a reflection", {"rotation": np.diag([1.0, 1.0, -1.0]).tolist()}, "refuse"),
+        ("a sloppy rotation", {"rotation": (np.eye(3) * (1 + 4e-7)).tolist()}, "accept"),
+        ("R × 1.1", {"rotation": (np.eye(3) * 1.1).tolist()}, "refuse"),
+        ("axis [0, 0, 1e200]", {"axis": [0, 0, 1e200]}, "accept"),
+        ("axis [1e308, 1e308, 0]", {"axis": [1e308, 1e308, 0]}, "accept"),
+        ("axis of 2 values", {"axis": [0, 1]}, "refuse"),
+        ("axis as a string", {"axis": "z"}, "refuse"),
+        ("kind 'ball'", {"kind": "ball"}, "refuse"),
+        ("kind 3", {"kind": 3}, "refuse"),
+        ("no axis", {"axis": None}, "refuse"),
+    ]
+    for what, patch, expect in extra:
+
+        def mixed(patch: dict[str, Any] = patch) -> None:
+            j = {"kind": "revolute", "axis": [0, 0, 1], **patch}
+            if j.get("axis") is None:
+                j.pop("axis")
+            arm = adaptimp.Chain([j], tip={"xyz": [0.3, 0, 0]})
+            _finite(arm.fk([0.2]), arm.jacobian([0.2]))
+            check(float(np.abs(arm.jacobian([0.2])).max()) > 0.1, "a zero axis")
+            r = arm.fk([0.2])[:3, :3]
+            check(abs(np.linalg.det(r) - 1.0) < 1e-12, f"det R = {np.linalg.det(r)}")
+
+        case(t, f"Chain with {what}", mixed, expect)
+    for what, names, expect in [
+        ("two names for one joint", ["a", "b"], "refuse"),
+        ("a string", "ab", "refuse"),
+        ("one name", ["a"], "accept"),
+    ]:
+        case(
+            t,
+            f"names: {what}",
+            lambda names=names: adaptimp.Chain(  # type: ignore[misc]
+                [{"kind": "revolute", "axis": [0, 0, 1]}], names=names
+            ),
+            expect,
+        )
+    arm = _arm3()
+    q = [0.3, 0.6, 0.2]
+    z23 = np.zeros((2, 3))
+    calls: list[tuple[str, Callable[[], object], str]] = []
+    for v in values:
+        either = "refuse" if not math.isfinite(v) or abs(v) > 1e6 else "either"
+        calls += [
+            (f"fk q[1] = {v:g}", lambda v=v: arm.fk([0.3, v, 0.2]), either),
+            (f"jacobian q[0] = {v:g}", lambda v=v: arm.jacobian([v, 0.6, 0.2]), either),
+            (f"jdot_qdot dq[2] = {v:g}", lambda v=v: arm.jdot_qdot(q, [0.1, 0.1, v]), either),
+            (f"motion dq = {v:g}", lambda v=v: arm.motion(z23, np.full((2, 3), v), z23), either),
+        ]
+    calls += [
+        ("fk of 2 values", lambda: arm.fk([0.1, 0.2]), "refuse"),
+        ("fk of a string", lambda: arm.fk("q"), "refuse"),
+        (
+            "motion of a 1-D array",
+            lambda: arm.motion(np.zeros(3), np.zeros(3), np.zeros(3)),
+            "refuse",
+        ),
+        ("motion of other lengths", lambda: arm.motion(z23, np.zeros((3, 3)), z23), "refuse"),
+        (
+            "motion of lists",
+            lambda: arm.motion([[0.1, 0.2, 0.3]], [[0, 0, 1]], [[0, 0, 0]]),
+            "accept",
+        ),
+    ]
+    for what, fn, expect in calls:
+
+        def out(fn: Callable[[], object] = fn) -> None:
+            r = fn()
+            _finite(*(r if isinstance(r, tuple) else (r,)))
+
+        case(t, what, out, expect)
+    try:
+        import mujoco
+    except ImportError:
+        return
+    m = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><joint type="hinge"/><geom size=".1"/>'
+        '<site name="s"/><site name="t"/></body></worldbody></mujoco>'
+    )
+    for site, expect in [(1.5, "refuse"), (True, "refuse"), (-1, "refuse"), (2, "refuse"),
+                         ("nope", "refuse"), (1, "accept"), (np.int64(0), "accept")]:  # fmt: skip
+        case(
+            t,
+            f"from_mujoco site {site!r}",
+            lambda site=site: adaptimp.Chain.from_mujoco(m, site),
+            expect,
+        )
+
+
+TURN = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+"""A quarter turn about z."""
+
+
+def _refused_step(c: Any, q: Any) -> bool:
+    """One step of a Cartesian controller: whether it was refused."""
+    import adaptimp
+
+    try:
+        c.step(q, np.zeros(3), np.zeros(6))
+    except (adaptimp.MeasurementError, ValueError, TypeError):
+        return True
+    return False
+
+
+def _cart(**kw: Any) -> Any:
+    import adaptimp
+
+    return adaptimp.CartesianController(
+        _arm3(), "pd", q0=[0.3, 0.6, 0.2], tau_max=20.0, Kp=5.0, Kzeta=25.0, **kw
+    )
+
+
+def _cart_steps(c: Any, k: int) -> np.ndarray:
+    q0 = np.array([0.3, 0.6, 0.2])
+    return np.array(
+        [c.step(q0 + 1e-3 * np.sin(i + np.arange(3)), np.zeros(3), np.zeros(6)) for i in range(k)]
+    )
+
+
+def cartesian(t: Tally, quick: bool) -> None:
+    """The Python Cartesian front: bad targets (each part, each bad value, R that
+    is no rotation or of the wrong shape), wrenches, postures, starts, resets,
+    stiffnesses, orbits and paths. A refused call keeps nothing: the controller
+    then steps bit-identically to a twin that never saw it; an accepted step's
+    torque is finite and within τmax."""
+    import adaptimp
+    from adaptimp.cartesian import CartesianImpedance
+
+    arm = _arm3()
+    q0 = np.array([0.3, 0.6, 0.2])
+    p0, R0 = arm.fk(q0)[:3, 3], arm.fk(q0)[:3, :3]
+    z3 = np.zeros(3)
+
+    def twin(call: Callable[[Any], object], expect: str, name: str) -> None:
+        def run() -> None:
+            a, b = _cart(), _cart()
+            _cart_steps(a, 3)
+            _cart_steps(b, 3)
+            try:
+                out = call(a)
+            except BaseException:
+                check(
+                    np.array_equal(_cart_steps(a, 10), _cart_steps(b, 10)),
+                    "a refused call changed what the controller does",
+                )
+                raise
+            if out is not None and np.ndim(out) == 1 and len(out) == 3:
+                _finite(out)
+                check(bool(np.all(np.abs(out) <= 20.0 + 1e-12)), f"torque {out} beyond τmax")
+            tau = _cart_steps(a, 10)
+            _finite(tau)
+
+        case(t, name, run, expect)
+
+    values = BAD if not quick else BAD[::2]
+    parts = [("xc", 3), ("dxc", 3), ("ddxc", 3), ("w", 3), ("dw", 3)]
+    for part, size in parts:
+        for i in range(size) if not quick else (0,):
+            for v in values:
+                bad = not math.isfinite(v) or abs(v) > 1e6
+
+                def target(c: Any, part: str = part, i: int = i, v: float = v) -> object:
+                    kw: dict[str, Any] = {"xc": p0.copy(), "R": R0}
+                    kw[part] = kw.get(part, z3).copy() if part in kw else z3.copy()
+                    kw[part][i] = v
+                    return c.step(q0, z3, np.zeros(6), **kw)
+
+                twin(target, "refuse" if bad else "either", f"step {part}[{i}] = {v:g}")
+    for what, R, expect in [
+        ("R0", R0, "accept"),
+        ("1.1·R0", 1.1 * R0, "refuse"),
+        ("a reflection", R0 @ np.diag([1.0, 1.0, -1.0]), "refuse"),
+        ("R0 + 1e-9", R0 + 1e-9, "accept"),
+        ("R0 + 1e-5", R0 + 1e-5, "refuse"),
+        ("NaN in R", np.where(np.eye(3) > 0, math.nan, 0.0), "refuse"),
+        ("flat (9,)", R0.ravel(), "refuse"),
+        ("4 values", [1, 0, 0, 1], "refuse"),
+        ("a string", "R", "refuse"),
+    ]:
+        twin(lambda c, R=R: c.step(q0, z3, np.zeros(6), xc=p0, R=R), expect, f"step R = {what}")
+        twin(lambda c, R=R: c.outer.target(p0, R=R), expect, f"target(R = {what})")
+    for what, w, expect in [
+        ("(6,)", np.zeros(6), "accept"),
+        ("(3,)", np.ones(3), "accept"),
+        ("(2, 3)", np.zeros((2, 3)), "refuse"),
+        ("(5,)", np.zeros(5), "refuse"),
+        ("NaN", [math.nan, 0, 0, 0, 0, 0], "refuse"),
+        ("1e10", [1e10, 0, 0, 0, 0, 0], "refuse"),
+        ("strings", ["a"] * 6, "refuse"),
+    ]:
+        twin(lambda c, w=w: c.step(q0, z3, w), expect, f"wrench {what}")
+
+    def started(v: float) -> None:
+        c = adaptimp.CartesianController(_arm3(), "pd", q0=[v, 0.6, 0.2], tau_max=20.0)
+        _finite(_cart_steps(c, 2))
+
+    for v in values:
+        far = "refuse" if not math.isfinite(v) or abs(v) > 1e6 else "either"
+        pull = "refuse" if not math.isfinite(v) or abs(v) > 4e4 else "either"  # null_k = 25
+        stiff = "refuse" if not math.isfinite(v) or v < 0 or v > 1e9 else "either"
+        twin(lambda c, v=v: c.outer.set_posture([0.3, v, 0.2]), pull, f"set_posture[1] = {v:g}")
+        twin(lambda c, v=v: c.outer.set_stiffness([v, 100.0, 100.0]), stiff, f"Kd[0] = {v:g}")
+        twin(lambda c, v=v: c.outer.reset([0.3, v, 0.2]), far, f"outer.reset q0[1] = {v:g}")
+        case(t, f"CartesianController q0[0] = {v:g}", lambda v=v: started(v), far)
+    for what, call, expect in [
+        ("set_stiffness of 2", lambda c: c.outer.set_stiffness([1, 2]), "refuse"),
+        ("set_stiffness (1, 1) rot", lambda c: c.outer.set_stiffness(100.0, [[1.0]]), "refuse"),
+        ("set_posture of 6", lambda c: c.outer.set_posture(np.zeros(6)), "refuse"),
+        ("reset(np.zeros(6))", lambda c: c.outer.reset(np.zeros(6)), "refuse"),
+        ("xc of 2", lambda c: c.step(q0, z3, np.zeros(6), xc=[0.3, 0.0]), "refuse"),
+        ("q of 2", lambda c: c.step([0.3, 0.6], z3, np.zeros(6)), "refuse"),
+        ("q NaN", lambda c: c.step([0.3, math.nan, 0.2], z3, np.zeros(6)), "refuse"),
+        ("q NaN with a new R", lambda c: c.step([math.nan, 0.6, 0.2], z3, np.zeros(6), xc=p0,
+                                                R=R0 @ TURN), "refuse"),
+    ]:  # fmt: skip
+        twin(call, expect, what)
+    ci = CartesianImpedance(arm, Ts=1e-3, q0=q0)
+    calls = [0]
+
+    def path(tt: float) -> Any:
+        calls[0] += 1
+        return (p0, z3, z3)
+
+    for what, kw, expect in [
+        ("T = 1e9", {"T": 1e9}, "refuse"),
+        ("T = NaN", {"T": math.nan}, "refuse"),
+        ("T = -1", {"T": -1.0}, "refuse"),
+        ("T = '1.0'", {"T": "1.0"}, "refuse"),
+        ("T = True", {"T": True}, "refuse"),
+        ("nodes = -5", {"T": 0.05, "nodes": -5}, "refuse"),
+        ("nodes = 0", {"T": 0.05, "nodes": 0}, "refuse"),
+        ("nodes = 2.5", {"T": 0.05, "nodes": 2.5}, "refuse"),
+        ("nodes = True", {"T": 0.05, "nodes": True}, "refuse"),
+        ("nodes = 10**12", {"T": 0.01, "nodes": 10**12}, "accept"),
+        ("nodes = 4", {"T": 0.05, "nodes": 4}, "accept"),
+    ]:
+
+        def orbit(kw: dict[str, Any] = kw, expect: str = expect) -> None:
+            calls[0] = 0
+            args = dict(kw)
+            try:
+                c, _ = ci.orbit_centres(path, args.pop("T"), **args)
+            finally:
+                if expect == "refuse":
+                    check(calls[0] == 0, "the path was tabulated before the refusal")
+            _finite(c)
+
+        case(t, f"orbit_centres {what}", orbit, expect)
+    # A path that returns one bad R, then good ones: that step is refused, no more.
+    for what, bad_value in [
+        ("1.1·R", lambda: 1.1 * R0),
+        ("a 2-tuple", None),
+        ("R of 4", lambda: [1, 0, 0, 1]),
+    ]:
+
+        def pathed(bad_value: Any = bad_value) -> None:
+            k = [0]
+
+            def pth(tt: float) -> Any:
+                k[0] += 1
+                if k[0] == 3:
+                    return (p0, z3) if bad_value is None else (p0, z3, z3, bad_value(), z3, z3)
+                return (p0, z3, z3, R0, z3, z3)
+
+            c = _cart(path=pth)
+            refused = sum(_refused_step(c, q0) for _ in range(8))
+            check(refused == 1, f"{refused} steps refused after one bad path value")
+
+        case(t, f"a path that returns {what} once", pathed, "accept")  # fmt: skip
+
+
+def formulations(t: Tally, quick: bool) -> None:
+    """The formulations (SPEC §19) and their share: by name, every bad value;
+    accepted ones step with finite torques within τmax."""
+
+    for form in ("admittance", "impedance", "unified", "Unified", "", None, 3):
+        for share in (None, 0.0, 0.3, 1.0, -0.1, 1.5, math.nan, True):
+            kw: dict[str, Any] = {"formulation": form}
+            if share is not None:
+                kw["admittance_share"] = share
+            ok_form = form in ("admittance", "impedance", "unified")
+            ok_share = share is None or (
+                form == "unified" and not isinstance(share, bool) and 0.0 <= share <= 1.0
+            )
+            expect = "either" if ok_form and ok_share else "refuse"
+
+            def run(kw: dict[str, Any] = kw) -> None:
+                c = _cart(**kw)
+                tau = _cart_steps(c, 20)
+                _finite(tau)
+                check(bool(np.all(np.abs(tau) <= 20.0 + 1e-12)), "torque beyond τmax")
+
+            case(t, f"formulation={form!r} share={share!r}", run, expect)
+
+
+def dynamics(t: Tally, quick: bool) -> None:
+    """Computed torque and its model (RNEA): construction with every bad value
+    of every scalar; the model's queries with bad rates; accepted: finite."""
+    try:
+        from adaptimp.baselines import ComputedTorque
+    except ImportError:
+        return
+    values = BAD if not quick else BAD[::2]
+    positive = ("Ts", "Kp", "mass_scale", "tau_max", "Dd")  # > 0; the others ≥ 0
+    for name in ("Ts", "Kp", "Kd", "mass_scale", "payload", "tau_max", "armature", "damping",
+                 "friction", "Dd", "Gd"):  # fmt: skip
+        for v in values:
+            bad = (
+                not math.isfinite(v)
+                or v < 0
+                or (v == 0.0 and name in positive)
+                or abs(v) > 1e9
+                or (name == "Ts" and v > 1.0)
+            )
+
+            def make(name: str = name, v: float = v) -> None:
+                ct = ComputedTorque(**{name: v})
+                for _ in range(5):
+                    _finite(ct.step([0.1, 0.2], [0.0, 0.0], [0.0, 0.0]))
+
+            case(t, f"ComputedTorque({name}={v:g})", make, "refuse" if bad else "either")
+    ct = ComputedTorque()
+    for v in values:
+        bad = not math.isfinite(v) or abs(v) > 1e6
+        for what, args in [
+            ("q", ([v, 0.0], [0.0, 0.0], [0.0, 0.0])),
+            ("dq", ([0.0, 0.0], [v, 0.0], [0.0, 0.0])),
+            ("ddq", ([0.0, 0.0], [0.0, 0.0], [0.0, v])),
+        ]:
+            rnea = lambda args=args: _finite(ct.inverse_dynamics(*args))  # noqa: E731
+            case(t, f"inverse_dynamics {what} = {v:g}", rnea, "refuse" if bad else "either")
+        case(t, f"mass_matrix q = {v:g}", lambda v=v: _finite(ct.mass_matrix([v, 0.0])),
+             "refuse" if bad else "either")  # fmt: skip
+
+
+def saves(t: Tally, quick: bool) -> None:
+    """SimResult and MujocoResult files: bit flips in every stored entry, arrays
+    swapped or scaled, truncations, JSON edits of every record. A damaged file
+    is a SaveError naming it; nothing damaged loads; an intact one loads bit
+    for bit."""
+    import adaptimp
+
+    root = Path(tempfile.mkdtemp(prefix="breakit-saves-"))
+    try:
+        fault = adaptimp.Fault("nan_burst", 0.01, 0.01)
+        runs: dict[str, Any] = {
+            "fault run": adaptimp.simulate("sf", T=0.05, fault=fault),
+            "rerun": adaptimp.simulate("pd", T=0.05),
+        }
+        try:
+            from adaptimp import mujoco as amj
+
+            runs["MuJoCo run"] = amj.simulate("pd", "two_link", T=0.05)
+        except ImportError:
+            pass
+        rng = np.random.default_rng(33)
+        for label, res in runs.items():
+            for compress in (True, False):
+                path = res.save(root / f"{label}-{compress}", compress=compress)
+                _save_cases(t, f"{label} compress={compress}", res, path, rng, quick)
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
+_ROWS = ("t", "q", "dq", "xc", "xd", "tau", "tau_sat", "tau_e", "zeta", "z1")
+
+
+def _save_cases(
+    t: Tally, label: str, res: Any, path: Path, rng: np.random.Generator, quick: bool
+) -> None:
+    """The damages of one saved file (see :func:`saves`)."""
+    import json as _json
+
+    with np.load(path, allow_pickle=False) as f:
+        content = {k: f[k] for k in f}
+    bad = path.with_name("bad.npz")
+
+    def intact(p: Path = path) -> None:
+        back = type(res).load(p)
+        for name in _ROWS:
+            same = np.array_equal(getattr(back, name), getattr(res, name), equal_nan=True)
+            check(same, f"{name} not bit for bit")
+        repr(back)
+
+    def refused(edited: dict[str, Any]) -> None:
+        np.savez(bad, **edited)
+        loaded = type(res).load(bad)
+        check(False, f"a damaged file loaded ({loaded.rows} rows)")
+
+    case(t, f"{label}: load intact", intact, "accept")
+    arrays = [k for k, v in content.items() if v.dtype.kind in "fu" and v.ndim >= 1]
+    for _ in range((6 if quick else 30) if arrays else 0):
+        name = arrays[int(rng.integers(len(arrays)))]
+        a = content[name].copy()
+        flat = a.reshape(-1).view(np.uint8)
+        i, bit = int(rng.integers(flat.size)), int(rng.integers(8))
+        flat[i] ^= np.uint8(1 << bit)
+        edited = {**content, name: a}
+        case(
+            t,
+            f"{label}: flip bit {bit} of byte {i} of {name}",
+            lambda e=edited: refused(e),
+            "refuse",
+        )
+    m = _json.loads(str(content["format"]))
+    for a, b in [("q", "dq"), ("q", "tau"), ("xc", "xd"), ("tau_e", "zeta")]:
+        if a in content and b in content and content[a].shape == content[b].shape:
+            mm = _json.loads(str(content["format"]))
+            d = mm.get("differences", {})
+            if a in d and b in d:
+                d[a], d[b] = d[b], d[a]
+            edited = {**content, a: content[b], b: content[a], "format": np.array(_json.dumps(mm))}
+            case(t, f"{label}: swap {a} and {b}", lambda e=edited: refused(e), "refuse")
+    if m.get("plain"):
+        edited = {**content, "q": content["q"] * 1.5}
+        case(t, f"{label}: q × 1.5", lambda e=edited: refused(e), "refuse")
+    data = path.read_bytes()
+    for frac in (0.0, 0.3, 0.9, 0.999) if quick else np.linspace(0, 0.999, 12):
+
+        def truncated(frac: float = float(frac)) -> None:
+            bad.write_bytes(data[: int(len(data) * frac)])
+            type(res).load(bad)
+            check(False, "a truncated file loaded")
+
+        case(t, f"{label}: truncated to {frac:.1%}", truncated, "refuse")
+    for key in [*m, "version"]:
+        informative = key in ("adaptimp", "result")  # what saved it: not checked
+        mm = dict(m)
+        if key == "version":
+            mm["version"] = 99
+        else:
+            del mm[key]
+        edited = {**content, "format": np.array(_json.dumps(mm))}
+
+        def dropped(edited: dict[str, Any] = edited, informative: bool = informative) -> None:
+            if not informative:
+                refused(edited)
+            np.savez(bad, **edited)
+            intact(bad)
+
+        expect = "accept" if informative else "refuse"
+        case(t, f"{label}: format record without {key}", dropped, expect)
+    for entry, value in [("params", "{"), ("metrics", "[]"), ("case", 3.0), ("record_every", 0)]:
+        edited = {**content, entry: np.array(value)}
+        case(t, f"{label}: {entry} = {value!r}", lambda e=edited: refused(e), "refuse")
+    params = _json.loads(str(content["params"]))
+    if "T" in params:
+        edited = {**content, "params": np.array(_json.dumps({**params, "T": 1e5}))}
+        case(t, f"{label}: params T edited", lambda e=edited: refused(e), "refuse")
+
+
+def mujoco_runs(t: Tally, quick: bool) -> None:
+    """adaptimp.mujoco.simulate's arguments: durations, periods, substeps,
+    payloads, references of the wrong shape, models without actuators."""
+    try:
+        from adaptimp import mujoco as amj
+    except ImportError:
+        return
+    root = Path(tempfile.mkdtemp(prefix="breakit-mujoco-"))
+    try:
+        noact = root / "noact.xml"
+        noact.write_text('<mujoco><worldbody><body><joint type="hinge"/><geom size=".1" mass="1"/>'
+                         "</body></worldbody></mujoco>")  # fmt: skip
+        z2, z3 = np.zeros(2), np.zeros(3)
+        cases_: list[tuple[str, dict[str, Any], str]] = [
+            ("payload=1e300", {"payload": 1e300}, "refuse"),
+            ("payload=-1", {"payload": -1.0}, "refuse"),
+            ("payload=True", {"payload": True}, "refuse"),
+            ("payload=0.5", {"payload": 0.5}, "accept"),
+            ("a reference of 2 values", {"reference": lambda tt: (z2, z2)}, "refuse"),
+            ("a reference of 3 joints", {"reference": lambda tt: (z3, z3, z3)}, "refuse"),
+            ("a reference of strings", {"reference": lambda tt: ("a", "b", "c")}, "refuse"),
+            ("q0 of 3", {"q0": [0.0, 0.0, 0.0]}, "refuse"),
+            ("q0 NaN", {"q0": [math.nan, 0.0]}, "refuse"),
+            ("T = NaN", {"T": math.nan}, "refuse"),
+            ("T = -1", {"T": -1.0}, "refuse"),
+        ]  # fmt: skip
+        if not quick:  # issue 33 D (the loop's arguments)
+            cases_ += [
+                ("substeps=2.5", {"substeps": 2.5}, "refuse"),
+                ("substeps=True", {"substeps": True}, "refuse"),
+                ("substeps=10**9", {"substeps": 10**9}, "refuse"),
+                ("T='1.0'", {"T": "1.0"}, "refuse"),
+                ("T=True", {"T": True}, "refuse"),
+            ]
+        for what, kw, expect in cases_:
+
+            def run(kw: dict[str, Any] = kw) -> None:
+                res = amj.simulate("pd", "two_link", **{"T": 0.02, **kw})
+                _finite(res.tau_sat)
+
+            case(t, f"mujoco.simulate {what}", run, expect)
+        case(t, "a model without actuators", lambda: amj.Plant(str(noact)), "refuse")
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
 CATEGORIES: dict[str, Callable[[Tally, bool], None]] = {
     "state restore": restore,
     "fault semantics": faults,
     "n-joint API": njoint,
     "sweeps and cache": sweeps,
+    "chains": chains,
+    "Cartesian front": cartesian,
+    "formulations": formulations,
+    "dynamics": dynamics,
+    "saves": saves,
+    "MuJoCo runs": mujoco_runs,
 }
 
 

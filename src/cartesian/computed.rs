@@ -102,7 +102,12 @@ impl<const N: usize> ComputedTorque<N> {
         check::nonnegative_vec("Kd ≥ 0", "Kd", &cfg.kd)?;
         check::at_most_each("|value| ≤ 1e9", "Kp", cfg.kp.as_slice(), PARAM_BOUND)?;
         check::at_most_each("|value| ≤ 1e9", "Kd", cfg.kd.as_slice(), PARAM_BOUND)?;
-        check::at_most_each("|value| ≤ 1e9", "tau_max", cfg.tau_max.as_slice(), PARAM_BOUND)?;
+        check::at_most_each(
+            "|value| ≤ 1e9",
+            "tau_max",
+            cfg.tau_max.as_slice(),
+            PARAM_BOUND,
+        )?;
         let sat = Saturation::new(cfg.tau_max)?;
         Ok(Self { cfg, model, sat })
     }

@@ -44,7 +44,12 @@ impl<const N: usize> TargetImpedance<N> {
         check::nonnegative_vec("Cd ≥ 0", "Cd", &cd)?;
         check::nonnegative_vec("Gd ≥ 0", "Gd", &gd)?;
         for (what, v) in [("Dd", &dd), ("Cd", &cd), ("Gd", &gd)] {
-            check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), crate::error::PARAM_BOUND)?;
+            check::at_most_each(
+                "|value| ≤ 1e9",
+                what,
+                v.as_slice(),
+                crate::error::PARAM_BOUND,
+            )?;
         }
         Ok(Self { dd, cd, gd })
     }

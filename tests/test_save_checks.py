@@ -146,7 +146,7 @@ def test_an_edited_file_is_refused_before_its_simulation_runs(
     del bad
 
 
-def test_an_earlier_format_3_file_without_inputs_is_not_run(
+def test_an_earlier_format_3_file_without_inputs_loads_and_an_edited_t_is_not_run(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path = adaptimp.simulate("pd", T=0.05).save(tmp_path / "run")
@@ -158,10 +158,24 @@ def test_an_earlier_format_3_file_without_inputs_is_not_run(
         m["version"] = 3
         c["format"] = np.array(json.dumps(m))
 
-    bad = _rewrite(path, tmp_path / "v3.npz", as_v3)
+    old = _rewrite(path, tmp_path / "v3.npz", as_v3)
+    assert SimResult.load(old).rows == 1000  # an earlier file still loads
+
+    def longer(c: dict[str, np.ndarray]) -> None:
+        as_v3(c)
+        params = json.loads(str(c["params"]))
+        params["T"] = 1e5
+        c["params"] = np.array(json.dumps(params))
+
+    bad = _rewrite(path, tmp_path / "T.npz", longer)
     monkeypatch.setattr(_result, "_rerun", lambda *a, **k: pytest.fail("it ran"))
-    with pytest.raises(SaveError, match=r"records no digest of the case, scenario and parameters"):
+    with pytest.raises(SaveError) as e:
         SimResult.load(bad)
+    assert str(e.value) == (
+        f"{bad}: the file's parameters (T = 100000.0, Ts = 5e-05, one row in 1) do not give "
+        "the 1000 rows it records: it was edited after it was saved (its simulation is not run "
+        "again)"
+    )
 
 
 def _damaged(path: Path, tmp_path: Path) -> list[tuple[str, Path, str]]:

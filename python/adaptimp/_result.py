@@ -971,6 +971,35 @@ def _input_digests(
     }
 
 
+def _check_rows(
+    path: str | os.PathLike[str],
+    params: Mapping[str, Any],
+    record_every: int,
+    manifest: Mapping[str, Any],
+) -> None:
+    """The rows a file's parameters give (round(T/Ts) steps, every
+    ``record_every``-th kept) are the rows it records: checked before its
+    simulation is run again, in a file without the digest of its inputs (an
+    edited T ran for as long as it said)."""
+    simulated: Mapping[str, Any] = manifest.get("simulated") or {}
+    shapes = [spec["shape"] for spec in simulated.values()]
+    if not shapes:
+        return
+    T, Ts = params.get("T"), params.get("Ts")
+    rows = shapes[0][0] if shapes[0] else -1
+    try:
+        steps = round(float(T) / float(Ts))  # type: ignore[arg-type]
+        expected = -(-steps // int(record_every))
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+        expected = None
+    if expected != rows or any(not s or s[0] != rows for s in shapes):
+        raise SaveError(
+            f"{path}: the file's parameters (T = {T!r}, Ts = {Ts!r}, one row in "
+            f"{record_every}) do not give the {rows} rows it records: it was edited "
+            "after it was saved (its simulation is not run again)"
+        )
+
+
 def _check_inputs(
     path: str | os.PathLike[str],
     case: str,
@@ -983,14 +1012,7 @@ def _check_inputs(
     recorded (the file edited after it was saved), naming each that differs."""
     recorded = manifest.get("inputs")
     if recorded is None:  # saved (in format 2 or 3) before the inputs were recorded
-        if manifest.get("simulated"):
-            # Running it again would run whatever the file says now (T = 1e5 …).
-            raise SaveError(
-                f"{path}: the file leaves arrays to the simulation to recompute but records "
-                "no digest of the case, scenario and parameters to run: it cannot be checked "
-                "before it runs (the file was edited after it was saved, or saved by a "
-                "development version of format 3)"
-            )
+        _check_rows(path, params, record_every, manifest)
         return
     if not isinstance(recorded.get("params"), dict):
         raise SaveError(f"{path}: its format record's 'inputs' is damaged")

@@ -20,15 +20,14 @@
 //! joint quantities (q, τ, sat(τ), τe, ζ, the velocity used) are the joint
 //! controller's, as for a joint-space run.
 
-use super::cartesian::TARGET_LEN;
+use super::computed::Computed;
 use super::dynamic::{
     drive_mujoco, FaultKind, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError,
     TaskMetrics, Typed,
 };
 use super::mujoco::MujocoSpec;
 use crate::cartesian::{
-    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain,
-    ComputedState, ComputedTorque, PoseTarget,
+    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, PoseTarget,
 };
 use crate::control::config::Law;
 use crate::control::impedance::TargetImpedance;
@@ -42,6 +41,9 @@ use adaptimp_mujoco::Sim;
 use core::cell::Cell;
 use nalgebra::Matrix3;
 use std::vec::Vec;
+
+/// Length of a flat pose target: p, ṗ, p̈ (3 each), R row-major (9), ω, ω̇ (3 each).
+pub const TARGET_LEN: usize = 24;
 
 /// A Cartesian run on MuJoCo ([`simulate_mujoco`]).
 pub struct CartesianRun<'a> {
@@ -112,15 +114,6 @@ impl<const N: usize> JointStep<N> for Typed<N> {
     fn applied(&self) -> Vector<N> {
         *self.state().applied()
     }
-}
-
-/// Computed torque (SPEC §20) with its state.
-#[derive(Clone, Debug)]
-pub struct Computed<const N: usize> {
-    /// The controller.
-    pub ctrl: ComputedTorque<N>,
-    /// Its state.
-    pub state: ComputedState<N>,
 }
 
 impl<const N: usize> JointStep<N> for Computed<N> {
@@ -550,6 +543,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         items: run.items,
         law,
         fault: run.fault,
+        abort: None,
     };
     let mut recorder = TaskRecorder {
         joint: &mut rec,

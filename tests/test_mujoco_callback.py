@@ -29,6 +29,7 @@ import numpy as np
 import pytest
 
 import adaptimp
+import mujoco_probe
 from adaptimp import _models
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque
@@ -274,3 +275,239 @@ if __name__ == "__main__" and sys.argv[1:] == ["--write"]:
     out.update({name: record_rows(make) for name, make in CONTACT_LIST.items()})
     DATA.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n", encoding="utf-8")
     print(f"wrote {DATA}")
+
+
+# ---------------------------------------------------------------------------
+# What the core's loop brings to a controller written in Python.
+# ---------------------------------------------------------------------------
+
+
+def _same(got: amj.MujocoResult, want: amj.MujocoResult, names: tuple[str, ...] = ARRAYS) -> None:
+    for name in names:
+        if name != "w_norms":
+            np.testing.assert_array_equal(getattr(got, name), getattr(want, name), err_msg=name)
+    assert set(got.metrics) == set(want.metrics)
+    for key, value in want.metrics.items():
+        np.testing.assert_array_equal(got.metrics[key], value, err_msg=key)
+
+
+def test_disturbances_act_on_a_controller_called_back() -> None:
+    """SPEC §17 on a controller written in Python: the same bits as the same
+    controller stepped natively, under noise, delay, friction and weak motors."""
+    kw: dict[str, Any] = {
+        "T": 1.0, "noise_q": 1e-3, "noise_dq": 1e-2, "seed": 4, "delay": 2,
+        "friction_viscous": 0.5, "friction_coulomb": 0.2, "actuator_fraction": 0.8,
+    }  # fmt: skip
+    native = amj.simulate(adaptimp.Controller("sf", "robot"), "two_link", **kw)
+    called = amj.simulate(InPython(adaptimp.Controller("sf", "robot")), "two_link", **kw)
+    assert (native.params["loop"], called.params["loop"]) == ("native", "callback")
+    _same(called, native)
+    clean = amj.simulate(InPython(adaptimp.Controller("sf", "robot")), "two_link", T=1.0)
+    assert not np.array_equal(called.tau, clean.tau)
+    assert called.metrics["steps_in_contact"] > 100
+
+
+@pytest.mark.parametrize(
+    "fault",
+    [
+        adaptimp.Fault("stale", 0.3, 0.05),
+        adaptimp.Fault("actuator_drop", 0.3, 0.1, fraction=0.2),
+        adaptimp.Fault("force_bias", 0.3, 0.1, bias=[2.0, -1.0]),
+    ],
+    ids=["stale", "actuator_drop", "force_bias"],
+)
+def test_a_fault_acts_on_a_controller_called_back(fault: adaptimp.Fault) -> None:
+    native = amj.simulate(adaptimp.Controller("sf", "robot"), "two_link", T=0.6, fault=fault)
+    called = amj.simulate(
+        InPython(adaptimp.Controller("sf", "robot")), "two_link", T=0.6, fault=fault
+    )
+    _same(called, native)
+    base = amj.simulate(adaptimp.Controller("sf", "robot"), "two_link", T=0.6)
+    assert not np.array_equal(called.tau_sat, base.tau_sat)
+
+
+def test_skipped_steps_and_a_torque_that_is_not_finite_are_refused() -> None:
+    """A fault's skipped steps are not called; with a fault, a non-finite torque
+    is a refused step (zero torque, the run goes on); without one it ends the
+    run, as a ValueError naming it."""
+    skip = adaptimp.Fault("skipped", 0.1, 0.01)
+    ctrl = PythonPD()
+    res = amj.simulate(ctrl, "two_link", T=0.2, reference=amj.paper_circle(), fault=skip)
+    assert res.refused is not None
+    assert int(np.sum(res.refused)) == 10
+    assert ctrl.calls == 190
+    native = amj.simulate(
+        adaptimp.Controller("pd", "robot"), "two_link", T=0.2, reference=amj.paper_circle(),
+        fault=skip,
+    )  # fmt: skip
+    np.testing.assert_array_equal(res.refused, native.refused)
+
+    class Blows(PythonPD):
+        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+            tau = super().step(q, tau_e, dq, **sp)
+            return np.array([math.nan, 1.0]) if 50 <= self.calls < 55 else tau
+
+    burst = adaptimp.Fault("nan_burst", 1.0, 0.01)  # a window after the run: refusals allowed
+    res = amj.simulate(Blows(), "two_link", T=0.2, reference=amj.paper_circle(), fault=burst)
+    assert res.refused is not None
+    assert np.flatnonzero(res.refused).tolist() == [49, 50, 51, 52, 53]
+    np.testing.assert_array_equal(res.tau_sat[49:54], np.zeros((5, 2)))
+    with pytest.raises(ValueError, match=r"^tau must be finite, got ") as e:
+        amj.simulate(Blows(), "two_link", T=0.2, reference=amj.paper_circle())
+    # The words of the loop written in Python, which NumPy's printing gave.
+    assert str(e.value) == f"tau must be finite, got {np.array([math.nan, 1.0])}"
+
+
+class Raises(PythonPD):
+    """Raises at its call number ``at``."""
+
+    def __init__(self, at: int) -> None:
+        super().__init__()
+        self.at = at
+
+    def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+        if self.calls + 1 == self.at:
+            raise RuntimeError(f"the controller gave up at call {self.at}")
+        return super().step(q, tau_e, dq, **sp)
+
+
+def test_an_exception_ends_the_run_with_it_and_the_plant_where_it_was() -> None:
+    """An exception of the controller ends the run with that exception (also
+    with a fault injected, which refuses only what the core refuses); the
+    plant is left at the start of the period that raised, so a run with
+    reset=False goes on from there."""
+    plant = amj.Plant("two_link")
+    ctrl = Raises(at=6)
+    with pytest.raises(RuntimeError, match=r"^the controller gave up at call 6$"):
+        amj.simulate(ctrl, plant, T=0.2, reference=amj.paper_circle())
+    assert ctrl.calls == 5
+    assert plant.data.time == pytest.approx(5 * ctrl.Ts, abs=1e-12)
+    ctrl.at = 0
+    on = amj.simulate(ctrl, plant, T=0.01, reference=amj.paper_circle(), reset=False)
+    assert on.rows == 10
+    assert plant.data.time == pytest.approx(15 * ctrl.Ts, abs=1e-12)
+    with pytest.raises(RuntimeError, match="at call 3"):
+        amj.simulate(
+            Raises(at=3), "two_link", T=0.2, reference=amj.paper_circle(),
+            fault=adaptimp.Fault("stale", 0.0, 0.1),
+        )  # fmt: skip
+
+
+def test_what_a_controller_returns_and_says_is_checked_by_name() -> None:
+    class Wide(PythonPD):
+        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+            return np.zeros(3)
+
+    with pytest.raises(ValueError, match=r"^tau must have shape \(2,\), got \(3,\)$"):
+        amj.simulate(Wide(), "two_link", T=0.01, reference=amj.paper_circle())
+
+    class Scalar(PythonPD):
+        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> float:
+            return 0.5
+
+    res = amj.simulate(Scalar(), "two_link", T=0.01, reference=amj.paper_circle())
+    np.testing.assert_array_equal(res.tau_sat, np.full((10, 2), 0.5))
+
+    class BadXd(PythonPD):
+        xd = np.zeros(3)
+
+    with pytest.raises(ValueError, match=r"^the controller's xd must have 2 values, got shape"):
+        amj.simulate(BadXd(), "two_link", T=0.01, reference=amj.paper_circle())
+
+    class Word(PythonPD):
+        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> str:
+            return "torque"
+
+    with pytest.raises(ValueError, match="could not convert string to float"):
+        amj.simulate(Word(), "two_link", T=0.01, reference=amj.paper_circle())
+
+
+def test_a_task_space_controller_called_back_refuses_what_acts_on_tau_e() -> None:
+    ctrl, model, kw = case_cartesian_in_python()
+    with pytest.raises(adaptimp.ConfigError, match="noise_tau_e: a task-space controller reads"):
+        amj.simulate(ctrl, model, noise_tau_e=0.1, **kw)
+    bias = adaptimp.Fault("force_bias", 0.1, 0.1, bias=[1.0, 1.0])
+    with pytest.raises(adaptimp.ConfigError, match="force_bias: a task-space controller reads"):
+        amj.simulate(ctrl, model, fault=bias, **kw)
+
+
+def test_ctrl_c_in_the_controller_ends_the_run() -> None:
+    """SIGINT while the controller's step runs: KeyboardInterrupt, at once."""
+    import os
+    import signal
+
+    class Interrupted(PythonPD):
+        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+            if self.calls == 20:
+                os.kill(os.getpid(), signal.SIGINT)
+            return super().step(q, tau_e, dq, **sp)
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        ctrl = Interrupted()
+        with pytest.raises(KeyboardInterrupt):
+            amj.simulate(ctrl, "two_link", T=10.0, reference=amj.paper_circle())
+        assert 20 <= ctrl.calls < 40
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def test_many_substeps_are_interrupted() -> None:
+    """A progress callback that raises ends a run of 10 000 MuJoCo steps per
+    period with its exception; the plant and controller run again after."""
+    plant = amj.Plant("two_link")
+    ctrl = adaptimp.Controller("sf", "robot")
+
+    def interrupt(done: int, total: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        amj.simulate(ctrl, plant, T=5.0, substeps=10_000, progress=interrupt)
+    assert plant.data.time < 5.0
+    res = amj.simulate(PythonPD(), plant, T=0.05, reference=amj.paper_circle())
+    assert res.rows == 50
+
+
+_SUBSTEPS = "substeps must be an integer (MuJoCo steps per period), got "
+_BOUND = "condition 1 ≤ substeps ≤ 10 000 is violated: substeps = {} (MuJoCo steps per period)"
+
+
+@pytest.mark.parametrize(
+    ("kw", "error", "message"),
+    [
+        ({"substeps": 2.5}, TypeError, _SUBSTEPS + "float"),
+        ({"substeps": True}, TypeError, _SUBSTEPS + "bool"),
+        ({"substeps": "3"}, TypeError, _SUBSTEPS + "str"),
+        ({"substeps": 0}, adaptimp.ConfigError, _BOUND.format(0)),
+        ({"substeps": -2}, adaptimp.ConfigError, _BOUND.format(-2)),
+        ({"substeps": 10_001}, adaptimp.ConfigError, _BOUND.format(10001)),
+        ({"substeps": 10**8}, adaptimp.ConfigError, _BOUND.format(100000000)),
+        ({"T": "1.0"}, TypeError, "T must be a real number (s), got str"),
+        ({"T": True}, TypeError, "T must be a real number (s), got bool"),
+        ({"T": [1.0]}, TypeError, "T must be a real number (s), got list"),
+        ({"Ts": True}, TypeError, "Ts must be a real number (s), got bool"),
+        ({"Ts": "1e-3"}, TypeError, "Ts must be a real number (s), got str"),
+    ],
+)
+def test_the_run_arguments_are_refused_by_name_before_any_work(
+    kw: dict[str, Any], error: type[Exception], message: str
+) -> None:
+    """Issue 33 D: before the model is even read (here a file that is not there)."""
+    with pytest.raises(error) as e:
+        amj.simulate("sf", "nowhere.xml", **kw)
+    assert str(e.value) == message
+
+
+def test_numpy_numbers_are_run_arguments() -> None:
+    res = amj.simulate("pd", "two_link", T=np.float64(0.01), substeps=np.int64(3), contact=False)
+    assert (res.rows, res.params["substeps"]) == (10, 3)
+    assert res.params["timestep"] == pytest.approx(1e-3 / 3)
+    res = amj.simulate("pd", "two_link", T=0.01, Ts=np.float32(1e-3), substeps=10_000)
+    assert res.params["substeps"] == 10_000
+    slow = mujoco_probe.Hold([0.0, 0.0], Ts=1.0)  # 20 000 of the model's 50 µs
+    with pytest.raises(adaptimp.ConfigError) as e:
+        amj.simulate(slow, "two_link", T=1.0)
+    assert str(e.value) == (
+        "condition 1 ≤ substeps ≤ 10 000 is violated: substeps = round(Ts / the model's "
+        "timestep) = 20000: give substeps"
+    )

@@ -424,10 +424,10 @@ def test_what_a_controller_returns_and_says_is_checked_by_name() -> None:
 
 def test_a_task_space_controller_called_back_refuses_what_acts_on_tau_e() -> None:
     ctrl, model, kw = case_cartesian_in_python()
-    with pytest.raises(adaptimp.ConfigError, match="noise_tau_e: a task-space controller reads"):
+    with pytest.raises(adaptimp.ConfigError, match="noise_tau_e: a Cartesian controller reads"):
         amj.simulate(ctrl, model, noise_tau_e=0.1, **kw)
     bias = adaptimp.Fault("force_bias", 0.1, 0.1, bias=[1.0, 1.0])
-    with pytest.raises(adaptimp.ConfigError, match="force_bias: a task-space controller reads"):
+    with pytest.raises(adaptimp.ConfigError, match="force_bias: a Cartesian controller reads"):
         amj.simulate(ctrl, model, fault=bias, **kw)
 
 

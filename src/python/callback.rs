@@ -27,6 +27,7 @@
 //! same rows by [`TaskMetrics`] (as `_adaptimp.metrics` computed them for
 //! the Python loop: the same bits).
 
+use super::cartesian_loop::reads_the_wrench;
 use super::dynamic::{
     drive_mujoco, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError, TaskMetrics,
 };
@@ -555,6 +556,48 @@ impl From<RunError> for RunOut {
     }
 }
 
+/// A run's records, metrics and target, made before it starts: the table
+/// and the disturbances checked, the rows allocated.
+struct Prepared<const N: usize, const M: usize> {
+    joint: Records,
+    reference: RefRows,
+    metrics: TaskMetrics<M>,
+    target: TargetImpedance<N>,
+}
+
+fn prepare<const N: usize, const M: usize>(
+    run: &CallbackRun<'_>,
+) -> Result<Prepared<N, M>, RunError> {
+    let w = run.m;
+    let total = crate::sim::simulator::steps(run.t_final, run.ts)?;
+    let need = usize::try_from(total)
+        .unwrap_or(usize::MAX)
+        .saturating_mul(w);
+    if run.table.iter().any(|t| t.len() < need) {
+        return Err(invalid("table", "needs one row per step"));
+    }
+    if run.wants_wrench {
+        reads_the_wrench::<N>(Law::Pd, run.items, run.fault)?;
+    }
+    let every = run.every.max(1);
+    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let joint = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let mut reference = RefRows::default();
+    for v in &mut reference {
+        let room = kept.checked_mul(w).ok_or(RunError::Memory(kept))?;
+        v.try_reserve_exact(room)
+            .map_err(|_| RunError::Memory(kept))?;
+    }
+    let joint_space = !run.wants_wrench && w == N;
+    let (metrics, target) = metrics_and_target::<N, M>(run, joint_space)?;
+    Ok(Prepared {
+        joint,
+        reference,
+        metrics,
+        target,
+    })
+}
+
 /// The closed loop of the Python controller `ctrl` on MuJoCo (`sim` as
 /// `spec` describes it), with the reference's width M = max(N, m) in the
 /// metrics' accumulator.
@@ -565,41 +608,9 @@ fn run_m<const N: usize, const M: usize>(
     run: &CallbackRun<'_>,
     hooks: &mut dyn Hooks,
 ) -> RunOut {
-    let fail = |e: RunError| RunOut::from(e);
-    let (n, w) = (N, run.m);
-    let total = match crate::sim::simulator::steps(run.t_final, run.ts) {
-        Ok(t) => t,
-        Err(e) => return fail(e.into()),
-    };
-    let need = usize::try_from(total)
-        .unwrap_or(usize::MAX)
-        .saturating_mul(w);
-    if run.table.iter().any(|t| t.len() < need) {
-        return fail(invalid("table", "needs one row per step"));
-    }
-    if run.wants_wrench {
-        if let Err(e) = wrench_only(run) {
-            return fail(e);
-        }
-    }
-    let every = run.every.max(1);
-    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-    let Some(joint) = Records::with_rows(n, kept, every, true) else {
-        return fail(RunError::Memory(kept));
-    };
-    let mut reference = RefRows::default();
-    for v in &mut reference {
-        if kept
-            .checked_mul(w)
-            .is_none_or(|c| v.try_reserve_exact(c).is_err())
-        {
-            return fail(RunError::Memory(kept));
-        }
-    }
-    let joint_space = !run.wants_wrench && w == n;
-    let (metrics, target) = match metrics_and_target::<N, M>(run, joint_space) {
-        Ok(mt) => mt,
-        Err(e) => return fail(e.into()),
+    let p = match prepare::<N, M>(run) {
+        Ok(p) => p,
+        Err(e) => return e.into(),
     };
     let (clock, report, abort) = (Cell::new(0.0), Cell::new(Report::NONE), Cell::new(false));
     let tau_max =
@@ -607,7 +618,7 @@ fn run_m<const N: usize, const M: usize>(
     let mut step = PyStep::<N> {
         ctrl,
         run,
-        target,
+        target: p.target,
         tau_max,
         clock: &clock,
         report: &report,
@@ -617,9 +628,9 @@ fn run_m<const N: usize, const M: usize>(
     let mut rows = Rows::<N, M> {
         run,
         report: &report,
-        joint,
-        reference,
-        metrics,
+        joint: p.joint,
+        reference: p.reference,
+        metrics: p.metrics,
         seen: 0,
     };
     let on = OnMujoco {
@@ -641,38 +652,6 @@ fn run_m<const N: usize, const M: usize>(
 
 fn invalid(what: &'static str, reason: &'static str) -> RunError {
     RunError::Core(Error::Invalid { what, reason }, None)
-}
-
-/// A task-space controller reads the wrench, not τe: what acts on τe alone
-/// would act on nothing (as for the core's Cartesian controller).
-fn wrench_only(run: &CallbackRun<'_>) -> Result<(), RunError> {
-    use super::dynamic::FaultKind;
-    let noisy = run.items.iter().any(|(name, v)| {
-        name == "noise_tau_e"
-            && match v {
-                super::dynamic::Owned::Real(x) => *x != 0.0,
-                super::dynamic::Owned::Int(i) => *i != 0,
-                super::dynamic::Owned::Vec(v) => v.iter().any(|x| *x != 0.0),
-                _ => false,
-            }
-    });
-    if noisy {
-        return Err(invalid(
-            "noise_tau_e",
-            "a task-space controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
-        ));
-    }
-    if let Some(FaultSpec {
-        kind: FaultKind::ForceBias(_),
-        ..
-    }) = run.fault
-    {
-        return Err(invalid(
-            "force_bias",
-            "a task-space controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
-        ));
-    }
-    Ok(())
 }
 
 /// The metrics' accumulator (n joints, the reference m wide) and the target

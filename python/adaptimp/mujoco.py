@@ -1561,7 +1561,8 @@ def _callback_loop(
         table = _tabulate(reference, steps, Ts)
     else:
         nan = np.full((steps, width), math.nan)
-        rates = None if own_rates else _builtin_rates(ctrl, steps, Ts)
+        # The rates of its own joint-space sinusoid, if its params declare one.
+        rates = None if own_rates or wants_wrench else _builtin_rates(ctrl, steps, Ts)
         table = (nan, *(rates or (nan, nan)))
     attrs = [name for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta") if has[name]]
     cparams = getattr(ctrl, "params", None)

@@ -512,6 +512,8 @@ impl<const N: usize, const M: usize> Recorder<N> for Rows<'_, N, M> {
             tau,
             dx_hat: own(rep.dq_hat, r.dx),
             zeta: Vector::from_fn(|i, _| rep.zeta[i]),
+            // No weights are read (also on a row refused before any step).
+            w_norms: [f64::NAN; 3],
             ..*r
         };
         self.joint.record(&row);

@@ -281,11 +281,18 @@ impl<'a, const N: usize> MjPlant<'a, N> {
         Err(invalid("run", "stopped"))
     }
 
-    /// One MuJoCo step done: the hook every [`TICK_STEPS`].
+    /// One MuJoCo step done: the hook every [`TICK_STEPS`]. Stopped within a
+    /// period, the data is left at the state reached, computed forward (as a
+    /// period leaves it: a run continued from it reads it).
     fn stepped(&mut self) -> Result<(), Error> {
         self.since += 1;
         if self.since >= TICK_STEPS {
-            self.ask(self.rows)?;
+            if let Err(e) = self.ask(self.rows) {
+                if let Err(fatal) = self.sim.forward() {
+                    return Err(self.fatal(fatal));
+                }
+                return Err(e);
+            }
         }
         Ok(())
     }

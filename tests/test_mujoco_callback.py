@@ -5,7 +5,9 @@ Python loop gave before it was deleted.
 The digests in ``tests/data/python_loop.json`` were written by the Python loop
 (``mujoco._python_loop``, the loop every controller the core could not step took
 until it was deleted) with ``python tests/test_mujoco_callback.py --write`` on the
-commit before the core's loop took these controllers over. Each case's arrays,
+commit before the core's loop took these controllers over; those of the runs the
+core stepped natively already (``NATIVE``: they must not change) by the build of
+that commit, with ``--write-native``. Each case's arrays,
 metrics and the controller left behind are compared digest by digest (bit for
 bit; a NaN is any NaN). The runs on a model whose wrench comes from its contacts
 (no force sensor) are compared to the recorded rows within a tolerance instead:
@@ -183,6 +185,42 @@ CASES: dict[str, Callable[[], tuple[Any, Any, dict[str, Any]]]] = {
 }
 """Cases compared bit for bit."""
 
+
+def case_native_sf_contact() -> tuple[Any, Any, dict[str, Any]]:
+    return adaptimp.Controller("sf", "robot"), "two_link", {"T": 1.0, "record_every": 3}
+
+
+def case_native_disturbed() -> tuple[Any, Any, dict[str, Any]]:
+    kw = {
+        "T": 1.0, "noise_q": 1e-3, "seed": 2, "delay": 1, "friction_viscous": 0.3,
+        "fault": adaptimp.Fault("stale", 0.4, 0.05),
+    }  # fmt: skip
+    return adaptimp.Controller("of", "robot"), "two_link", kw
+
+
+def case_native_cartesian_panda() -> tuple[Any, Any, dict[str, Any]]:
+    from adaptimp import cartesian as ac
+
+    sc = ac.panda_table()
+    return ac.panda_controller("sf", sc), amj.Plant(sc.model), {"T": 0.4, "q0": sc.q0}
+
+
+def case_native_ct_cartesian() -> tuple[Any, Any, dict[str, Any]]:
+    from adaptimp import cartesian as ac
+
+    sc = ac.panda_table()
+    return ac.panda_controller("ct", sc), amj.Plant(sc.model), {"T": 0.4, "q0": sc.q0}
+
+
+NATIVE: dict[str, Callable[[], tuple[Any, Any, dict[str, Any]]]] = {
+    "native_sf_contact": case_native_sf_contact,
+    "native_disturbed": case_native_disturbed,
+    "native_cartesian_panda": case_native_cartesian_panda,
+    "native_ct_cartesian": case_native_ct_cartesian,
+}
+"""Controllers the core stepped before: their runs must not change (digests
+written by the build before this loop, ``--write-native``)."""
+
 CONTACT_LIST: dict[str, Callable[[], tuple[Any, Any, dict[str, Any]]]] = {
     "contact_list_sf": case_contact_list_sf,
     "contact_list_pd": case_contact_list_pd,
@@ -243,6 +281,15 @@ def frozen() -> dict[str, Any]:
         return dict(json.load(f))
 
 
+@pytest.mark.parametrize("name", sorted(NATIVE))
+def test_a_native_run_gives_the_bits_it_gave(name: str, frozen: dict[str, Any]) -> None:
+    got, want = record(NATIVE[name]), frozen[name]
+    assert got["arrays"] == want["arrays"]
+    assert got["task"] == want["task"]
+    assert got["metrics"] == want["metrics"]
+    assert got["left"] == want["left"]
+
+
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_a_python_controller_gives_the_python_loops_bits(name: str, frozen: dict[str, Any]) -> None:
     got, want = record(CASES[name]), frozen[name]
@@ -273,6 +320,13 @@ def test_a_contact_measured_model_gives_the_python_loops_run(
 if __name__ == "__main__" and sys.argv[1:] == ["--write"]:
     out = {name: record(make) for name, make in CASES.items()}
     out.update({name: record_rows(make) for name, make in CONTACT_LIST.items()})
+    DATA.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+    print(f"wrote {DATA}")
+if __name__ == "__main__" and sys.argv[1:] == ["--write-native"]:
+    # Run with the build before the change on PYTHONPATH: the native runs' digests.
+    with DATA.open(encoding="utf-8") as f:
+        out = json.load(f)
+    out.update({name: record(make) for name, make in NATIVE.items()})
     DATA.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n", encoding="utf-8")
     print(f"wrote {DATA}")
 

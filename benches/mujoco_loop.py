@@ -626,7 +626,10 @@ BUILD_ROWS = (
     ("Panda SF joint", "Panda on its table, SF, joint space, 2 MuJoCo steps"),
     ("UR5 SF Cartesian", "UR5, SF behind the Cartesian impedance, path in Python"),
     ("Panda SF Cartesian", "Panda pressing on its table, SF behind the Cartesian impedance"),
-    ("two_link CT joint", "the paper's arm at 1 kHz, computed torque (+30 % mass)"),
+    (
+        "two_link CT joint",
+        "the paper's arm at 1 kHz, computed torque (+30 % mass); before: the Python loop",
+    ),
     ("two_link PD written in Python", "the paper's arm at 1 kHz, a PD written in Python"),
 )
 

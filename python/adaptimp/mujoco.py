@@ -50,14 +50,14 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._errors import ConfigError, needs_extra
+from ._errors import ConfigError, PlantWarning, needs_extra
 
 try:
     import mujoco
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
-from . import _adaptimp, _models
+from . import _adaptimp, _mjcf, _models
 from ._faults import Fault
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
@@ -94,7 +94,7 @@ MAX_JOINTS = 7
 """The most joints a :class:`Plant` accepts."""
 
 
-ModelSource = Union["mujoco.MjModel", str, "os.PathLike[str]"]
+ModelSource = Union["mujoco.MjModel", "mujoco.MjSpec", str, "os.PathLike[str]"]
 
 
 class ControllerLike(Protocol):
@@ -387,15 +387,21 @@ def panda(
     return spec.compile()
 
 
-def _load(source: ModelSource) -> mujoco.MjModel:
+def _prepare(source: ModelSource, tip: str | None, fix: tuple[str, ...]) -> _mjcf.Prepared:
+    """The plant's model of ``source`` (SPEC §18, ``adaptimp._mjcf``): an MJCF
+    file edited in memory (joints that are not the arm's locked, one torque
+    motor per arm joint), a URDF through :func:`from_urdf` (``tip`` a link),
+    a given ``MjModel`` or a packaged model checked (servos made motors)."""
     if isinstance(source, mujoco.MjModel):
-        return copy.deepcopy(source)
+        return _mjcf.prepare_model(source, tip, fix)
+    if isinstance(source, mujoco.MjSpec):
+        return _mjcf.prepare_spec(source.copy(), tip, fix)
     if isinstance(source, str) and source in _BUILTIN:
-        return _BUILTIN[source]()
+        return _mjcf.prepare_model(_BUILTIN[source](), tip, fix)
     path = _model_path(source)
     if path.suffix.lower() == ".urdf":
-        return from_urdf(path)
-    return mujoco.MjModel.from_xml_path(str(path))
+        return _mjcf.prepare_model(from_urdf(path, fix=fix, tip=tip), tip, ())
+    return _mjcf.prepare_file(path, tip, fix)
 
 
 def _model_path(source: str | os.PathLike[str]) -> Path:
@@ -424,56 +430,117 @@ class Plant:
     """A MuJoCo model of a serial arm as the plant of a control loop.
 
     ``D(q) q̈ + C(q, q̇) q̇ + G(q) = sat(τ) − τe`` with everything MuJoCo adds
-    (contact, joint limits, whatever the model declares). The plant owns a copy
-    of the model (``model``) and its ``data``.
+    (contact, joint limits, joint damping, armature and friction loss, whatever
+    the model declares). The plant owns a copy of the model (``model``) and
+    its ``data``.
+
+    A model as its maker ships it (SPEC §18, ``docs/your_arm.md``): the arm is
+    the model's serial chain of hinge joints (:func:`adaptimp._mjcf.arm_of`,
+    the URDF reduction's rules on MuJoCo's body tree), ending at ``tip`` if
+    given. Joints of the arm's own body tree that are not the arm's (a
+    gripper's fingers, coupled joints, a slide, a head) are **locked at their
+    reference position** (removed from an in-memory copy of the file with
+    their actuators, couplings and sensors: the hand is then one rigid body,
+    as the controller's model of the arm has it, and no finger swings
+    unmodelled on the wrist). Every arm joint is driven by **one torque
+    motor**: a ``motor`` as it is; a ``position``, ``velocity`` or
+    ``general`` actuator becomes a motor of the same force range (the
+    controller commands torque); a joint without one gets one. τmax is gear ×
+    the actuator's ``forcerange`` (a motor's ``ctrlrange``), or the joint's
+    ``actuatorfrcrange`` if smaller; where nothing declares it, it is
+    estimated from the arm, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within
+    the joint limits. Each change is a :class:`adaptimp.PlantWarning` and an
+    entry of :attr:`notes` (``res.params["plant"]``); the file is never
+    written. Joints on other body trees (a door, a table on a spring) are the
+    environment's and stay as they are.
 
     Parameters
     ----------
-    model : MjModel, str or path
-        An ``MjModel``; ``"two_link"`` or ``"panda"`` (the packaged models, see
+    model : MjModel, MjSpec, str or path
+        An ``MjModel``; an ``MjSpec`` (e.g. an arm with a gripper attached; a
+        copy is edited); ``"two_link"`` or ``"panda"`` (the packaged models, see
         :func:`two_link`, :func:`panda`); or a path to an MJCF file, or to a
-        URDF (compiled by :func:`from_urdf`).
+        URDF (compiled by :func:`from_urdf`). A compiled ``MjModel`` cannot
+        lose joints or gain actuators: one whose arm tree holds joints that
+        are not the arm's, or an arm joint without an actuator, is refused
+        (give the file's path instead).
     contact : bool
         False disables every contact (MuJoCo's ``mjDSBL_CONTACT``): free space.
+    tip : str, optional
+        The end effector, a site or a body (its origin; a site if both have
+        the name): the arm is the hinges on the way to it. Default: the site of
+        the model's force sensor, or the first site of the last joint's body,
+        or that body's origin. A URDF's ``tip`` is a link.
+    fix : tuple of str
+        Joints to lock as well (at their reference position), by name.
     site : str, optional
-        The end-effector site; by default the site of the model's force sensor,
-        or the first site of the last joint's body, or that body's origin.
+        The end-effector site (the earlier name of ``tip`` for a site).
 
     Raises
     ------
     ValueError
         The model is not an arm this class can drive; the message names the
-        offending joint or actuator (joints must all be hinges, at most
-        :data:`MAX_JOINTS`, along one kinematic chain; every joint needs exactly
-        one torque actuator: a ``motor``, ``ctrllimited`` with a symmetric
-        ``ctrlrange``).
+        file, joint, body or actuator and what to do (at most
+        :data:`MAX_JOINTS` arm joints along one kinematic chain, one joint per
+        body; one actuator per arm joint; a force range symmetric about 0).
 
     Attributes
     ----------
     n : int
         Number of joints.
+    joint_names : list of str
+        The arm's joints, base to tip.
     tau_max : ndarray, (n,)
-        Actuator limits τmax (N m): gear × ctrlrange.
+        Actuator limits τmax (N m): gear × ctrlrange of the plant's motors.
     wrench_source : str
         ``"sensor"`` (force/torque sensor), ``"contact sensor"`` (the net contact
         wrench on the end effector's subtree, a MuJoCo contact sensor) or
         ``"contact"`` (MuJoCo's contact list, ``mj_contactForce``).
+    tip : str or None
+        The end effector asked for (``tip`` or ``site``; None: found as above).
     site : str or None
-        The end-effector site asked for (None: found as above).
+        The end-effector site asked for with ``site=``.
+    notes : dict
+        What the plant made of the model: "locked" {joint: why}, "actuators"
+        {joint: servo → motor}, "added" [joints given a motor], "tau_max"
+        {joint: where τmax comes from: "forcerange", "ctrlrange",
+        "actuatorfrcrange" or "estimated"}, "warnings" [their texts], "tip".
     """
 
     def __init__(
-        self, model: ModelSource = "two_link", *, contact: bool = True, site: str | None = None
+        self,
+        model: ModelSource = "two_link",
+        *,
+        contact: bool = True,
+        site: str | None = None,
+        tip: str | None = None,
+        fix: Sequence[str] = (),
     ) -> None:
+        if site is not None and tip is not None:
+            raise ValueError("give the end effector as tip= (a site or a body) or site=, not both")
+        if isinstance(fix, str):
+            raise TypeError(f"fix must be a tuple of joint names, got the string {fix!r}")
         self.contact = contact
         self.site = site
-        self._setup_model(_load(model), site)
+        self.tip = tip if tip is not None else site
+        self.fix = tuple(fix)
+        prepared = _prepare(model, self.tip, self.fix)
+        self._arm_names: tuple[str, ...] = prepared.arm["joints"]
+        self.notes: dict[str, Any] = {**prepared.notes, "warnings": list(prepared.warnings)}
+        for text in prepared.warnings:
+            warnings.warn(text, PlantWarning, stacklevel=2)
+        self._setup_model(prepared.model, self.tip)
+        self.notes["tip"] = (
+            _name(self.model, mujoco.mjtObj.mjOBJ_SITE, self._site)
+            if self._site >= 0
+            else _name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body)
+        )
         if self.wrench_source == "contact" and self._contact_sensor_fits(model):
-            # An MJCF file's model: measure the contacts with a sensor of its own
-            # (the net contact wrench on the end effector's subtree), which the
-            # core's loop reads like the force sensor. A sensor changes no dynamics.
-            assert isinstance(model, (str, os.PathLike))
-            spec = mujoco.MjSpec.from_file(str(model))
+            # A file's model: measure the contacts with a sensor of its own (the
+            # net contact wrench on the end effector's subtree), which the core's
+            # loop reads like the force sensor. A sensor changes no dynamics.
+            spec = prepared.spec
+            assert spec is not None
             spec.add_sensor(
                 name=_CONTACT_SENSOR,
                 type=mujoco.mjtSensor.mjSENS_CONTACT,
@@ -481,7 +548,7 @@ class Plant:
                 objname=_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
                 intprm=[_NETFORCE_DATA, _NETFORCE, 1],
             )
-            self._setup_model(spec.compile(), site)
+            self._setup_model(spec.compile(), self.tip)
         m = self.model
         self.data = mujoco.MjData(m)
         self._jac = np.zeros((6, m.nv))
@@ -491,13 +558,18 @@ class Plant:
 
     # -- construction checks ------------------------------------------------
 
-    def _setup_model(self, model: mujoco.MjModel, site: str | None) -> None:
+    @property
+    def joint_names(self) -> list[str]:
+        """The arm's joints, base to tip (the order of q)."""
+        return [_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self._joints]
+
+    def _setup_model(self, model: mujoco.MjModel, tip: str | None) -> None:
         self.model = model
         if not self.contact:
             model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         self._check_joints()
         self._check_actuators()
-        self._find_end_effector(site)
+        self._find_end_effector(tip)
 
     def _contact_sensor_fits(self, source: ModelSource) -> bool:
         """Whether a contact sensor can measure this plant's wrench exactly as
@@ -509,7 +581,7 @@ class Plant:
         the subtree on different weld bodies whose contype and conaffinity meet."""
         if isinstance(source, mujoco.MjModel) or (isinstance(source, str) and source in _BUILTIN):
             return False
-        if Path(source).suffix.lower() == ".urdf":
+        if not isinstance(source, mujoco.MjSpec) and Path(source).suffix.lower() == ".urdf":
             return False
         m = self.model
         if m.npair > 0 or not self._contact_possible():
@@ -523,45 +595,26 @@ class Plant:
             for b in inside[i + 1 :]
         )
 
-    def _environment_joints(self) -> set[int]:
-        """Joints of the environment, not of the arm: unactuated, on a body tree
-        hanging from the world that holds no actuated joint (e.g. a table on a
-        spring, ``adaptimp.contact``)."""
-        m = self.model
-        joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
-        actuated = {
-            int(m.actuator_trnid[a, 0]) for a in range(m.nu) if m.actuator_trntype[a] == joint_trn
-        }
-
-        def root(body: int) -> int:
-            while int(m.body_parentid[body]) > 0:
-                body = int(m.body_parentid[body])
-            return body
-
-        arm_roots = {root(int(m.jnt_bodyid[j])) for j in actuated}
-        return {
-            j
-            for j in range(m.njnt)
-            if j not in actuated and root(int(m.jnt_bodyid[j])) not in arm_roots
-        }
-
     def _check_joints(self) -> None:
         m = self.model
+        ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in self._arm_names]
+        if not 1 <= len(ids) <= MAX_JOINTS:
+            raise ValueError(
+                f"Plant needs 1 to {MAX_JOINTS} joints; the arm has {len(ids)} "
+                f"({', '.join(self._arm_names)}): fix some with fix=(...) or name the "
+                "arm's end with tip="
+            )
         hinge = int(mujoco.mjtJoint.mjJNT_HINGE)
-        env = self._environment_joints()
-        arm = [j for j in range(m.njnt) if j not in env]
         bad = [
             f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)} ({mujoco.mjtJoint(m.jnt_type[j]).name})"
-            for j in arm
+            for j in ids
             if m.jnt_type[j] != hinge
         ]
         if bad:
             raise ValueError(f"Plant needs hinge joints only; not hinges: {', '.join(bad)}")
-        if not 1 <= len(arm) <= MAX_JOINTS:
-            raise ValueError(f"Plant needs 1 to {MAX_JOINTS} joints, the model has {len(arm)}")
-        self.n = len(arm)
+        self.n = len(ids)
         # Joints in kinematic order (hinges: one qpos and one dof each).
-        self._joints = sorted(arm, key=lambda j: int(m.jnt_dofadr[j]))
+        self._joints = sorted(ids, key=lambda j: int(m.jnt_dofadr[j]))
         self._qadr = np.array([m.jnt_qposadr[j] for j in self._joints])
         self._dofs = np.array([m.jnt_dofadr[j] for j in self._joints])
         bodies = [int(m.jnt_bodyid[j]) for j in self._joints]
@@ -582,25 +635,16 @@ class Plant:
         return out
 
     def _check_actuators(self) -> None:
+        """The arm joints' motors (one each, :func:`_prepare` made them), their
+        gear and τmax; actuators of the environment are left alone (zero
+        control)."""
         m = self.model
         joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
         act_of: dict[int, list[int]] = {j: [] for j in self._joints}
         for a in range(m.nu):
-            name = _name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)
-            if m.actuator_trntype[a] != joint_trn:
-                raise ValueError(f"actuator {name!r} does not act on a joint")
-            motor = (
-                m.actuator_dyntype[a] == int(mujoco.mjtDyn.mjDYN_NONE)
-                and m.actuator_gaintype[a] == int(mujoco.mjtGain.mjGAIN_FIXED)
-                and m.actuator_biastype[a] == int(mujoco.mjtBias.mjBIAS_NONE)
-                and m.actuator_gainprm[a, 0] == 1.0
-            )
-            if not motor:
-                raise ValueError(
-                    f"actuator {name!r} is not a torque actuator: use <motor> (no dynamics, "
-                    "gain 1, no bias)"
-                )
-            act_of[int(m.actuator_trnid[a, 0])].append(a)
+            target = int(m.actuator_trnid[a, 0])
+            if m.actuator_trntype[a] == joint_trn and target in act_of:
+                act_of[target].append(a)
         self._act = np.zeros(self.n, dtype=int)
         self._gear = np.zeros(self.n)
         self.tau_max = np.zeros(self.n)
@@ -624,24 +668,25 @@ class Plant:
             self._gear[i] = gear
             self.tau_max[i] = gear * hi
 
-    def _find_end_effector(self, site: str | None) -> None:
+    def _find_end_effector(self, tip: str | None) -> None:
         m = self.model
         force = int(mujoco.mjtSensor.mjSENS_FORCE)
         torque = int(mujoco.mjtSensor.mjSENS_TORQUE)
-        on_site = int(mujoco.mjtObj.mjOBJ_SITE)
-        sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
-        if site is not None:
-            sid = mujoco.mj_name2id(m, on_site, site)
-            if sid < 0:
-                raise ValueError(f"the model has no site {site!r}")
-            sensors = [s for s in sensors if m.sensor_objid[s] == sid]
-        elif sensors:
-            sid = int(m.sensor_objid[sensors[0]])
-        else:
-            on_last = [s for s in range(m.nsite) if m.site_bodyid[s] == self._last_body]
-            sid = on_last[0] if on_last else -1
+        sid, self._ee_body = _mjcf.end_effector(m, tip, self._last_body)
         self._site = sid
-        self._ee_body = int(m.site_bodyid[sid]) if sid >= 0 else self._last_body
+        sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
+        sensors = [s for s in sensors if m.sensor_objid[s] == sid and sid >= 0]
+        carried = float(m.body_subtreemass[self._ee_body])
+        if sensors and carried > 0:
+            # The sensor reads the force between the site's body and its parent:
+            # with mass below it (a gripper) that is gravity and inertia too, not
+            # the contact wrench. The contacts are measured instead.
+            name = _name(m, mujoco.mjtObj.mjOBJ_SENSOR, sensors[0])
+            self.notes["wrench"] = (
+                f"the force sensor {name!r} carries {carried:.3g} kg below it (it reads "
+                "gravity and inertia as well as contact): the wrench comes from the contacts"
+            )
+            sensors = []
         self._force_adr = int(m.sensor_adr[sensors[0]]) if sensors else -1
         torques = [
             s

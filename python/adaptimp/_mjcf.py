@@ -775,16 +775,26 @@ def moving_contacts(
     d: mujoco.MjData,
     moved_by: Sequence[frozenset[int]],
     tree: frozenset[int] | None = None,
+    clearance: float = 0.0,
 ) -> list[tuple[str, str, float]]:
     """The contacts in ``d`` (after collision detection) between two bodies the
     arm's joints move relative to each other (their sets in ``moved_by``
-    differ), as (body, body, distance in m); with ``tree``, only those whose
-    two bodies are in it (the arm touching itself)."""
+    differ) and closer than ``clearance`` (m; 0: touching or penetrating), as
+    (body, body, distance in m); with ``tree``, only those whose
+    two bodies are in it (the arm touching itself). Two links that meet at a
+    joint (one the other's parent, MuJoCo not filtering them because one is
+    welded to the world) count only where they penetrate (distance < 0): their
+    geometry is within any margin of each other at the joint."""
+    weld, parent = m.body_weldid, m.body_parentid
     out = []
     for c in d.contact[: d.ncon]:
         b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
-        if moved_by[b1] == moved_by[b2]:
+        if moved_by[b1] == moved_by[b2] or c.dist >= clearance:
             continue
+        w1, w2 = int(weld[b1]), int(weld[b2])
+        adjacent = int(weld[parent[w1]]) == w2 or int(weld[parent[w2]]) == w1
+        if adjacent and c.dist >= 0:
+            continue  # links that meet at their joint: only a penetration counts
         if tree is not None and not (b1 in tree and b2 in tree):
             continue
         pair = sorted((_name(m, _OBJ.mjOBJ_BODY, b1), _name(m, _OBJ.mjOBJ_BODY, b2)))
@@ -807,3 +817,89 @@ def end_effector(m: mujoco.MjModel, tip: str | None, last_body: int) -> tuple[in
             return sid, int(m.site_bodyid[sid])
     on_last = [s for s in range(m.nsite) if int(m.site_bodyid[s]) == last_body]
     return (on_last[0], last_body) if on_last else (-1, last_body)
+
+
+class Contacts:
+    """Collision detection at postures of the arm, on a copy of ``model``
+    (SPEC §18's safety checks): :meth:`at` gives :func:`moving_contacts` at a
+    posture q of the arm's joints (the other joints at the plant's current
+    state ``qpos``), with every geom's margin raised to ``margin`` (m) so that
+    a near miss counts too.
+
+    Parameters
+    ----------
+    model : MjModel
+        The plant's model (not changed).
+    qpos : array
+        The full configuration the arm's joints are set into.
+    joint_ids : sequence of int
+        The arm's joints.
+    margin : float
+        Clearance (m) below which two geoms count as touching.
+    self_only : bool
+        Only contacts between bodies of the arm's own tree.
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        qpos: FloatArray,
+        joint_ids: Sequence[int],
+        margin: float = 0.0,
+        self_only: bool = False,
+    ) -> None:
+        import copy
+
+        self.model = copy.deepcopy(model)
+        self.model.geom_margin[:] = np.maximum(self.model.geom_margin, margin)
+        self.model.geom_gap[:] = 0.0
+        self.data = mujoco.MjData(self.model)
+        self.qpos = np.array(qpos, dtype=np.float64)
+        self.qadr = [int(model.jnt_qposadr[j]) for j in joint_ids]
+        self.moved_by = movers(model, joint_ids)
+        self.tree = arm_tree(model, joint_ids) if self_only else None
+        self.clearance = margin
+        self.possible = self._possible()
+
+    def _possible(self) -> bool:
+        """Whether any two geoms that the arm moves relative to each other can collide."""
+        m = self.model
+        if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
+            return False
+        if m.npair > 0:
+            return True
+        ct, ca = m.geom_contype, m.geom_conaffinity
+        geoms = [
+            g
+            for g in range(m.ngeom)
+            if (ct[g] or ca[g]) and (self.tree is None or int(m.geom_bodyid[g]) in self.tree)
+        ]
+        groups: dict[frozenset[int], list[int]] = {}
+        for g in geoms:
+            groups.setdefault(self.moved_by[int(m.geom_bodyid[g])], []).append(g)
+        keys = list(groups)
+        for i, a in enumerate(keys):
+            for b in keys[i + 1 :]:
+                for ga in groups[a]:
+                    if any((ct[ga] & ca[gb]) or (ct[gb] & ca[ga]) for gb in groups[b]):
+                        return True
+        return False
+
+    def at(self, q: FloatArray) -> list[tuple[str, str, float]]:
+        """The contacts at the arm's posture ``q`` (rad)."""
+        if not self.possible:
+            return []
+        d = self.data
+        d.qpos[:] = self.qpos
+        d.qpos[self.qadr] = q
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_collision(self.model, d)
+        return moving_contacts(self.model, d, self.moved_by, self.tree, self.clearance)
+
+
+def pairs(found: Iterable[tuple[str, str, float]]) -> str:
+    """Contacts as "'a'–'b', 'c'–'d'" (each pair once, in order of first sight)."""
+    seen: dict[tuple[str, str], None] = {}
+    for a, b, _ in found:
+        seen.setdefault((a, b), None)
+    return ", ".join(f"{a!r}–{b!r}" for a, b in seen)

@@ -1157,36 +1157,65 @@ HOME_LOAD = 0.5
 """The zero posture is the home posture if gravity takes at most this share of
 every effort limit over the task's swing (:func:`home_posture`)."""
 
+HOME_CLEARANCE = 0.005
+"""The clearance (m) the default task keeps between bodies that the arm moves
+relative to each other (:func:`home_posture`)."""
+
+SWING_SAMPLES = 21
+"""Postures along the swing q − A … q + A at which :func:`home_posture` checks
+for contact."""
+
 
 def home_posture(plant: Plant) -> FloatArray:
     """A posture inside the joint limits where gravity is well within the
-    effort limits (SPEC §18). The gravity load of a posture q is the largest
-    max_i |G_i|/τmax_i over the task's swing (q − A, q, q + A). Every posture
-    is kept A = min(0.2 rad, range/4) inside each limit (a continuous joint
-    ranges over [−π, π]). The zero posture (the URDF's reference, clipped
-    into that box) if its load is at most :data:`HOME_LOAD`; else, of it, the
-    box's middle and 254 fixed-seed samples, the one of least load.
+    effort limits and the task's swing touches nothing (SPEC §18). The
+    gravity load of a posture q is the largest max_i |G_i|/τmax_i over the
+    task's swing (q − A, q, q + A). Every posture is kept A = min(0.2 rad,
+    range/4) inside each limit (a continuous joint ranges over [−π, π]).
+    With contact on, a posture qualifies only if, at :data:`SWING_SAMPLES`
+    postures along its swing q − A … q + A, no two bodies that the arm's
+    joints move relative to each other (the arm and itself, or the arm and
+    what is around it) come within :data:`HOME_CLEARANCE` of each other, by
+    the model's own collision geometry and filters. The zero posture (the
+    model's reference, clipped into the box) if it qualifies and its load is
+    at most :data:`HOME_LOAD`; else, of it, the box's middle and 254
+    fixed-seed samples, the qualifying one of least load.
 
     Raises
     ------
     ValueError
-        Gravity exceeds an effort limit at every posture compared: the arm
-        cannot hold itself anywhere (the message gives the best load).
+        Gravity exceeds an effort limit at every qualifying posture (the
+        message gives the best load), or every posture's swing touches (the
+        message names the bodies: give ``home=``).
     """
     m = plant.model
     lo, hi = _limits(m, plant._joints)
     width = np.where(np.isfinite(hi - lo), hi - lo, 2 * math.pi)
     amp = np.minimum(0.25 * width, TASK_AMPLITUDE)
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
+    contacts = _mjcf.Contacts(m, saved[0], plant._joints, margin=HOME_CLEARANCE)
+    swing = np.linspace(-1.0, 1.0, SWING_SAMPLES)
     best, best_load = None, math.inf
+    touching: list[tuple[str, str, float]] = []
     for k, q in enumerate(_postures(lo, hi, HOME_SAMPLES, amp)):
         load = max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0))
-        if load < best_load:
-            best, best_load = q, load
+        if load >= best_load:
+            continue
+        found = [c for s in swing for c in contacts.at(q + s * amp)]
+        if found:
+            touching += found
+            continue
+        best, best_load = q, load
         if k == 0 and load <= HOME_LOAD:
             break
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(m, plant.data)
+    if best is None and touching:
+        raise ValueError(
+            f"the default task's swing (±A about the home posture) brings the arm's bodies "
+            f"within {HOME_CLEARANCE:g} m of each other at every posture compared "
+            f"({_mjcf.pairs(touching)}): give home= (rad), or simulate with contact=False"
+        )
     if best is None or best_load >= 1.0:
         raise ValueError(
             f"gravity exceeds the effort limits at every posture compared: the least "
@@ -1503,9 +1532,13 @@ def _payload_plant(nominal: Plant, payload: float) -> Plant:
         raise TypeError(f"payload must be a number (kg), got {type(payload).__name__}")
     if payload == 0:
         return nominal
-    return Plant(
-        with_payload(nominal.model, float(payload)), contact=nominal.contact, site=nominal.site
+    plant = Plant(
+        with_payload(nominal.model, float(payload), body=nominal._last_body),
+        contact=nominal.contact,
+        tip=nominal.tip,
     )
+    plant.notes = nominal.notes
+    return plant
 
 
 def _rule_setup(
@@ -1515,13 +1548,18 @@ def _rule_setup(
     reference: Any,
     Ts: float,
     T: float,
+    home: ArrayLike | None = None,
 ) -> tuple[Task | None, Any, dict[str, Any]]:
     """The task and the rule's keywords for a case name on ``plant`` (SPEC §18):
     the default task unless a reference or the controller's own trajectory
     (``xc_*``) is given, which is then the path."""
     own = [k for k in ("xc_offset", "xc_sin", "xc_cos", "xc_omega") if k in params]
+    if home is not None and (reference is not None or own):
+        raise ValueError(
+            "home= sets the default task's posture: give it without a reference or xc_*"
+        )
     if reference is None and not own:
-        task = default_task(plant)
+        task = default_task(plant, home)
         kw = rule_keywords(plant, task, Ts=Ts, case=case)
         kw.pop("n")
         return task, task.reference, kw
@@ -1566,6 +1604,9 @@ def simulate(
     fault: Fault | None = None,
     payload: float = 0.0,
     reset: bool = True,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+    home: ArrayLike | None = None,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1642,6 +1683,12 @@ def simulate(
         controller, the parts are the whole run's rows; each part's t starts
         at 0 and its disturbances afresh); ``q0``, ``dq0`` must then be None
         and ``payload`` 0.
+    tip, fix : optional
+        The end effector (a site or a body; a URDF's link) and joints to lock,
+        for the :class:`Plant` built from ``model`` (not for a Plant given).
+    home : array_like, optional
+        The posture (rad, (n,)) the default task swings about, instead of
+        :func:`home_posture`'s.
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
@@ -1684,7 +1731,7 @@ def simulate(
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
         settle=settle, scenario=scenario, record_every=record_every, reference=reference,
-        payload=payload, params=params, reset=reset,
+        payload=payload, params=params, reset=reset, tip=tip, fix=fix, home=home,
     )  # fmt: skip
     from ._api import _progress
 
@@ -1713,7 +1760,94 @@ def simulate(
     finally:
         if bar is not None:
             bar.close()
-    return _result(run, out, m)
+    res = _result(run, out, m)
+    _check_run(run, res)
+    return res
+
+
+RUN_PEAK = 2.0
+"""A run whose commanded |τ_i| exceeds this many τmax_i after :data:`RUN_SETTLE`
+says so (:func:`simulate`'s check)."""
+
+RUN_SETTLE = 0.1
+"""The start (s) of the peak-torque check."""
+
+RUN_SATURATED = 0.01
+"""A run whose torque is at a limit in more than this share of its steps says so."""
+
+RUN_CONTACT_EVERY = 0.01
+"""The spacing (s) of the recorded rows at which a run's self-contact is checked."""
+
+
+def _check_run(run: _Run, res: MujocoResult) -> None:
+    """What a run found that its numbers alone do not say (SPEC §18), as
+    :class:`adaptimp.PlantWarning` and in ``res.params["warnings"]``: the arm
+    touching itself (rows every :data:`RUN_CONTACT_EVERY` s replayed through
+    MuJoCo's collision detection); and, for a joint-space controller in free
+    space (no step in contact: pressing on a table is a contact task's own
+    business, its metrics say how it went), a commanded torque beyond
+    :data:`RUN_PEAK` τmax after :data:`RUN_SETTLE` s, the torque at a limit in
+    more than :data:`RUN_SATURATED` of the steps. ``res.params["plant"]`` is
+    what the plant made of the model (:attr:`Plant.notes`). Not for the
+    paper's arm, whose scenario saturates by design."""
+    plant = run.plant
+    res.params["plant"] = dict(plant.notes)
+    found: list[str] = []
+    if _uses_rule(plant) and res.rows > 0:
+        found += _self_contact(plant, res)
+    free = res.metrics.get("steps_in_contact", 0) == 0 and not run.cartesian
+    free = free and not getattr(run.ctrl, "wants_wrench", False)
+    if _uses_rule(plant) and res.rows > 0 and free:
+        tau_max = np.asarray(plant.tau_max)
+        late = np.flatnonzero(res.t >= RUN_SETTLE - 1e-12)
+        if late.size:
+            ratio = np.abs(res.tau[late]) / tau_max
+            k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            if ratio[k, i] > RUN_PEAK:
+                found.append(
+                    f"the commanded torque reached {ratio[k, i]:.3g} τmax after {RUN_SETTLE:g} s "
+                    f"(joint {plant.joint_names[i]!r} at t = {res.t[late[k]]:.3f} s), beyond "
+                    f"{RUN_PEAK:g} τmax: the controller asks far more than the actuators give"
+                )
+        duty = float(res.metrics.get("sat_duty", math.nan))
+        if duty > RUN_SATURATED:
+            found.append(
+                f"the torque was at a limit in {100 * duty:.1f} % of the steps (more than "
+                f"{100 * RUN_SATURATED:g} %): the actuators saturate, so the tracking measured is "
+                "theirs as much as the controller's"
+            )
+    res.params["warnings"] = found
+    for text in found:
+        warnings.warn(text, PlantWarning, stacklevel=3)
+
+
+def _self_contact(plant: Plant, res: MujocoResult) -> list[str]:
+    """The warning of a run in which the arm touched itself, if it did."""
+    m = plant.model
+    if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
+        return []
+    contacts = _mjcf.Contacts(m, plant.data.qpos, plant._joints, self_only=True)
+    if not contacts.possible:
+        return []
+    dt = float(res.t[1] - res.t[0]) if res.rows > 1 else 1.0
+    stride = max(1, round(RUN_CONTACT_EVERY / dt))
+    rows = range(0, res.rows, stride)
+    touched: list[tuple[str, str, float]] = []
+    first, hits = math.nan, 0
+    for k in rows:
+        found = contacts.at(res.q[k])
+        if found:
+            hits += 1
+            touched += found
+            if math.isnan(first):
+                first = float(res.t[k])
+    if not hits:
+        return []
+    return [
+        f"the arm touched itself in {100 * hits / len(rows):.1f} % of the rows checked "
+        f"({_mjcf.pairs(touched)}; first at t = {first:.3f} s): its own links collide along "
+        "this task; give another home= or reference (or contact=False)"
+    ]
 
 
 def _cartesian_loop(
@@ -1783,6 +1917,9 @@ def _setup(
     payload: float = 0.0,
     params: Mapping[str, Any],
     reset: bool = True,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+    home: ArrayLike | None = None,
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
     plant at its initial state, the settings and the choice of loop."""
@@ -1798,17 +1935,23 @@ def _setup(
         raise ValueError(
             "q0, dq0 and a payload start a run afresh: give them with reset=True (the default)"
         )
-    nominal = model if isinstance(model, Plant) else Plant(model, contact=contact)
+    if isinstance(model, Plant) and (tip is not None or tuple(fix)):
+        raise ValueError("tip= and fix= build the Plant: give them to Plant(...), not with one")
+    nominal = model if isinstance(model, Plant) else Plant(model, contact=contact, tip=tip, fix=fix)
     plant = _payload_plant(nominal, payload)
     task: Task | None = None
     params = dict(params)
     disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
+    if home is not None and not (isinstance(controller, str) and _uses_rule(nominal)):
+        raise ValueError(
+            "home= sets the default task of a case name on an arm (not the paper's two_link)"
+        )
     if isinstance(controller, str):
         kwargs = dict(params)
         if _uses_rule(nominal):
             task, reference, rule = _rule_setup(
                 nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
-                float(defaults["T"]) if T is None else float(T),
+                float(defaults["T"]) if T is None else float(T), home,
             )  # fmt: skip
             kwargs = {**rule, **kwargs}
             if q0 is None and task is not None:

@@ -45,6 +45,15 @@ belong to a gripper (the URDF reduction's rule, ``adaptimp._models``)."""
 EFFORT_ACCEL = 10.0
 """The acceleration (rad/s²) an estimated τmax leaves beyond gravity."""
 
+FIRST_ORDER_STEP = 2.5e-4
+"""The largest MuJoCo timestep (s) of a file's model integrated to first order
+(Euler, implicit, implicitfast): :func:`adaptimp.mujoco.simulate` then takes
+4 MuJoCo steps per 1 ms period. The rule's velocity loop moves a quarter of
+its error per period (SPEC 18.1); integrated once a period, the plant's
+error is of the size of what learning removes (dm_control's Kinova: SF/PD
+0.225 at one Euler step per period, 0.134 at 2, 0.103 at 4, 0.088 with RK4).
+A file's RK4 keeps its timestep."""
+
 _OBJ = mujoco.mjtObj
 _HINGE = int(mujoco.mjtJoint.mjJNT_HINGE)
 _SLIDE = int(mujoco.mjtJoint.mjJNT_SLIDE)
@@ -76,14 +85,16 @@ def _root(m: mujoco.MjModel, body: int) -> int:
 
 
 def coupled_joints(m: mujoco.MjModel) -> dict[int, str]:
-    """Joints whose motion another joint dictates (MJCF's mimic joints): joint1
-    of a ``<joint>`` equality, and the joints of a fixed tendon of two or more
-    joints (a gripper's linkage: robotiq's and jaco's fingers)."""
+    """The joints of a coupled mechanism (MJCF's mimic joints, a gripper's
+    linkage; an arm's joints are never coupled): both joints of a ``<joint>``
+    equality (joint1 follows joint2, the gripper's driver), and the joints of
+    a fixed tendon of two or more joints (robotiq's and jaco's fingers)."""
     out: dict[int, str] = {}
     for e in range(m.neq):
         if int(m.eq_type[e]) == int(mujoco.mjtEq.mjEQ_JOINT) and m.eq_obj2id[e] >= 0:
-            other = _name(m, _OBJ.mjOBJ_JOINT, int(m.eq_obj2id[e]))
-            out[int(m.eq_obj1id[e])] = f"coupled to {other!r} (a joint equality)"
+            one, two = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+            out[one] = f"coupled to {_name(m, _OBJ.mjOBJ_JOINT, two)!r} (a joint equality)"
+            out.setdefault(two, f"drives {_name(m, _OBJ.mjOBJ_JOINT, one)!r} (a joint equality)")
     for t in range(m.ntendon):
         adr, num = int(m.tendon_adr[t]), int(m.tendon_num[t])
         joints = [
@@ -410,11 +421,14 @@ def prepare_file(path: str | os.PathLike[str], tip: str | None, fix: Sequence[st
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as e:
         raise ValueError(f"MuJoCo cannot load {str(path)!r}: {e}") from None
-    return prepare_spec(spec, tip, fix, _label(path))
+    return prepare_spec(spec, tip, fix, _label(path), "the file")
 
 
-def prepare_spec(spec: Any, tip: str | None, fix: Sequence[str], label: str = "") -> Prepared:
-    """:func:`prepare_file` for an ``MjSpec``, edited in place (give a copy)."""
+def prepare_spec(
+    spec: Any, tip: str | None, fix: Sequence[str], label: str = "", given: str = "the spec given"
+) -> Prepared:
+    """:func:`prepare_file` for an ``MjSpec``, edited in place (give a copy);
+    ``given`` names the source in the warnings ("the file", "the spec given")."""
     try:
         m0 = spec.compile()
     except ValueError as e:
@@ -424,6 +438,13 @@ def prepare_spec(spec: Any, tip: str | None, fix: Sequence[str], label: str = ""
     keep = set(arm["joint_ids"])
     lock = [j for j in range(m0.njnt) if j not in keep and int(m0.jnt_bodyid[j]) in tree]
     out = Prepared(model=m0, spec=spec, arm=arm)
+    first_order = int(spec.option.integrator) != int(mujoco.mjtIntegrator.mjINT_RK4)
+    if first_order and spec.option.timestep > FIRST_ORDER_STEP:
+        out.notes["timestep"] = (
+            f"{mujoco.mjtIntegrator(int(spec.option.integrator)).name} at "
+            f"{spec.option.timestep:g} s in the file: stepped at {FIRST_ORDER_STEP:g} s"
+        )
+        spec.option.timestep = FIRST_ORDER_STEP
     spec_actuators = list(spec.actuators)  # index = m0's actuator id
     for key in spec.keys:  # the plant's motors start at zero torque, without activation
         key.act = []
@@ -441,9 +462,9 @@ def prepare_spec(spec: Any, tip: str | None, fix: Sequence[str], label: str = ""
             f"{label}the joints {list(reasons)} are not the arm's "
             f"({'; '.join(f'{k}: {v}' for k, v in reasons.items())}): the plant locks them at "
             "their reference position (a rigid hand, as the controller's model of the arm "
-            "has it), with their actuators, couplings and sensors; the file is not changed"
+            f"has it), with their actuators, couplings and sensors; {given} is not changed"
         )
-    _motors(spec, m0, arm, out, label, spec_actuators)
+    _motors(spec, m0, arm, out, label, spec_actuators, given)
     m1 = _compile(spec)
     # Equality constraints left inside one rigid body (a gripper's linkage).
     dead = [
@@ -568,6 +589,7 @@ def _motors(
     out: Prepared,
     label: str,
     actuators: list[Any],
+    given: str,
 ) -> None:
     """One torque motor per arm joint in ``spec``: motors kept, servos converted
     (their force range kept), a motor added where a joint has none. Joints whose
@@ -626,7 +648,7 @@ def _motors(
             f"{label}the actuators of {list(converted)} are {' and '.join(servo_kinds)} "
             "servos, not torque motors: the plant drives these joints with torque motors of "
             "the same force range (their forcerange where declared), as the controller "
-            "commands torque; the file is not changed"
+            f"commands torque; {given} is not changed"
         )
     if added:
         out.notes["added"] = added
@@ -782,9 +804,9 @@ def moving_contacts(
     differ) and closer than ``clearance`` (m; 0: touching or penetrating), as
     (body, body, distance in m); with ``tree``, only those whose
     two bodies are in it (the arm touching itself). Two links that meet at a
-    joint (one the other's parent, MuJoCo not filtering them because one is
-    welded to the world) count only where they penetrate (distance < 0): their
-    geometry is within any margin of each other at the joint."""
+    joint (one the other's parent) do not count, as MuJoCo's parent filter
+    has it, also where the parent is welded to the world (a base, whose
+    geometry often meets the first link's at the joint whatever the task)."""
     weld, parent = m.body_weldid, m.body_parentid
     out = []
     for c in d.contact[: d.ncon]:
@@ -792,9 +814,8 @@ def moving_contacts(
         if moved_by[b1] == moved_by[b2] or c.dist >= clearance:
             continue
         w1, w2 = int(weld[b1]), int(weld[b2])
-        adjacent = int(weld[parent[w1]]) == w2 or int(weld[parent[w2]]) == w1
-        if adjacent and c.dist >= 0:
-            continue  # links that meet at their joint: only a penetration counts
+        if int(weld[parent[w1]]) == w2 or int(weld[parent[w2]]) == w1:
+            continue  # links that meet at their joint (as MuJoCo's filterparent)
         if tree is not None and not (b1 in tree and b2 in tree):
             continue
         pair = sorted((_name(m, _OBJ.mjOBJ_BODY, b1), _name(m, _OBJ.mjOBJ_BODY, b2)))

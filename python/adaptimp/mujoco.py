@@ -504,7 +504,10 @@ class Plant:
         What the plant made of the model: "locked" {joint: why}, "actuators"
         {joint: servo → motor}, "added" [joints given a motor], "tau_max"
         {joint: where τmax comes from: "forcerange", "ctrlrange",
-        "actuatorfrcrange" or "estimated"}, "warnings" [their texts], "tip".
+        "actuatorfrcrange" or "estimated"}, "timestep" (a file's Euler or
+        implicit integrator is stepped at ≤ 0.25 ms,
+        :data:`adaptimp._mjcf.FIRST_ORDER_STEP`), "wrench" (a force sensor
+        not used), "warnings" [their texts], "tip".
     """
 
     def __init__(
@@ -1178,8 +1181,10 @@ def home_posture(plant: Plant) -> FloatArray:
     what is around it) come within :data:`HOME_CLEARANCE` of each other, by
     the model's own collision geometry and filters. The zero posture (the
     model's reference, clipped into the box) if it qualifies and its load is
-    at most :data:`HOME_LOAD`; else, of it, the box's middle and 254
-    fixed-seed samples, the qualifying one of least load.
+    at most :data:`HOME_LOAD`; else the nearest qualifying posture of load at
+    most :data:`HOME_LOAD` among 255 fixed-seed samples of the box drawn in
+    towards it (the k-th by k/255 of the way out); else the qualifying one
+    of least load.
 
     Raises
     ------
@@ -1195,19 +1200,32 @@ def home_posture(plant: Plant) -> FloatArray:
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
     contacts = _mjcf.Contacts(m, saved[0], plant._joints, margin=HOME_CLEARANCE)
     swing = np.linspace(-1.0, 1.0, SWING_SAMPLES)
-    best, best_load = None, math.inf
     touching: list[tuple[str, str, float]] = []
-    for k, q in enumerate(_postures(lo, hi, HOME_SAMPLES, amp)):
-        load = max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0))
-        if load >= best_load:
-            continue
+
+    def clear(q: FloatArray) -> bool:
         found = [c for s in swing for c in contacts.at(q + s * amp)]
-        if found:
-            touching += found
-            continue
-        best, best_load = q, load
-        if k == 0 and load <= HOME_LOAD:
+        touching.extend(found)
+        return not found
+
+    samples = _postures(lo, hi, HOME_SAMPLES, amp)
+    zero = samples[0]
+    # Nearest the zero posture first: the samples drawn in towards it, the
+    # k-th by k/(K − 1) of the way out.
+    grow = np.arange(HOME_SAMPLES, dtype=np.float64)[:, None] / (HOME_SAMPLES - 1)
+    near = zero + grow * (samples - zero)
+    loads = [max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0)) for q in near]
+    best, best_load = None, math.inf
+    for q, load in zip(near, loads):
+        if load <= HOME_LOAD and clear(q):
+            best, best_load = q, load
             break
+    if best is None:
+        for k in np.argsort(loads, kind="stable"):
+            if loads[k] < 1.0 and clear(near[k]):
+                best, best_load = near[k], loads[k]
+                break
+        else:
+            best_load = min(loads)
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(m, plant.data)
     if best is None and touching:

@@ -26,7 +26,7 @@ computed torque with the exact and the nominal model on the same task.
     python examples/15_your_arm.py [FILE] [--payload 0.1] [--figure out.png]
     python examples/15_your_arm.py [FILE] --tip tool0 --fix wrist_3_joint --home 0,-1,1,0,0,0
     python examples/15_your_arm.py [FILE] --long 600     # weight norms over 600 s
-    python examples/15_your_arm.py [FILE] --T 8 --json out.json   # the docs' tables
+    python examples/15_your_arm.py FILE... --T 8 --rows [--json out.json]   # the docs' tables
 
 Default URDF: the UR5 of example-robot-data. ``ADAPTIMP_QUICK=1``: T = 2.5 s.
 """
@@ -160,9 +160,33 @@ def long_run(path: Path, seconds: float, arm: dict[str, Any], case: str = "sf") 
     print(f"({time.perf_counter() - start:.0f} s of wall time)")
 
 
+def summary(path: Path, out: dict[str, Any]) -> str:
+    """One markdown row of docs/your_arm.md's tables: the file, its joints, SF/PD,
+    OF/PD, SF's drift ([2, 4) s → last 2 s), the peak commanded τ/τmax and the
+    most steps at a limit over PD, SF, OF; with a payload, computed torque's
+    RMS ‖z1‖ (nominal, exact) and SF's ratios to them."""
+    rows, n = out["rows"], len(out["home"])
+    pd = rows["pd"]["rms"]
+    cases = [rows[c] for c in ("pd", "sf", "of")]
+    cells = [
+        f"`{path.name}` ({n})",
+        f"{pd:.3g}",
+        f"{rows['sf']['rms'] / pd:.3f}",
+        f"{rows['of']['rms'] / pd:.3f}",
+        f"{rows['sf']['early']:.3g} → {rows['sf']['late']:.3g}",
+        f"{max(m['peak'] for m in cases):.2f}",
+        f"{100 * max(m['at_limit'] for m in cases):.1f} %",
+    ]
+    if "CT nominal" in rows:
+        sf, nom, exact = rows["sf"]["rms"], rows["CT nominal"]["rms"], rows["CT exact"]["rms"]
+        cells += [f"{out['payload']:.3g}", f"{nom:.3g}", f"{exact:.3g}"]
+        cells += [f"{sf / nom:.3f}", f"{exact / sf:.2f}"]
+    return "| " + " | ".join(cells) + " |"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("path", nargs="?", type=Path, default=UR5, help="URDF or MJCF file")
+    parser.add_argument("paths", nargs="*", type=Path, help="URDF or MJCF files (default UR5)")
     parser.add_argument("--payload", type=float, default=None, help="fraction of the arm's mass")
     parser.add_argument("--figure", type=Path, default=None, help="write SF's tracking figure")
     parser.add_argument("--long", type=float, default=None, help="seconds of a long SF run")
@@ -171,7 +195,12 @@ def main() -> None:
     parser.add_argument("--home", default=None, help="the task's posture (rad), comma-separated")
     parser.add_argument("--T", type=float, default=None, help="duration (s), default 10")
     parser.add_argument("--json", type=Path, default=None, help="write the table's numbers")
+    parser.add_argument("--rows", action="store_true", help="one summary row per file at the end")
     args = parser.parse_args()
+    paths = args.paths or [UR5]
+    missing = [str(p) for p in paths if not p.is_file()]
+    if missing:
+        parser.error(f"no file {missing[0]!r}")
     arm: dict[str, Any] = {}
     if args.tip is not None:
         arm["tip"] = args.tip
@@ -186,28 +215,44 @@ def main() -> None:
     if args.json is not None and not args.json.parent.is_dir():
         parser.error(f"--json: no directory {str(args.json.parent)!r}")
     if args.long is not None:
-        long_run(args.path, 1.0 if QUICK else args.long, arm)
+        for path in paths:
+            long_run(path, 1.0 if QUICK else args.long, arm)
         return
     T = 2.5 if QUICK else (args.T if args.T is not None else 10.0)
-    out = table(args.path, T, args.payload, arm, home)
+    records, lines = [], []
+    for path in paths:
+        out = table(path, T, args.payload, arm, home)
+        lines.append(summary(path, out))
+        records.append(
+            {
+                "file": str(path),
+                "T": T,
+                "payload_kg": out["payload"],
+                "home": list(out["home"]),
+                "rows": out["rows"],
+                "warnings": {k: r.params.get("warnings", []) for k, r in out["runs"].items()},
+                "plant": out["runs"]["pd"].params.get("plant", {}),
+            }
+        )
+        if args.figure is not None:
+            fig = out["runs"]["sf"].plot("errors")
+            fig.savefig(args.figure, dpi=110)
+            print(f"wrote {args.figure}")
+    if args.rows:
+        head = (
+            "| file (joints) | PD (rad) | SF/PD | OF/PD | SF [2,4) → last 2 s | peak τ/τmax "
+            "| at a limit |"
+        )
+        if args.payload is not None:
+            head += " payload (kg) | CT nominal | CT exact | SF / CT nominal | CT exact / SF |"
+        print(head)
+        print("|" + "---|" * (head.count("|") - 1))
+        print("\n".join(lines))
     if args.json is not None:
         import json
 
-        record = {
-            "file": str(args.path),
-            "T": T,
-            "payload_kg": out["payload"],
-            "home": list(out["home"]),
-            "rows": out["rows"],
-            "warnings": {k: r.params.get("warnings", []) for k, r in out["runs"].items()},
-            "plant": out["runs"]["pd"].params.get("plant", {}),
-        }
-        args.json.write_text(json.dumps(record, indent=1, default=str))
+        args.json.write_text(json.dumps(records, indent=1, default=str))
         print(f"wrote {args.json}")
-    if args.figure is not None:
-        fig = out["runs"]["sf"].plot("errors")
-        fig.savefig(args.figure, dpi=110)
-        print(f"wrote {args.figure}")
 
 
 if __name__ == "__main__":

@@ -183,14 +183,17 @@ MOTORLESS = """
         <geom type="capsule" fromto="0 0 0 0.25 0 0" size="0.03" mass="1"/>
       </body>
     </body>
+    <body name="target" mocap="true" pos="0.5 0 0"/>
   </worldbody>
+  <equality><weld name="drag" body1="target" body2="l2"/></equality>
 </mujoco>
 """
 
 
 def test_joints_without_actuators_get_motors(tmp_path: Path) -> None:
     """dm_control's arms ship without actuators: the plant adds motors, τmax
-    from the joint's actuatorfrcrange, or estimated from the arm."""
+    from the joint's actuatorfrcrange, or estimated from the arm. A mocap
+    body welded to the hand (gymnasium's Fetch, metaworld's Sawyer) is let go."""
     path = tmp_path / "bare.xml"
     path.write_text(MOTORLESS)
     with pytest.warns(adaptimp.PlantWarning) as record:
@@ -201,11 +204,15 @@ def test_joints_without_actuators_get_motors(tmp_path: Path) -> None:
     assert estimate > 2 * 9.81 * 0.125  # at least twice the 1 kg link's gravity torque
     assert [str(w.message) for w in record] == [
         "bare.xml: the joints ['a', 'b'] have no actuator: the plant adds a torque motor to each",
+        "bare.xml: the equality constraints ['drag'] tie the arm to what it does not move "
+        "('target' to 'l2': a mocap body or a fixture): the plant turns them off, as the "
+        "controller drives the joints",
         "bare.xml: no force range is declared for ['b']: the plant estimates τmax = "
-        f"[{round(estimate, 3)}] N m (2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within the "
-        "joint limits)",
+        f"[{round(estimate, 3)}] N m (2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij| + damping · "
+        "1 rad/s + friction loss) within the joint limits)",
     ]
     assert plant.notes["tau_max"] == {"a": "actuatorfrcrange", "b": "estimated"}
+    assert plant.model.eq_active0.tolist() == [0]
 
 
 def test_the_default_task_keeps_the_arm_off_itself() -> None:

@@ -45,6 +45,10 @@ belong to a gripper (the URDF reduction's rule, ``adaptimp._models``)."""
 EFFORT_ACCEL = 10.0
 """The acceleration (rad/s²) an estimated τmax leaves beyond gravity."""
 
+EFFORT_SPEED = 1.0
+"""The joint speed (rad/s) at which an estimated τmax overcomes the joint's
+viscous damping."""
+
 FIRST_ORDER_STEP = 2.5e-4
 """The largest MuJoCo timestep (s) of a file's model integrated to first order
 (Euler, implicit, implicitfast): :func:`adaptimp.mujoco.simulate` then takes
@@ -382,8 +386,12 @@ def estimate(
     m: mujoco.MjModel, qadr: Sequence[int], dofs: Sequence[int], postures: int = 256
 ) -> FloatArray:
     """τmax (N m) per arm joint where nothing declares it: 2 (max |G_i| + 10
-    rad/s² · max Σ_j |D_ij|) over ``postures`` postures within the joint
-    limits (the URDF estimate, :func:`adaptimp.mujoco.estimate_effort`)."""
+    rad/s² · max Σ_j |D_ij| + b_i · 1 rad/s + F_i) over ``postures`` postures
+    within the joint limits: the URDF estimate
+    (:func:`adaptimp.mujoco.estimate_effort`; D with the rotors' armature)
+    and the joint's own viscous damping b_i at :data:`EFFORT_SPEED` and dry
+    friction F_i (``frictionloss``), which a file may make the larger part
+    (metaworld's Sawyer: b = 10 N m s/rad on a wrist of 0.01 kg m²)."""
     from .mujoco import _full_inertia, _limits, _postures
 
     joints = [int(m.dof_jntid[d]) for d in dofs]
@@ -400,7 +408,8 @@ def estimate(
         _full_inertia(m, data, full)
         g = np.maximum(g, np.abs(data.qfrc_bias[list(dofs)]))
         d = np.maximum(d, np.sum(np.abs(full[np.ix_(dofs, dofs)]), axis=1))
-    return np.asarray(2.0 * (g + EFFORT_ACCEL * d), dtype=np.float64)
+    drive = EFFORT_SPEED * m.dof_damping[list(dofs)] + m.dof_frictionloss[list(dofs)]
+    return np.asarray(2.0 * (g + EFFORT_ACCEL * d + drive), dtype=np.float64)
 
 
 def _label(path: str | os.PathLike[str] | None) -> str:
@@ -478,9 +487,45 @@ def prepare_spec(
         for k in dead:
             spec.delete(equalities[k])
         m1 = _compile(spec)
+    holds = holding(m1, [mujoco.mj_name2id(m1, _OBJ.mjOBJ_JOINT, n) for n in arm["joints"]])
+    if holds:
+        equalities = list(spec.equalities)
+        for k in holds:
+            equalities[k].active = False
+        _note_holds(m1, holds, out, label)
+        m1 = _compile(spec)
     _estimate_missing(spec, m1, out, label)
     out.model = spec.compile() if out.notes.get("estimated") else m1
     return out
+
+
+def holding(m: mujoco.MjModel, joint_ids: Sequence[int]) -> list[int]:
+    """The active connect and weld constraints that tie a body the arm moves to
+    one it does not (a mocap body that drags the hand, the world, a fixture):
+    they would hold the arm against the controller."""
+    moved_by = movers(m, joint_ids)
+    out = []
+    for k in range(m.neq):
+        if int(m.eq_type[k]) not in (int(mujoco.mjtEq.mjEQ_CONNECT), int(mujoco.mjtEq.mjEQ_WELD)):
+            continue
+        bodies = _eq_bodies(m, k)
+        if bodies is not None and m.eq_active0[k] and moved_by[bodies[0]] != moved_by[bodies[1]]:
+            out.append(k)
+    return out
+
+
+def _note_holds(m: mujoco.MjModel, holds: Sequence[int], out: Prepared, label: str) -> None:
+    pairs = {}
+    for k in holds:
+        a, b = _eq_bodies(m, k) or (0, 0)
+        name = _name(m, _OBJ.mjOBJ_EQUALITY, k)
+        pairs[name] = f"{_name(m, _OBJ.mjOBJ_BODY, a)!r} to {_name(m, _OBJ.mjOBJ_BODY, b)!r}"
+    out.notes["released"] = pairs
+    out.warnings.append(
+        f"{label}the equality constraints {list(pairs)} tie the arm to what it does not move "
+        f"({'; '.join(pairs.values())}: a mocap body or a fixture): the plant turns them off, "
+        "as the controller drives the joints"
+    )
 
 
 def _compile(spec: Any) -> mujoco.MjModel:
@@ -688,8 +733,8 @@ def _estimate_missing(spec: Any, m1: mujoco.MjModel, out: Prepared, label: str) 
             values[target] = round(float(tau[i]), 3)
     out.warnings.append(
         f"{label}no force range is declared for {missing}: the plant estimates τmax = "
-        f"{list(values.values())} N m (2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within "
-        "the joint limits)"
+        f"{list(values.values())} N m (2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij| + damping · "
+        "1 rad/s + friction loss) within the joint limits)"
     )
 
 
@@ -720,6 +765,10 @@ def prepare_model(m: mujoco.MjModel, tip: str | None, fix: Sequence[str]) -> Pre
             "in memory), or name the arm's joints with tip=/fix="
         )
     out = Prepared(model=m, spec=None, arm=arm)
+    holds = holding(m, arm["joint_ids"])
+    if holds:
+        m.eq_active0[holds] = 0
+        _note_holds(m, holds, out, "")
     converted: dict[str, str] = {}
     sources: dict[str, str] = {}
     by_joint: dict[int, list[int]] = {j: [] for j in keep}

@@ -169,7 +169,7 @@ def summary(path: Path, out: dict[str, Any]) -> str:
     pd = rows["pd"]["rms"]
     cases = [rows[c] for c in ("pd", "sf", "of")]
     cells = [
-        f"`{path.name}` ({n})",
+        f"`{path.parent.name}/{path.name}` ({n})",
         f"{pd:.3g}",
         f"{rows['sf']['rms'] / pd:.3f}",
         f"{rows['of']['rms'] / pd:.3f}",

@@ -293,3 +293,24 @@ def test_the_file_meets_the_targets_as_shipped() -> None:
         assert res.params["warnings"] == []
         assert np.max(np.abs(res.tau[t >= 0.1]) / plant.tau_max) <= 2.0
         assert res.metrics["sat_duty"] <= 0.01
+
+
+def test_a_force_sensor_with_a_gripper_below_it_is_not_the_wrench() -> None:
+    """robosuite's grippers carry a force/torque sensor at their mounting flange:
+    it reads the gripper's weight and inertia as well as contact, so the
+    plant measures the contacts instead (and the run is the core's)."""
+    spec = mujoco.MjSpec.from_file(str(UR5))
+    spec.body("tool0").add_site(name="ft_frame")
+    for kind in (mujoco.mjtSensor.mjSENS_FORCE, mujoco.mjtSensor.mjSENS_TORQUE):
+        spec.add_sensor(type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="ft_frame")
+    with pytest.warns(adaptimp.PlantWarning):
+        plant = amj.Plant(spec)
+    assert plant.notes["tip"] == "ft_frame"
+    assert plant.notes["wrench"] == (
+        "the force sensor '#0' carries 0.4 kg below it (it reads gravity and inertia as well "
+        "as contact): the wrench comes from the contacts"
+    )
+    assert plant.wrench_source == "contact sensor"
+    res = amj.simulate("pd", plant, T=0.05)
+    assert res.params["loop"] == "native"
+    assert np.all(res.wrench_ee == 0.0)

@@ -694,7 +694,7 @@ class Plant:
         torques = [
             s
             for s in range(m.nsensor)
-            if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sid >= 0
+            if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sensors
         ]
         self._torque_adr = int(m.sensor_adr[torques[0]]) if torques else -1
         subtree = [

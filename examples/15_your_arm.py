@@ -46,7 +46,12 @@ from adaptimp import _models
 from adaptimp import mujoco as amj
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
-UR5 = _models.panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
+
+
+def ur5() -> Path:
+    """The UR5 of example-robot-data (the extra ``pinocchio``): the default arm,
+    looked up only when no file is given (a given file needs only ``mujoco``)."""
+    return _models.panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
 
 
 def targets(res: Any) -> dict[str, float]:
@@ -197,7 +202,12 @@ def main() -> None:
     parser.add_argument("--json", type=Path, default=None, help="write the table's numbers")
     parser.add_argument("--rows", action="store_true", help="one summary row per file at the end")
     args = parser.parse_args()
-    paths = args.paths or [UR5]
+    if not args.paths:
+        try:
+            args.paths = [ur5()]
+        except ImportError as e:
+            parser.error(f"no file given, and the default UR5 needs the extra pinocchio: {e}")
+    paths = args.paths
     missing = [str(p) for p in paths if not p.is_file()]
     if missing:
         parser.error(f"no file {missing[0]!r}")
@@ -221,7 +231,10 @@ def main() -> None:
     T = 2.5 if QUICK else (args.T if args.T is not None else 10.0)
     records, lines = [], []
     for path in paths:
-        out = table(path, T, args.payload, arm, home)
+        try:
+            out = table(path, T, args.payload, arm, home)
+        except ImportError as e:  # --payload's computed torque needs the extra pinocchio
+            parser.error(str(e))
         lines.append(summary(path, out))
         records.append(
             {

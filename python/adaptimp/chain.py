@@ -318,7 +318,9 @@ class Chain(_adaptimp.Chain):
                 except ValueError as e:
                     raise ConfigError(f"MuJoCo cannot load {str(path)!r}: {e}") from None
         try:
-            if isinstance(tip, (int, np.integer)) and not isinstance(tip, bool):
+            if isinstance(tip, bool) or not isinstance(tip, (str, int, np.integer, type(None))):
+                raise TypeError(f"tip must be a site's or body's name or a site id, got {tip!r}")
+            if isinstance(tip, (int, np.integer)):
                 sid = int(tip)
                 if not 0 <= sid < model.nsite:
                     raise ConfigError(f"the MuJoCo model has no site {sid} ({model.nsite} sites)")

@@ -596,8 +596,9 @@ def suggest(
     period: float | None = None,
     gravity: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
-    """The gain and basis rule of SPEC §18: "params" (every controller keyword),
-    with a path also "centers" (L, 4n) and "widths" (4n,)."""
+    """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
+    samples along the path (SPEC (18.1)'s scales along it): "params" (every
+    controller keyword), with a path also "centers" (L, 4n) and "widths" (4n,)."""
 
 def default_task(
     home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]

@@ -357,5 +357,5 @@ def test_names_of_another_length_and_a_site_that_is_no_id_are_refused() -> None:
     for site in (1.5, True):  # taken as site 1
         with pytest.raises(TypeError) as e:
             adaptimp.Chain.from_mujoco(m, site)  # type: ignore[arg-type]
-        assert str(e.value) == f"site must be a site's name or its id (an int), got {site!r}"
+        assert str(e.value) == f"tip must be a site's or body's name or a site id, got {site!r}"
     assert adaptimp.Chain.from_mujoco(m, np.int64(1)).source == "MuJoCo model to site 't'"

@@ -91,7 +91,7 @@ def test_your_arm_with_a_urdf_needs_only_mujoco() -> None:
     # The default arm and --payload's computed torque need the extra: said so.
     proc = _without_pinocchio()
     assert proc.returncode == 2
-    assert "no URDF given, and the default UR5 needs the extra pinocchio" in proc.stderr
+    assert "no file given, and the default UR5 needs the extra pinocchio" in proc.stderr
     proc = _without_pinocchio(str(hobby), "--payload", "0.1")
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr

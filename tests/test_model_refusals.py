@@ -64,7 +64,10 @@ def test_a_payload_beyond_any_arm_is_refused_as_a_payload() -> None:
     assert str(e.value) == "payload must be ≥ 0 and ≤ 1e9 kg, got 1e+300"
 
 
-def test_a_model_without_actuators_is_refused_as_such(tmp_path: Any) -> None:
+def test_a_model_without_actuators_gets_the_plants_motors(tmp_path: Any) -> None:
+    """It said "Plant needs 1 to 7 joints, the model has 0"; then (the plant adds a
+    motor where a joint has none) MuJoCo's "unknown transmission target '#0'" for
+    unnamed joints: they are named, the motors added, τmax estimated and said."""
     from adaptimp import mujoco as amj
 
     path = tmp_path / "no_motors.xml"
@@ -73,13 +76,15 @@ def test_a_model_without_actuators_is_refused_as_such(tmp_path: Any) -> None:
         '<body pos="0 0 .3"><joint type="hinge" axis="0 1 0"/><geom size=".1" mass="1"/>'
         "</body></body></worldbody></mujoco>"
     )
-    # It said "Plant needs 1 to 7 joints, the model has 0".
-    with pytest.raises(ValueError, match=r"^Plant drives an arm's joints by actuators") as e:
-        amj.Plant(str(path))
-    assert str(e.value) == (
-        "Plant drives an arm's joints by actuators, and the model has none (2 joints, 0 "
-        "actuators): add a motor on each arm joint (<motor joint=...>)"
-    )
+    with pytest.warns(adaptimp.PlantWarning) as seen:
+        plant = amj.Plant(str(path))
+    said = [str(w.message) for w in seen]
+    assert (
+        "no_motors.xml: the joints ['adaptimp_joint0', 'adaptimp_joint1'] have no actuator: "
+        "the plant adds a torque motor to each"
+    ) in [m[: m.index("each") + 4] for m in said if "each" in m], said
+    assert plant.n == 2
+    assert plant.joint_names == ["adaptimp_joint0", "adaptimp_joint1"]
 
 
 @pytest.mark.parametrize(

@@ -19,7 +19,7 @@ the project's SPEC (docs/SPEC.md).
   or on a Dask cluster and returns a pandas DataFrame.
 - Errors by kind: :class:`ConfigError`, :class:`MeasurementError`,
   :class:`DivergedError`, :class:`FaultError`, :class:`SaveError`;
-  :class:`StabilityWarning`.
+  :class:`StabilityWarning`, :class:`PlantWarning`.
 
 Every SPEC quantity is a keyword parameter with the paper's default
 (:data:`PARAMS`, :data:`SCENARIOS`)::
@@ -40,6 +40,7 @@ from ._errors import (
     DivergedError,
     FaultError,
     MeasurementError,
+    PlantWarning,
     SaveError,
     StabilityWarning,
 )
@@ -72,6 +73,7 @@ __all__ = [
     "Normal",
     "Param",
     "PlanarArm",
+    "PlantWarning",
     "SaveError",
     "SimResult",
     "StabilityWarning",

@@ -359,3 +359,32 @@ def test_names_of_another_length_and_a_site_that_is_no_id_are_refused() -> None:
             adaptimp.Chain.from_mujoco(m, site)  # type: ignore[arg-type]
         assert str(e.value) == f"tip must be a site's or body's name or a site id, got {site!r}"
     assert adaptimp.Chain.from_mujoco(m, np.int64(1)).source == "MuJoCo model to site 't'"
+
+
+def test_an_interrupted_native_cartesian_run_keeps_its_rows_in_the_log() -> None:
+    """Ctrl-C (here from the progress callback) in a Cartesian run of the core's
+    loop: the rows of the steps it took are in ctrl.log, as its clock says
+    (they were missing: the log lost the interrupted run)."""
+    from adaptimp import mujoco as amj
+    from adaptimp import tuning
+
+    chain = adaptimp.Chain.from_urdf(_models.panda_urdf_path(), tip="panda_link8")
+    plant = amj.Plant(amj.panda(table_height=None))
+    p0, R0 = chain.pose(PANDA_Q0)
+    ctrl = adaptimp.CartesianController(
+        chain, "sf", "robot", q0=PANDA_Q0, Kd_rot=30.0,
+        **tuning.suggest(plant, PANDA_Q0, plant.tau_max),
+    )  # fmt: skip
+    plant.reset(PANDA_Q0)
+    ctrl.step(PANDA_Q0, np.zeros(7), np.zeros(6), xc=p0, R=R0)  # a row before the run
+
+    def stop(done: int, total: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        amj.simulate(ctrl, plant, T=60.0, reset=False, progress=stop)
+    k = int(ctrl.outer.core.steps)
+    assert 1 < k < 60_001
+    rows = ctrl.arrays()
+    assert {len(v) for v in rows.values()} == {k}, {n: len(v) for n, v in rows.items()}
+    np.testing.assert_array_equal(rows["qd"][-1], ctrl.q_d)

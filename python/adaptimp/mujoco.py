@@ -1738,15 +1738,20 @@ def _cartesian_loop(
     ctrl, reference = run.ctrl, run.reference
     table = reference.arrays if isinstance(reference, _Table) else reference
     targets = ctrl._targets(run.steps, table)
-    out: dict[str, Any] | None = None
+    task: dict[str, Any] | None = None
     try:
-        out = ctrl.outer.core.simulate_mujoco(
+        out: dict[str, Any] = ctrl.outer.core.simulate_mujoco(
             ctrl._joint, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
             run.settle, run.every, progress, targets, fault,
         )  # fmt: skip
+        task = out["task"]
+    except BaseException as e:
+        # Stopped (Ctrl-C, a diverged plant): the rows of the steps it took
+        # (the exception's `partial`), which the log keeps as the clock does.
+        task = getattr(e, "partial", None)
+        raise
     finally:
-        ctrl._ran(targets, None if out is None else out["task"])
-    assert out is not None
+        ctrl._ran(targets, task)
     return out
 
 

@@ -9,7 +9,7 @@
 //! exceptions of `adaptimp._errors`.
 
 use super::cartesian_loop::{
-    self, pose_target, CartesianOut, CartesianRun, JointStep, LastStep, TARGET_LEN,
+    self, pose_target, CartesianOut, CartesianRun, JointStep, LastStep, TaskRecords, TARGET_LEN,
 };
 use super::computed::{Computed, DynComputed, PyComputedTorque};
 use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JOINTS};
@@ -225,6 +225,7 @@ pub trait DynOuter: Send + Sync {
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
         hooks: &mut dyn Hooks,
+        partial: &mut Option<TaskRecords>,
     ) -> Result<CartesianOut, RunError>;
     /// Steps over recorded rows, the core's alone ([`cartesian_loop::replay`]).
     fn replay(
@@ -480,6 +481,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
         hooks: &mut dyn Hooks,
+        partial: &mut Option<TaskRecords>,
     ) -> Result<CartesianOut, RunError> {
         let joint = typed::<N>(joint)?;
         cartesian_loop::simulate_mujoco(
@@ -491,6 +493,7 @@ impl<const N: usize> DynOuter for Outer<N> {
             spec,
             run,
             hooks,
+            partial,
         )
     }
     fn replay(
@@ -635,6 +638,29 @@ fn target_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PoseTarget>> {
 fn wrench_of(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
     let v = flat("wrench", 6, obj)?;
     Ok(core::array::from_fn(|i| v[i]))
+}
+
+/// A Cartesian run's task rows (`k` of them) as the dict of
+/// `CartesianController.arrays()`'s keys.
+fn task_dict(py: Python<'_>, task: TaskRecords, k: usize) -> PyResult<Bound<'_, PyDict>> {
+    let n = task.n;
+    let [pc, dpc, ddpc] = task.pc;
+    let [pd, dpd, ddpd] = task.pd;
+    let d = PyDict::new(py);
+    for (name, v, w) in [
+        ("pc", pc, 3),
+        ("dpc", dpc, 3),
+        ("ddpc", ddpc, 3),
+        ("pd", pd, 3),
+        ("dpd", dpd, 3),
+        ("ddpd", ddpd, 3),
+        ("qd", task.qd, n),
+        ("wrench", task.wrench, 6),
+        ("error", task.error, 6),
+    ] {
+        d.set_item(name, array(py, v, (k, w))?)?;
+    }
+    Ok(d)
 }
 
 /// The rows of a table (K, n) of reals from any array or nested sequence
@@ -1198,38 +1224,40 @@ impl PyCartesian {
         };
         let mut hooks = super::PyHooks::new(progress);
         let mut outer = self.lock(py);
+        let mut partial = None;
         let result = {
             let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
-            py.detach(|| o.simulate_mujoco(t, &mut sim, &spec, &run, &mut hooks))
+            py.detach(|| o.simulate_mujoco(t, &mut sim, &spec, &run, &mut hooks, &mut partial))
         };
         drop(outer);
         drop(joint);
         drop(sim);
-        let (rec, task, metrics) = result.map_err(|e| super::run_error(e, &mut hooks))?;
+        let (rec, task, metrics) = match result {
+            Ok(out) => out,
+            Err(e) => {
+                // The rows of the steps taken before the error (Ctrl-C, a
+                // diverged plant), as the exception's `partial`: the
+                // controller's log keeps them.
+                let err = super::run_error(e, &mut hooks);
+                if let Some(task) = partial {
+                    let k = task.z1.len() / 3;
+                    err.value(py).setattr("partial", task_dict(py, task, k)?)?;
+                }
+                return Err(err);
+            }
+        };
         let k = rec.rows();
         let out = super::records_dict(py, rec, metrics)?;
-        let n = task.n;
-        let [pc, dpc, ddpc] = task.pc;
-        let [pd, dpd, ddpd] = task.pd;
-        for (name, v) in [("xc", &pc), ("dxc", &dpc), ("ddxc", &ddpc), ("xd", &pd)] {
+        for (name, v) in [
+            ("xc", &task.pc[0]),
+            ("dxc", &task.pc[1]),
+            ("ddxc", &task.pc[2]),
+            ("xd", &task.pd[0]),
+            ("z1", &task.z1),
+        ] {
             out.set_item(name, array(py, v.clone(), (k, 3))?)?;
         }
-        out.set_item("z1", array(py, task.z1, (k, 3))?)?;
-        let d = PyDict::new(py);
-        for (name, v, w) in [
-            ("pc", pc, 3),
-            ("dpc", dpc, 3),
-            ("ddpc", ddpc, 3),
-            ("pd", pd, 3),
-            ("dpd", dpd, 3),
-            ("ddpd", ddpd, 3),
-            ("qd", task.qd, n),
-            ("wrench", task.wrench, 6),
-            ("error", task.error, 6),
-        ] {
-            d.set_item(name, array(py, v, (k, w))?)?;
-        }
-        out.set_item("task", d)?;
+        out.set_item("task", task_dict(py, task, k)?)?;
         Ok(out)
     }
 

@@ -1240,6 +1240,54 @@ def mujoco_runs(t: Tally, quick: bool) -> None:
                 _finite(res.tau_sat)
 
             case(t, f"mujoco.simulate {what}", run, expect)
+
+        # Files as a user has them: broken, foreign, of the wrong kind, a tip or
+        # fix that is not there, too many joints, a joint with two motors.
+        def body(i: int, inner: str = "") -> str:
+            return (f'<body name="b{i}" pos="0 0 .1"><joint name="j{i}" type="hinge" '
+                    f'axis="0 1 0"/><geom size=".05" mass="1"/>{inner}</body>')  # fmt: skip
+
+        chain9 = ""
+        for i in reversed(range(9)):
+            chain9 = body(i, chain9)
+        motors9 = "".join(f'<motor joint="j{i}" ctrlrange="-5 5"/>' for i in range(9))
+        files = {
+            "missing.xml": None,
+            "broken.xml": "<mujoco><worldbody><body>",
+            "not_xml.xml": "\x00\x01 binary",
+            "a_free_body.xml": '<mujoco><worldbody><body><freejoint/><geom size=".1"/>'
+            "</body></worldbody></mujoco>",
+            "nine_joints.xml": f"<mujoco><worldbody>{chain9}</worldbody>"
+            f"<actuator>{motors9}</actuator></mujoco>",
+            "two_motors.xml": f"<mujoco><worldbody>{body(0)}</worldbody><actuator>"
+            '<motor joint="j0"/><motor joint="j0"/></actuator></mujoco>',
+            "arm.xml": f"<mujoco><worldbody>{body(0, body(1))}</worldbody><actuator>"
+            '<motor joint="j0" ctrlrange="-5 5"/><motor joint="j1" ctrlrange="-5 5"/>'
+            "</actuator></mujoco>",
+        }
+        for name, text in files.items():
+            if text is not None:
+                (root / name).write_text(text)
+        for name, kw, expect in [
+            ("missing.xml", {}, "refuse"),
+            ("broken.xml", {}, "refuse"),
+            ("not_xml.xml", {}, "refuse"),
+            ("a_free_body.xml", {}, "refuse"),
+            ("nine_joints.xml", {}, "refuse"),
+            ("two_motors.xml", {}, "refuse"),
+            ("arm.xml", {}, "accept"),
+            ("arm.xml", {"tip": "nowhere"}, "refuse"),
+            ("arm.xml", {"fix": ("j9",)}, "refuse"),
+            ("arm.xml", {"fix": "j0"}, "refuse"),
+            ("arm.xml", {"fix": ("j0",)}, "either"),
+            ("arm.xml", {"tip": "b0"}, "either"),
+        ]:
+
+            def plant(name: str = name, kw: dict[str, Any] = kw) -> None:
+                res = amj.simulate("pd", str(root / name), T=0.05, **kw)
+                _finite(res.tau_sat, res.q)
+
+            case(t, f"MJCF {name} {kw}", plant, expect)
         # The plant adds a motor where a joint has none (unnamed joints too).
         case(t, "a model without actuators",
              lambda: _finite(amj.simulate("pd", str(noact), T=0.05).tau_sat), "accept")  # fmt: skip

@@ -108,3 +108,34 @@ def test_a_reference_of_the_wrong_shape_is_refused_by_name(
     with pytest.raises(error) as e:  # a 2-tuple was an IndexError
         amj.simulate("pd", "two_link", T=0.01, reference=reference)
     assert str(e.value) == message
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "message"),
+    [
+        ("a_free_body.xml",
+         '<mujoco><worldbody><body><freejoint/><geom size=".1"/></body></worldbody></mujoco>',
+         "a_free_body.xml: the model has no hinge joint to drive"),
+        ("nine.xml", None,
+         "nine.xml: Plant needs 1 to 7 joints; the arm has 9 (j0, j1, j2, j3, j4, j5, j6, j7, "
+         "j8): fix some with fix=(...) or name the arm's end with tip="),
+    ],
+)  # fmt: skip
+def test_a_file_that_cannot_be_a_plant_is_named(
+    name: str, text: str | None, message: str, tmp_path: Any
+) -> None:
+    from adaptimp import mujoco as amj
+
+    if text is None:  # nine hinges in a chain, each with a motor
+        inner = ""
+        for i in reversed(range(9)):
+            inner = (
+                f'<body name="b{i}" pos="0 0 .1"><joint name="j{i}" type="hinge" axis="0 1 0"/>'
+                f'<geom size=".05" mass="1"/>{inner}</body>'
+            )
+        motors = "".join(f'<motor joint="j{i}" ctrlrange="-5 5"/>' for i in range(9))
+        text = f"<mujoco><worldbody>{inner}</worldbody><actuator>{motors}</actuator></mujoco>"
+    (tmp_path / name).write_text(text)
+    with pytest.raises(ValueError) as e:
+        amj.Plant(str(tmp_path / name))
+    assert str(e.value) == message

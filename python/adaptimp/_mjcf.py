@@ -451,7 +451,12 @@ def prepare_spec(
         m0 = spec.compile()
     except ValueError as e:
         raise ValueError(f"{label}MuJoCo cannot compile the model: {e}") from None
-    arm = arm_of(m0, tip, fix)
+    try:
+        arm = arm_of(m0, tip, fix)
+    except ValueError as e:  # named by the file it is about
+        if str(e).startswith(label):
+            raise
+        raise ValueError(f"{label}{e}") from None
     tree = arm_tree(m0, arm["joint_ids"])
     keep = set(arm["joint_ids"])
     lock = [j for j in range(m0.njnt) if j not in keep and int(m0.jnt_bodyid[j]) in tree]

@@ -438,6 +438,13 @@ def _name(m: mujoco.MjModel, objtype: Any, i: int) -> str:
     return mujoco.mj_id2name(m, objtype, i) or f"#{i}"
 
 
+
+def _source_label(model: object) -> str:
+    """``"name.xml: "`` for a model given as a file, else ``""`` (a message's prefix)."""
+    if isinstance(model, (str, os.PathLike)) and str(model) not in _BUILTIN:
+        return f"{Path(model).name}: "
+    return ""
+
 class Plant:
     """A MuJoCo model of a serial arm as the plant of a control loop.
 
@@ -545,7 +552,13 @@ class Plant:
         self.notes: dict[str, Any] = {**prepared.notes, "warnings": list(prepared.warnings)}
         for text in prepared.warnings:
             warnings.warn(text, PlantWarning, stacklevel=2)
-        self._setup_model(prepared.model, self.tip)
+        try:
+            self._setup_model(prepared.model, self.tip)
+        except ValueError as e:  # a file's arm that cannot be a plant: name the file
+            label = _source_label(model)
+            if str(e).startswith(label):
+                raise
+            raise ValueError(f"{label}{e}") from None
         self.notes["tip"] = (
             _name(self.model, mujoco.mjtObj.mjOBJ_SITE, self._site)
             if self._site >= 0

@@ -6,6 +6,7 @@ ceilings instead of returning NaN."""
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
@@ -136,6 +137,6 @@ def test_a_file_that_cannot_be_a_plant_is_named(
         motors = "".join(f'<motor joint="j{i}" ctrlrange="-5 5"/>' for i in range(9))
         text = f"<mujoco><worldbody>{inner}</worldbody><actuator>{motors}</actuator></mujoco>"
     (tmp_path / name).write_text(text)
-    with pytest.raises(ValueError) as e:
+    with pytest.raises(ValueError, match=f"^{re.escape(name)}: ") as e:
         amj.Plant(str(tmp_path / name))
     assert str(e.value) == message

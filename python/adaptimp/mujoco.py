@@ -438,12 +438,12 @@ def _name(m: mujoco.MjModel, objtype: Any, i: int) -> str:
     return mujoco.mj_id2name(m, objtype, i) or f"#{i}"
 
 
-
 def _source_label(model: object) -> str:
     """``"name.xml: "`` for a model given as a file, else ``""`` (a message's prefix)."""
     if isinstance(model, (str, os.PathLike)) and str(model) not in _BUILTIN:
         return f"{Path(model).name}: "
     return ""
+
 
 class Plant:
     """A MuJoCo model of a serial arm as the plant of a control loop.

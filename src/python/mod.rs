@@ -27,6 +27,7 @@ mod arm;
 mod cartesian;
 mod cartesian_loop;
 mod computed;
+mod description;
 mod dynamic;
 mod mujoco;
 mod tuning;
@@ -1867,6 +1868,8 @@ mod adaptimp_module {
     use super::cartesian::{centres_along, PyCartesian, PyChain};
     #[pymodule_export]
     use super::computed::PyComputedTorque;
+    #[pymodule_export]
+    use super::description::{arm_from_mujoco, description_kind, read_arm};
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -16,6 +16,7 @@ import pytest
 import adaptimp
 from adaptimp import _models
 from adaptimp import mujoco as amj
+from adaptimp._description import read_arm
 
 RNG_SEED = 20160301
 
@@ -215,18 +216,25 @@ def test_plant_rejects_models_it_cannot_drive() -> None:
 
 def test_a_urdf_arm_is_its_chain_with_the_gripper_fixed() -> None:
     path = _models.panda_urdf_path()
-    arm = _models.arm_urdf(path.read_text())
+    arm = read_arm(path)
     assert arm.joints == _models.PANDA_JOINTS
     assert arm.effort == _models.PANDA_EFFORT
     assert arm.tip == "panda_link7"
-    prismatic = "prismatic (the arm's joints are revolute)"
-    assert arm.fixed == dict.fromkeys(_models.PANDA_FINGERS, prismatic)
+    finger1, finger2 = _models.PANDA_FINGERS
+    assert arm.fixed == {
+        finger1: "prismatic (a lift, a rail or a finger): the arm found without tip= is "
+        "revolute; a tip beyond it drives it",
+        finger2: f"mimics '{finger1}': it moves with '{finger1}', not on its own",
+    }
     plant = amj.Plant(path)
     assert plant.n == 7
     assert plant.tau_max.tolist() == list(_models.PANDA_EFFORT)
-    # The plant itself still refuses a slide joint, by name.
-    spec, effort = amj._urdf_spec(path.read_text())
-    amj._add_motors(spec, effort)
+    # The plant itself still refuses a slide joint, by name: the chain to a
+    # finger drives its joint (tip= names the path).
+    finger = read_arm(path, tip="panda_leftfinger")
+    assert finger.joints == (*_models.PANDA_JOINTS, finger1)
+    spec = amj._spec_of(finger.urdf)
+    amj._add_motors(spec, dict(zip(finger.joints, finger.effort)))
     with pytest.raises(ValueError, match=r"panda_finger_joint1 \(mjJNT_SLIDE\)"):
         amj.Plant(spec.compile())
 

@@ -261,9 +261,9 @@ impl<'t> Reduction<'t> {
                 .is_some_and(|j| tree.joints()[j].kind == JointType::Fixed)
     }
 
-    /// The first tool frame on link `l` or on a link fixed to it, not
-    /// through the joint `except`: a named frame, or a frame link.
-    fn frame_beside(&self, l: usize, except: usize) -> Option<String> {
+    /// The first tool frame on link `l` or on a link fixed to it (beside
+    /// any movable joint of `l`): a named frame, or a frame link.
+    fn frame_beside(&self, l: usize) -> Option<String> {
         let tree = self.tree;
         let mut todo = VecDeque::from([l]);
         while let Some(link) = todo.pop_front() {
@@ -274,7 +274,7 @@ impl<'t> Reduction<'t> {
                 return Some(tree.links()[link].name.clone());
             }
             for &j in tree.child_joints(link) {
-                if j != except && tree.joints()[j].kind == JointType::Fixed {
+                if tree.joints()[j].kind == JointType::Fixed {
                     todo.push_back(tree.joint_links(j).1);
                 }
             }
@@ -412,9 +412,13 @@ pub fn reduce(tree: &Tree, tip: Option<&str>, fix: &[&str]) -> Result<Arm, Descr
                 .into_iter()
                 .filter(|&j| joints[j].kind.is_movable() && !r.held.contains_key(&j))
                 .collect();
+            let mut on_arm = alloc::vec![false; joints.len()];
+            for &j in &arm {
+                on_arm[j] = true;
+            }
             let tip_name = tip.unwrap_or_default().to_string();
             for (i, j) in joints.iter().enumerate() {
-                if j.kind != JointType::Fixed && !arm.contains(&i) && !r.held.contains_key(&i) {
+                if j.kind != JointType::Fixed && !on_arm[i] && !r.held.contains_key(&i) {
                     r.held.insert(
                         i,
                         Held::OffPath {
@@ -515,6 +519,8 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
     // of them is an arm's (not a gripper's); the gripper rules mark joints.
     let mut above = alloc::vec![0usize; nl];
     let mut arm_above = alloc::vec![false; nl];
+    // Per link, the tool frame beside its joints (looked for once).
+    let mut beside: Vec<Option<Option<String>>> = alloc::vec![None; nl];
     for &l in &order {
         for &j in tree.child_joints(l) {
             let c = tree.joint_links(j).1;
@@ -527,7 +533,10 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
                             .map(|&f| joints[f].name.clone())
                             .collect(),
                     })
-                } else if let Some(frame) = r.frame_beside(l, j).filter(|_| !frame_below[c]) {
+                } else if let Some(frame) = (!frame_below[c])
+                    .then(|| beside[l].get_or_insert_with(|| r.frame_beside(l)).clone())
+                    .flatten()
+                {
                     Some(Held::Jaw { frame })
                 } else {
                     word.map(|word| Held::Named { word })
@@ -600,6 +609,7 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
             ends.iter()
                 .map(|&j| tree.links()[tree.joint_links(j).1].name.as_str()),
         );
+        let tips = tips.trim_start_matches('[').trim_end_matches(']');
         return Err(arm_error(
             tree,
             format!(
@@ -615,25 +625,30 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
         .into_iter()
         .filter(|&j| r.drivable(j))
         .collect();
-    // Everything else with a coordinate: in a hand, or off the chain.
+    // Everything else with a coordinate: in a hand (the nearest hand link
+    // at or above its parent), or off the chain.
+    let mut in_hand: Vec<Option<usize>> = alloc::vec![None; nl];
+    for &l in &order {
+        let here = if hand[l] { Some(l) } else { in_hand[l] };
+        in_hand[l] = here;
+        for &j in tree.child_joints(l) {
+            in_hand[tree.joint_links(j).1] = here;
+        }
+    }
+    let mut on_arm = alloc::vec![false; joints.len()];
+    for &j in &arm {
+        on_arm[j] = true;
+    }
     for (i, j) in joints.iter().enumerate() {
-        if j.kind == JointType::Fixed || arm.contains(&i) || r.held.contains_key(&i) {
+        if j.kind == JointType::Fixed || on_arm[i] || r.held.contains_key(&i) {
             continue;
         }
-        let mut l = tree.joint_links(i).0;
-        let mut reason = Held::OffChain;
-        loop {
-            if hand[l] {
-                reason = Held::Hand {
-                    link: tree.links()[l].name.clone(),
-                };
-                break;
-            }
-            match tree.parent_joint(l) {
-                Some(p) => l = tree.joint_links(p).0,
-                None => break,
-            }
-        }
+        let reason = match in_hand[tree.joint_links(i).0] {
+            Some(l) => Held::Hand {
+                link: tree.links()[l].name.clone(),
+            },
+            None => Held::OffChain,
+        };
         r.held.insert(i, reason);
     }
     Ok(arm)
@@ -701,7 +716,11 @@ fn build(
     let joints = tree.joints();
     let last_link = tree.joint_links(arm[arm.len() - 1]).1;
     let tip_link = tip_link.unwrap_or(last_link);
-    let is_arm = |j: usize| arm.contains(&j);
+    let mut on_arm = alloc::vec![false; joints.len()];
+    for &j in &arm {
+        on_arm[j] = true;
+    }
+    let is_arm = |j: usize| on_arm[j];
     let value = |j: usize| {
         if is_arm(j) {
             joints[j].offset

@@ -427,21 +427,34 @@ impl Tree {
                 )?;
             }
         }
-        // Every link's way up ends at a root rather than running in a circle.
+        // Every link's way up ends at a root rather than running in a
+        // circle: each link is walked once (0 not yet, 1 on this walk, 2 ends
+        // at a root).
+        let mut seen = alloc::vec![0u8; links.len()];
         for start in 0..links.len() {
-            let (mut link, mut steps) = (start, 0);
-            while let Some(j) = parent_joint[link] {
-                link = ends[j].0;
-                steps += 1;
-                if steps > links.len() {
-                    return Err(structure(
-                        source,
-                        format!(
-                            "the joints form a loop through the link '{}': a tree cannot hold it; \
-                             remove a joint of the loop",
-                            links[link].name
-                        ),
-                    ));
+            let mut link = start;
+            while seen[link] == 0 {
+                seen[link] = 1;
+                match parent_joint[link] {
+                    Some(j) => link = ends[j].0,
+                    None => break,
+                }
+            }
+            if seen[link] == 1 && parent_joint[link].is_some() {
+                return Err(structure(
+                    source,
+                    format!(
+                        "the joints form a loop through the link '{}': a tree cannot hold it; \
+                         remove a joint of the loop",
+                        links[link].name
+                    ),
+                ));
+            }
+            let mut link = start;
+            while seen[link] == 1 {
+                seen[link] = 2;
+                if let Some(j) = parent_joint[link] {
+                    link = ends[j].0;
                 }
             }
         }

@@ -197,7 +197,7 @@ fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError>
         let at = first_bad_element(&root).map_or_else(String::new, |el| format!("{el}: "));
         parse_error(&format!("{at}{e}"))
     })?;
-    let with_inertial: Vec<String> = root
+    let with_inertial: std::collections::BTreeSet<String> = root
         .children
         .iter()
         .filter_map(|c| match c {
@@ -270,7 +270,7 @@ fn stated(v: f64) -> f64 {
 fn tree_of(
     robot: &urdf_rs::Robot,
     source: &str,
-    with_inertial: &[String],
+    with_inertial: &std::collections::BTreeSet<String>,
 ) -> Result<Tree, DescriptionError> {
     let links = robot
         .links

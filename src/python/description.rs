@@ -116,14 +116,15 @@ fn arm_dict<'py>(
 /// `ConfigError` naming the file, the element and what to do.
 /// `label` names URDF text in messages (default "URDF text").
 #[pyfunction]
-#[pyo3(signature = (source, tip=None, fix=Vec::new(), label=None))]
+#[pyo3(signature = (source, tip=None, fix=None, label=None))]
 pub fn read_arm<'py>(
     py: Python<'py>,
     source: &str,
     tip: Option<&str>,
-    fix: Vec<String>,
+    fix: Option<Vec<String>>,
     label: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let fix = fix.unwrap_or_default();
     let fix: Vec<&str> = fix.iter().map(String::as_str).collect();
     let (tree, arm) = py
         .detach(|| {
@@ -216,15 +217,16 @@ fn mujoco_arrays(d: &Bound<'_, PyDict>) -> PyResult<MujocoArrays> {
 /// for messages (e.g. "MJCF 'robot.xml'"), `tip` a body or a site, `fix`
 /// joints to hold. Returns the arm as a dict (its "urdf" is None).
 #[pyfunction]
-#[pyo3(signature = (arrays, source, tip=None, fix=Vec::new()))]
+#[pyo3(signature = (arrays, source, tip=None, fix=None))]
 pub fn arm_from_mujoco<'py>(
     py: Python<'py>,
     arrays: &Bound<'py, PyDict>,
     source: &str,
     tip: Option<&str>,
-    fix: Vec<String>,
+    fix: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let arrays = mujoco_arrays(arrays)?;
+    let fix = fix.unwrap_or_default();
     let fix: Vec<&str> = fix.iter().map(String::as_str).collect();
     let (tree, arm) = py
         .detach(|| {

@@ -295,6 +295,13 @@ class ComputedTorque:
         ``"external"``: the setpoint is already compliant (an outer loop such
         as that of :class:`adaptimp.CartesianController` made it, SPEC §16):
         xd = xc, ẋd = ẋc, ẍd = ẍc, and τe enters only as the feedforward +τe.
+    armature, damping, friction : float or (n,), optional
+        The joints' drive in the controller's model (SPEC (20.5), (20.6); ≥ 0):
+        the rotor inertia added to the mass matrix's diagonal (kg m²), the
+        viscous damping b q̇ (N m s/rad) and the dry friction loss (N m) that
+        the law compensates on its reference's velocity (MuJoCo's
+        ``dof_armature``, ``dof_damping``, ``dof_frictionloss``). None (the
+        default): the description's, as ``drive`` says (0 for a model).
     """
 
     def __init__(
@@ -312,6 +319,9 @@ class ComputedTorque:
         Gd: ArrayLike = 60.0,
         trajectory: Reference | None = None,
         impedance: str = "joint",
+        armature: ArrayLike | None = None,
+        damping: ArrayLike | None = None,
+        friction: ArrayLike | None = None,
         tip: str | None = None,
         fix: Sequence[str] = (),
         drive: bool | None = None,
@@ -332,7 +342,10 @@ class ComputedTorque:
             exact = pinocchio_model(model)
             joints, inertials, gravity = core_description(exact)
             limits = np.asarray(exact.effortLimit, dtype=np.float64)
-            self.drive: dict[str, list[float]] = {"armature": [], "damping": [], "friction": []}
+            nothing = [0.0] * len(joints)
+            self.drive: dict[str, list[float]] = dict.fromkeys(
+                ("armature", "damping", "friction"), nothing
+            )
         else:
             # A description (SPEC §21): the core's arm, its chain and bodies.
             arm = _arm(model, tip, fix)
@@ -363,6 +376,10 @@ class ComputedTorque:
                 raise ValueError("the model has no effort limits: give tau_max")
         self.tau_max = _joint("tau_max", tau_max, n)
         self.mass_scale = float(mass_scale)
+        given = {"armature": armature, "damping": damping, "friction": friction}
+        self.drive = {
+            k: _joint(k, self.drive[k] if v is None else v, n).tolist() for k, v in given.items()
+        }
         self._core = _adaptimp.ComputedTorque(
             joints,
             inertials,
@@ -377,6 +394,7 @@ class ComputedTorque:
             impedance=impedance,
             mass_scale=self.mass_scale,
             payload=float(payload),
+            **self.drive,
         )
         self._params: dict[str, Any] = {
             "Ts": self._ts,
@@ -389,6 +407,7 @@ class ComputedTorque:
             "Cd": self.Cd.tolist(),
             "Gd": self.Gd.tolist(),
             "impedance": impedance,
+            **self.drive,
         }
         if trajectory is None and n == 2:
             trajectory = paper_circle()

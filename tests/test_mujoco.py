@@ -222,8 +222,8 @@ def test_a_urdf_arm_is_its_chain_with_the_gripper_fixed() -> None:
     assert arm.tip == "panda_link7"
     finger1, finger2 = _models.PANDA_FINGERS
     assert arm.fixed == {
-        finger1: "prismatic (a lift, a rail or a finger): the arm found without tip= is "
-        "revolute; a tip beyond it drives it",
+        finger1: "in the hand at 'panda_hand' (branches of joints start there: two or more "
+        "each shorter than the arm, or three or more none longer)",
         finger2: f"mimics '{finger1}': it moves with '{finger1}', not on its own",
     }
     plant = amj.Plant(path)

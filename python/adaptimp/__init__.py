@@ -40,6 +40,7 @@ from ._errors import (
     FaultError,
     MeasurementError,
     StabilityWarning,
+    XacroError,
 )
 from ._faults import Fault
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
@@ -74,6 +75,7 @@ __all__ = [
     "StabilityWarning",
     "TwoLinkArm",
     "Uniform",
+    "XacroError",
     "__version__",
     "defaults",
     "metrics_table",

@@ -67,6 +67,8 @@ class Arm:
     urdf : str or None
         For a URDF: the reduced URDF for MuJoCo's compiler (inertials only,
         held joints fixed, the arm's joints with their limits).
+    urdf_drive : str or None
+        The same with the arm joints' ``<dynamics damping friction>``.
     gravity : tuple of float
         Gravity in the base frame (m/s²): the MuJoCo model's, or standard
         gravity along −z for a URDF.
@@ -93,6 +95,7 @@ class Arm:
     fixed: dict[str, str]
     held: dict[str, float]
     urdf: str | None
+    urdf_drive: str | None
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     joint_ids: tuple[int, ...] = ()
 

@@ -215,14 +215,10 @@ def _arm_spec(arm: _description.Arm, timestep: float, *, drive: bool, stacklevel
     the estimate of :func:`estimate_effort` on the arm itself, with a warning
     at ``stacklevel``. With ``drive``, each arm joint's damping and friction
     loss as the URDF's ``<dynamics>`` states them."""
-    assert arm.urdf is not None
-    spec = _spec_of(arm.urdf)
+    text = arm.urdf_drive if drive else arm.urdf
+    assert text is not None
+    spec = _spec_of(text)
     spec.option.timestep = timestep
-    if drive:
-        for name, damping, friction in zip(arm.joints, arm.damping, arm.friction):
-            joint = spec.joint(name)
-            joint.damping = damping
-            joint.frictionloss = friction
     missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
     _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
     if missing:

@@ -24,7 +24,8 @@
 //!     <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
 //!   <link name="tool"/>
 //!   <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
-//!     <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="20" velocity="2"/></joint>
+//!     <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="20" velocity="2"/>
+//!     <dynamics damping="0.5"/></joint>
 //!   <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/>
 //!     <origin xyz="0.3 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
 //!   <joint name="flange" type="fixed"><parent link="fore"/><child link="tool"/>
@@ -33,11 +34,12 @@
 //! let tree = urdf::read_str(text)?;                 // or urdf::read_file("arm.urdf")
 //! let arm = reduce(&tree, Some("tool"), &[])?;      // the chain from the root to "tool"
 //! let chain: Chain<2> = arm.to_chain()?;            // kinematics to the tip
-//! let dynamics: Dynamics<2> = arm.to_dynamics(GRAVITY)?;
+//! let dynamics: Dynamics<2> = arm.to_dynamics(GRAVITY)?.with_drive(arm.drive()?)?;
 //! let tip = chain.fk(&Vector::<2>::new(0.0, 0.0));
 //! assert!((tip.x - 0.5).abs() < 1e-15);             // 0.3 m + 0.2 m along x
 //! assert_eq!(arm.joints[1].effort, 10.0);           // N m
 //! assert!((dynamics.mass() - 3.0).abs() < 1e-15);   // kg
+//! assert_eq!(dynamics.drive().damping[0], 0.5);      // N m s/rad, its <dynamics damping>
 //! # }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

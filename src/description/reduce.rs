@@ -5,7 +5,7 @@
 use super::error::{DescriptionError, ErrorKind};
 use super::tree::{motion, JointType, Tree};
 use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
-use crate::cartesian::dynamics::{Dynamics, Inertial};
+use crate::cartesian::dynamics::{Drive, Dynamics, Inertial};
 use crate::error::Error;
 use alloc::collections::{BTreeMap, VecDeque};
 use alloc::format;
@@ -200,9 +200,32 @@ impl Arm {
     }
 
     /// The arm's rigid-body dynamics under `gravity` (m/s², the base frame),
-    /// as a [`Dynamics`] of `N` joints.
+    /// as a [`Dynamics`] of `N` joints (the links alone; the description's
+    /// drive terms are [`Arm::drive`], for [`Dynamics::with_drive`]).
     pub fn to_dynamics<const N: usize>(&self, gravity: [f64; 3]) -> Result<Dynamics<N>, Error> {
         Dynamics::new(&self.chain, &self.inertials, gravity)
+    }
+
+    /// The description's drive terms of the `N` arm joints (armature,
+    /// damping, friction loss; SPEC (20.5)), or an error if `N` is not
+    /// [`Arm::n`].
+    pub fn drive<const N: usize>(&self) -> Result<Drive<N>, Error> {
+        if self.joints.len() != N {
+            return Err(Error::Condition {
+                condition: "the arm has N joints (the Drive's N)",
+                lhs: "arm joints",
+                index: None,
+                value: self.joints.len() as f64,
+            });
+        }
+        let column = |f: fn(&ArmJoint) -> f64| {
+            crate::types::Vector::<N>::from_iterator(self.joints.iter().map(f))
+        };
+        Ok(Drive {
+            armature: column(|j| j.armature),
+            damping: column(|j| j.damping),
+            friction: column(|j| j.friction),
+        })
     }
 
     /// The reason joint `name` is held, if it is.
@@ -492,11 +515,6 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
     let tree = r.tree;
     let joints = tree.joints();
     let nl = tree.links().len();
-    for (i, j) in joints.iter().enumerate() {
-        if j.kind == JointType::Prismatic && !r.held.contains_key(&i) {
-            r.held.insert(i, Held::Prismatic);
-        }
-    }
     let order = r.order(root);
     // Bottom up: the longest run of joints with a coordinate below each link
     // (the structure: mimic, prismatic and held ones count), whether a
@@ -626,7 +644,7 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
         .filter(|&j| r.drivable(j))
         .collect();
     // Everything else with a coordinate: in a hand (the nearest hand link
-    // at or above its parent), or off the chain.
+    // at or above its parent), prismatic, or off the chain.
     let mut in_hand: Vec<Option<usize>> = alloc::vec![None; nl];
     for &l in &order {
         let here = if hand[l] { Some(l) } else { in_hand[l] };
@@ -647,6 +665,7 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
             Some(l) => Held::Hand {
                 link: tree.links()[l].name.clone(),
             },
+            None if j.kind == JointType::Prismatic => Held::Prismatic,
             None => Held::OffChain,
         };
         r.held.insert(i, reason);

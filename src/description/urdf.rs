@@ -96,17 +96,22 @@ fn document(text: &str) -> Result<xml::Element, String> {
 /// The first xacro markup in the document: an element in the xacro
 /// namespace, or an attribute with `${…}` or `$(…)` (comments do not count).
 fn xacro_markup(root: &xml::Element) -> Option<String> {
+    // In the document's order: the first markup a reader meets.
     let mut todo = std::vec![root];
     while let Some(e) = todo.pop() {
         if e.ns.as_deref() == Some(XACRO_NS) {
             return Some(format!("the element <xacro:{}>", e.name));
         }
-        for ((name, _), value) in &e.attributes {
+        // By name: the message is the same on every run.
+        let mut attributes: Vec<(&String, &String)> =
+            e.attributes.iter().map(|((n, _), v)| (n, v)).collect();
+        attributes.sort();
+        for (name, value) in attributes {
             if value.contains("${") || value.contains("$(") {
                 return Some(format!("the expression {name}=\"{value}\" in <{}>", e.name));
             }
         }
-        for c in &e.children {
+        for c in e.children.iter().rev() {
             if let xml::Xml::ElementNode(child) = c {
                 todo.push(child);
             }

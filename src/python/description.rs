@@ -101,10 +101,12 @@ fn arm_dict<'py>(
     }
     d.set_item("fixed", fixed)?;
     d.set_item("held", held)?;
-    if with_urdf {
-        d.set_item("urdf", urdf::reduced_urdf(tree, arm, false).map_err(error)?)?;
-    } else {
-        d.set_item("urdf", py.None())?;
+    for (key, drive) in [("urdf", false), ("urdf_drive", true)] {
+        if with_urdf {
+            d.set_item(key, urdf::reduced_urdf(tree, arm, drive).map_err(error)?)?;
+        } else {
+            d.set_item(key, py.None())?;
+        }
     }
     Ok(d)
 }

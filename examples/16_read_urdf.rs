@@ -51,7 +51,8 @@ fn report<const N: usize>(arm: &adaptimp::description::Arm) -> Result<(), adapti
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (mut source, mut tip, mut fix) = (None, None, Vec::new());
-    let mut args = std::env::args().skip(1);
+    // Under `cargo test` the arguments are the harness's: the text below.
+    let mut args = std::env::args().skip(if cfg!(test) { usize::MAX } else { 1 });
     while let Some(a) = args.next() {
         match a.as_str() {
             "--tip" => tip = args.next(),
@@ -86,4 +87,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         n => return Err(format!("the arm has {n} joints; hold some with --fix").into()),
     }
     Ok(())
+}
+
+/// `cargo test` runs this example on the text (`cfg!(test)`).
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn runs() {
+        super::main().unwrap();
+    }
 }

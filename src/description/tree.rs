@@ -161,7 +161,7 @@ pub struct Mimic {
     pub offset: f64,
 }
 
-/// A joint of a tree: see the [module docs](self).
+/// A joint of a tree (SPEC (21.1)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TreeJoint {
     /// Its name, unique in the tree.
@@ -241,7 +241,7 @@ pub struct NamedFrame {
     pub tool: bool,
 }
 
-/// A validated kinematic tree: see the [module docs](self).
+/// A validated kinematic tree (SPEC (21.1)): links, the joints between them, named frames.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tree {
     source: String,

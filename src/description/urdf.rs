@@ -199,7 +199,12 @@ fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError>
     let bare = std::panic::catch_unwind(|| format!("{root}"))
         .map_err(|_| parse_error("its namespaces cannot be written back"))?;
     let robot = parse(&bare).map_err(|e| {
-        let at = first_bad_element(&root).map_or_else(String::new, |el| format!("{el}: "));
+        // Writing an element alone can meet a prefix bound on the root: no
+        // pointer then, rather than a panic.
+        let at = std::panic::catch_unwind(|| first_bad_element(&root))
+            .ok()
+            .flatten()
+            .map_or_else(String::new, |el| format!("{el}: "));
         parse_error(&format!("{at}{e}"))
     })?;
     let with_inertial: std::collections::BTreeSet<String> = root

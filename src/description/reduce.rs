@@ -382,21 +382,31 @@ pub fn reduce(tree: &Tree, tip: Option<&str>, fix: &[&str]) -> Result<Arm, Descr
             r.held.insert(i, reason);
         }
     }
-    // Without a tip, a tool frame (where a force sensor measures) is the tip.
+    // Without a tip, a tool frame (where a force sensor measures) that a
+    // revolute joint not held moves is the tip.
+    let moved = |link: &str| {
+        tree.link_index(link).is_some_and(|l| {
+            tree.path_to(l).into_iter().any(|j| {
+                matches!(joints[j].kind, JointType::Revolute | JointType::Continuous)
+                    && !r.held.contains_key(&j)
+            })
+        })
+    };
     let tool = tree
         .frames()
         .iter()
-        .find(|f| f.tool)
+        .find(|f| f.tool && moved(&f.link))
         .map(|f| f.name.as_str());
     let tip = tip.or(tool);
     let (tip_link, tip_frame) = match tip {
         None => (None, None),
         Some(name) => {
-            if let Some(l) = tree.link_index(name) {
-                (Some(l), None)
-            } else if let Some(f) = tree.frame_index(name) {
+            // A frame first (a MuJoCo site and a body may share a name).
+            if let Some(f) = tree.frame_index(name) {
                 let link = tree.link_index(&tree.frames()[f].link);
                 (link, Some(f))
+            } else if let Some(l) = tree.link_index(name) {
+                (Some(l), None)
             } else {
                 return Err(arm_error(
                     tree,

@@ -114,8 +114,9 @@ def pinocchio_model(
         ``"two_link"``: the paper's arm (SPEC §1; ``arm`` keywords override its
         parameters, as for :class:`adaptimp.TwoLinkArm`), with frame ``"ee"``
         at the tip of link 2. ``"panda"``: the Franka Emika Panda of
-        example-robot-data's URDF with both finger joints fixed closed, 7
-        joints, frame ``"panda_hand_tcp"``. A path: a URDF or xacro file, its
+        example-robot-data's URDF (Pinocchio's parser) with both finger joints
+        locked closed (``buildReducedModel``), 7 joints, frame
+        ``"panda_hand_tcp"``. A path: a URDF or xacro file, its
         arm as the core's one reduction finds it (SPEC §21, with ``tip`` and
         ``fix``, as :func:`adaptimp.mujoco.from_urdf`): Pinocchio reads the
         reduced URDF the core writes. A ``pinocchio.Model`` is returned as it is.
@@ -128,7 +129,17 @@ def pinocchio_model(
         return _two_link(TwoLinkArm(**arm).params)
     if arm:
         raise TypeError(f"arm parameters {sorted(arm)} apply to 'two_link' only")
-    if (isinstance(source, str) and source == "panda") or _is_file(source):
+    if isinstance(source, str) and source == "panda":
+        if tip is not None or fix:
+            raise ValueError(
+                "'panda' has its tip and fixed fingers; give the Panda's URDF path to set them"
+            )
+        # Pinocchio's own model of the file (its parser, not adaptimp's), the
+        # fingers locked closed: the model the Panda table's numbers were made with.
+        full = pin.buildModelFromUrdf(str(_models.panda_urdf_path()))
+        lock = [full.getJointId(name) for name in _models.PANDA_FINGERS]
+        return pin.buildReducedModel(full, lock, pin.neutral(full))
+    if _is_file(source):
         described = _arm(source, tip, fix)
         if described.urdf is None:
             raise ValueError(

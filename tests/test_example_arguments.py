@@ -34,8 +34,9 @@ def test_a_broken_arm_is_a_usage_error(tmp_path: Path) -> None:
     broken = tmp_path / "broken.urdf"
     broken.write_text("<robot name='x'><link name='a'>")
     assert _usage_error("--arm", str(broken)) == (
-        f"13_panda_table.py: error: cannot read the URDF '{broken}': no element found: "
-        "line 1, column 31"
+        f"13_panda_table.py: error: cannot read {broken} as a URDF: it is not XML: it ends "
+        "before its root element is closed; correct it against the URDF format "
+        "(http://wiki.ros.org/urdf/XML)"
     )
 
 

@@ -43,6 +43,9 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     "examples/14_cartesian_pose.rs, which tests/test_ffi.py runs against C and Python",
     ("docs/index.md", 0): "installs the wheel or builds the checkout: scripts/test_wheel.sh",
     ("docs/mujoco.md", 0): "installs the extras: scripts/test.sh installs the test extra",
+    ("docs/mujoco.md", 2): "the callback protocol's three call shapes, not a program: the "
+    "next block runs one (MyPD); tests/test_python_real_work.py and test_mujoco_cartesian.py "
+    "run Python controllers of the other two",
     ("docs/paper.md", 0): "shell: run here (RUN_SHELL)",
     ("docs/panda.md", 0): "installs the extras and runs the Panda's table (9 min): "
     "tests/test_examples.py runs examples/13 with ADAPTIMP_QUICK=1",

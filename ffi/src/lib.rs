@@ -639,11 +639,13 @@ mod handles;
 mod cartesian;
 mod joint;
 mod params;
+mod urdf;
 
 pub use cartesian::*;
 pub use handles::ADAPTIMP_MAX_HANDLES;
 pub use joint::*;
 pub use params::*;
+pub use urdf::*;
 
 // ---------------------------------------------------------------------------
 // The library.

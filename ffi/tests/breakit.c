@@ -20,6 +20,7 @@
  * - false refusal: refused where it must succeed.
  *
  *   breakit            the table (markdown), and notes on any case not clean
+ *   BREAKIT_VERBOSE=1 breakit   also every case, its status and message, on stderr
  *
  * Each category runs in its own process (fork), so a crash or a hang of one
  * is counted and the others still run. Deterministic: no randomness.
@@ -63,6 +64,9 @@ static void note(const char *fmt, const char *what, const char *detail) {
 /* Classify one case: its status, whether the invariants held, what was expected. */
 static void outcome(const char *what, int expect, AdaptimpStatus s, int invariants) {
     T.cases++;
+    if (getenv("BREAKIT_VERBOSE")) /* every case: what, its status, the message */
+        fprintf(stderr, "%s: status %d%s%s\n", what, (int)s, s ? ": " : "",
+                s ? adaptimp_last_error() : "");
     if (s == ADAPTIMP_STATUS_INTERNAL) {
         T.crash++;
         note("%s: INTERNAL (%s)", what, adaptimp_last_error());
@@ -1086,6 +1090,234 @@ static void postures(void) {
     }
 }
 
+/* ---- Robot descriptions: adaptimp_chain_from_urdf. ---- */
+
+/* A 4-joint arm (3 revolute, one prismatic rail on a finger, which the rule
+   holds) with one field replaced by `value` when `field` >= 0. */
+static const char *URDF_FIELDS[] = {
+    "origin xyz", "origin rpy", "axis xyz", "mass", "inertia ixx", "limit lower",
+    "limit upper", "limit effort", "limit velocity", "dynamics damping",
+    "dynamics friction", "mimic multiplier"};
+enum { NURDF_FIELDS = sizeof URDF_FIELDS / sizeof URDF_FIELDS[0] };
+static const char *URDF_VALUES[] = {"nan",  "inf",  "-inf", "1e400",  "1e200", "-1", "0",
+                                    "1e-320", "abc", "",     "1 2",    "0 0 0", "1e9 0 0",
+                                    "0 0 1e200", "-0", "1e308 1e308 1e308"};
+enum { NURDF_VALUES = sizeof URDF_VALUES / sizeof URDF_VALUES[0] };
+
+static char *urdf_text(int field, const char *value) {
+    const char *v[NURDF_FIELDS];
+    static const char *normal[NURDF_FIELDS] = {"0 0 0.1", "0 0 0", "0 1 0", "0.5", "0.01",
+                                               "-2",      "2",     "10",    "3",   "0.1",
+                                               "0.05",    "1"};
+    for (int i = 0; i < NURDF_FIELDS; i++) v[i] = i == field ? value : normal[i];
+    size_t cap = 16384;
+    char *t = malloc(cap);
+    if (!t) abort();
+    int len = snprintf(t, cap, "<robot name='probe'><link name='base'/>");
+    const char *links[5] = {"base", "l1", "l2", "l3", "jaw"};
+    for (int j = 0; j < 4; j++) {
+        len += snprintf(
+            t + len, cap - (size_t)len,
+            "<link name='%s'><inertial><origin xyz='0 0 0.05'/><mass value='%s'/>"
+            "<inertia ixx='%s' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.01'/></inertial></link>"
+            "<joint name='j%d' type='%s'><parent link='%s'/><child link='%s'/>"
+            "<origin xyz='%s' rpy='%s'/><axis xyz='%s'/>"
+            "<limit lower='%s' upper='%s' effort='%s' velocity='%s'/>"
+            "<dynamics damping='%s' friction='%s'/>%s%s%s</joint>",
+            links[j + 1], v[3], v[4], j + 1, j == 3 ? "prismatic" : "revolute", links[j],
+            links[j + 1], v[0], v[1], v[2], v[5], v[6], v[7], v[8], v[9], v[10],
+            j == 3 ? "<mimic joint='j3' multiplier='" : "", j == 3 ? v[11] : "",
+            j == 3 ? "'/>" : "");
+    }
+    snprintf(t + len, cap - (size_t)len, "</robot>");
+    return t;
+}
+
+/* One call: its status, and the invariants: *out written exactly when OK
+   (preset to a sentinel), the chain's tip finite with every movable joint's
+   Jacobian column non-zero, the info's n the chain's, its drive terms finite
+   and not negative. */
+static int from_urdf(const char *source, const char *tip, const char *const *fix, size_t nfix,
+                     AdaptimpStatus *status) {
+    AdaptimpChain *sentinel = (AdaptimpChain *)(uintptr_t)0x10;
+    AdaptimpChain *ch = sentinel;
+    AdaptimpArmInfo info;
+    memset(&info, 0xff, sizeof info);
+    const AdaptimpStatus s = adaptimp_chain_from_urdf(source, tip, fix, nfix, &ch, &info);
+    *status = s;
+    if (s != ADAPTIMP_STATUS_OK) return ch == sentinel;
+    if (ch == sentinel || ch == NULL) return 0;
+    const size_t n = adaptimp_chain_joints(ch);
+    int ok = n >= 1 && n <= ADAPTIMP_MAX_JOINTS && info.n == n;
+    double q[ADAPTIMP_MAX_JOINTS], dq[ADAPTIMP_MAX_JOINTS];
+    for (size_t i = 0; i < n; i++) {
+        q[i] = 0.1 * (double)(i + 1);
+        dq[i] = -0.2;
+    }
+    AdaptimpTip t;
+    ok = ok && adaptimp_chain_tip(ch, n, q, dq, &t) == ADAPTIMP_STATUS_OK &&
+         finite_all(t.position, 3) && finite_all(&t.rotation[0][0], 9) && finite_all(t.bias, 6);
+    for (size_t i = 0; ok && i < n; i++) {
+        double norm = 0.0;
+        for (int r = 0; r < 6; r++) norm += t.jacobian[r][i] * t.jacobian[r][i];
+        ok = norm > 0.0 && isfinite(norm) && !isnan(info.lower[i]) && !isnan(info.upper[i]) &&
+             !(info.lower[i] > info.upper[i]) &&
+             isfinite(info.damping[i]) && info.damping[i] >= 0.0 &&
+             isfinite(info.friction[i]) && info.friction[i] >= 0.0 &&
+             !(info.effort[i] <= 0.0) && !(info.velocity[i] <= 0.0);
+    }
+    /* Freed, its handle is dead: refused, never read. */
+    adaptimp_chain_free(ch);
+    ok = ok && adaptimp_chain_joints(ch) == 0 &&
+         adaptimp_chain_tip(ch, n, q, dq, &t) == ADAPTIMP_STATUS_BAD_HANDLE;
+    adaptimp_chain_free(ch); /* twice: ignored */
+    return ok;
+}
+
+static void descriptions(void) {
+    char what[200];
+    AdaptimpStatus s;
+    /* Sources no arm is read from. */
+    char *deep = malloc(7 * 100000 + 64);
+    if (!deep) abort();
+    size_t len = (size_t)sprintf(deep, "<robot name='r'>");
+    for (int i = 0; i < 100000; i++) len += (size_t)sprintf(deep + len, "<a>");
+    for (int i = 0; i < 100000; i++) len += (size_t)sprintf(deep + len, "</a>");
+    sprintf(deep + len, "</robot>");
+    char xacro_text[] =
+        "<robot name='x' xmlns:xacro='http://www.ros.org/wiki/xacro'>"
+        "<xacro:property name='l' value='1'/><link name='a'/></robot>";
+    char nine[8192];
+    int n9 = snprintf(nine, sizeof nine, "<robot name='nine'><link name='l0'/>");
+    for (int i = 1; i <= 9; i++)
+        n9 += snprintf(nine + n9, sizeof nine - (size_t)n9,
+                       "<link name='l%d'/><joint name='j%d' type='continuous'><parent link='l%d'/>"
+                       "<child link='l%d'/><origin xyz='0 0 0.1'/><axis xyz='0 1 0'/></joint>",
+                       i, i, i - 1, i);
+    snprintf(nine + n9, sizeof nine - (size_t)n9, "</robot>");
+    struct {
+        const char *name, *source;
+    } bad[] = {
+        {"NULL", NULL},
+        {"an empty string", ""},
+        {"bytes that are not UTF-8", "\xff\xfe<robot/>"},
+        {"a directory", "/"},
+        {"a device that never ends", "/dev/zero"},
+        {"a file that is not there", "/nonexistent/arm.urdf"},
+        {"'<'", "<"},
+        {"an unclosed root", "<robot name='x'><link name='a'>"},
+        {"improper nesting", "<robot><a></robot></a>"},
+        {"an empty robot", "<robot name='x'/>"},
+        {"a link and no joint", "<robot name='x'><link name='a'/></robot>"},
+        {"MJCF text", "<mujoco><worldbody/></mujoco>"},
+        {"xacro text", xacro_text},
+        {"100 000 nested elements", deep},
+        {"a loop", "<robot name='x'><link name='a'/><link name='b'/>"
+                   "<joint name='j' type='revolute'><parent link='a'/><child link='b'/>"
+                   "<limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+                   "<joint name='k' type='revolute'><parent link='b'/><child link='a'/>"
+                   "<limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>"},
+        {"a joint to a missing link", "<robot name='x'><link name='a'/>"
+                   "<joint name='j' type='continuous'><parent link='a'/><child link='b'/></joint>"
+                   "</robot>"},
+        {"nine joints", nine},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        const int ok = from_urdf(bad[i].source, NULL, NULL, 0, &s);
+        snprintf(what, sizeof what, "source: %s", bad[i].name);
+        outcome(what, REFUSE, s, ok);
+        if (i == 0 && s != ADAPTIMP_STATUS_NULL_POINTER) note("%s: not NULL_POINTER%s", what, "");
+        if (bad[i].source == nine && s != ADAPTIMP_STATUS_BAD_SIZE)
+            note("%s: not BAD_SIZE%s", what, "");
+    }
+    free(deep);
+    /* Every field of every joint's element replaced by a bad value. */
+    for (int f = 0; f < NURDF_FIELDS; f++) {
+        for (int v = 0; v < NURDF_VALUES; v++) {
+            char *text = urdf_text(f, URDF_VALUES[v]);
+            const int ok = from_urdf(text, NULL, NULL, 0, &s);
+            snprintf(what, sizeof what, "%s = '%s'", URDF_FIELDS[f], URDF_VALUES[v]);
+            outcome(what, EITHER, s, ok);
+            free(text);
+        }
+    }
+    /* A good arm: tips and fixes, good and bad strings. */
+    char *good = urdf_text(-1, "");
+    const int ok = from_urdf(good, NULL, NULL, 0, &s);
+    outcome("the probe's arm", ACCEPT, s, ok);
+    struct {
+        const char *name, *tip;
+        int expect;
+    } tips[] = {
+        {"tip NULL", NULL, ACCEPT},     {"tip l2", "l2", ACCEPT},
+        {"tip base", "base", REFUSE},   {"tip ''", "", REFUSE},
+        {"tip not UTF-8", "\xc3\x28", REFUSE}, {"tip missing", "no_such_link", REFUSE},
+        {"tip the jaw (beyond the rail)", "jaw", EITHER},
+        {"tip a joint's name", "j1", REFUSE},
+    };
+    for (size_t i = 0; i < sizeof tips / sizeof tips[0]; i++) {
+        const int good_ok = from_urdf(good, tips[i].tip, NULL, 0, &s);
+        outcome(tips[i].name, tips[i].expect, s, good_ok);
+    }
+    const char *fix_j2[] = {"j2"}, *fix_null[] = {"j1", NULL}, *fix_bad[] = {"\xff"},
+               *fix_none[] = {"nope"}, *fix_twice[] = {"j2", "j2"},
+               *fix_all[] = {"j1", "j2", "j3", "j4"};
+    struct {
+        const char *name;
+        const char *const *fix;
+        size_t n;
+        int expect;
+    } fixes[] = {
+        {"fix j2", fix_j2, 1, ACCEPT},
+        {"fix NULL with nfix 2", NULL, 2, REFUSE},
+        {"fix holding NULL", fix_null, 2, REFUSE},
+        {"fix not UTF-8", fix_bad, 1, REFUSE},
+        {"fix an unknown joint", fix_none, 1, REFUSE},
+        {"fix a joint twice", fix_twice, 2, EITHER},
+        {"fix every joint", fix_all, 4, REFUSE},
+        {"fix NULL with nfix 0", NULL, 0, ACCEPT},
+    };
+    for (size_t i = 0; i < sizeof fixes / sizeof fixes[0]; i++) {
+        const int fix_ok = from_urdf(good, NULL, fixes[i].fix, fixes[i].n, &s);
+        outcome(fixes[i].name, fixes[i].expect, s, fix_ok);
+    }
+    /* out NULL: refused, nothing leaked; info NULL: accepted. */
+    s = adaptimp_chain_from_urdf(good, NULL, NULL, 0, NULL, NULL);
+    outcome("out NULL", REFUSE, s, 1);
+    AdaptimpChain *ch = NULL;
+    s = adaptimp_chain_from_urdf(good, NULL, NULL, 0, &ch, NULL);
+    outcome("info NULL", ACCEPT, s, ch != NULL);
+    /* The chain it made is a chain and nothing else: as any other kind it is
+       refused; a Cartesian controller can be built on it. */
+    const size_t n = adaptimp_chain_joints(ch);
+    const int mistyped =
+        n == 2 && /* j3 drives the mimic j4: both held, the gripper's */
+        !adaptimp_state_fault((AdaptimpState *)ch, NULL) &&
+        !adaptimp_cartesian_state_fault((AdaptimpCartesianState *)ch, NULL) &&
+        adaptimp_state_steps((AdaptimpState *)ch) == 0 &&
+        adaptimp_cartesian_state_steps((AdaptimpCartesianState *)ch) == 0 &&
+        adaptimp_controller_joints((AdaptimpController *)ch) == 0 &&
+        adaptimp_cartesian_joints((AdaptimpCartesian *)ch) == 0;
+    outcome("its chain as every other kind", EITHER, ADAPTIMP_STATUS_OK, mistyped);
+    AdaptimpCartesianParams cp;
+    AdaptimpParams p;
+    if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK ||
+        adaptimp_params_default(&p, 2, ADAPTIMP_LAW_STATE_FEEDBACK, ADAPTIMP_PRESET_ROBOT) !=
+            ADAPTIMP_STATUS_OK)
+        abort();
+    p.impedance = ADAPTIMP_IMPEDANCE_EXTERNAL;
+    static double centre[4 * 2 * 4];
+    for (int i = 0; i < 4 * 2 * 4; i++) centre[i] = 0.05 * (i % 5) - 0.1;
+    p.centers = centre;
+    p.nodes = 4;
+    AdaptimpCartesian *cart = NULL;
+    s = adaptimp_cartesian_new(ch, &cp, &p, &cart);
+    outcome("a Cartesian controller on it", ACCEPT, s, cart != NULL);
+    adaptimp_cartesian_free(cart);
+    adaptimp_chain_free(ch);
+    free(good);
+}
+
 /* ---- Forged handles at every entry point. ---- */
 
 /* The live handles of one world; every entry point is called with one of its
@@ -1446,6 +1678,7 @@ static const Category CATEGORIES[] = {
     {"parameters", construction}, {"steps and fallbacks", steps}, {"snapshots", snapshots},
     {"handles and buffers", handles}, {"chains", chains},        {"Cartesian", cartesian},
     {"forged handles", forged},       {"postures, axes, orbits", postures},
+    {"robot descriptions", descriptions},
 };
 
 int main(void) {

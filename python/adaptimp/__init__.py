@@ -43,6 +43,7 @@ from ._errors import (
     PlantWarning,
     SaveError,
     StabilityWarning,
+    XacroError,
 )
 from ._faults import Fault
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
@@ -79,6 +80,7 @@ __all__ = [
     "StabilityWarning",
     "TwoLinkArm",
     "Uniform",
+    "XacroError",
     "__version__",
     "defaults",
     "metrics_table",

@@ -32,7 +32,7 @@
 use crate::cartesian::kinematics::{Jacobian6, Kinematics, Tip};
 use crate::cartesian::rotation::ROTATION_TOLERANCE;
 use crate::error::{check, Error};
-use crate::math::{cos, sin, sqrt};
+use crate::math::{sin_cos, sqrt};
 use crate::types::Vector;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -212,19 +212,47 @@ impl Frame {
     }
 }
 
-/// One movable joint, its fixed predecessors folded into its origin.
+/// One movable joint in the core's form, its fixed predecessors folded in:
+/// the frame of link i (the joint's child) is
+///
+/// ```text
+/// F_i = F_{i−1} ∘ Trans(p) ∘ Rot(o) ∘ Rot_z(q_i + offset)     (revolute)
+/// F_i = F_{i−1} ∘ Trans(p) ∘ Rot(o) ∘ Trans(z (q_i + offset))  (prismatic)
+/// ```
+///
+/// so that every joint turns or slides along its own frame's z: the
+/// description's frame of joint i is F_i A_iᵀ with A_i a constant rotation
+/// taking z onto the joint's axis ([`align`]); its offset is −`offset`.
 #[derive(Copy, Clone, Debug, PartialEq)]
-struct Link {
-    origin: Frame,
-    axis: Vector3<f64>,
-    prismatic: bool,
+pub(crate) struct Link {
+    /// The joint's origin in the previous link's frame (m).
+    pub(crate) p: Vector3<f64>,
+    /// The joint frame's axes in the previous link's frame (at q_i = −offset).
+    pub(crate) o: Matrix3<f64>,
+    /// Added to q_i (rad, m): minus the description's offset.
+    pub(crate) offset: f64,
+    /// Slides (true) or turns (false) along z.
+    pub(crate) prismatic: bool,
 }
 
-/// The rotation by `theta` (rad) about the unit `axis` (Rodrigues).
-fn axis_rotation(axis: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
-    let (s, c) = (sin(theta), cos(theta));
-    let k = axis.cross_matrix();
-    Matrix3::identity() + k * s + k * k * (1.0 - c)
+/// A constant rotation A with A z = `axis` (unit): its columns are an
+/// orthonormal frame (u, axis × u, axis) with det +1. Exact (entries 0 and
+/// ±1) for an axis along ±x, ±y or ±z.
+fn align(axis: &Vector3<f64>) -> Matrix3<f64> {
+    let across = Vector3::y().cross(axis);
+    let u = if across.norm_squared() > 0.25 {
+        across.normalize()
+    } else {
+        Vector3::x().cross(axis).normalize()
+    };
+    Matrix3::from_columns(&[u, axis.cross(&u), *axis])
+}
+
+/// `r Rot_z(θ)` for s = sin θ, c = cos θ: the first two columns turned.
+#[inline(always)]
+pub(crate) fn turn(r: &Matrix3<f64>, s: f64, c: f64) -> Matrix3<f64> {
+    let (x, y) = (r.column(0), r.column(1));
+    Matrix3::from_columns(&[x * c + y * s, y * c - x * s, r.column(2).into_owned()])
 }
 
 /// A serial chain of `N` movable joints (1 ≤ N ≤ 7): see the [module docs](self).
@@ -244,6 +272,15 @@ impl<const N: usize> Chain<N> {
     /// or is a reflection, a zero or non-finite axis (a movable joint's axis
     /// is normalised), a non-finite or larger than 1e6 offset.
     pub fn new(joints: &[Joint], tip: &Transform) -> Result<Self, Error> {
+        Self::aligned(joints, tip).map(|(chain, _)| chain)
+    }
+
+    /// [`new`](Self::new), and the rotations A_i of [`Link`]: the
+    /// description's frame of movable joint i is link i's frame times A_iᵀ.
+    pub(crate) fn aligned(
+        joints: &[Joint],
+        tip: &Transform,
+    ) -> Result<(Self, [Matrix3<f64>; N]), Error> {
         if N == 0 || N > MAX_CHAIN_JOINTS {
             return Err(Error::Condition {
                 condition: "1 ≤ n ≤ 7 movable joints",
@@ -262,10 +299,14 @@ impl<const N: usize> Chain<N> {
             });
         }
         let mut links = [Link {
-            origin: Frame::IDENTITY,
-            axis: Vector3::z(),
+            p: Vector3::zeros(),
+            o: Matrix3::identity(),
+            offset: 0.0,
             prismatic: false,
         }; N];
+        let mut aligns = [Matrix3::identity(); N];
+        // The previous link's A (the base's frame is the description's).
+        let mut prev = Matrix3::identity();
         let mut pending = Frame::IDENTITY;
         let mut i = 0;
         for (index, j) in joints.iter().enumerate() {
@@ -295,29 +336,32 @@ impl<const N: usize> Chain<N> {
                     value: j.offset,
                 });
             }
-            let prismatic = j.kind == JointKind::Prismatic;
-            // The frame at q = 0: the motion by −offset folded into the origin.
-            let at_zero = if prismatic {
-                Frame {
-                    p: axis * -j.offset,
-                    r: Matrix3::identity(),
-                }
-            } else {
-                Frame {
-                    p: Vector3::zeros(),
-                    r: axis_rotation(&axis, -j.offset),
-                }
-            };
+            // Rot(axis, θ) = A Rot_z(θ) Aᵀ and Trans(axis d) = A Trans(z d) Aᵀ:
+            // the Aᵀ folds into what follows (the next origin, the tip, the
+            // link's inertials), the A into this origin.
+            let a = align(&axis);
             links[i] = Link {
-                origin: origin.then(&at_zero),
-                axis,
-                prismatic,
+                p: prev.tr_mul(&origin.p),
+                o: prev.tr_mul(&origin.r) * a,
+                offset: -j.offset,
+                prismatic: j.kind == JointKind::Prismatic,
             };
+            aligns[i] = a;
+            prev = a;
             pending = Frame::IDENTITY;
             i += 1;
         }
-        let tip = pending.then(&tip.check(joints.len())?);
-        Ok(Self { links, tip })
+        let t = pending.then(&tip.check(joints.len())?);
+        let tip = Frame {
+            p: prev.tr_mul(&t.p),
+            r: prev.tr_mul(&t.r),
+        };
+        Ok((Self { links, tip }, aligns))
+    }
+
+    /// The joints in the core's form, base to tip.
+    pub(crate) fn links(&self) -> &[Link; N] {
+        &self.links
     }
 
     /// Whether joint `i` (of the N movable ones) is prismatic.
@@ -326,11 +370,11 @@ impl<const N: usize> Chain<N> {
     }
 }
 
-/// The motion of one movable joint's frame in the world, from
-/// [`Chain::walk`]: its rotation `r` and origin `c` (on the axis of a
-/// revolute joint), the angular velocity `w` and acceleration `al` of its
-/// link, the classical acceleration `a` of `c`, the joint's world axis `z`
-/// and origin `o` (before a prismatic joint's travel).
+/// The motion of one link in the world, from [`Chain::walk`]: its frame's
+/// rotation `r` and origin `c` (on the axis of a revolute joint), its
+/// angular velocity `w` and acceleration `al`, the classical acceleration
+/// `a` of `c`, the joint's world axis `z` and origin `o` (before a prismatic
+/// joint's travel).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub(crate) struct LinkMotion {
     pub r: Matrix3<f64>,
@@ -343,11 +387,11 @@ pub(crate) struct LinkMotion {
 }
 
 impl<const N: usize> Chain<N> {
-    /// The forward recursion of (16.0), base to tip, with the joint
-    /// accelerations `ddq` (none: q̈ = 0) and the base's acceleration `a0`
-    /// (m/s²; −g for the dynamics, SPEC (20.2)): calls `visit(i, motion)`
-    /// for every movable joint i, and returns the last one's motion.
-    #[inline]
+    /// The forward recursion of (16.0), base to tip, world frame, with the
+    /// joint accelerations `ddq` (none: q̈ = 0) and the base's acceleration
+    /// `a0` (m/s²): calls `visit(i, motion)` for every link i, and returns
+    /// the last one's motion.
+    #[inline(always)]
     pub(crate) fn walk<F: FnMut(usize, &LinkMotion)>(
         &self,
         q: &Vector<N>,
@@ -356,9 +400,9 @@ impl<const N: usize> Chain<N> {
         a0: Vector3<f64>,
         mut visit: F,
     ) -> LinkMotion {
-        // The frame of the link before joint i: rotation r, origin c, the
-        // angular velocity w and acceleration al, and the acceleration a of
-        // c (no velocity of a point enters an acceleration).
+        // The link before joint i: its frame (r, c), the angular velocity w
+        // and acceleration al, the acceleration a of c (no velocity of a
+        // point enters an acceleration).
         let mut m = LinkMotion {
             r: Matrix3::identity(),
             c: Vector3::zeros(),
@@ -369,14 +413,18 @@ impl<const N: usize> Chain<N> {
             o: Vector3::zeros(),
         };
         for (i, link) in self.links.iter().enumerate() {
-            let d = m.r * link.origin.p;
+            let (r0, oi) = if i == 0 {
+                (link.o, link.p)
+            } else {
+                (m.r * link.o, m.c + m.r * link.p)
+            };
+            let d = oi - m.c;
             let wxd = m.w.cross(&d);
-            let (oi, ao) = (m.c + d, m.a + m.al.cross(&d) + m.w.cross(&wxd));
-            let r0 = m.r * link.origin.r;
-            let zi = r0 * link.axis;
+            let ao = m.a + m.al.cross(&d) + m.w.cross(&wxd);
+            let zi = r0.column(2).into_owned();
             let zdq = zi * dq[i];
             if link.prismatic {
-                let s = zi * q[i];
+                let s = zi * (q[i] + link.offset);
                 let wxs = m.w.cross(&s);
                 m.r = r0;
                 m.c = oi + s;
@@ -385,7 +433,8 @@ impl<const N: usize> Chain<N> {
                     m.a += zi * dd[i];
                 }
             } else {
-                m.r = r0 * axis_rotation(&link.axis, q[i]);
+                let (sn, cs) = sin_cos(q[i] + link.offset);
+                m.r = turn(&r0, sn, cs);
                 m.al += m.w.cross(&zdq);
                 if let Some(dd) = ddq {
                     m.al += zi * dd[i];
@@ -400,10 +449,78 @@ impl<const N: usize> Chain<N> {
         }
         m
     }
+
+    /// The tip's pose and Jacobian at q (J̇ q̇ zero): (16.0)'s positions
+    /// alone, without the recursion of velocities and accelerations.
+    #[inline]
+    pub fn pose_jacobian(&self, q: &Vector<N>) -> Tip<N> {
+        let mut z = [Vector3::zeros(); N];
+        let mut o = [Vector3::zeros(); N];
+        let (mut r, mut c) = (Matrix3::identity(), Vector3::zeros());
+        for (i, link) in self.links.iter().enumerate() {
+            let (r0, oi) = if i == 0 {
+                (link.o, link.p)
+            } else {
+                (r * link.o, c + r * link.p)
+            };
+            z[i] = r0.column(2).into_owned();
+            o[i] = oi;
+            if link.prismatic {
+                r = r0;
+                c = oi + z[i] * (q[i] + link.offset);
+            } else {
+                let (sn, cs) = sin_cos(q[i] + link.offset);
+                r = turn(&r0, sn, cs);
+                c = oi;
+            }
+        }
+        let p = c + r * self.tip.p;
+        Tip {
+            position: p,
+            rotation: Rotation3::from_matrix_unchecked(r * self.tip.r),
+            jacobian: self.jacobian_of(&p, &z, &o),
+            bias: Vector::<6>::zeros(),
+        }
+    }
+
+    /// J's columns [z_i × (p − o_i); z_i] (revolute), [z_i; 0] (prismatic).
+    #[inline(always)]
+    fn jacobian_of(
+        &self,
+        p: &Vector3<f64>,
+        z: &[Vector3<f64>; N],
+        o: &[Vector3<f64>; N],
+    ) -> Jacobian6<N> {
+        let mut jac = Jacobian6::<N>::zeros();
+        for (i, link) in self.links.iter().enumerate() {
+            if link.prismatic {
+                jac.fixed_view_mut::<3, 1>(0, i).copy_from(&z[i]);
+            } else {
+                jac.fixed_view_mut::<3, 1>(0, i)
+                    .copy_from(&z[i].cross(&(p - o[i])));
+                jac.fixed_view_mut::<3, 1>(3, i).copy_from(&z[i]);
+            }
+        }
+        jac
+    }
+
+    /// J̇ q̇ = [a(p); α_N] at (q, q̇) (m/s², rad/s²), (16.0), without the
+    /// Jacobian.
+    #[inline]
+    pub fn bias(&self, q: &Vector<N>, dq: &Vector<N>) -> Vector<6> {
+        let m = self.walk(q, dq, None, Vector3::zeros(), |_, _| {});
+        let d = m.r * self.tip.p;
+        let ap = m.a + m.al.cross(&d) + m.w.cross(&m.w.cross(&d));
+        Vector::<6>::new(ap[0], ap[1], ap[2], m.al[0], m.al[1], m.al[2])
+    }
 }
 
 impl<const N: usize> Kinematics<N> for Chain<N> {
     fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> Tip<N> {
+        if dq.iter().all(|v| *v == 0.0) {
+            // At rest J̇ q̇ = 0: the positions' pass alone.
+            return self.pose_jacobian(q);
+        }
         let mut z = [Vector3::zeros(); N];
         let mut o = [Vector3::zeros(); N];
         let last = self.walk(q, dq, None, Vector3::zeros(), |i, m| {
@@ -413,29 +530,26 @@ impl<const N: usize> Kinematics<N> for Chain<N> {
         let LinkMotion { r, c, w, al, a, .. } = last;
         let d = r * self.tip.p;
         let p = c + d;
-        let wxd = w.cross(&d);
-        let ap = a + al.cross(&d) + w.cross(&wxd);
-        let mut jac = Jacobian6::<N>::zeros();
-        for (i, link) in self.links.iter().enumerate() {
-            let lin = if link.prismatic {
-                z[i]
-            } else {
-                z[i].cross(&(p - o[i]))
-            };
-            jac.fixed_view_mut::<3, 1>(0, i).copy_from(&lin);
-            if !link.prismatic {
-                jac.fixed_view_mut::<3, 1>(3, i).copy_from(&z[i]);
-            }
-        }
-        let mut bias = Vector::<6>::zeros();
-        bias.fixed_rows_mut::<3>(0).copy_from(&ap);
-        bias.fixed_rows_mut::<3>(3).copy_from(&al);
+        let ap = a + al.cross(&d) + w.cross(&w.cross(&d));
         Tip {
             position: p,
             rotation: Rotation3::from_matrix_unchecked(r * self.tip.r),
-            jacobian: jac,
-            bias,
+            jacobian: self.jacobian_of(&p, &z, &o),
+            bias: Vector::<6>::new(ap[0], ap[1], ap[2], al[0], al[1], al[2]),
         }
+    }
+
+    fn fk(&self, q: &Vector<N>) -> Vector<3> {
+        self.pose_jacobian(q).position
+    }
+    fn rotation(&self, q: &Vector<N>) -> Rotation3<f64> {
+        self.pose_jacobian(q).rotation
+    }
+    fn jacobian(&self, q: &Vector<N>) -> Jacobian6<N> {
+        self.pose_jacobian(q).jacobian
+    }
+    fn jdot_qdot(&self, q: &Vector<N>, dq: &Vector<N>) -> Vector<6> {
+        self.bias(q, dq)
     }
 }
 

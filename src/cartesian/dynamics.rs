@@ -7,9 +7,9 @@
 //!
 //! Units: kg, m, kg m², rad (m for a prismatic joint), N m (N).
 
-use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
+use crate::cartesian::chain::{turn, Chain, Frame, Joint, JointKind, Transform};
 use crate::error::{check, Error};
-use crate::math::tanh;
+use crate::math::{sin_cos, tanh};
 use crate::types::{Matrix, Vector};
 use nalgebra::{Matrix3, Vector3};
 
@@ -203,7 +203,7 @@ impl<const N: usize> Dynamics<N> {
     /// mass, an inertia that is not finite or symmetric or has a negative
     /// diagonal, a non-finite gravity.
     pub fn new(joints: &[Joint], inertials: &[Inertial], gravity: [f64; 3]) -> Result<Self, Error> {
-        let chain = Chain::<N>::new(joints, &Transform::IDENTITY)?;
+        let (chain, aligns) = Chain::<N>::aligned(joints, &Transform::IDENTITY)?;
         if inertials.len() != joints.len() {
             return Err(Error::Condition {
                 condition: "one inertial per joint of the list (fixed ones too)",
@@ -230,6 +230,12 @@ impl<const N: usize> Dynamics<N> {
                 let f = pending.then(&origin);
                 bodies[b].add(inertial.mass, f.p, f.r * ic * f.r.transpose());
             }
+        }
+        // Into the links' frames of the core's form (the description's
+        // frame of joint i is link i's times A_iᵀ).
+        for (b, a) in bodies.iter_mut().zip(&aligns) {
+            b.h = a.tr_mul(&b.h);
+            b.i = a.tr_mul(&b.i) * a;
         }
         Ok(Self {
             chain,
@@ -314,50 +320,147 @@ impl<const N: usize> Dynamics<N> {
         self.rnea(q, &Vector::zeros(), v, Vector3::zeros()) + self.drive.armature.component_mul(v)
     }
 
-    /// M_a(q) = M(q) + diag(I_a) (kg m², kg), (20.5); column j = M_a e_j,
-    /// symmetrised.
+    /// M_a(q) = M(q) + diag(I_a) (kg m², kg), (20.5): the composite-rigid-body
+    /// algorithm, SPEC (20.2).
     pub fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
-        let mut m = Matrix::<N>::zeros();
-        for j in 0..N {
-            let mut e = Vector::<N>::zeros();
-            e[j] = 1.0;
-            m.set_column(j, &self.mass_times(q, &e));
+        let links = self.chain.links();
+        // Each link's place in the previous link's frame (the first one's
+        // does not enter M).
+        let (e, r) = self.placements(q, 1);
+        // Composite bodies, tip to base, each in its own link's frame.
+        let mut c = self.bodies;
+        for i in (1..N).rev() {
+            let (m, h, x) = {
+                let b = &c[i];
+                (b.m, e[i] * b.h, sandwich(&e[i], &b.i))
+            };
+            let ri = r[i];
+            let u = ri * m + h;
+            let d = ri.dot(&(u + h));
+            let p = &mut c[i - 1];
+            p.m += m;
+            p.h += u;
+            // + E I Eᵀ + m(|r|² 1 − r rᵀ) + 2 (r·h) 1 − r hᵀ − h rᵀ
+            for a in 0..3 {
+                for b in a..3 {
+                    let v = x[(a, b)] - ri[a] * u[b] - h[a] * ri[b] + if a == b { d } else { 0.0 };
+                    p.i[(a, b)] += v;
+                    if a != b {
+                        p.i[(b, a)] += v;
+                    }
+                }
+            }
         }
-        (m + m.transpose()) * 0.5
+        // Column j: the force and moment composite j needs for q̈_j = 1,
+        // carried to each link k < j: M_kj = z · (moment or force) there.
+        let mut cols = [[0.0; N]; N];
+        for j in 0..N {
+            let b = &c[j];
+            let (mut f, mut n) = if links[j].prismatic {
+                (
+                    Vector3::new(0.0, 0.0, b.m),
+                    Vector3::new(b.h[1], -b.h[0], 0.0),
+                )
+            } else {
+                (
+                    Vector3::new(-b.h[1], b.h[0], 0.0),
+                    b.i.column(2).into_owned(),
+                )
+            };
+            cols[j][j] = if links[j].prismatic { f[2] } else { n[2] } + self.drive.armature[j];
+            for k in (0..j).rev() {
+                f = e[k + 1] * f;
+                n = e[k + 1] * n + r[k + 1].cross(&f);
+                let v = if links[k].prismatic { f[2] } else { n[2] };
+                cols[j][k] = v;
+                cols[k][j] = v;
+            }
+        }
+        Matrix::from_data(nalgebra::ArrayStorage(cols))
     }
 
-    /// The recursion of (20.2) with the base accelerating at `a0`.
+    /// Link i's place in link i − 1's frame at q, for i ≥ `from`: the
+    /// rotation E_i = o Rot_z(θ_i) (o for a prismatic joint) and the origin
+    /// r_i (p, or p + o z (q_i + offset) for a prismatic joint).
+    #[inline(always)]
+    fn placements(&self, q: &Vector<N>, from: usize) -> ([Matrix3<f64>; N], [Vector3<f64>; N]) {
+        let links = self.chain.links();
+        let mut e = [Matrix3::identity(); N];
+        let mut r = [Vector3::zeros(); N];
+        for i in from..N {
+            let l = &links[i];
+            if l.prismatic {
+                e[i] = l.o;
+                r[i] = l.p + l.o.column(2) * (q[i] + l.offset);
+            } else {
+                let (sn, cs) = sin_cos(q[i] + l.offset);
+                e[i] = turn(&l.o, sn, cs);
+                r[i] = l.p;
+            }
+        }
+        (e, r)
+    }
+
+    /// The recursion of (20.2) in the links' frames with the base
+    /// accelerating at `a0` (world): τ of the rigid links (no drive).
+    #[inline]
     fn rnea(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>, a0: Vector3<f64>) -> Vector<N> {
-        // Forward: each body's force F_i and moment N_i about its origin O_i.
+        let links = self.chain.links();
+        let (e, r) = self.placements(q, 0);
         let mut f = [Vector3::zeros(); N];
         let mut n = [Vector3::zeros(); N];
-        let mut o = [Vector3::zeros(); N];
-        let mut z = [Vector3::zeros(); N];
-        self.chain.walk(q, dq, Some(ddq), a0, |i, m| {
+        // Forward: each link's angular velocity w, acceleration al and the
+        // classical acceleration a of its origin, in its own frame.
+        let (mut w, mut al, mut a) = (Vector3::zeros(), Vector3::zeros(), a0);
+        for (i, l) in links.iter().enumerate() {
+            // The previous link's motion at this link's origin, in its axes.
+            if i > 0 {
+                let ri = r[i];
+                a += al.cross(&ri) + w.cross(&w.cross(&ri));
+            }
+            let ei = &e[i];
+            a = ei.tr_mul(&a);
+            if l.prismatic {
+                w = ei.tr_mul(&w);
+                al = ei.tr_mul(&al);
+                // Prismatic: the link slides along z at q̇, q̈; the origin
+                // (r_i) already moved.
+                a += w.cross(&Vector3::new(0.0, 0.0, 2.0 * dq[i]));
+                a[2] += ddq[i];
+            } else {
+                w = ei.tr_mul(&w);
+                // al = Eᵀ al + w' × z q̇ + z q̈, w' = Eᵀ w.
+                al = ei.tr_mul(&al) + Vector3::new(w[1], -w[0], 0.0) * dq[i];
+                al[2] += ddq[i];
+                w[2] += dq[i];
+            }
             let b = &self.bodies[i];
-            let h = m.r * b.h;
-            let inertia = m.r * b.i * m.r.transpose();
-            f[i] = b.m * m.a + m.al.cross(&h) + m.w.cross(&m.w.cross(&h));
-            n[i] = inertia * m.al + m.w.cross(&(inertia * m.w)) + h.cross(&m.a);
-            o[i] = m.c;
-            z[i] = m.z;
-        });
+            let iw = b.i * w;
+            f[i] = a * b.m + al.cross(&b.h) + w.cross(&w.cross(&b.h));
+            n[i] = b.i * al + w.cross(&iw) + b.h.cross(&a);
+        }
         // Backward: what each joint transmits, tip to base.
         let mut tau = Vector::<N>::zeros();
         for i in (0..N).rev() {
-            if i + 1 < N {
-                let (fi, ni) = (f[i + 1], n[i + 1]);
-                f[i] += fi;
-                n[i] += ni + (o[i + 1] - o[i]).cross(&fi);
+            tau[i] = if links[i].prismatic { f[i][2] } else { n[i][2] };
+            if i > 0 {
+                let fp = e[i] * f[i];
+                let np = e[i] * n[i] + r[i].cross(&fp);
+                f[i - 1] += fp;
+                n[i - 1] += np;
             }
-            tau[i] = if self.chain.is_prismatic(i) {
-                z[i].dot(&f[i])
-            } else {
-                z[i].dot(&n[i])
-            };
         }
         tau
     }
+}
+
+/// O X Oᵀ for a symmetric X (symmetric).
+#[inline(always)]
+fn sandwich(o: &Matrix3<f64>, x: &Matrix3<f64>) -> Matrix3<f64> {
+    let y = o * x;
+    let e = |a: usize, b: usize| y.row(a).dot(&o.row(b));
+    let (xx, yy, zz, xy, xz, yz) = (e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2));
+    Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
 }
 
 #[cfg(test)]

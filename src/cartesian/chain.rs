@@ -221,18 +221,165 @@ impl Frame {
 /// ```
 ///
 /// so that every joint turns or slides along its own frame's z: the
-/// description's frame of joint i is F_i A_iᵀ with A_i a constant rotation
-/// taking z onto the joint's axis ([`align`]); its offset is −`offset`.
+/// description's frame of joint i is F_i B_iᵀ with B_i a constant rotation
+/// (it takes z onto the joint's axis, [`align`]). Between two revolute
+/// joints, o is moreover a twist about x, Rot_x(α) (the rest of o is turned
+/// into the two joints' angles, [`untwist`]), as in the modified
+/// Denavit–Hartenberg convention (Craig, *Introduction to Robotics*, 3rd ed.,
+/// Pearson 2005, §3.4), which makes a link's transform cheaper to apply.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub(crate) struct Link {
     /// The joint's origin in the previous link's frame (m).
     pub(crate) p: Vector3<f64>,
     /// The joint frame's axes in the previous link's frame (at q_i = −offset).
     pub(crate) o: Matrix3<f64>,
-    /// Added to q_i (rad, m): minus the description's offset.
+    /// (cos α, sin α) when o = Rot_x(α).
+    pub(crate) twist: Option<(f64, f64)>,
+    /// Added to q_i (rad, m).
     pub(crate) offset: f64,
     /// Slides (true) or turns (false) along z.
     pub(crate) prismatic: bool,
+}
+
+impl Link {
+    /// `r o`: the joint frame's axes in the world, given the previous
+    /// link's `r`.
+    #[inline(always)]
+    pub(crate) fn axes(&self, r: &Matrix3<f64>) -> Matrix3<f64> {
+        match self.twist {
+            Some((c, s)) => {
+                let (y, z) = (r.column(1), r.column(2));
+                Matrix3::from_columns(&[r.column(0).into_owned(), y * c + z * s, z * c - y * s])
+            }
+            None => r * self.o,
+        }
+    }
+}
+
+impl Link {
+    /// E = o Rot_z(θ) (o for a prismatic joint), s = sin θ, c = cos θ: link
+    /// i's axes in link i − 1's frame.
+    #[inline(always)]
+    pub(crate) fn rotation(&self, s: f64, c: f64) -> Matrix3<f64> {
+        match (self.prismatic, self.twist) {
+            (true, _) => self.o,
+            (false, Some((ca, sa))) => {
+                Matrix3::new(c, -s, 0.0, ca * s, ca * c, -sa, sa * s, sa * c, ca)
+            }
+            (false, None) => turn(&self.o, s, c),
+        }
+    }
+
+    /// E v: `v` of link i's frame in link i − 1's axes, E = o Rot_z(θ) (o
+    /// for a prismatic joint), s = sin θ, c = cos θ.
+    #[inline(always)]
+    pub(crate) fn parent_of(&self, s: f64, c: f64, v: &Vector3<f64>) -> Vector3<f64> {
+        let u = if self.prismatic {
+            *v
+        } else {
+            Vector3::new(c * v[0] - s * v[1], s * v[0] + c * v[1], v[2])
+        };
+        match self.twist {
+            Some((ca, sa)) => Vector3::new(u[0], ca * u[1] - sa * u[2], sa * u[1] + ca * u[2]),
+            None => self.o * u,
+        }
+    }
+
+    /// Eᵀ v: `v` of link i − 1's frame in link i's axes.
+    #[inline(always)]
+    pub(crate) fn child_of(&self, s: f64, c: f64, v: &Vector3<f64>) -> Vector3<f64> {
+        let u = match self.twist {
+            Some((ca, sa)) => Vector3::new(v[0], ca * v[1] + sa * v[2], ca * v[2] - sa * v[1]),
+            None => self.o.tr_mul(v),
+        };
+        if self.prismatic {
+            u
+        } else {
+            Vector3::new(c * u[0] + s * u[1], c * u[1] - s * u[0], u[2])
+        }
+    }
+
+    /// E X Eᵀ for a symmetric X (the inertia of link i's frame in link
+    /// i − 1's axes).
+    #[inline(always)]
+    pub(crate) fn sandwich(&self, s: f64, c: f64, x: &Matrix3<f64>) -> Matrix3<f64> {
+        let x = if self.prismatic {
+            *x
+        } else {
+            sandwich_z(x, s, c)
+        };
+        match self.twist {
+            Some((ca, sa)) => sandwich_x(&x, ca, sa),
+            None => {
+                let y = self.o * x;
+                let e = |a: usize, b: usize| y.row(a).dot(&self.o.row(b));
+                let (xx, yy, zz, xy, xz, yz) =
+                    (e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2));
+                Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+            }
+        }
+    }
+}
+
+/// Rot_z(θ) X Rot_z(θ)ᵀ for a symmetric X, s = sin θ, c = cos θ.
+#[inline(always)]
+fn sandwich_z(i: &Matrix3<f64>, s: f64, c: f64) -> Matrix3<f64> {
+    let (xx, yy, xy) = (i[(0, 0)], i[(1, 1)], i[(0, 1)]);
+    let (xz, yz) = (i[(0, 2)], i[(1, 2)]);
+    let (cc, ss, cs) = (c * c, s * s, c * s);
+    let m = 2.0 * cs * xy;
+    let nxx = cc * xx + ss * yy - m;
+    let nyy = ss * xx + cc * yy + m;
+    let nxy = cs * (xx - yy) + (cc - ss) * xy;
+    let nxz = c * xz - s * yz;
+    let nyz = s * xz + c * yz;
+    Matrix3::new(nxx, nxy, nxz, nxy, nyy, nyz, nxz, nyz, i[(2, 2)])
+}
+
+/// Rot_x(α) X Rot_x(α)ᵀ for a symmetric X, c = cos α, s = sin α.
+#[inline(always)]
+fn sandwich_x(i: &Matrix3<f64>, c: f64, s: f64) -> Matrix3<f64> {
+    let (yy, zz, yz) = (i[(1, 1)], i[(2, 2)], i[(1, 2)]);
+    let (xy, xz) = (i[(0, 1)], i[(0, 2)]);
+    let (cc, ss, cs) = (c * c, s * s, c * s);
+    let m = 2.0 * cs * yz;
+    let nyy = cc * yy + ss * zz - m;
+    let nzz = ss * yy + cc * zz + m;
+    let nyz = cs * (yy - zz) + (cc - ss) * yz;
+    let nxy = c * xy - s * xz;
+    let nxz = s * xy + c * xz;
+    Matrix3::new(i[(0, 0)], nxy, nxz, nxy, nyy, nyz, nxz, nyz, nzz)
+}
+
+/// Rot_z(θ) for s = sin θ, c = cos θ.
+fn rot_z(s: f64, c: f64) -> Matrix3<f64> {
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+
+/// o's decomposition Rot_z(a) Rot_x(α) Rot_z(c) (z–x–z Euler angles): (a,
+/// (cos α, sin α), c), or None if o is not one to 1e-15 (it always is, up to
+/// rounding).
+fn untwist(o: &Matrix3<f64>) -> Option<(f64, (f64, f64), f64)> {
+    let sin_b = sqrt(o[(0, 2)] * o[(0, 2)] + o[(1, 2)] * o[(1, 2)]);
+    let (a, c) = if sin_b > 1e-12 {
+        (
+            libm::atan2(o[(0, 2)], -o[(1, 2)]),
+            libm::atan2(o[(2, 0)], o[(2, 1)]),
+        )
+    } else {
+        // α = 0 or π: o = Rot_z(a) Rot_x(α), c = 0.
+        (libm::atan2(o[(1, 0)], o[(0, 0)]), 0.0)
+    };
+    let (sa, ca) = sin_cos(a);
+    let (sc, cc) = sin_cos(c);
+    let x = rot_z(sa, ca).transpose() * o * rot_z(sc, cc).transpose();
+    let off = [x[(0, 1)], x[(0, 2)], x[(1, 0)], x[(2, 0)], x[(0, 0)] - 1.0];
+    if off.iter().any(|v| v.abs() > 1e-15) {
+        return None;
+    }
+    let (cb, sb) = (0.5 * (x[(1, 1)] + x[(2, 2)]), 0.5 * (x[(2, 1)] - x[(1, 2)]));
+    let norm = sqrt(cb * cb + sb * sb);
+    Some((a, (cb / norm, sb / norm), c))
 }
 
 /// A constant rotation A with A z = `axis` (unit): its columns are an
@@ -301,6 +448,7 @@ impl<const N: usize> Chain<N> {
         let mut links = [Link {
             p: Vector3::zeros(),
             o: Matrix3::identity(),
+            twist: None,
             offset: 0.0,
             prismatic: false,
         }; N];
@@ -343,6 +491,7 @@ impl<const N: usize> Chain<N> {
             links[i] = Link {
                 p: prev.tr_mul(&origin.p),
                 o: prev.tr_mul(&origin.r) * a,
+                twist: None,
                 offset: -j.offset,
                 prismatic: j.kind == JointKind::Prismatic,
             };
@@ -356,6 +505,25 @@ impl<const N: usize> Chain<N> {
             p: prev.tr_mul(&t.p),
             r: prev.tr_mul(&t.r),
         };
+        // Between two revolute joints, o = Rot_z(a) Rot_x(α) Rot_z(c): Rot_z(a)
+        // turns link i − 1 (its angle + a, its frame by Rot_z(a): B_{i−1}),
+        // Rot_z(c) adds to joint i's angle, o becomes the twist Rot_x(α).
+        for i in 1..N {
+            if links[i - 1].prismatic || links[i].prismatic {
+                continue;
+            }
+            let Some((a, (ca, sa), c)) = untwist(&links[i].o) else {
+                continue;
+            };
+            let (sn, cs) = sin_cos(a);
+            let turn_a = rot_z(sn, cs);
+            links[i - 1].offset += a;
+            aligns[i - 1] *= turn_a;
+            links[i].p = turn_a.tr_mul(&links[i].p);
+            links[i].offset += c;
+            links[i].o = Matrix3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);
+            links[i].twist = Some((ca, sa));
+        }
         Ok((Self { links, tip }, aligns))
     }
 
@@ -416,7 +584,7 @@ impl<const N: usize> Chain<N> {
             let (r0, oi) = if i == 0 {
                 (link.o, link.p)
             } else {
-                (m.r * link.o, m.c + m.r * link.p)
+                (link.axes(&m.r), m.c + m.r * link.p)
             };
             let d = oi - m.c;
             let wxd = m.w.cross(&d);
@@ -461,7 +629,7 @@ impl<const N: usize> Chain<N> {
             let (r0, oi) = if i == 0 {
                 (link.o, link.p)
             } else {
-                (r * link.o, c + r * link.p)
+                (link.axes(&r), c + r * link.p)
             };
             z[i] = r0.column(2).into_owned();
             o[i] = oi;

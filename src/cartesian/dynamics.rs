@@ -7,7 +7,7 @@
 //!
 //! Units: kg, m, kg m², rad (m for a prismatic joint), N m (N).
 
-use crate::cartesian::chain::{turn, Chain, Frame, Joint, JointKind, Transform};
+use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Link, Transform};
 use crate::error::{check, Error};
 use crate::math::{sin_cos, tanh};
 use crate::types::{Matrix, Vector};
@@ -325,80 +325,81 @@ impl<const N: usize> Dynamics<N> {
     pub fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
         let links = self.chain.links();
         // Each link's place in the previous link's frame (the first one's
-        // does not enter M).
-        let (e, r) = self.placements(q, 1);
-        // Composite bodies, tip to base, each in its own link's frame.
-        let mut c = self.bodies;
-        for i in (1..N).rev() {
-            let (m, h, x) = {
-                let b = &c[i];
-                (b.m, e[i] * b.h, sandwich(&e[i], &b.i))
+        // does not enter M): sin and cos of its angle, its origin.
+        let mut sc = [(0.0, 1.0); N];
+        let mut r = [Vector3::zeros(); N];
+        for i in 1..N {
+            (sc[i], r[i]) = place(&links[i], q[i]);
+        }
+        // Tip to base: the composite body k (the links from k to the tip, in
+        // link k's frame) gives column k (the force and moment it needs for
+        // q̈_k = 1) and joins link k − 1; every column j ≥ k is carried into
+        // link k − 1's frame, where M_{k−1,j} = z · (the moment, or the force
+        // for a prismatic joint k − 1).
+        let mut cols = [[0.0; N]; N];
+        let mut f = [Vector3::zeros(); N];
+        let mut n = [Vector3::zeros(); N];
+        let mut comp = self.bodies[N - 1];
+        for k in (0..N).rev() {
+            let (fj, nj) = if links[k].prismatic {
+                (
+                    Vector3::new(0.0, 0.0, comp.m),
+                    Vector3::new(comp.h[1], -comp.h[0], 0.0),
+                )
+            } else {
+                (
+                    Vector3::new(-comp.h[1], comp.h[0], 0.0),
+                    comp.i.column(2).into_owned(),
+                )
             };
-            let ri = r[i];
-            let u = ri * m + h;
-            let d = ri.dot(&(u + h));
-            let p = &mut c[i - 1];
-            p.m += m;
-            p.h += u;
-            // + E I Eᵀ + m(|r|² 1 − r rᵀ) + 2 (r·h) 1 − r hᵀ − h rᵀ
+            (f[k], n[k]) = (fj, nj);
+            cols[k][k] = if links[k].prismatic { fj[2] } else { nj[2] } + self.drive.armature[k];
+            if k == 0 {
+                break;
+            }
+            let l = &links[k];
+            let (sn, cs) = sc[k];
+            let rk = r[k];
+            // The composite into link k − 1's frame, joined to its body:
+            // + E I Eᵀ + m(|r|² 1 − r rᵀ) + 2 (r·h) 1 − r hᵀ − h rᵀ.
+            let (m, h, x) = (
+                comp.m,
+                l.parent_of(sn, cs, &comp.h),
+                l.sandwich(sn, cs, &comp.i),
+            );
+            let u = rk * m + h;
+            let d = rk.dot(&(u + h));
+            let mut next = self.bodies[k - 1];
+            next.m += m;
+            next.h += u;
             for a in 0..3 {
                 for b in a..3 {
-                    let v = x[(a, b)] - ri[a] * u[b] - h[a] * ri[b] + if a == b { d } else { 0.0 };
-                    p.i[(a, b)] += v;
+                    let v = x[(a, b)] - rk[a] * u[b] - h[a] * rk[b] + if a == b { d } else { 0.0 };
+                    next.i[(a, b)] += v;
                     if a != b {
-                        p.i[(b, a)] += v;
+                        next.i[(b, a)] += v;
                     }
                 }
             }
-        }
-        // Column j: the force and moment composite j needs for q̈_j = 1,
-        // carried to each link k < j: M_kj = z · (moment or force) there.
-        let mut cols = [[0.0; N]; N];
-        for j in 0..N {
-            let b = &c[j];
-            let (mut f, mut n) = if links[j].prismatic {
-                (
-                    Vector3::new(0.0, 0.0, b.m),
-                    Vector3::new(b.h[1], -b.h[0], 0.0),
-                )
-            } else {
-                (
-                    Vector3::new(-b.h[1], b.h[0], 0.0),
-                    b.i.column(2).into_owned(),
-                )
+            comp = next;
+            let z_of = |f: &Vector3<f64>, n: &Vector3<f64>| {
+                if links[k - 1].prismatic {
+                    f[2]
+                } else {
+                    n[2]
+                }
             };
-            cols[j][j] = if links[j].prismatic { f[2] } else { n[2] } + self.drive.armature[j];
-            for k in (0..j).rev() {
-                f = e[k + 1] * f;
-                n = e[k + 1] * n + r[k + 1].cross(&f);
-                let v = if links[k].prismatic { f[2] } else { n[2] };
-                cols[j][k] = v;
-                cols[k][j] = v;
+            let e = l.rotation(sn, cs);
+            for j in k..N {
+                let fp = e * f[j];
+                let np = e * n[j] + rk.cross(&fp);
+                let v = z_of(&fp, &np);
+                cols[j][k - 1] = v;
+                cols[k - 1][j] = v;
+                (f[j], n[j]) = (fp, np);
             }
         }
         Matrix::from_data(nalgebra::ArrayStorage(cols))
-    }
-
-    /// Link i's place in link i − 1's frame at q, for i ≥ `from`: the
-    /// rotation E_i = o Rot_z(θ_i) (o for a prismatic joint) and the origin
-    /// r_i (p, or p + o z (q_i + offset) for a prismatic joint).
-    #[inline(always)]
-    fn placements(&self, q: &Vector<N>, from: usize) -> ([Matrix3<f64>; N], [Vector3<f64>; N]) {
-        let links = self.chain.links();
-        let mut e = [Matrix3::identity(); N];
-        let mut r = [Vector3::zeros(); N];
-        for i in from..N {
-            let l = &links[i];
-            if l.prismatic {
-                e[i] = l.o;
-                r[i] = l.p + l.o.column(2) * (q[i] + l.offset);
-            } else {
-                let (sn, cs) = sin_cos(q[i] + l.offset);
-                e[i] = turn(&l.o, sn, cs);
-                r[i] = l.p;
-            }
-        }
-        (e, r)
     }
 
     /// The recursion of (20.2) in the links' frames with the base
@@ -406,31 +407,30 @@ impl<const N: usize> Dynamics<N> {
     #[inline]
     fn rnea(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>, a0: Vector3<f64>) -> Vector<N> {
         let links = self.chain.links();
-        let (e, r) = self.placements(q, 0);
+        let mut sc = [(0.0, 1.0); N];
+        let mut r = [Vector3::zeros(); N];
         let mut f = [Vector3::zeros(); N];
         let mut n = [Vector3::zeros(); N];
         // Forward: each link's angular velocity w, acceleration al and the
         // classical acceleration a of its origin, in its own frame.
         let (mut w, mut al, mut a) = (Vector3::zeros(), Vector3::zeros(), a0);
         for (i, l) in links.iter().enumerate() {
+            let ((sn, cs), ri) = place(l, q[i]);
+            (sc[i], r[i]) = ((sn, cs), ri);
             // The previous link's motion at this link's origin, in its axes.
             if i > 0 {
-                let ri = r[i];
                 a += al.cross(&ri) + w.cross(&w.cross(&ri));
             }
-            let ei = &e[i];
-            a = ei.tr_mul(&a);
+            a = l.child_of(sn, cs, &a);
+            w = l.child_of(sn, cs, &w);
             if l.prismatic {
-                w = ei.tr_mul(&w);
-                al = ei.tr_mul(&al);
-                // Prismatic: the link slides along z at q̇, q̈; the origin
-                // (r_i) already moved.
-                a += w.cross(&Vector3::new(0.0, 0.0, 2.0 * dq[i]));
+                // The link slides along z at q̇, q̈ (its origin r_i moved).
+                al = l.child_of(sn, cs, &al);
+                a += Vector3::new(w[1], -w[0], 0.0) * (2.0 * dq[i]);
                 a[2] += ddq[i];
             } else {
-                w = ei.tr_mul(&w);
                 // al = Eᵀ al + w' × z q̇ + z q̈, w' = Eᵀ w.
-                al = ei.tr_mul(&al) + Vector3::new(w[1], -w[0], 0.0) * dq[i];
+                al = l.child_of(sn, cs, &al) + Vector3::new(w[1], -w[0], 0.0) * dq[i];
                 al[2] += ddq[i];
                 w[2] += dq[i];
             }
@@ -444,8 +444,10 @@ impl<const N: usize> Dynamics<N> {
         for i in (0..N).rev() {
             tau[i] = if links[i].prismatic { f[i][2] } else { n[i][2] };
             if i > 0 {
-                let fp = e[i] * f[i];
-                let np = e[i] * n[i] + r[i].cross(&fp);
+                let (sn, cs) = sc[i];
+                let l = &links[i];
+                let fp = l.parent_of(sn, cs, &f[i]);
+                let np = l.parent_of(sn, cs, &n[i]) + r[i].cross(&fp);
                 f[i - 1] += fp;
                 n[i - 1] += np;
             }
@@ -454,13 +456,16 @@ impl<const N: usize> Dynamics<N> {
     }
 }
 
-/// O X Oᵀ for a symmetric X (symmetric).
+/// Link `l`'s place in the previous link's frame at its joint value `q`:
+/// (sin θ, cos θ) of its angle ((0, 1) for a prismatic joint) and its origin
+/// (p, or p + o z (q + offset) for a prismatic joint).
 #[inline(always)]
-fn sandwich(o: &Matrix3<f64>, x: &Matrix3<f64>) -> Matrix3<f64> {
-    let y = o * x;
-    let e = |a: usize, b: usize| y.row(a).dot(&o.row(b));
-    let (xx, yy, zz, xy, xz, yz) = (e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2));
-    Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+fn place(l: &Link, q: f64) -> ((f64, f64), Vector3<f64>) {
+    if l.prismatic {
+        ((0.0, 1.0), l.p + l.o.column(2) * (q + l.offset))
+    } else {
+        (sin_cos(q + l.offset), l.p)
+    }
 }
 
 #[cfg(test)]

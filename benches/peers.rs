@@ -23,9 +23,10 @@
 //! STATES: "K n" then K rows of q, q̇, q̈ (3n numbers each). Rows and the
 //! impedance law's parameters: see `benches/peers/peers.cpp` and SPEC (20.7).
 
-use adaptimp::cartesian::rotation::log_quaternion;
-use adaptimp::{Chain, Dynamics, Inertial, Joint, JointKind, Kinematics, Transform, Vector};
-use nalgebra::{Matrix3, Rotation3, SMatrix, UnitQuaternion, Vector3};
+use adaptimp::{
+    Chain, Dynamics, ImpedanceTorque, Inertial, Joint, JointKind, Kinematics, PoseGoal, Transform,
+    Vector,
+};
 use std::hint::black_box;
 use std::process::exit;
 use std::time::Instant;
@@ -148,36 +149,16 @@ struct Ctx<const N: usize> {
     chain: Chain<N>,
     dynamics: Dynamics<N>,
     states: Vec<State<N>>,
-    k: Vec6,
-    d: Vec6,
-    lambda2: Vec6,
-    kn: f64,
-    dn: f64,
-    pd: Vector3<f64>,
-    rd: Matrix3<f64>,
+    law: ImpedanceTorque<N>,
+    goal: PoseGoal,
     qn: Vector<N>,
     sink: f64,
 }
 
 impl<const N: usize> Ctx<N> {
     fn impedance(&self, s: &State<N>) -> Vector<N> {
-        let tip = self.chain.tip(&s.q, &Vector::zeros());
-        let j = tip.jacobian;
-        let mut e = Vec6::zeros();
-        e.fixed_rows_mut::<3>(0)
-            .copy_from(&(tip.position - self.pd));
-        e.fixed_rows_mut::<3>(3)
-            .copy_from(&log_quaternion(&UnitQuaternion::from_rotation_matrix(
-                &Rotation3::from_matrix_unchecked(tip.rotation.matrix() * self.rd.transpose()),
-            )));
-        let f = -self.k.component_mul(&e) - self.d.component_mul(&(j * s.dq));
-        let t0 = self.kn * (self.qn - s.q) - self.dn * s.dq;
-        let a = j * j.transpose() + SMatrix::<f64, 6, 6>::from_diagonal(&self.lambda2);
-        let y = match a.cholesky() {
-            Some(ch) => ch.solve(&(j * t0)),
-            None => Vec6::zeros(),
-        };
-        j.transpose() * (f - y) + t0
+        let tip = self.chain.pose_jacobian(&s.q);
+        self.law.torque(&tip, &self.goal, &self.qn, &s.q, &s.dq)
     }
 }
 
@@ -185,7 +166,7 @@ impl<const N: usize> Ctx<N> {
 fn measured_pose_jacobian<const N: usize>(c: &mut Ctx<N>, calls: usize) {
     for i in 0..calls {
         let s = &c.states[i % c.states.len()];
-        let t = c.chain.tip(black_box(&s.q), &Vector::zeros());
+        let t = c.chain.pose_jacobian(black_box(&s.q));
         c.sink += t.jacobian[(0, 0)] + t.position[0] + t.rotation[(0, 0)];
     }
 }
@@ -255,17 +236,23 @@ fn run<const N: usize>(arm: &Arm, states: &str, mode: &str, arg: Option<&str>) {
     let qn = states[0].q;
     let home = chain.tip(&qn, &Vector::zeros());
     let k = Vec6::new(500.0, 500.0, 500.0, 20.0, 20.0, 20.0);
+    let law = ImpedanceTorque::new(
+        k,
+        k.map(|x| 2.0 * x.sqrt()),
+        25.0,
+        10.0,
+        Vec6::from_element(1e-4),
+    )
+    .unwrap_or_else(|e| die(&e.to_string()));
     let mut c = Ctx {
         chain,
         dynamics,
         states,
-        k,
-        d: k.map(|x| 2.0 * x.sqrt()),
-        lambda2: Vec6::from_element(1e-4),
-        kn: 25.0,
-        dn: 10.0,
-        pd: home.position,
-        rd: *home.rotation.matrix(),
+        law,
+        goal: PoseGoal {
+            position: home.position,
+            rotation: home.rotation,
+        },
         qn,
         sink: 0.0,
     };

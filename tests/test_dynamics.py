@@ -27,10 +27,11 @@ ROBOTS = Path(
     )
 )
 
-# Two recursions of the same model (the core's in the world frame, Pinocchio's
-# in the joints' frames) agree to rounding; a wrong axis, frame, lever or
+# Two implementations of the same model (the core's in its links' frames with
+# every joint about z, Pinocchio's in the URDF's joint frames) agree to
+# rounding, relative to the largest entry; a wrong axis, frame, lever or
 # inertia shows as O(1e-2) and more.
-RTOL = 1e-9
+RTOL = 1e-12
 
 ARMS = {
     "panda": "panda",

@@ -286,6 +286,12 @@ def timings(text: str) -> dict[str, float]:
     return {k: float(v) for k, v in (line.split() for line in text.splitlines())}
 
 
+def table_rows(times: dict[str, float]) -> dict[str, float]:
+    """The rows of the table (the core's side also times the calls behind the
+    Python entry points, for benches/python_calls.py)."""
+    return {k: v for k, v in times.items() if k in ROWS}
+
+
 def instructions(cmd: list[str], calls: int) -> dict[str, float]:
     """Instructions per call of each row under callgrind, inside ``measured_ROW``."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -349,7 +355,7 @@ def main() -> None:
             for name, (p, c) in cmds.items():
                 order = [("peer", p), ("core", c)] if k % 2 == 0 else [("core", c), ("peer", p)]
                 for side, cmd in order:
-                    for row, t in timings(run([*cmd, "time", str(args.ms)])).items():
+                    for row, t in table_rows(timings(run([*cmd, "time", str(args.ms)]))).items():
                         ns[name][side][row].append(t)
         ir: dict[str, dict[str, dict[str, float]]] = {}
         if not args.no_count and shutil.which("valgrind"):

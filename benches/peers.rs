@@ -24,8 +24,9 @@
 //! impedance law's parameters: see `benches/peers/peers.cpp` and SPEC (20.7).
 
 use adaptimp::{
-    Chain, Dynamics, ImpedanceTorque, Inertial, Joint, JointKind, Kinematics, PoseGoal, Transform,
-    Vector,
+    Chain, ComputedState, ComputedTorque, ComputedTorqueConfig, Dynamics, ImpedanceMode,
+    ImpedanceTorque, Inertial, Joint, JointKind, Kinematics, Measurement, PoseGoal, Setpoint,
+    Transform, Vector,
 };
 use std::hint::black_box;
 use std::process::exit;
@@ -148,6 +149,7 @@ fn read_states<const N: usize>(path: &str) -> Vec<State<N>> {
 struct Ctx<const N: usize> {
     chain: Chain<N>,
     dynamics: Dynamics<N>,
+    computed: ComputedTorque<N>,
     states: Vec<State<N>>,
     law: ImpedanceTorque<N>,
     goal: PoseGoal,
@@ -168,6 +170,36 @@ fn measured_pose_jacobian<const N: usize>(c: &mut Ctx<N>, calls: usize) {
         let s = &c.states[i % c.states.len()];
         let t = c.chain.pose_jacobian(black_box(&s.q));
         c.sink += t.jacobian[(0, 0)] + t.position[0] + t.rotation[(0, 0)];
+    }
+}
+
+#[inline(never)]
+fn measured_fk<const N: usize>(c: &mut Ctx<N>, calls: usize) {
+    for i in 0..calls {
+        let s = &c.states[i % c.states.len()];
+        let (p, r) = c.chain.pose(black_box(&s.q));
+        c.sink += p[0] + r[(0, 0)];
+    }
+}
+
+#[inline(never)]
+fn measured_ct_step<const N: usize>(c: &mut Ctx<N>, calls: usize) {
+    let mut st = ComputedState::default();
+    for i in 0..calls {
+        let s = &c.states[i % c.states.len()];
+        let m = Measurement {
+            x: s.q,
+            dx: Some(s.dq),
+            tau_e: Vector::zeros(),
+        };
+        let sp = Setpoint {
+            x: s.q,
+            dx: s.dq,
+            ddx: s.ddq,
+        };
+        if let Ok(cmd) = c.computed.step(&mut st, black_box(&m), black_box(&sp)) {
+            c.sink += cmd.tau_sat[0];
+        }
     }
 }
 
@@ -207,13 +239,18 @@ fn measured_impedance<const N: usize>(c: &mut Ctx<N>, calls: usize) {
 
 type Row<const N: usize> = (&'static str, fn(&mut Ctx<N>, usize));
 
-fn rows<const N: usize>() -> [Row<N>; 5] {
+/// The rows against Pinocchio, then the core's calls behind the Python
+/// entry points of `benches/python_calls.py` (`fk`: the pose alone;
+/// `ct_step`: a computed-torque step, SPEC (20.3), external mode).
+fn rows<const N: usize>() -> [Row<N>; 7] {
     [
         ("pose_jacobian", measured_pose_jacobian::<N>),
         ("jdot_qdot", measured_jdot_qdot::<N>),
         ("rnea", measured_rnea::<N>),
         ("crba", measured_crba::<N>),
         ("impedance", measured_impedance::<N>),
+        ("fk", measured_fk::<N>),
+        ("ct_step", measured_ct_step::<N>),
     ]
 }
 
@@ -229,6 +266,9 @@ fn run<const N: usize>(arm: &Arm, states: &str, mode: &str, arg: Option<&str>) {
     let chain = Chain::<N>::new(&arm.joints, &arm.tip).unwrap_or_else(|e| die(&e.to_string()));
     let dynamics = Dynamics::<N>::new(&arm.joints, &arm.inertials, arm.gravity)
         .unwrap_or_else(|e| die(&e.to_string()));
+    let mut cfg = ComputedTorqueConfig::new(1e-3, Vector::from_element(1e3));
+    cfg.mode = ImpedanceMode::External;
+    let computed = ComputedTorque::new(cfg, dynamics).unwrap_or_else(|e| die(&e.to_string()));
     let states = read_states::<N>(states);
     if states.is_empty() {
         die("no states");
@@ -247,6 +287,7 @@ fn run<const N: usize>(arm: &Arm, states: &str, mode: &str, arg: Option<&str>) {
     let mut c = Ctx {
         chain,
         dynamics,
+        computed,
         states,
         law,
         goal: PoseGoal {

@@ -618,12 +618,16 @@ impl<const N: usize> Chain<N> {
         m
     }
 
-    /// The tip's pose and Jacobian at q (J̇ q̇ zero): (16.0)'s positions
-    /// alone, without the recursion of velocities and accelerations.
-    #[inline]
-    pub fn pose_jacobian(&self, q: &Vector<N>) -> Tip<N> {
-        let mut z = [Vector3::zeros(); N];
-        let mut o = [Vector3::zeros(); N];
+    /// The positions' pass of (16.0): link i's frame (rotation, origin)
+    /// from the base out, calling `visit(i, z_i, o_i)` with joint i's world
+    /// axis and origin (before a prismatic joint's travel); returns the last
+    /// link's frame.
+    #[inline(always)]
+    fn frames<F: FnMut(usize, &Vector3<f64>, &Vector3<f64>)>(
+        &self,
+        q: &Vector<N>,
+        mut visit: F,
+    ) -> (Matrix3<f64>, Vector3<f64>) {
         let (mut r, mut c) = (Matrix3::identity(), Vector3::zeros());
         for (i, link) in self.links.iter().enumerate() {
             let (r0, oi) = if i == 0 {
@@ -631,17 +635,40 @@ impl<const N: usize> Chain<N> {
             } else {
                 (link.axes(&r), c + r * link.p)
             };
-            z[i] = r0.column(2).into_owned();
-            o[i] = oi;
+            let z = r0.column(2).into_owned();
+            visit(i, &z, &oi);
             if link.prismatic {
                 r = r0;
-                c = oi + z[i] * (q[i] + link.offset);
+                c = oi + z * (q[i] + link.offset);
             } else {
                 let (sn, cs) = sin_cos(q[i] + link.offset);
                 r = turn(&r0, sn, cs);
                 c = oi;
             }
         }
+        (r, c)
+    }
+
+    /// The tip's position p (m) and rotation R (world ← tip) at q.
+    #[inline]
+    pub fn pose(&self, q: &Vector<N>) -> (Vector3<f64>, Rotation3<f64>) {
+        let (r, c) = self.frames(q, |_, _, _| {});
+        (
+            c + r * self.tip.p,
+            Rotation3::from_matrix_unchecked(r * self.tip.r),
+        )
+    }
+
+    /// The tip's pose and Jacobian at q (J̇ q̇ zero): (16.0)'s positions
+    /// alone, without the recursion of velocities and accelerations.
+    #[inline]
+    pub fn pose_jacobian(&self, q: &Vector<N>) -> Tip<N> {
+        let mut z = [Vector3::zeros(); N];
+        let mut o = [Vector3::zeros(); N];
+        let (r, c) = self.frames(q, |i, zi, oi| {
+            z[i] = *zi;
+            o[i] = *oi;
+        });
         let p = c + r * self.tip.p;
         Tip {
             position: p,
@@ -708,10 +735,10 @@ impl<const N: usize> Kinematics<N> for Chain<N> {
     }
 
     fn fk(&self, q: &Vector<N>) -> Vector<3> {
-        self.pose_jacobian(q).position
+        self.pose(q).0
     }
     fn rotation(&self, q: &Vector<N>) -> Rotation3<f64> {
-        self.pose_jacobian(q).rotation
+        self.pose(q).1
     }
     fn jacobian(&self, q: &Vector<N>) -> Jacobian6<N> {
         self.pose_jacobian(q).jacobian

@@ -39,7 +39,9 @@ the MuJoCo loop: ``benches/mujoco_user_loop.py`` (``--no-mujoco`` skips it).
 ``--check`` builds both sides and checks the agreement only (no timing).
 ``--json`` writes ``{arm: {row: {"core_ns", "peer_ns", "ratio", "core_ir",
 "peer_ir", "ir_ratio"}}}`` (plus ``"machine"``), the MuJoCo loop as the arm
-``"mujoco"``, row ``"cartesian_loop"``.
+``"mujoco"``, rows ``"cartesian_loop_ur5"`` and ``"cartesian_loop_panda"``
+(``benches/mujoco_user_loop.py``: adaptimp's native Cartesian SF loop against
+the operational-space loop a MuJoCo user writes in Python, per period).
 """
 
 from __future__ import annotations
@@ -382,7 +384,10 @@ def main() -> None:
         sys.path.insert(0, str(ROOT / "benches"))
         from mujoco_user_loop import side_by_side
 
-        result["mujoco"] = {"cartesian_loop": side_by_side(count=not args.no_count)}
+        result["mujoco"] = {
+            f"cartesian_loop_{arm}": side_by_side(arm, count_ir=not args.no_count)
+            for arm in ("ur5", "panda")
+        }
     print_table(result)
     if args.json:
         args.json.write_text(json.dumps(result, indent=1) + "\n")

@@ -47,15 +47,17 @@ impl<const N: usize> Drive<N> {
         }
     }
 
-    /// The dry-friction compensation τ_F = F ⊙ tanh(v_r / v_s) at the
-    /// reference velocity `v_r` (rad/s, m/s), SPEC (20.6) (N m, N).
-    pub fn friction_torque(&self, v_r: &Vector<N>) -> Vector<N> {
+    /// The dry-friction compensation τ_F = F ⊙ tanh(v / v_s) (N m, N), SPEC
+    /// (20.6), on the motion the joint and its reference agree on: v_i =
+    /// sign(v_r,i) min(|q̇_i|, |v_r,i|) where the measured `dq` and the
+    /// reference velocity `v_r` (rad/s, m/s) have the same sign, else 0.
+    pub fn friction_torque(&self, v_r: &Vector<N>, dq: &Vector<N>) -> Vector<N> {
         Vector::from_fn(|i, _| {
-            let f = self.friction[i];
-            if f == 0.0 {
+            let (f, r, m) = (self.friction[i], v_r[i], dq[i]);
+            if f == 0.0 || r * m <= 0.0 || r.is_nan() || m.is_nan() {
                 0.0
             } else {
-                f * tanh(v_r[i] / FRICTION_VELOCITY)
+                f * tanh(r.signum() * r.abs().min(m.abs()) / FRICTION_VELOCITY)
             }
         })
     }
@@ -605,18 +607,20 @@ mod tests {
         assert_eq!(a.gravity_torque(&q), d.gravity_torque(&q));
         let mv = a.mass_times(&q, &ddq) - a.mass_matrix(&q) * ddq;
         assert!(mv.amax() < 1e-12, "{mv}");
-        // (20.6): the full friction beyond a few v_s, none at rest, odd.
+        // (20.6): the full friction beyond a few v_s when the joint moves
+        // with its reference, none at rest or against it, odd.
+        let drive = a.drive();
         let v = Vector::<3>::new(1.0, -1.0, 1.0);
-        let f = a.drive().friction_torque(&v);
+        let f = drive.friction_torque(&v, &v);
         assert!((f - Vector::<3>::new(2.0, -1.0, 0.0)).amax() < 1e-12, "{f}");
-        assert_eq!(
-            a.drive().friction_torque(&Vector::zeros()),
-            Vector::<3>::zeros()
-        );
-        let slow = a
-            .drive()
-            .friction_torque(&Vector::from_element(FRICTION_VELOCITY));
+        let zero = Vector::<3>::zeros();
+        assert_eq!(drive.friction_torque(&zero, &v), zero);
+        assert_eq!(drive.friction_torque(&v, &zero), zero);
+        assert_eq!(drive.friction_torque(&v, &-v), zero);
+        // The slower of the two: a joint starting to follow its reference.
+        let slow = drive.friction_torque(&v, &Vector::from_element(FRICTION_VELOCITY));
         assert!((slow[0] - 2.0 * libm::tanh(1.0)).abs() < 1e-15, "{slow}");
+        assert!(slow[1] == 0.0, "{slow}");
         // The default is no drive, bit for bit the rigid model.
         assert_eq!(d.with_drive(Drive::none()).unwrap(), d);
     }

@@ -294,8 +294,8 @@ def table_rows(times: dict[str, float]) -> dict[str, float]:
     return {k: v for k, v in times.items() if k in ROWS}
 
 
-def instructions(cmd: list[str], calls: int) -> dict[str, float]:
-    """Instructions per call of each row under callgrind, inside ``measured_ROW``."""
+def instructions(cmd: list[str], calls: int, rows: tuple[str, ...] = ROWS) -> dict[str, float]:
+    """Instructions per call of each of ``rows`` under callgrind, inside ``measured_ROW``."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "cg.out"
         subprocess.run(
@@ -315,7 +315,7 @@ def instructions(cmd: list[str], calls: int) -> dict[str, float]:
     got = {}
     for line in text.splitlines():
         m = re.match(r"\s*([\d,]+)\s.*measured_(\w+)", line)
-        if m and m.group(2) in ROWS:
+        if m and m.group(2) in rows:
             # The function's inclusive count is its largest line (others are calls from it).
             ir = int(m.group(1).replace(",", "")) / calls
             got[m.group(2)] = max(got.get(m.group(2), 0.0), ir)

@@ -82,63 +82,88 @@ def python_timers(name: str, states: list[tuple[Any, Any, Any]], calls: int) -> 
     rows = [states[i % k] for i in range(calls)]
     lwa = pin.LOCAL_WORLD_ALIGNED
 
-    def pin_ct(q: Any, dq: Any, ddq: Any) -> Any:
-        # (20.3), external mode, as a user writes it with Pinocchio.
-        a = ddq + kd * (dq - dq) + kp * (q - q)
-        return np.clip(pin.rnea(model, data, q, dq, a) + zero, -tau_max, tau_max)
+    fk, jac, jdq = chain.fk, chain.jacobian, chain.jdot_qdot
+    inv, step = ct.inverse_dynamics, ct.step
+    fwd, place, frame_jac = (
+        pin.forwardKinematics,
+        pin.updateFramePlacement,
+        pin.computeFrameJacobian,
+    )
+    accel, rnea, clip = pin.getFrameClassicalAcceleration, pin.rnea, np.clip
 
-    def loop(f: Callable[[Any, Any, Any], Any]) -> Callable[[], float]:
+    # Each loop calls the entry point directly, as a user's loop does (no
+    # wrapper in between): the loops differ only in the call.
+    def fk_ours() -> None:
+        for q, _, _ in rows:
+            fk(q)
+
+    def fk_pin() -> None:
+        for q, _, _ in rows:
+            fwd(model, data, q)
+            place(model, data, fid)
+
+    def jac_ours() -> None:
+        for q, _, _ in rows:
+            jac(q)
+
+    def jac_pin() -> None:
+        for q, _, _ in rows:
+            frame_jac(model, data, q, fid, lwa)
+
+    def jdq_ours() -> None:
+        for q, dq, _ in rows:
+            jdq(q, dq)
+
+    def jdq_pin() -> None:
+        for q, dq, _ in rows:
+            fwd(model, data, q, dq, zero)
+            accel(model, data, fid, lwa)
+
+    def inv_ours() -> None:
+        for q, dq, ddq in rows:
+            inv(q, dq, ddq)
+
+    def inv_pin() -> None:
+        for q, dq, ddq in rows:
+            rnea(model, data, q, dq, ddq)
+
+    def step_ours() -> None:
+        for q, dq, ddq in rows:
+            step(q, zero, dq, xc=q, dxc=dq, ddxc=ddq)
+
+    def step_pin() -> None:
+        # (20.3), external mode, as a user writes it with Pinocchio and NumPy.
+        for q, dq, ddq in rows:
+            a = ddq + kd * (dq - dq) + kp * (q - q)
+            clip(rnea(model, data, q, dq, a) + zero, -tau_max, tau_max)
+
+    def timed(f: Callable[[], None]) -> Callable[[], float]:
         def run() -> float:
             gc.disable()
             start = time.perf_counter()
-            for q, dq, ddq in rows:
-                f(q, dq, ddq)
+            f()
             seconds = time.perf_counter() - start
             gc.enable()
             return seconds / calls
 
         return run
 
-    fk, jac, jdq = chain.fk, chain.jacobian, chain.jdot_qdot
-    inv, step = ct.inverse_dynamics, ct.step
     return {
-        "fk": (
-            loop(lambda q, dq, ddq: fk(q)),
-            loop(
-                lambda q, dq, ddq: (
-                    pin.forwardKinematics(model, data, q),
-                    pin.updateFramePlacement(model, data, fid),
-                )
-            ),
-        ),
-        "jacobian": (
-            loop(lambda q, dq, ddq: jac(q)),
-            loop(lambda q, dq, ddq: pin.computeFrameJacobian(model, data, q, fid, lwa)),
-        ),
-        "jdot_qdot": (
-            loop(lambda q, dq, ddq: jdq(q, dq)),
-            loop(
-                lambda q, dq, ddq: (
-                    pin.forwardKinematics(model, data, q, dq, zero),
-                    pin.getFrameClassicalAcceleration(model, data, fid, lwa),
-                )
-            ),
-        ),
-        "inverse_dynamics": (
-            loop(lambda q, dq, ddq: inv(q, dq, ddq)),
-            loop(lambda q, dq, ddq: pin.rnea(model, data, q, dq, ddq)),
-        ),
-        "ct_step": (
-            loop(lambda q, dq, ddq: step(q, zero, dq, xc=q, dxc=dq, ddxc=ddq)),
-            loop(pin_ct),
-        ),
+        "fk": (timed(fk_ours), timed(fk_pin)),
+        "jacobian": (timed(jac_ours), timed(jac_pin)),
+        "jdot_qdot": (timed(jdq_ours), timed(jdq_pin)),
+        "inverse_dynamics": (timed(inv_ours), timed(inv_pin)),
+        "ct_step": (timed(step_ours), timed(step_pin)),
     }
 
 
-def cartesian_timers(name: str, calls: int) -> dict[str, Callable[[], float]]:
+def cartesian_timers(
+    name: str, calls: int
+) -> tuple[dict[str, Callable[[], float]], dict[str, Any]]:
     """``CartesianController.step`` (SF, a 5 cm circle, rows of a native MuJoCo
     run) against the core's replay of the same rows, the path's own calls and
-    the law of SPEC (20.7) written with Pinocchio."""
+    the law of SPEC (20.7) written with Pinocchio; and the controller, its
+    rows (q, q̇, F_e) and commanded poses (steps, 24)."""
     import pinocchio as pin
 
     from adaptimp import mujoco as amj
@@ -221,7 +246,80 @@ def cartesian_timers(name: str, calls: int) -> dict[str, Callable[[], float]]:
         gc.enable()
         return seconds / calls
 
-    return {"python": python_calls, "rust": rust, "path": path_calls, "pinocchio": pinocchio}
+    timers = {"python": python_calls, "rust": rust, "path": path_calls, "pinocchio": pinocchio}
+    return timers, {"ctrl": ctrl, "rows": rows, "targets": targets}
+
+
+def one(name: str, entry: str, calls: int) -> None:
+    """``calls`` calls of ``entry`` (or none: ``"none"``, the setup alone), for
+    callgrind: the setup of every entry runs, so two counts differ by the calls."""
+    with tempfile.TemporaryDirectory() as tmp:
+        arms = peers.write_arms([name], Path(tmp))
+        states = read_states(arms[name][2])
+    timers = python_timers(name, states, calls)
+    cart, _ = cartesian_timers(name, calls)
+    if entry == "none":
+        return
+    if entry.startswith("cartesian"):
+        cart[entry.split(":")[1]]()
+    else:
+        side = 1 if entry.endswith(":pinocchio") else 0
+        timers[entry.split(":")[0]][side]()
+
+
+def read_states(path: Path) -> list[tuple[Any, Any, Any]]:
+    text = path.read_text().split("\n")
+    n = int(text[0].split()[1])
+    out = []
+    for line in text[1:]:
+        if line.strip():
+            x = np.array([float(v) for v in line.split()])
+            out.append((x[:n], x[n : 2 * n], x[2 * n :]))
+    return out
+
+
+def count(name: str, entry: str, calls: int) -> float:
+    """Instructions of a run of :func:`one` under callgrind."""
+    import os
+    import subprocess
+
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "cg"
+        proc = subprocess.run(
+            ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", sys.executable,
+             __file__, "--one", entry, "--arms", name, "--calls", str(calls)],
+            capture_output=True, text=True, check=True,
+            env={**os.environ, "OPENBLAS_NUM_THREADS": "1", "PYTHONHASHSEED": "0"},
+        )  # fmt: skip
+    for line in proc.stderr.splitlines():
+        if "refs:" in line:
+            return float(line.split()[-1].replace(",", ""))
+    raise RuntimeError(f"callgrind gave no count for {entry}")
+
+
+def counts(name: str, core: Path, calls: int = 2000) -> dict[str, dict[str, float]]:
+    """Instructions per call: each entry point from Python, Pinocchio's Python
+    call, and the core's call (the peers binary's ``measured_*`` rows; the
+    Cartesian step's by the core's replay, the path's calls apart)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        arms = peers.write_arms([name], Path(tmp))
+        _, core_file, states_file, _ = arms[name]
+        rust = peers.instructions(
+            [str(core), str(core_file), str(states_file)], calls, tuple(RUST.values())
+        )
+    base = count(name, "none", calls)
+    out: dict[str, dict[str, float]] = {}
+    for key in RUST:
+        out[key] = {
+            "python": (count(name, key, calls) - base) / calls,
+            "pinocchio": (count(name, f"{key}:pinocchio", calls) - base) / calls,
+            "rust": rust[RUST[key]],
+        }
+    out["cartesian"] = {
+        side: (count(name, f"cartesian:{side}", calls) - base) / calls
+        for side in ("python", "rust", "path", "pinocchio")
+    }
+    return out
 
 
 def main() -> None:
@@ -230,21 +328,20 @@ def main() -> None:
     ap.add_argument("--calls", type=int, default=20000)
     ap.add_argument("--arms", nargs="+", default=["ur5", "panda"], choices=list(peers.ARMS))
     ap.add_argument("--json", type=Path)
+    ap.add_argument("--count", action="store_true", help="also count instructions (callgrind)")
+    ap.add_argument("--one", help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.one:
+        one(args.arms[0], args.one, args.calls)
+        return
     core = peers.build_core()
     out: dict[str, Any] = {"machine": peers.machine()}
     with tempfile.TemporaryDirectory() as tmp:
         arms = peers.write_arms(args.arms, Path(tmp))
         for name, (_, core_file, states_file, _) in arms.items():
-            text = states_file.read_text().split("\n")
-            n = int(text[0].split()[1])
-            states = []
-            for line in text[1:]:
-                if line.strip():
-                    x = np.array([float(v) for v in line.split()])
-                    states.append((x[:n], x[n : 2 * n], x[2 * n :]))
+            states = read_states(states_file)
             timers = python_timers(name, states, args.calls)
-            cart = cartesian_timers(name, min(args.calls, 5000))
+            cart, _ = cartesian_timers(name, min(args.calls, 5000))
             got: dict[str, dict[str, list[float]]] = {
                 k: {"python": [], "rust": [], "pinocchio": []} for k in [*timers, "cartesian"]
             }
@@ -261,6 +358,10 @@ def main() -> None:
             out[name] = {
                 k: {side: statistics.median(v) for side, v in d.items()} for k, d in got.items()
             }
+    if args.count:
+        for name in args.arms:
+            for key, ir in counts(name, core).items():
+                out[name][key].update({f"{side}_ir": round(v) for side, v in ir.items()})
     print_table(out)
     if args.json:
         args.json.write_text(json.dumps(out, indent=1) + "\n")
@@ -285,6 +386,29 @@ def print_table(out: dict[str, Any]) -> None:
                 f"{e['python'] / e['pinocchio']:.2f} |"
             )
     print("(cartesian: over = Python call − core's step − the path's own calls)")
+    if any(
+        "python_ir" in e
+        for rows in out.values()
+        if isinstance(rows, dict)
+        for e in rows.values()
+        if isinstance(e, dict)
+    ):
+        print(
+            "\n| arm | entry point | Python call (Ir) | core's call (Ir) | over it "
+            "| Pinocchio (Ir) |"
+        )
+        print("|---|---|---:|---:|---:|---:|")
+        for arm, rows in out.items():
+            if arm == "machine":
+                continue
+            for key, e in rows.items():
+                if "python_ir" not in e:
+                    continue
+                over = e["python_ir"] - e["rust_ir"] - e.get("path_ir", 0)
+                print(
+                    f"| {arm} | {key} | {e['python_ir']:,} | {e['rust_ir']:,} | {over:+,} | "
+                    f"{e['pinocchio_ir']:,} |"
+                )
 
 
 if __name__ == "__main__":

@@ -341,6 +341,8 @@ class ComputedTorque:
                 xc_offset=[0.2, 0.2], xc_sin=[0.0, 0.2], xc_cos=[-0.2, 0.0], xc_omega=[math.pi] * 2
             )
         self._trajectory = trajectory
+        self._core.set_trajectory(trajectory)
+        self._step = self._core.step
 
     def reset(self) -> None:
         """Back to t = 0; the reference starts at the next setpoint."""
@@ -434,14 +436,10 @@ class ComputedTorque:
         xc (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0), or
         none of them (then the built-in ``trajectory``).
         """
-        if xc is None:
-            if dxc is not None or ddxc is not None:
-                raise ValueError("give xc with dxc and ddxc")
-            if self._trajectory is None:
-                raise ValueError("no setpoint given and no trajectory to follow")
-            xc, dxc, ddxc = self._trajectory(self.t)
-        # The core checks every argument (shape and type here, values in the step).
-        return self._core.step(q, tau_e, dq, xc, dxc, ddxc)
+        # One call of the core, positional (cheaper than keywords through the
+        # binding): it checks every argument (shapes and types there, values in
+        # the step) and, given no setpoint, follows the trajectory.
+        return self._step(q, tau_e, dq, xc, dxc, ddxc)
 
     def __repr__(self) -> str:
         return (

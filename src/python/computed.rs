@@ -265,9 +265,42 @@ pub struct PyComputedTorque {
     inner: Mutex<Box<dyn DynComputed>>,
     /// Joints n.
     pub n: usize,
+    /// `trajectory(t) -> (xc, dxc, ddxc)` for a step given no setpoint.
+    trajectory: Mutex<Option<Py<PyAny>>>,
 }
 
 impl PyComputedTorque {
+    /// The setpoint (xc, ẋc, ẍc) into `b[3..6]` from the trajectory at t =
+    /// steps·Ts (called without holding the controller, which it may read).
+    fn setpoint_of_trajectory(
+        &self,
+        py: Python<'_>,
+        rates_given: bool,
+        b: &mut [[f64; MAX_JOINTS]; 6],
+    ) -> PyResult<()> {
+        if rates_given {
+            return Err(MeasurementError::new_err("give xc with dxc and ddxc"));
+        }
+        let traj = super::wait_lock(py, &self.trajectory)
+            .as_ref()
+            .map(|t| t.clone_ref(py));
+        let Some(traj) = traj else {
+            return Err(MeasurementError::new_err(
+                "no setpoint given and no trajectory to follow",
+            ));
+        };
+        let t = {
+            let g = self.lock(py);
+            g.steps() as f64 * g.ts()
+        };
+        let out = traj.call1(py, (t,))?;
+        let out = out.bind(py);
+        for (i, what) in ["xc", "dxc", "ddxc"].into_iter().enumerate() {
+            vector_into(what, self.n, &out.get_item(i)?, &mut b[3 + i])?;
+        }
+        Ok(())
+    }
+
     /// The controller, waiting (with the GIL released) while another thread
     /// uses it.
     pub fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynComputed>> {
@@ -368,7 +401,15 @@ impl PyComputedTorque {
         Ok(Self {
             n: inner.n(),
             inner: Mutex::new(inner),
+            trajectory: Mutex::new(None),
         })
+    }
+
+    /// The setpoint of a step given none: `trajectory(t) -> (xc, dxc,
+    /// ddxc)` at t = steps·Ts (None: a step must give xc).
+    #[pyo3(signature = (trajectory=None))]
+    fn set_trajectory(&self, py: Python<'_>, trajectory: Option<Py<PyAny>>) {
+        *super::wait_lock(py, &self.trajectory) = trajectory;
     }
 
     /// Joints n.
@@ -419,24 +460,27 @@ impl PyComputedTorque {
         ddxc: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
-        let (Some(dq), Some(xc)) = (dq, xc) else {
-            return Err(MeasurementError::new_err(if dq.is_none() {
-                "ComputedTorque needs the measured joint velocity dq"
-            } else {
-                "ComputedTorque needs the setpoint xc"
-            }));
+        let Some(dq) = dq else {
+            return Err(MeasurementError::new_err(
+                "ComputedTorque needs the measured joint velocity dq",
+            ));
         };
         // q, tau_e, dq, xc, dxc, ddxc: straight into their buffers.
         let mut b = [[0.0; MAX_JOINTS]; 6];
         vector_into("q", n, q, &mut b[0])?;
         vector_into("tau_e", n, tau_e, &mut b[1])?;
         vector_into("dq", n, dq, &mut b[2])?;
-        vector_into("xc", n, xc, &mut b[3])?;
-        if let Some(d) = dxc {
-            vector_into("dxc", n, d, &mut b[4])?;
-        }
-        if let Some(d) = ddxc {
-            vector_into("ddxc", n, d, &mut b[5])?;
+        match xc {
+            Some(xc) => {
+                vector_into("xc", n, xc, &mut b[3])?;
+                if let Some(d) = dxc {
+                    vector_into("dxc", n, d, &mut b[4])?;
+                }
+                if let Some(d) = ddxc {
+                    vector_into("ddxc", n, d, &mut b[5])?;
+                }
+            }
+            None => self.setpoint_of_trajectory(py, dxc.is_some() || ddxc.is_some(), &mut b)?,
         }
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)

@@ -74,12 +74,10 @@ def arm(name: str) -> tuple[Any, np.ndarray, adaptimp.Chain]:
         from adaptimp import _models
 
         urdf = _models.panda_urdf_path().parents[2] / "ur_description/urdf/ur5_robot.urdf"
-        arm_urdf = _models.arm_urdf(urdf.read_text())
-        pm = pin.buildModelFromXML(arm_urdf.text)
+        arm_urdf = amj._urdf_arm(urdf, None, ())
+        pm = pin.buildModelFromXML(arm_urdf.urdf)
         tool = pm.frames[pm.getFrameId("tool0")].placement
-        spec = amj._spec_of(arm_urdf.text)
-        spec.option.timestep = 1e-3
-        amj._add_motors(spec, dict(zip(arm_urdf.joints, arm_urdf.effort)))
+        spec = amj._arm_spec(arm_urdf, 1e-3, drive=False, stacklevel=2)
         quat = np.zeros(4)
         mujoco.mju_mat2Quat(quat, np.ascontiguousarray(tool.rotation).ravel())
         spec.body("wrist_3_link").add_site(name="tool0", pos=tool.translation, quat=quat)

@@ -125,12 +125,10 @@ def machine() -> dict[str, Any]:
 def pinocchio_arm(name: str) -> Any:
     """Pinocchio's model of the arm's URDF (its gripper fixed by the core's
     reduction, as everywhere in adaptimp)."""
-    import pinocchio as pin
-
-    from adaptimp import _models
+    from adaptimp.baselines import pinocchio_model
 
     urdf, _ = ARMS[name]
-    return pin.buildModelFromXML(_models.arm_urdf((robots() / urdf).read_text()).text)
+    return pinocchio_model(robots() / urdf)
 
 
 def core_lines(model: Any, frame: str) -> list[str]:

@@ -16,6 +16,8 @@ import pytest
 import adaptimp
 from adaptimp import _models
 from adaptimp import mujoco as amj
+from adaptimp._description import read_arm
+from mujoco_probe import contact_list_wrench, measure, push
 
 RNG_SEED = 20160301
 
@@ -78,56 +80,71 @@ def test_plant_reads_limits_and_sensor(two_link: mujoco.MjModel) -> None:
     p = adaptimp.TwoLinkArm().params
     x = p["l1"] * np.cos(0.25) + p["l2"] * np.cos(0.2)
     z = p["l1"] * np.sin(0.25) + p["l2"] * np.sin(0.2)
-    np.testing.assert_allclose(plant.ee_position(), [x, 0.0, z], atol=1e-15)
+    row = measure(plant, [100.0, -100.0])
+    assert row.x_ee is not None
+    np.testing.assert_allclose(row.x_ee[0], [x, 0.0, z], atol=1e-15)
     # Saturation is the actuators'.
-    np.testing.assert_array_equal(plant.apply([100.0, -100.0]), [17.0, -15.0])
+    np.testing.assert_array_equal(row.tau_sat[0], [17.0, -15.0])
+    np.testing.assert_array_equal(row.tau[0], [100.0, -100.0])
     # Free space: the sensor reads exactly zero.
-    np.testing.assert_array_equal(plant.tau_e(), [0.0, 0.0])
+    np.testing.assert_array_equal(row.tau_e[0], [0.0, 0.0])
 
 
 def _push_into_wall(plant: amj.Plant, target: list[float]) -> np.ndarray:
     """Press the end effector against the ceiling: gravity compensation and a
     joint PD towards ``target`` (rad, beyond the wall), until at rest. Returns the
     torque applied at rest (N m)."""
-    arm = adaptimp.TwoLinkArm()
-    plant.timestep = 1e-4
-    plant.reset([0.1, 0.1])
-    for _ in range(20_000):
-        plant.apply(arm.G(plant.q) + 20.0 * (np.array(target) - plant.q) - 3.0 * plant.dq)
-        plant.step()
-    tau = plant.apply(arm.G(plant.q) + 20.0 * (np.array(target) - plant.q))
-    plant.forward()
-    return tau
+    return push(plant, target, adaptimp.TwoLinkArm().G)
 
 
 def test_wall_force_balances_the_dynamics(two_link: mujoco.MjModel) -> None:
-    """Against the wall, (4) gives τe = τ − D q̈ − C q̇ − G: the sensor's Jᵀ F_e
-    does, to rounding (the sensor's body is massless); nearly at rest, τ − G."""
+    """Against the wall, (4) gives τe = τ − D q̈ − C q̇ − G: the core's Jᵀ F_e
+    from the sensor does, to rounding (the sensor's body is massless); nearly
+    at rest, τ − G."""
     plant = amj.Plant(two_link)
     tau = _push_into_wall(plant, [0.4, 0.2])
     assert plant.data.ncon == 1
     arm = adaptimp.TwoLinkArm()
-    q, dq, ddq = plant.q, plant.dq, plant.ddq
+    row = measure(plant, tau)
+    q, dq, ddq, tau_e = row.q[0], row.dq[0], row.ddq[0], row.tau_e[0]
     assert np.max(np.abs(dq)) < 1e-4  # resting (soft contact creeps slowly)
     expected = tau - arm.D(q) @ ddq - arm.C(q, dq) @ dq - arm.G(q)
-    np.testing.assert_allclose(plant.tau_e(), expected, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(plant.tau_e(), tau - arm.G(q), rtol=0, atol=1e-3)
+    np.testing.assert_allclose(tau_e, expected, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(tau_e, tau - arm.G(q), rtol=0, atol=1e-3)
     # The arm pushes the ceiling up, by several newtons.
-    assert plant.wrench()[2] > 1.0
+    assert row.wrench_ee is not None
+    assert row.wrench_ee[0, 2] > 1.0
 
 
-def test_sensor_and_contact_forces_agree(two_link: mujoco.MjModel) -> None:
-    plant = amj.Plant(two_link)
-    _push_into_wall(plant, [0.5, 0.0])
-    np.testing.assert_allclose(plant.sensor_wrench(), plant.contact_wrench(), rtol=0, atol=1e-9)
-    # A model without sensors measures through the contacts.
+def _bare() -> mujoco.MjSpec:
+    """The paper's arm without its sensors."""
     spec = mujoco.MjSpec.from_file(str(_models.TWO_LINK_XML))
     for sensor in list(spec.sensors):
         spec.delete(sensor)
-    bare = amj.Plant(spec.compile())
+    return spec
+
+
+def test_sensor_and_contact_forces_agree(two_link: mujoco.MjModel) -> None:
+    """The force/torque sensor the core reads and MuJoCo's contact list agree;
+    so do, on a model without sensors, the contact forces the core reads from
+    the bodies of the end effector's subtree (MuJoCo's cfrc_ext)."""
+    plant = amj.Plant(two_link)
+    tau = _push_into_wall(plant, [0.5, 0.0])
+    listed = contact_list_wrench(plant)
+    sensed = measure(plant, tau).wrench_ee
+    assert sensed is not None
+    np.testing.assert_allclose(sensed[0], listed, rtol=0, atol=1e-9)
+    assert listed[2] > 1.0
+    # A model without sensors measures through the contacts.
+    bare = amj.Plant(_bare().compile())
     assert bare.wrench_source == "contact"
-    with pytest.raises(ValueError, match="no force sensor"):
-        bare.sensor_wrench()
+    tau = _push_into_wall(bare, [0.5, 0.0])
+    listed = contact_list_wrench(bare)
+    summed = measure(bare, tau)
+    assert summed.wrench_ee is not None
+    assert summed.params["loop"] == "callback"
+    np.testing.assert_allclose(summed.wrench_ee[0], listed, rtol=0, atol=1e-12)
+    assert listed[2] > 1.0
 
 
 def test_a_files_model_without_force_sensor_gets_a_contact_sensor(
@@ -135,36 +152,38 @@ def test_a_files_model_without_force_sensor_gets_a_contact_sensor(
 ) -> None:
     """An MJCF file without a force sensor whose end effector can touch something:
     Plant adds a contact sensor (the net contact wrench on the end effector's
-    subtree), whose wrench is the contact list's to rounding, so the core's loop
-    runs it, and both loops give the same bits; the same model as an MjModel
-    keeps the contact list and the Python loop."""
-    spec = mujoco.MjSpec.from_file(str(_models.TWO_LINK_XML))
-    for sensor in list(spec.sensors):
-        spec.delete(sensor)
+    subtree), whose wrench is the contact list's to rounding; a controller
+    native and called back give the same bits on it. The same model as an
+    MjModel (it cannot be rebuilt with a sensor) is measured through the
+    external forces on the end effector's bodies, the same to rounding."""
+    spec = _bare()
     path = tmp_path / "bare.xml"
     path.write_text(spec.to_xml())
     plant = amj.Plant(path)
     assert plant.wrench_source == "contact sensor"
     assert plant.model.nsensor == 1
-    _push_into_wall(plant, [0.5, 0.0])
-    np.testing.assert_allclose(
-        plant.contact_sensor_wrench(), plant.contact_wrench(), rtol=0, atol=1e-12
-    )
-    assert plant.wrench()[2] > 1.0
+    tau = _push_into_wall(plant, [0.5, 0.0])
+    listed = contact_list_wrench(plant)
+    sensed = measure(plant, tau).wrench_ee
+    assert sensed is not None
+    np.testing.assert_allclose(sensed[0], listed, rtol=0, atol=1e-12)
+    assert listed[2] > 1.0
     native = amj.simulate(adaptimp.Controller("sf", "robot"), path, T=2.0)
     python = amj.simulate(_InPython(adaptimp.Controller("sf", "robot")), path, T=2.0)
     assert native.params["loop"] == "native"
-    assert python.params["loop"] == "python"
+    assert python.params["loop"] == "callback"
     _assert_same_run(native, python)
     assert native.metrics["steps_in_contact"] > 100
     same = mujoco.MjModel.from_xml_path(str(path))
-    listed = amj.simulate(adaptimp.Controller("sf", "robot"), same, T=2.0)
-    assert listed.params["wrench_source"] == "contact"
-    assert listed.params["loop"] == "python"
-    # The contact list and the sensor sum the same contact forces in another order.
-    np.testing.assert_allclose(listed.q, native.q, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(listed.wrench_ee, native.wrench_ee, rtol=0, atol=1e-9)
-    assert listed.metrics["steps_in_contact"] == native.metrics["steps_in_contact"]
+    listed_run = amj.simulate(adaptimp.Controller("sf", "robot"), same, T=2.0)
+    assert listed_run.params["wrench_source"] == "contact"
+    assert listed_run.params["loop"] == "native"
+    # The sensor and the bodies' external forces sum the same contact forces
+    # in another order: the runs part at rounding (measured over these 2 s:
+    # q 1e-15 rad, the wrench 1.6e-9 N of 8 N).
+    np.testing.assert_allclose(listed_run.q, native.q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(listed_run.wrench_ee, native.wrench_ee, rtol=0, atol=1e-8)
+    assert listed_run.metrics["steps_in_contact"] == native.metrics["steps_in_contact"]
     # Explicit contact pairs could collide geoms of the subtree with each other,
     # which the sensor would count and the contact list skips: the list stays.
     spec.add_pair(geomname1="ee", geomname2="wall")
@@ -194,20 +213,25 @@ def _motors(n: int, extra: str = 'ctrlrange="-1 1"') -> str:
 
 
 def test_plant_rejects_models_it_cannot_drive() -> None:
-    with pytest.raises(ValueError, match=r"hinge joints only; not hinges: j1 \(mjJNT_SLIDE\)"):
+    """A compiled MjModel cannot be edited: what a file's plant would lock or
+    add is refused by name, with what to do (adaptimp._mjcf; test_mjcf.py
+    has the files)."""
+    with pytest.raises(ValueError, match=r"joints \['j1'\] of the arm's body tree are not the arm"):
         amj.Plant(_mjcf(_chain(2, "slide"), _motors(2)))
-    with pytest.raises(ValueError, match="1 to 7 joints, the model has 8"):
+    with pytest.raises(
+        ValueError, match=r"1 to 7 joints; the arm has 8 \(j0, j1, .*fix=\(\.\.\.\)"
+    ):
         amj.Plant(_mjcf(_chain(8), _motors(8)))
-    with pytest.raises(ValueError, match="joint 'j1' has 0"):
+    with pytest.raises(ValueError, match=r"joint 'j1' has 0 actuators: .* the file's path"):
         amj.Plant(_mjcf(_chain(2), '<motor joint="j0" ctrlrange="-1 1"/>'))
-    with pytest.raises(ValueError, match="'a' is not a torque actuator"):
+    with pytest.raises(ValueError, match="the position actuator of joint 'j0' declares no force"):
         amj.Plant(_mjcf(_chain(1), '<position name="a" joint="j0" ctrlrange="-1 1"/>'))
-    with pytest.raises(ValueError, match=r"symmetric ctrlrange .* \[-1, 2\]"):
+    with pytest.raises(ValueError, match=r"ctrlrange of motor '#0' is \[-1, 2\]: .* symmetric"):
         amj.Plant(_mjcf(_chain(1), '<motor joint="j0" ctrlrange="-1 2"/>'))
-    with pytest.raises(ValueError, match="symmetric ctrlrange"):
+    with pytest.raises(ValueError, match="the motor of joint 'j0' declares no force range"):
         amj.Plant(_mjcf(_chain(1), '<motor joint="j0"/>'))  # unlimited
     branches = _LINK.format(n="j0", t="hinge", inner="") + _LINK.format(n="j1", t="hinge", inner="")
-    with pytest.raises(ValueError, match="serial chain"):
+    with pytest.raises(ValueError, match=r"2 serial chains of 1 joints from the root tie .* tip="):
         amj.Plant(_mjcf(branches, _motors(2)))
     with pytest.raises(ValueError, match=r"no file 'nowhere\.xml'"):
         amj.Plant("nowhere.xml")
@@ -215,20 +239,32 @@ def test_plant_rejects_models_it_cannot_drive() -> None:
 
 def test_a_urdf_arm_is_its_chain_with_the_gripper_fixed() -> None:
     path = _models.panda_urdf_path()
-    arm = _models.arm_urdf(path.read_text())
+    arm = read_arm(path)
     assert arm.joints == _models.PANDA_JOINTS
     assert arm.effort == _models.PANDA_EFFORT
     assert arm.tip == "panda_link7"
-    prismatic = "prismatic (the arm's joints are revolute)"
-    assert arm.fixed == dict.fromkeys(_models.PANDA_FINGERS, prismatic)
+    finger1, finger2 = _models.PANDA_FINGERS
+    assert arm.fixed == {
+        finger1: "in the hand at 'panda_hand' (branches of joints start there: two or more "
+        "each shorter than the arm, or three or more none longer)",
+        finger2: f"mimics '{finger1}': it moves with '{finger1}', not on its own",
+    }
     plant = amj.Plant(path)
     assert plant.n == 7
     assert plant.tau_max.tolist() == list(_models.PANDA_EFFORT)
-    # The plant itself still refuses a slide joint, by name.
-    spec, effort = amj._urdf_spec(path.read_text())
-    amj._add_motors(spec, effort)
-    with pytest.raises(ValueError, match=r"panda_finger_joint1 \(mjJNT_SLIDE\)"):
+    # A compiled model with a finger's slide (the chain to a finger drives
+    # it: tip= names the path) cannot lock it: refused by name; its spec (the
+    # same model, editable) is locked in memory.
+    finger = read_arm(path, tip="panda_leftfinger")
+    assert finger.joints == (*_models.PANDA_JOINTS, finger1)
+    assert finger.urdf is not None
+    spec = amj._spec_of(finger.urdf)
+    amj._add_motors(spec, dict(zip(finger.joints, finger.effort)))
+    with pytest.raises(ValueError, match=r"\['panda_finger_joint1'\]"):
         amj.Plant(spec.compile())
+    with pytest.warns(adaptimp.PlantWarning, match="the plant locks them at their reference"):
+        locked = amj.Plant(spec)
+    assert locked.joint_names == list(_models.PANDA_JOINTS)
 
 
 def test_import_error_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -376,8 +412,8 @@ def test_mujoco_result_is_a_sim_result() -> None:
 
 
 class _InPython:
-    """An adaptimp.Controller behind a Python object: simulate's Python loop
-    steps it through its Python ``step``."""
+    """An adaptimp.Controller behind a Python object: the core's loop calls its
+    Python ``step`` back once a period."""
 
     def __init__(self, inner: adaptimp.Controller) -> None:
         self.inner = inner
@@ -407,27 +443,28 @@ def _assert_same_run(got: amj.MujocoResult, want: amj.MujocoResult) -> None:
 
 @pytest.mark.parametrize("contact", [False, True])
 @pytest.mark.parametrize("case", ["pd", "sf", "of"])
-def test_the_native_loop_equals_the_python_loop(case: str, contact: bool) -> None:
-    """The core's loop (MuJoCo through its C library) and the Python loop
-    stepping the same controller through its Python ``step`` give the same
-    bits, row by row and metric by metric, in contact too."""
+def test_a_controller_called_back_gives_the_native_bits(case: str, contact: bool) -> None:
+    """The core's loop stepping a controller natively and calling the same
+    controller's Python ``step`` back give the same bits, row by row and
+    metric by metric, in contact too."""
     T = 2.5
     native = amj.simulate(adaptimp.Controller(case, "robot"), "two_link", T=T, contact=contact)
     python = amj.simulate(
         _InPython(adaptimp.Controller(case, "robot")), "two_link", T=T, contact=contact
     )
     assert native.params["loop"] == "native"
-    assert python.params["loop"] == "python"
+    assert python.params["loop"] == "callback"
     _assert_same_run(native, python)
     if contact:
         assert native.metrics["steps_in_contact"] > 100
-    # The native run records what the Python loop cannot see: the weights.
+    # The native run records what a controller called back does not say: the weights.
     assert case == "pd" or native.w_norms[-1, 2] > 0
     assert np.all(np.isnan(python.w_norms))
 
 
 def test_the_native_loop_with_a_reference_and_seven_joints_in_contact() -> None:
-    """The Panda on its table, a reference callable: native and Python loops agree."""
+    """The Panda on its table, a reference callable: the controller native and
+    called back agree."""
     q0 = np.array(_models.PANDA_HOME)
 
     def down(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -536,8 +573,9 @@ def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Issue 20, item 6: MuJoCo resets a diverged state and only warns, so the
-    run used to end at data.time = 0.001 s with a normal-looking result. Both
-    loops now raise DivergedError with the row, the time and MuJoCo's words."""
+    run used to end at data.time = 0.001 s with a normal-looking result. A
+    controller called back and a native one raise DivergedError with the row,
+    the time and MuJoCo's words."""
     monkeypatch.chdir(tmp_path)  # MuJoCo writes its warnings to MUJOCO_LOG.TXT here
     model = mujoco.MjModel.from_xml_string(_FEATHER)
     want = (
@@ -556,17 +594,6 @@ def test_an_exploding_run_raises_and_names_the_row_the_time_and_the_cause(
     # (q0 given: without it the run starts on the reference, xc(0) = 10 rad.)
     with pytest.raises(adaptimp.DivergedError, match=r"row 0 \(t = 0 s to 0.001 s\): MuJoCo"):
         amj.simulate(_kicking_controller(), model, T=1.0, reference=_step_at(0), q0=[0.0])
-
-
-def test_plant_step_raises_when_mujoco_resets(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warnings to MUJOCO_LOG.TXT here
-    plant = amj.Plant(mujoco.MjModel.from_xml_string(_FEATHER))
-    plant.step(3)
-    plant.apply([1e6])
-    with pytest.raises(adaptimp.DivergedError, match=r"from t = 0.003 s: MuJoCo warned mjWARN"):
-        plant.step(2)
 
 
 def test_after_an_error_the_plant_and_controller_run_again() -> None:
@@ -614,5 +641,3 @@ def test_disturbances_act_on_the_mujoco_plant() -> None:
         amj.simulate("sf", "two_link", T=0.1, jitter=0.1)
     with pytest.raises(ValueError, match="0 ≤ delay ≤ 64"):
         amj.simulate("sf", "two_link", T=0.1, delay=65)
-    with pytest.raises(TypeError, match=r"disturbances \['noise_q'\] need a controller the core"):
-        amj.simulate(_Hold([0.0, 0.0]), "two_link", T=0.01, noise_q=1e-3)

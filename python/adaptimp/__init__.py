@@ -18,7 +18,8 @@ the project's SPEC (docs/SPEC.md).
 - :func:`sweep` runs many simulations (a grid or random samples) on every core
   or on a Dask cluster and returns a pandas DataFrame.
 - Errors by kind: :class:`ConfigError`, :class:`MeasurementError`,
-  :class:`DivergedError`, :class:`FaultError`; :class:`StabilityWarning`.
+  :class:`DivergedError`, :class:`FaultError`; :class:`StabilityWarning`,
+  :class:`PlantWarning`.
 
 Every SPEC quantity is a keyword parameter with the paper's default
 (:data:`PARAMS`, :data:`SCENARIOS`)::
@@ -39,7 +40,9 @@ from ._errors import (
     DivergedError,
     FaultError,
     MeasurementError,
+    PlantWarning,
     StabilityWarning,
+    XacroError,
 )
 from ._faults import Fault
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
@@ -70,10 +73,12 @@ __all__ = [
     "Normal",
     "Param",
     "PlanarArm",
+    "PlantWarning",
     "SimResult",
     "StabilityWarning",
     "TwoLinkArm",
     "Uniform",
+    "XacroError",
     "__version__",
     "defaults",
     "metrics_table",

@@ -22,14 +22,18 @@ __all__ = [
     "PlanarArm",
     "TwoLinkArm",
     "__version__",
+    "arm_from_mujoco",
     "centres_along",
     "default_task",
     "defaults",
+    "description_kind",
     "metrics",
+    "read_arm",
     "schema_table",
     "simulate",
     "simulate_many",
     "simulate_mujoco",
+    "simulate_mujoco_callback",
     "simulate_mujoco_many",
     "suggest",
 ]
@@ -432,6 +436,27 @@ def simulate_mujoco(
 ) -> dict[str, Any]:
     """The closed loop on a MuJoCo MjModel/MjData with the GIL released (SPEC §13.2)."""
 
+def simulate_mujoco_callback(
+    controller: Any,
+    model: Any,
+    data: Any,
+    spec: dict[str, Any],
+    params: dict[str, Any],
+    ts: float,
+    t_final: float,
+    settle: float,
+    table: tuple[_F, _F, _F],
+    *,
+    setpoint: bool,
+    wants_wrench: bool,
+    attrs: list[str],
+    target: tuple[list[float], list[float], list[float]],
+    record_every: int = 1,
+    progress: Callable[[int, int], object] | None = None,
+    fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
+) -> dict[str, Any]:
+    """The closed loop on MuJoCo of a controller written in Python, called back once a period."""
+
 def simulate_mujoco_many(
     jobs: Sequence[
         tuple[
@@ -473,6 +498,27 @@ def schema_table() -> list[dict[str, Any]]:
 
 def defaults(scenario: str = "paper", n: int = 2) -> dict[str, Any]:
     """Every parameter's default in ``scenario`` ("paper" or "robot") for n joints."""
+
+def read_arm(
+    source: str,
+    tip: str | None = None,
+    fix: Sequence[str] | None = None,
+    label: str | None = None,
+) -> dict[str, Any]:
+    """The arm of a URDF path or URDF text (SPEC §21), as a dict of the arm's
+    joints, limits, efforts, drive terms, chain, bodies, tip, held joints and
+    the reduced URDF."""
+
+def arm_from_mujoco(
+    arrays: dict[str, Any],
+    source: str,
+    tip: str | None = None,
+    fix: Sequence[str] | None = None,
+) -> dict[str, Any]:
+    """The arm of a compiled MuJoCo model's arrays (SPEC §21), as :func:`read_arm`'s dict."""
+
+def description_kind(path: str) -> str:
+    """What the file at ``path`` is: "urdf", "xacro", "mjcf" or "unknown"."""
 
 @disjoint_base
 class Chain:
@@ -587,8 +633,9 @@ def suggest(
     period: float | None = None,
     gravity: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
-    """The gain and basis rule of SPEC §18: "params" (every controller keyword),
-    with a path also "centers" (L, 4n) and "widths" (4n,)."""
+    """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
+    samples along the path (SPEC (18.1)'s scales along it): "params" (every
+    controller keyword), with a path also "centers" (L, 4n) and "widths" (4n,)."""
 
 def default_task(
     home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
@@ -646,3 +693,17 @@ class ComputedTorque:
     def mass_matrix(self, q: ArrayLike) -> _F:
         """M(q) (kg m²), (n, n)."""
     def last(self, what: str) -> _F: ...
+    def simulate_mujoco(
+        self,
+        model: Any,
+        data: Any,
+        spec: dict[str, Any],
+        params: dict[str, Any],
+        t_final: float,
+        settle: float,
+        reference: tuple[_F, _F, _F],
+        record_every: int = 1,
+        progress: Callable[[int, int], object] | None = None,
+        fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
+    ) -> dict[str, Any]:
+        """The closed loop on MuJoCo in joint space along ``reference`` (every row)."""

@@ -18,6 +18,12 @@ class ConfigError(AdaptimpError, ValueError):
     an impossible value. A ``ValueError``."""
 
 
+class XacroError(ConfigError):
+    """A robot description with xacro markup (macros, ``${…}``, ``$(find …)``)
+    given where a URDF is read: expand it first (the message says how; the
+    extra ``xacro`` expands a ``.xacro`` path itself). A ``ConfigError``."""
+
+
 class MeasurementError(AdaptimpError, ValueError):
     """A step's input that is not a measurement: non-finite, of the wrong shape,
     beyond a plausibility limit, or missing (``dq`` for "pd"/"sf"). Named as you
@@ -44,13 +50,22 @@ class StabilityWarning(UserWarning):
     condition of docs/robot.md)."""
 
 
+class PlantWarning(UserWarning):
+    """What :class:`adaptimp.mujoco.Plant` made of a model as shipped (joints
+    locked, servos driven as torque motors, τmax estimated) and what a run of
+    :func:`adaptimp.mujoco.simulate` found (the arm touching itself, the
+    torque beyond 2 τmax or at its limit): the run is valid, read the message."""
+
+
 __all__ = [
     "AdaptimpError",
     "ConfigError",
     "DivergedError",
     "FaultError",
     "MeasurementError",
+    "PlantWarning",
     "StabilityWarning",
+    "XacroError",
 ]
 
 

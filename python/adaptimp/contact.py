@@ -309,22 +309,10 @@ def arm_model(
 
     from . import mujoco as amj
 
-    spec, effort = amj._urdf_spec(Path(urdf).read_text(), fix)
-    spec.option.timestep = timestep
-    missing = [j.name for j in spec.joints if not 0 < effort.get(j.name, math.nan) < math.inf]
-    if missing:
-        # The arm's own estimate, as adaptimp.mujoco.from_urdf makes it (and
-        # says so): 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|).
-        arm = amj.from_urdf(urdf, fix=fix, tip=tip)
-        for name in missing:
-            a = mujoco.mj_name2id(arm, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
-            if a < 0:
-                raise ValueError(
-                    f"joint {name!r} has no <limit effort=...> and is not one the arm's "
-                    f"model drives (from_urdf(tip={tip!r}) fixes it): give it in fix=..."
-                )
-            effort[name] = float(arm.actuator_ctrlrange[a][1])
-    amj._add_motors(spec, effort)
+    # The arm as adaptimp.mujoco.from_urdf makes it, by the core's one
+    # reduction (SPEC §21), with its motors (efforts estimated where the URDF
+    # gives none, and said so).
+    spec = amj._arm_spec(amj._urdf_arm(urdf, tip, fix), timestep, drive=False, stacklevel=3)
     _tool_and_table(
         spec,
         tip,
@@ -544,7 +532,7 @@ def arm_table(
 
     ``tip``: the tool's body (default: the child link of the arm's last joint).
     The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
-    the rule of :func:`adaptimp.mujoco.from_urdf` (``_models.arm_urdf``, with
+    the core's one rule (SPEC §21, as :func:`adaptimp.mujoco.from_urdf` with
     ``tip``): a gripper's, prismatic, mimic and off-chain joints are fixed,
     and chains that tie (legs, two arms) need ``tip``; ``home`` (rad): default the rule's home
     posture; ``spring``: the table's spring stiffness k_e (N/m), None: rigid;
@@ -627,21 +615,16 @@ def arm_table(
         _check_press(sc.chain, plant, sc.q0, sc.tau_max, _NOMINAL_KD * depth, friction, tool_radius)
         return sc
     path = Path(urdf)
-    # The arm's joints by the one rule of adaptimp.mujoco.simulate and the
-    # Pinocchio model (_models.arm_urdf): a gripper's, prismatic, mimic and
-    # off-chain joints are fixed; by default the tool goes on the last arm
-    # joint's link.
-    text = path.read_text()
-    import xml.etree.ElementTree as ET
+    # The arm's joints by the core's one rule (SPEC §21), as adaptimp.mujoco
+    # simulates it and the computed torque models it: a gripper's, prismatic,
+    # mimic and off-chain joints are held; by default the tool goes on the
+    # last arm joint's link. A fix= name the URDF does not have is refused.
+    from ._description import read_arm
 
-    names = {j.get("name") for j in ET.fromstring(text).iter("joint")}
-    unknown = [j for j in fix if j not in names]
-    if unknown:
-        raise ConfigError(f"fix names joints the URDF does not have: {unknown}")
-    arm = _models.arm_urdf(text, fix, tip=tip)
+    arm = read_arm(path, tip, fix)
     tip = arm.tip if tip is None else tip
     fix = (*fix, *(j for j in arm.fixed if j not in fix))
-    chain = Chain.from_urdf(path, tip=tip)
+    chain = Chain.from_urdf(path, tip=tip, fix=fix)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
     import mujoco
 
@@ -686,7 +669,7 @@ def arm_table(
         model=model,
         chain=chain,
         q0=q0,
-        pin_model=pinocchio_model(path),
+        pin_model=pinocchio_model(path, tip=tip, fix=fix),
         Ts=Ts,
         radius=radius,
         freq=freq,

@@ -5,14 +5,14 @@ rest of adaptimp never imports it.
 
 - :class:`Plant` wraps a MuJoCo model of a serial arm with n ≤ 7 hinge joints,
   one torque actuator (``motor``) per joint: it reads τmax from the actuators'
-  ``ctrlrange``, lets MuJoCo's constraint solver compute contact, and measures
-  the force the arm exerts on its environment, mapped to joint space as
-  τe = Jᵀ F_e.
-- :func:`simulate` closes the loop: any controller with
-  ``.step(q, tau_e, dq=None, **setpoint)`` and a period ``.Ts`` (s),
-  or one of the paper's cases by name, runs at Ts with the torque held over
-  ``substeps`` MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12
-  metrics.
+  ``ctrlrange`` and says where the core's loop measures the force the arm
+  exerts on its environment (mapped to joint space as τe = Jᵀ F_e); MuJoCo's
+  constraint solver computes contact.
+- :func:`simulate` closes the loop, the core's (SPEC §13.1): any controller
+  with ``.step(q, tau_e, dq=None, **setpoint)`` and a period ``.Ts`` (s)
+  (:class:`ControllerLike`, called back once a period), or one of the
+  paper's cases by name, runs at Ts with the torque held over ``substeps``
+  MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12 metrics.
 - Models: :func:`two_link` (the paper's arm, packaged as ``models/two_link.xml``),
   :func:`panda` (the Franka Emika Panda of ``example-robot-data``, arm only, on a
   table), :func:`from_urdf` (any URDF arm, with motors from its effort limits).
@@ -23,14 +23,15 @@ if any, for the moment; without one the moment is taken as zero). MuJoCo's
 force/torque sensors measure the wrench between the site's body and its parent,
 so the site should sit on a massless body welded to the last link, holding the
 contact geometry: then the reading is exactly the contact wrench (the packaged
-models do this). Without a force sensor, F_e is the sum over the active
-contacts of the end-effector body's subtree with anything outside it of
-``mj_contactForce``, with the moment about the end-effector point (the first
-site on the last joint's body, or that body's origin): read from MuJoCo's
-contact list, or, for a model :class:`Plant` loads from a file and in which no
-contact can arise inside that subtree, from a contact sensor it adds (the net
-contact wrench on the subtree, ``reduce="netforce"``; it changes no dynamics),
-which the core's loop reads. :attr:`Plant.wrench_source` says which is used.
+models do this). Without a force sensor, F_e is the net force of the active
+contacts between the end-effector body's subtree and anything outside it,
+with the moment about the end-effector point (the first site on the last
+joint's body, or that body's origin): for a model :class:`Plant` loads from a
+file and in which no contact can arise inside that subtree, from a contact
+sensor it adds (the net contact wrench on the subtree, ``reduce="netforce"``;
+it changes no dynamics); otherwise from the external forces MuJoCo sums from
+its contact list on each body of the subtree (``cfrc_ext``: a contact inside
+the subtree cancels). :attr:`Plant.wrench_source` says which is used.
 
 Units: rad, rad/s, rad/s², N, N m, m, s. Vectors in the world frame.
 """
@@ -39,8 +40,9 @@ from __future__ import annotations
 
 import copy
 import math
+import numbers
 import os
-import time
+import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -50,14 +52,14 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._errors import ConfigError, needs_extra
+from ._errors import ConfigError, PlantWarning, needs_extra
 
 try:
     import mujoco
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
-from . import _adaptimp, _models
+from . import _adaptimp, _description, _mjcf, _models
 from ._faults import Fault
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
@@ -94,27 +96,37 @@ MAX_JOINTS = 7
 """The most joints a :class:`Plant` accepts."""
 
 
-ModelSource = Union["mujoco.MjModel", str, "os.PathLike[str]"]
+ModelSource = Union["mujoco.MjModel", "mujoco.MjSpec", str, "os.PathLike[str]"]
 
 
 class ControllerLike(Protocol):
-    """What :func:`simulate` needs of a controller: a step and a period.
+    """What :func:`simulate` needs of a controller written in Python: a step and
+    a period. The core's loop calls it back once a period (with the GIL taken
+    for the call; the rest of the loop runs without it).
 
-    ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,);
-    ``setpoint`` is ``xc=, dxc=, ddxc=`` when :func:`simulate` is given a
-    ``reference``, nothing otherwise (the controller then follows its own
-    trajectory). The period is ``.Ts`` (s; ``.ts`` is read, deprecated). Optional attributes
-    that :func:`simulate` records when present: ``tau`` (commanded torque
-    before saturation), ``xc`` and, without a ``reference``, ``dxc``, ``ddxc``
-    (the controller's own commanded rates), ``xd``, ``z1``, ``dq_hat``,
-    ``zeta``, and ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``,
-    ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
+    ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,)
+    (or one number for every joint; saturated by the motors); q, tau_e, dq
+    are what the loop's sensors read (with the disturbances of SPEC §17 and a
+    fault, if any); ``setpoint`` is ``xc=, dxc=, ddxc=`` (the row's) when
+    :func:`simulate` is given a ``reference``, nothing otherwise (the
+    controller then follows its own trajectory). The period is ``.Ts`` (s;
+    ``.ts`` is read, deprecated). Optional attributes that :func:`simulate`
+    records when present: ``zeta`` (read before the step), then, after it,
+    ``xc`` and, without a ``reference``, ``dxc``, ``ddxc`` (the controller's
+    own commanded rates), ``xd``, ``z1``, ``dq_hat``, ``tau`` (commanded
+    torque before saturation); and ``params`` (a dict; ``xc_offset``,
+    ``xc_sin``, ``xc_cos``, ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for
+    the metrics when present). An exception raised by ``step`` (or a torque of
+    another shape) ends the run with it; a torque that is not finite ends it
+    too (``ValueError``), unless a fault is injected: then the step is
+    refused, as the core's controllers' are, and zero torque applied.
 
     Cartesian hook: a controller with ``wants_wrench = True`` is called as
     ``step(q, dq, wrench, **setpoint)`` instead, with the measured wrench
     F_e = [f; m] (6,), N and N m, world frame (the plant's measurement of the
     row, the one τe is computed from) in place of τe, e.g.
-    :class:`adaptimp.CartesianController` (which maps it to the joints itself).
+    :class:`adaptimp.CartesianController` (which maps it to the joints
+    itself); its ``xc``, ``xd``, ``z1`` are then of width 3.
     """
 
     def step(
@@ -157,11 +169,6 @@ def _add_motors(spec: Any, effort: Mapping[str, float]) -> None:
         )
 
 
-def _urdf_spec(text: str, fix: tuple[str, ...] = ()) -> tuple[Any, dict[str, float]]:
-    urdf, effort = _models.adapt_urdf(text, fix)
-    return _spec_of(urdf), effort
-
-
 def _spec_of(urdf: str) -> Any:
     spec = mujoco.MjSpec.from_string(urdf)
     # Keep the URDF's fixed links as bodies: a force sensor needs its own body.
@@ -170,7 +177,7 @@ def _spec_of(urdf: str) -> Any:
     return spec
 
 
-def _compile_arm(spec: Any, note: str = "") -> mujoco.MjModel:
+def _compile_arm(spec: Any, note: str = "", *, stacklevel: int = 3) -> mujoco.MjModel:
     """``spec`` compiled; if a URDF's inertias do not compile as they are (a
     massless moving link, an inertia that violates the triangle inequality),
     compiled again with every body bounded and balanced (1e-6 kg, 1e-10 kg m²,
@@ -183,12 +190,10 @@ def _compile_arm(spec: Any, note: str = "") -> mujoco.MjModel:
         spec.compiler.boundinertia = 1e-10
         spec.compiler.balanceinertia = True
         model = spec.compile()
-        import warnings
-
         warnings.warn(
             f"the URDF's inertias do not compile as they are ({e}); every body now has "
             f"at least 1e-6 kg and 1e-10 kg m², and inertias are balanced{note}",
-            stacklevel=3,
+            stacklevel=stacklevel,
         )
         return model
 
@@ -198,71 +203,95 @@ EFFORT_ACCEL = 10.0
 (:func:`from_urdf`)."""
 
 
+def _urdf_arm(
+    path: str | os.PathLike[str], tip: str | None, fix: Sequence[str]
+) -> _description.Arm:
+    """The arm of a URDF (or xacro) file by the core's one reduction (SPEC §21)."""
+    arm = _description.read_arm(path, tip, fix)
+    if arm.urdf is None:
+        raise ValueError(
+            f"{arm.source} is not a URDF: from_urdf reads URDF and xacro files; give an MJCF "
+            "path to Plant or simulate directly"
+        )
+    if arm.n > MAX_JOINTS:
+        raise ValueError(
+            f"the URDF's arm has {arm.n} joints ({', '.join(arm.joints)}); "
+            f"adaptimp drives at most {MAX_JOINTS}: fix some with fix=(...)"
+        )
+    return arm
+
+
+def _arm_spec(arm: _description.Arm, timestep: float, *, drive: bool, stacklevel: int) -> Any:
+    """The MjSpec of a URDF arm (its reduced URDF, RK4 at ``timestep`` s),
+    with a motor per arm joint at ± its effort; where the URDF gives none,
+    the estimate of :func:`estimate_effort` on the arm itself, with a warning
+    at ``stacklevel``. With ``drive``, each arm joint's damping and friction
+    loss as the URDF's ``<dynamics>`` states them."""
+    text = arm.urdf_drive if drive else arm.urdf
+    assert text is not None
+    spec = _spec_of(text)
+    spec.option.timestep = timestep
+    missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
+    _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
+    if missing:
+        estimate = estimate_effort(_compile_arm(spec, stacklevel=stacklevel + 1))
+        for j, name in enumerate(arm.joints):
+            if name in missing:
+                spec.actuator(name).ctrlrange = [-estimate[j], estimate[j]]
+        warnings.warn(
+            f"the URDF gives no effort limit for {missing}: estimated "
+            f"{[round(float(estimate[arm.joints.index(j)]), 3) for j in missing]} N m "
+            "(2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within the joint limits)",
+            stacklevel=stacklevel,
+        )
+    return spec
+
+
 def from_urdf(
     path: str | os.PathLike[str],
     timestep: float = 1e-3,
     *,
     fix: tuple[str, ...] = (),
     tip: str | None = None,
+    drive: bool = False,
 ) -> mujoco.MjModel:
-    """A URDF arm as a MuJoCo model :class:`Plant` accepts.
+    """A URDF (or xacro) arm as a MuJoCo model :class:`Plant` accepts.
 
-    The arm is the URDF's serial chain of revolute and continuous joints
-    (:func:`adaptimp._models.arm_urdf`, one reduction for MuJoCo and
-    Pinocchio): the longest chain from the root, ending at a hand (a branch
-    into shorter chains); prismatic and mimic joints, a gripper's joints
-    (named gripper/finger/jaw/claw, after the arm's) and every joint off the
-    chain are fixed at their zero position, and so are the joints named in
-    ``fix``. Chains that tie for the longest (a quadruped's legs, two arms)
-    are an error listing the link each ends at: ``tip`` names the link that
-    ends the arm (the movable joints on the way to it are the arm's). A
-    revolute joint with no range (lower ≥ upper) is continuous.
-    Visual and collision elements, joint ``<dynamics>`` (damping, friction)
-    and mimic tags are dropped (the rigid-body dynamics
-    only, no mesh files; no contact geometry). Continuous joints are
-    unlimited hinges. If the inertias do not compile as they are (a massless
-    moving link, an inertia that violates the triangle inequality), every
-    body gets at least 1e-6 kg and 1e-10 kg m² and inertias are balanced
-    (MuJoCo's ``boundmass``, ``boundinertia``, ``balanceinertia``), with a
-    warning. Each arm joint gets a motor with ctrlrange ± its
-    ``<limit effort>`` (N m); where the URDF gives none (or zero) the limit is
-    estimated from the arm itself, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|)
-    over 256 postures within the joint limits (:func:`estimate_effort`), with
-    a warning. RK4 at ``timestep`` (s).
+    The arm is the one the core's reduction finds (SPEC §21, the same rule
+    for the chain, the computed-torque model and C): the longest chain of
+    revolute and continuous joints from the root, ending at a hand or a
+    gripper (recognised by its structure: mimic joints, a joint other joints
+    mimic, a jaw beside the tool frame, a branching hand; by name last);
+    every other joint held fixed at its zero position (mimic joints where
+    their master's zero puts them), and the joints named in ``fix``. Chains
+    that tie for the longest (a quadruped's legs, two arms) are an error
+    listing the link each ends at: ``tip`` names the link that ends the arm
+    (the movable joints on the way to it are the arm's). MuJoCo compiles the
+    reduced URDF the core writes: the links' inertials (no visual or
+    collision elements, so no mesh files and no contact geometry) and the
+    arm joints' limits: the rigid-body dynamics only, unless ``drive``
+    (then each arm joint's ``<dynamics>`` damping and friction loss as the
+    URDF states them; :class:`adaptimp.baselines.ComputedTorque` takes the
+    same ``drive``). Continuous joints are unlimited hinges. If the
+    inertias do not compile as they are (a massless moving link, an inertia
+    that violates the triangle inequality), every body gets at least 1e-6 kg
+    and 1e-10 kg m² and inertias are balanced (MuJoCo's ``boundmass``,
+    ``boundinertia``, ``balanceinertia``), with a warning. Each arm joint
+    gets a motor with ctrlrange ± its ``<limit effort>`` (N m); where the
+    URDF gives none (or zero) the limit is estimated from the arm itself,
+    2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) over 256 postures within the
+    joint limits (:func:`estimate_effort`), with a warning. RK4 at
+    ``timestep`` (s).
 
     Raises
     ------
     ValueError
         The URDF has no revolute or continuous joint to drive, more than
-        :data:`MAX_JOINTS` on its longest chain, or several chains that tie
-        for the longest and no ``tip``.
+        :data:`MAX_JOINTS` on its arm, or several chains that tie for the
+        longest and no ``tip`` (the message names the file and what to do).
     """
-    arm = _models.arm_urdf(Path(path).read_text(), fix, tip=tip)
-    if len(arm.joints) > MAX_JOINTS:
-        raise ValueError(
-            f"the URDF's arm has {len(arm.joints)} joints ({', '.join(arm.joints)}); "
-            f"adaptimp drives at most {MAX_JOINTS}: fix some with fix=(...)"
-        )
-    spec = _spec_of(arm.text)
-    spec.option.timestep = timestep
-    missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
-    _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
-    model = _compile_arm(spec)
-    if missing:
-        estimate = estimate_effort(model)
-        for j, name in enumerate(arm.joints):
-            if name in missing:
-                a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
-                model.actuator_ctrlrange[a] = [-estimate[j], estimate[j]]
-        import warnings
-
-        warnings.warn(
-            f"the URDF gives no effort limit for {missing}: estimated "
-            f"{[round(float(estimate[arm.joints.index(j)]), 3) for j in missing]} N m "
-            "(2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within the joint limits)",
-            stacklevel=2,
-        )
-    return model
+    arm = _urdf_arm(path, tip, fix)
+    return _compile_arm(_arm_spec(arm, timestep, drive=drive, stacklevel=3))
 
 
 def _limits(model: mujoco.MjModel, joints: Sequence[int]) -> tuple[FloatArray, FloatArray]:
@@ -345,10 +374,9 @@ def panda(
     timestep : float
         MuJoCo's timestep (s); :func:`simulate` resets it to Ts / substeps.
     """
-    spec, effort = _urdf_spec(_models.panda_urdf_path().read_text(), fix=_models.PANDA_FINGERS)
+    arm = _urdf_arm(_models.panda_urdf_path(), _models.PANDA_EE, _models.PANDA_FINGERS)
+    spec = _arm_spec(arm, timestep, drive=False, stacklevel=2)
     spec.modelname = "panda"
-    spec.option.timestep = timestep
-    _add_motors(spec, effort)
     tcp = spec.body(_models.PANDA_EE)
     tcp.add_site(name="ee", size=[0.01, 0, 0])
     tcp.add_geom(
@@ -387,15 +415,21 @@ def panda(
     return spec.compile()
 
 
-def _load(source: ModelSource) -> mujoco.MjModel:
+def _prepare(source: ModelSource, tip: str | None, fix: tuple[str, ...]) -> _mjcf.Prepared:
+    """The plant's model of ``source`` (SPEC §18, ``adaptimp._mjcf``): an MJCF
+    file edited in memory (joints that are not the arm's locked, one torque
+    motor per arm joint), a URDF through :func:`from_urdf` (``tip`` a link),
+    a given ``MjModel`` or a packaged model checked (servos made motors)."""
     if isinstance(source, mujoco.MjModel):
-        return copy.deepcopy(source)
+        return _mjcf.prepare_model(source, tip, fix)
+    if isinstance(source, mujoco.MjSpec):
+        return _mjcf.prepare_spec(source.copy(), tip, fix)
     if isinstance(source, str) and source in _BUILTIN:
-        return _BUILTIN[source]()
+        return _mjcf.prepare_model(_BUILTIN[source](), tip, fix)
     path = _model_path(source)
-    if path.suffix.lower() == ".urdf":
-        return from_urdf(path)
-    return mujoco.MjModel.from_xml_path(str(path))
+    if path.suffix.lower() in (".urdf", ".xacro"):
+        return _mjcf.prepare_model(from_urdf(path, fix=fix, tip=tip), tip, ())
+    return _mjcf.prepare_file(path, tip, fix)
 
 
 def _model_path(source: str | os.PathLike[str]) -> Path:
@@ -424,56 +458,121 @@ class Plant:
     """A MuJoCo model of a serial arm as the plant of a control loop.
 
     ``D(q) q̈ + C(q, q̇) q̇ + G(q) = sat(τ) − τe`` with everything MuJoCo adds
-    (contact, joint limits, whatever the model declares). The plant owns a copy
-    of the model (``model``) and its ``data``.
+    (contact, joint limits, joint damping, armature and friction loss, whatever
+    the model declares). The plant owns a copy of the model (``model``) and
+    its ``data``.
+
+    A model as its maker ships it (SPEC §18, ``docs/your_arm.md``): the arm is
+    the model's serial chain of hinge joints (:func:`adaptimp._mjcf.arm_of`,
+    the URDF reduction's rules on MuJoCo's body tree), ending at ``tip`` if
+    given. Joints of the arm's own body tree that are not the arm's (a
+    gripper's fingers, coupled joints, a slide, a head) are **locked at their
+    reference position** (removed from an in-memory copy of the file with
+    their actuators, couplings and sensors: the hand is then one rigid body,
+    as the controller's model of the arm has it, and no finger swings
+    unmodelled on the wrist). Every arm joint is driven by **one torque
+    motor**: a ``motor`` as it is; a ``position``, ``velocity`` or
+    ``general`` actuator becomes a motor of the same force range (the
+    controller commands torque); a joint without one gets one. τmax is gear ×
+    the actuator's ``forcerange`` (a motor's ``ctrlrange``), or the joint's
+    ``actuatorfrcrange`` if smaller; where nothing declares it, it is
+    estimated from the arm, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within
+    the joint limits. Each change is a :class:`adaptimp.PlantWarning` and an
+    entry of :attr:`notes` (``res.params["plant"]``); the file is never
+    written. Joints on other body trees (a door, a table on a spring) are the
+    environment's and stay as they are.
 
     Parameters
     ----------
-    model : MjModel, str or path
-        An ``MjModel``; ``"two_link"`` or ``"panda"`` (the packaged models, see
+    model : MjModel, MjSpec, str or path
+        An ``MjModel``; an ``MjSpec`` (e.g. an arm with a gripper attached; a
+        copy is edited); ``"two_link"`` or ``"panda"`` (the packaged models, see
         :func:`two_link`, :func:`panda`); or a path to an MJCF file, or to a
-        URDF (compiled by :func:`from_urdf`).
+        URDF (compiled by :func:`from_urdf`). A compiled ``MjModel`` cannot
+        lose joints or gain actuators: one whose arm tree holds joints that
+        are not the arm's, or an arm joint without an actuator, is refused
+        (give the file's path instead).
     contact : bool
         False disables every contact (MuJoCo's ``mjDSBL_CONTACT``): free space.
+    tip : str, optional
+        The end effector, a site or a body (its origin; a site if both have
+        the name): the arm is the hinges on the way to it. Default: the site of
+        the model's force sensor, or the first site of the last joint's body,
+        or that body's origin. A URDF's ``tip`` is a link.
+    fix : tuple of str
+        Joints to lock as well (at their reference position), by name.
     site : str, optional
-        The end-effector site; by default the site of the model's force sensor,
-        or the first site of the last joint's body, or that body's origin.
+        The end-effector site (the earlier name of ``tip`` for a site).
 
     Raises
     ------
     ValueError
         The model is not an arm this class can drive; the message names the
-        offending joint or actuator (joints must all be hinges, at most
-        :data:`MAX_JOINTS`, along one kinematic chain; every joint needs exactly
-        one torque actuator: a ``motor``, ``ctrllimited`` with a symmetric
-        ``ctrlrange``).
+        file, joint, body or actuator and what to do (at most
+        :data:`MAX_JOINTS` arm joints along one kinematic chain, one joint per
+        body; one actuator per arm joint; a force range symmetric about 0).
 
     Attributes
     ----------
     n : int
         Number of joints.
+    joint_names : list of str
+        The arm's joints, base to tip.
     tau_max : ndarray, (n,)
-        Actuator limits τmax (N m): gear × ctrlrange.
+        Actuator limits τmax (N m): gear × ctrlrange of the plant's motors.
     wrench_source : str
         ``"sensor"`` (force/torque sensor), ``"contact sensor"`` (the net contact
         wrench on the end effector's subtree, a MuJoCo contact sensor) or
-        ``"contact"`` (MuJoCo's contact list, ``mj_contactForce``).
+        ``"contact"`` (the contacts' forces on the subtree's bodies, which
+        MuJoCo sums from its contact list: ``cfrc_ext``).
+    tip : str or None
+        The end effector asked for (``tip`` or ``site``; None: found as above).
     site : str or None
-        The end-effector site asked for (None: found as above).
+        The end-effector site asked for with ``site=``.
+    notes : dict
+        What the plant made of the model: "locked" {joint: why}, "actuators"
+        {joint: servo → motor}, "added" [joints given a motor], "tau_max"
+        {joint: where τmax comes from: "forcerange", "ctrlrange",
+        "actuatorfrcrange" or "estimated"}, "timestep" (a file's Euler or
+        implicit integrator is stepped at ≤ 0.25 ms,
+        :data:`adaptimp._mjcf.FIRST_ORDER_STEP`), "wrench" (a force sensor
+        not used), "warnings" [their texts], "tip".
     """
 
     def __init__(
-        self, model: ModelSource = "two_link", *, contact: bool = True, site: str | None = None
+        self,
+        model: ModelSource = "two_link",
+        *,
+        contact: bool = True,
+        site: str | None = None,
+        tip: str | None = None,
+        fix: Sequence[str] = (),
     ) -> None:
+        if site is not None and tip is not None:
+            raise ValueError("give the end effector as tip= (a site or a body) or site=, not both")
+        if isinstance(fix, str):
+            raise TypeError(f"fix must be a tuple of joint names, got the string {fix!r}")
         self.contact = contact
         self.site = site
-        self._setup_model(_load(model), site)
+        self.tip = tip if tip is not None else site
+        self.fix = tuple(fix)
+        prepared = _prepare(model, self.tip, self.fix)
+        self._arm_names: tuple[str, ...] = prepared.arm["joints"]
+        self.notes: dict[str, Any] = {**prepared.notes, "warnings": list(prepared.warnings)}
+        for text in prepared.warnings:
+            warnings.warn(text, PlantWarning, stacklevel=2)
+        self._setup_model(prepared.model, self.tip)
+        self.notes["tip"] = (
+            _name(self.model, mujoco.mjtObj.mjOBJ_SITE, self._site)
+            if self._site >= 0
+            else _name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body)
+        )
         if self.wrench_source == "contact" and self._contact_sensor_fits(model):
-            # An MJCF file's model: measure the contacts with a sensor of its own
-            # (the net contact wrench on the end effector's subtree), which the
-            # core's loop reads like the force sensor. A sensor changes no dynamics.
-            assert isinstance(model, (str, os.PathLike))
-            spec = mujoco.MjSpec.from_file(str(model))
+            # A file's model: measure the contacts with a sensor of its own (the
+            # net contact wrench on the end effector's subtree), which the core's
+            # loop reads like the force sensor. A sensor changes no dynamics.
+            spec = prepared.spec
+            assert spec is not None
             spec.add_sensor(
                 name=_CONTACT_SENSOR,
                 type=mujoco.mjtSensor.mjSENS_CONTACT,
@@ -481,27 +580,31 @@ class Plant:
                 objname=_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
                 intprm=[_NETFORCE_DATA, _NETFORCE, 1],
             )
-            self._setup_model(spec.compile(), site)
+            self._setup_model(spec.compile(), self.tip)
         m = self.model
         self.data = mujoco.MjData(m)
-        self._jac = np.zeros((6, m.nv))
-        self._jacp, self._jacr = self._jac[:3], self._jac[3:]
         self._mass = np.zeros((m.nv, m.nv))
         self.reset()
 
     # -- construction checks ------------------------------------------------
 
-    def _setup_model(self, model: mujoco.MjModel, site: str | None) -> None:
+    @property
+    def joint_names(self) -> list[str]:
+        """The arm's joints, base to tip (the order of q)."""
+        return [_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self._joints]
+
+    def _setup_model(self, model: mujoco.MjModel, tip: str | None) -> None:
         self.model = model
         if not self.contact:
             model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         self._check_joints()
         self._check_actuators()
-        self._find_end_effector(site)
+        self._find_end_effector(tip)
 
     def _contact_sensor_fits(self, source: ModelSource) -> bool:
-        """Whether a contact sensor can measure this plant's wrench exactly as
-        :meth:`contact_wrench` defines it: the model comes from an MJCF file (so
+        """Whether a contact sensor can measure this plant's wrench as the module
+        doc defines it (the contacts of the subtree with anything outside it):
+        the model comes from an MJCF file (so
         it can be rebuilt with the sensor; :func:`from_urdf` gives no contact
         geometry), a contact can reach the end effector, and no contact can
         arise inside its subtree (the sensor would count it; the contact list
@@ -509,7 +612,8 @@ class Plant:
         the subtree on different weld bodies whose contype and conaffinity meet."""
         if isinstance(source, mujoco.MjModel) or (isinstance(source, str) and source in _BUILTIN):
             return False
-        if Path(source).suffix.lower() == ".urdf":
+        suffix = "" if isinstance(source, mujoco.MjSpec) else Path(source).suffix.lower()
+        if suffix in (".urdf", ".xacro"):
             return False
         m = self.model
         if m.npair > 0 or not self._contact_possible():
@@ -523,45 +627,26 @@ class Plant:
             for b in inside[i + 1 :]
         )
 
-    def _environment_joints(self) -> set[int]:
-        """Joints of the environment, not of the arm: unactuated, on a body tree
-        hanging from the world that holds no actuated joint (e.g. a table on a
-        spring, ``adaptimp.contact``)."""
-        m = self.model
-        joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
-        actuated = {
-            int(m.actuator_trnid[a, 0]) for a in range(m.nu) if m.actuator_trntype[a] == joint_trn
-        }
-
-        def root(body: int) -> int:
-            while int(m.body_parentid[body]) > 0:
-                body = int(m.body_parentid[body])
-            return body
-
-        arm_roots = {root(int(m.jnt_bodyid[j])) for j in actuated}
-        return {
-            j
-            for j in range(m.njnt)
-            if j not in actuated and root(int(m.jnt_bodyid[j])) not in arm_roots
-        }
-
     def _check_joints(self) -> None:
         m = self.model
+        ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in self._arm_names]
+        if not 1 <= len(ids) <= MAX_JOINTS:
+            raise ValueError(
+                f"Plant needs 1 to {MAX_JOINTS} joints; the arm has {len(ids)} "
+                f"({', '.join(self._arm_names)}): fix some with fix=(...) or name the "
+                "arm's end with tip="
+            )
         hinge = int(mujoco.mjtJoint.mjJNT_HINGE)
-        env = self._environment_joints()
-        arm = [j for j in range(m.njnt) if j not in env]
         bad = [
             f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)} ({mujoco.mjtJoint(m.jnt_type[j]).name})"
-            for j in arm
+            for j in ids
             if m.jnt_type[j] != hinge
         ]
         if bad:
             raise ValueError(f"Plant needs hinge joints only; not hinges: {', '.join(bad)}")
-        if not 1 <= len(arm) <= MAX_JOINTS:
-            raise ValueError(f"Plant needs 1 to {MAX_JOINTS} joints, the model has {len(arm)}")
-        self.n = len(arm)
+        self.n = len(ids)
         # Joints in kinematic order (hinges: one qpos and one dof each).
-        self._joints = sorted(arm, key=lambda j: int(m.jnt_dofadr[j]))
+        self._joints = sorted(ids, key=lambda j: int(m.jnt_dofadr[j]))
         self._qadr = np.array([m.jnt_qposadr[j] for j in self._joints])
         self._dofs = np.array([m.jnt_dofadr[j] for j in self._joints])
         bodies = [int(m.jnt_bodyid[j]) for j in self._joints]
@@ -582,25 +667,16 @@ class Plant:
         return out
 
     def _check_actuators(self) -> None:
+        """The arm joints' motors (one each, :func:`_prepare` made them), their
+        gear and τmax; actuators of the environment are left alone (zero
+        control)."""
         m = self.model
         joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
         act_of: dict[int, list[int]] = {j: [] for j in self._joints}
         for a in range(m.nu):
-            name = _name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)
-            if m.actuator_trntype[a] != joint_trn:
-                raise ValueError(f"actuator {name!r} does not act on a joint")
-            motor = (
-                m.actuator_dyntype[a] == int(mujoco.mjtDyn.mjDYN_NONE)
-                and m.actuator_gaintype[a] == int(mujoco.mjtGain.mjGAIN_FIXED)
-                and m.actuator_biastype[a] == int(mujoco.mjtBias.mjBIAS_NONE)
-                and m.actuator_gainprm[a, 0] == 1.0
-            )
-            if not motor:
-                raise ValueError(
-                    f"actuator {name!r} is not a torque actuator: use <motor> (no dynamics, "
-                    "gain 1, no bias)"
-                )
-            act_of[int(m.actuator_trnid[a, 0])].append(a)
+            target = int(m.actuator_trnid[a, 0])
+            if m.actuator_trntype[a] == joint_trn and target in act_of:
+                act_of[target].append(a)
         self._act = np.zeros(self.n, dtype=int)
         self._gear = np.zeros(self.n)
         self.tau_max = np.zeros(self.n)
@@ -624,29 +700,30 @@ class Plant:
             self._gear[i] = gear
             self.tau_max[i] = gear * hi
 
-    def _find_end_effector(self, site: str | None) -> None:
+    def _find_end_effector(self, tip: str | None) -> None:
         m = self.model
         force = int(mujoco.mjtSensor.mjSENS_FORCE)
         torque = int(mujoco.mjtSensor.mjSENS_TORQUE)
-        on_site = int(mujoco.mjtObj.mjOBJ_SITE)
-        sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
-        if site is not None:
-            sid = mujoco.mj_name2id(m, on_site, site)
-            if sid < 0:
-                raise ValueError(f"the model has no site {site!r}")
-            sensors = [s for s in sensors if m.sensor_objid[s] == sid]
-        elif sensors:
-            sid = int(m.sensor_objid[sensors[0]])
-        else:
-            on_last = [s for s in range(m.nsite) if m.site_bodyid[s] == self._last_body]
-            sid = on_last[0] if on_last else -1
+        sid, self._ee_body = _mjcf.end_effector(m, tip, self._last_body)
         self._site = sid
-        self._ee_body = int(m.site_bodyid[sid]) if sid >= 0 else self._last_body
+        sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
+        sensors = [s for s in sensors if m.sensor_objid[s] == sid and sid >= 0]
+        carried = float(m.body_subtreemass[self._ee_body])
+        if sensors and carried > 0:
+            # The sensor reads the force between the site's body and its parent:
+            # with mass below it (a gripper) that is gravity and inertia too, not
+            # the contact wrench. The contacts are measured instead.
+            name = _name(m, mujoco.mjtObj.mjOBJ_SENSOR, sensors[0])
+            self.notes["wrench"] = (
+                f"the force sensor {name!r} carries {carried:.3g} kg below it (it reads "
+                "gravity and inertia as well as contact): the wrench comes from the contacts"
+            )
+            sensors = []
         self._force_adr = int(m.sensor_adr[sensors[0]]) if sensors else -1
         torques = [
             s
             for s in range(m.nsensor)
-            if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sid >= 0
+            if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sensors
         ]
         self._torque_adr = int(m.sensor_adr[torques[0]]) if torques else -1
         subtree = [
@@ -710,11 +787,6 @@ class Plant:
         return np.array(self.data.qvel[self._dofs], dtype=np.float64)
 
     @property
-    def ddq(self) -> FloatArray:
-        """Joint accelerations (rad/s²), (n,), of the last :meth:`forward`."""
-        return np.array(self.data.qacc[self._dofs], dtype=np.float64)
-
-    @property
     def timestep(self) -> float:
         """MuJoCo's timestep (s)."""
         return float(self.model.opt.timestep)
@@ -725,80 +797,7 @@ class Plant:
             raise ValueError(f"timestep must be > 0, got {value}")
         self.model.opt.timestep = value
 
-    # -- dynamics ------------------------------------------------------------
-
-    def forward(self) -> None:
-        """``mj_forward``: kinematics, contact, sensors and q̈ at the current
-        state and applied torque."""
-        mujoco.mj_forward(self.model, self.data)
-
-    def apply(self, tau: ArrayLike) -> FloatArray:
-        """Hold the torque sat(τ) (N m), (n,), from now on; returns sat(τ)."""
-        tau = np.asarray(tau, dtype=np.float64)
-        if tau.shape != (self.n,) or not math.isfinite(float(tau.sum())):
-            tau = self._vector("tau", tau)  # raises the precise error
-        tau_sat = np.minimum(np.maximum(tau, -self.tau_max), self.tau_max)
-        self.data.ctrl[self._act] = tau_sat / self._gear
-        return tau_sat
-
-    def step(self, substeps: int = 1, *, row: int | None = None, Ts: float | None = None) -> None:
-        """Advance ``substeps`` MuJoCo steps with the applied torque held.
-
-        MuJoCo resets its state on a bad position, velocity or acceleration
-        and only counts a warning (``data.warning``); a step after which
-        MuJoCo warned, whose time did not advance by ``substeps`` timesteps,
-        or whose state is not finite raises.
-
-        Parameters
-        ----------
-        substeps : int
-            MuJoCo steps.
-        row, Ts : int and float, optional
-            The loop's row k and period (s), named in the error.
-
-        Raises
-        ------
-        DivergedError
-            Naming the row (if given), the time and MuJoCo's warning with its
-            joint (e.g. "Nan, Inf or huge value in QACC at DOF 1 … (joint
-            'j1')").
-        """
-        m, d = self.model, self.data
-        before = d.warning.number.copy()
-        t0 = expected = float(d.time)
-        for _ in range(substeps):
-            mujoco.mj_step(m, d)
-            expected += m.opt.timestep
-        warned = np.flatnonzero(d.warning.number != before)
-        reset = abs(float(d.time) - expected) > 0.5 * m.opt.timestep
-        finite = math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum()))
-        if warned.size == 0 and not reset and finite:
-            return
-        from ._errors import DivergedError
-
-        if warned.size:
-            i = int(warned[0])
-            info = int(d.warning.lastinfo[i])
-            name = mujoco.mjtWarning(i).name
-            text = mujoco.mju_warningText(i, max(info, 0))
-            joint = ""
-            if name in _DOF_WARNINGS and 0 <= info < m.nv:
-                joint = f' (joint "{_name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[info]))}")'
-            now, want = _num(d.time), _num(expected)
-            note = f"; MuJoCo reset its state (its time is {now} s, not {want} s)" if reset else ""
-            cause = f"MuJoCo warned {name}: {text}{joint}{note}"
-        elif not finite:
-            cause = "the state is not finite"
-        else:
-            now, want = _num(d.time), _num(expected)
-            cause = f"MuJoCo's time is {now} s, not {want} s (its state was reset)"
-        if row is None or Ts is None:
-            where = f"from t = {_num(t0)} s"
-        else:
-            where = (
-                f"in the period of row {row} (t = {_num(row * Ts)} s to {_num((row + 1) * Ts)} s)"
-            )
-        raise DivergedError(f"the MuJoCo plant diverged {where}: {cause}")
+    # -- the model, as the core's loop and the rule read it -------------------
 
     def _contact_possible(self) -> bool:
         """Whether a contact can involve the end effector's subtree (contact
@@ -814,14 +813,15 @@ class Plant:
         ct, ca = m.geom_contype, m.geom_conaffinity
         return any((ct[a] & ca[b]) or (ct[b] & ca[a]) for a in inside for b in outside)
 
-    def _native(self, substeps: int) -> dict[str, Any] | None:
-        """The plant as the core's native loop takes it (SPEC §13.1), or None
-        if the core cannot measure its wrench (no force sensor and contacts
-        possible: the contact path reads MuJoCo's contact list, which only
-        the Python loop does)."""
+    def _core_spec(self, substeps: int) -> dict[str, Any]:
+        """The plant as the core's loop drives it (SPEC §13.1): where its joints,
+        motors and end effector are, and where the wrench is read: the force
+        (and torque) sensor, the contact sensor, or, without either when a
+        contact can reach the end effector, the external forces MuJoCo sums
+        from its contact list on each body of the end effector's subtree
+        (``subtree``, ``cfrc_ext``)."""
         m = self.model
-        if self.wrench_source == "contact" and self._contact_possible():
-            return None
+        listed = self.wrench_source == "contact" and self._contact_possible()
         return {
             "qadr": [int(a) for a in self._qadr],
             "dofs": [int(a) for a in self._dofs],
@@ -833,6 +833,8 @@ class Plant:
             "force_adr": int(self._force_adr) if self._force_adr >= 0 else None,
             "torque_adr": int(self._torque_adr) if self._torque_adr >= 0 else None,
             "contact_adr": int(self._contact_adr) if self._contact_adr >= 0 else None,
+            "subtree": sorted(int(b) for b in self._ee_subtree) if listed else [],
+            "root": int(m.body_rootid[self._ee_body]),
             "substeps": int(substeps),
             "timestep": float(m.opt.timestep),
             "integrator": int(m.opt.integrator),
@@ -850,116 +852,6 @@ class Plant:
     def bias(self) -> FloatArray:
         """C(q, q̇) q̇ + G(q) (N m), (n,), of the last :meth:`forward`."""
         return np.array(self.data.qfrc_bias[self._dofs], dtype=np.float64)
-
-    # -- end effector ----------------------------------------------------------
-
-    def ee_position(self) -> FloatArray:
-        """End-effector point (m), (3,), in the world frame."""
-        d = self.data
-        point = d.site_xpos[self._site] if self._site >= 0 else d.xpos[self._ee_body]
-        return np.array(point, dtype=np.float64)
-
-    def jacobian(self) -> FloatArray:
-        """End-effector Jacobian (6, n): linear velocity of the end-effector point
-        (m/s) over angular velocity (rad/s), world frame, per joint velocity."""
-        m, d = self.model, self.data
-        if self._site >= 0:
-            mujoco.mj_jacSite(m, d, self._jacp, self._jacr, self._site)
-        else:
-            mujoco.mj_jacBody(m, d, self._jacp, self._jacr, self._ee_body)
-        return self._jac[:, self._dofs]
-
-    def wrench(self) -> FloatArray:
-        """F_e = [f; m], (6,): the force (N) and the moment about the end-effector
-        point (N m) that the arm exerts on its environment, world frame, of the
-        last :meth:`forward` (from the sensor or the contacts, see the module doc)."""
-        if self._force_adr >= 0:
-            return self.sensor_wrench()
-        if self._contact_adr >= 0:
-            return self.contact_sensor_wrench()
-        return self.contact_wrench()
-
-    def contact_sensor_wrench(self) -> FloatArray:
-        """F_e (6,) from the model's contact sensor of the net contact wrench on the
-        end effector's subtree (force f and torque t about the force-weighted
-        centroid c of the contacts, world frame): [f; t + (c − p) × f], p the
-        end-effector point (summed in the order of the core's native loop).
-
-        Raises
-        ------
-        ValueError
-            The model has no such sensor.
-        """
-        if self._contact_adr < 0:
-            raise ValueError("the model has no contact sensor at the end effector")
-        a = self._contact_adr
-        f, t, c = (self.data.sensordata[a + 3 * i : a + 3 * i + 3] for i in range(3))
-        d = c - self.ee_position()
-        out = np.zeros(6)
-        out[:3] = f
-        out[3] = t[0] + (d[1] * f[2] - d[2] * f[1])
-        out[4] = t[1] + (d[2] * f[0] - d[0] * f[2])
-        out[5] = t[2] + (d[0] * f[1] - d[1] * f[0])
-        return out
-
-    def sensor_wrench(self) -> FloatArray:
-        """F_e (6,) from the force/torque sensors (world frame; see :meth:`wrench`).
-
-        MuJoCo's force sensor gives the force of the site's body on its parent,
-        in the site frame: for a massless end-effector body, the force it exerts
-        on the environment.
-
-        Raises
-        ------
-        ValueError
-            The model has no force sensor at the end effector.
-        """
-        d = self.data
-        if self._force_adr < 0:
-            raise ValueError("the model has no force sensor at the end effector")
-        out = np.zeros(6)
-        rot = d.site_xmat[self._site].reshape(3, 3)
-        out[:3] = _rotate(rot, d.sensordata[self._force_adr : self._force_adr + 3])
-        if self._torque_adr >= 0:
-            out[3:] = _rotate(rot, d.sensordata[self._torque_adr : self._torque_adr + 3])
-        return out
-
-    def contact_wrench(self) -> FloatArray:
-        """F_e (6,) summed over the active contacts of the end-effector body's
-        subtree with anything else, by ``mj_contactForce`` (world frame; the
-        moment about the end-effector point)."""
-        m, d = self.model, self.data
-        out = np.zeros(6)
-        point = self.ee_position()
-        local = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            if c.efc_address < 0:
-                continue
-            b1 = int(m.geom_bodyid[c.geom1]) in self._ee_subtree
-            b2 = int(m.geom_bodyid[c.geom2]) in self._ee_subtree
-            if b1 == b2:
-                continue
-            mujoco.mj_contactForce(m, d, i, local)
-            frame = c.frame.reshape(3, 3)
-            # The force geom1 exerts on geom2, rotated from the contact frame.
-            f = frame.T @ local[:3]
-            t = frame.T @ local[3:]
-            sign = 1.0 if b1 else -1.0
-            out[:3] += sign * f
-            out[3:] += sign * (np.cross(c.pos - point, f) + t)
-        return out
-
-    def tau_e(self, wrench: FloatArray | None = None) -> FloatArray:
-        """τe = Jᵀ F_e (N m), (n,): the wrench on the environment in joint space
-        (of :meth:`wrench`, or of ``wrench`` if given)."""
-        w = self.wrench() if wrench is None else np.asarray(wrench, dtype=np.float64)
-        jac = self.jacobian()
-        # Σ_r J[r, i] F[r] in the order of the core's native loop (the same bits).
-        out = jac[0] * w[0]
-        for r in range(1, 6):
-            out = out + jac[r] * w[r]
-        return np.asarray(out, dtype=np.float64)
 
     def __repr__(self) -> str:
         name = self.model.names[: self.model.names.find(b"\0")].decode() or "model"
@@ -989,21 +881,6 @@ _NETFORCE_DATA = sum(
 def _warning_names() -> list[str]:
     """MuJoCo's warning kinds by index (``mjtWarning``, without ``mjNWARNING``)."""
     return [mujoco.mjtWarning(i).name for i in range(int(mujoco.mjtWarning.mjNWARNING))]
-
-
-def _num(x: float) -> str:
-    """A float as the core's messages print it (Rust's shortest form: 0, 0.001)."""
-    text = repr(float(x))
-    return text[:-2] if text.endswith(".0") else text
-
-
-def _rotate(rot: FloatArray, v: FloatArray) -> FloatArray:
-    """R v for a 3 × 3 R, summed in the order of the core's native loop (the same bits)."""
-    return np.asarray(rot[:, 0] * v[0] + rot[:, 1] * v[1] + rot[:, 2] * v[2], dtype=np.float64)
-
-
-_DOF_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC", "mjWARN_INERTIA")
-"""MuJoCo's warnings whose info is a DOF (hinges: the joint's qpos and DOF index agree)."""
 
 
 def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
@@ -1112,36 +989,80 @@ HOME_LOAD = 0.5
 """The zero posture is the home posture if gravity takes at most this share of
 every effort limit over the task's swing (:func:`home_posture`)."""
 
+HOME_CLEARANCE = 0.005
+"""The clearance (m) the default task keeps between bodies that the arm moves
+relative to each other (:func:`home_posture`)."""
+
+SWING_SAMPLES = 21
+"""Postures along the swing q − A … q + A at which :func:`home_posture` checks
+for contact."""
+
 
 def home_posture(plant: Plant) -> FloatArray:
     """A posture inside the joint limits where gravity is well within the
-    effort limits (SPEC §18). The gravity load of a posture q is the largest
-    max_i |G_i|/τmax_i over the task's swing (q − A, q, q + A). Every posture
-    is kept A = min(0.2 rad, range/4) inside each limit (a continuous joint
-    ranges over [−π, π]). The zero posture (the URDF's reference, clipped
-    into that box) if its load is at most :data:`HOME_LOAD`; else, of it, the
-    box's middle and 254 fixed-seed samples, the one of least load.
+    effort limits and the task's swing touches nothing (SPEC §18). The
+    gravity load of a posture q is the largest max_i |G_i|/τmax_i over the
+    task's swing (q − A, q, q + A). Every posture is kept A = min(0.2 rad,
+    range/4) inside each limit (a continuous joint ranges over [−π, π]).
+    With contact on, a posture qualifies only if, at :data:`SWING_SAMPLES`
+    postures along its swing q − A … q + A, no two bodies that the arm's
+    joints move relative to each other (the arm and itself, or the arm and
+    what is around it) come within :data:`HOME_CLEARANCE` of each other, by
+    the model's own collision geometry and filters. The zero posture (the
+    model's reference, clipped into the box) if it qualifies and its load is
+    at most :data:`HOME_LOAD`; else the nearest qualifying posture of load at
+    most :data:`HOME_LOAD` among 255 fixed-seed samples of the box drawn in
+    towards it (the k-th by k/255 of the way out); else the qualifying one
+    of least load.
 
     Raises
     ------
     ValueError
-        Gravity exceeds an effort limit at every posture compared: the arm
-        cannot hold itself anywhere (the message gives the best load).
+        Gravity exceeds an effort limit at every qualifying posture (the
+        message gives the best load), or every posture's swing touches (the
+        message names the bodies: give ``home=``).
     """
     m = plant.model
     lo, hi = _limits(m, plant._joints)
     width = np.where(np.isfinite(hi - lo), hi - lo, 2 * math.pi)
     amp = np.minimum(0.25 * width, TASK_AMPLITUDE)
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
+    contacts = _mjcf.Contacts(m, saved[0], plant._joints, margin=HOME_CLEARANCE)
+    swing = np.linspace(-1.0, 1.0, SWING_SAMPLES)
+    touching: list[tuple[str, str, float]] = []
+
+    def clear(q: FloatArray) -> bool:
+        found = [c for s in swing for c in contacts.at(q + s * amp)]
+        touching.extend(found)
+        return not found
+
+    samples = _postures(lo, hi, HOME_SAMPLES, amp)
+    zero = samples[0]
+    # Nearest the zero posture first: the samples drawn in towards it, the
+    # k-th by k/(K − 1) of the way out.
+    grow = np.arange(HOME_SAMPLES, dtype=np.float64)[:, None] / (HOME_SAMPLES - 1)
+    near = zero + grow * (samples - zero)
+    loads = [max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0)) for q in near]
     best, best_load = None, math.inf
-    for k, q in enumerate(_postures(lo, hi, HOME_SAMPLES, amp)):
-        load = max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0))
-        if load < best_load:
+    for q, load in zip(near, loads):
+        if load <= HOME_LOAD and clear(q):
             best, best_load = q, load
-        if k == 0 and load <= HOME_LOAD:
             break
+    if best is None:
+        for k in np.argsort(loads, kind="stable"):
+            if loads[k] < 1.0 and clear(near[k]):
+                best, best_load = near[k], loads[k]
+                break
+        else:
+            best_load = min(loads)
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(m, plant.data)
+    if best is None and touching:
+        raise ValueError(
+            f"the default task's swing (±A about the home posture) brings the arm's bodies "
+            f"within {HOME_CLEARANCE:g} m of each other at every posture compared "
+            f"({_mjcf.pairs(touching)}): give home= (rad), or simulate with contact=False"
+        )
     if best is None or best_load >= 1.0:
         raise ValueError(
             f"gravity exceeds the effort limits at every posture compared: the least "
@@ -1299,15 +1220,17 @@ class MujocoResult(SimResult):
         and rates, = ``xc``, ``dxc``, ``ddxc``), "pd", "dpd", "ddpd" (the compliant
         reference, ``xd`` = pd), "qd" (the joint reference, (K, n)), "wrench" (the
         F_e it was given, (K, 6)), "error" (the impedance's [e_p; e_o], (K, 6)).
-        None for a joint-space controller (and in the Python loop for a Cartesian
-        one with ``record=False``).
+        None for a joint-space controller (and for a Cartesian one called back
+        with ``record=False``).
     metrics : dict
         The SPEC §12 metrics, with the keys of :attr:`adaptimp.SimResult.metrics`
         (NaN where they do not apply: ``imp_err_rms_after2`` needs a joint-space
         reference).
     params : dict
         The run: ``Ts``, ``substeps``, ``timestep``, ``T``, ``settle``,
-        ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``controller``.
+        ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``controller``,
+        ``loop`` (``"native"``: the core stepped the controller;
+        ``"callback"``: the core's loop called a controller written in Python).
     """
 
     x_ee: FloatArray | None = None
@@ -1415,6 +1338,18 @@ def _native(ctrl: Any) -> bool:
     return isinstance(ctrl, _adaptimp.Controller) and type(ctrl).step is _adaptimp.Controller.step
 
 
+def _native_computed(ctrl: Any) -> bool:
+    """Whether the core can step ``ctrl`` as it is in joint space: an
+    :class:`adaptimp.baselines.ComputedTorque` (its own ``step``, the core's
+    law of SPEC §20)."""
+    baselines = sys.modules.get("adaptimp.baselines")
+    return (
+        baselines is not None
+        and isinstance(ctrl, baselines.ComputedTorque)
+        and isinstance(ctrl._core_joint, _adaptimp.ComputedTorque)
+    )
+
+
 def _native_cartesian(ctrl: Any) -> bool:
     """Whether the core can step ``ctrl`` as a whole: an
     :class:`adaptimp.CartesianController` (its own ``step``) in front of a
@@ -1430,14 +1365,17 @@ def _native_cartesian(ctrl: Any) -> bool:
 
 
 def _tabulate(
-    reference: Reference, steps: int, Ts: float
+    reference: Reference, steps: int, Ts: float, k0: int = 0
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """``reference(k·Ts)`` for every row k, as three (K, m) arrays (called in
-    order, once per row, as the loop would; a table's own rows)."""
-    if isinstance(reference, _Table) and math.isclose(reference.Ts, Ts, rel_tol=1e-12):
+    """``reference((k0 + k)·Ts)`` for every row k, as three (K, m) arrays
+    (called in order, once per row, as the loop would; a table's own rows)."""
+    if isinstance(reference, _Table) and math.isclose(reference.Ts, Ts, rel_tol=1e-12) and not k0:
         xc, dxc, ddxc = (np.ascontiguousarray(a[:steps]) for a in reference.arrays)
         return xc, dxc, ddxc
-    rows = [tuple(np.asarray(v, dtype=np.float64) for v in reference(k * Ts)) for k in range(steps)]
+    rows = [
+        tuple(np.asarray(v, dtype=np.float64) for v in reference((k0 + k) * Ts))
+        for k in range(steps)
+    ]
     xc, dxc, ddxc = (np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
     return xc, dxc, ddxc
 
@@ -1458,9 +1396,13 @@ def _payload_plant(nominal: Plant, payload: float) -> Plant:
         raise TypeError(f"payload must be a number (kg), got {type(payload).__name__}")
     if payload == 0:
         return nominal
-    return Plant(
-        with_payload(nominal.model, float(payload)), contact=nominal.contact, site=nominal.site
+    plant = Plant(
+        with_payload(nominal.model, float(payload), body=nominal._last_body),
+        contact=nominal.contact,
+        tip=nominal.tip,
     )
+    plant.notes = nominal.notes
+    return plant
 
 
 def _rule_setup(
@@ -1470,13 +1412,18 @@ def _rule_setup(
     reference: Any,
     Ts: float,
     T: float,
+    home: ArrayLike | None = None,
 ) -> tuple[Task | None, Any, dict[str, Any]]:
     """The task and the rule's keywords for a case name on ``plant`` (SPEC §18):
     the default task unless a reference or the controller's own trajectory
     (``xc_*``) is given, which is then the path."""
     own = [k for k in ("xc_offset", "xc_sin", "xc_cos", "xc_omega") if k in params]
+    if home is not None and (reference is not None or own):
+        raise ValueError(
+            "home= sets the default task's posture: give it without a reference or xc_*"
+        )
     if reference is None and not own:
-        task = default_task(plant)
+        task = default_task(plant, home)
         kw = rule_keywords(plant, task, Ts=Ts, case=case)
         kw.pop("n")
         return task, task.reference, kw
@@ -1521,6 +1468,9 @@ def simulate(
     fault: Fault | None = None,
     payload: float = 0.0,
     reset: bool = True,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+    home: ArrayLike | None = None,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1531,14 +1481,14 @@ def simulate(
     saturated to the actuators' τmax and held for ``substeps`` MuJoCo steps of
     Ts / substeps each (SPEC §13.1).
 
-    An ``adaptimp.Controller`` (or a case name) runs in the compiled core: the
-    loop, the recording and the metrics are the core's, MuJoCo is driven
-    through its C library, the GIL is released (Ctrl-C is honoured within
-    0.1 s). Any other controller (:class:`ControllerLike`, e.g.
-    :class:`adaptimp.baselines.ComputedTorque`) is stepped from a Python loop
-    with the same semantics and the core's metrics, as is a model without a
-    force sensor whose end effector can touch something (its wrench comes
-    from MuJoCo's contact list, which only the Python loop reads).
+    The loop, the recording and the metrics are the compiled core's, MuJoCo
+    is driven through its C library and the GIL is released (Ctrl-C is
+    honoured within 0.2 s, also within a period of many substeps). The core
+    steps an ``adaptimp.Controller`` (or a case name), an
+    :class:`adaptimp.CartesianController` in front of one (or of computed
+    torque) and :class:`adaptimp.baselines.ComputedTorque` itself; any other
+    controller (:class:`ControllerLike`) is called back once a period, with
+    the GIL taken for that call (``params["loop"]`` is then ``"callback"``).
 
     Parameters
     ----------
@@ -1557,8 +1507,9 @@ def simulate(
         scenario's (``"robot"``: 1 ms, ``"paper"``: 50 µs). Must equal the
         period of a given controller.
     substeps : int, optional
-        MuJoCo steps per period; MuJoCo's timestep becomes Ts / substeps.
-        Default: round(Ts / the model's timestep), at least 1.
+        MuJoCo steps per period, 1 ≤ substeps ≤ 10 000; MuJoCo's timestep
+        becomes Ts / substeps. Default: round(Ts / the model's timestep), at
+        least 1.
     q0, dq0 : array_like, optional
         Initial joint positions (rad) and velocities (rad/s); default the
         default task's start (below), else the model's first keyframe (the
@@ -1586,7 +1537,7 @@ def simulate(
         as ``progress(done, total)`` about every 50 ms, and once when the run ends.
     fault : adaptimp.Fault, optional
         A fault injected over a window, as for :func:`adaptimp.simulate` (the
-        actuators' τmax for ``"actuator_drop"``); needs the native loop.
+        actuators' τmax for ``"actuator_drop"``), for any controller.
     payload : float
         A point mass (kg, ≥ 0) at the end effector's link of the plant only
         (:func:`with_payload`); the controller's gains come from the arm
@@ -1597,6 +1548,12 @@ def simulate(
         controller, the parts are the whole run's rows; each part's t starts
         at 0 and its disturbances afresh); ``q0``, ``dq0`` must then be None
         and ``payload`` 0.
+    tip, fix : optional
+        The end effector (a site or a body; a URDF's link) and joints to lock,
+        for the :class:`Plant` built from ``model`` (not for a Plant given).
+    home : array_like, optional
+        The posture (rad, (n,)) the default task swings about, instead of
+        :func:`home_posture`'s.
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
@@ -1639,62 +1596,230 @@ def simulate(
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
         settle=settle, scenario=scenario, record_every=record_every, reference=reference,
-        payload=payload, params=params, reset=reset,
+        payload=payload, params=params, reset=reset, tip=tip, fix=fix, home=home,
     )  # fmt: skip
     from ._api import _progress
 
     callback, bar = _progress(progress, "mujoco.simulate")
+    core_fault = None if fault is None else fault._core(run.plant.n)
     try:
-        if run.native and run.cartesian:
-            out = _cartesian_loop(run, run.reference, callback, fault)
-            m = out.pop("metrics")
-        elif run.native:
-            assert run.spec is not None
-            refs = None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts)
-            core_fault = None if fault is None else fault._core(run.plant.n)
-            out = _adaptimp.simulate_mujoco(
-                run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
-                run.settle, run.every, callback, refs, core_fault,
-            )  # fmt: skip
-            m = out.pop("metrics")
-        else:
-            if fault is not None:
-                raise TypeError(
-                    "fault= needs a controller the core steps (an adaptimp.Controller or a "
-                    "case name) and a plant with a force sensor or no possible contact; this "
-                    "run steps its controller from Python"
-                )
-            out, m = _python_loop(run, run.reference, callback)
+        out = _LOOPS[run.kind](run, callback, core_fault)
     finally:
         if bar is not None:
             bar.close()
-    return _result(run, out, m)
+    res = _result(run, out, out.pop("metrics"))
+    _check_run(run, res)
+    return res
+
+
+RUN_PEAK = 2.0
+"""A run whose commanded |τ_i| exceeds this many τmax_i after :data:`RUN_SETTLE`
+says so (:func:`simulate`'s check)."""
+
+RUN_SETTLE = 0.1
+"""The start (s) of the peak-torque check."""
+
+RUN_SATURATED = 0.01
+"""A run whose torque is at a limit in more than this share of its steps says so."""
+
+RUN_CONTACT_EVERY = 0.01
+"""The spacing (s) of the recorded rows at which a run's self-contact is checked."""
+
+
+def _check_run(run: _Run, res: MujocoResult) -> None:
+    """What a run found that its numbers alone do not say (SPEC §18), as
+    :class:`adaptimp.PlantWarning` and in ``res.params["warnings"]``: the arm
+    touching itself (rows every :data:`RUN_CONTACT_EVERY` s replayed through
+    MuJoCo's collision detection); and, for a joint-space controller in free
+    space (no step in contact: pressing on a table is a contact task's own
+    business, its metrics say how it went), a commanded torque beyond
+    :data:`RUN_PEAK` τmax after :data:`RUN_SETTLE` s, the torque at a limit in
+    more than :data:`RUN_SATURATED` of the steps. ``res.params["plant"]`` is
+    what the plant made of the model (:attr:`Plant.notes`). Not for the
+    paper's arm, whose scenario saturates by design."""
+    plant = run.plant
+    res.params["plant"] = dict(plant.notes)
+    found: list[str] = []
+    if _uses_rule(plant) and res.rows > 0:
+        found += _self_contact(plant, res)
+    free = res.metrics.get("steps_in_contact", 0) == 0 and run.kind != "cartesian"
+    free = free and not getattr(run.ctrl, "wants_wrench", False)
+    if _uses_rule(plant) and res.rows > 0 and free:
+        tau_max = np.asarray(plant.tau_max)
+        late = np.flatnonzero(res.t >= RUN_SETTLE - 1e-12)
+        if late.size:
+            ratio = np.abs(res.tau[late]) / tau_max
+            k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            if ratio[k, i] > RUN_PEAK:
+                found.append(
+                    f"the commanded torque reached {ratio[k, i]:.3g} τmax after {RUN_SETTLE:g} s "
+                    f"(joint {plant.joint_names[i]!r} at t = {res.t[late[k]]:.3f} s), beyond "
+                    f"{RUN_PEAK:g} τmax: the controller asks far more than the actuators give"
+                )
+        duty = float(res.metrics.get("sat_duty", math.nan))
+        if duty > RUN_SATURATED:
+            found.append(
+                f"the torque was at a limit in {100 * duty:.1f} % of the steps (more than "
+                f"{100 * RUN_SATURATED:g} %): the actuators saturate, so the tracking measured is "
+                "theirs as much as the controller's"
+            )
+    res.params["warnings"] = found
+    for text in found:
+        warnings.warn(text, PlantWarning, stacklevel=3)
+
+
+def _self_contact(plant: Plant, res: MujocoResult) -> list[str]:
+    """The warning of a run in which the arm touched itself, if it did."""
+    m = plant.model
+    if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
+        return []
+    contacts = _mjcf.Contacts(m, plant.data.qpos, plant._joints, self_only=True)
+    if not contacts.possible:
+        return []
+    dt = float(res.t[1] - res.t[0]) if res.rows > 1 else 1.0
+    stride = max(1, round(RUN_CONTACT_EVERY / dt))
+    rows = range(0, res.rows, stride)
+    touched: list[tuple[str, str, float]] = []
+    first, hits = math.nan, 0
+    for k in rows:
+        found = contacts.at(res.q[k])
+        if found:
+            hits += 1
+            touched += found
+            if math.isnan(first):
+                first = float(res.t[k])
+    if not hits:
+        return []
+    return [
+        f"the arm touched itself in {100 * hits / len(rows):.1f} % of the rows checked "
+        f"({_mjcf.pairs(touched)}; first at t = {first:.3f} s): its own links collide along "
+        "this task; give another home= or reference (or contact=False)"
+    ]
+
+
+def _native_loop(
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
+) -> dict[str, Any]:
+    """An ``adaptimp.Controller`` stepped by the core, along its own
+    trajectory or the run's reference tabulated at t_k."""
+    refs = None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts)
+    out: dict[str, Any] = _adaptimp.simulate_mujoco(
+        run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T, run.settle,
+        run.every, progress, refs, fault,
+    )  # fmt: skip
+    return out
 
 
 def _cartesian_loop(
-    run: _Run,
-    reference: Reference | None,
-    progress: Callable[[int, int], object] | None,
-    fault: Fault | None,
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
 ) -> dict[str, Any]:
     """The native loop of an :class:`adaptimp.CartesianController` whose joint
     controller the core steps: its commanded pose tabulated for every row
     (the reference at t_k, else its path on its own clock), then the core's
     loop; the controller's Python side brought up to date, whatever happens."""
-    assert run.spec is not None
-    ctrl = run.ctrl
+    ctrl, reference = run.ctrl, run.reference
     table = reference.arrays if isinstance(reference, _Table) else reference
     targets = ctrl._targets(run.steps, table)
-    core_fault = None if fault is None else fault._core(run.plant.n)
     out: dict[str, Any] | None = None
     try:
         out = ctrl.outer.core.simulate_mujoco(
             ctrl._joint, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
-            run.settle, run.every, progress, targets, core_fault,
+            run.settle, run.every, progress, targets, fault,
         )  # fmt: skip
     finally:
         ctrl._ran(targets, None if out is None else out["task"])
+    assert out is not None
     return out
+
+
+def _computed_loop(
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
+) -> dict[str, Any]:
+    """:class:`adaptimp.baselines.ComputedTorque` stepped by the core in joint
+    space, along the run's reference or its own trajectory, tabulated at its
+    t_k = (k0 + k)·Ts (k0 the steps it took before), as its ``step`` samples it."""
+    ctrl, Ts = run.ctrl, run.Ts
+    if run.reference is not None:
+        refs = _tabulate(run.reference, run.steps, Ts)
+    else:
+        if ctrl._trajectory is None:
+            raise ValueError("no setpoint given and no trajectory to follow")
+        k0 = int(ctrl._core.steps)
+        refs = _tabulate(lambda t: ctrl._trajectory(t), run.steps, Ts, k0)
+    out: dict[str, Any] = ctrl._core.simulate_mujoco(
+        run.plant.model, run.plant.data, run.spec, run.dist, run.T, run.settle, refs,
+        run.every, progress, fault,
+    )  # fmt: skip
+    return out
+
+
+_ATTRIBUTES = ("tau", "xc", "dxc", "ddxc", "xd", "z1", "dq_hat", "zeta")
+"""The attributes of a controller written in Python that a run records (ControllerLike)."""
+
+
+def _callback_loop(
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
+) -> dict[str, Any]:
+    """A controller written in Python in the core's loop, called back once a
+    period (the protocol :class:`ControllerLike`): its setpoint (the
+    reference's rows) and the attributes it has, the rates of its own
+    trajectory (if its params declare one), and its target impedance for
+    the metrics, given to the core."""
+    ctrl, n, steps, Ts = run.ctrl, run.plant.n, run.steps, run.Ts
+    wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
+    width = 3 if wants_wrench else n
+    has = {name: hasattr(ctrl, name) for name in _ATTRIBUTES}
+    reference = run.reference
+    own_rates = reference is None and has["dxc"] and has["ddxc"]
+    if reference is not None:
+        table = _tabulate(reference, steps, Ts)
+    else:
+        nan = np.full((steps, width), math.nan)
+        # The rates of its own joint-space sinusoid, if its params declare one.
+        rates = None if own_rates or wants_wrench else _builtin_rates(ctrl, steps, Ts)
+        table = (nan, *(rates or (nan, nan)))
+    attrs = [name for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta") if has[name]]
+    cparams = getattr(ctrl, "params", None)
+    cparams = cparams if isinstance(cparams, Mapping) else {}
+    target = tuple(
+        np.broadcast_to(np.asarray(cparams.get(k, v), dtype=np.float64), (n,)).tolist()
+        for k, v in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0))
+    )
+    out: dict[str, Any] = _adaptimp.simulate_mujoco_callback(
+        ctrl, run.plant.model, run.plant.data, run.spec, run.dist, Ts, run.T, run.settle, table,
+        setpoint=reference is not None, wants_wrench=wants_wrench,
+        attrs=attrs + (["rates"] if own_rates else []), target=target, record_every=run.every,
+        progress=progress, fault=fault,
+    )  # fmt: skip
+    # A task-space controller's own log of this run (adaptimp.CartesianController.arrays).
+    log = getattr(ctrl, "arrays", None) if wants_wrench and getattr(ctrl, "record", False) else None
+    if callable(log):
+        out["task"] = {k: v[len(v) - steps :: run.every] for k, v in log().items()}
+    return out
+
+
+def _builtin_rates(ctrl: Any, steps: int, Ts: float) -> tuple[FloatArray, FloatArray] | None:
+    """ẋc, ẍc of every row of the controller's own sinusoid, if its params
+    declare one (for the impedance metric), on its clock from the steps it
+    says it took."""
+    builtin = _builtin_reference(ctrl)
+    if builtin is None:
+        return None
+    k0 = getattr(ctrl, "steps", 0)
+    k0 = k0 if isinstance(k0, int) else 0
+    # (sinusoid's reference broadcasts: one row per time.)
+    own = (k0 + np.arange(steps, dtype=np.float64)) * Ts
+    _, dxc, ddxc = builtin(own[:, None])  # type: ignore[arg-type]
+    return np.ascontiguousarray(dxc, dtype=np.float64), np.ascontiguousarray(ddxc, dtype=np.float64)
+
+
+_LOOPS: dict[str, Callable[[_Run, Callable[[int, int], object] | None, Any], dict[str, Any]]] = {
+    "native": _native_loop,
+    "cartesian": _cartesian_loop,
+    "computed": _computed_loop,
+    "callback": _callback_loop,
+}
+"""How the core's loop takes each kind of controller (:func:`_setup` says which)."""
 
 
 @dataclass
@@ -1712,13 +1837,50 @@ class _Run:
     steps: int
     every: int
     dist: dict[str, Any]
-    spec: dict[str, Any] | None
-    native: bool
+    spec: dict[str, Any]
+    kind: str
     reference: Reference | None
     task: Task | None
     payload: float
     q0: FloatArray
-    cartesian: bool = False
+
+
+MAX_SUBSTEPS = 10_000
+"""The most MuJoCo steps per control period (the core's bound)."""
+
+
+def _check_arguments(T: object, Ts: object, substeps: object) -> None:
+    """``T`` and ``Ts`` real numbers (s) or None, ``substeps`` an integer in
+    1 … :data:`MAX_SUBSTEPS` or None: refused by name before any work."""
+    for name, value in (("T", T), ("Ts", Ts)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Real)):
+            raise TypeError(f"{name} must be a real number (s), got {type(value).__name__}")
+    if substeps is None:
+        return
+    if isinstance(substeps, bool) or not isinstance(substeps, numbers.Integral):
+        raise TypeError(
+            f"substeps must be an integer (MuJoCo steps per period), got {type(substeps).__name__}"
+        )
+    if not 1 <= int(substeps) <= MAX_SUBSTEPS:
+        raise ConfigError(
+            f"condition 1 ≤ substeps ≤ 10 000 is violated: substeps = {int(substeps)} "
+            "(MuJoCo steps per period)"
+        )
+
+
+def _kind(ctrl: Any) -> str:
+    """How the core's loop takes ``ctrl``: ``"native"`` (an
+    ``adaptimp.Controller``), ``"cartesian"`` (an
+    :class:`adaptimp.CartesianController` in front of a joint controller the
+    core steps), ``"computed"`` (computed torque in joint space) or
+    ``"callback"`` (written in Python: called back once a period)."""
+    if _native_cartesian(ctrl):
+        return "cartesian"
+    if getattr(ctrl, "wants_wrench", False):
+        return "callback"
+    if _native(ctrl):
+        return "native"
+    return "computed" if _native_computed(ctrl) else "callback"
 
 
 def _setup(
@@ -1738,13 +1900,17 @@ def _setup(
     payload: float = 0.0,
     params: Mapping[str, Any],
     reset: bool = True,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+    home: ArrayLike | None = None,
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
-    plant at its initial state, the settings and the choice of loop."""
+    plant at its initial state, the settings and the kind of loop."""
     from . import Controller
     from ._api import _record_every
     from ._params import SCENARIOS, check_settle, resolve
 
+    _check_arguments(T, Ts, substeps)
     defaults = SCENARIOS.get(scenario)
     if defaults is None:
         raise ValueError(f"scenario must be one of {sorted(SCENARIOS)}, got {scenario!r}")
@@ -1753,17 +1919,23 @@ def _setup(
         raise ValueError(
             "q0, dq0 and a payload start a run afresh: give them with reset=True (the default)"
         )
-    nominal = model if isinstance(model, Plant) else Plant(model, contact=contact)
+    if isinstance(model, Plant) and (tip is not None or tuple(fix)):
+        raise ValueError("tip= and fix= build the Plant: give them to Plant(...), not with one")
+    nominal = model if isinstance(model, Plant) else Plant(model, contact=contact, tip=tip, fix=fix)
     plant = _payload_plant(nominal, payload)
     task: Task | None = None
     params = dict(params)
     disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
+    if home is not None and not (isinstance(controller, str) and _uses_rule(nominal)):
+        raise ValueError(
+            "home= sets the default task of a case name on an arm (not the paper's two_link)"
+        )
     if isinstance(controller, str):
         kwargs = dict(params)
         if _uses_rule(nominal):
             task, reference, rule = _rule_setup(
                 nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
-                float(defaults["T"]) if T is None else float(T),
+                float(defaults["T"]) if T is None else float(T), home,
             )  # fmt: skip
             kwargs = {**rule, **kwargs}
             if q0 is None and task is not None:
@@ -1798,7 +1970,7 @@ def _setup(
     steps = round(T / Ts)
     if steps < 1:
         raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
-    # As the rigid plant's simulate (the core's condition, for either loop).
+    # As the rigid plant's simulate (the core's condition).
     if not math.isfinite(settle):
         raise ConfigError(f"settle must be finite, got {settle!r}")
     if settle < 0:
@@ -1807,8 +1979,11 @@ def _setup(
         check_settle(settle, T, Ts)
     if substeps is None:
         substeps = max(1, round(Ts / plant.timestep))
-    if substeps < 1:
-        raise ValueError(f"substeps must be ≥ 1, got {substeps}")
+        if substeps > MAX_SUBSTEPS:
+            raise ConfigError(
+                f"condition 1 ≤ substeps ≤ 10 000 is violated: substeps = round(Ts / the "
+                f"model's timestep) = {substeps}: give substeps"
+            )
     resolved = resolve(disturb, scenario="robot", groups=("sim",), caller="simulate()", n=plant.n)
     dist = {k: resolved[k] for k in DISTURBANCES}
     # A Cartesian controller's reference is its commanded position p_c (3,).
@@ -1819,15 +1994,12 @@ def _setup(
             start = reference(0.0)
             q0 = np.asarray(start[0], dtype=np.float64)
             dq0 = np.asarray(start[1], dtype=np.float64) if dq0 is None else dq0
-    plant.timestep = Ts / substeps
+    plant.timestep = Ts / int(substeps)
     if reset:
         plant.reset(q0, dq0)
-    spec = plant._native(substeps)
-    cartesian = _native_cartesian(ctrl)
-    native = spec is not None and (cartesian or (_native(ctrl) and not task_space))
     return _Run(
-        ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native,
-        reference, task, float(payload), plant.q, cartesian,
+        ctrl, plant, label, scenario, Ts, T, settle, int(substeps), steps, every, dist,
+        plant._core_spec(int(substeps)), _kind(ctrl), reference, task, float(payload), plant.q,
     )  # fmt: skip
 
 
@@ -1845,7 +2017,7 @@ def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
         "wrench_source": plant.wrench_source,
         "model": name,
         "controller": run.label,
-        "loop": "native" if run.native else "python",
+        "loop": "callback" if run.kind == "callback" else "native",
         "payload": run.payload,
         "q0": run.q0.tolist(),
         **run.dist,
@@ -1864,125 +2036,6 @@ def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
     )
 
 
-def _python_loop(
-    run: _Run, reference: Reference | None, progress: Callable[[int, int], object] | None
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The loop of :func:`simulate` for a controller the core cannot step: the
-    same order of operations, the core's metrics. Returns the arrays and the
-    metrics."""
-    from ._params import defaults as scenario_defaults
-
-    ctrl, plant, steps, Ts, substeps = run.ctrl, run.plant, run.steps, run.Ts, run.substeps
-    dist, every, settle = run.dist, run.every, run.settle
-    clean = scenario_defaults("robot", plant.n)
-    changed = sorted(k for k, v in dist.items() if v != clean[k])
-    if changed:
-        raise TypeError(
-            f"the disturbances {changed} need a controller the core steps (an "
-            "adaptimp.Controller or a case name) and a plant with a force sensor or "
-            "no possible contact; this run steps its controller from Python"
-        )
-    has = {
-        name: hasattr(ctrl, name)
-        for name in ("tau", "xc", "dxc", "ddxc", "xd", "z1", "dq_hat", "zeta")
-    }
-    # Its own commanded rates (a Cartesian controller's ṗ_c, p̈_c), if it says.
-    own_rates = reference is None and has["dxc"] and has["ddxc"]
-    # The Cartesian hook (ControllerLike): the measured wrench instead of τe.
-    wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
-    n = plant.n
-    rows: dict[str, list[Any]] = {name: [] for name in ARRAYS if name != "t"}
-    # The rows' own lists, bound once: this loop runs a Python step per period.
-    (r_q, r_dq, r_ddq, r_xc, r_dxc, r_ddxc, r_xd, r_dq_hat, r_tau, r_tau_sat, r_tau_e, r_zeta,
-     r_z1, r_x_ee, r_wrench) = rows.values()  # fmt: skip
-    zeros = np.zeros(n)
-    # Steps the controller took before (its own trajectory goes on from there).
-    k0 = getattr(ctrl, "steps", 0)
-    k0 = k0 if isinstance(k0, int) else 0
-    last = time.perf_counter()
-    for k in range(steps):
-        q, dq = plant.q, plant.dq
-        wrench = plant.wrench()
-        tau_e = plant.tau_e(wrench)
-        r_x_ee.append(plant.ee_position())
-        args = (q, dq, wrench) if wants_wrench else (q, tau_e, dq)
-        # ζ(t_k), what this step uses (SimResult's zeta), read before the step.
-        r_zeta.append(np.array(ctrl.zeta, dtype=np.float64) if has["zeta"] else zeros)
-        if reference is not None:
-            xc, dxc, ddxc = (np.asarray(v, dtype=np.float64) for v in reference(k * Ts))
-            tau_cmd = ctrl.step(*args, xc=xc, dxc=dxc, ddxc=ddxc)
-            r_xc.append(xc)
-            r_dxc.append(dxc)
-            r_ddxc.append(ddxc)
-        else:
-            tau_cmd = ctrl.step(*args)
-            xc = ctrl.xc if has["xc"] else q
-            r_xc.append(xc)
-            if own_rates:
-                r_dxc.append(ctrl.dxc)
-                r_ddxc.append(ctrl.ddxc)
-        tau_sat = plant.apply(tau_cmd)
-        plant.forward()  # q̈ at the row's state and applied torque (SPEC §12)
-        xd = ctrl.xd if has["xd"] else xc
-        r_q.append(q)
-        r_dq.append(dq)
-        r_ddq.append(plant.ddq)
-        r_xd.append(xd)
-        r_z1.append(ctrl.z1 if has["z1"] else np.asarray(xd) - q)
-        r_dq_hat.append(ctrl.dq_hat if has["dq_hat"] else dq)
-        r_tau.append(ctrl.tau if has["tau"] else tau_cmd)
-        r_tau_sat.append(tau_sat)
-        r_tau_e.append(tau_e)
-        r_wrench.append(wrench)
-        plant.step(substeps, row=k, Ts=Ts)
-        plant.forward()  # contact and sensors at the new state, torque held
-        if progress is not None and time.perf_counter() - last > 0.05:
-            last = time.perf_counter()
-            progress(k + 1, steps)
-
-    t: FloatArray = np.arange(steps, dtype=np.float64) * Ts
-    if reference is None and not own_rates:
-        # The controller's own trajectory, if its params declare one (for the
-        # impedance metric), evaluated for every row at once.
-        builtin = _builtin_reference(ctrl)
-        if builtin is not None:
-            # (sinusoid's reference broadcasts: one row per time.)
-            own = (k0 + np.arange(steps, dtype=np.float64)) * Ts
-            _, dxc_all, ddxc_all = builtin(own[:, None])  # type: ignore[arg-type]
-            rows["dxc"] = list(np.asarray(dxc_all, dtype=np.float64))
-            rows["ddxc"] = list(np.asarray(ddxc_all, dtype=np.float64))
-        else:
-            nan = np.full(len(r_xc[0]) if steps else n, math.nan)
-            rows["dxc"] = rows["ddxc"] = [nan] * steps
-    ref_width = len(rows["xc"][0]) if steps else n
-    width = {"x_ee": 3, "wrench_ee": 6}
-    width.update(dict.fromkeys(("xc", "dxc", "ddxc", "xd", "z1"), ref_width))
-    arrays = {
-        name: np.array(values, dtype=np.float64).reshape(steps, width.get(name, n))
-        for name, values in rows.items()
-    }
-    arrays["t"] = t
-    cparams = getattr(ctrl, "params", None)
-    cparams = cparams if isinstance(cparams, Mapping) else {}
-    target = [
-        np.broadcast_to(np.asarray(cparams.get(k, v), dtype=np.float64), (n,)).tolist()
-        for k, v in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0))
-    ]
-    a = arrays
-    m = _adaptimp.metrics(
-        a["t"], a["q"], a["dq"], a["ddq"], a["xc"], a["dxc"], a["ddxc"], a["z1"],
-        a["tau"], a["tau_sat"], a["tau_e"], settle, tuple(target),
-        False if wants_wrench else None,
-    )  # fmt: skip
-    kept: dict[str, Any] = {name: v[::every] for name, v in arrays.items()}
-    kept["w_norms"] = np.full((kept["t"].shape[0], 3), math.nan)
-    # A Cartesian controller's log of this run (adaptimp.CartesianController.arrays).
-    log = getattr(ctrl, "arrays", None) if wants_wrench and getattr(ctrl, "record", False) else None
-    if callable(log) and steps:
-        kept["task"] = {k: v[len(v) - steps :: every] for k, v in log().items()}
-    return kept, m
-
-
 def _run_many(
     jobs: Sequence[tuple[str, str, str, Mapping[str, Any]]],
     threads: int | None = None,
@@ -1991,9 +2044,9 @@ def _run_many(
     """Runs ``(case, scenario, model, keywords)`` of :func:`simulate`, their
     SPEC §12 metrics or their errors as text: in the core, on ``threads``
     threads (every core if None) with the GIL released, each run with its own
-    controller and MuJoCo data; a run the core cannot take alone (a Python
-    loop, a reference callable) runs here. Results are those of
-    :func:`simulate`, bit for bit."""
+    controller and MuJoCo data; a run the core cannot take alone (a reference
+    callable, a progress report) runs here through :func:`simulate`. Results
+    are those of :func:`simulate`, bit for bit."""
     out: list[dict[str, Any] | str | None] = [None] * len(jobs)
     native: list[tuple[int, _Run]] = []
     for i, (case, scenario, model, kw) in enumerate(jobs):
@@ -2009,10 +2062,8 @@ def _run_many(
                 case, model, scenario=scenario, params=kw,
                 **{k: kw.pop(k) for k in names if k in kw},
             )  # fmt: skip
-            if run.native:
-                native.append((i, run))
-            else:
-                out[i] = dict(_python_loop(run, run.reference, None)[1])
+            assert run.kind == "native", run.kind  # a case name: an adaptimp.Controller
+            native.append((i, run))
         except Exception as e:  # a run's failure, whatever it is (a model's ParseError)
             out[i] = f"{type(e).__name__}: {e}"
     if native:
@@ -2022,7 +2073,7 @@ def _run_many(
                     r.ctrl,
                     r.plant.model,
                     r.plant.data,
-                    r.spec or {},
+                    r.spec,
                     r.dist,
                     r.T,
                     r.settle,

@@ -9,7 +9,9 @@ and :func:`adaptimp.simulate` in the robot scenario. Every rate is in the
 joint's own units (each joint's inertia scale d_i = 1/(D⁻¹)_ii, SPEC §10):
 
 - **Kp_i = 0.25 d_i / Ts**: the sampled velocity loop of every joint keeps its
-  pole at 0.75, whatever the joint's size; **K1 = min(50 s⁻¹, 0.05/Ts)**;
+  pole at 0.75, whatever the joint's size (with a path, d_i is the mean along
+  it of 1/(D⁻¹(q))_ii, bounded so that the loop stays stable at every
+  posture of it: SPEC (18.1)); **K1 = min(50 s⁻¹, 0.05/Ts)**;
   **Kζ_i = Kp_i/d_i + ρ/2** with the conditions ``"scaled"`` of SPEC §10
   (met by construction, for any arm, τmax and Ts); kr_i = φ Kp_i/2.
 - **Centres along the path** (SPEC §15): L = clip(⌈2·(path length in q)/tube⌉,
@@ -38,6 +40,10 @@ Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]
 
 PATH_SAMPLES = 1000
 """Samples of one period of a path that :func:`suggest` hands the core."""
+
+INERTIA_SAMPLES = 50
+"""Postures along a path at which :func:`suggest` evaluates D(q) for the
+inertia scales (SPEC (18.1): their mean along the path, bounded)."""
 
 RULE_KEYS = (
     "Ts",
@@ -129,15 +135,17 @@ def suggest(
     period: float | None = None,
     case: str = "sf",
 ) -> dict[str, Any]:
-    """Controller keywords for an arm from its inertia at ``q0`` (rad), its actuator
-    limits ``tau_max`` (N m) and the task's joint path (SPEC §18, module docs).
+    """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
+    the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
+    actuator limits ``tau_max`` (N m) and the path (SPEC §18, module docs).
 
     Parameters
     ----------
     model
         What gives D(q): see :func:`inertia`.
     q0 : array_like, shape (n,)
-        The posture the gains are computed at (rad): the task's start.
+        The posture the gains are computed at without a path (rad), and the
+        gravity torque for the tube with one: the task's start.
     tau_max : float or array_like, shape (n,)
         Actuator limits (N m).
     Ts : float
@@ -172,6 +180,8 @@ def suggest(
         if period is None:
             raise ConfigError("a path needs its period (s)")
         rows = sample_path(path, period, n)
+        step = PATH_SAMPLES // INERTIA_SAMPLES
+        d = np.stack([inertia(model, q) for q in rows[::step, :n]])
     g = gravity(model, q0) if rows is not None else None
     out = _adaptimp.suggest(case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g)
     kw: dict[str, Any] = {"n": n}

@@ -402,6 +402,13 @@ pub(crate) fn turn(r: &Matrix3<f64>, s: f64, c: f64) -> Matrix3<f64> {
     Matrix3::from_columns(&[x * c + y * s, y * c - x * s, r.column(2).into_owned()])
 }
 
+/// The rotation by `theta` (rad) about the unit `axis` (Rodrigues).
+pub(crate) fn axis_rotation(axis: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
+    let (s, c) = sin_cos(theta);
+    let k = axis.cross_matrix();
+    Matrix3::identity() + k * s + k * k * (1.0 - c)
+}
+
 /// A serial chain of `N` movable joints (1 ≤ N ≤ 7): see the [module docs](self).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Chain<const N: usize> {

@@ -106,6 +106,63 @@ pub fn inertia_scales<const N: usize>(d: &Matrix<N>) -> Result<Vector<N>, Error>
     Ok(scales)
 }
 
+/// The inertia scales of an arm along a task's path, SPEC (18.1): the mean
+/// over the samples `ds` (D(q_k), kg m², symmetric positive definite) of
+/// each posture's scales d_i(q_k) = 1/(D(q_k)⁻¹)_ii, shrunk by one common
+/// factor c = min(1, N / max_k λmax(D(q_k)⁻¹ Dₛ)), Dₛ = diag(d) (λmax bounded
+/// from above within 1 %), so that at every sample the eigenvalues of
+/// D⁻¹Dₛ stay ≤ N, the bound one posture's
+/// own scales have (Dₛ^½ D⁻¹ Dₛ^½ has a unit diagonal). One posture's
+/// scales collapse near a posture where joint axes line up (a joint's
+/// motion is then absorbed by its neighbours: d_i ≪ D_ii), and gains from
+/// such a posture are too small along the rest of the path. Errors if `ds`
+/// is empty or a sample is not an inertia matrix ([`inertia_scales`]).
+pub fn inertia_scales_along<const N: usize>(ds: &[Matrix<N>]) -> Result<Vector<N>, Error> {
+    if ds.is_empty() {
+        return Err(Error::Invalid {
+            what: "inertia samples",
+            reason: "needs one posture or more",
+        });
+    }
+    let mut mean = Vector::<N>::zeros();
+    for d in ds {
+        mean += inertia_scales(d)?;
+    }
+    mean /= ds.len() as f64;
+    let root = mean.map(sqrt);
+    let mut largest = 0.0f64;
+    for d in ds {
+        // d is positive definite (inertia_scales checked it).
+        let inv = d.cholesky().map(|c| c.inverse()).ok_or(Error::Invalid {
+            what: "inertia matrix",
+            reason: "must be positive definite",
+        })?;
+        let m = Matrix::<N>::from_fn(|i, j| root[i] * inv[(i, j)] * root[j]);
+        largest = largest.max(largest_eigenvalue(&m));
+    }
+    let cap = N as f64 / largest;
+    let scales = if cap < 1.0 { mean * cap } else { mean };
+    check::finite_slice("inertia scale", scales.as_slice())?;
+    Ok(scales)
+}
+
+/// An upper bound on the largest eigenvalue of a symmetric positive definite
+/// `m`, within 1 % of it: λmax ≤ (tr m^(2^k))^(2^−k) ≤ N^(2^−k) λmax, k = 8
+/// (repeated squaring, each power scaled to unit trace).
+fn largest_eigenvalue<const N: usize>(m: &Matrix<N>) -> f64 {
+    const K: i32 = 8;
+    let t = m.trace();
+    let mut a = m / t;
+    let mut log_c = libm::log(t);
+    for _ in 0..K {
+        let sq = a * a;
+        let t = sq.trace();
+        a = sq / t;
+        log_c = 2.0 * log_c + libm::log(t);
+    }
+    libm::exp(log_c / f64::from(1 << K))
+}
+
 impl Rule {
     /// The rule with its tube widened to hold the sag of the arm under the
     /// feedback alone, SPEC (18.5): the weights start at zero, so at first the
@@ -145,10 +202,23 @@ impl Rule {
         tau_max: &Vector<N>,
         ts: f64,
     ) -> Result<Config<N>, Error> {
+        self.gains_scaled(law, &inertia_scales(d)?, tau_max, ts)
+    }
+
+    /// [`gains`](Self::gains) from the inertia scales d_i (kg m²) themselves,
+    /// e.g. [`inertia_scales_along`] a path.
+    pub fn gains_scaled<const N: usize>(
+        &self,
+        law: Law,
+        scales: &Vector<N>,
+        tau_max: &Vector<N>,
+        ts: f64,
+    ) -> Result<Config<N>, Error> {
         check::positive("Ts > 0", "Ts", ts)?;
         check::at_most("Ts ≤ 1 s", "Ts", ts, 1.0)?;
         check::positive_vec("τmax > 0", "tau_max", tau_max)?;
-        let scales = inertia_scales(d)?;
+        check::finite_slice("inertia scale", scales.as_slice())?;
+        let scales = *scales;
         if let Some(i) = scales
             .iter()
             .position(|d| *d < MIN_SCALE || *d > PARAM_BOUND)
@@ -328,7 +398,23 @@ impl Rule {
         period: f64,
         gravity: Option<&Vector<N>>,
     ) -> Result<Suggestion<N>, Error> {
-        let mut config = self.gains(law, d, tau_max, ts)?;
+        self.suggest_scaled(law, &inertia_scales(d)?, tau_max, ts, path, period, gravity)
+    }
+
+    /// [`suggest`](Self::suggest) from the inertia scales d_i (kg m²)
+    /// themselves: [`inertia_scales_along`] the path for SPEC (18.1).
+    #[allow(clippy::too_many_arguments)]
+    pub fn suggest_scaled<const N: usize>(
+        &self,
+        law: Law,
+        scales: &Vector<N>,
+        tau_max: &Vector<N>,
+        ts: f64,
+        path: &[Setpoint<N>],
+        period: f64,
+        gravity: Option<&Vector<N>>,
+    ) -> Result<Suggestion<N>, Error> {
+        let mut config = self.gains_scaled(law, scales, tau_max, ts)?;
         if let Some(g) = gravity {
             check::finite_slice("gravity", g.as_slice())?;
         }
@@ -433,6 +519,34 @@ mod tests {
             .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, None)
             .unwrap();
         Controller::new(s.config, s.centers).unwrap();
+    }
+
+    #[test]
+    fn scales_along_a_path_average_and_keep_the_bound() {
+        let d = arm_matrix();
+        let (bound, exact) = (largest_eigenvalue(&d), d.symmetric_eigenvalues().max());
+        assert!(exact <= bound && bound <= 1.01 * exact, "{bound} {exact}");
+        // One posture: its own scales.
+        let one = inertia_scales_along(&[d]).unwrap();
+        assert!((one - inertia_scales(&d).unwrap()).norm() < 1e-15);
+        // Two axes nearly in line at one posture (d_i ≪ D_ii there), apart at
+        // the other: the mean, capped so that λmax(D⁻¹Dₛ) ≤ N at both.
+        let lined = Matrix::<2>::new(1.0, 0.999, 0.999, 1.0);
+        let apart = Matrix::<2>::identity();
+        let s = inertia_scales_along(&[lined, apart]).unwrap();
+        let mean = (inertia_scales(&lined).unwrap() + inertia_scales(&apart).unwrap()) / 2.0;
+        let ratio = s.component_div(&mean);
+        assert!(
+            (ratio[0] - ratio[1]).abs() < 1e-12 && ratio[0] < 1.0,
+            "{ratio}"
+        );
+        for m in [lined, apart] {
+            let l = (m.try_inverse().unwrap() * Matrix::<2>::from_diagonal(&s))
+                .eigenvalues()
+                .unwrap();
+            assert!(l.max() <= 2.0 + 1e-9, "{l}");
+        }
+        assert!(inertia_scales_along::<2>(&[]).is_err());
     }
 
     #[test]

@@ -24,10 +24,13 @@
 //! Nothing here panics on user input and nothing is `unsafe`.
 
 mod arm;
+mod callback;
 mod cartesian;
 mod cartesian_loop;
 mod computed;
+mod description;
 mod dynamic;
+mod frames;
 mod mujoco;
 mod tuning;
 
@@ -1404,6 +1407,8 @@ fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
         force_adr: get(d, "force_adr")?,
         torque_adr: get(d, "torque_adr")?,
         contact_adr: get(d, "contact_adr")?,
+        subtree: get(d, "subtree")?,
+        root: get(d, "root")?,
         substeps: get(d, "substeps")?,
         timestep: get(d, "timestep")?,
         integrator: match get::<i32>(d, "integrator")? {
@@ -1864,9 +1869,13 @@ mod adaptimp_module {
     };
 
     #[pymodule_export]
+    use super::callback::simulate_mujoco_callback;
+    #[pymodule_export]
     use super::cartesian::{centres_along, PyCartesian, PyChain};
     #[pymodule_export]
     use super::computed::PyComputedTorque;
+    #[pymodule_export]
+    use super::description::{arm_from_mujoco, description_kind, read_arm};
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

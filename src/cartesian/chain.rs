@@ -402,7 +402,9 @@ pub(crate) fn turn(r: &Matrix3<f64>, s: f64, c: f64) -> Matrix3<f64> {
     Matrix3::from_columns(&[x * c + y * s, y * c - x * s, r.column(2).into_owned()])
 }
 
-/// The rotation by `theta` (rad) about the unit `axis` (Rodrigues).
+/// The rotation by `theta` (rad) about the unit `axis` (Rodrigues), for the
+/// description's tree.
+#[cfg(feature = "alloc")]
 pub(crate) fn axis_rotation(axis: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
     let (s, c) = sin_cos(theta);
     let k = axis.cross_matrix();
@@ -472,7 +474,11 @@ impl<const N: usize> Chain<N> {
             }
             let axis = Vector3::from(j.axis);
             check::finite_slice("joint axis", axis.as_slice())?;
-            let len = axis.norm();
+            // Scaled first: the norm of an axis of 1e300 overflows (to an
+            // axis of zeros, and a frame of NaN in `align`).
+            let scale = axis.amax();
+            let unit = if scale > 0.0 { axis / scale } else { axis };
+            let len = scale * unit.norm();
             if len.partial_cmp(&1e-12) != Some(core::cmp::Ordering::Greater) {
                 return Err(Error::Condition {
                     condition: "‖axis‖ > 0 (a movable joint needs an axis)",
@@ -481,7 +487,7 @@ impl<const N: usize> Chain<N> {
                     value: len,
                 });
             }
-            let axis = axis / len;
+            let axis = unit / unit.norm();
             check::finite("joint offset", j.offset)?;
             if j.offset.abs() > 1e6 {
                 return Err(Error::Condition {
@@ -846,6 +852,23 @@ mod tests {
         let e = Chain::<8>::new(&[ok; 8], &Transform::IDENTITY).unwrap_err();
         assert!(e.to_string().contains("1 ≤ n ≤ 7"), "{e}");
         assert!(Transform::from_pos_quat([0.0; 3], [0.0; 4]).is_err());
+    }
+
+    #[test]
+    fn an_axis_of_any_finite_length_is_its_direction() {
+        let tip = Transform::from_xyz_rpy([0.3, 0.1, 0.0], [0.0, 0.0, 0.0]);
+        let unit = Chain::<1>::new(
+            &[Joint::revolute(Transform::IDENTITY, [1.0, 0.0, 0.0])],
+            &tip,
+        )
+        .unwrap();
+        for axis in [[1e300, 0.0, 0.0], [1e300, 0.0, 1.0], [1e-10, 0.0, 0.0]] {
+            let c = Chain::<1>::new(&[Joint::revolute(Transform::IDENTITY, axis)], &tip).unwrap();
+            let q = Vector::<1>::new(0.7);
+            let (a, b) = (c.pose(&q), unit.pose(&q));
+            assert!((a.0 - b.0).norm() < 1e-15, "{axis:?}");
+            assert!((a.1.matrix() - b.1.matrix()).norm() < 1e-15, "{axis:?}");
+        }
     }
 
     #[test]

@@ -51,7 +51,7 @@ def test_inverse_dynamics_refuses_inputs_whose_torque_would_not_be_finite(
     with pytest.raises(adaptimp.MeasurementError) as e:
         ct.inverse_dynamics(*args)
     assert str(e.value).startswith(message)
-    with pytest.raises(ValueError, match=r"^q must be finite, got \[ 0\. nan\]$"):
+    with pytest.raises(adaptimp.MeasurementError, match=r"^q\[1\] is not finite"):
         ct.inverse_dynamics([0, math.nan], [0, 0], [0, 0])
     tau = ct.inverse_dynamics([0.1, 0.2], [1e6, -1e6], [1e6, 0.0])
     assert np.isfinite(tau).all()

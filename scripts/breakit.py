@@ -1,7 +1,9 @@
 """A break-it probe of the public Python API: state restore (bit flips,
 edits, truncations), the fault semantics, the n-joint API, sweeps and their
 cache, chains, the Cartesian front, formulations, the dynamics and computed
-torque, saved results, MuJoCo runs. Every case is classified:
+torque, saved results, MuJoCo runs, robot descriptions (URDF text and files
+through read_arm, Chain.from_urdf, ComputedTorque and MuJoCo runs). Every
+case is classified:
 
 - accepted: it succeeded and every invariant checked held;
 - clear error: it was refused by an adaptimp error (or a TypeError,
@@ -1295,6 +1297,189 @@ def mujoco_runs(t: Tally, quick: bool) -> None:
         shutil.rmtree(root, ignore_errors=True)
 
 
+_URDF_FIELDS = {
+    "origin xyz": "0 0 0.1", "origin rpy": "0 0 0", "axis xyz": "0 1 0", "mass": "0.5",
+    "inertia ixx": "0.01", "limit lower": "-2", "limit upper": "2", "limit effort": "10",
+    "limit velocity": "3", "dynamics damping": "0.1", "dynamics friction": "0.05",
+    "mimic multiplier": "1",
+}  # fmt: skip
+_URDF_VALUES = ("nan", "inf", "-inf", "1e400", "1e200", "-1", "0", "1e-320", "abc", "",
+                "1 2", "0 0 0", "1e9 0 0", "0 0 1e200", "-0", "1e308 1e308 1e308")  # fmt: skip
+
+
+def _urdf(field: str | None = None, value: str = "") -> str:
+    """breakit.c's probe arm: three revolute joints and a prismatic jaw that
+    mimics the third (the rule holds both), ``field`` replaced by ``value``."""
+    v = {k: (value if k == field else d) for k, d in _URDF_FIELDS.items()}
+    links = ["base", "l1", "l2", "l3", "jaw"]
+    text = "<robot name='probe'><link name='base'/>"
+    for j in range(4):
+        mimic = f"<mimic joint='j3' multiplier='{v['mimic multiplier']}'/>" if j == 3 else ""
+        text += (
+            f"<link name='{links[j + 1]}'><inertial><origin xyz='0 0 0.05'/>"
+            f"<mass value='{v['mass']}'/><inertia ixx='{v['inertia ixx']}' ixy='0' ixz='0' "
+            "iyy='0.01' iyz='0' izz='0.01'/></inertial></link>"
+            f"<joint name='j{j + 1}' type='{'prismatic' if j == 3 else 'revolute'}'>"
+            f"<parent link='{links[j]}'/><child link='{links[j + 1]}'/>"
+            f"<origin xyz='{v['origin xyz']}' rpy='{v['origin rpy']}'/>"
+            f"<axis xyz='{v['axis xyz']}'/><limit lower='{v['limit lower']}' "
+            f"upper='{v['limit upper']}' effort='{v['limit effort']}' "
+            f"velocity='{v['limit velocity']}'/><dynamics damping='{v['dynamics damping']}' "
+            f"friction='{v['dynamics friction']}'/>{mimic}</joint>"
+        )
+    return text + "</robot>"
+
+
+def _arm_ok(arm: Any) -> None:
+    """What a read arm must be: limits numbers with lower ≤ upper, an effort
+    and a speed positive or NaN (none stated), drive terms finite ≥ 0; its
+    chain moves its tip with every joint, finitely."""
+    import adaptimp
+
+    n = len(arm.joints)
+    check(1 <= n <= 7, f"{n} joints")
+    lo, hi = np.asarray(arm.lower), np.asarray(arm.upper)
+    check(not np.isnan(lo).any() and not np.isnan(hi).any() and bool(np.all(lo <= hi)),
+          f"limits {lo}, {hi}")  # fmt: skip
+    for what in ("effort", "velocity"):
+        x = np.asarray(getattr(arm, what))
+        check(bool(np.all(np.isnan(x) | (x > 0))), f"{what} {x}")
+    for what in ("armature", "damping", "friction"):
+        x = np.asarray(getattr(arm, what))
+        check(bool(np.all(np.isfinite(x) & (x >= 0))), f"{what} {x}")
+    chain = adaptimp.Chain(arm.chain, tip=arm.tip_origin)
+    q = 0.1 * np.arange(1, n + 1)
+    _finite(chain.fk(q))
+    jac = np.asarray(chain.jacobian(q))
+    _finite(jac)
+    check(bool(np.all(np.linalg.norm(jac, axis=0) > 0)), f"a joint moves nothing: {jac}")
+
+
+def _chain_ok(chain: Any) -> None:
+    q = np.full(chain.n, 0.1)
+    _finite(chain.fk(q), chain.jacobian(q))
+
+
+def descriptions(t: Tally, quick: bool) -> None:
+    """Robot descriptions (SPEC §21) through every Python front that reads one:
+    read_arm, Chain.from_urdf, ComputedTorque(PATH, tip=, fix=) and
+    mujoco.from_urdf, with sources no arm is read from, every field of the
+    probe arm's URDF replaced by a bad value, and tips, fixes and drive= of
+    every wrong kind. Accepted: the arm's numbers are what a user can use."""
+    from adaptimp import Chain
+    from adaptimp._description import read_arm
+
+    root = Path(tempfile.mkdtemp(prefix="breakit-urdf-"))
+    try:
+        deep = "<robot name='r'>" + "<a>" * 100_000 + "</a>" * 100_000 + "</robot>"
+        files = {
+            "probe.urdf": _urdf(),
+            "broken.urdf": "<robot name='x'><link name='a'>",
+            "mjcf.urdf": "<mujoco><worldbody/></mujoco>",
+            "urdf.xml": _urdf(),
+            "empty.urdf": "",
+            "binary.urdf": "\x00\x01\x02",
+            "deep.urdf": deep,
+            "a_dir.urdf": None,
+        }
+        for name, text in files.items():
+            if text is None:
+                (root / name).mkdir()
+            else:
+                (root / name).write_text(text)
+        probe = root / "probe.urdf"
+        sources: list[tuple[str, Any, str]] = [
+            ("None", None, "refuse"),
+            ("1.5", 1.5, "refuse"),
+            ("bytes", _urdf().encode(), "refuse"),
+            ("''", "", "refuse"),
+            ("'/'", "/", "refuse"),
+            ("/dev/zero", "/dev/zero", "refuse"),
+            ("a missing file", root / "missing.urdf", "refuse"),
+            ("100 000 nested elements (text)", deep, "refuse"),
+            ("'<'", "<", "refuse"),
+            ("MJCF text", "<mujoco><worldbody/></mujoco>", "refuse"),
+            ("xacro text", "<robot name='x' xmlns:xacro='http://www.ros.org/wiki/xacro'>"
+             "<xacro:property name='l' value='1'/><link name='a'/></robot>", "refuse"),
+            ("the probe arm (text)", _urdf(), "accept"),
+        ]  # fmt: skip
+        sources += [(f"file {n}", root / n, "accept" if n in ("probe.urdf", "urdf.xml")
+                     else "refuse") for n in files]  # fmt: skip
+        for what, source, expect in sources:
+            case(t, f"read_arm {what}", lambda s=source: _arm_ok(read_arm(s)), expect)
+        values = _URDF_VALUES if not quick else _URDF_VALUES[::3]
+        for fld in _URDF_FIELDS:
+            for v in values:
+                text = _urdf(fld, v)
+                case(t, f"read_arm {fld} = {v!r}", lambda s=text: _arm_ok(read_arm(s)), "either")
+        # Tips and fixes of every kind, through every front.
+        args: list[tuple[str, dict[str, Any], str]] = [
+            ("tip=None", {}, "accept"),
+            ("tip='l2'", {"tip": "l2"}, "accept"),
+            ("tip=''", {"tip": ""}, "refuse"),
+            ("tip=1", {"tip": 1}, "refuse"),
+            ("tip='base'", {"tip": "base"}, "refuse"),
+            ("tip='j1' (a joint)", {"tip": "j1"}, "refuse"),
+            ("tip='nowhere'", {"tip": "nowhere"}, "refuse"),
+            ("fix=('j2',)", {"fix": ("j2",)}, "accept"),
+            ("fix='j2' (a string)", {"fix": "j2"}, "refuse"),
+            ("fix=('nope',)", {"fix": ("nope",)}, "refuse"),
+            ("fix=(1,)", {"fix": (1,)}, "refuse"),
+            ("fix=None", {"fix": None}, "either"),
+            ("fix=every joint", {"fix": ("j1", "j2", "j3", "j4")}, "refuse"),
+        ]
+        fronts: list[tuple[str, Callable[..., None]]] = [
+            ("read_arm", lambda **kw: _arm_ok(read_arm(probe, **kw))),
+            ("Chain.from_urdf", lambda **kw: _chain_ok(Chain.from_urdf(probe, **kw))),
+        ]
+        try:
+            from adaptimp.baselines import ComputedTorque
+
+            def ct(**kw: Any) -> None:
+                c = ComputedTorque(str(probe), **kw)
+                q = [0.1] * c.n
+                for _ in range(3):
+                    _finite(c.step(q, [0.0] * c.n, [0.0] * c.n, xc=q))
+
+            fronts.append(("ComputedTorque", ct))
+        except ImportError:
+            pass
+        try:
+            from adaptimp import mujoco as amj
+
+            def plant(**kw: Any) -> None:
+                _finite(amj.simulate("pd", str(probe), T=0.02, **kw).tau_sat)
+
+            fronts.append(("mujoco.simulate", plant))
+        except ImportError:
+            pass
+        for front, fn in fronts:
+            for what, kw, expect in args:
+                case(t, f"{front} {what}", lambda fn=fn, kw=kw: fn(**kw), expect)
+        drives = [("True", True, "accept"), ("None", None, "accept"),
+                  ("'yes'", "yes", "refuse"), ("1.5", 1.5, "refuse")]  # fmt: skip
+        for what, drive, expect in drives:
+            if any(f == "ComputedTorque" for f, _ in fronts):
+                case(t, f"ComputedTorque drive={what}", lambda d=drive: ct(drive=d), expect)
+        # The inertials a computed torque would use: unphysical ones.
+        for fld, v in [("mass", "1e200"), ("mass", "1e-320"), ("inertia ixx", "-1"),
+                       ("inertia ixx", "1e200"), ("mass", "0")]:  # fmt: skip
+            path = root / f"inertial_{fld.replace(' ', '_')}_{v}.urdf"
+            path.write_text(_urdf(fld, v))
+            if any(f == "ComputedTorque" for f, _ in fronts):
+
+                def model(p: Path = path) -> None:
+                    c = ComputedTorque(str(p))
+                    _finite(c.inverse_dynamics([0.1, 0.2], [0.3, 0.0], [0.0, 1.0]))
+                    _finite(c.mass_matrix([0.1, 0.2]))
+                    check(bool(np.all(np.linalg.eigvalsh(c.mass_matrix([0.1, 0.2])) > 0)),
+                          "a mass matrix that is not positive definite")  # fmt: skip
+
+                case(t, f"ComputedTorque of a URDF with {fld} = {v}", model, "either")
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
 CATEGORIES: dict[str, Callable[[Tally, bool], None]] = {
     "state restore": restore,
     "fault semantics": faults,
@@ -1306,6 +1491,7 @@ CATEGORIES: dict[str, Callable[[Tally, bool], None]] = {
     "dynamics": dynamics,
     "saves": saves,
     "MuJoCo runs": mujoco_runs,
+    "robot descriptions": descriptions,
 }
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import re
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -142,3 +143,17 @@ def test_a_file_that_cannot_be_a_plant_is_named(
     with pytest.raises(ValueError, match=f"^{re.escape(name)}: ") as e:
         amj.Plant(str(tmp_path / name))
     assert str(e.value) == message
+
+
+def test_drive_that_is_not_a_bool_is_refused() -> None:
+    """drive='yes' (or 1.5) was taken as True: the description's drive terms in
+    the model, silently."""
+    from adaptimp import mujoco as amj
+
+    hobby = Path(__file__).parent / "data" / "hobby_arm.urdf"
+    for drive in ("yes", 1.5, 1):
+        with pytest.raises(TypeError, match=r"^drive must be True, False or None, got "):
+            ComputedTorque(str(hobby), drive=drive, tau_max=5.0)
+        with pytest.raises(TypeError, match=r"^drive must be True or False, got "):
+            amj.from_urdf(hobby, drive=drive)
+    assert ComputedTorque(str(hobby), drive=True, tau_max=5.0).drive["damping"][0] == 0.1

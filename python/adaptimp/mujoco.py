@@ -291,6 +291,8 @@ def from_urdf(
         longest and no ``tip`` (the message names the file and what to do).
     """
     arm = _urdf_arm(path, tip, fix)
+    if not isinstance(drive, bool):  # 'yes' was taken as True
+        raise TypeError(f"drive must be True or False, got {drive!r}")
     return _compile_arm(_arm_spec(arm, timestep, drive=drive, stacklevel=3))
 
 

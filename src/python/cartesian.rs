@@ -755,7 +755,7 @@ fn shape_other_than(obj: &Bound<'_, PyAny>, want: &[&[usize]]) -> Option<String>
         .and_then(|np| np.call_method1("shape", (obj,)))
         .and_then(|s| s.extract())
         .ok()?;
-    if want.iter().any(|w| *w == shape.as_slice()) {
+    if want.contains(&shape.as_slice()) {
         return None;
     }
     let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();

@@ -1,8 +1,8 @@
 """The break-it probe (scripts/breakit.py), its quick form: about a thousand
 deterministic cases over state restore (bit flips, edits), the fault
 semantics, the n-joint API, sweeps and their cache, chains, the Cartesian
-front, formulations, the dynamics and computed torque, saved results and
-MuJoCo runs, each category in its own process. Not one crash, hang, silent
+front, formulations, the dynamics and computed torque, saved results,
+MuJoCo runs and robot descriptions, each category in its own process. Not one crash, hang, silent
 wrong result or false refusal."""
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ def test_the_quick_break_it_probe_finds_nothing() -> None:
         "dynamics",
         "saves",
         "MuJoCo runs",
+        "robot descriptions",
     ]
     for t in tallies:
         assert t["cases"] >= 10, t

@@ -326,70 +326,75 @@ fn tree_of(
     let links = robot
         .links
         .iter()
-        .map(|l| {
-            let i = &l.inertial.inertia;
-            Link {
-                name: l.name.clone(),
-                inertial: with_inertial.contains(&l.name).then(|| LinkInertial {
-                    mass: l.inertial.mass.value,
-                    origin: origin(&l.inertial.origin),
-                    inertia: [
-                        [i.ixx, i.ixy, i.ixz],
-                        [i.ixy, i.iyy, i.iyz],
-                        [i.ixz, i.iyz, i.izz],
-                    ],
-                }),
-            }
-        })
+        .map(|l| link_of(l, with_inertial))
         .collect();
-    let joints = robot
-        .joints
-        .iter()
-        .map(|j| {
-            let mut kind = match j.joint_type {
-                urdf_rs::JointType::Fixed => JointType::Fixed,
-                urdf_rs::JointType::Revolute => JointType::Revolute,
-                urdf_rs::JointType::Continuous => JointType::Continuous,
-                urdf_rs::JointType::Prismatic => JointType::Prismatic,
-                urdf_rs::JointType::Floating => JointType::Floating,
-                urdf_rs::JointType::Planar => JointType::Planar,
-                urdf_rs::JointType::Spherical => JointType::Ball,
-            };
-            let mut joint = TreeJoint::new(
-                &j.name,
-                kind,
-                &j.parent.link,
-                &j.child.link,
-                origin(&j.origin),
-            );
-            joint.axis = *j.axis.xyz;
-            let (lo, hi) = (j.limit.lower, j.limit.upper);
-            let ranged = lo < hi;
-            if kind == JointType::Revolute && !ranged {
-                kind = JointType::Continuous;
-            }
-            joint.kind = kind;
-            if matches!(kind, JointType::Revolute | JointType::Prismatic) && ranged {
-                joint.lower = lo;
-                joint.upper = hi;
-            }
-            if kind.is_movable() {
-                joint.effort = stated(j.limit.effort);
-                joint.velocity = stated(j.limit.velocity);
-            }
-            if let Some(d) = &j.dynamics {
-                joint.damping = d.damping;
-                joint.friction = d.friction;
-            }
-            joint.mimic = j.mimic.as_ref().map(|m| Mimic {
-                joint: m.joint.clone(),
-                multiplier: m.multiplier.unwrap_or(1.0),
-                offset: m.offset.unwrap_or(0.0),
-            });
-            joint
-        })
-        .collect();
+    let joints = robot.joints.iter().map(joint_of).collect();
     Tree::new(source, &robot.name, links, joints, Vec::new())
+}
+
+/// A parsed link: its inertial if its element has one (`with_inertial`;
+/// urdf-rs gives every link one).
+fn link_of(l: &urdf_rs::Link, with_inertial: &std::collections::BTreeSet<String>) -> Link {
+    let i = &l.inertial.inertia;
+    Link {
+        name: l.name.clone(),
+        inertial: with_inertial.contains(&l.name).then(|| LinkInertial {
+            mass: l.inertial.mass.value,
+            origin: origin(&l.inertial.origin),
+            inertia: [
+                [i.ixx, i.ixy, i.ixz],
+                [i.ixy, i.iyy, i.iyz],
+                [i.ixz, i.iyz, i.izz],
+            ],
+        }),
+    }
+}
+
+/// A parsed joint (SPEC (21.1), URDF): a revolute joint without a range is
+/// continuous; limits only where they leave a range; an effort or velocity
+/// of a movable joint NaN unless stated; its dynamics and mimic.
+fn joint_of(j: &urdf_rs::Joint) -> TreeJoint {
+    let mut kind = match j.joint_type {
+        urdf_rs::JointType::Fixed => JointType::Fixed,
+        urdf_rs::JointType::Revolute => JointType::Revolute,
+        urdf_rs::JointType::Continuous => JointType::Continuous,
+        urdf_rs::JointType::Prismatic => JointType::Prismatic,
+        urdf_rs::JointType::Floating => JointType::Floating,
+        urdf_rs::JointType::Planar => JointType::Planar,
+        urdf_rs::JointType::Spherical => JointType::Ball,
+    };
+    let mut joint = TreeJoint::new(
+        &j.name,
+        kind,
+        &j.parent.link,
+        &j.child.link,
+        origin(&j.origin),
+    );
+    joint.axis = *j.axis.xyz;
+    let (lo, hi) = (j.limit.lower, j.limit.upper);
+    let ranged = lo < hi;
+    if kind == JointType::Revolute && !ranged {
+        kind = JointType::Continuous;
+    }
+    joint.kind = kind;
+    if matches!(kind, JointType::Revolute | JointType::Prismatic) && ranged {
+        joint.lower = lo;
+        joint.upper = hi;
+    }
+    if kind.is_movable() {
+        joint.effort = stated(j.limit.effort);
+        joint.velocity = stated(j.limit.velocity);
+    }
+    if let Some(d) = &j.dynamics {
+        joint.damping = d.damping;
+        joint.friction = d.friction;
+    }
+    joint.mimic = j.mimic.as_ref().map(|m| Mimic {
+        joint: m.joint.clone(),
+        multiplier: m.multiplier.unwrap_or(1.0),
+        offset: m.offset.unwrap_or(0.0),
+    });
+    joint
 }
 
 /// `s` as an XML attribute value (quoted, escaped).

@@ -74,9 +74,9 @@ from typing import Any
 import numpy as np
 
 import adaptimp
-from adaptimp import cartesian as ac
-from adaptimp import contact as act
 from adaptimp import mujoco as amj
+from adaptimp.scenarios import contact as act
+from adaptimp.scenarios import panda_table as apt
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
 """``ADAPTIMP_QUICK=1``: T = 2.5 s (the tool is pressed in at 1.8 s)."""
@@ -112,7 +112,7 @@ KEYS = (
 FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "contact_force.png"
 
 
-def controller(name: str, sc: ac.PandaTable, rule: dict[str, Any]) -> Any:
+def controller(name: str, sc: apt.PandaTable, rule: dict[str, Any]) -> Any:
     """The controller of one row on the scenario; ``rule``: the scenario's
     :func:`adaptimp.contact.rule_keywords`."""
     _, kind, formulation, ff, learn = ROWS[name]
@@ -121,11 +121,11 @@ def controller(name: str, sc: ac.PandaTable, rule: dict[str, Any]) -> Any:
         extra["admittance_share"] = SHARE
     if kind in ("pd", "sf", "of"):
         extra.update({k: v for k, v in rule.items() if learn or k not in LEARN_KEYS})
-    return ac.panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
+    return apt.panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
 
 
 def run(
-    name: str, sc: ac.PandaTable, rule: dict[str, Any], T: float
+    name: str, sc: apt.PandaTable, rule: dict[str, Any], T: float
 ) -> tuple[Any, Any, dict[str, float]]:
     """One row on the scenario: (result, controller, metrics)."""
     ctrl = controller(name, sc, rule)
@@ -170,7 +170,7 @@ def figure(path: Path, T: float) -> None:
     plt.close(fig)
 
 
-def long_run(sc: ac.PandaTable, rule: dict[str, Any], T: float) -> None:
+def long_run(sc: apt.PandaTable, rule: dict[str, Any], T: float) -> None:
     """SF (unified, n = SHARE) for T seconds, in parts of 10 s in the core's loop
     (the plant and the controller go on from one part to the next: the rows of
     one run); prints ‖Ŵ‖_F and the mean normal force every 10 s."""

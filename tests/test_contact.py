@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import cartesian as ac
-from adaptimp import contact as act
 from adaptimp import mujoco as amj
+from adaptimp.scenarios import contact as act
+from adaptimp.scenarios import panda_table as apt
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "13_panda_table.py"
 SLIDING = Path(__file__).resolve().parent.parent / "scripts" / "sliding_contact.py"
@@ -37,7 +37,7 @@ def test_the_torque_level_formulation_holds_a_rigid_frictionless_table() -> None
     feedforward (SPEC (19.2) with a model): the force is K_d δ_c, steady, and the
     tool never leaves the table."""
     sc = act.arm_table(friction=0.0)
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=3.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
     assert m["force_target_N"] == pytest.approx(7.5)
@@ -60,7 +60,7 @@ def test_the_unified_formulation_holds_the_table_with_the_paper_s_feedforward() 
     centres and learning: no chatter, no loss of contact on the frictionless
     table (the admittance alone chatters, SPEC §19)."""
     sc = act.arm_table(friction=0.0)
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, formulation="unified", admittance_share=0.3, **act.rule_keywords(sc)
     )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=3.0, q0=sc.q0)
@@ -78,7 +78,7 @@ def test_a_spring_table_gives_the_force_16_1_prescribes() -> None:
     k_e = 5000.0
     sc = act.arm_table(friction=0.0, spring=k_e, freq=1e-9)
     assert amj.Plant(sc.model).n == 7  # the spring's slide joint is the table's
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     fn = -res.wrench_ee[-500:, 2].mean()
     log = ctrl.arrays()
@@ -225,7 +225,7 @@ def test_the_panda_s_tool_slides_on_the_friction_table_without_chatter() -> None
     the torque-level formulation: the force is steady (MuJoCo's default contact:
     7.2 N of chatter, 1.2 s without contact over t ∈ [2, 6] s)."""
     sc = act.arm_table()
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
     assert m["force_chatter_N"] < 1e-3
@@ -239,7 +239,7 @@ def test_the_ur5_s_tool_stays_on_the_frictionless_table() -> None:
     (impedance): no single-step lift-offs (with the pyramid: 0.67 N of chatter
     and 0.019 s without contact over t ∈ [2, 6] s)."""
     sc = act.arm_table(_ur5(), friction=0.0)
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
     assert m["force_chatter_N"] < 1e-3
@@ -282,8 +282,6 @@ def test_the_scenario_s_joint_gains_take_continuous_joints_as_angles() -> None:
     through tuning.inertia, which takes the chain's angles; they equal the rule
     (18.1) computed from MuJoCo's mass matrix of the same arm, an independent
     engine, to 1e-9 (Pinocchio's CRBA on the 6 angles failed with "expected 9, got 6")."""
-    from adaptimp import panda_table as apt
-
     urdf = _ur5().parent.parent.parent / "kinova_description" / "robots" / "kinova.urdf"
     sc = act.arm_table(urdf)
     assert sc.pin_model.nq == 9
@@ -302,13 +300,11 @@ def test_a_light_wrist_does_not_ring_against_the_table() -> None:
     rang at half the sampling rate and the tool chattered on the table (SF
     unified: 183 N). panda_table.joint_gains carry SPEC (18.4)'s kr = φ Kp/2,
     as the rule does."""
-    from adaptimp import panda_table as apt
-
     urdf = _ur5().parent / "ur10_robot.urdf"
     sc = act.arm_table(urdf)
     gains = apt.joint_gains(sc)
     np.testing.assert_allclose(gains["kr"], 0.025 * np.asarray(gains["Kp"]), rtol=1e-15)
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf",
         sc,
         force_feedforward=False,
@@ -345,7 +341,7 @@ def test_the_heavy_ur10_learns_its_gravity_before_it_reaches_the_table() -> None
     never exceeds a few times K_d δ_c, and it holds (SPEC (19.6))."""
     urdf = _ur5().parent / "ur10_robot.urdf"
     sc = act.arm_table(urdf)
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3,
         **act.rule_keywords(sc),
     )  # fmt: skip
@@ -389,7 +385,7 @@ def test_the_z1_presses_on_the_table_with_the_rule() -> None:
     with the rule's keywords meets the issue's targets over t ≥ 2 s of a 4 s
     run (T = 20 s: 0.073 mm, 0.029 N, docs/contact.md)."""
     sc = act.arm_table(_erd("z1_description/urdf/z1.urdf"))
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3,
         **act.rule_keywords(sc),
     )  # fmt: skip
@@ -469,7 +465,7 @@ def test_an_arm_three_times_the_ur10_holds_the_table(tmp_path: Path) -> None:
     urdf.write_text(text)
     sc = act.arm_table(urdf)
     assert act.CONTACT_K1 == 10.0
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3,
         **act.rule_keywords(sc),
     )  # fmt: skip

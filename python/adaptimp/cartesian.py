@@ -22,8 +22,8 @@ Every parameter is declared once, in the core's schema (group ``"cartesian"``:
 ``force_feedforward``; ``adaptimp params`` lists them with units and defaults).
 ``Kd_rot = 0`` makes the loop position-only.
 
-The scenario "panda-table" (the Panda drawing a circle on a table) lives in
-:mod:`adaptimp.panda_table`; its names are re-exported here.
+The scenarios over this API (the Panda drawing a circle on a table, the same
+table for any arm) live in :mod:`adaptimp.scenarios`; this module imports none.
 
 Sign convention (SPEC §4, §16): the wrench F_e = [f; m] (N, N m) is what the
 tip exerts on the environment, world frame, the moment about the tip (pressing
@@ -44,28 +44,12 @@ from . import _adaptimp
 from ._errors import ConfigError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
 from .chain import Chain
-from .panda_table import (
-    PandaTable,
-    cartesian_metrics,
-    joint_gains,
-    orbit_basis,
-    panda_controller,
-    panda_table,
-    pinocchio_kinematics,
-)
 
 __all__ = [
     "CartesianController",
     "CartesianImpedance",
     "Chain",
-    "PandaTable",
     "Path",
-    "cartesian_metrics",
-    "joint_gains",
-    "orbit_basis",
-    "panda_controller",
-    "panda_table",
-    "pinocchio_kinematics",
     "pose_target",
 ]
 

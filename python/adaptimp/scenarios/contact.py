@@ -1,0 +1,887 @@
+"""Contact that holds (SPEC §19, ``docs/contact.md``): the table scenario on any arm.
+
+:func:`arm_table` builds the scenario "panda-table" (:mod:`adaptimp.scenarios.panda_table`)
+for any serial arm given as a URDF: the arm in MuJoCo with a tool sphere and a
+force/torque sensor at its tip, a table in front of it, the path (the home
+posture held while the networks learn gravity, an approach arriving at rest
+on the table's surface, the depth δ_c pressed in, then a 5 cm circle at 0.25
+Hz on it; SPEC (19.6)), placed from the arm's reach at its home posture. The
+table is rigid (MuJoCo's contact) or, with ``spring=k_e``, mounted on a
+vertical spring of stiffness k_e (N/m): a compliant environment where SPEC
+(16.1) prescribes the force.
+
+:func:`contact_metrics` gives a run's metrics under the names of the
+scenario's JSON table: ``track_mm``, ``force_rms_err_N``, ``force_target_N``,
+``force_chatter_N``, ``contact_lost_s``, ``peak_tau_ratio``, ``sat_duty``.
+
+MuJoCo and Pinocchio are imported when a function needs them. Units: m, s,
+rad, N, N m, kg.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .._errors import ConfigError
+from ..chain import Chain
+from .panda_table import PandaTable, cartesian_metrics
+
+__all__ = [
+    "AXIS_SHARE",
+    "CLEARANCE",
+    "CONTACT_K1",
+    "MAX_PATH_STEPS",
+    "MIN_REACH_SHARE",
+    "OUTWARD",
+    "REACH_SHARE",
+    "SAG_MARGIN",
+    "SLIP_SHARE",
+    "TABLE_MASS",
+    "TABLE_TIMECONST",
+    "T_APPROACH",
+    "T_HOLD",
+    "T_PRESS",
+    "arm_model",
+    "arm_table",
+    "contact_metrics",
+    "placement",
+    "rule_keywords",
+    "sag",
+    "sliding_timeconst",
+]
+
+FloatArray = NDArray[np.float64]
+
+CLEARANCE = 0.027
+"""The smallest gap (m) between the tool sphere at the home posture and the table
+top (the Panda scenario's); :func:`arm_table` makes it at least :data:`SAG_MARGIN`
+times the arm's :func:`sag`."""
+
+SAG_MARGIN = 2.0
+"""The table top lies at least this many times the arm's :func:`sag` below the
+tool at home: the networks start at zero, and until Ĝ has learnt gravity (the
+hold, :data:`T_HOLD`) the arm hangs below its path; it must not reach the table
+then (SPEC (19.6))."""
+
+CONTACT_K1 = 10.0
+"""K1 (1/s) of the table's joint controllers, at most the rule's (18.2)
+min(50, 0.05/Ts): the position loop that pulls the arm onto the compliant
+reference, which the contact wrench moves. At 50 s⁻¹ it follows the landing's
+force spike and the tool bounced off the table (87–240 N, 0.3–0.5 s off on
+the Panda, the UR5 and the UR10); at 20 s⁻¹ the six arms held, but a UR10 with
+three times its masses and torques landed early and rang (14 N of force error,
+3.4 s off); at 10 s⁻¹, between the impedance's K_d/B_d = 7.9 s⁻¹ and its
+√(K_d/M_d) = 15.8 s⁻¹, every arm measured holds. The learning keeps the
+rule's bandwidth (18.6) (SPEC (19.6))."""
+
+T_HOLD = 0.5
+"""The path holds the home posture this long (s) before the approach: the
+networks learn the arm's gravity in free space, where they will then act."""
+
+T_APPROACH = 1.3
+"""The approach (from home to the table's surface, arriving at rest) ends at
+this time (s)."""
+
+T_PRESS = 0.5
+"""After the approach the commanded depth grows from 0 to δ_c over this long
+(s): the force rises from zero instead of an impact."""
+
+OUTWARD = 0.10
+"""How far (m) beyond the home TCP, away from the base's vertical axis, the
+circle's centre lies (horizontally)."""
+
+REACH_SHARE = 0.7
+"""The circle's centre lies at most this share of the arm's horizontal reach
+from the base's vertical axis."""
+
+MIN_REACH_SHARE = 0.4
+"""… and at least this share of it: a folded home posture (the tip above the
+base, the Unitree Z1's rest) does not put the circle where the arm cannot
+press on the table."""
+
+AXIS_SHARE = 0.1
+"""A home tip closer than this share of the reach to the base's vertical axis
+has no outward direction of its own; the circle then lies along the base's x
+axis."""
+
+TABLE_MASS = 1.0
+"""Mass (kg) of a spring-mounted table top (``spring=``); critically damped, its
+weight carried by the spring's preload (the top at rest where the rigid one is)."""
+
+
+SLIP_SHARE = 0.5
+"""Share of the prescribed normal force that MuJoCo's friction-to-normal coupling
+may reach while the tool slides (SPEC (19.5)): the friction rows' time constant
+is set so that μ D_t B_t v ≤ SLIP_SHARE · F_n."""
+
+TABLE_TIMECONST = 0.01
+"""Time constant (s) of the tool–table contact's normal row (``solref``, damping
+ratio 1; MuJoCo's default is 0.02 s): a rigid table whose own compliance is
+small against K_d and k_e (SPEC §19: at 0.02 s the Panda's tool sinks 0.13 mm
+under 7.5 N, a 58 kN/m spring in series that takes 2.4 % off (16.1)'s force
+on the 5 kN/m table; at 0.01 s, 4 times stiffer, 0.7 %), within MuJoCo's
+stability advice (time constant ≥ 2 timesteps) for steps up to 5 ms. The
+friction rows are never made stiffer than this."""
+
+
+_NOMINAL_KD = 500.0
+"""K_d,z (N/m) of SPEC §16's default impedance: the scenario's prescribed force is
+K_d,z δ_c (:meth:`PandaTable.target_force`)."""
+
+
+def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float) -> float:
+    """The time constant (s) of the tool–table contact's friction rows (MuJoCo's
+    ``pair/solreffriction``, damping ratio 1) under which the tool, sliding at
+    ``speed`` (m/s) with sliding friction ``friction`` while it presses with
+    ``force`` (N), stays on the table (SPEC §19, (19.5)).
+
+    MuJoCo's convex contact is one cost over the normal and the friction rows:
+    while the contact slides, the friction rows' reference −B_t v (B_t =
+    2/(d_max τ_t)) cannot be met and the solver moves the unmet part into the
+    normal row, as an upward force of about μ D B_t v, D = d/((1 − d) A) with A
+    MuJoCo's inverse-mass approximation of the contact (``body_invweight0`` of
+    the tool and the table at qpos0) and d the impedance (``solimp``). When it
+    exceeds the pressing force the tool lifts off for a step, falls back, and
+    the force alternates. (19.5) keeps it at :data:`SLIP_SHARE` of ``force``
+    with d = d_max: B_t = SLIP_SHARE · F (1 − d_max) A/(d_max μ v), τ_t =
+    2/(d_max B_t), at least :data:`TABLE_TIMECONST`. ``friction``, ``speed``
+    or ``force`` zero: :data:`TABLE_TIMECONST` (nothing slides under load).
+    The normal row keeps its own time constant (:data:`TABLE_TIMECONST`).
+    """
+    import mujoco
+
+    tool = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "tool")
+    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "table")
+    if tool < 0 or table < 0:
+        raise ValueError("the model has no geoms 'tool' and 'table'")
+    if friction <= 0 or speed <= 0 or force <= 0:
+        return TABLE_TIMECONST
+    inv_mass = float(
+        model.body_invweight0[model.geom_bodyid[tool], 0]
+        + model.body_invweight0[model.geom_bodyid[table], 0]
+    )
+    dmax = float(max(model.geom_solimp[tool, 1], model.geom_solimp[table, 1]))
+    damping = SLIP_SHARE * force * (1.0 - dmax) * inv_mass / (dmax * friction * speed)
+    return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
+
+
+def _unused_body(spec: Any, name: str) -> str:
+    """``name``, or ``name_1``, ``name_2``, … if the arm already has a body of
+    that name (a URDF link called "tool" or "table"). Only the bodies are
+    renamed: the URDF's geoms are dropped, so the geoms, the site and the
+    sensors keep their names."""
+    i, candidate = 0, name
+    while spec.body(candidate) is not None:
+        i += 1
+        candidate = f"{name}_{i}"
+    return candidate
+
+
+def _tool_and_table(
+    spec: Any,
+    tip: str,
+    *,
+    tool_radius: float,
+    table_top: float | None,
+    centre: ArrayLike,
+    friction: float,
+    spring: float | None,
+) -> None:
+    """Add the tool: a massless body ``tool`` at the origin of the tip body with
+    the sphere (the arm's only collision geometry) and the site ``ee`` with
+    force/torque sensors; and the table (static, or on a vertical slide joint
+    with stiffness ``spring`` N/m)."""
+    import mujoco
+
+    parent = spec.body(tip)
+    if parent is None:
+        raise ValueError(f"the model has no body {tip!r} for the tool")
+    # A massless body of its own at the tip's origin: its force sensor reads
+    # the contact alone (on a body with mass it would add its weight).
+    body = parent.add_body(name=_unused_body(spec, "tool"))
+    body.add_site(name="ee", size=[0.01, 0, 0])
+    body.add_geom(
+        name="tool",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[tool_radius, 0, 0],
+        contype=1,
+        conaffinity=1,
+        mass=0.0,
+        density=0.0,
+        friction=[friction, 0.005, 0.0001],
+        solref=[TABLE_TIMECONST, 1.0],
+    )
+    for name, kind in (("ee_force", "mjSENS_FORCE"), ("ee_torque", "mjSENS_TORQUE")):
+        spec.add_sensor(
+            name=name,
+            type=getattr(mujoco.mjtSensor, kind),
+            objtype=mujoco.mjtObj.mjOBJ_SITE,
+            objname="ee",
+        )
+    if table_top is None:
+        return
+    thickness = 0.05
+    c = np.asarray(centre, dtype=np.float64)
+    table = spec.worldbody.add_body(
+        name=_unused_body(spec, "table"), pos=[float(c[0]), float(c[1]), table_top - thickness / 2]
+    )
+    if spring is not None:
+        table.add_joint(
+            name="table_spring",
+            type=mujoco.mjtJoint.mjJNT_SLIDE,
+            axis=[0, 0, 1],
+            stiffness=spring,
+            damping=2.0 * math.sqrt(spring * TABLE_MASS),
+            # At rest under its weight the top is at table_top: the spring
+            # carries the table (g = 9.81 m/s², MuJoCo's default).
+            springref=TABLE_MASS * 9.81 / spring,
+        )
+    table.add_geom(
+        name="table",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[0.35, 0.5, thickness / 2],
+        contype=1,
+        conaffinity=1,
+        friction=[friction, 0.005, 0.0001],
+        solref=[TABLE_TIMECONST, 1.0],
+        rgba=[0.6, 0.5, 0.4, 1.0],
+        mass=TABLE_MASS,
+    )
+    # The Coulomb cone itself, not its pyramid: a pyramid's edges mix the
+    # normal into every row and scale their regulariser by 2μ² (at μ = 0,
+    # MuJoCo's floor 1e-5: a contact so stiff that it lifts off for single
+    # steps; SPEC §19). The tool–table contact as an explicit pair, so that its
+    # friction rows get their own time constant (sliding_timeconst).
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    if friction > 0:
+        spec.add_pair(
+            name="tool_table",
+            geomname1="tool",
+            geomname2="table",
+            condim=3,
+            friction=[friction, friction, 0.005, 0.0001, 0.0001],
+            solref=[TABLE_TIMECONST, 1.0],
+            solreffriction=[TABLE_TIMECONST, 1.0],
+        )
+
+
+def arm_model(
+    urdf: str | os.PathLike[str],
+    tip: str,
+    *,
+    fix: tuple[str, ...] = (),
+    tool_radius: float = 0.01,
+    table_top: float | None = None,
+    centre: ArrayLike = (0.0, 0.0),
+    friction: float = 0.1,
+    spring: float | None = None,
+    home: ArrayLike | None = None,
+    timestep: float = 5e-4,
+    force: float = 0.0,
+    speed: float = 0.0,
+) -> Any:
+    """A URDF arm in MuJoCo with a tool and a table (see the module doc).
+
+    The arm as :func:`adaptimp.mujoco.from_urdf` makes it (rigid-body dynamics
+    only, a motor per joint with ctrlrange ± its effort limit, RK4), joints in
+    ``fix`` fixed at zero; the tool sphere of ``tool_radius`` (m) at the origin
+    of body ``tip`` with the site ``ee`` and its force/torque sensors; a 0.7 ×
+    1.0 m table whose top is at height ``table_top`` (m; None: no table),
+    centred at ``centre`` (x, y), sliding friction ``friction`` for the table
+    and the tool, rigid or on a vertical spring of ``spring`` N/m (a slide
+    joint, mass :data:`TABLE_MASS`, critically damped). Keyframe ``home``.
+
+    The contact (SPEC §19): MuJoCo's elliptic (Coulomb) cone, its default
+    ``solimp``, ``solref`` with the time constant :data:`TABLE_TIMECONST`; with
+    friction, the tool–table contact is the explicit pair ``tool_table`` whose
+    friction rows have the time constant :func:`sliding_timeconst` for a tool
+    pressing with ``force`` (N) while it slides at ``speed`` (m/s) (zero:
+    :data:`TABLE_TIMECONST`).
+    """
+    import mujoco
+
+    from .. import mujoco as amj
+
+    spec, effort = amj._urdf_spec(Path(urdf).read_text(), fix)
+    spec.option.timestep = timestep
+    missing = [j.name for j in spec.joints if not 0 < effort.get(j.name, math.nan) < math.inf]
+    if missing:
+        # The arm's own estimate, as adaptimp.mujoco.from_urdf makes it (and
+        # says so): 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|).
+        arm = amj.from_urdf(urdf, fix=fix, tip=tip)
+        for name in missing:
+            a = mujoco.mj_name2id(arm, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+            if a < 0:
+                raise ValueError(
+                    f"joint {name!r} has no <limit effort=...> and is not one the arm's "
+                    f"model drives (from_urdf(tip={tip!r}) fixes it): give it in fix=..."
+                )
+            effort[name] = float(arm.actuator_ctrlrange[a][1])
+    amj._add_motors(spec, effort)
+    _tool_and_table(
+        spec,
+        tip,
+        tool_radius=tool_radius,
+        table_top=table_top,
+        centre=centre,
+        friction=friction,
+        spring=spring,
+    )
+    if home is not None:
+        qpos = list(np.asarray(home, dtype=np.float64))
+        if spring is not None:
+            qpos.append(0.0)
+        spec.add_key(name="home", qpos=qpos)
+    # Inertias that do not compile as they are: bounded and balanced as
+    # adaptimp.mujoco.from_urdf does, and said as it says it.
+    model = amj._compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    if model.npair:
+        model.pair_solreffriction[0] = [
+            sliding_timeconst(model, force=force, speed=speed, friction=friction),
+            1.0,
+        ]
+    return model
+
+
+def placement(
+    chain: Chain,
+    home: ArrayLike,
+    limits: tuple[ArrayLike, ArrayLike],
+    *,
+    tool_radius: float = 0.01,
+    seed: int = 0,
+    clearance: float = CLEARANCE,
+) -> tuple[FloatArray, float, float]:
+    """Where the table and the circle go for an arm at ``home`` (rad), from its
+    reach (SPEC §19, "the scenario on any arm").
+
+    With p_h the tip at home and u the horizontal unit vector from the base's
+    vertical axis to p_h (the base's x axis if p_h is within :data:`AXIS_SHARE`
+    of R of that axis): the circle's centre lies :data:`OUTWARD` beyond p_h
+    along u, but at least :data:`MIN_REACH_SHARE` and at most
+    :data:`REACH_SHARE` of the horizontal reach R (the
+    largest horizontal distance of the tip over 1024 postures drawn uniformly
+    within ``limits`` = (lo, hi) (rad), each clipped to ±π, seed ``seed``); the
+    table top lies ``clearance`` (m, default :data:`CLEARANCE`) below the tool
+    sphere at home.
+
+    Returns (centre (2,) m, table top m, R m). ``ConfigError`` (naming it and
+    the value) for a ``tool_radius`` that is not a finite number > 0, a
+    ``clearance`` that is not a finite number ≥ 0, a
+    ``home`` or a limit that is not n finite numbers, and lo > hi.
+    """
+    _check_scenario(tool_radius=tool_radius, clearance=clearance)
+    tool_radius, clearance = float(tool_radius), float(clearance)
+    q = _joint_vector("home", home, chain)
+    unlimited = " (±π for an unlimited joint)"
+    lo_given = _joint_vector("limits[0] (lo)", limits[0], chain, unlimited)
+    hi_given = _joint_vector("limits[1] (hi)", limits[1], chain, unlimited)
+    inverted = np.flatnonzero(lo_given > hi_given)
+    if inverted.size:
+        i = int(inverted[0])
+        raise ConfigError(
+            f"limits must have lo ≤ hi for every joint; joint {i} ({chain.joint_names[i]!r}) "
+            f"has lo = {float(lo_given[i])!r} > hi = {float(hi_given[i])!r}"
+        )
+    p = np.asarray(chain.fk(q)[:3, 3], dtype=np.float64)
+    lo = np.clip(lo_given, -math.pi, math.pi)
+    hi = np.clip(hi_given, -math.pi, math.pi)
+    samples = np.random.default_rng(seed).uniform(lo, hi, size=(1024, q.shape[0]))
+    reach = max(float(np.linalg.norm(chain.fk(s)[:2, 3])) for s in samples)
+    radial = float(np.linalg.norm(p[:2]))
+    # A tip near the base's axis (a folded arm at rest) has no direction of
+    # its own: the base's forward axis x.
+    u = p[:2] / radial if radial > AXIS_SHARE * reach else np.array([1.0, 0.0])
+    dist = min(max(radial + OUTWARD, MIN_REACH_SHARE * reach), REACH_SHARE * reach)
+    return dist * u, float(p[2] - tool_radius - clearance), reach
+
+
+def _joint_vector(name: str, value: ArrayLike, chain: Chain, hint: str = "") -> FloatArray:
+    """``value`` as n finite numbers (rad), one per joint of ``chain``, or a
+    ``ConfigError`` naming ``name``, the joint and the value."""
+    n = chain.n
+    try:
+        v = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be {n} finite numbers (rad){hint}, got {value!r}") from None
+    if v.shape != (n,):
+        raise ConfigError(
+            f"{name} must be {n} finite numbers (rad){hint}, one per joint; got shape {v.shape}"
+        )
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        i = int(bad[0])
+        raise ConfigError(
+            f"{name} must be {n} finite numbers (rad){hint}; joint {i} "
+            f"({chain.joint_names[i]!r}) is {float(v[i])!r}"
+        )
+    return v
+
+
+def _limits(plant: Any) -> tuple[FloatArray, FloatArray]:
+    """The arm's joint ranges (rad) from the MuJoCo model (±π where unlimited)."""
+    m = plant.model
+    lo = np.full(plant.n, -math.pi)
+    hi = np.full(plant.n, math.pi)
+    for i, j in enumerate(plant._joints):
+        if m.jnt_limited[j]:
+            lo[i], hi[i] = m.jnt_range[j]
+    return lo, hi
+
+
+def _home(urdf: Path, chain: Chain, plant: Any) -> FloatArray:
+    """The rule's home posture (SPEC §18) if this version has it
+    (``adaptimp.mujoco.home_posture``), else the zero posture."""
+    from .. import mujoco as amj
+
+    rule = getattr(amj, "home_posture", None)
+    if rule is not None:
+        return np.asarray(rule(plant), dtype=np.float64)
+    return np.zeros(chain.n)
+
+
+TABLE_OFFSET_MARGIN = 0.2
+"""The table (0.7 m deep) is centred 0.15 m beyond the circle's centre: the
+circle and the tool stay on it for radius + tool_radius ≤ 0.35 − 0.15 m."""
+
+MAX_PATH_STEPS = 1_000_000
+"""The longest scenario path (periods) :func:`rule_keywords` samples: the hold,
+the approach, the press or ramp and one period of the circle (1000 s at 1 kHz);
+a longer one (a huge ``t_press`` or ``t_ramp``, a tiny ``freq``) is refused
+there, not by :func:`arm_table` (a press without a circle needs no rule)."""
+
+
+def _check_path_length(duration: float, Ts: float) -> None:
+    """Refuse a path whose one circle after the approach lasts beyond
+    :data:`MAX_PATH_STEPS` periods (a huge ``t_press`` or ``t_ramp``, a tiny
+    ``freq``): the rule samples it once, period by period."""
+    steps = duration / Ts
+    if not steps <= MAX_PATH_STEPS:
+        raise ConfigError(
+            f"the scenario's path (the approach, the press or ramp and one circle: "
+            f"{duration:.6g} s) is {steps:.3g} periods of Ts = {Ts:g} s, beyond "
+            f"{MAX_PATH_STEPS}: give a shorter t_press or t_ramp, or a higher freq"
+        )
+
+
+def _check_scenario(**values: float | None) -> None:
+    """Refuse, by name, a scenario quantity that is not a finite number in its
+    range (before any model is built)."""
+    ranges: dict[str, tuple[str, Callable[[float], bool]]] = {
+        "spring": ("> 0 (N/m), or None for a rigid table", lambda v: v > 0),
+        "friction": ("≥ 0", lambda v: v >= 0),
+        "radius": ("> 0 (m)", lambda v: v > 0),
+        "freq": ("> 0 (Hz)", lambda v: v > 0),
+        "depth": ("≥ 0 (m)", lambda v: v >= 0),
+        "tool_radius": ("> 0 (m)", lambda v: v > 0),
+        "Ts": ("> 0 (s)", lambda v: v > 0),
+        "t_approach": ("≥ 0 (s)", lambda v: v >= 0),
+        "t_ramp": ("≥ 0 (s)", lambda v: v >= 0),
+        "t_hold": ("≥ 0 (s)", lambda v: v >= 0),
+        "t_press": ("≥ 0 (s)", lambda v: v >= 0),
+        "clearance": ("≥ 0 (m)", lambda v: v >= 0),
+    }
+    for name, value in values.items():
+        if value is None and name == "spring":
+            continue
+        what, ok = ranges[name]
+        try:
+            # A bool is not a quantity (True would be 1 m, 1 s, 1 N/m).
+            v = math.nan if isinstance(value, bool) else float(value)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            v = math.nan
+        if not (math.isfinite(v) and ok(v)):
+            raise ConfigError(f"{name} must be a finite number {what}, got {value!r}")
+
+
+def arm_table(
+    urdf: str | os.PathLike[str] | None = None,
+    *,
+    tip: str | None = None,
+    fix: tuple[str, ...] = (),
+    home: ArrayLike | None = None,
+    spring: float | None = None,
+    friction: float = 0.1,
+    radius: float = 0.05,
+    freq: float = 0.25,
+    depth: float = 0.015,
+    tool_radius: float = 0.01,
+    Ts: float = 1e-3,
+    t_approach: float = T_APPROACH,
+    t_ramp: float = 1.0,
+    t_hold: float = T_HOLD,
+    t_press: float = T_PRESS,
+) -> PandaTable:
+    """The table scenario for the arm of ``urdf`` (None: the Panda of
+    :func:`adaptimp.scenarios.panda_table.panda_table`, whose table and circle are kept,
+    and which refuses ``tip``, ``fix`` and ``home``: it has its own).
+
+    The path (SPEC (19.6)): the home posture held over [0, ``t_hold``) s, the
+    approach to the circle's start on the table's surface, arriving at rest at
+    ``t_approach`` s, then the commanded depth δ_c pressed in over ``t_press``
+    s while the circle's speed ramps up over ``t_ramp`` s (``t_hold`` =
+    ``t_press`` = 0: the earlier path, straight from home to δ_c into the
+    table by ``t_approach``). For a URDF arm the table top lies
+    max(:data:`CLEARANCE`, :data:`SAG_MARGIN` · :func:`sag`) below the tool
+    at home.
+
+    Refused with a ``ConfigError`` naming the argument (before anything is
+    built where it can be): a quantity that is not a finite number in its
+    range (a bool is not one; a string or NumPy number that reads as one is
+    taken as that number), ``t_hold`` ≥ ``t_approach``, ``freq`` ≥ 1/(2 Ts),
+    a circle that leaves the table (``radius`` + ``tool_radius`` > 0.2 m),
+    ``fix`` that is not a tuple of the URDF's joint names, a ``home``
+    outside the joint limits, and an arm that cannot hold gravity and the
+    press with its friction at home (the joint and both torques named).
+
+    ``tip``: the tool's body (default: the child link of the arm's last joint).
+    The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
+    the rule of :func:`adaptimp.mujoco.from_urdf` (``_models.arm_urdf``, with
+    ``tip``): a gripper's, prismatic, mimic and off-chain joints are fixed,
+    and chains that tie (legs, two arms) need ``tip``; ``home`` (rad): default the rule's home
+    posture; ``spring``: the table's spring stiffness k_e (N/m), None: rigid;
+    ``friction``: sliding friction of table and tool. The rest as
+    :func:`~adaptimp.scenarios.panda_table.panda_table`. The table and the circle are
+    placed by :func:`placement`.
+    """
+    from .. import _models
+    from .. import mujoco as amj
+    from ..baselines import pinocchio_model
+    from .panda_table import panda_table
+
+    _check_scenario(
+        spring=spring, friction=friction, radius=radius, freq=freq, depth=depth,
+        tool_radius=tool_radius, Ts=Ts, t_approach=t_approach, t_ramp=t_ramp,
+        t_hold=t_hold, t_press=t_press,
+    )  # fmt: skip
+    # The checked values as numbers (a string that reads as one, a NumPy scalar).
+    friction, radius, freq, depth = float(friction), float(radius), float(freq), float(depth)
+    tool_radius, Ts, t_ramp = float(tool_radius), float(Ts), float(t_ramp)
+    spring = None if spring is None else float(spring)
+    t_hold, t_press, t_approach = float(t_hold), float(t_press), float(t_approach)
+    if freq >= 0.5 / Ts:
+        raise ConfigError(
+            f"freq must lie below the sampling's 1/(2 Ts) = {0.5 / Ts:g} Hz, got {freq!r}"
+        )
+    if radius + tool_radius > TABLE_OFFSET_MARGIN:
+        raise ConfigError(
+            f"radius must keep the circle and the tool on the table (radius + tool_radius ≤ "
+            f"{TABLE_OFFSET_MARGIN:g} m), got radius = {radius!r}"
+        )
+    given: object = fix  # typed a tuple; a caller may still pass a bare string
+    if not isinstance(given, (tuple, list)) or not all(isinstance(j, str) for j in given):
+        raise ConfigError(f"fix must be a tuple of joint names, got {fix!r}")
+    if t_hold > 0 and t_hold >= t_approach:
+        raise ConfigError(
+            f"t_hold must end before the approach does (t_hold < t_approach), got "
+            f"t_hold = {t_hold!r} and t_approach = {t_approach!r}"
+        )
+    speed = 2.0 * math.pi * freq * radius
+    if urdf is None:
+        # The Panda's scenario has its own tool body, fixed fingers and home.
+        given = {"tip": tip, "fix": fix or None, "home": home}
+        ignored = [k for k, v in given.items() if v is not None]
+        if ignored:
+            raise ConfigError(
+                f"{', '.join(ignored)} {'applies' if len(ignored) == 1 else 'apply'} to the arm "
+                "of a URDF; the Panda's scenario (urdf=None) has its own tool body, fixed "
+                "fingers and home posture: give the Panda's URDF path to set them"
+            )
+        sc = panda_table(
+            radius=radius,
+            freq=freq,
+            depth=depth,
+            friction=friction,
+            tool_radius=tool_radius,
+            Ts=Ts,
+            t_approach=t_approach,
+            t_ramp=t_ramp,
+        )
+        # The Panda of adaptimp.mujoco.panda (the same URDF, inertias, motors
+        # and table), with the tool on a body of its own and this module's
+        # contact (arm_model).
+        sc.model = arm_model(
+            _models.panda_urdf_path(),
+            _models.PANDA_EE,
+            fix=_models.PANDA_FINGERS,
+            tool_radius=tool_radius,
+            table_top=sc.surface_z - tool_radius,
+            centre=(0.55, 0.0),
+            friction=friction,
+            spring=spring,
+            home=sc.q0,
+            force=sc.target_force(),
+            speed=speed,
+        )
+        sc.t_hold, sc.t_press = float(t_hold), float(t_press)
+        sc.__post_init__()
+        plant = amj.Plant(sc.model)
+        _check_press(sc.chain, plant, sc.q0, sc.tau_max, _NOMINAL_KD * depth, friction, tool_radius)
+        return sc
+    path = Path(urdf)
+    # The arm's joints by the one rule of adaptimp.mujoco.simulate and the
+    # Pinocchio model (_models.arm_urdf): a gripper's, prismatic, mimic and
+    # off-chain joints are fixed; by default the tool goes on the last arm
+    # joint's link.
+    text = path.read_text()
+    import xml.etree.ElementTree as ET
+
+    names = {j.get("name") for j in ET.fromstring(text).iter("joint")}
+    unknown = [j for j in fix if j not in names]
+    if unknown:
+        raise ConfigError(f"fix names joints the URDF does not have: {unknown}")
+    arm = _models.arm_urdf(text, fix, tip=tip)
+    tip = arm.tip if tip is None else tip
+    fix = (*fix, *(j for j in arm.fixed if j not in fix))
+    chain = Chain.from_urdf(path, tip=tip)
+    bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
+    import mujoco
+
+    joint = mujoco.mjtObj.mjOBJ_JOINT
+    driven = [amj._name(bare.model, joint, j) for j in bare._joints]
+    if driven != chain.joint_names:
+        raise ConfigError(
+            f"the chain to {tip!r} has the joints {chain.joint_names}, but the arm's model "
+            f"drives {driven} (fix={fix!r}): give a tip whose path holds exactly the "
+            "driven joints, or fix the others"
+        )
+    q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
+    lo, hi = _limits(bare)
+    outside = np.flatnonzero((q0 < lo - 1e-12) | (q0 > hi + 1e-12))
+    if outside.size:
+        i = int(outside[0])
+        raise ConfigError(
+            f"home must lie within the joint limits; joint {i} ({chain.joint_names[i]!r}) "
+            f"has home = {float(q0[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
+        )
+    tau_max = np.asarray(bare.tau_max, dtype=np.float64)
+    _check_press(chain, bare, q0, tau_max, _NOMINAL_KD * depth, friction, tool_radius)
+    clearance = max(CLEARANCE, SAG_MARGIN * sag(chain, bare, q0, tau_max, Ts=Ts))
+    centre, top, _ = placement(
+        chain, q0, _limits(bare), tool_radius=tool_radius, clearance=clearance
+    )
+    table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)
+    model = arm_model(
+        path,
+        tip,
+        fix=fix,
+        tool_radius=tool_radius,
+        table_top=top,
+        centre=table_centre,
+        friction=friction,
+        spring=spring,
+        home=q0,
+        force=_NOMINAL_KD * depth,
+        speed=speed,
+    )
+    return PandaTable(
+        model=model,
+        chain=chain,
+        q0=q0,
+        pin_model=pinocchio_model(path),
+        Ts=Ts,
+        radius=radius,
+        freq=freq,
+        centre=np.asarray(centre, dtype=np.float64),
+        depth=depth,
+        surface_z=top + tool_radius,
+        t_approach=t_approach,
+        t_ramp=t_ramp,
+        tau_max=tau_max,
+        t_hold=float(t_hold),
+        t_press=float(t_press),
+    )
+
+
+def _check_press(
+    chain: Chain,
+    plant: Any,
+    q0: FloatArray,
+    tau_max: FloatArray,
+    force: float,
+    friction: float,
+    tool_radius: float,
+) -> None:
+    """Refuse an arm that cannot hold the press at its home posture: joint i
+    takes |G_i(q0)| + F (|J_c,z,i| + μ ‖J_c,xy,i‖) (N m), gravity and the
+    prescribed normal force F (N) with its sliding friction μF in the worst
+    horizontal direction, acting at the contact point (the tool's centre less
+    ``tool_radius`` along z, J_c its position Jacobian); beyond τmax_i no
+    controller can press (an estimated effort limit of a light wrist, say)."""
+    from .. import tuning
+
+    j = np.asarray(chain.jacobian(q0), dtype=np.float64)
+    o = np.array([0.0, 0.0, -tool_radius])
+    skew = np.array([[0.0, -o[2], o[1]], [o[2], 0.0, -o[0]], [-o[1], o[0], 0.0]])
+    jc = j[:3] - skew @ j[3:]  # v + ω × o
+    g = tuning.gravity(plant, q0)
+    load = np.abs(g if g is not None else 0.0) + force * (
+        np.abs(jc[2]) + friction * np.linalg.norm(jc[:2], axis=0)
+    )
+    over = np.flatnonzero(load > tau_max)
+    if over.size:
+        i = int(over[0])
+        raise ConfigError(
+            f"the arm cannot press on the table: at its home posture joint {i} "
+            f"({chain.joint_names[i]!r}) takes {load[i]:.4g} N m (gravity and the "
+            f"prescribed {force:.4g} N with friction {friction:g}) but its effort limit is "
+            f"{tau_max[i]:.4g} N m; give the URDF a larger <limit effort> for it, or a "
+            "smaller depth or friction"
+        )
+
+
+def sag(chain: Chain, model: Any, q0: ArrayLike, tau_max: ArrayLike, *, Ts: float = 1e-3) -> float:
+    """How far (m) the tip hangs below its path at ``q0`` (rad) under the joint
+    feedback alone, before the networks have learnt gravity: |(J Δq)_z| with
+    Δq_i = G_i/(Kp_i K1) (SPEC (18.5)'s sag, in the task), Kp from the rule
+    (:func:`adaptimp.tuning.suggest` with ``model``'s D(q0), ``tau_max`` (N m),
+    ``Ts`` (s)), K1 = min(:data:`CONTACT_K1`, the rule's), G(q0) and J the tip's position
+    Jacobian from ``chain``. ``model``: what :func:`adaptimp.tuning.gravity`
+    takes (here the arm's ``adaptimp.mujoco.Plant``)."""
+
+    q = _joint_vector("q0", q0, chain)
+    data: Any = getattr(model, "data", None)
+    if data is None:
+        return _sag(chain, model, q, tau_max, Ts)
+    saved = (data.qpos.copy(), data.qvel.copy())
+    try:
+        return _sag(chain, model, q, tau_max, Ts)
+    finally:  # a Plant's state as the caller left it
+        import mujoco
+
+        data.qpos[:], data.qvel[:] = saved
+        mujoco.mj_forward(model.model, data)
+
+
+def _sag(chain: Chain, model: Any, q: FloatArray, tau_max: ArrayLike, Ts: float) -> float:
+    """:func:`sag` without keeping ``model``'s state."""
+    from .. import tuning
+
+    g = tuning.gravity(model, q)
+    if g is None:
+        raise ConfigError(f"sag needs a model that gives G(q); got {type(model).__name__}")
+    kw = tuning.suggest(model, q, tau_max, Ts=Ts)
+    kp = np.asarray(kw["Kp"], dtype=np.float64)
+    dq = g / (kp * min(CONTACT_K1, float(kw["K1"][0])))
+    return float(abs(np.asarray(chain.jacobian(q))[2] @ dq))
+
+
+def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
+    """Keywords of :func:`adaptimp.cartesian.panda_controller` for the joint
+    controller ``case`` on the scenario ``sc``, from the core's rule (SPEC §18,
+    :func:`adaptimp.tuning.suggest`): gains (18.1)–(18.4) from D(q0), the RBF
+    centres (18.5) and the learning (18.6)–(18.8) along the scenario's whole
+    joint path (the hold, the approach, the press and one period of the circle,
+    as the outer loop maps the path on the table's surface into the joints,
+    F_e = 0, taken as one period of that length), and K1 = min(:data:`CONTACT_K1`,
+    the rule's (18.2)) (SPEC (19.6)). Returns ``gains`` (Kp, Kzeta, K1), ``basis`` (centres,
+    widths) and the rest (gamma, sigma, weight_bound, kr, …) as keywords."""
+    from .. import mujoco as amj
+    from .. import tuning
+
+    start = sc.t_approach + max(sc.t_ramp, sc.t_press)
+    _check_path_length(start + 1.0 / sc.freq, sc.Ts)
+    steps = round((start + 1.0 / sc.freq) / sc.Ts)
+    q, dq = sc.outer().joint_orbit(lambda t: sc.path(t, depth=0.0), steps * sc.Ts, samples=steps)
+    ddq = np.gradient(dq, sc.Ts, axis=0)
+
+    def path(t: float) -> tuple[Any, Any, Any]:
+        k = min(round(t / sc.Ts), steps - 1)
+        return q[k], dq[k], ddq[k]
+
+    kw = tuning.suggest(
+        amj.Plant(sc.model), sc.q0, sc.tau_max, Ts=sc.Ts, path=path, period=steps * sc.Ts,
+        case=case,
+    )  # fmt: skip
+    kw["K1"] = [min(CONTACT_K1, float(kw["K1"][0]))] * sc.n  # never above (18.2)
+    out: dict[str, Any] = {
+        "gains": {k: kw[k] for k in ("Kp", "Kzeta", "K1")},
+        "basis": (kw["centers"], kw["widths"]),
+    }
+    skip = {"n", "Kp", "Kzeta", "K1", "centers", "widths", "Ts", "tau_max"}
+    out.update({k: v for k, v in kw.items() if k not in skip})
+    return out
+
+
+def contact_metrics(
+    res: Any, ctrl: Any, sc: PandaTable, *, settle: float = 2.0
+) -> dict[str, float]:
+    """The scenario's table of a run (``res`` from :func:`adaptimp.mujoco.simulate`),
+    over t ≥ ``settle`` (s) unless said:
+
+    - ``track_mm``: RMS ‖p_d − p‖ (mm), the compliant reference against the tip;
+    - ``track_along_mm``: RMS ‖(p_d − p)_xy‖ (mm), its part along the table
+      (the table's plane; the normal part is the force error over K_d,z);
+    - ``force_target_N``: K_d,z δ_c, or for a spring table of k_e (16.1)'s
+      K_d k_e/(K_d + k_e) δ_c (N);
+    - ``force_rms_err_N``: RMS (F_n − target) (N), F_n = −F_e,z;
+    - ``force_chatter_N``: RMS (F_n,k+1 − F_n,k) (N), the sample-to-sample change;
+    - ``force_mean_N``: the mean of F_n (N);
+    - ``force_16_1_N``: what (16.1) prescribes with the measured mean n·e,
+      K_d k_e/(K_d + k_e)(δ_c + n·e) (K_d (δ_c + n·e) for a rigid table), n = −z,
+      e = p − p_d (N);
+    - ``contact_lost_s``: time (s) with F_n ≤ 0 after the first contact at or
+      after the end of the approach, when the commanded point has reached δ_c
+      into the table (``t_approach + t_press``; all the time after it, if
+      none; NaN for a run that ends before it);
+    - ``peak_force_N``: max F_n over the whole run (N), the approach's impact
+      included;
+    - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
+    - ``sat_duty``: fraction of all rows with sat(τ_i) ≠ τ_i on some joint.
+    """
+    m = cartesian_metrics(res, ctrl, sc, settle=settle)
+    kd = float(np.asarray(ctrl.params["Kd"])[2])
+    spring = _spring(sc)
+    target = kd * sc.depth if spring is None else kd * spring / (kd + spring) * sc.depth
+    fn = -np.asarray(res.wrench_ee)[:, 2]
+    t = np.asarray(res.t)
+    after = t >= settle - 1e-9
+    # (16.1) with the measured n·e, n = −z (into the table), e = p − p_d.
+    series = kd if spring is None else kd * spring / (kd + spring)
+    # The run's own task-space rows (the controller's log may hold earlier runs).
+    log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
+    ne = log["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
+    along = (log["pd"][after, :2] - np.asarray(res.x_ee)[after, :2]) * 1e3
+    # The approach ends when the commanded point has reached δ_c (with a
+    # soft landing, the press's end).
+    if t.size > 1 and not np.allclose(np.diff(t), sc.Ts, rtol=1e-9, atol=0.0):
+        raise ConfigError(
+            f"contact_metrics needs every period's row (Ts = {sc.Ts:g} s; the chatter is "
+            "sample to sample): run simulate with record_every=1"
+        )
+    approach = t >= sc.t_approach + sc.t_press - 1e-9
+    contact = np.flatnonzero(approach & (fn > 0))
+    # Never touched after the approach: all of that time is without contact. A
+    # run that ends before the approach does has no such time: NaN.
+    start = contact[0] if contact.size else int(np.argmax(approach))
+    lost = float(np.sum(fn[start:] <= 0) * sc.Ts) if approach.any() else math.nan
+    return {
+        "track_mm": m["rms_track"] * 1e3,
+        "track_along_mm": float(np.sqrt(np.mean(np.sum(along**2, axis=1)))),
+        "peak_force_N": float(np.max(fn)),
+        "force_rms_err_N": float(np.sqrt(np.mean((fn[after] - target) ** 2))),
+        "force_target_N": float(target),
+        "force_chatter_N": float(np.sqrt(np.mean(np.diff(fn[after]) ** 2))),
+        "force_mean_N": float(np.mean(fn[after])),
+        "force_16_1_N": float(series * (sc.depth + np.mean(ne))),
+        "contact_lost_s": lost,
+        "peak_tau_ratio": m["peak_tau_ratio"],
+        "sat_duty": m["sat_duty"],
+        "applied_ratio": m["applied_ratio"],
+    }
+
+
+def _spring(sc: PandaTable) -> float | None:
+    """The table's spring stiffness (N/m), None for a rigid table."""
+    import mujoco
+
+    j = mujoco.mj_name2id(sc.model, mujoco.mjtObj.mjOBJ_JOINT, "table_spring")
+    return None if j < 0 else float(sc.model.jnt_stiffness[j])

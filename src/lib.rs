@@ -79,6 +79,7 @@ pub mod control;
 pub mod error;
 mod math;
 pub mod networks;
+pub mod presets;
 #[cfg(feature = "python")]
 mod python;
 pub mod schema;

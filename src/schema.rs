@@ -2,10 +2,8 @@
 //! line spell it), group, kind, unit, one-line doc, validity condition and
 //! per-scenario default, declared once, in [`PARAMS`].
 //!
-//! Everything else derives from this table: the presets ([`Config::new`],
-//! [`Config::paper`], [`Config::robot`], [`SimConfig::paper`],
-//! [`Sinusoid::paper`], [`Wall::paper`], the default [`ArmParams`],
-//! [`Grid::paper`]), the setter by name ([`Scenario::set`]) through which the
+//! Everything else derives from this table: the presets
+//! ([`presets`](crate::presets): `Config::paper`, `Controller::robot`, …), the setter by name ([`Scenario::set`]) through which the
 //! Python bindings and the C ABI build configurations, and, in Python, the
 //! keyword table, `help(adaptimp.simulate)`, the command line and the stubs.
 //! [`Scenario::visit`] destructures every configuration struct exhaustively, so
@@ -24,8 +22,6 @@ use crate::networks::learning::{LearningStep, SaturationLearning};
 use crate::networks::rbf::Grid;
 #[cfg(feature = "sim")]
 use crate::sim::disturb::{DisturbanceParams, Disturbances, MAX_DELAY};
-#[cfg(feature = "sim")]
-use crate::sim::environment::Wall;
 #[cfg(feature = "sim")]
 use crate::sim::model::{ArmParams, TwoLinkArm};
 #[cfg(feature = "sim")]
@@ -647,7 +643,7 @@ pub struct Scenario<const N: usize> {
 
 /// A lookup that cannot fail: `name` is in [`PARAMS`] and its default suits
 /// `N` (tested for N = 1 … 7).
-fn preset_error(name: &str, e: Error) -> ! {
+pub(crate) fn preset_error(name: &str, e: Error) -> ! {
     unreachable!("the schema's default of {name} applies: {e}")
 }
 
@@ -1237,115 +1233,11 @@ fn choice<T: Copy>(p: &Param, v: Value<'_>, all: &[T]) -> Result<T, Error> {
         })
 }
 
-// ---------------------------------------------------------------------------
-// The presets, from the table.
-// ---------------------------------------------------------------------------
-
-impl<const N: usize> Config<N> {
-    /// The paper's gains for `N` joints with limits `tau_max` (N m); Ts = 50 µs
-    /// (the paper scenario, SPEC §11): the schema's paper defaults.
-    pub fn new(law: Law, tau_max: Vector<N>) -> Self {
-        let mut cfg = Scenario::<N>::preset(Preset::Paper, law).config;
-        cfg.tau_max = tau_max;
-        cfg
-    }
-
-    /// This configuration with every hardened option of the robot scenario
-    /// (SPEC §13), whatever Ts is: each controller parameter whose robot
-    /// default differs from the paper's, except Ts. That is:
-    ///
-    /// - [`LearningStep::Normalized`] with κ = 0.5 (the per-step learning gain
-    ///   stays below Kp/2; the printed Euler step exceeds Kp at 1 ms);
-    /// - [`SaturationLearning::Freeze`] (no learning into the limits);
-    /// - [`WeightBound::Auto`] (bounds from τmax and the commanded trajectory);
-    /// - the tanh robust term (sgn chatters at 1 kHz) with φ = 0.05 rad/s;
-    /// - observer: [`Hold::Triangle`] (at Ts ≫ ε it is the backward difference
-    ///   of the samples, where ZOH estimates ≈ 0 at the sample instants),
-    ///   started at the first measurement.
-    pub fn hardened(self) -> Self {
-        let mut s = Scenario::<N>::preset(Preset::Paper, self.law);
-        s.config = self;
-        for p in PARAMS {
-            if let (Group::Controller, Some(v), false) = (p.group, p.robot, p.name == "Ts") {
-                if let Err(e) = s.set(p.name, v) {
-                    preset_error(p.name, e)
-                }
-            }
-        }
-        s.config
-    }
-}
-
-impl Config<2> {
-    /// The paper scenario (SPEC §11) for the 2-link arm: every default of the SPEC.
-    pub fn paper(law: Law) -> Self {
-        Scenario::<2>::preset(Preset::Paper, law).config
-    }
-
-    /// The "robot" scenario (SPEC §13, beyond the paper): the paper's arm,
-    /// gains, Γ, σ, η² and 256 nodes at a robot's Ts = 1 ms, with the
-    /// [hardened](Self::hardened) options as defaults.
-    pub fn robot(law: Law) -> Self {
-        Scenario::<2>::preset(Preset::Robot, law).config
-    }
-}
-
-#[cfg(feature = "sim")]
-impl SimConfig<2> {
-    /// The paper scenario: T = 20 s, M = 1, q(0) = [0.25, −0.05], q̇(0) = 0 (SPEC §11, (65)).
-    pub fn paper() -> Self {
-        Scenario::<2>::preset(Preset::Paper, Law::Pd).sim
-    }
-
-    /// The "robot" scenario's run: the paper scenario with M = 10 RK4 substeps
-    /// per 1 ms period (SPEC §13). Use with [`Config::robot`].
-    pub fn robot() -> Self {
-        Scenario::<2>::preset(Preset::Robot, Law::Pd).sim
-    }
-}
-
-impl Sinusoid<2> {
-    /// The paper's commanded circle (64): centre [0.2, 0.2] rad, radius 0.2 rad, ω = π rad/s.
-    pub fn paper() -> Self {
-        Scenario::<2>::preset(Preset::Paper, Law::Pd)
-            .trajectory()
-            .unwrap_or_else(|e| preset_error("xc", e))
-    }
-}
-
-#[cfg(feature = "sim")]
-impl Wall<2> {
-    /// SPEC §3 defaults: joint 1 (index 0), w = 0.2 rad, ke = 1000 N m/rad, be = 10 N m s/rad.
-    pub fn paper() -> Self {
-        let s = Scenario::<2>::preset(Preset::Paper, Law::Pd);
-        let w = s
-            .wall
-            .unwrap_or_else(|| unreachable!("the paper has a wall"));
-        Wall::new(0, w, s.ke_be[0], s.ke_be[1]).unwrap_or_else(|e| preset_error("wall", e))
-    }
-}
-
-#[cfg(feature = "sim")]
-impl Default for ArmParams {
-    /// SPEC §1 defaults: m = [2.00, 0.85] kg, l = [0.35, 0.31] m, lc = l/2,
-    /// I = m l²/4, g = 9.81 m/s².
-    fn default() -> Self {
-        Scenario::<2>::preset(Preset::Paper, Law::Pd).arm.resolve()
-    }
-}
-
-impl Grid<2> {
-    /// The paper's grid for the 2-link arm: 256 nodes, η² = 25 (SPEC §6).
-    pub fn paper() -> Self {
-        Scenario::<2>::preset(Preset::Paper, Law::Pd)
-            .grid()
-            .unwrap_or_else(|e| preset_error("eta2", e))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[cfg(feature = "sim")]
+    use crate::sim::environment::Wall;
 
     #[test]
     fn visit_names_exactly_the_schema_in_its_order() {

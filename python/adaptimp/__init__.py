@@ -31,7 +31,8 @@ Every SPEC quantity is a keyword parameter with the paper's default
 """
 
 from ._adaptimp import __version__
-from ._api import Controller, PlanarArm, TwoLinkArm, simulate
+from ._api import Controller, simulate
+from ._arms import PlanarArm, TwoLinkArm
 from ._errors import (
     AdaptimpError,
     ConfigError,

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 import warnings
@@ -14,11 +13,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
+from ._arms import PlanarArm, TwoLinkArm, _two_link_arm  # noqa: F401 (pickles name _api._two_link_arm)
 from ._errors import ConfigError, StabilityWarning, period_alias
 from ._faults import Fault
 from ._params import (
     BY_NAME,
     N_JOINTS,
+    _basis,
+    _core_controller,
     check_case,
     check_n,
     check_scenario,
@@ -26,7 +28,6 @@ from ._params import (
     describe,
     names,
     resolve,
-    with_hint,
 )
 from ._result import SimResult
 
@@ -40,57 +41,6 @@ STATE_FORMAT = "adaptimp.state/1"
 # ---------------------------------------------------------------------------
 # Helpers shared by Controller and simulate.
 # ---------------------------------------------------------------------------
-
-
-def _basis(
-    n: int, centers: ArrayLike | None, widths: ArrayLike | None, params: Mapping[str, Any]
-) -> tuple[FloatArray | None, FloatArray | None]:
-    """User centres as a (L, 4n) float64 array and the widths η (4n,), or
-    (None, None) for the vertex grid."""
-    if centers is None:
-        if widths is not None:
-            raise TypeError("widths needs centers (the vertex grid's width is eta2)")
-        # n ≤ 3: the paper's vertex grid; beyond, the core places the rule's
-        # centres along the controller's own trajectory (SPEC §18).
-        return None, None
-    c = np.asarray(centers)
-    if c.dtype.kind not in "iuf":
-        raise TypeError(f"centers must be an array of real numbers, got dtype {c.dtype}")
-    c = np.ascontiguousarray(c, dtype=np.float64)
-    if c.ndim != 2 or c.shape[1] != 4 * n or c.shape[0] == 0:
-        raise ConfigError(
-            f"centers must have shape (L, {4 * n}) (L ≥ 1 rows of x, v, α1, α̇1 for "
-            f"{n} joints), got shape {c.shape}"
-        )
-    if not np.all(np.isfinite(c)):
-        raise ConfigError("centers must be finite")
-    w = np.sqrt(params["eta2"]) if widths is None else widths
-    wa = np.asarray(w, dtype=np.float64)
-    if wa.shape not in ((), (4 * n,)):
-        raise ConfigError(
-            f"widths must be a number or have shape ({4 * n},) (one per input dimension), "
-            f"got shape {wa.shape}"
-        )
-    wa = np.broadcast_to(wa, (4 * n,))
-    # +inf leaves an input out of the distance (SPEC §15.1); at least one finite.
-    if np.any(np.isnan(wa)) or np.any(wa <= 0) or not np.any(np.isfinite(wa)):
-        raise ConfigError("widths must be > 0, finite or +inf (that input left out), not all inf")
-    return c, np.ascontiguousarray(wa)
-
-
-def _core_controller(
-    case: str,
-    p: dict[str, Any],
-    n: int,
-    centers: FloatArray | None,
-    widths2: FloatArray | None,
-    cls: type[_adaptimp.Controller] = _adaptimp.Controller,
-) -> _adaptimp.Controller:
-    try:
-        # The compiled constructor, also for the Python subclass Controller.
-        return _adaptimp.Controller.__new__(cls, case, p, n, centers, widths2)
-    except ConfigError as e:
-        raise with_hint(e, p) from None
 
 
 def _check_stability(core: _adaptimp.Controller, p: Mapping[str, Any], stacklevel: int) -> None:
@@ -679,234 +629,4 @@ class Controller(_adaptimp.Controller):
             f"adaptimp.Controller({self.case!r}, scenario={self._scenario!r}, n={self.n}): "
             f"{self.nodes} RBF nodes ({basis}), Ts = {self.Ts:g} s, "
             f"t = {self.t:g} s after {self.steps} steps"
-        )
-
-
-# ---------------------------------------------------------------------------
-# Arms.
-# ---------------------------------------------------------------------------
-
-
-class TwoLinkArm:
-    """The paper's 2-link arm in a vertical plane, (55)–(63), SPEC §1.
-
-    ``D(q) q̈ + C(q, q̇) q̇ + G(q) = τ − τe``, with τ the applied (saturated)
-    torque and τe the force the arm exerts on the environment.
-
-    Parameters
-    ----------
-    **params
-        ``m1``, ``m2`` (kg), ``l1``, ``l2`` (m), ``lc1``, ``lc2`` (m; default
-        half the given lengths), ``I1``, ``I2`` (kg m²; default m l²/4 of the
-        given masses and lengths), ``g`` (m/s²). Defaults: SPEC §1.
-
-    Examples
-    --------
-    >>> import adaptimp
-    >>> arm = adaptimp.TwoLinkArm(m2=1.0)
-    >>> arm.D([0.0, 0.0]).shape
-    (2, 2)
-    """
-
-    __slots__ = ("_core", "_params")
-
-    n = 2
-    """Joints."""
-
-    def __init__(self, **params: Any) -> None:
-        self._params = resolve(params, groups=("arm",), caller="TwoLinkArm()")
-        self._core = _adaptimp.TwoLinkArm(self._params)
-        self._params.update(self._core.params)
-
-    def __reduce__(self) -> tuple[Any, ...]:
-        return (_two_link_arm, (self._params,))
-
-    @property
-    def params(self) -> dict[str, Any]:
-        """The arm's parameters (a copy), derived ones included."""
-        return dict(self._params)
-
-    @property
-    def lumped(self) -> tuple[float, float, float, float, float]:
-        """p1 … p5 of (59)–(63) (kg m², kg m², kg m², kg m, kg m), p4 with the erratum."""
-        p1, p2, p3, p4, p5 = self._core.lumped
-        return (p1, p2, p3, p4, p5)
-
-    def D(self, q: ArrayLike) -> FloatArray:
-        """Inertia matrix D(q) (kg m²), (2, 2), at joint positions ``q`` (rad), (56)."""
-        return self._core.D(q)
-
-    def C(self, q: ArrayLike, dq: ArrayLike) -> FloatArray:
-        """Coriolis and centripetal matrix C(q, q̇) (kg m²/s), (2, 2), (57)."""
-        return self._core.C(q, dq)
-
-    def G(self, q: ArrayLike) -> FloatArray:
-        """Gravity torque G(q) (N m), (2,), (58)."""
-        return self._core.G(q)
-
-    def forward_dynamics(
-        self, q: ArrayLike, dq: ArrayLike, tau: ArrayLike, tau_e: ArrayLike
-    ) -> FloatArray:
-        """Joint acceleration q̈ (rad/s²), (2,), from (4).
-
-        Parameters
-        ----------
-        q, dq : array_like, shape (2,)
-            Joint positions (rad) and velocities (rad/s).
-        tau : array_like, shape (2,)
-            Applied (already saturated) torque (N m).
-        tau_e : array_like, shape (2,)
-            Force the arm exerts on the environment (N m).
-        """
-        return self._core.forward_dynamics(q, dq, tau, tau_e)
-
-    def fk(self, q: ArrayLike) -> FloatArray:
-        """End-effector position (m), (3,), in the arm's plane (z = 0), SPEC §16."""
-        return self._core.fk(q)
-
-    def jacobian(self, q: ArrayLike) -> FloatArray:
-        """Position Jacobian J(q) = ∂fk/∂q (m/rad), (3, 2), SPEC §16."""
-        return self._core.jacobian(q)
-
-    def __repr__(self) -> str:
-        p = self._params
-        return (
-            f"adaptimp.TwoLinkArm(m1={p['m1']:g}, m2={p['m2']:g}, l1={p['l1']:g}, "
-            f"l2={p['l2']:g}, lc1={p['lc1']:g}, lc2={p['lc2']:g}, I1={p['I1']:g}, "
-            f"I2={p['I2']:g}, g={p['g']:g})"
-        )
-
-
-def _two_link_arm(params: dict[str, Any]) -> TwoLinkArm:
-    return TwoLinkArm(**params)
-
-
-def _per_link(name: str, value: ArrayLike, n: int, positive: bool) -> list[float]:
-    arr = np.asarray(value)
-    if arr.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be a number or {n} numbers, got {type(value).__name__}")
-    if arr.shape not in ((), (n,)):
-        raise ConfigError(f"{name} must be a number or have shape ({n},), got shape {arr.shape}")
-    out = np.broadcast_to(arr.astype(np.float64), (n,))
-    for i, x in enumerate(out):
-        if not math.isfinite(x) or (x <= 0 if positive else x < 0):
-            rel = "> 0" if positive else "≥ 0"
-            raise ConfigError(f"{name}[{i}] must be finite and {rel}, got {x}")
-    return [float(x) for x in out]
-
-
-class PlanarArm:
-    """An arm of n revolute joints (1 ≤ n ≤ 7) in a vertical plane.
-
-    Joint angles are relative (q_i is link i's angle to link i−1); link 1's
-    angle is measured from the horizontal, and gravity acts along −y. D is
-    assembled from the centre-of-mass Jacobians and C from the Christoffel
-    symbols of D, so Ḋ − 2C is skew-symmetric. For n = 2 it equals
-    :class:`TwoLinkArm` with the same links to rounding.
-
-    Parameters
-    ----------
-    n : int
-        Links (joints), 1 … 7.
-    masses : float or array_like, shape (n,)
-        Link masses (kg), > 0. Default 1 kg each.
-    lengths : float or array_like, shape (n,)
-        Joint-to-joint lengths (m), > 0. Default 0.3 m each.
-    coms : float or array_like, shape (n,), optional
-        Distances from each link's proximal joint to its centre of mass (m).
-        Default half the lengths.
-    inertias : float or array_like, shape (n,), optional
-        Moments of inertia about the centres of mass, normal to the plane
-        (kg m²). Default m l²/12 (uniform rods).
-    g : float
-        Gravity (m/s²).
-
-    Examples
-    --------
-    >>> import adaptimp
-    >>> arm = adaptimp.PlanarArm(3, masses=[2.0, 1.5, 1.0], lengths=0.4)
-    >>> arm.D([0.0, 0.1, 0.2]).shape
-    (3, 3)
-    """
-
-    __slots__ = ("_core", "_params")
-
-    def __init__(
-        self,
-        n: int,
-        masses: ArrayLike = 1.0,
-        lengths: ArrayLike = 0.3,
-        coms: ArrayLike | None = None,
-        inertias: ArrayLike | None = None,
-        g: float = 9.81,
-    ) -> None:
-        n = check_n(n)
-        m = _per_link("masses", masses, n, positive=True)
-        length = _per_link("lengths", lengths, n, positive=True)
-        c = [x / 2 for x in length] if coms is None else _per_link("coms", coms, n, False)
-        if inertias is None:
-            inertia = [mi * li * li / 12 for mi, li in zip(m, length)]
-        else:
-            inertia = _per_link("inertias", inertias, n, positive=False)
-        if isinstance(g, bool) or not isinstance(g, (int, float, np.floating, np.integer)):
-            raise TypeError(f"g must be a number (m/s²), got {type(g).__name__}")
-        if not math.isfinite(float(g)):
-            raise ConfigError(f"g must be finite, got {g}")
-        self._params: dict[str, Any] = {
-            "n": n,
-            "masses": m,
-            "lengths": length,
-            "coms": c,
-            "inertias": inertia,
-            "g": float(g),
-        }
-        self._core = _adaptimp.PlanarArm(m, length, c, inertia, float(g))
-
-    def __reduce__(self) -> tuple[Any, ...]:
-        p = self._params
-        return (PlanarArm, (p["n"], p["masses"], p["lengths"], p["coms"], p["inertias"], p["g"]))
-
-    @property
-    def n(self) -> int:
-        """Joints."""
-        return int(self._params["n"])
-
-    @property
-    def params(self) -> dict[str, Any]:
-        """The arm's parameters (a copy): n, masses, lengths, coms, inertias, g."""
-        return {k: list(v) if isinstance(v, list) else v for k, v in self._params.items()}
-
-    def D(self, q: ArrayLike) -> FloatArray:
-        """Inertia matrix D(q) (kg m²), (n, n), at joint positions ``q`` (rad)."""
-        return self._core.D(q)
-
-    def C(self, q: ArrayLike, dq: ArrayLike) -> FloatArray:
-        """Coriolis and centripetal matrix C(q, q̇) (kg m²/s), (n, n)."""
-        return self._core.C(q, dq)
-
-    def G(self, q: ArrayLike) -> FloatArray:
-        """Gravity torque G(q) (N m), (n,)."""
-        return self._core.G(q)
-
-    def forward_dynamics(
-        self, q: ArrayLike, dq: ArrayLike, tau: ArrayLike, tau_e: ArrayLike
-    ) -> FloatArray:
-        """Joint acceleration q̈ (rad/s²), (n,): D q̈ = τ − τe − C q̇ − G, with τ the
-        applied torque and τe the force on the environment (N m)."""
-        return self._core.forward_dynamics(q, dq, tau, tau_e)
-
-    def fk(self, q: ArrayLike) -> FloatArray:
-        """End-effector position (m), (3,): the tip of the last link, in the arm's
-        x–y plane (z = 0; x horizontal, y up), SPEC §16."""
-        return self._core.fk(q)
-
-    def jacobian(self, q: ArrayLike) -> FloatArray:
-        """Position Jacobian J(q) = ∂fk/∂q (m/rad), (3, n): ṗ = J q̇ (the z row is zero)."""
-        return self._core.jacobian(q)
-
-    def __repr__(self) -> str:
-        p = self._params
-        return (
-            f"adaptimp.PlanarArm({p['n']}, masses={p['masses']}, lengths={p['lengths']}, "
-            f"coms={p['coms']}, inertias={p['inertias']}, g={p['g']:g})"
         )

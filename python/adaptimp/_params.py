@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
 from ._errors import ConfigError
@@ -442,3 +443,59 @@ def with_hint(error: ConfigError, params: Mapping[str, Any]) -> ConfigError:
     """``error`` with the :func:`config_hint` for ``params`` appended."""
     hint = config_hint(str(error), params)
     return ConfigError(f"{error}; {hint}") if hint else error
+
+
+# ---------------------------------------------------------------------------
+# The compiled controller from resolved keywords (Controller, simulate, a save's rerun).
+# ---------------------------------------------------------------------------
+
+
+def _basis(
+    n: int, centers: ArrayLike | None, widths: ArrayLike | None, params: Mapping[str, Any]
+) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """User centres as a (L, 4n) float64 array and the widths η (4n,), or
+    (None, None) for the vertex grid."""
+    if centers is None:
+        if widths is not None:
+            raise TypeError("widths needs centers (the vertex grid's width is eta2)")
+        # n ≤ 3: the paper's vertex grid; beyond, the core places the rule's
+        # centres along the controller's own trajectory (SPEC §18).
+        return None, None
+    c = np.asarray(centers)
+    if c.dtype.kind not in "iuf":
+        raise TypeError(f"centers must be an array of real numbers, got dtype {c.dtype}")
+    c = np.ascontiguousarray(c, dtype=np.float64)
+    if c.ndim != 2 or c.shape[1] != 4 * n or c.shape[0] == 0:
+        raise ConfigError(
+            f"centers must have shape (L, {4 * n}) (L ≥ 1 rows of x, v, α1, α̇1 for "
+            f"{n} joints), got shape {c.shape}"
+        )
+    if not np.all(np.isfinite(c)):
+        raise ConfigError("centers must be finite")
+    w = np.sqrt(params["eta2"]) if widths is None else widths
+    wa = np.asarray(w, dtype=np.float64)
+    if wa.shape not in ((), (4 * n,)):
+        raise ConfigError(
+            f"widths must be a number or have shape ({4 * n},) (one per input dimension), "
+            f"got shape {wa.shape}"
+        )
+    wa = np.broadcast_to(wa, (4 * n,))
+    # +inf leaves an input out of the distance (SPEC §15.1); at least one finite.
+    if np.any(np.isnan(wa)) or np.any(wa <= 0) or not np.any(np.isfinite(wa)):
+        raise ConfigError("widths must be > 0, finite or +inf (that input left out), not all inf")
+    return c, np.ascontiguousarray(wa)
+
+
+def _core_controller(
+    case: str,
+    p: dict[str, Any],
+    n: int,
+    centers: NDArray[np.float64] | None,
+    widths2: NDArray[np.float64] | None,
+    cls: type[_adaptimp.Controller] = _adaptimp.Controller,
+) -> _adaptimp.Controller:
+    try:
+        # The compiled constructor, also for the Python subclass Controller.
+        return _adaptimp.Controller.__new__(cls, case, p, n, centers, widths2)
+    except ConfigError as e:
+        raise with_hint(e, p) from None

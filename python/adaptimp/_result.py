@@ -494,17 +494,16 @@ def _rerun(
     appended to ``why``."""
     import warnings
 
-    from . import _adaptimp, _api
-    from ._params import BY_NAME, N_JOINTS, names
+    from . import _adaptimp
+    from ._arms import PlanarArm, TwoLinkArm
+    from ._params import BY_NAME, N_JOINTS, _core_controller, names
 
     try:
         p = {k: v for k, v in params.items() if k in BY_NAME}
         if n == N_JOINTS and "arm" not in params:
-            arm: _api.TwoLinkArm | _api.PlanarArm = _api.TwoLinkArm(
-                **{k: p[k] for k in names("arm")}
-            )
+            arm: TwoLinkArm | PlanarArm = TwoLinkArm(**{k: p[k] for k in names("arm")})
         else:
-            arm = _api.PlanarArm(n)
+            arm = PlanarArm(n)
             if params.get("arm") != arm.params:
                 if why is not None:
                     why.append("its arm is not the default arm of its n")
@@ -515,7 +514,7 @@ def _rerun(
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            core = _api._core_controller(case, p, n, None, None)
+            core = _core_controller(case, p, n, None, None)
             out = _adaptimp.simulate(core, arm._core, p, record_every, None, None, None)
     except (TypeError, ValueError, KeyError, ArithmeticError) as e:
         if why is not None:

@@ -29,7 +29,7 @@ from ._params import BY_NAME, check_case, check_scenario, config_hint, resolve
 if TYPE_CHECKING:
     import pandas as pd
 
-    from ._api import TwoLinkArm
+    from ._arms import TwoLinkArm
 
 
 # ---------------------------------------------------------------------------
@@ -466,7 +466,8 @@ def sweep(
     >>> df[["Kp", "rms_z1"]].shape
     (2, 2)
     """
-    from ._api import ProgressReport, TwoLinkArm
+    from ._api import ProgressReport
+    from ._arms import TwoLinkArm
 
     try:  # before any run: the result is a DataFrame
         import pandas  # noqa: F401

@@ -90,7 +90,7 @@ def pinocchio_model(source: Any = "two_link", **arm: float) -> Any:
     if isinstance(source, pin.Model):
         return source
     if isinstance(source, str) and source == "two_link":
-        from ._api import TwoLinkArm
+        from ._arms import TwoLinkArm
 
         return _two_link(TwoLinkArm(**arm).params)
     if arm:

@@ -41,7 +41,6 @@ use crate::control::safety::{
 };
 use crate::error::{check, Error, BOUND, PARAM_BOUND};
 use crate::math::sqrt;
-use crate::schema::{Preset, Scenario};
 use crate::trajectory::Setpoint;
 use crate::types::{choices, Vector};
 use nalgebra::{Matrix3, SMatrix, UnitQuaternion};
@@ -139,13 +138,6 @@ pub struct CartesianConfig {
     /// The admittance's share n ∈ [0, 1] of the torque for
     /// [`Formulation::Unified`] (ignored otherwise).
     pub admittance_share: f64,
-}
-
-impl Default for CartesianConfig {
-    /// The schema's defaults (SPEC §16).
-    fn default() -> Self {
-        Scenario::<1>::preset(Preset::Robot, crate::Law::Pd).cartesian
-    }
 }
 
 impl CartesianConfig {

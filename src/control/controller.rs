@@ -27,7 +27,7 @@ use crate::error::{check, Error, BOUND, PARAM_BOUND};
 use crate::networks::learning::{Learning, Signals};
 use crate::networks::rbf::{Basis, Grid};
 use crate::networks::simd::SimdPath;
-use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
+use crate::trajectory::{Setpoint, Trajectory};
 use crate::types::Vector;
 
 /// The smallest inertia scale d (kg m²) and Young weight ρ (1/s), SPEC §10:
@@ -134,22 +134,6 @@ impl<const N: usize> Task<N> {
 struct Staged<const N: usize> {
     observer: ObserverState<N>,
     reference: Reference<N>,
-}
-
-impl Controller<2, Grid<2>> {
-    /// The paper's controller `law` with every SPEC default (the 256-node grid,
-    /// η² = 25).
-    pub fn paper(law: Law) -> Self {
-        Self::new(Config::paper(law), Grid::paper())
-            .unwrap_or_else(|e| unreachable!("the paper configuration is valid: {e}"))
-    }
-
-    /// The robot scenario's controller `law` (SPEC §13: Ts = 1 ms, the hardened
-    /// options), with its weight bounds for the paper's circle.
-    pub fn robot(law: Law) -> Self {
-        Self::for_trajectory(Config::robot(law), Grid::paper(), &Sinusoid::paper())
-            .unwrap_or_else(|e| unreachable!("the robot configuration is valid: {e}"))
-    }
 }
 
 impl<const N: usize, B: Basis<N>> Controller<N, B> {
@@ -1050,6 +1034,7 @@ mod tests {
     use super::*;
     use crate::control::state::HeapState;
     use crate::networks::learning::{LearningStep, SaturationLearning};
+    use crate::trajectory::Sinusoid;
 
     fn measurement() -> Measurement<2> {
         Measurement {

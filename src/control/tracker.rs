@@ -2,7 +2,6 @@
 //! [`Controller`], a [`Trajectory`] and a heap [`State`](crate::control::state::State) in one value, with
 //! the clock t_k = k·Ts (feature `alloc`).
 
-use crate::control::config::Law;
 use crate::control::controller::Controller;
 use crate::control::impedance::TargetImpedance;
 use crate::control::io::{Command, Control, Measurement, TaskTorque};
@@ -18,18 +17,6 @@ pub struct Tracker<const N: usize, B = Grid<N>, T = Sinusoid<N>> {
     ctrl: Controller<N, B>,
     traj: T,
     state: HeapState<N>,
-}
-
-impl Tracker<2, Grid<2>, Sinusoid<2>> {
-    /// The paper's controller `law` (every SPEC default) on the paper's circle (64).
-    pub fn paper(law: Law) -> Self {
-        Self::new(Controller::paper(law), Sinusoid::paper())
-    }
-
-    /// The robot scenario's controller `law` on the paper's circle (SPEC §13).
-    pub fn robot(law: Law) -> Self {
-        Self::new(Controller::robot(law), Sinusoid::paper())
-    }
 }
 
 impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Tracker<N, B, T> {

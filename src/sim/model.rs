@@ -75,12 +75,6 @@ pub struct TwoLinkArm {
 }
 
 impl TwoLinkArm {
-    /// The arm with the SPEC §1 default parameters.
-    pub fn paper() -> Self {
-        // The defaults satisfy every condition checked by `new`.
-        Self::from_valid(ArmParams::default())
-    }
-
     /// An arm with the given parameters, validated: masses and lengths > 0,
     /// centre-of-mass distances and inertias ≥ 0, everything finite, and D(q)
     /// positive definite for every q (p1·p2 − p3² > 0).
@@ -122,7 +116,7 @@ impl TwoLinkArm {
         Ok(arm)
     }
 
-    fn from_valid(a: ArmParams) -> Self {
+    pub(crate) fn from_valid(a: ArmParams) -> Self {
         let p = [
             a.m1 * a.lc1 * a.lc1 + a.m2 * a.l1 * a.l1 + a.i1, // (59)
             a.m2 * a.lc2 * a.lc2 + a.i2,                      // (60)

@@ -22,10 +22,13 @@ __all__ = [
     "PlanarArm",
     "TwoLinkArm",
     "__version__",
+    "assess_posture",
     "centres_along",
     "default_task",
     "defaults",
     "metrics",
+    "pose_circle",
+    "pose_metrics",
     "schema_table",
     "simulate",
     "simulate_many",
@@ -533,7 +536,7 @@ class CartesianImpedance:
     ) -> _F: ...
     def last(self, what: str) -> _F: ...
     def state(self, what: str) -> _F: ...
-    def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F]: ...
+    def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F, _F]: ...
     def simulate_mujoco(
         self,
         controller: Controller | ComputedTorque,
@@ -573,9 +576,50 @@ def suggest(
     path: NDArray[np.float64] | None = None,
     period: float | None = None,
     gravity: NDArray[np.float64] | None = None,
+    resolve: bool = False,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18: "params" (every controller keyword),
-    with a path also "centers" (L, 4n) and "widths" (4n,)."""
+    with a path also "centers" (L, 4n) and "widths" (4n,); ``resolve``: the tube
+    narrowed to the path's size, SPEC (16.10)."""
+
+def pose_circle(
+    p0: NDArray[np.float64],
+    r0: NDArray[np.float64],
+    ts: float,
+    steps: int,
+    radius: float | None = None,
+    freq: float | None = None,
+    hold: float | None = None,
+    ramp: float | None = None,
+    start: float = 0.0,
+) -> tuple[_F, float, list[float]]:
+    """The default Cartesian task of SPEC (16.8) tabulated: (targets (steps, 24),
+    span (s), centre (3,))."""
+
+def assess_posture(
+    chain: Chain,
+    q: NDArray[np.float64],
+    p: NDArray[np.float64],
+    gravity: NDArray[np.float64],
+    d0: NDArray[np.float64],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    tau_max: NDArray[np.float64],
+    orients: bool,
+) -> dict[str, Any]:
+    """How well a posture runs a task, SPEC (16.9): the figures along its joint
+    orbit, the score and the first condition it violates ("error", or None)."""
+
+def pose_metrics(
+    chain: Chain,
+    q: NDArray[np.float64],
+    targets: NDArray[np.float64],
+    t: NDArray[np.float64],
+    settle: float,
+    ts: float,
+) -> tuple[_F, _F, dict[str, float]]:
+    """The pose errors e_p (K,) (m), e_o (K,) (rad) of a run and their metrics,
+    SPEC (16.11)."""
 
 def default_task(
     home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]

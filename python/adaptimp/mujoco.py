@@ -58,6 +58,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _adaptimp, _models
+from ._cartesian_task import CartesianTask, task_of
 from ._faults import Fault
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
@@ -1202,6 +1203,37 @@ def rule_keywords(
     return kw
 
 
+def cartesian_task(
+    model: Plant | ModelSource,
+    q0: ArrayLike | None = None,
+    pose: Any = None,
+    *,
+    Ts: float = 1e-3,
+    span: float | None = None,
+) -> CartesianTask:
+    """A Cartesian task on ``model`` (SPEC §16 (16.8)–(16.11)), for
+    ``simulate(case, model, T=…, task=task)``.
+
+    ``pose`` None: the default path, hold the start pose 1 s, then a 3 cm circle
+    at 0.5 Hz in the horizontal plane through it, the orientation held (an arm
+    of fewer than six joints: the position only). Or the user's path: a callable
+    ``t -> (p, ṗ, p̈[, R, ω, ω̇])`` (m, m/s, m/s², (3, 3), rad/s, rad/s²; world
+    frame), or those arrays with a row per period ``Ts`` (K, 3), (K, 3, 3);
+    ``span`` (s) the part of it the rule samples (default: the arrays' length,
+    or 4 s for a callable).
+
+    ``q0`` None: a start posture drawn by the core's posture rule (16.9):
+    σmin of the 6 × n Jacobian ≥ 0.05, every joint 0.1 rad (or an eighth of
+    its range) inside its limits, gravity ≤ half of every actuator, the joint
+    rule's velocity loop well-conditioned and the path reachable, all along
+    the task, and no self-collision there; for a given ``pose`` the start is
+    the core's inverse kinematics of its first pose. A ``q0`` given must meet
+    the same rule, or a ``ConfigError`` names the condition it violates.
+    """
+    plant = model if isinstance(model, Plant) else Plant(model, contact=False)
+    return task_of(plant, q0, pose, Ts=Ts, span=span)
+
+
 class _Table:
     """A reference tabulated at t_k = k·Ts, as a callable of t (the row of t),
     with its arrays (xc, dxc, ddxc), one row per step."""
@@ -1331,6 +1363,18 @@ class MujocoResult(SimResult):
     def rows(self) -> int:
         """Number of recorded rows K."""
         return int(self.t.shape[0])
+
+    @property
+    def pos_err(self) -> FloatArray | None:
+        """A Cartesian task's position error ‖p_c − p‖ per row (m), (K,) (None for
+        a run without a ``task``)."""
+        return None if self.task is None else self.task.get("pos_err")
+
+    @property
+    def rot_err(self) -> FloatArray | None:
+        """A Cartesian task's orientation error ‖Log(R_c Rᵀ)‖ per row (rad), (K,)
+        (None for a run without a ``task``)."""
+        return None if self.task is None else self.task.get("rot_err")
 
     @property
     def dtau(self) -> FloatArray:
@@ -1521,6 +1565,7 @@ def simulate(
     fault: Fault | None = None,
     payload: float = 0.0,
     reset: bool = True,
+    task: CartesianTask | None = None,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1591,6 +1636,13 @@ def simulate(
         A point mass (kg, ≥ 0) at the end effector's link of the plant only
         (:func:`with_payload`); the controller's gains come from the arm
         without it, and no model the controller is given has it.
+    task : CartesianTask, optional
+        A Cartesian task (:func:`cartesian_task`): a case name's controller is
+        then the Cartesian controller of the core's rule for it
+        (:meth:`adaptimp.CartesianController.from_rule`), started at
+        ``task.q0``; the result carries the task's errors, ``res.pos_err``,
+        ``res.rot_err`` (K,) (m, rad), and ``metrics["rms_pos_after2"]``,
+        ``["rms_rot_after2"]`` (SPEC (16.11)).
     reset : bool
         True: the plant starts at ``q0``, ``dq0``. False: a :class:`Plant` goes
         on from where its last run left it (a long run in parts: with a used
@@ -1636,6 +1688,10 @@ def simulate(
     >>> res.q.shape, res.params["substeps"]
     ((50, 2), 20)
     """
+    if task is not None:  # the Cartesian task's controller, by the core's rule
+        model = model if isinstance(model, Plant) else Plant(model, contact=contact)
+        controller, params = task.prepare(controller, model, Ts, params, DISTURBANCES)
+        q0 = task.q0 if q0 is None else q0
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
         settle=settle, scenario=scenario, record_every=record_every, reference=reference,
@@ -1668,7 +1724,10 @@ def simulate(
     finally:
         if bar is not None:
             bar.close()
-    return _result(run, out, m)
+    res = _result(run, out, m)
+    if task is not None:
+        task.measure(res)
+    return res
 
 
 def _cartesian_loop(

@@ -125,9 +125,10 @@ def suggest(
     tau_max: ArrayLike,
     *,
     Ts: float = 1e-3,
-    path: Path | None = None,
+    path: Path | ArrayLike | None = None,
     period: float | None = None,
     case: str = "sf",
+    resolve: bool = False,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia at ``q0`` (rad), its actuator
     limits ``tau_max`` (N m) and the task's joint path (SPEC §18, module docs).
@@ -142,14 +143,19 @@ def suggest(
         Actuator limits (N m).
     Ts : float
         Control period (s).
-    path : callable, optional
+    path : callable or array_like, optional
         ``path(t) -> (q, dq, ddq)``, the task's joint path (rad, rad/s, rad/s²),
         periodic with ``period`` (s): the RBF centres go along it and the
-        learning rates follow from the basis it excites. Without it: the gains
-        only (a controller for n ≤ 3 then uses the vertex grid, beyond it the
-        default basis along its own trajectory, SPEC §18).
+        learning rates follow from the basis it excites; or its samples, (K,
+        3n) rows [q, q̇, q̈] evenly spaced in time over one period. Without it:
+        the gains only (a controller for n ≤ 3 then uses the vertex grid,
+        beyond it the default basis along its own trajectory, SPEC §18).
     case : {"pd", "sf", "of"}
         The controller (the keywords are the same for all three).
+    resolve : bool
+        Narrow the tube to the path's own size, SPEC (16.10): tube_b =
+        min(tube_b, ℓ_b/10), ℓ_b the closed path's length in q and in q̇ (the
+        Cartesian rule's: a small joint orbit gets the joint task's resolution).
 
     Returns
     -------
@@ -171,9 +177,14 @@ def suggest(
     if path is not None:
         if period is None:
             raise ConfigError("a path needs its period (s)")
-        rows = sample_path(path, period, n)
+        if callable(path):
+            rows = sample_path(path, period, n)
+        else:
+            rows = np.ascontiguousarray(np.asarray(path, dtype=np.float64))
     g = gravity(model, q0) if rows is not None else None
-    out = _adaptimp.suggest(case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g)
+    out = _adaptimp.suggest(
+        case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve
+    )
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})
     if "centers" in out:

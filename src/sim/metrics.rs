@@ -148,3 +148,128 @@ impl<const N: usize> Recorder<N> for MetricsAccumulator<N> {
         self.push(row);
     }
 }
+
+/// The metrics of a pose task, SPEC (16.11), over rows t_k with the
+/// position error e_p = ‖p_c − p‖ (m) and the orientation error e_o =
+/// ‖Log(R_c Rᵀ)‖ (rad) of the tip (p, R) against the commanded pose (p_c,
+/// R_c) ([`pose_error`]). "after" means t_k ≥ `settle` (− 1e-9 s), and a
+/// window [a, b) the rows with a − 1e-9 ≤ t_k < b − 1e-9. Means over no row
+/// are NaN.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct PoseMetrics {
+    /// Number of rows K.
+    pub rows: usize,
+    /// RMS e_p over the whole run (m).
+    pub rms_pos: f64,
+    /// RMS e_p over t ≥ settle (m).
+    pub rms_pos_after2: f64,
+    /// max e_p over t ≥ settle (m).
+    pub max_pos_after2: f64,
+    /// RMS e_o over the whole run (rad).
+    pub rms_rot: f64,
+    /// RMS e_o over t ≥ settle (rad).
+    pub rms_rot_after2: f64,
+    /// max e_o over t ≥ settle (rad).
+    pub max_rot_after2: f64,
+    /// RMS e_p over the first window [settle, settle + 2 s) (m).
+    pub rms_pos_first2: f64,
+    /// RMS e_p over the last 2 s of the rows, [t_K−1 + Ts − 2 s, end) (m):
+    /// with `rms_pos_first2`, whether learning goes on.
+    pub rms_pos_last2: f64,
+}
+
+/// The pose errors of the tip (p (m), rotation `r`) against the commanded
+/// (p_c, R_c): (‖p_c − p‖ (m), ‖Log(R_c Rᵀ)‖ (rad)), SPEC (16.2).
+pub fn pose_error(
+    p: &Vector<3>,
+    r: &nalgebra::UnitQuaternion<f64>,
+    pc: &Vector<3>,
+    rc: &nalgebra::UnitQuaternion<f64>,
+) -> (f64, f64) {
+    (
+        (pc - p).norm(),
+        crate::cartesian::rotation::rotation_error(rc, r).norm(),
+    )
+}
+
+/// [`PoseMetrics`] of rows given at once: `t` (s), `pos` (m) and `rot`
+/// (rad) per row, the window start `settle` (s) and the period `ts` (s)
+/// (the last window ends one period after the last row).
+pub fn pose_metrics(t: &[f64], pos: &[f64], rot: &[f64], settle: f64, ts: f64) -> PoseMetrics {
+    let k = t.len().min(pos.len()).min(rot.len());
+    let end = if k == 0 { f64::NAN } else { t[k - 1] + ts };
+    let window = |a: f64, b: f64, x: &[f64], f: fn(f64, f64) -> f64, init: f64| {
+        let (mut acc, mut n) = (init, 0usize);
+        for i in 0..k {
+            if t[i] >= a - 1e-9 && t[i] < b - 1e-9 {
+                acc = f(acc, x[i]);
+                n += 1;
+            }
+        }
+        (acc, n)
+    };
+    let rms = |a: f64, b: f64, x: &[f64]| {
+        let (s, n) = window(a, b, x, |s, v| s + v * v, 0.0);
+        if n == 0 {
+            f64::NAN
+        } else {
+            sqrt(s / n as f64)
+        }
+    };
+    let max = |a: f64, b: f64, x: &[f64]| {
+        let (m, n) = window(a, b, x, f64::max, 0.0);
+        if n == 0 {
+            f64::NAN
+        } else {
+            m
+        }
+    };
+    let all = f64::NEG_INFINITY;
+    let inf = f64::INFINITY;
+    PoseMetrics {
+        rows: k,
+        rms_pos: rms(all, inf, pos),
+        rms_pos_after2: rms(settle, inf, pos),
+        max_pos_after2: max(settle, inf, pos),
+        rms_rot: rms(all, inf, rot),
+        rms_rot_after2: rms(settle, inf, rot),
+        max_rot_after2: max(settle, inf, rot),
+        rms_pos_first2: rms(settle, settle + 2.0, pos),
+        rms_pos_last2: rms(end - 2.0, inf, pos),
+    }
+}
+
+#[cfg(test)]
+mod pose_tests {
+    use super::*;
+
+    #[test]
+    fn pose_metrics_average_over_their_windows() {
+        let ts = 0.5;
+        let t: std::vec::Vec<f64> = (0..12).map(|k| k as f64 * ts).collect();
+        let pos: std::vec::Vec<f64> = (0..12).map(|k| if k < 4 { 10.0 } else { 1.0 }).collect();
+        let rot: std::vec::Vec<f64> = (0..12).map(|k| k as f64).collect();
+        let m = pose_metrics(&t, &pos, &rot, 2.0, ts);
+        assert_eq!(m.rows, 12);
+        assert_eq!(m.rms_pos_after2, 1.0);
+        assert_eq!(m.max_pos_after2, 1.0);
+        assert_eq!(m.max_rot_after2, 11.0);
+        // [2, 4): rows 4…7; the last 2 s of a run that ends at 6 s: rows 8…11.
+        assert_eq!(m.rms_pos_first2, 1.0);
+        assert_eq!(
+            m.rms_rot_after2,
+            (((16 + 25 + 36 + 49 + 64 + 81 + 100 + 121) as f64) / 8.0).sqrt()
+        );
+        assert!((m.rms_pos - ((4.0 * 100.0 + 8.0) / 12.0f64).sqrt()).abs() < 1e-15);
+        let short = pose_metrics(&t[..3], &pos[..3], &rot[..3], 2.0, ts);
+        assert!(short.rms_pos_after2.is_nan() && short.max_rot_after2.is_nan());
+        let q = nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, 0.3);
+        let (ep, eo) = pose_error(
+            &Vector::<3>::new(1.0, 2.0, 3.0),
+            &q,
+            &Vector::<3>::new(1.0, 2.0, 3.5),
+            &nalgebra::UnitQuaternion::identity(),
+        );
+        assert!((ep - 0.5).abs() < 1e-15 && (eo - 0.3).abs() < 1e-15);
+    }
+}

@@ -103,8 +103,8 @@ pub use auxiliary::AuxLaw;
 pub use cartesian::{
     CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
     CartesianMeasurement, CartesianState, Chain, CompliantPose, ComputedState, ComputedTorque,
-    ComputedTorqueConfig, Dynamics, Formulation, Inertial, Joint, JointKind, OuterStep, PoseTarget,
-    Transform, GRAVITY,
+    ComputedTorqueConfig, Drive, Dynamics, Formulation, Inertial, Joint, JointKind, OuterStep,
+    PoseTarget, Transform, FRICTION_VELOCITY, GRAVITY,
 };
 pub use config::{Conditions, Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};

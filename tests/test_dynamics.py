@@ -215,3 +215,84 @@ def test_the_native_run_equals_the_python_loop_in_every_formulation(sc: apt.Pand
         for key, value in python.metrics.items():
             np.testing.assert_array_equal(native.metrics[key], value, err_msg=key)
         assert native.metrics["steps_in_contact"] > 150
+
+
+# The drive of SPEC (20.5): per joint armature (kg m²) and viscous damping
+# (N m s/rad), different on every joint so that a term on the wrong joint shows.
+ARMATURE = np.array([0.1, 0.2, 0.3, 0.05, 0.02, 0.01])
+DAMPING = np.array([1.0, 2.0, 0.5, 0.3, 0.2, 0.1])
+
+
+def test_the_drive_terms_equal_mujocos_inverse_dynamics() -> None:
+    """ID of (20.5) on the UR5 against MuJoCo's ``mj_inverse`` of the model with
+    ``dof_armature`` and ``dof_damping`` (M_a q̈ + bias − qfrc_passive), and M_a
+    against ``mj_fullM``."""
+    import mujoco
+
+    urdf = ARMS["ur5"]
+    m = amj.from_urdf(urdf)
+    m.dof_armature[:] = ARMATURE
+    m.dof_damping[:] = DAMPING
+    d = mujoco.MjData(m)
+    ct = ComputedTorque(urdf, tau_max=np.full(6, 100.0), armature=ARMATURE, damping=DAMPING)
+    rigid = ComputedTorque(urdf, tau_max=np.full(6, 100.0))
+    rng = np.random.default_rng(29)
+    for _ in range(10):
+        q, dq, ddq = rng.uniform(-3, 3, 6), rng.uniform(-4, 4, 6), rng.uniform(-10, 10, 6)
+        d.qpos[:], d.qvel[:], d.qacc[:] = q, dq, ddq
+        mujoco.mj_inverse(m, d)
+        got = ct.inverse_dynamics(q, dq, ddq)
+        want = d.qfrc_inverse
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
+        full = np.zeros((6, 6))
+        amj._full_inertia(m, d, full)
+        np.testing.assert_allclose(ct.mass_matrix(q), full, rtol=0, atol=1e-12 * np.abs(full).max())
+        # The drive's share is there (not a model MuJoCo and the core both lack).
+        extra = got - rigid.inverse_dynamics(q, dq, ddq)
+        np.testing.assert_allclose(extra, ARMATURE * ddq + DAMPING * dq, rtol=1e-9, atol=1e-12)
+
+
+def test_the_drive_terms_equal_pinocchios() -> None:
+    """Pinocchio's ``crba`` and ``rnea`` with ``model.armature`` (its rnea adds
+    armature ⊙ q̈ and leaves ``model.damping`` out: b ⊙ q̇ added here)."""
+    for arm in ("panda", "xarm7", "ur5"):
+        model = pinocchio_model(ARMS[arm]).copy()
+        n = model.nv
+        armature, damping = np.linspace(0.05, 0.4, n), np.linspace(0.2, 2.0, n)
+        model.armature[:] = armature
+        data = model.createData()
+        ct = ComputedTorque(model, tau_max=np.full(n, 100.0), armature=armature, damping=damping)
+        rng = np.random.default_rng(4)
+        for _ in range(10):
+            q, dq, ddq = rng.uniform(-3, 3, n), rng.uniform(-4, 4, n), rng.uniform(-10, 10, n)
+            want = pin.rnea(model, data, q, dq, ddq) + damping * dq
+            got = ct.inverse_dynamics(q, dq, ddq)
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
+            m = pin.crba(model, data, q)
+            m = np.triu(m) + np.triu(m, 1).T
+            np.testing.assert_allclose(ct.mass_matrix(q), m, rtol=0, atol=1e-12 * np.abs(m).max())
+
+
+def test_computed_torque_compensates_the_drives_friction() -> None:
+    """(20.6): the step with a drive is the rigid step plus I_a ⊙ a + b ⊙ q̇ +
+    F ⊙ tanh(ẋ_c / 0.01) (external mode: the reference moves at ẋ_c), and the
+    keywords are refused by name when negative."""
+    n = 7
+    friction = np.linspace(0.5, 2.0, n)
+    kw: dict[str, Any] = {"tau_max": np.full(n, 1e3), "impedance": "external", "Kp": 100.0}
+    rigid = ComputedTorque("panda", **kw)
+    driven = ComputedTorque("panda", armature=0.1, damping=0.5, friction=friction, **kw)
+    rng = np.random.default_rng(11)
+    q, dq, xc = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
+    dxc, ddxc = np.linspace(-0.03, 0.03, n), rng.uniform(-1, 1, n)
+    a = ddxc + 40.0 * (dxc - dq) + 100.0 * (xc - q)
+    got = driven.step(q, np.zeros(n), dq, xc=xc, dxc=dxc, ddxc=ddxc) - rigid.step(
+        q, np.zeros(n), dq, xc=xc, dxc=dxc, ddxc=ddxc
+    )
+    want = 0.1 * a + 0.5 * dq + friction * np.tanh(dxc / 0.01)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-10)
+    for key in ("armature", "damping", "friction"):
+        bad = np.zeros(n)
+        bad[3] = -1.0
+        with pytest.raises(ValueError, match=rf"{key} ≥ 0 is violated: {key}\[3\] = -1"):
+            ComputedTorque("panda", **{key: bad}, **kw)

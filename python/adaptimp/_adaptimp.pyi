@@ -646,6 +646,9 @@ class ComputedTorque:
         impedance: str,
         mass_scale: float,
         payload: float,
+        armature: float | Sequence[float] | None = None,
+        damping: float | Sequence[float] | None = None,
+        friction: float | Sequence[float] | None = None,
     ) -> ComputedTorque: ...
     @property
     def n(self) -> int: ...

@@ -247,6 +247,12 @@ class ComputedTorque:
         ``"external"``: the setpoint is already compliant (an outer loop such
         as that of :class:`adaptimp.CartesianController` made it, SPEC §16):
         xd = xc, ẋd = ẋc, ẍd = ẍc, and τe enters only as the feedforward +τe.
+    armature, damping, friction : float or (n,)
+        The joints' drive in the controller's model (SPEC (20.5), (20.6); ≥ 0,
+        default 0): the rotor inertia added to the mass matrix's diagonal
+        (kg m²), the viscous damping b q̇ (N m s/rad) and the dry friction
+        loss (N m) that the law compensates on its reference's velocity
+        (MuJoCo's ``dof_armature``, ``dof_damping``, ``dof_frictionloss``).
     """
 
     def __init__(
@@ -264,6 +270,9 @@ class ComputedTorque:
         Gd: ArrayLike = 60.0,
         trajectory: Reference | None = None,
         impedance: str = "joint",
+        armature: ArrayLike = 0.0,
+        damping: ArrayLike = 0.0,
+        friction: ArrayLike = 0.0,
     ) -> None:
         from . import _adaptimp
 
@@ -292,6 +301,11 @@ class ComputedTorque:
         self.tau_max = _joint("tau_max", tau_max, n)
         self.mass_scale = float(mass_scale)
         joints, inertials, gravity = core_description(exact)
+        drive = {
+            "armature": _joint("armature", armature, n).tolist(),
+            "damping": _joint("damping", damping, n).tolist(),
+            "friction": _joint("friction", friction, n).tolist(),
+        }
         self._core = _adaptimp.ComputedTorque(
             joints,
             inertials,
@@ -306,6 +320,7 @@ class ComputedTorque:
             impedance=impedance,
             mass_scale=self.mass_scale,
             payload=float(payload),
+            **drive,
         )
         self._params: dict[str, Any] = {
             "Ts": self._ts,
@@ -318,6 +333,7 @@ class ComputedTorque:
             "Cd": self.Cd.tolist(),
             "Gd": self.Gd.tolist(),
             "impedance": impedance,
+            **drive,
         }
         if trajectory is None and n == 2:
             trajectory = paper_circle()

@@ -1,5 +1,5 @@
 //! Computed torque (inverse-dynamics) impedance control, SPEC §20 (20.3),
-//! (20.4): the model-based baseline the paper's model-free laws are compared
+//! (20.4), with the drive's friction compensated (20.6): the model-based baseline the paper's model-free laws are compared
 //! with, on the core's [`Dynamics`]. No allocation.
 //!
 //! [`ComputedTorque`] holds the parameters and the model (immutable);
@@ -205,8 +205,12 @@ impl<const N: usize> ComputedTorque<N> {
         };
         // (20.3): the error dynamics' acceleration on the reference.
         let a = ddxd + kd.component_mul(&(r.dxd - dq)) + kp.component_mul(&(r.xd - q));
+        let drive = self.model.drive();
         let (tau, xc) = match task.filter(|t| t.share < 1.0) {
-            None => (self.model.inverse_dynamics(&q, &dq, &a) + m.tau_e, c.x),
+            None => (
+                self.model.inverse_dynamics(&q, &dq, &a) + drive.friction_torque(&r.dxd) + m.tau_e,
+                c.x,
+            ),
             Some(t) => {
                 check::within("share", &[t.share], 1.0)?;
                 if t.share.is_nan() || t.share < 0.0 {
@@ -237,7 +241,10 @@ impl<const N: usize> ComputedTorque<N> {
                 let null = t.null_space(kp).apply(&self.model.mass_times(&q, &pd));
                 let ddq = n * a + (1.0 - n) * qc.ddx;
                 let task_part = t.jacobian.transpose() * t.force(&dq) + null;
+                // (20.6) on the velocity the blend of references moves at.
+                let v_r = n * r.dxd + (1.0 - n) * qc.dx;
                 let tau = self.model.inverse_dynamics(&q, &dq, &ddq)
+                    + drive.friction_torque(&v_r)
                     + n * m.tau_e
                     + (1.0 - n) * task_part;
                 (tau, qc.x)
@@ -355,6 +362,43 @@ mod tests {
         // up to the sample-and-hold's residue.
         assert!((c.x - q).amax() < 1e-6, "{}", c.x - q);
         assert!(st.fault.is_none() && st.k == 2000);
+    }
+
+    #[test]
+    fn the_drive_enters_the_law_and_its_friction_is_compensated() {
+        // (20.3) with (20.5), (20.6): the same step with and without a drive
+        // differs by I_a ⊙ a + b ⊙ q̇ + F ⊙ tanh(ẋ_c / v_s) (external mode).
+        use crate::cartesian::dynamics::{Drive, FRICTION_VELOCITY};
+        let drive = Drive {
+            armature: Vector::<2>::new(0.2, 0.1),
+            damping: Vector::<2>::new(0.5, 0.3),
+            friction: Vector::<2>::new(1.5, 0.7),
+        };
+        let mut cfg = ComputedTorqueConfig::new(1e-3, Vector::<2>::new(1e3, 1e3));
+        cfg.mode = ImpedanceMode::External;
+        let rigid = ComputedTorque::new(cfg, two_link()).unwrap();
+        let driven = ComputedTorque::new(cfg, two_link().with_drive(drive).unwrap()).unwrap();
+        let c = Setpoint {
+            x: Vector::<2>::new(0.5, 0.3),
+            dx: Vector::<2>::new(0.02, -0.004),
+            ddx: Vector::<2>::new(0.3, -0.1),
+        };
+        let m = Measurement {
+            x: Vector::<2>::new(0.48, 0.31),
+            dx: Some(Vector::<2>::new(0.1, -0.2)),
+            tau_e: Vector::zeros(),
+        };
+        let step =
+            |ct: &ComputedTorque<2>| ct.step(&mut ComputedState::default(), &m, &c).unwrap().tau;
+        let dq = m.dx.unwrap();
+        let a = c.ddx + cfg.kd.component_mul(&(c.dx - dq)) + cfg.kp.component_mul(&(c.x - m.x));
+        let want = drive.armature.component_mul(&a)
+            + drive.damping.component_mul(&dq)
+            + Vector::<2>::from_fn(|i, _| {
+                drive.friction[i] * libm::tanh(c.dx[i] / FRICTION_VELOCITY)
+            });
+        let got = step(&driven) - step(&rigid);
+        assert!((got - want).amax() < 1e-12, "{got} vs {want}");
     }
 
     #[test]

@@ -1,19 +1,82 @@
 //! Rigid-body dynamics of a serial chain, SPEC §20: the inertials of its
-//! links (20.1) and the recursive Newton–Euler algorithm (20.2),
-//! τ = M(q) q̈ + C(q, q̇) q̇ + G(q), with the mass matrix and the gravity
-//! torque from it. No allocation; validation at construction returns errors
+//! links (20.1), the recursive Newton–Euler algorithm (20.2),
+//! τ = M(q) q̈ + C(q, q̇) q̇ + G(q), the mass matrix and the gravity torque,
+//! and the joints' drive terms (20.5): armature, viscous damping and the dry
+//! friction that computed torque compensates (20.6). No allocation; validation at construction returns errors
 //! naming the condition and the entry, never panics.
 //!
 //! Units: kg, m, kg m², rad (m for a prismatic joint), N m (N).
 
 use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
 use crate::error::{check, Error};
+use crate::math::tanh;
 use crate::types::{Matrix, Vector};
 use nalgebra::{Matrix3, Vector3};
 
 /// Standard gravity (m/s²), along −z of the chain's base frame: the default
 /// of [`Dynamics::new`]'s `gravity`.
 pub const GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+/// The velocity scale v_s of the dry-friction compensation (rad/s, or m/s
+/// for a prismatic joint), SPEC (20.6): τ_F = F tanh(v_r / v_s).
+pub const FRICTION_VELOCITY: f64 = 0.01;
+
+/// The drive of each joint, SPEC (20.5), (20.6): what the rigid links do not
+/// have. Every entry ≥ 0 and finite ([`Dynamics::with_drive`] checks).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Drive<const N: usize> {
+    /// Armature I_a (kg m², kg for a prismatic joint): the rotor's inertia
+    /// through the gear, added to the mass matrix's diagonal (MuJoCo's
+    /// `dof_armature`, Pinocchio's `model.armature`).
+    pub armature: Vector<N>,
+    /// Viscous damping b (N m s/rad, N s/m): the torque b q̇ (MuJoCo's
+    /// `dof_damping`, URDF's `<dynamics damping>`).
+    pub damping: Vector<N>,
+    /// Dry friction loss F (N m, N): the largest torque the friction
+    /// exerts (MuJoCo's `frictionloss`, URDF's `<dynamics friction>`).
+    pub friction: Vector<N>,
+}
+
+impl<const N: usize> Drive<N> {
+    /// No armature, damping or friction: the rigid links alone.
+    pub fn none() -> Self {
+        Self {
+            armature: Vector::zeros(),
+            damping: Vector::zeros(),
+            friction: Vector::zeros(),
+        }
+    }
+
+    /// The dry-friction compensation τ_F = F ⊙ tanh(v_r / v_s) at the
+    /// reference velocity `v_r` (rad/s, m/s), SPEC (20.6) (N m, N).
+    pub fn friction_torque(&self, v_r: &Vector<N>) -> Vector<N> {
+        Vector::from_fn(|i, _| {
+            let f = self.friction[i];
+            if f == 0.0 {
+                0.0
+            } else {
+                f * tanh(v_r[i] / FRICTION_VELOCITY)
+            }
+        })
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        for (what, condition, v) in [
+            ("armature", "armature ≥ 0", &self.armature),
+            ("damping", "damping ≥ 0", &self.damping),
+            ("friction", "friction ≥ 0", &self.friction),
+        ] {
+            check::nonnegative_vec(condition, what, v)?;
+        }
+        Ok(())
+    }
+}
+
+impl<const N: usize> Default for Drive<N> {
+    fn default() -> Self {
+        Self::none()
+    }
+}
 
 /// The inertial of one link as a URDF or a MuJoCo model states it: the
 /// mass, and the rotational inertia about the centre of mass in the frame
@@ -123,6 +186,7 @@ pub struct Dynamics<const N: usize> {
     chain: Chain<N>,
     bodies: [Body; N],
     gravity: Vector3<f64>,
+    drive: Drive<N>,
 }
 
 impl<const N: usize> Dynamics<N> {
@@ -171,7 +235,25 @@ impl<const N: usize> Dynamics<N> {
             chain,
             bodies,
             gravity: Vector3::from(gravity),
+            drive: Drive::none(),
         })
+    }
+
+    /// The model with the joints' drive terms `drive` (SPEC (20.5)): the
+    /// mass matrix gains diag(armature), inverse dynamics armature ⊙ q̈ +
+    /// damping ⊙ q̇, and computed torque compensates the friction (20.6).
+    /// Replaces any drive set before.
+    ///
+    /// Errors, naming the term and the joint: a negative or non-finite entry.
+    pub fn with_drive(mut self, drive: Drive<N>) -> Result<Self, Error> {
+        drive.check()?;
+        self.drive = drive;
+        Ok(self)
+    }
+
+    /// The joints' drive terms (zeros unless [`with_drive`](Self::with_drive)).
+    pub fn drive(&self) -> &Drive<N> {
+        &self.drive
     }
 
     /// The chain (for its kinematics; its tip is the last joint's frame).
@@ -211,10 +293,13 @@ impl<const N: usize> Dynamics<N> {
         Ok(self)
     }
 
-    /// RNEA(q, q̇, q̈) = M(q) q̈ + C(q, q̇) q̇ + G(q) (N m, N), (20.2).
+    /// ID(q, q̇, q̈) = M(q) q̈ + C(q, q̇) q̇ + G(q) + I_a ⊙ q̈ + b ⊙ q̇ (N m,
+    /// N): RNEA (20.2) with the drive's armature and damping (20.5).
     #[inline]
     pub fn inverse_dynamics(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>) -> Vector<N> {
         self.rnea(q, dq, ddq, -self.gravity)
+            + self.drive.armature.component_mul(ddq)
+            + self.drive.damping.component_mul(dq)
     }
 
     /// G(q) = RNEA(q, 0, 0) (N m, N).
@@ -223,13 +308,14 @@ impl<const N: usize> Dynamics<N> {
         self.rnea(q, &z, &z, -self.gravity)
     }
 
-    /// M(q) v = RNEA₀(q, 0, v), without gravity (N m, N).
+    /// M_a(q) v = RNEA₀(q, 0, v) + I_a ⊙ v, without gravity (N m, N), (20.5).
     #[inline]
     pub fn mass_times(&self, q: &Vector<N>, v: &Vector<N>) -> Vector<N> {
-        self.rnea(q, &Vector::zeros(), v, Vector3::zeros())
+        self.rnea(q, &Vector::zeros(), v, Vector3::zeros()) + self.drive.armature.component_mul(v)
     }
 
-    /// M(q) (kg m², kg), column j = M e_j, symmetrised.
+    /// M_a(q) = M(q) + diag(I_a) (kg m², kg), (20.5); column j = M_a e_j,
+    /// symmetrised.
     pub fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
         let mut m = Matrix::<N>::zeros();
         for j in 0..N {
@@ -387,6 +473,65 @@ mod tests {
         let loaded = d.with_payload(2.0).unwrap();
         assert!((loaded.mass() - d.mass() - 2.0).abs() < 1e-15);
         assert!(d.scaled(0.0).is_err() && d.with_payload(-1.0).is_err());
+    }
+
+    #[test]
+    fn the_drive_adds_armature_and_damping_as_stated() {
+        // (20.5): M_a = M + diag(I_a), ID = RNEA + I_a ⊙ q̈ + b ⊙ q̇, G unchanged.
+        let d = arm();
+        let drive = Drive {
+            armature: Vector::<3>::new(0.1, 0.25, 0.04),
+            damping: Vector::<3>::new(1.5, 0.0, 0.3),
+            friction: Vector::<3>::new(2.0, 1.0, 0.0),
+        };
+        let a = d.with_drive(drive).unwrap();
+        let (q, dq, ddq) = state();
+        let m = a.mass_matrix(&q) - d.mass_matrix(&q);
+        assert!(
+            (m - Matrix::<3>::from_diagonal(&drive.armature)).amax() < 1e-14,
+            "{m}"
+        );
+        let tau = a.inverse_dynamics(&q, &dq, &ddq) - d.inverse_dynamics(&q, &dq, &ddq);
+        let want = drive.armature.component_mul(&ddq) + drive.damping.component_mul(&dq);
+        assert!((tau - want).amax() < 1e-13, "{tau} vs {want}");
+        assert_eq!(a.gravity_torque(&q), d.gravity_torque(&q));
+        let mv = a.mass_times(&q, &ddq) - a.mass_matrix(&q) * ddq;
+        assert!(mv.amax() < 1e-12, "{mv}");
+        // (20.6): the full friction beyond a few v_s, none at rest, odd.
+        let v = Vector::<3>::new(1.0, -1.0, 1.0);
+        let f = a.drive().friction_torque(&v);
+        assert!((f - Vector::<3>::new(2.0, -1.0, 0.0)).amax() < 1e-12, "{f}");
+        assert_eq!(
+            a.drive().friction_torque(&Vector::zeros()),
+            Vector::<3>::zeros()
+        );
+        let slow = a
+            .drive()
+            .friction_torque(&Vector::from_element(FRICTION_VELOCITY));
+        assert!((slow[0] - 2.0 * libm::tanh(1.0)).abs() < 1e-15, "{slow}");
+        // The default is no drive, bit for bit the rigid model.
+        assert_eq!(d.with_drive(Drive::none()).unwrap(), d);
+    }
+
+    #[test]
+    fn a_bad_drive_is_refused_by_term_and_joint() {
+        let d = arm();
+        let bad = |f: fn(&mut Drive<3>)| {
+            let mut drive = Drive::none();
+            f(&mut drive);
+            d.with_drive(drive).unwrap_err().to_string()
+        };
+        let e = bad(|d| d.armature[1] = -0.1);
+        assert!(
+            e.contains("armature ≥ 0 is violated: armature[1] = -0.1"),
+            "{e}"
+        );
+        let e = bad(|d| d.damping[2] = -1.0);
+        assert!(e.contains("damping ≥ 0") && e.contains("damping[2]"), "{e}");
+        let e = bad(|d| d.friction[0] = f64::NAN);
+        assert!(e.contains("friction") && e.contains("[0]"), "{e}");
+        let e = bad(|d| d.armature[0] = f64::INFINITY);
+        assert!(e.contains("armature"), "{e}");
     }
 
     #[test]

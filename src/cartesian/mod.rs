@@ -13,7 +13,7 @@ pub mod rule;
 
 pub use chain::{Chain, Joint, JointKind, Transform, MAX_CHAIN_JOINTS};
 pub use computed::{ComputedState, ComputedTorque, ComputedTorqueConfig};
-pub use dynamics::{Dynamics, Inertial, GRAVITY};
+pub use dynamics::{Drive, Dynamics, Inertial, FRICTION_VELOCITY, GRAVITY};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{
     CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation, OuterStep,

@@ -10,7 +10,7 @@ use super::dynamic::MAX_JOINTS;
 use super::{array, array1, vector, ConfigError};
 use crate::cartesian::chain::JointKind;
 use crate::cartesian::{
-    ComputedState, ComputedTorque, ComputedTorqueConfig, Dynamics, Inertial, Joint,
+    ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
 };
 use crate::control::impedance::{ImpedanceMode, TargetImpedance};
 use crate::control::io::Measurement;
@@ -143,6 +143,9 @@ struct Params<'a> {
     mode: ImpedanceMode,
     mass_scale: f64,
     payload: f64,
+    armature: &'a [f64],
+    damping: &'a [f64],
+    friction: &'a [f64],
 }
 
 fn build<const N: usize>(
@@ -151,9 +154,15 @@ fn build<const N: usize>(
     gravity: [f64; 3],
     p: &Params<'_>,
 ) -> Result<Box<dyn DynComputed>, Error> {
+    let drive = Drive {
+        armature: vector_of(p.armature),
+        damping: vector_of(p.damping),
+        friction: vector_of(p.friction),
+    };
     let model = Dynamics::<N>::new(joints, inertials, gravity)?
         .scaled(p.mass_scale)?
-        .with_payload(p.payload)?;
+        .with_payload(p.payload)?
+        .with_drive(drive)?;
     let cfg = ComputedTorqueConfig {
         ts: p.ts,
         kp: vector_of(p.kp),
@@ -278,9 +287,12 @@ impl PyComputedTorque {
     /// "inertia" 3 × 3 (kg m²) about the centre of mass), `gravity` (m/s²),
     /// period `Ts` (s), K_P (1/s²), K_D (1/s), τmax (N m), the target
     /// impedance Dd, Cd, Gd, `impedance` ("joint" or "external"), the model's
-    /// masses times `mass_scale` and a `payload` (kg) at the last joint.
+    /// masses times `mass_scale`, a `payload` (kg) at the last joint, and the
+    /// joints' drive (SPEC (20.5), (20.6); a number or one per joint, ≥ 0,
+    /// default 0): `armature` (kg m²), viscous `damping` (N m s/rad) and dry
+    /// `friction` loss (N m) (kg, N s/m, N for a prismatic joint).
     #[new]
-    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload))]
+    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload, armature=None, damping=None, friction=None))]
     #[allow(clippy::too_many_arguments, non_snake_case)]
     fn new(
         joints: Vec<Bound<'_, PyDict>>,
@@ -296,6 +308,9 @@ impl PyComputedTorque {
         impedance: &str,
         mass_scale: f64,
         payload: f64,
+        armature: Option<&Bound<'_, PyAny>>,
+        damping: Option<&Bound<'_, PyAny>>,
+        friction: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let js = joints
             .iter()
@@ -325,6 +340,15 @@ impl PyComputedTorque {
             per_joint("Cd", n, Cd)?,
             per_joint("Gd", n, Gd)?,
         );
+        let drive = |what: &'static str, v: Option<&Bound<'_, PyAny>>| match v {
+            Some(v) => per_joint(what, n, v),
+            None => Ok(std::vec![0.0; n]),
+        };
+        let (armature, damping, friction) = (
+            drive("armature", armature)?,
+            drive("damping", damping)?,
+            drive("friction", friction)?,
+        );
         let p = Params {
             ts: Ts,
             kp: &kp,
@@ -336,6 +360,9 @@ impl PyComputedTorque {
             mode,
             mass_scale,
             payload,
+            armature: &armature,
+            damping: &damping,
+            friction: &friction,
         };
         let inner = computed(&js, &ins, gravity, &p).map_err(config_err)?;
         Ok(Self {

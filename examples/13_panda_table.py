@@ -195,14 +195,68 @@ def long_run(sc: apt.PandaTable, rule: dict[str, Any], T: float) -> None:
         )
 
 
+def posture(text: str) -> list[float]:
+    """``--home``: joint angles (rad) separated by commas; each a number or an
+    arithmetic expression of numbers and ``pi`` (``-pi/4``, ``3*pi/4``)."""
+    import ast
+    import operator
+
+    ops = {
+        ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+        ast.Div: operator.truediv, ast.USub: operator.neg, ast.UAdd: operator.pos,
+    }  # fmt: skip
+
+    def value(node: ast.AST) -> float:
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            return float(node.value)
+        if isinstance(node, ast.Name) and node.id == "pi":
+            return math.pi
+        if isinstance(node, ast.BinOp) and type(node.op) in ops:
+            return float(ops[type(node.op)](value(node.left), value(node.right)))
+        if isinstance(node, ast.UnaryOp) and type(node.op) in ops:
+            return float(ops[type(node.op)](value(node.operand)))
+        raise ValueError(ast.dump(node))
+
+    def angle(item: str) -> float:
+        try:
+            return value(ast.parse(item.strip(), mode="eval").body)
+        except (ValueError, SyntaxError):
+            raise argparse.ArgumentTypeError(
+                f"a joint angle (rad) must be a number or an expression of numbers and pi, "
+                f"got {item.strip()!r}"
+            ) from None
+
+    return [angle(item) for item in text.split(",")]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
-    parser.add_argument("--arm", type=str, default=None, help="URDF of the arm (default: Panda)")
+    parser.add_argument(
+        "--arm", type=str, default=None, help="URDF or MJCF file of the arm (default: Panda)"
+    )
+    parser.add_argument(
+        "--home",
+        type=posture,
+        default=None,
+        help="the home posture, q1,...,qn (rad; e.g. 0,-pi/4,0,-3*pi/4,0,pi/2,pi/4); "
+        "default: the first the table can run of the rule's home and postures drawn",
+    )
+    parser.add_argument("--tip", type=str, default=None, help="the tool's link (body)")
+    parser.add_argument(
+        "--fix", type=str, default="", help="joints to fix at zero, J1,J2 (a URDF's)"
+    )
+    parser.add_argument(
+        "--placements",
+        type=int,
+        default=0,
+        help="run the rows at this many home postures drawn within the joint limits "
+        "(each one the table can run) instead of one home",
+    )
     parser.add_argument("--T", type=float, default=2.5 if QUICK else 20.0, help="duration (s)")
     parser.add_argument("--json", type=str, default=None, help="write the table as JSON here")
     parser.add_argument("--friction", type=float, default=0.1, help="sliding friction")
     parser.add_argument("--spring", type=float, default=None, help="table spring k_e (N/m)")
-    parser.add_argument("--rows", type=str, default=",".join(ROWS), help="rows to run")
+    parser.add_argument("--rows", type=str, default=None, help="rows to run (default: all)")
     parser.add_argument("--figure", action="store_true", help=f"write {FIGURE.name}")
     parser.add_argument("--long", type=float, default=0.0, help="also a long SF run (s)")
     parser.add_argument(
@@ -220,26 +274,65 @@ def main() -> None:
         parser.error(
             f"--long must be 0 or a multiple of 10 s (it runs in parts of 10 s), got {args.long}"
         )
-    names = args.rows.split(",")
+    if args.placements < 0 or (args.placements and args.home is not None):
+        parser.error("--placements must be ≥ 0, and draws the homes: give it without --home")
+    names = list(ROWS) if args.rows is None else args.rows.split(",")
     unknown = [n for n in names if n not in ROWS]
     if unknown:
         parser.error(f"--rows: unknown {unknown}; the rows are {list(ROWS)}")
     if args.json and not Path(args.json).resolve().parent.is_dir():
         parser.error(f"--json: no directory {Path(args.json).resolve().parent}")
+    fix = tuple(j for j in args.fix.split(",") if j)
+    where = {"tip": args.tip, "fix": fix} if args.arm is not None else {}
     try:
-        sc = act.arm_table(args.arm, spring=args.spring, friction=args.friction)
+        if args.placements:
+            drawn = act.placements(
+                args.arm, args.placements, spring=args.spring, friction=args.friction, **where
+            )
+            scenarios = [(f"placement {k}", sc) for k, sc in enumerate(drawn)]
+        else:
+            home = {} if args.home is None else {"home": args.home}
+            sc = act.arm_table(
+                args.arm, spring=args.spring, friction=args.friction, **where, **home
+            )
+            scenarios = [("", sc)]
     except (adaptimp.ConfigError, ValueError, OSError) as e:
         parser.error(str(e))
-    if sc.t_approach + sc.t_press >= args.T:
-        parser.error(
-            f"--T must be longer than the approach, which ends with the tool pressed in at "
-            f"t = {sc.t_approach + sc.t_press:g} s; got {args.T:g}"
-        )
+    if scenarios[0][1].pin_model is None:
+        # Computed torque's model is Pinocchio's, read from a URDF.
+        given = [n for n in names if ROWS[n][1].startswith("ct")]
+        if args.rows is not None and given:
+            parser.error(f"--rows: {given} need a URDF arm (computed torque's model)")
+        names = [n for n in names if not ROWS[n][1].startswith("ct")]
+    table: dict[str, dict[str, Any]] = {}
+    for label, sc in scenarios:
+        if sc.t_approach + sc.t_press >= args.T:
+            parser.error(
+                f"--T must be longer than the approach, which ends with the tool pressed in "
+                f"at t = {sc.t_approach + sc.t_press:g} s; got {args.T:g}"
+            )
+        table.update(run_table(args, label, sc, names))
+    if args.json:
+        Path(args.json).write_text(json.dumps(table, indent=2) + "\n")
+        print(f"\nwrote {args.json}")
+    if args.figure and not QUICK:
+        figure(FIGURE, args.T)
+        print(f"\nwrote {FIGURE}")
+    if args.long > 0:
+        sc = scenarios[0][1]
+        long_run(sc, act.rule_keywords(sc), args.long)
+
+
+def run_table(
+    args: argparse.Namespace, label: str, sc: apt.PandaTable, names: list[str]
+) -> dict[str, dict[str, Any]]:
+    """The rows ``names`` on one scenario, printed as a Markdown table; their
+    metrics by row name (prefixed with ``label``)."""
     rule = act.rule_keywords(sc)
     print(
-        f"{args.arm or 'Panda'}: {sc.radius * 100:g} cm circle at {sc.freq:g} Hz about "
-        f"({sc.centre[0]:.3f}, {sc.centre[1]:.3f}) m, table top {sc.surface_z - 0.01:.4f} m, "
-        f"δ_c = {sc.depth * 1e3:g} mm, friction {args.friction:g}, "
+        f"\n{label + ': ' if label else ''}{args.arm or 'Panda'}: {sc.radius * 100:g} cm "
+        f"circle at {sc.freq:g} Hz about ({sc.centre[0]:.3f}, {sc.centre[1]:.3f}) m, table top "
+        f"{sc.surface_z - 0.01:.4f} m, δ_c = {sc.depth * 1e3:g} mm, friction {args.friction:g}, "
         f"{'rigid' if args.spring is None else f'spring {args.spring:g} N/m'}, T = {args.T:g} s, "
         f"home {np.round(sc.q0, 3).tolist()}, {rule['basis'][0].shape[0]} centres"
     )
@@ -249,7 +342,7 @@ def main() -> None:
         "| time (s) |"
     )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    table: dict[str, dict[str, float]] = {}
+    table: dict[str, dict[str, Any]] = {}
 
     def timed(name: str) -> tuple[dict[str, float] | None, float, str]:
         """One row: its metrics (None if it diverged), its own time (s), the error."""
@@ -270,7 +363,10 @@ def main() -> None:
         if m is None:
             print(f"| {ROWS[name][0]} | diverged: {error} |")
             continue
-        table[name] = {k: m[k] for k in KEYS}
+        table[f"{label}: {name}" if label else name] = {
+            **{k: m[k] for k in KEYS},
+            **({"home": [float(x) for x in sc.q0]} if label else {}),
+        }
         print(
             f"| {ROWS[name][0]} | {m['track_mm']:.3f} | {m['track_along_mm']:.3f} "
             f"| {m['force_rms_err_N']:.3f} "
@@ -281,14 +377,7 @@ def main() -> None:
         )
         assert m["applied_ratio"] <= 1.0 + 1e-12, "applied torque beyond its limit"
     print(f"\n{len(names)} rows in {wall:.1f} s on {min(args.jobs, len(names))} thread(s)")
-    if args.json:
-        Path(args.json).write_text(json.dumps(table, indent=2) + "\n")
-        print(f"\nwrote {args.json}")
-    if args.figure and not QUICK:
-        figure(FIGURE, args.T)
-        print(f"\nwrote {FIGURE}")
-    if args.long > 0:
-        long_run(sc, rule, args.long)
+    return table
 
 
 if __name__ == "__main__":

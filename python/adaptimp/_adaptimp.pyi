@@ -577,10 +577,12 @@ def suggest(
     period: float | None = None,
     gravity: NDArray[np.float64] | None = None,
     resolve: bool = False,
+    inertias: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18: "params" (every controller keyword),
     with a path also "centers" (L, 4n) and "widths" (4n,); ``resolve``: the tube
-    narrowed to the path's size, SPEC (16.10)."""
+    narrowed to the path's size, SPEC (16.10); ``inertias`` (K, n, n): D along the
+    path, the inertia scales the smallest over them, SPEC (16.12)."""
 
 def pose_circle(
     p0: NDArray[np.float64],
@@ -606,9 +608,12 @@ def assess_posture(
     hi: NDArray[np.float64],
     tau_max: NDArray[np.float64],
     orients: bool,
+    k1: float | None = None,
+    ts: float | None = None,
 ) -> dict[str, Any]:
     """How well a posture runs a task, SPEC (16.9): the figures along its joint
-    orbit, the score and the first condition it violates ("error", or None)."""
+    orbit, the score and the first condition it violates ("error", or None);
+    ``k1`` (1/s), ``ts`` (s): the joint controller's (conditioning ≥ K1·Ts/m)."""
 
 def pose_metrics(
     chain: Chain,

@@ -484,10 +484,11 @@ class CartesianController:
         arm of fewer than six joints, which cannot hold an orientation) runs
         kinematically from ``q0`` along ``path`` over its ``span`` (the
         hold, the ramp and one period of a periodic path); the joint rule
-        then takes D(q0), G(q0) from ``model``, the actuators' ``tau_max``
-        and that joint path (q_d, q̇_d, q̈_d of every step): the gains
-        (18.1)–(18.4), the centres along the joint orbit with the tube
-        narrowed to the orbit (16.10), the learning (18.6)–(18.8).
+        then takes D and G from ``model``, the actuators' ``tau_max`` and that
+        joint path (q_d, q̇_d, q̈_d of every step): the gains (18.1)–(18.4)
+        with the inertia scales the smallest along the path (16.12), the
+        centres along the joint orbit with the tube narrowed to the orbit
+        (16.10), the learning (18.6)–(18.8).
 
         Parameters
         ----------
@@ -548,7 +549,7 @@ class CartesianController:
         try:
             kw = tuning.suggest(
                 model, q0, limits, Ts=Ts, path=np.hstack([q, dq, ddq]), period=steps * Ts,
-                case=controller, resolve=True,
+                case=controller, resolve=True, along=True,
             )  # fmt: skip
         finally:
             forward = getattr(model, "forward", None)

@@ -58,7 +58,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _adaptimp, _models
-from ._cartesian_task import CartesianTask, task_of
+from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
 from ._faults import Fault
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
@@ -70,11 +70,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MAX_JOINTS",
+    "CartesianTask",
     "ControllerLike",
     "MujocoResult",
     "Plant",
     "Reference",
     "Task",
+    "cartesian_task",
+    "chain_of",
     "default_task",
     "estimate_effort",
     "from_urdf",
@@ -83,6 +86,7 @@ __all__ = [
     "panda",
     "paper_circle",
     "rule_keywords",
+    "self_collision",
     "simulate",
     "sinusoid",
     "two_link",

@@ -39,6 +39,9 @@ Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]
 PATH_SAMPLES = 1000
 """Samples of one period of a path that :func:`suggest` hands the core."""
 
+ALONG = 200
+"""Postures along a path at which :func:`suggest` evaluates D(q) with ``along=True``."""
+
 RULE_KEYS = (
     "Ts",
     "Kp",
@@ -129,6 +132,7 @@ def suggest(
     period: float | None = None,
     case: str = "sf",
     resolve: bool = False,
+    along: bool = False,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia at ``q0`` (rad), its actuator
     limits ``tau_max`` (N m) and the task's joint path (SPEC §18, module docs).
@@ -156,6 +160,11 @@ def suggest(
         Narrow the tube to the path's own size, SPEC (16.10): tube_b =
         min(tube_b, ℓ_b/10), ℓ_b the closed path's length in q and in q̇ (the
         Cartesian rule's: a small joint orbit gets the joint task's resolution).
+    along : bool
+        The inertia scales d_i the smallest of 1/(D⁻¹(q))_ii over q0 and
+        :data:`ALONG` postures evenly along the path, SPEC (16.12) (the
+        Cartesian and contact rules'): the sampled velocity loop stays within
+        its margin wherever the path takes the arm, not only at q0.
 
     Returns
     -------
@@ -182,9 +191,14 @@ def suggest(
         else:
             rows = np.ascontiguousarray(np.asarray(path, dtype=np.float64))
     g = gravity(model, q0) if rows is not None else None
+    more = None
+    if along and rows is not None:
+        idx = np.unique(np.linspace(0, rows.shape[0] - 1, ALONG).round().astype(int))
+        more = np.ascontiguousarray(np.array([inertia(model, rows[k, :n]) for k in idx]))
     out = _adaptimp.suggest(
-        case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve
-    )
+        case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
+        inertias=more,
+    )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})
     if "centers" in out:

@@ -263,6 +263,17 @@ impl Default for PostureRule {
 }
 
 impl PostureRule {
+    /// The rule for a joint controller whose position loop runs at `k1`
+    /// (1/s) with the velocity loop of `rule` at period `ts` (s): the
+    /// conditioning threshold K1·Ts/m (0.2 for the joint rule's K1 = 50 s⁻¹
+    /// at 1 kHz, 0.04 for the contact scenario's K1 = 10 s⁻¹, SPEC (19.6)).
+    pub fn for_loop(k1: f64, ts: f64, rule: &Rule) -> Self {
+        Self {
+            conditioning: k1 * ts / rule.margin,
+            ..Self::default()
+        }
+    }
+
     /// The margin (rad) joint i keeps inside [`lo`, `hi`]: min(margin,
     /// (hi − lo)/8) (the margin alone for an unlimited joint).
     pub fn margin_of(&self, lo: f64, hi: f64) -> f64 {
@@ -332,8 +343,8 @@ impl PostureRule {
 
     /// Whether `a` meets the rule: the first condition it violates, named
     /// (`σmin(J) ≥ 0.05`, `inside the joint limits with margin`, `gravity
-    /// load ≤ 0.5`, `velocity-loop conditioning ≥ 0.2`, `task reachable`),
-    /// with the value.
+    /// load ≤ 0.5`, `velocity-loop conditioning ≥ K1·Ts/m`, `task
+    /// reachable`), with the value.
     pub fn check(&self, a: &Assessment) -> Result<(), Error> {
         let conditions: [(bool, &'static str, &'static str, Option<usize>, f64); 5] = [
             (
@@ -359,7 +370,7 @@ impl PostureRule {
             ),
             (
                 a.conditioning >= self.conditioning,
-                "velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ 0.2",
+                "velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ K1·Ts/m",
                 "λmin",
                 None,
                 a.conditioning,

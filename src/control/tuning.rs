@@ -106,6 +106,26 @@ pub fn inertia_scales<const N: usize>(d: &Matrix<N>) -> Result<Vector<N>, Error>
     Ok(scales)
 }
 
+/// The inertia scales along a path, SPEC (16.12): d_i = min over the
+/// inertia matrices `ds` (kg m², each symmetric positive definite, e.g. D(q)
+/// at the samples of a task's joint path) of 1/(D⁻¹)_ii. With Kp = m Dₛ/Ts
+/// the sampled velocity loop keeps Ts (Kp D(q)⁻¹)_ii ≤ m at every posture
+/// of the path, not only at its start: where two joints' axes come to act
+/// alike (the Panda's base and upper-arm rotations as its shoulder rises),
+/// D(q)⁻¹ couples them and a gain set at the start rang at the sampling
+/// rate. Errors as [`inertia_scales`], for an empty `ds` too.
+pub fn inertia_scales_along<const N: usize>(ds: &[Matrix<N>]) -> Result<Vector<N>, Error> {
+    let mut out: Option<Vector<N>> = None;
+    for d in ds {
+        let s = inertia_scales(d)?;
+        out = Some(out.map_or(s, |o| o.zip_map(&s, f64::min)));
+    }
+    out.ok_or(Error::Invalid {
+        what: "inertia matrices",
+        reason: "need one or more",
+    })
+}
+
 impl Rule {
     /// The rule with its tube widened to hold the sag of the arm under the
     /// feedback alone, SPEC (18.5): the weights start at zero, so at first the
@@ -145,10 +165,23 @@ impl Rule {
         tau_max: &Vector<N>,
         ts: f64,
     ) -> Result<Config<N>, Error> {
+        self.gains_of_scales(law, &inertia_scales(d)?, tau_max, ts)
+    }
+
+    /// [`gains`](Self::gains) from the inertia scales d_i (kg m²) themselves
+    /// (e.g. [`inertia_scales_along`] a path, SPEC (16.12)).
+    pub fn gains_of_scales<const N: usize>(
+        &self,
+        law: Law,
+        scales: &Vector<N>,
+        tau_max: &Vector<N>,
+        ts: f64,
+    ) -> Result<Config<N>, Error> {
         check::positive("Ts > 0", "Ts", ts)?;
         check::at_most("Ts ≤ 1 s", "Ts", ts, 1.0)?;
         check::positive_vec("τmax > 0", "tau_max", tau_max)?;
-        let scales = inertia_scales(d)?;
+        check::finite_slice("inertia scale", scales.as_slice())?;
+        let scales = *scales;
         if let Some(i) = scales
             .iter()
             .position(|d| *d < MIN_SCALE || *d > PARAM_BOUND)
@@ -328,7 +361,23 @@ impl Rule {
         period: f64,
         gravity: Option<&Vector<N>>,
     ) -> Result<Suggestion<N>, Error> {
-        let mut config = self.gains(law, d, tau_max, ts)?;
+        self.suggest_scaled(law, &inertia_scales(d)?, tau_max, ts, path, period, gravity)
+    }
+
+    /// [`suggest`](Self::suggest) from the inertia scales d_i (kg m²) (e.g.
+    /// [`inertia_scales_along`] the path, SPEC (16.12)).
+    #[allow(clippy::too_many_arguments)]
+    pub fn suggest_scaled<const N: usize>(
+        &self,
+        law: Law,
+        scales: &Vector<N>,
+        tau_max: &Vector<N>,
+        ts: f64,
+        path: &[Setpoint<N>],
+        period: f64,
+        gravity: Option<&Vector<N>>,
+    ) -> Result<Suggestion<N>, Error> {
+        let mut config = self.gains_of_scales(law, scales, tau_max, ts)?;
         if let Some(g) = gravity {
             check::finite_slice("gravity", g.as_slice())?;
         }

@@ -26,8 +26,10 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// row, one period of `period` s, evenly spaced in time) with the gravity
 /// torque `gravity` (n,; N m) at its start, if known. `resolve`: the tube
 /// narrowed to the path's own size, SPEC (16.10) (the Cartesian rule's).
+/// `inertias` (K, n, n; kg m²): D at postures along the path; the inertia
+/// scales are then the smallest over them and `inertia`, SPEC (16.12).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, inertias=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -39,6 +41,7 @@ pub fn suggest<'py>(
     period: Option<f64>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
     resolve: bool,
+    inertias: Option<numpy::PyReadonlyArray3<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -49,7 +52,14 @@ pub fn suggest<'py>(
     if tau_max.shape() != [n] {
         return Err(shape_error("tau_max", format!("({n},)"), tau_max.shape()));
     }
-    let d: Vec<f64> = inertia.as_array().iter().copied().collect();
+    let mut d: Vec<f64> = inertia.as_array().iter().copied().collect();
+    if let Some(more) = inertias {
+        let sh = more.shape();
+        if sh[1] != n || sh[2] != n {
+            return Err(shape_error("inertias", format!("(K, {n}, {n})"), sh));
+        }
+        d.extend(more.as_array().iter().copied());
+    }
     let tau: Vec<f64> = tau_max.as_array().iter().copied().collect();
     let gravity: Option<Vec<f64>> = match gravity {
         None => None,
@@ -97,12 +107,16 @@ fn fill<'py, const N: usize>(
     let mut rule = Rule::default();
     // Row-major (n, n) into nalgebra's column-major: D is symmetric, but a
     // non-symmetric input must be reported, not transposed silently.
-    let d = Matrix::<N>::from_row_slice(d);
+    let ds: Vec<Matrix<N>> = d
+        .chunks_exact(N * N)
+        .map(Matrix::<N>::from_row_slice)
+        .collect();
+    let scales = crate::control::tuning::inertia_scales_along(&ds).map_err(err)?;
     let tau = Vector::<N>::from_column_slice(tau);
     let mut s = Scenario::<N>::preset(Preset::Robot, law);
     let centers = match path {
         None => {
-            s.config = rule.gains(law, &d, &tau, ts).map_err(err)?;
+            s.config = rule.gains_of_scales(law, &scales, &tau, ts).map_err(err)?;
             None
         }
         Some((rows, period)) => {
@@ -119,7 +133,7 @@ fn fill<'py, const N: usize>(
             }
             let g = gravity.map(Vector::<N>::from_column_slice);
             let sug = rule
-                .suggest(law, &d, &tau, ts, &samples, *period, g.as_ref())
+                .suggest_scaled(law, &scales, &tau, ts, &samples, *period, g.as_ref())
                 .map_err(err)?;
             s.config = sug.config;
             Some(sug.centers)
@@ -265,10 +279,13 @@ pub fn pose_circle<'py>(
 /// torque along it `gravity` (K, n; N m), the inertia matrix at its start
 /// `d0` (n, n; kg m²), the limits `lo`, `hi` (n,; rad, ±inf: unlimited),
 /// `tau_max` (n,; N m), `orients` (the 6 × n Jacobian, else its 3
-/// translation rows). Returns a dict: "sigma_min", "load", "conditioning",
-/// "slack", "slack_joint", "reach", "score" and "error" (the first
-/// condition it violates, or None).
+/// translation rows), `k1` (1/s) and `ts` (s) of the joint controller (the
+/// conditioning threshold K1·Ts/m; default the joint rule's at 1 kHz).
+/// Returns a dict: "sigma_min", "load", "conditioning", "slack",
+/// "slack_joint", "reach", "score" and "error" (the first condition it
+/// violates, or None).
 #[pyfunction]
+#[pyo3(signature = (chain, q, p, gravity, d0, lo, hi, tau_max, orients, k1=None, ts=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn assess_posture<'py>(
     py: Python<'py>,
@@ -281,7 +298,12 @@ pub fn assess_posture<'py>(
     hi: PyReadonlyArray1<'py, f64>,
     tau_max: PyReadonlyArray1<'py, f64>,
     orients: bool,
+    k1: Option<f64>,
+    ts: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let joint_rule = Rule::default();
+    let ts = ts.unwrap_or(1e-3);
+    let rule = PostureRule::for_loop(k1.unwrap_or_else(|| joint_rule.k1(ts)), ts, &joint_rule);
     let kin = chain.dyn_chain();
     let n = kin.n();
     let k = q.shape()[0];
@@ -307,12 +329,12 @@ pub fn assess_posture<'py>(
     let (q, p, g, d) = (flat(&q), flat(&p), flat(&gravity), flat(&d0));
     let (lo, hi, tau) = (flat1(&lo), flat1(&hi), flat1(&tau_max));
     fn run<const N: usize>(
+        rule: &PostureRule,
         kin: &dyn super::cartesian::DynChain,
         (q, p, g, d): (&[f64], &[f64], &[f64], &[f64]),
         (lo, hi, tau): (&[f64], &[f64], &[f64]),
         orients: bool,
     ) -> Result<(crate::cartesian::Assessment, f64, Option<String>), Error> {
-        let rule = PostureRule::default();
         let v = Vector::<N>::from_column_slice;
         let orbit: Vec<Vector<N>> = q.chunks_exact(N).map(v).collect();
         let targets: Vec<Vector<3>> = p
@@ -336,7 +358,7 @@ pub fn assess_posture<'py>(
     macro_rules! arms {
         ($($k:literal)*) => {
             match n {
-                $($k => run::<$k>(kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),)*
+                $($k => run::<$k>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),)*
                 _ => unreachable!("a chain has 1 to 7 joints"),
             }
         };

@@ -52,6 +52,8 @@ __all__ = [
     "arm_table",
     "contact_metrics",
     "placement",
+    "placements",
+    "refusal_of",
     "rule_keywords",
     "sag",
     "sliding_timeconst",
@@ -287,11 +289,13 @@ def arm_model(
     force: float = 0.0,
     speed: float = 0.0,
 ) -> Any:
-    """A URDF arm in MuJoCo with a tool and a table (see the module doc).
+    """A URDF or MJCF arm in MuJoCo with a tool and a table (see the module doc).
 
-    The arm as :func:`adaptimp.mujoco.from_urdf` makes it (rigid-body dynamics
-    only, a motor per joint with ctrlrange ± its effort limit, RK4), joints in
-    ``fix`` fixed at zero; the tool sphere of ``tool_radius`` (m) at the origin
+    A URDF: the arm as :func:`adaptimp.mujoco.from_urdf` makes it (rigid-body
+    dynamics only, a motor per joint with ctrlrange ± its effort limit, RK4),
+    joints in ``fix`` fixed at zero. An MJCF file (any other suffix): the
+    model as it is, its own actuators and geometry (``fix`` must be empty), RK4.
+    Then the tool sphere of ``tool_radius`` (m) at the origin
     of body ``tip`` with the site ``ee`` and its force/torque sensors; a 0.7 ×
     1.0 m table whose top is at height ``table_top`` (m; None: no table),
     centred at ``centre`` (x, y), sliding friction ``friction`` for the table
@@ -309,6 +313,12 @@ def arm_model(
 
     from .. import mujoco as amj
 
+    if Path(urdf).suffix.lower() != ".urdf":
+        return _mjcf_model(
+            Path(urdf), tip, fix=fix, tool_radius=tool_radius, table_top=table_top,
+            centre=centre, friction=friction, spring=spring, home=home, timestep=timestep,
+            force=force, speed=speed,
+        )  # fmt: skip
     spec, effort = amj._urdf_spec(Path(urdf).read_text(), fix)
     spec.option.timestep = timestep
     missing = [j.name for j in spec.joints if not 0 < effort.get(j.name, math.nan) < math.inf]
@@ -342,6 +352,69 @@ def arm_model(
     # Inertias that do not compile as they are: bounded and balanced as
     # adaptimp.mujoco.from_urdf does, and said as it says it.
     model = amj._compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    if model.npair:
+        model.pair_solreffriction[0] = [
+            sliding_timeconst(model, force=force, speed=speed, friction=friction),
+            1.0,
+        ]
+    return model
+
+
+def _mjcf_model(
+    path: Path,
+    tip: str,
+    *,
+    fix: tuple[str, ...],
+    tool_radius: float,
+    table_top: float | None,
+    centre: ArrayLike,
+    friction: float,
+    spring: float | None,
+    home: ArrayLike | None,
+    timestep: float,
+    force: float,
+    speed: float,
+) -> Any:
+    """:func:`arm_model` for an MJCF file: the model with the tool on body ``tip``
+    and the table; keyframe ``home`` at the arm's joints (the others at qpos0)."""
+    import mujoco
+
+    from .. import mujoco as amj
+
+    if fix:
+        raise ConfigError(
+            f"fix applies to the joints of a URDF; an MJCF arm's model is taken as it is "
+            f"(lock its joints in the file), got fix={fix!r}"
+        )
+    spec = mujoco.MjSpec.from_file(str(path))
+    spec.option.timestep = timestep
+    for key in list(spec.keys):  # the table may add a joint: the file's keys no longer fit
+        spec.delete(key)
+    arm_bodies = [b.name for b in spec.bodies if b.name and b.name != "world"]
+    _tool_and_table(
+        spec,
+        tip,
+        tool_radius=tool_radius,
+        table_top=table_top,
+        centre=centre,
+        friction=friction,
+        spring=spring,
+    )
+    if table_top is not None:
+        # The tool presses on the table, not the arm's own geometry (a URDF arm
+        # has none; an MJCF wrist around the tool would rest on the table):
+        # the arm's bodies and the table do not collide.
+        table = [b.name for b in spec.bodies if b.name.startswith("table")][-1]
+        for name in arm_bodies:
+            spec.add_exclude(bodyname1=name, bodyname2=table)
+    model = spec.compile()
+    if home is not None:
+        plant = amj.Plant(model)
+        qpos = np.array(model.qpos0, dtype=np.float64)
+        qpos[plant._qadr] = np.asarray(home, dtype=np.float64)
+        spec.add_key(name="home", qpos=qpos.tolist())
+        model = spec.compile()
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
         model.pair_solreffriction[0] = [
@@ -453,10 +526,10 @@ TABLE_OFFSET_MARGIN = 0.2
 circle and the tool stay on it for radius + tool_radius ≤ 0.35 − 0.15 m."""
 
 MAX_PATH_STEPS = 1_000_000
-"""The longest scenario path (periods) :func:`rule_keywords` samples: the hold,
-the approach, the press or ramp and one period of the circle (1000 s at 1 kHz);
-a longer one (a huge ``t_press`` or ``t_ramp``, a tiny ``freq``) is refused
-there, not by :func:`arm_table` (a press without a circle needs no rule)."""
+"""The longest scenario path (periods) :func:`rule_keywords` and :func:`refusal_of`
+sample: the hold, the approach, the press or ramp and one period of the circle
+(1000 s at 1 kHz); a longer one (a huge ``t_press`` or ``t_ramp``, a tiny
+``freq``) is refused by name."""
 
 
 def _check_path_length(duration: float, Ts: float) -> None:
@@ -627,13 +700,87 @@ def arm_table(
         _check_press(sc.chain, plant, sc.q0, sc.tau_max, _NOMINAL_KD * depth, friction, tool_radius)
         return sc
     path = Path(urdf)
-    # The arm's joints by the one rule of adaptimp.mujoco.simulate and the
-    # Pinocchio model (_models.arm_urdf): a gripper's, prismatic, mimic and
-    # off-chain joints are fixed; by default the tool goes on the last arm
-    # joint's link.
-    text = path.read_text()
+    if path.suffix.lower() == ".urdf":
+        chain, bare, tip, fix = _urdf_arm(path, tip, fix, tool_radius)
+        pin_model: Any = pinocchio_model(path)
+    else:
+        chain, bare, tip = _mjcf_arm(path, tip, fix, tool_radius)
+        pin_model = None  # computed torque's model is Pinocchio's, from a URDF
+    tau_max = np.asarray(bare.tau_max, dtype=np.float64)
+    lo, hi = _limits(bare)
+
+    def build(q0: FloatArray) -> PandaTable:
+        """The scenario with its home at ``q0``: the press checked, the table
+        and the circle placed from the arm's reach."""
+        outside = np.flatnonzero((q0 < lo - 1e-12) | (q0 > hi + 1e-12))
+        if outside.size:
+            i = int(outside[0])
+            raise ConfigError(
+                f"home must lie within the joint limits; joint {i} ({chain.joint_names[i]!r}) "
+                f"has home = {float(q0[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
+            )
+        _check_press(chain, bare, q0, tau_max, _NOMINAL_KD * depth, friction, tool_radius)
+        clearance = max(CLEARANCE, SAG_MARGIN * sag(chain, bare, q0, tau_max, Ts=Ts))
+        centre, top, _ = placement(
+            chain, q0, _limits(bare), tool_radius=tool_radius, clearance=clearance
+        )
+        table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)
+        model = arm_model(
+            path,
+            tip,
+            fix=fix,
+            tool_radius=tool_radius,
+            table_top=top,
+            centre=table_centre,
+            friction=friction,
+            spring=spring,
+            home=q0,
+            force=_NOMINAL_KD * depth,
+            speed=speed,
+        )
+        return PandaTable(
+            model=model,
+            chain=chain,
+            q0=q0,
+            pin_model=pin_model,
+            Ts=Ts,
+            radius=radius,
+            freq=freq,
+            centre=np.asarray(centre, dtype=np.float64),
+            depth=depth,
+            surface_z=top + tool_radius,
+            t_approach=t_approach,
+            t_ramp=t_ramp,
+            tau_max=tau_max,
+            t_hold=float(t_hold),
+            t_press=float(t_press),
+        )
+
+    if home is not None:
+        sc = build(_joint_vector("home", home, chain))
+        refusal = refusal_of(sc)
+        if refusal is not None:
+            raise ConfigError(f"the home posture cannot run the table: {refusal}")
+        return sc
+    return _drawn(build, path, chain, bare, (lo, hi), seed=0)
+
+
+def _urdf_arm(
+    path: Path, tip: str | None, fix: tuple[str, ...], tool_radius: float
+) -> tuple[Chain, Any, str, tuple[str, ...]]:
+    """A URDF arm's chain to the tool's body, its bare model's Plant (the tool,
+    no table), the tip and the joints fixed: by the one rule of
+    :func:`adaptimp.mujoco.simulate` and the Pinocchio model
+    (``_models.arm_urdf``: a gripper's, prismatic, mimic and off-chain joints
+    are fixed; by default the tool goes on the last arm joint's link)."""
     import xml.etree.ElementTree as ET
 
+    import mujoco
+
+    from .. import _models
+    from .. import mujoco as amj
+
+    text = path.read_text()
     names = {j.get("name") for j in ET.fromstring(text).iter("joint")}
     unknown = [j for j in fix if j not in names]
     if unknown:
@@ -643,8 +790,6 @@ def arm_table(
     fix = (*fix, *(j for j in arm.fixed if j not in fix))
     chain = Chain.from_urdf(path, tip=tip)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
-    import mujoco
-
     joint = mujoco.mjtObj.mjOBJ_JOINT
     driven = [amj._name(bare.model, joint, j) for j in bare._joints]
     if driven != chain.joint_names:
@@ -653,52 +798,204 @@ def arm_table(
             f"drives {driven} (fix={fix!r}): give a tip whose path holds exactly the "
             "driven joints, or fix the others"
         )
-    q0 = _home(path, chain, bare) if home is None else _joint_vector("home", home, chain)
-    lo, hi = _limits(bare)
-    outside = np.flatnonzero((q0 < lo - 1e-12) | (q0 > hi + 1e-12))
-    if outside.size:
-        i = int(outside[0])
-        raise ConfigError(
-            f"home must lie within the joint limits; joint {i} ({chain.joint_names[i]!r}) "
-            f"has home = {float(q0[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
-        )
-    tau_max = np.asarray(bare.tau_max, dtype=np.float64)
-    _check_press(chain, bare, q0, tau_max, _NOMINAL_KD * depth, friction, tool_radius)
-    clearance = max(CLEARANCE, SAG_MARGIN * sag(chain, bare, q0, tau_max, Ts=Ts))
-    centre, top, _ = placement(
-        chain, q0, _limits(bare), tool_radius=tool_radius, clearance=clearance
+    return chain, bare, tip, fix
+
+
+def _mjcf_arm(
+    path: Path, tip: str | None, fix: tuple[str, ...], tool_radius: float
+) -> tuple[Chain, Any, str]:
+    """An MJCF arm's chain to the tool's site ``ee``, its bare model's Plant
+    (the tool, no table) and the tool's body (default: the arm's end
+    effector's body as :class:`adaptimp.mujoco.Plant` finds it, or the body
+    its single chain of bodies without joints ends at: a hand, a flange)."""
+    import mujoco
+
+    from .. import mujoco as amj
+
+    if tip is None:
+        plain = amj.Plant(str(path))
+        m = plain.model
+        body = int(plain._ee_body)
+        while True:
+            children = [b for b in range(m.nbody) if int(m.body_parentid[b]) == body and b != 0]
+            if len(children) != 1 or m.body_jntnum[children[0]] > 0:
+                break
+            body = children[0]
+        tip = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body)
+    if tip is None:
+        raise ConfigError(f"the end effector's body of {path.name} has no name: give tip=")
+    bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius), site="ee")
+    return amj.chain_of(bare), bare, tip
+
+
+HOME_CANDIDATES = 64
+"""Postures :func:`arm_table` tries, after the rule's home, when no ``home`` is given."""
+
+
+def _drawn(
+    build: Callable[[FloatArray], PandaTable],
+    urdf: Path,
+    chain: Chain,
+    plant: Any,
+    limits: tuple[FloatArray, FloatArray],
+    *,
+    seed: int,
+    skip: int = 0,
+) -> PandaTable:
+    """The first home posture the table can run (:func:`refusal_of`): the
+    rule's home (SPEC §18), then postures drawn within the joint limits with
+    the posture rule's margin (fixed ``seed``), best first by the posture
+    rule's score at the start (SPEC (16.9)), the ``skip`` first passing ones
+    skipped."""
+    found = 0
+    first, last = "", "none was tried"
+    draws = _draws(limits, chain.n, seed, HOME_CANDIDATES)
+    scores = [_start_score(chain, plant, q, limits) for q in draws]
+    ranked = [draws[i] for i in sorted(range(len(draws)), key=lambda i: -scores[i])]
+    for q in [_home(urdf, chain, plant), *ranked]:
+        q = np.clip(q, limits[0], limits[1])
+        try:
+            sc = build(q)
+        except ConfigError as e:
+            last = str(e)
+            first = first or last
+            continue
+        refusal = refusal_of(sc)
+        if refusal is not None:
+            last = refusal
+            first = first or last
+            continue
+        if found == skip:
+            return sc
+        found += 1
+    raise ConfigError(
+        f"no home posture found for the table on this arm ({HOME_CANDIDATES + 1} tried, "
+        f"{found} passed, {skip + 1} needed); at the rule's home: {first}; at the last one "
+        f"tried: {last}"
     )
-    table_centre = centre + 0.15 * centre / max(float(np.linalg.norm(centre)), 1e-9)
-    model = arm_model(
-        path,
-        tip,
-        fix=fix,
-        tool_radius=tool_radius,
-        table_top=top,
-        centre=table_centre,
-        friction=friction,
-        spring=spring,
-        home=q0,
-        force=_NOMINAL_KD * depth,
-        speed=speed,
+
+
+def _start_score(
+    chain: Chain, plant: Any, q: FloatArray, limits: tuple[FloatArray, FloatArray]
+) -> float:
+    """The core's posture score at ``q`` alone (SPEC (16.9), the position rows),
+    −inf if the rule refuses it there already."""
+    from .. import _adaptimp, tuning
+
+    p = np.asarray(chain.fk(q)[:3, 3], dtype=np.float64)
+    a = _adaptimp.assess_posture(
+        chain, q[None, :], p[None, :], np.asarray(tuning.gravity(plant, q))[None, :],
+        tuning.inertia(plant, q), limits[0], limits[1],
+        np.asarray(plant.tau_max, dtype=np.float64), False, k1=CONTACT_K1,
+    )  # fmt: skip
+    return -math.inf if a["error"] is not None else float(a["score"])
+
+
+def _draws(limits: tuple[FloatArray, FloatArray], n: int, seed: int, count: int) -> FloatArray:
+    """``count`` postures drawn uniformly (``seed``) min(0.1 rad, range/8) inside
+    the limits (±π for an unlimited joint)."""
+    lo = np.where(np.isfinite(limits[0]), limits[0], -math.pi)
+    hi = np.where(np.isfinite(limits[1]), limits[1], math.pi)
+    margin = np.minimum(0.1, (hi - lo) / 8)
+    return np.random.default_rng(seed).uniform(lo + margin, hi - margin, size=(count, n))
+
+
+def placements(
+    urdf: str | os.PathLike[str], count: int = 8, *, seed: int = 1, **kwargs: Any
+) -> list[PandaTable]:
+    """``count`` table scenarios of the arm of ``urdf`` at home postures drawn
+    min(0.1 rad, range/8) inside its joint limits (``seed``), each one the
+    table can run (:func:`refusal_of`): reachable, well-conditioned placements
+    on which to measure the table's targets. ``kwargs`` as :func:`arm_table`
+    (not ``home``). A ``ConfigError`` if fewer than ``count`` of
+    4·:data:`HOME_CANDIDATES` draws pass."""
+    from .. import mujoco as amj
+
+    if "home" in kwargs:
+        raise ConfigError("placements draws the home postures: give no home")
+    first = arm_table(urdf, **kwargs)
+    limits = _limits(amj.Plant(first.model))
+    out: list[PandaTable] = []
+    draws = _draws(limits, first.n, seed, 4 * HOME_CANDIDATES)
+    for q in draws:
+        try:
+            out.append(arm_table(urdf, home=q, **kwargs))
+        except ConfigError:
+            continue
+        if len(out) == count:
+            return out
+    raise ConfigError(
+        f"only {len(out)} of {len(draws)} homes drawn (seed {seed}) can run the table; "
+        f"{count} asked"
     )
-    return PandaTable(
-        model=model,
-        chain=chain,
-        q0=q0,
-        pin_model=pinocchio_model(path),
-        Ts=Ts,
-        radius=radius,
-        freq=freq,
-        centre=np.asarray(centre, dtype=np.float64),
-        depth=depth,
-        surface_z=top + tool_radius,
-        t_approach=t_approach,
-        t_ramp=t_ramp,
-        tau_max=tau_max,
-        t_hold=float(t_hold),
-        t_press=float(t_press),
+
+
+REFUSAL_ROWS = 40
+"""Rows of the scenario's joint path at which :func:`refusal_of` checks the arm."""
+
+
+def refusal_of(sc: PandaTable) -> str | None:
+    """Why the table cannot run at the scenario's home, or None (SPEC (19.6)).
+
+    Along the scenario's joint path (the hold, the approach, the press and one
+    circle on the table's surface, as the outer loop maps it, F_e = 0): the
+    core's posture rule (SPEC (16.9), the position rows: not near a
+    singularity, inside the joint limits with margin, gravity at most half of
+    every actuator, the velocity loop well-conditioned at home, the path
+    reachable within 1 mm), no self-collision of the arm, and no joint of the
+    arm below the table top over the table."""
+    from .. import _adaptimp, tuning
+    from .. import mujoco as amj
+
+    start = sc.t_approach + max(sc.t_ramp, sc.t_press)
+    _check_path_length(start + 1.0 / sc.freq, sc.Ts)
+    steps = round((start + 1.0 / sc.freq) / sc.Ts)
+    q, _ = sc.outer().joint_orbit(lambda t: sc.path(t, depth=0.0), steps * sc.Ts, samples=steps)
+    idx = np.unique(np.linspace(0, steps - 1, REFUSAL_ROWS).round().astype(int))
+    rows = np.ascontiguousarray(q[idx])
+    targets = np.ascontiguousarray(
+        np.array([sc.path(k * sc.Ts, depth=0.0)[0] for k in idx], dtype=np.float64)
     )
+    plant = amj.Plant(sc.model, contact=False)
+    gravity = np.array([tuning.gravity(plant, x) for x in rows])
+    lo, hi = _limits(plant)
+    a = _adaptimp.assess_posture(
+        sc.chain, rows, targets, gravity, tuning.inertia(plant, sc.q0), lo, hi,
+        np.asarray(sc.tau_max, dtype=np.float64), False, k1=CONTACT_K1, ts=sc.Ts,
+    )  # fmt: skip
+    if a["error"] is not None:
+        return str(a["error"])
+    hit = amj.self_collision(plant, rows)
+    if hit is not None:
+        return f"free of self-collision along the path: {hit}"
+    return _through_table(sc, plant, rows)
+
+
+def _through_table(sc: PandaTable, plant: Any, rows: FloatArray) -> str | None:
+    """A joint of the arm (its anchor) below the table top over the table, at a
+    posture of ``rows``, named; None if none."""
+    import mujoco
+
+    m = plant.model
+    g = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "table")
+    if g < 0:
+        return None
+    d = mujoco.MjData(m)
+    tool = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "tool")
+    top = sc.surface_z - float(m.geom_size[tool, 0])
+    for k, q in enumerate(rows):
+        d.qpos[plant._qadr] = q
+        mujoco.mj_kinematics(m, d)
+        centre, half = d.geom_xpos[g], m.geom_size[g]
+        for i, j in enumerate(plant._joints):
+            a = d.xanchor[j]
+            over = abs(a[0] - centre[0]) <= half[0] and abs(a[1] - centre[1]) <= half[1]
+            if over and a[2] < top:
+                return (
+                    f"the arm clear of the table: at row {k} of the path joint {i} "
+                    f"({sc.chain.joint_names[i]!r}) is {top - a[2]:.3g} m below the table top"
+                )
+    return None
 
 
 def _check_press(
@@ -799,7 +1096,7 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
 
     kw = tuning.suggest(
         amj.Plant(sc.model), sc.q0, sc.tau_max, Ts=sc.Ts, path=path, period=steps * sc.Ts,
-        case=case,
+        case=case, along=True,
     )  # fmt: skip
     kw["K1"] = [min(CONTACT_K1, float(kw["K1"][0]))] * sc.n  # never above (18.2)
     out: dict[str, Any] = {

@@ -359,6 +359,11 @@ def panda_controller(
     if kind in ("ct", "ct+30"):
         from ..baselines import ComputedTorque
 
+        if sc.pin_model is None:
+            raise ConfigError(
+                f"{kind!r} needs the arm's Pinocchio model, which this scenario has only for "
+                "a URDF arm"
+            )
         inner = ComputedTorque(
             sc.pin_model,
             Ts=sc.Ts,

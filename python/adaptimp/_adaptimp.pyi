@@ -35,6 +35,7 @@ __all__ = [
     "simulate_mujoco",
     "simulate_mujoco_many",
     "suggest",
+    "table_metrics",
 ]
 
 __version__: str
@@ -625,6 +626,25 @@ def pose_metrics(
 ) -> tuple[_F, _F, dict[str, float]]:
     """The pose errors e_p (K,) (m), e_o (K,) (rad) of a run and their metrics,
     SPEC (16.11)."""
+
+def table_metrics(
+    t: _F,
+    p: _F,
+    dp: _F,
+    ddp: _F,
+    pd: _F,
+    pc: tuple[_F, _F, _F],
+    wrench: _F,
+    normal: _F,
+    tau: tuple[_F, _F],
+    tau_max: _F,
+    impedance: tuple[Sequence[float], Sequence[float], Sequence[float]],
+    depth: float,
+    series: float,
+    windows: tuple[float, float, float],
+    ts: float,
+) -> dict[str, float]:
+    """The table's metrics of a run, SPEC (19.7), by name."""
 
 def default_task(
     home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]

@@ -454,3 +454,87 @@ pub fn pose_metrics<'py>(
         out,
     ))
 }
+
+/// The table's metrics of a run, SPEC (19.7) ([`crate::sim::metrics::table_metrics`]):
+/// the rows (each K × width, row-major: `t` (K,), `p`, `dp`, `ddp`, `pd`,
+/// `pc`, `dpc`, `ddpc` (K, 3), `wrench` (K, 6), `normal` (K,), `tau`,
+/// `tau_sat` (K, n)) and what they are compared with (`tau_max` (n,), `md`,
+/// `bd`, `kd` (3,), `depth` (m), `series` (N/m), `settle`, `windup_after`,
+/// `approach_end`, `ts` (s)). Returns a dict of the metrics by name.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn table_metrics<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+    dp: PyReadonlyArray2<'py, f64>,
+    ddp: PyReadonlyArray2<'py, f64>,
+    pd: PyReadonlyArray2<'py, f64>,
+    pc: (
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+    ),
+    wrench: PyReadonlyArray2<'py, f64>,
+    normal: PyReadonlyArray1<'py, f64>,
+    tau: (PyReadonlyArray2<'py, f64>, PyReadonlyArray2<'py, f64>),
+    tau_max: PyReadonlyArray1<'py, f64>,
+    impedance: ([f64; 3], [f64; 3], [f64; 3]),
+    depth: f64,
+    series: f64,
+    windows: (f64, f64, f64),
+    ts: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use crate::sim::metrics::{table_metrics as core_metrics, TableRows, TableSpec};
+    let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let flat = |a: &PyReadonlyArray2<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let (t, normal, tau_max) = (flat1(&t), flat1(&normal), flat1(&tau_max));
+    let (p, dp, ddp, pd, wrench) = (flat(&p), flat(&dp), flat(&ddp), flat(&pd), flat(&wrench));
+    let (pc0, pc1, pc2) = (flat(&pc.0), flat(&pc.1), flat(&pc.2));
+    let (tau0, tau1) = (flat(&tau.0), flat(&tau.1));
+    let rows = TableRows {
+        t: &t,
+        p: &p,
+        dp: &dp,
+        ddp: &ddp,
+        pd: &pd,
+        pc: [&pc0, &pc1, &pc2],
+        wrench: &wrench,
+        normal: &normal,
+        tau: [&tau0, &tau1],
+    };
+    let spec = TableSpec {
+        tau_max: &tau_max,
+        md: impedance.0,
+        bd: impedance.1,
+        kd: impedance.2,
+        depth,
+        series,
+        settle: windows.0,
+        windup_after: windows.1,
+        approach_end: windows.2,
+        ts,
+    };
+    let m = core_metrics(&rows, &spec).map_err(|e| config_error(e.into()))?;
+    let out = PyDict::new(py);
+    for (name, v) in [
+        ("rms_track", m.rms_track),
+        ("rms_track_along", m.rms_track_along),
+        ("rms_path_xy", m.rms_path_xy),
+        ("rms_force", m.rms_force),
+        ("rms_imp", m.rms_imp),
+        ("force_target", m.force_target),
+        ("force_rms_err", m.force_rms_err),
+        ("force_chatter", m.force_chatter),
+        ("force_mean", m.force_mean),
+        ("force_16_1", m.force_16_1),
+        ("peak_force", m.peak_force),
+        ("contact_lost", m.contact_lost),
+        ("sat_duty", m.sat_duty),
+        ("peak_tau_ratio", m.peak_tau_ratio),
+        ("applied_ratio", m.applied_ratio),
+    ] {
+        out.set_item(name, v)?;
+    }
+    Ok(out)
+}

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._errors import ConfigError
 from ..chain import Chain
-from .panda_table import PandaTable, cartesian_metrics
+from .panda_table import PandaTable, table_metrics
 
 __all__ = [
     "AXIS_SHARE",
@@ -1134,51 +1134,24 @@ def contact_metrics(
     - ``peak_tau_ratio``: max_i max_{t ≥ 0.1 s} |τ_i|/τmax_i, commanded;
     - ``sat_duty``: fraction of all rows with sat(τ_i) ≠ τ_i on some joint.
     """
-    m = cartesian_metrics(res, ctrl, sc, settle=settle)
-    kd = float(np.asarray(ctrl.params["Kd"])[2])
-    spring = _spring(sc)
-    target = kd * sc.depth if spring is None else kd * spring / (kd + spring) * sc.depth
-    fn = -np.asarray(res.wrench_ee)[:, 2]
+    m = table_metrics(res, ctrl, sc, settle=settle)
     t = np.asarray(res.t)
-    after = t >= settle - 1e-9
-    # (16.1) with the measured n·e, n = −z (into the table), e = p − p_d.
-    series = kd if spring is None else kd * spring / (kd + spring)
-    # The run's own task-space rows (the controller's log may hold earlier runs).
-    log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
-    ne = log["pd"][after, 2] - np.asarray(res.x_ee)[after, 2]
-    along = (log["pd"][after, :2] - np.asarray(res.x_ee)[after, :2]) * 1e3
-    # The approach ends when the commanded point has reached δ_c (with a
-    # soft landing, the press's end).
     if t.size > 1 and not np.allclose(np.diff(t), sc.Ts, rtol=1e-9, atol=0.0):
         raise ConfigError(
             f"contact_metrics needs every period's row (Ts = {sc.Ts:g} s; the chatter is "
             "sample to sample): run simulate with record_every=1"
         )
-    approach = t >= sc.t_approach + sc.t_press - 1e-9
-    contact = np.flatnonzero(approach & (fn > 0))
-    # Never touched after the approach: all of that time is without contact. A
-    # run that ends before the approach does has no such time: NaN.
-    start = contact[0] if contact.size else int(np.argmax(approach))
-    lost = float(np.sum(fn[start:] <= 0) * sc.Ts) if approach.any() else math.nan
     return {
         "track_mm": m["rms_track"] * 1e3,
-        "track_along_mm": float(np.sqrt(np.mean(np.sum(along**2, axis=1)))),
-        "peak_force_N": float(np.max(fn)),
-        "force_rms_err_N": float(np.sqrt(np.mean((fn[after] - target) ** 2))),
-        "force_target_N": float(target),
-        "force_chatter_N": float(np.sqrt(np.mean(np.diff(fn[after]) ** 2))),
-        "force_mean_N": float(np.mean(fn[after])),
-        "force_16_1_N": float(series * (sc.depth + np.mean(ne))),
-        "contact_lost_s": lost,
+        "track_along_mm": m["rms_track_along"] * 1e3,
+        "peak_force_N": m["peak_force"],
+        "force_rms_err_N": m["force_rms_err"],
+        "force_target_N": m["force_target"],
+        "force_chatter_N": m["force_chatter"],
+        "force_mean_N": m["force_mean"],
+        "force_16_1_N": m["force_16_1"],
+        "contact_lost_s": m["contact_lost"],
         "peak_tau_ratio": m["peak_tau_ratio"],
         "sat_duty": m["sat_duty"],
         "applied_ratio": m["applied_ratio"],
     }
-
-
-def _spring(sc: PandaTable) -> float | None:
-    """The table's spring stiffness (N/m), None for a rigid table."""
-    import mujoco
-
-    j = mujoco.mj_name2id(sc.model, mujoco.mjtObj.mjOBJ_JOINT, "table_spring")
-    return None if j < 0 else float(sc.model.jnt_stiffness[j])

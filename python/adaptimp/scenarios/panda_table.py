@@ -41,6 +41,8 @@ __all__ = [
     "panda_controller",
     "panda_table",
     "pinocchio_kinematics",
+    "table_metrics",
+    "table_spring",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -448,35 +450,64 @@ def cartesian_metrics(
     ≥ 0, or if the run has no row in one of the windows (a run that ends
     before ``settle`` or ``windup_after``): its metrics would be empty.
     """
-    t = np.asarray(res.t, dtype=np.float64)
+    m = table_metrics(res, ctrl, sc, settle=settle, windup_after=windup_after)
+    return {
+        "rms_track": m["rms_track"],
+        "rms_path_xy": m["rms_path_xy"],
+        "rms_force": m["rms_force"],
+        "rms_imp": m["rms_imp"],
+        "sat_duty": m["sat_duty"],
+        "peak_tau_ratio": m["peak_tau_ratio"],
+        "applied_ratio": m["applied_ratio"],
+    }
+
+
+def table_metrics(
+    res: Any,
+    ctrl: CartesianController,
+    sc: PandaTable,
+    *,
+    settle: float = 2.0,
+    windup_after: float = 0.1,
+) -> dict[str, float]:
+    """Every metric of a table run, computed once, in the core (SPEC (19.7),
+    ``adaptimp._adaptimp.table_metrics``): the rows of ``res`` (the tip, its
+    twist and acceleration along the chain, the run's task-space rows, the
+    plant's normal force, τ and sat(τ)) against the controller's impedance
+    and the scenario's depth (and its table's spring). :func:`cartesian_metrics`
+    and :func:`adaptimp.scenarios.contact.contact_metrics` take their names
+    from it. Refused as :func:`cartesian_metrics`."""
+    from .. import _adaptimp
+
+    t = np.ascontiguousarray(res.t, dtype=np.float64)
     _check_windows(t, settle=settle, windup_after=windup_after)
     log = ctrl.arrays() if getattr(res, "task", None) is None else res.task
-    after = t >= settle - 1e-9
-    p = res.x_ee
     twist, accel = sc.chain.motion(
-        np.ascontiguousarray(res.q[after]),
-        np.ascontiguousarray(res.dq[after]),
-        np.ascontiguousarray(res.ddq[after]),
+        np.ascontiguousarray(res.q), np.ascontiguousarray(res.dq), np.ascontiguousarray(res.ddq)
     )
-    dp, ddp = twist[:, :3], accel[:, :3]
     prm = ctrl.params
-    md, kd = np.asarray(prm["Md"]), np.asarray(prm["Kd"])
-    bd = 2.0 * np.sqrt(kd * md) if prm["Bd"] is None else np.asarray(prm["Bd"])
-    f = log["wrench"][after, :3]
-    imp = md * (ddp - log["ddpc"][after]) + bd * (dp - log["dpc"][after])
-    imp += kd * (p[after] - log["pc"][after]) + f
+    md, kd = np.asarray(prm["Md"], dtype=np.float64), np.asarray(prm["Kd"], dtype=np.float64)
+    bd = 2.0 * np.sqrt(kd * md) if prm["Bd"] is None else np.asarray(prm["Bd"], dtype=np.float64)
+    spring = table_spring(sc)
+    series = float(kd[2]) if spring is None else float(kd[2]) * spring / (float(kd[2]) + spring)
 
-    def rms(x: FloatArray) -> float:
-        return float(np.sqrt(np.mean(x))) if x.size else math.nan
+    def c(a: Any) -> FloatArray:
+        return np.ascontiguousarray(a, dtype=np.float64)
 
-    tau_max = np.asarray(res.params["tau_max"])
-    late = t >= windup_after - 1e-9
-    return {
-        "rms_track": rms(np.sum((log["pd"][after] - p[after]) ** 2, axis=1)),
-        "rms_path_xy": rms(np.sum((log["pc"][after, :2] - p[after, :2]) ** 2, axis=1)),
-        "rms_force": rms((-f[:, 2] - float(kd[2]) * sc.depth) ** 2),
-        "rms_imp": rms(np.sum(imp**2, axis=1)),
-        "sat_duty": float(np.mean(np.any(res.tau_sat != res.tau, axis=1))),
-        "peak_tau_ratio": float(np.max(np.abs(res.tau[late]) / tau_max)),
-        "applied_ratio": float(np.max(np.abs(res.tau_sat) / tau_max)),
-    }
+    out: dict[str, float] = _adaptimp.table_metrics(
+        t, c(res.x_ee), c(twist[:, :3]), c(accel[:, :3]), c(log["pd"]),
+        (c(log["pc"]), c(log["dpc"]), c(log["ddpc"])), c(log["wrench"]),
+        c(-np.asarray(res.wrench_ee)[:, 2]), (c(res.tau), c(res.tau_sat)),
+        c(res.params["tau_max"]), (md.tolist(), bd.tolist(), kd.tolist()),
+        float(sc.depth), series, (float(settle), float(windup_after),
+        sc.t_approach + sc.t_press), float(sc.Ts),
+    )  # fmt: skip
+    return out
+
+
+def table_spring(sc: PandaTable) -> float | None:
+    """The table's spring stiffness k_e (N/m), None for a rigid table."""
+    import mujoco
+
+    j = mujoco.mj_name2id(sc.model, mujoco.mjtObj.mjOBJ_JOINT, "table_spring")
+    return None if j < 0 else float(sc.model.jnt_stiffness[j])

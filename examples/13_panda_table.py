@@ -98,6 +98,24 @@ ROWS: dict[str, tuple[str, str, str, bool, bool]] = {
     "ct": ("CT exact, impedance", "ct", "impedance", False, False),
     "ct+30": ("CT +30 % mass, impedance", "ct+30", "impedance", False, False),
 }
+GRAVITY_LEARNING = {
+    "gamma": [1.0, 1.0, 5000.0],
+    "sigma": [0.01, 0.01, 1e-5],
+    "weight_bound": [4.19, 13.2, 100.0],
+}
+"""docs/panda.md's gravity learning, found by hand on that scenario (before the rule's)."""
+# The scenario of docs/panda.md as first measured (--first): name: (label, joint
+# controller, +τe feedforward, learning keywords).
+FIRST: dict[str, tuple[str, str, bool, dict[str, Any]]] = {
+    "pd": ("PD", "pd", True, {}),
+    "sf-printed": ("SF as printed (+τe, Γ = 1)", "sf", True, {}),
+    "of-printed": ("OF as printed (+τe, Γ = 1)", "of", True, {}),
+    "sf-no-ff": ("SF, no τe feedforward, Γ = 1", "sf", False, {}),
+    "sf-gravity": ("SF, no τe feedforward, gravity learning", "sf", False, GRAVITY_LEARNING),
+    "of-gravity": ("OF, no τe feedforward, gravity learning", "of", False, GRAVITY_LEARNING),
+    "ct": ("CT exact", "ct", True, {}),
+    "ct+30": ("CT +30 % mass", "ct+30", True, {}),
+}
 KEYS = (
     "track_mm",
     "track_along_mm",
@@ -195,6 +213,40 @@ def long_run(sc: apt.PandaTable, rule: dict[str, Any], T: float) -> None:
         )
 
 
+def first(T: float, jobs: int, path: str | None) -> None:
+    """docs/panda.md's table: the Panda of ``panda_table()`` (its SRDF home,
+    MuJoCo's default contact, straight from home into the table, the
+    admittance), every joint controller with the core's gain rule
+    (``panda_table.rule_gains``) and Γ = 1 or the page's gravity learning."""
+    sc = apt.panda_table()
+    print(
+        f"docs/panda.md: the Panda, {sc.radius * 100:g} cm circle at {sc.freq:g} Hz, δ_c = "
+        f"{sc.depth * 1e3:g} mm, T = {T:g} s, the core's gain rule"
+    )
+    print("\n| controller | track (mm) | force (N) | imp (N) | sat | peak τ/τmax |")
+    print("|---|---:|---:|---:|---:|---:|")
+
+    def one(name: str) -> dict[str, float]:
+        _, kind, ff, learning = FIRST[name]
+        kw = {"gamma": 1.0, **learning} if kind in ("pd", "sf", "of") else {}
+        ctrl = apt.panda_controller(kind, sc, force_feedforward=ff, **kw)
+        res = amj.simulate(ctrl, amj.Plant(sc.model), T=T, q0=sc.q0)
+        return apt.cartesian_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        results = list(pool.map(one, FIRST))
+    table = {}
+    for name, m in zip(FIRST, results):
+        table[name] = m
+        print(
+            f"| {FIRST[name][0]} | {m['rms_track'] * 1e3:.3f} | {m['rms_force']:.2f} "
+            f"| {m['rms_imp']:.2f} | {m['sat_duty']:.3f} | {m['peak_tau_ratio']:.3f} |"
+        )
+    if path:
+        Path(path).write_text(json.dumps(table, indent=2) + "\n")
+        print(f"\nwrote {path}")
+
+
 def posture(text: str) -> list[float]:
     """``--home``: joint angles (rad) separated by commas; each a number or an
     arithmetic expression of numbers and ``pi`` (``-pi/4``, ``3*pi/4``)."""
@@ -252,6 +304,11 @@ def main() -> None:
         help="run the rows at this many home postures drawn within the joint limits "
         "(each one the table can run) instead of one home",
     )
+    parser.add_argument(
+        "--first",
+        action="store_true",
+        help="docs/panda.md's table: the scenario as first measured, the core's gain rule",
+    )
     parser.add_argument("--T", type=float, default=2.5 if QUICK else 20.0, help="duration (s)")
     parser.add_argument("--json", type=str, default=None, help="write the table as JSON here")
     parser.add_argument("--friction", type=float, default=0.1, help="sliding friction")
@@ -274,6 +331,9 @@ def main() -> None:
         parser.error(
             f"--long must be 0 or a multiple of 10 s (it runs in parts of 10 s), got {args.long}"
         )
+    if args.first:
+        first(args.T, args.jobs, args.json)
+        return
     if args.placements < 0 or (args.placements and args.home is not None):
         parser.error("--placements must be ≥ 0, and draws the homes: give it without --home")
     names = list(ROWS) if args.rows is None else args.rows.split(",")

@@ -277,9 +277,9 @@ def test_a_scenario_quantity_out_of_range_is_refused_by_name(
             act.arm_table(urdf, **{name: value})
 
 
-def test_the_scenario_s_joint_gains_take_continuous_joints_as_angles() -> None:
+def test_the_scenario_s_rule_gains_take_continuous_joints_as_angles() -> None:
     """Kinova's arm joints are continuous (Pinocchio: nq = 9 for nv = 6).
-    panda_table.joint_gains (the Panda scenario's, docs/panda.md) reads D(q0)
+    panda_table.rule_gains (the core's rule on Pinocchio's D(q0)) reads D(q0)
     through tuning.inertia, which takes the chain's angles; they equal the rule
     (18.1) computed from MuJoCo's mass matrix of the same arm, an independent
     engine, to 1e-9 (Pinocchio's CRBA on the 6 angles failed with "expected 9, got 6")."""
@@ -287,23 +287,23 @@ def test_the_scenario_s_joint_gains_take_continuous_joints_as_angles() -> None:
     sc = act.arm_table(urdf)
     assert sc.pin_model.nq == 9
     assert sc.n == 6
-    gains = apt.joint_gains(sc)
+    gains = apt.rule_gains(sc)
     plant = amj.Plant(sc.model)
     d = adaptimp.tuning.inertia(plant, sc.q0)
     kp = 0.25 / (sc.Ts * np.diag(np.linalg.inv(d)))
     np.testing.assert_allclose(gains["Kp"], kp, rtol=1e-9)
-    assert gains["K1"] == [20.0] * 6
+    assert gains["K1"] == [50.0] * 6
 
 
 def test_a_light_wrist_does_not_ring_against_the_table() -> None:
     """The UR10's last joint (d = 5e-4 kg m²) with the robot preset's fixed
     kr = 0.5 N m ran its sampled velocity loop at Ts (Kp + kr/φ)/d = 20 > 2: it
     rang at half the sampling rate and the tool chattered on the table (SF
-    unified: 183 N). panda_table.joint_gains carry SPEC (18.4)'s kr = φ Kp/2,
-    as the rule does."""
+    unified: 183 N). The core's rule (panda_table.rule_gains) carries SPEC
+    (18.4)'s kr = φ Kp/2."""
     urdf = _ur5().parent / "ur10_robot.urdf"
     sc = act.arm_table(urdf)
-    gains = apt.joint_gains(sc)
+    gains = apt.rule_gains(sc)
     np.testing.assert_allclose(gains["kr"], 0.025 * np.asarray(gains["Kp"]), rtol=1e-15)
     ctrl = apt.panda_controller(
         "sf",

@@ -8,7 +8,8 @@ SPEC §16. Everything Cartesian runs in the core
 
 - :func:`panda_table` (:class:`PandaTable`): the model, the start, the path;
 - :func:`orbit_basis`: RBF centres along the joint orbit (the core's rule);
-- :func:`joint_gains`, :func:`panda_controller`: the five controllers compared;
+- :func:`panda_controller`: the controllers compared, with the core's gain rule
+  (:func:`rule_gains`);
 - :func:`cartesian_metrics`: the table's metrics of a run.
 
 MuJoCo and Pinocchio are imported when a function needs them.
@@ -36,11 +37,11 @@ if TYPE_CHECKING:
 __all__ = [
     "PandaTable",
     "cartesian_metrics",
-    "joint_gains",
     "orbit_basis",
     "panda_controller",
     "panda_table",
     "pinocchio_kinematics",
+    "rule_gains",
     "table_metrics",
     "table_spring",
 ]
@@ -298,30 +299,22 @@ def orbit_basis(
     return sc.outer().orbit_centres(lambda t: sc.path(t, depth=0.0), t_end, nodes=nodes, tube=tube)
 
 
-def joint_gains(sc: PandaTable, k1: float = 20.0, scale: float = 0.25) -> dict[str, list[float]]:
-    """The joint gains shared by PD, state and output feedback (SPEC §15's rule,
-    with SPEC (18.4)'s robust term): Kp_i = scale/(Ts (D⁻¹)_ii) (N m s/rad)
-    with D the exact D(q0) from Pinocchio's CRBA (:func:`adaptimp.tuning.inertia`,
-    which takes continuous joints' angles as the chain does), Kζ_i = (1 +
-    Kp_i²)/2 + 10 (so 2Kζ − 1 − Kp² = 20 > 0), K1 = k1 (1/s), kr_i = φ Kp_i/2
-    (N m, φ = 0.05 rad/s, the robot preset's) and the fallback's damping Kp_i.
+GAINS = ("Kp", "K1", "Kzeta", "inertia", "rho", "conditions", "kr", "fallback_damping")
+"""The joint controller's gains the core's rule gives (SPEC (18.1)–(18.4)), the
+default gains of :func:`panda_controller`."""
 
-    kr scales with Kp as in the gain rule: the robot preset's fixed kr = 0.5 N m
-    (slope kr/φ = 10 N m s/rad) put the sampled velocity loop of a light wrist
-    joint beyond its limit, Ts (Kp_i + kr_i/φ)/d_i < 2 (the UR10's last joint,
-    d = 5e-4 kg m²: 20), and the wrist rang at half the sampling rate, which
-    the tool passed on to the table as force chatter."""
-    from ..tuning import inertia
 
-    m = inertia(sc.pin_model, sc.q0)
-    kp = scale / (sc.Ts * np.diag(np.linalg.inv(m)))
-    return {
-        "Kp": kp.tolist(),
-        "Kzeta": ((1 + kp**2) / 2 + 10).tolist(),
-        "K1": [k1] * sc.n,
-        "kr": (0.05 / 2 * kp).tolist(),
-        "fallback_damping": kp.tolist(),
-    }
+def rule_gains(sc: PandaTable) -> dict[str, Any]:
+    """The core's gain rule for the scenario's arm (SPEC (18.1)–(18.4),
+    :func:`adaptimp.tuning.suggest`): D(q0) from Pinocchio's CRBA on the
+    arm's URDF (from MuJoCo's model for an MJCF arm), τmax, Ts; the keywords
+    :data:`GAINS`."""
+    from .. import mujoco as amj
+    from .. import tuning
+
+    model = sc.pin_model if sc.pin_model is not None else amj.Plant(sc.model)
+    kw = tuning.suggest(model, sc.q0, sc.tau_max, Ts=sc.Ts)
+    return {k: kw[k] for k in GAINS}
 
 
 def panda_controller(
@@ -340,7 +333,7 @@ def panda_controller(
     kind : {"pd", "sf", "of", "ct", "ct+30"}
         PD (Case 1), adaptive state (14) and output feedback (35), all
         ``adaptimp.Controller(kind, "robot", n=7, impedance="external")`` with
-        ``gains`` (default :func:`joint_gains`), Γ = ``gamma`` for all three
+        ``gains`` (default :func:`rule_gains`, the core's rule), Γ = ``gamma`` for all three
         networks and the centres ``basis`` (default :func:`orbit_basis`); or
         computed torque with Pinocchio's exact model ("ct") or every link's mass
         and inertia +30 % ("ct+30"), K_P, K_D = ``ct_gains`` (1/s², 1/s).
@@ -378,7 +371,7 @@ def panda_controller(
         return CartesianController(sc.chain, inner, **common, **params)
     if kind in ("pd", "sf", "of"):
         centres, widths = orbit_basis(sc) if basis is None else basis
-        g: dict[str, Any] = dict(joint_gains(sc) if gains is None else gains)
+        g: dict[str, Any] = dict(rule_gains(sc) if gains is None else gains)
         return CartesianController(
             sc.chain,
             kind,

@@ -62,6 +62,7 @@ from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
 from ._faults import Fault
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
+from ._tooling import add_table, add_tool
 from ._trajectory import Reference, paper_circle, sinusoid
 
 if TYPE_CHECKING:
@@ -354,40 +355,9 @@ def panda(
     spec.modelname = "panda"
     spec.option.timestep = timestep
     _add_motors(spec, effort)
-    tcp = spec.body(_models.PANDA_EE)
-    tcp.add_site(name="ee", size=[0.01, 0, 0])
-    tcp.add_geom(
-        name="tool",
-        type=mujoco.mjtGeom.mjGEOM_SPHERE,
-        size=[tool_radius, 0, 0],
-        contype=1,
-        conaffinity=1,
-        mass=0.0,
-        density=0.0,
-    )
-    spec.add_sensor(
-        name="ee_force",
-        type=mujoco.mjtSensor.mjSENS_FORCE,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname="ee",
-    )
-    spec.add_sensor(
-        name="ee_torque",
-        type=mujoco.mjtSensor.mjSENS_TORQUE,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname="ee",
-    )
+    add_tool(spec, _models.PANDA_EE, radius=tool_radius, own_body=False)
     if table_height is not None:
-        thickness = 0.05
-        table = spec.worldbody.add_body(name="table", pos=[0.55, 0.0, table_height - thickness / 2])
-        table.add_geom(
-            name="table",
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[0.35, 0.5, thickness / 2],
-            contype=1,
-            conaffinity=1,
-            rgba=[0.6, 0.5, 0.4, 1.0],
-        )
+        add_table(spec, top=table_height, centre=(0.55, 0.0))
     spec.add_key(name="home", qpos=list(_models.PANDA_HOME))
     return spec.compile()
 

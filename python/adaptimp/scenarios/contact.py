@@ -174,18 +174,6 @@ def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float
     return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
 
 
-def _unused_body(spec: Any, name: str) -> str:
-    """``name``, or ``name_1``, ``name_2``, … if the arm already has a body of
-    that name (a URDF link called "tool" or "table"). Only the bodies are
-    renamed: the URDF's geoms are dropped, so the geoms, the site and the
-    sensors keep their names."""
-    i, candidate = 0, name
-    while spec.body(candidate) is not None:
-        i += 1
-        candidate = f"{name}_{i}"
-    return candidate
-
-
 def _tool_and_table(
     spec: Any,
     tip: str,
@@ -195,67 +183,29 @@ def _tool_and_table(
     centre: ArrayLike,
     friction: float,
     spring: float | None,
-) -> None:
-    """Add the tool: a massless body ``tool`` at the origin of the tip body with
-    the sphere (the arm's only collision geometry) and the site ``ee`` with
-    force/torque sensors; and the table (static, or on a vertical slide joint
-    with stiffness ``spring`` N/m)."""
+) -> str | None:
+    """The tool on a massless body of its own at the origin of body ``tip``
+    and the table (the shared builder, ``adaptimp._tooling``) with this
+    scenario's contact: both with sliding friction ``friction`` and the time
+    constant :data:`TABLE_TIMECONST`, the table of :data:`TABLE_MASS` on a
+    spring of ``spring`` N/m or static; MuJoCo's elliptic cone and, with
+    friction, the tool–table pair whose friction rows get their own time
+    constant (:func:`sliding_timeconst`). Returns the table's body (None:
+    no table)."""
     import mujoco
 
-    parent = spec.body(tip)
-    if parent is None:
-        raise ValueError(f"the model has no body {tip!r} for the tool")
-    # A massless body of its own at the tip's origin: its force sensor reads
-    # the contact alone (on a body with mass it would add its weight).
-    body = parent.add_body(name=_unused_body(spec, "tool"))
-    body.add_site(name="ee", size=[0.01, 0, 0])
-    body.add_geom(
-        name="tool",
-        type=mujoco.mjtGeom.mjGEOM_SPHERE,
-        size=[tool_radius, 0, 0],
-        contype=1,
-        conaffinity=1,
-        mass=0.0,
-        density=0.0,
-        friction=[friction, 0.005, 0.0001],
-        solref=[TABLE_TIMECONST, 1.0],
-    )
-    for name, kind in (("ee_force", "mjSENS_FORCE"), ("ee_torque", "mjSENS_TORQUE")):
-        spec.add_sensor(
-            name=name,
-            type=getattr(mujoco.mjtSensor, kind),
-            objtype=mujoco.mjtObj.mjOBJ_SITE,
-            objname="ee",
-        )
+    from .._tooling import add_table, add_tool
+
+    rows = [friction, 0.005, 0.0001]
+    solref = [TABLE_TIMECONST, 1.0]
+    add_tool(spec, tip, radius=tool_radius, own_body=True, friction=rows, solref=solref)
     if table_top is None:
-        return
-    thickness = 0.05
+        return None
     c = np.asarray(centre, dtype=np.float64)
-    table = spec.worldbody.add_body(
-        name=_unused_body(spec, "table"), pos=[float(c[0]), float(c[1]), table_top - thickness / 2]
-    )
-    if spring is not None:
-        table.add_joint(
-            name="table_spring",
-            type=mujoco.mjtJoint.mjJNT_SLIDE,
-            axis=[0, 0, 1],
-            stiffness=spring,
-            damping=2.0 * math.sqrt(spring * TABLE_MASS),
-            # At rest under its weight the top is at table_top: the spring
-            # carries the table (g = 9.81 m/s², MuJoCo's default).
-            springref=TABLE_MASS * 9.81 / spring,
-        )
-    table.add_geom(
-        name="table",
-        type=mujoco.mjtGeom.mjGEOM_BOX,
-        size=[0.35, 0.5, thickness / 2],
-        contype=1,
-        conaffinity=1,
-        friction=[friction, 0.005, 0.0001],
-        solref=[TABLE_TIMECONST, 1.0],
-        rgba=[0.6, 0.5, 0.4, 1.0],
-        mass=TABLE_MASS,
-    )
+    table = add_table(
+        spec, top=table_top, centre=(float(c[0]), float(c[1])), friction=rows, solref=solref,
+        mass=TABLE_MASS, spring=spring,
+    )  # fmt: skip
     # The Coulomb cone itself, not its pyramid: a pyramid's edges mix the
     # normal into every row and scale their regulariser by 2μ² (at μ = 0,
     # MuJoCo's floor 1e-5: a contact so stiff that it lifts off for single
@@ -269,9 +219,10 @@ def _tool_and_table(
             geomname2="table",
             condim=3,
             friction=[friction, friction, 0.005, 0.0001, 0.0001],
-            solref=[TABLE_TIMECONST, 1.0],
-            solreffriction=[TABLE_TIMECONST, 1.0],
+            solref=solref,
+            solreffriction=solref,
         )
+    return table
 
 
 def arm_model(
@@ -392,7 +343,7 @@ def _mjcf_model(
     for key in list(spec.keys):  # the table may add a joint: the file's keys no longer fit
         spec.delete(key)
     arm_bodies = [b.name for b in spec.bodies if b.name and b.name != "world"]
-    _tool_and_table(
+    table = _tool_and_table(
         spec,
         tip,
         tool_radius=tool_radius,
@@ -401,11 +352,10 @@ def _mjcf_model(
         friction=friction,
         spring=spring,
     )
-    if table_top is not None:
+    if table is not None:
         # The tool presses on the table, not the arm's own geometry (a URDF arm
         # has none; an MJCF wrist around the tool would rest on the table):
         # the arm's bodies and the table do not collide.
-        table = [b.name for b in spec.bodies if b.name.startswith("table")][-1]
         for name in arm_bodies:
             spec.add_exclude(bodyname1=name, bodyname2=table)
     model = spec.compile()

@@ -557,8 +557,11 @@ class CartesianController:
                 data.qpos[:], data.qvel[:] = saved
                 forward()
         kw.pop("n")
-        centres, widths = kw.pop("centers"), kw.pop("widths")
         joint = {k: v for k, v in params.items() if k not in cart}
+        centres, widths = (
+            joint.pop("centers", kw.pop("centers")),
+            joint.pop("widths", kw.pop("widths")),
+        )
         kw.update(joint)
         return cls(
             chain, controller, "robot", q0=q0, path=path, centers=centres, widths=widths,

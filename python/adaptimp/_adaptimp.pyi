@@ -579,11 +579,13 @@ def suggest(
     gravity: NDArray[np.float64] | None = None,
     resolve: bool = False,
     inertias: NDArray[np.float64] | None = None,
+    critical: bool = False,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18: "params" (every controller keyword),
     with a path also "centers" (L, 4n) and "widths" (4n,); ``resolve``: the tube
     narrowed to the path's size, SPEC (16.10); ``inertias`` (K, n, n): D along the
-    path, the inertia scales the smallest over them, SPEC (16.12)."""
+    path, the inertia scales the smallest over them, SPEC (16.12); ``critical``: Ĝ
+    learning at the velocity loop's critical bandwidth, SPEC (19.6)."""
 
 def pose_circle(
     p0: NDArray[np.float64],
@@ -611,6 +613,7 @@ def assess_posture(
     orients: bool,
     k1: float | None = None,
     ts: float | None = None,
+    load: float | None = None,
 ) -> dict[str, Any]:
     """How well a posture runs a task, SPEC (16.9): the figures along its joint
     orbit, the score and the first condition it violates ("error", or None);

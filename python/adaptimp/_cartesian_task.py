@@ -61,6 +61,10 @@ IK_TIME = 2.0
 kinematically, F_e = 0) holds a given path's first pose from a candidate
 posture to reach it."""
 
+GIVEN_LOAD = 1.0
+"""The largest gravity load max_i |G_i|/τmax_i along the task of a start the
+user gives (gravity within the actuators); a drawn start keeps the rule's 0.5."""
+
 CHECKED = 40
 """Rows of the task's joint orbit at which gravity and self-collision are
 checked (evenly spaced)."""
@@ -490,6 +494,7 @@ def _assess(
     span: float,
     Ts: float,
     orients: bool,
+    load: float | None = None,
 ) -> dict[str, Any]:
     """The core's posture rule (SPEC (16.9)) along the task's joint orbit from
     ``q0``, and its self-collision (:func:`self_collision`)."""
@@ -507,7 +512,7 @@ def _assess(
     a = dict(
         _adaptimp.assess_posture(
             chain, rows, np.ascontiguousarray(targets), gravity, probe.inertia(q0),
-            lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients,
+            lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients, load=load,
         )
     )  # fmt: skip
     if a["error"] is None:
@@ -566,7 +571,8 @@ def task_of(
                 f"q0 = {float(q[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
             )
         start, path, length = path_from(q)
-        a = _assess(plant, probe, chain, start, path, length, Ts, orients)
+        # A start the user gives: gravity within the actuators (a drawn one: half).
+        a = _assess(plant, probe, chain, start, path, length, Ts, orients, load=GIVEN_LOAD)
         if a["error"] is not None:
             raise ConfigError(f"q0 cannot run the task: {a['error']}")
         return CartesianTask(start, chain, path, length, orients, a, "given")

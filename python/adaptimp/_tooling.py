@@ -35,8 +35,14 @@ GRAVITY = 9.81
 def unused_body(spec: Any, name: str) -> str:
     """``name``, or ``name_1``, ``name_2``, … if the model already has a body of
     that name (a URDF link called "tool" or "table")."""
+    return _unused(spec.body, name)
+
+
+def _unused(find: Any, name: str) -> str:
+    """``name``, or ``name_1``, ``name_2``, … the first that ``find`` (an
+    ``MjSpec``'s lookup by name: ``spec.site``, ``spec.sensor``, …) does not find."""
     i, candidate = 0, name
-    while spec.body(candidate) is not None:
+    while find(candidate) is not None:
         i += 1
         candidate = f"{name}_{i}"
     return candidate
@@ -50,19 +56,23 @@ def add_tool(
     own_body: bool,
     friction: Sequence[float] | None = None,
     solref: Sequence[float] | None = None,
-) -> None:
+) -> tuple[str, str]:
     """The tool at the origin of ``body``: a sphere ``tool`` of ``radius`` (m),
     massless, that collides; the site ``ee`` and its sensors ``ee_force``,
-    ``ee_torque``. ``own_body``: on a massless body ``tool`` of its own (the
-    force sensor then reads the contact alone; on a body with mass it would
-    add the weight). ``friction``, ``solref``: the sphere's (None: MuJoCo's)."""
+    ``ee_torque`` (each name with ``_1``, ``_2``, … if the model has it
+    already). ``own_body``: on a massless body ``tool`` of its own (the force
+    sensor then reads the contact alone; on a body with mass it would add the
+    weight). ``friction``, ``solref``: the sphere's (None: MuJoCo's). Returns
+    the names of the site and of the sphere."""
     parent = spec.body(body)
     if parent is None:
         raise ValueError(f"the model has no body {body!r} for the tool")
     holder = parent.add_body(name=unused_body(spec, "tool")) if own_body else parent
-    holder.add_site(name="ee", size=[0.01, 0, 0])
+    site = _unused(spec.site, "ee")
+    sphere = _unused(spec.geom, "tool")
+    holder.add_site(name=site, size=[0.01, 0, 0])
     geom = holder.add_geom(
-        name="tool",
+        name=sphere,
         type=mujoco.mjtGeom.mjGEOM_SPHERE,
         size=[radius, 0, 0],
         contype=1,
@@ -76,11 +86,12 @@ def add_tool(
         geom.solref = list(solref)
     for name, kind in (("ee_force", "mjSENS_FORCE"), ("ee_torque", "mjSENS_TORQUE")):
         spec.add_sensor(
-            name=name,
+            name=_unused(spec.sensor, name),
             type=getattr(mujoco.mjtSensor, kind),
             objtype=mujoco.mjtObj.mjOBJ_SITE,
-            objname="ee",
+            objname=site,
         )
+    return site, sphere
 
 
 def add_table(
@@ -92,12 +103,13 @@ def add_table(
     solref: Sequence[float] | None = None,
     mass: float | None = None,
     spring: float | None = None,
-) -> str:
+) -> tuple[str, str]:
     """A table (a box of :data:`TABLE_SIZE` and :data:`TABLE_THICKNESS`, geom
     ``table``) whose top is at height ``top`` (m), centred at ``centre`` (x,
     y); static, or with ``spring`` (N/m) on a vertical slide joint
     ``table_spring``, critically damped for its ``mass`` (kg) and preloaded by
-    its weight (at rest the top is at ``top``). Returns its body's name."""
+    its weight (at rest the top is at ``top``). Returns the names of its body
+    and its geom."""
     name = unused_body(spec, "table")
     body = spec.worldbody.add_body(
         name=name, pos=[float(centre[0]), float(centre[1]), top - TABLE_THICKNESS / 2]
@@ -112,8 +124,9 @@ def add_table(
             damping=2.0 * math.sqrt(spring * m),
             springref=m * GRAVITY / spring,
         )
+    box = _unused(spec.geom, "table")
     geom = body.add_geom(
-        name="table",
+        name=box,
         type=mujoco.mjtGeom.mjGEOM_BOX,
         size=[TABLE_SIZE[0], TABLE_SIZE[1], TABLE_THICKNESS / 2],
         contype=1,
@@ -126,4 +139,4 @@ def add_table(
         geom.solref = list(solref)
     if mass is not None:
         geom.mass = mass
-    return name
+    return name, box

@@ -133,6 +133,7 @@ def suggest(
     case: str = "sf",
     resolve: bool = False,
     along: bool = False,
+    critical: bool = False,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia at ``q0`` (rad), its actuator
     limits ``tau_max`` (N m) and the task's joint path (SPEC §18, module docs).
@@ -165,6 +166,9 @@ def suggest(
         :data:`ALONG` postures evenly along the path, SPEC (16.12) (the
         Cartesian and contact rules'): the sampled velocity loop stays within
         its margin wherever the path takes the arm, not only at q0.
+    critical : bool
+        Ĝ learns at the velocity loop's critical bandwidth ω_G² = (m/Ts)²/4,
+        SPEC (19.6) (the table scenario's; (18.6)'s ½ (m/Ts) K1 otherwise).
 
     Returns
     -------
@@ -197,7 +201,7 @@ def suggest(
         more = np.ascontiguousarray(np.array([inertia(model, rows[k, :n]) for k in idx]))
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
-        inertias=more,
+        inertias=more, critical=critical,
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

@@ -343,8 +343,8 @@ impl PostureRule {
 
     /// Whether `a` meets the rule: the first condition it violates, named
     /// (`σmin(J) ≥ 0.05`, `inside the joint limits with margin`, `gravity
-    /// load ≤ 0.5`, `velocity-loop conditioning ≥ K1·Ts/m`, `task
-    /// reachable`), with the value.
+    /// load within its bound` (0.5 by default), `velocity-loop conditioning ≥
+    /// K1·Ts/m`, `task reachable`), with the value.
     pub fn check(&self, a: &Assessment) -> Result<(), Error> {
         let conditions: [(bool, &'static str, &'static str, Option<usize>, f64); 5] = [
             (
@@ -363,7 +363,7 @@ impl PostureRule {
             ),
             (
                 a.load <= self.load,
-                "gravity load max|G_i|/τmax_i ≤ 0.5 along the task",
+                "gravity load max|G_i|/τmax_i within its bound along the task",
                 "gravity load",
                 None,
                 a.load,

@@ -148,6 +148,24 @@ impl Rule {
         self.k1_max.min(self.k1_per_step / ts)
     }
 
+    /// The rule with Ĝ learning at the velocity loop's critical bandwidth,
+    /// SPEC (19.6): ω_G² = a²/4, a = m/Ts (the learning loop's pair
+    /// s² + a s + ω_G² critically damped), i.e. `learn` = a/(4 K1) for the
+    /// K1 of (18.2) at `ts` (2.5 at 1 kHz, against (18.6)'s ½). The table
+    /// scenario's K1 = 10 s⁻¹ slows the learning pole's reach (it tends to −K1
+    /// as ω_G grows); there the learning goes as fast as the velocity loop
+    /// lets it. D̂ and Ĉ keep their bandwidth ω_D = ω_C of (18.6): faster,
+    /// D̂ α̇1 carried the paper's +τe feedforward's loop through the contact
+    /// and the tool chattered (the Panda's table with +τe: 10.5 N).
+    pub fn critical(&self, ts: f64) -> Self {
+        let learn = self.margin / ts / (4.0 * self.k1(ts));
+        Self {
+            learn,
+            learn_dc: self.learn_dc * sqrt(self.learn / learn),
+            ..*self
+        }
+    }
+
     /// The robot-scenario configuration of `law` for an arm of inertia matrix
     /// `d` (kg m², at the task's start), limits `tau_max` (N m) and period
     /// `ts` (s): (18.1)–(18.4), the hardened options of SPEC §13 and the

@@ -28,8 +28,10 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// narrowed to the path's own size, SPEC (16.10) (the Cartesian rule's).
 /// `inertias` (K, n, n; kg m²): D at postures along the path; the inertia
 /// scales are then the smallest over them and `inertia`, SPEC (16.12).
+/// `critical`: Ĝ learns at the velocity loop's critical bandwidth, SPEC
+/// (19.6) (the table scenario's).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, inertias=None))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, inertias=None, critical=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -42,6 +44,7 @@ pub fn suggest<'py>(
     gravity: Option<PyReadonlyArray1<'py, f64>>,
     resolve: bool,
     inertias: Option<numpy::PyReadonlyArray3<'py, f64>>,
+    critical: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -82,7 +85,7 @@ pub fn suggest<'py>(
     macro_rules! arms {
         ($($k:literal)*) => {
             match n {
-                $($k => fill::<$k>(py, &out, law, &d, &tau, ts, path.as_ref(), gravity.as_deref(), resolve),)*
+                $($k => fill::<$k>(py, &out, law, &d, &tau, ts, path.as_ref(), gravity.as_deref(), (resolve, critical)),)*
                 _ => unreachable!("n checked above"),
             }
         };
@@ -101,10 +104,14 @@ fn fill<'py, const N: usize>(
     ts: f64,
     path: Option<&(Vec<f64>, f64)>,
     gravity: Option<&[f64]>,
-    resolve: bool,
+    (resolve, critical): (bool, bool),
 ) -> PyResult<()> {
     let err = |e: Error| config_error(e.into());
     let mut rule = Rule::default();
+    if critical {
+        crate::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
+        rule = rule.critical(ts);
+    }
     // Row-major (n, n) into nalgebra's column-major: D is symmetric, but a
     // non-symmetric input must be reported, not transposed silently.
     let ds: Vec<Matrix<N>> = d
@@ -280,12 +287,14 @@ pub fn pose_circle<'py>(
 /// `d0` (n, n; kg m²), the limits `lo`, `hi` (n,; rad, ±inf: unlimited),
 /// `tau_max` (n,; N m), `orients` (the 6 × n Jacobian, else its 3
 /// translation rows), `k1` (1/s) and `ts` (s) of the joint controller (the
-/// conditioning threshold K1·Ts/m; default the joint rule's at 1 kHz).
+/// conditioning threshold K1·Ts/m; default the joint rule's at 1 kHz),
+/// `load` the largest gravity load allowed (default 0.5; 1: gravity within
+/// the actuators, for a posture the caller gave).
 /// Returns a dict: "sigma_min", "load", "conditioning", "slack",
 /// "slack_joint", "reach", "score" and "error" (the first condition it
 /// violates, or None).
 #[pyfunction]
-#[pyo3(signature = (chain, q, p, gravity, d0, lo, hi, tau_max, orients, k1=None, ts=None))]
+#[pyo3(signature = (chain, q, p, gravity, d0, lo, hi, tau_max, orients, k1=None, ts=None, load=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn assess_posture<'py>(
     py: Python<'py>,
@@ -300,10 +309,15 @@ pub fn assess_posture<'py>(
     orients: bool,
     k1: Option<f64>,
     ts: Option<f64>,
+    load: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let joint_rule = Rule::default();
     let ts = ts.unwrap_or(1e-3);
-    let rule = PostureRule::for_loop(k1.unwrap_or_else(|| joint_rule.k1(ts)), ts, &joint_rule);
+    let mut rule = PostureRule::for_loop(k1.unwrap_or_else(|| joint_rule.k1(ts)), ts, &joint_rule);
+    if let Some(l) = load {
+        crate::error::check::positive("load > 0", "load", l).map_err(|e| config_error(e.into()))?;
+        rule.load = l;
+    }
     let kin = chain.dyn_chain();
     let n = kin.n();
     let k = q.shape()[0];

@@ -157,10 +157,8 @@ def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float
     or ``force`` zero: :data:`TABLE_TIMECONST` (nothing slides under load).
     The normal row keeps its own time constant (:data:`TABLE_TIMECONST`).
     """
-    import mujoco
 
-    tool = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "tool")
-    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "table")
+    tool, table = _tool_table(model)
     if tool < 0 or table < 0:
         raise ValueError("the model has no geoms 'tool' and 'table'")
     if friction <= 0 or speed <= 0 or force <= 0:
@@ -172,6 +170,26 @@ def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float
     dmax = float(max(model.geom_solimp[tool, 1], model.geom_solimp[table, 1]))
     damping = SLIP_SHARE * force * (1.0 - dmax) * inv_mass / (dmax * friction * speed)
     return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
+
+
+def _tool_table(model: Any) -> tuple[int, int]:
+    """The ids of the tool's sphere and the table's box (-1: none): the pair
+    ``tool_table``'s geoms, else the last geoms named ``tool``… and ``table``…
+    (the builder adds ``_1``, ``_2``, … to a name the model has already)."""
+    import mujoco
+
+    pair = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, "tool_table")
+    if pair >= 0:
+        return int(model.pair_geom1[pair]), int(model.pair_geom2[pair])
+    names = [
+        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) or "" for g in range(model.ngeom)
+    ]
+
+    def last(prefix: str) -> int:
+        found = [g for g, n in enumerate(names) if n == prefix or n.startswith(prefix + "_")]
+        return found[-1] if found else -1
+
+    return last("tool"), last("table")
 
 
 def _tool_and_table(
@@ -198,11 +216,11 @@ def _tool_and_table(
 
     rows = [friction, 0.005, 0.0001]
     solref = [TABLE_TIMECONST, 1.0]
-    add_tool(spec, tip, radius=tool_radius, own_body=True, friction=rows, solref=solref)
+    _, tool = add_tool(spec, tip, radius=tool_radius, own_body=True, friction=rows, solref=solref)
     if table_top is None:
         return None
     c = np.asarray(centre, dtype=np.float64)
-    table = add_table(
+    table, box = add_table(
         spec, top=table_top, centre=(float(c[0]), float(c[1])), friction=rows, solref=solref,
         mass=TABLE_MASS, spring=spring,
     )  # fmt: skip
@@ -215,8 +233,8 @@ def _tool_and_table(
     if friction > 0:
         spec.add_pair(
             name="tool_table",
-            geomname1="tool",
-            geomname2="table",
+            geomname1=tool,
+            geomname2=box,
             condim=3,
             friction=[friction, friction, 0.005, 0.0001, 0.0001],
             solref=solref,
@@ -708,7 +726,7 @@ def arm_table(
 
     if home is not None:
         sc = build(_joint_vector("home", home, chain))
-        refusal = refusal_of(sc)
+        refusal = refusal_of(sc, load=1.0)
         if refusal is not None:
             raise ConfigError(f"the home posture cannot run the table: {refusal}")
         return sc
@@ -774,7 +792,14 @@ def _mjcf_arm(
         tip = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body)
     if tip is None:
         raise ConfigError(f"the end effector's body of {path.name} has no name: give tip=")
-    bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius), site="ee")
+    model = arm_model(path, tip, fix=fix, tool_radius=tool_radius)
+    # The tool's site: the one on the body added at the tip (named "ee", or
+    # "ee_1", … where the file has an "ee" already).
+    body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, tip)
+    held = [b for b in range(model.nbody) if int(model.body_parentid[b]) == body]
+    sites = [s for s in range(model.nsite) if int(model.site_bodyid[s]) in held]
+    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, sites[-1])
+    bare = amj.Plant(model, site=name)
     return amj.chain_of(bare), bare, tip
 
 
@@ -884,7 +909,7 @@ REFUSAL_ROWS = 40
 """Rows of the scenario's joint path at which :func:`refusal_of` checks the arm."""
 
 
-def refusal_of(sc: PandaTable) -> str | None:
+def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
     """Why the table cannot run at the scenario's home, or None (SPEC (19.6)).
 
     Along the scenario's joint path (the hold, the approach, the press and one
@@ -893,7 +918,9 @@ def refusal_of(sc: PandaTable) -> str | None:
     singularity, inside the joint limits with margin, gravity at most half of
     every actuator, the velocity loop well-conditioned at home, the path
     reachable within 1 mm), no self-collision of the arm, and no joint of the
-    arm below the table top over the table."""
+    arm below the table top over the table. ``load``: the largest gravity
+    load max_i |G_i|/τmax_i allowed (1 for a home the user gives: gravity
+    within the actuators; the press, SPEC (19.6), is checked apart)."""
     from .. import _adaptimp, tuning
     from .. import mujoco as amj
 
@@ -911,7 +938,7 @@ def refusal_of(sc: PandaTable) -> str | None:
     lo, hi = _limits(plant)
     a = _adaptimp.assess_posture(
         sc.chain, rows, targets, gravity, tuning.inertia(plant, sc.q0), lo, hi,
-        np.asarray(sc.tau_max, dtype=np.float64), False, k1=CONTACT_K1, ts=sc.Ts,
+        np.asarray(sc.tau_max, dtype=np.float64), False, k1=CONTACT_K1, ts=sc.Ts, load=load,
     )  # fmt: skip
     if a["error"] is not None:
         return str(a["error"])
@@ -927,11 +954,10 @@ def _through_table(sc: PandaTable, plant: Any, rows: FloatArray) -> str | None:
     import mujoco
 
     m = plant.model
-    g = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "table")
+    tool, g = _tool_table(m)
     if g < 0:
         return None
     d = mujoco.MjData(m)
-    tool = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "tool")
     top = sc.surface_z - float(m.geom_size[tool, 0])
     for k, q in enumerate(rows):
         d.qpos[plant._qadr] = q
@@ -1046,7 +1072,7 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
 
     kw = tuning.suggest(
         amj.Plant(sc.model), sc.q0, sc.tau_max, Ts=sc.Ts, path=path, period=steps * sc.Ts,
-        case=case, along=True,
+        case=case, along=True, critical=True,
     )  # fmt: skip
     kw["K1"] = [min(CONTACT_K1, float(kw["K1"][0]))] * sc.n  # never above (18.2)
     out: dict[str, Any] = {

@@ -66,6 +66,7 @@ import argparse
 import json
 import math
 import os
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -322,7 +323,14 @@ def main() -> None:
         default=os.cpu_count() or 1,
         help="rows run at once, on threads (the core's loop releases the GIL); default: every core",
     )
-    args = parser.parse_args()
+    # A posture that starts with a negative angle (--home -0.47,…) is the
+    # option's value, not an option.
+    argv = sys.argv[1:]
+    for i, a in enumerate(argv[:-1]):
+        if a == "--home" and argv[i + 1].startswith("-"):
+            argv[i : i + 2] = [f"--home={argv[i + 1]}"]
+            break
+    args = parser.parse_args(argv)
     if args.jobs < 1:
         parser.error(f"--jobs must be ≥ 1, got {args.jobs}")
     if not (math.isfinite(args.T) and args.T > 0):

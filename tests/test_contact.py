@@ -629,6 +629,11 @@ def test_placements_draw_homes_the_table_runs(tmp_path: Path) -> None:
     assert "a joint angle (rad) must be a number or an expression of numbers and pi, got 'x'" in (
         run.stderr
     )
+    # A posture that starts with a negative angle is --home's value, not an option.
+    short = [sys.executable, str(EXAMPLE), "--arm", str(_ur5()), "--home", "-0.1,0.2"]
+    run = subprocess.run(short, capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 2
+    assert "home must be 6 finite numbers (rad), one per joint; got shape (2,)" in run.stderr
 
 
 def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:

@@ -155,7 +155,7 @@ impl Rule {
     /// The rule with Ĝ learning near the velocity loop's critical bandwidth,
     /// SPEC (19.6): ω_G² = a²/(4ζ²), a = m/Ts, ζ = [`LEARN_DAMPING`] (the
     /// learning loop's pair s² + a s + ω_G² just overdamped), i.e. `learn` =
-    /// a/(4ζ² K1) for the K1 of (18.2) at `ts` (2.07 at 1 kHz, against
+    /// a/(4ζ² K1) for the K1 of (18.2) at `ts` (1.03 at 1 kHz: 2.07 times
     /// (18.6)'s ½). The table scenario's K1 = 10 s⁻¹ slows the learning
     /// pole's reach (it tends to −K1 as ω_G grows); there the learning goes
     /// as fast as the velocity loop lets it. ζ = 1 (critical) was too close:

@@ -80,8 +80,9 @@ force spike and the tool bounced off the table (87–240 N, 0.3–0.5 s off on
 the Panda, the UR5 and the UR10); at 20 s⁻¹ the six arms held, but a UR10 with
 three times its masses and torques landed early and rang (14 N of force error,
 3.4 s off); at 10 s⁻¹, between the impedance's K_d/B_d = 7.9 s⁻¹ and its
-√(K_d/M_d) = 15.8 s⁻¹, every arm measured holds. The learning keeps the
-rule's bandwidth (18.6) (SPEC (19.6))."""
+√(K_d/M_d) = 15.8 s⁻¹, every arm measured holds. Ĝ learns at ω_G² =
+(m/Ts)²/(4·1.1²), the velocity loop's pair just overdamped (``Rule::critical``),
+D̂ and Ĉ at (18.6)'s bandwidth (SPEC (19.6))."""
 
 T_HOLD = 0.5
 """The path holds the home posture this long (s) before the approach: the
@@ -1054,7 +1055,9 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
     centres (18.5) and the learning (18.6)–(18.8) along the scenario's whole
     joint path (the hold, the approach, the press and one period of the circle,
     as the outer loop maps the path on the table's surface into the joints,
-    F_e = 0, taken as one period of that length), and K1 = min(:data:`CONTACT_K1`,
+    F_e = 0, taken as one period of that length), the inertia scales the
+    smallest along it (16.12), Ĝ's learning near the velocity loop's critical
+    bandwidth (``tuning.suggest(critical=True)``) and K1 = min(:data:`CONTACT_K1`,
     the rule's (18.2)) (SPEC (19.6)). Returns ``gains`` (Kp, Kzeta, K1), ``basis`` (centres,
     widths) and the rest (gamma, sigma, weight_bound, kr, …) as keywords."""
     from .. import mujoco as amj

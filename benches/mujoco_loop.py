@@ -22,8 +22,9 @@ gains and centres along a sinusoid of 0.15 rad at 1 rad/s about the posture:
 - for a path given as a Python callable: (d) the path's own calls at t_k
   (``path(k·Ts)`` K times in a Python loop, nothing else), divided by K, and
   ((a) − (d)) / ((b) + (c)): the loop's cost without the user's function;
-- for reference, the Python loop (``simulate`` with the same controller behind a
-  Python object: the fallback, the loop every controller took before).
+- the same controller behind a Python object (its ``step`` written in Python):
+  the core's loop calls it back once a period (before, a loop written in
+  Python stepped such controllers).
 
 Cartesian rows: ``adaptimp.CartesianController`` (the core's outer loop of SPEC
 §16, position-only, in front of state feedback with the same rule's gains and
@@ -31,20 +32,19 @@ centres along the joint orbit of its path): the UR5's tool on a 5 cm circle at
 0.5 Hz about its start (free space), and the Panda of the scenario
 "panda-table" (``adaptimp.panda_table``: the tool pressing on the table along
 its circle, contact on). Twice: with the controller's path, a Python callable,
-whose tabulation (one ``path(t)`` call per period, as the Python loop makes) is
-in (a); and with the path given to ``simulate`` as arrays (``reference=(xc,
-dxc, ddxc)``, tabulated before the clock starts). (c) is ``CartesianImpedance.replay``
+whose tabulation (one ``path(t)`` call per period) is in (a); and with the
+path given to ``simulate`` as arrays (``reference=(xc, dxc, ddxc)``,
+tabulated before the clock starts). (c) is ``CartesianImpedance.replay``
 (outer loop and joint step in a Rust loop) over (a)'s rows.
 
 The Panda table: ``examples/13_panda_table.py``'s controllers (T = ``--table-T``)
-each run natively and through the Python loop (the controller behind a Python
-object: what every Cartesian controller took before), side by side; computed
-torque steps in the core (SPEC §20) in both. A third column, "before", is the
-table as it ran before computed torque was in the core: the Python loop, with
-the computed-torque rows' joint law written with Pinocchio in Python
-(``PinocchioPDPlus`` below, the law of SPEC (20.4) at n = 0 that
-``adaptimp.baselines`` stepped then). Beside them, MuJoCo alone on the same
-motion (``mujoco.rollout`` of the native run's torques): the floor of any loop.
+each run natively and behind a Python object (called back), side by side;
+computed torque steps in the core (SPEC §20) in both. A third column,
+"before", is the computed-torque rows' joint law written with Pinocchio in
+Python (``PinocchioPDPlus`` below, the law of SPEC (20.4) at n = 0 that
+``adaptimp.baselines`` stepped before §20), called back. Beside them, MuJoCo
+alone on the same motion (``mujoco.rollout`` of the native run's torques):
+the floor of any loop.
 
 Then a sweep on MuJoCo: ``adaptimp.sweep(..., plant="mujoco")`` of 16 runs (the
 paper's arm with its ceiling, state feedback in the robot scenario, T =
@@ -52,21 +52,39 @@ paper's arm with its ceiling, state feedback in the robot scenario, T =
 against one thread (``threads=1``), and against the machine's ceiling: two
 independent processes running 8 runs each; target ≥ 1.7× on 2 cores.
 
+Builds side by side (``--only builds --before DIR``): the same rows timed in
+this build and in another one whose Python package is in DIR (put first on
+``PYTHONPATH``), alternating, each repeat in a fresh process of each: per
+period, every controller natively and written in Python (behind a Python
+object), on the paper's arm at its 50 µs (one MuJoCo step a period: the
+loop's own cost shows most), the UR5 and the Panda (joint space and behind
+the Cartesian impedance), and computed torque and a PD written in Python on
+the paper's arm. To build the package of a commit into DIR:
+
+    git worktree add --detach ../before COMMIT && cd ../before
+    python -m venv venv && venv/bin/pip install maturin numpy mujoco pin example-robot-data
+    venv/bin/maturin develop --release   # DIR = ../before/python
+
 Each measurement is repeated ``--repeats`` times, interleaved; medians.
 
     target/py-venv/bin/python benches/mujoco_loop.py [--T 10] [--repeats 5] [--sweep-T 2]
-        [--table-T 20] [--only loop,cartesian,table,sweep]
+        [--table-T 20] [--only loop,cartesian,table,sweep,builds] [--before DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import gc
+import json
+import math
 import os
 import platform
 import statistics
+import subprocess
+import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import mujoco
@@ -102,7 +120,7 @@ def controller(plant: amj.Plant, q0: np.ndarray) -> adaptimp.Controller:
 
 
 class PythonSide:
-    """The same controller behind a Python object: simulate's Python loop."""
+    """The same controller behind a Python object: its ``step`` in Python."""
 
     def __init__(self, inner: adaptimp.Controller) -> None:
         self.inner = inner
@@ -151,7 +169,7 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
 
     def hold() -> float:
         plant.reset(q0)
-        plant.apply(plant.bias())  # hold the posture against gravity
+        d.ctrl[plant._act] = plant.bias() / plant._gear  # hold the posture against gravity
         start = time.perf_counter()
         mujoco.mj_step(m, d, nstep=substeps * steps)
         seconds = time.perf_counter() - start
@@ -168,7 +186,7 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
         ctrl.reset()
         start = time.perf_counter()
         res = amj.simulate(PythonSide(ctrl), plant, T=T, q0=q0)
-        assert res.params["loop"] == "python"
+        assert res.params["loop"] == "callback"
         return (time.perf_counter() - start) / steps
 
     return (
@@ -185,7 +203,7 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
 
 
 class InPython:
-    """A controller behind a Python object: simulate's Python loop steps it."""
+    """A controller behind a Python object: its ``step`` in Python."""
 
     def __init__(self, inner: Any) -> None:
         self.inner = inner
@@ -275,7 +293,7 @@ def cartesian_timers(
 
     def hold() -> float:
         plant.reset(q0)
-        plant.apply(plant.bias())
+        d.ctrl[plant._act] = plant.bias() / plant._gear
         start = time.perf_counter()
         mujoco.mj_step(m, d, nstep=substeps * steps)
         seconds = time.perf_counter() - start
@@ -306,7 +324,7 @@ def cartesian_timers(
         ctrl.reset()
         start = time.perf_counter()
         res = amj.simulate(InPython(ctrl), plant, T=T, q0=q0, reference=reference)
-        assert res.params["loop"] == "python"
+        assert res.params["loop"] == "callback"
         return (time.perf_counter() - start) / steps
 
     return (
@@ -334,7 +352,7 @@ def loop_table(rows: list[tuple[str, str]], T: float, repeats: int) -> None:
     print(
         "\n| arm | controller | n | substeps | (a) simulate, native | (b) MuJoCo, same motion | "
         "(b') MuJoCo at rest | (c) Rust step | (a)/((b)+(c)) | (d) the path's calls | "
-        "((a)−(d))/((b)+(c)) | Python loop | Python/(a) |"
+        "((a)−(d))/((b)+(c)) | in Python, called back | Python/(a) |"
     )
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, kind in rows:
@@ -394,9 +412,8 @@ class PinocchioPDPlus:
 
 def panda_table_times(T: float, repeats: int) -> None:
     """examples/13's table, the issue's five controllers (its rows pd, sf, of, ct,
-    ct+30 on the default table): each natively and through the Python loop."""
+    ct+30 on the default table): each natively and behind a Python object."""
     import importlib.util
-    from pathlib import Path
 
     from adaptimp.scenarios import contact as act
     from adaptimp.scenarios import panda_table as apt
@@ -422,7 +439,7 @@ def panda_table_times(T: float, repeats: int) -> None:
         for kind in rows:
             for how in ("native", "python", "before"):
                 if how == "before" and not kind.startswith("ct"):
-                    # The rows the core stepped already: as the Python loop.
+                    # The rows the core stepped already: as called back.
                     times[kind]["before"].append(times[kind]["python"][-1])
                     continue
                 ctrl = example.controller(kind, sc, rule)
@@ -453,7 +470,7 @@ def panda_table_times(T: float, repeats: int) -> None:
         f"medians of {repeats}, s per controller: simulate and cartesian_metrics)"
     )
     print(
-        "\n| controller | loop | native (s) | Python loop (s) | before (s) | native/Python | "
+        "\n| controller | loop | native (s) | called back (s) | before (s) | native/Python | "
         "native/before | MuJoCo alone (s) |"
     )
     print("|---|---|---:|---:|---:|---:|---:|---:|")
@@ -483,7 +500,12 @@ def main() -> None:
     parser.add_argument(
         "--only", default="loop,cartesian,table,sweep", help="which tables, comma-separated"
     )
+    parser.add_argument("--before", default=None, help="the other build's Python package dir")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child:
+        print(json.dumps(build_rows(args.T)))
+        return
     only = set(args.only.split(","))
     load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
     print(
@@ -502,6 +524,164 @@ def main() -> None:
         panda_table_times(args.table_T, max(1, args.repeats // 2))
     if "sweep" in only:
         sweep_table(args.sweep_T, args.repeats)
+    if "builds" in only:
+        if args.before is None:
+            parser.error("--only builds needs --before DIR")
+        builds_table(args.before, args.T, args.repeats)
+
+
+class PythonPD:
+    """Joint PD with gravity compensation written in Python, on a reference."""
+
+    Ts = 1e-3
+
+    def __init__(self) -> None:
+        self.arm = adaptimp.TwoLinkArm()
+        self.Kp, self.Kd = np.array([60.0, 40.0]), np.array([8.0, 5.0])
+
+    def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+        q = np.asarray(q)
+        return np.asarray(self.arm.G(q) + self.Kp * (sp["xc"] - q) + self.Kd * (sp["dxc"] - dq))
+
+
+def build_rows(T: float) -> dict[str, float]:
+    """One measurement of each row of :func:`builds_table` in this process's
+    build: µs per control period of ``simulate`` (construction not counted)."""
+    from adaptimp.baselines import ComputedTorque
+
+    out: dict[str, float] = {}
+
+    def timed(key: str, ctrl: Any, plant: Any, **kw: Any) -> None:
+        start = time.perf_counter()
+        res = amj.simulate(ctrl, plant, T=T, **kw)
+        out[key] = (time.perf_counter() - start) / res.rows * 1e6
+
+    gc.disable()
+    try:
+        paper = amj.Plant("two_link", contact=False)
+        for how in ("native", "python"):
+            ctrl = adaptimp.Controller("sf", "paper")
+            timed(f"paper SF/{how}", ctrl if how == "native" else PythonSide(ctrl), paper)
+        for name in ("UR5", "Panda"):
+            model, q0 = arm(name)
+            plant = amj.Plant(model)
+            for how in ("native", "python"):
+                ctrl = controller(plant, q0)
+                side = ctrl if how == "native" else PythonSide(ctrl)
+                timed(f"{name} SF joint/{how}", side, plant, q0=q0)
+            plant, cart, q0 = cartesian(name)
+            for how in ("native", "python"):
+                cart.reset()
+                side = cart if how == "native" else InPython(cart)
+                timed(f"{name} SF Cartesian/{how}", side, plant, q0=q0)
+        two = amj.Plant("two_link")
+        ct = ComputedTorque(mass_scale=1.3)
+        timed("two_link CT joint/native", ct, two)
+        timed("two_link PD written in Python/python", PythonPD(), two, reference=amj.paper_circle())
+    finally:
+        gc.enable()
+    for how in ("native", "python"):
+        out[f"interrupt/{how}"] = interrupt_latency(how)
+    return out
+
+
+def interrupt_latency(how: str, after: float = 0.5) -> float:
+    """Seconds from SIGINT to KeyboardInterrupt out of ``simulate`` with 10 000
+    MuJoCo steps a period (the Panda on its table, SF natively or behind a
+    Python object; the signal sent by a timer thread ``after`` s after the
+    run's first progress report, inside the loop)."""
+    import signal
+    import threading
+
+    model, q0 = arm("Panda")
+    plant = amj.Plant(model)
+    ctrl = controller(plant, q0)
+    sent = [math.nan]
+
+    def fire() -> None:
+        sent[0] = time.perf_counter()
+        os.kill(os.getpid(), signal.SIGINT)
+
+    timer = threading.Timer(after, fire)
+
+    def started(done: int, total: int) -> None:
+        if not timer.is_alive() and math.isnan(sent[0]):
+            timer.start()
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        side = ctrl if how == "native" else PythonSide(ctrl)
+        amj.simulate(side, plant, T=60.0, q0=q0, substeps=10_000, progress=started)
+    except KeyboardInterrupt:
+        return time.perf_counter() - sent[0]
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
+    return math.nan
+
+
+BUILD_ROWS = (
+    ("paper SF", "the paper's arm, SF, Ts = 50 µs, 1 MuJoCo step"),
+    ("UR5 SF joint", "UR5, SF, joint space, 1 MuJoCo step"),
+    ("Panda SF joint", "Panda on its table, SF, joint space, 2 MuJoCo steps"),
+    ("UR5 SF Cartesian", "UR5, SF behind the Cartesian impedance, path in Python"),
+    ("Panda SF Cartesian", "Panda pressing on its table, SF behind the Cartesian impedance"),
+    (
+        "two_link CT joint",
+        "the paper's arm at 1 kHz, computed torque (+30 % mass); before: the Python loop",
+    ),
+    ("two_link PD written in Python", "the paper's arm at 1 kHz, a PD written in Python"),
+)
+
+
+def builds_table(before: str, T: float, repeats: int) -> None:
+    """:func:`build_rows` in this build and in the one at ``before``,
+    alternating, each repeat in a fresh process of each; medians."""
+    here = Path(__file__).resolve()
+    runs: dict[str, dict[str, list[float]]] = {"before": {}, "after": {}}
+    loads: list[float] = []
+    for _ in range(repeats):
+        for which in ("before", "after"):
+            env = dict(os.environ)
+            if which == "before":
+                env["PYTHONPATH"] = os.pathsep.join(p for p in (before, env.get("PYTHONPATH")) if p)
+            cmd = [sys.executable, str(here), "--child", "--T", str(T)]
+            done = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True)
+            for key, us in json.loads(done.stdout.splitlines()[-1]).items():
+                runs[which].setdefault(key, []).append(us)
+            loads.append(os.getloadavg()[0])
+    med = {w: {k: statistics.median(v) for k, v in r.items()} for w, r in runs.items()}
+    print(
+        f"\nthis build against {before}, T = {T:g} s per run, medians of {repeats} (alternating "
+        f"processes; load average {min(loads):.1f}–{max(loads):.1f}), µs per control period:"
+    )
+    print(
+        "\n| row | native before | native now | now/before | in Python before "
+        "| in Python now | now/before |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|")
+
+    def cell(which: str, key: str) -> str:
+        v = med[which].get(key)
+        return "—" if v is None else f"{v:.1f}"
+
+    def ratio(key: str) -> str:
+        a, b = med["after"].get(key), med["before"].get(key)
+        return "—" if a is None or b is None else f"{a / b:.2f}"
+
+    for key, label in BUILD_ROWS:
+        nat, py = f"{key}/native", f"{key}/python"
+        print(
+            f"| {label} | {cell('before', nat)} | {cell('after', nat)} | {ratio(nat)} | "
+            f"{cell('before', py)} | {cell('after', py)} | {ratio(py)} |"
+        )
+    print(
+        "\nCtrl-C: s from SIGINT to KeyboardInterrupt, the Panda with 10 000 MuJoCo steps "
+        "a period (about 0.3 s each):\n\n| controller | before | now |\n|---|---:|---:|"
+    )
+    for how, label in (("native", "SF, native"), ("python", "SF behind a Python object")):
+        key = f"interrupt/{how}"
+        print(f"| {label} | {med['before'][key]:.3f} | {med['after'][key]:.3f} |")
 
 
 def _half(vary: dict[str, list[float]], T: float, part: int) -> None:

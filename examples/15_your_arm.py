@@ -34,6 +34,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import mujoco
 import numpy as np
 
 import adaptimp
@@ -102,7 +103,7 @@ def table(urdf: Path, T: float, payload: float | None) -> dict[str, Any]:
 
 def long_run(urdf: Path, seconds: float, case: str = "sf") -> None:
     """The default route's controller for ``seconds`` of the default task in
-    your own loop (Plant and Controller.step), with the weight norms and the
+    your own loop (Controller.step and MuJoCo's mj_step), with the weight norms and the
     largest commanded |τ_i|/τmax_i every so often."""
     plant = amj.Plant(urdf)
     task = amj.default_task(plant)
@@ -130,8 +131,9 @@ def long_run(urdf: Path, seconds: float, case: str = "sf") -> None:
             peak = max(peak, float(np.max(np.abs(ctrl.tau) / plant.tau_max)))
         z2sum += float(np.sum(ctrl.z1**2))
         rows += 1
-        plant.apply(tau)
-        plant.step(substeps)
+        # The motors' limits, then MuJoCo's steps of the period (the torque held).
+        plant.data.ctrl[plant._act] = np.clip(tau, -plant.tau_max, plant.tau_max) / plant._gear
+        mujoco.mj_step(plant.model, plant.data, nstep=substeps)
         if k + 1 in marks:
             w = ctrl.weights
             norms = [float(np.linalg.norm(w[net])) for net in ("D", "C", "G")]

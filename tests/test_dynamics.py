@@ -1,7 +1,8 @@
 """The core's rigid-body dynamics and computed torque (SPEC §20) against
 Pinocchio: RNEA and the mass matrix on the arms of example-robot-data, the
 computed-torque law against the same law written here with Pinocchio's
-algorithms, and its native MuJoCo run against the Python loop, bit for bit."""
+algorithms, and its native MuJoCo run against the same controller called back
+through its Python ``step``, bit for bit."""
 
 from __future__ import annotations
 
@@ -191,10 +192,10 @@ def test_the_torque_level_law_is_pinocchios_pd_plus(sc: apt.PandaTable) -> None:
     np.testing.assert_array_equal(got, res.tau_sat[-1])
 
 
-def test_the_native_run_equals_the_python_loop_in_every_formulation(sc: apt.PandaTable) -> None:
+def test_the_native_run_equals_the_callback_in_every_formulation(sc: apt.PandaTable) -> None:
     """Computed torque behind the Cartesian impedance steps in the core's native
-    loop, bit for bit the Python loop's run (the five controllers' table, issue
-    of engine speed)."""
+    loop, bit for bit the run calling the same controller back through its
+    Python ``step`` (the five controllers' table, issue of engine speed)."""
     from test_mujoco_cartesian import _InPython
 
     for kind, formulation, share in (
@@ -208,7 +209,7 @@ def test_the_native_run_equals_the_python_loop_in_every_formulation(sc: apt.Pand
         a, b = apt.panda_controller(kind, sc, **kw), apt.panda_controller(kind, sc, **kw)
         native = amj.simulate(a, amj.Plant(sc.model), T=1.0, q0=sc.q0)
         python = amj.simulate(_InPython(b), amj.Plant(sc.model), T=1.0, q0=sc.q0)
-        assert (native.params["loop"], python.params["loop"]) == ("native", "python")
+        assert (native.params["loop"], python.params["loop"]) == ("native", "callback")
         for name in ("q", "dq", "tau", "tau_sat", "z1", "xd", "x_ee", "wrench_ee"):
             np.testing.assert_array_equal(getattr(native, name), getattr(python, name), name)
         assert set(native.metrics) == set(python.metrics)

@@ -1,7 +1,7 @@
 """adaptimp.CartesianController in the core's closed loop on MuJoCo (SPEC §13.1,
-§16): the native loop equals the Python loop bit for bit (every row, the task-space
-rows, the metrics, the controller left behind), with disturbances and faults, and an
-exploding run raises."""
+§16): stepped natively it equals the same controller called back through its Python
+``step`` bit for bit (every row, the task-space rows, the metrics, the controller
+left behind), with disturbances and faults, and an exploding run raises."""
 
 from __future__ import annotations
 
@@ -26,8 +26,8 @@ _ATTRS = ("xc", "dxc", "ddxc", "xd", "z1", "force", "tau", "q_d", "_k")
 
 
 class _InPython:
-    """A CartesianController behind a Python object: simulate's Python loop steps
-    it through its Python ``step`` (the loop every Cartesian controller took before)."""
+    """A CartesianController behind a Python object: the core's loop calls its
+    Python ``step`` back once a period."""
 
     def __init__(self, inner: adaptimp.CartesianController) -> None:
         self.inner = inner
@@ -47,7 +47,7 @@ def _assert_same_run(
     every: int = 1,
 ) -> None:
     """Every row, task row and metric, and the two controllers left behind (whose
-    logs hold every step of the Python loop, the kept rows of the native one)."""
+    logs hold every step taken through ``step``, the kept rows of the native run)."""
     for name in _ARRAYS:
         np.testing.assert_array_equal(getattr(got, name), getattr(want, name), err_msg=name)
     assert got.task is not None
@@ -78,18 +78,18 @@ def basis(sc: apt.PandaTable) -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.mark.parametrize("kind", ["pd", "sf", "of"])
-def test_the_panda_table_runs_natively_and_equals_the_python_loop(
+def test_the_panda_table_runs_natively_and_equals_the_callback(
     sc: apt.PandaTable, basis: Any, kind: str
 ) -> None:
     """The scenario of examples/13 (the Panda's tool pressing on the table along its
-    path): the native loop and the Python loop give the same bits, and the
-    Cartesian metrics of docs/panda.md need no Python loop."""
+    path): natively and called back, the same bits, and the Cartesian metrics
+    of docs/panda.md from the rows of either."""
     native_ctrl = apt.panda_controller(kind, sc, basis=basis)
     python_ctrl = apt.panda_controller(kind, sc, basis=basis)
     native = amj.simulate(native_ctrl, amj.Plant(sc.model), T=1.5, q0=sc.q0)
     python = amj.simulate(_InPython(python_ctrl), amj.Plant(sc.model), T=1.5, q0=sc.q0)
     assert native.params["loop"] == "native"
-    assert python.params["loop"] == "python"
+    assert python.params["loop"] == "callback"
     _assert_same_run(native, python, native_ctrl, python_ctrl)
     assert native.metrics["steps_in_contact"] > 50
     assert native.xc.shape == native.z1.shape == (1500, 3)
@@ -106,10 +106,11 @@ def test_the_panda_table_runs_natively_and_equals_the_python_loop(
     assert all(math.isfinite(v) for v in got.values())
 
 
-def test_a_python_joint_controller_keeps_the_python_loop(sc: apt.PandaTable) -> None:
+def test_a_python_joint_controller_is_called_back(sc: apt.PandaTable) -> None:
     """A joint controller with a ``step`` of its own (here computed torque's,
-    wrapped in Python) behind the core's outer loop: the Python loop steps it,
-    and it gives computed torque's run; the core's own is native."""
+    wrapped in Python) behind the core's outer loop: the core's loop calls the
+    Cartesian controller back, and it gives computed torque's run; the core's
+    own is native."""
     from adaptimp.baselines import ComputedTorque
 
     class Own(ComputedTorque):
@@ -121,7 +122,7 @@ def test_a_python_joint_controller_keeps_the_python_loop(sc: apt.PandaTable) -> 
         sc.chain, inner, q0=sc.q0, path=sc.path, Kd_rot=0.0, force_feedforward=True
     )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.05, q0=sc.q0)
-    assert res.params["loop"] == "python"
+    assert res.params["loop"] == "callback"
     core = amj.simulate(apt.panda_controller("ct", sc), amj.Plant(sc.model), T=0.05, q0=sc.q0)
     assert core.params["loop"] == "native"
     np.testing.assert_array_equal(res.tau_sat, core.tau_sat)
@@ -169,7 +170,8 @@ def test_two_joints_against_the_ceiling_with_a_reference(case: str) -> None:
 
 def test_a_held_target_and_a_used_controller() -> None:
     """No path and no reference: the start pose held (xc = the filtered target,
-    at rest); a second run goes on from the first's state and clock, in both loops."""
+    at rest); a second run goes on from the first's state and clock, natively
+    and called back."""
     model, chain, q0, _ = _two_link()
 
     def make() -> adaptimp.CartesianController:
@@ -188,7 +190,7 @@ def test_a_held_target_and_a_used_controller() -> None:
 
 
 def test_a_path_goes_on_along_the_controllers_clock(sc: apt.PandaTable, basis: Any) -> None:
-    """A used controller's path is sampled at its own t_k, in both loops."""
+    """A used controller's path is sampled at its own t_k, natively and called back."""
     a = apt.panda_controller("sf", sc, basis=basis)
     b = apt.panda_controller("sf", sc, basis=basis)
     plant = amj.Plant(sc.model)
@@ -199,7 +201,7 @@ def test_a_path_goes_on_along_the_controllers_clock(sc: apt.PandaTable, basis: A
     np.testing.assert_array_equal(native.xc[0], sc.path(0.3)[0])
 
 
-def test_six_d_turning_the_panda_equals_the_python_loop() -> None:
+def test_six_d_turning_the_panda_equals_the_callback() -> None:
     """The 6-D loop (orientation a task, the path giving R_c, ω_c): the same bits."""
     model = amj.panda(table_height=None)
     model.opt.gravity[:] = 0.0
@@ -289,8 +291,8 @@ def test_an_exploding_cartesian_run_raises_and_names_the_row(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """MuJoCo resets a diverged state and only warns: the native Cartesian run
-    raises DivergedError with the row, the time and MuJoCo's words, as the
-    Python loop does, and the controller's clock is that of the steps it took."""
+    raises DivergedError with the row, the time and MuJoCo's words, as the run
+    calling it back does, and the controller's clock is that of the steps it took."""
     monkeypatch.chdir(tmp_path)  # MuJoCo writes its warnings to MUJOCO_LOG.TXT here
     model = mujoco.MjModel.from_xml_string(_FEATHER)
     chain = adaptimp.Chain.from_mujoco(model, "ee")
@@ -321,7 +323,7 @@ def test_an_exploding_cartesian_run_raises_and_names_the_row(
 
 def test_a_reference_given_as_arrays(sc: apt.PandaTable, basis: Any) -> None:
     """simulate(reference=(xc, dxc, ddxc)) tabulated at k·Ts: the run of the same
-    reference as a callable, in both loops, joint space and task space."""
+    reference as a callable, natively and called back, joint space and task space."""
     steps = 300
     rows = [sc.path(k * sc.Ts) for k in range(steps + 5)]
     table = tuple(np.array([r[i] for r in rows]) for i in range(3))
@@ -342,7 +344,7 @@ def test_a_reference_given_as_arrays(sc: apt.PandaTable, basis: Any) -> None:
             res = amj.simulate(
                 ctrl if native else _InPython(ctrl), plant, T=0.3, q0=sc.q0, reference=ref
             )
-            assert res.params["loop"] == ("native" if native else "python")
+            assert res.params["loop"] == ("native" if native else "callback")
             runs.append((ctrl, res))
     for ctrl, res in runs[1:]:
         _assert_same_run(res, runs[0][1], ctrl, runs[0][0])

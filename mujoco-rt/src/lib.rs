@@ -6,13 +6,17 @@
 //! loaded, so the same code and the same global state — and resolves the few
 //! functions a closed loop needs (`mj_step`, `mj_forward`, `mj_forwardSkip`,
 //! `mj_checkPos`, `mj_checkVel`, `mj_checkAcc`, `mj_Euler`, `mj_RungeKutta`,
-//! `mj_implicit`, `mj_getState`, `mj_jacSite`, `mj_jacBody`, `mju_warningText`,
-//! `mj_version`). [`Sim`] is a handle on one `mjModel` and its `mjData`
-//! whose arrays (`qpos`, `qvel`, `qacc`, `ctrl`, `qfrc_applied`,
-//! `sensordata`, `site_xpos`, `site_xmat`, `xpos`, the warning counters) are
-//! reached through the addresses the Python objects give (NumPy views of
-//! MuJoCo's own memory), never through `mjData`'s struct layout, which
-//! changes between MuJoCo versions.
+//! `mj_implicit`, `mj_getState`, `mj_jacSite`, `mj_jacBody`,
+//! `mj_rnePostConstraint`, `mju_warningText`, `mj_version`). [`Sim`] is a
+//! handle on one `mjModel` and its `mjData` whose arrays (`qpos`, `qvel`,
+//! `qacc`, `ctrl`, `qfrc_applied`, `sensordata`, `site_xpos`, `site_xmat`,
+//! `xpos`, `subtree_com`, `cfrc_ext`, the warning counters) are reached
+//! through the addresses the Python objects give (NumPy views of MuJoCo's
+//! own memory), never through `mjData`'s struct layout, which changes
+//! between MuJoCo versions. (So the contact list, `d->contact`, which lives
+//! in MuJoCo's per-step arena behind a pointer and a count of `mjData`'s
+//! own, is not read: the contact forces on a body are read from `cfrc_ext`,
+//! which `mj_rnePostConstraint` fills from that list.)
 //!
 //! Everything `unsafe` of adaptimp's MuJoCo support is in this crate, each
 //! block with its invariant. The API is safe: `Sim::from_python` (feature
@@ -103,6 +107,7 @@ pub struct Library {
     get_state: StateFn,
     jac_site: JacFn,
     jac_body: JacFn,
+    rne_post_constraint: StepFn,
     warning_text: TextFn,
     // Kept open for as long as the function pointers above are used.
     _lib: libloading::Library,
@@ -163,6 +168,7 @@ impl Library {
         let get_state = sym!(b"mj_getState\0", StateFn);
         let jac_site = sym!(b"mj_jacSite\0", JacFn);
         let jac_body = sym!(b"mj_jacBody\0", JacFn);
+        let rne_post_constraint = sym!(b"mj_rnePostConstraint\0", StepFn);
         let warning_text = sym!(b"mju_warningText\0", TextFn);
         // SAFETY: `mju_user_error` is the global `void (*)(const char*)` of
         // mujoco.h. It is read and written here only, under LIBRARIES' lock,
@@ -192,6 +198,7 @@ impl Library {
             get_state,
             jac_site,
             jac_body,
+            rne_post_constraint,
             warning_text,
             _lib: lib,
         });
@@ -328,6 +335,10 @@ pub struct RawParts {
     pub site_xmat: Span,
     /// `d->xpos` (3 nbody).
     pub xpos: Span,
+    /// `d->subtree_com` (3 nbody).
+    pub subtree_com: Span,
+    /// `d->cfrc_ext` (6 nbody).
+    pub cfrc_ext: Span,
     /// `d->warning`.
     pub warnings: Warnings,
     /// `m->nv`.
@@ -399,7 +410,8 @@ impl Sim {
     /// for `model`; every [`Span`] points into `data`'s memory with the
     /// length of that `mjData` field for `model` (`qpos`: nq, `qvel`, `qacc`,
     /// `qfrc_applied`: nv, `ctrl`: nu, `sensordata`: nsensordata, `site_xpos`:
-    /// 3 nsite, `site_xmat`: 9 nsite, `xpos`: 3 nbody), `warnings` addresses
+    /// 3 nsite, `site_xmat`: 9 nsite, `xpos`, `subtree_com`: 3 nbody,
+    /// `cfrc_ext`: 6 nbody), `warnings` addresses
     /// `data`'s warning counters and `nv` is `model`'s; all of it stays valid
     /// while `owner` lives, and nothing else writes to `data` or `model` while
     /// the handle exists.
@@ -481,6 +493,15 @@ impl Sim {
     pub fn xpos(&self) -> &[f64] {
         self.slice(self.p.xpos)
     }
+    /// `subtree_com` (3 per body): the centre of mass of each body's subtree.
+    pub fn subtree_com(&self) -> &[f64] {
+        self.slice(self.p.subtree_com)
+    }
+    /// `cfrc_ext` (6 per body, [torque; force] about the `subtree_com` of
+    /// the body's root, world frame) of the last [`Sim::rne_post_constraint`].
+    pub fn cfrc_ext(&self) -> &[f64] {
+        self.slice(self.p.cfrc_ext)
+    }
     /// `ctrl` (nu), writable.
     pub fn ctrl_mut(&mut self) -> &mut [f64] {
         self.slice_mut(self.p.ctrl)
@@ -542,6 +563,16 @@ impl Sim {
         let (f, m, d) = (self.lib.forward_skip, self.p.model, self.p.data);
         // SAFETY: as `step`.
         guarded(|| unsafe { f(m, d, STAGE_VEL, 1) })
+    }
+
+    /// `mj_rnePostConstraint`: the external forces on every body (`cfrc_ext`:
+    /// the contacts' and the equality constraints' forces, and
+    /// `xfrc_applied`) at the last forward computation, with `cacc` and
+    /// `cfrc_int`. Changes nothing a later step reads.
+    pub fn rne_post_constraint(&mut self) -> Result<(), Error> {
+        let (f, m, d) = (self.lib.rne_post_constraint, self.p.model, self.p.data);
+        // SAFETY: as `step`.
+        guarded(|| unsafe { f(m, d) })
     }
 
     /// The simulation time `d->time` (s), through `mj_getState`.

@@ -179,6 +179,8 @@ impl Sim {
             site_xpos: span(data, "site_xpos", 3 * nsite, false, &mut keep)?,
             site_xmat: span(data, "site_xmat", 9 * nsite, false, &mut keep)?,
             xpos: span(data, "xpos", 3 * nbody, false, &mut keep)?,
+            subtree_com: span(data, "subtree_com", 3 * nbody, false, &mut keep)?,
+            cfrc_ext: span(data, "cfrc_ext", 6 * nbody, false, &mut keep)?,
             warnings: warnings(data, &mut keep)?,
             nv,
         };

@@ -33,6 +33,7 @@ __all__ = [
     "simulate",
     "simulate_many",
     "simulate_mujoco",
+    "simulate_mujoco_callback",
     "simulate_mujoco_many",
     "suggest",
     "table_metrics",
@@ -436,6 +437,27 @@ def simulate_mujoco(
 ) -> dict[str, Any]:
     """The closed loop on a MuJoCo MjModel/MjData with the GIL released (SPEC §13.2)."""
 
+def simulate_mujoco_callback(
+    controller: Any,
+    model: Any,
+    data: Any,
+    spec: dict[str, Any],
+    params: dict[str, Any],
+    ts: float,
+    t_final: float,
+    settle: float,
+    table: tuple[_F, _F, _F],
+    *,
+    setpoint: bool,
+    wants_wrench: bool,
+    attrs: list[str],
+    target: tuple[list[float], list[float], list[float]],
+    record_every: int = 1,
+    progress: Callable[[int, int], object] | None = None,
+    fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
+) -> dict[str, Any]:
+    """The closed loop on MuJoCo of a controller written in Python, called back once a period."""
+
 def simulate_mujoco_many(
     jobs: Sequence[
         tuple[
@@ -704,3 +726,17 @@ class ComputedTorque:
     def mass_matrix(self, q: ArrayLike) -> _F:
         """M(q) (kg m²), (n, n)."""
     def last(self, what: str) -> _F: ...
+    def simulate_mujoco(
+        self,
+        model: Any,
+        data: Any,
+        spec: dict[str, Any],
+        params: dict[str, Any],
+        t_final: float,
+        settle: float,
+        reference: tuple[_F, _F, _F],
+        record_every: int = 1,
+        progress: Callable[[int, int], object] | None = None,
+        fault: tuple[str, float, float, list[float] | None, float | None] | None = None,
+    ) -> dict[str, Any]:
+        """The closed loop on MuJoCo in joint space along ``reference`` (every row)."""

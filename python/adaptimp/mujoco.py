@@ -5,14 +5,14 @@ rest of adaptimp never imports it.
 
 - :class:`Plant` wraps a MuJoCo model of a serial arm with n ≤ 7 hinge joints,
   one torque actuator (``motor``) per joint: it reads τmax from the actuators'
-  ``ctrlrange``, lets MuJoCo's constraint solver compute contact, and measures
-  the force the arm exerts on its environment, mapped to joint space as
-  τe = Jᵀ F_e.
-- :func:`simulate` closes the loop: any controller with
-  ``.step(q, tau_e, dq=None, **setpoint)`` and a period ``.Ts`` (s),
-  or one of the paper's cases by name, runs at Ts with the torque held over
-  ``substeps`` MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12
-  metrics.
+  ``ctrlrange`` and says where the core's loop measures the force the arm
+  exerts on its environment (mapped to joint space as τe = Jᵀ F_e); MuJoCo's
+  constraint solver computes contact.
+- :func:`simulate` closes the loop, the core's (SPEC §13.1): any controller
+  with ``.step(q, tau_e, dq=None, **setpoint)`` and a period ``.Ts`` (s)
+  (:class:`ControllerLike`, called back once a period), or one of the
+  paper's cases by name, runs at Ts with the torque held over ``substeps``
+  MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12 metrics.
 - Models: :func:`two_link` (the paper's arm, packaged as ``models/two_link.xml``),
   :func:`panda` (the Franka Emika Panda of ``example-robot-data``, arm only, on a
   table), :func:`from_urdf` (any URDF arm, with motors from its effort limits).
@@ -23,14 +23,15 @@ if any, for the moment; without one the moment is taken as zero). MuJoCo's
 force/torque sensors measure the wrench between the site's body and its parent,
 so the site should sit on a massless body welded to the last link, holding the
 contact geometry: then the reading is exactly the contact wrench (the packaged
-models do this). Without a force sensor, F_e is the sum over the active
-contacts of the end-effector body's subtree with anything outside it of
-``mj_contactForce``, with the moment about the end-effector point (the first
-site on the last joint's body, or that body's origin): read from MuJoCo's
-contact list, or, for a model :class:`Plant` loads from a file and in which no
-contact can arise inside that subtree, from a contact sensor it adds (the net
-contact wrench on the subtree, ``reduce="netforce"``; it changes no dynamics),
-which the core's loop reads. :attr:`Plant.wrench_source` says which is used.
+models do this). Without a force sensor, F_e is the net force of the active
+contacts between the end-effector body's subtree and anything outside it,
+with the moment about the end-effector point (the first site on the last
+joint's body, or that body's origin): for a model :class:`Plant` loads from a
+file and in which no contact can arise inside that subtree, from a contact
+sensor it adds (the net contact wrench on the subtree, ``reduce="netforce"``;
+it changes no dynamics); otherwise from the external forces MuJoCo sums from
+its contact list on each body of the subtree (``cfrc_ext``: a contact inside
+the subtree cancels). :attr:`Plant.wrench_source` says which is used.
 
 Units: rad, rad/s, rad/s², N, N m, m, s. Vectors in the world frame.
 """
@@ -39,8 +40,9 @@ from __future__ import annotations
 
 import copy
 import math
+import numbers
 import os
-import time
+import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -104,23 +106,33 @@ ModelSource = Union["mujoco.MjModel", str, "os.PathLike[str]"]
 
 
 class ControllerLike(Protocol):
-    """What :func:`simulate` needs of a controller: a step and a period.
+    """What :func:`simulate` needs of a controller written in Python: a step and
+    a period. The core's loop calls it back once a period (with the GIL taken
+    for the call; the rest of the loop runs without it).
 
-    ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,);
-    ``setpoint`` is ``xc=, dxc=, ddxc=`` when :func:`simulate` is given a
-    ``reference``, nothing otherwise (the controller then follows its own
-    trajectory). The period is ``.Ts`` (s; ``.ts`` is read, deprecated). Optional attributes
-    that :func:`simulate` records when present: ``tau`` (commanded torque
-    before saturation), ``xc`` and, without a ``reference``, ``dxc``, ``ddxc``
-    (the controller's own commanded rates), ``xd``, ``z1``, ``dq_hat``,
-    ``zeta``, and ``params`` (a dict; ``xc_offset``, ``xc_sin``, ``xc_cos``,
-    ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for the metrics when present).
+    ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,)
+    (or one number for every joint; saturated by the motors); q, tau_e, dq
+    are what the loop's sensors read (with the disturbances of SPEC §17 and a
+    fault, if any); ``setpoint`` is ``xc=, dxc=, ddxc=`` (the row's) when
+    :func:`simulate` is given a ``reference``, nothing otherwise (the
+    controller then follows its own trajectory). The period is ``.Ts`` (s;
+    ``.ts`` is read, deprecated). Optional attributes that :func:`simulate`
+    records when present: ``zeta`` (read before the step), then, after it,
+    ``xc`` and, without a ``reference``, ``dxc``, ``ddxc`` (the controller's
+    own commanded rates), ``xd``, ``z1``, ``dq_hat``, ``tau`` (commanded
+    torque before saturation); and ``params`` (a dict; ``xc_offset``,
+    ``xc_sin``, ``xc_cos``, ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for
+    the metrics when present). An exception raised by ``step`` (or a torque of
+    another shape) ends the run with it; a torque that is not finite ends it
+    too (``ValueError``), unless a fault is injected: then the step is
+    refused, as the core's controllers' are, and zero torque applied.
 
     Cartesian hook: a controller with ``wants_wrench = True`` is called as
     ``step(q, dq, wrench, **setpoint)`` instead, with the measured wrench
     F_e = [f; m] (6,), N and N m, world frame (the plant's measurement of the
     row, the one τe is computed from) in place of τe, e.g.
-    :class:`adaptimp.CartesianController` (which maps it to the joints itself).
+    :class:`adaptimp.CartesianController` (which maps it to the joints
+    itself); its ``xc``, ``xd``, ``z1`` are then of width 3.
     """
 
     def step(
@@ -432,7 +444,8 @@ class Plant:
     wrench_source : str
         ``"sensor"`` (force/torque sensor), ``"contact sensor"`` (the net contact
         wrench on the end effector's subtree, a MuJoCo contact sensor) or
-        ``"contact"`` (MuJoCo's contact list, ``mj_contactForce``).
+        ``"contact"`` (the contacts' forces on the subtree's bodies, which
+        MuJoCo sums from its contact list: ``cfrc_ext``).
     site : str or None
         The end-effector site asked for (None: found as above).
     """
@@ -459,8 +472,6 @@ class Plant:
             self._setup_model(spec.compile(), site)
         m = self.model
         self.data = mujoco.MjData(m)
-        self._jac = np.zeros((6, m.nv))
-        self._jacp, self._jacr = self._jac[:3], self._jac[3:]
         self._mass = np.zeros((m.nv, m.nv))
         self.reset()
 
@@ -475,8 +486,9 @@ class Plant:
         self._find_end_effector(site)
 
     def _contact_sensor_fits(self, source: ModelSource) -> bool:
-        """Whether a contact sensor can measure this plant's wrench exactly as
-        :meth:`contact_wrench` defines it: the model comes from an MJCF file (so
+        """Whether a contact sensor can measure this plant's wrench as the module
+        doc defines it (the contacts of the subtree with anything outside it):
+        the model comes from an MJCF file (so
         it can be rebuilt with the sensor; :func:`from_urdf` gives no contact
         geometry), a contact can reach the end effector, and no contact can
         arise inside its subtree (the sensor would count it; the contact list
@@ -685,11 +697,6 @@ class Plant:
         return np.array(self.data.qvel[self._dofs], dtype=np.float64)
 
     @property
-    def ddq(self) -> FloatArray:
-        """Joint accelerations (rad/s²), (n,), of the last :meth:`forward`."""
-        return np.array(self.data.qacc[self._dofs], dtype=np.float64)
-
-    @property
     def timestep(self) -> float:
         """MuJoCo's timestep (s)."""
         return float(self.model.opt.timestep)
@@ -700,80 +707,7 @@ class Plant:
             raise ValueError(f"timestep must be > 0, got {value}")
         self.model.opt.timestep = value
 
-    # -- dynamics ------------------------------------------------------------
-
-    def forward(self) -> None:
-        """``mj_forward``: kinematics, contact, sensors and q̈ at the current
-        state and applied torque."""
-        mujoco.mj_forward(self.model, self.data)
-
-    def apply(self, tau: ArrayLike) -> FloatArray:
-        """Hold the torque sat(τ) (N m), (n,), from now on; returns sat(τ)."""
-        tau = np.asarray(tau, dtype=np.float64)
-        if tau.shape != (self.n,) or not math.isfinite(float(tau.sum())):
-            tau = self._vector("tau", tau)  # raises the precise error
-        tau_sat = np.minimum(np.maximum(tau, -self.tau_max), self.tau_max)
-        self.data.ctrl[self._act] = tau_sat / self._gear
-        return tau_sat
-
-    def step(self, substeps: int = 1, *, row: int | None = None, Ts: float | None = None) -> None:
-        """Advance ``substeps`` MuJoCo steps with the applied torque held.
-
-        MuJoCo resets its state on a bad position, velocity or acceleration
-        and only counts a warning (``data.warning``); a step after which
-        MuJoCo warned, whose time did not advance by ``substeps`` timesteps,
-        or whose state is not finite raises.
-
-        Parameters
-        ----------
-        substeps : int
-            MuJoCo steps.
-        row, Ts : int and float, optional
-            The loop's row k and period (s), named in the error.
-
-        Raises
-        ------
-        DivergedError
-            Naming the row (if given), the time and MuJoCo's warning with its
-            joint (e.g. "Nan, Inf or huge value in QACC at DOF 1 … (joint
-            'j1')").
-        """
-        m, d = self.model, self.data
-        before = d.warning.number.copy()
-        t0 = expected = float(d.time)
-        for _ in range(substeps):
-            mujoco.mj_step(m, d)
-            expected += m.opt.timestep
-        warned = np.flatnonzero(d.warning.number != before)
-        reset = abs(float(d.time) - expected) > 0.5 * m.opt.timestep
-        finite = math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum()))
-        if warned.size == 0 and not reset and finite:
-            return
-        from ._errors import DivergedError
-
-        if warned.size:
-            i = int(warned[0])
-            info = int(d.warning.lastinfo[i])
-            name = mujoco.mjtWarning(i).name
-            text = mujoco.mju_warningText(i, max(info, 0))
-            joint = ""
-            if name in _DOF_WARNINGS and 0 <= info < m.nv:
-                joint = f' (joint "{_name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[info]))}")'
-            now, want = _num(d.time), _num(expected)
-            note = f"; MuJoCo reset its state (its time is {now} s, not {want} s)" if reset else ""
-            cause = f"MuJoCo warned {name}: {text}{joint}{note}"
-        elif not finite:
-            cause = "the state is not finite"
-        else:
-            now, want = _num(d.time), _num(expected)
-            cause = f"MuJoCo's time is {now} s, not {want} s (its state was reset)"
-        if row is None or Ts is None:
-            where = f"from t = {_num(t0)} s"
-        else:
-            where = (
-                f"in the period of row {row} (t = {_num(row * Ts)} s to {_num((row + 1) * Ts)} s)"
-            )
-        raise DivergedError(f"the MuJoCo plant diverged {where}: {cause}")
+    # -- the model, as the core's loop and the rule read it -------------------
 
     def _contact_possible(self) -> bool:
         """Whether a contact can involve the end effector's subtree (contact
@@ -789,14 +723,15 @@ class Plant:
         ct, ca = m.geom_contype, m.geom_conaffinity
         return any((ct[a] & ca[b]) or (ct[b] & ca[a]) for a in inside for b in outside)
 
-    def _native(self, substeps: int) -> dict[str, Any] | None:
-        """The plant as the core's native loop takes it (SPEC §13.1), or None
-        if the core cannot measure its wrench (no force sensor and contacts
-        possible: the contact path reads MuJoCo's contact list, which only
-        the Python loop does)."""
+    def _core_spec(self, substeps: int) -> dict[str, Any]:
+        """The plant as the core's loop drives it (SPEC §13.1): where its joints,
+        motors and end effector are, and where the wrench is read: the force
+        (and torque) sensor, the contact sensor, or, without either when a
+        contact can reach the end effector, the external forces MuJoCo sums
+        from its contact list on each body of the end effector's subtree
+        (``subtree``, ``cfrc_ext``)."""
         m = self.model
-        if self.wrench_source == "contact" and self._contact_possible():
-            return None
+        listed = self.wrench_source == "contact" and self._contact_possible()
         return {
             "qadr": [int(a) for a in self._qadr],
             "dofs": [int(a) for a in self._dofs],
@@ -808,6 +743,8 @@ class Plant:
             "force_adr": int(self._force_adr) if self._force_adr >= 0 else None,
             "torque_adr": int(self._torque_adr) if self._torque_adr >= 0 else None,
             "contact_adr": int(self._contact_adr) if self._contact_adr >= 0 else None,
+            "subtree": sorted(int(b) for b in self._ee_subtree) if listed else [],
+            "root": int(m.body_rootid[self._ee_body]),
             "substeps": int(substeps),
             "timestep": float(m.opt.timestep),
             "integrator": int(m.opt.integrator),
@@ -825,116 +762,6 @@ class Plant:
     def bias(self) -> FloatArray:
         """C(q, q̇) q̇ + G(q) (N m), (n,), of the last :meth:`forward`."""
         return np.array(self.data.qfrc_bias[self._dofs], dtype=np.float64)
-
-    # -- end effector ----------------------------------------------------------
-
-    def ee_position(self) -> FloatArray:
-        """End-effector point (m), (3,), in the world frame."""
-        d = self.data
-        point = d.site_xpos[self._site] if self._site >= 0 else d.xpos[self._ee_body]
-        return np.array(point, dtype=np.float64)
-
-    def jacobian(self) -> FloatArray:
-        """End-effector Jacobian (6, n): linear velocity of the end-effector point
-        (m/s) over angular velocity (rad/s), world frame, per joint velocity."""
-        m, d = self.model, self.data
-        if self._site >= 0:
-            mujoco.mj_jacSite(m, d, self._jacp, self._jacr, self._site)
-        else:
-            mujoco.mj_jacBody(m, d, self._jacp, self._jacr, self._ee_body)
-        return self._jac[:, self._dofs]
-
-    def wrench(self) -> FloatArray:
-        """F_e = [f; m], (6,): the force (N) and the moment about the end-effector
-        point (N m) that the arm exerts on its environment, world frame, of the
-        last :meth:`forward` (from the sensor or the contacts, see the module doc)."""
-        if self._force_adr >= 0:
-            return self.sensor_wrench()
-        if self._contact_adr >= 0:
-            return self.contact_sensor_wrench()
-        return self.contact_wrench()
-
-    def contact_sensor_wrench(self) -> FloatArray:
-        """F_e (6,) from the model's contact sensor of the net contact wrench on the
-        end effector's subtree (force f and torque t about the force-weighted
-        centroid c of the contacts, world frame): [f; t + (c − p) × f], p the
-        end-effector point (summed in the order of the core's native loop).
-
-        Raises
-        ------
-        ValueError
-            The model has no such sensor.
-        """
-        if self._contact_adr < 0:
-            raise ValueError("the model has no contact sensor at the end effector")
-        a = self._contact_adr
-        f, t, c = (self.data.sensordata[a + 3 * i : a + 3 * i + 3] for i in range(3))
-        d = c - self.ee_position()
-        out = np.zeros(6)
-        out[:3] = f
-        out[3] = t[0] + (d[1] * f[2] - d[2] * f[1])
-        out[4] = t[1] + (d[2] * f[0] - d[0] * f[2])
-        out[5] = t[2] + (d[0] * f[1] - d[1] * f[0])
-        return out
-
-    def sensor_wrench(self) -> FloatArray:
-        """F_e (6,) from the force/torque sensors (world frame; see :meth:`wrench`).
-
-        MuJoCo's force sensor gives the force of the site's body on its parent,
-        in the site frame: for a massless end-effector body, the force it exerts
-        on the environment.
-
-        Raises
-        ------
-        ValueError
-            The model has no force sensor at the end effector.
-        """
-        d = self.data
-        if self._force_adr < 0:
-            raise ValueError("the model has no force sensor at the end effector")
-        out = np.zeros(6)
-        rot = d.site_xmat[self._site].reshape(3, 3)
-        out[:3] = _rotate(rot, d.sensordata[self._force_adr : self._force_adr + 3])
-        if self._torque_adr >= 0:
-            out[3:] = _rotate(rot, d.sensordata[self._torque_adr : self._torque_adr + 3])
-        return out
-
-    def contact_wrench(self) -> FloatArray:
-        """F_e (6,) summed over the active contacts of the end-effector body's
-        subtree with anything else, by ``mj_contactForce`` (world frame; the
-        moment about the end-effector point)."""
-        m, d = self.model, self.data
-        out = np.zeros(6)
-        point = self.ee_position()
-        local = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            if c.efc_address < 0:
-                continue
-            b1 = int(m.geom_bodyid[c.geom1]) in self._ee_subtree
-            b2 = int(m.geom_bodyid[c.geom2]) in self._ee_subtree
-            if b1 == b2:
-                continue
-            mujoco.mj_contactForce(m, d, i, local)
-            frame = c.frame.reshape(3, 3)
-            # The force geom1 exerts on geom2, rotated from the contact frame.
-            f = frame.T @ local[:3]
-            t = frame.T @ local[3:]
-            sign = 1.0 if b1 else -1.0
-            out[:3] += sign * f
-            out[3:] += sign * (np.cross(c.pos - point, f) + t)
-        return out
-
-    def tau_e(self, wrench: FloatArray | None = None) -> FloatArray:
-        """τe = Jᵀ F_e (N m), (n,): the wrench on the environment in joint space
-        (of :meth:`wrench`, or of ``wrench`` if given)."""
-        w = self.wrench() if wrench is None else np.asarray(wrench, dtype=np.float64)
-        jac = self.jacobian()
-        # Σ_r J[r, i] F[r] in the order of the core's native loop (the same bits).
-        out = jac[0] * w[0]
-        for r in range(1, 6):
-            out = out + jac[r] * w[r]
-        return np.asarray(out, dtype=np.float64)
 
     def __repr__(self) -> str:
         name = self.model.names[: self.model.names.find(b"\0")].decode() or "model"
@@ -964,21 +791,6 @@ _NETFORCE_DATA = sum(
 def _warning_names() -> list[str]:
     """MuJoCo's warning kinds by index (``mjtWarning``, without ``mjNWARNING``)."""
     return [mujoco.mjtWarning(i).name for i in range(int(mujoco.mjtWarning.mjNWARNING))]
-
-
-def _num(x: float) -> str:
-    """A float as the core's messages print it (Rust's shortest form: 0, 0.001)."""
-    text = repr(float(x))
-    return text[:-2] if text.endswith(".0") else text
-
-
-def _rotate(rot: FloatArray, v: FloatArray) -> FloatArray:
-    """R v for a 3 × 3 R, summed in the order of the core's native loop (the same bits)."""
-    return np.asarray(rot[:, 0] * v[0] + rot[:, 1] * v[1] + rot[:, 2] * v[2], dtype=np.float64)
-
-
-_DOF_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC", "mjWARN_INERTIA")
-"""MuJoCo's warnings whose info is a DOF (hinges: the joint's qpos and DOF index agree)."""
 
 
 def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
@@ -1305,15 +1117,17 @@ class MujocoResult(SimResult):
         and rates, = ``xc``, ``dxc``, ``ddxc``), "pd", "dpd", "ddpd" (the compliant
         reference, ``xd`` = pd), "qd" (the joint reference, (K, n)), "wrench" (the
         F_e it was given, (K, 6)), "error" (the impedance's [e_p; e_o], (K, 6)).
-        None for a joint-space controller (and in the Python loop for a Cartesian
-        one with ``record=False``).
+        None for a joint-space controller (and for a Cartesian one called back
+        with ``record=False``).
     metrics : dict
         The SPEC §12 metrics, with the keys of :attr:`adaptimp.SimResult.metrics`
         (NaN where they do not apply: ``imp_err_rms_after2`` needs a joint-space
         reference).
     params : dict
         The run: ``Ts``, ``substeps``, ``timestep``, ``T``, ``settle``,
-        ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``controller``.
+        ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``controller``,
+        ``loop`` (``"native"``: the core stepped the controller;
+        ``"callback"``: the core's loop called a controller written in Python).
     """
 
     x_ee: FloatArray | None = None
@@ -1433,6 +1247,18 @@ def _native(ctrl: Any) -> bool:
     return isinstance(ctrl, _adaptimp.Controller) and type(ctrl).step is _adaptimp.Controller.step
 
 
+def _native_computed(ctrl: Any) -> bool:
+    """Whether the core can step ``ctrl`` as it is in joint space: an
+    :class:`adaptimp.baselines.ComputedTorque` (its own ``step``, the core's
+    law of SPEC §20)."""
+    baselines = sys.modules.get("adaptimp.baselines")
+    return (
+        baselines is not None
+        and isinstance(ctrl, baselines.ComputedTorque)
+        and isinstance(ctrl._core_joint, _adaptimp.ComputedTorque)
+    )
+
+
 def _native_cartesian(ctrl: Any) -> bool:
     """Whether the core can step ``ctrl`` as a whole: an
     :class:`adaptimp.CartesianController` (its own ``step``) in front of a
@@ -1448,14 +1274,17 @@ def _native_cartesian(ctrl: Any) -> bool:
 
 
 def _tabulate(
-    reference: Reference, steps: int, Ts: float
+    reference: Reference, steps: int, Ts: float, k0: int = 0
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """``reference(k·Ts)`` for every row k, as three (K, m) arrays (called in
-    order, once per row, as the loop would; a table's own rows)."""
-    if isinstance(reference, _Table) and math.isclose(reference.Ts, Ts, rel_tol=1e-12):
+    """``reference((k0 + k)·Ts)`` for every row k, as three (K, m) arrays
+    (called in order, once per row, as the loop would; a table's own rows)."""
+    if isinstance(reference, _Table) and math.isclose(reference.Ts, Ts, rel_tol=1e-12) and not k0:
         xc, dxc, ddxc = (np.ascontiguousarray(a[:steps]) for a in reference.arrays)
         return xc, dxc, ddxc
-    rows = [tuple(np.asarray(v, dtype=np.float64) for v in reference(k * Ts)) for k in range(steps)]
+    rows = [
+        tuple(np.asarray(v, dtype=np.float64) for v in reference((k0 + k) * Ts))
+        for k in range(steps)
+    ]
     xc, dxc, ddxc = (np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
     return xc, dxc, ddxc
 
@@ -1550,14 +1379,14 @@ def simulate(
     saturated to the actuators' τmax and held for ``substeps`` MuJoCo steps of
     Ts / substeps each (SPEC §13.1).
 
-    An ``adaptimp.Controller`` (or a case name) runs in the compiled core: the
-    loop, the recording and the metrics are the core's, MuJoCo is driven
-    through its C library, the GIL is released (Ctrl-C is honoured within
-    0.1 s). Any other controller (:class:`ControllerLike`, e.g.
-    :class:`adaptimp.baselines.ComputedTorque`) is stepped from a Python loop
-    with the same semantics and the core's metrics, as is a model without a
-    force sensor whose end effector can touch something (its wrench comes
-    from MuJoCo's contact list, which only the Python loop reads).
+    The loop, the recording and the metrics are the compiled core's, MuJoCo
+    is driven through its C library and the GIL is released (Ctrl-C is
+    honoured within 0.2 s, also within a period of many substeps). The core
+    steps an ``adaptimp.Controller`` (or a case name), an
+    :class:`adaptimp.CartesianController` in front of one (or of computed
+    torque) and :class:`adaptimp.baselines.ComputedTorque` itself; any other
+    controller (:class:`ControllerLike`) is called back once a period, with
+    the GIL taken for that call (``params["loop"]`` is then ``"callback"``).
 
     Parameters
     ----------
@@ -1576,8 +1405,9 @@ def simulate(
         scenario's (``"robot"``: 1 ms, ``"paper"``: 50 µs). Must equal the
         period of a given controller.
     substeps : int, optional
-        MuJoCo steps per period; MuJoCo's timestep becomes Ts / substeps.
-        Default: round(Ts / the model's timestep), at least 1.
+        MuJoCo steps per period, 1 ≤ substeps ≤ 10 000; MuJoCo's timestep
+        becomes Ts / substeps. Default: round(Ts / the model's timestep), at
+        least 1.
     q0, dq0 : array_like, optional
         Initial joint positions (rad) and velocities (rad/s); default the
         default task's start (below), else the model's first keyframe (the
@@ -1605,7 +1435,7 @@ def simulate(
         as ``progress(done, total)`` about every 50 ms, and once when the run ends.
     fault : adaptimp.Fault, optional
         A fault injected over a window, as for :func:`adaptimp.simulate` (the
-        actuators' τmax for ``"actuator_drop"``); needs the native loop.
+        actuators' τmax for ``"actuator_drop"``), for any controller.
     payload : float
         A point mass (kg, ≥ 0) at the end effector's link of the plant only
         (:func:`with_payload`); the controller's gains come from the arm
@@ -1674,60 +1504,141 @@ def simulate(
     from ._api import _progress
 
     callback, bar = _progress(progress, "mujoco.simulate")
+    core_fault = None if fault is None else fault._core(run.plant.n)
     try:
-        if run.native and run.cartesian:
-            out = _cartesian_loop(run, run.reference, callback, fault)
-            m = out.pop("metrics")
-        elif run.native:
-            assert run.spec is not None
-            refs = None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts)
-            core_fault = None if fault is None else fault._core(run.plant.n)
-            out = _adaptimp.simulate_mujoco(
-                run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
-                run.settle, run.every, callback, refs, core_fault,
-            )  # fmt: skip
-            m = out.pop("metrics")
-        else:
-            if fault is not None:
-                raise TypeError(
-                    "fault= needs a controller the core steps (an adaptimp.Controller or a "
-                    "case name) and a plant with a force sensor or no possible contact; this "
-                    "run steps its controller from Python"
-                )
-            out, m = _python_loop(run, run.reference, callback)
+        out = _LOOPS[run.kind](run, callback, core_fault)
     finally:
         if bar is not None:
             bar.close()
-    res = _result(run, out, m)
+    res = _result(run, out, out.pop("metrics"))
     if task is not None:
         task.measure(res)
     return res
 
 
+def _native_loop(
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
+) -> dict[str, Any]:
+    """An ``adaptimp.Controller`` stepped by the core, along its own
+    trajectory or the run's reference tabulated at t_k."""
+    refs = None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts)
+    out: dict[str, Any] = _adaptimp.simulate_mujoco(
+        run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T, run.settle,
+        run.every, progress, refs, fault,
+    )  # fmt: skip
+    return out
+
+
 def _cartesian_loop(
-    run: _Run,
-    reference: Reference | None,
-    progress: Callable[[int, int], object] | None,
-    fault: Fault | None,
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
 ) -> dict[str, Any]:
     """The native loop of an :class:`adaptimp.CartesianController` whose joint
     controller the core steps: its commanded pose tabulated for every row
     (the reference at t_k, else its path on its own clock), then the core's
     loop; the controller's Python side brought up to date, whatever happens."""
-    assert run.spec is not None
-    ctrl = run.ctrl
+    ctrl, reference = run.ctrl, run.reference
     table = reference.arrays if isinstance(reference, _Table) else reference
     targets = ctrl._targets(run.steps, table)
-    core_fault = None if fault is None else fault._core(run.plant.n)
     out: dict[str, Any] | None = None
     try:
         out = ctrl.outer.core.simulate_mujoco(
             ctrl._joint, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
-            run.settle, run.every, progress, targets, core_fault,
+            run.settle, run.every, progress, targets, fault,
         )  # fmt: skip
     finally:
         ctrl._ran(targets, None if out is None else out["task"])
+    assert out is not None
     return out
+
+
+def _computed_loop(
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
+) -> dict[str, Any]:
+    """:class:`adaptimp.baselines.ComputedTorque` stepped by the core in joint
+    space, along the run's reference or its own trajectory, tabulated at its
+    t_k = (k0 + k)·Ts (k0 the steps it took before), as its ``step`` samples it."""
+    ctrl, Ts = run.ctrl, run.Ts
+    if run.reference is not None:
+        refs = _tabulate(run.reference, run.steps, Ts)
+    else:
+        if ctrl._trajectory is None:
+            raise ValueError("no setpoint given and no trajectory to follow")
+        k0 = int(ctrl._core.steps)
+        refs = _tabulate(lambda t: ctrl._trajectory(t), run.steps, Ts, k0)
+    out: dict[str, Any] = ctrl._core.simulate_mujoco(
+        run.plant.model, run.plant.data, run.spec, run.dist, run.T, run.settle, refs,
+        run.every, progress, fault,
+    )  # fmt: skip
+    return out
+
+
+_ATTRIBUTES = ("tau", "xc", "dxc", "ddxc", "xd", "z1", "dq_hat", "zeta")
+"""The attributes of a controller written in Python that a run records (ControllerLike)."""
+
+
+def _callback_loop(
+    run: _Run, progress: Callable[[int, int], object] | None, fault: Any
+) -> dict[str, Any]:
+    """A controller written in Python in the core's loop, called back once a
+    period (the protocol :class:`ControllerLike`): its setpoint (the
+    reference's rows) and the attributes it has, the rates of its own
+    trajectory (if its params declare one), and its target impedance for
+    the metrics, given to the core."""
+    ctrl, n, steps, Ts = run.ctrl, run.plant.n, run.steps, run.Ts
+    wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
+    width = 3 if wants_wrench else n
+    has = {name: hasattr(ctrl, name) for name in _ATTRIBUTES}
+    reference = run.reference
+    own_rates = reference is None and has["dxc"] and has["ddxc"]
+    if reference is not None:
+        table = _tabulate(reference, steps, Ts)
+    else:
+        nan = np.full((steps, width), math.nan)
+        # The rates of its own joint-space sinusoid, if its params declare one.
+        rates = None if own_rates or wants_wrench else _builtin_rates(ctrl, steps, Ts)
+        table = (nan, *(rates or (nan, nan)))
+    attrs = [name for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta") if has[name]]
+    cparams = getattr(ctrl, "params", None)
+    cparams = cparams if isinstance(cparams, Mapping) else {}
+    target = tuple(
+        np.broadcast_to(np.asarray(cparams.get(k, v), dtype=np.float64), (n,)).tolist()
+        for k, v in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0))
+    )
+    out: dict[str, Any] = _adaptimp.simulate_mujoco_callback(
+        ctrl, run.plant.model, run.plant.data, run.spec, run.dist, Ts, run.T, run.settle, table,
+        setpoint=reference is not None, wants_wrench=wants_wrench,
+        attrs=attrs + (["rates"] if own_rates else []), target=target, record_every=run.every,
+        progress=progress, fault=fault,
+    )  # fmt: skip
+    # A task-space controller's own log of this run (adaptimp.CartesianController.arrays).
+    log = getattr(ctrl, "arrays", None) if wants_wrench and getattr(ctrl, "record", False) else None
+    if callable(log):
+        out["task"] = {k: v[len(v) - steps :: run.every] for k, v in log().items()}
+    return out
+
+
+def _builtin_rates(ctrl: Any, steps: int, Ts: float) -> tuple[FloatArray, FloatArray] | None:
+    """ẋc, ẍc of every row of the controller's own sinusoid, if its params
+    declare one (for the impedance metric), on its clock from the steps it
+    says it took."""
+    builtin = _builtin_reference(ctrl)
+    if builtin is None:
+        return None
+    k0 = getattr(ctrl, "steps", 0)
+    k0 = k0 if isinstance(k0, int) else 0
+    # (sinusoid's reference broadcasts: one row per time.)
+    own = (k0 + np.arange(steps, dtype=np.float64)) * Ts
+    _, dxc, ddxc = builtin(own[:, None])  # type: ignore[arg-type]
+    return np.ascontiguousarray(dxc, dtype=np.float64), np.ascontiguousarray(ddxc, dtype=np.float64)
+
+
+_LOOPS: dict[str, Callable[[_Run, Callable[[int, int], object] | None, Any], dict[str, Any]]] = {
+    "native": _native_loop,
+    "cartesian": _cartesian_loop,
+    "computed": _computed_loop,
+    "callback": _callback_loop,
+}
+"""How the core's loop takes each kind of controller (:func:`_setup` says which)."""
 
 
 @dataclass
@@ -1745,13 +1656,50 @@ class _Run:
     steps: int
     every: int
     dist: dict[str, Any]
-    spec: dict[str, Any] | None
-    native: bool
+    spec: dict[str, Any]
+    kind: str
     reference: Reference | None
     task: Task | None
     payload: float
     q0: FloatArray
-    cartesian: bool = False
+
+
+MAX_SUBSTEPS = 10_000
+"""The most MuJoCo steps per control period (the core's bound)."""
+
+
+def _check_arguments(T: object, Ts: object, substeps: object) -> None:
+    """``T`` and ``Ts`` real numbers (s) or None, ``substeps`` an integer in
+    1 … :data:`MAX_SUBSTEPS` or None: refused by name before any work."""
+    for name, value in (("T", T), ("Ts", Ts)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, numbers.Real)):
+            raise TypeError(f"{name} must be a real number (s), got {type(value).__name__}")
+    if substeps is None:
+        return
+    if isinstance(substeps, bool) or not isinstance(substeps, numbers.Integral):
+        raise TypeError(
+            f"substeps must be an integer (MuJoCo steps per period), got {type(substeps).__name__}"
+        )
+    if not 1 <= int(substeps) <= MAX_SUBSTEPS:
+        raise ConfigError(
+            f"condition 1 ≤ substeps ≤ 10 000 is violated: substeps = {int(substeps)} "
+            "(MuJoCo steps per period)"
+        )
+
+
+def _kind(ctrl: Any) -> str:
+    """How the core's loop takes ``ctrl``: ``"native"`` (an
+    ``adaptimp.Controller``), ``"cartesian"`` (an
+    :class:`adaptimp.CartesianController` in front of a joint controller the
+    core steps), ``"computed"`` (computed torque in joint space) or
+    ``"callback"`` (written in Python: called back once a period)."""
+    if _native_cartesian(ctrl):
+        return "cartesian"
+    if getattr(ctrl, "wants_wrench", False):
+        return "callback"
+    if _native(ctrl):
+        return "native"
+    return "computed" if _native_computed(ctrl) else "callback"
 
 
 def _setup(
@@ -1773,11 +1721,12 @@ def _setup(
     reset: bool = True,
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
-    plant at its initial state, the settings and the choice of loop."""
+    plant at its initial state, the settings and the kind of loop."""
     from . import Controller
     from ._api import _record_every
     from ._params import SCENARIOS, check_settle, resolve
 
+    _check_arguments(T, Ts, substeps)
     defaults = SCENARIOS.get(scenario)
     if defaults is None:
         raise ValueError(f"scenario must be one of {sorted(SCENARIOS)}, got {scenario!r}")
@@ -1831,7 +1780,7 @@ def _setup(
     steps = round(T / Ts)
     if steps < 1:
         raise ValueError(f"T = {T:g} s is shorter than one period Ts = {Ts:g} s")
-    # As the rigid plant's simulate (the core's condition, for either loop).
+    # As the rigid plant's simulate (the core's condition).
     if not math.isfinite(settle):
         raise ConfigError(f"settle must be finite, got {settle!r}")
     if settle < 0:
@@ -1840,8 +1789,11 @@ def _setup(
         check_settle(settle, T, Ts)
     if substeps is None:
         substeps = max(1, round(Ts / plant.timestep))
-    if substeps < 1:
-        raise ValueError(f"substeps must be ≥ 1, got {substeps}")
+        if substeps > MAX_SUBSTEPS:
+            raise ConfigError(
+                f"condition 1 ≤ substeps ≤ 10 000 is violated: substeps = round(Ts / the "
+                f"model's timestep) = {substeps}: give substeps"
+            )
     resolved = resolve(disturb, scenario="robot", groups=("sim",), caller="simulate()", n=plant.n)
     dist = {k: resolved[k] for k in DISTURBANCES}
     # A Cartesian controller's reference is its commanded position p_c (3,).
@@ -1852,15 +1804,12 @@ def _setup(
             start = reference(0.0)
             q0 = np.asarray(start[0], dtype=np.float64)
             dq0 = np.asarray(start[1], dtype=np.float64) if dq0 is None else dq0
-    plant.timestep = Ts / substeps
+    plant.timestep = Ts / int(substeps)
     if reset:
         plant.reset(q0, dq0)
-    spec = plant._native(substeps)
-    cartesian = _native_cartesian(ctrl)
-    native = spec is not None and (cartesian or (_native(ctrl) and not task_space))
     return _Run(
-        ctrl, plant, label, scenario, Ts, T, settle, substeps, steps, every, dist, spec, native,
-        reference, task, float(payload), plant.q, cartesian,
+        ctrl, plant, label, scenario, Ts, T, settle, int(substeps), steps, every, dist,
+        plant._core_spec(int(substeps)), _kind(ctrl), reference, task, float(payload), plant.q,
     )  # fmt: skip
 
 
@@ -1878,7 +1827,7 @@ def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
         "wrench_source": plant.wrench_source,
         "model": name,
         "controller": run.label,
-        "loop": "native" if run.native else "python",
+        "loop": "callback" if run.kind == "callback" else "native",
         "payload": run.payload,
         "q0": run.q0.tolist(),
         **run.dist,
@@ -1897,125 +1846,6 @@ def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
     )
 
 
-def _python_loop(
-    run: _Run, reference: Reference | None, progress: Callable[[int, int], object] | None
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The loop of :func:`simulate` for a controller the core cannot step: the
-    same order of operations, the core's metrics. Returns the arrays and the
-    metrics."""
-    from ._params import defaults as scenario_defaults
-
-    ctrl, plant, steps, Ts, substeps = run.ctrl, run.plant, run.steps, run.Ts, run.substeps
-    dist, every, settle = run.dist, run.every, run.settle
-    clean = scenario_defaults("robot", plant.n)
-    changed = sorted(k for k, v in dist.items() if v != clean[k])
-    if changed:
-        raise TypeError(
-            f"the disturbances {changed} need a controller the core steps (an "
-            "adaptimp.Controller or a case name) and a plant with a force sensor or "
-            "no possible contact; this run steps its controller from Python"
-        )
-    has = {
-        name: hasattr(ctrl, name)
-        for name in ("tau", "xc", "dxc", "ddxc", "xd", "z1", "dq_hat", "zeta")
-    }
-    # Its own commanded rates (a Cartesian controller's ṗ_c, p̈_c), if it says.
-    own_rates = reference is None and has["dxc"] and has["ddxc"]
-    # The Cartesian hook (ControllerLike): the measured wrench instead of τe.
-    wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
-    n = plant.n
-    rows: dict[str, list[Any]] = {name: [] for name in ARRAYS if name != "t"}
-    # The rows' own lists, bound once: this loop runs a Python step per period.
-    (r_q, r_dq, r_ddq, r_xc, r_dxc, r_ddxc, r_xd, r_dq_hat, r_tau, r_tau_sat, r_tau_e, r_zeta,
-     r_z1, r_x_ee, r_wrench) = rows.values()  # fmt: skip
-    zeros = np.zeros(n)
-    # Steps the controller took before (its own trajectory goes on from there).
-    k0 = getattr(ctrl, "steps", 0)
-    k0 = k0 if isinstance(k0, int) else 0
-    last = time.perf_counter()
-    for k in range(steps):
-        q, dq = plant.q, plant.dq
-        wrench = plant.wrench()
-        tau_e = plant.tau_e(wrench)
-        r_x_ee.append(plant.ee_position())
-        args = (q, dq, wrench) if wants_wrench else (q, tau_e, dq)
-        # ζ(t_k), what this step uses (SimResult's zeta), read before the step.
-        r_zeta.append(np.array(ctrl.zeta, dtype=np.float64) if has["zeta"] else zeros)
-        if reference is not None:
-            xc, dxc, ddxc = (np.asarray(v, dtype=np.float64) for v in reference(k * Ts))
-            tau_cmd = ctrl.step(*args, xc=xc, dxc=dxc, ddxc=ddxc)
-            r_xc.append(xc)
-            r_dxc.append(dxc)
-            r_ddxc.append(ddxc)
-        else:
-            tau_cmd = ctrl.step(*args)
-            xc = ctrl.xc if has["xc"] else q
-            r_xc.append(xc)
-            if own_rates:
-                r_dxc.append(ctrl.dxc)
-                r_ddxc.append(ctrl.ddxc)
-        tau_sat = plant.apply(tau_cmd)
-        plant.forward()  # q̈ at the row's state and applied torque (SPEC §12)
-        xd = ctrl.xd if has["xd"] else xc
-        r_q.append(q)
-        r_dq.append(dq)
-        r_ddq.append(plant.ddq)
-        r_xd.append(xd)
-        r_z1.append(ctrl.z1 if has["z1"] else np.asarray(xd) - q)
-        r_dq_hat.append(ctrl.dq_hat if has["dq_hat"] else dq)
-        r_tau.append(ctrl.tau if has["tau"] else tau_cmd)
-        r_tau_sat.append(tau_sat)
-        r_tau_e.append(tau_e)
-        r_wrench.append(wrench)
-        plant.step(substeps, row=k, Ts=Ts)
-        plant.forward()  # contact and sensors at the new state, torque held
-        if progress is not None and time.perf_counter() - last > 0.05:
-            last = time.perf_counter()
-            progress(k + 1, steps)
-
-    t: FloatArray = np.arange(steps, dtype=np.float64) * Ts
-    if reference is None and not own_rates:
-        # The controller's own trajectory, if its params declare one (for the
-        # impedance metric), evaluated for every row at once.
-        builtin = _builtin_reference(ctrl)
-        if builtin is not None:
-            # (sinusoid's reference broadcasts: one row per time.)
-            own = (k0 + np.arange(steps, dtype=np.float64)) * Ts
-            _, dxc_all, ddxc_all = builtin(own[:, None])  # type: ignore[arg-type]
-            rows["dxc"] = list(np.asarray(dxc_all, dtype=np.float64))
-            rows["ddxc"] = list(np.asarray(ddxc_all, dtype=np.float64))
-        else:
-            nan = np.full(len(r_xc[0]) if steps else n, math.nan)
-            rows["dxc"] = rows["ddxc"] = [nan] * steps
-    ref_width = len(rows["xc"][0]) if steps else n
-    width = {"x_ee": 3, "wrench_ee": 6}
-    width.update(dict.fromkeys(("xc", "dxc", "ddxc", "xd", "z1"), ref_width))
-    arrays = {
-        name: np.array(values, dtype=np.float64).reshape(steps, width.get(name, n))
-        for name, values in rows.items()
-    }
-    arrays["t"] = t
-    cparams = getattr(ctrl, "params", None)
-    cparams = cparams if isinstance(cparams, Mapping) else {}
-    target = [
-        np.broadcast_to(np.asarray(cparams.get(k, v), dtype=np.float64), (n,)).tolist()
-        for k, v in (("Dd", 1.0), ("Cd", 10.0), ("Gd", 60.0))
-    ]
-    a = arrays
-    m = _adaptimp.metrics(
-        a["t"], a["q"], a["dq"], a["ddq"], a["xc"], a["dxc"], a["ddxc"], a["z1"],
-        a["tau"], a["tau_sat"], a["tau_e"], settle, tuple(target),
-        False if wants_wrench else None,
-    )  # fmt: skip
-    kept: dict[str, Any] = {name: v[::every] for name, v in arrays.items()}
-    kept["w_norms"] = np.full((kept["t"].shape[0], 3), math.nan)
-    # A Cartesian controller's log of this run (adaptimp.CartesianController.arrays).
-    log = getattr(ctrl, "arrays", None) if wants_wrench and getattr(ctrl, "record", False) else None
-    if callable(log) and steps:
-        kept["task"] = {k: v[len(v) - steps :: every] for k, v in log().items()}
-    return kept, m
-
-
 def _run_many(
     jobs: Sequence[tuple[str, str, str, Mapping[str, Any]]],
     threads: int | None = None,
@@ -2024,9 +1854,9 @@ def _run_many(
     """Runs ``(case, scenario, model, keywords)`` of :func:`simulate`, their
     SPEC §12 metrics or their errors as text: in the core, on ``threads``
     threads (every core if None) with the GIL released, each run with its own
-    controller and MuJoCo data; a run the core cannot take alone (a Python
-    loop, a reference callable) runs here. Results are those of
-    :func:`simulate`, bit for bit."""
+    controller and MuJoCo data; a run the core cannot take alone (a reference
+    callable, a progress report) runs here through :func:`simulate`. Results
+    are those of :func:`simulate`, bit for bit."""
     out: list[dict[str, Any] | str | None] = [None] * len(jobs)
     native: list[tuple[int, _Run]] = []
     for i, (case, scenario, model, kw) in enumerate(jobs):
@@ -2042,10 +1872,8 @@ def _run_many(
                 case, model, scenario=scenario, params=kw,
                 **{k: kw.pop(k) for k in names if k in kw},
             )  # fmt: skip
-            if run.native:
-                native.append((i, run))
-            else:
-                out[i] = dict(_python_loop(run, run.reference, None)[1])
+            assert run.kind == "native", run.kind  # a case name: an adaptimp.Controller
+            native.append((i, run))
         except Exception as e:  # a run's failure, whatever it is (a model's ParseError)
             out[i] = f"{type(e).__name__}: {e}"
     if native:
@@ -2055,7 +1883,7 @@ def _run_many(
                     r.ctrl,
                     r.plant.model,
                     r.plant.data,
-                    r.spec or {},
+                    r.spec,
                     r.dist,
                     r.T,
                     r.settle,

@@ -9,10 +9,11 @@
 //! exceptions of `adaptimp._errors`.
 
 use super::cartesian_loop::{
-    self, pose_target, CartesianOut, CartesianRun, Computed, JointStep, LastStep,
+    self, pose_target, CartesianOut, CartesianRun, JointStep, LastStep, TARGET_LEN,
 };
-use super::computed::{DynComputed, PyComputedTorque};
+use super::computed::{Computed, DynComputed, PyComputedTorque};
 use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JOINTS};
+use super::frames::{joint, transform};
 use super::mujoco::MujocoSpec;
 use super::{array, array1, config_error, items, python_shape, vector, ConfigError, PyController};
 use super::{DivergedError, MeasurementError};
@@ -35,9 +36,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
 use std::vec::Vec;
-
-/// Length of a flat pose target: p, ṗ, p̈ (3 each), R row-major (9), ω, ω̇ (3 each).
-pub const TARGET_LEN: usize = 24;
 
 // ---------------------------------------------------------------------------
 // The object-safe faces.
@@ -622,98 +620,6 @@ fn target_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PoseTarget>> {
 fn wrench_of(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
     let v = flat("wrench", 6, obj)?;
     Ok(core::array::from_fn(|i| v[i]))
-}
-
-/// A transform from a dict: {"xyz", "rpy"} (URDF), {"pos", "quat"} (MuJoCo,
-/// [w, x, y, z]) or {"translation", "rotation"} (3 × 3, row-major); empty:
-/// the identity.
-pub(super) fn transform(d: &Bound<'_, PyDict>) -> PyResult<Transform> {
-    let get = |key: &str, len: usize| -> PyResult<Option<Vec<f64>>> {
-        match d.get_item(key)? {
-            None => Ok(None),
-            Some(v) => {
-                let v: Vec<f64> = v
-                    .call_method0("__iter__")
-                    .ok()
-                    .and_then(|_| {
-                        v.extract::<Vec<Vec<f64>>>()
-                            .ok()
-                            .map(|rows| rows.concat())
-                            .or_else(|| v.extract::<Vec<f64>>().ok())
-                    })
-                    .ok_or_else(|| {
-                        PyTypeError::new_err(format!("{key} must be a sequence of {len} reals"))
-                    })?;
-                if v.len() != len {
-                    return Err(ConfigError::new_err(format!(
-                        "{key} must have {len} values, got {}",
-                        v.len()
-                    )));
-                }
-                Ok(Some(v))
-            }
-        }
-    };
-    let a3 = |v: Vec<f64>| -> [f64; 3] { core::array::from_fn(|i| v[i]) };
-    let err = |e: Error| ConfigError::new_err(e.to_string());
-    if let Some(q) = get("quat", 4)? {
-        let pos = get("pos", 3)?.map_or([0.0; 3], a3);
-        return Transform::from_pos_quat(pos, core::array::from_fn(|i| q[i])).map_err(err);
-    }
-    if let Some(r) = get("rotation", 9)? {
-        let t = get("translation", 3)?.map_or([0.0; 3], a3);
-        return Ok(Transform {
-            translation: t,
-            rotation: core::array::from_fn(|i| core::array::from_fn(|j| r[3 * i + j])),
-        });
-    }
-    let xyz = get("xyz", 3)?
-        .or(get("pos", 3)?)
-        .or(get("translation", 3)?)
-        .map_or([0.0; 3], a3);
-    let rpy = get("rpy", 3)?.map_or([0.0; 3], a3);
-    Ok(Transform::from_xyz_rpy(xyz, rpy))
-}
-
-pub(super) fn joint(d: &Bound<'_, PyDict>) -> PyResult<Joint> {
-    let kind: String = match d.get_item("kind")? {
-        Some(k) => k.extract()?,
-        None => return Err(PyTypeError::new_err("a joint needs its kind")),
-    };
-    let kind = match kind.as_str() {
-        "fixed" => JointKind::Fixed,
-        "revolute" => JointKind::Revolute,
-        "prismatic" => JointKind::Prismatic,
-        other => {
-            return Err(ConfigError::new_err(format!(
-                "joint kind must be 'fixed', 'revolute' or 'prismatic', got {other:?}"
-            )))
-        }
-    };
-    let axis: [f64; 3] = match d.get_item("axis")? {
-        Some(a) => {
-            let v: Vec<f64> = a.extract()?;
-            if v.len() != 3 {
-                return Err(ConfigError::new_err(format!(
-                    "axis must have 3 values, got {}",
-                    v.len()
-                )));
-            }
-            [v[0], v[1], v[2]]
-        }
-        None if kind == JointKind::Fixed => [0.0; 3],
-        None => return Err(PyTypeError::new_err("a movable joint needs its axis")),
-    };
-    let offset: f64 = match d.get_item("offset")? {
-        Some(o) => o.extract()?,
-        None => 0.0,
-    };
-    Ok(Joint {
-        kind,
-        origin: transform(d)?,
-        axis,
-        offset,
-    })
 }
 
 fn rows(n: usize, what: &str, a: &PyReadonlyArray2<'_, f64>, width: usize) -> PyResult<Vec<f64>> {

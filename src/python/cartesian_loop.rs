@@ -20,15 +20,14 @@
 //! joint quantities (q, τ, sat(τ), τe, ζ, the velocity used) are the joint
 //! controller's, as for a joint-space run.
 
-use super::cartesian::TARGET_LEN;
+use super::computed::Computed;
 use super::dynamic::{
     drive_mujoco, FaultKind, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError,
     TaskMetrics, Typed,
 };
 use super::mujoco::MujocoSpec;
 use crate::cartesian::{
-    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain,
-    ComputedState, ComputedTorque, PoseTarget,
+    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, PoseTarget,
 };
 use crate::control::config::Law;
 use crate::control::impedance::TargetImpedance;
@@ -42,6 +41,9 @@ use adaptimp_mujoco::Sim;
 use core::cell::Cell;
 use nalgebra::Matrix3;
 use std::vec::Vec;
+
+/// Length of a flat pose target: p, ṗ, p̈ (3 each), R row-major (9), ω, ω̇ (3 each).
+pub const TARGET_LEN: usize = 24;
 
 /// A Cartesian run on MuJoCo ([`simulate_mujoco`]).
 pub struct CartesianRun<'a> {
@@ -112,15 +114,6 @@ impl<const N: usize> JointStep<N> for Typed<N> {
     fn applied(&self) -> Vector<N> {
         *self.state().applied()
     }
-}
-
-/// Computed torque (SPEC §20) with its state.
-#[derive(Clone, Debug)]
-pub struct Computed<const N: usize> {
-    /// The controller.
-    pub ctrl: ComputedTorque<N>,
-    /// Its state.
-    pub state: ComputedState<N>,
 }
 
 impl<const N: usize> JointStep<N> for Computed<N> {
@@ -483,47 +476,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
 ) -> Result<CartesianOut, RunError> {
-    let ts = outer.period();
-    if joint.period() != ts {
-        return Err(invalid(
-            "joint controller of a Cartesian impedance",
-            "needs the same Ts as the Cartesian impedance",
-        ));
-    }
-    let total = crate::sim::simulator::steps(run.t_final, ts)?;
-    if let Some(tab) = run.targets {
-        let need = usize::try_from(total)
-            .unwrap_or(usize::MAX)
-            .saturating_mul(TARGET_LEN);
-        if tab.len() < need {
-            return Err(invalid("targets", "needs one pose target per step"));
-        }
-    }
-    // A Cartesian controller reads the wrench, not τe: what acts on τe alone
-    // would act on nothing.
-    let s = super::dynamic::scenario::<N>(crate::schema::Preset::Robot, joint.law(), run.items)
-        .map_err(|e| RunError::Core(e.error, None))?;
-    if s.disturbances()?
-        .params()
-        .noise_tau_e
-        .iter()
-        .any(|v| *v != 0.0)
-    {
-        return Err(invalid(
-            "noise_tau_e",
-            "a Cartesian controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
-        ));
-    }
-    if let Some(FaultSpec {
-        kind: FaultKind::ForceBias(_),
-        ..
-    }) = run.fault
-    {
-        return Err(invalid(
-            "force_bias",
-            "a Cartesian controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
-        ));
-    }
+    let total = checked(outer, &*joint, run)?;
     let every = run.every.max(1);
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
     let mut rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
@@ -550,6 +503,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         items: run.items,
         law,
         fault: run.fault,
+        abort: None,
     };
     let mut recorder = TaskRecorder {
         joint: &mut rec,
@@ -561,6 +515,68 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     *last = ctrl.last;
     result?;
     Ok((rec, task, metrics.finish()))
+}
+
+/// The steps of `run`, checked before it starts: the joint controller at the
+/// outer loop's period, a pose target per step, nothing that acts on τe.
+fn checked<const N: usize, J: JointStep<N> + ?Sized>(
+    outer: &CartesianImpedance<N, Chain<N>>,
+    joint: &J,
+    run: &CartesianRun<'_>,
+) -> Result<u64, RunError> {
+    let ts = outer.period();
+    if joint.period() != ts {
+        return Err(invalid(
+            "joint controller of a Cartesian impedance",
+            "needs the same Ts as the Cartesian impedance",
+        ));
+    }
+    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    if let Some(tab) = run.targets {
+        let need = usize::try_from(total)
+            .unwrap_or(usize::MAX)
+            .saturating_mul(TARGET_LEN);
+        if tab.len() < need {
+            return Err(invalid("targets", "needs one pose target per step"));
+        }
+    }
+    reads_the_wrench::<N>(joint.law(), run.items, run.fault)?;
+    Ok(total)
+}
+
+/// A Cartesian controller (the core's, or one written in Python with the
+/// wrench hook) reads the wrench, not τe: the disturbances of `items` (for
+/// `law`'s scenario) and the `fault` must not act on τe alone, which would
+/// act on nothing.
+pub(crate) fn reads_the_wrench<const N: usize>(
+    law: Law,
+    items: &Items,
+    fault: Option<&FaultSpec>,
+) -> Result<(), RunError> {
+    let s = super::dynamic::scenario::<N>(crate::schema::Preset::Robot, law, items)
+        .map_err(|e| RunError::Core(e.error, None))?;
+    if s.disturbances()?
+        .params()
+        .noise_tau_e
+        .iter()
+        .any(|v| *v != 0.0)
+    {
+        return Err(invalid(
+            "noise_tau_e",
+            "a Cartesian controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
+        ));
+    }
+    if let Some(FaultSpec {
+        kind: FaultKind::ForceBias(_),
+        ..
+    }) = fault
+    {
+        return Err(invalid(
+            "force_bias",
+            "a Cartesian controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
+        ));
+    }
+    Ok(())
 }
 
 /// A Cartesian step per row of recorded tables, the core's alone (for the

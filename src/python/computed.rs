@@ -2,21 +2,30 @@
 //! (SPEC §20): `ComputedTorque`, one monomorphised core per n behind an
 //! object-safe face ([`DynComputed`]); `adaptimp.baselines.ComputedTorque`
 //! is its front. As a joint controller behind `CartesianImpedance` it steps
-//! in the core's Cartesian step and native loop like `Controller`.
+//! in the core's Cartesian step and native loop like `Controller`; alone, in
+//! joint space, it is a [`Control`] of the core's loop on MuJoCo
+//! ([`DynComputed::simulate_mujoco`]) along its setpoint of every row.
 
-use super::cartesian::transform;
-use super::cartesian_loop::Computed;
-use super::dynamic::MAX_JOINTS;
+use super::dynamic::{
+    drive_mujoco, Hooks, MetricsOut, MujocoRun, OnMujoco, Records, RunError, TaskMetrics,
+    MAX_JOINTS,
+};
+use super::frames::{joint, transform};
+use super::mujoco::{MujocoSpec, Table};
 use super::{array, array1, vector, ConfigError};
 use crate::cartesian::chain::JointKind;
 use crate::cartesian::{
     ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
 };
+use crate::control::config::Law;
 use crate::control::impedance::{ImpedanceMode, TargetImpedance};
-use crate::control::io::Measurement;
+use crate::control::io::{Command, Control, Measurement};
 use crate::error::Error;
+use crate::sim::record::{Recorder, Row};
 use crate::trajectory::Setpoint;
 use crate::types::Vector;
+use adaptimp_mujoco::Sim;
+use core::cell::Cell;
 use numpy::PyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -54,8 +63,29 @@ pub trait DynComputed: Send + Sync {
     fn fault(&self) -> Option<(Error, u64)>;
     /// The controller's total moving mass (kg).
     fn mass(&self) -> f64;
+    /// The closed loop on MuJoCo (`sim` as `spec` describes it) in joint
+    /// space along `run.reference` (needed: the setpoint of every row), from
+    /// the controller's current state, with the disturbances and the fault
+    /// of `run` (SPEC §17). Records every `run.every`-th row with the end
+    /// effector, and the SPEC §12 metrics of every row.
+    fn simulate_mujoco(
+        &mut self,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &MujocoRun<'_>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(Records, MetricsOut), RunError>;
     /// As [`Any`], for the typed paths.
     fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// Computed torque (SPEC §20) with its state.
+#[derive(Clone, Debug)]
+pub struct Computed<const N: usize> {
+    /// The controller.
+    pub ctrl: ComputedTorque<N>,
+    /// Its state.
+    pub state: ComputedState<N>,
 }
 
 fn vector_of<const N: usize>(v: &[f64]) -> Vector<N> {
@@ -126,9 +156,168 @@ impl<const N: usize> DynComputed for Computed<N> {
     fn mass(&self) -> f64 {
         self.ctrl.model().mass()
     }
+    fn simulate_mujoco(
+        &mut self,
+        sim: &mut Sim,
+        spec: &MujocoSpec,
+        run: &MujocoRun<'_>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(Records, MetricsOut), RunError> {
+        run_mujoco(self, sim, spec, run, hooks)
+    }
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
     }
+}
+
+/// Computed torque as a joint controller of the core's loop: its step on
+/// the loop's setpoint; a refused step holds the torque last applied. It
+/// has no weights: their norms are NaN in the rows.
+impl<const N: usize> Control<N> for Computed<N> {
+    fn period(&self) -> f64 {
+        self.ctrl.period()
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        self.ctrl.impedance()
+    }
+    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        let cmd = self.ctrl.step(&mut self.state, m, c)?;
+        Ok(Command {
+            w_norms: [f64::NAN; 3],
+            ..cmd
+        })
+    }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        match Control::step(self, m, c) {
+            Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
+            Err(e) => (self.state.applied, Err(e)),
+        }
+    }
+}
+
+/// Computed torque as the loop steps it, keeping the torque it gives to
+/// apply (its sat(τ), or the torque it holds on a refusal).
+struct Stepped<'a, const N: usize> {
+    c: &'a mut Computed<N>,
+    applied: &'a Cell<Vector<N>>,
+}
+
+impl<const N: usize> Control<N> for Stepped<'_, N> {
+    fn period(&self) -> f64 {
+        self.c.period()
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        Control::target(self.c)
+    }
+    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        Control::step(self.c, m, c)
+    }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        let (tau, result) = self.c.step_or_fallback(m, c);
+        self.applied.set(tau);
+        (tau, result)
+    }
+}
+
+/// The rows of a joint-space run and the SPEC §12 metrics of every row (the
+/// accumulator of `_adaptimp.metrics`, as the Python loop measured computed
+/// torque), with the saturation the metrics count: the torque the
+/// controller gives within the actuators' limits, before a disturbance
+/// weakens it (a refused row: none).
+struct JointRows<'a, const N: usize> {
+    rec: Records,
+    metrics: TaskMetrics<N>,
+    applied: &'a Cell<Vector<N>>,
+    tau_max: Vector<N>,
+}
+
+impl<const N: usize> Recorder<N> for JointRows<'_, N> {
+    fn record(&mut self, r: &Row<N>) {
+        self.rec.record(r);
+        let sat = if r.refused {
+            r.tau
+        } else {
+            self.applied
+                .get()
+                .zip_map(&self.tau_max, |t, m| t.max(-m).min(m))
+        };
+        self.metrics.push(
+            r.t,
+            [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
+            [r.xc.as_slice(), r.dxc.as_slice(), r.ddxc.as_slice()],
+            r.z1.as_slice(),
+            [r.tau.as_slice(), sat.as_slice(), r.tau_e.as_slice()],
+        );
+    }
+}
+
+fn run_mujoco<const N: usize>(
+    c: &mut Computed<N>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &MujocoRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> Result<(Records, MetricsOut), RunError> {
+    let ts = c.ctrl.period();
+    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    let need = usize::try_from(total)
+        .unwrap_or(usize::MAX)
+        .saturating_mul(N);
+    let rows = match run.reference {
+        Some(rows) if rows.iter().all(|r| r.len() >= need) => rows,
+        _ => {
+            return Err(RunError::Core(
+                Error::Invalid {
+                    what: "reference",
+                    reason: "computed torque needs its setpoint of every step",
+                },
+                None,
+            ))
+        }
+    };
+    let every = run.every.max(1);
+    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let imp = *c.ctrl.impedance();
+    let target = [
+        imp.dd().as_slice(),
+        imp.cd().as_slice(),
+        imp.gd().as_slice(),
+    ];
+    let metrics = TaskMetrics::<N>::new(N, N, true, run.settle, target)?;
+    let applied = Cell::new(Vector::<N>::zeros());
+    let tau_max =
+        Vector::<N>::from_fn(|i, _| spec.tau_max.get(i).copied().unwrap_or(f64::INFINITY));
+    let mut out = JointRows {
+        rec,
+        metrics,
+        applied: &applied,
+        tau_max,
+    };
+    let on = OnMujoco {
+        sim,
+        spec,
+        t_final: run.t_final,
+        settle: run.settle,
+        items: run.items,
+        law: Law::Pd,
+        fault: run.fault,
+        abort: None,
+    };
+    let mut stepped = Stepped {
+        c,
+        applied: &applied,
+    };
+    drive_mujoco(&mut stepped, &Table::<N> { rows, ts }, on, hooks, &mut out)?;
+    Ok((out.rec, out.metrics.finish()))
 }
 
 /// The parameters of a [`DynComputed`], as reals per joint.
@@ -312,10 +501,7 @@ impl PyComputedTorque {
         damping: Option<&Bound<'_, PyAny>>,
         friction: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let js = joints
-            .iter()
-            .map(super::cartesian::joint)
-            .collect::<PyResult<Vec<_>>>()?;
+        let js = joints.iter().map(joint).collect::<PyResult<Vec<_>>>()?;
         let ins = inertials
             .iter()
             .map(inertial)
@@ -482,5 +668,55 @@ impl PyComputedTorque {
     #[getter]
     fn fault(&self, py: Python<'_>) -> Option<(String, u64)> {
         self.lock(py).fault().map(|(e, k)| (e.to_string(), k))
+    }
+
+    /// The closed loop on MuJoCo in joint space, from the controller's
+    /// current state (not reset), with the GIL released: the core's loop
+    /// (`adaptimp.mujoco.simulate`, SPEC §13.1) along `reference` = (xc, dxc,
+    /// ddxc), (K, n) each with K ≥ the steps (the run's reference, or the
+    /// controller's own trajectory tabulated). `model`, `data`, `spec`,
+    /// `params` (the disturbances of SPEC §17), `t_final`, `settle`,
+    /// `record_every`, `progress`, `fault` as for `simulate_mujoco`, whose
+    /// dict it returns.
+    #[pyo3(signature = (model, data, spec, params, t_final, settle, reference, record_every=1, progress=None, fault=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate_mujoco<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+        data: &Bound<'py, PyAny>,
+        spec: &Bound<'py, PyDict>,
+        params: &Bound<'py, PyDict>,
+        t_final: f64,
+        settle: f64,
+        reference: super::PyReference<'py>,
+        record_every: u64,
+        progress: Option<Py<PyAny>>,
+        fault: Option<super::PyFault>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let fault = super::fault_spec(fault)?;
+        if record_every == 0 {
+            return Err(ConfigError::new_err("record_every must be ≥ 1"));
+        }
+        let spec = super::mujoco_spec(spec)?;
+        let items = super::items(params)?;
+        let tables = super::reference_tables(self.n, Some(&reference))?;
+        let mut sim = Sim::from_python(model, data)?;
+        let run = MujocoRun {
+            t_final,
+            settle,
+            every: record_every,
+            items: &items,
+            reference: tables.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
+            fault: fault.as_ref(),
+        };
+        let mut hooks = super::PyHooks::new(progress);
+        let mut guard = self.lock(py);
+        let ctrl: &mut dyn DynComputed = &mut **guard;
+        let result = py.detach(|| ctrl.simulate_mujoco(&mut sim, &spec, &run, &mut hooks));
+        drop(guard);
+        drop(sim);
+        let (rec, metrics) = result.map_err(|e| super::run_error(e, &mut hooks))?;
+        super::records_dict(py, rec, metrics)
     }
 }

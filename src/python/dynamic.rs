@@ -25,7 +25,7 @@ use crate::sim::metrics::MetricsAccumulator;
 use crate::sim::model::{Link, PlanarArm, TwoLinkArm};
 use crate::sim::plant::{Plant, RigidBody};
 use crate::sim::record::{Recorder, Row};
-use crate::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapted, Adapter};
+use crate::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapter};
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 use adaptimp_mujoco::Sim;
@@ -494,6 +494,7 @@ fn run_mujoco<const N: usize>(
         items: run.items,
         law,
         fault: run.fault,
+        abort: None,
     };
     let rec2 = &mut (&mut metrics, &mut rec);
     match run.reference {
@@ -519,14 +520,19 @@ pub(crate) struct OnMujoco<'a> {
     pub law: Law,
     /// A fault to inject (τmax: the plant's actuators').
     pub fault: Option<&'a FaultSpec>,
+    /// Raised by the controller to end the run before the next period (a
+    /// controller written in Python that raised), whatever the fault.
+    pub abort: Option<&'a core::cell::Cell<bool>>,
 }
 
 /// The core's loop ([`simulate_disturbed`]) of `ctrl` along `traj` on MuJoCo,
 /// every row to `rec`: the disturbances of `on.items` (payload and jitter
 /// refused: the first is a change of the model, the second of its
-/// timestep), the fault, the hook every few periods; the plant's own failure
-/// (a diverged or fatal MuJoCo) as [`RunError::Plant`]. One loop for the
-/// joint controllers and the Cartesian ones.
+/// timestep), the fault, the hook every 64 MuJoCo steps ([`MjPlant::watch`]);
+/// the plant's own failure (a diverged or fatal MuJoCo) as
+/// [`RunError::Plant`], a stop (the hook, or `on.abort`) as
+/// [`RunError::Stopped`]. One loop for every controller: the joint ones, the
+/// Cartesian ones, computed torque and a controller written in Python.
 pub(crate) fn drive_mujoco<const N: usize, C, T, R>(
     ctrl: &mut C,
     traj: &T,
@@ -576,23 +582,25 @@ where
         }
         None => None,
     };
+    let mut tick = |done: u64, total: u64| hooks.tick(done, total);
     let mut plant = MjPlant::<N>::new(on.sim, spec, ts, *dist.friction())?;
+    plant.watch(&mut tick, total);
+    if let Some(flag) = on.abort {
+        plant.abort_on(flag);
+    }
     if let Err(e) = plant.start() {
         return Err(match plant.failure() {
             Some(f) => RunError::Plant(f.clone()),
             None => RunError::Core(e, None),
         });
     }
-    let mut watch = Watch::new(hooks, total);
-    let result = {
-        let mut p = Adapted::new(&mut plant, &mut watch);
-        simulate_disturbed(&mut p, ctrl, traj, on.t_final, inj.as_ref(), &dist, rec)
-    };
+    let result = simulate_disturbed(&mut plant, ctrl, traj, on.t_final, inj.as_ref(), &dist, rec);
     match result {
         Ok(_) => Ok(()),
         Err(e) => Err(match plant.failure() {
             Some(f) => RunError::Plant(f.clone()),
-            None => watch.error(e),
+            None if plant.stopped() => RunError::Stopped,
+            None => RunError::Core(e, Some(plant.rows())),
         }),
     }
 }

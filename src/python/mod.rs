@@ -24,10 +24,12 @@
 //! Nothing here panics on user input and nothing is `unsafe`.
 
 mod arm;
+mod callback;
 mod cartesian;
 mod cartesian_loop;
 mod computed;
 mod dynamic;
+mod frames;
 mod mujoco;
 mod tuning;
 
@@ -1404,6 +1406,8 @@ fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec> {
         force_adr: get(d, "force_adr")?,
         torque_adr: get(d, "torque_adr")?,
         contact_adr: get(d, "contact_adr")?,
+        subtree: get(d, "subtree")?,
+        root: get(d, "root")?,
         substeps: get(d, "substeps")?,
         timestep: get(d, "timestep")?,
         integrator: match get::<i32>(d, "integrator")? {
@@ -1865,6 +1869,8 @@ mod adaptimp_module {
         simulate_mujoco_many, PyArm, PyController, PyPlanarArm,
     };
 
+    #[pymodule_export]
+    use super::callback::simulate_mujoco_callback;
     #[pymodule_export]
     use super::cartesian::{centres_along, PyCartesian, PyChain};
     #[pymodule_export]

@@ -3,10 +3,11 @@
 //! in the loop) with the semantics of `adaptimp.mujoco` (SPEC §13.1):
 //!
 //! - at t_k, the state, the end-effector position, the wrench F_e (from the
-//!   force/torque sensors, or a contact sensor of the net contact wrench on
-//!   the end effector's subtree) and τe = Jᵀ F_e are those of MuJoCo's
-//!   forward computation at x_k with the previous torque held (sensors and
-//!   contact as a real sensor reads them just before the new command);
+//!   force/torque sensors, a contact sensor of the net contact wrench on the
+//!   end effector's subtree, or the contact forces on that subtree's bodies,
+//!   MuJoCo's `cfrc_ext`) and τe = Jᵀ F_e are those of MuJoCo's forward
+//!   computation at x_k with the previous torque held (sensors and contact
+//!   as a real sensor reads them just before the new command);
 //! - the command is saturated to the actuators' τmax (gear × ctrlrange) and
 //!   held for `substeps` MuJoCo steps of Ts/substeps; ẍ_k is MuJoCo's q̈ at
 //!   x_k with that torque (`mj_forwardSkip` from the velocity stage: the
@@ -15,7 +16,12 @@
 //! - a period after which MuJoCo has warned (it resets the state on a bad
 //!   position, velocity or acceleration and only counts a warning), whose
 //!   time did not advance by Ts, or whose state is not finite, ends the run
-//!   with the row, the time and MuJoCo's own message ([`MjPlant::failure`]).
+//!   with the row, the time and MuJoCo's own message ([`MjPlant::failure`]);
+//! - the run's hook (signals, progress) is asked every 64 MuJoCo steps and
+//!   at the end, so a period of many substeps is interrupted within it
+//!   ([`MjPlant::watch`]); a flag raised by the controller (a controller
+//!   written in Python that raised) stops the run before the next period
+//!   ([`MjPlant::abort_on`]).
 //!
 //! Nothing here is `unsafe`: the FFI lives in the `adaptimp-mujoco` crate.
 
@@ -25,6 +31,7 @@ use crate::sim::plant::Plant;
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 use adaptimp_mujoco::{Sim, MAX_WARNINGS};
+use core::cell::Cell;
 use std::string::String;
 use std::vec::Vec;
 
@@ -55,6 +62,13 @@ pub struct MujocoSpec {
     /// pos"`: f, t about the centroid c, c; world frame), used without a
     /// force sensor.
     pub contact_adr: Option<usize>,
+    /// The bodies of the end effector's subtree, whose external forces
+    /// (`cfrc_ext`: MuJoCo's contact list, summed by MuJoCo) are the
+    /// wrench when the model has neither sensor (empty: not read).
+    pub subtree: Vec<usize>,
+    /// The root body of the end effector (`body_rootid`): `cfrc_ext` is
+    /// about its `subtree_com`.
+    pub root: usize,
     /// MuJoCo steps per period.
     pub substeps: usize,
     /// MuJoCo's timestep (s): Ts / substeps.
@@ -67,6 +81,13 @@ pub struct MujocoSpec {
     /// The names of MuJoCo's warning kinds, by index (`mjtWarning`).
     pub warning_names: Vec<String>,
 }
+
+/// The run's hook as the plant asks it: `(periods done, periods in all)`
+/// in, false to stop.
+pub type Tick<'a> = dyn FnMut(u64, u64) -> bool + 'a;
+
+/// MuJoCo steps between two calls of the run's hook.
+const TICK_STEPS: u32 = 64;
 
 /// MuJoCo as a [`Plant`] of N joints.
 pub struct MjPlant<'a, const N: usize> {
@@ -84,6 +105,11 @@ pub struct MjPlant<'a, const N: usize> {
     wrench: [f64; 6],
     x_ee: [f64; 3],
     failure: Option<Failure>,
+    tick: Option<&'a mut Tick<'a>>,
+    total: u64,
+    since: u32,
+    abort: Option<&'a Cell<bool>>,
+    stopped: bool,
 }
 
 /// How the plant ended a run.
@@ -114,6 +140,59 @@ fn indices<const N: usize>(
     Ok(a)
 }
 
+/// The wrench [f; t + (c − p) × f] of the force f and the moment t about c
+/// (world frame), with the moment moved to p.
+fn moved(f: &[f64], t: &[f64], c: &[f64], p: &[f64; 3]) -> [f64; 6] {
+    let d = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
+    [
+        f[0],
+        f[1],
+        f[2],
+        t[0] + (d[1] * f[2] - d[2] * f[1]),
+        t[1] + (d[2] * f[0] - d[0] * f[2]),
+        t[2] + (d[0] * f[1] - d[1] * f[0]),
+    ]
+}
+
+/// The wrench's sources of `spec` in `sim`: one at most, every address in range.
+fn check_wrench(spec: &MujocoSpec, sim: &Sim) -> Result<(), Error> {
+    let sensors = sim.sensordata().len();
+    let bodies = sim.xpos().len() / 3;
+    for adr in [spec.force_adr, spec.torque_adr].into_iter().flatten() {
+        if adr + 3 > sensors {
+            return Err(invalid("sensor", "address out of sensordata"));
+        }
+    }
+    if spec.contact_adr.is_some_and(|adr| adr + 9 > sensors) {
+        return Err(invalid("contact sensor", "address out of sensordata"));
+    }
+    if spec.subtree.iter().any(|&b| b >= bodies) || spec.root >= bodies {
+        return Err(invalid("subtree", "out of the model's range"));
+    }
+    let sources = [
+        spec.force_adr.is_some(),
+        spec.contact_adr.is_some(),
+        !spec.subtree.is_empty(),
+    ];
+    if sources.iter().filter(|s| **s).count() > 1 {
+        return Err(invalid(
+            "wrench",
+            "comes from the force sensor, the contact sensor or the subtree's forces: one",
+        ));
+    }
+    if spec.force_adr.is_none() && spec.torque_adr.is_some() {
+        return Err(invalid("sensor", "a torque sensor needs a force sensor"));
+    }
+    match spec.site {
+        Some(s) if s >= sim.site_xpos().len() / 3 => {
+            Err(invalid("site", "out of the model's range"))
+        }
+        None if spec.ee_body >= bodies => Err(invalid("ee_body", "out of the model's range")),
+        None if spec.force_adr.is_some() => Err(invalid("sensor", "a force sensor needs its site")),
+        _ => Ok(()),
+    }
+}
+
 impl<'a, const N: usize> MjPlant<'a, N> {
     /// The plant of `sim` as `spec` describes it, at the period `ts` (s),
     /// with the joint `friction` of SPEC §17 applied through `qfrc_applied`
@@ -137,38 +216,7 @@ impl<'a, const N: usize> MjPlant<'a, N> {
         };
         let gear = vec(&spec.gear, "gear")?;
         let tau_max = vec(&spec.tau_max, "tau_max")?;
-        let sensors = sim.sensordata().len();
-        for adr in [spec.force_adr, spec.torque_adr].into_iter().flatten() {
-            if adr + 3 > sensors {
-                return Err(invalid("sensor", "address out of sensordata"));
-            }
-        }
-        if let Some(adr) = spec.contact_adr {
-            if adr + 9 > sensors {
-                return Err(invalid("contact sensor", "address out of sensordata"));
-            }
-            if spec.force_adr.is_some() {
-                return Err(invalid(
-                    "contact sensor",
-                    "the wrench comes from the force sensor, or the contact sensor, not both",
-                ));
-            }
-        }
-        if spec.force_adr.is_none() && spec.torque_adr.is_some() {
-            return Err(invalid("sensor", "a torque sensor needs a force sensor"));
-        }
-        match spec.site {
-            Some(s) if s >= sim.site_xpos().len() / 3 => {
-                return Err(invalid("site", "out of the model's range"))
-            }
-            None if spec.ee_body >= sim.xpos().len() / 3 => {
-                return Err(invalid("ee_body", "out of the model's range"))
-            }
-            _ => {}
-        }
-        if spec.force_adr.is_some() && spec.site.is_none() {
-            return Err(invalid("sensor", "a force sensor needs its site"));
-        }
+        check_wrench(spec, sim)?;
         if spec.substeps == 0 || !(spec.timestep > 0.0 && spec.timestep.is_finite()) {
             return Err(invalid("substeps", "need substeps ≥ 1 and a timestep > 0"));
         }
@@ -187,7 +235,66 @@ impl<'a, const N: usize> MjPlant<'a, N> {
             wrench: [0.0; 6],
             x_ee: [0.0; 3],
             failure: None,
+            tick: None,
+            total: 0,
+            since: 0,
+            abort: None,
+            stopped: false,
         })
+    }
+
+    /// Ask `tick` every 64 MuJoCo steps (also within a period) and at the
+    /// end of the run of `total` periods; when it returns false the period
+    /// stops there ([`MjPlant::stopped`]), between two MuJoCo steps.
+    pub fn watch(&mut self, tick: &'a mut Tick<'a>, total: u64) {
+        self.tick = Some(tick);
+        self.total = total;
+    }
+
+    /// Stop the run before the next period once `flag` is raised (by the
+    /// controller, between its step and the plant's advance).
+    pub fn abort_on(&mut self, flag: &'a Cell<bool>) {
+        self.abort = Some(flag);
+    }
+
+    /// Whether the hook or the flag stopped the run.
+    pub fn stopped(&self) -> bool {
+        self.stopped
+    }
+
+    /// Periods completed.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Ask the hook, with `done` periods completed; an error if it stops the run.
+    fn ask(&mut self, done: u64) -> Result<(), Error> {
+        self.since = 0;
+        let go_on = match self.tick.as_mut() {
+            Some(tick) => tick(done, self.total),
+            None => true,
+        };
+        if go_on {
+            return Ok(());
+        }
+        self.stopped = true;
+        Err(invalid("run", "stopped"))
+    }
+
+    /// One MuJoCo step done: the hook every [`TICK_STEPS`]. Stopped within a
+    /// period, the data is left at the state reached, computed forward (as a
+    /// period leaves it: a run continued from it reads it).
+    fn stepped(&mut self) -> Result<(), Error> {
+        self.since += 1;
+        if self.since >= TICK_STEPS {
+            if let Err(e) = self.ask(self.rows) {
+                if let Err(fatal) = self.sim.forward() {
+                    return Err(self.fatal(fatal));
+                }
+                return Err(e);
+            }
+        }
+        Ok(())
     }
 
     /// Read the end effector at the state MuJoCo's last forward computation
@@ -218,71 +325,99 @@ impl<'a, const N: usize> MjPlant<'a, N> {
     /// computation.
     fn sense(&mut self) -> Result<(), Error> {
         let spec = self.spec;
-        let (point, sid) = match spec.site {
-            Some(s) => (&self.sim.site_xpos()[3 * s..3 * s + 3], s),
-            None => (&self.sim.xpos()[3 * spec.ee_body..3 * spec.ee_body + 3], 0),
+        let point = match spec.site {
+            Some(s) => &self.sim.site_xpos()[3 * s..3 * s + 3],
+            None => &self.sim.xpos()[3 * spec.ee_body..3 * spec.ee_body + 3],
         };
         self.x_ee.copy_from_slice(point);
-        let mut w = [0.0; 6];
-        if let Some(a) = spec.contact_adr {
-            // The net contact wrench about the contacts' centroid c, moved to the
-            // end-effector point p: [f; t + (c − p) × f] (world frame).
+        let w = if spec.force_adr.is_some() {
+            self.sensor_wrench()
+        } else if let Some(a) = spec.contact_adr {
             let data = self.sim.sensordata();
             let (f, t, c) = (&data[a..a + 3], &data[a + 3..a + 6], &data[a + 6..a + 9]);
-            let p = self.x_ee;
-            let d = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
-            w = [
-                f[0],
-                f[1],
-                f[2],
-                t[0] + (d[1] * f[2] - d[2] * f[1]),
-                t[1] + (d[2] * f[0] - d[0] * f[2]),
-                t[2] + (d[0] * f[1] - d[1] * f[0]),
-            ];
-        }
-        if let Some(fa) = spec.force_adr {
-            // The sensors measure in the site frame: F_world = R F_site.
-            let r = &self.sim.site_xmat()[9 * sid..9 * sid + 9];
-            let data = self.sim.sensordata();
-            for (block, adr) in [(0, Some(fa)), (3, spec.torque_adr)] {
-                if let Some(a) = adr {
-                    for i in 0..3 {
-                        w[block + i] = r[3 * i] * data[a]
-                            + r[3 * i + 1] * data[a + 1]
-                            + r[3 * i + 2] * data[a + 2];
-                    }
-                }
-            }
-        }
+            moved(f, t, c, &self.x_ee)
+        } else if !spec.subtree.is_empty() {
+            self.body_forces()?
+        } else {
+            [0.0; 6]
+        };
         self.wrench = w;
         self.tau_e = Vector::zeros();
         if w.iter().any(|x| *x != 0.0) {
-            let nv = self.sim.nv();
-            let dofs = self.dofs;
-            let (by_site, id) = match spec.site {
-                Some(s) => (true, s),
-                None => (false, spec.ee_body),
-            };
-            let e = self.sim.jacobian(by_site, id);
-            let (jp, jr) = match e {
-                Ok(j) => j,
-                Err(e) => return Err(self.fatal(e)),
-            };
-            // τe = Jᵀ F_e, J = [Jp; Jr] (6 × n).
-            let mut te = Vector::<N>::zeros();
-            for (i, &d) in dofs.iter().enumerate() {
-                let mut acc = 0.0;
-                for r in 0..3 {
-                    acc += jp[r * nv + d] * w[r];
-                }
-                for r in 0..3 {
-                    acc += jr[r * nv + d] * w[3 + r];
-                }
-                te[i] = acc;
-            }
-            self.tau_e = te;
+            self.tau_e = self.joint_torque(&w)?;
         }
         Ok(())
+    }
+
+    /// F_e from the force (and torque) sensor at the site, which measure in
+    /// the site's frame: F_world = R F_site.
+    fn sensor_wrench(&self) -> [f64; 6] {
+        let spec = self.spec;
+        let sid = spec.site.unwrap_or(0);
+        let r = &self.sim.site_xmat()[9 * sid..9 * sid + 9];
+        let data = self.sim.sensordata();
+        let mut w = [0.0; 6];
+        for (block, adr) in [(0, spec.force_adr), (3, spec.torque_adr)] {
+            if let Some(a) = adr {
+                for i in 0..3 {
+                    w[block + i] = r[3 * i] * data[a]
+                        + r[3 * i + 1] * data[a + 1]
+                        + r[3 * i + 2] * data[a + 2];
+                }
+            }
+        }
+        w
+    }
+
+    /// F_e from the external forces on the end effector's subtree
+    /// (`cfrc_ext`, [torque; force] on each body about the root's
+    /// `subtree_com` c, world frame): minus their sum, the force the arm
+    /// exerts, with the moment moved to the end-effector point. A contact of
+    /// two bodies of the subtree adds opposite forces: it cancels, as the
+    /// contact list's sum skips it.
+    fn body_forces(&mut self) -> Result<[f64; 6], Error> {
+        if let Err(e) = self.sim.rne_post_constraint() {
+            return Err(self.fatal(e));
+        }
+        let ext = self.sim.cfrc_ext();
+        let (mut t, mut f) = ([0.0; 3], [0.0; 3]);
+        for &b in &self.spec.subtree {
+            for i in 0..3 {
+                t[i] += ext[6 * b + i];
+                f[i] += ext[6 * b + 3 + i];
+            }
+        }
+        let root = self.spec.root;
+        let c = &self.sim.subtree_com()[3 * root..3 * root + 3];
+        let w = moved(&f, &t, c, &self.x_ee);
+        // On the environment, not on the arm: −F (0 − x: no negative zeros).
+        Ok(w.map(|x| 0.0 - x))
+    }
+
+    /// τe = Jᵀ F_e (J = [Jp; Jr], 6 × n) at the current forward computation.
+    fn joint_torque(&mut self, w: &[f64; 6]) -> Result<Vector<N>, Error> {
+        let nv = self.sim.nv();
+        let dofs = self.dofs;
+        let (by_site, id) = match self.spec.site {
+            Some(s) => (true, s),
+            None => (false, self.spec.ee_body),
+        };
+        let (jp, jr) = match self.sim.jacobian(by_site, id) {
+            Ok(j) => j,
+            Err(e) => return Err(self.fatal(e)),
+        };
+        let mut te = Vector::<N>::zeros();
+        for (i, &d) in dofs.iter().enumerate() {
+            let mut acc = 0.0;
+            for r in 0..3 {
+                acc += jp[r * nv + d] * w[r];
+            }
+            for r in 0..3 {
+                acc += jr[r * nv + d] * w[3 + r];
+            }
+            te[i] = acc;
+        }
+        Ok(te)
     }
 
     /// The period's end: MuJoCo's warnings, the time, the state.
@@ -375,6 +510,10 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
     }
 
     fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
+        if self.abort.is_some_and(Cell::get) {
+            self.stopped = true;
+            return Err(invalid("run", "stopped by the controller"));
+        }
         if h != self.ts {
             return Err(invalid(
                 "jitter",
@@ -401,6 +540,7 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
                 if let Err(e) = self.sim.step_computed(self.spec.integrator) {
                     return Err(self.fatal(e));
                 }
+                self.stepped()?;
                 continue;
             }
             if !self.friction.is_none() {
@@ -415,6 +555,7 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
             if let Err(e) = self.sim.step() {
                 return Err(self.fatal(e));
             }
+            self.stepped()?;
         }
         if let Err(e) = self.sim.forward() {
             return Err(self.fatal(e));
@@ -422,6 +563,9 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
         self.check(&before, t0)?;
         self.sense()?;
         self.rows += 1;
+        if self.rows == self.total {
+            self.ask(self.rows)?;
+        }
         Ok(ddq)
     }
 }

@@ -1,7 +1,8 @@
 //! The gain and basis rule of SPEC §18 for Python (`adaptimp.tuning`), a thin
 //! face of [`crate::control::tuning`]: arrays in, the schema's names out.
 
-use super::cartesian::{PyChain, TypedChain, TARGET_LEN};
+use super::cartesian::{PyChain, TypedChain};
+use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
 use crate::cartesian::rule::{resolving, PoseCircle, PostureRule};
 use crate::control::tuning::{default_task as core_default_task, Rule};

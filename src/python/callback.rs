@@ -1,0 +1,796 @@
+//! A controller written in Python in the core's closed loop on MuJoCo (SPEC
+//! §13.1): [`PyStep`] is the loop's [`Control`], and its step calls the
+//! Python object's `step` once a period with the GIL taken for that call
+//! only (the loop runs with it released). The protocol is
+//! `adaptimp.mujoco.ControllerLike`:
+//!
+//! - `step(q, tau_e, dq, **setpoint)`, or with `wants_wrench`
+//!   `step(q, dq, wrench, **setpoint)`, the measurement as the core's loop
+//!   gives it (SPEC §17's disturbances and faults included), `setpoint` the
+//!   keywords `xc`, `dxc`, `ddxc` of the row when the run has a reference;
+//!   it returns the torque (n values, or one for every joint);
+//! - the attributes the run reads when the controller has them (Python
+//!   tells which, [`Attrs`]): `zeta` before the step; after it `xc` (and its
+//!   own `dxc`, `ddxc`) without a reference, then `xd`, `z1`, `dq_hat`,
+//!   `tau` (the order of the Python loop this replaces).
+//!
+//! A non-finite torque is a refused step (with a fault injected, the loop
+//! applies zero torque and goes on; without one, the run ends with
+//! `ValueError`, as before). An exception raised by the call, a torque of
+//! another shape, or an attribute of another width ends the run with that
+//! exception, before the plant advances: the rows recorded are those of the
+//! periods before, the plant at the start of the period that raised.
+//!
+//! The rows are the loop's, with the controller's own quantities in place
+//! of the core's (its τ, ζ, the velocity it used, its reference of width m
+//! = n, or 3 for a task-space controller), and the SPEC §12 metrics of the
+//! same rows by [`TaskMetrics`] (as `_adaptimp.metrics` computed them for
+//! the Python loop: the same bits).
+
+use super::cartesian_loop::reads_the_wrench;
+use super::dynamic::{
+    drive_mujoco, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError, TaskMetrics,
+};
+use super::mujoco::MujocoSpec;
+use crate::control::config::Law;
+use crate::control::impedance::TargetImpedance;
+use crate::control::io::{Command, Control, Measurement};
+use crate::error::Error;
+use crate::sim::record::{Recorder, Row};
+use crate::trajectory::{Setpoint, Trajectory};
+use crate::types::Vector;
+use adaptimp_mujoco::Sim;
+use core::cell::Cell;
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::intern;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString, PyTuple};
+use std::string::String;
+use std::vec::Vec;
+
+/// The most values of a row's vector (n ≤ 7 joints; a reference of m ≤ 7).
+const W: usize = 7;
+
+/// A vector of up to [`W`] values.
+type Buf = [f64; W];
+
+/// The attributes a controller has, read every period (`hasattr` in Python).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Attrs {
+    /// τ before saturation (n).
+    pub tau: bool,
+    /// Its commanded xc (m), read without a reference.
+    pub xc: bool,
+    /// Its own ẋc, ẍc (m), read without a reference.
+    pub rates: bool,
+    /// Its compliant reference xd (m).
+    pub xd: bool,
+    /// Its error z1 (m).
+    pub z1: bool,
+    /// The velocity it used (n).
+    pub dq_hat: bool,
+    /// ζ (n), read before the step.
+    pub zeta: bool,
+}
+
+impl Attrs {
+    /// From the names the controller has (unknown names are an error).
+    pub fn from_names(names: &[String]) -> Result<Self, String> {
+        let mut a = Self::default();
+        for name in names {
+            match name.as_str() {
+                "tau" => a.tau = true,
+                "xc" => a.xc = true,
+                "rates" => a.rates = true,
+                "xd" => a.xd = true,
+                "z1" => a.z1 = true,
+                "dq_hat" => a.dq_hat = true,
+                "zeta" => a.zeta = true,
+                other => return Err(std::format!("no controller attribute {other:?} is read")),
+            }
+        }
+        Ok(a)
+    }
+}
+
+/// A run of a controller written in Python ([`simulate`]).
+pub struct CallbackRun<'a> {
+    /// Ts (s).
+    pub ts: f64,
+    /// Duration T (s).
+    pub t_final: f64,
+    /// Start of the "after" window of the metrics (s).
+    pub settle: f64,
+    /// Keep every `every`-th row.
+    pub every: u64,
+    /// The disturbance parameters (SPEC §17) by schema name.
+    pub items: &'a Items,
+    /// A fault to inject (τmax: the plant's actuators').
+    pub fault: Option<&'a FaultSpec>,
+    /// The width m of the controller's reference: n, or 3 (task space).
+    pub m: usize,
+    /// xc, ẋc, ẍc of every row, K × m each, row-major: the keywords of the
+    /// step with `setpoint`; without, the rows' ẋc, ẍc (NaN: unknown).
+    pub table: [&'a [f64]; 3],
+    /// Pass the table's row to the step as `xc=`, `dxc=`, `ddxc=`.
+    pub setpoint: bool,
+    /// Call `step(q, dq, wrench)` (a task-space controller) instead of
+    /// `step(q, tau_e, dq)`.
+    pub wants_wrench: bool,
+    /// The attributes read.
+    pub attrs: Attrs,
+    /// The target impedance Dd, Cd, Gd (n values each) of the metrics.
+    pub target: [&'a [f64]; 3],
+}
+
+/// What the controller told about the row it stepped last.
+#[derive(Clone, Copy, Debug)]
+struct Report {
+    /// Its xc, when it has one and the run no reference.
+    xc: Option<Buf>,
+    /// Its ẋc, ẍc, when it has them and the run no reference.
+    rates: Option<(Buf, Buf)>,
+    xd: Option<Buf>,
+    z1: Option<Buf>,
+    dq_hat: Option<Buf>,
+    /// Its τ, else the torque it returned.
+    tau: Buf,
+    /// The torque it returned within the actuators' limits (the metrics'
+    /// sat(τ): saturated by the controller or the motors, not weakened by
+    /// a disturbance).
+    sat: Buf,
+    /// ζ before the step (zero if it has none).
+    zeta: Buf,
+}
+
+impl Report {
+    const NONE: Self = Self {
+        xc: None,
+        rates: None,
+        xd: None,
+        z1: None,
+        dq_hat: None,
+        tau: [f64::NAN; W],
+        sat: [f64::NAN; W],
+        zeta: [0.0; W],
+    };
+}
+
+/// The attribute `name` of `ctrl`: `width` reals of a 1-D float64 array (the
+/// fast path), or of whatever `numpy.asarray` makes of it, flattened.
+fn floats(
+    py: Python<'_>,
+    ctrl: &Bound<'_, PyAny>,
+    name: &Bound<'_, PyString>,
+    width: usize,
+) -> PyResult<Buf> {
+    let obj = ctrl.getattr(name)?;
+    let mut out = [0.0; W];
+    if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+        if let Ok(r) = a.try_readonly() {
+            if let Ok(s) = r.as_slice() {
+                if s.len() == width {
+                    out[..width].copy_from_slice(s);
+                    return Ok(out);
+                }
+            }
+        }
+    }
+    let a = as_float_array(py, &obj)?;
+    let r = a.try_readonly()?;
+    let v = r.as_array();
+    if v.len() != width {
+        let shape = a.getattr(intern!(py, "shape"))?.str()?;
+        return Err(PyValueError::new_err(std::format!(
+            "the controller's {name} must have {width} values, got shape {shape}"
+        )));
+    }
+    for (o, x) in out.iter_mut().zip(v.iter()) {
+        *o = *x;
+    }
+    Ok(out)
+}
+
+/// `numpy.asarray(obj, dtype=numpy.float64)`.
+fn as_float_array<'py>(
+    py: Python<'py>,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let np = py.import(intern!(py, "numpy"))?;
+    let kw = PyDict::new(py);
+    kw.set_item(intern!(py, "dtype"), np.getattr(intern!(py, "float64"))?)?;
+    let a = np
+        .getattr(intern!(py, "asarray"))?
+        .call((obj,), Some(&kw))?;
+    Ok(a.cast_into::<PyArrayDyn<f64>>()?)
+}
+
+/// The torque a step returned, as the Python loop's plant took it: n
+/// values, or one for every joint; an error naming its shape otherwise.
+/// `Ok(Err(e))`: not finite (`e` says so, as the Python loop did).
+fn torque(py: Python<'_>, obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Result<Buf, PyErr>> {
+    let mut out = [0.0; W];
+    let fast = obj
+        .cast::<PyArray1<f64>>()
+        .ok()
+        .and_then(|a| a.try_readonly().ok())
+        .is_some_and(|r| match r.as_slice() {
+            Ok(s) if s.len() == n => {
+                out[..n].copy_from_slice(s);
+                true
+            }
+            _ => false,
+        });
+    let mut given = None;
+    if !fast {
+        let a = as_float_array(py, obj)?;
+        let r = a.try_readonly()?;
+        let v = r.as_array();
+        match a.shape() {
+            [] => out[..n].fill(v.iter().copied().next().unwrap_or(f64::NAN)),
+            [k] if *k == n => {
+                for (o, x) in out.iter_mut().zip(v.iter()) {
+                    *o = *x;
+                }
+                given = Some(a.clone());
+            }
+            _ => {
+                let shape = a.getattr(intern!(py, "shape"))?.str()?;
+                return Err(PyValueError::new_err(std::format!(
+                    "tau must have shape ({n},), got {shape}"
+                )));
+            }
+        }
+    }
+    if out[..n].iter().all(|x| x.is_finite()) {
+        return Ok(Ok(out));
+    }
+    let text = match given {
+        Some(a) => a.str()?,
+        None => PyArray1::from_slice(py, &out[..n]).str()?,
+    };
+    Ok(Err(PyValueError::new_err(std::format!(
+        "tau must be finite, got {text}"
+    ))))
+}
+
+/// The row of a table for t_k = k·Ts.
+fn row_of(t: f64, ts: f64) -> usize {
+    libm::round(t / ts) as usize
+}
+
+/// The loop's clock: the trajectory the loop samples at every row, t_k in,
+/// nothing out (the controller's setpoint is the table's row of t_k).
+struct Clock<'a>(&'a Cell<f64>);
+
+impl<const N: usize> Trajectory<N> for Clock<'_> {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        self.0.set(t);
+        let nan = Vector::from_element(f64::NAN);
+        Setpoint {
+            x: nan,
+            dx: nan,
+            ddx: nan,
+        }
+    }
+}
+
+/// The Python controller as the loop's [`Control`].
+struct PyStep<'a, const N: usize> {
+    ctrl: &'a Py<PyAny>,
+    run: &'a CallbackRun<'a>,
+    target: TargetImpedance<N>,
+    tau_max: Vector<N>,
+    clock: &'a Cell<f64>,
+    report: &'a Cell<Report>,
+    abort: &'a Cell<bool>,
+    /// The exception that ended the run.
+    error: Option<PyErr>,
+}
+
+/// How a call ended.
+enum Called {
+    /// The torque to apply.
+    Torque(Buf),
+    /// A torque that is not finite (the message of the Python loop).
+    NotFinite(PyErr),
+}
+
+impl<const N: usize> PyStep<'_, N> {
+    /// The step's arguments: (q, tau_e, dq) or (q, dq, wrench), and the
+    /// row's setpoint as keywords.
+    fn arguments<'py>(
+        &self,
+        py: Python<'py>,
+        k: usize,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+    ) -> PyResult<(Bound<'py, PyTuple>, Option<Bound<'py, PyDict>>)> {
+        let q = PyArray1::from_slice(py, m.x.as_slice());
+        let dq = m.dx.unwrap_or(m.x.map(|_| f64::NAN));
+        let dq = PyArray1::from_slice(py, dq.as_slice());
+        let args = if self.run.wants_wrench {
+            PyTuple::new(py, [q, dq, PyArray1::from_slice(py, wrench)])?
+        } else {
+            let tau_e = PyArray1::from_slice(py, m.tau_e.as_slice());
+            PyTuple::new(py, [q, tau_e, dq])?
+        };
+        if !self.run.setpoint {
+            return Ok((args, None));
+        }
+        let w = self.run.m;
+        let kw = PyDict::new(py);
+        for (name, t) in [
+            (intern!(py, "xc"), self.run.table[0]),
+            (intern!(py, "dxc"), self.run.table[1]),
+            (intern!(py, "ddxc"), self.run.table[2]),
+        ] {
+            kw.set_item(name, PyArray1::from_slice(py, &t[k * w..(k + 1) * w]))?;
+        }
+        Ok((args, Some(kw)))
+    }
+
+    /// One call of the Python step at row `k`, and the attributes after it.
+    fn call(
+        &self,
+        py: Python<'_>,
+        k: usize,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+    ) -> PyResult<Called> {
+        let ctrl = self.ctrl.bind(py);
+        let (a, w) = (self.run.attrs, self.run.m);
+        let get = |name: &Bound<'_, PyString>, width: usize| floats(py, ctrl, name, width);
+        let mut r = Report::NONE;
+        if a.zeta {
+            r.zeta = get(intern!(py, "zeta"), N)?;
+        }
+        let (args, kw) = self.arguments(py, k, m, wrench)?;
+        let out = ctrl.call_method(intern!(py, "step"), args, kw.as_ref())?;
+        let tau = match torque(py, &out, N)? {
+            Ok(t) => t,
+            Err(e) => return Ok(Called::NotFinite(e)),
+        };
+        if !self.run.setpoint {
+            if a.xc {
+                r.xc = Some(get(intern!(py, "xc"), w)?);
+            }
+            if a.rates {
+                r.rates = Some((get(intern!(py, "dxc"), w)?, get(intern!(py, "ddxc"), w)?));
+            }
+        }
+        if a.xd {
+            r.xd = Some(get(intern!(py, "xd"), w)?);
+        }
+        if a.z1 {
+            r.z1 = Some(get(intern!(py, "z1"), w)?);
+        }
+        if a.dq_hat {
+            r.dq_hat = Some(get(intern!(py, "dq_hat"), N)?);
+        }
+        r.tau = if a.tau {
+            get(intern!(py, "tau"), N)?
+        } else {
+            tau
+        };
+        for ((s, t), m) in r.sat.iter_mut().zip(&tau).zip(self.tau_max.iter()) {
+            *s = t.max(-m).min(*m);
+        }
+        self.report.set(r);
+        Ok(Called::Torque(tau))
+    }
+
+    /// The step: the torque, or a refusal (a non-finite torque) or the end
+    /// of the run (an exception: [`PyStep::error`], the abort flag raised).
+    fn step_python(&mut self, m: &Measurement<N>, wrench: &[f64; 6]) -> Result<Vector<N>, Error> {
+        let k = row_of(self.clock.get(), self.run.ts);
+        match Python::attach(|py| self.call(py, k, m, wrench)) {
+            Ok(Called::Torque(t)) => Ok(Vector::from_fn(|i, _| t[i])),
+            Ok(Called::NotFinite(e)) => {
+                // Without a fault the run ends, as the Python loop's did.
+                if self.run.fault.is_none() {
+                    self.error = Some(e);
+                    self.abort.set(true);
+                }
+                Err(Error::Diverged { what: "tau" })
+            }
+            Err(e) => {
+                self.error = Some(e);
+                self.abort.set(true);
+                Err(Error::Invalid {
+                    what: "controller",
+                    reason: "its step raised an exception",
+                })
+            }
+        }
+    }
+}
+
+impl<const N: usize> Control<N> for PyStep<'_, N> {
+    fn period(&self) -> f64 {
+        self.run.ts
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        &self.target
+    }
+    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.step_with_wrench(m, &[0.0; 6], c).1
+    }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        self.step_with_wrench(m, &[0.0; 6], c)
+    }
+    /// The Python step; on a refusal zero torque (the trait's fallback).
+    fn step_with_wrench(
+        &mut self,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+        _c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        match self.step_python(m, wrench) {
+            Ok(tau) => {
+                let cmd = Command {
+                    tau_sat: tau,
+                    tau,
+                    w_norms: [f64::NAN; 3],
+                    ..Command::zeros()
+                };
+                (tau, Ok(cmd))
+            }
+            Err(e) => (Vector::zeros(), Err(e)),
+        }
+    }
+}
+
+/// The rows of the reference's width m: xc, ẋc, ẍc, xd, z1 (m per row each,
+/// row-major, in the order of [`REFERENCE`]).
+type RefRows = [Vec<f64>; 5];
+
+/// The names of the m-wide rows (they replace the joint rows of these names).
+pub const REFERENCE: [&str; 5] = ["xc", "dxc", "ddxc", "xd", "z1"];
+
+/// The loop's rows with the controller's quantities, and their metrics.
+struct Rows<'a, const N: usize, const M: usize> {
+    run: &'a CallbackRun<'a>,
+    report: &'a Cell<Report>,
+    joint: Records,
+    reference: RefRows,
+    metrics: TaskMetrics<M>,
+    seen: u64,
+}
+
+impl<const N: usize, const M: usize> Rows<'_, N, M> {
+    /// The reference-side values of row `r` (width m): xc, ẋc, ẍc, xd, z1.
+    fn reference(&self, r: &Row<N>, rep: &Report) -> [Buf; 5] {
+        let (run, w) = (self.run, self.run.m);
+        let k = row_of(r.t, run.ts);
+        let row = |t: &[f64]| -> Buf {
+            let mut o = [f64::NAN; W];
+            if let Some(v) = t.get(k * w..(k + 1) * w) {
+                o[..w].copy_from_slice(v);
+            }
+            o
+        };
+        let mut q = [0.0; W];
+        q[..N].copy_from_slice(r.x.as_slice());
+        let xc = match rep.xc {
+            Some(x) if !run.setpoint => x,
+            _ if run.setpoint => row(run.table[0]),
+            _ => q,
+        };
+        let (dxc, ddxc) = match rep.rates {
+            Some(r) if !run.setpoint => r,
+            _ => (row(run.table[1]), row(run.table[2])),
+        };
+        let xd = rep.xd.unwrap_or(xc);
+        let z1 = match rep.z1 {
+            // A refused row: the error of the last reference (the core's rule).
+            Some(_) if r.refused && w == N => core::array::from_fn(|i| xd[i] - q[i]),
+            Some(z) => z,
+            None => core::array::from_fn(|i| xd[i] - q[i]),
+        };
+        [xc, dxc, ddxc, xd, z1]
+    }
+}
+
+impl<const N: usize, const M: usize> Recorder<N> for Rows<'_, N, M> {
+    fn record(&mut self, r: &Row<N>) {
+        let rep = self.report.get();
+        let [xc, dxc, ddxc, xd, z1] = self.reference(r, &rep);
+        let w = self.run.m;
+        let tau = if r.refused {
+            r.tau
+        } else {
+            Vector::from_fn(|i, _| rep.tau[i])
+        };
+        let own = |v: Option<Buf>, or: Vector<N>| v.map_or(or, |b| Vector::from_fn(|i, _| b[i]));
+        let row = Row {
+            tau,
+            dx_hat: own(rep.dq_hat, r.dx),
+            zeta: Vector::from_fn(|i, _| rep.zeta[i]),
+            // No weights are read (also on a row refused before any step).
+            w_norms: [f64::NAN; 3],
+            ..*r
+        };
+        self.joint.record(&row);
+        if self.seen.is_multiple_of(self.joint.every) {
+            for (out, v) in self.reference.iter_mut().zip([xc, dxc, ddxc, xd, z1]) {
+                out.extend_from_slice(&v[..w]);
+            }
+        }
+        self.seen += 1;
+        // A refused row: sat(τ) = τ, the torque held (no saturation, as the core counts it).
+        let sat = if r.refused {
+            tau
+        } else {
+            Vector::<N>::from_fn(|i, _| rep.sat[i])
+        };
+        self.metrics.push(
+            r.t,
+            [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
+            [&xc[..w], &dxc[..w], &ddxc[..w]],
+            &z1[..w],
+            [tau.as_slice(), sat.as_slice(), r.tau_e.as_slice()],
+        );
+    }
+}
+
+/// What a run gives back: the joint rows, the reference rows (m wide) and
+/// the metrics, or how it ended; and the exception the controller raised,
+/// which ended it.
+pub struct RunOut {
+    /// The rows and metrics, or the run's error.
+    pub rows: Result<(Records, RefRows, MetricsOut), RunError>,
+    /// The controller's exception.
+    pub raised: Option<PyErr>,
+}
+
+impl From<RunError> for RunOut {
+    fn from(e: RunError) -> Self {
+        Self {
+            rows: Err(e),
+            raised: None,
+        }
+    }
+}
+
+/// A run's records, metrics and target, made before it starts: the table
+/// and the disturbances checked, the rows allocated.
+struct Prepared<const N: usize, const M: usize> {
+    joint: Records,
+    reference: RefRows,
+    metrics: TaskMetrics<M>,
+    target: TargetImpedance<N>,
+}
+
+fn prepare<const N: usize, const M: usize>(
+    run: &CallbackRun<'_>,
+) -> Result<Prepared<N, M>, RunError> {
+    let w = run.m;
+    let total = crate::sim::simulator::steps(run.t_final, run.ts)?;
+    let need = usize::try_from(total)
+        .unwrap_or(usize::MAX)
+        .saturating_mul(w);
+    if run.table.iter().any(|t| t.len() < need) {
+        return Err(invalid("table", "needs one row per step"));
+    }
+    if run.wants_wrench {
+        reads_the_wrench::<N>(Law::Pd, run.items, run.fault)?;
+    }
+    let every = run.every.max(1);
+    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let joint = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let mut reference = RefRows::default();
+    for v in &mut reference {
+        let room = kept.checked_mul(w).ok_or(RunError::Memory(kept))?;
+        v.try_reserve_exact(room)
+            .map_err(|_| RunError::Memory(kept))?;
+    }
+    let joint_space = !run.wants_wrench && w == N;
+    let (metrics, target) = metrics_and_target::<N, M>(run, joint_space)?;
+    Ok(Prepared {
+        joint,
+        reference,
+        metrics,
+        target,
+    })
+}
+
+/// The closed loop of the Python controller `ctrl` on MuJoCo (`sim` as
+/// `spec` describes it), with the reference's width M = max(N, m) in the
+/// metrics' accumulator.
+fn run_m<const N: usize, const M: usize>(
+    ctrl: &Py<PyAny>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &CallbackRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> RunOut {
+    let p = match prepare::<N, M>(run) {
+        Ok(p) => p,
+        Err(e) => return e.into(),
+    };
+    let (clock, report, abort) = (Cell::new(0.0), Cell::new(Report::NONE), Cell::new(false));
+    let tau_max =
+        Vector::<N>::from_fn(|i, _| spec.tau_max.get(i).copied().unwrap_or(f64::INFINITY));
+    let mut step = PyStep::<N> {
+        ctrl,
+        run,
+        target: p.target,
+        tau_max,
+        clock: &clock,
+        report: &report,
+        abort: &abort,
+        error: None,
+    };
+    let mut rows = Rows::<N, M> {
+        run,
+        report: &report,
+        joint: p.joint,
+        reference: p.reference,
+        metrics: p.metrics,
+        seen: 0,
+    };
+    let on = OnMujoco {
+        sim,
+        spec,
+        t_final: run.t_final,
+        settle: run.settle,
+        items: run.items,
+        law: Law::Pd,
+        fault: run.fault,
+        abort: Some(&abort),
+    };
+    let result = drive_mujoco(&mut step, &Clock(&clock), on, hooks, &mut rows);
+    RunOut {
+        rows: result.map(|()| (rows.joint, rows.reference, rows.metrics.finish())),
+        raised: step.error,
+    }
+}
+
+fn invalid(what: &'static str, reason: &'static str) -> RunError {
+    RunError::Core(Error::Invalid { what, reason }, None)
+}
+
+/// The metrics' accumulator (n joints, the reference m wide) and the target
+/// impedance of the run.
+fn metrics_and_target<const N: usize, const M: usize>(
+    run: &CallbackRun<'_>,
+    joint_space: bool,
+) -> Result<(TaskMetrics<M>, TargetImpedance<N>), Error> {
+    let metrics = TaskMetrics::<M>::new(N, run.m, joint_space, run.settle, run.target)?;
+    let t = |v: &[f64]| Vector::<N>::from_fn(|i, _| v.get(i).copied().unwrap_or(1.0));
+    let target = match TargetImpedance::new(t(run.target[0]), t(run.target[1]), t(run.target[2])) {
+        Ok(tgt) => tgt,
+        // Only the metrics read the target; in task space they do not.
+        Err(_) => {
+            TargetImpedance::new(Vector::from_element(1.0), Vector::zeros(), Vector::zeros())?
+        }
+    };
+    Ok((metrics, target))
+}
+
+/// The run of `ctrl` for N joints: M = N in joint space, max(N, 3) in task space.
+fn run_n<const N: usize>(
+    ctrl: &Py<PyAny>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &CallbackRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> RunOut {
+    if run.m == 3 && N < 3 {
+        run_m::<N, 3>(ctrl, sim, spec, run, hooks)
+    } else if run.m == 3 || run.m == N {
+        run_m::<N, N>(ctrl, sim, spec, run, hooks)
+    } else {
+        invalid("m", "the reference has n values, or 3 (task space)").into()
+    }
+}
+
+/// The closed loop of the Python controller `ctrl` (n joints) on MuJoCo.
+pub fn simulate(
+    n: usize,
+    ctrl: &Py<PyAny>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &CallbackRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> RunOut {
+    macro_rules! arms {
+        ($($k:literal)*) => {
+            match n {
+                $($k => run_n::<$k>(ctrl, sim, spec, run, hooks),)*
+                _ => invalid("n", "the number of joints must be between 1 and 7").into(),
+            }
+        };
+    }
+    arms!(1 2 3 4 5 6 7)
+}
+
+/// Close the loop of `controller`, a controller written in Python (the
+/// protocol `adaptimp.mujoco.ControllerLike`), with the MuJoCo `model` and
+/// its `data` as `spec` describes the plant, at the period `ts` (s) for
+/// `t_final` (s): the core's loop with the GIL released, taken once a period
+/// for the controller's step (and its attributes `attrs`: "tau", "xc",
+/// "rates" (its `dxc` and `ddxc`), "xd", "z1", "dq_hat", "zeta"). `table`
+/// = (xc, dxc, ddxc), (K, m) each with K ≥ the steps: passed to the step as
+/// keywords with `setpoint`, else the rows' rates. `wants_wrench`: the step
+/// is `step(q, dq, wrench)`, the reference m = 3 wide. `target` = (Dd, Cd,
+/// Gd), n values each, for the impedance metric. `params` (the disturbances
+/// of SPEC §17), `settle`, `record_every`, `progress`, `fault` as for
+/// `simulate_mujoco`. Returns its dict, with "xc", "dxc", "ddxc", "xd", "z1"
+/// (K, m). An exception of the controller ends the run and is raised.
+#[pyfunction]
+#[pyo3(signature = (controller, model, data, spec, params, ts, t_final, settle, table, *, setpoint, wants_wrench, attrs, target, record_every=1, progress=None, fault=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_mujoco_callback<'py>(
+    py: Python<'py>,
+    controller: Bound<'py, PyAny>,
+    model: &Bound<'py, PyAny>,
+    data: &Bound<'py, PyAny>,
+    spec: &Bound<'py, PyDict>,
+    params: &Bound<'py, PyDict>,
+    ts: f64,
+    t_final: f64,
+    settle: f64,
+    table: (
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+    ),
+    setpoint: bool,
+    wants_wrench: bool,
+    attrs: Vec<String>,
+    target: (Vec<f64>, Vec<f64>, Vec<f64>),
+    record_every: u64,
+    progress: Option<Py<PyAny>>,
+    fault: Option<super::PyFault>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let fault = super::fault_spec(fault)?;
+    if record_every == 0 {
+        return Err(super::ConfigError::new_err("record_every must be ≥ 1"));
+    }
+    let spec = super::mujoco_spec(spec)?;
+    let items = super::items(params)?;
+    let attrs = Attrs::from_names(&attrs).map_err(PyValueError::new_err)?;
+    let (rows, m) = (table.0.shape()[0], table.0.shape()[1]);
+    let tab = [
+        super::table("table xc", &table.0, rows, m)?,
+        super::table("table dxc", &table.1, rows, m)?,
+        super::table("table ddxc", &table.2, rows, m)?,
+    ];
+    let mut sim = Sim::from_python(model, data)?;
+    let run = CallbackRun {
+        ts,
+        t_final,
+        settle,
+        every: record_every,
+        items: &items,
+        fault: fault.as_ref(),
+        m,
+        table: [&tab[0], &tab[1], &tab[2]],
+        setpoint,
+        wants_wrench,
+        attrs,
+        target: [&target.0, &target.1, &target.2],
+    };
+    let ctrl = controller.unbind();
+    let n = spec.qadr.len();
+    let mut hooks = super::PyHooks::new(progress);
+    let result = py.detach(|| simulate(n, &ctrl, &mut sim, &spec, &run, &mut hooks));
+    drop(sim);
+    if let Some(raised) = result.raised {
+        return Err(raised);
+    }
+    let (rec, reference, metrics) = result.rows.map_err(|e| super::run_error(e, &mut hooks))?;
+    let k = rec.rows();
+    let out = super::records_dict(py, rec, metrics)?;
+    for (name, rows) in REFERENCE.iter().zip(reference) {
+        out.set_item(*name, super::array(py, rows, (k, m))?)?;
+    }
+    Ok(out)
+}

@@ -389,6 +389,7 @@ pub fn table_metrics(
         });
     }
     let v3 = |a: &[f64], i: usize| Vector::<3>::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+    let sq = |x: f64| x * x;
     let after = |i: usize| rows.t[i] >= spec.settle - 1e-9;
     let (mut n_after, mut track, mut along, mut path, mut force, mut imp) =
         (0usize, 0.0, 0.0, 0.0, 0.0, 0.0);
@@ -417,18 +418,18 @@ pub fn table_metrics(
             rows.wrench[6 * i + 1],
             rows.wrench[6 * i + 2],
         );
-        force += (-f[2] - kd[2] * spec.depth).powi(2);
+        force += sq(-f[2] - kd[2] * spec.depth);
         let r = md.component_mul(&(v3(rows.ddp, i) - ddpc))
             + bd.component_mul(&(v3(rows.dp, i) - dpc))
             + kd.component_mul(&(p - pc))
             + f;
         imp += r.norm_squared();
         let fn_ = rows.normal[i];
-        err += (fn_ - target).powi(2);
+        err += sq(fn_ - target);
         mean += fn_;
         ne += pd[2] - p[2];
         if i + 1 < k {
-            chatter += (rows.normal[i + 1] - fn_).powi(2);
+            chatter += sq(rows.normal[i + 1] - fn_);
             n_chatter += 1;
         }
     }

@@ -1,4 +1,4 @@
-"""Your arm in five lines: a URDF in, a figure and the metrics out (docs/your_arm.md).
+"""Your arm in five lines: a URDF or MJCF in, a figure and the metrics out (docs/your_arm.md).
 
 The five lines a user writes::
 
@@ -9,19 +9,24 @@ The five lines a user writes::
         print(case, res.metrics["rms_z1_after2"])
     runs["sf"].plot("tracking").savefig("my_arm.png")
 
-``simulate`` given only the URDF fixes the gripper and any branch, chooses a
-home posture inside the joint limits where gravity is well within the effort
-limits, a default task (every joint swings ±0.2 rad at 0.5 Hz about it, from
-rest), and the gains, the RBF centres and the learning rates by the rule of
-SPEC §18; nothing is tuned per arm. This script does that and prints, per
-controller, the targets of docs/your_arm.md: RMS ‖z1‖ over t ≥ 2 s and its
-ratio to PD's, the drift check (the last 2 s against [2, 4) s) and the peak
-commanded torque after 0.1 s over τmax; with ``--payload`` it adds a point
-mass (a fraction of the arm's moving mass) to the plant only and runs computed
-torque with the exact and the nominal model on the same task.
+``simulate`` given only the file (a URDF, or an MJCF as it ships: position
+servos become torque motors of their force range, a gripper's joints are
+locked, the end effector may be a body) fixes the gripper and any branch,
+chooses a home posture inside the joint limits where gravity is well within
+the effort limits and the swing keeps the arm off itself, a default task
+(every joint swings ±0.2 rad at 0.5 Hz about it, from rest), and the gains,
+the RBF centres and the learning rates by the rule of SPEC §18; nothing is
+tuned per arm. This script does that and prints, per controller, the targets
+of docs/your_arm.md: RMS ‖z1‖ over t ≥ 2 s and its ratio to PD's, the drift
+check (the last 2 s against [2, 4) s), the peak commanded torque after 0.1 s
+over τmax and the share of steps at a torque limit; with ``--payload`` it adds
+a point mass (a fraction of the arm's moving mass) to the plant only and runs
+computed torque with the exact and the nominal model on the same task.
 
-    python examples/15_your_arm.py [URDF] [--payload 0.1] [--figure out.png]
-    python examples/15_your_arm.py [URDF] --long 600     # weight norms over 600 s
+    python examples/15_your_arm.py [FILE] [--payload 0.1] [--figure out.png]
+    python examples/15_your_arm.py [FILE] --tip tool0 --fix wrist_3_joint --home 0,-1,1,0,0,0
+    python examples/15_your_arm.py [FILE] --long 600     # weight norms over 600 s
+    python examples/15_your_arm.py FILE... --T 8 --rows [--json out.json]   # the docs' tables
 
 Default URDF: the UR5 of example-robot-data. ``ADAPTIMP_QUICK=1``: T = 2.5 s.
 """
@@ -42,12 +47,18 @@ from adaptimp import _models
 from adaptimp import mujoco as amj
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
-UR5 = _models.panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
+
+
+def ur5() -> Path:
+    """The UR5 of example-robot-data (the extra ``pinocchio``): the default arm,
+    looked up only when no file is given (a given file needs only ``mujoco``)."""
+    return _models.panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
 
 
 def targets(res: Any) -> dict[str, float]:
     """RMS ‖z1‖ (t ≥ 2 s), over [2, 4) s and over the last 2 s (rad); peak
-    commanded |τ_i|/τmax_i after 0.1 s; the largest applied |τ_i|/τmax_i."""
+    commanded |τ_i|/τmax_i after 0.1 s; the largest applied |τ_i|/τmax_i; the
+    share of steps with a torque at its limit."""
     t, z = res.t, np.sum(res.z1**2, axis=1)
     end = t[-1] + (t[1] - t[0])
 
@@ -61,51 +72,62 @@ def targets(res: Any) -> dict[str, float]:
         "late": rms(end - 2.0, end),
         "peak": float(np.max(np.abs(res.tau[t >= 0.1]) / tau_max)),
         "applied": float(np.max(np.abs(res.tau_sat) / tau_max)),
+        "at_limit": float(res.metrics["sat_duty"]),
     }
 
 
-def table(urdf: Path, T: float, payload: float | None) -> dict[str, Any]:
-    """PD, SF and OF by the default route; with a payload fraction, computed
-    torque with the exact and the nominal model through simulate's controller
-    protocol on the SF run's reference (docs/your_arm.md)."""
-    kg = 0.0
-    if payload is not None:
-        kg = payload * amj.moving_mass(amj.Plant(urdf).model)
-    runs = {case: amj.simulate(case, urdf, T=T, payload=kg) for case in ("pd", "sf", "of")}
+def table(
+    path: Path, T: float, payload: float | None, arm: dict[str, Any], home: Any = None
+) -> dict[str, Any]:
+    """PD, SF and OF by the default route (``arm``: the Plant's ``tip``/``fix``;
+    ``home`` the task's posture); with a payload fraction, computed torque with
+    the exact and the nominal model through simulate's controller protocol on
+    the SF run's reference (docs/your_arm.md)."""
+    nominal = amj.Plant(path, **arm)
+    kg = 0.0 if payload is None else payload * amj.moving_mass(nominal.model)
+    runs = {
+        case: amj.simulate(case, nominal, T=T, payload=kg, home=home) for case in ("pd", "sf", "of")
+    }
     if payload is not None:
         from adaptimp.baselines import ComputedTorque
 
         sf = runs["sf"]
         for name, model_kg in (("CT exact", kg), ("CT nominal", 0.0)):
             ct = ComputedTorque(
-                urdf, Ts=sf.params["Ts"], tau_max=sf.params["tau_max"], payload=model_kg
+                path, Ts=sf.params["Ts"], tau_max=sf.params["tau_max"], payload=model_kg, **arm
             )
-            runs[name] = amj.simulate(ct, urdf, T=T, reference=sf, q0=sf.q[0], payload=kg)
+            runs[name] = amj.simulate(ct, nominal, T=T, reference=sf, q0=sf.q[0], payload=kg)
     rows = {name: targets(res) for name, res in runs.items()}
     task = runs["pd"].params["task"]
-    print(f"{urdf.name}: {runs['pd'].q.shape[1]} joints, τmax = {runs['pd'].params['tau_max']} N m")
+    print(
+        f"{path.name}: {nominal.n} joints {nominal.joint_names}, "
+        f"τmax = {nominal.tau_max.tolist()} N m"
+    )
     print(f"home posture (rad): {np.round(task['home'], 3).tolist()}; payload {kg:.3f} kg")
     pd = rows["pd"]["rms"]
     print(
         "| controller | RMS ‖z1‖, t ≥ 2 s (rad) | / PD | [2, 4) s | last 2 s | drift ok "
-        "| peak τ/τmax |"
+        "| peak τ/τmax | steps at a limit |"
     )
-    print("|---|---:|---:|---:|---:|:-:|---:|")
+    print("|---|---:|---:|---:|---:|:-:|---:|---:|")
     for name, m in rows.items():
         ok = "yes" if m["late"] <= m["early"] * (1 + 1e-9) else "no"  # (rounding: 1e-9)
         print(
             f"| {name} | {m['rms']:.3g} | {m['rms'] / pd:.3f} | {m['early']:.3g} | "
-            f"{m['late']:.3g} | {ok} | {m['peak']:.3f} |"
+            f"{m['late']:.3g} | {ok} | {m['peak']:.3f} | {100 * m['at_limit']:.1f} % |"
         )
         assert m["applied"] <= 1.0 + 1e-12, "the applied torque stays within the limits"
-    return runs
+    for name, res in runs.items():
+        for text in res.params.get("warnings", []):
+            print(f"  {name}: {text}")
+    return {"runs": runs, "rows": rows, "payload": kg, "home": task["home"]}
 
 
-def long_run(urdf: Path, seconds: float, case: str = "sf") -> None:
+def long_run(path: Path, seconds: float, arm: dict[str, Any], case: str = "sf") -> None:
     """The default route's controller for ``seconds`` of the default task in
     your own loop (Controller.step and MuJoCo's mj_step), with the weight norms and the
     largest commanded |τ_i|/τmax_i every so often."""
-    plant = amj.Plant(urdf)
+    plant = amj.Plant(path, **arm)
     task = amj.default_task(plant)
     kw = amj.rule_keywords(plant, task, case=case)
     n = kw.pop("n")
@@ -117,7 +139,7 @@ def long_run(urdf: Path, seconds: float, case: str = "sf") -> None:
     steps = round(seconds / ctrl.Ts)
     marks = {round(s / ctrl.Ts) for s in (10, 30, 60, 120, 180, 300, 450, 600, seconds)}
     peak, z2sum, rows = 0.0, 0.0, 0
-    print(f"{case} on {urdf.name}, {seconds:g} s of the default task:")
+    print(f"{case} on {path.name}, {seconds:g} s of the default task:")
     print(
         "| t (s) | RMS ‖z1‖ since the row above (rad) | ‖W_D‖ | ‖W_C‖ | ‖W_G‖ | bound ‖W_G‖ "
         "| max commanded \\|τ_i\\|/τmax_i, t ≥ 0.1 s |"
@@ -145,21 +167,107 @@ def long_run(urdf: Path, seconds: float, case: str = "sf") -> None:
     print(f"({time.perf_counter() - start:.0f} s of wall time)")
 
 
+def summary(path: Path, out: dict[str, Any]) -> str:
+    """One markdown row of docs/your_arm.md's tables: the file, its joints, SF/PD,
+    OF/PD, SF's drift ([2, 4) s → last 2 s), the peak commanded τ/τmax and the
+    most steps at a limit over PD, SF, OF; with a payload, computed torque's
+    RMS ‖z1‖ (nominal, exact) and SF's ratios to them."""
+    rows, n = out["rows"], len(out["home"])
+    pd = rows["pd"]["rms"]
+    cases = [rows[c] for c in ("pd", "sf", "of")]
+    cells = [
+        f"`{path.parent.name}/{path.name}` ({n})",
+        f"{pd:.3g}",
+        f"{rows['sf']['rms'] / pd:.3f}",
+        f"{rows['of']['rms'] / pd:.3f}",
+        f"{rows['sf']['early']:.3g} → {rows['sf']['late']:.3g}",
+        f"{max(m['peak'] for m in cases):.2f}",
+        f"{100 * max(m['at_limit'] for m in cases):.1f} %",
+    ]
+    if "CT nominal" in rows:
+        sf, nom, exact = rows["sf"]["rms"], rows["CT nominal"]["rms"], rows["CT exact"]["rms"]
+        cells += [f"{out['payload']:.3g}", f"{nom:.3g}", f"{exact:.3g}"]
+        cells += [f"{sf / nom:.3f}", f"{exact / sf:.2f}"]
+    return "| " + " | ".join(cells) + " |"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("urdf", nargs="?", type=Path, default=UR5)
+    parser.add_argument("paths", nargs="*", type=Path, help="URDF or MJCF files (default UR5)")
     parser.add_argument("--payload", type=float, default=None, help="fraction of the arm's mass")
     parser.add_argument("--figure", type=Path, default=None, help="write SF's tracking figure")
     parser.add_argument("--long", type=float, default=None, help="seconds of a long SF run")
+    parser.add_argument("--tip", default=None, help="the end effector: a link, body or site")
+    parser.add_argument("--fix", default="", help="joints to lock, comma-separated")
+    parser.add_argument("--home", default=None, help="the task's posture (rad), comma-separated")
+    parser.add_argument("--T", type=float, default=None, help="duration (s), default 10")
+    parser.add_argument("--json", type=Path, default=None, help="write the table's numbers")
+    parser.add_argument("--rows", action="store_true", help="one summary row per file at the end")
     args = parser.parse_args()
+    if not args.paths:
+        try:
+            args.paths = [ur5()]
+        except ImportError as e:
+            parser.error(f"no file given, and the default UR5 needs the extra pinocchio: {e}")
+    paths = args.paths
+    missing = [str(p) for p in paths if not p.is_file()]
+    if missing:
+        parser.error(f"no file {missing[0]!r}")
+    arm: dict[str, Any] = {}
+    if args.tip is not None:
+        arm["tip"] = args.tip
+    if args.fix:
+        arm["fix"] = tuple(j.strip() for j in args.fix.split(",") if j.strip())
+    home = None
+    if args.home is not None:
+        try:
+            home = [float(x) for x in args.home.split(",")]
+        except ValueError:
+            parser.error(f"--home must be numbers (rad) separated by commas, got {args.home!r}")
+    if args.json is not None and not args.json.parent.is_dir():
+        parser.error(f"--json: no directory {str(args.json.parent)!r}")
     if args.long is not None:
-        long_run(args.urdf, 1.0 if QUICK else args.long)
+        for path in paths:
+            long_run(path, 1.0 if QUICK else args.long, arm)
         return
-    runs = table(args.urdf, 2.5 if QUICK else 10.0, args.payload)
-    if args.figure is not None:
-        fig = runs["sf"].plot("errors")
-        fig.savefig(args.figure, dpi=110)
-        print(f"wrote {args.figure}")
+    T = 2.5 if QUICK else (args.T if args.T is not None else 10.0)
+    records, lines = [], []
+    for path in paths:
+        try:
+            out = table(path, T, args.payload, arm, home)
+        except ImportError as e:  # --payload's computed torque needs the extra pinocchio
+            parser.error(str(e))
+        lines.append(summary(path, out))
+        records.append(
+            {
+                "file": str(path),
+                "T": T,
+                "payload_kg": out["payload"],
+                "home": list(out["home"]),
+                "rows": out["rows"],
+                "warnings": {k: r.params.get("warnings", []) for k, r in out["runs"].items()},
+                "plant": out["runs"]["pd"].params.get("plant", {}),
+            }
+        )
+        if args.figure is not None:
+            fig = out["runs"]["sf"].plot("errors")
+            fig.savefig(args.figure, dpi=110)
+            print(f"wrote {args.figure}")
+    if args.rows:
+        head = (
+            "| file (joints) | PD (rad) | SF/PD | OF/PD | SF [2,4) → last 2 s | peak τ/τmax "
+            "| at a limit |"
+        )
+        if args.payload is not None:
+            head += " payload (kg) | CT nominal | CT exact | SF / CT nominal | CT exact / SF |"
+        print(head)
+        print("|" + "---|" * (head.count("|") - 1))
+        print("\n".join(lines))
+    if args.json is not None:
+        import json
+
+        args.json.write_text(json.dumps(records, indent=1, default=str))
+        print(f"wrote {args.json}")
 
 
 if __name__ == "__main__":

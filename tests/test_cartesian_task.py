@@ -201,6 +201,6 @@ def test_self_collision_is_seen_on_the_skeleton_and_on_geometry(tmp_path: Path) 
     arm = amj.Plant(str(path), contact=False)
     assert self_collision(arm, np.array([[0.0, 0.5, 0.5]])) is None
     hit = self_collision(arm, np.array([[0.0, 0.5, 0.5], [0.0, 2.6, 2.6]]))
-    assert hit == "row 1: body 'a' touches body 'c'"
+    assert hit == "row 1: 'a'–'c' touch"
     assert arm.model.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     assert chain_of(arm).joint_names == ["j1", "j2", "j3"]

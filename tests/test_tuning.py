@@ -30,8 +30,14 @@ def _swing(q0: np.ndarray, amp: float = 0.2, w: float = math.pi) -> Any:
 def test_suggest_follows_the_rule() -> None:
     arm = adaptimp.PlanarArm(3, masses=[2.0, 1.5, 1.0], lengths=[0.4, 0.35, 0.25])
     q0 = np.array([0.3, 0.3, 0.3])
-    kw = tuning.suggest(arm, q0, [60.0, 30.0, 15.0], Ts=1e-3, path=_swing(q0), period=2.0)
-    d = 1.0 / np.diag(np.linalg.inv(arm.D(q0)))
+    path = _swing(q0)
+    kw = tuning.suggest(arm, q0, [60.0, 30.0, 15.0], Ts=1e-3, path=path, period=2.0)
+    # (18.1): the mean along the path (50 postures) of 1/(D⁻¹)_ii, shrunk if
+    # needed so that λmax(D⁻¹ diag(d)) ≤ n at each of them (here it is not).
+    ds = [arm.D(path(2.0 * k / 50)[0]) for k in range(50)]
+    d = np.mean([1.0 / np.diag(np.linalg.inv(m)) for m in ds], axis=0)
+    worst = max(np.max(np.linalg.eigvals(np.linalg.solve(m, np.diag(d))).real) for m in ds)
+    assert worst < 3
     np.testing.assert_allclose(kw["inertia"], d, rtol=1e-12)
     np.testing.assert_allclose(kw["Kp"], 0.25 * d / 1e-3, rtol=1e-12)  # (18.1)
     assert kw["K1"] == [50.0] * 3  # (18.2): min(50, 0.05/Ts)

@@ -18,7 +18,8 @@ the project's SPEC (docs/SPEC.md).
 - :func:`sweep` runs many simulations (a grid or random samples) on every core
   or on a Dask cluster and returns a pandas DataFrame.
 - Errors by kind: :class:`ConfigError`, :class:`MeasurementError`,
-  :class:`DivergedError`, :class:`FaultError`; :class:`StabilityWarning`.
+  :class:`DivergedError`, :class:`FaultError`; :class:`StabilityWarning`,
+  :class:`PlantWarning`.
 
 Every SPEC quantity is a keyword parameter with the paper's default
 (:data:`PARAMS`, :data:`SCENARIOS`)::
@@ -39,6 +40,7 @@ from ._errors import (
     DivergedError,
     FaultError,
     MeasurementError,
+    PlantWarning,
     StabilityWarning,
 )
 from ._faults import Fault
@@ -70,6 +72,7 @@ __all__ = [
     "Normal",
     "Param",
     "PlanarArm",
+    "PlantWarning",
     "SimResult",
     "StabilityWarning",
     "TwoLinkArm",

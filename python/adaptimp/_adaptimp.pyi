@@ -600,14 +600,13 @@ def suggest(
     period: float | None = None,
     gravity: NDArray[np.float64] | None = None,
     resolve: bool = False,
-    inertias: NDArray[np.float64] | None = None,
     critical: bool = False,
 ) -> dict[str, Any]:
-    """The gain and basis rule of SPEC §18: "params" (every controller keyword),
-    with a path also "centers" (L, 4n) and "widths" (4n,); ``resolve``: the tube
-    narrowed to the path's size, SPEC (16.10); ``inertias`` (K, n, n): D along the
-    path, the inertia scales the smallest over them, SPEC (16.12); ``critical``: Ĝ
-    learning at the velocity loop's critical bandwidth, SPEC (19.6)."""
+    """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
+    samples along the path (SPEC (18.1)'s scales along it): "params" (every
+    controller keyword), with a path also "centers" (L, 4n) and "widths" (4n,);
+    ``resolve``: the tube narrowed to the path's size, SPEC (16.10); ``critical``:
+    Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6)."""
 
 def pose_circle(
     p0: NDArray[np.float64],

@@ -35,7 +35,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _adaptimp
+from . import _adaptimp, _mjcf
 from ._errors import ConfigError
 from .cartesian import CartesianController, Path, tabulate
 from .chain import Chain
@@ -240,30 +240,15 @@ class _Probe:
         return np.array(self._full[np.ix_(self.dofs, self.dofs)], dtype=np.float64)
 
 
-def _arm_bodies(m: Any, joints: Sequence[int]) -> set[int]:
-    """The arm's bodies: the subtree of the arm's root (the ancestor of the
-    first joint's body just below the world)."""
-    root = int(m.jnt_bodyid[joints[0]])
-    while int(m.body_parentid[root]) != 0:
-        root = int(m.body_parentid[root])
-    return {b for b in range(m.nbody) if _is_below(m, b, root)}
-
-
-def _is_below(m: Any, b: int, root: int) -> bool:
-    while b != 0:
-        if b == root:
-            return True
-        b = int(m.body_parentid[b])
-    return False
-
-
 def self_collision(plant: Any, rows: FloatArray) -> str | None:
     """The first self-collision of the arm at the postures ``rows`` (K, n)
-    (rad), named ("t-row k: body a touches body b"), or None.
+    (rad), named ("row k: 'a'–'b' touch"), or None.
 
-    With the model's collision geometry (geoms that collide, on two or more
-    of the arm's bodies): MuJoCo's collision detection, contacts enabled,
-    among the arm's bodies (its exclusions and parent–child filter kept).
+    With the model's collision geometry (two of the arm's bodies that can
+    collide): MuJoCo's collision detection, contacts enabled, among the arm's
+    own bodies, as the joint-space task's check has it (``_mjcf.Contacts``,
+    SPEC §18: bodies its joints move relative to each other, its exclusions
+    and parent–child filter kept).
     Without (a URDF compiled as :func:`adaptimp.mujoco.from_urdf` does, which
     keeps no collision geometry): the arm's skeleton, capsules along the
     segments between consecutive distinct joint anchors and the end effector,
@@ -272,30 +257,19 @@ def self_collision(plant: Any, rows: FloatArray) -> str | None:
     come within 2r.
     """
     m = plant.model
-    arm = _arm_bodies(m, list(plant._joints))
-    colliding = {
-        int(m.geom_bodyid[g])
-        for g in range(m.ngeom)
-        if int(m.geom_bodyid[g]) in arm and (m.geom_contype[g] or m.geom_conaffinity[g])
-    }
-    probe = _Probe(plant)
-    if len(colliding) >= 2:
-        flags = int(m.opt.disableflags)
-        m.opt.disableflags = flags & ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
-        try:
-            for k, q in enumerate(rows):
-                probe.at(q)
-                for c in probe.d.contact[: probe.d.ncon]:
-                    a, b = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
-                    if a in arm and b in arm and c.dist < 0:
-                        name = mujoco.mj_id2name
-                        return (
-                            f"row {k}: body {name(m, mujoco.mjtObj.mjOBJ_BODY, a)!r} touches "
-                            f"body {name(m, mujoco.mjtObj.mjOBJ_BODY, b)!r}"
-                        )
-        finally:
-            m.opt.disableflags = flags
+    flags = int(m.opt.disableflags)
+    m.opt.disableflags = flags & ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    try:  # the copy Contacts makes has contacts on, whatever the plant's setting
+        contacts = _mjcf.Contacts(m, plant.data.qpos, list(plant._joints), self_only=True)
+    finally:
+        m.opt.disableflags = flags
+    if contacts.possible:
+        for k, q in enumerate(rows):
+            found = contacts.at(q)
+            if found:
+                return f"row {k}: {_mjcf.pairs(found)} touch"
         return None
+    probe = _Probe(plant)
     for k, q in enumerate(rows):
         probe.at(q)
         points = [np.array(probe.d.xanchor[j]) for j in plant._joints]

@@ -44,12 +44,20 @@ class StabilityWarning(UserWarning):
     condition of docs/robot.md)."""
 
 
+class PlantWarning(UserWarning):
+    """What :class:`adaptimp.mujoco.Plant` made of a model as shipped (joints
+    locked, servos driven as torque motors, τmax estimated) and what a run of
+    :func:`adaptimp.mujoco.simulate` found (the arm touching itself, the
+    torque beyond 2 τmax or at its limit): the run is valid, read the message."""
+
+
 __all__ = [
     "AdaptimpError",
     "ConfigError",
     "DivergedError",
     "FaultError",
     "MeasurementError",
+    "PlantWarning",
     "StabilityWarning",
 ]
 

@@ -549,7 +549,7 @@ class CartesianController:
         try:
             kw = tuning.suggest(
                 model, q0, limits, Ts=Ts, path=np.hstack([q, dq, ddq]), period=steps * Ts,
-                case=controller, resolve=True, along=True,
+                case=controller, resolve=True,
             )  # fmt: skip
         finally:
             forward = getattr(model, "forward", None)

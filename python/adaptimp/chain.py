@@ -262,29 +262,84 @@ class Chain(_adaptimp.Chain):
         return cls(joints, None, names=names, source=f"URDF {Path(path).name} to {tip!r}")
 
     @classmethod
-    def from_mujoco(cls, model: Any, site: str | int) -> Chain:
-        """The chain from MuJoCo's world body to the site ``site`` (name or id)
-        of the ``mujoco.MjModel`` ``model``: each body's ``body_pos``,
-        ``body_quat``, each hinge or slide joint's ``jnt_pos`` (its anchor),
-        ``jnt_axis`` and ``qpos0`` (the value at which the body has its model
-        frame), the site's ``site_pos``, ``site_quat``. q is the path's joint
-        positions in ``qpos`` order along the chain (``joint_names``).
+    def from_mujoco(
+        cls,
+        model: Any,
+        tip: str | int | None = None,
+        *,
+        fix: Sequence[str] = (),
+        site: str | int | None = None,
+    ) -> Chain:
+        """The chain from MuJoCo's world body to the end effector ``tip`` of
+        ``model``: a ``mujoco.MjModel``, or the path of an MJCF file (compiled
+        as it is, nothing edited) or of a URDF (:func:`adaptimp.mujoco.from_urdf`).
 
-        Errors (``ValueError``) for an unknown site, a free or ball joint on
-        the path, more than 7 joints.
+        ``tip`` is a site (its frame) or a body (its frame, the point MuJoCo's
+        ``mj_jacBody`` differentiates), by name (a site first if both have
+        it), or a site id; ``site=`` is the earlier keyword for a site. By
+        default the plant's end effector (:class:`adaptimp.mujoco.Plant`): the
+        site of the model's force sensor, or the first site of the last arm
+        joint's body, or that body. The chain's joints are the arm's
+        (``adaptimp._mjcf.arm_of``: the hinges on the way to the tip that are
+        not a gripper's coupled joints, a slide or named in ``fix``); any
+        other joint on the way is held at its ``qpos0``, as the plant locks
+        it. From each body's ``body_pos``, ``body_quat``, each arm joint's
+        ``jnt_pos`` (its anchor), ``jnt_axis`` and ``qpos0`` (the value at
+        which the body has its model frame), the site's ``site_pos``,
+        ``site_quat``. q is the arm's joint positions base to tip
+        (``joint_names``); pose and Jacobian equal MuJoCo's (``mj_jacSite``,
+        ``mj_jacBody`` on those joints' columns) to rounding.
+
+        Errors (``ValueError``) for a file MuJoCo cannot load, an unknown tip
+        or ``fix`` joint, a free or ball joint on the way, more than 7 joints.
         """
         import mujoco
 
-        if isinstance(site, str):
-            sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, site)
-            if sid < 0:
-                raise ConfigError(f"the MuJoCo model has no site named {site!r}")
-        else:
-            sid = int(site)
-            if not 0 <= sid < model.nsite:
-                raise ConfigError(f"the MuJoCo model has no site {sid} ({model.nsite} sites)")
+        from . import _mjcf
+
+        if site is not None and tip is not None:
+            raise ConfigError("give the end effector as tip= (a site or a body) or site=, not both")
+        tip = site if tip is None else tip
+        if not isinstance(model, mujoco.MjModel):
+            path = Path(model)
+            if not path.is_file():
+                raise ConfigError(
+                    "model must be an MjModel or the path of an MJCF or URDF file; "
+                    f"no file {str(path)!r}"
+                )
+            if path.suffix.lower() == ".urdf":
+                from .mujoco import from_urdf
+
+                model = from_urdf(path, fix=tuple(fix), tip=tip if isinstance(tip, str) else None)
+                fix = ()
+            else:
+                try:
+                    model = mujoco.MjModel.from_xml_path(str(path))
+                except ValueError as e:
+                    raise ConfigError(f"MuJoCo cannot load {str(path)!r}: {e}") from None
+        try:
+            if isinstance(tip, bool) or not isinstance(tip, (str, int, np.integer, type(None))):
+                raise TypeError(f"tip must be a site's or body's name or a site id, got {tip!r}")
+            if isinstance(tip, (int, np.integer)):
+                sid = int(tip)
+                if not 0 <= sid < model.nsite:
+                    raise ConfigError(f"the MuJoCo model has no site {sid} ({model.nsite} sites)")
+                body = int(model.site_bodyid[sid])
+            elif tip is None:
+                arm = _mjcf.arm_of(model, None, tuple(fix))
+                last = int(model.jnt_bodyid[arm["joint_ids"][-1]])
+                sid, body = _mjcf.end_effector(model, None, last)
+            else:
+                sid, body = _mjcf.end_effector(model, str(tip), 0)
+        except ValueError as e:
+            raise ConfigError(str(e)) from None
+        # The path's hinges and slides, but for joints another one dictates (a
+        # gripper's linkage) and those named in fix.
+        held = set(_mjcf.coupled_joints(model)) | {
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f) for f in fix
+        }
         bodies: list[int] = []
-        b = int(model.site_bodyid[sid])
+        b = body
         while b != 0:
             bodies.append(b)
             b = int(model.body_parentid[b])
@@ -305,13 +360,15 @@ class Chain(_adaptimp.Chain):
             )
             first = int(model.body_jntadr[b])
             for j in range(first, first + int(model.body_jntnum[b])):
-                kind = kinds.get(int(model.jnt_type[j]))
                 name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint{j}"
+                kind = kinds.get(int(model.jnt_type[j]))
                 if kind is None:
                     raise ConfigError(
-                        f"the MuJoCo joint {name!r} on the way to the site is free or ball: "
+                        f"the MuJoCo joint {name!r} on the way to the tip is free or ball: "
                         "a chain has hinge and slide joints only"
                     )
+                if j in held:
+                    continue  # held at qpos0: the body at its model frame
                 anchor = model.jnt_pos[j].tolist()
                 joints.append(
                     {
@@ -323,9 +380,13 @@ class Chain(_adaptimp.Chain):
                 )
                 joints.append({"kind": "fixed", "pos": [-x for x in anchor]})
                 names.append(name)
-        tip = {"pos": model.site_pos[sid].tolist(), "quat": model.site_quat[sid].tolist()}
-        label = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, sid) or str(sid)
-        return cls(joints, tip, names=names, source=f"MuJoCo model to site {label!r}")
+        if sid >= 0:
+            end = {"pos": model.site_pos[sid].tolist(), "quat": model.site_quat[sid].tolist()}
+            label = f"site {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, sid) or sid!r}"
+        else:
+            end = None
+            label = f"body {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body) or body!r}"
+        return cls(joints, end, names=names, source=f"MuJoCo model to {label}")
 
     def pose(self, q: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The tip's position (m), (3,), and rotation (world ← tip), (3, 3), at q."""

@@ -52,14 +52,14 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._errors import ConfigError, needs_extra
+from ._errors import ConfigError, PlantWarning, needs_extra
 
 try:
     import mujoco
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
-from . import _adaptimp, _models
+from . import _adaptimp, _mjcf, _models
 from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
 from ._faults import Fault
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
@@ -102,7 +102,7 @@ MAX_JOINTS = 7
 """The most joints a :class:`Plant` accepts."""
 
 
-ModelSource = Union["mujoco.MjModel", str, "os.PathLike[str]"]
+ModelSource = Union["mujoco.MjModel", "mujoco.MjSpec", str, "os.PathLike[str]"]
 
 
 class ControllerLike(Protocol):
@@ -374,15 +374,21 @@ def panda(
     return spec.compile()
 
 
-def _load(source: ModelSource) -> mujoco.MjModel:
+def _prepare(source: ModelSource, tip: str | None, fix: tuple[str, ...]) -> _mjcf.Prepared:
+    """The plant's model of ``source`` (SPEC §18, ``adaptimp._mjcf``): an MJCF
+    file edited in memory (joints that are not the arm's locked, one torque
+    motor per arm joint), a URDF through :func:`from_urdf` (``tip`` a link),
+    a given ``MjModel`` or a packaged model checked (servos made motors)."""
     if isinstance(source, mujoco.MjModel):
-        return copy.deepcopy(source)
+        return _mjcf.prepare_model(source, tip, fix)
+    if isinstance(source, mujoco.MjSpec):
+        return _mjcf.prepare_spec(source.copy(), tip, fix)
     if isinstance(source, str) and source in _BUILTIN:
-        return _BUILTIN[source]()
+        return _mjcf.prepare_model(_BUILTIN[source](), tip, fix)
     path = _model_path(source)
     if path.suffix.lower() == ".urdf":
-        return from_urdf(path)
-    return mujoco.MjModel.from_xml_path(str(path))
+        return _mjcf.prepare_model(from_urdf(path, fix=fix, tip=tip), tip, ())
+    return _mjcf.prepare_file(path, tip, fix)
 
 
 def _model_path(source: str | os.PathLike[str]) -> Path:
@@ -411,57 +417,121 @@ class Plant:
     """A MuJoCo model of a serial arm as the plant of a control loop.
 
     ``D(q) q̈ + C(q, q̇) q̇ + G(q) = sat(τ) − τe`` with everything MuJoCo adds
-    (contact, joint limits, whatever the model declares). The plant owns a copy
-    of the model (``model``) and its ``data``.
+    (contact, joint limits, joint damping, armature and friction loss, whatever
+    the model declares). The plant owns a copy of the model (``model``) and
+    its ``data``.
+
+    A model as its maker ships it (SPEC §18, ``docs/your_arm.md``): the arm is
+    the model's serial chain of hinge joints (:func:`adaptimp._mjcf.arm_of`,
+    the URDF reduction's rules on MuJoCo's body tree), ending at ``tip`` if
+    given. Joints of the arm's own body tree that are not the arm's (a
+    gripper's fingers, coupled joints, a slide, a head) are **locked at their
+    reference position** (removed from an in-memory copy of the file with
+    their actuators, couplings and sensors: the hand is then one rigid body,
+    as the controller's model of the arm has it, and no finger swings
+    unmodelled on the wrist). Every arm joint is driven by **one torque
+    motor**: a ``motor`` as it is; a ``position``, ``velocity`` or
+    ``general`` actuator becomes a motor of the same force range (the
+    controller commands torque); a joint without one gets one. τmax is gear ×
+    the actuator's ``forcerange`` (a motor's ``ctrlrange``), or the joint's
+    ``actuatorfrcrange`` if smaller; where nothing declares it, it is
+    estimated from the arm, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within
+    the joint limits. Each change is a :class:`adaptimp.PlantWarning` and an
+    entry of :attr:`notes` (``res.params["plant"]``); the file is never
+    written. Joints on other body trees (a door, a table on a spring) are the
+    environment's and stay as they are.
 
     Parameters
     ----------
-    model : MjModel, str or path
-        An ``MjModel``; ``"two_link"`` or ``"panda"`` (the packaged models, see
+    model : MjModel, MjSpec, str or path
+        An ``MjModel``; an ``MjSpec`` (e.g. an arm with a gripper attached; a
+        copy is edited); ``"two_link"`` or ``"panda"`` (the packaged models, see
         :func:`two_link`, :func:`panda`); or a path to an MJCF file, or to a
-        URDF (compiled by :func:`from_urdf`).
+        URDF (compiled by :func:`from_urdf`). A compiled ``MjModel`` cannot
+        lose joints or gain actuators: one whose arm tree holds joints that
+        are not the arm's, or an arm joint without an actuator, is refused
+        (give the file's path instead).
     contact : bool
         False disables every contact (MuJoCo's ``mjDSBL_CONTACT``): free space.
+    tip : str, optional
+        The end effector, a site or a body (its origin; a site if both have
+        the name): the arm is the hinges on the way to it. Default: the site of
+        the model's force sensor, or the first site of the last joint's body,
+        or that body's origin. A URDF's ``tip`` is a link.
+    fix : tuple of str
+        Joints to lock as well (at their reference position), by name.
     site : str, optional
-        The end-effector site; by default the site of the model's force sensor,
-        or the first site of the last joint's body, or that body's origin.
+        The end-effector site (the earlier name of ``tip`` for a site).
 
     Raises
     ------
     ValueError
         The model is not an arm this class can drive; the message names the
-        offending joint or actuator (joints must all be hinges, at most
-        :data:`MAX_JOINTS`, along one kinematic chain; every joint needs exactly
-        one torque actuator: a ``motor``, ``ctrllimited`` with a symmetric
-        ``ctrlrange``).
+        file, joint, body or actuator and what to do (at most
+        :data:`MAX_JOINTS` arm joints along one kinematic chain, one joint per
+        body; one actuator per arm joint; a force range symmetric about 0).
 
     Attributes
     ----------
     n : int
         Number of joints.
+    joint_names : list of str
+        The arm's joints, base to tip.
     tau_max : ndarray, (n,)
-        Actuator limits τmax (N m): gear × ctrlrange.
+        Actuator limits τmax (N m): gear × ctrlrange of the plant's motors.
     wrench_source : str
         ``"sensor"`` (force/torque sensor), ``"contact sensor"`` (the net contact
         wrench on the end effector's subtree, a MuJoCo contact sensor) or
         ``"contact"`` (the contacts' forces on the subtree's bodies, which
         MuJoCo sums from its contact list: ``cfrc_ext``).
+    tip : str or None
+        The end effector asked for (``tip`` or ``site``; None: found as above).
     site : str or None
-        The end-effector site asked for (None: found as above).
+        The end-effector site asked for with ``site=``.
+    notes : dict
+        What the plant made of the model: "locked" {joint: why}, "actuators"
+        {joint: servo → motor}, "added" [joints given a motor], "tau_max"
+        {joint: where τmax comes from: "forcerange", "ctrlrange",
+        "actuatorfrcrange" or "estimated"}, "timestep" (a file's Euler or
+        implicit integrator is stepped at ≤ 0.25 ms,
+        :data:`adaptimp._mjcf.FIRST_ORDER_STEP`), "wrench" (a force sensor
+        not used), "warnings" [their texts], "tip".
     """
 
     def __init__(
-        self, model: ModelSource = "two_link", *, contact: bool = True, site: str | None = None
+        self,
+        model: ModelSource = "two_link",
+        *,
+        contact: bool = True,
+        site: str | None = None,
+        tip: str | None = None,
+        fix: Sequence[str] = (),
     ) -> None:
+        if site is not None and tip is not None:
+            raise ValueError("give the end effector as tip= (a site or a body) or site=, not both")
+        if isinstance(fix, str):
+            raise TypeError(f"fix must be a tuple of joint names, got the string {fix!r}")
         self.contact = contact
         self.site = site
-        self._setup_model(_load(model), site)
+        self.tip = tip if tip is not None else site
+        self.fix = tuple(fix)
+        prepared = _prepare(model, self.tip, self.fix)
+        self._arm_names: tuple[str, ...] = prepared.arm["joints"]
+        self.notes: dict[str, Any] = {**prepared.notes, "warnings": list(prepared.warnings)}
+        for text in prepared.warnings:
+            warnings.warn(text, PlantWarning, stacklevel=2)
+        self._setup_model(prepared.model, self.tip)
+        self.notes["tip"] = (
+            _name(self.model, mujoco.mjtObj.mjOBJ_SITE, self._site)
+            if self._site >= 0
+            else _name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body)
+        )
         if self.wrench_source == "contact" and self._contact_sensor_fits(model):
-            # An MJCF file's model: measure the contacts with a sensor of its own
-            # (the net contact wrench on the end effector's subtree), which the
-            # core's loop reads like the force sensor. A sensor changes no dynamics.
-            assert isinstance(model, (str, os.PathLike))
-            spec = mujoco.MjSpec.from_file(str(model))
+            # A file's model: measure the contacts with a sensor of its own (the
+            # net contact wrench on the end effector's subtree), which the core's
+            # loop reads like the force sensor. A sensor changes no dynamics.
+            spec = prepared.spec
+            assert spec is not None
             spec.add_sensor(
                 name=_CONTACT_SENSOR,
                 type=mujoco.mjtSensor.mjSENS_CONTACT,
@@ -469,7 +539,7 @@ class Plant:
                 objname=_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
                 intprm=[_NETFORCE_DATA, _NETFORCE, 1],
             )
-            self._setup_model(spec.compile(), site)
+            self._setup_model(spec.compile(), self.tip)
         m = self.model
         self.data = mujoco.MjData(m)
         self._mass = np.zeros((m.nv, m.nv))
@@ -477,13 +547,18 @@ class Plant:
 
     # -- construction checks ------------------------------------------------
 
-    def _setup_model(self, model: mujoco.MjModel, site: str | None) -> None:
+    @property
+    def joint_names(self) -> list[str]:
+        """The arm's joints, base to tip (the order of q)."""
+        return [_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self._joints]
+
+    def _setup_model(self, model: mujoco.MjModel, tip: str | None) -> None:
         self.model = model
         if not self.contact:
             model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         self._check_joints()
         self._check_actuators()
-        self._find_end_effector(site)
+        self._find_end_effector(tip)
 
     def _contact_sensor_fits(self, source: ModelSource) -> bool:
         """Whether a contact sensor can measure this plant's wrench as the module
@@ -496,7 +571,7 @@ class Plant:
         the subtree on different weld bodies whose contype and conaffinity meet."""
         if isinstance(source, mujoco.MjModel) or (isinstance(source, str) and source in _BUILTIN):
             return False
-        if Path(source).suffix.lower() == ".urdf":
+        if not isinstance(source, mujoco.MjSpec) and Path(source).suffix.lower() == ".urdf":
             return False
         m = self.model
         if m.npair > 0 or not self._contact_possible():
@@ -510,45 +585,26 @@ class Plant:
             for b in inside[i + 1 :]
         )
 
-    def _environment_joints(self) -> set[int]:
-        """Joints of the environment, not of the arm: unactuated, on a body tree
-        hanging from the world that holds no actuated joint (e.g. a table on a
-        spring, ``adaptimp.contact``)."""
-        m = self.model
-        joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
-        actuated = {
-            int(m.actuator_trnid[a, 0]) for a in range(m.nu) if m.actuator_trntype[a] == joint_trn
-        }
-
-        def root(body: int) -> int:
-            while int(m.body_parentid[body]) > 0:
-                body = int(m.body_parentid[body])
-            return body
-
-        arm_roots = {root(int(m.jnt_bodyid[j])) for j in actuated}
-        return {
-            j
-            for j in range(m.njnt)
-            if j not in actuated and root(int(m.jnt_bodyid[j])) not in arm_roots
-        }
-
     def _check_joints(self) -> None:
         m = self.model
+        ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in self._arm_names]
+        if not 1 <= len(ids) <= MAX_JOINTS:
+            raise ValueError(
+                f"Plant needs 1 to {MAX_JOINTS} joints; the arm has {len(ids)} "
+                f"({', '.join(self._arm_names)}): fix some with fix=(...) or name the "
+                "arm's end with tip="
+            )
         hinge = int(mujoco.mjtJoint.mjJNT_HINGE)
-        env = self._environment_joints()
-        arm = [j for j in range(m.njnt) if j not in env]
         bad = [
             f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)} ({mujoco.mjtJoint(m.jnt_type[j]).name})"
-            for j in arm
+            for j in ids
             if m.jnt_type[j] != hinge
         ]
         if bad:
             raise ValueError(f"Plant needs hinge joints only; not hinges: {', '.join(bad)}")
-        if not 1 <= len(arm) <= MAX_JOINTS:
-            raise ValueError(f"Plant needs 1 to {MAX_JOINTS} joints, the model has {len(arm)}")
-        self.n = len(arm)
+        self.n = len(ids)
         # Joints in kinematic order (hinges: one qpos and one dof each).
-        self._joints = sorted(arm, key=lambda j: int(m.jnt_dofadr[j]))
+        self._joints = sorted(ids, key=lambda j: int(m.jnt_dofadr[j]))
         self._qadr = np.array([m.jnt_qposadr[j] for j in self._joints])
         self._dofs = np.array([m.jnt_dofadr[j] for j in self._joints])
         bodies = [int(m.jnt_bodyid[j]) for j in self._joints]
@@ -569,25 +625,16 @@ class Plant:
         return out
 
     def _check_actuators(self) -> None:
+        """The arm joints' motors (one each, :func:`_prepare` made them), their
+        gear and τmax; actuators of the environment are left alone (zero
+        control)."""
         m = self.model
         joint_trn = int(mujoco.mjtTrn.mjTRN_JOINT)
         act_of: dict[int, list[int]] = {j: [] for j in self._joints}
         for a in range(m.nu):
-            name = _name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)
-            if m.actuator_trntype[a] != joint_trn:
-                raise ValueError(f"actuator {name!r} does not act on a joint")
-            motor = (
-                m.actuator_dyntype[a] == int(mujoco.mjtDyn.mjDYN_NONE)
-                and m.actuator_gaintype[a] == int(mujoco.mjtGain.mjGAIN_FIXED)
-                and m.actuator_biastype[a] == int(mujoco.mjtBias.mjBIAS_NONE)
-                and m.actuator_gainprm[a, 0] == 1.0
-            )
-            if not motor:
-                raise ValueError(
-                    f"actuator {name!r} is not a torque actuator: use <motor> (no dynamics, "
-                    "gain 1, no bias)"
-                )
-            act_of[int(m.actuator_trnid[a, 0])].append(a)
+            target = int(m.actuator_trnid[a, 0])
+            if m.actuator_trntype[a] == joint_trn and target in act_of:
+                act_of[target].append(a)
         self._act = np.zeros(self.n, dtype=int)
         self._gear = np.zeros(self.n)
         self.tau_max = np.zeros(self.n)
@@ -611,29 +658,30 @@ class Plant:
             self._gear[i] = gear
             self.tau_max[i] = gear * hi
 
-    def _find_end_effector(self, site: str | None) -> None:
+    def _find_end_effector(self, tip: str | None) -> None:
         m = self.model
         force = int(mujoco.mjtSensor.mjSENS_FORCE)
         torque = int(mujoco.mjtSensor.mjSENS_TORQUE)
-        on_site = int(mujoco.mjtObj.mjOBJ_SITE)
-        sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
-        if site is not None:
-            sid = mujoco.mj_name2id(m, on_site, site)
-            if sid < 0:
-                raise ValueError(f"the model has no site {site!r}")
-            sensors = [s for s in sensors if m.sensor_objid[s] == sid]
-        elif sensors:
-            sid = int(m.sensor_objid[sensors[0]])
-        else:
-            on_last = [s for s in range(m.nsite) if m.site_bodyid[s] == self._last_body]
-            sid = on_last[0] if on_last else -1
+        sid, self._ee_body = _mjcf.end_effector(m, tip, self._last_body)
         self._site = sid
-        self._ee_body = int(m.site_bodyid[sid]) if sid >= 0 else self._last_body
+        sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
+        sensors = [s for s in sensors if m.sensor_objid[s] == sid and sid >= 0]
+        carried = float(m.body_subtreemass[self._ee_body])
+        if sensors and carried > 0:
+            # The sensor reads the force between the site's body and its parent:
+            # with mass below it (a gripper) that is gravity and inertia too, not
+            # the contact wrench. The contacts are measured instead.
+            name = _name(m, mujoco.mjtObj.mjOBJ_SENSOR, sensors[0])
+            self.notes["wrench"] = (
+                f"the force sensor {name!r} carries {carried:.3g} kg below it (it reads "
+                "gravity and inertia as well as contact): the wrench comes from the contacts"
+            )
+            sensors = []
         self._force_adr = int(m.sensor_adr[sensors[0]]) if sensors else -1
         torques = [
             s
             for s in range(m.nsensor)
-            if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sid >= 0
+            if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sensors
         ]
         self._torque_adr = int(m.sensor_adr[torques[0]]) if torques else -1
         subtree = [
@@ -899,36 +947,80 @@ HOME_LOAD = 0.5
 """The zero posture is the home posture if gravity takes at most this share of
 every effort limit over the task's swing (:func:`home_posture`)."""
 
+HOME_CLEARANCE = 0.005
+"""The clearance (m) the default task keeps between bodies that the arm moves
+relative to each other (:func:`home_posture`)."""
+
+SWING_SAMPLES = 21
+"""Postures along the swing q − A … q + A at which :func:`home_posture` checks
+for contact."""
+
 
 def home_posture(plant: Plant) -> FloatArray:
     """A posture inside the joint limits where gravity is well within the
-    effort limits (SPEC §18). The gravity load of a posture q is the largest
-    max_i |G_i|/τmax_i over the task's swing (q − A, q, q + A). Every posture
-    is kept A = min(0.2 rad, range/4) inside each limit (a continuous joint
-    ranges over [−π, π]). The zero posture (the URDF's reference, clipped
-    into that box) if its load is at most :data:`HOME_LOAD`; else, of it, the
-    box's middle and 254 fixed-seed samples, the one of least load.
+    effort limits and the task's swing touches nothing (SPEC §18). The
+    gravity load of a posture q is the largest max_i |G_i|/τmax_i over the
+    task's swing (q − A, q, q + A). Every posture is kept A = min(0.2 rad,
+    range/4) inside each limit (a continuous joint ranges over [−π, π]).
+    With contact on, a posture qualifies only if, at :data:`SWING_SAMPLES`
+    postures along its swing q − A … q + A, no two bodies that the arm's
+    joints move relative to each other (the arm and itself, or the arm and
+    what is around it) come within :data:`HOME_CLEARANCE` of each other, by
+    the model's own collision geometry and filters. The zero posture (the
+    model's reference, clipped into the box) if it qualifies and its load is
+    at most :data:`HOME_LOAD`; else the nearest qualifying posture of load at
+    most :data:`HOME_LOAD` among 255 fixed-seed samples of the box drawn in
+    towards it (the k-th by k/255 of the way out); else the qualifying one
+    of least load.
 
     Raises
     ------
     ValueError
-        Gravity exceeds an effort limit at every posture compared: the arm
-        cannot hold itself anywhere (the message gives the best load).
+        Gravity exceeds an effort limit at every qualifying posture (the
+        message gives the best load), or every posture's swing touches (the
+        message names the bodies: give ``home=``).
     """
     m = plant.model
     lo, hi = _limits(m, plant._joints)
     width = np.where(np.isfinite(hi - lo), hi - lo, 2 * math.pi)
     amp = np.minimum(0.25 * width, TASK_AMPLITUDE)
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
+    contacts = _mjcf.Contacts(m, saved[0], plant._joints, margin=HOME_CLEARANCE)
+    swing = np.linspace(-1.0, 1.0, SWING_SAMPLES)
+    touching: list[tuple[str, str, float]] = []
+
+    def clear(q: FloatArray) -> bool:
+        found = [c for s in swing for c in contacts.at(q + s * amp)]
+        touching.extend(found)
+        return not found
+
+    samples = _postures(lo, hi, HOME_SAMPLES, amp)
+    zero = samples[0]
+    # Nearest the zero posture first: the samples drawn in towards it, the
+    # k-th by k/(K − 1) of the way out.
+    grow = np.arange(HOME_SAMPLES, dtype=np.float64)[:, None] / (HOME_SAMPLES - 1)
+    near = zero + grow * (samples - zero)
+    loads = [max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0)) for q in near]
     best, best_load = None, math.inf
-    for k, q in enumerate(_postures(lo, hi, HOME_SAMPLES, amp)):
-        load = max(_gravity_load(plant, q + s * amp) for s in (-1.0, 0.0, 1.0))
-        if load < best_load:
+    for q, load in zip(near, loads):
+        if load <= HOME_LOAD and clear(q):
             best, best_load = q, load
-        if k == 0 and load <= HOME_LOAD:
             break
+    if best is None:
+        for k in np.argsort(loads, kind="stable"):
+            if loads[k] < 1.0 and clear(near[k]):
+                best, best_load = near[k], loads[k]
+                break
+        else:
+            best_load = min(loads)
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(m, plant.data)
+    if best is None and touching:
+        raise ValueError(
+            f"the default task's swing (±A about the home posture) brings the arm's bodies "
+            f"within {HOME_CLEARANCE:g} m of each other at every posture compared "
+            f"({_mjcf.pairs(touching)}): give home= (rad), or simulate with contact=False"
+        )
     if best is None or best_load >= 1.0:
         raise ValueError(
             f"gravity exceeds the effort limits at every posture compared: the least "
@@ -996,6 +1088,8 @@ def cartesian_task(
     *,
     Ts: float = 1e-3,
     span: float | None = None,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
 ) -> CartesianTask:
     """A Cartesian task on ``model`` (SPEC §16 (16.8)–(16.11)), for
     ``simulate(case, model, T=…, task=task)``.
@@ -1015,8 +1109,12 @@ def cartesian_task(
     the task, and no self-collision there; for a given ``pose`` the start is
     the core's inverse kinematics of its first pose. A ``q0`` given must meet
     the same rule, or a ``ConfigError`` names the condition it violates.
+    ``tip``, ``fix``: the end effector and the joints held, as :class:`Plant`'s
+    (give the same to :func:`simulate`, or a :class:`Plant` to both).
     """
-    plant = model if isinstance(model, Plant) else Plant(model, contact=False)
+    if isinstance(model, Plant) and (tip is not None or tuple(fix)):
+        raise ValueError("tip= and fix= build the Plant: give them to Plant(...), not with one")
+    plant = model if isinstance(model, Plant) else Plant(model, contact=False, tip=tip, fix=fix)
     return task_of(plant, q0, pose, Ts=Ts, span=span)
 
 
@@ -1305,9 +1403,13 @@ def _payload_plant(nominal: Plant, payload: float) -> Plant:
         raise TypeError(f"payload must be a number (kg), got {type(payload).__name__}")
     if payload == 0:
         return nominal
-    return Plant(
-        with_payload(nominal.model, float(payload)), contact=nominal.contact, site=nominal.site
+    plant = Plant(
+        with_payload(nominal.model, float(payload), body=nominal._last_body),
+        contact=nominal.contact,
+        tip=nominal.tip,
     )
+    plant.notes = nominal.notes
+    return plant
 
 
 def _rule_setup(
@@ -1317,13 +1419,18 @@ def _rule_setup(
     reference: Any,
     Ts: float,
     T: float,
+    home: ArrayLike | None = None,
 ) -> tuple[Task | None, Any, dict[str, Any]]:
     """The task and the rule's keywords for a case name on ``plant`` (SPEC §18):
     the default task unless a reference or the controller's own trajectory
     (``xc_*``) is given, which is then the path."""
     own = [k for k in ("xc_offset", "xc_sin", "xc_cos", "xc_omega") if k in params]
+    if home is not None and (reference is not None or own):
+        raise ValueError(
+            "home= sets the default task's posture: give it without a reference or xc_*"
+        )
     if reference is None and not own:
-        task = default_task(plant)
+        task = default_task(plant, home)
         kw = rule_keywords(plant, task, Ts=Ts, case=case)
         kw.pop("n")
         return task, task.reference, kw
@@ -1368,6 +1475,9 @@ def simulate(
     fault: Fault | None = None,
     payload: float = 0.0,
     reset: bool = True,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+    home: ArrayLike | None = None,
     task: CartesianTask | None = None,
     **params: Any,
 ) -> MujocoResult:
@@ -1453,6 +1563,12 @@ def simulate(
         controller, the parts are the whole run's rows; each part's t starts
         at 0 and its disturbances afresh); ``q0``, ``dq0`` must then be None
         and ``payload`` 0.
+    tip, fix : optional
+        The end effector (a site or a body; a URDF's link) and joints to lock,
+        for the :class:`Plant` built from ``model`` (not for a Plant given).
+    home : array_like, optional
+        The posture (rad, (n,)) the default task swings about, instead of
+        :func:`home_posture`'s.
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
@@ -1493,13 +1609,17 @@ def simulate(
     ((50, 2), 20)
     """
     if task is not None:  # the Cartesian task's controller, by the core's rule
-        model = model if isinstance(model, Plant) else Plant(model, contact=contact)
+        if home is not None:
+            raise ValueError("home= sets the default joint-space task: give q0= to cartesian_task")
+        if not isinstance(model, Plant):
+            model = Plant(model, contact=contact, tip=tip, fix=fix)
+            tip, fix = None, ()
         controller, params = task.prepare(controller, model, Ts, params, DISTURBANCES)
         q0 = task.q0 if q0 is None else q0
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
         settle=settle, scenario=scenario, record_every=record_every, reference=reference,
-        payload=payload, params=params, reset=reset,
+        payload=payload, params=params, reset=reset, tip=tip, fix=fix, home=home,
     )  # fmt: skip
     from ._api import _progress
 
@@ -1513,7 +1633,93 @@ def simulate(
     res = _result(run, out, out.pop("metrics"))
     if task is not None:
         task.measure(res)
+    _check_run(run, res)
     return res
+
+
+RUN_PEAK = 2.0
+"""A run whose commanded |τ_i| exceeds this many τmax_i after :data:`RUN_SETTLE`
+says so (:func:`simulate`'s check)."""
+
+RUN_SETTLE = 0.1
+"""The start (s) of the peak-torque check."""
+
+RUN_SATURATED = 0.01
+"""A run whose torque is at a limit in more than this share of its steps says so."""
+
+RUN_CONTACT_EVERY = 0.01
+"""The spacing (s) of the recorded rows at which a run's self-contact is checked."""
+
+
+def _check_run(run: _Run, res: MujocoResult) -> None:
+    """What a run found that its numbers alone do not say (SPEC §18), as
+    :class:`adaptimp.PlantWarning` and in ``res.params["warnings"]``: the arm
+    touching itself (rows every :data:`RUN_CONTACT_EVERY` s replayed through
+    MuJoCo's collision detection); and, for a joint-space controller in free
+    space (no step in contact: pressing on a table is a contact task's own
+    business, its metrics say how it went), a commanded torque beyond
+    :data:`RUN_PEAK` τmax after :data:`RUN_SETTLE` s, the torque at a limit in
+    more than :data:`RUN_SATURATED` of the steps. ``res.params["plant"]`` is
+    what the plant made of the model (:attr:`Plant.notes`). Not for the
+    paper's arm, whose scenario saturates by design."""
+    plant = run.plant
+    res.params["plant"] = dict(plant.notes)
+    found: list[str] = []
+    if _uses_rule(plant) and res.rows > 0:
+        found += _self_contact(plant, res)
+    free = res.metrics.get("steps_in_contact", 0) == 0 and run.kind != "cartesian"
+    free = free and not getattr(run.ctrl, "wants_wrench", False)
+    if _uses_rule(plant) and res.rows > 0 and free:
+        tau_max = np.asarray(plant.tau_max)
+        late = np.flatnonzero(res.t >= RUN_SETTLE - 1e-12)
+        if late.size:
+            ratio = np.abs(res.tau[late]) / tau_max
+            k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            if ratio[k, i] > RUN_PEAK:
+                found.append(
+                    f"the commanded torque reached {ratio[k, i]:.3g} τmax after {RUN_SETTLE:g} s "
+                    f"(joint {plant.joint_names[i]!r} at t = {res.t[late[k]]:.3f} s), beyond "
+                    f"{RUN_PEAK:g} τmax: the controller asks far more than the actuators give"
+                )
+        duty = float(res.metrics.get("sat_duty", math.nan))
+        if duty > RUN_SATURATED:
+            found.append(
+                f"the torque was at a limit in {100 * duty:.1f} % of the steps (more than "
+                f"{100 * RUN_SATURATED:g} %): the actuators saturate, so the tracking measured is "
+                "theirs as much as the controller's"
+            )
+    res.params["warnings"] = found
+    for text in found:
+        warnings.warn(text, PlantWarning, stacklevel=3)
+
+
+def _self_contact(plant: Plant, res: MujocoResult) -> list[str]:
+    """The warning of a run in which the arm touched itself, if it did."""
+    m = plant.model
+    if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
+        return []
+    contacts = _mjcf.Contacts(m, plant.data.qpos, plant._joints, self_only=True)
+    if not contacts.possible:
+        return []
+    dt = float(res.t[1] - res.t[0]) if res.rows > 1 else 1.0
+    stride = max(1, round(RUN_CONTACT_EVERY / dt))
+    rows = range(0, res.rows, stride)
+    touched: list[tuple[str, str, float]] = []
+    first, hits = math.nan, 0
+    for k in rows:
+        found = contacts.at(res.q[k])
+        if found:
+            hits += 1
+            touched += found
+            if math.isnan(first):
+                first = float(res.t[k])
+    if not hits:
+        return []
+    return [
+        f"the arm touched itself in {100 * hits / len(rows):.1f} % of the rows checked "
+        f"({_mjcf.pairs(touched)}; first at t = {first:.3f} s): its own links collide along "
+        "this task; give another home= or reference (or contact=False)"
+    ]
 
 
 def _native_loop(
@@ -1719,6 +1925,9 @@ def _setup(
     payload: float = 0.0,
     params: Mapping[str, Any],
     reset: bool = True,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+    home: ArrayLike | None = None,
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
     plant at its initial state, the settings and the kind of loop."""
@@ -1735,17 +1944,23 @@ def _setup(
         raise ValueError(
             "q0, dq0 and a payload start a run afresh: give them with reset=True (the default)"
         )
-    nominal = model if isinstance(model, Plant) else Plant(model, contact=contact)
+    if isinstance(model, Plant) and (tip is not None or tuple(fix)):
+        raise ValueError("tip= and fix= build the Plant: give them to Plant(...), not with one")
+    nominal = model if isinstance(model, Plant) else Plant(model, contact=contact, tip=tip, fix=fix)
     plant = _payload_plant(nominal, payload)
     task: Task | None = None
     params = dict(params)
     disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
+    if home is not None and not (isinstance(controller, str) and _uses_rule(nominal)):
+        raise ValueError(
+            "home= sets the default task of a case name on an arm (not the paper's two_link)"
+        )
     if isinstance(controller, str):
         kwargs = dict(params)
         if _uses_rule(nominal):
             task, reference, rule = _rule_setup(
                 nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
-                float(defaults["T"]) if T is None else float(T),
+                float(defaults["T"]) if T is None else float(T), home,
             )  # fmt: skip
             kwargs = {**rule, **kwargs}
             if q0 is None and task is not None:

@@ -9,7 +9,9 @@ and :func:`adaptimp.simulate` in the robot scenario. Every rate is in the
 joint's own units (each joint's inertia scale d_i = 1/(D⁻¹)_ii, SPEC §10):
 
 - **Kp_i = 0.25 d_i / Ts**: the sampled velocity loop of every joint keeps its
-  pole at 0.75, whatever the joint's size; **K1 = min(50 s⁻¹, 0.05/Ts)**;
+  pole at 0.75, whatever the joint's size (with a path, d_i is the mean along
+  it of 1/(D⁻¹(q))_ii, bounded so that the loop stays stable at every
+  posture of it: SPEC (18.1)); **K1 = min(50 s⁻¹, 0.05/Ts)**;
   **Kζ_i = Kp_i/d_i + ρ/2** with the conditions ``"scaled"`` of SPEC §10
   (met by construction, for any arm, τmax and Ts); kr_i = φ Kp_i/2.
 - **Centres along the path** (SPEC §15): L = clip(⌈2·(path length in q)/tube⌉,
@@ -39,8 +41,9 @@ Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]
 PATH_SAMPLES = 1000
 """Samples of one period of a path that :func:`suggest` hands the core."""
 
-ALONG = 200
-"""Postures along a path at which :func:`suggest` evaluates D(q) with ``along=True``."""
+INERTIA_SAMPLES = 50
+"""Postures along a path at which :func:`suggest` evaluates D(q) for the
+inertia scales (SPEC (18.1): their mean along the path, bounded)."""
 
 RULE_KEYS = (
     "Ts",
@@ -132,18 +135,19 @@ def suggest(
     period: float | None = None,
     case: str = "sf",
     resolve: bool = False,
-    along: bool = False,
     critical: bool = False,
 ) -> dict[str, Any]:
-    """Controller keywords for an arm from its inertia at ``q0`` (rad), its actuator
-    limits ``tau_max`` (N m) and the task's joint path (SPEC §18, module docs).
+    """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
+    the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
+    actuator limits ``tau_max`` (N m) and the path (SPEC §18, module docs).
 
     Parameters
     ----------
     model
         What gives D(q): see :func:`inertia`.
     q0 : array_like, shape (n,)
-        The posture the gains are computed at (rad): the task's start.
+        The posture the gains are computed at without a path (rad), and the
+        gravity torque for the tube with one: the task's start.
     tau_max : float or array_like, shape (n,)
         Actuator limits (N m).
     Ts : float
@@ -161,11 +165,6 @@ def suggest(
         Narrow the tube to the path's own size, SPEC (16.10): tube_b =
         min(tube_b, ℓ_b/10), ℓ_b the closed path's length in q and in q̇ (the
         Cartesian rule's: a small joint orbit gets the joint task's resolution).
-    along : bool
-        The inertia scales d_i the smallest of 1/(D⁻¹(q))_ii over q0 and
-        :data:`ALONG` postures evenly along the path, SPEC (16.12) (the
-        Cartesian and contact rules'): the sampled velocity loop stays within
-        its margin wherever the path takes the arm, not only at q0.
     critical : bool
         Ĝ learns at the velocity loop's critical bandwidth ω_G² = (m/Ts)²/4,
         SPEC (19.6) (the table scenario's; (18.6)'s ½ (m/Ts) K1 otherwise).
@@ -194,14 +193,14 @@ def suggest(
             rows = sample_path(path, period, n)
         else:
             rows = np.ascontiguousarray(np.asarray(path, dtype=np.float64))
+        if rows.ndim != 2 or rows.shape[0] == 0 or rows.shape[1] != 3 * n:
+            raise ConfigError(f"path must have shape (K, {3 * n}), got {rows.shape}")
+        step = max(1, rows.shape[0] // INERTIA_SAMPLES)
+        d = np.stack([inertia(model, q) for q in rows[::step, :n]])
     g = gravity(model, q0) if rows is not None else None
-    more = None
-    if along and rows is not None:
-        idx = np.unique(np.linspace(0, rows.shape[0] - 1, ALONG).round().astype(int))
-        more = np.ascontiguousarray(np.array([inertia(model, rows[k, :n]) for k in idx]))
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
-        inertias=more, critical=critical,
+        critical=critical,
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

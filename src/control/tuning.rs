@@ -110,24 +110,61 @@ pub fn inertia_scales<const N: usize>(d: &Matrix<N>) -> Result<Vector<N>, Error>
     Ok(scales)
 }
 
-/// The inertia scales along a path, SPEC (16.12): d_i = min over the
-/// inertia matrices `ds` (kg m², each symmetric positive definite, e.g. D(q)
-/// at the samples of a task's joint path) of 1/(D⁻¹)_ii. With Kp = m Dₛ/Ts
-/// the sampled velocity loop keeps Ts (Kp D(q)⁻¹)_ii ≤ m at every posture
-/// of the path, not only at its start: where two joints' axes come to act
-/// alike (the Panda's base and upper-arm rotations as its shoulder rises),
-/// D(q)⁻¹ couples them and a gain set at the start rang at the sampling
-/// rate. Errors as [`inertia_scales`], for an empty `ds` too.
+/// The inertia scales of an arm along a task's path, SPEC (18.1): the mean
+/// over the samples `ds` (D(q_k), kg m², symmetric positive definite) of
+/// each posture's scales d_i(q_k) = 1/(D(q_k)⁻¹)_ii, shrunk by one common
+/// factor c = min(1, N / max_k λmax(D(q_k)⁻¹ Dₛ)), Dₛ = diag(d) (λmax bounded
+/// from above within 1 %), so that at every sample the eigenvalues of
+/// D⁻¹Dₛ stay ≤ N, the bound one posture's
+/// own scales have (Dₛ^½ D⁻¹ Dₛ^½ has a unit diagonal). One posture's
+/// scales collapse near a posture where joint axes line up (a joint's
+/// motion is then absorbed by its neighbours: d_i ≪ D_ii), and gains from
+/// such a posture are too small along the rest of the path. Errors if `ds`
+/// is empty or a sample is not an inertia matrix ([`inertia_scales`]).
 pub fn inertia_scales_along<const N: usize>(ds: &[Matrix<N>]) -> Result<Vector<N>, Error> {
-    let mut out: Option<Vector<N>> = None;
-    for d in ds {
-        let s = inertia_scales(d)?;
-        out = Some(out.map_or(s, |o| o.zip_map(&s, f64::min)));
+    if ds.is_empty() {
+        return Err(Error::Invalid {
+            what: "inertia samples",
+            reason: "needs one posture or more",
+        });
     }
-    out.ok_or(Error::Invalid {
-        what: "inertia matrices",
-        reason: "need one or more",
-    })
+    let mut mean = Vector::<N>::zeros();
+    for d in ds {
+        mean += inertia_scales(d)?;
+    }
+    mean /= ds.len() as f64;
+    let root = mean.map(sqrt);
+    let mut largest = 0.0f64;
+    for d in ds {
+        // d is positive definite (inertia_scales checked it).
+        let inv = d.cholesky().map(|c| c.inverse()).ok_or(Error::Invalid {
+            what: "inertia matrix",
+            reason: "must be positive definite",
+        })?;
+        let m = Matrix::<N>::from_fn(|i, j| root[i] * inv[(i, j)] * root[j]);
+        largest = largest.max(largest_eigenvalue(&m));
+    }
+    let cap = N as f64 / largest;
+    let scales = if cap < 1.0 { mean * cap } else { mean };
+    check::finite_slice("inertia scale", scales.as_slice())?;
+    Ok(scales)
+}
+
+/// An upper bound on the largest eigenvalue of a symmetric positive definite
+/// `m`, within 1 % of it: λmax ≤ (tr m^(2^k))^(2^−k) ≤ N^(2^−k) λmax, k = 8
+/// (repeated squaring, each power scaled to unit trace).
+fn largest_eigenvalue<const N: usize>(m: &Matrix<N>) -> f64 {
+    const K: i32 = 8;
+    let t = m.trace();
+    let mut a = m / t;
+    let mut log_c = libm::log(t);
+    for _ in 0..K {
+        let sq = a * a;
+        let t = sq.trace();
+        a = sq / t;
+        log_c = 2.0 * log_c + libm::log(t);
+    }
+    libm::exp(log_c / f64::from(1 << K))
 }
 
 impl Rule {
@@ -190,12 +227,12 @@ impl Rule {
         tau_max: &Vector<N>,
         ts: f64,
     ) -> Result<Config<N>, Error> {
-        self.gains_of_scales(law, &inertia_scales(d)?, tau_max, ts)
+        self.gains_scaled(law, &inertia_scales(d)?, tau_max, ts)
     }
 
-    /// [`gains`](Self::gains) from the inertia scales d_i (kg m²) themselves
-    /// (e.g. [`inertia_scales_along`] a path, SPEC (16.12)).
-    pub fn gains_of_scales<const N: usize>(
+    /// [`gains`](Self::gains) from the inertia scales d_i (kg m²) themselves,
+    /// e.g. [`inertia_scales_along`] a path.
+    pub fn gains_scaled<const N: usize>(
         &self,
         law: Law,
         scales: &Vector<N>,
@@ -389,8 +426,8 @@ impl Rule {
         self.suggest_scaled(law, &inertia_scales(d)?, tau_max, ts, path, period, gravity)
     }
 
-    /// [`suggest`](Self::suggest) from the inertia scales d_i (kg m²) (e.g.
-    /// [`inertia_scales_along`] the path, SPEC (16.12)).
+    /// [`suggest`](Self::suggest) from the inertia scales d_i (kg m²)
+    /// themselves: [`inertia_scales_along`] the path for SPEC (18.1).
     #[allow(clippy::too_many_arguments)]
     pub fn suggest_scaled<const N: usize>(
         &self,
@@ -402,7 +439,7 @@ impl Rule {
         period: f64,
         gravity: Option<&Vector<N>>,
     ) -> Result<Suggestion<N>, Error> {
-        let mut config = self.gains_of_scales(law, scales, tau_max, ts)?;
+        let mut config = self.gains_scaled(law, scales, tau_max, ts)?;
         if let Some(g) = gravity {
             check::finite_slice("gravity", g.as_slice())?;
         }
@@ -507,6 +544,34 @@ mod tests {
             .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, None)
             .unwrap();
         Controller::new(s.config, s.centers).unwrap();
+    }
+
+    #[test]
+    fn scales_along_a_path_average_and_keep_the_bound() {
+        let d = arm_matrix();
+        let (bound, exact) = (largest_eigenvalue(&d), d.symmetric_eigenvalues().max());
+        assert!(exact <= bound && bound <= 1.01 * exact, "{bound} {exact}");
+        // One posture: its own scales.
+        let one = inertia_scales_along(&[d]).unwrap();
+        assert!((one - inertia_scales(&d).unwrap()).norm() < 1e-15);
+        // Two axes nearly in line at one posture (d_i ≪ D_ii there), apart at
+        // the other: the mean, capped so that λmax(D⁻¹Dₛ) ≤ N at both.
+        let lined = Matrix::<2>::new(1.0, 0.999, 0.999, 1.0);
+        let apart = Matrix::<2>::identity();
+        let s = inertia_scales_along(&[lined, apart]).unwrap();
+        let mean = (inertia_scales(&lined).unwrap() + inertia_scales(&apart).unwrap()) / 2.0;
+        let ratio = s.component_div(&mean);
+        assert!(
+            (ratio[0] - ratio[1]).abs() < 1e-12 && ratio[0] < 1.0,
+            "{ratio}"
+        );
+        for m in [lined, apart] {
+            let l = (m.try_inverse().unwrap() * Matrix::<2>::from_diagonal(&s))
+                .eigenvalues()
+                .unwrap();
+            assert!(l.max() <= 2.0 + 1e-9, "{l}");
+        }
+        assert!(inertia_scales_along::<2>(&[]).is_err());
     }
 
     #[test]

@@ -5,13 +5,14 @@ use super::cartesian::{PyChain, TypedChain};
 use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
 use crate::cartesian::rule::{resolving, PoseCircle, PostureRule};
-use crate::control::tuning::{default_task as core_default_task, Rule};
+use crate::control::tuning::{default_task as core_default_task, inertia_scales_along, Rule};
 use crate::error::Error;
 use crate::schema::{Group, Preset, Scenario, PARAMS};
 use crate::trajectory::Setpoint;
 use crate::types::{Matrix, Vector};
 use numpy::{
-    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn,
+    PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -22,48 +23,49 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 
 /// The rule's controller keywords (every controller parameter of the schema,
 /// by name), the centres (L, 4n) and their widths η (4n,) for `case`, an arm
-/// of inertia matrix `inertia` (n, n; kg m²), limits `tau_max` (n,; N m),
+/// of inertia matrix `inertia` (n, n; kg m²; or (K, n, n): the inertia at K
+/// postures along the task's path, SPEC (18.1)'s scales along it), limits
+/// `tau_max` (n,; N m),
 /// period `ts` (s) and, if given, the task's `path` (K, 3n: q, q̇, q̈ per
 /// row, one period of `period` s, evenly spaced in time) with the gravity
 /// torque `gravity` (n,; N m) at its start, if known. `resolve`: the tube
 /// narrowed to the path's own size, SPEC (16.10) (the Cartesian rule's).
-/// `inertias` (K, n, n; kg m²): D at postures along the path; the inertia
-/// scales are then the smallest over them and `inertia`, SPEC (16.12).
 /// `critical`: Ĝ learns at the velocity loop's critical bandwidth, SPEC
 /// (19.6) (the table scenario's).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, inertias=None, critical=false))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
     case: &str,
-    inertia: PyReadonlyArray2<'py, f64>,
+    inertia: PyReadonlyArrayDyn<'py, f64>,
     tau_max: PyReadonlyArray1<'py, f64>,
     ts: f64,
     path: Option<PyReadonlyArray2<'py, f64>>,
     period: Option<f64>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
     resolve: bool,
-    inertias: Option<numpy::PyReadonlyArray3<'py, f64>>,
     critical: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
-    let n = shape[0];
-    if !(1..=super::MAX_JOINTS).contains(&n) || shape[1] != n {
-        return Err(shape_error("inertia", "(n, n), 1 ≤ n ≤ 7".into(), shape));
+    let (k, n) = match shape {
+        [a, b] if a == b => (1, *a),
+        [k, a, b] if a == b && *k > 0 => (*k, *a),
+        _ => (0, 0),
+    };
+    if !(1..=super::MAX_JOINTS).contains(&n) {
+        return Err(shape_error(
+            "inertia",
+            "(n, n) or (K, n, n), 1 ≤ n ≤ 7".into(),
+            shape,
+        ));
     }
+    let along = shape.len() == 3;
     if tau_max.shape() != [n] {
         return Err(shape_error("tau_max", format!("({n},)"), tau_max.shape()));
     }
-    let mut d: Vec<f64> = inertia.as_array().iter().copied().collect();
-    if let Some(more) = inertias {
-        let sh = more.shape();
-        if sh[1] != n || sh[2] != n {
-            return Err(shape_error("inertias", format!("(K, {n}, {n})"), sh));
-        }
-        d.extend(more.as_array().iter().copied());
-    }
+    let d: Vec<f64> = inertia.as_array().iter().copied().collect();
     let tau: Vec<f64> = tau_max.as_array().iter().copied().collect();
     let gravity: Option<Vec<f64>> = match gravity {
         None => None,
@@ -86,7 +88,7 @@ pub fn suggest<'py>(
     macro_rules! arms {
         ($($k:literal)*) => {
             match n {
-                $($k => fill::<$k>(py, &out, law, &d, &tau, ts, path.as_ref(), gravity.as_deref(), (resolve, critical)),)*
+                $($k => fill::<$k>(py, &out, law, (&d, k, along), &tau, ts, path.as_ref(), gravity.as_deref(), (resolve, critical)),)*
                 _ => unreachable!("n checked above"),
             }
         };
@@ -100,7 +102,7 @@ fn fill<'py, const N: usize>(
     py: Python<'py>,
     out: &Bound<'py, PyDict>,
     law: crate::control::config::Law,
-    d: &[f64],
+    (d, k, along): (&[f64], usize, bool),
     tau: &[f64],
     ts: f64,
     path: Option<&(Vec<f64>, f64)>,
@@ -115,16 +117,20 @@ fn fill<'py, const N: usize>(
     }
     // Row-major (n, n) into nalgebra's column-major: D is symmetric, but a
     // non-symmetric input must be reported, not transposed silently.
-    let ds: Vec<Matrix<N>> = d
-        .chunks_exact(N * N)
-        .map(Matrix::<N>::from_row_slice)
+    let ds: Vec<Matrix<N>> = (0..k)
+        .map(|i| Matrix::<N>::from_row_slice(&d[i * N * N..(i + 1) * N * N]))
         .collect();
-    let scales = crate::control::tuning::inertia_scales_along(&ds).map_err(err)?;
+    let scales = if along {
+        inertia_scales_along(&ds)
+    } else {
+        crate::control::tuning::inertia_scales(&ds[0])
+    }
+    .map_err(err)?;
     let tau = Vector::<N>::from_column_slice(tau);
     let mut s = Scenario::<N>::preset(Preset::Robot, law);
     let centers = match path {
         None => {
-            s.config = rule.gains_of_scales(law, &scales, &tau, ts).map_err(err)?;
+            s.config = rule.gains_scaled(law, &scales, &tau, ts).map_err(err)?;
             None
         }
         Some((rows, period)) => {

@@ -1075,7 +1075,7 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
 
     kw = tuning.suggest(
         amj.Plant(sc.model), sc.q0, sc.tau_max, Ts=sc.Ts, path=path, period=steps * sc.Ts,
-        case=case, along=True, critical=True,
+        case=case, critical=True,
     )  # fmt: skip
     kw["K1"] = [min(CONTACT_K1, float(kw["K1"][0]))] * sc.n  # never above (18.2)
     out: dict[str, Any] = {

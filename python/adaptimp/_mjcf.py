@@ -1,0 +1,975 @@
+"""MJCF files as their makers ship them, made into a plant (SPEC §18, docs/your_arm.md).
+
+What :class:`adaptimp.mujoco.Plant` does to a model before it drives it, each
+step a function of its own, none of them touching the file (the model is
+edited in memory, through MuJoCo's ``MjSpec``):
+
+- :func:`arm_of`: which joints are the arm's, the tip, and what is not the
+  arm's and why (a gripper's coupled or branching joints, a slide joint, a
+  joint named in ``fix``).
+- :func:`prepare_file` / :func:`prepare_model`: the joints of the arm's own
+  body tree that are not the arm's are **locked** at their reference
+  position (the joint is removed, so its bodies ride rigidly on the hand, as
+  the controller's model of the arm has them; with it go its actuators, the
+  tendons and equality constraints that coupled it, the sensors that read
+  it); every arm joint gets **one torque motor**: a ``motor`` as it is, a
+  ``position``, ``velocity`` or ``general`` actuator becomes a motor of the
+  same force range, a joint without an actuator gets one. Where nothing
+  declares a force range, τmax is estimated from the arm (:func:`estimate`).
+- :func:`moving_contacts`: the contacts between bodies that the arm's joints
+  move relative to each other (the arm with itself, or with what is around
+  it), for the default task's self-collision check and the check after a run.
+
+Needs MuJoCo (imported by :mod:`adaptimp.mujoco` only).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+GRIPPER_WORDS = ("gripper", "finger", "jaw", "claw")
+"""Joint names with one of these words after an arm joint named otherwise
+belong to a gripper (the URDF reduction's rule, ``adaptimp._models``)."""
+
+EFFORT_ACCEL = 10.0
+"""The acceleration (rad/s²) an estimated τmax leaves beyond gravity."""
+
+EFFORT_SPEED = 1.0
+"""The joint speed (rad/s) at which an estimated τmax overcomes the joint's
+viscous damping."""
+
+FIRST_ORDER_STEP = 2.5e-4
+"""The largest MuJoCo timestep (s) of a file's model integrated to first order
+(Euler, implicit, implicitfast): :func:`adaptimp.mujoco.simulate` then takes
+4 MuJoCo steps per 1 ms period. The rule's velocity loop moves a quarter of
+its error per period (SPEC 18.1); integrated once a period, the plant's
+error is of the size of what learning removes (dm_control's Kinova: SF/PD
+0.225 at one Euler step per period, 0.134 at 2, 0.103 at 4, 0.088 with RK4).
+A file's RK4 keeps its timestep."""
+
+_OBJ = mujoco.mjtObj
+_HINGE = int(mujoco.mjtJoint.mjJNT_HINGE)
+_SLIDE = int(mujoco.mjtJoint.mjJNT_SLIDE)
+_JOINT_TRN = (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT))
+
+
+def _name(m: mujoco.MjModel, objtype: Any, i: int) -> str:
+    return mujoco.mj_id2name(m, objtype, i) or f"#{i}"
+
+
+# ---------------------------------------------------------------------------
+# The arm's joints.
+# ---------------------------------------------------------------------------
+
+
+def _ancestors(m: mujoco.MjModel, body: int) -> list[int]:
+    out = []
+    while body > 0:
+        body = int(m.body_parentid[body])
+        out.append(body)
+    return out
+
+
+def _root(m: mujoco.MjModel, body: int) -> int:
+    """The child of the world body that ``body`` hangs from (0 for the world)."""
+    while body > 0 and int(m.body_parentid[body]) > 0:
+        body = int(m.body_parentid[body])
+    return body
+
+
+def coupled_joints(m: mujoco.MjModel) -> dict[int, str]:
+    """The joints of a coupled mechanism (MJCF's mimic joints, a gripper's
+    linkage; an arm's joints are never coupled): both joints of a ``<joint>``
+    equality (joint1 follows joint2, the gripper's driver), and the joints of
+    a fixed tendon of two or more joints (robotiq's and jaco's fingers)."""
+    out: dict[int, str] = {}
+    for e in range(m.neq):
+        if int(m.eq_type[e]) == int(mujoco.mjtEq.mjEQ_JOINT) and m.eq_obj2id[e] >= 0:
+            one, two = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+            out[one] = f"coupled to {_name(m, _OBJ.mjOBJ_JOINT, two)!r} (a joint equality)"
+            out.setdefault(two, f"drives {_name(m, _OBJ.mjOBJ_JOINT, one)!r} (a joint equality)")
+    for t in range(m.ntendon):
+        adr, num = int(m.tendon_adr[t]), int(m.tendon_num[t])
+        joints = [
+            int(m.wrap_objid[w])
+            for w in range(adr, adr + num)
+            if int(m.wrap_type[w]) == int(mujoco.mjtWrap.mjWRAP_JOINT)
+        ]
+        if len(joints) >= 2:
+            name = _name(m, _OBJ.mjOBJ_TENDON, t)
+            for j in joints:
+                out.setdefault(j, f"coupled by the tendon {name!r}")
+    return out
+
+
+def resolve_tip(m: mujoco.MjModel, tip: str) -> tuple[int, str]:
+    """A site or body of ``m`` by name: (its body, ``"site"`` or ``"body"``); a
+    site first if both have the name.
+
+    Raises
+    ------
+    ValueError
+        Neither a site nor a body has the name (the message lists the bodies).
+    """
+    sid = mujoco.mj_name2id(m, _OBJ.mjOBJ_SITE, tip)
+    if sid >= 0:
+        return int(m.site_bodyid[sid]), "site"
+    bid = mujoco.mj_name2id(m, _OBJ.mjOBJ_BODY, tip)
+    if bid > 0:
+        return bid, "body"
+    bodies = [_name(m, _OBJ.mjOBJ_BODY, b) for b in range(1, m.nbody)]
+    raise ValueError(
+        f"tip={tip!r}: the model has no site or body of that name (bodies: "
+        f"{', '.join(bodies[:40])}{', …' if len(bodies) > 40 else ''})"
+    )
+
+
+def _force_sensor_body(m: mujoco.MjModel) -> int | None:
+    """The body of the first force sensor's site, if a hinge moves it."""
+    for s in range(m.nsensor):
+        if m.sensor_type[s] == int(mujoco.mjtSensor.mjSENS_FORCE):
+            body = int(m.site_bodyid[int(m.sensor_objid[s])])
+            path = [body, *_ancestors(m, body)]
+            if any(
+                int(m.jnt_type[j]) == _HINGE
+                for b in path
+                for j in range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b]))
+            ):
+                return body
+    return None
+
+
+def arm_of(m: mujoco.MjModel, tip: str | None = None, fix: Sequence[str] = ()) -> dict[str, Any]:
+    """The arm of a compiled MuJoCo model, by the rules of the URDF reduction
+    (``adaptimp._models.arm_urdf``; SPEC §18) applied to its body tree:
+
+    - a joint named in ``fix`` ("asked"), a slide joint ("prismatic"), a joint
+      another one dictates (joint1 of a joint equality, the joints of a fixed
+      tendon of two or more joints: a gripper's linkage) is not the arm's;
+    - the arm is the longest serial chain of the remaining hinge joints from
+      the world, ending where the tree branches into chains each shorter than
+      the chain so far (a hand); chains that tie are an error listing where
+      each ends, unless ``tip`` names a site or a body (the arm is then the
+      hinges on the way to it); without ``tip``, the site of a force sensor
+      that a hinge moves ends the chain, if there is one;
+    - a joint named gripper/finger/jaw/claw after an arm joint named otherwise
+      is a gripper's; every other hinge off the chain is "off the arm's chain".
+
+    Returns a dict: ``joints`` (names, base to tip), ``joint_ids`` (MuJoCo
+    ids), ``fixed`` ({name: reason} for every joint that is not the arm's),
+    ``tip`` (the tip's name: ``tip`` if given, else the body of the last
+    joint), ``tip_kind`` ("site" or "body"), ``tip_body`` (its body id).
+
+    Raises
+    ------
+    ValueError
+        An unknown ``fix`` joint or ``tip``, no hinge to drive, chains that tie.
+    """
+    names = {_name(m, _OBJ.mjOBJ_JOINT, j): j for j in range(m.njnt)}
+    unknown = [f for f in fix if f not in names]
+    if unknown:
+        raise ValueError(f"fix={tuple(fix)!r}: the model has no joint {unknown[0]!r}")
+    fixed: dict[int, str] = {}
+    for j in range(m.njnt):
+        name = _name(m, _OBJ.mjOBJ_JOINT, j)
+        if name in fix:
+            fixed[j] = "asked"
+        elif int(m.jnt_type[j]) == _SLIDE:
+            fixed[j] = "prismatic (the arm's joints are hinges)"
+    for j, why in coupled_joints(m).items():
+        fixed.setdefault(j, why)
+
+    def movable(j: int) -> bool:
+        return int(m.jnt_type[j]) == _HINGE and j not in fixed
+
+    def word(j: int) -> str | None:
+        found = [w for w in GRIPPER_WORDS if w in _name(m, _OBJ.mjOBJ_JOINT, j).lower()]
+        return found[0] if found else None
+
+    children: dict[int, list[int]] = {}
+    for b in range(1, m.nbody):
+        children.setdefault(int(m.body_parentid[b]), []).append(b)
+
+    def own(b: int) -> list[int]:
+        return list(range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b])))
+
+    def longest(body: int, held: int, arm: bool) -> list[list[int]]:
+        per_child: list[list[list[int]]] = []
+        for c in children.get(body, []):
+            mine: list[int] = []
+            is_arm = arm
+            for j in own(c):
+                w = word(j)
+                if w is not None and is_arm and movable(j):
+                    fixed[j] = f"a gripper joint (its name contains {w!r})"
+                if movable(j):
+                    mine.append(j)
+                    is_arm = is_arm or w is None
+            below = longest(c, held + len(mine), is_arm)
+            per_child.append([mine + rest for rest in below])
+        carrying = [opts[0] for opts in per_child if opts[0]]
+        if held > 0 and len(carrying) >= 2 and all(len(c) < held for c in carrying):
+            return [[]]  # a hand: the arm ends here
+        every = [c for opts in per_child for c in opts]
+        best = max((len(c) for c in every), default=0)
+        return [c for c in every if len(c) == best] if best > 0 else [[]]
+
+    chains = longest(0, 0, False)
+    tip_body: int | None
+    tip_kind = "body"
+    if tip is not None:
+        tip_body, tip_kind = resolve_tip(m, tip)
+    else:
+        tip_body = _force_sensor_body(m)
+    if tip_body is not None:
+        path = list(reversed([tip_body, *_ancestors(m, tip_body)]))
+        chain = [j for b in path for j in own(b) if movable(j)]
+        if not chain:
+            where = f"tip={tip!r}" if tip is not None else "the force sensor's site"
+            raise ValueError(f"no hinge joint to drive on the way to {where}")
+    else:
+        chain = chains[0]
+        if len(chains) > 1:
+            ends = ", ".join(
+                repr(_name(m, _OBJ.mjOBJ_BODY, int(m.jnt_bodyid[c[-1]]))) for c in chains
+            )
+            raise ValueError(
+                f"the model has {len(chains)} serial chains of {len(chain)} hinge joints that "
+                f"tie for the arm (legs, or two arms), ending at the bodies {ends}: name one "
+                "with tip= (a body or a site) or fix the others' joints with fix="
+            )
+    if not chain:
+        raise ValueError(
+            "the model has no hinge joint to drive"
+            + (f" (not the arm's: {_named(m, fixed)})" if fixed else "")
+        )
+    on_chain = set(chain)
+    for j in range(m.njnt):
+        if movable(j) and j not in on_chain:
+            fixed[j] = "off the arm's chain (a branch)"
+    if tip is None:
+        tip = _name(m, _OBJ.mjOBJ_BODY, int(m.jnt_bodyid[chain[-1]]))
+        tip_body = int(m.jnt_bodyid[chain[-1]])
+        tip_kind = "body"
+    assert tip_body is not None
+    return {
+        "joints": tuple(_name(m, _OBJ.mjOBJ_JOINT, j) for j in chain),
+        "joint_ids": tuple(chain),
+        "fixed": _named(m, {j: r for j, r in fixed.items() if j not in on_chain}),
+        "tip": tip,
+        "tip_kind": tip_kind,
+        "tip_body": tip_body,
+    }
+
+
+def _named(m: mujoco.MjModel, by_id: dict[int, str]) -> dict[str, str]:
+    return {_name(m, _OBJ.mjOBJ_JOINT, j): r for j, r in sorted(by_id.items())}
+
+
+def arm_tree(m: mujoco.MjModel, joint_ids: Iterable[int]) -> frozenset[int]:
+    """The bodies of the arm's own tree: every body under the world's children
+    that carry an arm joint (the base, the links, the hand, a gripper)."""
+    roots = {_root(m, int(m.jnt_bodyid[j])) for j in joint_ids}
+    return frozenset(b for b in range(1, m.nbody) if _root(m, b) in roots)
+
+
+# ---------------------------------------------------------------------------
+# The plant's model: joints locked, one torque motor per arm joint.
+# ---------------------------------------------------------------------------
+
+
+@dataclass
+class Prepared:
+    """A model made ready for :class:`adaptimp.mujoco.Plant`.
+
+    Attributes
+    ----------
+    model : MjModel
+        The compiled model (the arm's joints driven by torque motors).
+    spec : MjSpec or None
+        The edited spec it compiles from (a file's model), for further
+        in-memory additions (a contact sensor); None for a given ``MjModel``.
+    arm : dict
+        :func:`arm_of`'s answer on the model as given.
+    notes : dict
+        What was done, for ``res.params["plant"]``: "locked" {joint: reason},
+        "actuators" {joint: what its actuator was → motor}, "tau_max"
+        {joint: where τmax comes from}.
+    warnings : list of str
+        The warnings to emit (one per kind of change).
+    """
+
+    model: mujoco.MjModel
+    spec: Any
+    arm: dict[str, Any]
+    notes: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+
+def _kind(m: mujoco.MjModel, a: int) -> str:
+    """ "motor" (a torque source: no dynamics, fixed gain, no bias) or what the
+    actuator is (a servo: "position", "velocity", "general")."""
+    dyn, gain, bias = (
+        int(m.actuator_dyntype[a]),
+        int(m.actuator_gaintype[a]),
+        int(m.actuator_biastype[a]),
+    )
+    fixed_gain = gain == int(mujoco.mjtGain.mjGAIN_FIXED)
+    if (
+        dyn == int(mujoco.mjtDyn.mjDYN_NONE)
+        and fixed_gain
+        and bias == int(mujoco.mjtBias.mjBIAS_NONE)
+    ):
+        return "motor"
+    if fixed_gain and bias == int(mujoco.mjtBias.mjBIAS_AFFINE):
+        kp, b1, b2 = (
+            float(m.actuator_gainprm[a, 0]),
+            float(m.actuator_biasprm[a, 1]),
+            float(m.actuator_biasprm[a, 2]),
+        )
+        if kp > 0 and b1 == -kp:
+            return "position"
+        if kp > 0 and b1 == 0 and b2 == -kp:
+            return "velocity"
+    return "general"
+
+
+def _force_limit(m: mujoco.MjModel, a: int, joint: int) -> tuple[float, str] | None:
+    """The largest joint torque (N m) actuator ``a`` can exert on ``joint`` and
+    where it comes from, or None if nothing declares it: the smaller of gear ×
+    its force range (a motor without one: gear × gain × its control range) and
+    the joint's ``actuatorfrcrange``. A range must be symmetric about zero."""
+    gear = abs(float(m.actuator_gear[a, 0]))
+    name = _name(m, _OBJ.mjOBJ_ACTUATOR, a)
+    limits: list[tuple[float, str]] = []
+    if m.actuator_forcelimited[a]:
+        lo, hi = (float(v) for v in m.actuator_forcerange[a])
+        limits.append(
+            (gear * _symmetric(lo, hi, f"the forcerange of actuator {name!r}"), "forcerange")
+        )
+    elif m.actuator_ctrllimited[a] and _kind(m, a) == "motor":
+        lo, hi = (float(v) for v in m.actuator_ctrlrange[a])
+        gain = abs(float(m.actuator_gainprm[a, 0]))
+        limits.append(
+            (gear * gain * _symmetric(lo, hi, f"the ctrlrange of motor {name!r}"), "ctrlrange")
+        )
+    if m.jnt_actfrclimited[joint]:
+        lo, hi = (float(v) for v in m.jnt_actfrcrange[joint])
+        jname = _name(m, _OBJ.mjOBJ_JOINT, joint)
+        limits.append(
+            (_symmetric(lo, hi, f"the actuatorfrcrange of joint {jname!r}"), "actuatorfrcrange")
+        )
+    return min(limits) if limits else None
+
+
+def _symmetric(lo: float, hi: float, what: str) -> float:
+    if not (hi > 0 and lo == -hi and math.isfinite(hi)):
+        raise ValueError(
+            f"{what} is [{lo:g}, {hi:g}]: the plant needs a range symmetric about zero "
+            "(its τmax); give the joint a symmetric range"
+        )
+    return hi
+
+
+def estimate(
+    m: mujoco.MjModel, qadr: Sequence[int], dofs: Sequence[int], postures: int = 256
+) -> FloatArray:
+    """τmax (N m) per arm joint where nothing declares it: 2 (max |G_i| + 10
+    rad/s² · max Σ_j |D_ij| + b_i · 1 rad/s + F_i) over ``postures`` postures
+    within the joint limits: the URDF estimate
+    (:func:`adaptimp.mujoco.estimate_effort`; D with the rotors' armature)
+    and the joint's own viscous damping b_i at :data:`EFFORT_SPEED` and dry
+    friction F_i (``frictionloss``), which a file may make the larger part
+    (metaworld's Sawyer: b = 10 N m s/rad on a wrist of 0.01 kg m²)."""
+    from .mujoco import _full_inertia, _limits, _postures
+
+    joints = [int(m.dof_jntid[d]) for d in dofs]
+    lo, hi = _limits(m, joints)
+    data = mujoco.MjData(m)
+    full = np.zeros((m.nv, m.nv))
+    g = np.zeros(len(dofs))
+    d = np.zeros(len(dofs))
+    for q in _postures(lo, hi, postures):
+        data.qpos[:] = m.qpos0
+        data.qpos[list(qadr)] = q
+        data.qvel[:] = 0.0
+        mujoco.mj_forward(m, data)
+        _full_inertia(m, data, full)
+        g = np.maximum(g, np.abs(data.qfrc_bias[list(dofs)]))
+        d = np.maximum(d, np.sum(np.abs(full[np.ix_(dofs, dofs)]), axis=1))
+    drive = EFFORT_SPEED * m.dof_damping[list(dofs)] + m.dof_frictionloss[list(dofs)]
+    return np.asarray(2.0 * (g + EFFORT_ACCEL * d + drive), dtype=np.float64)
+
+
+def _label(path: str | os.PathLike[str] | None) -> str:
+    return f"{Path(path).name}: " if path is not None else ""
+
+
+def prepare_file(path: str | os.PathLike[str], tip: str | None, fix: Sequence[str]) -> Prepared:
+    """An MJCF file's model for the plant, edited in memory (the module doc).
+
+    Raises
+    ------
+    ValueError
+        MuJoCo cannot compile the file (its message, with the file's name); the
+        reduction's errors (:func:`arm_of`); a tendon that couples an arm joint
+        with a joint to lock; an arm joint with two actuators.
+    """
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except ValueError as e:
+        raise ValueError(f"MuJoCo cannot load {str(path)!r}: {e}") from None
+    return prepare_spec(spec, tip, fix, _label(path), "the file")
+
+
+def prepare_spec(
+    spec: Any, tip: str | None, fix: Sequence[str], label: str = "", given: str = "the spec given"
+) -> Prepared:
+    """:func:`prepare_file` for an ``MjSpec``, edited in place (give a copy);
+    ``given`` names the source in the warnings ("the file", "the spec given")."""
+    try:
+        m0 = spec.compile()
+    except ValueError as e:
+        raise ValueError(f"{label}MuJoCo cannot compile the model: {e}") from None
+    arm = arm_of(m0, tip, fix)
+    tree = arm_tree(m0, arm["joint_ids"])
+    keep = set(arm["joint_ids"])
+    lock = [j for j in range(m0.njnt) if j not in keep and int(m0.jnt_bodyid[j]) in tree]
+    out = Prepared(model=m0, spec=spec, arm=arm)
+    first_order = int(spec.option.integrator) != int(mujoco.mjtIntegrator.mjINT_RK4)
+    if first_order and spec.option.timestep > FIRST_ORDER_STEP:
+        out.notes["timestep"] = (
+            f"{mujoco.mjtIntegrator(int(spec.option.integrator)).name} at "
+            f"{spec.option.timestep:g} s in the file: stepped at {FIRST_ORDER_STEP:g} s"
+        )
+        spec.option.timestep = FIRST_ORDER_STEP
+    spec_actuators = list(spec.actuators)  # index = m0's actuator id
+    for key in spec.keys:  # the plant's motors start at zero torque, without activation
+        key.act = []
+        key.ctrl = []
+    if lock:
+        _lock(spec, m0, lock, keep, spec_actuators)
+        reasons = {
+            _name(m0, _OBJ.mjOBJ_JOINT, j): arm["fixed"].get(
+                _name(m0, _OBJ.mjOBJ_JOINT, j), "not a hinge of the arm"
+            )
+            for j in lock
+        }
+        out.notes["locked"] = reasons
+        out.warnings.append(
+            f"{label}the joints {list(reasons)} are not the arm's "
+            f"({'; '.join(f'{k}: {v}' for k, v in reasons.items())}): the plant locks them at "
+            "their reference position (a rigid hand, as the controller's model of the arm "
+            f"has it), with their actuators, couplings and sensors; {given} is not changed"
+        )
+    _motors(spec, m0, arm, out, label, spec_actuators, given)
+    m1 = _compile(spec)
+    # Equality constraints left inside one rigid body (a gripper's linkage).
+    dead = [
+        k
+        for k in range(m1.neq)
+        if int(m1.eq_type[k]) in (int(mujoco.mjtEq.mjEQ_CONNECT), int(mujoco.mjtEq.mjEQ_WELD))
+        and len({int(m1.body_weldid[b]) for b in _eq_bodies(m1, k) or ()}) == 1
+    ]
+    if dead:
+        equalities = list(spec.equalities)
+        for k in dead:
+            spec.delete(equalities[k])
+        m1 = _compile(spec)
+    holds = holding(m1, [mujoco.mj_name2id(m1, _OBJ.mjOBJ_JOINT, n) for n in arm["joints"]])
+    if holds:
+        equalities = list(spec.equalities)
+        for k in holds:
+            equalities[k].active = False
+        _note_holds(m1, holds, out, label)
+        m1 = _compile(spec)
+    _estimate_missing(spec, m1, out, label)
+    out.model = spec.compile() if out.notes.get("estimated") else m1
+    return out
+
+
+def holding(m: mujoco.MjModel, joint_ids: Sequence[int]) -> list[int]:
+    """The active connect and weld constraints that tie a body the arm moves to
+    one it does not (a mocap body that drags the hand, the world, a fixture):
+    they would hold the arm against the controller."""
+    moved_by = movers(m, joint_ids)
+    out = []
+    for k in range(m.neq):
+        if int(m.eq_type[k]) not in (int(mujoco.mjtEq.mjEQ_CONNECT), int(mujoco.mjtEq.mjEQ_WELD)):
+            continue
+        bodies = _eq_bodies(m, k)
+        if bodies is not None and m.eq_active0[k] and moved_by[bodies[0]] != moved_by[bodies[1]]:
+            out.append(k)
+    return out
+
+
+def _note_holds(m: mujoco.MjModel, holds: Sequence[int], out: Prepared, label: str) -> None:
+    pairs = {}
+    for k in holds:
+        a, b = _eq_bodies(m, k) or (0, 0)
+        name = _name(m, _OBJ.mjOBJ_EQUALITY, k)
+        pairs[name] = f"{_name(m, _OBJ.mjOBJ_BODY, a)!r} to {_name(m, _OBJ.mjOBJ_BODY, b)!r}"
+    out.notes["released"] = pairs
+    out.warnings.append(
+        f"{label}the equality constraints {list(pairs)} tie the arm to what it does not move "
+        f"({'; '.join(pairs.values())}: a mocap body or a fixture): the plant turns them off, "
+        "as the controller drives the joints"
+    )
+
+
+def _compile(spec: Any) -> mujoco.MjModel:
+    return spec.compile()
+
+
+def _eq_bodies(m: mujoco.MjModel, e: int) -> tuple[int, int] | None:
+    objtype = int(m.eq_objtype[e])
+    a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+    if objtype == int(_OBJ.mjOBJ_SITE):
+        return int(m.site_bodyid[a]), int(m.site_bodyid[b]) if b >= 0 else 0
+    if objtype == int(_OBJ.mjOBJ_BODY):
+        return a, max(b, 0)
+    return None
+
+
+def _lock(
+    spec: Any, m0: mujoco.MjModel, lock: Sequence[int], keep: set[int], actuators_of: list[Any]
+) -> None:
+    """Remove the joints ``lock`` of ``m0`` from ``spec`` (their bodies then sit
+    at the joints' reference position), with the actuators, tendons, equality
+    constraints and sensors that use them; keyframes keep the other joints."""
+    joints = {_name(m0, _OBJ.mjOBJ_JOINT, j) for j in lock}
+    tendons: set[str] = set()
+    for t in range(m0.ntendon):
+        adr, num = int(m0.tendon_adr[t]), int(m0.tendon_num[t])
+        wrapped = [
+            int(m0.wrap_objid[w])
+            for w in range(adr, adr + num)
+            if int(m0.wrap_type[w]) == int(mujoco.mjtWrap.mjWRAP_JOINT)
+        ]
+        hit = [j for j in wrapped if j in lock]
+        if hit and any(j in keep for j in wrapped):
+            raise ValueError(
+                f"the tendon {_name(m0, _OBJ.mjOBJ_TENDON, t)!r} couples the arm's joint(s) "
+                f"{[_name(m0, _OBJ.mjOBJ_JOINT, j) for j in wrapped if j in keep]} with "
+                f"{[_name(m0, _OBJ.mjOBJ_JOINT, j) for j in hit]}, which are not the arm's: "
+                "the plant cannot lock them apart; name the arm with tip= or fix="
+            )
+        if hit:
+            tendons.add(_name(m0, _OBJ.mjOBJ_TENDON, t))
+    actuators: set[str] = set()
+    dropped: list[int] = []
+    for a in range(m0.nu):
+        trn, target = int(m0.actuator_trntype[a]), int(m0.actuator_trnid[a, 0])
+        if (trn in _JOINT_TRN and target in lock) or (
+            trn == int(mujoco.mjtTrn.mjTRN_TENDON)
+            and _name(m0, _OBJ.mjOBJ_TENDON, target) in tendons
+        ):
+            actuators.add(_name(m0, _OBJ.mjOBJ_ACTUATOR, a))
+            dropped.append(a)
+    for s in list(spec.sensors):
+        objtype, obj = int(s.objtype), s.objname
+        if (
+            (objtype == int(_OBJ.mjOBJ_JOINT) and obj in joints)
+            or (objtype == int(_OBJ.mjOBJ_TENDON) and obj in tendons)
+            or (objtype == int(_OBJ.mjOBJ_ACTUATOR) and obj in actuators)
+        ):
+            spec.delete(s)
+    for e in list(spec.equalities):
+        if (
+            int(e.type) == int(mujoco.mjtEq.mjEQ_JOINT) and (e.name1 in joints or e.name2 in joints)
+        ) or (
+            int(e.type) == int(mujoco.mjtEq.mjEQ_TENDON)
+            and (e.name1 in tendons or e.name2 in tendons)
+        ):
+            spec.delete(e)
+    for a in dropped:
+        spec.delete(actuators_of[a])
+    for t in list(spec.tendons):
+        if t.name in tendons:
+            spec.delete(t)
+    # Keyframes: the kept joints' positions and velocities; no controls (the
+    # plant's motors start at zero torque).
+    qkeep = [
+        i
+        for j in range(m0.njnt)
+        if j not in lock
+        for i in range(int(m0.jnt_qposadr[j]), int(m0.jnt_qposadr[j]) + _nq(m0, j))
+    ]
+    vkeep = [
+        i
+        for j in range(m0.njnt)
+        if j not in lock
+        for i in range(int(m0.jnt_dofadr[j]), int(m0.jnt_dofadr[j]) + _nv(m0, j))
+    ]
+    for k, key in enumerate(spec.keys):
+        key.qpos = [float(x) for x in np.asarray(m0.key_qpos[k])[qkeep]]
+        key.qvel = [float(x) for x in np.asarray(m0.key_qvel[k])[vkeep]]
+    for name in joints:
+        spec.delete(spec.joint(name))
+
+
+def _nq(m: mujoco.MjModel, j: int) -> int:
+    return {0: 7, 1: 4}.get(int(m.jnt_type[j]), 1)
+
+
+def _nv(m: mujoco.MjModel, j: int) -> int:
+    return {0: 6, 1: 3}.get(int(m.jnt_type[j]), 1)
+
+
+def _motors(
+    spec: Any,
+    m0: mujoco.MjModel,
+    arm: dict[str, Any],
+    out: Prepared,
+    label: str,
+    actuators: list[Any],
+    given: str,
+) -> None:
+    """One torque motor per arm joint in ``spec``: motors kept, servos converted
+    (their force range kept), a motor added where a joint has none. Joints whose
+    τmax nothing declares get ±1 for now and ``out.notes["estimated"]``."""
+    by_joint: dict[int, list[int]] = {j: [] for j in arm["joint_ids"]}
+    for a in range(m0.nu):
+        target = int(m0.actuator_trnid[a, 0])
+        if int(m0.actuator_trntype[a]) in _JOINT_TRN and target in by_joint:
+            by_joint[target].append(a)
+    converted: dict[str, str] = {}
+    added: list[str] = []
+    estimated: list[str] = []
+    sources: dict[str, str] = {}
+    for j in arm["joint_ids"]:
+        jname = _name(m0, _OBJ.mjOBJ_JOINT, j)
+        acts = by_joint[j]
+        if len(acts) > 1:
+            raise ValueError(
+                f"{label}joint {jname!r} has {len(acts)} actuators "
+                f"({', '.join(repr(_name(m0, _OBJ.mjOBJ_ACTUATOR, a)) for a in acts)}): the plant "
+                "drives each arm joint with one torque motor; remove the others or fix= the joint"
+            )
+        if not acts:
+            limit = _joint_limit(m0, j)
+            act = spec.add_actuator(name=f"adaptimp_motor_{jname}", target=jname)
+            act.trntype = mujoco.mjtTrn.mjTRN_JOINT
+            act.set_to_motor()
+            act.gear = [1.0, 0, 0, 0, 0, 0]
+            added.append(jname)
+            source = "actuatorfrcrange" if limit is not None else None
+        else:
+            a = acts[0]
+            act = actuators[a]
+            kind = _kind(m0, a)
+            found = _force_limit(m0, a, j)
+            limit = None if found is None else found[0] / abs(float(m0.actuator_gear[a, 0]))
+            source = None if found is None else found[1]
+            if kind != "motor":
+                converted[jname] = f"{kind} actuator {_name(m0, _OBJ.mjOBJ_ACTUATOR, a)!r} → motor"
+            act.set_to_motor()
+            act.gear = [abs(float(m0.actuator_gear[a, 0])), 0, 0, 0, 0, 0]
+            act.forcelimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        if limit is None:
+            act.ctrlrange = [-1.0, 1.0]
+            estimated.append(jname)
+            sources[jname] = "estimated"
+        else:
+            act.ctrlrange = [-limit, limit]
+            sources[jname] = str(source)
+    out.notes["tau_max"] = sources
+    if converted:
+        out.notes["actuators"] = converted
+        servo_kinds = sorted({v.split(" ")[0] for v in converted.values()})
+        out.warnings.append(
+            f"{label}the actuators of {list(converted)} are {' and '.join(servo_kinds)} "
+            "servos, not torque motors: the plant drives these joints with torque motors of "
+            "the same force range (their forcerange where declared), as the controller "
+            f"commands torque; {given} is not changed"
+        )
+    if added:
+        out.notes["added"] = added
+        out.warnings.append(
+            f"{label}the joints {added} have no actuator: the plant adds a torque motor to each"
+        )
+    if estimated:
+        out.notes["estimated"] = estimated
+
+
+def _joint_limit(m: mujoco.MjModel, j: int) -> float | None:
+    if m.jnt_actfrclimited[j]:
+        lo, hi = (float(v) for v in m.jnt_actfrcrange[j])
+        return _symmetric(
+            lo, hi, f"the actuatorfrcrange of joint {_name(m, _OBJ.mjOBJ_JOINT, j)!r}"
+        )
+    return None
+
+
+def _estimate_missing(spec: Any, m1: mujoco.MjModel, out: Prepared, label: str) -> None:
+    """τmax estimated (:func:`estimate`) for the joints in ``out.notes["estimated"]``,
+    written into ``spec``'s motors."""
+    missing: list[str] = out.notes.get("estimated", [])
+    if not missing:
+        return
+    ids = [mujoco.mj_name2id(m1, _OBJ.mjOBJ_JOINT, n) for n in out.arm["joints"]]
+    qadr = [int(m1.jnt_qposadr[j]) for j in ids]
+    dofs = [int(m1.jnt_dofadr[j]) for j in ids]
+    tau = estimate(m1, qadr, dofs)
+    values = {}
+    for a, act in enumerate(spec.actuators):
+        target = act.target
+        if target in missing:
+            i = out.arm["joints"].index(target)
+            gear = float(m1.actuator_gear[a, 0])
+            act.ctrlrange = [-tau[i] / gear, tau[i] / gear]
+            values[target] = round(float(tau[i]), 3)
+    out.warnings.append(
+        f"{label}no force range is declared for {missing}: the plant estimates τmax = "
+        f"{list(values.values())} N m (2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij| + damping · "
+        "1 rad/s + friction loss) within the joint limits)"
+    )
+
+
+def prepare_model(m: mujoco.MjModel, tip: str | None, fix: Sequence[str]) -> Prepared:
+    """A given ``MjModel`` for the plant: its arm (:func:`arm_of`) and its arm
+    joints' servos made torque motors in a copy (a compiled model cannot lose
+    joints or gain actuators: such a model must come as a file).
+
+    Raises
+    ------
+    ValueError
+        Joints of the arm's tree that are not the arm's, an arm joint without
+        an actuator or a force range (pass the file's path: the plant then
+        edits it in memory); the reduction's errors.
+    """
+    import copy
+
+    m = copy.deepcopy(m)
+    arm = arm_of(m, tip, fix)
+    tree = arm_tree(m, arm["joint_ids"])
+    keep = set(arm["joint_ids"])
+    extra = [j for j in range(m.njnt) if j not in keep and int(m.jnt_bodyid[j]) in tree]
+    if extra:
+        raise ValueError(
+            f"joints {[_name(m, _OBJ.mjOBJ_JOINT, j) for j in extra]} of the arm's body tree are "
+            f"not the arm's ({'; '.join(f'{k}: {v}' for k, v in arm['fixed'].items())}) and a "
+            "compiled MjModel cannot lock them: give the plant the file's path (it locks them "
+            "in memory), or name the arm's joints with tip=/fix="
+        )
+    out = Prepared(model=m, spec=None, arm=arm)
+    holds = holding(m, arm["joint_ids"])
+    if holds:
+        m.eq_active0[holds] = 0
+        _note_holds(m, holds, out, "")
+    converted: dict[str, str] = {}
+    sources: dict[str, str] = {}
+    by_joint: dict[int, list[int]] = {j: [] for j in keep}
+    for a in range(m.nu):
+        if int(m.actuator_trntype[a]) in _JOINT_TRN and int(m.actuator_trnid[a, 0]) in by_joint:
+            by_joint[int(m.actuator_trnid[a, 0])].append(a)
+    for j in arm["joint_ids"]:
+        jname = _name(m, _OBJ.mjOBJ_JOINT, j)
+        acts = by_joint[j]
+        if len(acts) != 1:
+            raise ValueError(
+                f"joint {jname!r} has {len(acts)} actuators: the plant needs exactly one per arm "
+                "joint (give the plant the file's path to have a motor added)"
+                if not acts
+                else f"joint {jname!r} has {len(acts)} actuators: the plant drives each arm "
+                "joint with one torque motor; remove the others or fix= the joint"
+            )
+        a = acts[0]
+        kind = _kind(m, a)
+        found = _force_limit(m, a, j)
+        if found is None:
+            raise ValueError(
+                f"the {'motor' if kind == 'motor' else kind + ' actuator'} of joint {jname!r} "
+                "declares no force range (ctrlrange of a motor, forcerange, or the joint's "
+                "actuatorfrcrange): give the plant the file's path (τmax is then estimated) or "
+                "declare one"
+            )
+        gear = abs(float(m.actuator_gear[a, 0]))
+        if kind != "motor" or float(m.actuator_gainprm[a, 0]) != 1.0:
+            converted[jname] = f"{kind} actuator {_name(m, _OBJ.mjOBJ_ACTUATOR, a)!r} → motor"
+        m.actuator_dyntype[a] = int(mujoco.mjtDyn.mjDYN_NONE)
+        m.actuator_gaintype[a] = int(mujoco.mjtGain.mjGAIN_FIXED)
+        m.actuator_biastype[a] = int(mujoco.mjtBias.mjBIAS_NONE)
+        m.actuator_gainprm[a, :] = 0.0
+        m.actuator_gainprm[a, 0] = 1.0
+        m.actuator_biasprm[a, :] = 0.0
+        m.actuator_gear[a, 0] = gear
+        m.actuator_ctrllimited[a] = 1
+        m.actuator_ctrlrange[a] = [-found[0] / gear, found[0] / gear]
+        m.actuator_forcelimited[a] = 0
+        sources[jname] = found[1]
+    out.notes["tau_max"] = sources
+    if converted:
+        out.notes["actuators"] = converted
+        out.warnings.append(
+            f"the actuators of {list(converted)} are servos, not torque motors: the plant drives "
+            "these joints with torque motors of the same force range (their forcerange where "
+            "declared), as the controller commands torque; the model given is not changed"
+        )
+    return out
+
+
+# ---------------------------------------------------------------------------
+# Contacts the arm's motion makes.
+# ---------------------------------------------------------------------------
+
+
+def movers(m: mujoco.MjModel, joint_ids: Sequence[int]) -> list[frozenset[int]]:
+    """For every body, the set of arm joints that move it (relative to the world)."""
+    arm = set(joint_ids)
+    out: list[frozenset[int]] = [frozenset()] * m.nbody
+    for b in range(1, m.nbody):
+        parent = out[int(m.body_parentid[b])]
+        own = {
+            j
+            for j in range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b]))
+            if j in arm
+        }
+        out[b] = parent | own
+    return out
+
+
+def moving_contacts(
+    m: mujoco.MjModel,
+    d: mujoco.MjData,
+    moved_by: Sequence[frozenset[int]],
+    tree: frozenset[int] | None = None,
+    clearance: float = 0.0,
+) -> list[tuple[str, str, float]]:
+    """The contacts in ``d`` (after collision detection) between two bodies the
+    arm's joints move relative to each other (their sets in ``moved_by``
+    differ) and closer than ``clearance`` (m; 0: touching or penetrating), as
+    (body, body, distance in m); with ``tree``, only those whose
+    two bodies are in it (the arm touching itself). Two links that meet at a
+    joint (one the other's parent) do not count, as MuJoCo's parent filter
+    has it, also where the parent is welded to the world (a base, whose
+    geometry often meets the first link's at the joint whatever the task)."""
+    weld, parent = m.body_weldid, m.body_parentid
+    out = []
+    for c in d.contact[: d.ncon]:
+        b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
+        if moved_by[b1] == moved_by[b2] or c.dist >= clearance:
+            continue
+        w1, w2 = int(weld[b1]), int(weld[b2])
+        if int(weld[parent[w1]]) == w2 or int(weld[parent[w2]]) == w1:
+            continue  # links that meet at their joint (as MuJoCo's filterparent)
+        if tree is not None and not (b1 in tree and b2 in tree):
+            continue
+        pair = sorted((_name(m, _OBJ.mjOBJ_BODY, b1), _name(m, _OBJ.mjOBJ_BODY, b2)))
+        out.append((pair[0], pair[1], float(c.dist)))
+    return out
+
+
+def end_effector(m: mujoco.MjModel, tip: str | None, last_body: int) -> tuple[int, int]:
+    """The end effector as (site id or −1, body): ``tip`` (a site, or a body:
+    its origin); else the site of the first force sensor, or the first site
+    on the last arm joint's body ``last_body``, or that body's origin."""
+    if tip is not None:
+        body, kind = resolve_tip(m, tip)
+        if kind == "site":
+            return mujoco.mj_name2id(m, _OBJ.mjOBJ_SITE, tip), body
+        return -1, body
+    for s in range(m.nsensor):
+        if m.sensor_type[s] == int(mujoco.mjtSensor.mjSENS_FORCE):
+            sid = int(m.sensor_objid[s])
+            return sid, int(m.site_bodyid[sid])
+    on_last = [s for s in range(m.nsite) if int(m.site_bodyid[s]) == last_body]
+    return (on_last[0], last_body) if on_last else (-1, last_body)
+
+
+class Contacts:
+    """Collision detection at postures of the arm, on a copy of ``model``
+    (SPEC §18's safety checks): :meth:`at` gives :func:`moving_contacts` at a
+    posture q of the arm's joints (the other joints at the plant's current
+    state ``qpos``), with every geom's margin raised to ``margin`` (m) so that
+    a near miss counts too.
+
+    Parameters
+    ----------
+    model : MjModel
+        The plant's model (not changed).
+    qpos : array
+        The full configuration the arm's joints are set into.
+    joint_ids : sequence of int
+        The arm's joints.
+    margin : float
+        Clearance (m) below which two geoms count as touching.
+    self_only : bool
+        Only contacts between bodies of the arm's own tree.
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        qpos: FloatArray,
+        joint_ids: Sequence[int],
+        margin: float = 0.0,
+        self_only: bool = False,
+    ) -> None:
+        import copy
+
+        self.model = copy.deepcopy(model)
+        self.model.geom_margin[:] = np.maximum(self.model.geom_margin, margin)
+        self.model.geom_gap[:] = 0.0
+        self.data = mujoco.MjData(self.model)
+        self.qpos = np.array(qpos, dtype=np.float64)
+        self.qadr = [int(model.jnt_qposadr[j]) for j in joint_ids]
+        self.moved_by = movers(model, joint_ids)
+        self.tree = arm_tree(model, joint_ids) if self_only else None
+        self.clearance = margin
+        self.possible = self._possible()
+
+    def _possible(self) -> bool:
+        """Whether any two geoms that the arm moves relative to each other can collide."""
+        m = self.model
+        if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
+            return False
+        if m.npair > 0:
+            return True
+        ct, ca = m.geom_contype, m.geom_conaffinity
+        geoms = [
+            g
+            for g in range(m.ngeom)
+            if (ct[g] or ca[g]) and (self.tree is None or int(m.geom_bodyid[g]) in self.tree)
+        ]
+        groups: dict[frozenset[int], list[int]] = {}
+        for g in geoms:
+            groups.setdefault(self.moved_by[int(m.geom_bodyid[g])], []).append(g)
+        keys = list(groups)
+        for i, a in enumerate(keys):
+            for b in keys[i + 1 :]:
+                for ga in groups[a]:
+                    if any((ct[ga] & ca[gb]) or (ct[gb] & ca[ga]) for gb in groups[b]):
+                        return True
+        return False
+
+    def at(self, q: FloatArray) -> list[tuple[str, str, float]]:
+        """The contacts at the arm's posture ``q`` (rad)."""
+        if not self.possible:
+            return []
+        d = self.data
+        d.qpos[:] = self.qpos
+        d.qpos[self.qadr] = q
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_collision(self.model, d)
+        return moving_contacts(self.model, d, self.moved_by, self.tree, self.clearance)
+
+
+def pairs(found: Iterable[tuple[str, str, float]]) -> str:
+    """Contacts as "'a'–'b', 'c'–'d'" (each pair once, in order of first sight)."""
+    seen: dict[tuple[str, str], None] = {}
+    for a, b, _ in found:
+        seen.setdefault((a, b), None)
+    return ", ".join(f"{a!r}–{b!r}" for a, b in seen)

@@ -21,6 +21,7 @@ import adaptimp
 from adaptimp import mujoco as amj
 from adaptimp.scenarios import contact as act
 from adaptimp.scenarios import panda_table as apt
+from mujoco_probe import ee_position
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "13_panda_table.py"
 SLIDING = Path(__file__).resolve().parent.parent / "scripts" / "sliding_contact.py"
@@ -299,21 +300,18 @@ def test_a_light_wrist_does_not_ring_against_the_table() -> None:
     """The UR10's last joint (d = 5e-4 kg m²) with the robot preset's fixed
     kr = 0.5 N m ran its sampled velocity loop at Ts (Kp + kr/φ)/d = 20 > 2: it
     rang at half the sampling rate and the tool chattered on the table (SF
-    unified: 183 N). The core's rule (panda_table.rule_gains) carries SPEC
-    (18.4)'s kr = φ Kp/2."""
+    unified: 183 N). The core's rule carries SPEC (18.4)'s kr = φ Kp/2
+    (panda_table.rule_gains, and the scenario's rule_keywords, whose learning
+    and K1 = 10 s⁻¹ the table needs at the UR10's home, the zero posture: its
+    wrist joints 4 and 6 in line, the velocity loop's λmin = 0.10)."""
     urdf = _ur5().parent / "ur10_robot.urdf"
     sc = act.arm_table(urdf)
     gains = apt.rule_gains(sc)
     np.testing.assert_allclose(gains["kr"], 0.025 * np.asarray(gains["Kp"]), rtol=1e-15)
+    kw = act.rule_keywords(sc)
+    np.testing.assert_allclose(kw["kr"], 0.025 * np.asarray(kw["gains"]["Kp"]), rtol=1e-15)
     ctrl = apt.panda_controller(
-        "sf",
-        sc,
-        force_feedforward=False,
-        formulation="unified",
-        admittance_share=0.3,
-        gamma=[1.0, 1.0, 5000.0],  # the table's learning before SPEC (19.6)
-        sigma=[0.01, 0.01, 1e-5],
-        weight_bound=[4.19, 13.2, 100.0],
+        "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3, **kw
     )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
@@ -659,7 +657,7 @@ def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:
     plant = amj.Plant(sc.model)
     assert plant.wrench_source == "sensor"
     plant.reset(sc.q0)
-    np.testing.assert_allclose(plant.ee_position(), sc.p0, atol=1e-12)
+    np.testing.assert_allclose(ee_position(plant), sc.p0, atol=1e-12)
     with pytest.raises(adaptimp.ConfigError, match=r"^'ct' needs the arm's Pinocchio model"):
         apt.panda_controller("ct", sc)
     with pytest.raises(adaptimp.ConfigError, match=r"^fix applies to the joints of a URDF"):

@@ -68,7 +68,7 @@ cargo test --quiet --examples runs
 
 step "Fuzzing: a short run of each cargo-fuzz target (nightly)"
 command -v cargo-fuzz >/dev/null || cargo install --locked --quiet cargo-fuzz
-for target in config steps abi; do
+for target in config steps abi urdf; do
     (cd fuzz && CARGO_TARGET_DIR="$PWD/target" cargo +nightly fuzz run -O "$target" -- \
         -max_total_time="${ADAPTIMP_FUZZ_SECONDS:-10}" -timeout=5 -rss_limit_mb=2048 2>&1 |
         grep -E "^Done|ERROR|panicked|SUMMARY")

@@ -24,6 +24,7 @@
 //! | [`control`] | the controller: [`config`], [`controller`] (PD, state and output feedback: the staged step), [`state`], [`io`], [`impedance`] (target-impedance reference xd), [`auxiliary`] (saturation compensator ζ), [`observer`] (high-gain observer), [`robust`], [`saturation`], [`safety`] (fallback, faults, limits), [`tracker`] | (3), (11), (14), (31)–(36), §4–§11, §14 |
 //! | [`networks`] | learning: [`rbf`] (bases S(Z): the grid, user centres, lattices, orbits), [`network`] (ŴD, ŴC, ŴG), [`learning`] (Euler, normalised, freeze, projection), [`simd`] | (1), (15)–(17), §6, §13, §15 |
 //! | [`cartesian`] | task space: [`kinematics`] (pose, 6 × N Jacobian, J̇ q̇), serial [`chain`](cartesian::chain)s from joint data, the [`rotation`](cartesian::rotation) error, the 6-D Cartesian impedance outer loop and its pair with a joint controller | (3), §16 |
+//! | [`description`] (feature `alloc`; URDF files with `urdf`) | reading an arm: a URDF or a compiled MuJoCo model to one kinematic tree, and the one reduction to the arm (which chain, which joints, the tip, what is held and why) | §21 |
 //! | [`schema`] | the parameter table: names, units, docs, conditions, defaults | §10 |
 //! | `sim` (feature `sim`) | simulation only: `model` (D, C, G of the paper's and planar arms), `environment` (walls), `plant` (the `Plant` trait, RK4), `simulator` (the closed loop), `record`, `metrics`, `disturb`, `inject` | (4), (55)–(63), §1–§3, §11, §12, §17 |
 //!
@@ -76,6 +77,8 @@ extern crate alloc;
 // short public path (`adaptimp::controller`, …) through the re-exports below.
 pub mod cartesian;
 pub mod control;
+#[cfg(feature = "alloc")]
+pub mod description;
 pub mod error;
 mod math;
 pub mod networks;

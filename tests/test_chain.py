@@ -15,6 +15,7 @@ import pytest
 import adaptimp
 from adaptimp import _models
 from adaptimp import mujoco as amj
+from adaptimp._description import read_arm
 
 ROBOTS = Path(
     str(
@@ -69,16 +70,20 @@ CASES = [
 ]
 
 
-def _pin_state(model: Any, names: list[str], q: np.ndarray, v: np.ndarray) -> tuple[Any, Any]:
-    """Pinocchio's q, v with the chain's joints set (continuous: cos, sin), the rest 0."""
+def _pin_state(
+    model: Any, names: list[str], q: np.ndarray, v: np.ndarray, held: dict[str, float]
+) -> tuple[Any, Any]:
+    """Pinocchio's q, v with the chain's joints set (continuous: cos, sin), the
+    joints the reduction holds at their held values, the rest 0."""
     qf, vf = pin.neutral(model), np.zeros(model.nv)
-    for i, name in enumerate(names):
+    values = [*zip(names, q, v), *((name, x, 0.0) for name, x in held.items())]
+    for name, x, dx in values:
         j = model.joints[model.getJointId(name)]
         if j.nq == 2:  # an unbounded revolute joint: (cos θ, sin θ)
-            qf[j.idx_q : j.idx_q + 2] = np.cos(q[i]), np.sin(q[i])
+            qf[j.idx_q : j.idx_q + 2] = np.cos(x), np.sin(x)
         else:
-            qf[j.idx_q] = q[i]
-        vf[j.idx_v] = v[i]
+            qf[j.idx_q] = x
+        vf[j.idx_v] = dx
     return qf, vf
 
 
@@ -103,7 +108,13 @@ def test_chain_equals_pinocchio(path: Path, tip: str, names: list[str]) -> None:
     model = _pinocchio(path)
     data = model.createData()
     chain = adaptimp.Chain.from_urdf(path, tip=tip)
-    assert chain.joint_names == names
+    # The one reduction (SPEC (21.2)): a mimic joint on the way moves with its
+    # master, so the chain holds it (Pinocchio, without its mimic option,
+    # counts it as a joint): compared at its held value.
+    held = {n: read_arm(path, tip).held[n] for n in names if n in chain.fixed}
+    assert all(chain.fixed[n].startswith("mimics") for n in held), chain.fixed
+    assert chain.joint_names == [n for n in names if n not in held]
+    names = chain.joint_names
     fid = model.getFrameId(tip, pin.BODY)
     rng = np.random.default_rng(abs(hash((path.name, tip))) % 2**32)
     prismatic = np.array(chain.prismatic)
@@ -112,7 +123,7 @@ def test_chain_equals_pinocchio(path: Path, tip: str, names: list[str]) -> None:
             prismatic, rng.uniform(-0.3, 0.3, chain.n), rng.uniform(-np.pi, np.pi, chain.n)
         )
         v = rng.normal(size=chain.n)
-        qf, vf = _pin_state(model, names, q, v)
+        qf, vf = _pin_state(model, names, q, v, held)
         pin.forwardKinematics(model, data, qf, vf, np.zeros(model.nv))
         pin.updateFramePlacements(model, data)
         frame = data.oMf[fid]
@@ -225,11 +236,14 @@ def _urdf(tmp_path: Path, text: str) -> Path:
             URDF.replace(
                 'type="revolute"><parent link="l1"/>', 'type="floating"><parent link="l1"/>'
             ),
-            "of type 'floating'",
+            "joint 'j2' on the way to 'l2' is floating",
         ),
         (URDF.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 0 0"/>'), "‖axis‖ > 0"),
-        (URDF.replace('<origin xyz="0.3 0 0"/>', '<origin xyz="0.3 0"/>'), "three numbers"),
-        ("<robot", "cannot read the URDF"),
+        (
+            URDF.replace('<origin xyz="0.3 0 0"/>', '<origin xyz="0.3 0"/>'),
+            r'<joint name="j2">: .*expected 3 found 2',
+        ),
+        ("<robot", "robot.urdf as a URDF: it is not XML"),
     ],
 )
 def test_bad_urdf_is_refused_by_name(tmp_path: Path, text: str, message: str) -> None:
@@ -245,12 +259,15 @@ def test_a_cycle_of_joints_is_a_loop(tmp_path: Path) -> None:
         adaptimp.Chain.from_urdf(_urdf(tmp_path, text), tip="l2")
 
 
-def test_tip_must_be_a_link_and_unambiguous() -> None:
-    with pytest.raises(ValueError, match="no link named 'hand'"):
+def test_tip_must_be_a_link_and_the_default_is_the_arm() -> None:
+    with pytest.raises(ValueError, match="tip= 'hand' is neither a link nor a frame"):
         adaptimp.Chain.from_urdf(_models.panda_urdf_path(), tip="hand")
-    # The fingers are two branches of movable joints: which one ends the chain?
-    with pytest.raises(ValueError, match="branch at the link 'panda_hand'"):
-        adaptimp.Chain.from_urdf(_models.panda_urdf_path())
+    # The fingers are the hand's, not the arm's (SPEC (21.2)): the chain is the
+    # arm the plant drives, to its last joint's link.
+    chain = adaptimp.Chain.from_urdf(_models.panda_urdf_path())
+    assert chain.joint_names == list(_models.PANDA_JOINTS)
+    assert chain.source == "URDF 'panda.urdf' to 'panda_link7'"
+    assert set(chain.fixed) == set(_models.PANDA_FINGERS)
 
 
 def test_more_than_seven_joints_is_refused(tmp_path: Path) -> None:
@@ -261,7 +278,7 @@ def test_more_than_seven_joints_is_refused(tmp_path: Path) -> None:
         for i in range(8)
     )
     path = _urdf(tmp_path, f'<robot name="long">{links}{joints}</robot>')
-    with pytest.raises(ValueError, match="1 ≤ n ≤ 7 movable joints"):
+    with pytest.raises(ValueError, match=r"has 8 joints \(j0, .*, j7\); a chain has at most 7"):
         adaptimp.Chain.from_urdf(path)
 
 

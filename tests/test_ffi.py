@@ -203,3 +203,42 @@ def test_the_c_break_it_probe_finds_no_crash_hang_or_wrong_result_under_valgrind
     )
     assert cases == accepted + clear > 10_000, proc.stdout
     assert (crash, hang, wrong, false_refusal) == (0, 0, 0, 0), proc.stdout
+
+
+def test_the_c_urdf_reader_reads_the_arm_python_reads(examples: Path) -> None:
+    """ffi/examples/16_read_urdf.c: adaptimp_chain_from_urdf reads a URDF file
+    (or text) by the core's one reduction (SPEC §21): the arm's joints, limits,
+    efforts, drive terms and tip equal Python's; each refusal is a status with
+    a message naming the file and the element; memcheck finds no error and no
+    leak, reading or refusing."""
+    from adaptimp._description import read_arm
+
+    assert shutil.which("valgrind"), "valgrind is needed (scripts/test.sh installs it)"
+    hobby = ROOT / "tests" / "data" / "hobby_arm.urdf"
+    out = sh(examples / "read_urdf", hobby).stdout
+    arm = read_arm(hobby)
+    assert f"n = {arm.n}\n" in out
+    for i, (lo, hi, effort, damping) in enumerate(
+        zip(arm.lower, arm.upper, arm.effort, arm.damping)
+    ):
+        line = re.search(
+            rf"^joint {i}: revolute, limits \[(\S+), (\S+)\], effort (\S+), "
+            rf"damping (\S+), friction",
+            out,
+            re.MULTILINE,
+        )
+        assert line, out
+        got = [float(x) for x in line.groups()]
+        np.testing.assert_array_equal(got, [lo, hi, effort, damping])
+    chain = adaptimp.Chain.from_urdf(hobby)
+    tip = re.search(r"^tip at q = 0: (\S+) (\S+) (\S+)$", out, re.MULTILINE)
+    assert tip, out
+    np.testing.assert_array_equal([float(x) for x in tip.groups()], chain.fk([0.0] * 5)[:3, 3])
+    # Held by the rule in C as in Python: a tip beyond the gripper's joint.
+    assert "n = 6\n" in sh(examples / "read_urdf", hobby, "--tip", "jaw").stdout
+    errors = sh(examples / "read_urdf", "--errors").stdout
+    assert "FAIL" not in errors, errors
+    assert errors.count("ok ") == 6, errors
+    valgrind(examples / "read_urdf")
+    valgrind(examples / "read_urdf", "--errors")
+    valgrind(examples / "read_urdf", hobby, "--fix", "wrist_roll")

@@ -35,8 +35,9 @@ ARM = [
 
 LOCKED = (
     "ur5_gripper.xml: the joints ['left_knuckle_joint', 'right_knuckle_joint'] are not the "
-    "arm's (left_knuckle_joint: drives 'right_knuckle_joint' (a joint equality); "
-    "right_knuckle_joint: coupled to 'left_knuckle_joint' (a joint equality)): the plant "
+    "arm's (left_knuckle_joint: drives a gripper ('right_knuckle_joint' mimic it); "
+    "right_knuckle_joint: mimics 'left_knuckle_joint': it moves with 'left_knuckle_joint', "
+    "not on its own): the plant "
     "locks them at their reference position (a rigid hand, as the controller's model of the "
     "arm has it), with their actuators, couplings and sensors; the file is not changed"
 )
@@ -94,16 +95,16 @@ def test_tip_is_a_body_or_a_site_and_fix_locks_more() -> None:
     assert plant.joint_names == ARM[:5]
     assert plant.notes["tip"] == "tool0"
     assert "wrist_3_joint" in plant.notes["locked"]
-    assert plant.notes["locked"]["wrist_3_joint"] == "asked"
+    assert plant.notes["locked"]["wrist_3_joint"] == "asked (fix=)"
     # The end effector is tool0's origin: its position and Jacobian are MuJoCo's.
     tool = plant.model.body("tool0").id
     plant.reset(np.full(5, 0.3))
     expected = plant.data.xpos[tool].copy()
     res = measure(plant, np.zeros(5))  # what the core's loop reads there
     np.testing.assert_array_equal(res.x_ee[0], expected)
-    with pytest.raises(ValueError, match=r"tip='nowhere': the model has no site or body"):
+    with pytest.raises(ValueError, match=r"tip= 'nowhere' is neither a link nor a frame"):
         amj.Plant(UR5, tip="nowhere")
-    with pytest.raises(ValueError, match=r"fix=\('elbow',\): the model has no joint 'elbow'"):
+    with pytest.raises(ValueError, match=r"fix= names joints it does not have: \['elbow'\]"):
         amj.Plant(UR5, fix=("elbow",))
     with pytest.raises(TypeError, match="fix must be a tuple of joint names"):
         amj.Plant(UR5, fix="elbow_joint")  # type: ignore[arg-type]

@@ -16,6 +16,7 @@ import pytest
 import adaptimp
 from adaptimp import _models
 from adaptimp import mujoco as amj
+from adaptimp._description import read_arm
 from mujoco_probe import contact_list_wrench, measure, push
 
 RNG_SEED = 20160301
@@ -230,7 +231,7 @@ def test_plant_rejects_models_it_cannot_drive() -> None:
     with pytest.raises(ValueError, match="the motor of joint 'j0' declares no force range"):
         amj.Plant(_mjcf(_chain(1), '<motor joint="j0"/>'))  # unlimited
     branches = _LINK.format(n="j0", t="hinge", inner="") + _LINK.format(n="j1", t="hinge", inner="")
-    with pytest.raises(ValueError, match=r"2 serial chains of 1 hinge joints that tie .* tip="):
+    with pytest.raises(ValueError, match=r"2 serial chains of 1 joints from the root tie .* tip="):
         amj.Plant(_mjcf(branches, _motors(2)))
     with pytest.raises(ValueError, match=r"no file 'nowhere\.xml'"):
         amj.Plant("nowhere.xml")
@@ -238,20 +239,28 @@ def test_plant_rejects_models_it_cannot_drive() -> None:
 
 def test_a_urdf_arm_is_its_chain_with_the_gripper_fixed() -> None:
     path = _models.panda_urdf_path()
-    arm = _models.arm_urdf(path.read_text())
+    arm = read_arm(path)
     assert arm.joints == _models.PANDA_JOINTS
     assert arm.effort == _models.PANDA_EFFORT
     assert arm.tip == "panda_link7"
-    prismatic = "prismatic (the arm's joints are revolute)"
-    assert arm.fixed == dict.fromkeys(_models.PANDA_FINGERS, prismatic)
+    finger1, finger2 = _models.PANDA_FINGERS
+    assert arm.fixed == {
+        finger1: "in the hand at 'panda_hand' (branches of joints start there: two or more "
+        "each shorter than the arm, or three or more none longer)",
+        finger2: f"mimics '{finger1}': it moves with '{finger1}', not on its own",
+    }
     plant = amj.Plant(path)
     assert plant.n == 7
     assert plant.tau_max.tolist() == list(_models.PANDA_EFFORT)
-    # A compiled model with the fingers' slides cannot lock them: refused by
-    # name; its spec (the same model, editable) is locked in memory.
-    spec, effort = amj._urdf_spec(path.read_text())
-    amj._add_motors(spec, effort)
-    with pytest.raises(ValueError, match=r"\['panda_finger_joint1', 'panda_finger_joint2'\]"):
+    # A compiled model with a finger's slide (the chain to a finger drives
+    # it: tip= names the path) cannot lock it: refused by name; its spec (the
+    # same model, editable) is locked in memory.
+    finger = read_arm(path, tip="panda_leftfinger")
+    assert finger.joints == (*_models.PANDA_JOINTS, finger1)
+    assert finger.urdf is not None
+    spec = amj._spec_of(finger.urdf)
+    amj._add_motors(spec, dict(zip(finger.joints, finger.effort)))
+    with pytest.raises(ValueError, match=r"\['panda_finger_joint1'\]"):
         amj.Plant(spec.compile())
     with pytest.warns(adaptimp.PlantWarning, match="the plant locks them at their reference"):
         locked = amj.Plant(spec)

@@ -15,6 +15,7 @@ import pytest
 
 import adaptimp
 from adaptimp import _models
+from adaptimp._description import read_arm
 from adaptimp.scenarios import contact as act
 
 PANDA = adaptimp.Chain.from_urdf(_models.panda_urdf_path(), tip=_models.PANDA_EE)
@@ -146,25 +147,24 @@ def test_a_quadruped_is_refused_unless_the_leg_is_named() -> None:
     from adaptimp.baselines import pinocchio_model
 
     message = (
-        f"the URDF has 4 serial chains of 3 joints from the root that tie for the arm (legs, "
-        f"or two arms), ending at the links {LEGS}: name one with tip= "
-        "(adaptimp.mujoco.from_urdf(path, tip=...), adaptimp.contact.arm_table(path, "
-        "tip=...)) or fix the others' joints with fix="
+        f"URDF 'solo12.urdf': 4 serial chains of 3 joints from the root tie for the arm (legs, "
+        f"or two arms), ending at the links {LEGS}: name one with tip= or hold the others' "
+        "joints with fix="
     )
-    for load in (amj.from_urdf, amj.Plant, pinocchio_model, act.arm_table):
-        with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+    for load in (
+        amj.from_urdf,
+        amj.Plant,
+        pinocchio_model,
+        act.arm_table,
+        adaptimp.Chain.from_urdf,
+    ):
+        with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
             load(SOLO)
-    with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
         amj.simulate("sf", SOLO, T=0.01)
-    branch = (
-        "the movable joints branch at the link 'base_link' ('FL_HAA', 'FR_HAA', 'HL_HAA', "
-        "'HR_HAA'): give tip= (the link that ends the chain)"
-    )
-    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(branch)}$"):
-        adaptimp.Chain.from_urdf(SOLO)
     # Named: that leg, the others fixed, the same in every loader.
     leg = ("HR_HAA", "HR_HFE", "HR_KFE")
-    arm = _models.arm_urdf(Path(SOLO).read_text(), tip="HR_LOWER_LEG")
+    arm = read_arm(SOLO, tip="HR_LOWER_LEG")
     assert arm.joints == leg
     assert sorted(arm.fixed) == sorted(
         f"{side}_{j}" for side in ("FL", "FR", "HL") for j in ("HAA", "HFE", "KFE")
@@ -173,21 +173,25 @@ def test_a_quadruped_is_refused_unless_the_leg_is_named() -> None:
     joint = amj.mujoco.mjtObj.mjOBJ_JOINT
     assert tuple(amj._name(plant.model, joint, j) for j in plant._joints) == leg
     assert adaptimp.Chain.from_urdf(SOLO, tip="HR_LOWER_LEG").joint_names == list(leg)
-    with pytest.raises(ValueError, match=re.escape("the URDF has no link named 'paw' (tip=)")):
-        _models.arm_urdf(Path(SOLO).read_text(), tip="paw")
+    paw = (
+        "URDF 'solo12.urdf': tip= 'paw' is neither a link nor a frame of it: name the link "
+        "(a MuJoCo body) or the frame (a site) that ends the arm"
+    )
+    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(paw)}$"):
+        read_arm(SOLO, tip="paw")
 
 
 def test_the_contact_scenario_drives_the_joints_simulate_drives() -> None:
     """The so100 arm ends in a gripper joint (named "gripper"): the contact
-    scenario and adaptimp.mujoco.simulate take the same arm, by the one rule of
-    _models.arm_urdf (the gripper's joint fixed, the tool on the wrist's link)."""
+    scenario and adaptimp.mujoco.simulate take the same arm, by the core's one
+    rule (SPEC (21.2): the gripper's joint fixed, the tool on the wrist's link)."""
     from adaptimp import mujoco as amj
 
     so100 = _erd("so_arm_description", "urdf", "so100.urdf")
     arm = ("shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll")
-    rule = _models.arm_urdf(Path(so100).read_text())
+    rule = read_arm(so100)
     assert rule.joints == arm
-    assert rule.fixed == {"gripper": "a gripper joint (its name contains 'gripper')"}
+    assert rule.fixed == {"gripper": "a gripper's (its name contains 'gripper')"}
     sc = act.arm_table(so100)
     assert sc.n == len(arm)
     assert tuple(sc.chain.joint_names) == arm
@@ -200,18 +204,15 @@ def test_the_contact_scenario_drives_the_joints_simulate_drives() -> None:
     assert tuple(amj._name(alone.model, joint, j) for j in alone._joints) == arm
 
 
-def test_a_tip_whose_chain_is_not_the_driven_arm_is_refused() -> None:
-    """Given tip= and fix= that leave a fixed joint on the chain, the chain and
-    the model would differ in n: refused, naming both joint lists."""
+def test_a_tip_beyond_a_fixed_joint_holds_it_on_the_chain_too() -> None:
+    """Given tip= and fix= that leave a fixed joint on the chain, the chain holds
+    it as the model does (one reduction, SPEC (21.2)): the tool rides on the jaw,
+    the gripper's joint held closed."""
     so100 = _erd("so_arm_description", "urdf", "so100.urdf")
-    message = (
-        "the chain to 'jaw' has the joints ['shoulder_pan', 'shoulder_lift', 'elbow_flex', "
-        "'wrist_flex', 'wrist_roll', 'gripper'], but the arm's model drives ['shoulder_pan', "
-        "'shoulder_lift', 'elbow_flex', 'wrist_flex', 'wrist_roll'] (fix=('gripper',)): give "
-        "a tip whose path holds exactly the driven joints, or fix the others"
-    )
-    with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(message)}$"):
-        act.arm_table(so100, tip="jaw", fix=("gripper",))
+    arm = ["shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll"]
+    sc = act.arm_table(so100, tip="jaw", fix=("gripper",))
+    assert sc.chain.joint_names == arm
+    assert sc.chain.fixed == {"gripper": "asked (fix=)"}
 
 
 @pytest.mark.parametrize("formulation", [None, "admittance", "impedance"])

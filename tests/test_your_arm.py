@@ -19,6 +19,7 @@ import pytest
 
 from adaptimp import _models
 from adaptimp import mujoco as amj
+from adaptimp._description import read_arm
 from adaptimp.baselines import ComputedTorque, pinocchio_model
 from adaptimp.baselines import with_payload as pin_payload
 
@@ -122,9 +123,12 @@ def test_the_payload_is_the_same_point_mass_in_both_engines() -> None:
 def test_a_light_servo_arm_with_a_gripper(recwarn: pytest.WarningsRecorder) -> None:
     """Five revolute joints (one continuous, without an effort limit), a
     revolute jaw and a mimic finger fixed, light links, servos of 1–2.5 N m."""
-    arm = _models.arm_urdf(HOBBY.read_text())
+    arm = read_arm(HOBBY)
     assert arm.joints == ("base_yaw", "shoulder_pitch", "elbow_pitch", "wrist_pitch", "wrist_roll")
-    assert set(arm.fixed) == {"gripper_jaw", "finger"}
+    assert arm.fixed == {
+        "gripper_jaw": "drives a gripper ('finger' mimic it)",
+        "finger": "mimics 'gripper_jaw': it moves with 'gripper_jaw', not on its own",
+    }
     with pytest.warns(UserWarning, match=r"no effort limit for \['wrist_roll'\]"):
         model = amj.from_urdf(HOBBY)
     plant = amj.Plant(model)
@@ -209,10 +213,14 @@ def test_the_arm_of_a_urdf_is_its_serial_chain() -> None:
         ("f2a", "revolute", "palm", "f2", LIM),
         ("f2b", "revolute", "f2", "f2t", LIM),
     ]
-    a = _models.arm_urdf(_urdf(arm + hand))
+    a = read_arm(_urdf(arm + hand))
     assert a.joints == ("a1", "a2", "a3")
     assert a.tip == "palm"
-    assert set(a.fixed) == {"f1a", "f1b", "f2a", "f2b"}
+    assert a.fixed == dict.fromkeys(
+        ("f1a", "f1b", "f2a", "f2b"),
+        "in the hand at 'palm' (branches of joints start there: two or more each shorter "
+        "than the arm, or three or more none longer)",
+    )
     # A torso of one joint with two arms of three: the chain goes on along an
     # arm (the arms are longer than the torso), but the two tie: which one is
     # the user's to say (tip=); the other is then fixed.
@@ -223,20 +231,20 @@ def test_the_arm_of_a_urdf_is_its_serial_chain() -> None:
             body.append((f"{side}{k}", "revolute", parent, f"{side}{k}link", LIM))
             parent = f"{side}{k}link"
     with pytest.raises(ValueError, match=r"2 serial chains of 4 joints .* 'l2link', 'r2link'"):
-        _models.arm_urdf(_urdf(body))
-    a = _models.arm_urdf(_urdf(body), tip="l2link")
+        read_arm(_urdf(body))
+    a = read_arm(_urdf(body), tip="l2link")
     assert a.joints == ("t", "l0", "l1", "l2")
-    assert a.fixed == dict.fromkeys(("r0", "r1", "r2"), "off the arm's chain (a branch)")
+    assert a.fixed == dict.fromkeys(("r0", "r1", "r2"), "not on the way to 'l2link'")
     # A robot that is itself a finger keeps its joints; limits of "0 0" mean
     # none (a continuous joint); no effort limit is NaN.
     finger = [
         ("finger_1", "revolute", "root", "l1", '<limit lower="0" upper="0" effort="1"/>'),
         ("finger_2", "revolute", "l1", "l2", '<limit lower="-1" upper="1"/>'),
     ]
-    a = _models.arm_urdf(_urdf(finger))
+    a = read_arm(_urdf(finger))
     assert a.joints == ("finger_1", "finger_2")
     assert a.lower[0] == -np.inf
     assert a.upper[0] == np.inf
     assert np.isnan(a.effort[1])
     with pytest.raises(ValueError, match="no revolute or continuous joint to drive"):
-        _models.arm_urdf(_urdf([("s", "prismatic", "root", "l1", LIM)]))
+        read_arm(_urdf([("s", "prismatic", "root", "l1", LIM)]))

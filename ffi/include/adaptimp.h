@@ -523,6 +523,27 @@ typedef struct AdaptimpCommand {
   double w_norms[3];
 } AdaptimpCommand;
 
+// What the core read of the arm beside its chain (SPEC §21), per arm joint
+// in the order of q (base to tip); entries from `n` on are 0.
+typedef struct AdaptimpArmInfo {
+  // The arm's joints n (the chain's).
+  size_t n;
+  // Whether each joint is prismatic (m, N) rather than revolute (rad, N m).
+  bool prismatic[ADAPTIMP_MAX_JOINTS];
+  // Lower position limits (rad or m); -INFINITY for an unlimited joint.
+  double lower[ADAPTIMP_MAX_JOINTS];
+  // Upper position limits (rad or m); INFINITY for an unlimited joint.
+  double upper[ADAPTIMP_MAX_JOINTS];
+  // The URDF's effort limits (N m or N); NAN where it states none.
+  double effort[ADAPTIMP_MAX_JOINTS];
+  // The URDF's velocity limits (rad/s or m/s); NAN where it states none.
+  double velocity[ADAPTIMP_MAX_JOINTS];
+  // Viscous damping (N m s/rad), the URDF's `<dynamics damping>`; 0 if none.
+  double damping[ADAPTIMP_MAX_JOINTS];
+  // Dry friction (N m), the URDF's `<dynamics friction>`; 0 if none.
+  double friction[ADAPTIMP_MAX_JOINTS];
+} AdaptimpArmInfo;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1058,6 +1079,30 @@ enum AdaptimpStatus adaptimp_params_suggest(struct AdaptimpParams *out,
                                             const double *gravity,
                                             double *centers,
                                             double *widths2);
+
+// The chain of the arm of a URDF into `*out` (free it with
+// `adaptimp_chain_free`), read and reduced by
+// the core (SPEC §21): `source` is the path of a URDF file or, if its first
+// non-blank character is '<', URDF text; `tip` the link that ends the arm
+// (NULL: the arm the rule finds, to its last joint's link); `fix` `nfix`
+// joint names to hold (NULL if `nfix` is 0). With `info` non-NULL, the
+// arm's limits, efforts and drive terms are written there.
+//
+// Statuses: INVALID_CONFIG with a message that names the file, the element
+// and what to do (a file that cannot be read, xacro, a URDF the parser
+// refuses, a missing link, a loop, an unknown tip or fix name, chains that
+// tie for the arm, no joint to drive); BAD_SIZE for an arm of more than 7
+// joints (hold some with `fix`); NULL_POINTER for a NULL `source` or `out`.
+//
+// # Safety
+// `source`, `tip` are NULL or NUL-terminated strings; `fix` is NULL or holds
+// `nfix` NUL-terminated strings; `out` and `info` are NULL or valid.
+enum AdaptimpStatus adaptimp_chain_from_urdf(const char *source,
+                                             const char *tip,
+                                             const char *const *fix,
+                                             size_t nfix,
+                                             struct AdaptimpChain **out,
+                                             struct AdaptimpArmInfo *info);
 
 #ifdef __cplusplus
 }  // extern "C"

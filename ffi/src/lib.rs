@@ -715,10 +715,12 @@ unsafe fn free_boxed<T: Handle>(p: *mut T, what: &str, tag: impl FnOnce(&mut T))
 mod cartesian;
 mod joint;
 mod params;
+mod urdf;
 
 pub use cartesian::*;
 pub use joint::*;
 pub use params::*;
+pub use urdf::*;
 
 // ---------------------------------------------------------------------------
 // The library.

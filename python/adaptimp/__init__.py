@@ -42,6 +42,7 @@ from ._errors import (
     MeasurementError,
     PlantWarning,
     StabilityWarning,
+    XacroError,
 )
 from ._faults import Fault
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
@@ -77,6 +78,7 @@ __all__ = [
     "StabilityWarning",
     "TwoLinkArm",
     "Uniform",
+    "XacroError",
     "__version__",
     "defaults",
     "metrics_table",

@@ -22,13 +22,16 @@ __all__ = [
     "PlanarArm",
     "TwoLinkArm",
     "__version__",
+    "arm_from_mujoco",
     "assess_posture",
     "centres_along",
     "default_task",
     "defaults",
+    "description_kind",
     "metrics",
     "pose_circle",
     "pose_metrics",
+    "read_arm",
     "schema_table",
     "simulate",
     "simulate_many",
@@ -499,6 +502,27 @@ def schema_table() -> list[dict[str, Any]]:
 
 def defaults(scenario: str = "paper", n: int = 2) -> dict[str, Any]:
     """Every parameter's default in ``scenario`` ("paper" or "robot") for n joints."""
+
+def read_arm(
+    source: str,
+    tip: str | None = None,
+    fix: Sequence[str] | None = None,
+    label: str | None = None,
+) -> dict[str, Any]:
+    """The arm of a URDF path or URDF text (SPEC §21), as a dict of the arm's
+    joints, limits, efforts, drive terms, chain, bodies, tip, held joints and
+    the reduced URDF."""
+
+def arm_from_mujoco(
+    arrays: dict[str, Any],
+    source: str,
+    tip: str | None = None,
+    fix: Sequence[str] | None = None,
+) -> dict[str, Any]:
+    """The arm of a compiled MuJoCo model's arrays (SPEC §21), as :func:`read_arm`'s dict."""
+
+def description_kind(path: str) -> str:
+    """What the file at ``path`` is: "urdf", "xacro", "mjcf" or "unknown"."""
 
 @disjoint_base
 class Chain:

@@ -18,6 +18,12 @@ class ConfigError(AdaptimpError, ValueError):
     an impossible value. A ``ValueError``."""
 
 
+class XacroError(ConfigError):
+    """A robot description with xacro markup (macros, ``${…}``, ``$(find …)``)
+    given where a URDF is read: expand it first (the message says how; the
+    extra ``xacro`` expands a ``.xacro`` path itself). A ``ConfigError``."""
+
+
 class MeasurementError(AdaptimpError, ValueError):
     """A step's input that is not a measurement: non-finite, of the wrong shape,
     beyond a plausibility limit, or missing (``dq`` for "pd"/"sf"). Named as you
@@ -59,6 +65,7 @@ __all__ = [
     "MeasurementError",
     "PlantWarning",
     "StabilityWarning",
+    "XacroError",
 ]
 
 

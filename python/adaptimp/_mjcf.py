@@ -5,8 +5,7 @@ step a function of its own, none of them touching the file (the model is
 edited in memory, through MuJoCo's ``MjSpec``):
 
 - :func:`arm_of`: which joints are the arm's, the tip, and what is not the
-  arm's and why (a gripper's coupled or branching joints, a slide joint, a
-  joint named in ``fix``).
+  arm's and why: the core's one reduction (SPEC §21), as for a URDF.
 - :func:`prepare_file` / :func:`prepare_model`: the joints of the arm's own
   body tree that are not the arm's are **locked** at their reference
   position (the joint is removed, so its bodies ride rigidly on the hand, as
@@ -37,10 +36,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
-
-GRIPPER_WORDS = ("gripper", "finger", "jaw", "claw")
-"""Joint names with one of these words after an arm joint named otherwise
-belong to a gripper (the URDF reduction's rule, ``adaptimp._models``)."""
 
 EFFORT_ACCEL = 10.0
 """The acceleration (rad/s²) an estimated τmax leaves beyond gravity."""
@@ -88,31 +83,6 @@ def _root(m: mujoco.MjModel, body: int) -> int:
     return body
 
 
-def coupled_joints(m: mujoco.MjModel) -> dict[int, str]:
-    """The joints of a coupled mechanism (MJCF's mimic joints, a gripper's
-    linkage; an arm's joints are never coupled): both joints of a ``<joint>``
-    equality (joint1 follows joint2, the gripper's driver), and the joints of
-    a fixed tendon of two or more joints (robotiq's and jaco's fingers)."""
-    out: dict[int, str] = {}
-    for e in range(m.neq):
-        if int(m.eq_type[e]) == int(mujoco.mjtEq.mjEQ_JOINT) and m.eq_obj2id[e] >= 0:
-            one, two = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
-            out[one] = f"coupled to {_name(m, _OBJ.mjOBJ_JOINT, two)!r} (a joint equality)"
-            out.setdefault(two, f"drives {_name(m, _OBJ.mjOBJ_JOINT, one)!r} (a joint equality)")
-    for t in range(m.ntendon):
-        adr, num = int(m.tendon_adr[t]), int(m.tendon_num[t])
-        joints = [
-            int(m.wrap_objid[w])
-            for w in range(adr, adr + num)
-            if int(m.wrap_type[w]) == int(mujoco.mjtWrap.mjWRAP_JOINT)
-        ]
-        if len(joints) >= 2:
-            name = _name(m, _OBJ.mjOBJ_TENDON, t)
-            for j in joints:
-                out.setdefault(j, f"coupled by the tendon {name!r}")
-    return out
-
-
 def resolve_tip(m: mujoco.MjModel, tip: str) -> tuple[int, str]:
     """A site or body of ``m`` by name: (its body, ``"site"`` or ``"body"``); a
     site first if both have the name.
@@ -135,146 +105,55 @@ def resolve_tip(m: mujoco.MjModel, tip: str) -> tuple[int, str]:
     )
 
 
-def _force_sensor_body(m: mujoco.MjModel) -> int | None:
-    """The body of the first force sensor's site, if a hinge moves it."""
-    for s in range(m.nsensor):
-        if m.sensor_type[s] == int(mujoco.mjtSensor.mjSENS_FORCE):
-            body = int(m.site_bodyid[int(m.sensor_objid[s])])
-            path = [body, *_ancestors(m, body)]
-            if any(
-                int(m.jnt_type[j]) == _HINGE
-                for b in path
-                for j in range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b]))
-            ):
-                return body
-    return None
+def _body_of(m: mujoco.MjModel, link: str) -> int:
+    """The MuJoCo body of a link of the core's tree: a body's name, ``body#i``
+    for an unnamed one, ``BODY:JOINT`` between two joints of one body."""
+    for name in (link, link.rpartition(":")[0]):
+        b = mujoco.mj_name2id(m, _OBJ.mjOBJ_BODY, name)
+        if b >= 0:
+            return int(b)
+        if name.startswith("body#") and name[5:].isdigit():
+            return int(name[5:])
+    return 0
 
 
 def arm_of(m: mujoco.MjModel, tip: str | None = None, fix: Sequence[str] = ()) -> dict[str, Any]:
-    """The arm of a compiled MuJoCo model, by the rules of the URDF reduction
-    (``adaptimp._models.arm_urdf``; SPEC §18) applied to its body tree:
-
-    - a joint named in ``fix`` ("asked"), a slide joint ("prismatic"), a joint
-      another one dictates (joint1 of a joint equality, the joints of a fixed
-      tendon of two or more joints: a gripper's linkage) is not the arm's;
-    - the arm is the longest serial chain of the remaining hinge joints from
-      the world, ending where the tree branches into chains each shorter than
-      the chain so far (a hand); chains that tie are an error listing where
-      each ends, unless ``tip`` names a site or a body (the arm is then the
-      hinges on the way to it); without ``tip``, the site of a force sensor
-      that a hinge moves ends the chain, if there is one;
-    - a joint named gripper/finger/jaw/claw after an arm joint named otherwise
-      is a gripper's; every other hinge off the chain is "off the arm's chain".
+    """The arm of a compiled MuJoCo model by the core's one reduction (SPEC
+    §21, :func:`adaptimp._description.read_arm`; the rule of a URDF's arm on
+    MuJoCo's body tree): the arm's hinges, the tip (``tip``, a site or a
+    body, a site first; without it the site of a force sensor a hinge moves,
+    else the body of the last arm joint), and why every other joint is not
+    the arm's (asked, mimic or coupled, a gripper's drive or jaw, in a hand,
+    prismatic, off the chain).
 
     Returns a dict: ``joints`` (names, base to tip), ``joint_ids`` (MuJoCo
-    ids), ``fixed`` ({name: reason} for every joint that is not the arm's),
-    ``tip`` (the tip's name: ``tip`` if given, else the body of the last
-    joint), ``tip_kind`` ("site" or "body"), ``tip_body`` (its body id).
+    ids), ``fixed`` ({name: reason}), ``tip`` (its name), ``tip_kind``
+    ("site" or "body"), ``tip_body`` (its body id).
 
     Raises
     ------
     ValueError
-        An unknown ``fix`` joint or ``tip``, no hinge to drive, chains that tie.
+        (``ConfigError``) An unknown ``fix`` joint or ``tip``, no joint to
+        drive, chains that tie; the message names the model and what to do.
     """
-    names = {_name(m, _OBJ.mjOBJ_JOINT, j): j for j in range(m.njnt)}
-    unknown = [f for f in fix if f not in names]
-    if unknown:
-        raise ValueError(f"fix={tuple(fix)!r}: the model has no joint {unknown[0]!r}")
-    fixed: dict[int, str] = {}
-    for j in range(m.njnt):
-        name = _name(m, _OBJ.mjOBJ_JOINT, j)
-        if name in fix:
-            fixed[j] = "asked"
-        elif int(m.jnt_type[j]) == _SLIDE:
-            fixed[j] = "prismatic (the arm's joints are hinges)"
-    for j, why in coupled_joints(m).items():
-        fixed.setdefault(j, why)
+    from ._description import read_arm
 
-    def movable(j: int) -> bool:
-        return int(m.jnt_type[j]) == _HINGE and j not in fixed
-
-    def word(j: int) -> str | None:
-        found = [w for w in GRIPPER_WORDS if w in _name(m, _OBJ.mjOBJ_JOINT, j).lower()]
-        return found[0] if found else None
-
-    children: dict[int, list[int]] = {}
-    for b in range(1, m.nbody):
-        children.setdefault(int(m.body_parentid[b]), []).append(b)
-
-    def own(b: int) -> list[int]:
-        return list(range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b])))
-
-    def longest(body: int, held: int, arm: bool) -> list[list[int]]:
-        per_child: list[list[list[int]]] = []
-        for c in children.get(body, []):
-            mine: list[int] = []
-            is_arm = arm
-            for j in own(c):
-                w = word(j)
-                if w is not None and is_arm and movable(j):
-                    fixed[j] = f"a gripper joint (its name contains {w!r})"
-                if movable(j):
-                    mine.append(j)
-                    is_arm = is_arm or w is None
-            below = longest(c, held + len(mine), is_arm)
-            per_child.append([mine + rest for rest in below])
-        carrying = [opts[0] for opts in per_child if opts[0]]
-        if held > 0 and len(carrying) >= 2 and all(len(c) < held for c in carrying):
-            return [[]]  # a hand: the arm ends here
-        every = [c for opts in per_child for c in opts]
-        best = max((len(c) for c in every), default=0)
-        return [c for c in every if len(c) == best] if best > 0 else [[]]
-
-    chains = longest(0, 0, False)
-    tip_body: int | None
-    tip_kind = "body"
-    if tip is not None:
-        tip_body, tip_kind = resolve_tip(m, tip)
+    arm = read_arm(m, tip, fix)
+    if arm.tip_is_frame:
+        site = mujoco.mj_name2id(m, _OBJ.mjOBJ_SITE, arm.tip)
+        if site < 0:  # an unnamed site, "site#i"
+            site = int(arm.tip.rpartition("#")[2])
+        tip_body, tip_kind = int(m.site_bodyid[site]), "site"
     else:
-        tip_body = _force_sensor_body(m)
-    if tip_body is not None:
-        path = list(reversed([tip_body, *_ancestors(m, tip_body)]))
-        chain = [j for b in path for j in own(b) if movable(j)]
-        if not chain:
-            where = f"tip={tip!r}" if tip is not None else "the force sensor's site"
-            raise ValueError(f"no hinge joint to drive on the way to {where}")
-    else:
-        chain = chains[0]
-        if len(chains) > 1:
-            ends = ", ".join(
-                repr(_name(m, _OBJ.mjOBJ_BODY, int(m.jnt_bodyid[c[-1]]))) for c in chains
-            )
-            raise ValueError(
-                f"the model has {len(chains)} serial chains of {len(chain)} hinge joints that "
-                f"tie for the arm (legs, or two arms), ending at the bodies {ends}: name one "
-                "with tip= (a body or a site) or fix the others' joints with fix="
-            )
-    if not chain:
-        raise ValueError(
-            "the model has no hinge joint to drive"
-            + (f" (not the arm's: {_named(m, fixed)})" if fixed else "")
-        )
-    on_chain = set(chain)
-    for j in range(m.njnt):
-        if movable(j) and j not in on_chain:
-            fixed[j] = "off the arm's chain (a branch)"
-    if tip is None:
-        tip = _name(m, _OBJ.mjOBJ_BODY, int(m.jnt_bodyid[chain[-1]]))
-        tip_body = int(m.jnt_bodyid[chain[-1]])
-        tip_kind = "body"
-    assert tip_body is not None
+        tip_body, tip_kind = _body_of(m, arm.tip), "body"
     return {
-        "joints": tuple(_name(m, _OBJ.mjOBJ_JOINT, j) for j in chain),
-        "joint_ids": tuple(chain),
-        "fixed": _named(m, {j: r for j, r in fixed.items() if j not in on_chain}),
-        "tip": tip,
+        "joints": arm.joints,
+        "joint_ids": arm.joint_ids,
+        "fixed": dict(arm.fixed),
+        "tip": arm.tip,
         "tip_kind": tip_kind,
         "tip_body": tip_body,
     }
-
-
-def _named(m: mujoco.MjModel, by_id: dict[int, str]) -> dict[str, str]:
-    return {_name(m, _OBJ.mjOBJ_JOINT, j): r for j, r in sorted(by_id.items())}
 
 
 def arm_tree(m: mujoco.MjModel, joint_ids: Iterable[int]) -> frozenset[int]:

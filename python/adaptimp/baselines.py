@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -74,7 +75,37 @@ def _two_link(params: dict[str, float]) -> Any:
     return model
 
 
-def pinocchio_model(source: Any = "two_link", **arm: float) -> Any:
+def _is_file(source: Any) -> bool:
+    return isinstance(source, os.PathLike) or (
+        isinstance(source, str) and source not in ("two_link", "panda")
+    )
+
+
+def _arm(source: Any, tip: str | None, fix: Sequence[str]) -> Any:
+    """The core's arm (SPEC §21) of ``"panda"``, a path or a MuJoCo model."""
+    from ._description import read_arm
+
+    if isinstance(source, str) and source == "panda":
+        if tip is not None or fix:
+            raise ValueError(
+                "'panda' has its tip and fixed fingers; give the Panda's URDF path to set them"
+            )
+        return read_arm(_models.panda_urdf_path(), _models.PANDA_EE, _models.PANDA_FINGERS)
+    if _is_file(source) and not Path(source).is_file():
+        raise ValueError(
+            f"source must be 'two_link', 'panda', a URDF or MJCF path, a mujoco.MjModel or a "
+            f"pinocchio.Model; no file {str(source)!r}"
+        )
+    return read_arm(source, tip, fix)
+
+
+def pinocchio_model(
+    source: Any = "two_link",
+    *,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+    **arm: float,
+) -> Any:
     """A Pinocchio ``Model`` of an arm.
 
     Parameters
@@ -82,10 +113,13 @@ def pinocchio_model(source: Any = "two_link", **arm: float) -> Any:
     source : {"two_link", "panda"}, path or pinocchio.Model
         ``"two_link"``: the paper's arm (SPEC §1; ``arm`` keywords override its
         parameters, as for :class:`adaptimp.TwoLinkArm`), with frame ``"ee"``
-        at the tip of link 2. ``"panda"``: the Franka Emika Panda from
-        example-robot-data's URDF with both finger joints locked closed
-        (``buildReducedModel``), 7 joints, frame ``"panda_hand_tcp"``.
-        A path: a URDF. A ``pinocchio.Model`` is returned as it is.
+        at the tip of link 2. ``"panda"``: the Franka Emika Panda of
+        example-robot-data's URDF (Pinocchio's parser) with both finger joints
+        locked closed (``buildReducedModel``), 7 joints, frame
+        ``"panda_hand_tcp"``. A path: a URDF or xacro file, its
+        arm as the core's one reduction finds it (SPEC §21, with ``tip`` and
+        ``fix``, as :func:`adaptimp.mujoco.from_urdf`): Pinocchio reads the
+        reduced URDF the core writes. A ``pinocchio.Model`` is returned as it is.
     """
     if isinstance(source, pin.Model):
         return source
@@ -96,11 +130,23 @@ def pinocchio_model(source: Any = "two_link", **arm: float) -> Any:
     if arm:
         raise TypeError(f"arm parameters {sorted(arm)} apply to 'two_link' only")
     if isinstance(source, str) and source == "panda":
+        if tip is not None or fix:
+            raise ValueError(
+                "'panda' has its tip and fixed fingers; give the Panda's URDF path to set them"
+            )
+        # Pinocchio's own model of the file (its parser, not adaptimp's), the
+        # fingers locked closed: the model the Panda table's numbers were made with.
         full = pin.buildModelFromUrdf(str(_models.panda_urdf_path()))
         lock = [full.getJointId(name) for name in _models.PANDA_FINGERS]
         return pin.buildReducedModel(full, lock, pin.neutral(full))
-    if isinstance(source, (str, os.PathLike)) and Path(source).is_file():
-        return pin.buildModelFromXML(_models.arm_urdf(Path(source).read_text()).text)
+    if _is_file(source):
+        described = _arm(source, tip, fix)
+        if described.urdf is None:
+            raise ValueError(
+                f"{described.source} is not a URDF: Pinocchio reads URDF; the core's "
+                "ComputedTorque reads this file itself (ComputedTorque(path))"
+            )
+        return pin.buildModelFromXML(described.urdf)
     raise ValueError(
         f"source must be 'two_link', 'panda', a URDF path or a pinocchio.Model, got {source!r}"
     )
@@ -217,10 +263,13 @@ class ComputedTorque:
 
     Parameters
     ----------
-    model : str, path or pinocchio.Model
-        What :func:`pinocchio_model` takes (default the paper's arm): a serial
-        chain of revolute and prismatic joints. Pinocchio only reads it; the
-        dynamics are the core's.
+    model : str, path, mujoco.MjModel or pinocchio.Model
+        ``"two_link"`` (the paper's arm, the default), ``"panda"``, a URDF,
+        xacro or MJCF path or a compiled MuJoCo model (read by the core, SPEC
+        §21: the arm adaptimp's plant of the file drives, with ``tip`` and
+        ``fix`` as :func:`adaptimp.mujoco.from_urdf` and
+        :class:`adaptimp.mujoco.Plant` take them), or a serial
+        ``pinocchio.Model``. The dynamics are the core's.
     Ts : float
         Period (s).
     Kp : float or (n,)
@@ -228,8 +277,9 @@ class ComputedTorque:
     Kd : float or (n,)
         Damping K_D (1/s); default 40 (critical damping at ω = 20 rad/s).
     tau_max : float or (n,), optional
-        Actuator limits (N m); default the model's ``effortLimit`` (the URDF's),
-        or the paper's [17, 15] for the paper's arm.
+        Actuator limits (N m); default the description's effort limits (the
+        URDF's, the MJCF's actuators'), or the paper's [17, 15] for the
+        paper's arm.
     mass_scale : float
         Every link mass and inertia of the controller's model times this
         (1: the exact model; 1.3: +30 %).
@@ -242,17 +292,27 @@ class ComputedTorque:
         1, 10, 60.
     trajectory : callable, optional
         ``trajectory(t) -> (xc, dxc, ddxc)`` for steps given no setpoint.
+    tip, fix :
+        For a description: the link (body) or frame (site) that ends the arm,
+        and joints to hold (SPEC §21).
+    drive : bool, optional
+        Whether the model has the description's drive terms (armature,
+        viscous damping, friction loss), as the plant has them: None (the
+        default) for an MJCF's (MuJoCo compiles them) and none for a URDF
+        (:func:`adaptimp.mujoco.from_urdf` models the rigid body only, unless
+        its ``drive=True``). ``.drive`` holds the values used.
     impedance : {"joint", "external"}
         ``"joint"`` (default): the compliant reference of SPEC §4 as above.
         ``"external"``: the setpoint is already compliant (an outer loop such
         as that of :class:`adaptimp.CartesianController` made it, SPEC §16):
         xd = xc, ẋd = ẋc, ẍd = ẍc, and τe enters only as the feedforward +τe.
-    armature, damping, friction : float or (n,)
-        The joints' drive in the controller's model (SPEC (20.5), (20.6); ≥ 0,
-        default 0): the rotor inertia added to the mass matrix's diagonal
-        (kg m²), the viscous damping b q̇ (N m s/rad) and the dry friction
-        loss (N m) that the law compensates on its reference's velocity
-        (MuJoCo's ``dof_armature``, ``dof_damping``, ``dof_frictionloss``).
+    armature, damping, friction : float or (n,), optional
+        The joints' drive in the controller's model (SPEC (20.5), (20.6); ≥ 0):
+        the rotor inertia added to the mass matrix's diagonal (kg m²), the
+        viscous damping b q̇ (N m s/rad) and the dry friction loss (N m) that
+        the law compensates on its reference's velocity (MuJoCo's
+        ``dof_armature``, ``dof_damping``, ``dof_frictionloss``). None (the
+        default): the description's, as ``drive`` says (0 for a model).
     """
 
     def __init__(
@@ -270,21 +330,49 @@ class ComputedTorque:
         Gd: ArrayLike = 60.0,
         trajectory: Reference | None = None,
         impedance: str = "joint",
-        armature: ArrayLike = 0.0,
-        damping: ArrayLike = 0.0,
-        friction: ArrayLike = 0.0,
+        armature: ArrayLike | None = None,
+        damping: ArrayLike | None = None,
+        friction: ArrayLike | None = None,
+        tip: str | None = None,
+        fix: Sequence[str] = (),
+        drive: bool | None = None,
     ) -> None:
         from . import _adaptimp
 
         if impedance not in ("joint", "external"):
             raise ValueError(f"impedance must be 'joint' or 'external', got {impedance!r}")
         self.impedance = impedance
-        exact = pinocchio_model(model)
         if not (mass_scale > 0 and math.isfinite(mass_scale)):
             raise ValueError(f"mass_scale must be > 0, got {mass_scale}")
         if not (math.isfinite(payload) and payload >= 0):
             raise ValueError(f"payload must be ≥ 0 kg, got {payload}")
-        n = self.n = int(exact.nv)
+        limits: FloatArray | None
+        if isinstance(model, pin.Model) or (isinstance(model, str) and model == "two_link"):
+            if tip is not None or fix or drive:
+                raise ValueError("tip, fix and drive apply to a robot description, not a model")
+            exact = pinocchio_model(model)
+            joints, inertials, gravity = core_description(exact)
+            limits = np.asarray(exact.effortLimit, dtype=np.float64)
+            nothing = [0.0] * len(joints)
+            self.drive: dict[str, list[float]] = dict.fromkeys(
+                ("armature", "damping", "friction"), nothing
+            )
+        else:
+            # A description (SPEC §21): the core's arm, its chain and bodies.
+            arm = _arm(model, tip, fix)
+            joints, inertials, gravity = arm.chain, arm.inertials, list(arm.gravity)
+            limits = np.asarray(arm.effort, dtype=np.float64)
+            # The drive terms adaptimp's plant of the file has: an MJCF's
+            # (MuJoCo compiles them), none for a URDF unless drive=True
+            # (adaptimp.mujoco.from_urdf(..., drive=True)).
+            use = arm.urdf is None if drive is None else drive
+            zero = [0.0] * arm.n
+            self.drive = {
+                "armature": list(arm.armature) if use else zero,
+                "damping": list(arm.damping) if use else zero,
+                "friction": list(arm.friction) if use else zero,
+            }
+        n = self.n = len(joints)
         if not (Ts > 0 and math.isfinite(Ts)):
             raise ValueError(f"Ts must be > 0, got {Ts}")
         self._ts = float(Ts)
@@ -293,18 +381,15 @@ class ComputedTorque:
         if np.any(self.Dd <= 0):
             raise ValueError(f"Dd must be > 0, got {self.Dd}")
         if tau_max is None:
-            limits = np.asarray(exact.effortLimit, dtype=np.float64)
             usable = limits.shape == (n,) and np.all((limits > 0) & (limits < 1e300))
             tau_max = limits if usable else [17.0, 15.0] if n == 2 else None
             if tau_max is None:
                 raise ValueError("the model has no effort limits: give tau_max")
         self.tau_max = _joint("tau_max", tau_max, n)
         self.mass_scale = float(mass_scale)
-        joints, inertials, gravity = core_description(exact)
-        drive = {
-            "armature": _joint("armature", armature, n).tolist(),
-            "damping": _joint("damping", damping, n).tolist(),
-            "friction": _joint("friction", friction, n).tolist(),
+        given = {"armature": armature, "damping": damping, "friction": friction}
+        self.drive = {
+            k: _joint(k, self.drive[k] if v is None else v, n).tolist() for k, v in given.items()
         }
         self._core = _adaptimp.ComputedTorque(
             joints,
@@ -320,7 +405,7 @@ class ComputedTorque:
             impedance=impedance,
             mass_scale=self.mass_scale,
             payload=float(payload),
-            **drive,
+            **self.drive,
         )
         self._params: dict[str, Any] = {
             "Ts": self._ts,
@@ -333,7 +418,7 @@ class ComputedTorque:
             "Cd": self.Cd.tolist(),
             "Gd": self.Gd.tolist(),
             "impedance": impedance,
-            **drive,
+            **self.drive,
         }
         if trajectory is None and n == 2:
             trajectory = paper_circle()

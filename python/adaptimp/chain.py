@@ -1,12 +1,12 @@
 """Serial-chain kinematics of any arm (SPEC §16): :class:`Chain`.
 
 A chain is the path of joints from a robot's root to its tip: each joint's
-fixed origin transform, its kind (revolute, prismatic, fixed) and axis. This
-module only *reads* that joint data, from a URDF file (with the standard
-library's XML parser) or a MuJoCo model, and hands it to the compiled core,
-which folds the fixed joints, validates everything and computes the tip's
-pose, its 6 × n geometric Jacobian and J̇ q̇ in one pass (no NumPy copy of
-the kinematics).
+fixed origin transform, its kind (revolute, prismatic, fixed) and axis. The
+compiled core reads a URDF (SPEC §21: the one reduction that also builds
+adaptimp's MuJoCo plants and computed-torque models), folds the fixed
+joints, validates everything and computes the tip's pose, its 6 × n
+geometric Jacobian and J̇ q̇ in one pass (no NumPy copy of the
+kinematics); this module passes a MuJoCo model's joint data to it.
 
 Conventions: world frame = the URDF's root link (MuJoCo's world body);
 the Jacobian is ``[J_v; J_ω]``, world-aligned, at the tip origin (Pinocchio's
@@ -17,9 +17,7 @@ Units: m, rad, m/s, rad/s.
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
 
@@ -32,125 +30,6 @@ from ._errors import ConfigError
 __all__ = ["Chain"]
 
 FloatArray = NDArray[np.float64]
-
-_MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
-
-
-@dataclass(frozen=True)
-class _UrdfJoint:
-    name: str
-    kind: str
-    parent: str
-    child: str
-    xyz: tuple[float, float, float]
-    rpy: tuple[float, float, float]
-    axis: tuple[float, float, float]
-
-
-def _triple(text: str | None, what: str, default: tuple[float, float, float]) -> Any:
-    if text is None:
-        return default
-    try:
-        values = tuple(float(x) for x in text.split())
-    except ValueError:
-        raise ConfigError(f"{what} must be three numbers, got {text!r}") from None
-    if len(values) != 3:
-        raise ConfigError(f"{what} must be three numbers, got {text!r}")
-    return values
-
-
-def _read_urdf(source: str | os.PathLike[str]) -> tuple[set[str], dict[str, _UrdfJoint]]:
-    """The links and the joints (by child link) of a URDF; errors for a missing
-    link, a link with two parents and a loop."""
-    try:
-        root = ET.parse(source).getroot()
-    except (ET.ParseError, OSError) as e:
-        raise ConfigError(f"cannot read the URDF {str(source)!r}: {e}") from None
-    if root.tag != "robot":
-        raise ConfigError(f"{str(source)!r} is not a URDF: its root element is <{root.tag}>")
-    links = {link.get("name", "") for link in root.findall("link")}
-    by_child: dict[str, _UrdfJoint] = {}
-    for j in root.findall("joint"):
-        name = j.get("name", "")
-        parent, child = j.find("parent"), j.find("child")
-        p = "" if parent is None else parent.get("link", "")
-        c = "" if child is None else child.get("link", "")
-        for role, link in (("parent", p), ("child", c)):
-            if link not in links:
-                raise ConfigError(
-                    f"URDF joint {name!r} names the {role} link {link!r}, which the URDF "
-                    "does not declare (a missing link)"
-                )
-        if c in by_child:
-            raise ConfigError(
-                f"URDF link {c!r} is the child of two joints ({by_child[c].name!r} and "
-                f"{name!r}): a kinematic loop, which a serial chain cannot describe"
-            )
-        origin = j.find("origin")
-        axis = j.find("axis")
-        by_child[c] = _UrdfJoint(
-            name=name,
-            kind=j.get("type", ""),
-            parent=p,
-            child=c,
-            xyz=_triple(
-                None if origin is None else origin.get("xyz"), f"{name} origin xyz", (0.0,) * 3
-            ),
-            rpy=_triple(
-                None if origin is None else origin.get("rpy"), f"{name} origin rpy", (0.0,) * 3
-            ),
-            axis=_triple(
-                None if axis is None else axis.get("xyz"), f"{name} axis", (1.0, 0.0, 0.0)
-            ),
-        )
-    # Every link's way up must end at a root, not run in a circle.
-    for start in by_child:
-        seen = {start}
-        link = start
-        while link in by_child:
-            link = by_child[link].parent
-            if link in seen:
-                raise ConfigError(
-                    f"URDF joints form a loop through the link {link!r}: "
-                    "a serial chain cannot describe it"
-                )
-            seen.add(link)
-    return links, by_child
-
-
-def _default_tip(links: set[str], by_child: dict[str, _UrdfJoint]) -> str:
-    """The deepest link of the single chain of movable joints from the root."""
-    children: dict[str, list[_UrdfJoint]] = {}
-    for j in by_child.values():
-        children.setdefault(j.parent, []).append(j)
-    roots = sorted(links - set(by_child))
-    if len(roots) != 1:
-        raise ConfigError(
-            f"the URDF has {len(roots)} root links {roots}: give tip= (the chain's last link)"
-        )
-
-    def movable_below(link: str) -> bool:
-        return any(j.kind in _MOVABLE or movable_below(j.child) for j in children.get(link, []))
-
-    link, tip = roots[0], None
-    while True:
-        branches = [
-            j for j in children.get(link, []) if j.kind in _MOVABLE or movable_below(j.child)
-        ]
-        if not branches:
-            break
-        if len(branches) > 1:
-            names = ", ".join(repr(j.name) for j in branches)
-            raise ConfigError(
-                f"the movable joints branch at the link {link!r} ({names}): give tip= "
-                "(the link that ends the chain)"
-            )
-        link = branches[0].child
-        if branches[0].kind in _MOVABLE:
-            tip = link
-    if tip is None:
-        raise ConfigError("the URDF has no movable joint (revolute, continuous or prismatic)")
-    return tip
 
 
 class Chain(_adaptimp.Chain):
@@ -174,6 +53,9 @@ class Chain(_adaptimp.Chain):
         Movable joints, base to tip: q has n entries (rad, or m for prismatic).
     joint_names : list of str
         Their names (from the URDF or the MuJoCo model), in the order of q.
+    fixed : dict
+        The description's other joints held by the reduction, and why
+        (:meth:`from_urdf`; empty otherwise).
     prismatic : list of bool
         Which are prismatic.
 
@@ -198,6 +80,7 @@ class Chain(_adaptimp.Chain):
 
     joint_names: list[str]
     source: str
+    fixed: dict[str, str]
 
     def __new__(
         cls,
@@ -217,49 +100,51 @@ class Chain(_adaptimp.Chain):
             list(names) if names is not None else [f"joint{i}" for i in range(len(movable))]
         )
         self.source = source
+        self.fixed = {}
         return self
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         """Everything happens in ``__new__`` (the compiled core is immutable)."""
 
     @classmethod
-    def from_urdf(cls, path: str | os.PathLike[str], tip: str | None = None) -> Chain:
-        """The chain from the root link of the URDF at ``path`` to the link ``tip``
-        (default: the deepest link of the single chain of movable joints).
+    def from_urdf(
+        cls,
+        path: str | os.PathLike[str],
+        tip: str | None = None,
+        *,
+        fix: Sequence[str] = (),
+    ) -> Chain:
+        """The chain of the arm of the URDF (or xacro) at ``path``, read by the
+        core's one reduction (SPEC §21): to the link ``tip`` (the revolute,
+        continuous and prismatic joints on the way are the chain's), or, by
+        default, the arm the rule finds (the longest chain of revolute
+        joints, ending at a hand or a gripper) to its last joint's link.
 
-        Fixed joints on the way fold into the next origin; ``continuous`` joints
-        are revolute; a ``<mimic>`` joint counts as an independent joint (as
-        Pinocchio loads it). Errors (``ValueError``) for a URDF that cannot be
-        read, a joint naming a missing link, a kinematic loop, branching movable
-        joints when ``tip`` is not given, an unknown ``tip``, a joint of another
-        kind (``floating``, ``planar``) on the path, more than 7 movable joints.
+        Fixed joints on the way fold into the next origin; ``continuous``
+        joints are revolute; a ``<mimic>`` joint and the joints named in
+        ``fix`` are held at their zero value (``chain.fixed`` says why).
+        Errors (``ValueError`` naming the file and the element) for a URDF
+        that cannot be read, a joint naming a missing link, a kinematic
+        loop, chains that tie for the arm when ``tip`` is not given, an
+        unknown ``tip``, a floating or planar joint on the path, more than 7
+        joints (hold some with ``fix``).
         """
-        links, by_child = _read_urdf(path)
-        if tip is None:
-            tip = _default_tip(links, by_child)
-        elif tip not in links:
-            raise ConfigError(f"the URDF {str(path)!r} has no link named {tip!r}")
-        path_joints: list[_UrdfJoint] = []
-        link = tip
-        while link in by_child:
-            path_joints.append(by_child[link])
-            link = by_child[link].parent
-        path_joints.reverse()
-        joints: list[dict[str, Any]] = []
-        names: list[str] = []
-        for j in path_joints:
-            if j.kind == "fixed":
-                kind = "fixed"
-            elif j.kind in _MOVABLE:
-                kind = _MOVABLE[j.kind]
-                names.append(j.name)
-            else:
-                raise ConfigError(
-                    f"the URDF joint {j.name!r} on the way to {tip!r} is of type {j.kind!r}: "
-                    "a chain has revolute, continuous, prismatic and fixed joints only"
-                )
-            joints.append({"kind": kind, "xyz": j.xyz, "rpy": j.rpy, "axis": j.axis})
-        return cls(joints, None, names=names, source=f"URDF {Path(path).name} to {tip!r}")
+        from ._description import read_arm
+
+        arm = read_arm(path, tip, fix)
+        if arm.n > 7:
+            raise ConfigError(
+                f"{arm.source}: the chain to {arm.tip!r} has {arm.n} joints "
+                f"({', '.join(arm.joints)}); a chain has at most 7: hold some with fix=(...)"
+            )
+        chain = cls(
+            arm.chain,
+            arm.tip_origin,
+            names=arm.joints,
+            source=f"{arm.source} to {arm.tip!r}",
+        )
+        chain.fixed = dict(arm.fixed)
+        return chain
 
     @classmethod
     def from_mujoco(
@@ -280,12 +165,13 @@ class Chain(_adaptimp.Chain):
         default the plant's end effector (:class:`adaptimp.mujoco.Plant`): the
         site of the model's force sensor, or the first site of the last arm
         joint's body, or that body. The chain's joints are the arm's
-        (``adaptimp._mjcf.arm_of``: the hinges on the way to the tip that are
-        not a gripper's coupled joints, a slide or named in ``fix``); any
-        other joint on the way is held at its ``qpos0``, as the plant locks
-        it. From each body's ``body_pos``, ``body_quat``, each arm joint's
-        ``jnt_pos`` (its anchor), ``jnt_axis`` and ``qpos0`` (the value at
-        which the body has its model frame), the site's ``site_pos``,
+        (the core's one reduction, SPEC §21: the hinges and slides on the way
+        to the tip that it does not hold, a gripper's coupled joints and those
+        named in ``fix``); any other joint on the way is held at its
+        ``qpos0``, as the plant locks it. From each body's ``body_pos``,
+        ``body_quat``, each arm joint's ``jnt_pos`` (its anchor), ``jnt_axis``
+        and ``qpos0`` (the value at which the body has its model frame), the
+        site's ``site_pos``,
         ``site_quat``. q is the arm's joint positions base to tip
         (``joint_names``); pose and Jacobian equal MuJoCo's (``mj_jacSite``,
         ``mj_jacBody`` on those joints' columns) to rounding.
@@ -307,7 +193,7 @@ class Chain(_adaptimp.Chain):
                     "model must be an MjModel or the path of an MJCF or URDF file; "
                     f"no file {str(path)!r}"
                 )
-            if path.suffix.lower() == ".urdf":
+            if path.suffix.lower() in (".urdf", ".xacro"):
                 from .mujoco import from_urdf
 
                 model = from_urdf(path, fix=tuple(fix), tip=tip if isinstance(tip, str) else None)
@@ -326,67 +212,33 @@ class Chain(_adaptimp.Chain):
                     raise ConfigError(f"the MuJoCo model has no site {sid} ({model.nsite} sites)")
                 body = int(model.site_bodyid[sid])
             elif tip is None:
-                arm = _mjcf.arm_of(model, None, tuple(fix))
-                last = int(model.jnt_bodyid[arm["joint_ids"][-1]])
+                found = _mjcf.arm_of(model, None, tuple(fix))
+                last = int(model.jnt_bodyid[found["joint_ids"][-1]])
                 sid, body = _mjcf.end_effector(model, None, last)
             else:
                 sid, body = _mjcf.end_effector(model, str(tip), 0)
         except ValueError as e:
             raise ConfigError(str(e)) from None
-        # The path's hinges and slides, but for joints another one dictates (a
-        # gripper's linkage) and those named in fix.
-        held = set(_mjcf.coupled_joints(model)) | {
-            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f) for f in fix
-        }
-        bodies: list[int] = []
-        b = body
-        while b != 0:
-            bodies.append(b)
-            b = int(model.body_parentid[b])
-        bodies.reverse()
-        kinds = {
-            int(mujoco.mjtJoint.mjJNT_HINGE): "revolute",
-            int(mujoco.mjtJoint.mjJNT_SLIDE): "prismatic",
-        }
-        joints: list[dict[str, Any]] = []
-        names: list[str] = []
-        for b in bodies:
-            joints.append(
-                {
-                    "kind": "fixed",
-                    "pos": model.body_pos[b].tolist(),
-                    "quat": model.body_quat[b].tolist(),
-                }
-            )
-            first = int(model.body_jntadr[b])
-            for j in range(first, first + int(model.body_jntnum[b])):
-                name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint{j}"
-                kind = kinds.get(int(model.jnt_type[j]))
-                if kind is None:
-                    raise ConfigError(
-                        f"the MuJoCo joint {name!r} on the way to the tip is free or ball: "
-                        "a chain has hinge and slide joints only"
-                    )
-                if j in held:
-                    continue  # held at qpos0: the body at its model frame
-                anchor = model.jnt_pos[j].tolist()
-                joints.append(
-                    {
-                        "kind": kind,
-                        "pos": anchor,
-                        "axis": model.jnt_axis[j].tolist(),
-                        "offset": float(model.qpos0[model.jnt_qposadr[j]]),
-                    }
-                )
-                joints.append({"kind": "fixed", "pos": [-x for x in anchor]})
-                names.append(name)
+        # The chain to that site or body by the core's one reduction (SPEC
+        # §21): the path's hinges and slides, but for the joints it holds (a
+        # gripper's linkage, those named in fix) at their reference.
+        from ._description import read_arm
+
         if sid >= 0:
-            end = {"pos": model.site_pos[sid].tolist(), "quat": model.site_quat[sid].tolist()}
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, sid) or f"site#{sid}"
             label = f"site {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, sid) or sid!r}"
         else:
-            end = None
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body) or f"body#{body}"
             label = f"body {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body) or body!r}"
-        return cls(joints, end, names=names, source=f"MuJoCo model to {label}")
+        arm = read_arm(model, name, fix)
+        if arm.n > 7:
+            raise ConfigError(
+                f"{arm.source}: the chain to {name!r} has {arm.n} joints "
+                f"({', '.join(arm.joints)}); a chain has at most 7: hold some with fix=(...)"
+            )
+        chain = cls(arm.chain, arm.tip_origin, names=arm.joints, source=f"MuJoCo model to {label}")
+        chain.fixed = dict(arm.fixed)
+        return chain
 
     def pose(self, q: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The tip's position (m), (3,), and rotation (world ← tip), (3, 3), at q."""

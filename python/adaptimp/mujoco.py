@@ -59,7 +59,7 @@ try:
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
-from . import _adaptimp, _mjcf, _models
+from . import _adaptimp, _description, _mjcf, _models
 from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
 from ._faults import Fault
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
@@ -175,11 +175,6 @@ def _add_motors(spec: Any, effort: Mapping[str, float]) -> None:
         )
 
 
-def _urdf_spec(text: str, fix: tuple[str, ...] = ()) -> tuple[Any, dict[str, float]]:
-    urdf, effort = _models.adapt_urdf(text, fix)
-    return _spec_of(urdf), effort
-
-
 def _spec_of(urdf: str) -> Any:
     spec = mujoco.MjSpec.from_string(urdf)
     # Keep the URDF's fixed links as bodies: a force sensor needs its own body.
@@ -188,7 +183,7 @@ def _spec_of(urdf: str) -> Any:
     return spec
 
 
-def _compile_arm(spec: Any, note: str = "") -> mujoco.MjModel:
+def _compile_arm(spec: Any, note: str = "", *, stacklevel: int = 3) -> mujoco.MjModel:
     """``spec`` compiled; if a URDF's inertias do not compile as they are (a
     massless moving link, an inertia that violates the triangle inequality),
     compiled again with every body bounded and balanced (1e-6 kg, 1e-10 kg m²,
@@ -201,12 +196,10 @@ def _compile_arm(spec: Any, note: str = "") -> mujoco.MjModel:
         spec.compiler.boundinertia = 1e-10
         spec.compiler.balanceinertia = True
         model = spec.compile()
-        import warnings
-
         warnings.warn(
             f"the URDF's inertias do not compile as they are ({e}); every body now has "
             f"at least 1e-6 kg and 1e-10 kg m², and inertias are balanced{note}",
-            stacklevel=3,
+            stacklevel=stacklevel,
         )
         return model
 
@@ -216,71 +209,95 @@ EFFORT_ACCEL = 10.0
 (:func:`from_urdf`)."""
 
 
+def _urdf_arm(
+    path: str | os.PathLike[str], tip: str | None, fix: Sequence[str]
+) -> _description.Arm:
+    """The arm of a URDF (or xacro) file by the core's one reduction (SPEC §21)."""
+    arm = _description.read_arm(path, tip, fix)
+    if arm.urdf is None:
+        raise ValueError(
+            f"{arm.source} is not a URDF: from_urdf reads URDF and xacro files; give an MJCF "
+            "path to Plant or simulate directly"
+        )
+    if arm.n > MAX_JOINTS:
+        raise ValueError(
+            f"the URDF's arm has {arm.n} joints ({', '.join(arm.joints)}); "
+            f"adaptimp drives at most {MAX_JOINTS}: fix some with fix=(...)"
+        )
+    return arm
+
+
+def _arm_spec(arm: _description.Arm, timestep: float, *, drive: bool, stacklevel: int) -> Any:
+    """The MjSpec of a URDF arm (its reduced URDF, RK4 at ``timestep`` s),
+    with a motor per arm joint at ± its effort; where the URDF gives none,
+    the estimate of :func:`estimate_effort` on the arm itself, with a warning
+    at ``stacklevel``. With ``drive``, each arm joint's damping and friction
+    loss as the URDF's ``<dynamics>`` states them."""
+    text = arm.urdf_drive if drive else arm.urdf
+    assert text is not None
+    spec = _spec_of(text)
+    spec.option.timestep = timestep
+    missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
+    _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
+    if missing:
+        estimate = estimate_effort(_compile_arm(spec, stacklevel=stacklevel + 1))
+        for j, name in enumerate(arm.joints):
+            if name in missing:
+                spec.actuator(name).ctrlrange = [-estimate[j], estimate[j]]
+        warnings.warn(
+            f"the URDF gives no effort limit for {missing}: estimated "
+            f"{[round(float(estimate[arm.joints.index(j)]), 3) for j in missing]} N m "
+            "(2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within the joint limits)",
+            stacklevel=stacklevel,
+        )
+    return spec
+
+
 def from_urdf(
     path: str | os.PathLike[str],
     timestep: float = 1e-3,
     *,
     fix: tuple[str, ...] = (),
     tip: str | None = None,
+    drive: bool = False,
 ) -> mujoco.MjModel:
-    """A URDF arm as a MuJoCo model :class:`Plant` accepts.
+    """A URDF (or xacro) arm as a MuJoCo model :class:`Plant` accepts.
 
-    The arm is the URDF's serial chain of revolute and continuous joints
-    (:func:`adaptimp._models.arm_urdf`, one reduction for MuJoCo and
-    Pinocchio): the longest chain from the root, ending at a hand (a branch
-    into shorter chains); prismatic and mimic joints, a gripper's joints
-    (named gripper/finger/jaw/claw, after the arm's) and every joint off the
-    chain are fixed at their zero position, and so are the joints named in
-    ``fix``. Chains that tie for the longest (a quadruped's legs, two arms)
-    are an error listing the link each ends at: ``tip`` names the link that
-    ends the arm (the movable joints on the way to it are the arm's). A
-    revolute joint with no range (lower ≥ upper) is continuous.
-    Visual and collision elements, joint ``<dynamics>`` (damping, friction)
-    and mimic tags are dropped (the rigid-body dynamics
-    only, no mesh files; no contact geometry). Continuous joints are
-    unlimited hinges. If the inertias do not compile as they are (a massless
-    moving link, an inertia that violates the triangle inequality), every
-    body gets at least 1e-6 kg and 1e-10 kg m² and inertias are balanced
-    (MuJoCo's ``boundmass``, ``boundinertia``, ``balanceinertia``), with a
-    warning. Each arm joint gets a motor with ctrlrange ± its
-    ``<limit effort>`` (N m); where the URDF gives none (or zero) the limit is
-    estimated from the arm itself, 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|)
-    over 256 postures within the joint limits (:func:`estimate_effort`), with
-    a warning. RK4 at ``timestep`` (s).
+    The arm is the one the core's reduction finds (SPEC §21, the same rule
+    for the chain, the computed-torque model and C): the longest chain of
+    revolute and continuous joints from the root, ending at a hand or a
+    gripper (recognised by its structure: mimic joints, a joint other joints
+    mimic, a jaw beside the tool frame, a branching hand; by name last);
+    every other joint held fixed at its zero position (mimic joints where
+    their master's zero puts them), and the joints named in ``fix``. Chains
+    that tie for the longest (a quadruped's legs, two arms) are an error
+    listing the link each ends at: ``tip`` names the link that ends the arm
+    (the movable joints on the way to it are the arm's). MuJoCo compiles the
+    reduced URDF the core writes: the links' inertials (no visual or
+    collision elements, so no mesh files and no contact geometry) and the
+    arm joints' limits: the rigid-body dynamics only, unless ``drive``
+    (then each arm joint's ``<dynamics>`` damping and friction loss as the
+    URDF states them; :class:`adaptimp.baselines.ComputedTorque` takes the
+    same ``drive``). Continuous joints are unlimited hinges. If the
+    inertias do not compile as they are (a massless moving link, an inertia
+    that violates the triangle inequality), every body gets at least 1e-6 kg
+    and 1e-10 kg m² and inertias are balanced (MuJoCo's ``boundmass``,
+    ``boundinertia``, ``balanceinertia``), with a warning. Each arm joint
+    gets a motor with ctrlrange ± its ``<limit effort>`` (N m); where the
+    URDF gives none (or zero) the limit is estimated from the arm itself,
+    2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) over 256 postures within the
+    joint limits (:func:`estimate_effort`), with a warning. RK4 at
+    ``timestep`` (s).
 
     Raises
     ------
     ValueError
         The URDF has no revolute or continuous joint to drive, more than
-        :data:`MAX_JOINTS` on its longest chain, or several chains that tie
-        for the longest and no ``tip``.
+        :data:`MAX_JOINTS` on its arm, or several chains that tie for the
+        longest and no ``tip`` (the message names the file and what to do).
     """
-    arm = _models.arm_urdf(Path(path).read_text(), fix, tip=tip)
-    if len(arm.joints) > MAX_JOINTS:
-        raise ValueError(
-            f"the URDF's arm has {len(arm.joints)} joints ({', '.join(arm.joints)}); "
-            f"adaptimp drives at most {MAX_JOINTS}: fix some with fix=(...)"
-        )
-    spec = _spec_of(arm.text)
-    spec.option.timestep = timestep
-    missing = [j for j, e in zip(arm.joints, arm.effort) if not math.isfinite(e)]
-    _add_motors(spec, {j: (e if math.isfinite(e) else 1.0) for j, e in zip(arm.joints, arm.effort)})
-    model = _compile_arm(spec)
-    if missing:
-        estimate = estimate_effort(model)
-        for j, name in enumerate(arm.joints):
-            if name in missing:
-                a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
-                model.actuator_ctrlrange[a] = [-estimate[j], estimate[j]]
-        import warnings
-
-        warnings.warn(
-            f"the URDF gives no effort limit for {missing}: estimated "
-            f"{[round(float(estimate[arm.joints.index(j)]), 3) for j in missing]} N m "
-            "(2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|) within the joint limits)",
-            stacklevel=2,
-        )
-    return model
+    arm = _urdf_arm(path, tip, fix)
+    return _compile_arm(_arm_spec(arm, timestep, drive=drive, stacklevel=3))
 
 
 def _limits(model: mujoco.MjModel, joints: Sequence[int]) -> tuple[FloatArray, FloatArray]:
@@ -363,10 +380,9 @@ def panda(
     timestep : float
         MuJoCo's timestep (s); :func:`simulate` resets it to Ts / substeps.
     """
-    spec, effort = _urdf_spec(_models.panda_urdf_path().read_text(), fix=_models.PANDA_FINGERS)
+    arm = _urdf_arm(_models.panda_urdf_path(), _models.PANDA_EE, _models.PANDA_FINGERS)
+    spec = _arm_spec(arm, timestep, drive=False, stacklevel=2)
     spec.modelname = "panda"
-    spec.option.timestep = timestep
-    _add_motors(spec, effort)
     add_tool(spec, _models.PANDA_EE, radius=tool_radius, own_body=False)
     if table_height is not None:
         add_table(spec, top=table_height, centre=(0.55, 0.0))
@@ -386,7 +402,7 @@ def _prepare(source: ModelSource, tip: str | None, fix: tuple[str, ...]) -> _mjc
     if isinstance(source, str) and source in _BUILTIN:
         return _mjcf.prepare_model(_BUILTIN[source](), tip, fix)
     path = _model_path(source)
-    if path.suffix.lower() == ".urdf":
+    if path.suffix.lower() in (".urdf", ".xacro"):
         return _mjcf.prepare_model(from_urdf(path, fix=fix, tip=tip), tip, ())
     return _mjcf.prepare_file(path, tip, fix)
 
@@ -571,7 +587,8 @@ class Plant:
         the subtree on different weld bodies whose contype and conaffinity meet."""
         if isinstance(source, mujoco.MjModel) or (isinstance(source, str) and source in _BUILTIN):
             return False
-        if not isinstance(source, mujoco.MjSpec) and Path(source).suffix.lower() == ".urdf":
+        suffix = "" if isinstance(source, mujoco.MjSpec) else Path(source).suffix.lower()
+        if suffix in (".urdf", ".xacro"):
             return False
         m = self.model
         if m.npair > 0 or not self._contact_possible():

@@ -221,7 +221,7 @@ struct Link {
 }
 
 /// The rotation by `theta` (rad) about the unit `axis` (Rodrigues).
-fn axis_rotation(axis: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
+pub(crate) fn axis_rotation(axis: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
     let (s, c) = (sin(theta), cos(theta));
     let k = axis.cross_matrix();
     Matrix3::identity() + k * s + k * k * (1.0 - c)

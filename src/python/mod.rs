@@ -28,6 +28,7 @@ mod callback;
 mod cartesian;
 mod cartesian_loop;
 mod computed;
+mod description;
 mod dynamic;
 mod frames;
 mod mujoco;
@@ -1875,6 +1876,8 @@ mod adaptimp_module {
     use super::cartesian::{centres_along, PyCartesian, PyChain};
     #[pymodule_export]
     use super::computed::PyComputedTorque;
+    #[pymodule_export]
+    use super::description::{arm_from_mujoco, description_kind, read_arm};
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -289,22 +289,10 @@ def arm_model(
             centre=centre, friction=friction, spring=spring, home=home, timestep=timestep,
             force=force, speed=speed,
         )  # fmt: skip
-    spec, effort = amj._urdf_spec(Path(urdf).read_text(), fix)
-    spec.option.timestep = timestep
-    missing = [j.name for j in spec.joints if not 0 < effort.get(j.name, math.nan) < math.inf]
-    if missing:
-        # The arm's own estimate, as adaptimp.mujoco.from_urdf makes it (and
-        # says so): 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij|).
-        arm = amj.from_urdf(urdf, fix=fix, tip=tip)
-        for name in missing:
-            a = mujoco.mj_name2id(arm, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
-            if a < 0:
-                raise ValueError(
-                    f"joint {name!r} has no <limit effort=...> and is not one the arm's "
-                    f"model drives (from_urdf(tip={tip!r}) fixes it): give it in fix=..."
-                )
-            effort[name] = float(arm.actuator_ctrlrange[a][1])
-    amj._add_motors(spec, effort)
+    # The arm as adaptimp.mujoco.from_urdf makes it, by the core's one
+    # reduction (SPEC §21), with its motors (efforts estimated where the URDF
+    # gives none, and said so).
+    spec = amj._arm_spec(amj._urdf_arm(urdf, tip, fix), timestep, drive=False, stacklevel=3)
     _tool_and_table(
         spec,
         tip,
@@ -586,7 +574,7 @@ def arm_table(
 
     ``tip``: the tool's body (default: the child link of the arm's last joint).
     The arm's joints are those :func:`adaptimp.mujoco.simulate` drives, by
-    the rule of :func:`adaptimp.mujoco.from_urdf` (``_models.arm_urdf``, with
+    the core's one rule (SPEC §21, as :func:`adaptimp.mujoco.from_urdf` with
     ``tip``): a gripper's, prismatic, mimic and off-chain joints are fixed,
     and chains that tie (legs, two arms) need ``tip``; ``home`` (rad): default the rule's home
     posture; ``spring``: the table's spring stiffness k_e (N/m), None: rigid;
@@ -671,7 +659,7 @@ def arm_table(
     path = Path(urdf)
     if path.suffix.lower() == ".urdf":
         chain, bare, tip, fix = _urdf_arm(path, tip, fix, tool_radius)
-        pin_model: Any = pinocchio_model(path)
+        pin_model: Any = pinocchio_model(path, tip=tip, fix=fix)
     else:
         chain, bare, tip = _mjcf_arm(path, tip, fix, tool_radius)
         pin_model = None  # computed torque's model is Pinocchio's, from a URDF
@@ -738,26 +726,20 @@ def _urdf_arm(
     path: Path, tip: str | None, fix: tuple[str, ...], tool_radius: float
 ) -> tuple[Chain, Any, str, tuple[str, ...]]:
     """A URDF arm's chain to the tool's body, its bare model's Plant (the tool,
-    no table), the tip and the joints fixed: by the one rule of
-    :func:`adaptimp.mujoco.simulate` and the Pinocchio model
-    (``_models.arm_urdf``: a gripper's, prismatic, mimic and off-chain joints
-    are fixed; by default the tool goes on the last arm joint's link)."""
-    import xml.etree.ElementTree as ET
-
+    no table), the tip and the joints fixed: by the core's one rule (SPEC §21),
+    as :func:`adaptimp.mujoco.simulate` simulates it and the computed torque
+    models it (a gripper's, prismatic, mimic and off-chain joints are held; by
+    default the tool goes on the last arm joint's link). A ``fix`` name the
+    URDF does not have is refused."""
     import mujoco
 
-    from .. import _models
     from .. import mujoco as amj
+    from .._description import read_arm
 
-    text = path.read_text()
-    names = {j.get("name") for j in ET.fromstring(text).iter("joint")}
-    unknown = [j for j in fix if j not in names]
-    if unknown:
-        raise ConfigError(f"fix names joints the URDF does not have: {unknown}")
-    arm = _models.arm_urdf(text, fix, tip=tip)
+    arm = read_arm(path, tip, fix)
     tip = arm.tip if tip is None else tip
     fix = (*fix, *(j for j in arm.fixed if j not in fix))
-    chain = Chain.from_urdf(path, tip=tip)
+    chain = Chain.from_urdf(path, tip=tip, fix=fix)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
     joint = mujoco.mjtObj.mjOBJ_JOINT
     driven = [amj._name(bare.model, joint, j) for j in bare._joints]

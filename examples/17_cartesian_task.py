@@ -18,9 +18,9 @@ gave before (the rule's gains without the path, so the schema's Γ = 100, σ =
 0.01 and "auto" bound, and 64 centres of tube (0.05 rad, 0.2 rad/s)) against
 the rule, one change at a time (SPEC §16, "Why the networks barely learned").
 
-    python examples/16_cartesian_task.py                       # the Panda, T = 12 s
-    python examples/16_cartesian_task.py ARM.urdf ARM.xml --json out.json
-    python examples/16_cartesian_task.py --why
+    python examples/17_cartesian_task.py                       # the Panda, T = 12 s
+    python examples/17_cartesian_task.py ARM.urdf ARM.xml --json out.json
+    python examples/17_cartesian_task.py --why
 
 Needs the extras ``mujoco`` and ``pinocchio``. ``ADAPTIMP_QUICK=1``: T = 3 s.
 """

@@ -1,0 +1,881 @@
+//! The one reduction of a tree to the arm adaptimp drives, SPEC (21.2):
+//! which chain, which joints are the arm's, the tip, what is held fixed and
+//! why, and the arm's kinematics, bodies and drive terms.
+
+use super::error::{DescriptionError, ErrorKind};
+use super::tree::{motion, JointType, Tree};
+use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
+use crate::cartesian::dynamics::{Drive, Dynamics, Inertial};
+use crate::error::Error;
+use alloc::collections::{BTreeMap, VecDeque};
+use alloc::format;
+use alloc::string::{String, ToString};
+use alloc::vec::Vec;
+use core::fmt;
+use nalgebra::{Matrix3, Vector3};
+
+/// Words that mark a joint as a gripper's when nothing in the structure
+/// does (the last hint of (21.2), rule 5c), matched in any case.
+pub const GRIPPER_WORDS: [&str; 5] = ["gripper", "finger", "jaw", "claw", "knuckle"];
+
+/// Why a joint of the tree is not one of the arm's (SPEC (21.2)).
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Held {
+    /// Named in `fix`.
+    Asked,
+    /// A mimic joint: it moves with its master.
+    Mimic {
+        /// The joint it follows.
+        master: String,
+    },
+    /// Coupled to other joints (a MuJoCo fixed tendon): it does not move
+    /// on its own.
+    Coupled {
+        /// What couples it.
+        by: String,
+    },
+    /// A joint of more than one coordinate (floating, planar, ball).
+    Free {
+        /// Its kind.
+        kind: JointType,
+    },
+    /// A prismatic joint, when the arm is found without a `tip`.
+    Prismatic,
+    /// Below a hand: a link where two or more branches of joints start,
+    /// each shorter than the arm that holds them.
+    Hand {
+        /// The hand's link.
+        link: String,
+    },
+    /// The last joint of a chain that other joints mimic: a gripper's drive.
+    GripperDrive {
+        /// The joints that mimic it.
+        followers: Vec<String>,
+    },
+    /// A last joint beside a tool frame, with no frame below it: a jaw.
+    Jaw {
+        /// The tool frame beside it.
+        frame: String,
+    },
+    /// A joint whose name says it is a gripper's, after an arm joint whose
+    /// name does not.
+    Named {
+        /// The word of [`GRIPPER_WORDS`] in its name.
+        word: &'static str,
+    },
+    /// A drivable joint on another chain than the arm's.
+    OffChain,
+    /// A joint not on the way to the `tip` asked for.
+    OffPath {
+        /// The tip.
+        tip: String,
+    },
+}
+
+impl fmt::Display for Held {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Asked => f.write_str("asked (fix=)"),
+            Self::Mimic { master } => {
+                write!(
+                    f,
+                    "mimics '{master}': it moves with '{master}', not on its own"
+                )
+            }
+            Self::Coupled { by } => write!(
+                f,
+                "coupled to other joints by '{by}': it does not move on its own"
+            ),
+            Self::Free { kind } => write!(
+                f,
+                "a {} joint: an arm's joints have one coordinate each",
+                kind.urdf_name()
+            ),
+            Self::Prismatic => f.write_str(
+                "prismatic (a lift, a rail or a finger): the arm found without tip= is revolute; \
+                 a tip beyond it drives it",
+            ),
+            Self::Hand { link } => write!(
+                f,
+                "in the hand at '{link}' (branches of joints start there: two or more each \
+                 shorter than the arm, or three or more none longer)"
+            ),
+            Self::GripperDrive { followers } => {
+                f.write_str("drives a gripper (")?;
+                for (i, name) in followers.iter().enumerate() {
+                    let sep = if i == 0 { "" } else { ", " };
+                    write!(f, "{sep}'{name}'")?;
+                }
+                f.write_str(" mimic it)")
+            }
+            Self::Jaw { frame } => write!(
+                f,
+                "moves a jaw beside the tool frame '{frame}' (the arm ends at the tool)"
+            ),
+            Self::Named { word } => write!(f, "a gripper's (its name contains '{word}')"),
+            Self::OffChain => f.write_str("off the arm's chain (another arm, a leg, a head)"),
+            Self::OffPath { tip } => write!(f, "not on the way to '{tip}'"),
+        }
+    }
+}
+
+/// A joint of the arm, base to tip.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArmJoint {
+    /// Its name in the description.
+    pub name: String,
+    /// Its index in [`Tree::joints`].
+    pub index: usize,
+    /// Prismatic (m, N) rather than revolute (rad, N m).
+    pub prismatic: bool,
+    /// Position limits (rad or m); −∞ and +∞ for an unlimited joint.
+    pub lower: f64,
+    /// See `lower`.
+    pub upper: f64,
+    /// The drive's largest torque (N m) or force (N); NaN where the
+    /// description states none.
+    pub effort: f64,
+    /// The largest speed (rad/s or m/s); NaN where none is stated.
+    pub velocity: f64,
+    /// Armature (kg m² or kg).
+    pub armature: f64,
+    /// Viscous damping (N m s/rad or N s/m).
+    pub damping: f64,
+    /// Dry friction loss (N m or N).
+    pub friction: f64,
+}
+
+/// A joint of the tree that is not the arm's, held at `value`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldJoint {
+    /// Its name.
+    pub name: String,
+    /// Its index in [`Tree::joints`].
+    pub index: usize,
+    /// The value (rad or m) it is held at: its `offset` (0 in a URDF,
+    /// `qpos0` in MuJoCo), or a mimic's value when its master is at its own.
+    pub value: f64,
+    /// Why.
+    pub reason: Held,
+}
+
+/// The arm of a tree (SPEC (21.2)): the result of [`reduce`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Arm {
+    /// The description it came from (for messages).
+    pub source: String,
+    /// The root link (the world frame of the chain).
+    pub base: String,
+    /// The tip: a link, or a named frame if `tip_is_frame`.
+    pub tip: String,
+    /// Whether `tip` names a frame (a MuJoCo site) rather than a link.
+    pub tip_is_frame: bool,
+    /// The arm's joints, base to tip.
+    pub joints: Vec<ArmJoint>,
+    /// Every other joint with a coordinate (movable, floating, planar,
+    /// ball), in the description's order, with the value it is held at and why.
+    pub held: Vec<HeldJoint>,
+    /// The chain (SPEC §16): the arm's joints only, each with the fixed
+    /// and held joints before it folded into its origin.
+    pub chain: Vec<Joint>,
+    /// The last arm joint's frame → the tip.
+    pub tip_origin: Transform,
+    /// Per arm joint, the body it moves (SPEC (20.1)): its child link and
+    /// every link carried by it through fixed and held joints, as one
+    /// inertial in the joint's frame (mass, centre of mass, inertia about it).
+    pub inertials: Vec<Inertial>,
+}
+
+impl Arm {
+    /// The number of arm joints n.
+    pub fn n(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// The arm's kinematics to its tip, as a [`Chain`] of `N` joints
+    /// (`N` must be [`Arm::n`]; the chain's errors otherwise).
+    pub fn to_chain<const N: usize>(&self) -> Result<Chain<N>, Error> {
+        Chain::new(&self.chain, &self.tip_origin)
+    }
+
+    /// The arm's rigid-body dynamics under `gravity` (m/s², the base frame),
+    /// as a [`Dynamics`] of `N` joints (the links alone; the description's
+    /// drive terms are [`Arm::drive`], for [`Dynamics::with_drive`]).
+    pub fn to_dynamics<const N: usize>(&self, gravity: [f64; 3]) -> Result<Dynamics<N>, Error> {
+        Dynamics::new(&self.chain, &self.inertials, gravity)
+    }
+
+    /// The description's drive terms of the `N` arm joints (armature,
+    /// damping, friction loss; SPEC (20.5)), or an error if `N` is not
+    /// [`Arm::n`].
+    pub fn drive<const N: usize>(&self) -> Result<Drive<N>, Error> {
+        if self.joints.len() != N {
+            return Err(Error::Condition {
+                condition: "the arm has N joints (the Drive's N)",
+                lhs: "arm joints",
+                index: None,
+                value: self.joints.len() as f64,
+            });
+        }
+        let column = |f: fn(&ArmJoint) -> f64| {
+            crate::types::Vector::<N>::from_iterator(self.joints.iter().map(f))
+        };
+        Ok(Drive {
+            armature: column(|j| j.armature),
+            damping: column(|j| j.damping),
+            friction: column(|j| j.friction),
+        })
+    }
+
+    /// The reason joint `name` is held, if it is.
+    pub fn held_reason(&self, name: &str) -> Option<&Held> {
+        self.held.iter().find(|h| h.name == name).map(|h| &h.reason)
+    }
+}
+
+fn arm_error(tree: &Tree, message: String) -> DescriptionError {
+    DescriptionError::new(ErrorKind::Arm, format!("{}: {message}", tree.source()))
+}
+
+fn names_list<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let mut out = String::from("[");
+    for (i, n) in names.enumerate() {
+        if i > 0 {
+            out.push_str(", ");
+        }
+        out.push('\'');
+        out.push_str(n);
+        out.push('\'');
+    }
+    out.push(']');
+    out
+}
+
+/// The word of [`GRIPPER_WORDS`] in `name`, if any.
+fn gripper_word(name: &str) -> Option<&'static str> {
+    let lower = name.to_lowercase();
+    GRIPPER_WORDS.iter().copied().find(|w| lower.contains(w))
+}
+
+/// The working data of one reduction.
+struct Reduction<'t> {
+    tree: &'t Tree,
+    held: BTreeMap<usize, Held>,
+    /// Per joint: the joints that mimic it.
+    followers: Vec<Vec<usize>>,
+}
+
+impl<'t> Reduction<'t> {
+    fn drivable(&self, j: usize) -> bool {
+        matches!(
+            self.tree.joints()[j].kind,
+            JointType::Revolute | JointType::Continuous
+        ) && !self.held.contains_key(&j)
+    }
+
+    /// A link that is a frame: no mass, no joint below, carried by a fixed joint.
+    fn is_frame_link(&self, l: usize) -> bool {
+        let tree = self.tree;
+        !tree.links()[l].inertial.is_some_and(|i| i.has_mass())
+            && tree.child_joints(l).is_empty()
+            && tree
+                .parent_joint(l)
+                .is_some_and(|j| tree.joints()[j].kind == JointType::Fixed)
+    }
+
+    /// The first tool frame on link `l` or on a link fixed to it (beside
+    /// any movable joint of `l`): a named frame, or a frame link.
+    fn frame_beside(&self, l: usize) -> Option<String> {
+        let tree = self.tree;
+        let mut todo = VecDeque::from([l]);
+        while let Some(link) = todo.pop_front() {
+            if let Some(&f) = tree.link_frames(link).first() {
+                return Some(tree.frames()[f].name.clone());
+            }
+            if link != l && self.is_frame_link(link) {
+                return Some(tree.links()[link].name.clone());
+            }
+            for &j in tree.child_joints(link) {
+                if tree.joints()[j].kind == JointType::Fixed {
+                    todo.push_back(tree.joint_links(j).1);
+                }
+            }
+        }
+        None
+    }
+
+    /// The links of the tree below `root`, parents before children.
+    fn order(&self, root: usize) -> Vec<usize> {
+        let mut order = Vec::new();
+        let mut todo = VecDeque::from([root]);
+        while let Some(l) = todo.pop_front() {
+            order.push(l);
+            for &j in self.tree.child_joints(l) {
+                todo.push_back(self.tree.joint_links(j).1);
+            }
+        }
+        order
+    }
+}
+
+/// The arm of `tree` (SPEC (21.2)): the chain to `tip` (a link or a named
+/// frame; None: found by the rule), with the joints named in `fix` held.
+///
+/// Errors (naming the description and what to do): `fix` names a joint the
+/// tree does not have; `tip` is neither a link nor a frame; a floating,
+/// planar or ball joint on the way to `tip`; several root links and no
+/// `tip`; chains that tie for the arm (legs, two arms) and no `tip`; no
+/// joint left to drive.
+pub fn reduce(tree: &Tree, tip: Option<&str>, fix: &[&str]) -> Result<Arm, DescriptionError> {
+    let joints = tree.joints();
+    let unknown: Vec<&str> = fix
+        .iter()
+        .copied()
+        .filter(|n| tree.joint_index(n).is_none())
+        .collect();
+    if !unknown.is_empty() {
+        let movable = joints
+            .iter()
+            .filter(|j| j.kind.is_movable())
+            .map(|j| j.name.as_str());
+        return Err(arm_error(
+            tree,
+            format!(
+                "fix= names joints it does not have: {}; its movable joints are {}",
+                names_list(unknown.into_iter()),
+                names_list(movable)
+            ),
+        ));
+    }
+    let mut r = Reduction {
+        tree,
+        held: BTreeMap::new(),
+        followers: alloc::vec![Vec::new(); joints.len()],
+    };
+    for (i, j) in joints.iter().enumerate() {
+        if let Some(m) = &j.mimic {
+            if let Some(master) = tree.joint_index(&m.joint) {
+                r.followers[master].push(i);
+            }
+        }
+    }
+    // Held whatever the chain: asked, mimic, more than one coordinate.
+    for (i, j) in joints.iter().enumerate() {
+        let reason = if fix.contains(&j.name.as_str()) {
+            Held::Asked
+        } else if let Some(m) = &j.mimic {
+            Held::Mimic {
+                master: m.joint.clone(),
+            }
+        } else if let Some(by) = &j.coupled {
+            Held::Coupled { by: by.clone() }
+        } else if matches!(
+            j.kind,
+            JointType::Floating | JointType::Planar | JointType::Ball
+        ) {
+            Held::Free { kind: j.kind }
+        } else {
+            continue;
+        };
+        if j.kind != JointType::Fixed {
+            r.held.insert(i, reason);
+        }
+    }
+    // Without a tip, a tool frame (where a force sensor measures) that a
+    // revolute joint not held moves is the tip.
+    let moved = |link: &str| {
+        tree.link_index(link).is_some_and(|l| {
+            tree.path_to(l).into_iter().any(|j| {
+                matches!(joints[j].kind, JointType::Revolute | JointType::Continuous)
+                    && !r.held.contains_key(&j)
+            })
+        })
+    };
+    let tool = tree
+        .frames()
+        .iter()
+        .find(|f| f.tool && moved(&f.link))
+        .map(|f| f.name.as_str());
+    let tip = tip.or(tool);
+    let (tip_link, tip_frame) = match tip {
+        None => (None, None),
+        Some(name) => {
+            // A frame first (a MuJoCo site and a body may share a name).
+            if let Some(f) = tree.frame_index(name) {
+                let link = tree.link_index(&tree.frames()[f].link);
+                (link, Some(f))
+            } else if let Some(l) = tree.link_index(name) {
+                (Some(l), None)
+            } else {
+                return Err(arm_error(
+                    tree,
+                    format!(
+                        "tip= '{name}' is neither a link nor a frame of it: name the link (a \
+                         MuJoCo body) or the frame (a site) that ends the arm"
+                    ),
+                ));
+            }
+        }
+    };
+    let (base, arm, tip_name) = match tip_link {
+        Some(l) => {
+            let path = tree.path_to(l);
+            for &j in &path {
+                let kind = joints[j].kind;
+                if matches!(
+                    kind,
+                    JointType::Floating | JointType::Planar | JointType::Ball
+                ) && !fix.contains(&joints[j].name.as_str())
+                {
+                    return Err(arm_error(
+                        tree,
+                        format!(
+                            "the joint '{}' on the way to '{}' is {}: a chain has revolute, \
+                             continuous, prismatic and fixed joints only; give a tip below it \
+                             or fix it with fix=",
+                            joints[j].name,
+                            tip.unwrap_or_default(),
+                            kind.urdf_name()
+                        ),
+                    ));
+                }
+            }
+            let arm: Vec<usize> = path
+                .into_iter()
+                .filter(|&j| joints[j].kind.is_movable() && !r.held.contains_key(&j))
+                .collect();
+            let mut on_arm = alloc::vec![false; joints.len()];
+            for &j in &arm {
+                on_arm[j] = true;
+            }
+            let tip_name = tip.unwrap_or_default().to_string();
+            for (i, j) in joints.iter().enumerate() {
+                if j.kind != JointType::Fixed && !on_arm[i] && !r.held.contains_key(&i) {
+                    r.held.insert(
+                        i,
+                        Held::OffPath {
+                            tip: tip_name.clone(),
+                        },
+                    );
+                }
+            }
+            if arm.is_empty() {
+                return Err(arm_error(
+                    tree,
+                    format!(
+                        "there is no revolute, continuous or prismatic joint to drive on the way \
+                         to '{tip_name}'{}: name a tip further out",
+                        held_summary(tree, &r.held, &[])
+                    ),
+                ));
+            }
+            (tree.root_of(l), arm, tip_name)
+        }
+        None => {
+            let roots = tree.roots();
+            let root = match roots.as_slice() {
+                [root] => *root,
+                [] => {
+                    return Err(arm_error(
+                        tree,
+                        "it has no links: it describes no robot".into(),
+                    ))
+                }
+                _ => {
+                    return Err(arm_error(
+                        tree,
+                        format!(
+                            "it has {} root links {}: a robot has one; name the arm's last link \
+                             with tip=",
+                            roots.len(),
+                            names_list(roots.iter().map(|&l| tree.links()[l].name.as_str()))
+                        ),
+                    ))
+                }
+            };
+            let arm = find_chain(&mut r, root)?;
+            let last = arm[arm.len() - 1];
+            let tip_name = tree.links()[tree.joint_links(last).1].name.clone();
+            (root, arm, tip_name)
+        }
+    };
+    build(&r, base, arm, tip_name, tip_link, tip_frame)
+}
+
+/// " (held: 'a' (why), …)" for messages, or "" when nothing is held.
+fn held_summary(tree: &Tree, held: &BTreeMap<usize, Held>, skip: &[usize]) -> String {
+    let mut out = String::new();
+    for (&j, why) in held {
+        if skip.contains(&j) || matches!(why, Held::OffPath { .. } | Held::OffChain) {
+            continue;
+        }
+        out.push_str(if out.is_empty() { " (held: " } else { "; " });
+        out.push_str(&format!("'{}' {why}", tree.joints()[j].name));
+    }
+    if !out.is_empty() {
+        out.push(')');
+    }
+    out
+}
+
+/// The arm found by the rule of (21.2) from `root`: the joints of the
+/// longest chain, base to tip. Marks what it holds in `r.held`.
+fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, DescriptionError> {
+    let tree = r.tree;
+    let joints = tree.joints();
+    let nl = tree.links().len();
+    let order = r.order(root);
+    // Bottom up: the longest run of joints with a coordinate below each link
+    // (the structure: mimic, prismatic and held ones count), whether a
+    // frame hangs anywhere below it, whether a movable joint that mimics
+    // nothing does.
+    let mut depth = alloc::vec![0usize; nl];
+    let mut frame_below = alloc::vec![false; nl];
+    let mut driven_below = alloc::vec![false; nl];
+    for &l in order.iter().rev() {
+        frame_below[l] = !tree.link_frames(l).is_empty() || r.is_frame_link(l);
+        for &j in tree.child_joints(l) {
+            let c = tree.joint_links(j).1;
+            let own = usize::from(joints[j].kind.is_movable());
+            depth[l] = depth[l].max(own + depth[c]);
+            frame_below[l] |= frame_below[c];
+            driven_below[l] |= driven_below[c] || (own == 1 && joints[j].mimic.is_none());
+        }
+    }
+    // Top down: the arm's joints held so far above each link, and whether one
+    // of them is an arm's (not a gripper's); the gripper rules mark joints.
+    let mut above = alloc::vec![0usize; nl];
+    let mut arm_above = alloc::vec![false; nl];
+    // Per link, the tool frame beside its joints (looked for once).
+    let mut beside: Vec<Option<Option<String>>> = alloc::vec![None; nl];
+    for &l in &order {
+        for &j in tree.child_joints(l) {
+            let c = tree.joint_links(j).1;
+            let word = gripper_word(&joints[j].name);
+            if arm_above[l] && r.drivable(j) {
+                let reason = if !r.followers[j].is_empty() && !driven_below[c] {
+                    Some(Held::GripperDrive {
+                        followers: r.followers[j]
+                            .iter()
+                            .map(|&f| joints[f].name.clone())
+                            .collect(),
+                    })
+                } else if let Some(frame) = (!frame_below[c])
+                    .then(|| beside[l].get_or_insert_with(|| r.frame_beside(l)).clone())
+                    .flatten()
+                {
+                    Some(Held::Jaw { frame })
+                } else {
+                    word.map(|word| Held::Named { word })
+                };
+                if let Some(reason) = reason {
+                    r.held.insert(j, reason);
+                }
+            }
+            let own = usize::from(r.drivable(j));
+            above[c] = above[l] + own;
+            arm_above[c] = arm_above[l] || (own == 1 && word.is_none());
+        }
+    }
+    // Bottom up again: per link, the length of the longest chains below it
+    // and the last joint of each; a hand ends the arm.
+    let mut hand = alloc::vec![false; nl];
+    let mut best = alloc::vec![(0usize, Vec::<usize>::new()); nl];
+    for &l in order.iter().rev() {
+        let branches: Vec<usize> = tree
+            .child_joints(l)
+            .iter()
+            .map(|&j| usize::from(joints[j].kind.is_movable()) + depth[tree.joint_links(j).1])
+            .filter(|&d| d > 0)
+            .collect();
+        // A hand: two or more branches each shorter than the arm that holds
+        // them, or three or more (fingers) none longer.
+        let shorter = branches.len() >= 2 && branches.iter().all(|&d| d < above[l]);
+        let fingers = branches.len() >= 3 && branches.iter().all(|&d| d <= above[l]);
+        if above[l] > 0 && (shorter || fingers) {
+            hand[l] = true;
+            continue;
+        }
+        let (mut len, mut ends) = (0usize, Vec::new());
+        for &j in tree.child_joints(l) {
+            let c = tree.joint_links(j).1;
+            let own = usize::from(r.drivable(j));
+            let (below, below_ends) = &best[c];
+            let this = below + own;
+            let these = if *below == 0 {
+                if own == 1 {
+                    alloc::vec![j]
+                } else {
+                    Vec::new()
+                }
+            } else {
+                below_ends.clone()
+            };
+            if this > len {
+                len = this;
+                ends = these;
+            } else if this == len && this > 0 {
+                ends.extend(these);
+            }
+        }
+        best[l] = (len, ends);
+    }
+    let (len, ends) = core::mem::take(&mut best[root]);
+    if len == 0 {
+        return Err(arm_error(
+            tree,
+            format!(
+                "it has no revolute or continuous joint to drive{}: name a tip (tip=) to drive \
+                 a prismatic joint",
+                held_summary(tree, &r.held, &[])
+            ),
+        ));
+    }
+    if ends.len() > 1 {
+        let tips = names_list(
+            ends.iter()
+                .map(|&j| tree.links()[tree.joint_links(j).1].name.as_str()),
+        );
+        let tips = tips.trim_start_matches('[').trim_end_matches(']');
+        return Err(arm_error(
+            tree,
+            format!(
+                "{} serial chains of {len} joints from the root tie for the arm (legs, or two \
+                 arms), ending at the links {tips}: name one with tip= or hold the others' \
+                 joints with fix=",
+                ends.len()
+            ),
+        ));
+    }
+    let arm: Vec<usize> = tree
+        .path_to(tree.joint_links(ends[0]).1)
+        .into_iter()
+        .filter(|&j| r.drivable(j))
+        .collect();
+    // Everything else with a coordinate: in a hand (the nearest hand link
+    // at or above its parent), prismatic, or off the chain.
+    let mut in_hand: Vec<Option<usize>> = alloc::vec![None; nl];
+    for &l in &order {
+        let here = if hand[l] { Some(l) } else { in_hand[l] };
+        in_hand[l] = here;
+        for &j in tree.child_joints(l) {
+            in_hand[tree.joint_links(j).1] = here;
+        }
+    }
+    let mut on_arm = alloc::vec![false; joints.len()];
+    for &j in &arm {
+        on_arm[j] = true;
+    }
+    for (i, j) in joints.iter().enumerate() {
+        if j.kind == JointType::Fixed || on_arm[i] || r.held.contains_key(&i) {
+            continue;
+        }
+        let reason = match in_hand[tree.joint_links(i).0] {
+            Some(l) => Held::Hand {
+                link: tree.links()[l].name.clone(),
+            },
+            None if j.kind == JointType::Prismatic => Held::Prismatic,
+            None => Held::OffChain,
+        };
+        r.held.insert(i, reason);
+    }
+    Ok(arm)
+}
+
+/// The value joint `j` is held at: its offset, or for a mimic joint the
+/// multiplier times its master's offset plus its own.
+fn held_value(tree: &Tree, j: usize) -> f64 {
+    let joint = &tree.joints()[j];
+    match &joint.mimic {
+        Some(m) => {
+            let master = tree
+                .joint_index(&m.joint)
+                .map_or(0.0, |k| tree.joints()[k].offset);
+            m.multiplier * master + m.offset
+        }
+        None => joint.offset,
+    }
+}
+
+fn config(tree: &Tree, e: Error) -> DescriptionError {
+    DescriptionError::new(ErrorKind::Value, format!("{}: {e}", tree.source()))
+}
+
+/// The frame of joint `j`'s child link in its parent link's frame, with the
+/// joint at `value` (fixed joints: their origin).
+fn joint_frame(tree: &Tree, j: usize, value: f64) -> Result<Frame, DescriptionError> {
+    let joint = &tree.joints()[j];
+    let origin = joint
+        .origin
+        .transform()
+        .and_then(|t| t.check(j))
+        .map_err(|e| config(tree, e))?;
+    let shift = value - joint.offset;
+    if !joint.kind.is_movable() || shift == 0.0 {
+        return Ok(origin);
+    }
+    let axis = Vector3::from(joint.axis);
+    let len = axis.norm();
+    if len.partial_cmp(&1e-12) != Some(core::cmp::Ordering::Greater) {
+        return Err(arm_error(
+            tree,
+            format!(
+                "joint '{}' has a zero axis: give its <axis xyz>",
+                joint.name
+            ),
+        ));
+    }
+    Ok(origin.then(&motion(
+        joint.kind == JointType::Prismatic,
+        &(axis / len),
+        shift,
+    )))
+}
+
+fn build(
+    r: &Reduction<'_>,
+    base: usize,
+    arm: Vec<usize>,
+    tip_name: String,
+    tip_link: Option<usize>,
+    tip_frame: Option<usize>,
+) -> Result<Arm, DescriptionError> {
+    let tree = r.tree;
+    let joints = tree.joints();
+    let last_link = tree.joint_links(arm[arm.len() - 1]).1;
+    let tip_link = tip_link.unwrap_or(last_link);
+    let mut on_arm = alloc::vec![false; joints.len()];
+    for &j in &arm {
+        on_arm[j] = true;
+    }
+    let is_arm = |j: usize| on_arm[j];
+    let value = |j: usize| {
+        if is_arm(j) {
+            joints[j].offset
+        } else {
+            held_value(tree, j)
+        }
+    };
+    // The chain: fixed and held joints fold into the next arm joint's origin.
+    let mut chain = Vec::with_capacity(arm.len());
+    let mut pending = Frame::IDENTITY;
+    for j in tree.path_to(tip_link) {
+        if is_arm(j) {
+            let origin = pending.then(&joint_frame(tree, j, joints[j].offset)?);
+            let joint = &joints[j];
+            chain.push(Joint {
+                kind: if joint.kind == JointType::Prismatic {
+                    JointKind::Prismatic
+                } else {
+                    JointKind::Revolute
+                },
+                origin: Transform::from_parts(origin.p, &origin.r),
+                axis: joint.axis,
+                offset: joint.offset,
+            });
+            pending = Frame::IDENTITY;
+        } else {
+            pending = pending.then(&joint_frame(tree, j, value(j))?);
+        }
+    }
+    if let Some(f) = tip_frame {
+        let t = tree.frames()[f]
+            .origin
+            .transform()
+            .and_then(|t| t.check(0))
+            .map_err(|e| config(tree, e))?;
+        pending = pending.then(&t);
+    }
+    let tip_origin = Transform::from_parts(pending.p, &pending.r);
+    // The body of each arm joint: its child link and every link it carries
+    // through joints that are not the arm's.
+    let mut inertials = Vec::with_capacity(arm.len());
+    for &a in &arm {
+        let start = tree.joint_links(a).1;
+        let (mut m, mut h, mut io) = (0.0, Vector3::zeros(), Matrix3::zeros());
+        let mut todo = VecDeque::from([(start, Frame::IDENTITY)]);
+        while let Some((l, at)) = todo.pop_front() {
+            if let Some(inertial) = tree.links()[l].inertial.filter(|i| i.has_mass()) {
+                let f = inertial
+                    .origin
+                    .transform()
+                    .and_then(|t| t.check(l))
+                    .map_err(|e| config(tree, e))?;
+                let f = at.then(&f);
+                let ic = Matrix3::from_fn(|i, k| inertial.inertia[i][k]);
+                let c = f.p;
+                let mass = inertial.mass;
+                m += mass;
+                h += mass * c;
+                io += f.r * ic * f.r.transpose()
+                    + mass * (Matrix3::identity() * c.norm_squared() - c * c.transpose());
+            }
+            for &j in tree.child_joints(l) {
+                if !is_arm(j) {
+                    let next = at.then(&joint_frame(tree, j, value(j))?);
+                    todo.push_back((tree.joint_links(j).1, next));
+                }
+            }
+        }
+        let com = if m > 0.0 { h / m } else { Vector3::zeros() };
+        let ic = io - m * (Matrix3::identity() * com.norm_squared() - com * com.transpose());
+        let ic = (ic + ic.transpose()) * 0.5;
+        inertials.push(Inertial {
+            mass: m,
+            origin: Transform {
+                translation: com.into(),
+                ..Transform::IDENTITY
+            },
+            inertia: core::array::from_fn(|i| core::array::from_fn(|k| ic[(i, k)])),
+        });
+    }
+    let arm_joints = arm
+        .iter()
+        .map(|&j| {
+            let joint = &joints[j];
+            let unlimited = joint.kind == JointType::Continuous;
+            ArmJoint {
+                name: joint.name.clone(),
+                index: j,
+                prismatic: joint.kind == JointType::Prismatic,
+                lower: if unlimited {
+                    f64::NEG_INFINITY
+                } else {
+                    joint.lower
+                },
+                upper: if unlimited {
+                    f64::INFINITY
+                } else {
+                    joint.upper
+                },
+                effort: joint.effort,
+                velocity: joint.velocity,
+                armature: joint.armature,
+                damping: joint.damping,
+                friction: joint.friction,
+            }
+        })
+        .collect();
+    let held = r
+        .held
+        .iter()
+        .map(|(&j, why)| HeldJoint {
+            name: joints[j].name.clone(),
+            index: j,
+            value: held_value(tree, j),
+            reason: why.clone(),
+        })
+        .collect();
+    Ok(Arm {
+        source: tree.source().into(),
+        base: tree.links()[base].name.clone(),
+        tip: tip_name,
+        tip_is_frame: tip_frame.is_some(),
+        joints: arm_joints,
+        held,
+        chain,
+        tip_origin,
+        inertials,
+    })
+}

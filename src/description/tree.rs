@@ -1,0 +1,604 @@
+//! The kinematic tree of a robot description, SPEC (21.1): links with their
+//! inertials, joints between them, named frames on links. What a URDF file
+//! or a compiled MuJoCo model holds, as plain data, validated once by
+//! [`Tree::new`].
+
+use super::error::{DescriptionError, ErrorKind};
+use crate::cartesian::chain::{Frame, Transform};
+use crate::cartesian::dynamics::Inertial;
+use alloc::collections::BTreeMap;
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+use nalgebra::{Matrix3, Rotation3, Vector3};
+
+/// What a joint of a tree does.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum JointType {
+    /// Rigid (URDF `fixed`; a MuJoCo body without joints).
+    Fixed,
+    /// Rotation about the axis within limits (URDF `revolute`; a MuJoCo
+    /// `hinge`), in rad.
+    Revolute,
+    /// Rotation about the axis without limits (URDF `continuous`), in rad.
+    Continuous,
+    /// Translation along the axis (URDF `prismatic`; MuJoCo `slide`), in m.
+    Prismatic,
+    /// Six degrees of freedom (URDF `floating`; MuJoCo `free`).
+    Floating,
+    /// Motion in a plane (URDF `planar`).
+    Planar,
+    /// Three rotations about a point (URDF `spherical`; MuJoCo `ball`).
+    Ball,
+}
+
+impl JointType {
+    /// Revolute, continuous or prismatic: one coordinate, a joint an arm can drive.
+    pub fn is_movable(self) -> bool {
+        matches!(self, Self::Revolute | Self::Continuous | Self::Prismatic)
+    }
+
+    /// The name a URDF gives it.
+    pub fn urdf_name(self) -> &'static str {
+        match self {
+            Self::Fixed => "fixed",
+            Self::Revolute => "revolute",
+            Self::Continuous => "continuous",
+            Self::Prismatic => "prismatic",
+            Self::Floating => "floating",
+            Self::Planar => "planar",
+            Self::Ball => "spherical",
+        }
+    }
+}
+
+/// A transform as the description states it: URDF's `xyz`/`rpy`, MuJoCo's
+/// `pos`/`quat` ([w, x, y, z]) or a computed one. Kept as written, so a
+/// reduced URDF writes the numbers it read (MuJoCo then compiles the same
+/// model from them).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Origin {
+    /// URDF `<origin xyz="…" rpy="…">` (m, rad): R = Rot_z(y) Rot_y(p) Rot_x(r).
+    XyzRpy([f64; 3], [f64; 3]),
+    /// A position (m) and a quaternion [w, x, y, z] (normalised when used).
+    PosQuat([f64; 3], [f64; 4]),
+    /// A translation and a rotation matrix.
+    Matrix(Transform),
+}
+
+impl Origin {
+    /// No translation, no rotation.
+    pub const IDENTITY: Self = Self::XyzRpy([0.0; 3], [0.0; 3]);
+
+    /// The transform (a zero or non-finite quaternion is an error).
+    pub fn transform(&self) -> Result<Transform, crate::error::Error> {
+        match *self {
+            Self::XyzRpy(xyz, rpy) => Ok(Transform::from_xyz_rpy(xyz, rpy)),
+            Self::PosQuat(pos, quat) => Transform::from_pos_quat(pos, quat),
+            Self::Matrix(t) => Ok(t),
+        }
+    }
+
+    /// As URDF writes it: `xyz` (m) and `rpy` (rad); exact for
+    /// [`Origin::XyzRpy`], from the rotation matrix otherwise.
+    pub fn xyz_rpy(&self) -> Result<([f64; 3], [f64; 3]), crate::error::Error> {
+        if let Self::XyzRpy(xyz, rpy) = *self {
+            return Ok((xyz, rpy));
+        }
+        let t = self.transform()?;
+        let r = Rotation3::from_matrix_unchecked(Matrix3::from_fn(|i, j| t.rotation[i][j]));
+        let (roll, pitch, yaw) = r.euler_angles();
+        Ok((t.translation, [roll, pitch, yaw]))
+    }
+}
+
+/// The inertial of a link: its mass, centre of mass and rotational inertia
+/// about the centre of mass, in the frame `origin` of the link
+/// (URDF `<inertial>`; MuJoCo `body_mass`, `body_ipos`, `body_iquat`,
+/// `body_inertia`).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct LinkInertial {
+    /// Mass (kg), ≥ 0.
+    pub mass: f64,
+    /// The centre of mass (m) and the inertia's axes in the link's frame.
+    pub origin: Origin,
+    /// Rotational inertia about the centre of mass in `origin`'s axes (kg
+    /// m², row-major), symmetric.
+    pub inertia: [[f64; 3]; 3],
+}
+
+impl LinkInertial {
+    /// No mass.
+    pub const NONE: Self = Self {
+        mass: 0.0,
+        origin: Origin::IDENTITY,
+        inertia: [[0.0; 3]; 3],
+    };
+
+    /// Whether it has a mass or an inertia.
+    pub fn has_mass(&self) -> bool {
+        self.mass != 0.0 || self.inertia.iter().flatten().any(|&x| x != 0.0)
+    }
+
+    /// As the core's dynamics takes it.
+    pub fn to_inertial(&self) -> Result<Inertial, crate::error::Error> {
+        Ok(Inertial {
+            mass: self.mass,
+            origin: self.origin.transform()?,
+            inertia: self.inertia,
+        })
+    }
+}
+
+/// A link (URDF `<link>`, a MuJoCo body).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Link {
+    /// Its name, unique in the tree.
+    pub name: String,
+    /// Its inertial (None: the description states none).
+    pub inertial: Option<LinkInertial>,
+}
+
+impl Link {
+    /// A link without mass.
+    pub fn new(name: &str) -> Self {
+        Self {
+            name: name.into(),
+            inertial: None,
+        }
+    }
+}
+
+/// A joint whose value follows another's: q = multiplier · q_master + offset
+/// (URDF `<mimic>`; a MuJoCo joint equality).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mimic {
+    /// The joint it follows.
+    pub joint: String,
+    /// The factor on the master's value.
+    pub multiplier: f64,
+    /// The value (rad or m) at a master's value of zero.
+    pub offset: f64,
+}
+
+/// A joint of a tree (SPEC (21.1)).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreeJoint {
+    /// Its name, unique in the tree.
+    pub name: String,
+    /// What it does.
+    pub kind: JointType,
+    /// The link it hangs from.
+    pub parent: String,
+    /// The link it carries: its frame is the joint's.
+    pub child: String,
+    /// The parent link's frame → the joint's frame at the joint value
+    /// `offset`.
+    pub origin: Origin,
+    /// The axis (in the joint's frame; URDF's default (1, 0, 0)).
+    pub axis: [f64; 3],
+    /// The joint value (rad or m) at which the joint's frame is `origin`
+    /// (URDF: 0; MuJoCo: `qpos0`), and the value a held joint is held at.
+    pub offset: f64,
+    /// Position limits (rad or m); −∞ and +∞ where there are none.
+    pub lower: f64,
+    /// See `lower`.
+    pub upper: f64,
+    /// The largest torque (N m) or force (N) the joint's drive gives; NaN
+    /// where the description states none.
+    pub effort: f64,
+    /// The largest speed (rad/s or m/s); NaN where the description states none.
+    pub velocity: f64,
+    /// Viscous damping (N m s/rad or N s/m), ≥ 0.
+    pub damping: f64,
+    /// Dry friction loss (N m or N), ≥ 0.
+    pub friction: f64,
+    /// Armature: the rotor's inertia reflected to the joint (kg m² or kg), ≥ 0.
+    pub armature: f64,
+    /// The joint it follows, if it is a mimic joint.
+    pub mimic: Option<Mimic>,
+    /// What couples it to other joints, if anything does (a MuJoCo fixed
+    /// tendon of two or more joints): it does not move on its own.
+    pub coupled: Option<String>,
+}
+
+impl TreeJoint {
+    /// A joint of `kind` from `parent` to `child` at `origin`, axis (1, 0, 0),
+    /// no limits, no effort, velocity, damping, friction, armature or mimic.
+    pub fn new(name: &str, kind: JointType, parent: &str, child: &str, origin: Origin) -> Self {
+        Self {
+            name: name.into(),
+            kind,
+            parent: parent.into(),
+            child: child.into(),
+            origin,
+            axis: [1.0, 0.0, 0.0],
+            offset: 0.0,
+            lower: f64::NEG_INFINITY,
+            upper: f64::INFINITY,
+            effort: f64::NAN,
+            velocity: f64::NAN,
+            damping: 0.0,
+            friction: 0.0,
+            armature: 0.0,
+            mimic: None,
+            coupled: None,
+        }
+    }
+}
+
+/// A named frame on a link (a MuJoCo site, a tool frame).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedFrame {
+    /// Its name, unique among frames.
+    pub name: String,
+    /// The link it is fixed to.
+    pub link: String,
+    /// The link's frame → this frame.
+    pub origin: Origin,
+    /// A tool frame: where a force/torque sensor measures (a MuJoCo force
+    /// sensor's site). Without `tip`, the first one ends the arm.
+    pub tool: bool,
+}
+
+/// A validated kinematic tree (SPEC (21.1)): links, the joints between them, named frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tree {
+    source: String,
+    name: String,
+    links: Vec<Link>,
+    joints: Vec<TreeJoint>,
+    frames: Vec<NamedFrame>,
+    /// Per link: the index of the joint that carries it.
+    parent_joint: Vec<Option<usize>>,
+    /// Per link: the joints that hang from it, in the description's order.
+    children: Vec<Vec<usize>>,
+    /// Per link: the frames on it.
+    link_frames: Vec<Vec<usize>>,
+    /// Per joint: the indices of its parent and child links.
+    ends: Vec<(usize, usize)>,
+    link_index: BTreeMap<String, usize>,
+    joint_index: BTreeMap<String, usize>,
+    frame_index: BTreeMap<String, usize>,
+}
+
+fn structure(source: &str, message: String) -> DescriptionError {
+    DescriptionError::new(ErrorKind::Structure, format!("{source}: {message}"))
+}
+
+fn finite_or(source: &str, what: &str, name: &str, v: &[f64]) -> Result<(), DescriptionError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(DescriptionError::new(
+            ErrorKind::Value,
+            format!("{source}: {what} of {name} is not finite ({v:?}): give finite numbers"),
+        ))
+    }
+}
+
+fn origin_ok(source: &str, what: &str, name: &str, o: &Origin) -> Result<(), DescriptionError> {
+    match o {
+        Origin::XyzRpy(a, b) => {
+            finite_or(source, what, name, a)?;
+            finite_or(source, what, name, b)
+        }
+        Origin::PosQuat(a, q) => {
+            finite_or(source, what, name, a)?;
+            finite_or(source, what, name, q)?;
+            if q.iter().all(|&x| x == 0.0) {
+                return Err(DescriptionError::new(
+                    ErrorKind::Value,
+                    format!("{source}: {what} of {name} has a zero quaternion: give a rotation"),
+                ));
+            }
+            Ok(())
+        }
+        Origin::Matrix(t) => {
+            finite_or(source, what, name, &t.translation)?;
+            finite_or(source, what, name, t.rotation.as_flattened())
+        }
+    }
+}
+
+impl Tree {
+    /// A tree of `links` and `joints` (and named `frames` on links) from the
+    /// description `source` (for messages, e.g. `"URDF 'panda.urdf'"`),
+    /// named `name`.
+    ///
+    /// Errors (each naming `source`, the element and what to do): two links,
+    /// two joints or two frames of one name; a joint whose parent or child
+    /// link is not declared; a link carried by two joints; joints that form
+    /// a loop (a mimic joint whose master is not a joint is still a mimic
+    /// joint: held, SPEC (21.2)); a frame on a link
+    /// not declared; a non-finite number; a negative mass, damping,
+    /// friction or armature; a lower limit above the upper one.
+    pub fn new(
+        source: &str,
+        name: &str,
+        links: Vec<Link>,
+        joints: Vec<TreeJoint>,
+        frames: Vec<NamedFrame>,
+    ) -> Result<Self, DescriptionError> {
+        let mut link_index = BTreeMap::new();
+        for (i, l) in links.iter().enumerate() {
+            if link_index.insert(l.name.clone(), i).is_some() {
+                return Err(structure(
+                    source,
+                    format!(
+                        "two links are named '{}': give each link its own name",
+                        l.name
+                    ),
+                ));
+            }
+            let what = format!("link '{}'", l.name);
+            if let Some(i) = &l.inertial {
+                origin_ok(source, "the inertial origin", &what, &i.origin)?;
+                finite_or(source, "the mass", &what, &[i.mass])?;
+                finite_or(source, "the inertia", &what, i.inertia.as_flattened())?;
+                if i.mass < 0.0 {
+                    return Err(DescriptionError::new(
+                        ErrorKind::Value,
+                        format!(
+                            "{source}: link '{}' has the mass {} kg: a mass is ≥ 0",
+                            l.name, i.mass
+                        ),
+                    ));
+                }
+            }
+        }
+        let mut joint_index = BTreeMap::new();
+        let mut parent_joint = alloc::vec![None; links.len()];
+        let mut children = alloc::vec![Vec::new(); links.len()];
+        let mut ends = Vec::with_capacity(joints.len());
+        for (i, j) in joints.iter().enumerate() {
+            if joint_index.insert(j.name.clone(), i).is_some() {
+                return Err(structure(
+                    source,
+                    format!(
+                        "two joints are named '{}': give each joint its own name",
+                        j.name
+                    ),
+                ));
+            }
+            let end = |role: &str, link: &str| {
+                link_index.get(link).copied().ok_or_else(|| {
+                    structure(
+                        source,
+                        format!(
+                            "joint '{}' names the {role} link '{link}', which is not declared \
+                             (a missing link): declare it or correct the joint's <{role}>",
+                            j.name
+                        ),
+                    )
+                })
+            };
+            let (p, c) = (end("parent", &j.parent)?, end("child", &j.child)?);
+            if let Some(other) = parent_joint[c] {
+                let other: &TreeJoint = &joints[other];
+                return Err(structure(
+                    source,
+                    format!(
+                        "link '{}' is the child of two joints ('{}' and '{}'): a kinematic loop, \
+                         which a tree cannot hold; remove one of them",
+                        j.child, other.name, j.name
+                    ),
+                ));
+            }
+            parent_joint[c] = Some(i);
+            children[p].push(i);
+            ends.push((p, c));
+            let what = format!("joint '{}'", j.name);
+            origin_ok(source, "the origin", &what, &j.origin)?;
+            finite_or(source, "the axis", &what, &j.axis)?;
+            finite_or(source, "the offset", &what, &[j.offset])?;
+            for (v, q) in [
+                (j.damping, "damping"),
+                (j.friction, "friction"),
+                (j.armature, "armature"),
+            ] {
+                if !(v >= 0.0 && v.is_finite()) {
+                    return Err(DescriptionError::new(
+                        ErrorKind::Value,
+                        format!(
+                            "{source}: joint '{}' has the {q} {v}: it must be finite and ≥ 0",
+                            j.name
+                        ),
+                    ));
+                }
+            }
+            if j.lower.is_nan() || j.upper.is_nan() || j.lower > j.upper {
+                return Err(DescriptionError::new(
+                    ErrorKind::Value,
+                    format!(
+                        "{source}: joint '{}' has the limits [{}, {}]: give lower ≤ upper",
+                        j.name, j.lower, j.upper
+                    ),
+                ));
+            }
+        }
+        for j in &joints {
+            if let Some(m) = &j.mimic {
+                finite_or(
+                    source,
+                    "the mimic multiplier and offset",
+                    &j.name,
+                    &[m.multiplier, m.offset],
+                )?;
+            }
+        }
+        // Every link's way up ends at a root rather than running in a
+        // circle: each link is walked once (0 not yet, 1 on this walk, 2 ends
+        // at a root).
+        let mut seen = alloc::vec![0u8; links.len()];
+        for start in 0..links.len() {
+            let mut link = start;
+            while seen[link] == 0 {
+                seen[link] = 1;
+                match parent_joint[link] {
+                    Some(j) => link = ends[j].0,
+                    None => break,
+                }
+            }
+            if seen[link] == 1 && parent_joint[link].is_some() {
+                return Err(structure(
+                    source,
+                    format!(
+                        "the joints form a loop through the link '{}': a tree cannot hold it; \
+                         remove a joint of the loop",
+                        links[link].name
+                    ),
+                ));
+            }
+            let mut link = start;
+            while seen[link] == 1 {
+                seen[link] = 2;
+                if let Some(j) = parent_joint[link] {
+                    link = ends[j].0;
+                }
+            }
+        }
+        let mut frame_index = BTreeMap::new();
+        let mut link_frames = alloc::vec![Vec::new(); links.len()];
+        for (i, f) in frames.iter().enumerate() {
+            if frame_index.insert(f.name.clone(), i).is_some() {
+                return Err(structure(
+                    source,
+                    format!("two frames are named '{}': give each its own name", f.name),
+                ));
+            }
+            let l = link_index.get(&f.link).copied().ok_or_else(|| {
+                structure(
+                    source,
+                    format!(
+                        "frame '{}' is on the link '{}', which is not declared",
+                        f.name, f.link
+                    ),
+                )
+            })?;
+            origin_ok(
+                source,
+                "the origin",
+                &format!("frame '{}'", f.name),
+                &f.origin,
+            )?;
+            link_frames[l].push(i);
+        }
+        Ok(Self {
+            source: source.into(),
+            name: name.into(),
+            links,
+            joints,
+            frames,
+            parent_joint,
+            children,
+            link_frames,
+            ends,
+            link_index,
+            joint_index,
+            frame_index,
+        })
+    }
+
+    /// What the tree was read from, for messages (e.g. `"URDF 'panda.urdf'"`).
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// The robot's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The links, in the description's order.
+    pub fn links(&self) -> &[Link] {
+        &self.links
+    }
+
+    /// The joints, in the description's order.
+    pub fn joints(&self) -> &[TreeJoint] {
+        &self.joints
+    }
+
+    /// The named frames.
+    pub fn frames(&self) -> &[NamedFrame] {
+        &self.frames
+    }
+
+    /// The index of the link `name`.
+    pub fn link_index(&self, name: &str) -> Option<usize> {
+        self.link_index.get(name).copied()
+    }
+
+    /// The index of the joint `name`.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joint_index.get(name).copied()
+    }
+
+    /// The index of the frame `name`.
+    pub fn frame_index(&self, name: &str) -> Option<usize> {
+        self.frame_index.get(name).copied()
+    }
+
+    /// The joint that carries link `l` (None for a root).
+    pub fn parent_joint(&self, l: usize) -> Option<usize> {
+        self.parent_joint[l]
+    }
+
+    /// The joints hanging from link `l`, in the description's order.
+    pub fn child_joints(&self, l: usize) -> &[usize] {
+        &self.children[l]
+    }
+
+    /// The frames on link `l`.
+    pub fn link_frames(&self, l: usize) -> &[usize] {
+        &self.link_frames[l]
+    }
+
+    /// The parent and child link of joint `j`.
+    pub fn joint_links(&self, j: usize) -> (usize, usize) {
+        self.ends[j]
+    }
+
+    /// The links no joint carries.
+    pub fn roots(&self) -> Vec<usize> {
+        (0..self.links.len())
+            .filter(|&l| self.parent_joint[l].is_none())
+            .collect()
+    }
+
+    /// The root at the top of link `l`'s way up.
+    pub fn root_of(&self, mut l: usize) -> usize {
+        while let Some(j) = self.parent_joint[l] {
+            l = self.ends[j].0;
+        }
+        l
+    }
+
+    /// The joints from the root down to link `l` (base to tip).
+    pub fn path_to(&self, mut l: usize) -> Vec<usize> {
+        let mut path = Vec::new();
+        while let Some(j) = self.parent_joint[l] {
+            path.push(j);
+            l = self.ends[j].0;
+        }
+        path.reverse();
+        path
+    }
+}
+
+/// The motion of a joint about or along its unit `axis` by `value` (rad or
+/// m), as the chain moves a joint (SPEC (16.0)).
+pub(crate) fn motion(prismatic: bool, axis: &Vector3<f64>, value: f64) -> Frame {
+    if prismatic {
+        Frame {
+            p: axis * value,
+            r: Matrix3::identity(),
+        }
+    } else {
+        Frame {
+            p: Vector3::zeros(),
+            r: crate::cartesian::chain::axis_rotation(axis, value),
+        }
+    }
+}

@@ -1,0 +1,483 @@
+//! URDF files to the [`Tree`] (feature `urdf`), SPEC (21.1), through the
+//! maintained `urdf-rs` crate; and the reduced URDF an [`Arm`] leaves for
+//! MuJoCo's compiler.
+//!
+//! What is read: each link's `<inertial>`; each joint's type, `<origin xyz
+//! rpy>`, `<axis>` (default (1, 0, 0)), `<limit lower upper effort
+//! velocity>`, `<dynamics damping friction>` and `<mimic joint multiplier
+//! offset>`. A `continuous` joint has no limits; so has a revolute or
+//! prismatic joint whose limits leave no range (lower ≥ upper, "0 0" in
+//! many exported files), and a revolute one is then continuous. An effort
+//! or velocity of zero (or none) is NaN: not stated. Meshes, `<gazebo>`,
+//! `<transmission>` and the rest are not needed and not read.
+//!
+//! A URDF with xacro markup (an element `<xacro:…>`, an attribute with
+//! `${…}` or `$(…)`; comments and a leftover `xmlns:xacro` do not count) is
+//! refused ([`ErrorKind::Xacro`]) with the one command that expands it.
+//! The document is read by the XML reader urdf-rs uses, its links' visual
+//! and collision geometry dropped (no mesh is needed, and a mesh element
+//! urdf-rs would refuse is no reason to refuse an arm), then by urdf-rs.
+
+use super::error::{DescriptionError, ErrorKind};
+use super::reduce::Arm;
+use super::tree::{JointType, Link, LinkInertial, Mimic, Origin, Tree, TreeJoint};
+use std::fmt::Write as _;
+use std::format;
+use std::path::Path;
+use std::string::{String, ToString};
+use std::vec::Vec;
+
+/// The xacro namespace.
+const XACRO_NS: &str = "http://www.ros.org/wiki/xacro";
+
+/// The tree of the URDF file at `path` (labelled by its file name in later
+/// messages).
+///
+/// Errors: the file cannot be read ([`ErrorKind::Io`]), is xacro
+/// ([`ErrorKind::Xacro`]), is not a URDF the parser reads
+/// ([`ErrorKind::Parse`], naming the element), or its tree is not one
+/// ([`Tree::new`]).
+pub fn read_file(path: impl AsRef<Path>) -> Result<Tree, DescriptionError> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        DescriptionError::new(
+            ErrorKind::Io,
+            format!(
+                "cannot read the URDF '{}': {e}: give the path of a URDF file",
+                path.display()
+            ),
+        )
+    })?;
+    let label = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    read(
+        &text,
+        &format!("URDF '{label}'"),
+        &path.display().to_string(),
+    )
+}
+
+/// The tree of the URDF `text` (labelled "URDF text" in messages).
+pub fn read_str(text: &str) -> Result<Tree, DescriptionError> {
+    read(text, "URDF text", "the URDF text")
+}
+
+/// The tree of the URDF `text`, labelled `label` in messages (e.g. "xacro
+/// 'arm.xacro'" for a file a front expanded).
+pub fn read_str_as(text: &str, label: &str) -> Result<Tree, DescriptionError> {
+    read(text, label, label)
+}
+
+/// What a description's text is, by its root element and its markup:
+/// `"mjcf"` (`<mujoco>`), `"xacro"` (a `<robot>` with xacro markup),
+/// `"urdf"` (a `<robot>`), or `"unknown"` (not XML, another root).
+pub fn kind_of(text: &str) -> &'static str {
+    match document(text) {
+        Ok(root) if root.name == "mujoco" => "mjcf",
+        Ok(root) if root.name == "robot" && xacro_markup(&root).is_some() => "xacro",
+        Ok(root) if root.name == "robot" => "urdf",
+        Ok(_) => "unknown",
+        Err(_) if text.contains("<xacro:") => "xacro",
+        Err(_) => "unknown",
+    }
+}
+
+/// The XML document (its root element), a panic of the parser turned into an error.
+fn document(text: &str) -> Result<xml::Element, String> {
+    match std::panic::catch_unwind(|| text.parse::<xml::Element>()) {
+        Ok(Ok(root)) => Ok(root),
+        Ok(Err(e)) => Err(format!("{e:?}")),
+        Err(_) => Err("the XML parser could not read it".into()),
+    }
+}
+
+/// The first xacro markup in the document: an element in the xacro
+/// namespace, or an attribute with `${…}` or `$(…)` (comments do not count).
+fn xacro_markup(root: &xml::Element) -> Option<String> {
+    // In the document's order: the first markup a reader meets.
+    let mut todo = std::vec![root];
+    while let Some(e) = todo.pop() {
+        if e.ns.as_deref() == Some(XACRO_NS) {
+            return Some(format!("the element <xacro:{}>", e.name));
+        }
+        // By name: the message is the same on every run.
+        let mut attributes: Vec<(&String, &String)> =
+            e.attributes.iter().map(|((n, _), v)| (n, v)).collect();
+        attributes.sort();
+        for (name, value) in attributes {
+            if value.contains("${") || value.contains("$(") {
+                return Some(format!("the expression {name}=\"{value}\" in <{}>", e.name));
+            }
+        }
+        for c in e.children.iter().rev() {
+            if let xml::Xml::ElementNode(child) = c {
+                todo.push(child);
+            }
+        }
+    }
+    None
+}
+
+fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError> {
+    let file = if shown.starts_with("the ") || shown.starts_with("xacro ") {
+        "FILE.xacro"
+    } else {
+        shown
+    };
+    let xacro = |what: &str| {
+        DescriptionError::new(
+            ErrorKind::Xacro,
+            format!(
+                "{source} is xacro, not a URDF (it has {what}): expand it into a URDF first \
+                 with `xacro {file} -o robot.urdf` (the xacro package: pip install xacro)"
+            ),
+        )
+    };
+    let parse_error = |e: &str| {
+        DescriptionError::new(
+            ErrorKind::Parse,
+            format!(
+                "cannot read {shown} as a URDF: {e}; correct it against the URDF format \
+                 (http://wiki.ros.org/urdf/XML)"
+            ),
+        )
+    };
+    let mut root = match document(text) {
+        Ok(root) => root,
+        Err(_) if text.contains("<xacro:") => return Err(xacro("xacro elements <xacro:…>")),
+        Err(e) => return Err(parse_error(&format!("it is not XML ({e})"))),
+    };
+    if root.name == "mujoco" {
+        return Err(DescriptionError::new(
+            ErrorKind::Parse,
+            format!(
+                "{shown} is an MJCF (its root element is <mujoco>), not a URDF: read it \
+                 through MuJoCo's compiler (Python: give its path to adaptimp, which compiles it)"
+            ),
+        ));
+    }
+    if root.name != "robot" {
+        return Err(parse_error(&format!(
+            "its root element is <{}>, not <robot>",
+            root.name
+        )));
+    }
+    if let Some(what) = xacro_markup(&root) {
+        return Err(xacro(&what));
+    }
+    // What the arm needs: no geometry or material (a mesh or a texture
+    // urdf-rs cannot read is no reason to refuse an arm; urdf-rs itself
+    // drops <gazebo> and <transmission>).
+    root.children
+        .retain(|c| !matches!(c, xml::Xml::ElementNode(e) if e.name == "material"));
+    for child in &mut root.children {
+        let xml::Xml::ElementNode(e) = child else {
+            continue;
+        };
+        if e.name == "link" {
+            e.children.retain(|c| {
+                !matches!(c, xml::Xml::ElementNode(g) if g.name == "visual" || g.name == "collision")
+            });
+        } else if e.name == "joint" {
+            // A <limit> without its effort or velocity states none (many
+            // files omit them; urdf-rs wants both).
+            for c in &mut e.children {
+                if let xml::Xml::ElementNode(limit) = c {
+                    if limit.name == "limit" {
+                        for key in ["effort", "velocity"] {
+                            if limit.get_attribute(key, None).is_none() {
+                                limit.set_attribute(key.into(), None, "0".into());
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let bare = std::panic::catch_unwind(|| format!("{root}"))
+        .map_err(|_| parse_error("its namespaces cannot be written back"))?;
+    let robot = parse(&bare).map_err(|e| {
+        // Writing an element alone can meet a prefix bound on the root: no
+        // pointer then, rather than a panic.
+        let at = std::panic::catch_unwind(|| first_bad_element(&root))
+            .ok()
+            .flatten()
+            .map_or_else(String::new, |el| format!("{el}: "));
+        parse_error(&format!("{at}{e}"))
+    })?;
+    let with_inertial: std::collections::BTreeSet<String> = root
+        .children
+        .iter()
+        .filter_map(|c| match c {
+            xml::Xml::ElementNode(e)
+                if e.name == "link" && e.get_child("inertial", None).is_some() =>
+            {
+                e.get_attribute("name", None).map(String::from)
+            }
+            _ => None,
+        })
+        .collect();
+    tree_of(&robot, source, &with_inertial)
+}
+
+/// urdf-rs's reading, with a panic inside it (a malformed document it does
+/// not expect) turned into an error.
+fn parse(text: &str) -> Result<urdf_rs::Robot, String> {
+    match std::panic::catch_unwind(|| urdf_rs::read_from_string(text)) {
+        Ok(Ok(robot)) => Ok(robot),
+        Ok(Err(e)) => Err(e.to_string()),
+        Err(_) => Err("the parser could not read it".into()),
+    }
+}
+
+/// The first `<link>` or `<joint>` that urdf-rs cannot read on its own
+/// (its kind and name), to point at it.
+fn first_bad_element(root: &xml::Element) -> Option<String> {
+    let mut links = String::new();
+    for child in &root.children {
+        if let xml::Xml::ElementNode(e) = child {
+            if e.name == "link" {
+                let _ = write!(links, "{e}");
+            }
+        }
+    }
+    for child in &root.children {
+        let xml::Xml::ElementNode(e) = child else {
+            continue;
+        };
+        if e.name != "link" && e.name != "joint" {
+            continue;
+        }
+        let body = if e.name == "link" {
+            format!("<robot name=\"r\">{e}</robot>")
+        } else {
+            format!("<robot name=\"r\">{links}{e}</robot>")
+        };
+        if parse(&body).is_err() {
+            let name = e.get_attribute("name", None).unwrap_or("");
+            return Some(format!("<{} name=\"{name}\">", e.name));
+        }
+    }
+    None
+}
+
+fn origin(p: &urdf_rs::Pose) -> Origin {
+    Origin::XyzRpy(*p.xyz, *p.rpy)
+}
+
+fn stated(v: f64) -> f64 {
+    if v > 0.0 && v.is_finite() {
+        v
+    } else {
+        f64::NAN
+    }
+}
+
+/// The tree of a parsed URDF.
+/// `with_inertial` names the links whose element has an `<inertial>`.
+fn tree_of(
+    robot: &urdf_rs::Robot,
+    source: &str,
+    with_inertial: &std::collections::BTreeSet<String>,
+) -> Result<Tree, DescriptionError> {
+    let links = robot
+        .links
+        .iter()
+        .map(|l| {
+            let i = &l.inertial.inertia;
+            Link {
+                name: l.name.clone(),
+                inertial: with_inertial.contains(&l.name).then(|| LinkInertial {
+                    mass: l.inertial.mass.value,
+                    origin: origin(&l.inertial.origin),
+                    inertia: [
+                        [i.ixx, i.ixy, i.ixz],
+                        [i.ixy, i.iyy, i.iyz],
+                        [i.ixz, i.iyz, i.izz],
+                    ],
+                }),
+            }
+        })
+        .collect();
+    let joints = robot
+        .joints
+        .iter()
+        .map(|j| {
+            let mut kind = match j.joint_type {
+                urdf_rs::JointType::Fixed => JointType::Fixed,
+                urdf_rs::JointType::Revolute => JointType::Revolute,
+                urdf_rs::JointType::Continuous => JointType::Continuous,
+                urdf_rs::JointType::Prismatic => JointType::Prismatic,
+                urdf_rs::JointType::Floating => JointType::Floating,
+                urdf_rs::JointType::Planar => JointType::Planar,
+                urdf_rs::JointType::Spherical => JointType::Ball,
+            };
+            let mut joint = TreeJoint::new(
+                &j.name,
+                kind,
+                &j.parent.link,
+                &j.child.link,
+                origin(&j.origin),
+            );
+            joint.axis = *j.axis.xyz;
+            let (lo, hi) = (j.limit.lower, j.limit.upper);
+            let ranged = lo < hi;
+            if kind == JointType::Revolute && !ranged {
+                kind = JointType::Continuous;
+            }
+            joint.kind = kind;
+            if matches!(kind, JointType::Revolute | JointType::Prismatic) && ranged {
+                joint.lower = lo;
+                joint.upper = hi;
+            }
+            if kind.is_movable() {
+                joint.effort = stated(j.limit.effort);
+                joint.velocity = stated(j.limit.velocity);
+            }
+            if let Some(d) = &j.dynamics {
+                joint.damping = d.damping;
+                joint.friction = d.friction;
+            }
+            joint.mimic = j.mimic.as_ref().map(|m| Mimic {
+                joint: m.joint.clone(),
+                multiplier: m.multiplier.unwrap_or(1.0),
+                offset: m.offset.unwrap_or(0.0),
+            });
+            joint
+        })
+        .collect();
+    Tree::new(source, &robot.name, links, joints, Vec::new())
+}
+
+/// `s` as an XML attribute value (quoted, escaped).
+fn attr(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            _ => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+fn triple(v: [f64; 3]) -> String {
+    format!("{} {} {}", v[0], v[1], v[2])
+}
+
+/// The reduced URDF of `arm` (from `tree`) for MuJoCo's compiler, SPEC
+/// (21.3): every link with its inertial only (no visual or collision, so no
+/// mesh is needed); every joint that is not the arm's fixed at the value it
+/// is held at; the arm's joints with their limits, and, with `drive`, their
+/// `<dynamics damping friction>`. Names and numbers are those of the
+/// description, in its order.
+pub fn reduced_urdf(tree: &Tree, arm: &Arm, drive: bool) -> Result<String, DescriptionError> {
+    let config = |e: crate::error::Error| {
+        DescriptionError::new(ErrorKind::Value, format!("{}: {e}", tree.source()))
+    };
+    let mut out = format!("<robot name={}>\n", attr(tree.name()));
+    for l in tree.links() {
+        let Some(i) = &l.inertial else {
+            let _ = writeln!(out, "  <link name={}/>", attr(&l.name));
+            continue;
+        };
+        let (xyz, rpy) = i.origin.xyz_rpy().map_err(config)?;
+        let m = &i.inertia;
+        let _ = writeln!(
+            out,
+            "  <link name={}>\n    <inertial>\n      <origin xyz=\"{}\" rpy=\"{}\"/>\n      \
+             <mass value=\"{}\"/>\n      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" \
+             iyz=\"{}\" izz=\"{}\"/>\n    </inertial>\n  </link>",
+            attr(&l.name),
+            triple(xyz),
+            triple(rpy),
+            i.mass,
+            m[0][0],
+            m[0][1],
+            m[0][2],
+            m[1][1],
+            m[1][2],
+            m[2][2]
+        );
+    }
+    for (index, j) in tree.joints().iter().enumerate() {
+        let arm_joint = arm.joints.iter().find(|a| a.index == index);
+        let held = arm.held.iter().find(|h| h.index == index);
+        let mut origin = j.origin;
+        let kind = match (arm_joint, held) {
+            (Some(_), _) => j.kind,
+            (None, Some(h)) => {
+                let shift = h.value - j.offset;
+                if j.kind.is_movable() && shift != 0.0 {
+                    // Held away from its origin: the motion folds into it.
+                    let t = j.origin.transform().map_err(config)?;
+                    let f = t.check(index).map_err(config)?;
+                    let axis = nalgebra::Vector3::from(j.axis);
+                    let len = axis.norm();
+                    if len > 1e-12 {
+                        let moved = f.then(&super::tree::motion(
+                            j.kind == JointType::Prismatic,
+                            &(axis / len),
+                            shift,
+                        ));
+                        origin = Origin::Matrix(crate::cartesian::chain::Transform::from_parts(
+                            moved.p, &moved.r,
+                        ));
+                    }
+                }
+                JointType::Fixed
+            }
+            (None, None) => JointType::Fixed,
+        };
+        let (xyz, rpy) = origin.xyz_rpy().map_err(config)?;
+        let _ = write!(
+            out,
+            "  <joint name={} type=\"{}\">\n    <origin xyz=\"{}\" rpy=\"{}\"/>\n    \
+             <parent link={}/>\n    <child link={}/>\n",
+            attr(&j.name),
+            kind.urdf_name(),
+            triple(xyz),
+            triple(rpy),
+            attr(&j.parent),
+            attr(&j.child)
+        );
+        if let Some(a) = arm_joint {
+            let _ = writeln!(out, "    <axis xyz=\"{}\"/>", triple(j.axis));
+            if (a.lower.is_finite() && a.upper.is_finite()) || kind == JointType::Continuous {
+                // A stated effort (MuJoCo's actuator force range), or 0: none.
+                let effort = if a.effort.is_finite() { a.effort } else { 0.0 };
+                let velocity = if a.velocity.is_finite() {
+                    a.velocity
+                } else {
+                    0.0
+                };
+                let range = if kind == JointType::Continuous {
+                    String::new()
+                } else {
+                    format!("lower=\"{}\" upper=\"{}\" ", a.lower, a.upper)
+                };
+                let _ = writeln!(
+                    out,
+                    "    <limit {range}effort=\"{effort}\" velocity=\"{velocity}\"/>"
+                );
+            }
+            if drive && (a.damping != 0.0 || a.friction != 0.0) {
+                let _ = writeln!(
+                    out,
+                    "    <dynamics damping=\"{}\" friction=\"{}\"/>",
+                    a.damping, a.friction
+                );
+            }
+        }
+        out.push_str("  </joint>\n");
+    }
+    out.push_str("</robot>\n");
+    Ok(out)
+}

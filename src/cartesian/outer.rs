@@ -706,16 +706,16 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         // (C0) the filters (16.6).
         if first {
             s.pd = c.p;
-            s.dpd = c.dp;
+            s.dpd = c.dp - (0.5 * ts) * c.ddp;
             s.rd = c.q;
-            s.wd = c.w;
+            s.wd = c.w - (0.5 * ts) * c.dw;
             s.wrench = *wrench;
             s.stiffness_filtered = s.stiffness;
             s.offset = Vector::zeros();
             let j = self.select_jacobian(self.kin.jacobian(&s.qd));
             let mut v = Vector::<6>::zeros();
-            v.fixed_rows_mut::<3>(0).copy_from(&c.dp);
-            v.fixed_rows_mut::<3>(3).copy_from(&c.w);
+            v.fixed_rows_mut::<3>(0).copy_from(&s.dpd);
+            v.fixed_rows_mut::<3>(3).copy_from(&s.wd);
             s.dqd = self.dls(&j, &self.select(v), &mut s.weak[0]);
             s.dqc = s.dqd;
         } else {
@@ -733,6 +733,12 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             s.wrench += af * (wrench - s.wrench);
         }
         s.last = c;
+        // (16.13) The commanded rates half a step back, at t_k − Ts/2, where
+        // the semi-implicit velocities of (C4) live: against them the
+        // damping holds a path exactly (with ṗ_c(t_k) the compliant pose
+        // lagged it by B·Ts·p̈_c/(2K)).
+        let dp_half = c.dp - (0.5 * ts) * c.ddp;
+        let w_half = c.w - (0.5 * ts) * c.dw;
         let pt = c.p + s.offset.fixed_rows::<3>(0);
         let qt = exp(&s.offset.fixed_rows::<3>(3).into_owned()) * c.q;
         // Damping: given, or critical for the filtered stiffness.
@@ -749,7 +755,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         damping_used.fixed_rows_mut::<3>(0).copy_from(&b);
         let kp = k.fixed_rows::<3>(0);
         let ddpd = c.ddp
-            + (-b.component_mul(&(s.dpd - c.dp)) + kp.component_mul(&ep) - f)
+            + (-b.component_mul(&(s.dpd - dp_half)) + kp.component_mul(&ep) - f)
                 .component_div(&cfg.md);
         let (eo, dwd) = if self.orients {
             let eo = clip(
@@ -760,7 +766,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             damping_used.fixed_rows_mut::<3>(3).copy_from(&b);
             let ko = k.fixed_rows::<3>(3);
             let dwd = c.dw
-                + (-b.component_mul(&(s.wd - c.w)) + ko.component_mul(&eo) - mom)
+                + (-b.component_mul(&(s.wd - w_half)) + ko.component_mul(&eo) - mom)
                     .component_div(&cfg.md_rot);
             (eo, dwd)
         } else {
@@ -795,7 +801,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         } else {
             let tip_c = self.kin.tip(&s.qc, &s.dqc);
             let (rc, wc, dwc) = if self.orients {
-                (qt, c.w, c.dw)
+                (qt, w_half, c.dw)
             } else {
                 let r = UnitQuaternion::from_rotation_matrix(&tip_c.rotation);
                 (
@@ -807,7 +813,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             let ddqc = self.clik(
                 &tip_c,
                 (&s.qc, &s.dqc, &s.posture),
-                (&pt, &c.dp, &c.ddp),
+                (&pt, &dp_half, &c.ddp),
                 (&rc, &wc, &dwc),
                 &mut s.weak[1],
             );
@@ -1031,6 +1037,45 @@ mod tests {
         let e = o6.step(&mut st6, Some(&mirror), &f).unwrap_err();
         assert!(e.to_string().contains("det R = +1"), "{e}");
         assert_eq!(st6, before);
+    }
+
+    #[test]
+    fn in_free_space_the_compliant_pose_follows_a_path_exactly() {
+        // (16.13): a 3 cm circle at 0.5 Hz and a swing about z, from their
+        // start in motion. The damping compares the semi-implicit velocities
+        // with the path's rates half a step back; with ṗ_c(t_k) the compliant
+        // pose lagged by B Ts p̈_c/(2K): 18.0 µm and 60 µrad here (now
+        // below 0.1 µm and 0.1 µrad).
+        let o = outer(CartesianConfig::default());
+        let q0 = Vector::<2>::new(0.5, 1.0);
+        let mut st = o.start(q0);
+        let centre = o.kinematics().fk(&q0);
+        let (w, a, amp) = (core::f64::consts::PI, 0.03, 0.1);
+        let target = |t: f64| {
+            let (s, c) = (w * t).sin_cos();
+            let angle = amp * s;
+            PoseTarget {
+                p: centre + Vector::<3>::new(a * c, a * s, 0.0),
+                dp: Vector::<3>::new(-a * w * s, a * w * c, 0.0),
+                ddp: Vector::<3>::new(-a * w * w * c, -a * w * w * s, 0.0),
+                r: *nalgebra::Rotation3::from_axis_angle(&Vector::<3>::z_axis(), angle).matrix(),
+                w: Vector::<3>::new(0.0, 0.0, amp * w * c),
+                dw: Vector::<3>::new(0.0, 0.0, -amp * w * w * s),
+            }
+        };
+        let (mut pos, mut rot) = (0.0_f64, 0.0_f64);
+        for k in 0..4000 {
+            let c = target(k as f64 * 1e-3);
+            if k > 0 {
+                // The compliant pose at t_k, integrated up to the last step.
+                pos = pos.max((st.pd - c.p).norm());
+                let rc = UnitQuaternion::from_matrix(&c.r);
+                rot = rot.max(rotation_error(&rc, &st.rd).norm());
+            }
+            o.step(&mut st, Some(&c), &Vector::zeros()).unwrap();
+        }
+        assert!(pos < 1e-7, "{pos}");
+        assert!(rot < 1e-7, "{rot}");
     }
 
     #[test]

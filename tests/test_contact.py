@@ -638,6 +638,35 @@ def test_placements_draw_homes_the_table_runs(tmp_path: Path) -> None:
     assert "home must be 6 finite numbers (rad), one per joint; got shape (2,)" in run.stderr
 
 
+def test_an_mjcf_arm_without_actuators_gets_motors_and_a_table_facing_it(tmp_path: Path) -> None:
+    """An MJCF arm without actuators (dm_control's Kinova is one) gets the
+    motors the plant gives it, and the table faces the base: its short side
+    along the direction to the arm's reach, so that an arm reaching sideways
+    (here along −y) does not have its base over the table (refused before as
+    "joint 0 … below the table top")."""
+    xml = """<mujoco><compiler angle="radian"/><worldbody><body name="base" pos="0 0 0.3">
+      <joint name="j1" axis="0 0 1" range="-3 3"/><geom type="cylinder" size="0.05 0.05"/>
+      <body name="l1" pos="0 0 0.05"><joint name="j2" axis="0 1 0" range="-2 2"/>
+        <geom type="capsule" fromto="0 0 0 0.35 0 0" size="0.03" mass="2"/>
+        <body name="l2" pos="0.35 0 0"><joint name="j3" axis="0 1 0" range="-2.5 2.5"/>
+          <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1"/>
+          <body name="hand" pos="0.3 0 0"><geom type="sphere" size="0.02" mass="0.2"/></body>
+        </body></body></body></worldbody></mujoco>"""
+    path = tmp_path / "bare.xml"
+    path.write_text(xml)
+    with pytest.warns(amj.PlantWarning):
+        sc = act.arm_table(path, home=[-math.pi / 2, -0.3, 1.5])
+    model = sc.model
+    assert model.nu == 3
+    assert np.all(model.actuator_gainprm[:, 0] == 1.0)
+    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "table")
+    d = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, d)
+    first_side = d.geom_xmat[table].reshape(3, 3)[:, 0]
+    np.testing.assert_allclose(first_side, [0.0, -1.0, 0.0], atol=1e-9)
+    assert d.geom_xpos[table][1] < -0.4  # beside the arm, along its reach
+
+
 def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:
     """An MJCF arm with its own actuators and geometry: the tool on its end
     effector's body, the arm's geometry kept off the table, the chain to the

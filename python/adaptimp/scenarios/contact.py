@@ -209,10 +209,8 @@ def _tool_and_table(
     constant :data:`TABLE_TIMECONST`, the table of :data:`TABLE_MASS` on a
     spring of ``spring`` N/m or static; MuJoCo's elliptic cone and, with
     friction, the tool–table pair whose friction rows get their own time
-    constant (:func:`sliding_timeconst`). The table faces the base's vertical
-    axis: its short side (0.7 m) along the direction from the axis to
-    ``centre``, so that a table placed beside the arm does not reach under
-    its base. Returns the table's body (None: no table)."""
+    constant (:func:`sliding_timeconst`). Returns the table's body (None:
+    no table)."""
     import mujoco
 
     from .._tooling import add_table, add_tool
@@ -225,7 +223,7 @@ def _tool_and_table(
     c = np.asarray(centre, dtype=np.float64)
     table, box = add_table(
         spec, top=table_top, centre=(float(c[0]), float(c[1])), friction=rows, solref=solref,
-        mass=TABLE_MASS, spring=spring, yaw=math.atan2(float(c[1]), float(c[0])),
+        mass=TABLE_MASS, spring=spring,
     )  # fmt: skip
     # The Coulomb cone itself, not its pyramid: a pyramid's edges mix the
     # normal into every row and scale their regulariser by 2μ² (at μ = 0,
@@ -952,15 +950,13 @@ def _through_table(sc: PandaTable, plant: Any, rows: FloatArray) -> str | None:
         d.qpos[plant._qadr] = q
         mujoco.mj_kinematics(m, d)
         centre, half = d.geom_xpos[g], m.geom_size[g]
-        axes = d.geom_xmat[g].reshape(3, 3)  # the table's axes, turned by its yaw
         for i, j in enumerate(plant._joints):
-            a = axes.T @ (d.xanchor[j] - centre)
-            over = abs(a[0]) <= half[0] and abs(a[1]) <= half[1]
-            if over and d.xanchor[j][2] < top:
+            a = d.xanchor[j]
+            over = abs(a[0] - centre[0]) <= half[0] and abs(a[1] - centre[1]) <= half[1]
+            if over and a[2] < top:
                 return (
                     f"the arm clear of the table: at row {k} of the path joint {i} "
-                    f"({sc.chain.joint_names[i]!r}) is {top - d.xanchor[j][2]:.3g} m below the "
-                    "table top"
+                    f"({sc.chain.joint_names[i]!r}) is {top - a[2]:.3g} m below the table top"
                 )
     return None
 

@@ -183,9 +183,12 @@ impl PoseCircle {
     pub fn sample(&self, t: f64) -> PoseTarget {
         let w = 2.0 * core::f64::consts::PI * self.freq;
         let s = t - self.hold;
-        let (phi, dphi, ddphi) = if s <= 0.0 {
-            (core::f64::consts::PI, 0.0, 0.0)
-        } else if s < self.ramp {
+        if s <= 0.0 {
+            // The hold: the start pose itself, at rest (not centre + r·(−u),
+            // which rounds).
+            return PoseTarget::at(self.start, self.rotation);
+        }
+        let (phi, dphi, ddphi) = if s < self.ramp {
             let x = s / self.ramp;
             (
                 core::f64::consts::PI + w * self.ramp * x * x * x * x * (2.5 - 3.0 * x + x * x),

@@ -432,10 +432,14 @@ pub fn pose_metrics<'py>(
     let tg: Vec<f64> = targets.as_array().iter().copied().collect();
     let t: Vec<f64> = t.as_array().iter().copied().collect();
     let (pos, rot) = py.detach(|| {
-        let zero = [0.0; super::MAX_JOINTS];
         let (mut pos, mut rot) = (Vec::with_capacity(k), Vec::with_capacity(k));
         for r in 0..k {
-            let tip = kin.tip(&q[r * n..(r + 1) * n], &zero[..n]);
+            // The tip's pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
+            let pose = kin.pose(&q[r * n..(r + 1) * n]);
+            let position = [pose[3], pose[7], pose[11]];
+            let rotation = [
+                pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
+            ];
             let row = &tg[r * TARGET_LEN..(r + 1) * TARGET_LEN];
             let quat = |m: &[f64]| {
                 nalgebra::UnitQuaternion::from_rotation_matrix(
@@ -445,8 +449,8 @@ pub fn pose_metrics<'py>(
                 )
             };
             let (ep, eo) = crate::sim::metrics::pose_error(
-                &Vector::<3>::from(tip.position),
-                &quat(&tip.rotation),
+                &Vector::<3>::from(position),
+                &quat(&rotation),
                 &Vector::<3>::from_column_slice(&row[..3]),
                 &quat(&row[9..18]),
             );

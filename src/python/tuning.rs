@@ -77,15 +77,11 @@ pub fn suggest<'py>(
         }
     };
     let out = PyDict::new(py);
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => fill::<$k>(py, &out, law, (&d, k, along), &tau, ts, path.as_ref(), gravity.as_deref()),)*
-                _ => unreachable!("n checked above"),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)?;
+    crate::with_joints!(
+        n,
+        K => fill::<K>(py, &out, law, (&d, k, along), &tau, ts, path.as_ref(), gravity.as_deref()),
+        _ => unreachable!("n checked above"),
+    )?;
     Ok(out)
 }
 
@@ -183,23 +179,19 @@ pub fn default_task(
         )));
     }
     let [h, l, u] = [home, lo, hi].map(|a| a.as_array().iter().copied().collect::<Vec<f64>>());
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => {
-                    let v = |x: &[f64]| Vector::<$k>::from_column_slice(x);
-                    let t = core_default_task(&v(&h), &v(&l), &v(&u))
-                        .map_err(|e| config_error(e.into()))?;
-                    Ok((
-                        t.offset().as_slice().to_vec(),
-                        t.sin_amplitude().as_slice().to_vec(),
-                        t.cos_amplitude().as_slice().to_vec(),
-                        t.omega().as_slice().to_vec(),
-                    ))
-                })*
-                _ => unreachable!("n checked above"),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        n,
+        K => {
+            let v = |x: &[f64]| Vector::<K>::from_column_slice(x);
+            let t = core_default_task(&v(&h), &v(&l), &v(&u))
+                .map_err(|e| config_error(e.into()))?;
+            Ok((
+                t.offset().as_slice().to_vec(),
+                t.sin_amplitude().as_slice().to_vec(),
+                t.cos_amplitude().as_slice().to_vec(),
+                t.omega().as_slice().to_vec(),
+            ))
+        },
+        _ => unreachable!("n checked above"),
+    )
 }

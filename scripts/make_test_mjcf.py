@@ -25,7 +25,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from adaptimp import _models
+from adaptimp import _description, _models
 
 OUT = Path(__file__).resolve().parents[1] / "tests" / "data" / "ur5_gripper.xml"
 UR5 = _models.panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
@@ -34,8 +34,9 @@ RADIUS = {"shoulder": 0.06, "upper": 0.05, "forearm": 0.04, "wrist": 0.035}
 
 
 def main() -> None:
-    arm = _models.arm_urdf(UR5.read_text())
-    spec = mujoco.MjSpec.from_string(arm.text)
+    arm = _description.read_arm(UR5)  # the core's reduction (SPEC §21)
+    assert arm.urdf is not None
+    spec = mujoco.MjSpec.from_string(arm.urdf)
     spec.compiler.fusestatic = False
     spec.modelname = "ur5_gripper"
     model = spec.compile()

@@ -5,7 +5,7 @@
 # Works on a fresh machine with Rust (stable and nightly) and Python 3.9+.
 #
 # What it installs, and where (README "Tests"):
-#   apt     cmake, valgrind                      (if missing; as root)
+#   apt     cmake, valgrind, g++, libeigen3-dev  (if missing; as root)
 #   cargo   cargo-fuzz into ~/.cargo/bin         (if missing)
 #   pip     target/build-venv: maturin, ziglang (zig, the wheel's linker), auditwheel
 #           target/py-venv:    the wheel with its `test` extra (pytest, hypothesis, ruff,
@@ -26,10 +26,12 @@ step() { printf '\n==> %s  [%d s]\n' "$*" "$SECONDS"; }
 export CARGO_TARGET_DIR="$PWD/target"
 export CARGO_INCREMENTAL=0
 
-step "System tools: CMake and valgrind for the C ABI's examples"
+step "System tools: CMake and valgrind for the C ABI's examples, g++ and Eigen for the Pinocchio peer"
 need=()
 command -v cmake >/dev/null || need+=(cmake)
 command -v valgrind >/dev/null || need+=(valgrind)
+command -v g++ >/dev/null || need+=(g++)
+[ -e /usr/include/eigen3/Eigen/Core ] || need+=(libeigen3-dev)
 if [ ${#need[@]} -gt 0 ]; then
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
         apt-get update -qq && apt-get install -y -qq "${need[@]}" >/dev/null
@@ -107,4 +109,7 @@ bash scripts/test_wheel.sh
 
 step "Python: tests"
 "$py" -m pytest
+
+step "The core against Pinocchio: benches/peers/peers.cpp built against the pin wheel, every row to 1e-12"
+"$py" benches/peers.py --check
 step "done"

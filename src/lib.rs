@@ -108,8 +108,8 @@ pub use auxiliary::AuxLaw;
 pub use cartesian::{
     CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
     CartesianMeasurement, CartesianState, Chain, CompliantPose, ComputedState, ComputedTorque,
-    ComputedTorqueConfig, Drive, Dynamics, Formulation, Inertial, Joint, JointKind, OuterStep,
-    PoseTarget, Transform, FRICTION_VELOCITY, GRAVITY,
+    ComputedTorqueConfig, Drive, Dynamics, Formulation, ImpedanceTorque, Inertial, Joint,
+    JointKind, OuterStep, PoseGoal, PoseTarget, Transform, FRICTION_VELOCITY, GRAVITY,
 };
 pub use config::{Conditions, Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};

@@ -890,6 +890,7 @@ impl<const N: usize> Scenario<N> {
         })
     }
 
+    // A table, one line per parameter in PARAMS' order: cut in parts, it would read no better.
     /// Call `f` with every parameter's name and current value. Every field of
     /// every struct is destructured without `..`: a field added without a
     /// schema name is a compile error here.

@@ -569,6 +569,19 @@ class CartesianImpedance:
         wrench: ArrayLike,
         target: ArrayLike | None = None,
     ) -> _F: ...
+    def step_sample(
+        self,
+        controller: Controller | ComputedTorque,
+        q: ArrayLike,
+        dq: ArrayLike | None,
+        wrench: ArrayLike | None,
+        sample: Any,
+        record: bool,
+    ) -> _F:
+        """One step of ``CartesianController.step`` in one call; sat(τ) (N m), (n,)."""
+    def held_rotation(self) -> _F: ...
+    def set_held_rotation(self, r: ArrayLike) -> None: ...
+    def take_log(self) -> _F: ...
     def step_python(
         self,
         inner: Any,
@@ -664,14 +677,15 @@ class ComputedTorque:
     @property
     def fault(self) -> tuple[str, int] | None: ...
     def reset(self) -> None: ...
+    def set_trajectory(self, trajectory: Callable[[float], Any] | None = None) -> None: ...
     def step(
         self,
         q: ArrayLike,
         tau_e: ArrayLike,
-        dq: ArrayLike | None,
-        xc: ArrayLike,
-        dxc: ArrayLike,
-        ddxc: ArrayLike,
+        dq: ArrayLike | None = None,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
     ) -> _F:
         """One step (SPEC (20.3)); sat(τ) (N m), (n,)."""
     def inverse_dynamics(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> _F:

@@ -426,6 +426,8 @@ class ComputedTorque:
                 xc_offset=[0.2, 0.2], xc_sin=[0.0, 0.2], xc_cos=[-0.2, 0.0], xc_omega=[math.pi] * 2
             )
         self._trajectory = trajectory
+        self._core.set_trajectory(trajectory)
+        self._step = self._core.step
 
     def reset(self) -> None:
         """Back to t = 0; the reference starts at the next setpoint."""
@@ -497,9 +499,10 @@ class ComputedTorque:
         return np.asarray(self._core.inverse_dynamics(q, dq, np.zeros(self.n)), dtype=np.float64)
 
     def inverse_dynamics(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> FloatArray:
-        """The controller's model M̂ q̈ + Ĉ q̇ + Ĝ (N m), (n,) (RNEA, SPEC (20.2))."""
-        q, dq, ddq = _joint("q", q, self.n), _joint("dq", dq, self.n), _joint("ddq", ddq, self.n)
-        return np.asarray(self._core.inverse_dynamics(q, dq, ddq), dtype=np.float64)
+        """The controller's model M̂ q̈ + Ĉ q̇ + Ĝ (N m), (n,) (RNEA, SPEC (20.2);
+        with the drive's armature and damping, (20.5)). q (rad), dq (rad/s), ddq
+        (rad/s²), each (n,), checked (shape, finiteness) by the core."""
+        return self._core.inverse_dynamics(q, dq, ddq)
 
     def step(
         self,
@@ -518,22 +521,10 @@ class ComputedTorque:
         xc (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0), or
         none of them (then the built-in ``trajectory``).
         """
-        n = self.n
-        if dq is None:
-            raise ValueError("ComputedTorque needs the measured joint velocity dq")
-        if xc is None:
-            if dxc is not None or ddxc is not None:
-                raise ValueError("give xc with dxc and ddxc")
-            if self._trajectory is None:
-                raise ValueError("no setpoint given and no trajectory to follow")
-            xc, dxc, ddxc = self._trajectory(self.t)
-        zero = np.zeros(n)
-        return np.asarray(
-            self._core.step(
-                q, tau_e, dq, xc, zero if dxc is None else dxc, zero if ddxc is None else ddxc
-            ),
-            dtype=np.float64,
-        )
+        # One call of the core, positional (cheaper than keywords through the
+        # binding): it checks every argument (shapes and types there, values in
+        # the step) and, given no setpoint, follows the trajectory.
+        return self._step(q, tau_e, dq, xc, dxc, ddxc)
 
     def __repr__(self) -> str:
         return (

@@ -112,7 +112,12 @@ def _wrench(wrench: ArrayLike | None) -> FloatArray:
 
 def _sample(path: Path, t: float, R: FloatArray) -> FloatArray:
     """path(t) as a flat target; a 3-tuple keeps the rotation R."""
-    s = tuple(path(t))
+    return _pose_of(path(t), R)
+
+
+def _pose_of(sample: Any, R: FloatArray) -> FloatArray:
+    """A path's value (p, ṗ, p̈[, R, ω, ω̇]) as a flat target; a 3-tuple keeps R."""
+    s = tuple(sample)
     if len(s) == 3:
         return pose_target(s[0], s[1], s[2], R)
     if len(s) == 6:
@@ -181,6 +186,15 @@ class CartesianImpedance:
     def ts(self) -> float:
         """Deprecated name of :attr:`Ts`."""
         return period_alias(self)
+
+    @property
+    def _R(self) -> FloatArray:
+        """The commanded rotation a target without one keeps (3, 3), held by the core."""
+        return np.asarray(self._core.held_rotation())
+
+    @_R.setter
+    def _R(self, R: ArrayLike) -> None:
+        self._core.set_held_rotation(np.asarray(R, dtype=np.float64).reshape(9))
 
     @property
     def n(self) -> int:
@@ -431,13 +445,10 @@ class CartesianController:
         self.chain, self.path, self.record = chain, path, record
         self._Ts = float(Ts)
         self._k = 0
-        n = chain.n
-        nan3 = np.full(3, math.nan)
-        self.xc, self.xd, self.z1, self.force = nan3, nan3, nan3, nan3
-        self.dxc, self.ddxc = nan3, nan3
-        self.tau = np.full(n, math.nan)
-        self.q_d = self.outer.q0.copy()
-        self.log: dict[str, list[FloatArray]] = {k: [] for k in _LOG}
+        self._tau = np.full(chain.n, math.nan)
+        self._log: dict[str, list[FloatArray]] = {k: [] for k in _LOG}
+        # The per-sample step: one call of the core (SPEC §16; issue 32).
+        self._step = self.outer.core.step_sample
 
     @property
     def Ts(self) -> float:
@@ -465,6 +476,61 @@ class CartesianController:
     def n(self) -> int:
         """Joints."""
         return self.chain.n
+
+    def _last(self, what: str) -> FloatArray:
+        return np.asarray(self.outer.core.last(what), dtype=np.float64)
+
+    @property
+    def xc(self) -> FloatArray:
+        """The last step's commanded position p_c (m), (3,) (NaN before a step)."""
+        return self._last("p_c")
+
+    @property
+    def dxc(self) -> FloatArray:
+        """The last step's ṗ_c (m/s), (3,)."""
+        return self._last("dp_c")
+
+    @property
+    def ddxc(self) -> FloatArray:
+        """The last step's p̈_c (m/s²), (3,)."""
+        return self._last("ddp_c")
+
+    @property
+    def xd(self) -> FloatArray:
+        """The last step's compliant reference p_d (m), (3,)."""
+        return self._last("p_d")
+
+    @property
+    def z1(self) -> FloatArray:
+        """The last step's p_d − p(q) (m), (3,)."""
+        return self._last("p_d") - self._last("p")
+
+    @property
+    def force(self) -> FloatArray:
+        """The last step's measured force f (N), (3,)."""
+        return self._last("wrench")[:3]
+
+    @property
+    def q_d(self) -> FloatArray:
+        """The joint reference q_d of the last step (rad), (n,) (q0 before one)."""
+        q = self._last("q_d")
+        return self.outer.q0.copy() if np.isnan(q).all() else q
+
+    @property
+    def tau(self) -> FloatArray:
+        """The last step's commanded τ of the joint controller (N m), (n,)."""
+        return self._last("tau") if self._core_inner else self._tau
+
+    @property
+    def log(self) -> dict[str, list[FloatArray]]:
+        """The kept rows, per quantity (see :meth:`arrays`): lists of rows or blocks."""
+        rows = self.outer.core.take_log()
+        if len(rows):
+            n = self.chain.n
+            cuts = np.cumsum([3, 3, 3, 3, 3, 3, n, 6])
+            for key, block in zip(_LOG, np.split(rows, cuts, axis=1)):
+                self._log[key].append(block)
+        return self._log
 
     @property
     def params(self) -> dict[str, Any]:
@@ -504,23 +570,27 @@ class CartesianController:
         rad/s²), each optional (R: the last commanded rotation); without
         ``xc`` the ``path`` at t_k, or the last target held.
         """
-        f = _wrench(wrench)
         if xc is not None:
-            target: FloatArray | None = self.outer.target(xc, dxc, ddxc, R, w, dw)
+            sample: Any = (xc, dxc, ddxc, R, w, dw)
         elif self.path is not None:
-            target = _sample(self.path, self._k * self.Ts, self.outer._R)
-            self.outer._R = target[9:18].reshape(3, 3).copy()
+            sample = self.path(self._k * self._Ts)
         else:
-            target = None
-        core = self.outer.core
+            sample = None
         if self._core_inner:
-            out = core.step_controller(self._joint, q, dq, f, target)
-            self.tau = core.last("tau")
-        else:
-            out = core.step_python(self.inner, q, dq, f, target)
-            self.tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
-        self._last_step()
-        pd = self.xd
+            # One call of the core: the pose and wrench read, the step, the row kept.
+            out: FloatArray = self._step(self._joint, q, dq, wrench, sample, self.record)
+            self._k += 1
+            return out
+        f = _wrench(wrench)
+        target: FloatArray | None = None
+        if xc is not None:
+            target = self.outer.target(xc, dxc, ddxc, R, w, dw)
+        elif sample is not None:
+            target = _pose_of(sample, self.outer._R)
+            self.outer._R = target[9:18].reshape(3, 3).copy()
+        core = self.outer.core
+        out = core.step_python(self.inner, q, dq, f, target)
+        self._tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
         if self.record:
             for key, v in zip(
                 _LOG,
@@ -528,7 +598,7 @@ class CartesianController:
                     self.xc,
                     self.dxc,
                     self.ddxc,
-                    pd,
+                    self.xd,
                     core.last("dp_d"),
                     core.last("ddp_d"),
                     self.q_d,
@@ -536,7 +606,7 @@ class CartesianController:
                     core.last("error"),
                 ),
             ):
-                self.log[key].append(np.array(v, dtype=np.float64))
+                self._log[key].append(np.array(v, dtype=np.float64))
         self._k += 1
         return np.asarray(out)
 
@@ -593,13 +663,6 @@ class CartesianController:
                 )
         return out
 
-    def _last_step(self) -> None:
-        """The attributes of the last step taken, from the core's outer loop."""
-        last = self.outer.core.last
-        self.xc, self.dxc, self.ddxc = last("p_c"), last("dp_c"), last("ddp_c")
-        self.xd, self.force, self.q_d = last("p_d"), last("wrench")[:3], last("q_d")
-        self.z1 = self.xd - last("p")
-
     def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None) -> None:
         """After a run of the core's loop (:func:`adaptimp.mujoco.simulate`) along
         ``targets`` (of :meth:`_targets`), whole or stopped by an error: the clock,
@@ -607,14 +670,12 @@ class CartesianController:
         extended by the run's kept rows ``task`` (None: none)."""
         core = self.outer.core
         k0, self._k = self._k, int(core.steps)
-        if self._k > k0:
-            if targets is not None and self.path is not None:
-                self.outer._R = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
-            self._last_step()
-            self.tau = core.last("tau")
+        if self._k > k0 and targets is not None and self.path is not None:
+            self.outer._R = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
         if self.record and task is not None and len(task["pc"]):
+            log = self.log
             for key in _LOG:
-                self.log[key].append(task[key])
+                log[key].append(task[key])
 
     def __repr__(self) -> str:
         kind = "position-only" if not self.outer.orients else "6-D"

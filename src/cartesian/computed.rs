@@ -208,7 +208,9 @@ impl<const N: usize> ComputedTorque<N> {
         let drive = self.model.drive();
         let (tau, xc) = match task.filter(|t| t.share < 1.0) {
             None => (
-                self.model.inverse_dynamics(&q, &dq, &a) + drive.friction_torque(&r.dxd) + m.tau_e,
+                self.model.inverse_dynamics(&q, &dq, &a)
+                    + drive.friction_torque(&r.dxd, &dq)
+                    + m.tau_e,
                 c.x,
             ),
             Some(t) => {
@@ -244,7 +246,7 @@ impl<const N: usize> ComputedTorque<N> {
                 // (20.6) on the velocity the blend of references moves at.
                 let v_r = n * r.dxd + (1.0 - n) * qc.dx;
                 let tau = self.model.inverse_dynamics(&q, &dq, &ddq)
-                    + drive.friction_torque(&v_r)
+                    + drive.friction_torque(&v_r, &dq)
                     + n * m.tau_e
                     + (1.0 - n) * task_part;
                 (tau, qc.x)
@@ -367,7 +369,8 @@ mod tests {
     #[test]
     fn the_drive_enters_the_law_and_its_friction_is_compensated() {
         // (20.3) with (20.5), (20.6): the same step with and without a drive
-        // differs by I_a ⊙ a + b ⊙ q̇ + F ⊙ tanh(ẋ_c / v_s) (external mode).
+        // differs by I_a ⊙ a + b ⊙ q̇ + F ⊙ tanh(v / v_s) (external mode: v the
+        // slower of ẋ_c and q̇ where they agree in sign, else 0).
         use crate::cartesian::dynamics::{Drive, FRICTION_VELOCITY};
         let drive = Drive {
             armature: Vector::<2>::new(0.2, 0.1),
@@ -385,7 +388,7 @@ mod tests {
         };
         let m = Measurement {
             x: Vector::<2>::new(0.48, 0.31),
-            dx: Some(Vector::<2>::new(0.1, -0.2)),
+            dx: Some(Vector::<2>::new(0.1, 0.2)),
             tau_e: Vector::zeros(),
         };
         let step =
@@ -394,9 +397,11 @@ mod tests {
         let a = c.ddx + cfg.kd.component_mul(&(c.dx - dq)) + cfg.kp.component_mul(&(c.x - m.x));
         let want = drive.armature.component_mul(&a)
             + drive.damping.component_mul(&dq)
-            + Vector::<2>::from_fn(|i, _| {
-                drive.friction[i] * libm::tanh(c.dx[i] / FRICTION_VELOCITY)
-            });
+            // Joint 0 moves with its reference (the slower: ẋ_c), joint 1 against it.
+            + Vector::<2>::new(
+                drive.friction[0] * libm::tanh(c.dx[0] / FRICTION_VELOCITY),
+                0.0,
+            );
         let got = step(&driven) - step(&rigid);
         assert!((got - want).amax() < 1e-12, "{got} vs {want}");
     }

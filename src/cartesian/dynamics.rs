@@ -7,9 +7,9 @@
 //!
 //! Units: kg, m, kg m², rad (m for a prismatic joint), N m (N).
 
-use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
+use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Link, Transform};
 use crate::error::{check, Error};
-use crate::math::tanh;
+use crate::math::{sin_cos, tanh};
 use crate::types::{Matrix, Vector};
 use nalgebra::{Matrix3, Vector3};
 
@@ -47,15 +47,17 @@ impl<const N: usize> Drive<N> {
         }
     }
 
-    /// The dry-friction compensation τ_F = F ⊙ tanh(v_r / v_s) at the
-    /// reference velocity `v_r` (rad/s, m/s), SPEC (20.6) (N m, N).
-    pub fn friction_torque(&self, v_r: &Vector<N>) -> Vector<N> {
+    /// The dry-friction compensation τ_F = F ⊙ tanh(v / v_s) (N m, N), SPEC
+    /// (20.6), on the motion the joint and its reference agree on: v_i =
+    /// sign(v_r,i) min(|q̇_i|, |v_r,i|) where the measured `dq` and the
+    /// reference velocity `v_r` (rad/s, m/s) have the same sign, else 0.
+    pub fn friction_torque(&self, v_r: &Vector<N>, dq: &Vector<N>) -> Vector<N> {
         Vector::from_fn(|i, _| {
-            let f = self.friction[i];
-            if f == 0.0 {
+            let (f, r, m) = (self.friction[i], v_r[i], dq[i]);
+            if f == 0.0 || r * m <= 0.0 || r.is_nan() || m.is_nan() {
                 0.0
             } else {
-                f * tanh(v_r[i] / FRICTION_VELOCITY)
+                f * tanh(r.signum() * r.abs().min(m.abs()) / FRICTION_VELOCITY)
             }
         })
     }
@@ -203,7 +205,7 @@ impl<const N: usize> Dynamics<N> {
     /// mass, an inertia that is not finite or symmetric or has a negative
     /// diagonal, a non-finite gravity.
     pub fn new(joints: &[Joint], inertials: &[Inertial], gravity: [f64; 3]) -> Result<Self, Error> {
-        let chain = Chain::<N>::new(joints, &Transform::IDENTITY)?;
+        let (chain, aligns) = Chain::<N>::aligned(joints, &Transform::IDENTITY)?;
         if inertials.len() != joints.len() {
             return Err(Error::Condition {
                 condition: "one inertial per joint of the list (fixed ones too)",
@@ -230,6 +232,12 @@ impl<const N: usize> Dynamics<N> {
                 let f = pending.then(&origin);
                 bodies[b].add(inertial.mass, f.p, f.r * ic * f.r.transpose());
             }
+        }
+        // Into the links' frames of the core's form (the description's
+        // frame of joint i is link i's times A_iᵀ).
+        for (b, a) in bodies.iter_mut().zip(&aligns) {
+            b.h = a.tr_mul(&b.h);
+            b.i = a.tr_mul(&b.i) * a;
         }
         Ok(Self {
             chain,
@@ -314,49 +322,151 @@ impl<const N: usize> Dynamics<N> {
         self.rnea(q, &Vector::zeros(), v, Vector3::zeros()) + self.drive.armature.component_mul(v)
     }
 
-    /// M_a(q) = M(q) + diag(I_a) (kg m², kg), (20.5); column j = M_a e_j,
-    /// symmetrised.
+    /// M_a(q) = M(q) + diag(I_a) (kg m², kg), (20.5): the composite-rigid-body
+    /// algorithm, SPEC (20.2).
     pub fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
-        let mut m = Matrix::<N>::zeros();
-        for j in 0..N {
-            let mut e = Vector::<N>::zeros();
-            e[j] = 1.0;
-            m.set_column(j, &self.mass_times(q, &e));
+        let links = self.chain.links();
+        // Each link's place in the previous link's frame (the first one's
+        // does not enter M): sin and cos of its angle, its origin.
+        let mut sc = [(0.0, 1.0); N];
+        let mut r = [Vector3::zeros(); N];
+        for i in 1..N {
+            (sc[i], r[i]) = place(&links[i], q[i]);
         }
-        (m + m.transpose()) * 0.5
-    }
-
-    /// The recursion of (20.2) with the base accelerating at `a0`.
-    fn rnea(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>, a0: Vector3<f64>) -> Vector<N> {
-        // Forward: each body's force F_i and moment N_i about its origin O_i.
+        // Tip to base: the composite body k (the links from k to the tip, in
+        // link k's frame) gives column k (the force and moment it needs for
+        // q̈_k = 1) and joins link k − 1; every column j ≥ k is carried into
+        // link k − 1's frame, where M_{k−1,j} = z · (the moment, or the force
+        // for a prismatic joint k − 1).
+        let mut cols = [[0.0; N]; N];
         let mut f = [Vector3::zeros(); N];
         let mut n = [Vector3::zeros(); N];
-        let mut o = [Vector3::zeros(); N];
-        let mut z = [Vector3::zeros(); N];
-        self.chain.walk(q, dq, Some(ddq), a0, |i, m| {
+        let mut comp = self.bodies[N - 1];
+        for k in (0..N).rev() {
+            let (fj, nj) = if links[k].prismatic {
+                (
+                    Vector3::new(0.0, 0.0, comp.m),
+                    Vector3::new(comp.h[1], -comp.h[0], 0.0),
+                )
+            } else {
+                (
+                    Vector3::new(-comp.h[1], comp.h[0], 0.0),
+                    comp.i.column(2).into_owned(),
+                )
+            };
+            (f[k], n[k]) = (fj, nj);
+            cols[k][k] = if links[k].prismatic { fj[2] } else { nj[2] } + self.drive.armature[k];
+            if k == 0 {
+                break;
+            }
+            let l = &links[k];
+            let (sn, cs) = sc[k];
+            let rk = r[k];
+            // The composite into link k − 1's frame, joined to its body:
+            // + E I Eᵀ + m(|r|² 1 − r rᵀ) + 2 (r·h) 1 − r hᵀ − h rᵀ.
+            let (m, h, x) = (
+                comp.m,
+                l.parent_of(sn, cs, &comp.h),
+                l.sandwich(sn, cs, &comp.i),
+            );
+            let u = rk * m + h;
+            let d = rk.dot(&(u + h));
+            let mut next = self.bodies[k - 1];
+            next.m += m;
+            next.h += u;
+            for a in 0..3 {
+                for b in a..3 {
+                    let v = x[(a, b)] - rk[a] * u[b] - h[a] * rk[b] + if a == b { d } else { 0.0 };
+                    next.i[(a, b)] += v;
+                    if a != b {
+                        next.i[(b, a)] += v;
+                    }
+                }
+            }
+            comp = next;
+            let z_of = |f: &Vector3<f64>, n: &Vector3<f64>| {
+                if links[k - 1].prismatic {
+                    f[2]
+                } else {
+                    n[2]
+                }
+            };
+            let e = l.rotation(sn, cs);
+            for j in k..N {
+                let fp = e * f[j];
+                let np = e * n[j] + rk.cross(&fp);
+                let v = z_of(&fp, &np);
+                cols[j][k - 1] = v;
+                cols[k - 1][j] = v;
+                (f[j], n[j]) = (fp, np);
+            }
+        }
+        Matrix::from_data(nalgebra::ArrayStorage(cols))
+    }
+
+    /// The recursion of (20.2) in the links' frames with the base
+    /// accelerating at `a0` (world): τ of the rigid links (no drive).
+    #[inline]
+    fn rnea(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>, a0: Vector3<f64>) -> Vector<N> {
+        let links = self.chain.links();
+        let mut sc = [(0.0, 1.0); N];
+        let mut r = [Vector3::zeros(); N];
+        let mut f = [Vector3::zeros(); N];
+        let mut n = [Vector3::zeros(); N];
+        // Forward: each link's angular velocity w, acceleration al and the
+        // classical acceleration a of its origin, in its own frame.
+        let (mut w, mut al, mut a) = (Vector3::zeros(), Vector3::zeros(), a0);
+        for (i, l) in links.iter().enumerate() {
+            let ((sn, cs), ri) = place(l, q[i]);
+            (sc[i], r[i]) = ((sn, cs), ri);
+            // The previous link's motion at this link's origin, in its axes.
+            if i > 0 {
+                a += al.cross(&ri) + w.cross(&w.cross(&ri));
+            }
+            a = l.child_of(sn, cs, &a);
+            w = l.child_of(sn, cs, &w);
+            if l.prismatic {
+                // The link slides along z at q̇, q̈ (its origin r_i moved).
+                al = l.child_of(sn, cs, &al);
+                a += Vector3::new(w[1], -w[0], 0.0) * (2.0 * dq[i]);
+                a[2] += ddq[i];
+            } else {
+                // al = Eᵀ al + w' × z q̇ + z q̈, w' = Eᵀ w.
+                al = l.child_of(sn, cs, &al) + Vector3::new(w[1], -w[0], 0.0) * dq[i];
+                al[2] += ddq[i];
+                w[2] += dq[i];
+            }
             let b = &self.bodies[i];
-            let h = m.r * b.h;
-            let inertia = m.r * b.i * m.r.transpose();
-            f[i] = b.m * m.a + m.al.cross(&h) + m.w.cross(&m.w.cross(&h));
-            n[i] = inertia * m.al + m.w.cross(&(inertia * m.w)) + h.cross(&m.a);
-            o[i] = m.c;
-            z[i] = m.z;
-        });
+            let iw = b.i * w;
+            f[i] = a * b.m + al.cross(&b.h) + w.cross(&w.cross(&b.h));
+            n[i] = b.i * al + w.cross(&iw) + b.h.cross(&a);
+        }
         // Backward: what each joint transmits, tip to base.
         let mut tau = Vector::<N>::zeros();
         for i in (0..N).rev() {
-            if i + 1 < N {
-                let (fi, ni) = (f[i + 1], n[i + 1]);
-                f[i] += fi;
-                n[i] += ni + (o[i + 1] - o[i]).cross(&fi);
+            tau[i] = if links[i].prismatic { f[i][2] } else { n[i][2] };
+            if i > 0 {
+                let (sn, cs) = sc[i];
+                let l = &links[i];
+                let fp = l.parent_of(sn, cs, &f[i]);
+                let np = l.parent_of(sn, cs, &n[i]) + r[i].cross(&fp);
+                f[i - 1] += fp;
+                n[i - 1] += np;
             }
-            tau[i] = if self.chain.is_prismatic(i) {
-                z[i].dot(&f[i])
-            } else {
-                z[i].dot(&n[i])
-            };
         }
         tau
+    }
+}
+
+/// Link `l`'s place in the previous link's frame at its joint value `q`:
+/// (sin θ, cos θ) of its angle ((0, 1) for a prismatic joint) and its origin
+/// (p, or p + o z (q + offset) for a prismatic joint).
+#[inline(always)]
+fn place(l: &Link, q: f64) -> ((f64, f64), Vector3<f64>) {
+    if l.prismatic {
+        ((0.0, 1.0), l.p + l.o.column(2) * (q + l.offset))
+    } else {
+        (sin_cos(q + l.offset), l.p)
     }
 }
 
@@ -497,18 +607,20 @@ mod tests {
         assert_eq!(a.gravity_torque(&q), d.gravity_torque(&q));
         let mv = a.mass_times(&q, &ddq) - a.mass_matrix(&q) * ddq;
         assert!(mv.amax() < 1e-12, "{mv}");
-        // (20.6): the full friction beyond a few v_s, none at rest, odd.
+        // (20.6): the full friction beyond a few v_s when the joint moves
+        // with its reference, none at rest or against it, odd.
+        let drive = a.drive();
         let v = Vector::<3>::new(1.0, -1.0, 1.0);
-        let f = a.drive().friction_torque(&v);
+        let f = drive.friction_torque(&v, &v);
         assert!((f - Vector::<3>::new(2.0, -1.0, 0.0)).amax() < 1e-12, "{f}");
-        assert_eq!(
-            a.drive().friction_torque(&Vector::zeros()),
-            Vector::<3>::zeros()
-        );
-        let slow = a
-            .drive()
-            .friction_torque(&Vector::from_element(FRICTION_VELOCITY));
+        let zero = Vector::<3>::zeros();
+        assert_eq!(drive.friction_torque(&zero, &v), zero);
+        assert_eq!(drive.friction_torque(&v, &zero), zero);
+        assert_eq!(drive.friction_torque(&v, &-v), zero);
+        // The slower of the two: a joint starting to follow its reference.
+        let slow = drive.friction_torque(&v, &Vector::from_element(FRICTION_VELOCITY));
         assert!((slow[0] - 2.0 * libm::tanh(1.0)).abs() < 1e-15, "{slow}");
+        assert!(slow[1] == 0.0, "{slow}");
         // The default is no drive, bit for bit the rigid model.
         assert_eq!(d.with_drive(Drive::none()).unwrap(), d);
     }

@@ -5,6 +5,7 @@
 pub mod chain;
 pub mod computed;
 pub mod dynamics;
+pub mod impedance_torque;
 pub mod kinematics;
 mod outer;
 mod pair;
@@ -13,6 +14,7 @@ pub mod rotation;
 pub use chain::{Chain, Joint, JointKind, Transform, MAX_CHAIN_JOINTS};
 pub use computed::{ComputedState, ComputedTorque, ComputedTorqueConfig};
 pub use dynamics::{Drive, Dynamics, Inertial, FRICTION_VELOCITY, GRAVITY};
+pub use impedance_torque::{ImpedanceTorque, PoseGoal};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{
     CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation, OuterStep,

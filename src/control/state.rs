@@ -309,8 +309,19 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
         Ok(())
     }
 
-    /// The checks of [`load`](Self::load), without a change.
+    /// The checks of [`load`](Self::load), without a change: the envelope
+    /// of the data, then the state it holds.
     pub(crate) fn check_snapshot<'a>(&self, data: &'a [f64]) -> Result<Snapshot<'a, N>, Error> {
+        let k = self.check_envelope(data)?;
+        let snap = self.read_snapshot(data, k);
+        snap.check()?;
+        Ok(snap)
+    }
+
+    /// The envelope of a snapshot, before any value is read: the header
+    /// (an earlier format named), the sizes, a whole step count (returned),
+    /// finite numbers, the checksum.
+    fn check_envelope(&self, data: &[f64]) -> Result<u64, Error> {
         let bad = |reason| Error::Invalid {
             what: "snapshot",
             reason,
@@ -343,6 +354,14 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
                 "its checksum does not match its values: the snapshot is corrupt",
             ));
         }
+        Ok(k as u64)
+    }
+
+    /// The values of a snapshot whose envelope
+    /// [`check_envelope`](Self::check_envelope) passed, with step count `k`,
+    /// in the order [`save`](Self::save) wrote them; the weight norms
+    /// recomputed from the weights beside the stored ones.
+    fn read_snapshot<'a>(&self, data: &'a [f64], k: u64) -> Snapshot<'a, N> {
         let mut r = Reader {
             data,
             at: SNAPSHOT_PREFIX,
@@ -380,8 +399,8 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
         let applied = r.vector();
         let q_seen = r.vector();
         let exact = Weights::<N>::new(rows, nodes, nodes).norms();
-        let snap = Snapshot {
-            k: k as u64,
+        Snapshot {
+            k,
             reference,
             zeta,
             observer,
@@ -393,9 +412,7 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
             exact,
             basis,
             rows,
-        };
-        snap.check()?;
-        Ok(snap)
+        }
     }
 
     /// Put a checked snapshot into this state (clearing a fault).

@@ -151,10 +151,11 @@ fn shifted(p: [f64; 3], by: [f64; 3]) -> [f64; 3] {
 }
 
 impl MujocoArrays {
-    /// Every array of one kind has the same length (a front's mistake
-    /// otherwise, named).
-    fn check_lengths(&self, source: &str) -> Result<(), DescriptionError> {
-        let groups: [(&str, usize, [usize; 8]); 5] = [
+    /// Per kind of object (body, jnt, site, actuator, eq): its prefix, its
+    /// count (the length of its names or types) and the lengths of its
+    /// arrays, padded with the count (a table: one row per kind).
+    fn length_groups(&self) -> [(&'static str, usize, [usize; 8]); 5] {
+        [
             (
                 "body",
                 self.body_name.len(),
@@ -225,8 +226,16 @@ impl MujocoArrays {
                     self.eq_type.len(),
                 ],
             ),
-        ];
-        for (what, n, lens) in groups {
+        ]
+    }
+
+    /// Every array of one kind has the same length, and every id names an
+    /// object that exists (a front's mistake otherwise, named): the
+    /// [`length_groups`](Self::length_groups), the joints' drive arrays and
+    /// the actuators' bias types, a world at least, each body's parent
+    /// before it, the force sites and the bodies of joints and sites.
+    fn check_lengths(&self, source: &str) -> Result<(), DescriptionError> {
+        for (what, n, lens) in self.length_groups() {
             if lens.iter().any(|&l| l != n) {
                 return Err(bad(
                     source,
@@ -327,30 +336,256 @@ impl MujocoArrays {
     /// body that does not exist, and those of [`Tree::new`].
     pub fn tree(&self, source: &str) -> Result<Tree, DescriptionError> {
         self.check_lengths(source)?;
-        let nb = self.body_name.len();
+        let mut build = TreeBuild::new(self, source);
+        for b in 0..self.body_name.len() {
+            build.body(b)?;
+        }
+        let frames = build.frames();
+        Tree::new(source, &self.model_name, build.links, build.joints, frames)
+    }
+}
+
+/// One model's tree being built, body by body (SPEC (21.1), MJCF): the
+/// names, each body's joints and what couples joints, read once from the
+/// arrays; the links and joints so far.
+struct TreeBuild<'m> {
+    m: &'m MujocoArrays,
+    source: &'m str,
+    body_names: Vec<String>,
+    joint_names: Vec<String>,
+    /// Per body: its joints, in order.
+    body_joints: Vec<Vec<usize>>,
+    /// Per joint: the joint a joint equality makes it follow.
+    mimic: Vec<Option<Mimic>>,
+    /// Per joint: a0 of a joint equality without a second joint (locked at qpos0 + a0).
+    locked: Vec<Option<f64>>,
+    /// Per joint: the fixed tendon of two or more joints that couples it.
+    coupled: Vec<Option<String>>,
+    links: Vec<Link>,
+    joints: Vec<TreeJoint>,
+}
+
+impl<'m> TreeBuild<'m> {
+    /// The names (a world without one is "world"; an unnamed object
+    /// `kind#i`), each body's joints and the couplings of the model `m`.
+    fn new(m: &'m MujocoArrays, source: &'m str) -> Self {
+        let nb = m.body_name.len();
         let body_names: Vec<String> = (0..nb)
             .map(|b| {
-                if b == 0 && self.body_name[0].is_empty() {
+                if b == 0 && m.body_name[0].is_empty() {
                     "world".into()
                 } else {
-                    named(&self.body_name[b], "body", b)
+                    named(&m.body_name[b], "body", b)
                 }
             })
             .collect();
-        let joint_names: Vec<String> = (0..self.jnt_name.len())
-            .map(|j| named(&self.jnt_name[j], "joint", j))
+        let joint_names: Vec<String> = (0..m.jnt_name.len())
+            .map(|j| named(&m.jnt_name[j], "joint", j))
             .collect();
         let mut body_joints = alloc::vec![Vec::new(); nb];
-        for (j, &b) in self.jnt_bodyid.iter().enumerate() {
+        for (j, &b) in m.jnt_bodyid.iter().enumerate() {
             body_joints[b].push(j);
         }
-        // Each body's link frame is its body frame moved by its last joint's anchor.
-        let anchor = |b: usize| -> [f64; 3] {
-            body_joints[b]
-                .last()
-                .map_or([0.0; 3], |&j: &usize| self.jnt_pos[j])
+        let (mimic, locked) = m.joint_equalities(&joint_names);
+        Self {
+            m,
+            source,
+            body_names,
+            joint_names,
+            body_joints,
+            mimic,
+            locked,
+            coupled: m.coupled_joints(),
+            links: Vec::with_capacity(nb),
+            joints: Vec::new(),
+        }
+    }
+
+    /// Body `b`'s link frame in its body frame: moved by its last joint's anchor.
+    fn anchor(&self, b: usize) -> [f64; 3] {
+        self.body_joints[b]
+            .last()
+            .map_or([0.0; 3], |&j: &usize| self.m.jnt_pos[j])
+    }
+
+    /// Body `b` as a link (its inertial from its link frame; none for the
+    /// world) and, but for the world, the joints it hangs from its parent
+    /// by: a weld, or its joints in order through links `BODY:jI`.
+    fn body(&mut self, b: usize) -> Result<(), DescriptionError> {
+        let m = self.m;
+        let a = self.anchor(b);
+        let mut link = Link::new(&self.body_names[b]);
+        if b > 0 {
+            let d = m.body_inertia[b];
+            link.inertial = Some(LinkInertial {
+                mass: m.body_mass[b],
+                origin: Origin::PosQuat(shifted(m.body_ipos[b], a), m.body_iquat[b]),
+                inertia: [[d[0], 0.0, 0.0], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]],
+            });
+        }
+        self.links.push(link);
+        if b == 0 {
+            return Ok(());
+        }
+        let p = m.body_parentid[b];
+        let parent = self.body_names[p].clone();
+        // The body's frame in its parent's link frame.
+        let body = Origin::PosQuat(shifted(m.body_pos[b], self.anchor(p)), m.body_quat[b]);
+        let js = self.body_joints[b].clone();
+        if js.is_empty() {
+            self.joints.push(TreeJoint::new(
+                &format!("weld:{}", self.body_names[b]),
+                JointType::Fixed,
+                &parent,
+                &self.body_names[b],
+                body,
+            ));
+            return Ok(());
+        }
+        let mut from = parent;
+        let mut previous = [0.0; 3];
+        for (k, &j) in js.iter().enumerate() {
+            let child = if k + 1 == js.len() {
+                self.body_names[b].clone()
+            } else {
+                let name = format!("{}:{}", self.body_names[b], self.joint_names[j]);
+                self.links.push(Link::new(&name));
+                name
+            };
+            let at = m.jnt_pos[j];
+            let origin = if k == 0 {
+                self.first_joint_origin(b, &body, at)?
+            } else {
+                Origin::XyzRpy(shifted(at, previous), [0.0; 3])
+            };
+            previous = at;
+            let joint = self.joint(j, &from, &child, origin)?;
+            self.joints.push(joint);
+            from = child;
+        }
+        Ok(())
+    }
+
+    /// The origin of body `b`'s first joint, anchored `at` in the body
+    /// whose frame in its parent's link frame is `body`.
+    fn first_joint_origin(
+        &self,
+        b: usize,
+        body: &Origin,
+        at: [f64; 3],
+    ) -> Result<Origin, DescriptionError> {
+        let t = body.transform().map_err(|e| {
+            bad(
+                self.source,
+                format!("body '{}' has a bad orientation: {e}", self.body_names[b]),
+            )
+        })?;
+        let r = nalgebra::Matrix3::from_fn(|i, c| t.rotation[i][c]);
+        let p = Vector3::from(t.translation) + r * Vector3::from(at);
+        Ok(Origin::Matrix(Transform {
+            translation: p.into(),
+            rotation: t.rotation,
+        }))
+    }
+
+    /// Joint `j` from link `from` to `child` at `origin`: its kind (a hinge
+    /// continuous when not limited), and for a movable one its axis, offset,
+    /// limits, effort, drive terms and couplings; locked by an equality, a
+    /// fixed joint at qpos0 + a0.
+    fn joint(
+        &self,
+        j: usize,
+        from: &str,
+        child: &str,
+        origin: Origin,
+    ) -> Result<TreeJoint, DescriptionError> {
+        let m = self.m;
+        let limited = m.jnt_limited[j];
+        let kind = match m.jnt_type[j] {
+            MJ_JOINT_HINGE if limited => JointType::Revolute,
+            MJ_JOINT_HINGE => JointType::Continuous,
+            MJ_JOINT_SLIDE => JointType::Prismatic,
+            MJ_JOINT_BALL => JointType::Ball,
+            MJ_JOINT_FREE => JointType::Floating,
+            other => {
+                return Err(bad(
+                    self.source,
+                    format!(
+                        "joint '{}' has the unknown type {other}",
+                        self.joint_names[j]
+                    ),
+                ))
+            }
         };
-        // Joint equalities: mimics and locks.
+        let mut joint = TreeJoint::new(&self.joint_names[j], kind, from, child, origin);
+        if !kind.is_movable() {
+            return Ok(joint);
+        }
+        joint.axis = m.jnt_axis[j];
+        joint.offset = m.jnt_qpos0[j];
+        if limited && m.jnt_range[j][0] < m.jnt_range[j][1] {
+            joint.lower = m.jnt_range[j][0];
+            joint.upper = m.jnt_range[j][1];
+        } else if kind == JointType::Revolute {
+            joint.kind = JointType::Continuous;
+        }
+        joint.effort = m.effort(j);
+        joint.armature = m.jnt_armature[j];
+        joint.damping = m.jnt_damping[j];
+        joint.friction = m.jnt_frictionloss[j];
+        joint.mimic = self.mimic[j].clone();
+        joint.coupled = self.coupled[j].clone();
+        if let Some(a0) = self.locked[j] {
+            self.lock(&mut joint, j, kind, a0)?;
+        }
+        Ok(joint)
+    }
+
+    /// Joint `j` (of `kind`) locked by an equality: a fixed joint at qpos0 + a0.
+    fn lock(
+        &self,
+        joint: &mut TreeJoint,
+        j: usize,
+        kind: JointType,
+        a0: f64,
+    ) -> Result<(), DescriptionError> {
+        let fail = |e| bad(self.source, format!("joint '{}': {e}", self.joint_names[j]));
+        let t = joint.origin.transform().map_err(fail)?;
+        let f = t.check(j).map_err(fail)?;
+        let axis = Vector3::from(joint.axis);
+        let len = axis.norm();
+        if len > 1e-12 {
+            let m = f.then(&motion(kind == JointType::Prismatic, &(axis / len), a0));
+            joint.origin = Origin::Matrix(Transform::from_parts(m.p, &m.r));
+        }
+        joint.kind = JointType::Fixed;
+        joint.mimic = None;
+        Ok(())
+    }
+
+    /// The sites as named frames on their bodies' links (a force sensor's
+    /// site a tool frame).
+    fn frames(&self) -> Vec<NamedFrame> {
+        let m = self.m;
+        (0..m.site_name.len())
+            .map(|s| {
+                let b = m.site_bodyid[s];
+                NamedFrame {
+                    name: named(&m.site_name[s], "site", s),
+                    link: self.body_names[b].clone(),
+                    origin: Origin::PosQuat(shifted(m.site_pos[s], self.anchor(b)), m.site_quat[s]),
+                    tool: m.force_sites.contains(&s),
+                }
+            })
+            .collect()
+    }
+}
+
+impl MujocoArrays {
+    /// The active joint equalities, per joint: y − y0 = a0 + a1 (x − x0)
+    /// makes y a mimic of x (multiplier a1, offset y0 + a0 − a1 x0); with
+    /// no x, y is locked at a0 from y0.
+    fn joint_equalities(&self, joint_names: &[String]) -> (Vec<Option<Mimic>>, Vec<Option<f64>>) {
         let mut mimic: Vec<Option<Mimic>> = alloc::vec![None; self.jnt_name.len()];
         let mut locked: Vec<Option<f64>> = alloc::vec![None; self.jnt_name.len()];
         for e in 0..self.eq_type.len() {
@@ -378,7 +613,12 @@ impl MujocoArrays {
                 None => locked[y] = Some(d[0]),
             }
         }
-        // Fixed tendons of two or more joints couple them.
+        (mimic, locked)
+    }
+
+    /// Per joint: the fixed tendon of two or more joints that couples it,
+    /// if one does (the last one).
+    fn coupled_joints(&self) -> Vec<Option<String>> {
         let mut coupled: Vec<Option<String>> = alloc::vec![None; self.jnt_name.len()];
         for (t, (name, js)) in self.tendons.iter().enumerate() {
             if js.len() >= 2 {
@@ -389,134 +629,6 @@ impl MujocoArrays {
                 }
             }
         }
-        let mut links = Vec::with_capacity(nb);
-        let mut joints = Vec::new();
-        for b in 0..nb {
-            let a = anchor(b);
-            let mut link = Link::new(&body_names[b]);
-            if b > 0 {
-                let d = self.body_inertia[b];
-                link.inertial = Some(LinkInertial {
-                    mass: self.body_mass[b],
-                    origin: Origin::PosQuat(shifted(self.body_ipos[b], a), self.body_iquat[b]),
-                    inertia: [[d[0], 0.0, 0.0], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]],
-                });
-            }
-            links.push(link);
-            if b == 0 {
-                continue;
-            }
-            let p = self.body_parentid[b];
-            let parent = body_names[p].clone();
-            // The body's frame in its parent's link frame.
-            let body = Origin::PosQuat(shifted(self.body_pos[b], anchor(p)), self.body_quat[b]);
-            let js = &body_joints[b];
-            if js.is_empty() {
-                joints.push(TreeJoint::new(
-                    &format!("weld:{}", body_names[b]),
-                    JointType::Fixed,
-                    &parent,
-                    &body_names[b],
-                    body,
-                ));
-                continue;
-            }
-            let mut from = parent;
-            let mut previous = [0.0; 3];
-            for (k, &j) in js.iter().enumerate() {
-                let child = if k + 1 == js.len() {
-                    body_names[b].clone()
-                } else {
-                    let name = format!("{}:{}", body_names[b], joint_names[j]);
-                    links.push(Link::new(&name));
-                    name
-                };
-                let at = self.jnt_pos[j];
-                let origin = if k == 0 {
-                    let t = body.transform().map_err(|e| {
-                        bad(
-                            source,
-                            format!("body '{}' has a bad orientation: {e}", body_names[b]),
-                        )
-                    })?;
-                    let r = nalgebra::Matrix3::from_fn(|i, c| t.rotation[i][c]);
-                    let p = Vector3::from(t.translation) + r * Vector3::from(at);
-                    Origin::Matrix(Transform {
-                        translation: p.into(),
-                        rotation: t.rotation,
-                    })
-                } else {
-                    Origin::XyzRpy(shifted(at, previous), [0.0; 3])
-                };
-                previous = at;
-                let limited = self.jnt_limited[j];
-                let kind = match self.jnt_type[j] {
-                    MJ_JOINT_HINGE if limited => JointType::Revolute,
-                    MJ_JOINT_HINGE => JointType::Continuous,
-                    MJ_JOINT_SLIDE => JointType::Prismatic,
-                    MJ_JOINT_BALL => JointType::Ball,
-                    MJ_JOINT_FREE => JointType::Floating,
-                    other => {
-                        return Err(bad(
-                            source,
-                            format!("joint '{}' has the unknown type {other}", joint_names[j]),
-                        ))
-                    }
-                };
-                let mut joint = TreeJoint::new(&joint_names[j], kind, &from, &child, origin);
-                if kind.is_movable() {
-                    joint.axis = self.jnt_axis[j];
-                    joint.offset = self.jnt_qpos0[j];
-                    if limited && self.jnt_range[j][0] < self.jnt_range[j][1] {
-                        joint.lower = self.jnt_range[j][0];
-                        joint.upper = self.jnt_range[j][1];
-                    } else if kind == JointType::Revolute {
-                        joint.kind = JointType::Continuous;
-                    }
-                    joint.effort = self.effort(j);
-                    joint.armature = self.jnt_armature[j];
-                    joint.damping = self.jnt_damping[j];
-                    joint.friction = self.jnt_frictionloss[j];
-                    joint.mimic = mimic[j].clone();
-                    joint.coupled = coupled[j].clone();
-                    if let Some(a0) = locked[j] {
-                        // Locked by an equality: a fixed joint at qpos0 + a0.
-                        let t = joint
-                            .origin
-                            .transform()
-                            .map_err(|e| bad(source, format!("joint '{}': {e}", joint_names[j])))?;
-                        let f = t
-                            .check(j)
-                            .map_err(|e| bad(source, format!("joint '{}': {e}", joint_names[j])))?;
-                        let axis = Vector3::from(joint.axis);
-                        let len = axis.norm();
-                        if len > 1e-12 {
-                            let m =
-                                f.then(&motion(kind == JointType::Prismatic, &(axis / len), a0));
-                            joint.origin = Origin::Matrix(Transform::from_parts(m.p, &m.r));
-                        }
-                        joint.kind = JointType::Fixed;
-                        joint.mimic = None;
-                    }
-                }
-                joints.push(joint);
-                from = child;
-            }
-        }
-        let frames = (0..self.site_name.len())
-            .map(|s| {
-                let b = self.site_bodyid[s];
-                NamedFrame {
-                    name: named(&self.site_name[s], "site", s),
-                    link: body_names[b].clone(),
-                    origin: Origin::PosQuat(
-                        shifted(self.site_pos[s], anchor(b)),
-                        self.site_quat[s],
-                    ),
-                    tool: self.force_sites.contains(&s),
-                }
-            })
-            .collect();
-        Tree::new(source, &self.model_name, links, joints, frames)
+        coupled
     }
 }

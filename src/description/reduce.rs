@@ -328,172 +328,19 @@ impl<'t> Reduction<'t> {
 /// `tip`; chains that tie for the arm (legs, two arms) and no `tip`; no
 /// joint left to drive.
 pub fn reduce(tree: &Tree, tip: Option<&str>, fix: &[&str]) -> Result<Arm, DescriptionError> {
-    let joints = tree.joints();
-    let unknown: Vec<&str> = fix
-        .iter()
-        .copied()
-        .filter(|n| tree.joint_index(n).is_none())
-        .collect();
-    if !unknown.is_empty() {
-        let movable = joints
-            .iter()
-            .filter(|j| j.kind.is_movable())
-            .map(|j| j.name.as_str());
-        return Err(arm_error(
-            tree,
-            format!(
-                "fix= names joints it does not have: {}; its movable joints are {}",
-                names_list(unknown.into_iter()),
-                names_list(movable)
-            ),
-        ));
-    }
-    let mut r = Reduction {
-        tree,
-        held: BTreeMap::new(),
-        followers: alloc::vec![Vec::new(); joints.len()],
-    };
-    for (i, j) in joints.iter().enumerate() {
-        if let Some(m) = &j.mimic {
-            if let Some(master) = tree.joint_index(&m.joint) {
-                r.followers[master].push(i);
-            }
-        }
-    }
-    // Held whatever the chain: asked, mimic, more than one coordinate.
-    for (i, j) in joints.iter().enumerate() {
-        let reason = if fix.contains(&j.name.as_str()) {
-            Held::Asked
-        } else if let Some(m) = &j.mimic {
-            Held::Mimic {
-                master: m.joint.clone(),
-            }
-        } else if let Some(by) = &j.coupled {
-            Held::Coupled { by: by.clone() }
-        } else if matches!(
-            j.kind,
-            JointType::Floating | JointType::Planar | JointType::Ball
-        ) {
-            Held::Free { kind: j.kind }
-        } else {
-            continue;
-        };
-        if j.kind != JointType::Fixed {
-            r.held.insert(i, reason);
-        }
-    }
-    // Without a tip, a tool frame (where a force sensor measures) that a
-    // revolute joint not held moves is the tip.
-    let moved = |link: &str| {
-        tree.link_index(link).is_some_and(|l| {
-            tree.path_to(l).into_iter().any(|j| {
-                matches!(joints[j].kind, JointType::Revolute | JointType::Continuous)
-                    && !r.held.contains_key(&j)
-            })
-        })
-    };
-    let tool = tree
-        .frames()
-        .iter()
-        .find(|f| f.tool && moved(&f.link))
-        .map(|f| f.name.as_str());
-    let tip = tip.or(tool);
-    let (tip_link, tip_frame) = match tip {
-        None => (None, None),
-        Some(name) => {
-            // A frame first (a MuJoCo site and a body may share a name).
-            if let Some(f) = tree.frame_index(name) {
-                let link = tree.link_index(&tree.frames()[f].link);
-                (link, Some(f))
-            } else if let Some(l) = tree.link_index(name) {
-                (Some(l), None)
-            } else {
-                return Err(arm_error(
-                    tree,
-                    format!(
-                        "tip= '{name}' is neither a link nor a frame of it: name the link (a \
-                         MuJoCo body) or the frame (a site) that ends the arm"
-                    ),
-                ));
-            }
-        }
-    };
+    check_fix(tree, fix)?;
+    let mut r = Reduction::new(tree);
+    r.hold_always(fix);
+    let tip = tip.or(r.tool_frame());
+    let (tip_link, tip_frame) = resolve_tip(tree, tip)?;
     let (base, arm, tip_name) = match tip_link {
         Some(l) => {
-            let path = tree.path_to(l);
-            for &j in &path {
-                let kind = joints[j].kind;
-                if matches!(
-                    kind,
-                    JointType::Floating | JointType::Planar | JointType::Ball
-                ) && !fix.contains(&joints[j].name.as_str())
-                {
-                    return Err(arm_error(
-                        tree,
-                        format!(
-                            "the joint '{}' on the way to '{}' is {}: a chain has revolute, \
-                             continuous, prismatic and fixed joints only; give a tip below it \
-                             or fix it with fix=",
-                            joints[j].name,
-                            tip.unwrap_or_default(),
-                            kind.urdf_name()
-                        ),
-                    ));
-                }
-            }
-            let arm: Vec<usize> = path
-                .into_iter()
-                .filter(|&j| joints[j].kind.is_movable() && !r.held.contains_key(&j))
-                .collect();
-            let mut on_arm = alloc::vec![false; joints.len()];
-            for &j in &arm {
-                on_arm[j] = true;
-            }
-            let tip_name = tip.unwrap_or_default().to_string();
-            for (i, j) in joints.iter().enumerate() {
-                if j.kind != JointType::Fixed && !on_arm[i] && !r.held.contains_key(&i) {
-                    r.held.insert(
-                        i,
-                        Held::OffPath {
-                            tip: tip_name.clone(),
-                        },
-                    );
-                }
-            }
-            if arm.is_empty() {
-                return Err(arm_error(
-                    tree,
-                    format!(
-                        "there is no revolute, continuous or prismatic joint to drive on the way \
-                         to '{tip_name}'{}: name a tip further out",
-                        held_summary(tree, &r.held, &[])
-                    ),
-                ));
-            }
-            (tree.root_of(l), arm, tip_name)
+            let tip_name = tip.unwrap_or_default();
+            let arm = r.path_to_tip(l, tip_name, fix)?;
+            (tree.root_of(l), arm, tip_name.to_string())
         }
         None => {
-            let roots = tree.roots();
-            let root = match roots.as_slice() {
-                [root] => *root,
-                [] => {
-                    return Err(arm_error(
-                        tree,
-                        "it has no links: it describes no robot".into(),
-                    ))
-                }
-                _ => {
-                    return Err(arm_error(
-                        tree,
-                        format!(
-                            "it has {} root links {}: a robot has one; name the arm's last link \
-                             with tip=",
-                            roots.len(),
-                            names_list(roots.iter().map(|&l| tree.links()[l].name.as_str()))
-                        ),
-                    ))
-                }
-            };
+            let root = single_root(tree)?;
             let arm = find_chain(&mut r, root)?;
             let last = arm[arm.len() - 1];
             let tip_name = tree.links()[tree.joint_links(last).1].name.clone();
@@ -501,6 +348,215 @@ pub fn reduce(tree: &Tree, tip: Option<&str>, fix: &[&str]) -> Result<Arm, Descr
         }
     };
     build(&r, base, arm, tip_name, tip_link, tip_frame)
+}
+
+/// Every joint `fix` names is the tree's; else an error listing the unknown
+/// names and the movable joints there are.
+fn check_fix(tree: &Tree, fix: &[&str]) -> Result<(), DescriptionError> {
+    let unknown: Vec<&str> = fix
+        .iter()
+        .copied()
+        .filter(|n| tree.joint_index(n).is_none())
+        .collect();
+    if unknown.is_empty() {
+        return Ok(());
+    }
+    let movable = tree
+        .joints()
+        .iter()
+        .filter(|j| j.kind.is_movable())
+        .map(|j| j.name.as_str());
+    Err(arm_error(
+        tree,
+        format!(
+            "fix= names joints it does not have: {}; its movable joints are {}",
+            names_list(unknown.into_iter()),
+            names_list(movable)
+        ),
+    ))
+}
+
+/// The link and the frame `tip` names (rule 2 of (21.2)): a frame first (a
+/// MuJoCo site and a body may share a name), else a link; (None, None)
+/// without a tip.
+fn resolve_tip(
+    tree: &Tree,
+    tip: Option<&str>,
+) -> Result<(Option<usize>, Option<usize>), DescriptionError> {
+    let Some(name) = tip else {
+        return Ok((None, None));
+    };
+    if let Some(f) = tree.frame_index(name) {
+        Ok((tree.link_index(&tree.frames()[f].link), Some(f)))
+    } else if let Some(l) = tree.link_index(name) {
+        Ok((Some(l), None))
+    } else {
+        Err(arm_error(
+            tree,
+            format!(
+                "tip= '{name}' is neither a link nor a frame of it: name the link (a \
+                 MuJoCo body) or the frame (a site) that ends the arm"
+            ),
+        ))
+    }
+}
+
+/// The one root link the arm is found from without a tip (rule 3 of
+/// (21.2)); an error when the tree has none or several.
+fn single_root(tree: &Tree) -> Result<usize, DescriptionError> {
+    let roots = tree.roots();
+    match roots.as_slice() {
+        [root] => Ok(*root),
+        [] => Err(arm_error(
+            tree,
+            "it has no links: it describes no robot".into(),
+        )),
+        _ => Err(arm_error(
+            tree,
+            format!(
+                "it has {} root links {}: a robot has one; name the arm's last link \
+                 with tip=",
+                roots.len(),
+                names_list(roots.iter().map(|&l| tree.links()[l].name.as_str()))
+            ),
+        )),
+    }
+}
+
+impl<'t> Reduction<'t> {
+    /// A reduction of `tree` holding nothing yet, with each joint's mimics.
+    fn new(tree: &'t Tree) -> Self {
+        let joints = tree.joints();
+        let mut followers = alloc::vec![Vec::new(); joints.len()];
+        for (i, j) in joints.iter().enumerate() {
+            if let Some(m) = &j.mimic {
+                if let Some(master) = tree.joint_index(&m.joint) {
+                    followers[master].push(i);
+                }
+            }
+        }
+        Self {
+            tree,
+            held: BTreeMap::new(),
+            followers,
+        }
+    }
+
+    /// Rule 1 of (21.2): hold what is held whatever the chain: asked,
+    /// mimic, coupled, more than one coordinate.
+    fn hold_always(&mut self, fix: &[&str]) {
+        for (i, j) in self.tree.joints().iter().enumerate() {
+            let reason = if fix.contains(&j.name.as_str()) {
+                Held::Asked
+            } else if let Some(m) = &j.mimic {
+                Held::Mimic {
+                    master: m.joint.clone(),
+                }
+            } else if let Some(by) = &j.coupled {
+                Held::Coupled { by: by.clone() }
+            } else if matches!(
+                j.kind,
+                JointType::Floating | JointType::Planar | JointType::Ball
+            ) {
+                Held::Free { kind: j.kind }
+            } else {
+                continue;
+            };
+            if j.kind != JointType::Fixed {
+                self.held.insert(i, reason);
+            }
+        }
+    }
+
+    /// The tip when none is asked for (rule 2 of (21.2)): the first tool
+    /// frame (where a force sensor measures) that a revolute joint not held
+    /// moves.
+    fn tool_frame(&self) -> Option<&'t str> {
+        let tree = self.tree;
+        let moved = |link: &str| {
+            tree.link_index(link).is_some_and(|l| {
+                tree.path_to(l).into_iter().any(|j| {
+                    matches!(
+                        tree.joints()[j].kind,
+                        JointType::Revolute | JointType::Continuous
+                    ) && !self.held.contains_key(&j)
+                })
+            })
+        };
+        tree.frames()
+            .iter()
+            .find(|f| f.tool && moved(&f.link))
+            .map(|f| f.name.as_str())
+    }
+
+    /// Rule 2 of (21.2), the arm to the tip's link `l`: the movable joints
+    /// on the way not held; every other joint held as not on the way to
+    /// `tip`. Errors: a floating, planar or ball joint on the way that
+    /// `fix` does not name; no joint left to drive.
+    fn path_to_tip(
+        &mut self,
+        l: usize,
+        tip: &str,
+        fix: &[&str],
+    ) -> Result<Vec<usize>, DescriptionError> {
+        let tree = self.tree;
+        let joints = tree.joints();
+        let path = tree.path_to(l);
+        for &j in &path {
+            let kind = joints[j].kind;
+            if matches!(
+                kind,
+                JointType::Floating | JointType::Planar | JointType::Ball
+            ) && !fix.contains(&joints[j].name.as_str())
+            {
+                return Err(arm_error(
+                    tree,
+                    format!(
+                        "the joint '{}' on the way to '{tip}' is {}: a chain has revolute, \
+                         continuous, prismatic and fixed joints only; give a tip below it \
+                         or fix it with fix=",
+                        joints[j].name,
+                        kind.urdf_name()
+                    ),
+                ));
+            }
+        }
+        let arm: Vec<usize> = path
+            .into_iter()
+            .filter(|&j| joints[j].kind.is_movable() && !self.held.contains_key(&j))
+            .collect();
+        let on_arm = on_arm(joints.len(), &arm);
+        for (i, j) in joints.iter().enumerate() {
+            if j.kind != JointType::Fixed && !on_arm[i] && !self.held.contains_key(&i) {
+                self.held.insert(
+                    i,
+                    Held::OffPath {
+                        tip: tip.to_string(),
+                    },
+                );
+            }
+        }
+        if arm.is_empty() {
+            return Err(arm_error(
+                tree,
+                format!(
+                    "there is no revolute, continuous or prismatic joint to drive on the way \
+                     to '{tip}'{}: name a tip further out",
+                    held_summary(tree, &self.held, &[])
+                ),
+            ));
+        }
+        Ok(arm)
+    }
+}
+
+/// Per joint of a tree of `n`: whether it is one of `arm`'s.
+fn on_arm(n: usize, arm: &[usize]) -> Vec<bool> {
+    let mut on_arm = alloc::vec![false; n];
+    for &j in arm {
+        on_arm[j] = true;
+    }
+    on_arm
 }
 
 /// " (held: 'a' (why), …)" for messages, or "" when nothing is held.
@@ -519,108 +575,35 @@ fn held_summary(tree: &Tree, held: &BTreeMap<usize, Held>, skip: &[usize]) -> St
     out
 }
 
+/// What hangs below each link of the tree (bottom up, [`Reduction::below`]).
+struct Below {
+    /// The longest run of joints with a coordinate below the link (the
+    /// structure: mimic, prismatic and held ones count).
+    depth: Vec<usize>,
+    /// Whether a frame hangs anywhere below it.
+    frame: Vec<bool>,
+    /// Whether a movable joint that mimics nothing does.
+    driven: Vec<bool>,
+}
+
+/// The longest chains of drivable joints below each link, found bottom up
+/// ([`Reduction::longest`]).
+struct Longest {
+    /// Whether the link is a hand (rule 4 of (21.2)): the arm ends there.
+    hand: Vec<bool>,
+    /// Per link: the length of the longest chains below it and the last
+    /// joint of each.
+    best: Vec<(usize, Vec<usize>)>,
+}
+
 /// The arm found by the rule of (21.2) from `root`: the joints of the
 /// longest chain, base to tip. Marks what it holds in `r.held`.
 fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, DescriptionError> {
     let tree = r.tree;
-    let joints = tree.joints();
-    let nl = tree.links().len();
     let order = r.order(root);
-    // Bottom up: the longest run of joints with a coordinate below each link
-    // (the structure: mimic, prismatic and held ones count), whether a
-    // frame hangs anywhere below it, whether a movable joint that mimics
-    // nothing does.
-    let mut depth = alloc::vec![0usize; nl];
-    let mut frame_below = alloc::vec![false; nl];
-    let mut driven_below = alloc::vec![false; nl];
-    for &l in order.iter().rev() {
-        frame_below[l] = !tree.link_frames(l).is_empty() || r.is_frame_link(l);
-        for &j in tree.child_joints(l) {
-            let c = tree.joint_links(j).1;
-            let own = usize::from(joints[j].kind.is_movable());
-            depth[l] = depth[l].max(own + depth[c]);
-            frame_below[l] |= frame_below[c];
-            driven_below[l] |= driven_below[c] || (own == 1 && joints[j].mimic.is_none());
-        }
-    }
-    // Top down: the arm's joints held so far above each link, and whether one
-    // of them is an arm's (not a gripper's); the gripper rules mark joints.
-    let mut above = alloc::vec![0usize; nl];
-    let mut arm_above = alloc::vec![false; nl];
-    // Per link, the tool frame beside its joints (looked for once).
-    let mut beside: Vec<Option<Option<String>>> = alloc::vec![None; nl];
-    for &l in &order {
-        for &j in tree.child_joints(l) {
-            let c = tree.joint_links(j).1;
-            let word = gripper_word(&joints[j].name);
-            if arm_above[l] && r.drivable(j) {
-                let reason = if !r.followers[j].is_empty() && !driven_below[c] {
-                    Some(Held::GripperDrive {
-                        followers: r.followers[j]
-                            .iter()
-                            .map(|&f| joints[f].name.clone())
-                            .collect(),
-                    })
-                } else if let Some(frame) = (!frame_below[c])
-                    .then(|| beside[l].get_or_insert_with(|| r.frame_beside(l)).clone())
-                    .flatten()
-                {
-                    Some(Held::Jaw { frame })
-                } else {
-                    word.map(|word| Held::Named { word })
-                };
-                if let Some(reason) = reason {
-                    r.held.insert(j, reason);
-                }
-            }
-            let own = usize::from(r.drivable(j));
-            above[c] = above[l] + own;
-            arm_above[c] = arm_above[l] || (own == 1 && word.is_none());
-        }
-    }
-    // Bottom up again: per link, the length of the longest chains below it
-    // and the last joint of each; a hand ends the arm.
-    let mut hand = alloc::vec![false; nl];
-    let mut best = alloc::vec![(0usize, Vec::<usize>::new()); nl];
-    for &l in order.iter().rev() {
-        let branches: Vec<usize> = tree
-            .child_joints(l)
-            .iter()
-            .map(|&j| usize::from(joints[j].kind.is_movable()) + depth[tree.joint_links(j).1])
-            .filter(|&d| d > 0)
-            .collect();
-        // A hand: two or more branches each shorter than the arm that holds
-        // them, or three or more (fingers) none longer.
-        let shorter = branches.len() >= 2 && branches.iter().all(|&d| d < above[l]);
-        let fingers = branches.len() >= 3 && branches.iter().all(|&d| d <= above[l]);
-        if above[l] > 0 && (shorter || fingers) {
-            hand[l] = true;
-            continue;
-        }
-        let (mut len, mut ends) = (0usize, Vec::new());
-        for &j in tree.child_joints(l) {
-            let c = tree.joint_links(j).1;
-            let own = usize::from(r.drivable(j));
-            let (below, below_ends) = &best[c];
-            let this = below + own;
-            let these = if *below == 0 {
-                if own == 1 {
-                    alloc::vec![j]
-                } else {
-                    Vec::new()
-                }
-            } else {
-                below_ends.clone()
-            };
-            if this > len {
-                len = this;
-                ends = these;
-            } else if this == len && this > 0 {
-                ends.extend(these);
-            }
-        }
-        best[l] = (len, ends);
-    }
+    let below = r.below(&order);
+    let above = r.hold_grippers(&order, &below);
+    let Longest { hand, mut best } = r.longest(&order, &below.depth, &above);
     let (len, ends) = core::mem::take(&mut best[root]);
     if len == 0 {
         return Err(arm_error(
@@ -653,34 +636,168 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
         .into_iter()
         .filter(|&j| r.drivable(j))
         .collect();
-    // Everything else with a coordinate: in a hand (the nearest hand link
-    // at or above its parent), prismatic, or off the chain.
-    let mut in_hand: Vec<Option<usize>> = alloc::vec![None; nl];
-    for &l in &order {
-        let here = if hand[l] { Some(l) } else { in_hand[l] };
-        in_hand[l] = here;
-        for &j in tree.child_joints(l) {
-            in_hand[tree.joint_links(j).1] = here;
-        }
-    }
-    let mut on_arm = alloc::vec![false; joints.len()];
-    for &j in &arm {
-        on_arm[j] = true;
-    }
-    for (i, j) in joints.iter().enumerate() {
-        if j.kind == JointType::Fixed || on_arm[i] || r.held.contains_key(&i) {
-            continue;
-        }
-        let reason = match in_hand[tree.joint_links(i).0] {
-            Some(l) => Held::Hand {
-                link: tree.links()[l].name.clone(),
-            },
-            None if j.kind == JointType::Prismatic => Held::Prismatic,
-            None => Held::OffChain,
-        };
-        r.held.insert(i, reason);
-    }
+    r.hold_rest(&order, &hand, &arm);
     Ok(arm)
+}
+
+impl Reduction<'_> {
+    /// Bottom up over `order` (parents before children): what hangs below
+    /// each link, the structure rules 4 and 5 of (21.2) read.
+    fn below(&self, order: &[usize]) -> Below {
+        let tree = self.tree;
+        let joints = tree.joints();
+        let nl = tree.links().len();
+        let mut depth = alloc::vec![0usize; nl];
+        let mut frame_below = alloc::vec![false; nl];
+        let mut driven_below = alloc::vec![false; nl];
+        for &l in order.iter().rev() {
+            frame_below[l] = !tree.link_frames(l).is_empty() || self.is_frame_link(l);
+            for &j in tree.child_joints(l) {
+                let c = tree.joint_links(j).1;
+                let own = usize::from(joints[j].kind.is_movable());
+                depth[l] = depth[l].max(own + depth[c]);
+                frame_below[l] |= frame_below[c];
+                driven_below[l] |= driven_below[c] || (own == 1 && joints[j].mimic.is_none());
+            }
+        }
+        Below {
+            depth,
+            frame: frame_below,
+            driven: driven_below,
+        }
+    }
+
+    /// Rule 5 of (21.2), top down over `order`: hold a gripper's joints
+    /// below an arm joint that is not a gripper's (a drive others mimic, a
+    /// jaw beside a tool frame, a gripper's name). Returns per link the
+    /// number of drivable joints above it.
+    fn hold_grippers(&mut self, order: &[usize], below: &Below) -> Vec<usize> {
+        let tree = self.tree;
+        let joints = tree.joints();
+        let nl = tree.links().len();
+        // The arm's joints held so far above each link, and whether one of
+        // them is an arm's (not a gripper's).
+        let mut above = alloc::vec![0usize; nl];
+        let mut arm_above = alloc::vec![false; nl];
+        // Per link, the tool frame beside its joints (looked for once).
+        let mut beside: Vec<Option<Option<String>>> = alloc::vec![None; nl];
+        for &l in order {
+            for &j in tree.child_joints(l) {
+                let c = tree.joint_links(j).1;
+                let word = gripper_word(&joints[j].name);
+                if arm_above[l] && self.drivable(j) {
+                    let reason = if !self.followers[j].is_empty() && !below.driven[c] {
+                        Some(Held::GripperDrive {
+                            followers: self.followers[j]
+                                .iter()
+                                .map(|&f| joints[f].name.clone())
+                                .collect(),
+                        })
+                    } else if let Some(frame) = (!below.frame[c])
+                        .then(|| {
+                            beside[l]
+                                .get_or_insert_with(|| self.frame_beside(l))
+                                .clone()
+                        })
+                        .flatten()
+                    {
+                        Some(Held::Jaw { frame })
+                    } else {
+                        word.map(|word| Held::Named { word })
+                    };
+                    if let Some(reason) = reason {
+                        self.held.insert(j, reason);
+                    }
+                }
+                let own = usize::from(self.drivable(j));
+                above[c] = above[l] + own;
+                arm_above[c] = arm_above[l] || (own == 1 && word.is_none());
+            }
+        }
+        above
+    }
+
+    /// Rules 3, 4 and 6 of (21.2), bottom up over `order`: per link the
+    /// longest chains of drivable joints below it and where each ends; a
+    /// hand (branches shorter than the `above` arm that holds them) ends
+    /// the arm.
+    fn longest(&self, order: &[usize], depth: &[usize], above: &[usize]) -> Longest {
+        let tree = self.tree;
+        let joints = tree.joints();
+        let nl = tree.links().len();
+        let mut hand = alloc::vec![false; nl];
+        let mut best = alloc::vec![(0usize, Vec::<usize>::new()); nl];
+        for &l in order.iter().rev() {
+            let branches: Vec<usize> = tree
+                .child_joints(l)
+                .iter()
+                .map(|&j| usize::from(joints[j].kind.is_movable()) + depth[tree.joint_links(j).1])
+                .filter(|&d| d > 0)
+                .collect();
+            // A hand: two or more branches each shorter than the arm that holds
+            // them, or three or more (fingers) none longer.
+            let shorter = branches.len() >= 2 && branches.iter().all(|&d| d < above[l]);
+            let fingers = branches.len() >= 3 && branches.iter().all(|&d| d <= above[l]);
+            if above[l] > 0 && (shorter || fingers) {
+                hand[l] = true;
+                continue;
+            }
+            let (mut len, mut ends) = (0usize, Vec::new());
+            for &j in tree.child_joints(l) {
+                let c = tree.joint_links(j).1;
+                let own = usize::from(self.drivable(j));
+                let (below, below_ends) = &best[c];
+                let this = below + own;
+                let these = if *below == 0 {
+                    if own == 1 {
+                        alloc::vec![j]
+                    } else {
+                        Vec::new()
+                    }
+                } else {
+                    below_ends.clone()
+                };
+                if this > len {
+                    len = this;
+                    ends = these;
+                } else if this == len && this > 0 {
+                    ends.extend(these);
+                }
+            }
+            best[l] = (len, ends);
+        }
+        Longest { hand, best }
+    }
+
+    /// Rule 6 of (21.2): hold every other joint with a coordinate, in a
+    /// hand (the nearest hand link at or above its parent), prismatic, or
+    /// off the chain.
+    fn hold_rest(&mut self, order: &[usize], hand: &[bool], arm: &[usize]) {
+        let tree = self.tree;
+        let joints = tree.joints();
+        let mut in_hand: Vec<Option<usize>> = alloc::vec![None; tree.links().len()];
+        for &l in order {
+            let here = if hand[l] { Some(l) } else { in_hand[l] };
+            in_hand[l] = here;
+            for &j in tree.child_joints(l) {
+                in_hand[tree.joint_links(j).1] = here;
+            }
+        }
+        let on_arm = on_arm(joints.len(), arm);
+        for (i, j) in joints.iter().enumerate() {
+            if j.kind == JointType::Fixed || on_arm[i] || self.held.contains_key(&i) {
+                continue;
+            }
+            let reason = match in_hand[tree.joint_links(i).0] {
+                Some(l) => Held::Hand {
+                    link: tree.links()[l].name.clone(),
+                },
+                None if j.kind == JointType::Prismatic => Held::Prismatic,
+                None => Held::OffChain,
+            };
+            self.held.insert(i, reason);
+        }
+    }
 }
 
 /// The value joint `j` is held at: its offset, or for a mimic joint the
@@ -733,65 +850,72 @@ fn joint_frame(tree: &Tree, j: usize, value: f64) -> Result<Frame, DescriptionEr
     )))
 }
 
-fn build(
-    r: &Reduction<'_>,
-    base: usize,
-    arm: Vec<usize>,
-    tip_name: String,
-    tip_link: Option<usize>,
-    tip_frame: Option<usize>,
-) -> Result<Arm, DescriptionError> {
-    let tree = r.tree;
-    let joints = tree.joints();
-    let last_link = tree.joint_links(arm[arm.len() - 1]).1;
-    let tip_link = tip_link.unwrap_or(last_link);
-    let mut on_arm = alloc::vec![false; joints.len()];
-    for &j in &arm {
-        on_arm[j] = true;
-    }
-    let is_arm = |j: usize| on_arm[j];
-    let value = |j: usize| {
-        if is_arm(j) {
-            joints[j].offset
+/// The arm's joints on the tree, for folding what is not the arm's into
+/// what is (the chain and bodies of [`build`]).
+struct Fold<'t> {
+    tree: &'t Tree,
+    /// Per joint: whether it is an arm joint.
+    on_arm: Vec<bool>,
+}
+
+impl Fold<'_> {
+    /// The value joint `j` is folded at: an arm joint's offset, a held
+    /// joint's held value.
+    fn value(&self, j: usize) -> f64 {
+        if self.on_arm[j] {
+            self.tree.joints()[j].offset
         } else {
-            held_value(tree, j)
-        }
-    };
-    // The chain: fixed and held joints fold into the next arm joint's origin.
-    let mut chain = Vec::with_capacity(arm.len());
-    let mut pending = Frame::IDENTITY;
-    for j in tree.path_to(tip_link) {
-        if is_arm(j) {
-            let origin = pending.then(&joint_frame(tree, j, joints[j].offset)?);
-            let joint = &joints[j];
-            chain.push(Joint {
-                kind: if joint.kind == JointType::Prismatic {
-                    JointKind::Prismatic
-                } else {
-                    JointKind::Revolute
-                },
-                origin: Transform::from_parts(origin.p, &origin.r),
-                axis: joint.axis,
-                offset: joint.offset,
-            });
-            pending = Frame::IDENTITY;
-        } else {
-            pending = pending.then(&joint_frame(tree, j, value(j))?);
+            held_value(self.tree, j)
         }
     }
-    if let Some(f) = tip_frame {
-        let t = tree.frames()[f]
-            .origin
-            .transform()
-            .and_then(|t| t.check(0))
-            .map_err(|e| config(tree, e))?;
-        pending = pending.then(&t);
+
+    /// The chain to `tip_link` (SPEC §16): fixed and held joints fold into
+    /// the next arm joint's origin; what is left after the last one, and
+    /// the frame `tip_frame`, is the tip's origin.
+    fn chain(
+        &self,
+        tip_link: usize,
+        tip_frame: Option<usize>,
+    ) -> Result<(Vec<Joint>, Transform), DescriptionError> {
+        let tree = self.tree;
+        let joints = tree.joints();
+        let mut chain = Vec::new();
+        let mut pending = Frame::IDENTITY;
+        for j in tree.path_to(tip_link) {
+            if self.on_arm[j] {
+                let origin = pending.then(&joint_frame(tree, j, joints[j].offset)?);
+                let joint = &joints[j];
+                chain.push(Joint {
+                    kind: if joint.kind == JointType::Prismatic {
+                        JointKind::Prismatic
+                    } else {
+                        JointKind::Revolute
+                    },
+                    origin: Transform::from_parts(origin.p, &origin.r),
+                    axis: joint.axis,
+                    offset: joint.offset,
+                });
+                pending = Frame::IDENTITY;
+            } else {
+                pending = pending.then(&joint_frame(tree, j, self.value(j))?);
+            }
+        }
+        if let Some(f) = tip_frame {
+            let t = tree.frames()[f]
+                .origin
+                .transform()
+                .and_then(|t| t.check(0))
+                .map_err(|e| config(tree, e))?;
+            pending = pending.then(&t);
+        }
+        Ok((chain, Transform::from_parts(pending.p, &pending.r)))
     }
-    let tip_origin = Transform::from_parts(pending.p, &pending.r);
-    // The body of each arm joint: its child link and every link it carries
-    // through joints that are not the arm's.
-    let mut inertials = Vec::with_capacity(arm.len());
-    for &a in &arm {
+
+    /// The body arm joint `a` moves (SPEC (20.1)): its child link and every
+    /// link it carries through joints that are not the arm's, as one
+    /// inertial in the joint's frame.
+    fn body(&self, a: usize) -> Result<Inertial, DescriptionError> {
+        let tree = self.tree;
         let start = tree.joint_links(a).1;
         let (mut m, mut h, mut io) = (0.0, Vector3::zeros(), Matrix3::zeros());
         let mut todo = VecDeque::from([(start, Frame::IDENTITY)]);
@@ -812,8 +936,8 @@ fn build(
                     + mass * (Matrix3::identity() * c.norm_squared() - c * c.transpose());
             }
             for &j in tree.child_joints(l) {
-                if !is_arm(j) {
-                    let next = at.then(&joint_frame(tree, j, value(j))?);
+                if !self.on_arm[j] {
+                    let next = at.then(&joint_frame(tree, j, self.value(j))?);
                     todo.push_back((tree.joint_links(j).1, next));
                 }
             }
@@ -821,47 +945,71 @@ fn build(
         let com = if m > 0.0 { h / m } else { Vector3::zeros() };
         let ic = io - m * (Matrix3::identity() * com.norm_squared() - com * com.transpose());
         let ic = (ic + ic.transpose()) * 0.5;
-        inertials.push(Inertial {
+        Ok(Inertial {
             mass: m,
             origin: Transform {
                 translation: com.into(),
                 ..Transform::IDENTITY
             },
             inertia: core::array::from_fn(|i| core::array::from_fn(|k| ic[(i, k)])),
-        });
-    }
-    let arm_joints = arm
-        .iter()
-        .map(|&j| {
-            let joint = &joints[j];
-            let unlimited = joint.kind == JointType::Continuous;
-            ArmJoint {
-                name: joint.name.clone(),
-                index: j,
-                prismatic: joint.kind == JointType::Prismatic,
-                lower: if unlimited {
-                    f64::NEG_INFINITY
-                } else {
-                    joint.lower
-                },
-                upper: if unlimited {
-                    f64::INFINITY
-                } else {
-                    joint.upper
-                },
-                effort: joint.effort,
-                velocity: joint.velocity,
-                armature: joint.armature,
-                damping: joint.damping,
-                friction: joint.friction,
-            }
         })
-        .collect();
+    }
+}
+
+/// Joint `j` of the tree as an arm joint: its limits (±∞ when continuous),
+/// effort, velocity and drive terms.
+fn arm_joint(tree: &Tree, j: usize) -> ArmJoint {
+    let joint = &tree.joints()[j];
+    let unlimited = joint.kind == JointType::Continuous;
+    ArmJoint {
+        name: joint.name.clone(),
+        index: j,
+        prismatic: joint.kind == JointType::Prismatic,
+        lower: if unlimited {
+            f64::NEG_INFINITY
+        } else {
+            joint.lower
+        },
+        upper: if unlimited {
+            f64::INFINITY
+        } else {
+            joint.upper
+        },
+        effort: joint.effort,
+        velocity: joint.velocity,
+        armature: joint.armature,
+        damping: joint.damping,
+        friction: joint.friction,
+    }
+}
+
+/// The [`Arm`] of the reduction `r` (the end of SPEC (21.2)): the arm
+/// joints `arm` from `base` to the tip, their chain and bodies, and every
+/// held joint with its value and reason.
+fn build(
+    r: &Reduction<'_>,
+    base: usize,
+    arm: Vec<usize>,
+    tip_name: String,
+    tip_link: Option<usize>,
+    tip_frame: Option<usize>,
+) -> Result<Arm, DescriptionError> {
+    let tree = r.tree;
+    let last_link = tree.joint_links(arm[arm.len() - 1]).1;
+    let fold = Fold {
+        tree,
+        on_arm: on_arm(tree.joints().len(), &arm),
+    };
+    let (chain, tip_origin) = fold.chain(tip_link.unwrap_or(last_link), tip_frame)?;
+    let inertials = arm
+        .iter()
+        .map(|&a| fold.body(a))
+        .collect::<Result<Vec<_>, _>>()?;
     let held = r
         .held
         .iter()
         .map(|(&j, why)| HeldJoint {
-            name: joints[j].name.clone(),
+            name: tree.joints()[j].name.clone(),
             index: j,
             value: held_value(tree, j),
             reason: why.clone(),
@@ -872,7 +1020,7 @@ fn build(
         base: tree.links()[base].name.clone(),
         tip: tip_name,
         tip_is_frame: tip_frame.is_some(),
-        joints: arm_joints,
+        joints: arm.iter().map(|&j| arm_joint(tree, j)).collect(),
         held,
         chain,
         tip_origin,

@@ -19,7 +19,7 @@
 //! urdf-rs would refuse is no reason to refuse an arm), then by urdf-rs.
 
 use super::error::{DescriptionError, ErrorKind};
-use super::reduce::Arm;
+use super::reduce::{Arm, ArmJoint};
 use super::tree::{JointType, Link, LinkInertial, Mimic, Origin, Tree, TreeJoint};
 use std::fmt::Write as _;
 use std::format;
@@ -121,55 +121,106 @@ fn xacro_markup(root: &xml::Element) -> Option<String> {
 }
 
 fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError> {
-    let file = if shown.starts_with("the ") || shown.starts_with("xacro ") {
-        "FILE.xacro"
-    } else {
-        shown
-    };
-    let xacro = |what: &str| {
+    let errors = ReadErrors { source, shown };
+    let mut root = errors.robot_root(text)?;
+    strip_for_arm(&mut root);
+    let robot = errors.parse_root(&root)?;
+    tree_of(&robot, source, &with_inertial(&root))
+}
+
+/// The errors of one reading, naming `source` (the label of later
+/// messages) and `shown` (the path or text as the user gave it).
+struct ReadErrors<'a> {
+    source: &'a str,
+    shown: &'a str,
+}
+
+impl ReadErrors<'_> {
+    /// Xacro markup (`what`), with the command that expands it.
+    fn xacro(&self, what: &str) -> DescriptionError {
+        let shown = self.shown;
+        let file = if shown.starts_with("the ") || shown.starts_with("xacro ") {
+            "FILE.xacro"
+        } else {
+            shown
+        };
         DescriptionError::new(
             ErrorKind::Xacro,
             format!(
-                "{source} is xacro, not a URDF (it has {what}): expand it into a URDF first \
-                 with `xacro {file} -o robot.urdf` (the xacro package: pip install xacro)"
+                "{} is xacro, not a URDF (it has {what}): expand it into a URDF first \
+                 with `xacro {file} -o robot.urdf` (the xacro package: pip install xacro)",
+                self.source
             ),
         )
-    };
-    let parse_error = |e: &str| {
+    }
+
+    /// Not a URDF the parser reads: `e`, and where the format is described.
+    fn parse_error(&self, e: &str) -> DescriptionError {
         DescriptionError::new(
             ErrorKind::Parse,
             format!(
-                "cannot read {shown} as a URDF: {e}; correct it against the URDF format \
-                 (http://wiki.ros.org/urdf/XML)"
+                "cannot read {} as a URDF: {e}; correct it against the URDF format \
+                 (http://wiki.ros.org/urdf/XML)",
+                self.shown
             ),
         )
-    };
-    let mut root = match document(text) {
-        Ok(root) => root,
-        Err(_) if text.contains("<xacro:") => return Err(xacro("xacro elements <xacro:…>")),
-        Err(e) => return Err(parse_error(&format!("it is not XML ({e})"))),
-    };
-    if root.name == "mujoco" {
-        return Err(DescriptionError::new(
-            ErrorKind::Parse,
-            format!(
-                "{shown} is an MJCF (its root element is <mujoco>), not a URDF: read it \
-                 through MuJoCo's compiler (Python: give its path to adaptimp, which compiles it)"
-            ),
-        ));
     }
-    if root.name != "robot" {
-        return Err(parse_error(&format!(
-            "its root element is <{}>, not <robot>",
-            root.name
-        )));
+
+    /// The document's root element, a `<robot>` without xacro markup:
+    /// else not XML, an MJCF, another root, or xacro (in that order).
+    fn robot_root(&self, text: &str) -> Result<xml::Element, DescriptionError> {
+        let root = match document(text) {
+            Ok(root) => root,
+            Err(_) if text.contains("<xacro:") => {
+                return Err(self.xacro("xacro elements <xacro:…>"))
+            }
+            Err(e) => return Err(self.parse_error(&format!("it is not XML ({e})"))),
+        };
+        if root.name == "mujoco" {
+            return Err(DescriptionError::new(
+                ErrorKind::Parse,
+                format!(
+                    "{} is an MJCF (its root element is <mujoco>), not a URDF: read it \
+                     through MuJoCo's compiler (Python: give its path to adaptimp, which \
+                     compiles it)",
+                    self.shown
+                ),
+            ));
+        }
+        if root.name != "robot" {
+            return Err(
+                self.parse_error(&format!("its root element is <{}>, not <robot>", root.name))
+            );
+        }
+        if let Some(what) = xacro_markup(&root) {
+            return Err(self.xacro(&what));
+        }
+        Ok(root)
     }
-    if let Some(what) = xacro_markup(&root) {
-        return Err(xacro(&what));
+
+    /// urdf-rs's robot of the (stripped) document `root`, written back and
+    /// parsed; on an error, the first element it cannot read named.
+    fn parse_root(&self, root: &xml::Element) -> Result<urdf_rs::Robot, DescriptionError> {
+        let bare = std::panic::catch_unwind(|| format!("{root}"))
+            .map_err(|_| self.parse_error("its namespaces cannot be written back"))?;
+        parse(&bare).map_err(|e| {
+            // Writing an element alone can meet a prefix bound on the root: no
+            // pointer then, rather than a panic.
+            let at = std::panic::catch_unwind(|| first_bad_element(root))
+                .ok()
+                .flatten()
+                .map_or_else(String::new, |el| format!("{el}: "));
+            self.parse_error(&format!("{at}{e}"))
+        })
     }
-    // What the arm needs: no geometry or material (a mesh or a texture
-    // urdf-rs cannot read is no reason to refuse an arm; urdf-rs itself
-    // drops <gazebo> and <transmission>).
+}
+
+/// What the arm needs of the document: no geometry or material (a mesh or
+/// a texture urdf-rs cannot read is no reason to refuse an arm; urdf-rs
+/// itself drops <gazebo> and <transmission>), and a `<limit>` without its
+/// effort or velocity stating none (many files omit them; urdf-rs wants
+/// both).
+fn strip_for_arm(root: &mut xml::Element) {
     root.children
         .retain(|c| !matches!(c, xml::Xml::ElementNode(e) if e.name == "material"));
     for child in &mut root.children {
@@ -181,8 +232,6 @@ fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError>
                 !matches!(c, xml::Xml::ElementNode(g) if g.name == "visual" || g.name == "collision")
             });
         } else if e.name == "joint" {
-            // A <limit> without its effort or velocity states none (many
-            // files omit them; urdf-rs wants both).
             for c in &mut e.children {
                 if let xml::Xml::ElementNode(limit) = c {
                     if limit.name == "limit" {
@@ -196,19 +245,12 @@ fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError>
             }
         }
     }
-    let bare = std::panic::catch_unwind(|| format!("{root}"))
-        .map_err(|_| parse_error("its namespaces cannot be written back"))?;
-    let robot = parse(&bare).map_err(|e| {
-        // Writing an element alone can meet a prefix bound on the root: no
-        // pointer then, rather than a panic.
-        let at = std::panic::catch_unwind(|| first_bad_element(&root))
-            .ok()
-            .flatten()
-            .map_or_else(String::new, |el| format!("{el}: "));
-        parse_error(&format!("{at}{e}"))
-    })?;
-    let with_inertial: std::collections::BTreeSet<String> = root
-        .children
+}
+
+/// The names of the links whose element has an `<inertial>` (urdf-rs
+/// gives every link one).
+fn with_inertial(root: &xml::Element) -> std::collections::BTreeSet<String> {
+    root.children
         .iter()
         .filter_map(|c| match c {
             xml::Xml::ElementNode(e)
@@ -218,8 +260,7 @@ fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError>
             }
             _ => None,
         })
-        .collect();
-    tree_of(&robot, source, &with_inertial)
+        .collect()
 }
 
 /// urdf-rs's reading, with a panic inside it (a malformed document it does
@@ -285,70 +326,75 @@ fn tree_of(
     let links = robot
         .links
         .iter()
-        .map(|l| {
-            let i = &l.inertial.inertia;
-            Link {
-                name: l.name.clone(),
-                inertial: with_inertial.contains(&l.name).then(|| LinkInertial {
-                    mass: l.inertial.mass.value,
-                    origin: origin(&l.inertial.origin),
-                    inertia: [
-                        [i.ixx, i.ixy, i.ixz],
-                        [i.ixy, i.iyy, i.iyz],
-                        [i.ixz, i.iyz, i.izz],
-                    ],
-                }),
-            }
-        })
+        .map(|l| link_of(l, with_inertial))
         .collect();
-    let joints = robot
-        .joints
-        .iter()
-        .map(|j| {
-            let mut kind = match j.joint_type {
-                urdf_rs::JointType::Fixed => JointType::Fixed,
-                urdf_rs::JointType::Revolute => JointType::Revolute,
-                urdf_rs::JointType::Continuous => JointType::Continuous,
-                urdf_rs::JointType::Prismatic => JointType::Prismatic,
-                urdf_rs::JointType::Floating => JointType::Floating,
-                urdf_rs::JointType::Planar => JointType::Planar,
-                urdf_rs::JointType::Spherical => JointType::Ball,
-            };
-            let mut joint = TreeJoint::new(
-                &j.name,
-                kind,
-                &j.parent.link,
-                &j.child.link,
-                origin(&j.origin),
-            );
-            joint.axis = *j.axis.xyz;
-            let (lo, hi) = (j.limit.lower, j.limit.upper);
-            let ranged = lo < hi;
-            if kind == JointType::Revolute && !ranged {
-                kind = JointType::Continuous;
-            }
-            joint.kind = kind;
-            if matches!(kind, JointType::Revolute | JointType::Prismatic) && ranged {
-                joint.lower = lo;
-                joint.upper = hi;
-            }
-            if kind.is_movable() {
-                joint.effort = stated(j.limit.effort);
-                joint.velocity = stated(j.limit.velocity);
-            }
-            if let Some(d) = &j.dynamics {
-                joint.damping = d.damping;
-                joint.friction = d.friction;
-            }
-            joint.mimic = j.mimic.as_ref().map(|m| Mimic {
-                joint: m.joint.clone(),
-                multiplier: m.multiplier.unwrap_or(1.0),
-                offset: m.offset.unwrap_or(0.0),
-            });
-            joint
-        })
-        .collect();
+    let joints = robot.joints.iter().map(joint_of).collect();
     Tree::new(source, &robot.name, links, joints, Vec::new())
+}
+
+/// A parsed link: its inertial if its element has one (`with_inertial`;
+/// urdf-rs gives every link one).
+fn link_of(l: &urdf_rs::Link, with_inertial: &std::collections::BTreeSet<String>) -> Link {
+    let i = &l.inertial.inertia;
+    Link {
+        name: l.name.clone(),
+        inertial: with_inertial.contains(&l.name).then(|| LinkInertial {
+            mass: l.inertial.mass.value,
+            origin: origin(&l.inertial.origin),
+            inertia: [
+                [i.ixx, i.ixy, i.ixz],
+                [i.ixy, i.iyy, i.iyz],
+                [i.ixz, i.iyz, i.izz],
+            ],
+        }),
+    }
+}
+
+/// A parsed joint (SPEC (21.1), URDF): a revolute joint without a range is
+/// continuous; limits only where they leave a range; an effort or velocity
+/// of a movable joint NaN unless stated; its dynamics and mimic.
+fn joint_of(j: &urdf_rs::Joint) -> TreeJoint {
+    let mut kind = match j.joint_type {
+        urdf_rs::JointType::Fixed => JointType::Fixed,
+        urdf_rs::JointType::Revolute => JointType::Revolute,
+        urdf_rs::JointType::Continuous => JointType::Continuous,
+        urdf_rs::JointType::Prismatic => JointType::Prismatic,
+        urdf_rs::JointType::Floating => JointType::Floating,
+        urdf_rs::JointType::Planar => JointType::Planar,
+        urdf_rs::JointType::Spherical => JointType::Ball,
+    };
+    let mut joint = TreeJoint::new(
+        &j.name,
+        kind,
+        &j.parent.link,
+        &j.child.link,
+        origin(&j.origin),
+    );
+    joint.axis = *j.axis.xyz;
+    let (lo, hi) = (j.limit.lower, j.limit.upper);
+    let ranged = lo < hi;
+    if kind == JointType::Revolute && !ranged {
+        kind = JointType::Continuous;
+    }
+    joint.kind = kind;
+    if matches!(kind, JointType::Revolute | JointType::Prismatic) && ranged {
+        joint.lower = lo;
+        joint.upper = hi;
+    }
+    if kind.is_movable() {
+        joint.effort = stated(j.limit.effort);
+        joint.velocity = stated(j.limit.velocity);
+    }
+    if let Some(d) = &j.dynamics {
+        joint.damping = d.damping;
+        joint.friction = d.friction;
+    }
+    joint.mimic = j.mimic.as_ref().map(|m| Mimic {
+        joint: m.joint.clone(),
+        multiplier: m.multiplier.unwrap_or(1.0),
+        offset: m.offset.unwrap_or(0.0),
+    });
+    joint
 }
 
 /// `s` as an XML attribute value (quoted, escaped).
@@ -384,57 +430,18 @@ pub fn reduced_urdf(tree: &Tree, arm: &Arm, drive: bool) -> Result<String, Descr
     };
     let mut out = format!("<robot name={}>\n", attr(tree.name()));
     for l in tree.links() {
-        let Some(i) = &l.inertial else {
-            let _ = writeln!(out, "  <link name={}/>", attr(&l.name));
-            continue;
-        };
-        let (xyz, rpy) = i.origin.xyz_rpy().map_err(config)?;
-        let m = &i.inertia;
-        let _ = writeln!(
-            out,
-            "  <link name={}>\n    <inertial>\n      <origin xyz=\"{}\" rpy=\"{}\"/>\n      \
-             <mass value=\"{}\"/>\n      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" \
-             iyz=\"{}\" izz=\"{}\"/>\n    </inertial>\n  </link>",
-            attr(&l.name),
-            triple(xyz),
-            triple(rpy),
-            i.mass,
-            m[0][0],
-            m[0][1],
-            m[0][2],
-            m[1][1],
-            m[1][2],
-            m[2][2]
-        );
+        write_link(&mut out, l).map_err(config)?;
     }
     for (index, j) in tree.joints().iter().enumerate() {
         let arm_joint = arm.joints.iter().find(|a| a.index == index);
         let held = arm.held.iter().find(|h| h.index == index);
-        let mut origin = j.origin;
-        let kind = match (arm_joint, held) {
-            (Some(_), _) => j.kind,
-            (None, Some(h)) => {
-                let shift = h.value - j.offset;
-                if j.kind.is_movable() && shift != 0.0 {
-                    // Held away from its origin: the motion folds into it.
-                    let t = j.origin.transform().map_err(config)?;
-                    let f = t.check(index).map_err(config)?;
-                    let axis = nalgebra::Vector3::from(j.axis);
-                    let len = axis.norm();
-                    if len > 1e-12 {
-                        let moved = f.then(&super::tree::motion(
-                            j.kind == JointType::Prismatic,
-                            &(axis / len),
-                            shift,
-                        ));
-                        origin = Origin::Matrix(crate::cartesian::chain::Transform::from_parts(
-                            moved.p, &moved.r,
-                        ));
-                    }
-                }
-                JointType::Fixed
-            }
-            (None, None) => JointType::Fixed,
+        let (kind, origin) = match (arm_joint, held) {
+            (Some(_), _) => (j.kind, j.origin),
+            (None, Some(h)) => (
+                JointType::Fixed,
+                held_origin(j, index, h.value).map_err(config)?,
+            ),
+            (None, None) => (JointType::Fixed, j.origin),
         };
         let (xyz, rpy) = origin.xyz_rpy().map_err(config)?;
         let _ = write!(
@@ -449,35 +456,91 @@ pub fn reduced_urdf(tree: &Tree, arm: &Arm, drive: bool) -> Result<String, Descr
             attr(&j.child)
         );
         if let Some(a) = arm_joint {
-            let _ = writeln!(out, "    <axis xyz=\"{}\"/>", triple(j.axis));
-            if (a.lower.is_finite() && a.upper.is_finite()) || kind == JointType::Continuous {
-                // A stated effort (MuJoCo's actuator force range), or 0: none.
-                let effort = if a.effort.is_finite() { a.effort } else { 0.0 };
-                let velocity = if a.velocity.is_finite() {
-                    a.velocity
-                } else {
-                    0.0
-                };
-                let range = if kind == JointType::Continuous {
-                    String::new()
-                } else {
-                    format!("lower=\"{}\" upper=\"{}\" ", a.lower, a.upper)
-                };
-                let _ = writeln!(
-                    out,
-                    "    <limit {range}effort=\"{effort}\" velocity=\"{velocity}\"/>"
-                );
-            }
-            if drive && (a.damping != 0.0 || a.friction != 0.0) {
-                let _ = writeln!(
-                    out,
-                    "    <dynamics damping=\"{}\" friction=\"{}\"/>",
-                    a.damping, a.friction
-                );
-            }
+            write_arm_joint(&mut out, j, kind, a, drive);
         }
         out.push_str("  </joint>\n");
     }
     out.push_str("</robot>\n");
     Ok(out)
+}
+
+/// Link `l` with its inertial only (SPEC (21.3)), or an empty link.
+fn write_link(out: &mut String, l: &Link) -> Result<(), crate::error::Error> {
+    let Some(i) = &l.inertial else {
+        let _ = writeln!(out, "  <link name={}/>", attr(&l.name));
+        return Ok(());
+    };
+    let (xyz, rpy) = i.origin.xyz_rpy()?;
+    let m = &i.inertia;
+    let _ = writeln!(
+        out,
+        "  <link name={}>\n    <inertial>\n      <origin xyz=\"{}\" rpy=\"{}\"/>\n      \
+         <mass value=\"{}\"/>\n      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" \
+         iyz=\"{}\" izz=\"{}\"/>\n    </inertial>\n  </link>",
+        attr(&l.name),
+        triple(xyz),
+        triple(rpy),
+        i.mass,
+        m[0][0],
+        m[0][1],
+        m[0][2],
+        m[1][1],
+        m[1][2],
+        m[2][2]
+    );
+    Ok(())
+}
+
+/// The origin of joint `j` (index `index`) held at `value` (SPEC (21.3)):
+/// held away from its offset, its motion folds into its origin.
+fn held_origin(j: &TreeJoint, index: usize, value: f64) -> Result<Origin, crate::error::Error> {
+    let shift = value - j.offset;
+    if !(j.kind.is_movable() && shift != 0.0) {
+        return Ok(j.origin);
+    }
+    let f = j.origin.transform()?.check(index)?;
+    let axis = nalgebra::Vector3::from(j.axis);
+    let len = axis.norm();
+    if len > 1e-12 {
+        let moved = f.then(&super::tree::motion(
+            j.kind == JointType::Prismatic,
+            &(axis / len),
+            shift,
+        ));
+        return Ok(Origin::Matrix(
+            crate::cartesian::chain::Transform::from_parts(moved.p, &moved.r),
+        ));
+    }
+    Ok(j.origin)
+}
+
+/// An arm joint's axis, its limits (when limited or continuous: a stated
+/// effort and velocity, or 0: none) and, with `drive`, its `<dynamics>`.
+fn write_arm_joint(out: &mut String, j: &TreeJoint, kind: JointType, a: &ArmJoint, drive: bool) {
+    let _ = writeln!(out, "    <axis xyz=\"{}\"/>", triple(j.axis));
+    if (a.lower.is_finite() && a.upper.is_finite()) || kind == JointType::Continuous {
+        // A stated effort (MuJoCo's actuator force range), or 0: none.
+        let effort = if a.effort.is_finite() { a.effort } else { 0.0 };
+        let velocity = if a.velocity.is_finite() {
+            a.velocity
+        } else {
+            0.0
+        };
+        let range = if kind == JointType::Continuous {
+            String::new()
+        } else {
+            format!("lower=\"{}\" upper=\"{}\" ", a.lower, a.upper)
+        };
+        let _ = writeln!(
+            out,
+            "    <limit {range}effort=\"{effort}\" velocity=\"{velocity}\"/>"
+        );
+    }
+    if drive && (a.damping != 0.0 || a.friction != 0.0) {
+        let _ = writeln!(
+            out,
+            "    <dynamics damping=\"{}\" friction=\"{}\"/>",
+            a.damping, a.friction
+        );
+    }
 }

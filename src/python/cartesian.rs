@@ -41,13 +41,8 @@ use std::vec::Vec;
 // The object-safe faces.
 // ---------------------------------------------------------------------------
 
-/// The tip at (q, q̇): position (3), rotation (3 × 3 row-major), Jacobian
-/// (6 × n row-major), J̇ q̇ (6).
+/// The tip's motion at (q, q̇): Jacobian (6 × n row-major), J̇ q̇ (6).
 pub struct TipOut {
-    /// p (m).
-    pub position: [f64; 3],
-    /// R, row-major.
-    pub rotation: [f64; 9],
     /// [J_v; J_ω], 6 × n row-major.
     pub jacobian: Vec<f64>,
     /// J̇ q̇.
@@ -62,6 +57,12 @@ pub trait DynChain: Send + Sync {
     fn prismatic(&self) -> Vec<bool>;
     /// The tip at (q, q̇) (n values each).
     fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut;
+    /// The tip's pose at q: the homogeneous transform, row-major (4 × 4).
+    fn pose(&self, q: &[f64]) -> Vec<f64>;
+    /// The Jacobian at q, 6 × n row-major.
+    fn jacobian(&self, q: &[f64]) -> Vec<f64>;
+    /// J̇ q̇ at (q, q̇).
+    fn bias(&self, q: &[f64], dq: &[f64]) -> [f64; 6];
     /// The outer loop of `cfg` over this chain at period `ts`, started at `q0`.
     fn outer(
         &self,
@@ -85,13 +86,33 @@ impl<const N: usize> DynChain for Chain<N> {
     }
     fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut {
         let t = Kinematics::tip(self, &vector_of(q), &vector_of(dq));
-        let r = t.rotation.matrix();
         TipOut {
-            position: t.position.into(),
-            rotation: core::array::from_fn(|k| r[(k / 3, k % 3)]),
             jacobian: t.jacobian.transpose().as_slice().to_vec(),
             bias: t.bias.into(),
         }
+    }
+    fn pose(&self, q: &[f64]) -> Vec<f64> {
+        let (p, r) = Chain::pose(self, &vector_of(q));
+        let mut m = std::vec![0.0; 16];
+        for i in 0..3 {
+            for j in 0..3 {
+                m[4 * i + j] = r[(i, j)];
+            }
+            m[4 * i + 3] = p[i];
+        }
+        m[15] = 1.0;
+        m
+    }
+    fn jacobian(&self, q: &[f64]) -> Vec<f64> {
+        // Column-major 6 × N storage of Jᵀ: J row-major.
+        self.pose_jacobian(&vector_of(q))
+            .jacobian
+            .transpose()
+            .as_slice()
+            .to_vec()
+    }
+    fn bias(&self, q: &[f64], dq: &[f64]) -> [f64; 6] {
+        Chain::bias(self, &vector_of(q), &vector_of(dq)).into()
     }
     fn outer(
         &self,
@@ -113,6 +134,9 @@ impl<const N: usize> DynChain for Chain<N> {
             q0,
             posture,
             last: None,
+            held: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            log: Vec::new(),
+            rows: 0,
         }))
     }
 }
@@ -201,6 +225,15 @@ pub trait DynOuter: Send + Sync {
     fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error>;
     /// A quantity of the last step (see [`LAST`]).
     fn last(&self, what: usize) -> Vec<f64>;
+    /// The commanded rotation held when a target gives none (row-major).
+    fn held(&self) -> [f64; 9];
+    /// Hold `r` (row-major) from now on.
+    fn set_held(&mut self, r: [f64; 9]);
+    /// Keep the last step's row of `CartesianController.log` (p_c, ṗ_c, p̈_c,
+    /// p_d, ṗ_d, p̈_d, q_d, F_e, the error: [`LOG_WIDTH`] + n values).
+    fn record(&mut self);
+    /// The rows kept since the last call, flat, and their number.
+    fn take_log(&mut self) -> (Vec<f64>, usize);
     /// A quantity of the state (see [`STATE`]).
     fn state(&self, what: usize) -> Vec<f64>;
     /// The orbit rule: (q_d rows, q̇_d rows) of `nodes` samples along `targets`.
@@ -268,7 +301,16 @@ struct Outer<const N: usize> {
     q0: Vector<N>,
     posture: Vector<N>,
     last: Option<LastStep<N>>,
+    /// The commanded rotation a target without one keeps (row-major).
+    held: [f64; 9],
+    /// Kept rows of the log, flat ([`LOG_WIDTH`] + N each), and their number.
+    log: Vec<f64>,
+    rows: usize,
 }
+
+/// The width of a log row besides q_d's n values: p_c, ṗ_c, p̈_c, p_d,
+/// ṗ_d, p̈_d (3 each), F_e and the error (6 each).
+pub const LOG_WIDTH: usize = 30;
 
 impl<const N: usize> Outer<N> {
     fn measurement(m: &StepIn<'_>) -> CartesianMeasurement<N> {
@@ -304,7 +346,36 @@ impl<const N: usize> DynOuter for Outer<N> {
         self.state = self.outer.start(self.q0);
         self.state.posture = self.posture;
         self.last = None;
+        self.log.clear();
+        self.rows = 0;
         Ok(())
+    }
+    fn held(&self) -> [f64; 9] {
+        self.held
+    }
+    fn set_held(&mut self, r: [f64; 9]) {
+        self.held = r;
+    }
+    fn record(&mut self) {
+        let Some(last) = &self.last else {
+            return;
+        };
+        let c = &last.cmd;
+        for v in last
+            .commanded
+            .iter()
+            .chain([&c.compliant.p, &c.compliant.dp, &c.compliant.ddp])
+        {
+            self.log.extend_from_slice(v.as_slice());
+        }
+        self.log.extend_from_slice(c.reference.x.as_slice());
+        self.log.extend_from_slice(&last.wrench);
+        self.log.extend_from_slice(c.error.as_slice());
+        self.rows += 1;
+    }
+    fn take_log(&mut self) -> (Vec<f64>, usize) {
+        let rows = core::mem::replace(&mut self.rows, 0);
+        (core::mem::take(&mut self.log), rows)
     }
     fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error> {
         let p = vector_of::<N>(posture);
@@ -604,6 +675,128 @@ fn flat(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<
     Ok(v)
 }
 
+/// `L` reals: an array of shape (L,) read in place, else any sequence
+/// ([`flat`]); None gives zeros.
+fn reals<const L: usize>(what: &'static str, obj: Option<&Bound<'_, PyAny>>) -> PyResult<[f64; L]> {
+    let mut out = [0.0; L];
+    let Some(obj) = obj.filter(|o| !o.is_none()) else {
+        return Ok(out);
+    };
+    if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+        if a.len() == L {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = a.get_owned(i).unwrap_or(f64::NAN);
+            }
+            return Ok(out);
+        }
+    }
+    let v = flat_any(what, L, obj)?;
+    out.copy_from_slice(&v);
+    Ok(out)
+}
+
+/// F_e from (6,), or f (3,) alone (no moment).
+fn wrench_sample(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
+    if obj.is_none() {
+        return Ok([0.0; 6]);
+    }
+    if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+        if a.len() == 6 || a.len() == 3 {
+            let mut out = [0.0; 6];
+            for (i, o) in out.iter_mut().enumerate().take(a.len()) {
+                *o = a.get_owned(i).unwrap_or(f64::NAN);
+            }
+            return Ok(out);
+        }
+    }
+    let v = flat_any("wrench", 0, obj)?;
+    match v.len() {
+        3 | 6 => Ok(core::array::from_fn(|i| v.get(i).copied().unwrap_or(0.0))),
+        k => Err(MeasurementError::new_err(format!(
+            "wrench must have shape (6,) or (3,), got {k} values"
+        ))),
+    }
+}
+
+/// The commanded pose of a step: a path's (p, ṗ, p̈) or (p, ṗ, p̈, R, ω, ω̇)
+/// (rates None: 0; R None: `held`; a given R becomes `held`), or a flat
+/// target (24,).
+fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTarget> {
+    if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+        let v = flat("target", TARGET_LEN, a.as_any())?;
+        held.copy_from_slice(&v[9..18]);
+        return Ok(pose_target(&v));
+    }
+    let items: Vec<Bound<'_, PyAny>> = match obj.cast::<pyo3::types::PyTuple>() {
+        Ok(t) => t.iter().collect(),
+        Err(_) => obj
+            .try_iter()
+            .and_then(|it| it.collect::<PyResult<Vec<_>>>())
+            .map_err(|_| {
+                PyTypeError::new_err(
+                    "a path returns (p, dp, ddp) or (p, dp, ddp, R, w, dw) (a tuple of arrays)",
+                )
+            })?,
+    };
+    if items.len() != 3 && items.len() != 6 {
+        return Err(PyValueError::new_err(format!(
+            "path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {}",
+            items.len()
+        )));
+    }
+    let get = |i: usize| items.get(i).filter(|o| !o.is_none());
+    let p = match get(0) {
+        Some(p) => reals::<3>("p_c", Some(p))?,
+        None => {
+            return Err(MeasurementError::new_err(
+                "the commanded position p_c is missing",
+            ))
+        }
+    };
+    let mut v = [0.0; TARGET_LEN];
+    v[..3].copy_from_slice(&p);
+    v[3..6].copy_from_slice(&reals::<3>("dp_c", get(1))?);
+    v[6..9].copy_from_slice(&reals::<3>("ddp_c", get(2))?);
+    if let Some(r) = get(3) {
+        let r = match r.cast::<PyArray2<f64>>() {
+            Ok(a) if a.shape() == [3, 3] => {
+                core::array::from_fn(|k| a.get_owned([k / 3, k % 3]).unwrap_or(f64::NAN))
+            }
+            _ => {
+                let f = flat_any("R_c", 9, r)?;
+                core::array::from_fn(|k| f[k])
+            }
+        };
+        *held = r;
+    }
+    v[9..18].copy_from_slice(held);
+    v[18..21].copy_from_slice(&reals::<3>("w_c", get(4))?);
+    v[21..24].copy_from_slice(&reals::<3>("dw_c", get(5))?);
+    Ok(pose_target(&v))
+}
+
+/// As [`flat`], without the finiteness check (the core's), of any length
+/// when `len` is 0.
+fn flat_any(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let v: Vec<f64> = obj
+        .call_method1("__array__", ())
+        .ok()
+        .and_then(|a| a.call_method1("astype", ("float64",)).ok())
+        .and_then(|a| a.call_method0("ravel").ok())
+        .and_then(|a| a.extract::<Vec<f64>>().ok())
+        .or_else(|| obj.extract::<Vec<f64>>().ok())
+        .ok_or_else(|| {
+            PyTypeError::new_err(format!("{what} must be a sequence or array of reals"))
+        })?;
+    if len > 0 && v.len() != len {
+        return Err(MeasurementError::new_err(format!(
+            "{what} must have {len} values, got {}",
+            v.len()
+        )));
+    }
+    Ok(v)
+}
+
 fn target_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PoseTarget>> {
     obj.map(|o| flat("target", TARGET_LEN, o).map(|v| pose_target(&v)))
         .transpose()
@@ -681,14 +874,7 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        let t = self.inner.tip(&q[..n], &[0.0; MAX_JOINTS][..n]);
-        let mut m = std::vec![0.0; 16];
-        for i in 0..3 {
-            m[4 * i..4 * i + 3].copy_from_slice(&t.rotation[3 * i..3 * i + 3]);
-            m[4 * i + 3] = t.position[i];
-        }
-        m[15] = 1.0;
-        array(py, m, (4, 4))
+        array(py, self.inner.pose(&q[..n]), (4, 4))
     }
 
     /// The tip's twist and acceleration along recorded rows q, q̇, q̈ (K, n)
@@ -745,8 +931,7 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        let t = self.inner.tip(&q[..n], &[0.0; MAX_JOINTS][..n]);
-        array(py, t.jacobian, (6, n))
+        array(py, self.inner.jacobian(&q[..n]), (6, n))
     }
 
     /// J̇ q̇ at (q, q̇), (6,): the tip's classical acceleration at q̈ = 0,
@@ -759,8 +944,7 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.inner.n();
         let (q, dq) = (self.qv("q", q)?, self.qv("dq", dq)?);
-        let t = self.inner.tip(&q[..n], &dq[..n]);
-        Ok(array1(py, &t.bias))
+        Ok(array1(py, &self.inner.bias(&q[..n], &dq[..n])))
     }
 }
 
@@ -935,6 +1119,77 @@ impl PyCartesian {
         let mut g = self.lock(py);
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
         Ok(array1(py, &g.last(16)))
+    }
+
+    /// One step of `CartesianController.step` with the core's joint
+    /// `controller`, in one call: q (rad), dq (rad/s), each (n,), the wrench
+    /// F_e = [f; m] (N, N m; (6,), f (3,) alone, or None: no contact), the
+    /// commanded pose `sample`: None (hold the last target), the tuple (p,
+    /// ṗ, p̈) or (p, ṗ, p̈, R, ω, ω̇) a path returns (m, m/s, m/s², (3, 3),
+    /// rad/s, rad/s²; a rate None is 0, R None the held rotation, a given R
+    /// held from now on) or a flat target (24,); with `record`, the step's row
+    /// kept for [`take_log`](Self::take_log). Shapes and types are checked
+    /// here, the values by the core (a refused step records its fault).
+    /// Returns sat(τ) (N m), (n,).
+    #[pyo3(signature = (controller, q, dq, wrench, sample, record))]
+    #[allow(clippy::too_many_arguments)]
+    fn step_sample<'py>(
+        &self,
+        py: Python<'py>,
+        controller: &Bound<'py, PyAny>,
+        q: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+        wrench: Option<&Bound<'py, PyAny>>,
+        sample: Option<&Bound<'py, PyAny>>,
+        record: bool,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.n;
+        let mut qb = [0.0; MAX_JOINTS];
+        super::vector_into("q", n, q, &mut qb)?;
+        let mut dqb = [0.0; MAX_JOINTS];
+        if let Some(d) = dq {
+            super::vector_into("dq", n, d, &mut dqb)?;
+        }
+        let f = match wrench {
+            None => [0.0; 6],
+            Some(w) => wrench_sample(w)?,
+        };
+        let mut joint = lock_joint(py, controller, n)?;
+        let mut g = self.lock(py);
+        let target = match sample {
+            None => None,
+            Some(s) => {
+                let mut held = g.held();
+                let t = sample_target(s, &mut held)?;
+                g.set_held(held);
+                Some(t)
+            }
+        };
+        let m = self.measurement(&qb, dq.map(|_| &dqb), f, target);
+        g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
+        if record {
+            g.record();
+        }
+        Ok(array1(py, &g.last(16)))
+    }
+
+    /// The commanded rotation a target without one keeps, (3, 3).
+    fn held_rotation<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        array(py, self.lock(py).held().to_vec(), (3, 3))
+    }
+
+    /// Hold the commanded rotation `r` (3, 3) from now on.
+    fn set_held_rotation(&self, py: Python<'_>, r: &Bound<'_, PyAny>) -> PyResult<()> {
+        let v = flat("R", 9, r)?;
+        self.lock(py).set_held(core::array::from_fn(|i| v[i]));
+        Ok(())
+    }
+
+    /// The rows `step_sample` kept since the last call, (K, 30 + n): p_c,
+    /// ṗ_c, p̈_c, p_d, ṗ_d, p̈_d (3 each), q_d (n), F_e (6), the error (6).
+    fn take_log<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (v, rows) = self.lock(py).take_log();
+        array(py, v, (rows, LOG_WIDTH + self.n))
     }
 
     /// One Cartesian step with a joint controller written in Python:

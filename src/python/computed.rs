@@ -12,7 +12,7 @@ use super::dynamic::{
 };
 use super::frames::{joint, transform};
 use super::mujoco::{MujocoSpec, Table};
-use super::{array, array1, vector, ConfigError};
+use super::{array, array1, vector, vector_into, ConfigError, MeasurementError};
 use crate::cartesian::chain::JointKind;
 use crate::cartesian::{
     ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
@@ -53,8 +53,8 @@ pub trait DynComputed: Send + Sync {
         c: [&[f64]; 3],
         out: &mut [f64],
     ) -> Result<(), Error>;
-    /// RNEA(q, q̇, q̈) of the controller's model.
-    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Vec<f64>;
+    /// ID(q, q̇, q̈) of the controller's model (SPEC (20.5)) into `out`.
+    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64], out: &mut [f64]);
     /// M(q), row-major.
     fn mass_matrix(&self, q: &[f64]) -> Vec<f64>;
     /// The last step's τ, sat(τ), xc, xd, z1 (by index).
@@ -127,12 +127,12 @@ impl<const N: usize> DynComputed for Computed<N> {
         out[..N].copy_from_slice(cmd.tau_sat.as_slice());
         Ok(())
     }
-    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64]) -> Vec<f64> {
+    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64], out: &mut [f64]) {
         let tau =
             self.ctrl
                 .model()
                 .inverse_dynamics(&vector_of(q), &vector_of(dq), &vector_of(ddq));
-        tau.as_slice().to_vec()
+        out[..N].copy_from_slice(tau.as_slice());
     }
     fn mass_matrix(&self, q: &[f64]) -> Vec<f64> {
         let m = self.ctrl.model().mass_matrix(&vector_of(q));
@@ -450,9 +450,42 @@ pub struct PyComputedTorque {
     inner: Mutex<Box<dyn DynComputed>>,
     /// Joints n.
     pub n: usize,
+    /// `trajectory(t) -> (xc, dxc, ddxc)` for a step given no setpoint.
+    trajectory: Mutex<Option<Py<PyAny>>>,
 }
 
 impl PyComputedTorque {
+    /// The setpoint (xc, ẋc, ẍc) into `b[3..6]` from the trajectory at t =
+    /// steps·Ts (called without holding the controller, which it may read).
+    fn setpoint_of_trajectory(
+        &self,
+        py: Python<'_>,
+        rates_given: bool,
+        b: &mut [[f64; MAX_JOINTS]; 6],
+    ) -> PyResult<()> {
+        if rates_given {
+            return Err(MeasurementError::new_err("give xc with dxc and ddxc"));
+        }
+        let traj = super::wait_lock(py, &self.trajectory)
+            .as_ref()
+            .map(|t| t.clone_ref(py));
+        let Some(traj) = traj else {
+            return Err(MeasurementError::new_err(
+                "no setpoint given and no trajectory to follow",
+            ));
+        };
+        let t = {
+            let g = self.lock(py);
+            g.steps() as f64 * g.ts()
+        };
+        let out = traj.call1(py, (t,))?;
+        let out = out.bind(py);
+        for (i, what) in ["xc", "dxc", "ddxc"].into_iter().enumerate() {
+            vector_into(what, self.n, &out.get_item(i)?, &mut b[3 + i])?;
+        }
+        Ok(())
+    }
+
     /// The controller, waiting (with the GIL released) while another thread
     /// uses it.
     pub fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynComputed>> {
@@ -550,7 +583,15 @@ impl PyComputedTorque {
         Ok(Self {
             n: inner.n(),
             inner: Mutex::new(inner),
+            trajectory: Mutex::new(None),
         })
+    }
+
+    /// The setpoint of a step given none: `trajectory(t) -> (xc, dxc,
+    /// ddxc)` at t = steps·Ts (None: a step must give xc).
+    #[pyo3(signature = (trajectory=None))]
+    fn set_trajectory(&self, py: Python<'_>, trajectory: Option<Py<PyAny>>) {
+        *super::wait_lock(py, &self.trajectory) = trajectory;
     }
 
     /// Joints n.
@@ -583,9 +624,12 @@ impl PyComputedTorque {
         self.lock(py).reset();
     }
 
-    /// One step (SPEC (20.3)): q (rad), tau_e (N m), dq (rad/s), the
-    /// setpoint xc (rad), dxc (rad/s), ddxc (rad/s²), each (n,). Returns
-    /// sat(τ) (N m), (n,).
+    /// One step (SPEC (20.3)): q (rad), tau_e (N m), dq (rad/s, required),
+    /// the setpoint xc (rad, required), dxc (rad/s), ddxc (rad/s²) (default
+    /// 0), each (n,). Returns sat(τ) (N m), (n,). Shapes and types are
+    /// checked here; the values are the core's to judge (a non-finite or
+    /// out-of-range one is a refused step that records its fault).
+    #[pyo3(signature = (q, tau_e, dq=None, xc=None, dxc=None, ddxc=None))]
     #[allow(clippy::too_many_arguments)]
     fn step<'py>(
         &self,
@@ -593,26 +637,40 @@ impl PyComputedTorque {
         q: &Bound<'py, PyAny>,
         tau_e: &Bound<'py, PyAny>,
         dq: Option<&Bound<'py, PyAny>>,
-        xc: &Bound<'py, PyAny>,
-        dxc: &Bound<'py, PyAny>,
-        ddxc: &Bound<'py, PyAny>,
+        xc: Option<&Bound<'py, PyAny>>,
+        dxc: Option<&Bound<'py, PyAny>>,
+        ddxc: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
-        let q = vector("q", n, q)?;
-        let tau_e = vector("tau_e", n, tau_e)?;
-        let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
-        let c = [
-            vector("xc", n, xc)?,
-            vector("dxc", n, dxc)?,
-            vector("ddxc", n, ddxc)?,
-        ];
+        let Some(dq) = dq else {
+            return Err(MeasurementError::new_err(
+                "ComputedTorque needs the measured joint velocity dq",
+            ));
+        };
+        // q, tau_e, dq, xc, dxc, ddxc: straight into their buffers.
+        let mut b = [[0.0; MAX_JOINTS]; 6];
+        vector_into("q", n, q, &mut b[0])?;
+        vector_into("tau_e", n, tau_e, &mut b[1])?;
+        vector_into("dq", n, dq, &mut b[2])?;
+        match xc {
+            Some(xc) => {
+                vector_into("xc", n, xc, &mut b[3])?;
+                if let Some(d) = dxc {
+                    vector_into("dxc", n, d, &mut b[4])?;
+                }
+                if let Some(d) = ddxc {
+                    vector_into("ddxc", n, d, &mut b[5])?;
+                }
+            }
+            None => self.setpoint_of_trajectory(py, dxc.is_some() || ddxc.is_some(), &mut b)?,
+        }
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)
             .step(
-                &q[..n],
-                dq.as_ref().map(|d| &d[..n]),
-                &tau_e[..n],
-                [&c[0][..n], &c[1][..n], &c[2][..n]],
+                &b[0][..n],
+                Some(&b[2][..n]),
+                &b[1][..n],
+                [&b[3][..n], &b[4][..n], &b[5][..n]],
                 &mut out[..n],
             )
             .map_err(super::step_error)?;
@@ -633,10 +691,10 @@ impl PyComputedTorque {
             vector("dq", n, dq)?,
             vector("ddq", n, ddq)?,
         );
-        Ok(array1(
-            py,
-            &self.lock(py).inverse_dynamics(&q[..n], &dq[..n], &ddq[..n]),
-        ))
+        let mut out = [0.0; MAX_JOINTS];
+        self.lock(py)
+            .inverse_dynamics(&q[..n], &dq[..n], &ddq[..n], &mut out[..n]);
+        Ok(array1(py, &out[..n]))
     }
 
     /// M(q) of the controller's model (kg m²), (n, n).

@@ -6,14 +6,14 @@
 
 use crate::control::io::{Command, Control, Measurement};
 use crate::error::{check, Error};
-use crate::sim::disturb::{Disturbances, TipPayload, WithFriction};
+use crate::sim::disturb::{Disturbances, Sample, TipPayload, WithFriction};
 use crate::sim::environment::Environment;
 use crate::sim::inject::Injection;
 use crate::sim::metrics::{Metrics, MetricsAccumulator};
 use crate::sim::model::Manipulator;
 use crate::sim::plant::{Plant, RigidBody};
 use crate::sim::record::{Recorder, Row};
-use crate::trajectory::Trajectory;
+use crate::trajectory::{Setpoint, Trajectory};
 use crate::types::Vector;
 
 /// Run settings (SPEC §11) of the rigid-body scenarios.
@@ -131,48 +131,26 @@ where
     let steps = steps(t_final, ts)?;
     let mut noise = disturbances.new_state();
     let (x0, dx0) = plant.state();
-    let mut sensed = (x0, dx0, plant.contact());
-    let mut sensed_wrench = plant.wrench();
-    let mut applied = Vector::<N>::zeros();
-    let mut last = Command::<N>::zeros();
+    let mut carried = Carried {
+        sensed: (x0, dx0, plant.contact()),
+        sensed_wrench: plant.wrench(),
+        applied: Vector::<N>::zeros(),
+        last: Command::<N>::zeros(),
+    };
     for k in 0..steps {
         let t = k as f64 * ts;
         let (x, dx) = plant.state();
         let tau_e = plant.contact();
         let (wrench, x_ee) = (plant.wrench(), plant.end_effector());
-        let (seen, seen_wrench) =
-            disturbances.measure_with_wrench(&mut noise, (x, dx, tau_e), wrench);
-        if let Some(inj) = injection {
-            sensed = inj.measure(t, seen, sensed);
-            sensed_wrench = inj.measure_wrench(t, seen_wrench, sensed_wrench);
-        } else {
-            sensed = seen;
-            sensed_wrench = seen_wrench;
-        }
+        let seen = disturbances.measure_with_wrench(&mut noise, (x, dx, tau_e), wrench);
+        carried.sense(t, seen, injection);
         let c = traj.sample(t);
-        let refused = if injection.is_some_and(|i| i.skips(t)) {
-            true
-        } else {
-            let m = Measurement {
-                x: sensed.0,
-                dx: Some(sensed.1),
-                tau_e: sensed.2,
-            };
-            let (tau, result) = ctrl.step_with_wrench(&m, &sensed_wrench, &c);
-            applied = tau;
-            match result {
-                Ok(cmd) => {
-                    last = cmd;
-                    false
-                }
-                Err(e) if injection.is_none() => return Err(e),
-                Err(_) => true,
-            }
-        };
-        let delivered = injection.map_or(applied, |i| i.actuate(t, &applied));
+        let refused = carried.control(ctrl, t, &c, injection)?;
+        let delivered = injection.map_or(carried.applied, |i| i.actuate(t, &carried.applied));
         let delivered = plant.actuate(&disturbances.actuate(&delivered));
         let h = disturbances.interval(&mut noise, ts);
         let ddx = plant.advance(&delivered, h)?;
+        let last = &carried.last;
         rec.record(&Row {
             t,
             x,
@@ -196,6 +174,65 @@ where
         });
     }
     Ok(steps)
+}
+
+/// What the loop of [`simulate_disturbed`] carries from one period to the next.
+struct Carried<const N: usize> {
+    /// The sample the controller was last given (a stale sensor repeats it).
+    sensed: Sample<N>,
+    /// The wrench it was last given.
+    sensed_wrench: [f64; 6],
+    /// The torque it last asked for (held while a step is skipped).
+    applied: Vector<N>,
+    /// Its last accepted command.
+    last: Command<N>,
+}
+
+impl<const N: usize> Carried<N> {
+    /// Step 1, the sensor path: the disturbed sample and wrench `seen`,
+    /// through the injected fault if any ([`Injection::measure`],
+    /// [`Injection::measure_wrench`]).
+    fn sense(&mut self, t: f64, seen: (Sample<N>, [f64; 6]), injection: Option<&Injection<N>>) {
+        let (seen, seen_wrench) = seen;
+        if let Some(inj) = injection {
+            self.sensed = inj.measure(t, seen, self.sensed);
+            self.sensed_wrench = inj.measure_wrench(t, seen_wrench, self.sensed_wrench);
+        } else {
+            self.sensed = seen;
+            self.sensed_wrench = seen_wrench;
+        }
+    }
+
+    /// Step 2, the controller's step on the sensed sample toward `c`:
+    /// whether it was refused (skipped by the injected fault, or an error
+    /// while a fault is injected; without one, an error is returned). The
+    /// torque it asks for is `applied` even when it refuses.
+    fn control<C: Control<N> + ?Sized>(
+        &mut self,
+        ctrl: &mut C,
+        t: f64,
+        c: &Setpoint<N>,
+        injection: Option<&Injection<N>>,
+    ) -> Result<bool, Error> {
+        if injection.is_some_and(|i| i.skips(t)) {
+            return Ok(true);
+        }
+        let m = Measurement {
+            x: self.sensed.0,
+            dx: Some(self.sensed.1),
+            tau_e: self.sensed.2,
+        };
+        let (tau, result) = ctrl.step_with_wrench(&m, &self.sensed_wrench, c);
+        self.applied = tau;
+        match result {
+            Ok(cmd) => {
+                self.last = cmd;
+                Ok(false)
+            }
+            Err(e) if injection.is_none() => Err(e),
+            Err(_) => Ok(true),
+        }
+    }
 }
 
 /// The rigid-body scenario of SPEC §11 in one call: `arm` against `env` from

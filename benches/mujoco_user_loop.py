@@ -1,0 +1,303 @@
+"""adaptimp's native Cartesian loop on MuJoCo against the loop a MuJoCo user writes,
+per control period, side by side in one run.
+
+The arms: the UR5 of example-robot-data as ``adaptimp.mujoco.from_urdf``
+compiles it (MuJoCo's RK4 at 1 ms: one step a period), with a site at the
+URDF's ``tool0``, and the Panda of ``adaptimp.mujoco.panda(table_height=None)``
+(free space, RK4 at 0.5 ms: two steps a period, its site ``ee``), each from
+its home posture; the task: the tool's position along a 5 cm circle at 0.5 Hz about its start,
+the orientation held (6-D), the commanded pose a Python function of t
+called once per period by both loops. The control period Ts = 1 ms in both,
+the torque held for the period's MuJoCo steps.
+
+- **adaptimp**: ``adaptimp.CartesianController(chain, "sf", …)`` (the core's
+  6-D Cartesian impedance of SPEC §16 in front of the adaptive state
+  feedback, which learns as it runs; gains and centres from SPEC §18's rule
+  and the circle's joint orbit), run by ``adaptimp.mujoco.simulate`` (the
+  loop in the core: MuJoCo through its C library, the controller and the
+  path's call each period, the log and the metrics).
+- **the user's loop**, as in kevinzakka/mjctrl's ``opspace.py``: each period,
+  in Python, ``mj_jacSite`` and ``mj_fullM``, the operational-space law
+  τ = Jᵀ Λ (K_p e − K_d J q̇) + (I − Jᵀ J̄ᵀ)(k_n (q_0 − q) − d_n q̇) + the
+  bias ``qfrc_bias`` with Λ = (J M⁻¹ Jᵀ)⁻¹, J̄ = M⁻¹ Jᵀ Λ and the
+  orientation error from MuJoCo's quaternion functions (``mju_mat2Quat``,
+  ``mju_negQuat``, ``mju_mulQuat``, ``mju_quat2Vel``), the torque clipped to
+  ``ctrlrange`` and set in ``ctrl``, then ``mj_step`` for the period's steps.
+
+Both runs track the circle (checked: the RMS position error after 1 s is
+printed, and must be below 5 mm), repeated ``--repeats`` times interleaved;
+medians per period. Target (issue 32): adaptimp ≤ 0.5× the user's loop.
+``--count`` also counts instructions per period under callgrind (two runs of
+each loop, of ``--T`` and 2 ``--T``: the difference over the extra periods).
+
+    python benches/mujoco_user_loop.py [--T 2] [--repeats 5] [--arms ur5 panda] [--count]
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+
+import adaptimp
+from adaptimp import mujoco as amj
+from adaptimp import tuning
+
+TS = 1e-3  # s: the control period of both loops
+RADIUS, OMEGA = 0.05, np.pi  # m, rad/s: 0.5 Hz
+
+
+SITES = {"panda": "ee", "ur5": "tool0"}
+
+
+def arm(name: str) -> tuple[Any, np.ndarray, adaptimp.Chain]:
+    """The arm's MuJoCo model (with its tool's site), home posture and chain."""
+    if name == "panda":
+        model = amj.panda(table_height=None)
+        q0 = np.array(adaptimp._models.PANDA_HOME)
+    else:
+        # The UR5 of example-robot-data as adaptimp.mujoco.from_urdf compiles it
+        # (RK4 at 1 ms, a motor per joint), with a site at the URDF's tool0.
+        import pinocchio as pin
+
+        from adaptimp import _models
+
+        urdf = _models.panda_urdf_path().parents[2] / "ur_description/urdf/ur5_robot.urdf"
+        arm_urdf = amj._urdf_arm(urdf, None, ())
+        pm = pin.buildModelFromXML(arm_urdf.urdf)
+        tool = pm.frames[pm.getFrameId("tool0")].placement
+        spec = amj._arm_spec(arm_urdf, 1e-3, drive=False, stacklevel=2)
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(tool.rotation).ravel())
+        spec.body("wrist_3_link").add_site(name="tool0", pos=tool.translation, quat=quat)
+        model = amj._compile_arm(spec)
+        q0 = np.array([0.0, -1.2, 1.2, -1.5, -1.5, 0.0])
+    return model, q0, adaptimp.Chain.from_mujoco(model, SITES[name])
+
+
+def circle(p0: np.ndarray) -> Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    def path(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        c, s = np.cos(OMEGA * t), np.sin(OMEGA * t)
+        return (
+            p0 + RADIUS * np.array([c - 1.0, s, 0.0]),
+            RADIUS * OMEGA * np.array([-s, c, 0.0]),
+            -RADIUS * OMEGA * OMEGA * np.array([c, s, 0.0]),
+        )
+
+    return path
+
+
+def adaptimp_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], float]]:
+    """(run: seconds per period, the last run's RMS position error after 1 s)."""
+    model, q0, chain = arm(name)
+    plant = amj.Plant(model)
+    p0 = chain.pose(q0)[0]
+    path = circle(p0)
+    outer = adaptimp.cartesian.CartesianImpedance(chain, Ts=TS, q0=q0)
+    centres, widths = outer.orbit_centres(path, 2.0, nodes=64)
+    kw = tuning.suggest(plant, q0, plant.tau_max, Ts=TS)
+    kw.pop("n")
+    ctrl = adaptimp.CartesianController(
+        chain, "sf", q0=q0, path=path, centers=centres, widths=widths, **kw
+    )
+    steps = round(T / TS)
+    error = [np.nan]
+
+    def run() -> float:
+        ctrl.reset()
+        start = time.perf_counter()
+        res = amj.simulate(ctrl, plant, T=T, q0=q0)
+        seconds = time.perf_counter() - start
+        assert res.params["loop"] == "native"
+        p = np.array([chain.pose(q)[0] for q in res.q[1000::10]])
+        want = np.array([path(t)[0] for t in res.t[1000::10]])
+        error[0] = float(np.sqrt(np.mean(np.sum((p - want) ** 2, axis=1))))
+        return seconds / steps
+
+    return run, lambda: error[0]
+
+
+def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], float]]:
+    """The mjctrl-style operational-space loop in Python (module doc)."""
+    model, q0, _ = arm(name)
+    data = mujoco.MjData(model)
+    substeps = round(TS / model.opt.timestep)
+    site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, SITES[name])
+    n = model.nv
+    kp = np.array([1500.0] * 3 + [200.0] * 3)  # 1/s² per unit of task inertia
+    kd = 2.0 * np.sqrt(kp)
+    kn, dn = 25.0, 10.0
+    lo, hi = model.actuator_ctrlrange.T
+    steps = round(T / TS)
+    error = [np.nan]
+
+    def reset() -> None:
+        mujoco.mj_resetData(model, data)
+        data.qpos[:] = q0
+        mujoco.mj_forward(model, data)
+
+    reset()
+    p0 = data.site_xpos[site].copy()
+    path = circle(p0)
+    quat_d = np.zeros(4)
+    mujoco.mju_mat2Quat(quat_d, data.site_xmat[site])
+
+    jacp, jacr = np.zeros((3, n)), np.zeros((3, n))
+    jac = np.zeros((6, n))
+    mass = np.zeros((n, n))
+    quat, conj, err_quat = np.zeros(4), np.zeros(4), np.zeros(4)
+    twist = np.zeros(6)
+    eye = np.eye(n)
+
+    def full_mass() -> None:
+        try:
+            mujoco.mj_fullM(model, data, mass)
+        except TypeError:  # MuJoCo 3: mj_fullM(m, dst, qM)
+            mujoco.mj_fullM(model, mass, data.qM)
+
+    def run() -> float:
+        reset()
+        errors = []
+        start = time.perf_counter()
+        for k in range(steps):
+            p_c, dp_c, _ = path(k * TS)
+            mujoco.mj_jacSite(model, data, jacp, jacr, site)
+            jac[:3], jac[3:] = jacp, jacr
+            full_mass()
+            m_inv = np.linalg.inv(mass)
+            task_inv = jac @ m_inv @ jac.T
+            task = np.linalg.inv(task_inv)
+            twist[:3] = p_c - data.site_xpos[site]
+            mujoco.mju_mat2Quat(quat, data.site_xmat[site])
+            mujoco.mju_negQuat(conj, quat)
+            mujoco.mju_mulQuat(err_quat, quat_d, conj)
+            mujoco.mju_quat2Vel(twist[3:], err_quat, 1.0)
+            dq = data.qvel
+            velocity = jac @ dq - np.concatenate([dp_c, np.zeros(3)])
+            tau = jac.T @ task @ (kp * twist - kd * velocity)
+            jbar = m_inv @ jac.T @ task
+            tau += (eye - jac.T @ jbar.T) @ (kn * (q0 - data.qpos) - dn * dq)
+            tau += data.qfrc_bias
+            data.ctrl[:] = np.clip(tau, lo, hi)
+            mujoco.mj_step(model, data, nstep=substeps)
+            if k >= 1000 and k % 10 == 0:
+                errors.append(np.sum((data.site_xpos[site] - path((k + 1) * TS)[0]) ** 2))
+        seconds = time.perf_counter() - start
+        error[0] = float(np.sqrt(np.mean(errors))) if errors else np.nan
+        return seconds / steps
+
+    return run, lambda: error[0]
+
+
+def measure(name: str, T: float, repeats: int) -> dict[str, Any]:
+    ours, our_error = adaptimp_loop(name, T)
+    theirs, their_error = user_loop(name, T)
+    a: list[float] = []
+    b: list[float] = []
+    gc.collect()
+    for k in range(repeats):
+        for f, out in ((ours, a), (theirs, b))[:: 1 if k % 2 == 0 else -1]:
+            out.append(f())
+    return {
+        "core_ns": round(statistics.median(a) * 1e9, 1),
+        "peer_ns": round(statistics.median(b) * 1e9, 1),
+        "ratio": round(statistics.median(a) / statistics.median(b), 3),
+        "core_rms_mm": round(our_error() * 1e3, 3),
+        "peer_rms_mm": round(their_error() * 1e3, 3),
+        "periods": round(T / TS),
+        "substeps": round(TS / arm_timestep(name)),
+    }
+
+
+def arm_timestep(name: str) -> float:
+    return 0.5e-3 if name == "panda" else 1e-3
+
+
+def count(name: str, side: str, T: float) -> float:
+    """Instructions of one run of ``side``'s loop of ``T`` s on the arm ``name`` (callgrind)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "cg"
+        proc = subprocess.run(
+            [
+                "valgrind",
+                "--tool=callgrind",
+                f"--callgrind-out-file={out}",
+                sys.executable,
+                __file__,
+                "--one",
+                side,
+                "--arms",
+                name,
+                "--T",
+                str(T),
+            ],
+            capture_output=True,
+            text=True,
+            check=True,
+            env={**os.environ, "OPENBLAS_NUM_THREADS": "1", "PYTHONHASHSEED": "0"},
+        )
+        for line in proc.stderr.splitlines():
+            if "refs:" in line:
+                return float(line.split()[-1].replace(",", ""))
+    raise RuntimeError(f"callgrind gave no count for {side}")
+
+
+def side_by_side(
+    name: str, count_ir: bool = False, T: float = 2.0, repeats: int = 5
+) -> dict[str, Any]:
+    """The JSON entry of ``benches/peers.py`` (arm "mujoco", row "cartesian_loop_ARM")."""
+    got = measure(name, T, repeats)
+    if count_ir:
+        t1, t2 = 1.2, 2.4
+        k = round((t2 - t1) / TS)
+        for side, key in (("adaptimp", "core_ir"), ("user", "peer_ir")):
+            got[key] = round((count(name, side, t2) - count(name, side, t1)) / k)
+        got["ir_ratio"] = round(got["core_ir"] / got["peer_ir"], 3)
+    return got
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--T", type=float, default=2.0, help="run length (s), ≥ 1.2")
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--arms", nargs="+", default=["ur5", "panda"], choices=list(SITES))
+    ap.add_argument("--count", action="store_true", help="also count instructions (callgrind)")
+    ap.add_argument("--one", choices=["adaptimp", "user"], help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.one:
+        run, _ = (adaptimp_loop if args.one == "adaptimp" else user_loop)(args.arms[0], args.T)
+        run()
+        return
+    for name in args.arms:
+        got = side_by_side(name, args.count, args.T, args.repeats)
+        print(
+            f"\n{name}, per period (Ts = 1 ms, {got['substeps']} MuJoCo steps), "
+            f"{got['periods']} periods, medians of {args.repeats}:\n"
+            f"  adaptimp (native Cartesian SF loop, learning): {got['core_ns'] / 1e3:.2f} µs "
+            f"(RMS error after 1 s {got['core_rms_mm']:.2f} mm)\n"
+            f"  the user's loop (mjctrl-style OSC in Python):  {got['peer_ns'] / 1e3:.2f} µs "
+            f"(RMS error after 1 s {got['peer_rms_mm']:.2f} mm)\n"
+            f"  adaptimp ÷ user: {got['ratio']:.2f} (target ≤ 0.5)"
+        )
+        if "core_ir" in got:
+            print(
+                f"  instructions per period: {got['core_ir']:,} against {got['peer_ir']:,} "
+                f"({got['ir_ratio']:.2f})"
+            )
+        for key in ("core_rms_mm", "peer_rms_mm"):
+            assert got[key] < 5.0, f"{key} = {got[key]} mm: a loop does not track the circle"
+
+
+if __name__ == "__main__":
+    main()

@@ -105,7 +105,8 @@ def _law(model: Any, data: Any, q: np.ndarray, dq: np.ndarray, a: np.ndarray) ->
 
 def test_the_joint_law_is_computed_torque_with_pinocchios_dynamics() -> None:
     """(20.3) in the joint mode along a run of setpoints: the compliant reference
-    of SPEC §4 and τ = M (ẍd + K_D ė + K_P e) + C q̇ + G + τe, clipped at τmax."""
+    of SPEC §4, advanced exactly for the acceleration ẍd held over the period,
+    and τ = M (ẍd + K_D ė + K_P e) + C q̇ + G + τe, clipped at τmax."""
     model = pinocchio_model("panda")
     data = model.createData()
     n = 7
@@ -125,8 +126,9 @@ def test_the_joint_law_is_computed_torque_with_pinocchios_dynamics() -> None:
         want = np.clip(_law(model, data, q, dq, a) + tau_e, -tau_max, tau_max)
         got = ct.step(q, tau_e, dq, xc=xc, dxc=dxc, ddxc=ddxc)
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.abs(want).max())
+        # The reference moves as the arm does under the held torque (SPEC (20.3)).
+        xd = xd + 1e-3 * dxd + 0.5e-6 * ddxd
         dxd = dxd + 1e-3 * ddxd
-        xd = xd + 1e-3 * dxd
     assert ct.t == pytest.approx(0.2)
 
 
@@ -282,7 +284,12 @@ def test_computed_torque_compensates_the_drives_friction() -> None:
     refused by name when negative."""
     n = 7
     friction = np.linspace(0.5, 2.0, n)
-    kw: dict[str, Any] = {"tau_max": np.full(n, 1e3), "impedance": "external", "Kp": 100.0}
+    kw: dict[str, Any] = {
+        "tau_max": np.full(n, 1e3),
+        "impedance": "external",
+        "Kp": 100.0,
+        "Kd": 40.0,
+    }
     rigid = ComputedTorque("panda", **kw)
     driven = ComputedTorque("panda", armature=0.1, damping=0.5, friction=friction, **kw)
     rng = np.random.default_rng(11)

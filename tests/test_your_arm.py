@@ -83,8 +83,9 @@ def test_the_task_swings_about_a_home_posture_inside_the_limits() -> None:
 
 def test_a_payload_nobody_told_the_controller_about() -> None:
     """UR5, 10 % of its moving mass at the last link: state feedback learns it
-    and beats computed torque with the nominal model (ω = 20 rad/s, critically
-    damped), though not computed torque with the exact one."""
+    and beats computed torque with the nominal model 5× over, and computed
+    torque with the exact model beats SF (issue targets; the default gains of
+    SPEC (20.8), the same for both models)."""
     nominal = amj.Plant(UR5)
     kg = 0.1 * amj.moving_mass(nominal.model)
     assert kg == pytest.approx(1.699, abs=1e-3)
@@ -97,7 +98,7 @@ def test_a_payload_nobody_told_the_controller_about() -> None:
         res = amj.simulate(ct, UR5, T=T, reference=sf, q0=sf.q[0], payload=kg)
         np.testing.assert_array_equal(res.xc, sf.xc)  # the same task
         rms[name] = _targets(res)["rms"]
-    assert rms["ct_exact"] < rms["sf"] < rms["ct_nominal"], rms
+    assert rms["ct_exact"] <= rms["sf"] <= 0.2 * rms["ct_nominal"], rms
     assert rms["sf"] < 0.2 * rms["pd"], rms
 
 

@@ -43,7 +43,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 from . import _models
 from ._trajectory import Reference, paper_circle
 
-__all__ = ["ComputedTorque", "core_description", "pinocchio_model", "with_payload"]
+__all__ = ["ComputedTorque", "core_description", "default_gains", "pinocchio_model", "with_payload"]
 
 FloatArray = NDArray[np.float64]
 
@@ -97,6 +97,15 @@ def _arm(source: Any, tip: str | None, fix: Sequence[str]) -> Any:
             f"pinocchio.Model; no file {str(source)!r}"
         )
     return read_arm(source, tip, fix)
+
+
+def default_gains(Ts: float) -> tuple[float, float]:
+    """Computed torque's default (K_P, K_D) for a robot description at period
+    ``Ts`` (s), SPEC (20.8): the error dynamics ë + K_D ė + K_P e = 0 with a
+    double pole at the rule's position-loop bandwidth K1 = min(50 s⁻¹,
+    0.05/Ts) (SPEC (18.2)), K_P = K1², K_D = 2 K1: (2500, 100) at 1 kHz."""
+    k1 = min(50.0, 0.05 / Ts)
+    return k1 * k1, 2.0 * k1
 
 
 def pinocchio_model(
@@ -272,10 +281,15 @@ class ComputedTorque:
         ``pinocchio.Model``. The dynamics are the core's.
     Ts : float
         Period (s).
-    Kp : float or (n,)
-        Stiffness K_P of the error dynamics (1/s²); default 400 (ω = 20 rad/s).
-    Kd : float or (n,)
-        Damping K_D (1/s); default 40 (critical damping at ω = 20 rad/s).
+    Kp : float or (n,), optional
+        Stiffness K_P of the error dynamics (1/s²). Default for a robot
+        description (a path, a MuJoCo model, ``"panda"``): K1², with K1 =
+        min(50 s⁻¹, 0.05/Ts) the rule's position-loop bandwidth (SPEC (18.2),
+        (20.8): 2500 at 1 kHz; :func:`default_gains`); for the paper's arm and a
+        ``pinocchio.Model``, 400 (ω = 20 rad/s), as in the paper's comparisons.
+    Kd : float or (n,), optional
+        Damping K_D (1/s): default 2 K1 (critically damped; 100 at 1 kHz), or
+        40 where K_P defaults to 400.
     tau_max : float or (n,), optional
         Actuator limits (N m); default the description's effort limits (the
         URDF's, the MJCF's actuators'), or the paper's [17, 15] for the
@@ -320,8 +334,8 @@ class ComputedTorque:
         model: Any = "two_link",
         *,
         Ts: float = 1e-3,
-        Kp: ArrayLike = 400.0,
-        Kd: ArrayLike = 40.0,
+        Kp: ArrayLike | None = None,
+        Kd: ArrayLike | None = None,
         tau_max: ArrayLike | None = None,
         mass_scale: float = 1.0,
         payload: float = 0.0,
@@ -347,7 +361,8 @@ class ComputedTorque:
         if not (math.isfinite(payload) and payload >= 0):
             raise ValueError(f"payload must be ≥ 0 kg, got {payload}")
         limits: FloatArray | None
-        if isinstance(model, pin.Model) or (isinstance(model, str) and model == "two_link"):
+        paper = isinstance(model, pin.Model) or (isinstance(model, str) and model == "two_link")
+        if paper:
             if tip is not None or fix or drive:
                 raise ValueError("tip, fix and drive apply to a robot description, not a model")
             exact = pinocchio_model(model)
@@ -376,7 +391,9 @@ class ComputedTorque:
         if not (Ts > 0 and math.isfinite(Ts)):
             raise ValueError(f"Ts must be > 0, got {Ts}")
         self._ts = float(Ts)
-        self.Kp, self.Kd = _joint("Kp", Kp, n), _joint("Kd", Kd, n)
+        kp, kd = (400.0, 40.0) if paper else default_gains(self._ts)
+        self.Kp = _joint("Kp", kp if Kp is None else Kp, n)
+        self.Kd = _joint("Kd", kd if Kd is None else Kd, n)
         self.Dd, self.Cd, self.Gd = _joint("Dd", Dd, n), _joint("Cd", Cd, n), _joint("Gd", Gd, n)
         if np.any(self.Dd <= 0):
             raise ValueError(f"Dd must be > 0, got {self.Dd}")

@@ -217,11 +217,11 @@ class InPython:
 
 def cartesian(name: str) -> tuple[Any, Any, np.ndarray]:
     """The arm's plant, Cartesian controller and start."""
-    from adaptimp import cartesian as ac
+    from adaptimp.scenarios import panda_table as apt
 
     if name == "Panda":
-        sc = ac.panda_table()
-        return amj.Plant(sc.model), ac.panda_controller("sf", sc), sc.q0
+        sc = apt.panda_table()
+        return amj.Plant(sc.model), apt.panda_controller("sf", sc), sc.q0
     from adaptimp._models import panda_urdf_path
 
     urdf = panda_urdf_path().parents[2] / "ur_description" / "urdf" / "ur5_robot.urdf"
@@ -415,8 +415,8 @@ def panda_table_times(T: float, repeats: int) -> None:
     ct+30 on the default table): each natively and behind a Python object."""
     import importlib.util
 
-    from adaptimp import cartesian as ac
-    from adaptimp import contact as act
+    from adaptimp.scenarios import contact as act
+    from adaptimp.scenarios import panda_table as apt
 
     path = Path(__file__).resolve().parent.parent / "examples" / "13_panda_table.py"
     spec = importlib.util.spec_from_file_location("panda_table_example", path)
@@ -453,7 +453,7 @@ def panda_table_times(T: float, repeats: int) -> None:
                 res = amj.simulate(
                     ctrl if how == "native" else InPython(ctrl), plant, T=T, q0=sc.q0
                 )
-                ac.cartesian_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
+                apt.cartesian_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
                 times[kind][how].append(time.perf_counter() - start)
                 if how == "native":
                     loops[kind] = res.params["loop"]

@@ -66,6 +66,7 @@ import argparse
 import json
 import math
 import os
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -74,9 +75,9 @@ from typing import Any
 import numpy as np
 
 import adaptimp
-from adaptimp import cartesian as ac
-from adaptimp import contact as act
 from adaptimp import mujoco as amj
+from adaptimp.scenarios import contact as act
+from adaptimp.scenarios import panda_table as apt
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
 """``ADAPTIMP_QUICK=1``: T = 2.5 s (the tool is pressed in at 1.8 s)."""
@@ -98,6 +99,24 @@ ROWS: dict[str, tuple[str, str, str, bool, bool]] = {
     "ct": ("CT exact, impedance", "ct", "impedance", False, False),
     "ct+30": ("CT +30 % mass, impedance", "ct+30", "impedance", False, False),
 }
+GRAVITY_LEARNING = {
+    "gamma": [1.0, 1.0, 5000.0],
+    "sigma": [0.01, 0.01, 1e-5],
+    "weight_bound": [4.19, 13.2, 100.0],
+}
+"""docs/panda.md's gravity learning, found by hand on that scenario (before the rule's)."""
+# The scenario of docs/panda.md as first measured (--first): name: (label, joint
+# controller, +τe feedforward, learning keywords).
+FIRST: dict[str, tuple[str, str, bool, dict[str, Any]]] = {
+    "pd": ("PD", "pd", True, {}),
+    "sf-printed": ("SF as printed (+τe, Γ = 1)", "sf", True, {}),
+    "of-printed": ("OF as printed (+τe, Γ = 1)", "of", True, {}),
+    "sf-no-ff": ("SF, no τe feedforward, Γ = 1", "sf", False, {}),
+    "sf-gravity": ("SF, no τe feedforward, gravity learning", "sf", False, GRAVITY_LEARNING),
+    "of-gravity": ("OF, no τe feedforward, gravity learning", "of", False, GRAVITY_LEARNING),
+    "ct": ("CT exact", "ct", True, {}),
+    "ct+30": ("CT +30 % mass", "ct+30", True, {}),
+}
 KEYS = (
     "track_mm",
     "track_along_mm",
@@ -112,7 +131,7 @@ KEYS = (
 FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "contact_force.png"
 
 
-def controller(name: str, sc: ac.PandaTable, rule: dict[str, Any]) -> Any:
+def controller(name: str, sc: apt.PandaTable, rule: dict[str, Any]) -> Any:
     """The controller of one row on the scenario; ``rule``: the scenario's
     :func:`adaptimp.contact.rule_keywords`."""
     _, kind, formulation, ff, learn = ROWS[name]
@@ -121,11 +140,11 @@ def controller(name: str, sc: ac.PandaTable, rule: dict[str, Any]) -> Any:
         extra["admittance_share"] = SHARE
     if kind in ("pd", "sf", "of"):
         extra.update({k: v for k, v in rule.items() if learn or k not in LEARN_KEYS})
-    return ac.panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
+    return apt.panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
 
 
 def run(
-    name: str, sc: ac.PandaTable, rule: dict[str, Any], T: float
+    name: str, sc: apt.PandaTable, rule: dict[str, Any], T: float
 ) -> tuple[Any, Any, dict[str, float]]:
     """One row on the scenario: (result, controller, metrics)."""
     ctrl = controller(name, sc, rule)
@@ -170,7 +189,7 @@ def figure(path: Path, T: float) -> None:
     plt.close(fig)
 
 
-def long_run(sc: ac.PandaTable, rule: dict[str, Any], T: float) -> None:
+def long_run(sc: apt.PandaTable, rule: dict[str, Any], T: float) -> None:
     """SF (unified, n = SHARE) for T seconds, in parts of 10 s in the core's loop
     (the plant and the controller go on from one part to the next: the rows of
     one run); prints ‖Ŵ‖_F and the mean normal force every 10 s."""
@@ -195,14 +214,107 @@ def long_run(sc: ac.PandaTable, rule: dict[str, Any], T: float) -> None:
         )
 
 
+def first(T: float, jobs: int, path: str | None) -> None:
+    """docs/panda.md's table: the Panda of ``panda_table()`` (its SRDF home,
+    MuJoCo's default contact, straight from home into the table, the
+    admittance), every joint controller with the core's gain rule
+    (``panda_table.rule_gains``) and Γ = 1 or the page's gravity learning."""
+    sc = apt.panda_table()
+    print(
+        f"docs/panda.md: the Panda, {sc.radius * 100:g} cm circle at {sc.freq:g} Hz, δ_c = "
+        f"{sc.depth * 1e3:g} mm, T = {T:g} s, the core's gain rule"
+    )
+    print("\n| controller | track (mm) | force (N) | imp (N) | sat | peak τ/τmax |")
+    print("|---|---:|---:|---:|---:|---:|")
+
+    def one(name: str) -> dict[str, float]:
+        _, kind, ff, learning = FIRST[name]
+        kw = {"gamma": 1.0, **learning} if kind in ("pd", "sf", "of") else {}
+        ctrl = apt.panda_controller(kind, sc, force_feedforward=ff, **kw)
+        res = amj.simulate(ctrl, amj.Plant(sc.model), T=T, q0=sc.q0)
+        return apt.cartesian_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        results = list(pool.map(one, FIRST))
+    table = {}
+    for name, m in zip(FIRST, results):
+        table[name] = m
+        print(
+            f"| {FIRST[name][0]} | {m['rms_track'] * 1e3:.3f} | {m['rms_force']:.2f} "
+            f"| {m['rms_imp']:.2f} | {m['sat_duty']:.3f} | {m['peak_tau_ratio']:.3f} |"
+        )
+    if path:
+        Path(path).write_text(json.dumps(table, indent=2) + "\n")
+        print(f"\nwrote {path}")
+
+
+def posture(text: str) -> list[float]:
+    """``--home``: joint angles (rad) separated by commas; each a number or an
+    arithmetic expression of numbers and ``pi`` (``-pi/4``, ``3*pi/4``)."""
+    import ast
+    import operator
+
+    ops = {
+        ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+        ast.Div: operator.truediv, ast.USub: operator.neg, ast.UAdd: operator.pos,
+    }  # fmt: skip
+
+    def value(node: ast.AST) -> float:
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            return float(node.value)
+        if isinstance(node, ast.Name) and node.id == "pi":
+            return math.pi
+        if isinstance(node, ast.BinOp) and type(node.op) in ops:
+            return float(ops[type(node.op)](value(node.left), value(node.right)))
+        if isinstance(node, ast.UnaryOp) and type(node.op) in ops:
+            return float(ops[type(node.op)](value(node.operand)))
+        raise ValueError(ast.dump(node))
+
+    def angle(item: str) -> float:
+        try:
+            return value(ast.parse(item.strip(), mode="eval").body)
+        except (ValueError, SyntaxError):
+            raise argparse.ArgumentTypeError(
+                f"a joint angle (rad) must be a number or an expression of numbers and pi, "
+                f"got {item.strip()!r}"
+            ) from None
+
+    return [angle(item) for item in text.split(",")]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
-    parser.add_argument("--arm", type=str, default=None, help="URDF of the arm (default: Panda)")
+    parser.add_argument(
+        "--arm", type=str, default=None, help="URDF or MJCF file of the arm (default: Panda)"
+    )
+    parser.add_argument(
+        "--home",
+        type=posture,
+        default=None,
+        help="the home posture, q1,...,qn (rad; e.g. 0,-pi/4,0,-3*pi/4,0,pi/2,pi/4); "
+        "default: the first the table can run of the rule's home and postures drawn",
+    )
+    parser.add_argument("--tip", type=str, default=None, help="the tool's link (body)")
+    parser.add_argument(
+        "--fix", type=str, default="", help="joints to fix at zero, J1,J2 (a URDF's)"
+    )
+    parser.add_argument(
+        "--placements",
+        type=int,
+        default=0,
+        help="run the rows at this many home postures drawn within the joint limits "
+        "(each one the table can run) instead of one home",
+    )
+    parser.add_argument(
+        "--first",
+        action="store_true",
+        help="docs/panda.md's table: the scenario as first measured, the core's gain rule",
+    )
     parser.add_argument("--T", type=float, default=2.5 if QUICK else 20.0, help="duration (s)")
     parser.add_argument("--json", type=str, default=None, help="write the table as JSON here")
     parser.add_argument("--friction", type=float, default=0.1, help="sliding friction")
     parser.add_argument("--spring", type=float, default=None, help="table spring k_e (N/m)")
-    parser.add_argument("--rows", type=str, default=",".join(ROWS), help="rows to run")
+    parser.add_argument("--rows", type=str, default=None, help="rows to run (default: all)")
     parser.add_argument("--figure", action="store_true", help=f"write {FIGURE.name}")
     parser.add_argument("--long", type=float, default=0.0, help="also a long SF run (s)")
     parser.add_argument(
@@ -211,7 +323,14 @@ def main() -> None:
         default=os.cpu_count() or 1,
         help="rows run at once, on threads (the core's loop releases the GIL); default: every core",
     )
-    args = parser.parse_args()
+    # A posture that starts with a negative angle (--home -0.47,…) is the
+    # option's value, not an option.
+    argv = sys.argv[1:]
+    for i, a in enumerate(argv[:-1]):
+        if a == "--home" and argv[i + 1].startswith("-"):
+            argv[i : i + 2] = [f"--home={argv[i + 1]}"]
+            break
+    args = parser.parse_args(argv)
     if args.jobs < 1:
         parser.error(f"--jobs must be ≥ 1, got {args.jobs}")
     if not (math.isfinite(args.T) and args.T > 0):
@@ -220,26 +339,68 @@ def main() -> None:
         parser.error(
             f"--long must be 0 or a multiple of 10 s (it runs in parts of 10 s), got {args.long}"
         )
-    names = args.rows.split(",")
+    if args.first:
+        first(args.T, args.jobs, args.json)
+        return
+    if args.placements < 0 or (args.placements and args.home is not None):
+        parser.error("--placements must be ≥ 0, and draws the homes: give it without --home")
+    names = list(ROWS) if args.rows is None else args.rows.split(",")
     unknown = [n for n in names if n not in ROWS]
     if unknown:
         parser.error(f"--rows: unknown {unknown}; the rows are {list(ROWS)}")
     if args.json and not Path(args.json).resolve().parent.is_dir():
         parser.error(f"--json: no directory {Path(args.json).resolve().parent}")
+    fix = tuple(j for j in args.fix.split(",") if j)
+    where = {"tip": args.tip, "fix": fix} if args.arm is not None else {}
     try:
-        sc = act.arm_table(args.arm, spring=args.spring, friction=args.friction)
+        if args.placements:
+            drawn = act.placements(
+                args.arm, args.placements, spring=args.spring, friction=args.friction, **where
+            )
+            scenarios = [(f"placement {k}", sc) for k, sc in enumerate(drawn)]
+        else:
+            home = {} if args.home is None else {"home": args.home}
+            sc = act.arm_table(
+                args.arm, spring=args.spring, friction=args.friction, **where, **home
+            )
+            scenarios = [("", sc)]
     except (adaptimp.ConfigError, ValueError, OSError) as e:
         parser.error(str(e))
-    if sc.t_approach + sc.t_press >= args.T:
-        parser.error(
-            f"--T must be longer than the approach, which ends with the tool pressed in at "
-            f"t = {sc.t_approach + sc.t_press:g} s; got {args.T:g}"
-        )
+    if scenarios[0][1].pin_model is None:
+        # Computed torque's model is Pinocchio's, read from a URDF.
+        given = [n for n in names if ROWS[n][1].startswith("ct")]
+        if args.rows is not None and given:
+            parser.error(f"--rows: {given} need a URDF arm (computed torque's model)")
+        names = [n for n in names if not ROWS[n][1].startswith("ct")]
+    table: dict[str, dict[str, Any]] = {}
+    for label, sc in scenarios:
+        if sc.t_approach + sc.t_press >= args.T:
+            parser.error(
+                f"--T must be longer than the approach, which ends with the tool pressed in "
+                f"at t = {sc.t_approach + sc.t_press:g} s; got {args.T:g}"
+            )
+        table.update(run_table(args, label, sc, names))
+    if args.json:
+        Path(args.json).write_text(json.dumps(table, indent=2) + "\n")
+        print(f"\nwrote {args.json}")
+    if args.figure and not QUICK:
+        figure(FIGURE, args.T)
+        print(f"\nwrote {FIGURE}")
+    if args.long > 0:
+        sc = scenarios[0][1]
+        long_run(sc, act.rule_keywords(sc), args.long)
+
+
+def run_table(
+    args: argparse.Namespace, label: str, sc: apt.PandaTable, names: list[str]
+) -> dict[str, dict[str, Any]]:
+    """The rows ``names`` on one scenario, printed as a Markdown table; their
+    metrics by row name (prefixed with ``label``)."""
     rule = act.rule_keywords(sc)
     print(
-        f"{args.arm or 'Panda'}: {sc.radius * 100:g} cm circle at {sc.freq:g} Hz about "
-        f"({sc.centre[0]:.3f}, {sc.centre[1]:.3f}) m, table top {sc.surface_z - 0.01:.4f} m, "
-        f"δ_c = {sc.depth * 1e3:g} mm, friction {args.friction:g}, "
+        f"\n{label + ': ' if label else ''}{args.arm or 'Panda'}: {sc.radius * 100:g} cm "
+        f"circle at {sc.freq:g} Hz about ({sc.centre[0]:.3f}, {sc.centre[1]:.3f}) m, table top "
+        f"{sc.surface_z - 0.01:.4f} m, δ_c = {sc.depth * 1e3:g} mm, friction {args.friction:g}, "
         f"{'rigid' if args.spring is None else f'spring {args.spring:g} N/m'}, T = {args.T:g} s, "
         f"home {np.round(sc.q0, 3).tolist()}, {rule['basis'][0].shape[0]} centres"
     )
@@ -249,7 +410,7 @@ def main() -> None:
         "| time (s) |"
     )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    table: dict[str, dict[str, float]] = {}
+    table: dict[str, dict[str, Any]] = {}
 
     def timed(name: str) -> tuple[dict[str, float] | None, float, str]:
         """One row: its metrics (None if it diverged), its own time (s), the error."""
@@ -270,7 +431,10 @@ def main() -> None:
         if m is None:
             print(f"| {ROWS[name][0]} | diverged: {error} |")
             continue
-        table[name] = {k: m[k] for k in KEYS}
+        table[f"{label}: {name}" if label else name] = {
+            **{k: m[k] for k in KEYS},
+            **({"home": [float(x) for x in sc.q0]} if label else {}),
+        }
         print(
             f"| {ROWS[name][0]} | {m['track_mm']:.3f} | {m['track_along_mm']:.3f} "
             f"| {m['force_rms_err_N']:.3f} "
@@ -281,14 +445,7 @@ def main() -> None:
         )
         assert m["applied_ratio"] <= 1.0 + 1e-12, "applied torque beyond its limit"
     print(f"\n{len(names)} rows in {wall:.1f} s on {min(args.jobs, len(names))} thread(s)")
-    if args.json:
-        Path(args.json).write_text(json.dumps(table, indent=2) + "\n")
-        print(f"\nwrote {args.json}")
-    if args.figure and not QUICK:
-        figure(FIGURE, args.T)
-        print(f"\nwrote {FIGURE}")
-    if args.long > 0:
-        long_run(sc, rule, args.long)
+    return table
 
 
 if __name__ == "__main__":

@@ -37,7 +37,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from adaptimp import contact as act
+from adaptimp.scenarios import contact as act
 
 MASS = 2.35
 """kg: the Panda tool's inverse-mass approximation in MuJoCo (``body_invweight0``

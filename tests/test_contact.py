@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import math
 import os
 import subprocess
 import sys
@@ -17,9 +18,10 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import cartesian as ac
-from adaptimp import contact as act
 from adaptimp import mujoco as amj
+from adaptimp.scenarios import contact as act
+from adaptimp.scenarios import panda_table as apt
+from mujoco_probe import ee_position
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "13_panda_table.py"
 SLIDING = Path(__file__).resolve().parent.parent / "scripts" / "sliding_contact.py"
@@ -37,7 +39,7 @@ def test_the_torque_level_formulation_holds_a_rigid_frictionless_table() -> None
     feedforward (SPEC (19.2) with a model): the force is K_d δ_c, steady, and the
     tool never leaves the table."""
     sc = act.arm_table(friction=0.0)
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=3.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
     assert m["force_target_N"] == pytest.approx(7.5)
@@ -60,7 +62,7 @@ def test_the_unified_formulation_holds_the_table_with_the_paper_s_feedforward() 
     centres and learning: no chatter, no loss of contact on the frictionless
     table (the admittance alone chatters, SPEC §19)."""
     sc = act.arm_table(friction=0.0)
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, formulation="unified", admittance_share=0.3, **act.rule_keywords(sc)
     )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=3.0, q0=sc.q0)
@@ -78,7 +80,7 @@ def test_a_spring_table_gives_the_force_16_1_prescribes() -> None:
     k_e = 5000.0
     sc = act.arm_table(friction=0.0, spring=k_e, freq=1e-9)
     assert amj.Plant(sc.model).n == 7  # the spring's slide joint is the table's
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     fn = -res.wrench_ee[-500:, 2].mean()
     log = ctrl.arrays()
@@ -225,7 +227,7 @@ def test_the_panda_s_tool_slides_on_the_friction_table_without_chatter() -> None
     the torque-level formulation: the force is steady (MuJoCo's default contact:
     7.2 N of chatter, 1.2 s without contact over t ∈ [2, 6] s)."""
     sc = act.arm_table()
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
     assert m["force_chatter_N"] < 1e-3
@@ -239,7 +241,7 @@ def test_the_ur5_s_tool_stays_on_the_frictionless_table() -> None:
     (impedance): no single-step lift-offs (with the pyramid: 0.67 N of chatter
     and 0.019 s without contact over t ∈ [2, 6] s)."""
     sc = act.arm_table(_ur5(), friction=0.0)
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
     assert m["force_chatter_N"] < 1e-3
@@ -276,47 +278,40 @@ def test_a_scenario_quantity_out_of_range_is_refused_by_name(
             act.arm_table(urdf, **{name: value})
 
 
-def test_the_scenario_s_joint_gains_take_continuous_joints_as_angles() -> None:
+def test_the_scenario_s_rule_gains_take_continuous_joints_as_angles() -> None:
     """Kinova's arm joints are continuous (Pinocchio: nq = 9 for nv = 6).
-    panda_table.joint_gains (the Panda scenario's, docs/panda.md) reads D(q0)
+    panda_table.rule_gains (the core's rule on Pinocchio's D(q0)) reads D(q0)
     through tuning.inertia, which takes the chain's angles; they equal the rule
     (18.1) computed from MuJoCo's mass matrix of the same arm, an independent
     engine, to 1e-9 (Pinocchio's CRBA on the 6 angles failed with "expected 9, got 6")."""
-    from adaptimp import panda_table as apt
-
     urdf = _ur5().parent.parent.parent / "kinova_description" / "robots" / "kinova.urdf"
     sc = act.arm_table(urdf)
     assert sc.pin_model.nq == 9
     assert sc.n == 6
-    gains = apt.joint_gains(sc)
+    gains = apt.rule_gains(sc)
     plant = amj.Plant(sc.model)
     d = adaptimp.tuning.inertia(plant, sc.q0)
     kp = 0.25 / (sc.Ts * np.diag(np.linalg.inv(d)))
     np.testing.assert_allclose(gains["Kp"], kp, rtol=1e-9)
-    assert gains["K1"] == [20.0] * 6
+    assert gains["K1"] == [50.0] * 6
 
 
 def test_a_light_wrist_does_not_ring_against_the_table() -> None:
     """The UR10's last joint (d = 5e-4 kg m²) with the robot preset's fixed
     kr = 0.5 N m ran its sampled velocity loop at Ts (Kp + kr/φ)/d = 20 > 2: it
     rang at half the sampling rate and the tool chattered on the table (SF
-    unified: 183 N). panda_table.joint_gains carry SPEC (18.4)'s kr = φ Kp/2,
-    as the rule does."""
-    from adaptimp import panda_table as apt
-
+    unified: 183 N). The core's rule carries SPEC (18.4)'s kr = φ Kp/2
+    (panda_table.rule_gains, and the scenario's rule_keywords, whose learning
+    and K1 = 10 s⁻¹ the table needs at the UR10's home, the zero posture: its
+    wrist joints 4 and 6 in line, the velocity loop's λmin = 0.10)."""
     urdf = _ur5().parent / "ur10_robot.urdf"
     sc = act.arm_table(urdf)
-    gains = apt.joint_gains(sc)
+    gains = apt.rule_gains(sc)
     np.testing.assert_allclose(gains["kr"], 0.025 * np.asarray(gains["Kp"]), rtol=1e-15)
-    ctrl = ac.panda_controller(
-        "sf",
-        sc,
-        force_feedforward=False,
-        formulation="unified",
-        admittance_share=0.3,
-        gamma=[1.0, 1.0, 5000.0],  # the table's learning before SPEC (19.6)
-        sigma=[0.01, 0.01, 1e-5],
-        weight_bound=[4.19, 13.2, 100.0],
+    kw = act.rule_keywords(sc)
+    np.testing.assert_allclose(kw["kr"], 0.025 * np.asarray(kw["gains"]["Kp"]), rtol=1e-15)
+    ctrl = apt.panda_controller(
+        "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3, **kw
     )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
     m = act.contact_metrics(res, ctrl, sc)
@@ -345,7 +340,7 @@ def test_the_heavy_ur10_learns_its_gravity_before_it_reaches_the_table() -> None
     never exceeds a few times K_d δ_c, and it holds (SPEC (19.6))."""
     urdf = _ur5().parent / "ur10_robot.urdf"
     sc = act.arm_table(urdf)
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3,
         **act.rule_keywords(sc),
     )  # fmt: skip
@@ -376,10 +371,11 @@ def test_a_folded_home_puts_the_circle_in_front_of_the_base() -> None:
     sc = act.arm_table(_erd("z1_description/urdf/z1.urdf"))
     plant = amj.Plant(sc.model)
     limits = act._limits(plant)
-    clearance = sc.p0[2] - sc.surface_z
-    centre, _, reach = act.placement(sc.chain, sc.q0, limits, clearance=clearance)
-    assert np.linalg.norm(sc.p0[:2]) < act.AXIS_SHARE * reach
-    np.testing.assert_allclose(sc.centre, centre)
+    folded = amj.home_posture(plant)  # the rule's home: the Z1 at rest
+    np.testing.assert_allclose(folded, [0.0, 0.2, -0.2, 0.0, 0.0, 0.0])
+    centre, _, reach = act.placement(sc.chain, folded, limits, clearance=0.03)
+    tip = sc.chain.fk(folded)[:3, 3]
+    assert np.linalg.norm(tip[:2]) < act.AXIS_SHARE * reach
     assert centre[1] == 0.0
     assert centre[0] == pytest.approx(act.MIN_REACH_SHARE * reach)
 
@@ -389,7 +385,7 @@ def test_the_z1_presses_on_the_table_with_the_rule() -> None:
     with the rule's keywords meets the issue's targets over t ≥ 2 s of a 4 s
     run (T = 20 s: 0.073 mm, 0.029 N, docs/contact.md)."""
     sc = act.arm_table(_erd("z1_description/urdf/z1.urdf"))
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3,
         **act.rule_keywords(sc),
     )  # fmt: skip
@@ -416,11 +412,12 @@ def test_an_arm_that_cannot_hold_the_press_is_refused_by_joint() -> None:
         r"its effort limit is 0\.00414 N m; give the URDF a larger <limit effort> for it, "
         r"or a smaller depth or friction$"
     )
-    warns = pytest.warns(UserWarning, match="no effort limit")
-    with warns, pytest.raises(adaptimp.ConfigError, match=message):
-        act.arm_table(urdf)
     with pytest.warns(UserWarning, match="no effort limit"):
         sc = act.arm_table(urdf, friction=0.0)
+    rule_home = amj.home_posture(amj.Plant(sc.model))
+    warns = pytest.warns(UserWarning, match="no effort limit")
+    with warns, pytest.raises(adaptimp.ConfigError, match=message):
+        act.arm_table(urdf, home=rule_home)
     with pytest.warns(UserWarning, match="no effort limit"):
         bare = amj.from_urdf(urdf)
     roll = mujoco.mj_name2id(sc.model, mujoco.mjtObj.mjOBJ_ACTUATOR, "wrist_roll")
@@ -469,7 +466,7 @@ def test_an_arm_three_times_the_ur10_holds_the_table(tmp_path: Path) -> None:
     urdf.write_text(text)
     sc = act.arm_table(urdf)
     assert act.CONTACT_K1 == 10.0
-    ctrl = ac.panda_controller(
+    ctrl = apt.panda_controller(
         "sf", sc, force_feedforward=False, formulation="unified", admittance_share=0.3,
         **act.rule_keywords(sc),
     )  # fmt: skip
@@ -556,10 +553,9 @@ def test_example_13_refuses_a_run_shorter_than_its_approach() -> None:
         assert what in run.stderr
 
 
-def test_the_rule_refuses_a_path_too_long_to_sample() -> None:
-    sc = act.arm_table(_ur5(), t_press=1e9)
+def test_a_path_too_long_to_sample_is_refused() -> None:
     with pytest.raises(adaptimp.ConfigError, match=r"beyond 1000000: give a shorter t_press"):
-        act.rule_keywords(sc)
+        act.arm_table(_ur5(), t_press=1e9)
 
 
 def test_the_panda_s_scenario_checks_the_press_too() -> None:
@@ -567,3 +563,130 @@ def test_the_panda_s_scenario_checks_the_press_too() -> None:
     500 N press that its wrist cannot hold."""
     with pytest.raises(adaptimp.ConfigError, match=r"^the arm cannot press on the table: "):
         act.arm_table(depth=1.0)
+
+
+READY = [0.0, -math.pi / 4, 0.0, -3 * math.pi / 4, 0.0, math.pi / 2, math.pi / 4]
+"""Franka's ready posture (the issue's: 45 mm, 30 N, 5.3 s off the table before
+the rule took D along the path, SPEC (16.12))."""
+
+
+def test_the_panda_urdf_holds_the_table_at_franka_s_ready_posture() -> None:
+    """The library's own Panda URDF at its maker's ready posture (--home): SF
+    unified meets the table's targets (4 s here; docs/contact.md has 10 s)."""
+    from adaptimp import _models
+
+    sc = act.arm_table(_models.panda_urdf_path(), home=READY)
+    np.testing.assert_array_equal(sc.q0, READY)
+    ctrl = apt.panda_controller(
+        "sf", sc, formulation="unified", admittance_share=0.3, **act.rule_keywords(sc)
+    )
+    res = amj.simulate(ctrl, amj.Plant(sc.model), T=4.0, q0=sc.q0)
+    m = act.contact_metrics(res, ctrl, sc)
+    assert m["track_mm"] < 1.0
+    assert m["force_rms_err_N"] < 0.1 * m["force_target_N"]
+    assert m["force_chatter_N"] < 0.05 * m["force_target_N"]
+    assert m["contact_lost_s"] == 0.0
+    assert m["peak_tau_ratio"] <= 2.0
+    assert m["sat_duty"] == 0.0
+
+
+def test_a_home_that_cannot_work_is_refused_by_name() -> None:
+    """Singular (the UR5 upright, its shoulder and elbow in line), gravity beyond
+    the actuators, the arm through the table: refused before anything runs."""
+    with pytest.raises(adaptimp.ConfigError) as e:
+        act.arm_table(_ur5(), home=[0.0, -math.pi / 2, 0.0, -math.pi / 2, 0.0, 0.0])
+    assert str(e.value).startswith(
+        "the home posture cannot run the table: condition σmin(J) ≥ 0.05 along the task "
+        "(not near a singularity) is violated: σmin(J) = "
+    )
+    from adaptimp import _models
+
+    with pytest.raises(adaptimp.ConfigError) as e:
+        act.arm_table(_models.panda_urdf_path(), home=[0.0, 0.0, 0.0, -0.27, 0.0, 0.182, 0.0])
+    assert str(e.value).startswith(
+        "the home posture cannot run the table: the arm clear of the table: at row "
+    )
+    assert "joint 3 ('panda_joint4') is 0.3" in str(e.value)
+
+
+def test_placements_draw_homes_the_table_runs(tmp_path: Path) -> None:
+    """placements: homes drawn within the limits, each one refusal_of passes;
+    example 13's --placements runs a row at each, --home takes pi."""
+    scs = act.placements(_ur5(), 2)
+    assert len(scs) == 2
+    assert not np.allclose(scs[0].q0, scs[1].q0)
+    for sc in scs:
+        assert act.refusal_of(sc) is None
+    out = tmp_path / "p.json"
+    args = [sys.executable, str(EXAMPLE), "--arm", str(_ur5()), "--placements", "2", "--T", "2",
+            "--rows", "pd", "--json", str(out)]  # fmt: skip
+    run = subprocess.run(args, capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 0, run.stderr
+    table = json.loads(out.read_text())
+    assert sorted(table) == ["placement 0: pd", "placement 1: pd"]
+    np.testing.assert_allclose(table["placement 1: pd"]["home"], scs[1].q0, rtol=0, atol=0)
+    bad = [sys.executable, str(EXAMPLE), "--arm", str(_ur5()), "--home", "0,-pi/2,x"]
+    run = subprocess.run(bad, capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 2
+    assert "a joint angle (rad) must be a number or an expression of numbers and pi, got 'x'" in (
+        run.stderr
+    )
+    # A posture that starts with a negative angle is --home's value, not an option.
+    short = [sys.executable, str(EXAMPLE), "--arm", str(_ur5()), "--home", "-0.1,0.2"]
+    run = subprocess.run(short, capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 2
+    assert "home must be 6 finite numbers (rad), one per joint; got shape (2,)" in run.stderr
+
+
+def test_an_mjcf_arm_without_actuators_gets_the_plants_motors(tmp_path: Path) -> None:
+    """An MJCF arm without actuators (dm_control's Kinova is one) gets the
+    torque motors the plant gives it (refused before: "joint 'j1' has 0
+    actuators"), said with a PlantWarning."""
+    xml = """<mujoco><compiler angle="radian"/><worldbody><body name="base" pos="0 0 0.3">
+      <joint name="j1" axis="0 0 1" range="-3 3"/><geom type="cylinder" size="0.05 0.05"/>
+      <body name="l1" pos="0 0 0.05"><joint name="j2" axis="0 1 0" range="-2 2"/>
+        <geom type="capsule" fromto="0 0 0 0.35 0 0" size="0.03" mass="2"/>
+        <body name="l2" pos="0.35 0 0"><joint name="j3" axis="0 1 0" range="-2.5 2.5"/>
+          <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1"/>
+          <body name="hand" pos="0.3 0 0"><geom type="sphere" size="0.02" mass="0.2"/></body>
+        </body></body></body></worldbody></mujoco>"""
+    path = tmp_path / "bare.xml"
+    path.write_text(xml)
+    with pytest.warns(amj.PlantWarning) as said:
+        sc = act.arm_table(path, home=[0.0, -0.3, 1.5])
+    assert any("have no actuator" in str(w.message) for w in said)
+    assert sc.model.nu == 3
+    assert np.all(sc.model.actuator_gainprm[:, 0] == 1.0)
+    assert np.all(sc.model.actuator_biasprm == 0.0)
+    assert np.all(np.isfinite(sc.tau_max))
+    assert np.all(sc.tau_max > 0.0)
+
+
+def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:
+    """An MJCF arm with its own actuators and geometry: the tool on its end
+    effector's body, the arm's geometry kept off the table, the chain to the
+    tool's site; computed torque, which needs a URDF, refused by name."""
+    xml = """<mujoco><compiler angle="radian"/><worldbody><body name="base" pos="0 0 0.3">
+      <joint name="j1" axis="0 0 1" range="-3 3"/><geom type="cylinder" size="0.05 0.05"/>
+      <body name="l1" pos="0 0 0.05"><joint name="j2" axis="0 1 0" range="-2 2"/>
+        <geom type="capsule" fromto="0 0 0 0.35 0 0" size="0.03" mass="2"/>
+        <body name="l2" pos="0.35 0 0"><joint name="j3" axis="0 1 0" range="-2.5 2.5"/>
+          <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1"/>
+          <body name="hand" pos="0.3 0 0"><geom type="sphere" size="0.02" mass="0.2"/></body>
+        </body></body></body></worldbody>
+      <actuator><motor joint="j1" ctrlrange="-40 40" ctrllimited="true"/>
+      <motor joint="j2" ctrlrange="-40 40" ctrllimited="true"/>
+      <motor joint="j3" ctrlrange="-20 20" ctrllimited="true"/></actuator></mujoco>"""
+    path = tmp_path / "arm.xml"
+    path.write_text(xml)
+    sc = act.arm_table(path, home=[0.0, -0.3, 1.5])
+    assert sc.pin_model is None
+    assert sc.chain.joint_names == ["j1", "j2", "j3"]
+    plant = amj.Plant(sc.model)
+    assert plant.wrench_source == "sensor"
+    plant.reset(sc.q0)
+    np.testing.assert_allclose(ee_position(plant), sc.p0, atol=1e-12)
+    with pytest.raises(adaptimp.ConfigError, match=r"^'ct' needs the arm's Pinocchio model"):
+        apt.panda_controller("ct", sc)
+    with pytest.raises(adaptimp.ConfigError, match=r"^fix applies to the joints of a URDF"):
+        act.arm_table(path, home=[0.0, -0.3, 1.5], fix=("j1",))

@@ -15,10 +15,10 @@ import pinocchio as pin
 import pytest
 
 import adaptimp
-from adaptimp import cartesian as ac
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque, core_description, pinocchio_model
-from adaptimp.panda_table import POSITION_ONLY
+from adaptimp.scenarios import panda_table as apt
+from adaptimp.scenarios.panda_table import POSITION_ONLY
 
 ROBOTS = Path(
     str(
@@ -133,8 +133,8 @@ def test_the_joint_law_is_computed_torque_with_pinocchios_dynamics() -> None:
 
 
 @pytest.fixture(scope="module")
-def sc() -> ac.PandaTable:
-    return ac.panda_table()
+def sc() -> apt.PandaTable:
+    return apt.panda_table()
 
 
 class _PinocchioLaw(ComputedTorque):
@@ -167,12 +167,12 @@ class _PinocchioLaw(ComputedTorque):
         return self.out
 
 
-def test_the_torque_level_law_is_pinocchios_pd_plus(sc: ac.PandaTable) -> None:
+def test_the_torque_level_law_is_pinocchios_pd_plus(sc: apt.PandaTable) -> None:
     """(20.4) with n = 0 behind the Cartesian impedance on the Panda table: the
     core's step and the law written with Pinocchio, row by row on the rows of a
     native run pressing on the table."""
     res = amj.simulate(
-        ac.panda_controller("ct", sc, formulation="impedance", force_feedforward=False),
+        apt.panda_controller("ct", sc, formulation="impedance", force_feedforward=False),
         amj.Plant(sc.model),
         T=1.0,
         q0=sc.q0,
@@ -180,7 +180,7 @@ def test_the_torque_level_law_is_pinocchios_pd_plus(sc: ac.PandaTable) -> None:
     assert res.params["loop"] == "native"
     assert res.metrics["steps_in_contact"] > 300
     assert res.task is not None
-    core = ac.panda_controller("ct", sc, formulation="impedance", force_feedforward=False)
+    core = apt.panda_controller("ct", sc, formulation="impedance", force_feedforward=False)
     law = _PinocchioLaw(sc.pin_model, Ts=sc.Ts, tau_max=sc.tau_max, impedance="external")
     law.pin = sc.pin_model
     written = adaptimp.CartesianController(
@@ -195,7 +195,7 @@ def test_the_torque_level_law_is_pinocchios_pd_plus(sc: ac.PandaTable) -> None:
     np.testing.assert_array_equal(got, res.tau_sat[-1])
 
 
-def test_the_native_run_equals_the_callback_in_every_formulation(sc: ac.PandaTable) -> None:
+def test_the_native_run_equals_the_callback_in_every_formulation(sc: apt.PandaTable) -> None:
     """Computed torque behind the Cartesian impedance steps in the core's native
     loop, bit for bit the run calling the same controller back through its
     Python ``step`` (the five controllers' table, issue of engine speed)."""
@@ -209,7 +209,7 @@ def test_the_native_run_equals_the_callback_in_every_formulation(sc: ac.PandaTab
         kw: dict[str, Any] = {"formulation": formulation, "force_feedforward": share is None}
         if share is not None:
             kw["admittance_share"] = share
-        a, b = ac.panda_controller(kind, sc, **kw), ac.panda_controller(kind, sc, **kw)
+        a, b = apt.panda_controller(kind, sc, **kw), apt.panda_controller(kind, sc, **kw)
         native = amj.simulate(a, amj.Plant(sc.model), T=1.0, q0=sc.q0)
         python = amj.simulate(_InPython(b), amj.Plant(sc.model), T=1.0, q0=sc.q0)
         assert (native.params["loop"], python.params["loop"]) == ("native", "callback")

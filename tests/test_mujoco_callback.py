@@ -22,6 +22,12 @@ bit; a NaN is any NaN). The runs on a model whose wrench comes from its contacts
 the Python loop summed MuJoCo's contact list in NumPy, the core reads the same
 contact forces from MuJoCo's per-body external forces (``cfrc_ext``), which
 round differently (the wrench agrees to 1e-14 N, docs/mujoco.md).
+
+Two cases were recorded again since, by this loop, for a change of the
+controller, not of the loop: the 2-link arm's Cartesian runs
+(``cartesian_python_joint``, ``cartesian_in_python``) start nearly stretched
+(σ_min(J) ≈ 0.008 m/rad), inside the singular region where the outer loop's
+damping now grows (SPEC (C3')).
 """
 
 from __future__ import annotations
@@ -206,18 +212,37 @@ def case_native_disturbed() -> tuple[Any, Any, dict[str, Any]]:
     return adaptimp.Controller("of", "robot"), "two_link", kw
 
 
-def case_native_cartesian_panda() -> tuple[Any, Any, dict[str, Any]]:
-    from adaptimp import cartesian as ac
+def _first_panda_gains(sc: Any) -> dict[str, Any]:
+    """The Panda scenario's joint gains as they were when the digests were
+    written (the scenario's own rule, since replaced by the core's: SPEC §15's
+    Kp_i = 0.25/(Ts (D⁻¹)_ii), Kζ_i = (1 + Kp_i²)/2 + 10, K1 = 20 s⁻¹, kr_i =
+    φ Kp_i/2): the run this pins is the loop's, not the gain rule's."""
+    from adaptimp import tuning
 
-    sc = ac.panda_table()
-    return ac.panda_controller("sf", sc), amj.Plant(sc.model), {"T": 0.4, "q0": sc.q0}
+    d = tuning.inertia(sc.pin_model, sc.q0)
+    kp = 0.25 / (sc.Ts * np.diag(np.linalg.inv(d)))
+    return {
+        "Kp": kp.tolist(),
+        "Kzeta": ((1 + kp**2) / 2 + 10).tolist(),
+        "K1": [20.0] * sc.n,
+        "kr": (0.05 / 2 * kp).tolist(),
+        "fallback_damping": kp.tolist(),
+    }
+
+
+def case_native_cartesian_panda() -> tuple[Any, Any, dict[str, Any]]:
+    from adaptimp.scenarios import panda_table as apt
+
+    sc = apt.panda_table()
+    ctrl = apt.panda_controller("sf", sc, gains=_first_panda_gains(sc))
+    return ctrl, amj.Plant(sc.model), {"T": 0.4, "q0": sc.q0}
 
 
 def case_native_ct_cartesian() -> tuple[Any, Any, dict[str, Any]]:
-    from adaptimp import cartesian as ac
+    from adaptimp.scenarios import panda_table as apt
 
-    sc = ac.panda_table()
-    return ac.panda_controller("ct", sc), amj.Plant(sc.model), {"T": 0.4, "q0": sc.q0}
+    sc = apt.panda_table()
+    return apt.panda_controller("ct", sc), amj.Plant(sc.model), {"T": 0.4, "q0": sc.q0}
 
 
 NATIVE: dict[str, Callable[[], tuple[Any, Any, dict[str, Any]]]] = {

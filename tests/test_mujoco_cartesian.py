@@ -15,8 +15,8 @@ import pytest
 
 import adaptimp
 from adaptimp import _models
-from adaptimp import cartesian as ac
 from adaptimp import mujoco as amj
+from adaptimp.scenarios import panda_table as apt
 
 _ARRAYS = (
     "t", "q", "dq", "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e",
@@ -68,24 +68,24 @@ def _assert_same_run(
 
 
 @pytest.fixture(scope="module")
-def sc() -> ac.PandaTable:
-    return ac.panda_table()
+def sc() -> apt.PandaTable:
+    return apt.panda_table()
 
 
 @pytest.fixture(scope="module")
-def basis(sc: ac.PandaTable) -> tuple[np.ndarray, np.ndarray]:
-    return ac.orbit_basis(sc)
+def basis(sc: apt.PandaTable) -> tuple[np.ndarray, np.ndarray]:
+    return apt.orbit_basis(sc)
 
 
 @pytest.mark.parametrize("kind", ["pd", "sf", "of"])
 def test_the_panda_table_runs_natively_and_equals_the_callback(
-    sc: ac.PandaTable, basis: Any, kind: str
+    sc: apt.PandaTable, basis: Any, kind: str
 ) -> None:
     """The scenario of examples/13 (the Panda's tool pressing on the table along its
     path): natively and called back, the same bits, and the Cartesian metrics
     of docs/panda.md from the rows of either."""
-    native_ctrl = ac.panda_controller(kind, sc, basis=basis)
-    python_ctrl = ac.panda_controller(kind, sc, basis=basis)
+    native_ctrl = apt.panda_controller(kind, sc, basis=basis)
+    python_ctrl = apt.panda_controller(kind, sc, basis=basis)
     native = amj.simulate(native_ctrl, amj.Plant(sc.model), T=1.5, q0=sc.q0)
     python = amj.simulate(_InPython(python_ctrl), amj.Plant(sc.model), T=1.5, q0=sc.q0)
     assert native.params["loop"] == "native"
@@ -101,12 +101,12 @@ def test_the_panda_table_runs_natively_and_equals_the_callback(
     np.testing.assert_allclose(native.z1, native.task["pd"] - p, rtol=0, atol=1e-15)
     # The joint controller's own quantities (ζ, its weights) are recorded natively.
     assert kind == "pd" or native.w_norms[-1, 2] > 0
-    got = ac.cartesian_metrics(native, native_ctrl, sc, settle=1.0)
-    assert got == ac.cartesian_metrics(python, python_ctrl, sc, settle=1.0)
+    got = apt.cartesian_metrics(native, native_ctrl, sc, settle=1.0)
+    assert got == apt.cartesian_metrics(python, python_ctrl, sc, settle=1.0)
     assert all(math.isfinite(v) for v in got.values())
 
 
-def test_a_python_joint_controller_is_called_back(sc: ac.PandaTable) -> None:
+def test_a_python_joint_controller_is_called_back(sc: apt.PandaTable) -> None:
     """A joint controller with a ``step`` of its own (here computed torque's,
     wrapped in Python) behind the core's outer loop: the core's loop calls the
     Cartesian controller back, and it gives computed torque's run; the core's
@@ -123,7 +123,7 @@ def test_a_python_joint_controller_is_called_back(sc: ac.PandaTable) -> None:
     )
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.05, q0=sc.q0)
     assert res.params["loop"] == "callback"
-    core = amj.simulate(ac.panda_controller("ct", sc), amj.Plant(sc.model), T=0.05, q0=sc.q0)
+    core = amj.simulate(apt.panda_controller("ct", sc), amj.Plant(sc.model), T=0.05, q0=sc.q0)
     assert core.params["loop"] == "native"
     np.testing.assert_array_equal(res.tau_sat, core.tau_sat)
     assert res.task is not None
@@ -189,10 +189,10 @@ def test_a_held_target_and_a_used_controller() -> None:
     assert len(a.arrays()["pc"]) == 800
 
 
-def test_a_path_goes_on_along_the_controllers_clock(sc: ac.PandaTable, basis: Any) -> None:
+def test_a_path_goes_on_along_the_controllers_clock(sc: apt.PandaTable, basis: Any) -> None:
     """A used controller's path is sampled at its own t_k, natively and called back."""
-    a = ac.panda_controller("sf", sc, basis=basis)
-    b = ac.panda_controller("sf", sc, basis=basis)
+    a = apt.panda_controller("sf", sc, basis=basis)
+    b = apt.panda_controller("sf", sc, basis=basis)
     plant = amj.Plant(sc.model)
     for _ in range(2):
         native = amj.simulate(a, plant, T=0.3, q0=sc.q0)
@@ -231,28 +231,28 @@ def test_six_d_turning_the_panda_equals_the_callback() -> None:
     assert math.acos(min(1.0, (np.trace(r) - 1) / 2)) > 0.1
 
 
-def test_the_replay_gives_the_runs_torques(sc: ac.PandaTable, basis: Any) -> None:
+def test_the_replay_gives_the_runs_torques(sc: apt.PandaTable, basis: Any) -> None:
     """CartesianImpedance.replay: the core's steps over a run's rows give its
     torques again (the controller's cost without a plant, benches/mujoco_loop.py)."""
-    ctrl = ac.panda_controller("of", sc, basis=basis)
+    ctrl = apt.panda_controller("of", sc, basis=basis)
     targets = ctrl._targets(400, None)
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.4, q0=sc.q0)
     assert res.task is not None
-    again = ac.panda_controller("of", sc, basis=basis)
+    again = apt.panda_controller("of", sc, basis=basis)
     tau = again.outer.core.replay(again.inner, res.q, res.dq, res.task["wrench"], targets)
     np.testing.assert_array_equal(tau, res.tau_sat)
     with pytest.raises(adaptimp.MeasurementError, match=r"targets must have shape \(400, 24\)"):
         again.outer.core.replay(again.inner, res.q, res.dq, res.task["wrench"], targets[:9])
 
 
-def test_disturbances_and_faults_act_on_a_cartesian_run(sc: ac.PandaTable, basis: Any) -> None:
+def test_disturbances_and_faults_act_on_a_cartesian_run(sc: apt.PandaTable, basis: Any) -> None:
     """SPEC §17 on the Cartesian loop: the wrench is delayed with the joint sample,
     a stale sensor freezes it, a NaN burst is refused with the joint controller's
     fallback; what acts on τe alone (which a Cartesian controller does not read)
     is refused by name."""
 
     def run(**kw: Any) -> amj.MujocoResult:
-        ctrl = ac.panda_controller("sf", sc, basis=basis)
+        ctrl = apt.panda_controller("sf", sc, basis=basis)
         return amj.simulate(ctrl, amj.Plant(sc.model), T=1.2, q0=sc.q0, **kw)
 
     base = run()
@@ -321,7 +321,7 @@ def test_an_exploding_cartesian_run_raises_and_names_the_row(
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
 
 
-def test_a_reference_given_as_arrays(sc: ac.PandaTable, basis: Any) -> None:
+def test_a_reference_given_as_arrays(sc: apt.PandaTable, basis: Any) -> None:
     """simulate(reference=(xc, dxc, ddxc)) tabulated at k·Ts: the run of the same
     reference as a callable, natively and called back, joint space and task space."""
     steps = 300
@@ -332,7 +332,7 @@ def test_a_reference_given_as_arrays(sc: ac.PandaTable, basis: Any) -> None:
         return sc.path(t)
 
     def make() -> adaptimp.CartesianController:
-        ctrl = ac.panda_controller("sf", sc, basis=basis)
+        ctrl = apt.panda_controller("sf", sc, basis=basis)
         ctrl.path = None  # the reference of simulate instead
         return ctrl
 
@@ -371,13 +371,13 @@ def test_a_reference_given_as_arrays(sc: ac.PandaTable, basis: Any) -> None:
         amj.simulate("pd", "two_link", T=0.3, reference=(bad, joint[1], joint[2]))
 
 
-def test_a_long_run_in_parts_is_the_whole_run(sc: ac.PandaTable, basis: Any) -> None:
+def test_a_long_run_in_parts_is_the_whole_run(sc: apt.PandaTable, basis: Any) -> None:
     """reset=False: the plant goes on from where the last part left it, the used
     controller along its path: two parts give the rows of one run, bit for bit."""
     plant = amj.Plant(sc.model)
-    whole_ctrl = ac.panda_controller("sf", sc, basis=basis)
+    whole_ctrl = apt.panda_controller("sf", sc, basis=basis)
     whole = amj.simulate(whole_ctrl, plant, T=1.4, q0=sc.q0)
-    ctrl = ac.panda_controller("sf", sc, basis=basis)
+    ctrl = apt.panda_controller("sf", sc, basis=basis)
     first = amj.simulate(ctrl, plant, T=0.7, q0=sc.q0)
     second = amj.simulate(ctrl, plant, T=0.7, reset=False)
     for name in _ARRAYS[1:]:
@@ -393,11 +393,11 @@ def test_a_long_run_in_parts_is_the_whole_run(sc: ac.PandaTable, basis: Any) -> 
 
 @pytest.mark.parametrize("options", [{}, {"every": 3}, {"compress": False}])
 def test_a_cartesian_run_saves_its_task_rows(
-    sc: ac.PandaTable, basis: Any, tmp_path: Path, options: dict[str, Any]
+    sc: apt.PandaTable, basis: Any, tmp_path: Path, options: dict[str, Any]
 ) -> None:
     """A MuJoCo result keeps, through save and load, the end effector's position
     and wrench and the task-space rows (the Cartesian metrics read them)."""
-    ctrl = ac.panda_controller("sf", sc, basis=basis)
+    ctrl = apt.panda_controller("sf", sc, basis=basis)
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.2, q0=sc.q0)
     assert res.task is not None
     assert res.x_ee is not None

@@ -7,14 +7,15 @@ import pytest
 
 from adaptimp import cartesian as ac
 from adaptimp import mujoco as amj
+from adaptimp.scenarios import panda_table as apt
 
 
 @pytest.fixture(scope="module")
-def sc() -> ac.PandaTable:
-    return ac.panda_table()
+def sc() -> apt.PandaTable:
+    return apt.panda_table()
 
 
-def test_free_space_clik_follows_the_command(sc: ac.PandaTable) -> None:
+def test_free_space_clik_follows_the_command(sc: apt.PandaTable) -> None:
     """F_e = 0: p_d ≡ p_c (Euler), and the CLIK drives fk(q_d) to p_d."""
     outer = sc.outer()
     err, gap = [], []
@@ -29,7 +30,7 @@ def test_free_space_clik_follows_the_command(sc: ac.PandaTable) -> None:
     assert max(err) < 1e-4
 
 
-def test_steady_contact_force_is_kd_times_depth(sc: ac.PandaTable) -> None:
+def test_steady_contact_force_is_kd_times_depth(sc: apt.PandaTable) -> None:
     """A plane z ≤ w of stiffness k_e with a perfect inner loop (p = fk(q_d)):
     F = K_d k_e/(K_d + k_e) δ_c (16.1), → K_d δ_c as k_e ≫ K_d."""
     outer = sc.outer()
@@ -48,7 +49,7 @@ def test_steady_contact_force_is_kd_times_depth(sc: ac.PandaTable) -> None:
     assert fn == pytest.approx(500.0 * 0.01, rel=0.1)
 
 
-def test_outer_loop_validates(sc: ac.PandaTable) -> None:
+def test_outer_loop_validates(sc: apt.PandaTable) -> None:
     with pytest.raises(ValueError, match="Ts·clik_kd < 1"):
         ac.CartesianImpedance(sc.chain, Ts=0.02, q0=sc.q0)
     with pytest.raises(ValueError, match=r"Md > 0"):
@@ -56,25 +57,25 @@ def test_outer_loop_validates(sc: ac.PandaTable) -> None:
 
 
 @pytest.mark.parametrize("kind", ["pd", "sf"])
-def test_short_run_within_limits(sc: ac.PandaTable, kind: str) -> None:
-    ctrl = ac.panda_controller(kind, sc)
+def test_short_run_within_limits(sc: apt.PandaTable, kind: str) -> None:
+    ctrl = apt.panda_controller(kind, sc)
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.6, q0=sc.q0)
-    m = ac.cartesian_metrics(res, ctrl, sc, settle=0.3)
+    m = apt.cartesian_metrics(res, ctrl, sc, settle=0.3)
     assert all(np.isfinite(v) for v in m.values())
     assert m["applied_ratio"] <= 1.0 + 1e-12
     assert np.all(np.abs(res.tau_sat) <= np.asarray(res.params["tau_max"]) + 1e-12)
 
 
-def test_computed_torque_tracks_the_circle(sc: ac.PandaTable) -> None:
-    ctrl = ac.panda_controller("ct", sc)
+def test_computed_torque_tracks_the_circle(sc: apt.PandaTable) -> None:
+    ctrl = apt.panda_controller("ct", sc)
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=3.0, q0=sc.q0)
-    m = ac.cartesian_metrics(res, ctrl, sc)
+    m = apt.cartesian_metrics(res, ctrl, sc)
     assert m["rms_track"] < 1e-3  # m
     assert m["rms_path_xy"] < 3e-3  # m: the circle on the table
     assert res.metrics["steps_in_contact"] > 500
 
 
-def test_cartesian_impedance_needs_external_inner(sc: ac.PandaTable) -> None:
+def test_cartesian_impedance_needs_external_inner(sc: apt.PandaTable) -> None:
     from adaptimp.baselines import ComputedTorque
 
     with pytest.raises(ValueError, match="external"):
@@ -83,16 +84,16 @@ def test_cartesian_impedance_needs_external_inner(sc: ac.PandaTable) -> None:
         ac.CartesianController(sc.chain, "pd", q0=sc.q0, impedance="joint")
 
 
-def test_gravity_learning_without_feedforward_beats_pd(sc: ac.PandaTable) -> None:
+def test_gravity_learning_without_feedforward_beats_pd(sc: apt.PandaTable) -> None:
     """5 s of the scenario of examples/13 (t ≥ 2.5 s): state feedback without the τe
     feedforward and with gravity learning tracks the tool at under half of PD's
     error, with PD's joint gains, and winds nothing up."""
-    basis = ac.orbit_basis(sc)
+    basis = apt.orbit_basis(sc)
     learn = {"gamma": [1.0, 1.0, 5000.0], "sigma": [0.01, 0.01, 1e-5]}
     track = {}
     for kind in ("pd", "sf"):
         extra = learn if kind == "sf" else {}
-        ctrl = ac.panda_controller(
+        ctrl = apt.panda_controller(
             kind,
             sc,
             basis=basis,
@@ -101,7 +102,7 @@ def test_gravity_learning_without_feedforward_beats_pd(sc: ac.PandaTable) -> Non
             **extra,
         )
         res = amj.simulate(ctrl, amj.Plant(sc.model), T=5.0, q0=sc.q0)
-        m = ac.cartesian_metrics(res, ctrl, sc, settle=2.5)
+        m = apt.cartesian_metrics(res, ctrl, sc, settle=2.5)
         assert m["applied_ratio"] <= 1.0 + 1e-12
         assert m["peak_tau_ratio"] <= 2.0
         track[kind] = m["rms_track"]

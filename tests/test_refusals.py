@@ -15,8 +15,8 @@ import pytest
 
 import adaptimp
 from adaptimp import _models
-from adaptimp import contact as act
 from adaptimp._description import read_arm
+from adaptimp.scenarios import contact as act
 
 PANDA = adaptimp.Chain.from_urdf(_models.panda_urdf_path(), tip=_models.PANDA_EE)
 LO, HI = np.full(7, -1.0), np.full(7, 1.0)
@@ -94,11 +94,11 @@ def test_arm_table_refuses_a_home_that_is_not_finite_by_name() -> None:
 def test_contact_metrics_of_a_run_without_rows_in_its_windows_is_refused() -> None:
     """A 0.05 s run: no row at t ≥ settle (default 2 s), and none at t ≥ 0.1 s
     (peak_tau_ratio's window): each is named with the run's last row."""
-    from adaptimp import cartesian as ac
     from adaptimp import mujoco as amj
+    from adaptimp.scenarios import panda_table as apt
 
     sc = act.arm_table(friction=0.0)
-    ctrl = ac.panda_controller("ct", sc, formulation="impedance")
+    ctrl = apt.panda_controller("ct", sc, formulation="impedance")
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.05, q0=sc.q0)
     message = (
         "the metrics' window t ≥ settle = 2 s holds no row of the run (50 rows, its last "

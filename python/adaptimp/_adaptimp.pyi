@@ -23,11 +23,14 @@ __all__ = [
     "TwoLinkArm",
     "__version__",
     "arm_from_mujoco",
+    "assess_posture",
     "centres_along",
     "default_task",
     "defaults",
     "description_kind",
     "metrics",
+    "pose_circle",
+    "pose_metrics",
     "read_arm",
     "schema_table",
     "simulate",
@@ -36,6 +39,7 @@ __all__ = [
     "simulate_mujoco_callback",
     "simulate_mujoco_many",
     "suggest",
+    "table_metrics",
 ]
 
 __version__: str
@@ -592,7 +596,7 @@ class CartesianImpedance:
     ) -> _F: ...
     def last(self, what: str) -> _F: ...
     def state(self, what: str) -> _F: ...
-    def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F]: ...
+    def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F, _F]: ...
     def simulate_mujoco(
         self,
         controller: Controller | ComputedTorque,
@@ -632,10 +636,76 @@ def suggest(
     path: NDArray[np.float64] | None = None,
     period: float | None = None,
     gravity: NDArray[np.float64] | None = None,
+    resolve: bool = False,
+    critical: bool = False,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every
-    controller keyword), with a path also "centers" (L, 4n) and "widths" (4n,)."""
+    controller keyword), with a path also "centers" (L, 4n) and "widths" (4n,);
+    ``resolve``: the tube narrowed to the path's size, SPEC (16.10); ``critical``:
+    Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6)."""
+
+def pose_circle(
+    p0: NDArray[np.float64],
+    r0: NDArray[np.float64],
+    ts: float,
+    steps: int,
+    radius: float | None = None,
+    freq: float | None = None,
+    hold: float | None = None,
+    ramp: float | None = None,
+    start: float = 0.0,
+) -> tuple[_F, float, list[float]]:
+    """The default Cartesian task of SPEC (16.8) tabulated: (targets (steps, 24),
+    span (s), centre (3,))."""
+
+def assess_posture(
+    chain: Chain,
+    q: NDArray[np.float64],
+    p: NDArray[np.float64],
+    gravity: NDArray[np.float64],
+    d0: NDArray[np.float64],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    tau_max: NDArray[np.float64],
+    orients: bool,
+    k1: float | None = None,
+    ts: float | None = None,
+    load: float | None = None,
+) -> dict[str, Any]:
+    """How well a posture runs a task, SPEC (16.9): the figures along its joint
+    orbit, the score and the first condition it violates ("error", or None);
+    ``k1`` (1/s), ``ts`` (s): the joint controller's (conditioning ≥ K1·Ts/m)."""
+
+def pose_metrics(
+    chain: Chain,
+    q: NDArray[np.float64],
+    targets: NDArray[np.float64],
+    t: NDArray[np.float64],
+    settle: float,
+    ts: float,
+) -> tuple[_F, _F, dict[str, float]]:
+    """The pose errors e_p (K,) (m), e_o (K,) (rad) of a run and their metrics,
+    SPEC (16.11)."""
+
+def table_metrics(
+    t: _F,
+    p: _F,
+    dp: _F,
+    ddp: _F,
+    pd: _F,
+    pc: tuple[_F, _F, _F],
+    wrench: _F,
+    normal: _F,
+    tau: tuple[_F, _F],
+    tau_max: _F,
+    impedance: tuple[Sequence[float], Sequence[float], Sequence[float]],
+    depth: float,
+    series: float,
+    windows: tuple[float, float, float],
+    ts: float,
+) -> dict[str, float]:
+    """The table's metrics of a run, SPEC (19.7), by name."""
 
 def default_task(
     home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]

@@ -100,12 +100,14 @@ def _arm(source: Any, tip: str | None, fix: Sequence[str]) -> Any:
 
 
 def default_gains(Ts: float) -> tuple[float, float]:
-    """Computed torque's default (K_P, K_D) for a robot description at period
-    ``Ts`` (s), SPEC (20.8): the error dynamics ë + K_D ė + K_P e = 0 with a
-    double pole at the rule's position-loop bandwidth K1 = min(50 s⁻¹,
-    0.05/Ts) (SPEC (18.2)), K_P = K1², K_D = 2 K1: (2500, 100) at 1 kHz."""
-    k1 = min(50.0, 0.05 / Ts)
-    return k1 * k1, 2.0 * k1
+    """Computed torque's default (K_P, K_D) at period ``Ts`` (s), SPEC (20.8):
+    the error dynamics ë + K_D ė + K_P e = 0 with a double pole at ω = 20
+    rad/s, (400 s⁻², 40 s⁻¹), for every model and period (the gains that
+    meet both of issue 29's payload targets on the most files measured;
+    gains tied to the rule's bandwidth did not)."""
+    if not (Ts > 0 and math.isfinite(Ts)):
+        raise ValueError(f"Ts must be > 0, got {Ts}")
+    return 400.0, 40.0
 
 
 def pinocchio_model(
@@ -282,14 +284,10 @@ class ComputedTorque:
     Ts : float
         Period (s).
     Kp : float or (n,), optional
-        Stiffness K_P of the error dynamics (1/s²). Default for a robot
-        description (a path, a MuJoCo model, ``"panda"``): K1², with K1 =
-        min(50 s⁻¹, 0.05/Ts) the rule's position-loop bandwidth (SPEC (18.2),
-        (20.8): 2500 at 1 kHz; :func:`default_gains`); for the paper's arm and a
-        ``pinocchio.Model``, 400 (ω = 20 rad/s), as in the paper's comparisons.
+        Stiffness K_P of the error dynamics (1/s²): default 400 (ω = 20
+        rad/s; SPEC (20.8), :func:`default_gains`).
     Kd : float or (n,), optional
-        Damping K_D (1/s): default 2 K1 (critically damped; 100 at 1 kHz), or
-        40 where K_P defaults to 400.
+        Damping K_D (1/s): default 40 (critically damped).
     tau_max : float or (n,), optional
         Actuator limits (N m); default the description's effort limits (the
         URDF's, the MJCF's actuators'), or the paper's [17, 15] for the
@@ -391,7 +389,7 @@ class ComputedTorque:
         if not (Ts > 0 and math.isfinite(Ts)):
             raise ValueError(f"Ts must be > 0, got {Ts}")
         self._ts = float(Ts)
-        kp, kd = (400.0, 40.0) if paper else default_gains(self._ts)
+        kp, kd = default_gains(self._ts)
         self.Kp = _joint("Kp", kp if Kp is None else Kp, n)
         self.Kd = _joint("Kd", kd if Kd is None else Kd, n)
         self.Dd, self.Cd, self.Gd = _joint("Dd", Dd, n), _joint("Cd", Cd, n), _joint("Gd", Gd, n)

@@ -22,8 +22,8 @@ Every parameter is declared once, in the core's schema (group ``"cartesian"``:
 ``force_feedforward``; ``adaptimp params`` lists them with units and defaults).
 ``Kd_rot = 0`` makes the loop position-only.
 
-The scenario "panda-table" (the Panda drawing a circle on a table) lives in
-:mod:`adaptimp.panda_table`; its names are re-exported here.
+The scenarios over this API (the Panda drawing a circle on a table, the same
+table for any arm) live in :mod:`adaptimp.scenarios`; this module imports none.
 
 Sign convention (SPEC §4, §16): the wrench F_e = [f; m] (N, N m) is what the
 tip exerts on the environment, world frame, the moment about the tip (pressing
@@ -44,28 +44,12 @@ from . import _adaptimp
 from ._errors import ConfigError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
 from .chain import Chain
-from .panda_table import (
-    PandaTable,
-    cartesian_metrics,
-    joint_gains,
-    orbit_basis,
-    panda_controller,
-    panda_table,
-    pinocchio_kinematics,
-)
 
 __all__ = [
     "CartesianController",
     "CartesianImpedance",
     "Chain",
-    "PandaTable",
     "Path",
-    "cartesian_metrics",
-    "joint_gains",
-    "orbit_basis",
-    "panda_controller",
-    "panda_table",
-    "pinocchio_kinematics",
     "pose_target",
 ]
 
@@ -123,6 +107,38 @@ def _pose_of(sample: Any, R: FloatArray) -> FloatArray:
     if len(s) == 6:
         return pose_target(*s)
     raise ValueError(f"path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}")
+
+
+def tabulate(path: Path, steps: int, Ts: float, R: ArrayLike, *, start: int = 0) -> FloatArray:
+    """The commanded pose of ``steps`` steps at t_k = (``start`` + k)·``Ts``, as
+    the rows (steps, 24) of :func:`pose_target`: the one tabulation of a path
+    (the outer loop's orbit, a run of the core's loop, a task's metrics).
+
+    ``path(t)`` returns (p, ṗ, p̈) or (p, ṗ, p̈, R, ω, ω̇) (:data:`Path`); a
+    3-tuple keeps the last rotation a 6-tuple gave (``R`` (3, 3) until one
+    does). A path with a ``table(steps, Ts, start)`` method (the default task's,
+    :func:`adaptimp.mujoco.cartesian_task`) tabulates itself in the core.
+    """
+    table = getattr(path, "table", None)
+    if callable(table):
+        return np.asarray(table(steps, Ts, start), dtype=np.float64)
+    out = np.zeros((steps, 24))
+    out[:, 9:18] = np.asarray(R, dtype=np.float64).reshape(9)
+    turned = False
+    for k in range(steps):
+        s = tuple(path((start + k) * Ts))
+        if len(s) == 3:
+            out[k, 0:3], out[k, 3:6], out[k, 6:9] = s
+            if turned:
+                out[k, 9:18] = out[k - 1, 9:18]
+        elif len(s) == 6:
+            out[k] = pose_target(*s)
+            turned = True
+        else:
+            raise ValueError(
+                f"path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}"
+            )
+    return out
 
 
 class CartesianImpedance:
@@ -301,14 +317,22 @@ class CartesianImpedance:
         (F_e = 0; its state unchanged) from ``q0`` (default the start's) along
         ``path`` sampled at k·Ts for t < ``T`` (the core's orbit; ``samples`` =
         round(T/Ts): every step)."""
+        q, dq, _ = self.joint_path(path, T, samples=samples, q0=q0)
+        return q, dq
+
+    def joint_path(
+        self, path: Path, T: float, *, samples: int, q0: ArrayLike | None = None
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:meth:`joint_orbit` with the accelerations: (q_d, q̇_d, q̈_d) (rad,
+        rad/s, rad/s²), each (``samples``, n), q̈_d the inverse kinematics' own
+        (C2)."""
         steps = round(T / self.Ts)
         if steps < 1:
             raise ConfigError(f"T must cover at least one step of {self.Ts:g} s, got {T}")
-        R = self.chain.fk(self.q0 if q0 is None else q0)[:3, :3]
-        table = np.array([_sample(path, k * self.Ts, R) for k in range(steps)])
         start = self.q0 if q0 is None else np.asarray(q0, dtype=np.float64)
-        q, dq = self._core.orbit(start, table, samples)
-        return np.asarray(q, dtype=np.float64), np.asarray(dq, dtype=np.float64)
+        table = tabulate(path, steps, self.Ts, self.chain.fk(start)[:3, :3])
+        q, dq, ddq = self._core.orbit(start, table, samples)
+        return tuple(np.asarray(a, dtype=np.float64) for a in (q, dq, ddq))  # type: ignore[return-value]
 
 
 class CartesianController:
@@ -449,6 +473,111 @@ class CartesianController:
         self._log: dict[str, list[FloatArray]] = {k: [] for k in _LOG}
         # The per-sample step: one call of the core (SPEC §16; issue 32).
         self._step = self.outer.core.step_sample
+
+    @classmethod
+    def from_rule(
+        cls,
+        chain: Chain,
+        controller: str,
+        path: Path,
+        q0: ArrayLike,
+        *,
+        model: Any,
+        tau_max: ArrayLike | None = None,
+        span: float | None = None,
+        Ts: float = 1e-3,
+        **params: Any,
+    ) -> CartesianController:
+        """The Cartesian controller of a case name built by the core's rule
+        (SPEC §16 (16.10), §18): nothing set per arm.
+
+        The outer loop (the schema's Cartesian defaults; position-only for an
+        arm of fewer than six joints, which cannot hold an orientation) runs
+        kinematically from ``q0`` along ``path`` over its ``span`` (the
+        hold, the ramp and one period of a periodic path); the joint rule
+        then takes D and G from ``model``, the actuators' ``tau_max`` and that
+        joint path (q_d, q̇_d, q̈_d of every step): the gains (18.1)–(18.4)
+        with the inertia scales the smallest along the path (16.12), the
+        centres along the joint orbit with the tube narrowed to the orbit
+        (16.10), the learning (18.6)–(18.8).
+
+        Parameters
+        ----------
+        chain : Chain
+            The arm's kinematics, to the point the task moves.
+        controller : {"pd", "sf", "of"}
+            The joint controller's case.
+        path : callable
+            :data:`Path`, the commanded pose (m, rad; world frame).
+        q0 : (n,)
+            The start posture (rad), an inverse-kinematics solution of
+            ``path(0)``.
+        model
+            What gives D(q) and G(q): an ``adaptimp.mujoco.Plant``, a
+            Pinocchio ``Model``, an object with ``D(q)`` and ``G(q)``
+            (:func:`adaptimp.tuning.inertia`, :func:`adaptimp.tuning.gravity`).
+        tau_max : (n,), optional
+            Actuator limits (N m); default ``model.tau_max``.
+        span : float, optional
+            The part of the path the rule samples (s); default ``path.span``
+            (the default task's: hold + ramp + one period).
+        Ts : float
+            The period (s).
+        **params
+            Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
+            and the joint controller's, e.g. ``gamma``).
+        """
+        from . import tuning
+
+        if not isinstance(controller, str):
+            raise TypeError(
+                f"from_rule builds a case name's controller ('pd', 'sf', 'of'), got {controller!r}"
+            )
+        q0 = np.asarray(q0, dtype=np.float64)
+        span = getattr(path, "span", None) if span is None else span
+        if (
+            span is None
+            or isinstance(span, bool)
+            or not (
+                isinstance(span, (int, float, np.floating)) and math.isfinite(span) and span > 0
+            )
+        ):
+            raise ConfigError(
+                f"span must be a finite number > 0 (s): the part of the path the rule samples "
+                f"(the path has no .span); got {span!r}"
+            )
+        limits = getattr(model, "tau_max", None) if tau_max is None else tau_max
+        if limits is None:
+            raise ConfigError("tau_max (N m) is needed: the model has no .tau_max")
+        cart = {k: v for k, v in params.items() if k in BY_NAME and BY_NAME[k].group == "cartesian"}
+        if chain.n < 6:
+            cart.setdefault("Kd_rot", 0.0)
+        outer = CartesianImpedance(chain, Ts=Ts, q0=q0, **cart)
+        steps = round(float(span) / Ts)
+        q, dq, ddq = outer.joint_path(path, steps * Ts, samples=steps)
+        data = getattr(model, "data", None)  # a Plant's state, as the caller left it
+        saved = None if data is None else (np.array(data.qpos), np.array(data.qvel))
+        try:
+            kw = tuning.suggest(
+                model, q0, limits, Ts=Ts, path=np.hstack([q, dq, ddq]), period=steps * Ts,
+                case=controller, resolve=True,
+            )  # fmt: skip
+        finally:
+            forward = getattr(model, "forward", None)
+            if data is not None and saved is not None and callable(forward):
+                data.qpos[:], data.qvel[:] = saved
+                forward()
+        kw.pop("n")
+        joint = {k: v for k, v in params.items() if k not in cart}
+        centres, widths = (
+            joint.pop("centers", kw.pop("centers")),
+            joint.pop("widths", kw.pop("widths")),
+        )
+        kw.update(joint)
+        return cls(
+            chain, controller, "robot", q0=q0, path=path, centers=centres, widths=widths,
+            **cart, **kw,
+        )  # fmt: skip
 
     @property
     def Ts(self) -> float:
@@ -634,34 +763,16 @@ class CartesianController:
         path = self.path
         if reference is None and path is None:
             return None
-        # The rows of pose_target, filled in place (a path is called once a period).
-        out = np.zeros((steps, 24))
-        out[:, 9:18] = self.outer._R.ravel()
         if reference is not None and not callable(reference):
+            out = np.zeros((steps, 24))
+            out[:, 9:18] = self.outer._R.ravel()
             for i in range(3):
                 out[:, 3 * i : 3 * i + 3] = reference[i][:steps]
             return out
         if reference is not None:
-            for k in range(steps):
-                out[k, 0:3], out[k, 3:6], out[k, 6:9] = reference(k * self.Ts)
-            return out
+            return tabulate(reference, steps, self.Ts, self.outer._R)
         assert path is not None
-        k0, ts = self._k, self.Ts
-        turned = False  # a 3-tuple keeps the rotation a 6-tuple set
-        for k in range(steps):
-            s = tuple(path((k0 + k) * ts))
-            if len(s) == 3:
-                out[k, 0:3], out[k, 3:6], out[k, 6:9] = s
-                if turned:
-                    out[k, 9:18] = out[k - 1, 9:18]
-            elif len(s) == 6:
-                out[k] = pose_target(*s)
-                turned = True
-            else:
-                raise ValueError(
-                    f"path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}"
-                )
-        return out
+        return tabulate(path, steps, self.Ts, self.outer._R, start=self._k)
 
     def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None) -> None:
         """After a run of the core's loop (:func:`adaptimp.mujoco.simulate`) along

@@ -60,10 +60,12 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _adaptimp, _description, _mjcf, _models
+from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
 from ._faults import Fault
 from ._mjcf import _full_inertia, _limits, _postures
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
+from ._tooling import add_table, add_tool
 from ._trajectory import Reference, paper_circle, sinusoid
 
 if TYPE_CHECKING:
@@ -72,11 +74,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MAX_JOINTS",
+    "CartesianTask",
     "ControllerLike",
     "MujocoResult",
     "Plant",
     "Reference",
     "Task",
+    "cartesian_task",
+    "chain_of",
     "default_task",
     "estimate_effort",
     "from_urdf",
@@ -85,6 +90,7 @@ __all__ = [
     "panda",
     "paper_circle",
     "rule_keywords",
+    "self_collision",
     "simulate",
     "sinusoid",
     "two_link",
@@ -353,40 +359,9 @@ def panda(
     arm = _urdf_arm(_models.panda_urdf_path(), _models.PANDA_EE, _models.PANDA_FINGERS)
     spec = _arm_spec(arm, timestep, drive=False, stacklevel=2)
     spec.modelname = "panda"
-    tcp = spec.body(_models.PANDA_EE)
-    tcp.add_site(name="ee", size=[0.01, 0, 0])
-    tcp.add_geom(
-        name="tool",
-        type=mujoco.mjtGeom.mjGEOM_SPHERE,
-        size=[tool_radius, 0, 0],
-        contype=1,
-        conaffinity=1,
-        mass=0.0,
-        density=0.0,
-    )
-    spec.add_sensor(
-        name="ee_force",
-        type=mujoco.mjtSensor.mjSENS_FORCE,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname="ee",
-    )
-    spec.add_sensor(
-        name="ee_torque",
-        type=mujoco.mjtSensor.mjSENS_TORQUE,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname="ee",
-    )
+    add_tool(spec, _models.PANDA_EE, radius=tool_radius, own_body=False)
     if table_height is not None:
-        thickness = 0.05
-        table = spec.worldbody.add_body(name="table", pos=[0.55, 0.0, table_height - thickness / 2])
-        table.add_geom(
-            name="table",
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[0.35, 0.5, thickness / 2],
-            contype=1,
-            conaffinity=1,
-            rgba=[0.6, 0.5, 0.4, 1.0],
-        )
+        add_table(spec, top=table_height, centre=(0.55, 0.0))
     spec.add_key(name="home", qpos=list(_models.PANDA_HOME))
     return spec.compile()
 
@@ -1091,6 +1066,43 @@ def rule_keywords(
     return kw
 
 
+def cartesian_task(
+    model: Plant | ModelSource,
+    q0: ArrayLike | None = None,
+    pose: Any = None,
+    *,
+    Ts: float = 1e-3,
+    span: float | None = None,
+    tip: str | None = None,
+    fix: Sequence[str] = (),
+) -> CartesianTask:
+    """A Cartesian task on ``model`` (SPEC §16 (16.8)–(16.11)), for
+    ``simulate(case, model, T=…, task=task)``.
+
+    ``pose`` None: the default path, hold the start pose 1 s, then a 3 cm circle
+    at 0.5 Hz in the horizontal plane through it, the orientation held (an arm
+    of fewer than six joints: the position only). Or the user's path: a callable
+    ``t -> (p, ṗ, p̈[, R, ω, ω̇])`` (m, m/s, m/s², (3, 3), rad/s, rad/s²; world
+    frame), or those arrays with a row per period ``Ts`` (K, 3), (K, 3, 3);
+    ``span`` (s) the part of it the rule samples (default: the arrays' length,
+    or 4 s for a callable).
+
+    ``q0`` None: a start posture drawn by the core's posture rule (16.9):
+    σmin of the 6 × n Jacobian ≥ 0.05, every joint 0.1 rad (or an eighth of
+    its range) inside its limits, gravity ≤ half of every actuator, the joint
+    rule's velocity loop well-conditioned and the path reachable, all along
+    the task, and no self-collision there; for a given ``pose`` the start is
+    the core's inverse kinematics of its first pose. A ``q0`` given must meet
+    the same rule, or a ``ConfigError`` names the condition it violates.
+    ``tip``, ``fix``: the end effector and the joints held, as :class:`Plant`'s
+    (give the same to :func:`simulate`, or a :class:`Plant` to both).
+    """
+    if isinstance(model, Plant) and (tip is not None or tuple(fix)):
+        raise ValueError("tip= and fix= build the Plant: give them to Plant(...), not with one")
+    plant = model if isinstance(model, Plant) else Plant(model, contact=False, tip=tip, fix=fix)
+    return task_of(plant, q0, pose, Ts=Ts, span=span)
+
+
 class _Table:
     """A reference tabulated at t_k = k·Ts, as a callable of t (the row of t),
     with its arrays (xc, dxc, ddxc), one row per step."""
@@ -1222,6 +1234,18 @@ class MujocoResult(SimResult):
     def rows(self) -> int:
         """Number of recorded rows K."""
         return int(self.t.shape[0])
+
+    @property
+    def pos_err(self) -> FloatArray | None:
+        """A Cartesian task's position error ‖p_c − p‖ per row (m), (K,) (None for
+        a run without a ``task``)."""
+        return None if self.task is None else self.task.get("pos_err")
+
+    @property
+    def rot_err(self) -> FloatArray | None:
+        """A Cartesian task's orientation error ‖Log(R_c Rᵀ)‖ per row (rad), (K,)
+        (None for a run without a ``task``)."""
+        return None if self.task is None else self.task.get("rot_err")
 
     @property
     def dtau(self) -> FloatArray:
@@ -1439,6 +1463,7 @@ def simulate(
     tip: str | None = None,
     fix: Sequence[str] = (),
     home: ArrayLike | None = None,
+    task: CartesianTask | None = None,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1510,6 +1535,13 @@ def simulate(
         A point mass (kg, ≥ 0) at the end effector's link of the plant only
         (:func:`with_payload`); the controller's gains come from the arm
         without it, and no model the controller is given has it.
+    task : CartesianTask, optional
+        A Cartesian task (:func:`cartesian_task`): a case name's controller is
+        then the Cartesian controller of the core's rule for it
+        (:meth:`adaptimp.CartesianController.from_rule`), started at
+        ``task.q0``; the result carries the task's errors, ``res.pos_err``,
+        ``res.rot_err`` (K,) (m, rad), and ``metrics["rms_pos_after2"]``,
+        ``["rms_rot_after2"]`` (SPEC (16.11)).
     reset : bool
         True: the plant starts at ``q0``, ``dq0``. False: a :class:`Plant` goes
         on from where its last run left it (a long run in parts: with a used
@@ -1561,6 +1593,14 @@ def simulate(
     >>> res.q.shape, res.params["substeps"]
     ((50, 2), 20)
     """
+    if task is not None:  # the Cartesian task's controller, by the core's rule
+        if home is not None:
+            raise ValueError("home= sets the default joint-space task: give q0= to cartesian_task")
+        if not isinstance(model, Plant):
+            model = Plant(model, contact=contact, tip=tip, fix=fix)
+            tip, fix = None, ()
+        controller, params = task.prepare(controller, model, Ts, params, DISTURBANCES)
+        q0 = task.q0 if q0 is None else q0
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
         settle=settle, scenario=scenario, record_every=record_every, reference=reference,
@@ -1576,6 +1616,8 @@ def simulate(
         if bar is not None:
             bar.close()
     res = _result(run, out, out.pop("metrics"))
+    if task is not None:
+        task.measure(res)
     _check_run(run, res)
     return res
 

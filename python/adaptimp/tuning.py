@@ -131,9 +131,11 @@ def suggest(
     tau_max: ArrayLike,
     *,
     Ts: float = 1e-3,
-    path: Path | None = None,
+    path: Path | ArrayLike | None = None,
     period: float | None = None,
     case: str = "sf",
+    resolve: bool = False,
+    critical: bool = False,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
     the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
@@ -150,14 +152,22 @@ def suggest(
         Actuator limits (N m).
     Ts : float
         Control period (s).
-    path : callable, optional
+    path : callable or array_like, optional
         ``path(t) -> (q, dq, ddq)``, the task's joint path (rad, rad/s, rad/s²),
         periodic with ``period`` (s): the RBF centres go along it and the
-        learning rates follow from the basis it excites. Without it: the gains
-        only (a controller for n ≤ 3 then uses the vertex grid, beyond it the
-        default basis along its own trajectory, SPEC §18).
+        learning rates follow from the basis it excites; or its samples, (K,
+        3n) rows [q, q̇, q̈] evenly spaced in time over one period. Without it:
+        the gains only (a controller for n ≤ 3 then uses the vertex grid,
+        beyond it the default basis along its own trajectory, SPEC §18).
     case : {"pd", "sf", "of"}
         The controller (the keywords are the same for all three).
+    resolve : bool
+        Narrow the tube to the path's own size, SPEC (16.10): tube_b =
+        min(tube_b, ℓ_b/10), ℓ_b the closed path's length in q and in q̇ (the
+        Cartesian rule's: a small joint orbit gets the joint task's resolution).
+    critical : bool
+        Ĝ learns at the velocity loop's critical bandwidth ω_G² = (m/Ts)²/4,
+        SPEC (19.6) (the table scenario's; (18.6)'s ½ (m/Ts) K1 otherwise).
 
     Returns
     -------
@@ -179,11 +189,19 @@ def suggest(
     if path is not None:
         if period is None:
             raise ConfigError("a path needs its period (s)")
-        rows = sample_path(path, period, n)
-        step = PATH_SAMPLES // INERTIA_SAMPLES
+        if callable(path):
+            rows = sample_path(path, period, n)
+        else:
+            rows = np.ascontiguousarray(np.asarray(path, dtype=np.float64))
+        if rows.ndim != 2 or rows.shape[0] == 0 or rows.shape[1] != 3 * n:
+            raise ConfigError(f"path must have shape (K, {3 * n}), got {rows.shape}")
+        step = max(1, rows.shape[0] // INERTIA_SAMPLES)
         d = np.stack([inertia(model, q) for q in rows[::step, :n]])
     g = gravity(model, q0) if rows is not None else None
-    out = _adaptimp.suggest(case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g)
+    out = _adaptimp.suggest(
+        case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
+        critical=critical,
+    )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})
     if "centers" in out:

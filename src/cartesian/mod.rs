@@ -10,6 +10,7 @@ pub mod kinematics;
 mod outer;
 mod pair;
 pub mod rotation;
+pub mod rule;
 
 pub use chain::{Chain, Joint, JointKind, Transform, MAX_CHAIN_JOINTS};
 pub use computed::{ComputedState, ComputedTorque, ComputedTorqueConfig};
@@ -21,3 +22,4 @@ pub use outer::{
     PoseTarget,
 };
 pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement};
+pub use rule::{Assessment, PoseCircle, PostureRule};

@@ -242,7 +242,7 @@ pub trait DynOuter: Send + Sync {
         q0: &[f64],
         targets: &[PoseTarget],
         nodes: usize,
-    ) -> Result<(Vec<f64>, Vec<f64>), Error>;
+    ) -> Result<[Vec<f64>; 3], Error>;
     /// The closed loop on MuJoCo of this outer loop in front of the core's
     /// joint controller behind `tracker`, from both states
     /// ([`cartesian_loop::simulate_mujoco`]).
@@ -522,7 +522,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         q0: &[f64],
         targets: &[PoseTarget],
         nodes: usize,
-    ) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    ) -> Result<[Vec<f64>; 3], Error> {
         let q0 = vector_of::<N>(q0);
         crate::error::check::finite_slice("q0", q0.as_slice())?;
         let zero = Setpoint {
@@ -536,7 +536,11 @@ impl<const N: usize> DynOuter for Outer<N> {
             .orbit(q0, targets.len(), |k| targets[k], &mut out)?;
         let q = out[..k].iter().flat_map(|s| s.x.iter().copied()).collect();
         let dq = out[..k].iter().flat_map(|s| s.dx.iter().copied()).collect();
-        Ok((q, dq))
+        let ddq = out[..k]
+            .iter()
+            .flat_map(|s| s.ddx.iter().copied())
+            .collect();
+        Ok([q, dq, ddq])
     }
     fn simulate_mujoco(
         &mut self,
@@ -832,6 +836,31 @@ pub struct PyChain {
 impl PyChain {
     fn qv(&self, what: &'static str, obj: &Bound<'_, PyAny>) -> PyResult<[f64; MAX_JOINTS]> {
         vector(what, self.inner.n(), obj)
+    }
+
+    /// The chain behind the object.
+    pub(super) fn dyn_chain(&self) -> &dyn DynChain {
+        &*self.inner
+    }
+}
+
+/// A [`DynChain`] of `N` joints as the core's [`Kinematics`] (for the rules
+/// that take an arm's kinematics, SPEC §16).
+pub(super) struct TypedChain<'a, const N: usize>(pub(super) &'a dyn DynChain);
+
+impl<const N: usize> Kinematics<N> for TypedChain<'_, N> {
+    fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> crate::cartesian::Tip<N> {
+        let t = self.0.tip(q.as_slice(), dq.as_slice());
+        // The pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
+        let pose = self.0.pose(q.as_slice());
+        crate::cartesian::Tip {
+            position: Vector::<3>::new(pose[3], pose[7], pose[11]),
+            rotation: nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::new(
+                pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
+            )),
+            jacobian: crate::cartesian::Jacobian6::<N>::from_row_slice(&t.jacobian),
+            bias: Vector::<6>::from(t.bias),
+        }
     }
 }
 
@@ -1434,8 +1463,9 @@ impl PyCartesian {
 
     /// The orbit rule (SPEC §15, §16): run this outer loop kinematically
     /// (F_e = 0) from `q0` along `targets` (K, 24) (one flat pose target per
-    /// step) and return the joint reference (q_d (L, n), q̇_d (L, n)) of every
-    /// max(1, K // nodes)-th step, L ≤ `nodes`. This loop's state is unchanged.
+    /// step) and return the joint reference (q_d, q̇_d, q̈_d, each (L, n)) of
+    /// every max(1, K // nodes)-th step, L ≤ `nodes`. This loop's state is
+    /// unchanged.
     #[allow(clippy::type_complexity)]
     fn orbit<'py>(
         &self,
@@ -1443,7 +1473,11 @@ impl PyCartesian {
         q0: &Bound<'py, PyAny>,
         targets: PyReadonlyArray2<'py, f64>,
         nodes: usize,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    ) -> PyResult<(
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray2<f64>>,
+    )> {
         let n = self.n;
         let q0 = vector("q0", n, q0)?;
         if nodes == 0 {
@@ -1453,11 +1487,15 @@ impl PyCartesian {
         let flat_rows = rows(k, "targets", &targets, TARGET_LEN)?;
         let ts: Vec<PoseTarget> = flat_rows.chunks(TARGET_LEN).map(pose_target).collect();
         let g = self.lock(py);
-        let (q, dq) = py
+        let [q, dq, ddq] = py
             .detach(|| g.orbit(&q0[..n], &ts, nodes))
             .map_err(cartesian_error)?;
         let l = q.len() / n;
-        Ok((array(py, q, (l, n))?, array(py, dq, (l, n))?))
+        Ok((
+            array(py, q, (l, n))?,
+            array(py, dq, (l, n))?,
+            array(py, ddq, (l, n))?,
+        ))
     }
 }
 

@@ -68,7 +68,9 @@ mod adaptimp_module {
     use pyo3::prelude::*;
 
     #[pymodule_export]
-    use super::tuning::{default_task, suggest};
+    use super::tuning::{
+        assess_posture, default_task, pose_circle, pose_metrics, suggest, table_metrics,
+    };
     #[pymodule_export]
     use super::{
         defaults, metrics, schema_table, simulate, simulate_many, simulate_mujoco,

@@ -1,14 +1,17 @@
 //! The gain and basis rule of SPEC §18 for Python (`adaptimp.tuning`), a thin
 //! face of [`crate::control::tuning`]: arrays in, the schema's names out.
 
-use super::{config_error, law_of, py_value, ConfigError};
+use super::cartesian::{PyChain, TypedChain};
+use super::cartesian_loop::TARGET_LEN;
+use super::{array, config_error, law_of, py_value, ConfigError};
+use crate::cartesian::rule::{resolving, PoseCircle, PostureRule};
 use crate::control::tuning::{default_task as core_default_task, inertia_scales_along, Rule};
 use crate::error::Error;
 use crate::schema::{Group, Preset, Scenario, PARAMS};
 use crate::trajectory::Setpoint;
 use crate::types::{Matrix, Vector};
 use numpy::{
-    PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn,
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn,
     PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
@@ -25,9 +28,12 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// `tau_max` (n,; N m),
 /// period `ts` (s) and, if given, the task's `path` (K, 3n: q, q̇, q̈ per
 /// row, one period of `period` s, evenly spaced in time) with the gravity
-/// torque `gravity` (n,; N m) at its start, if known.
+/// torque `gravity` (n,; N m) at its start, if known. `resolve`: the tube
+/// narrowed to the path's own size, SPEC (16.10) (the Cartesian rule's).
+/// `critical`: Ĝ learns at the velocity loop's critical bandwidth, SPEC
+/// (19.6) (the table scenario's).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -38,6 +44,8 @@ pub fn suggest<'py>(
     path: Option<PyReadonlyArray2<'py, f64>>,
     period: Option<f64>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
+    resolve: bool,
+    critical: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -79,7 +87,17 @@ pub fn suggest<'py>(
     let out = PyDict::new(py);
     crate::with_joints!(
         n,
-        K => fill::<K>(py, &out, law, (&d, k, along), &tau, ts, path.as_ref(), gravity.as_deref()),
+        K => fill::<K>(
+            py,
+            &out,
+            law,
+            (&d, k, along),
+            &tau,
+            ts,
+            path.as_ref(),
+            gravity.as_deref(),
+            (resolve, critical),
+        ),
         _ => unreachable!("n checked above"),
     )?;
     Ok(out)
@@ -95,9 +113,14 @@ fn fill<'py, const N: usize>(
     ts: f64,
     path: Option<&(Vec<f64>, f64)>,
     gravity: Option<&[f64]>,
+    (resolve, critical): (bool, bool),
 ) -> PyResult<()> {
     let err = |e: Error| config_error(e.into());
-    let rule = Rule::default();
+    let mut rule = Rule::default();
+    if critical {
+        crate::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
+        rule = rule.critical(ts);
+    }
     // Row-major (n, n) into nalgebra's column-major: D is symmetric, but a
     // non-symmetric input must be reported, not transposed silently.
     let ds: Vec<Matrix<N>> = (0..k)
@@ -125,6 +148,9 @@ fn fill<'py, const N: usize>(
                     ddx: Vector::from_column_slice(&r[2 * N..]),
                 })
                 .collect();
+            if resolve && !samples.is_empty() {
+                rule = resolving(&rule, &samples);
+            }
             let g = gravity.map(Vector::<N>::from_column_slice);
             let sug = rule
                 .suggest_scaled(law, &scales, &tau, ts, &samples, *period, g.as_ref())
@@ -194,4 +220,345 @@ pub fn default_task(
         },
         _ => unreachable!("n checked above"),
     )
+}
+
+/// The default Cartesian task of SPEC (16.8) about the start pose `p0` (3,;
+/// m) and `r0` (3, 3; world ← tip), tabulated at t_k = `start` + k·`ts`
+/// for k < `steps`: (targets (steps, 24): p, ṗ, p̈, R row-major, ω, ω̇ per
+/// row; the span hold + ramp + 1/freq (s); the circle's centre (3,; m)).
+/// `radius` (m), `freq` (Hz), `hold`, `ramp` (s): None, the defaults of
+/// SPEC (16.8) (3 cm, 0.5 Hz, 1 s, 1 s).
+#[pyfunction]
+#[pyo3(signature = (p0, r0, ts, steps, radius=None, freq=None, hold=None, ramp=None, start=0.0))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn pose_circle<'py>(
+    py: Python<'py>,
+    p0: PyReadonlyArray1<'py, f64>,
+    r0: PyReadonlyArray2<'py, f64>,
+    ts: f64,
+    steps: usize,
+    radius: Option<f64>,
+    freq: Option<f64>,
+    hold: Option<f64>,
+    ramp: Option<f64>,
+    start: f64,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, f64, Vec<f64>)> {
+    if p0.shape() != [3] || r0.shape() != [3, 3] {
+        return Err(ConfigError::new_err(format!(
+            "p0 must have shape (3,) and r0 (3, 3), got {:?} and {:?}",
+            p0.shape(),
+            r0.shape()
+        )));
+    }
+    let err = |e: Error| config_error(e.into());
+    crate::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
+    crate::error::check::finite("start", start).map_err(err)?;
+    if steps > 100_000_000 {
+        return Err(ConfigError::new_err(format!(
+            "steps must be at most 1e8, got {steps}"
+        )));
+    }
+    let p = Vector::<3>::from_iterator(p0.as_array().iter().copied());
+    let r = nalgebra::Matrix3::from_iterator(r0.as_array().t().iter().copied());
+    let c = PoseCircle::with(
+        p,
+        r,
+        radius.unwrap_or(PoseCircle::RADIUS),
+        freq.unwrap_or(PoseCircle::FREQ),
+        hold.unwrap_or(PoseCircle::HOLD),
+        ramp.unwrap_or(PoseCircle::RAMP),
+    )
+    .map_err(err)?;
+    let mut out = Vec::with_capacity(steps * TARGET_LEN);
+    for k in 0..steps {
+        let t = c.sample(start + k as f64 * ts);
+        for v in [&t.p, &t.dp, &t.ddp] {
+            out.extend_from_slice(v.as_slice());
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                out.push(t.r[(i, j)]);
+            }
+        }
+        out.extend_from_slice(t.w.as_slice());
+        out.extend_from_slice(t.dw.as_slice());
+    }
+    Ok((
+        array(py, out, (steps, TARGET_LEN))?,
+        c.span(),
+        c.centre().as_slice().to_vec(),
+    ))
+}
+
+/// How well a posture runs a task, SPEC (16.9): `chain`, the task's joint
+/// orbit `q` (K, n; rad), its commanded positions `p` (K, 3; m), the gravity
+/// torque along it `gravity` (K, n; N m), the inertia matrix at its start
+/// `d0` (n, n; kg m²), the limits `lo`, `hi` (n,; rad, ±inf: unlimited),
+/// `tau_max` (n,; N m), `orients` (the 6 × n Jacobian, else its 3
+/// translation rows), `k1` (1/s) and `ts` (s) of the joint controller (the
+/// conditioning threshold K1·Ts/m; default the joint rule's at 1 kHz),
+/// `load` the largest gravity load allowed (default 0.5; 1: gravity within
+/// the actuators, for a posture the caller gave).
+/// Returns a dict: "sigma_min", "load", "conditioning", "slack",
+/// "slack_joint", "reach", "score" and "error" (the first condition it
+/// violates, or None).
+#[pyfunction]
+#[pyo3(signature = (chain, q, p, gravity, d0, lo, hi, tau_max, orients, k1=None, ts=None, load=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn assess_posture<'py>(
+    py: Python<'py>,
+    chain: &PyChain,
+    q: PyReadonlyArray2<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+    gravity: PyReadonlyArray2<'py, f64>,
+    d0: PyReadonlyArray2<'py, f64>,
+    lo: PyReadonlyArray1<'py, f64>,
+    hi: PyReadonlyArray1<'py, f64>,
+    tau_max: PyReadonlyArray1<'py, f64>,
+    orients: bool,
+    k1: Option<f64>,
+    ts: Option<f64>,
+    load: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let joint_rule = Rule::default();
+    let ts = ts.unwrap_or(1e-3);
+    let mut rule = PostureRule::for_loop(k1.unwrap_or_else(|| joint_rule.k1(ts)), ts, &joint_rule);
+    if let Some(l) = load {
+        crate::error::check::positive("load > 0", "load", l).map_err(|e| config_error(e.into()))?;
+        rule.load = l;
+    }
+    let kin = chain.dyn_chain();
+    let n = kin.n();
+    let k = q.shape()[0];
+    let shape_ok = q.shape() == [k, n]
+        && p.shape() == [k, 3]
+        && gravity.shape() == [k, n]
+        && d0.shape() == [n, n]
+        && lo.shape() == [n]
+        && hi.shape() == [n]
+        && tau_max.shape() == [n];
+    if !shape_ok || k == 0 {
+        return Err(ConfigError::new_err(format!(
+            "assess_posture needs q (K, {n}), p (K, 3), gravity (K, {n}), d0 ({n}, {n}), \
+             lo, hi, tau_max ({n},) with K ≥ 1; got q {:?}, p {:?}, gravity {:?}, d0 {:?}",
+            q.shape(),
+            p.shape(),
+            gravity.shape(),
+            d0.shape()
+        )));
+    }
+    let flat = |a: &PyReadonlyArray2<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let (q, p, g, d) = (flat(&q), flat(&p), flat(&gravity), flat(&d0));
+    let (lo, hi, tau) = (flat1(&lo), flat1(&hi), flat1(&tau_max));
+    fn run<const N: usize>(
+        rule: &PostureRule,
+        kin: &dyn super::cartesian::DynChain,
+        (q, p, g, d): (&[f64], &[f64], &[f64], &[f64]),
+        (lo, hi, tau): (&[f64], &[f64], &[f64]),
+        orients: bool,
+    ) -> Result<(crate::cartesian::Assessment, f64, Option<String>), Error> {
+        let v = Vector::<N>::from_column_slice;
+        let orbit: Vec<Vector<N>> = q.chunks_exact(N).map(v).collect();
+        let targets: Vec<Vector<3>> = p
+            .chunks_exact(3)
+            .map(Vector::<3>::from_column_slice)
+            .collect();
+        let gravity: Vec<Vector<N>> = g.chunks_exact(N).map(v).collect();
+        let a = rule.assess(
+            &TypedChain::<N>(kin),
+            orients,
+            &orbit,
+            &targets,
+            &gravity,
+            &Matrix::<N>::from_row_slice(d),
+            (&v(lo), &v(hi)),
+            &v(tau),
+        )?;
+        let error = rule.check(&a).err().map(|e| e.to_string());
+        Ok((a, rule.score(&a), error))
+    }
+    let (a, score, error) = crate::with_joints!(
+        n,
+        K => run::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),
+        _ => unreachable!("a chain has 1 to 7 joints"),
+    )
+    .map_err(|e| config_error(e.into()))?;
+    let out = PyDict::new(py);
+    out.set_item("sigma_min", a.sigma_min)?;
+    out.set_item("load", a.load)?;
+    out.set_item("conditioning", a.conditioning)?;
+    out.set_item("slack", a.slack)?;
+    out.set_item("slack_joint", a.slack_joint)?;
+    out.set_item("reach", a.reach)?;
+    out.set_item("score", score)?;
+    out.set_item("error", error)?;
+    Ok(out)
+}
+
+/// The pose errors of a run, SPEC (16.11): the tip of `chain` at every row
+/// of `q` (K, n; rad) against the commanded pose of the same row of
+/// `targets` (K, 24), with the rows' times `t` (K,; s), the window start
+/// `settle` (s) and the period `ts` (s). Returns (e_p (K,; m), e_o (K,;
+/// rad), the metrics: a dict of `adaptimp`'s names).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+pub fn pose_metrics<'py>(
+    py: Python<'py>,
+    chain: &PyChain,
+    q: PyReadonlyArray2<'py, f64>,
+    targets: PyReadonlyArray2<'py, f64>,
+    t: PyReadonlyArray1<'py, f64>,
+    settle: f64,
+    ts: f64,
+) -> PyResult<(
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyDict>,
+)> {
+    let kin = chain.dyn_chain();
+    let n = kin.n();
+    let k = q.shape()[0];
+    if q.shape() != [k, n] || targets.shape() != [k, TARGET_LEN] || t.shape() != [k] {
+        return Err(ConfigError::new_err(format!(
+            "pose_metrics needs q (K, {n}), targets (K, {TARGET_LEN}) and t (K,); got {:?}, {:?}, {:?}",
+            q.shape(),
+            targets.shape(),
+            t.shape()
+        )));
+    }
+    let q: Vec<f64> = q.as_array().iter().copied().collect();
+    let tg: Vec<f64> = targets.as_array().iter().copied().collect();
+    let t: Vec<f64> = t.as_array().iter().copied().collect();
+    let (pos, rot) = py.detach(|| {
+        let (mut pos, mut rot) = (Vec::with_capacity(k), Vec::with_capacity(k));
+        for r in 0..k {
+            // The tip's pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
+            let pose = kin.pose(&q[r * n..(r + 1) * n]);
+            let position = [pose[3], pose[7], pose[11]];
+            let rotation = [
+                pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
+            ];
+            let row = &tg[r * TARGET_LEN..(r + 1) * TARGET_LEN];
+            let quat = |m: &[f64]| {
+                nalgebra::UnitQuaternion::from_rotation_matrix(
+                    &nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::from_row_slice(
+                        m,
+                    )),
+                )
+            };
+            let (ep, eo) = crate::sim::metrics::pose_error(
+                &Vector::<3>::from(position),
+                &quat(&rotation),
+                &Vector::<3>::from_column_slice(&row[..3]),
+                &quat(&row[9..18]),
+            );
+            pos.push(ep);
+            rot.push(eo);
+        }
+        (pos, rot)
+    });
+    let m = crate::sim::metrics::pose_metrics(&t, &pos, &rot, settle, ts);
+    let out = PyDict::new(py);
+    for (name, v) in [
+        ("rms_pos", m.rms_pos),
+        ("rms_pos_after2", m.rms_pos_after2),
+        ("max_pos_after2", m.max_pos_after2),
+        ("rms_rot", m.rms_rot),
+        ("rms_rot_after2", m.rms_rot_after2),
+        ("max_rot_after2", m.max_rot_after2),
+        ("rms_pos_first2", m.rms_pos_first2),
+        ("rms_pos_last2", m.rms_pos_last2),
+    ] {
+        out.set_item(name, v)?;
+    }
+    Ok((
+        PyArray1::from_vec(py, pos),
+        PyArray1::from_vec(py, rot),
+        out,
+    ))
+}
+
+/// The table's metrics of a run, SPEC (19.7) ([`crate::sim::metrics::table_metrics`]):
+/// the rows (each K × width, row-major: `t` (K,), `p`, `dp`, `ddp`, `pd`,
+/// `pc`, `dpc`, `ddpc` (K, 3), `wrench` (K, 6), `normal` (K,), `tau`,
+/// `tau_sat` (K, n)) and what they are compared with (`tau_max` (n,), `md`,
+/// `bd`, `kd` (3,), `depth` (m), `series` (N/m), `settle`, `windup_after`,
+/// `approach_end`, `ts` (s)). Returns a dict of the metrics by name.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn table_metrics<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    p: PyReadonlyArray2<'py, f64>,
+    dp: PyReadonlyArray2<'py, f64>,
+    ddp: PyReadonlyArray2<'py, f64>,
+    pd: PyReadonlyArray2<'py, f64>,
+    pc: (
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+        PyReadonlyArray2<'py, f64>,
+    ),
+    wrench: PyReadonlyArray2<'py, f64>,
+    normal: PyReadonlyArray1<'py, f64>,
+    tau: (PyReadonlyArray2<'py, f64>, PyReadonlyArray2<'py, f64>),
+    tau_max: PyReadonlyArray1<'py, f64>,
+    impedance: ([f64; 3], [f64; 3], [f64; 3]),
+    depth: f64,
+    series: f64,
+    windows: (f64, f64, f64),
+    ts: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use crate::sim::metrics::{table_metrics as core_metrics, TableRows, TableSpec};
+    let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let flat = |a: &PyReadonlyArray2<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let (t, normal, tau_max) = (flat1(&t), flat1(&normal), flat1(&tau_max));
+    let (p, dp, ddp, pd, wrench) = (flat(&p), flat(&dp), flat(&ddp), flat(&pd), flat(&wrench));
+    let (pc0, pc1, pc2) = (flat(&pc.0), flat(&pc.1), flat(&pc.2));
+    let (tau0, tau1) = (flat(&tau.0), flat(&tau.1));
+    let rows = TableRows {
+        t: &t,
+        p: &p,
+        dp: &dp,
+        ddp: &ddp,
+        pd: &pd,
+        pc: [&pc0, &pc1, &pc2],
+        wrench: &wrench,
+        normal: &normal,
+        tau: [&tau0, &tau1],
+    };
+    let spec = TableSpec {
+        tau_max: &tau_max,
+        md: impedance.0,
+        bd: impedance.1,
+        kd: impedance.2,
+        depth,
+        series,
+        settle: windows.0,
+        windup_after: windows.1,
+        approach_end: windows.2,
+        ts,
+    };
+    let m = core_metrics(&rows, &spec).map_err(|e| config_error(e.into()))?;
+    let out = PyDict::new(py);
+    for (name, v) in [
+        ("rms_track", m.rms_track),
+        ("rms_track_along", m.rms_track_along),
+        ("rms_path_xy", m.rms_path_xy),
+        ("rms_force", m.rms_force),
+        ("rms_imp", m.rms_imp),
+        ("force_target", m.force_target),
+        ("force_rms_err", m.force_rms_err),
+        ("force_chatter", m.force_chatter),
+        ("force_mean", m.force_mean),
+        ("force_16_1", m.force_16_1),
+        ("peak_force", m.peak_force),
+        ("contact_lost", m.contact_lost),
+        ("sat_duty", m.sat_duty),
+        ("peak_tau_ratio", m.peak_tau_ratio),
+        ("applied_ratio", m.applied_ratio),
+    ] {
+        out.set_item(name, v)?;
+    }
+    Ok(out)
 }

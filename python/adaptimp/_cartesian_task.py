@@ -1,0 +1,612 @@
+"""The Cartesian task of :func:`adaptimp.mujoco.cartesian_task` (SPEC §16, (16.8)–(16.11)).
+
+A pose task for any arm in five lines::
+
+    from adaptimp import mujoco as amj
+
+    task = amj.cartesian_task("my_arm.urdf")  # a start posture, the default path
+    res = amj.simulate("sf", "my_arm.urdf", T=12.0, task=task)
+    res.metrics["rms_pos_after2"], res.metrics["rms_rot_after2"]  # m, rad
+    res.pos_err, res.rot_err  # per row
+
+- :class:`CirclePath`: the default path, the core's (16.8): hold the start pose
+  1 s, then a 3 cm circle at 0.5 Hz in the horizontal plane through it, the
+  orientation held.
+- :func:`task_of`: the start posture when none is given, by the core's
+  posture rule (16.9) over candidates drawn within the joint limits, each
+  checked along its task's joint orbit and for self-collision
+  (:func:`self_collision`).
+- :class:`CartesianTask`: the task; :meth:`CartesianTask.controller` builds
+  :meth:`adaptimp.CartesianController.from_rule`, :meth:`CartesianTask.measure`
+  the pose errors and their metrics in the core (16.11).
+
+This module takes an ``adaptimp.mujoco.Plant`` object and never imports
+:mod:`adaptimp.mujoco` (which imports it). Units: m, rad, s, N m.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import mujoco
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _adaptimp, _mjcf
+from ._errors import ConfigError
+from .cartesian import CartesianController, Path, tabulate
+from .chain import Chain
+
+__all__ = [
+    "CANDIDATES",
+    "IK_TIME",
+    "CartesianTask",
+    "CirclePath",
+    "TablePath",
+    "chain_of",
+    "self_collision",
+    "task_of",
+]
+
+FloatArray = NDArray[np.float64]
+
+CANDIDATES = 512
+"""Postures drawn (fixed seed) within the joint limits when no start is given."""
+
+IK_TIME = 2.0
+"""How long (s) the core's inverse kinematics (the outer loop run
+kinematically, F_e = 0) holds a given path's first pose from a candidate
+posture to reach it."""
+
+GIVEN_LOAD = 1.0
+"""The largest gravity load max_i |G_i|/τmax_i along the task of a start the
+user gives (gravity within the actuators); a drawn start keeps the rule's 0.5."""
+
+CHECKED = 40
+"""Rows of the task's joint orbit at which gravity and self-collision are
+checked (evenly spaced)."""
+
+SKELETON_RADIUS = 0.04
+"""The radius of a link of the skeleton check (:func:`self_collision`), as a
+share of the sum of the skeleton's segment lengths (the arm's length)."""
+
+
+class CirclePath:
+    """The default Cartesian path of SPEC (16.8) about the start pose (``p0`` (m),
+    ``R0`` (3, 3), world ← tip), computed by the core: callable as ``path(t) ->
+    (p, ṗ, p̈, R, ω, ω̇)`` and tabulated at once (``table``)."""
+
+    def __init__(self, p0: ArrayLike, R0: ArrayLike) -> None:
+        self.p0 = np.array(p0, dtype=np.float64).reshape(3)
+        self.R0 = np.array(R0, dtype=np.float64).reshape(3, 3)
+        _, span, centre = _adaptimp.pose_circle(self.p0, self.R0, 1.0, 0)
+        self.span = float(span)
+        """Hold + ramp + one period (s): what a rule samples."""
+        self.centre = np.asarray(centre, dtype=np.float64)
+        """The circle's centre (m)."""
+
+    def table(self, steps: int, Ts: float, start: int = 0) -> FloatArray:
+        """The path at t_k = (start + k)·Ts, k < steps: (steps, 24) rows of
+        :func:`adaptimp.cartesian.pose_target`."""
+        rows, _, _ = _adaptimp.pose_circle(
+            self.p0, self.R0, float(Ts), int(steps), start=start * Ts
+        )
+        return np.asarray(rows, dtype=np.float64)
+
+    def __call__(self, t: float) -> tuple[FloatArray, ...]:
+        rows, _, _ = _adaptimp.pose_circle(self.p0, self.R0, 1.0, 1, start=float(t))
+        return _split(np.asarray(rows, dtype=np.float64).reshape(24))
+
+    def __repr__(self) -> str:
+        return f"CirclePath(p0={self.p0.round(4).tolist()}, span={self.span:g} s)"
+
+
+def _split(row: FloatArray) -> tuple[FloatArray, ...]:
+    """A row of :func:`adaptimp.cartesian.pose_target` as (p, ṗ, p̈, R, ω, ω̇)."""
+    return row[0:3], row[3:6], row[6:9], row[9:18].reshape(3, 3), row[18:21], row[21:24]
+
+
+class TablePath:
+    """A path given as arrays, row k at t_k = k·``Ts``: (p, ṗ, p̈) (K, 3) each
+    (m, m/s, m/s²) and optionally (R (K, 3, 3), ω, ω̇ (K, 3)); beyond its last
+    row the last pose at rest."""
+
+    def __init__(self, arrays: Sequence[ArrayLike], Ts: float) -> None:
+        a = [np.asarray(x, dtype=np.float64) for x in arrays]
+        if len(a) not in (3, 6):
+            raise ConfigError(
+                f"pose arrays must be (p, dp, ddp) or (p, dp, ddp, R, w, dw), got {len(a)} arrays"
+            )
+        k = a[0].shape[0] if a[0].ndim == 2 else 0
+        shapes = [(k, 3)] * 3 + [(k, 3, 3), (k, 3), (k, 3)]
+        for name, x, want in zip(("p", "dp", "ddp", "R", "w", "dw"), a, shapes):
+            if k == 0 or x.shape != want:
+                raise ConfigError(
+                    f"pose array {name} must have shape {want} (K ≥ 1), got {x.shape}"
+                )
+            if not np.all(np.isfinite(x)):
+                raise ConfigError(f"pose array {name} must be finite")
+        rows = np.zeros((k, 24))
+        rows[:, 9:18] = np.eye(3).reshape(9)
+        for i in range(3):
+            rows[:, 3 * i : 3 * i + 3] = a[i]
+        if len(a) == 6:
+            rows[:, 9:18] = a[3].reshape(k, 9)
+            rows[:, 18:21], rows[:, 21:24] = a[4], a[5]
+        self.rows, self.Ts, self.orients = rows, float(Ts), len(a) == 6
+        self.span = k * self.Ts
+        """The rows' duration (s)."""
+
+    def table(self, steps: int, Ts: float, start: int = 0) -> FloatArray:
+        """Rows start … start + steps − 1 (the table's period must be ``Ts``)."""
+        if not math.isclose(Ts, self.Ts, rel_tol=1e-12):
+            raise ConfigError(f"the pose arrays are at Ts = {self.Ts:g} s, not {Ts:g} s")
+        idx = np.arange(start, start + steps)
+        out = self.rows[np.minimum(idx, self.rows.shape[0] - 1)].copy()
+        out[idx >= self.rows.shape[0], 3:9] = 0.0  # held at rest
+        out[idx >= self.rows.shape[0], 18:24] = 0.0
+        return out
+
+    def __call__(self, t: float) -> tuple[FloatArray, ...]:
+        k = max(round(t / self.Ts), 0)
+        return _split(self.table(1, self.Ts, k)[0])
+
+
+def chain_of(plant: Any) -> Chain:
+    """The arm's :class:`~adaptimp.Chain` to the plant's end-effector point (its
+    site, or the origin of its end-effector body), the joints in the plant's
+    order."""
+    m = plant.model
+    site = int(getattr(plant, "_site", -1))
+    if site >= 0:
+        chain = Chain.from_mujoco(m, site)
+    else:
+        bodies, b = [], int(plant._ee_body)
+        while b != 0:
+            bodies.append(b)
+            b = int(m.body_parentid[b])
+        joints: list[dict[str, Any]] = []
+        names: list[str] = []
+        for b in reversed(bodies):
+            joints.append(
+                {"kind": "fixed", "pos": m.body_pos[b].tolist(), "quat": m.body_quat[b].tolist()}
+            )
+            for j in range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b])):
+                anchor = m.jnt_pos[j].tolist()
+                joints.append(
+                    {
+                        "kind": "revolute",
+                        "pos": anchor,
+                        "axis": m.jnt_axis[j].tolist(),
+                        "offset": float(m.qpos0[m.jnt_qposadr[j]]),
+                    }
+                )
+                joints.append({"kind": "fixed", "pos": [-x for x in anchor]})
+                names.append(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint{j}")
+        label = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(plant._ee_body))
+        chain = Chain(joints, None, names=names, source=f"MuJoCo model to body {label!r}")
+    plant_joints = [
+        mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(j)) or f"joint{int(j)}"
+        for j in plant._joints
+    ]
+    if chain.joint_names != plant_joints:
+        raise ConfigError(
+            f"the chain to the end effector has the joints {chain.joint_names}, but the plant "
+            f"drives {plant_joints}"
+        )
+    return chain
+
+
+def _limits(plant: Any) -> tuple[FloatArray, FloatArray]:
+    """The joint ranges (rad), ±inf where a joint is unlimited."""
+    m = plant.model
+    lo, hi = np.full(plant.n, -math.inf), np.full(plant.n, math.inf)
+    for i, j in enumerate(plant._joints):
+        if m.jnt_limited[j]:
+            lo[i], hi[i] = m.jnt_range[j]
+    return lo, hi
+
+
+class _Probe:
+    """Gravity, inertia and self-collision of the plant's model at postures,
+    on a data of its own (the plant's state untouched)."""
+
+    def __init__(self, plant: Any) -> None:
+        self.plant, self.m = plant, plant.model
+        self.d = mujoco.MjData(self.m)
+        self.qadr = np.asarray(plant._qadr)
+        self.dofs = np.asarray(plant._dofs)
+        self._full = np.zeros((self.m.nv, self.m.nv))
+
+    def at(self, q: FloatArray) -> None:
+        self.d.qpos[:] = self.m.qpos0
+        self.d.qpos[self.qadr] = q
+        self.d.qvel[:] = 0.0
+        mujoco.mj_forward(self.m, self.d)
+
+    def gravity(self, q: FloatArray) -> FloatArray:
+        self.at(q)
+        return np.array(self.d.qfrc_bias[self.dofs], dtype=np.float64)
+
+    def inertia(self, q: FloatArray) -> FloatArray:
+        self.at(q)
+        try:
+            mujoco.mj_fullM(self.m, self.d, self._full)
+        except TypeError:  # MuJoCo 3: mj_fullM(m, dst, qM)
+            mujoco.mj_fullM(self.m, self._full, self.d.qM)
+        return np.array(self._full[np.ix_(self.dofs, self.dofs)], dtype=np.float64)
+
+
+def self_collision(plant: Any, rows: FloatArray) -> str | None:
+    """The first self-collision of the arm at the postures ``rows`` (K, n)
+    (rad), named ("row k: 'a'–'b' touch"), or None.
+
+    With the model's collision geometry (two of the arm's bodies that can
+    collide): MuJoCo's collision detection, contacts enabled, among the arm's
+    own bodies, as the joint-space task's check has it (``_mjcf.Contacts``,
+    SPEC §18: bodies its joints move relative to each other, its exclusions
+    and parent–child filter kept).
+    Without (a URDF compiled as :func:`adaptimp.mujoco.from_urdf` does, which
+    keeps no collision geometry): the arm's skeleton, capsules along the
+    segments between consecutive distinct joint anchors and the end effector,
+    of radius r = :data:`SKELETON_RADIUS` times the skeleton's length, each
+    less r where it meets the next; two links that are not neighbours must not
+    come within 2r.
+    """
+    m = plant.model
+    flags = int(m.opt.disableflags)
+    m.opt.disableflags = flags & ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    try:  # the copy Contacts makes has contacts on, whatever the plant's setting
+        contacts = _mjcf.Contacts(m, plant.data.qpos, list(plant._joints), self_only=True)
+    finally:
+        m.opt.disableflags = flags
+    if contacts.possible:
+        for k, q in enumerate(rows):
+            found = contacts.at(q)
+            if found:
+                return f"row {k}: {_mjcf.pairs(found)} touch"
+        return None
+    probe = _Probe(plant)
+    for k, q in enumerate(rows):
+        probe.at(q)
+        points = [np.array(probe.d.xanchor[j]) for j in plant._joints]
+        site = int(getattr(plant, "_site", -1))
+        points.append(
+            np.array(probe.d.site_xpos[site] if site >= 0 else probe.d.xpos[plant._ee_body])
+        )
+        pts = [np.zeros(3)]
+        for p in points:
+            if np.linalg.norm(p - pts[-1]) > 1e-6:
+                pts.append(p)
+        length = sum(float(np.linalg.norm(b - a)) for a, b in zip(pts, pts[1:]))
+        r = SKELETON_RADIUS * length
+        segs = [
+            _trimmed(a, b, r, first=i == 0, last=i == len(pts) - 2)
+            for i, (a, b) in enumerate(zip(pts, pts[1:]))
+        ]
+        for i, si in enumerate(segs):
+            for j in range(i + 2, len(segs)):
+                sj = segs[j]
+                if si is None or sj is None:
+                    continue
+                if _segment_distance(si[0], si[1], sj[0], sj[1]) < 2 * r:
+                    return (
+                        f"row {k}: the skeleton's links {i} and {j} (between joint anchors) "
+                        f"come within {2 * r:.3g} m"
+                    )
+    return None
+
+
+def _trimmed(
+    a: FloatArray, b: FloatArray, r: float, *, first: bool, last: bool
+) -> tuple[FloatArray, FloatArray] | None:
+    """The segment [a, b] less a length ``r`` at each end where it meets another
+    link (not at the base or the end effector), or None if nothing is left:
+    two links meet at a joint, and their capsules overlap there by design."""
+    length = float(np.linalg.norm(b - a))
+    cut_a, cut_b = (0.0 if first else r), (0.0 if last else r)
+    if length <= cut_a + cut_b:
+        return None
+    u = (b - a) / length
+    return a + cut_a * u, b - cut_b * u
+
+
+def _segment_distance(p1: FloatArray, q1: FloatArray, p2: FloatArray, q2: FloatArray) -> float:
+    """The distance (m) between the segments [p1, q1] and [p2, q2] (Ericson,
+    *Real-Time Collision Detection*, 2005, §5.1.9)."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e, f = float(d1 @ d1), float(d2 @ d2), float(d2 @ r)
+    if a <= 1e-12 and e <= 1e-12:
+        return float(np.linalg.norm(r))
+    if a <= 1e-12:
+        s, t = 0.0, min(max(f / e, 0.0), 1.0)
+    else:
+        c = float(d1 @ r)
+        if e <= 1e-12:
+            s, t = min(max(-c / a, 0.0), 1.0), 0.0
+        else:
+            b = float(d1 @ d2)
+            den = a * e - b * b
+            s = min(max((b * f - c * e) / den, 0.0), 1.0) if den > 1e-12 else 0.0
+            t = (b * s + f) / e
+            if t < 0.0:
+                s, t = min(max(-c / a, 0.0), 1.0), 0.0
+            elif t > 1.0:
+                s, t = min(max((b - c) / a, 0.0), 1.0), 1.0
+    return float(np.linalg.norm(p1 + d1 * s - (p2 + d2 * t)))
+
+
+@dataclass(frozen=True)
+class CartesianTask:
+    """A Cartesian task on an arm (:func:`adaptimp.mujoco.cartesian_task`).
+
+    Attributes
+    ----------
+    q0 : ndarray, (n,)
+        The start posture (rad): the path's first pose, from rest.
+    chain : Chain
+        The arm's kinematics to the plant's end-effector point.
+    path : callable
+        ``path(t) -> (p, ṗ, p̈, R, ω, ω̇)`` (m, m/s, m/s², rotation (3, 3),
+        rad/s, rad/s²; world frame): :class:`CirclePath` by default.
+    span : float
+        The part of the path the rule samples (s): hold + ramp + one period.
+    orients : bool
+        Whether the orientation is held (six joints or more); else the task
+        is the position only.
+    assessment : dict
+        The start's figures along the task (SPEC (16.9)): ``sigma_min``
+        (m/rad), ``load``, ``conditioning``, ``slack`` (rad), ``reach`` (m),
+        ``score``.
+    source : str
+        How q0 was found: "given", or "drawn (candidate k of N)".
+    """
+
+    q0: FloatArray
+    chain: Chain
+    path: Path
+    span: float
+    orients: bool
+    assessment: dict[str, Any] = field(default_factory=dict)
+    source: str = "given"
+
+    @property
+    def pose0(self) -> tuple[FloatArray, FloatArray]:
+        """The start pose: p (m), R (3, 3)."""
+        return self.chain.pose(self.q0)
+
+    def targets(self, steps: int, Ts: float) -> FloatArray:
+        """The path at t_k = k·Ts, (steps, 24) (:func:`adaptimp.cartesian.tabulate`)."""
+        return tabulate(self.path, steps, Ts, self.pose0[1])
+
+    def controller(self, case: str, plant: Any, *, Ts: float = 1e-3, **params: Any) -> Any:
+        """The Cartesian controller of ``case`` for this task by the core's rule
+        (:meth:`adaptimp.CartesianController.from_rule`, D and G from the
+        ``plant``); ``params`` replace the rule's keywords."""
+        if not self.orients:
+            params.setdefault("Kd_rot", 0.0)
+        return CartesianController.from_rule(
+            self.chain, case, self.path, self.q0, model=plant, span=self.span, Ts=Ts, **params
+        )
+
+    def prepare(
+        self,
+        controller: Any,
+        plant: Any,
+        Ts: float | None,
+        params: dict[str, Any],
+        keep: Sequence[str],
+    ) -> tuple[Any, dict[str, Any]]:
+        """For ``simulate(case, model, task=self, **params)``: the controller of the
+        case name by :meth:`controller`, with the ``params`` not named in
+        ``keep`` (the simulator's own, e.g. disturbances), which are returned."""
+        if not isinstance(controller, str):
+            raise TypeError(
+                "task= builds the Cartesian controller of a case name ('pd', 'sf', 'of'); "
+                f"got {type(controller).__name__}: run your own controller without task="
+            )
+        own = {k: v for k, v in params.items() if k not in keep}
+        rest = {k: v for k, v in params.items() if k in keep}
+        return self.controller(controller, plant, Ts=1e-3 if Ts is None else Ts, **own), rest
+
+    def measure(self, res: Any) -> None:
+        """The task's errors of a run (``res`` from :func:`adaptimp.mujoco.simulate`),
+        in the core (SPEC (16.11)): ``res.task["pos_err"]`` (K,) ‖p_c − p‖ (m),
+        ``res.task["rot_err"]`` (K,) ‖Log(R_c Rᵀ)‖ (rad) (the commanded pose
+        of the row against the tip of the chain at the row's q), and the
+        metrics ``rms_pos_after2``, ``rms_rot_after2`` (over t ≥ settle),
+        ``max_pos_after2``, ``max_rot_after2``, ``rms_pos``, ``rms_rot``,
+        ``rms_pos_first2`` (over [settle, settle + 2 s)) and ``rms_pos_last2``
+        (over the run's last 2 s) added to ``res.metrics``."""
+        Ts, settle = float(res.params["Ts"]), float(res.params["settle"])
+        t = np.ascontiguousarray(res.t, dtype=np.float64)
+        rows = np.rint(t / Ts).astype(np.int64)
+        steps = int(rows[-1]) + 1 if rows.size else 0
+        table = np.ascontiguousarray(self.targets(steps, Ts)[rows])
+        pos, rot, m = _adaptimp.pose_metrics(
+            self.chain, np.ascontiguousarray(res.q, dtype=np.float64), table, t, settle, Ts
+        )
+        res.metrics.update(m)
+        if res.task is not None:
+            res.task["pos_err"], res.task["rot_err"] = pos, rot
+
+
+def _ik(chain: Chain, q: FloatArray, path: Path, Ts: float, orients: bool) -> FloatArray:
+    """The core's inverse kinematics of the path's first pose from ``q``: the
+    outer loop run kinematically with that pose held for :data:`IK_TIME`."""
+    from .cartesian import CartesianImpedance
+
+    first = tuple(path(0.0))
+    hold = (*first[:3], *first[3:]) if len(first) == 6 else first
+    R = chain.pose(q)[1]
+    held = [np.asarray(x, dtype=np.float64) for x in hold]
+    if len(held) == 6:
+        held[1:3] = [np.zeros(3), np.zeros(3)]
+        held[4:6] = [np.zeros(3), np.zeros(3)]
+    else:
+        held = [held[0], np.zeros(3), np.zeros(3), R, np.zeros(3), np.zeros(3)]
+
+    def at_rest(t: float) -> tuple[FloatArray, ...]:
+        return tuple(held)
+
+    position_only: dict[str, Any] = {} if orients else {"Kd_rot": 0.0}
+    outer = CartesianImpedance(chain, Ts=Ts, q0=q, **position_only)
+    steps = round(IK_TIME / Ts)
+    qs, _, _ = outer.joint_path(at_rest, steps * Ts, samples=steps)
+    return np.asarray(qs[-1], dtype=np.float64)
+
+
+def _assess(
+    plant: Any,
+    probe: _Probe,
+    chain: Chain,
+    q0: FloatArray,
+    path: Path,
+    span: float,
+    Ts: float,
+    orients: bool,
+    load: float | None = None,
+) -> dict[str, Any]:
+    """The core's posture rule (SPEC (16.9)) along the task's joint orbit from
+    ``q0``, and its self-collision (:func:`self_collision`)."""
+    from .cartesian import CartesianImpedance
+
+    position_only: dict[str, Any] = {} if orients else {"Kd_rot": 0.0}
+    outer = CartesianImpedance(chain, Ts=Ts, q0=q0, **position_only)
+    steps = round(span / Ts)
+    q, _, _ = outer.joint_path(path, steps * Ts, samples=steps)
+    idx = np.unique(np.linspace(0, q.shape[0] - 1, CHECKED).round().astype(int))
+    rows = np.ascontiguousarray(q[idx])
+    targets = tabulate(path, steps, Ts, chain.pose(q0)[1])[idx, 0:3]
+    gravity = np.array([probe.gravity(x) for x in rows])
+    lo, hi = _limits(plant)
+    a = dict(
+        _adaptimp.assess_posture(
+            chain, rows, np.ascontiguousarray(targets), gravity, probe.inertia(q0),
+            lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients, load=load,
+        )
+    )  # fmt: skip
+    if a["error"] is None:
+        hit = self_collision(plant, rows)
+        if hit is not None:
+            a["error"] = f"free of self-collision along the task: {hit}"
+    return a
+
+
+def task_of(
+    plant: Any,
+    q0: ArrayLike | None = None,
+    pose: Path | Sequence[ArrayLike] | None = None,
+    *,
+    Ts: float = 1e-3,
+    span: float | None = None,
+    seed: int = 0,
+) -> CartesianTask:
+    """The task of :func:`adaptimp.mujoco.cartesian_task` on ``plant`` (an
+    ``adaptimp.mujoco.Plant``); see there."""
+    chain = chain_of(plant)
+    n = chain.n
+    orients = n >= 6
+    probe = _Probe(plant)
+    user_path: Path | None
+    if pose is None:
+        user_path = None
+    elif callable(pose):
+        user_path = pose
+    else:
+        user_path = TablePath(pose, Ts)
+    if span is None:
+        span = getattr(user_path, "span", None) if user_path is not None else None
+    if user_path is not None and span is None:
+        span = 4.0
+    if span is not None and not (math.isfinite(span) and span > 0):
+        raise ConfigError(f"span must be a finite number > 0 (s), got {span!r}")
+
+    def path_from(q: FloatArray) -> tuple[FloatArray, Path, float]:
+        """The start (after the inverse kinematics of a given path), the path, its span."""
+        if user_path is None:
+            p, R = chain.pose(q)
+            circle = CirclePath(p, R)
+            return q, circle, circle.span
+        assert span is not None
+        return _ik(chain, q, user_path, Ts, orients), user_path, float(span)
+
+    if q0 is not None:
+        q = _vector("q0", q0, chain)
+        lo, hi = _limits(plant)
+        outside = np.flatnonzero((q < lo) | (q > hi))
+        if outside.size:
+            i = int(outside[0])
+            raise ConfigError(
+                f"q0 must lie within the joint limits; joint {i} ({chain.joint_names[i]!r}) has "
+                f"q0 = {float(q[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
+            )
+        start, path, length = path_from(q)
+        # A start the user gives: gravity within the actuators (a drawn one: half).
+        a = _assess(plant, probe, chain, start, path, length, Ts, orients, load=GIVEN_LOAD)
+        if a["error"] is not None:
+            raise ConfigError(f"q0 cannot run the task: {a['error']}")
+        return CartesianTask(start, chain, path, length, orients, a, "given")
+    screened = []
+    for k, q in enumerate(_candidates(plant, seed)):
+        quick = _screen(probe, chain, q, orients, plant)
+        if quick is not None:
+            screened.append((quick, k, q))
+    screened.sort(key=lambda x: (-x[0], x[1]))
+    first_error = "none passed the rule at its start"
+    tried = screened[:CHECKED]
+    for _, k, q in tried:
+        try:
+            start, path, length = path_from(q)
+            a = _assess(plant, probe, chain, start, path, length, Ts, orients)
+        except ConfigError as e:  # the core refused the orbit: not this posture
+            first_error = str(e)
+            continue
+        if a["error"] is None:
+            source = f"drawn (candidate {k} of {CANDIDATES + 2})"
+            return CartesianTask(start, chain, path, length, orients, a, source)
+        first_error = a["error"]
+    raise ConfigError(
+        f"no start posture found for a Cartesian task on this arm: {len(screened)} of "
+        f"{CANDIDATES + 2} candidates pass the rule at their start, {len(tried)} tried along "
+        f"the task; the last failed: {first_error}"
+    )
+
+
+def _candidates(plant: Any, seed: int) -> list[FloatArray]:
+    """The model's reference posture (qpos0) and the middle of the joint ranges,
+    each kept inside the limits with the rule's margin, then
+    :data:`CANDIDATES` drawn uniformly there (fixed seed; ±π for an unlimited
+    joint)."""
+    lo, hi = _limits(plant)
+    lo_, hi_ = np.where(np.isfinite(lo), lo, -math.pi), np.where(np.isfinite(hi), hi, math.pi)
+    margin = np.minimum(0.1, (hi_ - lo_) / 8)
+    a, b = lo_ + margin, hi_ - margin
+    zero = np.clip(np.asarray(plant.model.qpos0[plant._qadr], dtype=np.float64), a, b)
+    rng = np.random.default_rng(seed)
+    return [zero, 0.5 * (a + b), *rng.uniform(a, b, size=(CANDIDATES, plant.n))]
+
+
+def _screen(probe: _Probe, chain: Chain, q: FloatArray, orients: bool, plant: Any) -> float | None:
+    """The core's posture rule (SPEC (16.9)) at the candidate alone: its score,
+    or None if it fails there already (σmin, limits, gravity, conditioning)."""
+    lo, hi = _limits(plant)
+    a = _adaptimp.assess_posture(
+        chain, q[None, :], chain.pose(q)[0][None, :], probe.gravity(q)[None, :],
+        probe.inertia(q), lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients,
+    )  # fmt: skip
+    return None if a["error"] is not None else float(a["score"])
+
+
+def _vector(name: str, value: ArrayLike, chain: Chain) -> FloatArray:
+    """``value`` as n finite numbers (rad), or a ``ConfigError`` naming it."""
+    try:
+        v = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{name} must be {chain.n} finite numbers (rad), got {value!r}") from None
+    if v.shape != (chain.n,) or not np.all(np.isfinite(v)):
+        raise ConfigError(f"{name} must be {chain.n} finite numbers (rad), got {value!r}")
+    return v

@@ -1,0 +1,573 @@
+//! The Cartesian rule, SPEC §16 (16.8)–(16.10): a pose task for any arm, the
+//! start posture it is run from, and the basis that resolves its joint orbit.
+//!
+//! What a user of a new arm wants from "Cartesian in five lines" is what the
+//! joint-space rule of SPEC §18 gives in joint space: a task that moves the
+//! arm, a posture to run it from, and the joint controller's gains, centres
+//! and learning, with nothing set per arm.
+//!
+//! - [`PoseCircle`] (16.8) is the default task: hold the start pose, then a
+//!   circle in the horizontal plane through it, the orientation held.
+//! - [`PostureRule`] (16.9) says whether a posture can run a task: the
+//!   6 × N Jacobian well-conditioned along the task ([`sigma_min`]), the
+//!   joint limits kept with a margin, gravity well within the actuators, the
+//!   sampled velocity loop of the joint rule well-conditioned
+//!   ([`loop_conditioning`]), the task reachable (the inverse kinematics on
+//!   it). Each refusal names its condition.
+//! - [`resolving`] (16.10) narrows the joint rule's tube to the orbit's own
+//!   size, so that the RBF basis resolves a small orbit as it resolves the
+//!   joint-space task.
+//!
+//! Everything here is `no_std` and allocation-free.
+
+use crate::cartesian::kinematics::{Jacobian6, Kinematics};
+use crate::cartesian::outer::PoseTarget;
+use crate::cartesian::rotation;
+use crate::control::tuning::{inertia_scales, Rule};
+use crate::error::{check, Error};
+use crate::math::sqrt;
+use crate::trajectory::Setpoint;
+use crate::types::{Matrix, Vector};
+use nalgebra::Matrix3;
+
+/// The smallest singular value (m/rad for the translation rows) of the first
+/// `rows` rows of the Jacobian `j` (`rows` = 6: the 6 × N Jacobian; 3: its
+/// translation rows, for a position-only task): √λmin(J Jᵀ). Zero when the
+/// arm has fewer joints than rows (the task cannot be met in every direction).
+pub fn sigma_min<const N: usize>(j: &Jacobian6<N>, rows: usize) -> f64 {
+    if N < rows {
+        return 0.0;
+    }
+    let jjt = j * j.transpose();
+    let least = if rows >= 6 {
+        jjt.symmetric_eigenvalues().min()
+    } else {
+        jjt.fixed_view::<3, 3>(0, 0)
+            .into_owned()
+            .symmetric_eigenvalues()
+            .min()
+    };
+    sqrt(least.max(0.0))
+}
+
+/// The conditioning of the joint rule's sampled velocity loop at an inertia
+/// matrix `d` (kg m², symmetric positive definite): λmin(Dₛ^½ D⁻¹ Dₛ^½),
+/// Dₛ = diag(d_i), d_i = 1/(D⁻¹)_ii (SPEC (18.1)). The matrix has a unit
+/// diagonal, so the value lies in (0, 1]; with Kp = m Dₛ/Ts the slowest mode
+/// of the velocity loop decays at m·λmin/Ts (1/s).
+pub fn loop_conditioning<const N: usize>(d: &Matrix<N>) -> Result<f64, Error> {
+    let scales = inertia_scales(d)?;
+    let inv = d
+        .cholesky()
+        .ok_or(Error::Invalid {
+            what: "inertia matrix",
+            reason: "must be positive definite",
+        })?
+        .inverse();
+    if N > 7 {
+        return Err(Error::Invalid {
+            what: "inertia matrix",
+            reason: "the velocity-loop conditioning is for arms of at most 7 joints",
+        });
+    }
+    let s = scales.map(sqrt);
+    // The N × N matrix in the corner of a 7 × 7 one with a unit diagonal
+    // beyond it: its eigenvalues and 1, and λmin ≤ 1 (a unit diagonal).
+    let m = Matrix::<7>::from_fn(|i, j| {
+        if i < N && j < N {
+            s[i] * inv[(i, j)] * s[j]
+        } else if i == j {
+            1.0
+        } else {
+            0.0
+        }
+    });
+    Ok(m.symmetric_eigenvalues().min())
+}
+
+/// The default Cartesian task, SPEC (16.8): hold the start pose for `hold`
+/// s, then a circle of `radius` (m) at `freq` (Hz) in the horizontal plane
+/// through the start, the orientation held; the angular speed ramps from
+/// zero (a quintic) over `ramp` s, so the path starts at rest. The circle
+/// passes through the start and its centre lies `radius` from it toward the
+/// base's vertical axis (the world z axis through the origin; along x for a
+/// start on that axis): the circle stays inside the reach of the start.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct PoseCircle {
+    start: Vector<3>,
+    rotation: Matrix3<f64>,
+    radius: f64,
+    freq: f64,
+    hold: f64,
+    ramp: f64,
+    /// Unit vectors of the plane: `u` from the start toward the centre, `v`
+    /// = z × u.
+    u: Vector<3>,
+    v: Vector<3>,
+}
+
+impl PoseCircle {
+    /// The default radius (m): 3 cm.
+    pub const RADIUS: f64 = 0.03;
+    /// The default frequency (Hz): a period of 2 s.
+    pub const FREQ: f64 = 0.5;
+    /// The default hold (s).
+    pub const HOLD: f64 = 1.0;
+    /// The default ramp of the angular speed (s).
+    pub const RAMP: f64 = 1.0;
+
+    /// The default task about the start pose `start` (m), `rotation` (world ←
+    /// tip). Errors for a non-finite start or a rotation that is not one.
+    pub fn new(start: Vector<3>, rotation: Matrix3<f64>) -> Result<Self, Error> {
+        Self::with(
+            start,
+            rotation,
+            Self::RADIUS,
+            Self::FREQ,
+            Self::HOLD,
+            Self::RAMP,
+        )
+    }
+
+    /// The task with its own `radius` (m, > 0), `freq` (Hz, > 0), `hold` and
+    /// `ramp` (s, ≥ 0). Errors name the quantity.
+    pub fn with(
+        start: Vector<3>,
+        rotation: Matrix3<f64>,
+        radius: f64,
+        freq: f64,
+        hold: f64,
+        ramp: f64,
+    ) -> Result<Self, Error> {
+        check::finite_slice("start", start.as_slice())?;
+        rotation::rotation("rotation", &rotation)?;
+        check::positive("radius > 0", "radius", radius)?;
+        check::positive("freq > 0", "freq", freq)?;
+        check::nonnegative("hold ≥ 0", "hold", hold)?;
+        check::nonnegative("ramp ≥ 0", "ramp", ramp)?;
+        let radial = Vector::<3>::new(start[0], start[1], 0.0);
+        let r = radial.norm();
+        let u = if r > 1e-3 {
+            -radial / r
+        } else {
+            Vector::<3>::new(1.0, 0.0, 0.0)
+        };
+        let v = Vector::<3>::new(-u[1], u[0], 0.0);
+        Ok(Self {
+            start,
+            rotation,
+            radius,
+            freq,
+            hold,
+            ramp,
+            u,
+            v,
+        })
+    }
+
+    /// The part of the path a rule samples (s): the hold, the ramp and one
+    /// period, `hold + ramp + 1/freq`.
+    pub fn span(&self) -> f64 {
+        self.hold + self.ramp + 1.0 / self.freq
+    }
+
+    /// The circle's centre (m).
+    pub fn centre(&self) -> Vector<3> {
+        self.start + self.radius * self.u
+    }
+
+    /// The commanded pose at `t` (s): p, ṗ, p̈ on the circle (m, m/s, m/s²),
+    /// the start's rotation at rest. The phase φ runs from π (the start) with
+    /// φ̇ = ω s(τ), s the quintic 10τ³ − 15τ⁴ + 6τ⁵ of τ = (t − hold)/ramp,
+    /// so φ = π + ω·ramp·(2.5τ⁴ − 3τ⁵ + τ⁶) over the ramp, then ω = 2π·freq.
+    pub fn sample(&self, t: f64) -> PoseTarget {
+        let w = 2.0 * core::f64::consts::PI * self.freq;
+        let s = t - self.hold;
+        if s <= 0.0 {
+            // The hold: the start pose itself, at rest (not centre + r·(−u),
+            // which rounds).
+            return PoseTarget::at(self.start, self.rotation);
+        }
+        let (phi, dphi, ddphi) = if s < self.ramp {
+            let x = s / self.ramp;
+            (
+                core::f64::consts::PI + w * self.ramp * x * x * x * x * (2.5 - 3.0 * x + x * x),
+                w * x * x * x * (10.0 - 15.0 * x + 6.0 * x * x),
+                w * 30.0 * x * x * (1.0 - x) * (1.0 - x) / self.ramp,
+            )
+        } else {
+            (core::f64::consts::PI + w * (s - 0.5 * self.ramp), w, 0.0)
+        };
+        let (sn, c) = (crate::math::sin(phi), crate::math::cos(phi));
+        let radial = c * self.u + sn * self.v;
+        let tangent = -sn * self.u + c * self.v;
+        let r = self.radius;
+        PoseTarget {
+            p: self.centre() + r * radial,
+            dp: r * dphi * tangent,
+            ddp: r * ddphi * tangent - r * dphi * dphi * radial,
+            ..PoseTarget::at(self.start, self.rotation)
+        }
+    }
+}
+
+/// How well a posture can run a task, SPEC (16.9): the figures along the
+/// task's joint orbit (the inverse kinematics of the path from the posture,
+/// F_e = 0), each the worst over the orbit.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Assessment {
+    /// The smallest σmin(J) (m/rad) of the task's rows ([`sigma_min`]).
+    pub sigma_min: f64,
+    /// The largest gravity load max_i |G_i|/τmax_i.
+    pub load: f64,
+    /// λmin(Dₛ^½ D⁻¹ Dₛ^½) at the start ([`loop_conditioning`]).
+    pub conditioning: f64,
+    /// The smallest distance (rad) from a joint to its limit, less the
+    /// margin the rule keeps there (negative: inside the margin).
+    pub slack: f64,
+    /// The joint of `slack`.
+    pub slack_joint: usize,
+    /// The largest distance (m) from the commanded position to the tip of
+    /// the joint orbit: the task is reachable from the posture when small.
+    pub reach: f64,
+}
+
+/// The conditions a start posture meets, SPEC (16.9) ([`Default`]: the
+/// SPEC's).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct PostureRule {
+    /// σmin(J) ≥ this along the task (m/rad): 0.05.
+    pub sigma_min: f64,
+    /// max_i |G_i|/τmax_i ≤ this along the task: 0.5 (the joint-space
+    /// home's, SPEC §18).
+    pub load: f64,
+    /// λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ this at the start: 0.2 = K1·Ts/m of the joint
+    /// rule at 1 kHz (the slowest mode of the velocity loop no slower than
+    /// the position loop).
+    pub conditioning: f64,
+    /// Each joint stays min(this, range/8) (rad) inside its limits along the
+    /// task: 0.1.
+    pub margin: f64,
+    /// The task's tip within this (m) of the commanded position along the
+    /// joint orbit: 1 mm.
+    pub reach: f64,
+}
+
+impl Default for PostureRule {
+    fn default() -> Self {
+        Self {
+            sigma_min: 0.05,
+            load: 0.5,
+            conditioning: 0.2,
+            margin: 0.1,
+            reach: 1e-3,
+        }
+    }
+}
+
+impl PostureRule {
+    /// The rule for a joint controller whose position loop runs at `k1`
+    /// (1/s) with the velocity loop of `rule` at period `ts` (s): the
+    /// conditioning threshold K1·Ts/m (0.2 for the joint rule's K1 = 50 s⁻¹
+    /// at 1 kHz, 0.04 for the contact scenario's K1 = 10 s⁻¹, SPEC (19.6)).
+    pub fn for_loop(k1: f64, ts: f64, rule: &Rule) -> Self {
+        Self {
+            conditioning: k1 * ts / rule.margin,
+            ..Self::default()
+        }
+    }
+
+    /// The margin (rad) joint i keeps inside [`lo`, `hi`]: min(margin,
+    /// (hi − lo)/8) (the margin alone for an unlimited joint).
+    pub fn margin_of(&self, lo: f64, hi: f64) -> f64 {
+        let range = hi - lo;
+        if range.is_finite() {
+            self.margin.min(range / 8.0)
+        } else {
+            self.margin
+        }
+    }
+
+    /// The [`Assessment`] of the joint orbit `orbit` (the joint reference of
+    /// every sample, from the start), with `targets` the commanded positions
+    /// (m) of the same samples, `gravity` G (N m) at each sample, `d0` the
+    /// inertia matrix at the start (kg m²), the limits [`lo`, `hi`] (rad;
+    /// ±∞: unlimited) and `tau_max` (N m). `orients`: the task holds the
+    /// orientation (σmin of the 6 × N Jacobian; else of its translation
+    /// rows). Errors for empty or mismatched samples, non-finite values, a
+    /// `d0` that is not symmetric positive definite, τmax ≤ 0.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assess<const N: usize, K: Kinematics<N>>(
+        &self,
+        kin: &K,
+        orients: bool,
+        orbit: &[Vector<N>],
+        targets: &[Vector<3>],
+        gravity: &[Vector<N>],
+        d0: &Matrix<N>,
+        (lo, hi): (&Vector<N>, &Vector<N>),
+        tau_max: &Vector<N>,
+    ) -> Result<Assessment, Error> {
+        if orbit.is_empty() || targets.len() != orbit.len() || gravity.len() != orbit.len() {
+            return Err(Error::Invalid {
+                what: "posture assessment",
+                reason:
+                    "needs one target and one gravity torque per sample of the orbit (one or more)",
+            });
+        }
+        check::positive_vec("τmax > 0", "tau_max", tau_max)?;
+        let rows = if orients { 6 } else { 3 };
+        let mut a = Assessment {
+            sigma_min: f64::INFINITY,
+            load: 0.0,
+            conditioning: loop_conditioning(d0)?,
+            slack: f64::INFINITY,
+            slack_joint: 0,
+            reach: 0.0,
+        };
+        for ((q, p), g) in orbit.iter().zip(targets).zip(gravity) {
+            check::finite_slice("orbit", q.as_slice())?;
+            check::finite_slice("targets", p.as_slice())?;
+            check::finite_slice("gravity", g.as_slice())?;
+            let tip = kin.tip(q, &Vector::zeros());
+            a.sigma_min = a.sigma_min.min(sigma_min(&tip.jacobian, rows));
+            a.reach = a.reach.max((tip.position - p).norm());
+            for i in 0..N {
+                a.load = a.load.max(g[i].abs() / tau_max[i]);
+                let room = (q[i] - lo[i]).min(hi[i] - q[i]) - self.margin_of(lo[i], hi[i]);
+                if room < a.slack {
+                    a.slack = room;
+                    a.slack_joint = i;
+                }
+            }
+        }
+        Ok(a)
+    }
+
+    /// Whether `a` meets the rule: the first condition it violates, named
+    /// (`σmin(J) ≥ 0.05`, `inside the joint limits with margin`, `gravity
+    /// load within its bound` (0.5 by default), `velocity-loop conditioning ≥
+    /// K1·Ts/m`, `task reachable`), with the value.
+    pub fn check(&self, a: &Assessment) -> Result<(), Error> {
+        let conditions: [(bool, &'static str, &'static str, Option<usize>, f64); 5] = [
+            (
+                a.sigma_min >= self.sigma_min,
+                "σmin(J) ≥ 0.05 along the task (not near a singularity)",
+                "σmin(J)",
+                None,
+                a.sigma_min,
+            ),
+            (
+                a.slack >= 0.0,
+                "inside the joint limits with margin along the task",
+                "distance to the limit − margin (rad), joint",
+                Some(a.slack_joint),
+                a.slack,
+            ),
+            (
+                a.load <= self.load,
+                "gravity load max|G_i|/τmax_i within its bound along the task",
+                "gravity load",
+                None,
+                a.load,
+            ),
+            (
+                a.conditioning >= self.conditioning,
+                "velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ K1·Ts/m",
+                "λmin",
+                None,
+                a.conditioning,
+            ),
+            (
+                a.reach <= self.reach,
+                "task reachable: the inverse kinematics within 1 mm of the path",
+                "largest distance from the path (m)",
+                None,
+                a.reach,
+            ),
+        ];
+        for (ok, condition, lhs, index, value) in conditions {
+            if !ok {
+                return Err(Error::Condition {
+                    condition,
+                    lhs,
+                    index,
+                    value,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// A score to rank postures that pass [`check`](Self::check) (larger is
+    /// better): σmin(J)·(1 − load), the distance from a singularity
+    /// discounted by the share of the actuators gravity takes.
+    pub fn score(&self, a: &Assessment) -> f64 {
+        a.sigma_min * (1.0 - a.load)
+    }
+}
+
+/// The joint rule's constants with the tube narrowed to the orbit, SPEC
+/// (16.10): tube_b = min(tube_b, ℓ_b/10), ℓ_q (rad) and ℓ_q̇ (rad/s) the
+/// lengths of the closed path `path` in q and in q̇. The joint-space default
+/// task of SPEC §18 (±0.2 rad on every joint, ℓ_q ≈ 2 rad, ℓ_q̇ ≈ 6 rad/s)
+/// sits at the caps (0.2 rad, 0.5 rad/s); a Cartesian circle's joint orbit
+/// (ℓ_q ≈ 0.5–1.7 rad) gets the same number of distinct nodes along it.
+pub fn resolving<const N: usize>(rule: &Rule, path: &[Setpoint<N>]) -> Rule {
+    let (mut lq, mut lv) = (0.0, 0.0);
+    for (j, sp) in path.iter().enumerate() {
+        let next = &path[(j + 1) % path.len()];
+        lq += (next.x - sp.x).norm();
+        lv += (next.dx - sp.dx).norm();
+    }
+    let mut out = *rule;
+    for (t, l) in out.tube.iter_mut().zip([lq, lv]) {
+        let narrow = l / RESOLUTION;
+        if narrow.is_finite() && narrow > 0.0 {
+            *t = t.min(narrow);
+        }
+    }
+    out
+}
+
+/// ℓ_b / tube_b of [`resolving`]: the orbit's length in tube widths (10).
+pub const RESOLUTION: f64 = 10.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cartesian::chain::{Chain, Joint, Transform};
+
+    #[test]
+    fn sigma_min_is_the_smallest_singular_value() {
+        let mut j = Jacobian6::<7>::zeros();
+        for (i, s) in [3.0, 2.0, 1.5, 1.0, 0.5, 0.25].iter().enumerate() {
+            j[(i, i)] = *s;
+        }
+        assert!((sigma_min(&j, 6) - 0.25).abs() < 1e-12);
+        assert!((sigma_min(&j, 3) - 1.5).abs() < 1e-12);
+        let j2 = Jacobian6::<2>::from_element(1.0);
+        assert_eq!(sigma_min(&j2, 6), 0.0);
+    }
+
+    #[test]
+    fn a_diagonal_inertia_is_perfectly_conditioned() {
+        let d = Matrix::<3>::from_diagonal(&Vector::<3>::new(2.0, 0.5, 0.01));
+        assert!((loop_conditioning(&d).unwrap() - 1.0).abs() < 1e-12);
+        let mut c = d;
+        c[(0, 1)] = 0.99;
+        c[(1, 0)] = 0.99;
+        assert!(loop_conditioning(&c).unwrap() < 0.05);
+        assert!(loop_conditioning(&(-d)).is_err());
+    }
+
+    #[test]
+    fn the_circle_starts_at_rest_on_the_start_pose_and_closes() {
+        let r = *nalgebra::Rotation3::from_euler_angles(0.1, 0.2, 0.3).matrix();
+        let p0 = Vector::<3>::new(0.4, 0.3, 0.5);
+        let c = PoseCircle::new(p0, r).unwrap();
+        for t in [0.0, 0.5, 1.0] {
+            let s = c.sample(t);
+            assert_eq!(s.p, p0);
+            assert_eq!(s.dp, Vector::<3>::zeros());
+        }
+        // Toward the base's axis, in the horizontal plane.
+        let centre = c.centre();
+        assert!((centre - (p0 - 0.03 * Vector::<3>::new(0.8, 0.6, 0.0))).norm() < 1e-15);
+        // On the circle at full speed, one period later the same point.
+        let (a, b) = (c.sample(2.5), c.sample(4.5));
+        assert!((a.p - b.p).norm() < 1e-12);
+        assert!(((a.p - centre).norm() - 0.03).abs() < 1e-15);
+        assert!((a.dp.norm() - 0.03 * core::f64::consts::PI).abs() < 1e-12);
+        assert_eq!(a.r, r);
+        // ṗ and p̈ are the derivatives of p (central differences).
+        for t in [1.3, 1.7, 2.2, 3.1] {
+            let h = 1e-6;
+            let (m, s, p) = (c.sample(t - h), c.sample(t), c.sample(t + h));
+            assert!(((p.p - m.p) / (2.0 * h) - s.dp).norm() < 1e-8, "{t}");
+            assert!(((p.dp - m.dp) / (2.0 * h) - s.ddp).norm() < 1e-7, "{t}");
+        }
+        assert!((c.span() - 4.0).abs() < 1e-15);
+        let e = PoseCircle::with(p0, r, 0.0, 0.5, 1.0, 1.0).unwrap_err();
+        assert!(e.to_string().contains("radius > 0"), "{e}");
+    }
+
+    /// A 3-joint elbow arm in space (yaw, shoulder, elbow; links 0.4 m and
+    /// 0.3 m): stretched, it is singular.
+    fn elbow() -> Chain<3> {
+        let at = |x: f64| Transform {
+            translation: [x, 0.0, 0.0],
+            ..Transform::IDENTITY
+        };
+        Chain::new(
+            &[
+                Joint::revolute(Transform::IDENTITY, [0.0, 0.0, 1.0]),
+                Joint::revolute(Transform::IDENTITY, [0.0, 1.0, 0.0]),
+                Joint::revolute(at(0.4), [0.0, 1.0, 0.0]),
+            ],
+            &at(0.3),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_singular_posture_is_refused_by_name() {
+        let arm = elbow();
+        let rule = PostureRule::default();
+        let lo = Vector::<3>::from_element(-3.0);
+        let hi = Vector::<3>::from_element(3.0);
+        let d0 = Matrix::<3>::from_diagonal(&Vector::<3>::new(1.0, 0.5, 0.2));
+        let tau = Vector::<3>::from_element(10.0);
+        let g = [Vector::<3>::zeros()];
+        let assess = |q: Vector<3>| {
+            let p = arm.fk(&q);
+            rule.assess(&arm, false, &[q], &[p], &g, &d0, (&lo, &hi), &tau)
+                .unwrap()
+        };
+        // Stretched: the translation rows lose rank.
+        let a = assess(Vector::<3>::new(0.3, -0.5, 0.0));
+        assert!(a.sigma_min < 1e-6, "{}", a.sigma_min);
+        let e = rule.check(&a).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("condition σmin(J) ≥ 0.05 along the task"),
+            "{e}"
+        );
+        let a = assess(Vector::<3>::new(0.3, -0.5, 1.2));
+        rule.check(&a).unwrap();
+        assert!(rule.score(&a) > 0.0);
+        // Too near a limit: joint 0 at 2.95 rad, 0.05 rad from it, inside its 0.1 rad margin.
+        let a = assess(Vector::<3>::new(2.95, -0.5, 1.2));
+        let e = rule.check(&a).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "condition inside the joint limits with margin along the task is violated: \
+             distance to the limit − margin (rad), joint[0] = -0.05000000000000018 (SPEC §10)"
+        );
+        // Gravity beyond half an actuator: named with the load.
+        let heavy = [Vector::<3>::new(0.0, 6.0, 1.0)];
+        let q = Vector::<3>::new(0.3, -0.5, 1.2);
+        let a = rule
+            .assess(
+                &arm,
+                false,
+                &[q],
+                &[arm.fk(&q)],
+                &heavy,
+                &d0,
+                (&lo, &hi),
+                &tau,
+            )
+            .unwrap();
+        let e = rule.check(&a).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("gravity load max|G_i|/τmax_i within its bound"),
+            "{e}"
+        );
+        assert!(
+            e.to_string().ends_with("gravity load = 0.6 (SPEC §10)"),
+            "{e}"
+        );
+    }
+}

@@ -50,7 +50,7 @@ from ._plot import PLOT_KINDS
 from ._plot import compare as plot_compare
 from ._result import SimResult, metrics_table
 from ._sweep import Choice, LogUniform, Normal, Uniform, sweep
-from .cartesian import CartesianController
+from .cartesian import CartesianController, CartesianStep, PoseTarget
 from .chain import Chain
 
 __all__ = [
@@ -61,6 +61,7 @@ __all__ = [
     "SCENARIOS",
     "AdaptimpError",
     "CartesianController",
+    "CartesianStep",
     "Chain",
     "Choice",
     "ConfigError",
@@ -74,6 +75,7 @@ __all__ = [
     "Param",
     "PlanarArm",
     "PlantWarning",
+    "PoseTarget",
     "SimResult",
     "StabilityWarning",
     "TwoLinkArm",

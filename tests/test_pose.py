@@ -48,16 +48,14 @@ def _two_impedances() -> tuple[adaptimp.cartesian.CartesianImpedance, ...]:
         {"xyz": [0.25, 0, 0]},
     )
     q0 = np.array([0.1, 0.4, -0.8])
-    return tuple(
-        adaptimp.cartesian.CartesianImpedance(chain, Ts=1e-3, q0=q0) for _ in range(2)
-    )
+    return tuple(adaptimp.cartesian.CartesianImpedance(chain, Ts=1e-3, q0=q0) for _ in range(2))
 
 
 def test_a_step_takes_a_pose_target_as_it_takes_its_parts() -> None:
     a, b = _two_impedances()
     p0 = a.chain.fk(a.q0)[:3, 3]
     for k in range(5):
-        p = p0 + [0.001 * k, 0.0, 0.0]
+        p = p0 + np.array([0.001 * k, 0.0, 0.0])
         ra = a.step(p, [0.1, 0.0, 0.0], wrench=[0.0, 0.0, 1.0])
         rb = b.step(target=PoseTarget(p=p, dp=[0.1, 0.0, 0.0], R=a._R), wrench=[0.0, 0.0, 1.0])
         for x, y in zip(ra, rb):

@@ -266,8 +266,8 @@ class CartesianImpedance:
             if p is not None:
                 raise TypeError("give the commanded pose as p=… or as target=…, not both")
             p, dp, ddp, R, w, dw = target.p, target.dp, target.ddp, target.R, target.w, target.dw
-        target = None if p is None else self.target(p, dp, ddp, R, w, dw)
-        q, dq, ddq = self._core.reference(target, _wrench(wrench))
+        flat = None if p is None else self.target(p, dp, ddp, R, w, dw)
+        q, dq, ddq = self._core.reference(flat, _wrench(wrench))
         return q, dq, ddq
 
     def last(self, what: str) -> FloatArray:
@@ -740,14 +740,14 @@ class CartesianController:
             self._k += 1
             return out
         f = _wrench(wrench)
-        target: FloatArray | None = None
+        flat: FloatArray | None = None
         if xc is not None:
-            target = self.outer.target(xc, dxc, ddxc, R, w, dw)
+            flat = self.outer.target(xc, dxc, ddxc, R, w, dw)
         elif sample is not None:
-            target = _pose_of(sample, self.outer._R)
-            self.outer._R = target[9:18].reshape(3, 3).copy()
+            flat = _pose_of(sample, self.outer._R)
+            self.outer._R = flat[9:18].reshape(3, 3).copy()
         core = self.outer.core
-        out = core.step_python(self.inner, q, dq, f, target)
+        out = core.step_python(self.inner, q, dq, f, flat)
         self._tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
         if self.record:
             for key, v in zip(

@@ -214,6 +214,25 @@ def long_run(sc: apt.PandaTable, rule: dict[str, Any], T: float) -> None:
         )
 
 
+MAX_T = 3600.0
+"""The longest --T: each row keeps every step (a 20 s row is about 4 MB)."""
+
+
+def _writable(path: Path) -> bool:
+    """Whether ``path`` can be written (it is not a directory, and a file can
+    be made beside it), tried with a temporary file that is removed."""
+    import tempfile
+
+    if path.is_dir():
+        return False
+    try:
+        with tempfile.NamedTemporaryFile(dir=path.resolve().parent):
+            pass
+    except OSError:
+        return False
+    return not path.exists() or os.access(path, os.W_OK)
+
+
 def first(T: float, jobs: int, path: str | None) -> None:
     """docs/panda.md's table: the Panda of ``panda_table()`` (its SRDF home,
     MuJoCo's default contact, straight from home into the table, the
@@ -350,6 +369,13 @@ def main() -> None:
         parser.error(f"--rows: unknown {unknown}; the rows are {list(ROWS)}")
     if args.json and not Path(args.json).resolve().parent.is_dir():
         parser.error(f"--json: no directory {Path(args.json).resolve().parent}")
+    if args.json and not _writable(Path(args.json)):
+        # Known before the rows run, not after.
+        parser.error(f"--json: cannot write {args.json} (a directory, or not writable)")
+    # Every row keeps every step's record (about 190 bytes): 2e5 s were 36 GiB.
+    if args.T > MAX_T:
+        parser.error(f"--T must be at most {MAX_T:g} s (every step is kept), got {args.T:g}")
+
     fix = tuple(j for j in args.fix.split(",") if j)
     where = {"tip": args.tip, "fix": fix} if args.arm is not None else {}
     try:

@@ -1,6 +1,9 @@
 """A break-it probe of the public Python API: state restore (bit flips,
 edits, truncations), the fault semantics, the n-joint API, sweeps and their
-cache. Every case is classified:
+cache, chains, the Cartesian front, formulations, the dynamics and computed
+torque, saved results, MuJoCo runs, robot descriptions (URDF text and files
+through read_arm, Chain.from_urdf, ComputedTorque and MuJoCo runs). Every
+case is classified:
 
 - accepted: it succeeded and every invariant checked held;
 - clear error: it was refused by an adaptimp error (or a TypeError,
@@ -668,11 +671,827 @@ def _rekey(p: Path) -> str:
     return json.dumps(data)
 
 
+# ---------------------------------------------------------------------------
+# The surfaces of issue 33: chains, the Cartesian front, formulations, the
+# dynamics and computed torque, saves, MuJoCo runs.
+# ---------------------------------------------------------------------------
+
+BAD = (math.nan, math.inf, -math.inf, 1e300, -1e300, 1e200, 1e151, 1e50, 1e7, 1e-320, 0.0, -1.0)
+
+
+def _arm3() -> Any:
+    import adaptimp
+
+    return adaptimp.Chain(
+        [
+            {"kind": "revolute", "axis": [0, 0, 1]},
+            {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [0, 1, 0]},
+            {"kind": "revolute", "xyz": [0.3, 0, 0], "axis": [1, 0, 0]},
+        ],
+        tip={"xyz": [0.2, 0, 0]},
+    )
+
+
+def _finite(*arrays: Any) -> None:
+    for a in arrays:
+        check(bool(np.all(np.isfinite(np.asarray(a, dtype=float)))), f"not finite: {a}")
+
+
+def chains(t: Tally, quick: bool) -> None:
+    """Chains from joint data: every field of a joint with every bad value, the
+    origin conventions, names, sites; fk, Jacobian, J̇q̇ and motion with bad
+    rates and shapes. Accepted: finite outputs, and a movable joint that moves
+    the tip (no zero axis)."""
+    import adaptimp
+
+    base = [
+        {"kind": "revolute", "axis": [0, 0, 1]},
+        {"kind": "prismatic", "xyz": [0.3, 0, 0], "rpy": [0.1, 0.2, 0.3], "axis": [1, 0, 0]},
+        {"kind": "revolute", "pos": [0.1, 0, 0], "quat": [1, 0, 0, 0], "axis": [0, 1, 0]},
+    ]
+    fields = [("axis", 3), ("xyz", 3), ("rpy", 3), ("quat", 4), ("offset", 1)]
+    values = BAD if not quick else BAD[::2]
+    for j in range(3):
+        for key, size in fields:
+            if key not in base[j] and key != "offset":
+                continue
+            for i in range(size):
+                for v in values:
+
+                    def one(j: int = j, field: str = key, i: int = i, v: float = v) -> None:
+                        joints = [dict(x) for x in base]
+                        if field == "offset":
+                            joints[j]["offset"] = v
+                        else:
+                            joints[j][field] = list(joints[j][field])
+                            joints[j][field][i] = v
+                        arm = adaptimp.Chain(joints, tip={"xyz": [0.2, 0, 0]})
+                        q = [0.1, 0.05, -0.2]
+                        _finite(arm.fk(q), arm.jacobian(q), arm.jdot_qdot(q, [0.1] * 3))
+                        # Every movable joint moves the tip or turns it.
+                        col = np.abs(arm.jacobian(q)).max(axis=0)
+                        check(bool(np.all(col > 0)), f"a joint that moves nothing: {col}")
+
+                    axis = list(base[j]["axis"])
+                    if field == "axis":
+                        axis[i] = v
+                    zero_axis = field == "axis" and float(np.linalg.norm(axis)) <= 1e-12
+                    bad_value = not math.isfinite(v) or zero_axis
+                    case(
+                        t,
+                        f"joint {j} {field}[{i}] = {v:g}",
+                        one,
+                        "refuse" if bad_value else "either",
+                    )
+    extra: list[tuple[str, dict[str, Any], str]] = [
+        ("quat with rpy", {"quat": [1, 0, 0, 0], "rpy": [0, 0, 1]}, "refuse"),
+        ("xyz with pos", {"xyz": [0, 0, 1], "pos": [0, 0, 1]}, "refuse"),
+        ("rotation with rpy", {"rotation": np.eye(3).tolist(), "rpy": [0, 0, 1]}, "refuse"),
+        ("a reflection", {"rotation": np.diag([1.0, 1.0, -1.0]).tolist()}, "refuse"),
+        ("a sloppy rotation", {"rotation": (np.eye(3) * (1 + 4e-7)).tolist()}, "accept"),
+        ("R × 1.1", {"rotation": (np.eye(3) * 1.1).tolist()}, "refuse"),
+        ("axis [0, 0, 1e200]", {"axis": [0, 0, 1e200]}, "accept"),
+        ("axis [1e308, 1e308, 0]", {"axis": [1e308, 1e308, 0]}, "accept"),
+        ("axis of 2 values", {"axis": [0, 1]}, "refuse"),
+        ("axis as a string", {"axis": "z"}, "refuse"),
+        ("kind 'ball'", {"kind": "ball"}, "refuse"),
+        ("kind 3", {"kind": 3}, "refuse"),
+        ("no axis", {"axis": None}, "refuse"),
+    ]
+    for what, patch, expect in extra:
+
+        def mixed(patch: dict[str, Any] = patch) -> None:
+            j = {"kind": "revolute", "axis": [0, 0, 1], **patch}
+            if j.get("axis") is None:
+                j.pop("axis")
+            arm = adaptimp.Chain([j], tip={"xyz": [0.3, 0, 0]})
+            _finite(arm.fk([0.2]), arm.jacobian([0.2]))
+            check(float(np.abs(arm.jacobian([0.2])).max()) > 0.1, "a zero axis")
+            r = arm.fk([0.2])[:3, :3]
+            check(abs(np.linalg.det(r) - 1.0) < 1e-12, f"det R = {np.linalg.det(r)}")
+
+        case(t, f"Chain with {what}", mixed, expect)
+    for what, names, expect in [
+        ("two names for one joint", ["a", "b"], "refuse"),
+        ("a string", "ab", "refuse"),
+        ("one name", ["a"], "accept"),
+    ]:
+        case(
+            t,
+            f"names: {what}",
+            lambda names=names: adaptimp.Chain(  # type: ignore[misc]
+                [{"kind": "revolute", "axis": [0, 0, 1]}], names=names
+            ),
+            expect,
+        )
+    arm = _arm3()
+    q = [0.3, 0.6, 0.2]
+    z23 = np.zeros((2, 3))
+    calls: list[tuple[str, Callable[[], object], str]] = []
+    for v in values:
+        either = "refuse" if not math.isfinite(v) or abs(v) > 1e6 else "either"
+        calls += [
+            (f"fk q[1] = {v:g}", lambda v=v: arm.fk([0.3, v, 0.2]), either),
+            (f"jacobian q[0] = {v:g}", lambda v=v: arm.jacobian([v, 0.6, 0.2]), either),
+            (f"jdot_qdot dq[2] = {v:g}", lambda v=v: arm.jdot_qdot(q, [0.1, 0.1, v]), either),
+            (f"motion dq = {v:g}", lambda v=v: arm.motion(z23, np.full((2, 3), v), z23), either),
+        ]
+    calls += [
+        ("fk of 2 values", lambda: arm.fk([0.1, 0.2]), "refuse"),
+        ("fk of a string", lambda: arm.fk("q"), "refuse"),
+        (
+            "motion of a 1-D array",
+            lambda: arm.motion(np.zeros(3), np.zeros(3), np.zeros(3)),
+            "refuse",
+        ),
+        ("motion of other lengths", lambda: arm.motion(z23, np.zeros((3, 3)), z23), "refuse"),
+        (
+            "motion of lists",
+            lambda: arm.motion([[0.1, 0.2, 0.3]], [[0, 0, 1]], [[0, 0, 0]]),
+            "accept",
+        ),
+    ]
+    for what, fn, expect in calls:
+
+        def out(fn: Callable[[], object] = fn) -> None:
+            r = fn()
+            _finite(*(r if isinstance(r, tuple) else (r,)))
+
+        case(t, what, out, expect)
+    try:
+        import mujoco
+    except ImportError:
+        return
+    m = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><joint type="hinge"/><geom size=".1"/>'
+        '<site name="s"/><site name="t"/></body></worldbody></mujoco>'
+    )
+    for site, expect in [(1.5, "refuse"), (True, "refuse"), (-1, "refuse"), (2, "refuse"),
+                         ("nope", "refuse"), (1, "accept"), (np.int64(0), "accept")]:  # fmt: skip
+        case(
+            t,
+            f"from_mujoco site {site!r}",
+            lambda site=site: adaptimp.Chain.from_mujoco(m, site),
+            expect,
+        )
+
+
+TURN = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+"""A quarter turn about z."""
+
+
+def _refused_step(c: Any, q: Any) -> bool:
+    """One step of a Cartesian controller: whether it was refused."""
+    import adaptimp
+
+    try:
+        c.step(q, np.zeros(3), np.zeros(6))
+    except (adaptimp.MeasurementError, ValueError, TypeError):
+        return True
+    return False
+
+
+def _cart(**kw: Any) -> Any:
+    import adaptimp
+
+    return adaptimp.CartesianController(
+        _arm3(), "pd", q0=[0.3, 0.6, 0.2], tau_max=20.0, Kp=5.0, Kzeta=25.0, **kw
+    )
+
+
+def _cart_steps(c: Any, k: int) -> np.ndarray:
+    q0 = np.array([0.3, 0.6, 0.2])
+    return np.array(
+        [c.step(q0 + 1e-3 * np.sin(i + np.arange(3)), np.zeros(3), np.zeros(6)) for i in range(k)]
+    )
+
+
+def cartesian(t: Tally, quick: bool) -> None:
+    """The Python Cartesian front: bad targets (each part, each bad value, R that
+    is no rotation or of the wrong shape), wrenches, postures, starts, resets,
+    stiffnesses, orbits and paths. A refused call keeps nothing: the controller
+    then steps bit-identically to a twin that never saw it; an accepted step's
+    torque is finite and within τmax."""
+    import adaptimp
+    from adaptimp.cartesian import CartesianImpedance
+
+    arm = _arm3()
+    q0 = np.array([0.3, 0.6, 0.2])
+    p0, R0 = arm.fk(q0)[:3, 3], arm.fk(q0)[:3, :3]
+    z3 = np.zeros(3)
+
+    def twin(call: Callable[[Any], object], expect: str, name: str) -> None:
+        def run() -> None:
+            a, b = _cart(), _cart()
+            _cart_steps(a, 3)
+            _cart_steps(b, 3)
+            try:
+                out = call(a)
+            except BaseException:
+                check(
+                    np.array_equal(_cart_steps(a, 10), _cart_steps(b, 10)),
+                    "a refused call changed what the controller does",
+                )
+                raise
+            if out is not None and np.ndim(out) == 1 and len(out) == 3:
+                _finite(out)
+                check(bool(np.all(np.abs(out) <= 20.0 + 1e-12)), f"torque {out} beyond τmax")
+            tau = _cart_steps(a, 10)
+            _finite(tau)
+
+        case(t, name, run, expect)
+
+    values = BAD if not quick else BAD[::2]
+    parts = [("xc", 3), ("dxc", 3), ("ddxc", 3), ("w", 3), ("dw", 3)]
+    for part, size in parts:
+        for i in range(size) if not quick else (0,):
+            for v in values:
+                bad = not math.isfinite(v) or abs(v) > 1e6
+
+                def target(c: Any, part: str = part, i: int = i, v: float = v) -> object:
+                    kw: dict[str, Any] = {"xc": p0.copy(), "R": R0}
+                    kw[part] = kw.get(part, z3).copy() if part in kw else z3.copy()
+                    kw[part][i] = v
+                    return c.step(q0, z3, np.zeros(6), **kw)
+
+                twin(target, "refuse" if bad else "either", f"step {part}[{i}] = {v:g}")
+    for what, R, expect in [
+        ("R0", R0, "accept"),
+        ("1.1·R0", 1.1 * R0, "refuse"),
+        ("a reflection", R0 @ np.diag([1.0, 1.0, -1.0]), "refuse"),
+        ("R0 + 1e-9", R0 + 1e-9, "accept"),
+        ("R0 + 1e-5", R0 + 1e-5, "refuse"),
+        ("NaN in R", np.where(np.eye(3) > 0, math.nan, 0.0), "refuse"),
+        ("flat (9,)", R0.ravel(), "refuse"),
+        ("4 values", [1, 0, 0, 1], "refuse"),
+        ("a string", "R", "refuse"),
+    ]:
+        twin(lambda c, R=R: c.step(q0, z3, np.zeros(6), xc=p0, R=R), expect, f"step R = {what}")
+        twin(lambda c, R=R: c.outer.target(p0, R=R), expect, f"target(R = {what})")
+    for what, w, expect in [
+        ("(6,)", np.zeros(6), "accept"),
+        ("(3,)", np.ones(3), "accept"),
+        ("(2, 3)", np.zeros((2, 3)), "refuse"),
+        ("(5,)", np.zeros(5), "refuse"),
+        ("NaN", [math.nan, 0, 0, 0, 0, 0], "refuse"),
+        ("1e10", [1e10, 0, 0, 0, 0, 0], "refuse"),
+        ("strings", ["a"] * 6, "refuse"),
+    ]:
+        twin(lambda c, w=w: c.step(q0, z3, w), expect, f"wrench {what}")
+
+    def started(v: float) -> None:
+        c = adaptimp.CartesianController(_arm3(), "pd", q0=[v, 0.6, 0.2], tau_max=20.0)
+        _finite(_cart_steps(c, 2))
+
+    for v in values:
+        far = "refuse" if not math.isfinite(v) or abs(v) > 1e6 else "either"
+        pull = "refuse" if not math.isfinite(v) or abs(v) > 4e4 else "either"  # null_k = 25
+        stiff = "refuse" if not math.isfinite(v) or v < 0 or v > 1e9 else "either"
+        twin(lambda c, v=v: c.outer.set_posture([0.3, v, 0.2]), pull, f"set_posture[1] = {v:g}")
+        twin(lambda c, v=v: c.outer.set_stiffness([v, 100.0, 100.0]), stiff, f"Kd[0] = {v:g}")
+        twin(lambda c, v=v: c.outer.reset([0.3, v, 0.2]), far, f"outer.reset q0[1] = {v:g}")
+        case(t, f"CartesianController q0[0] = {v:g}", lambda v=v: started(v), far)
+    for what, call, expect in [
+        ("set_stiffness of 2", lambda c: c.outer.set_stiffness([1, 2]), "refuse"),
+        ("set_stiffness (1, 1) rot", lambda c: c.outer.set_stiffness(100.0, [[1.0]]), "refuse"),
+        ("set_posture of 6", lambda c: c.outer.set_posture(np.zeros(6)), "refuse"),
+        ("reset(np.zeros(6))", lambda c: c.outer.reset(np.zeros(6)), "refuse"),
+        ("xc of 2", lambda c: c.step(q0, z3, np.zeros(6), xc=[0.3, 0.0]), "refuse"),
+        ("q of 2", lambda c: c.step([0.3, 0.6], z3, np.zeros(6)), "refuse"),
+        ("q NaN", lambda c: c.step([0.3, math.nan, 0.2], z3, np.zeros(6)), "refuse"),
+        ("q NaN with a new R", lambda c: c.step([math.nan, 0.6, 0.2], z3, np.zeros(6), xc=p0,
+                                                R=R0 @ TURN), "refuse"),
+    ]:  # fmt: skip
+        twin(call, expect, what)
+    ci = CartesianImpedance(arm, Ts=1e-3, q0=q0)
+    calls = [0]
+
+    def path(tt: float) -> Any:
+        calls[0] += 1
+        return (p0, z3, z3)
+
+    for what, kw, expect in [
+        ("T = 1e9", {"T": 1e9}, "refuse"),
+        ("T = NaN", {"T": math.nan}, "refuse"),
+        ("T = -1", {"T": -1.0}, "refuse"),
+        ("T = '1.0'", {"T": "1.0"}, "refuse"),
+        ("T = True", {"T": True}, "refuse"),
+        ("nodes = -5", {"T": 0.05, "nodes": -5}, "refuse"),
+        ("nodes = 0", {"T": 0.05, "nodes": 0}, "refuse"),
+        ("nodes = 2.5", {"T": 0.05, "nodes": 2.5}, "refuse"),
+        ("nodes = True", {"T": 0.05, "nodes": True}, "refuse"),
+        ("nodes = 10**12", {"T": 0.01, "nodes": 10**12}, "accept"),
+        ("nodes = 4", {"T": 0.05, "nodes": 4}, "accept"),
+    ]:
+
+        def orbit(kw: dict[str, Any] = kw, expect: str = expect) -> None:
+            calls[0] = 0
+            args = dict(kw)
+            try:
+                c, _ = ci.orbit_centres(path, args.pop("T"), **args)
+            finally:
+                if expect == "refuse":
+                    check(calls[0] == 0, "the path was tabulated before the refusal")
+            _finite(c)
+
+        case(t, f"orbit_centres {what}", orbit, expect)
+    # A path that returns one bad R, then good ones: that step is refused, no more.
+    for what, bad_value in [
+        ("1.1·R", lambda: 1.1 * R0),
+        ("a 2-tuple", None),
+        ("R of 4", lambda: [1, 0, 0, 1]),
+    ]:
+
+        def pathed(bad_value: Any = bad_value) -> None:
+            k = [0]
+
+            def pth(tt: float) -> Any:
+                k[0] += 1
+                if k[0] == 3:
+                    return (p0, z3) if bad_value is None else (p0, z3, z3, bad_value(), z3, z3)
+                return (p0, z3, z3, R0, z3, z3)
+
+            c = _cart(path=pth)
+            refused = sum(_refused_step(c, q0) for _ in range(8))
+            check(refused == 1, f"{refused} steps refused after one bad path value")
+
+        case(t, f"a path that returns {what} once", pathed, "accept")  # fmt: skip
+
+
+def formulations(t: Tally, quick: bool) -> None:
+    """The formulations (SPEC §19) and their share: by name, every bad value;
+    accepted ones step with finite torques within τmax."""
+
+    for form in ("admittance", "impedance", "unified", "Unified", "", None, 3):
+        for share in (None, 0.0, 0.3, 1.0, -0.1, 1.5, math.nan, True):
+            kw: dict[str, Any] = {"formulation": form}
+            if share is not None:
+                kw["admittance_share"] = share
+            ok_form = form in ("admittance", "impedance", "unified")
+            ok_share = share is None or (
+                form == "unified" and not isinstance(share, bool) and 0.0 <= share <= 1.0
+            )
+            expect = "either" if ok_form and ok_share else "refuse"
+
+            def run(kw: dict[str, Any] = kw) -> None:
+                c = _cart(**kw)
+                tau = _cart_steps(c, 20)
+                _finite(tau)
+                check(bool(np.all(np.abs(tau) <= 20.0 + 1e-12)), "torque beyond τmax")
+
+            case(t, f"formulation={form!r} share={share!r}", run, expect)
+
+
+def dynamics(t: Tally, quick: bool) -> None:
+    """Computed torque and its model (RNEA): construction with every bad value
+    of every scalar; the model's queries with bad rates; accepted: finite."""
+    try:
+        from adaptimp.baselines import ComputedTorque
+    except ImportError:
+        return
+    values = BAD if not quick else BAD[::2]
+    positive = ("Ts", "Kp", "mass_scale", "tau_max", "Dd")  # > 0; the others ≥ 0
+    for name in ("Ts", "Kp", "Kd", "mass_scale", "payload", "tau_max", "armature", "damping",
+                 "friction", "Dd", "Gd"):  # fmt: skip
+        for v in values:
+            bad = (
+                not math.isfinite(v)
+                or v < 0
+                or (v == 0.0 and name in positive)
+                or abs(v) > 1e9
+                or (name == "Ts" and v > 1.0)
+            )
+
+            def make(name: str = name, v: float = v) -> None:
+                ct = ComputedTorque(**{name: v})
+                for _ in range(5):
+                    _finite(ct.step([0.1, 0.2], [0.0, 0.0], [0.0, 0.0]))
+
+            case(t, f"ComputedTorque({name}={v:g})", make, "refuse" if bad else "either")
+    ct = ComputedTorque()
+    for v in values:
+        bad = not math.isfinite(v) or abs(v) > 1e6
+        for what, args in [
+            ("q", ([v, 0.0], [0.0, 0.0], [0.0, 0.0])),
+            ("dq", ([0.0, 0.0], [v, 0.0], [0.0, 0.0])),
+            ("ddq", ([0.0, 0.0], [0.0, 0.0], [0.0, v])),
+        ]:
+            rnea = lambda args=args: _finite(ct.inverse_dynamics(*args))  # noqa: E731
+            case(t, f"inverse_dynamics {what} = {v:g}", rnea, "refuse" if bad else "either")
+        case(t, f"mass_matrix q = {v:g}", lambda v=v: _finite(ct.mass_matrix([v, 0.0])),
+             "refuse" if bad else "either")  # fmt: skip
+
+
+def saves(t: Tally, quick: bool) -> None:
+    """SimResult and MujocoResult files: bit flips in every stored entry, arrays
+    swapped or scaled, truncations, JSON edits of every record. A damaged file
+    is a SaveError naming it; nothing damaged loads; an intact one loads bit
+    for bit."""
+    import adaptimp
+
+    root = Path(tempfile.mkdtemp(prefix="breakit-saves-"))
+    try:
+        fault = adaptimp.Fault("nan_burst", 0.01, 0.01)
+        runs: dict[str, Any] = {
+            "fault run": adaptimp.simulate("sf", T=0.05, fault=fault),
+            "rerun": adaptimp.simulate("pd", T=0.05),
+        }
+        try:
+            from adaptimp import mujoco as amj
+
+            runs["MuJoCo run"] = amj.simulate("pd", "two_link", T=0.05)
+        except ImportError:
+            pass
+        rng = np.random.default_rng(33)
+        for label, res in runs.items():
+            for compress in (True, False):
+                path = res.save(root / f"{label}-{compress}", compress=compress)
+                _save_cases(t, f"{label} compress={compress}", res, path, rng, quick)
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
+_ROWS = ("t", "q", "dq", "xc", "xd", "tau", "tau_sat", "tau_e", "zeta", "z1")
+
+
+def _save_cases(
+    t: Tally, label: str, res: Any, path: Path, rng: np.random.Generator, quick: bool
+) -> None:
+    """The damages of one saved file (see :func:`saves`)."""
+    import json as _json
+
+    with np.load(path, allow_pickle=False) as f:
+        content = {k: f[k] for k in f}
+    bad = path.with_name("bad.npz")
+
+    def intact(p: Path = path) -> None:
+        back = type(res).load(p)
+        for name in _ROWS:
+            same = np.array_equal(getattr(back, name), getattr(res, name), equal_nan=True)
+            check(same, f"{name} not bit for bit")
+        repr(back)
+
+    def refused(edited: dict[str, Any]) -> None:
+        np.savez(bad, **edited)
+        loaded = type(res).load(bad)
+        check(False, f"a damaged file loaded ({loaded.rows} rows)")
+
+    case(t, f"{label}: load intact", intact, "accept")
+    arrays = [k for k, v in content.items() if v.dtype.kind in "fu" and v.ndim >= 1]
+    for _ in range((6 if quick else 30) if arrays else 0):
+        name = arrays[int(rng.integers(len(arrays)))]
+        a = content[name].copy()
+        flat = a.reshape(-1).view(np.uint8)
+        i, bit = int(rng.integers(flat.size)), int(rng.integers(8))
+        flat[i] ^= np.uint8(1 << bit)
+        edited = {**content, name: a}
+        case(
+            t,
+            f"{label}: flip bit {bit} of byte {i} of {name}",
+            lambda e=edited: refused(e),
+            "refuse",
+        )
+    m = _json.loads(str(content["format"]))
+    for a, b in [("q", "dq"), ("q", "tau"), ("xc", "xd"), ("tau_e", "zeta")]:
+        if a in content and b in content and content[a].shape == content[b].shape:
+            mm = _json.loads(str(content["format"]))
+            d = mm.get("differences", {})
+            if a in d and b in d:
+                d[a], d[b] = d[b], d[a]
+            edited = {**content, a: content[b], b: content[a], "format": np.array(_json.dumps(mm))}
+            case(t, f"{label}: swap {a} and {b}", lambda e=edited: refused(e), "refuse")
+    if m.get("plain"):
+        edited = {**content, "q": content["q"] * 1.5}
+        case(t, f"{label}: q × 1.5", lambda e=edited: refused(e), "refuse")
+    data = path.read_bytes()
+    for frac in (0.0, 0.3, 0.9, 0.999) if quick else np.linspace(0, 0.999, 12):
+
+        def truncated(frac: float = float(frac)) -> None:
+            bad.write_bytes(data[: int(len(data) * frac)])
+            type(res).load(bad)
+            check(False, "a truncated file loaded")
+
+        case(t, f"{label}: truncated to {frac:.1%}", truncated, "refuse")
+    for key in [*m, "version"]:
+        informative = key in ("adaptimp", "result")  # what saved it: not checked
+        mm = dict(m)
+        if key == "version":
+            mm["version"] = 99
+        else:
+            del mm[key]
+        edited = {**content, "format": np.array(_json.dumps(mm))}
+
+        def dropped(edited: dict[str, Any] = edited, informative: bool = informative) -> None:
+            if not informative:
+                refused(edited)
+            np.savez(bad, **edited)
+            intact(bad)
+
+        expect = "accept" if informative else "refuse"
+        case(t, f"{label}: format record without {key}", dropped, expect)
+    for entry, value in [("params", "{"), ("metrics", "[]"), ("case", 3.0), ("record_every", 0)]:
+        edited = {**content, entry: np.array(value)}
+        case(t, f"{label}: {entry} = {value!r}", lambda e=edited: refused(e), "refuse")
+    params = _json.loads(str(content["params"]))
+    if "T" in params:
+        edited = {**content, "params": np.array(_json.dumps({**params, "T": 1e5}))}
+        case(t, f"{label}: params T edited", lambda e=edited: refused(e), "refuse")
+
+
+def mujoco_runs(t: Tally, quick: bool) -> None:
+    """adaptimp.mujoco.simulate's arguments: durations, periods, substeps,
+    payloads, references of the wrong shape, models without actuators."""
+    try:
+        from adaptimp import mujoco as amj
+    except ImportError:
+        return
+    root = Path(tempfile.mkdtemp(prefix="breakit-mujoco-"))
+    try:
+        noact = root / "noact.xml"
+        noact.write_text('<mujoco><worldbody><body><joint type="hinge"/><geom size=".1" mass="1"/>'
+                         "</body></worldbody></mujoco>")  # fmt: skip
+        z2, z3 = np.zeros(2), np.zeros(3)
+        cases_: list[tuple[str, dict[str, Any], str]] = [
+            ("payload=1e300", {"payload": 1e300}, "refuse"),
+            ("payload=-1", {"payload": -1.0}, "refuse"),
+            ("payload=True", {"payload": True}, "refuse"),
+            ("payload=0.5", {"payload": 0.5}, "accept"),
+            ("a reference of 2 values", {"reference": lambda tt: (z2, z2)}, "refuse"),
+            ("a reference of 3 joints", {"reference": lambda tt: (z3, z3, z3)}, "refuse"),
+            ("a reference of strings", {"reference": lambda tt: ("a", "b", "c")}, "refuse"),
+            ("q0 of 3", {"q0": [0.0, 0.0, 0.0]}, "refuse"),
+            ("q0 NaN", {"q0": [math.nan, 0.0]}, "refuse"),
+            ("T = NaN", {"T": math.nan}, "refuse"),
+            ("T = -1", {"T": -1.0}, "refuse"),
+        ]  # fmt: skip
+        cases_ += [  # issue 33 D (the loop's arguments)
+            ("substeps=2.5", {"substeps": 2.5}, "refuse"),
+            ("substeps=True", {"substeps": True}, "refuse"),
+            ("substeps=10**9", {"substeps": 10**9}, "refuse"),
+            ("substeps=0", {"substeps": 0}, "refuse"),
+            ("substeps=2", {"substeps": 2}, "accept"),
+            ("T='1.0'", {"T": "1.0"}, "refuse"),
+            ("T=True", {"T": True}, "refuse"),
+            ("Ts=-1e-3", {"Ts": -1e-3}, "refuse"),
+            ("Ts=NaN", {"Ts": math.nan}, "refuse"),
+        ]
+        for what, kw, expect in cases_:
+
+            def run(kw: dict[str, Any] = kw) -> None:
+                res = amj.simulate("pd", "two_link", **{"T": 0.02, **kw})
+                _finite(res.tau_sat)
+
+            case(t, f"mujoco.simulate {what}", run, expect)
+
+        # Files as a user has them: broken, foreign, of the wrong kind, a tip or
+        # fix that is not there, too many joints, a joint with two motors.
+        def body(i: int, inner: str = "") -> str:
+            return (f'<body name="b{i}" pos="0 0 .1"><joint name="j{i}" type="hinge" '
+                    f'axis="0 1 0"/><geom size=".05" mass="1"/>{inner}</body>')  # fmt: skip
+
+        chain9 = ""
+        for i in reversed(range(9)):
+            chain9 = body(i, chain9)
+        motors9 = "".join(f'<motor joint="j{i}" ctrlrange="-5 5"/>' for i in range(9))
+        files = {
+            "missing.xml": None,
+            "broken.xml": "<mujoco><worldbody><body>",
+            "not_xml.xml": "\x00\x01 binary",
+            "a_free_body.xml": '<mujoco><worldbody><body><freejoint/><geom size=".1"/>'
+            "</body></worldbody></mujoco>",
+            "nine_joints.xml": f"<mujoco><worldbody>{chain9}</worldbody>"
+            f"<actuator>{motors9}</actuator></mujoco>",
+            "two_motors.xml": f"<mujoco><worldbody>{body(0)}</worldbody><actuator>"
+            '<motor joint="j0"/><motor joint="j0"/></actuator></mujoco>',
+            "arm.xml": f"<mujoco><worldbody>{body(0, body(1))}</worldbody><actuator>"
+            '<motor joint="j0" ctrlrange="-5 5"/><motor joint="j1" ctrlrange="-5 5"/>'
+            "</actuator></mujoco>",
+        }
+        for name, text in files.items():
+            if text is not None:
+                (root / name).write_text(text)
+        for name, kw, expect in [
+            ("missing.xml", {}, "refuse"),
+            ("broken.xml", {}, "refuse"),
+            ("not_xml.xml", {}, "refuse"),
+            ("a_free_body.xml", {}, "refuse"),
+            ("nine_joints.xml", {}, "refuse"),
+            ("two_motors.xml", {}, "refuse"),
+            ("arm.xml", {}, "accept"),
+            ("arm.xml", {"tip": "nowhere"}, "refuse"),
+            ("arm.xml", {"fix": ("j9",)}, "refuse"),
+            ("arm.xml", {"fix": "j0"}, "refuse"),
+            ("arm.xml", {"fix": ("j0",)}, "either"),
+            ("arm.xml", {"tip": "b0"}, "either"),
+        ]:
+
+            def plant(name: str = name, kw: dict[str, Any] = kw) -> None:
+                res = amj.simulate("pd", str(root / name), T=0.05, **kw)
+                _finite(res.tau_sat, res.q)
+
+            case(t, f"MJCF {name} {kw}", plant, expect)
+        # The plant adds a motor where a joint has none (unnamed joints too).
+        case(t, "a model without actuators",
+             lambda: _finite(amj.simulate("pd", str(noact), T=0.05).tau_sat), "accept")  # fmt: skip
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
+_URDF_FIELDS = {
+    "origin xyz": "0 0 0.1", "origin rpy": "0 0 0", "axis xyz": "0 1 0", "mass": "0.5",
+    "inertia ixx": "0.01", "limit lower": "-2", "limit upper": "2", "limit effort": "10",
+    "limit velocity": "3", "dynamics damping": "0.1", "dynamics friction": "0.05",
+    "mimic multiplier": "1",
+}  # fmt: skip
+_URDF_VALUES = ("nan", "inf", "-inf", "1e400", "1e200", "-1", "0", "1e-320", "abc", "",
+                "1 2", "0 0 0", "1e9 0 0", "0 0 1e200", "-0", "1e308 1e308 1e308")  # fmt: skip
+
+
+def _urdf(field: str | None = None, value: str = "") -> str:
+    """breakit.c's probe arm: three revolute joints and a prismatic jaw that
+    mimics the third (the rule holds both), ``field`` replaced by ``value``."""
+    v = {k: (value if k == field else d) for k, d in _URDF_FIELDS.items()}
+    links = ["base", "l1", "l2", "l3", "jaw"]
+    text = "<robot name='probe'><link name='base'/>"
+    for j in range(4):
+        mimic = f"<mimic joint='j3' multiplier='{v['mimic multiplier']}'/>" if j == 3 else ""
+        text += (
+            f"<link name='{links[j + 1]}'><inertial><origin xyz='0 0 0.05'/>"
+            f"<mass value='{v['mass']}'/><inertia ixx='{v['inertia ixx']}' ixy='0' ixz='0' "
+            "iyy='0.01' iyz='0' izz='0.01'/></inertial></link>"
+            f"<joint name='j{j + 1}' type='{'prismatic' if j == 3 else 'revolute'}'>"
+            f"<parent link='{links[j]}'/><child link='{links[j + 1]}'/>"
+            f"<origin xyz='{v['origin xyz']}' rpy='{v['origin rpy']}'/>"
+            f"<axis xyz='{v['axis xyz']}'/><limit lower='{v['limit lower']}' "
+            f"upper='{v['limit upper']}' effort='{v['limit effort']}' "
+            f"velocity='{v['limit velocity']}'/><dynamics damping='{v['dynamics damping']}' "
+            f"friction='{v['dynamics friction']}'/>{mimic}</joint>"
+        )
+    return text + "</robot>"
+
+
+def _arm_ok(arm: Any) -> None:
+    """What a read arm must be: limits numbers with lower ≤ upper, an effort
+    and a speed positive or NaN (none stated), drive terms finite ≥ 0; its
+    chain moves its tip with every joint, finitely."""
+    import adaptimp
+
+    n = len(arm.joints)
+    check(1 <= n <= 7, f"{n} joints")
+    lo, hi = np.asarray(arm.lower), np.asarray(arm.upper)
+    check(not np.isnan(lo).any() and not np.isnan(hi).any() and bool(np.all(lo <= hi)),
+          f"limits {lo}, {hi}")  # fmt: skip
+    for what in ("effort", "velocity"):
+        x = np.asarray(getattr(arm, what))
+        check(bool(np.all(np.isnan(x) | (x > 0))), f"{what} {x}")
+    for what in ("armature", "damping", "friction"):
+        x = np.asarray(getattr(arm, what))
+        check(bool(np.all(np.isfinite(x) & (x >= 0))), f"{what} {x}")
+    chain = adaptimp.Chain(arm.chain, tip=arm.tip_origin)
+    q = 0.1 * np.arange(1, n + 1)
+    _finite(chain.fk(q))
+    jac = np.asarray(chain.jacobian(q))
+    _finite(jac)
+    check(bool(np.all(np.linalg.norm(jac, axis=0) > 0)), f"a joint moves nothing: {jac}")
+
+
+def _chain_ok(chain: Any) -> None:
+    q = np.full(chain.n, 0.1)
+    _finite(chain.fk(q), chain.jacobian(q))
+
+
+def descriptions(t: Tally, quick: bool) -> None:
+    """Robot descriptions (SPEC §21) through every Python front that reads one:
+    read_arm, Chain.from_urdf, ComputedTorque(PATH, tip=, fix=) and
+    mujoco.from_urdf, with sources no arm is read from, every field of the
+    probe arm's URDF replaced by a bad value, and tips, fixes and drive= of
+    every wrong kind. Accepted: the arm's numbers are what a user can use."""
+    from adaptimp import Chain
+    from adaptimp._description import read_arm
+
+    root = Path(tempfile.mkdtemp(prefix="breakit-urdf-"))
+    try:
+        deep = "<robot name='r'>" + "<a>" * 100_000 + "</a>" * 100_000 + "</robot>"
+        files = {
+            "probe.urdf": _urdf(),
+            "broken.urdf": "<robot name='x'><link name='a'>",
+            "mjcf.urdf": "<mujoco><worldbody/></mujoco>",
+            "urdf.xml": _urdf(),
+            "empty.urdf": "",
+            "binary.urdf": "\x00\x01\x02",
+            "deep.urdf": deep,
+            "a_dir.urdf": None,
+        }
+        for name, text in files.items():
+            if text is None:
+                (root / name).mkdir()
+            else:
+                (root / name).write_text(text)
+        probe = root / "probe.urdf"
+        sources: list[tuple[str, Any, str]] = [
+            ("None", None, "refuse"),
+            ("1.5", 1.5, "refuse"),
+            ("bytes", _urdf().encode(), "refuse"),
+            ("''", "", "refuse"),
+            ("'/'", "/", "refuse"),
+            ("/dev/zero", "/dev/zero", "refuse"),
+            ("a missing file", root / "missing.urdf", "refuse"),
+            ("100 000 nested elements (text)", deep, "refuse"),
+            ("'<'", "<", "refuse"),
+            ("MJCF text", "<mujoco><worldbody/></mujoco>", "refuse"),
+            ("xacro text", "<robot name='x' xmlns:xacro='http://www.ros.org/wiki/xacro'>"
+             "<xacro:property name='l' value='1'/><link name='a'/></robot>", "refuse"),
+            ("the probe arm (text)", _urdf(), "accept"),
+        ]  # fmt: skip
+        sources += [(f"file {n}", root / n, "accept" if n in ("probe.urdf", "urdf.xml")
+                     else "refuse") for n in files]  # fmt: skip
+        for what, source, expect in sources:
+            case(t, f"read_arm {what}", lambda s=source: _arm_ok(read_arm(s)), expect)
+        values = _URDF_VALUES if not quick else _URDF_VALUES[::3]
+        for fld in _URDF_FIELDS:
+            for v in values:
+                text = _urdf(fld, v)
+                case(t, f"read_arm {fld} = {v!r}", lambda s=text: _arm_ok(read_arm(s)), "either")
+        # Tips and fixes of every kind, through every front.
+        args: list[tuple[str, dict[str, Any], str]] = [
+            ("tip=None", {}, "accept"),
+            ("tip='l2'", {"tip": "l2"}, "accept"),
+            ("tip=''", {"tip": ""}, "refuse"),
+            ("tip=1", {"tip": 1}, "refuse"),
+            ("tip='base'", {"tip": "base"}, "refuse"),
+            ("tip='j1' (a joint)", {"tip": "j1"}, "refuse"),
+            ("tip='nowhere'", {"tip": "nowhere"}, "refuse"),
+            ("fix=('j2',)", {"fix": ("j2",)}, "accept"),
+            ("fix='j2' (a string)", {"fix": "j2"}, "refuse"),
+            ("fix=('nope',)", {"fix": ("nope",)}, "refuse"),
+            ("fix=(1,)", {"fix": (1,)}, "refuse"),
+            ("fix=None", {"fix": None}, "either"),
+            ("fix=every joint", {"fix": ("j1", "j2", "j3", "j4")}, "refuse"),
+        ]
+        fronts: list[tuple[str, Callable[..., None]]] = [
+            ("read_arm", lambda **kw: _arm_ok(read_arm(probe, **kw))),
+            ("Chain.from_urdf", lambda **kw: _chain_ok(Chain.from_urdf(probe, **kw))),
+        ]
+        try:
+            from adaptimp.baselines import ComputedTorque
+
+            def ct(**kw: Any) -> None:
+                c = ComputedTorque(str(probe), **kw)
+                q = [0.1] * c.n
+                for _ in range(3):
+                    _finite(c.step(q, [0.0] * c.n, [0.0] * c.n, xc=q))
+
+            fronts.append(("ComputedTorque", ct))
+        except ImportError:
+            pass
+        try:
+            from adaptimp import mujoco as amj
+
+            def plant(**kw: Any) -> None:
+                _finite(amj.simulate("pd", str(probe), T=0.02, **kw).tau_sat)
+
+            fronts.append(("mujoco.simulate", plant))
+        except ImportError:
+            pass
+        for front, fn in fronts:
+            for what, kw, expect in args:
+                case(t, f"{front} {what}", lambda fn=fn, kw=kw: fn(**kw), expect)
+        drives = [("True", True, "accept"), ("None", None, "accept"),
+                  ("'yes'", "yes", "refuse"), ("1.5", 1.5, "refuse")]  # fmt: skip
+        for what, drive, expect in drives:
+            if any(f == "ComputedTorque" for f, _ in fronts):
+                case(t, f"ComputedTorque drive={what}", lambda d=drive: ct(drive=d), expect)
+        # The inertials a computed torque would use: unphysical ones.
+        for fld, v in [("mass", "1e200"), ("mass", "1e-320"), ("inertia ixx", "-1"),
+                       ("inertia ixx", "1e200"), ("mass", "0")]:  # fmt: skip
+            path = root / f"inertial_{fld.replace(' ', '_')}_{v}.urdf"
+            path.write_text(_urdf(fld, v))
+            if any(f == "ComputedTorque" for f, _ in fronts):
+
+                def model(p: Path = path) -> None:
+                    c = ComputedTorque(str(p))
+                    _finite(c.inverse_dynamics([0.1, 0.2], [0.3, 0.0], [0.0, 1.0]))
+                    _finite(c.mass_matrix([0.1, 0.2]))
+                    check(bool(np.all(np.linalg.eigvalsh(c.mass_matrix([0.1, 0.2])) > 0)),
+                          "a mass matrix that is not positive definite")  # fmt: skip
+
+                case(t, f"ComputedTorque of a URDF with {fld} = {v}", model, "either")
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
 CATEGORIES: dict[str, Callable[[Tally, bool], None]] = {
     "state restore": restore,
     "fault semantics": faults,
     "n-joint API": njoint,
     "sweeps and cache": sweeps,
+    "chains": chains,
+    "Cartesian front": cartesian,
+    "formulations": formulations,
+    "dynamics": dynamics,
+    "saves": saves,
+    "MuJoCo runs": mujoco_runs,
+    "robot descriptions": descriptions,
 }
 
 

@@ -83,7 +83,12 @@ impl fmt::Display for Error {
                 if let Some(i) = index {
                     write!(f, "[{i}]")?;
                 }
-                write!(f, " = {value} (SPEC §10)")
+                // Beyond 1e15 in scientific notation (1e300, not 301 digits).
+                if value.abs() >= 1e15 {
+                    write!(f, " = {value:e} (SPEC §10)")
+                } else {
+                    write!(f, " = {value} (SPEC §10)")
+                }
             }
             Error::NonFinite { what, index } => {
                 write!(f, "{what}[{index}] is not finite (NaN or infinite)")
@@ -244,6 +249,26 @@ pub(crate) mod check {
         }
     }
 
+    /// Every element finite with `|v_i| ≤ bound`, else the named condition
+    /// naming the element and its value (not the margin).
+    pub fn at_most_each(
+        condition: &'static str,
+        what: &'static str,
+        v: &[f64],
+        bound: f64,
+    ) -> Result<(), Error> {
+        finite_slice(what, v)?;
+        match v.iter().position(|x| x.abs() > bound) {
+            Some(i) => Err(Error::Condition {
+                condition,
+                lhs: what,
+                index: Some(i),
+                value: v[i],
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// Every element with `|v_i| ≤ bound` (NaN never is), else
     /// `Error::OutOfRange` (inputs and signals of a step).
     pub fn within(what: &'static str, v: &[f64], bound: f64) -> Result<(), Error> {
@@ -299,6 +324,31 @@ mod tests {
         assert!(s.contains("Kzeta"), "{s}");
         assert!(s.contains("[1]"), "{s}");
         assert!(s.contains("= -1"), "{s}");
+    }
+
+    #[test]
+    fn a_huge_value_is_written_in_scientific_notation() {
+        let e = Error::Condition {
+            condition: "|value| ≤ 1e9",
+            lhs: "payload",
+            index: None,
+            value: 1e300,
+        };
+        assert_eq!(
+            e.to_string(),
+            "condition |value| ≤ 1e9 is violated: payload = 1e300 (SPEC §10)"
+        );
+    }
+
+    #[test]
+    fn a_bound_names_the_value_not_the_margin() {
+        let e = check::at_most_each("|value| ≤ 1e9", "Kd", &[1.0, 1e10], PARAM_BOUND).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "condition |value| ≤ 1e9 is violated: Kd[1] = 10000000000 (SPEC §10)"
+        );
+        assert!(check::at_most_each("|value| ≤ 1e9", "Kd", &[-1e9, 1e9], PARAM_BOUND).is_ok());
+        assert!(check::at_most_each("|value| ≤ 1e9", "Kd", &[f64::NAN], PARAM_BOUND).is_err());
     }
 
     #[test]

@@ -157,13 +157,19 @@ pub use tracker::Tracker;
 pub use trajectory::{Setpoint, Sinusoid, Trajectory};
 pub use types::{grid_nodes, Jacobian, Matrix, Vector};
 
-/// The README's Rust quick start, compiled and run as a doctest inside
-/// `fn main() -> Result<(), Box<dyn std::error::Error>>` (`tests/readme.rs`
-/// keeps the README's copy identical).
+/// The README's Rust quick start, a whole `src/main.rs` (its `main` returns a
+/// `Result`), compiled and run as a doctest (`tests/readme.rs` keeps the
+/// README's copy identical).
 #[cfg(doctest)]
 #[doc = concat!(
-    "```\nfn main() -> Result<(), Box<dyn std::error::Error>> {\n",
+    "```\n",
     include_str!("../tests/snippets/readme_quickstart.rs"),
-    "Ok(())\n}\n```"
+    "```"
 )]
 pub struct ReadmeQuickStart;
+
+/// docs/robot.md's Rust block, a whole program, compiled and run as a
+/// doctest (`tests/test_readme.py` keeps the page's copy identical).
+#[cfg(doctest)]
+#[doc = concat!("```\n", include_str!("../tests/snippets/robot_hardened.rs"), "```")]
+pub struct RobotHardened;

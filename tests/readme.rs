@@ -1,7 +1,8 @@
-//! The README's Rust quick start is `tests/snippets/readme_quickstart.rs`,
-//! which the crate compiles and runs as a doctest wrapped in
-//! `fn main() -> Result<(), Box<dyn std::error::Error>>` (see `src/lib.rs`).
-//! This test keeps the README's copy identical to it.
+//! The README's Rust quick start is `tests/snippets/readme_quickstart.rs`, a
+//! whole `src/main.rs` with its dependency line, which the crate compiles and
+//! runs as a doctest (see `src/lib.rs`). This test keeps the README's copy
+//! identical to it, and the snippet a program as written: its own `main`
+//! returning a `Result` (the `?` needs it) and the dependency line.
 
 #[test]
 fn readme_rust_block_is_the_compiled_snippet() {
@@ -22,4 +23,6 @@ fn readme_rust_block_is_the_compiled_snippet() {
         block, snippet,
         "README's Rust block differs from the snippet"
     );
+    assert!(snippet.contains("fn main() -> Result<(), Box<dyn std::error::Error>> {"));
+    assert!(snippet.contains("adaptimp = { path = "));
 }

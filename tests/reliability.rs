@@ -349,3 +349,87 @@ fn the_rate_limit_bounds_the_change_of_torque_and_shows_in_dtau() {
     }
     assert!(limited, "the rate limit acted below the saturation limits");
 }
+
+/// The URDF reader (SPEC §21) on documents no robot file is: nested 100 000
+/// deep (the XML reader builds and drops elements recursively: this
+/// overflowed the stack, and 10⁶ deep took minutes), a device that never
+/// ends, a directory. Each is a refusal that says why, at once.
+#[cfg(feature = "urdf")]
+#[test]
+fn descriptions_that_would_overflow_or_never_end_are_refused() {
+    use adaptimp::description::urdf;
+    for depth in [1001, 100_000, 1_000_000] {
+        let text = format!(
+            "<robot name='r'>{}{}</robot>",
+            "<a>".repeat(depth),
+            "</a>".repeat(depth)
+        );
+        let e = urdf::read_str(&text).expect_err("nested too deep");
+        assert!(
+            e.to_string()
+                .contains("its elements nest more than 1000 deep (a URDF nests 5)"),
+            "{e}"
+        );
+        assert_eq!(urdf::kind_of(&text), "unknown");
+    }
+    // 999 deep (with comments, CDATA and quoted '>' that do not count) reads
+    // as XML and as a (linkless) URDF.
+    let text = format!(
+        "<robot name='r'><!-- <a><a> --><![CDATA[<a>]]>{}<b c='>'/>{}</robot>",
+        "<a x=\"<a>\">".repeat(998),
+        "</a>".repeat(998)
+    );
+    assert_eq!(urdf::kind_of(&text), "urdf");
+    let tree = urdf::read_str(&text).expect("999 deep is XML");
+    assert!(tree.links().is_empty());
+    for (path, why) in [
+        (
+            "/dev/zero",
+            "it is not a regular file (a device or a pipe), not a URDF",
+        ),
+        ("/", "it is a directory"),
+    ] {
+        let e = urdf::read_file(path).expect_err("not a file");
+        assert_eq!(
+            e.to_string(),
+            format!("cannot read the URDF '{path}': {why}: give the path of a URDF file")
+        );
+    }
+}
+
+/// A URDF limit that is not a number, or a negative effort or speed, is
+/// refused by name (NaN made a revolute joint continuous, silently).
+#[cfg(feature = "urdf")]
+#[test]
+fn a_urdf_limit_that_is_not_a_number_is_refused() {
+    use adaptimp::description::urdf;
+    for (attr, value) in [
+        ("lower", "nan"),
+        ("upper", "nan"),
+        ("effort", "nan"),
+        ("effort", "-1"),
+        ("velocity", "-3"),
+    ] {
+        let mut limit = std::collections::BTreeMap::from([
+            ("lower", "-1"),
+            ("upper", "1"),
+            ("effort", "5"),
+            ("velocity", "2"),
+        ]);
+        limit.insert(attr, value);
+        let text = format!(
+            "<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'>\
+             <parent link='a'/><child link='b'/><limit lower='{}' upper='{}' effort='{}' \
+             velocity='{}'/></joint></robot>",
+            limit["lower"], limit["upper"], limit["effort"], limit["velocity"]
+        );
+        let e = urdf::read_str(&text).expect_err("refused");
+        let v = if value == "nan" { "NaN" } else { value };
+        assert!(
+            e.to_string().starts_with(&format!(
+                "URDF text: joint 'j' has <limit {attr}=\"{v}\">: give a number"
+            )),
+            "{e}"
+        );
+    }
+}

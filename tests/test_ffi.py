@@ -205,6 +205,25 @@ def test_the_c_break_it_probe_finds_no_crash_hang_or_wrong_result_under_valgrind
     assert (crash, hang, wrong, false_refusal) == (0, 0, 0, 0), proc.stdout
 
 
+def test_the_forged_handle_probe_covers_every_entry_point_that_takes_a_handle() -> None:
+    """breakit.c's category "forged handles" calls each function of the header
+    that takes a handle, with every bad handle in each handle argument; a new
+    entry point must be added to its table (ENTRIES)."""
+    header = (ROOT / "ffi" / "include" / "adaptimp.h").read_text()
+    kinds = re.findall(r"typedef struct (Adaptimp\w+) \1;", header)
+    assert len(kinds) >= 5, kinds
+    takes = set()
+    for name, args in re.findall(r"\b(adaptimp_\w+)\(([^;]*?)\);", header, re.S):
+        if any(re.search(rf"struct {k} \*", args) and f"struct {k} **" not in args for k in kinds):
+            takes.add(name)
+    probe = (ROOT / "ffi" / "tests" / "breakit.c").read_text()
+    table = probe[probe.index("static const Entry ENTRIES[]") :]
+    table = table[: table.index("};")]
+    listed = set(re.findall(r'\{"(adaptimp_\w+)"', table))
+    assert takes - listed == set(), f"not probed with forged handles: {sorted(takes - listed)}"
+    assert listed - takes == set(), sorted(listed - takes)
+
+
 def test_the_c_urdf_reader_reads_the_arm_python_reads(examples: Path) -> None:
     """ffi/examples/16_read_urdf.c: adaptimp_chain_from_urdf reads a URDF file
     (or text) by the core's one reduction (SPEC §21): the arm's joints, limits,

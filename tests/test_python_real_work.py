@@ -12,6 +12,7 @@ import sys
 import textwrap
 import threading
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -334,7 +335,21 @@ def test_distinct_controllers_in_threads_give_the_serial_results() -> None:
 # ---------------------------------------------------------------------------
 
 
-def test_sigint_during_simulate_raises_keyboard_interrupt_and_leaves_objects_usable() -> None:
+@pytest.fixture
+def sigint() -> Iterator[None]:
+    """Python's SIGINT handler (KeyboardInterrupt) for the test, whatever the
+    suite was started with: under ``nohup … &`` SIGINT is ignored, Python then
+    installs no handler, and a Ctrl-C test would wait for a run of minutes."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def test_sigint_during_simulate_raises_keyboard_interrupt_and_leaves_objects_usable(
+    sigint: None,
+) -> None:
     """SIGINT from the outside (as Ctrl-C) while the core runs without the GIL."""
     ctrl = adaptimp.Controller("sf")
     timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
@@ -363,7 +378,7 @@ def test_an_exception_in_the_progress_callback_stops_the_run() -> None:
     assert 0 < calls[0] < 20_000_000
 
 
-def test_sigint_during_replay() -> None:
+def test_sigint_during_replay(sigint: None) -> None:
     ctrl = adaptimp.Controller("sf", "robot")
     seen: list[int] = []
 
@@ -380,9 +395,11 @@ def test_sigint_during_replay() -> None:
 
 
 def test_ctrl_c_in_a_fresh_process_is_a_keyboard_interrupt_not_a_panic() -> None:
+    # The child sets the handler: it inherits an ignored SIGINT under nohup.
     script = textwrap.dedent(
         """
-        import sys, adaptimp
+        import signal, sys, adaptimp
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         print("ready", flush=True)
         adaptimp.simulate("sf", T=1000.0)
         """
@@ -545,3 +562,25 @@ def test_stability_warning_for_euler_learning_at_1khz() -> None:
         adaptimp.Controller("of")  # the paper's 50 µs: stable
         adaptimp.Controller("of", "robot")  # normalised step
         adaptimp.Controller("pd", Ts=1e-3)  # PD does not learn
+
+
+def test_the_ctrl_c_tests_pass_when_the_suite_starts_with_sigint_ignored() -> None:
+    """As under ``nohup pytest … &``: SIGINT ignored from the start (they failed)."""
+    tests = [
+        f"{__file__}::{name}"
+        for name in (
+            "test_sigint_during_simulate_raises_keyboard_interrupt_and_leaves_objects_usable",
+            "test_sigint_during_replay",
+            "test_ctrl_c_in_a_fresh_process_is_a_keyboard_interrupt_not_a_panic",
+        )
+    ]
+    proc = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *tests],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "3 passed" in proc.stdout

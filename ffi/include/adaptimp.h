@@ -15,6 +15,10 @@
 // The largest number of joints (the arrays of the structs below have this many entries).
 #define ADAPTIMP_MAX_JOINTS 7
 
+// How many handles can live at once, of every kind together (a freed one
+// does not count): making one more is refused with TOO_MANY_HANDLES.
+#define ADAPTIMP_MAX_HANDLES 16384
+
 // The outcome of a call.
 typedef enum AdaptimpStatus {
   // Success.
@@ -53,6 +57,8 @@ typedef enum AdaptimpStatus {
   // must be: a rotation setpoint that is not a rotation (orthonormal to
   // 1e-6, det +1), a quaternion that is not a unit one.
   ADAPTIMP_STATUS_INVALID_INPUT = 13,
+  // `ADAPTIMP_MAX_HANDLES` handles are live: free some before making more.
+  ADAPTIMP_STATUS_TOO_MANY_HANDLES = 14,
 } AdaptimpStatus;
 
 // Which controller (SPEC §7).
@@ -196,21 +202,23 @@ typedef enum AdaptimpFormulation {
 } AdaptimpFormulation;
 
 // The 6-D Cartesian impedance over a chain and the joint controller it
-// drives (opaque; immutable: share it between threads).
+// drives (opaque: a handle; immutable: share it between threads).
 typedef struct AdaptimpCartesian AdaptimpCartesian;
 
-// The state of a Cartesian run (opaque): the outer loop's and the joint
-// controller's.
+// The state of a Cartesian run (opaque: a handle): the outer loop's and
+// the joint controller's.
 typedef struct AdaptimpCartesianState AdaptimpCartesianState;
 
-// An arm's kinematics: a serial chain of 1 … 7 movable joints (opaque).
+// An arm's kinematics: a serial chain of 1 … 7 movable joints (opaque: a handle).
 typedef struct AdaptimpChain AdaptimpChain;
 
-// A validated controller description (opaque).
+// A validated controller description (opaque: a handle, see
+// `ADAPTIMP_MAX_HANDLES`).
 typedef struct AdaptimpController AdaptimpController;
 
-// A controller's state (opaque): on the heap ([`adaptimp_state_new`]) or in
-// a buffer of the caller's ([`adaptimp_state_init`]).
+// A controller's state (opaque: a handle): on the heap
+// ([`adaptimp_state_new`]) or in a buffer of the caller's
+// ([`adaptimp_state_init`]).
 typedef struct AdaptimpState AdaptimpState;
 
 // A rigid transform as plain data: `x_parent = rotation · x + translation`.
@@ -722,11 +730,16 @@ enum AdaptimpStatus adaptimp_cartesian_state_reset(const struct AdaptimpCartesia
                                                    size_t n,
                                                    const double *q0);
 
-// The null-space posture (rad, `n` reals, finite) from the next step on.
+// The null-space posture (rad, `n` reals) of `state` under `cart` from
+// the next step on. The core checks it, as the step would need it:
+// finite, within the joint controller's `q_max` (at most 1e6 rad), and
+// null_k·|posture − q_d| ≤ 1e6 rad/s² (the ceiling of q̈_d) per joint;
+// else INVALID_CONFIG naming `posture` and the joint, nothing changed.
 //
 // # Safety
-// `state` is NULL or valid; `posture` NULL or holds `n` reals.
-enum AdaptimpStatus adaptimp_cartesian_set_posture(struct AdaptimpCartesianState *state,
+// `cart`, `state` NULL or valid; `posture` NULL or holds `n` reals.
+enum AdaptimpStatus adaptimp_cartesian_set_posture(const struct AdaptimpCartesian *cart,
+                                                   struct AdaptimpCartesianState *state,
                                                    size_t n,
                                                    const double *posture);
 
@@ -860,9 +873,9 @@ enum AdaptimpStatus adaptimp_controller_new_preset(AdaptimpPreset preset,
                                                    AdaptimpLaw law,
                                                    struct AdaptimpController **out);
 
-// Free a controller (NULL is ignored, and so is a pointer that is not a
-// live controller: freeing twice is the caller's bug, made unlikely to do
-// harm). Free its states first: a state does not keep its controller alive.
+// Free a controller (NULL is ignored, and so is a handle that is not a
+// live controller: freeing twice does nothing the second time). Free its
+// states first: a state does not keep its controller alive.
 //
 // # Safety
 // `ctrl` is NULL or came from `adaptimp_controller_new*`.
@@ -902,12 +915,12 @@ enum AdaptimpStatus adaptimp_state_buffer_size(const struct AdaptimpController *
 // A state at t = 0 for `ctrl` in the caller's buffer `buf` of `size` bytes
 // (at least what [`adaptimp_state_buffer_size`] says, aligned as it says),
 // no allocation: for firmware without a heap, or to place the state
-// yourself. `*out` gets the handle (it points into `buf`); use it as any
-// state. The buffer must stay where it is and must not be used otherwise
-// while the state lives (a state cannot be moved or copied bytewise: save
-// and restore it); [`adaptimp_state_free`] ends its life and gives the
-// buffer back (it frees nothing). BAD_SIZE for a buffer too small or
-// misaligned.
+// yourself. `*out` gets the handle (a number, as every handle: not the
+// buffer's address); use it as any state. The buffer must stay where it is
+// and must not be used otherwise while the state lives (a state cannot be
+// moved or copied bytewise: save and restore it); [`adaptimp_state_free`]
+// ends its life and gives the buffer back (it frees nothing). BAD_SIZE
+// for a buffer too small or misaligned.
 //
 // # Safety
 // `ctrl` and `out` are NULL or valid; `buf` is NULL or `size` writable
@@ -920,8 +933,8 @@ enum AdaptimpStatus adaptimp_state_init(const struct AdaptimpController *ctrl,
 // Free a state (NULL is ignored, and so is a pointer that is not a live
 // state): a heap state's memory is freed; a state in a caller buffer
 // ([`adaptimp_state_init`]) ends its life and its buffer is the caller's
-// again. Using a state after this is refused (BAD_HANDLE) as long as its
-// memory was not reused.
+// again. Using its handle after this is refused (BAD_HANDLE), even once
+// its memory holds a new state (which has a handle of its own).
 //
 // # Safety
 // `state` is NULL or came from `adaptimp_state_new` or `adaptimp_state_init`.

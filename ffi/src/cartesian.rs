@@ -4,14 +4,15 @@
 //! core's (`adaptimp::cartesian`); this converts and checks pointers, sizes
 //! and enum values.
 
+use crate::handles::{free, handle, handle_mut, publish, publish_at, release, Header};
 use crate::joint::{build_sized, copy_sized, fault_of, Buf, Place, St};
 use crate::*;
 use adaptimp::cartesian::rotation::quaternion_matrix;
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::{
     AnyBasis, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
-    CartesianState, Centers, Chain, Formulation, Joint, JointKind, Kinematics, Law, PoseTarget,
-    Setpoint, Transform, Vector,
+    CartesianState, Centers, Chain, Formulation, Joint, JointKind, Law, PoseTarget, Setpoint,
+    Transform, Vector,
 };
 use core::ffi::c_void;
 use nalgebra::{Matrix3, UnitQuaternion};
@@ -210,32 +211,50 @@ impl AdaptimpCartesianCommand {
     };
 }
 
-/// An arm's kinematics: a serial chain of 1 … 7 movable joints (opaque).
-#[derive(Debug)]
+/// An arm's kinematics: a serial chain of 1 … 7 movable joints (opaque: a handle).
 pub struct AdaptimpChain {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpChain`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct ChainObject {
+    head: Header,
     inner: Chains,
 }
-handle!(AdaptimpChain, b"adpCHAIN");
+handle_kind!(AdaptimpChain => ChainObject, b"adpCHAIN");
 
 /// The 6-D Cartesian impedance over a chain and the joint controller it
-/// drives (opaque; immutable: share it between threads).
-#[derive(Debug)]
+/// drives (opaque: a handle; immutable: share it between threads).
 pub struct AdaptimpCartesian {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpCartesian`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct CartesianObject {
+    head: Header,
     inner: Carts,
 }
-handle!(AdaptimpCartesian, b"adpCARTE");
+handle_kind!(AdaptimpCartesian => CartesianObject, b"adpCARTE");
 
-/// The state of a Cartesian run (opaque): the outer loop's and the joint
-/// controller's.
-#[derive(Debug)]
+/// The state of a Cartesian run (opaque: a handle): the outer loop's and
+/// the joint controller's.
 pub struct AdaptimpCartesianState {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpCartesianState`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct CartesianStateObject {
+    head: Header,
     place: Place,
     states: CStates,
 }
-handle!(AdaptimpCartesianState, b"adpCSTAT");
+handle_kind!(AdaptimpCartesianState => CartesianStateObject, b"adpCSTAT");
 
 /// One Cartesian controller of N joints.
 #[derive(Debug)]
@@ -561,10 +580,10 @@ pub unsafe extern "C" fn adaptimp_chain_new(
             });
         }
         let inner = chain_of(&js, &tip)?;
-        *out = Box::into_raw(Box::new(AdaptimpChain {
-            tag: <AdaptimpChain as Handle>::TAG,
+        *out = publish(Box::new(ChainObject {
+            head: Header::unpublished(),
             inner,
-        }));
+        }))?;
         Ok(())
     })
 }
@@ -577,7 +596,7 @@ pub unsafe extern "C" fn adaptimp_chain_new(
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_chain_free(chain: *mut AdaptimpChain) {
     // SAFETY: the caller's contract.
-    unsafe { free_boxed(chain, "chain", |c| c.tag = 0) }
+    unsafe { free(chain, "chain") }
 }
 
 /// The chain's number of movable joints, or 0 for NULL or a dead handle.
@@ -637,7 +656,9 @@ unsafe fn tip_sized<const N: usize>(
         // SAFETY: the caller's contract.
         unsafe { joint_values::<N>(dq, "dq", Context::Step) }?
     };
-    let t = c.tip(&q, &dq);
+    let t = c
+        .tip_checked(&q, &dq)
+        .map_err(|e| core_error(e, Context::Step))?;
     out.n = N;
     out.position = a3(&t.position);
     out.rotation = rows3(t.rotation.matrix());
@@ -844,10 +865,10 @@ pub unsafe extern "C" fn adaptimp_cartesian_new(
         let out = unsafe { crate::out(out, "out") }?;
         let cfg = cartesian_of(cart)?;
         let inner = cart_of(&chain.inner, cfg, joint)?;
-        *out = Box::into_raw(Box::new(AdaptimpCartesian {
-            tag: <AdaptimpCartesian as Handle>::TAG,
+        *out = publish(Box::new(CartesianObject {
+            head: Header::unpublished(),
             inner,
-        }));
+        }))?;
         Ok(())
     })
 }
@@ -860,7 +881,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_new(
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_cartesian_free(cart: *mut AdaptimpCartesian) {
     // SAFETY: the caller's contract.
-    unsafe { free_boxed(cart, "cart", |c| c.tag = 0) }
+    unsafe { free(cart, "cart") }
 }
 
 /// The number of joints, or 0 for NULL or a dead handle.
@@ -905,17 +926,10 @@ where
     check_n::<N>(n, "Cartesian controller")?;
     // SAFETY: the caller's contract.
     let q0 = unsafe { joint_values::<N>(q0, "q0", Context::Config) }?;
-    let inner = c
-        .pair
-        .inner()
-        .state_in(buf)
-        .map_err(|e| core_error(e, Context::Config))?;
-    Ok(CSt {
-        outer: c.pair.outer().start(q0),
-        inner,
-        q0,
-    }
-    .into_cstates())
+    let config = |e| core_error(e, Context::Config);
+    let outer = c.pair.start(&q0).map_err(config)?;
+    let inner = c.pair.inner().state_in(buf).map_err(config)?;
+    Ok(CSt { outer, inner, q0 }.into_cstates())
 }
 
 /// A state at t = 0 of `cart` into `*out`, on the heap (free it with
@@ -941,20 +955,20 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_new(
         let states = with_cart!(&c.inner, c => unsafe {
             cstate_over(c, n, q0, Buf::Heap(vec![0.0; c.pair.inner().buffer_len()]))
         })?;
-        *out = Box::into_raw(Box::new(AdaptimpCartesianState {
-            tag: <AdaptimpCartesianState as Handle>::TAG,
+        *out = publish(Box::new(CartesianStateObject {
+            head: Header::unpublished(),
             place: Place::Heap,
             states,
-        }));
+        }))?;
         Ok(())
     })
 }
 
 /// The header of a Cartesian state in a caller buffer, in bytes.
-const CSTATE_HEADER: usize = std::mem::size_of::<AdaptimpCartesianState>().next_multiple_of(8);
+const CSTATE_HEADER: usize = std::mem::size_of::<CartesianStateObject>().next_multiple_of(8);
 /// The alignment a caller buffer for a Cartesian state needs.
-const CSTATE_ALIGN: usize = if std::mem::align_of::<AdaptimpCartesianState>() > 8 {
-    std::mem::align_of::<AdaptimpCartesianState>()
+const CSTATE_ALIGN: usize = if std::mem::align_of::<CartesianStateObject>() > 8 {
+    std::mem::align_of::<CartesianStateObject>()
 } else {
     8
 };
@@ -1034,13 +1048,19 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_init(
             std::ptr::write_bytes(data, 0, reals);
             let data: &'static mut [f64] = std::slice::from_raw_parts_mut(data, reals);
             let states = with_cart!(&c.inner, c => cstate_over(c, n, q0, Buf::Caller(data)))?;
-            let p = buf.cast::<AdaptimpCartesianState>();
-            p.write(AdaptimpCartesianState {
-                tag: <AdaptimpCartesianState as Handle>::TAG,
+            let p = buf.cast::<CartesianStateObject>();
+            p.write(CartesianStateObject {
+                head: Header::unpublished(),
                 place: Place::Caller,
                 states,
             });
-            *out = p;
+            match publish_at::<AdaptimpCartesianState>(p) {
+                Ok(h) => *out = h,
+                Err(status) => {
+                    p.drop_in_place();
+                    return Err(status);
+                }
+            }
         }
         Ok(())
     })
@@ -1053,14 +1073,17 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_init(
 /// `state` is NULL or came from `adaptimp_cartesian_state_new` or `_init`.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_cartesian_state_free(state: *mut AdaptimpCartesianState) {
-    // SAFETY (in `handle_mut`): checked for NULL and a live handle.
-    let Ok(s) = (unsafe { handle_mut(state, "state") }) else {
+    let Some(o) = release(state, "state") else {
         return;
     };
-    s.tag = 0;
-    if s.place == Place::Heap {
-        // SAFETY: a live heap state came from Box::into_raw; freed once.
-        drop(unsafe { Box::from_raw(state) });
+    // SAFETY: as in `adaptimp_state_free`: a heap one came from `publish`,
+    // one in a caller's buffer is dropped in place.
+    unsafe {
+        if (*o).place == Place::Heap {
+            drop(Box::from_raw(o));
+        } else {
+            o.drop_in_place();
+        }
     }
 }
 
@@ -1100,41 +1123,54 @@ unsafe fn reset_sized<const N: usize>(
         unsafe { joint_values::<N>(q0, "q0", Context::Config) }?
     };
     let posture = s.outer.posture;
+    let outer = c
+        .pair
+        .start(&q0)
+        .map_err(|e| core_error(e, Context::Config))?;
     s.q0 = q0;
-    s.outer = c.pair.outer().start(q0);
+    s.outer = outer;
     s.outer.posture = posture;
     s.inner.reset();
     Ok(())
 }
 
-/// The null-space posture (rad, `n` reals, finite) from the next step on.
+/// The null-space posture (rad, `n` reals) of `state` under `cart` from
+/// the next step on. The core checks it, as the step would need it:
+/// finite, within the joint controller's `q_max` (at most 1e6 rad), and
+/// null_k·|posture − q_d| ≤ 1e6 rad/s² (the ceiling of q̈_d) per joint;
+/// else INVALID_CONFIG naming `posture` and the joint, nothing changed.
 ///
 /// # Safety
-/// `state` is NULL or valid; `posture` NULL or holds `n` reals.
+/// `cart`, `state` NULL or valid; `posture` NULL or holds `n` reals.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_cartesian_set_posture(
+    cart: *const AdaptimpCartesian,
     state: *mut AdaptimpCartesianState,
     n: usize,
     posture: *const f64,
 ) -> AdaptimpStatus {
     guard(|| {
         // SAFETY (in the helpers): checked; the caller's contract.
+        let c = unsafe { handle(cart, "cart") }?;
         let s = unsafe { handle_mut(state, "state") }?;
-        with_cstate!(&mut s.states, s => unsafe { posture_sized(s, n, posture) })
+        with_cpair!(&c.inner, &mut s.states, c, s => unsafe { posture_sized(c, s, n, posture) })
     })
 }
 
 /// # Safety
 /// `posture` NULL or holds `n` reals.
 unsafe fn posture_sized<const N: usize>(
+    c: &Cart<N>,
     s: &mut CSt<N>,
     n: usize,
     posture: *const f64,
 ) -> Result<(), AdaptimpStatus> {
     check_n::<N>(n, "state")?;
     // SAFETY: the caller's contract.
-    s.outer.posture = unsafe { joint_values::<N>(posture, "posture", Context::Config) }?;
-    Ok(())
+    let p = unsafe { joint_values::<N>(posture, "posture", Context::Config) }?;
+    c.pair
+        .set_posture(&mut s.outer, &p)
+        .map_err(|e| core_error(e, Context::Config))
 }
 
 /// Ask for the stiffness `kd` (3 reals, N/m) and `kd_rot` (3 reals, N m/rad):
@@ -1517,7 +1553,8 @@ unsafe fn orbit_sized<const N: usize>(
         dx: Vector::zeros(),
         ddx: Vector::zeros(),
     };
-    let mut samples = vec![zero; a.nodes];
+    // At most one sample a step (a huge `nodes` allocates no more).
+    let mut samples = vec![zero; a.nodes.min(a.targets.len()).max(1)];
     let l = outer
         .orbit(
             q0,

@@ -1,6 +1,7 @@
 //! The joint-space controller: its handle, its states (on the heap or in a
 //! caller buffer), the step, snapshots.
 
+use crate::handles::{free, handle, handle_mut, publish, publish_at, release, Header};
 use crate::*;
 use adaptimp::{
     AnyBasis, Centers, Command, Controller, Grid, Measurement, Setpoint, Sinusoid, State,
@@ -77,13 +78,20 @@ pub(crate) struct Ctl<const N: usize> {
     pub(crate) traj: Sinusoid<N>,
 }
 
-/// A validated controller description (opaque).
-#[derive(Debug)]
+/// A validated controller description (opaque: a handle, see
+/// `ADAPTIMP_MAX_HANDLES`).
 pub struct AdaptimpController {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpController`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct ControllerObject {
+    head: Header,
     inner: Inner,
 }
-handle!(AdaptimpController, b"adp-CTRL");
+handle_kind!(AdaptimpController => ControllerObject, b"adp-CTRL");
 
 /// The buffer of a state: the heap's, or the caller's.
 #[derive(Debug)]
@@ -122,15 +130,22 @@ pub(crate) enum Place {
     Caller,
 }
 
-/// A controller's state (opaque): on the heap ([`adaptimp_state_new`]) or in
-/// a buffer of the caller's ([`adaptimp_state_init`]).
-#[derive(Debug)]
+/// A controller's state (opaque: a handle): on the heap
+/// ([`adaptimp_state_new`]) or in a buffer of the caller's
+/// ([`adaptimp_state_init`]).
 pub struct AdaptimpState {
-    tag: u64,
+    _opaque: [u8; 0],
+}
+
+/// The object behind an [`AdaptimpState`] handle.
+#[repr(C)]
+#[derive(Debug)]
+pub(crate) struct StateObject {
+    head: Header,
     place: Place,
     states: States,
 }
-handle!(AdaptimpState, b"adpSTATE");
+handle_kind!(AdaptimpState => StateObject, b"adpSTATE");
 
 macro_rules! sized {
     ($($v:ident => $n:literal),+) => {
@@ -215,10 +230,10 @@ fn joints_of<const N: usize>(_: &Ctl<N>) -> usize {
 
 /// The size of a state's header in a caller buffer, in bytes: its buffer of
 /// reals follows, aligned for them.
-const STATE_HEADER: usize = std::mem::size_of::<AdaptimpState>().next_multiple_of(8);
+const STATE_HEADER: usize = std::mem::size_of::<StateObject>().next_multiple_of(8);
 /// The alignment a caller buffer for a state needs.
-const STATE_ALIGN: usize = if std::mem::align_of::<AdaptimpState>() > 8 {
-    std::mem::align_of::<AdaptimpState>()
+const STATE_ALIGN: usize = if std::mem::align_of::<StateObject>() > 8 {
+    std::mem::align_of::<StateObject>()
 } else {
     8
 };
@@ -265,10 +280,10 @@ pub unsafe extern "C" fn adaptimp_controller_new(
         let p = unsafe { read(params, "params") }?;
         let out = unsafe { crate::out(out, "out") }?;
         let inner = build(p)?;
-        *out = Box::into_raw(Box::new(AdaptimpController {
-            tag: <AdaptimpController as Handle>::TAG,
+        *out = publish(Box::new(ControllerObject {
+            head: Header::unpublished(),
             inner,
-        }));
+        }))?;
         Ok(())
     })
 }
@@ -298,16 +313,16 @@ pub unsafe extern "C" fn adaptimp_controller_new_preset(
     unsafe { adaptimp_controller_new(&p, out) }
 }
 
-/// Free a controller (NULL is ignored, and so is a pointer that is not a
-/// live controller: freeing twice is the caller's bug, made unlikely to do
-/// harm). Free its states first: a state does not keep its controller alive.
+/// Free a controller (NULL is ignored, and so is a handle that is not a
+/// live controller: freeing twice does nothing the second time). Free its
+/// states first: a state does not keep its controller alive.
 ///
 /// # Safety
 /// `ctrl` is NULL or came from `adaptimp_controller_new*`.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_controller_free(ctrl: *mut AdaptimpController) {
     // SAFETY: the caller's contract.
-    unsafe { free_boxed(ctrl, "ctrl", |c| c.tag = 0) }
+    unsafe { free(ctrl, "ctrl") }
 }
 
 /// The controller's number of joints, or 0 for NULL or a dead handle.
@@ -353,11 +368,11 @@ pub unsafe extern "C" fn adaptimp_state_new(
         let out = unsafe { crate::out(out, "out") }?;
         let states =
             with_ctl!(&c.inner, c => state_over(c, Buf::Heap(vec![0.0; c.ctrl.buffer_len()])))?;
-        *out = Box::into_raw(Box::new(AdaptimpState {
-            tag: <AdaptimpState as Handle>::TAG,
+        *out = publish(Box::new(StateObject {
+            head: Header::unpublished(),
             place: Place::Heap,
             states,
-        }));
+        }))?;
         Ok(())
     })
 }
@@ -388,12 +403,12 @@ pub unsafe extern "C" fn adaptimp_state_buffer_size(
 /// A state at t = 0 for `ctrl` in the caller's buffer `buf` of `size` bytes
 /// (at least what [`adaptimp_state_buffer_size`] says, aligned as it says),
 /// no allocation: for firmware without a heap, or to place the state
-/// yourself. `*out` gets the handle (it points into `buf`); use it as any
-/// state. The buffer must stay where it is and must not be used otherwise
-/// while the state lives (a state cannot be moved or copied bytewise: save
-/// and restore it); [`adaptimp_state_free`] ends its life and gives the
-/// buffer back (it frees nothing). BAD_SIZE for a buffer too small or
-/// misaligned.
+/// yourself. `*out` gets the handle (a number, as every handle: not the
+/// buffer's address); use it as any state. The buffer must stay where it is
+/// and must not be used otherwise while the state lives (a state cannot be
+/// moved or copied bytewise: save and restore it); [`adaptimp_state_free`]
+/// ends its life and gives the buffer back (it frees nothing). BAD_SIZE
+/// for a buffer too small or misaligned.
 ///
 /// # Safety
 /// `ctrl` and `out` are NULL or valid; `buf` is NULL or `size` writable
@@ -434,13 +449,19 @@ pub unsafe extern "C" fn adaptimp_state_init(
             std::ptr::write_bytes(data, 0, reals);
             let data: &'static mut [f64] = std::slice::from_raw_parts_mut(data, reals);
             let states = with_ctl!(&c.inner, c => state_over(c, Buf::Caller(data)))?;
-            let p = buf.cast::<AdaptimpState>();
-            p.write(AdaptimpState {
-                tag: <AdaptimpState as Handle>::TAG,
+            let p = buf.cast::<StateObject>();
+            p.write(StateObject {
+                head: Header::unpublished(),
                 place: Place::Caller,
                 states,
             });
-            *out = p;
+            match publish_at::<AdaptimpState>(p) {
+                Ok(h) => *out = h,
+                Err(status) => {
+                    p.drop_in_place();
+                    return Err(status);
+                }
+            }
         }
         Ok(())
     })
@@ -449,24 +470,27 @@ pub unsafe extern "C" fn adaptimp_state_init(
 /// Free a state (NULL is ignored, and so is a pointer that is not a live
 /// state): a heap state's memory is freed; a state in a caller buffer
 /// ([`adaptimp_state_init`]) ends its life and its buffer is the caller's
-/// again. Using a state after this is refused (BAD_HANDLE) as long as its
-/// memory was not reused.
+/// again. Using its handle after this is refused (BAD_HANDLE), even once
+/// its memory holds a new state (which has a handle of its own).
 ///
 /// # Safety
 /// `state` is NULL or came from `adaptimp_state_new` or `adaptimp_state_init`.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_state_free(state: *mut AdaptimpState) {
-    // SAFETY (in `handle_mut`): checked for NULL and for a live handle.
-    let Ok(s) = (unsafe { handle_mut(state, "state") }) else {
+    let Some(o) = release(state, "state") else {
         return;
     };
-    s.tag = 0;
-    if s.place == Place::Heap {
-        // SAFETY: a live heap state came from Box::into_raw; its tag is now
-        // cleared, so it is freed once.
-        drop(unsafe { Box::from_raw(state) });
+    // SAFETY: a live object until `release`, now unreachable by its handle:
+    // a heap one came from `publish` (Box::into_raw); one in a caller's
+    // buffer is dropped in place (it owns no other memory) and the buffer is
+    // the caller's again.
+    unsafe {
+        if (*o).place == Place::Heap {
+            drop(Box::from_raw(o));
+        } else {
+            o.drop_in_place();
+        }
     }
-    // A caller's buffer: nothing to free (the state owns no other memory).
 }
 
 /// Back to t = 0: weights, ζ, observer, reference and applied torque as at

@@ -12,7 +12,8 @@
 //! input that is not finite, …).
 //!
 //! The C front validates nothing the core validates: it converts, checks
-//! pointers (NULL, and the tag of a live handle of the right kind), sizes
+//! pointers (NULL; a handle against the registry of live handles, without
+//! reading anything at it: `handles.rs`), sizes
 //! and enum values (a C enum is an integer: each is read as one and a value
 //! outside its enum is refused, never transmuted), and calls the core. Every
 //! step's output struct is written on every status (the table is in the
@@ -20,10 +21,12 @@
 //! steps allocate nothing.
 //!
 //! This is the only crate of the project with `unsafe` code: dereferencing
-//! the caller's pointers. Each such place is one of the small helpers below
-//! (`read`, `out`, `slice`, `handle`, …), which check for NULL first; the
-//! caller promises the usual C contract (a non-NULL pointer points to as many
-//! valid elements as the length passed with it).
+//! the caller's pointers, and the objects behind handles. Each such place is
+//! one of the small helpers below (`read`, `out`, `slice`, …), which check
+//! for NULL first, or of `handles.rs` (`handle`, `publish`, `release`),
+//! which check a handle against the registry first; the caller promises the
+//! usual C contract (a non-NULL pointer points to as many valid elements as
+//! the length passed with it; a handle is used by one thread at a time).
 
 use adaptimp::Error;
 use core::ffi::c_char;
@@ -76,6 +79,8 @@ pub enum AdaptimpStatus {
     /// must be: a rotation setpoint that is not a rotation (orthonormal to
     /// 1e-6, det +1), a quaternion that is not a unit one.
     InvalidInput = 13,
+    /// `ADAPTIMP_MAX_HANDLES` handles are live: free some before making more.
+    TooManyHandles = 14,
 }
 
 // ---------------------------------------------------------------------------
@@ -592,6 +597,7 @@ unsafe fn slice<'a, T>(p: *const T, len: usize, what: &str) -> Result<&'a [T], A
     if p.is_null() {
         return Err(null(what));
     }
+    addressable::<T>(len, what)?;
     // SAFETY: non-NULL; `len` valid elements is the caller's contract.
     Ok(unsafe { std::slice::from_raw_parts(p, len) })
 }
@@ -608,111 +614,29 @@ unsafe fn slice_mut<'a>(
     if p.is_null() {
         return Err(null(what));
     }
+    addressable::<f64>(len, what)?;
     // SAFETY: non-NULL; `len` valid, exclusive elements is the caller's contract.
     Ok(unsafe { std::slice::from_raw_parts_mut(p, len) })
+}
+
+/// `len` values of `T` fit in an address space (a slice of more is
+/// undefined behaviour even to make), else BadSize naming `what`.
+fn addressable<T>(len: usize, what: &str) -> Result<(), AdaptimpStatus> {
+    match len.checked_mul(std::mem::size_of::<T>()) {
+        Some(bytes) if bytes <= isize::MAX as usize => Ok(()),
+        _ => Err(fail(
+            AdaptimpStatus::BadSize,
+            &format_args!("{what}: {len} values are more than an address space holds"),
+        )),
+    }
 }
 
 fn null(what: &str) -> AdaptimpStatus {
     fail(AdaptimpStatus::NullPointer, &format_args!("{what} is NULL"))
 }
 
-/// A handle of the ABI: a struct whose first word, `tag`, says what it is
-/// while it lives (zero once freed), so a freed handle, a pointer to another
-/// kind of handle or to anything else is refused with BadHandle instead of
-/// being used (it makes a use after free or a double free unlikely to go
-/// unnoticed; it cannot make it safe: that stays the caller's contract).
-trait Handle: Sized {
-    /// The tag of a live handle of this kind.
-    const TAG: u64;
-    /// Its C name, for messages.
-    const NAME: &'static str;
-    /// The tag at `p`, read as a plain integer before any reference to the
-    /// handle is made.
-    ///
-    /// # Safety
-    /// `p` is non-NULL, aligned, and points to readable memory of at least
-    /// `size_of::<Self>()` bytes whose `tag` field is initialised.
-    unsafe fn tag_at(p: *const Self) -> u64;
-}
-
-/// Implements [`Handle`] for a struct with a `tag: u64` field.
-macro_rules! handle {
-    ($t:ident, $tag:literal) => {
-        impl $crate::Handle for $t {
-            const TAG: u64 = u64::from_le_bytes(*$tag);
-            const NAME: &'static str = stringify!($t);
-            unsafe fn tag_at(p: *const Self) -> u64 {
-                // SAFETY: the caller's contract (`Handle::tag_at`); the field's
-                // place is computed without a reference to the whole.
-                unsafe { core::ptr::addr_of!((*p).tag).read() }
-            }
-        }
-    };
-}
-
-/// Checks the pointer of a handle: NULL, misaligned, or not a live one of its kind.
-///
-/// # Safety
-/// A non-NULL, aligned `p` points to readable memory as [`Handle::tag_at`] needs.
-unsafe fn check_handle<T: Handle>(p: *const T, what: &str) -> Result<(), AdaptimpStatus> {
-    if p.is_null() {
-        return Err(null(what));
-    }
-    if !(p as usize).is_multiple_of(std::mem::align_of::<T>())
-        // SAFETY: non-NULL, aligned; the caller's contract.
-        || unsafe { T::tag_at(p) } != T::TAG
-    {
-        return Err(fail(
-            AdaptimpStatus::BadHandle,
-            &format_args!(
-                "{what} is not a live {} (freed, never made, or another object)",
-                T::NAME
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// `&*p` for a live handle.
-///
-/// # Safety
-/// As [`check_handle`]; a live handle is valid for the call.
-unsafe fn handle<'a, T: Handle>(p: *const T, what: &str) -> Result<&'a T, AdaptimpStatus> {
-    // SAFETY: the caller's contract.
-    unsafe { check_handle(p, what) }?;
-    // SAFETY: a live handle of this kind: valid.
-    Ok(unsafe { &*p })
-}
-
-/// `&mut *p` for a live handle.
-///
-/// # Safety
-/// As [`check_handle`]; a live handle is valid and not accessed elsewhere during the call.
-unsafe fn handle_mut<'a, T: Handle>(p: *mut T, what: &str) -> Result<&'a mut T, AdaptimpStatus> {
-    // SAFETY: the caller's contract.
-    unsafe { check_handle(p, what) }?;
-    // SAFETY: a live handle of this kind: valid and exclusive.
-    Ok(unsafe { &mut *p })
-}
-
-/// Free a handle made by `Box::into_raw` (NULL and dead ones are ignored;
-/// a dead one records a message).
-///
-/// # Safety
-/// `p` is NULL or a pointer the library returned for this kind of handle.
-unsafe fn free_boxed<T: Handle>(p: *mut T, what: &str, tag: impl FnOnce(&mut T)) {
-    if p.is_null() {
-        return;
-    }
-    // SAFETY: the caller's contract; a live handle came from Box::into_raw.
-    if unsafe { check_handle(p, what) }.is_ok() {
-        // SAFETY: live, from Box::into_raw, freed once (its tag is cleared first).
-        let mut b = unsafe { Box::from_raw(p) };
-        tag(&mut b);
-        drop(b);
-    }
-}
-
+#[macro_use]
+mod handles;
 // In the header's order.
 mod cartesian;
 mod joint;
@@ -720,6 +644,7 @@ mod params;
 mod urdf;
 
 pub use cartesian::*;
+pub use handles::ADAPTIMP_MAX_HANDLES;
 pub use joint::*;
 pub use params::*;
 pub use urdf::*;

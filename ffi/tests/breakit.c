@@ -20,6 +20,7 @@
  * - false refusal: refused where it must succeed.
  *
  *   breakit            the table (markdown), and notes on any case not clean
+ *   BREAKIT_VERBOSE=1 breakit   also every case, its status and message, on stderr
  *
  * Each category runs in its own process (fork), so a crash or a hang of one
  * is counted and the others still run. Deterministic: no randomness.
@@ -35,6 +36,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -61,6 +64,9 @@ static void note(const char *fmt, const char *what, const char *detail) {
 /* Classify one case: its status, whether the invariants held, what was expected. */
 static void outcome(const char *what, int expect, AdaptimpStatus s, int invariants) {
     T.cases++;
+    if (getenv("BREAKIT_VERBOSE")) /* every case: what, its status, the message */
+        fprintf(stderr, "%s: status %d%s%s\n", what, (int)s, s ? ": " : "",
+                s ? adaptimp_last_error() : "");
     if (s == ADAPTIMP_STATUS_INTERNAL) {
         T.crash++;
         note("%s: INTERNAL (%s)", what, adaptimp_last_error());
@@ -942,6 +948,725 @@ static void cartesian(void) {
     }
 }
 
+/* ---- Issue 33: postures, starts, axes, rates, orbits. ---- */
+
+/* A Cartesian state steps (OK) k times from Q0 toward the start pose. */
+static int cart_steps_ok(const Cart *c, int k) {
+    const double dq[3] = {0}, w[6] = {0};
+    AdaptimpPoseTarget g = start_target();
+    AdaptimpCartesianCommand o;
+    for (int i = 0; i < k; i++)
+        if (adaptimp_cartesian_step(c->cart, c->state, 3, Q0, dq, w, &g, &o) != ADAPTIMP_STATUS_OK ||
+            !finite_all(o.tau_sat, 3))
+            return 0;
+    return 1;
+}
+
+static void postures(void) {
+    char what[160];
+    AdaptimpCartesianParams cp;
+    if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+    /* A posture: refused when given if far out of range (then every step
+       used to be refused), accepted otherwise; either way the loop steps. */
+    const double far[] = {1e7, -1e7, 2e6, 1e6 + 1, 1e5, 4.1e4, 1e4, 10.0, 0.0};
+    for (size_t f = 0; f < sizeof far / sizeof far[0]; f++) {
+        for (int j = 0; j < 3; j++) {
+            Cart c;
+            if (open_cart(&cp, &c) != ADAPTIMP_STATUS_OK) abort();
+            double p[3] = {Q0[0], Q0[1], Q0[2]};
+            p[j] = far[f];
+            const AdaptimpStatus s = adaptimp_cartesian_set_posture(c.cart, c.state, 3, p);
+            /* null_k = 25: a pull beyond 1e6 rad/s² is refused. */
+            const int bad = 25.0 * fabs(far[f] - Q0[j]) > 1e6;
+            snprintf(what, sizeof what, "set_posture[%d] = %g", j, far[f]);
+            outcome(what, bad ? REFUSE : ACCEPT, s,
+                    (s == ADAPTIMP_STATUS_OK || s == ADAPTIMP_STATUS_INVALID_CONFIG) &&
+                        cart_steps_ok(&c, 10));
+            close_cart(&c);
+        }
+    }
+    /* A start: within 1e6 rad accepted (the step decides), beyond refused. */
+    for (int b = 0; b < NBAD; b++) {
+        Cart c;
+        if (open_cart(&cp, &c) != ADAPTIMP_STATUS_OK) abort();
+        double q0[3] = {Q0[0], BAD[b], Q0[2]};
+        AdaptimpCartesianState *st = NULL;
+        AdaptimpStatus s = adaptimp_cartesian_state_new(c.cart, 3, q0, &st);
+        snprintf(what, sizeof what, "cartesian_state_new q0[1] = %g", BAD[b]);
+        const int bad = !isfinite(BAD[b]) || fabs(BAD[b]) > 1e6;
+        outcome(what, bad ? REFUSE : ACCEPT, s, (s == ADAPTIMP_STATUS_OK) == (st != NULL));
+        adaptimp_cartesian_state_free(st);
+        s = adaptimp_cartesian_state_reset(c.cart, c.state, 3, q0);
+        snprintf(what, sizeof what, "cartesian_state_reset q0[1] = %g", BAD[b]);
+        outcome(what, bad ? REFUSE : ACCEPT, s, 1);
+        /* A refused reset changed nothing: the state still steps. */
+        if (s != ADAPTIMP_STATUS_OK) {
+            snprintf(what, sizeof what, "steps after a refused reset to %g", BAD[b]);
+            outcome(what, ACCEPT, ADAPTIMP_STATUS_OK, cart_steps_ok(&c, 5));
+        }
+        close_cart(&c);
+    }
+    /* Axes of every magnitude: an axis whose norm overflows is an axis. */
+    const double scales[] = {1e-11, 1e-3, 1.0, 1e100, 1e200, 1e300, DBL_MAX, 1e-13, 0.0};
+    AdaptimpTip ref;
+    {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        AdaptimpChain *ch = NULL;
+        if (adaptimp_chain_new(j, 4, &tip, &ch) != ADAPTIMP_STATUS_OK ||
+            adaptimp_chain_tip(ch, 3, Q0, Q0, &ref) != ADAPTIMP_STATUS_OK)
+            abort();
+        adaptimp_chain_free(ch);
+    }
+    for (size_t k = 0; k < sizeof scales / sizeof scales[0]; k++) {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        for (int i = 0; i < 3; i++) j[0].axis[i] *= scales[k];
+        AdaptimpChain *ch = NULL;
+        const AdaptimpStatus s = adaptimp_chain_new(j, 4, &tip, &ch);
+        AdaptimpTip t;
+        int ok = (s == ADAPTIMP_STATUS_OK) == (ch != NULL);
+        if (ch) {
+            /* The same chain as the unit axis's, to rounding. */
+            ok = ok && adaptimp_chain_tip(ch, 3, Q0, Q0, &t) == ADAPTIMP_STATUS_OK;
+            for (int r = 0; ok && r < 6; r++)
+                for (int i = 0; i < 3; i++)
+                    ok = ok && fabs(t.jacobian[r][i] - ref.jacobian[r][i]) < 1e-12;
+            adaptimp_chain_free(ch);
+        }
+        snprintf(what, sizeof what, "joint axis × %g", scales[k]);
+        outcome(what, scales[k] >= 1e-11 ? ACCEPT : REFUSE, s, ok);
+    }
+    /* Rates: the tip's J̇ q̇ finite or refused, never NaN with OK. */
+    for (int b = 0; b < NBAD; b++) {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        AdaptimpChain *ch = NULL;
+        if (adaptimp_chain_new(j, 4, &tip, &ch) != ADAPTIMP_STATUS_OK) abort();
+        double dq[3] = {BAD[b], 0.1, 0.0};
+        AdaptimpTip t;
+        const AdaptimpStatus s = adaptimp_chain_tip(ch, 3, Q0, dq, &t);
+        snprintf(what, sizeof what, "chain_tip dq[0] = %g", BAD[b]);
+        const int bad = !isfinite(BAD[b]) || fabs(BAD[b]) > 1e6;
+        outcome(what, bad ? REFUSE : ACCEPT, s,
+                s != ADAPTIMP_STATUS_OK || (finite_all(t.bias, 6) && finite_all(t.position, 3)));
+        double q[3] = {Q0[0], BAD[b], Q0[2]};
+        const AdaptimpStatus s2 = adaptimp_chain_tip(ch, 3, q, NULL, &t);
+        snprintf(what, sizeof what, "chain_tip q[1] = %g", BAD[b]);
+        outcome(what, bad ? REFUSE : ACCEPT, s2,
+                s2 != ADAPTIMP_STATUS_OK || (finite_all(t.bias, 6) && finite_all(t.position, 3)));
+        adaptimp_chain_free(ch);
+    }
+    /* Orbits: a huge `nodes` allocates no more than one sample a step; a
+       zero one is refused; the number of steps is bounded. */
+    {
+        AdaptimpJoint j[4];
+        AdaptimpTransform tip;
+        arm(j, &tip);
+        AdaptimpChain *ch = NULL;
+        if (adaptimp_chain_new(j, 4, &tip, &ch) != ADAPTIMP_STATUS_OK) abort();
+        AdaptimpPoseTarget path[8];
+        for (int k = 0; k < 8; k++) path[k] = start_target();
+        const double tube[2] = {0.05, 0.2};
+        static double centres[8 * 12];
+        double w2[12];
+        const size_t nodes[] = {1, 8, 9, (size_t)1 << 40, SIZE_MAX / 96, 0};
+        for (size_t k = 0; k < sizeof nodes / sizeof nodes[0]; k++) {
+            size_t written = 99;
+            /* The contract is room for `nodes` rows: the huge ones get NULL
+               (refused before anything is allocated or written). */
+            double *out = nodes[k] <= 9 ? centres : NULL;
+            const AdaptimpStatus s = adaptimp_cartesian_orbit_centres(
+                ch, &cp, 1e-3, 3, Q0, path, 8, nodes[k], tube, out, w2, &written);
+            snprintf(what, sizeof what, "orbit_centres nodes = %zu", nodes[k]);
+            const int good = nodes[k] >= 1 && nodes[k] <= 9;
+            outcome(what, good ? ACCEPT : REFUSE, s,
+                    s != ADAPTIMP_STATUS_OK || written == (nodes[k] < 8 ? nodes[k] : 8));
+        }
+        adaptimp_chain_free(ch);
+    }
+}
+
+/* ---- Robot descriptions: adaptimp_chain_from_urdf. ---- */
+
+/* A 4-joint arm (3 revolute, one prismatic rail on a finger, which the rule
+   holds) with one field replaced by `value` when `field` >= 0. */
+static const char *URDF_FIELDS[] = {
+    "origin xyz", "origin rpy", "axis xyz", "mass", "inertia ixx", "limit lower",
+    "limit upper", "limit effort", "limit velocity", "dynamics damping",
+    "dynamics friction", "mimic multiplier"};
+enum { NURDF_FIELDS = sizeof URDF_FIELDS / sizeof URDF_FIELDS[0] };
+static const char *URDF_VALUES[] = {"nan",  "inf",  "-inf", "1e400",  "1e200", "-1", "0",
+                                    "1e-320", "abc", "",     "1 2",    "0 0 0", "1e9 0 0",
+                                    "0 0 1e200", "-0", "1e308 1e308 1e308"};
+enum { NURDF_VALUES = sizeof URDF_VALUES / sizeof URDF_VALUES[0] };
+
+static char *urdf_text(int field, const char *value) {
+    const char *v[NURDF_FIELDS];
+    static const char *normal[NURDF_FIELDS] = {"0 0 0.1", "0 0 0", "0 1 0", "0.5", "0.01",
+                                               "-2",      "2",     "10",    "3",   "0.1",
+                                               "0.05",    "1"};
+    for (int i = 0; i < NURDF_FIELDS; i++) v[i] = i == field ? value : normal[i];
+    size_t cap = 16384;
+    char *t = malloc(cap);
+    if (!t) abort();
+    int len = snprintf(t, cap, "<robot name='probe'><link name='base'/>");
+    const char *links[5] = {"base", "l1", "l2", "l3", "jaw"};
+    for (int j = 0; j < 4; j++) {
+        len += snprintf(
+            t + len, cap - (size_t)len,
+            "<link name='%s'><inertial><origin xyz='0 0 0.05'/><mass value='%s'/>"
+            "<inertia ixx='%s' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.01'/></inertial></link>"
+            "<joint name='j%d' type='%s'><parent link='%s'/><child link='%s'/>"
+            "<origin xyz='%s' rpy='%s'/><axis xyz='%s'/>"
+            "<limit lower='%s' upper='%s' effort='%s' velocity='%s'/>"
+            "<dynamics damping='%s' friction='%s'/>%s%s%s</joint>",
+            links[j + 1], v[3], v[4], j + 1, j == 3 ? "prismatic" : "revolute", links[j],
+            links[j + 1], v[0], v[1], v[2], v[5], v[6], v[7], v[8], v[9], v[10],
+            j == 3 ? "<mimic joint='j3' multiplier='" : "", j == 3 ? v[11] : "",
+            j == 3 ? "'/>" : "");
+    }
+    snprintf(t + len, cap - (size_t)len, "</robot>");
+    return t;
+}
+
+/* One call: its status, and the invariants: *out written exactly when OK
+   (preset to a sentinel), the chain's tip finite with every movable joint's
+   Jacobian column non-zero, the info's n the chain's, its drive terms finite
+   and not negative. */
+static int from_urdf(const char *source, const char *tip, const char *const *fix, size_t nfix,
+                     AdaptimpStatus *status) {
+    AdaptimpChain *sentinel = (AdaptimpChain *)(uintptr_t)0x10;
+    AdaptimpChain *ch = sentinel;
+    AdaptimpArmInfo info;
+    memset(&info, 0xff, sizeof info);
+    const AdaptimpStatus s = adaptimp_chain_from_urdf(source, tip, fix, nfix, &ch, &info);
+    *status = s;
+    if (s != ADAPTIMP_STATUS_OK) return ch == sentinel;
+    if (ch == sentinel || ch == NULL) return 0;
+    const size_t n = adaptimp_chain_joints(ch);
+    int ok = n >= 1 && n <= ADAPTIMP_MAX_JOINTS && info.n == n;
+    double q[ADAPTIMP_MAX_JOINTS], dq[ADAPTIMP_MAX_JOINTS];
+    for (size_t i = 0; i < n; i++) {
+        q[i] = 0.1 * (double)(i + 1);
+        dq[i] = -0.2;
+    }
+    AdaptimpTip t;
+    ok = ok && adaptimp_chain_tip(ch, n, q, dq, &t) == ADAPTIMP_STATUS_OK &&
+         finite_all(t.position, 3) && finite_all(&t.rotation[0][0], 9) && finite_all(t.bias, 6);
+    for (size_t i = 0; ok && i < n; i++) {
+        double norm = 0.0;
+        for (int r = 0; r < 6; r++) norm += t.jacobian[r][i] * t.jacobian[r][i];
+        ok = norm > 0.0 && isfinite(norm) && !isnan(info.lower[i]) && !isnan(info.upper[i]) &&
+             !(info.lower[i] > info.upper[i]) &&
+             isfinite(info.damping[i]) && info.damping[i] >= 0.0 &&
+             isfinite(info.friction[i]) && info.friction[i] >= 0.0 &&
+             !(info.effort[i] <= 0.0) && !(info.velocity[i] <= 0.0);
+    }
+    /* Freed, its handle is dead: refused, never read. */
+    adaptimp_chain_free(ch);
+    ok = ok && adaptimp_chain_joints(ch) == 0 &&
+         adaptimp_chain_tip(ch, n, q, dq, &t) == ADAPTIMP_STATUS_BAD_HANDLE;
+    adaptimp_chain_free(ch); /* twice: ignored */
+    return ok;
+}
+
+static void descriptions(void) {
+    char what[200];
+    AdaptimpStatus s;
+    /* Sources no arm is read from. */
+    char *deep = malloc(7 * 100000 + 64);
+    if (!deep) abort();
+    size_t len = (size_t)sprintf(deep, "<robot name='r'>");
+    for (int i = 0; i < 100000; i++) len += (size_t)sprintf(deep + len, "<a>");
+    for (int i = 0; i < 100000; i++) len += (size_t)sprintf(deep + len, "</a>");
+    sprintf(deep + len, "</robot>");
+    char xacro_text[] =
+        "<robot name='x' xmlns:xacro='http://www.ros.org/wiki/xacro'>"
+        "<xacro:property name='l' value='1'/><link name='a'/></robot>";
+    char nine[8192];
+    int n9 = snprintf(nine, sizeof nine, "<robot name='nine'><link name='l0'/>");
+    for (int i = 1; i <= 9; i++)
+        n9 += snprintf(nine + n9, sizeof nine - (size_t)n9,
+                       "<link name='l%d'/><joint name='j%d' type='continuous'><parent link='l%d'/>"
+                       "<child link='l%d'/><origin xyz='0 0 0.1'/><axis xyz='0 1 0'/></joint>",
+                       i, i, i - 1, i);
+    snprintf(nine + n9, sizeof nine - (size_t)n9, "</robot>");
+    struct {
+        const char *name, *source;
+    } bad[] = {
+        {"NULL", NULL},
+        {"an empty string", ""},
+        {"bytes that are not UTF-8", "\xff\xfe<robot/>"},
+        {"a directory", "/"},
+        {"a device that never ends", "/dev/zero"},
+        {"a file that is not there", "/nonexistent/arm.urdf"},
+        {"'<'", "<"},
+        {"an unclosed root", "<robot name='x'><link name='a'>"},
+        {"improper nesting", "<robot><a></robot></a>"},
+        {"an empty robot", "<robot name='x'/>"},
+        {"a link and no joint", "<robot name='x'><link name='a'/></robot>"},
+        {"MJCF text", "<mujoco><worldbody/></mujoco>"},
+        {"xacro text", xacro_text},
+        {"100 000 nested elements", deep},
+        {"a loop", "<robot name='x'><link name='a'/><link name='b'/>"
+                   "<joint name='j' type='revolute'><parent link='a'/><child link='b'/>"
+                   "<limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+                   "<joint name='k' type='revolute'><parent link='b'/><child link='a'/>"
+                   "<limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>"},
+        {"a joint to a missing link", "<robot name='x'><link name='a'/>"
+                   "<joint name='j' type='continuous'><parent link='a'/><child link='b'/></joint>"
+                   "</robot>"},
+        {"nine joints", nine},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        const int ok = from_urdf(bad[i].source, NULL, NULL, 0, &s);
+        snprintf(what, sizeof what, "source: %s", bad[i].name);
+        outcome(what, REFUSE, s, ok);
+        if (i == 0 && s != ADAPTIMP_STATUS_NULL_POINTER) note("%s: not NULL_POINTER%s", what, "");
+        if (bad[i].source == nine && s != ADAPTIMP_STATUS_BAD_SIZE)
+            note("%s: not BAD_SIZE%s", what, "");
+    }
+    free(deep);
+    /* Every field of every joint's element replaced by a bad value. */
+    for (int f = 0; f < NURDF_FIELDS; f++) {
+        for (int v = 0; v < NURDF_VALUES; v++) {
+            char *text = urdf_text(f, URDF_VALUES[v]);
+            const int ok = from_urdf(text, NULL, NULL, 0, &s);
+            snprintf(what, sizeof what, "%s = '%s'", URDF_FIELDS[f], URDF_VALUES[v]);
+            outcome(what, EITHER, s, ok);
+            free(text);
+        }
+    }
+    /* A good arm: tips and fixes, good and bad strings. */
+    char *good = urdf_text(-1, "");
+    const int ok = from_urdf(good, NULL, NULL, 0, &s);
+    outcome("the probe's arm", ACCEPT, s, ok);
+    struct {
+        const char *name, *tip;
+        int expect;
+    } tips[] = {
+        {"tip NULL", NULL, ACCEPT},     {"tip l2", "l2", ACCEPT},
+        {"tip base", "base", REFUSE},   {"tip ''", "", REFUSE},
+        {"tip not UTF-8", "\xc3\x28", REFUSE}, {"tip missing", "no_such_link", REFUSE},
+        {"tip the jaw (beyond the rail)", "jaw", EITHER},
+        {"tip a joint's name", "j1", REFUSE},
+    };
+    for (size_t i = 0; i < sizeof tips / sizeof tips[0]; i++) {
+        const int good_ok = from_urdf(good, tips[i].tip, NULL, 0, &s);
+        outcome(tips[i].name, tips[i].expect, s, good_ok);
+    }
+    const char *fix_j2[] = {"j2"}, *fix_null[] = {"j1", NULL}, *fix_bad[] = {"\xff"},
+               *fix_none[] = {"nope"}, *fix_twice[] = {"j2", "j2"},
+               *fix_all[] = {"j1", "j2", "j3", "j4"};
+    struct {
+        const char *name;
+        const char *const *fix;
+        size_t n;
+        int expect;
+    } fixes[] = {
+        {"fix j2", fix_j2, 1, ACCEPT},
+        {"fix NULL with nfix 2", NULL, 2, REFUSE},
+        {"fix holding NULL", fix_null, 2, REFUSE},
+        {"fix not UTF-8", fix_bad, 1, REFUSE},
+        {"fix an unknown joint", fix_none, 1, REFUSE},
+        {"fix a joint twice", fix_twice, 2, EITHER},
+        {"fix every joint", fix_all, 4, REFUSE},
+        {"fix NULL with nfix 0", NULL, 0, ACCEPT},
+    };
+    for (size_t i = 0; i < sizeof fixes / sizeof fixes[0]; i++) {
+        const int fix_ok = from_urdf(good, NULL, fixes[i].fix, fixes[i].n, &s);
+        outcome(fixes[i].name, fixes[i].expect, s, fix_ok);
+    }
+    /* out NULL: refused, nothing leaked; info NULL: accepted. */
+    s = adaptimp_chain_from_urdf(good, NULL, NULL, 0, NULL, NULL);
+    outcome("out NULL", REFUSE, s, 1);
+    AdaptimpChain *ch = NULL;
+    s = adaptimp_chain_from_urdf(good, NULL, NULL, 0, &ch, NULL);
+    outcome("info NULL", ACCEPT, s, ch != NULL);
+    /* The chain it made is a chain and nothing else: as any other kind it is
+       refused; a Cartesian controller can be built on it. */
+    const size_t n = adaptimp_chain_joints(ch);
+    const int mistyped =
+        n == 2 && /* j3 drives the mimic j4: both held, the gripper's */
+        !adaptimp_state_fault((AdaptimpState *)ch, NULL) &&
+        !adaptimp_cartesian_state_fault((AdaptimpCartesianState *)ch, NULL) &&
+        adaptimp_state_steps((AdaptimpState *)ch) == 0 &&
+        adaptimp_cartesian_state_steps((AdaptimpCartesianState *)ch) == 0 &&
+        adaptimp_controller_joints((AdaptimpController *)ch) == 0 &&
+        adaptimp_cartesian_joints((AdaptimpCartesian *)ch) == 0;
+    outcome("its chain as every other kind", EITHER, ADAPTIMP_STATUS_OK, mistyped);
+    AdaptimpCartesianParams cp;
+    AdaptimpParams p;
+    if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK ||
+        adaptimp_params_default(&p, 2, ADAPTIMP_LAW_STATE_FEEDBACK, ADAPTIMP_PRESET_ROBOT) !=
+            ADAPTIMP_STATUS_OK)
+        abort();
+    p.impedance = ADAPTIMP_IMPEDANCE_EXTERNAL;
+    static double centre[4 * 2 * 4];
+    for (int i = 0; i < 4 * 2 * 4; i++) centre[i] = 0.05 * (i % 5) - 0.1;
+    p.centers = centre;
+    p.nodes = 4;
+    AdaptimpCartesian *cart = NULL;
+    s = adaptimp_cartesian_new(ch, &cp, &p, &cart);
+    outcome("a Cartesian controller on it", ACCEPT, s, cart != NULL);
+    adaptimp_cartesian_free(cart);
+    adaptimp_chain_free(ch);
+    free(good);
+}
+
+/* ---- Forged handles at every entry point. ---- */
+
+/* The live handles of one world; every entry point is called with one of its
+   handle arguments replaced by a bad one, the others live. */
+typedef struct {
+    AdaptimpController *ctrl;
+    AdaptimpState *state;
+    AdaptimpChain *chain;
+    AdaptimpCartesian *cart;
+    AdaptimpCartesianState *cstate;
+} World;
+
+enum { KIND_CTRL, KIND_STATE, KIND_CHAIN, KIND_CART, KIND_CSTATE, NKINDS };
+static const char *KIND_NAMES[NKINDS] = {"controller", "state", "chain", "Cartesian",
+                                         "Cartesian state"};
+
+static void open_world(World *w) {
+    AdaptimpParams p = robot(ADAPTIMP_LAW_STATE_FEEDBACK);
+    if (adaptimp_controller_new(&p, &w->ctrl) != ADAPTIMP_STATUS_OK ||
+        adaptimp_state_new(w->ctrl, &w->state) != ADAPTIMP_STATUS_OK)
+        abort();
+    AdaptimpJoint j[4];
+    AdaptimpTransform tip;
+    arm(j, &tip);
+    if (adaptimp_chain_new(j, 4, &tip, &w->chain) != ADAPTIMP_STATUS_OK) abort();
+    AdaptimpCartesianParams cp;
+    if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+    Cart c;
+    if (open_cart(&cp, &c) != ADAPTIMP_STATUS_OK) abort();
+    w->cart = c.cart;
+    w->cstate = c.state;
+}
+
+static void close_world(World *w) {
+    adaptimp_cartesian_state_free(w->cstate);
+    adaptimp_cartesian_free(w->cart);
+    adaptimp_chain_free(w->chain);
+    adaptimp_state_free(w->state);
+    adaptimp_controller_free(w->ctrl);
+}
+
+/* The live handle of `kind` in `w`. */
+static void *live_of(const World *w, int kind) {
+    switch (kind) {
+    case KIND_CTRL: return w->ctrl;
+    case KIND_STATE: return w->state;
+    case KIND_CHAIN: return w->chain;
+    case KIND_CART: return w->cart;
+    default: return w->cstate;
+    }
+}
+
+/* Each entry point and the kinds of its handle arguments (-1: none). */
+typedef struct {
+    const char *name;
+    int kinds[2];
+} Entry;
+
+static const Entry ENTRIES[] = {
+    {"adaptimp_controller_joints", {KIND_CTRL, -1}},
+    {"adaptimp_controller_period", {KIND_CTRL, -1}},
+    {"adaptimp_state_new", {KIND_CTRL, -1}},
+    {"adaptimp_state_buffer_size", {KIND_CTRL, -1}},
+    {"adaptimp_state_init", {KIND_CTRL, -1}},
+    {"adaptimp_state_reset", {KIND_STATE, -1}},
+    {"adaptimp_state_fault", {KIND_STATE, -1}},
+    {"adaptimp_state_clear_fault", {KIND_STATE, -1}},
+    {"adaptimp_state_steps", {KIND_STATE, -1}},
+    {"adaptimp_state_applied", {KIND_STATE, -1}},
+    {"adaptimp_state_snapshot_len", {KIND_STATE, -1}},
+    {"adaptimp_state_save", {KIND_STATE, -1}},
+    {"adaptimp_state_restore", {KIND_CTRL, KIND_STATE}},
+    {"adaptimp_step", {KIND_CTRL, KIND_STATE}},
+    {"adaptimp_chain_joints", {KIND_CHAIN, -1}},
+    {"adaptimp_chain_tip", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_new", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_orbit_centres", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_joints", {KIND_CART, -1}},
+    {"adaptimp_cartesian_period", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_new", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_buffer_size", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_init", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_reset", {KIND_CART, KIND_CSTATE}},
+    {"adaptimp_cartesian_set_stiffness", {KIND_CART, KIND_CSTATE}},
+    {"adaptimp_cartesian_step", {KIND_CART, KIND_CSTATE}},
+    {"adaptimp_cartesian_set_posture", {KIND_CART, KIND_CSTATE}},
+    {"adaptimp_cartesian_state_fault", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_state_clear_fault", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_state_steps", {KIND_CSTATE, -1}},
+    {"adaptimp_cartesian_state_applied", {KIND_CSTATE, -1}},
+    /* The frees last: a bad handle is ignored, the live ones stay live. */
+    {"adaptimp_controller_free", {KIND_CTRL, -1}},
+    {"adaptimp_state_free", {KIND_STATE, -1}},
+    {"adaptimp_chain_free", {KIND_CHAIN, -1}},
+    {"adaptimp_cartesian_free", {KIND_CART, -1}},
+    {"adaptimp_cartesian_state_free", {KIND_CSTATE, -1}},
+};
+enum { NENTRIES = sizeof ENTRIES / sizeof ENTRIES[0] };
+
+/* Call entry `e` with the handle of `kind` h[kind] (the others as given):
+   1 if it refused as it must (BAD_HANDLE or NULL_POINTER, a getter's "none"
+   value, outputs untouched or zeroed as documented), 0 otherwise; *status the
+   status (OK for the void and value-returning ones that refused). */
+static int call_entry(int e, void *h[NKINDS], AdaptimpStatus *status) {
+    AdaptimpController *ctrl = h[KIND_CTRL];
+    AdaptimpState *state = h[KIND_STATE];
+    AdaptimpChain *chain = h[KIND_CHAIN];
+    AdaptimpCartesian *cart = h[KIND_CART];
+    AdaptimpCartesianState *cstate = h[KIND_CSTATE];
+    static const double q3[3] = {0.1, 0.05, -0.2}, zero6[6] = {0}, kd[3] = {100, 100, 100};
+    double q2[2], dq2[2], te2[2];
+    inputs(0, q2, dq2, te2);
+    double buf[16] = {0};
+    static uint64_t mem[1 << 14];
+    size_t size = 7, align = 7, written = 7;
+    uint64_t step = 77;
+    const char *name = ENTRIES[e].name;
+    AdaptimpStatus s = ADAPTIMP_STATUS_OK;
+    int ok = 1;
+    /* A refusal of a handle: BAD_HANDLE, or NULL_POINTER for NULL. */
+#define REFUSED(st) ((st) == ADAPTIMP_STATUS_BAD_HANDLE || (st) == ADAPTIMP_STATUS_NULL_POINTER)
+    if (!strcmp(name, "adaptimp_controller_joints")) {
+        ok = adaptimp_controller_joints(ctrl) == 0;
+    } else if (!strcmp(name, "adaptimp_controller_period")) {
+        ok = isnan(adaptimp_controller_period(ctrl));
+    } else if (!strcmp(name, "adaptimp_state_new")) {
+        AdaptimpState *o = NULL;
+        s = adaptimp_state_new(ctrl, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_state_buffer_size")) {
+        s = adaptimp_state_buffer_size(ctrl, &size, &align);
+        ok = REFUSED(s) && size == 7 && align == 7;
+    } else if (!strcmp(name, "adaptimp_state_init")) {
+        AdaptimpState *o = NULL;
+        s = adaptimp_state_init(ctrl, mem, sizeof mem, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_state_reset")) {
+        s = adaptimp_state_reset(state);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_state_fault")) {
+        ok = !adaptimp_state_fault(state, &step) && step == 77;
+    } else if (!strcmp(name, "adaptimp_state_clear_fault")) {
+        s = adaptimp_state_clear_fault(state);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_state_steps")) {
+        ok = adaptimp_state_steps(state) == 0;
+    } else if (!strcmp(name, "adaptimp_state_applied")) {
+        double tau[2] = {7, 7};
+        s = adaptimp_state_applied(state, 2, tau);
+        ok = REFUSED(s) && tau[0] == 7 && tau[1] == 7;
+    } else if (!strcmp(name, "adaptimp_state_snapshot_len")) {
+        ok = adaptimp_state_snapshot_len(state) == 0;
+    } else if (!strcmp(name, "adaptimp_state_save")) {
+        s = adaptimp_state_save(state, buf, 16, &written);
+        ok = REFUSED(s) && written == 7 && buf[0] == 0;
+    } else if (!strcmp(name, "adaptimp_state_restore")) {
+        s = adaptimp_state_restore(ctrl, state, buf, 16);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_step")) {
+        AdaptimpCommand c;
+        memset(&c, 0xAB, sizeof c);
+        s = adaptimp_step(ctrl, state, 2, q2, dq2, te2, NULL, &c);
+        ok = REFUSED(s) && c.n == 0 && c.tau_sat[0] == 0.0;
+    } else if (!strcmp(name, "adaptimp_chain_joints")) {
+        ok = adaptimp_chain_joints(chain) == 0;
+    } else if (!strcmp(name, "adaptimp_chain_tip")) {
+        AdaptimpTip t;
+        memset(&t, 0xAB, sizeof t);
+        s = adaptimp_chain_tip(chain, 3, q3, NULL, &t);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_new")) {
+        AdaptimpCartesianParams cp;
+        if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+        AdaptimpParams p;
+        if (adaptimp_params_default(&p, 3, ADAPTIMP_LAW_PD, ADAPTIMP_PRESET_ROBOT) !=
+            ADAPTIMP_STATUS_OK)
+            abort();
+        p.impedance = ADAPTIMP_IMPEDANCE_EXTERNAL;
+        AdaptimpCartesian *o = NULL;
+        s = adaptimp_cartesian_new(chain, &cp, &p, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_cartesian_orbit_centres")) {
+        AdaptimpCartesianParams cp;
+        if (adaptimp_cartesian_params_default(&cp) != ADAPTIMP_STATUS_OK) abort();
+        AdaptimpPoseTarget t = start_target();
+        const double tube[2] = {0.05, 0.2};
+        double centres[4 * 12], w2[12];
+        s = adaptimp_cartesian_orbit_centres(chain, &cp, 1e-3, 3, q3, &t, 1, 4, tube, centres, w2,
+                                             &written);
+        ok = REFUSED(s) && written == 7;
+    } else if (!strcmp(name, "adaptimp_cartesian_joints")) {
+        ok = adaptimp_cartesian_joints(cart) == 0;
+    } else if (!strcmp(name, "adaptimp_cartesian_period")) {
+        ok = isnan(adaptimp_cartesian_period(cart));
+    } else if (!strcmp(name, "adaptimp_cartesian_state_new")) {
+        AdaptimpCartesianState *o = NULL;
+        s = adaptimp_cartesian_state_new(cart, 3, q3, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_buffer_size")) {
+        s = adaptimp_cartesian_state_buffer_size(cart, &size, &align);
+        ok = REFUSED(s) && size == 7 && align == 7;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_init")) {
+        AdaptimpCartesianState *o = NULL;
+        s = adaptimp_cartesian_state_init(cart, 3, q3, mem, sizeof mem, &o);
+        ok = REFUSED(s) && o == NULL;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_reset")) {
+        s = adaptimp_cartesian_state_reset(cart, cstate, 3, NULL);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_set_stiffness")) {
+        s = adaptimp_cartesian_set_stiffness(cart, cstate, kd, kd);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_step")) {
+        AdaptimpCartesianCommand c;
+        memset(&c, 0xAB, sizeof c);
+        s = adaptimp_cartesian_step(cart, cstate, 3, q3, q3, zero6, NULL, &c);
+        ok = REFUSED(s) && c.n == 0 && c.tau_sat[0] == 0.0;
+    } else if (!strcmp(name, "adaptimp_cartesian_set_posture")) {
+        s = adaptimp_cartesian_set_posture(cart, cstate, 3, q3);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_state_fault")) {
+        ok = !adaptimp_cartesian_state_fault(cstate, &step) && step == 77;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_clear_fault")) {
+        s = adaptimp_cartesian_state_clear_fault(cstate);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_cartesian_state_steps")) {
+        ok = adaptimp_cartesian_state_steps(cstate) == 0;
+    } else if (!strcmp(name, "adaptimp_cartesian_state_applied")) {
+        double tau[3] = {7, 7, 7};
+        s = adaptimp_cartesian_state_applied(cstate, 3, tau);
+        ok = REFUSED(s) && tau[0] == 7;
+    } else if (!strcmp(name, "adaptimp_controller_free")) {
+        adaptimp_controller_free(ctrl);
+    } else if (!strcmp(name, "adaptimp_state_free")) {
+        adaptimp_state_free(state);
+    } else if (!strcmp(name, "adaptimp_chain_free")) {
+        adaptimp_chain_free(chain);
+    } else if (!strcmp(name, "adaptimp_cartesian_free")) {
+        adaptimp_cartesian_free(cart);
+    } else if (!strcmp(name, "adaptimp_cartesian_state_free")) {
+        adaptimp_cartesian_state_free(cstate);
+    } else {
+        abort();
+    }
+#undef REFUSED
+    /* A status-returning call names the bad argument in its message. */
+    if (s != ADAPTIMP_STATUS_OK) {
+        const char *msg = adaptimp_last_error();
+        ok = ok && (strstr(msg, "not a live") || strstr(msg, "is a live") || strstr(msg, "is NULL"));
+    }
+    *status = s;
+    return ok;
+}
+
+/* The world still works: each live handle answers, and the two states were
+   not stepped by anything but this check. */
+static int world_intact(const World *w, uint64_t steps, uint64_t csteps) {
+    return adaptimp_controller_joints(w->ctrl) == 2 && adaptimp_state_steps(w->state) == steps &&
+           adaptimp_chain_joints(w->chain) == 3 && adaptimp_cartesian_joints(w->cart) == 3 &&
+           adaptimp_cartesian_state_steps(w->cstate) == csteps;
+}
+
+static void forged(void) {
+    World w;
+    open_world(&w);
+    /* Freed handles of each kind: made, freed (the next handles may reuse
+       their memory: a stale one must not reach the new object). */
+    World dead;
+    open_world(&dead);
+    close_world(&dead);
+    World after; /* made after the frees: the memory of the dead ones */
+    open_world(&after);
+    /* Memory a foreign pointer may point to: 8 readable bytes before an
+       unmapped page, zeroed memory, memory that looks like a handle's tag,
+       small integers and unmapped addresses, a live handle's number + 1. */
+    const long page = sysconf(_SC_PAGESIZE);
+    const int zero_fd = open("/dev/zero", O_RDWR); /* POSIX: no MAP_ANONYMOUS in 2008 */
+    unsigned char *pages =
+        mmap(NULL, 2 * (size_t)page, PROT_READ | PROT_WRITE, MAP_PRIVATE, zero_fd, 0);
+    if (pages == MAP_FAILED || munmap(pages + page, (size_t)page) != 0) abort();
+    close(zero_fd);
+    memset(pages, 0, (size_t)page);
+    static uint64_t zeros[512];
+    static uint64_t looks[4];
+    memcpy(&looks[0], "adpSTATE", 8);
+    enum { NFORGED = 8 };
+    void *foreign[NFORGED] = {pages + page - 8, pages + page - 64, zeros, looks,
+                              (void *)(uintptr_t)0x1000, (void *)(uintptr_t)1,
+                              (void *)(uintptr_t)(UINTPTR_MAX - 7), NULL};
+    static const char *foreign_names[NFORGED] = {
+        "8 bytes before an unmapped page", "64 bytes before an unmapped page", "zeroed memory",
+        "memory that looks like a state",  "address 0x1000", "address 1", "the top address",
+        "a live handle's number + 1"};
+    char what[200];
+    for (int e = 0; e < NENTRIES; e++) {
+        for (int a = 0; a < 2; a++) {
+            const int kind = ENTRIES[e].kinds[a];
+            if (kind < 0) continue;
+            /* The bad values for this argument: NULL, the freed handle of its
+               kind, a live handle of each other kind, each foreign pointer. */
+            void *bad[2 + NKINDS + NFORGED];
+            const char *bad_names[2 + NKINDS + NFORGED];
+            char other_names[NKINDS][64];
+            int nbad = 0;
+            bad[nbad] = NULL;
+            bad_names[nbad++] = "NULL";
+            bad[nbad] = live_of(&dead, kind);
+            bad_names[nbad++] = "freed (its memory reused)";
+            for (int k = 0; k < NKINDS; k++) {
+                if (k == kind) continue;
+                snprintf(other_names[k], sizeof other_names[k], "a live %s", KIND_NAMES[k]);
+                bad[nbad] = live_of(&w, k);
+                bad_names[nbad++] = other_names[k];
+            }
+            foreign[NFORGED - 1] = (void *)((uintptr_t)live_of(&w, kind) + 1);
+            for (int f = 0; f < NFORGED; f++) {
+                bad[nbad] = foreign[f];
+                bad_names[nbad++] = foreign_names[f];
+            }
+            for (int b = 0; b < nbad; b++) {
+                void *h[NKINDS];
+                for (int k = 0; k < NKINDS; k++) h[k] = live_of(&w, k);
+                h[kind] = bad[b];
+                AdaptimpStatus s;
+                int ok = call_entry(e, h, &s);
+                ok = ok && world_intact(&w, 0, 0) && world_intact(&after, 0, 0);
+                snprintf(what, sizeof what, "%s, %s argument: %s", ENTRIES[e].name,
+                         KIND_NAMES[kind], bad_names[b]);
+                T.cases++;
+                if (!ok) {
+                    T.wrong++;
+                    note("%s: not refused as it must be (%s)", what, adaptimp_last_error());
+                } else {
+                    T.clear++;
+                }
+            }
+        }
+    }
+    /* The live ones still step. */
+    double q[2], dq[2], te[2];
+    inputs(0, q, dq, te);
+    AdaptimpCommand c;
+    const AdaptimpStatus s = adaptimp_step(w.ctrl, w.state, 2, q, dq, te, NULL, &c);
+    outcome("the live world steps after every forged call", ACCEPT, s,
+            c.n == 2 && world_intact(&w, 1, 0));
+    munmap(pages, (size_t)page);
+    close_world(&after);
+    close_world(&w);
+}
+
 /* ---- The driver. ---- */
 
 typedef struct {
@@ -952,6 +1677,8 @@ typedef struct {
 static const Category CATEGORIES[] = {
     {"parameters", construction}, {"steps and fallbacks", steps}, {"snapshots", snapshots},
     {"handles and buffers", handles}, {"chains", chains},        {"Cartesian", cartesian},
+    {"forged handles", forged},       {"postures, axes, orbits", postures},
+    {"robot descriptions", descriptions},
 };
 
 int main(void) {

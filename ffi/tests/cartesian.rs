@@ -779,3 +779,91 @@ fn the_cartesian_defaults_are_the_schemas() {
     assert_eq!(c.force_feedforward, AdaptimpBoolRaw(1));
     assert_eq!((c.clik_kp, c.clik_kd), (core.clik_kp, core.clik_kd));
 }
+
+#[test]
+fn a_posture_or_start_far_out_of_range_is_refused_when_given_by_name() {
+    // Issue 33 C: set_posture(1e7) returned OK, then every step was OUT_OF_RANGE.
+    let p = pair(AdaptimpLaw::Pd, Law::Pd);
+    let far = [0.1, 1e7, 0.0];
+    // SAFETY: valid handles; arrays of N reals.
+    unsafe {
+        let s = adaptimp_cartesian_set_posture(p.cart, p.state, N, far.as_ptr());
+        assert_eq!(s, AdaptimpStatus::InvalidConfig);
+        assert_eq!(
+            last_error(),
+            "posture[1] = 1e7 is beyond its limit ±1e6; the state was left unchanged"
+        );
+        // Within the ceiling, but farther than the posture task may pull.
+        let pull = [Q0[0], Q0[1], 1e5];
+        let s = adaptimp_cartesian_set_posture(p.cart, p.state, N, pull.as_ptr());
+        assert_eq!(s, AdaptimpStatus::InvalidConfig);
+        assert!(
+            last_error().contains("null_k·|posture − q_d|[2]"),
+            "{}",
+            last_error()
+        );
+        let mut state = ptr::null_mut();
+        let s = adaptimp_cartesian_state_new(p.cart, N, far.as_ptr(), &mut state);
+        assert_eq!(s, AdaptimpStatus::InvalidConfig);
+        assert!(state.is_null());
+        assert_eq!(
+            last_error(),
+            "q0[1] = 1e7 is beyond its limit ±1e6; the state was left unchanged"
+        );
+        let s = adaptimp_cartesian_state_reset(p.cart, p.state, N, far.as_ptr());
+        assert_eq!(s, AdaptimpStatus::InvalidConfig);
+        // Nothing changed: the loop steps as a twin that never saw them.
+        let near = [Q0[0] + 0.1, Q0[1], Q0[2]];
+        assert_eq!(
+            adaptimp_cartesian_set_posture(p.cart, p.state, N, near.as_ptr()),
+            AdaptimpStatus::Ok
+        );
+    }
+    for _ in 0..5 {
+        let (s, out) = step(&p, &Q0, Some(&[0.0; N]), &[0.0; 6], None);
+        assert_eq!(s, AdaptimpStatus::Ok, "{}", last_error());
+        assert!(out.tau_sat[..N].iter().all(|t| t.is_finite()));
+    }
+}
+
+#[test]
+fn an_axis_whose_norm_overflows_is_normalised_and_a_huge_rate_refused() {
+    // Issue 33 F: [0, 0, 1e200] made a zero axis (J = 0, fk ignoring q).
+    let (mut js, tip) = joints();
+    let (mut big, mut unit) = (ptr::null_mut(), ptr::null_mut());
+    // SAFETY: valid arrays and out pointers.
+    unsafe {
+        assert_eq!(
+            adaptimp_chain_new(js.as_ptr(), js.len(), &tip, &mut unit),
+            AdaptimpStatus::Ok
+        );
+        js[1].axis = [0.0, 0.0, 1e200];
+        assert_eq!(
+            adaptimp_chain_new(js.as_ptr(), js.len(), &tip, &mut big),
+            AdaptimpStatus::Ok
+        );
+        let zero = std::mem::MaybeUninit::<AdaptimpTip>::zeroed();
+        let (mut a, mut b) = (zero.assume_init(), zero.assume_init());
+        assert_eq!(
+            adaptimp_chain_tip(unit, N, Q0.as_ptr(), ptr::null(), &mut a),
+            AdaptimpStatus::Ok
+        );
+        assert_eq!(
+            adaptimp_chain_tip(big, N, Q0.as_ptr(), ptr::null(), &mut b),
+            AdaptimpStatus::Ok
+        );
+        assert_eq!(a, b);
+        assert!(b.jacobian[5][0] != 0.0);
+        // A rate whose J̇ q̇ overflowed (NaN with OK): refused by name.
+        let huge = [1e200, 0.0, 0.0];
+        let mut c = a;
+        let s = adaptimp_chain_tip(unit, N, Q0.as_ptr(), huge.as_ptr(), &mut c);
+        assert_eq!(s, AdaptimpStatus::OutOfRange);
+        assert_eq!(
+            last_error(),
+            "dq[0] = 1e200 is beyond its limit ±1e6; the state was left unchanged"
+        );
+        adaptimp_chain_free(big);
+        adaptimp_chain_free(unit);
+    }
+}

@@ -18,8 +18,8 @@ the project's SPEC (docs/SPEC.md).
 - :func:`sweep` runs many simulations (a grid or random samples) on every core
   or on a Dask cluster and returns a pandas DataFrame.
 - Errors by kind: :class:`ConfigError`, :class:`MeasurementError`,
-  :class:`DivergedError`, :class:`FaultError`; :class:`StabilityWarning`,
-  :class:`PlantWarning`.
+  :class:`DivergedError`, :class:`FaultError`, :class:`SaveError`;
+  :class:`StabilityWarning`, :class:`PlantWarning`.
 
 Every SPEC quantity is a keyword parameter with the paper's default
 (:data:`PARAMS`, :data:`SCENARIOS`)::
@@ -41,6 +41,7 @@ from ._errors import (
     FaultError,
     MeasurementError,
     PlantWarning,
+    SaveError,
     StabilityWarning,
     XacroError,
 )
@@ -76,6 +77,7 @@ __all__ = [
     "PlanarArm",
     "PlantWarning",
     "PoseTarget",
+    "SaveError",
     "SimResult",
     "StabilityWarning",
     "TwoLinkArm",

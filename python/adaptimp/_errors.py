@@ -44,6 +44,13 @@ class FaultError(AdaptimpError, RuntimeError):
     call ``clear_fault()`` once the cause is gone. A ``RuntimeError``."""
 
 
+class SaveError(AdaptimpError, ValueError):
+    """A file that cannot be read back as what was saved: not a save of
+    adaptimp's, truncated or damaged, of a format this version does not read,
+    or edited after it was saved (a recorded SHA-256 differs). The message
+    names the file and what is wrong. A ``ValueError``."""
+
+
 class StabilityWarning(UserWarning):
     """The chosen parameters are valid but known to be unstable in discrete
     time, e.g. explicit-Euler learning whose per-step gain exceeds Kp (the Jury
@@ -64,6 +71,7 @@ __all__ = [
     "FaultError",
     "MeasurementError",
     "PlantWarning",
+    "SaveError",
     "StabilityWarning",
     "XacroError",
 ]

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -316,11 +317,28 @@ def prepare_spec(
 ) -> Prepared:
     """:func:`prepare_file` for an ``MjSpec``, edited in place (give a copy);
     ``given`` names the source in the warnings ("the file", "the spec given")."""
+    # The plant's motors target joints by name: an unnamed one is named here
+    # (a model without actuators on unnamed joints failed in MuJoCo's compiler,
+    # "unknown transmission target '#0'").
+    for i, joint in enumerate(spec.joints):
+        if not joint.name:
+            joint.name = f"adaptimp_joint{i}"
+    for i, body in enumerate(spec.bodies):  # the contact sensor names its body
+        if not body.name:
+            body.name = f"adaptimp_body{i}"
     try:
         m0 = spec.compile()
     except ValueError as e:
         raise ValueError(f"{label}MuJoCo cannot compile the model: {e}") from None
-    arm = arm_of(m0, tip, fix)
+    try:
+        arm = arm_of(m0, tip, fix)
+    except ValueError as e:  # named by the file it is about
+        said = str(e)
+        if said.startswith(label):
+            raise
+        if label:  # the file says more than the compiled model's name
+            said = re.sub(r"^MuJoCo model '[^']*': ", "", said)
+        raise ValueError(f"{label}{said}") from None
     tree = arm_tree(m0, arm["joint_ids"])
     keep = set(arm["joint_ids"])
     lock = [j for j in range(m0.njnt) if j not in keep and int(m0.jnt_bodyid[j]) in tree]

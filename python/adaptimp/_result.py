@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -13,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ._errors import needs_extra
+from ._errors import SaveError, needs_extra
 from ._params import CASE_NAMES
 from ._plot import FIGURES, PLOT_KINDS, into
 
@@ -290,7 +291,18 @@ class SimResult:
             "params": np.array(json.dumps(self.params)),
             "record_every": np.array(record_every),
         }
+        # What every load checks, whatever the encoding: the digest of each
+        # array as saved (so a swapped, scaled or flipped array is refused),
+        # of each input and each metric.
+        record = {
+            "result": type(self).__name__,
+            "arrays": {name: _array_record(a) for name, a in arrays.items()},
+            "inputs": _input_digests(self.case, self.scenario, self.params, record_every),
+            "metrics": {k: _sha_json(v) for k, v in self.metrics.items()},
+        }
         if not compress:
+            # Plain float64 arrays, readable by NumPy alone; the record beside them.
+            meta["format"] = np.array(json.dumps({"version": FORMAT, "plain": True, **record}))
             np.savez(path, **{**arrays, **meta})
             return path
         # Only a SimResult of simulate() can be a run of the native loop; a
@@ -301,9 +313,7 @@ class SimResult:
             else None
         )
         stored, manifest = _encode(arrays, self.params, record_every, rerun)
-        manifest["inputs"] = _input_digests(self.case, self.scenario, self.params, record_every)
-        manifest["metrics"] = {k: _sha_json(v) for k, v in self.metrics.items()}
-        meta["format"] = np.array(json.dumps({"version": 3, **manifest}))
+        meta["format"] = np.array(json.dumps({"version": FORMAT, **manifest, **record}))
         np.savez_compressed(path, **{**stored, **meta})
         return path
 
@@ -311,49 +321,67 @@ class SimResult:
     def load(cls, path: str | os.PathLike[str]) -> SimResult:
         """Read a result written by :meth:`save` (by this or an earlier version).
 
-        The file's metrics are checked: against the SHA-256 of each that the
-        save recorded (a metric edited after the save is a ``ValueError``
-        naming it); in a file without that record (``compress=False``, an
-        earlier version) against its rows, where it holds every step: the
-        core's accumulator (the one the run used, bit for bit) recomputes them,
-        and a metric that differs is replaced, with a warning naming it and
-        both values (the impedance residual only where the parameters give the
-        target impedance, ``Dd``, ``Cd``, ``Gd``; not a MuJoCo run's).
+        Everything is checked before it is used: a file that is not a save of
+        adaptimp's, truncated or damaged, of an unknown format, or edited after
+        it was saved is a :class:`adaptimp.SaveError` naming the file and what
+        is wrong. A file of this version records the SHA-256 of every array
+        (stored plain, as differences, derived or left to the simulation), of
+        every input (case, scenario, parameters, rows kept) and of every metric:
+        the inputs are checked before the simulation is run again, each array
+        after it is decoded. In a file without that record (``compress=False``
+        of an earlier version, format 1) the metrics are checked against its
+        rows, where it holds every step: the core's accumulator recomputes them,
+        and a metric that differs is replaced, with a warning naming it and both
+        values (the impedance residual only where the parameters give the target
+        impedance, ``Dd``, ``Cd``, ``Gd``; not a MuJoCo run's).
+
+        ``SimResult.load`` of a MuJoCo run's file gives a
+        :class:`adaptimp.mujoco.MujocoResult` where ``adaptimp.mujoco`` imports.
         """
-        with np.load(path, allow_pickle=False) as f:
-            params = json.loads(str(f["params"]))
-            record_every = int(f["record_every"]) if "record_every" in f else 1
-            names = [*ARRAYS, *EXTRA_ARRAYS]
-            manifest = None
-            if "format" in f:
-                manifest = json.loads(str(f["format"]))
-                if manifest.get("version") not in (2, 3):
-                    raise ValueError(
-                        f"{path}: saved in format {manifest.get('version')!r}, which this "
-                        "version of adaptimp cannot read (it reads 1, 2 and 3)"
+        if cls is SimResult:
+            kind = _saved_kind(path)
+            if kind == "MujocoResult":
+                try:
+                    from .mujoco import MujocoResult
+                except ImportError:  # without the mujoco extra: its common arrays
+                    pass
+                else:
+                    return MujocoResult.load(path)
+        with _open(path) as f:
+            r = _Reader(path, f)
+            params = r.json("params", dict)
+            case, scenario = r.text("case"), r.text("scenario")
+            metrics = r.json("metrics", dict)
+            record_every = r.integer("record_every") if "record_every" in f else 1
+            manifest = r.manifest() if "format" in f else None
+            if manifest is None:  # format 1: plain float64 arrays
+                arrays = {name: r.array(name) for name in f if name not in _META}
+            else:
+                # The inputs before anything runs: an edited file is not simulated.
+                _check_inputs(path, case, scenario, params, record_every, manifest)
+                if manifest.get("plain"):
+                    arrays = {name: r.array(name) for name in f if name not in _META}
+                else:
+                    stored = {name: r.array(name) for name in f if name not in _META}
+                    _check_stored(path, stored, manifest)
+                    simulated = (
+                        _resimulated(path, case, scenario, params, record_every, manifest)
+                        if manifest.get("simulated")
+                        else {}
                     )
-                _check_inputs(
-                    path, str(f["case"]), str(f["scenario"]), params, record_every, manifest
-                )
-                simulated = (
-                    _resimulated(
-                        path, str(f["case"]), str(f["scenario"]), params, record_every, manifest
-                    )
-                    if manifest.get("simulated")
-                    else {}
-                )
-                arrays = _decode(f, manifest, params, record_every, simulated)
-            else:  # format 1: plain float64 arrays
-                arrays = {name: f[name] for name in f if name not in _META}
-            res = cls(
-                case=str(f["case"]),
-                scenario=str(f["scenario"]),
-                metrics=json.loads(str(f["metrics"])),
-                params=params,
-                record_every=record_every,
-                **{name: arrays[name] for name in names if name in arrays},
-                **cls._own_fields(arrays),
-            )
+                    arrays = _decode(path, stored, manifest, params, record_every, simulated)
+                _check_arrays(path, arrays, manifest)
+        _check_shapes(path, arrays, params, metrics)
+        names = [*ARRAYS, *EXTRA_ARRAYS]
+        res = cls(
+            case=case,
+            scenario=scenario,
+            metrics=metrics,
+            params=params,
+            record_every=record_every,
+            **{name: arrays[name] for name in names if name in arrays},
+            **cls._own_fields(arrays),
+        )
         _check_metrics(path, res, manifest)
         return res
 
@@ -376,12 +404,18 @@ class SimResult:
             if self.record_every == 1
             else f"{self.rows} rows (every {self.record_every}th step)"
         )
-        wall = "free space" if p["wall"] is None else f"wall at {p['wall']:g} rad"
+        wall = (
+            "free space"
+            if p.get("wall") is None
+            else f"wall at {p['wall']:g} rad"
+            if isinstance(p["wall"], (int, float))
+            else f"wall {p['wall']!r}"
+        )
         lines = [
             f"SimResult({self.case!r}: {CASE_NAMES.get(self.case, self.case)}, "
             f"scenario {self.scenario!r}; "
             f"{rows}, n = {self.n}, Ts = {p['Ts']:g} s, T = {t_end:g} s; {wall})",
-            f"  RMS ‖z1‖ = {m['rms_z1']:.4g} rad, over t ≥ {p['settle']:g} s: "
+            f"  RMS ‖z1‖ = {m['rms_z1']:.4g} rad, over t ≥ {p.get('settle', 2.0):g} s: "
             f"{m['rms_z1_after2']:.4g} rad "
             f"(per joint {_fmt_list(m['rms_z1_joint_after2'], '.4g')})",
             f"  saturated {100 * m['sat_duty']:.1f}% of steps; "
@@ -398,6 +432,253 @@ class SimResult:
 # ---------------------------------------------------------------------------
 
 _U64 = np.dtype("<u8")
+
+FORMAT = 4
+"""The format :meth:`SimResult.save` writes: 3 with the record of every array's,
+input's and metric's SHA-256 (``arrays``, ``inputs``, ``metrics``), required;
+``plain`` for ``compress=False``."""
+
+_VERSIONS = (2, 3, 4)
+"""The versions of the ``format`` entry :meth:`SimResult.load` reads (1 has none)."""
+
+
+def _saved_kind(path: str | os.PathLike[str]) -> str | None:
+    """The class that saved ``path`` (its format record's ``result``), if it says."""
+    try:
+        with _open(path) as f:
+            record = json.loads(str(f["format"])) if "format" in f else {}
+    except Exception:  # any damage is reported by the load itself
+        return None
+    kind = record.get("result") if isinstance(record, dict) else None
+    return kind if isinstance(kind, str) else None
+
+
+@contextlib.contextmanager
+def _open(path: str | os.PathLike[str]) -> Iterator[Any]:
+    """The archive of a saved result (closed after), or a SaveError naming the
+    file and why it is none (a missing file or a directory stays an OSError)."""
+    import zipfile
+    import zlib
+
+    with open(path, "rb") as fh:
+        try:
+            f = np.load(fh, allow_pickle=False)
+        except (zipfile.BadZipFile, EOFError, zlib.error, OSError, ValueError) as e:
+            raise SaveError(
+                f"{path}: not a result saved by SimResult.save (not a readable .npz archive: "
+                f"{type(e).__name__}: {e}); the file may be truncated"
+            ) from None
+        if not isinstance(f, np.lib.npyio.NpzFile):
+            raise SaveError(
+                f"{path}: a single NumPy array (.npy), not a result saved by SimResult.save (.npz)"
+            )
+        with f:
+            yield f
+
+
+class _Reader:
+    """The entries of a saved archive, each read with a SaveError naming the file
+    and the entry when it is missing, damaged or not what it must be."""
+
+    def __init__(self, path: str | os.PathLike[str], f: Any) -> None:
+        self.path, self.f = path, f
+
+    def fail(self, what: str) -> SaveError:
+        return SaveError(f"{self.path}: {what}")
+
+    def raw(self, name: str) -> NDArray[Any]:
+        import zipfile
+        import zlib
+
+        if name not in self.f:
+            raise self.fail(
+                f"the entry {name!r} is missing: not a result saved by SimResult.save, or truncated"
+            )
+        try:
+            return np.asarray(self.f[name])
+        except (zipfile.BadZipFile, EOFError, zlib.error, OSError, ValueError) as e:
+            raise self.fail(
+                f"the entry {name!r} cannot be read ({type(e).__name__}: {e}): the file is "
+                "damaged or truncated"
+            ) from None
+
+    def text(self, name: str) -> str:
+        a = self.raw(name)
+        if a.shape != () or a.dtype.kind != "U":
+            raise self.fail(f"the entry {name!r} is not a string (a {a.dtype} array {a.shape})")
+        return str(a)
+
+    def json(self, name: str, kind: type) -> Any:
+        try:
+            value = json.loads(self.text(name))
+        except json.JSONDecodeError as e:
+            raise self.fail(f"the entry {name!r} is not JSON ({e})") from None
+        if not isinstance(value, kind):
+            raise self.fail(
+                f"the entry {name!r} is not a JSON {'object' if kind is dict else kind.__name__}"
+            )
+        return value
+
+    def integer(self, name: str) -> int:
+        a = self.raw(name)
+        if a.shape != () or a.dtype.kind not in "iu" or int(a) < 1:
+            raise self.fail(f"the entry {name!r} is not an integer ≥ 1")
+        return int(a)
+
+    def array(self, name: str) -> NDArray[Any]:
+        a = self.raw(name)
+        if a.dtype.kind not in "fbu" or a.ndim == 0:
+            raise self.fail(f"the array {name!r} is a {a.dtype} array {a.shape}, not recorded rows")
+        return a
+
+    def manifest(self) -> dict[str, Any]:
+        """The format record, its structure checked."""
+        m: dict[str, Any] = self.json("format", dict)
+        version = m.get("version")
+        if isinstance(version, bool) or version not in _VERSIONS:
+            raise self.fail(
+                f"saved in format {version!r}, which this version of adaptimp cannot read "
+                "(it reads 1, 2, 3 and 4)"
+            )
+
+        def expect(key: str, kind: type, required: bool) -> None:
+            if key not in m:
+                if required:
+                    raise self.fail(
+                        f"its format {version} record has no {key!r}: the file was edited "
+                        "after it was saved"
+                    )
+                return
+            if not isinstance(m[key], kind):
+                raise self.fail(f"its format record's {key!r} is damaged (not a {kind.__name__})")
+
+        plain = m.get("plain") is True
+        for key, kind in (("derived", list), ("differences", dict)):
+            expect(key, kind, not plain)
+        expect("simulated", dict, not plain and version >= 3)
+        expect("n", int, not plain and version >= 3)
+        for key in ("inputs", "metrics", "arrays"):
+            expect(key, dict, version >= 4)
+        for key in ("derived",):
+            if any(not isinstance(x, str) for x in m.get(key, [])):
+                raise self.fail(f"its format record's {key!r} is damaged")
+        for key in ("differences", "simulated", "arrays"):
+            if any(not isinstance(x, dict) for x in m.get(key, {}).values()):
+                raise self.fail(f"its format record's {key!r} is damaged")
+        for key in ("simulated", "arrays"):
+            for spec in m.get(key, {}).values():
+                if not (
+                    isinstance(spec.get("shape"), list) and isinstance(spec.get("sha256"), str)
+                ):
+                    raise self.fail(f"its format record's {key!r} is damaged")
+        return m
+
+
+def _array_record(a: NDArray[Any]) -> dict[str, Any]:
+    """What a save records of an array: its shape, dtype and the SHA-256 of all three."""
+    return {"shape": list(a.shape), "dtype": a.dtype.str, "sha256": _array_digest(a)}
+
+
+def _array_digest(a: NDArray[Any]) -> str:
+    """SHA-256 of an array's dtype, shape and bytes (C order)."""
+    import hashlib
+
+    h = hashlib.sha256(f"{a.dtype.str}{list(a.shape)}".encode())
+    h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+def _check_stored(
+    path: str | os.PathLike[str], stored: Mapping[str, NDArray[Any]], manifest: Mapping[str, Any]
+) -> None:
+    """The stored entries of a compressed file are those its record names, with
+    the shapes it gives (before anything is decoded or run)."""
+    differences: Mapping[str, Any] = manifest["differences"]
+    for name, spec in differences.items():
+        if name not in stored:
+            raise SaveError(f"{path}: the array {name!r} its record names is missing")
+        shape, order = spec.get("shape"), spec.get("order")
+        ok = (
+            isinstance(shape, list)
+            and all(isinstance(d, int) and d >= 0 for d in shape)
+            and isinstance(order, int)
+            and 0 <= order <= 3
+            and stored[name].dtype == np.uint8
+            and stored[name].shape == (math.prod(shape[1:]), 8, shape[0] if shape else 0)
+        )
+        if not ok:
+            raise SaveError(
+                f"{path}: the array {name!r} is not what its record says ({stored[name].dtype} "
+                f"{stored[name].shape}, recorded {spec!r}): the file was edited or damaged"
+            )
+    derivable = set(_derivations(0, {"Ts": 1.0}, 1))
+    for name in manifest["derived"]:
+        if name not in derivable:
+            raise SaveError(f"{path}: its record derives {name!r}, which no rule gives")
+    for name in stored:
+        if name in manifest.get("simulated", {}) or name in manifest["derived"]:
+            # The record leaves it to the core; a stored copy would replace the
+            # checked one unseen.
+            raise SaveError(
+                f"{path}: {name} is both stored and left to the core to recompute: the file "
+                "was edited after it was saved"
+            )
+
+
+def _check_arrays(
+    path: str | os.PathLike[str], arrays: Mapping[str, NDArray[Any]], manifest: Mapping[str, Any]
+) -> None:
+    """Every array against the SHA-256 its save recorded (format 4; earlier files
+    do not record them): none missing, none added, none changed."""
+    recorded: Mapping[str, Any] | None = manifest.get("arrays")
+    if recorded is None:
+        return
+    missing = sorted(set(recorded) - set(arrays))
+    added = sorted(set(arrays) - set(recorded))
+    changed = sorted(
+        name
+        for name in set(recorded) & set(arrays)
+        if recorded[name].get("sha256") != _array_digest(arrays[name])
+    )
+    if missing or added or changed:
+        what = [f"{k} {', '.join(map(repr, v))}" for k, v in
+                (("changed:", changed), ("missing:", missing), ("added:", added)) if v]  # fmt: skip
+        raise SaveError(
+            f"{path}: the file was edited or damaged after it was saved: its arrays are "
+            f"not what the save recorded (their SHA-256 differs; {'; '.join(what)})"
+        )
+
+
+def _check_shapes(
+    path: str | os.PathLike[str],
+    arrays: Mapping[str, NDArray[Any]],
+    params: Mapping[str, Any],
+    metrics: Mapping[str, Any],
+) -> None:
+    """What any result needs, in a file of any version: every array of
+    :data:`ARRAYS` (float64, one row per step, per-joint ones (K, n) alike), the
+    metrics and the period."""
+    missing = [name for name in ARRAYS if name not in arrays]
+    if missing:
+        raise SaveError(
+            f"{path}: the arrays {', '.join(map(repr, missing))} are missing: not a result "
+            "saved by SimResult.save, or truncated"
+        )
+    rows = arrays["t"].shape[0]
+    q = arrays["q"]
+    if arrays["t"].ndim != 1 or q.ndim != 2 or q.shape[0] != rows or not 1 <= q.shape[1] <= 7:
+        raise SaveError(f"{path}: t {arrays['t'].shape} and q {q.shape} are not rows of one run")
+    for name, a in arrays.items():
+        if a.shape[:1] != (rows,):
+            raise SaveError(f"{path}: the array {name!r} has {a.shape[0]} rows, t has {rows}")
+    for name in ("dq", "tau", "tau_sat", "tau_e", "zeta", "dq_hat"):
+        if arrays[name].shape != q.shape:
+            raise SaveError(f"{path}: {name} has shape {arrays[name].shape}, q {q.shape}")
+    absent = [k for k in METRIC_KEYS if k not in metrics]
+    if absent:
+        raise SaveError(f"{path}: the metrics {', '.join(map(repr, absent))} are missing")
+    if not isinstance(params.get("Ts"), (int, float)) or isinstance(params.get("Ts"), bool):
+        raise SaveError(f"{path}: the parameters have no period Ts")
 
 
 def _derivations(
@@ -554,7 +835,7 @@ def _resimulated(
     out: dict[str, NDArray[Any]] = {}
     for name, spec in simulated.items():
         if rerun is None:
-            raise ValueError(
+            raise SaveError(
                 f"{path}: {name} was left to the simulation to recompute, but the file's "
                 f"case {case!r}, scenario {scenario!r} and parameters do not describe a run "
                 f"the core can repeat ({'; '.join(why)}); {version}"
@@ -562,7 +843,7 @@ def _resimulated(
         a = rerun.get(name)
         if a is None or list(a.shape) != spec["shape"]:
             got = "no such array" if a is None else f"shape {list(a.shape)}"
-            raise ValueError(
+            raise SaveError(
                 f"{path}: {name} was left to the simulation to recompute with shape "
                 f"{spec['shape']}, but running the file's case {case!r}, scenario "
                 f"{scenario!r} and parameters again gives {got}; {version}"
@@ -577,7 +858,7 @@ def _resimulated(
                 "gives other bits: load it with the version that saved it, and save it "
                 "there with recompute=False for a file that any version reads"
             )
-            raise ValueError(
+            raise SaveError(
                 f"{path}: {name} was left to the simulation to recompute, but running the "
                 f"file's case {case!r}, scenario {scenario!r} and parameters again does not "
                 f"give the same bits (SHA-256 {_digest(a)[:12]}…, the save recorded "
@@ -643,7 +924,7 @@ def _check_metrics(
         changed = [f"{k!r} (now {res.metrics[k]!r})" for k in now if now[k] != recorded.get(k)]
         changed += [f"{k!r} (removed)" for k in recorded if k not in now]
         if changed:
-            raise ValueError(
+            raise SaveError(
                 f"{path}: the file was edited after it was saved: the "
                 f"{'metric' if len(changed) == 1 else 'metrics'} {', '.join(changed)} "
                 f"{'is' if len(changed) == 1 else 'are'} not what the save recorded (its "
@@ -690,6 +971,35 @@ def _input_digests(
     }
 
 
+def _check_rows(
+    path: str | os.PathLike[str],
+    params: Mapping[str, Any],
+    record_every: int,
+    manifest: Mapping[str, Any],
+) -> None:
+    """The rows a file's parameters give (round(T/Ts) steps, every
+    ``record_every``-th kept) are the rows it records: checked before its
+    simulation is run again, in a file without the digest of its inputs (an
+    edited T ran for as long as it said)."""
+    simulated: Mapping[str, Any] = manifest.get("simulated") or {}
+    shapes = [spec["shape"] for spec in simulated.values()]
+    if not shapes:
+        return
+    T, Ts = params.get("T"), params.get("Ts")
+    rows = shapes[0][0] if shapes[0] else -1
+    try:
+        steps = round(float(T) / float(Ts))  # type: ignore[arg-type]
+        expected = -(-steps // int(record_every))
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+        expected = None
+    if expected != rows or any(not s or s[0] != rows for s in shapes):
+        raise SaveError(
+            f"{path}: the file's parameters (T = {T!r}, Ts = {Ts!r}, one row in "
+            f"{record_every}) do not give the {rows} rows it records: it was edited "
+            "after it was saved (its simulation is not run again)"
+        )
+
+
 def _check_inputs(
     path: str | os.PathLike[str],
     case: str,
@@ -701,8 +1011,11 @@ def _check_inputs(
     """Refuse a file whose case, scenario or parameters are not those its save
     recorded (the file edited after it was saved), naming each that differs."""
     recorded = manifest.get("inputs")
-    if recorded is None:  # saved before the inputs were recorded
+    if recorded is None:  # saved (in format 2 or 3) before the inputs were recorded
+        _check_rows(path, params, record_every, manifest)
         return
+    if not isinstance(recorded.get("params"), dict):
+        raise SaveError(f"{path}: its format record's 'inputs' is damaged")
     now = _input_digests(case, scenario, params, record_every)
     given = {"case": case, "scenario": scenario, "record_every": record_every}
     changed = [f"the {k} ({v!r})" for k, v in given.items() if now[k] != recorded.get(k)]
@@ -715,7 +1028,7 @@ def _check_inputs(
     changed += [f"the parameter {k!r} (added)" for k in found if k not in saved]
     changed += [f"the parameter {k!r} (removed)" for k in saved if k not in found]
     if changed:
-        raise ValueError(
+        raise SaveError(
             f"{path}: the file was edited after it was saved: {', '.join(changed)} "
             f"{'is' if len(changed) == 1 else 'are'} not what the save recorded (its SHA-256 "
             "differs), so its arrays and metrics are not those of a run with it"
@@ -763,33 +1076,34 @@ def _encode(
 
 
 def _decode(
-    f: Mapping[str, NDArray[Any]],
+    path: str | os.PathLike[str],
+    stored: Mapping[str, NDArray[Any]],
     manifest: Mapping[str, Any],
     params: Mapping[str, Any],
     record_every: int,
     simulated: Mapping[str, NDArray[Any]],
 ) -> dict[str, NDArray[Any]]:
     arrays: dict[str, NDArray[Any]] = dict(simulated)
-    for name in f:
-        if name in _META:
-            continue
-        if name in simulated or name in manifest["derived"]:
-            # The manifest leaves it to the core; a stored copy would replace the
-            # checked one unseen.
-            raise ValueError(
-                f"{name} is both stored and left to the core to recompute: the file was "
-                "edited after it was saved"
-            )
+    for name, a in stored.items():
         if name in manifest["differences"]:
             spec = manifest["differences"][name]
-            arrays[name] = _undifferences(f[name], spec["order"], spec["shape"])
+            arrays[name] = _undifferences(a, spec["order"], spec["shape"])
         else:
-            arrays[name] = f[name]
+            arrays[name] = a
     # Each rule reads only arrays that are stored or simulated (q, xd, tau, dq),
     # never derived.
+    if "q" not in arrays:
+        raise SaveError(f"{path}: the array 'q' is missing (neither stored nor recomputed)")
     derive = _derivations(arrays["q"].shape[0], params, record_every)
-    for name in manifest["derived"]:
-        arrays[name] = derive[name](arrays)
+    name = ""
+    try:
+        for name in manifest["derived"]:
+            arrays[name] = derive[name](arrays)
+    except (KeyError, ValueError) as e:
+        raise SaveError(
+            f"{path}: {name} cannot be derived from the arrays stored ({type(e).__name__}: "
+            f"{e}): the file was edited or damaged"
+        ) from None
     return arrays
 
 

@@ -354,6 +354,8 @@ class ComputedTorque:
         if impedance not in ("joint", "external"):
             raise ValueError(f"impedance must be 'joint' or 'external', got {impedance!r}")
         self.impedance = impedance
+        if drive is not None and not isinstance(drive, bool):  # 'yes' was taken as True
+            raise TypeError(f"drive must be True, False or None, got {drive!r}")
         if not (mass_scale > 0 and math.isfinite(mass_scale)):
             raise ValueError(f"mass_scale must be > 0, got {mass_scale}")
         if not (math.isfinite(payload) and payload >= 0):

@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
-from ._errors import ConfigError, period_alias
+from ._errors import ConfigError, MeasurementError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
 from ._pose import CartesianStep, PoseTarget
 from .chain import Chain
@@ -65,6 +65,33 @@ rad/s², world frame): the commanded pose at t (s)."""
 _EYE = np.eye(3)
 
 
+def _array(name: str, v: ArrayLike, shape: tuple[int, ...]) -> FloatArray:
+    """``v`` as reals of exactly ``shape``, else an error naming ``name`` (no
+    reshape: a flat (9,) R or a (2, 3) wrench is refused, not read)."""
+    try:
+        a = np.asarray(v, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of reals, got {v!r}") from None
+    if a.shape != shape:
+        raise MeasurementError(f"{name} must have shape {shape}, got shape {a.shape}")
+    return a
+
+
+_POSE_NAMES = ("p", "dp", "ddp", "R", "w", "dw")
+
+
+def _pose(values: Sequence[ArrayLike | None], names: Sequence[str] = _POSE_NAMES) -> FloatArray:
+    """:func:`pose_target` of (p, dp, ddp, R, w, dw), each checked by the name in ``names``."""
+    out = np.zeros(24)
+    for i, (v, name) in enumerate(zip(values, names)):
+        if i == 3:
+            out[9:18] = (_EYE if v is None else _array(name, v, (3, 3))).ravel()
+        elif v is not None:
+            at = 3 * i if i < 3 else 18 + 3 * (i - 4)
+            out[at : at + 3] = _array(name, v, (3,))
+    return out
+
+
 def pose_target(
     p: ArrayLike,
     dp: ArrayLike | None = None,
@@ -73,28 +100,45 @@ def pose_target(
     w: ArrayLike | None = None,
     dw: ArrayLike | None = None,
 ) -> FloatArray:
-    """The flat pose target (24,) the core takes: p_c, ṗ_c, p̈_c (m, m/s, m/s²), R_c
-    row-major (default the identity), ω_c, ω̇_c (rad/s, rad/s²); rates default to 0."""
-    out = np.zeros(24)
-    for i, v in enumerate((p, dp, ddp)):
-        if v is not None:
-            out[3 * i : 3 * i + 3] = np.asarray(v, dtype=np.float64).reshape(3)
-    out[9:18] = (_EYE if R is None else np.asarray(R, dtype=np.float64).reshape(3, 3)).ravel()
-    for i, v in enumerate((w, dw)):
-        if v is not None:
-            out[18 + 3 * i : 21 + 3 * i] = np.asarray(v, dtype=np.float64).reshape(3)
-    return out
+    """The flat pose target (24,) the core takes: p_c, ṗ_c, p̈_c (m, m/s, m/s², (3,)
+    each), R_c (3, 3) row-major (default the identity), ω_c, ω̇_c (rad/s, rad/s²,
+    (3,)); rates default to 0. Another shape is a MeasurementError naming it."""
+    return _pose((p, dp, ddp, R, w, dw))
 
 
 def _wrench(wrench: ArrayLike | None) -> FloatArray:
     """F_e = [f; m] (6,) from (6,), f (3,) alone (no moment) or None (no contact)."""
     f = np.zeros(6)
     if wrench is not None:
-        w = np.asarray(wrench, dtype=np.float64).reshape(-1)
+        try:
+            w = np.asarray(wrench, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise TypeError(f"wrench must be an array of reals, got {wrench!r}") from None
         if w.shape not in ((3,), (6,)):
-            raise ValueError(f"wrench must have shape (6,) or (3,), got {w.shape}")
+            raise MeasurementError(f"wrench must have shape (6,) or (3,), got shape {w.shape}")
         f[: w.shape[0]] = w
     return f
+
+
+def _per_axis(name: str, v: ArrayLike) -> FloatArray:
+    """A value per axis x, y, z: a scalar (every axis) or (3,), else a
+    ConfigError naming ``name``."""
+    try:
+        a = np.asarray(v, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a real or 3 reals, got {v!r}") from None
+    if a.shape not in ((), (3,)):
+        raise ConfigError(
+            f"{name} must be a scalar or have shape (3,) (x, y, z), got shape {a.shape}"
+        )
+    return np.broadcast_to(a, (3,)).copy()
+
+
+def _rates(s: Sequence[ArrayLike], what: str) -> list[FloatArray]:
+    """The 3 arrays (p, ṗ, p̈) a path or reference returned at t, each (3,)."""
+    if len(s) != 3:
+        raise ValueError(f"{what} must return 3 arrays (p, dp, ddp), got {len(s)}")
+    return [_array(f"{what}[{i}]", v, (3,)) for i, v in enumerate(s)]
 
 
 def _sample(path: Path, t: float, R: FloatArray) -> FloatArray:
@@ -105,14 +149,17 @@ def _sample(path: Path, t: float, R: FloatArray) -> FloatArray:
 def _pose_of(sample: Any, R: FloatArray) -> FloatArray:
     """A path's value (p, ṗ, p̈[, R, ω, ω̇]) as a flat target; a 3-tuple keeps R."""
     s = tuple(sample)
+    names = tuple(f"path(t)[{i}]" for i in range(6))
     if len(s) == 3:
-        return pose_target(s[0], s[1], s[2], R)
+        return _pose((*s, R), names)
     if len(s) == 6:
-        return pose_target(*s)
+        return _pose(s, names)
     raise ValueError(f"path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}")
 
 
-def tabulate(path: Path, steps: int, Ts: float, R: ArrayLike, *, start: int = 0) -> FloatArray:
+def tabulate(
+    path: Path, steps: int, Ts: float, R: ArrayLike, *, start: int = 0, what: str = "path(t)"
+) -> FloatArray:
     """The commanded pose of ``steps`` steps at t_k = (``start`` + k)·``Ts``, as
     the rows (steps, 24) of :func:`pose_target`: the one tabulation of a path
     (the outer loop's orbit, a run of the core's loop, a task's metrics).
@@ -131,15 +178,16 @@ def tabulate(path: Path, steps: int, Ts: float, R: ArrayLike, *, start: int = 0)
     for k in range(steps):
         s = tuple(path((start + k) * Ts))
         if len(s) == 3:
-            out[k, 0:3], out[k, 3:6], out[k, 6:9] = s
+            # Each value checked as (3,) by name (a raw broadcast error before).
+            out[k, 0:9] = np.concatenate(_rates(s, what))
             if turned:
                 out[k, 9:18] = out[k - 1, 9:18]
         elif len(s) == 6:
-            out[k] = pose_target(*s)
+            out[k] = _pose(s, tuple(f"{what}[{i}]" for i in range(6)))
             turned = True
         else:
             raise ValueError(
-                f"path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}"
+                f"{what} must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}"
             )
     return out
 
@@ -240,10 +288,29 @@ class CartesianImpedance:
         dw: ArrayLike | None = None,
     ) -> FloatArray:
         """:func:`pose_target`, with R the last commanded rotation when not given
-        (initially the start's, fk(q0))."""
-        if R is not None:
-            self._R = np.array(R, dtype=np.float64).reshape(3, 3)
-        return pose_target(p, dp, ddp, self._R, w, dw)
+        (initially the start's, fk(q0)). The core checks the target as a step
+        would (a rotation that is not one, a value not finite or beyond its
+        ceiling: MeasurementError); only a good R is kept as the last one."""
+        out = self._target((p, dp, ddp, R, w, dw))
+        self._core.check_target(out)
+        self._commit(out, R)
+        return out
+
+    def _target(
+        self, values: Sequence[ArrayLike | None], names: Sequence[str] = _POSE_NAMES
+    ) -> FloatArray:
+        """The flat target of (p, dp, ddp, R, w, dw), R the last commanded one if
+        None; nothing kept (see :meth:`_commit`)."""
+        v = list(values)
+        if v[3] is None:
+            v[3] = self._R
+        return _pose(v, names)
+
+    def _commit(self, target: FloatArray | None, R: object) -> None:
+        """After the core accepted ``target``: its rotation is the last commanded
+        one if it set one (``R`` given, or a path's 6-tuple)."""
+        if target is not None and R is not None:
+            self._R = target[9:18].reshape(3, 3).copy()
 
     def step(
         self,
@@ -266,8 +333,9 @@ class CartesianImpedance:
             if p is not None:
                 raise TypeError("give the commanded pose as p=… or as target=…, not both")
             p, dp, ddp, R, w, dw = target.p, target.dp, target.ddp, target.R, target.w, target.dw
-        flat = None if p is None else self.target(p, dp, ddp, R, w, dw)
+        flat = None if p is None else self._target((p, dp, ddp, R, w, dw))
         q, dq, ddq = self._core.reference(flat, _wrench(wrench))
+        self._commit(flat, R)
         return q, dq, ddq
 
     def last(self, what: str) -> FloatArray:
@@ -282,24 +350,27 @@ class CartesianImpedance:
         return CartesianStep.of(self._core)
 
     def reset(self, q0: ArrayLike | None = None) -> None:
-        """Back to t = 0 (at ``q0``, default the start's)."""
-        if q0 is not None:
-            self.q0 = np.array(q0, dtype=np.float64)
-        self._core.reset(self.q0)
+        """Back to t = 0 (at ``q0``, default the start's). A ``q0`` the core
+        refuses (another shape, not finite, beyond 1e6 rad) changes nothing."""
+        start = self.q0 if q0 is None else np.array(q0, dtype=np.float64)
+        self._core.reset(start)
+        self.q0 = start
         self._R = self.chain.fk(self.q0)[:3, :3].copy()
 
     def set_stiffness(self, Kd: ArrayLike, Kd_rot: ArrayLike | None = None) -> None:
         """Ask for the stiffness ``Kd`` (N/m) and ``Kd_rot`` (N m/rad; default
         unchanged): the impedance moves to it through the target filter, so the
         torque does not jump (SPEC (16.6))."""
-        kd = np.broadcast_to(np.asarray(Kd, dtype=np.float64), (3,))
-        rot = self._core.state("stiffness")[3:] if Kd_rot is None else Kd_rot
-        kr = np.broadcast_to(np.asarray(rot, dtype=np.float64), (3,))
+        kd = _per_axis("Kd", Kd)
+        kr = _per_axis("Kd_rot", self._core.state("stiffness")[3:] if Kd_rot is None else Kd_rot)
         self._core.set_stiffness(kd, kr)
 
     def set_posture(self, posture: ArrayLike) -> None:
-        """The null-space posture q_posture (rad), (n,), from the next step on."""
-        self._core.set_posture(np.asarray(posture, dtype=np.float64))
+        """The null-space posture q_posture (rad), (n,), from the next step on. The
+        core refuses (ConfigError, nothing changed) one not finite, beyond 1e6
+        rad, or farther from q_d than the posture task may pull (null_k·|q_posture
+        − q_d| ≤ 1e6 rad/s², the ceiling of q̈_d)."""
+        self._core.set_posture(posture)
 
     def orbit_centres(
         self,
@@ -321,7 +392,7 @@ class CartesianImpedance:
         (centres (L, 4n), widths (4n,)) for ``adaptimp.Controller(centers=,
         widths=)``.
         """
-        q, dq = self.joint_orbit(path, T, samples=int(nodes), q0=q0)
+        q, dq = self.joint_orbit(path, T, samples=nodes, q0=q0)
         centres, widths2 = _adaptimp.centres_along(q, dq, (float(tube[0]), float(tube[1])))
         return centres, np.sqrt(widths2)
 
@@ -342,9 +413,9 @@ class CartesianImpedance:
         """:meth:`joint_orbit` with the accelerations: (q_d, q̇_d, q̈_d) (rad,
         rad/s, rad/s²), each (``samples``, n), q̈_d the inverse kinematics' own
         (C2)."""
-        steps = round(T / self.Ts)
-        if steps < 1:
-            raise ConfigError(f"T must cover at least one step of {self.Ts:g} s, got {T}")
+        # T (1 … 1e6 periods) and samples (an integer ≥ 1), refused by name
+        # before the path is tabulated.
+        steps, samples = self._core.orbit_size(T, samples)
         start = self.q0 if q0 is None else np.asarray(q0, dtype=np.float64)
         table = tabulate(path, steps, self.Ts, self.chain.fk(start)[:3, :3])
         q, dq, ddq = self._core.orbit(start, table, samples)
@@ -740,15 +811,21 @@ class CartesianController:
             self._k += 1
             return out
         f = _wrench(wrench)
+        # The rotation a target sets is kept only once the core accepted the step.
         flat: FloatArray | None = None
+        turned: object = None
         if xc is not None:
-            flat = self.outer.target(xc, dxc, ddxc, R, w, dw)
+            flat = self.outer._target(
+                (xc, dxc, ddxc, R, w, dw), ("xc", "dxc", "ddxc", "R", "w", "dw")
+            )
+            turned = R
         elif sample is not None:
             flat = _pose_of(sample, self.outer._R)
-            self.outer._R = flat[9:18].reshape(3, 3).copy()
+            turned = True
         core = self.outer.core
         out = core.step_python(self.inner, q, dq, f, flat)
         self._tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
+        self.outer._commit(flat, turned)
         if self.record:
             for key, v in zip(
                 _LOG,
@@ -799,7 +876,7 @@ class CartesianController:
                 out[:, 3 * i : 3 * i + 3] = reference[i][:steps]
             return out
         if reference is not None:
-            return tabulate(reference, steps, self.Ts, self.outer._R)
+            return tabulate(reference, steps, self.Ts, self.outer._R, what="reference(t)")
         assert path is not None
         return tabulate(path, steps, self.Ts, self.outer._R, start=self._k)
 

@@ -96,6 +96,11 @@ class Chain(_adaptimp.Chain):
         except ValueError as e:
             raise ConfigError(f"{source}: {e}") from None
         movable = [j for j in data if j.get("kind") != "fixed"]
+        if names is not None and (isinstance(names, str) or len(names) != len(movable)):
+            raise ConfigError(
+                f"{source}: names must give one name per movable joint ({len(movable)}), "
+                f"got {names!r}"
+            )
         self.joint_names = (
             list(names) if names is not None else [f"joint{i}" for i in range(len(movable))]
         )

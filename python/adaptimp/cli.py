@@ -191,8 +191,28 @@ def cmd_params(args: argparse.Namespace, params: dict[str, Any]) -> int:
     return 0
 
 
+_GROUPS = {"sim": "the run", "controller": "the controller", "arm": "the arm", "env": "the wall"}
+
+
+def _params_epilog() -> str:
+    """Every parameter a run takes as --name value, by group, from the schema
+    (units, meanings and defaults: `adaptimp params`)."""
+    import textwrap
+
+    from ._params import PARAMS
+
+    lines = ["parameters (--name value; units, meanings, defaults: `adaptimp params`):"]
+    for group, title in _GROUPS.items():
+        names = " ".join(f"--{p.name}" for p in PARAMS if p.group == group)
+        lines += textwrap.wrap(
+            f"{title}: {names}", width=79, initial_indent="  ", subsequent_indent="    "
+        )
+    return "\n".join(lines)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser (parameters are parsed from the leftover arguments)."""
+    """The argument parser (parameters are parsed from the leftover arguments;
+    ``--help`` lists them, from the schema)."""
     parser = argparse.ArgumentParser(
         prog="adaptimp",
         description="Adaptive neural impedance control with input saturation "
@@ -211,6 +231,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run PD, state feedback and output feedback in the paper scenario; "
         "write per-case figures (tracking, errors, torques), a comparison figure, "
         "metrics.json and metrics.md into --out; print the metrics table.",
+        epilog=_params_epilog(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         allow_abbrev=False,
     )
     rep.add_argument("--out", default="reproduce", help="output directory (default: reproduce)")
@@ -222,6 +244,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="run one case and print its metrics",
         description="Run one case and print its SPEC §12 metrics. Any parameter "
         "as --name value (e.g. --T 5 --Kp 10.5 --wall none).",
+        epilog=_params_epilog(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         allow_abbrev=False,
     )
     sim.add_argument("--case", default="sf", choices=CASES, help="controller (default: sf)")

@@ -298,6 +298,8 @@ def from_urdf(
         longest and no ``tip`` (the message names the file and what to do).
     """
     arm = _urdf_arm(path, tip, fix)
+    if not isinstance(drive, bool):  # 'yes' was taken as True
+        raise TypeError(f"drive must be True or False, got {drive!r}")
     return _compile_arm(_arm_spec(arm, timestep, drive=drive, stacklevel=3))
 
 
@@ -403,6 +405,13 @@ _BUILTIN: dict[str, Callable[[], mujoco.MjModel]] = {"two_link": two_link, "pand
 
 def _name(m: mujoco.MjModel, objtype: Any, i: int) -> str:
     return mujoco.mj_id2name(m, objtype, i) or f"#{i}"
+
+
+def _source_label(model: object) -> str:
+    """``"name.xml: "`` for a model given as a file, else ``""`` (a message's prefix)."""
+    if isinstance(model, (str, os.PathLike)) and str(model) not in _BUILTIN:
+        return f"{Path(model).name}: "
+    return ""
 
 
 class Plant:
@@ -512,7 +521,13 @@ class Plant:
         self.notes: dict[str, Any] = {**prepared.notes, "warnings": list(prepared.warnings)}
         for text in prepared.warnings:
             warnings.warn(text, PlantWarning, stacklevel=2)
-        self._setup_model(prepared.model, self.tip)
+        try:
+            self._setup_model(prepared.model, self.tip)
+        except ValueError as e:  # a file's arm that cannot be a plant: name the file
+            label = _source_label(model)
+            if str(e).startswith(label):
+                raise
+            raise ValueError(f"{label}{e}") from None
         self.notes["tip"] = (
             _name(self.model, mujoco.mjtObj.mjOBJ_SITE, self._site)
             if self._site >= 0
@@ -858,13 +873,15 @@ def moving_mass(model: mujoco.MjModel) -> float:
 
 
 def with_payload(model: mujoco.MjModel, mass: float, body: int | None = None) -> mujoco.MjModel:
-    """A copy of ``model`` with a point mass ``mass`` (kg, ≥ 0) at the origin of
+    """A copy of ``model`` with a point mass ``mass`` (kg, 0 … 1e9, the bound of
+    every physical parameter) at the origin of
     ``body`` (default: the body of the last joint, the end effector's link;
     SPEC §17's payload for a MuJoCo arm). The body's mass, centre of mass and
     inertia change by the parallel-axis theorem; nothing else does. Give it
     to the plant only: the controller is not told."""
-    if not (math.isfinite(mass) and mass >= 0):
-        raise ValueError(f"payload must be ≥ 0 kg, got {mass}")
+    if not (math.isfinite(mass) and 0 <= mass <= 1e9):
+        # (1e300 kg was accepted, and the run ended in a DivergedError of MuJoCo's.)
+        raise ConfigError(f"payload must be ≥ 0 and ≤ 1e9 kg, got {mass}")
     m = copy.deepcopy(model)
     if mass == 0:
         return m
@@ -1116,13 +1133,46 @@ class _Table:
         return xc[k], dxc[k], ddxc[k]
 
 
+def _checked_reference(reference: Reference, n: int) -> Reference:
+    """``reference`` whose every value is checked: three arrays (xc, dxc, ddxc)
+    of shape (n,), else an error naming the reference, t and what it gave (a
+    2-tuple was an IndexError, a wrong length a broadcast error)."""
+
+    def checked(t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        got = reference(t)
+        values = tuple(got) if isinstance(got, (tuple, list)) else None
+        if values is None or len(values) != 3:
+            size = "not a tuple" if values is None else f"{len(values)} values"
+            raise ValueError(
+                f"reference(t) must return 3 arrays (xc, dxc, ddxc), got {size} at t = {t:g}"
+            )
+        out = []
+        for name, v in zip(("xc", "dxc", "ddxc"), values):
+            try:
+                a = np.asarray(v, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise TypeError(
+                    f"reference(t)'s {name} must be reals, got {v!r} at t = {t:g}"
+                ) from None
+            if a.shape != (n,):
+                raise ValueError(
+                    f"reference(t)'s {name} must have shape ({n},), got {a.shape} at t = {t:g}"
+                )
+            out.append(a)
+        return out[0], out[1], out[2]
+
+    return checked
+
+
 def _table_reference(reference: Any, n: int, Ts: float, steps: int) -> Reference:
     """``reference`` as a callable of t: a callable as it is; (xc, dxc, ddxc)
     arrays of shape (K, n), K ≥ ``steps`` (or an object with those attributes,
     e.g. a :class:`MujocoResult`), row k at t_k = k·Ts (n: the width of the
     controller's reference, 3 for a Cartesian controller's p_c)."""
+    if isinstance(reference, _Table):
+        return reference
     if callable(reference):
-        return reference  # type: ignore[no-any-return]
+        return _checked_reference(reference, n)
     if all(hasattr(reference, a) for a in ("xc", "dxc", "ddxc")):
         reference = (reference.xc, reference.dxc, reference.ddxc)
     try:
@@ -1730,15 +1780,20 @@ def _cartesian_loop(
     ctrl, reference = run.ctrl, run.reference
     table = reference.arrays if isinstance(reference, _Table) else reference
     targets = ctrl._targets(run.steps, table)
-    out: dict[str, Any] | None = None
+    task: dict[str, Any] | None = None
     try:
-        out = ctrl.outer.core.simulate_mujoco(
+        out: dict[str, Any] = ctrl.outer.core.simulate_mujoco(
             ctrl._joint, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
             run.settle, run.every, progress, targets, fault,
         )  # fmt: skip
+        task = out["task"]
+    except BaseException as e:
+        # Stopped (Ctrl-C, a diverged plant): the rows of the steps it took
+        # (the exception's `partial`), which the log keeps as the clock does.
+        task = getattr(e, "partial", None)
+        raise
     finally:
-        ctrl._ran(targets, None if out is None else out["task"])
-    assert out is not None
+        ctrl._ran(targets, task)
     return out
 
 

@@ -141,8 +141,30 @@ impl Transform {
                 value: det,
             });
         }
+        // Within the tolerance but not orthonormal to rounding (a matrix
+        // printed with 7 digits): the nearest rotation, so that seven such
+        // origins do not multiply into a matrix that is not one.
+        let r = if dev > ORTHONORMAL_TO_ROUNDING {
+            orthonormalised(r)
+        } else {
+            r
+        };
         Ok(Frame { p, r })
     }
+}
+
+/// |RᵀR − I| of a rotation matrix computed in floating point (a URDF's rpy,
+/// a unit quaternion's matrix): kept as given.
+const ORTHONORMAL_TO_ROUNDING: f64 = 1e-12;
+
+/// The nearest rotation to `r` (|RᵀR − I| ≤ 1e-6, det > 0): the polar
+/// factor by the Newton–Schulz iteration R ← R (3I − RᵀR)/2, which doubles
+/// the digits each time (1e-6 → 1e-12 → rounding).
+fn orthonormalised(mut r: Matrix3<f64>) -> Matrix3<f64> {
+    for _ in 0..3 {
+        r = 0.5 * r * (3.0 * Matrix3::identity() - r.transpose() * r);
+    }
+    r
 }
 
 /// One joint of a chain description, base to tip: see the [module docs](self).
@@ -549,6 +571,38 @@ impl<const N: usize> Chain<N> {
     pub fn is_prismatic(&self, i: usize) -> bool {
         self.links.get(i).is_some_and(|l| l.prismatic)
     }
+
+    /// q (and q̇) as [`Chain::tip_checked`] takes them: finite and within
+    /// their ceilings; the error names `q` or `dq` and the joint.
+    pub fn check_motion(&self, q: &Vector<N>, dq: Option<&Vector<N>>) -> Result<(), Error> {
+        use crate::control::safety::{CEILING_POSITION, CEILING_VELOCITY};
+        check::finite_slice("q", q.as_slice())?;
+        check::within("q", q.as_slice(), CEILING_POSITION)?;
+        if let Some(dq) = dq {
+            check::finite_slice("dq", dq.as_slice())?;
+            check::within("dq", dq.as_slice(), CEILING_VELOCITY)?;
+        }
+        Ok(())
+    }
+
+    /// [`Kinematics::tip`] for a front that hands a user's values in: q (rad
+    /// or m) and q̇ (rad/s or m/s) finite and within their ceilings (1e6, as
+    /// a step's measurement; docs/reliability.md), so the pose, Jacobian and
+    /// J̇ q̇ are finite (checked too). Errors name `q` or `dq` and the joint.
+    pub fn tip_checked(&self, q: &Vector<N>, dq: &Vector<N>) -> Result<Tip<N>, Error> {
+        self.check_motion(q, Some(dq))?;
+        let t = self.tip(q, dq);
+        let finite = t.position.iter().all(|x| x.is_finite())
+            && t.rotation.matrix().iter().all(|x| x.is_finite())
+            && t.jacobian.iter().all(|x| x.is_finite())
+            && t.bias.iter().all(|x| x.is_finite());
+        if !finite {
+            return Err(Error::Diverged {
+                what: "the chain's tip (pose, Jacobian or J̇ q̇)",
+            });
+        }
+        Ok(t)
+    }
 }
 
 /// The motion of one link in the world, from [`Chain::walk`]: its frame's
@@ -852,6 +906,85 @@ mod tests {
         let e = Chain::<8>::new(&[ok; 8], &Transform::IDENTITY).unwrap_err();
         assert!(e.to_string().contains("1 ≤ n ≤ 7"), "{e}");
         assert!(Transform::from_pos_quat([0.0; 3], [0.0; 4]).is_err());
+    }
+
+    #[test]
+    fn an_axis_whose_norm_overflows_or_underflows_is_normalised_not_zeroed() {
+        // ‖[0, 0, 1e200]‖ overflows: it made a zero axis (J = 0, fk ignored q).
+        let unit = Chain::<1>::new(
+            &[Joint::revolute(Transform::IDENTITY, [0.0, 0.0, 1.0])],
+            &Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0; 3]),
+        )
+        .unwrap();
+        for axis in [[0.0, 0.0, 1e200], [0.0, 0.0, f64::MAX], [0.0, 0.0, 1e-11]] {
+            let c = Chain::<1>::new(
+                &[Joint::revolute(Transform::IDENTITY, axis)],
+                &Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0; 3]),
+            )
+            .unwrap();
+            let q = Vector::<1>::new(0.7);
+            assert_eq!(c.jacobian(&q), unit.jacobian(&q), "{axis:?}");
+            assert_eq!(c.fk(&q), unit.fk(&q), "{axis:?}");
+        }
+        // Below 1e-12 (a subnormal one too) it is no axis.
+        let e = Chain::<1>::new(
+            &[Joint::revolute(Transform::IDENTITY, [0.0, 1e-320, 0.0])],
+            &Transform::IDENTITY,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("‖axis‖ > 0"), "{e}");
+    }
+
+    #[test]
+    fn rotations_within_the_tolerance_are_made_orthonormal() {
+        // Seven origins each 5e-7 off (accepted, within 1e-6): the product
+        // was 8e-6 from a rotation (det 1.0000084).
+        let mut sloppy = Transform::from_xyz_rpy([0.0, 0.0, 0.1], [0.3, -0.2, 0.5]);
+        for row in &mut sloppy.rotation {
+            for v in row.iter_mut() {
+                *v *= 1.0 + 2.5e-7;
+            }
+        }
+        let joints = [Joint::revolute(sloppy, [0.0, 0.0, 1.0]); 7];
+        let c = Chain::<7>::new(&joints, &sloppy).unwrap();
+        let r = c.rotation(&Vector::<7>::from_element(0.2));
+        let m = r.matrix();
+        assert!((m.transpose() * m - Matrix3::identity()).amax() < 1e-14);
+        assert!((m.determinant() - 1.0).abs() < 1e-14, "{}", m.determinant());
+        // An orthonormal one (to rounding) is kept as given, bit for bit.
+        let exact = Transform::from_xyz_rpy([0.0; 3], [0.3, -0.2, 0.5]);
+        assert_eq!(exact.check(0).unwrap().r, exact.matrix());
+    }
+
+    #[test]
+    fn a_checked_tip_refuses_inputs_beyond_the_ceilings_by_name() {
+        let c = Chain::<2>::new(
+            &[
+                Joint::revolute(Transform::IDENTITY, [0.0, 0.0, 1.0]),
+                Joint::revolute(
+                    Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0; 3]),
+                    [0.0, 1.0, 0.0],
+                ),
+            ],
+            &Transform::from_xyz_rpy([0.2, 0.0, 0.0], [0.0; 3]),
+        )
+        .unwrap();
+        let q = Vector::<2>::new(0.1, 0.2);
+        // J̇ q̇ at q̇ = 1e200 was −inf with an OK status.
+        let e = c
+            .tip_checked(&q, &Vector::<2>::new(1e200, 0.0))
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "dq[0] = 1e200 is beyond its limit ±1e6; the state was left unchanged"
+        );
+        let e = c
+            .tip_checked(&Vector::<2>::new(0.0, f64::NAN), &q)
+            .unwrap_err();
+        assert_eq!(e.to_string(), "q[1] is not finite (NaN or infinite)");
+        let t = c.tip_checked(&q, &Vector::<2>::from_element(1e6)).unwrap();
+        assert!(t.bias.iter().all(|x| x.is_finite()));
+        assert_eq!(t, c.tip(&q, &Vector::<2>::from_element(1e6)));
     }
 
     #[test]

@@ -14,7 +14,7 @@ use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
 use crate::control::io::{Command, Measurement, TaskTorque};
 use crate::control::safety::Fault;
 use crate::control::saturation::Saturation;
-use crate::error::{check, Error, BOUND};
+use crate::error::{check, Error, BOUND, PARAM_BOUND};
 use crate::trajectory::Setpoint;
 use crate::types::Vector;
 
@@ -92,12 +92,22 @@ impl<const N: usize> ComputedTorque<N> {
     /// The controller of `cfg` with the model `model` (the controller's, not
     /// necessarily the plant's: [`Dynamics::scaled`] for a model error).
     ///
-    /// Errors naming the parameter: Ts ≤ 0 or not finite, K_P ≤ 0, K_D < 0,
-    /// τmax ≤ 0, any of them not finite.
+    /// Errors naming the parameter: Ts ≤ 0, beyond 1 s or not finite (as
+    /// the joint controller's), K_P ≤ 0, K_D < 0, τmax ≤ 0, any of them
+    /// beyond 1e9 or not finite.
     pub fn new(cfg: ComputedTorqueConfig<N>, model: Dynamics<N>) -> Result<Self, Error> {
         check::positive("Ts > 0", "Ts", cfg.ts)?;
+        check::at_most("Ts ≤ 1 s", "Ts", cfg.ts, 1.0)?;
         check::positive_vec("Kp > 0", "Kp", &cfg.kp)?;
         check::nonnegative_vec("Kd ≥ 0", "Kd", &cfg.kd)?;
+        check::at_most_each("|value| ≤ 1e9", "Kp", cfg.kp.as_slice(), PARAM_BOUND)?;
+        check::at_most_each("|value| ≤ 1e9", "Kd", cfg.kd.as_slice(), PARAM_BOUND)?;
+        check::at_most_each(
+            "|value| ≤ 1e9",
+            "tau_max",
+            cfg.tau_max.as_slice(),
+            PARAM_BOUND,
+        )?;
         let sat = Saturation::new(cfg.tau_max)?;
         Ok(Self { cfg, model, sat })
     }

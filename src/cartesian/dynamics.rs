@@ -8,7 +8,7 @@
 //! Units: kg, m, kg m², rad (m for a prismatic joint), N m (N).
 
 use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Link, Transform};
-use crate::error::{check, Error};
+use crate::error::{check, Error, PARAM_BOUND};
 use crate::math::{sin_cos, tanh};
 use crate::types::{Matrix, Vector};
 use nalgebra::{Matrix3, Vector3};
@@ -69,6 +69,7 @@ impl<const N: usize> Drive<N> {
             ("friction", "friction ≥ 0", &self.friction),
         ] {
             check::nonnegative_vec(condition, what, v)?;
+            check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)?;
         }
         Ok(())
     }
@@ -128,8 +129,25 @@ impl Inertial {
                 value: self.mass,
             });
         }
+        // Bounded as every physical parameter (beyond, a model overflows in use).
+        if self.mass > PARAM_BOUND {
+            return Err(Error::Condition {
+                condition: "|value| ≤ 1e9",
+                lhs: "link mass",
+                index: Some(index),
+                value: self.mass,
+            });
+        }
         let i = Matrix3::from_fn(|r, c| self.inertia[r][c]);
         check::finite_slice("link inertia", i.as_slice())?;
+        if i.amax() > PARAM_BOUND {
+            return Err(Error::Condition {
+                condition: "|value| ≤ 1e9",
+                lhs: "link inertia",
+                index: Some(index),
+                value: i.amax(),
+            });
+        }
         let scale = i.amax();
         let asym = (i - i.transpose()).amax();
         if asym > 1e-9 * scale {
@@ -214,7 +232,7 @@ impl<const N: usize> Dynamics<N> {
                 value: inertials.len() as f64,
             });
         }
-        check::finite_slice("gravity", &gravity)?;
+        check::at_most_each("|value| ≤ 1e9", "gravity", &gravity, PARAM_BOUND)?;
         let mut bodies = [Body::EMPTY; N];
         // The body the entries belong to, and the frame of the current
         // entry's child link in that body's frame.
@@ -280,25 +298,89 @@ impl<const N: usize> Dynamics<N> {
     }
 
     /// Every mass and inertia times `factor` (> 0, finite), the centres of
-    /// mass kept: a uniform change of density (20.1).
+    /// mass kept: a uniform change of density (20.1). Each link's mass and
+    /// inertia stay at most 1e9, as a given link's (a factor of 1e300 was
+    /// accepted, and the model overflowed in use).
     pub fn scaled(mut self, factor: f64) -> Result<Self, Error> {
         check::positive("mass_scale > 0", "mass_scale", factor)?;
+        check::at_most("|value| ≤ 1e9", "mass_scale", factor, PARAM_BOUND)?;
         for b in &mut self.bodies {
             b.m *= factor;
             b.h *= factor;
             b.i *= factor;
         }
+        self.check_bodies("mass_scale·mass ≤ 1e9 kg and mass_scale·inertia ≤ 1e9 kg m²")?;
         Ok(self)
     }
 
-    /// A point mass `mass` (kg, ≥ 0, finite) at the origin of the last
-    /// joint's frame added (a payload, 20.1).
+    /// A point mass `mass` (kg, ≥ 0, at most 1e9, finite) at the origin of
+    /// the last joint's frame added (a payload, 20.1).
     pub fn with_payload(mut self, mass: f64) -> Result<Self, Error> {
         check::nonnegative("payload ≥ 0", "payload", mass)?;
+        check::at_most("|value| ≤ 1e9", "payload", mass, PARAM_BOUND)?;
         if let Some(b) = self.bodies.last_mut() {
             b.m += mass;
         }
+        self.check_bodies("mass + payload ≤ 1e9 kg")?;
         Ok(self)
+    }
+
+    /// Every body's mass and inertia at most [`PARAM_BOUND`], else `condition`.
+    fn check_bodies(&self, condition: &'static str) -> Result<(), Error> {
+        for (index, b) in self.bodies.iter().enumerate() {
+            let big = b.m.max(b.i.amax()).max(b.h.amax());
+            if big.is_nan() || big > PARAM_BOUND {
+                return Err(Error::Condition {
+                    condition,
+                    lhs: "link mass or inertia",
+                    index: Some(index),
+                    value: big,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// [`inverse_dynamics`](Self::inverse_dynamics) for a front that hands a
+    /// user's values in: q, q̇, q̈ finite and within their ceilings (1e6 rad,
+    /// rad/s, rad/s², as a step's), the torque finite. Errors name the input.
+    pub fn inverse_dynamics_checked(
+        &self,
+        q: &Vector<N>,
+        dq: &Vector<N>,
+        ddq: &Vector<N>,
+    ) -> Result<Vector<N>, Error> {
+        use crate::control::safety::{CEILING_ACCELERATION, CEILING_POSITION, CEILING_VELOCITY};
+        for (what, v, ceiling) in [
+            ("q", q, CEILING_POSITION),
+            ("dq", dq, CEILING_VELOCITY),
+            ("ddq", ddq, CEILING_ACCELERATION),
+        ] {
+            check::finite_slice(what, v.as_slice())?;
+            check::within(what, v.as_slice(), ceiling)?;
+        }
+        let tau = self.inverse_dynamics(q, dq, ddq);
+        if tau.iter().any(|t| !t.is_finite()) {
+            return Err(Error::Diverged {
+                what: "inverse dynamics (the torque)",
+            });
+        }
+        Ok(tau)
+    }
+
+    /// [`mass_matrix`](Self::mass_matrix) at a q finite and within 1e6, its
+    /// entries finite; else an error naming `q`.
+    pub fn mass_matrix_checked(&self, q: &Vector<N>) -> Result<Matrix<N>, Error> {
+        use crate::control::safety::CEILING_POSITION;
+        check::finite_slice("q", q.as_slice())?;
+        check::within("q", q.as_slice(), CEILING_POSITION)?;
+        let m = self.mass_matrix(q);
+        if m.iter().any(|x| !x.is_finite()) {
+            return Err(Error::Diverged {
+                what: "the mass matrix",
+            });
+        }
+        Ok(m)
     }
 
     /// ID(q, q̇, q̈) = M(q) q̈ + C(q, q̇) q̇ + G(q) + I_a ⊙ q̈ + b ⊙ q̇ (N m,
@@ -583,6 +665,38 @@ mod tests {
         let loaded = d.with_payload(2.0).unwrap();
         assert!((loaded.mass() - d.mass() - 2.0).abs() < 1e-15);
         assert!(d.scaled(0.0).is_err() && d.with_payload(-1.0).is_err());
+    }
+
+    #[test]
+    fn a_model_that_would_overflow_in_use_is_refused_by_name() {
+        let d = arm();
+        let e = d.scaled(1e300).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "condition |value| ≤ 1e9 is violated: mass_scale = 1e300 (SPEC §10)"
+        );
+        let e = d.with_payload(1e300).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "condition |value| ≤ 1e9 is violated: payload = 1e300 (SPEC §10)"
+        );
+        assert!(
+            d.scaled(1e9).is_err(),
+            "each link's mass then beyond 1e9 kg"
+        );
+        let (q, dq, ddq) = state();
+        assert_eq!(
+            d.inverse_dynamics_checked(&q, &dq, &ddq),
+            Ok(d.inverse_dynamics(&q, &dq, &ddq))
+        );
+        let mut huge = dq;
+        huge[0] = 1e200; // the torque was NaN
+        let e = d.inverse_dynamics_checked(&q, &huge, &ddq).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "dq[0] = 1e200 is beyond its limit ±1e6; the state was left unchanged"
+        );
+        assert!(d.mass_matrix_checked(&(q * 1e300)).is_err());
     }
 
     #[test]

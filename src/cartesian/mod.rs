@@ -18,8 +18,8 @@ pub use dynamics::{Drive, Dynamics, Inertial, FRICTION_VELOCITY, GRAVITY};
 pub use impedance_torque::{ImpedanceTorque, PoseGoal};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{
-    CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation, OuterStep,
-    PoseTarget,
+    orbit_steps, CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation,
+    OuterStep, PoseTarget, ORBIT_MAX_STEPS,
 };
 pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement};
 pub use rule::{Assessment, PoseCircle, PostureRule};

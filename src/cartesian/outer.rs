@@ -222,6 +222,48 @@ impl CartesianConfig {
     }
 }
 
+/// The most steps [`CartesianImpedance::orbit`] runs (1000 s at 1 kHz): a
+/// path is sampled once a period, so a longer one is refused before any work.
+pub const ORBIT_MAX_STEPS: usize = 1_000_000;
+
+/// The steps of an orbit of duration `t` (s) at period `ts` (s):
+/// round(t/ts), from 1 to [`ORBIT_MAX_STEPS`]; else an error naming `T`.
+pub fn orbit_steps(t: f64, ts: f64) -> Result<usize, Error> {
+    check::positive("T > 0", "T", t)?;
+    check::positive("Ts > 0", "Ts", ts)?;
+    let steps = libm::round(t / ts);
+    if !(1.0..=ORBIT_MAX_STEPS as f64).contains(&steps) {
+        return Err(Error::Condition {
+            condition: "1 ≤ round(T/Ts) ≤ 1e6 steps (an orbit is sampled once a period)",
+            lhs: "T/Ts",
+            index: None,
+            value: t / ts,
+        });
+    }
+    Ok(steps as usize)
+}
+
+/// `steps` within [`ORBIT_MAX_STEPS`] and at least one sample to write.
+fn check_orbit_size(steps: usize, samples: usize) -> Result<(), Error> {
+    if steps > ORBIT_MAX_STEPS {
+        return Err(Error::Condition {
+            condition: "steps ≤ 1e6 (an orbit is sampled once a period)",
+            lhs: "steps",
+            index: None,
+            value: steps as f64,
+        });
+    }
+    if samples == 0 {
+        return Err(Error::Condition {
+            condition: "nodes ≥ 1",
+            lhs: "nodes",
+            index: None,
+            value: 0.0,
+        });
+    }
+    Ok(())
+}
+
 /// The singular region of (C3'), s: the damping grows when the smallest
 /// singular value of Λ⁻¹J falls below s (with the default λ_p = λ_o = 0.01,
 /// σ_min(J) < 0.05 m/rad: the posture rule's threshold, SPEC (16.9)).
@@ -234,7 +276,7 @@ fn weak_start() -> Vector<6> {
 }
 
 fn bounded(what: &'static str, v: &Vector<3>) -> Result<(), Error> {
-    check::each("|value| ≤ 1e9", what, v, |_, x| PARAM_BOUND - x, false)
+    check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)
 }
 
 /// A commanded pose and its rates at t_k, world frame; plain data (a C
@@ -519,6 +561,59 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             weak: [weak_start(); 2],
             k: 0,
         }
+    }
+
+    /// Check a commanded pose as a step would (its parts finite and within
+    /// their ceilings, the rotation one, unless the loop is position-only),
+    /// without stepping: for a front that keeps a part of it (the last
+    /// commanded rotation) only once it is known to be good.
+    pub fn check_target(&self, target: &PoseTarget) -> Result<(), Error> {
+        Target::check(target, self.orients).map(|_| ())
+    }
+
+    /// [`start`](Self::start) at a `q0` checked as a joint position: finite
+    /// and within the position ceiling (1e6 rad, [`CEILING_POSITION`]: the
+    /// joint reference q_d starts there, and a step refuses a reference
+    /// beyond it). Errors name `q0` and the joint.
+    pub fn start_checked(&self, q0: &Vector<N>) -> Result<CartesianState<N>, Error> {
+        check::finite_slice("q0", q0.as_slice())?;
+        check::within("q0", q0.as_slice(), CEILING_POSITION)?;
+        Ok(self.start(*q0))
+    }
+
+    /// Check a null-space posture for a state whose joint reference is
+    /// `qd`: finite, within the position ceiling (1e6 rad), and close enough
+    /// that the posture task alone asks at most the ceiling of q̈_d (1e6
+    /// rad/s², which a step refuses beyond): k_0·|q_posture − q_d| ≤ 1e6 per
+    /// joint. Errors name `posture` and the joint.
+    pub fn check_posture(&self, qd: &Vector<N>, posture: &Vector<N>) -> Result<(), Error> {
+        check::finite_slice("posture", posture.as_slice())?;
+        check::within("posture", posture.as_slice(), CEILING_POSITION)?;
+        for i in 0..N {
+            let pull = self.cfg.null_k * (posture[i] - qd[i]).abs();
+            if pull > CEILING_ACCELERATION {
+                return Err(Error::Condition {
+                    condition: "null_k·|posture − q_d| ≤ 1e6 rad/s² (the ceiling of q̈_d)",
+                    lhs: "null_k·|posture − q_d|",
+                    index: Some(i),
+                    value: pull,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Set the null-space posture q_posture (rad) from the next step on,
+    /// checked by [`check_posture`](Self::check_posture) against the
+    /// state's joint reference; on an error nothing changes.
+    pub fn set_posture(
+        &self,
+        st: &mut CartesianState<N>,
+        posture: &Vector<N>,
+    ) -> Result<(), Error> {
+        self.check_posture(&st.qd, posture)?;
+        st.posture = *posture;
+        Ok(())
     }
 
     /// Ask for the stiffness K_d (N/m) and K_d,rot (N m/rad): the impedance
@@ -950,6 +1045,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         mut path: F,
         out: &mut [Setpoint<N>],
     ) -> Result<usize, Error> {
+        check_orbit_size(steps, out.len())?;
         let every = (steps / out.len().max(1)).max(1);
         let mut st = self.start(q0);
         let mut written = 0;
@@ -971,6 +1067,86 @@ mod tests {
 
     fn outer(cfg: CartesianConfig) -> CartesianImpedance<2, TwoLinkArm> {
         CartesianImpedance::new(cfg, TwoLinkArm::paper(), 1e-3).unwrap()
+    }
+
+    #[test]
+    fn a_posture_or_start_far_out_of_range_is_refused_by_name_and_changes_nothing() {
+        let o = outer(CartesianConfig::default());
+        let q0 = Vector::<2>::new(0.5, 1.0);
+        let e = o.start_checked(&Vector::<2>::new(0.5, 1e7)).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "q0[1] = 1e7 is beyond its limit ±1e6; the state was left unchanged"
+        );
+        let mut st = o.start_checked(&q0).unwrap();
+        let before = st;
+        let e = o
+            .set_posture(&mut st, &Vector::<2>::from_element(1e7))
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "posture[0] = 1e7 is beyond its limit ±1e6; the state was left unchanged"
+        );
+        // Within the position ceiling, but a pull the step would refuse
+        // (null_k = 25 1/s²: 1e5 rad asks 2.5e6 rad/s²).
+        let e = o
+            .set_posture(&mut st, &Vector::<2>::new(0.5, 1e5))
+            .unwrap_err();
+        assert!(
+            e.to_string().starts_with(
+                "condition null_k·|posture − q_d| ≤ 1e6 rad/s² (the ceiling of q̈_d) is violated: \
+                 null_k·|posture − q_d|[1] = 2499975"
+            ),
+            "{e}"
+        );
+        let e = o
+            .set_posture(&mut st, &Vector::<2>::new(f64::NAN, 0.0))
+            .unwrap_err();
+        assert_eq!(e.to_string(), "posture[0] is not finite (NaN or infinite)");
+        assert_eq!(st, before);
+        o.set_posture(&mut st, &Vector::<2>::new(0.2, 0.3)).unwrap();
+        assert_eq!(st.posture, Vector::<2>::new(0.2, 0.3));
+    }
+
+    #[test]
+    fn an_orbit_too_long_or_without_samples_is_refused_before_any_work() {
+        assert_eq!(orbit_steps(1.0, 1e-3), Ok(1000));
+        let e = orbit_steps(1e9, 1e-3).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "condition 1 ≤ round(T/Ts) ≤ 1e6 steps (an orbit is sampled once a period) is \
+             violated: T/Ts = 1000000000000 (SPEC §10)"
+        );
+        assert!(orbit_steps(f64::NAN, 1e-3)
+            .unwrap_err()
+            .to_string()
+            .contains("T[0] is not finite"));
+        assert!(orbit_steps(1e-5, 1e-3).is_err());
+        let o = outer(CartesianConfig::default());
+        let q0 = Vector::<2>::new(0.5, 1.0);
+        let t = PoseTarget::at(o.kinematics().fk(&q0), Matrix3::identity());
+        let mut out = [];
+        let e = o.orbit(q0, 10, |_| t, &mut out).unwrap_err();
+        assert!(e.to_string().contains("nodes ≥ 1"), "{e}");
+        let zero = Setpoint {
+            x: Vector::<2>::zeros(),
+            dx: Vector::zeros(),
+            ddx: Vector::zeros(),
+        };
+        let mut calls = 0;
+        let e = o
+            .orbit(
+                q0,
+                ORBIT_MAX_STEPS + 1,
+                |_| {
+                    calls += 1;
+                    t
+                },
+                &mut [zero; 4],
+            )
+            .unwrap_err();
+        assert!(e.to_string().contains("steps ≤ 1e6"), "{e}");
+        assert_eq!(calls, 0);
     }
 
     #[test]

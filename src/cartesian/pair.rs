@@ -89,6 +89,37 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
         &self.inner
     }
 
+    /// A state of the outer loop at `q0`, checked as a joint position the
+    /// joint controller's step would accept as its reference: finite and
+    /// within `q_max` (at most 1e6 rad). Errors name `q0` and the joint.
+    pub fn start(&self, q0: &Vector<N>) -> Result<CartesianState<N>, Error> {
+        let st = self.outer.start_checked(q0)?;
+        check::within_each(
+            "q0",
+            q0.as_slice(),
+            self.inner.config().limits.position().as_slice(),
+        )?;
+        Ok(st)
+    }
+
+    /// Set the null-space posture (rad) from the next step on, checked as
+    /// [`CartesianImpedance::check_posture`] checks it and within the joint
+    /// controller's `q_max`; on an error nothing changes.
+    pub fn set_posture(
+        &self,
+        outer: &mut CartesianState<N>,
+        posture: &Vector<N>,
+    ) -> Result<(), Error> {
+        self.outer.check_posture(&outer.qd, posture)?;
+        check::within_each(
+            "posture",
+            posture.as_slice(),
+            self.inner.config().limits.position().as_slice(),
+        )?;
+        outer.posture = *posture;
+        Ok(())
+    }
+
     /// One step at t_k: the measurement `m` and the commanded pose `target`
     /// (`None`: hold the last one) in, the command out; no allocation. The
     /// outer loop is staged, the joint step runs with the joint reference and

@@ -90,7 +90,11 @@ pub fn clip(e: &Vector<3>, max: f64) -> Vector<3> {
 /// [`ROTATION_TOLERANCE`] entrywise and det R > 0; else an error naming
 /// `what` and the deviation. The quaternion of the matrix is normalised.
 pub fn rotation(what: &'static str, m: &Matrix3<f64>) -> Result<UnitQuaternion<f64>, Error> {
-    crate::error::check::finite_slice(what, m.as_slice())?;
+    // Named by its row-major index, as a caller writes R (nalgebra stores
+    // it by columns).
+    if let Some(index) = (0..9).find(|k| !m[(k / 3, k % 3)].is_finite()) {
+        return Err(Error::NonFinite { what, index });
+    }
     let dev = (m.transpose() * m - Matrix3::identity()).amax();
     if dev > ROTATION_TOLERANCE {
         return Err(Error::Condition {

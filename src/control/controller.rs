@@ -275,14 +275,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             ("fallback_damping", &cfg.fallback_damping),
         ];
         for (what, v) in vectors {
-            check::finite_slice(what, v.as_slice())?;
-            check::each(
-                "|value| ≤ 1e9",
-                what,
-                v,
-                |_, x| PARAM_BOUND - x.abs(),
-                false,
-            )?;
+            check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)?;
         }
         let scalars = [
             ("mu", cfg.mu),

@@ -37,11 +37,20 @@ pub struct TargetImpedance<const N: usize> {
 
 impl<const N: usize> TargetImpedance<N> {
     /// Validated: Dd > 0 (SPEC §10), Cd ≥ 0 and Gd ≥ 0 (a negative damping or
-    /// stiffness would make the reference itself unstable), all finite.
+    /// stiffness would make the reference itself unstable), all finite and at
+    /// most 1e9 (as every gain: beyond, the reference overflows in use).
     pub fn new(dd: Vector<N>, cd: Vector<N>, gd: Vector<N>) -> Result<Self, Error> {
         check::positive_vec("Dd > 0", "Dd", &dd)?;
         check::nonnegative_vec("Cd ≥ 0", "Cd", &cd)?;
         check::nonnegative_vec("Gd ≥ 0", "Gd", &gd)?;
+        for (what, v) in [("Dd", &dd), ("Cd", &cd), ("Gd", &gd)] {
+            check::at_most_each(
+                "|value| ≤ 1e9",
+                what,
+                v.as_slice(),
+                crate::error::PARAM_BOUND,
+            )?;
+        }
         Ok(Self { dd, cd, gd })
     }
 

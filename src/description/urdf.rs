@@ -39,7 +39,7 @@ const XACRO_NS: &str = "http://www.ros.org/wiki/xacro";
 /// ([`Tree::new`]).
 pub fn read_file(path: impl AsRef<Path>) -> Result<Tree, DescriptionError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = read_text(path, "URDF").map_err(|e| {
         DescriptionError::new(
             ErrorKind::Io,
             format!(
@@ -57,6 +57,99 @@ pub fn read_file(path: impl AsRef<Path>) -> Result<Tree, DescriptionError> {
         &format!("URDF '{label}'"),
         &path.display().to_string(),
     )
+}
+
+/// The largest description file read (bytes): a robot's URDF or MJCF is a
+/// few MB at most; a device or a mistaken path (`/dev/zero`, a disk image)
+/// would otherwise be read until memory runs out.
+pub const MAX_FILE_BYTES: u64 = 32 << 20;
+
+/// The deepest element nesting read: a URDF nests 5 levels, a robot's MJCF
+/// a few tens; the XML reader's elements are built and dropped recursively,
+/// so a document nested 100 000 deep would overflow the stack.
+pub const MAX_DEPTH: usize = 1000;
+
+/// The text of the file at `path` (what: "URDF", "description"): a regular
+/// file of at most [`MAX_FILE_BYTES`], UTF-8; the error says which of these
+/// failed (to follow "cannot read 'PATH': ").
+pub fn read_text(path: &Path, what: &str) -> Result<String, String> {
+    use std::io::Read as _;
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if meta.is_dir() {
+        return Err("it is a directory".into());
+    }
+    if !meta.is_file() {
+        return Err(format!(
+            "it is not a regular file (a device or a pipe), not a {what}"
+        ));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(format!(
+            "it has {} bytes; a {what} file has at most {MAX_FILE_BYTES}",
+            meta.len()
+        ));
+    }
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut text = String::new();
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_string(&mut text)
+        .map_err(|e| e.to_string())?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(format!("it grew beyond {MAX_FILE_BYTES} bytes while read"));
+    }
+    Ok(text)
+}
+
+/// How deeply the elements of `text` nest, counting no further than
+/// `MAX_DEPTH + 1` (comments, CDATA, processing instructions, declarations
+/// and quoted attribute values are skipped). Linear in the text.
+fn nesting(text: &str) -> usize {
+    let b = text.as_bytes();
+    let skip_to = |from: usize, end: &[u8]| {
+        b[from..]
+            .windows(end.len())
+            .position(|w| w == end)
+            .map_or(b.len(), |p| from + p + end.len())
+    };
+    let (mut i, mut depth, mut deepest) = (0, 0usize, 0usize);
+    while i < b.len() {
+        if b[i] != b'<' {
+            i += 1;
+            continue;
+        }
+        let rest = &b[i..];
+        if rest.starts_with(b"<!--") {
+            i = skip_to(i + 4, b"-->");
+        } else if rest.starts_with(b"<![CDATA[") {
+            i = skip_to(i + 9, b"]]>");
+        } else if rest.starts_with(b"<?") {
+            i = skip_to(i + 2, b"?>");
+        } else if rest.starts_with(b"<!") || rest.starts_with(b"</") {
+            depth = depth.saturating_sub(usize::from(rest.starts_with(b"</")));
+            i = skip_to(i + 2, b">");
+        } else {
+            // A start tag: to its '>' outside quotes; "/>" closes it at once.
+            let mut j = i + 1;
+            let mut quote = 0u8;
+            while j < b.len() && (quote != 0 || b[j] != b'>') {
+                if quote == 0 && (b[j] == b'"' || b[j] == b'\'') {
+                    quote = b[j];
+                } else if b[j] == quote {
+                    quote = 0;
+                }
+                j += 1;
+            }
+            if !(j < b.len() && b[j - 1] == b'/') {
+                depth += 1;
+                deepest = deepest.max(depth);
+                if deepest > MAX_DEPTH {
+                    return deepest;
+                }
+            }
+            i = j + 1;
+        }
+    }
+    deepest
 }
 
 /// The tree of the URDF `text` (labelled "URDF text" in messages).
@@ -86,9 +179,23 @@ pub fn kind_of(text: &str) -> &'static str {
 
 /// The XML document (its root element), a panic of the parser turned into an error.
 fn document(text: &str) -> Result<xml::Element, String> {
+    if nesting(text) > MAX_DEPTH {
+        return Err(format!(
+            "its elements nest more than {MAX_DEPTH} deep (a URDF nests 5)"
+        ));
+    }
     match std::panic::catch_unwind(|| text.parse::<xml::Element>()) {
         Ok(Ok(root)) => Ok(root),
-        Ok(Err(e)) => Err(format!("{e:?}")),
+        Ok(Err(xml::BuilderError::Parser(e))) => Err(format!(
+            "it is not XML: line {}, column {}: {}",
+            e.line, e.col, e.msg
+        )),
+        Ok(Err(xml::BuilderError::ImproperNesting)) => {
+            Err("it is not XML: its elements are not properly nested".into())
+        }
+        Ok(Err(xml::BuilderError::NoElement)) => {
+            Err("it is not XML: it ends before its root element is closed".into())
+        }
         Err(_) => Err("the XML parser could not read it".into()),
     }
 }
@@ -174,7 +281,7 @@ impl ReadErrors<'_> {
             Err(_) if text.contains("<xacro:") => {
                 return Err(self.xacro("xacro elements <xacro:…>"))
             }
-            Err(e) => return Err(self.parse_error(&format!("it is not XML ({e})"))),
+            Err(e) => return Err(self.parse_error(&e)),
         };
         if root.name == "mujoco" {
             return Err(DescriptionError::new(
@@ -328,6 +435,33 @@ fn tree_of(
         .iter()
         .map(|l| link_of(l, with_inertial))
         .collect();
+    // A limit that is not a number, or a negative effort or speed, is a
+    // mistake in the file, not "no limit" (NaN made a revolute joint
+    // continuous, and a negative effort "none stated").
+    for j in &robot.joints {
+        let l = &j.limit;
+        for (v, what, signed) in [
+            (l.lower, "lower", true),
+            (l.upper, "upper", true),
+            (l.effort, "effort", false),
+            (l.velocity, "velocity", false),
+        ] {
+            if v.is_nan() || (!signed && v < 0.0) {
+                return Err(DescriptionError::new(
+                    ErrorKind::Value,
+                    format!(
+                        "{source}: joint '{}' has <limit {what}=\"{v}\">: give a number{}",
+                        j.name,
+                        if signed {
+                            ""
+                        } else {
+                            " ≥ 0 (0: none stated)"
+                        }
+                    ),
+                ));
+            }
+        }
+    }
     let joints = robot.joints.iter().map(joint_of).collect();
     Tree::new(source, &robot.name, links, joints, Vec::new())
 }

@@ -9,7 +9,7 @@
 //! exceptions of `adaptimp._errors`.
 
 use super::cartesian_loop::{
-    self, pose_target, CartesianOut, CartesianRun, JointStep, LastStep, TARGET_LEN,
+    self, pose_target, CartesianOut, CartesianRun, JointStep, LastStep, TaskRecords, TARGET_LEN,
 };
 use super::computed::{Computed, DynComputed, PyComputedTorque};
 use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JOINTS};
@@ -55,14 +55,21 @@ pub trait DynChain: Send + Sync {
     fn n(&self) -> usize;
     /// Which joints are prismatic.
     fn prismatic(&self) -> Vec<bool>;
-    /// The tip at (q, q̇) (n values each).
-    fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut;
-    /// The tip's pose at q: the homogeneous transform, row-major (4 × 4).
-    fn pose(&self, q: &[f64]) -> Vec<f64>;
-    /// The Jacobian at q, 6 × n row-major.
-    fn jacobian(&self, q: &[f64]) -> Vec<f64>;
-    /// J̇ q̇ at (q, q̇).
-    fn bias(&self, q: &[f64], dq: &[f64]) -> [f64; 6];
+    /// The tip at (q, q̇) (n values each), both finite and within their
+    /// ceilings (`Chain::tip_checked`).
+    fn tip(&self, q: &[f64], dq: &[f64]) -> Result<TipOut, Error>;
+    /// The tip's pose at q: the homogeneous transform, row-major (4 × 4);
+    /// q checked as by `tip`.
+    fn pose(&self, q: &[f64]) -> Result<Vec<f64>, Error>;
+    /// The Jacobian at q, 6 × n row-major; q checked as by `tip`.
+    fn jacobian(&self, q: &[f64]) -> Result<Vec<f64>, Error>;
+    /// J̇ q̇ at (q, q̇), checked as by `tip` (finite, or an error).
+    fn bias(&self, q: &[f64], dq: &[f64]) -> Result<[f64; 6], Error>;
+    /// The tip (Jacobian, J̇ q̇) and the pose (4 × 4 row-major) unchecked: for
+    /// the core's rules, which hand in their own postures.
+    fn tip_pose_unchecked(&self, q: &[f64], dq: &[f64]) -> (TipOut, Vec<f64>);
+    /// The pose (4 × 4 row-major) unchecked (a run's recorded postures).
+    fn pose_unchecked(&self, q: &[f64]) -> Vec<f64>;
     /// The outer loop of `cfg` over this chain at period `ts`, started at `q0`.
     fn outer(
         &self,
@@ -71,6 +78,17 @@ pub trait DynChain: Send + Sync {
         q0: &[f64],
         posture: Option<&[f64]>,
     ) -> Result<Box<dyn DynOuter>, Error>;
+}
+
+/// `v` if every value is finite, else the error `tip_checked` gives.
+fn finite_out(v: Vec<f64>) -> Result<Vec<f64>, Error> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(Error::Diverged {
+            what: "the chain's tip (pose, Jacobian or J̇ q̇)",
+        })
+    }
 }
 
 fn vector_of<const N: usize>(v: &[f64]) -> Vector<N> {
@@ -84,14 +102,26 @@ impl<const N: usize> DynChain for Chain<N> {
     fn prismatic(&self) -> Vec<bool> {
         (0..N).map(|i| self.is_prismatic(i)).collect()
     }
-    fn tip(&self, q: &[f64], dq: &[f64]) -> TipOut {
-        let t = Kinematics::tip(self, &vector_of(q), &vector_of(dq));
-        TipOut {
+    fn tip(&self, q: &[f64], dq: &[f64]) -> Result<TipOut, Error> {
+        let t = self.tip_checked(&vector_of(q), &vector_of(dq))?;
+        Ok(TipOut {
             jacobian: t.jacobian.transpose().as_slice().to_vec(),
             bias: t.bias.into(),
-        }
+        })
     }
-    fn pose(&self, q: &[f64]) -> Vec<f64> {
+    fn tip_pose_unchecked(&self, q: &[f64], dq: &[f64]) -> (TipOut, Vec<f64>) {
+        let t = Kinematics::tip(self, &vector_of(q), &vector_of(dq));
+        let tip = TipOut {
+            jacobian: t.jacobian.transpose().as_slice().to_vec(),
+            bias: t.bias.into(),
+        };
+        (tip, self.pose_unchecked(q))
+    }
+    fn pose(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
+        self.check_motion(&vector_of(q), None)?;
+        finite_out(self.pose_unchecked(q))
+    }
+    fn pose_unchecked(&self, q: &[f64]) -> Vec<f64> {
         let (p, r) = Chain::pose(self, &vector_of(q));
         let mut m = std::vec![0.0; 16];
         for i in 0..3 {
@@ -103,16 +133,29 @@ impl<const N: usize> DynChain for Chain<N> {
         m[15] = 1.0;
         m
     }
-    fn jacobian(&self, q: &[f64]) -> Vec<f64> {
+    fn jacobian(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
+        let q = vector_of::<N>(q);
+        self.check_motion(&q, None)?;
         // Column-major 6 × N storage of Jᵀ: J row-major.
-        self.pose_jacobian(&vector_of(q))
-            .jacobian
-            .transpose()
-            .as_slice()
-            .to_vec()
+        finite_out(
+            self.pose_jacobian(&q)
+                .jacobian
+                .transpose()
+                .as_slice()
+                .to_vec(),
+        )
     }
-    fn bias(&self, q: &[f64], dq: &[f64]) -> [f64; 6] {
-        Chain::bias(self, &vector_of(q), &vector_of(dq)).into()
+    fn bias(&self, q: &[f64], dq: &[f64]) -> Result<[f64; 6], Error> {
+        let (q, dq) = (vector_of::<N>(q), vector_of::<N>(dq));
+        self.check_motion(&q, Some(&dq))?;
+        let b: [f64; 6] = Chain::bias(self, &q, &dq).into();
+        if b.iter().all(|x| x.is_finite()) {
+            Ok(b)
+        } else {
+            Err(Error::Diverged {
+                what: "the chain's tip (pose, Jacobian or J̇ q̇)",
+            })
+        }
     }
     fn outer(
         &self,
@@ -124,10 +167,8 @@ impl<const N: usize> DynChain for Chain<N> {
         let outer = CartesianImpedance::new(cfg, *self, ts)?;
         let q0 = vector_of::<N>(q0);
         let posture = posture.map_or(q0, vector_of::<N>);
-        crate::error::check::finite_slice("q0", q0.as_slice())?;
-        crate::error::check::finite_slice("posture", posture.as_slice())?;
-        let mut state = outer.start(q0);
-        state.posture = posture;
+        let mut state = outer.start_checked(&q0)?;
+        outer.set_posture(&mut state, &posture)?;
         Ok(Box::new(Outer {
             outer,
             state,
@@ -215,6 +256,8 @@ pub trait DynOuter: Send + Sync {
     fn reset(&mut self, q0: Option<&[f64]>) -> Result<(), Error>;
     /// The null-space posture (rad).
     fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error>;
+    /// Check a commanded pose as a step would, changing nothing.
+    fn check_target(&self, target: &PoseTarget) -> Result<(), Error>;
     /// The stiffness asked for (N/m, N m/rad).
     fn set_stiffness(&mut self, kd: [f64; 3], kd_rot: [f64; 3]) -> Result<(), Error>;
     /// The outer loop alone: one committed step.
@@ -253,6 +296,7 @@ pub trait DynOuter: Send + Sync {
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
         hooks: &mut dyn Hooks,
+        partial: &mut Option<TaskRecords>,
     ) -> Result<CartesianOut, RunError>;
     /// Steps over recorded rows, the core's alone ([`cartesian_loop::replay`]).
     fn replay(
@@ -338,12 +382,10 @@ impl<const N: usize> DynOuter for Outer<N> {
         self.outer.orients()
     }
     fn reset(&mut self, q0: Option<&[f64]>) -> Result<(), Error> {
-        if let Some(q0) = q0 {
-            let q0 = vector_of::<N>(q0);
-            crate::error::check::finite_slice("q0", q0.as_slice())?;
-            self.q0 = q0;
-        }
-        self.state = self.outer.start(self.q0);
+        let q0 = q0.map_or(self.q0, vector_of::<N>);
+        let state = self.outer.start_checked(&q0)?;
+        self.q0 = q0;
+        self.state = state;
         self.state.posture = self.posture;
         self.last = None;
         self.log.clear();
@@ -379,14 +421,16 @@ impl<const N: usize> DynOuter for Outer<N> {
     }
     fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error> {
         let p = vector_of::<N>(posture);
-        crate::error::check::finite_slice("posture", p.as_slice())?;
+        self.outer.set_posture(&mut self.state, &p)?;
         self.posture = p;
-        self.state.posture = p;
         Ok(())
     }
     fn set_stiffness(&mut self, kd: [f64; 3], kd_rot: [f64; 3]) -> Result<(), Error> {
         self.outer
             .set_stiffness(&mut self.state, &kd.into(), &kd_rot.into())
+    }
+    fn check_target(&self, target: &PoseTarget) -> Result<(), Error> {
+        self.outer.check_target(target)
     }
     fn reference(&mut self, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Result<(), Error> {
         let staged = self.outer.stage(&self.state, target, &wrench.into())?;
@@ -530,7 +574,8 @@ impl<const N: usize> DynOuter for Outer<N> {
             dx: Vector::zeros(),
             ddx: Vector::zeros(),
         };
-        let mut out = std::vec![zero; nodes];
+        // At most one sample a step: a huge `nodes` allocates no more.
+        let mut out = std::vec![zero; nodes.min(targets.len()).max(1)];
         let k = self
             .outer
             .orbit(q0, targets.len(), |k| targets[k], &mut out)?;
@@ -549,6 +594,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
         hooks: &mut dyn Hooks,
+        partial: &mut Option<TaskRecords>,
     ) -> Result<CartesianOut, RunError> {
         let joint = typed::<N>(joint)?;
         cartesian_loop::simulate_mujoco(
@@ -560,6 +606,7 @@ impl<const N: usize> DynOuter for Outer<N> {
             spec,
             run,
             hooks,
+            partial,
         )
     }
     fn replay(
@@ -652,6 +699,26 @@ fn cartesian_error(e: Error) -> PyErr {
 
 /// A flat vector of exactly `len` finite reals (a sequence or an array).
 fn flat(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let v = flat_values(what, len, obj)?;
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(MeasurementError::new_err(format!(
+            "{what}[{i}] is not finite (NaN or infinite)"
+        )));
+    }
+    Ok(v)
+}
+
+/// `len` reals from a 1-D sequence or array (another shape, e.g. a (2, 3)
+/// wrench, is refused naming `what`), finite or not.
+fn flat_values(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    if let Ok(shape) = obj.getattr("shape").and_then(|s| s.extract::<Vec<usize>>()) {
+        if shape.len() != 1 {
+            return Err(MeasurementError::new_err(format!(
+                "{what} must have shape ({len},), got {}",
+                python_shape(&shape)
+            )));
+        }
+    }
     let v: Vec<f64> = match obj.cast::<PyArray1<f64>>() {
         Ok(a) => a.try_readonly()?.as_array().iter().copied().collect(),
         Err(_) => obj
@@ -669,11 +736,6 @@ fn flat(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<
         return Err(MeasurementError::new_err(format!(
             "{what} must have {len} values, got {}",
             v.len()
-        )));
-    }
-    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-        return Err(MeasurementError::new_err(format!(
-            "{what}[{i}] is not finite (NaN or infinite)"
         )));
     }
     Ok(v)
@@ -699,6 +761,25 @@ fn reals<const L: usize>(what: &'static str, obj: Option<&Bound<'_, PyAny>>) -> 
     Ok(out)
 }
 
+/// NumPy's shape of `obj` ("(2, 3)"), if it is not `want` (a (9,) R or a
+/// (2, 3) wrench was read flat, silently).
+fn shape_other_than(obj: &Bound<'_, PyAny>, want: &[&[usize]]) -> Option<String> {
+    let shape: Vec<usize> = obj
+        .py()
+        .import("numpy")
+        .and_then(|np| np.call_method1("shape", (obj,)))
+        .and_then(|s| s.extract())
+        .ok()?;
+    if want.contains(&shape.as_slice()) {
+        return None;
+    }
+    let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();
+    Some(match dims.len() {
+        1 => format!("({},)", dims[0]),
+        _ => format!("({})", dims.join(", ")),
+    })
+}
+
 /// F_e from (6,), or f (3,) alone (no moment).
 fn wrench_sample(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
     if obj.is_none() {
@@ -712,6 +793,11 @@ fn wrench_sample(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
             }
             return Ok(out);
         }
+    }
+    if let Some(shape) = shape_other_than(obj, &[&[6], &[3]]) {
+        return Err(MeasurementError::new_err(format!(
+            "wrench must have shape (6,) or (3,), got shape {shape}"
+        )));
     }
     let v = flat_any("wrench", 0, obj)?;
     match v.len() {
@@ -767,6 +853,11 @@ fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTa
                 core::array::from_fn(|k| a.get_owned([k / 3, k % 3]).unwrap_or(f64::NAN))
             }
             _ => {
+                if let Some(shape) = shape_other_than(r, &[&[3, 3]]) {
+                    return Err(MeasurementError::new_err(format!(
+                        "R_c must have shape (3, 3), got shape {shape}"
+                    )));
+                }
                 let f = flat_any("R_c", 9, r)?;
                 core::array::from_fn(|k| f[k])
             }
@@ -801,14 +892,100 @@ fn flat_any(what: &'static str, len: usize, obj: &Bound<'_, PyAny>) -> PyResult<
     Ok(v)
 }
 
+/// A flat target (24,); a value that is not finite is refused by the
+/// core's check of the target, naming its part (p_c, R_c, w_c, …).
 fn target_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PoseTarget>> {
-    obj.map(|o| flat("target", TARGET_LEN, o).map(|v| pose_target(&v)))
+    obj.map(|o| flat_values("target", TARGET_LEN, o).map(|v| pose_target(&v)))
         .transpose()
 }
 
 fn wrench_of(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
     let v = flat("wrench", 6, obj)?;
     Ok(core::array::from_fn(|i| v[i]))
+}
+
+/// A Cartesian run's task rows (`k` of them) as the dict of
+/// `CartesianController.arrays()`'s keys.
+fn task_dict(py: Python<'_>, task: TaskRecords, k: usize) -> PyResult<Bound<'_, PyDict>> {
+    let n = task.n;
+    let [pc, dpc, ddpc] = task.pc;
+    let [pd, dpd, ddpd] = task.pd;
+    let d = PyDict::new(py);
+    for (name, v, w) in [
+        ("pc", pc, 3),
+        ("dpc", dpc, 3),
+        ("ddpc", ddpc, 3),
+        ("pd", pd, 3),
+        ("dpd", dpd, 3),
+        ("ddpd", ddpd, 3),
+        ("qd", task.qd, n),
+        ("wrench", task.wrench, 6),
+        ("error", task.error, 6),
+    ] {
+        d.set_item(name, array(py, v, (k, w))?)?;
+    }
+    Ok(d)
+}
+
+/// The rows of a table (K, n) of reals from any array or nested sequence
+/// (K given: of that many rows), else a MeasurementError (TypeError for
+/// values that are not reals) naming `what` and the shape it had.
+fn rows_of(
+    what: &str,
+    obj: &Bound<'_, PyAny>,
+    k: Option<usize>,
+    n: usize,
+) -> PyResult<(usize, Vec<f64>)> {
+    let np = obj.py().import("numpy")?;
+    let a = np
+        .call_method1("asarray", (obj, "float64"))
+        .map_err(|_| PyTypeError::new_err(format!("{what} must be an array of reals")))?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    let rows = k.unwrap_or(shape.first().copied().unwrap_or(0));
+    if shape != [rows, n] {
+        let like = if k.is_some() { " like q" } else { "" };
+        return Err(MeasurementError::new_err(format!(
+            "{what} must have shape ({}, {n}){like}, got {}",
+            k.map_or("K".to_string(), |k| k.to_string()),
+            python_shape(&shape)
+        )));
+    }
+    let v: Vec<f64> = a.call_method0("ravel")?.extract()?;
+    Ok((rows, v))
+}
+
+/// A count given as a Python integer (not a bool, not a float): ≥ 1, else
+/// a ConfigError (TypeError for another type) naming `what`.
+fn count(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    use pyo3::types::{PyBool, PyInt};
+    if obj.is_instance_of::<PyBool>() || !obj.is_instance_of::<PyInt>() {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must be an integer ≥ 1, got {}",
+            obj.repr()?
+        )));
+    }
+    match obj.extract::<i128>() {
+        Ok(v) if v >= 1 => Ok(usize::try_from(v).unwrap_or(usize::MAX)),
+        _ => Err(ConfigError::new_err(format!(
+            "{what} must be an integer ≥ 1, got {}",
+            obj.repr()?
+        ))),
+    }
+}
+
+/// A real number (a Python or NumPy int or float; not a bool, not a
+/// string), else a TypeError naming `what`.
+fn real(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    use pyo3::types::PyBool;
+    let v = if obj.is_instance_of::<PyBool>() {
+        None
+    } else {
+        obj.extract::<f64>().ok()
+    };
+    v.ok_or_else(|| {
+        let shown = obj.repr().map_or_else(|_| "?".into(), |r| r.to_string());
+        PyTypeError::new_err(format!("{what} must be a real number, got {shown}"))
+    })
 }
 
 fn rows(n: usize, what: &str, a: &PyReadonlyArray2<'_, f64>, width: usize) -> PyResult<Vec<f64>> {
@@ -850,9 +1027,8 @@ pub(super) struct TypedChain<'a, const N: usize>(pub(super) &'a dyn DynChain);
 
 impl<const N: usize> Kinematics<N> for TypedChain<'_, N> {
     fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> crate::cartesian::Tip<N> {
-        let t = self.0.tip(q.as_slice(), dq.as_slice());
         // The pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
-        let pose = self.0.pose(q.as_slice());
+        let (t, pose) = self.0.tip_pose_unchecked(q.as_slice(), dq.as_slice());
         crate::cartesian::Tip {
             position: Vector::<3>::new(pose[3], pose[7], pose[11]),
             rotation: nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::new(
@@ -903,7 +1079,8 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        array(py, self.inner.pose(&q[..n]), (4, 4))
+        let pose = self.inner.pose(&q[..n]).map_err(cartesian_error)?;
+        array(py, pose, (4, 4))
     }
 
     /// The tip's twist and acceleration along recorded rows q, q̇, q̈ (K, n)
@@ -914,15 +1091,14 @@ impl PyChain {
     fn motion<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray2<'py, f64>,
-        dq: PyReadonlyArray2<'py, f64>,
-        ddq: PyReadonlyArray2<'py, f64>,
+        q: &Bound<'py, PyAny>,
+        dq: &Bound<'py, PyAny>,
+        ddq: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
         let n = self.inner.n();
-        let k = q.shape()[0];
-        let q = super::table("q", &q, k, n)?;
-        let dq = super::table("dq", &dq, k, n)?;
-        let ddq = super::table("ddq", &ddq, k, n)?;
+        let (k, q) = rows_of("q", q, None, n)?;
+        let (_, dq) = rows_of("dq", dq, Some(k), n)?;
+        let (_, ddq) = rows_of("ddq", ddq, Some(k), n)?;
         for (what, t) in [("q", &q), ("dq", &dq), ("ddq", &ddq)] {
             if let Some(i) = t.iter().position(|x| !x.is_finite()) {
                 return Err(MeasurementError::new_err(format!(
@@ -933,21 +1109,27 @@ impl PyChain {
             }
         }
         let inner = &self.inner;
-        let (v, a) = py.detach(|| {
-            let (mut v, mut a) = (std::vec![0.0; 6 * k], std::vec![0.0; 6 * k]);
-            for r in 0..k {
-                let rows = r * n..(r + 1) * n;
-                let t = inner.tip(&q[rows.clone()], &dq[rows.clone()]);
-                // TipOut's Jacobian is row-major 6 × n.
-                for i in 0..6 {
-                    let row = &t.jacobian[i * n..(i + 1) * n];
-                    let dot = |x: &[f64]| row.iter().zip(x).map(|(j, x)| j * x).sum::<f64>();
-                    v[6 * r + i] = dot(&dq[rows.clone()]);
-                    a[6 * r + i] = dot(&ddq[rows.clone()]) + t.bias[i];
+        let (v, a) = py
+            .detach(|| {
+                let (mut v, mut a) = (std::vec![0.0; 6 * k], std::vec![0.0; 6 * k]);
+                for r in 0..k {
+                    let rows = r * n..(r + 1) * n;
+                    let t = inner
+                        .tip(&q[rows.clone()], &dq[rows.clone()])
+                        .map_err(|e| (r, e))?;
+                    // TipOut's Jacobian is row-major 6 × n.
+                    for i in 0..6 {
+                        let row = &t.jacobian[i * n..(i + 1) * n];
+                        let dot = |x: &[f64]| row.iter().zip(x).map(|(j, x)| j * x).sum::<f64>();
+                        v[6 * r + i] = dot(&dq[rows.clone()]);
+                        a[6 * r + i] = dot(&ddq[rows.clone()]) + t.bias[i];
+                    }
                 }
-            }
-            (v, a)
-        });
+                Ok((v, a))
+            })
+            .map_err(|(r, e): (usize, Error)| {
+                MeasurementError::new_err(format!("row {r}: {}", super::python_names(e)))
+            })?;
         Ok((array(py, v, (k, 6))?, array(py, a, (k, 6))?))
     }
 
@@ -960,7 +1142,8 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        array(py, self.inner.jacobian(&q[..n]), (6, n))
+        let jacobian = self.inner.jacobian(&q[..n]).map_err(cartesian_error)?;
+        array(py, jacobian, (6, n))
     }
 
     /// J̇ q̇ at (q, q̇), (6,): the tip's classical acceleration at q̈ = 0,
@@ -973,7 +1156,11 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.inner.n();
         let (q, dq) = (self.qv("q", q)?, self.qv("dq", dq)?);
-        Ok(array1(py, &self.inner.bias(&q[..n], &dq[..n])))
+        let bias = self
+            .inner
+            .bias(&q[..n], &dq[..n])
+            .map_err(cartesian_error)?;
+        Ok(array1(py, &bias))
     }
 }
 
@@ -1073,7 +1260,7 @@ impl PyCartesian {
         let q0 = q0.map(|q| vector("q0", self.n, q)).transpose()?;
         self.lock(py)
             .reset(q0.as_ref().map(|q| &q[..self.n]))
-            .map_err(cartesian_error)
+            .map_err(|e| ConfigError::new_err(e.to_string()))
     }
 
     /// The null-space posture q_posture (rad), (n,).
@@ -1081,7 +1268,18 @@ impl PyCartesian {
         let p = vector("posture", self.n, posture)?;
         self.lock(py)
             .set_posture(&p[..self.n])
-            .map_err(cartesian_error)
+            .map_err(|e| ConfigError::new_err(e.to_string()))
+    }
+
+    /// Check a flat pose target (24,) as a step would (its parts finite and
+    /// within their ceilings, R_c a rotation), changing nothing:
+    /// MeasurementError naming the part.
+    fn check_target(&self, py: Python<'_>, target: &Bound<'_, PyAny>) -> PyResult<()> {
+        let t = target_of(Some(target))?;
+        match t {
+            Some(t) => self.lock(py).check_target(&t).map_err(cartesian_error),
+            None => Ok(()),
+        }
     }
 
     /// Ask for the stiffness `Kd` (N/m, (3,)) and `Kd_rot` (N m/rad, (3,)): the
@@ -1185,17 +1383,16 @@ impl PyCartesian {
         };
         let mut joint = lock_joint(py, controller, n)?;
         let mut g = self.lock(py);
+        // The rotation a sample sets is held only once the core accepted the
+        // step: a refused one (a rotation that is not one) keeps nothing.
+        let mut held = g.held();
         let target = match sample {
             None => None,
-            Some(s) => {
-                let mut held = g.held();
-                let t = sample_target(s, &mut held)?;
-                g.set_held(held);
-                Some(t)
-            }
+            Some(s) => Some(sample_target(s, &mut held)?),
         };
         let m = self.measurement(&qb, dq.map(|_| &dqb), f, target);
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
+        g.set_held(held);
         if record {
             g.record();
         }
@@ -1376,38 +1573,40 @@ impl PyCartesian {
         };
         let mut hooks = super::PyHooks::new(progress);
         let mut outer = self.lock(py);
+        let mut partial = None;
         let result = {
             let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
-            py.detach(|| o.simulate_mujoco(t, &mut sim, &spec, &run, &mut hooks))
+            py.detach(|| o.simulate_mujoco(t, &mut sim, &spec, &run, &mut hooks, &mut partial))
         };
         drop(outer);
         drop(joint);
         drop(sim);
-        let (rec, task, metrics) = result.map_err(|e| super::run_error(e, &mut hooks))?;
+        let (rec, task, metrics) = match result {
+            Ok(out) => out,
+            Err(e) => {
+                // The rows of the steps taken before the error (Ctrl-C, a
+                // diverged plant), as the exception's `partial`: the
+                // controller's log keeps them.
+                let err = super::run_error(e, &mut hooks);
+                if let Some(task) = partial {
+                    let k = task.z1.len() / 3;
+                    err.value(py).setattr("partial", task_dict(py, task, k)?)?;
+                }
+                return Err(err);
+            }
+        };
         let k = rec.rows();
         let out = super::records_dict(py, rec, metrics)?;
-        let n = task.n;
-        let [pc, dpc, ddpc] = task.pc;
-        let [pd, dpd, ddpd] = task.pd;
-        for (name, v) in [("xc", &pc), ("dxc", &dpc), ("ddxc", &ddpc), ("xd", &pd)] {
+        for (name, v) in [
+            ("xc", &task.pc[0]),
+            ("dxc", &task.pc[1]),
+            ("ddxc", &task.pc[2]),
+            ("xd", &task.pd[0]),
+            ("z1", &task.z1),
+        ] {
             out.set_item(name, array(py, v.clone(), (k, 3))?)?;
         }
-        out.set_item("z1", array(py, task.z1, (k, 3))?)?;
-        let d = PyDict::new(py);
-        for (name, v, w) in [
-            ("pc", pc, 3),
-            ("dpc", dpc, 3),
-            ("ddpc", ddpc, 3),
-            ("pd", pd, 3),
-            ("dpd", dpd, 3),
-            ("ddpd", ddpd, 3),
-            ("qd", task.qd, n),
-            ("wrench", task.wrench, 6),
-            ("error", task.error, 6),
-        ] {
-            d.set_item(name, array(py, v, (k, w))?)?;
-        }
-        out.set_item("task", d)?;
+        out.set_item("task", task_dict(py, task, k)?)?;
         Ok(out)
     }
 
@@ -1461,6 +1660,25 @@ impl PyCartesian {
         array(py, out, (k, n))
     }
 
+    /// The steps round(T/Ts) of an orbit of `T` (s) at this loop's period
+    /// (1 … 1e6) and the number of samples `nodes` (an integer ≥ 1), checked
+    /// by name before a path is tabulated.
+    #[pyo3(name = "orbit_size", signature = (T, nodes))]
+    #[allow(non_snake_case)]
+    fn orbit_size(
+        &self,
+        py: Python<'_>,
+        T: &Bound<'_, PyAny>,
+        nodes: &Bound<'_, PyAny>,
+    ) -> PyResult<(usize, usize)> {
+        let t = real("T", T)?;
+        let nodes = count("nodes", nodes)?;
+        let ts = self.lock(py).ts();
+        let steps = crate::cartesian::orbit_steps(t, ts)
+            .map_err(|e| ConfigError::new_err(e.to_string()))?;
+        Ok((steps, nodes))
+    }
+
     /// The orbit rule (SPEC §15, §16): run this outer loop kinematically
     /// (F_e = 0) from `q0` along `targets` (K, 24) (one flat pose target per
     /// step) and return the joint reference (q_d, q̇_d, q̈_d, each (L, n)) of
@@ -1472,7 +1690,7 @@ impl PyCartesian {
         py: Python<'py>,
         q0: &Bound<'py, PyAny>,
         targets: PyReadonlyArray2<'py, f64>,
-        nodes: usize,
+        nodes: &Bound<'py, PyAny>,
     ) -> PyResult<(
         Bound<'py, PyArray2<f64>>,
         Bound<'py, PyArray2<f64>>,
@@ -1480,9 +1698,7 @@ impl PyCartesian {
     )> {
         let n = self.n;
         let q0 = vector("q0", n, q0)?;
-        if nodes == 0 {
-            return Err(ConfigError::new_err("nodes must be ≥ 1"));
-        }
+        let nodes = count("nodes", nodes)?;
         let k = targets.shape()[0];
         let flat_rows = rows(k, "targets", &targets, TARGET_LEN)?;
         let ts: Vec<PoseTarget> = flat_rows.chunks(TARGET_LEN).map(pose_target).collect();

@@ -337,6 +337,8 @@ struct Cartesian<'a, const N: usize, J: ?Sized> {
     targets: Option<&'a [f64]>,
     clock: &'a Cell<f64>,
     row: &'a Cell<TaskRow<N>>,
+    /// Whether `row` holds a step the recorder has not recorded yet.
+    pending: &'a Cell<bool>,
     last: Option<LastStep<N>>,
 }
 
@@ -366,6 +368,7 @@ impl<const N: usize, J: JointStep<N> + ?Sized> Cartesian<'_, N, J> {
             wrench: *wrench,
             z1: c.p - cmd.p,
         });
+        self.pending.set(true);
         self.last = Some(last);
         Ok(cmd.joint)
     }
@@ -411,11 +414,13 @@ struct TaskRecorder<'a, const N: usize, const M: usize> {
     task: &'a mut TaskRecords,
     metrics: &'a mut TaskMetrics<M>,
     row: &'a Cell<TaskRow<N>>,
+    pending: &'a Cell<bool>,
 }
 
 impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
     fn record(&mut self, r: &Row<N>) {
         let tr = self.row.get();
+        self.pending.set(false);
         self.joint.record(r);
         self.task.record(&tr);
         self.metrics.push(
@@ -444,7 +449,9 @@ fn invalid(what: &'static str, reason: &'static str) -> RunError {
 /// the joint controller `joint` on MuJoCo (`sim` as `spec` describes it),
 /// from both controllers' current states (not reset: a used controller goes
 /// on). Returns the records and the task-space metrics, and leaves the last
-/// step taken in `last` (also when the run ends with an error).
+/// step taken in `last` (also when the run ends with an error); when it ends
+/// with an error (Ctrl-C, a diverged plant), the task rows of the steps it
+/// took in `partial` (the controller's log keeps them).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn simulate_mujoco<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
@@ -455,11 +462,12 @@ pub(crate) fn simulate_mujoco<const N: usize, J: JointStep<N> + ?Sized>(
     spec: &MujocoSpec,
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
+    partial: &mut Option<TaskRecords>,
 ) -> Result<CartesianOut, RunError> {
     if N <= 3 {
-        run_m::<N, 3, J>(outer, state, joint, last, sim, spec, run, hooks)
+        run_m::<N, 3, J>(outer, state, joint, last, sim, spec, run, hooks, partial)
     } else {
-        run_m::<N, N, J>(outer, state, joint, last, sim, spec, run, hooks)
+        run_m::<N, N, J>(outer, state, joint, last, sim, spec, run, hooks, partial)
     }
 }
 
@@ -475,6 +483,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     spec: &MujocoSpec,
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
+    partial: &mut Option<TaskRecords>,
 ) -> Result<CartesianOut, RunError> {
     let total = checked(outer, &*joint, run)?;
     let every = run.every.max(1);
@@ -485,6 +494,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     let mut metrics = TaskMetrics::<M>::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
     let clock = Cell::new(0.0);
     let row = Cell::new(TaskRow::<N>::nan());
+    let pending = Cell::new(false);
     let mut ctrl = Cartesian {
         outer,
         state,
@@ -492,6 +502,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         targets: run.targets,
         clock: &clock,
         row: &row,
+        pending: &pending,
         last: *last,
     };
     let law = ctrl.joint.law();
@@ -510,10 +521,19 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         task: &mut task,
         metrics: &mut metrics,
         row: &row,
+        pending: &pending,
     };
     let result = drive_mujoco(&mut ctrl, &Clock(&clock), on, hooks, &mut recorder);
     *last = ctrl.last;
-    result?;
+    if let Err(e) = result {
+        // A step taken in the period the error stopped: its task row too
+        // (the controller's clock counts it).
+        if pending.get() {
+            task.record(&row.get());
+        }
+        *partial = Some(task);
+        return Err(e);
+    }
     Ok((rec, task, metrics.finish()))
 }
 

@@ -53,10 +53,17 @@ pub trait DynComputed: Send + Sync {
         c: [&[f64]; 3],
         out: &mut [f64],
     ) -> Result<(), Error>;
-    /// ID(q, q̇, q̈) of the controller's model (SPEC (20.5)) into `out`.
-    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64], out: &mut [f64]);
+    /// ID(q, q̇, q̈) of the controller's model (SPEC (20.5)) into `out`: inputs
+    /// within their ceilings, the torque finite (else an error naming them).
+    fn inverse_dynamics(
+        &self,
+        q: &[f64],
+        dq: &[f64],
+        ddq: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), Error>;
     /// M(q), row-major.
-    fn mass_matrix(&self, q: &[f64]) -> Vec<f64>;
+    fn mass_matrix(&self, q: &[f64]) -> Result<Vec<f64>, Error>;
     /// The last step's τ, sat(τ), xc, xd, z1 (by index).
     fn last(&self, what: usize) -> Vec<f64>;
     /// The last refused step: (error, step).
@@ -77,6 +84,15 @@ pub trait DynComputed: Send + Sync {
     ) -> Result<(Records, MetricsOut), RunError>;
     /// As [`Any`], for the typed paths.
     fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// An input of a model query refused (MeasurementError, named), or a result
+/// that is not finite (DivergedError).
+fn input_error(e: Error) -> pyo3::PyErr {
+    match e {
+        Error::Diverged { .. } => super::DivergedError::new_err(e.to_string()),
+        _ => super::MeasurementError::new_err(e.to_string()),
+    }
 }
 
 /// Computed torque (SPEC §20) with its state.
@@ -127,17 +143,25 @@ impl<const N: usize> DynComputed for Computed<N> {
         out[..N].copy_from_slice(cmd.tau_sat.as_slice());
         Ok(())
     }
-    fn inverse_dynamics(&self, q: &[f64], dq: &[f64], ddq: &[f64], out: &mut [f64]) {
-        let tau =
-            self.ctrl
-                .model()
-                .inverse_dynamics(&vector_of(q), &vector_of(dq), &vector_of(ddq));
+    fn inverse_dynamics(
+        &self,
+        q: &[f64],
+        dq: &[f64],
+        ddq: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), Error> {
+        let tau = self.ctrl.model().inverse_dynamics_checked(
+            &vector_of(q),
+            &vector_of(dq),
+            &vector_of(ddq),
+        )?;
         out[..N].copy_from_slice(tau.as_slice());
+        Ok(())
     }
-    fn mass_matrix(&self, q: &[f64]) -> Vec<f64> {
-        let m = self.ctrl.model().mass_matrix(&vector_of(q));
+    fn mass_matrix(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
+        let m = self.ctrl.model().mass_matrix_checked(&vector_of(q))?;
         // Column-major storage of a symmetric matrix: its rows.
-        m.as_slice().to_vec()
+        Ok(m.as_slice().to_vec())
     }
     fn last(&self, what: usize) -> Vec<f64> {
         let c = &self.state.last;
@@ -673,7 +697,7 @@ impl PyComputedTorque {
                 [&b[3][..n], &b[4][..n], &b[5][..n]],
                 &mut out[..n],
             )
-            .map_err(super::step_error)?;
+            .map_err(input_error)?;
         Ok(array1(py, &out[..n]))
     }
 
@@ -693,7 +717,8 @@ impl PyComputedTorque {
         );
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)
-            .inverse_dynamics(&q[..n], &dq[..n], &ddq[..n], &mut out[..n]);
+            .inverse_dynamics(&q[..n], &dq[..n], &ddq[..n], &mut out[..n])
+            .map_err(input_error)?;
         Ok(array1(py, &out[..n]))
     }
 
@@ -705,7 +730,8 @@ impl PyComputedTorque {
     ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
         let n = self.n;
         let q = vector("q", n, q)?;
-        array(py, self.lock(py).mass_matrix(&q[..n]), (n, n))
+        let m = self.lock(py).mass_matrix(&q[..n]).map_err(input_error)?;
+        array(py, m, (n, n))
     }
 
     /// A quantity of the last step by name: "tau", "tau_sat", "xc", "xd",

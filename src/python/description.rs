@@ -149,7 +149,7 @@ pub fn read_arm<'py>(
 /// root element and its markup). `FileNotFoundError` if it cannot be read.
 #[pyfunction]
 pub fn description_kind(py: Python<'_>, path: &str) -> PyResult<&'static str> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = urdf::read_text(std::path::Path::new(path), "description").map_err(|e| {
         PyFileNotFoundError::new_err(format!(
             "cannot read '{path}': {e}: give the path of a URDF, xacro or MJCF file"
         ))

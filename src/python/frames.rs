@@ -9,6 +9,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::vec::Vec;
 
+/// The keys of an origin in a joint's or the tip's dict.
+const ORIGIN_KEYS: [&str; 6] = ["xyz", "rpy", "pos", "quat", "translation", "rotation"];
+
 /// A transform from a dict: {"xyz", "rpy"} (URDF), {"pos", "quat"} (MuJoCo,
 /// [w, x, y, z]) or {"translation", "rotation"} (3 × 3, row-major); empty:
 /// the identity.
@@ -41,6 +44,27 @@ pub fn transform(d: &Bound<'_, PyDict>) -> PyResult<Transform> {
     };
     let a3 = |v: Vec<f64>| -> [f64; 3] { core::array::from_fn(|i| v[i]) };
     let err = |e: Error| ConfigError::new_err(e.to_string());
+    // One convention per origin: two given together (quat and rpy, a rotation
+    // and rpy, xyz and pos) were read as one of them, the other ignored.
+    let given: Vec<&str> = ORIGIN_KEYS
+        .iter()
+        .copied()
+        .filter(|k| d.contains(*k).unwrap_or(false))
+        .collect();
+    let fits = |set: &[&str]| given.iter().all(|k| set.contains(k));
+    let conventions: [&[&str]; 4] = [
+        &["xyz", "rpy"],
+        &["pos", "rpy"],
+        &["pos", "quat"],
+        &["translation", "rotation"],
+    ];
+    if !conventions.iter().any(|set| fits(set)) {
+        return Err(ConfigError::new_err(format!(
+            "an origin is given by xyz and rpy (URDF), pos and quat (MuJoCo) or translation \
+             and rotation, one convention at a time; got {}",
+            given.join(" and ")
+        )));
+    }
     if let Some(q) = get("quat", 4)? {
         let pos = get("pos", 3)?.map_or([0.0; 3], a3);
         return Transform::from_pos_quat(pos, core::array::from_fn(|i| q[i])).map_err(err);

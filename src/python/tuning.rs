@@ -434,7 +434,7 @@ pub fn pose_metrics<'py>(
         let (mut pos, mut rot) = (Vec::with_capacity(k), Vec::with_capacity(k));
         for r in 0..k {
             // The tip's pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
-            let pose = kin.pose(&q[r * n..(r + 1) * n]);
+            let pose = kin.pose_unchecked(&q[r * n..(r + 1) * n]);
             let position = [pose[3], pose[7], pose[11]];
             let rotation = [
                 pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],

@@ -25,6 +25,7 @@
 //! | [`networks`] | learning: [`rbf`] (bases S(Z): the grid, user centres, lattices, orbits), [`network`] (ŴD, ŴC, ŴG), [`learning`] (Euler, normalised, freeze, projection), [`simd`] | (1), (15)–(17), §6, §13, §15 |
 //! | [`cartesian`] | task space: [`kinematics`] (pose, 6 × N Jacobian, J̇ q̇), serial [`chain`](cartesian::chain)s from joint data, the [`rotation`](cartesian::rotation) error, the 6-D Cartesian impedance outer loop and its pair with a joint controller | (3), §16 |
 //! | [`description`] (feature `alloc`; URDF files with `urdf`) | reading an arm: a URDF or a compiled MuJoCo model to one kinematic tree, and the one reduction to the arm (which chain, which joints, the tip, what is held and why) | §21 |
+//! | [`dynamic`] | the run-time number of joints dispatched once ([`with_joints!`], [`joint_counts!`]) for the Python and C fronts | — |
 //! | [`schema`] | the parameter table: names, units, docs, conditions, defaults | §10 |
 //! | `sim` (feature `sim`) | simulation only: `model` (D, C, G of the paper's and planar arms), `environment` (walls), `plant` (the `Plant` trait, RK4), `simulator` (the closed loop), `record`, `metrics`, `disturb`, `inject` | (4), (55)–(63), §1–§3, §11, §12, §17 |
 //!
@@ -79,6 +80,7 @@ pub mod cartesian;
 pub mod control;
 #[cfg(feature = "alloc")]
 pub mod description;
+pub mod dynamic;
 pub mod error;
 mod math;
 pub mod networks;

@@ -338,7 +338,7 @@ trait IntoCStates {
     fn into_cstates(self) -> CStates;
 }
 
-sized!(J1 => 1, J2 => 2, J3 => 3, J4 => 4, J5 => 5, J6 => 6, J7 => 7);
+adaptimp::joint_counts!(sized);
 
 fn cart_sized<const N: usize>(
     chain: &Chain<N>,

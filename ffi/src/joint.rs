@@ -196,7 +196,7 @@ pub(crate) trait IntoStates {
     fn into_states(self) -> States;
 }
 
-sized!(J1 => 1, J2 => 2, J3 => 3, J4 => 4, J5 => 5, J6 => 6, J7 => 7);
+adaptimp::joint_counts!(sized);
 
 pub(crate) fn build_sized<const N: usize>(p: &AdaptimpParams) -> Result<Ctl<N>, AdaptimpStatus> {
     let s = scenario_of::<N>(p)?;

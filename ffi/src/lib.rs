@@ -36,6 +36,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// The largest number of joints (the arrays of the structs below have this many entries).
 pub const ADAPTIMP_MAX_JOINTS: usize = 7;
+// A literal for the header's generator; the core's list of sizes is the truth.
+const _: () = assert!(ADAPTIMP_MAX_JOINTS == adaptimp::dynamic::MAX_JOINTS);
 
 /// The outcome of a call.
 #[repr(C)]

@@ -51,7 +51,7 @@ from ._plot import PLOT_KINDS
 from ._plot import compare as plot_compare
 from ._result import SimResult, metrics_table
 from ._sweep import Choice, LogUniform, Normal, Uniform, sweep
-from .cartesian import CartesianController
+from .cartesian import CartesianController, CartesianStep, PoseTarget
 from .chain import Chain
 
 __all__ = [
@@ -62,6 +62,7 @@ __all__ = [
     "SCENARIOS",
     "AdaptimpError",
     "CartesianController",
+    "CartesianStep",
     "Chain",
     "Choice",
     "ConfigError",
@@ -75,6 +76,7 @@ __all__ = [
     "Param",
     "PlanarArm",
     "PlantWarning",
+    "PoseTarget",
     "SaveError",
     "SimResult",
     "StabilityWarning",

@@ -19,7 +19,8 @@ edited in memory, through MuJoCo's ``MjSpec``):
   move relative to each other (the arm with itself, or with what is around
   it), for the default task's self-collision check and the check after a run.
 
-Needs MuJoCo (imported by :mod:`adaptimp.mujoco` only).
+Needs MuJoCo. Imports nothing of the package above the core's reader
+(:mod:`adaptimp._description`): :mod:`adaptimp.mujoco` and :class:`adaptimp.Chain` build on it.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
 
@@ -272,8 +273,6 @@ def estimate(
     and the joint's own viscous damping b_i at :data:`EFFORT_SPEED` and dry
     friction F_i (``frictionloss``), which a file may make the larger part
     (metaworld's Sawyer: b = 10 N m s/rad on a wrist of 0.01 kg m²)."""
-    from .mujoco import _full_inertia, _limits, _postures
-
     joints = [int(m.dof_jntid[d]) for d in dofs]
     lo, hi = _limits(m, joints)
     data = mujoco.MjData(m)
@@ -870,3 +869,36 @@ def pairs(found: Iterable[tuple[str, str, float]]) -> str:
     for a, b, _ in found:
         seen.setdefault((a, b), None)
     return ", ".join(f"{a!r}–{b!r}" for a, b in seen)
+
+
+def _limits(model: mujoco.MjModel, joints: Sequence[int]) -> tuple[FloatArray, FloatArray]:
+    """Position limits (rad) of ``joints``; ∓inf where a hinge is unlimited."""
+    lo = np.full(len(joints), -math.inf)
+    hi = np.full(len(joints), math.inf)
+    for i, j in enumerate(joints):
+        if model.jnt_limited[j]:
+            lo[i], hi[i] = model.jnt_range[j]
+    return lo, hi
+
+
+def _postures(lo: FloatArray, hi: FloatArray, count: int, margin: ArrayLike = 0.0) -> FloatArray:
+    """``count`` postures (rad), deterministic, uniform in the box [lo + margin,
+    hi − margin] (±π for an unlimited joint): the zero posture clipped into the
+    box first, then the box's middle, then samples of a fixed-seed generator."""
+    m = np.asarray(margin, dtype=np.float64)
+    a: FloatArray = np.where(np.isfinite(lo), lo, -math.pi) + m
+    b: FloatArray = np.where(np.isfinite(hi), hi, math.pi) - m
+    rng = np.random.default_rng(0)
+    out = rng.uniform(a, b, size=(count, len(lo)))
+    out[0] = np.clip(0.0, a, b)
+    if count > 1:
+        out[1] = (a + b) / 2
+    return np.asarray(out, dtype=np.float64)
+
+
+def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
+    """The dense joint-space inertia into ``out`` (mj_fullM's signature changed in MuJoCo 4)."""
+    try:
+        mujoco.mj_fullM(m, d, out)
+    except TypeError:  # MuJoCo 3: mj_fullM(m, dst, qM)
+        mujoco.mj_fullM(m, out, d.qM)

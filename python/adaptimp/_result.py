@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import importlib
 import json
 import math
 import os
@@ -341,12 +342,16 @@ class SimResult:
         if cls is SimResult:
             kind = _saved_kind(path)
             if kind == "MujocoResult":
+                # The class the file names, found by its module as pickle
+                # finds a class (this module is below adaptimp.mujoco and
+                # does not import it).
                 try:
-                    from .mujoco import MujocoResult
+                    mujoco_results = importlib.import_module(f"{__package__}.mujoco")
                 except ImportError:  # without the mujoco extra: its common arrays
                     pass
                 else:
-                    return MujocoResult.load(path)
+                    loaded: SimResult = mujoco_results.MujocoResult.load(path)
+                    return loaded
         with _open(path) as f:
             r = _Reader(path, f)
             params = r.json("params", dict)

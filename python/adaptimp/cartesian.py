@@ -43,13 +43,16 @@ from numpy.typing import ArrayLike, NDArray
 from . import _adaptimp
 from ._errors import ConfigError, MeasurementError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
+from ._pose import CartesianStep, PoseTarget
 from .chain import Chain
 
 __all__ = [
     "CartesianController",
     "CartesianImpedance",
+    "CartesianStep",
     "Chain",
     "Path",
+    "PoseTarget",
     "pose_target",
 ]
 
@@ -319,19 +322,32 @@ class CartesianImpedance:
         w: ArrayLike | None = None,
         dw: ArrayLike | None = None,
         wrench: ArrayLike | None = None,
+        target: PoseTarget | None = None,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """One committed step: the commanded pose (p_c (m); ṗ_c, p̈_c, R_c, ω_c,
-        ω̇_c; None: hold the last) and F_e = [f; m] ((6,), or f (3,) alone;
-        default 0) in; (q_d, q̇_d, q̈_d) of t_k out (rad, rad/s, rad/s²)."""
-        target = None if p is None else self._target((p, dp, ddp, R, w, dw))
-        q, dq, ddq = self._core.reference(target, _wrench(wrench))
-        self._commit(target, R)
+        ω̇_c; None: hold the last), or a :class:`PoseTarget` ``target``, and
+        F_e = [f; m] ((6,), or f (3,) alone; default 0) in; (q_d, q̇_d, q̈_d)
+        of t_k out (rad, rad/s, rad/s²); the rest of the step by name in
+        :attr:`output`."""
+        if target is not None:
+            if p is not None:
+                raise TypeError("give the commanded pose as p=… or as target=…, not both")
+            p, dp, ddp, R, w, dw = target.p, target.dp, target.ddp, target.R, target.w, target.dw
+        flat = None if p is None else self._target((p, dp, ddp, R, w, dw))
+        q, dq, ddq = self._core.reference(flat, _wrench(wrench))
+        self._commit(flat, R)
         return q, dq, ddq
 
     def last(self, what: str) -> FloatArray:
         """A quantity of the last step (``q_d``, ``p_d``, ``R_d``, ``error``, …; see
         ``adaptimp._adaptimp.CartesianImpedance.last``)."""
         return np.asarray(self._core.last(what))
+
+    @property
+    def output(self) -> CartesianStep:
+        """Every quantity of the last step by name, with its unit
+        (:class:`CartesianStep`; NaN before a first step)."""
+        return CartesianStep.of(self._core)
 
     def reset(self, q0: ArrayLike | None = None) -> None:
         """Back to t = 0 (at ``q0``, default the start's). A ``q0`` the core
@@ -681,6 +697,12 @@ class CartesianController:
         return np.asarray(self.outer.core.last(what), dtype=np.float64)
 
     @property
+    def output(self) -> CartesianStep:
+        """Every quantity of the last step by name, with its unit
+        (:class:`CartesianStep`; NaN before a first step)."""
+        return CartesianStep.of(self.outer.core)
+
+    @property
     def xc(self) -> FloatArray:
         """The last step's commanded position p_c (m), (3,) (NaN before a step)."""
         return self._last("p_c")
@@ -761,15 +783,22 @@ class CartesianController:
         R: ArrayLike | None = None,
         w: ArrayLike | None = None,
         dw: ArrayLike | None = None,
+        target: PoseTarget | None = None,
     ) -> FloatArray:
         """One step at t_k = k·Ts; returns the torque to apply (N m), (n,).
 
         q (rad), dq (rad/s) (n,); ``wrench`` F_e = [f; m] (N, N m), (6,) (f (3,)
         alone: no moment; None: no contact); the commanded pose ``xc`` = p_c (m),
         ``dxc``, ``ddxc`` (m/s, m/s²), ``R`` (3, 3), ``w``, ``dw`` (rad/s,
-        rad/s²), each optional (R: the last commanded rotation); without
-        ``xc`` the ``path`` at t_k, or the last target held.
+        rad/s²), each optional (R: the last commanded rotation), or all of it
+        as a :class:`PoseTarget` ``target``; without either the ``path`` at
+        t_k, or the last target held. The rest of the step by name:
+        :attr:`output`.
         """
+        if target is not None:
+            if xc is not None:
+                raise TypeError("give the commanded pose as xc=… or as target=…, not both")
+            xc, dxc, ddxc, R, w, dw = target.p, target.dp, target.ddp, target.R, target.w, target.dw
         if xc is not None:
             sample: Any = (xc, dxc, ddxc, R, w, dw)
         elif self.path is not None:
@@ -783,20 +812,20 @@ class CartesianController:
             return out
         f = _wrench(wrench)
         # The rotation a target sets is kept only once the core accepted the step.
-        target: FloatArray | None = None
+        flat: FloatArray | None = None
         turned: object = None
         if xc is not None:
-            target = self.outer._target(
+            flat = self.outer._target(
                 (xc, dxc, ddxc, R, w, dw), ("xc", "dxc", "ddxc", "R", "w", "dw")
             )
             turned = R
         elif sample is not None:
-            target = _pose_of(sample, self.outer._R)
+            flat = _pose_of(sample, self.outer._R)
             turned = True
         core = self.outer.core
-        out = core.step_python(self.inner, q, dq, f, target)
+        out = core.step_python(self.inner, q, dq, f, flat)
         self._tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
-        self.outer._commit(target, turned)
+        self.outer._commit(flat, turned)
         if self.record:
             for key, v in zip(
                 _LOG,

@@ -199,15 +199,15 @@ class Chain(_adaptimp.Chain):
                     f"no file {str(path)!r}"
                 )
             if path.suffix.lower() in (".urdf", ".xacro"):
-                from .mujoco import from_urdf
-
-                model = from_urdf(path, fix=tuple(fix), tip=tip if isinstance(tip, str) else None)
-                fix = ()
-            else:
-                try:
-                    model = mujoco.MjModel.from_xml_path(str(path))
-                except ValueError as e:
-                    raise ConfigError(f"MuJoCo cannot load {str(path)!r}: {e}") from None
+                if tip is not None and not isinstance(tip, str):
+                    raise ConfigError(f"the tip of a URDF is a link's name, got {tip!r}")
+                # The same reader and reduction as the MuJoCo model
+                # adaptimp.mujoco.from_urdf compiles from it (SPEC §21).
+                return cls.from_urdf(path, tip, fix=fix)
+            try:
+                model = mujoco.MjModel.from_xml_path(str(path))
+            except ValueError as e:
+                raise ConfigError(f"MuJoCo cannot load {str(path)!r}: {e}") from None
         try:
             if isinstance(tip, bool) or not isinstance(tip, (str, int, np.integer, type(None))):
                 raise TypeError(f"tip must be a site's or body's name or a site id, got {tip!r}")

@@ -62,6 +62,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 from . import _adaptimp, _description, _mjcf, _models
 from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
 from ._faults import Fault
+from ._mjcf import _full_inertia, _limits, _postures
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._result import SimResult
 from ._tooling import add_table, add_tool
@@ -300,31 +301,6 @@ def from_urdf(
     if not isinstance(drive, bool):  # 'yes' was taken as True
         raise TypeError(f"drive must be True or False, got {drive!r}")
     return _compile_arm(_arm_spec(arm, timestep, drive=drive, stacklevel=3))
-
-
-def _limits(model: mujoco.MjModel, joints: Sequence[int]) -> tuple[FloatArray, FloatArray]:
-    """Position limits (rad) of ``joints``; ∓inf where a hinge is unlimited."""
-    lo = np.full(len(joints), -math.inf)
-    hi = np.full(len(joints), math.inf)
-    for i, j in enumerate(joints):
-        if model.jnt_limited[j]:
-            lo[i], hi[i] = model.jnt_range[j]
-    return lo, hi
-
-
-def _postures(lo: FloatArray, hi: FloatArray, count: int, margin: ArrayLike = 0.0) -> FloatArray:
-    """``count`` postures (rad), deterministic, uniform in the box [lo + margin,
-    hi − margin] (±π for an unlimited joint): the zero posture clipped into the
-    box first, then the box's middle, then samples of a fixed-seed generator."""
-    m = np.asarray(margin, dtype=np.float64)
-    a: FloatArray = np.where(np.isfinite(lo), lo, -math.pi) + m
-    b: FloatArray = np.where(np.isfinite(hi), hi, math.pi) - m
-    rng = np.random.default_rng(0)
-    out = rng.uniform(a, b, size=(count, len(lo)))
-    out[0] = np.clip(0.0, a, b)
-    if count > 1:
-        out[1] = (a + b) / 2
-    return np.asarray(out, dtype=np.float64)
 
 
 def estimate_effort(model: mujoco.MjModel, postures: int = 256) -> FloatArray:
@@ -871,14 +847,6 @@ _NETFORCE_DATA = sum(
 def _warning_names() -> list[str]:
     """MuJoCo's warning kinds by index (``mjtWarning``, without ``mjNWARNING``)."""
     return [mujoco.mjtWarning(i).name for i in range(int(mujoco.mjtWarning.mjNWARNING))]
-
-
-def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
-    """The dense joint-space inertia into ``out`` (mj_fullM's signature changed in MuJoCo 4)."""
-    try:
-        mujoco.mj_fullM(m, d, out)
-    except TypeError:  # MuJoCo 3: mj_fullM(m, dst, qM)
-        mujoco.mj_fullM(m, out, d.qM)
 
 
 # ---------------------------------------------------------------------------

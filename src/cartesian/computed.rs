@@ -187,20 +187,8 @@ impl<const N: usize> ComputedTorque<N> {
         c: &Setpoint<N>,
         task: Option<&TaskTorque<N>>,
     ) -> Result<Command<N>, Error> {
+        let dq = check_measurement(m, c)?;
         let q = m.x;
-        let dq = m.dx.ok_or(Error::MissingVelocity)?;
-        for (what, v) in [
-            ("x", &q),
-            ("dx", &dq),
-            ("tau_e", &m.tau_e),
-            ("xc", &c.x),
-            ("dxc", &c.dx),
-            ("ddxc", &c.ddx),
-        ] {
-            check::finite_slice(what, v.as_slice())?;
-            check::within(what, v.as_slice(), BOUND)?;
-        }
-        let (kp, kd) = (&self.cfg.kp, &self.cfg.kd);
         let external = self.cfg.mode == ImpedanceMode::External || task.is_some();
         let r = if st.k == 0 || external {
             Reference::start(c)
@@ -214,53 +202,11 @@ impl<const N: usize> ComputedTorque<N> {
             self.cfg.impedance.accel(c, &r, &m.tau_e)
         };
         // (20.3): the error dynamics' acceleration on the reference.
+        let (kp, kd) = (&self.cfg.kp, &self.cfg.kd);
         let a = ddxd + kd.component_mul(&(r.dxd - dq)) + kp.component_mul(&(r.xd - q));
-        let drive = self.model.drive();
         let (tau, xc) = match task.filter(|t| t.share < 1.0) {
-            None => (
-                self.model.inverse_dynamics(&q, &dq, &a)
-                    + drive.friction_torque(&r.dxd, &dq)
-                    + m.tau_e,
-                c.x,
-            ),
-            Some(t) => {
-                check::within("share", &[t.share], 1.0)?;
-                if t.share.is_nan() || t.share < 0.0 {
-                    return Err(Error::Condition {
-                        condition: "0 ≤ admittance_share ≤ 1",
-                        lhs: "admittance_share",
-                        index: None,
-                        value: t.share,
-                    });
-                }
-                for (what, x) in [
-                    ("jacobian", t.jacobian.as_slice()),
-                    ("spring", t.spring.as_slice()),
-                    ("damping", t.damping.as_slice()),
-                    ("twist", t.twist.as_slice()),
-                    ("lambda2", t.lambda2.as_slice()),
-                    ("xc", t.commanded.x.as_slice()),
-                    ("dxc", t.commanded.dx.as_slice()),
-                    ("ddxc", t.commanded.ddx.as_slice()),
-                ] {
-                    check::finite_slice(what, x)?;
-                    check::within(what, x, BOUND)?;
-                }
-                // (20.4): one pass for both terms (RNEA is affine in q̈).
-                let n = t.share;
-                let qc = &t.commanded;
-                let pd = kp.component_mul(&(qc.x - q)) + kd.component_mul(&(qc.dx - dq));
-                let null = t.null_space(kp).apply(&self.model.mass_times(&q, &pd));
-                let ddq = n * a + (1.0 - n) * qc.ddx;
-                let task_part = t.jacobian.transpose() * t.force(&dq) + null;
-                // (20.6) on the velocity the blend of references moves at.
-                let v_r = n * r.dxd + (1.0 - n) * qc.dx;
-                let tau = self.model.inverse_dynamics(&q, &dq, &ddq)
-                    + drive.friction_torque(&v_r, &dq)
-                    + n * m.tau_e
-                    + (1.0 - n) * task_part;
-                (tau, qc.x)
-            }
+            None => (self.joint_torque(m, &dq, &r, &a), c.x),
+            Some(t) => (self.task_torque(m, &dq, &r, &a, t)?, t.commanded.x),
         };
         if tau.iter().any(|t| !t.is_finite()) {
             return Err(Error::Diverged { what: "tau" });
@@ -294,6 +240,98 @@ impl<const N: usize> ComputedTorque<N> {
         st.applied = tau_sat;
         Ok(cmd)
     }
+
+    /// (20.3) in joint space: τ = RNEA(q, q̇, a) + the friction term (20.6)
+    /// on the reference's velocity + τe.
+    fn joint_torque(
+        &self,
+        m: &Measurement<N>,
+        dq: &Vector<N>,
+        r: &Reference<N>,
+        a: &Vector<N>,
+    ) -> Vector<N> {
+        self.model.inverse_dynamics(&m.x, dq, a)
+            + self.model.drive().friction_torque(&r.dxd, dq)
+            + m.tau_e
+    }
+
+    /// (20.4): the blend, by the admittance share n, of the joint law on the
+    /// compliant reference and the task-level force JᵀF with its null-space
+    /// posture term on the commanded one, in one RNEA pass (RNEA is affine
+    /// in q̈). Errors if the task's quantities are not finite or in range.
+    fn task_torque(
+        &self,
+        m: &Measurement<N>,
+        dq: &Vector<N>,
+        r: &Reference<N>,
+        a: &Vector<N>,
+        t: &TaskTorque<N>,
+    ) -> Result<Vector<N>, Error> {
+        check_task(t)?;
+        let (kp, kd) = (&self.cfg.kp, &self.cfg.kd);
+        let q = m.x;
+        let n = t.share;
+        let qc = &t.commanded;
+        let pd = kp.component_mul(&(qc.x - q)) + kd.component_mul(&(qc.dx - dq));
+        let null = t.null_space(kp).apply(&self.model.mass_times(&q, &pd));
+        let ddq = n * a + (1.0 - n) * qc.ddx;
+        let task_part = t.jacobian.transpose() * t.force(dq) + null;
+        // (20.6) on the velocity the blend of references moves at.
+        let v_r = n * r.dxd + (1.0 - n) * qc.dx;
+        Ok(self.model.inverse_dynamics(&q, dq, &ddq)
+            + self.model.drive().friction_torque(&v_r, dq)
+            + n * m.tau_e
+            + (1.0 - n) * task_part)
+    }
+}
+
+/// The measurement's velocity, once the measurement and the setpoint are
+/// checked finite and within [`BOUND`] (named as the core names them).
+fn check_measurement<const N: usize>(
+    m: &Measurement<N>,
+    c: &Setpoint<N>,
+) -> Result<Vector<N>, Error> {
+    let dq = m.dx.ok_or(Error::MissingVelocity)?;
+    for (what, v) in [
+        ("x", &m.x),
+        ("dx", &dq),
+        ("tau_e", &m.tau_e),
+        ("xc", &c.x),
+        ("dxc", &c.dx),
+        ("ddxc", &c.ddx),
+    ] {
+        check::finite_slice(what, v.as_slice())?;
+        check::within(what, v.as_slice(), BOUND)?;
+    }
+    Ok(dq)
+}
+
+/// The task-level input of (20.4) checked: 0 ≤ share ≤ 1, every quantity
+/// finite and within [`BOUND`].
+fn check_task<const N: usize>(t: &TaskTorque<N>) -> Result<(), Error> {
+    check::within("share", &[t.share], 1.0)?;
+    if t.share.is_nan() || t.share < 0.0 {
+        return Err(Error::Condition {
+            condition: "0 ≤ admittance_share ≤ 1",
+            lhs: "admittance_share",
+            index: None,
+            value: t.share,
+        });
+    }
+    for (what, x) in [
+        ("jacobian", t.jacobian.as_slice()),
+        ("spring", t.spring.as_slice()),
+        ("damping", t.damping.as_slice()),
+        ("twist", t.twist.as_slice()),
+        ("lambda2", t.lambda2.as_slice()),
+        ("xc", t.commanded.x.as_slice()),
+        ("dxc", t.commanded.dx.as_slice()),
+        ("ddxc", t.commanded.ddx.as_slice()),
+    ] {
+        check::finite_slice(what, x)?;
+        check::within(what, x, BOUND)?;
+    }
+    Ok(())
 }
 
 #[cfg(all(test, feature = "sim"))]

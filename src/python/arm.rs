@@ -76,19 +76,15 @@ impl<const N: usize> DynArm for PlanarArm<N> {
 
 /// A planar arm of `links.len()` (1 … 7) links.
 pub fn planar(links: &[Link], g: f64) -> Result<Box<dyn DynArm>, Error> {
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match links.len() {
-                $($k => {
-                    let l: [Link; $k] = core::array::from_fn(|i| links[i]);
-                    Ok(Box::new(PlanarArm::<$k>::new(l, g)?))
-                })*
-                _ => Err(Error::Invalid {
-                    what: "n",
-                    reason: "the number of links must be between 1 and 7",
-                }),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        links.len(),
+        K => {
+            let l: [Link; K] = core::array::from_fn(|i| links[i]);
+            Ok(Box::new(PlanarArm::<K>::new(l, g)?))
+        },
+        _ => Err(Error::Invalid {
+            what: "n",
+            reason: "the number of links must be between 1 and 7",
+        }),
+    )
 }

@@ -700,15 +700,11 @@ pub fn simulate(
     run: &CallbackRun<'_>,
     hooks: &mut dyn Hooks,
 ) -> RunOut {
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => run_n::<$k>(ctrl, sim, spec, run, hooks),)*
-                _ => invalid("n", "the number of joints must be between 1 and 7").into(),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        n,
+        K => run_n::<K>(ctrl, sim, spec, run, hooks),
+        _ => invalid("n", "the number of joints must be between 1 and 7").into(),
+    )
 }
 
 /// Close the loop of `controller`, a controller written in Python (the

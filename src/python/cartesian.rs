@@ -186,20 +186,16 @@ impl<const N: usize> DynChain for Chain<N> {
 /// many joints as it has movable ones (1 … 7).
 pub fn chain(joints: &[Joint], tip: &Transform) -> Result<Box<dyn DynChain>, Error> {
     let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => Ok(Box::new(Chain::<$k>::new(joints, tip)?)),)*
-                _ => Err(Error::Condition {
-                    condition: "1 ≤ n ≤ 7 movable joints",
-                    lhs: "movable joints",
-                    index: None,
-                    value: n as f64,
-                }),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        n,
+        K => Ok(Box::new(Chain::<K>::new(joints, tip)?)),
+        _ => Err(Error::Condition {
+            condition: "1 ≤ n ≤ 7 movable joints",
+            lhs: "movable joints",
+            index: None,
+            value: n as f64,
+        }),
+    )
 }
 
 /// The quantities of the last Cartesian step, by name.
@@ -1767,14 +1763,11 @@ pub fn centres_along<'py>(
         Ok((c.centers().to_vec(), widths))
     }
     let tube = [tube.0, tube.1];
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => along::<$k>(&qs, &dqs, tube, periodic),)*
-                _ => unreachable!("n is checked above"),
-            }
-        };
-    }
-    let (c, w) = arms!(1 2 3 4 5 6 7).map_err(|e| ConfigError::new_err(e.to_string()))?;
+    let (c, w) = crate::with_joints!(
+        n,
+        K => along::<K>(&qs, &dqs, tube, periodic),
+        _ => unreachable!("n is checked above"),
+    )
+    .map_err(|e| ConfigError::new_err(e.to_string()))?;
     Ok((array(py, c, (l, 4 * n))?, array1(py, &w)))
 }

@@ -397,20 +397,16 @@ fn computed(
     p: &Params<'_>,
 ) -> Result<Box<dyn DynComputed>, Error> {
     let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => build::<$k>(joints, inertials, gravity, p),)*
-                _ => Err(Error::Condition {
-                    condition: "1 ≤ n ≤ 7 movable joints",
-                    lhs: "movable joints",
-                    index: None,
-                    value: n as f64,
-                }),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        n,
+        K => build::<K>(joints, inertials, gravity, p),
+        _ => Err(Error::Condition {
+            condition: "1 ≤ n ≤ 7 movable joints",
+            lhs: "movable joints",
+            index: None,
+            value: n as f64,
+        }),
+    )
 }
 
 /// A 3 × 3 matrix from a nested or a flat sequence of 9 reals.

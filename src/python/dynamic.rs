@@ -32,8 +32,7 @@ use adaptimp_mujoco::Sim;
 use std::any::Any;
 use std::vec::Vec;
 
-/// Joints the bindings are built for: 1 … 7.
-pub const MAX_JOINTS: usize = 7;
+pub use crate::dynamic::MAX_JOINTS;
 
 /// A parameter value, owned (the schema's [`Value`] borrows).
 #[derive(Clone, Debug, PartialEq)]
@@ -630,19 +629,15 @@ pub fn build(
     items: &Items,
     centers: Option<&CentersSpec>,
 ) -> Result<Box<dyn DynTracker>, ParamError> {
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => Ok(Box::new(build_n::<$k>(preset, law, items, centers)?)),)*
-                _ => Err(Error::Invalid {
-                    what: "n",
-                    reason: "the number of joints must be between 1 and 7",
-                }
-                .into()),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        n,
+        K => Ok(Box::new(build_n::<K>(preset, law, items, centers)?)),
+        _ => Err(Error::Invalid {
+            what: "n",
+            reason: "the number of joints must be between 1 and 7",
+        }
+        .into()),
+    )
 }
 
 fn build_n<const N: usize>(
@@ -1083,18 +1078,14 @@ pub fn metrics_of(
     target: [&[f64]; 3],
     joint_space: Option<bool>,
 ) -> Result<MetricsOut, Error> {
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match rows.n.max(rows.m) {
-                $($k => metrics_n::<$k>(rows, settle, target, joint_space),)*
-                _ => Err(Error::Invalid {
-                    what: "rows",
-                    reason: "the joints and the reference's width must be between 1 and 7",
-                }),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        rows.n.max(rows.m),
+        K => metrics_n::<K>(rows, settle, target, joint_space),
+        _ => Err(Error::Invalid {
+            what: "rows",
+            reason: "the joints and the reference's width must be between 1 and 7",
+        }),
+    )
 }
 
 /// The SPEC §12 metrics of a run's rows given one at a time as slices: n

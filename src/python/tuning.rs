@@ -85,15 +85,21 @@ pub fn suggest<'py>(
         }
     };
     let out = PyDict::new(py);
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => fill::<$k>(py, &out, law, (&d, k, along), &tau, ts, path.as_ref(), gravity.as_deref(), (resolve, critical)),)*
-                _ => unreachable!("n checked above"),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)?;
+    crate::with_joints!(
+        n,
+        K => fill::<K>(
+            py,
+            &out,
+            law,
+            (&d, k, along),
+            &tau,
+            ts,
+            path.as_ref(),
+            gravity.as_deref(),
+            (resolve, critical),
+        ),
+        _ => unreachable!("n checked above"),
+    )?;
     Ok(out)
 }
 
@@ -199,25 +205,21 @@ pub fn default_task(
         )));
     }
     let [h, l, u] = [home, lo, hi].map(|a| a.as_array().iter().copied().collect::<Vec<f64>>());
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => {
-                    let v = |x: &[f64]| Vector::<$k>::from_column_slice(x);
-                    let t = core_default_task(&v(&h), &v(&l), &v(&u))
-                        .map_err(|e| config_error(e.into()))?;
-                    Ok((
-                        t.offset().as_slice().to_vec(),
-                        t.sin_amplitude().as_slice().to_vec(),
-                        t.cos_amplitude().as_slice().to_vec(),
-                        t.omega().as_slice().to_vec(),
-                    ))
-                })*
-                _ => unreachable!("n checked above"),
-            }
-        };
-    }
-    arms!(1 2 3 4 5 6 7)
+    crate::with_joints!(
+        n,
+        K => {
+            let v = |x: &[f64]| Vector::<K>::from_column_slice(x);
+            let t = core_default_task(&v(&h), &v(&l), &v(&u))
+                .map_err(|e| config_error(e.into()))?;
+            Ok((
+                t.offset().as_slice().to_vec(),
+                t.sin_amplitude().as_slice().to_vec(),
+                t.cos_amplitude().as_slice().to_vec(),
+                t.omega().as_slice().to_vec(),
+            ))
+        },
+        _ => unreachable!("n checked above"),
+    )
 }
 
 /// The default Cartesian task of SPEC (16.8) about the start pose `p0` (3,;
@@ -376,15 +378,12 @@ pub fn assess_posture<'py>(
         let error = rule.check(&a).err().map(|e| e.to_string());
         Ok((a, rule.score(&a), error))
     }
-    macro_rules! arms {
-        ($($k:literal)*) => {
-            match n {
-                $($k => run::<$k>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),)*
-                _ => unreachable!("a chain has 1 to 7 joints"),
-            }
-        };
-    }
-    let (a, score, error) = arms!(1 2 3 4 5 6 7).map_err(|e| config_error(e.into()))?;
+    let (a, score, error) = crate::with_joints!(
+        n,
+        K => run::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),
+        _ => unreachable!("a chain has 1 to 7 joints"),
+    )
+    .map_err(|e| config_error(e.into()))?;
     let out = PyDict::new(py);
     out.set_item("sigma_min", a.sigma_min)?;
     out.set_item("load", a.load)?;

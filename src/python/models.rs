@@ -1,0 +1,240 @@
+//! `TwoLinkArm` and `PlanarArm`: the simulation's arm models (src/sim/model.rs).
+
+use super::arm::DynArm;
+use super::{arm, dynamic};
+use super::{arrays::*, errors::*, params::*};
+use crate::control::config::Law;
+use crate::schema::Preset;
+use crate::sim::model::{Link, TwoLinkArm};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// D(q), C(q, q̇), G(q) and q̈ of `arm`, for both arm classes.
+pub(super) fn arm_matrix<'py>(
+    py: Python<'py>,
+    n: usize,
+    data: Vec<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    array(py, data, (n, n))
+}
+
+macro_rules! arm_class {
+    ($ty:ty, { $($extra:tt)* }) => {
+        #[pymethods]
+        impl $ty {
+            $($extra)*
+
+            /// Inertia matrix D(q) (kg m²), (n, n).
+            #[pyo3(name = "D")]
+            fn inertia<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                arm_matrix(py, n, a.inertia(&vector("q", n, q)?[..n]))
+            }
+
+            /// Coriolis and centripetal matrix C(q, dq) (kg m²/s), (n, n).
+            #[pyo3(name = "C")]
+            fn coriolis<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+                dq: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                let m = a.coriolis(&vector("q", n, q)?[..n], &vector("dq", n, dq)?[..n]);
+                arm_matrix(py, n, m)
+            }
+
+            /// Gravity torque G(q) (N m), (n,).
+            #[pyo3(name = "G")]
+            fn gravity<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                Ok(array1(py, &a.gravity(&vector("q", n, q)?[..n])))
+            }
+
+            /// Joint acceleration (rad/s²), (n,), from (4):
+            /// D(q) q̈ = tau − tau_e − C(q, dq) dq − G(q).
+            fn forward_dynamics<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+                dq: &Bound<'py, PyAny>,
+                tau: &Bound<'py, PyAny>,
+                tau_e: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                let acc = a.forward_dynamics(
+                    &vector("q", n, q)?[..n],
+                    &vector("dq", n, dq)?[..n],
+                    &vector("tau", n, tau)?[..n],
+                    &vector("tau_e", n, tau_e)?[..n],
+                );
+                Ok(array1(py, &acc))
+            }
+
+            /// End-effector position fk(q) (m), (3,): the tip of the last link in
+            /// the arm's x–y plane (z = 0), SPEC §16.
+            fn fk<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                Ok(array1(py, &a.fk(&vector("q", n, q)?[..n])))
+            }
+
+            /// Position Jacobian J(q) = ∂fk/∂q (m/rad), (3, n): ṗ = J q̇, SPEC §16.
+            fn jacobian<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let a = self.dyn_arm();
+                let n = a.n();
+                array(py, a.jacobian(&vector("q", n, q)?[..n]), (3, n))
+            }
+
+            /// Joints n.
+            #[getter]
+            fn n(&self) -> usize {
+                self.dyn_arm().n()
+            }
+        }
+    };
+}
+
+/// The paper's 2-link arm in a vertical plane, (55)–(63), SPEC §1.
+///
+/// Built from a complete parameter dict; use `adaptimp.TwoLinkArm`.
+#[pyclass(name = "TwoLinkArm", module = "adaptimp._adaptimp", frozen)]
+pub(super) struct PyArm {
+    pub(super) inner: TwoLinkArm,
+}
+
+impl PyArm {
+    pub(super) fn dyn_arm(&self) -> &dyn DynArm {
+        &self.inner
+    }
+}
+
+arm_class!(PyArm, {
+    #[new]
+    #[pyo3(signature = (params))]
+    fn new(params: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let items = items(params)?;
+        let s = dynamic::scenario::<2>(Preset::Paper, Law::Pd, &items).map_err(config_error)?;
+        let inner = TwoLinkArm::new(s.arm.resolve()).map_err(|e| config_error(e.into()))?;
+        Ok(Self { inner })
+    }
+
+    /// The arm's parameters, derived ones included: "m1", "m2" (kg), "l1",
+    /// "l2", "lc1", "lc2" (m), "I1", "I2" (kg m²), "g" (m/s²).
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = self.inner.params();
+        let d = PyDict::new(py);
+        for (name, v) in [
+            ("m1", p.m1),
+            ("m2", p.m2),
+            ("l1", p.l1),
+            ("l2", p.l2),
+            ("lc1", p.lc1),
+            ("lc2", p.lc2),
+            ("I1", p.i1),
+            ("I2", p.i2),
+            ("g", p.g),
+        ] {
+            d.set_item(name, v)?;
+        }
+        Ok(d)
+    }
+
+    /// The lumped parameters p1..p5 of (59)–(63) (kg m², kg m², kg m², kg m, kg m).
+    #[getter]
+    fn lumped(&self) -> (f64, f64, f64, f64, f64) {
+        let [p1, p2, p3, p4, p5] = self.inner.lumped();
+        (p1, p2, p3, p4, p5)
+    }
+
+    fn __repr__(&self) -> String {
+        let p = self.inner.params();
+        format!(
+            "<adaptimp._adaptimp.TwoLinkArm m=[{}, {}] kg, l=[{}, {}] m, lc=[{}, {}] m, I=[{}, {}] kg m², g={} m/s²>",
+            p.m1, p.m2, p.l1, p.l2, p.lc1, p.lc2, p.i1, p.i2, p.g
+        )
+    }
+});
+
+/// An n-link planar arm (1 ≤ n ≤ 7) of revolute joints in a vertical plane:
+/// relative joint angles, link 1's angle from the horizontal, gravity along −y.
+#[pyclass(name = "PlanarArm", module = "adaptimp._adaptimp", frozen)]
+pub(super) struct PyPlanarArm {
+    pub(super) inner: Box<dyn DynArm>,
+    pub(super) links: Vec<Link>,
+    pub(super) g: f64,
+}
+
+impl PyPlanarArm {
+    pub(super) fn dyn_arm(&self) -> &dyn DynArm {
+        self.inner.as_ref()
+    }
+}
+
+arm_class!(PyPlanarArm, {
+    /// Links from per-link `masses` (kg), `lengths` (m), `coms` (m, joint to
+    /// centre of mass) and `inertias` (kg m², about the centre of mass), and
+    /// gravity `g` (m/s²).
+    #[new]
+    #[pyo3(signature = (masses, lengths, coms, inertias, g))]
+    fn new(
+        masses: Vec<f64>,
+        lengths: Vec<f64>,
+        coms: Vec<f64>,
+        inertias: Vec<f64>,
+        g: f64,
+    ) -> PyResult<Self> {
+        let n = masses.len();
+        if lengths.len() != n || coms.len() != n || inertias.len() != n {
+            return Err(ConfigError::new_err(
+                "masses, lengths, coms and inertias need one value per link each",
+            ));
+        }
+        let links: Vec<Link> = (0..n)
+            .map(|i| Link {
+                mass: masses[i],
+                length: lengths[i],
+                com: coms[i],
+                inertia: inertias[i],
+            })
+            .collect();
+        let inner = arm::planar(&links, g).map_err(|e| config_error(e.into()))?;
+        Ok(Self { inner, links, g })
+    }
+
+    /// Gravity (m/s²).
+    #[getter]
+    fn g(&self) -> f64 {
+        self.g
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<adaptimp._adaptimp.PlanarArm n={} g={} m/s²>",
+            self.links.len(),
+            self.g
+        )
+    }
+});

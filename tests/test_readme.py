@@ -42,6 +42,8 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     ("docs/cartesian.md", 4): "Rust: the shape of the calls; the whole program is "
     "examples/14_cartesian_pose.rs, which tests/test_ffi.py runs against C and Python",
     ("docs/index.md", 0): "installs the wheel or builds the checkout: scripts/test_wheel.sh",
+    ("docs/layout.md", 0): "the import graph's command: tests/test_layout.py runs its "
+    "graph() and asserts no circle",
     ("docs/mujoco.md", 0): "installs the extras: scripts/test.sh installs the test extra",
     ("docs/mujoco.md", 2): "the callback protocol's three call shapes, not a program: the "
     "next block runs one (MyPD); tests/test_python_real_work.py and test_mujoco_cartesian.py "

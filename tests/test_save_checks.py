@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import re
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -338,16 +339,8 @@ def test_simresult_load_of_a_mujoco_file_gives_a_mujoco_result_whose_repr_works(
     np.testing.assert_array_equal(back.x_ee, mujoco_run.x_ee)
     # Where adaptimp.mujoco does not import (no extra): a SimResult of its
     # common arrays, whose repr does not need the wall a native run has.
-    import builtins
-
-    real_import = builtins.__import__
-
-    def no_mujoco(name: str, *args: Any, **kwargs: Any) -> Any:
-        if name == "mujoco":  # `from .mujoco import …` and `import mujoco` alike
-            raise ImportError("no mujoco here")
-        return real_import(name, *args, **kwargs)
-
-    monkeypatch.setattr(builtins, "__import__", no_mujoco)
+    # (A module that is None in sys.modules raises ImportError on import.)
+    monkeypatch.setitem(sys.modules, "adaptimp.mujoco", None)
     plain = SimResult.load(path)
     assert type(plain) is SimResult
     text = repr(plain)

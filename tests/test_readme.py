@@ -39,7 +39,7 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     ("README.md", 7): "CMake: run here in a project of one C file "
     "(test_the_cmake_lines_link_a_project), path/to/adaptimp being this checkout",
     ("README.md", 8): "runs this whole suite (it is scripts/test.sh)",
-    ("docs/cartesian.md", 2): "Rust: the shape of the calls; the whole program is "
+    ("docs/cartesian.md", 4): "Rust: the shape of the calls; the whole program is "
     "examples/14_cartesian_pose.rs, which tests/test_ffi.py runs against C and Python",
     ("docs/index.md", 0): "installs the wheel or builds the checkout: scripts/test_wheel.sh",
     ("docs/mujoco.md", 0): "installs the extras: scripts/test.sh installs the test extra",

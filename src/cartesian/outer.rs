@@ -282,7 +282,12 @@ fn bounded(what: &'static str, v: &Vector<3>) -> Result<(), Error> {
 /// SPEC §16 (C1)'s damping: `given`, or critical for the filtered
 /// stiffness, 2√(K̃ M) per row (`row`: 0 translation, 3 rotation).
 #[inline]
-fn damping(given: &Option<Vector<3>>, m: &Vector<3>, k: &Vector<6>, row: usize) -> Vector<3> {
+fn impedance_damping(
+    given: &Option<Vector<3>>,
+    m: &Vector<3>,
+    k: &Vector<6>,
+    row: usize,
+) -> Vector<3> {
     match given {
         Some(b) => *b,
         None => Vector::<3>::from_fn(|i, _| 2.0 * sqrt(k[row + i] * m[i])),
@@ -955,7 +960,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         let k = &s.stiffness_filtered;
         let (f, mom) = (s.wrench.fixed_rows::<3>(0), s.wrench.fixed_rows::<3>(3));
         let ep = clip(&(pt - s.pd), cfg.pos_error_max.unwrap_or(f64::INFINITY));
-        let b = damping(&cfg.bd, &cfg.md, k, 0);
+        let b = impedance_damping(&cfg.bd, &cfg.md, k, 0);
         let mut damping_used = Vector::<6>::zeros();
         damping_used.fixed_rows_mut::<3>(0).copy_from(&b);
         let kp = k.fixed_rows::<3>(0);
@@ -967,7 +972,7 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
                 &rotation_error(qt, &s.rd),
                 cfg.rot_error_max.unwrap_or(f64::INFINITY),
             );
-            let b = damping(&cfg.bd_rot, &cfg.md_rot, k, 3);
+            let b = impedance_damping(&cfg.bd_rot, &cfg.md_rot, k, 3);
             damping_used.fixed_rows_mut::<3>(3).copy_from(&b);
             let ko = k.fixed_rows::<3>(3);
             let dwd = c.dw

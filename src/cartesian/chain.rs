@@ -417,6 +417,39 @@ fn align(axis: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::from_columns(&[u, axis.cross(&u), *axis])
 }
 
+/// A movable joint's unit axis in its own frame (SPEC §16 (16.0), the
+/// chain's description), checked with its offset: a finite, non-zero axis
+/// (normalised; scaled first, so an axis of 1e300 does not overflow), a
+/// finite offset of at most 1e6; the errors name joint `index`.
+fn movable_axis(j: &Joint, index: usize) -> Result<Vector3<f64>, Error> {
+    let axis = Vector3::from(j.axis);
+    check::finite_slice("joint axis", axis.as_slice())?;
+    // Scaled first: the norm of an axis of 1e300 overflows (to an
+    // axis of zeros, and a frame of NaN in `align`).
+    let scale = axis.amax();
+    let unit = if scale > 0.0 { axis / scale } else { axis };
+    let len = scale * unit.norm();
+    if len.partial_cmp(&1e-12) != Some(core::cmp::Ordering::Greater) {
+        return Err(Error::Condition {
+            condition: "‖axis‖ > 0 (a movable joint needs an axis)",
+            lhs: "joint axis",
+            index: Some(index),
+            value: len,
+        });
+    }
+    let axis = unit / unit.norm();
+    check::finite("joint offset", j.offset)?;
+    if j.offset.abs() > 1e6 {
+        return Err(Error::Condition {
+            condition: "|offset| ≤ 1e6",
+            lhs: "joint offset",
+            index: Some(index),
+            value: j.offset,
+        });
+    }
+    Ok(axis)
+}
+
 /// `r Rot_z(θ)` for s = sin θ, c = cos θ: the first two columns turned.
 #[inline(always)]
 pub(crate) fn turn(r: &Matrix3<f64>, s: f64, c: f64) -> Matrix3<f64> {
@@ -459,23 +492,7 @@ impl<const N: usize> Chain<N> {
         joints: &[Joint],
         tip: &Transform,
     ) -> Result<(Self, [Matrix3<f64>; N]), Error> {
-        if N == 0 || N > MAX_CHAIN_JOINTS {
-            return Err(Error::Condition {
-                condition: "1 ≤ n ≤ 7 movable joints",
-                lhs: "n",
-                index: None,
-                value: N as f64,
-            });
-        }
-        let movable = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
-        if movable != N {
-            return Err(Error::Condition {
-                condition: "the chain has n movable joints (the Chain's N)",
-                lhs: "movable joints",
-                index: None,
-                value: movable as f64,
-            });
-        }
+        Self::check_count(joints)?;
         let mut links = [Link {
             p: Vector3::zeros(),
             o: Matrix3::identity(),
@@ -494,31 +511,7 @@ impl<const N: usize> Chain<N> {
                 pending = origin;
                 continue;
             }
-            let axis = Vector3::from(j.axis);
-            check::finite_slice("joint axis", axis.as_slice())?;
-            // Scaled first: the norm of an axis of 1e300 overflows (to an
-            // axis of zeros, and a frame of NaN in `align`).
-            let scale = axis.amax();
-            let unit = if scale > 0.0 { axis / scale } else { axis };
-            let len = scale * unit.norm();
-            if len.partial_cmp(&1e-12) != Some(core::cmp::Ordering::Greater) {
-                return Err(Error::Condition {
-                    condition: "‖axis‖ > 0 (a movable joint needs an axis)",
-                    lhs: "joint axis",
-                    index: Some(index),
-                    value: len,
-                });
-            }
-            let axis = unit / unit.norm();
-            check::finite("joint offset", j.offset)?;
-            if j.offset.abs() > 1e6 {
-                return Err(Error::Condition {
-                    condition: "|offset| ≤ 1e6",
-                    lhs: "joint offset",
-                    index: Some(index),
-                    value: j.offset,
-                });
-            }
+            let axis = movable_axis(j, index)?;
             // Rot(axis, θ) = A Rot_z(θ) Aᵀ and Trans(axis d) = A Trans(z d) Aᵀ:
             // the Aᵀ folds into what follows (the next origin, the tip, the
             // link's inertials), the A into this origin.
@@ -540,9 +533,38 @@ impl<const N: usize> Chain<N> {
             p: prev.tr_mul(&t.p),
             r: prev.tr_mul(&t.r),
         };
-        // Between two revolute joints, o = Rot_z(a) Rot_x(α) Rot_z(c): Rot_z(a)
-        // turns link i − 1 (its angle + a, its frame by Rot_z(a): B_{i−1}),
-        // Rot_z(c) adds to joint i's angle, o becomes the twist Rot_x(α).
+        Self::untwist_links(&mut links, &mut aligns);
+        Ok((Self { links, tip }, aligns))
+    }
+
+    /// The first check of [`aligned`](Self::aligned) (SPEC §16 (16.0)):
+    /// 1 ≤ N ≤ 7, and the description has exactly N movable joints.
+    fn check_count(joints: &[Joint]) -> Result<(), Error> {
+        if N == 0 || N > MAX_CHAIN_JOINTS {
+            return Err(Error::Condition {
+                condition: "1 ≤ n ≤ 7 movable joints",
+                lhs: "n",
+                index: None,
+                value: N as f64,
+            });
+        }
+        let movable = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
+        if movable != N {
+            return Err(Error::Condition {
+                condition: "the chain has n movable joints (the Chain's N)",
+                lhs: "movable joints",
+                index: None,
+                value: movable as f64,
+            });
+        }
+        Ok(())
+    }
+
+    /// The last stage of [`aligned`](Self::aligned): between two revolute
+    /// joints, o = Rot_z(a) Rot_x(α) Rot_z(c): Rot_z(a) turns link i − 1
+    /// (its angle + a, its frame by Rot_z(a): B_{i−1}), Rot_z(c) adds to
+    /// joint i's angle, o becomes the twist Rot_x(α) (modified DH, [`Link`]).
+    fn untwist_links(links: &mut [Link; N], aligns: &mut [Matrix3<f64>; N]) {
         for i in 1..N {
             if links[i - 1].prismatic || links[i].prismatic {
                 continue;
@@ -559,7 +581,6 @@ impl<const N: usize> Chain<N> {
             links[i].o = Matrix3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);
             links[i].twist = Some((ca, sa));
         }
-        Ok((Self { links, tip }, aligns))
     }
 
     /// The joints in the core's form, base to tip.

@@ -279,6 +279,59 @@ fn bounded(what: &'static str, v: &Vector<3>) -> Result<(), Error> {
     check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)
 }
 
+/// SPEC §16 (C1)'s damping: `given`, or critical for the filtered
+/// stiffness, 2√(K̃ M) per row (`row`: 0 translation, 3 rotation).
+#[inline]
+fn impedance_damping(
+    given: &Option<Vector<3>>,
+    m: &Vector<3>,
+    k: &Vector<6>,
+    row: usize,
+) -> Vector<3> {
+    match given {
+        Some(b) => *b,
+        None => Vector::<3>::from_fn(|i, _| 2.0 * sqrt(k[row + i] * m[i])),
+    }
+}
+
+/// What (C1) of SPEC §16 gives a step: the clipped errors (16.5), the
+/// compliant accelerations (16.13) and the damping used.
+struct Impedance {
+    ep: Vector<3>,
+    eo: Vector<3>,
+    ddpd: Vector<3>,
+    dwd: Vector<3>,
+    damping: Vector<6>,
+}
+
+/// The end of a staged step (SPEC §16 (C4)): every integrated quantity
+/// within [`BOUND`] (`OutOfRange`), joint ones first.
+#[inline]
+fn check_integrated<const N: usize>(
+    s: &CartesianState<N>,
+    imp: &Impedance,
+    ddqd: &Vector<N>,
+    ddqc: &Vector<N>,
+) -> Result<(), Error> {
+    for (what, v) in [
+        ("ddqd", ddqd),
+        ("qd", &s.qd),
+        ("dqd", &s.dqd),
+        ("ddqc", ddqc),
+        ("qc", &s.qc),
+        ("dqc", &s.dqc),
+    ] {
+        check::within(what, v.as_slice(), BOUND)?;
+    }
+    for (what, v) in [("pd", &s.pd), ("dpd", &s.dpd), ("ddpd", &imp.ddpd)] {
+        check::within(what, v.as_slice(), BOUND)?;
+    }
+    for (what, v) in [("wd", &s.wd), ("dwd", &imp.dwd)] {
+        check::within(what, v.as_slice(), BOUND)?;
+    }
+    Ok(())
+}
+
 /// A commanded pose and its rates at t_k, world frame; plain data (a C
 /// caller fills it). The rotation is validated at every step (orthonormal to
 /// 1e-6, det +1).
@@ -779,13 +832,65 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         check::finite_slice("wrench", wrench.as_slice())?;
         // The ceiling of a measured τe (N m), here in N and N m.
         check::within("wrench", wrench.as_slice(), CEILING_TORQUE)?;
-        let cfg = &self.cfg;
         let ts = self.ts;
         let mut s = *st;
-        let first = s.k == 0;
-        let c = match target {
+        let c = self.commanded_pose(&s, target)?;
+        self.filter(&mut s, &c, wrench);
+        s.last = c;
+        // (16.13) The commanded rates half a step back, at t_k − Ts/2, where
+        // the semi-implicit velocities of (C4) live: against them the
+        // damping holds a path exactly (with ṗ_c(t_k) the compliant pose
+        // lagged it by B·Ts·p̈_c/(2K)).
+        let dp_half = c.dp - (0.5 * ts) * c.ddp;
+        let w_half = c.w - (0.5 * ts) * c.dw;
+        let pt = c.p + s.offset.fixed_rows::<3>(0);
+        let qt = exp(&s.offset.fixed_rows::<3>(3).into_owned()) * c.q;
+        let imp = self.impedance(&s, &c, (&pt, &qt), (&dp_half, &w_half));
+        let ddqd = self.reference_acceleration(&mut s, &imp);
+        let (commanded, twist_c) =
+            self.commanded_reference(&mut s, &c, (&pt, &qt), (&dp_half, &w_half), &ddqd);
+        let reference = Setpoint {
+            x: s.qd,
+            dx: s.dqd,
+            ddx: ddqd,
+        };
+        let compliant = CompliantPose {
+            p: s.pd,
+            dp: s.dpd,
+            ddp: imp.ddpd,
+            r: s.rd,
+            w: s.wd,
+            dw: imp.dwd,
+        };
+        let mut error = Vector::<6>::zeros();
+        error.fixed_rows_mut::<3>(0).copy_from(&imp.ep);
+        error.fixed_rows_mut::<3>(3).copy_from(&imp.eo);
+        self.integrate(&mut s, &imp, &ddqd, &commanded.ddx);
+        check_integrated(&s, &imp, &ddqd, &commanded.ddx)?;
+        Ok(OuterStep {
+            reference,
+            commanded,
+            twist: twist_c,
+            damping: imp.damping,
+            compliant,
+            target: (pt, qt),
+            error,
+            next: s,
+        })
+    }
+
+    /// The commanded pose at t_k of [`Self::stage`], SPEC §16 (C0): the
+    /// given `target` checked, or with none the last one held at rest (at
+    /// the first step, fk(q_d) at rest).
+    #[inline]
+    fn commanded_pose(
+        &self,
+        s: &CartesianState<N>,
+        target: Option<&PoseTarget>,
+    ) -> Result<Target, Error> {
+        Ok(match target {
             Some(t) => Target::check(t, self.orients)?,
-            None if first => {
+            None if s.k == 0 => {
                 let tip = self.kin.tip(&s.qd, &Vector::zeros());
                 Target {
                     p: tip.position,
@@ -797,9 +902,19 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
                 }
             }
             None => s.last.held(),
-        };
-        // (C0) the filters (16.6).
-        if first {
+        })
+    }
+
+    /// SPEC §16 (C0), the filters (16.6): at the first step their start
+    /// (the compliant pose on the target, its rates half a step back
+    /// (16.13), q̇_d and q̇_c by (C3) from them); after it, the target's
+    /// unexplained jump decayed into the offset, the stiffness and the
+    /// wrench low-passed.
+    #[inline]
+    fn filter(&self, s: &mut CartesianState<N>, c: &Target, wrench: &Vector<6>) {
+        let cfg = &self.cfg;
+        let ts = self.ts;
+        if s.k == 0 {
             s.pd = c.p;
             s.dpd = c.dp - (0.5 * ts) * c.ddp;
             s.rd = c.q;
@@ -827,25 +942,25 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             s.stiffness_filtered += at * (s.stiffness - s.stiffness_filtered);
             s.wrench += af * (wrench - s.wrench);
         }
-        s.last = c;
-        // (16.13) The commanded rates half a step back, at t_k − Ts/2, where
-        // the semi-implicit velocities of (C4) live: against them the
-        // damping holds a path exactly (with ṗ_c(t_k) the compliant pose
-        // lagged it by B·Ts·p̈_c/(2K)).
-        let dp_half = c.dp - (0.5 * ts) * c.ddp;
-        let w_half = c.w - (0.5 * ts) * c.dw;
-        let pt = c.p + s.offset.fixed_rows::<3>(0);
-        let qt = exp(&s.offset.fixed_rows::<3>(3).into_owned()) * c.q;
-        // Damping: given, or critical for the filtered stiffness.
-        let k = s.stiffness_filtered;
-        let damping = |given: &Option<Vector<3>>, m: &Vector<3>, row: usize| match given {
-            Some(b) => *b,
-            None => Vector::<3>::from_fn(|i, _| 2.0 * sqrt(k[row + i] * m[i])),
-        };
+    }
+
+    /// SPEC §16 (C1), the target impedance on the clipped errors (16.5)
+    /// toward the filtered target (p_t, R_t), against the commanded rates
+    /// half a step back (16.13); the damping given, or critical for the
+    /// filtered stiffness. The rotation rows stay zero when not orienting.
+    #[inline]
+    fn impedance(
+        &self,
+        s: &CartesianState<N>,
+        c: &Target,
+        (pt, qt): (&Vector<3>, &UnitQuaternion<f64>),
+        (dp_half, w_half): (&Vector<3>, &Vector<3>),
+    ) -> Impedance {
+        let cfg = &self.cfg;
+        let k = &s.stiffness_filtered;
         let (f, mom) = (s.wrench.fixed_rows::<3>(0), s.wrench.fixed_rows::<3>(3));
-        // (C1) the target impedance, with the clipped errors (16.5).
         let ep = clip(&(pt - s.pd), cfg.pos_error_max.unwrap_or(f64::INFINITY));
-        let b = damping(&cfg.bd, &cfg.md, 0);
+        let b = impedance_damping(&cfg.bd, &cfg.md, k, 0);
         let mut damping_used = Vector::<6>::zeros();
         damping_used.fixed_rows_mut::<3>(0).copy_from(&b);
         let kp = k.fixed_rows::<3>(0);
@@ -854,10 +969,10 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
                 .component_div(&cfg.md);
         let (eo, dwd) = if self.orients {
             let eo = clip(
-                &rotation_error(&qt, &s.rd),
+                &rotation_error(qt, &s.rd),
                 cfg.rot_error_max.unwrap_or(f64::INFINITY),
             );
-            let b = damping(&cfg.bd_rot, &cfg.md_rot, 3);
+            let b = impedance_damping(&cfg.bd_rot, &cfg.md_rot, k, 3);
             damping_used.fixed_rows_mut::<3>(3).copy_from(&b);
             let ko = k.fixed_rows::<3>(3);
             let dwd = c.dw
@@ -867,121 +982,115 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         } else {
             (Vector::zeros(), Vector::zeros())
         };
-        // (C2) second-order CLIK on the pose at q_d, posture in the null space.
+        Impedance {
+            ep,
+            eo,
+            ddpd,
+            dwd,
+            damping: damping_used,
+        }
+    }
+
+    /// SPEC §16 (C2): q̈_d by the second-order CLIK on the compliant pose at
+    /// q_d, the posture in the null space; position-only, the compliant
+    /// orientation is the reference's own (set in `s`).
+    #[inline]
+    fn reference_acceleration(&self, s: &mut CartesianState<N>, imp: &Impedance) -> Vector<N> {
         let tip = self.kin.tip(&s.qd, &s.dqd);
         if !self.orients {
             // Position-only: the compliant orientation is the reference's own.
             s.rd = UnitQuaternion::from_rotation_matrix(&tip.rotation);
             s.wd = tip.jacobian.fixed_rows::<3>(3) * s.dqd;
         }
-        let ddqd = self.clik(
+        self.clik(
             &tip,
             (&s.qd, &s.dqd, &s.posture),
-            (&s.pd, &s.dpd, &ddpd),
-            (&s.rd, &s.wd, &dwd),
+            (&s.pd, &s.dpd, &imp.ddpd),
+            (&s.rd, &s.wd, &imp.dwd),
             &mut s.weak[0],
-        );
-        // (19.1) the commanded joint reference: the same CLIK on the filtered
-        // commanded pose alone (F_e = 0), for the formulations whose torque
-        // must not carry the measured wrench.
-        let (commanded, twist_c) = if cfg.formulation == Formulation::Admittance {
-            (
+        )
+    }
+
+    /// SPEC (19.1), the commanded joint reference: the same CLIK on the
+    /// filtered commanded pose alone (F_e = 0), for the formulations whose
+    /// torque must not carry the measured wrench, with the commanded twist;
+    /// the admittance's is the compliant reference itself (twist zero).
+    #[inline]
+    fn commanded_reference(
+        &self,
+        s: &mut CartesianState<N>,
+        c: &Target,
+        (pt, qt): (&Vector<3>, &UnitQuaternion<f64>),
+        (dp_half, w_half): (&Vector<3>, &Vector<3>),
+        ddqd: &Vector<N>,
+    ) -> (Setpoint<N>, Vector<6>) {
+        if self.cfg.formulation == Formulation::Admittance {
+            return (
                 Setpoint {
                     x: s.qd,
                     dx: s.dqd,
-                    ddx: ddqd,
+                    ddx: *ddqd,
                 },
                 Vector::<6>::zeros(),
-            )
-        } else {
-            let tip_c = self.kin.tip(&s.qc, &s.dqc);
-            let (rc, wc, dwc) = if self.orients {
-                (qt, w_half, c.dw)
-            } else {
-                let r = UnitQuaternion::from_rotation_matrix(&tip_c.rotation);
-                (
-                    r,
-                    tip_c.jacobian.fixed_rows::<3>(3) * s.dqc,
-                    Vector::zeros(),
-                )
-            };
-            let ddqc = self.clik(
-                &tip_c,
-                (&s.qc, &s.dqc, &s.posture),
-                (&pt, &dp_half, &c.ddp),
-                (&rc, &wc, &dwc),
-                &mut s.weak[1],
             );
-            let mut tw = Vector::<6>::zeros();
-            tw.fixed_rows_mut::<3>(0).copy_from(&c.dp);
-            if self.orients {
-                tw.fixed_rows_mut::<3>(3).copy_from(&c.w);
-            }
+        }
+        let tip_c = self.kin.tip(&s.qc, &s.dqc);
+        let (rc, wc, dwc) = if self.orients {
+            (*qt, *w_half, c.dw)
+        } else {
+            let r = UnitQuaternion::from_rotation_matrix(&tip_c.rotation);
             (
-                Setpoint {
-                    x: s.qc,
-                    dx: s.dqc,
-                    ddx: ddqc,
-                },
-                tw,
+                r,
+                tip_c.jacobian.fixed_rows::<3>(3) * s.dqc,
+                Vector::zeros(),
             )
         };
-        let reference = Setpoint {
-            x: s.qd,
-            dx: s.dqd,
-            ddx: ddqd,
-        };
-        let compliant = CompliantPose {
-            p: s.pd,
-            dp: s.dpd,
-            ddp: ddpd,
-            r: s.rd,
-            w: s.wd,
-            dw: dwd,
-        };
-        let mut error = Vector::<6>::zeros();
-        error.fixed_rows_mut::<3>(0).copy_from(&ep);
-        error.fixed_rows_mut::<3>(3).copy_from(&eo);
-        // (C4) semi-implicit Euler, the velocity first; R_d on SO(3).
-        s.dpd += ts * ddpd;
+        let ddqc = self.clik(
+            &tip_c,
+            (&s.qc, &s.dqc, &s.posture),
+            (pt, dp_half, &c.ddp),
+            (&rc, &wc, &dwc),
+            &mut s.weak[1],
+        );
+        let mut tw = Vector::<6>::zeros();
+        tw.fixed_rows_mut::<3>(0).copy_from(&c.dp);
+        if self.orients {
+            tw.fixed_rows_mut::<3>(3).copy_from(&c.w);
+        }
+        (
+            Setpoint {
+                x: s.qc,
+                dx: s.dqc,
+                ddx: ddqc,
+            },
+            tw,
+        )
+    }
+
+    /// SPEC §16 (C4), (16.3): semi-implicit Euler, the velocity first; R_d
+    /// on SO(3); q_c only when the formulation has its own reference.
+    #[inline]
+    fn integrate(
+        &self,
+        s: &mut CartesianState<N>,
+        imp: &Impedance,
+        ddqd: &Vector<N>,
+        ddqc: &Vector<N>,
+    ) {
+        let ts = self.ts;
+        s.dpd += ts * imp.ddpd;
         s.pd += ts * s.dpd;
         if self.orients {
-            s.wd += ts * dwd;
+            s.wd += ts * imp.dwd;
             s.rd = exp(&(ts * s.wd)) * s.rd;
         }
         s.dqd += ts * ddqd;
         s.qd += ts * s.dqd;
-        if cfg.formulation != Formulation::Admittance {
-            s.dqc += ts * commanded.ddx;
+        if self.cfg.formulation != Formulation::Admittance {
+            s.dqc += ts * ddqc;
             s.qc += ts * s.dqc;
         }
         s.k += 1;
-        for (what, v) in [
-            ("ddqd", &ddqd),
-            ("qd", &s.qd),
-            ("dqd", &s.dqd),
-            ("ddqc", &commanded.ddx),
-            ("qc", &s.qc),
-            ("dqc", &s.dqc),
-        ] {
-            check::within(what, v.as_slice(), BOUND)?;
-        }
-        for (what, v) in [("pd", &s.pd), ("dpd", &s.dpd), ("ddpd", &ddpd)] {
-            check::within(what, v.as_slice(), BOUND)?;
-        }
-        for (what, v) in [("wd", &s.wd), ("dwd", &dwd)] {
-            check::within(what, v.as_slice(), BOUND)?;
-        }
-        Ok(OuterStep {
-            reference,
-            commanded,
-            twist: twist_c,
-            damping: damping_used,
-            compliant,
-            target: (pt, qt),
-            error,
-            next: s,
-        })
     }
 
     /// The torque-level part of (19.2) for a staged step at the measured

@@ -329,6 +329,37 @@ pub fn assess_posture<'py>(
     }
     let kin = chain.dyn_chain();
     let n = kin.n();
+    check_posture_shapes((&q, &p, &gravity, &d0), (&lo, &hi, &tau_max), n)?;
+    let flat = |a: &PyReadonlyArray2<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
+    let (q, p, g, d) = (flat(&q), flat(&p), flat(&gravity), flat(&d0));
+    let (lo, hi, tau) = (flat1(&lo), flat1(&hi), flat1(&tau_max));
+    let (a, score, error) = crate::with_joints!(
+        n,
+        K => assess_typed::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),
+        _ => unreachable!("a chain has 1 to 7 joints"),
+    )
+    .map_err(|e| config_error(e.into()))?;
+    assessment_dict(py, &a, score, error)
+}
+
+/// [`assess_posture`]'s shapes, SPEC (16.9): q (K, n), p (K, 3), gravity
+/// (K, n), d0 (n, n), lo, hi, τmax (n,) with K ≥ 1; else a `ConfigError`
+/// naming the shapes given.
+fn check_posture_shapes(
+    (q, p, gravity, d0): (
+        &PyReadonlyArray2<'_, f64>,
+        &PyReadonlyArray2<'_, f64>,
+        &PyReadonlyArray2<'_, f64>,
+        &PyReadonlyArray2<'_, f64>,
+    ),
+    (lo, hi, tau_max): (
+        &PyReadonlyArray1<'_, f64>,
+        &PyReadonlyArray1<'_, f64>,
+        &PyReadonlyArray1<'_, f64>,
+    ),
+    n: usize,
+) -> PyResult<()> {
     let k = q.shape()[0];
     let shape_ok = q.shape() == [k, n]
         && p.shape() == [k, 3]
@@ -347,43 +378,49 @@ pub fn assess_posture<'py>(
             d0.shape()
         )));
     }
-    let flat = |a: &PyReadonlyArray2<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
-    let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
-    let (q, p, g, d) = (flat(&q), flat(&p), flat(&gravity), flat(&d0));
-    let (lo, hi, tau) = (flat1(&lo), flat1(&hi), flat1(&tau_max));
-    fn run<const N: usize>(
-        rule: &PostureRule,
-        kin: &dyn super::cartesian::DynChain,
-        (q, p, g, d): (&[f64], &[f64], &[f64], &[f64]),
-        (lo, hi, tau): (&[f64], &[f64], &[f64]),
-        orients: bool,
-    ) -> Result<(crate::cartesian::Assessment, f64, Option<String>), Error> {
-        let v = Vector::<N>::from_column_slice;
-        let orbit: Vec<Vector<N>> = q.chunks_exact(N).map(v).collect();
-        let targets: Vec<Vector<3>> = p
-            .chunks_exact(3)
-            .map(Vector::<3>::from_column_slice)
-            .collect();
-        let gravity: Vec<Vector<N>> = g.chunks_exact(N).map(v).collect();
-        let a = rule.assess(
-            &TypedChain::<N>(kin),
-            orients,
-            &orbit,
-            &targets,
-            &gravity,
-            &Matrix::<N>::from_row_slice(d),
-            (&v(lo), &v(hi)),
-            &v(tau),
-        )?;
-        let error = rule.check(&a).err().map(|e| e.to_string());
-        Ok((a, rule.score(&a), error))
-    }
-    let (a, score, error) = crate::with_joints!(
-        n,
-        K => run::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),
-        _ => unreachable!("a chain has 1 to 7 joints"),
-    )
-    .map_err(|e| config_error(e.into()))?;
+    Ok(())
+}
+
+/// [`assess_posture`]'s assessment at N joints, SPEC (16.9): the flat
+/// rows (q, p, gravity, d0) and the limits (lo, hi, τmax) as the rule's
+/// vectors, the rule's assessment, its score and its first violated
+/// condition (None: none).
+fn assess_typed<const N: usize>(
+    rule: &PostureRule,
+    kin: &dyn super::cartesian::DynChain,
+    (q, p, g, d): (&[f64], &[f64], &[f64], &[f64]),
+    (lo, hi, tau): (&[f64], &[f64], &[f64]),
+    orients: bool,
+) -> Result<(crate::cartesian::Assessment, f64, Option<String>), Error> {
+    let v = Vector::<N>::from_column_slice;
+    let orbit: Vec<Vector<N>> = q.chunks_exact(N).map(v).collect();
+    let targets: Vec<Vector<3>> = p
+        .chunks_exact(3)
+        .map(Vector::<3>::from_column_slice)
+        .collect();
+    let gravity: Vec<Vector<N>> = g.chunks_exact(N).map(v).collect();
+    let a = rule.assess(
+        &TypedChain::<N>(kin),
+        orients,
+        &orbit,
+        &targets,
+        &gravity,
+        &Matrix::<N>::from_row_slice(d),
+        (&v(lo), &v(hi)),
+        &v(tau),
+    )?;
+    let error = rule.check(&a).err().map(|e| e.to_string());
+    Ok((a, rule.score(&a), error))
+}
+
+/// [`assess_posture`]'s result, SPEC (16.9): the assessment's figures,
+/// the score and the first violated condition as a dict.
+fn assessment_dict<'py>(
+    py: Python<'py>,
+    a: &crate::cartesian::Assessment,
+    score: f64,
+    error: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("sigma_min", a.sigma_min)?;
     out.set_item("load", a.load)?;

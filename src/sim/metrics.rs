@@ -369,6 +369,42 @@ pub fn table_metrics(
     rows: &TableRows<'_>,
     spec: &TableSpec<'_>,
 ) -> Result<TableMetrics, crate::error::Error> {
+    let (k, n) = table_widths(rows, spec)?;
+    let target = spec.series * spec.depth;
+    let s = TableSums::settled(rows, spec, k, target);
+    let avg = |s: f64, m: usize| if m == 0 { f64::NAN } else { s / m as f64 };
+    let rms = |s: f64, m: usize| sqrt(avg(s, m));
+    let contact_lost = table_contact_lost(rows, spec, k);
+    let (sat, peak, applied) = table_torque(rows, spec, k, n);
+    Ok(TableMetrics {
+        rms_track: rms(s.track, s.n_after),
+        rms_track_along: rms(s.along, s.n_after),
+        rms_path_xy: rms(s.path, s.n_after),
+        rms_force: rms(s.force, s.n_after),
+        rms_imp: rms(s.imp, s.n_after),
+        force_target: target,
+        force_rms_err: rms(s.err, s.n_after),
+        force_chatter: rms(s.chatter, s.n_chatter),
+        force_mean: avg(s.mean, s.n_after),
+        force_16_1: spec.series * (spec.depth + avg(s.ne, s.n_after)),
+        peak_force: rows
+            .normal
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max),
+        contact_lost,
+        sat_duty: sat as f64 / k as f64,
+        peak_tau_ratio: peak,
+        applied_ratio: applied,
+    })
+}
+
+/// The row count K and the joint count n of a table run, SPEC (19.7):
+/// errors unless K ≥ 1, n ≥ 1 and every quantity has K rows at its width.
+fn table_widths(
+    rows: &TableRows<'_>,
+    spec: &TableSpec<'_>,
+) -> Result<(usize, usize), crate::error::Error> {
     let k = rows.t.len();
     let n = spec.tau_max.len();
     let sized = |v: &[f64], w: usize| v.len() == k * w;
@@ -388,63 +424,115 @@ pub fn table_metrics(
             reason: "need K ≥ 1 rows of every quantity at its width, and τmax of τ's width",
         });
     }
-    let v3 = |a: &[f64], i: usize| Vector::<3>::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
-    let sq = |x: f64| x * x;
-    let after = |i: usize| rows.t[i] >= spec.settle - 1e-9;
-    let (mut n_after, mut track, mut along, mut path, mut force, mut imp) =
-        (0usize, 0.0, 0.0, 0.0, 0.0, 0.0);
-    let (mut err, mut mean, mut ne) = (0.0, 0.0, 0.0);
-    let (mut chatter, mut n_chatter) = (0.0, 0usize);
-    let target = spec.series * spec.depth;
-    let (md, bd, kd) = (
-        Vector::<3>::from(spec.md),
-        Vector::<3>::from(spec.bd),
-        Vector::<3>::from(spec.kd),
-    );
-    for i in 0..k {
-        if !after(i) {
-            continue;
-        }
-        n_after += 1;
-        let (p, pd) = (v3(rows.p, i), v3(rows.pd, i));
-        let (pc, dpc, ddpc) = (v3(rows.pc[0], i), v3(rows.pc[1], i), v3(rows.pc[2], i));
-        let e = pd - p;
-        track += e.norm_squared();
-        along += e[0] * e[0] + e[1] * e[1];
-        let c = pc - p;
-        path += c[0] * c[0] + c[1] * c[1];
-        let f = Vector::<3>::new(
-            rows.wrench[6 * i],
-            rows.wrench[6 * i + 1],
-            rows.wrench[6 * i + 2],
+    Ok((k, n))
+}
+
+/// The sums of SPEC (19.7)'s settled figures over the rows t_k ≥ `settle`
+/// (the chatter's over consecutive pairs from there), in row order.
+struct TableSums {
+    n_after: usize,
+    track: f64,
+    along: f64,
+    path: f64,
+    force: f64,
+    imp: f64,
+    err: f64,
+    mean: f64,
+    ne: f64,
+    chatter: f64,
+    n_chatter: usize,
+}
+
+impl TableSums {
+    /// Accumulate the settled rows of a checked table run of `k` rows:
+    /// tracking, path, force and the impedance residual (C1), against the
+    /// prescribed force `target` (SPEC (19.7), (16.1)).
+    fn settled(rows: &TableRows<'_>, spec: &TableSpec<'_>, k: usize, target: f64) -> Self {
+        let v3 = |a: &[f64], i: usize| Vector::<3>::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+        let sq = |x: f64| x * x;
+        let after = |i: usize| rows.t[i] >= spec.settle - 1e-9;
+        let (mut n_after, mut track, mut along, mut path, mut force, mut imp) =
+            (0usize, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut err, mut mean, mut ne) = (0.0, 0.0, 0.0);
+        let (mut chatter, mut n_chatter) = (0.0, 0usize);
+        let (md, bd, kd) = (
+            Vector::<3>::from(spec.md),
+            Vector::<3>::from(spec.bd),
+            Vector::<3>::from(spec.kd),
         );
-        force += sq(-f[2] - kd[2] * spec.depth);
-        let r = md.component_mul(&(v3(rows.ddp, i) - ddpc))
-            + bd.component_mul(&(v3(rows.dp, i) - dpc))
-            + kd.component_mul(&(p - pc))
-            + f;
-        imp += r.norm_squared();
-        let fn_ = rows.normal[i];
-        err += sq(fn_ - target);
-        mean += fn_;
-        ne += pd[2] - p[2];
-        if i + 1 < k {
-            chatter += sq(rows.normal[i + 1] - fn_);
-            n_chatter += 1;
+        for i in 0..k {
+            if !after(i) {
+                continue;
+            }
+            n_after += 1;
+            let (p, pd) = (v3(rows.p, i), v3(rows.pd, i));
+            let (pc, dpc, ddpc) = (v3(rows.pc[0], i), v3(rows.pc[1], i), v3(rows.pc[2], i));
+            let e = pd - p;
+            track += e.norm_squared();
+            along += e[0] * e[0] + e[1] * e[1];
+            let c = pc - p;
+            path += c[0] * c[0] + c[1] * c[1];
+            let f = Vector::<3>::new(
+                rows.wrench[6 * i],
+                rows.wrench[6 * i + 1],
+                rows.wrench[6 * i + 2],
+            );
+            force += sq(-f[2] - kd[2] * spec.depth);
+            let r = md.component_mul(&(v3(rows.ddp, i) - ddpc))
+                + bd.component_mul(&(v3(rows.dp, i) - dpc))
+                + kd.component_mul(&(p - pc))
+                + f;
+            imp += r.norm_squared();
+            let fn_ = rows.normal[i];
+            err += sq(fn_ - target);
+            mean += fn_;
+            ne += pd[2] - p[2];
+            if i + 1 < k {
+                chatter += sq(rows.normal[i + 1] - fn_);
+                n_chatter += 1;
+            }
+        }
+        Self {
+            n_after,
+            track,
+            along,
+            path,
+            force,
+            imp,
+            err,
+            mean,
+            ne,
+            chatter,
+            n_chatter,
         }
     }
-    let avg = |s: f64, m: usize| if m == 0 { f64::NAN } else { s / m as f64 };
-    let rms = |s: f64, m: usize| sqrt(avg(s, m));
+}
+
+/// SPEC (19.7)'s time off the table (s): rows with F_n ≤ 0 after the first
+/// contact at or after the approach's end (all of them after it, if none;
+/// NaN for a run ending before).
+fn table_contact_lost(rows: &TableRows<'_>, spec: &TableSpec<'_>, k: usize) -> f64 {
     // Time off the table after the approach.
     let approach = |i: usize| rows.t[i] >= spec.approach_end - 1e-9;
     let first_after = (0..k).find(|&i| approach(i));
-    let contact_lost = match first_after {
+    match first_after {
         None => f64::NAN,
         Some(a) => {
             let start = (a..k).find(|&i| rows.normal[i] > 0.0).unwrap_or(a);
             (start..k).filter(|&i| rows.normal[i] <= 0.0).count() as f64 * spec.ts
         }
-    };
+    }
+}
+
+/// SPEC (19.7)'s torque figures of `k` rows of `n` joints: the rows with
+/// sat(τ) ≠ τ, max |τ_i|/τmax_i commanded from `windup_after` on, and
+/// max |sat(τ)_i|/τmax_i applied.
+fn table_torque(
+    rows: &TableRows<'_>,
+    spec: &TableSpec<'_>,
+    k: usize,
+    n: usize,
+) -> (usize, f64, f64) {
     let (mut sat, mut peak, mut applied) = (0usize, 0.0f64, 0.0f64);
     for i in 0..k {
         let (tau, tsat) = (
@@ -461,27 +549,7 @@ pub fn table_metrics(
             applied = applied.max(tsat[j].abs() / spec.tau_max[j]);
         }
     }
-    Ok(TableMetrics {
-        rms_track: rms(track, n_after),
-        rms_track_along: rms(along, n_after),
-        rms_path_xy: rms(path, n_after),
-        rms_force: rms(force, n_after),
-        rms_imp: rms(imp, n_after),
-        force_target: target,
-        force_rms_err: rms(err, n_after),
-        force_chatter: rms(chatter, n_chatter),
-        force_mean: avg(mean, n_after),
-        force_16_1: spec.series * (spec.depth + avg(ne, n_after)),
-        peak_force: rows
-            .normal
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max),
-        contact_lost,
-        sat_duty: sat as f64 / k as f64,
-        peak_tau_ratio: peak,
-        applied_ratio: applied,
-    })
+    (sat, peak, applied)
 }
 
 #[cfg(test)]

@@ -172,3 +172,28 @@ impl Tracker<2, Grid<2>, Sinusoid<2>> {
         Self::new(Controller::robot(law), Sinusoid::paper())
     }
 }
+
+#[cfg(all(test, feature = "sim"))]
+mod tests {
+    use super::*;
+    use crate::control::config::WeightBound;
+
+    #[test]
+    fn presets_are_the_documented_values() {
+        let c = Config::paper(Law::StateFeedback);
+        assert_eq!(c.ts, 50e-6);
+        assert_eq!(c.tau_max, Vector::<2>::new(17.0, 15.0));
+        let r = Config::robot(Law::StateFeedback);
+        assert_eq!(r.ts, 1e-3);
+        assert_eq!(r.weight_bound, WeightBound::Auto);
+        assert_eq!(Config::paper(Law::StateFeedback).hardened().ts, 50e-6);
+        let mut h = Config::robot(Law::StateFeedback);
+        h.ts = 50e-6;
+        assert_eq!(Config::paper(Law::StateFeedback).hardened(), h);
+        assert_eq!(SimConfig::robot().substeps, 10);
+        let a = ArmParams::default();
+        assert!((a.i2 - 0.85 * 0.31 * 0.31 / 4.0).abs() < 1e-15);
+        assert_eq!(Wall::paper().position(), 0.2);
+        assert_eq!(Grid::paper().eta2(), 25.0);
+    }
+}

@@ -2,8 +2,8 @@
 //! line spell it), group, kind, unit, one-line doc, validity condition and
 //! per-scenario default, declared once, in [`PARAMS`].
 //!
-//! Everything else derives from this table: the presets
-//! ([`presets`](crate::presets): `Config::paper`, `Controller::robot`, …), the setter by name ([`Scenario::set`]) through which the
+//! Everything else derives from this table: the presets (`src/presets.rs`,
+//! above this module: `Config::paper`, `Controller::robot`, …), the setter by name ([`Scenario::set`]) through which the
 //! Python bindings and the C ABI build configurations, and, in Python, the
 //! keyword table, `help(adaptimp.simulate)`, the command line and the stubs.
 //! [`Scenario::visit`] destructures every configuration struct exhaustively, so
@@ -1237,8 +1237,6 @@ fn choice<T: Copy>(p: &Param, v: Value<'_>, all: &[T]) -> Result<T, Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    #[cfg(feature = "sim")]
-    use crate::sim::environment::Wall;
 
     #[test]
     fn visit_names_exactly_the_schema_in_its_order() {
@@ -1313,24 +1311,5 @@ mod tests {
         assert_eq!(s.config.weight_bound, WeightBound::Fixed([1.0, 2.0, 3.0]));
         s.set("weight_bound", Value::Real(2.0)).unwrap();
         assert_eq!(s.config.weight_bound, WeightBound::Fixed([2.0; 3]));
-    }
-
-    #[test]
-    fn presets_are_the_documented_values() {
-        let c = Config::paper(Law::StateFeedback);
-        assert_eq!(c.ts, 50e-6);
-        assert_eq!(c.tau_max, Vector::<2>::new(17.0, 15.0));
-        let r = Config::robot(Law::StateFeedback);
-        assert_eq!(r.ts, 1e-3);
-        assert_eq!(r.weight_bound, WeightBound::Auto);
-        assert_eq!(Config::paper(Law::StateFeedback).hardened().ts, 50e-6);
-        let mut h = Config::robot(Law::StateFeedback);
-        h.ts = 50e-6;
-        assert_eq!(Config::paper(Law::StateFeedback).hardened(), h);
-        assert_eq!(SimConfig::robot().substeps, 10);
-        let a = ArmParams::default();
-        assert!((a.i2 - 0.85 * 0.31 * 0.31 / 4.0).abs() < 1e-15);
-        assert_eq!(Wall::paper().position(), 0.2);
-        assert_eq!(Grid::paper().eta2(), 25.0);
     }
 }

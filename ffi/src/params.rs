@@ -712,6 +712,6 @@ mod tests {
         check::<7>();
         // scenario_of sets exactly the controller group's names, in order (its
         // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 43);
+        assert_eq!(controller_names().count(), 44);
     }
 }

@@ -699,7 +699,7 @@ def test_a_given_home_reaching_sideways_gets_a_table_facing_the_base(tmp_path: P
 
 
 def test_the_target_inertia_along_the_normal_follows_the_arms_own(tmp_path: Path) -> None:
-    """SPEC (19.8): M_d,n = max(M_d, k Λ_c (Ts/m)²), k = 1/(d_max τ_n)², Λ_c
+    """SPEC (19.8): M_d,n = max(M_d, k Λ_c (Ts/m)²), k = 1/τ_n², Λ_c
     the tool's Cartesian inertia along the normal (the larger of the path's
     and MuJoCo's estimate at qpos0): an arm whose armature makes it heavy at
     the tool gets a heavier target inertia on the normal axis only; a light
@@ -720,13 +720,38 @@ def test_the_target_inertia_along_the_normal_follows_the_arms_own(tmp_path: Path
     plant.reset(sc.q0)
     jz = np.asarray(sc.chain.jacobian(sc.q0))[2]
     lam_n = 1.0 / float(jz @ np.linalg.solve(plant.mass_matrix(), jz))
-    k = 1.0 / (0.95 * act.TABLE_TIMECONST) ** 2  # the pair's solimp, MuJoCo's default
+    k = 1.0 / act.TABLE_TIMECONST**2
     expected = k * max(lam_n, 1.0 / inv) * (sc.Ts / act.ADMITTANCE_SHARE_OF_PERIOD) ** 2
     assert expected > act.DEFAULT_MD
     assert md == pytest.approx(expected, rel=1e-12)
     kw = act.rule_keywords(sc)
     assert kw["Md"][:2] == [act.DEFAULT_MD, act.DEFAULT_MD]
     assert kw["Md"][2] >= md  # the path's postures as well as the home
+
+
+def test_a_heavy_tool_gets_a_softer_contact_impedance(tmp_path: Path) -> None:
+    """SPEC (19.9): the tool–table pair's impedance d = x/(1 + x), x = s F A/(μ a)
+    (A MuJoCo's inverse mass of the tool, a the circle's acceleration v²/r),
+    at most MuJoCo's 0.95: the normal force MuJoCo's cone takes from the
+    circle's acceleration, μ a d/((1 − d) A), stays at s F. A light arm keeps
+    MuJoCo's default (0.9, 0.95); a heavy one's contact is softer."""
+    light = tmp_path / "light.xml"
+    light.write_text(_SIDEWAYS_ARM.format(a=0.0))
+    sc = act.arm_table(light, home=[0.0, -0.3, 1.5])
+    np.testing.assert_array_equal(sc.model.pair_solimp[0, :2], [0.9, 0.95])
+    heavy = tmp_path / "heavy.xml"
+    heavy.write_text(_SIDEWAYS_ARM.format(a=40.0))
+    sc = act.arm_table(heavy, home=[0.0, -0.3, 1.5])
+    m = sc.model
+    tool, table = act._tool_table(m)
+    inv = m.body_invweight0[m.geom_bodyid[tool], 0] + m.body_invweight0[m.geom_bodyid[table], 0]
+    v = 2 * math.pi * sc.freq * sc.radius
+    x = act.SLIP_SHARE * sc.target_force() * inv / (0.1 * v**2 / sc.radius)
+    assert x / (1 + x) < 0.9
+    np.testing.assert_allclose(m.pair_solimp[0, :2], x / (1 + x), rtol=1e-12)
+    coupling = 0.1 * (v**2 / sc.radius) * x / (1 + x) / ((1 - x / (1 + x)) * inv)
+    assert coupling == pytest.approx(act.SLIP_SHARE * sc.target_force(), rel=1e-9)
+    assert act.contact_impedance(m, force=7.5, accel=0.0, friction=0.1) == act.CONTACT_IMPEDANCE
 
 
 def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:

@@ -37,6 +37,7 @@ __all__ = [
     "ADMITTANCE_SHARE_OF_PERIOD",
     "AXIS_SHARE",
     "CLEARANCE",
+    "CONTACT_IMPEDANCE",
     "CONTACT_K1",
     "MAX_PATH_STEPS",
     "MIN_REACH_SHARE",
@@ -51,6 +52,7 @@ __all__ = [
     "T_PRESS",
     "arm_model",
     "arm_table",
+    "contact_impedance",
     "contact_metrics",
     "normal_inertia",
     "placement",
@@ -126,6 +128,11 @@ SLIP_SHARE = 0.5
 may reach while the tool slides (SPEC (19.5)): the friction rows' time constant
 is set so that μ D_t B_t v ≤ SLIP_SHARE · F_n."""
 
+CONTACT_IMPEDANCE = 0.95
+"""The largest impedance d (``solimp``'s d0 and d_max) of the tool–table pair:
+MuJoCo's default d_max; :func:`contact_impedance` lowers it for a heavy tool
+(SPEC (19.9))."""
+
 TABLE_TIMECONST = 0.01
 """Time constant (s) of the tool–table contact's normal row (``solref``, damping
 ratio 1; MuJoCo's default is 0.02 s): a rigid table whose own compliance is
@@ -178,6 +185,43 @@ def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float
     dmax = float(max(model.geom_solimp[tool, 1], model.geom_solimp[table, 1]))
     damping = SLIP_SHARE * force * (1.0 - dmax) * inv_mass / (dmax * friction * speed)
     return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
+
+
+def contact_impedance(model: Any, *, force: float, accel: float, friction: float) -> float:
+    """The impedance d (MuJoCo's ``solimp`` d0 and d_max) of the tool–table
+    pair under which the tool, driven along the circle with the acceleration
+    ``accel`` (m/s², v²/r) while it presses with ``force`` (N) at sliding
+    friction ``friction``, stays on the table (SPEC (19.9)): MuJoCo's cone hands
+    the tangential acceleration its friction rows do not meet to the normal
+    row as about μ D a, D = d/((1 − d) A) (A as in :func:`sliding_timeconst`);
+    d = x/(1 + x), x = :data:`SLIP_SHARE` · F A/(μ a), keeps it at
+    :data:`SLIP_SHARE` of the press, and never above :data:`CONTACT_IMPEDANCE`
+    (MuJoCo's own 0.95, which every arm lighter than A < 19 μ a/(s F) keeps).
+    ``friction``, ``accel`` or ``force`` zero: :data:`CONTACT_IMPEDANCE`."""
+    tool, table = _tool_table(model)
+    if tool < 0 or table < 0:
+        raise ValueError("the model has no geoms 'tool' and 'table'")
+    if friction <= 0 or accel <= 0 or force <= 0:
+        return CONTACT_IMPEDANCE
+    inv_mass = float(
+        model.body_invweight0[model.geom_bodyid[tool], 0]
+        + model.body_invweight0[model.geom_bodyid[table], 0]
+    )
+    x = SLIP_SHARE * force * inv_mass / (friction * accel)
+    return min(CONTACT_IMPEDANCE, x / (1.0 + x))
+
+
+def _set_pair_contact(
+    model: Any, *, force: float, speed: float, accel: float, friction: float
+) -> None:
+    """The tool–table pair's friction time constant (19.5) and impedance (19.9)."""
+    model.pair_solreffriction[0] = [
+        sliding_timeconst(model, force=force, speed=speed, friction=friction),
+        1.0,
+    ]
+    d = contact_impedance(model, force=force, accel=accel, friction=friction)
+    model.pair_solimp[0, 0] = min(float(model.pair_solimp[0, 0]), d)
+    model.pair_solimp[0, 1] = min(float(model.pair_solimp[0, 1]), d)
 
 
 def _tool_table(model: Any) -> tuple[int, int]:
@@ -270,6 +314,7 @@ def arm_model(
     force: float = 0.0,
     speed: float = 0.0,
     facing: bool = False,
+    accel: float = 0.0,
 ) -> Any:
     """A URDF or MJCF arm in MuJoCo with a tool and a table (see the module doc).
 
@@ -289,7 +334,8 @@ def arm_model(
     friction, the tool–table contact is the explicit pair ``tool_table`` whose
     friction rows have the time constant :func:`sliding_timeconst` for a tool
     pressing with ``force`` (N) while it slides at ``speed`` (m/s) (zero:
-    :data:`TABLE_TIMECONST`). ``facing``: the table turned to face the base's
+    :data:`TABLE_TIMECONST`) and, driven along the circle with ``accel`` (m/s²),
+    the impedance :func:`contact_impedance`. ``facing``: the table turned to face the base's
     vertical axis (:func:`arm_table` turns it for a home whose arm would stand
     under a table on the world's axes).
     """
@@ -301,7 +347,7 @@ def arm_model(
         return _mjcf_model(
             Path(urdf), tip, fix=fix, tool_radius=tool_radius, table_top=table_top,
             centre=centre, friction=friction, spring=spring, home=home, timestep=timestep,
-            force=force, speed=speed, facing=facing,
+            force=force, speed=speed, facing=facing, accel=accel,
         )  # fmt: skip
     # The arm as adaptimp.mujoco.from_urdf makes it, by the core's one
     # reduction (SPEC §21), with its motors (efforts estimated where the URDF
@@ -327,10 +373,7 @@ def arm_model(
     model = amj._compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
-        model.pair_solreffriction[0] = [
-            sliding_timeconst(model, force=force, speed=speed, friction=friction),
-            1.0,
-        ]
+        _set_pair_contact(model, force=force, speed=speed, accel=accel, friction=friction)
     return model
 
 
@@ -349,6 +392,7 @@ def _mjcf_model(
     force: float,
     speed: float,
     facing: bool = False,
+    accel: float = 0.0,
 ) -> Any:
     """:func:`arm_model` for an MJCF file: the model with the tool on body ``tip``
     and the table; keyframe ``home`` at the arm's joints (the others at qpos0)."""
@@ -395,10 +439,7 @@ def _mjcf_model(
         model = spec.compile()
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
-        model.pair_solreffriction[0] = [
-            sliding_timeconst(model, force=force, speed=speed, friction=friction),
-            1.0,
-        ]
+        _set_pair_contact(model, force=force, speed=speed, accel=accel, friction=friction)
     return model
 
 
@@ -680,6 +721,7 @@ def arm_table(
             home=sc.q0,
             force=sc.target_force(),
             speed=speed,
+            accel=speed**2 / radius,
         )
         sc.t_hold, sc.t_press = float(t_hold), float(t_press)
         sc.__post_init__()
@@ -726,6 +768,7 @@ def arm_table(
             force=_NOMINAL_KD * depth,
             speed=speed,
             facing=facing,
+            accel=speed**2 / radius,
         )
         return PandaTable(
             model=model,
@@ -1124,9 +1167,8 @@ the tool's Cartesian inertia along the normal."""
 
 def normal_inertia(sc: PandaTable, q: ArrayLike) -> float:
     """The target inertia M_d,n (kg) along the table's normal by SPEC (19.8):
-    max(M_d, k Λ_c (Ts/m)²), k = 1/(d_max τ_n)² the table contact's stiffness
-    per unit apparent mass (τ_n = :data:`TABLE_TIMECONST`, d_max the
-    ``solimp`` of the tool–table pair, or of the geoms without one), Λ_c the
+    max(M_d, k Λ_c (Ts/m)²), k = 1/τ_n² the table contact's stiffness per
+    unit apparent mass (τ_n = :data:`TABLE_TIMECONST`), Λ_c the
     larger of the tool's Cartesian inertia along the normal, 1/(nᵀ J D⁻¹ Jᵀ
     n), over :data:`NORMAL_SAMPLES` postures of the joint path ``q`` (K, n)
     (rad; D the plant's, armature included) and
@@ -1154,16 +1196,7 @@ def normal_inertia(sc: PandaTable, q: ArrayLike) -> float:
     )
     if inv_mass > 0:
         lam = max(lam, 1.0 / inv_mass)
-    import mujoco
-
-    # The contact's impedance: the tool–table pair's where the scenario made one
-    # (with friction), else the geoms' (MuJoCo takes the larger of the two).
-    pair = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, "tool_table")
-    if pair >= 0:
-        dmax = float(model.pair_solimp[pair, 1])
-    else:
-        dmax = float(max(model.geom_solimp[tool, 1], model.geom_solimp[table, 1]))
-    stiffness = 1.0 / (dmax * TABLE_TIMECONST) ** 2  # 1/s², per kg of apparent mass
+    stiffness = 1.0 / TABLE_TIMECONST**2  # 1/s², per kg of apparent mass
     return max(DEFAULT_MD, stiffness * lam * (sc.Ts / ADMITTANCE_SHARE_OF_PERIOD) ** 2)
 
 

@@ -19,6 +19,7 @@ __all__ = [
     "Chain",
     "ComputedTorque",
     "Controller",
+    "Measurement",
     "PlanarArm",
     "TwoLinkArm",
     "__version__",
@@ -274,6 +275,29 @@ class CartesianParams(TypedDict, total=False):
 
 # END GENERATED
 
+@final
+class Measurement:
+    """One sample of the sensors: q (rad), dq (rad/s), tau_e (N m), wrench (N, N m)."""
+
+    def __new__(
+        cls,
+        q: ArrayLike,
+        dq: ArrayLike | None = None,
+        *,
+        tau_e: ArrayLike | None = None,
+        wrench: ArrayLike | None = None,
+    ) -> Measurement: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def q(self) -> _F: ...
+    @property
+    def dq(self) -> _F | None: ...
+    @property
+    def tau_e(self) -> _F | None: ...
+    @property
+    def wrench(self) -> _F | None: ...
+
 @disjoint_base
 class Controller:
     """One of the paper's controllers for an arm of n joints, with its state."""
@@ -288,20 +312,23 @@ class Controller:
     ) -> Controller: ...
     def step(
         self,
-        q: ArrayLike,
-        tau_e: ArrayLike,
+        m: Measurement | ArrayLike | None = None,
+        tau_e: ArrayLike | None = None,
         dq: ArrayLike | None = None,
         *,
+        q: ArrayLike | None = None,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
-    ) -> _F: ...
+    ) -> _F:
+        """One step from a :class:`Measurement` (``step(q, tau_e, dq)``: deprecated)."""
     def step_or_fallback(
         self,
-        q: ArrayLike,
-        tau_e: ArrayLike,
+        m: Measurement | ArrayLike | None = None,
+        tau_e: ArrayLike | None = None,
         dq: ArrayLike | None = None,
         *,
+        q: ArrayLike | None = None,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
@@ -452,7 +479,8 @@ def simulate_mujoco_callback(
     table: tuple[_F, _F, _F],
     *,
     setpoint: bool,
-    wants_wrench: bool,
+    task_space: bool,
+    call: str,
     attrs: list[str],
     target: tuple[list[float], list[float], list[float]],
     record_every: int = 1,
@@ -593,6 +621,8 @@ class CartesianImpedance:
         dq: ArrayLike | None,
         wrench: ArrayLike,
         target: ArrayLike | None = None,
+        *,
+        measurement: bool = True,
     ) -> _F: ...
     def last(self, what: str) -> _F: ...
     def state(self, what: str) -> _F: ...
@@ -752,12 +782,14 @@ class ComputedTorque:
     def set_trajectory(self, trajectory: Callable[[float], Any] | None = None) -> None: ...
     def step(
         self,
-        q: ArrayLike,
-        tau_e: ArrayLike,
+        m: Measurement | ArrayLike | None = None,
+        tau_e: ArrayLike | None = None,
         dq: ArrayLike | None = None,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
+        *,
+        q: ArrayLike | None = None,
     ) -> _F:
         """One step (SPEC (20.3)); sat(τ) (N m), (n,)."""
     def inverse_dynamics(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> _F:

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._adaptimp import Measurement
 from ._errors import needs_extra, period_alias
 
 try:
@@ -265,8 +266,9 @@ class ComputedTorque:
     """Computed-torque impedance control (module doc), stepped by the core
     (SPEC §20) with the inertials of a Pinocchio model.
 
-    The controller protocol of :func:`adaptimp.mujoco.simulate`: ``step(q,
-    tau_e, dq, xc=, dxc=, ddxc=)`` at t_k = k·Ts returns the applied torque
+    The controller protocol of :func:`adaptimp.mujoco.simulate`: ``step(m,
+    xc=, dxc=, ddxc=)`` (``m`` an :class:`adaptimp.Measurement`) at t_k =
+    k·Ts returns the applied torque
     sat(τ) (N m); without a setpoint it follows ``trajectory`` (by default,
     for two joints, the paper's circle (64)). Behind an
     :class:`adaptimp.CartesianController` the core steps it in its own
@@ -445,6 +447,10 @@ class ComputedTorque:
         self._trajectory = trajectory
         self._core.set_trajectory(trajectory)
         self._step = self._core.step
+        # The per-sample call goes straight to the core (its signature is
+        # step's, below): no Python frame in between (docs/performance.md).
+        if type(self).step is ComputedTorque.step:  # not a subclass's own step
+            self.step = self._step  # type: ignore[method-assign]
 
     def reset(self) -> None:
         """Back to t = 0; the reference starts at the next setpoint."""
@@ -523,25 +529,26 @@ class ComputedTorque:
 
     def step(
         self,
-        q: ArrayLike,
-        tau_e: ArrayLike,
+        m: Measurement | ArrayLike | None = None,
+        tau_e: ArrayLike | None = None,
         dq: ArrayLike | None = None,
         *,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
+        q: ArrayLike | None = None,
     ) -> FloatArray:
         """One step at t_k = k·Ts (SPEC (20.3)); returns the applied torque
         sat(τ) (N m), (n,).
 
-        q (rad), tau_e (N m), dq (rad/s; required), each (n,); the setpoint
-        xc (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0), or
-        none of them (then the built-in ``trajectory``).
+        ``m`` is an :class:`adaptimp.Measurement`: q (rad), dq (rad/s;
+        required), tau_e (N m; None: zeros), each (n,); the setpoint xc
+        (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0), or none
+        of them (then the built-in ``trajectory``). ``step(q, tau_e, dq)``
+        works, with a ``DeprecationWarning``. An instance's ``step`` is the
+        core's own method (this signature, no Python in between).
         """
-        # One call of the core, positional (cheaper than keywords through the
-        # binding): it checks every argument (shapes and types there, values in
-        # the step) and, given no setpoint, follows the trajectory.
-        return self._step(q, tau_e, dq, xc, dxc, ddxc)
+        return self._step(m, tau_e, dq, xc, dxc, ddxc, q=q)
 
     def __repr__(self) -> str:
         return (

@@ -14,6 +14,7 @@ use super::cartesian_loop::{
 use super::computed::{Computed, DynComputed, PyComputedTorque};
 use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JOINTS};
 use super::frames::{joint, transform};
+use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
 use super::{array, array1, config_error, items, python_shape, vector, ConfigError, PyController};
 use super::{DivergedError, MeasurementError};
@@ -1341,7 +1342,8 @@ impl PyCartesian {
         let n = self.n;
         let q = vector("q", n, q)?;
         let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
-        let m = self.measurement(&q, dq.as_ref(), wrench_of(wrench)?, target_of(target)?);
+        let f_e = wrench_of(wrench)?;
+        let m = self.measurement(&q, dq.as_ref(), f_e, target_of(target)?);
         let mut joint = lock_joint(py, controller, n)?;
         let mut g = self.lock(py);
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
@@ -1419,10 +1421,13 @@ impl PyCartesian {
     }
 
     /// One Cartesian step with a joint controller written in Python:
-    /// `inner.step(q, tau_e, dq, xc=q_d, dxc=q̇_d, ddxc=q̈_d)` is called with
-    /// the core's joint reference and τe, and the outer state is committed
-    /// only if it returns. Returns its torque (N m), (n,).
-    #[pyo3(signature = (inner, q, dq, wrench, target=None))]
+    /// `inner.step(m, xc=q_d, dxc=q̇_d, ddxc=q̈_d)` is called with the
+    /// measurement (q, q̇, τe = Jᵀ F_e, the wrench) and the core's joint
+    /// reference (`measurement=False`: the deprecated `inner.step(q, tau_e,
+    /// dq, …)`), and the outer state is committed only if it returns.
+    /// Returns its torque (N m), (n,).
+    #[pyo3(signature = (inner, q, dq, wrench, target=None, *, measurement=true))]
+    #[allow(clippy::too_many_arguments)]
     fn step_python<'py>(
         &self,
         py: Python<'py>,
@@ -1431,11 +1436,13 @@ impl PyCartesian {
         dq: Option<&Bound<'py, PyAny>>,
         wrench: &Bound<'py, PyAny>,
         target: Option<&Bound<'py, PyAny>>,
+        measurement: bool,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
         let q = vector("q", n, q)?;
         let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
-        let m = self.measurement(&q, dq.as_ref(), wrench_of(wrench)?, target_of(target)?);
+        let f_e = wrench_of(wrench)?;
+        let m = self.measurement(&q, dq.as_ref(), f_e, target_of(target)?);
         let mut raised: Option<PyErr> = None;
         let mut g = self.lock(py);
         let mut call = |q: &[f64],
@@ -1456,9 +1463,13 @@ impl PyCartesian {
                     let j = numpy::PyArray1::from_slice(py, jt).reshape([6, torque.len()])?;
                     kw.set_item("jacobian", j)?;
                 }
-                let dq = dq.map(|d| array1(py, d));
-                let tau =
-                    inner.call_method("step", (array1(py, q), array1(py, tau_e), dq), Some(&kw))?;
+                let tau = if measurement {
+                    let meas = PyMeasurement::of(q, dq, Some(tau_e), Some(&f_e));
+                    inner.call_method("step", (Bound::new(py, meas)?,), Some(&kw))?
+                } else {
+                    let dq = dq.map(|d| array1(py, d));
+                    inner.call_method("step", (array1(py, q), array1(py, tau_e), dq), Some(&kw))?
+                };
                 let v = flat("the joint controller's torque", out.len(), &tau)?;
                 Ok(v)
             })();

@@ -2,6 +2,7 @@
 
 use super::dynamic;
 use super::dynamic::{CentersSpec, DynTracker, Inputs, Last, Tables, MAX_JOINTS};
+use super::measurement::JointCall;
 use super::{arrays::*, errors::*, hooks::*, params::*};
 use crate::control::config::Law;
 use crate::schema::Preset;
@@ -78,18 +79,17 @@ impl PyController {
     /// any values). In place: the buffers are not moved about per call.
     pub(super) fn convert(
         &self,
-        q: &Bound<'_, PyAny>,
-        tau_e: &Bound<'_, PyAny>,
-        dq: Option<&Bound<'_, PyAny>>,
+        call: &JointCall<'_, '_>,
         setpoint: [Option<&Bound<'_, PyAny>>; 3],
         given: &mut Given,
     ) -> PyResult<()> {
         let n = self.n;
-        vector_into("q", n, q, &mut given.x)?;
-        vector_into("tau_e", n, tau_e, &mut given.tau_e)?;
-        given.dx = match (self.law, dq) {
-            (Law::OutputFeedback, _) | (_, None) => None,
-            (_, Some(dq)) => Some(vector_any("dq", n, dq)?),
+        let m = call.inputs(n)?;
+        given.x = m.q;
+        given.tau_e = m.tau_e;
+        given.dx = match self.law {
+            Law::OutputFeedback => None,
+            _ => m.dq,
         };
         given.setpoint = match setpoint {
             [None, None, None] => None,
@@ -155,22 +155,26 @@ impl PyController {
         Ok(Self::wrap(inner))
     }
 
-    /// One controller step at t_k = k·Ts: joint positions `q` (rad), the
-    /// measured force on the environment `tau_e` (N m) and, for "pd" and
-    /// "sf", joint velocities `dq` (rad/s; ignored by "of"); with `xc` (and
+    /// One controller step at t_k = k·Ts from the measurement `m`
+    /// (`adaptimp.Measurement`): joint positions q (rad), the measured force
+    /// on the environment τe (N m; none: zeros) and, for "pd" and "sf",
+    /// joint velocities q̇ (rad/s; ignored by "of"); with `xc` (and
     /// optionally `dxc`, `ddxc`, zero if not given) the controller tracks
     /// that setpoint instead of its trajectory. Returns sat(τ) (N m), (n,).
+    /// The old call `step(q, tau_e, dq)` still works, with a
+    /// `DeprecationWarning`.
     /// A refused step raises, and records the refusal as `step_or_fallback`
     /// does (the fault, the fallback as the torque applied, the measured
     /// position): the fault semantics of docs/reliability.md.
-    #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
+    #[pyo3(signature = (m=None, tau_e=None, dq=None, *, q=None, xc=None, dxc=None, ddxc=None))]
     #[allow(clippy::too_many_arguments)]
     fn step<'py>(
         &self,
         py: Python<'py>,
-        q: &Bound<'py, PyAny>,
-        tau_e: &Bound<'py, PyAny>,
+        m: Option<&Bound<'py, PyAny>>,
+        tau_e: Option<&Bound<'py, PyAny>>,
         dq: Option<&Bound<'py, PyAny>>,
+        q: Option<&Bound<'py, PyAny>>,
         xc: Option<&Bound<'py, PyAny>>,
         dxc: Option<&Bound<'py, PyAny>>,
         ddxc: Option<&Bound<'py, PyAny>>,
@@ -179,7 +183,14 @@ impl PyController {
         // Values are the core's to judge (a non-finite one is a refused step
         // that records its fault); shapes and types are checked here.
         let mut given = Given::EMPTY;
-        self.convert(q, tau_e, dq, [xc, dxc, ddxc], &mut given)
+        let call = JointCall {
+            who: "Controller.step",
+            m,
+            tau_e,
+            dq,
+            q,
+        };
+        self.convert(&call, [xc, dxc, ddxc], &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)
@@ -193,14 +204,15 @@ impl PyController {
     /// after a refusal the torque is the configured fallback, and the next
     /// step's rate limit starts from it. Shapes and types are still checked
     /// (a wrong one raises, and is recorded as a refused step).
-    #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
+    #[pyo3(signature = (m=None, tau_e=None, dq=None, *, q=None, xc=None, dxc=None, ddxc=None))]
     #[allow(clippy::too_many_arguments)]
     fn step_or_fallback<'py>(
         &self,
         py: Python<'py>,
-        q: &Bound<'py, PyAny>,
-        tau_e: &Bound<'py, PyAny>,
+        m: Option<&Bound<'py, PyAny>>,
+        tau_e: Option<&Bound<'py, PyAny>>,
         dq: Option<&Bound<'py, PyAny>>,
+        q: Option<&Bound<'py, PyAny>>,
         xc: Option<&Bound<'py, PyAny>>,
         dxc: Option<&Bound<'py, PyAny>>,
         ddxc: Option<&Bound<'py, PyAny>>,
@@ -209,7 +221,14 @@ impl PyController {
         // Shapes and types are checked (a refusal, recorded, then raised);
         // values are the controller's to judge.
         let mut given = Given::EMPTY;
-        self.convert(q, tau_e, dq, [xc, dxc, ddxc], &mut given)
+        let call = JointCall {
+            who: "Controller.step_or_fallback",
+            m,
+            tau_e,
+            dq,
+            q,
+        };
+        self.convert(&call, [xc, dxc, ddxc], &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         let result = self

@@ -12,7 +12,7 @@ q̈ seeded, within the joint limits), per call:
   ``getFrameClassicalAcceleration``;
 - ``ComputedTorque.inverse_dynamics``: ``Dynamics::inverse_dynamics``; ``rnea``;
 - ``ComputedTorque.step`` (external mode): ``ComputedTorque::step``; (20.3)
-  with ``rnea`` and NumPy; ``ct_step`` is ``step(m, xc=, dxc=, ddxc=)`` on
+  with ``rnea`` and NumPy; ``ct_step`` is ``step(m, xc, dxc, ddxc)`` on
   measurements made before, ``ct_step_measured`` makes ``m =
   adaptimp.Measurement(q, dq)`` in the loop too;
 - ``CartesianController.step`` (SF, its path in Python): the core's Cartesian
@@ -136,12 +136,12 @@ def python_timers(name: str, states: list[tuple[Any, Any, Any]], calls: int) -> 
     def step_ours() -> None:
         # The step alone, on measurements made before (the entry point's cost).
         for m, q, dq, ddq in made:
-            step(m, xc=q, dxc=dq, ddxc=ddq)
+            step(m, q, dq, ddq)
 
     def step_measured() -> None:
         # The measurement made from the sensors' arrays each call, then the step.
         for q, dq, ddq in rows:
-            step(Measurement(q, dq), xc=q, dxc=dq, ddxc=ddq)
+            step(Measurement(q, dq), q, dq, ddq)
 
     def step_pin() -> None:
         # (20.3), external mode, as a user writes it with Pinocchio and NumPy.

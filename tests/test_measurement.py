@@ -78,8 +78,22 @@ def test_a_measurement_of_other_joints_is_refused_and_recorded() -> None:
         ctrl.step(Measurement([0.0] * 3, [0.0] * 3))
     assert ctrl.fault is not None
     assert "wrong shape or type" in ctrl.fault[0]
-    with pytest.raises(TypeError, match=r"as an adaptimp\.Measurement or as arrays, not both"):
-        ctrl.step(Measurement(Q, DQ), TE)
+    with pytest.raises(
+        TypeError, match=r"^Controller\.step\(\) got an unexpected keyword argument 'q'$"
+    ):
+        ctrl.step(Measurement(Q, DQ), q=Q)
+    with pytest.raises(
+        TypeError, match=r"^Controller\.step\(\) got multiple values for argument 'xc'$"
+    ):
+        ctrl.step(Measurement(Q, DQ), Q, xc=Q)
+    with pytest.raises(TypeError, match=r"^Controller\.step\(\) takes at most 4 positional"):
+        ctrl.step(Measurement(Q, DQ), Q, DQ, DQ, DQ)
+    # The setpoint positionally (no keyword dictionary) or by keyword: the same step.
+    a, b = (adaptimp.Controller("sf", scenario="robot") for _ in range(2))
+    np.testing.assert_array_equal(
+        a.step(Measurement(Q, DQ), [0.3, 0.0], [0.1, 0.0]),
+        b.step(Measurement(Q, DQ), xc=[0.3, 0.0], dxc=[0.1, 0.0]),
+    )
 
 
 def _deprecated(call: Any, message: str) -> Any:

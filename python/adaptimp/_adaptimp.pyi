@@ -6,11 +6,11 @@ them from keywords with the paper's defaults.
 """
 
 from collections.abc import Callable, Sequence
-from typing import Any, Literal, TypedDict, final, type_check_only
+from typing import Any, Literal, TypedDict, final, overload, type_check_only
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from typing_extensions import disjoint_base
+from typing_extensions import deprecated, disjoint_base
 
 __all__ = [
     "MAX_JOINTS",
@@ -310,25 +310,41 @@ class Controller:
         centers: _F | None = None,
         widths2: _F | None = None,
     ) -> Controller: ...
+    @overload
     def step(
         self,
-        m: Measurement | ArrayLike | None = None,
-        tau_e: ArrayLike | None = None,
-        dq: ArrayLike | None = None,
-        *,
-        q: ArrayLike | None = None,
+        m: Measurement,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
     ) -> _F:
-        """One step from a :class:`Measurement` (``step(q, tau_e, dq)``: deprecated)."""
+        """One step from a :class:`Measurement`; sat(τ) (N m), (n,)."""
+    @overload
+    @deprecated("step(q, tau_e, dq): pass one adaptimp.Measurement(q, dq, tau_e=tau_e)")
+    def step(
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None = None,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> _F: ...
+    @overload
     def step_or_fallback(
         self,
-        m: Measurement | ArrayLike | None = None,
-        tau_e: ArrayLike | None = None,
+        m: Measurement,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> tuple[_F, str | None]: ...
+    @overload
+    @deprecated("step_or_fallback(q, tau_e, dq): pass one adaptimp.Measurement(q, dq, tau_e=tau_e)")
+    def step_or_fallback(
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
         dq: ArrayLike | None = None,
-        *,
-        q: ArrayLike | None = None,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
@@ -780,18 +796,26 @@ class ComputedTorque:
     def fault(self) -> tuple[str, int] | None: ...
     def reset(self) -> None: ...
     def set_trajectory(self, trajectory: Callable[[float], Any] | None = None) -> None: ...
+    @overload
     def step(
         self,
-        m: Measurement | ArrayLike | None = None,
-        tau_e: ArrayLike | None = None,
+        m: Measurement,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> _F:
+        """One step (SPEC (20.3)); sat(τ) (N m), (n,)."""
+    @overload
+    @deprecated("step(q, tau_e, dq): pass one adaptimp.Measurement(q, dq, tau_e=tau_e)")
+    def step(
+        self,
+        q: ArrayLike,
+        tau_e: ArrayLike,
         dq: ArrayLike | None = None,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
-        *,
-        q: ArrayLike | None = None,
-    ) -> _F:
-        """One step (SPEC (20.3)); sat(τ) (N m), (n,)."""
+    ) -> _F: ...
     def inverse_dynamics(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> _F:
         """RNEA(q, q̇, q̈) = M q̈ + C q̇ + G (N m), (n,)."""
     def mass_matrix(self, q: ArrayLike) -> _F:

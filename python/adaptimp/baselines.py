@@ -28,7 +28,7 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -450,7 +450,7 @@ class ComputedTorque:
         # The per-sample call goes straight to the core (its signature is
         # step's, below): no Python frame in between (docs/performance.md).
         if type(self).step is ComputedTorque.step:  # not a subclass's own step
-            self.step = self._step  # type: ignore[method-assign]
+            self.step = self._step  # type: ignore[method-assign,assignment]
 
     def reset(self) -> None:
         """Back to t = 0; the reference starts at the next setpoint."""
@@ -527,28 +527,39 @@ class ComputedTorque:
         (rad/s²), each (n,), checked (shape, finiteness) by the core."""
         return self._core.inverse_dynamics(q, dq, ddq)
 
+    @overload
     def step(
         self,
-        m: Measurement | ArrayLike | None = None,
-        tau_e: ArrayLike | None = None,
-        dq: ArrayLike | None = None,
-        *,
+        m: Measurement,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
-        q: ArrayLike | None = None,
-    ) -> FloatArray:
+    ) -> FloatArray: ...
+    @overload
+    def step(  # deprecated: the arrays' call, with a DeprecationWarning
+        self,
+        m: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None = None,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> FloatArray: ...
+    def step(self, *args: Any, **kwargs: Any) -> FloatArray:
         """One step at t_k = k·Ts (SPEC (20.3)); returns the applied torque
         sat(τ) (N m), (n,).
 
         ``m`` is an :class:`adaptimp.Measurement`: q (rad), dq (rad/s;
         required), tau_e (N m; None: zeros), each (n,); the setpoint xc
-        (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0), or none
-        of them (then the built-in ``trajectory``). ``step(q, tau_e, dq)``
-        works, with a ``DeprecationWarning``. An instance's ``step`` is the
-        core's own method (this signature, no Python in between).
+        (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0; given
+        positionally, a call skips the keyword dictionary), or none of them
+        (then the built-in ``trajectory``). The arrays' call ``step(q, tau_e,
+        dq, xc=, dxc=, ddxc=)`` works, with a ``DeprecationWarning``. An
+        instance's ``step`` is the core's own method (this signature, no
+        Python in between).
         """
-        return self._step(m, tau_e, dq, xc, dxc, ddxc, q=q)
+        out: FloatArray = self._step(*args, **kwargs)
+        return out
 
     def __repr__(self) -> str:
         return (

@@ -836,7 +836,12 @@ class CartesianController:
         :attr:`output`. ``step(q, dq, wrench)`` works, with a
         ``DeprecationWarning``.
         """
-        q, dq, wrench = _measured(self.chain.n, m, dq, wrench, q)
+        measured: Any
+        if self._core_inner and type(m) is Measurement and dq is wrench is q is None:
+            measured = m  # the core reads it itself: no arrays made here
+        else:
+            q, dq, wrench = _measured(self.chain.n, m, dq, wrench, q)
+            measured = q
         if target is not None:
             if xc is not None:
                 raise TypeError("give the commanded pose as xc=… or as target=…, not both")
@@ -849,7 +854,7 @@ class CartesianController:
             sample = None
         if self._core_inner:
             # One call of the core: the pose and wrench read, the step, the row kept.
-            out: FloatArray = self._step(self._joint, q, dq, wrench, sample, self.record)
+            out: FloatArray = self._step(self._joint, measured, dq, wrench, sample, self.record)
             self._k += 1
             return out
         f = _wrench(wrench)

@@ -16,7 +16,10 @@ use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JO
 use super::frames::{joint, transform};
 use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
-use super::{array, array1, config_error, items, python_shape, vector, ConfigError, PyController};
+use super::{
+    array, array1, config_error, items, python_shape, shape_error, vector, ConfigError,
+    PyController,
+};
 use super::{DivergedError, MeasurementError};
 use crate::cartesian::chain::MAX_CHAIN_JOINTS;
 use crate::cartesian::{
@@ -1351,7 +1354,8 @@ impl PyCartesian {
     }
 
     /// One step of `CartesianController.step` with the core's joint
-    /// `controller`, in one call: q (rad), dq (rad/s), each (n,), the wrench
+    /// `controller`, in one call: an `adaptimp.Measurement` as `q` (dq and
+    /// wrench None), or q (rad), dq (rad/s), each (n,), the wrench
     /// F_e = [f; m] (N, N m; (6,), f (3,) alone, or None: no contact), the
     /// commanded pose `sample`: None (hold the last target), the tuple (p,
     /// ṗ, p̈) or (p, ṗ, p̈, R, ω, ω̇) a path returns (m, m/s, m/s², (3, 3),
@@ -1374,14 +1378,31 @@ impl PyCartesian {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
         let mut qb = [0.0; MAX_JOINTS];
-        super::vector_into("q", n, q, &mut qb)?;
         let mut dqb = [0.0; MAX_JOINTS];
-        if let Some(d) = dq {
-            super::vector_into("dq", n, d, &mut dqb)?;
-        }
-        let f = match wrench {
-            None => [0.0; 6],
-            Some(w) => wrench_sample(w)?,
+        let (measured_dq, f) = if let Ok(m) = q.cast::<PyMeasurement>() {
+            // An adaptimp.Measurement: read as it is, no array made.
+            let m = m.get();
+            if dq.is_some() || wrench.is_some() {
+                return Err(PyTypeError::new_err(
+                    "give the measurement as an adaptimp.Measurement or as arrays, not both",
+                ));
+            }
+            if m.n != n {
+                return Err(shape_error("q", n, &format!("length {}", m.n)));
+            }
+            qb = m.q;
+            dqb = m.dq.unwrap_or(dqb);
+            (m.dq.is_some(), m.wrench.unwrap_or([0.0; 6]))
+        } else {
+            super::vector_into("q", n, q, &mut qb)?;
+            if let Some(d) = dq {
+                super::vector_into("dq", n, d, &mut dqb)?;
+            }
+            let f = match wrench {
+                None => [0.0; 6],
+                Some(w) => wrench_sample(w)?,
+            };
+            (dq.is_some(), f)
         };
         let mut joint = lock_joint(py, controller, n)?;
         let mut g = self.lock(py);
@@ -1392,7 +1413,7 @@ impl PyCartesian {
             None => None,
             Some(s) => Some(sample_target(s, &mut held)?),
         };
-        let m = self.measurement(&qb, dq.map(|_| &dqb), f, target);
+        let m = self.measurement(&qb, measured_dq.then_some(&dqb), f, target);
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
         g.set_held(held);
         if record {

@@ -30,7 +30,7 @@ use core::cell::Cell;
 use numpy::PyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 use std::any::Any;
 use std::sync::{Mutex, MutexGuard};
 use std::vec::Vec;
@@ -657,27 +657,16 @@ impl PyComputedTorque {
     /// core's to judge (a non-finite or out-of-range one is a refused step
     /// that records its fault). The old call `step(q, tau_e, dq, …)` works,
     /// with a `DeprecationWarning`.
-    #[pyo3(signature = (m=None, tau_e=None, dq=None, xc=None, dxc=None, ddxc=None, *, q=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (*args, **kwargs))]
     fn step<'py>(
         &self,
         py: Python<'py>,
-        m: Option<&Bound<'py, PyAny>>,
-        tau_e: Option<&Bound<'py, PyAny>>,
-        dq: Option<&Bound<'py, PyAny>>,
-        xc: Option<&Bound<'py, PyAny>>,
-        dxc: Option<&Bound<'py, PyAny>>,
-        ddxc: Option<&Bound<'py, PyAny>>,
-        q: Option<&Bound<'py, PyAny>>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
-        let call = JointCall {
-            who: "ComputedTorque.step",
-            m,
-            tau_e,
-            dq,
-            q,
-        };
+        let call = JointCall::parse("ComputedTorque.step", args, kwargs)?;
+        let [xc, dxc, ddxc] = &call.setpoint;
         let given = call.inputs(n)?;
         let Some(dq) = given.dq else {
             return Err(MeasurementError::new_err(

@@ -11,7 +11,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 use std::sync::{Mutex, MutexGuard};
 
 /// A step's arguments, converted: n values each in fixed buffers.
@@ -77,12 +77,7 @@ impl PyController {
 
     /// A step's arguments, converted into `given` (shapes and types checked;
     /// any values). In place: the buffers are not moved about per call.
-    pub(super) fn convert(
-        &self,
-        call: &JointCall<'_, '_>,
-        setpoint: [Option<&Bound<'_, PyAny>>; 3],
-        given: &mut Given,
-    ) -> PyResult<()> {
+    pub(super) fn convert(&self, call: &JointCall<'_>, given: &mut Given) -> PyResult<()> {
         let n = self.n;
         let m = call.inputs(n)?;
         given.x = m.q;
@@ -91,15 +86,21 @@ impl PyController {
             Law::OutputFeedback => None,
             _ => m.dq,
         };
-        given.setpoint = match setpoint {
+        given.setpoint = match &call.setpoint {
             [None, None, None] => None,
             [Some(x), dx, ddx] => {
                 let zero = [0.0; MAX_JOINTS];
                 let conv = |what, o| vector_any(what, n, o);
                 Some([
                     conv("xc", x)?,
-                    dx.map(|d| conv("dxc", d)).transpose()?.unwrap_or(zero),
-                    ddx.map(|d| conv("ddxc", d)).transpose()?.unwrap_or(zero),
+                    dx.as_ref()
+                        .map(|d| conv("dxc", d))
+                        .transpose()?
+                        .unwrap_or(zero),
+                    ddx.as_ref()
+                        .map(|d| conv("ddxc", d))
+                        .transpose()?
+                        .unwrap_or(zero),
                 ])
             }
             [None, ..] => {
@@ -166,31 +167,19 @@ impl PyController {
     /// A refused step raises, and records the refusal as `step_or_fallback`
     /// does (the fault, the fallback as the torque applied, the measured
     /// position): the fault semantics of docs/reliability.md.
-    #[pyo3(signature = (m=None, tau_e=None, dq=None, *, q=None, xc=None, dxc=None, ddxc=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (*args, **kwargs))]
     fn step<'py>(
         &self,
         py: Python<'py>,
-        m: Option<&Bound<'py, PyAny>>,
-        tau_e: Option<&Bound<'py, PyAny>>,
-        dq: Option<&Bound<'py, PyAny>>,
-        q: Option<&Bound<'py, PyAny>>,
-        xc: Option<&Bound<'py, PyAny>>,
-        dxc: Option<&Bound<'py, PyAny>>,
-        ddxc: Option<&Bound<'py, PyAny>>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
         // Values are the core's to judge (a non-finite one is a refused step
         // that records its fault); shapes and types are checked here.
         let mut given = Given::EMPTY;
-        let call = JointCall {
-            who: "Controller.step",
-            m,
-            tau_e,
-            dq,
-            q,
-        };
-        self.convert(&call, [xc, dxc, ddxc], &mut given)
+        let call = JointCall::parse("Controller.step", args, kwargs)?;
+        self.convert(&call, &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)
@@ -204,31 +193,19 @@ impl PyController {
     /// after a refusal the torque is the configured fallback, and the next
     /// step's rate limit starts from it. Shapes and types are still checked
     /// (a wrong one raises, and is recorded as a refused step).
-    #[pyo3(signature = (m=None, tau_e=None, dq=None, *, q=None, xc=None, dxc=None, ddxc=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (*args, **kwargs))]
     fn step_or_fallback<'py>(
         &self,
         py: Python<'py>,
-        m: Option<&Bound<'py, PyAny>>,
-        tau_e: Option<&Bound<'py, PyAny>>,
-        dq: Option<&Bound<'py, PyAny>>,
-        q: Option<&Bound<'py, PyAny>>,
-        xc: Option<&Bound<'py, PyAny>>,
-        dxc: Option<&Bound<'py, PyAny>>,
-        ddxc: Option<&Bound<'py, PyAny>>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Option<String>)> {
         let n = self.n;
         // Shapes and types are checked (a refusal, recorded, then raised);
         // values are the controller's to judge.
         let mut given = Given::EMPTY;
-        let call = JointCall {
-            who: "Controller.step_or_fallback",
-            m,
-            tau_e,
-            dq,
-            q,
-        };
-        self.convert(&call, [xc, dxc, ddxc], &mut given)
+        let call = JointCall::parse("Controller.step_or_fallback", args, kwargs)?;
+        self.convert(&call, &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         let result = self

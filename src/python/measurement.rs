@@ -14,6 +14,7 @@ use super::errors::*;
 use numpy::{PyArray1, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyDeprecationWarning, PyTypeError};
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString, PyTuple};
 use std::ffi::CString;
 use std::format;
 use std::string::String;
@@ -190,29 +191,97 @@ pub(super) struct JointInputs {
     pub(super) dq: Option<Buf>,
 }
 
-/// The call shapes of a joint step, old and new: `step(m)` with a
-/// [`PyMeasurement`], or the deprecated `step(q, tau_e, dq)` (positional or
-/// by keyword), which warns once per call site.
-pub(super) struct JointCall<'a, 'py> {
+/// The parameters of a joint step with a measurement, and of the deprecated
+/// call with arrays.
+const TYPED: [&str; 4] = ["m", "xc", "dxc", "ddxc"];
+const ARRAYS: [&str; 6] = ["q", "tau_e", "dq", "xc", "dxc", "ddxc"];
+
+/// A joint step's call, read from its `(*args, **kwargs)`: `step(m, xc=None,
+/// dxc=None, ddxc=None)` with a [`PyMeasurement`] (the setpoint positional
+/// or by keyword: positional arguments skip the keyword dictionary, which
+/// an abi3 call pays for), or the deprecated `step(q, tau_e, dq=None,
+/// xc=None, dxc=None, ddxc=None)`, which warns once per call site. A `None`
+/// is an argument not given.
+pub(super) struct JointCall<'py> {
     /// Who is called, for the messages: "Controller.step".
-    pub(super) who: &'static str,
-    pub(super) m: Option<&'a Bound<'py, PyAny>>,
-    pub(super) tau_e: Option<&'a Bound<'py, PyAny>>,
-    pub(super) dq: Option<&'a Bound<'py, PyAny>>,
-    pub(super) q: Option<&'a Bound<'py, PyAny>>,
+    who: &'static str,
+    /// The measurement, or the arrays' q, τe, q̇.
+    slots: [Option<Bound<'py, PyAny>>; 3],
+    typed: bool,
+    /// The setpoint xc, ẋc, ẍc.
+    pub(super) setpoint: [Option<Bound<'py, PyAny>>; 3],
 }
 
-impl JointCall<'_, '_> {
-    /// The inputs for `n` joints; shapes and types checked, values not.
-    pub(super) fn inputs(&self, n: usize) -> PyResult<JointInputs> {
-        if let Some(m) = self.m.and_then(|m| m.cast::<PyMeasurement>().ok()) {
-            let m = m.get();
-            if self.tau_e.is_some() || self.dq.is_some() || self.q.is_some() {
+impl<'py> JointCall<'py> {
+    /// The call `who(*args, **kwargs)`, its arguments matched to the
+    /// parameters of its shape (Python's own errors for a wrong count, a
+    /// repeated or an unknown keyword).
+    pub(super) fn parse(
+        who: &'static str,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Self> {
+        let first = match args.get_item(0) {
+            Ok(a) => Some(a),
+            Err(_) => kwargs.and_then(|k| k.get_item("m").ok().flatten()),
+        };
+        let typed = first.is_some_and(|f| f.is_instance_of::<PyMeasurement>());
+        let names: &[&str] = if typed { &TYPED } else { &ARRAYS };
+        if args.len() > names.len() {
+            return Err(PyTypeError::new_err(format!(
+                "{who}() takes at most {} positional arguments ({} given)",
+                names.len(),
+                args.len()
+            )));
+        }
+        let mut slots: [Option<Bound<'py, PyAny>>; 6] = Default::default();
+        for (slot, a) in slots.iter_mut().zip(args.iter()) {
+            *slot = Some(a);
+        }
+        for (k, v) in kwargs.into_iter().flat_map(|k| k.iter()) {
+            let k = k.cast_into::<PyString>()?;
+            let k = k.to_cow()?;
+            let Some(i) = names.iter().position(|n| *n == k) else {
                 return Err(PyTypeError::new_err(format!(
-                    "{}: give the measurement as an adaptimp.Measurement or as arrays, not both",
-                    self.who
+                    "{who}() got an unexpected keyword argument '{k}'"
+                )));
+            };
+            if slots[i].is_some() {
+                return Err(PyTypeError::new_err(format!(
+                    "{who}() got multiple values for argument '{k}'"
                 )));
             }
+            slots[i] = Some(v);
+        }
+        let [a, b, c, d, e, f] = slots.map(|s| s.filter(|v| !v.is_none()));
+        Ok(if typed {
+            Self {
+                who,
+                slots: [a, None, None],
+                typed,
+                setpoint: [b, c, d],
+            }
+        } else {
+            Self {
+                who,
+                slots: [a, b, c],
+                typed,
+                setpoint: [d, e, f],
+            }
+        })
+    }
+
+    /// The inputs for `n` joints; shapes and types checked, values not.
+    pub(super) fn inputs(&self, n: usize) -> PyResult<JointInputs> {
+        let who = self.who;
+        if self.typed {
+            let Some(m) = self.slots[0]
+                .as_ref()
+                .and_then(|m| m.cast::<PyMeasurement>().ok())
+            else {
+                return Err(PyTypeError::new_err(format!("{who} needs a measurement")));
+            };
+            let m = m.get();
             if m.n != n {
                 return Err(shape_error("q", n, &format!("length {}", m.n)));
             }
@@ -222,32 +291,22 @@ impl JointCall<'_, '_> {
                 dq: m.dq,
             });
         }
-        let q = match (self.m, self.q) {
-            (Some(q), None) | (None, Some(q)) => q,
-            (Some(_), Some(_)) => {
-                return Err(PyTypeError::new_err(format!(
-                    "{}: q given twice (positionally and by keyword)",
-                    self.who
-                )))
-            }
-            (None, None) => {
-                return Err(PyTypeError::new_err(format!(
-                    "{} needs a measurement: step(adaptimp.Measurement(q, dq, tau_e=…))",
-                    self.who
-                )))
-            }
-        };
-        let Some(tau_e) = self.tau_e else {
+        let [q, tau_e, dq] = &self.slots;
+        let Some(q) = q else {
             return Err(PyTypeError::new_err(format!(
-                "{}(q, tau_e, dq) needs tau_e; better, pass adaptimp.Measurement(q, dq, tau_e=…)",
-                self.who
+                "{who} needs a measurement: step(adaptimp.Measurement(q, dq, tau_e=…))"
             )));
         };
-        deprecated(q.py(), self.who)?;
+        let Some(tau_e) = tau_e else {
+            return Err(PyTypeError::new_err(format!(
+                "{who}(q, tau_e, dq) needs tau_e; better, pass adaptimp.Measurement(q, dq, tau_e=…)"
+            )));
+        };
+        deprecated(q.py(), who)?;
         Ok(JointInputs {
             q: vector_any("q", n, q)?,
             tau_e: vector_any("tau_e", n, tau_e)?,
-            dq: optional("dq", n, self.dq)?,
+            dq: optional("dq", n, dq.as_ref())?,
         })
     }
 }

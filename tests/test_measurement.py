@@ -31,6 +31,20 @@ def test_a_measurement_holds_what_it_was_given() -> None:
         m.q = np.zeros(2)  # type: ignore[misc]
 
 
+def test_a_measurement_pickles_copies_and_compares_by_value() -> None:
+    import copy
+    import pickle
+
+    m = Measurement(Q, DQ, tau_e=TE, wrench=[1.0, 2.0, 3.0])
+    for twin in (pickle.loads(pickle.dumps(m)), copy.deepcopy(m)):
+        assert twin == m
+        assert repr(twin) == repr(m)
+    assert Measurement(Q) == Measurement(np.array(Q))
+    assert Measurement(Q) != Measurement(Q, DQ)
+    assert Measurement(Q, wrench=[0.0] * 6) != Measurement(Q)
+    assert Measurement([np.nan]) != Measurement([np.nan])
+
+
 def test_a_measurement_keeps_a_sensor_nan_for_the_controller_to_refuse() -> None:
     m = Measurement([np.nan, 0.0], DQ)
     assert np.isnan(m.q[0])

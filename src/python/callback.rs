@@ -36,7 +36,7 @@ use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
 use crate::control::config::Law;
 use crate::control::impedance::TargetImpedance;
-use crate::control::io::{Command, Control, Measurement};
+use crate::control::io::{Command, Measurement, WrenchControl};
 use crate::error::Error;
 use crate::sim::record::{Recorder, Row};
 use crate::trajectory::{Setpoint, Trajectory};
@@ -448,22 +448,12 @@ impl<const N: usize> PyStep<'_, N> {
     }
 }
 
-impl<const N: usize> Control<N> for PyStep<'_, N> {
+impl<const N: usize> WrenchControl<N> for PyStep<'_, N> {
     fn period(&self) -> f64 {
         self.run.ts
     }
     fn target(&self) -> &TargetImpedance<N> {
         &self.target
-    }
-    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
-        self.step_with_wrench(m, &[0.0; 6], c).1
-    }
-    fn step_or_fallback(
-        &mut self,
-        m: &Measurement<N>,
-        c: &Setpoint<N>,
-    ) -> (Vector<N>, Result<Command<N>, Error>) {
-        self.step_with_wrench(m, &[0.0; 6], c)
     }
     /// The Python step; on a refusal zero torque (the trait's fallback).
     fn step_with_wrench(

@@ -169,6 +169,40 @@ impl PyMeasurement {
         self.wrench.as_ref().map(|v| array1(py, v))
     }
 
+    /// The arguments `pickle` and `copy` make it again with (`__new__`'s).
+    #[allow(clippy::type_complexity)]
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        (Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyArray1<f64>>>),
+        Bound<'py, PyDict>,
+    )> {
+        let kw = PyDict::new(py);
+        kw.set_item("tau_e", self.tau_e(py))?;
+        kw.set_item("wrench", self.wrench(py))?;
+        Ok(((self.q(py), self.dq(py)), kw))
+    }
+
+    /// Equal when every part is, value for value (a NaN never is).
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        let Ok(o) = other.cast::<PyMeasurement>() else {
+            return false;
+        };
+        let o = o.get();
+        let n = self.n;
+        let same = |a: &Option<Buf>, b: &Option<Buf>| match (a, b) {
+            (Some(a), Some(b)) => a[..n] == b[..n],
+            (None, None) => true,
+            _ => false,
+        };
+        n == o.n
+            && self.q[..n] == o.q[..n]
+            && same(&self.dq, &o.dq)
+            && same(&self.tau_e, &o.tau_e)
+            && self.wrench == o.wrench
+    }
+
     fn __repr__(&self) -> String {
         let show = |v: Option<&[f64]>| match v {
             Some(v) => format!("{v:?}"),

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import adaptimp
-from adaptimp import tuning
+from adaptimp import Measurement, tuning
 
 
 def _swing(q0: np.ndarray, amp: float = 0.2, w: float = math.pi) -> Any:
@@ -145,7 +145,7 @@ def test_the_rule_always_builds(
     for case in adaptimp.CASES:
         ctrl = adaptimp.Controller(case, "robot", **kw)
         # It also steps: the first step of an arm at rest on its path.
-        tau = ctrl.step(q0 - amp, np.zeros(model.n), np.zeros(model.n))
+        tau = ctrl.step(Measurement(q0 - amp, np.zeros(model.n), tau_e=np.zeros(model.n)))
         assert np.all(np.isfinite(tau))
         assert np.all(np.abs(tau) <= np.array(tau_max))
     # And the gains alone, for the vertex grid (n ≤ 3) or the default basis.

@@ -67,6 +67,25 @@ def test_gains_alone_without_a_path() -> None:
     adaptimp.Controller("sf", "robot", **kw)
 
 
+def test_a_damped_joint_gets_the_scale_its_sampled_loop_sees() -> None:
+    # SPEC (18.9): d̃ = b Ts/(1 − e^(−β)), β = b Ts/d; a near-massless wrist
+    # (1e-6 kg m²) with 0.01 N m s/rad of damping (β = 10) gets ≈ b Ts, ten
+    # times d; an undamped joint keeps its scale bit for bit.
+    ts, d = 1e-3, np.diag([2.0, 0.5, 1e-6])
+    plain = tuning.suggest(d, [0.0] * 3, 10.0, Ts=ts)
+    damped = tuning.suggest(d, [0.0] * 3, 10.0, Ts=ts, damping=[0.0, 0.1, 0.01])
+    assert damped["inertia"][0] == plain["inertia"][0]
+    beta = np.array([0.1 * ts / 0.5, 0.01 * ts / 1e-6])
+    expected = np.array([0.1, 0.01]) * ts / -np.expm1(-beta)
+    np.testing.assert_allclose(damped["inertia"][1:], expected, rtol=1e-12)
+    np.testing.assert_allclose(damped["Kp"], 0.25 * np.array(damped["inertia"]) / ts, rtol=1e-12)
+    assert damped["inertia"][2] == pytest.approx(1e-5, rel=1e-4)
+    with pytest.raises(adaptimp.ConfigError, match="damping"):
+        tuning.suggest(d, [0.0] * 3, 10.0, Ts=ts, damping=[0.0, -1.0, 0.0])
+    # A model that is not a MuJoCo plant has no damping to take.
+    assert tuning.joint_damping(d) is None
+
+
 def test_bad_arms_are_errors_naming_the_condition() -> None:
     with pytest.raises(adaptimp.ConfigError, match="positive definite"):
         tuning.suggest(np.diag([1.0, -1.0]), [0.0, 0.0], 10.0)

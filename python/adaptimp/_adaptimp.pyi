@@ -688,12 +688,15 @@ def suggest(
     gravity: NDArray[np.float64] | None = None,
     resolve: bool = False,
     critical: bool = False,
+    damping: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every
     controller keyword), with a path also "centers" (L, 4n) and "widths" (4n,);
     ``resolve``: the tube narrowed to the path's size, SPEC (16.10); ``critical``:
-    Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6)."""
+    Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6); ``damping``
+    (n,): the joints' viscous damping, the scales as the sampled loop sees them,
+    SPEC (18.9)."""
 
 def pose_circle(
     p0: NDArray[np.float64],

@@ -77,6 +77,7 @@ import numba
 import numpy as np
 
 import adaptimp
+from adaptimp import Measurement
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent / "reference"))
 import spec_numba
@@ -247,7 +248,7 @@ def step_sequence(ctrl: Any, q: np.ndarray, dq: np.ndarray | None, tau_e: np.nda
     tau = np.empty((steps, N))
     zeta_max = 0.0
     for k in range(steps):
-        tau_sat[k] = ctrl.step(q[k], tau_e[k], None if dq is None else dq[k])
+        tau_sat[k] = ctrl.step(Measurement(q[k], None if dq is None else dq[k], tau_e=tau_e[k]))
         tau[k] = ctrl.tau
         zeta_max = max(zeta_max, float(np.linalg.norm(_zeta_now(ctrl))))
     out = {"tau_sat": tau_sat, "tau": tau, "zeta": _zeta_now(ctrl), "zeta_max": zeta_max}

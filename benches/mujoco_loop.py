@@ -127,8 +127,8 @@ class PythonSide:
         self.Ts = inner.Ts
         self.params = inner.params
 
-    def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> Any:
-        return self.inner.step(q, tau_e, dq, **sp)
+    def step(self, m: Any, **sp: Any) -> Any:
+        return self.inner.step(m, **sp)
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.inner, name)
@@ -397,7 +397,8 @@ class PinocchioPDPlus:
         self.tau_max, self.Ts, self.impedance = tau_max, 1e-3, "external"
         self.n = self.model.nv
 
-    def step(self, q: Any, tau_e: Any, dq: Any = None, **kw: Any) -> np.ndarray:
+    def step(self, m: Any, **kw: Any) -> np.ndarray:
+        q, dq = m.q, m.dq
         pin, m_, d_ = self.pin, self.model, self.data
         xc, dxc, ddxc = kw["xc"], kw["dxc"], kw["ddxc"]
         j = np.asarray(kw["jacobian"]).reshape(6, self.n)
@@ -539,7 +540,8 @@ class PythonPD:
         self.arm = adaptimp.TwoLinkArm()
         self.Kp, self.Kd = np.array([60.0, 40.0]), np.array([8.0, 5.0])
 
-    def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+    def step(self, m: Any, **sp: Any) -> np.ndarray:
+        q, dq = m.q, m.dq
         q = np.asarray(q)
         return np.asarray(self.arm.G(q) + self.Kp * (sp["xc"] - q) + self.Kd * (sp["dxc"] - dq))
 

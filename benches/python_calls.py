@@ -12,7 +12,9 @@ q̈ seeded, within the joint limits), per call:
   ``getFrameClassicalAcceleration``;
 - ``ComputedTorque.inverse_dynamics``: ``Dynamics::inverse_dynamics``; ``rnea``;
 - ``ComputedTorque.step`` (external mode): ``ComputedTorque::step``; (20.3)
-  with ``rnea`` and NumPy;
+  with ``rnea`` and NumPy; ``ct_step`` is ``step(m, xc, dxc, ddxc)`` on
+  measurements made before, ``ct_step_measured`` makes ``m =
+  adaptimp.Measurement(q, dq)`` in the loop too;
 - ``CartesianController.step`` (SF, its path in Python): the core's Cartesian
   step (``CartesianImpedance.replay``, per row) plus the path's own calls;
   (20.7) with ``computeFrameJacobian`` and NumPy.
@@ -50,6 +52,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import peers
 
 import adaptimp
+from adaptimp import Measurement
 from adaptimp.baselines import ComputedTorque
 
 RUST = {
@@ -58,6 +61,7 @@ RUST = {
     "jdot_qdot": "jdot_qdot",
     "inverse_dynamics": "rnea",
     "ct_step": "ct_step",
+    "ct_step_measured": "ct_step",
 }
 
 
@@ -127,9 +131,17 @@ def python_timers(name: str, states: list[tuple[Any, Any, Any]], calls: int) -> 
         for q, dq, ddq in rows:
             rnea(model, data, q, dq, ddq)
 
+    made = [(Measurement(q, dq), q, dq, ddq) for q, dq, ddq in rows]
+
     def step_ours() -> None:
+        # The step alone, on measurements made before (the entry point's cost).
+        for m, q, dq, ddq in made:
+            step(m, q, dq, ddq)
+
+    def step_measured() -> None:
+        # The measurement made from the sensors' arrays each call, then the step.
         for q, dq, ddq in rows:
-            step(q, zero, dq, xc=q, dxc=dq, ddxc=ddq)
+            step(Measurement(q, dq), q, dq, ddq)
 
     def step_pin() -> None:
         # (20.3), external mode, as a user writes it with Pinocchio and NumPy.
@@ -154,6 +166,7 @@ def python_timers(name: str, states: list[tuple[Any, Any, Any]], calls: int) -> 
         "jdot_qdot": (timed(jdq_ours), timed(jdq_pin)),
         "inverse_dynamics": (timed(inv_ours), timed(inv_pin)),
         "ct_step": (timed(step_ours), timed(step_pin)),
+        "ct_step_measured": (timed(step_measured), timed(step_pin)),
     }
 
 
@@ -220,7 +233,7 @@ def cartesian_timers(
         gc.disable()
         start = time.perf_counter()
         for q, dq, f in rows:
-            step(q, dq, f)
+            step(Measurement(q, dq, wrench=f))
         seconds = time.perf_counter() - start
         gc.enable()
         return seconds / calls

@@ -3,8 +3,9 @@
 The Rust step is timed by ``Controller.replay`` over logged measurements: the
 loop runs in Rust (GIL released) and calls exactly the step a Python call
 reaches, so replay's time per row is the Rust step (plus a row copy of a few
-ns). The Python call is ``Controller.step(q, tau_e, dq)`` with NumPy arrays of
-shape (n,), one call per row of the same log, and the same with lists. Both
+ns). The Python call is ``Controller.step(m)``: alone, on measurements made
+before, and with ``m = Measurement(q, dq, tau_e=tau_e)`` made each step from
+NumPy arrays of shape (n,) or from lists, one call per row of the same log. All
 run K = 20 000 rows of a recorded run of the robot scenario (state feedback,
 Ts = 1 ms), interleaved round-robin (7 repeats, garbage collector off) so
 that load falls on all alike: n = 2 (the paper's arm, the 256-node grid) and
@@ -30,6 +31,7 @@ from typing import Any
 import numpy as np
 
 import adaptimp
+from adaptimp import Measurement
 
 
 def setup(rows: int, n: int) -> tuple[adaptimp.SimResult, dict[str, Any]]:
@@ -68,21 +70,35 @@ def timers(rows: int, n: int = 2) -> dict[str, Callable[[], float]]:
         ctrl.replay(q, tau_e, dq)
         return (time.perf_counter() - start) / rows
 
+    made = [Measurement(a, c, tau_e=b) for a, b, c in arrays]
+
     def calls(data: list[tuple]) -> Callable[[], float]:
+        """The measurement made each step from the sensors' arrays, then the step."""
+
         def run() -> float:
             ctrl.reset()
-            step = ctrl.step
+            step, measurement = ctrl.step, Measurement
             start = time.perf_counter()
             for a, b, c in data:
-                step(a, b, c)
+                step(measurement(a, c, tau_e=b))
             return (time.perf_counter() - start) / rows
 
         return run
 
+    def steps() -> float:
+        """The step alone, on measurements made before."""
+        ctrl.reset()
+        step = ctrl.step
+        start = time.perf_counter()
+        for m in made:
+            step(m)
+        return (time.perf_counter() - start) / rows
+
     return {
         "Rust step (Controller.replay, per row)": replay,
-        "Python call, NumPy arrays": calls(arrays),
-        "Python call, lists": calls(lists),
+        "Python call, step(m) alone": steps,
+        "Python call, Measurement of NumPy arrays + step": calls(arrays),
+        "Python call, Measurement of lists + step": calls(lists),
     }
 
 

@@ -16,6 +16,7 @@ import os
 import numpy as np
 
 import adaptimp
+from adaptimp import Measurement
 
 N = 3
 TS = 1e-3  # s
@@ -41,7 +42,7 @@ def run(case: str, seconds: float) -> float:
     z1 = []
     for k in range(steps):
         xc, dxc, ddxc = setpoint(k * TS)
-        tau = ctrl.step(q, np.zeros(N), dq, xc=xc, dxc=dxc, ddxc=ddxc)
+        tau = ctrl.step(Measurement(q, dq, tau_e=np.zeros(N)), xc=xc, dxc=dxc, ddxc=ddxc)
         dq = dq + TS * arm.forward_dynamics(q, dq, tau, np.zeros(N))  # semi-implicit Euler
         q = q + TS * dq
         if k + last >= steps:

@@ -29,11 +29,11 @@ def main() -> None:
     T = 3.0 if os.environ.get("ADAPTIMP_QUICK") else 20.0
     # 1. Pickle mid-run.
     ctrl = adaptimp.Controller("sf", "robot")
-    meas = (np.array([0.3, -0.1]), np.zeros(2), np.array([0.1, 0.2]))
+    meas = adaptimp.Measurement([0.3, -0.1], [0.1, 0.2], tau_e=[0.0, 0.0])
     for _ in range(500):
-        ctrl.step(*meas)
+        ctrl.step(meas)
     twin = pickle.loads(pickle.dumps(ctrl))
-    same = all(np.array_equal(ctrl.step(*meas), twin.step(*meas)) for _ in range(500))
+    same = all(np.array_equal(ctrl.step(meas), twin.step(meas)) for _ in range(500))
     print(f"pickled after 500 steps; the next 500 torques are identical: {same}")
 
     # 2. state_dict through a file.

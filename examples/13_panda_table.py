@@ -140,6 +140,8 @@ def controller(name: str, sc: apt.PandaTable, rule: dict[str, Any]) -> Any:
         extra["admittance_share"] = SHARE
     if kind in ("pd", "sf", "of"):
         extra.update({k: v for k, v in rule.items() if learn or k not in LEARN_KEYS})
+    elif "Md" in rule:  # the scenario's target inertia (SPEC (19.8)), whatever the joint law
+        extra["Md"] = rule["Md"]
     return apt.panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
 
 

@@ -21,7 +21,7 @@ import os
 import numpy as np
 
 import adaptimp
-from adaptimp import _models
+from adaptimp import Measurement, _models
 
 TS = 1e-3
 INERTIA = np.array([0.27, 0.97, 0.54, 0.40, 0.037, 0.034, 0.0065])  # kg m²
@@ -87,7 +87,7 @@ def main() -> None:
         jac = chain.jacobian(q)
         p, rot = chain.pose(q)
         wrench = table(z_table, p, jac[:3] @ dq)
-        tau = ctrl.step(q, dq, wrench)
+        tau = ctrl.step(Measurement(q, dq, wrench=wrench))
         if 0.2 <= t < 0.6:
             pc, _, _, rc, _, _ = target(p0, r0, t)
             worst_p = max(worst_p, float(np.linalg.norm(p - pc)))

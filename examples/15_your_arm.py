@@ -43,7 +43,7 @@ import mujoco
 import numpy as np
 
 import adaptimp
-from adaptimp import _models
+from adaptimp import Measurement, _models
 from adaptimp import mujoco as amj
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
@@ -148,7 +148,9 @@ def long_run(path: Path, seconds: float, arm: dict[str, Any], case: str = "sf") 
     start = time.perf_counter()
     for k in range(steps):
         xc, dxc, ddxc = ref(k * ctrl.Ts)
-        tau = ctrl.step(plant.q, np.zeros(n), plant.dq, xc=xc, dxc=dxc, ddxc=ddxc)
+        tau = ctrl.step(
+            Measurement(plant.q, plant.dq, tau_e=np.zeros(n)), xc=xc, dxc=dxc, ddxc=ddxc
+        )
         if k * ctrl.Ts >= 0.1:
             peak = max(peak, float(np.max(np.abs(ctrl.tau) / plant.tau_max)))
         z2sum += float(np.sum(ctrl.z1**2))

@@ -151,6 +151,14 @@ def _inputs(k: int, n: int = 2) -> tuple[list[float], list[float], list[float]]:
     return q, [0.0] * n, dq
 
 
+def _meas(k: int, n: int = 2) -> Any:
+    """The measurement of step k (``_inputs``)."""
+    import adaptimp
+
+    q, te, dq = _inputs(k, n)
+    return adaptimp.Measurement(q, dq, tau_e=te)
+
+
 def _controller(case_: str, scenario: str, n: int = 2, **kw: Any) -> Any:
     import adaptimp
 
@@ -166,7 +174,7 @@ def _controller(case_: str, scenario: str, n: int = 2, **kw: Any) -> Any:
 def _trained(case_: str, scenario: str, n: int = 2, steps: int = 200, **kw: Any) -> Any:
     ctrl = _controller(case_, scenario, n, **kw)
     for k in range(steps):
-        ctrl.step(*_inputs(k, n))
+        ctrl.step(_meas(k, n))
     return ctrl
 
 
@@ -255,7 +263,7 @@ def restore(t: Tally, quick: bool) -> None:
         def good(snap: np.ndarray = snap, src: Any = src, dst: Any = dst, n: int = n) -> None:
             dst.restore(snap)
             for k in range(200, 230):
-                a, b = src.step(*_inputs(k, n)), dst.step(*_inputs(k, n))
+                a, b = src.step(_meas(k, n)), dst.step(_meas(k, n))
                 check(np.array_equal(a, b), "a restored state does not continue identically")
 
         case(t, f"{case_}/n={n}: restore its own snapshot", good, "accept")
@@ -343,7 +351,7 @@ def faults(t: Tally, quick: bool) -> None:
 
             def good() -> tuple[np.ndarray, str | None]:
                 nonlocal k, applied
-                tau, err = ctrl.step_or_fallback(*_inputs(k))
+                tau, err = ctrl.step_or_fallback(_meas(k))
                 _torque_ok(ctrl, tau)
                 if err is None and rate is not None:
                     check(
@@ -420,7 +428,7 @@ def faults(t: Tally, quick: bool) -> None:
                             check(bool(np.all(tau == 0.0)), f"{kind}: zero fallback {tau}")
                     applied = np.asarray(tau)
                     if policy == "latch":
-                        tau2, err2 = ctrl.step_or_fallback(*_inputs(k))
+                        tau2, err2 = ctrl.step_or_fallback(_meas(k))
                         check(err2 is not None and "latched" in err2, f"{kind}: latch did not hold")
                         _torque_ok(ctrl, tau2)
                         applied = np.asarray(tau2)
@@ -480,7 +488,9 @@ def njoint(t: Tally, quick: bool) -> None:
                 ) -> None:
                     before = ctrl.steps
                     try:
-                        tau = ctrl.step(**args)
+                        sp = {k: v for k, v in args.items() if k in ("xc", "dxc", "ddxc")}
+                        m = adaptimp.Measurement(args["q"], args.get("dq"), tau_e=args["tau_e"])
+                        tau = ctrl.step(m, **sp)
                     finally:
                         if expect == "refuse":
                             check(ctrl.steps == before, "a refused step advanced the clock")
@@ -845,7 +855,7 @@ def _refused_step(c: Any, q: Any) -> bool:
     import adaptimp
 
     try:
-        c.step(q, np.zeros(3), np.zeros(6))
+        c.step(adaptimp.Measurement(q, np.zeros(3), wrench=np.zeros(6)))
     except (adaptimp.MeasurementError, ValueError, TypeError):
         return True
     return False
@@ -859,11 +869,16 @@ def _cart(**kw: Any) -> Any:
     )
 
 
+def _cart_meas(q: Any, w: Any = None) -> Any:
+    """A Cartesian step's measurement of the 3-joint arm at rest: q, the wrench ``w``."""
+    import adaptimp
+
+    return adaptimp.Measurement(q, np.zeros(3), wrench=np.zeros(6) if w is None else w)
+
+
 def _cart_steps(c: Any, k: int) -> np.ndarray:
     q0 = np.array([0.3, 0.6, 0.2])
-    return np.array(
-        [c.step(q0 + 1e-3 * np.sin(i + np.arange(3)), np.zeros(3), np.zeros(6)) for i in range(k)]
-    )
+    return np.array([c.step(_cart_meas(q0 + 1e-3 * np.sin(i + np.arange(3)))) for i in range(k)])
 
 
 def cartesian(t: Tally, quick: bool) -> None:
@@ -912,7 +927,7 @@ def cartesian(t: Tally, quick: bool) -> None:
                     kw: dict[str, Any] = {"xc": p0.copy(), "R": R0}
                     kw[part] = kw.get(part, z3).copy() if part in kw else z3.copy()
                     kw[part][i] = v
-                    return c.step(q0, z3, np.zeros(6), **kw)
+                    return c.step(_cart_meas(q0), **kw)
 
                 twin(target, "refuse" if bad else "either", f"step {part}[{i}] = {v:g}")
     for what, R, expect in [
@@ -926,7 +941,7 @@ def cartesian(t: Tally, quick: bool) -> None:
         ("4 values", [1, 0, 0, 1], "refuse"),
         ("a string", "R", "refuse"),
     ]:
-        twin(lambda c, R=R: c.step(q0, z3, np.zeros(6), xc=p0, R=R), expect, f"step R = {what}")
+        twin(lambda c, R=R: c.step(_cart_meas(q0), xc=p0, R=R), expect, f"step R = {what}")
         twin(lambda c, R=R: c.outer.target(p0, R=R), expect, f"target(R = {what})")
     for what, w, expect in [
         ("(6,)", np.zeros(6), "accept"),
@@ -937,7 +952,7 @@ def cartesian(t: Tally, quick: bool) -> None:
         ("1e10", [1e10, 0, 0, 0, 0, 0], "refuse"),
         ("strings", ["a"] * 6, "refuse"),
     ]:
-        twin(lambda c, w=w: c.step(q0, z3, w), expect, f"wrench {what}")
+        twin(lambda c, w=w: c.step(_cart_meas(q0, w)), expect, f"wrench {what}")
 
     def started(v: float) -> None:
         c = adaptimp.CartesianController(_arm3(), "pd", q0=[v, 0.6, 0.2], tau_max=20.0)
@@ -956,10 +971,10 @@ def cartesian(t: Tally, quick: bool) -> None:
         ("set_stiffness (1, 1) rot", lambda c: c.outer.set_stiffness(100.0, [[1.0]]), "refuse"),
         ("set_posture of 6", lambda c: c.outer.set_posture(np.zeros(6)), "refuse"),
         ("reset(np.zeros(6))", lambda c: c.outer.reset(np.zeros(6)), "refuse"),
-        ("xc of 2", lambda c: c.step(q0, z3, np.zeros(6), xc=[0.3, 0.0]), "refuse"),
-        ("q of 2", lambda c: c.step([0.3, 0.6], z3, np.zeros(6)), "refuse"),
-        ("q NaN", lambda c: c.step([0.3, math.nan, 0.2], z3, np.zeros(6)), "refuse"),
-        ("q NaN with a new R", lambda c: c.step([math.nan, 0.6, 0.2], z3, np.zeros(6), xc=p0,
+        ("xc of 2", lambda c: c.step(_cart_meas(q0), xc=[0.3, 0.0]), "refuse"),
+        ("q of 2", lambda c: c.step(adaptimp.Measurement([0.3, 0.6], [0.0] * 2)), "refuse"),
+        ("q NaN", lambda c: c.step(_cart_meas([0.3, math.nan, 0.2])), "refuse"),
+        ("q NaN with a new R", lambda c: c.step(_cart_meas([math.nan, 0.6, 0.2]), xc=p0,
                                                 R=R0 @ TURN), "refuse"),
     ]:  # fmt: skip
         twin(call, expect, what)
@@ -1046,6 +1061,7 @@ def dynamics(t: Tally, quick: bool) -> None:
     """Computed torque and its model (RNEA): construction with every bad value
     of every scalar; the model's queries with bad rates; accepted: finite."""
     try:
+        from adaptimp import Measurement
         from adaptimp.baselines import ComputedTorque
     except ImportError:
         return
@@ -1065,7 +1081,7 @@ def dynamics(t: Tally, quick: bool) -> None:
             def make(name: str = name, v: float = v) -> None:
                 ct = ComputedTorque(**{name: v})
                 for _ in range(5):
-                    _finite(ct.step([0.1, 0.2], [0.0, 0.0], [0.0, 0.0]))
+                    _finite(ct.step(Measurement([0.1, 0.2], [0.0, 0.0])))
 
             case(t, f"ComputedTorque({name}={v:g})", make, "refuse" if bad else "either")
     ct = ComputedTorque()
@@ -1366,7 +1382,7 @@ def descriptions(t: Tally, quick: bool) -> None:
     mujoco.from_urdf, with sources no arm is read from, every field of the
     probe arm's URDF replaced by a bad value, and tips, fixes and drive= of
     every wrong kind. Accepted: the arm's numbers are what a user can use."""
-    from adaptimp import Chain
+    from adaptimp import Chain, Measurement
     from adaptimp._description import read_arm
 
     root = Path(tempfile.mkdtemp(prefix="breakit-urdf-"))
@@ -1439,7 +1455,7 @@ def descriptions(t: Tally, quick: bool) -> None:
                 c = ComputedTorque(str(probe), **kw)
                 q = [0.1] * c.n
                 for _ in range(3):
-                    _finite(c.step(q, [0.0] * c.n, [0.0] * c.n, xc=q))
+                    _finite(c.step(Measurement(q, [0.0] * c.n), xc=q))
 
             fronts.append(("ComputedTorque", ct))
         except ImportError:

@@ -19,7 +19,7 @@ class Hold:
         self.tau_cmd = np.asarray(tau, dtype=np.float64)
         self.Ts = Ts
 
-    def step(self, q: Any, tau_e: Any, dq: Any = None, **setpoint: Any) -> np.ndarray:
+    def step(self, m: Any, **setpoint: Any) -> np.ndarray:
         return self.tau_cmd
 
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import SimResult, _adaptimp
+from adaptimp import Measurement, SimResult, _adaptimp
 from adaptimp._params import ALL_GROUPS, names, resolve
 from adaptimp._result import ARRAYS, METRIC_KEYS
 
@@ -139,7 +139,7 @@ def test_controller_keeps_its_clock_and_resets() -> None:
     ctrl = adaptimp.Controller("sf", Ts=1e-3, learning_step="normalized")
     assert (ctrl.t, ctrl.steps, ctrl.Ts, ctrl.case) == (0.0, 0, 1e-3, "sf")
     for _ in range(3):
-        tau = ctrl.step([0.25, -0.05], [5.0, 0.0], dq=[0.0, 0.0])
+        tau = ctrl.step(Measurement([0.25, -0.05], [0.0, 0.0], tau_e=[5.0, 0.0]))
     assert tau.shape == (2,)
     assert tau.dtype == np.float64
     assert ctrl.steps == 3
@@ -158,7 +158,7 @@ def test_controller_keeps_its_clock_and_resets() -> None:
 
 def test_controller_tracks_its_own_trajectory() -> None:
     ctrl = adaptimp.Controller("pd", xc_offset=[0.1, 0.3], xc_sin=0.0, xc_cos=0.0)
-    ctrl.step([0.0, 0.0], [0.0, 0.0], dq=[0.0, 0.0])
+    ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     np.testing.assert_array_equal(ctrl.xc, [0.1, 0.3])
     np.testing.assert_array_equal(ctrl.xd, [0.1, 0.3])
     np.testing.assert_array_equal(ctrl.z1, [0.1, 0.3])
@@ -177,7 +177,10 @@ def test_output_feedback_ignores_dq_and_estimates_the_velocity() -> None:
     a, b = adaptimp.Controller("of"), adaptimp.Controller("of")
     for k in range(50):
         q = [0.25 + 1e-4 * k, -0.05]
-        np.testing.assert_array_equal(a.step(q, [0.0, 0.0]), b.step(q, [0.0, 0.0], [9.0, 9.0]))
+        np.testing.assert_array_equal(
+            a.step(Measurement(q, tau_e=[0.0, 0.0])),
+            b.step(Measurement(q, [9.0, 9.0], tau_e=[0.0, 0.0])),
+        )
     np.testing.assert_array_equal(a.dq_hat, b.dq_hat)
 
 
@@ -187,7 +190,7 @@ def test_observer_estimates_a_ramp(hold: str, gain: float) -> None:
     (README, observer.rs), the triangle hold's is 1."""
     ctrl = adaptimp.Controller("of", observer_init="first", observer_hold=hold)
     for k in range(2000):
-        ctrl.step([0.25 + 2.0 * k * 50e-6, -0.05], [0.0, 0.0])
+        ctrl.step(Measurement([0.25 + 2.0 * k * 50e-6, -0.05], tau_e=[0.0, 0.0]))
     assert ctrl.dq_hat[0] == pytest.approx(2.0 * gain, rel=2e-3)
     assert ctrl.dq_hat[1] == pytest.approx(0.0, abs=1e-6)
 
@@ -197,7 +200,7 @@ def test_controller_matches_the_step_of_simulate(runs: dict[str, SimResult]) -> 
     res = runs["sf"]
     ctrl = adaptimp.Controller("sf")
     for k in range(200):
-        tau_sat = ctrl.step(res.q[k], res.tau_e[k], res.dq[k])
+        tau_sat = ctrl.step(Measurement(res.q[k], res.dq[k], tau_e=res.tau_e[k]))
         np.testing.assert_array_equal(tau_sat, res.tau_sat[k])
         np.testing.assert_array_equal(ctrl.tau, res.tau[k])
         np.testing.assert_array_equal(ctrl.z1, res.z1[k])
@@ -205,9 +208,13 @@ def test_controller_matches_the_step_of_simulate(runs: dict[str, SimResult]) -> 
 
 def test_step_accepts_lists_tuples_and_any_real_array() -> None:
     ctrl = adaptimp.Controller("pd")
-    a = ctrl.step([0.25, -0.05], (0.0, 0.0), np.zeros(2, dtype=np.int64))
+    a = ctrl.step(Measurement([0.25, -0.05], np.zeros(2, dtype=np.int64), tau_e=(0.0, 0.0)))
     ctrl.reset()
-    b = ctrl.step(np.array([0.25, -0.05, 9.0])[:2], np.zeros(2, np.float32), np.zeros(4)[::2])
+    b = ctrl.step(
+        Measurement(
+            np.array([0.25, -0.05, 9.0])[:2], np.zeros(4)[::2], tau_e=np.zeros(2, np.float32)
+        )
+    )
     np.testing.assert_array_equal(a, b)
 
 

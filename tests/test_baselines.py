@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 import adaptimp
-from adaptimp import _models
+from adaptimp import Measurement, _models
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque, pinocchio_model, scale_masses
 from mujoco_probe import contact_list_wrench, ee_jacobian, ee_position
@@ -155,9 +155,9 @@ def test_computed_torque_validates() -> None:
         ComputedTorque(Kp=[1.0, 2.0, 3.0])
     ct = ComputedTorque()
     with pytest.raises(ValueError, match="needs the measured joint velocity"):
-        ct.step([0.0, 0.0], [0.0, 0.0])
+        ct.step(Measurement([0.0, 0.0], tau_e=[0.0, 0.0]))
     with pytest.raises(ValueError, match="no setpoint given and no trajectory"):
-        ComputedTorque("panda").step(np.zeros(7), np.zeros(7), np.zeros(7))
-    tau = ct.step([0.25, -0.05], [0.0, 0.0], [0.0, 0.0])
+        ComputedTorque("panda").step(Measurement(np.zeros(7), np.zeros(7), tau_e=np.zeros(7)))
+    tau = ct.step(Measurement([0.25, -0.05], [0.0, 0.0], tau_e=[0.0, 0.0]))
     assert np.all(np.abs(tau) <= ct.tau_max)
     assert ct.t == pytest.approx(1e-3)

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import adaptimp
-from adaptimp import _models
+from adaptimp import Measurement, _models
 from adaptimp import mujoco as amj
 from adaptimp.cartesian import CartesianImpedance
 
@@ -153,7 +153,7 @@ def test_without_force_feedforward_the_joint_controller_gets_no_tau_e() -> None:
             PANDA, "pd", q0=HOME, Kd_rot=0.0, force_feedforward=ff, tau_max=87.0, Kp=5.0,
             Kzeta=25.0, **ONE,
         )  # fmt: skip
-        ctrl.step(HOME, np.zeros(7), wrench)
+        ctrl.step(Measurement(HOME, np.zeros(7), wrench=wrench))
         expect = PANDA.jacobian(HOME).T @ wrench if ff else np.zeros(7)
         np.testing.assert_allclose(ctrl.outer.last("tau_e"), expect, rtol=0, atol=1e-12)
 

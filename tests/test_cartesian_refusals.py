@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _models
+from adaptimp import Measurement, _models
 from adaptimp.cartesian import CartesianImpedance
 
 ARM = adaptimp.Chain(
@@ -28,6 +28,8 @@ ARM = adaptimp.Chain(
 Q0 = np.array([0.3, 0.6, 0.2])
 P0 = ARM.fk(Q0)[:3, 3]
 R0 = ARM.fk(Q0)[:3, :3]
+#: The measurement at rest at Q0, without contact (immutable: shared by the tests).
+M0 = Measurement(Q0, np.zeros(3), wrench=np.zeros(6))
 PANDA_Q0 = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.6, 0.8])
 
 
@@ -45,7 +47,7 @@ def _steps(c: adaptimp.CartesianController, q0: np.ndarray, k: int, **kw: Any) -
     out = []
     for i in range(k):
         q = q0 + 1e-3 * np.sin(i + np.arange(len(q0)))
-        out.append(c.step(q, np.zeros(len(q0)), np.zeros(6), **kw))
+        out.append(c.step(Measurement(q, np.zeros(len(q0)), wrench=np.zeros(6)), **kw))
     return np.array(out)
 
 
@@ -68,32 +70,32 @@ ORTHONORMAL = re.escape(
 
 def test_a_refused_rotation_is_not_kept_as_the_last_commanded_one() -> None:
     c = _ctrl()
-    c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=R0)
+    c.step(M0, xc=P0, R=R0)
     with pytest.raises(adaptimp.MeasurementError, match=ORTHONORMAL):
-        c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=1.1 * R0)
+        c.step(M0, xc=P0, R=1.1 * R0)
     np.testing.assert_array_equal(c.outer._R, R0)
     # The next step without R holds the last good one (it was bricked).
-    c.step(Q0, np.zeros(3), np.zeros(6), xc=P0)
+    c.step(M0, xc=P0)
     with pytest.raises(adaptimp.MeasurementError, match=ORTHONORMAL):
         c.outer.target(P0, R=1.1 * R0)
     np.testing.assert_array_equal(c.outer._R, R0)
-    c.step(Q0, np.zeros(3), np.zeros(6), xc=P0)
+    c.step(M0, xc=P0)
 
     def refuse(c: adaptimp.CartesianController) -> None:
         with pytest.raises(adaptimp.MeasurementError):
-            c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=1.1 * R0)
+            c.step(M0, xc=P0, R=1.1 * R0)
 
     _twins(refuse)
 
 
 def test_a_good_rotation_of_a_refused_step_is_not_kept_either() -> None:
     c = _ctrl()
-    c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=R0)
+    c.step(M0, xc=P0, R=R0)
     turned = R0 @ np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     with pytest.raises(adaptimp.MeasurementError, match=r"^q\[1\] is not finite"):
-        c.step([0.3, math.nan, 0.2], np.zeros(3), np.zeros(6), xc=P0, R=turned)
+        c.step(Measurement([0.3, math.nan, 0.2], np.zeros(3), wrench=np.zeros(6)), xc=P0, R=turned)
     np.testing.assert_array_equal(c.outer._R, R0)
-    c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=turned)
+    c.step(M0, xc=P0, R=turned)
     np.testing.assert_array_equal(c.outer._R, turned)
 
 
@@ -107,13 +109,13 @@ def test_a_path_that_returns_one_bad_rotation_costs_one_step() -> None:
 
     c = _ctrl(path=path)
     for _ in range(bad_at):
-        c.step(Q0, np.zeros(3), np.zeros(6))
+        c.step(M0)
     with pytest.raises(adaptimp.MeasurementError, match=ORTHONORMAL):
-        c.step(Q0, np.zeros(3), np.zeros(6))
+        c.step(M0)
     np.testing.assert_array_equal(c.outer._R, R0)
     # The refused step did not advance the clock: the path is asked for the
     # same t again, still bad, until the caller gives a target.
-    c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=R0)
+    c.step(M0, xc=P0, R=R0)
     np.testing.assert_array_equal(c.outer._R, R0)
 
 
@@ -254,21 +256,22 @@ def test_an_orbit_with_more_nodes_than_steps_samples_every_step() -> None:
          "Kd must be a scalar or have shape (3,) (x, y, z), got shape (2,)"),
         (lambda c: c.outer.set_stiffness(100.0, [[1.0]]), adaptimp.ConfigError,
          "Kd_rot must be a scalar or have shape (3,) (x, y, z), got shape (1, 1)"),
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros(6), xc=[0.3, 0]), adaptimp.MeasurementError,
+        (lambda c: c.step(M0, xc=[0.3, 0]), adaptimp.MeasurementError,
          "p_c must have 3 values, got 2"),  # xc is p_c (the core reads it)
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=[1, 0, 0, 1]),
+        (lambda c: c.step(M0, xc=P0, R=[1, 0, 0, 1]),
          adaptimp.MeasurementError, "R_c must have shape (3, 3), got shape (4,)"),
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=R0.ravel()),
+        (lambda c: c.step(M0, xc=P0, R=R0.ravel()),
          adaptimp.MeasurementError, "R_c must have shape (3, 3), got shape (9,)"),
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, dw=["x", 0, 0]), TypeError,
+        (lambda c: c.step(M0, xc=P0, dw=["x", 0, 0]), TypeError,
          "dw_c must be a sequence or array of reals"),
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros((2, 3))), adaptimp.MeasurementError,
-         "wrench must have shape (6,) or (3,), got shape (2, 3)"),
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, w=[math.nan, 0, 0]),
+        (lambda c: c.step(Measurement(Q0, np.zeros(3), wrench=np.zeros((2, 3)))),
+         adaptimp.MeasurementError,
+         "wrench must have shape (6,) ([f; m], N and N m) or (3,) (f alone), got shape (2, 3)"),
+        (lambda c: c.step(M0, xc=P0, w=[math.nan, 0, 0]),
          adaptimp.MeasurementError, "w_c[0] is not finite (NaN or infinite)"),
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros(6), xc=P0, R=np.diag([1.0, math.nan, 1.0])),
+        (lambda c: c.step(M0, xc=P0, R=np.diag([1.0, math.nan, 1.0])),
          adaptimp.MeasurementError, "R_c[4] is not finite (NaN or infinite)"),
-        (lambda c: c.step(Q0, np.zeros(3), np.zeros(6), xc=[0, 0, 2e6]),
+        (lambda c: c.step(M0, xc=[0, 0, 2e6]),
          adaptimp.MeasurementError,
          "p_c[2] = 2e6 is beyond its limit ±1e6; the state was left unchanged"),
     ],
@@ -376,7 +379,9 @@ def test_an_interrupted_native_cartesian_run_keeps_its_rows_in_the_log() -> None
         **tuning.suggest(plant, PANDA_Q0, plant.tau_max),
     )  # fmt: skip
     plant.reset(PANDA_Q0)
-    ctrl.step(PANDA_Q0, np.zeros(7), np.zeros(6), xc=p0, R=R0)  # a row before the run
+    ctrl.step(
+        Measurement(PANDA_Q0, np.zeros(7), wrench=np.zeros(6)), xc=p0, R=R0
+    )  # a row before the run
 
     def stop(done: int, total: int) -> None:
         raise KeyboardInterrupt

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import adaptimp
+from adaptimp import Measurement
 
 WALL, KE, BE = 0.2, 1000.0, 10.0
 
@@ -27,7 +28,7 @@ def python_loop(case: str, T: float, substeps: int = 1) -> dict[str, np.ndarray]
     rec: dict[str, list[np.ndarray]] = {"q": [], "dq": [], "tau": [], "tau_sat": [], "tau_e": []}
     for _ in range(round(T / ctrl.Ts)):
         tau_e = wall_force(q, dq)
-        tau_s = ctrl.step(q, tau_e, dq)
+        tau_s = ctrl.step(Measurement(q, dq, tau_e=tau_e))
         for name, value in (("q", q), ("dq", dq), ("tau", ctrl.tau), ("tau_sat", tau_s)):
             rec[name].append(value)
         rec["tau_e"].append(tau_e)

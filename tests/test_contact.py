@@ -662,6 +662,98 @@ def test_an_mjcf_arm_without_actuators_gets_the_plants_motors(tmp_path: Path) ->
     assert np.all(sc.tau_max > 0.0)
 
 
+_SIDEWAYS_ARM = """<mujoco><compiler angle="radian"/><worldbody><body name="base" pos="0 0 0.3">
+  <joint name="j1" pos="0 0 -0.25" axis="0 0 1" range="-3 3" armature="{a}"/>
+  <geom type="cylinder" size="0.05 0.05"/>
+  <body name="l1" pos="0 0 0.05"><joint name="j2" axis="0 1 0" range="-2 2" armature="{a}"/>
+    <geom type="capsule" fromto="0 0 0 0.35 0 0" size="0.03" mass="2"/>
+    <body name="l2" pos="0.35 0 0"><joint name="j3" axis="0 1 0" range="-2.5 2.5" armature="{a}"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1"/>
+      <body name="hand" pos="0.3 0 0"><geom type="sphere" size="0.02" mass="0.2"/></body>
+    </body></body></body></worldbody>
+  <actuator><motor joint="j1" ctrlrange="-80 80"/><motor joint="j2" ctrlrange="-80 80"/>
+    <motor joint="j3" ctrlrange="-80 80"/></actuator></mujoco>"""
+
+
+def test_a_given_home_reaching_sideways_gets_a_table_facing_the_base(tmp_path: Path) -> None:
+    """A home the user gives whose tip reaches along −y, folded (its base
+    joint 0.05 m up): on the world's axes the 1 m side of the table would run
+    over the base joint, below the top ("the arm clear of the table" refused
+    it); turned to face the base, its short side along
+    the reach, the table lies beyond the tool and the posture runs. A drawn
+    placement keeps the table on the world's axes."""
+    path = tmp_path / "sideways.xml"
+    path.write_text(_SIDEWAYS_ARM.format(a=0.0))
+    sc = act.arm_table(path, home=[-math.pi / 2, -0.3, 2.2])
+    table = mujoco.mj_name2id(sc.model, mujoco.mjtObj.mjOBJ_GEOM, "table")
+    d = mujoco.MjData(sc.model)
+    mujoco.mj_kinematics(sc.model, d)
+    first_side = d.geom_xmat[table].reshape(3, 3)[:, 0]
+    np.testing.assert_allclose(first_side, [0.0, -1.0, 0.0], atol=1e-9)
+    assert d.geom_xpos[table][1] < -0.4  # beside the arm, along its reach
+    assert act.refusal_of(sc, load=1.0) is None
+    # Along x the table on the world's axes already lies beyond the tool.
+    ahead = act.arm_table(path, home=[0.0, -0.3, 2.2])
+    mujoco.mj_kinematics(ahead.model, d := mujoco.MjData(ahead.model))
+    np.testing.assert_allclose(d.geom_xmat[table], np.eye(3).ravel(), atol=0)
+
+
+def test_the_target_inertia_along_the_normal_follows_the_arms_own(tmp_path: Path) -> None:
+    """SPEC (19.8): M_d,n = max(M_d, k Λ_c (Ts/m)²), k = 1/τ_n², Λ_c
+    the tool's Cartesian inertia along the normal (the larger of the path's
+    and MuJoCo's estimate at qpos0): an arm whose armature makes it heavy at
+    the tool gets a heavier target inertia on the normal axis only; a light
+    one keeps the default (no ``Md`` keyword: its rows as before)."""
+    light = tmp_path / "light.xml"
+    light.write_text(_SIDEWAYS_ARM.format(a=0.0))
+    sc = act.arm_table(light, home=[0.0, -0.3, 1.5])
+    assert act.normal_inertia(sc, [sc.q0]) == act.DEFAULT_MD
+    assert "Md" not in act.rule_keywords(sc)
+    heavy = tmp_path / "heavy.xml"
+    heavy.write_text(_SIDEWAYS_ARM.format(a=4.0))
+    sc = act.arm_table(heavy, home=[0.0, -0.3, 1.5])
+    md = act.normal_inertia(sc, [sc.q0])
+    m = sc.model
+    tool, table = act._tool_table(m)
+    inv = m.body_invweight0[m.geom_bodyid[tool], 0] + m.body_invweight0[m.geom_bodyid[table], 0]
+    plant = amj.Plant(m, contact=False)
+    plant.reset(sc.q0)
+    jz = np.asarray(sc.chain.jacobian(sc.q0))[2]
+    lam_n = 1.0 / float(jz @ np.linalg.solve(plant.mass_matrix(), jz))
+    k = 1.0 / act.TABLE_TIMECONST**2
+    expected = k * max(lam_n, 1.0 / inv) * (sc.Ts / act.ADMITTANCE_SHARE_OF_PERIOD) ** 2
+    assert expected > act.DEFAULT_MD
+    assert md == pytest.approx(expected, rel=1e-12)
+    kw = act.rule_keywords(sc)
+    assert kw["Md"][:2] == [act.DEFAULT_MD, act.DEFAULT_MD]
+    assert kw["Md"][2] >= md  # the path's postures as well as the home
+
+
+def test_a_heavy_tool_gets_a_softer_contact_impedance(tmp_path: Path) -> None:
+    """SPEC (19.9): the tool–table pair's impedance d = x/(1 + x), x = s F A/(μ a)
+    (A MuJoCo's inverse mass of the tool, a the circle's acceleration v²/r),
+    at most MuJoCo's 0.95: the normal force MuJoCo's cone takes from the
+    circle's acceleration, μ a d/((1 − d) A), stays at s F. A light arm keeps
+    MuJoCo's default (0.9, 0.95); a heavy one's contact is softer."""
+    light = tmp_path / "light.xml"
+    light.write_text(_SIDEWAYS_ARM.format(a=0.0))
+    sc = act.arm_table(light, home=[0.0, -0.3, 1.5])
+    np.testing.assert_array_equal(sc.model.pair_solimp[0, :2], [0.9, 0.95])
+    heavy = tmp_path / "heavy.xml"
+    heavy.write_text(_SIDEWAYS_ARM.format(a=40.0))
+    sc = act.arm_table(heavy, home=[0.0, -0.3, 1.5])
+    m = sc.model
+    tool, table = act._tool_table(m)
+    inv = m.body_invweight0[m.geom_bodyid[tool], 0] + m.body_invweight0[m.geom_bodyid[table], 0]
+    v = 2 * math.pi * sc.freq * sc.radius
+    x = act.SLIP_SHARE * sc.target_force() * inv / (0.1 * v**2 / sc.radius)
+    assert x / (1 + x) < 0.9
+    np.testing.assert_allclose(m.pair_solimp[0, :2], x / (1 + x), rtol=1e-12)
+    coupling = 0.1 * (v**2 / sc.radius) * x / (1 + x) / ((1 - x / (1 + x)) * inv)
+    assert coupling == pytest.approx(act.SLIP_SHARE * sc.target_force(), rel=1e-9)
+    assert act.contact_impedance(m, force=7.5, accel=0.0, friction=0.1) == act.CONTACT_IMPEDANCE
+
+
 def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:
     """An MJCF arm with its own actuators and geometry: the tool on its end
     effector's body, the arm's geometry kept off the table, the chain to the

@@ -15,6 +15,7 @@ import pinocchio as pin
 import pytest
 
 import adaptimp
+from adaptimp import Measurement
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque, core_description, pinocchio_model
 from adaptimp.scenarios import panda_table as apt
@@ -124,7 +125,7 @@ def test_the_joint_law_is_computed_torque_with_pinocchios_dynamics() -> None:
         ddxd = ddxc + (12.0 * (dxc - dxd) + 80.0 * (xc - xd) - tau_e) / 1.5
         a = ddxd + kd * (dxd - dq) + kp * (xd - q)
         want = np.clip(_law(model, data, q, dq, a) + tau_e, -tau_max, tau_max)
-        got = ct.step(q, tau_e, dq, xc=xc, dxc=dxc, ddxc=ddxc)
+        got = ct.step(Measurement(q, dq, tau_e=tau_e), xc=xc, dxc=dxc, ddxc=ddxc)
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.abs(want).max())
         # The reference moves as the arm does under the held torque (SPEC (20.3)).
         xd = xd + 1e-3 * dxd + 0.5e-6 * ddxd
@@ -144,9 +145,7 @@ class _PinocchioLaw(ComputedTorque):
 
     def step(  # type: ignore[override]
         self,
-        q: Any,
-        tau_e: Any,
-        dq: Any = None,
+        m: Any,
         *,
         xc: Any = None,
         dxc: Any = None,
@@ -154,6 +153,7 @@ class _PinocchioLaw(ComputedTorque):
         task_torque: Any = None,
         jacobian: Any = None,
     ) -> np.ndarray:
+        q, dq = m.q, m.dq
         model = self.pin
         data = model.createData()
         j = np.asarray(jacobian).reshape(6, self.n)
@@ -189,8 +189,8 @@ def test_the_torque_level_law_is_pinocchios_pd_plus(sc: apt.PandaTable) -> None:
     )  # fmt: skip
     for k in range(len(res.t)):
         q, dq, f = res.q[k], res.dq[k], res.task["wrench"][k]
-        got = core.step(q, dq, f)
-        want = written.step(q, dq, f)
+        got = core.step(Measurement(q, dq, wrench=f))
+        want = written.step(Measurement(q, dq, wrench=f))
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.abs(want).max(), err_msg=k)
     np.testing.assert_array_equal(got, res.tau_sat[-1])
 
@@ -296,9 +296,8 @@ def test_computed_torque_compensates_the_drives_friction() -> None:
     q, dq, xc = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
     dxc, ddxc = np.linspace(-0.03, 0.03, n), rng.uniform(-1, 1, n)
     a = ddxc + 40.0 * (dxc - dq) + 100.0 * (xc - q)
-    got = driven.step(q, np.zeros(n), dq, xc=xc, dxc=dxc, ddxc=ddxc) - rigid.step(
-        q, np.zeros(n), dq, xc=xc, dxc=dxc, ddxc=ddxc
-    )
+    m = Measurement(q, dq)
+    got = driven.step(m, xc=xc, dxc=dxc, ddxc=ddxc) - rigid.step(m, xc=xc, dxc=dxc, ddxc=ddxc)
     v = np.where(dq * dxc > 0, np.sign(dxc) * np.minimum(abs(dq), abs(dxc)), 0.0)
     assert 2 <= np.count_nonzero(v) <= n - 2  # joints with and against their reference
     want = 0.1 * a + 0.5 * dq + friction * np.tanh(v / 0.01)

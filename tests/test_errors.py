@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import adaptimp
+from adaptimp import Measurement
 
 Q, TE, DQ = [0.25, -0.05], [0.0, 0.0], [0.0, 0.0]
 
@@ -178,7 +179,7 @@ def test_controller_and_arm_report_conditions_too() -> None:
 def test_missing_dq_is_an_error_for_state_feedback_and_pd(case: str) -> None:
     ctrl = adaptimp.Controller(case)
     with pytest.raises(ValueError, match="uses the measured velocity: pass dq"):
-        ctrl.step(Q, TE)
+        ctrl.step(Measurement(Q, tau_e=TE))
     assert ctrl.steps == 0
 
 
@@ -186,7 +187,7 @@ def test_missing_dq_is_an_error_for_state_feedback_and_pd(case: str) -> None:
     ("args", "error", "pattern"),
     [
         (
-            ([0.1, 0.2, 0.3], TE, DQ),
+            ([0.1, 0.2, 0.3], [0.0] * 3, [0.0] * 3),  # a measurement of 3 joints
             ValueError,
             r"q must have shape \(2,\) \(one value per joint\), got length 3",
         ),
@@ -195,12 +196,20 @@ def test_missing_dq_is_an_error_for_state_feedback_and_pd(case: str) -> None:
             ValueError,
             r"tau_e must have shape \(2,\) .*got shape \(2, 1\)",
         ),
-        ((0.25, TE, DQ), ValueError, r"q must have shape \(2,\) .*got a scalar"),
+        (
+            (0.25, TE, DQ),
+            ValueError,
+            r"q must be one value per joint \(a 1-D array\), got a scalar",
+        ),
         (("ab", TE, DQ), TypeError, r"q must be a sequence or array of 2 real numbers .*got str"),
         ((Q, TE, {"a": 1}), TypeError, r"dq must be a sequence or array of 2 real numbers"),
         ((Q, TE, [1.0, "x"]), TypeError, r"dq must be a sequence or array"),
         ((Q, TE, [10**400, 0.0]), ValueError, r"dq holds a number too large for a float"),
-        (([0.1, 0.2, 0.3, 0.4], TE, DQ), ValueError, r"q must have shape \(2,\) .*got length 4"),
+        (
+            ([0.1, 0.2, 0.3, 0.4], [0.0] * 4, [0.0] * 4),
+            ValueError,
+            r"q must have shape \(2,\) .*got length 4",
+        ),
         (
             (np.array([1 + 1j, 0]), TE, DQ),
             TypeError,
@@ -213,10 +222,10 @@ def test_missing_dq_is_an_error_for_state_feedback_and_pd(case: str) -> None:
 )
 def test_bad_step_inputs_raise_and_leave_the_state_untouched(args, error, pattern) -> None:
     ctrl = adaptimp.Controller("sf")
-    ctrl.step(Q, TE, DQ)
+    ctrl.step(Measurement(Q, DQ, tau_e=TE))
     zeta, weights = ctrl.zeta, ctrl.weights
     with pytest.raises(error, match=pattern):
-        ctrl.step(*args)
+        ctrl.step(Measurement(args[0], args[2], tau_e=args[1]))
     assert ctrl.steps == 1
     np.testing.assert_array_equal(ctrl.zeta, zeta)
     np.testing.assert_array_equal(ctrl.weights["G"], weights["G"])
@@ -234,7 +243,7 @@ def test_lists_tuples_and_arrays_step_alike() -> None:
     torques = []
     for q, te, dq in forms:
         ctrl = adaptimp.Controller("sf")
-        torques.append(ctrl.step(q, te, dq))
+        torques.append(ctrl.step(Measurement(q, dq, tau_e=te)))
     for tau in torques[1:3]:
         assert np.array_equal(tau, torques[0])
     assert not np.array_equal(torques[3], torques[0])  # 0.2 as a float32 is another number

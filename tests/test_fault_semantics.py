@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import ConfigError, FaultError, MeasurementError
+from adaptimp import ConfigError, FaultError, Measurement, MeasurementError
 
 
 def _inputs(k: int) -> tuple[list[float], list[float], list[float]]:
@@ -26,9 +26,15 @@ def _inputs(k: int) -> tuple[list[float], list[float], list[float]]:
     )
 
 
+def _m(k: int) -> Measurement:
+    """The measurement of step k (`_inputs`)."""
+    q, tau_e, dq = _inputs(k)
+    return Measurement(q, dq, tau_e=tau_e)
+
+
 def _run(ctrl: adaptimp.Controller, k0: int, k1: int) -> None:
     for k in range(k0, k1):
-        ctrl.step(*_inputs(k))
+        ctrl.step(_m(k))
 
 
 # -- item 1: every refusal latches -------------------------------------------
@@ -39,16 +45,16 @@ def test_a_non_finite_measurement_raised_by_step_latches(bad: list[float]) -> No
     ctrl = adaptimp.Controller("sf", scenario="robot", fault_policy="latch")
     _run(ctrl, 0, 10)
     with pytest.raises(MeasurementError, match=r"q\[\d\] is not finite"):
-        ctrl.step(bad, [0.0, 0.0], [0.0, 0.0])
+        ctrl.step(Measurement(bad, [0.0, 0.0], tau_e=[0.0, 0.0]))
     assert ctrl.fault is not None
     assert ctrl.fault[1] == 10
     # The next valid step is refused (it used to be accepted).
     with pytest.raises(FaultError, match=r"latched \(non-finite input\)"):
-        ctrl.step(*_inputs(10))
+        ctrl.step(_m(10))
     # The fault that latched is kept, not replaced by the refusals it causes.
     assert ctrl.fault[0].startswith("q[")
     ctrl.clear_fault()
-    ctrl.step(*_inputs(10))
+    ctrl.step(_m(10))
     assert ctrl.steps == 11
 
 
@@ -61,6 +67,9 @@ def test_a_non_finite_measurement_raised_by_step_latches(bad: list[float]) -> No
         ({"tau_e": np.zeros(2, dtype=complex)}, TypeError),
     ],
 )
+# The arrays' call shape (deprecated) hands the controller what a Measurement
+# would refuse before any call: it refuses them too, and records it.
+@pytest.mark.filterwarnings("ignore:Controller.step.* is deprecated:DeprecationWarning")
 def test_a_step_refused_for_its_arguments_latches_too(
     kwargs: dict[str, object], exc: type[Exception]
 ) -> None:
@@ -76,7 +85,7 @@ def test_a_step_refused_for_its_arguments_latches_too(
         # The torque to apply: the fallback (hold: the torque before).
         np.testing.assert_array_equal(ctrl.applied, ctrl.tau_sat)
         with pytest.raises(FaultError):
-            ctrl.step(*_inputs(5))
+            ctrl.step(_m(5))
 
 
 # -- item 2: the rate limit starts from the torque applied --------------------
@@ -89,19 +98,19 @@ def test_the_rate_limit_starts_from_the_fallback_after_a_refusal_and_clear_fault
         )
         zero, far = [0.0, 0.0], [1.0, 1.0]
         for _ in range(200):
-            tau, error = ctrl.step_or_fallback(zero, zero, zero, xc=far)
+            tau, error = ctrl.step_or_fallback(Measurement(zero, zero, tau_e=zero), xc=far)
         np.testing.assert_array_equal(tau, [17.0, 15.0])
         with pytest.raises(MeasurementError):
-            ctrl.step([np.nan, 0.0], zero, zero, xc=far)
+            ctrl.step(Measurement([np.nan, 0.0], zero, tau_e=zero), xc=far)
         np.testing.assert_array_equal(ctrl.applied, [0.0, 0.0])
-        tau, error = ctrl.step_or_fallback([np.nan, 0.0], zero, zero, xc=far)
+        tau, error = ctrl.step_or_fallback(Measurement([np.nan, 0.0], zero, tau_e=zero), xc=far)
         assert error is not None
         np.testing.assert_array_equal(tau, [0.0, 0.0])
         if policy == "latch":
             ctrl.clear_fault()
         # It used to jump back to [17, 15] at once.
         for k in range(1, 20):
-            tau, error = ctrl.step_or_fallback(zero, zero, zero, xc=far)
+            tau, error = ctrl.step_or_fallback(Measurement(zero, zero, tau_e=zero), xc=far)
             assert error is None
             np.testing.assert_array_equal(tau, [min(k, 17.0), min(k, 15.0)])
 
@@ -113,21 +122,21 @@ def test_a_motion_during_refused_steps_does_not_lock_out_the_jump_limit() -> Non
     ctrl = adaptimp.Controller("sf", scenario="robot", q_jump_max=0.05, fault_policy="latch")
     _run(ctrl, 0, 100)
     q, te, dq = _inputs(100)
-    _, error = ctrl.step_or_fallback([np.nan, q[1]], te, dq)
+    _, error = ctrl.step_or_fallback(Measurement([np.nan, q[1]], dq, tau_e=te))
     assert error is not None
     for _ in range(50):  # latched while the arm moves 0.61 rad
-        _, error = ctrl.step_or_fallback([np.nan, q[1]], te, dq)
+        _, error = ctrl.step_or_fallback(Measurement([np.nan, q[1]], dq, tau_e=te))
     ctrl.clear_fault()
     moved = [q[0] + 0.61, q[1]]
     # No plausible sample in between: the first is a jump, refused once ...
-    _, error = ctrl.step_or_fallback(moved, te, dq)
+    _, error = ctrl.step_or_fallback(Measurement(moved, dq, tau_e=te))
     assert error is not None
     assert error.startswith("q jump[0] = 6.1")
     ctrl.clear_fault()
     # ... and the motion is accepted from its second sample (it used to be
     # refused 1000 times out of 1000, clear_fault or not).
     for k in range(1000):
-        _, error = ctrl.step_or_fallback([moved[0] + 1e-5 * k, moved[1]], te, dq)
+        _, error = ctrl.step_or_fallback(Measurement([moved[0] + 1e-5 * k, moved[1]], dq, tau_e=te))
         assert error is None
 
 
@@ -136,7 +145,7 @@ def test_a_jump_is_a_measurement_error() -> None:
     _run(ctrl, 0, 10)
     q, te, dq = _inputs(10)
     with pytest.raises(MeasurementError, match=r"q jump\[1\]"):
-        ctrl.step([q[0], q[1] + 0.5], te, dq)
+        ctrl.step(Measurement([q[0], q[1] + 0.5], dq, tau_e=te))
 
 
 # -- item 4: setpoints are checked like measurements --------------------------
@@ -164,21 +173,21 @@ def test_a_bad_setpoint_is_refused_and_changes_nothing(
     q, te, dq = _inputs(100)
     xc = setpoint.pop("xc", q)
     with pytest.raises(MeasurementError, match=message):
-        ctrl.step(q, te, dq, xc=xc, **setpoint)
+        ctrl.step(Measurement(q, dq, tau_e=te), xc=xc, **setpoint)
     # It used to commit a reference every later step refused, for ever.
     for k in range(100, 200):
-        np.testing.assert_array_equal(ctrl.step(*_inputs(k)), twin.step(*_inputs(k)))
+        np.testing.assert_array_equal(ctrl.step(_m(k)), twin.step(_m(k)))
 
 
 def test_without_limits_the_ceilings_hold() -> None:
     ctrl = adaptimp.Controller("sf")
     q, te, dq = _inputs(0)
     with pytest.raises(MeasurementError, match=r"xc\[0\] = 1e50 is beyond its limit ±1e6"):
-        ctrl.step(q, te, dq, xc=[1e50, 0.0])
+        ctrl.step(Measurement(q, dq, tau_e=te), xc=[1e50, 0.0])
     with pytest.raises(MeasurementError, match=r"tau_e\[0\] = 1e99 is beyond its limit ±1e9"):
-        ctrl.step(q, [1e99, 0.0], dq)
+        ctrl.step(Measurement(q, dq, tau_e=[1e99, 0.0]))
     with pytest.raises(MeasurementError, match=r"q\[1\] = 2e6 is beyond its limit ±1e6"):
-        ctrl.step([0.0, 2e6], te, dq)
+        ctrl.step(Measurement([0.0, 2e6], dq, tau_e=te))
     assert ctrl.steps == 0
 
 
@@ -262,7 +271,7 @@ def test_load_state_dict_refuses_keys_that_disagree_with_the_snapshot() -> None:
     # The whole state, unedited: continues bit-identically.
     other.load_state_dict(state)
     for k in range(300, 400):
-        np.testing.assert_array_equal(other.step(*_inputs(k)), ctrl.step(*_inputs(k)))
+        np.testing.assert_array_equal(other.step(_m(k)), ctrl.step(_m(k)))
 
 
 def test_copies_and_pickles_carry_the_refusal_record() -> None:
@@ -270,14 +279,14 @@ def test_copies_and_pickles_carry_the_refusal_record() -> None:
         "sf", scenario="robot", fallback="zero", tau_rate_max=0.5, q_jump_max=0.05
     )
     _run(ctrl, 0, 100)
-    ctrl.step_or_fallback([np.nan, 0.0], [0.0, 0.0], [0.0, 0.0])
+    ctrl.step_or_fallback(Measurement([np.nan, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     twins = (copy.deepcopy(ctrl), pickle.loads(pickle.dumps(ctrl)))
     for k in range(100, 150):
-        tau = ctrl.step_or_fallback(*_inputs(k))[0]
+        tau = ctrl.step_or_fallback(_m(k))[0]
         if k == 100:  # rate-limited from the zero fallback
             np.testing.assert_array_equal(np.abs(tau), [0.5, 0.5])
         for twin in twins:
-            np.testing.assert_array_equal(twin.step_or_fallback(*_inputs(k))[0], tau)
+            np.testing.assert_array_equal(twin.step_or_fallback(_m(k))[0], tau)
 
 
 # -- minor items --------------------------------------------------------------
@@ -288,10 +297,10 @@ def test_an_infinite_limit_means_none_as_in_c() -> None:
     ctrl = adaptimp.Controller("sf", q_jump_max=[0.05, np.inf])
     assert ctrl.params["q_jump_max"] == [0.05, np.inf]
     q, te, dq = _inputs(0)
-    ctrl.step(q, te, dq)
-    ctrl.step([q[0], q[1] + 0.5], te, dq)  # no limit on joint 2
+    ctrl.step(Measurement(q, dq, tau_e=te))
+    ctrl.step(Measurement([q[0], q[1] + 0.5], dq, tau_e=te))  # no limit on joint 2
     with pytest.raises(MeasurementError, match=r"q jump\[0\]"):
-        ctrl.step([q[0] + 0.5, q[1] + 0.5], te, dq)
+        ctrl.step(Measurement([q[0] + 0.5, q[1] + 0.5], dq, tau_e=te))
     with pytest.raises(ConfigError, match=r"q_jump_max\[0\] must be a number \(inf: no limit\)"):
         adaptimp.Controller("sf", q_jump_max=np.nan)
     with pytest.raises(ConfigError, match="limit > 0"):

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import adaptimp
+from adaptimp import Measurement
 
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "target" / "ffi-examples"
@@ -57,7 +58,7 @@ def test_c_torques_equal_python_and_rust_for_the_same_inputs(examples: Path) -> 
                 q = [0.25 + 0.01 * math.sin(0.1 * s), -0.05 + 0.01 * math.cos(0.07 * s)]
                 dq = [0.1 * math.cos(0.1 * s), -0.1 * math.sin(0.07 * s)]
                 te = [max(0.0, 5.0 * math.sin(0.05 * s)), 0.0]
-                tau = ctrl.step(q, te, dq)
+                tau = ctrl.step(Measurement(q, dq, tau_e=te))
                 np.testing.assert_allclose(c_tau[k], tau, rtol=1e-12, atol=1e-12)
 
 

@@ -12,6 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import adaptimp
+from adaptimp import Measurement
 from adaptimp._params import BY_NAME, PARAMS
 
 # Numbers a user may pass: ordinary, extreme, non-finite, and of other types.
@@ -54,7 +55,7 @@ def test_controller_parameters_only_raise_value_or_type_errors(
     # A controller that was accepted steps (or refuses a step) cleanly.
     for _ in range(3):
         try:
-            tau = ctrl.step([0.25, -0.05], [1.0, 0.0], [0.0, 0.0])
+            tau = ctrl.step(Measurement([0.25, -0.05], [0.0, 0.0], tau_e=[1.0, 0.0]))
         except ValueError:
             continue
         assert np.all(np.isfinite(tau))

@@ -352,7 +352,7 @@ class _Hold:
         self.tau_cmd = np.array(tau)
         self.calls: list[dict[str, object]] = []
 
-    def step(self, q: object, tau_e: object, dq: object = None, **setpoint: object) -> np.ndarray:
+    def step(self, m: object, **setpoint: object) -> np.ndarray:
         self.calls.append(setpoint)
         return self.tau_cmd
 
@@ -420,8 +420,8 @@ class _InPython:
         self.Ts = inner.Ts
         self.params = inner.params
 
-    def step(self, q: object, tau_e: object, dq: object = None, **sp: object) -> np.ndarray:
-        return self.inner.step(q, tau_e, dq, **sp)
+    def step(self, m: object, **sp: object) -> np.ndarray:
+        return self.inner.step(m, **sp)
 
     def __getattr__(self, name: str) -> object:
         return getattr(self.inner, name)
@@ -552,7 +552,7 @@ class _Kick:
     def __init__(self, at: int) -> None:
         self.at, self.k = at, 0
 
-    def step(self, q: object, tau_e: object, dq: object = None, **sp: object) -> np.ndarray:
+    def step(self, m: object, **sp: object) -> np.ndarray:
         self.k += 1
         return np.array([0.0 if self.k <= self.at else 1e6])
 

@@ -91,7 +91,8 @@ class PythonPD:
         self.z1 = np.zeros(2)
         self.calls = 0
 
-    def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+    def step(self, m: Any, **sp: Any) -> np.ndarray:
+        q, tau_e, dq = m.q, m.tau_e, m.dq
         q, dq = np.asarray(q), np.asarray(dq)
         self.z1 = sp["xc"] - q
         self.tau = self.arm.G(q) + self.Kp * self.z1 + self.Kd * (sp["dxc"] - dq) - tau_e
@@ -430,8 +431,8 @@ def test_skipped_steps_and_a_torque_that_is_not_finite_are_refused() -> None:
     np.testing.assert_array_equal(res.refused, native.refused)
 
     class Blows(PythonPD):
-        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
-            tau = super().step(q, tau_e, dq, **sp)
+        def step(self, m: Any, **sp: Any) -> np.ndarray:
+            tau = super().step(m, **sp)
             return np.array([math.nan, 1.0]) if 50 <= self.calls < 55 else tau
 
     burst = adaptimp.Fault("nan_burst", 1.0, 0.01)  # a window after the run: refusals allowed
@@ -452,10 +453,10 @@ class Raises(PythonPD):
         super().__init__()
         self.at = at
 
-    def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+    def step(self, m: Any, **sp: Any) -> np.ndarray:
         if self.calls + 1 == self.at:
             raise RuntimeError(f"the controller gave up at call {self.at}")
-        return super().step(q, tau_e, dq, **sp)
+        return super().step(m, **sp)
 
 
 def test_an_exception_ends_the_run_with_it_and_the_plant_where_it_was() -> None:
@@ -482,14 +483,14 @@ def test_an_exception_ends_the_run_with_it_and_the_plant_where_it_was() -> None:
 
 def test_what_a_controller_returns_and_says_is_checked_by_name() -> None:
     class Wide(PythonPD):
-        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+        def step(self, m: Any, **sp: Any) -> np.ndarray:
             return np.zeros(3)
 
     with pytest.raises(ValueError, match=r"^tau must have shape \(2,\), got \(3,\)$"):
         amj.simulate(Wide(), "two_link", T=0.01, reference=amj.paper_circle())
 
     class Scalar(PythonPD):
-        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> float:
+        def step(self, m: Any, **sp: Any) -> float:
             return 0.5
 
     res = amj.simulate(Scalar(), "two_link", T=0.01, reference=amj.paper_circle())
@@ -502,7 +503,7 @@ def test_what_a_controller_returns_and_says_is_checked_by_name() -> None:
         amj.simulate(BadXd(), "two_link", T=0.01, reference=amj.paper_circle())
 
     class Word(PythonPD):
-        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> str:
+        def step(self, m: Any, **sp: Any) -> str:
             return "torque"
 
     with pytest.raises(ValueError, match="could not convert string to float"):
@@ -524,10 +525,10 @@ def test_ctrl_c_in_the_controller_ends_the_run() -> None:
     import signal
 
     class Interrupted(PythonPD):
-        def step(self, q: Any, tau_e: Any, dq: Any = None, **sp: Any) -> np.ndarray:
+        def step(self, m: Any, **sp: Any) -> np.ndarray:
             if self.calls == 20:
                 os.kill(os.getpid(), signal.SIGINT)
-            return super().step(q, tau_e, dq, **sp)
+            return super().step(m, **sp)
 
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:

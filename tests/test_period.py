@@ -40,7 +40,7 @@ class _Old:
 
     ts = 1e-3
 
-    def step(self, q: object, tau_e: object, dq: object = None, **setpoint: object) -> np.ndarray:
+    def step(self, m: object, **setpoint: object) -> np.ndarray:
         return np.zeros(2)
 
 

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import adaptimp
+from adaptimp import Measurement
 
 angle = st.floats(-10.0, 10.0)
 speed = st.floats(-50.0, 50.0)
@@ -72,7 +73,7 @@ def test_step_never_raises_and_respects_the_limits(case: str, steps, robust: str
     500 N m): every step returns a finite torque within ±τmax."""
     ctrl = adaptimp.Controller(case, robust=robust)
     for q, tau_e, dq in steps:
-        tau = ctrl.step(q, tau_e, dq)
+        tau = ctrl.step(Measurement(q, dq, tau_e=tau_e))
         assert np.all(np.isfinite(tau))
         assert np.all(np.abs(tau) <= LIMITS)
         np.testing.assert_array_equal(tau, np.clip(ctrl.tau, -LIMITS, LIMITS))

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import adaptimp
+from adaptimp import Measurement
 
 
 def _centers(n: int, nodes: int, seed: int = 0) -> np.ndarray:
@@ -96,7 +97,7 @@ def _user_loop(case: str, n: int, g: float, centers: int | None) -> tuple[float,
     h = ctrl.Ts
     errors = []
     for _ in range(4000):
-        tau = ctrl.step(q, np.zeros(n), dq)
+        tau = ctrl.step(Measurement(q, dq, tau_e=np.zeros(n)))
         assert tau.shape == (n,)
         assert np.all(np.abs(tau) <= 40.0)
         dq = dq + h * arm.forward_dynamics(q, dq, tau, np.zeros(n))
@@ -154,7 +155,7 @@ def test_centres_per_dimension_widths_reach_the_basis() -> None:
     b = adaptimp.Controller("sf", "robot", centers=c, widths=w)
     for ctrl in (a, b):
         for _ in range(5):
-            ctrl.step([0.1, 0.2], [0.0, 0.0], [0.3, -0.2])
+            ctrl.step(Measurement([0.1, 0.2], [0.3, -0.2], tau_e=[0.0, 0.0]))
     assert not np.array_equal(a.weights["G"], b.weights["G"])
     with pytest.raises(adaptimp.ConfigError, match=r"widths must be a number or have shape \(8,\)"):
         adaptimp.Controller("sf", centers=c, widths=[1.0, 2.0])
@@ -177,7 +178,9 @@ def test_external_setpoints_streamed_from_a_file_equal_the_trajectory(tmp_path: 
     # its own trajectory is not used.
     ctrl = adaptimp.Controller("sf", "robot")
     for k in range(res.rows):
-        tau = ctrl.step(res.q[k], res.tau_e[k], res.dq[k], xc=xc[k], dxc=dxc[k], ddxc=ddxc[k])
+        tau = ctrl.step(
+            Measurement(res.q[k], res.dq[k], tau_e=res.tau_e[k]), xc=xc[k], dxc=dxc[k], ddxc=ddxc[k]
+        )
         assert np.array_equal(tau, res.tau_sat[k]), k
     again = adaptimp.Controller("sf", "robot")
     out = again.replay(res.q, res.tau_e, res.dq, xc=xc, dxc=dxc, ddxc=ddxc)
@@ -191,11 +194,11 @@ def test_external_setpoints_streamed_from_a_file_equal_the_trajectory(tmp_path: 
 def test_setpoint_arguments_are_checked() -> None:
     ctrl = adaptimp.Controller("sf", "robot")
     with pytest.raises(TypeError, match="dxc and ddxc need xc"):
-        ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], dxc=[0.0, 0.0])
+        ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]), dxc=[0.0, 0.0])
     with pytest.raises(adaptimp.MeasurementError, match=r"xc\[1\] is not finite"):
-        ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], xc=[0.0, np.inf])
+        ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]), xc=[0.0, np.inf])
     with pytest.raises(adaptimp.MeasurementError, match=r"xc must have shape \(2,\)"):
-        ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], xc=[0.0])
+        ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]), xc=[0.0])
     assert ctrl.steps == 0
 
 
@@ -209,7 +212,13 @@ def _drive(ctrl: adaptimp.Controller, k0: int, k1: int) -> np.ndarray:
     for k in range(k0, k1):
         t = 1e-3 * k
         q = np.array([0.25 + 0.1 * np.sin(t), -0.05 + 0.1 * np.cos(t)])
-        out.append(ctrl.step(q, [0.5 * np.sin(3 * t), 0.0], [0.1 * np.cos(t), -0.1 * np.sin(t)]))
+        out.append(
+            ctrl.step(
+                Measurement(
+                    q, [0.1 * np.cos(t), -0.1 * np.sin(t)], tau_e=[0.5 * np.sin(3 * t), 0.0]
+                )
+            )
+        )
     return np.array(out)
 
 
@@ -238,11 +247,11 @@ def test_copies_are_independent() -> None:
 
 def test_pickle_keeps_user_centres() -> None:
     a = adaptimp.Controller("sf", "robot", n=4, centers=_centers(4, 20), widths=1.5)
-    a.step(np.zeros(4), np.zeros(4), np.ones(4))
+    a.step(Measurement(np.zeros(4), np.ones(4), tau_e=np.zeros(4)))
     b = pickle.loads(pickle.dumps(a))
     assert (b.n, b.nodes) == (4, 20)
     x = np.full(4, 0.1)
-    assert np.array_equal(a.step(x, x, x), b.step(x, x, x))
+    assert np.array_equal(a.step(Measurement(x, x, tau_e=x)), b.step(Measurement(x, x, tau_e=x)))
 
 
 def test_state_dict_round_trip_and_warm_start(tmp_path: Path) -> None:
@@ -301,7 +310,7 @@ def test_two_threads_stepping_one_controller_never_collide() -> None:
     def work() -> None:
         try:
             for _ in range(500):
-                ctrl.step([0.1, 0.0], [0.0, 0.0], [0.0, 0.0])
+                ctrl.step(Measurement([0.1, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
             ctrl.replay(np.zeros((2000, 2)), np.zeros((2000, 2)), np.zeros((2000, 2)))
         except BaseException as e:  # pragma: no cover - reported below
             errors.append(e)
@@ -362,7 +371,7 @@ def test_sigint_during_simulate_raises_keyboard_interrupt_and_leaves_objects_usa
         timer.cancel()
     # Everything still works.
     assert adaptimp.simulate("sf", T=0.05).rows == 1000
-    assert ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, 0.0]).shape == (2,)
+    assert ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0])).shape == (2,)
 
 
 def test_an_exception_in_the_progress_callback_stops_the_run() -> None:
@@ -391,7 +400,7 @@ def test_sigint_during_replay(sigint: None) -> None:
     with pytest.raises(KeyboardInterrupt):
         ctrl.replay(z, z, z, progress=progress)
     assert 0 < ctrl.steps < rows
-    assert ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, 0.0]).shape == (2,)
+    assert ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0])).shape == (2,)
 
 
 def test_ctrl_c_in_a_fresh_process_is_a_keyboard_interrupt_not_a_panic() -> None:
@@ -518,13 +527,13 @@ def test_config_error_says_what_to_change() -> None:
 def test_measurement_error_names_the_argument_as_given() -> None:
     ctrl = adaptimp.Controller("sf", "robot")
     with pytest.raises(adaptimp.MeasurementError, match=r"q\[0\] is not finite"):
-        ctrl.step([np.nan, 0.0], [0.0, 0.0], [0.0, 0.0])
+        ctrl.step(Measurement([np.nan, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     with pytest.raises(adaptimp.MeasurementError, match=r"dq\[1\] is not finite"):
-        ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, np.inf])
+        ctrl.step(Measurement([0.0, 0.0], [0.0, np.inf], tau_e=[0.0, 0.0]))
     with pytest.raises(adaptimp.MeasurementError, match=r"tau_e must have shape \(2,\)"):
-        ctrl.step([0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0])
+        ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0, 0.0]))
     with pytest.raises(adaptimp.MeasurementError, match="q holds a number too large"):
-        ctrl.step([10**400, 0], [0.0, 0.0], [0.0, 0.0])
+        ctrl.step(Measurement([10**400, 0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     assert ctrl.steps == 0
 
 
@@ -546,12 +555,12 @@ def test_diverged_error() -> None:
 
 def test_fault_error_is_raised_while_a_fault_is_latched() -> None:
     ctrl = adaptimp.Controller("sf", "robot", fault_policy="latch")
-    _, error = ctrl.step_or_fallback([np.nan, 0.0], [0.0, 0.0], [0.0, 0.0])
+    _, error = ctrl.step_or_fallback(Measurement([np.nan, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     assert error is not None
     with pytest.raises(adaptimp.FaultError, match="latched"):
-        ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, 0.0])
+        ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     ctrl.clear_fault()
-    ctrl.step([0.0, 0.0], [0.0, 0.0], [0.0, 0.0])
+    ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
 
 
 def test_stability_warning_for_euler_learning_at_1khz() -> None:

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import adaptimp
+from adaptimp import Measurement
 
 
 @pytest.mark.parametrize(
@@ -57,20 +58,22 @@ def test_a_spike_is_refused_and_nothing_learned_is_lost(spike: dict[str, list[fl
     ctrl, twin = (adaptimp.Controller("sf", scenario="robot") for _ in range(2))
     for k in range(300):
         q, te, dq = _inputs(k)
-        ctrl.step(q, te, dq)
-        twin.step(q, te, dq)
+        ctrl.step(Measurement(q, dq, tau_e=te))
+        twin.step(Measurement(q, dq, tau_e=te))
     before = ctrl.weights
     q, te, dq = _inputs(300)
     args = {"q": q, "tau_e": te, "dq": dq, **spike}
     with pytest.raises(ValueError, match="beyond its limit"):
-        ctrl.step(**args)
+        ctrl.step(Measurement(args["q"], args["dq"], tau_e=args["tau_e"]))
     for name, w in ctrl.weights.items():
         np.testing.assert_array_equal(w, before[name])
     assert ctrl.fault is not None
     assert ctrl.fault[1] == 300
     for k in range(300, 400):
         q, te, dq = _inputs(k)
-        np.testing.assert_array_equal(ctrl.step(q, te, dq), twin.step(q, te, dq))
+        np.testing.assert_array_equal(
+            ctrl.step(Measurement(q, dq, tau_e=te)), twin.step(Measurement(q, dq, tau_e=te))
+        )
 
 
 def test_the_fail_safe_step_returns_the_fallback_and_latches() -> None:
@@ -79,20 +82,20 @@ def test_the_fail_safe_step_returns_the_fallback_and_latches() -> None:
     )
     for k in range(100):
         q, te, dq = _inputs(k)
-        tau, error = ctrl.step_or_fallback(q, te, dq)
+        tau, error = ctrl.step_or_fallback(Measurement(q, dq, tau_e=te))
         assert error is None
     q, te, dq = _inputs(100)
-    tau, error = ctrl.step_or_fallback([np.nan, q[1]], te, [0.5, -0.5])
+    tau, error = ctrl.step_or_fallback(Measurement([np.nan, q[1]], [0.5, -0.5], tau_e=te))
     assert error == "q[0] is not finite (NaN or infinite)"
     np.testing.assert_array_equal(tau, [-1.0, 1.0])
     # Latched: refused until cleared, then the run goes on.
-    tau, error = ctrl.step_or_fallback(q, te, dq)
+    tau, error = ctrl.step_or_fallback(Measurement(q, dq, tau_e=te))
     assert error is not None
     assert "clear_fault()" in error
     assert ctrl.steps == 100
     ctrl.clear_fault()
     assert ctrl.fault is None
-    tau, error = ctrl.step_or_fallback(q, te, dq)
+    tau, error = ctrl.step_or_fallback(Measurement(q, dq, tau_e=te))
     assert error is None
     assert ctrl.steps == 101
 
@@ -100,11 +103,11 @@ def test_the_fail_safe_step_returns_the_fallback_and_latches() -> None:
 def test_plausibility_and_rate_limits_from_python() -> None:
     ctrl = adaptimp.Controller("sf", scenario="robot", q_max=1.0, tau_rate_max=[0.5, 0.5])
     with pytest.raises(ValueError, match=r"q\[0\] = 1.5e0 is beyond its limit"):
-        ctrl.step([1.5, 0.0], [0.0, 0.0], [0.0, 0.0])
+        ctrl.step(Measurement([1.5, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     last = np.zeros(2)
     for k in range(50):
         q, te, dq = _inputs(k)
-        tau = ctrl.step(q, te, dq)
+        tau = ctrl.step(Measurement(q, dq, tau_e=te))
         assert np.max(np.abs(tau - last)) <= 0.5 + 1e-12
         last = tau
     assert adaptimp.Controller("sf", q_max=None).params["q_max"] is None

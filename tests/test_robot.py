@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _adaptimp
+from adaptimp import Measurement, _adaptimp
 from adaptimp._params import ALL_GROUPS, resolve
 
 
@@ -81,7 +81,7 @@ def test_hardened_options_are_validated() -> None:
     # The options reach the core: a bound this small pins the weights to it.
     c = adaptimp.Controller("sf", Ts=1e-3, weight_bound=1e-3, learning_step="normalized")
     for _ in range(50):
-        c.step([0.1, 0.3], [0.0, 0.0], [0.2, -0.1])
+        c.step(Measurement([0.1, 0.3], [0.2, -0.1], tau_e=[0.0, 0.0]))
     assert np.linalg.norm(c.weights["G"]) == pytest.approx(1e-3)
 
 
@@ -98,7 +98,7 @@ def test_replay_equals_a_step_loop(case: str) -> None:
     q, dq, tau_e = _log(300)
     a = adaptimp.Controller(case, scenario="robot")
     b = adaptimp.Controller(case, scenario="robot")
-    stepped = np.array([a.step(q[k], tau_e[k], dq[k]) for k in range(len(q))])
+    stepped = np.array([a.step(Measurement(q[k], dq[k], tau_e=tau_e[k])) for k in range(len(q))])
     replayed = b.replay(q, tau_e, dq)
     assert replayed.shape == (300, 2)
     np.testing.assert_array_equal(replayed, stepped)

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import adaptimp
-from adaptimp import tuning
+from adaptimp import Measurement, tuning
 
 
 def _swing(q0: np.ndarray, amp: float = 0.2, w: float = math.pi) -> Any:
@@ -65,6 +65,25 @@ def test_gains_alone_without_a_path() -> None:
     assert kw["K1"] == [25.0, 25.0]
     assert "centers" not in kw
     adaptimp.Controller("sf", "robot", **kw)
+
+
+def test_a_damped_joint_gets_the_scale_its_sampled_loop_sees() -> None:
+    # SPEC (18.9): d̃ = b Ts/(1 − e^(−β)), β = b Ts/d; a near-massless wrist
+    # (1e-6 kg m²) with 0.01 N m s/rad of damping (β = 10) gets ≈ b Ts, ten
+    # times d; an undamped joint keeps its scale bit for bit.
+    ts, d = 1e-3, np.diag([2.0, 0.5, 1e-6])
+    plain = tuning.suggest(d, [0.0] * 3, 10.0, Ts=ts)
+    damped = tuning.suggest(d, [0.0] * 3, 10.0, Ts=ts, damping=[0.0, 0.1, 0.01])
+    assert damped["inertia"][0] == plain["inertia"][0]
+    beta = np.array([0.1 * ts / 0.5, 0.01 * ts / 1e-6])
+    expected = np.array([0.1, 0.01]) * ts / -np.expm1(-beta)
+    np.testing.assert_allclose(damped["inertia"][1:], expected, rtol=1e-12)
+    np.testing.assert_allclose(damped["Kp"], 0.25 * np.array(damped["inertia"]) / ts, rtol=1e-12)
+    assert damped["inertia"][2] == pytest.approx(1e-5, rel=1e-4)
+    with pytest.raises(adaptimp.ConfigError, match="damping"):
+        tuning.suggest(d, [0.0] * 3, 10.0, Ts=ts, damping=[0.0, -1.0, 0.0])
+    # A model that is not a MuJoCo plant has no damping to take.
+    assert tuning.joint_damping(d) is None
 
 
 def test_bad_arms_are_errors_naming_the_condition() -> None:
@@ -126,7 +145,7 @@ def test_the_rule_always_builds(
     for case in adaptimp.CASES:
         ctrl = adaptimp.Controller(case, "robot", **kw)
         # It also steps: the first step of an arm at rest on its path.
-        tau = ctrl.step(q0 - amp, np.zeros(model.n), np.zeros(model.n))
+        tau = ctrl.step(Measurement(q0 - amp, np.zeros(model.n), tau_e=np.zeros(model.n)))
         assert np.all(np.isfinite(tau))
         assert np.all(np.abs(tau) <= np.array(tau_max))
     # And the gains alone, for the vertex grid (n ≤ 3) or the default basis.

@@ -31,7 +31,7 @@ Every SPEC quantity is a keyword parameter with the paper's default
     res.plot("tracking").savefig("tracking.png")
 """
 
-from ._adaptimp import __version__
+from ._adaptimp import Measurement, __version__
 from ._api import Controller, simulate
 from ._arms import PlanarArm, TwoLinkArm
 from ._errors import (
@@ -71,6 +71,7 @@ __all__ = [
     "Fault",
     "FaultError",
     "LogUniform",
+    "Measurement",
     "MeasurementError",
     "Normal",
     "Param",

@@ -6,11 +6,11 @@ them from keywords with the paper's defaults.
 """
 
 from collections.abc import Callable, Sequence
-from typing import Any, Literal, TypedDict, final, type_check_only
+from typing import Any, Literal, TypedDict, final, overload, type_check_only
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from typing_extensions import disjoint_base
+from typing_extensions import deprecated, disjoint_base
 
 __all__ = [
     "MAX_JOINTS",
@@ -19,6 +19,7 @@ __all__ = [
     "Chain",
     "ComputedTorque",
     "Controller",
+    "Measurement",
     "PlanarArm",
     "TwoLinkArm",
     "__version__",
@@ -277,6 +278,31 @@ class CartesianParams(TypedDict, total=False):
 
 # END GENERATED
 
+@final
+class Measurement:
+    """One sample of the sensors: q (rad), dq (rad/s), tau_e (N m), wrench (N, N m)."""
+
+    def __new__(
+        cls,
+        q: ArrayLike,
+        dq: ArrayLike | None = None,
+        *,
+        tau_e: ArrayLike | None = None,
+        wrench: ArrayLike | None = None,
+    ) -> Measurement: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def q(self) -> _F: ...
+    @property
+    def dq(self) -> _F | None: ...
+    @property
+    def tau_e(self) -> _F | None: ...
+    @property
+    def wrench(self) -> _F | None: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[_F, _F | None], dict[str, _F | None]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+
 @disjoint_base
 class Controller:
     """One of the paper's controllers for an arm of n joints, with its state."""
@@ -289,22 +315,41 @@ class Controller:
         centers: _F | None = None,
         widths2: _F | None = None,
     ) -> Controller: ...
+    @overload
+    def step(
+        self,
+        m: Measurement,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> _F:
+        """One step from a :class:`Measurement`; sat(τ) (N m), (n,)."""
+    @overload
+    @deprecated("step(q, tau_e, dq): pass one adaptimp.Measurement(q, dq, tau_e=tau_e)")
     def step(
         self,
         q: ArrayLike,
         tau_e: ArrayLike,
         dq: ArrayLike | None = None,
-        *,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
     ) -> _F: ...
+    @overload
+    def step_or_fallback(
+        self,
+        m: Measurement,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> tuple[_F, str | None]: ...
+    @overload
+    @deprecated("step_or_fallback(q, tau_e, dq): pass one adaptimp.Measurement(q, dq, tau_e=tau_e)")
     def step_or_fallback(
         self,
         q: ArrayLike,
         tau_e: ArrayLike,
         dq: ArrayLike | None = None,
-        *,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
@@ -455,7 +500,8 @@ def simulate_mujoco_callback(
     table: tuple[_F, _F, _F],
     *,
     setpoint: bool,
-    wants_wrench: bool,
+    task_space: bool,
+    call: str,
     attrs: list[str],
     target: tuple[list[float], list[float], list[float]],
     record_every: int = 1,
@@ -596,6 +642,8 @@ class CartesianImpedance:
         dq: ArrayLike | None,
         wrench: ArrayLike,
         target: ArrayLike | None = None,
+        *,
+        measurement: bool = True,
     ) -> _F: ...
     def last(self, what: str) -> _F: ...
     def state(self, what: str) -> _F: ...
@@ -643,12 +691,15 @@ def suggest(
     gravity: NDArray[np.float64] | None = None,
     resolve: bool = False,
     critical: bool = False,
+    damping: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every
     controller keyword), with a path also "centers" (L, 4n) and "widths" (4n,);
     ``resolve``: the tube narrowed to the path's size, SPEC (16.10); ``critical``:
-    Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6)."""
+    Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6); ``damping``
+    (n,): the joints' viscous damping, the scales as the sampled loop sees them,
+    SPEC (18.9)."""
 
 def pose_circle(
     p0: NDArray[np.float64],
@@ -753,6 +804,17 @@ class ComputedTorque:
     def fault(self) -> tuple[str, int] | None: ...
     def reset(self) -> None: ...
     def set_trajectory(self, trajectory: Callable[[float], Any] | None = None) -> None: ...
+    @overload
+    def step(
+        self,
+        m: Measurement,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> _F:
+        """One step (SPEC (20.3)); sat(τ) (N m), (n,)."""
+    @overload
+    @deprecated("step(q, tau_e, dq): pass one adaptimp.Measurement(q, dq, tau_e=tau_e)")
     def step(
         self,
         q: ArrayLike,
@@ -761,8 +823,7 @@ class ComputedTorque:
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
-    ) -> _F:
-        """One step (SPEC (20.3)); sat(τ) (N m), (n,)."""
+    ) -> _F: ...
     def inverse_dynamics(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> _F:
         """RNEA(q, q̇, q̈) = M q̈ + C q̇ + G (N m), (n,)."""
     def mass_matrix(self, q: ArrayLike) -> _F:

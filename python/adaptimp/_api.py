@@ -363,12 +363,15 @@ class Controller(_adaptimp.Controller):
 
     Notes
     -----
-    **Methods from the compiled core.** ``step(q, tau_e, dq=None, *, xc=None,
-    dxc=None, ddxc=None)`` takes positions q (rad), the measured force on the
-    environment τe (N m) and, for "pd"/"sf", velocities dq (rad/s), each of shape
-    (n,), and returns the applied torque sat(τ) (N m), (n,); ``xc``, ``dxc``,
-    ``ddxc`` (rad, rad/s, rad/s²; the last two zero if omitted) replace the
-    trajectory's setpoint. ``step_or_fallback`` never raises for a refused
+    **Methods from the compiled core.** ``step(m, *, xc=None, dxc=None,
+    ddxc=None)`` takes an :class:`adaptimp.Measurement` ``m``: positions q
+    (rad), for "pd"/"sf" velocities dq (rad/s), and the measured force on the
+    environment τe (N m; none: zeros), each of shape (n,); it returns the
+    applied torque sat(τ) (N m), (n,). ``xc``, ``dxc``, ``ddxc`` (rad, rad/s,
+    rad/s²; the last two zero if omitted) replace the trajectory's setpoint.
+    Every controller takes the same call (``CartesianController`` reads the
+    measurement's wrench instead of τe); the old ``step(q, tau_e, dq)`` works,
+    with a ``DeprecationWarning``. ``step_or_fallback`` never raises for a refused
     measurement and returns (torque, error message or None). ``replay`` runs K
     steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
     ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
@@ -398,7 +401,8 @@ class Controller(_adaptimp.Controller):
     --------
     >>> import adaptimp
     >>> ctrl = adaptimp.Controller("sf", scenario="robot")
-    >>> tau = ctrl.step(q=[0.25, -0.05], tau_e=[0.0, 0.0], dq=[0.0, 0.0])
+    >>> m = adaptimp.Measurement([0.25, -0.05], [0.0, 0.0], tau_e=[0.0, 0.0])
+    >>> tau = ctrl.step(m)
     >>> tau.shape, ctrl.t
     ((2,), 0.001)
     """

@@ -1,5 +1,7 @@
-"""Typed task-space I/O: the pose target a Cartesian step takes and the named
-outputs it gives (SPEC §16), in place of a flat array and string keys.
+"""Typed I/O: the pose target a Cartesian step takes and the named outputs it
+gives (SPEC §16), in place of a flat array and string keys; and how a
+controller written in Python is called (one step signature,
+``step(m, **setpoint)`` with an :class:`adaptimp.Measurement`).
 
 :class:`PoseTarget` is the core's ``PoseTarget`` (Rust) and ``AdaptimpPoseTarget``
 (C) in Python: the commanded pose p_c, R_c and its rates. :class:`CartesianStep`
@@ -8,6 +10,9 @@ is what the last step computed, each quantity an attribute with its unit.
 
 from __future__ import annotations
 
+import inspect
+import sys
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -179,3 +184,57 @@ def target_of(target: PoseTarget | ArrayLike) -> FloatArray:
     if isinstance(target, PoseTarget):
         return target.flat
     return _vec("target", target, (FLAT,))
+
+
+def task_space(ctrl: Any) -> bool:
+    """A controller in task space (``task_space = True``; ``wants_wrench`` is
+    its deprecated name): it reads the wrench, and its reference is p_c (3,)."""
+    return bool(getattr(ctrl, "task_space", getattr(ctrl, "wants_wrench", False)))
+
+
+def _outside() -> int:
+    """The ``stacklevel`` of the first caller outside the adaptimp package,
+    for a warning raised by the function that calls this one: the user's
+    line that asked for the deprecated call."""
+    frame = sys._getframe(1)
+    level = 1
+    while frame.f_back is not None and frame.f_globals.get("__name__", "").startswith("adaptimp"):
+        frame = frame.f_back
+        level += 1
+    return level
+
+
+def call_shape(ctrl: Any) -> str:
+    """How a controller written in Python is called: ``"measurement"``, the
+    protocol (``step(m, **setpoint)``), or a deprecated shape (a step that
+    one positional argument does not bind but three do, with or without the
+    setpoint's keywords), with a ``DeprecationWarning`` at the user's line:
+    ``"joint"`` (``step(q, tau_e, dq, …)``) or, for a task-space controller,
+    ``"wrench"`` (``step(q, dq, wrench, …)``)."""
+    try:
+        sig = inspect.signature(ctrl.step)
+    except (TypeError, ValueError):  # no signature to read (a compiled step): the protocol
+        return "measurement"
+    sp = dict.fromkeys(("xc", "dxc", "ddxc"))
+
+    def binds(*args: object) -> bool:
+        """Whether ``args`` bind, with the setpoint's keywords or without."""
+        for kw in (sp, {}):
+            try:
+                sig.bind(*args, **kw)
+            except TypeError:
+                continue
+            return True
+        return False
+
+    old = not binds(None) and binds(None, None, None)
+    if not old:
+        return "measurement"
+    shape = "step(q, dq, wrench)" if task_space(ctrl) else "step(q, tau_e, dq)"
+    warnings.warn(
+        f"{type(ctrl).__name__}.{shape} is deprecated: write step(m, **setpoint), m an "
+        "adaptimp.Measurement (m.q, m.dq, m.tau_e, m.wrench)",
+        DeprecationWarning,
+        stacklevel=_outside(),
+    )
+    return "wrench" if task_space(ctrl) else "joint"

@@ -103,17 +103,22 @@ def add_table(
     solref: Sequence[float] | None = None,
     mass: float | None = None,
     spring: float | None = None,
+    yaw: float = 0.0,
 ) -> tuple[str, str]:
     """A table (a box of :data:`TABLE_SIZE` and :data:`TABLE_THICKNESS`, geom
     ``table``) whose top is at height ``top`` (m), centred at ``centre`` (x,
-    y); static, or with ``spring`` (N/m) on a vertical slide joint
-    ``table_spring``, critically damped for its ``mass`` (kg) and preloaded by
-    its weight (at rest the top is at ``top``). Returns the names of its body
+    y), turned by ``yaw`` (rad) about the vertical (its first side along the
+    direction ``yaw`` from the world's x axis); static, or with ``spring``
+    (N/m) on a vertical slide joint ``table_spring``, critically damped for
+    its ``mass`` (kg) and preloaded by its weight (at rest the top is at
+    ``top``). Returns the names of its body
     and its geom."""
     name = unused_body(spec, "table")
     body = spec.worldbody.add_body(
         name=name, pos=[float(centre[0]), float(centre[1]), top - TABLE_THICKNESS / 2]
     )
+    if yaw != 0.0:
+        body.quat = [math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
     if spring is not None:
         m = 1.0 if mass is None else mass
         body.add_joint(

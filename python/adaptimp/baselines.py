@@ -28,11 +28,12 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._adaptimp import Measurement
 from ._errors import needs_extra, period_alias
 
 try:
@@ -265,8 +266,9 @@ class ComputedTorque:
     """Computed-torque impedance control (module doc), stepped by the core
     (SPEC §20) with the inertials of a Pinocchio model.
 
-    The controller protocol of :func:`adaptimp.mujoco.simulate`: ``step(q,
-    tau_e, dq, xc=, dxc=, ddxc=)`` at t_k = k·Ts returns the applied torque
+    The controller protocol of :func:`adaptimp.mujoco.simulate`: ``step(m,
+    xc=, dxc=, ddxc=)`` (``m`` an :class:`adaptimp.Measurement`) at t_k =
+    k·Ts returns the applied torque
     sat(τ) (N m); without a setpoint it follows ``trajectory`` (by default,
     for two joints, the paper's circle (64)). Behind an
     :class:`adaptimp.CartesianController` the core steps it in its own
@@ -445,6 +447,10 @@ class ComputedTorque:
         self._trajectory = trajectory
         self._core.set_trajectory(trajectory)
         self._step = self._core.step
+        # The per-sample call goes straight to the core (its signature is
+        # step's, below): no Python frame in between (docs/performance.md).
+        if type(self).step is ComputedTorque.step:  # not a subclass's own step
+            self.step = self._step  # type: ignore[method-assign,assignment]
 
     def reset(self) -> None:
         """Back to t = 0; the reference starts at the next setpoint."""
@@ -521,27 +527,39 @@ class ComputedTorque:
         (rad/s²), each (n,), checked (shape, finiteness) by the core."""
         return self._core.inverse_dynamics(q, dq, ddq)
 
+    @overload
     def step(
         self,
-        q: ArrayLike,
-        tau_e: ArrayLike,
-        dq: ArrayLike | None = None,
-        *,
+        m: Measurement,
         xc: ArrayLike | None = None,
         dxc: ArrayLike | None = None,
         ddxc: ArrayLike | None = None,
-    ) -> FloatArray:
+    ) -> FloatArray: ...
+    @overload
+    def step(  # deprecated: the arrays' call, with a DeprecationWarning
+        self,
+        m: ArrayLike,
+        tau_e: ArrayLike,
+        dq: ArrayLike | None = None,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+    ) -> FloatArray: ...
+    def step(self, *args: Any, **kwargs: Any) -> FloatArray:
         """One step at t_k = k·Ts (SPEC (20.3)); returns the applied torque
         sat(τ) (N m), (n,).
 
-        q (rad), tau_e (N m), dq (rad/s; required), each (n,); the setpoint
-        xc (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0), or
-        none of them (then the built-in ``trajectory``).
+        ``m`` is an :class:`adaptimp.Measurement`: q (rad), dq (rad/s;
+        required), tau_e (N m; None: zeros), each (n,); the setpoint xc
+        (rad), dxc (rad/s), ddxc (rad/s²), (n,) (dxc, ddxc default 0; given
+        positionally, a call skips the keyword dictionary), or none of them
+        (then the built-in ``trajectory``). The arrays' call ``step(q, tau_e,
+        dq, xc=, dxc=, ddxc=)`` works, with a ``DeprecationWarning``. An
+        instance's ``step`` is the core's own method (this signature, no
+        Python in between).
         """
-        # One call of the core, positional (cheaper than keywords through the
-        # binding): it checks every argument (shapes and types there, values in
-        # the step) and, given no setpoint, follows the trajectory.
-        return self._step(q, tau_e, dq, xc, dxc, ddxc)
+        out: FloatArray = self._step(*args, **kwargs)
+        return out
 
     def __repr__(self) -> str:
         return (

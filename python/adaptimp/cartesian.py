@@ -34,6 +34,7 @@ kg m², s.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -41,9 +42,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
+from ._adaptimp import Measurement
 from ._errors import ConfigError, MeasurementError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
-from ._pose import CartesianStep, PoseTarget
+from ._pose import CartesianStep, PoseTarget, call_shape
 from .chain import Chain
 
 __all__ = [
@@ -118,6 +120,39 @@ def _wrench(wrench: ArrayLike | None) -> FloatArray:
             raise MeasurementError(f"wrench must have shape (6,) or (3,), got shape {w.shape}")
         f[: w.shape[0]] = w
     return f
+
+
+def _measured(
+    n: int, m: Any, dq: ArrayLike | None, wrench: ArrayLike | None, q: ArrayLike | None
+) -> tuple[Any, Any, Any]:
+    """q, q̇ and the wrench of a Cartesian step: from an
+    :class:`adaptimp.Measurement` ``m``, or the deprecated arrays (warned)."""
+    if isinstance(m, Measurement):
+        if dq is not None or wrench is not None or q is not None:
+            raise TypeError(
+                "CartesianController.step: give the measurement as an adaptimp.Measurement "
+                "or as arrays, not both"
+            )
+        if m.n != n:
+            raise MeasurementError(
+                f"q must have shape ({n},) (one value per joint), got length {m.n}"
+            )
+        return m.q, m.dq, m.wrench
+    if m is not None and q is not None:
+        raise TypeError("CartesianController.step: q given twice (positionally and by keyword)")
+    q = m if m is not None else q
+    if q is None:
+        raise TypeError(
+            "CartesianController.step needs a measurement: "
+            "step(adaptimp.Measurement(q, dq, wrench=…))"
+        )
+    warnings.warn(
+        "CartesianController.step(q, dq, wrench) is deprecated: pass one "
+        "adaptimp.Measurement(q, dq, wrench=wrench)",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    return q, dq, wrench
 
 
 def _per_axis(name: str, v: ArrayLike) -> FloatArray:
@@ -458,8 +493,8 @@ class CartesianController:
 
     Notes
     -----
-    The :func:`adaptimp.mujoco.simulate` protocol: ``wants_wrench = True``, so it
-    calls ``step(q, dq, wrench, xc=, dxc=, ddxc=)``; ``.Ts``; after a step
+    The :func:`adaptimp.mujoco.simulate` protocol: ``task_space = True``, so it
+    reads the measurement's wrench; ``step(m, xc=, dxc=, ddxc=)``; ``.Ts``; after a step
     ``xc``, ``dxc``, ``ddxc`` = p_c, ṗ_c, p̈_c (the commanded position and its
     rates; when no target is given, the held target after its filter, p_t, at
     rest), ``xd`` = p_d (the compliant reference), ``z1`` = p_d − p(q) (m,
@@ -483,12 +518,12 @@ class CartesianController:
     >>> ctrl = adaptimp.CartesianController(
     ...     arm, "pd", q0=[0.3, 0.6], Kd_rot=0.0, tau_max=20.0, Kp=5.0, Kzeta=25.0
     ... )
-    >>> tau = ctrl.step([0.3, 0.6], [0.0, 0.0], [0.0] * 6)
+    >>> tau = ctrl.step(adaptimp.Measurement([0.3, 0.6], [0.0, 0.0]))
     >>> tau.shape
     (2,)
     """
 
-    wants_wrench = True
+    task_space = True
 
     def __init__(
         self,
@@ -548,6 +583,8 @@ class CartesianController:
             core_joint = getattr(controller, "_core_joint", None)
             self._core_inner = isinstance(core_joint, _adaptimp.ComputedTorque)
             self._joint = core_joint if self._core_inner else controller
+            # A joint controller written in Python: called as the protocol says.
+            self._inner_measurement = self._core_inner or call_shape(controller) == "measurement"
         Ts = getattr(inner, "Ts", None)
         if Ts is None:
             raise TypeError(f"the joint controller {inner!r} has no period .Ts (s)")
@@ -773,7 +810,7 @@ class CartesianController:
 
     def step(
         self,
-        q: ArrayLike,
+        m: Measurement | ArrayLike | None = None,
         dq: ArrayLike | None = None,
         wrench: ArrayLike | None = None,
         *,
@@ -784,17 +821,27 @@ class CartesianController:
         w: ArrayLike | None = None,
         dw: ArrayLike | None = None,
         target: PoseTarget | None = None,
+        q: ArrayLike | None = None,
     ) -> FloatArray:
         """One step at t_k = k·Ts; returns the torque to apply (N m), (n,).
 
-        q (rad), dq (rad/s) (n,); ``wrench`` F_e = [f; m] (N, N m), (6,) (f (3,)
-        alone: no moment; None: no contact); the commanded pose ``xc`` = p_c (m),
-        ``dxc``, ``ddxc`` (m/s, m/s²), ``R`` (3, 3), ``w``, ``dw`` (rad/s,
-        rad/s²), each optional (R: the last commanded rotation), or all of it
-        as a :class:`PoseTarget` ``target``; without either the ``path`` at
-        t_k, or the last target held. The rest of the step by name:
-        :attr:`output`.
+        ``m`` is an :class:`adaptimp.Measurement`: q (rad), dq (rad/s) (n,),
+        and the wrench F_e = [f; m] (N, N m), (6,) (f (3,) alone: no moment;
+        None: no contact); its tau_e is not read (the step maps the wrench to
+        the joints itself). The commanded pose: ``xc`` = p_c (m), ``dxc``,
+        ``ddxc`` (m/s, m/s²), ``R`` (3, 3), ``w``, ``dw`` (rad/s, rad/s²),
+        each optional (R: the last commanded rotation), or all of it as a
+        :class:`PoseTarget` ``target``; without either the ``path`` at t_k,
+        or the last target held. The rest of the step by name:
+        :attr:`output`. ``step(q, dq, wrench)`` works, with a
+        ``DeprecationWarning``.
         """
+        measured: Any
+        if self._core_inner and type(m) is Measurement and dq is wrench is q is None:
+            measured = m  # the core reads it itself: no arrays made here
+        else:
+            q, dq, wrench = _measured(self.chain.n, m, dq, wrench, q)
+            measured = q
         if target is not None:
             if xc is not None:
                 raise TypeError("give the commanded pose as xc=… or as target=…, not both")
@@ -807,7 +854,7 @@ class CartesianController:
             sample = None
         if self._core_inner:
             # One call of the core: the pose and wrench read, the step, the row kept.
-            out: FloatArray = self._step(self._joint, q, dq, wrench, sample, self.record)
+            out: FloatArray = self._step(self._joint, measured, dq, wrench, sample, self.record)
             self._k += 1
             return out
         f = _wrench(wrench)
@@ -823,7 +870,7 @@ class CartesianController:
             flat = _pose_of(sample, self.outer._R)
             turned = True
         core = self.outer.core
-        out = core.step_python(self.inner, q, dq, f, flat)
+        out = core.step_python(self.inner, q, dq, f, flat, measurement=self._inner_measurement)
         self._tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
         self.outer._commit(flat, turned)
         if self.record:

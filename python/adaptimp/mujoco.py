@@ -9,7 +9,7 @@ rest of adaptimp never imports it.
   exerts on its environment (mapped to joint space as τe = Jᵀ F_e); MuJoCo's
   constraint solver computes contact.
 - :func:`simulate` closes the loop, the core's (SPEC §13.1): any controller
-  with ``.step(q, tau_e, dq=None, **setpoint)`` and a period ``.Ts`` (s)
+  with ``.step(m, **setpoint)`` (``m`` an :class:`adaptimp.Measurement`) and a period ``.Ts`` (s)
   (:class:`ControllerLike`, called back once a period), or one of the
   paper's cases by name, runs at Ts with the torque held over ``substeps``
   MuJoCo steps; returns a :class:`MujocoResult` with the SPEC §12 metrics.
@@ -64,6 +64,7 @@ from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
 from ._faults import Fault
 from ._mjcf import _full_inertia, _limits, _postures
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
+from ._pose import call_shape, task_space
 from ._result import SimResult
 from ._tooling import add_table, add_tool
 from ._trajectory import Reference, paper_circle, sinusoid
@@ -111,34 +112,39 @@ class ControllerLike(Protocol):
     a period. The core's loop calls it back once a period (with the GIL taken
     for the call; the rest of the loop runs without it).
 
-    ``step(q, tau_e, dq, **setpoint)`` returns the torque to apply (N m), (n,)
-    (or one number for every joint; saturated by the motors); q, tau_e, dq
-    are what the loop's sensors read (with the disturbances of SPEC §17 and a
-    fault, if any); ``setpoint`` is ``xc=, dxc=, ddxc=`` (the row's) when
-    :func:`simulate` is given a ``reference``, nothing otherwise (the
-    controller then follows its own trajectory). The period is ``.Ts`` (s;
-    ``.ts`` is read, deprecated). Optional attributes that :func:`simulate`
-    records when present: ``zeta`` (read before the step), then, after it,
-    ``xc`` and, without a ``reference``, ``dxc``, ``ddxc`` (the controller's
-    own commanded rates), ``xd``, ``z1``, ``dq_hat``, ``tau`` (commanded
-    torque before saturation); and ``params`` (a dict; ``xc_offset``,
-    ``xc_sin``, ``xc_cos``, ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for
-    the metrics when present). An exception raised by ``step`` (or a torque of
-    another shape) ends the run with it; a torque that is not finite ends it
-    too (``ValueError``), unless a fault is injected: then the step is
-    refused, as the core's controllers' are, and zero torque applied.
+    ``step(m, **setpoint)`` returns the torque to apply (N m), (n,) (or one
+    number for every joint; saturated by the motors). ``m`` is an
+    :class:`adaptimp.Measurement`: what the loop's sensors read (with the
+    disturbances of SPEC §17 and a fault, if any), ``m.q`` (rad), ``m.dq``
+    (rad/s), ``m.tau_e`` (N m, (n,)) and the wrench at the tip ``m.wrench``
+    F_e = [f; m] (N, N m, (6,), world frame; the plant's measurement of the
+    row, the one τe is computed from): a joint-space controller reads τe, a
+    task-space one F_e. Every controller of adaptimp takes the same call.
+    ``setpoint`` is ``xc=, dxc=, ddxc=`` (the row's) when :func:`simulate` is
+    given a ``reference``, nothing otherwise (the controller then follows
+    its own trajectory). The period is ``.Ts`` (s; ``.ts`` is read,
+    deprecated). Optional attributes that :func:`simulate` records when
+    present: ``zeta`` (read before the step), then, after it, ``xc`` and,
+    without a ``reference``, ``dxc``, ``ddxc`` (the controller's own
+    commanded rates), ``xd``, ``z1``, ``dq_hat``, ``tau`` (commanded torque
+    before saturation); and ``params`` (a dict; ``xc_offset``, ``xc_sin``,
+    ``xc_cos``, ``xc_omega``, ``Dd``, ``Cd``, ``Gd`` are used for the metrics
+    when present). An exception raised by ``step`` (or a torque of another
+    shape) ends the run with it; a torque that is not finite ends it too
+    (``ValueError``), unless a fault is injected: then the step is refused,
+    as the core's controllers' are, and zero torque applied.
 
-    Cartesian hook: a controller with ``wants_wrench = True`` is called as
-    ``step(q, dq, wrench, **setpoint)`` instead, with the measured wrench
-    F_e = [f; m] (6,), N and N m, world frame (the plant's measurement of the
-    row, the one τe is computed from) in place of τe, e.g.
-    :class:`adaptimp.CartesianController` (which maps it to the joints
-    itself); its ``xc``, ``xd``, ``z1`` are then of width 3.
+    A controller in task space says so with ``task_space = True`` (e.g.
+    :class:`adaptimp.CartesianController`, which maps the wrench to the
+    joints itself): its ``xc``, ``xd``, ``z1`` are then of width 3 (m).
+
+    Deprecated (one release, with a ``DeprecationWarning``): a step that
+    takes ``(q, tau_e, dq, **setpoint)`` (a step one positional argument
+    cannot bind) is called so, and with ``wants_wrench = True`` (the old name
+    of ``task_space``) as ``(q, dq, wrench, **setpoint)``.
     """
 
-    def step(
-        self, q: ArrayLike, tau_e: ArrayLike, dq: ArrayLike | None = None, **setpoint: Any
-    ) -> ArrayLike: ...
+    def step(self, m: _adaptimp.Measurement, **setpoint: Any) -> ArrayLike: ...
 
 
 # ---------------------------------------------------------------------------
@@ -1703,7 +1709,7 @@ def _check_run(run: _Run, res: MujocoResult) -> None:
     if _uses_rule(plant) and res.rows > 0:
         found += _self_contact(plant, res)
     free = res.metrics.get("steps_in_contact", 0) == 0 and run.kind != "cartesian"
-    free = free and not getattr(run.ctrl, "wants_wrench", False)
+    free = free and not task_space(run.ctrl)
     if _uses_rule(plant) and res.rows > 0 and free:
         tau_max = np.asarray(plant.tau_max)
         late = np.flatnonzero(res.t >= RUN_SETTLE - 1e-12)
@@ -1831,8 +1837,9 @@ def _callback_loop(
     trajectory (if its params declare one), and its target impedance for
     the metrics, given to the core."""
     ctrl, n, steps, Ts = run.ctrl, run.plant.n, run.steps, run.Ts
-    wants_wrench = bool(getattr(ctrl, "wants_wrench", False))
-    width = 3 if wants_wrench else n
+    in_task = task_space(ctrl)
+    call = call_shape(ctrl)
+    width = 3 if in_task else n
     has = {name: hasattr(ctrl, name) for name in _ATTRIBUTES}
     reference = run.reference
     own_rates = reference is None and has["dxc"] and has["ddxc"]
@@ -1841,7 +1848,7 @@ def _callback_loop(
     else:
         nan = np.full((steps, width), math.nan)
         # The rates of its own joint-space sinusoid, if its params declare one.
-        rates = None if own_rates or wants_wrench else _builtin_rates(ctrl, steps, Ts)
+        rates = None if own_rates or in_task else _builtin_rates(ctrl, steps, Ts)
         table = (nan, *(rates or (nan, nan)))
     attrs = [name for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta") if has[name]]
     cparams = getattr(ctrl, "params", None)
@@ -1852,12 +1859,12 @@ def _callback_loop(
     )
     out: dict[str, Any] = _adaptimp.simulate_mujoco_callback(
         ctrl, run.plant.model, run.plant.data, run.spec, run.dist, Ts, run.T, run.settle, table,
-        setpoint=reference is not None, wants_wrench=wants_wrench,
+        setpoint=reference is not None, task_space=in_task, call=call,
         attrs=attrs + (["rates"] if own_rates else []), target=target, record_every=run.every,
         progress=progress, fault=fault,
     )  # fmt: skip
     # A task-space controller's own log of this run (adaptimp.CartesianController.arrays).
-    log = getattr(ctrl, "arrays", None) if wants_wrench and getattr(ctrl, "record", False) else None
+    log = getattr(ctrl, "arrays", None) if in_task and getattr(ctrl, "record", False) else None
     if callable(log):
         out["task"] = {k: v[len(v) - steps :: run.every] for k, v in log().items()}
     return out
@@ -1941,7 +1948,7 @@ def _kind(ctrl: Any) -> str:
     ``"callback"`` (written in Python: called back once a period)."""
     if _native_cartesian(ctrl):
         return "cartesian"
-    if getattr(ctrl, "wants_wrench", False):
+    if task_space(ctrl):
         return "callback"
     if _native(ctrl):
         return "native"
@@ -2052,10 +2059,10 @@ def _setup(
     resolved = resolve(disturb, scenario="robot", groups=("sim",), caller="simulate()", n=plant.n)
     dist = {k: resolved[k] for k in DISTURBANCES}
     # A Cartesian controller's reference is its commanded position p_c (3,).
-    task_space = bool(getattr(ctrl, "wants_wrench", False))
+    in_task = task_space(ctrl)
     if reference is not None:
-        reference = _table_reference(reference, 3 if task_space else plant.n, Ts, steps)
-        if q0 is None and plant.model.nkey == 0 and not task_space and reset:
+        reference = _table_reference(reference, 3 if in_task else plant.n, Ts, steps)
+        if q0 is None and plant.model.nkey == 0 and not in_task and reset:
             start = reference(0.0)
             q0 = np.asarray(start[0], dtype=np.float64)
             dq0 = np.asarray(start[1], dtype=np.float64) if dq0 is None else dq0

@@ -111,6 +111,20 @@ def gravity(model: Any, q: ArrayLike) -> FloatArray | None:
     return None
 
 
+def joint_damping(model: Any) -> FloatArray | None:
+    """The viscous damping (N m s/rad, (n,)) of ``model``'s joints if it has any:
+    an ``adaptimp.mujoco.Plant``'s (MuJoCo's ``dof_damping`` of the arm's
+    joints, which MuJoCo integrates implicitly); None for every other model
+    (a Pinocchio ``Model`` or a URDF compiled without its drive terms carries
+    none), or if every joint's is zero."""
+    m = getattr(model, "model", None)
+    dofs = getattr(model, "_dofs", None)
+    if m is None or dofs is None or not hasattr(m, "dof_damping"):
+        return None
+    b = np.asarray(m.dof_damping[np.asarray(dofs)], dtype=np.float64)
+    return b if np.any(b > 0) else None
+
+
 def sample_path(path: Path, period: float, n: int) -> FloatArray:
     """One period of ``path(t) -> (q, dq, ddq)`` as a (K, 3n) array, K =
     :data:`PATH_SAMPLES` instants evenly spaced from t = 0 (the first not
@@ -136,6 +150,7 @@ def suggest(
     case: str = "sf",
     resolve: bool = False,
     critical: bool = False,
+    damping: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
     the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
@@ -168,6 +183,11 @@ def suggest(
     critical : bool
         Ĝ learns at the velocity loop's critical bandwidth ω_G² = (m/Ts)²/4,
         SPEC (19.6) (the table scenario's; (18.6)'s ½ (m/Ts) K1 otherwise).
+    damping : float or array_like, shape (n,), optional
+        The joints' viscous damping (N m s/rad); default the plant's own
+        (:func:`damping`: an ``adaptimp.mujoco.Plant``'s joints, none for
+        other models). The inertia scales become those the sampled velocity
+        loop sees, SPEC (18.9): d̃ = b Ts/(1 − e^(−b Ts/d)), d for b = 0.
 
     Returns
     -------
@@ -198,9 +218,15 @@ def suggest(
         step = max(1, rows.shape[0] // INERTIA_SAMPLES)
         d = np.stack([inertia(model, q) for q in rows[::step, :n]])
     g = gravity(model, q0) if rows is not None else None
+    b = joint_damping(model) if damping is None else damping
+    b_arr = (
+        None
+        if b is None
+        else np.ascontiguousarray(np.broadcast_to(np.asarray(b, dtype=np.float64), (n,)))
+    )
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
-        critical=critical,
+        critical=critical, damping=b_arr,
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

@@ -182,3 +182,130 @@ pub trait Control<const N: usize> {
         self.step_or_fallback(m, c)
     }
 }
+
+/// A controller of the closed loop that reads the measured wrench at every
+/// step (a task-space law, or a controller written in another language that
+/// is handed the whole measurement): implement its one step, and
+/// [`Control`]'s steps follow from it, with a zero wrench where none is
+/// measured.
+pub trait WrenchControl<const N: usize> {
+    /// Sampling period Ts (s).
+    fn period(&self) -> f64;
+    /// The target impedance (3) the controller realises (SPEC §12).
+    fn target(&self) -> &TargetImpedance<N>;
+    /// The step with the measured wrench F_e = [f; m] (N, N m, world frame),
+    /// and the torque to apply whatever happened (its fallback on an error).
+    fn step_with_wrench(
+        &mut self,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>);
+}
+
+impl<const N: usize, T: WrenchControl<N>> Control<N> for T {
+    fn period(&self) -> f64 {
+        WrenchControl::period(self)
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        WrenchControl::target(self)
+    }
+    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        WrenchControl::step_with_wrench(self, m, &[0.0; 6], c).1
+    }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        WrenchControl::step_with_wrench(self, m, &[0.0; 6], c)
+    }
+    fn step_with_wrench(
+        &mut self,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        WrenchControl::step_with_wrench(self, m, wrench, c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A law that pushes back along the measured force: τ = −f (the first
+    /// N components of the wrench), refusing a NaN wrench.
+    struct Pushback(TargetImpedance<2>);
+
+    impl WrenchControl<2> for Pushback {
+        fn period(&self) -> f64 {
+            1e-3
+        }
+        fn target(&self) -> &TargetImpedance<2> {
+            &self.0
+        }
+        fn step_with_wrench(
+            &mut self,
+            _m: &Measurement<2>,
+            wrench: &[f64; 6],
+            _c: &Setpoint<2>,
+        ) -> (Vector<2>, Result<Command<2>, Error>) {
+            if wrench.iter().any(|w| w.is_nan()) {
+                let e = Error::NonFinite {
+                    what: "wrench",
+                    index: 0,
+                };
+                return (Vector::<2>::zeros(), Err(e));
+            }
+            let tau = Vector::<2>::new(-wrench[0], -wrench[1]);
+            let cmd = Command {
+                tau_sat: tau,
+                tau,
+                ..Command::zeros()
+            };
+            (tau, Ok(cmd))
+        }
+    }
+
+    #[test]
+    fn a_wrench_controller_is_a_control_that_reads_no_wrench_where_none_is_given() {
+        let mut law = Pushback(TargetImpedance::paper());
+        let m = Measurement {
+            x: Vector::<2>::zeros(),
+            dx: None,
+            tau_e: Vector::<2>::zeros(),
+        };
+        let z = Vector::<2>::zeros();
+        let c = Setpoint {
+            x: z,
+            dx: z,
+            ddx: z,
+        };
+        let w = [3.0, -2.0, 0.0, 0.0, 0.0, 0.0];
+        let (tau, cmd) = Control::step_with_wrench(&mut law, &m, &w, &c);
+        assert_eq!(tau, Vector::<2>::new(-3.0, 2.0));
+        assert_eq!(cmd.map(|c| c.tau), Ok(tau));
+        assert_eq!(
+            Control::step(&mut law, &m, &c).map(|c| c.tau),
+            Ok(Vector::<2>::zeros())
+        );
+        assert_eq!(
+            Control::step_or_fallback(&mut law, &m, &c).0,
+            Vector::<2>::zeros()
+        );
+        assert_eq!(Control::period(&law), 1e-3);
+        let nan = [f64::NAN; 6];
+        let (tau, err) = Control::step_with_wrench(&mut law, &m, &nan, &c);
+        assert_eq!(
+            (tau, err.err()),
+            (
+                Vector::<2>::zeros(),
+                Some(Error::NonFinite {
+                    what: "wrench",
+                    index: 0
+                })
+            )
+        );
+    }
+}

@@ -150,6 +150,43 @@ pub fn inertia_scales_along<const N: usize>(ds: &[Matrix<N>]) -> Result<Vector<N
     Ok(scales)
 }
 
+/// The inertia scales `scales` (kg m², each > 0) of joints with viscous
+/// damping `damping` (N m s/rad, each ≥ 0, the plant's own) as the sampled
+/// velocity loop at period `ts` (s) sees them, SPEC (18.9):
+///
+/// ```text
+/// d̃_i = b_i Ts / (1 − e^(−β_i)),   β_i = b_i Ts / d_i
+/// ```
+///
+/// Over one period a held torque τ moves a damped joint's velocity by
+/// (1 − e^(−β)) τ/b where an undamped one moves by Ts τ/d: d̃ is the inertia
+/// that answers a held torque as the damped joint does, so the rule's
+/// Kp = m d̃/Ts takes the share m of the velocity error per period on either
+/// (18.1). d̃ = d for b = 0 (bit for bit), d (1 + β/2 + O(β²)) for a damping
+/// small against d/Ts, and b Ts for a joint its damping dominates (a
+/// near-massless wrist). Errors if a scale is not finite and > 0, a damping
+/// not finite and ≥ 0, or `ts` not finite and > 0.
+pub fn damped_scales<const N: usize>(
+    scales: &Vector<N>,
+    damping: &Vector<N>,
+    ts: f64,
+) -> Result<Vector<N>, Error> {
+    check::positive("Ts > 0", "Ts", ts)?;
+    check::positive_vec("inertia scale > 0", "inertia scale", scales)?;
+    check::nonnegative_vec("damping ≥ 0", "damping", damping)?;
+    let mut out = *scales;
+    for i in 0..N {
+        let (d, b) = (scales[i], damping[i]);
+        let beta = b * ts / d;
+        if beta > 0.0 {
+            // −expm1(−β) = 1 − e^(−β), accurate for small β.
+            out[i] = b * ts / -libm::expm1(-beta);
+        }
+    }
+    check::finite_slice("inertia scale", out.as_slice())?;
+    Ok(out)
+}
+
 /// An upper bound on the largest eigenvalue of a symmetric positive definite
 /// `m`, within 1 % of it: λmax ≤ (tr m^(2^k))^(2^−k) ≤ N^(2^−k) λmax, k = 8
 /// (repeated squaring, each power scaled to unit trace).
@@ -582,6 +619,39 @@ mod tests {
         assert!(e.to_string().contains("symmetric"), "{e}");
         let e = inertia_scales(&-arm_matrix()).unwrap_err();
         assert!(e.to_string().contains("positive definite"), "{e}");
+    }
+
+    #[test]
+    fn a_damped_joint_scale_answers_a_held_torque_as_the_joint_does() {
+        let ts = 1e-3;
+        let d = Vector::<3>::new(2.0, 1e-2, 1e-6);
+        // No damping: the scales as they are, bit for bit.
+        let same = damped_scales(&d, &Vector::<3>::zeros(), ts).unwrap();
+        assert_eq!(same, d);
+        let b = Vector::<3>::new(0.0, 0.1, 0.01);
+        let s = damped_scales(&d, &b, ts).unwrap();
+        assert_eq!(s[0], d[0]);
+        // Small β = b Ts/d = 0.01: d (1 + β/2 + β²/12 + …).
+        let beta = 0.1 * ts / 1e-2;
+        assert!((s[1] / d[1] - (1.0 + beta / 2.0 + beta * beta / 12.0)).abs() < 1e-9);
+        // A wrist its damping dominates (β = 10): b Ts/(1 − e^(−10)).
+        assert!((s[2] - 0.01 * ts / (1.0 - (-10.0f64).exp())).abs() < 1e-18);
+        // A held torque τ over Ts moves the damped joint's velocity by
+        // (1 − e^(−β)) τ/b, the scale's joint by Ts τ/d̃: the same.
+        for i in 1..3 {
+            let beta = b[i] * ts / d[i];
+            let damped = (1.0 - (-beta).exp()) / b[i];
+            assert!((ts / s[i] - damped).abs() < 1e-9 * damped);
+        }
+        for (bad, what) in [
+            (Vector::<3>::new(0.0, -0.1, 0.0), "damping"),
+            (Vector::<3>::new(0.0, f64::NAN, 0.0), "damping"),
+        ] {
+            let e = damped_scales(&d, &bad, ts).unwrap_err().to_string();
+            assert!(e.contains(what), "{e}");
+        }
+        assert!(damped_scales(&Vector::<3>::new(1.0, 0.0, 1.0), &b, ts).is_err());
+        assert!(damped_scales(&d, &b, 0.0).is_err());
     }
 
     #[test]

@@ -4,9 +4,10 @@
 //! only (the loop runs with it released). The protocol is
 //! `adaptimp.mujoco.ControllerLike`:
 //!
-//! - `step(q, tau_e, dq, **setpoint)`, or with `wants_wrench`
-//!   `step(q, dq, wrench, **setpoint)`, the measurement as the core's loop
-//!   gives it (SPEC §17's disturbances and faults included), `setpoint` the
+//! - `step(m, **setpoint)`, `m` an `adaptimp.Measurement` (q, q̇, τe and the
+//!   wrench F_e, as the core's loop measures them, SPEC §17's disturbances
+//!   and faults included; a joint controller reads τe, a task-space one
+//!   F_e), or one of the deprecated shapes [`CallShape`] names, `setpoint` the
 //!   keywords `xc`, `dxc`, `ddxc` of the row when the run has a reference;
 //!   it returns the torque (n values, or one for every joint);
 //! - the attributes the run reads when the controller has them (Python
@@ -31,10 +32,11 @@ use super::cartesian_loop::reads_the_wrench;
 use super::dynamic::{
     drive_mujoco, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError, TaskMetrics,
 };
+use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
 use crate::control::config::Law;
 use crate::control::impedance::TargetImpedance;
-use crate::control::io::{Command, Control, Measurement};
+use crate::control::io::{Command, Measurement, WrenchControl};
 use crate::error::Error;
 use crate::sim::record::{Recorder, Row};
 use crate::trajectory::{Setpoint, Trajectory};
@@ -115,13 +117,39 @@ pub struct CallbackRun<'a> {
     pub table: [&'a [f64]; 3],
     /// Pass the table's row to the step as `xc=`, `dxc=`, `ddxc=`.
     pub setpoint: bool,
-    /// Call `step(q, dq, wrench)` (a task-space controller) instead of
-    /// `step(q, tau_e, dq)`.
-    pub wants_wrench: bool,
+    /// A task-space controller: it reads the wrench (the plant must
+    /// measure it), and its reference is m = 3 wide.
+    pub task_space: bool,
+    /// How its step is called.
+    pub shape: CallShape,
     /// The attributes read.
     pub attrs: Attrs,
     /// The target impedance Dd, Cd, Gd (n values each) of the metrics.
     pub target: [&'a [f64]; 3],
+}
+
+/// How a Python controller's step is called.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CallShape {
+    /// `step(m, **setpoint)` with an `adaptimp.Measurement`: the protocol.
+    Measurement,
+    /// `step(q, tau_e, dq, **setpoint)`: deprecated (the caller warned).
+    Joint,
+    /// `step(q, dq, wrench, **setpoint)`: deprecated (the caller warned).
+    Wrench,
+}
+
+impl CallShape {
+    fn from_name(name: &str) -> PyResult<Self> {
+        match name {
+            "measurement" => Ok(Self::Measurement),
+            "joint" => Ok(Self::Joint),
+            "wrench" => Ok(Self::Wrench),
+            _ => Err(PyValueError::new_err(format!(
+                "call must be 'measurement', 'joint' or 'wrench', got {name:?}"
+            ))),
+        }
+    }
 }
 
 /// What the controller told about the row it stepped last.
@@ -298,8 +326,8 @@ enum Called {
 }
 
 impl<const N: usize> PyStep<'_, N> {
-    /// The step's arguments: (q, tau_e, dq) or (q, dq, wrench), and the
-    /// row's setpoint as keywords.
+    /// The step's arguments: a measurement (or the deprecated (q, tau_e, dq)
+    /// or (q, dq, wrench)), and the row's setpoint as keywords.
     fn arguments<'py>(
         &self,
         py: Python<'py>,
@@ -307,14 +335,27 @@ impl<const N: usize> PyStep<'_, N> {
         m: &Measurement<N>,
         wrench: &[f64; 6],
     ) -> PyResult<(Bound<'py, PyTuple>, Option<Bound<'py, PyDict>>)> {
-        let q = PyArray1::from_slice(py, m.x.as_slice());
-        let dq = m.dx.unwrap_or(m.x.map(|_| f64::NAN));
-        let dq = PyArray1::from_slice(py, dq.as_slice());
-        let args = if self.run.wants_wrench {
-            PyTuple::new(py, [q, dq, PyArray1::from_slice(py, wrench)])?
-        } else {
-            let tau_e = PyArray1::from_slice(py, m.tau_e.as_slice());
-            PyTuple::new(py, [q, tau_e, dq])?
+        let args = match self.run.shape {
+            CallShape::Measurement => {
+                let meas = PyMeasurement::of(
+                    m.x.as_slice(),
+                    m.dx.as_ref().map(|d| d.as_slice()),
+                    Some(m.tau_e.as_slice()),
+                    Some(wrench),
+                );
+                PyTuple::new(py, [Bound::new(py, meas)?.into_any()])?
+            }
+            shape => {
+                let q = PyArray1::from_slice(py, m.x.as_slice());
+                let dq = m.dx.unwrap_or(m.x.map(|_| f64::NAN));
+                let dq = PyArray1::from_slice(py, dq.as_slice());
+                if shape == CallShape::Wrench {
+                    PyTuple::new(py, [q, dq, PyArray1::from_slice(py, wrench)])?
+                } else {
+                    let tau_e = PyArray1::from_slice(py, m.tau_e.as_slice());
+                    PyTuple::new(py, [q, tau_e, dq])?
+                }
+            }
         };
         if !self.run.setpoint {
             return Ok((args, None));
@@ -407,22 +448,12 @@ impl<const N: usize> PyStep<'_, N> {
     }
 }
 
-impl<const N: usize> Control<N> for PyStep<'_, N> {
+impl<const N: usize> WrenchControl<N> for PyStep<'_, N> {
     fn period(&self) -> f64 {
         self.run.ts
     }
     fn target(&self) -> &TargetImpedance<N> {
         &self.target
-    }
-    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
-        self.step_with_wrench(m, &[0.0; 6], c).1
-    }
-    fn step_or_fallback(
-        &mut self,
-        m: &Measurement<N>,
-        c: &Setpoint<N>,
-    ) -> (Vector<N>, Result<Command<N>, Error>) {
-        self.step_with_wrench(m, &[0.0; 6], c)
     }
     /// The Python step; on a refusal zero torque (the trait's fallback).
     fn step_with_wrench(
@@ -578,7 +609,7 @@ fn prepare<const N: usize, const M: usize>(
     if run.table.iter().any(|t| t.len() < need) {
         return Err(invalid("table", "needs one row per step"));
     }
-    if run.wants_wrench {
+    if run.task_space {
         reads_the_wrench::<N>(Law::Pd, run.items, run.fault)?;
     }
     let every = run.every.max(1);
@@ -590,7 +621,7 @@ fn prepare<const N: usize, const M: usize>(
         v.try_reserve_exact(room)
             .map_err(|_| RunError::Memory(kept))?;
     }
-    let joint_space = !run.wants_wrench && w == N;
+    let joint_space = !run.task_space && w == N;
     let (metrics, target) = metrics_and_target::<N, M>(run, joint_space)?;
     Ok(Prepared {
         joint,
@@ -714,14 +745,16 @@ pub fn simulate(
 /// for the controller's step (and its attributes `attrs`: "tau", "xc",
 /// "rates" (its `dxc` and `ddxc`), "xd", "z1", "dq_hat", "zeta"). `table`
 /// = (xc, dxc, ddxc), (K, m) each with K ≥ the steps: passed to the step as
-/// keywords with `setpoint`, else the rows' rates. `wants_wrench`: the step
-/// is `step(q, dq, wrench)`, the reference m = 3 wide. `target` = (Dd, Cd,
+/// keywords with `setpoint`, else the rows' rates. `task_space`: the
+/// controller reads the wrench, its reference m = 3 wide. `call`: how its
+/// step is called, "measurement" (`step(m, **setpoint)`), or the deprecated
+/// "joint" (`step(q, tau_e, dq, …)`) and "wrench" (`step(q, dq, wrench, …)`). `target` = (Dd, Cd,
 /// Gd), n values each, for the impedance metric. `params` (the disturbances
 /// of SPEC §17), `settle`, `record_every`, `progress`, `fault` as for
 /// `simulate_mujoco`. Returns its dict, with "xc", "dxc", "ddxc", "xd", "z1"
 /// (K, m). An exception of the controller ends the run and is raised.
 #[pyfunction]
-#[pyo3(signature = (controller, model, data, spec, params, ts, t_final, settle, table, *, setpoint, wants_wrench, attrs, target, record_every=1, progress=None, fault=None))]
+#[pyo3(signature = (controller, model, data, spec, params, ts, t_final, settle, table, *, setpoint, task_space, call, attrs, target, record_every=1, progress=None, fault=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_mujoco_callback<'py>(
     py: Python<'py>,
@@ -739,7 +772,8 @@ pub fn simulate_mujoco_callback<'py>(
         PyReadonlyArray2<'py, f64>,
     ),
     setpoint: bool,
-    wants_wrench: bool,
+    task_space: bool,
+    call: &str,
     attrs: Vec<String>,
     target: (Vec<f64>, Vec<f64>, Vec<f64>),
     record_every: u64,
@@ -770,7 +804,8 @@ pub fn simulate_mujoco_callback<'py>(
         m,
         table: [&tab[0], &tab[1], &tab[2]],
         setpoint,
-        wants_wrench,
+        task_space,
+        shape: CallShape::from_name(call)?,
         attrs,
         target: [&target.0, &target.1, &target.2],
     };

@@ -14,8 +14,12 @@ use super::cartesian_loop::{
 use super::computed::{Computed, DynComputed, PyComputedTorque};
 use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JOINTS};
 use super::frames::{joint, transform};
+use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
-use super::{array, array1, config_error, items, python_shape, vector, ConfigError, PyController};
+use super::{
+    array, array1, config_error, items, python_shape, shape_error, vector, ConfigError,
+    PyController,
+};
 use super::{DivergedError, MeasurementError};
 use crate::cartesian::chain::MAX_CHAIN_JOINTS;
 use crate::cartesian::{
@@ -1341,7 +1345,8 @@ impl PyCartesian {
         let n = self.n;
         let q = vector("q", n, q)?;
         let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
-        let m = self.measurement(&q, dq.as_ref(), wrench_of(wrench)?, target_of(target)?);
+        let f_e = wrench_of(wrench)?;
+        let m = self.measurement(&q, dq.as_ref(), f_e, target_of(target)?);
         let mut joint = lock_joint(py, controller, n)?;
         let mut g = self.lock(py);
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
@@ -1349,7 +1354,8 @@ impl PyCartesian {
     }
 
     /// One step of `CartesianController.step` with the core's joint
-    /// `controller`, in one call: q (rad), dq (rad/s), each (n,), the wrench
+    /// `controller`, in one call: an `adaptimp.Measurement` as `q` (dq and
+    /// wrench None), or q (rad), dq (rad/s), each (n,), the wrench
     /// F_e = [f; m] (N, N m; (6,), f (3,) alone, or None: no contact), the
     /// commanded pose `sample`: None (hold the last target), the tuple (p,
     /// ṗ, p̈) or (p, ṗ, p̈, R, ω, ω̇) a path returns (m, m/s, m/s², (3, 3),
@@ -1372,14 +1378,31 @@ impl PyCartesian {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
         let mut qb = [0.0; MAX_JOINTS];
-        super::vector_into("q", n, q, &mut qb)?;
         let mut dqb = [0.0; MAX_JOINTS];
-        if let Some(d) = dq {
-            super::vector_into("dq", n, d, &mut dqb)?;
-        }
-        let f = match wrench {
-            None => [0.0; 6],
-            Some(w) => wrench_sample(w)?,
+        let (measured_dq, f) = if let Ok(m) = q.cast::<PyMeasurement>() {
+            // An adaptimp.Measurement: read as it is, no array made.
+            let m = m.get();
+            if dq.is_some() || wrench.is_some() {
+                return Err(PyTypeError::new_err(
+                    "give the measurement as an adaptimp.Measurement or as arrays, not both",
+                ));
+            }
+            if m.n != n {
+                return Err(shape_error("q", n, &format!("length {}", m.n)));
+            }
+            qb = m.q;
+            dqb = m.dq.unwrap_or(dqb);
+            (m.dq.is_some(), m.wrench.unwrap_or([0.0; 6]))
+        } else {
+            super::vector_into("q", n, q, &mut qb)?;
+            if let Some(d) = dq {
+                super::vector_into("dq", n, d, &mut dqb)?;
+            }
+            let f = match wrench {
+                None => [0.0; 6],
+                Some(w) => wrench_sample(w)?,
+            };
+            (dq.is_some(), f)
         };
         let mut joint = lock_joint(py, controller, n)?;
         let mut g = self.lock(py);
@@ -1390,7 +1413,7 @@ impl PyCartesian {
             None => None,
             Some(s) => Some(sample_target(s, &mut held)?),
         };
-        let m = self.measurement(&qb, dq.map(|_| &dqb), f, target);
+        let m = self.measurement(&qb, measured_dq.then_some(&dqb), f, target);
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
         g.set_held(held);
         if record {
@@ -1419,10 +1442,13 @@ impl PyCartesian {
     }
 
     /// One Cartesian step with a joint controller written in Python:
-    /// `inner.step(q, tau_e, dq, xc=q_d, dxc=q̇_d, ddxc=q̈_d)` is called with
-    /// the core's joint reference and τe, and the outer state is committed
-    /// only if it returns. Returns its torque (N m), (n,).
-    #[pyo3(signature = (inner, q, dq, wrench, target=None))]
+    /// `inner.step(m, xc=q_d, dxc=q̇_d, ddxc=q̈_d)` is called with the
+    /// measurement (q, q̇, τe = Jᵀ F_e, the wrench) and the core's joint
+    /// reference (`measurement=False`: the deprecated `inner.step(q, tau_e,
+    /// dq, …)`), and the outer state is committed only if it returns.
+    /// Returns its torque (N m), (n,).
+    #[pyo3(signature = (inner, q, dq, wrench, target=None, *, measurement=true))]
+    #[allow(clippy::too_many_arguments)]
     fn step_python<'py>(
         &self,
         py: Python<'py>,
@@ -1431,11 +1457,13 @@ impl PyCartesian {
         dq: Option<&Bound<'py, PyAny>>,
         wrench: &Bound<'py, PyAny>,
         target: Option<&Bound<'py, PyAny>>,
+        measurement: bool,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
         let q = vector("q", n, q)?;
         let dq = dq.map(|d| vector("dq", n, d)).transpose()?;
-        let m = self.measurement(&q, dq.as_ref(), wrench_of(wrench)?, target_of(target)?);
+        let f_e = wrench_of(wrench)?;
+        let m = self.measurement(&q, dq.as_ref(), f_e, target_of(target)?);
         let mut raised: Option<PyErr> = None;
         let mut g = self.lock(py);
         let mut call = |q: &[f64],
@@ -1456,9 +1484,13 @@ impl PyCartesian {
                     let j = numpy::PyArray1::from_slice(py, jt).reshape([6, torque.len()])?;
                     kw.set_item("jacobian", j)?;
                 }
-                let dq = dq.map(|d| array1(py, d));
-                let tau =
-                    inner.call_method("step", (array1(py, q), array1(py, tau_e), dq), Some(&kw))?;
+                let tau = if measurement {
+                    let meas = PyMeasurement::of(q, dq, Some(tau_e), Some(&f_e));
+                    inner.call_method("step", (Bound::new(py, meas)?,), Some(&kw))?
+                } else {
+                    let dq = dq.map(|d| array1(py, d));
+                    inner.call_method("step", (array1(py, q), array1(py, tau_e), dq), Some(&kw))?
+                };
                 let v = flat("the joint controller's torque", out.len(), &tau)?;
                 Ok(v)
             })();

@@ -32,7 +32,7 @@ use crate::cartesian::{
 use crate::control::config::Law;
 use crate::control::impedance::TargetImpedance;
 use crate::control::io::TaskTorque;
-use crate::control::io::{Command, Control, Measurement};
+use crate::control::io::{Command, Measurement, WrenchControl};
 use crate::error::Error;
 use crate::sim::record::{Recorder, Row};
 use crate::trajectory::{Setpoint, Trajectory};
@@ -374,23 +374,12 @@ impl<const N: usize, J: JointStep<N> + ?Sized> Cartesian<'_, N, J> {
     }
 }
 
-impl<const N: usize, J: JointStep<N> + ?Sized> Control<N> for Cartesian<'_, N, J> {
+impl<const N: usize, J: JointStep<N> + ?Sized> WrenchControl<N> for Cartesian<'_, N, J> {
     fn period(&self) -> f64 {
         self.outer.period()
     }
     fn target(&self) -> &TargetImpedance<N> {
         self.joint.impedance()
-    }
-    /// The Cartesian step with no wrench measured.
-    fn step(&mut self, m: &Measurement<N>, _c: &Setpoint<N>) -> Result<Command<N>, Error> {
-        self.step_cartesian(m, &[0.0; 6])
-    }
-    fn step_or_fallback(
-        &mut self,
-        m: &Measurement<N>,
-        c: &Setpoint<N>,
-    ) -> (Vector<N>, Result<Command<N>, Error>) {
-        self.step_with_wrench(m, &[0.0; 6], c)
     }
     /// The Cartesian step; on an error (of the outer loop or of the joint
     /// step, recorded in the joint controller: [`cartesian_step`]) its

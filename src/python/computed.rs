@@ -11,6 +11,7 @@ use super::dynamic::{
     MAX_JOINTS,
 };
 use super::frames::{joint, transform};
+use super::measurement::JointCall;
 use super::mujoco::{MujocoSpec, Table};
 use super::{array, array1, vector, vector_into, ConfigError, MeasurementError};
 use crate::cartesian::chain::JointKind;
@@ -29,7 +30,7 @@ use core::cell::Cell;
 use numpy::PyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 use std::any::Any;
 use std::sync::{Mutex, MutexGuard};
 use std::vec::Vec;
@@ -648,34 +649,39 @@ impl PyComputedTorque {
         self.lock(py).reset();
     }
 
-    /// One step (SPEC (20.3)): q (rad), tau_e (N m), dq (rad/s, required),
-    /// the setpoint xc (rad, required), dxc (rad/s), ddxc (rad/s²) (default
-    /// 0), each (n,). Returns sat(τ) (N m), (n,). Shapes and types are
-    /// checked here; the values are the core's to judge (a non-finite or
-    /// out-of-range one is a refused step that records its fault).
-    #[pyo3(signature = (q, tau_e, dq=None, xc=None, dxc=None, ddxc=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// One step (SPEC (20.3)) from the measurement `m`
+    /// (`adaptimp.Measurement`: q (rad), dq (rad/s, required), tau_e (N m;
+    /// none: zeros)) and the setpoint xc (rad), dxc (rad/s), ddxc (rad/s²)
+    /// (default 0), each (n,), or none (the trajectory's). Returns sat(τ)
+    /// (N m), (n,). Shapes and types are checked here; the values are the
+    /// core's to judge (a non-finite or out-of-range one is a refused step
+    /// that records its fault). The old call `step(q, tau_e, dq, …)` works,
+    /// with a `DeprecationWarning`.
+    #[pyo3(signature = (*args, **kwargs))]
     fn step<'py>(
         &self,
         py: Python<'py>,
-        q: &Bound<'py, PyAny>,
-        tau_e: &Bound<'py, PyAny>,
-        dq: Option<&Bound<'py, PyAny>>,
-        xc: Option<&Bound<'py, PyAny>>,
-        dxc: Option<&Bound<'py, PyAny>>,
-        ddxc: Option<&Bound<'py, PyAny>>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
-        let Some(dq) = dq else {
+        let call = JointCall::parse("ComputedTorque.step", args, kwargs)?;
+        let [xc, dxc, ddxc] = &call.setpoint;
+        let given = call.inputs(n)?;
+        let Some(dq) = given.dq else {
             return Err(MeasurementError::new_err(
                 "ComputedTorque needs the measured joint velocity dq",
             ));
         };
         // q, tau_e, dq, xc, dxc, ddxc: straight into their buffers.
-        let mut b = [[0.0; MAX_JOINTS]; 6];
-        vector_into("q", n, q, &mut b[0])?;
-        vector_into("tau_e", n, tau_e, &mut b[1])?;
-        vector_into("dq", n, dq, &mut b[2])?;
+        let mut b = [
+            given.q,
+            given.tau_e,
+            dq,
+            [0.0; MAX_JOINTS],
+            [0.0; MAX_JOINTS],
+            [0.0; MAX_JOINTS],
+        ];
         match xc {
             Some(xc) => {
                 vector_into("xc", n, xc, &mut b[3])?;

@@ -2,6 +2,7 @@
 
 use super::dynamic;
 use super::dynamic::{CentersSpec, DynTracker, Inputs, Last, Tables, MAX_JOINTS};
+use super::measurement::JointCall;
 use super::{arrays::*, errors::*, hooks::*, params::*};
 use crate::control::config::Law;
 use crate::schema::Preset;
@@ -10,7 +11,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 use std::sync::{Mutex, MutexGuard};
 
 /// A step's arguments, converted: n values each in fixed buffers.
@@ -76,30 +77,30 @@ impl PyController {
 
     /// A step's arguments, converted into `given` (shapes and types checked;
     /// any values). In place: the buffers are not moved about per call.
-    pub(super) fn convert(
-        &self,
-        q: &Bound<'_, PyAny>,
-        tau_e: &Bound<'_, PyAny>,
-        dq: Option<&Bound<'_, PyAny>>,
-        setpoint: [Option<&Bound<'_, PyAny>>; 3],
-        given: &mut Given,
-    ) -> PyResult<()> {
+    pub(super) fn convert(&self, call: &JointCall<'_>, given: &mut Given) -> PyResult<()> {
         let n = self.n;
-        vector_into("q", n, q, &mut given.x)?;
-        vector_into("tau_e", n, tau_e, &mut given.tau_e)?;
-        given.dx = match (self.law, dq) {
-            (Law::OutputFeedback, _) | (_, None) => None,
-            (_, Some(dq)) => Some(vector_any("dq", n, dq)?),
+        let m = call.inputs(n)?;
+        given.x = m.q;
+        given.tau_e = m.tau_e;
+        given.dx = match self.law {
+            Law::OutputFeedback => None,
+            _ => m.dq,
         };
-        given.setpoint = match setpoint {
+        given.setpoint = match &call.setpoint {
             [None, None, None] => None,
             [Some(x), dx, ddx] => {
                 let zero = [0.0; MAX_JOINTS];
                 let conv = |what, o| vector_any(what, n, o);
                 Some([
                     conv("xc", x)?,
-                    dx.map(|d| conv("dxc", d)).transpose()?.unwrap_or(zero),
-                    ddx.map(|d| conv("ddxc", d)).transpose()?.unwrap_or(zero),
+                    dx.as_ref()
+                        .map(|d| conv("dxc", d))
+                        .transpose()?
+                        .unwrap_or(zero),
+                    ddx.as_ref()
+                        .map(|d| conv("ddxc", d))
+                        .transpose()?
+                        .unwrap_or(zero),
                 ])
             }
             [None, ..] => {
@@ -155,31 +156,30 @@ impl PyController {
         Ok(Self::wrap(inner))
     }
 
-    /// One controller step at t_k = k·Ts: joint positions `q` (rad), the
-    /// measured force on the environment `tau_e` (N m) and, for "pd" and
-    /// "sf", joint velocities `dq` (rad/s; ignored by "of"); with `xc` (and
+    /// One controller step at t_k = k·Ts from the measurement `m`
+    /// (`adaptimp.Measurement`): joint positions q (rad), the measured force
+    /// on the environment τe (N m; none: zeros) and, for "pd" and "sf",
+    /// joint velocities q̇ (rad/s; ignored by "of"); with `xc` (and
     /// optionally `dxc`, `ddxc`, zero if not given) the controller tracks
     /// that setpoint instead of its trajectory. Returns sat(τ) (N m), (n,).
+    /// The old call `step(q, tau_e, dq)` still works, with a
+    /// `DeprecationWarning`.
     /// A refused step raises, and records the refusal as `step_or_fallback`
     /// does (the fault, the fallback as the torque applied, the measured
     /// position): the fault semantics of docs/reliability.md.
-    #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (*args, **kwargs))]
     fn step<'py>(
         &self,
         py: Python<'py>,
-        q: &Bound<'py, PyAny>,
-        tau_e: &Bound<'py, PyAny>,
-        dq: Option<&Bound<'py, PyAny>>,
-        xc: Option<&Bound<'py, PyAny>>,
-        dxc: Option<&Bound<'py, PyAny>>,
-        ddxc: Option<&Bound<'py, PyAny>>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let n = self.n;
         // Values are the core's to judge (a non-finite one is a refused step
         // that records its fault); shapes and types are checked here.
         let mut given = Given::EMPTY;
-        self.convert(q, tau_e, dq, [xc, dxc, ddxc], &mut given)
+        let call = JointCall::parse("Controller.step", args, kwargs)?;
+        self.convert(&call, &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         self.lock(py)
@@ -193,23 +193,19 @@ impl PyController {
     /// after a refusal the torque is the configured fallback, and the next
     /// step's rate limit starts from it. Shapes and types are still checked
     /// (a wrong one raises, and is recorded as a refused step).
-    #[pyo3(signature = (q, tau_e, dq=None, *, xc=None, dxc=None, ddxc=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (*args, **kwargs))]
     fn step_or_fallback<'py>(
         &self,
         py: Python<'py>,
-        q: &Bound<'py, PyAny>,
-        tau_e: &Bound<'py, PyAny>,
-        dq: Option<&Bound<'py, PyAny>>,
-        xc: Option<&Bound<'py, PyAny>>,
-        dxc: Option<&Bound<'py, PyAny>>,
-        ddxc: Option<&Bound<'py, PyAny>>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Option<String>)> {
         let n = self.n;
         // Shapes and types are checked (a refusal, recorded, then raised);
         // values are the controller's to judge.
         let mut given = Given::EMPTY;
-        self.convert(q, tau_e, dq, [xc, dxc, ddxc], &mut given)
+        let call = JointCall::parse("Controller.step_or_fallback", args, kwargs)?;
+        self.convert(&call, &mut given)
             .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
         let mut out = [0.0; MAX_JOINTS];
         let result = self

@@ -45,6 +45,7 @@ mod errors;
 mod export;
 mod frames;
 mod hooks;
+mod measurement;
 mod models;
 mod mujoco;
 mod params;
@@ -85,6 +86,8 @@ mod adaptimp_module {
     use super::computed::PyComputedTorque;
     #[pymodule_export]
     use super::description::{arm_from_mujoco, description_kind, read_arm};
+    #[pymodule_export]
+    use super::measurement::PyMeasurement;
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -5,7 +5,9 @@ use super::cartesian::{PyChain, TypedChain};
 use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
 use crate::cartesian::rule::{resolving, PoseCircle, PostureRule};
-use crate::control::tuning::{default_task as core_default_task, inertia_scales_along, Rule};
+use crate::control::tuning::{
+    damped_scales, default_task as core_default_task, inertia_scales_along, Rule,
+};
 use crate::error::Error;
 use crate::schema::{Group, Preset, Scenario, PARAMS};
 use crate::trajectory::Setpoint;
@@ -31,9 +33,11 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// torque `gravity` (n,; N m) at its start, if known. `resolve`: the tube
 /// narrowed to the path's own size, SPEC (16.10) (the Cartesian rule's).
 /// `critical`: Ĝ learns at the velocity loop's critical bandwidth, SPEC
-/// (19.6) (the table scenario's).
+/// (19.6) (the table scenario's). `damping` (n,; N m s/rad): the joints'
+/// viscous damping, if the plant has it: the scales as the sampled velocity
+/// loop sees them, SPEC (18.9).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -46,6 +50,7 @@ pub fn suggest<'py>(
     gravity: Option<PyReadonlyArray1<'py, f64>>,
     resolve: bool,
     critical: bool,
+    damping: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -72,6 +77,11 @@ pub fn suggest<'py>(
         Some(g) if g.shape() == [n] => Some(g.as_array().iter().copied().collect()),
         Some(g) => return Err(shape_error("gravity", format!("({n},)"), g.shape())),
     };
+    let damping: Option<Vec<f64>> = match damping {
+        None => None,
+        Some(b) if b.shape() == [n] => Some(b.as_array().iter().copied().collect()),
+        Some(b) => return Err(shape_error("damping", format!("({n},)"), b.shape())),
+    };
     let path: Option<(Vec<f64>, f64)> = match (path, period) {
         (None, _) => None,
         (Some(p), Some(period)) => {
@@ -96,6 +106,7 @@ pub fn suggest<'py>(
             ts,
             path.as_ref(),
             gravity.as_deref(),
+            damping.as_deref(),
             (resolve, critical),
         ),
         _ => unreachable!("n checked above"),
@@ -113,6 +124,7 @@ fn fill<'py, const N: usize>(
     ts: f64,
     path: Option<&(Vec<f64>, f64)>,
     gravity: Option<&[f64]>,
+    damping: Option<&[f64]>,
     (resolve, critical): (bool, bool),
 ) -> PyResult<()> {
     let err = |e: Error| config_error(e.into());
@@ -132,6 +144,10 @@ fn fill<'py, const N: usize>(
         crate::control::tuning::inertia_scales(&ds[0])
     }
     .map_err(err)?;
+    let scales = match damping {
+        None => scales,
+        Some(b) => damped_scales(&scales, &Vector::<N>::from_column_slice(b), ts).map_err(err)?,
+    };
     let tau = Vector::<N>::from_column_slice(tau);
     let mut s = Scenario::<N>::preset(Preset::Robot, law);
     let centers = match path {

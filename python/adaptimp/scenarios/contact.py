@@ -34,8 +34,10 @@ from ..chain import Chain
 from .panda_table import PandaTable, table_metrics
 
 __all__ = [
+    "ADMITTANCE_SHARE_OF_PERIOD",
     "AXIS_SHARE",
     "CLEARANCE",
+    "CONTACT_IMPEDANCE",
     "CONTACT_K1",
     "MAX_PATH_STEPS",
     "MIN_REACH_SHARE",
@@ -50,7 +52,9 @@ __all__ = [
     "T_PRESS",
     "arm_model",
     "arm_table",
+    "contact_impedance",
     "contact_metrics",
+    "normal_inertia",
     "placement",
     "placements",
     "refusal_of",
@@ -124,6 +128,11 @@ SLIP_SHARE = 0.5
 may reach while the tool slides (SPEC (19.5)): the friction rows' time constant
 is set so that μ D_t B_t v ≤ SLIP_SHARE · F_n."""
 
+CONTACT_IMPEDANCE = 0.95
+"""The largest impedance d (``solimp``'s d0 and d_max) of the tool–table pair:
+MuJoCo's default d_max; :func:`contact_impedance` lowers it for a heavy tool
+(SPEC (19.9))."""
+
 TABLE_TIMECONST = 0.01
 """Time constant (s) of the tool–table contact's normal row (``solref``, damping
 ratio 1; MuJoCo's default is 0.02 s): a rigid table whose own compliance is
@@ -133,6 +142,11 @@ on the 5 kN/m table; at 0.01 s, 4 times stiffer, 0.7 %), within MuJoCo's
 stability advice (time constant ≥ 2 timesteps) for steps up to 5 ms. The
 friction rows are never made stiffer than this."""
 
+
+ADMITTANCE_SHARE_OF_PERIOD = 0.25
+"""m of SPEC (18.1), for (19.8): the admittance's mode on the table's stiffness,
+√(k_e/M_d), takes at most this share of a period (Ts √(k_e/M_d) ≤ m), as the
+joint rule's sampled velocity loop takes m of its error per period."""
 
 _NOMINAL_KD = 500.0
 """K_d,z (N/m) of SPEC §16's default impedance: the scenario's prescribed force is
@@ -173,6 +187,43 @@ def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float
     return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
 
 
+def contact_impedance(model: Any, *, force: float, accel: float, friction: float) -> float:
+    """The impedance d (MuJoCo's ``solimp`` d0 and d_max) of the tool–table
+    pair under which the tool, driven along the circle with the acceleration
+    ``accel`` (m/s², v²/r) while it presses with ``force`` (N) at sliding
+    friction ``friction``, stays on the table (SPEC (19.9)): MuJoCo's cone hands
+    the tangential acceleration its friction rows do not meet to the normal
+    row as about μ D a, D = d/((1 − d) A) (A as in :func:`sliding_timeconst`);
+    d = x/(1 + x), x = :data:`SLIP_SHARE` · F A/(μ a), keeps it at
+    :data:`SLIP_SHARE` of the press, and never above :data:`CONTACT_IMPEDANCE`
+    (MuJoCo's own 0.95, which every arm lighter than A < 19 μ a/(s F) keeps).
+    ``friction``, ``accel`` or ``force`` zero: :data:`CONTACT_IMPEDANCE`."""
+    tool, table = _tool_table(model)
+    if tool < 0 or table < 0:
+        raise ValueError("the model has no geoms 'tool' and 'table'")
+    if friction <= 0 or accel <= 0 or force <= 0:
+        return CONTACT_IMPEDANCE
+    inv_mass = float(
+        model.body_invweight0[model.geom_bodyid[tool], 0]
+        + model.body_invweight0[model.geom_bodyid[table], 0]
+    )
+    x = SLIP_SHARE * force * inv_mass / (friction * accel)
+    return min(CONTACT_IMPEDANCE, x / (1.0 + x))
+
+
+def _set_pair_contact(
+    model: Any, *, force: float, speed: float, accel: float, friction: float
+) -> None:
+    """The tool–table pair's friction time constant (19.5) and impedance (19.9)."""
+    model.pair_solreffriction[0] = [
+        sliding_timeconst(model, force=force, speed=speed, friction=friction),
+        1.0,
+    ]
+    d = contact_impedance(model, force=force, accel=accel, friction=friction)
+    model.pair_solimp[0, 0] = min(float(model.pair_solimp[0, 0]), d)
+    model.pair_solimp[0, 1] = min(float(model.pair_solimp[0, 1]), d)
+
+
 def _tool_table(model: Any) -> tuple[int, int]:
     """The ids of the tool's sphere and the table's box (-1: none): the pair
     ``tool_table``'s geoms, else the last geoms named ``tool``… and ``table``…
@@ -202,6 +253,7 @@ def _tool_and_table(
     centre: ArrayLike,
     friction: float,
     spring: float | None,
+    facing: bool = False,
 ) -> str | None:
     """The tool on a massless body of its own at the origin of body ``tip``
     and the table (the shared builder, ``adaptimp._tooling``) with this
@@ -209,8 +261,10 @@ def _tool_and_table(
     constant :data:`TABLE_TIMECONST`, the table of :data:`TABLE_MASS` on a
     spring of ``spring`` N/m or static; MuJoCo's elliptic cone and, with
     friction, the tool–table pair whose friction rows get their own time
-    constant (:func:`sliding_timeconst`). Returns the table's body (None:
-    no table)."""
+    constant (:func:`sliding_timeconst`). ``facing``: the table turned to face
+    the base's vertical axis, its short side (0.7 m) along the direction from
+    the axis to ``centre`` (else on the world's axes). Returns the table's body
+    (None: no table)."""
     import mujoco
 
     from .._tooling import add_table, add_tool
@@ -224,6 +278,7 @@ def _tool_and_table(
     table, box = add_table(
         spec, top=table_top, centre=(float(c[0]), float(c[1])), friction=rows, solref=solref,
         mass=TABLE_MASS, spring=spring,
+        yaw=math.atan2(float(c[1]), float(c[0])) if facing else 0.0,
     )  # fmt: skip
     # The Coulomb cone itself, not its pyramid: a pyramid's edges mix the
     # normal into every row and scale their regulariser by 2μ² (at μ = 0,
@@ -258,6 +313,8 @@ def arm_model(
     timestep: float = 5e-4,
     force: float = 0.0,
     speed: float = 0.0,
+    facing: bool = False,
+    accel: float = 0.0,
 ) -> Any:
     """A URDF or MJCF arm in MuJoCo with a tool and a table (see the module doc).
 
@@ -277,7 +334,10 @@ def arm_model(
     friction, the tool–table contact is the explicit pair ``tool_table`` whose
     friction rows have the time constant :func:`sliding_timeconst` for a tool
     pressing with ``force`` (N) while it slides at ``speed`` (m/s) (zero:
-    :data:`TABLE_TIMECONST`).
+    :data:`TABLE_TIMECONST`) and, driven along the circle with ``accel`` (m/s²),
+    the impedance :func:`contact_impedance`. ``facing``: the table turned to face the base's
+    vertical axis (:func:`arm_table` turns it for a home whose arm would stand
+    under a table on the world's axes).
     """
     import mujoco
 
@@ -287,7 +347,7 @@ def arm_model(
         return _mjcf_model(
             Path(urdf), tip, fix=fix, tool_radius=tool_radius, table_top=table_top,
             centre=centre, friction=friction, spring=spring, home=home, timestep=timestep,
-            force=force, speed=speed,
+            force=force, speed=speed, facing=facing, accel=accel,
         )  # fmt: skip
     # The arm as adaptimp.mujoco.from_urdf makes it, by the core's one
     # reduction (SPEC §21), with its motors (efforts estimated where the URDF
@@ -301,6 +361,7 @@ def arm_model(
         centre=centre,
         friction=friction,
         spring=spring,
+        facing=facing,
     )
     if home is not None:
         qpos = list(np.asarray(home, dtype=np.float64))
@@ -312,10 +373,7 @@ def arm_model(
     model = amj._compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
-        model.pair_solreffriction[0] = [
-            sliding_timeconst(model, force=force, speed=speed, friction=friction),
-            1.0,
-        ]
+        _set_pair_contact(model, force=force, speed=speed, accel=accel, friction=friction)
     return model
 
 
@@ -333,6 +391,8 @@ def _mjcf_model(
     timestep: float,
     force: float,
     speed: float,
+    facing: bool = False,
+    accel: float = 0.0,
 ) -> Any:
     """:func:`arm_model` for an MJCF file: the model with the tool on body ``tip``
     and the table; keyframe ``home`` at the arm's joints (the others at qpos0)."""
@@ -362,6 +422,7 @@ def _mjcf_model(
         centre=centre,
         friction=friction,
         spring=spring,
+        facing=facing,
     )
     if table is not None:
         # The tool presses on the table, not the arm's own geometry (a URDF arm
@@ -378,10 +439,7 @@ def _mjcf_model(
         model = spec.compile()
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
-        model.pair_solreffriction[0] = [
-            sliding_timeconst(model, force=force, speed=speed, friction=friction),
-            1.0,
-        ]
+        _set_pair_contact(model, force=force, speed=speed, accel=accel, friction=friction)
     return model
 
 
@@ -482,6 +540,10 @@ def _home(urdf: Path, chain: Chain, plant: Any) -> FloatArray:
     return np.zeros(chain.n)
 
 
+THROUGH_TABLE = "the arm clear of the table"
+"""How :func:`refusal_of` begins the refusal of an arm whose joint lies below
+the table top over the table."""
+
 TABLE_OFFSET_MARGIN = 0.2
 """The table (0.7 m deep) is centred 0.15 m beyond the circle's centre: the
 circle and the tool stay on it for radius + tool_radius ≤ 0.35 − 0.15 m."""
@@ -553,6 +615,7 @@ def arm_table(
     t_ramp: float = 1.0,
     t_hold: float = T_HOLD,
     t_press: float = T_PRESS,
+    facing: bool | None = None,
 ) -> PandaTable:
     """The table scenario for the arm of ``urdf`` (None: the Panda of
     :func:`adaptimp.scenarios.panda_table.panda_table`, whose table and circle are kept,
@@ -584,7 +647,11 @@ def arm_table(
     posture; ``spring``: the table's spring stiffness k_e (N/m), None: rigid;
     ``friction``: sliding friction of table and tool. The rest as
     :func:`~adaptimp.scenarios.panda_table.panda_table`. The table and the circle are
-    placed by :func:`placement`.
+    placed by :func:`placement`; ``facing``: the table turned to face the
+    base's vertical axis (its short side along the reach) or on the world's
+    axes (False); None (default): on the world's axes, turned for a ``home``
+    given whose arm would otherwise stand under the table (the posture is the
+    user's; a drawn one, :func:`placements`, is drawn again instead).
     """
     from .. import _models
     from .. import mujoco as amj
@@ -621,7 +688,7 @@ def arm_table(
     speed = 2.0 * math.pi * freq * radius
     if urdf is None:
         # The Panda's scenario has its own tool body, fixed fingers and home.
-        given = {"tip": tip, "fix": fix or None, "home": home}
+        given = {"tip": tip, "fix": fix or None, "home": home, "facing": facing or None}
         ignored = [k for k, v in given.items() if v is not None]
         if ignored:
             raise ConfigError(
@@ -654,6 +721,7 @@ def arm_table(
             home=sc.q0,
             force=sc.target_force(),
             speed=speed,
+            accel=speed**2 / radius,
         )
         sc.t_hold, sc.t_press = float(t_hold), float(t_press)
         sc.__post_init__()
@@ -670,9 +738,10 @@ def arm_table(
     tau_max = np.asarray(bare.tau_max, dtype=np.float64)
     lo, hi = _limits(bare)
 
-    def build(q0: FloatArray) -> PandaTable:
+    def build(q0: FloatArray, facing: bool = False) -> PandaTable:
         """The scenario with its home at ``q0``: the press checked, the table
-        and the circle placed from the arm's reach."""
+        and the circle placed from the arm's reach (``facing``: the table
+        turned to face the base)."""
         outside = np.flatnonzero((q0 < lo - 1e-12) | (q0 > hi + 1e-12))
         if outside.size:
             i = int(outside[0])
@@ -698,6 +767,8 @@ def arm_table(
             home=q0,
             force=_NOMINAL_KD * depth,
             speed=speed,
+            facing=facing,
+            accel=speed**2 / radius,
         )
         return PandaTable(
             model=model,
@@ -718,12 +789,19 @@ def arm_table(
         )
 
     if home is not None:
-        sc = build(_joint_vector("home", home, chain))
+        q_home = _joint_vector("home", home, chain)
+        sc = build(q_home, facing=bool(facing))
         refusal = refusal_of(sc, load=1.0)
+        if facing is None and refusal is not None and refusal.startswith(THROUGH_TABLE):
+            # The posture is the user's: a table on the world's axes that
+            # reaches under the arm's base is the placement's fault, not the
+            # posture's. Turned to face the base it lies beyond the tool.
+            sc = build(q_home, facing=True)
+            refusal = refusal_of(sc, load=1.0)
         if refusal is not None:
             raise ConfigError(f"the home posture cannot run the table: {refusal}")
         return sc
-    return _drawn(build, path, chain, bare, (lo, hi), seed=0)
+    return _drawn(lambda q: build(q, facing=bool(facing)), path, chain, bare, (lo, hi), seed=0)
 
 
 def _urdf_arm(
@@ -875,6 +953,7 @@ def placements(
 
     if "home" in kwargs:
         raise ConfigError("placements draws the home postures: give no home")
+    kwargs.setdefault("facing", False)  # a drawn home is drawn again, not given a turned table
     first = arm_table(urdf, **kwargs)
     limits = _limits(amj.Plant(first.model))
     out: list[PandaTable] = []
@@ -950,13 +1029,15 @@ def _through_table(sc: PandaTable, plant: Any, rows: FloatArray) -> str | None:
         d.qpos[plant._qadr] = q
         mujoco.mj_kinematics(m, d)
         centre, half = d.geom_xpos[g], m.geom_size[g]
+        axes = d.geom_xmat[g].reshape(3, 3)  # the table's axes (turned if it faces the base)
         for i, j in enumerate(plant._joints):
-            a = d.xanchor[j]
-            over = abs(a[0] - centre[0]) <= half[0] and abs(a[1] - centre[1]) <= half[1]
-            if over and a[2] < top:
+            a = axes.T @ (d.xanchor[j] - centre)
+            over = abs(a[0]) <= half[0] and abs(a[1]) <= half[1]
+            if over and d.xanchor[j][2] < top:
                 return (
-                    f"the arm clear of the table: at row {k} of the path joint {i} "
-                    f"({sc.chain.joint_names[i]!r}) is {top - a[2]:.3g} m below the table top"
+                    f"{THROUGH_TABLE}: at row {k} of the path joint {i} "
+                    f"({sc.chain.joint_names[i]!r}) is {top - d.xanchor[j][2]:.3g} m below the "
+                    "table top"
                 )
     return None
 
@@ -1068,9 +1149,55 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
         "gains": {k: kw[k] for k in ("Kp", "Kzeta", "K1")},
         "basis": (kw["centers"], kw["widths"]),
     }
+    md = normal_inertia(sc, q)
+    if md > DEFAULT_MD:  # (19.8); the default target inertia otherwise, as before
+        out["Md"] = [DEFAULT_MD, DEFAULT_MD, md]
     skip = {"n", "Kp", "Kzeta", "K1", "centers", "widths", "Ts", "tau_max"}
     out.update({k: v for k, v in kw.items() if k not in skip})
     return out
+
+
+DEFAULT_MD = 2.0
+"""The target inertia M_d (kg) of SPEC §16's defaults, per axis."""
+
+NORMAL_SAMPLES = 50
+"""Postures of the scenario's joint path at which :func:`normal_inertia` takes
+the tool's Cartesian inertia along the normal."""
+
+
+def normal_inertia(sc: PandaTable, q: ArrayLike) -> float:
+    """The target inertia M_d,n (kg) along the table's normal by SPEC (19.8):
+    max(M_d, k Λ_c (Ts/m)²), k = 1/τ_n² the table contact's stiffness per
+    unit apparent mass (τ_n = :data:`TABLE_TIMECONST`), Λ_c the
+    larger of the tool's Cartesian inertia along the normal, 1/(nᵀ J D⁻¹ Jᵀ
+    n), over :data:`NORMAL_SAMPLES` postures of the joint path ``q`` (K, n)
+    (rad; D the plant's, armature included) and
+    MuJoCo's own estimate of it (1/``body_invweight0`` of the tool and the
+    table), m = :data:`ADMITTANCE_SHARE_OF_PERIOD`: the admittance's mode on
+    the table's stiffness takes at most m of a period."""
+    from .. import mujoco as amj
+    from .. import tuning
+
+    model = sc.model
+    tool, table = _tool_table(model)
+    if tool < 0 or table < 0:
+        return DEFAULT_MD
+    rows = np.asarray(q, dtype=np.float64)
+    plant = amj.Plant(model, contact=False)
+    idx = np.unique(np.linspace(0, rows.shape[0] - 1, NORMAL_SAMPLES).round().astype(int))
+    lam = 0.0
+    for k in idx:
+        d = tuning.inertia(plant, rows[k])
+        jz = np.asarray(sc.chain.jacobian(rows[k]), dtype=np.float64)[2]
+        lam = max(lam, 1.0 / float(jz @ np.linalg.solve(d, jz)))
+    inv_mass = float(
+        model.body_invweight0[model.geom_bodyid[tool], 0]
+        + model.body_invweight0[model.geom_bodyid[table], 0]
+    )
+    if inv_mass > 0:
+        lam = max(lam, 1.0 / inv_mass)
+    stiffness = 1.0 / TABLE_TIMECONST**2  # 1/s², per kg of apparent mass
+    return max(DEFAULT_MD, stiffness * lam * (sc.Ts / ADMITTANCE_SHARE_OF_PERIOD) ** 2)
 
 
 def contact_metrics(

@@ -1347,7 +1347,7 @@ mod tests {
 
     /// (9.1), SPEC §9: without the lead the estimated error of exact tracking
     /// is a L (the estimate half a period late: learning would drive the true
-    /// z2 to −a L); with it, −K1 a L², second order (K1 L ≈ 0.01).
+    /// z2 to −a L); with it, −K1 a L², second order (K1 L = 0.003 here).
     #[test]
     fn the_lead_removes_the_estimated_errors_bias_on_a_ramp_accelerating_path() {
         let (paper, a, lag) = estimated_error_on_a_parabola(false);

@@ -251,7 +251,7 @@ impl<const N: usize> ComputedTorque<N> {
         a: &Vector<N>,
     ) -> Vector<N> {
         self.model.inverse_dynamics(&m.x, dq, a)
-            + self.model.drive().friction_torque(&r.dxd, dq)
+            + self.model.drive_torque(&m.x, dq, a, &r.dxd)
             + m.tau_e
     }
 
@@ -279,7 +279,7 @@ impl<const N: usize> ComputedTorque<N> {
         // (20.6) on the velocity the blend of references moves at.
         let v_r = n * r.dxd + (1.0 - n) * qc.dx;
         Ok(self.model.inverse_dynamics(&q, dq, &ddq)
-            + self.model.drive().friction_torque(&v_r, dq)
+            + self.model.drive_torque(&q, dq, &ddq, &v_r)
             + n * m.tau_e
             + (1.0 - n) * task_part)
     }

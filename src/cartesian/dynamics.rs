@@ -75,6 +75,139 @@ impl<const N: usize> Drive<N> {
     }
 }
 
+/// How a simulated plant realises the drive within one period, SPEC
+/// (20.9): the period is `substeps` integrator steps of `substep` h (s), the
+/// viscous damping is integrated implicitly or not, and the dry friction is a
+/// soft constraint (MuJoCo's friction loss) whose force, below its bound F,
+/// is −(a + b_r q̇)/R. Computed torque then inverts the plant's own period,
+/// joint by joint, in place of (20.6). Every entry finite; checked by
+/// [`Dynamics::with_sampled_drive`].
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SampledDrive<const N: usize> {
+    /// The plant's integrator step h (s), > 0.
+    pub substep: f64,
+    /// Integrator steps per period s (1 ≤ s ≤ 1000): the torque is held over
+    /// s·h.
+    pub substeps: u32,
+    /// Whether the damping is integrated implicitly, (M + h b) q̈ = τ − b q̇ − …
+    /// (MuJoCo's Euler, implicit and implicitfast integrators), or
+    /// explicitly (RK4).
+    pub implicit_damping: bool,
+    /// The friction constraint's regularisation R (rad/s² per N m, ≥ 0):
+    /// (1 − d)/d · `dof_invweight0` with d = `solimp[0]` in MuJoCo.
+    pub regularisation: Vector<N>,
+    /// The friction constraint's reference damping b_r (1/s, ≥ 0): 2/(d_max
+    /// · max(solref[0], 2 h)) in MuJoCo (d_max = `solimp[1]`).
+    pub rate: Vector<N>,
+}
+
+impl<const N: usize> SampledDrive<N> {
+    /// The joint velocity after one period from `v0` under the torque `u`
+    /// held (N m; gravity, Coriolis and coupling already taken off): `s`
+    /// steps of (20.9) for a joint of inertia `m`, damping `b`, friction loss
+    /// `f` and constraint terms `r`, `br`.
+    fn velocity_after(&self, u: f64, v0: f64, joint: JointTerms) -> f64 {
+        let JointTerms { m, b, f, r, br } = joint;
+        let h = self.substep;
+        let implicit = if self.implicit_damping { h * b } else { 0.0 };
+        let mut v = v0;
+        for _ in 0..self.substeps {
+            // The friction constraint's force at the acceleration the step
+            // would have without it: −(a + b_r v)/R, a = (u − b v + force)/m,
+            // bounded by F (MuJoCo's Huber cost: linear beyond R·F).
+            let force = if f > 0.0 {
+                let free = (u - b * v) / m;
+                (-(free + br * v) / (r + 1.0 / m)).clamp(-f, f)
+            } else {
+                0.0
+            };
+            v += h * (u - b * v + force) / (m + implicit);
+        }
+        v
+    }
+
+    /// (20.9): the torque u (N m) that takes joint `joint` from `v0` to `v0 +
+    /// a·s·h` over the period, by bisection on the plant's own period
+    /// (monotone in u). `guess` starts the bracket (the continuous inverse
+    /// m a + b v0); returned unchanged if no bracket is found (a value that
+    /// is not finite).
+    fn joint_torque(&self, joint: JointTerms, v0: f64, a: f64, guess: f64) -> f64 {
+        let target = v0 + a * self.substep * f64::from(self.substeps);
+        let below = |u: f64| self.velocity_after(u, v0, joint) < target;
+        let width = 1.0 + 2.0 * joint.f + guess.abs();
+        let (mut lo, mut hi) = (guess - width, guess + width);
+        let mut grow = width;
+        let mut tries = 0;
+        while !below(lo) || below(hi) {
+            tries += 1;
+            if tries > 60 || !lo.is_finite() || !hi.is_finite() {
+                return guess;
+            }
+            grow *= 2.0;
+            if !below(lo) {
+                lo -= grow;
+            } else {
+                hi += grow;
+            }
+        }
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if below(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        check::positive("substep > 0", "substep", self.substep)?;
+        check::at_most("substep ≤ 1 s", "substep", self.substep, 1.0)?;
+        if self.substeps == 0 || self.substeps > 1000 {
+            return Err(Error::Condition {
+                condition: "1 ≤ substeps ≤ 1000",
+                lhs: "substeps",
+                index: None,
+                value: f64::from(self.substeps),
+            });
+        }
+        for (what, condition, v) in [
+            ("regularisation", "regularisation ≥ 0", &self.regularisation),
+            ("rate", "rate ≥ 0", &self.rate),
+        ] {
+            check::nonnegative_vec(condition, what, v)?;
+            check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)?;
+        }
+        Ok(())
+    }
+}
+
+/// A passive joint spring, SPEC (20.5'): the torque k ⊙ (q − q_s) the
+/// joint needs against it (MuJoCo's `jnt_stiffness` about `qpos_spring`).
+/// Every entry finite, k ≥ 0 ([`Dynamics::with_spring`] checks).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Spring<const N: usize> {
+    /// Stiffness k (N m/rad, N/m), ≥ 0.
+    pub stiffness: Vector<N>,
+    /// The spring's rest position q_s (rad, m).
+    pub reference: Vector<N>,
+}
+
+/// One joint's terms in (20.9): inertia m (the mass matrix's diagonal, with
+/// the armature), damping b, friction loss F, the constraint's R and b_r.
+#[derive(Copy, Clone, Debug)]
+struct JointTerms {
+    m: f64,
+    b: f64,
+    f: f64,
+    r: f64,
+    br: f64,
+}
+
 impl<const N: usize> Default for Drive<N> {
     fn default() -> Self {
         Self::none()
@@ -207,6 +340,8 @@ pub struct Dynamics<const N: usize> {
     bodies: [Body; N],
     gravity: Vector3<f64>,
     drive: Drive<N>,
+    sampled: Option<SampledDrive<N>>,
+    spring: Option<Spring<N>>,
 }
 
 impl<const N: usize> Dynamics<N> {
@@ -262,6 +397,8 @@ impl<const N: usize> Dynamics<N> {
             bodies,
             gravity: Vector3::from(gravity),
             drive: Drive::none(),
+            sampled: None,
+            spring: None,
         })
     }
 
@@ -275,6 +412,83 @@ impl<const N: usize> Dynamics<N> {
         drive.check()?;
         self.drive = drive;
         Ok(self)
+    }
+
+    /// The model with how a simulated plant realises the drive within a
+    /// period (SPEC (20.9)): computed torque then inverts the plant's period
+    /// joint by joint for its damping and friction, in place of (20.6).
+    ///
+    /// Errors, naming the term: h ≤ 0 or beyond 1 s, s outside 1 … 1000, a
+    /// negative or non-finite R or b_r.
+    pub fn with_sampled_drive(mut self, sampled: SampledDrive<N>) -> Result<Self, Error> {
+        sampled.check()?;
+        self.sampled = Some(sampled);
+        Ok(self)
+    }
+
+    /// The model with passive joint springs (SPEC (20.5')): inverse dynamics
+    /// gains k ⊙ (q − q_s). Errors, naming the term and the joint: a negative
+    /// or non-finite stiffness, a reference not finite or beyond 1e9.
+    pub fn with_spring(mut self, spring: Spring<N>) -> Result<Self, Error> {
+        check::nonnegative_vec("stiffness ≥ 0", "stiffness", &spring.stiffness)?;
+        for (what, v) in [
+            ("stiffness", &spring.stiffness),
+            ("spring reference", &spring.reference),
+        ] {
+            check::finite_slice(what, v.as_slice())?;
+            check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)?;
+        }
+        self.spring = Some(spring);
+        Ok(self)
+    }
+
+    /// The passive springs, if given ([`with_spring`](Self::with_spring)).
+    pub fn spring(&self) -> Option<&Spring<N>> {
+        self.spring.as_ref()
+    }
+
+    /// How the plant realises the drive, if given ([`with_sampled_drive`](Self::with_sampled_drive)).
+    pub fn sampled_drive(&self) -> Option<&SampledDrive<N>> {
+        self.sampled.as_ref()
+    }
+
+    /// The drive's torque beyond the rigid links' that computed torque
+    /// applies at (q, q̇) for the acceleration `a` (rad/s²) it commands, on
+    /// the reference velocity `v_r`: with a [`SampledDrive`], (20.9): for
+    /// each joint with damping or friction, the torque that gives joint i
+    /// the velocity q̇_i + a_i·s·h after the plant's period, less the
+    /// continuous model's own M_ii a_i + b_i q̇_i (which
+    /// [`inverse_dynamics`](Self::inverse_dynamics) holds); without one, the
+    /// compensation (20.6).
+    pub fn drive_torque(
+        &self,
+        q: &Vector<N>,
+        dq: &Vector<N>,
+        a: &Vector<N>,
+        v_r: &Vector<N>,
+    ) -> Vector<N> {
+        let Some(s) = &self.sampled else {
+            return self.drive.friction_torque(v_r, dq);
+        };
+        let d = &self.drive;
+        if d.damping.iter().chain(d.friction.iter()).all(|x| *x == 0.0) {
+            return Vector::zeros();
+        }
+        let m = self.mass_matrix(q);
+        Vector::from_fn(|i, _| {
+            let joint = JointTerms {
+                m: m[(i, i)],
+                b: d.damping[i],
+                f: d.friction[i],
+                r: s.regularisation[i],
+                br: s.rate[i],
+            };
+            if (joint.b == 0.0 && joint.f == 0.0) || joint.m.is_nan() || joint.m <= 0.0 {
+                return 0.0;
+            }
+            let continuous = joint.m * a[i] + joint.b * dq[i];
+            s.joint_torque(joint, dq[i], a[i], continuous) - continuous
+        })
     }
 
     /// The joints' drive terms (zeros unless [`with_drive`](Self::with_drive)).
@@ -384,12 +598,17 @@ impl<const N: usize> Dynamics<N> {
     }
 
     /// ID(q, q̇, q̈) = M(q) q̈ + C(q, q̇) q̇ + G(q) + I_a ⊙ q̈ + b ⊙ q̇ (N m,
-    /// N): RNEA (20.2) with the drive's armature and damping (20.5).
+    /// N): RNEA (20.2) with the drive's armature and damping (20.5), and
+    /// + k ⊙ (q − q_s) with springs (20.5').
     #[inline]
     pub fn inverse_dynamics(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>) -> Vector<N> {
-        self.rnea(q, dq, ddq, -self.gravity)
+        let tau = self.rnea(q, dq, ddq, -self.gravity)
             + self.drive.armature.component_mul(ddq)
-            + self.drive.damping.component_mul(dq)
+            + self.drive.damping.component_mul(dq);
+        match &self.spring {
+            None => tau,
+            Some(s) => tau + s.stiffness.component_mul(&(q - s.reference)),
+        }
     }
 
     /// G(q) = RNEA(q, 0, 0) (N m, N).

@@ -918,6 +918,137 @@ mod tests {
         assert!(d.mass_matrix_checked(&(q * 1e300)).is_err());
     }
 
+    fn sampled(regularisation: f64, rate: f64) -> SampledDrive<3> {
+        SampledDrive {
+            substep: 2.5e-4,
+            substeps: 4,
+            implicit_damping: true,
+            regularisation: Vector::from_element(regularisation),
+            rate: Vector::from_element(rate),
+        }
+    }
+
+    #[test]
+    fn the_plants_period_is_inverted_as_stated() {
+        // (20.9) with damping only, implicit steps: the closed form
+        // u = b v0 + b a s h / (1 − ρ^s), ρ = m / (m + h b), beside ID's m a + b v0.
+        let (q, dq, a) = state();
+        let drive = Drive {
+            armature: Vector::<3>::new(0.1, 0.0, 0.0),
+            damping: Vector::<3>::new(1.5, 0.0, 40.0),
+            friction: Vector::zeros(),
+        };
+        let d = arm().with_drive(drive).unwrap();
+        let s = sampled(0.0, 0.0);
+        let p = d.with_sampled_drive(s).unwrap();
+        let tau = p.drive_torque(&q, &dq, &a, &dq);
+        let m = p.mass_matrix(&q);
+        for i in [0, 2] {
+            let (mi, b) = (m[(i, i)], drive.damping[i]);
+            let rho = mi / (mi + s.substep * b);
+            let u = b * dq[i] + b * a[i] * 1e-3 / (1.0 - libm::pow(rho, 4.0));
+            let want = u - (mi * a[i] + b * dq[i]);
+            assert!(
+                (tau[i] - want).abs() < 1e-9 * (1.0 + u.abs()),
+                "{i}: {tau} vs {want}"
+            );
+        }
+        assert_eq!(tau[1], 0.0, "no damping, no friction: ID's torque exactly");
+        // First order in h b/m: the damping of the period's mean velocity.
+        let first = drive.damping[0] * (1e-3 + s.substep) / 2.0 * a[0];
+        assert!(
+            (tau[0] - first).abs() < 0.05 * first.abs(),
+            "{} vs {first}",
+            tau[0]
+        );
+        // Friction only, far beyond its bound (|q̇| ≫ F R / b_r): (20.6)'s F sign(q̇).
+        let drive = Drive {
+            armature: Vector::zeros(),
+            damping: Vector::zeros(),
+            friction: Vector::<3>::new(2.0, 1.0, 0.5),
+        };
+        let f = arm()
+            .with_drive(drive)
+            .unwrap()
+            .with_sampled_drive(sampled(1e-6, 100.0))
+            .unwrap();
+        let v = Vector::<3>::new(1.0, -0.5, 2.0);
+        let tau = f.drive_torque(&q, &v, &a, &v);
+        let want = Vector::<3>::new(2.0, -1.0, 0.5);
+        assert!((tau - want).amax() < 1e-9, "{tau} vs {want}");
+        // Below the bound it is MuJoCo's regularised force: at rest, asked
+        // for no acceleration, nothing; a light joint's friction with a
+        // large R is a small damping b_r/R q̇, not F.
+        let rest = Vector::<3>::zeros();
+        assert!(f.drive_torque(&q, &rest, &rest, &rest).amax() < 1e-12);
+        let soft = arm()
+            .with_drive(drive)
+            .unwrap()
+            .with_sampled_drive(sampled(1e4, 100.0))
+            .unwrap()
+            .drive_torque(&q, &v, &rest, &v);
+        let damping = v * (100.0 / 1e4);
+        assert!(
+            (soft - damping).amax() < 0.1 * damping.amax(),
+            "{soft} vs {damping}"
+        );
+        // Without a SampledDrive: (20.6) as before.
+        let plain = arm().with_drive(drive).unwrap();
+        assert_eq!(
+            plain.drive_torque(&q, &v, &a, &v),
+            drive.friction_torque(&v, &v)
+        );
+    }
+
+    #[test]
+    fn springs_and_sampled_drives_are_checked() {
+        let d = arm();
+        let (q, dq, ddq) = state();
+        let spring = Spring {
+            stiffness: Vector::<3>::new(10.0, 0.0, 2.0),
+            reference: Vector::<3>::new(0.1, 0.2, -0.3),
+        };
+        let k = d.with_spring(spring).unwrap();
+        let tau = k.inverse_dynamics(&q, &dq, &ddq) - d.inverse_dynamics(&q, &dq, &ddq);
+        let want = spring.stiffness.component_mul(&(q - spring.reference));
+        assert!((tau - want).amax() < 1e-13, "{tau} vs {want}");
+        let mut bad = spring;
+        bad.stiffness[1] = -1.0;
+        let e = d.with_spring(bad).unwrap_err().to_string();
+        assert!(e.contains("stiffness") && e.contains("[1]"), "{e}");
+        bad = spring;
+        bad.reference[2] = f64::NAN;
+        assert!(d.with_spring(bad).is_err());
+        for (what, s) in [
+            (
+                "substep",
+                SampledDrive {
+                    substep: 0.0,
+                    ..sampled(1.0, 1.0)
+                },
+            ),
+            (
+                "substeps",
+                SampledDrive {
+                    substeps: 0,
+                    ..sampled(1.0, 1.0)
+                },
+            ),
+            (
+                "substeps",
+                SampledDrive {
+                    substeps: 1001,
+                    ..sampled(1.0, 1.0)
+                },
+            ),
+            ("regularisation", sampled(-1.0, 1.0)),
+            ("rate", sampled(1.0, f64::NAN)),
+        ] {
+            let e = d.with_sampled_drive(s).unwrap_err().to_string();
+            assert!(e.contains(what), "{what}: {e}");
+        }
+    }
+
     #[test]
     fn the_drive_adds_armature_and_damping_as_stated() {
         // (20.5): M_a = M + diag(I_a), ID = RNEA + I_a ⊙ q̈ + b ⊙ q̇, G unchanged.

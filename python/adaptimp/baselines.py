@@ -111,18 +111,21 @@ def plant_drive(
 ) -> dict[str, Any] | None:
     """What adaptimp's MuJoCo plant of ``model`` (an MJCF path or a compiled
     ``MjModel``, with ``tip``/``fix``) has of the drive of ``joints`` beyond
-    the arm's description, as ``_adaptimp.ComputedTorque``'s keywords: the
-    passive springs ``stiffness`` k and ``spring_reference`` q_s (SPEC (20.5'),
-    MuJoCo's ``jnt_stiffness`` and ``qpos_spring``, if any k > 0), and how the
-    plant realises the drive over a period ``Ts`` (s), SPEC (20.9): ``substep`` h and ``substeps`` s as
+    the arm's description, as ``_adaptimp.ComputedTorque``'s keywords.
+
+    The passive springs ``stiffness`` k and ``spring_reference`` q_s (SPEC
+    (20.5'), MuJoCo's ``jnt_stiffness`` and ``qpos_spring``; only if some
+    k > 0), and how the plant realises the drive over a period ``Ts`` (s),
+    SPEC (20.9): ``substep`` h and ``substeps`` s as
     :func:`adaptimp.mujoco.simulate` steps it (s = round(Ts / the plant's
-    timestep), h = Ts / s), ``implicit_damping`` (MuJoCo's Euler, unless
-    ``eulerdamp`` is disabled, implicit and implicitfast integrate the damping
-    implicitly; RK4 does not), and per joint the friction-loss constraint's
-    ``friction_regularisation`` R = (1 − d)/d · ``dof_invweight0`` (d =
-    ``solimp[0]``) and ``friction_rate`` b_r = 2/(``solimp[1]`` ·
-    max(``solref[0]``, 2 h)) (−``solref[1]``/``solimp[1]`` for a direct
-    ``solref``). None if the plant cannot be built from ``model``."""
+    timestep), h = Ts / s); ``implicit_damping`` (MuJoCo's Euler unless
+    ``eulerdamp`` is disabled, implicit and implicitfast integrate the
+    damping implicitly; RK4 does not); per joint the friction-loss
+    constraint's ``friction_regularisation`` R = (1 − d)/d ·
+    ``dof_invweight0`` (d = ``solimp[0]``) and ``friction_rate`` b_r =
+    2/(``solimp[1]`` · max(``solref[0]``, 2 h)) (−``solref[1]``/``solimp[1]``
+    for a direct ``solref``). None if the plant cannot be built from
+    ``model`` or drives other joints."""
     import warnings
 
     import mujoco
@@ -499,7 +502,9 @@ class ComputedTorque:
             impedance=impedance,
             mass_scale=self.mass_scale,
             payload=float(payload),
-            **self.drive,
+            armature=self.drive["armature"],
+            damping=self.drive["damping"],
+            friction=self.drive["friction"],
             **(self.plant_drive or {}),
         )
         self._params: dict[str, Any] = {

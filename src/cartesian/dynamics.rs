@@ -96,8 +96,8 @@ pub struct SampledDrive<const N: usize> {
     /// The friction constraint's regularisation R (rad/s² per N m, ≥ 0):
     /// (1 − d)/d · `dof_invweight0` with d = `solimp[0]` in MuJoCo.
     pub regularisation: Vector<N>,
-    /// The friction constraint's reference damping b_r (1/s, ≥ 0): 2/(d_max
-    /// · max(solref[0], 2 h)) in MuJoCo (d_max = `solimp[1]`).
+    /// The friction constraint's reference damping b_r (1/s, ≥ 0): `2/(d_max
+    /// · max(solref[0], 2 h))` in MuJoCo (`d_max = solimp[1]`).
     pub rate: Vector<N>,
 }
 

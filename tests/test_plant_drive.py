@@ -74,13 +74,15 @@ def state(plant: amj.Plant, q: np.ndarray, dq: np.ndarray) -> None:
 
 def test_the_plant_drive_is_read_off_the_plant(light: Path) -> None:
     """The terms (20.5'), (20.9) come from the plant adaptimp builds from the
-    file: Euler at 0.25 ms (4 steps a period, damping implicit), the spring,
+    file: Euler at 0.25 ms (4 steps a period, damping implicit, the position
+    moved with the new velocity), the spring,
     R and b_r from the dofs' solimp/solref/invweight0."""
     plant = plant_of(light)
     got = baselines.plant_drive(light, TS, plant.joint_names)
     assert got is not None
     assert (got["substep"], got["substeps"]) == (2.5e-4, 4)
     assert got["implicit_damping"] is True
+    assert got["semi_implicit"] is True
     assert got["stiffness"] == [5.0, 0.0, 0.0]
     assert got["spring_reference"] == [0.1, 0.0, 0.0]
     m = plant.model

@@ -740,6 +740,7 @@ class ComputedTorque:
         substep: float | None = None,
         substeps: int = 1,
         implicit_damping: bool = False,
+        semi_implicit: bool = False,
         friction_regularisation: float | Sequence[float] | None = None,
         friction_rate: float | Sequence[float] | None = None,
         stiffness: float | Sequence[float] | None = None,

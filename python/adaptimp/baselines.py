@@ -120,7 +120,9 @@ def plant_drive(
     :func:`adaptimp.mujoco.simulate` steps it (s = round(Ts / the plant's
     timestep), h = Ts / s); ``implicit_damping`` (MuJoCo's Euler unless
     ``eulerdamp`` is disabled, implicit and implicitfast integrate the
-    damping implicitly; RK4 does not); per joint the friction-loss
+    damping implicitly; RK4 does not); ``semi_implicit`` (all but RK4 move
+    the position with the new velocity: the plant's velocity is h/2 old,
+    SPEC (20.9')); per joint the friction-loss
     constraint's ``friction_regularisation`` R = (1 − d)/d ·
     ``dof_invweight0`` (d = ``solimp[0]``) and ``friction_rate`` b_r =
     2/(``solimp[1]`` · max(``solref[0]``, 2 h)) (−``solref[1]``/``solimp[1]``
@@ -168,6 +170,7 @@ def plant_drive(
         "substep": h,
         "substeps": substeps,
         "implicit_damping": not rk4 and not (euler and no_eulerdamp),
+        "semi_implicit": not rk4,
         "friction_regularisation": regularisation.tolist(),
         "friction_rate": rate.tolist(),
     }

@@ -93,6 +93,11 @@ pub struct SampledDrive<const N: usize> {
     /// (MuJoCo's Euler, implicit and implicitfast integrators), or
     /// explicitly (RK4).
     pub implicit_damping: bool,
+    /// Whether each integrator step updates the position with the new
+    /// velocity, q ← q + h q̇_{j+1} (MuJoCo's Euler, implicit and
+    /// implicitfast; not RK4): the velocity the plant reports is then the
+    /// mean over its last step, the continuous velocity h/2 back (20.9').
+    pub semi_implicit: bool,
     /// The friction constraint's regularisation R (rad/s² per N m, ≥ 0):
     /// (1 − d)/d · `dof_invweight0` with d = `solimp[0]` in MuJoCo.
     pub regularisation: Vector<N>,
@@ -445,6 +450,15 @@ impl<const N: usize> Dynamics<N> {
     /// The passive springs, if given ([`with_spring`](Self::with_spring)).
     pub fn spring(&self) -> Option<&Spring<N>> {
         self.spring.as_ref()
+    }
+
+    /// How far back (s) the plant's reported velocity is (SPEC (20.9')):
+    /// h/2 for semi-implicit integrator steps, else 0.
+    pub fn velocity_lag(&self) -> f64 {
+        match &self.sampled {
+            Some(s) if s.semi_implicit => 0.5 * s.substep,
+            _ => 0.0,
+        }
     }
 
     /// How the plant realises the drive, if given ([`with_sampled_drive`](Self::with_sampled_drive)).
@@ -923,6 +937,7 @@ mod tests {
             substep: 2.5e-4,
             substeps: 4,
             implicit_damping: true,
+            semi_implicit: true,
             regularisation: Vector::from_element(regularisation),
             rate: Vector::from_element(rate),
         }
@@ -998,6 +1013,20 @@ mod tests {
             plain.drive_torque(&q, &v, &a, &v),
             drive.friction_torque(&v, &v)
         );
+    }
+
+    #[test]
+    fn a_semi_implicit_plants_velocity_is_half_a_step_old() {
+        // (20.9'): h/2 for semi-implicit steps; 0 for RK4 or no SampledDrive.
+        let d = arm();
+        assert_eq!(d.velocity_lag(), 0.0);
+        let s = sampled(1.0, 1.0);
+        assert_eq!(d.with_sampled_drive(s).unwrap().velocity_lag(), 1.25e-4);
+        let rk4 = SampledDrive {
+            semi_implicit: false,
+            ..s
+        };
+        assert_eq!(d.with_sampled_drive(rk4).unwrap().velocity_lag(), 0.0);
     }
 
     #[test]

@@ -371,6 +371,7 @@ struct Sampled<'a> {
     substep: f64,
     substeps: u32,
     implicit_damping: bool,
+    semi_implicit: bool,
     regularisation: &'a [f64],
     rate: &'a [f64],
 }
@@ -396,6 +397,7 @@ fn build<const N: usize>(
             substep: sp.substep,
             substeps: sp.substeps,
             implicit_damping: sp.implicit_damping,
+            semi_implicit: sp.semi_implicit,
             regularisation: vector_of(sp.regularisation),
             rate: vector_of(sp.rate),
         })?,
@@ -566,13 +568,14 @@ impl PyComputedTorque {
     /// `friction` loss (N m) (kg, N s/m, N for a prismatic joint). With
     /// `substep` h (s), the plant's period as it is simulated (SPEC (20.9)):
     /// `substeps` integrator steps of h, the damping integrated implicitly
-    /// if `implicit_damping`, the friction a soft constraint of
+    /// if `implicit_damping`, the position moved with the new velocity if
+    /// `semi_implicit` (its velocity then compared h/2 back, (20.9')), the friction a soft constraint of
     /// regularisation `friction_regularisation` R and reference damping
     /// `friction_rate` b_r (per joint, default 0); computed torque inverts
     /// that period in place of (20.6). `stiffness` k (N m/rad) and
     /// `spring_reference` q_s (rad): passive joint springs (SPEC (20.5')).
     #[new]
-    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload, armature=None, damping=None, friction=None, substep=None, substeps=1, implicit_damping=false, friction_regularisation=None, friction_rate=None, stiffness=None, spring_reference=None))]
+    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload, armature=None, damping=None, friction=None, substep=None, substeps=1, implicit_damping=false, semi_implicit=false, friction_regularisation=None, friction_rate=None, stiffness=None, spring_reference=None))]
     #[allow(clippy::too_many_arguments, non_snake_case)]
     fn new(
         joints: Vec<Bound<'_, PyDict>>,
@@ -594,6 +597,7 @@ impl PyComputedTorque {
         substep: Option<f64>,
         substeps: u32,
         implicit_damping: bool,
+        semi_implicit: bool,
         friction_regularisation: Option<&Bound<'_, PyAny>>,
         friction_rate: Option<&Bound<'_, PyAny>>,
         stiffness: Option<&Bound<'_, PyAny>>,
@@ -659,6 +663,7 @@ impl PyComputedTorque {
                 substep,
                 substeps,
                 implicit_damping,
+                semi_implicit,
                 regularisation: &regularisation,
                 rate: &rate,
             }),

@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from adaptimp import baselines
+from adaptimp import Measurement, baselines
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque
 
@@ -144,7 +144,7 @@ def one_period(
     """The joint velocities after one period of MuJoCo's steps under computed
     torque's torque for the acceleration a (external mode, xc = q, ẋc = q̇)."""
     ct.reset()
-    tau = ct.step(q, np.zeros(3), dq, xc=q, dxc=dq, ddxc=a)
+    tau = ct.step(Measurement(q, dq), q, dq, a)  # the setpoint xc, dxc, ddxc
     state(plant, q, dq)
     plant.data.ctrl[plant._act] = tau / plant._gear
     mujoco.mj_step(plant.model, plant.data, nstep=4)

@@ -17,7 +17,8 @@ those pages give, nothing set per arm.
    within the joint limits that the rule accepts, each run to the same
    targets.
 4. **Postures refused by name** (singular, out of reach, the arm below the
-   table): the message the user gets before anything runs.
+   table, the rule's gains ringing on the path): the message the user gets
+   before anything runs.
 
 The arms: example-robot-data's URDFs (installed with the extra ``pinocchio``),
 robosuite's MJCF arms (``robot.xml``, no gripper), dm_control's Kinova Jaco
@@ -121,6 +122,11 @@ REFUSALS = (
     ("UR5 (ERD)", (0.0, -PI / 2, 0.0, -PI / 2, 0.0, 0.0), "upright"),
     ("Panda (ERD)", (0.0, 0.0, 0.0, -0.07, 0.0, 0.0, 0.0), "upright"),
     ("Kinova (ERD)", (0.0, PI, PI, 0.0, PI, 0.0), "stretched up"),
+    (
+        "xArm7 (ERD)",
+        (3.953, 0.742, 3.550, 0.659, 3.739, -0.706, -5.175),
+        "joints 1 and 3 in line on the circle",
+    ),
 )
 """Postures a table cannot run at, and what they are."""
 

@@ -109,7 +109,8 @@ pub use cartesian::{
     CartesianCommand, CartesianConfig, CartesianController, CartesianImpedance,
     CartesianMeasurement, CartesianState, Chain, CompliantPose, ComputedState, ComputedTorque,
     ComputedTorqueConfig, Drive, Dynamics, Formulation, ImpedanceTorque, Inertial, Joint,
-    JointKind, OuterStep, PoseGoal, PoseTarget, Transform, FRICTION_VELOCITY, GRAVITY,
+    JointKind, OuterStep, PoseGoal, PoseTarget, SampledDrive, Spring, Transform, FRICTION_VELOCITY,
+    GRAVITY,
 };
 pub use config::{Conditions, Config, Law, ObserverInit, WeightBound};
 pub use controller::{Bound, Controller, Errors};

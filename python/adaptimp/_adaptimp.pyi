@@ -791,6 +791,14 @@ class ComputedTorque:
         armature: float | Sequence[float] | None = None,
         damping: float | Sequence[float] | None = None,
         friction: float | Sequence[float] | None = None,
+        substep: float | None = None,
+        substeps: int = 1,
+        implicit_damping: bool = False,
+        semi_implicit: bool = False,
+        friction_regularisation: float | Sequence[float] | None = None,
+        friction_rate: float | Sequence[float] | None = None,
+        stiffness: float | Sequence[float] | None = None,
+        spring_reference: float | Sequence[float] | None = None,
     ) -> ComputedTorque: ...
     @property
     def n(self) -> int: ...

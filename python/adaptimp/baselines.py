@@ -44,7 +44,14 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 from . import _models
 from ._trajectory import Reference, paper_circle
 
-__all__ = ["ComputedTorque", "core_description", "default_gains", "pinocchio_model", "with_payload"]
+__all__ = [
+    "ComputedTorque",
+    "core_description",
+    "default_gains",
+    "pinocchio_model",
+    "plant_drive",
+    "with_payload",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -98,6 +105,76 @@ def _arm(source: Any, tip: str | None, fix: Sequence[str]) -> Any:
             f"pinocchio.Model; no file {str(source)!r}"
         )
     return read_arm(source, tip, fix)
+
+
+def plant_drive(
+    model: Any, Ts: float, joints: Sequence[str], tip: str | None = None, fix: Sequence[str] = ()
+) -> dict[str, Any] | None:
+    """What adaptimp's MuJoCo plant of ``model`` (an MJCF path or a compiled
+    ``MjModel``, with ``tip``/``fix``) has of the drive of ``joints`` beyond
+    the arm's description, as ``_adaptimp.ComputedTorque``'s keywords.
+
+    The passive springs ``stiffness`` k and ``spring_reference`` q_s (SPEC
+    (20.5'), MuJoCo's ``jnt_stiffness`` and ``qpos_spring``; only if some
+    k > 0), and how the plant realises the drive over a period ``Ts`` (s),
+    SPEC (20.9): ``substep`` h and ``substeps`` s as
+    :func:`adaptimp.mujoco.simulate` steps it (s = round(Ts / the plant's
+    timestep), h = Ts / s); ``implicit_damping`` (MuJoCo's Euler unless
+    ``eulerdamp`` is disabled, implicit and implicitfast integrate the
+    damping implicitly; RK4 does not); ``semi_implicit`` (all but RK4 move
+    the position with the new velocity: the plant's velocity is h/2 old,
+    SPEC (20.9')); per joint the friction-loss
+    constraint's ``friction_regularisation`` R = (1 − d)/d ·
+    ``dof_invweight0`` (d = ``solimp[0]``) and ``friction_rate`` b_r =
+    2/(``solimp[1]`` · max(``solref[0]``, 2 h)) (−``solref[1]``/``solimp[1]``
+    for a direct ``solref``). None if the plant cannot be built from
+    ``model`` or drives other joints."""
+    import warnings
+
+    import mujoco
+
+    from . import mujoco as amj
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            plant = amj.Plant(model, tip=tip, fix=fix)
+    except (ValueError, TypeError):
+        return None
+    m = plant.model
+    names = list(plant.joint_names)
+    if sorted(names) != sorted(joints):
+        return None
+    dofs = np.array([plant._dofs[names.index(j)] for j in joints])
+    substeps = max(1, round(Ts / float(m.opt.timestep)))
+    h = Ts / substeps
+    integrator = int(m.opt.integrator)
+    rk4 = integrator == int(mujoco.mjtIntegrator.mjINT_RK4)
+    euler = integrator == int(mujoco.mjtIntegrator.mjINT_EULER)
+    no_eulerdamp = bool(int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP))
+    solimp, solref = m.dof_solimp[dofs], m.dof_solref[dofs]
+    d, dmax = solimp[:, 0], solimp[:, 1]
+    regularisation = (1.0 - d) / d * m.dof_invweight0[dofs]
+    direct = solref[:, 0] < 0
+    rate = np.where(
+        direct,
+        -solref[:, 1] / dmax,
+        2.0 / (dmax * np.maximum(np.abs(solref[:, 0]), 2.0 * h)),
+    )
+    out: dict[str, Any] = {}
+    jids = [int(m.dof_jntid[i]) for i in dofs]
+    stiffness = m.jnt_stiffness[jids]
+    if np.any(stiffness > 0):
+        out["stiffness"] = stiffness.tolist()
+        out["spring_reference"] = m.qpos_spring[m.jnt_qposadr[jids]].tolist()
+    return out | {
+        "substep": h,
+        "substeps": substeps,
+        "implicit_damping": not rk4 and not (euler and no_eulerdamp),
+        "semi_implicit": not rk4,
+        "friction_regularisation": regularisation.tolist(),
+        "friction_rate": rate.tolist(),
+    }
 
 
 def default_gains(Ts: float) -> tuple[float, float]:
@@ -392,6 +469,12 @@ class ComputedTorque:
         n = self.n = len(joints)
         if not (Ts > 0 and math.isfinite(Ts)):
             raise ValueError(f"Ts must be > 0, got {Ts}")
+        # SPEC (20.5'), (20.9): an MJCF's springs, and its drive as adaptimp's
+        # plant of the file realises it over a period (its integrator's steps,
+        # MuJoCo's soft friction).
+        self.plant_drive: dict[str, Any] | None = None
+        if not paper and use and arm.urdf is None:
+            self.plant_drive = plant_drive(model, float(Ts), list(arm.joints), tip, fix)
         self._ts = float(Ts)
         kp, kd = default_gains(self._ts)
         self.Kp = _joint("Kp", kp if Kp is None else Kp, n)
@@ -424,7 +507,10 @@ class ComputedTorque:
             impedance=impedance,
             mass_scale=self.mass_scale,
             payload=float(payload),
-            **self.drive,
+            armature=self.drive["armature"],
+            damping=self.drive["damping"],
+            friction=self.drive["friction"],
+            **(self.plant_drive or {}),
         )
         self._params: dict[str, Any] = {
             "Ts": self._ts,
@@ -438,6 +524,7 @@ class ComputedTorque:
             "Gd": self.Gd.tolist(),
             "impedance": impedance,
             **self.drive,
+            "plant_drive": self.plant_drive,
         }
         if trajectory is None and n == 2:
             trajectory = paper_circle()

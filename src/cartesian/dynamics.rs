@@ -75,6 +75,144 @@ impl<const N: usize> Drive<N> {
     }
 }
 
+/// How a simulated plant realises the drive within one period, SPEC
+/// (20.9): the period is `substeps` integrator steps of `substep` h (s), the
+/// viscous damping is integrated implicitly or not, and the dry friction is a
+/// soft constraint (MuJoCo's friction loss) whose force, below its bound F,
+/// is −(a + b_r q̇)/R. Computed torque then inverts the plant's own period,
+/// joint by joint, in place of (20.6). Every entry finite; checked by
+/// [`Dynamics::with_sampled_drive`].
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SampledDrive<const N: usize> {
+    /// The plant's integrator step h (s), > 0.
+    pub substep: f64,
+    /// Integrator steps per period s (1 ≤ s ≤ 1000): the torque is held over
+    /// s·h.
+    pub substeps: u32,
+    /// Whether the damping is integrated implicitly, (M + h b) q̈ = τ − b q̇ − …
+    /// (MuJoCo's Euler, implicit and implicitfast integrators), or
+    /// explicitly (RK4).
+    pub implicit_damping: bool,
+    /// Whether each integrator step updates the position with the new
+    /// velocity, q ← q + h q̇_{j+1} (MuJoCo's Euler, implicit and
+    /// implicitfast; not RK4): the velocity the plant reports is then the
+    /// mean over its last step, the continuous velocity h/2 back (20.9').
+    pub semi_implicit: bool,
+    /// The friction constraint's regularisation R (rad/s² per N m, ≥ 0):
+    /// (1 − d)/d · `dof_invweight0` with d = `solimp[0]` in MuJoCo.
+    pub regularisation: Vector<N>,
+    /// The friction constraint's reference damping b_r (1/s, ≥ 0): `2/(d_max
+    /// · max(solref[0], 2 h))` in MuJoCo (`d_max = solimp[1]`).
+    pub rate: Vector<N>,
+}
+
+impl<const N: usize> SampledDrive<N> {
+    /// The joint velocity after one period from `v0` under the torque `u`
+    /// held (N m; gravity, Coriolis and coupling already taken off): `s`
+    /// steps of (20.9) for a joint of inertia `m`, damping `b`, friction loss
+    /// `f` and constraint terms `r`, `br`.
+    fn velocity_after(&self, u: f64, v0: f64, joint: JointTerms) -> f64 {
+        let JointTerms { m, b, f, r, br } = joint;
+        let h = self.substep;
+        let implicit = if self.implicit_damping { h * b } else { 0.0 };
+        let mut v = v0;
+        for _ in 0..self.substeps {
+            // The friction constraint's force at the acceleration the step
+            // would have without it: −(a + b_r v)/R, a = (u − b v + force)/m,
+            // bounded by F (MuJoCo's Huber cost: linear beyond R·F).
+            let force = if f > 0.0 {
+                let free = (u - b * v) / m;
+                (-(free + br * v) / (r + 1.0 / m)).clamp(-f, f)
+            } else {
+                0.0
+            };
+            v += h * (u - b * v + force) / (m + implicit);
+        }
+        v
+    }
+
+    /// (20.9): the torque u (N m) that takes joint `joint` from `v0` to `v0 +
+    /// a·s·h` over the period, by bisection on the plant's own period
+    /// (monotone in u). `guess` starts the bracket (the continuous inverse
+    /// m a + b v0); returned unchanged if no bracket is found (a value that
+    /// is not finite).
+    fn joint_torque(&self, joint: JointTerms, v0: f64, a: f64, guess: f64) -> f64 {
+        let target = v0 + a * self.substep * f64::from(self.substeps);
+        let below = |u: f64| self.velocity_after(u, v0, joint) < target;
+        let width = 1.0 + 2.0 * joint.f + guess.abs();
+        let (mut lo, mut hi) = (guess - width, guess + width);
+        let mut grow = width;
+        let mut tries = 0;
+        while !below(lo) || below(hi) {
+            tries += 1;
+            if tries > 60 || !lo.is_finite() || !hi.is_finite() {
+                return guess;
+            }
+            grow *= 2.0;
+            if !below(lo) {
+                lo -= grow;
+            } else {
+                hi += grow;
+            }
+        }
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if below(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        check::positive("substep > 0", "substep", self.substep)?;
+        check::at_most("substep ≤ 1 s", "substep", self.substep, 1.0)?;
+        if self.substeps == 0 || self.substeps > 1000 {
+            return Err(Error::Condition {
+                condition: "1 ≤ substeps ≤ 1000",
+                lhs: "substeps",
+                index: None,
+                value: f64::from(self.substeps),
+            });
+        }
+        for (what, condition, v) in [
+            ("regularisation", "regularisation ≥ 0", &self.regularisation),
+            ("rate", "rate ≥ 0", &self.rate),
+        ] {
+            check::nonnegative_vec(condition, what, v)?;
+            check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)?;
+        }
+        Ok(())
+    }
+}
+
+/// A passive joint spring, SPEC (20.5'): the torque k ⊙ (q − q_s) the
+/// joint needs against it (MuJoCo's `jnt_stiffness` about `qpos_spring`).
+/// Every entry finite, k ≥ 0 ([`Dynamics::with_spring`] checks).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Spring<const N: usize> {
+    /// Stiffness k (N m/rad, N/m), ≥ 0.
+    pub stiffness: Vector<N>,
+    /// The spring's rest position q_s (rad, m).
+    pub reference: Vector<N>,
+}
+
+/// One joint's terms in (20.9): inertia m (the mass matrix's diagonal, with
+/// the armature), damping b, friction loss F, the constraint's R and b_r.
+#[derive(Copy, Clone, Debug)]
+struct JointTerms {
+    m: f64,
+    b: f64,
+    f: f64,
+    r: f64,
+    br: f64,
+}
+
 impl<const N: usize> Default for Drive<N> {
     fn default() -> Self {
         Self::none()
@@ -207,6 +345,8 @@ pub struct Dynamics<const N: usize> {
     bodies: [Body; N],
     gravity: Vector3<f64>,
     drive: Drive<N>,
+    sampled: Option<SampledDrive<N>>,
+    spring: Option<Spring<N>>,
 }
 
 impl<const N: usize> Dynamics<N> {
@@ -262,6 +402,8 @@ impl<const N: usize> Dynamics<N> {
             bodies,
             gravity: Vector3::from(gravity),
             drive: Drive::none(),
+            sampled: None,
+            spring: None,
         })
     }
 
@@ -275,6 +417,92 @@ impl<const N: usize> Dynamics<N> {
         drive.check()?;
         self.drive = drive;
         Ok(self)
+    }
+
+    /// The model with how a simulated plant realises the drive within a
+    /// period (SPEC (20.9)): computed torque then inverts the plant's period
+    /// joint by joint for its damping and friction, in place of (20.6).
+    ///
+    /// Errors, naming the term: h ≤ 0 or beyond 1 s, s outside 1 … 1000, a
+    /// negative or non-finite R or b_r.
+    pub fn with_sampled_drive(mut self, sampled: SampledDrive<N>) -> Result<Self, Error> {
+        sampled.check()?;
+        self.sampled = Some(sampled);
+        Ok(self)
+    }
+
+    /// The model with passive joint springs (SPEC (20.5')): inverse dynamics
+    /// gains k ⊙ (q − q_s). Errors, naming the term and the joint: a negative
+    /// or non-finite stiffness, a reference not finite or beyond 1e9.
+    pub fn with_spring(mut self, spring: Spring<N>) -> Result<Self, Error> {
+        check::nonnegative_vec("stiffness ≥ 0", "stiffness", &spring.stiffness)?;
+        for (what, v) in [
+            ("stiffness", &spring.stiffness),
+            ("spring reference", &spring.reference),
+        ] {
+            check::finite_slice(what, v.as_slice())?;
+            check::at_most_each("|value| ≤ 1e9", what, v.as_slice(), PARAM_BOUND)?;
+        }
+        self.spring = Some(spring);
+        Ok(self)
+    }
+
+    /// The passive springs, if given ([`with_spring`](Self::with_spring)).
+    pub fn spring(&self) -> Option<&Spring<N>> {
+        self.spring.as_ref()
+    }
+
+    /// How far back (s) the plant's reported velocity is (SPEC (20.9')):
+    /// h/2 for semi-implicit integrator steps, else 0.
+    pub fn velocity_lag(&self) -> f64 {
+        match &self.sampled {
+            Some(s) if s.semi_implicit => 0.5 * s.substep,
+            _ => 0.0,
+        }
+    }
+
+    /// How the plant realises the drive, if given ([`with_sampled_drive`](Self::with_sampled_drive)).
+    pub fn sampled_drive(&self) -> Option<&SampledDrive<N>> {
+        self.sampled.as_ref()
+    }
+
+    /// The drive's torque beyond the rigid links' that computed torque
+    /// applies at (q, q̇) for the acceleration `a` (rad/s²) it commands, on
+    /// the reference velocity `v_r`: with a [`SampledDrive`], (20.9): for
+    /// each joint with damping or friction, the torque that gives joint i
+    /// the velocity q̇_i + a_i·s·h after the plant's period, less the
+    /// continuous model's own M_ii a_i + b_i q̇_i (which
+    /// [`inverse_dynamics`](Self::inverse_dynamics) holds); without one, the
+    /// compensation (20.6).
+    pub fn drive_torque(
+        &self,
+        q: &Vector<N>,
+        dq: &Vector<N>,
+        a: &Vector<N>,
+        v_r: &Vector<N>,
+    ) -> Vector<N> {
+        let Some(s) = &self.sampled else {
+            return self.drive.friction_torque(v_r, dq);
+        };
+        let d = &self.drive;
+        if d.damping.iter().chain(d.friction.iter()).all(|x| *x == 0.0) {
+            return Vector::zeros();
+        }
+        let m = self.mass_matrix(q);
+        Vector::from_fn(|i, _| {
+            let joint = JointTerms {
+                m: m[(i, i)],
+                b: d.damping[i],
+                f: d.friction[i],
+                r: s.regularisation[i],
+                br: s.rate[i],
+            };
+            if (joint.b == 0.0 && joint.f == 0.0) || joint.m.is_nan() || joint.m <= 0.0 {
+                return 0.0;
+            }
+            let continuous = joint.m * a[i] + joint.b * dq[i];
+            s.joint_torque(joint, dq[i], a[i], continuous) - continuous
+        })
     }
 
     /// The joints' drive terms (zeros unless [`with_drive`](Self::with_drive)).
@@ -384,12 +612,17 @@ impl<const N: usize> Dynamics<N> {
     }
 
     /// ID(q, q̇, q̈) = M(q) q̈ + C(q, q̇) q̇ + G(q) + I_a ⊙ q̈ + b ⊙ q̇ (N m,
-    /// N): RNEA (20.2) with the drive's armature and damping (20.5).
+    /// N): RNEA (20.2) with the drive's armature and damping (20.5), and
+    /// + k ⊙ (q − q_s) with springs (20.5').
     #[inline]
     pub fn inverse_dynamics(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>) -> Vector<N> {
-        self.rnea(q, dq, ddq, -self.gravity)
+        let tau = self.rnea(q, dq, ddq, -self.gravity)
             + self.drive.armature.component_mul(ddq)
-            + self.drive.damping.component_mul(dq)
+            + self.drive.damping.component_mul(dq);
+        match &self.spring {
+            None => tau,
+            Some(s) => tau + s.stiffness.component_mul(&(q - s.reference)),
+        }
     }
 
     /// G(q) = RNEA(q, 0, 0) (N m, N).
@@ -697,6 +930,152 @@ mod tests {
             "dq[0] = 1e200 is beyond its limit ±1e6; the state was left unchanged"
         );
         assert!(d.mass_matrix_checked(&(q * 1e300)).is_err());
+    }
+
+    fn sampled(regularisation: f64, rate: f64) -> SampledDrive<3> {
+        SampledDrive {
+            substep: 2.5e-4,
+            substeps: 4,
+            implicit_damping: true,
+            semi_implicit: true,
+            regularisation: Vector::from_element(regularisation),
+            rate: Vector::from_element(rate),
+        }
+    }
+
+    #[test]
+    fn the_plants_period_is_inverted_as_stated() {
+        // (20.9) with damping only, implicit steps: the closed form
+        // u = b v0 + b a s h / (1 − ρ^s), ρ = m / (m + h b), beside ID's m a + b v0.
+        let (q, dq, a) = state();
+        let drive = Drive {
+            armature: Vector::<3>::new(0.1, 0.0, 0.0),
+            damping: Vector::<3>::new(1.5, 0.0, 40.0),
+            friction: Vector::zeros(),
+        };
+        let d = arm().with_drive(drive).unwrap();
+        let s = sampled(0.0, 0.0);
+        let p = d.with_sampled_drive(s).unwrap();
+        let tau = p.drive_torque(&q, &dq, &a, &dq);
+        let m = p.mass_matrix(&q);
+        for i in [0, 2] {
+            let (mi, b) = (m[(i, i)], drive.damping[i]);
+            let rho = mi / (mi + s.substep * b);
+            let u = b * dq[i] + b * a[i] * 1e-3 / (1.0 - libm::pow(rho, 4.0));
+            let want = u - (mi * a[i] + b * dq[i]);
+            assert!(
+                (tau[i] - want).abs() < 1e-9 * (1.0 + u.abs()),
+                "{i}: {tau} vs {want}"
+            );
+        }
+        assert_eq!(tau[1], 0.0, "no damping, no friction: ID's torque exactly");
+        // First order in h b/m: the damping of the period's mean velocity.
+        let first = drive.damping[0] * (1e-3 + s.substep) / 2.0 * a[0];
+        assert!(
+            (tau[0] - first).abs() < 0.05 * first.abs(),
+            "{} vs {first}",
+            tau[0]
+        );
+        // Friction only, far beyond its bound (|q̇| ≫ F R / b_r): (20.6)'s F sign(q̇).
+        let drive = Drive {
+            armature: Vector::zeros(),
+            damping: Vector::zeros(),
+            friction: Vector::<3>::new(2.0, 1.0, 0.5),
+        };
+        let f = arm()
+            .with_drive(drive)
+            .unwrap()
+            .with_sampled_drive(sampled(1e-6, 100.0))
+            .unwrap();
+        let v = Vector::<3>::new(1.0, -0.5, 2.0);
+        let tau = f.drive_torque(&q, &v, &a, &v);
+        let want = Vector::<3>::new(2.0, -1.0, 0.5);
+        assert!((tau - want).amax() < 1e-9, "{tau} vs {want}");
+        // Below the bound it is MuJoCo's regularised force: at rest, asked
+        // for no acceleration, nothing; a light joint's friction with a
+        // large R is a small damping b_r/R q̇, not F.
+        let rest = Vector::<3>::zeros();
+        assert!(f.drive_torque(&q, &rest, &rest, &rest).amax() < 1e-12);
+        let soft = arm()
+            .with_drive(drive)
+            .unwrap()
+            .with_sampled_drive(sampled(1e4, 100.0))
+            .unwrap()
+            .drive_torque(&q, &v, &rest, &v);
+        let damping = v * (100.0 / 1e4);
+        assert!(
+            (soft - damping).amax() < 0.1 * damping.amax(),
+            "{soft} vs {damping}"
+        );
+        // Without a SampledDrive: (20.6) as before.
+        let plain = arm().with_drive(drive).unwrap();
+        assert_eq!(
+            plain.drive_torque(&q, &v, &a, &v),
+            drive.friction_torque(&v, &v)
+        );
+    }
+
+    #[test]
+    fn a_semi_implicit_plants_velocity_is_half_a_step_old() {
+        // (20.9'): h/2 for semi-implicit steps; 0 for RK4 or no SampledDrive.
+        let d = arm();
+        assert_eq!(d.velocity_lag(), 0.0);
+        let s = sampled(1.0, 1.0);
+        assert_eq!(d.with_sampled_drive(s).unwrap().velocity_lag(), 1.25e-4);
+        let rk4 = SampledDrive {
+            semi_implicit: false,
+            ..s
+        };
+        assert_eq!(d.with_sampled_drive(rk4).unwrap().velocity_lag(), 0.0);
+    }
+
+    #[test]
+    fn springs_and_sampled_drives_are_checked() {
+        let d = arm();
+        let (q, dq, ddq) = state();
+        let spring = Spring {
+            stiffness: Vector::<3>::new(10.0, 0.0, 2.0),
+            reference: Vector::<3>::new(0.1, 0.2, -0.3),
+        };
+        let k = d.with_spring(spring).unwrap();
+        let tau = k.inverse_dynamics(&q, &dq, &ddq) - d.inverse_dynamics(&q, &dq, &ddq);
+        let want = spring.stiffness.component_mul(&(q - spring.reference));
+        assert!((tau - want).amax() < 1e-13, "{tau} vs {want}");
+        let mut bad = spring;
+        bad.stiffness[1] = -1.0;
+        let e = d.with_spring(bad).unwrap_err().to_string();
+        assert!(e.contains("stiffness") && e.contains("[1]"), "{e}");
+        bad = spring;
+        bad.reference[2] = f64::NAN;
+        assert!(d.with_spring(bad).is_err());
+        for (what, s) in [
+            (
+                "substep",
+                SampledDrive {
+                    substep: 0.0,
+                    ..sampled(1.0, 1.0)
+                },
+            ),
+            (
+                "substeps",
+                SampledDrive {
+                    substeps: 0,
+                    ..sampled(1.0, 1.0)
+                },
+            ),
+            (
+                "substeps",
+                SampledDrive {
+                    substeps: 1001,
+                    ..sampled(1.0, 1.0)
+                },
+            ),
+            ("regularisation", sampled(-1.0, 1.0)),
+            ("rate", sampled(1.0, f64::NAN)),
+        ] {
+            let e = d.with_sampled_drive(s).unwrap_err().to_string();
+            assert!(e.contains(what), "{what}: {e}");
+        }
     }
 
     #[test]

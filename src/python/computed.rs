@@ -17,6 +17,7 @@ use super::{array, array1, vector, vector_into, ConfigError, MeasurementError};
 use crate::cartesian::chain::JointKind;
 use crate::cartesian::{
     ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
+    SampledDrive, Spring,
 };
 use crate::control::config::Law;
 use crate::control::impedance::{ImpedanceMode, TargetImpedance};
@@ -360,6 +361,20 @@ struct Params<'a> {
     armature: &'a [f64],
     damping: &'a [f64],
     friction: &'a [f64],
+    /// SPEC (20.9), if given.
+    sampled: Option<Sampled<'a>>,
+    /// SPEC (20.5'): (k, q_s), if any stiffness is given.
+    spring: Option<(&'a [f64], &'a [f64])>,
+}
+
+/// SPEC (20.9)'s terms, as reals per joint: h, s, implicit damping, R, b_r.
+struct Sampled<'a> {
+    substep: f64,
+    substeps: u32,
+    implicit_damping: bool,
+    semi_implicit: bool,
+    regularisation: &'a [f64],
+    rate: &'a [f64],
 }
 
 fn build<const N: usize>(
@@ -377,6 +392,24 @@ fn build<const N: usize>(
         .scaled(p.mass_scale)?
         .with_payload(p.payload)?
         .with_drive(drive)?;
+    let model = match &p.sampled {
+        None => model,
+        Some(sp) => model.with_sampled_drive(SampledDrive {
+            substep: sp.substep,
+            substeps: sp.substeps,
+            implicit_damping: sp.implicit_damping,
+            semi_implicit: sp.semi_implicit,
+            regularisation: vector_of(sp.regularisation),
+            rate: vector_of(sp.rate),
+        })?,
+    };
+    let model = match p.spring {
+        None => model,
+        Some((k, qs)) => model.with_spring(Spring {
+            stiffness: vector_of(k),
+            reference: vector_of(qs),
+        })?,
+    };
     let cfg = ComputedTorqueConfig {
         ts: p.ts,
         kp: vector_of(p.kp),
@@ -533,9 +566,17 @@ impl PyComputedTorque {
     /// masses times `mass_scale`, a `payload` (kg) at the last joint, and the
     /// joints' drive (SPEC (20.5), (20.6); a number or one per joint, ≥ 0,
     /// default 0): `armature` (kg m²), viscous `damping` (N m s/rad) and dry
-    /// `friction` loss (N m) (kg, N s/m, N for a prismatic joint).
+    /// `friction` loss (N m) (kg, N s/m, N for a prismatic joint). With
+    /// `substep` h (s), the plant's period as it is simulated (SPEC (20.9)):
+    /// `substeps` integrator steps of h, the damping integrated implicitly
+    /// if `implicit_damping`, the position moved with the new velocity if
+    /// `semi_implicit` (its velocity then compared h/2 back, (20.9')), the friction a soft constraint of
+    /// regularisation `friction_regularisation` R and reference damping
+    /// `friction_rate` b_r (per joint, default 0); computed torque inverts
+    /// that period in place of (20.6). `stiffness` k (N m/rad) and
+    /// `spring_reference` q_s (rad): passive joint springs (SPEC (20.5')).
     #[new]
-    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload, armature=None, damping=None, friction=None))]
+    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload, armature=None, damping=None, friction=None, substep=None, substeps=1, implicit_damping=false, semi_implicit=false, friction_regularisation=None, friction_rate=None, stiffness=None, spring_reference=None))]
     #[allow(clippy::too_many_arguments, non_snake_case)]
     fn new(
         joints: Vec<Bound<'_, PyDict>>,
@@ -554,6 +595,14 @@ impl PyComputedTorque {
         armature: Option<&Bound<'_, PyAny>>,
         damping: Option<&Bound<'_, PyAny>>,
         friction: Option<&Bound<'_, PyAny>>,
+        substep: Option<f64>,
+        substeps: u32,
+        implicit_damping: bool,
+        semi_implicit: bool,
+        friction_regularisation: Option<&Bound<'_, PyAny>>,
+        friction_rate: Option<&Bound<'_, PyAny>>,
+        stiffness: Option<&Bound<'_, PyAny>>,
+        spring_reference: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let js = joints.iter().map(joint).collect::<PyResult<Vec<_>>>()?;
         let ins = inertials
@@ -589,6 +638,14 @@ impl PyComputedTorque {
             drive("damping", damping)?,
             drive("friction", friction)?,
         );
+        let (regularisation, rate) = (
+            drive("friction_regularisation", friction_regularisation)?,
+            drive("friction_rate", friction_rate)?,
+        );
+        let (k, qs) = (
+            drive("stiffness", stiffness)?,
+            drive("spring_reference", spring_reference)?,
+        );
         let p = Params {
             ts: Ts,
             kp: &kp,
@@ -603,6 +660,15 @@ impl PyComputedTorque {
             armature: &armature,
             damping: &damping,
             friction: &friction,
+            sampled: substep.map(|substep| Sampled {
+                substep,
+                substeps,
+                implicit_damping,
+                semi_implicit,
+                regularisation: &regularisation,
+                rate: &rate,
+            }),
+            spring: stiffness.map(|_| (&k[..], &qs[..])),
         };
         let inner = computed(&js, &ins, gravity, &p).map_err(config_err)?;
         Ok(Self {

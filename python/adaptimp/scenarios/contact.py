@@ -61,6 +61,7 @@ __all__ = [
     "rule_keywords",
     "sag",
     "sliding_timeconst",
+    "velocity_loop_radius",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -983,8 +984,10 @@ def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
     core's posture rule (SPEC (16.9), the position rows: not near a
     singularity, inside the joint limits with margin, gravity at most half of
     every actuator, the velocity loop well-conditioned at home, the path
-    reachable within 1 mm), no self-collision of the arm, and no joint of the
-    arm below the table top over the table. ``load``: the largest gravity
+    reachable within 1 mm), no self-collision of the arm, no joint of the
+    arm below the table top over the table, and the rule's gains' sampled
+    velocity loop stable at every posture of the path (SPEC (19.10),
+    :func:`velocity_loop_radius`). ``load``: the largest gravity
     load max_i |G_i|/τmax_i allowed (1 for a home the user gives: gravity
     within the actuators; the press, SPEC (19.6), is checked apart)."""
     from .. import _adaptimp, tuning
@@ -1011,7 +1014,66 @@ def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
     hit = amj.self_collision(plant, rows)
     if hit is not None:
         return f"free of self-collision along the path: {hit}"
-    return _through_table(sc, plant, rows)
+    through = _through_table(sc, plant, rows)
+    if through is not None:
+        return through
+    return _velocity_loop_gain(sc, plant, rows)
+
+
+ROBUST_SLOPE = 0.5
+"""The slope of (18.4)'s robust term at z2 = 0 against Kp: kr_i/φ = Kp_i/2."""
+
+
+def velocity_loop_radius(
+    inertia: ArrayLike, gain: ArrayLike, damping: ArrayLike | None, Ts: float
+) -> float:
+    """The spectral radius of the sampled velocity loop, SPEC (19.10): a joint
+    law whose torque τ_k = −K_v v_k is held over a period Ts (s) on an arm of
+    inertia D (kg m², (n, n)) with viscous damping B = diag(``damping``)
+    (N m s/rad, MuJoCo integrates it within the period; None: none) moves the
+    velocity by v_(k+1) = (E − F D⁻¹ K_v) v_k, E = e^(−Ts D⁻¹B), F = ∫₀^Ts
+    e^(−s D⁻¹B) ds; K_v = diag(``gain``) (N m s/rad). Stable below 1; without
+    damping ρ = max_i |1 − Ts λ_i(D⁻¹ K_v)|, i.e. Ts λmax < 2."""
+    d = np.asarray(inertia, dtype=np.float64)
+    n = d.shape[0]
+    b = np.zeros(n) if damping is None else np.asarray(damping, dtype=np.float64)
+    w, u = np.linalg.eigh(d)
+    half, inv_half = (u * np.sqrt(w)) @ u.T, (u / np.sqrt(w)) @ u.T
+    # D⁻¹B = D^(−½) S D^(½), S = D^(−½) B D^(−½) symmetric ≥ 0.
+    lam, v = np.linalg.eigh(inv_half @ np.diag(b) @ inv_half)
+    lam = np.maximum(lam, 0.0)
+    x = lam * Ts
+    share = np.where(x > 1e-12, -np.expm1(-x) / np.where(x > 1e-12, lam, 1.0), Ts)
+    e = inv_half @ (v * np.exp(-x)) @ v.T @ half
+    f = inv_half @ (v * share) @ v.T @ half
+    loop = e - f @ np.linalg.solve(d, np.diag(np.asarray(gain, dtype=np.float64)))
+    return float(np.max(np.abs(np.linalg.eigvals(loop))))
+
+
+def _velocity_loop_gain(sc: PandaTable, plant: Any, rows: FloatArray) -> str | None:
+    """SPEC (19.10): the rule's joint gains (:func:`rule_keywords`: the
+    inertia scales along the path) close a sampled velocity loop
+    (:func:`velocity_loop_radius`, K_v = Kp (1 + :data:`ROBUST_SLOPE`), the
+    plant's own damping) that must stay stable (ρ < 1) at every posture of
+    ``rows``; the first posture where it is not, named with ρ, or None."""
+    from .. import tuning
+
+    kv = np.asarray(rule_keywords(sc)["gains"]["Kp"], dtype=np.float64) * (1.0 + ROBUST_SLOPE)
+    damping = tuning.joint_damping(plant)
+    for k, q in enumerate(rows):
+        rho = velocity_loop_radius(tuning.inertia(plant, q), kv, damping, sc.Ts)
+        if not rho < 1.0:
+            return (
+                f"{RINGING}: at row {k} of the path the sampled velocity loop's spectral "
+                f"radius ρ(E − F D⁻¹ K_v) = {rho:.3g} ≥ 1 (K_v = Kp + kr/φ of the rule's "
+                "gains: joints whose axes line up along the path share a light inertia)"
+            )
+    return None
+
+
+RINGING = "the velocity loop stable along the path"
+"""How :func:`refusal_of` begins the refusal of a path on which the rule's
+gains would ring at half the sampling rate (SPEC (19.10))."""
 
 
 def _through_table(sc: PandaTable, plant: Any, rows: FloatArray) -> str | None:

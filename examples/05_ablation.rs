@@ -26,7 +26,7 @@ impl Recorder<2> for MaxNorms {
 
 type Variant = (&'static str, fn(&mut Config<2>));
 
-const VARIANTS: [Variant; 9] = [
+const VARIANTS: [Variant; 10] = [
     ("printed (paper)", |c| {
         *c = Config::paper(c.law).with_ts(c.ts)
     }),
@@ -46,6 +46,9 @@ const VARIANTS: [Variant; 9] = [
     ("− triangle hold (ZOH)", |c| c.observer_hold = Hold::Zero),
     ("− observer start at x(0) (π(0) = 0)", |c| {
         c.observer_init = ObserverInit::Zero
+    }),
+    ("− observer lead (9.1) (ẑ2 = α1 − ẋ̂)", |c| {
+        c.observer_lead = false
     }),
     ("+ β-free auxiliary law", |c| c.aux_law = AuxLaw::Linear),
 ];

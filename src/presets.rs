@@ -46,7 +46,8 @@ impl<const N: usize> Config<N> {
     /// - the tanh robust term (sgn chatters at 1 kHz) with φ = 0.05 rad/s;
     /// - observer: [`Hold::Triangle`](crate::control::observer::Hold::Triangle) (at Ts ≫ ε it is the backward difference
     ///   of the samples, where ZOH estimates ≈ 0 at the sample instants),
-    ///   started at the first measurement.
+    ///   started at the first measurement, its estimate compared with the
+    ///   reference the observer's lag back (`observer_lead`, (9.1), SPEC §9).
     pub fn hardened(self) -> Self {
         let mut s = Scenario::<N>::preset(Preset::Paper, self.law);
         s.config = self;

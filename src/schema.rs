@@ -372,6 +372,18 @@ pub const PARAMS: &[Param] = &[
         ),
         S("triangle"),
     ),
+    robot(
+        p(
+            "observer_lead",
+            Ctrl,
+            Flag,
+            "",
+            "output feedback compares its velocity estimate with the reference the observer's lag back, ẑ2 = α1 − L α̇1 − ẋ̂ (L: Ts/2 at Ts ≫ ε), (9.1); False: the paper's ẑ2 = α1 − ẋ̂",
+            "",
+            B(false),
+        ),
+        B(true),
+    ),
     p("tau_max", Ctrl, Joint, "N m", "actuator limits τmax (SPEC §2)", "τmax > 0", V(&[17.0, 15.0])),
     p("Dd", Ctrl, Joint, "kg m²", "target inertia Dd, (3)", "Dd > 0", R(1.0)),
     p("Cd", Ctrl, Joint, "N m s/rad", "target damping Cd, (3)", "Cd ≥ 0", R(10.0)),
@@ -750,6 +762,7 @@ impl<const N: usize> Scenario<N> {
             "lam1" => c.lam1 = joint(n, value)?,
             "observer_init" => c.observer_init = choice(p, value, &ObserverInit::ALL)?,
             "observer_hold" => c.observer_hold = choice(p, value, &Hold::ALL)?,
+            "observer_lead" => c.observer_lead = flag(n, value)?,
             "tau_max" => c.tau_max = joint(n, value)?,
             "Dd" => c.dd = joint(n, value)?,
             "Cd" => c.cd = joint(n, value)?,
@@ -922,6 +935,7 @@ impl<const N: usize> Scenario<N> {
             lam1,
             observer_init,
             observer_hold,
+            observer_lead,
             tau_max,
             dd,
             cd,
@@ -984,6 +998,7 @@ impl<const N: usize> Scenario<N> {
         f("lam1", V(lam1.as_slice()));
         f("observer_init", S(observer_init.name()));
         f("observer_hold", S(observer_hold.name()));
+        f("observer_lead", B(*observer_lead));
         f("tau_max", V(tau_max.as_slice()));
         f("Dd", V(dd.as_slice()));
         f("Cd", V(cd.as_slice()));

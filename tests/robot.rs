@@ -3,7 +3,7 @@
 
 use adaptimp::{
     run as run_loop, Config, Controller, Grid, Law, Metrics, Recorder, Row, SimConfig, Sinusoid,
-    TwoLinkArm, Vector, Wall, WeightBound,
+    Trajectory, TwoLinkArm, Vector, Wall, WeightBound,
 };
 
 /// Per-row facts the metrics do not keep.
@@ -90,10 +90,22 @@ fn robot_scenario_meets_its_targets() {
                 w.peak_after_first
             );
         }
-        // ... and the first is (14) at the paper's initial state, before any
+        // ... and the first is (14) (OF: (35) with (9.1)) at the paper's initial state, before any
         // learning or saturation: z1 + Kp z2 + r + τe with x(0) 0.05 rad inside
         // the wall (τe = 50 N m): −0.25 + 10·(−1.5) − 0.5·tanh(1.5/0.05) + 50.
-        let expect = -0.25 - 15.0 - 0.5 * (1.5f64 / 0.05).tanh() + 50.0;
+        // Output feedback compares with α1 the observer's lag L back, (9.1):
+        // ẑ2 = z2 − L α̇1, α̇1(0) = ẍd(0) = ẍc(0) − τe/Dd (ẋc(0) = 0 on joint 1,
+        // the estimate starts at 0): Kp L (50 − 0.2π²) N m more.
+        let lead = match law {
+            Law::OutputFeedback => {
+                let lag = Controller::robot(law).observer().lag()[0];
+                let c = Sinusoid::paper().sample(0.0);
+                assert_eq!(c.dx[0], 0.0);
+                -10.0 * lag * (c.ddx[0] - 50.0)
+            }
+            _ => 0.0,
+        };
+        let expect = -0.25 - 15.0 - 0.5 * (1.5f64 / 0.05).tanh() + 50.0 + lead;
         assert!(
             (w.first_tau[0] - expect).abs() < 1e-9,
             "{law:?}: τ(0) = {}",

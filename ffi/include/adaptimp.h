@@ -375,6 +375,9 @@ typedef struct AdaptimpParams {
   AdaptimpObserverInit observer_init;
   // Observer discretisation.
   AdaptimpObserverHold observer_hold;
+  // Output feedback compares its estimate with the reference the
+  // observer's lag back, (9.1) (0 or 1; paper 0, robot 1).
+  bool observer_lead;
   // Actuator limits τmax (N m).
   double tau_max[ADAPTIMP_MAX_JOINTS];
   // Target inertia Dd (kg m²), (3).

@@ -70,6 +70,9 @@ pub struct AdaptimpParams {
     pub observer_init: AdaptimpObserverInitRaw,
     /// Observer discretisation.
     pub observer_hold: AdaptimpObserverHoldRaw,
+    /// Output feedback compares its estimate with the reference the
+    /// observer's lag back, (9.1) (0 or 1; paper 0, robot 1).
+    pub observer_lead: AdaptimpBoolRaw,
     /// Actuator limits τmax (N m).
     pub tau_max: [f64; ADAPTIMP_MAX_JOINTS],
     /// Target inertia Dd (kg m²), (3).
@@ -181,6 +184,7 @@ pub(crate) fn scenario_of<const N: usize>(
         lam1,
         observer_init,
         observer_hold,
+        observer_lead,
         tau_max,
         dd,
         cd,
@@ -214,6 +218,7 @@ pub(crate) fn scenario_of<const N: usize>(
         decode::<AdaptimpWeightBound>(*weight_bound_mode, "params.weight_bound_mode")?;
     let observer_init = decode::<AdaptimpObserverInit>(*observer_init, "params.observer_init")?;
     let observer_hold = decode::<AdaptimpObserverHold>(*observer_hold, "params.observer_hold")?;
+    let observer_lead = decode_bool(*observer_lead, "params.observer_lead")?;
     let impedance = decode::<AdaptimpImpedance>(*impedance, "params.impedance")?;
     let fallback = decode::<AdaptimpFallback>(*fallback, "params.fallback")?;
     let fault_policy = decode::<AdaptimpFaultPolicy>(*fault_policy, "params.fault_policy")?;
@@ -228,7 +233,7 @@ pub(crate) fn scenario_of<const N: usize>(
         AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
         AdaptimpWeightBound::Auto => Value::Str("auto"),
     };
-    let values: [(&str, Value<'_>); 43] = [
+    let values: [(&str, Value<'_>); 44] = [
         ("Ts", Value::Real(*ts)),
         ("K1", joint(k1)),
         ("Kp", joint(kp)),
@@ -260,6 +265,7 @@ pub(crate) fn scenario_of<const N: usize>(
             "observer_hold",
             Value::Str(name_of(observer_hold, &Hold::NAMES)),
         ),
+        ("observer_lead", Value::Bool(observer_lead)),
         ("tau_max", joint(tau_max)),
         ("Dd", joint(dd)),
         ("Cd", joint(cd)),
@@ -348,6 +354,7 @@ pub(crate) fn fill_from<const N: usize>(s: &Scenario<N>, law: Law, out: &mut Ada
         lam1: [0.0; ADAPTIMP_MAX_JOINTS],
         observer_init: AdaptimpObserverInit::Zero.raw(),
         observer_hold: AdaptimpObserverHold::Zoh.raw(),
+        observer_lead: false.into(),
         tau_max: [0.0; ADAPTIMP_MAX_JOINTS],
         dd: [0.0; ADAPTIMP_MAX_JOINTS],
         cd: [0.0; ADAPTIMP_MAX_JOINTS],
@@ -418,6 +425,11 @@ pub(crate) fn fill_from<const N: usize>(s: &Scenario<N>, law: Law, out: &mut Ada
             }
             "observer_hold" => {
                 p.observer_hold = from_name::<AdaptimpObserverHold>(&Hold::NAMES, choice)
+            }
+            "observer_lead" => {
+                if let Value::Bool(b) = v {
+                    p.observer_lead = b.into();
+                }
             }
             "tau_max" => joint(&mut p.tau_max),
             "Dd" => joint(&mut p.dd),
@@ -700,6 +712,6 @@ mod tests {
         check::<7>();
         // scenario_of sets exactly the controller group's names, in order (its
         // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 43);
+        assert_eq!(controller_names().count(), 44);
     }
 }

@@ -103,6 +103,9 @@ class ControllerParams(TypedDict, total=False):
     """observer start: π(0) = 0 (paper), or π1(0) = the first measurement."""
     observer_hold: Literal["zoh", "triangle"]
     """observer discretisation: zero-order hold (SPEC §11) or triangle hold."""
+    observer_lead: bool
+    """output feedback compares its velocity estimate with the reference the observer's lag
+    back, ẑ2 = α1 − L α̇1 − ẋ̂ (L: Ts/2 at Ts ≫ ε), (9.1); False: the paper's ẑ2 = α1 − ẋ̂."""
     tau_max: float | _Joint
     """actuator limits τmax (SPEC §2) (N m)."""
     Dd: float | _Joint

@@ -142,6 +142,9 @@ pub struct Config<const N: usize> {
     pub observer_init: ObserverInit,
     /// Observer inter-sample model. SPEC §11: zero-order hold.
     pub observer_hold: Hold,
+    /// Output feedback compares the estimate with the reference the
+    /// observer's lag L back, ẑ2 = α1 − L α̇1 − ẋ̂, (9.1), SPEC §9. Paper: off.
+    pub observer_lead: bool,
     /// Actuator limits τmax (N m). Paper: [17, 15].
     pub tau_max: Vector<N>,
     /// Desired inertia Dd (kg m²). Paper: 1.
@@ -194,6 +197,7 @@ impl<const N: usize> Config<N> {
             lam1: z,
             observer_init: ObserverInit::Zero,
             observer_hold: Hold::Zero,
+            observer_lead: false,
             tau_max: z,
             dd: z,
             cd: z,

@@ -44,6 +44,9 @@ pub struct Controller<const N: usize, B = Grid<N>> {
     imp: TargetImpedance<N>,
     aux: Auxiliary<N>,
     obs: HighGainObserver<N>,
+    /// Output feedback with `observer_lead`: the observer's lag L (s) per
+    /// joint, by which ẑ2 compares with the reference half a period back (9.1).
+    lead: Option<Vector<N>>,
     robust: Robust<N>,
     learning: Learning,
     /// The weight pass's instruction set, chosen once in [`Controller::new`].
@@ -59,7 +62,8 @@ pub struct Errors<const N: usize> {
     pub z1: Vector<N>,
     /// α1 = ẋd + K1 z1 (rad/s), (7).
     pub alpha1: Vector<N>,
-    /// z2 = α1 − v (rad/s), (8).
+    /// z2 = α1 − v (rad/s), (8); with `observer_lead`, ẑ2 = α1 − L α̇1 − v
+    /// (9.1), SPEC §9.
     pub z2: Vector<N>,
     /// α̇1 = ẍd + K1 (ẋd − v) (rad/s²).
     pub dalpha1: Vector<N>,
@@ -174,11 +178,14 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
                 })
             }
         };
+        let obs = HighGainObserver::new(cfg.eps, cfg.lam1, cfg.ts, cfg.observer_hold)?;
+        let lead = (cfg.law == Law::OutputFeedback && cfg.observer_lead).then(|| *obs.lag());
         Ok(Self {
             sat: Saturation::new(cfg.tau_max)?,
             imp: TargetImpedance::new(cfg.dd, cfg.cd, cfg.gd)?,
             aux: Auxiliary::weighted(cfg.kzeta, cfg.mu, cfg.aux_law, cfg.inertia, cfg.rho)?,
-            obs: HighGainObserver::new(cfg.eps, cfg.lam1, cfg.ts, cfg.observer_hold)?,
+            obs,
+            lead,
             learning: Learning::new(
                 cfg.ts,
                 cfg.gamma,
@@ -873,7 +880,8 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
 
     /// Stages "reference" and "errors", SPEC §4, §5: ẍd from the target
     /// impedance (ẍc with [`ImpedanceMode::External`], SPEC §16), then z1,
-    /// α1, z2, α̇1 with the velocity `v` (rad/s).
+    /// α1, z2, α̇1 with the velocity `v` (rad/s); output feedback with
+    /// `observer_lead` compares with α1 the observer's lag back, (9.1), SPEC §9.
     pub fn errors(
         &self,
         r: &Reference<N>,
@@ -888,12 +896,18 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         let k1 = &self.cfg.k1;
         let z1 = r.xd - m.x;
         let alpha1 = r.dxd + k1.component_mul(&z1);
+        let dalpha1 = ddxd + k1.component_mul(&(r.dxd - v));
+        let mut z2 = alpha1 - v;
+        if let Some(lag) = &self.lead {
+            // (9.1), SPEC §9: the estimate is the velocity L back; so is α1.
+            z2 -= lag.component_mul(&dalpha1);
+        }
         Errors {
             ddxd,
             z1,
             alpha1,
-            z2: alpha1 - v,
-            dalpha1: ddxd + k1.component_mul(&(r.dxd - v)),
+            z2,
+            dalpha1,
         }
     }
 
@@ -1296,6 +1310,89 @@ mod tests {
         }
         assert!((ca.xd - ca.xc).norm() > 1e-4, "{ca:?}");
         assert_ne!(ca.tau, cb.tau);
+    }
+
+    /// The mean estimated error ẑ2 over t ∈ [0.1, 0.5) s of output feedback
+    /// (robot preset, external impedance: xd = xc) whose measurement follows a
+    /// ramp-accelerating setpoint exactly, xc = x0 + ½ a t²: the true z2 is 0.
+    fn estimated_error_on_a_parabola(lead: bool) -> (Vector<2>, Vector<2>, Vector<2>) {
+        let mut cfg = Config::robot(Law::OutputFeedback);
+        cfg.impedance = crate::control::impedance::ImpedanceMode::External;
+        cfg.observer_lead = lead;
+        let c = Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper()).unwrap();
+        let (x0, a) = (Vector::<2>::new(0.1, -0.2), Vector::<2>::new(2.0, -1.5));
+        let mut st = c.new_state();
+        let (mut sum, mut rows) = (Vector::<2>::zeros(), 0.0);
+        for k in 0..500 {
+            let t = k as f64 * c.period();
+            let sp = Setpoint {
+                x: x0 + a * (0.5 * t * t),
+                dx: a * t,
+                ddx: a,
+            };
+            let m = Measurement {
+                x: sp.x,
+                dx: None,
+                tau_e: Vector::zeros(),
+            };
+            let cmd = c.step(&mut st, &m, &sp).unwrap();
+            assert_eq!(cmd.z1, Vector::<2>::zeros());
+            if k >= 100 {
+                sum += cmd.z2;
+                rows += 1.0;
+            }
+        }
+        (sum / rows, a, *c.observer().lag())
+    }
+
+    /// (9.1), SPEC §9: without the lead the estimated error of exact tracking
+    /// is a L (the estimate half a period late: learning would drive the true
+    /// z2 to −a L); with it, −K1 a L², second order (K1 L = 0.003 here).
+    #[test]
+    fn the_lead_removes_the_estimated_errors_bias_on_a_ramp_accelerating_path() {
+        let (paper, a, lag) = estimated_error_on_a_parabola(false);
+        let (lead, ..) = estimated_error_on_a_parabola(true);
+        let k1 = Config::<2>::robot(Law::OutputFeedback).k1;
+        assert!((lag[0] / 1e-3 - 0.5263).abs() < 1e-4, "{lag}");
+        for i in 0..2 {
+            let bias = a[i] * lag[i];
+            assert!(
+                (paper[i] - bias).abs() < 1e-6 * bias.abs(),
+                "joint {i}: {} against a L = {bias}",
+                paper[i]
+            );
+            let second = -k1[i] * a[i] * lag[i] * lag[i];
+            assert!(
+                (lead[i] - second).abs() < 1e-6 * second.abs(),
+                "joint {i}: {} against −K1 a L² = {second}",
+                lead[i]
+            );
+            assert!(lead[i].abs() < 0.02 * paper[i].abs(), "{lead} vs {paper}");
+        }
+    }
+
+    #[test]
+    fn the_lead_is_output_feedbacks_only_and_the_papers_is_off() {
+        assert!(!Config::<2>::paper(Law::OutputFeedback).observer_lead);
+        assert!(Config::<2>::robot(Law::OutputFeedback).observer_lead);
+        // State feedback measures the velocity at t_k: no lag, no lead.
+        let mut on = Config::robot(Law::StateFeedback);
+        on.observer_lead = true;
+        let mut off = on;
+        off.observer_lead = false;
+        let [a, b] = [on, off].map(|cfg| {
+            let c = Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper()).unwrap();
+            let mut st = c.new_state();
+            let m = measurement();
+            (0..20)
+                .map(|k| {
+                    let sp = Sinusoid::paper().sample(k as f64 * c.period());
+                    c.step(&mut st, &m, &sp).unwrap()
+                })
+                .last()
+                .unwrap()
+        });
+        assert_eq!(a, b);
     }
 
     #[test]

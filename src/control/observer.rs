@@ -12,6 +12,12 @@
 //! sampled impulse response): −2.1% at the paper's Ts = 50 µs, ε = 1e-4.
 //! [`Hold::Triangle`] interpolates y linearly between samples, which a ramp
 //! satisfies exactly, and has no such deficit.
+//!
+//! **Lag.** Either way the estimate of a ramp-accelerating signal is late:
+//! with y_k = ½ a t_k², the steady estimate is `ẋ̂_k = g a (t_k − L)` with the
+//! gain g above (1 for the triangle hold) and the lag L of [`lag`](HighGainObserver::lag),
+//! (9.1), SPEC §9: λ1 ε when Ts ≪ ε, Ts/2 when Ts ≫ ε (the backward
+//! difference of the samples).
 
 use crate::error::{check, Error};
 use crate::types::{choices, Vector};
@@ -46,6 +52,8 @@ pub struct HighGainObserver<const N: usize> {
     gam0: [Vector2<f64>; N],
     /// Response to the input's increment over the period, ramped (triangle hold).
     gam1: [Vector2<f64>; N],
+    /// The estimate's lag L (s) to a ramp-accelerating signal, (9.1).
+    lag: Vector<N>,
 }
 
 /// Observer state per joint: π1 (rad, tracks x), π2 (rad; ε × velocity), and
@@ -104,6 +112,10 @@ impl<const N: usize> HighGainObserver<N> {
             gam1[i] = e.fixed_view::<2, 1>(0, 3).into_owned();
             check::finite_slice("observer discretisation", e.as_slice())?;
         }
+        let mut lag = Vector::zeros();
+        for i in 0..N {
+            lag[i] = lag_of(&phi[i], &gam0[i], &gam1[i], ts, hold);
+        }
         Ok(Self {
             eps,
             lam1,
@@ -111,6 +123,7 @@ impl<const N: usize> HighGainObserver<N> {
             phi,
             gam0,
             gam1,
+            lag,
         })
     }
 
@@ -125,6 +138,13 @@ impl<const N: usize> HighGainObserver<N> {
     /// The inter-sample model.
     pub fn hold(&self) -> Hold {
         self.hold
+    }
+    /// The lag L (s) of the sampled estimate behind the velocity of a
+    /// ramp-accelerating signal, per joint, (9.1), SPEC §9: with y_k = ½ a t_k²
+    /// the steady estimate is g a (t_k − L) (g = 1 for the triangle hold).
+    /// 0.526 ms at the robot preset's Ts = 1 ms, ε = 1e-4 s, λ1 = 3.
+    pub fn lag(&self) -> &Vector<N> {
+        &self.lag
     }
 
     /// Velocity estimate ẋ̂ = π2/ε (rad/s).
@@ -173,6 +193,37 @@ impl<const N: usize> HighGainObserver<N> {
         let (f, g0, g1) = (&self.phi[i], &self.gam0[i], &self.gam1[i]);
         st.pi1[i] = f[(0, 0)] * p1 + f[(0, 1)] * p2 + g0[0] * y + g1[0] * dy;
         st.pi2[i] = f[(1, 0)] * p1 + f[(1, 1)] * p2 + g0[1] * y + g1[1] * dy;
+    }
+}
+
+/// The lag L (s) of one joint's discrete observer, (9.1), SPEC §9: the
+/// steady response to the samples y_k = ½ (k Ts)² is a polynomial in k,
+/// π_k = p + q k + r k², since each step is
+/// π_k = Φ π_{k−1} + Γ0 y_{k−1} + h Γ1 (y_k − y_{k−1}) (h = 1 for the triangle
+/// hold, 0 for ZOH, the estimate read at t_k). Matching the powers of k, with
+/// c = Ts²/2 and (I − Φ) invertible (Φ = e^{A Ts} is stable):
+/// (I − Φ) r = c Γ0, (I − Φ) q = 2c (h Γ1 − Γ0) − 2Φ r,
+/// (I − Φ) p = c (Γ0 − h Γ1) − Φ (q − r).
+/// Then r₂ = 0, ẋ̂_k = (p₂ + q₂ k)/ε = g (t_k − L) with L = −Ts p₂/q₂.
+/// An estimate that does not move with the signal (q₂ = 0: ZOH at Ts/ε in
+/// the thousands) has no lag to speak of: 0.
+fn lag_of(phi: &Matrix2<f64>, g0: &Vector2<f64>, g1: &Vector2<f64>, ts: f64, hold: Hold) -> f64 {
+    let h = match hold {
+        Hold::Zero => 0.0,
+        Hold::Triangle => 1.0,
+    };
+    let Some(m) = (Matrix2::identity() - phi).try_inverse() else {
+        return 0.0;
+    };
+    let c = 0.5 * ts * ts;
+    let r = m * (g0 * c);
+    let q = m * ((g1 * h - g0) * (2.0 * c) - phi * r * 2.0);
+    let p = m * ((g0 - g1 * h) * c - phi * (q - r));
+    let lag = -ts * p[1] / q[1];
+    if lag.is_finite() {
+        lag
+    } else {
+        0.0
     }
 }
 
@@ -352,6 +403,58 @@ mod tests {
         m[(2, 3)] = 1.0;
         let err = (expm_taylor(&m) - expm(&m)).abs().max();
         assert!(err < 1e-14, "{err:e}");
+    }
+
+    /// The lag (9.1) is what running the observer on y = ½ a t² shows: the
+    /// last two estimates give the gain g (their slope over a) and the offset,
+    /// ẋ̂_k = g a (t_k − L).
+    #[test]
+    fn lag_is_the_estimates_delay_on_a_ramp_accelerating_signal() {
+        let a = 2.0;
+        for (hold, periods) in [
+            (Hold::Triangle, &[1e-5, 5e-5, 2e-4, 1e-3, 4e-3][..]),
+            (Hold::Zero, &[1e-5, 5e-5, 2e-4, 1e-3][..]),
+        ] {
+            for &ts in periods {
+                let obs =
+                    HighGainObserver::<1>::new(1e-4, Vector::<1>::new(3.0), ts, hold).unwrap();
+                let mut st = ObserverState::zeros();
+                let steps = ((0.05 / ts).round() as usize).max(100);
+                let mut est = [0.0; 2];
+                for k in 0..steps {
+                    let t = k as f64 * ts;
+                    let y = Vector::<1>::new(0.5 * a * t * t);
+                    obs.measure(&mut st, &y, k == 0);
+                    est = [est[1], obs.estimate(&st)[0]];
+                    obs.finish(&mut st, &y);
+                }
+                let t = (steps - 1) as f64 * ts;
+                let g = (est[1] - est[0]) / (a * ts);
+                let lag = t - est[1] / (g * a);
+                let want = obs.lag()[0];
+                assert!(
+                    (lag - want).abs() < 1e-6 * ts,
+                    "{hold:?} Ts = {ts}: ran {lag:e} s, (9.1) {want:e} s (gain {g})"
+                );
+                if hold == Hold::Triangle {
+                    assert!((g - 1.0).abs() < 1e-6, "Ts = {ts}: gain {g}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_triangle_holds_lag_is_lam1_eps_when_fast_and_half_a_period_when_slow() {
+        let lag = |ts: f64| {
+            HighGainObserver::<1>::new(1e-4, Vector::<1>::new(3.0), ts, Hold::Triangle)
+                .unwrap()
+                .lag()[0]
+        };
+        // Ts ≪ ε: the continuous observer's λ1 ε = 0.3 ms.
+        assert!((lag(1e-6) - 3e-4).abs() < 1e-3 * 3e-4, "{:e}", lag(1e-6));
+        // Ts ≫ ε: the backward difference, Ts/2 (0.526 Ts at Ts/ε = 10).
+        assert!((lag(1e-2) / 1e-2 - 0.5).abs() < 1e-6, "{:e}", lag(1e-2));
+        assert!((lag(1e-3) / 1e-3 - 0.5263).abs() < 1e-4, "{:e}", lag(1e-3));
     }
 
     #[test]

@@ -45,7 +45,7 @@ from . import _adaptimp
 from ._adaptimp import Measurement
 from ._errors import ConfigError, MeasurementError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
-from ._pose import CartesianStep, PoseTarget, call_shape
+from ._pose import CartesianStep, PoseTarget, _outside, call_shape
 from .chain import Chain
 
 __all__ = [
@@ -150,7 +150,7 @@ def _measured(
         "CartesianController.step(q, dq, wrench) is deprecated: pass one "
         "adaptimp.Measurement(q, dq, wrench=wrench)",
         DeprecationWarning,
-        stacklevel=3,
+        stacklevel=_outside(),
     )
     return q, dq, wrench
 

@@ -198,6 +198,49 @@ def test_the_cartesian_controllers_old_call_gives_the_same_bits() -> None:
     )
 
 
+def test_the_cartesian_step_is_the_cores_own_method() -> None:
+    """``CartesianController.step(m)`` goes from the call to the core (no
+    Python frame between: docs/performance.md) with the Python method's bits;
+    a path or ``record`` set later takes effect; a path that holds its
+    controller is collected with it."""
+    import gc
+    import weakref
+
+    kw: dict[str, Any] = {"q0": [0.3, 0.6], "Kd_rot": 0.0, "tau_max": 20.0, "Kp": 5.0}
+    p0 = _arm().pose(np.array(kw["q0"]))[0]
+
+    def circle(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        c, s = np.cos(np.pi * t), np.sin(np.pi * t)
+        p = p0 + 0.01 * np.array([c - 1.0, s, 0.0])
+        return p, 0.01 * np.pi * np.array([-s, c, 0.0]), np.zeros(3)
+
+    fast = adaptimp.CartesianController(_arm(), "sf", path=circle, **kw)
+    slow = adaptimp.CartesianController(_arm(), "sf", path=circle, **kw)
+    assert type(fast.step).__name__ == "builtin_function_or_method"
+    python_step = adaptimp.CartesianController.step  # the method written in Python
+    wrench = [0.5, -0.2, 0.0, 0.0, 0.0, 0.1]
+    for k in range(20):
+        m = Measurement([0.3 + 1e-3 * k, 0.6 - 1e-3 * k], [0.01, -0.02], wrench=wrench)
+        if k == 10:
+            fast.path = slow.path = None  # from now on the last target held
+        if k == 15:
+            fast.record = slow.record = False
+        np.testing.assert_array_equal(fast.step(m), python_step(slow, m))
+    assert fast._k == slow._k == 20
+    for key, rows in fast.arrays().items():
+        np.testing.assert_array_equal(rows, slow.arrays()[key])
+        assert len(rows) == 15  # rows 15 to 19 not kept
+    np.testing.assert_array_equal(fast.arrays()["pc"][9], circle(9e-3)[0])
+    # A path that refers to its controller: a cycle through the core's step.
+    held = adaptimp.CartesianController(_arm(), "sf", **kw)
+    held.path = lambda t, ctrl=held: circle(t + ctrl.Ts)
+    held.step(Measurement(kw["q0"], [0.0, 0.0]))
+    gone = weakref.ref(held)
+    del held
+    gc.collect()
+    assert gone() is None
+
+
 class _PD:
     """A joint PD written in Python, in the protocol's call shape."""
 

@@ -16,6 +16,7 @@ __all__ = [
     "MAX_JOINTS",
     "N_NODES",
     "CartesianImpedance",
+    "CartesianStep",
     "Chain",
     "ComputedTorque",
     "Controller",
@@ -769,6 +770,21 @@ def default_task(
     home: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """The default task of SPEC §18: (xc_offset, xc_sin, xc_cos, xc_omega)."""
+
+@final
+class CartesianStep:
+    """``CartesianController.step`` as the core's own method: ``step(m)`` goes
+    straight to the core; any other call to ``other``."""
+
+    def __new__(
+        cls,
+        core: CartesianImpedance,
+        joint: Controller | ComputedTorque | None,
+        path: Any,
+        other: Callable[..., _F],
+        record: bool,
+    ) -> CartesianStep: ...
+    def step(self, *args: Any, **kwargs: Any) -> _F: ...
 
 @disjoint_base
 class ComputedTorque:

@@ -45,7 +45,7 @@ from . import _adaptimp
 from ._adaptimp import Measurement
 from ._errors import ConfigError, MeasurementError, period_alias
 from ._params import BY_NAME, check_scenario, describe, resolve
-from ._pose import CartesianStep, PoseTarget, call_shape
+from ._pose import CartesianStep, PoseTarget, _outside, call_shape
 from .chain import Chain
 
 __all__ = [
@@ -150,7 +150,7 @@ def _measured(
         "CartesianController.step(q, dq, wrench) is deprecated: pass one "
         "adaptimp.Measurement(q, dq, wrench=wrench)",
         DeprecationWarning,
-        stacklevel=3,
+        stacklevel=_outside(),
     )
     return q, dq, wrench
 
@@ -590,13 +590,51 @@ class CartesianController:
             raise TypeError(f"the joint controller {inner!r} has no period .Ts (s)")
         self.inner = inner
         self.outer = CartesianImpedance(chain, Ts=float(Ts), q0=q0, posture=posture, **cart)
-        self.chain, self.path, self.record = chain, path, record
+        self.chain = chain
+        self._path, self._record = path, bool(record)
         self._Ts = float(Ts)
-        self._k = 0
         self._tau = np.full(chain.n, math.nan)
         self._log: dict[str, list[FloatArray]] = {k: [] for k in _LOG}
-        # The per-sample step: one call of the core (SPEC §16; issue 32).
-        self._step = self.outer.core.step_sample
+        self._bind()
+
+    def _bind(self) -> None:
+        """The per-sample step as the core's own method (docs/performance.md):
+        ``step(m)`` goes from the call to the core with no Python frame
+        between; any other call is :meth:`step`'s. A subclass's own ``step``
+        is left as it is."""
+        if type(self).step is not CartesianController.step:
+            return
+        joint = self._joint if self._core_inner else None
+        bound = _adaptimp.CartesianStep(
+            self.outer.core, joint, self._path, self._step_python, self._record
+        )
+        self.step = bound.step  # type: ignore[method-assign]
+
+    @property
+    def path(self) -> Path | None:
+        """The commanded pose's path ``path(t) -> (p, ṗ, p̈[, R, ω, ω̇])``, called
+        at t_k by a step given no pose (None: the last target held)."""
+        return self._path
+
+    @path.setter
+    def path(self, path: Path | None) -> None:
+        self._path = path
+        self._bind()
+
+    @property
+    def record(self) -> bool:
+        """Whether each step's row is kept for :attr:`log` and :meth:`arrays`."""
+        return self._record
+
+    @record.setter
+    def record(self, record: bool) -> None:
+        self._record = bool(record)
+        self._bind()
+
+    @property
+    def _k(self) -> int:
+        """Steps taken: the outer loop's clock, t_k = k·Ts."""
+        return int(self.outer.core.steps)
 
     @classmethod
     def from_rule(
@@ -804,7 +842,6 @@ class CartesianController:
         reset = getattr(self.inner, "reset", None)
         if callable(reset):
             reset()
-        self._k = 0
         for v in self.log.values():
             v.clear()
 
@@ -836,6 +873,28 @@ class CartesianController:
         :attr:`output`. ``step(q, dq, wrench)`` works, with a
         ``DeprecationWarning``.
         """
+        return self._step_python(
+            m, dq, wrench, xc=xc, dxc=dxc, ddxc=ddxc, R=R, w=w, dw=dw, target=target, q=q
+        )
+
+    def _step_python(
+        self,
+        m: Measurement | ArrayLike | None = None,
+        dq: ArrayLike | None = None,
+        wrench: ArrayLike | None = None,
+        *,
+        xc: ArrayLike | None = None,
+        dxc: ArrayLike | None = None,
+        ddxc: ArrayLike | None = None,
+        R: ArrayLike | None = None,
+        w: ArrayLike | None = None,
+        dw: ArrayLike | None = None,
+        target: PoseTarget | None = None,
+        q: ArrayLike | None = None,
+    ) -> FloatArray:
+        """:meth:`step` as written in Python: the calls the core's bound step
+        hands on (a pose given, the deprecated arrays, a joint controller
+        written in Python), and a subclass's ``super().step``."""
         measured: Any
         if self._core_inner and type(m) is Measurement and dq is wrench is q is None:
             measured = m  # the core reads it itself: no arrays made here
@@ -854,8 +913,10 @@ class CartesianController:
             sample = None
         if self._core_inner:
             # One call of the core: the pose and wrench read, the step, the row kept.
-            out: FloatArray = self._step(self._joint, measured, dq, wrench, sample, self.record)
-            self._k += 1
+            core = self.outer.core
+            out: FloatArray = core.step_sample(
+                self._joint, measured, dq, wrench, sample, self.record
+            )
             return out
         f = _wrench(wrench)
         # The rotation a target sets is kept only once the core accepted the step.
@@ -889,7 +950,6 @@ class CartesianController:
                 ),
             ):
                 self._log[key].append(np.array(v, dtype=np.float64))
-        self._k += 1
         return np.asarray(out)
 
     def arrays(self) -> dict[str, FloatArray]:
@@ -927,13 +987,12 @@ class CartesianController:
         assert path is not None
         return tabulate(path, steps, self.Ts, self.outer._R, start=self._k)
 
-    def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None) -> None:
+    def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None, k0: int) -> None:
         """After a run of the core's loop (:func:`adaptimp.mujoco.simulate`) along
         ``targets`` (of :meth:`_targets`), whole or stopped by an error: the clock,
         the held rotation and the attributes as after the steps it took; the log
-        extended by the run's kept rows ``task`` (None: none)."""
-        core = self.outer.core
-        k0, self._k = self._k, int(core.steps)
+        extended by the run's kept rows ``task`` (None: none); ``k0`` the steps
+        taken before it."""
         if self._k > k0 and targets is not None and self.path is not None:
             self.outer._R = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
         if self.record and task is not None and len(task["pc"]):

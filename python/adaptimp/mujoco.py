@@ -1786,6 +1786,7 @@ def _cartesian_loop(
     ctrl, reference = run.ctrl, run.reference
     table = reference.arrays if isinstance(reference, _Table) else reference
     targets = ctrl._targets(run.steps, table)
+    k0 = ctrl._k
     task: dict[str, Any] | None = None
     try:
         out: dict[str, Any] = ctrl.outer.core.simulate_mujoco(
@@ -1799,7 +1800,7 @@ def _cartesian_loop(
         task = getattr(e, "partial", None)
         raise
     finally:
-        ctrl._ran(targets, task)
+        ctrl._ran(targets, task, k0)
     return out
 
 

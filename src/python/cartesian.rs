@@ -272,6 +272,10 @@ pub trait DynOuter: Send + Sync {
     fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error>;
     /// A quantity of the last step (see [`LAST`]).
     fn last(&self, what: usize) -> Vec<f64>;
+    /// The last step's applied torque sat(τ) (N m), first n values (NaN
+    /// before a step): `last("tau_sat")` without its name's lookup or a
+    /// vector made.
+    fn applied(&self) -> [f64; MAX_JOINTS];
     /// The commanded rotation held when a target gives none (row-major).
     fn held(&self) -> [f64; 9];
     /// Hold `r` (row-major) from now on.
@@ -512,6 +516,13 @@ impl<const N: usize> DynOuter for Outer<N> {
                 })?;
         self.last = Some(LastStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
+    }
+    fn applied(&self) -> [f64; MAX_JOINTS] {
+        let mut out = [f64::NAN; MAX_JOINTS];
+        if let Some(last) = &self.last {
+            out[..N].copy_from_slice(last.cmd.joint.tau_sat.as_slice());
+        }
+        out
     }
     fn last(&self, what: usize) -> Vec<f64> {
         let Some(last) = &self.last else {
@@ -821,9 +832,12 @@ fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTa
         held.copy_from_slice(&v[9..18]);
         return Ok(pose_target(&v));
     }
-    let items: Vec<Bound<'_, PyAny>> = match obj.cast::<pyo3::types::PyTuple>() {
-        Ok(t) => t.iter().collect(),
-        Err(_) => obj
+    // A tuple (a path's return) is read in place; any other iterable is
+    // collected first.
+    let tuple = obj.cast::<pyo3::types::PyTuple>().ok();
+    let collected: Vec<Bound<'_, PyAny>> = match tuple {
+        Some(_) => Vec::new(),
+        None => obj
             .try_iter()
             .and_then(|it| it.collect::<PyResult<Vec<_>>>())
             .map_err(|_| {
@@ -832,15 +846,22 @@ fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTa
                 )
             })?,
     };
-    if items.len() != 3 && items.len() != 6 {
+    let len = tuple.map_or(collected.len(), |t| t.len());
+    if len != 3 && len != 6 {
         return Err(PyValueError::new_err(format!(
-            "path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {}",
-            items.len()
+            "path(t) must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len}"
         )));
     }
-    let get = |i: usize| items.get(i).filter(|o| !o.is_none());
+    let get = |i: usize| -> Option<Bound<'_, PyAny>> {
+        let item = match tuple {
+            Some(t) if i < len => t.get_item(i).ok(),
+            Some(_) => None,
+            None => collected.get(i).cloned(),
+        };
+        item.filter(|o| !o.is_none())
+    };
     let p = match get(0) {
-        Some(p) => reals::<3>("p_c", Some(p))?,
+        Some(p) => reals::<3>("p_c", Some(&p))?,
         None => {
             return Err(MeasurementError::new_err(
                 "the commanded position p_c is missing",
@@ -849,28 +870,28 @@ fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTa
     };
     let mut v = [0.0; TARGET_LEN];
     v[..3].copy_from_slice(&p);
-    v[3..6].copy_from_slice(&reals::<3>("dp_c", get(1))?);
-    v[6..9].copy_from_slice(&reals::<3>("ddp_c", get(2))?);
+    v[3..6].copy_from_slice(&reals::<3>("dp_c", get(1).as_ref())?);
+    v[6..9].copy_from_slice(&reals::<3>("ddp_c", get(2).as_ref())?);
     if let Some(r) = get(3) {
         let r = match r.cast::<PyArray2<f64>>() {
             Ok(a) if a.shape() == [3, 3] => {
                 core::array::from_fn(|k| a.get_owned([k / 3, k % 3]).unwrap_or(f64::NAN))
             }
             _ => {
-                if let Some(shape) = shape_other_than(r, &[&[3, 3]]) {
+                if let Some(shape) = shape_other_than(&r, &[&[3, 3]]) {
                     return Err(MeasurementError::new_err(format!(
                         "R_c must have shape (3, 3), got shape {shape}"
                     )));
                 }
-                let f = flat_any("R_c", 9, r)?;
+                let f = flat_any("R_c", 9, &r)?;
                 core::array::from_fn(|k| f[k])
             }
         };
         *held = r;
     }
     v[9..18].copy_from_slice(held);
-    v[18..21].copy_from_slice(&reals::<3>("w_c", get(4))?);
-    v[21..24].copy_from_slice(&reals::<3>("dw_c", get(5))?);
+    v[18..21].copy_from_slice(&reals::<3>("w_c", get(4).as_ref())?);
+    v[21..24].copy_from_slice(&reals::<3>("dw_c", get(5).as_ref())?);
     Ok(pose_target(&v))
 }
 
@@ -1187,6 +1208,71 @@ impl PyCartesian {
         super::wait_lock(py, &self.inner)
     }
 
+    /// The time of the next step, t_k = k·Ts (s).
+    pub(super) fn clock(&self, py: Python<'_>) -> f64 {
+        let g = self.lock(py);
+        g.steps() as f64 * g.ts()
+    }
+
+    /// The body of [`step_sample`](Self::step_sample), for the bound step of
+    /// `cartesian_step.rs` too.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn sample_step<'py>(
+        &self,
+        py: Python<'py>,
+        controller: &Bound<'py, PyAny>,
+        q: &Bound<'py, PyAny>,
+        dq: Option<&Bound<'py, PyAny>>,
+        wrench: Option<&Bound<'py, PyAny>>,
+        sample: Option<&Bound<'py, PyAny>>,
+        record: bool,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.n;
+        let mut qb = [0.0; MAX_JOINTS];
+        let mut dqb = [0.0; MAX_JOINTS];
+        let (measured_dq, f) = if let Ok(m) = q.cast::<PyMeasurement>() {
+            // An adaptimp.Measurement: read as it is, no array made.
+            let m = m.get();
+            if dq.is_some() || wrench.is_some() {
+                return Err(PyTypeError::new_err(
+                    "give the measurement as an adaptimp.Measurement or as arrays, not both",
+                ));
+            }
+            if m.n != n {
+                return Err(shape_error("q", n, &format!("length {}", m.n)));
+            }
+            qb = m.q;
+            dqb = m.dq.unwrap_or(dqb);
+            (m.dq.is_some(), m.wrench.unwrap_or([0.0; 6]))
+        } else {
+            super::vector_into("q", n, q, &mut qb)?;
+            if let Some(d) = dq {
+                super::vector_into("dq", n, d, &mut dqb)?;
+            }
+            let f = match wrench {
+                None => [0.0; 6],
+                Some(w) => wrench_sample(w)?,
+            };
+            (dq.is_some(), f)
+        };
+        let mut joint = lock_joint(py, controller, n)?;
+        let mut g = self.lock(py);
+        // The rotation a sample sets is held only once the core accepted the
+        // step: a refused one (a rotation that is not one) keeps nothing.
+        let mut held = g.held();
+        let target = match sample {
+            None => None,
+            Some(s) => Some(sample_target(s, &mut held)?),
+        };
+        let m = self.measurement(&qb, measured_dq.then_some(&dqb), f, target);
+        g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
+        g.set_held(held);
+        if record {
+            g.record();
+        }
+        Ok(array1(py, &g.applied()[..n]))
+    }
+
     fn measurement<'a>(
         &self,
         q: &'a [f64; MAX_JOINTS],
@@ -1376,50 +1462,7 @@ impl PyCartesian {
         sample: Option<&Bound<'py, PyAny>>,
         record: bool,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let n = self.n;
-        let mut qb = [0.0; MAX_JOINTS];
-        let mut dqb = [0.0; MAX_JOINTS];
-        let (measured_dq, f) = if let Ok(m) = q.cast::<PyMeasurement>() {
-            // An adaptimp.Measurement: read as it is, no array made.
-            let m = m.get();
-            if dq.is_some() || wrench.is_some() {
-                return Err(PyTypeError::new_err(
-                    "give the measurement as an adaptimp.Measurement or as arrays, not both",
-                ));
-            }
-            if m.n != n {
-                return Err(shape_error("q", n, &format!("length {}", m.n)));
-            }
-            qb = m.q;
-            dqb = m.dq.unwrap_or(dqb);
-            (m.dq.is_some(), m.wrench.unwrap_or([0.0; 6]))
-        } else {
-            super::vector_into("q", n, q, &mut qb)?;
-            if let Some(d) = dq {
-                super::vector_into("dq", n, d, &mut dqb)?;
-            }
-            let f = match wrench {
-                None => [0.0; 6],
-                Some(w) => wrench_sample(w)?,
-            };
-            (dq.is_some(), f)
-        };
-        let mut joint = lock_joint(py, controller, n)?;
-        let mut g = self.lock(py);
-        // The rotation a sample sets is held only once the core accepted the
-        // step: a refused one (a rotation that is not one) keeps nothing.
-        let mut held = g.held();
-        let target = match sample {
-            None => None,
-            Some(s) => Some(sample_target(s, &mut held)?),
-        };
-        let m = self.measurement(&qb, measured_dq.then_some(&dqb), f, target);
-        g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
-        g.set_held(held);
-        if record {
-            g.record();
-        }
-        Ok(array1(py, &g.last(16)))
+        self.sample_step(py, controller, q, dq, wrench, sample, record)
     }
 
     /// The commanded rotation a target without one keeps, (3, 3).

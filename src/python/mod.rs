@@ -37,6 +37,7 @@ mod arrays;
 mod callback;
 mod cartesian;
 mod cartesian_loop;
+mod cartesian_step;
 mod computed;
 mod controller;
 mod description;
@@ -82,6 +83,8 @@ mod adaptimp_module {
     use super::callback::simulate_mujoco_callback;
     #[pymodule_export]
     use super::cartesian::{centres_along, PyCartesian, PyChain};
+    #[pymodule_export]
+    use super::cartesian_step::PyCartesianStep;
     #[pymodule_export]
     use super::computed::PyComputedTorque;
     #[pymodule_export]

@@ -296,6 +296,25 @@ def test_the_scenario_s_rule_gains_take_continuous_joints_as_angles() -> None:
     assert gains["K1"] == [50.0] * 6
 
 
+def test_the_table_s_basis_spans_the_circle_s_joint_orbit() -> None:
+    """SPEC (19.11): the widths in q of the table's centres are at least the
+    diameter of one period of the circle's joint orbit (after the approach);
+    on the Panda's default table the rule's own widths (twice the largest step
+    between its centres) are narrower, so the widths are that diameter."""
+    sc = act.arm_table()
+    start = sc.t_approach + max(sc.t_ramp, sc.t_press)
+    steps = round((start + 1.0 / sc.freq) / sc.Ts)
+    q, _ = sc.outer().joint_orbit(lambda t: sc.path(t, depth=0.0), steps * sc.Ts, samples=steps)
+    circle = np.asarray(q)[round(start / sc.Ts) :: 4]
+    diameter = max(float(np.max(np.linalg.norm(circle - row, axis=1))) for row in circle)
+    centres, widths = act.rule_keywords(sc)["basis"]
+    n = sc.n
+    assert diameter > 0.3
+    np.testing.assert_allclose(widths[:n], diameter, rtol=2e-3)
+    steps_q = np.linalg.norm(np.diff(np.asarray(centres)[:, :n], axis=0), axis=1)
+    assert 2.0 * steps_q.max() < diameter
+
+
 def test_a_light_wrist_does_not_ring_against_the_table() -> None:
     """The UR10's last joint (d = 5e-4 kg m²) with the robot preset's fixed
     kr = 0.5 N m ran its sampled velocity loop at Ts (Kp + kr/φ)/d = 20 > 2: it

@@ -59,6 +59,39 @@ def test_suggest_follows_the_rule() -> None:
         adaptimp.Controller(case, "robot", **kw)
 
 
+def test_centres_that_span_the_orbit() -> None:
+    # SPEC (19.11): given one period of the motion that repeats, the widths in
+    # q are at least its diameter; the centres, their number and q̇'s widths
+    # are the rule's, and Ĝ's rate is normalised on the wider basis.
+    arm = adaptimp.PlanarArm(3, masses=[2.0, 1.5, 1.0], lengths=[0.4, 0.35, 0.25])
+    q0 = np.array([0.3, 0.3, 0.3])
+    args = (arm, q0, [60.0, 30.0, 15.0])
+    opts: dict[str, Any] = {"Ts": 1e-3, "path": _swing(q0), "period": 2.0}
+    rule = tuning.suggest(*args, **opts)
+    # A circle of radius 0.4 rad in joints 1 and 2: diameter 0.8 rad.
+    phi = np.linspace(0.0, 2 * math.pi, 400, endpoint=False)
+    orbit = q0 + 0.4 * np.stack([np.cos(phi), np.sin(phi), 0 * phi], axis=1)
+    wide = tuning.suggest(*args, **opts, orbit=orbit)
+    assert rule["widths"][0] < 0.8
+    np.testing.assert_allclose(wide["widths"][:3], 0.8, rtol=1e-12)
+    np.testing.assert_array_equal(wide["widths"][3:], rule["widths"][3:])
+    np.testing.assert_array_equal(wide["centers"], rule["centers"])
+    assert wide["gamma"][2] < rule["gamma"][2]
+    assert wide["Kp"] == rule["Kp"]
+    assert wide["K1"] == rule["K1"]
+    # An orbit inside the rule's widths changes nothing.
+    small = tuning.suggest(*args, **opts, orbit=q0 + 0.01 * np.eye(3))
+    for key in ("centers", "widths", "gamma", "sigma", "weight_bound"):
+        np.testing.assert_array_equal(small[key], rule[key])
+    adaptimp.Controller("sf", "robot", **wide)
+    with pytest.raises(adaptimp.ConfigError, match="orbit must have shape"):
+        tuning.suggest(*args, **opts, orbit=orbit[:, :2])
+    bad = orbit.copy()
+    bad[3, 1] = np.nan
+    with pytest.raises(adaptimp.ConfigError, match="orbit must be finite"):
+        tuning.suggest(*args, **opts, orbit=bad)
+
+
 def test_gains_alone_without_a_path() -> None:
     kw = tuning.suggest(np.diag([2.0, 0.5]), [0.0, 0.0], 10.0, Ts=2e-3)
     np.testing.assert_allclose(kw["Kp"], [250.0, 62.5], rtol=1e-15)

@@ -693,6 +693,7 @@ def suggest(
     resolve: bool = False,
     critical: bool = False,
     damping: NDArray[np.float64] | None = None,
+    orbit: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every
@@ -700,7 +701,8 @@ def suggest(
     ``resolve``: the tube narrowed to the path's size, SPEC (16.10); ``critical``:
     Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6); ``damping``
     (n,): the joints' viscous damping, the scales as the sampled loop sees them,
-    SPEC (18.9)."""
+    SPEC (18.9); ``orbit`` (K', n): one period of the joint positions that repeat,
+    the widths in q at least its diameter, SPEC (19.11)."""
 
 def pose_circle(
     p0: NDArray[np.float64],

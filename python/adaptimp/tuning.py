@@ -151,6 +151,7 @@ def suggest(
     resolve: bool = False,
     critical: bool = False,
     damping: ArrayLike | None = None,
+    orbit: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
     the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
@@ -188,6 +189,10 @@ def suggest(
         (:func:`damping`: an ``adaptimp.mujoco.Plant``'s joints, none for
         other models). The inertia scales become those the sampled velocity
         loop sees, SPEC (18.9): d̃ = b Ts/(1 − e^(−b Ts/d)), d for b = 0.
+    orbit : array_like, shape (K', n), optional
+        The joint positions (rad) of one period of the motion that repeats
+        (the table's circle, after the approach): the centres' widths in q at
+        least its diameter, SPEC (19.11) (the table scenario's). With a path only.
 
     Returns
     -------
@@ -224,9 +229,13 @@ def suggest(
         if b is None
         else np.ascontiguousarray(np.broadcast_to(np.asarray(b, dtype=np.float64), (n,)))
     )
+    if orbit is not None:
+        orbit = np.ascontiguousarray(np.asarray(orbit, dtype=np.float64))
+        if orbit.ndim != 2 or orbit.shape[1] != n:
+            raise ConfigError(f"orbit must have shape (K, {n}), got {orbit.shape}")
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
-        critical=critical, damping=b_arr,
+        critical=critical, damping=b_arr, orbit=orbit,
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

@@ -68,6 +68,10 @@ pub struct Rule {
     pub tube: [f64; 2],
     /// The factor on the smallest bound that realises τmax (2).
     pub bound_margin: f64,
+    /// The smallest width in q (rad) of the centres along the path, whatever
+    /// their spacing: the diameter of the orbit that repeats, SPEC (19.11)
+    /// ([`spanning`](Self::spanning); 0, none, by default).
+    pub span: f64,
 }
 
 impl Default for Rule {
@@ -81,6 +85,7 @@ impl Default for Rule {
             leak_periods: 25.0,
             tube: [0.2, 0.5],
             bound_margin: 2.0,
+            span: 0.0,
         }
     }
 }
@@ -221,6 +226,23 @@ impl Rule {
         rule
     }
 
+    /// The rule whose centres span the orbit `orbit` (its joint positions,
+    /// rad; one period of the motion that repeats), SPEC (19.11): the widths
+    /// in q at least its diameter max_{j,k} ‖q_j − q_k‖, so that every node
+    /// acts over the whole orbit. The number of centres (18.5) and their
+    /// places are unchanged; [`learning`](Self::learning) then normalises Γ
+    /// by the wider basis's ⟨‖S‖²⟩ as before. An empty orbit, or one whose
+    /// diameter is not finite, leaves the rule as it is.
+    #[must_use]
+    pub fn spanning<const N: usize>(&self, orbit: &[Vector<N>]) -> Self {
+        let d = diameter(orbit);
+        let mut rule = *self;
+        if d.is_finite() {
+            rule.span = rule.span.max(d);
+        }
+        rule
+    }
+
     /// K1 (1/s) at period `ts` (s), (18.2).
     pub fn k1(&self, ts: f64) -> f64 {
         self.k1_max.min(self.k1_per_step / ts)
@@ -331,7 +353,8 @@ impl Rule {
     /// Centres along `path` (one period, evenly spaced in time; see
     /// [`nodes`](Self::nodes)) in the caller's buffer `buf` (length
     /// [`nodes`](Self::nodes) · 4N): sample `⌊j·K/L⌋` for node j, widths
-    /// (15.2) with the rule's tube ([`Centers::along_in`], SPEC §15).
+    /// (15.2) with the rule's tube ([`Centers::along_in`], SPEC §15), in q at
+    /// least the rule's [`span`](Self::span) (SPEC (19.11)).
     /// `scratch` holds L setpoints.
     pub fn centres_in<const N: usize, C: AsRef<[f64]> + AsMut<[f64]>>(
         &self,
@@ -349,7 +372,8 @@ impl Rule {
         for (j, s) in scratch.iter_mut().enumerate() {
             *s = path[j * path.len() / l];
         }
-        Centers::along_in(buf, scratch, self.tube)
+        // (19.11): widths in q of at least the span; the spacing (18.5) as it is.
+        Centers::along_in(buf, scratch, [self.tube[0].max(self.span), self.tube[1]])
     }
 
     /// The learning of SPEC (18.6)–(18.8) into `cfg` for `basis` along `path`
@@ -543,6 +567,22 @@ pub fn default_task<const N: usize>(
     )
 }
 
+/// The diameter max_{j,k} ‖q_j − q_k‖ (rad) of the joint positions `orbit`
+/// (0 for fewer than two), SPEC (19.11). NaN if a position is not finite.
+pub fn diameter<const N: usize>(orbit: &[Vector<N>]) -> f64 {
+    let mut d2 = 0.0f64;
+    for (j, a) in orbit.iter().enumerate() {
+        for b in &orbit[j + 1..] {
+            let e = (a - b).norm_squared();
+            if !e.is_finite() {
+                return f64::NAN;
+            }
+            d2 = d2.max(e);
+        }
+    }
+    sqrt(d2)
+}
+
 /// The largest swing A (rad) of [`default_task`].
 pub const TASK_AMPLITUDE: f64 = 0.2;
 
@@ -666,6 +706,74 @@ mod tests {
         assert!((t.sample(1.0).x - Vector::<2>::new(0.5, 0.3)).norm() < 1e-15);
         let e = default_task(&Vector::<2>::new(0.9, 0.2), &lo, &hi).unwrap_err();
         assert!(e.to_string().contains("lo + A ≤ home ≤ hi − A"), "{e}");
+    }
+
+    #[test]
+    fn centres_that_span_the_orbit_keep_their_places_and_learn_at_the_same_bandwidth() {
+        // Four points of a circle of radius 0.3 rad in two joints: diameter 0.6.
+        let r = 0.3;
+        let ring = [
+            Vector::<2>::new(r, 0.0),
+            Vector::<2>::new(0.0, r),
+            Vector::<2>::new(-r, 0.0),
+            Vector::<2>::new(0.0, -r),
+        ];
+        assert!((diameter(&ring) - 2.0 * r).abs() < 1e-15);
+        assert_eq!(diameter::<2>(&ring[..1]), 0.0);
+        assert!(diameter(&[Vector::<2>::new(f64::NAN, 0.0), ring[0]]).is_nan());
+        let rule = Rule::default();
+        assert_eq!(rule.span, 0.0);
+        assert_eq!(rule.spanning::<2>(&[]), rule);
+        assert_eq!(
+            rule.spanning(&[Vector::<2>::new(f64::NAN, 0.0), ring[0]]),
+            rule
+        );
+        // The default task on three joints (±0.2 rad): the rule's widths in q
+        // are below 1 rad; spanning an orbit of diameter 1.5 rad widens them
+        // to 1.5 and nothing else: the same centres, the same q̇ widths, and
+        // Γ_G ⟨‖S‖²⟩ = ω_G² for the wider basis as for the rule's (18.6).
+        let d = arm_matrix();
+        let tau = Vector::<3>::new(50.0, 20.0, 5.0);
+        let traj = default_task(
+            &Vector::<3>::zeros(),
+            &Vector::from_element(-1.0),
+            &Vector::from_element(1.0),
+        )
+        .unwrap();
+        let path = Rule::sample(&traj, 2.0);
+        let orbit = [Vector::<3>::zeros(), Vector::<3>::new(1.5, 0.0, 0.0)];
+        let wide = rule.spanning(&orbit);
+        assert_eq!(wide.span, 1.5);
+        let suggest = |r: &Rule| {
+            r.suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, None)
+                .unwrap()
+        };
+        let (a, b) = (suggest(&rule), suggest(&wide));
+        assert_eq!(a.centers.centers(), b.centers.centers());
+        assert_eq!(a.centers.widths2()[1], b.centers.widths2()[1]);
+        let (wa, wb) = (a.centers.widths2()[0][0], b.centers.widths2()[0][0]);
+        assert!(
+            sqrt(wa) < 1.0 && (sqrt(wb) - 1.5).abs() < 1e-12,
+            "{wa} {wb}"
+        );
+        let s2 = |c: &Centers<3, alloc::vec::Vec<f64>>| {
+            let mut s = alloc::vec![0.0; c.nodes()];
+            path.iter()
+                .map(|sp| {
+                    c.eval(&[sp.x, sp.dx, sp.dx, sp.ddx], &mut s);
+                    s.iter().map(|v| v * v).sum::<f64>()
+                })
+                .sum::<f64>()
+                / path.len() as f64
+        };
+        let omega2 = |g: f64, c| g * s2(c);
+        let (oa, ob) = (
+            omega2(a.config.gamma[2], &a.centers),
+            omega2(b.config.gamma[2], &b.centers),
+        );
+        assert!((oa - ob).abs() < 1e-9 * oa, "{oa} {ob}");
+        assert!(b.config.gamma[2] < a.config.gamma[2]);
+        Controller::new(b.config, b.centers).unwrap();
     }
 
     #[test]

@@ -35,9 +35,11 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// `critical`: Ĝ learns at the velocity loop's critical bandwidth, SPEC
 /// (19.6) (the table scenario's). `damping` (n,; N m s/rad): the joints'
 /// viscous damping, if the plant has it: the scales as the sampled velocity
-/// loop sees them, SPEC (18.9).
+/// loop sees them, SPEC (18.9). `orbit` (K', n; rad): the joint positions of
+/// one period of the motion that repeats (the table's circle): the widths in
+/// q at least its diameter, SPEC (19.11) (the table scenario's).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -51,6 +53,7 @@ pub fn suggest<'py>(
     resolve: bool,
     critical: bool,
     damping: Option<PyReadonlyArray1<'py, f64>>,
+    orbit: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -82,6 +85,22 @@ pub fn suggest<'py>(
         Some(b) if b.shape() == [n] => Some(b.as_array().iter().copied().collect()),
         Some(b) => return Err(shape_error("damping", format!("({n},)"), b.shape())),
     };
+    let orbit: Option<Vec<f64>> = match orbit {
+        None => None,
+        Some(o) if o.shape()[1] == n => {
+            let v: Vec<f64> = o.as_array().iter().copied().collect();
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Err(ConfigError::new_err(format!(
+                    "orbit must be finite (rad), got {} at row {}, joint {}",
+                    v[i],
+                    i / n,
+                    i % n
+                )));
+            }
+            Some(v)
+        }
+        Some(o) => return Err(shape_error("orbit", format!("(K, {n})"), o.shape())),
+    };
     let path: Option<(Vec<f64>, f64)> = match (path, period) {
         (None, _) => None,
         (Some(p), Some(period)) => {
@@ -107,6 +126,7 @@ pub fn suggest<'py>(
             path.as_ref(),
             gravity.as_deref(),
             damping.as_deref(),
+            orbit.as_deref(),
             (resolve, critical),
         ),
         _ => unreachable!("n checked above"),
@@ -125,6 +145,7 @@ fn fill<'py, const N: usize>(
     path: Option<&(Vec<f64>, f64)>,
     gravity: Option<&[f64]>,
     damping: Option<&[f64]>,
+    orbit: Option<&[f64]>,
     (resolve, critical): (bool, bool),
 ) -> PyResult<()> {
     let err = |e: Error| config_error(e.into());
@@ -166,6 +187,10 @@ fn fill<'py, const N: usize>(
                 .collect();
             if resolve && !samples.is_empty() {
                 rule = resolving(&rule, &samples);
+            }
+            if let Some(o) = orbit {
+                let qs: Vec<Vector<N>> = o.chunks_exact(N).map(Vector::from_column_slice).collect();
+                rule = rule.spanning(&qs);
             }
             let g = gravity.map(Vector::<N>::from_column_slice);
             let sug = rule

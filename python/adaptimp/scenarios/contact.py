@@ -1187,7 +1187,9 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
     F_e = 0, taken as one period of that length), the inertia scales the
     smallest along it (16.12), Ĝ's learning near the velocity loop's critical
     bandwidth (``tuning.suggest(critical=True)``) and K1 = min(:data:`CONTACT_K1`,
-    the rule's (18.2)) (SPEC (19.6)). Returns ``gains`` (Kp, Kzeta, K1), ``basis`` (centres,
+    the rule's (18.2)) (SPEC (19.6)), the centres' widths in q at least the
+    diameter of the circle's joint orbit, one period after the approach (SPEC
+    (19.11)). Returns ``gains`` (Kp, Kzeta, K1), ``basis`` (centres,
     widths) and the rest (gamma, sigma, weight_bound, kr, …) as keywords."""
     from .. import mujoco as amj
     from .. import tuning
@@ -1202,9 +1204,12 @@ def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
         k = min(round(t / sc.Ts), steps - 1)
         return q[k], dq[k], ddq[k]
 
+    # (19.11): the circle repeats, the hold and the approach do not; the
+    # centres' widths in q span the circle's joint orbit.
+    circle = q[min(round(start / sc.Ts), steps - 1) :]
     kw = tuning.suggest(
         amj.Plant(sc.model), sc.q0, sc.tau_max, Ts=sc.Ts, path=path, period=steps * sc.Ts,
-        case=case, critical=True,
+        case=case, critical=True, orbit=circle,
     )  # fmt: skip
     kw["K1"] = [min(CONTACT_K1, float(kw["K1"][0]))] * sc.n  # never above (18.2)
     out: dict[str, Any] = {

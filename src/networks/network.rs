@@ -680,6 +680,43 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
         }
     }
 
+    /// [`scale_network`](Self::scale_network) on the instruction set `path`
+    /// (each weight times `factor`, the same bits on every path).
+    pub fn scale_network_on(&mut self, path: SimdPath, net: usize, factor: f64) {
+        struct Scale<'w, 'v, const N: usize> {
+            w: &'v mut WeightsMut<'w, N>,
+            net: usize,
+            factor: f64,
+        }
+        impl<const N: usize> WithSimd for Scale<'_, '_, N> {
+            type Output = ();
+            #[inline(always)]
+            fn with_simd<S: Simd>(self, simd: S) {
+                let Self { w, net, factor } = self;
+                let (first, count) = match net {
+                    D => (row_index(N, D, 0), N * N),
+                    C => (row_index(N, C, 0), N * N),
+                    _ => (row_index(N, G, 0), N),
+                };
+                let f = simd.splat_f64s(factor);
+                for i in first..first + count {
+                    let (head, tail) = S::as_mut_simd_f64s(w.row_mut(i));
+                    for v in head {
+                        *v = simd.mul_f64s(*v, f);
+                    }
+                    for x in tail {
+                        *x *= factor;
+                    }
+                }
+            }
+        }
+        path.run(Scale {
+            w: self,
+            net,
+            factor,
+        });
+    }
+
     /// One step of the networks in a single pass over the weights, on the
     /// instruction set `path` (a controller passes its own,
     /// [`Controller::simd`](crate::Controller::simd)): returns the output

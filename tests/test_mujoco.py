@@ -492,6 +492,46 @@ def test_the_native_loop_with_a_reference_and_seven_joints_in_contact() -> None:
     assert np.max(np.abs(native.wrench_ee[:, 2])) > 1.0
 
 
+def test_steps_inside_a_period_skip_pure_sensors_and_change_nothing(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The Panda on its table (two MuJoCo steps a period, a force and a torque
+    sensor at the tool): the step inside each period leaves the sensors out
+    (they are pure functions of the state, and only the period's end is
+    sensed), and the run is the same bits as with every step's sensors, in
+    contact too. A sensor with noise is not pure."""
+    q0 = np.array(_models.PANDA_HOME)
+
+    def down(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        xc = q0.copy()
+        xc[1] += 0.6 * t
+        v = np.zeros(7)
+        v[1] = 0.6
+        return xc, v, np.zeros(7)
+
+    def run() -> amj.MujocoResult:
+        ctrl = adaptimp.Controller(
+            "pd", "robot", n=7, tau_max=list(_models.PANDA_EFFORT), impedance="external",
+            Kp=[40.0, 40.0, 40.0, 40.0, 4.0, 4.0, 4.0], K1=20.0, Kzeta=1000.0,
+            centers=np.zeros((1, 28)), widths=1.0,
+        )  # fmt: skip
+        return amj.simulate(ctrl, amj.Plant("panda"), T=0.6, q0=q0, reference=down)
+
+    plant = amj.Plant("panda")
+    assert plant.model.nsensor >= 2
+    assert amj._pure_sensors(plant.model)
+    quiet = run()
+    monkeypatch.setattr(amj, "_pure_sensors", lambda m: False)
+    every = run()
+    _assert_same_run(quiet, every)
+    assert quiet.metrics["steps_in_contact"] > 50
+    np.testing.assert_array_equal(quiet.wrench_ee, every.wrench_ee)
+    monkeypatch.undo()
+    noisy = amj.panda(table_height=None)
+    noisy.sensor_noise[0] = 0.1
+    assert not amj._pure_sensors(noisy)
+
+
 def test_a_used_controller_goes_on_along_its_trajectory() -> None:
     """A controller that has run before is used as it is: its clock goes on."""
     a = adaptimp.Controller("sf", "robot")

@@ -88,6 +88,8 @@ type Handler = Option<unsafe extern "C-unwind" fn(*const c_char)>;
 
 /// mjtStage: `mjSTAGE_VEL` (mjtype.h), the stage `mj_forwardSkip` skips to.
 const STAGE_VEL: c_int = 2;
+/// mjtStage: `mjSTAGE_NONE` (mjtype.h): `mj_forwardSkip` skips nothing.
+const STAGE_NONE: c_int = 0;
 /// mjtState: `mjSTATE_TIME` (mjtype.h).
 const STATE_TIME: c_int = 1;
 
@@ -540,6 +542,32 @@ impl Sim {
         let l = &self.lib;
         // SAFETY: as above; the integrator functions take the computed data.
         guarded(|| unsafe {
+            (l.check_acc)(m, d);
+            match integrator {
+                0 => (l.euler)(m, d),
+                1 => (l.runge_kutta)(m, d, 4),
+                _ => (l.implicit)(m, d),
+            }
+        })
+    }
+
+    /// `mj_step` without the sensors of its forward computation: what
+    /// `mj_step` does (`mj_checkPos`, `mj_checkVel`, the forward
+    /// computation, `mj_checkAcc`, the model's `integrator` as in
+    /// [`Sim::step_computed`]) with the forward computation
+    /// `mj_forwardSkip(m, d, mjSTAGE_NONE, 1)`. The same state as `mj_step`
+    /// when the model's sensors are pure functions of the state (no noise,
+    /// history, delay or interval, no user or plugin sensors): only
+    /// `sensordata` (and what the acceleration sensors leave in `cacc`,
+    /// `cfrc_int`, `cfrc_ext`) is not brought up to date.
+    pub fn step_without_sensors(&mut self, integrator: i32) -> Result<(), Error> {
+        let l = &self.lib;
+        let (m, d) = (self.p.model, self.p.data);
+        // SAFETY: model and data are a live pair (from_raw), used by us only.
+        guarded(|| unsafe {
+            (l.check_pos)(m, d);
+            (l.check_vel)(m, d);
+            (l.forward_skip)(m, d, STAGE_NONE, 1);
             (l.check_acc)(m, d);
             match integrator {
                 0 => (l.euler)(m, d),

@@ -810,6 +810,7 @@ class Plant:
             "substeps": int(substeps),
             "timestep": float(m.opt.timestep),
             "integrator": int(m.opt.integrator),
+            "pure_sensors": _pure_sensors(m),
             "dof_names": [
                 _name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)
             ],
@@ -848,6 +849,24 @@ _NETFORCE_DATA = sum(
     )
 )
 """The contact sensor's ``data="force torque pos"`` (sensor_intprm[0])."""
+
+
+def _pure_sensors(m: Any) -> bool:
+    """Whether every sensor of ``m`` is a pure function of the state: no
+    noise, history, delay or interval (fields of newer MuJoCo, absent:
+    none), no user or plugin sensors, no plugins. A MuJoCo step inside a
+    control period may then skip the sensors (only the period's last forward
+    computation is read)."""
+    if m.nplugin or m.nsensor == 0:
+        return bool(m.nplugin == 0)
+    kinds = {int(mujoco.mjtSensor.mjSENS_USER), int(mujoco.mjtSensor.mjSENS_PLUGIN)}
+    if any(int(t) in kinds for t in m.sensor_type):
+        return False
+    for field in ("sensor_noise", "sensor_history", "sensor_delay", "sensor_interval"):
+        values = getattr(m, field, None)
+        if values is not None and np.any(np.asarray(values) != 0):
+            return False
+    return True
 
 
 def _warning_names() -> list[str]:

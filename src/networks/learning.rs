@@ -237,7 +237,7 @@ impl Learning {
         let z2 = self.learning_error(&sig.z2, dtau);
         let mut new = w.update(path, s, &sig.dalpha1, &sig.alpha1, &z2, &rates);
         if let Some(bound) = self.bound {
-            project(w, &mut new, &bound);
+            project_on(path, w, &mut new, &bound);
         }
         *norms = new;
     }
@@ -260,9 +260,20 @@ impl Learning {
 /// 1996, ch. 4 and 8: the Euler step followed by the projection). `norms` are
 /// the networks' norms, updated.
 pub fn project<const N: usize>(w: &mut WeightsMut<'_, N>, norms: &mut [f64; 3], bound: &[f64; 3]) {
+    project_on(SimdPath::portable(), w, norms, bound);
+}
+
+/// [`project`] with the scaling on the instruction set `path` (the same
+/// bits; a controller passes its own).
+pub fn project_on<const N: usize>(
+    path: SimdPath,
+    w: &mut WeightsMut<'_, N>,
+    norms: &mut [f64; 3],
+    bound: &[f64; 3],
+) {
     for net in 0..3 {
         if norms[net] > bound[net] {
-            w.scale_network(net, bound[net] / norms[net]);
+            w.scale_network_on(path, net, bound[net] / norms[net]);
             norms[net] = bound[net];
         }
     }

@@ -381,6 +381,93 @@ pub(crate) fn dot_on(path: SimdPath, a: &[f64], b: &[f64]) -> f64 {
     path.run(Dot(a, b))
 }
 
+/// `Ŵr · S` of `R` rows sharing the basis, each vector of S loaded once
+/// for all of them. Each row's sum is [`dot`]'s, operation for operation
+/// (two accumulators, even and odd vectors, then the scalar tail), so the
+/// results are the same bits as `R` calls of [`dot`]; each row at least as
+/// long as S. Plain loops over the rows (no closures, which would leave the
+/// vector operations outside the instruction set's compiled function).
+#[inline(always)]
+fn dot_rows<S: Simd, const R: usize>(simd: S, rows: [&[f64]; R], s: &[f64]) -> [f64; R] {
+    let l = s.len();
+    let n = l - l % (2 * S::F64_LANES);
+    let (sh, sr) = s.split_at(n);
+    let (sv, _) = pulp::as_arrays::<2, _>(S::as_simd_f64s(sh).0);
+    let pairs = sv.len();
+    let mut wv: [&[[S::f64s; 2]]; R] = [&[]; R];
+    for r in 0..R {
+        wv[r] = &pulp::as_arrays::<2, _>(S::as_simd_f64s(&rows[r][..n]).0).0[..pairs];
+    }
+    let mut d = [[simd.splat_f64s(0.0); 2]; R];
+    for (p, y) in sv.iter().enumerate() {
+        for r in 0..R {
+            let x = &wv[r][p];
+            for i in 0..2 {
+                d[r][i] = simd.add_f64s(d[r][i], simd.mul_f64s(x[i], y[i]));
+            }
+        }
+    }
+    let mut out = [0.0; R];
+    for r in 0..R {
+        let mut sum = simd.reduce_sum_f64s(simd.add_f64s(d[r][0], d[r][1]));
+        for (x, y) in rows[r][n..l].iter().zip(sr) {
+            sum += x * y;
+        }
+        out[r] = sum;
+    }
+    out
+}
+
+/// `Ŵ0 ← a0 Ŵ0 + b0 S` and `Ŵ1 ← a1 Ŵ1 + b1 S`, each vector of S loaded
+/// once for both; returns each new row's `‖Ŵr‖²`. Each row is
+/// [`update_row`]'s, operation for operation (the same bits); both rows as
+/// long as S.
+#[inline(always)]
+fn update_pair<S: Simd>(
+    simd: S,
+    w0: &mut [f64],
+    w1: &mut [f64],
+    s: &[f64],
+    (a0, b0): (f64, f64),
+    (a1, b1): (f64, f64),
+) -> (f64, f64) {
+    let l = s.len();
+    let n = l - l % (2 * S::F64_LANES);
+    let (sh, sr) = s.split_at(n);
+    let (sv, _) = pulp::as_arrays::<2, _>(S::as_simd_f64s(sh).0);
+    let pairs = sv.len();
+    let (h0, t0) = w0[..l].split_at_mut(n);
+    let (h1, t1) = w1[..l].split_at_mut(n);
+    let h0 = &mut pulp::as_arrays_mut::<2, _>(S::as_mut_simd_f64s(h0).0).0[..pairs];
+    let h1 = &mut pulp::as_arrays_mut::<2, _>(S::as_mut_simd_f64s(h1).0).0[..pairs];
+    let (a0v, b0v, a1v, b1v) = (
+        simd.splat_f64s(a0),
+        simd.splat_f64s(b0),
+        simd.splat_f64s(a1),
+        simd.splat_f64s(b1),
+    );
+    let (mut q0, mut q1) = ([simd.splat_f64s(0.0); 2], [simd.splat_f64s(0.0); 2]);
+    for ((x0, x1), y) in h0.iter_mut().zip(h1.iter_mut()).zip(sv) {
+        for i in 0..2 {
+            let v0 = simd.add_f64s(simd.mul_f64s(a0v, x0[i]), simd.mul_f64s(b0v, y[i]));
+            let v1 = simd.add_f64s(simd.mul_f64s(a1v, x1[i]), simd.mul_f64s(b1v, y[i]));
+            q0[i] = simd.add_f64s(q0[i], simd.mul_f64s(v0, v0));
+            q1[i] = simd.add_f64s(q1[i], simd.mul_f64s(v1, v1));
+            x0[i] = v0;
+            x1[i] = v1;
+        }
+    }
+    let mut sq0 = simd.reduce_sum_f64s(simd.add_f64s(q0[0], q0[1]));
+    let mut sq1 = simd.reduce_sum_f64s(simd.add_f64s(q1[0], q1[1]));
+    for ((v0, v1), &sv) in t0.iter_mut().zip(t1.iter_mut()).zip(sr) {
+        *v0 = a0 * *v0 + b0 * sv;
+        sq0 += *v0 * *v0;
+        *v1 = a1 * *v1 + b1 * sv;
+        sq1 += *v1 * *v1;
+    }
+    (sq0, sq1)
+}
+
 /// The weights of the three networks, read-only: a view of a state's buffer
 /// (or of a caller's flat array, [`Weights::from_rows`]).
 ///
@@ -505,11 +592,25 @@ impl<'a, const N: usize> Weights<'a, N> {
                     dalpha1,
                     alpha1,
                 } = self;
+                // Each row's dot as `dot` sums it, four rows per pass over
+                // S (the sums, and so the output, are the same bits).
+                let s = &s[..s.len().min(w.nodes)];
                 Vector::from_fn(|k, _| {
-                    let mut out = dot(simd, w.g(k), s);
-                    for j in 0..N {
-                        out += dot(simd, w.d(k, j), s) * dalpha1[j]
-                            + dot(simd, w.c(k, j), s) * alpha1[j];
+                    let [mut out] = dot_rows(simd, [w.g(k)], s);
+                    let mut j = 0;
+                    while j + 1 < N {
+                        let [d0, c0, d1, c1] = dot_rows(
+                            simd,
+                            [w.d(k, j), w.c(k, j), w.d(k, j + 1), w.c(k, j + 1)],
+                            s,
+                        );
+                        out += d0 * dalpha1[j] + c0 * alpha1[j];
+                        out += d1 * dalpha1[j + 1] + c1 * alpha1[j + 1];
+                        j += 2;
+                    }
+                    if j < N {
+                        let [d0, c0] = dot_rows(simd, [w.d(k, j), w.c(k, j)], s);
+                        out += d0 * dalpha1[j] + c0 * alpha1[j];
                     }
                     out
                 })
@@ -577,6 +678,43 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
         for i in first..first + count {
             self.row_mut(i).iter_mut().for_each(|w| *w *= factor);
         }
+    }
+
+    /// [`scale_network`](Self::scale_network) on the instruction set `path`
+    /// (each weight times `factor`, the same bits on every path).
+    pub fn scale_network_on(&mut self, path: SimdPath, net: usize, factor: f64) {
+        struct Scale<'w, 'v, const N: usize> {
+            w: &'v mut WeightsMut<'w, N>,
+            net: usize,
+            factor: f64,
+        }
+        impl<const N: usize> WithSimd for Scale<'_, '_, N> {
+            type Output = ();
+            #[inline(always)]
+            fn with_simd<S: Simd>(self, simd: S) {
+                let Self { w, net, factor } = self;
+                let (first, count) = match net {
+                    D => (row_index(N, D, 0), N * N),
+                    C => (row_index(N, C, 0), N * N),
+                    _ => (row_index(N, G, 0), N),
+                };
+                let f = simd.splat_f64s(factor);
+                for i in first..first + count {
+                    let (head, tail) = S::as_mut_simd_f64s(w.row_mut(i));
+                    for v in head {
+                        *v = simd.mul_f64s(*v, f);
+                    }
+                    for x in tail {
+                        *x *= factor;
+                    }
+                }
+            }
+        }
+        path.run(Scale {
+            w: self,
+            net,
+            factor,
+        });
     }
 
     /// One step of the networks in a single pass over the weights, on the
@@ -734,14 +872,34 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
                 let s = &s[..w.nodes];
                 let mut sq = [0.0; 3];
                 let (a, gain) = (rates.decay, rates.gain);
+                let (l, stride) = (w.nodes, w.stride);
+                let (d, rest) = w.rows.split_at_mut(N * N * stride);
+                let (c, g) = rest.split_at_mut(N * N * stride);
                 for k in 0..N {
                     let gz = z2[k];
                     for j in 0..N {
                         let (bd, bc) = (gain[D] * dalpha1[j] * gz, gain[C] * alpha1[j] * gz);
-                        sq[D] += update_row(simd, w.d_mut(k, j), s, a[D], bd);
-                        sq[C] += update_row(simd, w.c_mut(k, j), s, a[C], bc);
+                        // ŴD[k][j] and ŴC[k][j] in one pass over S, each row
+                        // as `update_row` updates it; the norms summed in order.
+                        let r = (k * N + j) * stride;
+                        let (nd, nc) = update_pair(
+                            simd,
+                            &mut d[r..r + l],
+                            &mut c[r..r + l],
+                            s,
+                            (a[D], bd),
+                            (a[C], bc),
+                        );
+                        sq[D] += nd;
+                        sq[C] += nc;
                     }
-                    sq[G] += update_row(simd, w.g_mut(k), s, a[G], gain[G] * gz);
+                    sq[G] += update_row(
+                        simd,
+                        &mut g[k * stride..k * stride + l],
+                        s,
+                        a[G],
+                        gain[G] * gz,
+                    );
                 }
                 sq.map(sqrt)
             }

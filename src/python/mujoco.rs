@@ -76,6 +76,12 @@ pub struct MujocoSpec {
     /// The model's integrator (`mjtIntegrator`: 0 Euler, 1 RK4, 2 implicit,
     /// 3 implicitfast).
     pub integrator: i32,
+    /// Whether every sensor of the model is a pure function of the state
+    /// (none with noise, history, delay or interval, no user or plugin
+    /// sensors): a MuJoCo step inside a period may then leave the sensors
+    /// out of its forward computation, as only the period's last forward
+    /// computation is sensed ([`Sim::step_without_sensors`]).
+    pub pure_sensors: bool,
     /// The joint name of each DOF of the model (for messages).
     pub dof_names: Vec<String>,
     /// The names of MuJoCo's warning kinds, by index (`mjtWarning`).
@@ -552,7 +558,14 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
                     applied[dofs[i]] = f[i];
                 }
             }
-            if let Err(e) = self.sim.step() {
+            // A step inside the period: its sensors are not read (the
+            // period's last forward computation is sensed).
+            let stepped = if self.spec.pure_sensors {
+                self.sim.step_without_sensors(self.spec.integrator)
+            } else {
+                self.sim.step()
+            };
+            if let Err(e) = stepped {
                 return Err(self.fatal(e));
             }
             self.stepped()?;

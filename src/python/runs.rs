@@ -222,6 +222,7 @@ pub(super) fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec>
                 )))
             }
         },
+        pure_sensors: get(d, "pure_sensors")?,
         dof_names: get(d, "dof_names")?,
         warning_names: get(d, "warning_names")?,
     })

@@ -93,15 +93,16 @@ fn robot_scenario_meets_its_targets() {
         // ... and the first is (14) (OF: (35) with (9.1)) at the paper's initial state, before any
         // learning or saturation: z1 + Kp z2 + r + τe with x(0) 0.05 rad inside
         // the wall (τe = 50 N m): −0.25 + 10·(−1.5) − 0.5·tanh(1.5/0.05) + 50.
-        // Output feedback compares with α1 the observer's lag L back, (9.1):
-        // ẑ2 = z2 − L α̇1, α̇1(0) = ẍd(0) = ẍc(0) − τe/Dd (ẋc(0) = 0 on joint 1,
-        // the estimate starts at 0): Kp L (50 − 0.2π²) N m more.
+        // Output feedback compares with α1 the observer's lag L back, (9.1),
+        // along the commanded motion, (9.2): ẑ2 = z2 − L α̇1°, α̇1°(0) = ẍc(0)
+        // (ẋc(0) = 0 on joint 1, the estimate starts at 0; not ẍd(0), which
+        // holds the wall's −τe/Dd of this sample): Kp L 0.2π² N m less.
         let lead = match law {
             Law::OutputFeedback => {
                 let lag = Controller::robot(law).observer().lag()[0];
                 let c = Sinusoid::paper().sample(0.0);
                 assert_eq!(c.dx[0], 0.0);
-                -10.0 * lag * (c.ddx[0] - 50.0)
+                -10.0 * lag * c.ddx[0]
             }
             _ => 0.0,
         };

@@ -32,7 +32,9 @@ The native output-feedback run (``native_disturbed``, the robot preset) was
 written again, ``--write-native`` by this loop's build, when output feedback
 came to compare its estimate with the reference the observer's lag back (SPEC
 (9.1)): its RMS ‖z1‖ 0.25495 → 0.25462 rad (a noisy, delayed, faulted 1 s run,
-75 % saturated), the other native cases' digests unchanged.
+75 % saturated), the other native cases' digests unchanged; and again when
+the lead came to extrapolate the commanded motion, not the wall's sampled
+τe (SPEC (9.2)): 0.25462 → 0.25457 rad, the others unchanged.
 """
 
 from __future__ import annotations

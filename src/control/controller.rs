@@ -62,8 +62,8 @@ pub struct Errors<const N: usize> {
     pub z1: Vector<N>,
     /// α1 = ẋd + K1 z1 (rad/s), (7).
     pub alpha1: Vector<N>,
-    /// z2 = α1 − v (rad/s), (8); with `observer_lead`, ẑ2 = α1 − L α̇1 − v
-    /// (9.1), SPEC §9.
+    /// z2 = α1 − v (rad/s), (8); with `observer_lead`, ẑ2 = α1 − L α̇1° − v,
+    /// α̇1° = ẍc + K1 (ẋd − v) (9.1), (9.2), SPEC §9.
     pub z2: Vector<N>,
     /// α̇1 = ẍd + K1 (ẋd − v) (rad/s²).
     pub dalpha1: Vector<N>,
@@ -660,7 +660,13 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             },
         };
         let v = self.velocity(st.k, &mut staged.observer, m)?;
-        let e = self.errors(&staged.reference, c, m, &v);
+        // (9.2), SPEC §9: the lead extrapolates the commanded motion, never
+        // the compliance that this sample's wrench accelerates.
+        let planned = match task {
+            Some(t) if t.share < 1.0 => t.commanded.ddx,
+            _ => c.ddx,
+        };
+        let e = self.errors_along(&staged.reference, c, m, &v, &planned);
         self.check_bounded(st, &e, &v)?;
         let task = match task {
             // n = 1 is the admittance law itself, bit for bit.
@@ -881,13 +887,27 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     /// Stages "reference" and "errors", SPEC §4, §5: ẍd from the target
     /// impedance (ẍc with [`ImpedanceMode::External`], SPEC §16), then z1,
     /// α1, z2, α̇1 with the velocity `v` (rad/s); output feedback with
-    /// `observer_lead` compares with α1 the observer's lag back, (9.1), SPEC §9.
+    /// `observer_lead` compares with α1 the observer's lag back, (9.1), along
+    /// the setpoint's acceleration ẍc, (9.2), SPEC §9.
     pub fn errors(
         &self,
         r: &Reference<N>,
         c: &Setpoint<N>,
         m: &Measurement<N>,
         v: &Vector<N>,
+    ) -> Errors<N> {
+        self.errors_along(r, c, m, v, &c.ddx)
+    }
+
+    /// [`errors`](Self::errors) with the lead of (9.1) along the commanded
+    /// acceleration `planned` (rad/s²), (9.2): α1 − L (ẍc + K1 (ẋd − v)).
+    fn errors_along(
+        &self,
+        r: &Reference<N>,
+        c: &Setpoint<N>,
+        m: &Measurement<N>,
+        v: &Vector<N>,
+        planned: &Vector<N>,
     ) -> Errors<N> {
         let ddxd = match self.cfg.impedance {
             ImpedanceMode::Joint => self.imp.accel(c, r, &m.tau_e),
@@ -899,8 +919,11 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         let dalpha1 = ddxd + k1.component_mul(&(r.dxd - v));
         let mut z2 = alpha1 - v;
         if let Some(lag) = &self.lead {
-            // (9.1), SPEC §9: the estimate is the velocity L back; so is α1.
-            z2 -= lag.component_mul(&dalpha1);
+            // (9.1), SPEC §9: the estimate is the velocity L back; so is α1,
+            // extrapolated along the commanded acceleration, (9.2): ẍd holds
+            // the sampled wrench, which the lead would feed through.
+            let along = planned + k1.component_mul(&(r.dxd - v));
+            z2 -= lag.component_mul(&along);
         }
         Errors {
             ddxd,
@@ -1368,6 +1391,68 @@ mod tests {
                 lead[i]
             );
             assert!(lead[i].abs() < 0.02 * paper[i].abs(), "{lead} vs {paper}");
+        }
+    }
+
+    /// (9.2), SPEC §9: the lead extrapolates the commanded motion, so the
+    /// wrench sampled at t_k (in ẍd: τe in the joint impedance, the compliant
+    /// reference's acceleration J⁺F/M_d in the torque-level formulations)
+    /// does not reach ẑ2 of the same step; it still reaches the torque
+    /// (τe, α̇1), so the steps compared are not one and the same.
+    #[test]
+    fn the_lead_does_not_feed_the_sampled_wrench_through() {
+        let steps = |cfg: Config<2>, wrench: f64| {
+            let c = Controller::for_trajectory(cfg, Grid::paper(), &Sinusoid::paper()).unwrap();
+            let mut st = c.new_state();
+            let task = |sp: Setpoint<2>, share: f64| TaskTorque {
+                commanded: sp,
+                jacobian: nalgebra::SMatrix::<f64, 6, 2>::from_fn(|r, k| {
+                    if r < 2 {
+                        0.3 + 0.1 * (r + 2 * k) as f64
+                    } else {
+                        0.0
+                    }
+                }),
+                spring: Vector::<6>::from_element(1.0),
+                damping: Vector::<6>::from_element(20.0),
+                twist: Vector::zeros(),
+                lambda2: Vector::<6>::from_element(1e-4),
+                share,
+            };
+            let mut cmd = None;
+            for k in 0..40 {
+                let sp = Sinusoid::paper().sample(c.time(&st));
+                let x = sp.x + Vector::<2>::new(1e-3, -2e-3) * (k as f64 * 0.1).sin();
+                let last = k == 39;
+                let w = if last { wrench } else { 0.0 };
+                let m = Measurement {
+                    x,
+                    dx: None,
+                    tau_e: Vector::<2>::new(3.0, -2.0) * w,
+                };
+                // The compliant reference the outer loop hands over: the
+                // commanded one, but accelerated by this sample's wrench.
+                let compliant = Setpoint {
+                    ddx: sp.ddx + Vector::<2>::new(40.0, 25.0) * w,
+                    ..sp
+                };
+                cmd = Some(match cfg.impedance {
+                    ImpedanceMode::Joint => c.step(&mut st, &m, &sp),
+                    ImpedanceMode::External => c.step_task(&mut st, &m, &compliant, &task(sp, 0.3)),
+                });
+            }
+            cmd.unwrap().unwrap()
+        };
+        for impedance in [ImpedanceMode::Joint, ImpedanceMode::External] {
+            let mut cfg = Config::robot(Law::OutputFeedback);
+            cfg.impedance = impedance;
+            assert!(cfg.observer_lead);
+            let (free, pressed) = (steps(cfg, 0.0), steps(cfg, 1.0));
+            assert_eq!(free.z2, pressed.z2, "{impedance:?}");
+            assert_ne!(free.tau, pressed.tau, "{impedance:?}");
+            // The lead is on: ẑ2 is not the paper's.
+            cfg.observer_lead = false;
+            assert_ne!(steps(cfg, 1.0).z2, pressed.z2, "{impedance:?}");
         }
     }
 

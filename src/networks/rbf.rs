@@ -578,6 +578,32 @@ mod tests {
     }
 
     #[test]
+    fn grouped_nodes_give_each_node_its_own_sum_bit_for_bit() {
+        // L = 11: two groups of four, a pair and one node left over; a block
+        // left out (infinite widths) and one infinite width inside a block.
+        const L: usize = 11;
+        let c: [f64; L * 8] = core::array::from_fn(|i| ((i * 37 % 101) as f64 - 50.0) / 17.0);
+        let mut w = [Vector::<2>::new(0.7, 1.3); 4];
+        w[1] = Vector::<2>::from_element(f64::INFINITY);
+        w[3] = Vector::<2>::new(2.5, f64::INFINITY);
+        let basis = Centers::<2, &[f64]>::new(&c[..], w).unwrap();
+        let z = z_of([0.3, -1.2, 4.0, -0.5, 0.9, 0.0, -2.2, 1.7]);
+        let mut s = [0.0; L];
+        basis.eval(&z, &mut s);
+        let inv = w.map(|b| b.map(|v| 1.0 / v));
+        for (j, sj) in s.iter().enumerate() {
+            let mut d = 0.0;
+            for b in [0, 2, 3] {
+                for i in 0..2 {
+                    let e = z[b][i] - c[j * 8 + b * 2 + i];
+                    d += e * e * inv[b][i];
+                }
+            }
+            assert_eq!(sj.to_bits(), exp(-d).to_bits(), "node {j}");
+        }
+    }
+
+    #[test]
     fn widths_per_dimension_scale_each_dimension() {
         // One node at the origin of R^4 (N = 1); widths 1, 4, 9, 16.
         let w = [1.0, 4.0, 9.0, 16.0].map(Vector::<1>::new);

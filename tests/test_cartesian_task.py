@@ -204,3 +204,26 @@ def test_self_collision_is_seen_on_the_skeleton_and_on_geometry(tmp_path: Path) 
     assert hit == "row 1: 'a'–'c' touch"
     assert arm.model.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     assert chain_of(arm).joint_names == ["j1", "j2", "j3"]
+
+
+def test_a_table_path_gives_its_rows_then_holds_the_last_pose_at_rest() -> None:
+    from adaptimp._cartesian_task import TablePath
+
+    p = np.arange(9.0).reshape(3, 3)
+    dp, ddp = p + 1.0, p + 2.0
+    path = TablePath((p, dp, ddp), 1e-3)
+    rows = path.table(5, 1e-3)
+    assert rows.shape == (5, 24)
+    np.testing.assert_array_equal(rows[:3, 0:9], np.hstack([p, dp, ddp]))
+    np.testing.assert_array_equal(rows[3:, 0:3], np.repeat(p[-1:], 2, axis=0))
+    assert not rows[3:, 3:9].any()
+    assert not rows[:, 18:24].any()
+    np.testing.assert_array_equal(rows[:, 9:18], np.tile(np.eye(3).ravel(), (5, 1)))
+    within = path.table(2, 1e-3, start=1)
+    np.testing.assert_array_equal(within, rows[1:3])
+    within[:] = 0.0  # a copy: the path's rows are untouched
+    np.testing.assert_array_equal(path.table(3, 1e-3), rows[:3])
+    bad = dp.copy()
+    bad[1, 2] = np.nan
+    with pytest.raises(adaptimp.ConfigError, match="pose array dp must be finite"):
+        TablePath((p, bad, ddp), 1e-3)

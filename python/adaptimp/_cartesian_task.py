@@ -122,20 +122,24 @@ class TablePath:
             )
         k = a[0].shape[0] if a[0].ndim == 2 else 0
         shapes = [(k, 3)] * 3 + [(k, 3, 3), (k, 3), (k, 3)]
-        for name, x, want in zip(("p", "dp", "ddp", "R", "w", "dw"), a, shapes):
+        names = ("p", "dp", "ddp", "R", "w", "dw")
+        for name, x, want in zip(names, a, shapes):
             if k == 0 or x.shape != want:
                 raise ConfigError(
                     f"pose array {name} must have shape {want} (K ≥ 1), got {x.shape}"
                 )
-            if not np.all(np.isfinite(x)):
-                raise ConfigError(f"pose array {name} must be finite")
-        rows = np.zeros((k, 24))
-        rows[:, 9:18] = np.eye(3).reshape(9)
+        rows = np.empty((k, 24))
         for i in range(3):
             rows[:, 3 * i : 3 * i + 3] = a[i]
         if len(a) == 6:
             rows[:, 9:18] = a[3].reshape(k, 9)
             rows[:, 18:21], rows[:, 21:24] = a[4], a[5]
+        else:
+            rows[:, 9:18] = np.eye(3).reshape(9)
+            rows[:, 18:24] = 0.0
+        if not np.isfinite(rows).all():  # one pass; the first array that is not, named
+            bad = next(n for n, x in zip(names, a) if not np.all(np.isfinite(x)))
+            raise ConfigError(f"pose array {bad} must be finite")
         self.rows, self.Ts, self.orients = rows, float(Ts), len(a) == 6
         self.span = k * self.Ts
         """The rows' duration (s)."""
@@ -144,8 +148,10 @@ class TablePath:
         """Rows start … start + steps − 1 (the table's period must be ``Ts``)."""
         if not math.isclose(Ts, self.Ts, rel_tol=1e-12):
             raise ConfigError(f"the pose arrays are at Ts = {self.Ts:g} s, not {Ts:g} s")
+        if start >= 0 and start + steps <= self.rows.shape[0]:
+            return self.rows[start : start + steps].copy()  # within the rows: one copy
         idx = np.arange(start, start + steps)
-        out = self.rows[np.minimum(idx, self.rows.shape[0] - 1)].copy()
+        out = self.rows[np.minimum(idx, self.rows.shape[0] - 1)]
         out[idx >= self.rows.shape[0], 3:9] = 0.0  # held at rest
         out[idx >= self.rows.shape[0], 18:24] = 0.0
         return out

@@ -822,11 +822,14 @@ impl<const N: usize> Kinematics<N> for Chain<N> {
         }
     }
 
+    fn pose(&self, q: &Vector<N>) -> (Vector<3>, Rotation3<f64>) {
+        Chain::pose(self, q)
+    }
     fn fk(&self, q: &Vector<N>) -> Vector<3> {
-        self.pose(q).0
+        Chain::pose(self, q).0
     }
     fn rotation(&self, q: &Vector<N>) -> Rotation3<f64> {
-        self.pose(q).1
+        Chain::pose(self, q).1
     }
     fn jacobian(&self, q: &Vector<N>) -> Jacobian6<N> {
         self.pose_jacobian(q).jacobian

@@ -54,6 +54,13 @@ pub trait Kinematics<const N: usize> {
     /// Cartesian step makes).
     fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> Tip<N>;
 
+    /// Position p (m) and rotation R (world ← tip) at q, the pose of
+    /// [`tip`](Self::tip) without its Jacobian and `J̇ q̇` (the same values:
+    /// an implementation that overrides it computes them as `tip` does).
+    fn pose(&self, q: &Vector<N>) -> (Vector<3>, Rotation3<f64>) {
+        let t = self.tip(q, &Vector::zeros());
+        (t.position, t.rotation)
+    }
     /// Position p = fk(q) (m).
     fn fk(&self, q: &Vector<N>) -> Vector<3> {
         self.tip(q, &Vector::zeros()).position

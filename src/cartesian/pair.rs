@@ -199,19 +199,30 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         check::finite_slice("q", m.q.as_slice())?;
         check::within("q", m.q.as_slice(), BOUND)?;
         let staged = self.stage(outer, target, &m.wrench)?;
-        let tip = self.kinematics().tip(&m.q, &Vector::zeros());
-        let tau_e = if self.config().force_feedforward {
-            tip.jacobian.transpose() * m.wrench
+        let cfg = self.config();
+        let torque_level = cfg.formulation != Formulation::Admittance;
+        // The Jacobian at the measured q only when the force feed-forward or
+        // a torque-level formulation needs it; the pose alone otherwise (the
+        // same values).
+        let mut tau_e = Vector::zeros();
+        let mut task = None;
+        let (position, rotation) = if cfg.force_feedforward || torque_level {
+            let tip = self.kinematics().tip(&m.q, &Vector::zeros());
+            if cfg.force_feedforward {
+                tau_e = tip.jacobian.transpose() * m.wrench;
+            }
+            if torque_level {
+                task = Some(self.task_torque(&staged, &tip));
+            }
+            (tip.position, tip.rotation)
         } else {
-            Vector::zeros()
+            self.kinematics().pose(&m.q)
         };
         let meas = Measurement {
             x: m.q,
             dx: m.dq,
             tau_e,
         };
-        let task = (self.config().formulation != Formulation::Admittance)
-            .then(|| self.task_torque(&staged, &tip));
         let joint = joint(&meas, &staged.reference, task.as_ref())?;
         *outer = staged.next;
         Ok(CartesianCommand {
@@ -221,8 +232,8 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             compliant: staged.compliant,
             target: staged.target,
             error: staged.error,
-            p: tip.position,
-            r: tip.rotation,
+            p: position,
+            r: rotation,
             tau_e,
         })
     }

@@ -114,6 +114,7 @@ impl<const N: usize> Grid<N> {
             }
         }
         Centers {
+            quads: quads(&c, 4 * N),
             centers: c,
             nodes: grid_nodes(N),
             inv_w2: [Vector::from_element(self.inv_eta2); 4],
@@ -173,6 +174,28 @@ pub struct Centers<const N: usize, C> {
     inv_w2: [Vector<N>; 4],
     /// The blocks with at least one finite width (the others add nothing).
     active: [bool; 4],
+    /// The centres of the first ⌊L/4⌋·4 nodes by groups of four, coordinate
+    /// by coordinate (group g: μ_{4g..4g+4, d} for d = 0, 1, …): the
+    /// evaluation takes four nodes per pass over Z, lane by lane, each node's
+    /// sum in the order of the row-major one (the same bits). With a heap only.
+    #[cfg(feature = "alloc")]
+    quads: alloc::vec::Vec<f64>,
+}
+
+/// The centres `c` (rows of `width` coordinates) of the first ⌊L/4⌋·4 nodes
+/// by groups of four, coordinate by coordinate ([`Centers`]' `quads`).
+#[cfg(feature = "alloc")]
+fn quads(c: &[f64], width: usize) -> alloc::vec::Vec<f64> {
+    let groups = c.len() / width / 4;
+    let mut out = alloc::vec::Vec::with_capacity(groups * 4 * width);
+    for g in 0..groups {
+        for d in 0..width {
+            for l in 0..4 {
+                out.push(c[(4 * g + l) * width + d]);
+            }
+        }
+    }
+    out
 }
 
 impl<const N: usize, C: AsRef<[f64]>> Centers<N, C> {
@@ -207,6 +230,8 @@ impl<const N: usize, C: AsRef<[f64]>> Centers<N, C> {
         }
         Ok(Self {
             nodes: len / (4 * N),
+            #[cfg(feature = "alloc")]
+            quads: quads(centers.as_ref(), 4 * N),
             centers,
             inv_w2,
             active,
@@ -239,6 +264,36 @@ impl<const N: usize, C: AsRef<[f64]>> Basis<N> for Centers<N, C> {
     #[inline(always)]
     fn eval(&self, z: &[Vector<N>; 4], s: &mut [f64]) {
         let c = self.centers.as_ref();
+        // Four nodes per pass over Z from the grouped centres: each lane's
+        // sum term by term as the pairs' below (the same bits), the four
+        // lanes one vector operation where the path has them.
+        #[cfg(feature = "alloc")]
+        let (s, c) = {
+            let groups = s.len().min(self.nodes) / 4;
+            for (sg, mg) in s
+                .chunks_exact_mut(4)
+                .zip(self.quads.chunks_exact(16 * N))
+                .take(groups)
+            {
+                let mut acc = [0.0f64; 4];
+                for (b, (zb, wb)) in z.iter().zip(&self.inv_w2).enumerate() {
+                    if !self.active[b] {
+                        continue;
+                    }
+                    let block = &mg[4 * b * N..4 * (b + 1) * N];
+                    for ((zi, wi), m) in zb.iter().zip(wb.iter()).zip(block.chunks_exact(4)) {
+                        for l in 0..4 {
+                            let e = zi - m[l];
+                            acc[l] += e * e * wi;
+                        }
+                    }
+                }
+                for l in 0..4 {
+                    sg[l] = exp(-acc[l]);
+                }
+            }
+            (&mut s[4 * groups..], &c[16 * N * groups..])
+        };
         // Σ_d (Z_d − μ_jd)² / η_d² over the active blocks, in order: one
         // bounds check per block (not per term), two nodes per iteration
         // sharing each Z_d and 1/η_d² (each node's sum is the same bits).
@@ -519,6 +574,32 @@ mod tests {
                 let tol = 1e-13 * b[j].abs() + 1e-300;
                 assert!((a[j] - b[j]).abs() <= tol, "node {j}: {} vs {}", a[j], b[j]);
             }
+        }
+    }
+
+    #[test]
+    fn grouped_nodes_give_each_node_its_own_sum_bit_for_bit() {
+        // L = 11: two groups of four, a pair and one node left over; a block
+        // left out (infinite widths) and one infinite width inside a block.
+        const L: usize = 11;
+        let c: [f64; L * 8] = core::array::from_fn(|i| ((i * 37 % 101) as f64 - 50.0) / 17.0);
+        let mut w = [Vector::<2>::new(0.7, 1.3); 4];
+        w[1] = Vector::<2>::from_element(f64::INFINITY);
+        w[3] = Vector::<2>::new(2.5, f64::INFINITY);
+        let basis = Centers::<2, &[f64]>::new(&c[..], w).unwrap();
+        let z = z_of([0.3, -1.2, 4.0, -0.5, 0.9, 0.0, -2.2, 1.7]);
+        let mut s = [0.0; L];
+        basis.eval(&z, &mut s);
+        let inv = w.map(|b| b.map(|v| 1.0 / v));
+        for (j, sj) in s.iter().enumerate() {
+            let mut d = 0.0;
+            for b in [0, 2, 3] {
+                for i in 0..2 {
+                    let e = z[b][i] - c[j * 8 + b * 2 + i];
+                    d += e * e * inv[b][i];
+                }
+            }
+            assert_eq!(sj.to_bits(), exp(-d).to_bits(), "node {j}");
         }
     }
 

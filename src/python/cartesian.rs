@@ -1020,7 +1020,12 @@ fn rows(n: usize, what: &str, a: &PyReadonlyArray2<'_, f64>, width: usize) -> Py
             python_shape(a.shape())
         )));
     }
-    Ok(a.as_array().iter().copied().collect())
+    // A C-contiguous array (as NumPy makes one) in one copy; any other
+    // layout element by element, in the same row-major order.
+    Ok(match a.as_slice() {
+        Ok(flat) => flat.to_vec(),
+        Err(_) => a.as_array().iter().copied().collect(),
+    })
 }
 
 // ---------------------------------------------------------------------------

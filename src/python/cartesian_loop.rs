@@ -38,7 +38,7 @@ use crate::sim::record::{Recorder, Row};
 use crate::trajectory::{Setpoint, Trajectory};
 use crate::types::Vector;
 use adaptimp_mujoco::Sim;
-use core::cell::Cell;
+use core::cell::{Cell, RefCell};
 use nalgebra::Matrix3;
 use std::vec::Vec;
 
@@ -146,37 +146,6 @@ impl<const N: usize> JointStep<N> for Computed<N> {
     }
 }
 
-/// The task-space quantities of one row.
-#[derive(Copy, Clone, Debug, PartialEq)]
-struct TaskRow<const N: usize> {
-    /// p_c, ṗ_c, p̈_c (m, m/s, m/s²).
-    pc: [Vector<3>; 3],
-    /// p_d, ṗ_d, p̈_d (m, m/s, m/s²).
-    pd: [Vector<3>; 3],
-    /// q_d (rad).
-    qd: Vector<N>,
-    /// [e_p; e_o] (m, rad) after clipping.
-    error: Vector<6>,
-    /// F_e the controller was given (N, N m).
-    wrench: [f64; 6],
-    /// p_d − p(q) (m).
-    z1: Vector<3>,
-}
-
-impl<const N: usize> TaskRow<N> {
-    fn nan() -> Self {
-        let v3 = Vector::<3>::from_element(f64::NAN);
-        Self {
-            pc: [v3; 3],
-            pd: [v3; 3],
-            qd: Vector::from_element(f64::NAN),
-            error: Vector::from_element(f64::NAN),
-            wrench: [f64::NAN; 6],
-            z1: v3,
-        }
-    }
-}
-
 /// Every kept row's task-space quantities, one flat row-major buffer each.
 #[derive(Clone, Debug, Default)]
 pub struct TaskRecords {
@@ -214,22 +183,35 @@ impl TaskRecords {
         Some(r)
     }
 
-    fn record<const N: usize>(&mut self, r: &TaskRow<N>) {
+    /// The row of the step `last` (its z1 = p_d − p(q) given); none: a row
+    /// before any step, NaN.
+    fn record<const N: usize>(&mut self, last: Option<&LastStep<N>>, z1: &Vector<3>) {
         let keep = self.seen.is_multiple_of(self.every);
         self.seen += 1;
         if !keep {
             return;
         }
-        for (out, v) in self.pc.iter_mut().zip(&r.pc) {
+        let Some(last) = last else {
+            for out in self.pc.iter_mut().chain(self.pd.iter_mut()) {
+                out.extend_from_slice(&[f64::NAN; 3]);
+            }
+            self.qd.extend((0..N).map(|_| f64::NAN));
+            self.error.extend_from_slice(&[f64::NAN; 6]);
+            self.wrench.extend_from_slice(&[f64::NAN; 6]);
+            self.z1.extend_from_slice(z1.as_slice());
+            return;
+        };
+        let (cmd, c) = (&last.cmd, &last.cmd.compliant);
+        for (out, v) in self.pc.iter_mut().zip(&last.commanded) {
             out.extend_from_slice(v.as_slice());
         }
-        for (out, v) in self.pd.iter_mut().zip(&r.pd) {
+        for (out, v) in self.pd.iter_mut().zip([&c.p, &c.dp, &c.ddp]) {
             out.extend_from_slice(v.as_slice());
         }
-        self.qd.extend_from_slice(r.qd.as_slice());
-        self.error.extend_from_slice(r.error.as_slice());
-        self.wrench.extend_from_slice(&r.wrench);
-        self.z1.extend_from_slice(r.z1.as_slice());
+        self.qd.extend_from_slice(cmd.reference.x.as_slice());
+        self.error.extend_from_slice(cmd.error.as_slice());
+        self.wrench.extend_from_slice(&last.wrench);
+        self.z1.extend_from_slice(z1.as_slice());
     }
 }
 
@@ -330,16 +312,17 @@ pub(crate) fn pose_target(v: &[f64]) -> PoseTarget {
 /// [`Control`]: [`Control::step_with_wrench`] runs
 /// [`CartesianImpedance::step_with`] with the measured wrench and the
 /// joint controller's step, the commanded pose of the row from the table.
+/// The step is kept in `last`, where the recorder reads the row's task
+/// quantities (no copy of them per row).
 struct Cartesian<'a, const N: usize, J: ?Sized> {
     outer: &'a CartesianImpedance<N, Chain<N>>,
     state: &'a mut CartesianState<N>,
     joint: &'a mut J,
     targets: Option<&'a [f64]>,
     clock: &'a Cell<f64>,
-    row: &'a Cell<TaskRow<N>>,
-    /// Whether `row` holds a step the recorder has not recorded yet.
+    last: &'a RefCell<Option<LastStep<N>>>,
+    /// Whether `last` holds a step the recorder has not recorded yet.
     pending: &'a Cell<bool>,
-    last: Option<LastStep<N>>,
 }
 
 impl<const N: usize, J: JointStep<N> + ?Sized> Cartesian<'_, N, J> {
@@ -358,19 +341,10 @@ impl<const N: usize, J: JointStep<N> + ?Sized> Cartesian<'_, N, J> {
             wrench: Vector::<6>::from(*wrench),
         };
         let cmd = cartesian_step(self.outer, self.state, self.joint, &meas, target.as_ref())?;
-        let last = LastStep::new(cmd, target.as_ref(), *wrench);
-        let c = &cmd.compliant;
-        self.row.set(TaskRow {
-            pc: last.commanded,
-            pd: [c.p, c.dp, c.ddp],
-            qd: cmd.reference.x,
-            error: cmd.error,
-            wrench: *wrench,
-            z1: c.p - cmd.p,
-        });
+        let mut slot = self.last.borrow_mut();
+        let last = slot.insert(LastStep::new(cmd, target.as_ref(), *wrench));
         self.pending.set(true);
-        self.last = Some(last);
-        Ok(cmd.joint)
+        Ok(last.cmd.joint)
     }
 }
 
@@ -402,25 +376,26 @@ struct TaskRecorder<'a, const N: usize, const M: usize> {
     joint: &'a mut Records,
     task: &'a mut TaskRecords,
     metrics: &'a mut TaskMetrics<M>,
-    row: &'a Cell<TaskRow<N>>,
+    last: &'a RefCell<Option<LastStep<N>>>,
     pending: &'a Cell<bool>,
 }
 
 impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
     fn record(&mut self, r: &Row<N>) {
-        let tr = self.row.get();
         self.pending.set(false);
         self.joint.record(r);
-        self.task.record(&tr);
+        let slot = self.last.borrow();
+        let nan = [Vector::<3>::from_element(f64::NAN); 3];
+        let (pc, z1) = match slot.as_ref() {
+            Some(l) => (&l.commanded, l.cmd.compliant.p - l.cmd.p),
+            None => (&nan, nan[0]),
+        };
+        self.task.record(slot.as_ref(), &z1);
         self.metrics.push(
             r.t,
             [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
-            [
-                tr.pc[0].as_slice(),
-                tr.pc[1].as_slice(),
-                tr.pc[2].as_slice(),
-            ],
-            tr.z1.as_slice(),
+            [pc[0].as_slice(), pc[1].as_slice(), pc[2].as_slice()],
+            z1.as_slice(),
             [r.tau.as_slice(), r.tau_sat.as_slice(), r.tau_e.as_slice()],
         );
     }
@@ -482,7 +457,8 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     let ones = [1.0; N];
     let mut metrics = TaskMetrics::<M>::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
     let clock = Cell::new(0.0);
-    let row = Cell::new(TaskRow::<N>::nan());
+    // This run's steps (the previous run's last step is kept until one is taken).
+    let steps = RefCell::new(None);
     let pending = Cell::new(false);
     let mut ctrl = Cartesian {
         outer,
@@ -490,9 +466,8 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         joint,
         targets: run.targets,
         clock: &clock,
-        row: &row,
+        last: &steps,
         pending: &pending,
-        last: *last,
     };
     let law = ctrl.joint.law();
     let on = OnMujoco {
@@ -509,16 +484,21 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         joint: &mut rec,
         task: &mut task,
         metrics: &mut metrics,
-        row: &row,
+        last: &steps,
         pending: &pending,
     };
     let result = drive_mujoco(&mut ctrl, &Clock(&clock), on, hooks, &mut recorder);
-    *last = ctrl.last;
+    let taken = steps.into_inner();
+    if taken.is_some() {
+        *last = taken;
+    }
     if let Err(e) = result {
         // A step taken in the period the error stopped: its task row too
         // (the controller's clock counts it).
         if pending.get() {
-            task.record(&row.get());
+            if let Some(l) = last.as_ref() {
+                task.record(Some(l), &(l.cmd.compliant.p - l.cmd.p));
+            }
         }
         *partial = Some(task);
         return Err(e);

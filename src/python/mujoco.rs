@@ -116,6 +116,10 @@ pub struct MjPlant<'a, const N: usize> {
     since: u32,
     abort: Option<&'a Cell<bool>>,
     stopped: bool,
+    /// MuJoCo's time where the last period ended (or the run started), read
+    /// then: the next period's start when nothing touches the data between
+    /// periods (no controller written in Python, see [`MjPlant::period_start`]).
+    time: Option<f64>,
 }
 
 /// How the plant ended a run.
@@ -246,6 +250,7 @@ impl<'a, const N: usize> MjPlant<'a, N> {
             since: 0,
             abort: None,
             stopped: false,
+            time: None,
         })
     }
 
@@ -306,7 +311,22 @@ impl<'a, const N: usize> MjPlant<'a, N> {
     /// Read the end effector at the state MuJoCo's last forward computation
     /// left: call once before the run.
     pub fn start(&mut self) -> Result<(), Error> {
+        self.time = Some(self.sim.time());
         self.sense()
+    }
+
+    /// MuJoCo's time at the start of this period: the time the last period
+    /// ended at (read by its check, [`MjPlant::check`]), unless a controller
+    /// written in Python runs between periods ([`MjPlant::abort_on`]), which
+    /// could change the data (a reset): then read again. Between two periods
+    /// of the core's controllers only the controller's step and the records
+    /// run, and the run's hook is asked inside a period (a reset there is
+    /// caught by the period's check) or after the last one.
+    fn period_start(&self) -> f64 {
+        match (self.abort, self.time) {
+            (None, Some(t)) => t,
+            _ => self.sim.time(),
+        }
     }
 
     /// Why the run ended, if the plant ended it.
@@ -436,6 +456,7 @@ impl<'a, const N: usize> MjPlant<'a, N> {
             expected += self.spec.timestep; // as mj_step advances d->time
         }
         let time = self.sim.time();
+        self.time = Some(time);
         let warned = (0..count).find(|&i| after[i].0 != before[i].0);
         let nonfinite = {
             let (x, dx) = self.state();
@@ -538,7 +559,7 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
         let qacc = self.sim.qacc();
         let ddq = Vector::from_fn(|i, _| qacc[self.dofs[i]]);
         let (before, _) = self.sim.warnings();
-        let t0 = self.sim.time();
+        let t0 = self.period_start();
         for sub in 0..self.spec.substeps {
             if sub == 0 && self.friction.is_none() {
                 // The forward computation at x_k with these controls is the

@@ -34,6 +34,7 @@ kg m², s.
 from __future__ import annotations
 
 import math
+import types
 import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -605,9 +606,9 @@ class CartesianController:
         if type(self).step is not CartesianController.step:
             return
         joint = self._joint if self._core_inner else None
-        bound = _adaptimp.CartesianStep(
-            self.outer.core, joint, self._path, self._step_python, self._record
-        )
+        # Any call but step(m) goes on to the method below, as written in Python.
+        other = types.MethodType(CartesianController.step, self)
+        bound = _adaptimp.CartesianStep(self.outer.core, joint, self._path, other, self._record)
         self.step = bound.step  # type: ignore[method-assign]
 
     @property
@@ -873,28 +874,6 @@ class CartesianController:
         :attr:`output`. ``step(q, dq, wrench)`` works, with a
         ``DeprecationWarning``.
         """
-        return self._step_python(
-            m, dq, wrench, xc=xc, dxc=dxc, ddxc=ddxc, R=R, w=w, dw=dw, target=target, q=q
-        )
-
-    def _step_python(
-        self,
-        m: Measurement | ArrayLike | None = None,
-        dq: ArrayLike | None = None,
-        wrench: ArrayLike | None = None,
-        *,
-        xc: ArrayLike | None = None,
-        dxc: ArrayLike | None = None,
-        ddxc: ArrayLike | None = None,
-        R: ArrayLike | None = None,
-        w: ArrayLike | None = None,
-        dw: ArrayLike | None = None,
-        target: PoseTarget | None = None,
-        q: ArrayLike | None = None,
-    ) -> FloatArray:
-        """:meth:`step` as written in Python: the calls the core's bound step
-        hands on (a pose given, the deprecated arrays, a joint controller
-        written in Python), and a subclass's ``super().step``."""
         measured: Any
         if self._core_inner and type(m) is Measurement and dq is wrench is q is None:
             measured = m  # the core reads it itself: no arrays made here

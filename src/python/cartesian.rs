@@ -1219,65 +1219,6 @@ impl PyCartesian {
         g.steps() as f64 * g.ts()
     }
 
-    /// The body of [`step_sample`](Self::step_sample), for the bound step of
-    /// `cartesian_step.rs` too.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn sample_step<'py>(
-        &self,
-        py: Python<'py>,
-        controller: &Bound<'py, PyAny>,
-        q: &Bound<'py, PyAny>,
-        dq: Option<&Bound<'py, PyAny>>,
-        wrench: Option<&Bound<'py, PyAny>>,
-        sample: Option<&Bound<'py, PyAny>>,
-        record: bool,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let n = self.n;
-        let mut qb = [0.0; MAX_JOINTS];
-        let mut dqb = [0.0; MAX_JOINTS];
-        let (measured_dq, f) = if let Ok(m) = q.cast::<PyMeasurement>() {
-            // An adaptimp.Measurement: read as it is, no array made.
-            let m = m.get();
-            if dq.is_some() || wrench.is_some() {
-                return Err(PyTypeError::new_err(
-                    "give the measurement as an adaptimp.Measurement or as arrays, not both",
-                ));
-            }
-            if m.n != n {
-                return Err(shape_error("q", n, &format!("length {}", m.n)));
-            }
-            qb = m.q;
-            dqb = m.dq.unwrap_or(dqb);
-            (m.dq.is_some(), m.wrench.unwrap_or([0.0; 6]))
-        } else {
-            super::vector_into("q", n, q, &mut qb)?;
-            if let Some(d) = dq {
-                super::vector_into("dq", n, d, &mut dqb)?;
-            }
-            let f = match wrench {
-                None => [0.0; 6],
-                Some(w) => wrench_sample(w)?,
-            };
-            (dq.is_some(), f)
-        };
-        let mut joint = lock_joint(py, controller, n)?;
-        let mut g = self.lock(py);
-        // The rotation a sample sets is held only once the core accepted the
-        // step: a refused one (a rotation that is not one) keeps nothing.
-        let mut held = g.held();
-        let target = match sample {
-            None => None,
-            Some(s) => Some(sample_target(s, &mut held)?),
-        };
-        let m = self.measurement(&qb, measured_dq.then_some(&dqb), f, target);
-        g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
-        g.set_held(held);
-        if record {
-            g.record();
-        }
-        Ok(array1(py, &g.applied()[..n]))
-    }
-
     fn measurement<'a>(
         &self,
         q: &'a [f64; MAX_JOINTS],
@@ -1457,7 +1398,7 @@ impl PyCartesian {
     /// Returns sat(τ) (N m), (n,).
     #[pyo3(signature = (controller, q, dq, wrench, sample, record))]
     #[allow(clippy::too_many_arguments)]
-    fn step_sample<'py>(
+    pub(super) fn step_sample<'py>(
         &self,
         py: Python<'py>,
         controller: &Bound<'py, PyAny>,
@@ -1467,7 +1408,50 @@ impl PyCartesian {
         sample: Option<&Bound<'py, PyAny>>,
         record: bool,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        self.sample_step(py, controller, q, dq, wrench, sample, record)
+        let n = self.n;
+        let mut qb = [0.0; MAX_JOINTS];
+        let mut dqb = [0.0; MAX_JOINTS];
+        let (measured_dq, f) = if let Ok(m) = q.cast::<PyMeasurement>() {
+            // An adaptimp.Measurement: read as it is, no array made.
+            let m = m.get();
+            if dq.is_some() || wrench.is_some() {
+                return Err(PyTypeError::new_err(
+                    "give the measurement as an adaptimp.Measurement or as arrays, not both",
+                ));
+            }
+            if m.n != n {
+                return Err(shape_error("q", n, &format!("length {}", m.n)));
+            }
+            qb = m.q;
+            dqb = m.dq.unwrap_or(dqb);
+            (m.dq.is_some(), m.wrench.unwrap_or([0.0; 6]))
+        } else {
+            super::vector_into("q", n, q, &mut qb)?;
+            if let Some(d) = dq {
+                super::vector_into("dq", n, d, &mut dqb)?;
+            }
+            let f = match wrench {
+                None => [0.0; 6],
+                Some(w) => wrench_sample(w)?,
+            };
+            (dq.is_some(), f)
+        };
+        let mut joint = lock_joint(py, controller, n)?;
+        let mut g = self.lock(py);
+        // The rotation a sample sets is held only once the core accepted the
+        // step: a refused one (a rotation that is not one) keeps nothing.
+        let mut held = g.held();
+        let target = match sample {
+            None => None,
+            Some(s) => Some(sample_target(s, &mut held)?),
+        };
+        let m = self.measurement(&qb, measured_dq.then_some(&dqb), f, target);
+        g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
+        g.set_held(held);
+        if record {
+            g.record();
+        }
+        Ok(array1(py, &g.applied()[..n]))
     }
 
     /// The commanded rotation a target without one keeps, (3, 3).

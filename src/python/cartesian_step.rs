@@ -1,7 +1,7 @@
 //! `CartesianController.step` as the core's own method (issue 32, item 6;
 //! docs/performance.md): the common call `step(m)` (an `adaptimp.Measurement`,
 //! the commanded pose from the controller's path at t_k, or held) goes from
-//! Python's call straight to [`PyCartesian::sample_step`], with no Python
+//! Python's call straight to [`PyCartesian::step_sample`], with no Python
 //! frame between. Every other call (a pose given, the deprecated arrays, a
 //! joint controller written in Python) is the Python method's, called as it
 //! came.
@@ -67,7 +67,7 @@ impl PyCartesianStep {
                 };
                 let joint = joint.bind(py);
                 let tau: Bound<'py, PyArray1<f64>> =
-                    core.sample_step(py, joint, &m, None, None, sample.as_ref(), self.record)?;
+                    core.step_sample(py, joint, &m, None, None, sample.as_ref(), self.record)?;
                 return Ok(tau.into_any());
             }
         }

@@ -175,14 +175,9 @@ def sliding_timeconst(model: Any, *, force: float, speed: float, friction: float
     """
 
     tool, table = _tool_table(model)
-    if tool < 0 or table < 0:
-        raise ValueError("the model has no geoms 'tool' and 'table'")
+    inv_mass = _pair_inverse_mass(model, tool, table)
     if friction <= 0 or speed <= 0 or force <= 0:
         return TABLE_TIMECONST
-    inv_mass = float(
-        model.body_invweight0[model.geom_bodyid[tool], 0]
-        + model.body_invweight0[model.geom_bodyid[table], 0]
-    )
     dmax = float(max(model.geom_solimp[tool, 1], model.geom_solimp[table, 1]))
     damping = SLIP_SHARE * force * (1.0 - dmax) * inv_mass / (dmax * friction * speed)
     return max(TABLE_TIMECONST, 2.0 / (dmax * damping))
@@ -199,15 +194,9 @@ def contact_impedance(model: Any, *, force: float, accel: float, friction: float
     :data:`SLIP_SHARE` of the press, and never above :data:`CONTACT_IMPEDANCE`
     (MuJoCo's own 0.95, which every arm lighter than A < 19 μ a/(s F) keeps).
     ``friction``, ``accel`` or ``force`` zero: :data:`CONTACT_IMPEDANCE`."""
-    tool, table = _tool_table(model)
-    if tool < 0 or table < 0:
-        raise ValueError("the model has no geoms 'tool' and 'table'")
+    inv_mass = _pair_inverse_mass(model, *_tool_table(model))
     if friction <= 0 or accel <= 0 or force <= 0:
         return CONTACT_IMPEDANCE
-    inv_mass = float(
-        model.body_invweight0[model.geom_bodyid[tool], 0]
-        + model.body_invweight0[model.geom_bodyid[table], 0]
-    )
     x = SLIP_SHARE * force * inv_mass / (friction * accel)
     return min(CONTACT_IMPEDANCE, x / (1.0 + x))
 
@@ -223,6 +212,18 @@ def _set_pair_contact(
     d = contact_impedance(model, force=force, accel=accel, friction=friction)
     model.pair_solimp[0, 0] = min(float(model.pair_solimp[0, 0]), d)
     model.pair_solimp[0, 1] = min(float(model.pair_solimp[0, 1]), d)
+
+
+def _pair_inverse_mass(model: Any, tool: int, table: int) -> float:
+    """A = the tool's and the table's bodies' inverse masses summed (1/kg,
+    MuJoCo's ``body_invweight0``), of the geoms ``tool`` and ``table`` (ids;
+    -1: none, refused)."""
+    if tool < 0 or table < 0:
+        raise ValueError("the model has no geoms 'tool' and 'table'")
+    return float(
+        model.body_invweight0[model.geom_bodyid[tool], 0]
+        + model.body_invweight0[model.geom_bodyid[table], 0]
+    )
 
 
 def _tool_table(model: Any) -> tuple[int, int]:
@@ -1257,10 +1258,7 @@ def normal_inertia(sc: PandaTable, q: ArrayLike) -> float:
         d = tuning.inertia(plant, rows[k])
         jz = np.asarray(sc.chain.jacobian(rows[k]), dtype=np.float64)[2]
         lam = max(lam, 1.0 / float(jz @ np.linalg.solve(d, jz)))
-    inv_mass = float(
-        model.body_invweight0[model.geom_bodyid[tool], 0]
-        + model.body_invweight0[model.geom_bodyid[table], 0]
-    )
+    inv_mass = _pair_inverse_mass(model, tool, table)
     if inv_mass > 0:
         lam = max(lam, 1.0 / inv_mass)
     stiffness = 1.0 / TABLE_TIMECONST**2  # 1/s², per kg of apparent mass

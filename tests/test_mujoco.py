@@ -462,29 +462,32 @@ def test_a_controller_called_back_gives_the_native_bits(case: str, contact: bool
     assert np.all(np.isnan(python.w_norms))
 
 
+def _lean_down(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Panda's reference from its home: the shoulder leans towards the
+    table at 0.6 rad/s, so the tool meets it within 0.3 s."""
+    xc = np.array(_models.PANDA_HOME)
+    xc[1] += 0.6 * t
+    v = np.zeros(7)
+    v[1] = 0.6
+    return xc, v, np.zeros(7)
+
+
+def _panda_pd() -> adaptimp.Controller:
+    """A joint PD for the Panda pressing on its table."""
+    return adaptimp.Controller(
+        "pd", "robot", n=7, tau_max=list(_models.PANDA_EFFORT), impedance="external",
+        Kp=[40.0, 40.0, 40.0, 40.0, 4.0, 4.0, 4.0], K1=20.0, Kzeta=1000.0,
+        centers=np.zeros((1, 28)), widths=1.0,
+    )  # fmt: skip
+
+
 def test_the_native_loop_with_a_reference_and_seven_joints_in_contact() -> None:
     """The Panda on its table, a reference callable: the controller native and
     called back agree."""
     q0 = np.array(_models.PANDA_HOME)
-
-    def down(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        # The shoulder leans towards the table: the tool meets it within 0.3 s.
-        xc = q0.copy()
-        xc[1] += 0.6 * t
-        v = np.zeros(7)
-        v[1] = 0.6
-        return xc, v, np.zeros(7)
-
-    def ctrl() -> adaptimp.Controller:
-        return adaptimp.Controller(
-            "pd", "robot", n=7, tau_max=list(_models.PANDA_EFFORT), impedance="external",
-            Kp=[40.0, 40.0, 40.0, 40.0, 4.0, 4.0, 4.0], K1=20.0, Kzeta=1000.0,
-            centers=np.zeros((1, 28)), widths=1.0,
-        )  # fmt: skip
-
     plant = amj.Plant("panda")
-    native = amj.simulate(ctrl(), plant, T=0.6, q0=q0, reference=down)
-    python = amj.simulate(_InPython(ctrl()), plant, T=0.6, q0=q0, reference=down)
+    native = amj.simulate(_panda_pd(), plant, T=0.6, q0=q0, reference=_lean_down)
+    python = amj.simulate(_InPython(_panda_pd()), plant, T=0.6, q0=q0, reference=_lean_down)
     assert native.params["loop"] == "native"
     _assert_same_run(native, python)
     assert native.metrics["steps_in_contact"] > 50
@@ -502,20 +505,8 @@ def test_steps_inside_a_period_skip_pure_sensors_and_change_nothing(
     contact too. A sensor with noise is not pure."""
     q0 = np.array(_models.PANDA_HOME)
 
-    def down(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        xc = q0.copy()
-        xc[1] += 0.6 * t
-        v = np.zeros(7)
-        v[1] = 0.6
-        return xc, v, np.zeros(7)
-
     def run() -> amj.MujocoResult:
-        ctrl = adaptimp.Controller(
-            "pd", "robot", n=7, tau_max=list(_models.PANDA_EFFORT), impedance="external",
-            Kp=[40.0, 40.0, 40.0, 40.0, 4.0, 4.0, 4.0], K1=20.0, Kzeta=1000.0,
-            centers=np.zeros((1, 28)), widths=1.0,
-        )  # fmt: skip
-        return amj.simulate(ctrl, amj.Plant("panda"), T=0.6, q0=q0, reference=down)
+        return amj.simulate(_panda_pd(), amj.Plant("panda"), T=0.6, q0=q0, reference=_lean_down)
 
     plant = amj.Plant("panda")
     assert plant.model.nsensor >= 2

@@ -144,7 +144,11 @@ class ControllerLike(Protocol):
     of ``task_space``) as ``(q, dq, wrench, **setpoint)``.
     """
 
-    def step(self, m: _adaptimp.Measurement, **setpoint: Any) -> ArrayLike: ...
+    # Typed by what every call needs, ``step(m)``: the setpoint keywords are
+    # passed only with a ``reference``, and a step that takes them by name
+    # (``xc=None, …``, as adaptimp's own controllers do) or as ``**setpoint``
+    # fits alike; with ``**setpoint`` here, no named-keyword step would.
+    def step(self, m: _adaptimp.Measurement, /) -> ArrayLike: ...
 
 
 # ---------------------------------------------------------------------------

@@ -25,8 +25,11 @@ the torque held for the period's MuJoCo steps.
   ``ctrlrange`` and set in ``ctrl``, then ``mj_step`` for the period's steps.
 
 Both runs track the circle (checked: the RMS position error after 1 s is
-printed, and must be below 5 mm), repeated ``--repeats`` times interleaved;
-medians per period. Target (issue 32): adaptimp ≤ 0.5× the user's loop.
+printed, and must be below 5 mm), runs of ``--T`` and 2 ``--T`` repeated
+``--repeats`` times interleaved; per period, the difference of their
+medians over the extra periods (a run's setup is not a period's cost; the
+whole run's time a period is printed too). Target (issue 32): adaptimp ≤
+0.5× the user's loop.
 ``--count`` also counts instructions per period under callgrind (two runs of
 each loop, of ``--T`` and 2 ``--T``: the difference over the extra periods).
 
@@ -116,7 +119,8 @@ def circle_table(p0: np.ndarray, R0: np.ndarray, steps: int) -> Any:
 def adaptimp_loop(
     name: str, T: float, python_path: bool = False
 ) -> tuple[Callable[[], float], Callable[[], float]]:
-    """(run: seconds per period, the last run's RMS position error after 1 s).
+    """(run: the seconds of one run, setup included; the last run's RMS
+    position error after 1 s).
 
     The commanded pose: the circle's table (:func:`circle_table`, built in
     each timed run), or with ``python_path`` the user's Python function
@@ -144,7 +148,7 @@ def adaptimp_loop(
         seconds = time.perf_counter() - start
         assert res.params["loop"] == "native"
         last[0] = res
-        return seconds / steps
+        return seconds
 
     def error() -> float:
         """The last run's RMS position error after 1 s (m), computed when asked
@@ -158,7 +162,9 @@ def adaptimp_loop(
 
 
 def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], float]]:
-    """The mjctrl-style operational-space loop in Python (module doc)."""
+    """The mjctrl-style operational-space loop in Python (module doc): (run:
+    the seconds of one run's loop, after its reset; the RMS position error
+    after 1 s)."""
     model, q0, _ = arm(name)
     data = mujoco.MjData(model)
     substeps = round(TS / model.opt.timestep)
@@ -224,34 +230,42 @@ def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], fl
                 errors.append(np.sum((data.site_xpos[site] - path((k + 1) * TS)[0]) ** 2))
         seconds = time.perf_counter() - start
         error[0] = float(np.sqrt(np.mean(errors))) if errors else np.nan
-        return seconds / steps
+        return seconds
 
     return run, lambda: error[0]
 
 
 def measure(name: str, T: float, repeats: int) -> dict[str, Any]:
-    ours, our_error = adaptimp_loop(name, T)
-    ours_py, ours_py_error = adaptimp_loop(name, T, python_path=True)
-    theirs, their_error = user_loop(name, T)
-    a: list[float] = []
-    c: list[float] = []
-    b: list[float] = []
+    """Per period, each loop's time by the slope: runs of ``T`` and ``2 T``,
+    interleaved, the difference of their medians over the extra periods (as
+    the instruction counts): what a run's setup costs (the model's check,
+    the table, the result's arrays; the user's reset) is not a period's.
+    ``*_run_ns``: a ``T`` run's whole time over its periods, setup included."""
+    loops = {
+        "core": (adaptimp_loop(name, T), adaptimp_loop(name, 2 * T)),
+        "py_path": (
+            adaptimp_loop(name, T, python_path=True),
+            adaptimp_loop(name, 2 * T, python_path=True),
+        ),
+        "peer": (user_loop(name, T), user_loop(name, 2 * T)),
+    }
+    runs = [(key, i, pair[i][0]) for key, pair in loops.items() for i in (0, 1)]
+    times: dict[tuple[str, int], list[float]] = {(key, i): [] for key, i, _ in runs}
     gc.collect()
     for k in range(repeats):
-        for f, out in ((ours, a), (ours_py, c), (theirs, b))[:: 1 if k % 2 == 0 else -1]:
-            out.append(f())
-    return {
-        "core_ns": round(statistics.median(a) * 1e9, 1),
-        "peer_ns": round(statistics.median(b) * 1e9, 1),
-        "ratio": round(statistics.median(a) / statistics.median(b), 3),
-        "py_path_ns": round(statistics.median(c) * 1e9, 1),
-        "py_path_ratio": round(statistics.median(c) / statistics.median(b), 3),
-        "core_rms_mm": round(our_error() * 1e3, 3),
-        "py_path_rms_mm": round(ours_py_error() * 1e3, 3),
-        "peer_rms_mm": round(their_error() * 1e3, 3),
-        "periods": round(T / TS),
-        "substeps": round(TS / arm_timestep(name)),
-    }
+        for key, i, run in runs[:: 1 if k % 2 == 0 else -1]:
+            times[key, i].append(run())
+    periods = round(T / TS)
+    got: dict[str, Any] = {}
+    for key in loops:
+        one, two = (statistics.median(times[key, i]) for i in (0, 1))
+        got[f"{key}_ns"] = round((two - one) / periods * 1e9, 1)
+        got[f"{key}_run_ns"] = round(one / periods * 1e9, 1)
+        got[f"{key}_rms_mm"] = round(loops[key][1][1]() * 1e3, 3)
+    got["ratio"] = round(got["core_ns"] / got["peer_ns"], 3)
+    got["py_path_ratio"] = round(got["py_path_ns"] / got["peer_ns"], 3)
+    got["run_ratio"] = round(got["core_run_ns"] / got["peer_run_ns"], 3)
+    return {**got, "periods": periods, "substeps": round(TS / arm_timestep(name))}
 
 
 def arm_timestep(name: str) -> float:
@@ -326,8 +340,9 @@ def main() -> None:
     for name in args.arms:
         got = side_by_side(name, args.count, args.T, args.repeats)
         print(
-            f"\n{name}, per period (Ts = 1 ms, {got['substeps']} MuJoCo steps), "
-            f"{got['periods']} periods, medians of {args.repeats}:\n"
+            f"\n{name}, per period (Ts = 1 ms, {got['substeps']} MuJoCo steps), runs of "
+            f"{got['periods']} and {2 * got['periods']} periods, medians of {args.repeats}, "
+            "the slope:\n"
             f"  adaptimp (native Cartesian SF loop, learning; the path's table): "
             f"{got['core_ns'] / 1e3:.2f} µs (RMS error after 1 s {got['core_rms_mm']:.2f} mm)\n"
             f"  adaptimp (the same, the user's Python path tabulated first): "
@@ -335,8 +350,11 @@ def main() -> None:
             f"{got['py_path_rms_mm']:.2f} mm)\n"
             f"  the user's loop (mjctrl-style OSC in Python):  {got['peer_ns'] / 1e3:.2f} µs "
             f"(RMS error after 1 s {got['peer_rms_mm']:.2f} mm)\n"
-            f"  adaptimp ÷ user: {got['ratio']:.2f} (target ≤ 0.5); with the Python path "
-            f"{got['py_path_ratio']:.2f}"
+            f"  adaptimp ÷ user: {got['ratio']:.3f} (target ≤ 0.5); with the Python path "
+            f"{got['py_path_ratio']:.3f}\n"
+            f"  a {args.T:g} s run's whole time a period, setup included: "
+            f"{got['core_run_ns'] / 1e3:.2f} µs against {got['peer_run_ns'] / 1e3:.2f} µs "
+            f"({got['run_ratio']:.3f})"
         )
         if "core_ir" in got:
             print(

@@ -122,13 +122,36 @@ def machine() -> dict[str, Any]:
 # --- the arms ----------------------------------------------------------------
 
 
-def pinocchio_arm(name: str) -> Any:
+def pinocchio_arm(urdf: Path) -> Any:
     """Pinocchio's model of the arm's URDF (its gripper fixed by the core's
     reduction, as everywhere in adaptimp)."""
     from adaptimp.baselines import pinocchio_model
 
-    urdf, _ = ARMS[name]
-    return pinocchio_model(robots() / urdf)
+    return pinocchio_model(urdf)
+
+
+def arm_files(names: list[str], urdfs: list[str]) -> dict[str, tuple[Path, str]]:
+    """The arms to run: the named ones (:data:`ARMS`) and each ``--urdf
+    FILE[:FRAME]`` (a path, or one inside example-robot-data's ``robots/``;
+    named by the file's stem; its tool frame FRAME, default
+    the link that ends the arm as adaptimp reads the file, ``Chain.from_urdf``'s
+    tip)."""
+    out: dict[str, tuple[Path, str]] = {
+        name: (robots() / ARMS[name][0], ARMS[name][1]) for name in names
+    }
+    for spec in urdfs:
+        file, _, frame = spec.partition(":")
+        path = Path(file)
+        if not path.is_file() and (robots() / file).is_file():
+            path = robots() / file  # a path inside example-robot-data's robots/
+        if not path.is_file():
+            raise SystemExit(f"--urdf {spec}: no such file {file!r}")
+        if not frame:
+            from adaptimp._description import read_arm
+
+            frame = read_arm(path, None, ()).tip
+        out[path.stem] = (path, frame)
+    return out
 
 
 def core_lines(model: Any, frame: str) -> list[str]:
@@ -137,7 +160,10 @@ def core_lines(model: Any, frame: str) -> list[str]:
     from adaptimp.baselines import core_description
 
     joints, inertials, gravity = core_description(model)
-    fid = model.getFrameId(frame)
+    import pinocchio as pin
+
+    body = model.existFrame(frame, pin.FrameType.BODY)
+    fid = model.getFrameId(frame, pin.FrameType.BODY) if body else model.getFrameId(frame)
     if model.frames[fid].parentJoint != model.njoints - 1:
         raise SystemExit(f"the frame {frame!r} is not on the last joint")
 
@@ -155,9 +181,16 @@ def core_lines(model: Any, frame: str) -> list[str]:
 
 
 def states(model: Any, rng: np.random.Generator) -> list[str]:
+    """``STATES`` rows of (q, q̇, q̈), the angles within the joints' limits
+    (±π where a joint has none: a continuous joint, whose configuration in
+    Pinocchio is (cos θ, sin θ), which the peer makes of θ)."""
     n = model.nv
-    lo = np.maximum(model.lowerPositionLimit, -np.pi)
-    hi = np.minimum(model.upperPositionLimit, np.pi)
+    lo, hi = np.full(n, -np.pi), np.full(n, np.pi)
+    for j in range(1, model.njoints):
+        if model.nqs[j] == 1:
+            iq, iv = model.idx_qs[j], model.idx_vs[j]
+            lo[iv] = max(model.lowerPositionLimit[iq], -np.pi)
+            hi[iv] = min(model.upperPositionLimit[iq], np.pi)
     rows = [f"{STATES} {n}"]
     for _ in range(STATES):
         x = np.concatenate([rng.uniform(lo, hi), rng.uniform(-2, 2, n), rng.uniform(-10, 10, n)])
@@ -165,13 +198,15 @@ def states(model: Any, rng: np.random.Generator) -> list[str]:
     return rows
 
 
-def write_arms(names: list[str], where: Path) -> dict[str, tuple[Path, Path, Path, str]]:
+def write_arms(
+    arms: dict[str, tuple[Path, str]], where: Path
+) -> dict[str, tuple[Path, Path, Path, str]]:
     """Per arm: Pinocchio's model file, the core's, the states and the frame."""
     out = {}
     rng = np.random.default_rng(20240601)
-    for name in names:
-        model = pinocchio_arm(name)
-        frame = ARMS[name][1]
+    for name, (urdf, tip) in arms.items():
+        model = pinocchio_arm(urdf)
+        frame = tip
         pin_file, core_file, states_file = (
             where / f"{name}.pinocchio.txt",
             where / f"{name}.core.txt",
@@ -310,7 +345,7 @@ def instructions(cmd: list[str], calls: int, rows: tuple[str, ...] = ROWS) -> di
             capture_output=True,
         )
         text = run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", str(out)])
-    got = {}
+    got: dict[str, float] = {}
     for line in text.splitlines():
         m = re.match(r"\s*([\d,]+)\s.*measured_(\w+)", line)
         if m and m.group(2) in rows:
@@ -325,7 +360,14 @@ def main() -> None:
     ap.add_argument("--json", type=Path, help="write the results here")
     ap.add_argument("--rounds", type=int, default=7)
     ap.add_argument("--ms", type=float, default=30.0, help="time per row per round (ms)")
-    ap.add_argument("--arms", nargs="+", default=list(ARMS), choices=list(ARMS))
+    ap.add_argument("--arms", nargs="*", default=list(ARMS), choices=list(ARMS))
+    ap.add_argument(
+        "--urdf",
+        action="append",
+        default=[],
+        metavar="FILE[:FRAME]",
+        help="also this arm (its tool frame FRAME, default the link that ends the arm); repeatable",
+    )
     ap.add_argument("--no-count", action="store_true", help="skip the callgrind counts")
     ap.add_argument("--no-mujoco", action="store_true", help="skip the MuJoCo loop")
     ap.add_argument("--check", action="store_true", help="agreement only, no timing")
@@ -333,7 +375,7 @@ def main() -> None:
 
     peer, core = build_peer(), build_core()
     with tempfile.TemporaryDirectory() as tmp:
-        arms = write_arms(args.arms, Path(tmp))
+        arms = write_arms(arm_files(args.arms, args.urdf), Path(tmp))
         cmds = {
             name: (
                 [str(peer), str(pf), frame, str(sf)],

@@ -72,7 +72,7 @@ def python_timers(name: str, states: list[tuple[Any, Any, Any]], calls: int) -> 
 
     urdf, frame = peers.ARMS[name]
     path = peers.robots() / urdf
-    model = peers.pinocchio_arm(name)
+    model = peers.pinocchio_arm(peers.robots() / peers.ARMS[name][0])
     data = model.createData()
     fid = model.getFrameId(frame)
     chain = adaptimp.Chain.from_urdf(path, tip=frame)
@@ -210,9 +210,10 @@ def cartesian_timers(
     assert log.task is not None
     ctrl.reset()
     targets = ctrl._targets(calls, None)
-    rows = list(zip(log.q, log.dq, log.task["wrench"]))
+    wrenches = log.task["wrench"]
+    rows = list(zip(log.q, log.dq, wrenches))
 
-    pm = peers.pinocchio_arm(name)
+    pm = peers.pinocchio_arm(peers.robots() / peers.ARMS[name][0])
     pd = pm.createData()
     fid = pm.getFrameId(frame)
     stiff = np.array([500.0] * 3 + [20.0] * 3)
@@ -255,7 +256,7 @@ def cartesian_timers(
     def rust() -> float:
         ctrl.reset()
         start = time.perf_counter()
-        ctrl.outer.core.replay(ctrl.inner, log.q, log.dq, log.task["wrench"], targets)
+        ctrl.outer.core.replay(ctrl.inner, log.q, log.dq, wrenches, targets)
         return (time.perf_counter() - start) / calls
 
     def path_calls() -> float:
@@ -287,7 +288,7 @@ def one(name: str, entry: str, calls: int) -> None:
     """``calls`` calls of ``entry`` (or none: ``"none"``, the setup alone), for
     callgrind: the setup of every entry runs, so two counts differ by the calls."""
     with tempfile.TemporaryDirectory() as tmp:
-        arms = peers.write_arms([name], Path(tmp))
+        arms = peers.write_arms(peers.arm_files([name], []), Path(tmp))
         states = read_states(arms[name][2])
     timers = python_timers(name, states, calls)
     cart, _ = cartesian_timers(name, calls)
@@ -335,7 +336,7 @@ def counts(name: str, core: Path, calls: int = 2000) -> dict[str, dict[str, floa
     call, and the core's call (the peers binary's ``measured_*`` rows; the
     Cartesian step's by the core's replay, the path's calls apart)."""
     with tempfile.TemporaryDirectory() as tmp:
-        arms = peers.write_arms([name], Path(tmp))
+        arms = peers.write_arms(peers.arm_files([name], []), Path(tmp))
         _, core_file, states_file, _ = arms[name]
         rust = peers.instructions(
             [str(core), str(core_file), str(states_file)], calls, tuple(RUST.values())
@@ -379,7 +380,7 @@ def main() -> None:
     core = peers.build_core()
     out: dict[str, Any] = {"machine": peers.machine()}
     with tempfile.TemporaryDirectory() as tmp:
-        arms = peers.write_arms(args.arms, Path(tmp))
+        arms = peers.write_arms(peers.arm_files(args.arms, []), Path(tmp))
         for name, (_, core_file, states_file, _) in arms.items():
             states = read_states(states_file)
             timers = python_timers(name, states, args.calls)

@@ -50,8 +50,10 @@ using Mat6x = pin::Data::Matrix6x;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
+// q: Pinocchio's configuration (nq: cos θ, sin θ for a continuous joint);
+// angle: the joint angles (nv), as the states file and the core have them.
 struct State {
-  Vec q, dq, ddq;
+  Vec q, angle, dq, ddq;
 };
 
 struct Ctx {
@@ -71,7 +73,8 @@ struct Ctx {
   double sink = 0.0;
 };
 
-static std::vector<State> read_states(const char *path, int nv) {
+static std::vector<State> read_states(const char *path, const pin::Model &model) {
+  const int nv = model.nv;
   std::ifstream f(path);
   int k = 0, n = 0;
   f >> k >> n;
@@ -81,16 +84,30 @@ static std::vector<State> read_states(const char *path, int nv) {
   }
   std::vector<State> out(k);
   for (auto &s : out) {
-    s.q.resize(n);
+    s.angle.resize(n);
     s.dq.resize(n);
     s.ddq.resize(n);
-    for (int i = 0; i < n; ++i) f >> s.q[i];
+    for (int i = 0; i < n; ++i) f >> s.angle[i];
     for (int i = 0; i < n; ++i) f >> s.dq[i];
     for (int i = 0; i < n; ++i) f >> s.ddq[i];
   }
   if (!f) {
     std::fprintf(stderr, "%s: fewer numbers than K rows of 3n\n", path);
     std::exit(2);
+  }
+  // The configuration a Pinocchio user passes: the angle itself, or its cosine
+  // and sine for a joint without limits (JointModelRUB*, nq = 2).
+  for (auto &s : out) {
+    s.q.resize(model.nq);
+    for (pin::JointIndex j = 1; j < (pin::JointIndex)model.njoints; ++j) {
+      const int iq = model.idx_qs[j], iv = model.idx_vs[j];
+      if (model.nqs[j] == 2) {
+        s.q[iq] = std::cos(s.angle[iv]);
+        s.q[iq + 1] = std::sin(s.angle[iv]);
+      } else {
+        s.q[iq] = s.angle[iv];
+      }
+    }
   }
   return out;
 }
@@ -136,7 +153,7 @@ static inline const Vec &impedance(Ctx &c, const State &s) {
   e.head<3>() = x.translation() - c.pd;
   e.tail<3>() = log_rotation(x.rotation() * c.Rd.transpose());
   const Vec6 f = -c.K.cwiseProduct(e) - c.D.cwiseProduct(c.J * s.dq);
-  const Vec t0 = c.kn * (c.qn - s.q) - c.dn * s.dq;
+  const Vec t0 = c.kn * (c.qn - s.angle) - c.dn * s.dq;
   Mat6 a = c.J * c.J.transpose();
   a.diagonal() += c.lambda2;
   const Vec6 y = a.llt().solve(c.J * t0);
@@ -202,19 +219,24 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "the model has no frame %s\n", argv[2]);
     return 2;
   }
-  c.frame = c.model.getFrameId(argv[2]);
-  if (c.model.nq != c.model.nv) {
-    std::fprintf(stderr, "nq != nv (continuous joints): not a benchmark arm\n");
-    return 2;
+  // The link's own frame where a joint or another frame has its name too.
+  c.frame = c.model.existFrame(argv[2], pin::BODY) ? c.model.getFrameId(argv[2], pin::BODY)
+                                                   : c.model.getFrameId(argv[2]);
+  for (pin::JointIndex j = 1; j < (pin::JointIndex)c.model.njoints; ++j) {
+    if (c.model.nvs[j] != 1) {
+      std::fprintf(stderr, "joint %s has %d degrees of freedom: not a serial arm\n",
+                   c.model.names[j].c_str(), c.model.nvs[j]);
+      return 2;
+    }
   }
   const int n = c.model.nv;
-  c.states = read_states(argv[3], n);
+  c.states = read_states(argv[3], c.model);
   c.J = Mat6x::Zero(6, n);
   c.K << 500, 500, 500, 20, 20, 20;
   for (int i = 0; i < 6; ++i) c.D[i] = 2.0 * std::sqrt(c.K[i]);
   c.lambda2.setConstant(1e-4);
-  c.qn = c.states[0].q;
-  pin::framesForwardKinematics(c.model, c.data, c.qn);
+  c.qn = c.states[0].angle;
+  pin::framesForwardKinematics(c.model, c.data, c.states[0].q);
   c.pd = c.data.oMf[c.frame].translation();
   c.Rd = c.data.oMf[c.frame].rotation();
   c.tau = Vec::Zero(n);

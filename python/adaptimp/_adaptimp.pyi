@@ -42,6 +42,7 @@ __all__ = [
     "simulate_mujoco_many",
     "suggest",
     "table_metrics",
+    "tabulate_path",
 ]
 
 __version__: str
@@ -681,6 +682,18 @@ def centres_along(
     q: _F, dq: _F, tube: tuple[float, float], periodic: bool = False
 ) -> tuple[_F, _F]:
     """RBF centres (L, 4n) along an orbit and their squared widths (4n,), SPEC (15.2)."""
+
+def tabulate_path(
+    path: Callable[[float], Any],
+    steps: int,
+    ts: float,
+    r0: _F,
+    start: int,
+    what: str,
+    check: Callable[[str, Any, tuple[int, ...]], _F],
+) -> _F:
+    """The rows (steps, 24) of a Python path at t_k = (start + k)·Ts (s), as
+    pose targets (m, m/s, m/s², R row-major, rad/s, rad/s²)."""
 
 def suggest(
     case: str,

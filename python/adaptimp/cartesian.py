@@ -170,13 +170,6 @@ def _per_axis(name: str, v: ArrayLike) -> FloatArray:
     return np.broadcast_to(a, (3,)).copy()
 
 
-def _rates(s: Sequence[ArrayLike], what: str) -> list[FloatArray]:
-    """The 3 arrays (p, ṗ, p̈) a path or reference returned at t, each (3,)."""
-    if len(s) != 3:
-        raise ValueError(f"{what} must return 3 arrays (p, dp, ddp), got {len(s)}")
-    return [_array(f"{what}[{i}]", v, (3,)) for i, v in enumerate(s)]
-
-
 def _sample(path: Path, t: float, R: FloatArray) -> FloatArray:
     """path(t) as a flat target; a 3-tuple keeps the rotation R."""
     return _pose_of(path(t), R)
@@ -208,23 +201,10 @@ def tabulate(
     table = getattr(path, "table", None)
     if callable(table):
         return np.asarray(table(steps, Ts, start), dtype=np.float64)
-    out = np.zeros((steps, 24))
-    out[:, 9:18] = np.asarray(R, dtype=np.float64).reshape(9)
-    turned = False
-    for k in range(steps):
-        s = tuple(path((start + k) * Ts))
-        if len(s) == 3:
-            # Each value checked as (3,) by name (a raw broadcast error before).
-            out[k, 0:9] = np.concatenate(_rates(s, what))
-            if turned:
-                out[k, 9:18] = out[k - 1, 9:18]
-        elif len(s) == 6:
-            out[k] = _pose(s, tuple(f"{what}[{i}]" for i in range(6)))
-            turned = True
-        else:
-            raise ValueError(
-                f"{what} must return 3 or 6 arrays (p, dp, ddp[, R, w, dw]), got {len(s)}"
-            )
+    # The loop, the reads and the layout in the core; a value that is not a
+    # float64 array of its shape goes through _array, which names it.
+    r0 = np.asarray(R, dtype=np.float64).reshape(9)
+    out: FloatArray = _adaptimp.tabulate_path(path, steps, Ts, r0, start, what, _array)
     return out
 
 

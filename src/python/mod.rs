@@ -52,6 +52,7 @@ mod mujoco;
 mod params;
 mod runs;
 mod sweeps;
+mod tabulate;
 mod tuning;
 
 use self::{
@@ -91,6 +92,8 @@ mod adaptimp_module {
     use super::description::{arm_from_mujoco, description_kind, read_arm};
     #[pymodule_export]
     use super::measurement::PyMeasurement;
+    #[pymodule_export]
+    use super::tabulate::tabulate_path;
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

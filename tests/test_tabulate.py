@@ -104,3 +104,11 @@ def test_an_error_of_the_path_itself_comes_through() -> None:
 
     with pytest.raises(KeyError, match="the user's"):
         tabulate(path, 2, TS, np.eye(3))
+
+
+def test_a_table_too_large_for_memory_is_a_memory_error() -> None:
+    def path(t: float) -> Any:
+        raise AssertionError("called")
+
+    with pytest.raises(MemoryError, match="a path table of 100000000000000 rows"):
+        tabulate(path, 10**14, TS, np.eye(3))

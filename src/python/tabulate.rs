@@ -12,7 +12,7 @@
 //! (d) against (a) − (b) − (c)).
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::format;
@@ -82,7 +82,10 @@ pub fn tabulate_path<'py>(
     what: &str,
     check: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let mut out = Vec::with_capacity(steps.saturating_mul(ROW));
+    let mut out = Vec::new();
+    // A table too large for memory is Python's MemoryError, not an abort.
+    out.try_reserve_exact(steps.saturating_mul(ROW))
+        .map_err(|_| PyMemoryError::new_err(format!("a path table of {steps} rows")))?;
     let mut r = r0;
     for k in 0..steps as u64 {
         let sample = path.call1((((start + k) as f64) * ts,))?;

@@ -27,8 +27,8 @@ the torque held for the period's MuJoCo steps.
 Both runs track the circle (checked: the RMS position error after 1 s is
 printed, and must be below 5 mm), runs of ``--T`` and 2 ``--T`` repeated
 ``--repeats`` times interleaved; per period, the difference of their
-medians over the extra periods (a run's setup is not a period's cost; the
-whole run's time a period is printed too). Target (issue 32): adaptimp ≤
+medians over the extra periods (what a run costs once is not a period's
+cost; the whole run's time a period is printed too). Target (issue 32): adaptimp ≤
 0.5× the user's loop.
 ``--count`` also counts instructions per period under callgrind (two runs of
 each loop, of ``--T`` and 2 ``--T``: the difference over the extra periods).
@@ -238,8 +238,9 @@ def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], fl
 def measure(name: str, T: float, repeats: int) -> dict[str, Any]:
     """Per period, each loop's time by the slope: runs of ``T`` and ``2 T``,
     interleaved, the difference of their medians over the extra periods (as
-    the instruction counts): what a run's setup costs (the model's check,
-    the table, the result's arrays; the user's reset) is not a period's.
+    the instruction counts): what a run costs once whatever its length (the
+    model's checks, the resets) is not a period's; what grows with the run
+    (the path's table, the result's arrays) stays in the slope.
     ``*_run_ns``: a ``T`` run's whole time over its periods, setup included."""
     loops = {
         "core": (adaptimp_loop(name, T), adaptimp_loop(name, 2 * T)),

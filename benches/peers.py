@@ -140,7 +140,9 @@ def arm_files(names: list[str], urdfs: list[str]) -> dict[str, tuple[Path, str]]
         name: (robots() / ARMS[name][0], ARMS[name][1]) for name in names
     }
     for spec in urdfs:
-        file, _, frame = spec.partition(":")
+        file, _, frame = spec.rpartition(":") if ":" in spec else (spec, "", "")
+        if not Path(file).suffix:  # the colon was the path's own (no frame given)
+            file, frame = spec, ""
         path = Path(file)
         if not path.is_file() and (robots() / file).is_file():
             path = robots() / file  # a path inside example-robot-data's robots/
@@ -150,6 +152,12 @@ def arm_files(names: list[str], urdfs: list[str]) -> dict[str, tuple[Path, str]]
             from adaptimp._description import read_arm
 
             frame = read_arm(path, None, ()).tip
+        if path.stem in out:
+            raise SystemExit(
+                f"--urdf {spec}: an arm named {path.stem!r} already runs "
+                f"({out[path.stem][0]}); leave it out of --arms, or copy the file "
+                "under another name"
+            )
         out[path.stem] = (path, frame)
     return out
 

@@ -670,14 +670,7 @@ impl<'a, const N: usize> WeightsMut<'a, N> {
 
     /// Multiply every weight of network `net` ([`D`], [`C`] or [`G`]) by `factor`.
     pub fn scale_network(&mut self, net: usize, factor: f64) {
-        let (first, count) = match net {
-            D => (row_index(N, D, 0), N * N),
-            C => (row_index(N, C, 0), N * N),
-            _ => (row_index(N, G, 0), N),
-        };
-        for i in first..first + count {
-            self.row_mut(i).iter_mut().for_each(|w| *w *= factor);
-        }
+        self.scale_network_on(SimdPath::portable(), net, factor);
     }
 
     /// [`scale_network`](Self::scale_network) on the instruction set `path`

@@ -591,6 +591,17 @@ mod tests {
     use super::*;
     use crate::control::controller::Controller;
 
+    /// Two seconds of the default task on three joints about zero (±1 rad limits).
+    fn default_path() -> alloc::vec::Vec<Setpoint<3>> {
+        let traj = default_task(
+            &Vector::<3>::zeros(),
+            &Vector::from_element(-1.0),
+            &Vector::from_element(1.0),
+        )
+        .unwrap();
+        Rule::sample(&traj, 2.0)
+    }
+
     fn arm_matrix() -> Matrix<3> {
         Matrix::<3>::new(2.0, 0.5, 0.1, 0.5, 1.0, 0.2, 0.1, 0.2, 0.05)
     }
@@ -610,13 +621,7 @@ mod tests {
         }
         assert_eq!(cfg.k1, Vector::<3>::from_element(50.0));
         assert_eq!(cfg.conditions, Conditions::Scaled);
-        let traj = default_task(
-            &Vector::<3>::zeros(),
-            &Vector::from_element(-1.0),
-            &Vector::from_element(1.0),
-        )
-        .unwrap();
-        let path = Rule::sample(&traj, 2.0);
+        let path = default_path();
         let s = Rule::default()
             .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, None)
             .unwrap();
@@ -734,13 +739,7 @@ mod tests {
         // Γ_G ⟨‖S‖²⟩ = ω_G² for the wider basis as for the rule's (18.6).
         let d = arm_matrix();
         let tau = Vector::<3>::new(50.0, 20.0, 5.0);
-        let traj = default_task(
-            &Vector::<3>::zeros(),
-            &Vector::from_element(-1.0),
-            &Vector::from_element(1.0),
-        )
-        .unwrap();
-        let path = Rule::sample(&traj, 2.0);
+        let path = default_path();
         let orbit = [Vector::<3>::zeros(), Vector::<3>::new(1.5, 0.0, 0.0)];
         let wide = rule.spanning(&orbit);
         assert_eq!(wide.span, 1.5);

@@ -170,11 +170,6 @@ def _per_axis(name: str, v: ArrayLike) -> FloatArray:
     return np.broadcast_to(a, (3,)).copy()
 
 
-def _sample(path: Path, t: float, R: FloatArray) -> FloatArray:
-    """path(t) as a flat target; a 3-tuple keeps the rotation R."""
-    return _pose_of(path(t), R)
-
-
 def _pose_of(sample: Any, R: FloatArray) -> FloatArray:
     """A path's value (p, ṗ, p̈[, R, ω, ω̇]) as a flat target; a 3-tuple keeps R."""
     s = tuple(sample)

@@ -72,7 +72,7 @@ def python_timers(name: str, states: list[tuple[Any, Any, Any]], calls: int) -> 
 
     urdf, frame = peers.ARMS[name]
     path = peers.robots() / urdf
-    model = peers.pinocchio_arm(peers.robots() / peers.ARMS[name][0])
+    model = peers.pinocchio_arm(path)
     data = model.createData()
     fid = model.getFrameId(frame)
     chain = adaptimp.Chain.from_urdf(path, tip=frame)
@@ -213,7 +213,7 @@ def cartesian_timers(
     wrenches = log.task["wrench"]
     rows = list(zip(log.q, log.dq, wrenches))
 
-    pm = peers.pinocchio_arm(peers.robots() / peers.ARMS[name][0])
+    pm = peers.pinocchio_arm(path)
     pd = pm.createData()
     fid = pm.getFrameId(frame)
     stiff = np.array([500.0] * 3 + [20.0] * 3)

@@ -824,14 +824,11 @@ class Contacts:
         self.clearance = margin
         self.possible = self._possible()
 
-    @property
-    def model(self) -> mujoco.MjModel:
-        """The copy of the model collision detection runs on (margins raised,
-        gaps zero), made at the first use: a check that finds no possible
-        contact (:attr:`possible`) costs no copy (the Panda's: 0.5 ms)."""
-        return self._copied()[0]
-
     def _copied(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        """The copy of the model collision detection runs on (margins raised,
+        gaps zero) and its data, made at the first check: a check that finds
+        no possible contact (:attr:`possible`) costs no copy (the Panda's:
+        0.5 ms)."""
         if self._copy is None:
             import copy
 

@@ -15,6 +15,7 @@ import pytest
 
 import adaptimp
 from adaptimp import _models
+from adaptimp._mjcf import WATCH
 from adaptimp import mujoco as amj
 from adaptimp._description import read_arm
 from mujoco_probe import contact_list_wrench, measure, push
@@ -161,7 +162,8 @@ def test_a_files_model_without_force_sensor_gets_a_contact_sensor(
     path.write_text(spec.to_xml())
     plant = amj.Plant(path)
     assert plant.wrench_source == "contact sensor"
-    assert plant.model.nsensor == 1
+    names = [plant.model.sensor(s).name for s in range(plant.model.nsensor)]
+    assert [n for n in names if not n.startswith(WATCH)] == [amj._CONTACT_SENSOR]
     tau = _push_into_wall(plant, [0.5, 0.0])
     listed = contact_list_wrench(plant)
     sensed = measure(plant, tau).wrench_ee

@@ -341,6 +341,8 @@ pub struct RawParts {
     pub subtree_com: Span,
     /// `d->cfrc_ext` (6 nbody).
     pub cfrc_ext: Span,
+    /// `d->userdata` (nuserdata): the user's, never written by MuJoCo's steps.
+    pub userdata: Span,
     /// `d->warning`.
     pub warnings: Warnings,
     /// `m->nv`.
@@ -413,7 +415,7 @@ impl Sim {
     /// length of that `mjData` field for `model` (`qpos`: nq, `qvel`, `qacc`,
     /// `qfrc_applied`: nv, `ctrl`: nu, `sensordata`: nsensordata, `site_xpos`:
     /// 3 nsite, `site_xmat`: 9 nsite, `xpos`, `subtree_com`: 3 nbody,
-    /// `cfrc_ext`: 6 nbody), `warnings` addresses
+    /// `cfrc_ext`: 6 nbody, `userdata`: nuserdata), `warnings` addresses
     /// `data`'s warning counters and `nv` is `model`'s; all of it stays valid
     /// while `owner` lives, and nothing else writes to `data` or `model` while
     /// the handle exists.
@@ -511,6 +513,15 @@ impl Sim {
     /// `qfrc_applied` (nv), writable.
     pub fn qfrc_applied_mut(&mut self) -> &mut [f64] {
         self.slice_mut(self.p.qfrc_applied)
+    }
+    /// The length of `userdata` (nuserdata).
+    pub fn userdata_len(&self) -> usize {
+        self.p.userdata.len
+    }
+    /// `userdata` (nuserdata), writable: MuJoCo's steps leave it alone, so a
+    /// loop may keep what it finds there for the caller to read afterwards.
+    pub fn userdata_mut(&mut self) -> &mut [f64] {
+        self.slice_mut(self.p.userdata)
     }
 
     /// `mj_step`: one timestep.

@@ -166,6 +166,7 @@ impl Sim {
         let size = |name: &str| -> PyResult<usize> { model.getattr(name)?.extract() };
         let (nq, nv, nu) = (size("nq")?, size("nv")?, size("nu")?);
         let (nsensordata, nsite, nbody) = (size("nsensordata")?, size("nsite")?, size("nbody")?);
+        let nuserdata = size("nuserdata")?;
         let mut keep: Vec<Py<PyAny>> = vec![model.clone().unbind(), data.clone().unbind()];
         let parts = RawParts {
             model: m_addr as *const c_void,
@@ -181,6 +182,7 @@ impl Sim {
             xpos: span(data, "xpos", 3 * nbody, false, &mut keep)?,
             subtree_com: span(data, "subtree_com", 3 * nbody, false, &mut keep)?,
             cfrc_ext: span(data, "cfrc_ext", 6 * nbody, false, &mut keep)?,
+            userdata: span(data, "userdata", nuserdata, true, &mut keep)?,
             warnings: warnings(data, &mut keep)?,
             nv,
         };

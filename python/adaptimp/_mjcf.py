@@ -351,9 +351,10 @@ def prepare_spec(
         )
         spec.option.timestep = FIRST_ORDER_STEP
     spec_actuators = list(spec.actuators)  # index = m0's actuator id
-    for key in spec.keys:  # the plant's motors start at zero torque, without activation
-        key.act = []
-        key.ctrl = []
+    # The keyframes, read off the compiled model by name and taken out of the
+    # spec: written back for the plant's model once its joints and actuators
+    # are final (:func:`_restore_keys`).
+    keys = _file_keys(spec, m0)
     if lock:
         _lock(spec, m0, lock, keep, spec_actuators)
         reasons = {
@@ -390,9 +391,121 @@ def prepare_spec(
             equalities[k].active = False
         _note_holds(m1, holds, out, label)
         m1 = _compile(spec)
+    if keys:
+        _restore_keys(spec, m1, keys, set(arm["joints"]))
+        m1 = _compile(spec)
     _estimate_missing(spec, m1, out, label)
     out.model = spec.compile() if out.notes.get("estimated") else m1
     return out
+
+
+@dataclass
+class _Key:
+    """A keyframe of the file, by name: every joint's qpos and qvel, every
+    actuator's ctrl and act, every mocap body's mpos and mquat."""
+
+    name: str
+    time: float
+    qpos: dict[str, FloatArray]
+    qvel: dict[str, FloatArray]
+    ctrl: dict[str, float]
+    act: dict[str, FloatArray]
+    mpos: dict[str, FloatArray]
+    mquat: dict[str, FloatArray]
+
+
+def _file_keys(spec: Any, m0: mujoco.MjModel) -> list[_Key]:
+    """The keyframes of ``m0`` (compiled from ``spec``) by name, removed from
+    ``spec``: the plant's edits (joints locked, actuators made motors or
+    removed) change the keyframes' layout, and MuJoCo's compiler checks their
+    sizes, not their meaning."""
+    out = []
+    for k in range(m0.nkey):
+        qpos, qvel, act = {}, {}, {}
+        for j in range(m0.njnt):
+            name = _name(m0, _OBJ.mjOBJ_JOINT, j)
+            qa, da = int(m0.jnt_qposadr[j]), int(m0.jnt_dofadr[j])
+            qpos[name] = np.array(m0.key_qpos[k, qa : qa + _nq(m0, j)])
+            qvel[name] = np.array(m0.key_qvel[k, da : da + _nv(m0, j)])
+        for a in range(m0.nu):
+            adr, num = int(m0.actuator_actadr[a]), int(m0.actuator_actnum[a])
+            if adr >= 0 and num > 0:
+                act[_name(m0, _OBJ.mjOBJ_ACTUATOR, a)] = np.array(m0.key_act[k, adr : adr + num])
+        mocap = [b for b in range(m0.nbody) if int(m0.body_mocapid[b]) >= 0]
+        out.append(
+            _Key(
+                name=_name(m0, _OBJ.mjOBJ_KEY, k) if mujoco.mj_id2name(m0, _OBJ.mjOBJ_KEY, k)
+                else "",
+                time=float(m0.key_time[k]),
+                qpos=qpos,
+                qvel=qvel,
+                ctrl={
+                    _name(m0, _OBJ.mjOBJ_ACTUATOR, a): float(m0.key_ctrl[k, a])
+                    for a in range(m0.nu)
+                },
+                act=act,
+                mpos={
+                    _name(m0, _OBJ.mjOBJ_BODY, b): np.array(m0.key_mpos[k, 3 * i : 3 * i + 3])
+                    for b in mocap
+                    for i in [int(m0.body_mocapid[b])]
+                },
+                mquat={
+                    _name(m0, _OBJ.mjOBJ_BODY, b): np.array(m0.key_mquat[k, 4 * i : 4 * i + 4])
+                    for b in mocap
+                    for i in [int(m0.body_mocapid[b])]
+                },
+            )
+        )
+    for key in list(spec.keys):
+        spec.delete(key)
+    # <size nkey> reserves keyframes, which a compile adds to the spec as
+    # blank ones: the file's (blank ones too) are all in ``out``.
+    spec.nkey = 0
+    return out
+
+
+def _restore_keys(spec: Any, m: mujoco.MjModel, keys: Sequence[_Key], arm: set[str]) -> None:
+    """The file's keyframes in ``spec``, laid out for ``m`` (compiled from it
+    without keyframes): each joint, actuator and mocap body that ``m`` keeps
+    has the file's values; a locked joint has gone with its entries; the arm's
+    motors start at zero torque (the controller commands them)."""
+    mocap = [b for b in range(m.nbody) if int(m.body_mocapid[b]) >= 0]
+    for key in keys:
+        qpos, qvel = np.array(m.qpos0), np.zeros(m.nv)
+        for j in range(m.njnt):
+            name = _name(m, _OBJ.mjOBJ_JOINT, j)
+            if name in key.qpos and key.qpos[name].size == _nq(m, j):
+                qa, da = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
+                qpos[qa : qa + _nq(m, j)] = key.qpos[name]
+                qvel[da : da + _nv(m, j)] = key.qvel[name]
+        ctrl, act = np.zeros(m.nu), np.zeros(m.na)
+        for a in range(m.nu):
+            name = _name(m, _OBJ.mjOBJ_ACTUATOR, a)
+            target = int(m.actuator_trnid[a, 0])
+            motor = int(m.actuator_trntype[a]) in _JOINT_TRN and (
+                _name(m, _OBJ.mjOBJ_JOINT, target) in arm
+            )
+            if not motor:
+                ctrl[a] = key.ctrl.get(name, 0.0)
+            adr, num = int(m.actuator_actadr[a]), int(m.actuator_actnum[a])
+            if adr >= 0 and num > 0 and not motor and name in key.act:
+                if key.act[name].size == num:
+                    act[adr : adr + num] = key.act[name]
+        mpos, mquat = np.zeros(3 * m.nmocap), np.zeros(4 * m.nmocap)
+        for b in mocap:
+            i, name = int(m.body_mocapid[b]), _name(m, _OBJ.mjOBJ_BODY, b)
+            mpos[3 * i : 3 * i + 3] = key.mpos.get(name, m.body_pos[b])
+            mquat[4 * i : 4 * i + 4] = key.mquat.get(name, m.body_quat[b])
+        spec.add_key(
+            name=key.name,
+            time=key.time,
+            qpos=qpos.tolist(),
+            qvel=qvel.tolist(),
+            ctrl=ctrl.tolist(),
+            act=act.tolist(),
+            mpos=mpos.tolist(),
+            mquat=mquat.tolist(),
+        )
 
 
 def holding(m: mujoco.MjModel, joint_ids: Sequence[int]) -> list[int]:
@@ -443,7 +556,8 @@ def _lock(
 ) -> None:
     """Remove the joints ``lock`` of ``m0`` from ``spec`` (their bodies then sit
     at the joints' reference position), with the actuators, tendons, equality
-    constraints and sensors that use them; keyframes keep the other joints."""
+    constraints and sensors that use them (the keyframes are laid out again
+    afterwards, :func:`_restore_keys`)."""
     joints = {_name(m0, _OBJ.mjOBJ_JOINT, j) for j in lock}
     tendons: set[str] = set()
     for t in range(m0.ntendon):
@@ -494,23 +608,6 @@ def _lock(
     for t in list(spec.tendons):
         if t.name in tendons:
             spec.delete(t)
-    # Keyframes: the kept joints' positions and velocities; no controls (the
-    # plant's motors start at zero torque).
-    qkeep = [
-        i
-        for j in range(m0.njnt)
-        if j not in lock
-        for i in range(int(m0.jnt_qposadr[j]), int(m0.jnt_qposadr[j]) + _nq(m0, j))
-    ]
-    vkeep = [
-        i
-        for j in range(m0.njnt)
-        if j not in lock
-        for i in range(int(m0.jnt_dofadr[j]), int(m0.jnt_dofadr[j]) + _nv(m0, j))
-    ]
-    for k, key in enumerate(spec.keys):
-        key.qpos = [float(x) for x in np.asarray(m0.key_qpos[k])[qkeep]]
-        key.qvel = [float(x) for x in np.asarray(m0.key_qvel[k])[vkeep]]
     for name in joints:
         spec.delete(spec.joint(name))
 
@@ -916,3 +1013,165 @@ def _full_inertia(m: mujoco.MjModel, d: mujoco.MjData, out: FloatArray) -> None:
         mujoco.mj_fullM(m, d, out)
     except TypeError:  # MuJoCo 3: mj_fullM(m, dst, qM)
         mujoco.mj_fullM(m, out, d.qM)
+
+
+# ---------------------------------------------------------------------------
+# Contacts watched during a run.
+# ---------------------------------------------------------------------------
+
+WATCH = "adaptimp_watch"
+"""The name prefix of the contact sensors :func:`watch_contacts` adds."""
+
+WATCH_MAX = 400
+"""The most (arm body, other body) pairs watched one by one; beyond, the other
+side is watched by the subtree of each child of the world."""
+
+_CONDATA_FOUND_FORCE = (1 << int(mujoco.mjtConDataField.mjCONDATA_FOUND)) | (
+    1 << int(mujoco.mjtConDataField.mjCONDATA_FORCE)
+)
+_NETFORCE = 3  # the contact sensor's reduce="netforce"
+
+
+def _collidable(m: mujoco.MjModel) -> tuple[dict[int, list[int]], set[tuple[int, int]]]:
+    """The geoms of each body that take part in contacts, and the body pairs of
+    explicit contact pairs (both orders)."""
+    geoms: dict[int, list[int]] = {}
+    for g in range(m.ngeom):
+        if m.geom_contype[g] or m.geom_conaffinity[g]:
+            geoms.setdefault(int(m.geom_bodyid[g]), []).append(g)
+    paired: set[tuple[int, int]] = set()
+    for p in range(m.npair):
+        a, b = (int(m.geom_bodyid[m.pair_geom1[p]]), int(m.geom_bodyid[m.pair_geom2[p]]))
+        paired |= {(a, b), (b, a)}
+        geoms.setdefault(a, [])
+        geoms.setdefault(b, [])
+    return geoms, paired
+
+
+def _excluded(m: mujoco.MjModel) -> set[tuple[int, int]]:
+    """Body pairs of the model's ``<exclude>`` elements (both orders)."""
+    out: set[tuple[int, int]] = set()
+    for s in np.asarray(m.exclude_signature, dtype=np.int64):
+        a, b = int(s) >> 16, int(s) & 0xFFFF
+        out |= {(a, b), (b, a)}
+    return out
+
+
+def watch_pairs(
+    m: mujoco.MjModel,
+    joint_ids: Sequence[int],
+    surface: Iterable[tuple[str, str]] = (),
+) -> list[tuple[int, int, bool]]:
+    """The contacts a run watches (SPEC §18.10): each body the arm's joints
+    move that has collision geometry, against each body outside the arm's own
+    body tree that can touch it by the model's filters (contype/conaffinity,
+    explicit pairs, excludes; the world's own geoms too), as (arm body, other
+    body, other is a subtree). ``surface``: (arm body, other body) names of
+    the task's own contact (a tool on its table), left out. Beyond
+    :data:`WATCH_MAX` pairs the other side is each child of the world's
+    subtree. The arm touching itself is the run's other check (it depends on
+    the arm's posture alone)."""
+    geoms, paired = _collidable(m)
+    excluded = _excluded(m)
+    moved = movers(m, joint_ids)
+    tree = arm_tree(m, joint_ids)
+    skip = set()
+    for a, b in surface:
+        ia, ib = (mujoco.mj_name2id(m, _OBJ.mjOBJ_BODY, n) for n in (a, b))
+        skip |= {(ia, ib), (ib, ia)}
+    ct, ca = m.geom_contype, m.geom_conaffinity
+
+    def meet(a: int, b: int) -> bool:
+        if (a, b) in skip or (a, b) in excluded:
+            return False
+        if (a, b) in paired:
+            return True
+        return any((ct[x] & ca[y]) or (ct[y] & ca[x]) for x in geoms[a] for y in geoms[b])
+
+    arm = [b for b in sorted(geoms) if moved[b] and b in tree]
+    others = [b for b in sorted(geoms) if b not in tree]
+    pairs = [(a, o, False) for a in arm for o in others if meet(a, o)]
+    if len(pairs) <= WATCH_MAX:
+        return pairs
+    roots: dict[int, list[int]] = {}
+    for o in others:
+        roots.setdefault(_root(m, o) if o > 0 else 0, []).append(o)
+    return [
+        (a, r, r > 0)
+        for a in arm
+        for r, members in roots.items()
+        if any(meet(a, o) for o in members)
+    ]
+
+
+def watch_contacts(
+    spec: Any,
+    m: mujoco.MjModel,
+    joint_ids: Sequence[int],
+    surface: Iterable[tuple[str, str]] = (),
+) -> int:
+    """Add to ``spec`` (compiled as ``m``) a contact sensor for each pair of
+    :func:`watch_pairs` (the number of contacts found and their net force, N)
+    and three ``userdata`` values each, where the run's loop keeps the periods
+    in contact, the peak force and its row (SPEC §18.10). A sensor reads and
+    changes nothing of the dynamics. Returns the number of sensors."""
+    pairs = watch_pairs(m, joint_ids, surface)
+    for i, (a, o, subtree) in enumerate(pairs):
+        spec.add_sensor(
+            name=f"{WATCH}{i}",
+            type=mujoco.mjtSensor.mjSENS_CONTACT,
+            objtype=_OBJ.mjOBJ_BODY,
+            objname=_name(m, _OBJ.mjOBJ_BODY, a),
+            reftype=_OBJ.mjOBJ_XBODY if subtree else _OBJ.mjOBJ_BODY,
+            refname="world" if o == 0 else _name(m, _OBJ.mjOBJ_BODY, o),
+            intprm=[_CONDATA_FOUND_FORCE, _NETFORCE, 1],
+        )
+    spec.nuserdata = int(spec.nuserdata) + 3 * len(pairs)
+    return len(pairs)
+
+
+@dataclass(frozen=True)
+class Watch:
+    """The watched contacts of a compiled model (its sensors named
+    :data:`WATCH`…): each sensor's ``sensordata`` address, its two bodies'
+    names and where their three ``userdata`` values start."""
+
+    adr: list[int]
+    pairs: list[tuple[str, str]]
+    out: int
+
+    @staticmethod
+    def of(m: mujoco.MjModel) -> Watch | None:
+        ids = [
+            s
+            for s in range(m.nsensor)
+            if (mujoco.mj_id2name(m, _OBJ.mjOBJ_SENSOR, s) or "").startswith(WATCH)
+            and int(m.sensor_type[s]) == int(mujoco.mjtSensor.mjSENS_CONTACT)
+        ]
+        if not ids or m.nuserdata < 3 * len(ids):
+            return None
+        return Watch(
+            adr=[int(m.sensor_adr[s]) for s in ids],
+            pairs=[
+                (
+                    _name(m, _OBJ.mjOBJ_BODY, int(m.sensor_objid[s])),
+                    _name(m, _OBJ.mjOBJ_BODY, int(m.sensor_refid[s])),
+                )
+                for s in ids
+            ],
+            out=int(m.nuserdata) - 3 * len(ids),
+        )
+
+    def clear(self, d: mujoco.MjData) -> None:
+        """Forget what a run found (before the next)."""
+        d.userdata[self.out : self.out + 3 * len(self.adr)] = 0.0
+
+    def found(self, d: mujoco.MjData) -> list[tuple[str, str, int, float, int]]:
+        """What the last run found: (arm body, other body, periods in contact,
+        peak force in N, its row), for each pair that touched."""
+        v = np.asarray(d.userdata[self.out : self.out + 3 * len(self.adr)]).reshape(-1, 3)
+        return [
+            (a, b, int(c), float(f), int(r))
+            for (a, b), (c, f, r) in zip(self.pairs, v)
+            if c > 0
+        ]

@@ -471,6 +471,11 @@ class Plant:
         or that body's origin. A URDF's ``tip`` is a link.
     fix : tuple of str
         Joints to lock as well (at their reference position), by name.
+    surface : str or tuple of str
+        The bodies a contact task presses on (a table): their contacts with
+        the end effector's subtree are the task's own, not watched. Every
+        other contact of the arm with the scene is watched through a run
+        and warned of by name (SPEC §18.10).
     site : str, optional
         The end-effector site (the earlier name of ``tip`` for a site).
 
@@ -517,6 +522,7 @@ class Plant:
         site: str | None = None,
         tip: str | None = None,
         fix: Sequence[str] = (),
+        surface: Sequence[str] = (),
     ) -> None:
         if site is not None and tip is not None:
             raise ValueError("give the end effector as tip= (a site or a body) or site=, not both")
@@ -543,11 +549,11 @@ class Plant:
             if self._site >= 0
             else _name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body)
         )
+        spec, sensed = prepared.spec, False
         if self.wrench_source == "contact" and self._contact_sensor_fits(model):
             # A file's model: measure the contacts with a sensor of its own (the
             # net contact wrench on the end effector's subtree), which the core's
             # loop reads like the force sensor. A sensor changes no dynamics.
-            spec = prepared.spec
             assert spec is not None
             spec.add_sensor(
                 name=_CONTACT_SENSOR,
@@ -556,7 +562,25 @@ class Plant:
                 objname=_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
                 intprm=[_NETFORCE_DATA, _NETFORCE, 1],
             )
+            sensed = True
+        if isinstance(surface, str):
+            surface = (surface,)
+        for name in surface:
+            _mjcf.resolve_tip(self.model, name)  # a body of the model, or refused by name
+        if spec is not None and contact and _mjcf.Watch.of(self.model) is None:
+            # The contacts of the arm with the rest of the scene, watched
+            # through the run (SPEC §18.10): sensors, which change no dynamics.
+            # The end effector on the task's own surface is the task's.
+            own = [
+                (_name(self.model, mujoco.mjtObj.mjOBJ_BODY, b), name)
+                for b in sorted(self._ee_subtree)
+                for name in surface
+            ]
+            sensed = _mjcf.watch_contacts(spec, self.model, self._joints, own) > 0 or sensed
+        if sensed:
+            assert spec is not None
             self._setup_model(spec.compile(), self.tip)
+        self._watch = _mjcf.Watch.of(self.model) if contact else None
         m = self.model
         self.data = mujoco.MjData(m)
         self._mass = np.zeros((m.nv, m.nv))
@@ -729,13 +753,21 @@ class Plant:
 
     def reset(self, q0: ArrayLike | None = None, dq0: ArrayLike | None = None) -> None:
         """Back to the first keyframe (or ``qpos0`` without one), then q = ``q0``
-        (rad) and q̇ = ``dq0`` (rad/s) where given; zero torque."""
+        (rad) and q̇ = ``dq0`` (rad/s) where given; zero torque on the arm's
+        motors; every other position servo (another arm's, a gripper's of the
+        scene) commanded to hold the keyframe's posture (:func:`holding_controls`)."""
         m, d = self.model, self.data
         if m.nkey > 0:
             mujoco.mj_resetDataKeyframe(m, d, 0)
         else:
             mujoco.mj_resetData(m, d)
+        mujoco.mj_forward(m, d)
+        held = holding_controls(m, d, self._act)
         d.ctrl[:] = 0.0
+        for a, (ctrl, act) in held.items():
+            d.ctrl[a] = ctrl
+            if act is not None:
+                d.act[int(m.actuator_actadr[a])] = act
         if q0 is not None:
             d.qpos[self._qadr] = self._vector("q0", q0)
         if dq0 is not None:
@@ -815,6 +847,8 @@ class Plant:
             "timestep": float(m.opt.timestep),
             "integrator": int(m.opt.integrator),
             "pure_sensors": _pure_sensors(m),
+            "watch": self._watch.adr if self._watch is not None else [],
+            "watch_out": self._watch.out if self._watch is not None else None,
             "dof_names": [
                 _name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)
             ],
@@ -836,6 +870,43 @@ class Plant:
             f"adaptimp.mujoco.Plant({name!r}: {self.n} joints, τmax = {self.tau_max.tolist()} N m,"
             f" wrench from {self.wrench_source}, timestep {self.timestep:g} s)"
         )
+
+
+def holding_controls(
+    m: mujoco.MjModel, d: mujoco.MjData, arm: Sequence[int] | FloatArray
+) -> dict[int, tuple[float, float | None]]:
+    """The control (and activation) under which each position-like servo that
+    is not one of the ``arm``'s actuators holds the posture of ``d`` (after
+    ``mj_forward``): force = g ctrl + b0 + b1 l + b2 l̇ vanishes at rest at
+    its length l, ctrl = −(b0 + b1 l)/g (fixed gain g ≠ 0, affine bias with
+    b1 ≠ 0: MuJoCo's ``position`` and the Menagerie's ``general`` servos),
+    within its control range. A filter's activation starts there too; an
+    integrator's activation holds it at zero control. Other actuators are not
+    in the answer (a motor or a velocity servo holds no posture: they keep the
+    keyframe's control). Returns {actuator: (ctrl, act or None)}."""
+    out: dict[int, tuple[float, float | None]] = {}
+    arm_set = {int(a) for a in arm}
+    fixed = int(mujoco.mjtGain.mjGAIN_FIXED)
+    affine = int(mujoco.mjtBias.mjBIAS_AFFINE)
+    for a in range(m.nu):
+        g, b0, b1 = (float(m.actuator_gainprm[a, 0]), *map(float, m.actuator_biasprm[a, :2]))
+        if a in arm_set or int(m.actuator_gaintype[a]) != fixed:
+            continue
+        if int(m.actuator_biastype[a]) != affine or g == 0.0 or b1 == 0.0:
+            continue
+        target = -(b0 + b1 * float(d.actuator_length[a])) / g
+        if m.actuator_ctrllimited[a]:
+            lo, hi = (float(v) for v in m.actuator_ctrlrange[a])
+            target = min(max(target, lo), hi)
+        dyn = int(m.actuator_dyntype[a])
+        has_act = int(m.actuator_actnum[a]) > 0 and int(m.actuator_actadr[a]) >= 0
+        if dyn == int(mujoco.mjtDyn.mjDYN_INTEGRATOR) and has_act:
+            out[a] = (0.0, target)
+        elif has_act:
+            out[a] = (target, target)
+        else:
+            out[a] = (target, None)
+    return out
 
 
 _CONTACT_SENSOR = "adaptimp_ee_contact"
@@ -1716,45 +1787,103 @@ RUN_CONTACT_EVERY = 0.01
 
 
 def _check_run(run: _Run, res: MujocoResult) -> None:
-    """What a run found that its numbers alone do not say (SPEC §18), as
-    :class:`adaptimp.PlantWarning` and in ``res.params["warnings"]``: the arm
-    touching itself (rows every :data:`RUN_CONTACT_EVERY` s replayed through
-    MuJoCo's collision detection); and, for a joint-space controller in free
-    space (no step in contact: pressing on a table is a contact task's own
-    business, its metrics say how it went), a commanded torque beyond
-    :data:`RUN_PEAK` τmax after :data:`RUN_SETTLE` s, the torque at a limit in
-    more than :data:`RUN_SATURATED` of the steps. ``res.params["plant"]`` is
-    what the plant made of the model (:attr:`Plant.notes`). Not for the
-    paper's arm, whose scenario saturates by design."""
+    """What a run found that its numbers alone do not say (SPEC §18, §18.10),
+    as :class:`adaptimp.PlantWarning` and in ``res.params["warnings"]``: the
+    arm touching itself (rows every :data:`RUN_CONTACT_EVERY` s replayed
+    through MuJoCo's collision detection); the arm touching the rest of the
+    scene (another arm, a pedestal, the table, a free body: the plant's
+    watched contacts, at the end of every period; a contact task's own
+    surface is not watched); a commanded torque beyond :data:`RUN_PEAK` τmax
+    after :data:`RUN_SETTLE` s; the torque at a limit in more than
+    :data:`RUN_SATURATED` of the steps. Every run is checked, in contact or
+    not, joint or Cartesian. ``res.params["plant"]`` is what the plant made
+    of the model (:attr:`Plant.notes`). Not for the paper's arm, whose
+    scenario saturates by design."""
     plant = run.plant
     res.params["plant"] = dict(plant.notes)
     found: list[str] = []
     if _uses_rule(plant) and res.rows > 0:
         found += _self_contact(plant, res)
-    free = res.metrics.get("steps_in_contact", 0) == 0 and run.kind != "cartesian"
-    free = free and not task_space(run.ctrl)
-    if _uses_rule(plant) and res.rows > 0 and free:
-        tau_max = np.asarray(plant.tau_max)
-        late = np.flatnonzero(res.t >= RUN_SETTLE - 1e-12)
-        if late.size:
-            ratio = np.abs(res.tau[late]) / tau_max
-            k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-            if ratio[k, i] > RUN_PEAK:
-                found.append(
-                    f"the commanded torque reached {ratio[k, i]:.3g} τmax after {RUN_SETTLE:g} s "
-                    f"(joint {plant.joint_names[i]!r} at t = {res.t[late[k]]:.3f} s), beyond "
-                    f"{RUN_PEAK:g} τmax: the controller asks far more than the actuators give"
-                )
-        duty = float(res.metrics.get("sat_duty", math.nan))
-        if duty > RUN_SATURATED:
-            found.append(
-                f"the torque was at a limit in {100 * duty:.1f} % of the steps (more than "
-                f"{100 * RUN_SATURATED:g} %): the actuators saturate, so the tracking measured is "
-                "theirs as much as the controller's"
-            )
+    if plant._watch is not None and _uses_rule(plant):
+        found += _scene_contact(plant, int(res.metrics.get("rows", run.steps)), run.Ts)
+    if _uses_rule(plant) and res.rows > 0:
+        found += torque_findings(res.t, res.tau, plant.tau_max, plant.joint_names,
+                                 float(res.metrics.get("sat_duty", math.nan)))  # fmt: skip
     res.params["warnings"] = found
     for text in found:
         warnings.warn(text, PlantWarning, stacklevel=3)
+
+
+def torque_findings(
+    t: FloatArray,
+    tau: FloatArray,
+    tau_max: ArrayLike,
+    joints: Sequence[str],
+    sat_duty: float,
+) -> list[str]:
+    """The torque checks of every run (SPEC §18): the commanded |τ_i| (N m,
+    rows ``tau`` at times ``t``, s) beyond :data:`RUN_PEAK` τmax_i after
+    :data:`RUN_SETTLE` s, and the torque at a limit in more than
+    :data:`RUN_SATURATED` of the steps (``sat_duty``, the run's metric)."""
+    found: list[str] = []
+    limit = np.asarray(tau_max, dtype=np.float64)
+    late = np.flatnonzero(np.asarray(t) >= RUN_SETTLE - 1e-12)
+    if late.size:
+        ratio = np.abs(np.asarray(tau)[late]) / limit
+        k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        if ratio[k, i] > RUN_PEAK:
+            found.append(
+                f"the commanded torque reached {ratio[k, i]:.3g} τmax after {RUN_SETTLE:g} s "
+                f"(joint {joints[i]!r} at t = {t[late[k]]:.3f} s), beyond "
+                f"{RUN_PEAK:g} τmax: the controller asks far more than the actuators give"
+            )
+    if sat_duty > RUN_SATURATED:
+        found.append(
+            f"the torque was at a limit in {100 * sat_duty:.1f} % of the steps (more than "
+            f"{100 * RUN_SATURATED:g} %): the actuators saturate, so the tracking measured is "
+            "theirs as much as the controller's"
+        )
+    return found
+
+
+def _scene_contact(plant: Plant, rows: int, Ts: float) -> list[str]:
+    """The warning of a run in which the arm touched the rest of the scene
+    (the plant's watched contacts, SPEC §18.10), if it did."""
+    assert plant._watch is not None
+    return scene_contact_findings(plant._watch.found(plant.data), rows, Ts)
+
+
+def scene_contact_findings(
+    found: Sequence[tuple[str, str, int, float, int]], rows: int, Ts: float
+) -> list[str]:
+    """The warning for watched contacts ``found`` ((arm body, other body,
+    periods in contact, peak force N, its row), :class:`adaptimp._mjcf.Watch`)
+    over a run of ``rows`` periods of ``Ts`` s: the pairs by name, most
+    steps first, each with its share of the steps, its peak force and when."""
+    if not found or rows <= 0:
+        return []
+    pairs: dict[tuple[str, str], list[float]] = {}
+    for a, b, count, peak, row in found:
+        key = (a, b)
+        old = pairs.get(key)
+        if old is None:
+            pairs[key] = [count, peak, row]
+        else:  # one pair watched twice (a body and a subtree): the larger
+            old[0] = max(old[0], count)
+            if peak > old[1]:
+                old[1], old[2] = peak, row
+    order = sorted(pairs.items(), key=lambda kv: (-kv[1][0], -kv[1][1]))
+    said = "; ".join(
+        f"{a!r}–{b!r} in {100 * c / rows:.1f} % of the steps, up to {f:.3g} N "
+        f"(t = {(r + 1) * Ts:.3f} s)"
+        for (a, b), (c, f, r) in order[:3]
+    )
+    more = f"; and {len(order) - 3} more pairs" if len(order) > 3 else ""
+    return [
+        f"the arm touched the rest of the scene: {said}{more}: the task runs into what is "
+        "around the arm, so the tracking measured is the contact's as much as the "
+        "controller's; give another home= or reference, or move what is in the way"
+    ]
 
 
 def _self_contact(plant: Plant, res: MujocoResult) -> list[str]:
@@ -2093,6 +2222,8 @@ def _setup(
     plant.timestep = Ts / int(substeps)
     if reset:
         plant.reset(q0, dq0)
+    if plant._watch is not None:  # this run's contacts only
+        plant._watch.clear(plant.data)
     return _Run(
         ctrl, plant, label, scenario, Ts, T, settle, int(substeps), steps, every, dist,
         plant._core_spec(int(substeps)), _kind(ctrl), reference, task, float(payload), plant.q,

@@ -82,6 +82,15 @@ pub struct MujocoSpec {
     /// out of its forward computation, as only the period's last forward
     /// computation is sensed ([`Sim::step_without_sensors`]).
     pub pure_sensors: bool,
+    /// Contacts watched (SPEC §18.10): the `sensordata` address of each
+    /// contact sensor whose first value is the number of contacts it found
+    /// and the next three their net force (N), read at the end of each
+    /// period.
+    pub watch: Vec<usize>,
+    /// Where in `userdata` the plant keeps, for each watched sensor, three
+    /// numbers: the periods at whose end it found a contact, the largest
+    /// ‖force‖ (N) and the row of that largest (none: nothing watched).
+    pub watch_out: Option<usize>,
     /// The joint name of each DOF of the model (for messages).
     pub dof_names: Vec<String>,
     /// The names of MuJoCo's warning kinds, by index (`mjtWarning`).
@@ -192,6 +201,17 @@ fn check_wrench(spec: &MujocoSpec, sim: &Sim) -> Result<(), Error> {
     }
     if spec.force_adr.is_none() && spec.torque_adr.is_some() {
         return Err(invalid("sensor", "a torque sensor needs a force sensor"));
+    }
+    if spec.watch.iter().any(|&adr| adr + 4 > sensors) {
+        return Err(invalid("watch", "address out of sensordata"));
+    }
+    if !spec.watch.is_empty() {
+        let fits = spec
+            .watch_out
+            .is_some_and(|base| base + 3 * spec.watch.len() <= sim.userdata_len());
+        if !fits {
+            return Err(invalid("watch_out", "needs three userdata values per watched sensor"));
+        }
     }
     match spec.site {
         Some(s) if s >= sim.site_xpos().len() / 3 => {
@@ -373,6 +393,33 @@ impl<'a, const N: usize> MjPlant<'a, N> {
             self.tau_e = self.joint_torque(&w)?;
         }
         Ok(())
+    }
+
+    /// The watched contacts at this period's end (SPEC §18.10): for each
+    /// watched sensor that found a contact, one more period in contact and
+    /// the largest ‖force‖ so far with its row, kept in `userdata`.
+    fn watch_contacts(&mut self) {
+        let (spec, row) = (self.spec, self.rows as f64);
+        let Some(base) = spec.watch_out else {
+            return;
+        };
+        for (i, &adr) in spec.watch.iter().enumerate() {
+            let data = self.sim.sensordata();
+            if data[adr] <= 0.0 {
+                continue;
+            }
+            let f = libm::sqrt(
+                data[adr + 1] * data[adr + 1]
+                    + data[adr + 2] * data[adr + 2]
+                    + data[adr + 3] * data[adr + 3],
+            );
+            let out = &mut self.sim.userdata_mut()[base + 3 * i..base + 3 * i + 3];
+            out[0] += 1.0;
+            if f > out[1] {
+                out[1] = f;
+                out[2] = row;
+            }
+        }
     }
 
     /// F_e from the force (and torque) sensor at the site, which measure in
@@ -596,6 +643,7 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
         }
         self.check(&before, t0)?;
         self.sense()?;
+        self.watch_contacts();
         self.rows += 1;
         if self.rows == self.total {
             self.ask(self.rows)?;

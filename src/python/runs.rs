@@ -223,6 +223,14 @@ pub(super) fn mujoco_spec(d: &Bound<'_, PyDict>) -> PyResult<mujoco::MujocoSpec>
             }
         },
         pure_sensors: get(d, "pure_sensors")?,
+        watch: match d.get_item("watch")? {
+            Some(v) => v.extract()?,
+            None => Vec::new(),
+        },
+        watch_out: match d.get_item("watch_out")? {
+            Some(v) => v.extract()?,
+            None => None,
+        },
         dof_names: get(d, "dof_names")?,
         warning_names: get(d, "warning_names")?,
     })

@@ -76,6 +76,7 @@ def test_panda_dynamics_agree_with_pinocchio(panda_pair: tuple[mujoco.MjModel, o
         np.testing.assert_allclose(ee_jacobian(plant), jac, rtol=0, atol=TOL)
 
 
+@pytest.mark.filterwarnings("ignore:the (torque was|commanded torque):adaptimp.PlantWarning")
 def test_panda_pushes_on_the_table() -> None:
     """The table 13 mm above the tool at home: held at home by computed torque
     with a stiff target impedance, the tool presses down all along; the sensor's

@@ -117,9 +117,9 @@ def test_a_reference_of_the_wrong_shape_is_refused_by_name(
     [
         ("a_free_body.xml",
          '<mujoco><worldbody><body><freejoint/><geom size=".1"/></body></worldbody></mujoco>',
-         "a_free_body.xml: it has no revolute or continuous joint to drive (held: "
-         "'adaptimp_joint0' a floating joint: an arm's joints have one coordinate each): "
-         "name a tip (tip=) to drive a prismatic joint"),
+         "a_free_body.xml: it has no hinge joint to drive (held: "
+         "'adaptimp_joint0' a free joint: an arm's joints have one coordinate each): "
+         "name a tip (tip=) to drive a slide joint"),
         ("nine.xml", None,
          "nine.xml: Plant needs 1 to 7 joints; the arm has 9 (j0, j1, j2, j3, j4, j5, j6, j7, "
          "j8): fix some with fix=(...) or name the arm's end with tip="),

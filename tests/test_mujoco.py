@@ -483,6 +483,7 @@ def _panda_pd() -> adaptimp.Controller:
     )  # fmt: skip
 
 
+@pytest.mark.filterwarnings("ignore:the (torque was|commanded torque):adaptimp.PlantWarning")
 def test_the_native_loop_with_a_reference_and_seven_joints_in_contact() -> None:
     """The Panda on its table, a reference callable: the controller native and
     called back agree."""
@@ -497,6 +498,7 @@ def test_the_native_loop_with_a_reference_and_seven_joints_in_contact() -> None:
     assert np.max(np.abs(native.wrench_ee[:, 2])) > 1.0
 
 
+@pytest.mark.filterwarnings("ignore:the (torque was|commanded torque):adaptimp.PlantWarning")
 def test_steps_inside_a_period_skip_pure_sensors_and_change_nothing(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

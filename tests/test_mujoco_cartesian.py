@@ -77,6 +77,7 @@ def basis(sc: apt.PandaTable) -> tuple[np.ndarray, np.ndarray]:
     return apt.orbit_basis(sc)
 
 
+@pytest.mark.filterwarnings("ignore:the (torque was|commanded torque):adaptimp.PlantWarning")
 @pytest.mark.parametrize("kind", ["pd", "sf", "of"])
 def test_the_panda_table_runs_natively_and_equals_the_callback(
     sc: apt.PandaTable, basis: Any, kind: str
@@ -189,6 +190,7 @@ def test_a_held_target_and_a_used_controller() -> None:
     assert len(a.arrays()["pc"]) == 800
 
 
+@pytest.mark.filterwarnings("ignore:the (torque was|commanded torque):adaptimp.PlantWarning")
 def test_a_path_goes_on_along_the_controllers_clock(sc: apt.PandaTable, basis: Any) -> None:
     """A used controller's path is sampled at its own t_k, natively and called back."""
     a = apt.panda_controller("sf", sc, basis=basis)
@@ -245,6 +247,7 @@ def test_the_replay_gives_the_runs_torques(sc: apt.PandaTable, basis: Any) -> No
         again.outer.core.replay(again.inner, res.q, res.dq, res.task["wrench"], targets[:9])
 
 
+@pytest.mark.filterwarnings("ignore:the (torque was|commanded torque):adaptimp.PlantWarning")
 def test_disturbances_and_faults_act_on_a_cartesian_run(sc: apt.PandaTable, basis: Any) -> None:
     """SPEC §17 on the Cartesian loop: the wrench is delayed with the joint sample,
     a stale sensor freezes it, a NaN burst is refused with the joint controller's

@@ -47,6 +47,7 @@ __all__ = [
     "CirclePath",
     "TablePath",
     "chain_of",
+    "collision",
     "self_collision",
     "task_of",
 ]
@@ -247,14 +248,26 @@ class _Probe:
 
 
 def self_collision(plant: Any, rows: FloatArray) -> str | None:
-    """The first self-collision of the arm at the postures ``rows`` (K, n)
-    (rad), named ("row k: 'a'–'b' touch"), or None.
+    """The first collision of the arm with itself at the postures ``rows``
+    (K, n) (rad), named ("row k: 'a'–'b' touch"), or None (:func:`collision`
+    among the arm's own bodies)."""
+    return collision(plant, rows, scene=False)
 
-    With the model's collision geometry (two of the arm's bodies that can
-    collide): MuJoCo's collision detection, contacts enabled, among the arm's
-    own bodies, as the joint-space task's check has it (``_mjcf.Contacts``,
-    SPEC §18: bodies its joints move relative to each other, its exclusions
-    and parent–child filter kept).
+
+def collision(
+    plant: Any, rows: FloatArray, *, scene: bool = True, skip: frozenset[int] = frozenset()
+) -> str | None:
+    """The first collision of the arm at the postures ``rows`` (K, n) (rad),
+    with itself or (``scene``) with the rest of the scene (another arm, a
+    pedestal, the table, a free or mocap body, where the plant's state puts
+    them: the file's keyframe), named ("row k: 'a'–'b' touch"), or None.
+    Contacts of the bodies ``skip`` (ids: a tool meant to touch) are left out.
+
+    With the model's collision geometry (two bodies that the arm's joints
+    move relative to each other and that can collide): MuJoCo's collision
+    detection, contacts enabled, as the joint-space task's check has it
+    (``_mjcf.Contacts``, SPEC §18: its exclusions and parent–child filter
+    kept).
     Without (a URDF compiled as :func:`adaptimp.mujoco.from_urdf` does, which
     keeps no collision geometry): the arm's skeleton, capsules along the
     segments between consecutive distinct joint anchors and the end effector,
@@ -266,12 +279,13 @@ def self_collision(plant: Any, rows: FloatArray) -> str | None:
     flags = int(m.opt.disableflags)
     m.opt.disableflags = flags & ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     try:  # the copy Contacts makes has contacts on, whatever the plant's setting
-        contacts = _mjcf.Contacts(m, plant.data.qpos, list(plant._joints), self_only=True)
+        contacts = _mjcf.Contacts(m, plant.data.qpos, list(plant._joints), self_only=not scene)
     finally:
         m.opt.disableflags = flags
+    names = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in skip}
     if contacts.possible:
         for k, q in enumerate(rows):
-            found = contacts.at(q)
+            found = [c for c in contacts.at(q) if c[0] not in names and c[1] not in names]
             if found:
                 return f"row {k}: {_mjcf.pairs(found)} touch"
         return None
@@ -496,9 +510,9 @@ def _assess(
         )
     )  # fmt: skip
     if a["error"] is None:
-        hit = self_collision(plant, rows)
+        hit = collision(plant, rows)
         if hit is not None:
-            a["error"] = f"free of self-collision along the task: {hit}"
+            a["error"] = f"free of collision along the task (with itself and the scene): {hit}"
     return a
 
 

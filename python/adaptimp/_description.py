@@ -74,6 +74,11 @@ class Arm:
         gravity along −z for a URDF.
     joint_ids : tuple of int
         For a MuJoCo model: the arm's joints' ids in it (empty otherwise).
+    balanced : tuple of str
+        The links whose inertia breaks the triangle inequality (A + B ≥ C of
+        its principal moments) and which the reader balanced (the moments
+        set to their mean, SPEC (21.6)): the plant, the chain, computed
+        torque and Pinocchio's model all have the balanced one.
     """
 
     source: str
@@ -98,6 +103,7 @@ class Arm:
     urdf_drive: str | None
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     joint_ids: tuple[int, ...] = ()
+    balanced: tuple[str, ...] = ()
 
     @property
     def n(self) -> int:
@@ -126,9 +132,38 @@ class Arm:
             "armature",
             "damping",
             "friction",
+            "balanced",
         )
         fields: dict[str, Any] = {k: tuple(v) if k in tuples else v for k, v in d.items()}
-        return cls(**fields, **extra)
+        arm = cls(**fields, **extra)
+        if arm.balanced:
+            _say_balanced(arm)
+        return arm
+
+
+_BALANCED_SAID: set[tuple[str, tuple[str, ...]]] = set()
+
+
+def _say_balanced(arm: Arm) -> None:
+    """The reader's balancing of ``arm``'s inertias, said once per file and
+    links in a process (every front reads the same balanced inertia: one
+    model, one warning)."""
+    key = (arm.source, arm.balanced)
+    if key in _BALANCED_SAID:
+        return
+    _BALANCED_SAID.add(key)
+    import warnings
+
+    from ._errors import PlantWarning
+
+    warnings.warn(
+        f"{arm.source}: the inertia of {list(arm.balanced)} breaks the triangle inequality "
+        "(A + B ≥ C of its principal moments, which every rigid body meets): the reader "
+        "balances it (the moments set to their mean, about the same centre of mass), for "
+        "the plant, the chain and computed torque alike (SPEC (21.6))",
+        PlantWarning,
+        stacklevel=4,
+    )
 
 
 def _fix(fix: object) -> tuple[str, ...]:
@@ -301,12 +336,46 @@ def _is_model(source: object) -> bool:
 
 
 def kind_of(source: str | os.PathLike[str]) -> str:
-    """What the file at ``source`` is: ``"urdf"``, ``"xacro"`` or ``"mjcf"``
-    (the core looks at its root element and its markup)."""
+    """What the file at ``source`` is: ``"urdf"``, ``"xacro"``, ``"mjcf"`` or
+    ``"mjcf-fragment"`` (a file MJCF scenes include; the core looks at its
+    root element and its markup)."""
     path = Path(source)
     if path.suffix.lower() == ".xacro":
         return "xacro"
     return str(_adaptimp.description_kind(str(path)))
+
+
+def fragment_error(path: str | os.PathLike[str]) -> ConfigError:
+    """The refusal of an MJCF fragment (a ``<mujocoinclude>``, or a ``<mujoco>``
+    whose bodies are not in a ``<worldbody>``: a file that a package's task
+    scenes include), naming the files beside it (and one folder up) that
+    include it: load one of those."""
+    import re
+
+    p = Path(path)
+    pattern = re.compile(r"<include\s+file\s*=\s*[\"']([^\"']*)[\"']")
+    includers: list[str] = []
+    for folder in (p.parent, p.parent.parent):
+        for other in sorted(folder.glob("*.xml"))[:500]:
+            if other == p or other.stat().st_size > 4 << 20:
+                continue
+            try:
+                text = other.read_text(errors="replace")
+            except OSError:
+                continue
+            if any((folder / f).resolve() == p.resolve() for f in pattern.findall(text)):
+                includers.append(str(other.relative_to(p.parent.parent)) if folder != p.parent
+                                 else other.name)  # fmt: skip
+    hint = (
+        f"load a scene that includes it ({', '.join(includers[:8])}"
+        f"{', …' if len(includers) > 8 else ''})"
+        if includers
+        else "load the scene of its package that includes it"
+    )
+    return ConfigError(
+        f"{p.name} is an MJCF fragment (its bodies are not in a <worldbody>: a file that other "
+        f"MJCF files include), not a model of its own: {hint}"
+    )
 
 
 def read_arm(
@@ -355,6 +424,8 @@ def read_arm(
     if kind == "xacro":
         text = expand_xacro(path)
         return Arm._of(_adaptimp.read_arm(text, tip, list(fix), f"xacro '{path.name}'"))
+    if kind == "mjcf-fragment":
+        raise fragment_error(path)
     if kind == "mjcf":
         try:
             import mujoco

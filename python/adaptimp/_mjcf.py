@@ -305,6 +305,10 @@ def prepare_file(path: str | os.PathLike[str], tip: str | None, fix: Sequence[st
         reduction's errors (:func:`arm_of`); a tendon that couples an arm joint
         with a joint to lock; an arm joint with two actuators.
     """
+    from ._description import fragment_error, kind_of
+
+    if Path(path).is_file() and kind_of(path) == "mjcf-fragment":
+        raise fragment_error(path)
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as e:
@@ -364,6 +368,10 @@ def prepare_spec(
             for j in lock
         }
         out.notes["locked"] = reasons
+        out.notes["locked_bodies"] = {
+            _name(m0, _OBJ.mjOBJ_JOINT, j): _name(m0, _OBJ.mjOBJ_BODY, int(m0.jnt_bodyid[j]))
+            for j in lock
+        }
         out.warnings.append(
             f"{label}the joints {list(reasons)} are not the arm's "
             f"({'; '.join(f'{k}: {v}' for k, v in reasons.items())}): the plant locks them at "

@@ -204,6 +204,10 @@ class Chain(_adaptimp.Chain):
                 # The same reader and reduction as the MuJoCo model
                 # adaptimp.mujoco.from_urdf compiles from it (SPEC §21).
                 return cls.from_urdf(path, tip, fix=fix)
+            from ._description import fragment_error, kind_of
+
+            if kind_of(path) == "mjcf-fragment":
+                raise fragment_error(path)
             try:
                 model = mujoco.MjModel.from_xml_path(str(path))
             except ValueError as e:

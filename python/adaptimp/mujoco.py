@@ -60,7 +60,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _adaptimp, _description, _mjcf, _models
-from ._cartesian_task import CartesianTask, chain_of, self_collision, task_of
+from ._cartesian_task import CartesianTask, chain_of, collision, self_collision, task_of
 from ._faults import Fault
 from ._mjcf import _full_inertia, _limits, _postures
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
@@ -91,6 +91,7 @@ __all__ = [
     "panda",
     "paper_circle",
     "rule_keywords",
+    "collision",
     "self_collision",
     "simulate",
     "sinusoid",
@@ -506,7 +507,9 @@ class Plant:
         The end-effector site asked for with ``site=``.
     notes : dict
         What the plant made of the model: "locked" {joint: why}, "actuators"
-        {joint: servo → motor}, "added" [joints given a motor], "tau_max"
+        {joint: servo → motor}, "added" [joints given a motor], "scene"
+        {joint that is not the arm's and is kept: where it starts and what
+        holds it (another arm's servos hold the keyframe's posture)}, "tau_max"
         {joint: where τmax comes from: "forcerange", "ctrlrange",
         "actuatorfrcrange" or "estimated"}, "timestep" (a file's Euler or
         implicit integrator is stepped at ≤ 0.25 ms,
@@ -585,6 +588,54 @@ class Plant:
         self.data = mujoco.MjData(m)
         self._mass = np.zeros((m.nv, m.nv))
         self.reset()
+        scene = self._scene_notes()
+        if scene:
+            self.notes["scene"] = scene
+
+    def _scene_notes(self) -> dict[str, str]:
+        """What the plant does with the joints that are not the arm's and that
+        it keeps (another arm, a free body, a door): each starts where the
+        file's first keyframe (or qpos0) puts it; a position servo holds that
+        posture (:func:`holding_controls`), other actuators keep the
+        keyframe's control; the rest is passive."""
+        m, d = self.model, self.data
+        start = (
+            f"the keyframe {_name(m, mujoco.mjtObj.mjOBJ_KEY, 0)!r}"
+            if m.nkey > 0 and mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_KEY, 0)
+            else "the file's keyframe"
+            if m.nkey > 0
+            else "qpos0 (no keyframe)"
+        )
+        held = holding_controls(m, d, self._act)
+        arm = set(self._joints)
+        out: dict[str, str] = {}
+        for j in range(m.njnt):
+            if j in arm:
+                continue
+            name = _name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+            acts = [
+                a
+                for a in range(m.nu)
+                if int(m.actuator_trntype[a]) in (0, 1) and int(m.actuator_trnid[a, 0]) == j
+            ]
+            q = float(d.qpos[int(m.jnt_qposadr[j])])
+            if int(m.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_FREE):
+                out[name] = f"a free body: starts at its pose in {start}"
+            elif any(a in held for a in acts):
+                a = next(a for a in acts if a in held)
+                out[name] = (
+                    f"held at {q:.4g} (its posture in {start}) by its servo "
+                    f"{_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)!r}, commanded to it"
+                )
+            elif acts:
+                out[name] = (
+                    f"starts at {q:.4g} (its posture in {start}); its actuator "
+                    f"{_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, acts[0])!r} keeps the keyframe's "
+                    "control (it holds no posture of its own)"
+                )
+            else:
+                out[name] = f"passive: starts at {q:.4g} (its posture in {start})"
+        return out
 
     # -- construction checks ------------------------------------------------
 

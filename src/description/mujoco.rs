@@ -342,6 +342,7 @@ impl MujocoArrays {
         }
         let frames = build.frames();
         Tree::new(source, &self.model_name, build.links, build.joints, frames)
+            .map(|t| t.in_dialect(super::tree::Dialect::Mujoco))
     }
 }
 

@@ -3,7 +3,7 @@
 //! why, and the arm's kinematics, bodies and drive terms.
 
 use super::error::{DescriptionError, ErrorKind};
-use super::tree::{motion, JointType, Tree};
+use super::tree::{motion, Dialect, JointType, Tree};
 use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
 use crate::cartesian::dynamics::{Drive, Dynamics, Inertial};
 use crate::error::Error;
@@ -71,6 +71,24 @@ pub enum Held {
         /// The tip.
         tip: String,
     },
+}
+
+impl Held {
+    /// Why the joint is held, in the words of `dialect` (a MuJoCo model's
+    /// `free` and `slide` joints, a URDF's `floating` and `prismatic`).
+    pub fn describe(&self, dialect: Dialect) -> String {
+        match (dialect, self) {
+            (Dialect::Mujoco, Self::Free { kind }) => format!(
+                "a {} joint: an arm's joints have one coordinate each",
+                kind.name_in(dialect)
+            ),
+            (Dialect::Mujoco, Self::Prismatic) => String::from(
+                "a slide (a lift, a rail or a finger): the arm found without tip= is of hinges; \
+                 a tip beyond it drives it",
+            ),
+            _ => self.to_string(),
+        }
+    }
 }
 
 impl fmt::Display for Held {
@@ -181,6 +199,9 @@ pub struct Arm {
     pub chain: Vec<Joint>,
     /// The last arm joint's frame → the tip.
     pub tip_origin: Transform,
+    /// The links the arm moves whose inertia the reader balanced (SPEC
+    /// (21.6)); the tree's others do not enter the arm's dynamics.
+    pub balanced: Vec<String>,
     /// Per arm joint, the body it moves (SPEC (20.1)): its child link and
     /// every link carried by it through fixed and held joints, as one
     /// inertial in the joint's frame (mass, centre of mass, inertia about it).
@@ -512,11 +533,14 @@ impl<'t> Reduction<'t> {
                 return Err(arm_error(
                     tree,
                     format!(
-                        "the joint '{}' on the way to '{tip}' is {}: a chain has revolute, \
-                         continuous, prismatic and fixed joints only; give a tip below it \
-                         or fix it with fix=",
+                        "the joint '{}' on the way to '{tip}' is {}: a chain has {} joints only; \
+                         give a tip below it or fix it with fix=",
                         joints[j].name,
-                        kind.urdf_name()
+                        kind.name_in(tree.dialect()),
+                        match tree.dialect() {
+                            Dialect::Urdf => "revolute, continuous, prismatic and fixed",
+                            Dialect::Mujoco => "hinge and slide",
+                        }
                     ),
                 ));
             }
@@ -540,8 +564,10 @@ impl<'t> Reduction<'t> {
             return Err(arm_error(
                 tree,
                 format!(
-                    "there is no revolute, continuous or prismatic joint to drive on the way \
-                     to '{tip}'{}: name a tip further out",
+                    "there is no {} or {} to drive on the way to '{tip}'{}: name a tip \
+                     further out",
+                    tree.dialect().rotary(),
+                    tree.dialect().linear(),
                     held_summary(tree, &self.held, &[])
                 ),
             ));
@@ -567,7 +593,11 @@ fn held_summary(tree: &Tree, held: &BTreeMap<usize, Held>, skip: &[usize]) -> St
             continue;
         }
         out.push_str(if out.is_empty() { " (held: " } else { "; " });
-        out.push_str(&format!("'{}' {why}", tree.joints()[j].name));
+        out.push_str(&format!(
+            "'{}' {}",
+            tree.joints()[j].name,
+            why.describe(tree.dialect())
+        ));
     }
     if !out.is_empty() {
         out.push(')');
@@ -609,9 +639,10 @@ fn find_chain(r: &mut Reduction<'_>, root: usize) -> Result<Vec<usize>, Descript
         return Err(arm_error(
             tree,
             format!(
-                "it has no revolute or continuous joint to drive{}: name a tip (tip=) to drive \
-                 a prismatic joint",
-                held_summary(tree, &r.held, &[])
+                "it has no {} to drive{}: name a tip (tip=) to drive a {}",
+                tree.dialect().rotary(),
+                held_summary(tree, &r.held, &[]),
+                tree.dialect().linear()
             ),
         ));
     }
@@ -914,6 +945,23 @@ impl Fold<'_> {
     /// The body arm joint `a` moves (SPEC (20.1)): its child link and every
     /// link it carries through joints that are not the arm's, as one
     /// inertial in the joint's frame.
+    /// The links arm joint `a` moves as one body (its child link and every
+    /// link below it that no arm joint moves): the links [`Fold::body`] sums.
+    fn links(&self, a: usize) -> Vec<usize> {
+        let tree = self.tree;
+        let mut out = Vec::new();
+        let mut todo = VecDeque::from([tree.joint_links(a).1]);
+        while let Some(l) = todo.pop_front() {
+            out.push(l);
+            for &j in tree.child_joints(l) {
+                if !self.on_arm[j] {
+                    todo.push_back(tree.joint_links(j).1);
+                }
+            }
+        }
+        out
+    }
+
     fn body(&self, a: usize) -> Result<Inertial, DescriptionError> {
         let tree = self.tree;
         let start = tree.joint_links(a).1;
@@ -1024,6 +1072,18 @@ fn build(
         held,
         chain,
         tip_origin,
+        balanced: {
+            let moved: Vec<&str> = arm
+                .iter()
+                .flat_map(|&a| fold.links(a))
+                .map(|l| tree.links()[l].name.as_str())
+                .collect();
+            tree.balanced()
+                .iter()
+                .filter(|b| moved.contains(&b.as_str()))
+                .cloned()
+                .collect()
+        },
         inertials,
     })
 }

@@ -38,6 +38,18 @@ impl JointType {
         matches!(self, Self::Revolute | Self::Continuous | Self::Prismatic)
     }
 
+    /// The name a description of `dialect` gives it.
+    pub fn name_in(self, dialect: Dialect) -> &'static str {
+        match (dialect, self) {
+            (Dialect::Mujoco, Self::Fixed) => "fixed (no joint)",
+            (Dialect::Mujoco, Self::Revolute | Self::Continuous) => "hinge",
+            (Dialect::Mujoco, Self::Prismatic) => "slide",
+            (Dialect::Mujoco, Self::Floating) => "free",
+            (Dialect::Mujoco, Self::Ball) => "ball",
+            _ => self.urdf_name(),
+        }
+    }
+
     /// The name a URDF gives it.
     pub fn urdf_name(self) -> &'static str {
         match self {
@@ -92,6 +104,11 @@ impl Origin {
     }
 }
 
+/// The share of the trace by which the two smaller principal moments of an
+/// inertia may fall short of the largest before [`LinkInertial::balance`]
+/// balances it (rounding in a file's six numbers).
+pub const BALANCE_TOLERANCE: f64 = 1e-9;
+
 /// The inertial of a link: its mass, centre of mass and rotational inertia
 /// about the centre of mass, in the frame `origin` of the link
 /// (URDF `<inertial>`; MuJoCo `body_mass`, `body_ipos`, `body_iquat`,
@@ -108,6 +125,24 @@ pub struct LinkInertial {
 }
 
 impl LinkInertial {
+    /// The inertia balanced where its principal moments break the triangle
+    /// inequality (A + B ≥ C, which every rigid body's meet): the moments
+    /// set to their mean, about the same centre of mass (MuJoCo's
+    /// `balanceinertia`), SPEC (21.6). Returns whether it changed it. An
+    /// inertia with a negative moment is left as it is (not a body's).
+    pub fn balance(&mut self) -> bool {
+        let m = Matrix3::from_fn(|i, j| self.inertia[i][j]);
+        let d = m.symmetric_eigenvalues();
+        let (lo, hi) = (d.min(), d.max());
+        let sum = d[0] + d[1] + d[2];
+        if !sum.is_finite() || lo < 0.0 || sum - hi >= hi - BALANCE_TOLERANCE * sum {
+            return false;
+        }
+        let mean = sum / 3.0;
+        self.inertia = [[mean, 0.0, 0.0], [0.0, mean, 0.0], [0.0, 0.0, mean]];
+        true
+    }
+
     /// No mass.
     pub const NONE: Self = Self {
         mass: 0.0,
@@ -127,6 +162,33 @@ impl LinkInertial {
             origin: self.origin.transform()?,
             inertia: self.inertia,
         })
+    }
+}
+
+/// The description a tree was read from, for the words of its messages.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Dialect {
+    /// A URDF: `revolute`, `continuous`, `prismatic`.
+    Urdf,
+    /// A MuJoCo model: `hinge`, `slide`.
+    Mujoco,
+}
+
+impl Dialect {
+    /// The joints an arm drives, in these words.
+    pub fn rotary(self) -> &'static str {
+        match self {
+            Dialect::Urdf => "revolute or continuous joint",
+            Dialect::Mujoco => "hinge joint",
+        }
+    }
+
+    /// A joint that translates, in these words.
+    pub fn linear(self) -> &'static str {
+        match self {
+            Dialect::Urdf => "prismatic joint",
+            Dialect::Mujoco => "slide joint",
+        }
     }
 }
 
@@ -245,6 +307,10 @@ pub struct NamedFrame {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tree {
     source: String,
+    /// Whose words the messages use for its joints.
+    dialect: Dialect,
+    /// The links whose inertia the reader balanced ([`LinkInertial::balance`]).
+    balanced: Vec<String>,
     name: String,
     links: Vec<Link>,
     joints: Vec<TreeJoint>,
@@ -556,6 +622,8 @@ impl Tree {
         let (frame_index, link_frames) = index_frames(source, &link_index, &frames)?;
         Ok(Self {
             source: source.into(),
+            dialect: Dialect::Urdf,
+            balanced: Vec::new(),
             name: name.into(),
             links,
             joints,
@@ -568,6 +636,38 @@ impl Tree {
             joint_index,
             frame_index,
         })
+    }
+
+    /// The tree in the words of `dialect` (its messages name MuJoCo's
+    /// `hinge` and `slide` for a model MuJoCo compiled).
+    pub fn in_dialect(mut self, dialect: Dialect) -> Self {
+        self.dialect = dialect;
+        self
+    }
+
+    /// Whose words the messages use for its joints.
+    pub fn dialect(&self) -> Dialect {
+        self.dialect
+    }
+
+    /// Every link's inertia balanced where it breaks the triangle
+    /// inequality ([`LinkInertial::balance`], SPEC (21.6)): the reader does
+    /// it once, so every model built from the tree (the plant, the chain,
+    /// computed torque, Pinocchio's from the reduced URDF) has the same.
+    pub fn balanced_inertias(mut self) -> Self {
+        for link in &mut self.links {
+            if let Some(inertial) = link.inertial.as_mut() {
+                if inertial.balance() {
+                    self.balanced.push(link.name.clone());
+                }
+            }
+        }
+        self
+    }
+
+    /// The links whose inertia the reader balanced, in the tree's order.
+    pub fn balanced(&self) -> &[String] {
+        &self.balanced
     }
 
     /// What the tree was read from, for messages (e.g. `"URDF 'panda.urdf'"`).

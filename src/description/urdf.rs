@@ -164,16 +164,44 @@ pub fn read_str_as(text: &str, label: &str) -> Result<Tree, DescriptionError> {
 }
 
 /// What a description's text is, by its root element and its markup:
-/// `"mjcf"` (`<mujoco>`), `"xacro"` (a `<robot>` with xacro markup),
+/// `"mjcf"` (`<mujoco>`), `"mjcf-fragment"` (a `<mujocoinclude>`, or a
+/// `<mujoco>` whose bodies are not in a `<worldbody>`: a file other MJCF
+/// files include), `"xacro"` (a `<robot>` with xacro markup),
 /// `"urdf"` (a `<robot>`), or `"unknown"` (not XML, another root).
 pub fn kind_of(text: &str) -> &'static str {
     match document(text) {
+        Ok(root) if is_mjcf_fragment(&root) => "mjcf-fragment",
         Ok(root) if root.name == "mujoco" => "mjcf",
         Ok(root) if root.name == "robot" && xacro_markup(&root).is_some() => "xacro",
         Ok(root) if root.name == "robot" => "urdf",
         Ok(_) => "unknown",
         Err(_) if text.contains("<xacro:") => "xacro",
         Err(_) => "unknown",
+    }
+}
+
+/// Whether `root` is an MJCF fragment: a `<mujocoinclude>`, or a `<mujoco>`
+/// whose bodies are not inside a `<worldbody>` (a file that task scenes
+/// include inside theirs; MuJoCo compiles it to an empty world).
+fn is_mjcf_fragment(root: &xml::Element) -> bool {
+    fn elements(e: &xml::Element) -> impl Iterator<Item = &xml::Element> {
+        e.children.iter().filter_map(|c| match c {
+            xml::Xml::ElementNode(e) => Some(e),
+            _ => None,
+        })
+    }
+    fn has_body(e: &xml::Element) -> bool {
+        elements(e).any(|c| c.name == "body" || has_body(c))
+    }
+    match root.name.as_str() {
+        "mujocoinclude" => true,
+        "mujoco" => {
+            let world = elements(root)
+                .filter(|c| c.name == "worldbody")
+                .any(has_body);
+            !world && elements(root).any(|c| c.name == "body")
+        }
+        _ => false,
     }
 }
 
@@ -283,6 +311,16 @@ impl ReadErrors<'_> {
             }
             Err(e) => return Err(self.parse_error(&e)),
         };
+        if is_mjcf_fragment(&root) {
+            return Err(DescriptionError::new(
+                ErrorKind::Parse,
+                format!(
+                    "{} is an MJCF fragment (its bodies are not in a <worldbody>: a file that \
+                     other MJCF files include), not a URDF: load the scene that includes it",
+                    self.shown
+                ),
+            ));
+        }
         if root.name == "mujoco" {
             return Err(DescriptionError::new(
                 ErrorKind::Parse,
@@ -463,7 +501,7 @@ fn tree_of(
         }
     }
     let joints = robot.joints.iter().map(joint_of).collect();
-    Tree::new(source, &robot.name, links, joints, Vec::new())
+    Tree::new(source, &robot.name, links, joints, Vec::new()).map(Tree::balanced_inertias)
 }
 
 /// A parsed link: its inertial if its element has one (`with_inertial`;

@@ -100,6 +100,7 @@ fn arm_dict<'py>(
         held.set_item(&h.name, h.value)?;
     }
     d.set_item("fixed", fixed)?;
+    d.set_item("balanced", arm.balanced.clone())?;
     d.set_item("held", held)?;
     for (key, drive) in [("urdf", false), ("urdf_drive", true)] {
         if with_urdf {

@@ -301,6 +301,27 @@ def _tool_and_table(
     return table
 
 
+def _watch_scene(spec: Any, model: Any, joints: Sequence[str], table: str | None) -> Any:
+    """``model`` compiled again from ``spec`` with the arm's contacts with the
+    rest of the scene watched through a run (SPEC §18.10,
+    :func:`adaptimp._mjcf.watch_contacts`): the tool on the table is the
+    task's own contact, every other one is warned of by name."""
+    import mujoco
+
+    from .. import _mjcf
+
+    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in joints]
+    tool = [
+        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, int(model.site_bodyid[s]))
+        for s in range(model.nsite)
+        if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, s) or "").startswith("ee")
+    ]
+    surface = [(tool[-1], table)] if tool and table is not None else []
+    if _mjcf.watch_contacts(spec, model, ids, surface) == 0:
+        return model
+    return spec.compile()
+
+
 def arm_model(
     urdf: str | os.PathLike[str],
     tip: str,
@@ -355,7 +376,8 @@ def arm_model(
     # reduction (SPEC §21), with its motors (efforts estimated where the URDF
     # gives none, and said so).
     spec = amj._arm_spec(amj._urdf_arm(urdf, tip, fix), timestep, drive=False, stacklevel=3)
-    _tool_and_table(
+    arm = amj._urdf_arm(urdf, tip, fix)
+    table = _tool_and_table(
         spec,
         tip,
         tool_radius=tool_radius,
@@ -370,9 +392,11 @@ def arm_model(
         if spring is not None:
             qpos.append(0.0)
         spec.add_key(name="home", qpos=qpos)
-    # Inertias that do not compile as they are: bounded and balanced as
-    # adaptimp.mujoco.from_urdf does, and said as it says it.
+    # A massless moving link: bounded as adaptimp.mujoco.from_urdf does, and
+    # said as it says it (an inertia that breaks the triangle inequality the
+    # reader has balanced already, for the chain and Pinocchio's model too).
     model = amj._compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
+    model = _watch_scene(spec, model, arm.joints, table)
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
         _set_pair_contact(model, force=force, speed=speed, accel=accel, friction=friction)
@@ -403,15 +427,12 @@ def _mjcf_model(
     from .. import _mjcf
     from .. import mujoco as amj
 
-    if fix:
-        raise ConfigError(
-            f"fix applies to the joints of a URDF; an MJCF arm's model is taken as it is "
-            f"(lock its joints in the file), got fix={fix!r}"
-        )
     # The file as the plant takes it (SPEC §18, adaptimp._mjcf): a torque
     # motor on each arm joint that has none, with τmax estimated where the
-    # file declares no range, and the joints that are not the arm's locked.
-    spec = _mjcf.prepare_file(path, tip, ()).spec
+    # file declares no range, and the joints that are not the arm's locked
+    # (those of fix= too, as for a URDF).
+    prepared = _mjcf.prepare_file(path, tip, fix)
+    spec = prepared.spec
     spec.option.timestep = timestep
     for key in list(spec.keys):  # the table may add a joint: the file's keys no longer fit
         spec.delete(key)
@@ -433,12 +454,37 @@ def _mjcf_model(
         for name in arm_bodies:
             spec.add_exclude(bodyname1=name, bodyname2=table)
     model = spec.compile()
+    # The rest of the scene where the file's first keyframe puts it (another
+    # arm, a free body, a mocap body; SPEC §18), the arm at ``home``.
+    qpos = np.array(model.qpos0, dtype=np.float64)
+    mocap = [b for b in range(model.nbody) if int(model.body_mocapid[b]) >= 0]
+    mpos = np.zeros(3 * model.nmocap)
+    mquat = np.zeros(4 * model.nmocap)
+    for b in mocap:
+        i = int(model.body_mocapid[b])
+        mpos[3 * i : 3 * i + 3], mquat[4 * i : 4 * i + 4] = model.body_pos[b], model.body_quat[b]
+    file = prepared.model
+    if file.nkey > 0:
+        for j in range(model.njnt):
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+            k = mujoco.mj_name2id(file, mujoco.mjtObj.mjOBJ_JOINT, name) if name else -1
+            if k >= 0 and int(file.jnt_type[k]) == int(model.jnt_type[j]):
+                n = {0: 7, 1: 4}.get(int(model.jnt_type[j]), 1)
+                a, fa = int(model.jnt_qposadr[j]), int(file.jnt_qposadr[k])
+                qpos[a : a + n] = file.key_qpos[0, fa : fa + n]
+        for b in mocap:
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b)
+            k = mujoco.mj_name2id(file, mujoco.mjtObj.mjOBJ_BODY, name) if name else -1
+            if k >= 0 and int(file.body_mocapid[k]) >= 0:
+                i, fi = int(model.body_mocapid[b]), int(file.body_mocapid[k])
+                mpos[3 * i : 3 * i + 3] = file.key_mpos[0, 3 * fi : 3 * fi + 3]
+                mquat[4 * i : 4 * i + 4] = file.key_mquat[0, 4 * fi : 4 * fi + 4]
     if home is not None:
-        plant = amj.Plant(model)
-        qpos = np.array(model.qpos0, dtype=np.float64)
-        qpos[plant._qadr] = np.asarray(home, dtype=np.float64)
-        spec.add_key(name="home", qpos=qpos.tolist())
-        model = spec.compile()
+        ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in prepared.arm["joints"]]
+        qpos[[int(model.jnt_qposadr[j]) for j in ids]] = np.asarray(home, dtype=np.float64)
+    spec.add_key(name="home", qpos=qpos.tolist(), mpos=mpos.tolist(), mquat=mquat.tolist())
+    model = spec.compile()
+    model = _watch_scene(spec, model, prepared.arm["joints"], table)
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
         _set_pair_contact(model, force=force, speed=speed, accel=accel, friction=friction)
@@ -848,12 +894,26 @@ def _mjcf_arm(
     from .. import mujoco as amj
 
     if tip is None:
-        plain = amj.Plant(str(path))
+        plain = amj.Plant(str(path), fix=fix)
         m = plain.model
+        # The bodies that carry a joint in the file (the plant's model has
+        # lost the ones it locks: a jaw is no flange).
+        jointed = {
+            mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)
+            for b in range(m.nbody)
+            if m.body_jntnum[b] > 0
+        } | {
+            str(plain.notes["locked_bodies"][j])
+            for j in plain.notes.get("locked", {})
+            if j in plain.notes.get("locked_bodies", {})
+        }
         body = int(plain._ee_body)
         while True:
             children = [b for b in range(m.nbody) if int(m.body_parentid[b]) == body and b != 0]
-            if len(children) != 1 or m.body_jntnum[children[0]] > 0:
+            name = (
+                mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, children[0]) if children else None
+            )
+            if len(children) != 1 or name in jointed:
                 break
             body = children[0]
         tip = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body)
@@ -1012,9 +1072,11 @@ def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
     )  # fmt: skip
     if a["error"] is not None:
         return str(a["error"])
-    hit = amj.self_collision(plant, rows)
+    # The arm with itself and with the rest of the scene (a pedestal, another
+    # arm), the tool on the table left out: that is the task.
+    hit = amj.collision(plant, rows, skip=frozenset({int(plant._ee_body)}))
     if hit is not None:
-        return f"free of self-collision along the path: {hit}"
+        return f"free of collision along the path (with itself and the scene): {hit}"
     through = _through_table(sc, plant, rows)
     if through is not None:
         return through

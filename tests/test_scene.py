@@ -1,4 +1,4 @@
-"""The rest of the scene (SPEC §18, §18.10, (21.6); docs/your_arm.md): what
+"""The rest of the scene (SPEC §18, §18.10, (21.4); docs/your_arm.md): what
 the plant does with another arm, a keyframe, a pedestal and free bodies; the
 run's checks that never go quiet; one arm and one model for every front.
 
@@ -238,7 +238,7 @@ def test_a_balanced_inertia_is_one_model_said_once(tmp_path: Path) -> None:
         "URDF 'tri.urdf': the inertia of ['upper'] breaks the triangle inequality (A + B ≥ C "
         "of its principal moments, which every rigid body meets): the reader balances it (the "
         "moments set to their mean, about the same centre of mass), for the plant, the chain "
-        "and computed torque alike (SPEC (21.6))"
+        "and computed torque alike (SPEC (21.4))"
     ]
     assert arm.balanced == ("upper",)
     mean = (0.001 + 0.001 + 0.02) / 3  # about the centre of mass, every axis

@@ -77,7 +77,7 @@ class Arm:
     balanced : tuple of str
         The links whose inertia breaks the triangle inequality (A + B ≥ C of
         its principal moments) and which the reader balanced (the moments
-        set to their mean, SPEC (21.6)): the plant, the chain, computed
+        set to their mean, SPEC (21.4)): the plant, the chain, computed
         torque and Pinocchio's model all have the balanced one.
     """
 
@@ -160,7 +160,7 @@ def _say_balanced(arm: Arm) -> None:
         f"{arm.source}: the inertia of {list(arm.balanced)} breaks the triangle inequality "
         "(A + B ≥ C of its principal moments, which every rigid body meets): the reader "
         "balances it (the moments set to their mean, about the same centre of mass), for "
-        "the plant, the chain and computed torque alike (SPEC (21.6))",
+        "the plant, the chain and computed torque alike (SPEC (21.4))",
         PlantWarning,
         stacklevel=4,
     )

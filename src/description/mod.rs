@@ -54,4 +54,6 @@ pub mod urdf;
 pub use error::{DescriptionError, ErrorKind};
 pub use mujoco::MujocoArrays;
 pub use reduce::{reduce, Arm, ArmJoint, Held, HeldJoint, GRIPPER_WORDS};
-pub use tree::{Dialect, JointType, Link, LinkInertial, Mimic, NamedFrame, Origin, Tree, TreeJoint};
+pub use tree::{
+    Dialect, JointType, Link, LinkInertial, Mimic, NamedFrame, Origin, Tree, TreeJoint,
+};

@@ -200,7 +200,7 @@ pub struct Arm {
     /// The last arm joint's frame → the tip.
     pub tip_origin: Transform,
     /// The links the arm moves whose inertia the reader balanced (SPEC
-    /// (21.6)); the tree's others do not enter the arm's dynamics.
+    /// (21.4)); the tree's others do not enter the arm's dynamics.
     pub balanced: Vec<String>,
     /// Per arm joint, the body it moves (SPEC (20.1)): its child link and
     /// every link carried by it through fixed and held joints, as one

@@ -128,7 +128,7 @@ impl LinkInertial {
     /// The inertia balanced where its principal moments break the triangle
     /// inequality (A + B ≥ C, which every rigid body's meet): the moments
     /// set to their mean, about the same centre of mass (MuJoCo's
-    /// `balanceinertia`), SPEC (21.6). Returns whether it changed it. An
+    /// `balanceinertia`), SPEC (21.4). Returns whether it changed it. An
     /// inertia with a negative moment is left as it is (not a body's).
     pub fn balance(&mut self) -> bool {
         let m = Matrix3::from_fn(|i, j| self.inertia[i][j]);
@@ -651,7 +651,7 @@ impl Tree {
     }
 
     /// Every link's inertia balanced where it breaks the triangle
-    /// inequality ([`LinkInertial::balance`], SPEC (21.6)): the reader does
+    /// inequality ([`LinkInertial::balance`], SPEC (21.4)): the reader does
     /// it once, so every model built from the tree (the plant, the chain,
     /// computed torque, Pinocchio's from the reduced URDF) has the same.
     pub fn balanced_inertias(mut self) -> Self {

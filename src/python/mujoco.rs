@@ -210,7 +210,10 @@ fn check_wrench(spec: &MujocoSpec, sim: &Sim) -> Result<(), Error> {
             .watch_out
             .is_some_and(|base| base + 3 * spec.watch.len() <= sim.userdata_len());
         if !fits {
-            return Err(invalid("watch_out", "needs three userdata values per watched sensor"));
+            return Err(invalid(
+                "watch_out",
+                "needs three userdata values per watched sensor",
+            ));
         }
     }
     match spec.site {

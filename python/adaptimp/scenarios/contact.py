@@ -433,6 +433,13 @@ def _mjcf_model(
     # (those of fix= too, as for a URDF).
     prepared = _mjcf.prepare_file(path, tip, fix)
     spec = prepared.spec
+    # The tool's force/torque sensor is the end effector's (a plant of the
+    # model finds its end effector at the first force sensor's site): the
+    # file's own (a wrist's, above its gripper) would put it at the wrist.
+    for sensor in list(spec.sensors):
+        kinds = (mujoco.mjtSensor.mjSENS_FORCE, mujoco.mjtSensor.mjSENS_TORQUE)
+        if int(sensor.type) in [int(k) for k in kinds]:
+            spec.delete(sensor)
     spec.option.timestep = timestep
     for key in list(spec.keys):  # the table may add a joint: the file's keys no longer fit
         spec.delete(key)

@@ -246,3 +246,29 @@ def test_a_balanced_inertia_is_one_model_said_once(tmp_path: Path) -> None:
     for q in ([0.0, 0.0], [0.4, -1.1]):
         plant.reset(q)
         np.testing.assert_allclose(plant.mass_matrix(), ct.mass_matrix(q), rtol=0, atol=1e-12)
+
+
+def test_a_mocap_target_welded_to_the_other_arm_holds_it_where_the_keyframe_puts_it(
+    tmp_path: Path,
+) -> None:
+    """The other arm driven through a mocap weld (an end-effector task scene):
+    the mocap body is placed where its weld holds that hand at the keyframe,
+    so the weld holds the keyframe's posture instead of dragging the hand to
+    the mocap body's own position."""
+    text = SCENE.read_text().replace(
+        "  <keyframe>", '  <equality><weld body1="target" body2="right/hand"/></equality>\n  <keyframe>'
+    )
+    path = tmp_path / "welded.xml"
+    path.write_text(text)
+    with pytest.warns(adaptimp.PlantWarning):
+        plant = amj.Plant(path, tip="left/tcp")
+    m, d = plant.model, plant.data
+    welds = d.efc_type == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    assert welds.sum() == 6
+    np.testing.assert_allclose(d.efc_pos[welds], 0.0, atol=1e-12)
+    assert plant.notes["scene"]["target"] == (
+        "a mocap body welded to 'right/hand': placed where the weld holds 'right/hand' in the "
+        "keyframe 'ready'"
+    )
+    for joint, value in READY.items():
+        assert _qpos(m, d, joint) == value

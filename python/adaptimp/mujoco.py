@@ -609,6 +609,11 @@ class Plant:
         held = holding_controls(m, d, self._act)
         arm = set(self._joints)
         out: dict[str, str] = {}
+        for mocap, body in mocap_welds(m, d, self._joints):
+            out[mocap] = (
+                f"a mocap body welded to {body!r}: placed where the weld holds {body!r} in "
+                f"{start}"
+            )
         for j in range(m.njnt):
             if j in arm:
                 continue
@@ -819,6 +824,8 @@ class Plant:
             d.ctrl[a] = ctrl
             if act is not None:
                 d.act[int(m.actuator_actadr[a])] = act
+        if mocap_welds(m, d, self._joints):
+            mujoco.mj_forward(m, d)
         if q0 is not None:
             d.qpos[self._qadr] = self._vector("q0", q0)
         if dq0 is not None:
@@ -921,6 +928,53 @@ class Plant:
             f"adaptimp.mujoco.Plant({name!r}: {self.n} joints, τmax = {self.tau_max.tolist()} N m,"
             f" wrench from {self.wrench_source}, timestep {self.timestep:g} s)"
         )
+
+
+def mocap_welds(
+    m: mujoco.MjModel, d: mujoco.MjData, arm: Sequence[int] | FloatArray
+) -> list[tuple[str, str]]:
+    """Each mocap body welded (an active weld) to a body the ``arm``'s joints
+    do not move (another arm's hand, driven through its mocap target) put
+    where the weld holds that body at the state of ``d`` (after
+    ``mj_forward``: the keyframe's posture), as a task scene's reset does;
+    (18.10). Returns the (mocap body, body) pairs moved. With the weld's
+    relative pose (p_r, q_r) of body 2 in body 1: q_1 = q_2 q_r⁻¹,
+    p_1 = p_2 − R_1 p_r, or q_2 = q_1 q_r, p_2 = p_1 + R_1 p_r."""
+    moved = _mjcf.movers(m, [int(j) for j in arm])
+    out: list[tuple[str, str]] = []
+    for k in range(m.neq):
+        if int(m.eq_type[k]) != int(mujoco.mjtEq.mjEQ_WELD) or not d.eq_active[k]:
+            continue
+        if int(m.eq_objtype[k]) != int(mujoco.mjtObj.mjOBJ_BODY):
+            continue
+        b1, b2 = int(m.eq_obj1id[k]), int(m.eq_obj2id[k])
+        if b2 < 0 or moved[b1] or moved[b2]:
+            continue
+        relpos, relq = np.array(m.eq_data[k, 3:6]), np.array(m.eq_data[k, 6:10])
+        if int(m.body_mocapid[b1]) >= 0 and int(m.body_mocapid[b2]) < 0:
+            inv, q1, r1 = np.zeros(4), np.zeros(4), np.zeros(9)
+            mujoco.mju_negQuat(inv, relq)
+            mujoco.mju_mulQuat(q1, np.array(d.xquat[b2]), inv)
+            mujoco.mju_quat2Mat(r1, q1)
+            i = int(m.body_mocapid[b1])
+            d.mocap_pos[i] = d.xpos[b2] - r1.reshape(3, 3) @ relpos
+            d.mocap_quat[i] = q1
+        elif int(m.body_mocapid[b2]) >= 0 and int(m.body_mocapid[b1]) < 0:
+            q2, r1 = np.zeros(4), np.zeros(9)
+            mujoco.mju_mulQuat(q2, np.array(d.xquat[b1]), relq)
+            mujoco.mju_quat2Mat(r1, np.array(d.xquat[b1]))
+            i = int(m.body_mocapid[b2])
+            d.mocap_pos[i] = d.xpos[b1] + r1.reshape(3, 3) @ relpos
+            d.mocap_quat[i] = q2
+        else:
+            continue
+        out.append(
+            (
+                _name(m, mujoco.mjtObj.mjOBJ_BODY, b1 if m.body_mocapid[b1] >= 0 else b2),
+                _name(m, mujoco.mjtObj.mjOBJ_BODY, b2 if m.body_mocapid[b1] >= 0 else b1),
+            )
+        )
+    return out
 
 
 def holding_controls(

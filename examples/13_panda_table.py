@@ -317,7 +317,10 @@ def main() -> None:
     )
     parser.add_argument("--tip", type=str, default=None, help="the tool's link (body)")
     parser.add_argument(
-        "--fix", type=str, default="", help="joints to hold at their reference, J1,J2 (a URDF's or an MJCF's)"
+        "--fix",
+        type=str,
+        default="",
+        help="joints to hold at their reference, J1,J2 (a URDF's or an MJCF's)",
     )
     parser.add_argument(
         "--placements",

@@ -811,9 +811,11 @@ def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:
         act.arm_table(path, home=[-0.3, 1.5], fix=("j1",))
     with pytest.warns(adaptimp.PlantWarning):  # the plant's arm: the same two joints
         assert amj.Plant(path, fix=("j1",)).joint_names == ["j2", "j3"]
-    with pytest.raises(adaptimp.ConfigError, match=r"home must be 2 finite numbers"):
-        with pytest.warns(adaptimp.PlantWarning):
-            act.arm_table(path, home=[0.0, -0.3, 1.5], fix=("j1",))
+    with (
+        pytest.raises(adaptimp.ConfigError, match=r"home must be 2 finite numbers"),
+        pytest.warns(adaptimp.PlantWarning),
+    ):
+        act.arm_table(path, home=[0.0, -0.3, 1.5], fix=("j1",))
 
 
 def test_the_velocity_loop_radius_is_the_sampled_loops() -> None:

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _description, _mjcf
+from adaptimp import _description
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque
 
@@ -57,7 +57,8 @@ def test_the_keyframe_is_laid_out_again_for_the_plants_model() -> None:
     np.testing.assert_array_equal(d.mocap_pos[0], [0.0, -0.2, 0.8])
     np.testing.assert_array_equal(d.mocap_quat[0], [1.0, 0.0, 0.0, 0.0])
     assert plant.q.tolist() == [1.4, 0.2, 0.5]
-    assert m.nkey == 1 and m.key(0).name == "ready"
+    assert m.nkey == 1
+    assert m.key(0).name == "ready"
     # The box sits where the file has it, on the table, and stays there.
     plant.reset()
     for _ in range(400):
@@ -104,7 +105,8 @@ def test_a_run_that_touches_the_scene_says_so_by_name() -> None:
     plant = _left()
     assert plant._watch is not None
     watched = set(plant._watch.pairs)
-    assert ("left/hand", "right/hand") in watched and ("left/fore", "pedestal") in watched
+    assert ("left/hand", "right/hand") in watched
+    assert ("left/fore", "pedestal") in watched
     assert not any(a.startswith("right/") or b.startswith("left/") for a, b in watched)
     quiet = amj.simulate("sf", plant, T=4.0)
     assert quiet.params["warnings"] == []
@@ -123,10 +125,11 @@ def test_a_run_that_touches_the_scene_says_so_by_name() -> None:
         "the torque was at a limit in 4.0 % of the steps (more than 1 %)",
     ]
     said = res.params["warnings"][0]
-    pair = re.search(r"'(left/[^']+)'–'(right/[^']+)' in ([0-9.]+) % of the steps, up to ([0-9.]+) N",
-                     said)  # fmt: skip
+    found = r"'(left/[^']+)'–'(right/[^']+)' in ([0-9.]+) % of the steps, up to ([0-9.]+) N"
+    pair = re.search(found, said)
     assert pair is not None, said
-    assert 0.0 < float(pair.group(3)) <= 100.0 and float(pair.group(4)) > 0.0
+    assert 0.0 < float(pair.group(3)) <= 100.0
+    assert float(pair.group(4)) > 0.0
     assert said.endswith(
         "the task runs into what is around the arm, so the tracking measured is the contact's "
         "as much as the controller's; give another home= or reference, or move what is in "
@@ -143,9 +146,11 @@ def test_a_contact_tasks_surface_is_its_own() -> None:
     watched = set(plant._watch.pairs) if plant._watch else set()
     assert ("left/hand", "table") not in watched
     assert ("left/fore", "table") in watched
-    with pytest.raises(ValueError, match=r"tip='nowhere': the model has no site or body"):
-        with pytest.warns(adaptimp.PlantWarning):
-            amj.Plant(SCENE, tip="left/hand", surface="nowhere")
+    with (
+        pytest.raises(ValueError, match=r"tip='nowhere': the model has no site or body"),
+        pytest.warns(adaptimp.PlantWarning),
+    ):
+        amj.Plant(SCENE, tip="left/hand", surface="nowhere")
 
 
 def test_the_default_tasks_start_keeps_off_the_scene() -> None:
@@ -160,7 +165,8 @@ def test_the_default_tasks_start_keeps_off_the_scene() -> None:
         rows = np.array([q])
         assert amj.self_collision(plant, rows) is None
         hit = collision(plant, rows)
-        assert hit is not None and body in hit, hit
+        assert hit is not None
+        assert body in hit, hit
 
 
 def test_an_mjcf_fragment_is_named_with_the_scenes_that_include_it(tmp_path: Path) -> None:
@@ -192,8 +198,11 @@ def test_an_mjcf_fragment_is_named_with_the_scenes_that_include_it(tmp_path: Pat
     # The core's URDF reader (C's too) given its text: named, not read as a URDF.
     from adaptimp import _adaptimp
 
-    with pytest.raises(ValueError, match=r"is an MJCF fragment \(its bodies are not in a "
-                       r"<worldbody>: a file that other MJCF files include\), not a URDF"):  # fmt: skip
+    fragment = (
+        r"is an MJCF fragment \(its bodies are not in a <worldbody>: a file that other MJCF "
+        r"files include\), not a URDF"
+    )
+    with pytest.raises(ValueError, match=fragment):
         _adaptimp.read_arm((tmp_path / "gripper.xml").read_text(), None, [])
 
 
@@ -203,7 +212,7 @@ def test_a_mujoco_models_joints_are_named_in_mujocos_words() -> None:
         '<mujoco><worldbody><body><joint type="slide"/><geom size=".1"/></body></worldbody>'
         "</mujoco>"
     )
-    with pytest.raises(adaptimp.ConfigError, match="no hinge joint to drive.*a slide joint"):
+    with pytest.raises(adaptimp.ConfigError, match=r"no hinge joint to drive.*a slide joint"):
         _description.read_arm(m)
 
 
@@ -230,9 +239,7 @@ def test_a_balanced_inertia_is_one_model_said_once(tmp_path: Path) -> None:
     path.write_text(TRIANGLE)
     _description._BALANCED_SAID.clear()
     with pytest.warns(adaptimp.PlantWarning) as said:
-        arm = _description.read_arm(path)
-        plant = amj.Plant(path)
-        ct = ComputedTorque(path)
+        arm, plant, ct = _description.read_arm(path), amj.Plant(path), ComputedTorque(path)
     balanced = [str(w.message) for w in said if "triangle" in str(w.message)]
     assert balanced == [
         "URDF 'tri.urdf': the inertia of ['upper'] breaks the triangle inequality (A + B ≥ C "
@@ -256,7 +263,8 @@ def test_a_mocap_target_welded_to_the_other_arm_holds_it_where_the_keyframe_puts
     so the weld holds the keyframe's posture instead of dragging the hand to
     the mocap body's own position."""
     text = SCENE.read_text().replace(
-        "  <keyframe>", '  <equality><weld body1="target" body2="right/hand"/></equality>\n  <keyframe>'
+        "  <keyframe>",
+        '  <equality><weld body1="target" body2="right/hand"/></equality>\n  <keyframe>',
     )
     path = tmp_path / "welded.xml"
     path.write_text(text)

@@ -442,7 +442,8 @@ def _file_keys(spec: Any, m0: mujoco.MjModel) -> list[_Key]:
         mocap = [b for b in range(m0.nbody) if int(m0.body_mocapid[b]) >= 0]
         out.append(
             _Key(
-                name=_name(m0, _OBJ.mjOBJ_KEY, k) if mujoco.mj_id2name(m0, _OBJ.mjOBJ_KEY, k)
+                name=_name(m0, _OBJ.mjOBJ_KEY, k)
+                if mujoco.mj_id2name(m0, _OBJ.mjOBJ_KEY, k)
                 else "",
                 time=float(m0.key_time[k]),
                 qpos=qpos,
@@ -496,9 +497,8 @@ def _restore_keys(spec: Any, m: mujoco.MjModel, keys: Sequence[_Key], arm: set[s
             if not motor:
                 ctrl[a] = key.ctrl.get(name, 0.0)
             adr, num = int(m.actuator_actadr[a]), int(m.actuator_actnum[a])
-            if adr >= 0 and num > 0 and not motor and name in key.act:
-                if key.act[name].size == num:
-                    act[adr : adr + num] = key.act[name]
+            if adr >= 0 and not motor and name in key.act and key.act[name].size == num > 0:
+                act[adr : adr + num] = key.act[name]
         mpos, mquat = np.zeros(3 * m.nmocap), np.zeros(4 * m.nmocap)
         for b in mocap:
             i, name = int(m.body_mocapid[b]), _name(m, _OBJ.mjOBJ_BODY, b)
@@ -1179,7 +1179,5 @@ class Watch:
         peak force in N, its row), for each pair that touched."""
         v = np.asarray(d.userdata[self.out : self.out + 3 * len(self.adr)]).reshape(-1, 3)
         return [
-            (a, b, int(c), float(f), int(r))
-            for (a, b), (c, f, r) in zip(self.pairs, v)
-            if c > 0
+            (a, b, int(c), float(f), int(r)) for (a, b), (c, f, r) in zip(self.pairs, v) if c > 0
         ]

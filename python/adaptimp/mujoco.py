@@ -83,6 +83,7 @@ __all__ = [
     "Task",
     "cartesian_task",
     "chain_of",
+    "collision",
     "default_task",
     "estimate_effort",
     "from_urdf",
@@ -91,7 +92,6 @@ __all__ = [
     "panda",
     "paper_circle",
     "rule_keywords",
-    "collision",
     "self_collision",
     "simulate",
     "sinusoid",
@@ -611,8 +611,7 @@ class Plant:
         out: dict[str, str] = {}
         for mocap, body in mocap_welds(m, d, self._joints):
             out[mocap] = (
-                f"a mocap body welded to {body!r}: placed where the weld holds {body!r} in "
-                f"{start}"
+                f"a mocap body welded to {body!r}: placed where the weld holds {body!r} in {start}"
             )
         for j in range(m.njnt):
             if j in arm:
@@ -1939,7 +1938,7 @@ def torque_findings(
         if ratio[k, i] > RUN_PEAK:
             found.append(
                 f"the commanded torque reached {ratio[k, i]:.3g} τmax after {RUN_SETTLE:g} s "
-                f"(joint {joints[i]!r} at t = {t[late[k]]:.3f} s), beyond "
+                f"(joint {joints[int(i)]!r} at t = {t[late[k]]:.3f} s), beyond "
                 f"{RUN_PEAK:g} τmax: the controller asks far more than the actuators give"
             )
     if sat_duty > RUN_SATURATED:

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -425,7 +425,6 @@ def _mjcf_model(
     import mujoco
 
     from .. import _mjcf
-    from .. import mujoco as amj
 
     # The file as the plant takes it (SPEC §18, adaptimp._mjcf): a torque
     # motor on each arm joint that has none, with τmax estimated where the
@@ -487,7 +486,9 @@ def _mjcf_model(
                 mpos[3 * i : 3 * i + 3] = file.key_mpos[0, 3 * fi : 3 * fi + 3]
                 mquat[4 * i : 4 * i + 4] = file.key_mquat[0, 4 * fi : 4 * fi + 4]
     if home is not None:
-        ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in prepared.arm["joints"]]
+        ids = [
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in prepared.arm["joints"]
+        ]
         qpos[[int(model.jnt_qposadr[j]) for j in ids]] = np.asarray(home, dtype=np.float64)
     spec.add_key(name="home", qpos=qpos.tolist(), mpos=mpos.tolist(), mquat=mquat.tolist())
     model = spec.compile()
@@ -917,9 +918,7 @@ def _mjcf_arm(
         body = int(plain._ee_body)
         while True:
             children = [b for b in range(m.nbody) if int(m.body_parentid[b]) == body and b != 0]
-            name = (
-                mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, children[0]) if children else None
-            )
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, children[0]) if children else None
             if len(children) != 1 or name in jointed:
                 break
             body = children[0]

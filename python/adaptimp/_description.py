@@ -135,21 +135,19 @@ class Arm:
             "balanced",
         )
         fields: dict[str, Any] = {k: tuple(v) if k in tuples else v for k, v in d.items()}
-        arm = cls(**fields, **extra)
-        if arm.balanced:
-            _say_balanced(arm)
-        return arm
+        return cls(**fields, **extra)
 
 
 _BALANCED_SAID: set[tuple[str, tuple[str, ...]]] = set()
 
 
-def _say_balanced(arm: Arm) -> None:
-    """The reader's balancing of ``arm``'s inertias, said once per file and
-    links in a process (every front reads the same balanced inertia: one
-    model, one warning)."""
+def say_balanced(arm: Arm, stacklevel: int = 4) -> None:
+    """The reader's balancing of ``arm``'s inertias (SPEC (21.4)), said once
+    per file and links in a process by the fronts that build its dynamics
+    (the plant, computed torque): they read the same balanced inertia, one
+    model, one warning. A chain (kinematics) has no inertia to speak of."""
     key = (arm.source, arm.balanced)
-    if key in _BALANCED_SAID:
+    if not arm.balanced or key in _BALANCED_SAID:
         return
     _BALANCED_SAID.add(key)
     import warnings
@@ -162,7 +160,7 @@ def _say_balanced(arm: Arm) -> None:
         "balances it (the moments set to their mean, about the same centre of mass), for "
         "the plant, the chain and computed torque alike (SPEC (21.4))",
         PlantWarning,
-        stacklevel=4,
+        stacklevel=stacklevel,
     )
 
 

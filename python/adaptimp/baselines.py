@@ -91,7 +91,7 @@ def _is_file(source: Any) -> bool:
 
 def _arm(source: Any, tip: str | None, fix: Sequence[str]) -> Any:
     """The core's arm (SPEC §21) of ``"panda"``, a path or a MuJoCo model."""
-    from ._description import read_arm
+    from ._description import read_arm, say_balanced
 
     if isinstance(source, str) and source == "panda":
         if tip is not None or fix:
@@ -104,7 +104,9 @@ def _arm(source: Any, tip: str | None, fix: Sequence[str]) -> Any:
             f"source must be 'two_link', 'panda', a URDF or MJCF path, a mujoco.MjModel or a "
             f"pinocchio.Model; no file {str(source)!r}"
         )
-    return read_arm(source, tip, fix)
+    arm = read_arm(source, tip, fix)
+    say_balanced(arm, stacklevel=5)
+    return arm
 
 
 def plant_drive(

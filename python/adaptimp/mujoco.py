@@ -226,6 +226,7 @@ def _urdf_arm(
 ) -> _description.Arm:
     """The arm of a URDF (or xacro) file by the core's one reduction (SPEC §21)."""
     arm = _description.read_arm(path, tip, fix)
+    _description.say_balanced(arm, stacklevel=5)
     if arm.urdf is None:
         raise ValueError(
             f"{arm.source} is not a URDF: from_urdf reads URDF and xacro files; give an MJCF "

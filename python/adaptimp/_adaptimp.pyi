@@ -573,7 +573,7 @@ def arm_from_mujoco(
     """The arm of a compiled MuJoCo model's arrays (SPEC §21), as :func:`read_arm`'s dict."""
 
 def description_kind(path: str) -> str:
-    """What the file at ``path`` is: "urdf", "xacro", "mjcf" or "unknown"."""
+    """What the file at ``path`` is: "urdf", "xacro", "mjcf", "mjcf-fragment" or "unknown"."""
 
 @disjoint_base
 class Chain:

@@ -146,7 +146,7 @@ pub fn read_arm<'py>(
     arm_dict(py, &tree, &arm, true)
 }
 
-/// What the file at `path` is: "urdf", "xacro", "mjcf" or "unknown" (by its
+/// What the file at `path` is: "urdf", "xacro", "mjcf", "mjcf-fragment" or "unknown" (by its
 /// root element and its markup). `FileNotFoundError` if it cannot be read.
 #[pyfunction]
 pub fn description_kind(py: Python<'_>, path: &str) -> PyResult<&'static str> {

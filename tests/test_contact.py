@@ -800,7 +800,7 @@ def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:
     with pytest.raises(adaptimp.ConfigError, match=r"^'ct' needs the arm's Pinocchio model"):
         apt.panda_controller("ct", sc)
     # fix= holds an MJCF arm's joints as a URDF's: the arm is then two joints,
-    # its home two values (issue: the same arm in the table as in simulate).
+    # its home two values (the same arm in the table as in simulate).
     # Its two joints in a vertical plane cannot draw the horizontal circle:
     # refused by name before the run, not for the home's length.
     with (

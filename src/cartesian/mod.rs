@@ -21,5 +21,7 @@ pub use outer::{
     orbit_steps, CartesianConfig, CartesianImpedance, CartesianState, CompliantPose, Formulation,
     OuterStep, PoseTarget, ORBIT_MAX_STEPS,
 };
-pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement};
+#[cfg(feature = "alloc")]
+pub(crate) use pair::{check_joint, set_posture as set_pair_posture, start as start_pair};
+pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement, JointLaw};
 pub use rule::{Assessment, PoseCircle, PostureRule};

@@ -2,6 +2,7 @@
 //! controller it drives (C5), one step over plain data (q, q̇, the measured
 //! wrench, an optional pose target), transactional, allocation-free.
 
+use crate::cartesian::computed::{ComputedState, ComputedTorque};
 use crate::cartesian::kinematics::Kinematics;
 use crate::cartesian::outer::Formulation;
 use crate::cartesian::outer::{CartesianImpedance, CartesianState, CompliantPose, PoseTarget};
@@ -65,18 +66,7 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
     /// `impedance = "external"` (the Cartesian impedance is the only one:
     /// a joint impedance would answer τe a second time) and the same Ts.
     pub fn new(outer: CartesianImpedance<N, K>, inner: Controller<N, B>) -> Result<Self, Error> {
-        if inner.config().impedance != ImpedanceMode::External {
-            return Err(Error::Invalid {
-                what: "joint controller of a Cartesian impedance",
-                reason: "needs impedance = \"external\" (ImpedanceMode::External): the joint impedance would act on τe a second time",
-            });
-        }
-        if inner.period() != outer.period() {
-            return Err(Error::Invalid {
-                what: "joint controller of a Cartesian impedance",
-                reason: "needs the same Ts as the Cartesian impedance",
-            });
-        }
+        check_joint(&outer, &inner)?;
         Ok(Self { outer, inner })
     }
 
@@ -93,13 +83,7 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
     /// joint controller's step would accept as its reference: finite and
     /// within `q_max` (at most 1e6 rad). Errors name `q0` and the joint.
     pub fn start(&self, q0: &Vector<N>) -> Result<CartesianState<N>, Error> {
-        let st = self.outer.start_checked(q0)?;
-        check::within_each(
-            "q0",
-            q0.as_slice(),
-            self.inner.config().limits.position().as_slice(),
-        )?;
-        Ok(st)
+        start(&self.outer, &self.inner, q0)
     }
 
     /// Set the null-space posture (rad) from the next step on, checked as
@@ -110,14 +94,7 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
         outer: &mut CartesianState<N>,
         posture: &Vector<N>,
     ) -> Result<(), Error> {
-        self.outer.check_posture(&outer.qd, posture)?;
-        check::within_each(
-            "posture",
-            posture.as_slice(),
-            self.inner.config().limits.position().as_slice(),
-        )?;
-        outer.posture = *posture;
-        Ok(())
+        set_posture(&self.outer, &self.inner, outer, posture)
     }
 
     /// One step at t_k: the measurement `m` and the commanded pose `target`
@@ -137,23 +114,8 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
         m: &CartesianMeasurement<N>,
         target: Option<&PoseTarget>,
     ) -> Result<CartesianCommand<N>, Error> {
-        let mut reached = false;
-        let result = self.outer.step_with(outer, m, target, |meas, r, task| {
-            reached = true;
-            match task {
-                Some(t) => self.inner.step_task(inner, meas, r, t),
-                None => self.inner.step(inner, meas, r),
-            }
-        });
-        if let (Err(e), false) = (&result, reached) {
-            let meas = Measurement {
-                x: m.q,
-                dx: m.dq,
-                tau_e: Vector::zeros(),
-            };
-            self.inner.refuse_measured(inner, &meas, *e);
-        }
-        result
+        self.outer
+            .step_joint(outer, &mut (&self.inner, inner), m, target)
     }
 
     /// [`step`](Self::step), and the torque to apply whatever happened: the
@@ -171,6 +133,153 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
             Ok(cmd) => (cmd.joint.tau_sat, Ok(cmd)),
             Err(e) => (*inner.applied(), Err(e)),
         }
+    }
+}
+
+/// The pair's checks: the joint controller `inner` of the outer loop
+/// `outer` has `impedance = "external"` and the same Ts.
+pub(crate) fn check_joint<const N: usize, K, B: Basis<N>>(
+    outer: &CartesianImpedance<N, K>,
+    inner: &Controller<N, B>,
+) -> Result<(), Error>
+where
+    K: Kinematics<N>,
+{
+    if inner.config().impedance != ImpedanceMode::External {
+        return Err(Error::Invalid {
+            what: "joint controller of a Cartesian impedance",
+            reason: "needs impedance = \"external\" (ImpedanceMode::External): the joint impedance would act on τe a second time",
+        });
+    }
+    if inner.period() != outer.period() {
+        return Err(Error::Invalid {
+            what: "joint controller of a Cartesian impedance",
+            reason: "needs the same Ts as the Cartesian impedance",
+        });
+    }
+    Ok(())
+}
+
+/// [`CartesianController::start`] of the pair `outer`, `inner`.
+pub(crate) fn start<const N: usize, K: Kinematics<N>, B: Basis<N>>(
+    outer: &CartesianImpedance<N, K>,
+    inner: &Controller<N, B>,
+    q0: &Vector<N>,
+) -> Result<CartesianState<N>, Error> {
+    let st = outer.start_checked(q0)?;
+    check::within_each(
+        "q0",
+        q0.as_slice(),
+        inner.config().limits.position().as_slice(),
+    )?;
+    Ok(st)
+}
+
+/// [`CartesianController::set_posture`] of the pair `outer`, `inner`.
+pub(crate) fn set_posture<const N: usize, K: Kinematics<N>, B: Basis<N>>(
+    outer: &CartesianImpedance<N, K>,
+    inner: &Controller<N, B>,
+    st: &mut CartesianState<N>,
+    posture: &Vector<N>,
+) -> Result<(), Error> {
+    outer.check_posture(&st.qd, posture)?;
+    check::within_each(
+        "posture",
+        posture.as_slice(),
+        inner.config().limits.position().as_slice(),
+    )?;
+    st.posture = *posture;
+    Ok(())
+}
+
+/// A joint controller a Cartesian impedance drives (C5), with its state:
+/// what [`CartesianImpedance::step_joint`] steps. The paper's laws
+/// (`(&Controller, &mut State)`) and computed torque (`(&ComputedTorque,
+/// &mut ComputedState)`, SPEC §20) are two.
+pub trait JointLaw<const N: usize> {
+    /// One step on the compliant joint reference `r` (q_d, q̇_d, q̈_d).
+    fn step(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error>;
+    /// One step of the torque-level formulations (SPEC §19).
+    fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        r: &Setpoint<N>,
+        task: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error>;
+    /// A step the outer loop refused before the joint step ran (a target
+    /// that is not a rotation, a wrench not finite, a result beyond the
+    /// bound), recorded as a refused joint step with its measurement `m`.
+    fn refuse(&mut self, m: &Measurement<N>, error: Error);
+}
+
+impl<const N: usize, B: Basis<N>, S: AsRef<[f64]> + AsMut<[f64]>> JointLaw<N>
+    for (&Controller<N, B>, &mut State<N, S>)
+{
+    fn step(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.0.step(self.1, m, r)
+    }
+    fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        r: &Setpoint<N>,
+        task: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error> {
+        self.0.step_task(self.1, m, r, task)
+    }
+    fn refuse(&mut self, m: &Measurement<N>, error: Error) {
+        self.0.refuse_measured(self.1, m, error);
+    }
+}
+
+impl<const N: usize> JointLaw<N> for (&ComputedTorque<N>, &mut ComputedState<N>) {
+    fn step(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.0.step(self.1, m, r)
+    }
+    fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        r: &Setpoint<N>,
+        task: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error> {
+        self.0.step_task(self.1, m, r, task)
+    }
+    fn refuse(&mut self, _m: &Measurement<N>, error: Error) {
+        self.0.refuse(self.1, error);
+    }
+}
+
+impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
+    /// The Cartesian step with the joint controller `joint` (C5): stage the
+    /// outer loop, step `joint` on the joint reference (the torque-level
+    /// formulations' part too, SPEC §19), and commit the outer state only
+    /// if it succeeds. A refusal of the outer loop before the joint step
+    /// ran is recorded in `joint` ([`JointLaw::refuse`]), so every refusal
+    /// has its fault and fallback. [`CartesianController::step`] is this
+    /// with the pair's joint controller.
+    pub fn step_joint<J: JointLaw<N> + ?Sized>(
+        &self,
+        outer: &mut CartesianState<N>,
+        joint: &mut J,
+        m: &CartesianMeasurement<N>,
+        target: Option<&PoseTarget>,
+    ) -> Result<CartesianCommand<N>, Error> {
+        let mut reached = false;
+        let result = self.step_with(outer, m, target, |meas, r, task| {
+            reached = true;
+            match task {
+                Some(t) => joint.step_task(meas, r, t),
+                None => joint.step(meas, r),
+            }
+        });
+        if let (Err(e), false) = (&result, reached) {
+            let meas = Measurement {
+                x: m.q,
+                dx: m.dq,
+                tau_e: Vector::zeros(),
+            };
+            joint.refuse(&meas, *e);
+        }
+        result
     }
 }
 

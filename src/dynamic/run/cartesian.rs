@@ -1,0 +1,309 @@
+//! The Cartesian controller in the run-time closed loop (SPEC §13.1,
+//! §16): the outer loop and its joint controller as the loop's controller,
+//! with the measured wrench, recorded in task space ([`TaskRows`]) and
+//! measured by the one accumulator of the SPEC §12 metrics.
+
+use super::super::cartesian::{CartesianImpedance, CartesianState, Joint};
+use super::super::sized::each;
+use super::super::values::mismatch;
+use super::rows::{TaskMetrics, TaskStep};
+use super::{
+    drive, Disturbances, Hooks, Injected, Injection, Metrics, On, Plant, Rows, Run, RunError,
+    TaskRows,
+};
+use crate::cartesian::{self, PoseTarget};
+use crate::control::impedance::TargetImpedance;
+use crate::control::io::{self, WrenchControl};
+use crate::error::Error;
+use crate::sim::record::{Recorder, Row};
+use crate::sim::simulator;
+use crate::trajectory::{self, Trajectory};
+use crate::types::Vector;
+use core::cell::{Cell, RefCell};
+
+/// The loop's clock: the trajectory the loop samples at every row, t_k in,
+/// NaN out (a Cartesian run has no joint-space reference; its commanded
+/// pose is its own table, read at the row of t_k).
+struct Clock<'a>(&'a Cell<f64>);
+
+impl<const N: usize> Trajectory<N> for Clock<'_> {
+    fn sample(&self, t: f64) -> trajectory::Setpoint<N> {
+        self.0.set(t);
+        let nan = Vector::from_element(f64::NAN);
+        trajectory::Setpoint {
+            x: nan,
+            dx: nan,
+            ddx: nan,
+        }
+    }
+}
+
+/// The joint controller behind the outer loop, typed: the paper's laws or
+/// computed torque.
+trait JointLoop<const N: usize>: cartesian::JointLaw<N> {
+    fn applied(&self) -> Vector<N>;
+}
+
+impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> JointLoop<N>
+    for (
+        &crate::control::controller::Controller<N, crate::networks::rbf::AnyBasis<N>>,
+        &mut crate::control::state::State<N, S>,
+    )
+{
+    fn applied(&self) -> Vector<N> {
+        *self.1.applied()
+    }
+}
+
+impl<const N: usize> JointLoop<N>
+    for (
+        &cartesian::ComputedTorque<N>,
+        &mut cartesian::ComputedState<N>,
+    )
+{
+    fn applied(&self) -> Vector<N> {
+        self.1.applied
+    }
+}
+
+/// The outer loop and the joint controller behind it as the loop's
+/// controller: the Cartesian step with the measured wrench, the row's pose
+/// target, the step kept for the recorder.
+struct CartesianLoop<'a, const N: usize, J> {
+    outer: &'a cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
+    state: &'a mut cartesian::CartesianState<N>,
+    joint: J,
+    target: TargetImpedance<N>,
+    targets: Option<&'a [PoseTarget]>,
+    clock: &'a Cell<f64>,
+    last: &'a RefCell<Option<TaskStep>>,
+    pending: &'a Cell<bool>,
+}
+
+impl<const N: usize, J: JointLoop<N>> WrenchControl<N> for CartesianLoop<'_, N, J> {
+    fn period(&self) -> f64 {
+        self.outer.period()
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        &self.target
+    }
+    fn step_with_wrench(
+        &mut self,
+        m: &io::Measurement<N>,
+        wrench: &[f64; 6],
+        _c: &trajectory::Setpoint<N>,
+    ) -> (Vector<N>, Result<io::Command<N>, Error>) {
+        let target = self.targets.map(|tab| {
+            let k = libm::round(self.clock.get() / self.outer.period()) as usize;
+            tab[k]
+        });
+        let meas = cartesian::CartesianMeasurement {
+            q: m.x,
+            dq: m.dx,
+            wrench: Vector::<6>::from(*wrench),
+        };
+        match self
+            .outer
+            .step_joint(self.state, &mut self.joint, &meas, target.as_ref())
+        {
+            Ok(cmd) => {
+                *self.last.borrow_mut() = Some(TaskStep::new(&cmd, target.as_ref(), *wrench));
+                self.pending.set(true);
+                (cmd.joint.tau_sat, Ok(cmd.joint))
+            }
+            Err(e) => (self.joint.applied(), Err(e)),
+        }
+    }
+}
+
+/// The joint rows, the task rows and the task-space metrics of every row.
+struct TaskRecorder<'a, const M: usize> {
+    joint: &'a mut Rows,
+    task: &'a mut TaskRows,
+    metrics: &'a mut TaskMetrics<M>,
+    last: &'a RefCell<Option<TaskStep>>,
+    pending: &'a Cell<bool>,
+}
+
+impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, M> {
+    fn record(&mut self, r: &Row<N>) {
+        self.pending.set(false);
+        self.joint.record(r);
+        let slot = self.last.borrow();
+        let nan = [Vector::<3>::from_element(f64::NAN); 3];
+        let (pc, z1) = match slot.as_ref() {
+            Some(s) => (&s.commanded, s.z1()),
+            None => (&nan, nan[0]),
+        };
+        self.task.record(slot.as_ref(), &z1);
+        self.metrics.push(
+            r.t,
+            [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
+            [pc[0].as_slice(), pc[1].as_slice(), pc[2].as_slice()],
+            z1.as_slice(),
+            [r.tau.as_slice(), r.tau_sat.as_slice(), r.tau_e.as_slice()],
+        );
+    }
+}
+
+/// The closed loop of the Cartesian controller (SPEC §13.1, §16): the
+/// outer loop `outer` (its state `state`) in front of `joint` on `plant`,
+/// with the measured wrench, the commanded pose of row k the k-th of
+/// `targets` (none: the last target held), for `run`. The joint rows go to
+/// `rows` (xc, ẋc, ẍc NaN: the reference is in task space), the task rows
+/// and the last step to `task` (also those before an error); returns the
+/// SPEC §12 metrics in task space (z1 = p_d − p, m = 3; the impedance
+/// residual NaN). From both controllers' current states. A disturbance or
+/// a fault acting on τe alone is refused: the controller reads F_e.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_cartesian<S: AsRef<[f64]> + AsMut<[f64]>>(
+    plant: &mut dyn Plant,
+    outer: &CartesianImpedance,
+    state: &mut CartesianState,
+    joint: Joint<'_, S>,
+    targets: Option<&[PoseTarget]>,
+    run: &Run<'_>,
+    hooks: &mut dyn Hooks,
+    rows: &mut Rows,
+    task: &mut TaskRows,
+) -> Result<Metrics, RunError> {
+    let n = outer.n();
+    if plant.n() != n || rows.n() != n || task.n != n {
+        return Err(mismatch("plant").into());
+    }
+    if joint.period() != outer.period() {
+        return Err(Error::Invalid {
+            what: "joint controller of a Cartesian impedance",
+            reason: "needs the same Ts as the Cartesian impedance",
+        }
+        .into());
+    }
+    let total = simulator::steps(run.t_final, outer.period())?;
+    if targets.is_some_and(|t| (t.len() as u64) < total) {
+        return Err(Error::Invalid {
+            what: "targets",
+            reason: "needs one pose target per step",
+        }
+        .into());
+    }
+    if run.disturbances.is_some_and(Disturbances::noise_on_tau_e) {
+        return Err(Error::Invalid {
+            what: "noise_tau_e",
+            reason: "a Cartesian controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
+        }
+        .into());
+    }
+    if let Some(Injection {
+        fault: Injected::ForceBias(_),
+        ..
+    }) = run.injection
+    {
+        return Err(Error::Invalid {
+            what: "force_bias",
+            reason: "a Cartesian controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
+        }
+        .into());
+    }
+    each!(&outer.inner, o, N => {
+        let st = state.inner.get_mut::<N>().ok_or(mismatch("state"))?;
+        let dist = match run.disturbances {
+            Some(d) => Some(d.inner.get::<N>().ok_or(mismatch("disturbances"))?),
+            None => None,
+        };
+        let on = On { plant, dist, run, hooks, rows };
+        match joint {
+            Joint::Adaptive(c, s) => {
+                let c = c.inner.get::<N>().ok_or(mismatch("joint controller"))?;
+                let s = s.inner.get_mut::<N>().ok_or(mismatch("joint state"))?;
+                let target = *c.ctrl.impedance();
+                cartesian_n(on, o, st, (&c.ctrl, s), target, targets, task)
+            }
+            Joint::Computed(c, s) => {
+                let c = c.inner.get::<N>().ok_or(mismatch("joint controller"))?;
+                let s = s.inner.get_mut::<N>().ok_or(mismatch("joint state"))?;
+                let target = *c.impedance();
+                cartesian_n(on, o, st, (&**c, s), target, targets, task)
+            }
+        }
+    })
+}
+
+/// [`simulate_cartesian`] for N joints, the metrics in M = max(N, 3) slots.
+#[allow(clippy::too_many_arguments)]
+fn cartesian_n<const N: usize, J: JointLoop<N>>(
+    on: On<'_, '_, N>,
+    outer: &cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
+    state: &mut cartesian::CartesianState<N>,
+    joint: J,
+    target: TargetImpedance<N>,
+    targets: Option<&[PoseTarget]>,
+    task: &mut TaskRows,
+) -> Result<Metrics, RunError> {
+    if N <= 3 {
+        cartesian_m::<N, 3, J>(on, outer, state, joint, target, targets, task)
+    } else {
+        cartesian_m::<N, N, J>(on, outer, state, joint, target, targets, task)
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn cartesian_m<const N: usize, const M: usize, J: JointLoop<N>>(
+    on: On<'_, '_, N>,
+    outer: &cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
+    state: &mut cartesian::CartesianState<N>,
+    joint: J,
+    target: TargetImpedance<N>,
+    targets: Option<&[PoseTarget]>,
+    task: &mut TaskRows,
+) -> Result<Metrics, RunError> {
+    let On {
+        plant,
+        dist,
+        run,
+        hooks,
+        rows,
+    } = on;
+    let ones = [1.0; N];
+    let mut metrics = TaskMetrics::<M>::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
+    let clock = Cell::new(0.0);
+    let steps = RefCell::new(None);
+    let pending = Cell::new(false);
+    let mut ctrl = CartesianLoop {
+        outer,
+        state,
+        joint,
+        target,
+        targets,
+        clock: &clock,
+        last: &steps,
+        pending: &pending,
+    };
+    let mut recorder = TaskRecorder {
+        joint: rows,
+        task,
+        metrics: &mut metrics,
+        last: &steps,
+        pending: &pending,
+    };
+    let result = drive(
+        plant,
+        &mut ctrl,
+        &Clock(&clock),
+        dist,
+        run,
+        hooks,
+        &mut recorder,
+    );
+    let taken = steps.into_inner();
+    if taken.is_some() {
+        task.last = taken;
+    }
+    if result.is_err() && pending.get() {
+        // A step taken in the period the error stopped: its task row too.
+        if let Some(s) = task.last {
+            task.record(Some(&s), &s.z1());
+        }
+    }
+    result?;
+    Ok(metrics.finish())
+}

@@ -1,0 +1,841 @@
+//! The run-time API (`adaptimp::dynamic`) against the const-generic core
+//! it wraps: the same bits, step for step, for every n = 1 … 7 (the
+//! controller, the Cartesian controller, the chain, the dynamics, computed
+//! torque, the closed loop), and the same errors.
+
+use adaptimp::control::tuning::Rule;
+use adaptimp::dynamic as dy;
+use adaptimp::schema::{Preset, Scenario, Value};
+use adaptimp::{
+    AnyBasis, Basis, CartesianController, CartesianImpedance, CartesianMeasurement, Chain, Command,
+    ComputedState, ComputedTorque, ComputedTorqueConfig, Controller, Dynamics, Error,
+    ImpedanceMode, Inertial, Joint, Kinematics, Law, Measurement, PoseTarget, Setpoint, Sinusoid,
+    Trajectory, Transform, Vector,
+};
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// `a` and `b` hold the same bits.
+#[track_caller]
+fn same(what: &str, a: &[f64], b: &[f64]) {
+    assert_eq!(bits(a), bits(b), "{what}: {a:?} ≠ {b:?}");
+}
+
+/// A run-time command equals the core's, bit for bit.
+#[track_caller]
+fn same_command<const N: usize>(d: &dy::Command, c: &Command<N>) {
+    for (what, a, b) in [
+        ("tau_sat", &d.tau_sat, &c.tau_sat),
+        ("tau", &d.tau, &c.tau),
+        ("dtau", &d.dtau, &c.dtau),
+        ("z1", &d.z1, &c.z1),
+        ("z2", &d.z2, &c.z2),
+        ("xc", &d.xc, &c.xc),
+        ("xd", &d.xd, &c.xd),
+        ("v", &d.v, &c.v),
+        ("zeta", &d.zeta, &c.zeta),
+    ] {
+        same(what, a, b.as_slice());
+    }
+    same("w_norms", &d.w_norms, &c.w_norms);
+}
+
+/// The parameters both sides are given for N joints: a sinusoid of N
+/// joints, the limits of a robot's and the learning on.
+fn items<const N: usize>() -> Vec<(&'static str, Vec<f64>)> {
+    let j = |f: fn(usize) -> f64| (0..N).map(f).collect::<Vec<f64>>();
+    vec![
+        ("xc_offset", j(|i| 0.1 * i as f64 - 0.2)),
+        ("xc_sin", j(|i| 0.1 + 0.02 * i as f64)),
+        ("xc_cos", j(|_| 0.0)),
+        ("xc_omega", j(|i| 1.0 + 0.3 * i as f64)),
+        ("tau_max", j(|i| 40.0 - 4.0 * i as f64)),
+    ]
+}
+
+fn scenario<const N: usize>(law: Law, external: bool) -> (dy::Scenario, Scenario<N>) {
+    let mut d = dy::Scenario::new(N, Preset::Robot, law).expect("n");
+    let mut s = Scenario::<N>::preset(Preset::Robot, law);
+    for (name, v) in items::<N>() {
+        d.set(name, Value::Vec(&v)).expect(name);
+        s.set(name, Value::Vec(&v)).expect(name);
+    }
+    if external {
+        d.set("impedance", Value::Str("external"))
+            .expect("impedance");
+        s.set("impedance", Value::Str("external"))
+            .expect("impedance");
+    }
+    (d, s)
+}
+
+/// The core's controller of `s`, with the basis the run-time builder
+/// decides: the grid for n ≤ 3, the rule's default basis beyond.
+fn core_controller<const N: usize>(s: &Scenario<N>) -> (Controller<N, AnyBasis<N>>, Sinusoid<N>) {
+    let traj = s.trajectory().expect("trajectory");
+    let basis = if N <= 3 {
+        AnyBasis::Grid(s.grid().expect("grid"))
+    } else {
+        AnyBasis::Centers(Rule::default().default_basis(&traj).expect("basis"))
+    };
+    let ctrl = Controller::for_trajectory(s.config, basis, &traj).expect("controller");
+    (ctrl, traj)
+}
+
+/// The measurement of step k near the trajectory (a NaN at `bad`).
+fn measurement<const N: usize>(traj: &Sinusoid<N>, k: usize, bad: usize) -> Measurement<N> {
+    let t = k as f64 * 1e-3;
+    let c = traj.sample(t);
+    let mut x = c.x + Vector::<N>::from_fn(|i, _| 0.01 * (3.0 * t + i as f64).sin());
+    if k == bad {
+        x[N - 1] = f64::NAN;
+    }
+    Measurement {
+        x,
+        dx: Some(c.dx * 0.9),
+        tau_e: Vector::from_fn(|i, _| if i == 0 { 2.0 * (t * 5.0).sin() } else { 0.0 }),
+    }
+}
+
+fn joint_controller<const N: usize>(law: Law) {
+    let (d, s) = scenario::<N>(law, false);
+    let dc = d.controller().expect("run-time controller");
+    let (cc, traj) = core_controller(&s);
+    assert_eq!((dc.n(), dc.nodes(), dc.law()), (N, cc.basis().nodes(), law));
+    let (mut ds, mut cs) = (dc.new_state(), cc.new_state());
+    for k in 0..200 {
+        let m = measurement(&traj, k, 120);
+        let dm = dy::Measurement {
+            x: m.x.as_slice(),
+            dx: m.dx.as_ref().map(|v| v.as_slice()),
+            tau_e: m.tau_e.as_slice(),
+        };
+        // Every third step with a setpoint of the caller's, else its own.
+        let given = traj.sample(k as f64 * 1e-3 + 1e-4);
+        let (a, b) = if k % 3 == 0 {
+            let sp = dy::Setpoint {
+                x: given.x.as_slice(),
+                dx: given.dx.as_slice(),
+                ddx: given.ddx.as_slice(),
+            };
+            (
+                dc.step_or_fallback(&mut ds, &dm, Some(&sp)),
+                cc.step_or_fallback(&mut cs, &m, &given),
+            )
+        } else {
+            let own = traj.sample(cc.time(&cs));
+            (
+                dc.step_or_fallback(&mut ds, &dm, None),
+                cc.step_or_fallback(&mut cs, &m, &own),
+            )
+        };
+        same("applied", &a.0.expect("same n"), b.0.as_slice());
+        match (a.1, b.1) {
+            (Ok(x), Ok(y)) => same_command(&x, &y),
+            (Err(x), Err(y)) => assert_eq!(x, y, "step {k}"),
+            (x, y) => panic!("step {k}: {x:?} against {y:?}"),
+        }
+    }
+    assert!(ds.fault().is_some(), "the NaN step was refused");
+    assert_eq!(ds.fault(), cs.fault());
+    same("zeta", ds.zeta(), cs.zeta().as_slice());
+    let mut snap = vec![0.0; cs.snapshot_len()];
+    cs.save(&mut snap).expect("save");
+    let mut dsnap = vec![0.0; ds.snapshot_len()];
+    ds.save(&mut dsnap).expect("save");
+    same("snapshot", &dsnap, &snap);
+}
+
+#[test]
+fn the_joint_step_is_the_const_generic_one_bit_for_bit_for_every_n() {
+    for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
+        joint_controller::<1>(law);
+        joint_controller::<2>(law);
+        joint_controller::<3>(law);
+        joint_controller::<4>(law);
+        joint_controller::<5>(law);
+        joint_controller::<6>(law);
+        joint_controller::<7>(law);
+    }
+}
+
+#[test]
+fn the_joint_step_refuses_inputs_of_another_length_by_name_and_records_it() {
+    let (d, _) = scenario::<3>(Law::Pd, false);
+    let c = d.controller().expect("controller");
+    let mut st = c.new_state();
+    let m = dy::Measurement {
+        x: &[0.0; 2],
+        dx: Some(&[0.0; 3]),
+        tau_e: &[0.0; 3],
+    };
+    let e = c.step(&mut st, &m, None).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "x: needs one value per joint (as many as the controller has)"
+    );
+    assert_eq!(st.fault().map(|f| f.error), Some(e));
+    // A state of another controller is refused and left as it was.
+    let (d2, _) = scenario::<2>(Law::Pd, false);
+    let mut other = d2.controller().expect("controller").new_state();
+    let m = dy::Measurement {
+        x: &[0.0; 3],
+        dx: Some(&[0.0; 3]),
+        tau_e: &[0.0; 3],
+    };
+    let e = c.step(&mut other, &m, None).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "state: was made for another number of joints"
+    );
+    assert_eq!(other.steps(), 0);
+    assert!(other.fault().is_none());
+    let e = dy::Scenario::new(8, Preset::Robot, Law::Pd).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "condition 1 ≤ n ≤ 7 joints is violated: n = 8 (SPEC §10)"
+    );
+}
+
+#[test]
+fn one_builder_gives_both_fronts_the_same_basis() {
+    // n > 3 without centres: the rule's default basis (SPEC §18), not an error.
+    let (d, s) = scenario::<5>(Law::StateFeedback, false);
+    let (cc, _) = core_controller(&s);
+    assert_eq!(d.controller().expect("n = 5").nodes(), cc.basis().nodes());
+    // The grid asked for beyond n = 3 is the grid's error.
+    let mut d = d;
+    let e = d.basis(dy::Basis::Grid).controller().unwrap_err();
+    assert_eq!(e, s.grid().unwrap_err());
+    // Centres without widths take η² everywhere; widths of another length are refused.
+    let rows = vec![0.0; 2 * 4 * 5];
+    d.basis(dy::Basis::Centres(dy::Centres {
+        rows: rows.clone(),
+        widths2: None,
+    }));
+    assert_eq!(d.controller().expect("centres").nodes(), 2);
+    d.basis(dy::Basis::Centres(dy::Centres {
+        rows,
+        widths2: Some(vec![1.0; 4]),
+    }));
+    assert_eq!(
+        d.controller().unwrap_err().to_string(),
+        "widths: need one width per input dimension (4n: x, v, α1, α̇1)"
+    );
+}
+
+/// A chain of N revolute joints about alternating axes, a fixed joint and
+/// a tip offset.
+fn joints<const N: usize>() -> Vec<Joint> {
+    let mut js: Vec<Joint> = (0..N)
+        .map(|i| {
+            let axis = if i % 2 == 0 {
+                [0.0, 0.0, 1.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            Joint::revolute(
+                Transform::from_xyz_rpy([0.05 * i as f64, 0.0, 0.12], [0.1 * i as f64, 0.0, 0.0]),
+                axis,
+            )
+        })
+        .collect();
+    js.push(Joint::fixed(Transform::from_xyz_rpy(
+        [0.0, 0.0, 0.1],
+        [0.0; 3],
+    )));
+    js
+}
+
+fn q_of<const N: usize>(k: usize) -> Vector<N> {
+    Vector::from_fn(|i, _| 0.3 * ((k + 1) as f64 * 0.7 + i as f64).sin())
+}
+
+fn chain_and_dynamics<const N: usize>() {
+    let js = joints::<N>();
+    let tip = Transform::from_xyz_rpy([0.0, 0.02, 0.05], [0.0; 3]);
+    let (dc, cc) = (
+        dy::Chain::new(&js, &tip).expect("run-time chain"),
+        Chain::<N>::new(&js, &tip).expect("chain"),
+    );
+    for k in 0..5 {
+        let (q, dq) = (q_of::<N>(k), q_of::<N>(k + 10));
+        let (a, b) = (
+            dc.tip(q.as_slice(), dq.as_slice()).expect("tip"),
+            cc.tip_checked(&q, &dq).expect("tip"),
+        );
+        same("position", a.position.as_slice(), b.position.as_slice());
+        same(
+            "rotation",
+            a.rotation.matrix().as_slice(),
+            b.rotation.matrix().as_slice(),
+        );
+        let j = a.jacobian.matrix().iter().copied().collect::<Vec<_>>();
+        same("jacobian", &j, b.jacobian.as_slice());
+        same("bias", a.bias.as_slice(), b.bias.as_slice());
+        let (p, r) = dc.pose(q.as_slice()).expect("pose");
+        let (p2, r2) = cc.pose(&q);
+        same("pose", p.as_slice(), p2.as_slice());
+        same("pose R", r.matrix().as_slice(), r2.matrix().as_slice());
+        let j = dc.jacobian(q.as_slice()).expect("jacobian");
+        let j = j.matrix().iter().copied().collect::<Vec<_>>();
+        same("jacobian(q)", &j, cc.pose_jacobian(&q).jacobian.as_slice());
+        same(
+            "bias(q, dq)",
+            dc.bias(q.as_slice(), dq.as_slice())
+                .expect("bias")
+                .as_slice(),
+            cc.bias(&q, &dq).as_slice(),
+        );
+    }
+    let mut bad = q_of::<N>(0);
+    bad[0] = f64::NAN;
+    assert_eq!(
+        dc.tip(bad.as_slice(), bad.as_slice()).unwrap_err(),
+        cc.tip_checked(&bad, &bad).unwrap_err()
+    );
+    // The dynamics, with a drive.
+    // One inertial per joint of the list, the fixed one's too.
+    let inertials: Vec<Inertial> = (0..=N)
+        .map(|i| Inertial::point(1.0 + 0.1 * i as f64, [0.02, 0.01, 0.06]))
+        .collect();
+    let g = adaptimp::GRAVITY;
+    let drive = [0.1; N];
+    let dd = dy::Dynamics::new(&js, &inertials, g)
+        .and_then(|d| {
+            d.with_drive(&dy::Drive {
+                armature: &drive,
+                damping: &drive,
+                friction: &drive,
+            })
+        })
+        .expect("run-time dynamics");
+    let cd = Dynamics::<N>::new(&js, &inertials, g)
+        .and_then(|d| {
+            d.with_drive(adaptimp::Drive {
+                armature: Vector::from(drive),
+                damping: Vector::from(drive),
+                friction: Vector::from(drive),
+            })
+        })
+        .expect("dynamics");
+    assert_eq!(dd.mass().to_bits(), cd.mass().to_bits());
+    for k in 0..5 {
+        let (q, dq, ddq) = (q_of::<N>(k), q_of::<N>(k + 3), q_of::<N>(k + 6));
+        same(
+            "inverse dynamics",
+            &dd.inverse_dynamics(q.as_slice(), dq.as_slice(), ddq.as_slice())
+                .expect("id"),
+            cd.inverse_dynamics_checked(&q, &dq, &ddq)
+                .expect("id")
+                .as_slice(),
+        );
+        let m = dd.mass_matrix(q.as_slice()).expect("M");
+        let m = m.matrix().iter().copied().collect::<Vec<_>>();
+        same("mass matrix", &m, cd.mass_matrix(&q).as_slice());
+        same(
+            "gravity",
+            &dd.gravity_torque(q.as_slice()).expect("G"),
+            cd.gravity_torque(&q).as_slice(),
+        );
+    }
+    // Computed torque on that model (SPEC §20).
+    let tau_max = [30.0; N];
+    let (kp, kd, ones) = ([400.0; N], [40.0; N], [1.0; N]);
+    let dct = dy::ComputedTorque::new(
+        &dy::ComputedTorqueConfig {
+            ts: 1e-3,
+            kp: &kp,
+            kd: &kd,
+            tau_max: &tau_max,
+            dd: &ones,
+            cd: &[20.0; N],
+            gd: &[100.0; N],
+            mode: ImpedanceMode::Joint,
+        },
+        dd,
+    )
+    .expect("run-time computed torque");
+    let cct = ComputedTorque::new(
+        ComputedTorqueConfig {
+            ts: 1e-3,
+            kp: Vector::from(kp),
+            kd: Vector::from(kd),
+            tau_max: Vector::from(tau_max),
+            impedance: adaptimp::TargetImpedance::new(
+                Vector::from(ones),
+                Vector::from_element(20.0),
+                Vector::from_element(100.0),
+            )
+            .expect("impedance"),
+            mode: ImpedanceMode::Joint,
+        },
+        cd,
+    )
+    .expect("computed torque");
+    let (mut ds, mut cs) = (dct.new_state(), ComputedState::default());
+    for k in 0..100 {
+        let (q, dq) = (q_of::<N>(k), q_of::<N>(k + 1));
+        let c = Setpoint {
+            x: q_of::<N>(k + 2),
+            dx: q_of::<N>(k + 3),
+            ddx: q_of::<N>(k + 4),
+        };
+        let m = Measurement {
+            x: q,
+            dx: (k != 50).then_some(dq),
+            tau_e: Vector::zeros(),
+        };
+        let a = dct.step(
+            &mut ds,
+            &dy::Measurement {
+                x: q.as_slice(),
+                dx: m.dx.as_ref().map(|v| v.as_slice()),
+                tau_e: &[0.0; N],
+            },
+            &dy::Setpoint {
+                x: c.x.as_slice(),
+                dx: c.dx.as_slice(),
+                ddx: c.ddx.as_slice(),
+            },
+        );
+        match (a, cct.step(&mut cs, &m, &c)) {
+            (Ok(x), Ok(y)) => same_command(&x, &y),
+            (Err(x), Err(y)) => assert_eq!(x, y),
+            (x, y) => panic!("{x:?} against {y:?}"),
+        }
+    }
+    assert_eq!(ds.fault(), cs.fault);
+    assert_eq!(ds.fault().map(|f| f.error), Some(Error::MissingVelocity));
+}
+
+#[test]
+fn the_chain_dynamics_and_computed_torque_are_the_const_generic_ones_bit_for_bit() {
+    chain_and_dynamics::<1>();
+    chain_and_dynamics::<2>();
+    chain_and_dynamics::<3>();
+    chain_and_dynamics::<4>();
+    chain_and_dynamics::<5>();
+    chain_and_dynamics::<6>();
+    chain_and_dynamics::<7>();
+}
+
+/// The commanded pose of step k: a small circle about `p0`, `r0` held.
+fn target(p0: &Vector<3>, r0: &nalgebra::Matrix3<f64>, k: usize) -> PoseTarget {
+    let t = k as f64 * 1e-3;
+    let (s, c) = ((3.0 * t).sin(), (3.0 * t).cos());
+    PoseTarget {
+        p: p0 + Vector::<3>::new(0.01 * (c - 1.0), 0.01 * s, 0.0),
+        dp: Vector::<3>::new(-0.03 * s, 0.03 * c, 0.0),
+        ..PoseTarget::at(*p0, *r0)
+    }
+}
+
+fn cartesian<const N: usize>() {
+    let js = joints::<N>();
+    let tip = Transform::IDENTITY;
+    let (d, s) = scenario::<N>(Law::StateFeedback, true);
+    let (cc, _) = core_controller(&s);
+    let chain = Chain::<N>::new(&js, &tip).expect("chain");
+    let outer = CartesianImpedance::new(s.cartesian, chain, cc.period()).expect("outer");
+    let pair = CartesianController::new(outer, cc).expect("pair");
+    let dchain = dy::Chain::new(&js, &tip).expect("chain");
+    let douter = dy::CartesianImpedance::new(d.cartesian(), &dchain, 1e-3).expect("outer");
+    let dpair = dy::CartesianController::new(douter, d.controller().expect("joint")).expect("pair");
+    let q0 = q_of::<N>(0);
+    let (mut ost, mut ist) = (pair.start(&q0).expect("start"), pair.inner().new_state());
+    let (mut dost, mut dist) = (
+        dpair.start(q0.as_slice()).expect("start"),
+        dpair.joint().new_state(),
+    );
+    let t0 = chain.tip(&q0, &Vector::zeros());
+    for k in 0..150 {
+        let q = q0 + Vector::<N>::from_element(1e-3 * (k as f64 * 0.01).sin());
+        let wrench = Vector::<6>::new(1.0, -0.5, 0.2, 0.0, 0.05, 0.0);
+        let m = CartesianMeasurement {
+            q,
+            dq: Some(Vector::from_element(1e-3)),
+            wrench: if k == 90 { wrench * f64::NAN } else { wrench },
+        };
+        let dm = dy::CartesianMeasurement {
+            q: m.q.as_slice(),
+            dq: m.dq.as_ref().map(|v| v.as_slice()),
+            wrench: m.wrench,
+        };
+        let c = (k % 4 != 3).then(|| target(&t0.position, t0.rotation.matrix(), k));
+        let a = dpair.step_or_fallback(&mut dost, &mut dist, &dm, c.as_ref());
+        let b = pair.step_or_fallback(&mut ost, &mut ist, &m, c.as_ref());
+        same("applied", &a.0.expect("same n"), b.0.as_slice());
+        match (a.1, b.1) {
+            (Ok(x), Ok(y)) => {
+                same_command(&x.joint, &y.joint);
+                same("q_d", &x.reference.x, y.reference.x.as_slice());
+                same("ddq_d", &x.reference.ddx, y.reference.ddx.as_slice());
+                same("q_c", &x.commanded.x, y.commanded.x.as_slice());
+                same("p_d", x.compliant.p.as_slice(), y.compliant.p.as_slice());
+                same("error", x.error.as_slice(), y.error.as_slice());
+                same("tau_e", &x.tau_e, y.tau_e.as_slice());
+                assert_eq!(x.compliant, y.compliant);
+                assert_eq!((x.p, x.r, x.target), (y.p, y.r, y.target));
+            }
+            (Err(x), Err(y)) => assert_eq!(x, y, "step {k}"),
+            (x, y) => panic!("step {k}: {x:?} against {y:?}"),
+        }
+    }
+    assert!(dist.fault().is_some(), "the NaN wrench was refused");
+    assert_eq!(dist.fault(), ist.fault());
+    assert_eq!(dost.steps(), ost.k);
+}
+
+#[test]
+fn the_cartesian_step_is_the_const_generic_one_bit_for_bit_for_every_n() {
+    cartesian::<1>();
+    cartesian::<2>();
+    cartesian::<3>();
+    cartesian::<4>();
+    cartesian::<5>();
+    cartesian::<6>();
+    cartesian::<7>();
+}
+
+/// The closed loop of the paper's arm and wall with disturbances and a
+/// fault, through the run-time plant and loop, against the core's
+/// `run_disturbed_with`: the same rows and metrics.
+#[test]
+fn the_closed_loop_is_the_const_generic_one_bit_for_bit() {
+    use adaptimp::sim::simulator::run_disturbed_with;
+    use adaptimp::{Injected, Injection, Row, TwoLinkArm, Wall};
+    let law = Law::StateFeedback;
+    let settings = [
+        ("T", Value::Real(0.3)),
+        ("noise_q", Value::Real(1e-4)),
+        ("payload", Value::Real(0.2)),
+        ("friction_viscous", Value::Real(0.3)),
+        ("delay", Value::Int(2)),
+    ];
+    let mut d = dy::Scenario::new(2, Preset::Paper, law).expect("n");
+    let mut s = Scenario::<2>::preset(Preset::Paper, law);
+    for (name, v) in settings {
+        d.set(name, v).expect(name);
+        s.set(name, v).expect(name);
+    }
+    // The core's run.
+    struct Rows(Vec<Row<2>>);
+    impl adaptimp::Recorder<2> for Rows {
+        fn record(&mut self, r: &Row<2>) {
+            self.0.push(*r);
+        }
+    }
+    let ctrl = Controller::for_trajectory(s.config, s.grid().unwrap(), &s.trajectory().unwrap())
+        .expect("controller");
+    let mut state = ctrl.new_state();
+    let arm = TwoLinkArm::paper();
+    let wall = Wall::<2>::new(0, s.wall.unwrap(), s.ke_be[0], s.ke_be[1]).unwrap();
+    let dist = s.disturbances().unwrap();
+    let inj = Injection {
+        fault: Injected::Stale,
+        start: 0.1,
+        duration: 0.02,
+    };
+    let mut rows = Rows(Vec::new());
+    let metrics = run_disturbed_with(
+        &arm,
+        &wall,
+        &mut ctrl.bind(&mut state),
+        &s.trajectory().unwrap(),
+        &s.sim,
+        &dist,
+        Some(&inj),
+        &mut (),
+        &mut rows,
+    )
+    .expect("core run");
+    // The run-time one.
+    let dc = d.controller().expect("controller");
+    let mut ds = dc.new_state();
+    let ddist = d.disturbances().expect("disturbances");
+    let mut plant = dy::RigidBody::new(&dy::ModelArm::Paper(arm), &d, &ddist).expect("plant");
+    let (t_final, settle, _) = d.run_settings();
+    let dinj = dy::Injection {
+        fault: dy::Injected::Stale,
+        start: 0.1,
+        duration: 0.02,
+    };
+    let run = dy::Run {
+        t_final,
+        settle,
+        every: 1,
+        disturbances: Some(&ddist),
+        injection: Some(&dinj),
+    };
+    let mut drows = dy::Rows::for_run(2, &run, dc.period()).expect("rows");
+    let dmetrics = dy::simulate(
+        &mut plant,
+        dy::Controlled::Joint(dy::Joint::Adaptive(&dc, &mut ds)),
+        dy::Reference::Trajectory,
+        &run,
+        &mut (),
+        &mut drows,
+    )
+    .expect("run-time run");
+    assert_eq!(drows.len(), rows.0.len());
+    assert!(drows.refused.iter().any(|r| *r) || rows.0.iter().all(|r| !r.refused));
+    let col = |f: fn(&Row<2>) -> Vector<2>| -> Vec<f64> {
+        rows.0
+            .iter()
+            .flat_map(|r| f(r).iter().copied().collect::<Vec<_>>())
+            .collect()
+    };
+    same("x", &drows.x, &col(|r| r.x));
+    same("ddx", &drows.ddx, &col(|r| r.ddx));
+    same("tau_sat", &drows.tau_sat, &col(|r| r.tau_sat));
+    same("tau_e", &drows.tau_e, &col(|r| r.tau_e));
+    same("z1", &drows.z1, &col(|r| r.z1));
+    same("zeta", &drows.zeta, &col(|r| r.zeta));
+    assert_eq!(
+        drows.refused,
+        rows.0.iter().map(|r| r.refused).collect::<Vec<_>>()
+    );
+    same(
+        "metrics",
+        &[
+            dmetrics.rms_z1,
+            dmetrics.rms_z1_after2,
+            dmetrics.sat_duty,
+            dmetrics.imp_err_rms_after2,
+            dmetrics.peak_contact_after2,
+        ],
+        &[
+            metrics.rms_z1,
+            metrics.rms_z1_after2,
+            metrics.sat_duty,
+            metrics.imp_err_rms_after2,
+            metrics.peak_contact_after2,
+        ],
+    );
+    same(
+        "peak τ",
+        &dmetrics.peak_abs_tau,
+        metrics.peak_abs_tau.as_slice(),
+    );
+    assert_eq!(ds.steps(), state.steps());
+}
+
+/// The Cartesian loop on a planar arm of three links: its joint rows are
+/// those of the core's loop with the pair's step as the controller.
+#[test]
+fn the_cartesian_loop_steps_the_pair_as_the_core_loop_does() {
+    use adaptimp::sim::simulator::simulate;
+    use adaptimp::{
+        CartesianConfig, FreeSpace, Link, PlanarArm, RigidBody, Row, TargetImpedance, WrenchControl,
+    };
+    const N: usize = 3;
+    let links = [Link {
+        mass: 1.0,
+        length: 0.3,
+        com: 0.15,
+        inertia: 0.01,
+    }; N];
+    let js: Vec<Joint> = (0..N)
+        .map(|i| {
+            let x = if i == 0 { 0.0 } else { 0.3 };
+            Joint::revolute(
+                Transform::from_xyz_rpy([x, 0.0, 0.0], [0.0; 3]),
+                [0.0, 0.0, 1.0],
+            )
+        })
+        .collect();
+    let tip = Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0; 3]);
+    let q0 = [0.3, 0.5, 0.4];
+    let (mut d, mut s) = scenario::<N>(Law::Pd, true);
+    for (name, v) in [
+        ("q0", Value::Vec(&q0)),
+        ("T", Value::Real(0.2)),
+        ("wall", Value::None),
+    ] {
+        d.set(name, v).expect(name);
+        s.set(name, v).expect(name);
+    }
+    let cfg = CartesianConfig::default().position_only();
+    // The core's: the pair as a `WrenchControl` in the core's loop.
+    struct Pair<'a> {
+        pair: &'a CartesianController<N, Chain<N>, AnyBasis<N>>,
+        ost: &'a mut adaptimp::CartesianState<N>,
+        ist: &'a mut adaptimp::HeapState<N>,
+        target: TargetImpedance<N>,
+    }
+    impl WrenchControl<N> for Pair<'_> {
+        fn period(&self) -> f64 {
+            1e-3
+        }
+        fn target(&self) -> &TargetImpedance<N> {
+            &self.target
+        }
+        fn step_with_wrench(
+            &mut self,
+            m: &Measurement<N>,
+            wrench: &[f64; 6],
+            _c: &Setpoint<N>,
+        ) -> (Vector<N>, Result<Command<N>, Error>) {
+            let meas = CartesianMeasurement {
+                q: m.x,
+                dq: m.dx,
+                wrench: Vector::<6>::from(*wrench),
+            };
+            let (tau, r) = self.pair.step_or_fallback(self.ost, self.ist, &meas, None);
+            (tau, r.map(|c| c.joint))
+        }
+    }
+    struct Rows(Vec<Row<N>>);
+    impl adaptimp::Recorder<N> for Rows {
+        fn record(&mut self, r: &Row<N>) {
+            self.0.push(*r);
+        }
+    }
+    let (cc, _) = core_controller(&s);
+    let chain = Chain::<N>::new(&js, &tip).expect("chain");
+    let pair = CartesianController::new(
+        CartesianImpedance::new(cfg, chain, 1e-3).expect("outer"),
+        cc,
+    )
+    .expect("pair");
+    let q0v = Vector::from(q0);
+    let (mut ost, mut ist) = (pair.start(&q0v).expect("start"), pair.inner().new_state());
+    let target = *pair.inner().impedance();
+    let mut plant = RigidBody::new(
+        PlanarArm::new(links, 9.81).expect("arm"),
+        FreeSpace,
+        q0v,
+        Vector::zeros(),
+        s.sim.substeps,
+    )
+    .expect("plant");
+    let mut rows = Rows(Vec::new());
+    let nan = |_t: f64| Setpoint {
+        x: Vector::<N>::from_element(f64::NAN),
+        dx: Vector::from_element(f64::NAN),
+        ddx: Vector::from_element(f64::NAN),
+    };
+    let mut ctrl = Pair {
+        pair: &pair,
+        ost: &mut ost,
+        ist: &mut ist,
+        target,
+    };
+    simulate(&mut plant, &mut ctrl, &nan, 0.2, &mut rows).expect("core run");
+    // The run-time one.
+    let outer =
+        dy::CartesianImpedance::new(cfg, &dy::Chain::new(&js, &tip).unwrap(), 1e-3).expect("outer");
+    let joint = d.controller().expect("joint");
+    let mut dstate = outer.start(&q0).expect("start");
+    let mut jstate = joint.new_state();
+    let none = dy::Disturbances::none(N).expect("n");
+    let mut dplant = dy::RigidBody::new(
+        &dy::ModelArm::Planar {
+            links: links.to_vec(),
+            g: 9.81,
+        },
+        &d,
+        &none,
+    )
+    .expect("plant");
+    let run = dy::Run {
+        t_final: 0.2,
+        settle: 0.1,
+        every: 1,
+        disturbances: None,
+        injection: None,
+    };
+    let mut drows = dy::Rows::for_run(N, &run, 1e-3).expect("rows");
+    let mut task = dy::TaskRows::for_run(N, &run, 1e-3).expect("rows");
+    let metrics = dy::simulate_cartesian(
+        &mut dplant,
+        &outer,
+        &mut dstate,
+        dy::Joint::Adaptive(&joint, &mut jstate),
+        None,
+        &run,
+        &mut (),
+        &mut drows,
+        &mut task,
+    )
+    .expect("run-time run");
+    let col = |f: fn(&Row<N>) -> Vector<N>| -> Vec<f64> {
+        rows.0
+            .iter()
+            .flat_map(|r| f(r).iter().copied().collect::<Vec<_>>())
+            .collect()
+    };
+    assert_eq!(drows.len(), 200);
+    same("x", &drows.x, &col(|r| r.x));
+    same("tau_sat", &drows.tau_sat, &col(|r| r.tau_sat));
+    same("z1", &drows.z1, &col(|r| r.z1));
+    assert_eq!(task.len(), 200);
+    assert_eq!(
+        task.last.map(|s| s.command.joint.tau_sat.to_vec()),
+        Some(drows.tau_sat[drows.tau_sat.len() - N..].to_vec())
+    );
+    // Task space: z1 = p_d − p (m), the impedance residual not defined there.
+    assert_eq!(metrics.rms_z1_joint_after2.len(), 3);
+    assert!(metrics.imp_err_rms_after2.is_nan());
+    let rms = (task
+        .z1
+        .chunks(3)
+        .map(|z| z.iter().map(|v| v * v).sum::<f64>())
+        .sum::<f64>()
+        / 200.0)
+        .sqrt();
+    assert!(
+        (metrics.rms_z1 - rms).abs() <= 1e-12 * rms,
+        "{} {rms}",
+        metrics.rms_z1
+    );
+}
+
+/// An arm read from a URDF at run time (one this crate did not write the
+/// code for): its chain, its dynamics and both controllers, no match over n.
+#[test]
+fn a_urdf_read_at_run_time_drives_both_controllers() {
+    use adaptimp::description::{reduce, urdf};
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/hobby_arm.urdf");
+    let arm = reduce(&urdf::read_file(path).expect("urdf"), None, &[]).expect("arm");
+    let n = arm.n();
+    let chain = dy::Chain::from_arm(&arm).expect("chain");
+    let dynamics = dy::Dynamics::from_arm(&arm, adaptimp::GRAVITY).expect("dynamics");
+    assert_eq!((chain.n(), dynamics.n()), (n, n));
+    let (q, zero) = (vec![0.1; n], vec![0.0; n]);
+    // At rest, inverse dynamics is gravity plus nothing of the drive.
+    let id = dynamics.inverse_dynamics(&q, &zero, &zero).expect("id");
+    same("G", &id, &dynamics.gravity_torque(&q).expect("G"));
+    // Where the URDF states no effort limit, one of ours (5 N m).
+    let effort: Vec<f64> = arm
+        .joints
+        .iter()
+        .map(|j| if j.effort > 0.0 { j.effort } else { 5.0 })
+        .collect();
+    let mut s = dy::Scenario::new(n, Preset::Robot, Law::Pd).expect("n");
+    s.set("tau_max", Value::Vec(&effort)).expect("tau_max");
+    s.set("impedance", Value::Str("external"))
+        .expect("impedance");
+    let joint = s.controller().expect("joint controller");
+    let outer = dy::CartesianImpedance::new(s.cartesian(), &chain, joint.period()).expect("outer");
+    let pair = dy::CartesianController::new(outer, joint).expect("pair");
+    let (mut task, mut inner) = (pair.start(&q).expect("start"), pair.joint().new_state());
+    let m = dy::CartesianMeasurement {
+        q: &q,
+        dq: Some(&zero),
+        wrench: Vector::zeros(),
+    };
+    for _ in 0..10 {
+        let cmd = pair.step(&mut task, &mut inner, &m, None).expect("step");
+        assert_eq!(cmd.joint.tau_sat.len(), n);
+        // Held at q: the outer loop keeps the reference where the arm is.
+        assert!(
+            cmd.joint.z1.iter().all(|z| z.abs() < 1e-9),
+            "{:?}",
+            cmd.joint.z1
+        );
+    }
+}

@@ -1,7 +1,10 @@
 //! Read an arm from a URDF in Rust (SPEC §21), the same in Python
 //! (`examples/16_read_urdf.py`) and C (`ffi/examples/16_read_urdf.c`): the
 //! core reads the file, finds the arm by its one rule (which chain, which
-//! joints, the tip, what is held and why) and builds its chain and dynamics.
+//! joints, the tip, what is held and why) and builds its chain and dynamics;
+//! then the joint and the Cartesian controller step, through the run-time
+//! API (`adaptimp::dynamic`): the number of joints is the file's, known only
+//! when it is read, and nothing here matches over it.
 //!
 //! ```text
 //! cargo run --example read_urdf [PATH] [--tip LINK] [--fix JOINT]...
@@ -10,8 +13,12 @@
 //! Without PATH, the URDF text below: a 3-joint arm holding a gripper whose
 //! jaw a finger mimics (the jaw is held: a gripper's drive).
 
-use adaptimp::description::{reduce, urdf};
-use adaptimp::{Chain, Dynamics, Kinematics, Vector, GRAVITY};
+use adaptimp::description::{reduce, urdf, Arm};
+use adaptimp::dynamic::{
+    CartesianController, CartesianImpedance, CartesianMeasurement, Chain, Dynamics, Measurement,
+    Scenario,
+};
+use adaptimp::{schema::Value, Law, Preset, Vector, GRAVITY};
 
 const URDF: &str = "<robot name='demo'>\
 <link name='base'/>\
@@ -39,13 +46,48 @@ const URDF: &str = "<robot name='demo'>\
 <mimic joint='jaw_joint' multiplier='-1'/></joint>\
 </robot>";
 
-/// The tip's position at q = 0 and the moving mass, for an arm of `N` joints.
-fn report<const N: usize>(arm: &adaptimp::description::Arm) -> Result<(), adaptimp::Error> {
-    let chain: Chain<N> = arm.to_chain()?;
-    let dynamics: Dynamics<N> = arm.to_dynamics(GRAVITY)?;
-    let p = chain.fk(&Vector::<N>::zeros());
+/// The arm's model and both controllers through the run-time API (n known
+/// only now, no match over it): the tip and the moving mass, then a step of
+/// the joint controller and of the Cartesian controller with the arm
+/// measured 0.05 rad from the start q = 0 on every joint.
+fn drive(arm: &Arm) -> Result<(), Box<dyn std::error::Error>> {
+    let n = arm.n();
+    let (chain, dynamics) = (Chain::from_arm(arm)?, Dynamics::from_arm(arm, GRAVITY)?);
+    let (p, _) = chain.pose(&vec![0.0; n])?;
     println!("tip at q = 0: {} {} {}", p.x, p.y, p.z);
     println!("moving mass: {:.6} kg", dynamics.mass());
+    // τmax: the URDF's effort limits; where it states none, said, and 5 N m.
+    let effort: Vec<f64> = arm.joints.iter().map(|j| j.effort).collect();
+    for j in arm.joints.iter().filter(|j| j.effort.is_nan()) {
+        println!("  {} states no effort limit: tau_max = 5 N m here", j.name);
+    }
+    let tau_max: Vec<f64> = effort
+        .iter()
+        .map(|e| if e.is_nan() { 5.0 } else { *e })
+        .collect();
+    let mut s = Scenario::new(n, Preset::Robot, Law::Pd)?;
+    s.set("tau_max", Value::Vec(&tau_max))?;
+    let joint = s.controller()?; // sized for n, once
+    let mut state = joint.new_state();
+    let (q, zero) = (vec![0.05; n], vec![0.0; n]);
+    let m = Measurement {
+        x: &q,
+        dx: Some(&zero),
+        tau_e: &zero,
+    };
+    let cmd = joint.step(&mut state, &m, None)?; // its own trajectory at t_0
+    println!("joint controller: tau = {:.4?} N m", cmd.tau_sat);
+    s.set("impedance", Value::Str("external"))?; // the outer loop is the impedance
+    let outer = CartesianImpedance::new(s.cartesian(), &chain, joint.period())?;
+    let pair = CartesianController::new(outer, s.controller()?)?;
+    let (mut task, mut inner) = (pair.start(&zero)?, pair.joint().new_state());
+    let m = CartesianMeasurement {
+        q: &q,
+        dq: Some(&zero),
+        wrench: Vector::zeros(),
+    };
+    let cmd = pair.step(&mut task, &mut inner, &m, None)?; // hold the pose at q = 0
+    println!("Cartesian controller: tau = {:.4?} N m", cmd.joint.tau_sat);
     Ok(())
 }
 
@@ -76,17 +118,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for h in &arm.held {
         println!("  held {} = {}: {}", h.name, h.value, h.reason);
     }
-    match arm.n() {
-        1 => report::<1>(&arm)?,
-        2 => report::<2>(&arm)?,
-        3 => report::<3>(&arm)?,
-        4 => report::<4>(&arm)?,
-        5 => report::<5>(&arm)?,
-        6 => report::<6>(&arm)?,
-        7 => report::<7>(&arm)?,
-        n => return Err(format!("the arm has {n} joints; hold some with --fix").into()),
-    }
-    Ok(())
+    drive(&arm)
 }
 
 /// `cargo test` runs this example on the text (`cfg!(test)`).

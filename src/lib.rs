@@ -25,7 +25,7 @@
 //! | [`networks`] | learning: [`rbf`] (bases S(Z): the grid, user centres, lattices, orbits), [`network`] (ŴD, ŴC, ŴG), [`learning`] (Euler, normalised, freeze, projection), [`simd`] | (1), (15)–(17), §6, §13, §15 |
 //! | [`cartesian`] | task space: [`kinematics`] (pose, 6 × N Jacobian, J̇ q̇), serial [`chain`](cartesian::chain)s from joint data, the [`rotation`](cartesian::rotation) error, the 6-D Cartesian impedance outer loop and its pair with a joint controller | (3), §16 |
 //! | [`description`] (feature `alloc`; URDF files with `urdf`) | reading an arm: a URDF or a compiled MuJoCo model to one kinematic tree, and the one reduction to the arm (which chain, which joints, the tip, what is held and why) | §21 |
-//! | [`dynamic`] | the run-time number of joints dispatched once ([`with_joints!`], [`joint_counts!`]) for the Python and C fronts | — |
+//! | [`dynamic`] (feature `alloc`; the loop with `sim`) | the run-time API, for n known only at run time (an arm read from a file): one builder, the joint and Cartesian controllers, chain, dynamics, computed torque and the closed loop, each the const-generic type for its n (chosen once, dispatched by [`with_joints!`]); what the Python and C fronts convert to | — |
 //! | [`schema`] | the parameter table: names, units, docs, conditions, defaults | §10 |
 //! | `sim` (feature `sim`) | simulation only: `model` (D, C, G of the paper's and planar arms), `environment` (walls), `plant` (the `Plant` trait, RK4), `simulator` (the closed loop), `record`, `metrics`, `disturb`, `inject` | (4), (55)–(63), §1–§3, §11, §12, §17 |
 //!

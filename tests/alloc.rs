@@ -326,3 +326,189 @@ fn no_heap_allocation_in_computed_torque_steps() {
     assert_eq!(n, 0, "a computed-torque step allocated");
     assert_eq!(st.k, 2000);
 }
+
+/// The run-time API (`adaptimp::dynamic`, n known at run time): built once
+/// for its n, its steps allocate nothing, as the const-generic ones: the
+/// n = 7 joint step (the rule's default basis), the n = 7 Cartesian pair,
+/// computed torque, the chain and the dynamics, and the closed loops with
+/// their rows sized before.
+#[test]
+fn no_heap_allocation_in_the_run_time_api() {
+    use adaptimp::dynamic as dy;
+    use adaptimp::schema::{Preset, Value};
+    use adaptimp::{ImpedanceMode, Inertial, Joint, Link, Transform};
+    const N: usize = 7;
+    let mut s = dy::Scenario::new(N, Preset::Robot, Law::StateFeedback).expect("n");
+    let tau_max = common::PANDA_EFFORT;
+    s.set("tau_max", Value::Vec(&tau_max)).expect("tau_max");
+    s.set("impedance", Value::Str("external"))
+        .expect("impedance");
+    let joint = s.controller().expect("joint controller");
+    let mut st = joint.new_state();
+    let q = common::PANDA_HOME;
+    let (zero, dq) = ([0.0; N], [0.01; N]);
+    let (n, ()) = allocations_in(|| {
+        for _ in 0..1000 {
+            let m = dy::Measurement {
+                x: &q,
+                dx: Some(&dq),
+                tau_e: &zero,
+            };
+            joint.step(&mut st, &m, None).expect("step");
+        }
+    });
+    assert_eq!(n, 0, "the run-time n = 7 step allocated");
+    // The Cartesian pair on the Panda's chain, along a circle.
+    let h = std::f64::consts::FRAC_PI_2;
+    let rev = |xyz: [f64; 3], roll: f64| {
+        Joint::revolute(
+            Transform::from_xyz_rpy(xyz, [roll, 0.0, 0.0]),
+            [0.0, 0.0, 1.0],
+        )
+    };
+    let js = [
+        rev([0.0, 0.0, 0.333], 0.0),
+        rev([0.0, 0.0, 0.0], -h),
+        rev([0.0, -0.316, 0.0], h),
+        rev([0.0825, 0.0, 0.0], h),
+        rev([-0.0825, 0.384, 0.0], -h),
+        rev([0.0, 0.0, 0.0], h),
+        rev([0.088, 0.0, 0.0], h),
+    ];
+    let tcp = Transform::from_xyz_rpy([0.0, 0.0, 0.2104], [0.0; 3]);
+    let chain = dy::Chain::new(&js, &tcp).expect("chain");
+    let outer = dy::CartesianImpedance::new(s.cartesian(), &chain, 1e-3).expect("outer");
+    let pair = dy::CartesianController::new(outer, joint).expect("pair");
+    let (mut ost, mut ist) = (pair.start(&q).expect("start"), pair.joint().new_state());
+    let tip = chain.tip(&q, &zero).expect("tip");
+    let (n, ()) = allocations_in(|| {
+        for k in 0..1000 {
+            let t = k as f64 * 1e-3;
+            let target = adaptimp::PoseTarget::at(
+                tip.position + Vector::<3>::new(0.02 * t.sin(), 0.0, 0.0),
+                *tip.rotation.matrix(),
+            );
+            let m = dy::CartesianMeasurement {
+                q: &q,
+                dq: Some(&dq),
+                wrench: Vector::<6>::new(0.0, 0.0, -2.0, 0.0, 0.0, 0.0),
+            };
+            pair.step(&mut ost, &mut ist, &m, Some(&target))
+                .expect("step");
+            chain.tip(&q, &dq).expect("tip");
+        }
+    });
+    assert_eq!(n, 0, "the run-time Cartesian step allocated");
+    // Computed torque and the dynamics (one inertial per joint of the list).
+    let inertials = [Inertial::point(1.5, [0.02, 0.01, 0.06]); N];
+    let model = dy::Dynamics::new(&js, &inertials, adaptimp::GRAVITY).expect("model");
+    let ct = dy::ComputedTorque::new(
+        &dy::ComputedTorqueConfig {
+            ts: 1e-3,
+            kp: &[400.0; N],
+            kd: &[40.0; N],
+            tau_max: &tau_max,
+            dd: &[1.0; N],
+            cd: &[20.0; N],
+            gd: &[100.0; N],
+            mode: ImpedanceMode::External,
+        },
+        model.clone(),
+    )
+    .expect("computed torque");
+    let mut cst = ct.new_state();
+    let sp = dy::Setpoint {
+        x: &q[..],
+        dx: &dq[..],
+        ddx: &zero[..],
+    };
+    let (n, ()) = allocations_in(|| {
+        for _ in 0..1000 {
+            let m = dy::Measurement {
+                x: &q,
+                dx: Some(&dq),
+                tau_e: &zero,
+            };
+            ct.step(&mut cst, &m, &sp).expect("step");
+            model.inverse_dynamics(&q, &dq, &zero).expect("id");
+            model.mass_matrix(&q).expect("M");
+        }
+    });
+    assert_eq!(n, 0, "run-time computed torque or dynamics allocated");
+    // The closed loop: a planar arm of three links, its rows sized before.
+    let mut s = dy::Scenario::new(3, Preset::Paper, Law::StateFeedback).expect("n");
+    s.set("q0", Value::Vec(&[0.1, 0.2, 0.3])).expect("q0");
+    let ctrl = s.controller().expect("controller");
+    let mut st = ctrl.new_state();
+    let dist = s.disturbances().expect("disturbances");
+    let arm = dy::ModelArm::Planar {
+        links: vec![
+            Link {
+                mass: 1.0,
+                length: 0.3,
+                com: 0.15,
+                inertia: 0.01
+            };
+            3
+        ],
+        g: 9.81,
+    };
+    let mut plant = dy::RigidBody::new(&arm, &s, &dist).expect("plant");
+    let run = dy::Run {
+        t_final: 0.05,
+        settle: 0.0,
+        every: 1,
+        disturbances: Some(&dist),
+        injection: None,
+    };
+    let mut rows = dy::Rows::for_run(3, &run, ctrl.period()).expect("rows");
+    let (n, metrics) = allocations_in(|| {
+        dy::simulate(
+            &mut plant,
+            dy::Controlled::Joint(dy::Joint::Adaptive(&ctrl, &mut st)),
+            dy::Reference::Trajectory,
+            &run,
+            &mut (),
+            &mut rows,
+        )
+    });
+    assert_eq!(metrics.expect("run").rows, 1000);
+    assert_eq!(n, 0, "the run-time closed loop allocated");
+    // The Cartesian loop on the same arm, position-only, its rows sized before.
+    let js: Vec<Joint> = (0..3)
+        .map(|i| {
+            let x = if i == 0 { 0.0 } else { 0.3 };
+            Joint::revolute(
+                Transform::from_xyz_rpy([x, 0.0, 0.0], [0.0; 3]),
+                [0.0, 0.0, 1.0],
+            )
+        })
+        .collect();
+    let tip = Transform::from_xyz_rpy([0.3, 0.0, 0.0], [0.0; 3]);
+    let chain = dy::Chain::new(&js, &tip).expect("chain");
+    s.set("impedance", Value::Str("external"))
+        .expect("impedance");
+    let joint = s.controller().expect("joint");
+    let cfg = adaptimp::CartesianConfig::default().position_only();
+    let outer = dy::CartesianImpedance::new(cfg, &chain, joint.period()).expect("outer");
+    let mut ost = outer.start(&[0.1, 0.2, 0.3]).expect("start");
+    let mut ist = joint.new_state();
+    let mut plant = dy::RigidBody::new(&arm, &s, &dist).expect("plant");
+    let mut rows = dy::Rows::for_run(3, &run, joint.period()).expect("rows");
+    let mut task = dy::TaskRows::for_run(3, &run, joint.period()).expect("rows");
+    let (n, metrics) = allocations_in(|| {
+        dy::simulate_cartesian(
+            &mut plant,
+            &outer,
+            &mut ost,
+            dy::Joint::Adaptive(&joint, &mut ist),
+            None,
+            &run,
+            &mut (),
+            &mut rows,
+            &mut task,
+        )
+    });
+    assert_eq!(metrics.expect("run").rows, 1000);
+    assert_eq!(n, 0, "the run-time Cartesian loop allocated");
+}

@@ -13,7 +13,7 @@
 //! Without PATH, the URDF text below: a 3-joint arm holding a gripper whose
 //! jaw a finger mimics (the jaw is held: a gripper's drive).
 
-use adaptimp::description::{reduce, urdf, Arm};
+use adaptimp::description::{reduce, urdf, Arm, ArmJoint};
 use adaptimp::dynamic::{
     CartesianController, CartesianImpedance, CartesianMeasurement, Chain, Dynamics, Measurement,
     Scenario,
@@ -47,27 +47,20 @@ const URDF: &str = "<robot name='demo'>\
 </robot>";
 
 /// The arm's model and both controllers through the run-time API (n known
-/// only now, no match over it): the tip and the moving mass, then a step of
-/// the joint controller and of the Cartesian controller with the arm
-/// measured 0.05 rad from the start q = 0 on every joint.
+/// only now, no match over it): the tip and the moving mass, then 0.1 s of
+/// steps of the joint controller and of the Cartesian controller with the
+/// arm measured 0.05 rad from the start q = 0 on every joint.
 fn drive(arm: &Arm) -> Result<(), Box<dyn std::error::Error>> {
     let n = arm.n();
-    let (chain, dynamics) = (Chain::from_arm(arm)?, Dynamics::from_arm(arm, GRAVITY)?);
+    let chain = Chain::from_arm(arm)?;
     let (p, _) = chain.pose(&vec![0.0; n])?;
     println!("tip at q = 0: {} {} {}", p.x, p.y, p.z);
-    println!("moving mass: {:.6} kg", dynamics.mass());
-    // τmax: the URDF's effort limits; where it states none, said, and 5 N m.
-    let effort: Vec<f64> = arm.joints.iter().map(|j| j.effort).collect();
-    for j in arm.joints.iter().filter(|j| j.effort.is_nan()) {
-        println!("  {} states no effort limit: tau_max = 5 N m here", j.name);
-    }
-    let tau_max: Vec<f64> = effort
-        .iter()
-        .map(|e| if e.is_nan() { 5.0 } else { *e })
-        .collect();
-    let mut s = Scenario::new(n, Preset::Robot, Law::Pd)?;
+    let mass = Dynamics::from_arm(arm, GRAVITY)?.mass();
+    println!("moving mass: {mass:.6} kg");
+    let tau_max: Vec<f64> = arm.joints.iter().map(effort).collect();
+    let mut s = Scenario::new(n, Preset::Robot, Law::Pd)?; // every parameter by name
     s.set("tau_max", Value::Vec(&tau_max))?;
-    let joint = s.controller()?; // sized for n, once
+    let joint = s.controller()?; // sized for n, once; its steps allocate nothing
     let mut state = joint.new_state();
     let (q, zero) = (vec![0.05; n], vec![0.0; n]);
     let m = Measurement {
@@ -75,8 +68,10 @@ fn drive(arm: &Arm) -> Result<(), Box<dyn std::error::Error>> {
         dx: Some(&zero),
         tau_e: &zero,
     };
-    let cmd = joint.step(&mut state, &m, None)?; // its own trajectory at t_0
-    println!("joint controller: tau = {:.4?} N m", cmd.tau_sat);
+    for _ in 0..100 {
+        joint.step(&mut state, &m, None)?; // along its own trajectory
+    }
+    println!("joint controller: tau = {:.3?} N m", state.last().tau_sat);
     s.set("impedance", Value::Str("external"))?; // the outer loop is the impedance
     let outer = CartesianImpedance::new(s.cartesian(), &chain, joint.period())?;
     let pair = CartesianController::new(outer, s.controller()?)?;
@@ -86,9 +81,27 @@ fn drive(arm: &Arm) -> Result<(), Box<dyn std::error::Error>> {
         dq: Some(&zero),
         wrench: Vector::zeros(),
     };
-    let cmd = pair.step(&mut task, &mut inner, &m, None)?; // hold the pose at q = 0
-    println!("Cartesian controller: tau = {:.4?} N m", cmd.joint.tau_sat);
+    for _ in 0..100 {
+        pair.step(&mut task, &mut inner, &m, None)?; // hold the pose of q = 0
+    }
+    println!(
+        "Cartesian controller: tau = {:.3?} N m",
+        inner.last().tau_sat
+    );
     Ok(())
+}
+
+/// τmax of a joint (N m): the URDF's effort limit; where it states none,
+/// 10 N m, and said.
+fn effort(j: &ArmJoint) -> f64 {
+    if j.effort > 0.0 {
+        return j.effort;
+    }
+    println!(
+        "  {}: no effort limit in the URDF, tau_max = 10 N m",
+        j.name
+    );
+    10.0
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -54,6 +54,8 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     ("docs/robot.md", 1): "Rust: tests/snippets/robot_hardened.rs, a doctest of src/lib.rs; "
     "test_every_block_is_accounted_for keeps the page's copy identical",
     ("docs/rust.md", 0): "an error message the page shows, not code",
+    ("docs/rust.md", 1): "Rust: tests/snippets/dynamic_urdf.rs, a doctest of "
+    "src/dynamic/mod.rs; test_every_block_is_accounted_for keeps the page's copy identical",
     ("docs/sweeps.md", 2): "needs Ray, which no extra of adaptimp installs",
 }
 
@@ -64,6 +66,7 @@ RUN_SHELL = {("README.md", 5), ("docs/paper.md", 0)}
 RUST_SNIPPETS = {
     ("README.md", 6): "tests/snippets/readme_quickstart.rs",
     ("docs/robot.md", 1): "tests/snippets/robot_hardened.rs",
+    ("docs/rust.md", 1): "tests/snippets/dynamic_urdf.rs",
 }
 
 

@@ -22,43 +22,12 @@
 //! once ([`with_joints!`](crate::with_joints), [`joint_counts!`](crate::joint_counts)).
 //!
 //! A Rust program whose arm comes from a URDF read at run time steps the
-//! joint controller and the Cartesian controller without a match over n:
-//!
-//! ```
-//! # #[cfg(feature = "urdf")] {
-//! use adaptimp::description::{reduce, urdf};
-//! use adaptimp::dynamic::{CartesianController, CartesianImpedance, CartesianMeasurement, Chain, Measurement, Scenario};
-//! use adaptimp::{schema::Value, Law, Preset, Vector};
-//!
-//! let text = r#"<robot name="two"><link name="base"/><link name="upper"/><link name="fore"/>
-//!   <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
-//!     <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="20" velocity="2"/></joint>
-//!   <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/>
-//!     <origin xyz="0.3 0 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
-//! </robot>"#;
-//! let arm = reduce(&urdf::read_str(text)?, None, &[])?; // n is known from here on
-//! let effort: Vec<f64> = arm.joints.iter().map(|j| j.effort).collect();
-//! let mut s = Scenario::new(arm.n(), Preset::Robot, Law::Pd)?;
-//! s.set("tau_max", Value::Vec(&effort))?;
-//! let joint = s.controller()?; // sized for n, once
-//! let mut state = joint.new_state();
-//! let (q, dq, tau_e) = (vec![0.1; arm.n()], vec![0.0; arm.n()], vec![0.0; arm.n()]);
-//! let m = Measurement { x: &q, dx: Some(&dq), tau_e: &tau_e };
-//! let cmd = joint.step(&mut state, &m, None)?; // its own trajectory at t_k
-//! assert_eq!(cmd.tau_sat.len(), 2);
-//!
-//! // The Cartesian controller: the outer loop over the arm's chain, and a
-//! // joint controller that leaves the impedance to it.
-//! s.set("impedance", Value::Str("external"))?;
-//! let outer = CartesianImpedance::new(s.cartesian(), &Chain::from_arm(&arm)?, joint.period())?;
-//! let pair = CartesianController::new(outer, s.controller()?)?;
-//! let (mut task, mut inner) = (pair.start(&q)?, pair.joint().new_state());
-//! let m = CartesianMeasurement { q: &q, dq: Some(&dq), wrench: Vector::zeros() };
-//! let cmd = pair.step(&mut task, &mut inner, &m, None)?; // hold the pose at q
-//! assert!(cmd.joint.tau_sat.iter().all(|t| t.abs() <= 20.0));
-//! # }
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
+//! joint controller and the Cartesian controller without a match over n
+//! (a whole `src/main.rs`; give it the path of your URDF):
+#![cfg_attr(
+    feature = "urdf",
+    doc = concat!("\n```\n", include_str!("../../tests/snippets/dynamic_urdf.rs"), "```\n")
+)]
 //!
 //! The list of sizes itself, for code that needs a const `N`:
 //!

@@ -114,8 +114,27 @@ impl<const N: usize, K: Kinematics<N>, B: Basis<N>> CartesianController<N, K, B>
         m: &CartesianMeasurement<N>,
         target: Option<&PoseTarget>,
     ) -> Result<CartesianCommand<N>, Error> {
-        self.outer
-            .step_joint(outer, &mut (&self.inner, inner), m, target)
+        // `step_joint` with this pair's joint controller, written out: the
+        // pair's step compiles as it did before `step_joint` (the same
+        // instructions, `benches/cartesian_cost.rs`); tests/dynamic.rs checks
+        // the two give the same bits.
+        let mut reached = false;
+        let result = self.outer.step_with(outer, m, target, |meas, r, task| {
+            reached = true;
+            match task {
+                Some(t) => self.inner.step_task(inner, meas, r, t),
+                None => self.inner.step(inner, meas, r),
+            }
+        });
+        if let (Err(e), false) = (&result, reached) {
+            let meas = Measurement {
+                x: m.q,
+                dx: m.dq,
+                tau_e: Vector::zeros(),
+            };
+            self.inner.refuse_measured(inner, &meas, *e);
+        }
+        result
     }
 
     /// [`step`](Self::step), and the torque to apply whatever happened: the

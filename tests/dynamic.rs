@@ -487,6 +487,54 @@ fn cartesian<const N: usize>() {
     assert!(dist.fault().is_some(), "the NaN wrench was refused");
     assert_eq!(dist.fault(), ist.fault());
     assert_eq!(dost.steps(), ost.k);
+    // A joint law of the caller's (`step_with`): the core's joint step on
+    // what it is given gives the pair's torque.
+    let (cc2, _) = core_controller(&s);
+    let mut st2 = cc2.new_state();
+    let douter = dy::CartesianImpedance::new(d.cartesian(), &dchain, 1e-3).expect("outer");
+    let mut dost = douter.start(q0.as_slice()).expect("start");
+    let (mut ost, mut ist) = (pair.start(&q0).expect("start"), pair.inner().new_state());
+    for k in 0..50 {
+        let q = q0 + Vector::<N>::from_element(1e-3);
+        let m = CartesianMeasurement {
+            q,
+            dq: Some(Vector::zeros()),
+            wrench: Vector::<6>::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.0),
+        };
+        let c = target(&t0.position, t0.rotation.matrix(), k);
+        let want = pair.step(&mut ost, &mut ist, &m, Some(&c)).expect("step");
+        let dm = dy::CartesianMeasurement {
+            q: m.q.as_slice(),
+            dq: Some(&[0.0; N]),
+            wrench: m.wrench,
+        };
+        let got = douter
+            .step_with(&mut dost, &dm, Some(&c), |input| {
+                let meas = Measurement {
+                    x: Vector::from_column_slice(input.measurement.x),
+                    dx: input.measurement.dx.map(Vector::from_column_slice),
+                    tau_e: Vector::from_column_slice(input.measurement.tau_e),
+                };
+                let r = Setpoint {
+                    x: Vector::from_column_slice(input.reference.x),
+                    dx: Vector::from_column_slice(input.reference.dx),
+                    ddx: Vector::from_column_slice(input.reference.ddx),
+                };
+                let cmd = cc2.step(&mut st2, &meas, &r)?;
+                dy::Joints::from_slice(cmd.tau_sat.as_slice())
+            })
+            .expect("step_with");
+        same(
+            "tau of step_with",
+            &got.joint.tau_sat,
+            want.joint.tau_sat.as_slice(),
+        );
+        same(
+            "q_d of step_with",
+            &got.reference.x,
+            want.reference.x.as_slice(),
+        );
+    }
 }
 
 #[test]

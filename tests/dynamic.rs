@@ -887,3 +887,78 @@ fn a_urdf_read_at_run_time_drives_both_controllers() {
         );
     }
 }
+
+/// The centres along an orbit, the model arms' dynamics and kinematics and
+/// the parameters' listing: the const-generic ones.
+#[test]
+fn the_orbit_centres_and_the_model_arms_are_the_const_generic_ones() {
+    use adaptimp::{Centers, Link, Manipulator, PlanarArm, TwoLinkArm};
+    let traj = Sinusoid::<3>::new(
+        Vector::from_element(0.1),
+        Vector::from_element(0.2),
+        Vector::zeros(),
+        Vector::from_element(1.5),
+    )
+    .expect("trajectory");
+    let samples: Vec<Setpoint<3>> = (0..40).map(|k| traj.sample(0.1 * k as f64)).collect();
+    let dsamples: Vec<dy::Setpoint> = samples
+        .iter()
+        .map(|s| dy::Setpoint {
+            x: dy::Joints::from_slice(s.x.as_slice()).unwrap(),
+            dx: dy::Joints::from_slice(s.dx.as_slice()).unwrap(),
+            ddx: dy::Joints::from_slice(s.ddx.as_slice()).unwrap(),
+        })
+        .collect();
+    for periodic in [false, true] {
+        let c = if periodic {
+            Centers::along_periodic(&samples, [0.2, 0.5])
+        } else {
+            Centers::along(&samples, [0.2, 0.5])
+        }
+        .expect("centres");
+        let d = dy::Centres::along(&dsamples, [0.2, 0.5], periodic).expect("centres");
+        same("centres", &d.rows, c.centers());
+        let w: Vec<f64> = c.widths2().iter().flat_map(|b| b.iter().copied()).collect();
+        same("widths", d.widths2.as_deref().unwrap(), &w);
+    }
+    // The model arms.
+    let links = [Link {
+        mass: 1.2,
+        length: 0.4,
+        com: 0.2,
+        inertia: 0.02,
+    }; 3];
+    let planar = PlanarArm::new(links, 9.81).unwrap();
+    let arm = dy::ModelArm::Planar {
+        links: links.to_vec(),
+        g: 9.81,
+    };
+    let (q, dq, tau) = (q_of::<3>(1), q_of::<3>(2), q_of::<3>(3));
+    let (d, c, g, a) = arm
+        .dynamics(q.as_slice(), dq.as_slice(), tau.as_slice(), &[0.0; 3])
+        .expect("dynamics");
+    let m = |j: &dy::JointMatrix| j.matrix().iter().copied().collect::<Vec<_>>();
+    same("D", &m(&d), planar.inertia(&q).as_slice());
+    same("C", &m(&c), planar.coriolis(&q, &dq).as_slice());
+    same("G", &g, planar.gravity(&q).as_slice());
+    let a2 = planar.forward_dynamics(&q, &dq, &tau, &Vector::zeros());
+    same("q̈", &a, a2.as_slice());
+    let (p, j) = arm.kinematics(q.as_slice()).expect("kinematics");
+    same("fk", p.as_slice(), planar.fk(&q).as_slice());
+    let j: Vec<f64> = j.matrix().iter().copied().collect();
+    same("Jp", &j, planar.position_jacobian(&q).as_slice());
+    let two = dy::ModelArm::Paper(TwoLinkArm::paper());
+    assert_eq!(two.n(), 2);
+    let e = two.dynamics(&[0.0; 3], &[0.0; 3], &[0.0; 3], &[0.0; 3]);
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "q: needs one value per joint (as many as the controller has)"
+    );
+    // The parameters' listing.
+    let (d, s) = scenario::<4>(Law::Pd, false);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    d.visit(|name, v| a.push(format!("{name} {v:?}")));
+    s.visit(|name, v| b.push(format!("{name} {v:?}")));
+    assert_eq!(a, b);
+    assert!(!a.is_empty());
+}

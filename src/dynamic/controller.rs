@@ -27,6 +27,45 @@ impl Family for ScenarioF {
     type Of<const N: usize> = Box<schema::Scenario<N>>;
 }
 
+impl Centres {
+    /// Centres along an orbit (SPEC §15 (15.2), [`Centers::along`]): one
+    /// node at each sample's [q; q̇] (n values each), widths per block
+    /// max(2 h, `tube`) (rad, rad/s; h the largest spacing of consecutive
+    /// samples, the last to the first too when `periodic`), α1 and α̇1 left
+    /// out (width +∞).
+    pub fn along(samples: &[Setpoint], tube: [f64; 2], periodic: bool) -> Result<Self, Error> {
+        let n = samples.first().map_or(0, |s| s.x.len());
+        crate::with_joints!(n, N => {
+            let typed: Vec<crate::trajectory::Setpoint<N>> = samples
+                .iter()
+                .map(|s| {
+                    if s.x.len() != N || s.dx.len() != N || s.ddx.len() != N {
+                        return Err(super::values::length("samples"));
+                    }
+                    Ok(crate::trajectory::Setpoint {
+                        x: s.x.vector(),
+                        dx: s.dx.vector(),
+                        ddx: s.ddx.vector(),
+                    })
+                })
+                .collect::<Result<_, _>>()?;
+            let c = if periodic {
+                Centers::along_periodic(&typed, tube)?
+            } else {
+                Centers::along(&typed, tube)?
+            };
+            let widths2 = c.widths2().iter().flat_map(|b| b.iter().copied()).collect();
+            Ok(Self {
+                rows: c.centers().to_vec(),
+                widths2: Some(widths2),
+            })
+        }, _ => Err(Error::Invalid {
+            what: "samples",
+            reason: "need at least one sample of 1 to 7 joints",
+        }))
+    }
+}
+
 /// The basis the controller's networks take.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Basis {
@@ -98,6 +137,12 @@ impl Scenario {
     /// The controller's law.
     pub fn law(&self) -> Law {
         self.law
+    }
+
+    /// Every parameter's name and value, in the schema's order
+    /// ([`schema::Scenario::visit`]): the defaults a front shows.
+    pub fn visit(&self, f: impl FnMut(&'static str, Value<'_>)) {
+        each!(&self.inner, s, N => s.visit(f))
     }
 
     /// The 6-D Cartesian impedance's parameters (the schema's group

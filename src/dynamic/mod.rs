@@ -404,8 +404,8 @@ pub use model::{
 #[cfg(all(feature = "alloc", feature = "sim"))]
 pub use run::{
     metrics_of, simulate, simulate_cartesian, Arm as ModelArm, Control, Controlled, Disturbances,
-    Hooks, Injected, Injection, Metrics, Plant, Recorded, Reference, RigidBody, Rows, Run,
-    RunError, Table, TaskRows, TaskStep,
+    Hooks, Injected, Injection, Jacobian3, Metrics, Plant, Recorded, Reference, RigidBody, Rows,
+    Run, RunError, Table, TaskRows, TaskStep,
 };
 #[cfg(feature = "alloc")]
 pub use values::{Command, Joints, Measurement, Setpoint};

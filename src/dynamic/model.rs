@@ -93,7 +93,7 @@ pub struct JointMatrix {
 }
 
 impl JointMatrix {
-    fn of<const N: usize>(v: &crate::types::Matrix<N>) -> Self {
+    pub(crate) fn of<const N: usize>(v: &crate::types::Matrix<N>) -> Self {
         let mut m = SMatrix::<f64, MAX_JOINTS, MAX_JOINTS>::zeros();
         m.fixed_view_mut::<N, N>(0, 0).copy_from(v);
         Self { n: N, m }

@@ -55,7 +55,6 @@ impl Joints {
     }
 
     /// The N values as the core's vector (N = n).
-    #[cfg(feature = "sim")]
     pub(crate) fn vector<const N: usize>(&self) -> Vector<N> {
         Vector::from_column_slice(&self.v[..N])
     }

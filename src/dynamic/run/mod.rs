@@ -16,7 +16,7 @@ mod plant;
 mod rows;
 
 pub use cartesian::simulate_cartesian;
-pub use plant::{Arm, Disturbances, Injected, Injection, Plant, RigidBody};
+pub use plant::{Arm, Disturbances, Injected, Injection, Jacobian3, Plant, RigidBody};
 pub use rows::{metrics_of, Metrics, Recorded, Rows, TaskRows, TaskStep};
 
 use super::cartesian::Joint;

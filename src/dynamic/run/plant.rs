@@ -3,8 +3,10 @@
 //! [`Injection`]).
 
 use super::super::controller::Scenario;
+use super::super::model::JointMatrix;
 use super::super::sized::{each, make, map, ByJoints, Family};
-use super::super::values::{length, mismatch, too_many, Joints};
+use super::super::values::{length, mismatch, too_many, vector, Joints};
+use super::super::MAX_JOINTS;
 use crate::error::{check, Error};
 use crate::sim::disturb::{self, WithFriction};
 use crate::sim::environment::{FreeSpace, Wall};
@@ -90,6 +92,104 @@ pub enum Arm {
         /// Gravity (m/s²).
         g: f64,
     },
+}
+
+impl Arm {
+    /// The number of joints n.
+    pub fn n(&self) -> usize {
+        match self {
+            Arm::Paper(_) => 2,
+            Arm::Planar { links, .. } => links.len(),
+        }
+    }
+
+    /// D(q) (kg m²), C(q, q̇) (kg m²/s), G(q) (N m) and q̈ (rad/s²) of (4)
+    /// at (q, q̇) under τ and τe (n values each; the paper's arm's (55)–(63),
+    /// a planar arm's): [`Manipulator`](crate::Manipulator)'s, checked for
+    /// their lengths.
+    pub fn dynamics(
+        &self,
+        q: &[f64],
+        dq: &[f64],
+        tau: &[f64],
+        tau_e: &[f64],
+    ) -> Result<(JointMatrix, JointMatrix, Joints, Joints), Error> {
+        use crate::sim::model::Manipulator;
+        fn of<const N: usize, M: Manipulator<N>>(
+            m: &M,
+            q: &[f64],
+            dq: &[f64],
+            tau: &[f64],
+            tau_e: &[f64],
+        ) -> Result<(JointMatrix, JointMatrix, Joints, Joints), Error> {
+            let (q, dq) = (vector::<N>("q", q)?, vector::<N>("dq", dq)?);
+            let (tau, tau_e) = (vector::<N>("tau", tau)?, vector::<N>("tau_e", tau_e)?);
+            Ok((
+                JointMatrix::of(&m.inertia(&q)),
+                JointMatrix::of(&m.coriolis(&q, &dq)),
+                Joints::of(&m.gravity(&q)),
+                Joints::of(&m.forward_dynamics(&q, &dq, &tau, &tau_e)),
+            ))
+        }
+        match self {
+            Arm::Paper(a) => of::<2, _>(a, q, dq, tau, tau_e),
+            Arm::Planar { links, g } => crate::with_joints!(links.len(), N => {
+                let links: [Link; N] = links.as_slice().try_into().map_err(|_| mismatch("arm"))?;
+                of::<N, _>(&PlanarArm::new(links, *g)?, q, dq, tau, tau_e)
+            }, _ => Err(too_many(links.len()))),
+        }
+    }
+
+    /// The end-effector position p = fk(q) (m) and the position Jacobian
+    /// ∂p/∂q (3 × n, m/rad) at q (SPEC §16).
+    pub fn kinematics(&self, q: &[f64]) -> Result<(Vector<3>, Jacobian3), Error> {
+        use crate::cartesian::Kinematics;
+        fn of<const N: usize, K: Kinematics<N>>(
+            k: &K,
+            q: &[f64],
+        ) -> Result<(Vector<3>, Jacobian3), Error> {
+            let q = vector::<N>("q", q)?;
+            let j = k.position_jacobian(&q);
+            let mut m = nalgebra::SMatrix::<f64, 3, MAX_JOINTS>::zeros();
+            m.fixed_columns_mut::<N>(0).copy_from(&j);
+            Ok((k.fk(&q), Jacobian3 { n: N, m }))
+        }
+        match self {
+            Arm::Paper(a) => of::<2, _>(a, q),
+            Arm::Planar { links, g } => crate::with_joints!(links.len(), N => {
+                let links: [Link; N] = links.as_slice().try_into().map_err(|_| mismatch("arm"))?;
+                of::<N, _>(&PlanarArm::new(links, *g)?, q)
+            }, _ => Err(too_many(links.len()))),
+        }
+    }
+}
+
+/// The `3 × n` position Jacobian ∂p/∂q of an arm model's end effector (m/rad).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Jacobian3 {
+    n: usize,
+    m: nalgebra::SMatrix<f64, 3, MAX_JOINTS>,
+}
+
+impl Jacobian3 {
+    /// The number of joints n (columns).
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The 3 × n matrix.
+    pub fn matrix(
+        &self,
+    ) -> nalgebra::MatrixView<
+        '_,
+        f64,
+        nalgebra::Const<3>,
+        nalgebra::Dyn,
+        nalgebra::Const<1>,
+        nalgebra::Const<3>,
+    > {
+        self.m.columns(0, self.n)
+    }
 }
 
 struct RigidF;
@@ -247,7 +347,7 @@ impl Disturbances {
     pub fn friction_torque(&self, dq: &[f64], out: &mut [f64]) -> Result<bool, Error> {
         each!(&self.inner, d, N => {
             let f = d.friction();
-            let t = f.torque(&super::super::values::vector::<N>("dq", dq)?);
+            let t = f.torque(&vector::<N>("dq", dq)?);
             if out.len() != N {
                 return Err(length("friction torque"));
             }

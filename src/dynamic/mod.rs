@@ -288,7 +288,7 @@ mod sized {
 
     /// The variant of each N (a const item: every N = 1 … `MAX_JOINTS`
     /// has its impl), checked at compile time.
-    pub(crate) trait Sized<F: Family, const N: usize> {
+    pub(crate) trait Variant<F: Family, const N: usize> {
         fn wrap(v: F::Of<N>) -> ByJoints<F>;
         fn get(b: &ByJoints<F>) -> Option<&F::Of<N>>;
         fn get_mut(b: &mut ByJoints<F>) -> Option<&mut F::Of<N>>;
@@ -296,7 +296,7 @@ mod sized {
 
     macro_rules! sized {
         ($($v:ident => $n:literal),+) => {
-            $(impl<F: Family> Sized<F, $n> for ByJoints<F> {
+            $(impl<F: Family> Variant<F, $n> for ByJoints<F> {
                 fn wrap(v: F::Of<$n>) -> ByJoints<F> {
                     ByJoints::$v(v)
                 }
@@ -323,25 +323,25 @@ mod sized {
         /// The variant of N holding `v`.
         pub(crate) fn from_n<const N: usize>(v: F::Of<N>) -> Self
         where
-            Self: Sized<F, N>,
+            Self: Variant<F, N>,
         {
-            <Self as Sized<F, N>>::wrap(v)
+            <Self as Variant<F, N>>::wrap(v)
         }
 
         /// The value, if it was made for N joints.
         pub(crate) fn get<const N: usize>(&self) -> Option<&F::Of<N>>
         where
-            Self: Sized<F, N>,
+            Self: Variant<F, N>,
         {
-            <Self as Sized<F, N>>::get(self)
+            <Self as Variant<F, N>>::get(self)
         }
 
         /// The value, to change, if it was made for N joints.
         pub(crate) fn get_mut<const N: usize>(&mut self) -> Option<&mut F::Of<N>>
         where
-            Self: Sized<F, N>,
+            Self: Variant<F, N>,
         {
-            <Self as Sized<F, N>>::get_mut(self)
+            <Self as Variant<F, N>>::get_mut(self)
         }
     }
 

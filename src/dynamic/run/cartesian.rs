@@ -168,8 +168,11 @@ pub fn simulate_cartesian<S: AsRef<[f64]> + AsMut<[f64]>>(
     task: &mut TaskRows,
 ) -> Result<Metrics, RunError> {
     let n = outer.n();
-    if plant.n() != n || rows.n() != n || task.n != n {
+    if plant.n() != n {
         return Err(mismatch("plant").into());
+    }
+    if rows.n() != n || task.n != n {
+        return Err(mismatch("rows").into());
     }
     if joint.period() != outer.period() {
         return Err(Error::Invalid {

@@ -409,8 +409,11 @@ pub fn simulate<S: AsRef<[f64]> + AsMut<[f64]>>(
         Controlled::Joint(j) => j.n(),
         Controlled::Own(c) => c.n(),
     };
-    if plant.n() != n || rows.n() != n {
+    if plant.n() != n {
         return Err(mismatch("plant").into());
+    }
+    if rows.n() != n {
+        return Err(mismatch("rows").into());
     }
     crate::with_joints!(n, N => {
         let dist = match run.disturbances {

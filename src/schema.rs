@@ -12,6 +12,7 @@
 
 use crate::cartesian::{CartesianConfig, Formulation};
 use crate::control::auxiliary::AuxLaw;
+use crate::control::config::MAX_DELAY;
 use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound};
 use crate::control::impedance::ImpedanceMode;
 use crate::control::observer::Hold;
@@ -21,7 +22,7 @@ use crate::error::Error;
 use crate::networks::learning::{LearningStep, SaturationLearning};
 use crate::networks::rbf::Grid;
 #[cfg(feature = "sim")]
-use crate::sim::disturb::{DisturbanceParams, Disturbances, MAX_DELAY};
+use crate::sim::disturb::{DisturbanceParams, Disturbances};
 #[cfg(feature = "sim")]
 use crate::sim::model::{ArmParams, TwoLinkArm};
 #[cfg(feature = "sim")]
@@ -246,7 +247,15 @@ pub const PARAMS: &[Param] = &[
         R(0.0),
     ),
     p("seed", Sim, Int, "", "seed of the noise and jitter generators (xoshiro256++): same seed, same run", "seed ≥ 0", I(0)),
-    p("delay", Sim, Int, "steps", "measurement delay d: the controller sees the sample of step k − d", "0 ≤ delay ≤ 64", I(0)),
+    p(
+        "plant_delay",
+        Sim,
+        Int,
+        "steps",
+        "the loop's delay alone, the controller not told of it: the controller sees the sample of step k − d (simulate's delay= sets it and the controller's delay)",
+        "0 ≤ plant_delay ≤ 64",
+        I(0),
+    ),
     p(
         "jitter",
         Sim,
@@ -270,6 +279,18 @@ pub const PARAMS: &[Param] = &[
     ),
     // The controller, SPEC §4–§9, §11.
     robot(p("Ts", Ctrl, Real, "s", "sampling period of the controller", "Ts > 0", R(50e-6)), R(1e-3)),
+    robot(
+        p(
+            "delay",
+            Ctrl,
+            Int,
+            "periods",
+            "the loop's delay δ the controller is made for: its torque acts δ periods after its measurement was taken (libfranka: 1); in simulate, also the plant's (SPEC (18.11))",
+            "0 ≤ delay ≤ 64",
+            I(0),
+        ),
+        I(1),
+    ),
     p("K1", Ctrl, Joint, "1/s", "K1 of α1 = ẋd + K1 z1, (7)", "K1 > 0", R(6.0)),
     p(
         "Kp",
@@ -741,6 +762,7 @@ impl<const N: usize> Scenario<N> {
             _ if p.group == Group::Sim => return self.set_run(n, value),
             _ if p.group == Group::Cartesian => return self.set_cartesian(n, value),
             "Ts" => c.ts = real(n, value)?,
+            "delay" => c.delay = delay(n, value, "0 ≤ delay ≤ 64")?,
             "K1" => c.k1 = joint(n, value)?,
             "Kp" => c.kp = joint(n, value)?,
             "Kzeta" => c.kzeta = joint(n, value)?,
@@ -839,19 +861,7 @@ impl<const N: usize> Scenario<N> {
                     value: v as f64,
                 })?
             }
-            "delay" => {
-                let v = int(n, value)?;
-                self.disturb.delay =
-                    usize::try_from(v)
-                        .ok()
-                        .filter(|d| *d <= MAX_DELAY)
-                        .ok_or(Error::Condition {
-                            condition: "0 ≤ delay ≤ 64",
-                            lhs: "delay",
-                            index: None,
-                            value: v as f64,
-                        })?
-            }
+            "plant_delay" => self.disturb.delay = delay(n, value, "0 ≤ plant_delay ≤ 64")?,
             "jitter" => self.disturb.jitter = real(n, value)?,
             "friction_viscous" => self.disturb.friction_viscous = joint(n, value)?,
             "friction_coulomb" => self.disturb.friction_coulomb = joint(n, value)?,
@@ -911,6 +921,7 @@ impl<const N: usize> Scenario<N> {
         let Config {
             law: _,
             ts,
+            delay,
             k1,
             kp,
             kzeta,
@@ -977,6 +988,7 @@ impl<const N: usize> Scenario<N> {
         #[cfg(feature = "sim")]
         self.visit_run(&mut f);
         f("Ts", R(*ts));
+        f("delay", I(*delay as i64));
         f("K1", V(k1.as_slice()));
         f("Kp", V(kp.as_slice()));
         f("Kzeta", V(kzeta.as_slice()));
@@ -1127,7 +1139,7 @@ impl<const N: usize> Scenario<N> {
         f("noise_tau_e", V(noise_tau_e.as_slice()));
         // The setter admits 0 ≤ seed ≤ i64::MAX only.
         f("seed", I(i64::try_from(*seed).unwrap_or(i64::MAX)));
-        f("delay", I(*delay as i64));
+        f("plant_delay", I(*delay as i64));
         f("jitter", R(*jitter));
         f("friction_viscous", V(friction_viscous.as_slice()));
         f("friction_coulomb", V(friction_coulomb.as_slice()));
@@ -1180,12 +1192,25 @@ fn real(name: &'static str, v: Value<'_>) -> Result<f64, Error> {
     }
 }
 
-#[cfg(feature = "sim")]
 fn int(name: &'static str, v: Value<'_>) -> Result<i64, Error> {
     match v {
         Value::Int(i) => Ok(i),
         _ => Err(kind_error(name)),
     }
+}
+
+/// A delay in periods, 0 ≤ d ≤ [`MAX_DELAY`] (`condition` names it).
+fn delay(name: &'static str, v: Value<'_>, condition: &'static str) -> Result<usize, Error> {
+    let v = int(name, v)?;
+    usize::try_from(v)
+        .ok()
+        .filter(|d| *d <= MAX_DELAY)
+        .ok_or(Error::Condition {
+            condition,
+            lhs: name,
+            index: None,
+            value: v as f64,
+        })
 }
 
 fn flag(name: &'static str, v: Value<'_>) -> Result<bool, Error> {

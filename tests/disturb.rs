@@ -46,6 +46,7 @@ struct Spy {
     tau: V2,
     target: TargetImpedance<2>,
     seen: Vec<Measurement<2>>,
+    setpoints: Vec<Setpoint<2>>,
 }
 
 impl Spy {
@@ -55,6 +56,7 @@ impl Spy {
             tau,
             target: TargetImpedance::paper(),
             seen: Vec::new(),
+            setpoints: Vec::new(),
         }
     }
 }
@@ -66,8 +68,9 @@ impl Control<2> for Spy {
     fn target(&self) -> &TargetImpedance<2> {
         &self.target
     }
-    fn step(&mut self, m: &Measurement<2>, _c: &Setpoint<2>) -> Result<Command<2>, Error> {
+    fn step(&mut self, m: &Measurement<2>, c: &Setpoint<2>) -> Result<Command<2>, Error> {
         self.seen.push(*m);
+        self.setpoints.push(*c);
         Ok(Command {
             tau_sat: self.tau,
             tau: self.tau,
@@ -204,18 +207,30 @@ fn delay_shows_the_controller_the_sample_of_k_minus_d() {
             &mut trace,
         )
         .unwrap();
-        (spy.seen, trace)
+        (spy.seen, spy.setpoints, trace)
     };
-    let (now, truth) = spy_run(0);
+    let (now, at, truth) = spy_run(0);
     assert!(
         truth.rows.iter().any(|r| r.tau_e[0] > 0.0),
         "the wall is touched"
     );
+    let motion = |t: &Trace<2>| -> Vec<(V2, V2, V2, V2)> {
+        t.rows.iter().map(|r| (r.x, r.dx, r.tau_e, r.xc)).collect()
+    };
     for delay in [1, 7, 64] {
-        let (late, rows) = spy_run(delay);
-        assert!(rows == truth, "the delay changed the plant's motion");
+        let (late, late_at, rows) = spy_run(delay);
+        assert!(
+            motion(&rows) == motion(&truth),
+            "the delay changed the plant's motion"
+        );
         for (k, m) in late.iter().enumerate() {
-            assert_eq!(*m, now[k.saturating_sub(delay)], "d = {delay}, k = {k}");
+            let then = k.saturating_sub(delay);
+            assert_eq!(*m, now[then], "d = {delay}, k = {k}");
+            // SPEC (17.1): the setpoint of the sample's own instant, t_(k−d).
+            assert_eq!(late_at[k], at[then], "d = {delay}, k = {k}");
+            // The row's z1: the spy's (zero) plus the sample's error, here the
+            // delay's: the true q of step k − d less the true q of step k − d.
+            assert_eq!(rows.rows[k].z1, V2::zeros(), "d = {delay}, k = {k}");
         }
     }
     // What the controller saw without delay is the plant's sample, exactly.
@@ -660,7 +675,7 @@ fn arm_parameters_and_disturbances_reach_the_plant_only() {
         ("noise_q", Value::Real(1e-4)),
         ("friction_coulomb", Value::Vec(&[0.2, 0.1])),
         ("actuator_fraction", Value::Real(0.7)),
-        ("delay", Value::Int(3)),
+        ("plant_delay", Value::Int(3)),
         ("jitter", Value::Real(0.05)),
         ("seed", Value::Int(9)),
     ] {
@@ -750,6 +765,9 @@ fn the_schema_builds_the_disturbances_and_names_bad_values() {
     let mut s = Scenario::<2>::preset(Preset::Paper, Law::Pd);
     let e = s.set("seed", Value::Int(-1)).unwrap_err();
     assert!(e.to_string().contains("seed ≥ 0"), "{e}");
+    let e = s.set("plant_delay", Value::Int(65)).unwrap_err();
+    assert!(e.to_string().contains("0 ≤ plant_delay ≤ 64"), "{e}");
+    // The controller's own delay (SPEC (18.11)) is checked by the same bound.
     let e = s.set("delay", Value::Int(65)).unwrap_err();
     assert!(e.to_string().contains("0 ≤ delay ≤ 64"), "{e}");
     for (name, v, condition) in [
@@ -769,8 +787,32 @@ fn the_schema_builds_the_disturbances_and_names_bad_values() {
             "{name}: the schema states another condition"
         );
     }
-    s.set("delay", Value::Int(64)).unwrap();
+    s.set("plant_delay", Value::Int(64)).unwrap();
     s.set("seed", Value::Int(i64::MAX)).unwrap();
     let d = s.disturbances().unwrap();
     assert_eq!((d.params().delay, d.params().seed), (64, i64::MAX as u64));
+}
+
+#[test]
+fn the_rows_tracking_error_is_the_true_states_not_the_noisy_samples() {
+    // SPEC (17.1): with sensor noise the controller compares its reference
+    // with a noisy q; the row's z1 is the reference less the plant's true q.
+    let noisy = disturbances(DisturbanceParams {
+        noise_q: V2::from_element(1e-3),
+        seed: 5,
+        ..DisturbanceParams::default()
+    });
+    let trace = robot_run(Law::StateFeedback, 0.3, &noisy);
+    for r in &trace.rows {
+        let truth = r.xd - r.x;
+        assert!(
+            (r.z1 - truth).amax() <= 1e-12,
+            "{:?} against {:?}",
+            r.z1,
+            truth
+        );
+    }
+    // Without noise or delay the row's z1 is the controller's own, bit for bit.
+    let clean = robot_run(Law::StateFeedback, 0.3, &Disturbances::none());
+    assert!(clean.rows.iter().all(|r| r.z1 == r.xd - r.x));
 }

@@ -329,6 +329,10 @@ typedef struct AdaptimpParams {
   AdaptimpLaw law;
   // Sampling period Ts (s).
   double ts;
+  // The loop's delay δ (periods) the controller is made for, 0…64: its
+  // torque acts δ periods after its measurement was taken (libfranka: 1),
+  // SPEC (18.11).
+  size_t delay;
   // K1 (1/s), (7).
   double k1[ADAPTIMP_MAX_JOINTS];
   // Kp (N m s/rad), (14).
@@ -1069,8 +1073,10 @@ enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
 // The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
 // the robot scenario's parameters for `law` with the rule's gains from the
 // inertia matrix `inertia` (n × n, row-major, kg m², at the task's start),
-// the limits `tau_max` (n, N m) and the period `ts` (s), and the conditions
-// "scaled" (SPEC §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
+// the limits `tau_max` (n, N m), the period `ts` (s) and the loop's delay
+// `delay` (periods, 0…64: libfranka's loop 1; the margin of SPEC (18.11)
+// at the largest mode at `inertia`), and the conditions "scaled" (SPEC
+// §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
 // one period of `period` s, evenly spaced in time) also the centres along
 // it, the learning rates and the weight bounds: the centres are written to
 // `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
@@ -1089,6 +1095,7 @@ enum AdaptimpStatus adaptimp_params_suggest(struct AdaptimpParams *out,
                                             const double *inertia,
                                             const double *tau_max,
                                             double ts,
+                                            size_t delay,
                                             const double *path,
                                             size_t rows,
                                             double period,

@@ -24,6 +24,10 @@ pub struct AdaptimpParams {
     pub law: AdaptimpLawRaw,
     /// Sampling period Ts (s).
     pub ts: f64,
+    /// The loop's delay δ (periods) the controller is made for, 0…64: its
+    /// torque acts δ periods after its measurement was taken (libfranka: 1),
+    /// SPEC (18.11).
+    pub delay: usize,
     /// K1 (1/s), (7).
     pub k1: [f64; ADAPTIMP_MAX_JOINTS],
     /// Kp (N m s/rad), (14).
@@ -161,6 +165,7 @@ pub(crate) fn scenario_of<const N: usize>(
         n: _,
         law,
         ts,
+        delay,
         k1,
         kp,
         kzeta,
@@ -233,8 +238,11 @@ pub(crate) fn scenario_of<const N: usize>(
         AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
         AdaptimpWeightBound::Auto => Value::Str("auto"),
     };
-    let values: [(&str, Value<'_>); 44] = [
+    // usize → i64: a count beyond i64 is refused by the schema's check (≤ 64).
+    let delay = i64::try_from(*delay).unwrap_or(i64::MAX);
+    let values: [(&str, Value<'_>); 45] = [
         ("Ts", Value::Real(*ts)),
+        ("delay", Value::Int(delay)),
         ("K1", joint(k1)),
         ("Kp", joint(kp)),
         ("Kzeta", joint(kzeta)),
@@ -331,6 +339,7 @@ pub(crate) fn fill_from<const N: usize>(s: &Scenario<N>, law: Law, out: &mut Ada
         }
         .raw(),
         ts: 0.0,
+        delay: 0,
         k1: [0.0; ADAPTIMP_MAX_JOINTS],
         kp: [0.0; ADAPTIMP_MAX_JOINTS],
         kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
@@ -399,6 +408,11 @@ pub(crate) fn fill_from<const N: usize>(s: &Scenario<N>, law: Law, out: &mut Ada
         };
         match name {
             "Ts" => real(&mut p.ts),
+            "delay" => {
+                if let Value::Int(d) = v {
+                    p.delay = usize::try_from(d).unwrap_or(0);
+                }
+            }
             "K1" => joint(&mut p.k1),
             "Kp" => joint(&mut p.kp),
             "Kzeta" => joint(&mut p.kzeta),
@@ -515,6 +529,8 @@ struct Suggest<'a> {
     inertia: &'a [f64],
     tau_max: &'a [f64],
     ts: f64,
+    /// The loop's delay (periods), SPEC (18.11).
+    delay: usize,
     /// Rows of 3n (q, q̇, q̈) and the period (s), or none.
     path: Option<(&'a [f64], f64)>,
     gravity: Option<&'a [f64]>,
@@ -527,13 +543,16 @@ fn suggest_sized<const N: usize>(
     a: &Suggest<'_>,
     out: &mut AdaptimpParams,
 ) -> Result<(), AdaptimpStatus> {
-    use adaptimp::tuning::Rule;
+    use adaptimp::tuning::{inertia_scales, loop_bound, Rule};
     use adaptimp::{Setpoint, Vector};
-    let rule = Rule::default();
+    let config = |e| core_error(e, Context::Config);
     let d = adaptimp::Matrix::<N>::from_row_slice(a.inertia);
+    // SPEC (18.11): the margin for the loop's delay at the largest mode at D.
+    let rule = Rule::default().with_delay(a.delay).map_err(config)?;
+    let rule =
+        rule.bounded(loop_bound(&[d], &inertia_scales(&d).map_err(config)?).map_err(config)?);
     let tau = Vector::<N>::from_column_slice(a.tau_max);
     let mut s = Scenario::<N>::preset(Preset::Robot, a.law);
-    let config = |e| core_error(e, Context::Config);
     let centers = match a.path {
         None => {
             s.config = rule.gains(a.law, &d, &tau, a.ts).map_err(config)?;
@@ -581,8 +600,10 @@ pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = adaptimp::tuning::NODES.1;
 /// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
 /// the robot scenario's parameters for `law` with the rule's gains from the
 /// inertia matrix `inertia` (n × n, row-major, kg m², at the task's start),
-/// the limits `tau_max` (n, N m) and the period `ts` (s), and the conditions
-/// "scaled" (SPEC §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
+/// the limits `tau_max` (n, N m), the period `ts` (s) and the loop's delay
+/// `delay` (periods, 0…64: libfranka's loop 1; the margin of SPEC (18.11)
+/// at the largest mode at `inertia`), and the conditions "scaled" (SPEC
+/// §10). With a `path` (`rows` rows of 3n reals: q, q̇, q̈,
 /// one period of `period` s, evenly spaced in time) also the centres along
 /// it, the learning rates and the weight bounds: the centres are written to
 /// `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
@@ -604,6 +625,7 @@ pub unsafe extern "C" fn adaptimp_params_suggest(
     inertia: *const f64,
     tau_max: *const f64,
     ts: f64,
+    delay: usize,
     path: *const f64,
     rows: usize,
     period: f64,
@@ -622,6 +644,7 @@ pub unsafe extern "C" fn adaptimp_params_suggest(
             inertia: unsafe { slice(inertia, n * n, "inertia") }?,
             tau_max: unsafe { slice(tau_max, n, "tau_max") }?,
             ts,
+            delay,
             path: if path.is_null() {
                 None
             } else {
@@ -712,6 +735,6 @@ mod tests {
         check::<7>();
         // scenario_of sets exactly the controller group's names, in order (its
         // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 44);
+        assert_eq!(controller_names().count(), 45);
     }
 }

@@ -60,6 +60,10 @@ class ControllerParams(TypedDict, total=False):
 
     Ts: float
     """sampling period of the controller (s)."""
+    delay: int
+    """the loop's delay δ the controller is made for: its torque acts δ periods after its
+    measurement was taken (libfranka: 1); in simulate, also the plant's (SPEC (18.11))
+    (periods)."""
     K1: float | _Joint
     """K1 of α1 = ẋd + K1 z1, (7) (1/s)."""
     Kp: float | _Joint
@@ -183,8 +187,9 @@ class SimParams(TypedDict, total=False):
     """standard deviation of the Gaussian noise on each measured τe_i (N m)."""
     seed: int
     """seed of the noise and jitter generators (xoshiro256++): same seed, same run."""
-    delay: int
-    """measurement delay d: the controller sees the sample of step k − d (steps)."""
+    plant_delay: int
+    """the loop's delay alone, the controller not told of it: the controller sees the sample of
+    step k − d (simulate's delay= sets it and the controller's delay) (steps)."""
     jitter: float
     """sampling-time jitter j: the plant advances Ts (1 + u), u uniform on [−j, j), the
     controller assumes Ts."""
@@ -707,6 +712,7 @@ def suggest(
     critical: bool = False,
     damping: NDArray[np.float64] | None = None,
     orbit: NDArray[np.float64] | None = None,
+    delay: int = 0,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every

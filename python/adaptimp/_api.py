@@ -26,6 +26,7 @@ from ._params import (
     check_scenario,
     check_settle,
     describe,
+    loop_delay,
     names,
     resolve,
 )
@@ -247,6 +248,9 @@ def simulate(
         BY_NAME[k].group == "arm" for k in params if k in BY_NAME
     ):
         raise TypeError("give the arm's parameters to the arm, not to simulate(), with arm=")
+    params = dict(params)
+    # SPEC (18.11): the loop's delay is the plant's and the controller's alike.
+    params["delay"] = loop_delay(params)
     p = resolve(params, scenario=scenario, caller="simulate()", n=n)
     if "settle" in params:
         check_settle(p["settle"], p["T"], p["Ts"])

@@ -360,6 +360,25 @@ def _reject_unknown(
         )
 
 
+def loop_delay(params: dict[str, Any]) -> Any:
+    """``simulate``'s ``delay`` (SPEC (18.11), (17.1)): the loop's delay in
+    periods, the plant's and the delay a case name's controller is made for
+    alike; ``plant_delay`` alone delays the plant only (a controller not
+    told). Pops ``delay`` from ``params`` (in place), sets ``plant_delay`` to
+    it unless that is given, and returns the controller's delay: ``delay``,
+    or 0 without it (the library's own loop, whatever the scenario's
+    default for a controller alone). Validated where it is used."""
+    d = params.pop("delay", None)
+    if d is None:
+        return 0
+    if isinstance(d, bool) or not isinstance(d, (int, np.integer)):
+        raise TypeError(f"delay must be an integer number of periods, got {_type_name(d)}")
+    if not 0 <= int(d) <= 64:
+        raise ConfigError(f"condition 0 ≤ delay ≤ 64 is violated: delay = {int(d)}")
+    params.setdefault("plant_delay", int(d))
+    return int(d)
+
+
 def resolve(
     given: Mapping[str, object],
     *,

@@ -24,7 +24,7 @@ import numpy as np
 from . import _adaptimp
 from ._adaptimp import __version__
 from ._errors import needs_extra
-from ._params import BY_NAME, check_case, check_scenario, config_hint, resolve
+from ._params import BY_NAME, check_case, check_scenario, config_hint, loop_delay, resolve
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -205,6 +205,9 @@ def _prepare(
         return _Run(dict(varied), run_case, dict(given), None, key)
     try:
         check_case(run_case)
+        given = dict(given)
+        # SPEC (18.11): the loop's delay, the plant's and the controller's, as simulate().
+        given["delay"] = loop_delay(given)
         p = resolve(given, scenario=scenario, caller="sweep()")
         more = {"arm": None if arm is None else arm.params}
         key = _key(run_case, scenario, p, **more) if keyed else ""

@@ -624,6 +624,7 @@ class CartesianController:
         tau_max: ArrayLike | None = None,
         span: float | None = None,
         Ts: float = 1e-3,
+        delay: int = 0,
         **params: Any,
     ) -> CartesianController:
         """The Cartesian controller of a case name built by the core's rule
@@ -661,6 +662,9 @@ class CartesianController:
             (the default task's: hold + ramp + one period).
         Ts : float
             The period (s).
+        delay : int
+            The loop's delay (periods) the rule sizes the joint gains for,
+            SPEC (18.11) (libfranka: 1); the joint controller's ``delay``.
         **params
             Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
             and the joint controller's, e.g. ``gamma``).
@@ -698,7 +702,7 @@ class CartesianController:
         try:
             kw = tuning.suggest(
                 model, q0, limits, Ts=Ts, path=np.hstack([q, dq, ddq]), period=steps * Ts,
-                case=controller, resolve=True,
+                case=controller, resolve=True, delay=delay,
             )  # fmt: skip
         finally:
             forward = getattr(model, "forward", None)

@@ -63,6 +63,7 @@ from . import _adaptimp, _description, _mjcf, _models
 from ._cartesian_task import CartesianTask, chain_of, collision, self_collision, task_of
 from ._faults import Fault
 from ._mjcf import _full_inertia, _limits, _postures
+from ._params import loop_delay
 from ._plot import MUJOCO_FIGURES, MUJOCO_PLOT_KINDS
 from ._pose import call_shape, task_space
 from ._result import SimResult
@@ -1267,21 +1268,28 @@ def default_task(plant: Plant, home: ArrayLike | None = None) -> Task:
 
 
 def rule_keywords(
-    plant: Plant, task: Task | None = None, *, Ts: float = 1e-3, case: str = "sf"
+    plant: Plant,
+    task: Task | None = None,
+    *,
+    Ts: float = 1e-3,
+    case: str = "sf",
+    delay: int = 0,
 ) -> dict[str, Any]:
     """The rule's controller keywords for ``plant`` on ``task`` (default
-    :func:`default_task`) at period ``Ts`` (s), SPEC §18
-    (:func:`adaptimp.tuning.suggest` with D at the task's home, the plant's
-    τmax and the task's path), with ``impedance="external"`` (in free space
-    the controller tracks the reference as given). The plant's own model:
-    give it the nominal plant (no payload)."""
+    :func:`default_task`) at period ``Ts`` (s) for a loop of ``delay``
+    periods, SPEC §18 (:func:`adaptimp.tuning.suggest` with D at the task's
+    home, the plant's τmax and the task's path; (18.11) for the delay), with
+    ``impedance="external"`` (in free space the controller tracks the
+    reference as given). The plant's own model: give it the nominal plant (no
+    payload)."""
     from . import tuning
 
     task = default_task(plant) if task is None else task
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
     kw = tuning.suggest(
-        plant, task.home, plant.tau_max, Ts=Ts, path=task.reference, period=task.period, case=case
-    )
+        plant, task.home, plant.tau_max, Ts=Ts, path=task.reference, period=task.period,
+        case=case, delay=delay,
+    )  # fmt: skip
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(plant.model, plant.data)
     kw["impedance"] = "external"
@@ -1568,7 +1576,7 @@ DISTURBANCES = (
     "noise_dq",
     "noise_tau_e",
     "seed",
-    "delay",
+    "plant_delay",
     "jitter",
     "friction_viscous",
     "friction_coulomb",
@@ -1660,6 +1668,7 @@ def _rule_setup(
     Ts: float,
     T: float,
     home: ArrayLike | None = None,
+    delay: int = 0,
 ) -> tuple[Task | None, Any, dict[str, Any]]:
     """The task and the rule's keywords for a case name on ``plant`` (SPEC §18):
     the default task unless a reference or the controller's own trajectory
@@ -1671,7 +1680,7 @@ def _rule_setup(
         )
     if reference is None and not own:
         task = default_task(plant, home)
-        kw = rule_keywords(plant, task, Ts=Ts, case=case)
+        kw = rule_keywords(plant, task, Ts=Ts, case=case, delay=delay)
         kw.pop("n")
         return task, task.reference, kw
     from . import tuning
@@ -1689,7 +1698,9 @@ def _rule_setup(
         period = T
     home = np.asarray(path(0.0)[0], dtype=np.float64)
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
-    kw = tuning.suggest(plant, home, plant.tau_max, Ts=Ts, path=path, period=period, case=case)
+    kw = tuning.suggest(
+        plant, home, plant.tau_max, Ts=Ts, path=path, period=period, case=case, delay=delay
+    )
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(plant.model, plant.data)
     kw.pop("n")
@@ -1854,7 +1865,11 @@ def simulate(
         if not isinstance(model, Plant):
             model = Plant(model, contact=contact, tip=tip, fix=fix)
             tip, fix = None, ()
-        controller, params = task.prepare(controller, model, Ts, params, DISTURBANCES)
+        params = dict(params)
+        delay = loop_delay(params)
+        controller, params = task.prepare(
+            controller, model, Ts, {**params, "delay": delay}, DISTURBANCES
+        )
         q0 = task.q0 if q0 is None else q0
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
@@ -1874,7 +1889,25 @@ def simulate(
     if task is not None:
         task.measure(res)
     _check_run(run, res)
+    _check_delay(res)
     return res
+
+
+def _check_delay(res: MujocoResult) -> None:
+    """SPEC (18.11): a controller made for a shorter delay than the plant's
+    says so (a :class:`adaptimp.PlantWarning`, also in
+    ``res.params["warnings"]``): its velocity loop's gains are sized for a
+    loop that answers sooner than this one does, and may ring."""
+    made, plant = res.params.get("delay"), int(res.params.get("plant_delay", 0))
+    if made is None or made >= plant:
+        return
+    text = (
+        f"the controller was made for a loop delay of {made} period(s), the plant's is "
+        f"{plant}: its velocity loop may ring (SPEC (18.11)); build it with delay={plant}, "
+        f"or give simulate delay={plant} and a case name"
+    )
+    res.params.setdefault("warnings", []).append(text)
+    warnings.warn(text, PlantWarning, stacklevel=3)
 
 
 RUN_PEAK = 2.0
@@ -2255,6 +2288,7 @@ def _setup(
     plant = _payload_plant(nominal, payload)
     task: Task | None = None
     params = dict(params)
+    delay = loop_delay(params)
     disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
     if home is not None and not (isinstance(controller, str) and _uses_rule(nominal)):
         raise ValueError(
@@ -2265,12 +2299,13 @@ def _setup(
         if _uses_rule(nominal):
             task, reference, rule = _rule_setup(
                 nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
-                float(defaults["T"]) if T is None else float(T), home,
+                float(defaults["T"]) if T is None else float(T), home, delay,
             )  # fmt: skip
             kwargs = {**rule, **kwargs}
             if q0 is None and task is not None:
                 q0 = task.q0
         kwargs.setdefault("tau_max", plant.tau_max.tolist())
+        kwargs["delay"] = delay
         if Ts is not None:
             kwargs["Ts"] = Ts
         if plant.n != 2:
@@ -2335,6 +2370,17 @@ def _setup(
     )  # fmt: skip
 
 
+def _controller_delay(ctrl: Any) -> int | None:
+    """The loop's delay (periods) ``ctrl`` was made for, SPEC (18.11): an
+    ``adaptimp.Controller``'s ``delay``, a Cartesian controller's joint
+    controller's; None for a controller that does not say."""
+    for c in (ctrl, getattr(ctrl, "inner", None)):
+        params = getattr(c, "params", None)
+        if isinstance(params, Mapping) and isinstance(params.get("delay"), int):
+            return int(params["delay"])
+    return None
+
+
 def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
     plant, ctrl = run.plant, run.ctrl
     name = plant.model.names[: plant.model.names.find(b"\0")].decode()
@@ -2354,6 +2400,9 @@ def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
         "q0": run.q0.tolist(),
         **run.dist,
     }
+    # SPEC (18.11): the delay the controller was made for, beside the plant's
+    # (``plant_delay``); they differ only for a controller the caller made.
+    params["delay"] = _controller_delay(ctrl)
     if run.task is not None:
         params["task"] = {"home": run.task.home.tolist(), **run.task.keywords}
     case = getattr(ctrl, "case", None)

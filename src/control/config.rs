@@ -80,6 +80,10 @@ pub enum WeightBound {
     Auto,
 }
 
+/// The longest loop delay (periods) a controller is made for, and the
+/// longest measurement delay the simulator's delay line holds.
+pub const MAX_DELAY: usize = 64;
+
 /// Every parameter of a controller. Start from [`Config::paper`] (or
 /// [`Config::new`] for other sizes) and change fields;
 /// `Controller::new` validates. Gains are diagonal
@@ -92,6 +96,12 @@ pub struct Config<const N: usize> {
     pub law: Law,
     /// Sampling period Ts (s).
     pub ts: f64,
+    /// The loop's delay δ (periods): a step's torque starts to act δ periods
+    /// after the instant its measurement was taken (libfranka: 1), SPEC
+    /// (18.11). The step is given the setpoint of the measurement's instant;
+    /// the rule ([`Rule`](crate::control::tuning::Rule)) sizes the gains for
+    /// δ. Paper: 0; robot preset: 1. 0 ≤ δ ≤ [`MAX_DELAY`].
+    pub delay: usize,
     /// K1 (1/s), (7): α1 = ẋd + K1 z1. Paper: 6.
     pub k1: Vector<N>,
     /// Kp (N m s/rad), (14). Paper: 10.
@@ -173,6 +183,7 @@ impl<const N: usize> Config<N> {
         Self {
             law,
             ts: 0.0,
+            delay: 0,
             k1: z,
             kp: z,
             kzeta: z,

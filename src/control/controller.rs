@@ -15,7 +15,7 @@
 //! advance.
 
 use crate::control::auxiliary::Auxiliary;
-use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound};
+use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound, MAX_DELAY};
 use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
 use crate::control::io::{Command, Control, Measurement, TaskTorque};
 use crate::control::observer::{HighGainObserver, ObserverState};
@@ -303,6 +303,12 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         for (what, x) in scalars {
             check::at_most("|value| ≤ 1e9", what, x, PARAM_BOUND)?;
         }
+        check::at_most(
+            "0 ≤ delay ≤ 64",
+            "delay",
+            cfg.delay as f64,
+            MAX_DELAY as f64,
+        )?;
         check::at_most("Ts ≤ 1 s", "Ts", cfg.ts, 1.0)
     }
 

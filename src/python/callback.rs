@@ -521,6 +521,12 @@ impl<const N: usize, const M: usize> Rows<'_, N, M> {
         let z1 = match rep.z1 {
             // A refused row: the error of the last reference (the core's rule).
             Some(_) if r.refused && w == N => core::array::from_fn(|i| xd[i] - q[i]),
+            // SPEC (17.1): with noise or delay, the loop's row carries (the
+            // step's z1, zero here, plus) the sample's error y_q − q_true: the
+            // controller's z1 becomes the error of the plant's true q.
+            Some(z) if w == N && r.z1.iter().any(|e| *e != 0.0) => {
+                core::array::from_fn(|i| if i < N { z[i] + r.z1[i] } else { z[i] })
+            }
             Some(z) => z,
             None => core::array::from_fn(|i| xd[i] - q[i]),
         };

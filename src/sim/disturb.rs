@@ -38,8 +38,9 @@ use rand_xoshiro::rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 /// The longest measurement delay, in controller steps (the delay line is a
-/// fixed array of `MAX_DELAY + 1` samples: no allocation).
-pub const MAX_DELAY: usize = 64;
+/// fixed array of `MAX_DELAY + 1` samples: no allocation); the same bound as
+/// a controller's own delay.
+pub use crate::control::config::MAX_DELAY;
 
 /// What the sensors deliver at one sample: joint position q (rad), joint
 /// velocity q̇ (rad/s) and the contact force τe (N m).
@@ -386,6 +387,7 @@ impl<const N: usize> Disturbances<N> {
             jitter,
             line: [(zero, zero, zero); MAX_DELAY + 1],
             wrenches: [[0.0; 6]; MAX_DELAY + 1],
+            truths: [zero; MAX_DELAY + 1],
             k: 0,
         }
     }
@@ -412,9 +414,32 @@ impl<const N: usize> Disturbances<N> {
         sample: Sample<N>,
         wrench: [f64; 6],
     ) -> (Sample<N>, [f64; 6]) {
+        let seen = self.sense(state, sample, wrench);
+        (seen.sample, seen.wrench)
+    }
+
+    /// [`measure_with_wrench`](Self::measure_with_wrench) with what the loop
+    /// needs besides: the step the sample was taken at (k − d, 0 while k < d)
+    /// and the true joint position q of that step, before the noise. The
+    /// loop gives the controller the setpoint of that step's instant and
+    /// measures its tracking error against that true q (SPEC §17).
+    pub fn sense(
+        &self,
+        state: &mut DisturbanceState<N>,
+        sample: Sample<N>,
+        wrench: [f64; 6],
+    ) -> Seen<N> {
+        let k = state.k;
+        state.k = k + 1;
         if !self.noisy && self.params.delay == 0 {
-            return (sample, wrench);
+            return Seen {
+                sample,
+                wrench,
+                step: k,
+                truth: sample.0,
+            };
         }
+        let truth = sample.0;
         let (mut q, mut dq, mut tau_e) = sample;
         if self.noisy {
             let p = &self.params;
@@ -430,12 +455,17 @@ impl<const N: usize> Disturbances<N> {
             }
         }
         let slots = (MAX_DELAY + 1) as u64;
-        let k = state.k;
         state.line[(k % slots) as usize] = (q, dq, tau_e);
         state.wrenches[(k % slots) as usize] = wrench;
-        let then = (k.saturating_sub(self.params.delay as u64) % slots) as usize;
-        state.k = k + 1;
-        (state.line[then], state.wrenches[then])
+        state.truths[(k % slots) as usize] = truth;
+        let step = k.saturating_sub(self.params.delay as u64);
+        let then = (step % slots) as usize;
+        Seen {
+            sample: state.line[then],
+            wrench: state.wrenches[then],
+            step,
+            truth: state.truths[then],
+        }
     }
 
     /// The true interval (s) between this sample and the next, for the
@@ -461,8 +491,21 @@ impl<const N: usize> Disturbances<N> {
     }
 }
 
+/// What the controller is given at one step ([`Disturbances::sense`]).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Seen<const N: usize> {
+    /// The sample as the sensors deliver it: noisy, of step `step`.
+    pub sample: Sample<N>,
+    /// The end effector's wrench of the same step (N, N m).
+    pub wrench: [f64; 6],
+    /// The step the sample was taken at: k − d (0 while k < d).
+    pub step: u64,
+    /// The true joint position q (rad) at that step, without the noise.
+    pub truth: Vector<N>,
+}
+
 /// What a run with [`Disturbances`] changes: the noise and jitter generators
-/// and the delay line (a fixed array; `(MAX_DELAY + 1)·(3N + 6)` reals).
+/// and the delay line (a fixed array; `(MAX_DELAY + 1)·(4N + 6)` reals).
 #[derive(Clone, Debug)]
 pub struct DisturbanceState<const N: usize> {
     noise: Xoshiro256PlusPlus,
@@ -470,6 +513,9 @@ pub struct DisturbanceState<const N: usize> {
     line: [Sample<N>; MAX_DELAY + 1],
     /// The wrenches of the same samples ([`Disturbances::measure_with_wrench`]).
     wrenches: [[f64; 6]; MAX_DELAY + 1],
+    /// The true joint positions of the same samples, before the noise
+    /// ([`Disturbances::sense`]).
+    truths: [Vector<N>; MAX_DELAY + 1],
     /// Samples taken.
     k: u64,
 }

@@ -96,7 +96,8 @@ where
 /// 1. the sensors sample the plant; noise is added and the controller sees
 ///    the noisy sample of step k − d ([`Disturbances::measure`]), then the
 ///    injected fault, if any, acts on what it sees;
-/// 2. the controller steps with the trajectory at t_k (it assumes Ts);
+/// 2. the controller steps with the trajectory at the instant its sample
+///    was taken, t_{k−d} (SPEC (17.1); it assumes Ts);
 /// 3. the actuators deliver the applied torque (the injected fault, then the
 ///    fraction ρ: [`Disturbances::actuate`], then the plant's own limits:
 ///    [`Plant::actuate`]), recorded as `tau_sat`;
@@ -107,8 +108,10 @@ where
 /// ([`Control::step_with_wrench`]) through the same sensor path: delayed
 /// with the joint sample, frozen with it by a stale-sensor fault, without
 /// noise ([`Disturbances::measure_with_wrench`],
-/// [`Injection::measure_wrench`]). Rows carry t_k, the controller's time,
-/// and the plant's true state, end-effector position and wrench. With
+/// [`Injection::measure_wrench`]). Rows carry t_k, the plant's true state,
+/// end-effector position and wrench at t_k, the trajectory at t_k, and z1:
+/// the controller's reference less the plant's true q at the sample's
+/// instant (with noise or delay, not the noisy sample it saw). With
 /// [`Disturbances::none`] it is [`simulate_with`], bit for bit. The
 /// generators start from the seed at every call: the same arguments give the
 /// same rows. Allocation-free itself.
@@ -142,10 +145,17 @@ where
         let (x, dx) = plant.state();
         let tau_e = plant.contact();
         let (wrench, x_ee) = (plant.wrench(), plant.end_effector());
-        let seen = disturbances.measure_with_wrench(&mut noise, (x, dx, tau_e), wrench);
-        carried.sense(t, seen, injection);
+        let seen = disturbances.sense(&mut noise, (x, dx, tau_e), wrench);
+        carried.sense(t, (seen.sample, seen.wrench), injection);
         let c = traj.sample(t);
-        let refused = carried.control(ctrl, t, &c, injection)?;
+        // SPEC (17.1): the setpoint of the instant the sample was taken, as a
+        // robot's loop samples its trajectory at the measurement's time stamp.
+        let c_seen = if seen.step == k {
+            c
+        } else {
+            traj.sample(seen.step as f64 * ts)
+        };
+        let refused = carried.control(ctrl, t, &c_seen, injection)?;
         let delivered = injection.map_or(carried.applied, |i| i.actuate(t, &carried.applied));
         let delivered = plant.actuate(&disturbances.actuate(&delivered));
         let h = disturbances.interval(&mut noise, ts);
@@ -166,7 +176,15 @@ where
             dtau: if refused { Vector::zeros() } else { last.dtau },
             tau_e,
             zeta: last.zeta,
-            z1: if refused { last.xd - x } else { last.z1 },
+            // SPEC (17.1): the tracking error of the plant's true q at the
+            // sample's instant, not of the noisy sample the controller saw.
+            z1: if refused {
+                last.xd - seen.truth
+            } else if seen.step == k && seen.sample.0 == seen.truth {
+                last.z1
+            } else {
+                last.z1 + (carried.sensed.0 - seen.truth)
+            },
             w_norms: last.w_norms,
             x_ee,
             wrench,

@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
 from ._errors import ConfigError
+from ._params import loop_delay
 
 FloatArray = NDArray[np.float64]
 Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]
@@ -47,6 +48,7 @@ inertia scales (SPEC (18.1): their mean along the path, bounded)."""
 
 RULE_KEYS = (
     "Ts",
+    "delay",
     "Kp",
     "K1",
     "Kzeta",
@@ -152,6 +154,7 @@ def suggest(
     critical: bool = False,
     damping: ArrayLike | None = None,
     orbit: ArrayLike | None = None,
+    delay: int = 0,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
     the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
@@ -193,6 +196,12 @@ def suggest(
         The joint positions (rad) of one period of the motion that repeats
         (the table's circle, after the approach): the centres' widths in q at
         least its diameter, SPEC (19.11) (the table scenario's). With a path only.
+    delay : int
+        The loop's delay δ (periods, 0 ≤ δ ≤ 64): the torque of a sample acts
+        δ periods after it was taken (libfranka: 1). The margin m of Kp = m
+        d/Ts keeps the sampled velocity loop's largest mode along the path at
+        the pole radius of SPEC (18.11) (δ = 0: m = 0.25 as it is); the
+        controller's ``delay`` keyword.
 
     Returns
     -------
@@ -235,7 +244,7 @@ def suggest(
             raise ConfigError(f"orbit must have shape (K, {n}), got {orbit.shape}")
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
-        critical=critical, damping=b_arr, orbit=orbit,
+        critical=critical, damping=b_arr, orbit=orbit, delay=loop_delay({'delay': delay}),
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

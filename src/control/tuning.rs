@@ -8,7 +8,7 @@
 //!
 //! ```text
 //! Kp_i = m d_i / Ts,   m = 0.25                          (18.1)
-//! K1   = min(50 s⁻¹, 0.05 / Ts)                          (18.2)
+//! K1   = min(50 s⁻¹, 0.2 m / Ts)                        (18.2)
 //! Kζ_i = Kp_i/d_i + ρ/2,  ρ = 1 s⁻¹  (conditions "scaled") (18.3)
 //! kr_i = φ Kp_i / 2,  Kd_i (fallback) = Kp_i             (18.4)
 //! ```
@@ -28,7 +28,7 @@
 //! [`default_task`] is the joint-space motion `adaptimp.mujoco.simulate` runs
 //! when given only a model.
 
-use crate::control::config::{Conditions, Config, Law, WeightBound};
+use crate::control::config::{Conditions, Config, Law, WeightBound, MAX_DELAY};
 use crate::control::controller::MIN_SCALE;
 use crate::error::{check, Error, PARAM_BOUND};
 use crate::math::sqrt;
@@ -41,6 +41,82 @@ use crate::types::{Matrix, Vector};
 /// The damping ratio ζ of the learning loop's pair in [`Rule::critical`]
 /// (1.1: just overdamped), SPEC (19.6).
 pub const LEARN_DAMPING: f64 = 1.1;
+
+/// The robust term's slope kr/φ as a share of Kp, (18.4): kr = s φ Kp.
+pub const ROBUST_SHARE: f64 = 0.5;
+
+/// The pole radius r_δ the sampled velocity loop of a loop of `delay`
+/// periods keeps in its largest mode, SPEC (18.11): 1 − m = 0.75, the
+/// undelayed rule's pole (18.1), or, where a δ-periods-late loop cannot
+/// reach it (its fastest pole is δ/(δ+1): δ ≥ 3), halfway from there to
+/// the unit circle, (2δ + 1)/(2δ + 2).
+pub fn pole_radius(delay: usize) -> f64 {
+    let d = delay as f64;
+    (1.0 - Rule::default().margin).max((2.0 * d + 1.0) / (2.0 * d + 2.0))
+}
+
+/// The largest per-period gain g of the sampled velocity loop of a loop of
+/// `delay` periods whose poles stay within [`pole_radius`], SPEC (18.11):
+/// the roots of z^(δ+1) − z^δ + g = 0 (one joint, unit inertia scale: the
+/// torque −g d/Ts · v of sample k acts over period k + δ) lie in |z| ≤ r
+/// for g ∈ [r^δ (1 − r), g_δ]. δ = 0: g = 1 + r (the real root at −r);
+/// δ ≥ 1: a complex pair reaches |z| = r at z = r e^(iθ) with
+/// δθ + arg(r e^(iθ) − 1) = π, θ ∈ (0, π), and g = r^δ |r e^(iθ) − 1|
+/// (θ by bisection to machine precision). δ = 1: r², 0.5625.
+pub fn loop_gain(delay: usize) -> f64 {
+    let r = pole_radius(delay);
+    if delay == 0 {
+        return 1.0 + r;
+    }
+    let d = delay as f64;
+    let f = |th: f64| {
+        let (s, c) = (libm::sin(th), libm::cos(th));
+        d * th + libm::atan2(r * s, r * c - 1.0) - core::f64::consts::PI
+    };
+    // f < 0 just above 0 (r/(1 − r) > δ by pole_radius), f(π) = δπ > 0.
+    let (mut lo, mut hi) = (1e-12, core::f64::consts::PI);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= f64::EPSILON * hi {
+            break;
+        }
+    }
+    let th = 0.5 * (lo + hi);
+    let (s, c) = (libm::sin(th), libm::cos(th));
+    libm::pow(r, d) * libm::hypot(r * c - 1.0, r * s)
+}
+
+/// The largest mode of the sampled velocity loop along a path, SPEC
+/// (18.11): max over the samples `ds` (D(q_k), kg m²) of λmax(Dₛ^½ D(q_k)⁻¹
+/// Dₛ^½) for the scales `scales` (Dₛ = diag(d), kg m²; ≤ N for the scales
+/// of [`inertia_scales_along`]), bounded from above within 1 %. Errors if
+/// `ds` is empty or a sample is not symmetric positive definite.
+pub fn loop_bound<const N: usize>(ds: &[Matrix<N>], scales: &Vector<N>) -> Result<f64, Error> {
+    if ds.is_empty() {
+        return Err(Error::Invalid {
+            what: "inertia samples",
+            reason: "needs one posture or more",
+        });
+    }
+    check::positive_vec("inertia scale > 0", "inertia scale", scales)?;
+    let root = scales.map(sqrt);
+    let mut largest = 0.0f64;
+    for d in ds {
+        inertia_scales(d)?;
+        let inv = d.cholesky().map(|c| c.inverse()).ok_or(Error::Invalid {
+            what: "inertia matrix",
+            reason: "must be positive definite",
+        })?;
+        let m = Matrix::<N>::from_fn(|i, j| root[i] * inv[(i, j)] * root[j]);
+        largest = largest.max(largest_eigenvalue(&m));
+    }
+    Ok(largest)
+}
 
 /// The smallest and largest number of centres [`Rule::nodes`] gives.
 pub const NODES: (usize, usize) = (16, 256);
@@ -56,8 +132,9 @@ pub struct Rule {
     pub margin: f64,
     /// The largest K1 (1/s) (50).
     pub k1_max: f64,
-    /// K1 ≤ this/Ts: the position loop inside the velocity loop (0.05).
-    pub k1_per_step: f64,
+    /// K1 ≤ this · m/Ts: the position loop 5× inside the velocity loop's
+    /// rate a = m/Ts (0.2; K1 ≤ 0.05/Ts at the rule's m = 0.25).
+    pub k1_share: f64,
     /// ω_G² = this · (m/Ts) · K1: the Ĝ loop's slow pole near K1/3 (0.5).
     pub learn: f64,
     /// ω_D = ω_C = this · ω_G: D̂ and Ĉ learn slower than Ĝ (0.2).
@@ -72,6 +149,9 @@ pub struct Rule {
     /// their spacing: the diameter of the orbit that repeats, SPEC (19.11)
     /// ([`spanning`](Self::spanning); 0, none, by default).
     pub span: f64,
+    /// The loop's delay δ (periods) the gains are made for, SPEC (18.11)
+    /// (0 by default: the torque acts over the period its sample opens).
+    pub delay: usize,
 }
 
 impl Default for Rule {
@@ -79,13 +159,14 @@ impl Default for Rule {
         Self {
             margin: 0.25,
             k1_max: 50.0,
-            k1_per_step: 0.05,
+            k1_share: 0.2,
             learn: 0.5,
             learn_dc: 0.2,
             leak_periods: 25.0,
             tube: [0.2, 0.5],
             bound_margin: 2.0,
             span: 0.0,
+            delay: 0,
         }
     }
 }
@@ -243,9 +324,59 @@ impl Rule {
         rule
     }
 
-    /// K1 (1/s) at period `ts` (s), (18.2).
+    /// The rule for a loop of `delay` periods, SPEC (18.11): the margin of
+    /// (18.1) is then taken at the path's largest mode
+    /// ([`bounded`](Self::bounded)), and D̂ and Ĉ learn at ω_G/(5(δ + 1))
+    /// ((18.6)'s ω_G/5 for δ = 0, bit for bit). Errors unless 0 ≤ δ ≤
+    /// [`MAX_DELAY`].
+    pub fn with_delay(self, delay: usize) -> Result<Self, Error> {
+        check::at_most("0 ≤ delay ≤ 64", "delay", delay as f64, MAX_DELAY as f64)?;
+        // (18.11): D̂ and Ĉ, whose regressors α̇1 and α1 carry the measured
+        // velocity, learn δ + 1 times further inside Ĝ's bandwidth.
+        Ok(Self {
+            delay,
+            learn_dc: self.learn_dc / (delay as f64 + 1.0),
+            ..self
+        })
+    }
+
+    /// The rule whose margin m keeps the sampled velocity loop of a loop of
+    /// [`delay`](Self::delay) periods at the pole radius r_δ in its largest
+    /// mode `lmax` (λmax of Dₛ^½ D⁻¹ Dₛ^½ along the path, [`loop_bound`]),
+    /// SPEC (18.11):
+    ///
+    /// ```text
+    /// m_δ = min(m, g_δ / λmax)     (δ ≥ 1: the robust term off, (18.4))
+    /// ```
+    ///
+    /// with g_δ = [`loop_gain`]`(δ)`; K1 (18.2) and the learning (18.6)
+    /// follow m_δ. δ = 0 keeps m (18.1) as it is, bit for bit. A `lmax`
+    /// that is not finite and > 0 leaves the rule as it is.
+    #[must_use]
+    pub fn bounded(&self, lmax: f64) -> Self {
+        let mut rule = *self;
+        if self.delay > 0 && lmax.is_finite() && lmax > 0.0 {
+            let m = loop_gain(self.delay) / ((1.0 + self.robust_share()) * lmax);
+            rule.margin = rule.margin.min(m);
+        }
+        rule
+    }
+
+    /// The robust term's slope kr/φ as a share of Kp, (18.4), (18.11):
+    /// [`ROBUST_SHARE`] without delay, 0 with one (a delayed loop's gain is
+    /// spent on Kp, not on the robust term's slope at z2 = 0).
+    pub fn robust_share(&self) -> f64 {
+        if self.delay == 0 {
+            ROBUST_SHARE
+        } else {
+            0.0
+        }
+    }
+
+    /// K1 (1/s) at period `ts` (s), (18.2): min(k1_max, k1_share · m/Ts),
+    /// with the rule's margin m (the delay's, SPEC (18.11)).
     pub fn k1(&self, ts: f64) -> f64 {
-        self.k1_max.min(self.k1_per_step / ts)
+        self.k1_max.min(self.k1_share * self.margin / ts)
     }
 
     /// The rule with Ĝ learning near the velocity loop's critical bandwidth,
@@ -327,7 +458,8 @@ impl Rule {
         cfg.kp = scales * rate;
         cfg.k1 = Vector::from_element(self.k1(ts));
         cfg.kzeta = Vector::from_element(rate + 0.5 * cfg.rho);
-        cfg.kr = cfg.kp * (0.5 * cfg.phi);
+        cfg.kr = cfg.kp * (self.robust_share() * cfg.phi);
+        cfg.delay = self.delay;
         cfg.fallback_damping = cfg.kp;
         Ok(cfg)
     }
@@ -773,6 +905,96 @@ mod tests {
         assert!((oa - ob).abs() < 1e-9 * oa, "{oa} {ob}");
         assert!(b.config.gamma[2] < a.config.gamma[2]);
         Controller::new(b.config, b.centers).unwrap();
+    }
+
+    /// The largest root modulus of z^(δ+1) − z^δ + g (companion matrix).
+    fn radius(delay: usize, g: f64) -> f64 {
+        let n = delay + 1;
+        let mut c = nalgebra::DMatrix::<f64>::zeros(n, n);
+        // z^n = z^(n−1) − g: the first row holds the coefficients.
+        c[(0, 0)] = 1.0;
+        c[(0, n - 1)] -= g;
+        for i in 1..n {
+            c[(i, i - 1)] = 1.0;
+        }
+        c.complex_eigenvalues()
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn the_loop_gain_puts_the_delayed_loops_poles_on_the_pole_radius() {
+        assert_eq!(pole_radius(0), 0.75);
+        assert_eq!(pole_radius(1), 0.75);
+        assert!((pole_radius(2) - 5.0 / 6.0).abs() < 1e-15);
+        assert_eq!(loop_gain(0), 1.75);
+        // δ = 1: the pair √g reaches r at g = r².
+        assert!((loop_gain(1) - 0.5625).abs() < 1e-12, "{}", loop_gain(1));
+        for delay in 1..=6 {
+            let (g, r) = (loop_gain(delay), pole_radius(delay));
+            assert!((radius(delay, g) - r).abs() < 1e-9, "δ = {delay}");
+            // Just above g_δ a pole leaves the radius; below, the poles stay in.
+            assert!(radius(delay, 1.001 * g) > r, "δ = {delay}");
+            assert!(radius(delay, 0.999 * g) <= r + 1e-12, "δ = {delay}");
+            // Inside the stability limit 2 sin(π/(4δ + 2)).
+            let limit = 2.0 * libm::sin(core::f64::consts::PI / (4.0 * delay as f64 + 2.0));
+            assert!(
+                g < limit && radius(delay, limit) > 1.0 - 1e-9,
+                "δ = {delay}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_delayed_rule_slows_the_loop_at_the_paths_largest_mode() {
+        let (d, tau) = (arm_matrix(), Vector::<3>::new(50.0, 20.0, 5.0));
+        let rule = Rule::default();
+        // δ = 0: the rule as it is, whatever the mode.
+        assert_eq!(rule.bounded(6.0), rule);
+        assert_eq!(rule.with_delay(0).unwrap().bounded(6.0), rule);
+        let e = rule.with_delay(65).unwrap_err().to_string();
+        assert!(e.contains("0 ≤ delay ≤ 64"), "{e}");
+        // δ = 1 at λmax = 4: m = 0.5625/4, K1 = 0.2 m/Ts, no robust term.
+        let late = rule.with_delay(1).unwrap().bounded(4.0);
+        assert!((late.margin - 0.5625 / 4.0).abs() < 1e-15);
+        assert!((late.k1(1e-3) - 0.2 * late.margin / 1e-3).abs() < 1e-9);
+        let cfg = late.gains(Law::StateFeedback, &d, &tau, 1e-3).unwrap();
+        assert_eq!(cfg.delay, 1);
+        assert_eq!(cfg.kr, Vector::<3>::zeros());
+        let undelayed = rule.gains(Law::StateFeedback, &d, &tau, 1e-3).unwrap();
+        for i in 0..3 {
+            let ratio = cfg.kp[i] / undelayed.kp[i];
+            assert!((ratio - late.margin / 0.25).abs() < 1e-12, "{ratio}");
+        }
+        let s = late
+            .suggest(
+                Law::StateFeedback,
+                &d,
+                &tau,
+                1e-3,
+                &default_path(),
+                2.0,
+                None,
+            )
+            .unwrap();
+        assert_eq!((s.config.delay, s.config.kr), (1, Vector::<3>::zeros()));
+        Controller::new(s.config, s.centers).unwrap();
+        // A small mode keeps m: the delayed loop is well inside r_δ already.
+        assert_eq!(rule.with_delay(1).unwrap().bounded(1.0).margin, 0.25);
+        // The bound of the loop along a path: λmax of Dₛ^½ D⁻¹ Dₛ^½.
+        let s = inertia_scales(&d).unwrap();
+        let lb = loop_bound(&[d], &s).unwrap();
+        let exact = (Matrix::<3>::from_diagonal(&s.map(sqrt))
+            * d.try_inverse().unwrap()
+            * Matrix::<3>::from_diagonal(&s.map(sqrt)))
+        .symmetric_eigenvalues()
+        .max();
+        assert!(
+            exact * (1.0 - 1e-12) <= lb && lb <= 1.01 * exact,
+            "{lb} {exact}"
+        );
+        assert!(loop_bound::<3>(&[], &s).is_err());
     }
 
     #[test]

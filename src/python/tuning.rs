@@ -6,7 +6,7 @@ use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
 use crate::cartesian::rule::{resolving, PoseCircle, PostureRule};
 use crate::control::tuning::{
-    damped_scales, default_task as core_default_task, inertia_scales_along, Rule,
+    damped_scales, default_task as core_default_task, inertia_scales_along, loop_bound, Rule,
 };
 use crate::error::Error;
 use crate::schema::{Group, Preset, Scenario, PARAMS};
@@ -39,7 +39,7 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// one period of the motion that repeats (the table's circle): the widths in
 /// q at least its diameter, SPEC (19.11) (the table scenario's).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -54,6 +54,7 @@ pub fn suggest<'py>(
     critical: bool,
     damping: Option<PyReadonlyArray1<'py, f64>>,
     orbit: Option<PyReadonlyArray2<'py, f64>>,
+    delay: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -127,7 +128,7 @@ pub fn suggest<'py>(
             gravity.as_deref(),
             damping.as_deref(),
             orbit.as_deref(),
-            (resolve, critical),
+            (resolve, critical, delay),
         ),
         _ => unreachable!("n checked above"),
     )?;
@@ -146,10 +147,10 @@ fn fill<'py, const N: usize>(
     gravity: Option<&[f64]>,
     damping: Option<&[f64]>,
     orbit: Option<&[f64]>,
-    (resolve, critical): (bool, bool),
+    (resolve, critical, delay): (bool, bool, usize),
 ) -> PyResult<()> {
     let err = |e: Error| config_error(e.into());
-    let mut rule = Rule::default();
+    let mut rule = Rule::default().with_delay(delay).map_err(err)?;
     if critical {
         crate::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
         rule = rule.critical(ts);
@@ -165,6 +166,9 @@ fn fill<'py, const N: usize>(
         crate::control::tuning::inertia_scales(&ds[0])
     }
     .map_err(err)?;
+    // SPEC (18.11): the margin at the largest mode of the undamped scales.
+    // SPEC (18.11): the margin at the largest mode of the undamped scales.
+    rule = rule.bounded(loop_bound(&ds, &scales).map_err(err)?);
     let scales = match damping {
         None => scales,
         Some(b) => damped_scales(&scales, &Vector::<N>::from_column_slice(b), ts).map_err(err)?,

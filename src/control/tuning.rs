@@ -326,18 +326,10 @@ impl Rule {
 
     /// The rule for a loop of `delay` periods, SPEC (18.11): the margin of
     /// (18.1) is then taken at the path's largest mode
-    /// ([`bounded`](Self::bounded)), and D̂ and Ĉ learn at ω_G/(5(δ + 1))
-    /// ((18.6)'s ω_G/5 for δ = 0, bit for bit). Errors unless 0 ≤ δ ≤
-    /// [`MAX_DELAY`].
+    /// ([`bounded`](Self::bounded)). Errors unless 0 ≤ δ ≤ [`MAX_DELAY`].
     pub fn with_delay(self, delay: usize) -> Result<Self, Error> {
         check::at_most("0 ≤ delay ≤ 64", "delay", delay as f64, MAX_DELAY as f64)?;
-        // (18.11): D̂ and Ĉ, whose regressors α̇1 and α1 carry the measured
-        // velocity, learn δ + 1 times further inside Ĝ's bandwidth.
-        Ok(Self {
-            delay,
-            learn_dc: self.learn_dc / (delay as f64 + 1.0),
-            ..self
-        })
+        Ok(Self { delay, ..self })
     }
 
     /// The rule whose margin m keeps the sampled velocity loop of a loop of

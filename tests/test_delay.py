@@ -151,3 +151,15 @@ def test_suggest_refuses_a_delay_by_name() -> None:
     assert tuning.suggest(d, [0.0, 0.0], [10.0, 10.0], delay=1)["delay"] == 1
     with pytest.raises(ConfigError, match="0 ≤ delay ≤ 64"):
         tuning.suggest(d, [0.0, 0.0], [10.0, 10.0], delay=-1)
+
+
+def test_an_arm_that_does_not_follow_its_task_is_said_to() -> None:
+    """A joint run whose error exceeds half the reference's own motion warns by
+    name (the check of SPEC (18.11)); a run that tracks does not."""
+    arm = adaptimp._models.panda_urdf_path()
+    good = amj.simulate("pd", arm, T=3.0)
+    assert not any("did not follow" in w for w in good.params["warnings"])
+    kp = np.asarray(amj.rule_keywords(amj.Plant(arm))["Kp"])
+    with pytest.warns(adaptimp.PlantWarning, match="the arm did not follow its task"):
+        weak = amj.simulate("pd", arm, T=3.0, Kp=list(1e-3 * kp), Kzeta=260.0)
+    assert any("did not follow" in w for w in weak.params["warnings"])

@@ -1890,7 +1890,39 @@ def simulate(
         task.measure(res)
     _check_run(run, res)
     _check_delay(res)
+    _check_tracking(run, res)
     return res
+
+
+RUN_TRACKING = 0.5
+"""A joint-space run whose RMS tracking error over t ≥ settle exceeds this share
+of the reference's own RMS motion there says so (:func:`simulate`'s check)."""
+
+
+def _check_tracking(run: _Run, res: MujocoResult) -> None:
+    """A joint-space run on an arm whose arm did not follow its task says so
+    (a :class:`adaptimp.PlantWarning`, also in ``res.params["warnings"]``):
+    the RMS ‖z1‖ over t ≥ settle beyond :data:`RUN_TRACKING` of the RMS of the
+    reference's motion about its mean over the same rows (an arm that sags
+    or rings through its task, whatever the reason: gains too low for its
+    load, a delay that leaves little bandwidth, SPEC (18.11))."""
+    if not _uses_rule(run.plant) or task_space(run.ctrl) or res.rows == 0:
+        return
+    rows = res.t >= run.settle - 1e-12
+    if not np.any(rows) or res.xc.shape != res.q.shape:
+        return
+    xc = res.xc[rows]
+    motion = float(np.sqrt(np.mean(np.sum((xc - xc.mean(axis=0)) ** 2, axis=1))))
+    error = float(res.metrics.get("rms_z1_after2", math.nan))
+    if not (motion > 0 and error > RUN_TRACKING * motion):
+        return
+    text = (
+        f"the arm did not follow its task: RMS tracking error {error:.3g} rad over "
+        f"t ≥ {run.settle:g} s, more than {RUN_TRACKING:g} of the reference's own RMS motion "
+        f"{motion:.3g} rad (gains too low for the load or the loop's delay, SPEC (18.11))"
+    )
+    res.params.setdefault("warnings", []).append(text)
+    warnings.warn(text, PlantWarning, stacklevel=3)
 
 
 def _check_delay(res: MujocoResult) -> None:

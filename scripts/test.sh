@@ -81,9 +81,15 @@ bash scripts/wheel.sh
 wheel=$(ls dist/adaptimp-*-cp39-abi3-*.whl)
 # The sdist holds what a build needs: its crate, unpacked outside this workspace,
 # resolves and compiles (check) offline.
+# Its own target dir, and the files' times made new: cargo names a path crate's
+# artifacts without its path and judges them fresh by the files' times, so the
+# tarball's old times beside the workspace's newer build of the same crates
+# would check that build, not the sdist's files.
 sdist_dir=$(mktemp -d)
 tar xzf dist/adaptimp-*.tar.gz -C "$sdist_dir"
-(cd "$sdist_dir"/adaptimp-* && cargo check --quiet --offline --features python)
+find "$sdist_dir" -type f -exec touch {} +
+(cd "$sdist_dir"/adaptimp-* &&
+    CARGO_TARGET_DIR="$CARGO_TARGET_DIR/sdist-check" cargo check --quiet --offline --features python)
 rm -rf "$sdist_dir"
 
 step "Python: the test environment (the wheel with its test extra)"

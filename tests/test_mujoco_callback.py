@@ -393,12 +393,12 @@ def test_disturbances_act_on_a_controller_called_back() -> None:
         "T": 1.0, "noise_q": 1e-3, "noise_dq": 1e-2, "seed": 4, "delay": 2,
         "friction_viscous": 0.5, "friction_coulomb": 0.2, "actuator_fraction": 0.8,
     }  # fmt: skip
-    native = amj.simulate(adaptimp.Controller("sf", "robot"), "two_link", **kw)
+    native = amj.simulate(adaptimp.Controller("sf", "robot", delay=2), "two_link", **kw)
     # SPEC (17.1): the loop gives the setpoint of the delayed sample's instant; a
     # controller called back with its own clock would sample t_k instead, so the
     # run hands it the same trajectory as a reference (the native run's rows).
     called = amj.simulate(
-        InPython(adaptimp.Controller("sf", "robot")), "two_link", reference=native, **kw
+        InPython(adaptimp.Controller("sf", "robot", delay=2)), "two_link", reference=native, **kw
     )
     assert (native.params["loop"], called.params["loop"]) == ("native", "callback")
     _same(called, native)

@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from adaptimp import Measurement, baselines
+from adaptimp import Measurement, PlantWarning, baselines
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque
 
@@ -191,7 +191,11 @@ def test_the_exact_model_is_ideal_on_a_light_wrist_with_friction(
         if name == "before":
             monkeypatch.setattr(baselines, "plant_drive", lambda *args, **kw: None)
         ct = ComputedTorque(light, Ts=TS, tau_max=tau_max, payload=kg)
-        res = amj.simulate(ct, plant, T=4.0, reference=sf, q0=sf.q[0], payload=kg)
+        if name == "before":  # the wrist spins away, which the run says
+            with pytest.warns(PlantWarning, match="did not follow its task"):
+                res = amj.simulate(ct, plant, T=4.0, reference=sf, q0=sf.q[0], payload=kg)
+        else:
+            res = amj.simulate(ct, plant, T=4.0, reference=sf, q0=sf.q[0], payload=kg)
         rms[name] = res.metrics["rms_z1_after2"]
     assert rms["exact"] < 0.05 * sf.metrics["rms_z1_after2"], (rms, sf.metrics)
     assert rms["before"] > 0.1, rms

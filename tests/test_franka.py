@@ -57,6 +57,13 @@ def test_the_controller_is_the_rule_a_simulate_user_gets() -> None:
     assert s.controller.params == same.params
     assert s.controller.params["tau_rate_max"] == [1.0] * 7
     np.testing.assert_array_equal(s.task.home, READY)
+    with pytest.raises(
+        adaptimp.ConfigError,
+        match=r"^the arm stands at q = \[0\.0, 0\.0, 0\.0, -1\.57, 0\.0, 1\.57, 0\.785\] rad, "
+        r"where q0 cannot run the task: condition velocity-loop conditioning .* move it first "
+        r"\(run\(\.\.\., start=franka\.READY\), or franka\.move_to\)$",
+    ):
+        franka.setup("sf", plant, [0.0, 0.0, 0.0, -1.57, 0.0, 1.57, 0.785], task="cartesian")
     c = franka.setup("sf", plant, READY, task="cartesian")
     ctask = amj.cartesian_task(plant, q0=READY)
     assert c.controller.params == ctask.controller("sf", plant, **limits).params

@@ -293,7 +293,13 @@ def setup(
     if task == "cartesian":
         if home is not None:
             raise ValueError("home= sets the joint task's posture; the Cartesian task starts at q")
-        ctask = amj.cartesian_task(arm, q0=q, Ts=PERIOD)
+        try:
+            ctask = amj.cartesian_task(arm, q0=q, Ts=PERIOD)
+        except ConfigError as e:
+            raise ConfigError(
+                f"the arm stands at q = {np.round(q, 4).tolist()} rad, where {e}: move it "
+                "first (run(..., start=franka.READY), or franka.move_to)"
+            ) from e
         ctrl = ctask.controller(controller, arm, Ts=PERIOD, **keywords)
         return Setup(ctrl, "cartesian", arm, q, ctask, 0.0)
     h = q if home is None else _posture("home", home)

@@ -47,9 +47,10 @@ def fr3_urdf() -> str:
 
 
 def stretch(k: int, t: float, state: Any) -> None:
-    """1 % of the cycles stretched to 2–3 ms: the client sleeps 1.5 or 2.5 ms."""
+    """1 % of the cycles stretched to 2–3 ms: the client sleeps 2.5 or 3.5 ms (the
+    newest state is then 2 or 3 ms after the last)."""
     if k % 100 == 99:
-        time.sleep(0.0015 if (k // 100) % 2 else 0.0025)
+        time.sleep(0.0025 if (k // 100) % 2 else 0.0035)
 
 
 def one(args: argparse.Namespace, case: str, task: str, load: float) -> dict[str, Any]:

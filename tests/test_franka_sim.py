@@ -45,10 +45,11 @@ STRETCH_EVERY = 100
 
 
 def stretch(k: int, t: float, state: Any) -> None:
-    """The client sleeps after every 100th cycle's torque went out, 1.5 or
-    2.5 ms in turn: that cycle lasts 2 or 3 ms."""
+    """The client sleeps after every 100th cycle's torque went out, 2.5 or
+    3.5 ms in turn: the state it reads next is 2 or 3 ms after the last
+    (libfranka hands over the newest state; the server sends one a ms)."""
     if k % STRETCH_EVERY == STRETCH_EVERY - 1:
-        time.sleep(0.0015 if (k // STRETCH_EVERY) % 2 else 0.0025)
+        time.sleep(0.0025 if (k // STRETCH_EVERY) % 2 else 0.0035)
 
 
 def run(case: str, task: str = "joint", load: float = 0.0, stretched: bool = False) -> Any:
@@ -61,6 +62,7 @@ def run(case: str, task: str = "joint", load: float = 0.0, stretched: bool = Fal
         res = franka.run(case, FR3, robot, T=T, task=task, on_cycle=stretch if stretched else None)
         after = robot.read_once()
     res.params["holding"] = holding
+    res.params["stretched"] = stretched
     res.params["after"] = {"mode": str(after.robot_mode), "errors": str(after.current_errors)}
     return res
 
@@ -118,12 +120,16 @@ def test_the_run_starts_from_where_the_arm_stands_and_stays_within_the_limits(
 
 def test_late_cycles_advance_the_clock(runs: dict[str, Any]) -> None:
     """Every row's t is the cycles counted by libfranka's durations: a late
-    cycle leaves a gap of whole milliseconds, and the result counts them."""
+    cycle leaves a gap of whole milliseconds, and the result counts them; the
+    stretched runs have about 1 % of them (the machine's own stalls add some)."""
     for name, res in runs.items():
         gaps = np.diff(res.t) / 1e-3
         np.testing.assert_allclose(gaps, np.round(gaps), rtol=0, atol=1e-9)
-        assert res.params["cycles"]["missed"] == int(np.sum(np.round(gaps) > 1)), name
+        late = int(np.sum(np.round(gaps) > 1))
+        assert res.params["cycles"]["missed"] == late, name
         assert res.params["cycles"]["total"] == res.rows, name
+        if res.params["stretched"]:
+            assert late >= 80, (name, late)
 
 
 def test_an_unknown_load_on_the_hand_is_learnt(loaded: dict[str, Any]) -> None:

@@ -11,10 +11,12 @@ Cartesian task: position and orientation). Printed with the machine: its
 cores and load average before and after the runs (the server shares the
 machine: its wall-clock loop and the client compete for the cores).
 
-``--simulate`` adds the library's own loop on the same URDF for comparison:
+``--simulate`` adds the library's own loop for comparison:
 ``adaptimp.mujoco.simulate(case, URDF, T=8, delay=1)`` (the plant's delay one
 period, the arm with gravity) and on ``franka.plant(URDF)`` (the arm as the
-controller acts on it on a Franka: no gravity).
+controller acts on it on a Franka: no gravity); and the controllers the robot
+route builds on franky-sim's own MuJoCo FR3 (rotor inertia, damping, friction
+loss; gravity compensated) in the library's loop with one period of delay.
 
     python benches/franka_loop.py [--T 10] [--cases pd sf of] [--tasks joint cartesian]
                                   [--load 0.1] [--stretch] [--simulate] [--ip ADDRESS] [--json]
@@ -80,6 +82,49 @@ def one(args: argparse.Namespace, case: str, task: str, load: float) -> dict[str
     }
 
 
+def franky_plant() -> amj.Plant:
+    """franky-sim's own MuJoCo FR3 (its scene, built in this process, never
+    served: rotor inertia, damping and friction loss on every joint, the hand's
+    fingers locked) as a plant of the library's loop, its gravity compensated
+    exactly, as franky-sim's server does."""
+    import xml.etree.ElementTree as ET
+
+    import mujoco
+    from franky_sim.mujoco_simulator import MujocoSimulator
+
+    sim = MujocoSimulator()
+    sim.init()
+    sim.add_robot()
+    spec = mujoco.MjSpec.from_string(ET.tostring(sim.scene, encoding="unicode"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlantWarning)  # the fingers locked, said so
+        plant = amj.Plant(spec, contact=False, tip="robot0_fr3_link7")
+    plant.model.opt.gravity[:] = 0.0
+    return plant
+
+
+def twin(urdf: str, T: float) -> list[dict[str, Any]]:
+    """franka.setup's controllers (from the URDF, as the robot route builds them)
+    on franky-sim's MuJoCo FR3 in the library's loop, one period of delay, from
+    the ready posture: the robot route without the network and the wall clock."""
+    out = []
+    for task in ("joint", "cartesian"):
+        row: dict[str, Any] = {"loop": f"franky-sim's MJCF FR3, delay=1, {task}"}
+        for case in ("pd", "sf") if task == "cartesian" else ("pd", "sf", "of"):
+            s = franka.setup(case, urdf, franka.READY, task=task)
+            q0 = np.array(franka.READY)
+            if task == "joint":
+                ref = s.reference(round(T / franka.PERIOD))
+                res = amj.simulate(s.controller, franky_plant(), T=T, reference=ref, q0=q0, delay=1)
+                row[case] = res.metrics["rms_z1_after2"]
+            else:
+                res = amj.simulate(s.controller, franky_plant(), T=T, q0=q0, delay=1)
+                s.task.measure(res)
+                row[case] = (res.metrics["rms_pos_after2"], res.metrics["rms_rot_after2"])
+        out.append(row)
+    return out
+
+
 def simulated(urdf: str, T: float) -> list[dict[str, Any]]:
     """The library's own loop on the same arm: delay 1, with and without gravity."""
     out = []
@@ -124,6 +169,7 @@ def main() -> None:
     ]
     load_after = os.getloadavg()
     sim = simulated(args.urdf, 8.0) if args.simulate else []
+    twins = twin(args.urdf, args.T) if args.simulate and not args.ip else []
     machine = {
         "cpus": os.cpu_count(),
         "machine": platform.machine(),
@@ -132,7 +178,9 @@ def main() -> None:
         "load_after": [round(x, 2) for x in load_after],
     }
     if args.json:
-        print(json.dumps({"machine": machine, "runs": rows, "simulate": sim}, indent=1))
+        print(
+            json.dumps({"machine": machine, "runs": rows, "simulate": sim, "twin": twins}, indent=1)
+        )
         return
     print(
         f"{machine['cpus']} cores ({machine['machine']}), Python {machine['python']}; load "
@@ -173,6 +221,18 @@ def main() -> None:
         for s in sim:
             for w in s["warnings"]:
                 print(f"  {s['loop']}, {w}")
+    if twins:
+        print(
+            "\nThe same controllers on franky-sim's own MuJoCo FR3 in the library's loop "
+            f"(T = {args.T:g} s):"
+        )
+        print("| loop | SF/PD | OF/PD |\n|---|---|---|")
+        for s in twins:
+            if isinstance(s["pd"], tuple):
+                ratio = ", ".join(f"{a / b:.3f}" for a, b in zip(s["sf"], s["pd"]))
+                print(f"| {s['loop']} (position, orientation) | {ratio} | |")
+            else:
+                print(f"| {s['loop']} | {s['sf'] / s['pd']:.3f} | {s['of'] / s['pd']:.3f} |")
 
 
 if __name__ == "__main__":

@@ -51,7 +51,7 @@ def test_the_controller_is_the_rule_a_simulate_user_gets() -> None:
     limits = {"tau_max": list(franka.TAU_MAX), "tau_rate_max": 1.0}
     s = franka.setup("sf", plant, READY)
     task = amj.default_task(plant, READY)
-    kw = amj.rule_keywords(plant, task, Ts=1e-3, case="sf")
+    kw = amj.rule_keywords(plant, task, Ts=1e-3, case="sf", delay=franka.DELAY)
     kw.pop("n")
     same = adaptimp.Controller("sf", scenario="robot", n=7, **{**kw, **limits})
     assert s.controller.params == same.params
@@ -66,7 +66,8 @@ def test_the_controller_is_the_rule_a_simulate_user_gets() -> None:
         franka.setup("sf", plant, [0.0, 0.0, 0.0, -1.57, 0.0, 1.57, 0.785], task="cartesian")
     c = franka.setup("sf", plant, READY, task="cartesian")
     ctask = amj.cartesian_task(plant, q0=READY)
-    assert c.controller.params == ctask.controller("sf", plant, **limits).params
+    assert c.controller.params == ctask.controller("sf", plant, delay=franka.DELAY, **limits).params
+    assert s.controller.params["delay"] == 1
 
 
 def test_the_joint_task_starts_at_rest_where_the_arm_stands() -> None:

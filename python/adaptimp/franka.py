@@ -77,6 +77,7 @@ from .chain import Chain
 __all__ = [
     "BLEND",
     "COLLISION",
+    "DELAY",
     "PERIOD",
     "READY",
     "TAU_MAX",
@@ -94,6 +95,11 @@ FloatArray = NDArray[np.float64]
 
 PERIOD = 1e-3
 """libfranka's control period (s): a state in and a torque out every 1 ms."""
+
+DELAY = 1
+"""Periods from the state a torque was computed from to the tick it acts at:
+libfranka applies a torque at the next 1 ms tick (the controller's ``delay``,
+SPEC (17.1), (18.11))."""
 
 TAU_MAX = (87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0)
 """The FR3's and the Panda's joint torque limits (N m)."""
@@ -185,8 +191,9 @@ class Setup:
     Attributes
     ----------
     controller : adaptimp.Controller or adaptimp.CartesianController
-        The rule's controller of the case name, at Ts = 1 ms, with the
-        Franka's torque limits and libfranka's torque rate.
+        The rule's controller of the case name, at Ts = 1 ms, made for
+        libfranka's one period of delay (:data:`DELAY`), with the Franka's
+        torque limits and libfranka's torque rate.
     kind : {"joint", "cartesian"}
         The task's space.
     plant : adaptimp.mujoco.Plant
@@ -274,9 +281,11 @@ def setup(
       posture rule (SPEC (16.9)), else the ``ConfigError`` names the
       condition (move the arm first: :func:`move_to`).
 
-    The controller gets the Franka's torque limits (:data:`TAU_MAX`, at most
-    the URDF's effort) and libfranka's torque rate (``tau_rate_max`` =
-    :data:`TORQUE_RATE` × 1 ms); ``params`` replace the rule's keywords.
+    The rule sizes the controller for libfranka's one period of delay
+    (``delay`` = :data:`DELAY`, SPEC (18.11)); it gets the Franka's torque
+    limits (:data:`TAU_MAX`, at most the URDF's effort) and libfranka's
+    torque rate (``tau_rate_max`` = :data:`TORQUE_RATE` × 1 ms); ``params``
+    replace the rule's keywords.
     """
     if controller not in ("pd", "sf", "of"):
         raise ConfigError(f"controller must be 'pd', 'sf' or 'of', got {controller!r}")
@@ -300,11 +309,11 @@ def setup(
                 f"the arm stands at q = {np.round(q, 4).tolist()} rad, where {e}: move it "
                 "first (run(..., start=franka.READY), or franka.move_to)"
             ) from e
-        ctrl = ctask.controller(controller, arm, Ts=PERIOD, **keywords)
+        ctrl = ctask.controller(controller, arm, Ts=PERIOD, delay=DELAY, **keywords)
         return Setup(ctrl, "cartesian", arm, q, ctask, 0.0)
     h = q if home is None else _posture("home", home)
     jtask = amj.default_task(arm, h)
-    kw = amj.rule_keywords(arm, jtask, Ts=PERIOD, case=controller)
+    kw = amj.rule_keywords(arm, jtask, Ts=PERIOD, case=controller, delay=DELAY)
     kw.pop("n")
     kw.update(keywords)
     ctrl = _adaptimp_controller(controller, kw)

@@ -2,7 +2,8 @@
 // adaptimp's C ABI (SPEC §22; docs/franka.md shows the same loop in Python).
 //
 // The controller: the rule of SPEC §18 (adaptimp_params_suggest) from the robot's
-// own mass matrix at the start, for an arm without gravity: the robot adds its
+// own mass matrix at the start, for libfranka's one period of delay and an arm
+// without gravity: the robot adds its
 // model's gravity torque to every command (SPEC (22.1)), so none is given to the
 // rule and the controller never commands it. Its torque rate is libfranka's
 // kMaxTorqueRate, 1 N m a 1 ms cycle (SPEC (22.3)): the controller limits it
@@ -38,6 +39,8 @@ namespace {
 constexpr std::size_t kJoints = 7;
 // The most centres adaptimp_params_suggest writes (SPEC §18: 16 … 256).
 constexpr std::size_t kMaxNodes = 256;
+// libfranka applies a torque at the next 1 ms tick: one period of delay (SPEC (18.11)).
+constexpr std::size_t kDelay = 1;
 // libfranka's kMaxTorqueRate (N m/s) over one 1 ms cycle.
 constexpr double kRatePerCycle = 1000.0 * 1e-3;
 constexpr std::array<double, kJoints> kTauMax{{87, 87, 87, 87, 12, 12, 12}};
@@ -87,7 +90,7 @@ int main(int argc, char** argv) {
         std::vector<double> centers(kMaxNodes * 4 * kJoints), widths2(4 * kJoints);
         AdaptimpParams params;
         check(adaptimp_params_suggest(&params, kJoints, ADAPTIMP_LAW_STATE_FEEDBACK, mass.data(),
-                                      kTauMax.data(), 1e-3, path.data(), 100, 1.0, nullptr,
+                                      kTauMax.data(), 1e-3, kDelay, path.data(), 100, 1.0, nullptr,
                                       centers.data(), widths2.data()),
               "the rule");
         params.impedance = ADAPTIMP_IMPEDANCE_EXTERNAL;

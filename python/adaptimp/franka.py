@@ -132,6 +132,12 @@ BLEND_SPEED = 0.5
 SETTLE = 2.0
 """The start (s) of the metrics' "after2" window, as :func:`adaptimp.mujoco.simulate`'s."""
 
+SETTLED = 0.01
+"""After :func:`move_to`, the arm is at rest when no joint moves faster (rad/s)."""
+
+SETTLE_WAIT = 2.0
+"""How long (s) :func:`move_to` waits at most for the arm to come to rest."""
+
 
 class RobotError(AdaptimpError, RuntimeError):
     """The motion ended before its time: libfranka raised (a reflex, the
@@ -370,9 +376,11 @@ def move_to(
 ) -> None:
     """Move the arm to ``q`` (rad, (7,)) with the robot's own joint position
     controller (libfranka's joint position interface, joint impedance mode)
-    along a quintic from rest to rest, no joint faster than ``speed`` (rad/s);
-    ``robot`` a ``pylibfranka.Robot`` or its address. A libfranka exception is
-    a :class:`RobotError` naming it."""
+    along a quintic from rest to rest, no joint faster than ``speed`` (rad/s),
+    then waits (at most :data:`SETTLE_WAIT` s) until no joint moves faster
+    than :data:`SETTLED` (the robot's controller lags its command): a run
+    started next starts at rest. ``robot`` a ``pylibfranka.Robot`` or its
+    address. A libfranka exception is a :class:`RobotError` naming it."""
     r, _ = _robot(robot, realtime)
     goal = _posture("q", q)
     if not (math.isfinite(speed) and speed > 0):
@@ -392,8 +400,12 @@ def move_to(
             if x >= 1.0:
                 command.motion_finished = True
                 ctl.writeOnce(command)
-                return
+                break
             ctl.writeOnce(command)
+        deadline = time.monotonic() + SETTLE_WAIT
+        while time.monotonic() < deadline:
+            if np.max(np.abs(r.read_once().dq)) < SETTLED:
+                return
     except LIBFRANKA_ERRORS as e:
         raise RobotError(
             f"the move to {np.round(goal, 4).tolist()} stopped: libfranka raised "

@@ -10,7 +10,7 @@
 #   pip     target/build-venv: maturin, ziglang (zig, the wheel's linker), auditwheel
 #           target/py-venv:    the wheel with its `test` extra (pytest, hypothesis, ruff,
 #                              mypy, pandas, xarray, tqdm, MkDocs, MuJoCo, Pinocchio,
-#                              example-robot-data, Dask)
+#                              example-robot-data, Dask, pylibfranka, franky-sim)
 #           target/wheel-test: the wheel with its `mujoco` extra, without Rust on PATH
 # Disk it leaves: target/ (Rust builds and the venvs), fuzz/target/, dist/.
 #
@@ -100,6 +100,11 @@ fi
 py="$venv/bin/python"
 "$py" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$wheel"
 "$py" -m pip install --quiet --disable-pip-version-check "$wheel[test]"
+# adaptimp.franka's tests drive franky-sim's FR3 through pylibfranka: both must be here
+# from Python 3.10 on (below it they have no wheels, and those tests skip).
+if "$py" -c "import sys; sys.exit(sys.version_info < (3, 10))"; then
+    "$py" -c "import pylibfranka, franky_sim"
+fi
 
 step "Python: ruff, type stubs, mypy"
 "$py" -m ruff check python tests examples benches scripts

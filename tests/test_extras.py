@@ -59,5 +59,5 @@ def test_every_extra_a_message_names_is_declared() -> None:
     for path in (ROOT / "python" / "adaptimp").glob("*.py"):
         source = path.read_text(encoding="utf-8")
         named |= set(re.findall(r'needs_extra\((?:"[^"]*",\s*){2}"(\w+)"\)', source))
-    assert named == {"mujoco", "pinocchio", "pandas", "xarray", "sweep"}
+    assert named == {"mujoco", "pinocchio", "pandas", "xarray", "sweep", "franka"}
     assert named <= declared

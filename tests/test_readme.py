@@ -41,6 +41,15 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     ("README.md", 8): "runs this whole suite (it is scripts/test.sh)",
     ("docs/cartesian.md", 4): "Rust: the shape of the calls; the whole program is "
     "examples/14_cartesian_pose.rs, which tests/test_ffi.py runs against C and Python",
+    ("docs/franka.md", 0): "installs the extra and starts a server that runs until Ctrl-C: "
+    "scripts/test.sh installs both, tests/test_franka_sim.py starts the same server "
+    "(franka.Simulator)",
+    ("docs/franka.md", 1): "drives a robot (or a server) at 127.0.0.1 for 20 s: "
+    "tests/test_franka_sim.py makes the same calls against franky-sim on a loopback address",
+    ("docs/franka.md", 2): "a 10 s run on a server of its own: tests/test_franka_sim.py's "
+    "loaded runs are these calls",
+    ("docs/franka.md", 3): "needs libfranka's C++ library (its CMake package), which CI does "
+    "not install",
     ("docs/index.md", 0): "installs the wheel or builds the checkout: scripts/test_wheel.sh",
     ("docs/layout.md", 0): "the import graph's command: tests/test_layout.py runs its "
     "graph() and asserts no circle",

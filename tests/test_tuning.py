@@ -119,6 +119,36 @@ def test_a_damped_joint_gets_the_scale_its_sampled_loop_sees() -> None:
     assert tuning.joint_damping(d) is None
 
 
+@pytest.mark.filterwarnings("ignore:the URDF gives no effort limit:UserWarning")
+def test_an_arm_without_gravity_learns_d_and_c_at_gs_bandwidth() -> None:
+    """SPEC (22.2): Γ_D, Γ_C 25 times (18.6)'s (ω_D = ω_G instead of ω_G/5), σ
+    with the same leak time, the rest as it was; by default for a model
+    without gravity (a plant whose MuJoCo gravity is zero), never for D alone."""
+    from adaptimp import mujoco as amj
+
+    plant = amj.Plant(str(Path(__file__).parent / "data" / "hobby_arm.urdf"), contact=False)
+    task = amj.default_task(plant)
+    args = (plant, task.home, plant.tau_max)
+    opts: dict[str, Any] = {"Ts": 1e-3, "path": task.reference, "period": task.period}
+    heavy = tuning.suggest(*args, **opts)
+    light = tuning.suggest(*args, **opts, weightless=True)
+    for i in (0, 1):
+        assert light["gamma"][i] == pytest.approx(25 * heavy["gamma"][i], rel=1e-12)
+        assert light["sigma"][i] == pytest.approx(heavy["sigma"][i] / 25, rel=1e-12)
+    assert light["gamma"][2] == heavy["gamma"][2]
+    assert light["Kp"] == heavy["Kp"]
+    assert not tuning.is_weightless(plant)
+    assert not tuning.is_weightless(np.eye(5))
+    plant.model.opt.gravity[:] = 0.0
+    assert tuning.is_weightless(plant)
+    inferred = tuning.suggest(plant, task.home, plant.tau_max, **opts)
+    told = tuning.suggest(plant, task.home, plant.tau_max, **opts, weightless=True)
+    assert inferred["gamma"] == told["gamma"]
+    assert tuning.suggest(plant, task.home, plant.tau_max, **opts, weightless=False)["gamma"][
+        0
+    ] == pytest.approx(inferred["gamma"][0] / 25, rel=1e-12)
+
+
 def test_bad_arms_are_errors_naming_the_condition() -> None:
     with pytest.raises(adaptimp.ConfigError, match="positive definite"):
         tuning.suggest(np.diag([1.0, -1.0]), [0.0, 0.0], 10.0)

@@ -713,6 +713,7 @@ def suggest(
     damping: NDArray[np.float64] | None = None,
     orbit: NDArray[np.float64] | None = None,
     delay: int = 0,
+    weightless: bool = False,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every
@@ -721,7 +722,8 @@ def suggest(
     Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6); ``damping``
     (n,): the joints' viscous damping, the scales as the sampled loop sees them,
     SPEC (18.9); ``orbit`` (K', n): one period of the joint positions that repeat,
-    the widths in q at least its diameter, SPEC (19.11)."""
+    the widths in q at least its diameter, SPEC (19.11); ``weightless``: D̂ and Ĉ
+    learning at Ĝ's bandwidth, an arm without gravity, SPEC (22.2)."""
 
 def pose_circle(
     p0: NDArray[np.float64],

@@ -113,6 +113,20 @@ def gravity(model: Any, q: ArrayLike) -> FloatArray | None:
     return None
 
 
+def is_weightless(model: Any) -> bool:
+    """Whether ``model`` has no gravity at all: an ``adaptimp.mujoco.Plant``
+    whose MuJoCo gravity is zero (e.g. :func:`adaptimp.franka.plant`, the arm
+    as the controller acts on it on a robot that compensates gravity), or a
+    Pinocchio ``Model`` whose gravity is zero; False for any other model
+    (one that gives only D(q) and G(q) cannot say it everywhere)."""
+    m = getattr(model, "model", None)
+    if m is not None and hasattr(m, "opt") and hasattr(model, "reset"):
+        return bool(np.all(np.asarray(m.opt.gravity) == 0.0))
+    if type(model).__name__ == "Model" and hasattr(model, "gravity") and hasattr(model, "nq"):
+        return bool(np.all(np.asarray(model.gravity.linear) == 0.0))
+    return False
+
+
 def joint_damping(model: Any) -> FloatArray | None:
     """The viscous damping (N m s/rad, (n,)) of ``model``'s joints if it has any:
     an ``adaptimp.mujoco.Plant``'s (MuJoCo's ``dof_damping`` of the arm's
@@ -155,6 +169,7 @@ def suggest(
     damping: ArrayLike | None = None,
     orbit: ArrayLike | None = None,
     delay: int = 0,
+    weightless: bool | None = None,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
     the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
@@ -202,6 +217,12 @@ def suggest(
         d/Ts keeps the sampled velocity loop's largest mode along the path at
         the pole radius of SPEC (18.11) (δ = 0: m = 0.25 as it is); the
         controller's ``delay`` keyword.
+    weightless : bool, optional
+        The arm bears no gravity the controller must hold (a robot that adds
+        its own model's gravity torque to every command, as a Franka does,
+        or an arm in a horizontal plane): D̂ and Ĉ learn at Ĝ's bandwidth,
+        SPEC (22.2). Default: whether the model has no gravity at all
+        (:func:`is_weightless`).
 
     Returns
     -------
@@ -242,9 +263,11 @@ def suggest(
         orbit = np.ascontiguousarray(np.asarray(orbit, dtype=np.float64))
         if orbit.ndim != 2 or orbit.shape[1] != n:
             raise ConfigError(f"orbit must have shape (K, {n}), got {orbit.shape}")
+    light = is_weightless(model) if weightless is None else bool(weightless)
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
         critical=critical, damping=b_arr, orbit=orbit, delay=loop_delay({'delay': delay}),
+        weightless=light,
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

@@ -392,6 +392,23 @@ impl Rule {
         }
     }
 
+    /// The rule for an arm that bears no gravity the controller must hold,
+    /// SPEC (22.2): a robot that adds its own model's gravity torque to every
+    /// command (a Franka through libfranka), or an arm moving in a
+    /// horizontal plane. What the networks learn is then the inertia the
+    /// model lacks (a drive's rotor, its inertia times the gear ratio
+    /// squared, which a URDF's links do not carry), the Coriolis terms and
+    /// friction: D̂'s regressor α̇1 carries an inertia error with one weight
+    /// along the whole orbit, so D̂ and Ĉ learn at Ĝ's bandwidth
+    /// (`learn_dc` = 1, ω_D = ω_C = ω_G of (18.6)).
+    #[must_use]
+    pub fn weightless(&self) -> Self {
+        Self {
+            learn_dc: 1.0,
+            ..*self
+        }
+    }
+
     /// The robot-scenario configuration of `law` for an arm of inertia matrix
     /// `d` (kg m², at the task's start), limits `tau_max` (N m) and period
     /// `ts` (s): (18.1)–(18.4), the hardened options of SPEC §13 and the
@@ -987,6 +1004,39 @@ mod tests {
             "{lb} {exact}"
         );
         assert!(loop_bound::<3>(&[], &s).is_err());
+    }
+
+    #[test]
+    fn a_weightless_arm_learns_d_and_c_at_gs_bandwidth() {
+        let rule = Rule::default();
+        let light = rule.weightless();
+        assert_eq!(light.learn_dc, 1.0);
+        assert_eq!(
+            Rule {
+                learn_dc: 0.2,
+                ..light
+            },
+            rule
+        );
+        let d = arm_matrix();
+        let tau = Vector::<3>::new(50.0, 20.0, 5.0);
+        let path = default_path();
+        let g = Vector::<3>::zeros();
+        let base = rule
+            .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, Some(&g))
+            .unwrap()
+            .config;
+        let fast = light
+            .suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, Some(&g))
+            .unwrap()
+            .config;
+        // Γ_D, Γ_C 25× (ω² ∝ learn_dc²), σ 1/25× (the same leak time), Γ_G as it was.
+        for i in 0..2 {
+            assert!((fast.gamma[i] / base.gamma[i] - 25.0).abs() < 1e-12);
+            assert!((fast.sigma[i] * 25.0 / base.sigma[i] - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(fast.gamma[2], base.gamma[2]);
+        assert_eq!(fast.kp, base.kp);
     }
 
     #[test]

@@ -38,8 +38,10 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// loop sees them, SPEC (18.9). `orbit` (K', n; rad): the joint positions of
 /// one period of the motion that repeats (the table's circle): the widths in
 /// q at least its diameter, SPEC (19.11) (the table scenario's).
+/// `weightless`: the arm bears no gravity the controller must hold (a robot
+/// that compensates it itself): D̂ and Ĉ learn at Ĝ's bandwidth, SPEC (22.2).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0, weightless=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -55,6 +57,7 @@ pub fn suggest<'py>(
     damping: Option<PyReadonlyArray1<'py, f64>>,
     orbit: Option<PyReadonlyArray2<'py, f64>>,
     delay: usize,
+    weightless: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -128,7 +131,7 @@ pub fn suggest<'py>(
             gravity.as_deref(),
             damping.as_deref(),
             orbit.as_deref(),
-            (resolve, critical, delay),
+            (resolve, critical, delay, weightless),
         ),
         _ => unreachable!("n checked above"),
     )?;
@@ -147,10 +150,13 @@ fn fill<'py, const N: usize>(
     gravity: Option<&[f64]>,
     damping: Option<&[f64]>,
     orbit: Option<&[f64]>,
-    (resolve, critical, delay): (bool, bool, usize),
+    (resolve, critical, delay, weightless): (bool, bool, usize, bool),
 ) -> PyResult<()> {
     let err = |e: Error| config_error(e.into());
     let mut rule = Rule::default().with_delay(delay).map_err(err)?;
+    if weightless {
+        rule = rule.weightless();
+    }
     if critical {
         crate::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
         rule = rule.critical(ts);

@@ -413,6 +413,10 @@ impl PostureRule {
 /// task of SPEC §18 (±0.2 rad on every joint, ℓ_q ≈ 2 rad, ℓ_q̇ ≈ 6 rad/s)
 /// sits at the caps (0.2 rad, 0.5 rad/s); a Cartesian circle's joint orbit
 /// (ℓ_q ≈ 0.5–1.7 rad) gets the same number of distinct nodes along it.
+/// With a loop delay δ ≥ 1 (SPEC (18.11)), D̂ and Ĉ learn δ + 1 times
+/// further inside Ĝ's bandwidth on such an orbit: its slow joint motion
+/// leaves their regressors α̇1, α1 to the velocity errors of the delayed
+/// loop, and at (18.6)'s ω_G/5 they rang on three arms.
 pub fn resolving<const N: usize>(rule: &Rule, path: &[Setpoint<N>]) -> Rule {
     let (mut lq, mut lv) = (0.0, 0.0);
     for (j, sp) in path.iter().enumerate() {
@@ -427,6 +431,9 @@ pub fn resolving<const N: usize>(rule: &Rule, path: &[Setpoint<N>]) -> Rule {
             *t = t.min(narrow);
         }
     }
+    if rule.delay > 0 {
+        out.learn_dc /= rule.delay as f64 + 1.0;
+    }
     out
 }
 
@@ -437,6 +444,29 @@ pub const RESOLUTION: f64 = 10.0;
 mod tests {
     use super::*;
     use crate::cartesian::chain::{Chain, Joint, Transform};
+
+    #[test]
+    fn an_orbit_of_a_delayed_loop_slows_d_and_c_only() {
+        // A slow circle in two joints: 0.1 rad across, 0.3 rad/s.
+        let path: alloc::vec::Vec<Setpoint<2>> = (0..100)
+            .map(|k| {
+                let a = 2.0 * core::f64::consts::PI * k as f64 / 100.0;
+                Setpoint {
+                    x: Vector::<2>::new(0.05 * a.cos(), 0.05 * a.sin()),
+                    dx: Vector::<2>::new(-0.3 * a.sin(), 0.3 * a.cos()),
+                    ddx: Vector::<2>::zeros(),
+                }
+            })
+            .collect();
+        let now = resolving(&Rule::default(), &path);
+        assert_eq!(now.learn_dc, Rule::default().learn_dc);
+        assert!(now.tube[0] < Rule::default().tube[0]);
+        for delay in [1, 2] {
+            let late = resolving(&Rule::default().with_delay(delay).unwrap(), &path);
+            assert_eq!(late.learn_dc, now.learn_dc / (delay as f64 + 1.0));
+            assert_eq!((late.tube, late.learn), (now.tube, now.learn));
+        }
+    }
 
     #[test]
     fn sigma_min_is_the_smallest_singular_value() {

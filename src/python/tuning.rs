@@ -173,7 +173,6 @@ fn fill<'py, const N: usize>(
     }
     .map_err(err)?;
     // SPEC (18.11): the margin at the largest mode of the undamped scales.
-    // SPEC (18.11): the margin at the largest mode of the undamped scales.
     rule = rule.bounded(loop_bound(&ds, &scales).map_err(err)?);
     let scales = match damping {
         None => scales,
@@ -196,7 +195,12 @@ fn fill<'py, const N: usize>(
                 })
                 .collect();
             if resolve && !samples.is_empty() {
+                let learn_dc = rule.learn_dc;
                 rule = resolving(&rule, &samples);
+                if weightless {
+                    // (22.2): D̂ and Ĉ at Ĝ's bandwidth, whatever the orbit.
+                    rule.learn_dc = learn_dc;
+                }
             }
             if let Some(o) = orbit {
                 let qs: Vec<Vector<N>> = o.chunks_exact(N).map(Vector::from_column_slice).collect();

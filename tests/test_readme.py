@@ -66,6 +66,9 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     ("docs/rust.md", 1): "Rust: tests/snippets/dynamic_urdf.rs, a doctest of "
     "src/dynamic/mod.rs; test_every_block_is_accounted_for keeps the page's copy identical",
     ("docs/sweeps.md", 2): "needs Ray, which no extra of adaptimp installs",
+    ("docs/your_arm.md", 4): "the delay tables on robot files of packages CI does not "
+    "install (robosuite, gymnasium, dm_control, metaworld, franky-sim, pybullet): "
+    "tests/test_delay.py makes the same simulate calls on the Panda",
 }
 
 # Shell blocks run here as written (each line, from the checkout's root).

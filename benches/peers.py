@@ -152,6 +152,11 @@ def arm_files(names: list[str], urdfs: list[str]) -> dict[str, tuple[Path, str]]
             from adaptimp._description import read_arm
 
             frame = read_arm(path, None, ()).tip
+        elif not pinocchio_arm(path).existFrame(frame):  # an IndexError after the build
+            raise SystemExit(
+                f"--urdf {spec}: the file has no link or frame {frame!r}; give one of its "
+                "links (FILE:LINK), or no frame for the link that ends the arm"
+            )
         if path.stem in out:
             raise SystemExit(
                 f"--urdf {spec}: an arm named {path.stem!r} already runs "
@@ -381,9 +386,10 @@ def main() -> None:
     ap.add_argument("--check", action="store_true", help="agreement only, no timing")
     args = ap.parse_args()
 
+    chosen = arm_files(args.arms, args.urdf)  # refused by name before anything is built
     peer, core = build_peer(), build_core()
     with tempfile.TemporaryDirectory() as tmp:
-        arms = write_arms(arm_files(args.arms, args.urdf), Path(tmp))
+        arms = write_arms(chosen, Path(tmp))
         cmds = {
             name: (
                 [str(peer), str(pf), frame, str(sf)],

@@ -264,11 +264,19 @@ def main() -> None:
     parser.add_argument("--placements", type=int, default=8)
     args = parser.parse_args()
     parts = set(args.only.split(","))
+    known = {"cartesian", "ready", "placements", "refusals"}
+    if not parts <= known:  # ran nothing and exited 0
+        parser.error(
+            f"--only: unknown part(s) {', '.join(sorted(parts - known))}; "
+            f"choose from {', '.join(sorted(known))}"
+        )
     picked = [
         a
         for a in ARMS
         if args.arms is None or any(s.lower() in a.label.lower() for s in args.arms.split(","))
     ]
+    if not picked:
+        parser.error(f"--arms {args.arms}: no arm's label contains it")
     found: dict[str, Path] = {}
     for arm in picked:
         path = locate(arm, args.robots)

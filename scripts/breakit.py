@@ -1,9 +1,11 @@
 """A break-it probe of the public Python API: state restore (bit flips,
 edits, truncations), the fault semantics, the n-joint API, sweeps and their
 cache, chains, the Cartesian front, formulations, the dynamics and computed
-torque, saved results, MuJoCo runs, robot descriptions (URDF text and files
-through read_arm, Chain.from_urdf, ComputedTorque and MuJoCo runs). Every
-case is classified:
+torque, saved results (atomic, concurrent, forged formats), MuJoCo runs,
+robot descriptions (URDF text and files through read_arm, Chain.from_urdf,
+ComputedTorque and MuJoCo runs), callbacks reading the object that calls them
+(each in a process with a time limit), and wrong inputs refused by the name
+the user wrote. Every case is classified:
 
 - accepted: it succeeded and every invariant checked held;
 - clear error: it was refused by an adaptimp error (or a TypeError,
@@ -1096,6 +1098,51 @@ def dynamics(t: Tally, quick: bool) -> None:
             case(t, f"inverse_dynamics {what} = {v:g}", rnea, "refuse" if bad else "either")
         case(t, f"mass_matrix q = {v:g}", lambda v=v: _finite(ct.mass_matrix([v, 0.0])),
              "refuse" if bad else "either")  # fmt: skip
+    for name in ("payload", "mass_scale", "Ts"):  # a bool was taken as 1
+        case(t, f"ComputedTorque({name}=True)", lambda n=name: ComputedTorque(**{n: True}),
+             "refuse")  # fmt: skip
+    _gravcomp(t)
+
+
+_GRAVCOMP = """<mujoco><option gravity='0.3 -0.2 -9.81'/><worldbody>
+<body name='a' pos='0 0 0.1'><joint name='j1' axis='0 0 1'/><geom size='0.05' mass='1'/>
+ <body name='b' pos='0.3 0 0' gravcomp='{b}'><joint name='j2' axis='0 1 0'/>
+  <geom type='capsule' fromto='0 0 0 0.25 0 0' size='0.03' mass='2'/>
+  <body name='held' pos='0.25 0 0' gravcomp='{held}'>
+   <geom size='0.04' pos='0.02 0.01 0' mass='0.5'/></body>
+  <body name='c' pos='0.25 0 0' gravcomp='{c}'><joint name='j3' axis='0 1 0'/>
+   <geom type='box' size='0.1 0.02 0.02' pos='0.1 0 0' mass='0.7'/><site name='tip' pos='0.2 0 0'/>
+  </body></body></body></worldbody>
+<actuator><motor joint='j1' ctrlrange='-50 50'/><motor joint='j2' ctrlrange='-50 50'/>
+<motor joint='j3' ctrlrange='-50 50'/></actuator></mujoco>"""
+
+
+def _gravcomp(t: Tally) -> None:
+    """Computed torque's inverse dynamics against MuJoCo's with gravity
+    compensation on some bodies (``gravcomp``: it was off by exactly
+    ``qfrc_gravcomp``): to 1e-12 of its scale."""
+    try:
+        import mujoco
+
+        from adaptimp.baselines import ComputedTorque
+    except ImportError:
+        return
+    for shares in ((0.5, 1.0, 0.2), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (-0.5, 2.0, 0.3)):
+
+        def exact(shares: tuple[float, ...] = shares) -> None:
+            b, held, c = shares
+            m = mujoco.MjModel.from_xml_string(_GRAVCOMP.format(b=b, held=held, c=c))
+            d = mujoco.MjData(m)
+            ct = ComputedTorque(m, tip="tip")
+            rng = np.random.default_rng(3)
+            for _ in range(5):
+                q, dq, ddq = rng.uniform(-2, 2, 3), rng.normal(size=3), rng.normal(size=3)
+                d.qpos[:], d.qvel[:], d.qacc[:] = q, dq, ddq
+                mujoco.mj_inverse(m, d)
+                err = np.abs(ct.inverse_dynamics(q, dq, ddq) - d.qfrc_inverse).max()
+                check(err <= 1e-12 * max(1.0, np.abs(d.qfrc_inverse).max()), f"off by {err:g}")
+
+        case(t, f"computed torque with gravcomp {shares} = mj_inverse", exact, "accept")
 
 
 def saves(t: Tally, quick: bool) -> None:
@@ -1123,8 +1170,122 @@ def saves(t: Tally, quick: bool) -> None:
             for compress in (True, False):
                 path = res.save(root / f"{label}-{compress}", compress=compress)
                 _save_cases(t, f"{label} compress={compress}", res, path, rng, quick)
+        _save_writes(t, root, runs["rerun"], runs["fault run"], quick)
     finally:
         shutil.rmtree(root, ignore_errors=True)
+
+
+def _same_run(a: Any, b: Any) -> bool:
+    return a.case == b.case and all(np.array_equal(getattr(a, k), getattr(b, k)) for k in _ROWS)
+
+
+def _save_writes(t: Tally, root: Path, a: Any, b: Any, quick: bool) -> None:
+    """How a save is written and what a file says it is: saves from several
+    threads to one path (one of them whole, every load meanwhile good), a save
+    that fails partway (the old file intact), a folder as the path, a numpy
+    integer ``every``, a format-4 file declared format 2 or 3 (its record
+    dropped and q and tau swapped, or its record kept), a MuJoCo result's load
+    of another kind's file."""
+    import threading
+
+    import adaptimp
+
+    path = root / "shared.npz"
+
+    def concurrent() -> None:
+        a.save(path, recompute=False)
+        failures: list[str] = []
+        done = threading.Event()
+
+        def save(r: Any) -> None:
+            for _ in range(3 if quick else 10):
+                r.save(path, recompute=False)
+
+        def load_once() -> None:
+            try:
+                adaptimp.SimResult.load(path)
+            except Exception as e:  # the failure is the result
+                failures.append(repr(e))
+
+        def load() -> None:
+            while not done.is_set():
+                load_once()
+
+        reader = threading.Thread(target=load)
+        reader.start()
+        savers = [threading.Thread(target=save, args=(r,)) for r in (a, b, a, b)]
+        for th in savers:
+            th.start()
+        for th in savers:
+            th.join()
+        done.set()
+        reader.join()
+        check(not failures, f"a load failed while others saved: {failures[:1]}")
+        left = adaptimp.SimResult.load(path)
+        check(_same_run(left, a) or _same_run(left, b), "the file left is neither save")
+        check(sorted(p.name for p in root.glob("*shared*")) == ["shared.npz"], "a part left")
+
+    case(t, "saves: 4 threads save to one path, a fifth loads", concurrent, "accept")
+
+    def failed_save() -> None:
+        a.save(path, recompute=False)
+        before = path.read_bytes()
+        code = (
+            "import resource, signal, adaptimp\n"
+            "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+            "res = adaptimp.simulate('sf', T=0.05)\n"
+            "resource.setrlimit(resource.RLIMIT_FSIZE, (2048, 2048))\n"
+            f"try:\n    res.save({str(path)!r}, recompute=False)\n"
+            "except OSError:\n    print('refused')\n"
+        )
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        check(out.stdout.strip() == "refused", f"the failing save did not fail: {out.stderr}")
+        check(path.read_bytes() == before, "a failed save changed the file that was there")
+
+    case(t, "saves: a save that fails partway over a good one", failed_save, "accept")
+    (root / "folder").mkdir(exist_ok=True)
+    for what in (f"{root / 'folder'}/", str(root / "folder"), f"{root / 'new'}/"):
+        case(t, f"saves: save({what!r}) (a folder)", lambda w=what: a.save(w), "refuse")
+    case(t, "saves: every=np.int64(2)",
+         lambda: check(adaptimp.SimResult.load(a.save(root / "half", every=np.int64(2)))
+                       .record_every == 2, "record_every"), "accept")  # fmt: skip
+    saved = b.save(root / "v4", recompute=False)
+    with np.load(saved, allow_pickle=False) as f:
+        content = {k: f[k] for k in f}
+    for version in (2, 3):
+        for swap, keep in ((True, False), (False, True), (False, False)):
+            fmt = json.loads(str(content["format"]))
+            fmt["version"] = version
+            if not keep:
+                for key in ("arrays", "inputs", "metrics", "result"):
+                    fmt.pop(key)
+                if version < 3:
+                    fmt.pop("simulated")
+                    fmt.pop("n")
+            edited = dict(content)
+            if swap:
+                edited["q"], edited["tau"] = content["tau"], content["q"]
+                d = fmt["differences"]
+                d["q"], d["tau"] = d["tau"], d["q"]
+            edited["format"] = np.array(json.dumps(fmt))
+            label = (f"saves: format 4 declared {version}, record {'kept' if keep else 'dropped'}"
+                     f"{', q and tau swapped' if swap else ''}")  # fmt: skip
+
+            def declared(e: dict[str, Any] = edited, honest: bool = not (swap or keep)) -> None:
+                out = root / "declared.npz"
+                np.savez(out, **e)
+                back = adaptimp.SimResult.load(out)
+                check(honest, "an edited file loaded")
+                check(_same_run(back, b), "not bit for bit")
+
+            case(t, label, declared, "accept" if not (swap or keep) else "refuse")
+    try:
+        from adaptimp import mujoco as amj
+    except ImportError:
+        return
+    plain = a.save(root / "plain", compress=False)
+    case(t, "saves: MujocoResult.load of a SimResult's file",
+         lambda: repr(amj.MujocoResult.load(plain)), "refuse")  # fmt: skip
 
 
 _ROWS = ("t", "q", "dq", "xc", "xd", "tau", "tau_sat", "tau_e", "zeta", "z1")
@@ -1309,8 +1470,75 @@ def mujoco_runs(t: Tally, quick: bool) -> None:
         # The plant adds a motor where a joint has none (unnamed joints too).
         case(t, "a model without actuators",
              lambda: _finite(amj.simulate("pd", str(noact), T=0.05).tau_sat), "accept")  # fmt: skip
+        _controllers_said(t, amj)
     finally:
         shutil.rmtree(root, ignore_errors=True)
+
+
+def _controllers_said(t: Tally, amj: Any) -> None:
+    """What a run was given that it cannot honour, said or refused (it ran
+    silently): a task from another arm, a task and a reference, a controller
+    of another joint count, a controller written in Python that returns None,
+    text or a dict, or whose every torque is refused with a fault configured
+    elsewhere, or that takes the old call."""
+    import adaptimp
+
+    class Returns:
+        Ts = 1e-3
+
+        def __init__(self, value: Any) -> None:
+            self.value = value
+
+        def step(self, m: Any, **sp: Any) -> Any:
+            return self.value
+
+    for what, value in [("None", None), ("the text '3.5'", "3.5"), ("['3.5', '0']", ["3.5", "0"]),
+                        ("a dict", {"tau": [0.0, 0.0]})]:  # fmt: skip
+        case(t, f"a Python step returns {what}",
+             lambda v=value: amj.simulate(Returns(v), "two_link", T=0.01), "refuse")  # fmt: skip
+
+    def nan_with_fault() -> None:
+        res = amj.simulate(Returns([math.nan, 0.0]), "two_link", T=0.05,
+                           fault=adaptimp.Fault("nan_burst", 5.0, 0.1))  # fmt: skip
+        check(int(res.refused.sum()) == res.rows, "not every row refused")
+        check(any("were refused" in w for w in res.params["warnings"]), "no warning")
+
+    case(t, "every torque NaN, a fault configured after the run", nan_with_fault, "accept")
+
+    class Old:
+        Ts = 1e-3
+
+        def step(self, q: Any, tau_e: Any = None, dq: Any = None) -> Any:
+            return -1.0 * np.asarray(q)  # a Measurement here would raise
+
+    case(t, "an old-style step(q, tau_e=None, dq=None)",
+         lambda: _finite(amj.simulate(Old(), "two_link", T=0.01).tau_sat), "accept")  # fmt: skip
+
+    def other_count() -> None:
+        try:
+            amj.simulate(adaptimp.Controller("pd", n=3), "two_link", T=0.01)
+        except adaptimp.ConfigError as e:
+            check("3 joints, the plant 2" in str(e), f"not named: {e}")
+            raise
+
+    case(t, "a controller of 3 joints on 2", other_count, "refuse")
+    try:
+        from adaptimp import _models
+
+        robots = _models.panda_urdf_path().parents[2]
+        ur5, ur10 = (robots / f"ur_description/urdf/{a}_robot.urdf" for a in ("ur5", "ur10"))
+        if not (ur5.is_file() and ur10.is_file()):
+            return
+        task = amj.cartesian_task(ur5)
+    except (ImportError, OSError, adaptimp.ConfigError):
+        return
+    case(t, "a UR5's task run on a UR10",
+         lambda: amj.simulate("sf", ur10, T=0.01, task=task), "refuse")  # fmt: skip
+    case(t, "a task and a reference",
+         lambda: amj.simulate("sf", ur5, T=0.01, task=task,
+                              reference=lambda tt: (np.zeros(6),) * 3), "refuse")  # fmt: skip
+    case(t, "the UR5's task on the UR5",
+         lambda: _finite(amj.simulate("sf", ur5, T=0.01, task=task).tau_sat), "accept")  # fmt: skip
 
 
 _URDF_FIELDS = {
@@ -1492,8 +1720,344 @@ def descriptions(t: Tally, quick: bool) -> None:
                           "a mass matrix that is not positive definite")  # fmt: skip
 
                 case(t, f"ComputedTorque of a URDF with {fld} = {v}", model, "either")
+        _descriptions_said(t, root)
     finally:
         shutil.rmtree(root, ignore_errors=True)
+
+
+def _descriptions_said(t: Tally, root: Path) -> None:
+    """A description's mistakes the reader held or took silently: text after a
+    byte-order mark (taken for a path, the whole text printed as its name), a
+    mimic of a joint the file lacks or of itself (on the arm's way: refused;
+    off it: held and warned), a floating joint on the way to the arm the rule
+    finds, an inertia no rigid body has (its dynamics refused, by link)."""
+    from adaptimp import Chain
+    from adaptimp._description import read_arm
+
+    case(t, "URDF text after a byte-order mark",
+         lambda: _arm_ok(read_arm("\ufeff" + _urdf())), "accept")  # fmt: skip
+    for master in ("nope", "j2"):
+        text = _urdf().replace("<limit lower='-2' upper='2' effort='10' velocity='3'/>"
+                               "<dynamics damping='0.1' friction='0.05'/></joint>"
+                               "<link name='l3'>",
+                               "<limit lower='-2' upper='2' effort='10' velocity='3'/>"
+                               f"<dynamics damping='0.1' friction='0.05'/><mimic joint='{master}'/>"
+                               "</joint><link name='l3'>", 1)  # fmt: skip
+        check(text != _urdf(), "the probe arm changed")
+        case(t, f"j2 mimics {master!r} (on the way)", lambda s=text: read_arm(s), "refuse")
+
+        def off_the_way(s: str = text) -> None:
+            with warnings.catch_warnings(record=True) as seen:
+                warnings.simplefilter("always")
+                arm = read_arm(s, "l1")
+            check(bool(arm.warnings) and bool(seen), "the mistake was not said")
+
+        case(t, f"j2 mimics {master!r} (off the way to l1)", off_the_way, "accept")
+    floating = _urdf().replace("type='revolute'", "type='floating'", 1)
+    case(t, "a floating joint on the rule's way", lambda: read_arm(floating), "refuse")
+    path = root / "ixy5.urdf"
+    path.write_text(_urdf().replace("ixy='0'", "ixy='5'", 1))
+    case(t, "an inertia with ixy = 5: its chain", lambda: _chain_ok(Chain.from_urdf(path)),
+         "accept")  # fmt: skip
+    try:
+        from adaptimp import mujoco as amj
+        from adaptimp.baselines import ComputedTorque
+    except ImportError:
+        return
+    case(t, "an inertia with ixy = 5: ComputedTorque", lambda: ComputedTorque(path), "refuse")
+    slide = root / "slide.xml"
+    slide.write_text(
+        "<mujoco><worldbody><body name='a' pos='0 0 0.1'><joint name='j1' axis='0 0 1'/>"
+        "<geom size='0.05' mass='1'/><body name='b' pos='0.3 0 0'>"
+        "<joint name='s' type='slide' axis='1 0 0' range='-0.1 0.1'/>"
+        "<geom size='0.03' mass='0.5'/><body name='c' pos='0.25 0 0'>"
+        "<joint name='j3' axis='0 1 0'/><geom size='0.05' pos='0.1 0 0' mass='0.7'/>"
+        "<site name='tip' pos='0.2 0 0'/></body></body></body></worldbody></mujoco>"
+    )
+
+    def same_count() -> None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            plant, chain = amj.Plant(slide), Chain.from_mujoco(slide)
+        check(plant.n == chain.n, f"the plant drives {plant.n} joints, the chain has {chain.n}")
+
+    case(t, "a slide on the default way: the chain's joints are the plant's", same_count,
+         "accept")  # fmt: skip
+    case(t, "an inertia with ixy = 5: mujoco.simulate",
+         lambda: amj.simulate("pd", path, T=0.02), "refuse")  # fmt: skip
+
+
+# ---------------------------------------------------------------------------
+# Callbacks that read the object that called them (each in a process of its
+# own with a time limit: a deadlock holds the GIL-less thread that SIGALRM
+# cannot interrupt).
+# ---------------------------------------------------------------------------
+
+
+def _properties(obj: Any) -> list[str]:
+    """The public properties of ``obj``'s class (Python ones and getters)."""
+    import inspect
+
+    out = []
+    for name in dir(type(obj)):
+        attr = inspect.getattr_static(type(obj), name)
+        if not name.startswith("_") and (
+            isinstance(attr, property) or type(attr).__name__ == "getset_descriptor"
+        ):
+            out.append(name)
+    return out
+
+
+def _read_all(*objects: Any) -> None:
+    """Read every public property of ``objects``: an AttributeError of a
+    property the object does not have is fine, anything else is not."""
+    for obj in objects:
+        for name in _properties(obj):
+            _read_one(obj, name)
+
+
+def _read_one(obj: Any, name: str) -> None:
+    try:
+        getattr(obj, name)
+    except AttributeError as e:
+        if "has no" not in str(e) and "does not say" not in str(e):
+            raise
+    except DeprecationWarning:
+        pass
+
+
+def _callback_case(name: str) -> None:
+    """One callback case, run in a child process (``--callback NAME``)."""
+    import adaptimp
+    from adaptimp import mujoco as amj
+    from adaptimp.baselines import ComputedTorque
+
+    warnings.simplefilter("ignore")
+    q0 = np.array([0.25, -0.05])
+    chain = adaptimp.Chain.from_mujoco(amj.two_link(), "ee")
+    p0 = chain.pose(q0)[0]
+
+    def hold(tt: float) -> tuple[np.ndarray, ...]:
+        return p0, np.zeros(3), np.zeros(3)
+
+    def cart(joint: Any = "sf", **kw: Any) -> Any:
+        extra = {"tau_max": [17.0, 15.0]} if isinstance(joint, str) else {}
+        return adaptimp.CartesianController(chain, joint, q0=q0, Kd_rot=0.0, **extra, **kw)
+
+    calls = [0]
+
+    def reading(*objects: Any) -> Callable[..., None]:
+        def read(*_: Any, **__: Any) -> None:
+            calls[0] += 1
+            _read_all(*objects)
+
+        return read
+
+    if name == "replay progress":
+        c = adaptimp.Controller("sf")
+        z = np.zeros((5000, 2))
+        c.replay(z + 0.2, z, z, progress=reading(c))
+    elif name == "replay progress resets":
+        c = adaptimp.Controller("sf")
+        z = np.zeros((500, 2))
+        try:
+            c.replay(z + 0.2, z, z, progress=lambda d, t: c.reset())
+        except RuntimeError as e:
+            check("can read the Controller, not change it" in str(e), str(e))
+            calls[0] += 1
+    elif name == "MuJoCo run progress":
+        c = adaptimp.Controller("sf", scenario="robot")
+        amj.simulate(c, "two_link", T=0.2, progress=reading(c))
+    elif name == "computed torque progress":
+        ct = ComputedTorque("two_link")
+        amj.simulate(ct, "two_link", T=0.2, contact=False, progress=reading(ct))
+    elif name == "Cartesian run progress":
+        k = cart()
+        amj.simulate(k, amj.two_link(), T=0.2, q0=q0, reference=hold, progress=reading(k, k.inner))
+    elif name == "Cartesian replay progress":
+        k = cart()
+        q = np.tile(q0, (500, 1))
+        k.outer.core.replay(k.inner, q, 0 * q, np.zeros((500, 6)), None, reading(k, k.outer))
+    elif name == "a Python joint controller reads its Cartesian controller":
+
+        class Joint:
+            impedance, Ts = "external", 1e-3
+
+            def step(self, m: Any, **sp: Any) -> Any:
+                read()
+                return 50.0 * (sp["xc"] - m.q)
+
+        j = Joint()
+        k = cart(j)
+        read = reading(k, k.outer)
+        for _ in range(3):
+            k.step(adaptimp.Measurement(q0, [0.0, 0.0]))
+        amj.simulate(k, amj.two_link(), T=0.02, q0=q0, reference=hold)
+    elif name == "a path reads its Cartesian controller":
+        holder: list[Any] = []
+
+        def path(tt: float) -> tuple[np.ndarray, ...]:
+            if holder:
+                reading(holder[0], holder[0].inner)()
+            return hold(tt)
+
+        k = cart("pd", path=path)
+        holder.append(k)
+        for _ in range(3):
+            k.step(adaptimp.Measurement(q0, [0.0, 0.0]))
+    elif name == "a Python controller in a MuJoCo run reads the one it wraps":
+        inner = adaptimp.Controller("sf", scenario="robot")
+
+        class InPython:
+            Ts = inner.Ts
+
+            def step(self, m: Any, **sp: Any) -> Any:
+                reading(inner)()
+                return inner.step(m, **sp)
+
+        amj.simulate(InPython(), "two_link", T=0.02, progress=reading(inner))
+    elif name == "a trajectory reads its computed torque":
+        holder = []
+
+        def traj(tt: float) -> tuple[np.ndarray, ...]:
+            reading(holder[0])()
+            return q0, np.zeros(2), np.zeros(2)
+
+        ct = ComputedTorque("two_link", trajectory=traj)
+        holder.append(ct)
+        for _ in range(3):
+            ct.step(adaptimp.Measurement(q0, [0.0, 0.0]))
+    assert calls[0] > 0, "the callback was not called"
+    print("done")
+
+
+CALLBACK_CASES = (
+    "replay progress",
+    "replay progress resets",
+    "MuJoCo run progress",
+    "computed torque progress",
+    "Cartesian run progress",
+    "Cartesian replay progress",
+    "a Python joint controller reads its Cartesian controller",
+    "a path reads its Cartesian controller",
+    "a Python controller in a MuJoCo run reads the one it wraps",
+    "a trajectory reads its computed torque",
+)
+
+
+def callbacks(t: Tally, quick: bool) -> None:
+    """Each kind of callback (progress of a replay, a MuJoCo run, computed
+    torque, a Cartesian run and replay; a joint controller written in Python;
+    a path; a trajectory) reads every public property of the object that
+    called it, and one that resets it is refused by name: each in a process of
+    its own, 120 s at most (they deadlocked: the call held its object's lock
+    while the Python code ran)."""
+    for name in CALLBACK_CASES:
+        t.cases += 1
+        cmd = [sys.executable, __file__, "--callback", name]
+        try:
+            out = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+        except subprocess.TimeoutExpired:
+            t.hang += 1
+            t.note(f"hang: {name}")
+            continue
+        if out.returncode == 0 and out.stdout.strip().endswith("done"):
+            t.accepted += 1
+        else:
+            t.crash += 1
+            t.note(f"crash: {name}: {out.stderr.strip()[-300:]}")
+
+
+# ---------------------------------------------------------------------------
+# Wrong inputs, refused by the name written.
+# ---------------------------------------------------------------------------
+
+
+def _named(message: str, name: str) -> bool:
+    import re
+
+    return re.search(rf"(?<![A-Za-z_]){re.escape(name)}(?![A-Za-z_])", message) is not None
+
+
+def named_inputs(t: Tally, quick: bool) -> None:
+    """Entry points given a wrong type or value (text, bools, NaN, wrong
+    shapes, complex numbers, numbers for paths): each refused, the message
+    naming the argument as written."""
+    import adaptimp
+    from adaptimp import Measurement, tuning
+
+    nan = math.nan
+    scalar = [("text", "2"), ("bool", True), ("NaN", nan), ("complex", 1j)]
+    positive = [*scalar, ("zero", 0.0), ("negative", -1.0)]
+    count = [("text", "2"), ("bool", True), ("float", 2.5), ("zero", 0)]
+
+    def vector(n: int, nan_ok: bool = False) -> list[tuple[str, Any]]:
+        out = [("text", "abc"), ("bools", [True] * n), ("short", [0.1] * (n - 1)),
+               ("2-D", [[0.1] * n]), ("complex", [1j] * n), ("strings", ["0.1"] * n)]  # fmt: skip
+        return out if nan_ok else [*out, ("NaN", [nan] * n)]
+
+    q2 = [0.25, -0.05]
+    m2 = Measurement(q2, [0.0, 0.0])
+    table: list[tuple[str, str, list[tuple[str, Any]], Callable[[Any], Any]]] = [
+        ("simulate", "T", positive, lambda v: adaptimp.simulate("pd", T=v)),
+        ("simulate", "record_every", count,
+         lambda v: adaptimp.simulate("pd", T=0.01, record_every=v)),
+        ("Controller", "Ts", positive, lambda v: adaptimp.Controller("pd", Ts=v)),
+        ("Measurement", "q", vector(2, nan_ok=True), lambda v: Measurement(v, [0.0, 0.0])),
+        ("Measurement", "dq", vector(2, nan_ok=True), lambda v: Measurement(q2, v)),
+        ("Controller.step", "xc", vector(2), lambda v: adaptimp.Controller("sf").step(m2, xc=v)),
+        ("Chain.from_urdf", "source", [("number", 3), ("list", [1])],
+         lambda v: adaptimp.Chain.from_urdf(v)),
+        ("PoseTarget", "p", vector(3), lambda v: adaptimp.PoseTarget(p=v)),
+        ("Fault", "start", scalar, lambda v: adaptimp.Fault("nan_burst", v, 0.1)),
+        ("Fault", "duration", positive, lambda v: adaptimp.Fault("nan_burst", 0.1, v)),
+        ("SimResult.load", "path", [("number", 3), ("list", [1])],
+         lambda v: adaptimp.SimResult.load(v)),
+        ("tuning.suggest", "q0", vector(2),
+         lambda v: tuning.suggest(adaptimp.TwoLinkArm(), v, [17.0, 15.0])),
+        ("tuning.suggest", "Ts", positive,
+         lambda v: tuning.suggest(adaptimp.TwoLinkArm(), q2, [17.0, 15.0], Ts=v)),
+    ]  # fmt: skip
+    try:
+        from adaptimp import mujoco as amj
+        from adaptimp.baselines import ComputedTorque
+
+        chain = adaptimp.Chain.from_mujoco(amj.two_link(), "ee")
+        table += [
+            ("ComputedTorque", "payload", scalar, lambda v: ComputedTorque(payload=v)),
+            ("ComputedTorque", "mass_scale", positive, lambda v: ComputedTorque(mass_scale=v)),
+            ("ComputedTorque.mass_matrix", "q", vector(2),
+             lambda v: ComputedTorque().mass_matrix(v)),
+            ("Chain.from_mujoco", "model", [("number", 3), ("None", None)],
+             lambda v: adaptimp.Chain.from_mujoco(v)),
+            ("Chain.from_mujoco", "fix", [("text", "joint1")],
+             lambda v: adaptimp.Chain.from_mujoco(amj.two_link(), fix=v)),
+            ("CartesianController", "q0", vector(2),
+             lambda v: adaptimp.CartesianController(chain, "pd", q0=v, Kd_rot=0.0)),
+            ("CartesianController.step", "xc", vector(3),
+             lambda v: adaptimp.CartesianController(
+                 chain, "pd", q0=q2, Kd_rot=0.0, tau_max=[17.0, 15.0]).step(m2, xc=v)),
+            ("mujoco.simulate", "q0", vector(2),
+             lambda v: amj.simulate("pd", "two_link", T=0.01, q0=v)),
+            ("mujoco.simulate", "task", [("text", "abc")],
+             lambda v: amj.simulate("pd", "two_link", T=0.01, task=v)),
+            ("mujoco.Plant", "model", [("number", 3)], lambda v: amj.Plant(v)),
+        ]  # fmt: skip
+    except ImportError:
+        pass
+    for entry, name, wrong, call in table:
+        for label, value in wrong:
+
+            def refused(call: Callable[[Any], Any] = call, value: Any = value,
+                        name: str = name) -> None:  # fmt: skip
+                try:
+                    call(value)
+                except (TypeError, ValueError) as e:
+                    check(_named(str(e), name), f"the refusal does not name {name}: {e}")
+                    raise
+                check(False, "accepted")
+
+            case(t, f"{entry}({name}=) {label}", refused, "refuse")
 
 
 CATEGORIES: dict[str, Callable[[Tally, bool], None]] = {
@@ -1508,6 +2072,8 @@ CATEGORIES: dict[str, Callable[[Tally, bool], None]] = {
     "saves": saves,
     "MuJoCo runs": mujoco_runs,
     "robot descriptions": descriptions,
+    "callbacks": callbacks,
+    "named inputs": named_inputs,
 }
 
 
@@ -1540,8 +2106,12 @@ def main() -> int:
     ap.add_argument("--quick", action="store_true", help="fewer cases")
     ap.add_argument("--json", action="store_true", help="print the counts as JSON")
     ap.add_argument("--child", help=argparse.SUPPRESS)
+    ap.add_argument("--callback", help=argparse.SUPPRESS)
     ap.add_argument("--timeout", type=float, default=1800.0, help="per category (s)")
     args = ap.parse_args()
+    if args.callback:
+        _callback_case(args.callback)
+        return 0
     if args.child:
         _child(args.child, args.quick)
         return 0

@@ -447,6 +447,7 @@ fn mujoco_arrays() -> MujocoArrays {
             [1.0, 0.0, 0.0, 0.0]
         ],
         body_mass: std::vec![0.0, 1.0, 2.0],
+        body_gravcomp: Vec::new(),
         body_ipos: std::vec![[0.0; 3], [0.05, 0.0, 0.0], [0.0, 0.1, 0.0]],
         body_iquat: std::vec![[1.0, 0.0, 0.0, 0.0]; 3],
         body_inertia: std::vec![[0.0; 3], [0.01; 3], [0.02; 3]],
@@ -585,4 +586,147 @@ fn a_tree_is_built_from_plain_data_too() {
         ErrorKind::Arm
     ));
     let _: Option<&Held> = arm.held_reason("nothing");
+}
+
+/// A link the arm moves with an inertia no rigid body has (ixy = 5 on a
+/// 0.01 kg m² box: a negative principal moment) is named with the file, and
+/// the arm's dynamics refused with it (its mass matrix was indefinite); the
+/// kinematics reads. Links the arm does not move are not its business.
+#[test]
+fn an_inertia_no_rigid_body_has_refuses_the_arms_dynamics_by_name() {
+    let text = robot(
+        &[
+            ("j1", "revolute", "root", "a", ""),
+            ("j2", "revolute", "a", "b", ""),
+        ],
+        &[],
+    )
+    .replacen(
+        "<link name='b'><inertial><mass value='1'/><inertia ixx='0.01' ixy='0'",
+        "<link name='b'><inertial><mass value='1'/><inertia ixx='0.01' ixy='5'",
+        1,
+    );
+    let tree = urdf::read_str(&text).expect("a URDF");
+    let arm = reduce(&tree, None, &[]).expect("its kinematics reads");
+    assert!(arm.to_chain::<2>().is_ok());
+    let e = arm.to_dynamics::<2>(GRAVITY).expect_err("indefinite");
+    assert_eq!(e.kind(), ErrorKind::Value);
+    assert!(
+        e.to_string().starts_with(
+            "URDF text: link 'b' has the inertia [[0.01, 5, 0], [5, 0.01, 0], [0, 0, 0.01]] \
+             kg m², which no rigid body has: its principal moments are -4.990e0, 1.000e-2, \
+             5.010e0 kg m², one negative"
+        ),
+        "{e}"
+    );
+    assert_eq!(arm.inertia_error.as_ref(), Some(&e));
+    // The root's link is the base's: nothing of the arm.
+    let text = text.replace("ixy='5'", "ixy='0'").replacen(
+        "<inertia ixx='0.01' ixy='0'",
+        "<inertia ixx='0.01' ixy='5'",
+        1,
+    );
+    let arm = reduce(&urdf::read_str(&text).unwrap(), None, &[]).unwrap();
+    assert!(arm.inertia_error.is_none());
+    assert!(arm.to_dynamics::<2>(GRAVITY).is_ok());
+}
+
+/// A mimic joint whose master is not another joint of the file was held
+/// silently (on the arm's way: the arm one joint short), in every front.
+/// On the way it is refused by name; off the arm it is held and said
+/// (`Arm::warnings`): real files have such mimics on hands off the arm.
+#[test]
+fn a_mimic_of_no_joint_is_refused_on_the_way_and_said_off_it() {
+    for (mimic, why) in [
+        (
+            "nope",
+            "joint 'j2' mimics 'nope', which is not a joint of it",
+        ),
+        ("j2", "joint 'j2' mimics itself"),
+    ] {
+        let text = robot(
+            &[
+                ("j1", "revolute", "root", "a", ""),
+                (
+                    "j2",
+                    "revolute",
+                    "a",
+                    "b",
+                    &format!("<mimic joint='{mimic}'/>"),
+                ),
+                ("j3", "revolute", "b", "c", ""),
+            ],
+            &[],
+        );
+        let tree = urdf::read_str(&text).expect("a tree");
+        for tip in [None, Some("c")] {
+            let e = reduce(&tree, tip, &[]).expect_err("on the way");
+            assert_eq!(
+                e.to_string(),
+                format!(
+                    "URDF text: {why}, on the way to 'c': correct its <mimic joint=…>, or \
+                     hold it with fix="
+                )
+            );
+        }
+        // The last joint of the rule's arm: the rule ended short of it.
+        let last = robot(
+            &[
+                ("j1", "revolute", "root", "a", ""),
+                ("j2", "revolute", "a", "b", ""),
+                (
+                    "j3",
+                    "revolute",
+                    "b",
+                    "c",
+                    &format!("<mimic joint='{}'/>", mimic.replace("j2", "j3")),
+                ),
+            ],
+            &[],
+        );
+        let e = reduce(&urdf::read_str(&last).unwrap(), None, &[]).expect_err("the rule's end");
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "URDF text: {}, on the way to 'c': correct its <mimic joint=…>, or hold it \
+                 with fix=",
+                why.replace("j2", "j3")
+            )
+        );
+        // Held as asked: the file's mistake is then the user's choice.
+        assert_eq!(reduce(&tree, Some("c"), &["j2"]).unwrap().n(), 2);
+        // Off the arm (the way to 'a'): held, and said.
+        let arm = reduce(&tree, Some("a"), &[]).expect("off the arm");
+        assert_eq!(arm.n(), 1);
+        assert_eq!(
+            arm.warnings,
+            [format!(
+                "URDF text: {why}: held at its reference position (correct its <mimic joint=…>)"
+            )]
+        );
+    }
+}
+
+/// A floating joint on the way to the arm the rule finds was held silently
+/// (refused with the same tip given, as the docs say).
+#[test]
+fn a_floating_joint_on_the_way_is_refused_with_or_without_a_tip() {
+    let text = robot(
+        &[
+            ("float", "floating", "root", "a", ""),
+            ("j1", "revolute", "a", "b", ""),
+            ("j2", "revolute", "b", "c", ""),
+        ],
+        &[],
+    );
+    let tree = urdf::read_str(&text).expect("a tree");
+    for tip in [None, Some("c")] {
+        let e = reduce(&tree, tip, &[]).expect_err("floating on the way");
+        assert_eq!(
+            e.to_string(),
+            "URDF text: the joint 'float' on the way to 'c' is floating: a chain has revolute, \
+             continuous, prismatic and fixed joints only; give a tip below it or fix it with fix="
+        );
+    }
+    assert_eq!(reduce(&tree, None, &["float"]).unwrap().n(), 2);
 }

@@ -2,8 +2,9 @@
 deterministic cases over state restore (bit flips, edits), the fault
 semantics, the n-joint API, sweeps and their cache, chains, the Cartesian
 front, formulations, the dynamics and computed torque, saved results,
-MuJoCo runs and robot descriptions, each category in its own process. Not one crash, hang, silent
-wrong result or false refusal."""
+MuJoCo runs, robot descriptions, callbacks reading their controller and
+wrong inputs named, each category in its own process. Not one crash, hang,
+silent wrong result or false refusal."""
 
 from __future__ import annotations
 
@@ -36,6 +37,8 @@ def test_the_quick_break_it_probe_finds_nothing() -> None:
         "saves",
         "MuJoCo runs",
         "robot descriptions",
+        "callbacks",
+        "named inputs",
     ]
     for t in tallies:
         assert t["cases"] >= 10, t

@@ -62,21 +62,27 @@ def _twins(refuse: Callable[[adaptimp.CartesianController], None], make: Any = _
     np.testing.assert_array_equal(_steps(a, q0, 20), _steps(b, q0, 20))
 
 
+# The deviation named as what it is (it read "R_c = 0.21", as if it were R_c),
+# of R_c (a path's rotation, the core's name) or of R (the keyword given).
 ORTHONORMAL = re.escape(
     "condition RᵀR = I (an orthonormal rotation matrix, to 1e-6) is violated: "
-    "R_c = 0.2100000000000004 (SPEC §10)"
+    "max |R_cᵀR_c − I| of R_c = 0.2100000000000004 (SPEC §10)"
+)
+ORTHONORMAL_R = re.escape(
+    "condition RᵀR = I (an orthonormal rotation matrix, to 1e-6) is violated: "
+    "max |RᵀR − I| of R = 0.2100000000000004 (SPEC §10)"
 )
 
 
 def test_a_refused_rotation_is_not_kept_as_the_last_commanded_one() -> None:
     c = _ctrl()
     c.step(M0, xc=P0, R=R0)
-    with pytest.raises(adaptimp.MeasurementError, match=ORTHONORMAL):
+    with pytest.raises(adaptimp.MeasurementError, match=ORTHONORMAL_R):
         c.step(M0, xc=P0, R=1.1 * R0)
     np.testing.assert_array_equal(c.outer._R, R0)
     # The next step without R holds the last good one (it was bricked).
     c.step(M0, xc=P0)
-    with pytest.raises(adaptimp.MeasurementError, match=ORTHONORMAL):
+    with pytest.raises(adaptimp.MeasurementError, match=ORTHONORMAL_R):
         c.outer.target(P0, R=1.1 * R0)
     np.testing.assert_array_equal(c.outer._R, R0)
     c.step(M0, xc=P0)
@@ -256,24 +262,25 @@ def test_an_orbit_with_more_nodes_than_steps_samples_every_step() -> None:
          "Kd must be a scalar or have shape (3,) (x, y, z), got shape (2,)"),
         (lambda c: c.outer.set_stiffness(100.0, [[1.0]]), adaptimp.ConfigError,
          "Kd_rot must be a scalar or have shape (3,) (x, y, z), got shape (1, 1)"),
+        # Named as the step's keywords (the core's p_c, R_c, … are its own).
         (lambda c: c.step(M0, xc=[0.3, 0]), adaptimp.MeasurementError,
-         "p_c must have 3 values, got 2"),  # xc is p_c (the core reads it)
+         "xc must have shape (3,), got shape (2,)"),
         (lambda c: c.step(M0, xc=P0, R=[1, 0, 0, 1]),
-         adaptimp.MeasurementError, "R_c must have shape (3, 3), got shape (4,)"),
+         adaptimp.MeasurementError, "R must have shape (3, 3), got shape (4,)"),
         (lambda c: c.step(M0, xc=P0, R=R0.ravel()),
-         adaptimp.MeasurementError, "R_c must have shape (3, 3), got shape (9,)"),
+         adaptimp.MeasurementError, "R must have shape (3, 3), got shape (9,)"),
         (lambda c: c.step(M0, xc=P0, dw=["x", 0, 0]), TypeError,
-         "dw_c must be a sequence or array of reals"),
+         "dw must hold real numbers, got an array of dtype <U21"),
         (lambda c: c.step(Measurement(Q0, np.zeros(3), wrench=np.zeros((2, 3)))),
          adaptimp.MeasurementError,
          "wrench must have shape (6,) ([f; m], N and N m) or (3,) (f alone), got shape (2, 3)"),
         (lambda c: c.step(M0, xc=P0, w=[math.nan, 0, 0]),
-         adaptimp.MeasurementError, "w_c[0] is not finite (NaN or infinite)"),
+         adaptimp.MeasurementError, "w[0] is not finite (NaN or infinite)"),
         (lambda c: c.step(M0, xc=P0, R=np.diag([1.0, math.nan, 1.0])),
-         adaptimp.MeasurementError, "R_c[4] is not finite (NaN or infinite)"),
+         adaptimp.MeasurementError, "R[4] is not finite (NaN or infinite)"),
         (lambda c: c.step(M0, xc=[0, 0, 2e6]),
          adaptimp.MeasurementError,
-         "p_c[2] = 2e6 is beyond its limit ±1e6; the state was left unchanged"),
+         "xc[2] = 2e6 is beyond its limit ±1e6; the state was left unchanged"),
     ],
 )  # fmt: skip
 def test_malformed_arguments_are_refused_by_name_and_change_nothing(

@@ -307,3 +307,48 @@ def test_computed_torque_compensates_the_drives_friction() -> None:
         bad[3] = -1.0
         with pytest.raises(ValueError, match=rf"{key} ≥ 0 is violated: {key}\[3\] = -1"):
             ComputedTorque("panda", **{key: bad}, **kw)
+
+
+GRAVCOMP_MJCF = """<mujoco><option gravity='0.3 -0.2 -9.81'/><worldbody>
+<body name='a' pos='0 0 0.1'><joint name='j1' axis='0 0 1'/><geom size='0.05' mass='1'/>
+ <body name='b' pos='0.3 0 0' gravcomp='0.5'><joint name='j2' axis='0 1 0'/>
+  <geom type='capsule' fromto='0 0 0 0.25 0 0' size='0.03' mass='2'/>
+  <body name='held' pos='0.25 0 0' gravcomp='1'>
+   <geom size='0.04' pos='0.02 0.01 0' mass='0.5'/></body>
+  <body name='c' pos='0.25 0 0' gravcomp='0.2'><joint name='j3' axis='0 1 0'/>
+   <geom type='box' size='0.1 0.02 0.02' pos='0.1 0 0' mass='0.7'/><site name='tip' pos='0.2 0 0'/>
+  </body></body></body></worldbody>
+<actuator><motor joint='j1' ctrlrange='-50 50'/><motor joint='j2' ctrlrange='-50 50'/>
+<motor joint='j3' ctrlrange='-50 50'/></actuator></mujoco>"""
+
+
+# Shares of both signs in one moving body: b lifts 0.5 × 2 kg, the welded
+# body adds 2 × 0.5 kg: no net mass lifted, a couple (a first moment) left.
+COUPLE_MJCF = GRAVCOMP_MJCF.replace(
+    "name='held' pos='0.25 0 0' gravcomp='1'", "name='held' pos='0.25 0 0' gravcomp='-2'"
+)
+
+
+@pytest.mark.parametrize("xml", [GRAVCOMP_MJCF, COUPLE_MJCF], ids=["shares", "couple"])
+def test_inverse_dynamics_takes_mujocos_gravity_compensation(xml: str) -> None:
+    """A body's ``gravcomp`` lifts that share of its weight in the plant
+    (MuJoCo's ``qfrc_gravcomp``, a passive force); computed torque's model
+    lifts the same (SPEC (20.1')), a welded body with its own share folded
+    in, shares of both signs too (a couple, no net mass): inverse dynamics is
+    ``mj_inverse``'s to rounding. It was off by exactly ``qfrc_gravcomp``
+    (1.3 N m on the UR-sized arm of the report)."""
+    import mujoco
+
+    assert xml.count("gravcomp='-2'") == (xml is COUPLE_MJCF)
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    ct = ComputedTorque(m, tip="tip")
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        q, dq, ddq = rng.uniform(-2, 2, 3), rng.normal(size=3), rng.normal(size=3)
+        d.qpos[:], d.qvel[:], d.qacc[:] = q, dq, ddq
+        mujoco.mj_inverse(m, d)
+        assert np.abs(d.qfrc_gravcomp).max() > 0.1
+        want = d.qfrc_inverse
+        got = ct.inverse_dynamics(q, dq, ddq)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())

@@ -62,7 +62,7 @@ def test_faults_are_checked() -> None:
         adaptimp.Fault("stale", 0.0, 1.0, bias=1.0)
     with pytest.raises(adaptimp.ConfigError, match="0 ≤ fraction ≤ 1"):
         adaptimp.simulate("sf", T=0.1, fault=adaptimp.Fault("actuator_drop", 0, 1, fraction=2.0))
-    with pytest.raises(adaptimp.ConfigError, match="duration > 0"):
+    with pytest.raises(adaptimp.ConfigError, match="Fault duration must be a finite number > 0"):
         amj.simulate("sf", "two_link", T=0.1, fault=adaptimp.Fault("skipped", 0.0, 0.0))
     with pytest.raises(ValueError, match=r"bias must be a number or have shape \(2,\)"):
         adaptimp.simulate("sf", T=0.1, fault=adaptimp.Fault("force_bias", 0, 1, bias=[1, 2, 3]))

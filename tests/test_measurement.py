@@ -66,10 +66,11 @@ def test_a_measurement_keeps_a_sensor_nan_for_the_controller_to_refuse() -> None
          "q must be one value per joint (a 1-D array), got a scalar"),
         (lambda: Measurement(np.zeros((2, 1))), MeasurementError,
          "q must be one value per joint (a 1-D array), got shape (2, 1)"),
+        # Both named: the length q set, and the one that differs.
         (lambda: Measurement(Q, [0.0]), MeasurementError,
-         "dq must have shape (2,) (one value per joint), got length 1"),
+         "dq has 1 values and q 2: one value per joint each"),
         (lambda: Measurement(Q, tau_e=[0.0] * 3), MeasurementError,
-         "tau_e must have shape (2,) (one value per joint), got length 3"),
+         "tau_e has 3 values and q 2: one value per joint each"),
         (lambda: Measurement(Q, wrench=[0.0] * 5), MeasurementError,
          "wrench must have shape (6,) ([f; m], N and N m) or (3,) (f alone), got shape (5,)"),
         (lambda: Measurement(object()), TypeError,

@@ -69,7 +69,11 @@ def test_a_menagerie_style_file_becomes_a_torque_plant_in_memory() -> None:
     assert np.all(m.actuator_biastype == int(mujoco.mjtBias.mjBIAS_NONE))
     notes = plant.notes
     assert notes["tau_max"] == dict.fromkeys(ARM, "forcerange")
-    assert notes["actuators"]["wrist_1_joint"] == "position actuator 'wrist_1' → motor"
+    # Named by what it does (a <general> like it was called a "position actuator").
+    assert notes["actuators"]["wrist_1_joint"] == (
+        "actuator 'wrist_1' (a position servo, kp = 560: a <position>, or a <general> with its "
+        "gain and bias) → motor"
+    )
     assert set(notes["locked"]) == {"left_knuckle_joint", "right_knuckle_joint"}
     assert notes["timestep"] == "mjINT_EULER at 0.002 s in the file: stepped at 0.00025 s"
     assert notes["tip"] == "wrist_3_link"

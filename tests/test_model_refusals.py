@@ -157,3 +157,36 @@ def test_drive_that_is_not_a_bool_is_refused() -> None:
         with pytest.raises(TypeError, match=r"^drive must be True or False, got "):
             amj.from_urdf(hobby, drive=drive)
     assert ComputedTorque(str(hobby), drive=True, tau_max=5.0).drive["damping"][0] == 0.1
+
+
+@pytest.mark.parametrize(
+    ("attribute", "value", "moments"),
+    [
+        ("ixy", "5", "-5.000e0, 5.000e-5, 5.000e0"),
+        ("ixx", "-0.01", "-1.000e-2, 5.000e-5, 5.000e-5"),
+    ],
+)
+def test_an_inertia_no_rigid_body_has_is_refused_by_link_and_file(
+    tmp_path: Path, attribute: str, value: str, moments: str
+) -> None:
+    """An inertia that is not positive semi-definite made M(q) indefinite
+    (ixy = 5: its smallest eigenvalue −11.1) and was accepted; MuJoCo refuses
+    such a file, unnamed. The core's reduction names the link and the file,
+    and the arm's dynamics is refused with it, by computed torque and the
+    plant alike (ixx < 0 was refused by the dynamics with no name); its
+    kinematics, which the inertia plays no part in, reads (real files have
+    such links: example-robot-data's Romeo's hips)."""
+    from adaptimp import mujoco as amj
+
+    hobby = Path(__file__).parent / "data" / "hobby_arm.urdf"
+    text = hobby.read_text()
+    found = list(re.finditer(rf'{attribute}="[^"]*"', text))[1]
+    path = tmp_path / "bad_inertia.urdf"
+    path.write_text(text[: found.start()] + f'{attribute}="{value}"' + text[found.end() :])
+    for read in (ComputedTorque, amj.from_urdf):
+        with pytest.raises(adaptimp.ConfigError) as e:
+            read(path)
+        message = str(e.value)
+        assert message.startswith("URDF 'bad_inertia.urdf': link 'shoulder' has the inertia ")
+        assert f"its principal moments are {moments} kg m², one negative" in message
+    assert adaptimp.Chain.from_urdf(path).n == 5

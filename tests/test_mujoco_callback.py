@@ -42,6 +42,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -448,7 +449,9 @@ def test_skipped_steps_and_a_torque_that_is_not_finite_are_refused() -> None:
             return np.array([math.nan, 1.0]) if 50 <= self.calls < 55 else tau
 
     burst = adaptimp.Fault("nan_burst", 1.0, 0.01)  # a window after the run: refusals allowed
-    res = amj.simulate(Blows(), "two_link", T=0.2, reference=amj.paper_circle(), fault=burst)
+    # ... and said: refused steps outside the fault's window (they were silent).
+    with pytest.warns(adaptimp.PlantWarning, match=r"^5 of 200 recorded steps were refused "):
+        res = amj.simulate(Blows(), "two_link", T=0.2, reference=amj.paper_circle(), fault=burst)
     assert res.refused is not None
     assert np.flatnonzero(res.refused).tolist() == [49, 50, 51, 52, 53]
     np.testing.assert_array_equal(res.tau_sat[49:54], np.zeros((5, 2)))
@@ -518,8 +521,18 @@ def test_what_a_controller_returns_and_says_is_checked_by_name() -> None:
         def step(self, m: Any, **sp: Any) -> str:
             return "torque"
 
-    with pytest.raises(ValueError, match="could not convert string to float"):
-        amj.simulate(Word(), "two_link", T=0.01, reference=amj.paper_circle())
+    # Text is not a torque ("3.5" was taken as 3.5 N m), nor None (it became
+    # NaN: "tau must be finite"), nor a dict: refused naming tau.
+    returned = (
+        ("torque", "a str of dtype <U6"), (["3.5", "0"], "a list of dtype <U3"),
+        (None, "None"), ({"tau": [0, 0]}, "a dict of dtype object"),
+    )  # fmt: skip
+    for value, what in returned:
+        Word.step = lambda self, m, _v=value, **sp: _v  # type: ignore[method-assign,misc]
+        with pytest.raises(
+            TypeError, match=re.escape(f"the controller's step returned {what} for its torque")
+        ):
+            amj.simulate(Word(), "two_link", T=0.01, reference=amj.paper_circle())
 
 
 def test_a_task_space_controller_called_back_refuses_what_acts_on_tau_e() -> None:

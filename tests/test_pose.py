@@ -29,11 +29,27 @@ def test_a_pose_target_is_the_flat_target_it_replaces() -> None:
         ({"p": [0.0, 0.0, 0.0], "R": np.eye(3).ravel()}, "R must have shape (3, 3), got (9,)"),
         ({"p": [0.0, float("nan"), 0.0]}, "p[1] = nan is not finite"),
         ({"p": [0.0, 0.0, 0.0], "w": [0.0, 0.0, float("inf")]}, "w[2] = inf is not finite"),
-        ({"p": "abc"}, "p must be (3,) reals, got 'abc'"),
     ],
 )
 def test_a_bad_pose_target_is_refused_by_name(kw: dict[str, object], message: str) -> None:
     with pytest.raises(ConfigError) as e:
+        PoseTarget(**kw)  # type: ignore[arg-type]
+    assert str(e.value) == message
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"p": "abc"}, "p must be real numbers, got str 'abc'"),
+        ({"p": [True, False, True]}, "p must hold real numbers, got an array of dtype bool"),
+        ({"p": ["0.1", "0", "0"]}, "p must hold real numbers, got an array of dtype <U3"),
+    ],
+)
+def test_a_pose_target_of_another_type_is_refused_by_name(
+    kw: dict[str, object], message: str
+) -> None:
+    """Text and bools were read as numbers ("0.1" as 0.1, True as 1)."""
+    with pytest.raises(TypeError) as e:
         PoseTarget(**kw)  # type: ignore[arg-type]
     assert str(e.value) == message
 

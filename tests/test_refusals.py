@@ -269,15 +269,16 @@ def _set(key: str, value: object) -> object:
 
 
 def _as_format_3(m: dict[str, object]) -> dict[str, object]:
-    """A record of format 3 (before every array's digest was recorded)."""
+    """A record of format 3 (before the digests of the arrays, inputs and
+    metrics and the class were recorded: a file of format 3 holds none of
+    them, and one that declares 3 with any of them is refused)."""
     m["version"] = 3
-    for key in ("arrays", "result"):
+    for key in ("arrays", "result", "inputs", "metrics"):
         m.pop(key, None)
     return m
 
 
 def _without_inputs(m: dict[str, object]) -> dict[str, object]:
-    del m["inputs"]
     return _as_format_3(m)
 
 
@@ -341,9 +342,10 @@ def test_a_file_without_recorded_inputs_names_what_differs_and_both_causes(
 
 def test_metrics_edited_after_the_save_are_refused_or_recomputed(tmp_path: Path) -> None:
     """A save records each metric's SHA-256: an edited one is refused by name. A
-    file without that record (an earlier version) has its metrics recomputed
-    from its rows by the core's accumulator (bit for bit the run's), with a
-    warning naming each that differed."""
+    file of format 2 or 3 saved the metrics of the rows it holds: one that
+    disagrees with its rows is refused too. A file of format 1 (no record)
+    has its metrics recomputed from its rows by the core's accumulator (bit
+    for bit the run's), with a warning naming each that differed."""
     res = adaptimp.simulate("sf", T=2.05)
     path = res.save(tmp_path / "run")
     edited = _edited(path, tmp_path / "m.npz", metrics=_set("rms_z1", 0.001))
@@ -361,7 +363,18 @@ def test_metrics_edited_after_the_save_are_refused_or_recomputed(tmp_path: Path)
     with pytest.raises(ValueError, match=re.escape(f"{plain}: the file was edited")):
         adaptimp.SimResult.load(plain)
     true = res.metrics["rms_z1_after2"]
-    for name, source in (("old", _edited(path, tmp_path / "old.npz", format=_without_metrics)),):
+    old = _edited(path, tmp_path / "old.npz", format=_without_metrics)
+    bad = _edited(old, tmp_path / "old_m.npz", metrics=_set("rms_z1_after2", 0.5))
+    message = (
+        f"{bad}: the file was edited after it was saved: its metrics are not those of its rows "
+        f"(rms_z1_after2 = 0.5 stored, {true!r} from the rows; format 3 saved them together)"
+    )
+    with pytest.raises(adaptimp.SaveError, match=f"^{re.escape(message)}$"):
+        adaptimp.SimResult.load(bad)
+    with np.load(res.save(tmp_path / "plain1", compress=False), allow_pickle=False) as f:
+        first = {k: f[k] for k in f if k != "format"}  # format 1: plain arrays, no record
+    np.savez(tmp_path / "v1.npz", **first)
+    for name, source in (("v1", tmp_path / "v1.npz"),):
         bad = _edited(source, tmp_path / f"{name}_m.npz", metrics=_set("rms_z1_after2", 0.5))
         warning = (
             f"{bad}: the stored metrics disagree with what its rows give (rms_z1_after2 = 0.5 "
@@ -377,7 +390,6 @@ def test_metrics_edited_after_the_save_are_refused_or_recomputed(tmp_path: Path)
 
 
 def _without_metrics(m: dict[str, object]) -> dict[str, object]:
-    del m["metrics"]
     return _as_format_3(m)
 
 

@@ -3,6 +3,9 @@ named conditions, a spike poisons nothing, and the fail-safe step."""
 
 from __future__ import annotations
 
+import signal
+import time
+
 import numpy as np
 import pytest
 
@@ -111,3 +114,59 @@ def test_plausibility_and_rate_limits_from_python() -> None:
         assert np.max(np.abs(tau - last)) <= 0.5 + 1e-12
         last = tau
     assert adaptimp.Controller("sf", q_max=None).params["q_max"] is None
+
+
+def _chain_urdf(n: int) -> str:
+    """A URDF of ``n`` links in a chain: fixed joints, the last three revolute."""
+    parts = ["<robot name='big'>", "<link name='l0'/>"]
+    for i in range(1, n + 1):
+        parts.append(f"<link name='l{i}'/>")
+        if i + 3 > n:
+            parts.append(
+                f"<joint name='j{i}' type='revolute'><parent link='l{i - 1}'/>"
+                f"<child link='l{i}'/><axis xyz='0 0 1'/>"
+                "<limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+            )
+        else:
+            parts.append(
+                f"<joint name='j{i}' type='fixed'><parent link='l{i - 1}'/>"
+                f"<child link='l{i}'/><origin xyz='0 0 0.001'/></joint>"
+            )
+    parts.append("</robot>")
+    return "\n".join(parts)
+
+
+class _Interrupted(Exception):
+    pass
+
+
+def test_reading_a_large_urdf_stops_on_a_signal() -> None:
+    """A signal's handler runs while a URDF is read, and its exception stops
+    the reading there (Ctrl-C's KeyboardInterrupt is such an exception): the
+    reader asks between two pieces of its work. Timed in CPU seconds by the
+    process's own profiling timer, which fires after 0.1 s of CPU whatever
+    the machine's load: the interrupted reading spends a small part of a
+    whole one's CPU (it spent all of it before: no signal was seen until the
+    reading returned)."""
+    n = 40_000
+    text = _chain_urdf(n)
+    t0 = time.process_time()
+    assert adaptimp.Chain.from_urdf(text, tip=f"l{n}").n == 3
+    whole = time.process_time() - t0
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise _Interrupted
+
+    old = signal.signal(signal.SIGPROF, interrupt)
+    try:
+        signal.setitimer(signal.ITIMER_PROF, 0.1)
+        t0 = time.process_time()
+        with pytest.raises(_Interrupted) as stopped:
+            adaptimp.Chain.from_urdf(text, tip=f"l{n}")
+        spent = time.process_time() - t0
+    finally:
+        signal.setitimer(signal.ITIMER_PROF, 0)
+        signal.signal(signal.SIGPROF, old)
+    # Raised inside the reading, not after it ended (then with its context).
+    assert stopped.value.__context__ is None
+    assert spent < 0.5 * whole, (spent, whole)

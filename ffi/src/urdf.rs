@@ -116,7 +116,7 @@ pub unsafe extern "C" fn adaptimp_chain_from_urdf(
         if out.is_null() {
             return Err(fail(AdaptimpStatus::NullPointer, &"out is NULL"));
         }
-        let tree = if source.trim_start().starts_with('<') {
+        let tree = if urdf::is_text(source) {
             urdf::read_str(source)
         } else {
             urdf::read_file(source)

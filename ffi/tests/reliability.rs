@@ -502,3 +502,94 @@ fn a_freed_or_foreign_pointer_is_refused_not_used() {
     // The handles still work.
     assert!(h.step(&Q, Some(&DQ), &TE).is_ok());
 }
+
+/// URDF text that starts with a byte-order mark (as an editor on Windows
+/// saves it) is text, not a path: it was taken for a file name, and the
+/// whole text printed as one.
+#[test]
+fn urdf_text_with_a_byte_order_mark_is_read_as_text() {
+    let text = "\u{feff}<robot name='r'><link name='a'/><link name='b'/>\
+                <joint name='j' type='revolute'><parent link='a'/><child link='b'/>\
+                <axis xyz='0 0 1'/><limit lower='-1' upper='1' effort='1' velocity='1'/>\
+                </joint></robot>";
+    let source = std::ffi::CString::new(text).unwrap();
+    let mut chain: *mut AdaptimpChain = ptr::null_mut();
+    // SAFETY: NUL-terminated strings, a valid out pointer, no fix names.
+    let status = unsafe {
+        adaptimp_chain_from_urdf(
+            source.as_ptr(),
+            ptr::null(),
+            ptr::null(),
+            0,
+            &mut chain,
+            ptr::null_mut(),
+        )
+    };
+    assert_eq!(status, AdaptimpStatus::Ok, "{}", last_error());
+    // SAFETY: the chain the call made.
+    unsafe { adaptimp_chain_free(chain) };
+    // A path that does not exist is named, a long one shortened.
+    let long = std::ffi::CString::new(format!("/nope/{}\nmore", "x".repeat(300))).unwrap();
+    // SAFETY: as above.
+    let status = unsafe {
+        adaptimp_chain_from_urdf(
+            long.as_ptr(),
+            ptr::null(),
+            ptr::null(),
+            0,
+            &mut chain,
+            ptr::null_mut(),
+        )
+    };
+    assert_eq!(status, AdaptimpStatus::InvalidConfig);
+    let e = last_error();
+    assert!(e.starts_with("cannot read the URDF '/nope/xxx"), "{e}");
+    assert!(e.contains("… (311 characters)"), "{e}");
+    assert!(e.len() < 300, "{e}");
+}
+
+/// A mimic joint of a joint the file lacks, or of itself, on the arm's way
+/// was held silently in C as in Python (the arm one joint short): refused
+/// by name, by the core's reduction every front shares.
+#[test]
+fn a_mimic_of_no_joint_on_the_way_is_refused_in_c() {
+    for (master, why) in [
+        (
+            "nope",
+            "joint 'j2' mimics 'nope', which is not a joint of it",
+        ),
+        ("j2", "joint 'j2' mimics itself"),
+    ] {
+        let text = format!(
+            "<robot name='r'><link name='a'/><link name='b'/><link name='c'/>\
+             <joint name='j1' type='revolute'><parent link='a'/><child link='b'/>\
+             <axis xyz='0 0 1'/><limit lower='-1' upper='1' effort='1' velocity='1'/>\
+             </joint><joint name='j2' type='revolute'><parent link='b'/><child link='c'/>\
+             <origin xyz='0 0 0.1'/><axis xyz='0 1 0'/>\
+             <limit lower='-1' upper='1' effort='1' velocity='1'/><mimic joint='{master}'/>\
+             </joint></robot>"
+        );
+        let source = std::ffi::CString::new(text).unwrap();
+        for tip in [None, Some(c"c")] {
+            let mut chain: *mut AdaptimpChain = ptr::null_mut();
+            // SAFETY: NUL-terminated strings, a valid out pointer, no fix names.
+            let status = unsafe {
+                adaptimp_chain_from_urdf(
+                    source.as_ptr(),
+                    tip.map_or(ptr::null(), |t| t.as_ptr()),
+                    ptr::null(),
+                    0,
+                    &mut chain,
+                    ptr::null_mut(),
+                )
+            };
+            assert_eq!(status, AdaptimpStatus::InvalidConfig, "{tip:?}");
+            assert!(chain.is_null());
+            let e = last_error();
+            assert!(
+                e.starts_with(&format!("URDF text: {why}, on the way to 'c'")),
+                "{e}"
+            );
+        }
+    }
+}

@@ -838,6 +838,7 @@ class ComputedTorque:
         friction_rate: float | Sequence[float] | None = None,
         stiffness: float | Sequence[float] | None = None,
         spring_reference: float | Sequence[float] | None = None,
+        lifted: list[dict[str, Any]] | None = None,
     ) -> ComputedTorque: ...
     @property
     def n(self) -> int: ...

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp, _mjcf
-from ._errors import ConfigError
+from ._errors import ConfigError, DivergedError
 from .cartesian import CartesianController, Path, tabulate
 from .chain import Chain
 
@@ -110,20 +110,33 @@ def _split(row: FloatArray) -> tuple[FloatArray, ...]:
     return row[0:3], row[3:6], row[6:9], row[9:18].reshape(3, 3), row[18:21], row[21:24]
 
 
+def _pose_array(name: str, x: Any) -> FloatArray:
+    """A pose array of reals, or a TypeError naming it ("abc" gave NumPy's words)."""
+    try:
+        return np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"pose array {name} must hold real numbers, got {x!r:.40}") from None
+
+
 class TablePath:
     """A path given as arrays, row k at t_k = k·``Ts``: (p, ṗ, p̈) (K, 3) each
     (m, m/s, m/s²) and optionally (R (K, 3, 3), ω, ω̇ (K, 3)); beyond its last
     row the last pose at rest."""
 
     def __init__(self, arrays: Sequence[ArrayLike], Ts: float) -> None:
-        a = [np.asarray(x, dtype=np.float64) for x in arrays]
-        if len(a) not in (3, 6):
+        names = ("p", "dp", "ddp", "R", "w", "dw")
+        if isinstance(arrays, (str, bytes)) or not isinstance(arrays, (Sequence, np.ndarray)):
+            raise TypeError(
+                "pose must be a path (a callable t -> (p, dp, ddp[, R, w, dw])) or the arrays "
+                f"(p, dp, ddp[, R, w, dw]), got {type(arrays).__name__} {arrays!r:.40}"
+            )
+        a = [_pose_array(name, x) for name, x in zip(names, arrays)]
+        if len(arrays) not in (3, 6):
             raise ConfigError(
                 f"pose arrays must be (p, dp, ddp) or (p, dp, ddp, R, w, dw), got {len(a)} arrays"
             )
         k = a[0].shape[0] if a[0].ndim == 2 else 0
         shapes = [(k, 3)] * 3 + [(k, 3, 3), (k, 3), (k, 3)]
-        names = ("p", "dp", "ddp", "R", "w", "dw")
         for name, x, want in zip(names, a, shapes):
             if k == 0 or x.shape != want:
                 raise ConfigError(
@@ -428,9 +441,35 @@ class CartesianTask:
                 "task= builds the Cartesian controller of a case name ('pd', 'sf', 'of'); "
                 f"got {type(controller).__name__}: run your own controller without task="
             )
+        self.check_arm(plant)
         own = {k: v for k, v in params.items() if k not in keep}
         rest = {k: v for k, v in params.items() if k in keep}
         return self.controller(controller, plant, Ts=1e-3 if Ts is None else Ts, **own), rest
+
+    def check_arm(self, plant: Any) -> None:
+        """The task is this plant's: its chain's tip is the plant's end-effector
+        point (to 1e-9 m and rad) at its start and at two other postures; else a
+        ConfigError with the distance (a task made on another arm was run, and
+        its errors measured with the other arm's kinematics: 0.2 mm reported
+        while the tip was 219 mm off)."""
+        mine = chain_of(plant)
+        if mine.n != self.chain.n:
+            raise ConfigError(
+                f"the task was made on an arm of {self.chain.n} joints, the plant has {mine.n}: "
+                "make the task on this plant (cartesian_task(plant))"
+            )
+        worst = (0.0, 0.0)
+        for shift in (0.0, 0.3, -0.5):
+            q = self.q0 + shift
+            (p, r), (pm, rm) = self.chain.pose(q), mine.pose(q)
+            turn = float(np.linalg.norm(r.T @ rm - np.eye(3)))
+            worst = max(worst, (float(np.linalg.norm(p - pm)), turn))
+        if worst[0] > 1e-9 or worst[1] > 1e-9:
+            raise ConfigError(
+                f"the task was made on another arm: its chain's tip is {worst[0]:.3g} m (and "
+                f"{worst[1]:.3g} in rotation) from this plant's end effector at the same "
+                "joint values: make the task on this plant (cartesian_task(plant))"
+            )
 
     def measure(self, res: Any) -> None:
         """The task's errors of a run (``res`` from :func:`adaptimp.mujoco.simulate`),
@@ -530,6 +569,9 @@ def task_of(
     chain = chain_of(plant)
     n = chain.n
     orients = n >= 6
+    # Named before the search (Ts = 0 was "no start posture found … 40 tried").
+    Ts = _positive("Ts", Ts)
+    _configured(chain, Ts, orients, plant)
     probe = _Probe(plant)
     user_path: Path | None
     if pose is None:
@@ -542,8 +584,8 @@ def task_of(
         span = getattr(user_path, "span", None) if user_path is not None else None
     if user_path is not None and span is None:
         span = 4.0
-    if span is not None and not (math.isfinite(span) and span > 0):
-        raise ConfigError(f"span must be a finite number > 0 (s), got {span!r}")
+    if span is not None:
+        span = _positive("span", span)
 
     def path_from(q: FloatArray) -> tuple[FloatArray, Path, float]:
         """The start (after the inverse kinematics of a given path), the path, its span."""
@@ -564,19 +606,32 @@ def task_of(
                 f"q0 must lie within the joint limits; joint {i} ({chain.joint_names[i]!r}) has "
                 f"q0 = {float(q[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
             )
-        start, path, length = path_from(q)
+        try:
+            start, path, length = path_from(q)
+        except DivergedError as e:
+            raise ConfigError(
+                f"q0 cannot run the task: the inverse kinematics of the pose path's first pose "
+                f"from q0 diverged ({e}): is the pose within the arm's reach?"
+            ) from None
         # A start the user gives: gravity within the actuators (a drawn one: half).
         a = _assess(plant, probe, chain, start, path, length, Ts, orients, load=GIVEN_LOAD)
         if a["error"] is not None:
             raise ConfigError(f"q0 cannot run the task: {a['error']}")
         return CartesianTask(start, chain, path, length, orients, a, "given")
     screened = []
+    failures: dict[str, int] = {}
     for k, q in enumerate(_candidates(plant, seed)):
-        quick = _screen(probe, chain, q, orients, plant)
+        quick, why = _screen(probe, chain, q, orients, plant)
         if quick is not None:
             screened.append((quick, k, q))
+        elif why is not None:
+            condition = why.split(" is violated")[0]
+            failures[condition] = failures.get(condition, 0) + 1
     screened.sort(key=lambda x: (-x[0], x[1]))
     first_error = "none passed the rule at its start"
+    if failures:  # the condition that failed most, named
+        common, count = max(failures.items(), key=lambda kv: kv[1])
+        first_error += f" (the {common} failed at {count} of them)"
     tried = screened[:CHECKED]
     for _, k, q in tried:
         try:
@@ -584,6 +639,12 @@ def task_of(
             a = _assess(plant, probe, chain, start, path, length, Ts, orients)
         except ConfigError as e:  # the core refused the orbit: not this posture
             first_error = str(e)
+            continue
+        except DivergedError as e:  # the inverse kinematics of the path's first pose
+            first_error = (
+                f"the inverse kinematics of the pose path's first pose diverged ({e}): is the "
+                "pose within the arm's reach?"
+            )
             continue
         if a["error"] is None:
             source = f"drawn (candidate {k} of {CANDIDATES + 2})"
@@ -610,15 +671,46 @@ def _candidates(plant: Any, seed: int) -> list[FloatArray]:
     return [zero, 0.5 * (a + b), *rng.uniform(a, b, size=(CANDIDATES, plant.n))]
 
 
-def _screen(probe: _Probe, chain: Chain, q: FloatArray, orients: bool, plant: Any) -> float | None:
+def _screen(
+    probe: _Probe, chain: Chain, q: FloatArray, orients: bool, plant: Any
+) -> tuple[float | None, str | None]:
     """The core's posture rule (SPEC (16.9)) at the candidate alone: its score,
-    or None if it fails there already (σmin, limits, gravity, conditioning)."""
+    or None and why it fails there already (σmin, limits, gravity,
+    conditioning)."""
     lo, hi = _limits(plant)
     a = _adaptimp.assess_posture(
         chain, q[None, :], chain.pose(q)[0][None, :], probe.gravity(q)[None, :],
         probe.inertia(q), lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients,
     )  # fmt: skip
-    return None if a["error"] is not None else float(a["score"])
+    if a["error"] is not None:
+        return None, str(a["error"])
+    return float(a["score"]), None
+
+
+def _positive(name: str, value: Any) -> float:
+    """``value`` as a finite number > 0, or an error naming ``name`` (a
+    TypeError for text or a bool, "2" gave Python's own message)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a finite number > 0 (s), got {value!r:.40}")
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise ConfigError(f"{name} must be a finite number > 0 (s), got {value!r}")
+    return v
+
+
+def _configured(chain: Chain, Ts: float, orients: bool, plant: Any) -> None:
+    """The outer loop's configuration at the period ``Ts``, checked once by the
+    core before any posture is tried (Ts = 0.5 s failed every candidate,
+    reported as "no start posture found")."""
+    from .cartesian import CartesianImpedance
+
+    lo, hi = _limits(plant)
+    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
+    position_only: dict[str, Any] = {} if orients else {"Kd_rot": 0.0}
+    try:
+        CartesianImpedance(chain, Ts=Ts, q0=mid, **position_only)
+    except ConfigError as e:
+        raise ConfigError(f"Ts = {Ts!r} s: {e}") from None
 
 
 def _vector(name: str, value: ArrayLike, chain: Chain) -> FloatArray:

@@ -12,14 +12,15 @@ why. This module parses no XML.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from . import _adaptimp
-from ._errors import ConfigError, XacroError
+from ._errors import ConfigError, PlantWarning, XacroError
 
 __all__ = ["Arm", "mujoco_arrays", "read_arm"]
 
@@ -56,6 +57,19 @@ class Arm:
         Per joint, the body it moves (its link and everything fixed to it):
         ``mass`` (kg), the centre of mass ``translation`` (m) in the joint's
         frame, ``inertia`` about it (kg m², 3 × 3).
+    lifted : list of dict
+        Per joint, what gravity compensation lifts of its body (MuJoCo's
+        ``gravcomp``; zeros for a URDF): ``mass`` (kg, gravcomp × mass summed
+        over its links) and its first ``moment`` (kg m, gravcomp × mass ×
+        centre summed, in the joint's frame; SPEC (20.1')).
+    warnings : tuple of str
+        The description's mistakes the arm does not depend on, held (a mimic
+        joint off the arm whose master is not a joint of it): warned as
+        :class:`adaptimp.PlantWarning` when the arm is read.
+    inertia_error : str or None
+        The first link the arm moves whose inertia no rigid body has (not
+        positive semi-definite), named with the file: a model of the arm's
+        dynamics is refused with it (its kinematics reads).
     base, tip : str
         The root link, and the link (or frame, MuJoCo site) that ends the arm.
     tip_is_frame : bool
@@ -104,6 +118,9 @@ class Arm:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     joint_ids: tuple[int, ...] = ()
     balanced: tuple[str, ...] = ()
+    lifted: list[dict[str, Any]] = field(default_factory=list)
+    inertia_error: str | None = None
+    warnings: tuple[str, ...] = ()
 
     @property
     def n(self) -> int:
@@ -133,9 +150,13 @@ class Arm:
             "damping",
             "friction",
             "balanced",
+            "warnings",
         )
         fields: dict[str, Any] = {k: tuple(v) if k in tuples else v for k, v in d.items()}
-        return cls(**fields, **extra)
+        arm = cls(**fields, **extra)
+        for text in arm.warnings:
+            warnings.warn(text, PlantWarning, stacklevel=4)
+        return arm
 
 
 _BALANCED_SAID: set[tuple[str, tuple[str, ...]]] = set()
@@ -263,6 +284,7 @@ def mujoco_arrays(model: Any) -> dict[str, Any]:
         "body_ipos": model.body_ipos.tolist(),
         "body_iquat": model.body_iquat.tolist(),
         "body_inertia": model.body_inertia.tolist(),
+        "body_gravcomp": model.body_gravcomp.tolist(),
         "jnt_name": names(obj.mjOBJ_JOINT, model.njnt),
         "jnt_type": model.jnt_type.tolist(),
         "jnt_bodyid": model.jnt_bodyid.tolist(),
@@ -411,7 +433,7 @@ def read_arm(
     if _is_model(source):
         label = f"MuJoCo model '{_model_name(source)}'"
         return _from_model(source, label, tip, fix)
-    if isinstance(source, str) and source.lstrip().startswith("<"):
+    if isinstance(source, str) and source.removeprefix("\ufeff").lstrip().startswith("<"):
         return Arm._of(_adaptimp.read_arm(source, tip, list(fix)))
     if not isinstance(source, (str, os.PathLike)):
         raise ConfigError(

@@ -4,12 +4,13 @@ wrong on a real robot, over a window of time, for :func:`adaptimp.simulate` and
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Union
 
 import numpy as np
+
+from ._inputs import number, positive
 
 FAULT_KINDS = ("stale", "nan_burst", "force_bias", "actuator_drop", "skipped")
 """The kinds of :class:`Fault`."""
@@ -55,10 +56,10 @@ class Fault:
             raise TypeError("bias= goes with kind 'force_bias' (and only with it)")
         if (self.fraction is not None) != (self.kind == "actuator_drop"):
             raise TypeError("fraction= goes with kind 'actuator_drop' (and only with it)")
-        for name in ("start", "duration"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not math.isfinite(float(value)):
-                raise ValueError(f"Fault {name} must be a finite number of seconds, got {value!r}")
+        # By name, before any run: "2" was taken as 2 s, a duration ≤ 0 refused
+        # only when a run began.
+        number("Fault start", self.start)
+        positive("Fault duration", self.duration)
 
     def _core(self, n: int) -> CoreFault:
         """The form the compiled core takes, for n joints."""

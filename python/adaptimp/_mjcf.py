@@ -226,6 +226,18 @@ def _kind(m: mujoco.MjModel, a: int) -> str:
     return "general"
 
 
+def _servo(m: mujoco.MjModel, a: int, kind: str) -> str:
+    """What servo actuator ``a`` of :func:`_kind` ``kind`` is, by its parameters
+    (a compiled model does not say which element declared it: a ``<general>``
+    with a position servo's gain and bias was named "position actuator")."""
+    kp = float(m.actuator_gainprm[a, 0])
+    if kind == "position":
+        return f"a position servo, kp = {kp:g}: a <position>, or a <general> with its gain and bias"
+    if kind == "velocity":
+        return f"a velocity servo, kv = {kp:g}: a <velocity>, or a <general> with its gain and bias"
+    return "a <general> actuator with dynamics, a gain or a bias of its own"
+
+
 def _force_limit(m: mujoco.MjModel, a: int, joint: int) -> tuple[float, str] | None:
     """The largest joint torque (N m) actuator ``a`` can exert on ``joint`` and
     where it comes from, or None if nothing declares it: the smaller of gear ×
@@ -646,6 +658,7 @@ def _motors(
         if int(m0.actuator_trntype[a]) in _JOINT_TRN and target in by_joint:
             by_joint[target].append(a)
     converted: dict[str, str] = {}
+    kinds: set[str] = set()
     added: list[str] = []
     estimated: list[str] = []
     sources: dict[str, str] = {}
@@ -674,7 +687,9 @@ def _motors(
             limit = None if found is None else found[0] / abs(float(m0.actuator_gear[a, 0]))
             source = None if found is None else found[1]
             if kind != "motor":
-                converted[jname] = f"{kind} actuator {_name(m0, _OBJ.mjOBJ_ACTUATOR, a)!r} → motor"
+                kinds.add(kind)
+                servo, name = _servo(m0, a, kind), _name(m0, _OBJ.mjOBJ_ACTUATOR, a)
+                converted[jname] = f"actuator {name!r} ({servo}) → motor"
             act.set_to_motor()
             act.gear = [abs(float(m0.actuator_gear[a, 0])), 0, 0, 0, 0, 0]
             act.forcelimited = mujoco.mjtLimited.mjLIMITED_FALSE
@@ -689,7 +704,7 @@ def _motors(
     out.notes["tau_max"] = sources
     if converted:
         out.notes["actuators"] = converted
-        servo_kinds = sorted({v.split(" ")[0] for v in converted.values()})
+        servo_kinds = sorted(kinds)
         out.warnings.append(
             f"{label}the actuators of {list(converted)} are {' and '.join(servo_kinds)} "
             "servos, not torque motors: the plant drives these joints with torque motors of "
@@ -799,7 +814,8 @@ def prepare_model(m: mujoco.MjModel, tip: str | None, fix: Sequence[str]) -> Pre
             )
         gear = abs(float(m.actuator_gear[a, 0]))
         if kind != "motor" or float(m.actuator_gainprm[a, 0]) != 1.0:
-            converted[jname] = f"{kind} actuator {_name(m, _OBJ.mjOBJ_ACTUATOR, a)!r} → motor"
+            what = "a motor of gain ≠ 1" if kind == "motor" else _servo(m, a, kind)
+            converted[jname] = f"actuator {_name(m, _OBJ.mjOBJ_ACTUATOR, a)!r} ({what}) → motor"
         m.actuator_dyntype[a] = int(mujoco.mjtDyn.mjDYN_NONE)
         m.actuator_gaintype[a] = int(mujoco.mjtGain.mjGAIN_FIXED)
         m.actuator_biastype[a] = int(mujoco.mjtBias.mjBIAS_NONE)

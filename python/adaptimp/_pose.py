@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._errors import ConfigError
+from ._inputs import reals
 
 FloatArray = NDArray[np.float64]
 
@@ -28,19 +29,15 @@ FLAT = 24
 
 
 def _vec(name: str, v: ArrayLike | None, shape: tuple[int, ...]) -> FloatArray:
-    """``v`` as a read-only float array of ``shape`` (zeros if None), named in every error."""
+    """``v`` as a read-only float array of ``shape`` (zeros if None), named in every
+    error (text, bools and complex numbers refused: "0.1" was taken as 0.1)."""
     if v is None:
         a = np.zeros(shape)
     else:
         try:
-            a = np.array(v, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise ConfigError(f"{name} must be {shape} reals, got {v!r}") from None
-        if a.shape != shape:
-            raise ConfigError(f"{name} must have shape {shape}, got {a.shape}")
-        bad = np.flatnonzero(~np.isfinite(a))
-        if bad.size:
-            raise ConfigError(f"{name}[{int(bad[0])}] = {a.flat[bad[0]]} is not finite")
+            a = reals(name, v, shape).copy()
+        except ValueError as e:
+            raise ConfigError(str(e)) from None
     a.setflags(write=False)
     return a
 
@@ -106,6 +103,18 @@ class PoseTarget:
         return bool(np.array_equal(self.flat, other.flat))
 
     __hash__ = None  # type: ignore[assignment]
+
+    # Copies and pickles are built by the constructor, so their arrays are
+    # read-only too (deepcopy and pickle gave writable ones, the class
+    # documented immutable); a copy of a value is the value.
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (PoseTarget, (self.p, self.dp, self.ddp, self.R, self.w, self.dw))
+
+    def __copy__(self) -> PoseTarget:
+        return self
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> PoseTarget:
+        return self
 
 
 #: The quantities of a Cartesian step, in the core's order (its ``last`` names).
@@ -208,7 +217,8 @@ def call_shape(ctrl: Any) -> str:
     """How a controller written in Python is called: ``"measurement"``, the
     protocol (``step(m, **setpoint)``), or a deprecated shape (a step that
     one positional argument does not bind but three do, with or without the
-    setpoint's keywords), with a ``DeprecationWarning`` at the user's line:
+    setpoint's keywords, or whose parameters are named ``q`` then ``tau_e``
+    or ``dq``), with a ``DeprecationWarning`` at the user's line:
     ``"joint"`` (``step(q, tau_e, dq, …)``) or, for a task-space controller,
     ``"wrench"`` (``step(q, dq, wrench, …)``)."""
     try:
@@ -227,7 +237,16 @@ def call_shape(ctrl: Any) -> str:
             return True
         return False
 
-    old = not binds(None) and binds(None, None, None)
+    # A step whose parameters are the old call's names (q, then tau_e or dq)
+    # is the old shape, though defaults let one argument bind it (it was
+    # given a Measurement as q, with no warning).
+    positional = [
+        p.name
+        for p in sig.parameters.values()
+        if p.kind in (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    ]
+    named_old = positional[:1] == ["q"] and positional[1:2] in (["tau_e"], ["dq"])
+    old = (not binds(None) or named_old) and binds(None, None, None)
     if not old:
         return "measurement"
     shape = "step(q, dq, wrench)" if task_space(ctrl) else "step(q, tau_e, dq)"

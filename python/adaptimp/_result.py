@@ -10,7 +10,7 @@ import os
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -252,6 +252,13 @@ class SimResult:
             Keep every k-th row (k ≥ 1): rows 0, k, 2k, … exactly as recorded (the
             loaded result has ``record_every`` multiplied by k); the metrics stay
             those of the whole run.
+
+        The file is written whole or not at all: into a new file beside ``path``,
+        flushed to the disk, then renamed over ``path`` (an atomic rename), so a
+        save that fails partway (a full disk, Ctrl-C) leaves what ``path`` held,
+        and saves to one path from several threads or processes leave one of
+        them complete. A ``path`` that is a folder (or ends with a separator) is
+        refused (``IsADirectoryError``): name the file.
         compress : bool
             True (default): arrays that the core recomputes exactly are not
             stored: a run of :func:`adaptimp.simulate` is deterministic, so the
@@ -272,11 +279,10 @@ class SimResult:
             False: store every array, for a file that any later version loads on
             any platform.
         """
-        if isinstance(every, bool) or not isinstance(every, int) or every < 1:
+        if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
             raise ValueError(f"every must be an integer ≥ 1, got {every!r}")
-        path = Path(path)
-        if path.suffix != ".npz":
-            path = path.with_name(path.name + ".npz")
+        every = int(every)
+        path = _save_path(path)
         arrays: dict[str, NDArray[Any]] = {name: getattr(self, name) for name in ARRAYS}
         for name in EXTRA_ARRAYS:
             if getattr(self, name) is not None:
@@ -304,7 +310,7 @@ class SimResult:
         if not compress:
             # Plain float64 arrays, readable by NumPy alone; the record beside them.
             meta["format"] = np.array(json.dumps({"version": FORMAT, "plain": True, **record}))
-            np.savez(path, **{**arrays, **meta})
+            _write_atomically(path, lambda f: np.savez(f, **{**arrays, **meta}))
             return path
         # Only a SimResult of simulate() can be a run of the native loop; a
         # subclass (a MuJoCo run) comes from another engine and keeps its arrays.
@@ -315,7 +321,7 @@ class SimResult:
         )
         stored, manifest = _encode(arrays, self.params, record_every, rerun)
         meta["format"] = np.array(json.dumps({"version": FORMAT, **manifest, **record}))
-        np.savez_compressed(path, **{**stored, **meta})
+        _write_atomically(path, lambda f: np.savez_compressed(f, **{**stored, **meta}))
         return path
 
     @classmethod
@@ -339,19 +345,22 @@ class SimResult:
         ``SimResult.load`` of a MuJoCo run's file gives a
         :class:`adaptimp.mujoco.MujocoResult` where ``adaptimp.mujoco`` imports.
         """
-        if cls is SimResult:
-            kind = _saved_kind(path)
-            if kind == "MujocoResult":
-                # The class the file names, found by its module as pickle
-                # finds a class (this module is below adaptimp.mujoco and
-                # does not import it).
-                try:
-                    mujoco_results = importlib.import_module(f"{__package__}.mujoco")
-                except ImportError:  # without the mujoco extra: its common arrays
-                    pass
-                else:
-                    loaded: SimResult = mujoco_results.MujocoResult.load(path)
-                    return loaded
+        kind = _saved_kind(path)
+        if kind in {c.__name__ for c in cls.__mro__[1:]}:  # a parent's save
+            raise SaveError(
+                f"{path}: holds a {kind} (saved by {kind}.save), not a {cls.__name__}: load it "
+                "with adaptimp.SimResult.load"
+            )
+        if cls is SimResult and kind == "MujocoResult":
+            # The class the file names, found by its module as pickle finds a
+            # class (this module is below adaptimp.mujoco and does not import it).
+            try:
+                mujoco_results = importlib.import_module(f"{__package__}.mujoco")
+            except ImportError:  # without the mujoco extra: its common arrays
+                pass
+            else:
+                loaded: SimResult = mujoco_results.MujocoResult.load(path)
+                return loaded
         with _open(path) as f:
             r = _Reader(path, f)
             params = r.json("params", dict)
@@ -377,6 +386,14 @@ class SimResult:
                     arrays = _decode(path, stored, manifest, params, record_every, simulated)
                 _check_arrays(path, arrays, manifest)
         _check_shapes(path, arrays, params, metrics)
+        missing = [k for k in cls._own_params if k not in params]
+        if missing:
+            raise SaveError(
+                f"{path}: its parameters have no {', '.join(map(repr, missing))}: not a "
+                f"{cls.__name__}'s save (a SimResult's?): load it with adaptimp.SimResult.load"
+            )
+        if manifest is not None and manifest.get("inputs") is None:
+            _check_row_count(path, arrays, params, record_every)
         names = [*ARRAYS, *EXTRA_ARRAYS]
         res = cls(
             case=case,
@@ -389,6 +406,10 @@ class SimResult:
         )
         _check_metrics(path, res, manifest)
         return res
+
+    _own_params: ClassVar[tuple[str, ...]] = ()
+    """The parameters a subclass's results always have (its file is refused
+    without them)."""
 
     def _own_arrays(self) -> dict[str, NDArray[Any]]:
         """A subclass's own recorded arrays (one row per recorded step), by the
@@ -446,6 +467,66 @@ input's and metric's SHA-256 (``arrays``, ``inputs``, ``metrics``), required;
 _VERSIONS = (2, 3, 4)
 """The versions of the ``format`` entry :meth:`SimResult.load` reads (1 has none)."""
 
+_INTRODUCED = {
+    3: ("simulated", "n"),
+    4: ("result", "arrays", "inputs", "metrics", "plain"),
+}
+"""What a format's record first held, by the version that introduced it: a file
+that declares an earlier version and holds any of it is a later format's file
+edited to skip its checks (a genuine format 2 or 3 file never held it; a plain
+file before format 4 had no record at all)."""
+
+
+def _save_path(path: str | os.PathLike[str]) -> Path:
+    """Where :meth:`SimResult.save` writes: ``path`` with ``.npz`` appended if it
+    has another suffix; a folder (or a path that ends with a separator, as
+    ``"runs/"``) is refused, naming it (it wrote ``runs.npz`` beside the folder)."""
+    if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
+        raise TypeError(f"path must be a file path (str or os.PathLike), got {path!r}")
+    text = os.fspath(path)
+    given = Path(text)
+    if text.endswith((os.sep, "/")) or given.is_dir():
+        raise IsADirectoryError(
+            f"path {text!r} is a folder: give the file to write, e.g. {str(given / 'run.npz')!r}"
+        )
+    return given if given.suffix == ".npz" else given.with_name(given.name + ".npz")
+
+
+def _write_atomically(path: Path, write: Callable[[Any], None]) -> None:
+    """``write(file)`` into a new file beside ``path`` (its own name, so that
+    saves from several threads or processes never share one), flushed and
+    synced to the disk, then renamed over ``path``: ``path`` holds the old file
+    or the new one whole, never a part; on any error the new file is removed."""
+    import itertools
+    import threading
+
+    folder = path.parent
+    for attempt in itertools.count():
+        temp = folder / (f".{path.name}.{os.getpid()}.{threading.get_ident()}.{attempt}.part")
+        try:
+            # O_EXCL: never another's file; the mode as any new file's (umask).
+            fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except FileExistsError:
+            continue
+        break
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(temp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temp)
+        raise
+    # The rename itself on the disk (where the platform can sync a folder).
+    with contextlib.suppress(OSError):
+        dfd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(dfd)
+        finally:
+            os.close(dfd)
+
 
 def _saved_kind(path: str | os.PathLike[str]) -> str | None:
     """The class that saved ``path`` (its format record's ``result``), if it says."""
@@ -465,6 +546,8 @@ def _open(path: str | os.PathLike[str]) -> Iterator[Any]:
     import zipfile
     import zlib
 
+    if not isinstance(path, (str, os.PathLike)):  # an int was opened as a file descriptor
+        raise TypeError(f"path must be a file path (str or os.PathLike), got {path!r:.40}")
     with open(path, "rb") as fh:
         try:
             f = np.load(fh, allow_pickle=False)
@@ -557,6 +640,14 @@ class _Reader:
             if not isinstance(m[key], kind):
                 raise self.fail(f"its format record's {key!r} is damaged (not a {kind.__name__})")
 
+        for later, keys in _INTRODUCED.items():
+            held = [k for k in keys if k in m] if version < later else []
+            if held:
+                raise self.fail(
+                    f"it declares format {version} but holds {', '.join(map(repr, held))} of "
+                    f"format {later}'s record: a later file edited after it was saved (its "
+                    "checks would be skipped)"
+                )
         plain = m.get("plain") is True
         for key, kind in (("derived", list), ("differences", dict)):
             expect(key, kind, not plain)
@@ -940,6 +1031,15 @@ def _check_metrics(
     if again is None:
         return
     differ = [k for k in again if not _same_metric(res.metrics[k], again[k])]
+    if differ and manifest is not None:
+        # Format 2 and 3 saved the metrics of the rows they hold, bit for bit.
+        values = "; ".join(
+            f"{k} = {res.metrics[k]!r} stored, {again[k]!r} from the rows" for k in differ
+        )
+        raise SaveError(
+            f"{path}: the file was edited after it was saved: its metrics are not those of "
+            f"its rows ({values}; format {manifest.get('version')} saved them together)"
+        )
     if differ:
         import warnings
 
@@ -1002,6 +1102,29 @@ def _check_rows(
             f"{path}: the file's parameters (T = {T!r}, Ts = {Ts!r}, one row in "
             f"{record_every}) do not give the {rows} rows it records: it was edited "
             "after it was saved (its simulation is not run again)"
+        )
+
+
+def _check_row_count(
+    path: str | os.PathLike[str],
+    arrays: Mapping[str, NDArray[Any]],
+    params: Mapping[str, Any],
+    record_every: int,
+) -> None:
+    """A file without the digests of its inputs (format 2 or 3) records the rows
+    its parameters give: round(T/Ts) steps, every ``record_every``-th kept."""
+    T, Ts = params.get("T"), params.get("Ts")
+    rows = int(arrays["t"].shape[0])
+    try:
+        steps = round(float(T) / float(Ts))  # type: ignore[arg-type]
+        expected = -(-steps // int(record_every))
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return  # a file without T: nothing to compare
+    if expected != rows:
+        raise SaveError(
+            f"{path}: the file's parameters (T = {T!r}, Ts = {Ts!r}, one row in "
+            f"{record_every}) give {expected} rows, and it records {rows}: it was edited "
+            "after it was saved"
         )
 
 

@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._adaptimp import Measurement
-from ._errors import needs_extra, period_alias
+from ._errors import ConfigError, needs_extra, period_alias
 
 try:
     import pinocchio as pin
@@ -271,7 +271,18 @@ def with_payload(model: Any, mass: float) -> Any:
 
 
 def _joint(name: str, value: ArrayLike, n: int) -> FloatArray:
-    v = np.asarray(value, dtype=np.float64)
+    """``value`` as n reals (one number for every joint), named in every error:
+    text, bools, complex numbers and other objects are refused (``"x"`` gave
+    NumPy's own message)."""
+    if isinstance(value, (str, bytes, bool)):
+        raise TypeError(f"{name} must be a number or {n} numbers, got {value!r:.60}")
+    try:
+        given = np.asarray(value)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name} must be a number or {n} numbers ({e})") from None
+    if given.dtype.kind not in "fiu":
+        raise TypeError(f"{name} must hold real numbers, got an array of dtype {given.dtype}")
+    v = given.astype(np.float64)
     if v.shape == ():
         v = np.full(n, float(v))
     if v.shape != (n,):
@@ -437,6 +448,10 @@ class ComputedTorque:
         self.impedance = impedance
         if drive is not None and not isinstance(drive, bool):  # 'yes' was taken as True
             raise TypeError(f"drive must be True, False or None, got {drive!r}")
+        for name, value in (("Ts", Ts), ("mass_scale", mass_scale), ("payload", payload)):
+            real = isinstance(value, (int, float, np.integer, np.floating))
+            if isinstance(value, bool) or not real:
+                raise TypeError(f"{name} must be a number, got {value!r:.60}")
         if not (mass_scale > 0 and math.isfinite(mass_scale)):
             raise ValueError(f"mass_scale must be > 0, got {mass_scale}")
         if not (math.isfinite(payload) and payload >= 0):
@@ -449,6 +464,7 @@ class ComputedTorque:
             exact = pinocchio_model(model)
             joints, inertials, gravity = core_description(exact)
             limits = np.asarray(exact.effortLimit, dtype=np.float64)
+            lifted: list[dict[str, Any]] = []
             nothing = [0.0] * len(joints)
             self.drive: dict[str, list[float]] = dict.fromkeys(
                 ("armature", "damping", "friction"), nothing
@@ -456,7 +472,14 @@ class ComputedTorque:
         else:
             # A description (SPEC §21): the core's arm, its chain and bodies.
             arm = _arm(model, tip, fix)
+            if arm.inertia_error is not None:
+                raise ConfigError(arm.inertia_error)
             joints, inertials, gravity = arm.chain, arm.inertials, list(arm.gravity)
+            # What an MJCF's gravity compensation (gravcomp) lifts: the plant's
+            # qfrc_gravcomp, SPEC (20.1').
+            lifted = (
+                arm.lifted if any(x["mass"] != 0.0 or any(x["moment"]) for x in arm.lifted) else []
+            )
             limits = np.asarray(arm.effort, dtype=np.float64)
             # The drive terms adaptimp's plant of the file has: an MJCF's
             # (MuJoCo compiles them), none for a URDF unless drive=True
@@ -513,6 +536,7 @@ class ComputedTorque:
             damping=self.drive["damping"],
             friction=self.drive["friction"],
             **(self.plant_drive or {}),
+            lifted=lifted or None,
         )
         self._params: dict[str, Any] = {
             "Ts": self._ts,

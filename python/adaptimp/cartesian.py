@@ -33,6 +33,7 @@ kg m², s.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import types
 import warnings
@@ -45,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _adaptimp
 from ._adaptimp import Measurement
 from ._errors import ConfigError, MeasurementError, period_alias
+from ._inputs import reals
 from ._params import BY_NAME, check_scenario, describe, resolve
 from ._pose import CartesianStep, PoseTarget, _outside, call_shape
 from .chain import Chain
@@ -70,17 +72,47 @@ _EYE = np.eye(3)
 
 def _array(name: str, v: ArrayLike, shape: tuple[int, ...]) -> FloatArray:
     """``v`` as reals of exactly ``shape``, else an error naming ``name`` (no
-    reshape: a flat (9,) R or a (2, 3) wrench is refused, not read)."""
-    try:
-        a = np.asarray(v, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be an array of reals, got {v!r}") from None
+    reshape: a flat (9,) R or a (2, 3) wrench is refused, not read; text,
+    bools and complex numbers refused, not converted)."""
+    a = reals(name, v, finite=False)
     if a.shape != shape:
         raise MeasurementError(f"{name} must have shape {shape}, got shape {a.shape}")
     return a
 
 
 _POSE_NAMES = ("p", "dp", "ddp", "R", "w", "dw")
+
+_CORE_POSE = ("p_c", "dp_c", "ddp_c", "R_c", "w_c", "dw_c")
+"""The core's names of a pose target's parts (SPEC §16)."""
+
+# Where each part of a flat target (24,) lies: p, ṗ, p̈ (3 each), R (9), ω, ω̇.
+_SLICES = ((0, 3), (3, 6), (6, 9), (9, 18), (18, 21), (21, 24))
+
+
+def _finite_pose(flat: FloatArray, names: Sequence[str]) -> None:
+    """Every part of ``flat`` finite, else a MeasurementError naming the part as
+    ``names`` do (the user's keywords) and its index."""
+    bad = np.flatnonzero(~np.isfinite(flat))
+    if bad.size:
+        k = int(bad[0])
+        part = next(i for i, (a, b) in enumerate(_SLICES) if a <= k < b)
+        raise MeasurementError(
+            f"{names[part]}[{k - _SLICES[part][0]}] is not finite (NaN or infinite)"
+        )
+
+
+def _as_given(e: MeasurementError, names: Sequence[str]) -> MeasurementError:
+    """The core's refusal of a target, its parts named as the caller gave them
+    (``xc``, not ``p_c``)."""
+    import re
+
+    mapping = dict(zip(_CORE_POSE, names))
+    text = re.sub(
+        r"(?<![A-Za-z_])(ddp_c|dp_c|p_c|dw_c|w_c|R_c)(?![A-Za-z_])",
+        lambda m: mapping[m.group(1)],
+        str(e),
+    )
+    return type(e)(text)
 
 
 def _pose(values: Sequence[ArrayLike | None], names: Sequence[str] = _POSE_NAMES) -> FloatArray:
@@ -255,7 +287,10 @@ class CartesianImpedance:
                 "of the torque for formulation='unified' only (give formulation='unified', "
                 "or leave admittance_share out)"
             )
-        self.q0 = np.array(q0, dtype=np.float64)
+        # Types here (text, bools, complex numbers), shapes and values by the core.
+        self.q0 = reals("q0", q0, finite=False).copy()
+        if posture is not None:
+            posture = reals("posture", posture, finite=False)
         self._core = _adaptimp.CartesianImpedance(chain, self.params, float(Ts), self.q0, posture)
         self.Ts = float(Ts)
         self._R = chain.fk(self.q0)[:3, :3].copy()
@@ -303,7 +338,10 @@ class CartesianImpedance:
         would (a rotation that is not one, a value not finite or beyond its
         ceiling: MeasurementError); only a good R is kept as the last one."""
         out = self._target((p, dp, ddp, R, w, dw))
-        self._core.check_target(out)
+        try:
+            self._core.check_target(out)
+        except MeasurementError as e:
+            raise _as_given(e, _POSE_NAMES) from None
         self._commit(out, R)
         return out
 
@@ -697,18 +735,13 @@ class CartesianController:
         outer = CartesianImpedance(chain, Ts=Ts, q0=q0, **cart)
         steps = round(float(span) / Ts)
         q, dq, ddq = outer.joint_path(path, steps * Ts, samples=steps)
-        data = getattr(model, "data", None)  # a Plant's state, as the caller left it
-        saved = None if data is None else (np.array(data.qpos), np.array(data.qvel))
-        try:
+        # A Plant's state as the caller left it, whatever the rule reads D and G at.
+        kept = getattr(model, "state_kept", None)
+        with kept() if callable(kept) else contextlib.nullcontext():
             kw = tuning.suggest(
                 model, q0, limits, Ts=Ts, path=np.hstack([q, dq, ddq]), period=steps * Ts,
                 case=controller, resolve=True, delay=delay,
             )  # fmt: skip
-        finally:
-            forward = getattr(model, "forward", None)
-            if data is not None and saved is not None and callable(forward):
-                data.qpos[:], data.qvel[:] = saved
-                forward()
         kw.pop("n")
         joint = {k: v for k, v in params.items() if k not in cart}
         centres, widths = (
@@ -859,37 +892,57 @@ class CartesianController:
         else:
             q, dq, wrench = _measured(self.chain.n, m, dq, wrench, q)
             measured = q
+        names = ("xc", "dxc", "ddxc", "R", "w", "dw")
         if target is not None:
             if xc is not None:
                 raise TypeError("give the commanded pose as xc=… or as target=…, not both")
+            if not isinstance(target, PoseTarget):
+                raise TypeError(f"target must be a PoseTarget, got {type(target).__name__}")
             xc, dxc, ddxc, R, w, dw = target.p, target.dp, target.ddp, target.R, target.w, target.dw
+            names = ("target.p", "target.dp", "target.ddp", "target.R", "target.w", "target.dw")
+        given: FloatArray | None = None
         if xc is not None:
-            sample: Any = (xc, dxc, ddxc, R, w, dw)
+            # Read here, each part named as given (the core reads p_c, R_c, …).
+            given = self.outer._target((xc, dxc, ddxc, R, w, dw), names)
+            _finite_pose(given, names)
+            sample: Any = given
         elif self.path is not None:
             sample = self.path(self._k * self._Ts)
+            if sample is None:  # held silently before (the core's step refuses it too)
+                raise TypeError(
+                    "a path returns (p, dp, ddp) or (p, dp, ddp, R, w, dw) (a tuple of arrays), "
+                    "got NoneType"
+                )
         else:
             sample = None
         if self._core_inner:
             # One call of the core: the pose and wrench read, the step, the row kept.
             core = self.outer.core
-            out: FloatArray = core.step_sample(
-                self._joint, measured, dq, wrench, sample, self.record
-            )
+            try:
+                out: FloatArray = core.step_sample(
+                    self._joint, measured, dq, wrench, sample, self.record
+                )
+            except MeasurementError as e:
+                if given is None:
+                    raise
+                raise _as_given(e, names) from None
             return out
         f = _wrench(wrench)
         # The rotation a target sets is kept only once the core accepted the step.
         flat: FloatArray | None = None
         turned: object = None
-        if xc is not None:
-            flat = self.outer._target(
-                (xc, dxc, ddxc, R, w, dw), ("xc", "dxc", "ddxc", "R", "w", "dw")
-            )
-            turned = R
+        if given is not None:
+            flat, turned = given, R
         elif sample is not None:
             flat = _pose_of(sample, self.outer._R)
             turned = True
         core = self.outer.core
-        out = core.step_python(self.inner, q, dq, f, flat, measurement=self._inner_measurement)
+        try:
+            out = core.step_python(self.inner, q, dq, f, flat, measurement=self._inner_measurement)
+        except MeasurementError as e:
+            if given is None:
+                raise
+            raise _as_given(e, names) from None
         self._tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
         self.outer._commit(flat, turned)
         if self.record:

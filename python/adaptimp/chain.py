@@ -173,7 +173,10 @@ class Chain(_adaptimp.Chain):
         (the core's one reduction, SPEC §21: the hinges and slides on the way
         to the tip that it does not hold, a gripper's coupled joints and those
         named in ``fix``); any other joint on the way is held at its
-        ``qpos0``, as the plant locks it. From each body's ``body_pos``,
+        ``qpos0``, as the plant locks it. Without ``tip``, the joints the
+        plant's rule holds on the way to its end effector (a slide off a
+        revolute arm) are held too: the chain and the plant drive the same
+        joints. From each body's ``body_pos``,
         ``body_quat``, each arm joint's ``jnt_pos`` (its anchor), ``jnt_axis``
         and ``qpos0`` (the value at which the body has its model frame), the
         site's ``site_pos``,
@@ -187,10 +190,17 @@ class Chain(_adaptimp.Chain):
         import mujoco
 
         from . import _mjcf
+        from ._description import _fix
 
         if site is not None and tip is not None:
             raise ConfigError("give the end effector as tip= (a site or a body) or site=, not both")
         tip = site if tip is None else tip
+        fix = _fix(fix)  # a name alone was iterated: "j1" as ('j', '1')
+        if not isinstance(model, (mujoco.MjModel, str, os.PathLike)):
+            raise TypeError(
+                "model must be a mujoco.MjModel or the path of an MJCF or URDF file, got "
+                f"{type(model).__name__} {model!r:.40}"
+            )
         if not isinstance(model, mujoco.MjModel):
             path = Path(model)
             if not path.is_file():
@@ -212,6 +222,7 @@ class Chain(_adaptimp.Chain):
                 model = mujoco.MjModel.from_xml_path(str(path))
             except ValueError as e:
                 raise ConfigError(f"MuJoCo cannot load {str(path)!r}: {e}") from None
+        found: dict[str, Any] | None = None
         try:
             if isinstance(tip, bool) or not isinstance(tip, (str, int, np.integer, type(None))):
                 raise TypeError(f"tip must be a site's or body's name or a site id, got {tip!r}")
@@ -240,6 +251,14 @@ class Chain(_adaptimp.Chain):
             name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body) or f"body#{body}"
             label = f"body {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body) or body!r}"
         arm = read_arm(model, name, fix)
+        if found is not None and arm.joints != tuple(found["joints"]):
+            # The default tip is the end of the arm the rule finds (the
+            # plant's): the joints it holds on the way there (a slide, a
+            # rail) are held here too, for their reason, so the chain and
+            # the plant count the same joints.
+            extra = [j for j in arm.joints if j not in found["joints"]]
+            arm = read_arm(model, name, (*fix, *extra))
+            arm.fixed.update({j: found["fixed"][j] for j in extra if j in found["fixed"]})
         if arm.n > 7:
             raise ConfigError(
                 f"{arm.source}: the chain to {name!r} has {arm.n} joints "

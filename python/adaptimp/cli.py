@@ -116,6 +116,20 @@ def _run(case: str, scenario: str, params: dict[str, Any]) -> tuple[SimResult, f
     return res, time.perf_counter() - start
 
 
+def _figure_format(path: str) -> None:
+    """A figure's file name whose suffix matplotlib writes, checked before a run
+    (``x.unknownext`` ended the run in a traceback)."""
+    from matplotlib.figure import Figure
+
+    supported = Figure().canvas.get_supported_filetypes()
+    suffix = Path(path).suffix[1:].lower()
+    if suffix not in supported:
+        raise CliError(
+            f"--plot {path}: {'no suffix' if not suffix else f'.{suffix} is not a figure format'}; "
+            f"give one of {', '.join('.' + s for s in sorted(supported))}"
+        )
+
+
 def _save_figure(res: SimResult, kind: str, path: Path) -> None:
     import matplotlib.pyplot as plt
 
@@ -127,6 +141,8 @@ def _save_figure(res: SimResult, kind: str, path: Path) -> None:
 def cmd_reproduce(args: argparse.Namespace, params: dict[str, Any]) -> int:
     """Run the three cases; write figures, metrics.json, metrics.md; print the table."""
     out = Path(args.out)
+    if out.exists() and not out.is_dir():  # /dev/null ended in a traceback
+        raise CliError(f"--out {out}: not a folder (the figures and metrics go into one)")
     out.mkdir(parents=True, exist_ok=True)
     note = f" with {params}" if params else ""
     print(f"adaptimp {__version__}: the paper's three cases, scenario {args.scenario!r}{note}")
@@ -162,6 +178,8 @@ def cmd_reproduce(args: argparse.Namespace, params: dict[str, Any]) -> int:
 
 def cmd_simulate(args: argparse.Namespace, params: dict[str, Any]) -> int:
     """Run one case; print its metrics; optionally plot and save."""
+    if args.plot:
+        _figure_format(args.plot)
     res, seconds = _run(args.case, args.scenario, params)
     if args.json:
         print(json.dumps(metrics_json(res.metrics), indent=2))
@@ -282,6 +300,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         status: int = args.func(args, params)
     except CliError as e:
         parser.exit(2, f"adaptimp {args.command}: error: {e}\n")
+    except OSError as e:  # a file that cannot be written (a folder, a full disk): one line
+        parser.exit(1, f"adaptimp {args.command}: error: {e}\n")
     return status
 
 

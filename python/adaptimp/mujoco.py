@@ -38,13 +38,14 @@ Units: rad, rad/s, rad/s², N, N m, m, s. Vectors in the world frame.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import math
 import numbers
 import os
 import sys
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, Union
@@ -53,6 +54,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._errors import ConfigError, PlantWarning, needs_extra
+from ._inputs import reals
 
 try:
     import mujoco
@@ -228,6 +230,8 @@ def _urdf_arm(
     """The arm of a URDF (or xacro) file by the core's one reduction (SPEC §21)."""
     arm = _description.read_arm(path, tip, fix)
     _description.say_balanced(arm, stacklevel=5)
+    if arm.inertia_error is not None:  # MuJoCo refuses it, unnamed
+        raise ConfigError(arm.inertia_error)
     if arm.urdf is None:
         raise ValueError(
             f"{arm.source} is not a URDF: from_urdf reads URDF and xacro files; give an MJCF "
@@ -533,6 +537,11 @@ class Plant:
             raise ValueError("give the end effector as tip= (a site or a body) or site=, not both")
         if isinstance(fix, str):
             raise TypeError(f"fix must be a tuple of joint names, got the string {fix!r}")
+        if not isinstance(model, (str, os.PathLike, mujoco.MjModel, mujoco.MjSpec)):
+            raise TypeError(
+                "model must be 'two_link', 'panda', the path of an MJCF or URDF file, a "
+                f"mujoco.MjModel or a mujoco.MjSpec, got {type(model).__name__} {model!r:.40}"
+            )
         self.contact = contact
         self.site = site
         self.tip = tip if tip is not None else site
@@ -833,8 +842,21 @@ class Plant:
             d.qvel[self._dofs] = self._vector("dq0", dq0)
         mujoco.mj_forward(m, d)
 
+    @contextlib.contextmanager
+    def state_kept(self) -> Iterator[None]:
+        """The plant's whole state (MuJoCo's data: positions, velocities,
+        controls, activations, time) as it is now, put back when the block
+        ends, whatever it did (a rule that reads D(q) and G(q) at postures of
+        its own, :meth:`adaptimp.CartesianController.from_rule`)."""
+        saved = mujoco.MjData(self.model)
+        mujoco.mj_copyData(saved, self.model, self.data)
+        try:
+            yield
+        finally:
+            mujoco.mj_copyData(self.data, self.model, saved)
+
     def _vector(self, name: str, value: ArrayLike) -> FloatArray:
-        v = np.asarray(value, dtype=np.float64)
+        v = reals(name, value, finite=False)
         if v.shape == ():
             v = np.full(self.n, float(v))
         if v.shape != (self.n,):
@@ -1480,6 +1502,8 @@ class MujocoResult(SimResult):
     wrench_ee: FloatArray | None = None
     task: dict[str, FloatArray] | None = None
 
+    _own_params = ("controller", "model", "Ts", "substeps", "contact", "settle")
+
     def _own_arrays(self) -> dict[str, FloatArray]:
         out = {n: a for n in ("x_ee", "wrench_ee") if (a := getattr(self, n)) is not None}
         out.update({f"task.{k}": v for k, v in (self.task or {}).items()})
@@ -1860,8 +1884,18 @@ def simulate(
     ((50, 2), 20)
     """
     if task is not None:  # the Cartesian task's controller, by the core's rule
+        if not isinstance(task, CartesianTask):
+            raise TypeError(
+                f"task must be a CartesianTask (from adaptimp.mujoco.cartesian_task), got "
+                f"{type(task).__name__} {task!r:.60}"
+            )
         if home is not None:
             raise ValueError("home= sets the default joint-space task: give q0= to cartesian_task")
+        if reference is not None:
+            raise ValueError(
+                "give the task or a reference, not both: the arm would track the reference "
+                "while the task's errors were measured against its own path"
+            )
         if not isinstance(model, Plant):
             model = Plant(model, contact=contact, tip=tip, fix=fix)
             tip, fix = None, ()
@@ -1891,6 +1925,7 @@ def simulate(
     _check_run(run, res)
     _check_delay(res)
     _check_tracking(run, res)
+    _check_refused(res, fault)
     return res
 
 
@@ -1937,6 +1972,33 @@ def _check_delay(res: MujocoResult) -> None:
         f"the controller was made for a loop delay of {made} period(s), the plant's is "
         f"{plant}: its velocity loop may ring (SPEC (18.11)); build it with delay={plant}, "
         f"or give simulate delay={plant} and a case name"
+    )
+    res.params.setdefault("warnings", []).append(text)
+    warnings.warn(text, PlantWarning, stacklevel=3)
+
+
+def _check_refused(res: MujocoResult, fault: Fault | None) -> None:
+    """Steps refused where no fault was injected, said (a
+    :class:`adaptimp.PlantWarning`, in ``res.params["warnings"]``): with a
+    fault configured a refused step applies the fallback and the run goes
+    on, and a controller whose every torque was refused (a step that returned
+    NaN) ran 200 of 200 rows at zero torque with no word."""
+    if res.refused is None or not res.refused.any():
+        return
+    t = res.t
+    outside = res.refused.copy()
+    if fault is not None:
+        start = float(fault.start)
+        end = start + float(fault.duration or 0.0)
+        outside &= (t < start - 1e-12) | (t >= end - 1e-12)
+    if not outside.any():
+        return
+    first = float(t[np.flatnonzero(outside)[0]])
+    text = (
+        f"{int(outside.sum())} of {res.rows} recorded steps were refused"
+        f"{' outside the fault' if fault is not None else ''} (the first at t = {first:.3f} s): "
+        "the controller's step failed there (a torque or a measurement that was not finite, "
+        "or beyond its limits) and its fallback was applied"
     )
     res.params.setdefault("warnings", []).append(text)
     warnings.warn(text, PlantWarning, stacklevel=3)
@@ -2352,6 +2414,13 @@ def _setup(
             )
         ctrl = controller
         label = type(controller).__name__
+        joints = getattr(ctrl, "n", None)
+        if isinstance(joints, int) and not isinstance(joints, bool) and joints != plant.n:
+            # It failed later as "noise_q: wrong length", noise_q never given.
+            raise ConfigError(
+                f"the controller ({label}) has {joints} joints, the plant {plant.n} "
+                f"({', '.join(plant.joint_names)}): build the controller for the plant's arm"
+            )
     period = _period(ctrl)
     if Ts is not None and not math.isclose(Ts, period, rel_tol=1e-12):
         raise ValueError(f"Ts = {Ts:g} s differs from the controller's period {period:g} s")

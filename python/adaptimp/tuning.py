@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _adaptimp
 from ._errors import ConfigError
 from ._params import loop_delay
+from ._inputs import positive, reals
 
 FloatArray = NDArray[np.float64]
 Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]
@@ -237,9 +238,19 @@ def suggest(
         D(q0) not symmetric positive definite, τmax ≤ 0, Ts outside (0, 1] s,
         a shape that does not match (each named).
     """
+    # Named as written (text, bools, complex numbers, a NaN q0, a τmax of
+    # another length were taken, or refused in NumPy's words).
+    q0 = reals("q0", q0)
+    Ts = positive("Ts", Ts)
+    joints = getattr(model, "n", getattr(model, "nv", None))
+    if isinstance(joints, int) and q0.shape != (joints,):
+        raise ConfigError(f"q0 must have shape ({joints},) (one value per joint), got {q0.shape}")
     d = inertia(model, q0)
     n = d.shape[0]
-    tau = np.ascontiguousarray(np.broadcast_to(np.asarray(tau_max, dtype=np.float64), (n,)))
+    limits = reals("tau_max", tau_max, finite=False)
+    if limits.shape not in ((), (n,)):
+        raise ConfigError(f"tau_max must be a number or have shape ({n},), got {limits.shape}")
+    tau = np.ascontiguousarray(np.broadcast_to(limits, (n,)))
     rows = None
     if path is not None:
         if period is None:

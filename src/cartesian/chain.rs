@@ -81,6 +81,11 @@ impl Transform {
     /// finite and non-zero.
     pub fn from_pos_quat(pos: [f64; 3], quat: [f64; 4]) -> Result<Self, Error> {
         check::finite_slice("quaternion", &quat)?;
+        // Scaled by its largest entry first: a quaternion of norm 1e-200 is
+        // non-zero (its squares underflowed, and it was refused as zero).
+        let largest = quat.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        check::positive("‖quaternion‖ > 0", "‖quaternion‖", largest)?;
+        let quat = quat.map(|x| x / largest);
         let norm = sqrt(quat.iter().map(|x| x * x).sum::<f64>());
         check::positive("‖quaternion‖ > 0", "‖quaternion‖", norm)?;
         let q = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(

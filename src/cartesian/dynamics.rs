@@ -230,8 +230,56 @@ pub struct Inertial {
     /// (rotation) in the link's frame (URDF's `<inertial><origin>`).
     pub origin: Transform,
     /// Rotational inertia about the centre of mass in `origin`'s axes (kg
-    /// m², row-major), symmetric with a non-negative diagonal.
+    /// m², row-major), symmetric and positive semi-definite
+    /// ([`principal_moments`] ≥ 0).
     pub inertia: [[f64; 3]; 3],
+}
+
+/// What gravity compensation lifts of one link (MuJoCo's body `gravcomp`,
+/// SPEC (20.1')): the mass l whose weight is lifted (kg; Σ gravcomp × mass,
+/// negative where a negative share adds weight) and its first moment λ = Σ
+/// gravcomp × mass × centre (kg m), in the link's frame. A first moment, not
+/// a centre: shares of both signs can lift a couple with l = 0.
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct Lifted {
+    /// l (kg).
+    pub mass: f64,
+    /// λ (kg m), in the link's frame.
+    pub moment: [f64; 3],
+}
+
+/// The principal moments of the inertia `i` (kg m², the symmetric part's
+/// eigenvalues), smallest first. A rigid body's are ≥ 0 (and any two sum to
+/// at least the third): a negative one makes the mass matrix indefinite.
+pub fn principal_moments(i: &[[f64; 3]; 3]) -> [f64; 3] {
+    let m = Matrix3::from_fn(|r, c| 0.5 * (i[r][c] + i[c][r]));
+    let e = m.symmetric_eigenvalues();
+    let mut v = [e[0], e[1], e[2]];
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// The most negative smallest principal moment an inertia may have,
+/// relative to its largest (rounding in a file that prints six digits of a
+/// singular inertia: a rod, a thin plate).
+pub const INERTIA_TOLERANCE: f64 = 1e-6;
+
+/// A principal moment (kg m²) no arm's dynamics can tell from zero: an
+/// exported file's rounding noise on a massless link (1e-35 in a file of
+/// example-robot-data's iCub).
+pub const INERTIA_FLOOR: f64 = 1e-12;
+
+/// Whether the inertia `i` is one a rigid body has: positive semi-definite,
+/// its smallest principal moment ≥ −([`INERTIA_TOLERANCE`] × its largest +
+/// [`INERTIA_FLOOR`]). Returns the principal moments (smallest first) on
+/// failure.
+pub fn physical_inertia(i: &[[f64; 3]; 3]) -> Result<(), [f64; 3]> {
+    let m = principal_moments(i);
+    if m[0] >= -(INERTIA_TOLERANCE * m[2].abs() + INERTIA_FLOOR) {
+        Ok(())
+    } else {
+        Err(m)
+    }
 }
 
 impl Inertial {
@@ -296,15 +344,13 @@ impl Inertial {
                 value: asym,
             });
         }
-        for k in 0..3 {
-            if i[(k, k)] < 0.0 {
-                return Err(Error::Condition {
-                    condition: "the inertia's diagonal ≥ 0",
-                    lhs: "link inertia diagonal",
-                    index: Some(index),
-                    value: i[(k, k)],
-                });
-            }
+        if let Err(m) = physical_inertia(&self.inertia) {
+            return Err(Error::Condition {
+                condition: "the inertia is positive semi-definite (its principal moments ≥ 0)",
+                lhs: "link inertia's smallest principal moment",
+                index: Some(index),
+                value: m[0],
+            });
         }
         Ok((frame, i))
     }
@@ -343,6 +389,10 @@ impl Body {
 pub struct Dynamics<const N: usize> {
     chain: Chain<N>,
     bodies: [Body; N],
+    /// The weight each body's gravity compensation lifts (MuJoCo's
+    /// `gravcomp`): the mass m and first moment h of what it lifts, in the
+    /// body's frame (its inertia unused); None: no compensation.
+    lifted: Option<[Body; N]>,
     gravity: Vector3<f64>,
     drive: Drive<N>,
     sampled: Option<SampledDrive<N>>,
@@ -373,13 +423,61 @@ impl<const N: usize> Dynamics<N> {
             });
         }
         check::at_most_each("|value| ≤ 1e9", "gravity", &gravity, PARAM_BOUND)?;
+        let bodies = fold::<N>(joints, inertials, &aligns)?;
+        Ok(Self {
+            chain,
+            bodies,
+            lifted: None,
+            gravity: Vector3::from(gravity),
+            drive: Drive::none(),
+            sampled: None,
+            spring: None,
+        })
+    }
+
+    /// The model with gravity compensation (MuJoCo's `gravcomp`, SPEC
+    /// (20.1')): `lifted[k]` what is lifted in the link of entry k of
+    /// `joints` (as [`new`](Self::new) took them, fixed ones too). Inverse
+    /// dynamics and the gravity torque then carry the weight less what is
+    /// lifted: MuJoCo's `qfrc_gravcomp` taken off. Replaces any compensation
+    /// set before.
+    ///
+    /// Errors, naming the entry: other joints than the model's, another
+    /// number of entries, a mass or moment not finite or beyond 1e9.
+    pub fn with_gravity_compensation(
+        mut self,
+        joints: &[Joint],
+        lifted: &[Lifted],
+    ) -> Result<Self, Error> {
+        let (chain, aligns) = Chain::<N>::aligned(joints, &Transform::IDENTITY)?;
+        if chain != self.chain {
+            return Err(Error::Invalid {
+                what: "gravity compensation",
+                reason: "needs the joints the model was built from",
+            });
+        }
+        if lifted.len() != joints.len() {
+            return Err(Error::Condition {
+                condition: "one lifted mass per joint of the list (fixed ones too)",
+                lhs: "lifted",
+                index: None,
+                value: lifted.len() as f64,
+            });
+        }
         let mut bodies = [Body::EMPTY; N];
-        // The body the entries belong to, and the frame of the current
-        // entry's child link in that body's frame.
         let mut body: Option<usize> = None;
         let mut pending = Frame::IDENTITY;
-        for (index, (j, inertial)) in joints.iter().zip(inertials).enumerate() {
-            let (origin, ic) = inertial.check(index)?;
+        for (index, (j, l)) in joints.iter().zip(lifted).enumerate() {
+            check::finite("lifted mass", l.mass)?;
+            check::finite_slice("lifted moment", &l.moment)?;
+            for v in [l.mass, l.moment[0], l.moment[1], l.moment[2]] {
+                check::at_most(
+                    "|value| ≤ 1e9",
+                    "lifted mass or moment",
+                    v.abs(),
+                    PARAM_BOUND,
+                )?;
+            }
             if j.kind == JointKind::Fixed {
                 pending = pending.then(&j.origin.check(index)?);
             } else {
@@ -387,24 +485,18 @@ impl<const N: usize> Dynamics<N> {
                 pending = Frame::IDENTITY;
             }
             if let Some(b) = body {
-                let f = pending.then(&origin);
-                bodies[b].add(inertial.mass, f.p, f.r * ic * f.r.transpose());
+                bodies[b].m += l.mass;
+                bodies[b].h += pending.r * Vector3::from(l.moment) + l.mass * pending.p;
             }
         }
-        // Into the links' frames of the core's form (the description's
-        // frame of joint i is link i's times A_iᵀ).
         for (b, a) in bodies.iter_mut().zip(&aligns) {
             b.h = a.tr_mul(&b.h);
-            b.i = a.tr_mul(&b.i) * a;
         }
-        Ok(Self {
-            chain,
-            bodies,
-            gravity: Vector3::from(gravity),
-            drive: Drive::none(),
-            sampled: None,
-            spring: None,
-        })
+        self.lifted = bodies
+            .iter()
+            .any(|b| b.m != 0.0 || b.h != Vector3::zeros())
+            .then_some(bodies);
+        Ok(self)
     }
 
     /// The model with the joints' drive terms `drive` (SPEC (20.5)): the
@@ -532,7 +624,11 @@ impl<const N: usize> Dynamics<N> {
     pub fn scaled(mut self, factor: f64) -> Result<Self, Error> {
         check::positive("mass_scale > 0", "mass_scale", factor)?;
         check::at_most("|value| ≤ 1e9", "mass_scale", factor, PARAM_BOUND)?;
-        for b in &mut self.bodies {
+        for b in self
+            .bodies
+            .iter_mut()
+            .chain(self.lifted.iter_mut().flatten())
+        {
             b.m *= factor;
             b.h *= factor;
             b.i *= factor;
@@ -616,7 +712,7 @@ impl<const N: usize> Dynamics<N> {
     /// + k ⊙ (q − q_s) with springs (20.5').
     #[inline]
     pub fn inverse_dynamics(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>) -> Vector<N> {
-        let tau = self.rnea(q, dq, ddq, -self.gravity)
+        let tau = self.rnea(q, dq, ddq, -self.gravity) - self.lifted_torque(q)
             + self.drive.armature.component_mul(ddq)
             + self.drive.damping.component_mul(dq);
         match &self.spring {
@@ -625,10 +721,22 @@ impl<const N: usize> Dynamics<N> {
         }
     }
 
-    /// G(q) = RNEA(q, 0, 0) (N m, N).
+    /// G(q) = RNEA(q, 0, 0) (N m, N), less what gravity compensation lifts.
     pub fn gravity_torque(&self, q: &Vector<N>) -> Vector<N> {
         let z = Vector::<N>::zeros();
-        self.rnea(q, &z, &z, -self.gravity)
+        self.rnea(q, &z, &z, -self.gravity) - self.lifted_torque(q)
+    }
+
+    /// The torque of the weight gravity compensation lifts at q (N m, N):
+    /// MuJoCo's `qfrc_gravcomp` with the opposite sign (zero without it).
+    fn lifted_torque(&self, q: &Vector<N>) -> Vector<N> {
+        match &self.lifted {
+            None => Vector::zeros(),
+            Some(lifted) => {
+                let z = Vector::<N>::zeros();
+                self.rnea_of(lifted, q, &z, &z, -self.gravity)
+            }
+        }
     }
 
     /// M_a(q) v = RNEA₀(q, 0, v) + I_a ⊙ v, without gravity (N m, N), (20.5).
@@ -723,6 +831,19 @@ impl<const N: usize> Dynamics<N> {
     /// accelerating at `a0` (world): τ of the rigid links (no drive).
     #[inline]
     fn rnea(&self, q: &Vector<N>, dq: &Vector<N>, ddq: &Vector<N>, a0: Vector3<f64>) -> Vector<N> {
+        self.rnea_of(&self.bodies, q, dq, ddq, a0)
+    }
+
+    /// [`rnea`](Self::rnea) of other bodies on the same chain.
+    #[inline]
+    fn rnea_of(
+        &self,
+        bodies: &[Body; N],
+        q: &Vector<N>,
+        dq: &Vector<N>,
+        ddq: &Vector<N>,
+        a0: Vector3<f64>,
+    ) -> Vector<N> {
         let links = self.chain.links();
         let mut sc = [(0.0, 1.0); N];
         let mut r = [Vector3::zeros(); N];
@@ -751,7 +872,7 @@ impl<const N: usize> Dynamics<N> {
                 al[2] += ddq[i];
                 w[2] += dq[i];
             }
-            let b = &self.bodies[i];
+            let b = &bodies[i];
             let iw = b.i * w;
             f[i] = a * b.m + al.cross(&b.h) + w.cross(&w.cross(&b.h));
             n[i] = b.i * al + w.cross(&iw) + b.h.cross(&a);
@@ -771,6 +892,42 @@ impl<const N: usize> Dynamics<N> {
         }
         tau
     }
+}
+
+/// The bodies of (20.1) of `inertials` on `joints` (one each, fixed ones
+/// too): each inertial belongs to the last movable joint at or before its
+/// entry (those before the first movable joint to the base, left out), in
+/// the links' frames of the core's form (`aligns`, [`Chain::aligned`]).
+fn fold<const N: usize>(
+    joints: &[Joint],
+    inertials: &[Inertial],
+    aligns: &[Matrix3<f64>; N],
+) -> Result<[Body; N], Error> {
+    let mut bodies = [Body::EMPTY; N];
+    // The body the entries belong to, and the frame of the current entry's
+    // child link in that body's frame.
+    let mut body: Option<usize> = None;
+    let mut pending = Frame::IDENTITY;
+    for (index, (j, inertial)) in joints.iter().zip(inertials).enumerate() {
+        let (origin, ic) = inertial.check(index)?;
+        if j.kind == JointKind::Fixed {
+            pending = pending.then(&j.origin.check(index)?);
+        } else {
+            body = Some(body.map_or(0, |b| b + 1));
+            pending = Frame::IDENTITY;
+        }
+        if let Some(b) = body {
+            let f = pending.then(&origin);
+            bodies[b].add(inertial.mass, f.p, f.r * ic * f.r.transpose());
+        }
+    }
+    // Into the links' frames of the core's form (the description's frame of
+    // joint i is link i's times A_iᵀ).
+    for (b, a) in bodies.iter_mut().zip(aligns) {
+        b.h = a.tr_mul(&b.h);
+        b.i = a.tr_mul(&b.i) * a;
+    }
+    Ok(bodies)
 }
 
 /// Link `l`'s place in the previous link's frame at its joint value `q`:
@@ -855,6 +1012,41 @@ mod tests {
                 v -= d.gravity.dot(&(b.m * m.c + m.r * b.h));
             });
         v
+    }
+
+    #[test]
+    fn gravity_compensation_lifts_its_share_of_each_weight() {
+        // Every link's whole weight lifted (MuJoCo's gravcomp = 1): no
+        // gravity torque, the rest of inverse dynamics unchanged; half of it:
+        // half the gravity torque.
+        let joints = crate::cartesian::chain::sample_joints();
+        let d = arm();
+        let (q, dq, ddq) = state();
+        let inertials = [
+            (5.0, [0.0; 3]),
+            (2.0, [0.1, 0.02, 0.05]),
+            (1.5, [0.15, 0.0, -0.01]),
+            (0.7, [0.05, 0.01, 0.0]),
+            (0.9, [0.0, 0.1, 0.03]),
+        ];
+        let lift = |share: f64| {
+            inertials.map(|(m, c)| Lifted {
+                mass: share * m,
+                moment: c.map(|x| share * m * x),
+            })
+        };
+        let whole = d.with_gravity_compensation(&joints, &lift(1.0)).unwrap();
+        assert!(whole.gravity_torque(&q).amax() < 1e-12);
+        let free = d.inverse_dynamics(&q, &dq, &ddq) - d.gravity_torque(&q);
+        assert!((whole.inverse_dynamics(&q, &dq, &ddq) - free).amax() < 1e-12);
+        let half = d.with_gravity_compensation(&joints, &lift(0.5)).unwrap();
+        assert!((half.gravity_torque(&q) - 0.5 * d.gravity_torque(&q)).amax() < 1e-12);
+        // Scaled with the masses; refused on other joints.
+        let scaled = half.scaled(2.0).unwrap();
+        assert!((scaled.gravity_torque(&q) - d.gravity_torque(&q)).amax() < 1e-12);
+        assert!(d
+            .with_gravity_compensation(&joints[1..], &lift(1.0)[1..])
+            .is_err());
     }
 
     #[test]

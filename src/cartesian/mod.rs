@@ -14,7 +14,9 @@ pub mod rule;
 
 pub use chain::{Chain, Joint, JointKind, Transform, MAX_CHAIN_JOINTS};
 pub use computed::{ComputedState, ComputedTorque, ComputedTorqueConfig};
-pub use dynamics::{Drive, Dynamics, Inertial, SampledDrive, Spring, FRICTION_VELOCITY, GRAVITY};
+pub use dynamics::{
+    Drive, Dynamics, Inertial, Lifted, SampledDrive, Spring, FRICTION_VELOCITY, GRAVITY,
+};
 pub use impedance_torque::{ImpedanceTorque, PoseGoal};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use outer::{

@@ -99,7 +99,7 @@ pub fn rotation(what: &'static str, m: &Matrix3<f64>) -> Result<UnitQuaternion<f
     if dev > ROTATION_TOLERANCE {
         return Err(Error::Condition {
             condition: "RᵀR = I (an orthonormal rotation matrix, to 1e-6)",
-            lhs: what,
+            lhs: named(what).0,
             index: None,
             value: dev,
         });
@@ -108,7 +108,7 @@ pub fn rotation(what: &'static str, m: &Matrix3<f64>) -> Result<UnitQuaternion<f
     if det <= 0.0 {
         return Err(Error::Condition {
             condition: "det R = +1 (a rotation, not a reflection)",
-            lhs: what,
+            lhs: named(what).1,
             index: None,
             value: det,
         });
@@ -116,6 +116,18 @@ pub fn rotation(what: &'static str, m: &Matrix3<f64>) -> Result<UnitQuaternion<f
     Ok(UnitQuaternion::from_rotation_matrix(
         &Rotation3::from_matrix_unchecked(*m),
     ))
+}
+
+/// What [`rotation`]'s refusals measure of the matrix `what`, named with
+/// it (the deviation was printed as if it were the matrix: "R_c = 0.21"):
+/// its largest |RᵀR − I| entry, its determinant.
+fn named(what: &'static str) -> (&'static str, &'static str) {
+    match what {
+        "R_c" => ("max |R_cᵀR_c − I| of R_c", "det R_c"),
+        "R" => ("max |RᵀR − I| of R", "det R"),
+        "rotation" => ("max |RᵀR − I| of the rotation", "det of the rotation"),
+        _ => ("max |RᵀR − I| of the matrix", "det of the matrix"),
+    }
 }
 
 /// The rotation matrix of the unit quaternion `q = [w, x, y, z]` (world ←

@@ -25,6 +25,8 @@ pub enum ErrorKind {
     /// The reduction to an arm: an unknown `tip` or `fix` name, no joint to
     /// drive, chains that tie, a joint an arm cannot have on its path.
     Arm,
+    /// The reading was stopped by its caller (a front's Ctrl-C).
+    Stopped,
 }
 
 /// A description that could not be read or reduced (SPEC §21).

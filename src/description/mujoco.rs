@@ -64,6 +64,9 @@ pub struct MujocoArrays {
     pub body_iquat: Vec<[f64; 4]>,
     /// Its principal inertia about the centre of mass (kg m²).
     pub body_inertia: Vec<[f64; 3]>,
+    /// The share of its weight gravity compensation lifts (`gravcomp`);
+    /// empty: none on any body.
+    pub body_gravcomp: Vec<f64>,
     /// Per joint: its name.
     pub jnt_name: Vec<String>,
     /// Its `mjtJoint` type.
@@ -422,6 +425,7 @@ impl<'m> TreeBuild<'m> {
                 mass: m.body_mass[b],
                 origin: Origin::PosQuat(shifted(m.body_ipos[b], a), m.body_iquat[b]),
                 inertia: [[d[0], 0.0, 0.0], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]],
+                gravcomp: m.body_gravcomp.get(b).copied().unwrap_or(0.0),
             });
         }
         self.links.push(link);

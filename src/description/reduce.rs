@@ -5,7 +5,7 @@
 use super::error::{DescriptionError, ErrorKind};
 use super::tree::{motion, Dialect, JointType, Tree};
 use crate::cartesian::chain::{Chain, Frame, Joint, JointKind, Transform};
-use crate::cartesian::dynamics::{Drive, Dynamics, Inertial};
+use crate::cartesian::dynamics::{physical_inertia, Drive, Dynamics, Inertial, Lifted};
 use crate::error::Error;
 use alloc::collections::{BTreeMap, VecDeque};
 use alloc::format;
@@ -28,6 +28,13 @@ pub enum Held {
     Mimic {
         /// The joint it follows.
         master: String,
+    },
+    /// A mimic joint whose master is not another joint of the description
+    /// (off the arm; on the arm's way it is refused): held at its
+    /// reference, the description's mistake said ([`Arm::warnings`]).
+    MimicOfNone {
+        /// What is wrong ([`Tree::mimic_error`]).
+        why: String,
     },
     /// Coupled to other joints (a MuJoCo fixed tendon): it does not move
     /// on its own.
@@ -101,6 +108,10 @@ impl fmt::Display for Held {
                     "mimics '{master}': it moves with '{master}', not on its own"
                 )
             }
+            Self::MimicOfNone { why } => write!(
+                f,
+                "{why}: held at its reference position (correct its <mimic joint=…>)"
+            ),
             Self::Coupled { by } => write!(
                 f,
                 "coupled to other joints by '{by}': it does not move on its own"
@@ -206,6 +217,18 @@ pub struct Arm {
     /// every link carried by it through fixed and held joints, as one
     /// inertial in the joint's frame (mass, centre of mass, inertia about it).
     pub inertials: Vec<Inertial>,
+    /// Per arm joint, what gravity compensation lifts of its body (MuJoCo's
+    /// `gravcomp`: Σ gravcomp × mass and its first moment over its links, in
+    /// the joint's frame, SPEC (20.1')); zeros without compensation.
+    pub lifted: Vec<Lifted>,
+    /// The first link the arm moves whose inertia no rigid body has (not
+    /// positive semi-definite), named with the file: its dynamics
+    /// ([`Arm::to_dynamics`]) is refused with it; its kinematics reads.
+    pub inertia_error: Option<DescriptionError>,
+    /// The description's mistakes the arm does not depend on, held and
+    /// said (a front shows them: Python warns): a mimic joint off the arm
+    /// whose master is not a joint of it ([`Held::MimicOfNone`]).
+    pub warnings: Vec<String>,
 }
 
 impl Arm {
@@ -223,8 +246,24 @@ impl Arm {
     /// The arm's rigid-body dynamics under `gravity` (m/s², the base frame),
     /// as a [`Dynamics`] of `N` joints (the links alone; the description's
     /// drive terms are [`Arm::drive`], for [`Dynamics::with_drive`]).
-    pub fn to_dynamics<const N: usize>(&self, gravity: [f64; 3]) -> Result<Dynamics<N>, Error> {
-        Dynamics::new(&self.chain, &self.inertials, gravity)
+    ///
+    /// Errors: [`Arm::inertia_error`], and the dynamics' own (a mass or an
+    /// inertia beyond 1e9, another N), named with the description.
+    pub fn to_dynamics<const N: usize>(
+        &self,
+        gravity: [f64; 3],
+    ) -> Result<Dynamics<N>, DescriptionError> {
+        if let Some(e) = &self.inertia_error {
+            return Err(e.clone());
+        }
+        let named =
+            |e: Error| DescriptionError::new(ErrorKind::Value, format!("{}: {e}", self.source));
+        let d = Dynamics::new(&self.chain, &self.inertials, gravity).map_err(named)?;
+        if self.lifted.iter().all(|l| *l == Lifted::default()) {
+            return Ok(d);
+        }
+        d.with_gravity_compensation(&self.chain, &self.lifted)
+            .map_err(named)
     }
 
     /// The description's drive terms of the `N` arm joints (armature,
@@ -362,13 +401,77 @@ pub fn reduce(tree: &Tree, tip: Option<&str>, fix: &[&str]) -> Result<Arm, Descr
         }
         None => {
             let root = single_root(tree)?;
+            if (0..tree.joints().len()).any(|j| tree.mimic_error(j).is_some()) {
+                // A mimic of no joint is held; were the rule's arm to pass it
+                // as a joint to drive, the arm would end short of it
+                // silently: refused, as on the way to a tip given.
+                let mut probe = Reduction::new(tree);
+                probe.hold_always(fix);
+                probe
+                    .held
+                    .retain(|_, why| !matches!(why, Held::MimicOfNone { .. }));
+                if let Ok(arm) = find_chain(&mut probe, root) {
+                    let end = tree.joint_links(arm[arm.len() - 1]).1;
+                    on_the_way(tree, &tree.path_to(end), &tree.links()[end].name, fix)?;
+                }
+            }
             let arm = find_chain(&mut r, root)?;
             let last = arm[arm.len() - 1];
-            let tip_name = tree.links()[tree.joint_links(last).1].name.clone();
+            let end = tree.joint_links(last).1;
+            let tip_name = tree.links()[end].name.clone();
+            // The joints the rule passes on its way are the arm's business
+            // too (a floating one was held silently here, refused with the
+            // same tip given).
+            on_the_way(tree, &tree.path_to(end), &tip_name, fix)?;
             (root, arm, tip_name)
         }
     };
     build(&r, base, arm, tip_name, tip_link, tip_frame)
+}
+
+/// The joints on `path` (to `tip`) fit a chain: no floating, planar or ball
+/// joint that `fix` does not name, no mimic joint of a joint the tree does
+/// not have (its coordinate would be held silently: the arm one short).
+fn on_the_way(
+    tree: &Tree,
+    path: &[usize],
+    tip: &str,
+    fix: &[&str],
+) -> Result<(), DescriptionError> {
+    let joints = tree.joints();
+    for &j in path {
+        let kind = joints[j].kind;
+        let named = fix.contains(&joints[j].name.as_str());
+        if matches!(
+            kind,
+            JointType::Floating | JointType::Planar | JointType::Ball
+        ) && !named
+        {
+            return Err(arm_error(
+                tree,
+                format!(
+                    "the joint '{}' on the way to '{tip}' is {}: a chain has {} joints only; \
+                     give a tip below it or fix it with fix=",
+                    joints[j].name,
+                    kind.name_in(tree.dialect()),
+                    match tree.dialect() {
+                        Dialect::Urdf => "revolute, continuous, prismatic and fixed",
+                        Dialect::Mujoco => "hinge and slide",
+                    }
+                ),
+            ));
+        }
+        if let Some(why) = tree.mimic_error(j).filter(|_| !named) {
+            return Err(arm_error(
+                tree,
+                format!(
+                    "{why}, on the way to '{tip}': correct its <mimic joint=…>, or hold it \
+                     with fix="
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Every joint `fix` names is the tree's; else an error listing the unknown
@@ -451,7 +554,8 @@ impl<'t> Reduction<'t> {
         let mut followers = alloc::vec![Vec::new(); joints.len()];
         for (i, j) in joints.iter().enumerate() {
             if let Some(m) = &j.mimic {
-                if let Some(master) = tree.joint_index(&m.joint) {
+                // (A joint mimicking itself follows none: held as a mistake.)
+                if let Some(master) = tree.joint_index(&m.joint).filter(|&k| k != i) {
                     followers[master].push(i);
                 }
             }
@@ -469,6 +573,8 @@ impl<'t> Reduction<'t> {
         for (i, j) in self.tree.joints().iter().enumerate() {
             let reason = if fix.contains(&j.name.as_str()) {
                 Held::Asked
+            } else if let Some(why) = self.tree.mimic_error(i) {
+                Held::MimicOfNone { why }
             } else if let Some(m) = &j.mimic {
                 Held::Mimic {
                     master: m.joint.clone(),
@@ -523,28 +629,7 @@ impl<'t> Reduction<'t> {
         let tree = self.tree;
         let joints = tree.joints();
         let path = tree.path_to(l);
-        for &j in &path {
-            let kind = joints[j].kind;
-            if matches!(
-                kind,
-                JointType::Floating | JointType::Planar | JointType::Ball
-            ) && !fix.contains(&joints[j].name.as_str())
-            {
-                return Err(arm_error(
-                    tree,
-                    format!(
-                        "the joint '{}' on the way to '{tip}' is {}: a chain has {} joints only; \
-                         give a tip below it or fix it with fix=",
-                        joints[j].name,
-                        kind.name_in(tree.dialect()),
-                        match tree.dialect() {
-                            Dialect::Urdf => "revolute, continuous, prismatic and fixed",
-                            Dialect::Mujoco => "hinge and slide",
-                        }
-                    ),
-                ));
-            }
-        }
+        on_the_way(tree, &path, tip, fix)?;
         let arm: Vec<usize> = path
             .into_iter()
             .filter(|&j| joints[j].kind.is_movable() && !self.held.contains_key(&j))
@@ -887,6 +972,8 @@ struct Fold<'t> {
     tree: &'t Tree,
     /// Per joint: whether it is an arm joint.
     on_arm: Vec<bool>,
+    /// The first link folded into a body whose inertia no rigid body has.
+    unphysical: core::cell::RefCell<Option<DescriptionError>>,
 }
 
 impl Fold<'_> {
@@ -942,9 +1029,6 @@ impl Fold<'_> {
         Ok((chain, Transform::from_parts(pending.p, &pending.r)))
     }
 
-    /// The body arm joint `a` moves (SPEC (20.1)): its child link and every
-    /// link it carries through joints that are not the arm's, as one
-    /// inertial in the joint's frame.
     /// The links arm joint `a` moves as one body (its child link and every
     /// link below it that no arm joint moves): the links [`Fold::body`] sums.
     fn links(&self, a: usize) -> Vec<usize> {
@@ -962,13 +1046,21 @@ impl Fold<'_> {
         out
     }
 
-    fn body(&self, a: usize) -> Result<Inertial, DescriptionError> {
+    /// The body arm joint `a` moves (SPEC (20.1)): its child link and every
+    /// link it carries through joints that are not the arm's, as one
+    /// inertial in the joint's frame; and what gravity compensation lifts
+    /// of it.
+    fn body(&self, a: usize) -> Result<(Inertial, Lifted), DescriptionError> {
         let tree = self.tree;
         let start = tree.joint_links(a).1;
         let (mut m, mut h, mut io) = (0.0, Vector3::zeros(), Matrix3::zeros());
+        let (mut lm, mut lh) = (0.0, Vector3::zeros());
         let mut todo = VecDeque::from([(start, Frame::IDENTITY)]);
         while let Some((l, at)) = todo.pop_front() {
             if let Some(inertial) = tree.links()[l].inertial.filter(|i| i.has_mass()) {
+                if let Err(e) = physical(tree, l, &inertial.inertia) {
+                    self.unphysical.borrow_mut().get_or_insert(e);
+                }
                 let f = inertial
                     .origin
                     .transform()
@@ -980,6 +1072,8 @@ impl Fold<'_> {
                 let mass = inertial.mass;
                 m += mass;
                 h += mass * c;
+                lm += inertial.gravcomp * mass;
+                lh += inertial.gravcomp * mass * c;
                 io += f.r * ic * f.r.transpose()
                     + mass * (Matrix3::identity() * c.norm_squared() - c * c.transpose());
             }
@@ -993,15 +1087,52 @@ impl Fold<'_> {
         let com = if m > 0.0 { h / m } else { Vector3::zeros() };
         let ic = io - m * (Matrix3::identity() * com.norm_squared() - com * com.transpose());
         let ic = (ic + ic.transpose()) * 0.5;
-        Ok(Inertial {
+        let body = Inertial {
             mass: m,
             origin: Transform {
                 translation: com.into(),
                 ..Transform::IDENTITY
             },
             inertia: core::array::from_fn(|i| core::array::from_fn(|k| ic[(i, k)])),
-        })
+        };
+        let lifted = Lifted {
+            mass: lm,
+            moment: lh.into(),
+        };
+        Ok((body, lifted))
     }
+}
+
+/// Link `l`'s inertia `i` is one a rigid body has (positive semi-definite),
+/// else an error naming the link and the file: a link the arm moves with a
+/// negative principal moment makes the mass matrix indefinite.
+fn physical(tree: &Tree, l: usize, i: &[[f64; 3]; 3]) -> Result<(), DescriptionError> {
+    let Err(m) = physical_inertia(i) else {
+        return Ok(());
+    };
+    let v = |x: f64| {
+        if x != 0.0 && x.abs() < 1e-4 {
+            format!("{x:e}")
+        } else {
+            format!("{x}")
+        }
+    };
+    let rows = i.map(|r| format!("[{}, {}, {}]", v(r[0]), v(r[1]), v(r[2])));
+    Err(DescriptionError::new(
+        ErrorKind::Value,
+        format!(
+            "{}: link '{}' has the inertia [{}] kg m², which no rigid body has: its \
+             principal moments are {:.3e}, {:.3e}, {:.3e} kg m², one negative (the arm's \
+             mass matrix would not be positive; MuJoCo refuses it too): correct the link's \
+             <inertia> (ixx, iyy, izz ≥ 0 and |ixy| ≤ √(ixx iyy), …)",
+            tree.source(),
+            tree.links()[l].name,
+            rows.join(", "),
+            m[0],
+            m[1],
+            m[2]
+        ),
+    ))
 }
 
 /// Joint `j` of the tree as an arm joint: its limits (±∞ when continuous),
@@ -1047,12 +1178,13 @@ fn build(
     let fold = Fold {
         tree,
         on_arm: on_arm(tree.joints().len(), &arm),
+        unphysical: core::cell::RefCell::new(None),
     };
     let (chain, tip_origin) = fold.chain(tip_link.unwrap_or(last_link), tip_frame)?;
-    let inertials = arm
+    let (inertials, lifted) = arm
         .iter()
         .map(|&a| fold.body(a))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<(Vec<_>, Vec<_>), _>>()?;
     let held = r
         .held
         .iter()
@@ -1085,5 +1217,13 @@ fn build(
                 .collect()
         },
         inertials,
+        lifted,
+        inertia_error: fold.unphysical.into_inner(),
+        warnings: r
+            .held
+            .iter()
+            .filter(|(_, why)| matches!(why, Held::MimicOfNone { .. }))
+            .map(|(_, why)| format!("{}: {why}", tree.source()))
+            .collect(),
     })
 }

@@ -122,6 +122,10 @@ pub struct LinkInertial {
     /// Rotational inertia about the centre of mass in `origin`'s axes (kg
     /// m², row-major), symmetric.
     pub inertia: [[f64; 3]; 3],
+    /// The share of its weight gravity compensation lifts (MuJoCo's body
+    /// `gravcomp`; 0 in a URDF): a force of `gravcomp` × mass × (−gravity)
+    /// at its centre of mass.
+    pub gravcomp: f64,
 }
 
 impl LinkInertial {
@@ -148,6 +152,7 @@ impl LinkInertial {
         mass: 0.0,
         origin: Origin::IDENTITY,
         inertia: [[0.0; 3]; 3],
+        gravcomp: 0.0,
     };
 
     /// Whether it has a mass or an inertia.
@@ -388,6 +393,7 @@ fn index_links(source: &str, links: &[Link]) -> Result<Index, DescriptionError> 
         if let Some(i) = &l.inertial {
             origin_ok(source, "the inertial origin", &what, &i.origin)?;
             finite_or(source, "the mass", &what, &[i.mass])?;
+            finite_or(source, "the gravity compensation", &what, &[i.gravcomp])?;
             finite_or(source, "the inertia", &what, i.inertia.as_flattened())?;
             if i.mass < 0.0 {
                 return Err(DescriptionError::new(
@@ -590,10 +596,10 @@ impl Tree {
     /// Errors (each naming `source`, the element and what to do): two links,
     /// two joints or two frames of one name; a joint whose parent or child
     /// link is not declared; a link carried by two joints; joints that form
-    /// a loop (a mimic joint whose master is not a joint is still a mimic
-    /// joint: held, SPEC (21.2)); a frame on a link
-    /// not declared; a non-finite number; a negative mass, damping,
-    /// friction or armature; a lower limit above the upper one.
+    /// a loop; a frame on a link not declared; a non-finite number; a
+    /// negative mass, damping, friction or armature; a lower limit above the
+    /// upper one. (A mimic joint whose master is not another joint of the
+    /// tree is the reduction's to judge: [`Tree::mimic_error`].)
     pub fn new(
         source: &str,
         name: &str,
@@ -668,6 +674,44 @@ impl Tree {
     /// The links whose inertia the reader balanced, in the tree's order.
     pub fn balanced(&self) -> &[String] {
         &self.balanced
+    }
+
+    /// Why joint `j`'s mimic names no joint it can follow, if it does not:
+    /// a joint the tree does not have, itself, or a circle of mimics none of
+    /// which is driven (a file's mistake: real files have mimics of joints
+    /// renamed since, on hands off the arm).
+    pub fn mimic_error(&self, j: usize) -> Option<String> {
+        let m = self.joints[j].mimic.as_ref()?;
+        let name = &self.joints[j].name;
+        let Some(mut k) = self.joint_index(&m.joint) else {
+            return Some(format!(
+                "joint '{name}' mimics '{}', which is not a joint of it",
+                m.joint
+            ));
+        };
+        if k == j {
+            return Some(format!("joint '{name}' mimics itself"));
+        }
+        // Following masters ends at a joint that mimics none, within as many
+        // steps as there are joints.
+        for _ in 0..self.joints.len() {
+            match self.joints[k]
+                .mimic
+                .as_ref()
+                .map(|m| self.joint_index(&m.joint))
+            {
+                None | Some(None) => return None,
+                Some(Some(next)) if next == j => {
+                    return Some(format!(
+                        "joint '{name}' mimics '{}', which follows it back: a circle of mimic \
+                         joints none of which is driven",
+                        m.joint
+                    ))
+                }
+                Some(Some(next)) => k = next,
+            }
+        }
+        None
     }
 
     /// What the tree was read from, for messages (e.g. `"URDF 'panda.urdf'"`).

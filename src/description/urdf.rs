@@ -38,25 +38,69 @@ const XACRO_NS: &str = "http://www.ros.org/wiki/xacro";
 /// ([`ErrorKind::Parse`], naming the element), or its tree is not one
 /// ([`Tree::new`]).
 pub fn read_file(path: impl AsRef<Path>) -> Result<Tree, DescriptionError> {
+    read_file_with(path, &mut || true)
+}
+
+/// [`read_file`], asking `go_on` between two pieces of the work (at most
+/// [`CHUNK_BYTES`] of text or [`BATCH_ELEMENTS`] elements apart): false
+/// stops it ([`ErrorKind::Stopped`]). A front's Ctrl-C.
+pub fn read_file_with(
+    path: impl AsRef<Path>,
+    go_on: &mut GoOn<'_>,
+) -> Result<Tree, DescriptionError> {
     let path = path.as_ref();
     let text = read_text(path, "URDF").map_err(|e| {
         DescriptionError::new(
             ErrorKind::Io,
             format!(
                 "cannot read the URDF '{}': {e}: give the path of a URDF file",
-                path.display()
+                shown_path(path)
             ),
         )
     })?;
-    let label = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into(),
-    );
-    read(
-        &text,
-        &format!("URDF '{label}'"),
-        &path.display().to_string(),
-    )
+    let label = path
+        .file_name()
+        .map_or_else(|| shown_path(path), |n| n.to_string_lossy().into());
+    read(&text, &format!("URDF '{label}'"), &shown_path(path), go_on)
+}
+
+/// What a reading asks between two pieces of its work: whether to go on.
+pub type GoOn<'a> = dyn FnMut() -> bool + 'a;
+
+/// Bytes of text the XML reader is given at a time (a reading asks its
+/// [`GoOn`] after each).
+pub const CHUNK_BYTES: usize = 64 << 10;
+
+/// Links and joints handed to urdf-rs at a time (a reading asks its
+/// [`GoOn`] after each batch): the elements of a document are never all in
+/// memory at once, and each is read once, so a reading is linear in the
+/// document's size.
+pub const BATCH_ELEMENTS: usize = 256;
+
+/// A path as messages show it: whole, unless it is long or holds a line
+/// break (text given where a path was expected): then its start and its
+/// length.
+pub(crate) fn shown_path(path: &Path) -> String {
+    let s = path.display().to_string();
+    if s.chars().count() <= 200 && !s.contains(['\n', '\r']) {
+        return s;
+    }
+    let start: String = s
+        .chars()
+        .take(60)
+        .take_while(|c| *c != '\n' && *c != '\r')
+        .collect();
+    format!("{start}… ({} characters)", s.chars().count())
+}
+
+/// Whether `source` is description text (its first character, after a
+/// byte-order mark and white space, a `<`) rather than a path.
+pub fn is_text(source: &str) -> bool {
+    source
+        .strip_prefix('\u{feff}')
+        .unwrap_or(source)
+        .trim_start()
+        .starts_with('<')
 }
 
 /// The largest description file read (bytes): a robot's URDF or MJCF is a
@@ -154,78 +198,309 @@ fn nesting(text: &str) -> usize {
 
 /// The tree of the URDF `text` (labelled "URDF text" in messages).
 pub fn read_str(text: &str) -> Result<Tree, DescriptionError> {
-    read(text, "URDF text", "the URDF text")
+    read(text, "URDF text", "the URDF text", &mut || true)
 }
 
 /// The tree of the URDF `text`, labelled `label` in messages (e.g. "xacro
 /// 'arm.xacro'" for a file a front expanded).
 pub fn read_str_as(text: &str, label: &str) -> Result<Tree, DescriptionError> {
-    read(text, label, label)
+    read(text, label, label, &mut || true)
+}
+
+/// [`read_str`] (`label` None) or [`read_str_as`], asking `go_on` between
+/// two pieces of the work, as [`read_file_with`] does.
+pub fn read_str_with(
+    text: &str,
+    label: Option<&str>,
+    go_on: &mut GoOn<'_>,
+) -> Result<Tree, DescriptionError> {
+    match label {
+        Some(l) => read(text, l, l, go_on),
+        None => read(text, "URDF text", "the URDF text", go_on),
+    }
 }
 
 /// What a description's text is, by its root element and its markup:
 /// `"mjcf"` (`<mujoco>`), `"mjcf-fragment"` (a `<mujocoinclude>`, or a
 /// `<mujoco>` whose bodies are not in a `<worldbody>`: a file other MJCF
-/// files include), `"xacro"` (a `<robot>` with xacro markup),
-/// `"urdf"` (a `<robot>`), or `"unknown"` (not XML, another root).
+/// files include), `"xacro"` (a `<robot>` with xacro markup), `"urdf"` (a
+/// `<robot>`), or `"unknown"` (not XML before its root element, nested too
+/// deep, another root). The rest of a `<robot>` is read only where its text
+/// could hold xacro markup; its validity is the reader's to judge.
 pub fn kind_of(text: &str) -> &'static str {
-    match document(text) {
-        Ok(root) if is_mjcf_fragment(&root) => "mjcf-fragment",
-        Ok(root) if root.name == "mujoco" => "mjcf",
-        Ok(root) if root.name == "robot" && xacro_markup(&root).is_some() => "xacro",
-        Ok(root) if root.name == "robot" => "urdf",
-        Ok(_) => "unknown",
-        Err(_) if text.contains("<xacro:") => "xacro",
-        Err(_) => "unknown",
-    }
+    kind_of_with(text, &mut || true).unwrap_or("unknown")
 }
 
-/// Whether `root` is an MJCF fragment: a `<mujocoinclude>`, or a `<mujoco>`
-/// whose bodies are not inside a `<worldbody>` (a file that task scenes
-/// include inside theirs; MuJoCo compiles it to an empty world).
-fn is_mjcf_fragment(root: &xml::Element) -> bool {
-    fn elements(e: &xml::Element) -> impl Iterator<Item = &xml::Element> {
-        e.children.iter().filter_map(|c| match c {
-            xml::Xml::ElementNode(e) => Some(e),
-            _ => None,
-        })
-    }
-    fn has_body(e: &xml::Element) -> bool {
-        elements(e).any(|c| c.name == "body" || has_body(c))
-    }
-    match root.name.as_str() {
-        "mujocoinclude" => true,
-        "mujoco" => {
-            let world = elements(root)
-                .filter(|c| c.name == "worldbody")
-                .any(has_body);
-            !world && elements(root).any(|c| c.name == "body")
-        }
-        _ => false,
-    }
-}
-
-/// The XML document (its root element), a panic of the parser turned into an error.
-fn document(text: &str) -> Result<xml::Element, String> {
+/// [`kind_of`], asking `go_on` between two pieces of the work: an error
+/// ([`ErrorKind::Stopped`]) if it says stop.
+pub fn kind_of_with(text: &str, go_on: &mut GoOn<'_>) -> Result<&'static str, DescriptionError> {
     if nesting(text) > MAX_DEPTH {
-        return Err(format!(
-            "its elements nest more than {MAX_DEPTH} deep (a URDF nests 5)"
-        ));
+        return Ok("unknown");
     }
-    match std::panic::catch_unwind(|| text.parse::<xml::Element>()) {
-        Ok(Ok(root)) => Ok(root),
-        Ok(Err(xml::BuilderError::Parser(e))) => Err(format!(
+    let text = without_bom(text);
+    let scan = might_be_xacro(text);
+    let kind = core::cell::Cell::new("unknown");
+    let mut bodies = Bodies::default();
+    let found = stream(
+        text,
+        go_on,
+        |tag| {
+            kind.set(match tag.name.as_str() {
+                "mujoco" => "mjcf",
+                "mujocoinclude" => "mjcf-fragment",
+                "robot" => "urdf",
+                _ => "unknown",
+            });
+            // Read on where the rest decides: an MJCF's bodies, a URDF's markup.
+            Ok(kind.get() == "mjcf" || (kind.get() == "urdf" && scan))
+        },
+        |root| {
+            if kind.get() == "mjcf" {
+                bodies.add(&root);
+                return Ok(());
+            }
+            match xacro_markup(&root) {
+                Some(what) => Err(DescriptionError::new(ErrorKind::Xacro, what)),
+                None => Ok(()),
+            }
+        },
+    );
+    match found {
+        Ok(()) if kind.get() == "mjcf" && bodies.fragment() => Ok("mjcf-fragment"),
+        Ok(()) => Ok(kind.get()),
+        Err(Streamed::Described(e)) if e.kind() == ErrorKind::Xacro => Ok("xacro"),
+        Err(Streamed::Described(e)) => Err(e),
+        Err(Streamed::Stopped) => Err(stopped()),
+        Err(Streamed::NotXml(_)) if text.contains("<xacro:") => Ok("xacro"),
+        Err(Streamed::NotXml(_)) => Ok(kind.get()),
+    }
+}
+
+/// Where an MJCF's bodies are, over the batches of its root's children: in
+/// its `<worldbody>`, or loose under the root (a fragment, a file that task
+/// scenes include inside theirs; MuJoCo compiles it to an empty world).
+#[derive(Default)]
+struct Bodies {
+    in_world: bool,
+    loose: bool,
+}
+
+impl Bodies {
+    fn add(&mut self, root: &xml::Element) {
+        fn elements(e: &xml::Element) -> impl Iterator<Item = &xml::Element> {
+            e.children.iter().filter_map(|c| match c {
+                xml::Xml::ElementNode(e) => Some(e),
+                _ => None,
+            })
+        }
+        fn has_body(e: &xml::Element) -> bool {
+            elements(e).any(|c| c.name == "body" || has_body(c))
+        }
+        self.in_world |= elements(root)
+            .filter(|c| c.name == "worldbody")
+            .any(has_body);
+        self.loose |= elements(root).any(|c| c.name == "body");
+    }
+
+    fn fragment(&self) -> bool {
+        !self.in_world && self.loose
+    }
+}
+
+/// Whether the MJCF `text` (its root `<mujoco>` or `<mujocoinclude>`) is a
+/// fragment: a `<mujocoinclude>`, or a `<mujoco>` whose bodies are not in a
+/// `<worldbody>`.
+fn mjcf_fragment(text: &str, go_on: &mut GoOn<'_>) -> Result<bool, Streamed> {
+    let mut include = false;
+    let mut bodies = Bodies::default();
+    stream(
+        text,
+        go_on,
+        |tag| {
+            include = tag.name == "mujocoinclude";
+            Ok(!include)
+        },
+        |root| {
+            bodies.add(&root);
+            Ok(())
+        },
+    )?;
+    Ok(include || bodies.fragment())
+}
+
+/// The error of a reading its [`GoOn`] stopped.
+fn stopped() -> DescriptionError {
+    DescriptionError::new(
+        ErrorKind::Stopped,
+        "the reading was stopped by its caller".into(),
+    )
+}
+
+/// `text` without a leading byte-order mark.
+fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
+
+/// Whether `text` could hold xacro markup at all: the xacro namespace, an
+/// expression `${…}` or `$(…)`, an element `<xacro:…>`.
+fn might_be_xacro(text: &str) -> bool {
+    ["${", "$(", XACRO_NS, "<xacro:"]
+        .iter()
+        .any(|m| text.contains(m))
+}
+
+/// Why a [`stream`] ended early.
+enum Streamed {
+    /// The text is not XML (the message, to follow "cannot read … as a URDF: ").
+    NotXml(String),
+    /// The caller's [`GoOn`] said stop.
+    Stopped,
+    /// A callback refused.
+    Described(DescriptionError),
+}
+
+impl From<DescriptionError> for Streamed {
+    fn from(e: DescriptionError) -> Self {
+        Streamed::Described(e)
+    }
+}
+
+/// A copy of a start tag (RustyXML's is not `Clone`).
+fn copy_tag(t: &xml::StartTag) -> xml::StartTag {
+    xml::StartTag {
+        name: t.name.clone(),
+        ns: t.ns.clone(),
+        prefix: t.prefix.clone(),
+        attributes: t.attributes.clone(),
+    }
+}
+
+/// The end tag of `t`.
+fn end_of(t: &xml::StartTag) -> xml::EndTag {
+    xml::EndTag {
+        name: t.name.clone(),
+        ns: t.ns.clone(),
+        prefix: t.prefix.clone(),
+    }
+}
+
+fn builder_error(e: xml::BuilderError) -> Streamed {
+    Streamed::NotXml(match e {
+        xml::BuilderError::Parser(e) => format!(
             "it is not XML: line {}, column {}: {}",
             e.line, e.col, e.msg
-        )),
-        Ok(Err(xml::BuilderError::ImproperNesting)) => {
-            Err("it is not XML: its elements are not properly nested".into())
+        ),
+        xml::BuilderError::ImproperNesting => {
+            "it is not XML: its elements are not properly nested".into()
         }
-        Ok(Err(xml::BuilderError::NoElement)) => {
-            Err("it is not XML: it ends before its root element is closed".into())
+        xml::BuilderError::NoElement => {
+            "it is not XML: it ends before its root element is closed".into()
         }
-        Err(_) => Err("the XML parser could not read it".into()),
-    }
+    })
+}
+
+/// Read the XML `text` a piece at a time, each piece once: `root` gets the
+/// root element's start tag and says whether to read on (false: the reading
+/// ends there, `Ok`); then `batch` gets the root element holding the next
+/// children of the root, whole, at most [`BATCH_ELEMENTS`] of them, until
+/// the root closes (at least once). The text is given to the XML reader
+/// [`CHUNK_BYTES`] at a time; `go_on` is asked after each chunk and each
+/// batch. Elements nested more than [`MAX_DEPTH`] deep are refused as they
+/// come; the text after the root element is not read (as RustyXML's own
+/// reading of a document).
+fn stream(
+    text: &str,
+    go_on: &mut GoOn<'_>,
+    mut root: impl FnMut(&xml::StartTag) -> Result<bool, DescriptionError>,
+    mut batch: impl FnMut(xml::Element) -> Result<(), DescriptionError>,
+) -> Result<(), Streamed> {
+    let run = std::panic::AssertUnwindSafe(|| -> Result<(), Streamed> {
+        let mut parser = xml::Parser::new();
+        let mut at = 0;
+        let mut depth = 0usize;
+        // The root's start tag, and the builder of the batch being read.
+        let mut open: Option<(xml::StartTag, xml::ElementBuilder)> = None;
+        let mut children = 0usize;
+        let start = |tag: &xml::StartTag| {
+            let mut b = xml::ElementBuilder::new();
+            b.handle_event(Ok(xml::Event::ElementStart(copy_tag(tag))));
+            b
+        };
+        loop {
+            if at < text.len() {
+                let mut end = (at + CHUNK_BYTES).min(text.len());
+                while !text.is_char_boundary(end) {
+                    end += 1;
+                }
+                parser.feed_str(&text[at..end]);
+                at = end;
+            }
+            for event in parser.by_ref() {
+                let event = event.map_err(|e| builder_error(xml::BuilderError::Parser(e)))?;
+                let closed = match &event {
+                    xml::Event::ElementStart(tag) => {
+                        depth += 1;
+                        if depth > MAX_DEPTH {
+                            return Err(Streamed::NotXml(format!(
+                                "its elements nest more than {MAX_DEPTH} deep (a URDF nests 5)"
+                            )));
+                        }
+                        if depth == 1 {
+                            if !root(tag)? {
+                                return Ok(());
+                            }
+                            open = Some((copy_tag(tag), start(tag)));
+                            continue;
+                        }
+                        false
+                    }
+                    xml::Event::ElementEnd(_) => {
+                        depth = depth
+                            .checked_sub(1)
+                            .ok_or_else(|| builder_error(xml::BuilderError::ImproperNesting))?;
+                        true
+                    }
+                    _ => false,
+                };
+                let Some((tag, b)) = open.as_mut() else {
+                    continue; // before the root: text, comments, declarations
+                };
+                match b.handle_event(Ok(event)) {
+                    Some(Ok(element)) => {
+                        // The root closed: the last batch.
+                        batch(element)?;
+                        return Ok(());
+                    }
+                    Some(Err(e)) => return Err(builder_error(e)),
+                    None => {}
+                }
+                if closed && depth == 1 {
+                    children += 1;
+                    if children == BATCH_ELEMENTS {
+                        children = 0;
+                        let full = core::mem::replace(b, start(tag));
+                        let mut full = full;
+                        match full.handle_event(Ok(xml::Event::ElementEnd(end_of(tag)))) {
+                            Some(Ok(element)) => batch(element)?,
+                            Some(Err(e)) => return Err(builder_error(e)),
+                            None => {}
+                        }
+                        if !go_on() {
+                            return Err(Streamed::Stopped);
+                        }
+                    }
+                }
+            }
+            if at == text.len() {
+                return Err(builder_error(xml::BuilderError::NoElement));
+            }
+            if !go_on() {
+                return Err(Streamed::Stopped);
+            }
+        }
+    });
+    std::panic::catch_unwind(run)
+        .unwrap_or_else(|_| Err(Streamed::NotXml("the XML parser could not read it".into())))
 }
 
 /// The first xacro markup in the document: an element in the xacro
@@ -255,12 +530,69 @@ fn xacro_markup(root: &xml::Element) -> Option<String> {
     None
 }
 
-fn read(text: &str, source: &str, shown: &str) -> Result<Tree, DescriptionError> {
+fn read(
+    text: &str,
+    source: &str,
+    shown: &str,
+    go_on: &mut GoOn<'_>,
+) -> Result<Tree, DescriptionError> {
     let errors = ReadErrors { source, shown };
-    let mut root = errors.robot_root(text)?;
-    strip_for_arm(&mut root);
-    let robot = errors.parse_root(&root)?;
-    tree_of(&robot, source, &with_inertial(&root))
+    let text = without_bom(text);
+    let scan = might_be_xacro(text);
+    // Each batch's elements as the tree's at once (urdf-rs's own are
+    // dropped), a value error kept until the whole document has parsed.
+    let mut name: Option<String> = None;
+    let (mut links, mut joints) = (Vec::new(), Vec::new());
+    let mut value_error = None;
+    let mut mjcf = false;
+    let read = stream(
+        text,
+        go_on,
+        |tag| {
+            mjcf = matches!(tag.name.as_str(), "mujoco" | "mujocoinclude");
+            errors.robot_root(tag).map(|()| true)
+        },
+        |mut root| {
+            if scan {
+                if let Some(what) = xacro_markup(&root) {
+                    return Err(errors.xacro(&what));
+                }
+            }
+            strip_for_arm(&mut root);
+            let inertial = with_inertial(&root);
+            let part = errors.parse_root(&root)?;
+            drop(root);
+            links.extend(part.links.iter().map(|l| link_of(l, &inertial)));
+            if value_error.is_none() {
+                value_error = limits_ok(&part, source).err();
+            }
+            joints.extend(part.joints.iter().map(joint_of));
+            name.get_or_insert(part.name);
+            Ok(())
+        },
+    );
+    match read {
+        Ok(()) => {}
+        Err(Streamed::Described(e)) if mjcf => {
+            return match mjcf_fragment(text, go_on) {
+                Ok(true) => Err(errors.mjcf_fragment()),
+                Err(Streamed::Stopped) => Err(stopped()),
+                _ => Err(e),
+            }
+        }
+        Err(Streamed::Described(e)) => return Err(e),
+        Err(Streamed::Stopped) => return Err(stopped()),
+        Err(Streamed::NotXml(_)) if text.contains("<xacro:") => {
+            return Err(errors.xacro("xacro elements <xacro:…>"))
+        }
+        Err(Streamed::NotXml(e)) => return Err(errors.parse_error(&e)),
+    }
+    // The root closed: at least one batch was read.
+    let name = name.ok_or_else(|| errors.parse_error("it has no root element"))?;
+    if let Some(e) = value_error {
+        return Err(e);
+    }
+    Tree::new(source, &name, links, joints, Vec::new()).map(Tree::balanced_inertias)
 }
 
 /// The errors of one reading, naming `source` (the label of later
@@ -301,26 +633,21 @@ impl ReadErrors<'_> {
         )
     }
 
-    /// The document's root element, a `<robot>` without xacro markup:
-    /// else not XML, an MJCF, another root, or xacro (in that order).
-    fn robot_root(&self, text: &str) -> Result<xml::Element, DescriptionError> {
-        let root = match document(text) {
-            Ok(root) => root,
-            Err(_) if text.contains("<xacro:") => {
-                return Err(self.xacro("xacro elements <xacro:…>"))
-            }
-            Err(e) => return Err(self.parse_error(&e)),
-        };
-        if is_mjcf_fragment(&root) {
-            return Err(DescriptionError::new(
-                ErrorKind::Parse,
-                format!(
-                    "{} is an MJCF fragment (its bodies are not in a <worldbody>: a file that \
-                     other MJCF files include), not a URDF: load the scene that includes it",
-                    self.shown
-                ),
-            ));
-        }
+    /// An MJCF fragment given as a URDF.
+    fn mjcf_fragment(&self) -> DescriptionError {
+        DescriptionError::new(
+            ErrorKind::Parse,
+            format!(
+                "{} is an MJCF fragment (its bodies are not in a <worldbody>: a file that \
+                 other MJCF files include), not a URDF: load the scene that includes it",
+                self.shown
+            ),
+        )
+    }
+
+    /// The document's root element is a `<robot>`: else an MJCF or another
+    /// root.
+    fn robot_root(&self, root: &xml::StartTag) -> Result<(), DescriptionError> {
         if root.name == "mujoco" {
             return Err(DescriptionError::new(
                 ErrorKind::Parse,
@@ -337,10 +664,7 @@ impl ReadErrors<'_> {
                 self.parse_error(&format!("its root element is <{}>, not <robot>", root.name))
             );
         }
-        if let Some(what) = xacro_markup(&root) {
-            return Err(self.xacro(&what));
-        }
-        Ok(root)
+        Ok(())
     }
 
     /// urdf-rs's robot of the (stripped) document `root`, written back and
@@ -443,7 +767,32 @@ fn first_bad_element(root: &xml::Element) -> Option<String> {
         };
         if parse(&body).is_err() {
             let name = e.get_attribute("name", None).unwrap_or("");
-            return Some(format!("<{} name=\"{name}\">", e.name));
+            let inner = bad_vector(e).map_or_else(String::new, |v| format!(": {v}"));
+            return Some(format!("<{} name=\"{name}\">{inner}", e.name));
+        }
+    }
+    None
+}
+
+/// The first element below `e` whose vector attribute (`xyz`, `rpy`) does
+/// not hold three numbers (`<axis xyz="0 1">`), to name beside its joint.
+fn bad_vector(e: &xml::Element) -> Option<String> {
+    let mut todo = std::vec![e];
+    while let Some(el) = todo.pop() {
+        for key in ["xyz", "rpy"] {
+            if let Some(v) = el.get_attribute(key, None) {
+                if v.split_whitespace().count() != 3 {
+                    return Some(format!(
+                        "<{} {key}=\"{v}\"> (three numbers, x y z)",
+                        el.name
+                    ));
+                }
+            }
+        }
+        for c in el.children.iter().rev() {
+            if let xml::Xml::ElementNode(child) = c {
+                todo.push(child);
+            }
         }
     }
     None
@@ -461,18 +810,8 @@ fn stated(v: f64) -> f64 {
     }
 }
 
-/// The tree of a parsed URDF.
-/// `with_inertial` names the links whose element has an `<inertial>`.
-fn tree_of(
-    robot: &urdf_rs::Robot,
-    source: &str,
-    with_inertial: &std::collections::BTreeSet<String>,
-) -> Result<Tree, DescriptionError> {
-    let links = robot
-        .links
-        .iter()
-        .map(|l| link_of(l, with_inertial))
-        .collect();
+/// The parsed joints' limits are numbers, efforts and speeds ≥ 0.
+fn limits_ok(robot: &urdf_rs::Robot, source: &str) -> Result<(), DescriptionError> {
     // A limit that is not a number, or a negative effort or speed, is a
     // mistake in the file, not "no limit" (NaN made a revolute joint
     // continuous, and a negative effort "none stated").
@@ -500,8 +839,7 @@ fn tree_of(
             }
         }
     }
-    let joints = robot.joints.iter().map(joint_of).collect();
-    Tree::new(source, &robot.name, links, joints, Vec::new()).map(Tree::balanced_inertias)
+    Ok(())
 }
 
 /// A parsed link: its inertial if its element has one (`with_inertial`;
@@ -518,6 +856,7 @@ fn link_of(l: &urdf_rs::Link, with_inertial: &std::collections::BTreeSet<String>
                 [i.ixy, i.iyy, i.iyz],
                 [i.ixz, i.iyz, i.izz],
             ],
+            gravcomp: 0.0,
         }),
     }
 }

@@ -9,10 +9,11 @@ use super::MAX_JOINTS;
 use crate::cartesian::{self, Inertial, Joint, JointKind, Kinematics, Transform};
 use crate::control::impedance::{ImpedanceMode, TargetImpedance};
 use crate::control::safety::{Fault, CEILING_POSITION};
-use crate::description::Arm;
+use crate::description::{Arm, DescriptionError, ErrorKind};
 use crate::error::{check, Error};
 use crate::types::Vector;
 use alloc::boxed::Box;
+use alloc::format;
 use core::convert::Infallible;
 use nalgebra::{Const, Dyn, MatrixView, Rotation3, SMatrix};
 
@@ -290,14 +291,21 @@ impl Dynamics {
     }
 
     /// The dynamics of `arm` (its links, and its joints' drive terms) under
-    /// `gravity` (m/s², base frame).
-    pub fn from_arm(arm: &Arm, gravity: [f64; 3]) -> Result<Self, Error> {
+    /// `gravity` (m/s², base frame). Errors name the description: an
+    /// inertia no rigid body has names its link ([`Arm::inertia_error`]),
+    /// as [`Arm::to_dynamics`] does.
+    pub fn from_arm(arm: &Arm, gravity: [f64; 3]) -> Result<Self, DescriptionError> {
         let n = arm.n();
+        let named =
+            |e: Error| DescriptionError::new(ErrorKind::Value, format!("{}: {e}", arm.source));
         let inner = make!(n, N => {
-            arm.to_dynamics::<N>(gravity)
-                .and_then(|d| d.with_drive(arm.drive::<N>()?))
-                .map(Box::new)
-        }, _ => movable(n))?;
+            arm.to_dynamics::<N>(gravity).and_then(|d| {
+                arm.drive::<N>()
+                    .and_then(|drive| d.with_drive(drive))
+                    .map(Box::new)
+                    .map_err(named)
+            })
+        }, _ => named(movable(n)))?;
         Ok(Self { inner })
     }
 

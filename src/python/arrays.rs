@@ -10,7 +10,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict, PyList, PyString};
+use pyo3::types::{PyBool, PyBytes, PyDict, PyList, PyString, PyTuple};
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
 /// Up to [`MAX_JOINTS`] values on the stack.
@@ -63,12 +63,28 @@ pub(super) fn list_into(obj: &Bound<'_, PyAny>, out: &mut [f64]) -> bool {
         return false;
     }
     for (o, item) in out.iter_mut().zip(list.iter()) {
+        if item.is_instance_of::<PyBool>() {
+            return false; // the general path refuses it by name
+        }
         match item.extract::<f64>() {
             Ok(x) => *o = x,
             Err(_) => return false,
         }
     }
     true
+}
+
+/// The index of the first bool in a list or tuple `obj` (a bool is not a
+/// number here: `[True, False]` was taken as [1, 0]).
+fn first_bool(obj: &Bound<'_, PyAny>) -> Option<usize> {
+    let items: Vec<Bound<'_, PyAny>> = if let Ok(l) = obj.cast::<PyList>() {
+        l.iter().collect()
+    } else if let Ok(t) = obj.cast::<PyTuple>() {
+        t.iter().collect()
+    } else {
+        return None;
+    };
+    items.iter().position(|i| i.is_instance_of::<PyBool>())
 }
 
 /// As [`vector_any`], into `out` (the entries past n untouched): a step's
@@ -107,6 +123,10 @@ pub(super) fn vector_into(
     } else if list_into(obj, &mut out[..n]) {
     } else if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() {
         return Err(type_error(what, n, obj));
+    } else if let Some(i) = first_bool(obj) {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must hold real numbers, got a bool at [{i}]"
+        )));
     } else if let Ok(v) = obj.extract::<Vec<f64>>() {
         if v.len() != n {
             return Err(shape_error(what, n, &format!("length {}", v.len())));

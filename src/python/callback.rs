@@ -234,6 +234,40 @@ fn as_float_array<'py>(
     Ok(a.cast_into::<PyArrayDyn<f64>>()?)
 }
 
+/// A controller's step returned numbers for its torque (reals: a number, a
+/// sequence or an array of a real dtype), else a `TypeError` naming tau and
+/// what it returned: None (a step that forgot to return: it became NaN), text
+/// ("3.5" became 3.5 N m), a dict, bools.
+pub(super) fn numeric_torque(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<()> {
+    let py = obj.py();
+    let refuse = |what: &str| {
+        Err(pyo3::exceptions::PyTypeError::new_err(std::format!(
+            "the controller's step returned {what} for its torque: return tau, {n} real \
+             numbers (N m), as an array or a sequence (or one number for every joint)"
+        )))
+    };
+    if obj.is_none() {
+        return refuse("None");
+    }
+    let np = py.import(intern!(py, "numpy"))?;
+    let a = match np.getattr(intern!(py, "asarray"))?.call1((obj,)) {
+        Ok(a) => a,
+        Err(_) => return refuse(&std::format!("a {}", obj.get_type().name()?)),
+    };
+    let kind: String = a
+        .getattr(intern!(py, "dtype"))?
+        .getattr(intern!(py, "kind"))?
+        .extract()?;
+    if matches!(kind.as_str(), "f" | "i" | "u") {
+        return Ok(());
+    }
+    let dtype = a.getattr(intern!(py, "dtype"))?.str()?;
+    refuse(&std::format!(
+        "a {} of dtype {dtype}",
+        obj.get_type().name()?
+    ))
+}
+
 /// The torque a step returned, as the Python loop's plant took it: n
 /// values, or one for every joint; an error naming its shape otherwise.
 /// `Ok(Err(e))`: not finite (`e` says so, as the Python loop did).
@@ -252,6 +286,7 @@ fn torque(py: Python<'_>, obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Result<B
         });
     let mut given = None;
     if !fast {
+        numeric_torque(obj, n)?;
         let a = as_float_array(py, obj)?;
         let r = a.try_readonly()?;
         let v = r.as_array();
@@ -315,6 +350,13 @@ struct PyStep<'a, const N: usize> {
     abort: &'a Cell<bool>,
     /// The exception that ended the run.
     error: Option<PyErr>,
+}
+
+/// A controller written in Python has no state of the core's to copy.
+impl<const N: usize> super::dynamic::View for PyStep<'_, N> {
+    fn copy(&self, _part: core::any::TypeId) -> Option<Box<dyn core::any::Any + Send>> {
+        None
+    }
 }
 
 /// How a call ended.

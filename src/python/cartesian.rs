@@ -16,6 +16,7 @@ use super::dynamic::{scenario, DynTracker, Hooks, Owned, RunError, Typed, MAX_JO
 use super::frames::{joint, transform};
 use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
+use super::shared::{Read, Shared, Slot, Write};
 use super::{
     array, array1, config_error, items, python_shape, shape_error, vector, ConfigError,
     PyController,
@@ -34,11 +35,11 @@ use crate::schema::Preset;
 use crate::trajectory::Setpoint;
 use crate::types::Vector;
 use adaptimp_mujoco::Sim;
+use core::any::{Any, TypeId};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::sync::{Mutex, MutexGuard};
 use std::vec::Vec;
 
 // ---------------------------------------------------------------------------
@@ -316,6 +317,9 @@ pub trait DynOuter: Send + Sync {
         out: &mut Vec<f64>,
         hooks: &mut dyn Hooks,
     ) -> Result<(), RunError>;
+    /// A copy of the state, without the kept log rows: what Python code a
+    /// step or a run calls reads meanwhile.
+    fn view(&self) -> Box<dyn DynOuter>;
 }
 
 /// A joint controller of the core, of any n: the paper's laws or computed
@@ -365,6 +369,31 @@ struct Outer<const N: usize> {
 pub const LOG_WIDTH: usize = 30;
 
 impl<const N: usize> Outer<N> {
+    /// This loop at `state`, after `last` (None: the last step kept), without
+    /// its log: a copy for the Python code a run calls.
+    fn at(&self, state: &CartesianState<N>, last: Option<&LastStep<N>>) -> Self {
+        Self {
+            state: *state,
+            last: last.copied().or(self.last),
+            log: Vec::new(),
+            rows: 0,
+            ..*self
+        }
+    }
+
+    /// [`Self::at`] for the part `part` a binding keeps, as a run's
+    /// [`OuterCopy`] gives it.
+    fn copy_as(
+        &self,
+        part: TypeId,
+        state: &CartesianState<N>,
+        last: Option<&LastStep<N>>,
+    ) -> Option<Box<dyn Any + Send>> {
+        (part == TypeId::of::<Box<dyn DynOuter>>()).then(|| {
+            Box::new(Box::new(self.at(state, last)) as Box<dyn DynOuter>) as Box<dyn Any + Send>
+        })
+    }
+
     fn measurement(m: &StepIn<'_>) -> CartesianMeasurement<N> {
         CartesianMeasurement {
             q: vector_of(m.q),
@@ -612,6 +641,10 @@ impl<const N: usize> DynOuter for Outer<N> {
         partial: &mut Option<TaskRecords>,
     ) -> Result<CartesianOut, RunError> {
         let joint = typed::<N>(joint)?;
+        let before = self.at(&self.state, None);
+        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&LastStep<N>>| {
+            before.copy_as(part, state, last)
+        };
         cartesian_loop::simulate_mujoco(
             &self.outer,
             &mut self.state,
@@ -622,6 +655,7 @@ impl<const N: usize> DynOuter for Outer<N> {
             run,
             hooks,
             partial,
+            &copy,
         )
     }
     fn replay(
@@ -634,6 +668,10 @@ impl<const N: usize> DynOuter for Outer<N> {
         hooks: &mut dyn Hooks,
     ) -> Result<(), RunError> {
         let joint = typed::<N>(joint)?;
+        let before = self.at(&self.state, None);
+        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&LastStep<N>>| {
+            before.copy_as(part, state, last)
+        };
         cartesian_loop::replay(
             &self.outer,
             &mut self.state,
@@ -644,22 +682,33 @@ impl<const N: usize> DynOuter for Outer<N> {
             targets,
             out,
             hooks,
+            &copy,
         )
+    }
+    fn view(&self) -> Box<dyn DynOuter> {
+        Box::new(self.at(&self.state, None))
     }
 }
 
 /// The core's joint controller behind a Python object, locked: an
-/// `adaptimp.Controller` or a `ComputedTorque` (SPEC §20) of n joints.
+/// `adaptimp.Controller` or a `ComputedTorque` (SPEC §20) of n joints, with
+/// where a run publishes its copy.
 enum Locked<'a> {
-    Adaptive(MutexGuard<'a, Box<dyn DynTracker>>),
-    Computed(MutexGuard<'a, Box<dyn DynComputed>>),
+    Adaptive(Write<'a, dyn DynTracker>, &'a dyn Slot),
+    Computed(Write<'a, dyn DynComputed>, &'a dyn Slot),
 }
 
-impl Locked<'_> {
+impl<'a> Locked<'a> {
     fn joint(&mut self) -> JointRef<'_> {
         match self {
-            Locked::Adaptive(g) => JointRef::Adaptive(&mut ***g),
-            Locked::Computed(g) => JointRef::Computed(&mut ***g),
+            Locked::Adaptive(g, _) => JointRef::Adaptive(&mut ***g),
+            Locked::Computed(g, _) => JointRef::Computed(&mut ***g),
+        }
+    }
+
+    fn slot(&self) -> &'a dyn Slot {
+        match self {
+            Locked::Adaptive(_, s) | Locked::Computed(_, s) => *s,
         }
     }
 }
@@ -671,10 +720,10 @@ fn lock_joint<'a>(
 ) -> PyResult<Locked<'a>> {
     let (got, locked) = if let Ok(c) = controller.cast::<PyController>() {
         let c = c.get();
-        (c.n, Locked::Adaptive(c.lock(py)))
+        (c.n, Locked::Adaptive(c.lock(py)?, c.slot()))
     } else if let Ok(c) = controller.cast::<PyComputedTorque>() {
         let c = c.get();
-        (c.n, Locked::Computed(c.lock(py)))
+        (c.n, Locked::Computed(c.lock(py)?, c.slot()))
     } else {
         return Err(PyTypeError::new_err(
             "the joint controller must be an adaptimp.Controller or a core ComputedTorque",
@@ -696,8 +745,20 @@ fn lock_joint<'a>(
 /// inputs (`MeasurementError`), a signal beyond the finite range is
 /// `DivergedError`, a parameter `ConfigError`.
 fn cartesian_error(e: Error) -> PyErr {
-    const INPUTS: [&str; 11] = [
-        "q", "x", "dq", "dx", "wrench", "p_c", "dp_c", "ddp_c", "R_c", "w_c", "dw_c",
+    const INPUTS: [&str; 13] = [
+        "q",
+        "x",
+        "dq",
+        "dx",
+        "wrench",
+        "p_c",
+        "dp_c",
+        "ddp_c",
+        "R_c",
+        "max |R_cᵀR_c − I| of R_c",
+        "det R_c",
+        "w_c",
+        "dw_c",
     ];
     let input = match e {
         Error::NonFinite { what, .. } | Error::OutOfRange { what, .. } => INPUTS.contains(&what),
@@ -841,9 +902,14 @@ fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTa
             .try_iter()
             .and_then(|it| it.collect::<PyResult<Vec<_>>>())
             .map_err(|_| {
-                PyTypeError::new_err(
-                    "a path returns (p, dp, ddp) or (p, dp, ddp, R, w, dw) (a tuple of arrays)",
-                )
+                let got = obj
+                    .get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_owned(), |n| n.to_string());
+                PyTypeError::new_err(format!(
+                    "a path returns (p, dp, ddp) or (p, dp, ddp, R, w, dw) (a tuple of arrays), \
+                     got {got}"
+                ))
             })?,
     };
     let len = tuple.map_or(collected.len(), |t| t.len());
@@ -962,9 +1028,18 @@ fn rows_of(
     n: usize,
 ) -> PyResult<(usize, Vec<f64>)> {
     let np = obj.py().import("numpy")?;
-    let a = np
-        .call_method1("asarray", (obj, "float64"))
+    let given = np
+        .call_method1("asarray", (obj,))
         .map_err(|_| PyTypeError::new_err(format!("{what} must be an array of reals")))?;
+    // Reals only: a complex row lost its imaginary part, text became numbers.
+    let kind: String = given.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "f" | "i" | "u") {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must hold real numbers, got an array of dtype {}",
+            given.getattr("dtype")?.str()?
+        )));
+    }
+    let a = given.call_method1("astype", ("float64",))?;
     let shape: Vec<usize> = a.getattr("shape")?.extract()?;
     let rows = k.unwrap_or(shape.first().copied().unwrap_or(0));
     if shape != [rows, n] {
@@ -1204,19 +1279,25 @@ impl PyChain {
 /// written in Python (`step_python`). Use `adaptimp.CartesianController`.
 #[pyclass(name = "CartesianImpedance", module = "adaptimp._adaptimp", frozen)]
 pub struct PyCartesian {
-    inner: Mutex<Box<dyn DynOuter>>,
+    inner: Shared<dyn DynOuter>,
     n: usize,
 }
 
 impl PyCartesian {
-    fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynOuter>> {
-        super::wait_lock(py, &self.inner)
+    /// The outer loop for a call that may change it ([`Shared::write`]).
+    fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, dyn DynOuter>> {
+        self.inner.write(py)
+    }
+
+    /// The outer loop to read ([`Shared::read`]).
+    fn read(&self, py: Python<'_>) -> PyResult<Read<'_, dyn DynOuter>> {
+        self.inner.read(py)
     }
 
     /// The time of the next step, t_k = k·Ts (s).
-    pub(super) fn clock(&self, py: Python<'_>) -> f64 {
-        let g = self.lock(py);
-        g.steps() as f64 * g.ts()
+    pub(super) fn clock(&self, py: Python<'_>) -> PyResult<f64> {
+        let g = self.read(py)?;
+        Ok(g.steps() as f64 * g.ts())
     }
 
     fn measurement<'a>(
@@ -1261,7 +1342,7 @@ impl PyCartesian {
             .outer(cfg, ts, &q0[..n], posture.as_ref().map(|p| &p[..n]))
             .map_err(|e| ConfigError::new_err(e.to_string()))?;
         Ok(Self {
-            inner: Mutex::new(inner),
+            inner: Shared::new(inner, "CartesianController"),
             n,
         })
     }
@@ -1274,27 +1355,27 @@ impl PyCartesian {
 
     /// Period Ts (s).
     #[getter]
-    fn ts(&self, py: Python<'_>) -> f64 {
-        self.lock(py).ts()
+    fn ts(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.read(py)?.ts())
     }
 
     /// Steps taken.
     #[getter]
-    fn steps(&self, py: Python<'_>) -> u64 {
-        self.lock(py).steps()
+    fn steps(&self, py: Python<'_>) -> PyResult<u64> {
+        Ok(self.read(py)?.steps())
     }
 
     /// Whether the orientation is a task (False: position-only, Kd_rot = 0).
     #[getter]
-    fn orients(&self, py: Python<'_>) -> bool {
-        self.lock(py).orients()
+    fn orients(&self, py: Python<'_>) -> PyResult<bool> {
+        Ok(self.read(py)?.orients())
     }
 
     /// Back to t = 0 at `q0` (rad; default the start's); the posture is kept.
     #[pyo3(signature = (q0=None))]
     fn reset(&self, py: Python<'_>, q0: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
         let q0 = q0.map(|q| vector("q0", self.n, q)).transpose()?;
-        self.lock(py)
+        self.lock(py)?
             .reset(q0.as_ref().map(|q| &q[..self.n]))
             .map_err(|e| ConfigError::new_err(e.to_string()))
     }
@@ -1302,7 +1383,7 @@ impl PyCartesian {
     /// The null-space posture q_posture (rad), (n,).
     fn set_posture(&self, py: Python<'_>, posture: &Bound<'_, PyAny>) -> PyResult<()> {
         let p = vector("posture", self.n, posture)?;
-        self.lock(py)
+        self.lock(py)?
             .set_posture(&p[..self.n])
             .map_err(|e| ConfigError::new_err(e.to_string()))
     }
@@ -1313,7 +1394,7 @@ impl PyCartesian {
     fn check_target(&self, py: Python<'_>, target: &Bound<'_, PyAny>) -> PyResult<()> {
         let t = target_of(Some(target))?;
         match t {
-            Some(t) => self.lock(py).check_target(&t).map_err(cartesian_error),
+            Some(t) => self.read(py)?.check_target(&t).map_err(cartesian_error),
             None => Ok(()),
         }
     }
@@ -1329,7 +1410,7 @@ impl PyCartesian {
         Kd_rot: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
         let (a, b) = (flat("Kd", 3, Kd)?, flat("Kd_rot", 3, Kd_rot)?);
-        self.lock(py)
+        self.lock(py)?
             .set_stiffness([a[0], a[1], a[2]], [b[0], b[1], b[2]])
             .map_err(|e| ConfigError::new_err(e.to_string()))
     }
@@ -1351,7 +1432,7 @@ impl PyCartesian {
     )> {
         let target = target_of(target)?;
         let wrench = wrench_of(wrench)?;
-        let mut g = self.lock(py);
+        let mut g = self.lock(py)?;
         g.reference(target.as_ref(), wrench)
             .map_err(cartesian_error)?;
         Ok((
@@ -1380,7 +1461,7 @@ impl PyCartesian {
         let f_e = wrench_of(wrench)?;
         let m = self.measurement(&q, dq.as_ref(), f_e, target_of(target)?);
         let mut joint = lock_joint(py, controller, n)?;
-        let mut g = self.lock(py);
+        let mut g = self.lock(py)?;
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
         Ok(array1(py, &g.last(16)))
     }
@@ -1437,7 +1518,7 @@ impl PyCartesian {
             (dq.is_some(), f)
         };
         let mut joint = lock_joint(py, controller, n)?;
-        let mut g = self.lock(py);
+        let mut g = self.lock(py)?;
         // The rotation a sample sets is held only once the core accepted the
         // step: a refused one (a rotation that is not one) keeps nothing.
         let mut held = g.held();
@@ -1456,20 +1537,25 @@ impl PyCartesian {
 
     /// The commanded rotation a target without one keeps, (3, 3).
     fn held_rotation<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        array(py, self.lock(py).held().to_vec(), (3, 3))
+        array(py, self.read(py)?.held().to_vec(), (3, 3))
     }
 
     /// Hold the commanded rotation `r` (3, 3) from now on.
     fn set_held_rotation(&self, py: Python<'_>, r: &Bound<'_, PyAny>) -> PyResult<()> {
         let v = flat("R", 9, r)?;
-        self.lock(py).set_held(core::array::from_fn(|i| v[i]));
+        self.lock(py)?.set_held(core::array::from_fn(|i| v[i]));
         Ok(())
     }
 
     /// The rows `step_sample` kept since the last call, (K, 30 + n): p_c,
     /// ṗ_c, p̈_c, p_d, ṗ_d, p̈_d (3 each), q_d (n), F_e (6), the error (6).
     fn take_log<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let (v, rows) = self.lock(py).take_log();
+        // A callback of a run of this controller reads a copy, which keeps
+        // no rows: the run's rows join the log when it ends.
+        let (v, rows) = match self.inner.write_or_copy(py)? {
+            Some(mut g) => g.take_log(),
+            None => (Vec::new(), 0),
+        };
         array(py, v, (rows, LOG_WIDTH + self.n))
     }
 
@@ -1497,7 +1583,9 @@ impl PyCartesian {
         let f_e = wrench_of(wrench)?;
         let m = self.measurement(&q, dq.as_ref(), f_e, target_of(target)?);
         let mut raised: Option<PyErr> = None;
-        let mut g = self.lock(py);
+        let mut g = self.lock(py)?;
+        // The joint controller may read this one: the state before the step.
+        let shown = self.inner.showing(g.view());
         let mut call = |q: &[f64],
                         dq: Option<&[f64]>,
                         tau_e: &[f64],
@@ -1523,6 +1611,7 @@ impl PyCartesian {
                     let dq = dq.map(|d| array1(py, d));
                     inner.call_method("step", (array1(py, q), array1(py, tau_e), dq), Some(&kw))?
                 };
+                super::callback::numeric_torque(&tau, out.len())?;
                 let v = flat("the joint controller's torque", out.len(), &tau)?;
                 Ok(v)
             })();
@@ -1541,6 +1630,7 @@ impl PyCartesian {
             }
         };
         let r = g.step_joint(&m, &mut call);
+        drop(shown);
         if let Some(e) = raised {
             return Err(e);
         }
@@ -1561,7 +1651,7 @@ impl PyCartesian {
             .iter()
             .position(|n| *n == what)
             .ok_or_else(|| PyValueError::new_err(format!("last: one of {LAST:?}, got {what:?}")))?;
-        let v = self.lock(py).last(i);
+        let v = self.read(py)?.last(i);
         if v.len() == 9 && what.starts_with('R') {
             Ok(array(py, v, (3, 3))?.into_any())
         } else {
@@ -1577,7 +1667,7 @@ impl PyCartesian {
         let i = STATE.iter().position(|n| *n == what).ok_or_else(|| {
             PyValueError::new_err(format!("state: one of {STATE:?}, got {what:?}"))
         })?;
-        let v = self.lock(py).state(i);
+        let v = self.read(py)?.state(i);
         if what == "R_d" {
             Ok(array(py, v, (3, 3))?.into_any())
         } else {
@@ -1635,8 +1725,8 @@ impl PyCartesian {
             targets: targets.as_deref(),
             fault: fault.as_ref(),
         };
-        let mut hooks = super::PyHooks::new(progress);
-        let mut outer = self.lock(py);
+        let mut hooks = super::PyHooks::holding(progress, vec![&self.inner, joint.slot()]);
+        let mut outer = self.lock(py)?;
         let mut partial = None;
         let result = {
             let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
@@ -1702,9 +1792,9 @@ impl PyCartesian {
             Some(t) => Some(super::table("targets", t, k, TARGET_LEN)?),
         };
         let mut out = Vec::with_capacity(k * n);
-        let mut hooks = super::PyHooks::new(progress);
         let mut joint = lock_joint(py, controller, n)?;
-        let mut outer = self.lock(py);
+        let mut hooks = super::PyHooks::holding(progress, vec![&self.inner, joint.slot()]);
+        let mut outer = self.lock(py)?;
         let result = {
             let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
             py.detach(|| {
@@ -1737,7 +1827,7 @@ impl PyCartesian {
     ) -> PyResult<(usize, usize)> {
         let t = real("T", T)?;
         let nodes = count("nodes", nodes)?;
-        let ts = self.lock(py).ts();
+        let ts = self.read(py)?.ts();
         let steps = crate::cartesian::orbit_steps(t, ts)
             .map_err(|e| ConfigError::new_err(e.to_string()))?;
         Ok((steps, nodes))
@@ -1766,7 +1856,7 @@ impl PyCartesian {
         let k = targets.shape()[0];
         let flat_rows = rows(k, "targets", &targets, TARGET_LEN)?;
         let ts: Vec<PoseTarget> = flat_rows.chunks(TARGET_LEN).map(pose_target).collect();
-        let g = self.lock(py);
+        let g = self.read(py)?;
         let [q, dq, ddq] = py
             .detach(|| g.orbit(&q0[..n], &ts, nodes))
             .map_err(cartesian_error)?;

@@ -23,7 +23,7 @@
 use super::computed::Computed;
 use super::dynamic::{
     drive_mujoco, FaultKind, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError,
-    TaskMetrics, Typed,
+    TaskMetrics, Typed, View,
 };
 use super::mujoco::MujocoSpec;
 use crate::cartesian::{
@@ -38,6 +38,7 @@ use crate::sim::record::{Recorder, Row};
 use crate::trajectory::{Setpoint, Trajectory};
 use crate::types::Vector;
 use adaptimp_mujoco::Sim;
+use core::any::{Any, TypeId};
 use core::cell::{Cell, RefCell};
 use nalgebra::Matrix3;
 use std::vec::Vec;
@@ -64,8 +65,9 @@ pub struct CartesianRun<'a> {
 
 /// A joint controller of the core behind a Cartesian impedance: the
 /// paper's laws ([`Typed`]) or computed torque ([`Computed`]), as the
-/// Cartesian step and the native loop drive it.
-pub(crate) trait JointStep<const N: usize> {
+/// Cartesian step and the native loop drive it; copied for the Python code
+/// a run calls ([`View`]).
+pub(crate) trait JointStep<const N: usize>: View {
     /// Ts (s).
     fn period(&self) -> f64;
     /// The target impedance (3) (for the impedance residual of SPEC §12).
@@ -308,6 +310,13 @@ pub(crate) fn pose_target(v: &[f64]) -> PoseTarget {
     }
 }
 
+/// How a run copies its outer loop for the Python code it calls (a
+/// progress callback): the copy a binding keeps as the type `part` (None:
+/// another type), from the outer loop's state and the run's last step (None:
+/// none taken yet). The binding that starts the run knows the rest of it.
+pub(crate) type OuterCopy<'a, const N: usize> =
+    dyn Fn(TypeId, &CartesianState<N>, Option<&LastStep<N>>) -> Option<Box<dyn Any + Send>> + 'a;
+
 /// The outer loop and the joint controller behind it as the loop's
 /// [`Control`]: [`Control::step_with_wrench`] runs
 /// [`CartesianImpedance::step_with`] with the measured wrench and the
@@ -323,6 +332,27 @@ struct Cartesian<'a, const N: usize, J: ?Sized> {
     last: &'a RefCell<Option<LastStep<N>>>,
     /// Whether `last` holds a step the recorder has not recorded yet.
     pending: &'a Cell<bool>,
+    copy: &'a OuterCopy<'a, N>,
+}
+
+impl<const N: usize, J: JointStep<N> + ?Sized> View for Cartesian<'_, N, J> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        (self.copy)(part, self.state, self.last.borrow().as_ref()).or_else(|| self.joint.copy(part))
+    }
+}
+
+/// The state of a replay between two rows, as a [`View`].
+struct Replayed<'a, const N: usize, J: ?Sized> {
+    state: &'a CartesianState<N>,
+    last: Option<&'a LastStep<N>>,
+    joint: &'a J,
+    copy: &'a OuterCopy<'a, N>,
+}
+
+impl<const N: usize, J: JointStep<N> + ?Sized> View for Replayed<'_, N, J> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        (self.copy)(part, self.state, self.last).or_else(|| self.joint.copy(part))
+    }
 }
 
 impl<const N: usize, J: JointStep<N> + ?Sized> Cartesian<'_, N, J> {
@@ -427,11 +457,16 @@ pub(crate) fn simulate_mujoco<const N: usize, J: JointStep<N> + ?Sized>(
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
     partial: &mut Option<TaskRecords>,
+    copy: &OuterCopy<'_, N>,
 ) -> Result<CartesianOut, RunError> {
     if N <= 3 {
-        run_m::<N, 3, J>(outer, state, joint, last, sim, spec, run, hooks, partial)
+        run_m::<N, 3, J>(
+            outer, state, joint, last, sim, spec, run, hooks, partial, copy,
+        )
     } else {
-        run_m::<N, N, J>(outer, state, joint, last, sim, spec, run, hooks, partial)
+        run_m::<N, N, J>(
+            outer, state, joint, last, sim, spec, run, hooks, partial, copy,
+        )
     }
 }
 
@@ -448,6 +483,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
     partial: &mut Option<TaskRecords>,
+    copy: &OuterCopy<'_, N>,
 ) -> Result<CartesianOut, RunError> {
     let total = checked(outer, &*joint, run)?;
     let every = run.every.max(1);
@@ -468,6 +504,7 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         clock: &clock,
         last: &steps,
         pending: &pending,
+        copy,
     };
     let law = ctrl.joint.law();
     let on = OnMujoco {
@@ -583,6 +620,7 @@ pub(crate) fn replay<const N: usize, J: JointStep<N> + ?Sized>(
     targets: Option<&[f64]>,
     out: &mut Vec<f64>,
     hooks: &mut dyn Hooks,
+    copy: &OuterCopy<'_, N>,
 ) -> Result<(), RunError> {
     let [q, dq, wrench] = tables;
     if q.len() < rows * N || dq.len() < rows * N || wrench.len() < rows * 6 {
@@ -592,8 +630,16 @@ pub(crate) fn replay<const N: usize, J: JointStep<N> + ?Sized>(
         return Err(invalid("targets", "needs one pose target per row"));
     }
     for k in 0..rows {
-        if k > 0 && k % 64 == 0 && !hooks.tick(k as u64, rows as u64) {
-            return Err(RunError::Stopped);
+        if k > 0 && k % 64 == 0 {
+            let view = Replayed {
+                state: &*state,
+                last: last.as_ref(),
+                joint: &*joint,
+                copy,
+            };
+            if !hooks.report(k as u64, rows as u64, &view) {
+                return Err(RunError::Stopped);
+            }
         }
         let m = CartesianMeasurement {
             q: Vector::<N>::from_column_slice(&q[k * N..(k + 1) * N]),
@@ -605,6 +651,16 @@ pub(crate) fn replay<const N: usize, J: JointStep<N> + ?Sized>(
             .map_err(|e| RunError::Core(e, Some(k as u64)))?;
         out.extend_from_slice(cmd.joint.tau_sat.as_slice());
         *last = Some(LastStep::new(cmd, target.as_ref(), m.wrench.into()));
+    }
+    // The last row reported too (a progress bar ends at 100 %).
+    let view = Replayed {
+        state: &*state,
+        last: last.as_ref(),
+        joint: &*joint,
+        copy,
+    };
+    if rows > 0 && !hooks.report(rows as u64, rows as u64, &view) {
+        return Err(RunError::Stopped);
     }
     Ok(())
 }

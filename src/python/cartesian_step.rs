@@ -62,7 +62,7 @@ impl PyCartesianStep {
             if m.is_instance_of::<PyMeasurement>() {
                 let core = self.core.get();
                 let sample = match &self.path {
-                    Some(path) => Some(path.bind(py).call1((core.clock(py),))?),
+                    Some(path) => Some(path.bind(py).call1((core.clock(py)?,))?),
                     None => None,
                 };
                 let joint = joint.bind(py);

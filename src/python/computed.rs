@@ -7,14 +7,16 @@
 //! ([`DynComputed::simulate_mujoco`]) along its setpoint of every row.
 
 use super::dynamic::{
-    drive_mujoco, Hooks, MetricsOut, MujocoRun, OnMujoco, Records, RunError, TaskMetrics,
+    drive_mujoco, Hooks, MetricsOut, MujocoRun, OnMujoco, Records, RunError, TaskMetrics, View,
     MAX_JOINTS,
 };
 use super::frames::{joint, transform};
 use super::measurement::JointCall;
 use super::mujoco::{MujocoSpec, Table};
+use super::shared::{Read, Shared, Slot, Write};
 use super::{array, array1, vector, vector_into, ConfigError, MeasurementError};
 use crate::cartesian::chain::JointKind;
+use crate::cartesian::dynamics::Lifted;
 use crate::cartesian::{
     ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
     SampledDrive, Spring,
@@ -32,8 +34,8 @@ use numpy::PyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use std::any::Any;
-use std::sync::{Mutex, MutexGuard};
+use std::any::{Any, TypeId};
+use std::sync::Mutex;
 use std::vec::Vec;
 
 /// A computed-torque controller of any n ≤ 7 with its state, over slices.
@@ -91,6 +93,8 @@ pub trait DynComputed: Send + Sync {
 /// An input of a model query refused (MeasurementError, named), or a result
 /// that is not finite (DivergedError).
 fn input_error(e: Error) -> pyo3::PyErr {
+    // Named as in Python: q, dq (the core's x, dx).
+    let e = super::python_names(e);
     match e {
         Error::Diverged { .. } => super::DivergedError::new_err(e.to_string()),
         _ => super::MeasurementError::new_err(e.to_string()),
@@ -222,6 +226,21 @@ impl<const N: usize> Control<N> for Computed<N> {
             Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
             Err(e) => (self.state.applied, Err(e)),
         }
+    }
+}
+
+/// The copy of computed torque as the bindings keep it.
+impl<const N: usize> View for Computed<N> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        (part == TypeId::of::<Box<dyn DynComputed>>()).then(|| {
+            Box::new(Box::new(self.clone()) as Box<dyn DynComputed>) as Box<dyn Any + Send>
+        })
+    }
+}
+
+impl<const N: usize> View for Stepped<'_, N> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        self.c.copy(part)
     }
 }
 
@@ -365,6 +384,8 @@ struct Params<'a> {
     sampled: Option<Sampled<'a>>,
     /// SPEC (20.5'): (k, q_s), if any stiffness is given.
     spring: Option<(&'a [f64], &'a [f64])>,
+    /// What gravity compensation lifts, one per joint entry (SPEC (20.1')).
+    lifted: Option<&'a [Lifted]>,
 }
 
 /// SPEC (20.9)'s terms, as reals per joint: h, s, implicit damping, R, b_r.
@@ -388,7 +409,12 @@ fn build<const N: usize>(
         damping: vector_of(p.damping),
         friction: vector_of(p.friction),
     };
-    let model = Dynamics::<N>::new(joints, inertials, gravity)?
+    let model = Dynamics::<N>::new(joints, inertials, gravity)?;
+    let model = match p.lifted {
+        Some(lifted) => model.with_gravity_compensation(joints, lifted)?,
+        None => model,
+    };
+    let model = model
         .scaled(p.mass_scale)?
         .with_payload(p.payload)?
         .with_drive(drive)?;
@@ -477,6 +503,18 @@ fn inertial(d: &Bound<'_, PyDict>) -> PyResult<Inertial> {
     })
 }
 
+/// What gravity compensation lifts of one link: {"mass" (kg), "moment" (kg m, 3)}.
+fn lifted_of(d: &Bound<'_, PyDict>) -> PyResult<Lifted> {
+    let get = |key: &str| {
+        d.get_item(key)?
+            .ok_or_else(|| PyTypeError::new_err(format!("a lifted mass needs its {key}")))
+    };
+    Ok(Lifted {
+        mass: get("mass")?.extract()?,
+        moment: get("moment")?.extract()?,
+    })
+}
+
 fn per_joint(what: &'static str, n: usize, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     let v = match obj.extract::<f64>() {
         Ok(x) => std::vec![x; n],
@@ -505,7 +543,7 @@ const LAST: [&str; 5] = ["tau", "tau_sat", "xc", "xd", "z1"];
     subclass
 )]
 pub struct PyComputedTorque {
-    inner: Mutex<Box<dyn DynComputed>>,
+    inner: Shared<dyn DynComputed>,
     /// Joints n.
     pub n: usize,
     /// `trajectory(t) -> (xc, dxc, ddxc)` for a step given no setpoint.
@@ -533,7 +571,7 @@ impl PyComputedTorque {
             ));
         };
         let t = {
-            let g = self.lock(py);
+            let g = self.read(py)?;
             g.steps() as f64 * g.ts()
         };
         let out = traj.call1(py, (t,))?;
@@ -544,10 +582,21 @@ impl PyComputedTorque {
         Ok(())
     }
 
-    /// The controller, waiting (with the GIL released) while another thread
-    /// uses it.
-    pub fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynComputed>> {
-        super::wait_lock(py, &self.inner)
+    /// The controller for a call that may change it, waiting (with the GIL
+    /// released) while another thread uses it.
+    pub(super) fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, dyn DynComputed>> {
+        self.inner.write(py)
+    }
+
+    /// The controller to read (during a run of its own, the copy the run
+    /// publishes for the Python code it calls).
+    pub(super) fn read(&self, py: Python<'_>) -> PyResult<Read<'_, dyn DynComputed>> {
+        self.inner.read(py)
+    }
+
+    /// Where a run of this controller publishes its copy.
+    pub(super) fn slot(&self) -> &dyn Slot {
+        &self.inner
     }
 }
 
@@ -576,7 +625,7 @@ impl PyComputedTorque {
     /// that period in place of (20.6). `stiffness` k (N m/rad) and
     /// `spring_reference` q_s (rad): passive joint springs (SPEC (20.5')).
     #[new]
-    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload, armature=None, damping=None, friction=None, substep=None, substeps=1, implicit_damping=false, semi_implicit=false, friction_regularisation=None, friction_rate=None, stiffness=None, spring_reference=None))]
+    #[pyo3(signature = (joints, inertials, gravity, *, Ts, Kp, Kd, tau_max, Dd, Cd, Gd, impedance, mass_scale, payload, armature=None, damping=None, friction=None, substep=None, substeps=1, implicit_damping=false, semi_implicit=false, friction_regularisation=None, friction_rate=None, stiffness=None, spring_reference=None, lifted=None))]
     #[allow(clippy::too_many_arguments, non_snake_case)]
     fn new(
         joints: Vec<Bound<'_, PyDict>>,
@@ -603,8 +652,12 @@ impl PyComputedTorque {
         friction_rate: Option<&Bound<'_, PyAny>>,
         stiffness: Option<&Bound<'_, PyAny>>,
         spring_reference: Option<&Bound<'_, PyAny>>,
+        lifted: Option<Vec<Bound<'_, PyDict>>>,
     ) -> PyResult<Self> {
         let js = joints.iter().map(joint).collect::<PyResult<Vec<_>>>()?;
+        let lifted = lifted
+            .map(|l| l.iter().map(lifted_of).collect::<PyResult<Vec<_>>>())
+            .transpose()?;
         let ins = inertials
             .iter()
             .map(inertial)
@@ -669,11 +722,12 @@ impl PyComputedTorque {
                 rate: &rate,
             }),
             spring: stiffness.map(|_| (&k[..], &qs[..])),
+            lifted: lifted.as_deref(),
         };
         let inner = computed(&js, &ins, gravity, &p).map_err(config_err)?;
         Ok(Self {
             n: inner.n(),
-            inner: Mutex::new(inner),
+            inner: Shared::new(inner, "ComputedTorque"),
             trajectory: Mutex::new(None),
         })
     }
@@ -694,25 +748,26 @@ impl PyComputedTorque {
     /// Period Ts (s).
     #[getter]
     #[allow(non_snake_case)]
-    fn Ts(&self, py: Python<'_>) -> f64 {
-        self.lock(py).ts()
+    fn Ts(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.read(py)?.ts())
     }
 
     /// Steps taken k (the next step is at t_k = k·Ts).
     #[getter]
-    fn steps(&self, py: Python<'_>) -> u64 {
-        self.lock(py).steps()
+    fn steps(&self, py: Python<'_>) -> PyResult<u64> {
+        Ok(self.read(py)?.steps())
     }
 
     /// Total mass of the model's moving links (kg).
     #[getter]
-    fn mass(&self, py: Python<'_>) -> f64 {
-        self.lock(py).mass()
+    fn mass(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.read(py)?.mass())
     }
 
     /// Back to t = 0 (the reference starts at the next setpoint).
-    fn reset(&self, py: Python<'_>) {
-        self.lock(py).reset();
+    fn reset(&self, py: Python<'_>) -> PyResult<()> {
+        self.lock(py)?.reset();
+        Ok(())
     }
 
     /// One step (SPEC (20.3)) from the measurement `m`
@@ -761,7 +816,7 @@ impl PyComputedTorque {
             None => self.setpoint_of_trajectory(py, dxc.is_some() || ddxc.is_some(), &mut b)?,
         }
         let mut out = [0.0; MAX_JOINTS];
-        self.lock(py)
+        self.lock(py)?
             .step(
                 &b[0][..n],
                 Some(&b[2][..n]),
@@ -788,7 +843,7 @@ impl PyComputedTorque {
             vector("ddq", n, ddq)?,
         );
         let mut out = [0.0; MAX_JOINTS];
-        self.lock(py)
+        self.read(py)?
             .inverse_dynamics(&q[..n], &dq[..n], &ddq[..n], &mut out[..n])
             .map_err(input_error)?;
         Ok(array1(py, &out[..n]))
@@ -802,7 +857,7 @@ impl PyComputedTorque {
     ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
         let n = self.n;
         let q = vector("q", n, q)?;
-        let m = self.lock(py).mass_matrix(&q[..n]).map_err(input_error)?;
+        let m = self.read(py)?.mass_matrix(&q[..n]).map_err(input_error)?;
         array(py, m, (n, n))
     }
 
@@ -813,13 +868,13 @@ impl PyComputedTorque {
             .iter()
             .position(|w| *w == what)
             .ok_or_else(|| ConfigError::new_err(format!("last() knows {LAST:?}, got {what:?}")))?;
-        Ok(array1(py, &self.lock(py).last(i)))
+        Ok(array1(py, &self.read(py)?.last(i)))
     }
 
     /// The last refused step as (message, step), or None.
     #[getter]
-    fn fault(&self, py: Python<'_>) -> Option<(String, u64)> {
-        self.lock(py).fault().map(|(e, k)| (e.to_string(), k))
+    fn fault(&self, py: Python<'_>) -> PyResult<Option<(String, u64)>> {
+        Ok(self.read(py)?.fault().map(|(e, k)| (e.to_string(), k)))
     }
 
     /// The closed loop on MuJoCo in joint space, from the controller's
@@ -862,8 +917,8 @@ impl PyComputedTorque {
             reference: tables.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
             fault: fault.as_ref(),
         };
-        let mut hooks = super::PyHooks::new(progress);
-        let mut guard = self.lock(py);
+        let mut hooks = super::PyHooks::holding(progress, vec![self.slot()]);
+        let mut guard = self.lock(py)?;
         let ctrl: &mut dyn DynComputed = &mut **guard;
         let result = py.detach(|| ctrl.simulate_mujoco(&mut sim, &spec, &run, &mut hooks));
         drop(guard);

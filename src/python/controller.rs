@@ -1,8 +1,11 @@
-//! `Controller`: the joint-space controller of n joints behind a mutex, each call atomic.
+//! `Controller`: the joint-space controller of n joints behind a mutex, each
+//! call atomic, readable by the Python code its own runs call
+//! ([`super::shared`]).
 
 use super::dynamic;
 use super::dynamic::{CentersSpec, DynTracker, Inputs, Last, Tables, MAX_JOINTS};
 use super::measurement::JointCall;
+use super::shared::{Read, Shared, Slot, Write};
 use super::{arrays::*, errors::*, hooks::*, params::*};
 use crate::control::config::Law;
 use crate::schema::Preset;
@@ -12,7 +15,6 @@ use numpy::{
 use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use std::sync::{Mutex, MutexGuard};
 
 /// A step's arguments, converted: n values each in fixed buffers.
 pub(super) struct Given {
@@ -51,28 +53,43 @@ impl Given {
 /// fills in the defaults and checks the keywords.
 #[pyclass(name = "Controller", module = "adaptimp._adaptimp", frozen, subclass)]
 pub(super) struct PyController {
-    pub(super) inner: Mutex<Box<dyn DynTracker>>,
+    pub(super) inner: Shared<dyn DynTracker>,
     pub(super) n: usize,
     pub(super) law: Law,
 }
 
 impl PyController {
-    /// The controller, waiting (with the GIL released) while another thread
-    /// uses it.
-    pub(super) fn lock(&self, py: Python<'_>) -> MutexGuard<'_, Box<dyn DynTracker>> {
-        wait_lock(py, &self.inner)
+    /// The controller for a call that may change it, waiting (with the GIL
+    /// released) while another thread uses it.
+    pub(super) fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, dyn DynTracker>> {
+        self.inner.write(py)
+    }
+
+    /// The controller to read (during a run of its own, the copy the run
+    /// publishes for the Python code it calls).
+    pub(super) fn read(&self, py: Python<'_>) -> PyResult<Read<'_, dyn DynTracker>> {
+        self.inner.read(py)
+    }
+
+    /// Where a run of this controller publishes its copy.
+    pub(super) fn slot(&self) -> &dyn Slot {
+        &self.inner
     }
 
     pub(super) fn wrap(inner: Box<dyn DynTracker>) -> Self {
         Self {
             n: inner.n(),
             law: inner.law(),
-            inner: Mutex::new(inner),
+            inner: Shared::new(inner, "Controller"),
         }
     }
 
-    pub(super) fn last<'py>(&self, py: Python<'py>, what: Last) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.lock(py).last(what))
+    pub(super) fn last<'py>(
+        &self,
+        py: Python<'py>,
+        what: Last,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(array1(py, self.read(py)?.last(what)))
     }
 
     /// A step's arguments, converted into `given` (shapes and types checked;
@@ -110,6 +127,17 @@ impl PyController {
             }
         };
         Ok(())
+    }
+}
+
+/// A step's arguments refused before the core saw them: recorded as a
+/// refused step ([`BAD_ARGUMENTS`]), unless what stopped the call is a
+/// warning turned into an error (the deprecated call shape under
+/// `-W error`): the call was not made, nothing was wrong with the
+/// measurement.
+fn refused_arguments(py: Python<'_>, e: &PyErr, g: &mut Write<'_, dyn DynTracker>) {
+    if !e.is_instance_of::<pyo3::exceptions::PyWarning>(py) {
+        g.refuse(BAD_ARGUMENTS);
     }
 }
 
@@ -179,11 +207,13 @@ impl PyController {
         // that records its fault); shapes and types are checked here.
         let mut given = Given::EMPTY;
         let call = JointCall::parse("Controller.step", args, kwargs)?;
-        self.convert(&call, &mut given)
-            .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
+        // Converted before the controller is taken: a value's own Python
+        // code (an `__float__`) may read it.
+        let converted = self.convert(&call, &mut given);
+        let mut g = self.lock(py)?;
+        converted.inspect_err(|e| refused_arguments(py, e, &mut g))?;
         let mut out = [0.0; MAX_JOINTS];
-        self.lock(py)
-            .step(&given.inputs(n), &mut out[..n])
+        g.step(&given.inputs(n), &mut out[..n])
             .map_err(step_error)?;
         Ok(array1(py, &out[..n]))
     }
@@ -205,12 +235,13 @@ impl PyController {
         // values are the controller's to judge.
         let mut given = Given::EMPTY;
         let call = JointCall::parse("Controller.step_or_fallback", args, kwargs)?;
-        self.convert(&call, &mut given)
-            .inspect_err(|_| self.lock(py).refuse(BAD_ARGUMENTS))?;
+        // Converted before the controller is taken: a value's own Python
+        // code (an `__float__`) may read it.
+        let converted = self.convert(&call, &mut given);
+        let mut g = self.lock(py)?;
+        converted.inspect_err(|e| refused_arguments(py, e, &mut g))?;
         let mut out = [0.0; MAX_JOINTS];
-        let result = self
-            .lock(py)
-            .step_or_fallback(&given.inputs(n), &mut out[..n]);
+        let result = g.step_or_fallback(&given.inputs(n), &mut out[..n]);
         Ok((
             array1(py, &out[..n]),
             result.err().map(|e| python_names(e).to_string()),
@@ -219,16 +250,18 @@ impl PyController {
 
     /// The fault recorded by the last failed step: (message, step k), or None.
     #[getter]
-    fn fault(&self, py: Python<'_>) -> Option<(String, u64)> {
-        self.lock(py)
+    fn fault(&self, py: Python<'_>) -> PyResult<Option<(String, u64)>> {
+        Ok(self
+            .read(py)?
             .fault()
-            .map(|(e, k)| (python_names(e).to_string(), k))
+            .map(|(e, k)| (python_names(e).to_string(), k)))
     }
 
     /// Clear the recorded fault; nothing else changes (the learned state,
     /// the torque last applied and the jump anchors are kept).
-    fn clear_fault(&self, py: Python<'_>) {
-        self.lock(py).clear_fault();
+    fn clear_fault(&self, py: Python<'_>) -> PyResult<()> {
+        self.lock(py)?.clear_fault();
+        Ok(())
     }
 
     /// `K` steps in one call from (K, n) float64 tables, without the GIL;
@@ -282,8 +315,8 @@ impl PyController {
                 "cannot allocate the torques of {rows} rows"
             )));
         }
-        let mut hooks = PyHooks::new(progress);
-        let mut guard = self.lock(py);
+        let mut hooks = PyHooks::holding(progress, vec![self.slot()]);
+        let mut guard = self.lock(py)?;
         let tables = Tables {
             x: &x,
             dx: dx.as_deref(),
@@ -299,17 +332,18 @@ impl PyController {
 
     /// Back to t = 0, everything as at construction: weights, ζ, observer,
     /// reference, the torque last applied (zero), the jump anchors, the fault.
-    fn reset(&self, py: Python<'_>) {
-        self.lock(py).reset();
+    fn reset(&self, py: Python<'_>) -> PyResult<()> {
+        self.lock(py)?.reset();
+        Ok(())
     }
 
     /// The whole state as a flat float64 array (header, n, L, step count,
     /// reference, ζ, observer, last command, norms, basis, weights, the
     /// torque applied, the last measured position, a checksum); `restore`
     /// puts it back exactly, so a run continues bit-identically.
-    fn snapshot<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let data = self.lock(py).snapshot();
-        data.into_pyarray(py)
+    fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let data = self.read(py)?.snapshot();
+        Ok(data.into_pyarray(py))
     }
 
     /// Restore a `snapshot` of a controller with the same n and L. Checked
@@ -319,16 +353,16 @@ impl PyController {
     /// norms those of the weights). Clears a recorded fault.
     fn restore(&self, py: Python<'_>, data: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let data: Vec<f64> = data.as_array().iter().copied().collect();
-        self.lock(py).restore(&data).map_err(state_error)
+        self.lock(py)?.restore(&data).map_err(state_error)
     }
 
     /// Replace the network weights: "D" (n, n, L), "C" (n, n, L), "G" (n, L)
     /// float64 arrays (checked: shape, finite, norms within the projection
     /// bounds and 1e100; on an error nothing changes).
     fn load_weights(&self, py: Python<'_>, weights: &Bound<'_, PyDict>) -> PyResult<()> {
-        let l = self.lock(py).nodes();
+        let l = self.read(py)?.nodes();
         let rows = weight_rows(self.n, l, weights)?;
-        self.lock(py).load_weights(&rows).map_err(state_error)
+        self.lock(py)?.load_weights(&rows).map_err(state_error)
     }
 
     /// "pd", "sf" or "of".
@@ -345,49 +379,49 @@ impl PyController {
 
     /// RBF nodes L.
     #[getter]
-    fn nodes(&self, py: Python<'_>) -> usize {
-        self.lock(py).nodes()
+    fn nodes(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(self.read(py)?.nodes())
     }
 
     /// Time of the next step t_k = k·Ts (s).
     #[getter]
-    fn t(&self, py: Python<'_>) -> f64 {
-        self.lock(py).time()
+    fn t(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.read(py)?.time())
     }
 
     /// Steps taken since construction or reset.
     #[getter]
-    fn steps(&self, py: Python<'_>) -> u64 {
-        self.lock(py).steps()
+    fn steps(&self, py: Python<'_>) -> PyResult<u64> {
+        Ok(self.read(py)?.steps())
     }
 
     /// Sampling period Ts (s).
     #[getter(Ts)]
-    fn ts(&self, py: Python<'_>) -> f64 {
-        self.lock(py).ts()
+    fn ts(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.read(py)?.ts())
     }
 
     /// Auxiliary state ζ (N m) now, i.e. what the next step uses, (11).
     #[getter]
-    fn zeta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.lock(py).zeta())
+    fn zeta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(array1(py, self.read(py)?.zeta()))
     }
 
     /// Velocity the last step used (rad/s): dq, or the observer's estimate for "of".
     #[getter]
-    fn dq_hat<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn dq_hat<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::V)
     }
 
     /// The last step's commanded torque τ (N m), before saturation.
     #[getter]
-    fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn tau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::Tau)
     }
 
     /// The last step's applied torque sat(τ) (N m).
     #[getter]
-    fn tau_sat<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn tau_sat<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::TauSat)
     }
 
@@ -395,31 +429,31 @@ impl PyController {
     /// after a refused call (also one that raised), the configured fallback;
     /// the next step's rate limit is measured from it.
     #[getter]
-    fn applied<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn applied<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::Applied)
     }
 
     /// The last step's Δτ = sat(τ) − τ (N m).
     #[getter]
-    fn dtau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn dtau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::Dtau)
     }
 
     /// The last step's tracking error z1 = xd − q (rad).
     #[getter]
-    fn z1<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn z1<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::Z1)
     }
 
     /// The last step's commanded position xc (rad).
     #[getter]
-    fn xc<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn xc<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::Xc)
     }
 
     /// The last step's compliant reference xd (rad).
     #[getter]
-    fn xd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn xd<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.last(py, Last::Xd)
     }
 
@@ -429,7 +463,7 @@ impl PyController {
     #[getter]
     fn weights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let (mut w, l) = {
-            let g = self.lock(py);
+            let g = self.read(py)?;
             (g.weights(), g.nodes())
         };
         let n = self.n;
@@ -445,21 +479,21 @@ impl PyController {
     /// The projection's weight bounds on ‖ŴD‖_F, ‖ŴC‖_F, ‖ŴG‖_F as resolved,
     /// or None.
     #[getter]
-    fn weight_bound(&self, py: Python<'_>) -> Option<[f64; 3]> {
-        self.lock(py).weight_bound()
+    fn weight_bound(&self, py: Python<'_>) -> PyResult<Option<[f64; 3]>> {
+        Ok(self.read(py)?.weight_bound())
     }
 
     /// (g, min Kp): the per-step gain of the explicit-Euler learning step at
     /// the start of the trajectory (N m per rad/s) and the smallest Kp; the
     /// learning loop is stable for g < Kp (docs/robot.md).
     #[getter]
-    fn learning_gain(&self, py: Python<'_>) -> (f64, f64) {
-        self.lock(py).learning_gain()
+    fn learning_gain(&self, py: Python<'_>) -> PyResult<(f64, f64)> {
+        Ok(self.read(py)?.learning_gain())
     }
 
-    fn __repr__(&self, py: Python<'_>) -> String {
-        let g = self.lock(py);
-        format!(
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let g = self.read(py)?;
+        Ok(format!(
             "<adaptimp._adaptimp.Controller case={:?} n={} L={} Ts={} s, t={} s, steps={}>",
             case_of(self.law),
             self.n,
@@ -467,6 +501,6 @@ impl PyController {
             g.ts(),
             g.time(),
             g.steps()
-        )
+        ))
     }
 }

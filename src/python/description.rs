@@ -90,6 +90,19 @@ fn arm_dict<'py>(
         inertials.append(e)?;
     }
     d.set_item("inertials", inertials)?;
+    let lifted = PyList::empty(py);
+    for l in &arm.lifted {
+        let e = PyDict::new(py);
+        e.set_item("mass", l.mass)?;
+        e.set_item("moment", l.moment.to_vec())?;
+        lifted.append(e)?;
+    }
+    d.set_item("lifted", lifted)?;
+    d.set_item("warnings", arm.warnings.clone())?;
+    d.set_item(
+        "inertia_error",
+        arm.inertia_error.as_ref().map(|e| e.message().to_owned()),
+    )?;
     d.set_item("base", &arm.base)?;
     d.set_item("tip", &arm.tip)?;
     d.set_item("tip_is_frame", arm.tip_is_frame)?;
@@ -129,21 +142,58 @@ pub fn read_arm<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let fix = fix.unwrap_or_default();
     let fix: Vec<&str> = fix.iter().map(String::as_str).collect();
+    let mut signals = Signals::new();
     let (tree, arm) = py
         .detach(|| {
-            let tree = if source.trim_start().starts_with('<') {
-                match label {
-                    Some(l) => urdf::read_str_as(source, l)?,
-                    None => urdf::read_str(source)?,
-                }
+            let go_on = &mut || signals.go_on();
+            let tree = if urdf::is_text(source) {
+                urdf::read_str_with(source, label, go_on)?
             } else {
-                urdf::read_file(source)?
+                urdf::read_file_with(source, go_on)?
             };
             let arm = description::reduce(&tree, tip, &fix)?;
             Ok::<_, DescriptionError>((tree, arm))
         })
-        .map_err(error)?;
+        .map_err(|e| signals.error(e))?;
     arm_dict(py, &tree, &arm, true)
+}
+
+/// A reading's Ctrl-C: signals checked at most every 50 ms of its work,
+/// with the GIL taken only then; the error (`KeyboardInterrupt`) kept.
+struct Signals {
+    last: std::time::Instant,
+    raised: Option<PyErr>,
+}
+
+impl Signals {
+    fn new() -> Self {
+        Self {
+            last: std::time::Instant::now(),
+            raised: None,
+        }
+    }
+
+    fn go_on(&mut self) -> bool {
+        if self.last.elapsed() < super::hooks::CHECK_EVERY {
+            return true;
+        }
+        self.last = std::time::Instant::now();
+        match Python::attach(|py| py.check_signals()) {
+            Ok(()) => true,
+            Err(e) => {
+                self.raised = Some(e);
+                false
+            }
+        }
+    }
+
+    /// The reading's error as Python's: the signal's own if it stopped it.
+    fn error(&mut self, e: DescriptionError) -> PyErr {
+        match (e.kind(), self.raised.take()) {
+            (ErrorKind::Stopped, Some(raised)) => raised,
+            _ => error(e),
+        }
+    }
 }
 
 /// What the file at `path` is: "urdf", "xacro", "mjcf", "mjcf-fragment" or "unknown" (by its
@@ -152,10 +202,13 @@ pub fn read_arm<'py>(
 pub fn description_kind(py: Python<'_>, path: &str) -> PyResult<&'static str> {
     let text = urdf::read_text(std::path::Path::new(path), "description").map_err(|e| {
         PyFileNotFoundError::new_err(format!(
-            "cannot read '{path}': {e}: give the path of a URDF, xacro or MJCF file"
+            "cannot read '{}': {e}: give the path of a URDF, xacro or MJCF file",
+            urdf::shown_path(std::path::Path::new(path))
         ))
     })?;
-    Ok(py.detach(|| urdf::kind_of(&text)))
+    let mut signals = Signals::new();
+    py.detach(|| urdf::kind_of_with(&text, &mut || signals.go_on()))
+        .map_err(|e| signals.error(e))
 }
 
 fn get<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -175,6 +228,10 @@ fn mujoco_arrays(d: &Bound<'_, PyDict>) -> PyResult<MujocoArrays> {
         body_pos: get(d, "body_pos")?,
         body_quat: get(d, "body_quat")?,
         body_mass: get(d, "body_mass")?,
+        body_gravcomp: match d.get_item("body_gravcomp")? {
+            Some(_) => get(d, "body_gravcomp")?,
+            None => Vec::new(),
+        },
         body_ipos: get(d, "body_ipos")?,
         body_iquat: get(d, "body_iquat")?,
         body_inertia: get(d, "body_inertia")?,

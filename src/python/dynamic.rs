@@ -11,7 +11,7 @@ use super::mujoco::{Continued, Failure, MjPlant, MujocoSpec, Table};
 use crate::control::config::Law;
 use crate::control::controller::Controller;
 use crate::control::impedance::TargetImpedance;
-use crate::control::io::{Command, Measurement};
+use crate::control::io::{Command, Control, Measurement};
 use crate::control::tracker::Tracker;
 use crate::control::tuning::Rule;
 use crate::error::Error;
@@ -29,7 +29,8 @@ use crate::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapter};
 use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 use adaptimp_mujoco::Sim;
-use std::any::Any;
+use core::cell::{Cell, RefCell};
+use std::any::{Any, TypeId};
 use std::vec::Vec;
 
 pub use crate::dynamic::MAX_JOINTS;
@@ -193,8 +194,135 @@ fn injection<const N: usize>(f: &FaultSpec, tau_max: &Vector<N>) -> Result<Injec
 /// The run-time hook of long calls: asked every few steps whether to go on
 /// (signals) and told the progress.
 pub trait Hooks {
-    /// `done` of `total` steps are taken; false stops the run.
+    /// `done` of `total` steps are taken; false stops the run. Asked where
+    /// the run's controllers cannot be read (within a period): the hook
+    /// checks for signals only.
     fn tick(&mut self, done: u64, total: u64) -> bool;
+    /// `done` of `total` steps are taken, between two steps, the run's
+    /// controllers readable through `view` (a binding publishes them for the
+    /// progress callback it calls here); false stops the run.
+    fn report(&mut self, done: u64, total: u64, view: &dyn View) -> bool {
+        let _ = view;
+        self.tick(done, total)
+    }
+}
+
+/// What a run's controllers are at a [`Hooks::report`], copied on demand.
+pub trait View {
+    /// A copy of the part of the run's state that a binding keeps as the
+    /// type `part` (the `TypeId` of a `Box<dyn DynTracker>`, of a
+    /// `Box<dyn DynOuter>`, …), boxed as `Any`; None if the run has no such
+    /// part.
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>>;
+}
+
+/// A run with nothing to copy (a controller written in Python).
+impl View for () {
+    fn copy(&self, _part: TypeId) -> Option<Box<dyn Any + Send>> {
+        None
+    }
+}
+
+/// The copy of a joint controller as the bindings keep it.
+impl<const N: usize> View for Typed<N> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        (part == TypeId::of::<Box<dyn DynTracker>>())
+            .then(|| Box::new(Box::new(self.clone()) as Box<dyn DynTracker>) as Box<dyn Any + Send>)
+    }
+}
+
+/// A run's controller that reports to the hooks ([`Hooks::report`]) after
+/// every [`HOOK_EVERY`]-th of its steps, readable then; when they say stop,
+/// `stop` is raised and the plant ends the run before its next period.
+pub(crate) struct Reporting<'a, 'h, C: ?Sized> {
+    ctrl: &'a mut C,
+    hooks: &'a RefCell<&'h mut dyn Hooks>,
+    stop: &'a Cell<bool>,
+    done: u64,
+    total: u64,
+}
+
+impl<'a, 'h, C: View + ?Sized> Reporting<'a, 'h, C> {
+    pub(crate) fn new(
+        ctrl: &'a mut C,
+        hooks: &'a RefCell<&'h mut dyn Hooks>,
+        stop: &'a Cell<bool>,
+        total: u64,
+    ) -> Self {
+        Self {
+            ctrl,
+            hooks,
+            stop,
+            done: 0,
+            total,
+        }
+    }
+
+    /// One step taken (or refused).
+    fn stepped(&mut self) {
+        self.done += 1;
+        if self.done.is_multiple_of(HOOK_EVERY) || self.done == self.total {
+            self.report(self.done);
+        }
+    }
+
+    fn report(&mut self, done: u64) {
+        let view = ViewOf(&*self.ctrl);
+        if !self.hooks.borrow_mut().report(done, self.total, &view) {
+            self.stop.set(true);
+        }
+    }
+
+    /// After the run: the last report, if the steps did not make it (a
+    /// fault skipped some); whether the hooks let the run end.
+    pub(crate) fn finish(&mut self) -> bool {
+        if self.done < self.total && !self.stop.get() {
+            self.report(self.total);
+        }
+        !self.stop.get()
+    }
+}
+
+/// `&C` as a [`View`], for a `C` that may be unsized.
+struct ViewOf<'a, C: ?Sized>(&'a C);
+
+impl<C: View + ?Sized> View for ViewOf<'_, C> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        self.0.copy(part)
+    }
+}
+
+impl<const N: usize, C: Control<N> + View + ?Sized> Control<N> for Reporting<'_, '_, C> {
+    fn period(&self) -> f64 {
+        self.ctrl.period()
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        self.ctrl.target()
+    }
+    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
+        let r = self.ctrl.step(m, c);
+        self.stepped();
+        r
+    }
+    fn step_or_fallback(
+        &mut self,
+        m: &Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        let r = self.ctrl.step_or_fallback(m, c);
+        self.stepped();
+        r
+    }
+    fn step_with_wrench(
+        &mut self,
+        m: &Measurement<N>,
+        wrench: &[f64; 6],
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<Command<N>, Error>) {
+        let r = self.ctrl.step_with_wrench(m, wrench, c);
+        self.stepped();
+        r
+    }
 }
 
 /// Every recorded row (every `every`-th step), one flat row-major buffer per
@@ -540,7 +668,7 @@ pub(crate) fn drive_mujoco<const N: usize, C, T, R>(
     rec: &mut R,
 ) -> Result<(), RunError>
 where
-    C: crate::control::io::Control<N> + ?Sized,
+    C: crate::control::io::Control<N> + View + ?Sized,
     T: Trajectory<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
@@ -581,21 +709,35 @@ where
         }
         None => None,
     };
-    let mut tick = |done: u64, total: u64| hooks.tick(done, total);
+    // Signals within a period (the plant's hook); the progress between
+    // periods, the controller readable (`Reporting`), which stops the run
+    // through the plant's flag (the controller's own, if it has one).
+    let hooks = RefCell::new(hooks);
+    let own = Cell::new(false);
+    let stop = on.abort.unwrap_or(&own);
+    let mut tick = |done: u64, total: u64| hooks.borrow_mut().tick(done, total);
     let mut plant = MjPlant::<N>::new(on.sim, spec, ts, *dist.friction())?;
     plant.watch(&mut tick, total);
-    if let Some(flag) = on.abort {
-        plant.abort_on(flag);
-    }
+    plant.abort_on(stop);
     if let Err(e) = plant.start() {
         return Err(match plant.failure() {
             Some(f) => RunError::Plant(f.clone()),
             None => RunError::Core(e, None),
         });
     }
-    let result = simulate_disturbed(&mut plant, ctrl, traj, on.t_final, inj.as_ref(), &dist, rec);
+    let mut reporting = Reporting::new(ctrl, &hooks, stop, total);
+    let result = simulate_disturbed(
+        &mut plant,
+        &mut reporting,
+        traj,
+        on.t_final,
+        inj.as_ref(),
+        &dist,
+        rec,
+    );
     match result {
-        Ok(_) => Ok(()),
+        Ok(_) if reporting.finish() => Ok(()),
+        Ok(_) => Err(RunError::Stopped),
         Err(e) => Err(match plant.failure() {
             Some(f) => RunError::Plant(f.clone()),
             None if plant.stopped() => RunError::Stopped,
@@ -709,9 +851,11 @@ fn metrics_out<const N: usize>(m: &crate::sim::metrics::Metrics<N>) -> MetricsOu
     }
 }
 
-/// The adapter that asks the hook every [`HOOK_EVERY`] periods whether to go on.
-pub(crate) struct Watch<'a> {
-    hooks: &'a mut dyn Hooks,
+/// The adapter that asks the hook every [`HOOK_EVERY`] periods whether to go
+/// on (signals), and ends the run once `stop` is raised (by [`Reporting`]).
+pub(crate) struct Watch<'a, 'h> {
+    hooks: &'a RefCell<&'h mut dyn Hooks>,
+    stop: &'a Cell<bool>,
     done: u64,
     total: u64,
     stopped: bool,
@@ -720,10 +864,15 @@ pub(crate) struct Watch<'a> {
 /// Steps between two calls of [`Hooks::tick`].
 const HOOK_EVERY: u64 = 64;
 
-impl<'a> Watch<'a> {
-    pub(crate) fn new(hooks: &'a mut dyn Hooks, total: u64) -> Self {
+impl<'a, 'h> Watch<'a, 'h> {
+    pub(crate) fn new(
+        hooks: &'a RefCell<&'h mut dyn Hooks>,
+        stop: &'a Cell<bool>,
+        total: u64,
+    ) -> Self {
         Self {
             hooks,
+            stop,
             done: 0,
             total,
             stopped: false,
@@ -740,22 +889,30 @@ impl<'a> Watch<'a> {
     }
 }
 
-impl<const N: usize> Adapter<N> for Watch<'_> {
+fn stopped() -> Error {
+    Error::Invalid {
+        what: "run",
+        reason: "stopped",
+    }
+}
+
+impl<const N: usize> Adapter<N> for Watch<'_, '_> {
     fn advance<P: Plant<N> + ?Sized>(
         &mut self,
         plant: &mut P,
         tau: &Vector<N>,
         h: f64,
     ) -> Result<Vector<N>, Error> {
+        if self.stop.get() {
+            self.stopped = true;
+            return Err(stopped());
+        }
         let a = plant.advance(tau, h)?;
         self.done += 1;
         let due = self.done.is_multiple_of(HOOK_EVERY) || self.done == self.total;
-        if due && !self.hooks.tick(self.done, self.total) {
+        if due && !self.hooks.borrow_mut().tick(self.done, self.total) {
             self.stopped = true;
-            return Err(Error::Invalid {
-                what: "run",
-                reason: "stopped",
-            });
+            return Err(stopped());
         }
         Ok(a)
     }
@@ -794,14 +951,17 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
         cfg.dq0,
         cfg.substeps,
     )?;
-    let mut watch = Watch::new(hooks, total);
+    let hooks = RefCell::new(hooks);
+    let stop = Cell::new(false);
+    let mut watch = Watch::new(&hooks, &stop, total);
+    let mut t = Reporting::new(t, &hooks, &stop, total);
     let metrics = match s.wall {
         Some(w) => {
             let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
             run_disturbed_with(
                 arm,
                 &wall,
-                t,
+                &mut t,
                 &traj,
                 cfg,
                 &dist,
@@ -815,7 +975,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
             run_disturbed_with(
                 arm,
                 &env,
-                t,
+                &mut t,
                 &traj,
                 cfg,
                 &dist,
@@ -826,6 +986,9 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
         }
     }
     .map_err(|e| watch.error(e))?;
+    if !t.finish() {
+        return Err(RunError::Stopped);
+    }
     Ok((rec, metrics_out(&metrics)))
 }
 
@@ -958,7 +1121,9 @@ impl<const N: usize> DynTracker for Typed<N> {
     ) -> Result<(), RunError> {
         let row = |v: &[f64], k: usize| Vector::<N>::from_column_slice(&v[k * N..(k + 1) * N]);
         for k in 0..rows {
-            if k > 0 && (k as u64).is_multiple_of(HOOK_EVERY) && !hooks.tick(k as u64, rows as u64)
+            if k > 0
+                && (k as u64).is_multiple_of(HOOK_EVERY)
+                && !hooks.report(k as u64, rows as u64, &*self)
             {
                 return Err(RunError::Stopped);
             }
@@ -980,6 +1145,10 @@ impl<const N: usize> DynTracker for Typed<N> {
             }
             .map_err(|e| RunError::Core(e, Some(k as u64)))?;
             out.extend_from_slice(cmd.tau_sat.as_slice());
+        }
+        // The last row reported too (a progress bar ends at 100 %).
+        if rows > 0 && !hooks.report(rows as u64, rows as u64, &*self) {
+            return Err(RunError::Stopped);
         }
         Ok(())
     }

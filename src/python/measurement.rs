@@ -104,6 +104,23 @@ fn optional(what: &'static str, n: usize, obj: Option<&Bound<'_, PyAny>>) -> PyR
         .transpose()
 }
 
+/// [`optional`] for a measurement, whose length q set: a length that
+/// differs names both (a q one short was reported as "dq must have shape").
+fn like_q(what: &'static str, n: usize, obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Buf>> {
+    let read = optional(what, n, obj);
+    if let (Err(e), Some(o)) = (&read, obj) {
+        let shape = e.is_instance_of::<MeasurementError>(o.py());
+        if let (true, Ok(k)) = (shape, length(what, "be one value per joint", o)) {
+            if k != n {
+                return Err(MeasurementError::new_err(format!(
+                    "{what} has {k} values and q {n}: one value per joint each"
+                )));
+            }
+        }
+    }
+    read
+}
+
 #[pymethods]
 impl PyMeasurement {
     /// A measurement: joint positions `q` (rad), velocities `dq` (rad/s;
@@ -130,8 +147,8 @@ impl PyMeasurement {
         Ok(Self {
             n,
             q: vector_any("q", n, q)?,
-            dq: optional("dq", n, dq)?,
-            tau_e: optional("tau_e", n, tau_e)?,
+            dq: like_q("dq", n, dq)?,
+            tau_e: like_q("tau_e", n, tau_e)?,
             wrench: wrench
                 .filter(|o| !o.is_none())
                 .map(self::wrench)

@@ -19,13 +19,17 @@
 //!   optional callback; records are moved into NumPy without copying.
 //! - A controller is behind a mutex: each call is atomic; a thread that finds
 //!   it in use by another waits with the GIL released (never "Already
-//!   borrowed").
+//!   borrowed"). Python code a call runs (a progress callback, a joint
+//!   controller written in Python, a path) reads the object that called it
+//!   from a copy the call publishes, and cannot change it ([`shared`]): no
+//!   call deadlocks on its own thread.
 //!
 //! Nothing here panics on user input and nothing is `unsafe`.
 //!
 //! One file a concern: `errors` (core errors to exceptions), `params` (names
 //! and the schema's items), `arrays` (NumPy in and out), `hooks` (Ctrl-C and
-//! progress), `controller`, `models` (the simulation's arms), `runs`
+//! progress), `shared` (the state a call holds, read by the Python code it
+//! calls), `controller`, `models` (the simulation's arms), `runs`
 //! (`simulate`, `metrics`, `simulate_mujoco`), `sweeps` (`simulate_many`,
 //! `simulate_mujoco_many`), `export` (the schema's table); the task-space
 //! classes (`cartesian`, `computed`, `description`, `tuning`) and the loops
@@ -51,6 +55,7 @@ mod models;
 mod mujoco;
 mod params;
 mod runs;
+mod shared;
 mod sweeps;
 mod tabulate;
 mod tuning;

@@ -53,11 +53,11 @@ pub(super) fn simulate<'py>(
     let items = items(params)?;
     let ctrl = controller.get();
     let weights = match weights {
-        Some(w) => Some(weight_rows(ctrl.n, ctrl.lock(py).nodes(), w)?),
+        Some(w) => Some(weight_rows(ctrl.n, ctrl.read(py)?.nodes(), w)?),
         None => None,
     };
-    let mut hooks = PyHooks::new(progress);
-    let mut guard = ctrl.lock(py);
+    let mut hooks = PyHooks::holding(progress, vec![ctrl.slot()]);
+    let mut guard = ctrl.lock(py)?;
     let tracker: &mut dyn DynTracker = &mut **guard;
     let result = py.detach(|| {
         let w = weights.as_deref();
@@ -282,8 +282,8 @@ pub(super) fn simulate_mujoco<'py>(
         reference: tables.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
         fault: fault.as_ref(),
     };
-    let mut hooks = PyHooks::new(progress);
-    let mut guard = ctrl.lock(py);
+    let mut hooks = PyHooks::holding(progress, vec![ctrl.slot()]);
+    let mut guard = ctrl.lock(py)?;
     let tracker: &mut dyn DynTracker = &mut **guard;
     let result = py.detach(|| tracker.simulate_mujoco(&mut sim, &spec, &run, &mut hooks));
     drop(guard);

@@ -265,12 +265,7 @@ pub(super) fn simulate_mujoco_many<'py>(
         };
         let mut hooks = StopHooks(stop);
         let mut sim = job.sim.lock().unwrap_or_else(|p| p.into_inner());
-        let mut tracker = job
-            .ctrl
-            .get()
-            .inner
-            .lock()
-            .unwrap_or_else(|p| p.into_inner());
+        let mut tracker = job.ctrl.get().inner.write_blocking();
         tracker
             .simulate_mujoco(&mut sim, &job.spec, &run, &mut hooks)
             .map(|(_, m)| m)

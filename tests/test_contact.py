@@ -615,7 +615,7 @@ def test_a_home_that_cannot_work_is_refused_by_name() -> None:
     with pytest.raises(adaptimp.ConfigError) as e:
         act.arm_table(_ur5(), home=[0.0, -math.pi / 2, 0.0, -math.pi / 2, 0.0, 0.0])
     assert str(e.value).startswith(
-        "the home posture cannot run the table: condition σmin(J) ≥ 0.05 along the task "
+        "the home posture cannot run the table: condition σmin(J) ≥ 0.05 m/rad along the task "
         "(not near a singularity) is violated: σmin(J) = "
     )
     from adaptimp import _models

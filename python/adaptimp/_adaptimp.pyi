@@ -31,8 +31,10 @@ __all__ = [
     "defaults",
     "description_kind",
     "metrics",
+    "plane_normal",
     "pose_circle",
     "pose_metrics",
+    "posture_needs",
     "read_arm",
     "schema_table",
     "simulate",
@@ -735,9 +737,22 @@ def pose_circle(
     hold: float | None = None,
     ramp: float | None = None,
     start: float = 0.0,
+    normal: Sequence[float] | None = None,
 ) -> tuple[_F, float, list[float]]:
     """The default Cartesian task of SPEC (16.8) tabulated: (targets (steps, 24),
-    span (s), centre (3,))."""
+    span (s), centre (3,)); ``normal``: its plane (None: horizontal)."""
+
+def plane_normal(jacobian: NDArray[np.float64]) -> list[float] | None:
+    """A planar arm's plane normal from its 6 × n Jacobian (SPEC (16.8)), or None."""
+
+def posture_needs(
+    best: dict[str, Any],
+    k1: float | None = None,
+    ts: float | None = None,
+    load: float | None = None,
+) -> str:
+    """What each condition of the posture rule (SPEC (16.9)) needs, with the best
+    value found of each."""
 
 def assess_posture(
     chain: Chain,
@@ -752,10 +767,12 @@ def assess_posture(
     k1: float | None = None,
     ts: float | None = None,
     load: float | None = None,
+    normal: Sequence[float] | None = None,
 ) -> dict[str, Any]:
     """How well a posture runs a task, SPEC (16.9): the figures along its joint
-    orbit, the score and the first condition it violates ("error", or None);
-    ``k1`` (1/s), ``ts`` (s): the joint controller's (conditioning ≥ K1·Ts/m)."""
+    orbit, the score, the first condition it violates ("error", or None) and
+    the rule's bounds ("needs"); ``k1`` (1/s), ``ts`` (s): the joint
+    controller's (conditioning ≥ K1·Ts/m); ``normal``: a planar arm's plane."""
 
 def pose_metrics(
     chain: Chain,

@@ -15,7 +15,10 @@ A pose task for any arm in five lines::
 - :func:`task_of`: the start posture when none is given, by the core's
   posture rule (16.9) over candidates drawn within the joint limits, each
   checked along its task's joint orbit and for self-collision
-  (:func:`self_collision`).
+  (:func:`self_collision`; the one check, :func:`adaptimp._posture.assess`);
+  where none passes, the search widens (:data:`WIDENINGS`: more candidates,
+  a smaller circle, the position alone) before it refuses, saying what each
+  condition needs.
 - :class:`CartesianTask`: the task; :meth:`CartesianTask.controller` builds
   :meth:`adaptimp.CartesianController.from_rule`, :meth:`CartesianTask.measure`
   the pose errors and their metrics in the core (16.11).
@@ -35,7 +38,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _adaptimp, _mjcf
+from . import _adaptimp, _mjcf, _posture
 from ._errors import ConfigError, DivergedError
 from .cartesian import CartesianController, Path, tabulate
 from .chain import Chain
@@ -43,11 +46,13 @@ from .chain import Chain
 __all__ = [
     "CANDIDATES",
     "IK_TIME",
+    "WIDENINGS",
     "CartesianTask",
     "CirclePath",
     "TablePath",
     "chain_of",
     "collision",
+    "measure",
     "self_collision",
     "task_of",
 ]
@@ -62,13 +67,38 @@ IK_TIME = 2.0
 kinematically, F_e = 0) holds a given path's first pose from a candidate
 posture to reach it."""
 
-GIVEN_LOAD = 1.0
+GIVEN_LOAD = _posture.GIVEN_LOAD
 """The largest gravity load max_i |G_i|/τmax_i along the task of a start the
 user gives (gravity within the actuators); a drawn start keeps the rule's 0.5."""
 
-CHECKED = 40
+CHECKED = _posture.CHECKED
 """Rows of the task's joint orbit at which gravity and self-collision are
-checked (evenly spaced)."""
+checked (evenly spaced); also the candidates checked along the task, best
+first, before the search widens."""
+
+WIDE = 4
+"""How much the widened search draws and checks along the task: 4 ×
+:data:`CANDIDATES` postures, 4 × :data:`CHECKED` of them along it."""
+
+RADII = (0.03, 0.015, 0.0075)
+"""The default circle's radius (m), then the smaller ones the widened search
+tries (halved twice): a small arm's circle through a start near its base's
+axis comes close to the axis, where σmin(J) vanishes."""
+
+WIDENINGS = (
+    ("the default task", 1, RADII[0], True),
+    ("more candidates", WIDE, RADII[0], True),
+    ("a 1.5 cm circle", WIDE, RADII[1], True),
+    ("a 0.75 cm circle", WIDE, RADII[2], True),
+    ("the position alone", WIDE, RADII[0], False),
+    ("the position alone, a 1.5 cm circle", WIDE, RADII[1], False),
+    ("the position alone, a 0.75 cm circle", WIDE, RADII[2], False),
+)
+"""The default task's search, in order, until a start passes (SPEC (16.9)):
+(what it is, how many times :data:`CANDIDATES` postures are drawn and
+:data:`CHECKED` checked along the task, the circle's radius (m), whether the
+orientation is held (an arm of six joints or more; fewer hold the position
+alone from the start)). The first is the default task as it always was."""
 
 SKELETON_RADIUS = 0.04
 """The radius of a link of the skeleton check (:func:`self_collision`), as a
@@ -80,29 +110,47 @@ class CirclePath:
     ``R0`` (3, 3), world ← tip), computed by the core: callable as ``path(t) ->
     (p, ṗ, p̈, R, ω, ω̇)`` and tabulated at once (``table``)."""
 
-    def __init__(self, p0: ArrayLike, R0: ArrayLike) -> None:
+    def __init__(
+        self,
+        p0: ArrayLike,
+        R0: ArrayLike,
+        *,
+        radius: float = RADII[0],
+        normal: ArrayLike | None = None,
+    ) -> None:
         self.p0 = np.array(p0, dtype=np.float64).reshape(3)
         self.R0 = np.array(R0, dtype=np.float64).reshape(3, 3)
-        _, span, centre = _adaptimp.pose_circle(self.p0, self.R0, 1.0, 0)
+        self.radius = float(radius)
+        """The circle's radius (m)."""
+        self.normal = None if normal is None else [float(x) for x in np.ravel(normal)]
+        """The normal of its plane (None: horizontal; a planar arm's, SPEC (16.8))."""
+        _, span, centre = self._rows(1.0, 0, 0.0)
         self.span = float(span)
         """Hold + ramp + one period (s): what a rule samples."""
         self.centre = np.asarray(centre, dtype=np.float64)
         """The circle's centre (m)."""
 
+    def _rows(self, Ts: float, steps: int, start: float) -> Any:
+        return _adaptimp.pose_circle(
+            self.p0, self.R0, float(Ts), int(steps), start=start, radius=self.radius,
+            normal=self.normal,
+        )  # fmt: skip
+
     def table(self, steps: int, Ts: float, start: int = 0) -> FloatArray:
         """The path at t_k = (start + k)·Ts, k < steps: (steps, 24) rows of
         :func:`adaptimp.cartesian.pose_target`."""
-        rows, _, _ = _adaptimp.pose_circle(
-            self.p0, self.R0, float(Ts), int(steps), start=start * Ts
-        )
+        rows, _, _ = self._rows(Ts, steps, start * Ts)
         return np.asarray(rows, dtype=np.float64)
 
     def __call__(self, t: float) -> tuple[FloatArray, ...]:
-        rows, _, _ = _adaptimp.pose_circle(self.p0, self.R0, 1.0, 1, start=float(t))
+        rows, _, _ = self._rows(1.0, 1, float(t))
         return _split(np.asarray(rows, dtype=np.float64).reshape(24))
 
     def __repr__(self) -> str:
-        return f"CirclePath(p0={self.p0.round(4).tolist()}, span={self.span:g} s)"
+        return (
+            f"CirclePath(p0={self.p0.round(4).tolist()}, radius={self.radius:g} m, "
+            f"span={self.span:g} s)"
+        )
 
 
 def _split(row: FloatArray) -> tuple[FloatArray, ...]:
@@ -480,17 +528,32 @@ class CartesianTask:
         ``max_pos_after2``, ``max_rot_after2``, ``rms_pos``, ``rms_rot``,
         ``rms_pos_first2`` (over [settle, settle + 2 s)) and ``rms_pos_last2``
         (over the run's last 2 s) added to ``res.metrics``."""
-        Ts, settle = float(res.params["Ts"]), float(res.params["settle"])
-        t = np.ascontiguousarray(res.t, dtype=np.float64)
-        rows = np.rint(t / Ts).astype(np.int64)
+        Ts = float(res.params["Ts"])
+        rows = np.rint(np.asarray(res.t, dtype=np.float64) / Ts).astype(np.int64)
         steps = int(rows[-1]) + 1 if rows.size else 0
-        table = np.ascontiguousarray(self.targets(steps, Ts)[rows])
-        pos, rot, m = _adaptimp.pose_metrics(
-            self.chain, np.ascontiguousarray(res.q, dtype=np.float64), table, t, settle, Ts
-        )
-        res.metrics.update(m)
-        if res.task is not None:
-            res.task["pos_err"], res.task["rot_err"] = pos, rot
+        measure(res, self.chain, self.targets(steps, Ts))
+
+
+def measure(res: Any, chain: Chain, table: FloatArray) -> None:
+    """The pose errors of a run in the core (SPEC (16.11)): the tip of ``chain``
+    at each row's q against the commanded pose of the row, ``table`` (steps,
+    24) the commanded pose of every step of the run (row k at t_k = k·Ts; a
+    run that kept every j-th row reads rows 0, j, 2j, …). Sets
+    ``res.task["pos_err"]`` (K,) (m), ``res.task["rot_err"]`` (K,) (rad) and
+    adds the metrics ``rms_pos_after2``, ``rms_rot_after2``,
+    ``max_pos_after2``, ``max_rot_after2``, ``rms_pos``, ``rms_rot``,
+    ``rms_pos_first2`` and ``rms_pos_last2`` to ``res.metrics``."""
+    Ts, settle = float(res.params["Ts"]), float(res.params["settle"])
+    t = np.ascontiguousarray(res.t, dtype=np.float64)
+    rows = np.rint(t / Ts).astype(np.int64)
+    table = np.ascontiguousarray(np.asarray(table, dtype=np.float64)[rows])
+    pos, rot, m = _adaptimp.pose_metrics(
+        chain, np.ascontiguousarray(res.q, dtype=np.float64), table, t, settle, Ts
+    )
+    res.metrics.update(m)
+    if res.task is None:
+        res.task = {}
+    res.task["pos_err"], res.task["rot_err"] = pos, rot
 
 
 def _ik(chain: Chain, q: FloatArray, path: Path, Ts: float, orients: bool) -> FloatArray:
@@ -529,30 +592,21 @@ def _assess(
     orients: bool,
     load: float | None = None,
 ) -> dict[str, Any]:
-    """The core's posture rule (SPEC (16.9)) along the task's joint orbit from
-    ``q0``, and its self-collision (:func:`self_collision`)."""
+    """The one posture check (:func:`adaptimp._posture.assess`, SPEC (16.9))
+    along the task's joint orbit from ``q0``: the outer loop run kinematically
+    on ``path`` over ``span`` s, checked at :data:`CHECKED` rows."""
     from .cartesian import CartesianImpedance
 
     position_only: dict[str, Any] = {} if orients else {"Kd_rot": 0.0}
     outer = CartesianImpedance(chain, Ts=Ts, q0=q0, **position_only)
     steps = round(span / Ts)
     q, _, _ = outer.joint_path(path, steps * Ts, samples=steps)
-    idx = np.unique(np.linspace(0, q.shape[0] - 1, CHECKED).round().astype(int))
-    rows = np.ascontiguousarray(q[idx])
+    idx = _posture.checked_rows(q.shape[0])
     targets = tabulate(path, steps, Ts, chain.pose(q0)[1])[idx, 0:3]
-    gravity = np.array([probe.gravity(x) for x in rows])
-    lo, hi = _limits(plant)
-    a = dict(
-        _adaptimp.assess_posture(
-            chain, rows, np.ascontiguousarray(targets), gravity, probe.inertia(q0),
-            lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients, load=load,
-        )
+    return _posture.assess(
+        plant, chain, q0, q[idx], targets, orients=orients, Ts=Ts, load=load,
+        dynamics=(probe.gravity, probe.inertia),
     )  # fmt: skip
-    if a["error"] is None:
-        hit = collision(plant, rows)
-        if hit is not None:
-            a["error"] = f"free of collision along the task (with itself and the scene): {hit}"
-    return a
 
 
 def task_of(
@@ -568,11 +622,13 @@ def task_of(
     ``adaptimp.mujoco.Plant``); see there."""
     chain = chain_of(plant)
     n = chain.n
-    orients = n >= 6
     # Named before the search (Ts = 0 was "no start posture found … 40 tried").
     Ts = _positive("Ts", Ts)
-    _configured(chain, Ts, orients, plant)
+    _configured(chain, Ts, n >= 6, plant)
     probe = _Probe(plant)
+    # A planar arm's task lies in its plane (SPEC (16.8)): the circle, and the
+    # rule's σmin over the plane's directions.
+    planar = _posture.plane(chain)
     user_path: Path | None
     if pose is None:
         user_path = None
@@ -587,16 +643,17 @@ def task_of(
     if span is not None:
         span = _positive("span", span)
 
-    def path_from(q: FloatArray) -> tuple[FloatArray, Path, float]:
+    def path_from(q: FloatArray, radius: float, orients: bool) -> tuple[FloatArray, Path, float]:
         """The start (after the inverse kinematics of a given path), the path, its span."""
         if user_path is None:
             p, R = chain.pose(q)
-            circle = CirclePath(p, R)
+            circle = CirclePath(p, R, radius=radius, normal=planar)
             return q, circle, circle.span
         assert span is not None
         return _ik(chain, q, user_path, Ts, orients), user_path, float(span)
 
     if q0 is not None:
+        orients = n >= 6
         q = _vector("q0", q0, chain)
         lo, hi = _limits(plant)
         outside = np.flatnonzero((q < lo) | (q > hi))
@@ -607,7 +664,7 @@ def task_of(
                 f"q0 = {float(q[i])!r} outside [{float(lo[i])!r}, {float(hi[i])!r}] rad"
             )
         try:
-            start, path, length = path_from(q)
+            start, path, length = path_from(q, RADII[0], orients)
         except DivergedError as e:
             raise ConfigError(
                 f"q0 cannot run the task: the inverse kinematics of the pose path's first pose "
@@ -618,73 +675,177 @@ def task_of(
         if a["error"] is not None:
             raise ConfigError(f"q0 cannot run the task: {a['error']}")
         return CartesianTask(start, chain, path, length, orients, a, "given")
-    screened = []
+    return _search(plant, probe, chain, path_from, Ts, seed, user_path is not None)
+
+
+def _search(
+    plant: Any,
+    probe: _Probe,
+    chain: Chain,
+    path_from: Any,
+    Ts: float,
+    seed: int,
+    own_path: bool,
+) -> CartesianTask:
+    """A drawn start, by :data:`WIDENINGS` in order (a path of the user's: its
+    own path, the search widened only), or a ``ConfigError`` that says what
+    each condition needs, with the best value found, and what to try."""
+    n = chain.n
+    best: dict[str, Any] = {}
+    collisions, tried_rows, drawn, failed = 0, 0, 0, ""
     failures: dict[str, int] = {}
-    for k, q in enumerate(_candidates(plant, seed)):
-        quick, why = _screen(probe, chain, q, orients, plant)
-        if quick is not None:
-            screened.append((quick, k, q))
-        elif why is not None:
-            condition = why.split(" is violated")[0]
-            failures[condition] = failures.get(condition, 0) + 1
-    screened.sort(key=lambda x: (-x[0], x[1]))
-    first_error = "none passed the rule at its start"
-    if failures:  # the condition that failed most, named
-        common, count = max(failures.items(), key=lambda kv: kv[1])
-        first_error += f" (the {common} failed at {count} of them)"
-    tried = screened[:CHECKED]
-    for _, k, q in tried:
-        try:
-            start, path, length = path_from(q)
-            a = _assess(plant, probe, chain, start, path, length, Ts, orients)
-        except ConfigError as e:  # the core refused the orbit: not this posture
-            first_error = str(e)
-            continue
-        except DivergedError as e:  # the inverse kinematics of the path's first pose
-            first_error = (
-                f"the inverse kinematics of the pose path's first pose diverged ({e}): is the "
-                "pose within the arm's reach?"
-            )
-            continue
-        if a["error"] is None:
-            source = f"drawn (candidate {k} of {CANDIDATES + 2})"
-            return CartesianTask(start, chain, path, length, orients, a, source)
-        first_error = a["error"]
-    raise ConfigError(
-        f"no start posture found for a Cartesian task on this arm: {len(screened)} of "
-        f"{CANDIDATES + 2} candidates pass the rule at their start, {len(tried)} tried along "
-        f"the task; the last failed: {first_error}"
+    screens: dict[tuple[int, bool], list[tuple[float, int, FloatArray]]] = {}
+    tried: set[tuple[int, float, bool]] = set()
+    for label, wide, radius, holds in WIDENINGS:
+        orients = holds and n >= 6
+        if own_path and radius != RADII[0]:
+            continue  # the user's path keeps its size
+        if not holds and n < 6:
+            continue  # the position alone from the start
+        count = wide * CANDIDATES
+        if (count, orients) not in screens:
+            screened = []
+            failures = {}  # of the latest screen: the condition that failed most, named
+            for k, q in enumerate(_candidates(plant, seed, count)):
+                quick = _screen(probe, chain, q, orients, plant)
+                _best(best, quick)
+                if quick["error"] is None:
+                    screened.append((float(quick["score"]), k, q))
+                else:
+                    condition = str(quick["error"]).split(" is violated")[0]
+                    failures[condition] = failures.get(condition, 0) + 1
+            screened.sort(key=lambda x: (-x[0], x[1]))
+            screens[(count, orients)] = screened
+            drawn = max(drawn, count + 2)
+        for _, k, q in screens[(count, orients)][: wide * CHECKED]:
+            if (k, radius, orients) in tried:
+                continue
+            tried.add((k, radius, orients))
+            tried_rows += 1
+            try:
+                start, path, length = path_from(q, radius, orients)
+                a = _assess(plant, probe, chain, start, path, length, Ts, orients)
+            except ConfigError as e:  # the core refused the orbit: not this posture
+                failed = str(e)
+                continue
+            except DivergedError as e:  # the inverse kinematics of the path's first pose
+                failed = (
+                    f"the inverse kinematics of the pose path's first pose diverged ({e}): is "
+                    "the pose within the arm's reach?"
+                )
+                continue
+            if a["error"] is None:
+                source = f"drawn (candidate {k} of {count + 2}; {label})"
+                return CartesianTask(start, chain, path, length, orients, a, source)
+            if a.get("collides"):
+                collisions += 1
+            else:
+                _best(best, a)
+            failed = a["error"]
+    if not failed and failures:
+        common, times = max(failures.items(), key=lambda kv: kv[1])
+        failed = f"none passed the rule at its start (the {common} failed at {times} of them)"
+    raise ConfigError(_refusal(plant, chain, best, drawn, tried_rows, collisions, failed, own_path))
+
+
+_BEST = {"sigma_min": max, "slack": max, "load": min, "conditioning": max, "reach": min}
+"""How each figure of an assessment improves (the best over the search)."""
+
+
+def _best(best: dict[str, Any], a: dict[str, Any]) -> None:
+    """``best`` updated with the assessment ``a``: each figure the best seen."""
+    for key, pick in _BEST.items():
+        value = float(a[key])
+        if key not in best or pick(value, best[key]) == value != best[key]:
+            best[key] = value
+            if key == "slack":
+                best["slack_joint"] = int(a["slack_joint"])
+
+
+def _refusal(
+    plant: Any,
+    chain: Chain,
+    best: dict[str, Any],
+    drawn: int,
+    tried: int,
+    collisions: int,
+    last: str,
+    own_path: bool,
+) -> str:
+    """The refusal of :func:`_search`: what was searched, what each condition
+    needs with the best value found, what to try."""
+    n = chain.n
+    what = "your path" if own_path else (
+        "the default task (circles of 3, 1.5 and 0.75 cm"
+        + (", holding the orientation and not)" if n >= 6 else ", the position only)")
+    )  # fmt: skip
+    hints = []
+    jv = np.asarray(chain.jacobian(_candidates(plant, 0, 0)[1]), dtype=np.float64)[:3]
+    still = [chain.joint_names[i] for i in range(n) if not np.any(jv[:, i])]
+    if still:
+        hints.append(
+            f"joint(s) {still} do not move the tip (their axes pass through it): give tip= a "
+            "link, body or site beyond them"
+        )
+    elif n < 3 and _posture.plane(chain) is None:
+        hints.append(
+            f"the tip of this {n}-joint arm moves on a surface that is not a plane (its "
+            "joints' axes are not parallel): no circle of the default task lies on it"
+        )
+    needs = _adaptimp.posture_needs({"slack_joint": 0, **best} if best else _NO_BEST, load=None)
+    coll = (
+        f"; {collisions} of them collide along it (the arm with itself or the scene)"
+        if collisions
+        else ""
+    )
+    return (
+        f"no start posture found for a Cartesian task on this arm ({n} joints "
+        f"{chain.joint_names}) with {what}: {drawn} postures drawn within its joint limits, "
+        f"{tried} checked along the task{coll}; the last refused: "
+        f"{last or 'none passed the rule at its start'}. "
+        f"Each condition of the rule (SPEC (16.9)) with what it needs and the best value found: "
+        f"{needs}. "
+        + (" ".join(h + "." for h in hints) + " " if hints else "")
+        + "Try: q0= a start of your own that meets these (cartesian_task(model, q0=...), "
+        "checked with gravity up to the actuators' limits), pose= a path of your own, or "
+        "tip= another end effector"
     )
 
 
-def _candidates(plant: Any, seed: int) -> list[FloatArray]:
+_NO_BEST = {
+    "sigma_min": 0.0, "slack": -math.inf, "slack_joint": 0, "load": math.inf,
+    "conditioning": 0.0, "reach": math.inf,
+}  # fmt: skip
+"""The figures of a search that assessed nothing."""
+
+
+def _candidates(plant: Any, seed: int, count: int = CANDIDATES) -> list[FloatArray]:
     """The model's reference posture (qpos0) and the middle of the joint ranges,
-    each kept inside the limits with the rule's margin, then
-    :data:`CANDIDATES` drawn uniformly there (fixed seed; ±π for an unlimited
-    joint)."""
+    each kept inside the limits with the rule's margin, then ``count``
+    (:data:`CANDIDATES`) drawn uniformly there (fixed seed; ±π for an
+    unlimited joint; the first draws of a larger count are those of a smaller)."""
     lo, hi = _limits(plant)
     lo_, hi_ = np.where(np.isfinite(lo), lo, -math.pi), np.where(np.isfinite(hi), hi, math.pi)
     margin = np.minimum(0.1, (hi_ - lo_) / 8)
     a, b = lo_ + margin, hi_ - margin
     zero = np.clip(np.asarray(plant.model.qpos0[plant._qadr], dtype=np.float64), a, b)
     rng = np.random.default_rng(seed)
-    return [zero, 0.5 * (a + b), *rng.uniform(a, b, size=(CANDIDATES, plant.n))]
+    return [zero, 0.5 * (a + b), *rng.uniform(a, b, size=(count, plant.n))]
 
 
 def _screen(
     probe: _Probe, chain: Chain, q: FloatArray, orients: bool, plant: Any
-) -> tuple[float | None, str | None]:
-    """The core's posture rule (SPEC (16.9)) at the candidate alone: its score,
-    or None and why it fails there already (σmin, limits, gravity,
-    conditioning)."""
+) -> dict[str, Any]:
+    """The core's posture rule (SPEC (16.9)) at the candidate alone (σmin,
+    limits, gravity, conditioning): its assessment (``error`` None if it
+    passes there)."""
     lo, hi = _limits(plant)
     a = _adaptimp.assess_posture(
         chain, q[None, :], chain.pose(q)[0][None, :], probe.gravity(q)[None, :],
         probe.inertia(q), lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients,
+        normal=None if orients else _posture.plane(chain),
     )  # fmt: skip
-    if a["error"] is not None:
-        return None, str(a["error"])
-    return float(a["score"]), None
+    return dict(a)
 
 
 def _positive(name: str, value: Any) -> float:

@@ -678,6 +678,14 @@ class CartesianController:
         centres along the joint orbit with the tube narrowed to the orbit
         (16.10), the learning (18.6)–(18.8).
 
+        The start must pass the posture rule along that joint path, the one
+        check :func:`adaptimp.mujoco.cartesian_task` and the table scenario
+        apply (SPEC (16.9): σmin(J), the joint limits with their margin,
+        gravity within the actuators, the velocity loop's conditioning at
+        K1·Ts/m of the controller built, the path within 1 mm; for an
+        ``adaptimp.mujoco.Plant`` the arm free of collisions), or a
+        ``ConfigError`` names the condition, its bound and the value.
+
         Parameters
         ----------
         chain : Chain
@@ -706,8 +714,14 @@ class CartesianController:
         **params
             Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
             and the joint controller's, e.g. ``gamma``).
+
+        Raises
+        ------
+        ConfigError
+            ``q0`` cannot run the path (the condition with its bound and the
+            value measured), or a keyword is refused.
         """
-        from . import tuning
+        from . import _posture, tuning
 
         if not isinstance(controller, str):
             raise TypeError(
@@ -744,6 +758,16 @@ class CartesianController:
             )  # fmt: skip
         kw.pop("n")
         joint = {k: v for k, v in params.items() if k not in cart}
+        # The one posture check (SPEC (16.9)) along the joint path, at the K1
+        # of the controller built; a start given: gravity within the actuators.
+        idx = _posture.checked_rows(q.shape[0])
+        targets = tabulate(path, steps, Ts, chain.pose(q0)[1])[idx, 0:3]
+        a = _posture.assess(
+            model, chain, q0, q[idx], targets, orients=outer.orients,
+            k1=_posture.k1_of(joint, kw), Ts=Ts, load=_posture.GIVEN_LOAD, tau_max=limits,
+        )  # fmt: skip
+        if a["error"] is not None:
+            raise ConfigError(f"q0 cannot run the path: {a['error']}")
         centres, widths = (
             joint.pop("centers", kw.pop("centers")),
             joint.pop("widths", kw.pop("widths")),

@@ -62,7 +62,14 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.mujoco", "mujoco>=3", "mujoco") from e
 
 from . import _adaptimp, _description, _mjcf, _models
-from ._cartesian_task import CartesianTask, chain_of, collision, self_collision, task_of
+from ._cartesian_task import (
+    CartesianTask,
+    chain_of,
+    collision,
+    measure,
+    self_collision,
+    task_of,
+)
 from ._faults import Fault
 from ._mjcf import _full_inertia, _limits, _postures
 from ._params import loop_delay
@@ -1919,9 +1926,14 @@ def simulate(
     finally:
         if bar is not None:
             bar.close()
+    targets = out.pop("targets", None)
     res = _result(run, out, out.pop("metrics"))
     if task is not None:
         task.measure(res)
+    elif targets is not None:
+        # A Cartesian controller's run, whichever way it was built: its pose
+        # errors against the commanded pose of every row (SPEC (16.11)).
+        measure(res, run.ctrl.chain, targets)
     _check_run(run, res)
     _check_delay(res)
     _check_tracking(run, res)
@@ -2185,7 +2197,26 @@ def _cartesian_loop(
         raise
     finally:
         ctrl._ran(targets, task, k0)
+    out["targets"] = _pose_table(ctrl, targets, out.get("task"), run.every)
     return out
+
+
+def _pose_table(
+    ctrl: Any, targets: FloatArray | None, log: dict[str, FloatArray] | None, every: int
+) -> FloatArray | None:
+    """The commanded pose of every step of a Cartesian controller's run (steps,
+    24): its ``targets``, or, where it held its last target (no path, no
+    reference), the run's commanded positions ``log["pc"]`` (kept every
+    ``every``-th row) with the rotation held."""
+    if targets is not None:
+        return targets
+    if log is None or "pc" not in log or len(log["pc"]) == 0:
+        return None
+    pc = np.asarray(log["pc"], dtype=np.float64)
+    table = np.zeros((len(pc) * every, 24))
+    table[:, 0:3] = np.repeat(pc, every, axis=0)
+    table[:, 9:18] = np.asarray(ctrl.outer._R, dtype=np.float64).reshape(9)
+    return table
 
 
 def _computed_loop(
@@ -2236,6 +2267,14 @@ def _callback_loop(
         rates = None if own_rates or in_task else _builtin_rates(ctrl, steps, Ts)
         table = (nan, *(rates or (nan, nan)))
     attrs = [name for name in ("tau", "xc", "xd", "z1", "dq_hat", "zeta") if has[name]]
+    # An adaptimp.CartesianController's commanded pose of every step (or that of
+    # one behind an object of the user's), for its pose errors: taken before it
+    # steps (its path on its own clock).
+    cartesian = in_task and hasattr(ctrl, "chain") and callable(getattr(ctrl, "_targets", None))
+    poses = None
+    if cartesian:
+        given = reference.arrays if isinstance(reference, _Table) else reference
+        poses = ctrl._targets(steps, given)
     cparams = getattr(ctrl, "params", None)
     cparams = cparams if isinstance(cparams, Mapping) else {}
     target = tuple(
@@ -2252,6 +2291,8 @@ def _callback_loop(
     log = getattr(ctrl, "arrays", None) if in_task and getattr(ctrl, "record", False) else None
     if callable(log):
         out["task"] = {k: v[len(v) - steps :: run.every] for k, v in log().items()}
+    if cartesian:
+        out["targets"] = _pose_table(ctrl, poses, out.get("task"), run.every)
     return out
 
 

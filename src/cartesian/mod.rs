@@ -26,4 +26,4 @@ pub use outer::{
 #[cfg(feature = "alloc")]
 pub(crate) use pair::{check_joint, set_posture as set_pair_posture, start as start_pair};
 pub use pair::{CartesianCommand, CartesianController, CartesianMeasurement, JointLaw};
-pub use rule::{Assessment, PoseCircle, PostureRule};
+pub use rule::{Assessment, PoseCircle, PostureRule, Refusal, TaskRows};

@@ -28,6 +28,7 @@ use crate::error::{check, Error};
 use crate::math::sqrt;
 use crate::trajectory::Setpoint;
 use crate::types::{Matrix, Vector};
+use core::fmt;
 use nalgebra::Matrix3;
 
 /// The smallest singular value (m/rad for the translation rows) of the first
@@ -48,6 +49,78 @@ pub fn sigma_min<const N: usize>(j: &Jacobian6<N>, rows: usize) -> f64 {
             .min()
     };
     sqrt(least.max(0.0))
+}
+
+/// The smallest singular value (m/rad) of the translation rows of `j` within
+/// the plane of the unit `normal` (a planar arm's task, SPEC (16.8)): of P J_v,
+/// P the 2 × 3 projection onto two orthonormal directions of the plane. Zero
+/// for an arm of one joint.
+pub fn sigma_min_in_plane<const N: usize>(j: &Jacobian6<N>, normal: &Vector<3>) -> f64 {
+    if N < 2 {
+        return 0.0;
+    }
+    let (u, v) = plane_axes(normal);
+    let jv = j.fixed_rows::<3>(0);
+    let (a, b) = (u.transpose() * jv, v.transpose() * jv);
+    // The 2 × 2 Gram matrix of the projected rows and its smaller eigenvalue.
+    let (p, q, r) = (a.dot(&a), a.dot(&b), b.dot(&b));
+    let mean = 0.5 * (p + r);
+    let spread = sqrt((0.5 * (p - r)) * (0.5 * (p - r)) + q * q);
+    sqrt((mean - spread).max(0.0))
+}
+
+/// Two orthonormal directions of the plane of the unit `normal`: x less its
+/// part along the normal (y for a normal along x), and normal × that.
+fn plane_axes(normal: &Vector<3>) -> (Vector<3>, Vector<3>) {
+    let axis = if normal[0].abs() > 0.9 {
+        Vector::<3>::new(0.0, 1.0, 0.0)
+    } else {
+        Vector::<3>::new(1.0, 0.0, 0.0)
+    };
+    let w = axis - normal.dot(&axis) * normal;
+    let u = w / w.norm();
+    (u, normal.cross(&u))
+}
+
+/// The normal (unit, world frame) of a planar arm's plane, from its 6 × N
+/// Jacobian `j` at any posture, SPEC (16.8): every revolute joint's axis (a
+/// column of J_ω) parallel to one direction n (|a_i × n| ≤ 1e-9 |a_i|) and
+/// every prismatic joint's (a column of J_v where J_ω's is zero) at right
+/// angles to it: the tip then moves in the plane ⊥ n at every posture
+/// (rotations about parallel axes keep them parallel). None for an arm that
+/// is not planar or has one joint (its tip moves along a curve). The sign
+/// makes the largest component positive (+z for an arm in the horizontal
+/// plane).
+pub fn plane_normal<const N: usize>(j: &Jacobian6<N>) -> Option<Vector<3>> {
+    if N < 2 {
+        return None;
+    }
+    let mut normal: Option<Vector<3>> = None;
+    for i in 0..N {
+        let w = Vector::<3>::new(j[(3, i)], j[(4, i)], j[(5, i)]);
+        let size = w.norm();
+        if size == 0.0 {
+            continue;
+        }
+        match normal {
+            None => normal = Some(w / size),
+            Some(n) if n.cross(&w).norm() <= 1e-9 * size => {}
+            Some(_) => return None,
+        }
+    }
+    let mut n = normal?;
+    for i in 0..N {
+        let w = Vector::<3>::new(j[(3, i)], j[(4, i)], j[(5, i)]);
+        let t = Vector::<3>::new(j[(0, i)], j[(1, i)], j[(2, i)]);
+        if w.norm() == 0.0 && n.dot(&t).abs() > 1e-9 * t.norm() {
+            return None;
+        }
+    }
+    let k = n.iamax();
+    if n[k] < 0.0 {
+        n = -n;
+    }
+    Some(n)
 }
 
 /// The conditioning of the joint rule's sampled velocity loop at an inertia
@@ -86,12 +159,14 @@ pub fn loop_conditioning<const N: usize>(d: &Matrix<N>) -> Result<f64, Error> {
 }
 
 /// The default Cartesian task, SPEC (16.8): hold the start pose for `hold`
-/// s, then a circle of `radius` (m) at `freq` (Hz) in the horizontal plane
-/// through the start, the orientation held; the angular speed ramps from
-/// zero (a quintic) over `ramp` s, so the path starts at rest. The circle
-/// passes through the start and its centre lies `radius` from it toward the
-/// base's vertical axis (the world z axis through the origin; along x for a
-/// start on that axis): the circle stays inside the reach of the start.
+/// s, then a circle of `radius` (m) at `freq` (Hz) in a plane through the
+/// start, the orientation held; the angular speed ramps from zero (a quintic)
+/// over `ramp` s, so the path starts at rest. The plane is horizontal (its
+/// normal the world z axis), or a planar arm's own ([`plane_normal`]). The
+/// circle passes through the start and its centre lies `radius` from it
+/// toward the base's axis (the line through the world origin along the
+/// normal; along x, or y for a normal along x, for a start on that line): the
+/// circle stays inside the reach of the start.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct PoseCircle {
     start: Vector<3>,
@@ -101,7 +176,7 @@ pub struct PoseCircle {
     hold: f64,
     ramp: f64,
     /// Unit vectors of the plane: `u` from the start toward the centre, `v`
-    /// = z × u.
+    /// = normal × u.
     u: Vector<3>,
     v: Vector<3>,
 }
@@ -130,10 +205,33 @@ impl PoseCircle {
     }
 
     /// The task with its own `radius` (m, > 0), `freq` (Hz, > 0), `hold` and
-    /// `ramp` (s, ≥ 0). Errors name the quantity.
+    /// `ramp` (s, ≥ 0), in the horizontal plane. Errors name the quantity.
     pub fn with(
         start: Vector<3>,
         rotation: Matrix3<f64>,
+        radius: f64,
+        freq: f64,
+        hold: f64,
+        ramp: f64,
+    ) -> Result<Self, Error> {
+        Self::in_plane(
+            start,
+            rotation,
+            Vector::<3>::new(0.0, 0.0, 1.0),
+            radius,
+            freq,
+            hold,
+            ramp,
+        )
+    }
+
+    /// [`with`](Self::with) in the plane of the unit `normal` (world frame;
+    /// normalised here; finite and non-zero, else an error naming it).
+    #[allow(clippy::too_many_arguments)]
+    pub fn in_plane(
+        start: Vector<3>,
+        rotation: Matrix3<f64>,
+        normal: Vector<3>,
         radius: f64,
         freq: f64,
         hold: f64,
@@ -145,14 +243,35 @@ impl PoseCircle {
         check::positive("freq > 0", "freq", freq)?;
         check::nonnegative("hold ≥ 0", "hold", hold)?;
         check::nonnegative("ramp ≥ 0", "ramp", ramp)?;
-        let radial = Vector::<3>::new(start[0], start[1], 0.0);
-        let r = radial.norm();
-        let u = if r > 1e-3 {
-            -radial / r
+        check::finite_slice("normal", normal.as_slice())?;
+        let length = normal.norm();
+        if !(length > 0.0) {
+            return Err(Error::Invalid {
+                what: "normal",
+                reason: "must be a non-zero vector (the circle's plane)",
+            });
+        }
+        let n = normal / length;
+        let (u, v) = if n == Vector::<3>::new(0.0, 0.0, 1.0) {
+            // The horizontal plane (every arm that is not planar).
+            let radial = Vector::<3>::new(start[0], start[1], 0.0);
+            let r = radial.norm();
+            let u = if r > 1e-3 {
+                -radial / r
+            } else {
+                Vector::<3>::new(1.0, 0.0, 0.0)
+            };
+            (u, Vector::<3>::new(-u[1], u[0], 0.0))
         } else {
-            Vector::<3>::new(1.0, 0.0, 0.0)
+            let radial = start - n.dot(&start) * n;
+            let r = radial.norm();
+            let u = if r > 1e-3 {
+                -radial / r
+            } else {
+                plane_axes(&n).0 // any direction of the plane
+            };
+            (u, n.cross(&u))
         };
-        let v = Vector::<3>::new(-u[1], u[0], 0.0);
         Ok(Self {
             start,
             rotation,
@@ -207,6 +326,42 @@ impl PoseCircle {
             dp: r * dphi * tangent,
             ddp: r * ddphi * tangent - r * dphi * dphi * radial,
             ..PoseTarget::at(self.start, self.rotation)
+        }
+    }
+}
+
+/// The directions a task commands, over which [`PostureRule::assess`] takes
+/// σmin(J), SPEC (16.9): the pose (the 6 × N Jacobian), the position (its
+/// translation rows), or a position in a plane (a planar arm's task: its
+/// translation rows within the plane of the normal, [`plane_normal`]).
+/// `true` is the pose, `false` the position.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum TaskRows {
+    /// Position and orientation.
+    Pose,
+    /// The position in space.
+    Position,
+    /// The position in the plane of this unit normal (world frame).
+    Plane(Vector<3>),
+}
+
+impl TaskRows {
+    /// σmin of the task's rows of `j` (m/rad for the translation rows).
+    pub fn sigma_min<const N: usize>(&self, j: &Jacobian6<N>) -> f64 {
+        match self {
+            TaskRows::Pose => sigma_min(j, 6),
+            TaskRows::Position => sigma_min(j, 3),
+            TaskRows::Plane(n) => sigma_min_in_plane(j, n),
+        }
+    }
+}
+
+impl From<bool> for TaskRows {
+    fn from(orients: bool) -> Self {
+        if orients {
+            TaskRows::Pose
+        } else {
+            TaskRows::Position
         }
     }
 }
@@ -294,13 +449,14 @@ impl PostureRule {
     /// inertia matrix at the start (kg m²), the limits [`lo`, `hi`] (rad;
     /// ±∞: unlimited) and `tau_max` (N m). `orients`: the task holds the
     /// orientation (σmin of the 6 × N Jacobian; else of its translation
-    /// rows). Errors for empty or mismatched samples, non-finite values, a
-    /// `d0` that is not symmetric positive definite, τmax ≤ 0.
+    /// rows; [`TaskRows`] for a planar arm's task). Errors for empty or
+    /// mismatched samples, non-finite values, a `d0` that is not symmetric
+    /// positive definite, τmax ≤ 0.
     #[allow(clippy::too_many_arguments)]
     pub fn assess<const N: usize, K: Kinematics<N>>(
         &self,
         kin: &K,
-        orients: bool,
+        task: impl Into<TaskRows>,
         orbit: &[Vector<N>],
         targets: &[Vector<3>],
         gravity: &[Vector<N>],
@@ -316,7 +472,7 @@ impl PostureRule {
             });
         }
         check::positive_vec("τmax > 0", "tau_max", tau_max)?;
-        let rows = if orients { 6 } else { 3 };
+        let task = task.into();
         let mut a = Assessment {
             sigma_min: f64::INFINITY,
             load: 0.0,
@@ -330,7 +486,7 @@ impl PostureRule {
             check::finite_slice("targets", p.as_slice())?;
             check::finite_slice("gravity", g.as_slice())?;
             let tip = kin.tip(q, &Vector::zeros());
-            a.sigma_min = a.sigma_min.min(sigma_min(&tip.jacobian, rows));
+            a.sigma_min = a.sigma_min.min(task.sigma_min(&tip.jacobian));
             a.reach = a.reach.max((tip.position - p).norm());
             for i in 0..N {
                 a.load = a.load.max(g[i].abs() / tau_max[i]);
@@ -344,59 +500,35 @@ impl PostureRule {
         Ok(a)
     }
 
-    /// Whether `a` meets the rule: the first condition it violates, named
-    /// (`σmin(J) ≥ 0.05`, `inside the joint limits with margin`, `gravity
-    /// load within its bound` (0.5 by default), `velocity-loop conditioning ≥
-    /// K1·Ts/m`, `task reachable`), with the value.
-    pub fn check(&self, a: &Assessment) -> Result<(), Error> {
-        let conditions: [(bool, &'static str, &'static str, Option<usize>, f64); 5] = [
-            (
-                a.sigma_min >= self.sigma_min,
-                "σmin(J) ≥ 0.05 along the task (not near a singularity)",
-                "σmin(J)",
-                None,
-                a.sigma_min,
-            ),
-            (
-                a.slack >= 0.0,
-                "inside the joint limits with margin along the task",
-                "distance to the limit − margin (rad), joint",
-                Some(a.slack_joint),
-                a.slack,
-            ),
-            (
-                a.load <= self.load,
-                "gravity load max|G_i|/τmax_i within its bound along the task",
-                "gravity load",
-                None,
-                a.load,
-            ),
-            (
-                a.conditioning >= self.conditioning,
-                "velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ K1·Ts/m",
-                "λmin",
-                None,
-                a.conditioning,
-            ),
-            (
-                a.reach <= self.reach,
-                "task reachable: the inverse kinematics within 1 mm of the path",
-                "largest distance from the path (m)",
-                None,
-                a.reach,
-            ),
-        ];
-        for (ok, condition, lhs, index, value) in conditions {
-            if !ok {
-                return Err(Error::Condition {
+    /// Whether `a` meets the rule: the first condition it violates
+    /// ([`Refusal`]: the condition with its bound, the value measured).
+    pub fn check(&self, a: &Assessment) -> Result<(), Refusal> {
+        for condition in Condition::ALL {
+            let (value, joint) = condition.value(a);
+            let threshold = condition.threshold(self);
+            let met = match condition {
+                Condition::Slack => value >= threshold,
+                Condition::Load | Condition::Reach => value <= threshold,
+                Condition::Singular | Condition::Conditioning => value >= threshold,
+            };
+            if !met {
+                return Err(Refusal {
                     condition,
-                    lhs,
-                    index,
                     value,
+                    threshold,
+                    joint,
+                    margin: self.margin,
                 });
             }
         }
         Ok(())
+    }
+
+    /// What each condition needs, with the best value `best` reached (the
+    /// assessment of the posture closest to passing on each condition, one
+    /// condition at a time): for a refusal that says what a start would need.
+    pub fn needs<'a>(&'a self, best: &'a Assessment) -> Needs<'a> {
+        Needs { rule: self, best }
     }
 
     /// A score to rank postures that pass [`check`](Self::check) (larger is
@@ -404,6 +536,220 @@ impl PostureRule {
     /// discounted by the share of the actuators gravity takes.
     pub fn score(&self, a: &Assessment) -> f64 {
         a.sigma_min * (1.0 - a.load)
+    }
+}
+
+/// A condition of the posture rule, SPEC (16.9), in the order it is checked.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Condition {
+    /// σmin(J) ≥ [`PostureRule::sigma_min`] along the task.
+    Singular,
+    /// Every joint inside its limits by its margin along the task.
+    Slack,
+    /// The gravity load ≤ [`PostureRule::load`] along the task.
+    Load,
+    /// λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ [`PostureRule::conditioning`] at the start.
+    Conditioning,
+    /// The inverse kinematics within [`PostureRule::reach`] of the path.
+    Reach,
+}
+
+impl Condition {
+    /// Every condition, in the order [`PostureRule::check`] checks them.
+    pub const ALL: [Condition; 5] = [
+        Condition::Singular,
+        Condition::Slack,
+        Condition::Load,
+        Condition::Conditioning,
+        Condition::Reach,
+    ];
+
+    /// The value of `a` this condition bounds, and the joint it is at (for
+    /// the limits' slack).
+    pub fn value(self, a: &Assessment) -> (f64, Option<usize>) {
+        match self {
+            Condition::Singular => (a.sigma_min, None),
+            Condition::Slack => (a.slack, Some(a.slack_joint)),
+            Condition::Load => (a.load, None),
+            Condition::Conditioning => (a.conditioning, None),
+            Condition::Reach => (a.reach, None),
+        }
+    }
+
+    /// Its bound in `rule`.
+    pub fn threshold(self, rule: &PostureRule) -> f64 {
+        match self {
+            Condition::Singular => rule.sigma_min,
+            Condition::Slack => 0.0,
+            Condition::Load => rule.load,
+            Condition::Conditioning => rule.conditioning,
+            Condition::Reach => rule.reach,
+        }
+    }
+
+    /// What the condition is, for a reader (with `threshold` and the limits'
+    /// `margin`, rad).
+    fn describe(self, f: &mut fmt::Formatter<'_>, threshold: f64, margin: f64) -> fmt::Result {
+        match self {
+            Condition::Singular => {
+                write!(f, "σmin(J) ≥ ")?;
+                significant(f, threshold)?;
+                write!(f, " m/rad along the task (not near a singularity)")
+            }
+            Condition::Slack => {
+                write!(f, "every joint min(")?;
+                significant(f, margin)?;
+                write!(f, " rad, range/8) inside its limits along the task")
+            }
+            Condition::Load => {
+                write!(f, "gravity load max_i |G_i|/τmax_i ≤ ")?;
+                significant(f, threshold)?;
+                write!(f, " along the task (gravity within the actuators)")
+            }
+            Condition::Conditioning => {
+                write!(
+                    f,
+                    "velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ K1·Ts/m = "
+                )?;
+                significant(f, threshold)?;
+                write!(f, " at the start")
+            }
+            Condition::Reach => {
+                write!(f, "the path reachable: the inverse kinematics within ")?;
+                significant(f, threshold)?;
+                write!(f, " m of it")
+            }
+        }
+    }
+
+    /// The quantity measured, as a refusal names it.
+    fn quantity(self) -> &'static str {
+        match self {
+            Condition::Singular => "σmin(J)",
+            Condition::Slack => "distance to the limit − margin (rad), joint",
+            Condition::Load => "gravity load",
+            Condition::Conditioning => "λmin",
+            Condition::Reach => "largest distance from the path (m)",
+        }
+    }
+}
+
+/// A condition of the posture rule a posture violates (SPEC (16.9)): the
+/// condition with its bound, the value measured (and the joint, for the
+/// limits). Its text: `condition <the condition, with its bound> is violated:
+/// <quantity> = <value>`.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Refusal {
+    /// The condition violated.
+    pub condition: Condition,
+    /// The value measured.
+    pub value: f64,
+    /// The bound the rule needs.
+    pub threshold: f64,
+    /// The joint of the limits' slack.
+    pub joint: Option<usize>,
+    /// The rule's margin inside the limits (rad).
+    pub margin: f64,
+}
+
+impl fmt::Display for Refusal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "condition ")?;
+        self.condition.describe(f, self.threshold, self.margin)?;
+        write!(f, " is violated: {}", self.condition.quantity())?;
+        if let Some(i) = self.joint {
+            write!(f, "[{i}]")?;
+        }
+        write!(f, " = ")?;
+        significant(f, self.value)?;
+        write!(f, " (SPEC (16.9))")
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for Refusal {}
+
+/// [`PostureRule::needs`]: each condition with its bound and the best value
+/// reached, `; `-separated.
+pub struct Needs<'a> {
+    rule: &'a PostureRule,
+    best: &'a Assessment,
+}
+
+impl fmt::Display for Needs<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, c) in Condition::ALL.into_iter().enumerate() {
+            if i > 0 {
+                write!(f, "; ")?;
+            }
+            c.describe(f, c.threshold(self.rule), self.rule.margin)?;
+            let (value, joint) = c.value(self.best);
+            write!(f, " (best ")?;
+            significant(f, value)?;
+            if let (Condition::Slack, Some(j)) = (c, joint) {
+                write!(f, " rad, joint {j}")?;
+            }
+            write!(f, ")")?;
+        }
+        Ok(())
+    }
+}
+
+/// `x` to four significant digits (as `%.4g`: 0.003976, 0.1781, 12.35,
+/// 1.235e-05), without allocating.
+fn significant(f: &mut fmt::Formatter<'_>, x: f64) -> fmt::Result {
+    let a = x.abs();
+    if !x.is_finite() {
+        return write!(f, "{x}");
+    }
+    if a == 0.0 {
+        return write!(f, "0");
+    }
+    if !(1e-4..1e4).contains(&a) {
+        return write!(f, "{x:.3e}");
+    }
+    let mut decimals = 3usize;
+    let mut scale = 1.0;
+    while a < scale && decimals < 8 {
+        scale /= 10.0;
+        decimals += 1;
+    }
+    while a >= 10.0 * scale.max(1.0) && decimals > 0 {
+        scale *= 10.0;
+        decimals -= 1;
+    }
+    // Trailing zeros dropped, as %g does.
+    let mut buf = [0u8; 32];
+    let mut w = Cursor {
+        buf: &mut buf,
+        len: 0,
+    };
+    fmt::write(&mut w, format_args!("{x:.decimals$}"))?;
+    let len = w.len;
+    let text = core::str::from_utf8(&buf[..len]).map_err(|_| fmt::Error)?;
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        text
+    };
+    f.write_str(text)
+}
+
+/// A fixed buffer to format into without allocating.
+struct Cursor<'a> {
+    buf: &'a mut [u8],
+    len: usize,
+}
+
+impl fmt::Write for Cursor<'_> {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        let end = self.len + s.len();
+        if end > self.buf.len() {
+            return Err(fmt::Error);
+        }
+        self.buf[self.len..end].copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
     }
 }
 
@@ -478,6 +824,47 @@ mod tests {
         assert!((sigma_min(&j, 3) - 1.5).abs() < 1e-12);
         let j2 = Jacobian6::<2>::from_element(1.0);
         assert_eq!(sigma_min(&j2, 6), 0.0);
+        // A planar arm: both axes along −y, its tip in the x–z plane.
+        let mut planar = Jacobian6::<2>::zeros();
+        planar[(0, 0)] = 0.5;
+        planar[(2, 1)] = 0.2;
+        planar[(4, 0)] = -1.0;
+        planar[(4, 1)] = -1.0;
+        assert_eq!(sigma_min(&planar, 3), 0.0);
+        let n = plane_normal(&planar).unwrap();
+        assert_eq!(n, Vector::<3>::new(0.0, 1.0, 0.0));
+        assert!((sigma_min_in_plane(&planar, &n) - 0.2).abs() < 1e-15);
+        // Not planar: axes that are not parallel.
+        assert_eq!(plane_normal(&j), None);
+        let mut spatial = planar;
+        spatial[(5, 1)] = 1.0;
+        assert_eq!(plane_normal(&spatial), None);
+    }
+
+    #[test]
+    fn a_planar_arm_s_circle_lies_in_its_plane() {
+        let p0 = Vector::<3>::new(0.4, 0.0, 0.3);
+        let c = PoseCircle::in_plane(
+            p0,
+            Matrix3::identity(),
+            Vector::<3>::new(0.0, -2.0, 0.0),
+            0.03,
+            0.5,
+            1.0,
+            1.0,
+        )
+        .unwrap();
+        // Toward the base's axis (the y axis through the origin), in the x–z plane.
+        assert!((c.centre() - p0 * (1.0 - 0.03 / 0.5)).norm() < 1e-15);
+        for t in [1.5, 2.2, 3.9] {
+            assert_eq!(c.sample(t).p[1], 0.0);
+        }
+        // The horizontal plane's circle is the one of `with`, to the bit.
+        let r = *nalgebra::Rotation3::from_euler_angles(0.1, 0.2, 0.3).matrix();
+        let z = Vector::<3>::new(0.0, 0.0, 1.0);
+        let a = PoseCircle::in_plane(p0, r, z, 0.03, 0.5, 1.0, 1.0).unwrap();
+        assert_eq!(a, PoseCircle::new(p0, r).unwrap());
+        assert!(PoseCircle::in_plane(p0, r, Vector::<3>::zeros(), 0.03, 0.5, 1.0, 1.0).is_err());
     }
 
     #[test]
@@ -560,7 +947,7 @@ mod tests {
         let e = rule.check(&a).unwrap_err();
         assert!(
             e.to_string()
-                .starts_with("condition σmin(J) ≥ 0.05 along the task"),
+                .starts_with("condition σmin(J) ≥ 0.05 m/rad along the task"),
             "{e}"
         );
         let a = assess(Vector::<3>::new(0.3, -0.5, 1.2));
@@ -571,8 +958,8 @@ mod tests {
         let e = rule.check(&a).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "condition inside the joint limits with margin along the task is violated: \
-             distance to the limit − margin (rad), joint[0] = -0.05000000000000018 (SPEC §10)"
+            "condition every joint min(0.1 rad, range/8) inside its limits along the task is \
+             violated: distance to the limit − margin (rad), joint[0] = -0.05 (SPEC (16.9))"
         );
         // Gravity beyond half an actuator: named with the load.
         let heavy = [Vector::<3>::new(0.0, 6.0, 1.0)];
@@ -590,14 +977,20 @@ mod tests {
             )
             .unwrap();
         let e = rule.check(&a).unwrap_err();
-        assert!(
-            e.to_string()
-                .contains("gravity load max|G_i|/τmax_i within its bound"),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "condition gravity load max_i |G_i|/τmax_i ≤ 0.5 along the task (gravity within \
+             the actuators) is violated: gravity load = 0.6 (SPEC (16.9))"
         );
-        assert!(
-            e.to_string().ends_with("gravity load = 0.6 (SPEC §10)"),
-            "{e}"
+        // What each condition needs, with the best values found.
+        assert_eq!(
+            rule.needs(&a).to_string(),
+            "σmin(J) ≥ 0.05 m/rad along the task (not near a singularity) (best 0.1779); every \
+             joint min(0.1 rad, range/8) inside its limits along the task (best 1.7 rad, joint \
+             2); gravity load max_i |G_i|/τmax_i ≤ 0.5 along the task (gravity within the \
+             actuators) (best 0.6); velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ K1·Ts/m = \
+             0.2 at the start (best 1); the path reachable: the inverse kinematics within 0.001 \
+             m of it (best 0)"
         );
     }
 }

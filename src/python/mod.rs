@@ -77,7 +77,8 @@ mod adaptimp_module {
 
     #[pymodule_export]
     use super::tuning::{
-        assess_posture, default_task, pose_circle, pose_metrics, suggest, table_metrics,
+        assess_posture, default_task, plane_normal, pose_circle, pose_metrics, posture_needs,
+        suggest, table_metrics,
     };
     #[pymodule_export]
     use super::{

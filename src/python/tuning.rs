@@ -4,7 +4,7 @@
 use super::cartesian::{PyChain, TypedChain};
 use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
-use crate::cartesian::rule::{resolving, PoseCircle, PostureRule};
+use crate::cartesian::rule::{resolving, PoseCircle, PostureRule, TaskRows};
 use crate::control::tuning::{
     damped_scales, default_task as core_default_task, inertia_scales_along, loop_bound, Rule,
 };
@@ -282,9 +282,10 @@ pub fn default_task(
 /// for k < `steps`: (targets (steps, 24): p, ṗ, p̈, R row-major, ω, ω̇ per
 /// row; the span hold + ramp + 1/freq (s); the circle's centre (3,; m)).
 /// `radius` (m), `freq` (Hz), `hold`, `ramp` (s): None, the defaults of
-/// SPEC (16.8) (3 cm, 0.5 Hz, 1 s, 1 s).
+/// SPEC (16.8) (3 cm, 0.5 Hz, 1 s, 1 s); `normal` (3,): the circle's plane
+/// (None: horizontal; a planar arm's, [`plane_normal`]).
 #[pyfunction]
-#[pyo3(signature = (p0, r0, ts, steps, radius=None, freq=None, hold=None, ramp=None, start=0.0))]
+#[pyo3(signature = (p0, r0, ts, steps, radius=None, freq=None, hold=None, ramp=None, start=0.0, normal=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn pose_circle<'py>(
     py: Python<'py>,
@@ -297,6 +298,7 @@ pub fn pose_circle<'py>(
     hold: Option<f64>,
     ramp: Option<f64>,
     start: f64,
+    normal: Option<[f64; 3]>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, f64, Vec<f64>)> {
     if p0.shape() != [3] || r0.shape() != [3, 3] {
         return Err(ConfigError::new_err(format!(
@@ -315,9 +317,10 @@ pub fn pose_circle<'py>(
     }
     let p = Vector::<3>::from_iterator(p0.as_array().iter().copied());
     let r = nalgebra::Matrix3::from_iterator(r0.as_array().t().iter().copied());
-    let c = PoseCircle::with(
+    let c = PoseCircle::in_plane(
         p,
         r,
+        Vector::<3>::from(normal.unwrap_or([0.0, 0.0, 1.0])),
         radius.unwrap_or(PoseCircle::RADIUS),
         freq.unwrap_or(PoseCircle::FREQ),
         hold.unwrap_or(PoseCircle::HOLD),
@@ -350,15 +353,18 @@ pub fn pose_circle<'py>(
 /// torque along it `gravity` (K, n; N m), the inertia matrix at its start
 /// `d0` (n, n; kg m²), the limits `lo`, `hi` (n,; rad, ±inf: unlimited),
 /// `tau_max` (n,; N m), `orients` (the 6 × n Jacobian, else its 3
-/// translation rows), `k1` (1/s) and `ts` (s) of the joint controller (the
+/// translation rows; `normal` (3,): a planar arm's task, its translation rows
+/// within that plane), `k1` (1/s) and `ts` (s) of the joint controller (the
 /// conditioning threshold K1·Ts/m; default the joint rule's at 1 kHz),
 /// `load` the largest gravity load allowed (default 0.5; 1: gravity within
 /// the actuators, for a posture the caller gave).
 /// Returns a dict: "sigma_min", "load", "conditioning", "slack",
-/// "slack_joint", "reach", "score" and "error" (the first condition it
-/// violates, or None).
+/// "slack_joint", "reach", "score", "error" (the first condition it
+/// violates, with its bound and the value, or None) and "needs" (what each
+/// condition needs: the rule's bounds "sigma_min", "load", "conditioning",
+/// "reach" and the limits' "margin").
 #[pyfunction]
-#[pyo3(signature = (chain, q, p, gravity, d0, lo, hi, tau_max, orients, k1=None, ts=None, load=None))]
+#[pyo3(signature = (chain, q, p, gravity, d0, lo, hi, tau_max, orients, k1=None, ts=None, load=None, normal=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn assess_posture<'py>(
     py: Python<'py>,
@@ -374,14 +380,27 @@ pub fn assess_posture<'py>(
     k1: Option<f64>,
     ts: Option<f64>,
     load: Option<f64>,
+    normal: Option<[f64; 3]>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let joint_rule = Rule::default();
-    let ts = ts.unwrap_or(1e-3);
-    let mut rule = PostureRule::for_loop(k1.unwrap_or_else(|| joint_rule.k1(ts)), ts, &joint_rule);
-    if let Some(l) = load {
-        crate::error::check::positive("load > 0", "load", l).map_err(|e| config_error(e.into()))?;
-        rule.load = l;
-    }
+    let rule = posture_rule(k1, ts, load)?;
+    let task = match normal {
+        None => TaskRows::from(orients),
+        Some(n) if !orients => {
+            let n = Vector::<3>::from(n);
+            let size = n.norm();
+            if !(size.is_finite() && size > 0.0) {
+                return Err(ConfigError::new_err(format!(
+                    "normal must be a finite non-zero vector, got {n:?}"
+                )));
+            }
+            TaskRows::Plane(n / size)
+        }
+        Some(_) => {
+            return Err(ConfigError::new_err(
+                "a planar task (normal=) holds no orientation: give orients=False",
+            ))
+        }
+    };
     let kin = chain.dyn_chain();
     let n = kin.n();
     check_posture_shapes((&q, &p, &gravity, &d0), (&lo, &hi, &tau_max), n)?;
@@ -391,11 +410,83 @@ pub fn assess_posture<'py>(
     let (lo, hi, tau) = (flat1(&lo), flat1(&hi), flat1(&tau_max));
     let (a, score, error) = crate::with_joints!(
         n,
-        K => assess_typed::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), orients),
+        K => assess_typed::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), task),
         _ => unreachable!("a chain has 1 to 7 joints"),
     )
     .map_err(|e| config_error(e.into()))?;
-    assessment_dict(py, &a, score, error)
+    let out = assessment_dict(py, &a, score, error)?;
+    let needs = PyDict::new(py);
+    needs.set_item("sigma_min", rule.sigma_min)?;
+    needs.set_item("load", rule.load)?;
+    needs.set_item("conditioning", rule.conditioning)?;
+    needs.set_item("reach", rule.reach)?;
+    needs.set_item("margin", rule.margin)?;
+    out.set_item("needs", needs)?;
+    Ok(out)
+}
+
+/// The posture rule of SPEC (16.9) for a joint controller of `k1` (1/s) at
+/// `ts` (s) (default the joint rule's at 1 kHz), with the gravity load bound
+/// `load` (default 0.5).
+fn posture_rule(k1: Option<f64>, ts: Option<f64>, load: Option<f64>) -> PyResult<PostureRule> {
+    let joint_rule = Rule::default();
+    let ts = ts.unwrap_or(1e-3);
+    let mut rule = PostureRule::for_loop(k1.unwrap_or_else(|| joint_rule.k1(ts)), ts, &joint_rule);
+    if let Some(l) = load {
+        crate::error::check::positive("load > 0", "load", l).map_err(|e| config_error(e.into()))?;
+        rule.load = l;
+    }
+    Ok(rule)
+}
+
+/// What each condition of the posture rule (SPEC (16.9); `k1`, `ts`, `load`
+/// as [`assess_posture`]'s) needs, with the best value found of each:
+/// `best` a dict with "sigma_min", "slack", "slack_joint", "load",
+/// "conditioning", "reach" (an assessment, or the best of each over many).
+#[pyfunction]
+#[pyo3(signature = (best, k1=None, ts=None, load=None))]
+pub fn posture_needs(
+    best: &Bound<'_, PyDict>,
+    k1: Option<f64>,
+    ts: Option<f64>,
+    load: Option<f64>,
+) -> PyResult<String> {
+    let rule = posture_rule(k1, ts, load)?;
+    let get = |key: &str| -> PyResult<f64> {
+        best.get_item(key)?
+            .ok_or_else(|| ConfigError::new_err(format!("best needs {key:?}")))?
+            .extract()
+    };
+    let a = crate::cartesian::Assessment {
+        sigma_min: get("sigma_min")?,
+        load: get("load")?,
+        conditioning: get("conditioning")?,
+        slack: get("slack")?,
+        slack_joint: get("slack_joint")? as usize,
+        reach: get("reach")?,
+    };
+    Ok(rule.needs(&a).to_string())
+}
+
+/// The normal (3,) of a planar arm's plane from its 6 × n Jacobian at any
+/// posture, SPEC (16.8) ([`crate::cartesian::rule::plane_normal`]), or None
+/// for an arm that is not planar.
+#[pyfunction]
+pub fn plane_normal(jacobian: PyReadonlyArray2<'_, f64>) -> PyResult<Option<[f64; 3]>> {
+    let shape = jacobian.shape();
+    if shape.len() != 2 || shape[0] != 6 || !(1..=super::MAX_JOINTS).contains(&shape[1]) {
+        return Err(shape_error("jacobian", "(6, n), 1 ≤ n ≤ 7".into(), shape));
+    }
+    let n = shape[1];
+    let j: Vec<f64> = jacobian.as_array().iter().copied().collect();
+    Ok(crate::with_joints!(
+        n,
+        K => {
+            let m = crate::cartesian::kinematics::Jacobian6::<K>::from_row_slice(&j);
+            crate::cartesian::rule::plane_normal(&m).map(|v| [v[0], v[1], v[2]])
+        },
+        _ => unreachable!("n checked above"),
+    ))
 }
 
 /// [`assess_posture`]'s shapes, SPEC (16.9): q (K, n), p (K, 3), gravity
@@ -445,7 +536,7 @@ fn assess_typed<const N: usize>(
     kin: &dyn super::cartesian::DynChain,
     (q, p, g, d): (&[f64], &[f64], &[f64], &[f64]),
     (lo, hi, tau): (&[f64], &[f64], &[f64]),
-    orients: bool,
+    task: TaskRows,
 ) -> Result<(crate::cartesian::Assessment, f64, Option<String>), Error> {
     let v = Vector::<N>::from_column_slice;
     let orbit: Vec<Vector<N>> = q.chunks_exact(N).map(v).collect();
@@ -456,7 +547,7 @@ fn assess_typed<const N: usize>(
     let gravity: Vec<Vector<N>> = g.chunks_exact(N).map(v).collect();
     let a = rule.assess(
         &TypedChain::<N>(kin),
-        orients,
+        task,
         &orbit,
         &targets,
         &gravity,

@@ -1040,7 +1040,8 @@ def placements(
 
 
 REFUSAL_ROWS = 40
-"""Rows of the scenario's joint path at which :func:`refusal_of` checks the arm."""
+"""Rows of the scenario's joint path at which :func:`refusal_of` checks the arm
+(those of the one posture check, ``adaptimp._posture.CHECKED``)."""
 
 
 def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
@@ -1048,41 +1049,39 @@ def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
 
     Along the scenario's joint path (the hold, the approach, the press and one
     circle on the table's surface, as the outer loop maps it, F_e = 0): the
-    core's posture rule (SPEC (16.9), the position rows: not near a
-    singularity, inside the joint limits with margin, gravity at most half of
-    every actuator, the velocity loop well-conditioned at home, the path
-    reachable within 1 mm), no self-collision of the arm, no joint of the
+    one posture check of :func:`adaptimp.mujoco.cartesian_task` and
+    :meth:`adaptimp.CartesianController.from_rule` (SPEC (16.9), the position
+    rows: not near a singularity, inside the joint limits with margin, gravity
+    at most half of every actuator, the velocity loop well-conditioned at home
+    for the table's K1 = 10 s⁻¹, the path reachable within 1 mm, no
+    collision of the arm with itself and the scene, the tool left out), then the table's own: no joint of the
     arm below the table top over the table, and the rule's gains' sampled
     velocity loop stable at every posture of the path (SPEC (19.10),
     :func:`velocity_loop_radius`). ``load``: the largest gravity
     load max_i |G_i|/τmax_i allowed (1 for a home the user gives: gravity
     within the actuators; the press, SPEC (19.6), is checked apart)."""
-    from .. import _adaptimp, tuning
+    from .. import _posture
     from .. import mujoco as amj
 
     start = sc.t_approach + max(sc.t_ramp, sc.t_press)
     _check_path_length(start + 1.0 / sc.freq, sc.Ts)
     steps = round((start + 1.0 / sc.freq) / sc.Ts)
     q, _ = sc.outer().joint_orbit(lambda t: sc.path(t, depth=0.0), steps * sc.Ts, samples=steps)
-    idx = np.unique(np.linspace(0, steps - 1, REFUSAL_ROWS).round().astype(int))
+    idx = _posture.checked_rows(steps)
     rows = np.ascontiguousarray(q[idx])
     targets = np.ascontiguousarray(
         np.array([sc.path(k * sc.Ts, depth=0.0)[0] for k in idx], dtype=np.float64)
     )
     plant = amj.Plant(sc.model, contact=False)
-    gravity = np.array([tuning.gravity(plant, x) for x in rows])
-    lo, hi = _limits(plant)
-    a = _adaptimp.assess_posture(
-        sc.chain, rows, targets, gravity, tuning.inertia(plant, sc.q0), lo, hi,
-        np.asarray(sc.tau_max, dtype=np.float64), False, k1=CONTACT_K1, ts=sc.Ts, load=load,
+    # The one posture check (SPEC (16.9)), at the table's K1; the collisions of
+    # the arm with itself and the rest of the scene (a pedestal, another arm),
+    # the tool on the table left out: that is the task.
+    a = _posture.assess(
+        plant, sc.chain, sc.q0, rows, targets, orients=False, k1=CONTACT_K1, Ts=sc.Ts,
+        load=load, tau_max=sc.tau_max, skip=frozenset({int(plant._ee_body)}),
     )  # fmt: skip
     if a["error"] is not None:
         return str(a["error"])
-    # The arm with itself and with the rest of the scene (a pedestal, another
-    # arm), the tool on the table left out: that is the task.
-    hit = amj.collision(plant, rows, skip=frozenset({int(plant._ee_body)}))
-    if hit is not None:
-        return f"free of collision along the path (with itself and the scene): {hit}"
     through = _through_table(sc, plant, rows)
     if through is not None:
         return through

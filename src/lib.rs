@@ -122,7 +122,7 @@ pub use error::Error;
 pub use impedance::{ImpedanceMode, Reference, TargetImpedance};
 #[cfg(feature = "sim")]
 pub use inject::{Injected, Injection};
-pub use io::{Command, Control, Measurement, TaskTorque, WrenchControl};
+pub use io::{Command, Control, Feedforward, Measurement, TaskTorque, WrenchControl};
 pub use kinematics::{Jacobian6, Kinematics, Tip};
 pub use learning::{Learning, LearningStep, SaturationLearning};
 #[cfg(feature = "sim")]

@@ -323,6 +323,7 @@ class Controller:
         n: int = 2,
         centers: _F | None = None,
         widths2: _F | None = None,
+        gravity: tuple[list[dict[str, Any]], list[dict[str, Any]], Sequence[float]] | None = None,
     ) -> Controller: ...
     @overload
     def step(

@@ -323,6 +323,41 @@ simulate.__doc__ = (simulate.__doc__ or "") + _PARAMS_DOC + describe()
 # ---------------------------------------------------------------------------
 
 
+Gravity = tuple[list[dict[str, Any]], list[dict[str, Any]], list[float]]
+"""A nominal model as the core takes it for (20.10): the chain's joints, their
+inertials and the gravity vector (m/s²)."""
+
+
+def gravity_model(source: Any, n: int) -> Gravity | None:
+    """The nominal model whose gravity a controller of ``n`` joints feeds
+    forward, SPEC (20.10), from ``source``: None (none); a URDF, xacro or MJCF
+    path, a ``mujoco.MjModel`` or an ``adaptimp.mujoco.Plant`` (its model),
+    read by the core (SPEC §21); or the (joints, inertials, gravity) triple
+    itself. A ``ConfigError`` if its arm has not n movable joints; a path
+    that is no file, ``FileNotFoundError``."""
+    if source is None:
+        return None
+    if isinstance(source, tuple) and len(source) == 3:
+        joints, inertials, g = source
+        return list(joints), list(inertials), [float(x) for x in g]
+    if isinstance(source, str) and source == "model":
+        raise ConfigError(
+            "gravity='model' takes the plant's own model: give it to adaptimp.mujoco.simulate "
+            "or CartesianController.from_rule; adaptimp.Controller takes the model itself "
+            "(gravity=PATH, a mujoco.MjModel or an adaptimp.mujoco.Plant)"
+        )
+    from ._description import read_arm
+
+    plant_model = getattr(source, "model", None)
+    arm = read_arm(plant_model if hasattr(source, "_qadr") else source)
+    if arm.n != n:
+        raise ConfigError(
+            f"gravity's model has {arm.n} movable joints ({', '.join(arm.joints)}), the "
+            f"controller {n}"
+        )
+    return list(arm.chain), list(arm.inertials), [float(x) for x in arm.gravity]
+
+
 def _rebuild_controller(state: dict[str, Any]) -> Controller:
     """Unpickle: a controller from the state :meth:`Controller.__reduce__` wrote."""
     with warnings.catch_warnings():
@@ -334,6 +369,7 @@ def _rebuild_controller(state: dict[str, Any]) -> Controller:
             state["params"],
             state["centers"],
             state["widths"],
+            state.get("gravity"),
         )
     ctrl.restore(np.asarray(state["snapshot"], dtype=np.float64))
     return ctrl
@@ -359,6 +395,15 @@ class Controller(_adaptimp.Controller):
         RBF centres (L, 4n) and widths (4n,) instead of the vertex grid (see
         :func:`simulate`); for n > 3 without them, the rule's default basis
         along the commanded trajectory (SPEC §18).
+    gravity : path, MjModel or Plant, optional
+        Feed the nominal model's gravity forward, SPEC (20.10): the law adds
+        G₀(q) (N m) at the measured position, the arm's description read by
+        the core (a URDF, xacro or MJCF path, a ``mujoco.MjModel`` or an
+        ``adaptimp.mujoco.Plant``; its movable joints must be the n of this
+        controller). For a robot that does not compensate gravity itself;
+        None (default, the paper's law) for one that does (Franka's torque
+        interface adds its own model's gravity: feeding it again counts it
+        twice).
     **params
         Controller parameters by name, as for :func:`simulate` (``Ts``, ``Kp``,
         ``K1``, ``Kzeta``, ``gamma``, ``tau_max``, ``xc_offset``, …). The run's,
@@ -415,6 +460,7 @@ class Controller(_adaptimp.Controller):
     _scenario: str
     _centers: FloatArray | None
     _widths: FloatArray | None
+    _gravity: Gravity | None
 
     def __new__(
         cls,
@@ -424,6 +470,7 @@ class Controller(_adaptimp.Controller):
         n: int = N_JOINTS,
         centers: ArrayLike | None = None,
         widths: ArrayLike | None = None,
+        gravity: Any = None,
         **params: Any,
     ) -> Controller:
         check_case(case)
@@ -431,7 +478,7 @@ class Controller(_adaptimp.Controller):
         n = check_n(n)
         p = resolve(params, scenario=scenario, groups=("controller",), caller="Controller()", n=n)
         c, eta = _basis(n, centers, widths, p)
-        self = cls._make(case, scenario, n, p, c, eta)
+        self = cls._make(case, scenario, n, p, c, eta, gravity_model(gravity, n))
         _check_stability(self, p, stacklevel=2)
         return self
 
@@ -444,16 +491,23 @@ class Controller(_adaptimp.Controller):
         p: dict[str, Any],
         centers: FloatArray | None,
         widths: FloatArray | None,
+        gravity: Gravity | None = None,
     ) -> Controller:
         w2 = None if widths is None else np.ascontiguousarray(np.asarray(widths) ** 2)
-        self = _core_controller(case, p, n, centers, w2, cls)
+        self = _core_controller(case, p, n, centers, w2, cls, gravity)
         assert isinstance(self, Controller)
         self._params = dict(p)
         self._params["weight_bound"] = self.weight_bound
         self._scenario = scenario
         self._centers = centers
         self._widths = widths
+        self._gravity = gravity
         return self
+
+    @property
+    def gravity(self) -> bool:
+        """Whether the law feeds a nominal model's gravity forward (SPEC (20.10))."""
+        return self._gravity is not None
 
     def __init__(
         self,
@@ -463,6 +517,7 @@ class Controller(_adaptimp.Controller):
         n: int = N_JOINTS,
         centers: ArrayLike | None = None,
         widths: ArrayLike | None = None,
+        gravity: Any = None,
         **params: Any,
     ) -> None:
         """Everything happens in ``__new__`` (the compiled core is immutable); the
@@ -478,6 +533,7 @@ class Controller(_adaptimp.Controller):
             "params": self._params,
             "centers": self._centers,
             "widths": self._widths,
+            "gravity": self._gravity,
             "snapshot": self.snapshot(),
         }
         return (_rebuild_controller, (state,))

@@ -512,9 +512,10 @@ def _core_controller(
     centers: NDArray[np.float64] | None,
     widths2: NDArray[np.float64] | None,
     cls: type[_adaptimp.Controller] = _adaptimp.Controller,
+    gravity: tuple[list[dict[str, Any]], list[dict[str, Any]], list[float]] | None = None,
 ) -> _adaptimp.Controller:
     try:
         # The compiled constructor, also for the Python subclass Controller.
-        return _adaptimp.Controller.__new__(cls, case, p, n, centers, widths2)
+        return _adaptimp.Controller.__new__(cls, case, p, n, centers, widths2, gravity)
     except ConfigError as e:
         raise with_hint(e, p) from None

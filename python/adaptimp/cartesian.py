@@ -713,7 +713,10 @@ class CartesianController:
             SPEC (18.11) (libfranka: 1); the joint controller's ``delay``.
         **params
             Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
-            and the joint controller's, e.g. ``gamma``).
+            and the joint controller's, e.g. ``gamma``). ``gravity="model"``:
+            the joint controller feeds ``model``'s gravity forward, SPEC
+            (20.10) (an ``adaptimp.mujoco.Plant``; or give the description
+            itself, ``gravity=PATH``), for a robot that does not compensate it.
 
         Raises
         ------
@@ -723,6 +726,13 @@ class CartesianController:
         """
         from . import _posture, tuning
 
+        if params.get("gravity") == "model":
+            if not hasattr(model, "_qadr"):
+                raise ConfigError(
+                    "gravity='model' reads the model's description from an "
+                    "adaptimp.mujoco.Plant: give the arm's file itself, gravity=PATH"
+                )
+            params = {**params, "gravity": model}
         if not isinstance(controller, str):
             raise TypeError(
                 f"from_rule builds a case name's controller ('pd', 'sf', 'of'), got {controller!r}"

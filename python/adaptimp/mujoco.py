@@ -1761,6 +1761,7 @@ def simulate(
     fix: Sequence[str] = (),
     home: ArrayLike | None = None,
     task: CartesianTask | None = None,
+    gravity: str | None = None,
     **params: Any,
 ) -> MujocoResult:
     """Run a controller on a MuJoCo plant: the loop of SPEC §11 with MuJoCo as the plant.
@@ -1851,6 +1852,14 @@ def simulate(
     home : array_like, optional
         The posture (rad, (n,)) the default task swings about, instead of
         :func:`home_posture`'s.
+    gravity : {None, "model"}
+        ``"model"``: a case name's controller (joint space, or the Cartesian
+        one of ``task``) feeds the plant's nominal model's gravity G₀(q)
+        forward, SPEC (20.10), read by the core from the plant's model (the
+        arm without the run's ``payload``): for a robot that does not
+        compensate gravity itself, the arm does not sag while the networks
+        learn. None (default, SPEC's law): gravity is left to the networks,
+        as on a robot that compensates it (Franka).
     **params
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
@@ -1890,6 +1899,8 @@ def simulate(
     >>> res.q.shape, res.params["substeps"]
     ((50, 2), 20)
     """
+    if gravity not in (None, "model"):
+        raise ConfigError(f"gravity must be None or 'model', got {gravity!r}")
     if task is not None:  # the Cartesian task's controller, by the core's rule
         if not isinstance(task, CartesianTask):
             raise TypeError(
@@ -1907,11 +1918,20 @@ def simulate(
             model = Plant(model, contact=contact, tip=tip, fix=fix)
             tip, fix = None, ()
         params = dict(params)
+        if gravity is not None:
+            params["gravity"] = gravity
         delay = loop_delay(params)
         controller, params = task.prepare(
             controller, model, Ts, {**params, "delay": delay}, DISTURBANCES
         )
         q0 = task.q0 if q0 is None else q0
+    elif gravity is not None:
+        if not isinstance(controller, str):
+            raise TypeError(
+                "gravity='model' builds a case name's controller ('pd', 'sf', 'of'); give "
+                "your own controller its gravity itself (adaptimp.Controller(gravity=...))"
+            )
+        params = {**params, "gravity": gravity}
     run = _setup(
         controller, model, T=T, Ts=Ts, substeps=substeps, q0=q0, dq0=dq0, contact=contact,
         settle=settle, scenario=scenario, record_every=record_every, reference=reference,
@@ -2441,6 +2461,8 @@ def _setup(
                 q0 = task.q0
         kwargs.setdefault("tau_max", plant.tau_max.tolist())
         kwargs["delay"] = delay
+        if kwargs.get("gravity") == "model":  # (20.10): the nominal plant's, no payload
+            kwargs["gravity"] = nominal
         if Ts is not None:
             kwargs["Ts"] = Ts
         if plant.n != 2:

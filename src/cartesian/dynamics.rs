@@ -738,7 +738,17 @@ impl<const N: usize> Dynamics<N> {
             }
         }
     }
+}
 
+/// The model's gravity G(q) fed forward by a joint controller, SPEC (20.10)
+/// ([`Controller::with_feedforward`](crate::control::controller::Controller::with_feedforward)).
+impl<const N: usize> crate::control::io::Feedforward<N> for Dynamics<N> {
+    fn torque(&self, q: &Vector<N>) -> Vector<N> {
+        self.gravity_torque(q)
+    }
+}
+
+impl<const N: usize> Dynamics<N> {
     /// M_a(q) v = RNEA₀(q, 0, v) + I_a ⊙ v, without gravity (N m, N), (20.5).
     #[inline]
     pub fn mass_times(&self, q: &Vector<N>, v: &Vector<N>) -> Vector<N> {

@@ -17,6 +17,8 @@
 use crate::control::auxiliary::Auxiliary;
 use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound, MAX_DELAY};
 use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
+#[cfg(feature = "alloc")]
+use crate::control::io::Feedforward;
 use crate::control::io::{Command, Control, Measurement, TaskTorque};
 use crate::control::observer::{HighGainObserver, ObserverState};
 use crate::control::robust::Robust;
@@ -51,6 +53,10 @@ pub struct Controller<const N: usize, B = Grid<N>> {
     learning: Learning,
     /// The weight pass's instruction set, chosen once in [`Controller::new`].
     simd: SimdPath,
+    /// A torque added to the law's at the measured position (the nominal
+    /// model's gravity, SPEC (20.10)); none by default.
+    #[cfg(feature = "alloc")]
+    feedforward: Option<alloc::sync::Arc<dyn Feedforward<N>>>,
 }
 
 /// The errors of one step at t_k, SPEC §5, from the reference and the velocity used.
@@ -201,7 +207,27 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             cfg,
             basis,
             simd: SimdPath::detect(),
+            #[cfg(feature = "alloc")]
+            feedforward: None,
         })
+    }
+
+    /// This controller with `feedforward`'s torque added to the law's at
+    /// every step, SPEC (20.10): τ = τ_law + τ_ff(q) at the measured q, before
+    /// the rate limit and the saturation (Δτ of the auxiliary system includes
+    /// it). The nominal model's gravity (a `cartesian::Dynamics`) for a robot
+    /// that does not compensate it itself; none (the default) for one that
+    /// does, as Franka's torque interface.
+    #[cfg(feature = "alloc")]
+    pub fn with_feedforward(mut self, feedforward: alloc::sync::Arc<dyn Feedforward<N>>) -> Self {
+        self.feedforward = Some(feedforward);
+        self
+    }
+
+    /// The torque fed forward, if any ([`with_feedforward`](Self::with_feedforward)).
+    #[cfg(feature = "alloc")]
+    pub fn feedforward(&self) -> Option<&dyn Feedforward<N>> {
+        self.feedforward.as_deref()
     }
 
     /// The stability conditions of SPEC §10 that [`Config::conditions`]
@@ -785,6 +811,11 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         } else {
             [0.0; 3]
         };
+        // (20.10): the nominal model's gravity at the measured position.
+        #[cfg(feature = "alloc")]
+        if let Some(f) = &self.feedforward {
+            tau += f.torque(&m.x);
+        }
         if tau.iter().any(|t| !t.is_finite()) {
             // Unreachable when the checks hold (SPEC §14); kept so that a
             // non-finite torque is never returned, whatever the cause.

@@ -139,6 +139,17 @@ impl<const N: usize> Command<N> {
     }
 }
 
+/// A torque (N m, per joint) the joint law adds to its own at the measured
+/// position q (rad), before the rate limit and the saturation: the nominal
+/// model's gravity G₀(q) fed forward, SPEC (20.10)
+/// ([`Controller::with_feedforward`](crate::control::controller::Controller::with_feedforward);
+/// a `Dynamics<N>` of the `cartesian` module is one). It must not allocate
+/// and must be finite for a finite q.
+pub trait Feedforward<const N: usize>: core::fmt::Debug + Send + Sync {
+    /// The torque at the measured position `q` (rad).
+    fn torque(&self, q: &Vector<N>) -> Vector<N>;
+}
+
 /// A controller as a closed loop sees it: a period, the target impedance it
 /// realises, and a step from measurement and commanded setpoint to command.
 ///

@@ -487,7 +487,7 @@ fn matrix3(key: &str, v: &Bound<'_, PyAny>) -> PyResult<[[f64; 3]; 3]> {
     }))
 }
 
-fn inertial(d: &Bound<'_, PyDict>) -> PyResult<Inertial> {
+pub(super) fn inertial(d: &Bound<'_, PyDict>) -> PyResult<Inertial> {
     let mass: f64 = match d.get_item("mass")? {
         Some(m) => m.extract()?,
         None => return Err(PyTypeError::new_err("an inertial needs its mass (kg)")),

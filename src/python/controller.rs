@@ -145,15 +145,18 @@ fn refused_arguments(py: Python<'_>, e: &PyErr, g: &mut Write<'_, dyn DynTracker
 impl PyController {
     /// The controller `case` ("pd", "sf", "of") for `n` joints from the
     /// complete parameter dict `params`, with the paper's vertex grid (n ≤ 3)
-    /// or the RBF `centers` (L, 4n) with squared widths `widths2` (4n,).
+    /// or the RBF `centers` (L, 4n) with squared widths `widths2` (4n,);
+    /// `gravity`: (joints, inertials, gravity (3,)) of a nominal model (dicts
+    /// as computed torque takes them) whose G(q) the law adds, SPEC (20.10).
     #[new]
-    #[pyo3(signature = (case, params, n=2, centers=None, widths2=None))]
+    #[pyo3(signature = (case, params, n=2, centers=None, widths2=None, gravity=None))]
     fn new(
         case: &str,
         params: &Bound<'_, PyDict>,
         n: usize,
         centers: Option<PyReadonlyArray2<'_, f64>>,
         widths2: Option<PyReadonlyArray1<'_, f64>>,
+        gravity: Option<(Vec<Bound<'_, PyDict>>, Vec<Bound<'_, PyDict>>, [f64; 3])>,
     ) -> PyResult<Self> {
         let n = check_n(n)?;
         let law = law_of(case)?;
@@ -179,8 +182,41 @@ impl PyController {
                 ))
             }
         };
-        let inner = dynamic::build(n, Preset::Paper, law, &items, centers.as_ref())
-            .map_err(config_error)?;
+        let gravity = match gravity {
+            None => None,
+            Some((joints, inertials, g)) => Some(dynamic::GravitySpec {
+                joints: joints
+                    .iter()
+                    .map(super::frames::joint)
+                    .collect::<PyResult<Vec<_>>>()?,
+                inertials: inertials
+                    .iter()
+                    .map(super::computed::inertial)
+                    .collect::<PyResult<Vec<_>>>()?,
+                gravity: g,
+            }),
+        };
+        if let Some(g) = &gravity {
+            let movable = g
+                .joints
+                .iter()
+                .filter(|j| j.kind != crate::cartesian::chain::JointKind::Fixed)
+                .count();
+            if movable != n {
+                return Err(ConfigError::new_err(format!(
+                    "gravity's model has {movable} movable joints, the controller {n}"
+                )));
+            }
+        }
+        let inner = dynamic::build(
+            n,
+            Preset::Paper,
+            law,
+            &items,
+            centers.as_ref(),
+            gravity.as_ref(),
+        )
+        .map_err(config_error)?;
         Ok(Self::wrap(inner))
     }
 

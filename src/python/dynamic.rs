@@ -109,6 +109,19 @@ pub struct CentersSpec {
     pub widths2: Vec<f64>,
 }
 
+/// The nominal model whose gravity a joint controller feeds forward, SPEC
+/// (20.10): a chain's joints and inertials and the gravity vector, as
+/// computed torque takes them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GravitySpec {
+    /// The chain's joints (fixed ones too).
+    pub joints: Vec<crate::cartesian::chain::Joint>,
+    /// One inertial per joint.
+    pub inertials: Vec<crate::cartesian::dynamics::Inertial>,
+    /// Gravity (m/s², base frame).
+    pub gravity: [f64; 3],
+}
+
 /// The arm a run's plant is built from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ArmSpec {
@@ -763,17 +776,19 @@ pub struct Tables<'a> {
 pub(crate) type Typed<const N: usize> = Tracker<N, AnyBasis<N>, Sinusoid<N>>;
 
 /// Build the controller `law` for n joints from `preset` and `items`, with the
-/// paper's grid (n ≤ 3) or `centers`.
+/// paper's grid (n ≤ 3) or `centers`, feeding forward `gravity`'s G(q) if
+/// given (SPEC (20.10)).
 pub fn build(
     n: usize,
     preset: Preset,
     law: Law,
     items: &Items,
     centers: Option<&CentersSpec>,
+    gravity: Option<&GravitySpec>,
 ) -> Result<Box<dyn DynTracker>, ParamError> {
     crate::with_joints!(
         n,
-        K => Ok(Box::new(build_n::<K>(preset, law, items, centers)?)),
+        K => Ok(Box::new(build_n::<K>(preset, law, items, centers, gravity)?)),
         _ => Err(Error::Invalid {
             what: "n",
             reason: "the number of joints must be between 1 and 7",
@@ -787,6 +802,7 @@ fn build_n<const N: usize>(
     law: Law,
     items: &Items,
     centers: Option<&CentersSpec>,
+    gravity: Option<&GravitySpec>,
 ) -> Result<Typed<N>, ParamError> {
     let s = scenario::<N>(preset, law, items)?;
     let traj = s.trajectory()?;
@@ -807,7 +823,12 @@ fn build_n<const N: usize>(
             AnyBasis::Centers(Centers::new(c.centers.clone(), w)?)
         }
     };
-    let ctrl = Controller::for_trajectory(s.config, basis, &traj)?;
+    let mut ctrl = Controller::for_trajectory(s.config, basis, &traj)?;
+    if let Some(g) = gravity {
+        let model =
+            crate::cartesian::dynamics::Dynamics::<N>::new(&g.joints, &g.inertials, g.gravity)?;
+        ctrl = ctrl.with_feedforward(std::sync::Arc::new(model));
+    }
     Ok(Tracker::new(ctrl, traj))
 }
 

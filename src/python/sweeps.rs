@@ -45,7 +45,7 @@ pub(super) fn run_job(
 ) -> Result<dynamic::MetricsOut, String> {
     let job = job.as_ref().map_err(Clone::clone)?;
     let mut tracker =
-        dynamic::build(2, Preset::Paper, job.law, &job.items, None).map_err(param_message)?;
+        dynamic::build(2, Preset::Paper, job.law, &job.items, None, None).map_err(param_message)?;
     let mut hooks = StopHooks(stop);
     tracker
         .simulate(&job.arm, &job.items, None, None, u64::MAX, &mut hooks)

@@ -49,7 +49,8 @@ def test_the_first_torque_at_rest_is_the_model_s_gravity(plant: amj.Plant) -> No
     # millimetre without the feedforward, and by nothing with it.
     off = amj.simulate("sf", plant, T=1.0, task=task)
     on = amj.simulate("sf", plant, T=1.0, task=task, gravity="model")
-    assert off.pos_err is not None and on.pos_err is not None
+    assert off.pos_err is not None
+    assert on.pos_err is not None
     assert np.max(off.pos_err) > 5e-4
     assert np.max(on.pos_err) < 1e-5
 

@@ -393,7 +393,15 @@ fn bad_descriptions_are_refused_by_name() {
     assert_eq!(
         e.to_string(),
         "URDF text: tip= 'l9' is neither a link nor a frame of it: name the link (a MuJoCo \
-         body) or the frame (a site) that ends the arm"
+         body) or the frame (a site) that ends the arm; its 7 links and 0 frames, closest \
+         first: ['l1', 'l2', 'l3', 'l4', 'l5', 'l6', 'root']"
+    );
+    // Closest first: a misspelt link name leads the list.
+    let e = reduce(&tree, Some("L_5"), &[]).unwrap_err();
+    assert!(
+        e.to_string()
+            .ends_with("closest first: ['l5', 'l1', 'l2', 'l3', 'l4', 'l6', 'root']"),
+        "{e}"
     );
     let e = reduce(&tree, None, &["a9"]).unwrap_err();
     assert_eq!(

@@ -175,10 +175,22 @@ def test_a_quadruped_is_refused_unless_the_leg_is_named() -> None:
     assert adaptimp.Chain.from_urdf(SOLO, tip="HR_LOWER_LEG").joint_names == list(leg)
     paw = (
         "URDF 'solo12.urdf': tip= 'paw' is neither a link nor a frame of it: name the link "
-        "(a MuJoCo body) or the frame (a site) that ends the arm"
+        "(a MuJoCo body) or the frame (a site) that ends the arm; its 17 links and 0 frames, "
+        "closest first: ['base_link', 'FL_UPPER_LEG', 'FL_LOWER_LEG', 'FR_UPPER_LEG', "
+        "'FR_LOWER_LEG', 'HL_UPPER_LEG', 'HL_LOWER_LEG', 'HR_UPPER_LEG', 'HR_LOWER_LEG', "
+        "'FL_FOOT', 'FR_FOOT', 'HL_FOOT', 'HR_FOOT', 'FL_SHOULDER', 'FR_SHOULDER', "
+        "'HL_SHOULDER', 'HR_SHOULDER']"
     )
     with pytest.raises(adaptimp.ConfigError, match=f"^{re.escape(paw)}$"):
         read_arm(SOLO, tip="paw")
+    # A misspelt tip: the link meant leads the list (issue 45).
+    with pytest.raises(adaptimp.ConfigError) as e:
+        amj.Plant(str(_models.panda_urdf_path()), tip="panda_tcp")
+    assert str(e.value).startswith(
+        "URDF 'panda.urdf': tip= 'panda_tcp' is neither a link nor a frame of it: name the "
+        "link (a MuJoCo body) or the frame (a site) that ends the arm; its 13 links and 0 "
+        "frames, closest first: ['panda_hand_tcp', "
+    )
 
 
 def test_the_contact_scenario_drives_the_joints_simulate_drives() -> None:

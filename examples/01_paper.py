@@ -9,7 +9,9 @@ instead of the paper's 20 s.
 
 from __future__ import annotations
 
+import argparse
 import os
+import textwrap
 
 import adaptimp
 from adaptimp._params import CASE_NAMES
@@ -23,4 +25,11 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    # --help: what the example does and how to run it (it takes no arguments).
+    doc = (__doc__ or "").split("\n\n")
+    argparse.ArgumentParser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(p for p in doc[1:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    ).parse_args()
     main()

@@ -3,8 +3,10 @@
 Runs state and output feedback at Ts = 1 ms (M = 10 RK4 substeps) twice: with
 the laws as printed (``scenario="paper", Ts=1e-3, substeps=10``) and with the
 hardened options of SPEC §13 (``scenario="robot"``), prints the SPEC §12
-metrics and writes ``docs/figures/robot_1khz.png``: the tracking error of
-joint 1 and the commanded torque of joint 1 for each.
+metrics and writes a figure, by default ``out/robot_1khz.png``: the
+tracking error of joint 1 and the commanded torque of joint 1 for each
+(docs/robot.md's is ``python examples/02_robot_1khz.py
+docs/figures/robot_1khz.png``).
 
     python examples/02_robot_1khz.py [output.png]
 
@@ -13,8 +15,9 @@ Mirrored in Rust by ``examples/02_robot_1khz.rs``. ``ADAPTIMP_QUICK=1`` runs 3 s
 
 from __future__ import annotations
 
+import argparse
 import os
-import sys
+import textwrap
 import warnings
 from pathlib import Path
 
@@ -82,5 +85,14 @@ def main(out: Path) -> None:
 
 
 if __name__ == "__main__":
-    default = Path(__file__).resolve().parent.parent / "docs" / "figures" / "robot_1khz.png"
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else default)
+    doc = (__doc__ or "").split("\n\n")
+    parser = argparse.ArgumentParser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(doc[1:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "output", nargs="?", type=Path, default=Path("out") / "robot_1khz.png",
+        help="the figure (default: out/robot_1khz.png)",
+    )  # fmt: skip
+    main(parser.parse_args().output)

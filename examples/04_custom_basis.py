@@ -14,7 +14,9 @@ Mirrored in Rust by ``examples/04_custom_basis.rs``. ``ADAPTIMP_QUICK=1`` shorte
 
 from __future__ import annotations
 
+import argparse
 import os
+import textwrap
 
 import numpy as np
 
@@ -46,4 +48,11 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    # --help: what the example does and how to run it (it takes no arguments).
+    doc = (__doc__ or "").split("\n\n")
+    argparse.ArgumentParser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(p for p in doc[1:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    ).parse_args()
     main()

@@ -15,9 +15,11 @@ warm-start a new run with it.
 
 from __future__ import annotations
 
+import argparse
 import os
 import pickle
 import tempfile
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -58,4 +60,11 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    # --help: what the example does and how to run it (it takes no arguments).
+    doc = (__doc__ or "").split("\n\n")
+    argparse.ArgumentParser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(p for p in doc[1:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    ).parse_args()
     main()

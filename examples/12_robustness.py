@@ -6,8 +6,9 @@ last link (0 … 2 kg, the plant's only: the controllers are model-free), sensor
 noise on q and q̇ (σ_q = 0 … 2 mrad, σ_q̇ = 50 σ_q /s, seeded), and a
 measurement delay (0 … 8 steps). Two sweeps on every core, drawn as heatmaps of
 the RMS tracking error (t ≥ 2 s) and the saturation duty, written to
-``docs/figures/robustness_noise.png`` and ``docs/figures/robustness_delay.png``
-(or the directory given), and the tables printed.
+``robustness_noise.png`` and ``robustness_delay.png`` in the directory given
+(default ``out/``; docs/sweeps.md's are ``python examples/12_robustness.py
+docs/figures``), and the tables printed.
 
     python examples/12_robustness.py [output_dir]
 
@@ -18,8 +19,10 @@ Needs the extra ``sweep`` (pandas; from a checkout: ``pip install ".[sweep]"``).
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -117,5 +120,14 @@ def main(out_dir: Path) -> None:
 
 
 if __name__ == "__main__":
-    default = Path(__file__).resolve().parent.parent / "docs" / "figures"
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else default)
+    doc = (__doc__ or "").split("\n\n")
+    parser = argparse.ArgumentParser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(doc[1:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "output", nargs="?", type=Path, default=Path("out"),
+        help="the directory of the figures (default: out)",
+    )  # fmt: skip
+    main(parser.parse_args().output)

@@ -47,14 +47,17 @@ share of steps that saturate.
     python examples/13_panda_table.py --friction 0         # a frictionless table
     python examples/13_panda_table.py --spring 5000        # a table on a 5 kN/m spring
     python examples/13_panda_table.py --arm path/to/ur5_robot.urdf --json ur5.json
-    python examples/13_panda_table.py --figure             # docs/figures/contact_force.png
+    python examples/13_panda_table.py --figure --out out   # out/contact_force.png, of the arm run
     python examples/13_panda_table.py --long 120           # and a long SF run, weight norms
     python examples/13_panda_table.py --jobs 1             # the rows one after another
 
 The rows run at once on threads, one per core (``--jobs``): each is its own
 plant and controller in the core's loop, which releases the GIL; the table
 is the same to the bit whatever ``--jobs``. The time column is each row's
-own (they overlap); the last line gives the table's wall time.
+own (they overlap); the last line gives the table's wall time. On a terminal
+a progress bar counts the rows' steps (the extra ``progress``: tqdm). A
+wrong argument or an arm the table cannot run is one line on stderr, exit
+status 2.
 
 Needs the extras ``mujoco`` and ``pinocchio`` (from a checkout:
 ``pip install ".[mujoco,pinocchio]"``). ``ADAPTIMP_QUICK=1``: T = 2.5 s.
@@ -67,10 +70,13 @@ import json
 import math
 import os
 import sys
+import textwrap
+import threading
 import time
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -81,24 +87,9 @@ from adaptimp.scenarios import panda_table as apt
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
 """``ADAPTIMP_QUICK=1``: T = 2.5 s (the tool is pressed in at 1.8 s)."""
-LEARN_KEYS = ("gamma", "sigma", "weight_bound")
-"""The rule's learning keywords; the rows without learning (PD, SF with +τe and Γ = 1)
-leave them out."""
-SHARE = 0.3
-"""The admittance's share n of the unified rows (docs/contact.md)."""
-# name: (label, joint controller, formulation, +τe feedforward, learning)
-ROWS: dict[str, tuple[str, str, str, bool, bool]] = {
-    "pd": ("PD, admittance", "pd", "admittance", False, False),
-    "sf-printed": ("SF with +τe, Γ = 1, admittance", "sf", "admittance", True, False),
-    "sf-admittance": ("SF, admittance, no τe feedforward", "sf", "admittance", False, True),
-    "sf": (f"SF, unified n = {SHARE}", "sf", "unified", False, True),
-    "of": (f"OF, unified n = {SHARE}", "of", "unified", False, True),
-    "sf-ff": (f"SF with +τe, unified n = {SHARE}", "sf", "unified", True, True),
-    "sf-impedance": ("SF, impedance", "sf", "impedance", False, True),
-    "ct-admittance": ("CT exact, admittance (+τe)", "ct", "admittance", True, False),
-    "ct": ("CT exact, impedance", "ct", "impedance", False, False),
-    "ct+30": ("CT +30 % mass, impedance", "ct+30", "impedance", False, False),
-}
+ROWS = act.TABLE_ROWS
+"""The table's rows (adaptimp.scenarios.contact.TABLE_ROWS): name: (label, joint
+controller, formulation, +τe feedforward, learning)."""
 GRAVITY_LEARNING = {
     "gamma": [1.0, 1.0, 5000.0],
     "sigma": [0.01, 0.01, 1e-5],
@@ -128,50 +119,87 @@ KEYS = (
     "peak_tau_ratio",
     "sat_duty",
 )
-FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "contact_force.png"
+FIGURE = "contact_force.png"
+"""The figure ``--figure`` writes into ``--out``."""
 
 
-def controller(name: str, sc: apt.PandaTable, rule: dict[str, Any]) -> Any:
-    """The controller of one row on the scenario; ``rule``: the scenario's
-    :func:`adaptimp.contact.rule_keywords`."""
-    _, kind, formulation, ff, learn = ROWS[name]
-    extra: dict[str, Any] = {}
-    if formulation == "unified":
-        extra["admittance_share"] = SHARE
-    if kind in ("pd", "sf", "of"):
-        extra.update({k: v for k, v in rule.items() if learn or k not in LEARN_KEYS})
-    elif "Md" in rule:  # the scenario's target inertia (SPEC (19.8)), whatever the joint law
-        extra["Md"] = rule["Md"]
-    return apt.panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
+class Parser(argparse.ArgumentParser):
+    """A usage error is one line (``prog: error: …``), exit status 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+class Progress:
+    """One progress bar on a terminal for rows that run at once (tqdm, the extra
+    ``progress``; without it a line per finished row): :meth:`of` is a row's
+    ``progress(done, total)`` for :func:`adaptimp.mujoco.simulate`."""
+
+    def __init__(self, rows: int, steps: int, desc: str) -> None:
+        self.bar: Any = None
+        self.shown = sys.stderr.isatty()
+        self.done: dict[str, int] = {}
+        self.lock = threading.Lock()
+        if self.shown:
+            try:
+                from tqdm import tqdm
+            except ImportError:
+                return
+            self.bar = tqdm(total=rows * steps, desc=desc, unit="step", unit_scale=True)
+
+    def of(self, row: str) -> Any:
+        if not self.shown:
+            return None
+
+        def report(done: int, total: int) -> None:
+            with self.lock:
+                if self.bar is not None:
+                    self.bar.update(done - self.done.get(row, 0))
+                elif done == total:
+                    print(f"  {row}: done", file=sys.stderr, flush=True)
+                self.done[row] = done
+
+        return report
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def run(
-    name: str, sc: apt.PandaTable, rule: dict[str, Any], T: float
+    name: str, sc: apt.PandaTable, rule: dict[str, Any], T: float, progress: Any = None
 ) -> tuple[Any, Any, dict[str, float]]:
     """One row on the scenario: (result, controller, metrics)."""
-    ctrl = controller(name, sc, rule)
-    res = amj.simulate(ctrl, amj.Plant(sc.model), T=T, q0=sc.q0)
-    return res, ctrl, act.contact_metrics(res, ctrl, sc, settle=min(2.0, T / 2))
+    return act.run_row(name, sc, rule, T, progress=progress)
 
 
-def figure(path: Path, T: float) -> None:
-    """Normal force against time, old (admittance) and new formulations, on the
-    Panda's table without and with friction."""
+def figure(
+    path: Path, T: float, build: Callable[[float], apt.PandaTable], arm: str, frictions: list[float]
+) -> None:
+    """Normal force against time, the admittance with the +τe feedforward and the
+    new formulations, on the table of the arm that was run (``build(friction)``:
+    its scenario, home, tip and spring), at each of ``frictions``."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 1, figsize=(11, 7), sharex=True, layout="constrained")
-    for ax, friction in zip(axes, (0.0, 0.1), strict=True):
-        sc = act.arm_table(friction=friction)
+    fig, axes = plt.subplots(
+        len(frictions), 1, figsize=(11, 3.5 * len(frictions) + 0.5), sharex=True,
+        layout="constrained", squeeze=False,
+    )  # fmt: skip
+    for ax, friction in zip(axes[:, 0], frictions, strict=True):
+        sc = build(friction)
         rule = act.rule_keywords(sc)
-        for name, color, lw in (
+        rows = [
             ("sf-printed", "tab:red", 0.5),
             ("ct-admittance", "tab:orange", 0.5),
             ("sf", "tab:blue", 0.9),
             ("ct", "tab:green", 0.9),
-        ):
+        ]
+        for name, color, lw in rows:
+            if sc.pin_model is None and ROWS[name][1].startswith("ct"):
+                continue  # computed torque's model is Pinocchio's, read from a URDF
             res, _, m = run(name, sc, rule, T)
             ax.plot(
                 res.t,
@@ -181,11 +209,11 @@ def figure(path: Path, T: float) -> None:
                 label=f"{ROWS[name][0]}: chatter {m['force_chatter_N']:.2f} N",
             )
         ax.axhline(sc.target_force(), color="k", ls="--", lw=1, label="K_d δ_c")
-        ax.set_ylim(-2, 30)
+        ax.set_ylim(-2, 4 * sc.target_force())
         ax.set_ylabel("normal force F_n (N)")
-        ax.set_title(f"Panda on a rigid table, sliding friction {friction:g}")
+        ax.set_title(f"{arm} on a rigid table, sliding friction {friction:g}")
         ax.legend(loc="upper right", fontsize=7)
-    axes[-1].set_xlabel("t (s)")
+    axes[-1, 0].set_xlabel("t (s)")
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -195,7 +223,7 @@ def long_run(sc: apt.PandaTable, rule: dict[str, Any], T: float) -> None:
     """SF (unified, n = SHARE) for T seconds, in parts of 10 s in the core's loop
     (the plant and the controller go on from one part to the next: the rows of
     one run); prints ‖Ŵ‖_F and the mean normal force every 10 s."""
-    ctrl = controller("sf", sc, rule)
+    ctrl = act.row_controller("sf", sc, rule)
     plant = amj.Plant(sc.model)
     print(f"\nlong run, {ROWS['sf'][0]}, T = {T:g} s: weight norms, mean normal force")
     print("| t (s) | ‖W_D‖ | ‖W_C‖ | ‖W_G‖ | mean F_n over the last 10 s (N) |")
@@ -304,7 +332,12 @@ def posture(text: str) -> list[float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    doc = (__doc__ or "").split("\n\n")
+    parser = Parser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(p for p in doc if p.startswith("    python")),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument(
         "--arm", type=str, default=None, help="URDF or MJCF file of the arm (default: Panda)"
     )
@@ -339,7 +372,15 @@ def main() -> None:
     parser.add_argument("--friction", type=float, default=0.1, help="sliding friction")
     parser.add_argument("--spring", type=float, default=None, help="table spring k_e (N/m)")
     parser.add_argument("--rows", type=str, default=None, help="rows to run (default: all)")
-    parser.add_argument("--figure", action="store_true", help=f"write {FIGURE.name}")
+    parser.add_argument(
+        "--figure",
+        action="store_true",
+        help=f"also write {FIGURE} into --out: the normal force of the arm run, without "
+        "friction and at --friction",
+    )
+    parser.add_argument(
+        "--out", type=Path, default=Path("out"), help="where --figure writes (default: out)"
+    )
     parser.add_argument("--long", type=float, default=0.0, help="also a long SF run (s)")
     parser.add_argument(
         "--jobs",
@@ -414,9 +455,16 @@ def main() -> None:
     if args.json:
         Path(args.json).write_text(json.dumps(table, indent=2) + "\n")
         print(f"\nwrote {args.json}")
-    if args.figure and not QUICK:
-        figure(FIGURE, args.T)
-        print(f"\nwrote {FIGURE}")
+    if args.figure:
+        home = {"home": scenarios[0][1].q0} if args.arm is not None else {}
+
+        def build(friction: float) -> apt.PandaTable:
+            return act.arm_table(args.arm, spring=args.spring, friction=friction, **where, **home)
+
+        path = args.out / FIGURE
+        frictions = sorted({0.0, args.friction})
+        figure(path, args.T, build, Path(args.arm).name if args.arm else "Panda", frictions)
+        print(f"\nwrote {path}")
     if args.long > 0:
         sc = scenarios[0][1]
         long_run(sc, act.rule_keywords(sc), args.long)
@@ -443,11 +491,11 @@ def run_table(
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     table: dict[str, dict[str, Any]] = {}
 
-    def timed(name: str) -> tuple[dict[str, float] | None, float, str]:
+    def timed(name: str, progress: Any) -> tuple[dict[str, float] | None, float, str]:
         """One row: its metrics (None if it diverged), its own time (s), the error."""
         t0 = time.perf_counter()
         try:
-            _, _, m = run(name, sc, rule, args.T)
+            _, _, m = run(name, sc, rule, args.T, progress)
         except adaptimp.DivergedError as e:
             return None, time.perf_counter() - t0, str(e).splitlines()[0]
         return m, time.perf_counter() - t0, ""
@@ -455,8 +503,12 @@ def run_table(
     # The rows are independent runs: on every core at once (each its own
     # plant and controller; the model is shared read-only), printed in order.
     start = time.perf_counter()
-    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        results = list(pool.map(timed, names))
+    bar = Progress(len(names), round(args.T / sc.Ts), f"{len(names)} rows")
+    try:
+        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            results = list(pool.map(lambda name: timed(name, bar.of(name)), names))
+    finally:
+        bar.close()
     wall = time.perf_counter() - start
     for name, (m, took, error) in zip(names, results):
         if m is None:

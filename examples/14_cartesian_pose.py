@@ -15,8 +15,10 @@ prescribes, (16.1), and the torques. ``ADAPTIMP_QUICK=1``: 1.2 s.
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
+import textwrap
 
 import numpy as np
 
@@ -131,4 +133,11 @@ def angle(r: np.ndarray) -> float:
 
 
 if __name__ == "__main__":
+    # --help: what the example does and how to run it (it takes no arguments).
+    doc = (__doc__ or "").split("\n\n")
+    argparse.ArgumentParser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(p for p in doc[1:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    ).parse_args()
     main()

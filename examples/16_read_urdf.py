@@ -14,6 +14,8 @@ compiled by MuJoCo (the extra ``mujoco``).
 from __future__ import annotations
 
 import argparse
+import textwrap
+from typing import NoReturn
 
 import adaptimp
 from adaptimp._description import read_arm
@@ -47,14 +49,29 @@ URDF = (
 )
 
 
+class Parser(argparse.ArgumentParser):
+    """A usage error is one line (``prog: error: …``), exit status 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    doc = (__doc__ or "").split("\n\n")
+    parser = Parser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(doc[1:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument("path", nargs="?", help="a URDF, xacro or MJCF file (default: the text)")
     parser.add_argument("--tip", help="the link (or site) that ends the arm")
     parser.add_argument("--fix", action="append", default=[], help="a joint to hold")
     args = parser.parse_args()
     source = args.path if args.path else URDF
-    arm = read_arm(source, tip=args.tip, fix=tuple(args.fix))
+    try:
+        arm = read_arm(source, tip=args.tip, fix=tuple(args.fix))
+    except (OSError, ValueError, ImportError) as e:  # a path, tip or joint it does not have
+        parser.error(str(e))
     print(f"{arm.source}: n = {arm.n}, tip {arm.tip!r}")
     for name, lo, hi, effort, damping, friction in zip(
         arm.joints, arm.lower, arm.upper, arm.effort, arm.damping, arm.friction

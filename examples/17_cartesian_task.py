@@ -23,6 +23,8 @@ the rule, one change at a time (SPEC §16, "Why the networks barely learned").
     python examples/17_cartesian_task.py --why
 
 Needs the extras ``mujoco`` and ``pinocchio``. ``ADAPTIMP_QUICK=1``: T = 3 s.
+On a terminal each run longer than 2 s shows a progress bar (the extra
+``progress``: tqdm); a wrong argument or path is one line on stderr.
 """
 
 from __future__ import annotations
@@ -31,9 +33,11 @@ import argparse
 import json
 import math
 import os
+import sys
+import textwrap
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -43,13 +47,24 @@ from adaptimp import mujoco as amj
 from adaptimp.cartesian import CartesianImpedance
 
 QUICK = os.environ.get("ADAPTIMP_QUICK") == "1"
+PROGRESS = sys.stderr.isatty()
+"""A progress bar for runs longer than 2 s, on a terminal only."""
+
+
+class Parser(argparse.ArgumentParser):
+    """A usage error is one line (``prog: error: …``), exit status 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message}\n")
 
 
 def measure(path: str, T: float) -> dict[str, Any]:
     """PD and SF on the arm's default Cartesian task: the row of the table."""
     t0 = time.perf_counter()
     task = amj.cartesian_task(path)
-    runs = {case: amj.simulate(case, path, T=T, task=task) for case in ("pd", "sf")}
+    runs = {
+        case: amj.simulate(case, path, T=T, task=task, progress=PROGRESS) for case in ("pd", "sf")
+    }
     pd, sf = (runs[c].metrics for c in ("pd", "sf"))
     peak = max(
         float(np.max(np.abs(r.tau) / np.asarray(r.params["tau_max"]))) for r in runs.values()
@@ -114,7 +129,12 @@ def why(path: str, T: float) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    doc = (__doc__ or "").split("\n\n")
+    parser = Parser(
+        description=textwrap.fill(" ".join(doc[0].split()), 79),
+        epilog="\n\n".join(p for p in doc if p.startswith("    python")),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument("arms", nargs="*", help="URDF or MJCF files (default: the Panda)")
     parser.add_argument("--T", type=float, default=3.0 if QUICK else 12.0, help="duration (s)")
     parser.add_argument("--json", type=str, default=None, help="write the table as JSON here")
@@ -123,6 +143,9 @@ def main() -> None:
     if not (math.isfinite(args.T) and args.T > 2.0):
         parser.error(f"--T must be a finite number > 2 s (the metrics' window), got {args.T}")
     arms = args.arms or [str(_models.panda_urdf_path())]
+    missing = [a for a in arms if not Path(a).is_file()]
+    if missing:
+        parser.error(f"no file {missing[0]!r}")
     if args.why:
         why(arms[0], args.T)
         return

@@ -157,7 +157,7 @@ def test_the_chain_to_a_body_or_a_site_is_mujocos() -> None:
     assert adaptimp.Chain.from_mujoco(UR5).source == "MuJoCo model to body 'wrist_3_link'"
     with pytest.raises(adaptimp.ConfigError, match="no site or body of that name"):
         adaptimp.Chain.from_mujoco(UR5, tip="nowhere")
-    with pytest.raises(adaptimp.ConfigError, match=r"no file 'nowhere\.xml'"):
+    with pytest.raises(FileNotFoundError, match=r"no file 'nowhere\.xml'"):
         adaptimp.Chain.from_mujoco("nowhere.xml")
 
 

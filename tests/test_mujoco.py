@@ -235,7 +235,7 @@ def test_plant_rejects_models_it_cannot_drive() -> None:
     branches = _LINK.format(n="j0", t="hinge", inner="") + _LINK.format(n="j1", t="hinge", inner="")
     with pytest.raises(ValueError, match=r"2 serial chains of 1 joints from the root tie .* tip="):
         amj.Plant(_mjcf(branches, _motors(2)))
-    with pytest.raises(ValueError, match=r"no file 'nowhere\.xml'"):
+    with pytest.raises(FileNotFoundError, match=r"no file 'nowhere\.xml'"):
         amj.Plant("nowhere.xml")
 
 

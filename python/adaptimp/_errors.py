@@ -101,3 +101,10 @@ def needs_extra(what: str, package: str, extra: str) -> ImportError:
         f'pip install "{package}"; or adaptimp with the extra: pip install ".[{extra}]" '
         f'from a checkout, pip install "adaptimp-<version>-<tags>.whl[{extra}]" from a wheel'
     )
+
+
+def no_file(what: str, path: object) -> FileNotFoundError:
+    """The error of a path that is no file, the same wherever a file is read:
+    ``FileNotFoundError`` whose text says what was expected there and names
+    the path."""
+    return FileNotFoundError(f"{what}; no file {str(path)!r}")

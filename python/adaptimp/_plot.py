@@ -279,41 +279,67 @@ def contact(res: MujocoRun) -> Figure:
     return fig
 
 
+def _coordinates(res: MujocoRun, width: int) -> list[tuple[str, str]]:
+    """The name and unit of each of ``width`` coordinates of a MuJoCo run: the
+    joints by their names in the model (rad) for a joint-space quantity, the
+    world axes x, y, z (m) for a task-space one (a Cartesian controller's xc,
+    xd, z1)."""
+    joints = list(res.params.get("joints") or [])
+    if width == res.q.shape[1]:
+        names = joints if len(joints) == width else [f"joint {i + 1}" for i in range(width)]
+        return [(name, "rad") for name in names]
+    if width == 3:
+        return [(axis, "m") for axis in "xyz"]
+    return [(f"x{i + 1}", "") for i in range(width)]
+
+
+def _unit(unit: str) -> str:
+    return f" ({unit})" if unit else ""
+
+
 def mujoco_tracking(res: MujocoRun) -> Figure:
-    """xc and xd, and q where the reference is in joint space, per coordinate."""
+    """xc and xd per coordinate, with q where the reference is in joint space
+    (each joint by its name in the model, rad) and the tip's position where it
+    is in task space (the world axes, m)."""
     n = res.z1.shape[1]
     fig, axes = _figure(_mujoco_title(res, "tracking"), rows=n)
-    for i, ax in enumerate(axes):
+    tip = getattr(res, "x_ee", None)
+    for i, ((name, unit), ax) in enumerate(zip(_coordinates(res, n), axes)):
         ax.plot(res.t, res.xc[:, i], color="k", lw=1.0, ls="--", label="xc, commanded")
         ax.plot(res.t, res.xd[:, i], color="tab:orange", lw=1.2, label="xd, compliant reference")
         if res.q.shape[1] == n:
             ax.plot(res.t, res.q[:, i], color="tab:blue", lw=1.0, label="q, arm")
-        ax.set_ylabel(f"x{i + 1}")
+        elif n == 3 and tip is not None:
+            ax.plot(res.t, tip[:, i], color="tab:blue", lw=1.0, label="p, the tip")
+        ax.set_ylabel(f"{name}{_unit(unit)}")
     _legend(fig, axes[0], ncol=3)
     return fig
 
 
 def mujoco_errors(res: MujocoRun) -> Figure:
-    """The tracking error z1 = xd − x per coordinate."""
-    fig, axes = _figure(_mujoco_title(res, "errors"), rows=res.z1.shape[1])
-    for i, ax in enumerate(axes):
+    """The tracking error z1 = xd − x per coordinate (each joint by its name,
+    rad; or the world axes, m)."""
+    n = res.z1.shape[1]
+    fig, axes = _figure(_mujoco_title(res, "errors"), rows=n)
+    for i, ((name, unit), ax) in enumerate(zip(_coordinates(res, n), axes)):
         ax.plot(res.t, res.z1[:, i], color="tab:blue", lw=0.9, label="z1 = xd − x")
-        ax.set_ylabel(f"z1,{i + 1}")
+        ax.set_ylabel(f"z1, {name}{_unit(unit)}")
     _legend(fig, axes[0], ncol=3)
     return fig
 
 
 def mujoco_torques(res: MujocoRun) -> Figure:
-    """Commanded and applied torque per joint, with ±τmax."""
-    fig, axes = _figure(_mujoco_title(res, "torques"), rows=res.q.shape[1])
-    for i, ax in enumerate(axes):
+    """Commanded and applied torque per joint (by its name, N m), with ±τmax."""
+    n = res.q.shape[1]
+    fig, axes = _figure(_mujoco_title(res, "torques"), rows=n)
+    for i, ((name, _), ax) in enumerate(zip(_coordinates(res, n), axes)):
         m = float(res.params["tau_max"][i])
         ax.plot(res.t, res.tau[:, i], color="tab:orange", lw=0.7, label="τ, commanded")
         ax.plot(res.t, res.tau_sat[:, i], color="tab:blue", lw=0.9, label="sat(τ), applied")
         ax.axhline(m, color="tab:red", lw=1.0, ls="--", label="±τmax")
         ax.axhline(-m, color="tab:red", lw=1.0, ls="--")
         ax.set_ylim(-1.6 * m, 1.6 * m)
-        ax.set_ylabel(f"τ{i + 1} (N m)")
+        ax.set_ylabel(f"τ, {name} (N m)")
     _legend(fig, axes[0], ncol=3)
     return fig
 

@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._adaptimp import Measurement
-from ._errors import ConfigError, needs_extra, period_alias
+from ._errors import ConfigError, needs_extra, no_file, period_alias
 
 try:
     import pinocchio as pin
@@ -100,9 +100,10 @@ def _arm(source: Any, tip: str | None, fix: Sequence[str]) -> Any:
             )
         return read_arm(_models.panda_urdf_path(), _models.PANDA_EE, _models.PANDA_FINGERS)
     if _is_file(source) and not Path(source).is_file():
-        raise ValueError(
-            f"source must be 'two_link', 'panda', a URDF or MJCF path, a mujoco.MjModel or a "
-            f"pinocchio.Model; no file {str(source)!r}"
+        raise no_file(
+            "source must be 'two_link', 'panda', a URDF or MJCF path, a mujoco.MjModel or a "
+            "pinocchio.Model",
+            source,
         )
     arm = read_arm(source, tip, fix)
     say_balanced(arm, stacklevel=5)

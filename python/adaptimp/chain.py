@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
-from ._errors import ConfigError
+from ._errors import ConfigError, no_file
 
 __all__ = ["Chain"]
 
@@ -204,10 +204,7 @@ class Chain(_adaptimp.Chain):
         if not isinstance(model, mujoco.MjModel):
             path = Path(model)
             if not path.is_file():
-                raise ConfigError(
-                    "model must be an MjModel or the path of an MJCF or URDF file; "
-                    f"no file {str(path)!r}"
-                )
+                raise no_file("model must be an MjModel or the path of an MJCF or URDF file", path)
             if path.suffix.lower() in (".urdf", ".xacro"):
                 if tip is not None and not isinstance(tip, str):
                     raise ConfigError(f"the tip of a URDF is a link's name, got {tip!r}")

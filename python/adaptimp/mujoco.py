@@ -53,7 +53,7 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._errors import ConfigError, PlantWarning, needs_extra
+from ._errors import ConfigError, PlantWarning, needs_extra, no_file
 from ._inputs import reals
 
 try:
@@ -412,9 +412,10 @@ def _prepare(source: ModelSource, tip: str | None, fix: tuple[str, ...]) -> _mjc
 def _model_path(source: str | os.PathLike[str]) -> Path:
     path = Path(source)
     if not path.is_file():
-        raise ValueError(
+        raise no_file(
             f"model must be an MjModel, one of {sorted(_BUILTIN)} or a path to an MJCF or URDF "
-            f"file; no file {str(path)!r}"
+            "file",
+            path,
         )
     return path
 
@@ -1500,7 +1501,8 @@ class MujocoResult(SimResult):
         reference).
     params : dict
         The run: ``Ts``, ``substeps``, ``timestep``, ``T``, ``settle``,
-        ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``controller``,
+        ``contact``, ``tau_max``, ``wrench_source``, ``model``, ``joints``
+        (the arm's joint names, base to tip), ``controller``,
         ``loop`` (``"native"``: the core stepped the controller;
         ``"callback"``: the core's loop called a controller written in Python).
     """
@@ -2558,6 +2560,7 @@ def _result(run: _Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
         "tau_max": plant.tau_max.tolist(),
         "wrench_source": plant.wrench_source,
         "model": name,
+        "joints": list(plant.joint_names),
         "controller": run.label,
         "loop": "callback" if run.kind == "callback" else "native",
         "payload": run.payload,

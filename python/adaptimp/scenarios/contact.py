@@ -1379,3 +1379,64 @@ def contact_metrics(
         "sat_duty": m["sat_duty"],
         "applied_ratio": m["applied_ratio"],
     }
+
+
+SHARE = 0.3
+"""The admittance's share n of the table's unified rows (docs/contact.md)."""
+
+LEARN_KEYS = ("gamma", "sigma", "weight_bound")
+"""The rule's learning keywords; the rows without learning (PD, SF with +τe and
+Γ = 1) leave them out."""
+
+TABLE_ROWS: dict[str, tuple[str, str, str, bool, bool]] = {
+    "pd": ("PD, admittance", "pd", "admittance", False, False),
+    "sf-printed": ("SF with +τe, Γ = 1, admittance", "sf", "admittance", True, False),
+    "sf-admittance": ("SF, admittance, no τe feedforward", "sf", "admittance", False, True),
+    "sf": (f"SF, unified n = {SHARE}", "sf", "unified", False, True),
+    "of": (f"OF, unified n = {SHARE}", "of", "unified", False, True),
+    "sf-ff": (f"SF with +τe, unified n = {SHARE}", "sf", "unified", True, True),
+    "sf-impedance": ("SF, impedance", "sf", "impedance", False, True),
+    "ct-admittance": ("CT exact, admittance (+τe)", "ct", "admittance", True, False),
+    "ct": ("CT exact, impedance", "ct", "impedance", False, False),
+    "ct+30": ("CT +30 % mass, impedance", "ct+30", "impedance", False, False),
+}
+"""The table's rows (docs/contact.md): name: (label, joint controller, the
+impedance's formulation (SPEC §19), the +τe feedforward, the rule's learning).
+Computed torque's rows ("ct…") need a URDF arm (Pinocchio's model)."""
+
+
+def row_controller(name: str, sc: PandaTable, rule: dict[str, Any]) -> Any:
+    """The controller of the table's row ``name`` (:data:`TABLE_ROWS`) on the
+    scenario ``sc``, with the scenario's rule keywords ``rule``
+    (:func:`rule_keywords`)."""
+    from .panda_table import panda_controller
+
+    if name not in TABLE_ROWS:
+        raise ConfigError(f"no row {name!r}; the rows are {list(TABLE_ROWS)}")
+    _, kind, formulation, ff, learn = TABLE_ROWS[name]
+    extra: dict[str, Any] = {}
+    if formulation == "unified":
+        extra["admittance_share"] = SHARE
+    if kind in ("pd", "sf", "of"):
+        extra.update({k: v for k, v in rule.items() if learn or k not in LEARN_KEYS})
+    elif "Md" in rule:  # the scenario's target inertia (SPEC (19.8)), whatever the joint law
+        extra["Md"] = rule["Md"]
+    return panda_controller(kind, sc, force_feedforward=ff, formulation=formulation, **extra)
+
+
+def run_row(
+    name: str,
+    sc: PandaTable,
+    rule: dict[str, Any],
+    T: float,
+    *,
+    progress: Callable[[int, int], object] | None = None,
+) -> tuple[Any, Any, dict[str, float]]:
+    """One row of the table on the scenario: (result, controller, metrics of
+    :func:`contact_metrics` over t ≥ min(2 s, T/2)); ``progress(done,
+    total)`` as :func:`adaptimp.mujoco.simulate` calls it."""
+    from .. import mujoco as amj
+
+    ctrl = row_controller(name, sc, rule)
+    res = amj.simulate(ctrl, amj.Plant(sc.model), T=T, q0=sc.q0, progress=progress or False)
+    return res, ctrl, contact_metrics(res, ctrl, sc, settle=min(2.0, T / 2))

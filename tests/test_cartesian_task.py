@@ -229,3 +229,143 @@ def test_a_table_path_gives_its_rows_then_holds_the_last_pose_at_rest() -> None:
     bad[1, 2] = np.nan
     with pytest.raises(adaptimp.ConfigError, match="pose array dp must be finite"):
         TablePath((p, bad, ddp), 1e-3)
+
+
+HOBBY = str(Path(__file__).resolve().parent / "data" / "hobby_arm.urdf")
+
+
+def test_the_readme_s_arm_gets_a_task_by_the_widened_search() -> None:
+    """The README's servo arm: none of the default search's 40 starts holds σmin
+    along the 3 cm circle (it runs toward the base's axis on so small an arm);
+    four times the candidates find one, on which SF meets the task's targets
+    (issue 45, finding 1; 6 s here, docs/cartesian.md's table 12 s)."""
+    with pytest.warns(UserWarning, match="effort limit"):
+        plant = amj.Plant(HOBBY)
+    task = amj.cartesian_task(plant)
+    assert task.source == "drawn (candidate 889 of 2050; more candidates)"
+    assert not task.orients
+    assert task.assessment["sigma_min"] >= 0.05
+    runs = {c: amj.simulate(c, plant, T=6.0, task=task) for c in ("pd", "sf")}
+    pd, sf = (runs[c].metrics for c in ("pd", "sf"))
+    assert sf["rms_pos_after2"] <= 0.2 * pd["rms_pos_after2"], (sf, pd)
+
+
+def test_the_widenings_are_tried_in_order_and_keep_the_default_task_first() -> None:
+    """SPEC (16.9): the default task as it was, then more candidates, smaller
+    circles, then the position alone; every arm that passed before passes at the
+    first (its start and numbers unchanged)."""
+    from adaptimp._cartesian_task import RADII, WIDENINGS
+
+    assert WIDENINGS[0] == ("the default task", 1, 0.03, True)
+    assert [w[2] for w in WIDENINGS] == [0.03, 0.03, *RADII[1:], *RADII]
+    assert [w[3] for w in WIDENINGS] == [True] * 4 + [False] * 3
+    task = amj.cartesian_task(UR5)
+    assert task.source.endswith("; the default task)")
+    assert isinstance(task.path, CirclePath)
+    assert task.path.radius == 0.03
+
+
+def test_a_planar_arm_s_task_lies_in_its_plane() -> None:
+    """The paper's two-link arm moves in the x–z plane: its circle lies there and
+    σmin is that of its plane's directions (the three rows had σmin = 0 at every
+    posture)."""
+    task = amj.cartesian_task("two_link")
+    assert isinstance(task.path, CirclePath)
+    assert task.path.normal == [0.0, 1.0, 0.0]
+    rows = task.targets(4000, 1e-3)
+    assert np.ptp(rows[:, 1]) == 0.0  # y never moves
+    assert np.ptp(rows[:, 0]) > 0.05
+    assert np.ptp(rows[:, 2]) > 0.05
+    assert task.assessment["sigma_min"] >= 0.05
+
+
+def test_a_refusal_says_what_each_condition_needs_and_what_to_try() -> None:
+    """An arm whose tip lies on its last joint's axis (tests/data/fold_arm.xml:
+    the hand body's origin) moves its tip in two directions only: refused with
+    the bound and the best value of every condition, the joint that does not
+    move the tip, and what to try."""
+    fold = str(Path(__file__).resolve().parent / "data" / "fold_arm.xml")
+    with pytest.raises(adaptimp.ConfigError) as e:
+        amj.cartesian_task(fold)
+    text = str(e.value)
+    assert text.startswith(
+        "no start posture found for a Cartesian task on this arm (3 joints ['j1', 'j2', "
+        "'j3']) with the default task (circles of 3, 1.5 and 0.75 cm, the position only): "
+        "2050 postures drawn within its joint limits, 0 checked along the task; the last "
+        "refused: none passed the rule at its start. Each condition of the rule (SPEC "
+        "(16.9)) with what it needs and the best value found: σmin(J) ≥ 0.05 m/rad along "
+        "the task (not near a singularity) (best "
+    )
+    for need in (
+        "gravity load max_i |G_i|/τmax_i ≤ 0.5 along the task (gravity within the actuators)",
+        "velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ K1·Ts/m = 0.2 at the start (best ",
+        "the path reachable: the inverse kinematics within 0.001 m of it (best ",
+        "joint(s) ['j3'] do not move the tip (their axes pass through it): give tip= a "
+        "link, body or site beyond them.",
+        "Try: q0= a start of your own that meets these",
+    ):
+        assert need in text, need
+
+
+def test_one_posture_check_for_the_task_from_rule_and_the_table() -> None:
+    """The same start refused by the same condition, with its bound and value,
+    by cartesian_task and by CartesianController.from_rule (issue 45, finding
+    2); the table applies it at its own K1 (0.04 = 10 s⁻¹ · 1 ms / 0.25)."""
+    plant = amj.Plant(UR5, contact=False)
+    q0 = np.zeros(6)  # stretched up: singular
+    with pytest.raises(adaptimp.ConfigError) as a:
+        amj.cartesian_task(plant, q0=q0)
+    chain = chain_of(plant)
+    p0, R0 = chain.pose(q0)
+
+    def hold(t: float) -> tuple[np.ndarray, ...]:
+        z = np.zeros(3)
+        return p0, z, z, R0, z, z
+
+    with pytest.raises(adaptimp.ConfigError) as b:
+        adaptimp.CartesianController.from_rule(chain, "sf", hold, q0, model=plant, span=1.0)
+    condition = (
+        "condition σmin(J) ≥ 0.05 m/rad along the task (not near a singularity) is violated: "
+        "σmin(J) = 0 (SPEC (16.9))"
+    )
+    assert str(a.value) == f"q0 cannot run the task: {condition}"
+    assert str(b.value) == f"q0 cannot run the path: {condition}"
+    from adaptimp import _posture
+
+    rows = np.repeat(q0[None, :], 3, axis=0)
+    table = _posture.assess(
+        plant, chain, q0, rows, np.repeat(p0[None, :], 3, axis=0), orients=False, k1=10.0
+    )
+    assert table["needs"]["conditioning"] == pytest.approx(0.04, rel=1e-12)
+
+
+def test_every_cartesian_run_carries_its_pose_errors(panda_task: amj.CartesianTask) -> None:
+    """amj.simulate(cartesian_controller, plant, ...) carries pos_err, rot_err and
+    their metrics as simulate(case, model, task=) does, whichever loop ran it
+    (issue 45, finding 3): the same numbers, natively and called back."""
+    plant = amj.Plant(PANDA)
+    by_task = amj.simulate("sf", plant, T=2.5, task=panda_task)
+    ctrl = panda_task.controller("sf", plant)
+    native = amj.simulate(ctrl, plant, T=2.5, q0=panda_task.q0)
+
+    class InPython:  # the same controller behind an object of the user's: called back
+        def __init__(self, inner: adaptimp.CartesianController) -> None:
+            self.inner = inner
+
+        def step(self, *args: object, **kwargs: object) -> object:
+            return self.inner.step(*args, **kwargs)  # type: ignore[arg-type]
+
+        def __getattr__(self, name: str) -> object:
+            return getattr(self.inner, name)
+
+    called = amj.simulate(
+        InPython(panda_task.controller("sf", plant)), plant, T=2.5, q0=panda_task.q0
+    )
+    assert called.params["loop"] == "callback"
+    for res in (native, called):
+        assert res.pos_err is not None
+        assert res.rot_err is not None
+        np.testing.assert_array_equal(res.pos_err, by_task.pos_err)
+        np.testing.assert_array_equal(res.rot_err, by_task.rot_err)
+        for key in ("rms_pos_after2", "rms_rot_after2", "max_pos_after2", "rms_pos_last2"):
+            assert res.metrics[key] == by_task.metrics[key], key

@@ -91,7 +91,12 @@ def test_simulate_prints_a_table_by_default() -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--Kq", "1"], "unknown parameter --Kq"),
+        (["--Kq", "1"], "unknown parameter --Kq (every name: `adaptimp params`, and --help)"),
+        (["--Kpp", "1"], "unknown parameter --Kpp; did you mean --Kp? (every name:"),
+        (["--kzeta", "1"], "unknown parameter --kzeta; did you mean --Kzeta?"),
+        (["--modle", "x.urdf"], "unknown parameter --modle; did you mean --model?"),
+        (["--model", "nowhere.urdf"], "no file 'nowhere.urdf'"),
+        (["--tip", "tool0"], "--tip applies to an arm given with --model FILE"),
         (["--Kp", "abc"], "--Kp: cannot read 'abc' as a number or comma-separated numbers"),
         (["--Kp"], "--Kp needs a value"),
         (["--Kp", "0.25", "--T", "0.01"], "condition 2Kp − I > 0 is violated"),
@@ -114,3 +119,57 @@ def test_params_lists_every_parameter_and_module_entry_point_works() -> None:
         [sys.executable, "-m", "adaptimp", "--version"], capture_output=True, text=True, check=True
     )
     assert version.stdout.startswith("adaptimp ")
+
+
+HOBBY = str(Path(__file__).resolve().parent / "data" / "hobby_arm.urdf")
+FOLD = str(Path(__file__).resolve().parent / "data" / "fold_arm.xml")
+
+
+def test_simulate_runs_any_arm_on_the_python_route(tmp_path: Path) -> None:
+    """``--model FILE`` (a URDF, an MJCF) runs amj.simulate on it: the default
+    joint task, or the Cartesian task; the figure names the joints (issue 45,
+    finding 8)."""
+    png = tmp_path / "arm.png"
+    proc = run("simulate", "--model", HOBBY, "--T", "2.5", "--plot", str(png), "--json")
+    metrics = json.loads(proc.stdout)
+    from adaptimp import mujoco as amj
+
+    with pytest.warns(UserWarning, match="effort limit"):
+        want = amj.simulate("sf", HOBBY, T=2.5)
+    assert metrics["rms_z1_after2"] == want.metrics["rms_z1_after2"]
+    assert png.read_bytes().startswith(b"\x89PNG")
+    proc = run("simulate", "--model", FOLD, "--task", "cartesian", "--case", "pd", "--T", "2.5",
+               check=False)  # fmt: skip
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("adaptimp simulate: error: no start posture found")
+    assert len(proc.stderr.strip().splitlines()) == 1
+    proc = run("simulate", "--model", HOBBY, "--task", "cartesian", "--T", "2.5")
+    assert "on hobby_arm.urdf: 2500 steps" in proc.stdout
+    assert "the Cartesian task, t ≥ 2 s: position RMS " in proc.stdout
+    assert "(the position only: fewer than six joints)" in proc.stdout
+    proc = run("simulate", "--model", HOBBY, "--tip", "tcp", check=False)
+    assert proc.returncode == 2
+    assert proc.stderr == (
+        "adaptimp simulate: error: URDF 'hobby_arm.urdf': tip= 'tcp' is neither a link nor a "
+        "frame of it: name the link (a MuJoCo body) or the frame (a site) that ends the arm; "
+        "its 10 links and 0 frames, closest first: ['tool', 'wrist', 'upper_arm', 'jaw', "
+        "'base', 'hand', 'world', 'forearm', 'shoulder', 'finger_link']\n"
+    )
+
+
+def test_table_runs_an_arm_at_a_home_given(tmp_path: Path) -> None:
+    """``adaptimp table --model FILE --home …`` (pi in the angles, a negative
+    first one) runs the table's rows on the arm, as arm_table and run_row do."""
+    out = tmp_path / "t.json"
+    ur5 = Path(adaptimp._models.panda_urdf_path()).parents[2] / "ur_description/urdf/ur5_robot.urdf"
+    proc = run("table", "--model", str(ur5), "--home", "-pi/2+pi/2,-pi/2,pi/2,-pi/2,-pi/2,0",
+               "--rows", "sf", "--T", "2.5", "--json", str(out))  # fmt: skip
+    assert "| SF, unified n = 0.3 |" in proc.stdout
+    table = json.loads(out.read_text())
+    assert table["home"] == pytest.approx([0.0, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0])
+    assert set(table["rows"]) == {"sf"}
+    proc = run("table", "--rows", "sff", check=False)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith(
+        "adaptimp table: error: --rows: no row 'sff'; did you mean sf or sf-ff?"
+    )

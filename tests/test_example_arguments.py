@@ -97,3 +97,59 @@ def test_your_arm_with_a_urdf_needs_only_mujoco() -> None:
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr
     assert "pinocchio" in proc.stderr.strip().splitlines()[-1]
+
+
+EXAMPLES = sorted(EXAMPLE.parent.glob("[0-9][0-9]_*.py"))
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_every_example_s_help_is_whole(path: Path) -> None:
+    """--help prints the docstring's whole first paragraph (it stopped
+    mid-sentence: issue 45, finding 4) and runs nothing."""
+    proc = subprocess.run(
+        [sys.executable, str(path), "--help"], capture_output=True, text=True, timeout=120,
+        check=False,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    first = " ".join(path.read_text().split('"""')[1].split("\n\n")[0].split())
+    assert first in " ".join(proc.stdout.split())
+    assert first.endswith((".", "?", ")")), first
+
+
+def test_the_figure_is_of_the_arm_run_and_goes_to_the_output_folder(tmp_path: Path) -> None:
+    """examples/13 --arm FILE --figure plots that arm, into --out; docs/ is never
+    written (issue 45, finding 4)."""
+    docs = EXAMPLE.parent.parent / "docs" / "figures" / "contact_force.png"
+    before = docs.stat().st_mtime_ns
+    hobby = Path(__file__).resolve().parent / "data" / "hobby_arm.urdf"
+    proc = subprocess.run(
+        [sys.executable, str(EXAMPLE), "--arm", str(hobby), "--rows", "sf", "--figure",
+         "--out", str(tmp_path / "figs")],
+        capture_output=True, text=True, timeout=600, check=False,
+        env={**os.environ, "ADAPTIMP_QUICK": "1", "MPLBACKEND": "Agg"},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    figure = tmp_path / "figs" / "contact_force.png"
+    assert f"wrote {figure}" in proc.stdout
+    assert figure.read_bytes().startswith(b"\x89PNG")
+    assert docs.stat().st_mtime_ns == before
+
+
+def test_a_wrong_tip_is_one_line_not_a_traceback() -> None:
+    """examples/15 given a tip its arm does not have: one line naming the links,
+    closest first (issue 45, finding 6)."""
+    hobby = Path(__file__).resolve().parent / "data" / "hobby_arm.urdf"
+    proc = subprocess.run(
+        [sys.executable, str(EXAMPLE.with_name("15_your_arm.py")), str(hobby), "--tip", "tcp"],
+        capture_output=True, text=True, timeout=300, check=False,
+        env={**os.environ, "ADAPTIMP_QUICK": "1"},
+    )  # fmt: skip
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert "Traceback" not in proc.stderr
+    assert lines[-1].startswith(
+        "15_your_arm.py: error: URDF 'hobby_arm.urdf': tip= 'tcp' is neither a link nor a "
+        "frame of it"
+    )
+    assert lines[-1].endswith("closest first: ['tool', 'wrist', 'upper_arm', 'jaw', 'base', "
+                              "'hand', 'world', 'forearm', 'shoulder', 'finger_link']")  # fmt: skip

@@ -90,3 +90,35 @@ def test_comparison_figure_has_one_line_per_case_and_joint(
         assert ax.get_ylabel().endswith("(rad)")
     fig.savefig(tmp_path / "comparison.png", dpi=80)
     assert (tmp_path / "comparison.png").stat().st_size > 20_000
+
+
+def test_a_mujoco_run_names_each_joint_and_its_unit() -> None:
+    """A run on a URDF arm labels each joint by its name in the model, with its
+    unit (issue 45, finding 7: they were x1 … x5); a Cartesian run the world
+    axes, in metres."""
+    from pathlib import Path
+
+    from adaptimp import mujoco as amj
+
+    with pytest.warns(UserWarning, match="effort limit"):
+        plant = amj.Plant(Path(__file__).resolve().parent / "data" / "hobby_arm.urdf")
+    names = ["base_yaw", "shoulder_pitch", "elbow_pitch", "wrist_pitch", "wrist_roll"]
+    assert plant.joint_names == names
+    res = amj.simulate("sf", plant, T=0.05)
+    assert res.params["joints"] == names
+    want = {
+        "tracking": [f"{n} (rad)" for n in names],
+        "errors": [f"z1, {n} (rad)" for n in names],
+        "torques": [f"τ, {n} (N m)" for n in names],
+    }
+    for kind, ylabels in want.items():
+        assert [ax.get_ylabel() for ax in res.plot(kind).axes] == ylabels, kind
+    task = amj.cartesian_task(plant)
+    cart = amj.simulate("pd", plant, T=0.05, task=task)
+    assert [ax.get_ylabel() for ax in cart.plot("tracking").axes] == ["x (m)", "y (m)", "z (m)"]
+    assert [ax.get_ylabel() for ax in cart.plot("errors").axes] == [
+        "z1, x (m)",
+        "z1, y (m)",
+        "z1, z (m)",
+    ]
+    assert [ax.get_ylabel() for ax in cart.plot("torques").axes] == want["torques"]

@@ -156,10 +156,3 @@ def assess(
             a["error"] = f"free of collision along the task (with itself and the scene): {hit}"
             a["collides"] = True
     return a
-
-
-def k1_of(params: dict[str, Any], rule: dict[str, Any]) -> float:
-    """The smallest K1 (1/s) of the joint controller a build will make: the
-    keyword given, else the rule's."""
-    k1 = params.get("K1", rule.get("K1"))
-    return float(np.min(np.asarray(k1, dtype=np.float64)))

@@ -759,25 +759,29 @@ class CartesianController:
         outer = CartesianImpedance(chain, Ts=Ts, q0=q0, **cart)
         steps = round(float(span) / Ts)
         q, dq, ddq = outer.joint_path(path, steps * Ts, samples=steps)
-        # A Plant's state as the caller left it, whatever the rule reads D and G at.
+        # A Plant's state as the caller left it, whatever the check and the rule
+        # read D and G at.
         kept = getattr(model, "state_kept", None)
         with kept() if callable(kept) else contextlib.nullcontext():
+            # The one posture check (SPEC (16.9)) along the joint path, at the K1
+            # of the controller built (the rule's, or the one given); a start
+            # given: gravity within the actuators.
+            idx = _posture.checked_rows(q.shape[0])
+            targets = tabulate(path, steps, Ts, chain.pose(q0)[1])[idx, 0:3]
+            k1 = params.get("K1")
+            a = _posture.assess(
+                model, chain, q0, q[idx], targets, orients=outer.orients,
+                k1=None if k1 is None else float(np.min(np.asarray(k1, dtype=np.float64))),
+                Ts=Ts, load=_posture.GIVEN_LOAD, tau_max=limits,
+            )  # fmt: skip
+            if a["error"] is not None:
+                raise ConfigError(f"q0 cannot run the path: {a['error']}")
             kw = tuning.suggest(
                 model, q0, limits, Ts=Ts, path=np.hstack([q, dq, ddq]), period=steps * Ts,
                 case=controller, resolve=True, delay=delay,
             )  # fmt: skip
         kw.pop("n")
         joint = {k: v for k, v in params.items() if k not in cart}
-        # The one posture check (SPEC (16.9)) along the joint path, at the K1
-        # of the controller built; a start given: gravity within the actuators.
-        idx = _posture.checked_rows(q.shape[0])
-        targets = tabulate(path, steps, Ts, chain.pose(q0)[1])[idx, 0:3]
-        a = _posture.assess(
-            model, chain, q0, q[idx], targets, orients=outer.orients,
-            k1=_posture.k1_of(joint, kw), Ts=Ts, load=_posture.GIVEN_LOAD, tau_max=limits,
-        )  # fmt: skip
-        if a["error"] is not None:
-            raise ConfigError(f"q0 cannot run the path: {a['error']}")
         centres, widths = (
             joint.pop("centers", kw.pop("centers")),
             joint.pop("widths", kw.pop("widths")),

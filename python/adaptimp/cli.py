@@ -101,15 +101,15 @@ def _expected(kind: str) -> str:
 
 def suggest(name: str, choices: Sequence[str]) -> str:
     """ " did you mean --x (or --y)?" for the ``choices`` closest to ``name``
-    (case aside, then by difflib's ratio), or "" if none is close."""
+    (the same name in another case, else by difflib's ratio), or "" if none
+    is close."""
     lower = {c.lower(): c for c in choices}
-    close = [lower[name.lower()]] if name.lower() in lower else []
-    close += [
-        c for c in difflib.get_close_matches(name, choices, n=3, cutoff=0.6) if c not in close
-    ]
+    if name.lower() in lower:  # the name in another case: that one alone
+        return f" did you mean --{lower[name.lower()]}?"
+    close = difflib.get_close_matches(name, choices, n=3, cutoff=0.6)
     if not close:
         return ""
-    return " did you mean " + " or ".join(f"--{c}" for c in close[:3]) + "?"
+    return " did you mean " + " or ".join(f"--{c}" for c in close) + "?"
 
 
 def parse_params(tokens: Sequence[str], options: Sequence[str] = ()) -> dict[str, Any]:
@@ -126,8 +126,8 @@ def parse_params(tokens: Sequence[str], options: Sequence[str] = ()) -> dict[str
         if name not in BY_NAME:
             hint = suggest(name, [*BY_NAME, *options])
             raise CliError(
-                f"unknown parameter --{name};{hint or ''} (every name: `adaptimp params`"
-                f"{', and --help' if options else ''})"
+                f"unknown parameter --{name}{';' + hint if hint else ''} (every name: "
+                f"`adaptimp params`{', and --help' if options else ''})"
             )
         if not eq:
             if i + 1 >= len(tokens):
@@ -218,7 +218,8 @@ def cmd_simulate(args: argparse.Namespace, params: dict[str, Any]) -> int:
             if getattr(args, k) not in (None, "", "joint")
         ]  # fmt: skip
         if mujoco_only:
-            raise CliError(f"{', '.join(mujoco_only)} apply to an arm given with --model FILE")
+            verb = "applies" if len(mujoco_only) == 1 else "apply"
+            raise CliError(f"{', '.join(mujoco_only)} {verb} to an arm given with --model FILE")
         res, seconds = _run(args.case, args.scenario or "paper", params)
     else:
         res, seconds = _run_model(args, params)
@@ -299,7 +300,7 @@ def _run_model(args: argparse.Namespace, params: dict[str, Any]) -> tuple[Any, f
     start = time.perf_counter()
     where: dict[str, Any] = {"tip": args.tip, "fix": _fix(args.fix)}
     scenario = args.scenario or "robot"
-    extra: dict[str, Any] = {"gravity": args.gravity, "payload": args.payload}
+    extra: dict[str, Any] = {"gravity": args.gravity, "payload": args.payload or 0.0}
     try:
         if args.task == "cartesian":
             if args.home is not None:
@@ -501,7 +502,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--payload",
         type=float,
-        default=0.0,
+        default=None,
         help="with --model: a point mass (kg) at the end effector, the plant's only",
     )
     sim.add_argument(

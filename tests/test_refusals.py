@@ -454,3 +454,27 @@ def test_the_panda_s_scenario_refuses_a_urdf_s_keywords() -> None:
         act.arm_table(tip="panda_link8", home=HOME)
     with pytest.raises(adaptimp.ConfigError, match=r"^fix applies to the arm of a URDF"):
         act.arm_table(fix=("panda_joint7",))
+
+
+def test_a_path_that_is_no_file_is_file_not_found_everywhere() -> None:
+    """Every entry point that reads an arm's file raises FileNotFoundError for a
+    path that is not there, naming it (issue 45, finding 10: simulate raised
+    ValueError, Chain FileNotFoundError)."""
+    from adaptimp import mujoco as amj
+    from adaptimp.baselines import ComputedTorque
+    from adaptimp.scenarios import contact as act
+
+    for call in (
+        lambda: amj.simulate("sf", "nowhere.urdf", T=0.1),
+        lambda: amj.Plant("nowhere.xml"),
+        lambda: amj.cartesian_task("nowhere.urdf"),
+        lambda: amj.from_urdf("nowhere.urdf"),
+        lambda: adaptimp.Chain.from_urdf("nowhere.urdf"),
+        lambda: adaptimp.Chain.from_mujoco("nowhere.xml"),
+        lambda: ComputedTorque("nowhere.urdf"),
+        lambda: act.arm_table("nowhere.urdf"),
+        lambda: adaptimp.Controller("sf", gravity="nowhere.urdf"),
+        lambda: read_arm("nowhere.urdf"),
+    ):
+        with pytest.raises(FileNotFoundError, match=r"'nowhere\.(urdf|xml)'"):
+            call()

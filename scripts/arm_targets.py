@@ -28,10 +28,14 @@ wheels: DIR/robosuite/robosuite/…). An arm whose files are not found is left
 out and said so; nothing is downloaded.
 
     python scripts/arm_targets.py [--robots DIR] [--only cartesian,ready,placements,refusals]
-                                  [--arms SUBSTRING,...] [--json out.json]
+                                  [--arms SUBSTRING,...] [--json out.json] [--check]
 
 Prints one Markdown table per part (the tables of docs/cartesian.md and
-docs/contact.md). About 25 min on one core for every part and arm.
+docs/contact.md). About 25 min on one core for every part and arm; the
+Cartesian table alone about 1 min. ``--check``: the Cartesian rows printed
+must be docs/cartesian.md's, cell for cell (exit status 1 and the rows that
+differ otherwise); ``tests/test_doc_numbers.py`` checks the rows of
+example-robot-data's arms so in every test run.
 """
 
 from __future__ import annotations
@@ -216,6 +220,31 @@ def cartesian(model: Any, T: float) -> dict[str, Any]:
     return row
 
 
+def cartesian_row(label: str, r: dict[str, Any]) -> str:
+    """The Markdown row of docs/cartesian.md's table for the arm ``label``."""
+    failed = [k for k, ok in r["pass"].items() if not ok]
+    verdict = "met" if not failed else "NOT met: " + ", ".join(failed)
+    return (
+        f"| {label} | {r['n']} | {r['sigma_min']:.3f} | {r['pd_pos_mm']:.4f} "
+        f"| {r['sf_pos_mm']:.4f} | {r['pos_ratio']:.3f} | {r['pd_rot_mrad']:.3f} "
+        f"| {r['sf_rot_mrad']:.4f} | {fmt(r['rot_ratio'])} | {r['learning']:.3f} "
+        f"| {r['peak_tau_ratio']:.3f} | {verdict} |"
+    )
+
+
+CARTESIAN_PAGE = ROOT / "docs" / "cartesian.md"
+
+
+def documented_rows(page: Path = CARTESIAN_PAGE) -> dict[str, str]:
+    """The rows of docs/cartesian.md's table of the default Cartesian task, by arm."""
+    out = {}
+    for line in page.read_text(encoding="utf-8").splitlines():
+        label = line.split("|")[1].strip() if line.startswith("| ") else ""
+        if any(a.label == label for a in ARMS):
+            out[label] = line
+    return out
+
+
 def table_ok(r: dict[str, Any]) -> dict[str, bool]:
     """The table's targets for one row of examples/13's JSON."""
     target = r["force_target_N"]
@@ -262,6 +291,9 @@ def main() -> None:
     parser.add_argument("--T", type=float, default=12.0, help="the Cartesian task's duration")
     parser.add_argument("--T-table", type=float, default=10.0, help="the table's duration")
     parser.add_argument("--placements", type=int, default=8)
+    parser.add_argument(
+        "--check", action="store_true", help="the Cartesian rows must be docs/cartesian.md's"
+    )
     args = parser.parse_args()
     parts = set(args.only.split(","))
     known = {"cartesian", "ready", "placements", "refusals"}
@@ -287,6 +319,7 @@ def main() -> None:
     out: dict[str, Any] = {"cartesian": {}, "ready": {}, "placements": {}, "refusals": {}}
     warnings.simplefilter("ignore")
 
+    documented, differ = documented_rows(), []
     if "cartesian" in parts:
         print(f"\n### The default Cartesian task, T = {args.T:g} s, metrics over t ≥ 2 s\n")
         print("| arm | n | σmin | PD pos (mm) | SF pos (mm) | SF/PD pos | PD rot (mrad) "
@@ -305,15 +338,10 @@ def main() -> None:
                 continue
             r["time_s"] = time.perf_counter() - t0
             out["cartesian"][arm.label] = r
-            failed = [k for k, ok in r["pass"].items() if not ok]
-            verdict = "met" if not failed else "NOT met: " + ", ".join(failed)
-            print(
-                f"| {arm.label} | {r['n']} | {r['sigma_min']:.3f} | {r['pd_pos_mm']:.4f} "
-                f"| {r['sf_pos_mm']:.4f} | {r['pos_ratio']:.3f} | {r['pd_rot_mrad']:.3f} "
-                f"| {r['sf_rot_mrad']:.4f} | {fmt(r['rot_ratio'])} | {r['learning']:.3f} "
-                f"| {r['peak_tau_ratio']:.3f} | {verdict} |",
-                flush=True,
-            )
+            row = cartesian_row(arm.label, r)
+            print(row, flush=True)
+            if args.check and documented.get(arm.label) != row:
+                differ.append(f"documented: {documented.get(arm.label)}\nmeasured:   {row}")
 
     if "ready" in parts:
         print(f"\n### The table at the maker's ready posture, T = {args.T_table:g} s\n")
@@ -390,6 +418,9 @@ def main() -> None:
     if args.json is not None:
         args.json.write_text(json.dumps(out, indent=1) + "\n")
         print(f"\nwrote {args.json}")
+    if differ:
+        print("\nrows that differ from docs/cartesian.md:\n" + "\n".join(differ), file=sys.stderr)
+        sys.exit(1)
 
 
 if __name__ == "__main__":

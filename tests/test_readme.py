@@ -33,12 +33,12 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     "an installed wheel",
     ("README.md", 1): "builds and installs the wheel: scripts/wheel.sh and "
     "scripts/test_wheel.sh do, in scripts/test.sh",
-    ("README.md", 5): "shell: run here (RUN_SHELL)",
-    ("README.md", 6): "Rust: tests/snippets/readme_quickstart.rs, a doctest of src/lib.rs; "
+    ("README.md", 6): "shell: run here (RUN_SHELL)",
+    ("README.md", 7): "Rust: tests/snippets/readme_quickstart.rs, a doctest of src/lib.rs; "
     "tests/readme.rs keeps the README's copy identical",
-    ("README.md", 7): "CMake: run here in a project of one C file "
+    ("README.md", 8): "CMake: run here in a project of one C file "
     "(test_the_cmake_lines_link_a_project), path/to/adaptimp being this checkout",
-    ("README.md", 8): "runs this whole suite (it is scripts/test.sh)",
+    ("README.md", 9): "runs this whole suite (it is scripts/test.sh)",
     ("docs/cartesian.md", 4): "Rust: the shape of the calls; the whole program is "
     "examples/14_cartesian_pose.rs, which tests/test_ffi.py runs against C and Python",
     ("docs/franka.md", 0): "installs the extra and starts a server that runs until Ctrl-C: "
@@ -72,18 +72,47 @@ ELSEWHERE: dict[tuple[str, int], str] = {
 }
 
 # Shell blocks run here as written (each line, from the checkout's root).
-RUN_SHELL = {("README.md", 5), ("docs/paper.md", 0)}
+RUN_SHELL = {("README.md", 6), ("docs/paper.md", 0)}
 
 # Rust blocks kept identical to a compiled snippet (a doctest of src/lib.rs).
 RUST_SNIPPETS = {
-    ("README.md", 6): "tests/snippets/readme_quickstart.rs",
+    ("README.md", 7): "tests/snippets/readme_quickstart.rs",
     ("docs/robot.md", 1): "tests/snippets/robot_hardened.rs",
     ("docs/rust.md", 1): "tests/snippets/dynamic_urdf.rs",
 }
 
 
+# Numbers a page states of what its own blocks compute: after block i of the
+# page, (an expression in the page's namespace, the text the page must contain
+# with the value formatted into it). The numbers cannot go stale: a change
+# that moves one fails here, with the value to write.
+CHECKS: dict[tuple[str, int], list[tuple[str, str]]] = {
+    ("README.md", 2): [
+        ('res.metrics["rms_z1_after2"]', "# {:.2g} rad (SPEC §12)"),
+        ('ctrl.weights["G"].shape', "# {}"),
+    ],
+    ("README.md", 3): [
+        ('runs["sf"].metrics["rms_z1_after2"] / runs["pd"].metrics["rms_z1_after2"]',
+         "on this arm SF tracks at {:.2g}× PD's error"),
+    ],
+    ("README.md", 4): [("len(df)", "one row per run: {} runs")],
+    ("README.md", 5): [
+        ('cart["sf"].metrics["rms_pos_after2"]', "# {:.3g} m, RMS ‖p_c − p‖ over t ≥ 2 s"),
+        ('cart["pd"].metrics["rms_pos_after2"]', "(PD: {:.3g} m)"),
+    ],
+    ("docs/cartesian.md", 3): [
+        ("1e3 * res.pos_err[-1]", "the tip ends {:.2g} mm from the target"),
+    ],
+}  # fmt: skip
+
+
 def _blocks(page: str) -> list[tuple[str, str]]:
     return BLOCK.findall((ROOT / page).read_text(encoding="utf-8"))
+
+
+def test_every_check_is_of_a_python_block() -> None:
+    for page, i in CHECKS:
+        assert _blocks(page)[i][0] == "python", (page, i)
 
 
 def test_every_block_is_accounted_for() -> None:
@@ -103,13 +132,28 @@ def test_every_block_is_accounted_for() -> None:
         assert i < len(_blocks(page)), f"{key}: no such block (the page changed)"
 
 
+PRIVATE = re.compile(r"adaptimp\._\w+|from adaptimp import (?:[\w, ]*, )?_\w+")
+
+
+def test_no_block_of_the_docs_uses_a_private_name() -> None:
+    """What a reader copies uses the public API only (issue 45, finding 9:
+    docs/cartesian.md called adaptimp._models.panda_urdf_path())."""
+    found = [
+        f"{page} block {i}: {m.group(0)}"
+        for page in PAGES
+        for i, (_, code) in enumerate(_blocks(page))
+        for m in PRIVATE.finditer(code)
+    ]
+    assert not found, found
+
+
 def test_the_cmake_lines_link_a_project(tmp_path: pathlib.Path) -> None:
     """The README's two CMake lines in a project of one C file: it configures,
     builds (the library with cargo, into this checkout's target/) and runs."""
     import shutil
 
     assert shutil.which("cmake"), "cmake is needed (scripts/test.sh installs it)"
-    lang, lines = _blocks("README.md")[7]
+    lang, lines = _blocks("README.md")[8]
     assert lang == "cmake"
     (tmp_path / "main.c").write_text(
         '#include "adaptimp.h"\n#include <stdio.h>\n'
@@ -149,6 +193,7 @@ def test_the_python_blocks_of_a_page_run_in_order(
 
     monkeypatch.chdir(_workdir(tmp_path))
     namespace: dict[str, Any] = {"__name__": "__docs__"}
+    text = (ROOT / page).read_text(encoding="utf-8")
     # A reader sees the warnings a block gives (the hobby arm's estimated
     # effort limit): kept; none may say that the page uses what is deprecated.
     with warnings.catch_warnings(record=True) as seen:
@@ -157,6 +202,9 @@ def test_the_python_blocks_of_a_page_run_in_order(
             if lang != "python" or (page, i) in ELSEWHERE:
                 continue
             exec(compile(code, f"{page} block {i}", "exec"), namespace)
+            for expression, template in CHECKS.get((page, i), []):
+                stated = template.format(eval(expression, namespace))
+                assert stated in text, f"{page} must say {stated!r} ({expression})"
     old = [
         str(w.message) for w in seen if issubclass(w.category, (DeprecationWarning, FutureWarning))
     ]

@@ -245,7 +245,7 @@ impl PoseCircle {
         check::nonnegative("ramp ≥ 0", "ramp", ramp)?;
         check::finite_slice("normal", normal.as_slice())?;
         let length = normal.norm();
-        if !(length > 0.0) {
+        if length <= 0.0 {
             return Err(Error::Invalid {
                 what: "normal",
                 reason: "must be a non-zero vector (the circle's plane)",

@@ -45,6 +45,10 @@ impl Given {
     }
 }
 
+/// A nominal model as the constructor takes it, SPEC (20.10): the chain's
+/// joints and their inertials (dicts) and the gravity vector (m/s²).
+type GravityModel<'py> = (Vec<Bound<'py, PyDict>>, Vec<Bound<'py, PyDict>>, [f64; 3]);
+
 /// One of the paper's controllers (SPEC §7) for an arm of n joints, with its
 /// commanded trajectory and its state, stepped by the caller at the period
 /// Ts (SPEC §11).
@@ -156,7 +160,7 @@ impl PyController {
         n: usize,
         centers: Option<PyReadonlyArray2<'_, f64>>,
         widths2: Option<PyReadonlyArray1<'_, f64>>,
-        gravity: Option<(Vec<Bound<'_, PyDict>>, Vec<Bound<'_, PyDict>>, [f64; 3])>,
+        gravity: Option<GravityModel<'_>>,
     ) -> PyResult<Self> {
         let n = check_n(n)?;
         let law = law_of(case)?;

@@ -1188,6 +1188,37 @@ mod tests {
         assert_eq!(quiet.z2, Vector::<2>::new(0.02, 0.01));
     }
 
+    /// A feedforward of a constant torque, for (20.10)'s test.
+    #[derive(Debug)]
+    struct Constant(Vector<2>);
+
+    impl Feedforward<2> for Constant {
+        fn torque(&self, _q: &Vector<2>) -> Vector<2> {
+            self.0
+        }
+    }
+
+    #[test]
+    fn the_feedforward_adds_to_the_law_before_the_saturation() {
+        // SPEC (20.10): τ = τ_law + τ_ff; sat(τ) of the sum; Δτ of ζ from the sum.
+        let plain = Controller::paper(Law::StateFeedback);
+        let ff = Vector::<2>::new(3.0, -40.0); // the second beyond τmax = 15 N m
+        let fed = plain
+            .clone()
+            .with_feedforward(alloc::sync::Arc::new(Constant(ff)));
+        assert!(plain.feedforward().is_none());
+        assert!(fed.feedforward().is_some());
+        let (mut a, mut b) = (plain.new_state(), fed.new_state());
+        let m = measurement();
+        let (sa, sb) = (setpoint(&plain, &a), setpoint(&fed, &b));
+        let without = plain.step(&mut a, &m, &sa).unwrap();
+        let with = fed.step(&mut b, &m, &sb).unwrap();
+        assert_eq!(with.tau, without.tau + ff);
+        assert_eq!(with.tau_sat, fed.saturation().apply(&with.tau));
+        assert_eq!(with.dtau, with.tau_sat - with.tau);
+        assert!(with.tau_sat[1] == -15.0 && with.dtau[1] > 0.0, "{with:?}");
+    }
+
     #[test]
     fn printed_euler_gain_exceeds_kp_at_1ms_normalized_stays_below_kappa_kp() {
         let mut printed = Config::paper(Law::StateFeedback);

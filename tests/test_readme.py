@@ -103,6 +103,12 @@ CHECKS: dict[tuple[str, int], list[tuple[str, str]]] = {
     ("docs/cartesian.md", 3): [
         ("1e3 * res.pos_err[-1]", "the tip ends {:.2g} mm from the target"),
     ],
+    ("docs/contact.md", 0): [
+        ("act.contact_metrics(res, ctrl, sc)",
+         "track_mm {0[track_mm]:.3f}, force_rms_err_N {0[force_rms_err_N]:.3f}, "
+         "force_chatter_N {0[force_chatter_N]:.3f}"),
+    ],
+    ("docs/index.md", 1): [('res.metrics["rms_z1_after2"]', "# {:.2g} rad (SPEC §12)")],
 }  # fmt: skip
 
 

@@ -13,7 +13,7 @@ on the table). A refusal names the condition with its bound and the value
 measured.
 
 No MuJoCo import here: a Plant's own data is probed through
-:mod:`adaptimp._cartesian_task`, imported only for one.
+:mod:`adaptimp._collision`, imported only for one.
 """
 
 from __future__ import annotations
@@ -82,7 +82,7 @@ def _dynamics(model: Any) -> tuple[Any, Any]:
     own (its state untouched), else :func:`adaptimp.tuning.gravity` and
     :func:`adaptimp.tuning.inertia`."""
     if _is_plant(model):
-        from ._cartesian_task import _Probe
+        from ._collision import _Probe
 
         probe = _Probe(model)
         return probe.gravity, probe.inertia
@@ -149,7 +149,7 @@ def assess(
         )
     )  # fmt: skip
     if a["error"] is None and _is_plant(model):
-        from ._cartesian_task import collision
+        from ._collision import collision
 
         hit = collision(model, rows, skip=skip)
         if hit is not None:

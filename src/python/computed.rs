@@ -10,7 +10,7 @@ use super::dynamic::{
     drive_mujoco, Hooks, MetricsOut, MujocoRun, OnMujoco, Records, RunError, TaskMetrics, View,
     MAX_JOINTS,
 };
-use super::frames::{joint, transform};
+use super::frames::{inertial, joint};
 use super::measurement::JointCall;
 use super::mujoco::{MujocoSpec, Table};
 use super::shared::{Read, Shared, Slot, Write};
@@ -467,40 +467,6 @@ fn computed(
             value: n as f64,
         }),
     )
-}
-
-/// A 3 × 3 matrix from a nested or a flat sequence of 9 reals.
-fn matrix3(key: &str, v: &Bound<'_, PyAny>) -> PyResult<[[f64; 3]; 3]> {
-    let flat = v
-        .extract::<Vec<Vec<f64>>>()
-        .map(|rows| rows.concat())
-        .or_else(|_| v.extract::<Vec<f64>>())
-        .map_err(|_| PyTypeError::new_err(format!("{key} must be 3 × 3 reals")))?;
-    if flat.len() != 9 {
-        return Err(ConfigError::new_err(format!(
-            "{key} must have 3 × 3 values, got {}",
-            flat.len()
-        )));
-    }
-    Ok(core::array::from_fn(|i| {
-        core::array::from_fn(|j| flat[3 * i + j])
-    }))
-}
-
-pub(super) fn inertial(d: &Bound<'_, PyDict>) -> PyResult<Inertial> {
-    let mass: f64 = match d.get_item("mass")? {
-        Some(m) => m.extract()?,
-        None => return Err(PyTypeError::new_err("an inertial needs its mass (kg)")),
-    };
-    let inertia = match d.get_item("inertia")? {
-        Some(i) => matrix3("inertia", &i)?,
-        None => [[0.0; 3]; 3],
-    };
-    Ok(Inertial {
-        mass,
-        origin: transform(d)?,
-        inertia,
-    })
 }
 
 /// What gravity compensation lifts of one link: {"mass" (kg), "moment" (kg m, 3)}.

@@ -195,7 +195,7 @@ impl PyController {
                     .collect::<PyResult<Vec<_>>>()?,
                 inertials: inertials
                     .iter()
-                    .map(super::computed::inertial)
+                    .map(super::frames::inertial)
                     .collect::<PyResult<Vec<_>>>()?,
                 gravity: g,
             }),

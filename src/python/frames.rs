@@ -1,7 +1,8 @@
 //! Joints and frames of a serial chain from Python dicts (the joint data
 //! `Chain` and `ComputedTorque` take): the conversions both bindings use.
 
-use super::ConfigError;
+use super::errors::ConfigError;
+use crate::cartesian::dynamics::Inertial;
 use crate::cartesian::{Joint, JointKind, Transform};
 use crate::error::Error;
 use pyo3::exceptions::PyTypeError;
@@ -124,5 +125,41 @@ pub fn joint(d: &Bound<'_, PyDict>) -> PyResult<Joint> {
         origin: transform(d)?,
         axis,
         offset,
+    })
+}
+
+/// A 3 × 3 matrix from a nested or a flat sequence of 9 reals.
+fn matrix3(key: &str, v: &Bound<'_, PyAny>) -> PyResult<[[f64; 3]; 3]> {
+    let flat = v
+        .extract::<Vec<Vec<f64>>>()
+        .map(|rows| rows.concat())
+        .or_else(|_| v.extract::<Vec<f64>>())
+        .map_err(|_| PyTypeError::new_err(format!("{key} must be 3 × 3 reals")))?;
+    if flat.len() != 9 {
+        return Err(ConfigError::new_err(format!(
+            "{key} must have 3 × 3 values, got {}",
+            flat.len()
+        )));
+    }
+    Ok(core::array::from_fn(|i| {
+        core::array::from_fn(|j| flat[3 * i + j])
+    }))
+}
+
+/// An inertial from its dict: `mass` (kg), the centre of mass as a frame's
+/// `translation` (m) and `rotation`, `inertia` (kg m², 3 × 3) about it.
+pub(super) fn inertial(d: &Bound<'_, PyDict>) -> PyResult<Inertial> {
+    let mass: f64 = match d.get_item("mass")? {
+        Some(m) => m.extract()?,
+        None => return Err(PyTypeError::new_err("an inertial needs its mass (kg)")),
+    };
+    let inertia = match d.get_item("inertia")? {
+        Some(i) => matrix3("inertia", &i)?,
+        None => [[0.0; 3]; 3],
+    };
+    Ok(Inertial {
+        mass,
+        origin: transform(d)?,
+        inertia,
     })
 }

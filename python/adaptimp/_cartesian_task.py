@@ -38,8 +38,8 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _adaptimp, _mjcf, _posture
-from ._collision import _Probe, self_collision
+from . import _adaptimp, _posture
+from ._collision import _Probe, collision, self_collision
 from ._errors import ConfigError, DivergedError
 from .cartesian import CartesianController, Path, tabulate
 from .chain import Chain

@@ -1053,9 +1053,9 @@ def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
     :meth:`adaptimp.CartesianController.from_rule` (SPEC (16.9), the position
     rows: not near a singularity, inside the joint limits with margin, gravity
     at most half of every actuator, the velocity loop well-conditioned at home
-    for the table's K1 = 10 s⁻¹, the path reachable within 1 mm, no
-    collision of the arm with itself and the scene, the tool left out), then the table's own: no joint of the
-    arm below the table top over the table, and the rule's gains' sampled
+    for the table's K1 = 10 s⁻¹, the path reachable within 1 mm, no collision
+    of the arm with itself and the scene, the tool left out), then the table's
+    own: no joint of the arm below the table top over the table, and the rule's gains' sampled
     velocity loop stable at every posture of the path (SPEC (19.10),
     :func:`velocity_loop_radius`). ``load``: the largest gravity
     load max_i |G_i|/τmax_i allowed (1 for a home the user gives: gravity

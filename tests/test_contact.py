@@ -802,11 +802,12 @@ def test_an_mjcf_arm_gets_the_table_too(tmp_path: Path) -> None:
     # fix= holds an MJCF arm's joints as a URDF's: the arm is then two joints,
     # its home two values (the same arm in the table as in simulate).
     # Its two joints in a vertical plane cannot draw the horizontal circle:
-    # refused by name before the run, not for the home's length.
+    # refused by name before the run, not for the home's length (σmin is that
+    # of its plane, SPEC (16.8): the circle off it is out of reach).
     with (
         pytest.warns(adaptimp.PlantWarning, match=r"the joints \['j1'\] are not the arm's"),
         pytest.raises(adaptimp.ConfigError, match=r"^the home posture cannot run the table: "
-                      r"condition σmin\(J\) ≥ 0.05"),
+                      r"condition the path reachable: the inverse kinematics within 0.001 m"),
     ):  # fmt: skip
         act.arm_table(path, home=[-0.3, 1.5], fix=("j1",))
     with pytest.warns(adaptimp.PlantWarning):  # the plant's arm: the same two joints

@@ -34,8 +34,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
 from ._errors import ConfigError
-from ._params import loop_delay
 from ._inputs import positive, reals
+from ._params import loop_delay
 
 FloatArray = NDArray[np.float64]
 Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]

@@ -292,14 +292,16 @@ def test_a_refusal_says_what_each_condition_needs_and_what_to_try() -> None:
         "no start posture found for a Cartesian task on this arm (3 joints ['j1', 'j2', "
         "'j3']) with the default task (circles of 3, 1.5 and 0.75 cm, the position only): "
         "2050 postures drawn within its joint limits, 0 checked along the task; the last "
-        "refused: none passed the rule at its start. Each condition of the rule (SPEC "
-        "(16.9)) with what it needs and the best value found: σmin(J) ≥ 0.05 m/rad along "
+        "refused: none passed the rule at its start (the condition σmin(J) ≥ 0.05 m/rad along "
+        "the task (not near a singularity) failed at 2050 of them). Each condition of the rule "
+        "(SPEC (16.9)) with what it needs and the best value found: σmin(J) ≥ 0.05 m/rad along "
         "the task (not near a singularity) (best "
     )
     for need in (
         "gravity load max_i |G_i|/τmax_i ≤ 0.5 along the task (gravity within the actuators)",
         "velocity-loop conditioning λmin(Dₛ^½ D⁻¹ Dₛ^½) ≥ K1·Ts/m = 0.2 at the start (best ",
-        "the path reachable: the inverse kinematics within 0.001 m of it (best ",
+        "the path reachable: the inverse kinematics within 0.001 m of it (none measured: no "
+        "start checked along the task).",
         "joint(s) ['j3'] do not move the tip (their axes pass through it): give tip= a "
         "link, body or site beyond them.",
         "Try: q0= a start of your own that meets these",

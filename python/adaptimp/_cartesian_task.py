@@ -547,7 +547,7 @@ def _search(
     each condition needs, with the best value found, and what to try."""
     n = chain.n
     best: dict[str, Any] = {}
-    collisions, tried_rows, drawn, failed = 0, 0, 0, ""
+    collisions, tried_rows, drawn, failed, diverged = 0, 0, 0, "", 0
     failures: dict[str, int] = {}
     screens: dict[tuple[int, bool], list[tuple[float, int, FloatArray]]] = {}
     tried: set[tuple[int, float, bool]] = set()
@@ -563,7 +563,7 @@ def _search(
             failures = {}  # of the latest screen: the condition that failed most, named
             for k, q in enumerate(_candidates(plant, seed, count)):
                 quick = _screen(probe, chain, q, orients, plant)
-                _best(best, quick)
+                _best(best, quick, along=False)
                 if quick["error"] is None:
                     screened.append((float(quick["score"]), k, q))
                 else:
@@ -588,6 +588,7 @@ def _search(
                     f"the inverse kinematics of the pose path's first pose diverged ({e}): is "
                     "the pose within the arm's reach?"
                 )
+                diverged += 1
                 continue
             if a["error"] is None:
                 source = f"drawn (candidate {k} of {count + 2}; {label})"
@@ -600,16 +601,23 @@ def _search(
     if not failed and failures:
         common, times = max(failures.items(), key=lambda kv: kv[1])
         failed = f"none passed the rule at its start (the {common} failed at {times} of them)"
-    raise ConfigError(_refusal(plant, chain, best, drawn, tried_rows, collisions, failed, own_path))
+    raise ConfigError(
+        _refusal(plant, chain, best, drawn, tried_rows, collisions, diverged, failed, own_path)
+    )
 
 
 _BEST = {"sigma_min": max, "slack": max, "load": min, "conditioning": max, "reach": min}
 """How each figure of an assessment improves (the best over the search)."""
 
 
-def _best(best: dict[str, Any], a: dict[str, Any]) -> None:
-    """``best`` updated with the assessment ``a``: each figure the best seen."""
+def _best(best: dict[str, Any], a: dict[str, Any], *, along: bool = True) -> None:
+    """``best`` updated with the assessment ``a``: each figure the best seen (a
+    start screened alone, ``along=False``, measures no reach: its path is not
+    tracked, and its reach of 0 read "the path reachable (best 0)" when every
+    path checked diverged)."""
     for key, pick in _BEST.items():
+        if key == "reach" and not along:
+            continue
         value = float(a[key])
         if key not in best or pick(value, best[key]) == value != best[key]:
             best[key] = value
@@ -624,6 +632,7 @@ def _refusal(
     drawn: int,
     tried: int,
     collisions: int,
+    diverged: int,
     last: str,
     own_path: bool,
 ) -> str:
@@ -647,7 +656,12 @@ def _refusal(
             f"the tip of this {n}-joint arm moves on a surface that is not a plane (its "
             "joints' axes are not parallel): no circle of the default task lies on it"
         )
-    needs = _adaptimp.posture_needs({"slack_joint": 0, **best} if best else _NO_BEST, load=None)
+    if diverged:  # a later start's refusal is not the cause (a path 1 m away: "σmin = 3e-6")
+        hints.append(
+            f"the inverse kinematics of the pose path's first pose diverged from {diverged} of "
+            f"the {tried} starts checked: is the pose within the arm's reach?"
+        )
+    needs = _adaptimp.posture_needs({**_NO_BEST, **best}, load=None)
     coll = (
         f"; {collisions} of them collide along it (the arm with itself or the scene)"
         if collisions
@@ -660,7 +674,7 @@ def _refusal(
         f"{last or 'none passed the rule at its start'}. "
         f"Each condition of the rule (SPEC (16.9)) with what it needs and the best value found: "
         f"{needs}. "
-        + (" ".join(h + "." for h in hints) + " " if hints else "")
+        + (" ".join(h if h.endswith("?") else h + "." for h in hints) + " " if hints else "")
         + "Try: q0= a start of your own that meets these (cartesian_task(model, q0=...), "
         "checked with gravity up to the actuators' limits), pose= a path of your own, or "
         "tip= another end effector"
@@ -721,7 +735,9 @@ def _configured(chain: Chain, Ts: float, orients: bool, plant: Any) -> None:
     from .cartesian import CartesianImpedance
 
     lo, hi = _limits(plant)
-    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
+    limited = np.isfinite(lo) & np.isfinite(hi)
+    mid = np.zeros(chain.n)
+    mid[limited] = 0.5 * (lo[limited] + hi[limited])  # an unlimited joint at 0
     position_only: dict[str, Any] = {} if orients else {"Kd_rot": 0.0}
     try:
         CartesianImpedance(chain, Ts=Ts, q0=mid, **position_only)

@@ -684,6 +684,12 @@ impl fmt::Display for Needs<'_> {
             }
             c.describe(f, c.threshold(self.rule), self.rule.margin)?;
             let (value, joint) = c.value(self.best);
+            if !value.is_finite() {
+                // No start got as far as this condition (every path checked
+                // diverged, or none was checked): no value to print.
+                write!(f, " (none measured: no start checked along the task)")?;
+                continue;
+            }
             write!(f, " (best ")?;
             significant(f, value)?;
             if let (Condition::Slack, Some(j)) = (c, joint) {
@@ -992,5 +998,15 @@ mod tests {
              0.2 at the start (best 1); the path reachable: the inverse kinematics within 0.001 \
              m of it (best 0)"
         );
+        // A condition no start reached (the path's reach when every path checked
+        // diverged) printed as such, not as "best inf".
+        let unmeasured = Assessment {
+            reach: f64::INFINITY,
+            ..a
+        };
+        assert!(rule.needs(&unmeasured).to_string().ends_with(
+            "the path reachable: the inverse kinematics within 0.001 m of it (none measured: \
+             no start checked along the task)"
+        ));
     }
 }

@@ -147,6 +147,10 @@ def test_simulate_runs_any_arm_on_the_python_route(tmp_path: Path) -> None:
     assert "on hobby_arm.urdf: 2500 steps" in proc.stdout
     assert "the Cartesian task, t ≥ 2 s: position RMS " in proc.stdout
     assert "(the position only: fewer than six joints)" in proc.stdout
+    # z1 of a Cartesian run is the tip's position error: three axes in m, not joints in rad.
+    assert "| RMS z1 per axis x, y, z, t ≥ 2 s (m) " in proc.stdout
+    assert "| RMS ‖z1‖ (m) " in proc.stdout
+    assert "(rad)" not in proc.stdout
     proc = run("simulate", "--model", HOBBY, "--tip", "tcp", check=False)
     assert proc.returncode == 2
     assert proc.stderr == (

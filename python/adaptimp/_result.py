@@ -1267,6 +1267,18 @@ def _cell(value: Any, spec: str) -> str:
     return format(value, spec)
 
 
+def _label(label: str, results: Sequence[Any]) -> str:
+    """``label`` for these runs: a Cartesian run's z1 is the tip's position
+    error in task space (x, y, z in m), not a joint's (the table printed
+    three "per joint" values in rad for a 5-joint arm)."""
+    task = ["rms_pos" in r.metrics for r in results]
+    if not any(task) or "z1" not in label:
+        return label
+    if all(task):
+        return label.replace("per joint", "per axis x, y, z").replace("(rad)", "(m)")
+    return label.replace("(rad)", "(rad; a Cartesian run's: m, per axis x, y, z)")
+
+
 def metrics_table(results: Mapping[str, SimResult] | Iterable[SimResult]) -> str:
     """The SPEC §12 metrics of several runs as a Markdown table, one column per run.
 
@@ -1280,7 +1292,8 @@ def metrics_table(results: Mapping[str, SimResult] | Iterable[SimResult]) -> str
     after = ", ".join(sorted({f"{r.params['settle']:g}" for _, r in cols}))
     header = ["metric (SPEC §12)"] + [title for title, _ in cols]
     body = [
-        [label.replace("{after}", after)] + [_cell(r.metrics[key], spec) for _, r in cols]
+        [_label(label, [r for _, r in cols]).replace("{after}", after)]
+        + [_cell(r.metrics[key], spec) for _, r in cols]
         for key, label, spec in _ROWS
     ]
     widths = [max(len(row[i]) for row in [header, *body]) for i in range(len(header))]

@@ -826,6 +826,7 @@ mod tests {
             mass: 1.0,
             origin: Origin::IDENTITY,
             inertia: [[d[0], 0.0, 0.0], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]],
+            gravcomp: 0.0,
         }
     }
 

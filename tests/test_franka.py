@@ -70,6 +70,25 @@ def test_the_controller_is_the_rule_a_simulate_user_gets() -> None:
     assert s.controller.params["delay"] == 1
 
 
+@pytest.mark.parametrize("task", ["joint", "cartesian"])
+def test_gravity_fed_forward_is_refused_on_a_franka(task: str) -> None:
+    """The robot adds its own model's gravity torque (docs/franka.md): the
+    Cartesian task took gravity="model" without a word, the joint task named
+    another reason."""
+    with pytest.raises(
+        adaptimp.ConfigError,
+        match=r"^gravity='model': the Franka adds its own model's gravity torque to every "
+        r"command \(libfranka\), so the controller never commands gravity; fed forward again "
+        r"it would count twice: keep the default \(docs/franka\.md, SPEC \(20\.10\)\)$",
+    ):
+        franka.setup("sf", franka.plant(FR3), READY, task=task, gravity="model")
+    robot = FakeRobot(FR3)
+    with pytest.raises(adaptimp.ConfigError, match=r"^gravity='model': the Franka adds"):
+        franka.run("sf", FR3, robot, T=1.0, task=task, start=READY, gravity="model")
+    assert robot.sent == []  # refused before the robot moved
+    assert robot.collision is None
+
+
 def test_the_joint_task_starts_at_rest_where_the_arm_stands() -> None:
     """The reference: at the standing posture, at rest, at t = 0; the path
     itself from t = blend on; its rates the derivatives of its position."""

@@ -291,10 +291,12 @@ def setup(
     (``delay`` = :data:`DELAY`, SPEC (18.11)); it gets the Franka's torque
     limits (:data:`TAU_MAX`, at most the URDF's effort) and libfranka's
     torque rate (``tau_rate_max`` = :data:`TORQUE_RATE` × 1 ms); ``params``
-    replace the rule's keywords.
+    replace the rule's keywords. ``gravity=`` is refused: the robot
+    compensates gravity itself (SPEC (20.10)).
     """
     if controller not in ("pd", "sf", "of"):
         raise ConfigError(f"controller must be 'pd', 'sf' or 'of', got {controller!r}")
+    _no_gravity(params)
     if task not in ("joint", "cartesian"):
         raise ConfigError(f"task must be 'joint' or 'cartesian', got {task!r}")
     if isinstance(urdf, amj.Plant):
@@ -325,6 +327,17 @@ def setup(
     ctrl = _adaptimp_controller(controller, kw)
     far = float(np.max(np.abs(jtask.q0 - q)))
     return Setup(ctrl, "joint", arm, q, jtask, max(float(blend), 1.875 * far / BLEND_SPEED))
+
+
+def _no_gravity(params: dict[str, Any]) -> None:
+    """``gravity=`` refused (the Cartesian task took ``gravity="model"``
+    without a word): the robot compensates gravity itself."""
+    if params.get("gravity") is not None:
+        raise ConfigError(
+            f"gravity={params['gravity']!r}: the Franka adds its own model's gravity torque to "
+            "every command (libfranka), so the controller never commands gravity; fed forward "
+            "again it would count twice: keep the default (docs/franka.md, SPEC (20.10))"
+        )
 
 
 def _adaptimp_controller(case: str, kw: dict[str, Any]) -> Any:
@@ -533,6 +546,7 @@ def run(
     """
     if not (isinstance(T, (int, float)) and math.isfinite(T) and T >= PERIOD):
         raise ConfigError(f"T must be a finite number ≥ 1 ms (s), got {T!r}")
+    _no_gravity(params)  # before the robot is touched
     r, enforced = _robot(robot, realtime)
     first = r.read_once()
     errors = _error_names(first.current_errors)

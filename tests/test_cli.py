@@ -142,7 +142,17 @@ def test_simulate_runs_any_arm_on_the_python_route(tmp_path: Path) -> None:
                check=False)  # fmt: skip
     assert proc.returncode == 2
     assert proc.stderr.startswith("adaptimp simulate: error: no start posture found")
+    assert proc.stderr.endswith(" (from the shell: --home q1,…,qn gives q0, --tip the tip)\n")
     assert len(proc.stderr.strip().splitlines()) == 1
+    # The refusal's advice runs from the shell: --home is the Cartesian task's start.
+    with pytest.warns(UserWarning, match="effort limit"):
+        plant = amj.Plant(HOBBY)
+    task = amj.cartesian_task(plant)
+    home = ",".join(repr(float(x)) for x in task.q0)
+    proc = run("simulate", "--model", HOBBY, "--task", "cartesian", "--home", home, "--T", "2.5",
+               "--json")  # fmt: skip
+    given = amj.simulate("sf", plant, T=2.5, task=amj.cartesian_task(plant, q0=task.q0))
+    assert json.loads(proc.stdout)["rms_pos_after2"] == given.metrics["rms_pos_after2"]
     proc = run("simulate", "--model", HOBBY, "--task", "cartesian", "--T", "2.5")
     assert "on hobby_arm.urdf: 2500 steps" in proc.stdout
     assert "the Cartesian task, t ≥ 2 s: position RMS " in proc.stdout

@@ -46,6 +46,7 @@ from typing import Any
 
 from . import __version__
 from ._api import simulate
+from ._errors import ConfigError
 from ._params import BY_NAME, CASE_NAMES, CASES, SCENARIOS, describe
 from ._plot import PLOT_KINDS, compare
 from ._result import SimResult, metrics_json, metrics_table
@@ -303,12 +304,14 @@ def _run_model(args: argparse.Namespace, params: dict[str, Any]) -> tuple[Any, f
     extra: dict[str, Any] = {"gravity": args.gravity, "payload": args.payload or 0.0}
     try:
         if args.task == "cartesian":
-            if args.home is not None:
-                raise CliError(
-                    "--home sets the joint task's posture; a Cartesian task draws its own"
-                )
             plant = amj.Plant(args.model, **where)
-            task = amj.cartesian_task(plant)
+            q0 = None if args.home is None else _angles(args.home)
+            try:
+                task = amj.cartesian_task(plant, q0=q0)
+            except ConfigError as e:  # its advice in the shell's words, too
+                raise CliError(
+                    f"{e} (from the shell: --home q1,…,qn gives q0, --tip the tip)"
+                ) from None
             params.setdefault("T", 12.0)
             res = amj.simulate(args.case, plant, task=task, scenario=scenario, **extra, **params)
             res.params["orients"] = task.orients
@@ -506,7 +509,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="with --model: a point mass (kg) at the end effector, the plant's only",
     )
     sim.add_argument(
-        "--home", help="with --model: the joint task's posture, q1,…,qn (rad; -pi/4 allowed)"
+        "--home",
+        help="with --model: the joint task's posture, or the Cartesian task's start, q1,…,qn "
+        "(rad; -pi/4 allowed)",
     )
     sim.add_argument(
         "--gravity",

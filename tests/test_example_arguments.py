@@ -153,3 +153,19 @@ def test_a_wrong_tip_is_one_line_not_a_traceback() -> None:
     )
     assert lines[-1].endswith("closest first: ['tool', 'wrist', 'upper_arm', 'jaw', 'base', "
                               "'hand', 'world', 'forearm', 'shoulder', 'finger_link']")  # fmt: skip
+
+
+def test_drift_is_read_as_printed() -> None:
+    """Both windows printed 0.000106 and the column read "no" (issue 45,
+    finding 11): the verdict compares the numbers the table shows."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("your_arm", EXAMPLE.with_name("15_your_arm.py"))
+    assert spec is not None
+    assert spec.loader is not None
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    assert f"{0.00010601:.3g}" == f"{0.00010649:.3g}" == "0.000106"
+    assert example.drift_ok(0.00010601, 0.00010649) == "yes"
+    assert example.drift_ok(0.000106, 0.000107) == "no"
+    assert example.drift_ok(0.000107, 0.000106) == "yes"

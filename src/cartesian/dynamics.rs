@@ -255,7 +255,7 @@ pub fn principal_moments(i: &[[f64; 3]; 3]) -> [f64; 3] {
     let m = Matrix3::from_fn(|r, c| 0.5 * (i[r][c] + i[c][r]));
     let e = m.symmetric_eigenvalues();
     let mut v = [e[0], e[1], e[2]];
-    v.sort_by(f64::total_cmp);
+    v.sort_unstable_by(f64::total_cmp);
     v
 }
 

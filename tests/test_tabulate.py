@@ -83,7 +83,7 @@ Z = np.zeros(3)
     [
         ((np.zeros(2), Z, Z), MeasurementError,
          "path(t)[0] must have shape (3,), got shape (2,)"),
-        ((Z, "x", Z), TypeError, "path(t)[1] must be an array of reals, got 'x'"),
+        ((Z, "x", Z), TypeError, "path(t)[1] must be real numbers, got str 'x'"),
         ((Z, Z, Z, np.zeros(9), Z, Z), MeasurementError,
          "path(t)[3] must have shape (3, 3), got shape (9,)"),
         ((Z, Z, Z, None, np.zeros((3, 1)), None), MeasurementError,

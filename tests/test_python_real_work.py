@@ -530,7 +530,9 @@ def test_measurement_error_names_the_argument_as_given() -> None:
         ctrl.step(Measurement([np.nan, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0]))
     with pytest.raises(adaptimp.MeasurementError, match=r"dq\[1\] is not finite"):
         ctrl.step(Measurement([0.0, 0.0], [0.0, np.inf], tau_e=[0.0, 0.0]))
-    with pytest.raises(adaptimp.MeasurementError, match=r"tau_e has 3 values and q 2: one value per joint each"):
+    with pytest.raises(
+        adaptimp.MeasurementError, match=r"tau_e has 3 values and q 2: one value per joint each"
+    ):
         ctrl.step(Measurement([0.0, 0.0], [0.0, 0.0], tau_e=[0.0, 0.0, 0.0]))
     with pytest.raises(adaptimp.MeasurementError, match="q holds a number too large"):
         ctrl.step(Measurement([10**400, 0], [0.0, 0.0], tau_e=[0.0, 0.0]))

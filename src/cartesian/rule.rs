@@ -768,7 +768,9 @@ impl fmt::Write for Cursor<'_> {
 /// With a loop delay δ ≥ 1 (SPEC (18.11)), D̂ and Ĉ learn δ + 1 times
 /// further inside Ĝ's bandwidth on such an orbit: its slow joint motion
 /// leaves their regressors α̇1, α1 to the velocity errors of the delayed
-/// loop, and at (18.6)'s ω_G/5 they rang on three arms.
+/// loop, and at (18.6)'s ω_G/5 they rang on three arms (so without the
+/// joint task's [`Rule::dc_boost`]: ω_D = ω_C = ω_G/(5(δ + 1)) of the
+/// delayed loop's ω_G).
 pub fn resolving<const N: usize>(rule: &Rule, path: &[Setpoint<N>]) -> Rule {
     let (mut lq, mut lv) = (0.0, 0.0);
     for (j, sp) in path.iter().enumerate() {
@@ -785,6 +787,8 @@ pub fn resolving<const N: usize>(rule: &Rule, path: &[Setpoint<N>]) -> Rule {
     }
     if rule.delay > 0 {
         out.learn_dc /= rule.delay as f64 + 1.0;
+        // Of the delayed loop's ω_G: not the joint task's undelayed ω_D.
+        out.dc_boost = 1.0;
     }
     out
 }
@@ -816,6 +820,10 @@ mod tests {
         for delay in [1, 2] {
             let late = resolving(&Rule::default().with_delay(delay).unwrap(), &path);
             assert_eq!(late.learn_dc, now.learn_dc / (delay as f64 + 1.0));
+            // Not the joint task's undelayed ω_D: the orbit's of the delayed ω_G.
+            let bounded = Rule::default().with_delay(delay).unwrap().bounded(6.0);
+            assert!(bounded.dc_boost > 1.0);
+            assert_eq!(resolving(&bounded, &path).dc_boost, 1.0);
             assert_eq!((late.tube, late.learn), (now.tube, now.learn));
         }
     }

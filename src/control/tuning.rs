@@ -152,6 +152,10 @@ pub struct Rule {
     /// The loop's delay δ (periods) the gains are made for, SPEC (18.11)
     /// (0 by default: the torque acts over the period its sample opens).
     pub delay: usize,
+    /// The factor on ω_D = ω_C that [`bounded`](Self::bounded) sets when it
+    /// slows the loop for a delay, SPEC (18.11): m/m_δ, so that D̂ and Ĉ keep
+    /// the undelayed rule's bandwidth, at most Ĝ's (1 without a delay).
+    pub dc_boost: f64,
 }
 
 impl Default for Rule {
@@ -167,6 +171,7 @@ impl Default for Rule {
             bound_margin: 2.0,
             span: 0.0,
             delay: 0,
+            dc_boost: 1.0,
         }
     }
 }
@@ -341,15 +346,24 @@ impl Rule {
     /// m_δ = min(m, g_δ / λmax)     (δ ≥ 1: the robust term off, (18.4))
     /// ```
     ///
-    /// with g_δ = [`loop_gain`]`(δ)`; K1 (18.2) and the learning (18.6)
-    /// follow m_δ. δ = 0 keeps m (18.1) as it is, bit for bit. A `lmax`
-    /// that is not finite and > 0 leaves the rule as it is.
+    /// with g_δ = [`loop_gain`]`(δ)`; K1 (18.2) and Ĝ's learning (18.6)
+    /// follow m_δ, while D̂ and Ĉ keep the undelayed rule's bandwidth
+    /// ([`dc_boost`](Self::dc_boost) = m/m_δ, ω_D = ω_C ≤ ω_G). δ = 0 keeps m
+    /// (18.1) as it is, bit for bit. A `lmax` that is not finite and > 0
+    /// leaves the rule as it is.
     #[must_use]
     pub fn bounded(&self, lmax: f64) -> Self {
         let mut rule = *self;
         if self.delay > 0 && lmax.is_finite() && lmax > 0.0 {
             let m = loop_gain(self.delay) / ((1.0 + self.robust_share()) * lmax);
-            rule.margin = rule.margin.min(m);
+            if m < rule.margin {
+                // D̂ and Ĉ keep the undelayed bandwidth ω_G(m)/5, at most ω_G.
+                let most = (1.0 / self.learn_dc).max(1.0);
+                rule.dc_boost = (self.dc_boost * rule.margin / m)
+                    .min(most)
+                    .max(self.dc_boost);
+                rule.margin = m;
+            }
         }
         rule
     }
@@ -563,7 +577,8 @@ impl Rule {
         }
         let rate = cfg.kp.component_div(&cfg.inertia).min();
         let omega2 = self.learn * rate * cfg.k1.min();
-        let dc2 = self.learn_dc * self.learn_dc * omega2;
+        let dc = self.learn_dc * self.dc_boost;
+        let dc2 = dc * dc * omega2;
         let or_one = |x: f64| if x > 0.0 { x } else { 1.0 };
         let gamma_g = omega2 / s2;
         cfg.gamma = [dc2 / (s2 * or_one(a2)), dc2 / (s2 * or_one(v2)), gamma_g];
@@ -1004,6 +1019,43 @@ mod tests {
             "{lb} {exact}"
         );
         assert!(loop_bound::<3>(&[], &s).is_err());
+    }
+
+    #[test]
+    fn a_delayed_rule_keeps_d_and_cs_undelayed_bandwidth() {
+        let rule = Rule::default();
+        let d = arm_matrix();
+        let tau = Vector::<3>::new(50.0, 20.0, 5.0);
+        let (path, g) = (default_path(), Vector::<3>::zeros());
+        let suggest = |r: &Rule| {
+            r.suggest(Law::StateFeedback, &d, &tau, 1e-3, &path, 2.0, Some(&g))
+                .unwrap()
+                .config
+        };
+        let late_rule = rule.with_delay(1).unwrap().bounded(4.0);
+        let f = late_rule.margin / rule.margin;
+        assert!((late_rule.dc_boost * f - 1.0).abs() < 1e-15);
+        let (base, late) = (suggest(&rule), suggest(&late_rule));
+        // Ĝ: ω_G² ∝ m K1 ∝ m², so Γ_G falls by f²; D̂ and Ĉ learn as undelayed.
+        assert!((late.gamma[2] / base.gamma[2] / (f * f) - 1.0).abs() < 1e-12);
+        for i in 0..2 {
+            assert!((late.gamma[i] / base.gamma[i] - 1.0).abs() < 1e-12, "{i}");
+        }
+        // Never faster than Ĝ: ω_D ≤ ω_G (learn_dc · dc_boost ≤ 1).
+        let slow = rule.with_delay(2).unwrap().bounded(100.0);
+        assert_eq!(slow.dc_boost, 1.0 / rule.learn_dc);
+        // Undelayed, or a mode small enough for m: no boost.
+        assert_eq!(rule.bounded(4.0).dc_boost, 1.0);
+        assert_eq!(rule.with_delay(1).unwrap().bounded(1.0).dc_boost, 1.0);
+        // A weightless arm's D̂ and Ĉ are at ω_G already.
+        assert_eq!(
+            rule.weightless()
+                .with_delay(1)
+                .unwrap()
+                .bounded(4.0)
+                .dc_boost,
+            1.0
+        );
     }
 
     #[test]

@@ -59,5 +59,19 @@ def test_every_extra_a_message_names_is_declared() -> None:
     for path in (ROOT / "python" / "adaptimp").glob("*.py"):
         source = path.read_text(encoding="utf-8")
         named |= set(re.findall(r'needs_extra\((?:"[^"]*",\s*){2}"(\w+)"\)', source))
-    assert named == {"mujoco", "pinocchio", "pandas", "xarray", "sweep", "franka"}
+    assert named == {"mujoco", "pinocchio", "pandas", "xarray", "sweep", "franka", "robosuite"}
     assert named <= declared
+
+
+def test_the_robosuite_controller_names_its_extra(monkeypatch: pytest.MonkeyPatch) -> None:
+    import importlib
+
+    monkeypatch.setitem(sys.modules, "robosuite", None)
+    monkeypatch.delitem(sys.modules, "adaptimp.robosuite", raising=False)
+    with pytest.raises(ImportError) as err:
+        importlib.import_module("adaptimp.robosuite")
+    assert str(err.value).startswith(
+        "adaptimp.robosuite needs robosuite>=1.5, an optional dependency (adaptimp's extra "
+        "'robosuite')"
+    )
+    assert err.match(HINT.format(pkg="robosuite>=1.5", extra="robosuite"))

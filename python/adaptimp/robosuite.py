@@ -1,0 +1,466 @@
+"""adaptimp's Cartesian impedance as a robosuite controller: ``ADAPTIMP``.
+
+Needs robosuite ≥ 1.5 and the MuJoCo it runs on (the extra ``robosuite``;
+robosuite 1.5.2 runs on MuJoCo 3.3.x). Importing this module registers the
+composite controller ``ADAPTIMP`` in robosuite's registry
+(``register_composite_controller``); nothing inside robosuite is changed::
+
+    import robosuite as suite
+    import adaptimp.robosuite
+
+    config = adaptimp.robosuite.controller_config("Panda")
+    env = suite.make("Lift", robots="Panda", controller_configs=config)
+
+(``controller_config(robot)`` is robosuite's own default configuration of the
+robot, ``load_composite_controller_config(robot=robot)``, with ``"type":
+"ADAPTIMP"``.) Per arm of the robot:
+
+- **The action is OSC_POSE's.** The arm's part configuration stays
+  robosuite's (``OSC_POSE`` or ``OSC_POSITION``: ``input_max``,
+  ``output_max``, ``input_type``, ``input_ref_frame``…), and robosuite's own
+  part controller turns each action into the goal pose, as it does for its
+  operational-space controller (the delta clipped and scaled, in the base
+  frame, from the pose reached): the same action dimension, limits and
+  frames. A script or a policy written for OSC_POSE runs unchanged; the
+  gripper keeps robosuite's own part controller, as do a torso, a head, a base.
+- **The torque is adaptimp's**: the core's Cartesian controller
+  (:meth:`adaptimp.CartesianController.from_rule`, case ``"sf"``) steps
+  towards that goal pose, world frame, at the gripper's grip site (the point
+  robosuite's OSC controls), at every model timestep (robosuite's controller
+  rate, 2 ms by default). It is built by the rule, nothing set per arm, from
+  robosuite's compiled model: the chain by :meth:`adaptimp.Chain.from_mujoco`
+  (gripper included: its fingers are not on the way to the grip site, so
+  they ride on the hand), the inertia D(q) and gravity G(q) the rule sizes
+  the joint controller by from MuJoCo's mass matrix (armature included) and
+  bias of that same model with the gripper's joints where they are, the
+  actuator limits robosuite gives the arm, the period of the model timestep,
+  and a loop delay of 0: robosuite computes the torque from the state after
+  ``mj_step1`` and applies it in ``mj_step2`` of the same timestep
+  (``MujocoEnv.step``). SPEC §22 has the equations and the decisions:
+  :func:`impedance` (the target impedance at the joint loop's bandwidth, no
+  filter on the goal's jumps, which are robosuite's by design), the wrench
+  (:class:`SceneWrench`: contact with the fixed scene, filtered over one
+  policy period, no feedforward).
+- ``reset()``: robosuite builds its controllers anew at every
+  ``env.reset()``, and so does ADAPTIMP (the networks start from zero, the
+  outer loop at the arm's posture). ``reset_goal()`` (robosuite's
+  ``composite_controller.reset()``) holds the pose reached, as OSC's does, and
+  restarts the outer loop at the measured posture (the networks keep what
+  they learnt).
+
+Per-arm options (the ``"adaptimp"`` entry of the arm's part configuration,
+:func:`controller_config`'s keywords): ``case`` ("sf", "pd", "of"), and any
+parameter of :class:`adaptimp.CartesianController` (``Kd``, ``Md``,
+``force_filter``, ``gamma``, …), which replaces the rule's.
+
+Units: m, rad, s, N, N m; vectors in the world frame.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._errors import ConfigError, PlantWarning, needs_extra
+
+try:
+    import mujoco
+    from robosuite.controllers import controller_factory, load_composite_controller_config
+    from robosuite.controllers.composite.composite_controller import (
+        CompositeController,
+        register_composite_controller,
+    )
+except ImportError as e:  # pragma: no cover - depends on the environment
+    raise needs_extra("adaptimp.robosuite", "robosuite>=1.5", "robosuite") from e
+
+from . import tuning
+from ._adaptimp import Measurement
+from ._cartesian_task import CirclePath
+from ._description import read_arm
+from ._params import defaults
+from .cartesian import CartesianController
+from .chain import Chain
+
+__all__ = [
+    "ARM_TYPES",
+    "NAME",
+    "AdaptimpComposite",
+    "ArmController",
+    "SceneWrench",
+    "arm_chain",
+    "controller_config",
+    "held_joints",
+    "impedance",
+]
+
+FloatArray = NDArray[np.float64]
+
+NAME = "ADAPTIMP"
+"""The composite controller's name in robosuite's registry (a configuration's ``"type"``)."""
+
+ARM_TYPES = ("OSC_POSE", "OSC_POSITION")
+"""The arm part types whose actions ADAPTIMP takes."""
+
+
+def controller_config(robot: str, **params: Any) -> dict[str, Any]:
+    """robosuite's own default controller configuration of ``robot`` (as
+    ``load_composite_controller_config(robot=robot)`` loads it) with the
+    composite type ADAPTIMP: the arms' OSC_POSE parts, and so the actions,
+    unchanged. ``params`` go to every arm's adaptimp controller (its part's
+    ``"adaptimp"`` entry): ``case`` and the parameters of
+    :class:`adaptimp.CartesianController`."""
+    config: dict[str, Any] = load_composite_controller_config(robot=robot)
+    config["type"] = NAME
+    if params:
+        for part in config["body_parts"].values():
+            if isinstance(part, dict) and part.get("type") in ARM_TYPES:
+                part["adaptimp"] = dict(params)
+    return config
+
+
+def impedance(k1: float, policy_period: float) -> dict[str, Any]:
+    """The Cartesian parameters ADAPTIMP gives the rule (SPEC (22.1)–(22.3)),
+    for a joint loop whose position gain is ``k1`` (1/s, the rule's K1) under
+    a policy that sets a goal every ``policy_period`` (s):
+
+    - the target impedance at the joint loop's bandwidth, critically damped:
+      K_d = M_d K1², K_d,rot = M_d,rot K1² (N/m, N m/rad; M_d, M_d,rot the
+      schema's, B_d, B_d,rot critical);
+    - no filter on the commanded pose (``target_filter = 0``): robosuite's goal
+      jumps at every action by design, and OSC takes it as it jumps;
+    - the measured wrench filtered over one policy period, and not fed
+      forward to the joint law (``force_filter``, ``force_feedforward``)."""
+    d = defaults("robot")
+    md = np.asarray(d["Md"], dtype=np.float64)
+    mr = np.asarray(d["Md_rot"], dtype=np.float64)
+    return {
+        "Kd": (md * k1 * k1).tolist(),
+        "Kd_rot": (mr * k1 * k1).tolist(),
+        "target_filter": 0.0,
+        "force_filter": float(policy_period),
+        "force_feedforward": False,
+    }
+
+
+class _ArmModel:
+    """The inertia D(q) (kg m², (n, n)) and gravity G(q) (N m, (n,)) of an arm
+    of a compiled MuJoCo model, as the rule reads a model
+    (:func:`adaptimp.tuning.inertia`): MuJoCo's mass matrix (armature
+    included) and bias at rest, on a state of its own in which every other
+    joint (a gripper's fingers, the scene's objects) stays where ``data`` has it."""
+
+    def __init__(self, model: Any, data: Any, qpos: ArrayLike, dofs: ArrayLike) -> None:
+        self._m = model
+        self._d = mujoco.MjData(model)
+        self._d.qpos[:] = data.qpos
+        self._qpos = np.asarray(qpos, dtype=np.intp)
+        self._dofs = np.asarray(dofs, dtype=np.intp)
+        self._full = np.zeros((model.nv, model.nv))
+
+    def _at(self, q: ArrayLike) -> None:
+        self._d.qpos[self._qpos] = q
+        self._d.qvel[:] = 0.0
+        mujoco.mj_forward(self._m, self._d)
+
+    def D(self, q: ArrayLike) -> FloatArray:
+        """D(q) (kg m²), (n, n)."""
+        self._at(q)
+        mujoco.mj_fullM(self._m, self._full, self._d.qM)
+        return np.array(self._full[np.ix_(self._dofs, self._dofs)], dtype=np.float64)
+
+    def G(self, q: ArrayLike) -> FloatArray:
+        """G(q) (N m), (n,)."""
+        self._at(q)
+        return np.array(self._d.qfrc_bias[self._dofs], dtype=np.float64)
+
+
+def held_joints(model: Any, data: Any, joints: ArrayLike) -> dict[int, str]:
+    """The arm joints (ids among ``joints``) that a contact of the arm with
+    itself pins where it stands (SPEC (22.5)): a contact, in ``data``'s
+    contact list, between two bodies of the arm (its base and everything
+    below it) on either side of the joint in the kinematic tree. Such a joint
+    cannot turn without sliding that contact: robosuite's Sawyer stands with
+    its first link on its base (MuJoCo does not filter a contact with a parent
+    welded to the world), and 80 N m turn it by 0.4 mrad in 1 s. Returns
+    {joint id: the contact's bodies}."""
+    ids = [int(j) for j in np.asarray(joints).ravel()]
+    parent = np.asarray(model.body_parentid)
+    base = int(parent[int(model.jnt_bodyid[ids[0]])])
+    arm = _subtree(model, base)
+
+    def above(b: int) -> set[int]:
+        out = {b}
+        while b > 0:
+            b = int(parent[b])
+            out.add(b)
+        return out
+
+    held: dict[int, str] = {}
+    for i in range(data.ncon):
+        a, b = (int(model.geom_bodyid[g]) for g in data.contact.geom[i])
+        if not (arm[a] and arm[b]):
+            continue
+        path_a, path_b = above(a), above(b)
+        for j in ids:
+            if (int(model.jnt_bodyid[j]) in path_a) != (int(model.jnt_bodyid[j]) in path_b):
+                held.setdefault(j, " and ".join(_body_name(model, x) for x in (a, b)))
+    return held
+
+
+def arm_chain(model: Any, site: str, held: Mapping[str, float] | None = None) -> Chain:
+    """The chain of a compiled MuJoCo model's arm to ``site``
+    (:meth:`adaptimp.Chain.from_mujoco`), with the joints named in ``held``
+    held at the given values (rad or m): each folds into the next joint's
+    origin as a fixed joint turned (or slid) by its value from its reference."""
+    if not held:
+        return Chain.from_mujoco(model, site)
+    arm = read_arm(model, site)
+    joints: list[dict[str, Any]] = []
+    names: list[str] = []
+    for name, joint in zip(arm.joints, arm.chain):
+        if name not in held:
+            joints.append(joint)
+            names.append(name)
+            continue
+        axis = np.asarray(joint["axis"], dtype=np.float64)
+        axis = axis / np.linalg.norm(axis)
+        shift = float(held[name]) - float(joint.get("offset", 0.0))
+        joints.append({**{k: v for k, v in joint.items() if k not in ("axis", "offset")},
+                       "kind": "fixed"})  # fmt: skip
+        if joint["kind"] == "prismatic":
+            joints.append({"kind": "fixed", "translation": (shift * axis).tolist()})
+        else:  # the turn about the axis, as a quaternion [w, x, y, z]
+            half = 0.5 * shift
+            joints.append({"kind": "fixed", "quat": [math.cos(half), *(math.sin(half) * axis)]})
+    chain = Chain(joints, arm.tip_origin, names=names, source=f"MuJoCo model to site {site!r}")
+    chain.fixed = {**arm.fixed, **{n: f"held at {held[n]:.6g}" for n in held}}
+    return chain
+
+
+def _body_name(model: Any, b: int) -> str:
+    return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"body {b}"
+
+
+def _subtree(model: Any, top: int) -> NDArray[np.bool_]:
+    """Which bodies are ``top`` or below it."""
+    parent = np.asarray(model.body_parentid)
+    inside = np.zeros(model.nbody, dtype=bool)
+    for b in range(model.nbody):
+        c = b
+        while c > 0 and c != top:
+            c = int(parent[c])
+        inside[b] = c == top
+    return inside
+
+
+class SceneWrench:
+    """The wrench F_e = [f; m] (N, N m), (6,), that the end effector exerts on
+    the fixed scene, world frame, the moment about the grip site (SPEC
+    (22.4)): the sum of MuJoCo's contact forces (``mj_contactForce``) between
+    the end effector (the body of the arm's last joint and everything below
+    it: hand and gripper) and the bodies welded to the world (a table, a
+    wall). A free object in the gripper (a cube) is a load the arm carries,
+    which the networks learn, not a wrench to comply with.
+
+    robosuite runs its controllers between ``mj_step1`` and ``mj_step2``: the
+    contacts are the timestep's, their forces not yet solved. When the end
+    effector touches the fixed scene, this solves them (``mj_fwdActuation``,
+    ``mj_fwdAcceleration``, ``mj_fwdConstraint``, with the torque of the last
+    timestep still applied); ``mj_step2`` solves them again with the new one."""
+
+    def __init__(self, model: Any, data: Any, last_joint: int, site: int) -> None:
+        self._m, self._d, self._site = model, data, site
+        body = np.asarray(model.geom_bodyid)
+        self._ee = _subtree(model, int(model.jnt_bodyid[last_joint]))[body]
+        self._fixed = (np.asarray(model.body_weldid) == 0)[body]
+        self._f = np.zeros(6)
+        self.wrench = np.zeros(6)
+        """The last wrench (N, N m), (6,): read it, do not keep it (overwritten)."""
+
+    def __call__(self) -> FloatArray:
+        """F_e now (N, N m), (6,)."""
+        m, d, w = self._m, self._d, self.wrench
+        w[:] = 0.0
+        if d.ncon == 0:
+            return w
+        contact = d.contact
+        g = contact.geom
+        first = self._ee[g[:, 0]] & self._fixed[g[:, 1]]
+        second = self._ee[g[:, 1]] & self._fixed[g[:, 0]]
+        hits = np.flatnonzero(first | second)
+        if hits.size == 0:
+            return w
+        mujoco.mj_fwdActuation(m, d)
+        mujoco.mj_fwdAcceleration(m, d)
+        mujoco.mj_fwdConstraint(m, d)
+        local = np.empty((hits.size, 3))
+        for j, i in enumerate(hits):
+            mujoco.mj_contactForce(m, d, int(i), self._f)
+            local[j] = self._f[:3]
+        # The force on geom2 in the world frame (the frame's rows are the
+        # contact's axes, the normal from geom1 to geom2): what the end
+        # effector exerts when it is geom1, the opposite when it is geom2.
+        f = np.einsum("kji,kj->ki", contact.frame[hits].reshape(-1, 3, 3), local)
+        f[second[hits]] *= -1.0
+        w[:3] = f.sum(axis=0)
+        w[3:] = np.cross(contact.pos[hits] - d.site_xpos[self._site], f).sum(axis=0)
+        return w
+
+
+class ArmController:
+    """One arm of ADAPTIMP: robosuite's OSC part controller ``osc`` reads the
+    action into the goal pose; adaptimp's Cartesian controller :attr:`ctrl`
+    computes the torque. Every attribute but the ones below is ``osc``'s (the
+    goal, the reference pose, the limits robosuite reads).
+
+    Parameters
+    ----------
+    osc : robosuite OperationalSpaceController
+        The arm's part controller as robosuite's ``controller_factory`` makes it.
+    params : dict, optional
+        ``case`` and :class:`adaptimp.CartesianController` parameters replacing
+        the rule's.
+    """
+
+    def __init__(self, osc: Any, params: Mapping[str, Any] | None = None) -> None:
+        self.osc = osc
+        sim = osc.sim
+        self._model, self._data = sim.model._model, sim.data._data
+        m = self._model
+        self.held = {
+            mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint {j}": bodies
+            for j, bodies in held_joints(m, self._data, osc.joint_index).items()
+        }
+        """The arm's joints a contact of the arm with itself pins, and the
+        contact's bodies (:func:`held_joints`): held, the chain without them,
+        no torque."""
+        for name, bodies in self.held.items():
+            warnings.warn(
+                f"{NAME}: the arm touches itself across joint {name!r} ({bodies}), which "
+                "cannot turn without sliding that contact: the joint is held where it "
+                "stands (no torque), the arm's other joints do the task",
+                PlantWarning,
+                stacklevel=4,
+            )
+        names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(j)) for j in osc.joint_index]
+        self._active = np.array([n not in self.held for n in names])
+        self._qpos = np.asarray(osc.qpos_index, dtype=np.intp)[self._active]
+        self._qvel = np.asarray(osc.qvel_index, dtype=np.intp)[self._active]
+        self._tau = np.zeros(len(names))
+        self.params = dict(params or {})
+        self.ctrl = self._build()
+        """The arm's :class:`adaptimp.CartesianController`."""
+        site = mujoco.mj_name2id(self._model, mujoco.mjtObj.mjOBJ_SITE, osc.ref_name)
+        self.wrench = SceneWrench(self._model, self._data, int(osc.joint_index[-1]), site)
+        """The arm's :class:`SceneWrench`."""
+
+    def _build(self) -> CartesianController:
+        m, d, osc = self._model, self._data, self.osc
+        joint = mujoco.mjtObj.mjOBJ_JOINT
+        where = {n: float(d.qpos[m.jnt_qposadr[mujoco.mj_name2id(m, joint, n)]]) for n in self.held}
+        chain = arm_chain(m, osc.ref_name, where)
+        names = [
+            mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(j))
+            for j, on in zip(osc.joint_index, self._active)
+            if on
+        ]
+        if chain.joint_names != names:
+            raise ConfigError(
+                f"robosuite's arm joints {names} are not the chain to its grip site "
+                f"{osc.ref_name!r} ({chain.joint_names})"
+            )
+        q0 = np.array(d.qpos[self._qpos], dtype=np.float64)
+        model = _ArmModel(m, d, self._qpos, self._qvel)
+        tau_max = np.asarray(osc.actuator_max, dtype=np.float64)[self._active]
+        Ts = float(m.opt.timestep)
+        kw = dict(self.params)
+        case = kw.pop("case", "sf")
+        # The rule's position gain K1 (one value for every joint, SPEC (18.2)).
+        k1 = float(np.min(tuning.suggest(model, q0, tau_max, Ts=Ts, case=case)["K1"]))
+        rule = impedance(k1, 1.0 / float(osc.control_freq))
+        rule.update(kw)
+        ctrl = CartesianController.from_rule(
+            chain, case, CirclePath(*chain.pose(q0)), q0, model=model, tau_max=tau_max, Ts=Ts,
+            delay=0, **rule,
+        )  # fmt: skip
+        ctrl.record = False
+        return ctrl
+
+    def __getattr__(self, name: str) -> Any:
+        if name == "osc":  # not yet set: construction failed
+            raise AttributeError(name)
+        return getattr(self.osc, name)
+
+    def goal(self) -> tuple[FloatArray, FloatArray]:
+        """The goal pose robosuite's OSC derives from the action, world frame:
+        the grip site's position (m), (3,), and rotation (world ← site), (3, 3)."""
+        o = self.osc
+        if o.input_ref_frame == "base":
+            return o.origin_pos + o.origin_ori @ o.goal_pos, o.origin_ori @ o.goal_ori
+        return np.asarray(o.goal_pos, dtype=np.float64), np.asarray(o.goal_ori, dtype=np.float64)
+
+    def run_controller(self) -> FloatArray:
+        """The torque (N m), (n,), of one model timestep towards :meth:`goal`."""
+        p, R = self.goal()
+        d = self._data
+        m = Measurement(d.qpos[self._qpos], d.qvel[self._qvel], wrench=self.wrench())
+        tau = self._tau
+        tau[self._active] = self.ctrl.step(m, xc=p, R=R)
+        out = tau.copy()
+        o = self.osc
+        o.torques = out
+        o.new_update = True  # robosuite reads the state again at the next action, as after OSC
+        return out
+
+    def reset_goal(self, *args: Any, **kwargs: Any) -> None:
+        """OSC's ``reset_goal`` (the goal: the pose reached, read now), and the
+        outer loop restarted at the measured posture."""
+        self.osc.update()  # the pose reached (OSC reads it at every step; ADAPTIMP at actions)
+        self.osc.reset_goal(*args, **kwargs)
+        self.ctrl.outer.reset(np.array(self._data.qpos[self._qpos], dtype=np.float64))
+
+    @property
+    def name(self) -> str:
+        """``"ADAPTIMP_OSC_POSE"`` (or ``_OSC_POSITION``)."""
+        return f"{NAME}_{self.osc.name}"
+
+
+@register_composite_controller
+class AdaptimpComposite(CompositeController):  # type: ignore[misc]
+    """robosuite's composite controller with adaptimp on the arms (module doc)."""
+
+    name = NAME
+
+    def _init_controllers(self) -> None:
+        for part, params in self.part_controller_config.items():
+            kind = params["type"]
+            arm = part in self.arms
+            if arm:
+                _check_arm(part, params)
+            own = controller_factory(part_name=part, controller_type=kind, controller_params=params)
+            self.part_controllers[part] = ArmController(own, params.get("adaptimp")) if arm else own
+
+
+def _check_arm(part: str, params: Mapping[str, Any]) -> None:
+    """An arm part configuration ADAPTIMP can take, or a ConfigError naming what not."""
+    kind = params["type"]
+    if kind not in ARM_TYPES:
+        raise ConfigError(
+            f"{NAME} takes the actions of {' or '.join(ARM_TYPES)} on arm {part!r}, got {kind!r}"
+        )
+    if params.get("interpolation") not in (None, "null"):
+        raise ConfigError(
+            f"{NAME} steps towards the goal robosuite's OSC sets at each action; arm {part!r} "
+            f"asks for interpolation {params['interpolation']!r} (give null)"
+        )
+    mode = params.get("impedance_mode", "fixed")
+    if mode != "fixed":
+        raise ConfigError(
+            f"{NAME} sizes its impedance by the rule; arm {part!r} asks for impedance_mode "
+            f"{mode!r}, whose actions set OSC's gains (give 'fixed')"
+        )

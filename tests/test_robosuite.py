@@ -1,0 +1,229 @@
+"""ADAPTIMP, adaptimp's controller in robosuite (adaptimp.robosuite, SPEC §22).
+
+Runs where robosuite is installed (CI: scripts/test.sh makes an environment
+with the extra ``robosuite``, robosuite 1.5 on MuJoCo 3.3); skipped elsewhere.
+Short runs on robosuite's own Lift and Panda: the registry, the action
+(dimension, limits, the goal, the gripper: OSC_POSE's), the torque (the core's
+controller by the rule, applied as computed), reset and reset_goal, the
+refusals, the scene's wrench.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+suite = pytest.importorskip("robosuite")
+
+import mujoco  # noqa: E402
+from robosuite.controllers import load_composite_controller_config  # noqa: E402
+from robosuite.controllers.composite.composite_controller import (  # noqa: E402
+    REGISTERED_COMPOSITE_CONTROLLERS_DICT,
+)
+
+import adaptimp  # noqa: E402
+import adaptimp.robosuite as ars  # noqa: E402
+from adaptimp import ConfigError  # noqa: E402
+
+
+def make(config: dict, seed: int = 3, env: str = "Lift"):
+    return suite.make(
+        env, robots="Panda", controller_configs=config, has_renderer=False,
+        has_offscreen_renderer=False, use_camera_obs=False, seed=seed,
+    )  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def pair():
+    """The same Lift (same seed) under OSC_POSE and under ADAPTIMP, reset."""
+    osc = make(load_composite_controller_config(robot="Panda"))
+    ours = make(ars.controller_config("Panda"))
+    return osc, osc.reset(), ours, ours.reset()
+
+
+def arm(env):
+    return env.robots[0].part_controllers["right"]
+
+
+def test_importing_registers_adaptimp():
+    assert REGISTERED_COMPOSITE_CONTROLLERS_DICT["ADAPTIMP"] is ars.AdaptimpComposite
+    assert ars.NAME == "ADAPTIMP"
+
+
+def test_the_config_is_robosuites_own_with_the_type():
+    own = load_composite_controller_config(robot="Panda")
+    ours = ars.controller_config("Panda")
+    assert ours["type"] == "ADAPTIMP"
+    assert {k: v for k, v in ours.items() if k != "type"} == {
+        k: v for k, v in own.items() if k != "type"
+    }
+    tuned = ars.controller_config("Panda", Kd=800.0, case="pd")
+    assert tuned["body_parts"]["right"]["adaptimp"] == {"Kd": 800.0, "case": "pd"}
+
+
+def test_the_action_space_is_osc_poses(pair):
+    osc, _, ours, _ = pair
+    assert ours.action_dim == osc.action_dim == 7
+    for a, b in zip(ours.action_spec, osc.action_spec):
+        assert np.array_equal(a, b)
+    parts = ours.robots[0].part_controllers
+    assert isinstance(parts["right"], ars.ArmController)
+    assert parts["right"].name == "ADAPTIMP_OSC_POSE"
+    # The gripper keeps robosuite's own part controller.
+    assert type(parts["right_gripper"]) is type(osc.robots[0].part_controllers["right_gripper"])
+
+
+def test_the_arm_runs_the_rules_cartesian_controller(pair):
+    _, _, ours, _ = pair
+    part = arm(ours)
+    ctrl = part.ctrl
+    assert isinstance(ctrl, adaptimp.CartesianController)
+    assert ctrl.chain.joint_names == [f"robot0_joint{i}" for i in range(1, 8)]
+    inner = ctrl.params["inner"]
+    # robosuite's controller rate (its model timestep) and loop delay (0).
+    assert ctrl.Ts == ours.sim.model.opt.timestep == 0.002
+    assert inner["delay"] == 0
+    assert inner["tau_max"] == [80.0] * 5 + [12.0] * 2
+    # The target impedance at the rule's K1, critically damped (SPEC (22.1)).
+    k1 = min(inner["K1"])
+    assert k1 == pytest.approx(25.0)
+    assert ctrl.params["Kd"] == [2.0 * k1 * k1] * 3
+    assert ctrl.params["Kd_rot"] == [0.08 * k1 * k1] * 3
+    assert ctrl.params["target_filter"] == 0.0
+    assert ctrl.params["force_filter"] == 1.0 / ours.control_freq
+    assert ctrl.params["force_feedforward"] is False
+
+
+def test_the_goal_is_oscs_and_the_gripper_acts_the_same(pair):
+    osc, obs_osc, ours, obs_ours = pair
+    # The same seed: the same start.
+    assert np.array_equal(obs_osc["robot0_joint_pos"], obs_ours["robot0_joint_pos"])
+    action = np.array([0.4, -0.2, 0.3, 0.1, -0.2, 0.05, 1.0])
+    osc.step(action)
+    ours.step(action)
+    o = arm(osc)
+    p_osc = o.origin_pos + o.origin_ori @ o.goal_pos
+    p, R = arm(ours).goal()
+    # Set from the same state by robosuite's own code.
+    assert np.array_equal(p, p_osc)
+    assert np.array_equal(R, o.origin_ori @ o.goal_ori)
+    assert np.array_equal(arm(ours).osc.goal_pos, o.goal_pos)
+    # The grippers' commands are equal (robosuite's gripper controller, the same action).
+    g_osc = osc.robots[0]._ref_actuators_indexes_dict["right_gripper"]
+    g_ours = ours.robots[0]._ref_actuators_indexes_dict["right_gripper"]
+    assert np.array_equal(osc.sim.data.ctrl[g_osc], ours.sim.data.ctrl[g_ours])
+
+
+def test_the_torque_is_the_cores_and_applied_as_computed():
+    env = make(ars.controller_config("Panda"), seed=5)
+    env.reset()
+    env.step(np.array([0.2, 0.0, -0.1, 0.0, 0.0, 0.0, -1.0]))
+    part = arm(env)
+    d = env.sim.data
+    # Two controllers by the rule from the same state: the arm's step is the
+    # core controller's step on the measured state towards OSC's goal, bit for bit.
+    ours, twin = ars.ArmController(part.osc), ars.ArmController(part.osc)
+    p, R = ours.goal()
+    m = adaptimp.Measurement(d.qpos[ours._qpos], d.qvel[ours._qvel], wrench=np.zeros(6))
+    assert np.array_equal(ours.run_controller(), twin.ctrl.step(m, xc=p, R=R))
+    # robosuite writes the arm's torque into ctrl, clipped to ctrlrange, in the
+    # timestep it is computed for (delay 0).
+    env.step(np.zeros(7))
+    acts = env.robots[0]._ref_actuators_indexes_dict["right"]
+    lo, hi = env.sim.model.actuator_ctrlrange[acts].T
+    assert np.array_equal(d.ctrl[acts], np.clip(part.osc.torques, lo, hi))
+
+
+def test_a_policy_moves_the_arm_where_osc_pose_would():
+    env = make(ars.controller_config("Panda"), seed=1)
+    obs = env.reset()
+    start = obs["robot0_eef_pos"].copy()
+    target = start + np.array([0.05, -0.03, 0.04])
+    for _ in range(40):  # 2 s at 20 Hz: a policy's proportional step, clipped
+        a = np.zeros(7)
+        a[:3] = np.clip((target - obs["robot0_eef_pos"]) / 0.05, -1, 1)
+        a[6] = -1.0
+        obs, *_ = env.step(a)
+    assert np.linalg.norm(obs["robot0_eef_pos"] - target) < 2e-3
+    assert arm(env).ctrl.inner.fault is None
+
+
+def test_reset_builds_a_fresh_controller_and_reset_goal_holds_the_pose():
+    env = make(ars.controller_config("Panda"), seed=2)
+    env.reset()
+    first = arm(env)
+    for _ in range(5):
+        env.step(np.array([0.5, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0]))
+    assert first.ctrl.outer.core.steps == 125
+    comp = env.robots[0].composite_controller
+    comp.update_state()
+    comp.reset()
+    # OSC's reset_goal: the goal is the grip site's pose now (as robosuite sets it).
+    site = env.sim.model.site_name2id(first.ref_name)
+    assert np.array_equal(first.osc.goal_pos, env.sim.data.site_xpos[site])
+    assert np.array_equal(first.osc.goal_ori, env.sim.data.site_xmat[site].reshape(3, 3))
+    assert first.ctrl.outer.core.steps == 0
+    env.reset()
+    second = arm(env)
+    assert second is not first
+    assert second.ctrl.outer.core.steps == 0
+    assert all(np.count_nonzero(w) == 0 for w in second.ctrl.inner.weights.values())
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("type", "JOINT_VELOCITY", "ADAPTIMP takes the actions of OSC_POSE or OSC_POSITION on "
+         "arm 'right', got 'JOINT_VELOCITY'"),
+        ("interpolation", "linear", "asks for interpolation 'linear' (give null)"),
+        ("impedance_mode", "variable", "asks for impedance_mode 'variable'"),
+    ],
+)  # fmt: skip
+def test_refusals_name_the_arm_and_the_key(key, value, message):
+    config = ars.controller_config("Panda")
+    config["body_parts"]["right"][key] = value
+    with pytest.raises(ConfigError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        make(config).reset()
+
+
+SCENE = """
+<mujoco>
+  <option timestep="0.002"/>
+  <worldbody>
+    <geom name="table" type="box" size="0.5 0.5 0.05" pos="0 0 -0.05"/>
+    <body name="arm" pos="0 0 0.2">
+      <joint name="slide" type="slide" axis="0 0 1"/>
+      <geom type="capsule" fromto="0 0 0 0 0 0.1" size="0.01" mass="0.1" contype="0"
+            conaffinity="0"/>
+      <body name="hand" pos="0 0 0">
+        <joint name="hinge" type="hinge" axis="0 0 1"/>
+        <geom name="pad" type="box" size="0.05 0.05 0.01" pos="0.1 0 -0.1" mass="2"/>
+        <site name="tip" pos="0 0 -0.11"/>
+      </body>
+    </body>
+    <body name="box" pos="0.1 0 0.2">
+      <freejoint/>
+      <geom type="box" size="0.02 0.02 0.02" mass="0.5"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_the_scene_wrench_is_the_push_on_fixed_bodies_only():
+    m = mujoco.MjModel.from_xml_string(SCENE)
+    d = mujoco.MjData(m)
+    for _ in range(1500):  # settle: the pad on the table, the box on the pad
+        mujoco.mj_step(m, d)
+    hinge = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "hinge")
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "tip")
+    wrench = ars.SceneWrench(m, d, hinge, site)
+    mujoco.mj_step1(m, d)
+    w = wrench().copy()
+    g = 9.81
+    # The arm (0.1 kg), the pad (2 kg) and the box the pad carries (0.5 kg, a
+    # free body: a load, not a wrench) press on the table through the pad.
+    weight = (0.1 + 2.0 + 0.5) * g
+    assert w[:3] == pytest.approx([0.0, 0.0, -weight], abs=1e-3)
+    # About the tip, 0.1 m beside the pad's centre: the moment of that force.
+    assert w[3:] == pytest.approx([0.0, weight * 0.1, 0.0], abs=1e-3)

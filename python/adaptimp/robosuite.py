@@ -36,7 +36,7 @@ robot, ``load_composite_controller_config(robot=robot)``, with ``"type":
   actuator limits robosuite gives the arm, the period of the model timestep,
   and a loop delay of 0: robosuite computes the torque from the state after
   ``mj_step1`` and applies it in ``mj_step2`` of the same timestep
-  (``MujocoEnv.step``). SPEC §22 has the equations and the decisions:
+  (``MujocoEnv.step``). SPEC §23 has the equations and the decisions:
   :func:`impedance` (the target impedance at the joint loop's bandwidth, no
   filter on the goal's jumps, which are robosuite's by design), the wrench
   (:class:`SceneWrench`: contact with the fixed scene, filtered over one
@@ -124,7 +124,7 @@ def controller_config(robot: str, **params: Any) -> dict[str, Any]:
 
 
 def impedance(k1: float, policy_period: float) -> dict[str, Any]:
-    """The Cartesian parameters ADAPTIMP gives the rule (SPEC (22.1)–(22.3)),
+    """The Cartesian parameters ADAPTIMP gives the rule (SPEC (23.1)–(23.3)),
     for a joint loop whose position gain is ``k1`` (1/s, the rule's K1) under
     a policy that sets a goal every ``policy_period`` (s):
 
@@ -181,7 +181,7 @@ class _ArmModel:
 
 def held_joints(model: Any, data: Any, joints: ArrayLike) -> dict[int, str]:
     """The arm joints (ids among ``joints``) that a contact of the arm with
-    itself pins where it stands (SPEC (22.5)): a contact, in ``data``'s
+    itself pins where it stands (SPEC (23.5)): a contact, in ``data``'s
     contact list, between two bodies of the arm (its base and everything
     below it) on either side of the joint in the kinematic tree. Such a joint
     cannot turn without sliding that contact: robosuite's Sawyer stands with
@@ -261,7 +261,7 @@ def _subtree(model: Any, top: int) -> NDArray[np.bool_]:
 class SceneWrench:
     """The wrench F_e = [f; m] (N, N m), (6,), that the end effector exerts on
     the fixed scene, world frame, the moment about the grip site (SPEC
-    (22.4)): the sum of MuJoCo's contact forces (``mj_contactForce``) between
+    (23.4)): the sum of MuJoCo's contact forces (``mj_contactForce``) between
     the end effector (the body of the arm's last joint and everything below
     it: hand and gripper) and the bodies welded to the world (a table, a
     wall). A free object in the gripper (a cube) is a load the arm carries,

@@ -10,12 +10,14 @@ the orientation held (6-D), the commanded pose a Python function of t
 called once per period by both loops. The control period Ts = 1 ms in both,
 the torque held for the period's MuJoCo steps.
 
-- **adaptimp**: ``adaptimp.CartesianController(chain, "sf", …)`` (the core's
-  6-D Cartesian impedance of SPEC §16 in front of the adaptive state
-  feedback, which learns as it runs; gains and centres from SPEC §18's rule
-  and the circle's joint orbit), run by ``adaptimp.mujoco.simulate`` (the
-  loop in the core: MuJoCo through its C library, the controller and the
-  path's call each period, the log and the metrics).
+- **adaptimp**: ``adaptimp.CartesianController.from_rule(chain, "sf", circle,
+  q0, model=plant)`` (the core's 6-D Cartesian impedance of SPEC §16 in
+  front of the adaptive state feedback, which learns as it runs; gains,
+  centres and learning by the rule, SPEC (16.10)–(16.12) and §18, from the
+  arm's model and the circle's joint path over one period; nothing set per
+  arm), run by ``adaptimp.mujoco.simulate`` (the loop in the core: MuJoCo
+  through its C library, the controller and the path's call each period,
+  the log and the metrics).
 - **the user's loop**, as in kevinzakka/mjctrl's ``opspace.py``: each period,
   in Python, ``mj_jacSite`` and ``mj_fullM``, the operational-space law
   τ = Jᵀ Λ (K_p e − K_d J q̇) + (I − Jᵀ J̄ᵀ)(k_n (q_0 − q) − d_n q̇) + the
@@ -33,13 +35,22 @@ cost; the whole run's time a period is printed too). Target (issue 32): adaptimp
 ``--count`` also counts instructions per period under callgrind (two runs of
 each loop, of ``--T`` and 2 ``--T``: the difference over the extra periods).
 
+``--tracking`` compares tracking instead of time (:func:`tracking`): each
+loop's RMS position error over the last 2 s of a 12 s run, once learning has
+run, on the nominal arm and with a payload of 10 % of the arm's moving mass
+on its last link that neither the OSC's model (M, the bias, evaluated on the
+nominal arm at the measured state) nor adaptimp's rule knows of. Target
+(issue 42): adaptimp ≤ 1.5× the user's OSC with the exact model.
+
     python benches/mujoco_user_loop.py [--T 2] [--repeats 5] [--arms ur5 panda] [--count]
+    python benches/mujoco_user_loop.py --tracking [--json] [--arms ur5 panda]
 """
 
 from __future__ import annotations
 
 import argparse
 import gc
+import math
 import os
 import statistics
 import subprocess
@@ -55,7 +66,6 @@ import numpy as np
 
 import adaptimp
 from adaptimp import mujoco as amj
-from adaptimp import tuning
 
 TS = 1e-3  # s: the control period of both loops
 RADIUS, OMEGA = 0.05, np.pi  # m, rad/s: 0.5 Hz
@@ -117,24 +127,29 @@ def circle_table(p0: np.ndarray, R0: np.ndarray, steps: int) -> Any:
 
 
 def adaptimp_loop(
-    name: str, T: float, python_path: bool = False
+    name: str,
+    T: float,
+    python_path: bool = False,
+    payload: float = 0.0,
+    window: tuple[float, float] = (1.0, math.inf),
 ) -> tuple[Callable[[], float], Callable[[], float]]:
     """(run: the seconds of one run, setup included; the last run's RMS
-    position error after 1 s).
+    position error over ``window`` (s), by default after 1 s).
 
     The commanded pose: the circle's table (:func:`circle_table`, built in
     each timed run), or with ``python_path`` the user's Python function
-    :func:`circle` itself (called once per period, before the loop starts)."""
+    :func:`circle` itself (called once per period, before the loop starts).
+    ``payload`` (kg): a point mass on the last link of the arm the loop
+    drives (:func:`adaptimp.mujoco.with_payload`), which the controller's
+    model (the nominal arm the rule reads) lacks."""
     model, q0, chain = arm(name)
     plant = amj.Plant(model)
+    driven = amj.Plant(amj.with_payload(model, payload)) if payload > 0 else plant
     p0, R0 = chain.pose(q0)
     path = circle(p0)
-    outer = adaptimp.cartesian.CartesianImpedance(chain, Ts=TS, q0=q0)
-    centres, widths = outer.orbit_centres(path, 2.0, nodes=64)
-    kw = tuning.suggest(plant, q0, plant.tau_max, Ts=TS)
-    kw.pop("n")
-    ctrl = adaptimp.CartesianController(
-        chain, "sf", q0=q0, path=path, centers=centres, widths=widths, **kw
+    # The rule's controller for the circle (one period, 2 s): nothing set per arm.
+    ctrl = adaptimp.CartesianController.from_rule(
+        chain, "sf", path, q0, model=plant, Ts=TS, span=2.0
     )
     steps = round(T / TS)
     last: list[Any] = [None]
@@ -144,29 +159,39 @@ def adaptimp_loop(
         start = time.perf_counter()
         if not python_path:
             ctrl.path = circle_table(p0, R0, steps)
-        res = amj.simulate(ctrl, plant, T=T, q0=q0)
+        res = amj.simulate(ctrl, driven, T=T, q0=q0)
         seconds = time.perf_counter() - start
         assert res.params["loop"] == "native"
         last[0] = res
         return seconds
 
     def error() -> float:
-        """The last run's RMS position error after 1 s (m), computed when asked
-        (outside the run, as it is outside its time: not in a count either)."""
+        """The last run's RMS position error over ``window`` (m), every 10th
+        period, computed when asked (outside the run, as it is outside its
+        time: not in a count either)."""
         res = last[0]
-        p = np.array([chain.pose(q)[0] for q in res.q[1000::10]])
-        want = np.array([path(t)[0] for t in res.t[1000::10]])
+        rows = np.flatnonzero((res.t >= window[0] - 1e-9) & (res.t < window[1] - 1e-9))[::10]
+        p = np.array([chain.pose(q)[0] for q in res.q[rows]])
+        want = np.array([path(t)[0] for t in res.t[rows]])
         return float(np.sqrt(np.mean(np.sum((p - want) ** 2, axis=1))))
 
     return run, error
 
 
-def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], float]]:
+def user_loop(
+    name: str, T: float, payload: float = 0.0, window: tuple[float, float] = (1.0, math.inf)
+) -> tuple[Callable[[], float], Callable[[], float]]:
     """The mjctrl-style operational-space loop in Python (module doc): (run:
     the seconds of one run's loop, after its reset; the RMS position error
-    after 1 s)."""
+    over ``window`` (s), by default after 1 s). ``payload`` (kg): a point mass
+    on the last link of the simulated arm (:func:`adaptimp.mujoco.with_payload`);
+    the law's model (J, M, the bias) stays the nominal arm's, evaluated at the
+    measured q, q̇ on a data of its own."""
     model, q0, _ = arm(name)
-    data = mujoco.MjData(model)
+    sim = amj.with_payload(model, payload) if payload > 0 else model
+    data = mujoco.MjData(sim)
+    # The law's own model: the nominal arm (the same data when nothing differs).
+    known = mujoco.MjData(model) if payload > 0 else data
     substeps = round(TS / model.opt.timestep)
     site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, SITES[name])
     n = model.nv
@@ -178,9 +203,9 @@ def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], fl
     error = [np.nan]
 
     def reset() -> None:
-        mujoco.mj_resetData(model, data)
+        mujoco.mj_resetData(sim, data)
         data.qpos[:] = q0
-        mujoco.mj_forward(model, data)
+        mujoco.mj_forward(sim, data)
 
     reset()
     p0 = data.site_xpos[site].copy()
@@ -197,9 +222,11 @@ def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], fl
 
     def full_mass() -> None:
         try:
-            mujoco.mj_fullM(model, data, mass)
+            mujoco.mj_fullM(model, known, mass)
         except TypeError:  # MuJoCo 3: mj_fullM(m, dst, qM)
-            mujoco.mj_fullM(model, mass, data.qM)
+            mujoco.mj_fullM(model, mass, known.qM)
+
+    lo_k, hi_k = (round(w / TS) if math.isfinite(w) else steps for w in window)
 
     def run() -> float:
         reset()
@@ -207,7 +234,10 @@ def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], fl
         start = time.perf_counter()
         for k in range(steps):
             p_c, dp_c, _ = path(k * TS)
-            mujoco.mj_jacSite(model, data, jacp, jacr, site)
+            if known is not data:  # the nominal model at the measured state
+                known.qpos[:], known.qvel[:] = data.qpos, data.qvel
+                mujoco.mj_forward(model, known)
+            mujoco.mj_jacSite(model, known, jacp, jacr, site)
             jac[:3], jac[3:] = jacp, jacr
             full_mass()
             m_inv = np.linalg.inv(mass)
@@ -223,10 +253,10 @@ def user_loop(name: str, T: float) -> tuple[Callable[[], float], Callable[[], fl
             tau = jac.T @ task @ (kp * twist - kd * velocity)
             jbar = m_inv @ jac.T @ task
             tau += (eye - jac.T @ jbar.T) @ (kn * (q0 - data.qpos) - dn * dq)
-            tau += data.qfrc_bias
+            tau += known.qfrc_bias
             data.ctrl[:] = np.clip(tau, lo, hi)
-            mujoco.mj_step(model, data, nstep=substeps)
-            if k >= 1000 and k % 10 == 0:
+            mujoco.mj_step(sim, data, nstep=substeps)
+            if lo_k <= k + 1 < hi_k and (k + 1) % 10 == 0:
                 errors.append(np.sum((data.site_xpos[site] - path((k + 1) * TS)[0]) ** 2))
         seconds = time.perf_counter() - start
         error[0] = float(np.sqrt(np.mean(errors))) if errors else np.nan
@@ -321,12 +351,66 @@ def side_by_side(
     return got
 
 
+PAYLOAD_SHARE = 0.10
+"""The payload of :func:`tracking`: this share of the arm's moving mass (kg)."""
+
+
+def tracking(name: str, T: float = 12.0, last: float = 2.0) -> dict[str, Any]:
+    """Tracking, not time: each loop's RMS position error (mm) over the last
+    ``last`` s of a ``T`` s run, on the nominal arm and with a payload of
+    :data:`PAYLOAD_SHARE` of its moving mass on the last link that neither
+    the OSC's model nor adaptimp's rule knows of (adaptimp learning from zero
+    weights in each run)."""
+    model, _, _ = arm(name)
+    payload = round(PAYLOAD_SHARE * amj.moving_mass(model), 3)
+    window = (T - last, T)
+    got: dict[str, Any] = {"T": T, "last": last, "payload_kg": payload}
+    for key, mass in (("", 0.0), ("_payload", payload)):
+        core, core_err = adaptimp_loop(name, T, payload=mass, window=window)
+        peer, peer_err = user_loop(name, T, payload=mass, window=window)
+        core()
+        peer()
+        got[f"core{key}_mm"] = round(core_err() * 1e3, 4)
+        got[f"peer{key}_mm"] = round(peer_err() * 1e3, 4)
+        got[f"ratio{key}"] = round(got[f"core{key}_mm"] / got[f"peer{key}_mm"], 3)
+    return got
+
+
+ARM_NAMES = {"ur5": "UR5 (example-robot-data)", "panda": "Panda (example-robot-data)"}
+
+
+def tracking_markdown(rows: dict[str, dict[str, Any]]) -> str:
+    """The table of docs/robosuite.md from ``--tracking --json``'s output."""
+    out = [
+        "| arm | payload (kg) | nominal: adaptimp (mm) | the user's OSC (mm) | ÷ "
+        "| with the payload: adaptimp (mm) | the user's OSC (mm) | ÷ |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for name, g in rows.items():
+        out.append(
+            f"| {ARM_NAMES.get(name, name)} | {g['payload_kg']:.3f} | {g['core_mm']:.4f} | "
+            f"{g['peer_mm']:.4f} | **{g['ratio']:.3f}** | {g['core_payload_mm']:.4f} | "
+            f"{g['peer_payload_mm']:.4f} | **{g['ratio_payload']:.3f}** |"
+        )
+    return "\n".join(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--T", type=float, default=2.0, help="run length (s), ≥ 1.2")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--arms", nargs="+", default=["ur5", "panda"], choices=list(SITES))
     ap.add_argument("--count", action="store_true", help="also count instructions (callgrind)")
+    ap.add_argument(
+        "--tracking",
+        action="store_true",
+        help="compare tracking instead of time: T = 12 s, the last 2 s, with and without "
+        "a payload the OSC's model lacks",
+    )
+    ap.add_argument("--json", action="store_true", help="with --tracking: print JSON")
+    ap.add_argument(
+        "--markdown", metavar="FILE", help="print the table of a --tracking --json FILE and exit"
+    )
     ap.add_argument(
         "--one", choices=["adaptimp", "adaptimp-python-path", "user"], help=argparse.SUPPRESS
     )
@@ -337,6 +421,30 @@ def main() -> None:
         else:
             run, _ = adaptimp_loop(args.arms[0], args.T, args.one == "adaptimp-python-path")
         run()
+        return
+    if args.markdown:
+        import json
+
+        with open(args.markdown, encoding="utf-8") as f:
+            print(tracking_markdown(json.load(f)))
+        return
+    if args.tracking:
+        rows = {name: tracking(name) for name in args.arms}
+        if args.json:
+            import json
+
+            print(json.dumps(rows, indent=1))
+            return
+        for name, got in rows.items():
+            print(
+                f"\n{name}, tracking, T = {got['T']:g} s, RMS position error over the last "
+                f"{got['last']:g} s (mm):\n"
+                f"  nominal arm: adaptimp {got['core_mm']:.4f}, the user's OSC (exact model) "
+                f"{got['peer_mm']:.4f}: {got['ratio']:.3f}× (target ≤ 1.5)\n"
+                f"  payload {got['payload_kg']:g} kg the models lack: adaptimp "
+                f"{got['core_payload_mm']:.4f}, the user's OSC {got['peer_payload_mm']:.4f}: "
+                f"{got['ratio_payload']:.3f}×"
+            )
         return
     for name in args.arms:
         got = side_by_side(name, args.count, args.T, args.repeats)

@@ -462,15 +462,132 @@ def measure(robot: str, task: str, error: str, seeds: int,
     return out
 
 
+TASK_TITLES = {
+    "square": "A square in the air (Lift's arm: 10 cm at 5 cm/s, 1 s at each corner)",
+    "lift": "Pick and lift (Lift's cube: down, grasp, up 15 cm, hold 2 s)",
+    "wipe": "Wipe (Wipe's table: pressed 1 cm in, along the dirt at 5 cm/s)",
+}
+ERROR_NAMES = {
+    "none": "none",
+    "cube": "cube 1 kg",
+    "payload": "payload 10 %",
+    "friction": "friction ×5",
+}
+
+
+def _pair(o: float, a: float, digits: int = 2) -> str:
+    return f"{o:.{digits}f} → {a:.{digits}f}"
+
+
+def _horizontal(c: dict[str, Any]) -> float:
+    """The RMS error along the table (mm): the position's less the vertical's
+    (both means over the same samples)."""
+    return float(np.sqrt(max(c["rms_pos_mm"] ** 2 - c["rms_vertical_mm"] ** 2, 0.0)))
+
+
+def _cut_short(r: dict[str, Any]) -> bool:
+    """robosuite ended every episode of both controllers before the script
+    did, and none succeeded (Wipe ends an episode on any contact of the robot)."""
+    return all(r[c]["terminated"] == r[c]["seeds"] and r[c]["success"] == 0 for c in CONTROLLERS)
+
+
+def markdown(results: list[dict[str, Any]]) -> str:
+    """The tables of docs/robosuite.md from ``--json``'s results: one per task
+    (OSC_POSE → ADAPTIMP in each cell), then the targets per arm."""
+    out: list[str] = []
+    for task in TASKS:
+        rows = [r for r in results if r["task"] == task]
+        if not rows:
+            continue
+        seeds = rows[0]["OSC_POSE"]["seeds"]
+        out.append(f"#### {TASK_TITLES[task]}, {seeds} seeds\n")
+        wipe = task == "wipe"
+        extra = " along the table (mm) | ÷ | wiped (%) | peak force (N) |" if wipe else ""
+        out.append(
+            "| arm | model error | position (mm) | ADAPTIMP ÷ OSC | orientation (mrad) "
+            f"| successes | env.step (ms) |{extra}"
+        )
+        out.append("|---|---|---:|---:|---:|---:|---:|" + ("---:|" * 4 if wipe else ""))
+        for r in rows:
+            o, a = r["OSC_POSE"], r["ADAPTIMP"]
+            if _cut_short(r):
+                out.append(
+                    f"| {r['arm']} | {ERROR_NAMES[r['error']]} | robosuite ends every "
+                    "episode before the script does, under either controller | — | — | "
+                    f"{o['success']} → {a['success']} | — |" + (" — |" * 4 if wipe else "")
+                )
+                continue
+            ratio = "—" if r["pos_ratio"] is None else f"**{r['pos_ratio']:.3f}**"
+            line = (
+                f"| {r['arm']} | {ERROR_NAMES[r['error']]} | "
+                f"{_pair(o['rms_pos_mm'], a['rms_pos_mm'])} | {ratio} | "
+                f"{_pair(o['rms_rot_mrad'], a['rms_rot_mrad'])} | "
+                f"{o['success']} → {a['success']} | {_pair(o['step_ms'], a['step_ms'])} |"
+            )
+            if wipe:
+                ho, ha = _horizontal(o), _horizontal(a)
+                line += (
+                    f" {_pair(ho, ha)} | {ha / ho:.3f} | "
+                    f"{_pair(100 * o['wiped'], 100 * a['wiped'], 0)} | "
+                    f"{_pair(o['force_max_N'], a['force_max_N'], 1)} |"
+                )
+            out.append(line)
+        out.append("")
+    out.append(targets_markdown(results))
+    return "\n".join(out)
+
+
+def targets_markdown(results: list[dict[str, Any]]) -> str:
+    """Per arm, the issue's targets against the rows: the largest ADAPTIMP ÷
+    OSC_POSE position ratio under model error (target ≤ 0.5) and without
+    (≤ 1.0), the successes summed over those rows (ADAPTIMP ≥ OSC_POSE), the
+    largest env.step ratio (≤ 1.0). Rows robosuite cut short are left out."""
+    out = [
+        "#### The targets per arm (the rows above)\n",
+        "| arm | model error: largest ÷ (≤ 0.5) | its row | successes OSC → ADAPTIMP "
+        "| no model error: largest ÷ (≤ 1.0) | successes OSC → ADAPTIMP "
+        "| env.step: largest ÷ (≤ 1.0) |",
+        "|---|---:|---|---:|---:|---:|---:|",
+    ]
+    for arm in dict.fromkeys(r["arm"] for r in results):
+        rows = [r for r in results if r["arm"] == arm and not _cut_short(r)]
+        err = [r for r in rows if r["error"] != "none"]
+        nom = [r for r in rows if r["error"] == "none"]
+        if not err or not nom:
+            continue
+        worst = max(err, key=lambda r: r["pos_ratio"])
+
+        def wins(rs: list[dict[str, Any]]) -> str:
+            o = sum(r["OSC_POSE"]["success"] for r in rs)
+            a = sum(r["ADAPTIMP"]["success"] for r in rs)
+            n = sum(r["OSC_POSE"]["seeds"] for r in rs)
+            return f"{o} → {a} of {n}"
+
+        out.append(
+            f"| {arm} | **{worst['pos_ratio']:.3f}** | {worst['task']}, "
+            f"{ERROR_NAMES[worst['error']]} | {wins(err)} | "
+            f"**{max(r['pos_ratio'] for r in nom):.3f}** | {wins(nom)} | "
+            f"**{max(r['step_ratio'] for r in rows):.3f}** |"
+        )
+    return "\n".join(out) + "\n"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object")
+    ap.add_argument(
+        "--markdown", metavar="FILE", help="print the tables of a --json output FILE and exit"
+    )
     ap.add_argument("--arms", nargs="+", default=ARMS)
     ap.add_argument("--tasks", nargs="+", default=TASKS, choices=TASKS)
     ap.add_argument("--errors", nargs="+", default=ERRORS, choices=ERRORS)
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--params", type=json.loads, default={}, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.markdown:
+        with open(args.markdown, encoding="utf-8") as f:
+            print(markdown(json.load(f)["results"]))
+        return
     results: list[dict[str, Any]] = []
     for robot in args.arms:
         for task in args.tasks:

@@ -34,6 +34,8 @@ median ``env.step`` time (ms, one policy step: 25 model timesteps).
 
     python benches/osc.py [--json] [--arms Panda Sawyer ...] [--tasks square lift wipe]
         [--errors none cube payload friction] [--seeds 10]
+    python benches/osc.py --phases [--json] [--arms ...] [--errors ...]   # the lift's phases
+    python benches/osc.py --markdown FILE   # the tables of docs/robosuite.md from a --json FILE
 """
 
 from __future__ import annotations
@@ -462,6 +464,55 @@ def measure(robot: str, task: str, error: str, seeds: int,
     return out
 
 
+PHASES = ["approach", "grasp", "lift", "hold"]
+
+
+def lift_phases(robot: str, error: str, seed: int = 0) -> dict[str, Any]:
+    """Where the lift's error is: the RMS position error (mm) of each
+    controller over each phase of the lift script (down to the cube at 10
+    cm/s, the grasp, up 15 cm at 10 cm/s, the 2 s hold), one seed, the two
+    episodes stepped in turn."""
+    episodes = {c: Episode(robot, "lift", error, c, seed, {}) for c in CONTROLLERS}
+    marks: dict[str, list[int]] = {c: [] for c in CONTROLLERS}
+    while any(e.running for e in episodes.values()):
+        for c, e in episodes.items():
+            if e.running:
+                e.step()
+                marks[c].append(len(e.probe.pos))
+    out: dict[str, Any] = {"arm": robot, "error": error, "seed": seed}
+    for c, e in episodes.items():
+        script = e.script
+        assert isinstance(script, Lift)
+        assert script.lift_at is not None
+        k = [
+            0,
+            round(script.close_at / POLICY_DT),
+            round(script.lift_at / POLICY_DT),
+            round((script.lift_at + script.LIFT / script.SPEED) / POLICY_DT),
+            len(marks[c]) - 1,
+        ]
+        pos = np.asarray(e.probe.pos)
+        out[c] = {
+            name: round(1e3 * float(np.sqrt(pos[marks[c][a] : marks[c][b]].mean())), 3)
+            for name, a, b in zip(PHASES, k[:-1], k[1:])
+        }
+        e.env.close()
+    return out
+
+
+def phases_markdown(rows: list[dict[str, Any]]) -> str:
+    """The lift's error per phase, OSC_POSE → ADAPTIMP (ADAPTIMP ÷ OSC)."""
+    out = [
+        "| arm | model error | " + " | ".join(f"{p} (mm)" for p in PHASES) + " |",
+        "|---|---|" + "---:|" * len(PHASES),
+    ]
+    for r in rows:
+        o, a = r["OSC_POSE"], r["ADAPTIMP"]
+        cells = " | ".join(f"{o[p]:.2f} → {a[p]:.2f} ({a[p] / o[p]:.2f})" for p in PHASES)
+        out.append(f"| {r['arm']} | {ERROR_NAMES[r['error']]} | {cells} |")
+    return "\n".join(out) + "\n"
+
+
 TASK_TITLES = {
     "square": "A square in the air (Lift's arm: 10 cm at 5 cm/s, 1 s at each corner)",
     "lift": "Pick and lift (Lift's cube: down, grasp, up 15 cm, hold 2 s)",
@@ -582,11 +633,25 @@ def main() -> None:
     ap.add_argument("--tasks", nargs="+", default=TASKS, choices=TASKS)
     ap.add_argument("--errors", nargs="+", default=ERRORS, choices=ERRORS)
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument(
+        "--phases",
+        action="store_true",
+        help="the lift's error per phase of its script, one seed (JSON with --json)",
+    )
     ap.add_argument("--params", type=json.loads, default={}, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.markdown:
         with open(args.markdown, encoding="utf-8") as f:
-            print(markdown(json.load(f)["results"]))
+            data = json.load(f)
+        print(phases_markdown(data["phases"]) if "phases" in data else markdown(data["results"]))
+        return
+    if args.phases:
+        rows = [lift_phases(robot, error) for robot in args.arms for error in args.errors]
+        if args.json:
+            json.dump({"phases": rows}, sys.stdout, indent=1)
+            print()
+        else:
+            print(phases_markdown(rows))
         return
     results: list[dict[str, Any]] = []
     for robot in args.arms:

@@ -12,6 +12,8 @@
 #                              mypy, pandas, xarray, tqdm, MkDocs, MuJoCo, Pinocchio,
 #                              example-robot-data, Dask, pylibfranka, franky-sim)
 #           target/wheel-test: the wheel with its `mujoco` extra, without Rust on PATH
+#           target/robosuite-venv: the wheel with its `robosuite` extra (robosuite 1.5 on
+#                              MuJoCo 3.3, which robosuite runs on), pytest, hypothesis
 # Disk it leaves: target/ (Rust builds and the venvs), fuzz/target/, dist/.
 #
 # ADAPTIMP_VENV=DIR overrides the test environment, PYTHON=... the interpreter,
@@ -120,6 +122,16 @@ bash scripts/test_wheel.sh
 
 step "Python: tests"
 "$py" -m pytest
+
+step "Python: ADAPTIMP in robosuite (the extra robosuite: robosuite 1.5 on its MuJoCo 3.3, an environment of its own)"
+rsvenv="$PWD/target/robosuite-venv"
+if [ ! -x "$rsvenv/bin/python" ]; then
+    "${PYTHON:-python3}" -m venv "$rsvenv"
+fi
+"$rsvenv/bin/python" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$wheel"
+"$rsvenv/bin/python" -m pip install --quiet --disable-pip-version-check "$wheel[robosuite]" \
+    "pytest>=7" "hypothesis>=6"
+"$rsvenv/bin/python" -m pytest tests/test_robosuite.py
 
 step "The core against Pinocchio: benches/peers/peers.cpp built against the pin wheel, every row to 1e-12 (the bench's three arms and three more, the Kinova's joints continuous)"
 "$py" benches/peers.py --check --urdf kinova_description/robots/kinova.urdf \

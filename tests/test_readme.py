@@ -62,6 +62,18 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     "tests/test_examples.py runs examples/13 with ADAPTIMP_QUICK=1",
     ("docs/robot.md", 1): "Rust: tests/snippets/robot_hardened.rs, a doctest of src/lib.rs; "
     "test_every_block_is_accounted_for keeps the page's copy identical",
+    ("docs/robosuite.md", 0): "installs the extra robosuite: scripts/test.sh installs it in "
+    "target/robosuite-venv",
+    ("docs/robosuite.md", 1): "needs robosuite, which runs on MuJoCo 3.3 (an environment of its "
+    "own): tests/test_robosuite.py runs this block there (test_the_two_lines_of_the_page_run)",
+    ("docs/robosuite.md", 2): "the head-to-head bench, an hour of robosuite episodes on two "
+    "cores: tests/test_robosuite.py runs one of its rows (the square with a payload) and checks "
+    "the page's tables against its --markdown of the committed results",
+    ("docs/robosuite.md", 3): "the lift's phases on six arms (a few minutes of robosuite "
+    "episodes): tests/test_robosuite.py checks the page's table against its --markdown of the "
+    "committed results",
+    ("docs/robosuite.md", 4): "the tracking bench (12 s runs): tests/test_robosuite.py checks "
+    "the page's table against its --markdown of the committed results",
     ("docs/rust.md", 0): "an error message the page shows, not code",
     ("docs/rust.md", 1): "Rust: tests/snippets/dynamic_urdf.rs, a doctest of "
     "src/dynamic/mod.rs; test_every_block_is_accounted_for keeps the page's copy identical",

@@ -66,6 +66,10 @@ def test_every_extra_a_message_names_is_declared() -> None:
 def test_the_robosuite_controller_names_its_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     import importlib
 
+    # robosuite and every submodule already imported (tests/test_robosuite.py
+    # in the same process): each None, so that each import of it fails.
+    for name in [n for n in sys.modules if n == "robosuite" or n.startswith("robosuite.")]:
+        monkeypatch.setitem(sys.modules, name, None)
     monkeypatch.setitem(sys.modules, "robosuite", None)
     monkeypatch.delitem(sys.modules, "adaptimp.robosuite", raising=False)
     with pytest.raises(ImportError) as err:

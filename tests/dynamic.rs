@@ -850,6 +850,17 @@ fn a_urdf_read_at_run_time_drives_both_controllers() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/hobby_arm.urdf");
     let arm = reduce(&urdf::read_file(path).expect("urdf"), None, &[]).expect("arm");
     let n = arm.n();
+    // More joints than a chain may hold: refused by name, with what to do.
+    arm.within(dy::MAX_JOINTS).expect("within 7");
+    let e = arm.within(n - 1).unwrap_err().to_string();
+    assert!(e.contains(&format!("the arm has {n} joints (")), "{e}");
+    assert!(
+        e.ends_with(&format!(
+            "a chain has at most {}: hold some with fix",
+            n - 1
+        )),
+        "{e}"
+    );
     let chain = dy::Chain::from_arm(&arm).expect("chain");
     let dynamics = dy::Dynamics::from_arm(&arm, adaptimp::GRAVITY).expect("dynamics");
     assert_eq!((chain.n(), dynamics.n()), (n, n));
@@ -961,4 +972,237 @@ fn the_orbit_centres_and_the_model_arms_are_the_const_generic_ones() {
     s.visit(|name, v| b.push(format!("{name} {v:?}")));
     assert_eq!(a, b);
     assert!(!a.is_empty());
+}
+
+/// An arm's inertia at posture k: symmetric, diagonally dominant (so
+/// positive definite), row-major.
+fn inertia<const N: usize>(k: usize) -> Vec<f64> {
+    (0..N * N)
+        .map(|e| {
+            let (i, j) = (e / N, e % N);
+            if i == j {
+                1.0 + 0.2 * i as f64 + 0.01 * k as f64
+            } else {
+                0.05 / (1.0 + i.abs_diff(j) as f64)
+            }
+        })
+        .collect()
+}
+
+/// The rule of SPEC §18 the run-time way ([`dy::Tuning::suggest`]) and the
+/// const-generic way, step for step as the fronts took it: the same
+/// parameters and centres, bit for bit.
+fn rule<const N: usize>() {
+    use adaptimp::cartesian::rule::resolving;
+    use adaptimp::control::tuning::{
+        damped_scales, inertia_scales, inertia_scales_along, loop_bound,
+    };
+    use adaptimp::Matrix;
+    let tau: Vec<f64> = (0..N).map(|i| 20.0 - i as f64).collect();
+    let period = 2.0;
+    let path: Vec<f64> = (0..64)
+        .flat_map(|k| {
+            let w = core::f64::consts::TAU / period;
+            let t = period * k as f64 / 64.0;
+            let q = (0..N).map(move |i| 0.3 * (w * t + i as f64).sin());
+            let dq = (0..N).map(move |i| 0.3 * w * (w * t + i as f64).cos());
+            let ddq = (0..N).map(move |i| -0.3 * w * w * (w * t + i as f64).sin());
+            q.chain(dq).chain(ddq).collect::<Vec<_>>()
+        })
+        .collect();
+    let gravity: Vec<f64> = (0..N).map(|i| 3.0 - 0.5 * i as f64).collect();
+    let damping: Vec<f64> = (0..N).map(|i| 0.1 * (i + 1) as f64).collect();
+    let orbit: Vec<f64> = path
+        .chunks_exact(3 * N)
+        .flat_map(|r| r[..N].to_vec())
+        .collect();
+    let along: Vec<f64> = (0..3).flat_map(inertia::<N>).collect();
+    let at = inertia::<N>(0);
+    for (case, law) in [Law::Pd, Law::StateFeedback, Law::OutputFeedback]
+        .into_iter()
+        .enumerate()
+    {
+        let ts = 1e-3;
+        let mut t = dy::Tuning::new(law, dy::Inertia::At(&at), &tau, ts);
+        if case >= 1 {
+            t.delay = case;
+            t.path = Some(dy::TaskPath {
+                rows: &path,
+                period,
+            });
+            t.gravity = Some(&gravity);
+        }
+        if case == 2 {
+            t.inertia = dy::Inertia::Along(&along);
+            t.damping = Some(&damping);
+            t.orbit = Some(&orbit);
+            t.resolve = true;
+            t.critical = true;
+        }
+        let got = t.suggest().expect("suggest");
+        // The const-generic rule, as the fronts took it.
+        let mut rule = Rule::default().with_delay(t.delay).unwrap();
+        if t.critical {
+            rule = rule.critical(ts);
+        }
+        let flat = if case == 2 { &along } else { &at };
+        let ds: Vec<Matrix<N>> = flat
+            .chunks_exact(N * N)
+            .map(Matrix::<N>::from_row_slice)
+            .collect();
+        let scales = if case == 2 {
+            inertia_scales_along(&ds)
+        } else {
+            inertia_scales(&ds[0])
+        }
+        .unwrap();
+        rule = rule.bounded(loop_bound(&ds, &scales).unwrap());
+        let scales = match t.damping {
+            None => scales,
+            Some(b) => damped_scales(&scales, &Vector::<N>::from_column_slice(b), ts).unwrap(),
+        };
+        let tau_v = Vector::<N>::from_column_slice(&tau);
+        let mut want = Scenario::<N>::preset(Preset::Robot, law);
+        let centres = if t.path.is_none() {
+            want.config = rule.gains_scaled(law, &scales, &tau_v, ts).unwrap();
+            None
+        } else {
+            let samples: Vec<Setpoint<N>> = path
+                .chunks_exact(3 * N)
+                .map(|r| Setpoint {
+                    x: Vector::from_column_slice(&r[..N]),
+                    dx: Vector::from_column_slice(&r[N..2 * N]),
+                    ddx: Vector::from_column_slice(&r[2 * N..]),
+                })
+                .collect();
+            if t.resolve {
+                rule = resolving(&rule, &samples);
+            }
+            if t.orbit.is_some() {
+                let qs: Vec<Vector<N>> = orbit
+                    .chunks_exact(N)
+                    .map(Vector::from_column_slice)
+                    .collect();
+                rule = rule.spanning(&qs);
+            }
+            let g = Vector::<N>::from_column_slice(&gravity);
+            let sug = rule
+                .suggest_scaled(law, &scales, &tau_v, ts, &samples, period, Some(&g))
+                .unwrap();
+            want.config = sug.config;
+            Some(sug.centers)
+        };
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        got.visit(|name, v| a.push(format!("{name} {v:?}")));
+        want.visit(|name, v| b.push(format!("{name} {v:?}")));
+        assert_eq!(a, b, "N = {N}, case {case}");
+        assert_eq!((got.n(), got.law()), (N, law));
+        match (got.centres(), centres) {
+            (None, None) => {}
+            (Some(d), Some(c)) => {
+                same("centres", &d.rows, c.centers());
+                let w: Vec<f64> = c.widths2().iter().flat_map(|b| b.iter().copied()).collect();
+                same("widths", d.widths2.as_deref().unwrap(), &w);
+                // The scenario builds the controller on its centres.
+                assert_eq!(got.controller().unwrap().nodes(), c.nodes());
+            }
+            (d, c) => panic!("centres {d:?} against {c:?}"),
+        }
+    }
+}
+
+#[test]
+fn the_rule_at_run_time_is_the_const_generic_rule_bit_for_bit() {
+    rule::<1>();
+    rule::<2>();
+    rule::<4>();
+    rule::<7>();
+    // Inputs of the wrong length, by name.
+    let tau = [10.0; 3];
+    let e = |t: dy::Tuning<'_>| t.suggest().unwrap_err().to_string();
+    let t = dy::Tuning::new(Law::Pd, dy::Inertia::At(&[1.0; 4]), &tau, 1e-3);
+    assert_eq!(
+        e(t),
+        "inertia: needs n × n values (n: tau_max's), or K ≥ 1 matrices of n × n along a path"
+    );
+    let d = inertia::<3>(0);
+    let mut t = dy::Tuning::new(Law::Pd, dy::Inertia::At(&d), &tau, 1e-3);
+    t.damping = Some(&[0.1; 2]);
+    assert_eq!(
+        e(t),
+        "damping: needs one value per joint (as many as the controller has)"
+    );
+    let t = dy::Tuning::new(Law::Pd, dy::Inertia::At(&[1.0; 64]), &[1.0; 8], 1e-3);
+    assert_eq!(
+        e(t),
+        "condition 1 ≤ n ≤ 7 joints is violated: n = 8 (SPEC §10)"
+    );
+    let mut t = dy::Tuning::new(Law::Pd, dy::Inertia::At(&d), &tau, 1e-3);
+    t.delay = 65;
+    assert!(e(t).contains("delay"));
+}
+
+/// A Cartesian state restarted at another q0: a fresh start there, with the
+/// null-space posture kept (the outer loop's and the pair's restart).
+#[test]
+fn a_restarted_cartesian_state_is_a_fresh_start_that_keeps_its_posture() {
+    const N: usize = 3;
+    let js = joints::<N>();
+    let (d, s) = scenario::<N>(Law::StateFeedback, true);
+    let (cc, _) = core_controller(&s);
+    let chain = Chain::<N>::new(&js, &Transform::IDENTITY).expect("chain");
+    let outer = CartesianImpedance::new(s.cartesian, chain, cc.period()).expect("outer");
+    let pair = CartesianController::new(outer, cc).expect("pair");
+    let dchain = dy::Chain::new(&js, &Transform::IDENTITY).expect("chain");
+    let douter = dy::CartesianImpedance::new(d.cartesian(), &dchain, 1e-3).expect("outer");
+    let dpair =
+        dy::CartesianController::new(douter.clone(), d.controller().expect("joint")).expect("pair");
+    let (q0, q1, posture) = (q_of::<N>(0), q_of::<N>(1), q_of::<N>(2));
+    let mut dst = dpair.start(q0.as_slice()).expect("start");
+    let mut jst = dpair.joint().new_state();
+    let m = dy::CartesianMeasurement {
+        q: q0.as_slice(),
+        dq: Some(&[0.0; N]),
+        wrench: Vector::zeros(),
+    };
+    for _ in 0..5 {
+        dpair.step(&mut dst, &mut jst, &m, None).expect("step");
+    }
+    dpair
+        .set_posture(&mut dst, posture.as_slice())
+        .expect("posture");
+    for (restart, want) in [
+        (dpair.restart(&mut dst, q1.as_slice()), pair.start(&q1)),
+        (
+            douter.restart(&mut dst, q1.as_slice()),
+            outer.start_checked(&q1),
+        ),
+    ] {
+        restart.expect("restart");
+        let want = want.expect("start");
+        assert_eq!(dst.steps(), 0);
+        same("posture", &dst.posture(), posture.as_slice());
+        let (qd, dqd) = dst.joint_d();
+        same("q_d", &qd, want.qd.as_slice());
+        same("q̇_d", &dqd, want.dqd.as_slice());
+        assert_eq!(dst.pose_d(), (want.pd, want.rd));
+        assert_eq!(dst.stiffness(), (want.stiffness, want.stiffness_filtered));
+    }
+    // Checked as a start is, nothing changed on an error.
+    let e = dpair.restart(&mut dst, &[f64::NAN, 0.0, 0.0]).unwrap_err();
+    assert_eq!(e.to_string(), "q0[0] is not finite (NaN or infinite)");
+    same("posture", &dst.posture(), posture.as_slice());
+    let e = dpair.restart(&mut dst, &[0.0; 2]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "q0: needs one value per joint (as many as the controller has)"
+    );
+    let other = dy::Chain::new(&joints::<2>(), &Transform::IDENTITY).expect("chain");
+    let (d2, _) = scenario::<2>(Law::StateFeedback, true);
+    let outer2 = dy::CartesianImpedance::new(d2.cartesian(), &other, 1e-3).expect("outer");
+    let e = outer2.restart(&mut dst, &[0.0; 2]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "state: was made for another number of joints"
+    );
 }

@@ -97,6 +97,30 @@ impl Transform {
         ))
     }
 
+    /// A 4 × 4 homogeneous transform `m`, row-major ([R p; 0 0 0 1]): its
+    /// last row must be 0 0 0 1 to 1e-6 (an error naming the entry
+    /// otherwise); R is checked where the transform is used (a chain's
+    /// origin, its tip).
+    pub fn from_matrix(m: &[f64; 16]) -> Result<Self, Error> {
+        const LAST: [f64; 4] = [0.0, 0.0, 0.0, 1.0];
+        for (j, want) in LAST.iter().enumerate() {
+            let off = (m[12 + j] - want).abs();
+            // A NaN is not within the tolerance either.
+            if off.is_nan() || off > 1e-6 {
+                return Err(Error::Condition {
+                    condition: "the last row of a homogeneous transform is 0 0 0 1 (to 1e-6)",
+                    lhs: "m[3]",
+                    index: Some(j),
+                    value: m[12 + j],
+                });
+            }
+        }
+        Ok(Self {
+            translation: [m[3], m[7], m[11]],
+            rotation: core::array::from_fn(|i| core::array::from_fn(|j| m[4 * i + j])),
+        })
+    }
+
     /// From a translation (m) and a rotation matrix.
     pub fn from_parts(translation: Vector3<f64>, rotation: &Matrix3<f64>) -> Self {
         Self {
@@ -935,6 +959,21 @@ mod tests {
         let e = Chain::<8>::new(&[ok; 8], &Transform::IDENTITY).unwrap_err();
         assert!(e.to_string().contains("1 ≤ n ≤ 7"), "{e}");
         assert!(Transform::from_pos_quat([0.0; 3], [0.0; 4]).is_err());
+        let mut m = [0.0; 16];
+        (m[0], m[3], m[5], m[10], m[15]) = (1.0, 0.4, 1.0, 1.0, 1.0);
+        let t = Transform::from_matrix(&m).unwrap();
+        assert_eq!(
+            (t.translation, t.rotation),
+            ([0.4, 0.0, 0.0], Transform::IDENTITY.rotation)
+        );
+        for bad in [0.5, f64::NAN] {
+            m[14] = bad;
+            let e = Transform::from_matrix(&m).unwrap_err().to_string();
+            assert!(
+                e.contains("last row of a homogeneous transform") && e.contains("m[3][2]"),
+                "{e}"
+            );
+        }
     }
 
     #[test]

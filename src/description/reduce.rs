@@ -288,6 +288,25 @@ impl Arm {
         })
     }
 
+    /// The arm within `max` joints (the run-time API's
+    /// [`MAX_JOINTS`](crate::dynamic::MAX_JOINTS)), else an error of kind
+    /// [`ErrorKind::Arm`] naming its joints and what to do.
+    pub fn within(&self, max: usize) -> Result<(), DescriptionError> {
+        if self.n() <= max {
+            return Ok(());
+        }
+        let names: Vec<&str> = self.joints.iter().map(|j| j.name.as_str()).collect();
+        Err(DescriptionError::new(
+            ErrorKind::Arm,
+            format!(
+                "{}: the arm has {} joints ({}); a chain has at most {max}: hold some with fix",
+                self.source,
+                self.n(),
+                names.join(", ")
+            ),
+        ))
+    }
+
     /// The reason joint `name` is held, if it is.
     pub fn held_reason(&self, name: &str) -> Option<&Held> {
         self.held.iter().find(|h| h.name == name).map(|h| &h.reason)

@@ -215,6 +215,19 @@ impl CartesianImpedance {
         Ok(CartesianState { inner })
     }
 
+    /// `state` back to t = 0 at `q0` (rad, n values), checked as
+    /// [`start`](Self::start) checks it, its null-space posture kept; on an
+    /// error `state` is unchanged.
+    pub fn restart(&self, state: &mut CartesianState, q0: &[f64]) -> Result<(), Error> {
+        pair!(&self.inner, &mut state.inner, o, s, N => {
+            let fresh = o.start_checked(&vector::<N>("q0", q0)?)?;
+            let posture = s.posture;
+            *s = fresh;
+            s.posture = posture;
+            Ok(())
+        }, _ => Err(mismatch("state")))
+    }
+
     /// The null-space posture (rad) from the next step on:
     /// [`CartesianImpedance::set_posture`](crate::CartesianImpedance::set_posture).
     pub fn set_posture(&self, state: &mut CartesianState, posture: &[f64]) -> Result<(), Error> {
@@ -475,6 +488,21 @@ impl CartesianController {
             start_pair(&**o, &c.ctrl, &vector::<N>("q0", q0)?)
         })?;
         Ok(CartesianState { inner })
+    }
+
+    /// `state` back to t = 0 at `q0` (rad, n values), checked as
+    /// [`start`](Self::start) checks it, its null-space posture kept; on an
+    /// error `state` is unchanged.
+    pub fn restart(&self, state: &mut CartesianState, q0: &[f64]) -> Result<(), Error> {
+        each!(&self.outer.inner, o, N => {
+            let c = self.joint.inner.get::<N>().ok_or(mismatch("joint controller"))?;
+            let s = state.inner.get_mut::<N>().ok_or(mismatch("state"))?;
+            let fresh = start_pair(&**o, &c.ctrl, &vector::<N>("q0", q0)?)?;
+            let posture = s.posture;
+            *s = fresh;
+            s.posture = posture;
+            Ok(())
+        })
     }
 
     /// The null-space posture (rad) from the next step on, checked as the

@@ -54,15 +54,19 @@ impl Centres {
             } else {
                 Centers::along(&typed, tube)?
             };
-            let widths2 = c.widths2().iter().flat_map(|b| b.iter().copied()).collect();
-            Ok(Self {
-                rows: c.centers().to_vec(),
-                widths2: Some(widths2),
-            })
+            Ok(Self::of(&c))
         }, _ => Err(Error::Invalid {
             what: "samples",
             reason: "need at least one sample of 1 to 7 joints",
         }))
+    }
+
+    /// The rows and squared widths of the core's centres of N joints.
+    pub(crate) fn of<const N: usize>(c: &Centers<N, Vec<f64>>) -> Self {
+        Self {
+            rows: c.centers().to_vec(),
+            widths2: Some(c.widths2().iter().flat_map(|b| b.iter().copied()).collect()),
+        }
     }
 }
 
@@ -127,6 +131,20 @@ impl Scenario {
     pub fn basis(&mut self, basis: Basis) -> &mut Self {
         self.basis = basis;
         self
+    }
+
+    /// The centres of the caller's (or of the rule's, [`Tuning::suggest`](super::Tuning::suggest)),
+    /// if the basis is made of them.
+    pub fn centres(&self) -> Option<&Centres> {
+        match &self.basis {
+            Basis::Centres(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// The scenario of N joints `inner` for `law` with `basis`.
+    pub(super) fn of(inner: ByJoints<ScenarioF>, law: Law, basis: Basis) -> Self {
+        Self { inner, law, basis }
     }
 
     /// The number of joints n.

@@ -10,6 +10,7 @@
 //! | here | the const-generic core | what |
 //! |---|---|---|
 //! | [`Scenario`] | [`schema::Scenario`](crate::schema::Scenario) | every parameter by name, and the one builder of the joint controller (feature `alloc`) |
+//! | [`Tuning`] | [`tuning::Rule`](crate::tuning::Rule) | the gain and basis rule of SPEC §18: an arm's inertia, limits and period (and its task's path) to a [`Scenario`] |
 //! | [`Controller`], [`State`] | [`Controller`](crate::Controller), [`State`](crate::State) | the joint controller, its own trajectory, its state (heap or the caller's buffer) |
 //! | [`Measurement`], [`Setpoint`], [`Command`], [`Joints`] | [`Measurement`](crate::Measurement), … | a step's typed input and output: n values per joint quantity |
 //! | [`Chain`], [`Dynamics`] | [`Chain`](crate::Chain), [`Dynamics`](crate::Dynamics) | kinematics and rigid-body dynamics, from joint data or an [`Arm`](crate::description::Arm) read from a URDF or an MJCF |
@@ -385,6 +386,8 @@ mod controller;
 mod model;
 #[cfg(all(feature = "alloc", feature = "sim"))]
 mod run;
+#[cfg(feature = "alloc")]
+mod tuning;
 
 #[cfg(feature = "alloc")]
 mod values;
@@ -407,6 +410,8 @@ pub use run::{
     Hooks, Injected, Injection, Jacobian3, Metrics, Plant, Recorded, Reference, RigidBody, Rows,
     Run, RunError, Table, TaskRows, TaskStep,
 };
+#[cfg(feature = "alloc")]
+pub use tuning::{Inertia, TaskPath, Tuning};
 #[cfg(feature = "alloc")]
 pub use values::{Command, Joints, Measurement, Setpoint};
 

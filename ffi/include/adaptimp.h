@@ -393,10 +393,12 @@ typedef struct AdaptimpParams {
   // Where the target impedance acts (`ADAPTIMP_IMPEDANCE_EXTERNAL` for the
   // joint controller of an `AdaptimpCartesian`).
   AdaptimpImpedance impedance;
-  // Width η² of the vertex grid (used when `centers` is NULL; n ≤ 3).
+  // Width η² of the vertex grid (used when `centers` is NULL and n ≤ 3).
   double eta2;
   // User centres: `nodes` rows of 4n reals (x, v, α1, α̇1 blocks of n), or
-  // NULL for the paper's vertex grid. Copied at construction.
+  // NULL for the default basis: the paper's vertex grid for n ≤ 3, the
+  // rule's centres along the commanded trajectory beyond (SPEC §18), as
+  // Python builds it. Copied at construction.
   const double *centers;
   // The number of user centres L.
   size_t nodes;

@@ -4,15 +4,18 @@
 //! core's (`adaptimp::cartesian`); this converts and checks pointers, sizes
 //! and enum values.
 
-use crate::handles::{free, handle, handle_mut, publish, publish_at, release, Header};
-use crate::joint::{build_sized, copy_sized, fault_of, Buf, Place, St};
+use crate::handles::{buffer_size, free, handle, handle_mut, publish, publish_in, Buf, Header};
+use crate::joint::{copy_sized, fault_of};
+use crate::params::controller_of;
 use crate::*;
 use adaptimp::cartesian::rotation::quaternion_matrix;
-use adaptimp::schema::{Preset, Scenario, Value};
+use adaptimp::dynamic::{
+    CartesianCommand, CartesianController, CartesianImpedance, CartesianMeasurement,
+    CartesianState, Centres, Chain, Joints, Scenario, State,
+};
+use adaptimp::schema::{Preset, Value};
 use adaptimp::{
-    AnyBasis, CartesianConfig, CartesianController, CartesianImpedance, CartesianMeasurement,
-    CartesianState, Centers, Chain, Formulation, Joint, JointKind, Law, PoseTarget, Setpoint,
-    Transform, Vector,
+    CartesianConfig, Formulation, Joint, JointKind, Law, PoseTarget, Transform, Vector,
 };
 use core::ffi::c_void;
 use nalgebra::{Matrix3, UnitQuaternion};
@@ -221,7 +224,7 @@ pub struct AdaptimpChain {
 #[derive(Debug)]
 pub(crate) struct ChainObject {
     head: Header,
-    inner: Chains,
+    chain: Chain,
 }
 handle_kind!(AdaptimpChain => ChainObject, b"adpCHAIN");
 
@@ -236,7 +239,7 @@ pub struct AdaptimpCartesian {
 #[derive(Debug)]
 pub(crate) struct CartesianObject {
     head: Header,
-    inner: Carts,
+    pair: CartesianController,
 }
 handle_kind!(AdaptimpCartesian => CartesianObject, b"adpCARTE");
 
@@ -246,116 +249,37 @@ pub struct AdaptimpCartesianState {
     _opaque: [u8; 0],
 }
 
-/// The object behind an [`AdaptimpCartesianState`] handle.
+/// The object behind an [`AdaptimpCartesianState`] handle: the outer
+/// loop's state, the joint controller's (its reals in `Buf`), and the start
+/// (a reset goes back to it).
 #[repr(C)]
 #[derive(Debug)]
 pub(crate) struct CartesianStateObject {
     head: Header,
-    place: Place,
-    states: CStates,
+    outer: CartesianState,
+    joint: State<Buf>,
+    q0: Joints,
 }
 handle_kind!(AdaptimpCartesianState => CartesianStateObject, b"adpCSTAT");
 
-/// One Cartesian controller of N joints.
-#[derive(Debug)]
-struct Cart<const N: usize> {
-    pair: CartesianController<N, Chain<N>, AnyBasis<N>>,
-}
-
-/// One Cartesian state of N joints: the outer loop's, the joint
-/// controller's, and the start (a reset goes back to it).
-#[derive(Debug)]
-struct CSt<const N: usize> {
-    outer: CartesianState<N>,
-    inner: St<N>,
-    q0: Vector<N>,
-}
-
-macro_rules! sized {
-    ($($v:ident => $n:literal),+) => {
-        #[derive(Debug)]
-        enum Chains { $($v(Box<Chain<$n>>)),+ }
-        #[derive(Debug)]
-        enum Carts { $($v(Box<Cart<$n>>)),+ }
-        // By value: a state lives in one block, the heap's or the caller's.
-        #[allow(clippy::large_enum_variant)]
-        #[derive(Debug)]
-        enum CStates { $($v(CSt<$n>)),+ }
-        macro_rules! with_chain {
-            ($e:expr, $c:ident => $body:expr) => {
-                match $e { $(Chains::$v($c) => $body),+ }
-            };
-        }
-        macro_rules! with_cart {
-            ($e:expr, $c:ident => $body:expr) => {
-                match $e { $(Carts::$v($c) => $body),+ }
-            };
-        }
-        macro_rules! with_cstate {
-            ($e:expr, $s:ident => $body:expr) => {
-                match $e { $(CStates::$v($s) => $body),+ }
-            };
-        }
-        macro_rules! with_cpair {
-            ($ce:expr, $se:expr, $c:ident, $s:ident => $body:expr) => {
-                match ($ce, $se) {
-                    $((Carts::$v($c), CStates::$v($s)) => $body,)+
-                    #[allow(unreachable_patterns)]
-                    _ => Err(fail(AdaptimpStatus::WrongState, &"the state was made for a Cartesian controller with another number of joints")),
-                }
-            };
-        }
-        fn chain_of(joints: &[Joint], tip: &Transform) -> Result<Chains, AdaptimpStatus> {
-            let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
-            let config = |e| core_error(e, Context::Config);
-            match n {
-                $($n => Ok(Chains::$v(Box::new(Chain::<$n>::new(joints, tip).map_err(config)?))),)+
-                n => Err(fail(
-                    AdaptimpStatus::BadSize,
-                    &adaptimp::Error::Condition {
-                        condition: "1 ≤ n ≤ 7 movable joints",
-                        lhs: "movable joints",
-                        index: None,
-                        value: n as f64,
-                    },
-                )),
-            }
-        }
-        fn cart_of(chain: &Chains, cfg: CartesianConfig, joint: &AdaptimpParams) -> Result<Carts, AdaptimpStatus> {
-            match chain {
-                $(Chains::$v(c) => Ok(Carts::$v(Box::new(cart_sized::<$n>(c, cfg, joint)?))),)+
-            }
-        }
-        $(impl IntoCStates for CSt<$n> {
-            fn into_cstates(self) -> CStates {
-                CStates::$v(self)
-            }
-        })+
-    };
-}
-
-trait IntoCStates {
-    fn into_cstates(self) -> CStates;
-}
-
-adaptimp::joint_counts!(sized);
-
-fn cart_sized<const N: usize>(
-    chain: &Chain<N>,
-    cfg: CartesianConfig,
-    joint: &AdaptimpParams,
-) -> Result<Cart<N>, AdaptimpStatus> {
-    if joint.n != N {
-        return Err(fail(
-            AdaptimpStatus::BadSize,
-            &format_args!("joint.n = {}, but the chain has {N} joints", joint.n),
-        ));
+/// A chain's error: BAD_SIZE for its number of movable joints (none, or
+/// more than 7), INVALID_CONFIG for every other.
+pub(crate) fn chain_error(e: adaptimp::Error) -> AdaptimpStatus {
+    match e {
+        adaptimp::Error::Condition {
+            lhs: "movable joints",
+            ..
+        } => fail(AdaptimpStatus::BadSize, &e),
+        e => core_error(e, Context::Config),
     }
-    let config = |e| core_error(e, Context::Config);
-    let inner = build_sized::<N>(joint)?.ctrl;
-    let outer = CartesianImpedance::new(cfg, *chain, inner.period()).map_err(config)?;
-    let pair = CartesianController::new(outer, inner).map_err(config)?;
-    Ok(Cart { pair })
+}
+
+/// Publish `chain` as a handle.
+pub(crate) fn publish_chain(chain: Chain) -> Result<*mut AdaptimpChain, AdaptimpStatus> {
+    publish(Box::new(ChainObject {
+        head: Header::unpublished(),
+        chain,
+    }))
 }
 
 fn transform_of(t: &AdaptimpTransform) -> Transform {
@@ -388,9 +312,9 @@ fn a3(v: &Vector<3>) -> [f64; 3] {
     [v[0], v[1], v[2]]
 }
 
-fn joints7<const N: usize>(v: &Vector<N>) -> [f64; ADAPTIMP_MAX_JOINTS] {
+fn joints7(v: &[f64]) -> [f64; ADAPTIMP_MAX_JOINTS] {
     let mut a = [0.0; ADAPTIMP_MAX_JOINTS];
-    a[..N].copy_from_slice(v.as_slice());
+    a[..v.len()].copy_from_slice(v);
     a
 }
 
@@ -403,38 +327,6 @@ fn pose_target(t: &AdaptimpPoseTarget) -> PoseTarget {
         w: v3(&t.w),
         dw: v3(&t.dw),
     }
-}
-
-/// `n` equal to the object's N, or BadSize naming `what`.
-fn check_n<const N: usize>(n: usize, what: &str) -> Result<(), AdaptimpStatus> {
-    if n != N {
-        return Err(fail(
-            AdaptimpStatus::BadSize,
-            &format_args!("n = {n}, but the {what} has {N} joints"),
-        ));
-    }
-    Ok(())
-}
-
-/// N reals at `p` (NULL: refused), every one finite, else `status` naming
-/// `what` (NonFinite for a measurement, InvalidConfig for a setting).
-///
-/// # Safety
-/// A non-NULL `p` holds N reals.
-unsafe fn joint_values<const N: usize>(
-    p: *const f64,
-    what: &'static str,
-    context: Context,
-) -> Result<Vector<N>, AdaptimpStatus> {
-    // SAFETY: the caller's contract.
-    let v = unsafe { slice(p, N, what) }?;
-    if let Some(index) = v.iter().position(|x| !x.is_finite()) {
-        return Err(core_error(
-            adaptimp::Error::NonFinite { what, index },
-            context,
-        ));
-    }
-    Ok(Vector::<N>::from_column_slice(v))
 }
 
 // ---------------------------------------------------------------------------
@@ -508,28 +400,9 @@ pub unsafe extern "C" fn adaptimp_transform_matrix(
         // SAFETY (in the helpers): checked for NULL; the caller's contract.
         let m = unsafe { slice(m, 16, "m") }?;
         let out = unsafe { crate::out(out, "out") }?;
-        let last = [0.0, 0.0, 0.0, 1.0];
-        // A NaN is not within the tolerance either.
-        let off = |j: usize| {
-            use core::cmp::Ordering::{Equal, Less};
-            !matches!(
-                (m[12 + j] - last[j]).abs().partial_cmp(&1e-6),
-                Some(Less | Equal)
-            )
-        };
-        if let Some(j) = (0..4).find(|&j| off(j)) {
-            return Err(fail(
-                AdaptimpStatus::InvalidConfig,
-                &format_args!(
-                    "m[3][{j}] = {}: the last row of a homogeneous transform is 0 0 0 1",
-                    m[12 + j]
-                ),
-            ));
-        }
-        *out = AdaptimpTransform {
-            translation: [m[3], m[7], m[11]],
-            rotation: core::array::from_fn(|i| core::array::from_fn(|j| m[4 * i + j])),
-        };
+        let m: [f64; 16] = core::array::from_fn(|i| m[i]);
+        let t = Transform::from_matrix(&m).map_err(|e| core_error(e, Context::Config))?;
+        *out = transform_out(&t);
         Ok(())
     })
 }
@@ -579,11 +452,7 @@ pub unsafe extern "C" fn adaptimp_chain_new(
                 offset: j.offset,
             });
         }
-        let inner = chain_of(&js, &tip)?;
-        *out = publish(Box::new(ChainObject {
-            head: Header::unpublished(),
-            inner,
-        }))?;
+        *out = publish_chain(Chain::new(&js, &tip).map_err(chain_error)?)?;
         Ok(())
     })
 }
@@ -607,13 +476,9 @@ pub unsafe extern "C" fn adaptimp_chain_free(chain: *mut AdaptimpChain) {
 pub unsafe extern "C" fn adaptimp_chain_joints(chain: *const AdaptimpChain) -> usize {
     // SAFETY (in `handle`): checked.
     match unsafe { handle(chain, "chain") } {
-        Ok(c) => with_chain!(&c.inner, c => n_of(c.as_ref())),
+        Ok(c) => c.chain.n(),
         Err(_) => 0,
     }
-}
-
-fn n_of<const N: usize>(_: &Chain<N>) -> usize {
-    N
 }
 
 /// The tip at q (rad or m, `n` reals) and q̇ (`n` reals; NULL: zero) into
@@ -634,43 +499,29 @@ pub unsafe extern "C" fn adaptimp_chain_tip(
         // SAFETY (in the helpers): checked for NULL; the caller's contract.
         let c = unsafe { handle(chain, "chain") }?;
         let out = unsafe { crate::out(out, "out") }?;
-        with_chain!(&c.inner, c => unsafe { tip_sized(c, n, q, dq, out) })
+        let c = &c.chain;
+        check_n(n, c.n(), "chain")?;
+        let q = unsafe { slice(q, n, "q") }?;
+        let zero = [0.0; ADAPTIMP_MAX_JOINTS];
+        let dq = if dq.is_null() {
+            &zero[..n]
+        } else {
+            unsafe { slice(dq, n, "dq") }?
+        };
+        let t = c.tip(q, dq).map_err(|e| core_error(e, Context::Step))?;
+        out.n = n;
+        out.position = a3(&t.position);
+        out.rotation = rows3(t.rotation.matrix());
+        out.jacobian = core::array::from_fn(|i| {
+            let mut row = [0.0; ADAPTIMP_MAX_JOINTS];
+            for (j, v) in row.iter_mut().enumerate().take(n) {
+                *v = t.jacobian[(i, j)];
+            }
+            row
+        });
+        out.bias = core::array::from_fn(|i| t.bias[i]);
+        Ok(())
     })
-}
-
-/// # Safety
-/// `q`, `dq` NULL or hold `n` reals.
-unsafe fn tip_sized<const N: usize>(
-    c: &Chain<N>,
-    n: usize,
-    q: *const f64,
-    dq: *const f64,
-    out: &mut AdaptimpTip,
-) -> Result<(), AdaptimpStatus> {
-    check_n::<N>(n, "chain")?;
-    // SAFETY: the caller's contract.
-    let q = unsafe { joint_values::<N>(q, "q", Context::Step) }?;
-    let dq = if dq.is_null() {
-        Vector::<N>::zeros()
-    } else {
-        // SAFETY: the caller's contract.
-        unsafe { joint_values::<N>(dq, "dq", Context::Step) }?
-    };
-    let t = c
-        .tip_checked(&q, &dq)
-        .map_err(|e| core_error(e, Context::Step))?;
-    out.n = N;
-    out.position = a3(&t.position);
-    out.rotation = rows3(t.rotation.matrix());
-    out.jacobian = core::array::from_fn(|i| {
-        let mut row = [0.0; ADAPTIMP_MAX_JOINTS];
-        for (j, v) in row.iter_mut().enumerate().take(N) {
-            *v = t.jacobian[(i, j)];
-        }
-        row
-    });
-    out.bias = core::array::from_fn(|i| t.bias[i]);
-    Ok(())
 }
 
 // ---------------------------------------------------------------------------
@@ -755,11 +606,12 @@ fn cartesian_of(p: &AdaptimpCartesianParams) -> Result<CartesianConfig, Adaptimp
         ("admittance_share", Value::Real(*admittance_share)),
     ];
     debug_assert!(values.iter().map(|(n, _)| *n).eq(cartesian_names()));
-    let mut s = Scenario::<1>::preset(Preset::Robot, Law::Pd);
+    let config = |e| core_error(e, Context::Config);
+    let mut s = Scenario::new(1, Preset::Robot, Law::Pd).map_err(config)?;
     for (name, v) in values {
-        s.set(name, v).map_err(|e| core_error(e, Context::Config))?;
+        s.set(name, v).map_err(config)?;
     }
-    Ok(s.cartesian)
+    Ok(s.cartesian())
 }
 
 /// The schema's Cartesian parameters, in its order.
@@ -783,7 +635,9 @@ pub unsafe extern "C" fn adaptimp_cartesian_params_default(
     guard(|| {
         // SAFETY (in `out`): checked for NULL.
         let out = unsafe { crate::out(out, "out") }?;
-        let c = Scenario::<1>::preset(Preset::Robot, Law::Pd).cartesian;
+        let c = Scenario::new(1, Preset::Robot, Law::Pd)
+            .map_err(|e| core_error(e, Context::Config))?
+            .cartesian();
         let CartesianConfig {
             md,
             bd,
@@ -864,10 +718,25 @@ pub unsafe extern "C" fn adaptimp_cartesian_new(
         let joint = unsafe { read(joint, "joint") }?;
         let out = unsafe { crate::out(out, "out") }?;
         let cfg = cartesian_of(cart)?;
-        let inner = cart_of(&chain.inner, cfg, joint)?;
+        let chain = &chain.chain;
+        if joint.n != chain.n() {
+            return Err(fail(
+                AdaptimpStatus::BadSize,
+                &format_args!(
+                    "joint.n = {}, but the chain has {} joints",
+                    joint.n,
+                    chain.n()
+                ),
+            ));
+        }
+        // SAFETY (in `controller_of`): `joint`'s pointers are the caller's.
+        let ctrl = unsafe { controller_of(joint) }?;
+        let config = |e| core_error(e, Context::Config);
+        let outer = CartesianImpedance::new(cfg, chain, ctrl.period()).map_err(config)?;
+        let pair = CartesianController::new(outer, ctrl).map_err(config)?;
         *out = publish(Box::new(CartesianObject {
             head: Header::unpublished(),
-            inner,
+            pair,
         }))?;
         Ok(())
     })
@@ -892,7 +761,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_free(cart: *mut AdaptimpCartesian) {
 pub unsafe extern "C" fn adaptimp_cartesian_joints(cart: *const AdaptimpCartesian) -> usize {
     // SAFETY (in `handle`): checked.
     match unsafe { handle(cart, "cart") } {
-        Ok(c) => with_cart!(&c.inner, c => n_of(c.pair.outer().kinematics())),
+        Ok(c) => c.pair.joint().n(),
         Err(_) => 0,
     }
 }
@@ -905,31 +774,31 @@ pub unsafe extern "C" fn adaptimp_cartesian_joints(cart: *const AdaptimpCartesia
 pub unsafe extern "C" fn adaptimp_cartesian_period(cart: *const AdaptimpCartesian) -> f64 {
     // SAFETY (in `handle`): checked.
     match unsafe { handle(cart, "cart") } {
-        Ok(c) => with_cart!(&c.inner, c => c.pair.outer().period()),
+        Ok(c) => c.pair.outer().period(),
         Err(_) => f64::NAN,
     }
 }
 
-/// A state at t = 0 of `c` started at `q0` over `buf`.
+/// A state at t = 0 of `pair` started at `q0` over `buf`.
 ///
 /// # Safety
-/// `q0` is NULL or holds N reals.
-unsafe fn cstate_over<const N: usize>(
-    c: &Cart<N>,
+/// `q0` is NULL or holds `n` reals.
+unsafe fn cstate_over(
+    pair: &CartesianController,
     n: usize,
     q0: *const f64,
     buf: Buf,
-) -> Result<CStates, AdaptimpStatus>
-where
-    CSt<N>: IntoCStates,
-{
-    check_n::<N>(n, "Cartesian controller")?;
+) -> Result<CartesianStateObject, AdaptimpStatus> {
+    check_n(n, pair.joint().n(), "Cartesian controller")?;
     // SAFETY: the caller's contract.
-    let q0 = unsafe { joint_values::<N>(q0, "q0", Context::Config) }?;
+    let q0 = unsafe { slice(q0, n, "q0") }?;
     let config = |e| core_error(e, Context::Config);
-    let outer = c.pair.start(&q0).map_err(config)?;
-    let inner = c.pair.inner().state_in(buf).map_err(config)?;
-    Ok(CSt { outer, inner, q0 }.into_cstates())
+    Ok(CartesianStateObject {
+        head: Header::unpublished(),
+        outer: pair.start(q0).map_err(config)?,
+        joint: pair.joint().state_in(buf).map_err(config)?,
+        q0: Joints::from_slice(q0).map_err(config)?,
+    })
 }
 
 /// A state at t = 0 of `cart` into `*out`, on the heap (free it with
@@ -952,34 +821,11 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_new(
         // SAFETY (in the helpers): checked for NULL; the caller's contract.
         let c = unsafe { handle(cart, "cart") }?;
         let out = unsafe { crate::out(out, "out") }?;
-        let states = with_cart!(&c.inner, c => unsafe {
-            cstate_over(c, n, q0, Buf::Heap(vec![0.0; c.pair.inner().buffer_len()]))
-        })?;
-        *out = publish(Box::new(CartesianStateObject {
-            head: Header::unpublished(),
-            place: Place::Heap,
-            states,
-        }))?;
+        let buf = Buf::Heap(vec![0.0; c.pair.joint().buffer_len()]);
+        // SAFETY (in `cstate_over`): `q0` is the caller's.
+        *out = publish(Box::new(unsafe { cstate_over(&c.pair, n, q0, buf) }?))?;
         Ok(())
     })
-}
-
-/// The header of a Cartesian state in a caller buffer, in bytes.
-const CSTATE_HEADER: usize = std::mem::size_of::<CartesianStateObject>().next_multiple_of(8);
-/// The alignment a caller buffer for a Cartesian state needs.
-const CSTATE_ALIGN: usize = if std::mem::align_of::<CartesianStateObject>() > 8 {
-    std::mem::align_of::<CartesianStateObject>()
-} else {
-    8
-};
-
-fn cstate_bytes<const N: usize>(c: &Cart<N>) -> Result<usize, AdaptimpStatus> {
-    c.pair
-        .inner()
-        .buffer_len()
-        .checked_mul(8)
-        .and_then(|b| b.checked_add(CSTATE_HEADER))
-        .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"the state's size overflows"))
 }
 
 /// The size (bytes) and alignment a caller buffer for a state of `cart`
@@ -998,8 +844,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_buffer_size(
         let c = unsafe { handle(cart, "cart") }?;
         let size = unsafe { crate::out(size, "size") }?;
         let align = unsafe { crate::out(align, "align") }?;
-        *size = with_cart!(&c.inner, c => cstate_bytes(c))?;
-        *align = CSTATE_ALIGN;
+        (*size, *align) = buffer_size::<AdaptimpCartesianState>(c.pair.joint().buffer_len())?;
         Ok(())
     })
 }
@@ -1025,43 +870,16 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_init(
         // SAFETY (in the helpers): checked for NULL; the caller's contract.
         let c = unsafe { handle(cart, "cart") }?;
         let out = unsafe { crate::out(out, "out") }?;
-        if buf.is_null() {
-            return Err(null("buf"));
-        }
-        let need = with_cart!(&c.inner, c => cstate_bytes(c))?;
-        if size < need || !(buf as usize).is_multiple_of(CSTATE_ALIGN) {
-            return Err(fail(
-                AdaptimpStatus::BadSize,
-                &format_args!(
-                    "buf: {size} bytes at an address {} a multiple of {CSTATE_ALIGN}; a state of this controller needs {need} bytes aligned to {CSTATE_ALIGN} (adaptimp_cartesian_state_buffer_size)",
-                    if (buf as usize).is_multiple_of(CSTATE_ALIGN) { "that is" } else { "that is not" }
-                ),
-            ));
-        }
-        let reals = (need - CSTATE_HEADER) / 8;
-        // SAFETY: as in `adaptimp_state_init`: `size` writable bytes, aligned;
-        // the reals after the header zeroed before the slice is made; the
-        // header written once; no overlap; the buffer outlives the state (the
-        // caller's promise).
-        unsafe {
-            let data = buf.cast::<u8>().add(CSTATE_HEADER).cast::<f64>();
-            std::ptr::write_bytes(data, 0, reals);
-            let data: &'static mut [f64] = std::slice::from_raw_parts_mut(data, reals);
-            let states = with_cart!(&c.inner, c => cstate_over(c, n, q0, Buf::Caller(data)))?;
-            let p = buf.cast::<CartesianStateObject>();
-            p.write(CartesianStateObject {
-                head: Header::unpublished(),
-                place: Place::Caller,
-                states,
-            });
-            match publish_at::<AdaptimpCartesianState>(p) {
-                Ok(h) => *out = h,
-                Err(status) => {
-                    p.drop_in_place();
-                    return Err(status);
-                }
-            }
-        }
+        // SAFETY (in `publish_in`, `cstate_over`): `buf`, `size` and `q0` are the caller's.
+        *out = unsafe {
+            publish_in(
+                buf,
+                size,
+                c.pair.joint().buffer_len(),
+                "adaptimp_cartesian_state_buffer_size",
+                |buf| cstate_over(&c.pair, n, q0, buf),
+            )
+        }?;
         Ok(())
     })
 }
@@ -1073,18 +891,8 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_init(
 /// `state` is NULL or came from `adaptimp_cartesian_state_new` or `_init`.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_cartesian_state_free(state: *mut AdaptimpCartesianState) {
-    let Some(o) = release(state, "state") else {
-        return;
-    };
-    // SAFETY: as in `adaptimp_state_free`: a heap one came from `publish`,
-    // one in a caller's buffer is dropped in place.
-    unsafe {
-        if (*o).place == Place::Heap {
-            drop(Box::from_raw(o));
-        } else {
-            o.drop_in_place();
-        }
-    }
+    // SAFETY: the caller's contract.
+    unsafe { free(state, "state") }
 }
 
 /// Back to t = 0: the outer loop started at `q0` (`n` reals; NULL: the
@@ -1103,35 +911,21 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_reset(
         // SAFETY (in the helpers): checked; the caller's contract.
         let c = unsafe { handle(cart, "cart") }?;
         let s = unsafe { handle_mut(state, "state") }?;
-        with_cpair!(&c.inner, &mut s.states, c, s => unsafe { reset_sized(c, s, n, q0) })
+        same_joints(c.pair.joint().n(), s.joint.n(), "Cartesian controller")?;
+        check_n(n, s.joint.n(), "state")?;
+        let q0 = if q0.is_null() {
+            s.q0
+        } else {
+            let q0 = unsafe { slice(q0, n, "q0") }?;
+            Joints::from_slice(q0).map_err(|e| core_error(e, Context::Config))?
+        };
+        c.pair
+            .restart(&mut s.outer, &q0)
+            .map_err(|e| core_error(e, Context::Config))?;
+        s.q0 = q0;
+        s.joint.reset();
+        Ok(())
     })
-}
-
-/// # Safety
-/// `q0` NULL or holds `n` reals.
-unsafe fn reset_sized<const N: usize>(
-    c: &Cart<N>,
-    s: &mut CSt<N>,
-    n: usize,
-    q0: *const f64,
-) -> Result<(), AdaptimpStatus> {
-    check_n::<N>(n, "state")?;
-    let q0 = if q0.is_null() {
-        s.q0
-    } else {
-        // SAFETY: the caller's contract.
-        unsafe { joint_values::<N>(q0, "q0", Context::Config) }?
-    };
-    let posture = s.outer.posture;
-    let outer = c
-        .pair
-        .start(&q0)
-        .map_err(|e| core_error(e, Context::Config))?;
-    s.q0 = q0;
-    s.outer = outer;
-    s.outer.posture = posture;
-    s.inner.reset();
-    Ok(())
 }
 
 /// The null-space posture (rad, `n` reals) of `state` under `cart` from
@@ -1153,24 +947,13 @@ pub unsafe extern "C" fn adaptimp_cartesian_set_posture(
         // SAFETY (in the helpers): checked; the caller's contract.
         let c = unsafe { handle(cart, "cart") }?;
         let s = unsafe { handle_mut(state, "state") }?;
-        with_cpair!(&c.inner, &mut s.states, c, s => unsafe { posture_sized(c, s, n, posture) })
+        same_joints(c.pair.joint().n(), s.joint.n(), "Cartesian controller")?;
+        check_n(n, s.joint.n(), "state")?;
+        let posture = unsafe { slice(posture, n, "posture") }?;
+        c.pair
+            .set_posture(&mut s.outer, posture)
+            .map_err(|e| core_error(e, Context::Config))
     })
-}
-
-/// # Safety
-/// `posture` NULL or holds `n` reals.
-unsafe fn posture_sized<const N: usize>(
-    c: &Cart<N>,
-    s: &mut CSt<N>,
-    n: usize,
-    posture: *const f64,
-) -> Result<(), AdaptimpStatus> {
-    check_n::<N>(n, "state")?;
-    // SAFETY: the caller's contract.
-    let p = unsafe { joint_values::<N>(posture, "posture", Context::Config) }?;
-    c.pair
-        .set_posture(&mut s.outer, &p)
-        .map_err(|e| core_error(e, Context::Config))
 }
 
 /// Ask for the stiffness `kd` (3 reals, N/m) and `kd_rot` (3 reals, N m/rad):
@@ -1197,11 +980,11 @@ pub unsafe extern "C" fn adaptimp_cartesian_set_stiffness(
             Vector::<3>::from_column_slice(kd),
             Vector::<3>::from_column_slice(kd_rot),
         );
-        with_cpair!(&c.inner, &mut s.states, c, s => c
-            .pair
+        same_joints(c.pair.joint().n(), s.joint.n(), "Cartesian controller")?;
+        c.pair
             .outer()
             .set_stiffness(&mut s.outer, &kd, &kd_rot)
-            .map_err(|e| core_error(e, Context::Config)))
+            .map_err(|e| core_error(e, Context::Config))
     })
 }
 
@@ -1219,7 +1002,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_fault(
     let Ok(s) = (unsafe { handle(state, "state") }) else {
         return false;
     };
-    fault_of(with_cstate!(&s.states, s => s.inner.fault()), step)
+    fault_of(s.joint.fault(), step)
 }
 
 /// Clear the recorded fault (as [`adaptimp_state_clear_fault`]).
@@ -1233,7 +1016,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_clear_fault(
     guard(|| {
         // SAFETY (in `handle_mut`): checked.
         let s = unsafe { handle_mut(state, "state") }?;
-        with_cstate!(&mut s.states, s => s.inner.clear_fault());
+        s.joint.clear_fault();
         Ok(())
     })
 }
@@ -1248,7 +1031,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_steps(
 ) -> u64 {
     // SAFETY (in `handle`): checked.
     match unsafe { handle(state, "state") } {
-        Ok(s) => with_cstate!(&s.states, s => s.inner.steps()),
+        Ok(s) => s.joint.steps(),
         Err(_) => 0,
     }
 }
@@ -1267,7 +1050,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_applied(
         // SAFETY (in the helpers): checked; the caller's contract.
         let s = unsafe { handle(state, "state") }?;
         let tau = unsafe { slice_mut(tau, n, "tau") }?;
-        with_cstate!(&s.states, s => copy_sized(s.inner.applied().as_slice(), tau, "tau"))
+        copy_sized(&s.joint.applied(), tau, "tau")
     })
 }
 
@@ -1343,7 +1126,8 @@ pub unsafe extern "C" fn adaptimp_cartesian_step(
             wrench,
             target,
         };
-        with_cpair!(&c.inner, &mut s.states, c, s => cart_step(c, s, &args, cmd))
+        same_joints(c.pair.joint().n(), s.joint.n(), "Cartesian controller")?;
+        cart_step(&c.pair, s, &args, cmd)
     });
     if status == AdaptimpStatus::Internal && !out.is_null() {
         // SAFETY: non-NULL; the caller's contract.
@@ -1361,51 +1145,52 @@ struct CartArgs {
     target: *const AdaptimpPoseTarget,
 }
 
-/// A refused step's output: the fallback to apply, n, the rest zero.
-fn write_fallback<const N: usize>(tau: &Vector<N>, out: &mut AdaptimpCartesianCommand) {
+/// A refused step's output: the fallback to apply (none: no controller
+/// answered, n = 0), n, the rest zero.
+fn write_fallback(tau: Option<&[f64]>, out: &mut AdaptimpCartesianCommand) {
     *out = AdaptimpCartesianCommand::ZERO;
-    out.n = N;
-    out.tau_sat = joints7(tau);
+    if let Some(tau) = tau {
+        out.n = tau.len();
+        out.tau_sat = joints7(tau);
+    }
 }
 
 /// The refusal of a step the front refused (`status` already the last error).
-fn refused<const N: usize>(
-    c: &Cart<N>,
-    s: &mut CSt<N>,
+fn refused(
+    pair: &CartesianController,
+    s: &mut CartesianStateObject,
     out: Option<&mut AdaptimpCartesianCommand>,
     status: AdaptimpStatus,
 ) -> AdaptimpStatus {
-    let tau = c.pair.inner().refuse(&mut s.inner, BAD_ARGUMENTS);
+    let tau = pair.joint().refuse(&mut s.joint, BAD_ARGUMENTS);
     if let Some(out) = out {
-        write_fallback(&tau, out);
+        write_fallback(tau.as_deref(), out);
     }
     status
 }
 
-fn cart_step<const N: usize>(
-    c: &Cart<N>,
-    s: &mut CSt<N>,
+/// The step of a Cartesian controller and a state of the same n.
+fn cart_step(
+    pair: &CartesianController,
+    s: &mut CartesianStateObject,
     a: &CartArgs,
     out: Option<&mut AdaptimpCartesianCommand>,
 ) -> Result<(), AdaptimpStatus> {
-    if a.n != N {
-        let e = fail(
-            AdaptimpStatus::BadSize,
-            &format_args!("n = {}, but the Cartesian controller has {N} joints", a.n),
-        );
-        return Err(refused(c, s, out, e));
+    let n = pair.joint().n();
+    if let Err(status) = check_n(a.n, n, "Cartesian controller") {
+        return Err(refused(pair, s, out, status));
     }
     let Some(out) = out else {
-        return Err(refused(c, s, None, null("out")));
+        return Err(refused(pair, s, None, null("out")));
     };
     // SAFETY (in `slice`, `read`): checked for NULL; the caller's contract.
     let inputs = (|| {
-        let q = unsafe { slice(a.q, N, "q") }?;
+        let q = unsafe { slice(a.q, n, "q") }?;
         let wrench = unsafe { slice(a.wrench, 6, "wrench") }?;
         let dq = if a.dq.is_null() {
             None
         } else {
-            Some(unsafe { slice(a.dq, N, "dq") }?)
+            Some(unsafe { slice(a.dq, n, "dq") }?)
         };
         let target = if a.target.is_null() {
             None
@@ -1416,45 +1201,47 @@ fn cart_step<const N: usize>(
     })();
     let (q, wrench, dq, target) = match inputs {
         Ok(v) => v,
-        Err(status) => return Err(refused(c, s, Some(out), status)),
+        Err(status) => return Err(refused(pair, s, Some(out), status)),
     };
     let m = CartesianMeasurement {
-        q: Vector::<N>::from_column_slice(q),
-        dq: dq.map(Vector::<N>::from_column_slice),
+        q,
+        dq,
         wrench: Vector::<6>::from_column_slice(wrench),
     };
     let target = target.map(pose_target);
-    match c
-        .pair
-        .step_or_fallback(&mut s.outer, &mut s.inner, &m, target.as_ref())
-    {
+    match pair.step_or_fallback(&mut s.outer, &mut s.joint, &m, target.as_ref()) {
         (_, Ok(cmd)) => {
-            out.n = N;
-            out.tau_sat = joints7(&cmd.joint.tau_sat);
-            out.tau = joints7(&cmd.joint.tau);
-            out.z1 = joints7(&cmd.joint.z1);
-            out.q_d = joints7(&cmd.reference.x);
-            out.dq_d = joints7(&cmd.reference.dx);
-            out.ddq_d = joints7(&cmd.reference.ddx);
-            out.tau_e = joints7(&cmd.tau_e);
-            out.p = a3(&cmd.p);
-            out.rotation = rows3(cmd.r.matrix());
-            out.p_d = a3(&cmd.compliant.p);
-            out.dp_d = a3(&cmd.compliant.dp);
-            out.ddp_d = a3(&cmd.compliant.ddp);
-            out.rotation_d = rows_q(&cmd.compliant.r);
-            out.w_d = a3(&cmd.compliant.w);
-            out.dw_d = a3(&cmd.compliant.dw);
-            out.p_t = a3(&cmd.target.0);
-            out.rotation_t = rows_q(&cmd.target.1);
-            out.error = core::array::from_fn(|i| cmd.error[i]);
+            write_cartesian(&cmd, out);
             Ok(())
         }
         (fallback, Err(e)) => {
-            write_fallback(&fallback, out);
+            write_fallback(fallback.as_deref(), out);
             Err(core_error(e, Context::Step))
         }
     }
+}
+
+/// An accepted step's output.
+fn write_cartesian(cmd: &CartesianCommand, out: &mut AdaptimpCartesianCommand) {
+    out.n = cmd.joint.tau_sat.len();
+    out.tau_sat = joints7(&cmd.joint.tau_sat);
+    out.tau = joints7(&cmd.joint.tau);
+    out.z1 = joints7(&cmd.joint.z1);
+    out.q_d = joints7(&cmd.reference.x);
+    out.dq_d = joints7(&cmd.reference.dx);
+    out.ddq_d = joints7(&cmd.reference.ddx);
+    out.tau_e = joints7(&cmd.tau_e);
+    out.p = a3(&cmd.p);
+    out.rotation = rows3(cmd.r.matrix());
+    out.p_d = a3(&cmd.compliant.p);
+    out.dp_d = a3(&cmd.compliant.dp);
+    out.ddp_d = a3(&cmd.compliant.ddp);
+    out.rotation_d = rows_q(&cmd.compliant.r);
+    out.w_d = a3(&cmd.compliant.w);
+    out.dw_d = a3(&cmd.compliant.dw);
+    out.p_t = a3(&cmd.target.0);
+    out.rotation_t = rows_q(&cmd.target.1);
+    out.error = core::array::from_fn(|i| cmd.error[i]);
 }
 
 // ---------------------------------------------------------------------------
@@ -1502,70 +1289,25 @@ pub unsafe extern "C" fn adaptimp_cartesian_orbit_centres(
         if nodes == 0 {
             return Err(fail(AdaptimpStatus::BadSize, &"nodes must be ≥ 1"));
         }
-        let orbit = OrbitArgs {
-            cfg,
-            ts,
-            n,
-            q0,
-            targets,
-            nodes,
-            tube: [tube[0], tube[1]],
-            centers,
-            widths2,
-        };
-        *written = with_chain!(&chain.inner, c => unsafe { orbit_sized(c, &orbit) })?;
+        let c = &chain.chain;
+        check_n(n, c.n(), "chain")?;
+        let q0 = unsafe { slice(q0, n, "q0") }?;
+        let len = nodes
+            .checked_mul(4 * n)
+            .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"nodes × 4n overflows"))?;
+        let centers = unsafe { slice_mut(centers, len, "centers") }?;
+        let widths2 = unsafe { slice_mut(widths2, 4 * n, "widths2") }?;
+        let config = |e| core_error(e, Context::Config);
+        let outer = CartesianImpedance::new(cfg, c, ts).map_err(config)?;
+        let samples = outer
+            .orbit(q0, targets.len(), |k| pose_target(&targets[k]), nodes)
+            .map_err(config)?;
+        let along = Centres::along(&samples, [tube[0], tube[1]], false).map_err(config)?;
+        centers[..along.rows.len()].copy_from_slice(&along.rows);
+        if let Some(w) = &along.widths2 {
+            widths2.copy_from_slice(w);
+        }
+        *written = samples.len();
         Ok(())
     })
-}
-
-struct OrbitArgs<'a> {
-    cfg: CartesianConfig,
-    ts: f64,
-    n: usize,
-    q0: *const f64,
-    targets: &'a [AdaptimpPoseTarget],
-    nodes: usize,
-    tube: [f64; 2],
-    centers: *mut f64,
-    widths2: *mut f64,
-}
-
-/// # Safety
-/// The pointers of `a` as [`adaptimp_cartesian_orbit_centres`] says.
-unsafe fn orbit_sized<const N: usize>(
-    chain: &Chain<N>,
-    a: &OrbitArgs<'_>,
-) -> Result<usize, AdaptimpStatus> {
-    check_n::<N>(a.n, "chain")?;
-    let config = |e| core_error(e, Context::Config);
-    // SAFETY: the caller's contract.
-    let q0 = unsafe { joint_values::<N>(a.q0, "q0", Context::Config) }?;
-    let len = a
-        .nodes
-        .checked_mul(4 * N)
-        .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"nodes × 4n overflows"))?;
-    // SAFETY: the caller's contract.
-    let centers = unsafe { slice_mut(a.centers, len, "centers") }?;
-    let widths2 = unsafe { slice_mut(a.widths2, 4 * N, "widths2") }?;
-    let outer = CartesianImpedance::new(a.cfg, *chain, a.ts).map_err(config)?;
-    let zero = Setpoint {
-        x: Vector::<N>::zeros(),
-        dx: Vector::zeros(),
-        ddx: Vector::zeros(),
-    };
-    // At most one sample a step (a huge `nodes` allocates no more).
-    let mut samples = vec![zero; a.nodes.min(a.targets.len()).max(1)];
-    let l = outer
-        .orbit(
-            q0,
-            a.targets.len(),
-            |k| pose_target(&a.targets[k]),
-            &mut samples,
-        )
-        .map_err(config)?;
-    let c = Centers::along_in(&mut centers[..l * 4 * N], &samples[..l], a.tube).map_err(config)?;
-    for (b, w) in c.widths2().iter().enumerate() {
-        widths2[b * N..(b + 1) * N].copy_from_slice(w.as_slice());
-    }
-    Ok(l)
 }

@@ -24,6 +24,7 @@
 //! 2^50 on a 64-bit target).
 
 use crate::{fail, null, AdaptimpStatus};
+use core::ffi::c_void;
 use std::sync::atomic::{AtomicPtr, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -39,6 +40,15 @@ const _: () = assert!(ADAPTIMP_MAX_HANDLES.is_power_of_two());
 /// zeroed memory do not decode to a slot and a creation that are live.
 const MIX: usize = 0x9e37_79b9_7f4a_7c15_u64 as usize;
 
+/// Where an object's memory is.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub(crate) enum Place {
+    /// A `Box` of this library's ([`publish`]): freed by [`free`].
+    Heap,
+    /// The caller's buffer ([`publish_in`]): [`free`] only ends its life.
+    Caller,
+}
+
 /// The first field of every object behind a handle (`#[repr(C)]`, so at
 /// offset 0 whatever the kind: reading it is valid for any live object).
 #[repr(C)]
@@ -48,12 +58,43 @@ pub(crate) struct Header {
     tag: u64,
     /// The number of the handle this object was published under.
     id: usize,
+    /// Where the object is.
+    place: Place,
 }
 
 impl Header {
     /// A header to be filled in when the object is published.
     pub(crate) const fn unpublished() -> Self {
-        Self { tag: 0, id: 0 }
+        Self {
+            tag: 0,
+            id: 0,
+            place: Place::Heap,
+        }
+    }
+}
+
+/// The buffer of reals a state works in: the heap's, or the caller's.
+#[derive(Debug)]
+pub(crate) enum Buf {
+    Heap(Vec<f64>),
+    Caller(&'static mut [f64]),
+}
+
+impl AsRef<[f64]> for Buf {
+    fn as_ref(&self) -> &[f64] {
+        match self {
+            Buf::Heap(v) => v,
+            Buf::Caller(s) => s,
+        }
+    }
+}
+
+impl AsMut<[f64]> for Buf {
+    fn as_mut(&mut self) -> &mut [f64] {
+        match self {
+            Buf::Heap(v) => v,
+            Buf::Caller(s) => s,
+        }
     }
 }
 
@@ -138,8 +179,8 @@ fn slot_of(id: usize) -> &'static Slot {
 /// its header filled in, its number returned as the handle the caller gets.
 ///
 /// # Safety
-/// `o` points to a valid object of `T` that stays valid until [`release`].
-unsafe fn register<T: Handle>(o: *mut T::Object) -> Result<*mut T, AdaptimpStatus> {
+/// `o` points to a valid object of `T`, at `place`, that stays valid until [`release`].
+unsafe fn register<T: Handle>(o: *mut T::Object, place: Place) -> Result<*mut T, AdaptimpStatus> {
     let mut b = book();
     let Some(slot) = (0..CAPACITY)
         .map(|i| (b.cursor + i) % CAPACITY)
@@ -166,6 +207,7 @@ unsafe fn register<T: Handle>(o: *mut T::Object) -> Result<*mut T, AdaptimpStatu
     let head = T::head(unsafe { &mut *o });
     head.tag = T::TAG;
     head.id = id;
+    head.place = place;
     SLOTS[slot].object.store(o.cast(), Ordering::Relaxed);
     SLOTS[slot].live.store(id, Ordering::Release);
     Ok(std::ptr::without_provenance_mut(id))
@@ -175,19 +217,85 @@ unsafe fn register<T: Handle>(o: *mut T::Object) -> Result<*mut T, AdaptimpStatu
 pub(crate) fn publish<T: Handle>(o: Box<T::Object>) -> Result<*mut T, AdaptimpStatus> {
     let p = Box::into_raw(o);
     // SAFETY: a fresh box, valid until `free` takes it back.
-    unsafe { register::<T>(p) }.inspect_err(|_| {
+    unsafe { register::<T>(p, Place::Heap) }.inspect_err(|_| {
         // SAFETY: from Box::into_raw just above, never published.
         drop(unsafe { Box::from_raw(p) });
     })
 }
 
-/// Publish an object the caller's buffer holds (written there) as a handle of kind `T`.
+/// The bytes a caller buffer gives an object of kind `T` before its reals
+/// (a multiple of 8, so the reals are aligned).
+const fn head_bytes<T: Handle>() -> usize {
+    std::mem::size_of::<T::Object>().next_multiple_of(8)
+}
+
+/// The alignment of a caller buffer for an object of kind `T`.
+const fn align<T: Handle>() -> usize {
+    let a = std::mem::align_of::<T::Object>();
+    if a > 8 {
+        a
+    } else {
+        8
+    }
+}
+
+/// The size (bytes) and alignment of a caller buffer for an object of kind
+/// `T` that works in `reals` reals: fixed for a controller and a build of
+/// the library.
+pub(crate) fn buffer_size<T: Handle>(reals: usize) -> Result<(usize, usize), AdaptimpStatus> {
+    let size = reals
+        .checked_mul(8)
+        .and_then(|b| b.checked_add(head_bytes::<T>()))
+        .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"the state's size overflows"))?;
+    Ok((size, align::<T>()))
+}
+
+/// Publish an object of kind `T` in the caller's buffer `buf` of `size`
+/// bytes, no allocation: `make` builds it over the `reals` reals after its
+/// place (zeroed first), and it is written at the start of `buf`. NULL_POINTER
+/// for a NULL `buf`; BAD_SIZE for a buffer smaller or less aligned than
+/// [`buffer_size`] says (`sizer` names the function that says it).
 ///
 /// # Safety
-/// `o` points to a valid object that stays where it is until [`release`] (the caller's promise).
-pub(crate) unsafe fn publish_at<T: Handle>(o: *mut T::Object) -> Result<*mut T, AdaptimpStatus> {
-    // SAFETY: the caller's contract.
-    unsafe { register::<T>(o) }
+/// `buf` is NULL or `size` writable bytes that nothing else uses while the
+/// object lives, and that stay where they are until [`free`] (the caller's
+/// promise).
+pub(crate) unsafe fn publish_in<T: Handle>(
+    buf: *mut c_void,
+    size: usize,
+    reals: usize,
+    sizer: &str,
+    make: impl FnOnce(Buf) -> Result<T::Object, AdaptimpStatus>,
+) -> Result<*mut T, AdaptimpStatus> {
+    if buf.is_null() {
+        return Err(null("buf"));
+    }
+    let (need, align) = buffer_size::<T>(reals)?;
+    let aligned = (buf as usize).is_multiple_of(align);
+    if size < need || !aligned {
+        return Err(fail(
+            AdaptimpStatus::BadSize,
+            &format_args!(
+                "buf: {size} bytes at an address {} a multiple of {align}; a state of this controller needs {need} bytes aligned to {align} ({sizer})",
+                if aligned { "that is" } else { "that is not" }
+            ),
+        ));
+    }
+    // SAFETY: `buf` holds `size` ≥ head_bytes + 8·reals writable bytes,
+    // aligned for the object and for reals (the caller's contract, checked
+    // above): the reals after the object's place are zeroed (so initialised)
+    // before a slice is made, and the object is written once with `write`.
+    // The slice and the object do not overlap; 'static is the caller's
+    // promise that the buffer outlives the object.
+    unsafe {
+        let data = buf.cast::<u8>().add(head_bytes::<T>()).cast::<f64>();
+        std::ptr::write_bytes(data, 0, reals);
+        let data: &'static mut [f64] = std::slice::from_raw_parts_mut(data, reals);
+        let o = make(Buf::Caller(data))?;
+        let p = buf.cast::<T::Object>();
+        p.write(o);
+        register::<T>(p, Place::Caller).inspect_err(|_| p.drop_in_place())
+    }
 }
 
 /// What the registry knows of a number given as a handle of kind `T`.
@@ -306,14 +414,24 @@ pub(crate) fn release<T: Handle>(p: *mut T, what: &str) -> Option<*mut T::Object
     Some(o)
 }
 
-/// Free a heap handle (NULL and dead ones ignored; a dead one records a message).
+/// Free a handle (NULL and dead ones ignored; a dead one records a
+/// message): a heap object's memory is freed; one in a caller's buffer
+/// ends its life, and the buffer is the caller's again.
 ///
 /// # Safety
-/// `p` is NULL or any pointer; if live, it was published with [`publish`]
-/// and no other thread uses it during the call.
+/// `p` is NULL or any pointer; if live, no other thread uses it during the call.
 pub(crate) unsafe fn free<T: Handle>(p: *mut T, what: &str) {
     if let Some(o) = release(p, what) {
-        // SAFETY: from Box::into_raw in `publish`, released once.
-        drop(unsafe { Box::from_raw(o) });
+        // SAFETY: live until `release`, now unreachable by its handle: a
+        // heap one came from Box::into_raw in `publish`, released once; one
+        // in a caller's buffer is dropped in place (its reals are the
+        // caller's, it owns no other memory).
+        unsafe {
+            if T::head(&mut *o).place == Place::Heap {
+                drop(Box::from_raw(o));
+            } else {
+                o.drop_in_place();
+            }
+        }
     }
 }

@@ -1,12 +1,9 @@
 //! The joint-space controller: its handle, its states (on the heap or in a
 //! caller buffer), the step, snapshots.
 
-use crate::handles::{free, handle, handle_mut, publish, publish_at, release, Header};
+use crate::handles::{buffer_size, free, handle, handle_mut, publish, publish_in, Buf, Header};
 use crate::*;
-use adaptimp::{
-    AnyBasis, Centers, Command, Controller, Grid, Measurement, Setpoint, Sinusoid, State,
-    Trajectory, Vector,
-};
+use adaptimp::dynamic::{Command, Controller, Measurement, Setpoint, State};
 use core::ffi::c_void;
 
 /// A commanded setpoint at t_k: position (rad), velocity (rad/s) and
@@ -71,13 +68,6 @@ impl AdaptimpCommand {
     };
 }
 
-/// One controller of N joints with the trajectory it tracks by default.
-#[derive(Debug)]
-pub(crate) struct Ctl<const N: usize> {
-    pub(crate) ctrl: Controller<N, AnyBasis<N>>,
-    pub(crate) traj: Sinusoid<N>,
-}
-
 /// A validated controller description (opaque: a handle, see
 /// `ADAPTIMP_MAX_HANDLES`).
 pub struct AdaptimpController {
@@ -89,46 +79,9 @@ pub struct AdaptimpController {
 #[derive(Debug)]
 pub(crate) struct ControllerObject {
     head: Header,
-    inner: Inner,
+    ctrl: Controller,
 }
 handle_kind!(AdaptimpController => ControllerObject, b"adp-CTRL");
-
-/// The buffer of a state: the heap's, or the caller's.
-#[derive(Debug)]
-pub(crate) enum Buf {
-    Heap(Vec<f64>),
-    Caller(&'static mut [f64]),
-}
-
-impl AsRef<[f64]> for Buf {
-    fn as_ref(&self) -> &[f64] {
-        match self {
-            Buf::Heap(v) => v,
-            Buf::Caller(s) => s,
-        }
-    }
-}
-
-impl AsMut<[f64]> for Buf {
-    fn as_mut(&mut self) -> &mut [f64] {
-        match self {
-            Buf::Heap(v) => v,
-            Buf::Caller(s) => s,
-        }
-    }
-}
-
-/// A state of N joints over either buffer.
-pub(crate) type St<const N: usize> = State<N, Buf>;
-
-/// Where a state's memory is.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub(crate) enum Place {
-    /// A `Box` of this library's: freed by `adaptimp_state_free`.
-    Heap,
-    /// The caller's buffer: `adaptimp_state_free` only ends its life.
-    Caller,
-}
 
 /// A controller's state (opaque: a handle): on the heap
 /// ([`adaptimp_state_new`]) or in a buffer of the caller's
@@ -137,126 +90,15 @@ pub struct AdaptimpState {
     _opaque: [u8; 0],
 }
 
-/// The object behind an [`AdaptimpState`] handle.
+/// The object behind an [`AdaptimpState`] handle: the state by value (in
+/// one block, the heap's or the caller's), its reals in `Buf`.
 #[repr(C)]
 #[derive(Debug)]
 pub(crate) struct StateObject {
     head: Header,
-    place: Place,
-    states: States,
+    state: State<Buf>,
 }
 handle_kind!(AdaptimpState => StateObject, b"adpSTATE");
-
-macro_rules! sized {
-    ($($v:ident => $n:literal),+) => {
-        #[derive(Debug)]
-        pub(crate) enum Inner { $($v(Box<Ctl<$n>>)),+ }
-        // By value: a state lives in one block, the heap's or the caller's.
-        #[allow(clippy::large_enum_variant)]
-        #[derive(Debug)]
-        pub(crate) enum States { $($v(St<$n>)),+ }
-        /// `$body` with `$c` the controller of its size, typed.
-        macro_rules! with_ctl {
-            ($e:expr, $c:ident => $body:expr) => {
-                match $e { $(Inner::$v($c) => $body),+ }
-            };
-        }
-        /// `$body` with `$c`, `$s` a controller and a state of one size, or WrongState.
-        macro_rules! with_pair {
-            ($ce:expr, $se:expr, $c:ident, $s:ident => $body:expr) => {
-                match ($ce, $se) {
-                    $((Inner::$v($c), States::$v($s)) => $body,)+
-                    #[allow(unreachable_patterns)]
-                    _ => Err(fail(AdaptimpStatus::WrongState, &"the state was made for a controller with another number of joints")),
-                }
-            };
-        }
-        /// `$body` with `$s` the state of its size.
-        macro_rules! with_state {
-            ($e:expr, $s:ident => $body:expr) => {
-                match $e { $(States::$v($s) => $body),+ }
-            };
-        }
-        pub(crate) fn build(p: &AdaptimpParams) -> Result<Inner, AdaptimpStatus> {
-            match p.n {
-                $($n => Ok(Inner::$v(Box::new(build_sized::<$n>(p)?))),)+
-                n => Err(bad_n(n)),
-            }
-        }
-        $(impl IntoStates for St<$n> {
-            fn into_states(self) -> States {
-                States::$v(self)
-            }
-        })+
-    };
-}
-
-/// A state of one size as the enum.
-pub(crate) trait IntoStates {
-    fn into_states(self) -> States;
-}
-
-adaptimp::joint_counts!(sized);
-
-pub(crate) fn build_sized<const N: usize>(p: &AdaptimpParams) -> Result<Ctl<N>, AdaptimpStatus> {
-    let s = scenario_of::<N>(p)?;
-    let config = |e| core_error(e, Context::Config);
-    let basis = if p.centers.is_null() {
-        AnyBasis::Grid(Grid::new(s.eta2).map_err(config)?)
-    } else {
-        let len = p
-            .nodes
-            .checked_mul(4 * N)
-            .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"params.nodes × 4n overflows"))?;
-        // SAFETY (in `slice`): the caller gives `nodes` rows of 4n reals.
-        let c = unsafe { slice(p.centers, len, "params.centers") }?.to_vec();
-        let widths2 = if p.widths2.is_null() {
-            [Vector::<N>::from_element(s.eta2); 4]
-        } else {
-            // SAFETY (in `slice`): the caller gives 4n reals.
-            let w = unsafe { slice(p.widths2, 4 * N, "params.widths2") }?;
-            core::array::from_fn(|b| Vector::<N>::from_column_slice(&w[b * N..(b + 1) * N]))
-        };
-        AnyBasis::Centers(Centers::new(c, widths2).map_err(config)?)
-    };
-    let traj = s.trajectory().map_err(config)?;
-    let ctrl = Controller::for_trajectory(s.config, basis, &traj).map_err(config)?;
-    Ok(Ctl { ctrl, traj })
-}
-
-fn joints_of<const N: usize>(_: &Ctl<N>) -> usize {
-    N
-}
-
-/// The size of a state's header in a caller buffer, in bytes: its buffer of
-/// reals follows, aligned for them.
-const STATE_HEADER: usize = std::mem::size_of::<StateObject>().next_multiple_of(8);
-/// The alignment a caller buffer for a state needs.
-const STATE_ALIGN: usize = if std::mem::align_of::<StateObject>() > 8 {
-    std::mem::align_of::<StateObject>()
-} else {
-    8
-};
-
-/// The bytes of a caller buffer for a state of `c`.
-fn state_bytes<const N: usize>(c: &Ctl<N>) -> Result<usize, AdaptimpStatus> {
-    c.ctrl
-        .buffer_len()
-        .checked_mul(8)
-        .and_then(|b| b.checked_add(STATE_HEADER))
-        .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"the state's size overflows"))
-}
-
-/// A new state of `c` over `buf`, as the enum.
-fn state_over<const N: usize>(c: &Ctl<N>, buf: Buf) -> Result<States, AdaptimpStatus>
-where
-    St<N>: IntoStates,
-{
-    c.ctrl
-        .state_in(buf)
-        .map(IntoStates::into_states)
-        .map_err(|e| core_error(e, Context::Config))
-}
 
 // ---------------------------------------------------------------------------
 // The API.
@@ -279,10 +121,11 @@ pub unsafe extern "C" fn adaptimp_controller_new(
         // SAFETY (in `read`, `out`): checked for NULL; the caller's contract.
         let p = unsafe { read(params, "params") }?;
         let out = unsafe { crate::out(out, "out") }?;
-        let inner = build(p)?;
+        // SAFETY (in `controller_of`): `params`' pointers are the caller's.
+        let ctrl = unsafe { controller_of(p) }?;
         *out = publish(Box::new(ControllerObject {
             head: Header::unpublished(),
-            inner,
+            ctrl,
         }))?;
         Ok(())
     })
@@ -333,7 +176,7 @@ pub unsafe extern "C" fn adaptimp_controller_free(ctrl: *mut AdaptimpController)
 pub unsafe extern "C" fn adaptimp_controller_joints(ctrl: *const AdaptimpController) -> usize {
     // SAFETY (in `handle`): checked for NULL and for a live handle.
     match unsafe { handle(ctrl, "ctrl") } {
-        Ok(c) => with_ctl!(&c.inner, c => joints_of(c)),
+        Ok(c) => c.ctrl.n(),
         Err(_) => 0,
     }
 }
@@ -346,7 +189,7 @@ pub unsafe extern "C" fn adaptimp_controller_joints(ctrl: *const AdaptimpControl
 pub unsafe extern "C" fn adaptimp_controller_period(ctrl: *const AdaptimpController) -> f64 {
     // SAFETY (in `handle`): checked for NULL and for a live handle.
     match unsafe { handle(ctrl, "ctrl") } {
-        Ok(c) => with_ctl!(&c.inner, c => c.ctrl.period()),
+        Ok(c) => c.ctrl.period(),
         Err(_) => f64::NAN,
     }
 }
@@ -366,13 +209,8 @@ pub unsafe extern "C" fn adaptimp_state_new(
         // SAFETY (in `handle`, `out`): checked for NULL; the caller's contract.
         let c = unsafe { handle(ctrl, "ctrl") }?;
         let out = unsafe { crate::out(out, "out") }?;
-        let states =
-            with_ctl!(&c.inner, c => state_over(c, Buf::Heap(vec![0.0; c.ctrl.buffer_len()])))?;
-        *out = publish(Box::new(StateObject {
-            head: Header::unpublished(),
-            place: Place::Heap,
-            states,
-        }))?;
+        let buf = Buf::Heap(vec![0.0; c.ctrl.buffer_len()]);
+        *out = publish(Box::new(state_over(&c.ctrl, buf)?))?;
         Ok(())
     })
 }
@@ -394,8 +232,7 @@ pub unsafe extern "C" fn adaptimp_state_buffer_size(
         let c = unsafe { handle(ctrl, "ctrl") }?;
         let size = unsafe { out(size, "size") }?;
         let align = unsafe { out(align, "align") }?;
-        *size = with_ctl!(&c.inner, c => state_bytes(c))?;
-        *align = STATE_ALIGN;
+        (*size, *align) = buffer_size::<AdaptimpState>(c.ctrl.buffer_len())?;
         Ok(())
     })
 }
@@ -424,45 +261,16 @@ pub unsafe extern "C" fn adaptimp_state_init(
         // SAFETY (in `handle`, `out`): checked for NULL; the caller's contract.
         let c = unsafe { handle(ctrl, "ctrl") }?;
         let out = unsafe { crate::out(out, "out") }?;
-        if buf.is_null() {
-            return Err(null("buf"));
-        }
-        let need = with_ctl!(&c.inner, c => state_bytes(c))?;
-        if size < need || !(buf as usize).is_multiple_of(STATE_ALIGN) {
-            return Err(fail(
-                AdaptimpStatus::BadSize,
-                &format_args!(
-                    "buf: {size} bytes at an address {} a multiple of {STATE_ALIGN}; a state of this controller needs {need} bytes aligned to {STATE_ALIGN} (adaptimp_state_buffer_size)",
-                    if (buf as usize).is_multiple_of(STATE_ALIGN) { "that is" } else { "that is not" }
-                ),
-            ));
-        }
-        let reals = (need - STATE_HEADER) / 8;
-        // SAFETY: `buf` holds `size` ≥ STATE_HEADER + 8·reals writable bytes,
-        // aligned to 8 (the caller's contract, checked above): the reals after
-        // the header are zeroed (so initialised) before a slice is made, and
-        // the header is written once with `write`. The slice and the header do
-        // not overlap; 'static is the caller's promise that the buffer
-        // outlives the state.
-        unsafe {
-            let data = buf.cast::<u8>().add(STATE_HEADER).cast::<f64>();
-            std::ptr::write_bytes(data, 0, reals);
-            let data: &'static mut [f64] = std::slice::from_raw_parts_mut(data, reals);
-            let states = with_ctl!(&c.inner, c => state_over(c, Buf::Caller(data)))?;
-            let p = buf.cast::<StateObject>();
-            p.write(StateObject {
-                head: Header::unpublished(),
-                place: Place::Caller,
-                states,
-            });
-            match publish_at::<AdaptimpState>(p) {
-                Ok(h) => *out = h,
-                Err(status) => {
-                    p.drop_in_place();
-                    return Err(status);
-                }
-            }
-        }
+        // SAFETY (in `publish_in`): `buf` and `size` are the caller's.
+        *out = unsafe {
+            publish_in(
+                buf,
+                size,
+                c.ctrl.buffer_len(),
+                "adaptimp_state_buffer_size",
+                |buf| state_over(&c.ctrl, buf),
+            )
+        }?;
         Ok(())
     })
 }
@@ -477,20 +285,8 @@ pub unsafe extern "C" fn adaptimp_state_init(
 /// `state` is NULL or came from `adaptimp_state_new` or `adaptimp_state_init`.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_state_free(state: *mut AdaptimpState) {
-    let Some(o) = release(state, "state") else {
-        return;
-    };
-    // SAFETY: a live object until `release`, now unreachable by its handle:
-    // a heap one came from `publish` (Box::into_raw); one in a caller's
-    // buffer is dropped in place (it owns no other memory) and the buffer is
-    // the caller's again.
-    unsafe {
-        if (*o).place == Place::Heap {
-            drop(Box::from_raw(o));
-        } else {
-            o.drop_in_place();
-        }
-    }
+    // SAFETY: the caller's contract.
+    unsafe { free(state, "state") }
 }
 
 /// Back to t = 0: weights, ζ, observer, reference and applied torque as at
@@ -503,7 +299,7 @@ pub unsafe extern "C" fn adaptimp_state_reset(state: *mut AdaptimpState) -> Adap
     guard(|| {
         // SAFETY (in `handle_mut`): checked for NULL and for a live handle.
         let s = unsafe { handle_mut(state, "state") }?;
-        with_state!(&mut s.states, s => s.reset());
+        s.state.reset();
         Ok(())
     })
 }
@@ -520,7 +316,7 @@ pub unsafe extern "C" fn adaptimp_state_fault(state: *const AdaptimpState, step:
     let Ok(s) = (unsafe { handle(state, "state") }) else {
         return false;
     };
-    fault_of(with_state!(&s.states, s => s.fault()), step)
+    fault_of(s.state.fault(), step)
 }
 
 /// Whether there is a fault, its step written to `step` if not NULL.
@@ -547,7 +343,7 @@ pub unsafe extern "C" fn adaptimp_state_clear_fault(state: *mut AdaptimpState) -
     guard(|| {
         // SAFETY (in `handle_mut`): checked for NULL and for a live handle.
         let s = unsafe { handle_mut(state, "state") }?;
-        with_state!(&mut s.states, s => s.clear_fault());
+        s.state.clear_fault();
         Ok(())
     })
 }
@@ -560,7 +356,7 @@ pub unsafe extern "C" fn adaptimp_state_clear_fault(state: *mut AdaptimpState) -
 pub unsafe extern "C" fn adaptimp_state_steps(state: *const AdaptimpState) -> u64 {
     // SAFETY (in `handle`): checked for NULL and for a live handle.
     match unsafe { handle(state, "state") } {
-        Ok(s) => with_state!(&s.states, s => s.steps()),
+        Ok(s) => s.state.steps(),
         Err(_) => 0,
     }
 }
@@ -582,7 +378,7 @@ pub unsafe extern "C" fn adaptimp_state_applied(
         // SAFETY (in the helpers): checked for NULL; the caller's contract.
         let s = unsafe { handle(state, "state") }?;
         let tau = unsafe { slice_mut(tau, n, "tau") }?;
-        with_state!(&s.states, s => copy_sized(s.applied().as_slice(), tau, "tau"))
+        copy_sized(&s.state.applied(), tau, "tau")
     })
 }
 
@@ -611,7 +407,7 @@ pub(crate) fn copy_sized(src: &[f64], dst: &mut [f64], what: &str) -> Result<(),
 pub unsafe extern "C" fn adaptimp_state_snapshot_len(state: *const AdaptimpState) -> usize {
     // SAFETY (in `handle`): checked for NULL and for a live handle.
     match unsafe { handle(state, "state") } {
-        Ok(s) => with_state!(&s.states, s => s.snapshot_len()),
+        Ok(s) => s.state.snapshot_len(),
         Err(_) => 0,
     }
 }
@@ -637,7 +433,9 @@ pub unsafe extern "C" fn adaptimp_state_save(
         // SAFETY (in `handle`, `slice_mut`): checked for NULL; the caller's contract.
         let s = unsafe { handle(state, "state") }?;
         let buf = unsafe { slice_mut(buf, len, "buf") }?;
-        let n = with_state!(&s.states, s => s.save(buf))
+        let n = s
+            .state
+            .save(buf)
             .map_err(|e| fail(AdaptimpStatus::BadSize, &e))?;
         if !written.is_null() {
             // SAFETY: non-NULL; the caller's contract.
@@ -670,10 +468,10 @@ pub unsafe extern "C" fn adaptimp_state_restore(
         let c = unsafe { handle(ctrl, "ctrl") }?;
         let s = unsafe { handle_mut(state, "state") }?;
         let buf = unsafe { slice(buf, len, "buf") }?;
-        with_pair!(&c.inner, &mut s.states, c, s => c
-            .ctrl
-            .restore(s, buf)
-            .map_err(|e| core_error(e, Context::Restore)))
+        same_joints(c.ctrl.n(), s.state.n(), "controller")?;
+        c.ctrl
+            .restore(&mut s.state, buf)
+            .map_err(|e| core_error(e, Context::Restore))
     })
 }
 
@@ -727,7 +525,8 @@ pub unsafe extern "C" fn adaptimp_step(
             tau_e,
             setpoint,
         };
-        with_pair!(&c.inner, &mut s.states, c, s => step_sized(c, s, &args, cmd))
+        same_joints(c.ctrl.n(), s.state.n(), "controller")?;
+        step_checked(&c.ctrl, &mut s.state, &args, cmd)
     });
     if status == AdaptimpStatus::Internal && !out.is_null() {
         // SAFETY: non-NULL; the caller's contract.
@@ -745,46 +544,55 @@ struct StepArgs {
     setpoint: *const AdaptimpSetpoint,
 }
 
+/// A state of `ctrl` over `buf`, at t = 0.
+fn state_over(ctrl: &Controller, buf: Buf) -> Result<StateObject, AdaptimpStatus> {
+    let state = ctrl
+        .state_in(buf)
+        .map_err(|e| core_error(e, Context::Config))?;
+    Ok(StateObject {
+        head: Header::unpublished(),
+        state,
+    })
+}
+
 /// The fallback of a step the front refused (`status` already recorded as
 /// the last error): the refusal recorded in the state as the core records
 /// one, the fallback written.
-fn refused<const N: usize>(
-    c: &Ctl<N>,
-    s: &mut St<N>,
+fn refused(
+    c: &Controller,
+    s: &mut State<Buf>,
     out: Option<&mut AdaptimpCommand>,
     status: AdaptimpStatus,
 ) -> AdaptimpStatus {
-    let tau = c.ctrl.refuse(s, BAD_ARGUMENTS);
+    let tau = c.refuse(s, BAD_ARGUMENTS);
     if let Some(out) = out {
-        write_fallback(&tau, out);
+        write_fallback(tau.as_deref(), out);
     }
     status
 }
 
-fn step_sized<const N: usize>(
-    c: &Ctl<N>,
-    s: &mut St<N>,
+/// The step of a controller and a state of the same n.
+fn step_checked(
+    c: &Controller,
+    s: &mut State<Buf>,
     a: &StepArgs,
     out: Option<&mut AdaptimpCommand>,
 ) -> Result<(), AdaptimpStatus> {
-    if a.n != N {
-        let e = fail(
-            AdaptimpStatus::BadSize,
-            &format_args!("n = {}, but the controller has {N} joints", a.n),
-        );
-        return Err(refused(c, s, out, e));
+    let n = c.n();
+    if let Err(status) = check_n(a.n, n, "controller") {
+        return Err(refused(c, s, out, status));
     }
     let Some(out) = out else {
         return Err(refused(c, s, None, null("out")));
     };
     // SAFETY (in `slice`, `read`): checked for NULL; the caller's contract.
     let inputs = (|| {
-        let q = unsafe { slice(a.q, N, "q") }?;
-        let tau_e = unsafe { slice(a.tau_e, N, "tau_e") }?;
+        let q = unsafe { slice(a.q, n, "q") }?;
+        let tau_e = unsafe { slice(a.tau_e, n, "tau_e") }?;
         let dq = if a.dq.is_null() {
             None
         } else {
-            Some(unsafe { slice(a.dq, N, "dq") }?)
+            Some(unsafe { slice(a.dq, n, "dq") }?)
         };
         let sp = if a.setpoint.is_null() {
             None
@@ -798,39 +606,41 @@ fn step_sized<const N: usize>(
         Err(status) => return Err(refused(c, s, Some(out), status)),
     };
     let m = Measurement {
-        x: Vector::<N>::from_column_slice(q),
-        dx: dq.map(Vector::<N>::from_column_slice),
-        tau_e: Vector::<N>::from_column_slice(tau_e),
+        x: q,
+        dx: dq,
+        tau_e,
     };
-    let setpoint = match sp {
-        Some(sp) => Setpoint {
-            x: Vector::<N>::from_column_slice(&sp.x[..N]),
-            dx: Vector::<N>::from_column_slice(&sp.dx[..N]),
-            ddx: Vector::<N>::from_column_slice(&sp.ddx[..N]),
-        },
-        None => c.traj.sample(c.ctrl.time(s)),
-    };
-    match c.ctrl.step_or_fallback(s, &m, &setpoint) {
+    let setpoint = sp.map(|sp| Setpoint {
+        x: &sp.x[..n],
+        dx: &sp.dx[..n],
+        ddx: &sp.ddx[..n],
+    });
+    match c.step_or_fallback(s, &m, setpoint.as_ref()) {
         (_, Ok(cmd)) => {
             write_command(&cmd, out);
             Ok(())
         }
         (fallback, Err(e)) => {
-            write_fallback(&fallback, out);
+            write_fallback(fallback.as_deref(), out);
             Err(core_error(e, Context::Step))
         }
     }
 }
 
-/// A refused step's output: the fallback to apply, n, every other field zero.
-pub(crate) fn write_fallback<const N: usize>(tau: &Vector<N>, out: &mut AdaptimpCommand) {
-    let mut cmd = Command::<N>::zeros();
-    cmd.tau_sat = *tau;
-    write_command(&cmd, out);
+/// A refused step's output: the fallback to apply (none: no controller
+/// answered, n = 0), n, every other field zero.
+pub(crate) fn write_fallback(tau: Option<&[f64]>, out: &mut AdaptimpCommand) {
+    *out = AdaptimpCommand::ZERO;
+    if let Some(tau) = tau {
+        out.n = tau.len();
+        out.tau_sat[..tau.len()].copy_from_slice(tau);
+    }
 }
 
-pub(crate) fn write_command<const N: usize>(cmd: &Command<N>, out: &mut AdaptimpCommand) {
-    out.n = N;
+/// An accepted step's output, n = the command's joints.
+pub(crate) fn write_command(cmd: &Command, out: &mut AdaptimpCommand) {
+    let n = cmd.tau_sat.len();
+    out.n = n;
     for (dst, src) in [
         (&mut out.tau_sat, &cmd.tau_sat),
         (&mut out.tau, &cmd.tau),
@@ -843,7 +653,7 @@ pub(crate) fn write_command<const N: usize>(cmd: &Command<N>, out: &mut Adaptimp
         (&mut out.zeta, &cmd.zeta),
     ] {
         dst.fill(0.0);
-        dst[..N].copy_from_slice(src.as_slice());
+        dst[..n].copy_from_slice(src);
     }
     out.w_norms = cmd.w_norms;
 }

@@ -545,6 +545,29 @@ fn core_error(e: Error, context: Context) -> AdaptimpStatus {
     fail(status, &e)
 }
 
+/// WRONG_STATE unless a state of `state` joints is one of a `what` of
+/// `joints` joints (a state of another n: no controller to ask).
+fn same_joints(joints: usize, state: usize, what: &str) -> Result<(), AdaptimpStatus> {
+    if joints != state {
+        return Err(fail(
+            AdaptimpStatus::WrongState,
+            &format_args!("the state was made for a {what} with another number of joints"),
+        ));
+    }
+    Ok(())
+}
+
+/// BAD_SIZE unless the caller's `n` is the `joints` of the `what` it names.
+fn check_n(n: usize, joints: usize, what: &str) -> Result<(), AdaptimpStatus> {
+    if n != joints {
+        return Err(fail(
+            AdaptimpStatus::BadSize,
+            &format_args!("n = {n}, but the {what} has {joints} joints"),
+        ));
+    }
+    Ok(())
+}
+
 /// Run `f`, turning a panic into `AdaptimpStatus::Internal`.
 fn guard(f: impl FnOnce() -> Result<(), AdaptimpStatus>) -> AdaptimpStatus {
     match catch_unwind(AssertUnwindSafe(f)) {

@@ -4,10 +4,10 @@
 //! is the core's (`adaptimp::description`); this converts strings and
 //! checks pointers.
 
-use crate::cartesian::{adaptimp_chain_new, AdaptimpChain, AdaptimpJoint, AdaptimpTransform};
+use crate::cartesian::{chain_error, publish_chain, AdaptimpChain};
 use crate::*;
 use adaptimp::description::{self, urdf, DescriptionError};
-use adaptimp::{JointKind, Transform};
+use adaptimp::dynamic::Chain;
 use core::ffi::{c_char, CStr};
 
 /// What the core read of the arm beside its chain (SPEC §21), per arm joint
@@ -54,13 +54,6 @@ unsafe fn text<'a>(p: *const c_char, what: &str) -> Result<Option<&'a str>, Adap
 /// A reader's error (every kind: the file, the element, what to do) as INVALID_CONFIG.
 fn described(e: DescriptionError) -> AdaptimpStatus {
     fail(AdaptimpStatus::InvalidConfig, &e)
-}
-
-fn transform_out(t: &Transform) -> AdaptimpTransform {
-    AdaptimpTransform {
-        translation: t.translation,
-        rotation: t.rotation,
-    }
 }
 
 /// The chain of the arm of a URDF into `*out` (free it with
@@ -113,9 +106,7 @@ pub unsafe extern "C" fn adaptimp_chain_from_urdf(
             })?;
             fixed.push(name);
         }
-        if out.is_null() {
-            return Err(fail(AdaptimpStatus::NullPointer, &"out is NULL"));
-        }
+        let out = unsafe { crate::out(out, "out") }?;
         let tree = if urdf::is_text(source) {
             urdf::read_str(source)
         } else {
@@ -123,39 +114,9 @@ pub unsafe extern "C" fn adaptimp_chain_from_urdf(
         }
         .map_err(described)?;
         let arm = description::reduce(&tree, tip, &fixed).map_err(described)?;
-        if arm.n() > ADAPTIMP_MAX_JOINTS {
-            let names: Vec<&str> = arm.joints.iter().map(|j| j.name.as_str()).collect();
-            return Err(fail(
-                AdaptimpStatus::BadSize,
-                &format_args!(
-                    "{}: the arm has {} joints ({}); a chain has at most {ADAPTIMP_MAX_JOINTS}: \
-                     hold some with fix",
-                    arm.source,
-                    arm.n(),
-                    names.join(", ")
-                ),
-            ));
-        }
-        let joints: Vec<AdaptimpJoint> = arm
-            .chain
-            .iter()
-            .map(|j| AdaptimpJoint {
-                kind: AdaptimpJointKindRaw(match j.kind {
-                    JointKind::Fixed => AdaptimpJointKind::Fixed,
-                    JointKind::Revolute => AdaptimpJointKind::Revolute,
-                    JointKind::Prismatic => AdaptimpJointKind::Prismatic,
-                } as u32),
-                origin: transform_out(&j.origin),
-                axis: j.axis,
-                offset: j.offset,
-            })
-            .collect();
-        let tip_origin = transform_out(&arm.tip_origin);
-        // SAFETY: `joints` holds `joints.len()` joints, `tip_origin` and `out` are valid.
-        let status = unsafe { adaptimp_chain_new(joints.as_ptr(), joints.len(), &tip_origin, out) };
-        if status != AdaptimpStatus::Ok {
-            return Err(status);
-        }
+        arm.within(ADAPTIMP_MAX_JOINTS)
+            .map_err(|e| fail(AdaptimpStatus::BadSize, &e))?;
+        *out = publish_chain(Chain::from_arm(&arm).map_err(chain_error)?)?;
         if !info.is_null() {
             // SAFETY: non-NULL and valid: the caller's contract.
             let info = unsafe { crate::out(info, "info") }?;

@@ -191,12 +191,47 @@ fn three_joints_with_user_centres_and_widths() {
         "{}",
         last_error()
     );
-    // NULL centres with n > 3: the grid does not exist.
-    p.centers = ptr::null();
-    p.n = 4;
-    let (status, msg) = Handles::new(&p).err().expect("refused");
-    assert_eq!(status, AdaptimpStatus::InvalidConfig);
-    assert!(msg.contains("1 ≤ n ≤ 3"), "{msg}");
+}
+
+#[test]
+fn more_than_three_joints_without_centres_get_the_one_builders_default_basis() {
+    // NULL centres with n > 3: the rule's centres along the commanded
+    // trajectory (SPEC §18), as `dynamic::Scenario::controller` (Python's
+    // builder too) makes them: the same torques, bit for bit.
+    use adaptimp::dynamic;
+    for n in 4..=7 {
+        for (law, c_law) in [
+            (Law::Pd, AdaptimpLaw::Pd),
+            (Law::StateFeedback, AdaptimpLaw::StateFeedback),
+            (Law::OutputFeedback, AdaptimpLaw::OutputFeedback),
+        ] {
+            let p = defaults(n, c_law, AdaptimpPreset::Robot);
+            assert!(p.centers.is_null());
+            let c = Handles::new(&p).expect("controller");
+            let ctrl = dynamic::Scenario::new(n, adaptimp::Preset::Robot, law)
+                .unwrap()
+                .controller()
+                .unwrap();
+            assert!(ctrl.nodes() > 0);
+            let mut st = ctrl.new_state();
+            for k in 0..20 {
+                let q: Vec<f64> = (0..n)
+                    .map(|i| 0.1 * (0.01 * k as f64 + i as f64).sin())
+                    .collect();
+                let dq: Vec<f64> = (0..n).map(|i| 0.01 * i as f64).collect();
+                let te = vec![0.0; n];
+                let ours = c.step(&q, Some(&dq), &te).expect("step");
+                let m = dynamic::Measurement {
+                    x: &q,
+                    dx: Some(&dq),
+                    tau_e: &te,
+                };
+                let theirs = ctrl.step(&mut st, &m, None).unwrap();
+                assert_eq!(&ours.tau_sat[..n], &*theirs.tau_sat, "n={n} {law:?} k={k}");
+                assert_eq!(&ours.tau[..n], &*theirs.tau, "n={n} {law:?} k={k}");
+            }
+        }
+    }
 }
 
 #[test]

@@ -867,3 +867,63 @@ fn an_axis_whose_norm_overflows_is_normalised_and_a_huge_rate_refused() {
         adaptimp_chain_free(unit);
     }
 }
+
+/// A URDF arm of more joints than a chain holds: BAD_SIZE, naming its
+/// joints and what to do; holding one gives the chain of the rest.
+#[test]
+fn a_urdf_arm_of_eight_joints_is_refused_by_name_and_read_with_one_held() {
+    let mut urdf = String::from("<robot name='eight'><link name='l0'/>");
+    for i in 0..8 {
+        urdf += &format!(
+            "<link name='l{}'><inertial><mass value='1'/><inertia ixx='0.01' ixy='0' ixz='0' \
+             iyy='0.01' iyz='0' izz='0.01'/></inertial></link>\
+             <joint name='j{i}' type='revolute'><parent link='l{i}'/><child link='l{}'/>\
+             <origin xyz='0 0 0.1'/><axis xyz='0 0 1'/>\
+             <limit lower='-1' upper='1' effort='5' velocity='1'/></joint>",
+            i + 1,
+            i + 1
+        );
+    }
+    urdf += "</robot>\0";
+    let source = urdf.as_ptr().cast();
+    let mut chain = ptr::null_mut();
+    // SAFETY: NUL-terminated text, a valid out pointer.
+    let s = unsafe {
+        adaptimp_chain_from_urdf(
+            source,
+            ptr::null(),
+            ptr::null(),
+            0,
+            &mut chain,
+            ptr::null_mut(),
+        )
+    };
+    assert_eq!(s, AdaptimpStatus::BadSize);
+    assert!(chain.is_null());
+    assert!(
+        last_error().ends_with(
+            "the arm has 8 joints (j0, j1, j2, j3, j4, j5, j6, j7); a chain has at most 7: \
+             hold some with fix"
+        ),
+        "{}",
+        last_error()
+    );
+    let fix = [c"j7".as_ptr()];
+    // SAFETY: as above, one NUL-terminated name.
+    let s = unsafe {
+        adaptimp_chain_from_urdf(
+            source,
+            ptr::null(),
+            fix.as_ptr(),
+            1,
+            &mut chain,
+            ptr::null_mut(),
+        )
+    };
+    assert_eq!(s, AdaptimpStatus::Ok, "{}", last_error());
+    // SAFETY: a live chain.
+    unsafe {
+        assert_eq!(adaptimp_chain_joints(chain), 7);
+        adaptimp_chain_free(chain);
+    }
+}

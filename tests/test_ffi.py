@@ -9,6 +9,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -60,6 +61,86 @@ def test_c_torques_equal_python_and_rust_for_the_same_inputs(examples: Path) -> 
                 te = [max(0.0, 5.0 * math.sin(0.05 * s)), 0.0]
                 tau = ctrl.step(Measurement(q, dq, tau_e=te))
                 np.testing.assert_allclose(c_tau[k], tau, rtol=1e-12, atol=1e-12)
+
+
+# The same parameters given to both fronts: (n, case, scenario, parameters);
+# n > 3 without centres takes the rule's default basis (SPEC §18) in both.
+SAME = [
+    (1, "pd", "robot", {"Kp": [3.0]}),
+    (2, "sf", "paper", {}),
+    (3, "of", "robot", {"tau_max": [30.0, 20.0, 10.0], "delay": 1}),
+    (4, "sf", "robot", {}),
+    (5, "pd", "paper", {"xc_sin": [0.1, 0.2, 0.3, 0.2, 0.1], "xc_omega": [1.0] * 5}),
+    (6, "of", "robot", {"Ts": 0.002, "gamma": [20.0, 10.0, 5.0]}),
+    (7, "sf", "robot", {"tau_max": [80.0, 80.0, 60.0, 60.0, 30.0, 20.0, 10.0]}),
+]
+
+
+def _inputs(n: int, steps: int) -> np.ndarray:
+    """q (rad), dq (rad/s), tau_e (N m) of each step: (steps, 3n)."""
+    k = np.arange(steps)[:, None]
+    i = np.arange(n)[None, :]
+    q = 0.2 * np.sin(0.05 * k + i)
+    dq = 0.01 * np.cos(0.05 * k + i)
+    te = np.where(i == 0, 0.5 * np.sin(0.03 * k), 0.0)
+    return np.hstack([q, dq, te])
+
+
+def _c_controller(
+    examples: Path, n: int, case: str, scenario: str, params: dict[str, Any], x: np.ndarray
+) -> np.ndarray:
+    args = [
+        f"{k}={','.join(repr(float(v)) for v in np.atleast_1d(val))}" for k, val in params.items()
+    ]
+    proc = subprocess.run(
+        [str(examples / "same_controller"), str(n), case, scenario, *args],
+        input="\n".join(" ".join(repr(float(v)) for v in row) for row in x) + "\n",
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    return np.array([[float(v) for v in ln.split()] for ln in proc.stdout.splitlines()])
+
+
+def _python_controller(ctrl: adaptimp.Controller, n: int, x: np.ndarray) -> np.ndarray:
+    rows = []
+    for row in x:
+        tau_sat = ctrl.step(Measurement(row[:n], row[n : 2 * n], tau_e=row[2 * n :]))
+        rows.append(np.concatenate([tau_sat, ctrl.tau]))
+    return np.array(rows)
+
+
+@pytest.mark.parametrize(("n", "case", "scenario", "params"), SAME)
+def test_c_and_python_build_the_same_controller_from_the_same_parameters(
+    examples: Path, n: int, case: str, scenario: str, params: dict[str, Any]
+) -> None:
+    """The same parameters through the C ABI (ffi/tests/same_controller.c) and
+    through Python, the same inputs: the same sat(τ) and τ at every step, bit
+    for bit, for every n, law and preset (n > 3 without centres included: C
+    refused it, Python made the rule's basis; both now take the core's one
+    builder's)."""
+    x = _inputs(n, 40)
+    c = _c_controller(examples, n, case, scenario, params, x)
+    py = _python_controller(adaptimp.Controller(case, scenario=scenario, n=n, **params), n, x)
+    assert c.shape == (40, 2 * n)
+    np.testing.assert_array_equal(c, py)
+    assert np.abs(c[:, n:]).max() > 0.0
+
+
+def test_c_and_python_build_the_same_controller_on_user_centres(examples: Path) -> None:
+    """User centres and widths (L, 4n), (4n,) given to both fronts: the same
+    torques, bit for bit."""
+    n, nodes = 6, 30
+    rng = np.random.default_rng(7)
+    centers = rng.uniform(-0.5, 0.5, size=(nodes, 4 * n))
+    widths = np.linspace(0.5, 2.0, 4 * n)
+    x = _inputs(n, 30)
+    params = {"centers": centers.ravel(), "widths2": widths**2}
+    c = _c_controller(examples, n, "sf", "robot", params, x)
+    ctrl = adaptimp.Controller("sf", scenario="robot", n=n, centers=centers, widths=widths)
+    np.testing.assert_array_equal(c, _python_controller(ctrl, n, x))
 
 
 def test_the_c_paper_example_prints_the_rust_examples_metrics(examples: Path) -> None:
@@ -114,7 +195,7 @@ def test_the_c_examples_build_as_iso_c11_and_cxx17(examples: Path) -> None:
         )
 
 
-def valgrind(*args: str | Path) -> str:
+def valgrind(*args: str | Path, stdin: str | None = None) -> str:
     """Run under valgrind's memcheck: no error, no leak; its stderr."""
     proc = subprocess.run(
         [
@@ -124,6 +205,7 @@ def valgrind(*args: str | Path) -> str:
             "--error-exitcode=3",
             *[str(a) for a in args],
         ],
+        input=stdin,
         capture_output=True,
         text=True,
         timeout=900,
@@ -140,6 +222,18 @@ def test_valgrind_finds_no_error_and_no_leak_in_the_cartesian_example(examples: 
     valgrind(examples / "cartesian_pose")
     valgrind(examples / "cartesian_pose", "--abi-checks")
     valgrind(examples / "paper", "--abi-checks")
+
+
+def test_valgrind_finds_no_error_and_no_leak_building_seven_joints_without_centres(
+    examples: Path,
+) -> None:
+    """The one builder's default basis for n > 3 through the C ABI, and user
+    centres, under memcheck."""
+    assert shutil.which("valgrind"), "valgrind is needed (scripts/test.sh installs it)"
+    rows = "\n".join(" ".join(repr(float(v)) for v in row) for row in _inputs(7, 5)) + "\n"
+    valgrind(examples / "same_controller", "7", "of", "robot", stdin=rows)
+    centres = ",".join(["0.1"] * (2 * 4 * 7))
+    valgrind(examples / "same_controller", "7", "sf", "robot", f"centers={centres}", stdin=rows)
 
 
 def test_valgrind_finds_no_error_no_leak_and_allocations_do_not_grow(examples: Path) -> None:

@@ -421,9 +421,18 @@ static int abi_checks(void) {
     EXPECT(adaptimp_controller_new(&p, &ctrl), ADAPTIMP_STATUS_INVALID_CONFIG,
            "2·Kzeta − 1 − Kp²[1] = -1");
     p.kzeta[1] = 60.0;
-    p.n = 5; /* the grid exists for n <= 3 */
-    EXPECT(adaptimp_controller_new(&p, &ctrl), ADAPTIMP_STATUS_INVALID_CONFIG, "1 ≤ n ≤ 3");
+    p.n = 5; /* a 2-joint struct given n = 5: joints 3 … 5 have no gains */
+    EXPECT(adaptimp_controller_new(&p, &ctrl), ADAPTIMP_STATUS_INVALID_CONFIG, "K1[2] = 0");
     p.n = 2;
+    {
+        /* n > 3 without centres: the rule's centres along the trajectory (SPEC §18). */
+        AdaptimpParams p5;
+        AdaptimpController *five = NULL;
+        EXPECT(adaptimp_params_default(&p5, 5, ADAPTIMP_LAW_STATE_FEEDBACK, ADAPTIMP_PRESET_ROBOT),
+               ADAPTIMP_STATUS_OK, "");
+        EXPECT(adaptimp_controller_new(&p5, &five), ADAPTIMP_STATUS_OK, "");
+        adaptimp_controller_free(five);
+    }
     EXPECT(adaptimp_controller_new(&p, &ctrl), ADAPTIMP_STATUS_OK, "");
     EXPECT(adaptimp_state_new(ctrl, NULL), ADAPTIMP_STATUS_NULL_POINTER, "out is NULL");
     EXPECT(adaptimp_state_new(ctrl, &state), ADAPTIMP_STATUS_OK, "");

@@ -86,9 +86,9 @@ macro_rules! with_joints {
     };
 }
 
-/// `$m! { J1 => 1, J2 => 2, …, J7 => 7 }`: a front's macro that defines one
-/// enum variant per joint count (a C handle holds a `Controller<N>` by value
-/// of its size) gets the same sizes as [`with_joints!`](crate::with_joints).
+/// `$m! { J1 => 1, J2 => 2, …, J7 => 7 }`: a macro that defines one item
+/// per joint count (the run-time types' impls for each N) gets the same
+/// sizes as [`with_joints!`](crate::with_joints).
 #[macro_export]
 macro_rules! joint_counts {
     ($m:ident) => {

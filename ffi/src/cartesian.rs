@@ -4,6 +4,7 @@
 //! core's (`adaptimp::cartesian`); this converts and checks pointers, sizes
 //! and enum values.
 
+use crate::fields::{cartesian_fields, read_into, write_from};
 use crate::handles::{buffer_size, free, handle, handle_mut, publish, publish_in, Buf, Header};
 use crate::joint::{copy_sized, fault_of};
 use crate::params::controller_of;
@@ -13,10 +14,8 @@ use adaptimp::dynamic::{
     CartesianCommand, CartesianController, CartesianImpedance, CartesianMeasurement,
     CartesianState, Centres, Chain, Joints, Scenario, State,
 };
-use adaptimp::schema::{Preset, Value};
-use adaptimp::{
-    CartesianConfig, Formulation, Joint, JointKind, Law, PoseTarget, Transform, Vector,
-};
+use adaptimp::schema::Preset;
+use adaptimp::{CartesianConfig, Joint, JointKind, Law, PoseTarget, Transform, Vector};
 use core::ffi::c_void;
 use nalgebra::{Matrix3, UnitQuaternion};
 
@@ -71,7 +70,7 @@ pub struct AdaptimpTip {
 /// (SPEC §16), named as there, per axis of the world frame (x, y, z). Fill it
 /// with [`adaptimp_cartesian_params_default`], then change fields.
 #[repr(C)]
-#[derive(Copy, Clone, Debug, PartialEq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
 pub struct AdaptimpCartesianParams {
     /// Target inertia M_d of the translation (kg), > 0.
     pub md: [f64; 3],
@@ -528,98 +527,14 @@ pub unsafe extern "C" fn adaptimp_chain_tip(
 // Cartesian parameters.
 // ---------------------------------------------------------------------------
 
-/// The parameters as the core's configuration, each set by its schema name
-/// (the destructuring fails to compile if a field is added unmapped).
+/// The parameters as the core's configuration, each set from its field
+/// ([`cartesian_fields`]).
 fn cartesian_of(p: &AdaptimpCartesianParams) -> Result<CartesianConfig, AdaptimpStatus> {
-    let AdaptimpCartesianParams {
-        md,
-        bd,
-        bd_critical,
-        kd,
-        md_rot,
-        bd_rot,
-        bd_rot_critical,
-        kd_rot,
-        clik_kp,
-        clik_kd,
-        clik_lambda,
-        clik_lambda_rot,
-        null_k,
-        null_d,
-        pos_error_max,
-        rot_error_max,
-        target_filter,
-        force_filter,
-        force_feedforward,
-        formulation,
-        admittance_share,
-    } = p;
-    // INFINITY: no clipping (the schema's None).
-    let clipping = |v: f64| {
-        if v == f64::INFINITY {
-            Value::None
-        } else {
-            Value::Real(v)
-        }
-    };
-    /// The damping of the schema: None when critical, else the values.
-    fn derived<'a>(
-        critical: AdaptimpBoolRaw,
-        field: &str,
-        v: &'a [f64; 3],
-    ) -> Result<Value<'a>, AdaptimpStatus> {
-        Ok(if decode_bool(critical, field)? {
-            Value::None
-        } else {
-            Value::Vec(v)
-        })
-    }
-    let formulation = decode::<AdaptimpFormulation>(*formulation, "cart.formulation")?;
-    let values: [(&str, Value<'_>); 19] = [
-        ("Md", Value::Vec(md)),
-        ("Bd", derived(*bd_critical, "cart.bd_critical", bd)?),
-        ("Kd", Value::Vec(kd)),
-        ("Md_rot", Value::Vec(md_rot)),
-        (
-            "Bd_rot",
-            derived(*bd_rot_critical, "cart.bd_rot_critical", bd_rot)?,
-        ),
-        ("Kd_rot", Value::Vec(kd_rot)),
-        ("clik_kp", Value::Real(*clik_kp)),
-        ("clik_kd", Value::Real(*clik_kd)),
-        ("clik_lambda", Value::Real(*clik_lambda)),
-        ("clik_lambda_rot", Value::Real(*clik_lambda_rot)),
-        ("null_k", Value::Real(*null_k)),
-        ("null_d", Value::Real(*null_d)),
-        ("pos_error_max", clipping(*pos_error_max)),
-        ("rot_error_max", clipping(*rot_error_max)),
-        ("target_filter", Value::Real(*target_filter)),
-        ("force_filter", Value::Real(*force_filter)),
-        (
-            "force_feedforward",
-            Value::Bool(decode_bool(*force_feedforward, "cart.force_feedforward")?),
-        ),
-        (
-            "formulation",
-            Value::Str(Formulation::NAMES[formulation.index()]),
-        ),
-        ("admittance_share", Value::Real(*admittance_share)),
-    ];
-    debug_assert!(values.iter().map(|(n, _)| *n).eq(cartesian_names()));
-    let config = |e| core_error(e, Context::Config);
-    let mut s = Scenario::new(1, Preset::Robot, Law::Pd).map_err(config)?;
-    for (name, v) in values {
-        s.set(name, v).map_err(config)?;
-    }
+    let mut s =
+        Scenario::new(1, Preset::Robot, Law::Pd).map_err(|e| core_error(e, Context::Config))?;
+    let mut p = *p;
+    read_into(&mut s, 1, cartesian_fields(&mut p), "cart")?;
     Ok(s.cartesian())
-}
-
-/// The schema's Cartesian parameters, in its order.
-fn cartesian_names() -> impl Iterator<Item = &'static str> {
-    adaptimp::schema::PARAMS
-        .iter()
-        .filter(|p| p.group == adaptimp::schema::Group::Cartesian)
-        .map(|p| p.name)
 }
 
 /// Fill `out` with the schema's defaults of the group "cartesian" (SPEC
@@ -635,57 +550,11 @@ pub unsafe extern "C" fn adaptimp_cartesian_params_default(
     guard(|| {
         // SAFETY (in `out`): checked for NULL.
         let out = unsafe { crate::out(out, "out") }?;
-        let c = Scenario::new(1, Preset::Robot, Law::Pd)
-            .map_err(|e| core_error(e, Context::Config))?
-            .cartesian();
-        let CartesianConfig {
-            md,
-            bd,
-            kd,
-            md_rot,
-            bd_rot,
-            kd_rot,
-            clik_kp,
-            clik_kd,
-            clik_lambda,
-            clik_lambda_rot,
-            null_k,
-            null_d,
-            pos_error_max,
-            rot_error_max,
-            target_filter,
-            force_filter,
-            force_feedforward,
-            formulation,
-            admittance_share,
-        } = c;
-        *out = AdaptimpCartesianParams {
-            md: a3(&md),
-            bd: bd.as_ref().map_or([0.0; 3], a3),
-            bd_critical: bd.is_none().into(),
-            kd: a3(&kd),
-            md_rot: a3(&md_rot),
-            bd_rot: bd_rot.as_ref().map_or([0.0; 3], a3),
-            bd_rot_critical: bd_rot.is_none().into(),
-            kd_rot: a3(&kd_rot),
-            clik_kp,
-            clik_kd,
-            clik_lambda,
-            clik_lambda_rot,
-            null_k,
-            null_d,
-            pos_error_max: pos_error_max.unwrap_or(f64::INFINITY),
-            rot_error_max: rot_error_max.unwrap_or(f64::INFINITY),
-            target_filter,
-            force_filter,
-            force_feedforward: force_feedforward.into(),
-            formulation: AdaptimpFormulation::ALL[Formulation::ALL
-                .iter()
-                .position(|f| *f == formulation)
-                .unwrap_or(0)]
-            .raw(),
-            admittance_share,
-        };
+        let s =
+            Scenario::new(1, Preset::Robot, Law::Pd).map_err(|e| core_error(e, Context::Config))?;
+        let mut p = AdaptimpCartesianParams::default();
+        write_from(&s, &mut cartesian_fields(&mut p));
+        *out = p;
         Ok(())
     })
 }

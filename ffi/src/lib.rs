@@ -264,67 +264,67 @@ pub enum AdaptimpJointKind {
 
 /// An [`AdaptimpLaw`] as the caller passed it: an integer, checked when read.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpLawRaw(pub u32);
 /// An [`AdaptimpPreset`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpPresetRaw(pub u32);
 /// An [`AdaptimpAuxLaw`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpAuxLawRaw(pub u32);
 /// An [`AdaptimpConditions`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpConditionsRaw(pub u32);
 /// An [`AdaptimpFormulation`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpFormulationRaw(pub u32);
 /// An [`AdaptimpRobust`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpRobustRaw(pub u32);
 /// An [`AdaptimpLearningStep`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpLearningStepRaw(pub u32);
 /// An [`AdaptimpSaturationLearning`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpSaturationLearningRaw(pub u32);
 /// An [`AdaptimpWeightBound`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpWeightBoundRaw(pub u32);
 /// An [`AdaptimpObserverInit`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpObserverInitRaw(pub u32);
 /// An [`AdaptimpObserverHold`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpObserverHoldRaw(pub u32);
 /// An [`AdaptimpImpedance`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpImpedanceRaw(pub u32);
 /// An [`AdaptimpFallback`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpFallbackRaw(pub u32);
 /// An [`AdaptimpFaultPolicy`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpFaultPolicyRaw(pub u32);
 /// An [`AdaptimpJointKind`] as the caller passed it.
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpJointKindRaw(pub u32);
 /// A C `bool` as the caller passed it: a byte, 0 or 1 (anything else is refused).
 #[repr(transparent)]
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpBoolRaw(pub u8);
 
 /// An enum of the ABI and the integer that carries it.
@@ -337,6 +337,8 @@ pub trait CEnum: Copy + std::fmt::Debug + PartialEq + 'static {
     type Raw: Copy;
     /// The integer the caller passed.
     fn raw_value(raw: Self::Raw) -> u32;
+    /// The integer `v` as the caller passes it.
+    fn from_raw(v: u32) -> Self::Raw;
     /// This value as that integer.
     fn raw(self) -> Self::Raw;
     /// Its integer value.
@@ -356,6 +358,9 @@ macro_rules! c_enums {
                 type Raw = $raw;
                 fn raw_value(raw: $raw) -> u32 {
                     raw.0
+                }
+                fn from_raw(v: u32) -> $raw {
+                    $raw(v)
                 }
                 fn raw(self) -> $raw {
                     $raw(self as u32)
@@ -662,6 +667,7 @@ fn null(what: &str) -> AdaptimpStatus {
 mod handles;
 // In the header's order.
 mod cartesian;
+mod fields;
 mod joint;
 mod params;
 mod urdf;

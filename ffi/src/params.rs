@@ -1,13 +1,11 @@
 //! The joint controller's parameters as a C struct: every field of the
 //! schema's group "controller", converted by name to the core's scenario.
 
+use crate::fields::{controller_fields, read_into, write_from};
 use crate::*;
 use adaptimp::dynamic::{Basis, Centres, Controller, Inertia, Scenario, TaskPath, Tuning};
-use adaptimp::schema::{Preset, Value};
-use adaptimp::{
-    AuxLaw, Conditions, Fallback, FaultPolicy, Hold, ImpedanceMode, Law, LearningStep,
-    ObserverInit, RobustKind, SaturationLearning,
-};
+use adaptimp::schema::Preset;
+use adaptimp::Law;
 
 /// Every parameter of a controller for `n` joints (1…7): the fields of the
 /// parameter schema (`adaptimp::schema::PARAMS`, group "controller"), named as
@@ -132,17 +130,6 @@ pub struct AdaptimpParams {
     pub tau_rate_max: [f64; ADAPTIMP_MAX_JOINTS],
 }
 
-/// The name the schema gives to C choice `v` of enum `E`, by position.
-fn name_of<E: CEnum>(v: E, names: &[&'static str]) -> &'static str {
-    names[v.index()]
-}
-
-/// The C choice of schema name `name`, by position.
-fn from_name<E: CEnum>(names: &[&str], name: &str) -> E::Raw {
-    let i = names.iter().position(|n| *n == name).unwrap_or(0);
-    E::ALL[i].raw()
-}
-
 pub(crate) fn law_of(law: AdaptimpLaw) -> Law {
     match law {
         AdaptimpLaw::Pd => Law::Pd,
@@ -167,166 +154,19 @@ pub(crate) fn preset_of(p: AdaptimpPreset) -> Preset {
     }
 }
 
-/// The parameters as the core's scenario of n joints (every controller
-/// field set by its schema name: the destructuring fails to compile if a
-/// field is added without being mapped), its basis not yet given. Every
-/// error is a parameter's: InvalidConfig (BadSize for n).
+/// The parameters as the core's scenario of n joints (each controller
+/// parameter of the schema set from its field, [`controller_fields`]), its
+/// basis not yet given. Every error is a parameter's: INVALID_CONFIG
+/// (BAD_SIZE for n).
 pub(crate) fn scenario_of(p: &AdaptimpParams) -> Result<Scenario, AdaptimpStatus> {
-    let AdaptimpParams {
-        n,
-        law,
-        ts,
-        delay,
-        k1,
-        kp,
-        kzeta,
-        inertia,
-        rho,
-        conditions,
-        mu,
-        aux_law,
-        robust,
-        kr,
-        phi,
-        k_remark1,
-        learning_step,
-        kappa,
-        saturation_learning,
-        weight_bound_mode,
-        weight_bound,
-        gamma,
-        sigma,
-        eps,
-        lam1,
-        observer_init,
-        observer_hold,
-        observer_lead,
-        tau_max,
-        dd,
-        cd,
-        gd,
-        impedance,
-        eta2,
-        centers: _,
-        nodes: _,
-        widths2: _,
-        xc_offset,
-        xc_sin,
-        xc_cos,
-        xc_omega,
-        fallback,
-        fallback_damping,
-        fault_policy,
-        q_max,
-        dq_max,
-        tau_e_max,
-        q_jump_max,
-        tau_rate_max,
-    } = p;
-    let n = *n;
+    let n = p.n;
     if !(1..=ADAPTIMP_MAX_JOINTS).contains(&n) {
         return Err(bad_n(n));
     }
-    let law = decode::<AdaptimpLaw>(*law, "params.law")?;
-    let aux_law = decode::<AdaptimpAuxLaw>(*aux_law, "params.aux_law")?;
-    let conditions = decode::<AdaptimpConditions>(*conditions, "params.conditions")?;
-    let robust = decode::<AdaptimpRobust>(*robust, "params.robust")?;
-    let learning_step = decode::<AdaptimpLearningStep>(*learning_step, "params.learning_step")?;
-    let saturation_learning =
-        decode::<AdaptimpSaturationLearning>(*saturation_learning, "params.saturation_learning")?;
-    let weight_bound_mode =
-        decode::<AdaptimpWeightBound>(*weight_bound_mode, "params.weight_bound_mode")?;
-    let observer_init = decode::<AdaptimpObserverInit>(*observer_init, "params.observer_init")?;
-    let observer_hold = decode::<AdaptimpObserverHold>(*observer_hold, "params.observer_hold")?;
-    let observer_lead = decode_bool(*observer_lead, "params.observer_lead")?;
-    let impedance = decode::<AdaptimpImpedance>(*impedance, "params.impedance")?;
-    let fallback = decode::<AdaptimpFallback>(*fallback, "params.fallback")?;
-    let fault_policy = decode::<AdaptimpFaultPolicy>(*fault_policy, "params.fault_policy")?;
-    let config = |e| core_error(e, Context::Config);
-    let mut s = Scenario::new(n, Preset::Paper, law_of(law)).map_err(config)?;
-    // INFINITY in a limit is "none" (the core's, as Python's None).
-    fn joint(v: &[f64; ADAPTIMP_MAX_JOINTS], n: usize) -> Value<'_> {
-        Value::Vec(&v[..n])
-    }
-    let bound = match weight_bound_mode {
-        AdaptimpWeightBound::None => Value::None,
-        AdaptimpWeightBound::Fixed => Value::Vec(weight_bound),
-        AdaptimpWeightBound::Auto => Value::Str("auto"),
-    };
-    // usize → i64: a count beyond i64 is refused by the schema's check (≤ 64).
-    let delay = i64::try_from(*delay).unwrap_or(i64::MAX);
-    let values: [(&str, Value<'_>); 45] = [
-        ("Ts", Value::Real(*ts)),
-        ("delay", Value::Int(delay)),
-        ("K1", joint(k1, n)),
-        ("Kp", joint(kp, n)),
-        ("Kzeta", joint(kzeta, n)),
-        ("inertia", joint(inertia, n)),
-        ("rho", Value::Real(*rho)),
-        (
-            "conditions",
-            Value::Str(name_of(conditions, &Conditions::NAMES)),
-        ),
-        ("mu", Value::Real(*mu)),
-        ("aux_law", Value::Str(name_of(aux_law, &AuxLaw::NAMES))),
-        ("robust", Value::Str(name_of(robust, &RobustKind::NAMES))),
-        ("kr", joint(kr, n)),
-        ("phi", Value::Real(*phi)),
-        ("kD", Value::Real(k_remark1[0])),
-        ("kC", Value::Real(k_remark1[1])),
-        ("kG", Value::Real(k_remark1[2])),
-        ("gamma", Value::Vec(gamma)),
-        ("sigma", Value::Vec(sigma)),
-        ("eta2", Value::Real(*eta2)),
-        ("eps", Value::Real(*eps)),
-        ("lam1", joint(lam1, n)),
-        (
-            "observer_init",
-            Value::Str(name_of(observer_init, &ObserverInit::NAMES)),
-        ),
-        (
-            "observer_hold",
-            Value::Str(name_of(observer_hold, &Hold::NAMES)),
-        ),
-        ("observer_lead", Value::Bool(observer_lead)),
-        ("tau_max", joint(tau_max, n)),
-        ("Dd", joint(dd, n)),
-        ("Cd", joint(cd, n)),
-        ("Gd", joint(gd, n)),
-        (
-            "impedance",
-            Value::Str(name_of(impedance, &ImpedanceMode::NAMES)),
-        ),
-        ("xc_offset", joint(xc_offset, n)),
-        ("xc_sin", joint(xc_sin, n)),
-        ("xc_cos", joint(xc_cos, n)),
-        ("xc_omega", joint(xc_omega, n)),
-        (
-            "learning_step",
-            Value::Str(name_of(learning_step, &LearningStep::NAMES)),
-        ),
-        ("kappa", Value::Real(*kappa)),
-        (
-            "saturation_learning",
-            Value::Str(name_of(saturation_learning, &SaturationLearning::NAMES)),
-        ),
-        ("weight_bound", bound),
-        ("fallback", Value::Str(name_of(fallback, &Fallback::NAMES))),
-        ("fallback_damping", joint(fallback_damping, n)),
-        (
-            "fault_policy",
-            Value::Str(name_of(fault_policy, &FaultPolicy::NAMES)),
-        ),
-        ("q_max", joint(q_max, n)),
-        ("dq_max", joint(dq_max, n)),
-        ("tau_e_max", joint(tau_e_max, n)),
-        ("q_jump_max", joint(q_jump_max, n)),
-        ("tau_rate_max", joint(tau_rate_max, n)),
-    ];
-    debug_assert!(values.iter().map(|(n, _)| *n).eq(controller_names()));
-    for (name, v) in values {
-        s.set(name, v).map_err(config)?;
-    }
+    let law = law_of(decode::<AdaptimpLaw>(p.law, "params.law")?);
+    let mut s = Scenario::new(n, Preset::Paper, law).map_err(|e| core_error(e, Context::Config))?;
+    let mut p = *p;
+    read_into(&mut s, n, controller_fields(&mut p), "params")?;
     Ok(s)
 }
 
@@ -354,166 +194,68 @@ pub(crate) unsafe fn controller_of(p: &AdaptimpParams) -> Result<Controller, Ada
     s.controller().map_err(|e| core_error(e, Context::Config))
 }
 
-/// The schema's controller parameters, in its order.
-pub(crate) fn controller_names() -> impl Iterator<Item = &'static str> {
-    adaptimp::schema::PARAMS
-        .iter()
-        .filter(|p| p.group == adaptimp::schema::Group::Controller)
-        .map(|p| p.name)
-}
+/// Every field zero but the limits (INFINITY: none), no centres: what
+/// [`params_of`] fills in.
+pub(crate) const BLANK: AdaptimpParams = AdaptimpParams {
+    n: 0,
+    law: AdaptimpLawRaw(0),
+    ts: 0.0,
+    delay: 0,
+    k1: [0.0; ADAPTIMP_MAX_JOINTS],
+    kp: [0.0; ADAPTIMP_MAX_JOINTS],
+    kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
+    inertia: [0.0; ADAPTIMP_MAX_JOINTS],
+    rho: 0.0,
+    conditions: AdaptimpConditionsRaw(0),
+    mu: 0.0,
+    aux_law: AdaptimpAuxLawRaw(0),
+    robust: AdaptimpRobustRaw(0),
+    kr: [0.0; ADAPTIMP_MAX_JOINTS],
+    phi: 0.0,
+    k_remark1: [0.0; 3],
+    learning_step: AdaptimpLearningStepRaw(0),
+    kappa: 0.0,
+    saturation_learning: AdaptimpSaturationLearningRaw(0),
+    weight_bound_mode: AdaptimpWeightBoundRaw(0),
+    weight_bound: [0.0; 3],
+    gamma: [0.0; 3],
+    sigma: [0.0; 3],
+    eps: 0.0,
+    lam1: [0.0; ADAPTIMP_MAX_JOINTS],
+    observer_init: AdaptimpObserverInitRaw(0),
+    observer_hold: AdaptimpObserverHoldRaw(0),
+    observer_lead: AdaptimpBoolRaw(0),
+    tau_max: [0.0; ADAPTIMP_MAX_JOINTS],
+    dd: [0.0; ADAPTIMP_MAX_JOINTS],
+    cd: [0.0; ADAPTIMP_MAX_JOINTS],
+    gd: [0.0; ADAPTIMP_MAX_JOINTS],
+    impedance: AdaptimpImpedanceRaw(0),
+    eta2: 0.0,
+    centers: std::ptr::null(),
+    nodes: 0,
+    widths2: std::ptr::null(),
+    xc_offset: [0.0; ADAPTIMP_MAX_JOINTS],
+    xc_sin: [0.0; ADAPTIMP_MAX_JOINTS],
+    xc_cos: [0.0; ADAPTIMP_MAX_JOINTS],
+    xc_omega: [0.0; ADAPTIMP_MAX_JOINTS],
+    fallback: AdaptimpFallbackRaw(0),
+    fallback_damping: [0.0; ADAPTIMP_MAX_JOINTS],
+    fault_policy: AdaptimpFaultPolicyRaw(0),
+    q_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+    dq_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+    tau_e_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+    q_jump_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+    tau_rate_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+};
 
 /// The controller parameters of scenario `s` (centres: none).
 pub(crate) fn params_of(s: &Scenario) -> AdaptimpParams {
     let mut p = AdaptimpParams {
         n: s.n(),
         law: law_raw(s.law()),
-        ts: 0.0,
-        delay: 0,
-        k1: [0.0; ADAPTIMP_MAX_JOINTS],
-        kp: [0.0; ADAPTIMP_MAX_JOINTS],
-        kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
-        inertia: [0.0; ADAPTIMP_MAX_JOINTS],
-        rho: 0.0,
-        conditions: AdaptimpConditions::Paper.raw(),
-        mu: 0.0,
-        aux_law: AdaptimpAuxLaw::Default.raw(),
-        robust: AdaptimpRobust::Sign.raw(),
-        kr: [0.0; ADAPTIMP_MAX_JOINTS],
-        phi: 0.0,
-        k_remark1: [0.0; 3],
-        learning_step: AdaptimpLearningStep::Euler.raw(),
-        kappa: 0.0,
-        saturation_learning: AdaptimpSaturationLearning::Ignore.raw(),
-        weight_bound_mode: AdaptimpWeightBound::None.raw(),
-        weight_bound: [0.0; 3],
-        gamma: [0.0; 3],
-        sigma: [0.0; 3],
-        eps: 0.0,
-        lam1: [0.0; ADAPTIMP_MAX_JOINTS],
-        observer_init: AdaptimpObserverInit::Zero.raw(),
-        observer_hold: AdaptimpObserverHold::Zoh.raw(),
-        observer_lead: false.into(),
-        tau_max: [0.0; ADAPTIMP_MAX_JOINTS],
-        dd: [0.0; ADAPTIMP_MAX_JOINTS],
-        cd: [0.0; ADAPTIMP_MAX_JOINTS],
-        gd: [0.0; ADAPTIMP_MAX_JOINTS],
-        impedance: AdaptimpImpedance::Joint.raw(),
-        eta2: 0.0,
-        centers: std::ptr::null(),
-        nodes: 0,
-        widths2: std::ptr::null(),
-        xc_offset: [0.0; ADAPTIMP_MAX_JOINTS],
-        xc_sin: [0.0; ADAPTIMP_MAX_JOINTS],
-        xc_cos: [0.0; ADAPTIMP_MAX_JOINTS],
-        xc_omega: [0.0; ADAPTIMP_MAX_JOINTS],
-        fallback: AdaptimpFallback::Hold.raw(),
-        fallback_damping: [0.0; ADAPTIMP_MAX_JOINTS],
-        fault_policy: AdaptimpFaultPolicy::Report.raw(),
-        q_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-        dq_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-        tau_e_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-        q_jump_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-        tau_rate_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
+        ..BLANK
     };
-    s.visit(|name, v| {
-        let joint = |dst: &mut [f64; ADAPTIMP_MAX_JOINTS]| {
-            if let Value::Vec(v) = v {
-                dst[..v.len()].copy_from_slice(v);
-            }
-        };
-        let real = |dst: &mut f64| {
-            if let Value::Real(x) = v {
-                *dst = x;
-            }
-        };
-        let three = |dst: &mut [f64; 3]| {
-            if let Value::Vec(v) = v {
-                dst.copy_from_slice(v);
-            }
-        };
-        let choice = match v {
-            Value::Str(s) => s,
-            _ => "",
-        };
-        match name {
-            "Ts" => real(&mut p.ts),
-            "delay" => {
-                if let Value::Int(d) = v {
-                    p.delay = usize::try_from(d).unwrap_or(0);
-                }
-            }
-            "K1" => joint(&mut p.k1),
-            "Kp" => joint(&mut p.kp),
-            "Kzeta" => joint(&mut p.kzeta),
-            "inertia" => joint(&mut p.inertia),
-            "rho" => real(&mut p.rho),
-            "conditions" => {
-                p.conditions = from_name::<AdaptimpConditions>(&Conditions::NAMES, choice)
-            }
-            "mu" => real(&mut p.mu),
-            "aux_law" => p.aux_law = from_name::<AdaptimpAuxLaw>(&AuxLaw::NAMES, choice),
-            "robust" => p.robust = from_name::<AdaptimpRobust>(&RobustKind::NAMES, choice),
-            "kr" => joint(&mut p.kr),
-            "phi" => real(&mut p.phi),
-            "kD" => real(&mut p.k_remark1[0]),
-            "kC" => real(&mut p.k_remark1[1]),
-            "kG" => real(&mut p.k_remark1[2]),
-            "gamma" => three(&mut p.gamma),
-            "sigma" => three(&mut p.sigma),
-            "eta2" => real(&mut p.eta2),
-            "eps" => real(&mut p.eps),
-            "lam1" => joint(&mut p.lam1),
-            "observer_init" => {
-                p.observer_init = from_name::<AdaptimpObserverInit>(&ObserverInit::NAMES, choice)
-            }
-            "observer_hold" => {
-                p.observer_hold = from_name::<AdaptimpObserverHold>(&Hold::NAMES, choice)
-            }
-            "observer_lead" => {
-                if let Value::Bool(b) = v {
-                    p.observer_lead = b.into();
-                }
-            }
-            "tau_max" => joint(&mut p.tau_max),
-            "Dd" => joint(&mut p.dd),
-            "Cd" => joint(&mut p.cd),
-            "Gd" => joint(&mut p.gd),
-            "impedance" => {
-                p.impedance = from_name::<AdaptimpImpedance>(&ImpedanceMode::NAMES, choice)
-            }
-            "xc_offset" => joint(&mut p.xc_offset),
-            "xc_sin" => joint(&mut p.xc_sin),
-            "xc_cos" => joint(&mut p.xc_cos),
-            "xc_omega" => joint(&mut p.xc_omega),
-            "learning_step" => {
-                p.learning_step = from_name::<AdaptimpLearningStep>(&LearningStep::NAMES, choice)
-            }
-            "kappa" => real(&mut p.kappa),
-            "saturation_learning" => {
-                p.saturation_learning =
-                    from_name::<AdaptimpSaturationLearning>(&SaturationLearning::NAMES, choice)
-            }
-            "weight_bound" => match v {
-                Value::None => p.weight_bound_mode = AdaptimpWeightBound::None.raw(),
-                Value::Str(_) => p.weight_bound_mode = AdaptimpWeightBound::Auto.raw(),
-                _ => {
-                    p.weight_bound_mode = AdaptimpWeightBound::Fixed.raw();
-                    three(&mut p.weight_bound);
-                }
-            },
-            "fallback" => p.fallback = from_name::<AdaptimpFallback>(&Fallback::NAMES, choice),
-            "fallback_damping" => joint(&mut p.fallback_damping),
-            "fault_policy" => {
-                p.fault_policy = from_name::<AdaptimpFaultPolicy>(&FaultPolicy::NAMES, choice)
-            }
-            "q_max" => joint(&mut p.q_max),
-            "dq_max" => joint(&mut p.dq_max),
-            "tau_e_max" => joint(&mut p.tau_e_max),
-            "q_jump_max" => joint(&mut p.q_jump_max),
-            "tau_rate_max" => joint(&mut p.tau_rate_max),
-            _ => {} // the run, the environment, the arm and the Cartesian group are not the controller's
-        }
-    });
+    write_from(s, &mut controller_fields(&mut p));
     p
 }
 
@@ -635,27 +377,7 @@ pub(crate) fn bad_n(n: usize) -> AdaptimpStatus {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_c_enums_follow_the_schemas_choice_order() {
-        fn check<E: CEnum>(names: &[&str]) {
-            assert_eq!(E::ALL.len(), names.len(), "{}", E::NAME);
-            for (c, name) in E::ALL.iter().zip(names) {
-                assert_eq!(format!("{c:?}").to_lowercase(), *name, "{}", E::NAME);
-            }
-        }
-        check::<AdaptimpAuxLaw>(&AuxLaw::NAMES);
-        check::<AdaptimpConditions>(&Conditions::NAMES);
-        check::<AdaptimpFormulation>(&adaptimp::Formulation::NAMES);
-        check::<AdaptimpRobust>(&RobustKind::NAMES);
-        check::<AdaptimpLearningStep>(&LearningStep::NAMES);
-        check::<AdaptimpSaturationLearning>(&SaturationLearning::NAMES);
-        check::<AdaptimpObserverInit>(&ObserverInit::NAMES);
-        check::<AdaptimpObserverHold>(&Hold::NAMES);
-        check::<AdaptimpImpedance>(&ImpedanceMode::NAMES);
-        check::<AdaptimpFallback>(&Fallback::NAMES);
-        check::<AdaptimpFaultPolicy>(&FaultPolicy::NAMES);
-    }
+    use adaptimp::schema::{Group, PARAMS};
 
     #[test]
     fn every_controller_parameter_of_the_schema_is_a_field() {
@@ -669,7 +391,10 @@ mod tests {
                     let controller = |s: &Scenario| {
                         let mut out = Vec::new();
                         s.visit(|name, v| {
-                            if controller_names().any(|c| c == name) {
+                            if PARAMS
+                                .iter()
+                                .any(|p| p.name == name && p.group == Group::Controller)
+                            {
                                 out.push(format!("{name} {v:?}"));
                             }
                         });
@@ -684,8 +409,5 @@ mod tests {
                 }
             }
         }
-        // scenario_of sets exactly the controller group's names, in order (its
-        // debug assertion); the array's length is the group's size.
-        assert_eq!(controller_names().count(), 45);
     }
 }

@@ -3,7 +3,8 @@
 //! [`Scenario`] of the robot preset with the rule's gains (and its centres
 //! along the path) out, the one builder of both fronts then making the
 //! controller. Each step is the const-generic [`Rule`]'s, in the order the
-//! fronts took them: [`Rule::with_delay`], [`Rule::critical`], the inertia
+//! fronts took them: [`Rule::with_delay`], [`Rule::weightless`],
+//! [`Rule::critical`], the inertia
 //! scales, [`Rule::bounded`] by [`loop_bound`] (SPEC (18.11)),
 //! [`damped_scales`], [`resolving`], [`Rule::spanning`], then
 //! [`Rule::gains_scaled`] or [`Rule::suggest_scaled`].
@@ -76,6 +77,9 @@ pub struct Tuning<'a> {
     pub resolve: bool,
     /// Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6).
     pub critical: bool,
+    /// The arm bears no gravity the controller must hold (a robot that
+    /// compensates it itself): D̂ and Ĉ learn at Ĝ's bandwidth, SPEC (22.2).
+    pub weightless: bool,
 }
 
 impl<'a> Tuning<'a> {
@@ -94,6 +98,7 @@ impl<'a> Tuning<'a> {
             orbit: None,
             resolve: false,
             critical: false,
+            weightless: false,
         }
     }
 
@@ -129,6 +134,9 @@ fn typed<const N: usize>(
         return Err(INERTIA_SHAPE);
     }
     let mut rule = Rule::default().with_delay(t.delay)?;
+    if t.weightless {
+        rule = rule.weightless();
+    }
     if t.critical {
         check::positive("Ts > 0", "Ts", t.ts)?;
         rule = rule.critical(t.ts);
@@ -168,7 +176,12 @@ fn typed<const N: usize>(
                 })
                 .collect();
             if t.resolve && !samples.is_empty() {
+                let learn_dc = rule.learn_dc;
                 rule = resolving(&rule, &samples);
+                if t.weightless {
+                    // (22.2): D̂ and Ĉ at Ĝ's bandwidth, whatever the orbit.
+                    rule.learn_dc = learn_dc;
+                }
             }
             if let Some(o) = t.orbit {
                 if !o.len().is_multiple_of(N) {

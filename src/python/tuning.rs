@@ -4,13 +4,11 @@
 use super::cartesian::{PyChain, TypedChain};
 use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
-use crate::cartesian::rule::{resolving, PoseCircle, PostureRule, TaskRows};
-use crate::control::tuning::{
-    damped_scales, default_task as core_default_task, inertia_scales_along, loop_bound, Rule,
-};
+use crate::cartesian::rule::{PoseCircle, PostureRule, TaskRows};
+use crate::control::tuning::{default_task as core_default_task, Rule};
+use crate::dynamic::{Inertia, TaskPath, Tuning};
 use crate::error::Error;
-use crate::schema::{Group, Preset, Scenario, PARAMS};
-use crate::trajectory::Setpoint;
+use crate::schema::{Group, PARAMS};
 use crate::types::{Matrix, Vector};
 use numpy::{
     PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn,
@@ -61,10 +59,10 @@ pub fn suggest<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
-    let (k, n) = match shape {
-        [a, b] if a == b => (1, *a),
-        [k, a, b] if a == b && *k > 0 => (*k, *a),
-        _ => (0, 0),
+    let n = match shape {
+        [a, b] if a == b => *a,
+        [k, a, b] if a == b && *k > 0 => *a,
+        _ => 0,
     };
     if !(1..=super::MAX_JOINTS).contains(&n) {
         return Err(shape_error(
@@ -117,103 +115,27 @@ pub fn suggest<'py>(
             return Err(ConfigError::new_err("a path needs its period (s)"));
         }
     };
+    let mut rule = Tuning::new(
+        law,
+        if along {
+            Inertia::Along(&d)
+        } else {
+            Inertia::At(&d)
+        },
+        &tau,
+        ts,
+    );
+    rule.delay = delay;
+    rule.path = path.as_ref().map(|(rows, period)| TaskPath {
+        rows,
+        period: *period,
+    });
+    rule.gravity = gravity.as_deref();
+    rule.damping = damping.as_deref();
+    rule.orbit = orbit.as_deref();
+    (rule.resolve, rule.critical, rule.weightless) = (resolve, critical, weightless);
+    let s = rule.suggest().map_err(|e| config_error(e.into()))?;
     let out = PyDict::new(py);
-    crate::with_joints!(
-        n,
-        K => fill::<K>(
-            py,
-            &out,
-            law,
-            (&d, k, along),
-            &tau,
-            ts,
-            path.as_ref(),
-            gravity.as_deref(),
-            damping.as_deref(),
-            orbit.as_deref(),
-            (resolve, critical, delay, weightless),
-        ),
-        _ => unreachable!("n checked above"),
-    )?;
-    Ok(out)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn fill<'py, const N: usize>(
-    py: Python<'py>,
-    out: &Bound<'py, PyDict>,
-    law: crate::control::config::Law,
-    (d, k, along): (&[f64], usize, bool),
-    tau: &[f64],
-    ts: f64,
-    path: Option<&(Vec<f64>, f64)>,
-    gravity: Option<&[f64]>,
-    damping: Option<&[f64]>,
-    orbit: Option<&[f64]>,
-    (resolve, critical, delay, weightless): (bool, bool, usize, bool),
-) -> PyResult<()> {
-    let err = |e: Error| config_error(e.into());
-    let mut rule = Rule::default().with_delay(delay).map_err(err)?;
-    if weightless {
-        rule = rule.weightless();
-    }
-    if critical {
-        crate::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
-        rule = rule.critical(ts);
-    }
-    // Row-major (n, n) into nalgebra's column-major: D is symmetric, but a
-    // non-symmetric input must be reported, not transposed silently.
-    let ds: Vec<Matrix<N>> = (0..k)
-        .map(|i| Matrix::<N>::from_row_slice(&d[i * N * N..(i + 1) * N * N]))
-        .collect();
-    let scales = if along {
-        inertia_scales_along(&ds)
-    } else {
-        crate::control::tuning::inertia_scales(&ds[0])
-    }
-    .map_err(err)?;
-    // SPEC (18.11): the margin at the largest mode of the undamped scales.
-    rule = rule.bounded(loop_bound(&ds, &scales).map_err(err)?);
-    let scales = match damping {
-        None => scales,
-        Some(b) => damped_scales(&scales, &Vector::<N>::from_column_slice(b), ts).map_err(err)?,
-    };
-    let tau = Vector::<N>::from_column_slice(tau);
-    let mut s = Scenario::<N>::preset(Preset::Robot, law);
-    let centers = match path {
-        None => {
-            s.config = rule.gains_scaled(law, &scales, &tau, ts).map_err(err)?;
-            None
-        }
-        Some((rows, period)) => {
-            let samples: Vec<Setpoint<N>> = rows
-                .chunks_exact(3 * N)
-                .map(|r| Setpoint {
-                    x: Vector::from_column_slice(&r[..N]),
-                    dx: Vector::from_column_slice(&r[N..2 * N]),
-                    ddx: Vector::from_column_slice(&r[2 * N..]),
-                })
-                .collect();
-            if resolve && !samples.is_empty() {
-                let learn_dc = rule.learn_dc;
-                rule = resolving(&rule, &samples);
-                if weightless {
-                    // (22.2): D̂ and Ĉ at Ĝ's bandwidth, whatever the orbit.
-                    rule.learn_dc = learn_dc;
-                }
-            }
-            if let Some(o) = orbit {
-                let qs: Vec<Vector<N>> = o.chunks_exact(N).map(Vector::from_column_slice).collect();
-                rule = rule.spanning(&qs);
-            }
-            let g = gravity.map(Vector::<N>::from_column_slice);
-            let sug = rule
-                .suggest_scaled(law, &scales, &tau, ts, &samples, *period, g.as_ref())
-                .map_err(err)?;
-            s.config = sug.config;
-            Some(sug.centers)
-        }
-    };
     let params = PyDict::new(py);
     let mut res = Ok(());
     s.visit(|name, v| {
@@ -226,18 +148,13 @@ fn fill<'py, const N: usize>(
     });
     res?;
     out.set_item("params", params)?;
-    if let Some(c) = centers {
-        let l = c.centers().len() / (4 * N);
-        let rows = PyArray1::from_slice(py, c.centers()).reshape([l, 4 * N])?;
-        let widths: Vec<f64> = c
-            .widths2()
-            .iter()
-            .flat_map(|b| b.iter().map(|w| w.sqrt()).collect::<Vec<_>>())
-            .collect();
+    if let Some(c) = s.centres() {
+        let rows = PyArray1::from_slice(py, &c.rows).reshape([c.rows.len() / (4 * n), 4 * n])?;
+        let widths: Vec<f64> = c.widths2.iter().flatten().map(|w| w.sqrt()).collect();
         out.set_item("centers", rows)?;
         out.set_item("widths", PyArray1::from_vec(py, widths))?;
     }
-    Ok(())
+    Ok(out)
 }
 
 /// The default task of SPEC §18 about `home` within [`lo`, `hi`] (rad, (n,)

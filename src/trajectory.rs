@@ -3,6 +3,7 @@
 use crate::error::{check, Error};
 use crate::math::{cos, sin, sqrt};
 use crate::types::Vector;
+use core::cell::Cell;
 
 /// Position, velocity and acceleration of a trajectory at one instant
 /// (rad, rad/s, rad/s²).
@@ -34,6 +35,25 @@ pub trait Trajectory<const N: usize> {
 impl<const N: usize, F: Fn(f64) -> Setpoint<N>> Trajectory<N> for F {
     fn sample(&self, t: f64) -> Setpoint<N> {
         self(t)
+    }
+}
+
+/// The clock of a loop that has no joint-space reference (a Cartesian run,
+/// a controller of the caller's): the trajectory the loop samples at every
+/// row, t_k written to the cell, NaN out. What the row commands is read
+/// elsewhere at the row of t_k.
+#[derive(Copy, Clone, Debug)]
+pub struct Clock<'a>(pub &'a Cell<f64>);
+
+impl<const N: usize> Trajectory<N> for Clock<'_> {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        self.0.set(t);
+        let nan = Vector::from_element(f64::NAN);
+        Setpoint {
+            x: nan,
+            dx: nan,
+            ddx: nan,
+        }
     }
 }
 

@@ -39,7 +39,7 @@ use crate::control::impedance::TargetImpedance;
 use crate::control::io::{Command, Measurement, WrenchControl};
 use crate::error::Error;
 use crate::sim::record::{Recorder, Row};
-use crate::trajectory::{Setpoint, Trajectory};
+use crate::trajectory::{Clock, Setpoint};
 use crate::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::cell::Cell;
@@ -321,22 +321,6 @@ fn torque(py: Python<'_>, obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Result<B
 /// The row of a table for t_k = k·Ts.
 fn row_of(t: f64, ts: f64) -> usize {
     libm::round(t / ts) as usize
-}
-
-/// The loop's clock: the trajectory the loop samples at every row, t_k in,
-/// nothing out (the controller's setpoint is the table's row of t_k).
-struct Clock<'a>(&'a Cell<f64>);
-
-impl<const N: usize> Trajectory<N> for Clock<'_> {
-    fn sample(&self, t: f64) -> Setpoint<N> {
-        self.0.set(t);
-        let nan = Vector::from_element(f64::NAN);
-        Setpoint {
-            x: nan,
-            dx: nan,
-            ddx: nan,
-        }
-    }
 }
 
 /// The Python controller as the loop's [`Control`].

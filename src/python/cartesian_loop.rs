@@ -35,7 +35,7 @@ use crate::control::io::TaskTorque;
 use crate::control::io::{Command, Measurement, WrenchControl};
 use crate::error::Error;
 use crate::sim::record::{Recorder, Row};
-use crate::trajectory::{Setpoint, Trajectory};
+use crate::trajectory::{Clock, Setpoint};
 use crate::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::any::{Any, TypeId};
@@ -214,24 +214,6 @@ impl TaskRecords {
         self.error.extend_from_slice(cmd.error.as_slice());
         self.wrench.extend_from_slice(&last.wrench);
         self.z1.extend_from_slice(z1.as_slice());
-    }
-}
-
-/// The loop's clock: the trajectory the loop samples at every row, t_k in,
-/// nothing out (the Cartesian controller's commanded pose is its own table,
-/// read at the row of t_k). Its joint setpoint is NaN: a Cartesian run has
-/// no joint-space reference.
-struct Clock<'a>(&'a Cell<f64>);
-
-impl<const N: usize> Trajectory<N> for Clock<'_> {
-    fn sample(&self, t: f64) -> Setpoint<N> {
-        self.0.set(t);
-        let nan = Vector::from_element(f64::NAN);
-        Setpoint {
-            x: nan,
-            dx: nan,
-            ddx: nan,
-        }
     }
 }
 

@@ -17,26 +17,9 @@ use crate::control::io::{self, WrenchControl};
 use crate::error::Error;
 use crate::sim::record::{Recorder, Row};
 use crate::sim::simulator;
-use crate::trajectory::{self, Trajectory};
+use crate::trajectory::{self, Clock};
 use crate::types::Vector;
 use core::cell::{Cell, RefCell};
-
-/// The loop's clock: the trajectory the loop samples at every row, t_k in,
-/// NaN out (a Cartesian run has no joint-space reference; its commanded
-/// pose is its own table, read at the row of t_k).
-struct Clock<'a>(&'a Cell<f64>);
-
-impl<const N: usize> Trajectory<N> for Clock<'_> {
-    fn sample(&self, t: f64) -> trajectory::Setpoint<N> {
-        self.0.set(t);
-        let nan = Vector::from_element(f64::NAN);
-        trajectory::Setpoint {
-            x: nan,
-            dx: nan,
-            ddx: nan,
-        }
-    }
-}
 
 /// The joint controller behind the outer loop, typed: the paper's laws or
 /// computed torque.

@@ -669,6 +669,67 @@ fn the_closed_loop_is_the_const_generic_one_bit_for_bit() {
         metrics.peak_abs_tau.as_slice(),
     );
     assert_eq!(ds.steps(), state.steps());
+    // The typed run: the same rows and metrics, its rows sized by itself.
+    let mut ds2 = dc.new_state();
+    let mut plant2 = dy::RigidBody::new(&dy::ModelArm::Paper(arm), &d, &ddist).expect("plant");
+    let out = dy::run(dy::Spec {
+        plant: &mut plant2,
+        looped: dy::Loop::Joint {
+            ctrl: dy::Controlled::Joint(dy::Joint::Adaptive(&dc, &mut ds2)),
+            reference: dy::Reference::Trajectory,
+        },
+        run,
+        hooks: None,
+    });
+    same_rows(&out.rows, &drows);
+    assert!(out.task.is_none());
+    same_metrics(&out.ended.expect("typed run"), &dmetrics);
+}
+
+/// Every metric of two runs, bit for bit (NaN included).
+fn same_metrics(a: &dy::Metrics, b: &dy::Metrics) {
+    assert_eq!((a.rows, a.steps_in_contact), (b.rows, b.steps_in_contact));
+    let scalars = |m: &dy::Metrics| {
+        [
+            m.rms_z1,
+            m.rms_z1_after2,
+            m.sat_duty,
+            m.peak_contact_after2,
+            m.mean_contact,
+            m.imp_err_rms_after2,
+        ]
+    };
+    same("metrics", &scalars(a), &scalars(b));
+    same(
+        "rms z1 per joint",
+        &a.rms_z1_joint_after2,
+        &b.rms_z1_joint_after2,
+    );
+    same(
+        "max z1 per joint",
+        &a.max_abs_z1_joint_after2,
+        &b.max_abs_z1_joint_after2,
+    );
+    same("peak τ", &a.peak_abs_tau, &b.peak_abs_tau);
+}
+
+/// Every table of two runs' rows, bit for bit (NaN included).
+fn same_rows(a: &dy::Rows, b: &dy::Rows) {
+    assert_eq!(a.len(), b.len());
+    for (what, x, y) in [
+        ("t", &a.t, &b.t),
+        ("x", &a.x, &b.x),
+        ("dx", &a.dx, &b.dx),
+        ("ddx", &a.ddx, &b.ddx),
+        ("xc", &a.xc, &b.xc),
+        ("tau_sat", &a.tau_sat, &b.tau_sat),
+        ("tau_e", &a.tau_e, &b.tau_e),
+        ("z1", &a.z1, &b.z1),
+        ("w_norms", &a.w_norms, &b.w_norms),
+    ] {
+        same(what, x, y);
+    }
+    assert_eq!(a.refused, b.refused);
 }
 
 /// The Cartesian loop on a planar arm of three links: its joint rows are
@@ -840,6 +901,34 @@ fn the_cartesian_loop_steps_the_pair_as_the_core_loop_does() {
         "{} {rms}",
         metrics.rms_z1
     );
+    // The typed run: the same joint and task rows, the same metrics.
+    let mut dstate2 = outer.start(&q0).expect("start");
+    let mut jstate2 = joint.new_state();
+    let mut dplant2 = dy::RigidBody::new(
+        &dy::ModelArm::Planar {
+            links: links.to_vec(),
+            g: 9.81,
+        },
+        &d,
+        &none,
+    )
+    .expect("plant");
+    let out = dy::run(dy::Spec {
+        plant: &mut dplant2,
+        looped: dy::Loop::Cartesian {
+            outer: &outer,
+            state: &mut dstate2,
+            joint: dy::Joint::Adaptive(&joint, &mut jstate2),
+            targets: None,
+        },
+        run,
+        hooks: None,
+    });
+    same_rows(&out.rows, &drows);
+    let out_task = out.task.expect("task rows");
+    same("task z1", &out_task.z1, &task.z1);
+    assert_eq!(out_task.last, task.last);
+    same_metrics(&out.ended.expect("typed run"), &metrics);
 }
 
 /// An arm read from a URDF at run time (one this crate did not write the

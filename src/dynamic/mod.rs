@@ -406,9 +406,9 @@ pub use model::{
 };
 #[cfg(all(feature = "alloc", feature = "sim"))]
 pub use run::{
-    metrics_of, simulate, simulate_cartesian, Arm as ModelArm, Control, Controlled, Disturbances,
-    Hooks, Injected, Injection, Jacobian3, Metrics, Plant, Recorded, Reference, RigidBody, Rows,
-    Run, RunError, Table, TaskRows, TaskStep,
+    metrics_of, run, simulate, simulate_cartesian, Arm as ModelArm, Control, Controlled,
+    Disturbances, Hooks, Injected, Injection, Jacobian3, Loop, Metrics, Output, Plant, Recorded,
+    Reference, RigidBody, Rows, Run, RunError, Spec, Table, TaskRows, TaskStep,
 };
 #[cfg(feature = "alloc")]
 pub use tuning::{Inertia, TaskPath, Tuning};

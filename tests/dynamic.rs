@@ -1295,3 +1295,41 @@ fn a_restarted_cartesian_state_is_a_fresh_start_that_keeps_its_posture() {
         "state: was made for another number of joints"
     );
 }
+
+/// The effort estimate of SPEC §18's plant preparation: 2 (max |G_i| + 10 ·
+/// max Σ_j |D_ij| + b_i · 1 + F_i), each maximum over the postures on its
+/// own; inputs of another length named.
+#[test]
+fn the_effort_estimate_takes_each_maximum_over_the_postures() {
+    // Two postures of a 2-joint arm.
+    let gravity = [3.0, -1.0, -4.0, 0.5];
+    let inertia = [2.0, -0.5, -0.5, 1.0, 1.0, 0.25, 0.25, 1.5];
+    let s = dy::Sampled {
+        n: 2,
+        gravity: &gravity,
+        inertia: &inertia,
+    };
+    let tau = dy::estimate_effort(&s, None).expect("estimate");
+    assert_eq!(tau, [2.0 * (4.0 + 10.0 * 2.5), 2.0 * (1.0 + 10.0 * 1.75)]);
+    let drag = dy::estimate_effort(&s, Some((&[0.5, 1.0], &[0.1, 0.2]))).expect("estimate");
+    assert_eq!(drag, [2.0 * (4.0 + 25.0 + 0.6), 2.0 * (1.0 + 17.5 + 1.2)]);
+    let nan = dy::Sampled {
+        gravity: &[f64::NAN, 0.0, 0.0, 0.0],
+        ..s
+    };
+    assert!(dy::estimate_effort(&nan, None).expect("estimate")[0].is_nan());
+    let short = dy::Sampled {
+        inertia: &inertia[..7],
+        ..s
+    };
+    assert_eq!(
+        dy::estimate_effort(&short, None).unwrap_err().to_string(),
+        "inertia: needs one n × n matrix per row of gravity"
+    );
+    assert_eq!(
+        dy::estimate_effort(&s, Some((&[0.5], &[0.1, 0.2])))
+            .unwrap_err()
+            .to_string(),
+        "damping: needs n values"
+    );
+}

@@ -30,6 +30,7 @@ __all__ = [
     "default_task",
     "defaults",
     "description_kind",
+    "estimate_effort",
     "metrics",
     "plane_normal",
     "pose_circle",
@@ -582,6 +583,16 @@ def arm_from_mujoco(
 
 def description_kind(path: str) -> str:
     """What the file at ``path`` is: "urdf", "xacro", "mjcf", "mjcf-fragment" or "unknown"."""
+
+def estimate_effort(
+    gravity: NDArray[np.float64],
+    inertia: NDArray[np.float64],
+    damping: NDArray[np.float64] | None = None,
+    friction: NDArray[np.float64] | None = None,
+) -> NDArray[np.float64]:
+    """Effort limits (N m per joint) where a description states none: 2 (max |G_i| +
+    10 rad/s² · max Σ_j |D_ij| + b_i · 1 rad/s + F_i) over the sampled postures
+    (``gravity`` (K, n), ``inertia`` (K, n, n))."""
 
 @disjoint_base
 class Chain:

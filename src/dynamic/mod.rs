@@ -383,6 +383,8 @@ mod cartesian;
 #[cfg(feature = "alloc")]
 mod controller;
 #[cfg(feature = "alloc")]
+mod effort;
+#[cfg(feature = "alloc")]
 mod model;
 #[cfg(all(feature = "alloc", feature = "sim"))]
 mod run;
@@ -399,6 +401,8 @@ pub use cartesian::{
 };
 #[cfg(feature = "alloc")]
 pub use controller::{Basis, Centres, Controller, Scenario, State};
+#[cfg(feature = "alloc")]
+pub use effort::{estimate_effort, Sampled, EFFORT_ACCEL, EFFORT_SPEED};
 #[cfg(feature = "alloc")]
 pub use model::{
     Chain, ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Jacobian,

@@ -297,3 +297,52 @@ pub fn arm_from_mujoco<'py>(
         .map_err(error)?;
     arm_dict(py, &tree, &arm, false)
 }
+
+/// The effort limits (N m, per joint) of an arm whose description states
+/// none, by the core's one rule (`adaptimp::dynamic::estimate_effort`):
+/// 2 (max |G_i| + 10 rad/s² · max Σ_j |D_ij| + b_i · 1 rad/s + F_i) over the
+/// sampled postures. `gravity` (K, n; N m) and `inertia` (K, n, n; kg m²)
+/// at K postures; `damping` (n,; N m s/rad) and `friction` (n,; N m), both
+/// or neither.
+#[pyfunction]
+#[pyo3(signature = (gravity, inertia, damping=None, friction=None))]
+pub fn estimate_effort<'py>(
+    py: Python<'py>,
+    gravity: numpy::PyReadonlyArray2<'py, f64>,
+    inertia: numpy::PyReadonlyArray3<'py, f64>,
+    damping: Option<numpy::PyReadonlyArray1<'py, f64>>,
+    friction: Option<numpy::PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    use numpy::PyUntypedArrayMethods;
+    let n = gravity.shape()[1];
+    let flat = |a: numpy::PyReadonlyArray1<'py, f64>| a.as_array().to_vec();
+    let g: Vec<f64> = gravity.as_array().iter().copied().collect();
+    let d: Vec<f64> = inertia.as_array().iter().copied().collect();
+    if inertia.shape()[1..] != [n, n] || inertia.shape()[0] != gravity.shape()[0] {
+        return Err(ConfigError::new_err(format!(
+            "inertia must have shape ({}, {n}, {n}), got {:?}",
+            gravity.shape()[0],
+            inertia.shape()
+        )));
+    }
+    let drag = match (damping, friction) {
+        (None, None) => None,
+        (Some(b), Some(f)) => Some((flat(b), flat(f))),
+        _ => {
+            return Err(ConfigError::new_err(
+                "damping and friction are given together (N m s/rad, N m), or neither",
+            ))
+        }
+    };
+    let s = crate::dynamic::Sampled {
+        n,
+        gravity: &g,
+        inertia: &d,
+    };
+    let out = crate::dynamic::estimate_effort(
+        &s,
+        drag.as_ref().map(|(b, f)| (b.as_slice(), f.as_slice())),
+    )
+    .map_err(|e| super::config_error(e.into()))?;
+    Ok(numpy::PyArray1::from_vec(py, out))
+}

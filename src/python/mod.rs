@@ -95,7 +95,7 @@ mod adaptimp_module {
     #[pymodule_export]
     use super::computed::PyComputedTorque;
     #[pymodule_export]
-    use super::description::{arm_from_mujoco, description_kind, read_arm};
+    use super::description::{arm_from_mujoco, description_kind, estimate_effort, read_arm};
     #[pymodule_export]
     use super::measurement::PyMeasurement;
     #[pymodule_export]

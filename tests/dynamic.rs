@@ -1333,3 +1333,45 @@ fn the_effort_estimate_takes_each_maximum_over_the_postures() {
         "damping: needs n values"
     );
 }
+
+/// A model arm's quantities one by one are those of `dynamics`, and a
+/// planar arm is checked when it is made.
+#[test]
+fn a_model_arm_gives_each_quantity_of_its_dynamics() {
+    use adaptimp::Link;
+    let link = Link {
+        mass: 1.0,
+        length: 0.3,
+        com: 0.15,
+        inertia: 0.01,
+    };
+    let arm = dy::ModelArm::planar(&[link; 3], 9.81).expect("arm");
+    let (q, dq, tau, te) = (
+        [0.1, -0.2, 0.3],
+        [0.5, 0.0, -1.0],
+        [1.0, 2.0, 3.0],
+        [0.0; 3],
+    );
+    let (d, c, g, acc) = arm.dynamics(&q, &dq, &tau, &te).expect("dynamics");
+    assert_eq!(arm.inertia(&q).expect("D"), d);
+    assert_eq!(arm.coriolis(&q, &dq).expect("C"), c);
+    assert_eq!(&*arm.gravity(&q).expect("G"), &*g);
+    assert_eq!(
+        &*arm.forward_dynamics(&q, &dq, &tau, &te).expect("q̈"),
+        &*acc
+    );
+    assert_eq!(
+        dy::ModelArm::planar(&[], 9.81).unwrap_err().to_string(),
+        "n: the number of links must be between 1 and 7"
+    );
+    let bad = Link { mass: -1.0, ..link };
+    assert!(dy::ModelArm::planar(&[bad], 9.81).is_err());
+    assert_eq!(
+        arm.inertia(&q[..2]).unwrap_err().to_string(),
+        dy::ModelArm::planar(&[link; 2], 9.81)
+            .expect("arm")
+            .gravity(&q)
+            .unwrap_err()
+            .to_string()
+    );
+}

@@ -9,7 +9,7 @@
 //!
 //! - The controller of n joints is a [`dynamic::DynTracker`] (one
 //!   monomorphised core per n behind one object-safe face), the arms are
-//!   [`arm::DynArm`]s.
+//!   the core's run-time [`crate::dynamic::ModelArm`]s.
 //! - Errors become the exception classes of `adaptimp._errors` in one place
 //!   each: [`config_error`] (construction: `ConfigError`) and [`step_error`]
 //!   (a step: `MeasurementError`, `DivergedError`, `FaultError`), with the
@@ -36,7 +36,6 @@
 //! (`dynamic`, `mujoco`, `cartesian_loop`, `callback`). The joint count is
 //! dispatched by the core's `with_joints!` (src/dynamic.rs) for every front.
 
-mod arm;
 mod arrays;
 mod callback;
 mod cartesian;

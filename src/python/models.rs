@@ -1,22 +1,32 @@
 //! `TwoLinkArm` and `PlanarArm`: the simulation's arm models (src/sim/model.rs).
 
-use super::arm::DynArm;
-use super::{arm, dynamic};
+use super::dynamic;
 use super::{arrays::*, errors::*, params::*};
 use crate::control::config::Law;
+use crate::dynamic::{JointMatrix, ModelArm};
 use crate::schema::Preset;
 use crate::sim::model::{Link, TwoLinkArm};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// D(q), C(q, q̇), G(q) and q̈ of `arm`, for both arm classes.
-pub(super) fn arm_matrix<'py>(
+/// D(q) or C(q, q̇) of an arm as a NumPy array (n, n).
+fn arm_matrix<'py>(
     py: Python<'py>,
-    n: usize,
-    data: Vec<f64>,
+    m: Result<JointMatrix, crate::error::Error>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    array(py, data, (n, n))
+    let m = m.map_err(|e| config_error(e.into()))?;
+    let n = m.n();
+    let v = m.matrix();
+    array(py, (0..n * n).map(|k| v[(k / n, k % n)]).collect(), (n, n))
+}
+
+/// A joint quantity of an arm as a NumPy array (n,).
+fn arm_vector<'py>(
+    py: Python<'py>,
+    v: Result<crate::dynamic::Joints, crate::error::Error>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    Ok(array1(py, &v.map_err(|e| config_error(e.into()))?))
 }
 
 macro_rules! arm_class {
@@ -32,9 +42,9 @@ macro_rules! arm_class {
                 py: Python<'py>,
                 q: &Bound<'py, PyAny>,
             ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-                let a = self.dyn_arm();
+                let a = self.model();
                 let n = a.n();
-                arm_matrix(py, n, a.inertia(&vector("q", n, q)?[..n]))
+                arm_matrix(py, a.inertia(&vector("q", n, q)?[..n]))
             }
 
             /// Coriolis and centripetal matrix C(q, dq) (kg m²/s), (n, n).
@@ -45,10 +55,9 @@ macro_rules! arm_class {
                 q: &Bound<'py, PyAny>,
                 dq: &Bound<'py, PyAny>,
             ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-                let a = self.dyn_arm();
+                let a = self.model();
                 let n = a.n();
-                let m = a.coriolis(&vector("q", n, q)?[..n], &vector("dq", n, dq)?[..n]);
-                arm_matrix(py, n, m)
+                arm_matrix(py, a.coriolis(&vector("q", n, q)?[..n], &vector("dq", n, dq)?[..n]))
             }
 
             /// Gravity torque G(q) (N m), (n,).
@@ -58,9 +67,9 @@ macro_rules! arm_class {
                 py: Python<'py>,
                 q: &Bound<'py, PyAny>,
             ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-                let a = self.dyn_arm();
+                let a = self.model();
                 let n = a.n();
-                Ok(array1(py, &a.gravity(&vector("q", n, q)?[..n])))
+                arm_vector(py, a.gravity(&vector("q", n, q)?[..n]))
             }
 
             /// Joint acceleration (rad/s²), (n,), from (4):
@@ -73,7 +82,7 @@ macro_rules! arm_class {
                 tau: &Bound<'py, PyAny>,
                 tau_e: &Bound<'py, PyAny>,
             ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-                let a = self.dyn_arm();
+                let a = self.model();
                 let n = a.n();
                 let acc = a.forward_dynamics(
                     &vector("q", n, q)?[..n],
@@ -81,7 +90,7 @@ macro_rules! arm_class {
                     &vector("tau", n, tau)?[..n],
                     &vector("tau_e", n, tau_e)?[..n],
                 );
-                Ok(array1(py, &acc))
+                arm_vector(py, acc)
             }
 
             /// End-effector position fk(q) (m), (3,): the tip of the last link in
@@ -91,9 +100,10 @@ macro_rules! arm_class {
                 py: Python<'py>,
                 q: &Bound<'py, PyAny>,
             ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-                let a = self.dyn_arm();
+                let a = self.model();
                 let n = a.n();
-                Ok(array1(py, &a.fk(&vector("q", n, q)?[..n])))
+                let (p, _) = a.kinematics(&vector("q", n, q)?[..n]).map_err(|e| config_error(e.into()))?;
+                Ok(array1(py, p.as_slice()))
             }
 
             /// Position Jacobian J(q) = ∂fk/∂q (m/rad), (3, n): ṗ = J q̇, SPEC §16.
@@ -102,15 +112,17 @@ macro_rules! arm_class {
                 py: Python<'py>,
                 q: &Bound<'py, PyAny>,
             ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-                let a = self.dyn_arm();
+                let a = self.model();
                 let n = a.n();
-                array(py, a.jacobian(&vector("q", n, q)?[..n]), (3, n))
+                let (_, j) = a.kinematics(&vector("q", n, q)?[..n]).map_err(|e| config_error(e.into()))?;
+                let j = j.matrix();
+                array(py, (0..3 * n).map(|k| j[(k / n, k % n)]).collect(), (3, n))
             }
 
             /// Joints n.
             #[getter]
             fn n(&self) -> usize {
-                self.dyn_arm().n()
+                self.model().n()
             }
         }
     };
@@ -125,8 +137,8 @@ pub(super) struct PyArm {
 }
 
 impl PyArm {
-    pub(super) fn dyn_arm(&self) -> &dyn DynArm {
-        &self.inner
+    fn model(&self) -> ModelArm {
+        ModelArm::Paper(self.inner)
     }
 }
 
@@ -182,14 +194,14 @@ arm_class!(PyArm, {
 /// relative joint angles, link 1's angle from the horizontal, gravity along −y.
 #[pyclass(name = "PlanarArm", module = "adaptimp._adaptimp", frozen)]
 pub(super) struct PyPlanarArm {
-    pub(super) inner: Box<dyn DynArm>,
+    arm: ModelArm,
     pub(super) links: Vec<Link>,
     pub(super) g: f64,
 }
 
 impl PyPlanarArm {
-    pub(super) fn dyn_arm(&self) -> &dyn DynArm {
-        self.inner.as_ref()
+    fn model(&self) -> &ModelArm {
+        &self.arm
     }
 }
 
@@ -220,8 +232,8 @@ arm_class!(PyPlanarArm, {
                 inertia: inertias[i],
             })
             .collect();
-        let inner = arm::planar(&links, g).map_err(|e| config_error(e.into()))?;
-        Ok(Self { inner, links, g })
+        let arm = ModelArm::planar(&links, g).map_err(|e| config_error(e.into()))?;
+        Ok(Self { arm, links, g })
     }
 
     /// Gravity (m/s²).

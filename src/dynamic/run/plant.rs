@@ -94,7 +94,43 @@ pub enum Arm {
     },
 }
 
+/// `$body` with `$m` the typed model of `$arm` (the paper's arm, or a
+/// planar arm of N links) and `$N` its joint count.
+macro_rules! on_model {
+    ($arm:expr, $m:ident, $N:ident => $body:expr) => {
+        match $arm {
+            Arm::Paper(a) => {
+                const $N: usize = 2;
+                let $m = a;
+                $body
+            }
+            Arm::Planar { links, g } => crate::with_joints!(links.len(), $N => {
+                let links: [Link; $N] = links.as_slice().try_into().map_err(|_| mismatch("arm"))?;
+                let $m = &PlanarArm::new(links, *g)?;
+                $body
+            }, _ => Err(too_many(links.len()))),
+        }
+    };
+}
+
 impl Arm {
+    /// A planar arm of `links` (1 … 7) under gravity `g` (m/s²), checked
+    /// as [`PlanarArm::new`] checks it.
+    pub fn planar(links: &[Link], g: f64) -> Result<Self, Error> {
+        if !(1..=MAX_JOINTS).contains(&links.len()) {
+            return Err(Error::Invalid {
+                what: "n",
+                reason: "the number of links must be between 1 and 7",
+            });
+        }
+        let arm = Arm::Planar {
+            links: links.to_vec(),
+            g,
+        };
+        on_model!(&arm, _m, _N => Ok::<(), Error>(()))?;
+        Ok(arm)
+    }
+
     /// The number of joints n.
     pub fn n(&self) -> usize {
         match self {
@@ -103,10 +139,46 @@ impl Arm {
         }
     }
 
-    /// D(q) (kg m²), C(q, q̇) (kg m²/s), G(q) (N m) and q̈ (rad/s²) of (4)
-    /// at (q, q̇) under τ and τe (n values each; the paper's arm's (55)–(63),
-    /// a planar arm's): [`Manipulator`](crate::Manipulator)'s, checked for
-    /// their lengths.
+    /// The inertia matrix D(q) (kg m²) of (4), n × n.
+    pub fn inertia(&self, q: &[f64]) -> Result<JointMatrix, Error> {
+        use crate::sim::model::Manipulator;
+        on_model!(self, m, N => Ok(JointMatrix::of(&m.inertia(&vector::<N>("q", q)?))))
+    }
+
+    /// The Coriolis and centripetal matrix C(q, q̇) (kg m²/s) of (4), n × n.
+    pub fn coriolis(&self, q: &[f64], dq: &[f64]) -> Result<JointMatrix, Error> {
+        use crate::sim::model::Manipulator;
+        on_model!(self, m, N => {
+            let (q, dq) = (vector::<N>("q", q)?, vector::<N>("dq", dq)?);
+            Ok(JointMatrix::of(&m.coriolis(&q, &dq)))
+        })
+    }
+
+    /// The gravity torque G(q) (N m) of (4).
+    pub fn gravity(&self, q: &[f64]) -> Result<Joints, Error> {
+        use crate::sim::model::Manipulator;
+        on_model!(self, m, N => Ok(Joints::of(&m.gravity(&vector::<N>("q", q)?))))
+    }
+
+    /// q̈ (rad/s²) of (4), D(q) q̈ = τ − τe − C(q, q̇) q̇ − G(q).
+    pub fn forward_dynamics(
+        &self,
+        q: &[f64],
+        dq: &[f64],
+        tau: &[f64],
+        tau_e: &[f64],
+    ) -> Result<Joints, Error> {
+        use crate::sim::model::Manipulator;
+        on_model!(self, m, N => {
+            let (q, dq) = (vector::<N>("q", q)?, vector::<N>("dq", dq)?);
+            let (tau, tau_e) = (vector::<N>("tau", tau)?, vector::<N>("tau_e", tau_e)?);
+            Ok(Joints::of(&m.forward_dynamics(&q, &dq, &tau, &tau_e)))
+        })
+    }
+
+    /// D(q), C(q, q̇), G(q) and q̈ of (4) at (q, q̇) under τ and τe (n
+    /// values each; the paper's arm's (55)–(63), a planar arm's):
+    /// [`Manipulator`](crate::Manipulator)'s, checked for their lengths.
     pub fn dynamics(
         &self,
         q: &[f64],
@@ -114,53 +186,25 @@ impl Arm {
         tau: &[f64],
         tau_e: &[f64],
     ) -> Result<(JointMatrix, JointMatrix, Joints, Joints), Error> {
-        use crate::sim::model::Manipulator;
-        fn of<const N: usize, M: Manipulator<N>>(
-            m: &M,
-            q: &[f64],
-            dq: &[f64],
-            tau: &[f64],
-            tau_e: &[f64],
-        ) -> Result<(JointMatrix, JointMatrix, Joints, Joints), Error> {
-            let (q, dq) = (vector::<N>("q", q)?, vector::<N>("dq", dq)?);
-            let (tau, tau_e) = (vector::<N>("tau", tau)?, vector::<N>("tau_e", tau_e)?);
-            Ok((
-                JointMatrix::of(&m.inertia(&q)),
-                JointMatrix::of(&m.coriolis(&q, &dq)),
-                Joints::of(&m.gravity(&q)),
-                Joints::of(&m.forward_dynamics(&q, &dq, &tau, &tau_e)),
-            ))
-        }
-        match self {
-            Arm::Paper(a) => of::<2, _>(a, q, dq, tau, tau_e),
-            Arm::Planar { links, g } => crate::with_joints!(links.len(), N => {
-                let links: [Link; N] = links.as_slice().try_into().map_err(|_| mismatch("arm"))?;
-                of::<N, _>(&PlanarArm::new(links, *g)?, q, dq, tau, tau_e)
-            }, _ => Err(too_many(links.len()))),
-        }
+        Ok((
+            self.inertia(q)?,
+            self.coriolis(q, dq)?,
+            self.gravity(q)?,
+            self.forward_dynamics(q, dq, tau, tau_e)?,
+        ))
     }
 
     /// The end-effector position p = fk(q) (m) and the position Jacobian
     /// ∂p/∂q (3 × n, m/rad) at q (SPEC §16).
     pub fn kinematics(&self, q: &[f64]) -> Result<(Vector<3>, Jacobian3), Error> {
         use crate::cartesian::Kinematics;
-        fn of<const N: usize, K: Kinematics<N>>(
-            k: &K,
-            q: &[f64],
-        ) -> Result<(Vector<3>, Jacobian3), Error> {
+        on_model!(self, k, N => {
             let q = vector::<N>("q", q)?;
             let j = k.position_jacobian(&q);
             let mut m = nalgebra::SMatrix::<f64, 3, MAX_JOINTS>::zeros();
             m.fixed_columns_mut::<N>(0).copy_from(&j);
             Ok((k.fk(&q), Jacobian3 { n: N, m }))
-        }
-        match self {
-            Arm::Paper(a) => of::<2, _>(a, q),
-            Arm::Planar { links, g } => crate::with_joints!(links.len(), N => {
-                let links: [Link; N] = links.as_slice().try_into().map_err(|_| mismatch("arm"))?;
-                of::<N, _>(&PlanarArm::new(links, *g)?, q)
-            }, _ => Err(too_many(links.len()))),
-        }
+        })
     }
 }
 

@@ -45,6 +45,7 @@ __all__ = [
     "simulate_mujoco_many",
     "suggest",
     "table_metrics",
+    "tabulate_joints",
     "tabulate_path",
 ]
 
@@ -634,7 +635,7 @@ class CartesianImpedance:
     def reset(self, q0: ArrayLike | None = None) -> None: ...
     def set_posture(self, posture: ArrayLike) -> None: ...
     def set_stiffness(self, Kd: ArrayLike, Kd_rot: ArrayLike) -> None: ...
-    def reference(self, target: ArrayLike | None, wrench: ArrayLike) -> tuple[_F, _F, _F]: ...
+    def reference(self, target: ArrayLike | None, wrench: ArrayLike) -> list[_F]: ...
     def step_controller(
         self,
         controller: Controller | ComputedTorque,
@@ -668,7 +669,7 @@ class CartesianImpedance:
     ) -> _F: ...
     def last(self, what: str) -> _F: ...
     def state(self, what: str) -> _F: ...
-    def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> tuple[_F, _F, _F]: ...
+    def orbit(self, q0: ArrayLike, targets: _F, nodes: int) -> list[_F]: ...
     def orbit_size(self, T: float, nodes: int) -> tuple[int, int]: ...
     def check_target(self, target: ArrayLike) -> None: ...
     def simulate_mujoco(
@@ -701,6 +702,18 @@ def centres_along(
     q: _F, dq: _F, tube: tuple[float, float], periodic: bool = False
 ) -> tuple[_F, _F]:
     """RBF centres (L, 4n) along an orbit and their squared widths (4n,), SPEC (15.2)."""
+
+def tabulate_joints(
+    reference: Callable[[float], Any],
+    steps: int,
+    ts: float,
+    n: int,
+    start: int,
+    what: str,
+    check: Callable[[str, Any, tuple[int, ...]], _F],
+) -> list[_F]:
+    """The tables (steps, n) of xc, ẋc, ẍc (rad, rad/s, rad/s²) of a Python
+    joint reference at t_k = (start + k)·Ts (s)."""
 
 def tabulate_path(
     path: Callable[[float], Any],

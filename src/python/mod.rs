@@ -98,7 +98,7 @@ mod adaptimp_module {
     #[pymodule_export]
     use super::measurement::PyMeasurement;
     #[pymodule_export]
-    use super::tabulate::tabulate_path;
+    use super::tabulate::{tabulate_joints, tabulate_path};
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -1,6 +1,7 @@
 //! `tabulate_path`: a path written in Python, called at t_k = (start + k)·Ts
 //! and laid out as the rows (steps, 24) of the core's pose targets (SPEC §16,
-//! the layout of `pose_target`). The loop, the reading of each returned
+//! the layout of `pose_target`); `tabulate_joints`: a joint reference
+//! likewise, as the tables (steps, n) of xc, ẋc, ẍc. The loop, the reading of each returned
 //! value and the layout run here; a value that is not a float64 NumPy array of
 //! its exact shape goes to the caller's `check(name, value, shape)` (the
 //! Python front's one validation, which converts it or raises naming it), so
@@ -125,4 +126,79 @@ pub fn tabulate_path<'py>(
         out.extend_from_slice(&row);
     }
     super::arrays::array(py, out, (steps, ROW))
+}
+
+/// `v`, the value `name`, into `out` (n values, shape (n,)): straight from a
+/// float64 array of that shape, else through `check(name, v, (n,))`.
+fn read_joints(
+    check: &Bound<'_, PyAny>,
+    name: impl FnOnce() -> String,
+    v: &Bound<'_, PyAny>,
+    out: &mut [f64],
+) -> PyResult<()> {
+    if let Ok(a) = v.cast::<PyArray1<f64>>() {
+        if a.len() == out.len() {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = a.get_owned(i).unwrap_or(f64::NAN);
+            }
+            return Ok(());
+        }
+    }
+    let shape = PyTuple::new(v.py(), [out.len()])?;
+    let checked = check.call1((name(), v, shape))?;
+    let flat = checked.call_method0("ravel")?;
+    let a = flat.cast::<PyArray1<f64>>()?;
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = a.get_owned(i).unwrap_or(f64::NAN);
+    }
+    Ok(())
+}
+
+/// A joint reference written in Python, `reference(t)` → (x, ẋ, ẍ) (n
+/// values each), at t_k = (start + k)·Ts for k < `steps`: the three tables
+/// (steps, n) of xc, ẋc, ẍc, beside [`tabulate_path`]'s pose targets. Each
+/// value that is not a float64 array of shape (n,) goes to `check(name,
+/// value, shape)`, `name` being `what[i]` (i = 0, 1, 2).
+#[pyfunction]
+#[pyo3(signature = (reference, steps, ts, n, start, what, check))]
+#[allow(clippy::too_many_arguments)]
+pub fn tabulate_joints<'py>(
+    py: Python<'py>,
+    reference: &Bound<'py, PyAny>,
+    steps: usize,
+    ts: f64,
+    n: usize,
+    start: u64,
+    what: &str,
+    check: &Bound<'py, PyAny>,
+) -> PyResult<[Bound<'py, PyArray2<f64>>; 3]> {
+    let len = steps.saturating_mul(n);
+    let mut tables: [Vec<f64>; 3] = Default::default();
+    for t in &mut tables {
+        // A table too large for memory is Python's MemoryError, not an abort.
+        t.try_reserve_exact(len).map_err(|_| {
+            PyMemoryError::new_err(format!("a reference table of {steps} rows of {n}"))
+        })?;
+    }
+    let mut row = std::vec![0.0; n];
+    for k in 0..steps as u64 {
+        let sample = reference.call1((((start + k) as f64) * ts,))?;
+        let values: Vec<Bound<'py, PyAny>> = match sample.cast::<PyTuple>() {
+            Ok(t) => t.iter().collect(),
+            Err(_) => sample.try_iter()?.collect::<PyResult<_>>()?,
+        };
+        if values.len() != 3 {
+            return Err(PyValueError::new_err(format!(
+                "{what} must return 3 arrays (x, dx, ddx), got {}",
+                values.len()
+            )));
+        }
+        for (i, (v, table)) in values.iter().zip(&mut tables).enumerate() {
+            read_joints(check, || format!("{what}[{i}]"), v, &mut row)?;
+            table.extend_from_slice(&row);
+        }
+    }
+    let [x, dx, ddx] = tables;
+    let array = |t: Vec<f64>| super::arrays::array(py, t, (steps, n));
+    Ok([array(x)?, array(dx)?, array(ddx)?])
 }

@@ -1,7 +1,8 @@
 """The effort estimate of an arm whose description states no limits is the
 core's one rule (``_adaptimp.estimate_effort``): bit for bit what the URDF
-front (:func:`adaptimp.mujoco.estimate_effort`) and the MJCF front
-(``adaptimp._mjcf.estimate``, with the joints' damping and friction) compute."""
+front (:func:`adaptimp.mujoco.estimate_effort`) computes, and what the MJCF
+front (``adaptimp._mjcf.estimate``, which calls it, with the joints' damping
+and friction) computed in NumPy before."""
 
 from __future__ import annotations
 
@@ -53,8 +54,13 @@ def test_the_mjcf_estimate_with_damping_and_friction_is_the_cores() -> None:
     model.dof_damping[:] = 0.3 + 0.1 * np.arange(model.nv)
     model.dof_frictionloss[:] = 0.05
     g, d = _samples(model, dofs, qadr)
-    core = _adaptimp.estimate_effort(g, d, model.dof_damping[dofs], model.dof_frictionloss[dofs])
+    b, f = model.dof_damping[dofs], model.dof_frictionloss[dofs]
+    core = _adaptimp.estimate_effort(g, d, b, f)
     assert np.array_equal(core, _mjcf.estimate(model, qadr, dofs))
+    # The NumPy formula the front had: the same bits.
+    gmax = np.max(np.abs(g), axis=0)
+    dmax = np.max(np.sum(np.abs(d), axis=2), axis=0)
+    assert np.array_equal(core, 2.0 * (gmax + 10.0 * dmax + (1.0 * b + f)))
     # Without the drag terms, 2 (b_i · 1 rad/s + F_i) less.
     bare = _adaptimp.estimate_effort(g, d)
     np.testing.assert_allclose(core - bare, 2 * (model.dof_damping + 0.05), rtol=1e-12)

@@ -39,13 +39,6 @@ from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
 
-EFFORT_ACCEL = 10.0
-"""The acceleration (rad/s²) an estimated τmax leaves beyond gravity."""
-
-EFFORT_SPEED = 1.0
-"""The joint speed (rad/s) at which an estimated τmax overcomes the joint's
-viscous damping."""
-
 FIRST_ORDER_STEP = 2.5e-4
 """The largest MuJoCo timestep (s) of a file's model integrated to first order
 (Euler, implicit, implicitfast): :func:`adaptimp.mujoco.simulate` then takes
@@ -280,27 +273,32 @@ def estimate(
 ) -> FloatArray:
     """τmax (N m) per arm joint where nothing declares it: 2 (max |G_i| + 10
     rad/s² · max Σ_j |D_ij| + b_i · 1 rad/s + F_i) over ``postures`` postures
-    within the joint limits: the URDF estimate
-    (:func:`adaptimp.mujoco.estimate_effort`; D with the rotors' armature)
-    and the joint's own viscous damping b_i at :data:`EFFORT_SPEED` and dry
-    friction F_i (``frictionloss``), which a file may make the larger part
-    (metaworld's Sawyer: b = 10 N m s/rad on a wrist of 0.01 kg m²)."""
+    within the joint limits, by the core's one rule
+    (``_adaptimp.estimate_effort``, the URDF estimate's
+    :func:`adaptimp.mujoco.estimate_effort` with the drag terms; D with the
+    rotors' armature): the joint's own viscous damping b_i at 1 rad/s and
+    dry friction F_i (``frictionloss``), which a file
+    may make the larger part (metaworld's Sawyer: b = 10 N m s/rad on a wrist
+    of 0.01 kg m²). G and D are MuJoCo's at each posture."""
+    from . import _adaptimp
+
     joints = [int(m.dof_jntid[d]) for d in dofs]
     lo, hi = _limits(m, joints)
     data = mujoco.MjData(m)
     full = np.zeros((m.nv, m.nv))
-    g = np.zeros(len(dofs))
-    d = np.zeros(len(dofs))
-    for q in _postures(lo, hi, postures):
+    samples = _postures(lo, hi, postures)
+    g = np.empty((len(samples), len(dofs)))
+    d = np.empty((len(samples), len(dofs), len(dofs)))
+    for k, q in enumerate(samples):
         data.qpos[:] = m.qpos0
         data.qpos[list(qadr)] = q
         data.qvel[:] = 0.0
         mujoco.mj_forward(m, data)
         _full_inertia(m, data, full)
-        g = np.maximum(g, np.abs(data.qfrc_bias[list(dofs)]))
-        d = np.maximum(d, np.sum(np.abs(full[np.ix_(dofs, dofs)]), axis=1))
-    drive = EFFORT_SPEED * m.dof_damping[list(dofs)] + m.dof_frictionloss[list(dofs)]
-    return np.asarray(2.0 * (g + EFFORT_ACCEL * d + drive), dtype=np.float64)
+        g[k] = data.qfrc_bias[list(dofs)]
+        d[k] = full[np.ix_(dofs, dofs)]
+    drag = (m.dof_damping[list(dofs)], m.dof_frictionloss[list(dofs)])
+    return np.asarray(_adaptimp.estimate_effort(g, d, *drag), dtype=np.float64)
 
 
 def _label(path: str | os.PathLike[str] | None) -> str:

@@ -57,6 +57,53 @@ impl<const N: usize> Trajectory<N> for Clock<'_> {
     }
 }
 
+/// A trajectory tabulated at t_k = k·Ts: K rows of N values each for xc,
+/// ẋc, ẍc (row-major); row round(t/Ts) is the setpoint at t (beyond the
+/// last row: NaN). The reference of a run whose setpoints were computed
+/// before it (a table, a path written in another language).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Tabulated<'a, const N: usize> {
+    /// xc, ẋc, ẍc, row-major K × N.
+    pub rows: [&'a [f64]; 3],
+    /// Ts (s).
+    pub ts: f64,
+}
+
+impl<const N: usize> Trajectory<N> for Tabulated<'_, N> {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        let k = libm::round(t / self.ts) as usize;
+        let row = |v: &[f64]| match v.get(k * N..(k + 1) * N) {
+            Some(r) => Vector::from_column_slice(r),
+            None => Vector::from_element(f64::NAN),
+        };
+        Setpoint {
+            x: row(self.rows[0]),
+            dx: row(self.rows[1]),
+            ddx: row(self.rows[2]),
+        }
+    }
+}
+
+/// A controller's own sinusoid on its own clock: at a run's t = k·Ts, the
+/// trajectory at (k0 + k)·Ts, k0 the steps the controller had taken before
+/// the run (a used controller goes on where it was).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Continued<const N: usize> {
+    /// The trajectory.
+    pub traj: Sinusoid<N>,
+    /// Steps taken before the run.
+    pub k0: u64,
+    /// Ts (s).
+    pub ts: f64,
+}
+
+impl<const N: usize> Trajectory<N> for Continued<N> {
+    fn sample(&self, t: f64) -> Setpoint<N> {
+        let k = libm::round(t / self.ts) as u64;
+        self.traj.sample((self.k0 + k) as f64 * self.ts)
+    }
+}
+
 /// Per-joint sinusoid `x_i(t) = o_i + a_i sin(ω_i t) + b_i cos(ω_i t)`.
 ///
 /// The paper's circle (64), `xc = [0.2 − 0.2 cos(πt), 0.2 + 0.2 sin(πt)]`,

@@ -28,9 +28,12 @@
 use crate::error::Error;
 use crate::sim::disturb::Friction;
 use crate::sim::plant::Plant;
-use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
 use crate::types::Vector;
 use adaptimp_mujoco::{Sim, MAX_WARNINGS};
+
+/// The run's references, the core's ([`Tabulated`](crate::trajectory::Tabulated)
+/// as `Table`).
+pub use crate::trajectory::{Continued, Tabulated as Table};
 use core::cell::Cell;
 use std::string::String;
 use std::vec::Vec;
@@ -652,48 +655,5 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
             self.ask(self.rows)?;
         }
         Ok(ddq)
-    }
-}
-
-/// A commanded trajectory tabulated at t_k = k·Ts (K rows of N values each
-/// for xc, ẋc, ẍc): the setpoint of row k.
-pub struct Table<'a, const N: usize> {
-    /// xc, ẋc, ẍc, row-major K × N.
-    pub rows: [&'a [f64]; 3],
-    /// Ts (s).
-    pub ts: f64,
-}
-
-impl<const N: usize> Trajectory<N> for Table<'_, N> {
-    fn sample(&self, t: f64) -> Setpoint<N> {
-        let k = libm::round(t / self.ts) as usize;
-        let row = |v: &[f64]| match v.get(k * N..(k + 1) * N) {
-            Some(r) => Vector::from_column_slice(r),
-            None => Vector::from_element(f64::NAN),
-        };
-        Setpoint {
-            x: row(self.rows[0]),
-            dx: row(self.rows[1]),
-            ddx: row(self.rows[2]),
-        }
-    }
-}
-
-/// A controller's own sinusoid on its own clock: at the loop's t = k·Ts, the
-/// trajectory at (k0 + k)·Ts, k0 the steps the controller had taken before
-/// the run (exactly its `time()`).
-pub struct Continued<const N: usize> {
-    /// The trajectory.
-    pub traj: Sinusoid<N>,
-    /// Steps taken before the run.
-    pub k0: u64,
-    /// Ts (s).
-    pub ts: f64,
-}
-
-impl<const N: usize> Trajectory<N> for Continued<N> {
-    fn sample(&self, t: f64) -> Setpoint<N> {
-        let k = libm::round(t / self.ts) as u64;
-        self.traj.sample((self.k0 + k) as f64 * self.ts)
     }
 }

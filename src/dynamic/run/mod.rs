@@ -33,7 +33,7 @@ use crate::sim::metrics::MetricsAccumulator;
 use crate::sim::plant as core_plant;
 use crate::sim::record::Recorder;
 use crate::sim::simulator::{self, simulate_disturbed, Adapted, Adapter};
-use crate::trajectory::{self, Sinusoid, Trajectory};
+use crate::trajectory::{self, Continued, Tabulated, Trajectory};
 use crate::types::Vector;
 use alloc::vec::Vec;
 use plant::Typed;
@@ -82,6 +82,14 @@ impl<'a> Table<'a> {
         self.x.len() / self.n
     }
 
+    /// The table as the trajectory the loop samples, at period `ts` (s).
+    fn trajectory<const N: usize>(&self, ts: f64) -> Tabulated<'a, N> {
+        Tabulated {
+            rows: [self.x, self.dx, self.ddx],
+            ts,
+        }
+    }
+
     /// Row k.
     pub fn row(&self, k: usize) -> Option<Setpoint<&'a [f64]>> {
         let r = k * self.n..(k + 1) * self.n;
@@ -90,39 +98,6 @@ impl<'a> Table<'a> {
             dx: self.dx.get(r.clone())?,
             ddx: self.ddx.get(r)?,
         })
-    }
-}
-
-/// The trajectory of a table: row round(t/Ts).
-struct TableTrajectory<'a, const N: usize>(Table<'a>, f64);
-
-impl<const N: usize> Trajectory<N> for TableTrajectory<'_, N> {
-    fn sample(&self, t: f64) -> trajectory::Setpoint<N> {
-        let k = libm::round(t / self.1) as usize;
-        let row = |v: &[f64]| match v.get(k * N..(k + 1) * N) {
-            Some(r) => Vector::from_column_slice(r),
-            None => Vector::from_element(f64::NAN),
-        };
-        trajectory::Setpoint {
-            x: row(self.0.x),
-            dx: row(self.0.dx),
-            ddx: row(self.0.ddx),
-        }
-    }
-}
-
-/// A controller's own sinusoid on its own clock: at the loop's t = k·Ts,
-/// the trajectory at (k0 + k)·Ts, k0 the steps it had taken before the run.
-struct Continued<const N: usize> {
-    traj: Sinusoid<N>,
-    k0: u64,
-    ts: f64,
-}
-
-impl<const N: usize> Trajectory<N> for Continued<N> {
-    fn sample(&self, t: f64) -> trajectory::Setpoint<N> {
-        let k = libm::round(t / self.ts) as u64;
-        self.traj.sample((self.k0 + k) as f64 * self.ts)
     }
 }
 
@@ -489,7 +464,7 @@ fn adaptive<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>>(
         }
         Reference::Table(t) => {
             table::<N>(&t, on.run, ts)?;
-            on.go(&mut bound, &TableTrajectory::<N>(t, ts), target)
+            on.go(&mut bound, &t.trajectory::<N>(ts), target)
         }
     }
 }
@@ -511,7 +486,7 @@ fn computed<const N: usize>(
     table::<N>(&t, on.run, ts)?;
     let target = *c.impedance();
     let mut ctrl = ComputedLoop { ctrl: c, state: s };
-    on.go(&mut ctrl, &TableTrajectory::<N>(t, ts), target)
+    on.go(&mut ctrl, &t.trajectory::<N>(ts), target)
 }
 
 fn own<const N: usize>(
@@ -534,5 +509,5 @@ fn own<const N: usize>(
     }
     let target = TargetImpedance::new(dd.vector(), cd.vector(), gd.vector())?;
     let mut ctrl = OwnLoop::<N> { ctrl: c, target };
-    on.go(&mut ctrl, &TableTrajectory::<N>(t, ts), target)
+    on.go(&mut ctrl, &t.trajectory::<N>(ts), target)
 }

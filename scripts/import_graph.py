@@ -2,7 +2,7 @@
 
 Reads the imports of the Python package (``python/adaptimp``: module-level and
 function-level ``import``/``from … import``, relative or absolute) and of the
-Rust crates (``src/``, ``ffi/src/``: ``use crate::…``, ``use super::…``,
+Rust crates (``src/``, ``bindings/python/src/``, ``ffi/src/``: ``use crate::…``, ``use super::…``,
 ``use self::…``, paths written inline such as ``super::dynamic::MAX_JOINTS``),
 as text, with the standard library alone, and prints every circle: a set of
 files each of which reaches the others through imports.
@@ -228,9 +228,11 @@ def circles(edges: dict[str, set[str]]) -> list[list[str]]:
 
 
 def graph() -> dict[str, set[str]]:
-    """Every edge of the project: the Python package, the core, the C ABI."""
+    """Every edge of the project: the Python package, the core, the Python
+    bindings, the C ABI."""
     edges = python_edges(ROOT / "python" / "adaptimp")
     edges.update(rust_edges(ROOT / "src", "adaptimp"))
+    edges.update(rust_edges(ROOT / "bindings" / "python" / "src", "adaptimp-python"))
     edges.update(rust_edges(ROOT / "ffi" / "src", "adaptimp-ffi"))
     return edges
 

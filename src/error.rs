@@ -149,7 +149,7 @@ impl Error {
 }
 
 /// Validation helpers shared by every constructor.
-pub(crate) mod check {
+pub mod check {
     use super::Error;
     use crate::types::Vector;
 

@@ -85,8 +85,6 @@ pub mod error;
 mod math;
 pub mod networks;
 pub mod presets;
-#[cfg(feature = "python")]
-mod python;
 pub mod schema;
 #[cfg(feature = "sim")]
 pub mod sim;

@@ -35,7 +35,7 @@ def test_the_graph_sees_the_imports_it_must() -> None:
     edges = _graph_module().graph()
     assert "adaptimp._description" in edges["adaptimp._mjcf"]
     assert "src/control/state.rs" in edges["src/control/controller.rs"]
-    assert "src/python/dynamic.rs" in edges["src/python/cartesian_loop.rs"]
+    assert "bindings/python/src/dynamic.rs" in edges["bindings/python/src/cartesian_loop.rs"]
     assert (
         "ffi/src/handles.rs" in edges["ffi/src/joint.rs"]
         or "ffi/src/lib.rs" in edges["ffi/src/joint.rs"]

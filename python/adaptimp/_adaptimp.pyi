@@ -1,4 +1,4 @@
-"""Type stubs of the compiled core ``adaptimp._adaptimp`` (src/python/).
+"""Type stubs of the compiled core ``adaptimp._adaptimp`` (bindings/python/src/).
 
 The classes take complete parameter dicts keyed by the Python parameter names;
 ``adaptimp.Controller``, ``adaptimp.TwoLinkArm`` and ``adaptimp.simulate`` build

@@ -85,7 +85,7 @@ pub const BATCH_ELEMENTS: usize = 256;
 /// A path as messages show it: whole, unless it is long or holds a line
 /// break (text given where a path was expected): then its start and its
 /// length.
-pub(crate) fn shown_path(path: &Path) -> String {
+pub fn shown_path(path: &Path) -> String {
     let s = path.display().to_string();
     if s.chars().count() <= 200 && !s.contains(['\n', '\r']) {
         return s;

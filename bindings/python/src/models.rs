@@ -2,10 +2,10 @@
 
 use super::dynamic;
 use super::{arrays::*, errors::*, params::*};
-use crate::control::config::Law;
-use crate::dynamic::{JointMatrix, ModelArm};
-use crate::schema::Preset;
-use crate::sim::model::{Link, TwoLinkArm};
+use adaptimp::control::config::Law;
+use adaptimp::dynamic::{JointMatrix, ModelArm};
+use adaptimp::schema::Preset;
+use adaptimp::sim::model::{Link, TwoLinkArm};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -13,7 +13,7 @@ use pyo3::types::PyDict;
 /// D(q) or C(q, q̇) of an arm as a NumPy array (n, n).
 fn arm_matrix<'py>(
     py: Python<'py>,
-    m: Result<JointMatrix, crate::error::Error>,
+    m: Result<JointMatrix, adaptimp::error::Error>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let m = m.map_err(|e| config_error(e.into()))?;
     let n = m.n();
@@ -24,7 +24,7 @@ fn arm_matrix<'py>(
 /// A joint quantity of an arm as a NumPy array (n,).
 fn arm_vector<'py>(
     py: Python<'py>,
-    v: Result<crate::dynamic::Joints, crate::error::Error>,
+    v: Result<adaptimp::dynamic::Joints, adaptimp::error::Error>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     Ok(array1(py, &v.map_err(|e| config_error(e.into()))?))
 }

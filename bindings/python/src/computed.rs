@@ -15,19 +15,19 @@ use super::measurement::JointCall;
 use super::mujoco::{MujocoSpec, Table};
 use super::shared::{Read, Shared, Slot, Write};
 use super::{array, array1, vector, vector_into, ConfigError, MeasurementError};
-use crate::cartesian::chain::JointKind;
-use crate::cartesian::dynamics::Lifted;
-use crate::cartesian::{
+use adaptimp::cartesian::chain::JointKind;
+use adaptimp::cartesian::dynamics::Lifted;
+use adaptimp::cartesian::{
     ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
     SampledDrive, Spring,
 };
-use crate::control::config::Law;
-use crate::control::impedance::{ImpedanceMode, TargetImpedance};
-use crate::control::io::{Command, Control, Measurement};
-use crate::error::Error;
-use crate::sim::record::{Recorder, Row};
-use crate::trajectory::Setpoint;
-use crate::types::Vector;
+use adaptimp::control::config::Law;
+use adaptimp::control::impedance::{ImpedanceMode, TargetImpedance};
+use adaptimp::control::io::{Command, Control, Measurement};
+use adaptimp::error::Error;
+use adaptimp::sim::record::{Recorder, Row};
+use adaptimp::trajectory::Setpoint;
+use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::cell::Cell;
 use numpy::PyArray1;
@@ -312,7 +312,7 @@ fn run_mujoco<const N: usize>(
     hooks: &mut dyn Hooks,
 ) -> Result<(Records, MetricsOut), RunError> {
     let ts = c.ctrl.period();
-    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
     let need = usize::try_from(total)
         .unwrap_or(usize::MAX)
         .saturating_mul(N);
@@ -457,7 +457,7 @@ fn computed(
     p: &Params<'_>,
 ) -> Result<Box<dyn DynComputed>, Error> {
     let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
-    crate::with_joints!(
+    adaptimp::with_joints!(
         n,
         K => build::<K>(joints, inertials, gravity, p),
         _ => Err(Error::Condition {

@@ -2,7 +2,7 @@
 
 use super::dynamic::MAX_JOINTS;
 use super::errors::*;
-use crate::error::Error;
+use adaptimp::error::Error;
 use numpy::ndarray::{Array, Dimension, IntoDimension};
 use numpy::{
     IntoPyArray, PyArray, PyArray1, PyArrayDescrMethods, PyArrayMethods, PyReadonlyArray2,

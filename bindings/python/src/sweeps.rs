@@ -3,9 +3,9 @@
 use super::dynamic::{ArmSpec, Hooks, Owned, ParamError, RunError};
 use super::{arrays::*, controller::*, errors::*, hooks::*, models::*, params::*, runs::*};
 use super::{dynamic, mujoco};
-use crate::control::config::Law;
-use crate::schema::Preset;
-use crate::sim::model::TwoLinkArm;
+use adaptimp::control::config::Law;
+use adaptimp::schema::Preset;
+use adaptimp::sim::model::TwoLinkArm;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};

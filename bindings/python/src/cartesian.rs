@@ -22,18 +22,18 @@ use super::{
     PyController,
 };
 use super::{DivergedError, MeasurementError};
-use crate::cartesian::chain::MAX_CHAIN_JOINTS;
-use crate::cartesian::{
+use adaptimp::cartesian::chain::MAX_CHAIN_JOINTS;
+use adaptimp::cartesian::{
     CartesianCommand, CartesianConfig, CartesianImpedance, CartesianMeasurement, CartesianState,
     Chain, Joint, JointKind, Kinematics, PoseTarget, Transform,
 };
-use crate::control::config::Law;
-use crate::control::io::Command;
-use crate::error::Error;
-use crate::networks::rbf::Centers;
-use crate::schema::Preset;
-use crate::trajectory::Setpoint;
-use crate::types::Vector;
+use adaptimp::control::config::Law;
+use adaptimp::control::io::Command;
+use adaptimp::error::Error;
+use adaptimp::networks::rbf::Centers;
+use adaptimp::schema::Preset;
+use adaptimp::trajectory::Setpoint;
+use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::any::{Any, TypeId};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -191,7 +191,7 @@ impl<const N: usize> DynChain for Chain<N> {
 /// many joints as it has movable ones (1 … 7).
 pub fn chain(joints: &[Joint], tip: &Transform) -> Result<Box<dyn DynChain>, Error> {
     let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
-    crate::with_joints!(
+    adaptimp::with_joints!(
         n,
         K => Ok(Box::new(Chain::<K>::new(joints, tip)?)),
         _ => Err(Error::Condition {
@@ -612,7 +612,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         nodes: usize,
     ) -> Result<[Vec<f64>; 3], Error> {
         let q0 = vector_of::<N>(q0);
-        crate::error::check::finite_slice("q0", q0.as_slice())?;
+        adaptimp::error::check::finite_slice("q0", q0.as_slice())?;
         let zero = Setpoint {
             x: Vector::<N>::zeros(),
             dx: Vector::zeros(),
@@ -1131,15 +1131,15 @@ impl PyChain {
 pub(super) struct TypedChain<'a, const N: usize>(pub(super) &'a dyn DynChain);
 
 impl<const N: usize> Kinematics<N> for TypedChain<'_, N> {
-    fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> crate::cartesian::Tip<N> {
+    fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> adaptimp::cartesian::Tip<N> {
         // The pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
         let (t, pose) = self.0.tip_pose_unchecked(q.as_slice(), dq.as_slice());
-        crate::cartesian::Tip {
+        adaptimp::cartesian::Tip {
             position: Vector::<3>::new(pose[3], pose[7], pose[11]),
             rotation: nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::new(
                 pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
             )),
-            jacobian: crate::cartesian::Jacobian6::<N>::from_row_slice(&t.jacobian),
+            jacobian: adaptimp::cartesian::Jacobian6::<N>::from_row_slice(&t.jacobian),
             bias: Vector::<6>::from(t.bias),
         }
     }
@@ -1828,7 +1828,7 @@ impl PyCartesian {
         let t = real("T", T)?;
         let nodes = count("nodes", nodes)?;
         let ts = self.read(py)?.ts();
-        let steps = crate::cartesian::orbit_steps(t, ts)
+        let steps = adaptimp::cartesian::orbit_steps(t, ts)
             .map_err(|e| ConfigError::new_err(e.to_string()))?;
         Ok((steps, nodes))
     }
@@ -1917,7 +1917,7 @@ pub fn centres_along<'py>(
         Ok((c.centers().to_vec(), widths))
     }
     let tube = [tube.0, tube.1];
-    let (c, w) = crate::with_joints!(
+    let (c, w) = adaptimp::with_joints!(
         n,
         K => along::<K>(&qs, &dqs, tube, periodic),
         _ => unreachable!("n is checked above"),

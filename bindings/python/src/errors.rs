@@ -2,7 +2,7 @@
 
 use super::dynamic::{ParamError, RunError};
 use super::hooks::*;
-use crate::error::Error;
+use adaptimp::error::Error;
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError};
 use pyo3::prelude::*;
 

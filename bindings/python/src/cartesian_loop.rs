@@ -26,17 +26,17 @@ use super::dynamic::{
     TaskMetrics, Typed, View,
 };
 use super::mujoco::MujocoSpec;
-use crate::cartesian::{
+use adaptimp::cartesian::{
     CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, PoseTarget,
 };
-use crate::control::config::Law;
-use crate::control::impedance::TargetImpedance;
-use crate::control::io::TaskTorque;
-use crate::control::io::{Command, Measurement, WrenchControl};
-use crate::error::Error;
-use crate::sim::record::{Recorder, Row};
-use crate::trajectory::{Clock, Setpoint};
-use crate::types::Vector;
+use adaptimp::control::config::Law;
+use adaptimp::control::impedance::TargetImpedance;
+use adaptimp::control::io::TaskTorque;
+use adaptimp::control::io::{Command, Measurement, WrenchControl};
+use adaptimp::error::Error;
+use adaptimp::sim::record::{Recorder, Row};
+use adaptimp::trajectory::{Clock, Setpoint};
+use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::any::{Any, TypeId};
 use core::cell::{Cell, RefCell};
@@ -255,7 +255,7 @@ impl<const N: usize> LastStep<N> {
 /// every step: a step the joint controller refuses is recorded there (the
 /// fault, its fallback as the applied torque); so is one the outer loop
 /// refuses before the joint step runs (a non-finite q, wrench or target), as
-/// a front's refused call is ([`Tracker::refuse`](crate::control::tracker::Tracker::refuse)).
+/// a front's refused call is ([`Tracker::refuse`](adaptimp::control::tracker::Tracker::refuse)).
 pub(crate) fn cartesian_step<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
@@ -539,7 +539,7 @@ fn checked<const N: usize, J: JointStep<N> + ?Sized>(
             "needs the same Ts as the Cartesian impedance",
         ));
     }
-    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
     if let Some(tab) = run.targets {
         let need = usize::try_from(total)
             .unwrap_or(usize::MAX)
@@ -561,7 +561,7 @@ pub(crate) fn reads_the_wrench<const N: usize>(
     items: &Items,
     fault: Option<&FaultSpec>,
 ) -> Result<(), RunError> {
-    let s = super::dynamic::scenario::<N>(crate::schema::Preset::Robot, law, items)
+    let s = super::dynamic::scenario::<N>(adaptimp::schema::Preset::Robot, law, items)
         .map_err(|e| RunError::Core(e.error, None))?;
     if s.disturbances()?
         .params()

@@ -7,8 +7,8 @@ use super::dynamic::{CentersSpec, DynTracker, Inputs, Last, Tables, MAX_JOINTS};
 use super::measurement::JointCall;
 use super::shared::{Read, Shared, Slot, Write};
 use super::{arrays::*, errors::*, hooks::*, params::*};
-use crate::control::config::Law;
-use crate::schema::Preset;
+use adaptimp::control::config::Law;
+use adaptimp::schema::Preset;
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
 };
@@ -204,7 +204,7 @@ impl PyController {
             let movable = g
                 .joints
                 .iter()
-                .filter(|j| j.kind != crate::cartesian::chain::JointKind::Fixed)
+                .filter(|j| j.kind != adaptimp::cartesian::chain::JointKind::Fixed)
                 .count();
             if movable != n {
                 return Err(ConfigError::new_err(format!(

@@ -8,32 +8,32 @@
 //! slices and errors to exceptions.
 
 use super::mujoco::{Continued, Failure, MjPlant, MujocoSpec, Table};
-use crate::control::config::Law;
-use crate::control::controller::Controller;
-use crate::control::impedance::TargetImpedance;
-use crate::control::io::{Command, Control, Measurement};
-use crate::control::tracker::Tracker;
-use crate::control::tuning::Rule;
-use crate::error::Error;
-use crate::networks::network::{Weights, C, D, G};
-use crate::networks::rbf::{AnyBasis, Basis, Centers, GRID_MAX_JOINTS};
-use crate::schema::{Preset, Scenario, Value};
-use crate::sim::disturb::TipPayload;
-use crate::sim::environment::{FreeSpace, Wall};
-use crate::sim::inject::{Injected, Injection};
-use crate::sim::metrics::MetricsAccumulator;
-use crate::sim::model::{Link, PlanarArm, TwoLinkArm};
-use crate::sim::plant::{Plant, RigidBody};
-use crate::sim::record::{Recorder, Row};
-use crate::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapter};
-use crate::trajectory::{Setpoint, Sinusoid, Trajectory};
-use crate::types::Vector;
+use adaptimp::control::config::Law;
+use adaptimp::control::controller::Controller;
+use adaptimp::control::impedance::TargetImpedance;
+use adaptimp::control::io::{Command, Control, Measurement};
+use adaptimp::control::tracker::Tracker;
+use adaptimp::control::tuning::Rule;
+use adaptimp::error::Error;
+use adaptimp::networks::network::{Weights, C, D, G};
+use adaptimp::networks::rbf::{AnyBasis, Basis, Centers, GRID_MAX_JOINTS};
+use adaptimp::schema::{Preset, Scenario, Value};
+use adaptimp::sim::disturb::TipPayload;
+use adaptimp::sim::environment::{FreeSpace, Wall};
+use adaptimp::sim::inject::{Injected, Injection};
+use adaptimp::sim::metrics::MetricsAccumulator;
+use adaptimp::sim::model::{Link, PlanarArm, TwoLinkArm};
+use adaptimp::sim::plant::{Plant, RigidBody};
+use adaptimp::sim::record::{Recorder, Row};
+use adaptimp::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapter};
+use adaptimp::trajectory::{Setpoint, Sinusoid, Trajectory};
+use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::cell::{Cell, RefCell};
 use std::any::{Any, TypeId};
 use std::vec::Vec;
 
-pub use crate::dynamic::MAX_JOINTS;
+pub use adaptimp::dynamic::MAX_JOINTS;
 
 /// A parameter value, owned (the schema's [`Value`] borrows).
 #[derive(Clone, Debug, PartialEq)]
@@ -115,9 +115,9 @@ pub struct CentersSpec {
 #[derive(Clone, Debug, PartialEq)]
 pub struct GravitySpec {
     /// The chain's joints (fixed ones too).
-    pub joints: Vec<crate::cartesian::chain::Joint>,
+    pub joints: Vec<adaptimp::cartesian::chain::Joint>,
     /// One inertial per joint.
-    pub inertials: Vec<crate::cartesian::dynamics::Inertial>,
+    pub inertials: Vec<adaptimp::cartesian::dynamics::Inertial>,
     /// Gravity (m/s², base frame).
     pub gravity: [f64; 3],
 }
@@ -164,8 +164,8 @@ pub enum FaultKind {
 
 /// The core's injection of `f`, with the actuators' limits `tau_max` (N m).
 fn injection<const N: usize>(f: &FaultSpec, tau_max: &Vector<N>) -> Result<Injection<N>, Error> {
-    crate::error::check::nonnegative("fault start ≥ 0", "start", f.start)?;
-    crate::error::check::positive("fault duration > 0", "duration", f.duration)?;
+    adaptimp::error::check::nonnegative("fault start ≥ 0", "start", f.start)?;
+    adaptimp::error::check::positive("fault duration > 0", "duration", f.duration)?;
     let fault = match &f.kind {
         FaultKind::Stale => Injected::Stale,
         FaultKind::NanBurst => Injected::NanBurst,
@@ -177,7 +177,7 @@ fn injection<const N: usize>(f: &FaultSpec, tau_max: &Vector<N>) -> Result<Injec
                     reason: "needs one value per joint (N m)",
                 });
             }
-            crate::error::check::finite_slice("bias", b)?;
+            adaptimp::error::check::finite_slice("bias", b)?;
             Injected::ForceBias {
                 bias: Vector::from_column_slice(b),
             }
@@ -507,7 +507,7 @@ pub trait DynTracker: Send + Sync {
     /// One step that always writes a torque to apply into `out`.
     fn step_or_fallback(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
     /// A step call refused by the front (its arguments' shapes or types):
-    /// recorded as a refused step ([`Controller::refuse`](crate::Controller::refuse)).
+    /// recorded as a refused step ([`Controller::refuse`](adaptimp::Controller::refuse)).
     fn refuse(&mut self, error: Error);
     /// A quantity of the last step.
     fn last(&self, what: Last) -> &[f64];
@@ -523,7 +523,7 @@ pub trait DynTracker: Send + Sync {
     fn weights(&self) -> Vec<f64>;
     /// Replace the weights (same layout as [`weights`](Self::weights)).
     fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error>;
-    /// The whole state as reals ([`State::save`](crate::control::state::State::save)).
+    /// The whole state as reals ([`State::save`](adaptimp::control::state::State::save)).
     fn snapshot(&self) -> Vec<f64>;
     /// Restore a [`snapshot`](Self::snapshot).
     fn restore(&mut self, data: &[f64]) -> Result<(), Error>;
@@ -600,7 +600,7 @@ fn run_mujoco<const N: usize>(
     hooks: &mut dyn Hooks,
 ) -> Result<(Records, MetricsOut), RunError> {
     let ts = t.controller().period();
-    let total = crate::sim::simulator::steps(run.t_final, ts)?;
+    let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
     if let Some(rows) = run.reference {
         let need = usize::try_from(total)
             .unwrap_or(usize::MAX)
@@ -681,13 +681,13 @@ pub(crate) fn drive_mujoco<const N: usize, C, T, R>(
     rec: &mut R,
 ) -> Result<(), RunError>
 where
-    C: crate::control::io::Control<N> + View + ?Sized,
+    C: adaptimp::control::io::Control<N> + View + ?Sized,
     T: Trajectory<N> + ?Sized,
     R: Recorder<N> + ?Sized,
 {
     let ts = ctrl.period();
-    let total = crate::sim::simulator::steps(on.t_final, ts)?;
-    crate::error::check::nonnegative("settle ≥ 0", "settle", on.settle)?;
+    let total = adaptimp::sim::simulator::steps(on.t_final, ts)?;
+    adaptimp::error::check::nonnegative("settle ≥ 0", "settle", on.settle)?;
     let s = scenario::<N>(Preset::Robot, on.law, on.items)
         .map_err(|e| RunError::Core(e.error, None))?;
     let dist = s.disturbances()?;
@@ -772,7 +772,7 @@ pub struct Tables<'a> {
 }
 
 /// The typed controller behind a [`DynTracker`] of N joints (the Cartesian
-/// bindings step it directly, `src/python/cartesian.rs`).
+/// bindings step it directly, `bindings/python/src/cartesian.rs`).
 pub(crate) type Typed<const N: usize> = Tracker<N, AnyBasis<N>, Sinusoid<N>>;
 
 /// Build the controller `law` for n joints from `preset` and `items`, with the
@@ -786,7 +786,7 @@ pub fn build(
     centers: Option<&CentersSpec>,
     gravity: Option<&GravitySpec>,
 ) -> Result<Box<dyn DynTracker>, ParamError> {
-    crate::with_joints!(
+    adaptimp::with_joints!(
         n,
         K => Ok(Box::new(build_n::<K>(preset, law, items, centers, gravity)?)),
         _ => Err(Error::Invalid {
@@ -826,7 +826,7 @@ fn build_n<const N: usize>(
     let mut ctrl = Controller::for_trajectory(s.config, basis, &traj)?;
     if let Some(g) = gravity {
         let model =
-            crate::cartesian::dynamics::Dynamics::<N>::new(&g.joints, &g.inertials, g.gravity)?;
+            adaptimp::cartesian::dynamics::Dynamics::<N>::new(&g.joints, &g.inertials, g.gravity)?;
         ctrl = ctrl.with_feedforward(std::sync::Arc::new(model));
     }
     Ok(Tracker::new(ctrl, traj))
@@ -852,7 +852,7 @@ fn setpoint<const N: usize>(s: [&[f64]; 3]) -> Setpoint<N> {
     }
 }
 
-fn metrics_out<const N: usize>(m: &crate::sim::metrics::Metrics<N>) -> MetricsOut {
+fn metrics_out<const N: usize>(m: &adaptimp::sim::metrics::Metrics<N>) -> MetricsOut {
     let v = |x: &Vector<N>| x.as_slice().to_vec();
     MetricsOut {
         scalars: Vec::from([
@@ -953,7 +953,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
         .map(|f| injection::<N>(f, &t.controller().config().tau_max))
         .transpose()?;
     let ts = t.controller().period();
-    let total = crate::sim::simulator::steps(cfg.t_final, ts)?;
+    let total = adaptimp::sim::simulator::steps(cfg.t_final, ts)?;
     let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
     let mut rec = Records::with_rows(N, kept, every, false).ok_or(RunError::Memory(kept))?;
     t.reset();
@@ -964,7 +964,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     // The plant the controller does not know (SPEC §17): payload and friction.
     let dist = s.disturbances()?;
     // The set-up's errors name no row: check what the run builds first.
-    crate::error::check::nonnegative("settle ≥ 0", "settle", cfg.settle)?;
+    adaptimp::error::check::nonnegative("settle ≥ 0", "settle", cfg.settle)?;
     RigidBody::new(
         arm.with_payload(dist.payload())?,
         FreeSpace,
@@ -1052,7 +1052,7 @@ impl<const N: usize> DynTracker for Typed<N> {
             Some(s) => setpoint(s),
             None => self.trajectory().sample(Tracker::time(self)),
         };
-        let (tau, result) = crate::control::io::Control::step_or_fallback(self, &meas, &c);
+        let (tau, result) = adaptimp::control::io::Control::step_or_fallback(self, &meas, &c);
         out.copy_from_slice(tau.as_slice());
         result.map(|_| ())
     }
@@ -1268,7 +1268,7 @@ pub fn metrics_of(
     target: [&[f64]; 3],
     joint_space: Option<bool>,
 ) -> Result<MetricsOut, Error> {
-    crate::with_joints!(
+    adaptimp::with_joints!(
         rows.n.max(rows.m),
         K => metrics_n::<K>(rows, settle, target, joint_space),
         _ => Err(Error::Invalid {

@@ -1,15 +1,15 @@
 //! The gain and basis rule of SPEC §18 for Python (`adaptimp.tuning`), a thin
-//! face of [`crate::control::tuning`]: arrays in, the schema's names out.
+//! face of [`adaptimp::control::tuning`]: arrays in, the schema's names out.
 
 use super::cartesian::{PyChain, TypedChain};
 use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
-use crate::cartesian::rule::{PoseCircle, PostureRule, TaskRows};
-use crate::control::tuning::{default_task as core_default_task, Rule};
-use crate::dynamic::{Inertia, TaskPath, Tuning};
-use crate::error::Error;
-use crate::schema::{Group, PARAMS};
-use crate::types::{Matrix, Vector};
+use adaptimp::cartesian::rule::{PoseCircle, PostureRule, TaskRows};
+use adaptimp::control::tuning::{default_task as core_default_task, Rule};
+use adaptimp::dynamic::{Inertia, TaskPath, Tuning};
+use adaptimp::error::Error;
+use adaptimp::schema::{Group, PARAMS};
+use adaptimp::types::{Matrix, Vector};
 use numpy::{
     PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn,
     PyUntypedArrayMethods,
@@ -177,7 +177,7 @@ pub fn default_task(
         )));
     }
     let [h, l, u] = [home, lo, hi].map(|a| a.as_array().iter().copied().collect::<Vec<f64>>());
-    crate::with_joints!(
+    adaptimp::with_joints!(
         n,
         K => {
             let v = |x: &[f64]| Vector::<K>::from_column_slice(x);
@@ -225,8 +225,8 @@ pub fn pose_circle<'py>(
         )));
     }
     let err = |e: Error| config_error(e.into());
-    crate::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
-    crate::error::check::finite("start", start).map_err(err)?;
+    adaptimp::error::check::positive("Ts > 0", "Ts", ts).map_err(err)?;
+    adaptimp::error::check::finite("start", start).map_err(err)?;
     if steps > 100_000_000 {
         return Err(ConfigError::new_err(format!(
             "steps must be at most 1e8, got {steps}"
@@ -325,7 +325,7 @@ pub fn assess_posture<'py>(
     let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
     let (q, p, g, d) = (flat(&q), flat(&p), flat(&gravity), flat(&d0));
     let (lo, hi, tau) = (flat1(&lo), flat1(&hi), flat1(&tau_max));
-    let (a, score, error) = crate::with_joints!(
+    let (a, score, error) = adaptimp::with_joints!(
         n,
         K => assess_typed::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), task),
         _ => unreachable!("a chain has 1 to 7 joints"),
@@ -350,7 +350,8 @@ fn posture_rule(k1: Option<f64>, ts: Option<f64>, load: Option<f64>) -> PyResult
     let ts = ts.unwrap_or(1e-3);
     let mut rule = PostureRule::for_loop(k1.unwrap_or_else(|| joint_rule.k1(ts)), ts, &joint_rule);
     if let Some(l) = load {
-        crate::error::check::positive("load > 0", "load", l).map_err(|e| config_error(e.into()))?;
+        adaptimp::error::check::positive("load > 0", "load", l)
+            .map_err(|e| config_error(e.into()))?;
         rule.load = l;
     }
     Ok(rule)
@@ -374,7 +375,7 @@ pub fn posture_needs(
             .ok_or_else(|| ConfigError::new_err(format!("best needs {key:?}")))?
             .extract()
     };
-    let a = crate::cartesian::Assessment {
+    let a = adaptimp::cartesian::Assessment {
         sigma_min: get("sigma_min")?,
         load: get("load")?,
         conditioning: get("conditioning")?,
@@ -386,7 +387,7 @@ pub fn posture_needs(
 }
 
 /// The normal (3,) of a planar arm's plane from its 6 × n Jacobian at any
-/// posture, SPEC (16.8) ([`crate::cartesian::rule::plane_normal`]), or None
+/// posture, SPEC (16.8) ([`adaptimp::cartesian::rule::plane_normal`]), or None
 /// for an arm that is not planar.
 #[pyfunction]
 pub fn plane_normal(jacobian: PyReadonlyArray2<'_, f64>) -> PyResult<Option<[f64; 3]>> {
@@ -396,11 +397,11 @@ pub fn plane_normal(jacobian: PyReadonlyArray2<'_, f64>) -> PyResult<Option<[f64
     }
     let n = shape[1];
     let j: Vec<f64> = jacobian.as_array().iter().copied().collect();
-    Ok(crate::with_joints!(
+    Ok(adaptimp::with_joints!(
         n,
         K => {
-            let m = crate::cartesian::kinematics::Jacobian6::<K>::from_row_slice(&j);
-            crate::cartesian::rule::plane_normal(&m).map(|v| [v[0], v[1], v[2]])
+            let m = adaptimp::cartesian::kinematics::Jacobian6::<K>::from_row_slice(&j);
+            adaptimp::cartesian::rule::plane_normal(&m).map(|v| [v[0], v[1], v[2]])
         },
         _ => unreachable!("n checked above"),
     ))
@@ -454,7 +455,7 @@ fn assess_typed<const N: usize>(
     (q, p, g, d): (&[f64], &[f64], &[f64], &[f64]),
     (lo, hi, tau): (&[f64], &[f64], &[f64]),
     task: TaskRows,
-) -> Result<(crate::cartesian::Assessment, f64, Option<String>), Error> {
+) -> Result<(adaptimp::cartesian::Assessment, f64, Option<String>), Error> {
     let v = Vector::<N>::from_column_slice;
     let orbit: Vec<Vector<N>> = q.chunks_exact(N).map(v).collect();
     let targets: Vec<Vector<3>> = p
@@ -480,7 +481,7 @@ fn assess_typed<const N: usize>(
 /// the score and the first violated condition as a dict.
 fn assessment_dict<'py>(
     py: Python<'py>,
-    a: &crate::cartesian::Assessment,
+    a: &adaptimp::cartesian::Assessment,
     score: f64,
     error: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -547,7 +548,7 @@ pub fn pose_metrics<'py>(
                     )),
                 )
             };
-            let (ep, eo) = crate::sim::metrics::pose_error(
+            let (ep, eo) = adaptimp::sim::metrics::pose_error(
                 &Vector::<3>::from(position),
                 &quat(&rotation),
                 &Vector::<3>::from_column_slice(&row[..3]),
@@ -558,7 +559,7 @@ pub fn pose_metrics<'py>(
         }
         (pos, rot)
     });
-    let m = crate::sim::metrics::pose_metrics(&t, &pos, &rot, settle, ts);
+    let m = adaptimp::sim::metrics::pose_metrics(&t, &pos, &rot, settle, ts);
     let out = PyDict::new(py);
     for (name, v) in [
         ("rms_pos", m.rms_pos),
@@ -579,7 +580,7 @@ pub fn pose_metrics<'py>(
     ))
 }
 
-/// The table's metrics of a run, SPEC (19.7) ([`crate::sim::metrics::table_metrics`]):
+/// The table's metrics of a run, SPEC (19.7) ([`adaptimp::sim::metrics::table_metrics`]):
 /// the rows (each K × width, row-major: `t` (K,), `p`, `dp`, `ddp`, `pd`,
 /// `pc`, `dpc`, `ddpc` (K, 3), `wrench` (K, 6), `normal` (K,), `tau`,
 /// `tau_sat` (K, n)) and what they are compared with (`tau_max` (n,), `md`,
@@ -609,7 +610,7 @@ pub fn table_metrics<'py>(
     windows: (f64, f64, f64),
     ts: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use crate::sim::metrics::{table_metrics as core_metrics, TableRows, TableSpec};
+    use adaptimp::sim::metrics::{table_metrics as core_metrics, TableRows, TableSpec};
     let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
     let flat = |a: &PyReadonlyArray2<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
     let (t, normal, tau_max) = (flat1(&t), flat1(&normal), flat1(&tau_max));

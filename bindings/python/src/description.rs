@@ -3,8 +3,8 @@
 //! the one reduction's arm as a dict; `adaptimp._description` is their front.
 
 use super::ConfigError;
-use crate::cartesian::chain::{JointKind, Transform};
-use crate::description::{self, urdf, Arm, DescriptionError, ErrorKind, MujocoArrays, Tree};
+use adaptimp::cartesian::chain::{JointKind, Transform};
+use adaptimp::description::{self, urdf, Arm, DescriptionError, ErrorKind, MujocoArrays, Tree};
 use pyo3::exceptions::{PyFileNotFoundError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -334,12 +334,12 @@ pub fn estimate_effort<'py>(
             ))
         }
     };
-    let s = crate::dynamic::Sampled {
+    let s = adaptimp::dynamic::Sampled {
         n,
         gravity: &g,
         inertia: &d,
     };
-    let out = crate::dynamic::estimate_effort(
+    let out = adaptimp::dynamic::estimate_effort(
         &s,
         drag.as_ref().map(|(b, f)| (b.as_slice(), f.as_slice())),
     )

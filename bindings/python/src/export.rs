@@ -1,8 +1,8 @@
 //! The schema's table and a scenario's defaults, for the Python layer's docs and keyword parameters.
 
 use super::params::*;
-use crate::control::config::Law;
-use crate::schema::{Kind, Preset, Scenario, Value, PARAMS};
+use adaptimp::control::config::Law;
+use adaptimp::schema::{Kind, Preset, Scenario, Value, PARAMS};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
@@ -61,7 +61,7 @@ pub(super) fn defaults<'py>(
     let preset = preset_of(scenario)?;
     let d = PyDict::new(py);
     let mut err = Ok(());
-    crate::with_joints!(
+    adaptimp::with_joints!(
         check_n(n)?,
         K => Scenario::<K>::preset(preset, Law::StateFeedback).visit(|name, v| {
             if err.is_ok() {

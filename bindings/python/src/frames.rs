@@ -2,9 +2,9 @@
 //! `Chain` and `ComputedTorque` take): the conversions both bindings use.
 
 use super::errors::ConfigError;
-use crate::cartesian::dynamics::Inertial;
-use crate::cartesian::{Joint, JointKind, Transform};
-use crate::error::Error;
+use adaptimp::cartesian::dynamics::Inertial;
+use adaptimp::cartesian::{Joint, JointKind, Transform};
+use adaptimp::error::Error;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

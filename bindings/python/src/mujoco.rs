@@ -25,15 +25,15 @@
 //!
 //! Nothing here is `unsafe`: the FFI lives in the `adaptimp-mujoco` crate.
 
-use crate::error::Error;
-use crate::sim::disturb::Friction;
-use crate::sim::plant::Plant;
-use crate::types::Vector;
+use adaptimp::error::Error;
+use adaptimp::sim::disturb::Friction;
+use adaptimp::sim::plant::Plant;
+use adaptimp::types::Vector;
 use adaptimp_mujoco::{Sim, MAX_WARNINGS};
 
-/// The run's references, the core's ([`Tabulated`](crate::trajectory::Tabulated)
+/// The run's references, the core's ([`Tabulated`](adaptimp::trajectory::Tabulated)
 /// as `Table`).
-pub use crate::trajectory::{Continued, Tabulated as Table};
+pub use adaptimp::trajectory::{Continued, Tabulated as Table};
 use core::cell::Cell;
 use std::string::String;
 use std::vec::Vec;

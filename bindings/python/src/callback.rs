@@ -34,13 +34,13 @@ use super::dynamic::{
 };
 use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
-use crate::control::config::Law;
-use crate::control::impedance::TargetImpedance;
-use crate::control::io::{Command, Measurement, WrenchControl};
-use crate::error::Error;
-use crate::sim::record::{Recorder, Row};
-use crate::trajectory::{Clock, Setpoint};
-use crate::types::Vector;
+use adaptimp::control::config::Law;
+use adaptimp::control::impedance::TargetImpedance;
+use adaptimp::control::io::{Command, Measurement, WrenchControl};
+use adaptimp::error::Error;
+use adaptimp::sim::record::{Recorder, Row};
+use adaptimp::trajectory::{Clock, Setpoint};
+use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::cell::Cell;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -634,7 +634,7 @@ fn prepare<const N: usize, const M: usize>(
     run: &CallbackRun<'_>,
 ) -> Result<Prepared<N, M>, RunError> {
     let w = run.m;
-    let total = crate::sim::simulator::steps(run.t_final, run.ts)?;
+    let total = adaptimp::sim::simulator::steps(run.t_final, run.ts)?;
     let need = usize::try_from(total)
         .unwrap_or(usize::MAX)
         .saturating_mul(w);
@@ -763,7 +763,7 @@ pub fn simulate(
     run: &CallbackRun<'_>,
     hooks: &mut dyn Hooks,
 ) -> RunOut {
-    crate::with_joints!(
+    adaptimp::with_joints!(
         n,
         K => run_n::<K>(ctrl, sim, spec, run, hooks),
         _ => invalid("n", "the number of joints must be between 1 and 7").into(),

@@ -2,8 +2,8 @@
 
 use super::dynamic::{Owned, MAX_JOINTS};
 use super::errors::*;
-use crate::control::config::Law;
-use crate::schema::Preset;
+use adaptimp::control::config::Law;
+use adaptimp::schema::Preset;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};

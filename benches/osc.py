@@ -40,6 +40,7 @@ median ``env.step`` time (ms, one policy step: 25 model timesteps).
 
 from __future__ import annotations
 
+import abc
 import argparse
 import json
 import statistics
@@ -192,7 +193,7 @@ class Probe:
 # -- the scripted policies -----------------------------------------------------------
 
 
-class Script:
+class Script(abc.ABC):
     """A closed-loop scripted policy: a reference pose r(t) of the grip site and
     a gripper command; the action moves the goal to r(t + Δt) (clipped as
     OSC_POSE clips it), in the arm's base frame."""
@@ -210,8 +211,10 @@ class Script:
         self.R0 = T.quat2mat(obs["robot0_eef_quat"])
         self.R_target = self.R0
 
+    @abc.abstractmethod
     def reference(self, t: float) -> tuple[np.ndarray, float]:
-        raise NotImplementedError
+        """The grip site's reference position (m, world frame) at time ``t`` (s)
+        and the gripper command (−1 open … 1 closed): each task's own script."""
 
     def action(self, obs: dict[str, Any], t: float) -> np.ndarray:
         target, grip = self.reference(t + POLICY_DT)
@@ -227,7 +230,7 @@ class Script:
     def success(self) -> bool:
         return bool(self.env._check_success())
 
-    def observe(self, obs: dict[str, Any], t: float) -> None:
+    def observe(self, obs: dict[str, Any], t: float) -> None:  # noqa: B027 (an optional hook)
         """Called after every step (a script that checks its own success)."""
 
 

@@ -14,7 +14,7 @@ use adaptimp::dynamic::{
     CartesianCommand, CartesianController, CartesianImpedance, CartesianMeasurement,
     CartesianState, Centres, Chain, Joints, Scenario, State,
 };
-use adaptimp::schema::Preset;
+use adaptimp::schema::{Group, Preset};
 use adaptimp::{CartesianConfig, Joint, JointKind, Law, PoseTarget, Transform, Vector};
 use core::ffi::c_void;
 use nalgebra::{Matrix3, UnitQuaternion};

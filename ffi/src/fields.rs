@@ -1,62 +1,19 @@
-//! The parameter structs' fields by the schema's names, declared once: each
-//! struct's table ([`controller_fields`], [`cartesian_fields`]) says which
-//! field holds which parameter of the schema and how C writes it (an enum
-//! as an integer, INFINITY for none, a flag for a derived value), and the
-//! same table reads a struct into the core's scenario ([`read_into`]) and
-//! writes the scenario's values into a struct ([`write_from`]).
+//! The parameter structs read and written through the core's schema: a C
+//! field is its parameter's name in lower case, so the tables here
+//! ([`controller_fields`], [`cartesian_fields`]) say only where each
+//! parameter sits in its struct; what the field means is the parameter's
+//! kind in `adaptimp::schema::PARAMS` (an optional's none is INFINITY, a
+//! limit's none INFINITY per joint, a choice the C enum's value in the
+//! order of the kind's names), and the schema's scenario checks the value.
 
 use crate::*;
 use adaptimp::dynamic::Scenario;
-use adaptimp::schema::Value;
-use adaptimp::{
-    AuxLaw, Conditions, Fallback, FaultPolicy, Formulation, Hold, ImpedanceMode, LearningStep,
-    ObserverInit, RobustKind, SaturationLearning,
-};
+use adaptimp::schema::{param, Group, Kind, Param, Value, PARAMS};
 
-/// A C enum whose values are a schema choice's names, in their order.
-pub(crate) trait Choice: CEnum {
-    /// The schema's names of its values.
-    const NAMES: &'static [&'static str];
-}
-
-macro_rules! choices {
-    ($($e:ident => $names:expr),+ $(,)?) => {
-        $(impl Choice for $e {
-            const NAMES: &'static [&'static str] = &$names;
-        })+
-    };
-}
-
-choices! {
-    AdaptimpAuxLaw => AuxLaw::NAMES,
-    AdaptimpConditions => Conditions::NAMES,
-    AdaptimpRobust => RobustKind::NAMES,
-    AdaptimpLearningStep => LearningStep::NAMES,
-    AdaptimpSaturationLearning => SaturationLearning::NAMES,
-    AdaptimpObserverInit => ObserverInit::NAMES,
-    AdaptimpObserverHold => Hold::NAMES,
-    AdaptimpImpedance => ImpedanceMode::NAMES,
-    AdaptimpFallback => Fallback::NAMES,
-    AdaptimpFaultPolicy => FaultPolicy::NAMES,
-    AdaptimpFormulation => Formulation::NAMES,
-}
-
-/// The schema's name of choice `raw` of `E`, or INVALID_CONFIG naming `field`.
-fn read_choice<E: Choice>(raw: u32, field: &str) -> Result<&'static str, AdaptimpStatus> {
-    Ok(E::NAMES[decode::<E>(E::from_raw(raw), field)?.index()])
-}
-
-/// The integer of `E`'s choice named `name` by the schema.
-fn write_choice<E: Choice>(name: &str) -> u32 {
-    E::ALL[E::NAMES.iter().position(|n| *n == name).unwrap_or(0)].value()
-}
-
-/// A field of a parameter struct, as the schema's value it carries.
+/// Where a parameter sits in a C struct, by the C type that holds it.
 pub(crate) enum Field<'a> {
-    /// A real.
+    /// A real (INFINITY: none, for an optional parameter).
     Real(&'a mut f64),
-    /// A real whose INFINITY is the schema's none (no clipping).
-    Clip(&'a mut f64),
     /// A count (the loop's delay).
     Count(&'a mut usize),
     /// One real per joint, of which the first n are read.
@@ -68,19 +25,44 @@ pub(crate) enum Field<'a> {
     Derived(&'a mut [f64; 3], &'a mut AdaptimpBoolRaw),
     /// A C bool.
     Flag(&'a mut AdaptimpBoolRaw),
-    /// An enum's integer, read and written by its enum.
+    /// An enum's integer: its position in the enum (INVALID_CONFIG naming
+    /// the field if it is none of its values), and the integer at a position.
     Choice(
         &'a mut u32,
-        fn(u32, &str) -> Result<&'static str, AdaptimpStatus>,
-        fn(&str) -> u32,
+        fn(u32, &str) -> Result<usize, AdaptimpStatus>,
+        fn(usize) -> u32,
     ),
     /// The weight bound: its mode (`<name>_mode`) and its three bounds.
     Bound(&'a mut AdaptimpWeightBoundRaw, &'a mut [f64; 3]),
 }
 
-/// The field of enum `E` whose integer is `raw`.
-fn choice<E: Choice>(raw: &mut u32) -> Field<'_> {
-    Field::Choice(raw, read_choice::<E>, write_choice::<E>)
+impl<'a> Field<'a> {
+    /// The field of enum `E` whose integer is `raw`.
+    pub(crate) fn choice<E: CEnum>(raw: &'a mut u32) -> Self {
+        Field::Choice(
+            raw,
+            |v, field| Ok(decode::<E>(E::from_raw(v), field)?.index()),
+            |i| E::ALL.get(i).unwrap_or(&E::ALL[0]).value(),
+        )
+    }
+}
+
+macro_rules! from_places {
+    ($($t:ty => $v:ident),+) => {
+        $(impl<'a> From<&'a mut $t> for Field<'a> {
+            fn from(x: &'a mut $t) -> Self {
+                Field::$v(x)
+            }
+        })+
+    };
+}
+
+from_places! {
+    f64 => Real,
+    usize => Count,
+    [f64; ADAPTIMP_MAX_JOINTS] => Joint,
+    [f64; 3] => Three,
+    AdaptimpBoolRaw => Flag
 }
 
 /// `v` into the first of `dst`.
@@ -89,15 +71,22 @@ fn copy(dst: &mut [f64], v: &[f64]) {
     dst[..k].copy_from_slice(&v[..k]);
 }
 
+/// The names of a choice parameter's values (none for another kind).
+fn names(kind: Kind) -> &'static [&'static str] {
+    match kind {
+        Kind::Choice(names) => names,
+        _ => &[],
+    }
+}
+
 impl Field<'_> {
-    /// The value the caller gave (the first `n` of a per-joint field), or
-    /// INVALID_CONFIG naming a field (`field`, the struct's name of the
-    /// parameter) that is no value of its enum.
-    fn value(&self, n: usize, field: &str) -> Result<Value<'_>, AdaptimpStatus> {
+    /// The value the caller gave for a parameter of `kind` (the first `n`
+    /// of a per-joint field), or INVALID_CONFIG naming a field (`field`,
+    /// the struct's name of the parameter) that is no value of its enum.
+    fn value(&self, kind: Kind, n: usize, field: &str) -> Result<Value<'_>, AdaptimpStatus> {
         Ok(match self {
+            Field::Real(x) if **x == f64::INFINITY && kind == Kind::Optional => Value::None,
             Field::Real(x) => Value::Real(**x),
-            Field::Clip(x) if **x == f64::INFINITY => Value::None,
-            Field::Clip(x) => Value::Real(**x),
             // usize → i64: a count beyond i64 is refused by the schema's check (≤ 64).
             Field::Count(d) => Value::Int(i64::try_from(**d).unwrap_or(i64::MAX)),
             Field::Joint(v) => Value::Vec(&v[..n]),
@@ -109,7 +98,15 @@ impl Field<'_> {
                 }
             }
             Field::Flag(b) => Value::Bool(decode_bool(**b, field)?),
-            Field::Choice(raw, read, _) => Value::Str(read(**raw, field)?),
+            Field::Choice(raw, index, _) => {
+                let i = index(**raw, field)?;
+                Value::Str(names(kind).get(i).copied().ok_or_else(|| {
+                    fail(
+                        AdaptimpStatus::Internal,
+                        &format_args!("{field}: the schema has no choice {i}"),
+                    )
+                })?)
+            }
             Field::Bound(mode, v) => {
                 match decode::<AdaptimpWeightBound>(**mode, &format!("{field}_mode"))? {
                     AdaptimpWeightBound::None => Value::None,
@@ -120,13 +117,14 @@ impl Field<'_> {
         })
     }
 
-    /// Set from the schema's value `v`.
-    fn put(&mut self, v: Value<'_>) {
+    /// Set from the schema's value `v` of a parameter of `kind`.
+    fn put(&mut self, kind: Kind, v: Value<'_>) {
         match (self, v) {
-            (Field::Real(x) | Field::Clip(x), Value::Real(y)) => **x = y,
-            (Field::Clip(x), Value::None) => **x = f64::INFINITY,
+            (Field::Real(x), Value::Real(y)) => **x = y,
+            (Field::Real(x), Value::None) => **x = f64::INFINITY,
             (Field::Count(d), Value::Int(i)) => **d = usize::try_from(i).unwrap_or(0),
             (Field::Joint(dst), Value::Vec(v)) => copy(&mut dst[..], v),
+            (Field::Joint(dst), Value::None) => dst.fill(f64::INFINITY),
             (Field::Three(dst), Value::Vec(v)) => copy(&mut dst[..], v),
             (Field::Derived(dst, critical), Value::None) => {
                 **dst = [0.0; 3];
@@ -137,7 +135,11 @@ impl Field<'_> {
                 **critical = false.into();
             }
             (Field::Flag(b), Value::Bool(x)) => **b = x.into(),
-            (Field::Choice(raw, _, write), Value::Str(s)) => **raw = write(s),
+            (Field::Choice(raw, _, int), Value::Str(s)) => {
+                if let Some(i) = names(kind).iter().position(|n| *n == s) {
+                    **raw = int(i);
+                }
+            }
             (Field::Bound(mode, _), Value::None) => **mode = AdaptimpWeightBound::None.raw(),
             (Field::Bound(mode, _), Value::Str(_)) => **mode = AdaptimpWeightBound::Auto.raw(),
             (Field::Bound(mode, dst), Value::Vec(v)) => {
@@ -149,250 +151,133 @@ impl Field<'_> {
     }
 }
 
-/// Set each parameter of `fields` (the first `n` values of a per-joint
-/// one) in `s`; every error is a parameter's: INVALID_CONFIG, naming the
-/// field as `owner` names the struct ("params", "cart") and the field as
-/// the schema names the parameter (in lower case).
-pub(crate) fn read_into<'a>(
+/// A struct's table: each parameter's name (the schema's, but for case)
+/// and where it sits.
+pub(crate) type Table<'a> = Vec<(&'static str, Field<'a>)>;
+
+/// The field of `table` that holds parameter `p`.
+fn field_of<'t, 'a>(table: &'t mut Table<'a>, p: &Param) -> Option<&'t mut Field<'a>> {
+    table
+        .iter_mut()
+        .find(|(name, _)| name.eq_ignore_ascii_case(p.name))
+        .map(|(_, f)| f)
+}
+
+/// Set each parameter of `group` in `s` from its field of `table` (the
+/// first `n` values of a per-joint one), in the schema's order; every error
+/// is a parameter's: INVALID_CONFIG, naming the field as `owner` names the
+/// struct ("params", "cart") and the field as the schema names the
+/// parameter (in lower case).
+pub(crate) fn read_into(
     s: &mut Scenario,
     n: usize,
-    fields: impl IntoIterator<Item = (&'static str, Field<'a>)>,
+    group: Group,
+    mut table: Table<'_>,
     owner: &str,
 ) -> Result<(), AdaptimpStatus> {
-    for (name, field) in fields {
-        let v = field.value(n, &format!("{owner}.{}", name.to_lowercase()))?;
-        s.set(name, v).map_err(|e| core_error(e, Context::Config))?;
+    for p in PARAMS.iter().filter(|p| p.group == group) {
+        let field = &format!("{owner}.{}", p.name.to_lowercase());
+        let Some(f) = field_of(&mut table, p) else {
+            return Err(fail(AdaptimpStatus::Internal, &format_args!("no {field}")));
+        };
+        let v = f.value(p.kind, n, field)?;
+        s.set(p.name, v)
+            .map_err(|e| core_error(e, Context::Config))?;
     }
     Ok(())
 }
 
-/// Each field of `fields` from the value of its parameter in `s`.
-pub(crate) fn write_from(s: &Scenario, fields: &mut [(&'static str, Field<'_>)]) {
+/// Each field of `table` from the value of its parameter (of `group`) in `s`.
+pub(crate) fn write_from(s: &Scenario, group: Group, mut table: Table<'_>) {
     s.visit(|name, v| {
-        if let Some((_, field)) = fields.iter_mut().find(|(n, _)| *n == name) {
-            field.put(v);
+        let Some(p) = param(name).filter(|p| p.group == group) else {
+            return;
+        };
+        if let Some(f) = field_of(&mut table, p) {
+            f.put(p.kind, v);
         }
     });
 }
 
-/// Every controller parameter of the schema as a field of `p`, in the
-/// schema's order (the destructuring fails to compile if a field is added
-/// without being mapped; `n`, `law` and the centres are not parameters).
-pub(crate) fn controller_fields(p: &mut AdaptimpParams) -> [(&'static str, Field<'_>); 45] {
-    use Field::{Bound, Count, Flag, Joint, Real, Three};
-    let AdaptimpParams {
-        n: _,
-        law: _,
-        centers: _,
-        nodes: _,
-        widths2: _,
-        ts,
-        delay,
-        k1,
-        kp,
-        kzeta,
-        inertia,
-        rho,
-        conditions,
-        mu,
-        aux_law,
-        robust,
-        kr,
-        phi,
-        k_remark1: [kd, kc, kg],
-        learning_step,
-        kappa,
-        saturation_learning,
-        weight_bound_mode,
-        weight_bound,
-        gamma,
-        sigma,
-        eps,
-        lam1,
-        observer_init,
-        observer_hold,
-        observer_lead,
-        tau_max,
-        dd,
-        cd,
-        gd,
-        impedance,
-        eta2,
-        xc_offset,
-        xc_sin,
-        xc_cos,
-        xc_omega,
-        fallback,
-        fallback_damping,
-        fault_policy,
-        q_max,
-        dq_max,
-        tau_e_max,
-        q_jump_max,
-        tau_rate_max,
-    } = p;
-    [
-        ("Ts", Real(ts)),
-        ("delay", Count(delay)),
-        ("K1", Joint(k1)),
-        ("Kp", Joint(kp)),
-        ("Kzeta", Joint(kzeta)),
-        ("inertia", Joint(inertia)),
-        ("rho", Real(rho)),
-        (
-            "conditions",
-            choice::<AdaptimpConditions>(&mut conditions.0),
-        ),
-        ("mu", Real(mu)),
-        ("aux_law", choice::<AdaptimpAuxLaw>(&mut aux_law.0)),
-        ("robust", choice::<AdaptimpRobust>(&mut robust.0)),
-        ("kr", Joint(kr)),
-        ("phi", Real(phi)),
-        ("kD", Real(kd)),
-        ("kC", Real(kc)),
-        ("kG", Real(kg)),
-        ("gamma", Three(gamma)),
-        ("sigma", Three(sigma)),
-        ("eta2", Real(eta2)),
-        ("eps", Real(eps)),
-        ("lam1", Joint(lam1)),
-        (
-            "observer_init",
-            choice::<AdaptimpObserverInit>(&mut observer_init.0),
-        ),
-        (
-            "observer_hold",
-            choice::<AdaptimpObserverHold>(&mut observer_hold.0),
-        ),
-        ("observer_lead", Flag(observer_lead)),
-        ("tau_max", Joint(tau_max)),
-        ("Dd", Joint(dd)),
-        ("Cd", Joint(cd)),
-        ("Gd", Joint(gd)),
-        ("impedance", choice::<AdaptimpImpedance>(&mut impedance.0)),
-        ("xc_offset", Joint(xc_offset)),
-        ("xc_sin", Joint(xc_sin)),
-        ("xc_cos", Joint(xc_cos)),
-        ("xc_omega", Joint(xc_omega)),
-        (
-            "learning_step",
-            choice::<AdaptimpLearningStep>(&mut learning_step.0),
-        ),
-        ("kappa", Real(kappa)),
-        (
-            "saturation_learning",
-            choice::<AdaptimpSaturationLearning>(&mut saturation_learning.0),
-        ),
-        ("weight_bound", Bound(weight_bound_mode, weight_bound)),
-        ("fallback", choice::<AdaptimpFallback>(&mut fallback.0)),
-        ("fallback_damping", Joint(fallback_damping)),
-        (
-            "fault_policy",
-            choice::<AdaptimpFaultPolicy>(&mut fault_policy.0),
-        ),
-        ("q_max", Joint(q_max)),
-        ("dq_max", Joint(dq_max)),
-        ("tau_e_max", Joint(tau_e_max)),
-        ("q_jump_max", Joint(q_jump_max)),
-        ("tau_rate_max", Joint(tau_rate_max)),
-    ]
+/// The table of `$p`: each named field by its own name, then the others.
+macro_rules! table {
+    ($p:ident: $($f:ident),+; $($name:literal => $field:expr),+ $(,)?) => {
+        vec![$((stringify!($f), Field::from(&mut $p.$f)),)+ $(($name, $field)),+]
+    };
 }
 
-/// Every parameter of the schema's group "cartesian" as a field of `p`, in
-/// the schema's order (the destructuring fails to compile if a field is
-/// added without being mapped).
-pub(crate) fn cartesian_fields(p: &mut AdaptimpCartesianParams) -> [(&'static str, Field<'_>); 19] {
-    use Field::{Clip, Derived, Flag, Real, Three};
-    let AdaptimpCartesianParams {
-        md,
-        bd,
-        bd_critical,
-        kd,
-        md_rot,
-        bd_rot,
-        bd_rot_critical,
-        kd_rot,
-        clik_kp,
-        clik_kd,
-        clik_lambda,
-        clik_lambda_rot,
-        null_k,
-        null_d,
-        pos_error_max,
-        rot_error_max,
-        target_filter,
-        force_filter,
-        force_feedforward,
-        formulation,
-        admittance_share,
-    } = p;
-    [
-        ("Md", Three(md)),
-        ("Bd", Derived(bd, bd_critical)),
-        ("Kd", Three(kd)),
-        ("Md_rot", Three(md_rot)),
-        ("Bd_rot", Derived(bd_rot, bd_rot_critical)),
-        ("Kd_rot", Three(kd_rot)),
-        ("clik_kp", Real(clik_kp)),
-        ("clik_kd", Real(clik_kd)),
-        ("clik_lambda", Real(clik_lambda)),
-        ("clik_lambda_rot", Real(clik_lambda_rot)),
-        ("null_k", Real(null_k)),
-        ("null_d", Real(null_d)),
-        ("pos_error_max", Clip(pos_error_max)),
-        ("rot_error_max", Clip(rot_error_max)),
-        ("target_filter", Real(target_filter)),
-        ("force_filter", Real(force_filter)),
-        ("force_feedforward", Flag(force_feedforward)),
-        (
-            "formulation",
-            choice::<AdaptimpFormulation>(&mut formulation.0),
-        ),
-        ("admittance_share", Real(admittance_share)),
-    ]
+/// Every controller parameter of the schema as a field of `p` (`n`, `law`
+/// and the centres are not parameters).
+pub(crate) fn controller_fields(p: &mut AdaptimpParams) -> Table<'_> {
+    let [kd, kc, kg] = &mut p.k_remark1;
+    table!(p: ts, delay, k1, kp, kzeta, inertia, rho, conditions, mu, aux_law, robust, kr,
+        phi, learning_step, kappa, saturation_learning, gamma, sigma, eps, lam1,
+        observer_init, observer_hold, observer_lead, tau_max, dd, cd, gd, impedance, eta2,
+        xc_offset, xc_sin, xc_cos, xc_omega, fallback, fallback_damping, fault_policy, q_max,
+        dq_max, tau_e_max, q_jump_max, tau_rate_max;
+        "kD" => Field::Real(kd),
+        "kC" => Field::Real(kc),
+        "kG" => Field::Real(kg),
+        "weight_bound" => Field::Bound(&mut p.weight_bound_mode, &mut p.weight_bound),
+    )
+}
+
+/// Every parameter of the schema's group "cartesian" as a field of `p`.
+pub(crate) fn cartesian_fields(p: &mut AdaptimpCartesianParams) -> Table<'_> {
+    table!(p: md, kd, md_rot, kd_rot, clik_kp, clik_kd, clik_lambda, clik_lambda_rot, null_k,
+        null_d, pos_error_max, rot_error_max, target_filter, force_filter, force_feedforward,
+        formulation, admittance_share;
+        "Bd" => Field::Derived(&mut p.bd, &mut p.bd_critical),
+        "Bd_rot" => Field::Derived(&mut p.bd_rot, &mut p.bd_rot_critical),
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use adaptimp::schema::{Group, PARAMS};
 
-    fn group(g: Group) -> Vec<&'static str> {
-        PARAMS
-            .iter()
-            .filter(|p| p.group == g)
-            .map(|p| p.name)
-            .collect()
+    /// The schema's parameters of `group`, and which of them `table` holds
+    /// (each once).
+    fn coverage(table: &mut Table<'_>, group: Group) {
+        let names: Vec<_> = PARAMS.iter().filter(|p| p.group == group).collect();
+        assert_eq!(table.len(), names.len(), "{group:?}");
+        for p in names {
+            let held = table
+                .iter()
+                .filter(|(n, _)| n.eq_ignore_ascii_case(p.name))
+                .count();
+            assert_eq!(held, 1, "{}", p.name);
+            assert!(field_of(table, p).is_some());
+        }
     }
 
     #[test]
-    fn each_table_is_its_groups_parameters_in_the_schemas_order() {
+    fn each_table_holds_each_parameter_of_its_group_once() {
         let mut p = crate::params::BLANK;
-        let names: Vec<_> = controller_fields(&mut p).iter().map(|(n, _)| *n).collect();
-        assert_eq!(names, group(Group::Controller));
+        coverage(&mut controller_fields(&mut p), Group::Controller);
         let mut c = AdaptimpCartesianParams::default();
-        let names: Vec<_> = cartesian_fields(&mut c).iter().map(|(n, _)| *n).collect();
-        assert_eq!(names, group(Group::Cartesian));
+        coverage(&mut cartesian_fields(&mut c), Group::Cartesian);
     }
 
     #[test]
     fn the_c_enums_follow_the_schemas_choice_order() {
-        fn check<E: Choice>() {
-            assert_eq!(E::ALL.len(), E::NAMES.len(), "{}", E::NAME);
-            for (c, name) in E::ALL.iter().zip(E::NAMES) {
-                assert_eq!(format!("{c:?}").to_lowercase(), *name, "{}", E::NAME);
+        fn check<E: CEnum>(name: &str) {
+            let names = names(param(name).unwrap().kind);
+            assert_eq!(E::ALL.len(), names.len(), "{}", E::NAME);
+            for (c, n) in E::ALL.iter().zip(names) {
+                assert_eq!(format!("{c:?}").to_lowercase(), *n, "{}", E::NAME);
             }
         }
-        check::<AdaptimpAuxLaw>();
-        check::<AdaptimpConditions>();
-        check::<AdaptimpFormulation>();
-        check::<AdaptimpRobust>();
-        check::<AdaptimpLearningStep>();
-        check::<AdaptimpSaturationLearning>();
-        check::<AdaptimpObserverInit>();
-        check::<AdaptimpObserverHold>();
-        check::<AdaptimpImpedance>();
-        check::<AdaptimpFallback>();
-        check::<AdaptimpFaultPolicy>();
+        check::<AdaptimpAuxLaw>("aux_law");
+        check::<AdaptimpConditions>("conditions");
+        check::<AdaptimpFormulation>("formulation");
+        check::<AdaptimpRobust>("robust");
+        check::<AdaptimpLearningStep>("learning_step");
+        check::<AdaptimpSaturationLearning>("saturation_learning");
+        check::<AdaptimpObserverInit>("observer_init");
+        check::<AdaptimpObserverHold>("observer_hold");
+        check::<AdaptimpImpedance>("impedance");
+        check::<AdaptimpFallback>("fallback");
+        check::<AdaptimpFaultPolicy>("fault_policy");
     }
 }

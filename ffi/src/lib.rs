@@ -374,6 +374,11 @@ macro_rules! c_enums {
                     $raw(v as u32)
                 }
             }
+            impl<'a> From<&'a mut $raw> for fields::Field<'a> {
+                fn from(raw: &'a mut $raw) -> Self {
+                    fields::Field::choice::<$e>(&mut raw.0)
+                }
+            }
         )+
         /// The enum and value of the ABI that integer `raw` is, if any.
         fn describe(raw: u32) -> Option<(&'static str, String)> {

@@ -4,7 +4,7 @@
 use crate::fields::{controller_fields, read_into, write_from};
 use crate::*;
 use adaptimp::dynamic::{Basis, Centres, Controller, Inertia, Scenario, TaskPath, Tuning};
-use adaptimp::schema::Preset;
+use adaptimp::schema::{Group, Preset};
 use adaptimp::Law;
 
 /// Every parameter of a controller for `n` joints (1…7): the fields of the
@@ -166,7 +166,13 @@ pub(crate) fn scenario_of(p: &AdaptimpParams) -> Result<Scenario, AdaptimpStatus
     let law = law_of(decode::<AdaptimpLaw>(p.law, "params.law")?);
     let mut s = Scenario::new(n, Preset::Paper, law).map_err(|e| core_error(e, Context::Config))?;
     let mut p = *p;
-    read_into(&mut s, n, controller_fields(&mut p), "params")?;
+    read_into(
+        &mut s,
+        n,
+        Group::Controller,
+        controller_fields(&mut p),
+        "params",
+    )?;
     Ok(s)
 }
 
@@ -255,7 +261,7 @@ pub(crate) fn params_of(s: &Scenario) -> AdaptimpParams {
         law: law_raw(s.law()),
         ..BLANK
     };
-    write_from(s, &mut controller_fields(&mut p));
+    write_from(s, Group::Controller, controller_fields(&mut p));
     p
 }
 

@@ -205,7 +205,13 @@ pub(super) fn cartesian_of(p: &AdaptimpCartesianParams) -> Result<CartesianConfi
     let mut s =
         Scenario::new(1, Preset::Robot, Law::Pd).map_err(|e| core_error(e, Context::Config))?;
     let mut p = *p;
-    read_into(&mut s, 1, cartesian_fields(&mut p), "cart")?;
+    read_into(
+        &mut s,
+        1,
+        Group::Cartesian,
+        cartesian_fields(&mut p),
+        "cart",
+    )?;
     Ok(s.cartesian())
 }
 
@@ -225,7 +231,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_params_default(
         let s =
             Scenario::new(1, Preset::Robot, Law::Pd).map_err(|e| core_error(e, Context::Config))?;
         let mut p = AdaptimpCartesianParams::default();
-        write_from(&s, &mut cartesian_fields(&mut p));
+        write_from(&s, Group::Cartesian, cartesian_fields(&mut p));
         *out = p;
         Ok(())
     })

@@ -6,8 +6,8 @@
 
 use crate::fields::{cartesian_fields, read_into, write_from};
 use crate::handles::{buffer_size, free, handle, handle_mut, publish, publish_in, Buf, Header};
-use crate::joint::{copy_sized, fault_of};
 use crate::params::controller_of;
+use crate::shared::{self, answer, front_step, step_entry, HoldsJoint, Output};
 use crate::*;
 use adaptimp::cartesian::rotation::quaternion_matrix;
 use adaptimp::dynamic::{

@@ -2,6 +2,7 @@
 //! caller buffer), the step, snapshots.
 
 use crate::handles::{buffer_size, free, handle, handle_mut, publish, publish_in, Buf, Header};
+use crate::shared::{self, answer, front_step, step_entry, HoldsJoint, Output};
 use crate::*;
 use adaptimp::dynamic::{Command, Controller, Measurement, Setpoint, State};
 use core::ffi::c_void;
@@ -312,25 +313,8 @@ pub unsafe extern "C" fn adaptimp_state_reset(state: *mut AdaptimpState) -> Adap
 /// `state` is NULL or valid; `step` is NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_state_fault(state: *const AdaptimpState, step: *mut u64) -> bool {
-    // SAFETY (in `handle`): checked for NULL and for a live handle.
-    let Ok(s) = (unsafe { handle(state, "state") }) else {
-        return false;
-    };
-    fault_of(s.state.fault(), step)
-}
-
-/// Whether there is a fault, its step written to `step` if not NULL.
-pub(crate) fn fault_of(fault: Option<adaptimp::Fault>, step: *mut u64) -> bool {
-    match fault {
-        Some(f) => {
-            if !step.is_null() {
-                // SAFETY: non-NULL; the caller's contract.
-                unsafe { *step = f.step };
-            }
-            true
-        }
-        None => false,
-    }
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_fault(state, step) }
 }
 
 /// Clear the recorded fault: the documented recovery after a latched fault
@@ -340,12 +324,8 @@ pub(crate) fn fault_of(fault: Option<adaptimp::Fault>, step: *mut u64) -> bool {
 /// `state` is NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_state_clear_fault(state: *mut AdaptimpState) -> AdaptimpStatus {
-    guard(|| {
-        // SAFETY (in `handle_mut`): checked for NULL and for a live handle.
-        let s = unsafe { handle_mut(state, "state") }?;
-        s.state.clear_fault();
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_clear_fault(state) }
 }
 
 /// Steps taken since creation or reset, or 0 for NULL or a dead handle.
@@ -354,11 +334,8 @@ pub unsafe extern "C" fn adaptimp_state_clear_fault(state: *mut AdaptimpState) -
 /// `state` is NULL or valid.
 #[no_mangle]
 pub unsafe extern "C" fn adaptimp_state_steps(state: *const AdaptimpState) -> u64 {
-    // SAFETY (in `handle`): checked for NULL and for a live handle.
-    match unsafe { handle(state, "state") } {
-        Ok(s) => s.state.steps(),
-        Err(_) => 0,
-    }
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_steps(state) }
 }
 
 /// The torque to apply now (N m) into `tau` (`n` reals, the state's number
@@ -374,28 +351,8 @@ pub unsafe extern "C" fn adaptimp_state_applied(
     n: usize,
     tau: *mut f64,
 ) -> AdaptimpStatus {
-    guard(|| {
-        // SAFETY (in the helpers): checked for NULL; the caller's contract.
-        let s = unsafe { handle(state, "state") }?;
-        let tau = unsafe { slice_mut(tau, n, "tau") }?;
-        copy_sized(&s.state.applied(), tau, "tau")
-    })
-}
-
-/// `src` into `dst` if their lengths match, else BadSize naming `what`.
-pub(crate) fn copy_sized(src: &[f64], dst: &mut [f64], what: &str) -> Result<(), AdaptimpStatus> {
-    if src.len() != dst.len() {
-        return Err(fail(
-            AdaptimpStatus::BadSize,
-            &format_args!(
-                "{what}: n = {}, but the state has {} joints",
-                dst.len(),
-                src.len()
-            ),
-        ));
-    }
-    dst.copy_from_slice(src);
-    Ok(())
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_applied(state, n, tau) }
 }
 
 /// The number of reals [`adaptimp_state_save`] writes for this state,
@@ -510,38 +467,56 @@ pub unsafe extern "C" fn adaptimp_step(
     setpoint: *const AdaptimpSetpoint,
     out: *mut AdaptimpCommand,
 ) -> AdaptimpStatus {
-    let status = guard(|| {
-        // SAFETY (in the helpers): each pointer checked for NULL; the caller's contract.
-        let mut cmd = unsafe { out.as_mut() };
-        if let Some(o) = cmd.as_deref_mut() {
-            *o = AdaptimpCommand::ZERO;
-        }
-        let c = unsafe { handle(ctrl, "ctrl") }?;
-        let s = unsafe { handle_mut(state, "state") }?;
-        let args = StepArgs {
-            n,
-            q,
-            dq,
-            tau_e,
-            setpoint,
-        };
-        same_joints(c.ctrl.n(), s.state.n(), "controller")?;
-        step_checked(&c.ctrl, &mut s.state, &args, cmd)
-    });
-    if status == AdaptimpStatus::Internal && !out.is_null() {
-        // SAFETY: non-NULL; the caller's contract.
-        unsafe { *out = AdaptimpCommand::ZERO };
+    // SAFETY (in the helpers): each pointer checked for NULL; the caller's contract.
+    unsafe {
+        step_entry(out, |cmd| {
+            let c = handle(ctrl, "ctrl")?;
+            let s = handle_mut(state, "state")?;
+            same_joints(c.ctrl.n(), s.state.n(), "controller")?;
+            let inputs = |n| {
+                let q = slice(q, n, "q")?;
+                let tau_e = slice(tau_e, n, "tau_e")?;
+                let dq = if dq.is_null() {
+                    None
+                } else {
+                    Some(slice(dq, n, "dq")?)
+                };
+                let sp = if setpoint.is_null() {
+                    None
+                } else {
+                    Some(read(setpoint, "setpoint")?)
+                };
+                Ok((
+                    Measurement {
+                        x: q,
+                        dx: dq,
+                        tau_e,
+                    },
+                    sp,
+                ))
+            };
+            front_step(
+                &c.ctrl,
+                &mut s.state,
+                n,
+                "controller",
+                cmd,
+                inputs,
+                |(m, sp), s, out| {
+                    let sp = sp.map(|sp| Setpoint {
+                        x: &sp.x[..m.x.len()],
+                        dx: &sp.dx[..m.x.len()],
+                        ddx: &sp.ddx[..m.x.len()],
+                    });
+                    answer(
+                        c.ctrl.step_or_fallback(s, &m, sp.as_ref()),
+                        out,
+                        write_command,
+                    )
+                },
+            )
+        })
     }
-    status
-}
-
-/// A step's pointers, as the caller gave them.
-struct StepArgs {
-    n: usize,
-    q: *const f64,
-    dq: *const f64,
-    tau_e: *const f64,
-    setpoint: *const AdaptimpSetpoint,
 }
 
 /// A state of `ctrl` over `buf`, at t = 0.
@@ -555,90 +530,29 @@ fn state_over(ctrl: &Controller, buf: Buf) -> Result<StateObject, AdaptimpStatus
     })
 }
 
-/// The fallback of a step the front refused (`status` already recorded as
-/// the last error): the refusal recorded in the state as the core records
-/// one, the fallback written.
-fn refused(
-    c: &Controller,
-    s: &mut State<Buf>,
-    out: Option<&mut AdaptimpCommand>,
-    status: AdaptimpStatus,
-) -> AdaptimpStatus {
-    let tau = c.refuse(s, BAD_ARGUMENTS);
-    if let Some(out) = out {
-        write_fallback(tau.as_deref(), out);
+impl Output for AdaptimpCommand {
+    fn zero() -> Self {
+        Self::ZERO
     }
-    status
-}
-
-/// The step of a controller and a state of the same n.
-fn step_checked(
-    c: &Controller,
-    s: &mut State<Buf>,
-    a: &StepArgs,
-    out: Option<&mut AdaptimpCommand>,
-) -> Result<(), AdaptimpStatus> {
-    let n = c.n();
-    if let Err(status) = check_n(a.n, n, "controller") {
-        return Err(refused(c, s, out, status));
-    }
-    let Some(out) = out else {
-        return Err(refused(c, s, None, null("out")));
-    };
-    // SAFETY (in `slice`, `read`): checked for NULL; the caller's contract.
-    let inputs = (|| {
-        let q = unsafe { slice(a.q, n, "q") }?;
-        let tau_e = unsafe { slice(a.tau_e, n, "tau_e") }?;
-        let dq = if a.dq.is_null() {
-            None
-        } else {
-            Some(unsafe { slice(a.dq, n, "dq") }?)
-        };
-        let sp = if a.setpoint.is_null() {
-            None
-        } else {
-            Some(unsafe { read(a.setpoint, "setpoint") }?)
-        };
-        Ok((q, tau_e, dq, sp))
-    })();
-    let (q, tau_e, dq, sp) = match inputs {
-        Ok(v) => v,
-        Err(status) => return Err(refused(c, s, Some(out), status)),
-    };
-    let m = Measurement {
-        x: q,
-        dx: dq,
-        tau_e,
-    };
-    let setpoint = sp.map(|sp| Setpoint {
-        x: &sp.x[..n],
-        dx: &sp.dx[..n],
-        ddx: &sp.ddx[..n],
-    });
-    match c.step_or_fallback(s, &m, setpoint.as_ref()) {
-        (_, Ok(cmd)) => {
-            write_command(&cmd, out);
-            Ok(())
-        }
-        (fallback, Err(e)) => {
-            write_fallback(fallback.as_deref(), out);
-            Err(core_error(e, Context::Step))
-        }
-    }
-}
-
-/// A refused step's output: the fallback to apply (none: no controller
-/// answered, n = 0), n, every other field zero.
-pub(crate) fn write_fallback(tau: Option<&[f64]>, out: &mut AdaptimpCommand) {
-    *out = AdaptimpCommand::ZERO;
-    if let Some(tau) = tau {
+    fn fallback(tau: &[f64]) -> Self {
+        let mut out = Self::ZERO;
         out.n = tau.len();
         out.tau_sat[..tau.len()].copy_from_slice(tau);
+        out
+    }
+}
+
+impl HoldsJoint for AdaptimpState {
+    fn joint(o: &StateObject) -> &State<Buf> {
+        &o.state
+    }
+    fn joint_mut(o: &mut StateObject) -> &mut State<Buf> {
+        &mut o.state
     }
 }
 
 /// An accepted step's output, n = the command's joints.
-pub(crate) fn write_command(cmd: &Command, out: &mut AdaptimpCommand) {
+fn write_command(cmd: &Command, out: &mut AdaptimpCommand) {
     let n = cmd.tau_sat.len();
     out.n = n;
     for (dst, src) in [

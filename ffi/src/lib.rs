@@ -675,6 +675,7 @@ mod cartesian;
 mod fields;
 mod joint;
 mod params;
+mod shared;
 mod urdf;
 
 pub use cartesian::*;

@@ -200,59 +200,11 @@ pub(crate) unsafe fn controller_of(p: &AdaptimpParams) -> Result<Controller, Ada
     s.controller().map_err(|e| core_error(e, Context::Config))
 }
 
-/// Every field zero but the limits (INFINITY: none), no centres: what
-/// [`params_of`] fills in.
-pub(crate) const BLANK: AdaptimpParams = AdaptimpParams {
-    n: 0,
-    law: AdaptimpLawRaw(0),
-    ts: 0.0,
-    delay: 0,
-    k1: [0.0; ADAPTIMP_MAX_JOINTS],
-    kp: [0.0; ADAPTIMP_MAX_JOINTS],
-    kzeta: [0.0; ADAPTIMP_MAX_JOINTS],
-    inertia: [0.0; ADAPTIMP_MAX_JOINTS],
-    rho: 0.0,
-    conditions: AdaptimpConditionsRaw(0),
-    mu: 0.0,
-    aux_law: AdaptimpAuxLawRaw(0),
-    robust: AdaptimpRobustRaw(0),
-    kr: [0.0; ADAPTIMP_MAX_JOINTS],
-    phi: 0.0,
-    k_remark1: [0.0; 3],
-    learning_step: AdaptimpLearningStepRaw(0),
-    kappa: 0.0,
-    saturation_learning: AdaptimpSaturationLearningRaw(0),
-    weight_bound_mode: AdaptimpWeightBoundRaw(0),
-    weight_bound: [0.0; 3],
-    gamma: [0.0; 3],
-    sigma: [0.0; 3],
-    eps: 0.0,
-    lam1: [0.0; ADAPTIMP_MAX_JOINTS],
-    observer_init: AdaptimpObserverInitRaw(0),
-    observer_hold: AdaptimpObserverHoldRaw(0),
-    observer_lead: AdaptimpBoolRaw(0),
-    tau_max: [0.0; ADAPTIMP_MAX_JOINTS],
-    dd: [0.0; ADAPTIMP_MAX_JOINTS],
-    cd: [0.0; ADAPTIMP_MAX_JOINTS],
-    gd: [0.0; ADAPTIMP_MAX_JOINTS],
-    impedance: AdaptimpImpedanceRaw(0),
-    eta2: 0.0,
-    centers: std::ptr::null(),
-    nodes: 0,
-    widths2: std::ptr::null(),
-    xc_offset: [0.0; ADAPTIMP_MAX_JOINTS],
-    xc_sin: [0.0; ADAPTIMP_MAX_JOINTS],
-    xc_cos: [0.0; ADAPTIMP_MAX_JOINTS],
-    xc_omega: [0.0; ADAPTIMP_MAX_JOINTS],
-    fallback: AdaptimpFallbackRaw(0),
-    fallback_damping: [0.0; ADAPTIMP_MAX_JOINTS],
-    fault_policy: AdaptimpFaultPolicyRaw(0),
-    q_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-    dq_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-    tau_e_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-    q_jump_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-    tau_rate_max: [f64::INFINITY; ADAPTIMP_MAX_JOINTS],
-};
+/// Every field zero, no centres: what [`params_of`] fills in (the
+/// schema's none of a limit is written as INFINITY).
+// SAFETY: every field is a number, a C enum's or bool's integer, or a
+// pointer, for each of which all-zero bytes are a value (NULL for a pointer).
+pub(crate) const BLANK: AdaptimpParams = unsafe { std::mem::zeroed() };
 
 /// The controller parameters of scenario `s` (centres: none).
 pub(crate) fn params_of(s: &Scenario) -> AdaptimpParams {

@@ -308,11 +308,8 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_fault(
     state: *const AdaptimpCartesianState,
     step: *mut u64,
 ) -> bool {
-    // SAFETY (in `handle`): checked.
-    let Ok(s) = (unsafe { handle(state, "state") }) else {
-        return false;
-    };
-    fault_of(s.joint.fault(), step)
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_fault(state, step) }
 }
 
 /// Clear the recorded fault (as [`adaptimp_state_clear_fault`]).
@@ -323,12 +320,8 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_fault(
 pub unsafe extern "C" fn adaptimp_cartesian_state_clear_fault(
     state: *mut AdaptimpCartesianState,
 ) -> AdaptimpStatus {
-    guard(|| {
-        // SAFETY (in `handle_mut`): checked.
-        let s = unsafe { handle_mut(state, "state") }?;
-        s.joint.clear_fault();
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_clear_fault(state) }
 }
 
 /// Steps taken since creation or reset, or 0 for NULL or a dead handle.
@@ -339,11 +332,8 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_clear_fault(
 pub unsafe extern "C" fn adaptimp_cartesian_state_steps(
     state: *const AdaptimpCartesianState,
 ) -> u64 {
-    // SAFETY (in `handle`): checked.
-    match unsafe { handle(state, "state") } {
-        Ok(s) => s.joint.steps(),
-        Err(_) => 0,
-    }
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_steps(state) }
 }
 
 /// The torque to apply now (N m, `n` reals), as [`adaptimp_state_applied`].
@@ -356,12 +346,8 @@ pub unsafe extern "C" fn adaptimp_cartesian_state_applied(
     n: usize,
     tau: *mut f64,
 ) -> AdaptimpStatus {
-    guard(|| {
-        // SAFETY (in the helpers): checked; the caller's contract.
-        let s = unsafe { handle(state, "state") }?;
-        let tau = unsafe { slice_mut(tau, n, "tau") }?;
-        copy_sized(&s.joint.applied(), tau, "tau")
-    })
+    // SAFETY: the caller's contract.
+    unsafe { shared::state_applied(state, n, tau) }
 }
 
 /// The unit quaternion `quat` = [w, x, y, z] as `target`'s rotation matrix
@@ -421,118 +407,73 @@ pub unsafe extern "C" fn adaptimp_cartesian_step(
     target: *const AdaptimpPoseTarget,
     out: *mut AdaptimpCartesianCommand,
 ) -> AdaptimpStatus {
-    let status = guard(|| {
-        // SAFETY (in the helpers): each pointer checked for NULL; the caller's contract.
-        let mut cmd = unsafe { out.as_mut() };
-        if let Some(o) = cmd.as_deref_mut() {
-            *o = AdaptimpCartesianCommand::ZERO;
+    // SAFETY (in the helpers): each pointer checked for NULL; the caller's contract.
+    unsafe {
+        step_entry(out, |cmd| {
+            let c = handle(cart, "cart")?;
+            let s = handle_mut(state, "state")?;
+            same_joints(c.pair.joint().n(), s.joint.n(), "Cartesian controller")?;
+            let inputs = |n| {
+                let q = slice(q, n, "q")?;
+                let wrench = slice(wrench, 6, "wrench")?;
+                let dq = if dq.is_null() {
+                    None
+                } else {
+                    Some(slice(dq, n, "dq")?)
+                };
+                let target = if target.is_null() {
+                    None
+                } else {
+                    Some(read(target, "target")?)
+                };
+                let wrench = Vector::<6>::from_column_slice(wrench);
+                Ok((
+                    CartesianMeasurement { q, dq, wrench },
+                    target.map(pose_target),
+                ))
+            };
+            let CartesianStateObject { outer, joint, .. } = s;
+            let what = "Cartesian controller";
+            front_step(
+                c.pair.joint(),
+                joint,
+                n,
+                what,
+                cmd,
+                inputs,
+                |(m, t), joint, out| {
+                    let answered = c.pair.step_or_fallback(outer, joint, &m, t.as_ref());
+                    answer(answered, out, write_cartesian)
+                },
+            )
+        })
+    }
+}
+
+impl Output for AdaptimpCartesianCommand {
+    fn zero() -> Self {
+        Self::ZERO
+    }
+    fn fallback(tau: &[f64]) -> Self {
+        Self {
+            n: tau.len(),
+            tau_sat: joints7(tau),
+            ..Self::ZERO
         }
-        let c = unsafe { handle(cart, "cart") }?;
-        let s = unsafe { handle_mut(state, "state") }?;
-        let args = CartArgs {
-            n,
-            q,
-            dq,
-            wrench,
-            target,
-        };
-        same_joints(c.pair.joint().n(), s.joint.n(), "Cartesian controller")?;
-        cart_step(&c.pair, s, &args, cmd)
-    });
-    if status == AdaptimpStatus::Internal && !out.is_null() {
-        // SAFETY: non-NULL; the caller's contract.
-        unsafe { *out = AdaptimpCartesianCommand::ZERO };
-    }
-    status
-}
-
-/// A Cartesian step's pointers, as the caller gave them.
-pub(super) struct CartArgs {
-    pub(super) n: usize,
-    pub(super) q: *const f64,
-    pub(super) dq: *const f64,
-    pub(super) wrench: *const f64,
-    pub(super) target: *const AdaptimpPoseTarget,
-}
-
-/// A refused step's output: the fallback to apply (none: no controller
-/// answered, n = 0), n, the rest zero.
-pub(super) fn write_fallback(tau: Option<&[f64]>, out: &mut AdaptimpCartesianCommand) {
-    *out = AdaptimpCartesianCommand::ZERO;
-    if let Some(tau) = tau {
-        out.n = tau.len();
-        out.tau_sat = joints7(tau);
     }
 }
 
-/// The refusal of a step the front refused (`status` already the last error).
-pub(super) fn refused(
-    pair: &CartesianController,
-    s: &mut CartesianStateObject,
-    out: Option<&mut AdaptimpCartesianCommand>,
-    status: AdaptimpStatus,
-) -> AdaptimpStatus {
-    let tau = pair.joint().refuse(&mut s.joint, BAD_ARGUMENTS);
-    if let Some(out) = out {
-        write_fallback(tau.as_deref(), out);
+impl HoldsJoint for AdaptimpCartesianState {
+    fn joint(o: &CartesianStateObject) -> &State<Buf> {
+        &o.joint
     }
-    status
-}
-
-/// The step of a Cartesian controller and a state of the same n.
-pub(super) fn cart_step(
-    pair: &CartesianController,
-    s: &mut CartesianStateObject,
-    a: &CartArgs,
-    out: Option<&mut AdaptimpCartesianCommand>,
-) -> Result<(), AdaptimpStatus> {
-    let n = pair.joint().n();
-    if let Err(status) = check_n(a.n, n, "Cartesian controller") {
-        return Err(refused(pair, s, out, status));
-    }
-    let Some(out) = out else {
-        return Err(refused(pair, s, None, null("out")));
-    };
-    // SAFETY (in `slice`, `read`): checked for NULL; the caller's contract.
-    let inputs = (|| {
-        let q = unsafe { slice(a.q, n, "q") }?;
-        let wrench = unsafe { slice(a.wrench, 6, "wrench") }?;
-        let dq = if a.dq.is_null() {
-            None
-        } else {
-            Some(unsafe { slice(a.dq, n, "dq") }?)
-        };
-        let target = if a.target.is_null() {
-            None
-        } else {
-            Some(unsafe { read(a.target, "target") }?)
-        };
-        Ok((q, wrench, dq, target))
-    })();
-    let (q, wrench, dq, target) = match inputs {
-        Ok(v) => v,
-        Err(status) => return Err(refused(pair, s, Some(out), status)),
-    };
-    let m = CartesianMeasurement {
-        q,
-        dq,
-        wrench: Vector::<6>::from_column_slice(wrench),
-    };
-    let target = target.map(pose_target);
-    match pair.step_or_fallback(&mut s.outer, &mut s.joint, &m, target.as_ref()) {
-        (_, Ok(cmd)) => {
-            write_cartesian(&cmd, out);
-            Ok(())
-        }
-        (fallback, Err(e)) => {
-            write_fallback(fallback.as_deref(), out);
-            Err(core_error(e, Context::Step))
-        }
+    fn joint_mut(o: &mut CartesianStateObject) -> &mut State<Buf> {
+        &mut o.joint
     }
 }
 
 /// An accepted step's output.
-pub(super) fn write_cartesian(cmd: &CartesianCommand, out: &mut AdaptimpCartesianCommand) {
+fn write_cartesian(cmd: &CartesianCommand, out: &mut AdaptimpCartesianCommand) {
     out.n = cmd.joint.tau_sat.len();
     out.tau_sat = joints7(&cmd.joint.tau_sat);
     out.tau = joints7(&cmd.joint.tau);

@@ -376,7 +376,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         // every signal and weight within BOUND nothing below can overflow.
         let cmd = self.command(st, m, c, &e, &v, &staged.reference, task.as_ref())?;
         staged.reference = next;
-        self.advance(st, staged, m, &e, &cmd);
+        self.advance(st, &mut staged, m, &e, &cmd);
         Ok(cmd)
     }
 
@@ -488,7 +488,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     fn advance<S>(
         &self,
         st: &mut State<N, S>,
-        mut staged: Staged<N>,
+        staged: &mut Staged<N>,
         m: &Measurement<N>,
         e: &Errors<N>,
         cmd: &Command<N>,

@@ -1,6 +1,7 @@
 """A joint reference written in Python tabulated by the bindings
-(``_adaptimp.tabulate_joints``): the rows the Python loop of
-``adaptimp.mujoco`` makes, bit for bit, and a wrong value named."""
+(``_adaptimp.tabulate_joints``, the one tabulation ``adaptimp.mujoco``'s
+runs use): the reference's own values at t_k = (start + k)·Ts, bit for bit,
+and a wrong value named."""
 
 from __future__ import annotations
 
@@ -23,10 +24,12 @@ def _reference(t: float) -> tuple[np.ndarray, np.ndarray, list[float]]:
 
 def test_the_tables_are_the_python_loops() -> None:
     got = _adaptimp.tabulate_joints(_reference, 250, 1e-3, 3, 7, "reference(t)", _array)
-    want = am._tabulate(_reference, 250, 1e-3, 7)
-    for g, w in zip(got, want):
+    rows = [_reference((7 + k) * 1e-3) for k in range(250)]
+    want = [np.array([np.asarray(r[i], dtype=np.float64) for r in rows]) for i in range(3)]
+    for g, w, run in zip(got, want, am._tabulate(_reference, 250, 1e-3, 3, 7)):
         assert g.shape == (250, 3)
         assert np.array_equal(g, w)
+        assert np.array_equal(run, w)  # what a run of adaptimp.mujoco tabulates
 
 
 def test_a_wrong_value_is_named() -> None:

@@ -225,36 +225,12 @@ def chain_of(plant: Any) -> Chain:
     site, or the origin of its end-effector body), the joints in the plant's
     order."""
     m = plant.model
-    site = int(getattr(plant, "_site", -1))
-    if site >= 0:
-        chain = Chain.from_mujoco(m, site)
-    else:
-        bodies, b = [], int(plant._ee_body)
-        while b != 0:
-            bodies.append(b)
-            b = int(m.body_parentid[b])
-        joints: list[dict[str, Any]] = []
-        names: list[str] = []
-        for b in reversed(bodies):
-            joints.append(
-                {"kind": "fixed", "pos": m.body_pos[b].tolist(), "quat": m.body_quat[b].tolist()}
-            )
-            for j in range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b])):
-                anchor = m.jnt_pos[j].tolist()
-                joints.append(
-                    {
-                        "kind": "revolute",
-                        "pos": anchor,
-                        "axis": m.jnt_axis[j].tolist(),
-                        "offset": float(m.qpos0[m.jnt_qposadr[j]]),
-                    }
-                )
-                joints.append({"kind": "fixed", "pos": [-x for x in anchor]})
-                names.append(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint{j}")
-        label = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(plant._ee_body))
-        chain = Chain(joints, None, names=names, source=f"MuJoCo model to body {label!r}")
+    site, body = int(plant._site), int(plant._ee_body)
+    tip = site if site >= 0 else mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body)
+    # The core's one reader of the chain (SPEC §21), to a site or a body's origin.
+    chain = Chain.from_mujoco(m, tip if tip is not None else f"body#{body}")
     plant_joints = [
-        mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(j)) or f"joint{int(j)}"
+        mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(j)) or f"joint#{int(j)}"
         for j in plant._joints
     ]
     if chain.joint_names != plant_joints:

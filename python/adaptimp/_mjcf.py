@@ -269,17 +269,22 @@ def _symmetric(lo: float, hi: float, what: str) -> float:
 
 
 def estimate(
-    m: mujoco.MjModel, qadr: Sequence[int], dofs: Sequence[int], postures: int = 256
+    m: mujoco.MjModel,
+    qadr: Sequence[int],
+    dofs: Sequence[int],
+    postures: int = 256,
+    *,
+    drag: bool = True,
 ) -> FloatArray:
     """τmax (N m) per arm joint where nothing declares it: 2 (max |G_i| + 10
     rad/s² · max Σ_j |D_ij| + b_i · 1 rad/s + F_i) over ``postures`` postures
     within the joint limits, by the core's one rule
-    (``_adaptimp.estimate_effort``, the URDF estimate's
-    :func:`adaptimp.mujoco.estimate_effort` with the drag terms; D with the
-    rotors' armature): the joint's own viscous damping b_i at 1 rad/s and
-    dry friction F_i (``frictionloss``), which a file
-    may make the larger part (metaworld's Sawyer: b = 10 N m s/rad on a wrist
-    of 0.01 kg m²). G and D are MuJoCo's at each posture."""
+    (``_adaptimp.estimate_effort``; D with the rotors' armature). With
+    ``drag``, the joint's own viscous damping b_i at 1 rad/s and dry friction
+    F_i (``frictionloss``), which a file may make the larger part
+    (metaworld's Sawyer: b = 10 N m s/rad on a wrist of 0.01 kg m²); without
+    it (a URDF's arm, :func:`adaptimp.mujoco.estimate_effort`), b = F = 0. G
+    and D are MuJoCo's at each posture."""
     from . import _adaptimp
 
     joints = [int(m.dof_jntid[d]) for d in dofs]
@@ -297,8 +302,10 @@ def estimate(
         _full_inertia(m, data, full)
         g[k] = data.qfrc_bias[list(dofs)]
         d[k] = full[np.ix_(dofs, dofs)]
-    drag = (m.dof_damping[list(dofs)], m.dof_frictionloss[list(dofs)])
-    return np.asarray(_adaptimp.estimate_effort(g, d, *drag), dtype=np.float64)
+    if not drag:
+        return np.asarray(_adaptimp.estimate_effort(g, d), dtype=np.float64)
+    drag_terms = (m.dof_damping[list(dofs)], m.dof_frictionloss[list(dofs)])
+    return np.asarray(_adaptimp.estimate_effort(g, d, *drag_terms), dtype=np.float64)
 
 
 def _label(path: str | os.PathLike[str] | None) -> str:
@@ -887,21 +894,29 @@ def moving_contacts(
     return out
 
 
-def end_effector(m: mujoco.MjModel, tip: str | None, last_body: int) -> tuple[int, int]:
-    """The end effector as (site id or −1, body): ``tip`` (a site, or a body:
-    its origin); else the site of the first force sensor, or the first site
-    on the last arm joint's body ``last_body``, or that body's origin."""
-    if tip is not None:
-        body, kind = resolve_tip(m, tip)
-        if kind == "site":
-            return mujoco.mj_name2id(m, _OBJ.mjOBJ_SITE, tip), body
+def end_effector(m: mujoco.MjModel, tip: str) -> tuple[int, int]:
+    """The end effector ``tip`` as (site id or −1, body): a site (a site first
+    if a body has the name too, ``site#i`` for an unnamed one), or a body (its
+    origin; a link of the core's tree, :func:`_body_of`). ``tip`` is the one
+    asked for, or the one the core's reduction found (:func:`arm_of`'s
+    ``"tip"``: the site of a force sensor a hinge of the arm moves, else the
+    body of the last arm joint; SPEC (21.2)).
+
+    Raises
+    ------
+    ValueError
+        Neither a site nor a body has the name (:func:`resolve_tip`'s message).
+    """
+    sid = mujoco.mj_name2id(m, _OBJ.mjOBJ_SITE, tip)
+    if sid < 0 and tip.startswith("site#") and tip[5:].isdigit() and int(tip[5:]) < m.nsite:
+        sid = int(tip[5:])
+    if sid >= 0:
+        return sid, int(m.site_bodyid[sid])
+    body = _body_of(m, tip)
+    if body > 0:
         return -1, body
-    for s in range(m.nsensor):
-        if m.sensor_type[s] == int(mujoco.mjtSensor.mjSENS_FORCE):
-            sid = int(m.sensor_objid[s])
-            return sid, int(m.site_bodyid[sid])
-    on_last = [s for s in range(m.nsite) if int(m.site_bodyid[s]) == last_body]
-    return (on_last[0], last_body) if on_last else (-1, last_body)
+    resolve_tip(m, tip)  # raises, naming the bodies
+    raise AssertionError("unreachable")
 
 
 class Contacts:

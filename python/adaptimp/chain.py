@@ -167,9 +167,9 @@ class Chain(_adaptimp.Chain):
         ``tip`` is a site (its frame) or a body (its frame, the point MuJoCo's
         ``mj_jacBody`` differentiates), by name (a site first if both have
         it), or a site id; ``site=`` is the earlier keyword for a site. By
-        default the plant's end effector (:class:`adaptimp.mujoco.Plant`): the
-        site of the model's force sensor, or the first site of the last arm
-        joint's body, or that body. The chain's joints are the arm's
+        default the plant's end effector (:class:`adaptimp.mujoco.Plant`), the
+        core's rule (SPEC (21.2)): the site of a force sensor that a hinge of
+        the arm moves, else the last arm joint's body. The chain's joints are the arm's
         (the core's one reduction, SPEC §21: the hinges and slides on the way
         to the tip that it does not hold, a gripper's coupled joints and those
         named in ``fix``); any other joint on the way is held at its
@@ -230,10 +230,9 @@ class Chain(_adaptimp.Chain):
                 body = int(model.site_bodyid[sid])
             elif tip is None:
                 found = _mjcf.arm_of(model, None, tuple(fix))
-                last = int(model.jnt_bodyid[found["joint_ids"][-1]])
-                sid, body = _mjcf.end_effector(model, None, last)
+                sid, body = _mjcf.end_effector(model, found["tip"])
             else:
-                sid, body = _mjcf.end_effector(model, str(tip), 0)
+                sid, body = _mjcf.end_effector(model, str(tip))
         except ValueError as e:
             raise ConfigError(str(e)) from None
         # The chain to that site or body by the core's one reduction (SPEC

@@ -25,8 +25,8 @@ so the site should sit on a massless body welded to the last link, holding the
 contact geometry: then the reading is exactly the contact wrench (the packaged
 models do this). Without a force sensor, F_e is the net force of the active
 contacts between the end-effector body's subtree and anything outside it,
-with the moment about the end-effector point (the first site on the last
-joint's body, or that body's origin): for a model :class:`Plant` loads from a
+with the moment about the end-effector point (the plant's ``tip``, by
+default the last arm joint's body's origin): for a model :class:`Plant` loads from a
 file and in which no contact can arise inside that subtree, from a contact
 sensor it adds (the net contact wrench on the subtree, ``reduce="netforce"``;
 it changes no dynamics); otherwise from the external forces MuJoCo sums from
@@ -226,11 +226,6 @@ def _compile_arm(spec: Any, note: str = "", *, stacklevel: int = 3) -> mujoco.Mj
         return model
 
 
-EFFORT_ACCEL = 10.0
-"""The acceleration (rad/s²) an estimated effort limit leaves beyond gravity
-(:func:`from_urdf`)."""
-
-
 def _urdf_arm(
     path: str | os.PathLike[str], tip: str | None, fix: Sequence[str]
 ) -> _description.Arm:
@@ -331,24 +326,12 @@ def estimate_effort(model: mujoco.MjModel, postures: int = 256) -> FloatArray:
     """Effort limits (N m, per joint of ``model``'s arm) for an arm whose URDF
     gives none: 2 (max |G_i(q)| + 10 rad/s² · max Σ_j |D_ij(q)|) over
     ``postures`` postures within the joint limits (:func:`from_urdf`): gravity
-    and an acceleration of 10 rad/s² of every joint at once, twice over."""
+    and an acceleration of 10 rad/s² of every joint at once, twice over (the
+    core's rule, :func:`adaptimp._mjcf.estimate` without the drag terms)."""
     joints = sorted(range(model.njnt), key=lambda j: int(model.jnt_dofadr[j]))
     qadr = [int(model.jnt_qposadr[j]) for j in joints]
     dofs = [int(model.jnt_dofadr[j]) for j in joints]
-    lo, hi = _limits(model, joints)
-    data = mujoco.MjData(model)
-    full = np.zeros((model.nv, model.nv))
-    g = np.zeros(len(joints))
-    d = np.zeros(len(joints))
-    for q in _postures(lo, hi, postures):
-        data.qpos[:] = model.qpos0
-        data.qpos[qadr] = q
-        data.qvel[:] = 0.0
-        mujoco.mj_forward(model, data)
-        _full_inertia(model, data, full)
-        g = np.maximum(g, np.abs(data.qfrc_bias[dofs]))
-        d = np.maximum(d, np.sum(np.abs(full[np.ix_(dofs, dofs)]), axis=1))
-    return np.asarray(2.0 * (g + EFFORT_ACCEL * d), dtype=np.float64)
+    return _mjcf.estimate(model, qadr, dofs, postures, drag=False)
 
 
 def panda(
@@ -481,9 +464,10 @@ class Plant:
         False disables every contact (MuJoCo's ``mjDSBL_CONTACT``): free space.
     tip : str, optional
         The end effector, a site or a body (its origin; a site if both have
-        the name): the arm is the hinges on the way to it. Default: the site of
-        the model's force sensor, or the first site of the last joint's body,
-        or that body's origin. A URDF's ``tip`` is a link.
+        the name): the arm is the hinges on the way to it. Default: the core's
+        rule (SPEC (21.2)), the site of a force sensor that a hinge of the arm
+        moves, else the origin of the last arm joint's body. A URDF's ``tip``
+        is a link.
     fix : tuple of str
         Joints to lock as well (at their reference position), by name.
     surface : str or tuple of str
@@ -556,11 +540,13 @@ class Plant:
         self.fix = tuple(fix)
         prepared = _prepare(model, self.tip, self.fix)
         self._arm_names: tuple[str, ...] = prepared.arm["joints"]
+        # The end effector asked for, else the one the core's reduction found.
+        self._tip_name: str = self.tip if self.tip is not None else prepared.arm["tip"]
         self.notes: dict[str, Any] = {**prepared.notes, "warnings": list(prepared.warnings)}
         for text in prepared.warnings:
             warnings.warn(text, PlantWarning, stacklevel=2)
         try:
-            self._setup_model(prepared.model, self.tip)
+            self._setup_model(prepared.model)
         except ValueError as e:  # a file's arm that cannot be a plant: name the file
             label = _source_label(model)
             if str(e).startswith(label):
@@ -601,7 +587,7 @@ class Plant:
             sensed = _mjcf.watch_contacts(spec, self.model, self._joints, own) > 0 or sensed
         if sensed:
             assert spec is not None
-            self._setup_model(spec.compile(), self.tip)
+            self._setup_model(spec.compile())
         self._watch = _mjcf.Watch.of(self.model) if contact else None
         m = self.model
         self.data = mujoco.MjData(m)
@@ -667,13 +653,13 @@ class Plant:
         """The arm's joints, base to tip (the order of q)."""
         return [_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self._joints]
 
-    def _setup_model(self, model: mujoco.MjModel, tip: str | None) -> None:
+    def _setup_model(self, model: mujoco.MjModel) -> None:
         self.model = model
         if not self.contact:
             model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         self._check_joints()
         self._check_actuators()
-        self._find_end_effector(tip)
+        self._find_end_effector(self._tip_name)
 
     def _contact_sensor_fits(self, source: ModelSource) -> bool:
         """Whether a contact sensor can measure this plant's wrench as the module
@@ -774,11 +760,11 @@ class Plant:
             self._gear[i] = gear
             self.tau_max[i] = gear * hi
 
-    def _find_end_effector(self, tip: str | None) -> None:
+    def _find_end_effector(self, tip: str) -> None:
         m = self.model
         force = int(mujoco.mjtSensor.mjSENS_FORCE)
         torque = int(mujoco.mjtSensor.mjSENS_TORQUE)
-        sid, self._ee_body = _mjcf.end_effector(m, tip, self._last_body)
+        sid, self._ee_body = _mjcf.end_effector(m, tip)
         self._site = sid
         sensors = [s for s in range(m.nsensor) if m.sensor_type[s] == force]
         sensors = [s for s in sensors if m.sensor_objid[s] == sid and sid >= 0]
@@ -1653,19 +1639,24 @@ def _native_cartesian(ctrl: Any) -> bool:
 
 
 def _tabulate(
-    reference: Reference, steps: int, Ts: float, k0: int = 0
+    reference: Reference, steps: int, Ts: float, width: int, k0: int = 0
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """``reference((k0 + k)·Ts)`` for every row k, as three (K, m) arrays
-    (called in order, once per row, as the loop would; a table's own rows)."""
+    """``reference((k0 + k)·Ts)`` for every row k, as three (K, ``width``)
+    arrays (called in order, once per row, as the loop would; a table's own
+    rows), by the core's tabulation (``_adaptimp.tabulate_joints``)."""
     if isinstance(reference, _Table) and math.isclose(reference.Ts, Ts, rel_tol=1e-12) and not k0:
         xc, dxc, ddxc = (np.ascontiguousarray(a[:steps]) for a in reference.arrays)
         return xc, dxc, ddxc
-    rows = [
-        tuple(np.asarray(v, dtype=np.float64) for v in reference((k0 + k) * Ts))
-        for k in range(steps)
-    ]
-    xc, dxc, ddxc = (np.ascontiguousarray(np.stack([r[i] for r in rows])) for i in range(3))
+    xc, dxc, ddxc = _adaptimp.tabulate_joints(
+        reference, steps, Ts, width, k0, "reference(t)", _reals_of_shape
+    )
     return xc, dxc, ddxc
+
+
+def _reals_of_shape(name: str, value: Any, shape: tuple[int, ...]) -> FloatArray:
+    """The core's tabulation's check of a value that is not a float64 array of
+    ``shape`` (:func:`adaptimp._inputs.reals`, NaN let through as before)."""
+    return reals(name, value, shape, finite=False)
 
 
 def _uses_rule(plant: Plant) -> bool:
@@ -2186,7 +2177,9 @@ def _native_loop(
 ) -> dict[str, Any]:
     """An ``adaptimp.Controller`` stepped by the core, along its own
     trajectory or the run's reference tabulated at t_k."""
-    refs = None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts)
+    refs = (
+        None if run.reference is None else _tabulate(run.reference, run.steps, run.Ts, run.plant.n)
+    )
     out: dict[str, Any] = _adaptimp.simulate_mujoco(
         run.ctrl, run.plant.model, run.plant.data, run.spec, run.dist, run.T, run.settle,
         run.every, progress, refs, fault,
@@ -2249,12 +2242,12 @@ def _computed_loop(
     t_k = (k0 + k)·Ts (k0 the steps it took before), as its ``step`` samples it."""
     ctrl, Ts = run.ctrl, run.Ts
     if run.reference is not None:
-        refs = _tabulate(run.reference, run.steps, Ts)
+        refs = _tabulate(run.reference, run.steps, Ts, run.plant.n)
     else:
         if ctrl._trajectory is None:
             raise ValueError("no setpoint given and no trajectory to follow")
         k0 = int(ctrl._core.steps)
-        refs = _tabulate(lambda t: ctrl._trajectory(t), run.steps, Ts, k0)
+        refs = _tabulate(lambda t: ctrl._trajectory(t), run.steps, Ts, run.plant.n, k0)
     out: dict[str, Any] = ctrl._core.simulate_mujoco(
         run.plant.model, run.plant.data, run.spec, run.dist, run.T, run.settle, refs,
         run.every, progress, fault,
@@ -2282,7 +2275,7 @@ def _callback_loop(
     reference = run.reference
     own_rates = reference is None and has["dxc"] and has["ddxc"]
     if reference is not None:
-        table = _tabulate(reference, steps, Ts)
+        table = _tabulate(reference, steps, Ts, width)
     else:
         nan = np.full((steps, width), math.nan)
         # The rates of its own joint-space sinusoid, if its params declare one.
@@ -2625,7 +2618,9 @@ def _run_many(
                     r.dist,
                     r.T,
                     r.settle,
-                    None if r.reference is None else _tabulate(r.reference, r.steps, r.Ts),
+                    None
+                    if r.reference is None
+                    else _tabulate(r.reference, r.steps, r.Ts, r.plant.n),
                 )
                 for _, r in native
             ],

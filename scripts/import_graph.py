@@ -31,10 +31,23 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def python_edges(pkg: Path) -> dict[str, set[str]]:
-    """module → the package's modules it imports (dotted names under ``adaptimp``)."""
+    """module → the package's modules it imports (dotted names under ``adaptimp``).
+
+    Every import counts, at module or function level: ``import a.b``; ``from
+    a import b`` (an edge to the module ``a.b`` if ``b`` is one, else to ``a``
+    itself, whose ``__init__`` defines or re-exports ``b``: a child taking a
+    name from its parent package is an edge to that package);
+    ``importlib.import_module(name[, package])`` and ``__import__(name)``
+    with a literal name, or an f-string of ``__package__``/``__name__`` and
+    literals. A dynamic import whose name cannot be read is an error
+    (:class:`Unread`), not an edge left out."""
     top = pkg.name
     files = {_py_name(pkg, f): f for f in pkg.rglob("*.py")}
-    edges: dict[str, set[str]] = {m: set() for m in files}
+    # A compiled module (the extension, ``_adaptimp``, known by its stub) is
+    # a leaf: it imports nothing of the package.
+    leaves = {_py_name(pkg, f) for f in pkg.rglob("*.pyi")} - set(files)
+    edges: dict[str, set[str]] = {m: set() for m in [*files, *leaves]}
+    known = set(edges)
     for mod, f in files.items():
         tree = ast.parse(f.read_text(encoding="utf-8"), str(f))
         is_pkg = f.name == "__init__.py"
@@ -44,20 +57,66 @@ def python_edges(pkg: Path) -> dict[str, set[str]]:
             if isinstance(node, ast.Import):
                 targets = [a.name for a in node.names]
             elif isinstance(node, ast.ImportFrom):
-                if node.level:
-                    parts = base.split(".")
-                    anchor = ".".join(parts[: len(parts) - node.level + 1])
-                    stem = f"{anchor}.{node.module}" if node.module else anchor
-                else:
-                    stem = node.module or ""
-                targets = [stem] + [f"{stem}.{a.name}" for a in node.names]
+                stem = _absolute(base, node.module or "", node.level)
+                for a in node.names:
+                    child = f"{stem}.{a.name}"
+                    targets.append(child if child in known else stem)
+            elif isinstance(node, ast.Call) and _is_dynamic_import(node.func):
+                name = _literal(node.args[0], mod, base) if node.args else None
+                if name is None:
+                    raise Unread(f"{f}:{node.lineno}: a dynamic import of a name not read")
+                level = len(name) - len(name.lstrip("."))
+                if level:  # import_module(".x", package)
+                    pkg_arg = node.args[1] if len(node.args) > 1 else None
+                    anchor = _literal(pkg_arg, mod, base) if pkg_arg is not None else None
+                    if anchor is None:
+                        raise Unread(f"{f}:{node.lineno}: a relative import_module without package")
+                    name = _absolute(anchor, name[level:], level)
+                targets = [name]
             for t in targets:
                 if t.split(".")[0] != top:
                     continue
-                hit = _longest_module(t, files)
-                if hit is not None and hit != mod and not _is_parent_package(hit, mod):
+                hit = _longest_module(t, known)
+                if hit is not None and hit != mod:
                     edges[mod].add(hit)
     return edges
+
+
+class Unread(Exception):
+    """A dynamic import whose module name the graph cannot read."""
+
+
+def _absolute(base: str, name: str, level: int) -> str:
+    """``name`` imported ``level`` packages up from the package ``base``."""
+    if not level:
+        return name
+    parts = base.split(".")
+    anchor = ".".join(parts[: len(parts) - level + 1])
+    return f"{anchor}.{name}" if name else anchor
+
+
+def _is_dynamic_import(func: ast.expr) -> bool:
+    """``importlib.import_module``, ``import_module`` or ``__import__``."""
+    if isinstance(func, ast.Attribute):
+        return func.attr == "import_module"
+    return isinstance(func, ast.Name) and func.id in ("import_module", "__import__")
+
+
+def _literal(node: ast.expr, mod: str, base: str) -> str | None:
+    """The text of a literal or of an f-string of ``__package__``/``__name__``."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return node.value
+    if isinstance(node, ast.Name) and node.id in ("__package__", "__name__"):
+        return base if node.id == "__package__" else mod
+    if isinstance(node, ast.JoinedStr):
+        out = []
+        for v in node.values:
+            part = _literal(v.value if isinstance(v, ast.FormattedValue) else v, mod, base)
+            if part is None:
+                return None
+            out.append(part)
+        return "".join(out)
+    return None
 
 
 def _py_name(pkg: Path, f: Path) -> str:
@@ -76,13 +135,6 @@ def _longest_module(name: str, modules: Iterable[str]) -> str | None:
         if cand in known:
             return cand
     return None
-
-
-def _is_parent_package(target: str, mod: str) -> bool:
-    """``from . import x`` names the package itself first: not an edge to it
-    unless the module really takes a name defined there (a package's
-    ``__init__`` imports its children, so every child would look circular)."""
-    return mod.startswith(target + ".")
 
 
 # --------------------------------------------------------------------------- Rust

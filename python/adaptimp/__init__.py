@@ -49,10 +49,23 @@ from ._faults import Fault
 from ._params import CASES, MAX_JOINTS, PARAMS, SCENARIOS, Param, defaults
 from ._plot import PLOT_KINDS
 from ._plot import compare as plot_compare
-from ._result import SimResult, metrics_table
+from ._result import RESULT_KINDS, SimResult, metrics_table
 from ._sweep import Choice, LogUniform, Normal, Uniform, sweep
 from .cartesian import CartesianController, CartesianStep, PoseTarget
 from .chain import Chain
+
+
+def _mujoco_result() -> type[SimResult] | None:
+    """:class:`adaptimp.mujoco.MujocoResult`, for ``SimResult.load`` of its
+    files; None without the mujoco extra."""
+    try:
+        from .mujoco import MujocoResult
+    except ImportError:
+        return None
+    return MujocoResult
+
+
+RESULT_KINDS["MujocoResult"] = _mujoco_result
 
 __all__ = [
     "CASES",

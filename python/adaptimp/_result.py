@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import importlib
 import json
 import math
 import os
@@ -15,6 +14,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from ._adaptimp import __version__
 from ._errors import SaveError, needs_extra
 from ._params import CASE_NAMES
 from ._plot import FIGURES, PLOT_KINDS, into
@@ -67,6 +67,12 @@ METRIC_KEYS = (
     "imp_err_rms_after2",
 )
 """Keys of :attr:`SimResult.metrics` (SPEC §12), besides ``rows``."""
+
+RESULT_KINDS: dict[str, Callable[[], type[SimResult] | None]] = {}
+"""The subclasses :meth:`SimResult.load` gives for a file saved by one, by
+the class's name: a callable that returns the class, or None where its
+extra does not import. Filled by the package above both (``adaptimp``'s
+``__init__``: ``"MujocoResult"``), so this module imports none of them."""
 
 
 @dataclass(frozen=True, repr=False, eq=False)
@@ -351,16 +357,13 @@ class SimResult:
                 f"{path}: holds a {kind} (saved by {kind}.save), not a {cls.__name__}: load it "
                 "with adaptimp.SimResult.load"
             )
-        if cls is SimResult and kind == "MujocoResult":
-            # The class the file names, found by its module as pickle finds a
-            # class (this module is below adaptimp.mujoco and does not import it).
-            try:
-                mujoco_results = importlib.import_module(f"{__package__}.mujoco")
-            except ImportError:  # without the mujoco extra: its common arrays
-                pass
-            else:
-                loaded: SimResult = mujoco_results.MujocoResult.load(path)
-                return loaded
+        if cls is SimResult and kind in RESULT_KINDS:
+            # The class the file names, given by the package above (this module
+            # is below adaptimp.mujoco and does not import it); None without
+            # its extra: the common arrays.
+            kind_cls = RESULT_KINDS[kind]()
+            if kind_cls is not None:
+                return kind_cls.load(path)
         with _open(path) as f:
             r = _Reader(path, f)
             params = r.json("params", dict)
@@ -917,8 +920,6 @@ def _resimulated(
 ) -> dict[str, NDArray[Any]]:
     """The arrays a format-3 file left to the core, run again and checked against
     the SHA-256 the save recorded."""
-    from . import __version__
-
     simulated: Mapping[str, Any] = manifest["simulated"]
     why: list[str] = []
     rerun = _rerun(case, scenario, params, int(manifest["n"]), record_every, why)
@@ -1169,8 +1170,6 @@ def _encode(
     record_every: int,
     rerun: Mapping[str, NDArray[Any]] | None = None,
 ) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
-    from . import __version__
-
     stored: dict[str, NDArray[Any]] = {}
     manifest: dict[str, Any] = {
         "derived": [],

@@ -44,7 +44,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from . import __version__
+from ._adaptimp import __version__
 from ._api import simulate
 from ._errors import ConfigError
 from ._params import BY_NAME, CASE_NAMES, CASES, SCENARIOS, describe
@@ -331,7 +331,7 @@ def cmd_table(args: argparse.Namespace, params: dict[str, Any]) -> int:
     if params:
         raise CliError(f"`adaptimp table` takes no parameters, got {sorted(params)}")
     try:
-        from . import DivergedError
+        from ._errors import DivergedError
         from .scenarios import contact as act
     except ImportError as e:
         raise CliError(str(e)) from None

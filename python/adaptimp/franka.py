@@ -341,7 +341,7 @@ def _no_gravity(params: dict[str, Any]) -> None:
 
 
 def _adaptimp_controller(case: str, kw: dict[str, Any]) -> Any:
-    from . import Controller
+    from ._api import Controller
 
     return Controller(case, scenario="robot", n=7, **kw)
 

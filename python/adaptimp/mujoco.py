@@ -2419,8 +2419,7 @@ def _setup(
 ) -> _Run:
     """Everything :func:`simulate` does before the loop: the controller, the
     plant at its initial state, the settings and the kind of loop."""
-    from . import Controller
-    from ._api import _record_every
+    from ._api import Controller, _record_every
     from ._params import SCENARIOS, check_settle, resolve
 
     _check_arguments(T, Ts, substeps)

@@ -14,7 +14,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
 from ._arms import PlanarArm, TwoLinkArm, _two_link_arm  # noqa: F401 (pickles name _api._two_link_arm)
-from ._errors import ConfigError, StabilityWarning, period_alias
+from ._deprecated import period_alias
+from ._errors import ConfigError, StabilityWarning
 from ._faults import Fault
 from ._params import (
     BY_NAME,

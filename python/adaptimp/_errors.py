@@ -77,22 +77,6 @@ __all__ = [
 ]
 
 
-def period_alias(owner: object) -> float:
-    """The deprecated ``.ts`` of adaptimp's objects: warns, then returns ``.Ts`` (s).
-
-    ``Ts`` is the one name of the sampling period (the schema's, ``simulate(Ts=…)``);
-    ``.ts`` stays readable, for code written before, with a ``DeprecationWarning``.
-    """
-    import warnings
-
-    warnings.warn(
-        f"{type(owner).__name__}.ts is deprecated: the period is .Ts (s)",
-        DeprecationWarning,
-        stacklevel=3,
-    )
-    return float(owner.Ts)  # type: ignore[attr-defined]
-
-
 def needs_extra(what: str, package: str, extra: str) -> ImportError:
     """The ImportError of an optional dependency: what needs it, and the pip
     commands that install it, as they install (quoted, for zsh too)."""

@@ -11,14 +11,13 @@ is what the last step computed, each quantity an attribute with its unit.
 from __future__ import annotations
 
 import inspect
-import sys
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._deprecated import old_step_shape
 from ._errors import ConfigError
 from ._inputs import reals
 
@@ -201,18 +200,6 @@ def task_space(ctrl: Any) -> bool:
     return bool(getattr(ctrl, "task_space", getattr(ctrl, "wants_wrench", False)))
 
 
-def _outside() -> int:
-    """The ``stacklevel`` of the first caller outside the adaptimp package,
-    for a warning raised by the function that calls this one: the user's
-    line that asked for the deprecated call."""
-    frame = sys._getframe(1)
-    level = 1
-    while frame.f_back is not None and frame.f_globals.get("__name__", "").startswith("adaptimp"):
-        frame = frame.f_back
-        level += 1
-    return level
-
-
 def call_shape(ctrl: Any) -> str:
     """How a controller written in Python is called: ``"measurement"``, the
     protocol (``step(m, **setpoint)``), or a deprecated shape (a step that
@@ -249,11 +236,5 @@ def call_shape(ctrl: Any) -> str:
     old = (not binds(None) or named_old) and binds(None, None, None)
     if not old:
         return "measurement"
-    shape = "step(q, dq, wrench)" if task_space(ctrl) else "step(q, tau_e, dq)"
-    warnings.warn(
-        f"{type(ctrl).__name__}.{shape} is deprecated: write step(m, **setpoint), m an "
-        "adaptimp.Measurement (m.q, m.dq, m.tau_e, m.wrench)",
-        DeprecationWarning,
-        stacklevel=_outside(),
-    )
+    old_step_shape(ctrl, "step(q, dq, wrench)" if task_space(ctrl) else "step(q, tau_e, dq)")
     return "wrench" if task_space(ctrl) else "joint"

@@ -34,7 +34,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._adaptimp import Measurement
-from ._errors import ConfigError, needs_extra, no_file, period_alias
+from ._deprecated import period_alias
+from ._errors import ConfigError, needs_extra, no_file
 
 try:
     import pinocchio as pin

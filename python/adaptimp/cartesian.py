@@ -36,7 +36,6 @@ from __future__ import annotations
 import contextlib
 import math
 import types
-import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -45,10 +44,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _adaptimp
 from ._adaptimp import Measurement
-from ._errors import ConfigError, MeasurementError, period_alias
+from ._deprecated import old_cartesian_step, period_alias
+from ._errors import ConfigError, MeasurementError
 from ._inputs import reals
 from ._params import BY_NAME, check_scenario, describe, resolve
-from ._pose import CartesianStep, PoseTarget, _outside, call_shape
+from ._pose import CartesianStep, PoseTarget, call_shape
 from .chain import Chain
 
 __all__ = [
@@ -179,12 +179,7 @@ def _measured(
             "CartesianController.step needs a measurement: "
             "step(adaptimp.Measurement(q, dq, wrench=…))"
         )
-    warnings.warn(
-        "CartesianController.step(q, dq, wrench) is deprecated: pass one "
-        "adaptimp.Measurement(q, dq, wrench=wrench)",
-        DeprecationWarning,
-        stacklevel=_outside(),
-    )
+    old_cartesian_step()
     return q, dq, wrench
 
 

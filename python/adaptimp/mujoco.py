@@ -53,6 +53,7 @@ from typing import TYPE_CHECKING, Any, Protocol, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._deprecated import period_of
 from ._errors import ConfigError, PlantWarning, needs_extra, no_file
 from ._inputs import reals
 
@@ -1571,13 +1572,9 @@ def _period(ctrl: Any) -> float:
     value = getattr(ctrl, "Ts", None)
     if value is not None:
         return float(value)
-    if getattr(ctrl, "ts", None) is not None:  # the earlier name, deprecated
-        warnings.warn(
-            f"the controller's period .ts is deprecated: name it .Ts ({type(ctrl).__name__})",
-            DeprecationWarning,
-            stacklevel=3,
-        )
-        return float(ctrl.ts)
+    old = period_of(ctrl)  # the earlier name, deprecated
+    if old is not None:
+        return old
     raise TypeError(f"the controller {ctrl!r} has no period: give it a .Ts (s)")
 
 

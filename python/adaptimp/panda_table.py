@@ -1,20 +1,15 @@
 """Deprecated: the scenario moved to :mod:`adaptimp.scenarios.panda_table` (the public API
 never imports a scenario). This alias imports it with a DeprecationWarning
-and goes away in the next release."""
+and goes away in 0.3 (:mod:`adaptimp._deprecated`)."""
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
+from ._deprecated import moved_module
 from .scenarios import panda_table as _moved
 
-warnings.warn(
-    "adaptimp.panda_table is deprecated: import adaptimp.scenarios.panda_table instead "
-    "(the same names; this alias goes away in the next release)",
-    DeprecationWarning,
-    stacklevel=2,
-)
+moved_module("adaptimp.panda_table", "adaptimp.scenarios.panda_table")
 
 __all__ = list(_moved.__all__)
 

@@ -65,6 +65,7 @@ import mujoco
 import numpy as np
 
 import adaptimp
+from adaptimp import _plant_models
 from adaptimp import mujoco as amj
 
 TS = 1e-3  # s: the control period of both loops
@@ -87,14 +88,14 @@ def arm(name: str) -> tuple[Any, np.ndarray, adaptimp.Chain]:
         from adaptimp import _models
 
         urdf = _models.panda_urdf_path().parents[2] / "ur_description/urdf/ur5_robot.urdf"
-        arm_urdf = amj._urdf_arm(urdf, None, ())
+        arm_urdf = _plant_models.urdf_arm(urdf, None, ())
         pm = pin.buildModelFromXML(arm_urdf.urdf)
         tool = pm.frames[pm.getFrameId("tool0")].placement
-        spec = amj._arm_spec(arm_urdf, 1e-3, drive=False, stacklevel=2)
+        spec = _plant_models.arm_spec(arm_urdf, 1e-3, drive=False, stacklevel=2)
         quat = np.zeros(4)
         mujoco.mju_mat2Quat(quat, np.ascontiguousarray(tool.rotation).ravel())
         spec.body("wrist_3_link").add_site(name="tool0", pos=tool.translation, quat=quat)
-        model = amj._compile_arm(spec)
+        model = _plant_models.compile_arm(spec)
         q0 = np.array([0.0, -1.2, 1.2, -1.5, -1.5, 0.0])
     return model, q0, adaptimp.Chain.from_mujoco(model, SITES[name])
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _models
+from adaptimp import _models, _plant, _plant_models
 from adaptimp import mujoco as amj
 from adaptimp._description import read_arm
 from adaptimp._mjcf import WATCH
@@ -163,7 +163,7 @@ def test_a_files_model_without_force_sensor_gets_a_contact_sensor(
     plant = amj.Plant(path)
     assert plant.wrench_source == "contact sensor"
     names = [plant.model.sensor(s).name for s in range(plant.model.nsensor)]
-    assert [n for n in names if not n.startswith(WATCH)] == [amj._CONTACT_SENSOR]
+    assert [n for n in names if not n.startswith(WATCH)] == [_plant._CONTACT_SENSOR]
     tau = _push_into_wall(plant, [0.5, 0.0])
     listed = contact_list_wrench(plant)
     sensed = measure(plant, tau).wrench_ee
@@ -260,8 +260,8 @@ def test_a_urdf_arm_is_its_chain_with_the_gripper_fixed() -> None:
     finger = read_arm(path, tip="panda_leftfinger")
     assert finger.joints == (*_models.PANDA_JOINTS, finger1)
     assert finger.urdf is not None
-    spec = amj._spec_of(finger.urdf)
-    amj._add_motors(spec, dict(zip(finger.joints, finger.effort)))
+    spec = _plant_models.spec_of(finger.urdf)
+    _plant_models.add_motors(spec, dict(zip(finger.joints, finger.effort)))
     with pytest.raises(ValueError, match=r"\['panda_finger_joint1'\]"):
         amj.Plant(spec.compile())
     with pytest.warns(adaptimp.PlantWarning, match="the plant locks them at their reference"):
@@ -514,9 +514,9 @@ def test_steps_inside_a_period_skip_pure_sensors_and_change_nothing(
 
     plant = amj.Plant("panda")
     assert plant.model.nsensor >= 2
-    assert amj._pure_sensors(plant.model)
+    assert _plant._pure_sensors(plant.model)
     quiet = run()
-    monkeypatch.setattr(amj, "_pure_sensors", lambda m: False)
+    monkeypatch.setattr(_plant, "_pure_sensors", lambda m: False)
     every = run()
     _assert_same_run(quiet, every)
     assert quiet.metrics["steps_in_contact"] > 50
@@ -524,7 +524,7 @@ def test_steps_inside_a_period_skip_pure_sensors_and_change_nothing(
     monkeypatch.undo()
     noisy = amj.panda(table_height=None)
     noisy.sensor_noise[0] = 0.1
-    assert not amj._pure_sensors(noisy)
+    assert not _plant._pure_sensors(noisy)
 
 
 def test_a_used_controller_goes_on_along_its_trajectory() -> None:

@@ -171,7 +171,7 @@ def test_a_quadruped_is_refused_unless_the_leg_is_named() -> None:
     )
     plant = amj.Plant(amj.from_urdf(SOLO, tip="HR_LOWER_LEG"))
     joint = amj.mujoco.mjtObj.mjOBJ_JOINT
-    assert tuple(amj._name(plant.model, joint, j) for j in plant._joints) == leg
+    assert tuple(amj.mujoco.mj_id2name(plant.model, joint, j) for j in plant._joints) == leg
     assert adaptimp.Chain.from_urdf(SOLO, tip="HR_LOWER_LEG").joint_names == list(leg)
     paw = (
         "URDF 'solo12.urdf': tip= 'paw' is neither a link nor a frame of it: name the link "
@@ -209,11 +209,11 @@ def test_the_contact_scenario_drives_the_joints_simulate_drives() -> None:
     assert tuple(sc.chain.joint_names) == arm
     plant = amj.Plant(sc.model)
     joint = amj.mujoco.mjtObj.mjOBJ_JOINT
-    assert tuple(amj._name(plant.model, joint, j) for j in plant._joints) == arm
+    assert tuple(amj.mujoco.mj_id2name(plant.model, joint, j) for j in plant._joints) == arm
     res = amj.simulate("sf", so100, T=0.01)
     assert res.q.shape == (10, len(arm))
     alone = amj.Plant(so100)
-    assert tuple(amj._name(alone.model, joint, j) for j in alone._joints) == arm
+    assert tuple(amj.mujoco.mj_id2name(alone.model, joint, j) for j in alone._joints) == arm
 
 
 def test_a_tip_beyond_a_fixed_joint_holds_it_on_the_chain_too() -> None:

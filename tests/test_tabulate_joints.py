@@ -8,8 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from adaptimp import MeasurementError, _adaptimp
-from adaptimp import mujoco as am
+from adaptimp import MeasurementError, _adaptimp, _loops
 from adaptimp.cartesian import _array
 
 
@@ -26,7 +25,7 @@ def test_the_tables_are_the_python_loops() -> None:
     got = _adaptimp.tabulate_joints(_reference, 250, 1e-3, 3, 7, "reference(t)", _array)
     rows = [_reference((7 + k) * 1e-3) for k in range(250)]
     want = [np.array([np.asarray(r[i], dtype=np.float64) for r in rows]) for i in range(3)]
-    for g, w, run in zip(got, want, am._tabulate(_reference, 250, 1e-3, 3, 7)):
+    for g, w, run in zip(got, want, _loops.tabulate(_reference, 250, 1e-3, 3, 7)):
         assert g.shape == (250, 3)
         assert np.array_equal(g, w)
         assert np.array_equal(run, w)  # what a run of adaptimp.mujoco tabulates

@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from adaptimp import _models
+from adaptimp import _mjcf, _models, _tasks
 from adaptimp import mujoco as amj
 from adaptimp._description import read_arm
 from adaptimp.baselines import ComputedTorque, pinocchio_model
@@ -71,7 +71,7 @@ def test_the_default_route_meets_the_targets(arm_runs: dict[str, Any]) -> None:
 def test_the_task_swings_about_a_home_posture_inside_the_limits() -> None:
     plant = amj.Plant(PANDA)
     task = amj.default_task(plant)
-    lo, hi = amj._limits(plant.model, plant._joints)
+    lo, hi = _mjcf._limits(plant.model, plant._joints)
     amp = -np.asarray(task.keywords["xc_cos"])
     assert np.all(amp == 0.2)
     assert np.all(task.home - amp >= lo - 1e-12)
@@ -157,10 +157,10 @@ def test_weak_or_missing_effort_limits(tmp_path: Path) -> None:
     # Gravity takes more than half of the limits at the zero posture: the home
     # posture is the one of least load among the samples, and it is lighter.
     weak = amj.Plant(_edited(tmp_path, "weak.urdf", scaled(0.3)))
-    zero_load = max(amj._gravity_load(weak, np.array([0, 0, 0, 0, s * 0.2, 0])) for s in (-1, 1))
+    zero_load = max(_tasks._gravity_load(weak, np.array([0, 0, 0, 0, s * 0.2, 0])) for s in (-1, 1))
     home = amj.home_posture(weak)
     assert np.any(home != 0.0)
-    assert amj._gravity_load(weak, home) < 0.5 < zero_load
+    assert _tasks._gravity_load(weak, home) < 0.5 < zero_load
     # Nowhere to hold itself: a clear error.
     with pytest.raises(ValueError, match="gravity exceeds the effort limits at every posture"):
         amj.home_posture(amj.Plant(_edited(tmp_path, "feeble.urdf", scaled(0.001))))

@@ -275,7 +275,7 @@ def mujoco_arrays(model: Any) -> dict[str, Any]:
         return [bool(x) for x in a]
 
     return {
-        "model_name": _model_name(model),
+        "model_name": model_name(model),
         "body_name": names(obj.mjOBJ_BODY, model.nbody),
         "body_parentid": model.body_parentid.tolist(),
         "body_pos": model.body_pos.tolist(),
@@ -334,7 +334,7 @@ def mujoco_arrays(model: Any) -> dict[str, Any]:
     }
 
 
-def _model_name(model: Any) -> str:
+def model_name(model: Any) -> str:
     return bytes(model.names[: bytes(model.names).find(b"\0")]).decode()
 
 
@@ -431,7 +431,7 @@ def read_arm(
     if tip is not None and not isinstance(tip, str):
         raise ConfigError(f"tip must be a link or site name, got {tip!r}")
     if _is_model(source):
-        label = f"MuJoCo model '{_model_name(source)}'"
+        label = f"MuJoCo model '{model_name(source)}'"
         return _from_model(source, label, tip, fix)
     if isinstance(source, str) and source.removeprefix("\ufeff").lstrip().startswith("<"):
         return Arm._of(_adaptimp.read_arm(source, tip, list(fix)))

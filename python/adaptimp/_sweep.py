@@ -235,9 +235,9 @@ def _run_mujoco_batch(
     """Run ``jobs`` (case, scenario, model, keywords) on the MuJoCo plant in this
     process on ``threads`` threads (the core's loop, the GIL released): the task
     an executor runs, and the batches of ``executor=None``."""
-    from . import mujoco as amj
+    from ._run import run_many
 
-    return amj._run_many(jobs, threads, progress)
+    return run_many(jobs, threads, progress)
 
 
 def _batches(items: list[Any], size: int) -> Iterator[list[Any]]:

@@ -72,6 +72,7 @@ from . import _adaptimp
 from . import mujoco as amj
 from ._adaptimp import Measurement
 from ._cartesian_task import CartesianTask, chain_of
+from ._description import model_name
 from .chain import Chain
 
 __all__ = [
@@ -818,7 +819,7 @@ class _Loop:
             "contact": False,
             "tau_max": _limits(self.s.plant),
             "wrench_source": "O_F_ext_hat_K",
-            "model": amj._model_name(self.s.plant.model),
+            "model": model_name(self.s.plant.model),
             "controller": f"adaptimp.franka.setup({case!r}, task={self.s.kind!r})",
             "loop": "libfranka",
             "payload": 0.0,

@@ -364,7 +364,7 @@ def arm_model(
     """
     import mujoco
 
-    from .. import mujoco as amj
+    from .._plant_models import arm_spec, compile_arm, urdf_arm
 
     if Path(urdf).suffix.lower() != ".urdf":
         return _mjcf_model(
@@ -375,8 +375,8 @@ def arm_model(
     # The arm as adaptimp.mujoco.from_urdf makes it, by the core's one
     # reduction (SPEC §21), with its motors (efforts estimated where the URDF
     # gives none, and said so).
-    spec = amj._arm_spec(amj._urdf_arm(urdf, tip, fix), timestep, drive=False, stacklevel=3)
-    arm = amj._urdf_arm(urdf, tip, fix)
+    arm = urdf_arm(urdf, tip, fix)
+    spec = arm_spec(arm, timestep, drive=False, stacklevel=3)
     table = _tool_and_table(
         spec,
         tip,
@@ -395,7 +395,7 @@ def arm_model(
     # A massless moving link: bounded as adaptimp.mujoco.from_urdf does, and
     # said as it says it (an inertia that breaks the triangle inequality the
     # reader has balanced already, for the chain and Pinocchio's model too).
-    model = amj._compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
+    model = compile_arm(spec, " (the chain and Pinocchio's model keep the URDF's)")
     model = _watch_scene(spec, model, arm.joints, table)
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     if model.npair:
@@ -873,6 +873,7 @@ def _urdf_arm(
 
     from .. import mujoco as amj
     from .._description import read_arm
+    from .._mjcf import _name
 
     arm = read_arm(path, tip, fix)
     tip = arm.tip if tip is None else tip
@@ -880,7 +881,7 @@ def _urdf_arm(
     chain = Chain.from_urdf(path, tip=tip, fix=fix)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
     joint = mujoco.mjtObj.mjOBJ_JOINT
-    driven = [amj._name(bare.model, joint, j) for j in bare._joints]
+    driven = [_name(bare.model, joint, j) for j in bare._joints]
     if driven != chain.joint_names:
         raise ConfigError(
             f"the chain to {tip!r} has the joints {chain.joint_names}, but the arm's model "

@@ -35,7 +35,8 @@ def test_each_says_the_release_that_removes_it() -> None:
     assert len(_deprecated.DEPRECATED) == 8
     for d in _deprecated.DEPRECATED:
         assert _release(d.removed_in) > _release(adaptimp.__version__), d
-        assert d.new and d.old != d.new
+        assert d.new
+        assert d.old != d.new
 
 
 @pytest.mark.parametrize("old", ["contact", "panda_table"])

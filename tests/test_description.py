@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _adaptimp, _mjcf
+from adaptimp import _adaptimp, _mjmodel
 from adaptimp import mujoco as amj
 from adaptimp._description import read_arm
 from adaptimp.baselines import ComputedTorque, pinocchio_model
@@ -84,7 +84,7 @@ def test_a_mimic_gripper_is_held_and_every_front_drives_the_same_joints() -> Non
     with pytest.warns(UserWarning, match=r"no effort limit for \['wrist_roll'\]"):
         plant = amj.Plant(amj.from_urdf(HOBBY))
     joint = mujoco.mjtObj.mjOBJ_JOINT
-    assert [_mjcf._name(plant.model, joint, j) for j in plant._joints] == list(joints)
+    assert [_mjmodel.obj_name(plant.model, joint, j) for j in plant._joints] == list(joints)
     model = pinocchio_model(HOBBY)
     assert [model.names[j] for j in range(1, model.njoints)] == list(joints)
     assert ComputedTorque(HOBBY, tau_max=1.0).n == len(joints)

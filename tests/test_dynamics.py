@@ -15,7 +15,7 @@ import pinocchio as pin
 import pytest
 
 import adaptimp
-from adaptimp import Measurement, _mjcf
+from adaptimp import Measurement, _sampled
 from adaptimp import mujoco as amj
 from adaptimp.baselines import ComputedTorque, core_description, pinocchio_model
 from adaptimp.scenarios import panda_table as apt
@@ -249,7 +249,7 @@ def test_the_drive_terms_equal_mujocos_inverse_dynamics() -> None:
         want = d.qfrc_inverse
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
         full = np.zeros((6, 6))
-        _mjcf._full_inertia(m, d, full)
+        _sampled._full_inertia(m, d, full)
         np.testing.assert_allclose(ct.mass_matrix(q), full, rtol=0, atol=1e-12 * np.abs(full).max())
         # The drive's share is there (not a model MuJoCo and the core both lack).
         extra = got - rigid.inverse_dynamics(q, dq, ddq)

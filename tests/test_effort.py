@@ -1,7 +1,7 @@
 """The effort estimate of an arm whose description states no limits is the
 core's one rule (``_adaptimp.estimate_effort``): bit for bit what the URDF
 front (:func:`adaptimp.mujoco.estimate_effort`) computes, and what the MJCF
-front (``adaptimp._mjcf.estimate``, which calls it, with the joints' damping
+front (``adaptimp._sampled.estimate``, which calls it, with the joints' damping
 and friction) computed in NumPy before."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from adaptimp import _adaptimp, _mjcf
+from adaptimp import _adaptimp, _sampled
 from adaptimp import mujoco as am
 
 DATA = Path(__file__).parent / "data"
@@ -23,16 +23,16 @@ def _samples(
 ) -> tuple[np.ndarray, np.ndarray]:
     """G (K, n) and D (K, n, n) at the fronts' 256 postures."""
     joints = [int(model.dof_jntid[d]) for d in dofs]
-    lo, hi = _mjcf._limits(model, joints)
+    lo, hi = _sampled._limits(model, joints)
     data = mujoco.MjData(model)
     full = np.zeros((model.nv, model.nv))
     g, d = [], []
-    for q in _mjcf._postures(lo, hi, 256):
+    for q in _sampled._postures(lo, hi, 256):
         data.qpos[:] = model.qpos0
         data.qpos[qadr] = q
         data.qvel[:] = 0.0
         mujoco.mj_forward(model, data)
-        _mjcf._full_inertia(model, data, full)
+        _sampled._full_inertia(model, data, full)
         g.append(data.qfrc_bias[dofs].copy())
         d.append(full[np.ix_(dofs, dofs)].copy())
     return np.array(g), np.array(d)
@@ -56,7 +56,7 @@ def test_the_mjcf_estimate_with_damping_and_friction_is_the_cores() -> None:
     g, d = _samples(model, dofs, qadr)
     b, f = model.dof_damping[dofs], model.dof_frictionloss[dofs]
     core = _adaptimp.estimate_effort(g, d, b, f)
-    assert np.array_equal(core, _mjcf.estimate(model, qadr, dofs))
+    assert np.array_equal(core, _sampled.estimate(model, qadr, dofs))
     # The NumPy formula the front had: the same bits.
     gmax = np.max(np.abs(g), axis=0)
     dmax = np.max(np.sum(np.abs(d), axis=2), axis=0)

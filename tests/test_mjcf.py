@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _mjcf
+from adaptimp import _contacts, _sampled
 from adaptimp import mujoco as amj
 from mujoco_probe import measure
 
@@ -206,7 +206,7 @@ def test_joints_without_actuators_get_motors(tmp_path: Path) -> None:
     path.write_text(MOTORLESS)
     with pytest.warns(adaptimp.PlantWarning) as record:
         plant = amj.Plant(path)
-    estimate = _mjcf.estimate(plant.model, plant._qadr, plant._dofs)[1]
+    estimate = _sampled.estimate(plant.model, plant._qadr, plant._dofs)[1]
     assert plant.tau_max[0] == 30.0
     assert plant.tau_max[1] == pytest.approx(estimate, rel=1e-12)
     assert estimate > 2 * 9.81 * 0.125  # at least twice the 1 kg link's gravity torque
@@ -227,7 +227,7 @@ def test_the_default_task_keeps_the_arm_off_itself() -> None:
     """At the zero posture the hand of fold_arm.xml lies in its upper arm: the
     home is the nearest posture whose swing keeps 5 mm between them."""
     plant = amj.Plant(FOLD)
-    contacts = _mjcf.Contacts(plant.model, plant.data.qpos, plant._joints, margin=0.005)
+    contacts = _contacts.Contacts(plant.model, plant.data.qpos, plant._joints, margin=0.005)
     assert contacts.at(np.zeros(3))[0][:2] == ("hand", "upper")
     task = amj.default_task(plant)
     amp = -np.asarray(task.keywords["xc_cos"])

@@ -16,8 +16,8 @@ import pytest
 import adaptimp
 from adaptimp import _models, _plant, _plant_models
 from adaptimp import mujoco as amj
+from adaptimp._contacts import WATCH
 from adaptimp._description import read_arm
-from adaptimp._mjcf import WATCH
 from mujoco_probe import contact_list_wrench, measure, push
 
 RNG_SEED = 20160301

@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from adaptimp import _mjcf, _models, _tasks
+from adaptimp import _models, _sampled, _tasks
 from adaptimp import mujoco as amj
 from adaptimp._description import read_arm
 from adaptimp.baselines import ComputedTorque, pinocchio_model
@@ -71,7 +71,7 @@ def test_the_default_route_meets_the_targets(arm_runs: dict[str, Any]) -> None:
 def test_the_task_swings_about_a_home_posture_inside_the_limits() -> None:
     plant = amj.Plant(PANDA)
     task = amj.default_task(plant)
-    lo, hi = _mjcf._limits(plant.model, plant._joints)
+    lo, hi = _sampled._limits(plant.model, plant._joints)
     amp = -np.asarray(task.keywords["xc_cos"])
     assert np.all(amp == 0.2)
     assert np.all(task.home - amp >= lo - 1e-12)

@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _mjcf
+from . import _contacts
 
 FloatArray = NDArray[np.float64]
 
@@ -70,7 +70,7 @@ def collision(
     With the model's collision geometry (two bodies that the arm's joints
     move relative to each other and that can collide): MuJoCo's collision
     detection, contacts enabled, as the joint-space task's check has it
-    (``_mjcf.Contacts``, SPEC §18: its exclusions and parent–child filter
+    (``_contacts.Contacts``, SPEC §18: its exclusions and parent–child filter
     kept).
     Without (a URDF compiled as :func:`adaptimp.mujoco.from_urdf` does, which
     keeps no collision geometry): the arm's skeleton, capsules along the
@@ -83,7 +83,7 @@ def collision(
     flags = int(m.opt.disableflags)
     m.opt.disableflags = flags & ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     try:  # the copy Contacts makes has contacts on, whatever the plant's setting
-        contacts = _mjcf.Contacts(m, plant.data.qpos, list(plant._joints), self_only=not scene)
+        contacts = _contacts.Contacts(m, plant.data.qpos, list(plant._joints), self_only=not scene)
     finally:
         m.opt.disableflags = flags
     names = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in skip}
@@ -91,7 +91,7 @@ def collision(
         for k, q in enumerate(rows):
             found = [c for c in contacts.at(q) if c[0] not in names and c[1] not in names]
             if found:
-                return f"row {k}: {_mjcf.pairs(found)} touch"
+                return f"row {k}: {_contacts.pairs(found)} touch"
         return None
     probe = _Probe(plant)
     for k, q in enumerate(rows):

@@ -20,12 +20,13 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _mjcf
+from . import _contacts, _mjcf
 from ._description import model_name
 from ._errors import PlantWarning, no_file
 from ._inputs import reals
-from ._mjcf import _full_inertia, _name
+from ._mjmodel import obj_name
 from ._plant_models import MAX_JOINTS, ModelSource, from_urdf, panda, two_link
+from ._sampled import _full_inertia
 
 FloatArray = NDArray[np.float64]
 
@@ -204,9 +205,9 @@ class Plant:
                 raise
             raise ValueError(f"{label}{e}") from None
         self.notes["tip"] = (
-            _name(self.model, mujoco.mjtObj.mjOBJ_SITE, self._site)
+            obj_name(self.model, mujoco.mjtObj.mjOBJ_SITE, self._site)
             if self._site >= 0
-            else _name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body)
+            else obj_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body)
         )
         spec, sensed = prepared.spec, False
         if self.wrench_source == "contact" and self._contact_sensor_fits(model):
@@ -218,7 +219,7 @@ class Plant:
                 name=_CONTACT_SENSOR,
                 type=mujoco.mjtSensor.mjSENS_CONTACT,
                 objtype=mujoco.mjtObj.mjOBJ_XBODY,
-                objname=_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
+                objname=obj_name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._ee_body),
                 intprm=[_NETFORCE_DATA, _NETFORCE, 1],
             )
             sensed = True
@@ -226,20 +227,20 @@ class Plant:
             surface = (surface,)
         for name in surface:
             _mjcf.resolve_tip(self.model, name)  # a body of the model, or refused by name
-        if spec is not None and contact and _mjcf.Watch.of(self.model) is None:
+        if spec is not None and contact and _contacts.Watch.of(self.model) is None:
             # The contacts of the arm with the rest of the scene, watched
             # through the run (SPEC §18.10): sensors, which change no dynamics.
             # The end effector on the task's own surface is the task's.
             own = [
-                (_name(self.model, mujoco.mjtObj.mjOBJ_BODY, b), name)
+                (obj_name(self.model, mujoco.mjtObj.mjOBJ_BODY, b), name)
                 for b in sorted(self._ee_subtree)
                 for name in surface
             ]
-            sensed = _mjcf.watch_contacts(spec, self.model, self._joints, own) > 0 or sensed
+            sensed = _contacts.watch_contacts(spec, self.model, self._joints, own) > 0 or sensed
         if sensed:
             assert spec is not None
             self._setup_model(spec.compile())
-        self._watch = _mjcf.Watch.of(self.model) if contact else None
+        self._watch = _contacts.Watch.of(self.model) if contact else None
         m = self.model
         self.data = mujoco.MjData(m)
         self._mass = np.zeros((m.nv, m.nv))
@@ -256,7 +257,7 @@ class Plant:
         keyframe's control; the rest is passive."""
         m, d = self.model, self.data
         start = (
-            f"the keyframe {_name(m, mujoco.mjtObj.mjOBJ_KEY, 0)!r}"
+            f"the keyframe {obj_name(m, mujoco.mjtObj.mjOBJ_KEY, 0)!r}"
             if m.nkey > 0 and mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_KEY, 0)
             else "the file's keyframe"
             if m.nkey > 0
@@ -272,7 +273,7 @@ class Plant:
         for j in range(m.njnt):
             if j in arm:
                 continue
-            name = _name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+            name = obj_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
             acts = [
                 a
                 for a in range(m.nu)
@@ -285,12 +286,12 @@ class Plant:
                 a = next(a for a in acts if a in held)
                 out[name] = (
                     f"held at {q:.4g} (its posture in {start}) by its servo "
-                    f"{_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)!r}, commanded to it"
+                    f"{obj_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a)!r}, commanded to it"
                 )
             elif acts:
                 out[name] = (
                     f"starts at {q:.4g} (its posture in {start}); its actuator "
-                    f"{_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, acts[0])!r} keeps the keyframe's "
+                    f"{obj_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, acts[0])!r} keeps the keyframe's "
                     "control (it holds no posture of its own)"
                 )
             else:
@@ -302,7 +303,7 @@ class Plant:
     @property
     def joint_names(self) -> list[str]:
         """The arm's joints, base to tip (the order of q)."""
-        return [_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self._joints]
+        return [obj_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self._joints]
 
     def _setup_model(self, model: mujoco.MjModel) -> None:
         self.model = model
@@ -349,7 +350,7 @@ class Plant:
             )
         hinge = int(mujoco.mjtJoint.mjJNT_HINGE)
         bad = [
-            f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)} ({mujoco.mjtJoint(m.jnt_type[j]).name})"
+            f"{obj_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)} ({mujoco.mjtJoint(m.jnt_type[j]).name})"
             for j in ids
             if m.jnt_type[j] != hinge
         ]
@@ -365,8 +366,8 @@ class Plant:
             if body == prev or prev not in self._ancestors(body):
                 raise ValueError(
                     "Plant needs a serial chain, one joint per body: joint "
-                    f"{_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} is not on a descendant "
-                    f"of body {_name(m, mujoco.mjtObj.mjOBJ_BODY, prev)!r}"
+                    f"{obj_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} is not on a descendant "
+                    f"of body {obj_name(m, mujoco.mjtObj.mjOBJ_BODY, prev)!r}"
                 )
         self._last_body = bodies[-1]
 
@@ -392,7 +393,7 @@ class Plant:
         self._gear = np.zeros(self.n)
         self.tau_max = np.zeros(self.n)
         for i, j in enumerate(self._joints):
-            jname = _name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+            jname = obj_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
             acts = act_of[j]
             if len(acts) != 1:
                 raise ValueError(
@@ -424,7 +425,7 @@ class Plant:
             # The sensor reads the force between the site's body and its parent:
             # with mass below it (a gripper) that is gravity and inertia too, not
             # the contact wrench. The contacts are measured instead.
-            name = _name(m, mujoco.mjtObj.mjOBJ_SENSOR, sensors[0])
+            name = obj_name(m, mujoco.mjtObj.mjOBJ_SENSOR, sensors[0])
             self.notes["wrench"] = (
                 f"the force sensor {name!r} carries {carried:.3g} kg below it (it reads "
                 "gravity and inertia as well as contact): the wrench comes from the contacts"
@@ -576,7 +577,7 @@ class Plant:
             "watch": self._watch.adr if self._watch is not None else [],
             "watch_out": self._watch.out if self._watch is not None else None,
             "dof_names": [
-                _name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)
+                obj_name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.dof_jntid[i])) for i in range(m.nv)
             ],
             "warning_names": _warning_names(),
         }
@@ -638,8 +639,8 @@ def mocap_welds(
             continue
         out.append(
             (
-                _name(m, mujoco.mjtObj.mjOBJ_BODY, b1 if m.body_mocapid[b1] >= 0 else b2),
-                _name(m, mujoco.mjtObj.mjOBJ_BODY, b2 if m.body_mocapid[b1] >= 0 else b1),
+                obj_name(m, mujoco.mjtObj.mjOBJ_BODY, b1 if m.body_mocapid[b1] >= 0 else b2),
+                obj_name(m, mujoco.mjtObj.mjOBJ_BODY, b2 if m.body_mocapid[b1] >= 0 else b1),
             )
         )
     return out

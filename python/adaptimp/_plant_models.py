@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _description, _mjcf, _models
+from . import _description, _models, _sampled
 from ._errors import ConfigError
 from ._tooling import add_table, add_tool
 
@@ -185,11 +185,11 @@ def estimate_effort(model: mujoco.MjModel, postures: int = 256) -> FloatArray:
     gives none: 2 (max |G_i(q)| + 10 rad/s² · max Σ_j |D_ij(q)|) over
     ``postures`` postures within the joint limits (:func:`from_urdf`): gravity
     and an acceleration of 10 rad/s² of every joint at once, twice over (the
-    core's rule, :func:`adaptimp._mjcf.estimate` without the drag terms)."""
+    core's rule, :func:`adaptimp._sampled.estimate` without the drag terms)."""
     joints = sorted(range(model.njnt), key=lambda j: int(model.jnt_dofadr[j]))
     qadr = [int(model.jnt_qposadr[j]) for j in joints]
     dofs = [int(model.jnt_dofadr[j]) for j in joints]
-    return _mjcf.estimate(model, qadr, dofs, postures, drag=False)
+    return _sampled.estimate(model, qadr, dofs, postures, drag=False)
 
 
 def panda(

@@ -14,7 +14,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _mjcf
+from . import _contacts
 from ._errors import PlantWarning
 from ._faults import Fault
 from ._loops import Run
@@ -184,7 +184,7 @@ def scene_contact_findings(
     found: Sequence[tuple[str, str, int, float, int]], rows: int, Ts: float
 ) -> list[str]:
     """The warning for watched contacts ``found`` ((arm body, other body,
-    periods in contact, peak force N, its row), :class:`adaptimp._mjcf.Watch`)
+    periods in contact, peak force N, its row), :class:`adaptimp._contacts.Watch`)
     over a run of ``rows`` periods of ``Ts`` s: the pairs by name, most
     steps first, each with its share of the steps, its peak force and when."""
     if not found or rows <= 0:
@@ -218,7 +218,7 @@ def _self_contact(plant: Plant, res: MujocoResult) -> list[str]:
     m = plant.model
     if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
         return []
-    contacts = _mjcf.Contacts(m, plant.data.qpos, plant._joints, self_only=True)
+    contacts = _contacts.Contacts(m, plant.data.qpos, plant._joints, self_only=True)
     if not contacts.possible:
         return []
     dt = float(res.t[1] - res.t[0]) if res.rows > 1 else 1.0
@@ -237,6 +237,6 @@ def _self_contact(plant: Plant, res: MujocoResult) -> list[str]:
         return []
     return [
         f"the arm touched itself in {100 * hits / len(rows):.1f} % of the rows checked "
-        f"({_mjcf.pairs(touched)}; first at t = {first:.3f} s): its own links collide along "
+        f"({_contacts.pairs(touched)}; first at t = {first:.3f} s): its own links collide along "
         "this task; give another home= or reference (or contact=False)"
     ]

@@ -16,11 +16,11 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _mjcf
+from . import _contacts
 from ._cartesian_task import CartesianTask, task_of
-from ._mjcf import _limits, _postures
 from ._plant import Plant
 from ._plant_models import ModelSource
+from ._sampled import _limits, _postures
 from ._trajectory import Reference, sinusoid
 
 FloatArray = NDArray[np.float64]
@@ -100,7 +100,7 @@ def home_posture(plant: Plant) -> FloatArray:
     width = np.where(np.isfinite(hi - lo), hi - lo, 2 * math.pi)
     amp = np.minimum(0.25 * width, TASK_AMPLITUDE)
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
-    contacts = _mjcf.Contacts(m, saved[0], plant._joints, margin=HOME_CLEARANCE)
+    contacts = _contacts.Contacts(m, saved[0], plant._joints, margin=HOME_CLEARANCE)
     swing = np.linspace(-1.0, 1.0, SWING_SAMPLES)
     touching: list[tuple[str, str, float]] = []
 
@@ -134,7 +134,7 @@ def home_posture(plant: Plant) -> FloatArray:
         raise ValueError(
             f"the default task's swing (±A about the home posture) brings the arm's bodies "
             f"within {HOME_CLEARANCE:g} m of each other at every posture compared "
-            f"({_mjcf.pairs(touching)}): give home= (rad), or simulate with contact=False"
+            f"({_contacts.pairs(touching)}): give home= (rad), or simulate with contact=False"
         )
     if best is None or best_load >= 1.0:
         raise ValueError(

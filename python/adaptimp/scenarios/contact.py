@@ -304,11 +304,11 @@ def _tool_and_table(
 def _watch_scene(spec: Any, model: Any, joints: Sequence[str], table: str | None) -> Any:
     """``model`` compiled again from ``spec`` with the arm's contacts with the
     rest of the scene watched through a run (SPEC §18.10,
-    :func:`adaptimp._mjcf.watch_contacts`): the tool on the table is the
+    :func:`adaptimp._contacts.watch_contacts`): the tool on the table is the
     task's own contact, every other one is warned of by name."""
     import mujoco
 
-    from .. import _mjcf
+    from .. import _contacts
 
     ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in joints]
     tool = [
@@ -317,7 +317,7 @@ def _watch_scene(spec: Any, model: Any, joints: Sequence[str], table: str | None
         if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, s) or "").startswith("ee")
     ]
     surface = [(tool[-1], table)] if tool and table is not None else []
-    if _mjcf.watch_contacts(spec, model, ids, surface) == 0:
+    if _contacts.watch_contacts(spec, model, ids, surface) == 0:
         return model
     return spec.compile()
 
@@ -873,7 +873,7 @@ def _urdf_arm(
 
     from .. import mujoco as amj
     from .._description import read_arm
-    from .._mjcf import _name
+    from .._mjmodel import obj_name
 
     arm = read_arm(path, tip, fix)
     tip = arm.tip if tip is None else tip
@@ -881,7 +881,7 @@ def _urdf_arm(
     chain = Chain.from_urdf(path, tip=tip, fix=fix)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
     joint = mujoco.mjtObj.mjOBJ_JOINT
-    driven = [_name(bare.model, joint, j) for j in bare._joints]
+    driven = [obj_name(bare.model, joint, j) for j in bare._joints]
     if driven != chain.joint_names:
         raise ConfigError(
             f"the chain to {tip!r} has the joints {chain.joint_names}, but the arm's model "

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from adaptimp import MeasurementError, _adaptimp, _loops
-from adaptimp.cartesian import _array
+from adaptimp._cartesian_impedance import _array
 
 
 def _reference(t: float) -> tuple[np.ndarray, np.ndarray, list[float]]:

@@ -19,6 +19,7 @@ import pytest
 
 import adaptimp
 from adaptimp import mujoco as amj
+from adaptimp.scenarios import _contact_model
 from adaptimp.scenarios import contact as act
 from adaptimp.scenarios import panda_table as apt
 from mujoco_probe import ee_position
@@ -733,7 +734,7 @@ def test_the_target_inertia_along_the_normal_follows_the_arms_own(tmp_path: Path
     sc = act.arm_table(heavy, home=[0.0, -0.3, 1.5])
     md = act.normal_inertia(sc, [sc.q0])
     m = sc.model
-    tool, table = act._tool_table(m)
+    tool, table = _contact_model.tool_table(m)
     inv = m.body_invweight0[m.geom_bodyid[tool], 0] + m.body_invweight0[m.geom_bodyid[table], 0]
     plant = amj.Plant(m, contact=False)
     plant.reset(sc.q0)
@@ -762,7 +763,7 @@ def test_a_heavy_tool_gets_a_softer_contact_impedance(tmp_path: Path) -> None:
     heavy.write_text(_SIDEWAYS_ARM.format(a=40.0))
     sc = act.arm_table(heavy, home=[0.0, -0.3, 1.5])
     m = sc.model
-    tool, table = act._tool_table(m)
+    tool, table = _contact_model.tool_table(m)
     inv = m.body_invweight0[m.geom_bodyid[tool], 0] + m.body_invweight0[m.geom_bodyid[table], 0]
     v = 2 * math.pi * sc.freq * sc.radius
     x = act.SLIP_SHARE * sc.target_force() * inv / (0.1 * v**2 / sc.radius)

@@ -225,13 +225,13 @@ def chain_of(plant: Any) -> Chain:
     site, or the origin of its end-effector body), the joints in the plant's
     order."""
     m = plant.model
-    site, body = int(plant._site), int(plant._ee_body)
+    site, body = int(plant.ee_site), int(plant.ee_body)
     tip = site if site >= 0 else mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, body)
     # The core's one reader of the chain (SPEC §21), to a site or a body's origin.
     chain = Chain.from_mujoco(m, tip if tip is not None else f"body#{body}")
     plant_joints = [
         mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(j)) or f"joint#{int(j)}"
-        for j in plant._joints
+        for j in plant.joint_ids
     ]
     if chain.joint_names != plant_joints:
         raise ConfigError(
@@ -239,16 +239,6 @@ def chain_of(plant: Any) -> Chain:
             f"drives {plant_joints}"
         )
     return chain
-
-
-def _limits(plant: Any) -> tuple[FloatArray, FloatArray]:
-    """The joint ranges (rad), ±inf where a joint is unlimited."""
-    m = plant.model
-    lo, hi = np.full(plant.n, -math.inf), np.full(plant.n, math.inf)
-    for i, j in enumerate(plant._joints):
-        if m.jnt_limited[j]:
-            lo[i], hi[i] = m.jnt_range[j]
-    return lo, hi
 
 
 @dataclass(frozen=True)
@@ -486,7 +476,7 @@ def task_of(
     if q0 is not None:
         orients = n >= 6
         q = _vector("q0", q0, chain)
-        lo, hi = _limits(plant)
+        lo, hi = _posture.limits_of(plant, plant.n)
         outside = np.flatnonzero((q < lo) | (q > hi))
         if outside.size:
             i = int(outside[0])
@@ -669,11 +659,11 @@ def _candidates(plant: Any, seed: int, count: int = CANDIDATES) -> list[FloatArr
     each kept inside the limits with the rule's margin, then ``count``
     (:data:`CANDIDATES`) drawn uniformly there (fixed seed; ±π for an
     unlimited joint; the first draws of a larger count are those of a smaller)."""
-    lo, hi = _limits(plant)
+    lo, hi = _posture.limits_of(plant, plant.n)
     lo_, hi_ = np.where(np.isfinite(lo), lo, -math.pi), np.where(np.isfinite(hi), hi, math.pi)
     margin = np.minimum(0.1, (hi_ - lo_) / 8)
     a, b = lo_ + margin, hi_ - margin
-    zero = np.clip(np.asarray(plant.model.qpos0[plant._qadr], dtype=np.float64), a, b)
+    zero = np.clip(np.asarray(plant.model.qpos0[plant.qpos_adr], dtype=np.float64), a, b)
     rng = np.random.default_rng(seed)
     return [zero, 0.5 * (a + b), *rng.uniform(a, b, size=(count, plant.n))]
 
@@ -684,7 +674,7 @@ def _screen(
     """The core's posture rule (SPEC (16.9)) at the candidate alone (σmin,
     limits, gravity, conditioning): its assessment (``error`` None if it
     passes there)."""
-    lo, hi = _limits(plant)
+    lo, hi = _posture.limits_of(plant, plant.n)
     a = _adaptimp.assess_posture(
         chain, q[None, :], chain.pose(q)[0][None, :], probe.gravity(q)[None, :],
         probe.inertia(q), lo, hi, np.asarray(plant.tau_max, dtype=np.float64), orients,
@@ -710,7 +700,7 @@ def _configured(chain: Chain, Ts: float, orients: bool, plant: Any) -> None:
     reported as "no start posture found")."""
     from .cartesian import CartesianImpedance
 
-    lo, hi = _limits(plant)
+    lo, hi = _posture.limits_of(plant, plant.n)
     limited = np.isfinite(lo) & np.isfinite(hi)
     mid = np.zeros(chain.n)
     mid[limited] = 0.5 * (lo[limited] + hi[limited])  # an unlimited joint at 0

@@ -28,8 +28,8 @@ class _Probe:
     def __init__(self, plant: Any) -> None:
         self.plant, self.m = plant, plant.model
         self.d = mujoco.MjData(self.m)
-        self.qadr = np.asarray(plant._qadr)
-        self.dofs = np.asarray(plant._dofs)
+        self.qadr = np.asarray(plant.qpos_adr)
+        self.dofs = np.asarray(plant.dof_adr)
         self._full = np.zeros((self.m.nv, self.m.nv))
 
     def at(self, q: FloatArray) -> None:
@@ -83,7 +83,9 @@ def collision(
     flags = int(m.opt.disableflags)
     m.opt.disableflags = flags & ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     try:  # the copy Contacts makes has contacts on, whatever the plant's setting
-        contacts = _contacts.Contacts(m, plant.data.qpos, list(plant._joints), self_only=not scene)
+        contacts = _contacts.Contacts(
+            m, plant.data.qpos, list(plant.joint_ids), self_only=not scene
+        )
     finally:
         m.opt.disableflags = flags
     names = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in skip}
@@ -96,10 +98,10 @@ def collision(
     probe = _Probe(plant)
     for k, q in enumerate(rows):
         probe.at(q)
-        points = [np.array(probe.d.xanchor[j]) for j in plant._joints]
-        site = int(getattr(plant, "_site", -1))
+        points = [np.array(probe.d.xanchor[j]) for j in plant.joint_ids]
+        site = plant.ee_site
         points.append(
-            np.array(probe.d.site_xpos[site] if site >= 0 else probe.d.xpos[plant._ee_body])
+            np.array(probe.d.site_xpos[site] if site >= 0 else probe.d.xpos[plant.ee_body])
         )
         pts = [np.zeros(3)]
         for p in points:

@@ -60,7 +60,8 @@ _SLIDE = int(mujoco.mjtJoint.mjJNT_SLIDE)
 # ---------------------------------------------------------------------------
 
 
-def _ancestors(m: mujoco.MjModel, body: int) -> list[int]:
+def ancestors(m: mujoco.MjModel, body: int) -> list[int]:
+    """The bodies ``body`` hangs from, its parent first, the world (0) last."""
     out = []
     while body > 0:
         body = int(m.body_parentid[body])

@@ -305,6 +305,50 @@ class Plant:
         """The arm's joints, base to tip (the order of q)."""
         return [obj_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in self._joints]
 
+    # What the run, the tasks and the scenarios read of the plant's model
+    # (read-only): MuJoCo's ids and addresses, base to tip.
+
+    @property
+    def joint_ids(self) -> list[int]:
+        """MuJoCo's ids of the arm's joints, base to tip (the order of q)."""
+        return list(self._joints)
+
+    @property
+    def qpos_adr(self) -> NDArray[np.int_]:
+        """Where each arm joint's angle lies in ``data.qpos``, (n,)."""
+        return np.array(self._qadr)
+
+    @property
+    def dof_adr(self) -> NDArray[np.int_]:
+        """Where each arm joint's rate lies in ``data.qvel`` (and its dof), (n,)."""
+        return np.array(self._dofs)
+
+    @property
+    def ee_site(self) -> int:
+        """The end effector's site id, or −1 (the origin of :attr:`ee_body`)."""
+        return int(self._site)
+
+    @property
+    def ee_body(self) -> int:
+        """The end effector's body id."""
+        return int(self._ee_body)
+
+    @property
+    def last_body(self) -> int:
+        """The body of the last arm joint (where a payload is added)."""
+        return int(self._last_body)
+
+    @property
+    def watch(self) -> _contacts.Watch | None:
+        """The contact sensors that watch the arm's contacts with the scene
+        through a run (SPEC §18.10), or None."""
+        return self._watch
+
+    def vector(self, name: str, value: ArrayLike) -> FloatArray:
+        """``value`` as one finite value per arm joint, (n,) (a scalar: every
+        joint), else an error naming ``name``."""
+        return self._vector(name, value)
+
     def _setup_model(self, model: mujoco.MjModel) -> None:
         self.model = model
         if not self.contact:
@@ -363,20 +407,13 @@ class Plant:
         self._dofs = np.array([m.jnt_dofadr[j] for j in self._joints])
         bodies = [int(m.jnt_bodyid[j]) for j in self._joints]
         for prev, (j, body) in zip(bodies, list(zip(self._joints, bodies))[1:]):
-            if body == prev or prev not in self._ancestors(body):
+            if body == prev or prev not in _mjcf.ancestors(m, body):
                 raise ValueError(
                     "Plant needs a serial chain, one joint per body: joint "
                     f"{obj_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} is not on a descendant "
                     f"of body {obj_name(m, mujoco.mjtObj.mjOBJ_BODY, prev)!r}"
                 )
         self._last_body = bodies[-1]
-
-    def _ancestors(self, body: int) -> list[int]:
-        out = []
-        while body > 0:
-            body = int(self.model.body_parentid[body])
-            out.append(body)
-        return out
 
     def _check_actuators(self) -> None:
         """The arm joints' motors (one each, :func:`_prepare` made them), their
@@ -438,10 +475,10 @@ class Plant:
             if m.sensor_type[s] == torque and m.sensor_objid[s] == sid and sensors
         ]
         self._torque_adr = int(m.sensor_adr[torques[0]]) if torques else -1
-        subtree = [
-            b for b in range(m.nbody) if b == self._ee_body or self._ee_body in self._ancestors(b)
-        ]
-        self._ee_subtree = frozenset(subtree)
+        ee = self._ee_body
+        self._ee_subtree = frozenset(
+            b for b in range(m.nbody) if b == ee or ee in _mjcf.ancestors(m, b)
+        )
         # A contact sensor of the net contact wrench on the end effector's subtree.
         nets = [
             s
@@ -548,7 +585,7 @@ class Plant:
         ct, ca = m.geom_contype, m.geom_conaffinity
         return any((ct[a] & ca[b]) or (ct[b] & ca[a]) for a in inside for b in outside)
 
-    def _core_spec(self, substeps: int) -> dict[str, Any]:
+    def core_spec(self, substeps: int) -> dict[str, Any]:
         """The plant as the core's loop drives it (SPEC §13.1): where its joints,
         motors and end effector are, and where the wrench is read: the force
         (and torque) sensor, the contact sensor, or, without either when a

@@ -62,7 +62,7 @@ def limits_of(model: Any, n: int) -> tuple[FloatArray, FloatArray]:
     lo, hi = np.full(n, -math.inf), np.full(n, math.inf)
     if _is_plant(model):
         m = model.model
-        for i, j in enumerate(model._joints):
+        for i, j in enumerate(model.joint_ids):
             if m.jnt_limited[j]:
                 lo[i], hi[i] = m.jnt_range[j]
     elif (

@@ -105,7 +105,7 @@ def _payload_plant(nominal: Plant, payload: float) -> Plant:
     if payload == 0:
         return nominal
     plant = Plant(
-        with_payload(nominal.model, float(payload), body=nominal._last_body),
+        with_payload(nominal.model, float(payload), body=nominal.last_body),
         contact=nominal.contact,
         tip=nominal.tip,
     )
@@ -545,11 +545,11 @@ def _setup(
     plant.timestep = Ts / int(substeps)
     if reset:
         plant.reset(q0, dq0)
-    if plant._watch is not None:  # this run's contacts only
-        plant._watch.clear(plant.data)
+    if plant.watch is not None:  # this run's contacts only
+        plant.watch.clear(plant.data)
     return Run(
         ctrl, plant, label, scenario, Ts, T, settle, int(substeps), steps, every, dist,
-        plant._core_spec(int(substeps)), _kind(ctrl), reference, task, float(payload), plant.q,
+        plant.core_spec(int(substeps)), _kind(ctrl), reference, task, float(payload), plant.q,
     )  # fmt: skip
 
 

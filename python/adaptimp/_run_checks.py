@@ -131,7 +131,7 @@ def check_run(run: Run, res: MujocoResult) -> None:
     found: list[str] = []
     if uses_rule(plant) and res.rows > 0:
         found += _self_contact(plant, res)
-    if plant._watch is not None and uses_rule(plant):
+    if plant.watch is not None and uses_rule(plant):
         found += _scene_contact(plant, int(res.metrics.get("rows", run.steps)), run.Ts)
     if uses_rule(plant) and res.rows > 0:
         found += torque_findings(res.t, res.tau, plant.tau_max, plant.joint_names,
@@ -176,8 +176,8 @@ def torque_findings(
 def _scene_contact(plant: Plant, rows: int, Ts: float) -> list[str]:
     """The warning of a run in which the arm touched the rest of the scene
     (the plant's watched contacts, SPEC §18.10), if it did."""
-    assert plant._watch is not None
-    return scene_contact_findings(plant._watch.found(plant.data), rows, Ts)
+    assert plant.watch is not None
+    return scene_contact_findings(plant.watch.found(plant.data), rows, Ts)
 
 
 def scene_contact_findings(
@@ -218,7 +218,7 @@ def _self_contact(plant: Plant, res: MujocoResult) -> list[str]:
     m = plant.model
     if m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_CONTACT):
         return []
-    contacts = _contacts.Contacts(m, plant.data.qpos, plant._joints, self_only=True)
+    contacts = _contacts.Contacts(m, plant.data.qpos, plant.joint_ids, self_only=True)
     if not contacts.possible:
         return []
     dt = float(res.t[1] - res.t[0]) if res.rows > 1 else 1.0

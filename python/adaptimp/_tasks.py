@@ -96,11 +96,11 @@ def home_posture(plant: Plant) -> FloatArray:
         message names the bodies: give ``home=``).
     """
     m = plant.model
-    lo, hi = _limits(m, plant._joints)
+    lo, hi = _limits(m, plant.joint_ids)
     width = np.where(np.isfinite(hi - lo), hi - lo, 2 * math.pi)
     amp = np.minimum(0.25 * width, TASK_AMPLITUDE)
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
-    contacts = _contacts.Contacts(m, saved[0], plant._joints, margin=HOME_CLEARANCE)
+    contacts = _contacts.Contacts(m, saved[0], plant.joint_ids, margin=HOME_CLEARANCE)
     swing = np.linspace(-1.0, 1.0, SWING_SAMPLES)
     touching: list[tuple[str, str, float]] = []
 
@@ -147,10 +147,10 @@ def home_posture(plant: Plant) -> FloatArray:
 def _gravity_load(plant: Plant, q: FloatArray) -> float:
     """max_i |G_i(q)|/τmax_i at rest."""
     d = plant.data
-    d.qpos[plant._qadr] = q
+    d.qpos[plant.qpos_adr] = q
     d.qvel[:] = 0.0
     mujoco.mj_forward(plant.model, d)
-    return float(np.max(np.abs(d.qfrc_bias[plant._dofs]) / plant.tau_max))
+    return float(np.max(np.abs(d.qfrc_bias[plant.dof_adr]) / plant.tau_max))
 
 
 TASK_AMPLITUDE = 0.2
@@ -167,8 +167,8 @@ def default_task(plant: Plant, home: ArrayLike | None = None) -> Task:
     from . import tuning
 
     m = plant.model
-    lo, hi = _limits(m, plant._joints)
-    h = home_posture(plant) if home is None else plant._vector("home", home)
+    lo, hi = _limits(m, plant.joint_ids)
+    h = home_posture(plant) if home is None else plant.vector("home", home)
     kw = tuning.default_task(h, lo, hi)
     q0 = np.asarray(kw["xc_offset"]) + np.asarray(kw["xc_cos"])
     return Task(home=h, q0=q0, keywords=kw, period=2 * math.pi / kw["xc_omega"][0])

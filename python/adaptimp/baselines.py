@@ -149,7 +149,7 @@ def plant_drive(
     names = list(plant.joint_names)
     if sorted(names) != sorted(joints):
         return None
-    dofs = np.array([plant._dofs[names.index(j)] for j in joints])
+    dofs = np.array([plant.dof_adr[names.index(j)] for j in joints])
     substeps = max(1, round(Ts / float(m.opt.timestep)))
     h = Ts / substeps
     integrator = int(m.opt.integrator)

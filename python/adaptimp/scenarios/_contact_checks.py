@@ -69,7 +69,7 @@ def refusal_of(sc: PandaTable, *, load: float = 0.5) -> str | None:
     # the tool on the table left out: that is the task.
     a = _posture.assess(
         plant, sc.chain, sc.q0, rows, targets, orients=False, k1=CONTACT_K1, Ts=sc.Ts,
-        load=load, tau_max=sc.tau_max, skip=frozenset({int(plant._ee_body)}),
+        load=load, tau_max=sc.tau_max, skip=frozenset({int(plant.ee_body)}),
     )  # fmt: skip
     if a["error"] is not None:
         return str(a["error"])
@@ -147,11 +147,11 @@ def _through_table(sc: PandaTable, plant: Any, rows: FloatArray) -> str | None:
     d = mujoco.MjData(m)
     top = sc.surface_z - float(m.geom_size[tool, 0])
     for k, q in enumerate(rows):
-        d.qpos[plant._qadr] = q
+        d.qpos[plant.qpos_adr] = q
         mujoco.mj_kinematics(m, d)
         centre, half = d.geom_xpos[g], m.geom_size[g]
         axes = d.geom_xmat[g].reshape(3, 3)  # the table's axes (turned if it faces the base)
-        for i, j in enumerate(plant._joints):
+        for i, j in enumerate(plant.joint_ids):
             a = axes.T @ (d.xanchor[j] - centre)
             over = abs(a[0]) <= half[0] and abs(a[1]) <= half[1]
             if over and d.xanchor[j][2] < top:

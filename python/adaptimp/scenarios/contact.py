@@ -164,7 +164,7 @@ def _limits(plant: Any) -> tuple[FloatArray, FloatArray]:
     m = plant.model
     lo = np.full(plant.n, -math.pi)
     hi = np.full(plant.n, math.pi)
-    for i, j in enumerate(plant._joints):
+    for i, j in enumerate(plant.joint_ids):
         if m.jnt_limited[j]:
             lo[i], hi[i] = m.jnt_range[j]
     return lo, hi
@@ -438,7 +438,7 @@ def _urdf_arm(
     chain = Chain.from_urdf(path, tip=tip, fix=fix)
     bare = amj.Plant(arm_model(path, tip, fix=fix, tool_radius=tool_radius))
     joint = mujoco.mjtObj.mjOBJ_JOINT
-    driven = [obj_name(bare.model, joint, j) for j in bare._joints]
+    driven = [obj_name(bare.model, joint, j) for j in bare.joint_ids]
     if driven != chain.joint_names:
         raise ConfigError(
             f"the chain to {tip!r} has the joints {chain.joint_names}, but the arm's model "
@@ -473,7 +473,7 @@ def _mjcf_arm(
             for j in plain.notes.get("locked", {})
             if j in plain.notes.get("locked_bodies", {})
         }
-        body = int(plain._ee_body)
+        body = plain.ee_body
         while True:
             children = [b for b in range(m.nbody) if int(m.body_parentid[b]) == body and b != 0]
             name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, children[0]) if children else None

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import _contacts, _sampled
+from adaptimp import _contacts, _mjcf, _sampled
 from adaptimp import mujoco as amj
 from mujoco_probe import measure
 
@@ -159,6 +159,36 @@ def test_the_chain_to_a_body_or_a_site_is_mujocos() -> None:
         adaptimp.Chain.from_mujoco(UR5, tip="nowhere")
     with pytest.raises(FileNotFoundError, match=r"no file 'nowhere\.xml'"):
         adaptimp.Chain.from_mujoco("nowhere.xml")
+
+
+def test_the_default_tip_is_the_cores(tmp_path: Path) -> None:
+    """Without tip=, the plant's end effector, the chain's tip and the Cartesian
+    task's chain are the core's reduction's (SPEC (21.2) rule 7): a site on the
+    last arm joint's body that no force sensor measures at is not the tip (the
+    body's origin is); a force sensor's site a hinge of the arm moves is."""
+    spec = mujoco.MjSpec.from_file(str(UR5))
+    spec.body("wrist_3_link").add_site(name="marker", pos=[0.0, 0.05, 0.0])
+    path = tmp_path / "ur5_marker.xml"
+    path.write_text(spec.to_xml())
+    with pytest.warns(adaptimp.PlantWarning):
+        plant = amj.Plant(str(path))
+    core = _mjcf.arm_of(mujoco.MjModel.from_xml_path(str(path)))
+    assert core["tip"] == "wrist_3_link"
+    assert plant.notes["tip"] == "wrist_3_link"
+    assert plant.ee_site == -1
+    assert plant.ee_body == plant.model.body("wrist_3_link").id
+    assert adaptimp.Chain.from_mujoco(str(path)).source == "MuJoCo model to body 'wrist_3_link'"
+    assert amj.chain_of(plant).source == "MuJoCo model to body 'wrist_3_link'"
+    # A force sensor at the site makes it the tool frame, the tip.
+    spec.add_sensor(
+        type=mujoco.mjtSensor.mjSENS_FORCE, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="marker"
+    )
+    path.write_text(spec.to_xml())
+    with pytest.warns(adaptimp.PlantWarning):
+        plant = amj.Plant(str(path))
+    assert plant.notes["tip"] == "marker"
+    assert plant.ee_site == plant.model.site("marker").id
+    assert amj.chain_of(plant).source == "MuJoCo model to site 'marker'"
 
 
 def test_a_compiled_model_is_refused_where_only_the_file_can_be_edited() -> None:

@@ -73,7 +73,9 @@ def test_a_step_takes_a_pose_target_as_it_takes_its_parts() -> None:
     for k in range(5):
         p = p0 + np.array([0.001 * k, 0.0, 0.0])
         ra = a.step(p, [0.1, 0.0, 0.0], wrench=[0.0, 0.0, 1.0])
-        rb = b.step(target=PoseTarget(p=p, dp=[0.1, 0.0, 0.0], R=a._R), wrench=[0.0, 0.0, 1.0])
+        rb = b.step(
+            target=PoseTarget(p=p, dp=[0.1, 0.0, 0.0], R=a.held_rotation), wrench=[0.0, 0.0, 1.0]
+        )
         for x, y in zip(ra, rb):
             assert np.array_equal(x, y)
     out = a.output

@@ -252,7 +252,7 @@ class CartesianImpedance:
             posture = reals("posture", posture, finite=False)
         self._core = _adaptimp.CartesianImpedance(chain, self.params, float(Ts), self.q0, posture)
         self.Ts = float(Ts)
-        self._R = chain.fk(self.q0)[:3, :3].copy()
+        self.held_rotation = chain.fk(self.q0)[:3, :3].copy()
 
     @property
     def ts(self) -> float:
@@ -260,12 +260,13 @@ class CartesianImpedance:
         return period_alias(self)
 
     @property
-    def _R(self) -> FloatArray:
-        """The commanded rotation a target without one keeps (3, 3), held by the core."""
+    def held_rotation(self) -> FloatArray:
+        """The commanded rotation a target without one keeps (3, 3), world ←
+        tip, held by the core."""
         return np.asarray(self._core.held_rotation())
 
-    @_R.setter
-    def _R(self, R: ArrayLike) -> None:
+    @held_rotation.setter
+    def held_rotation(self, R: ArrayLike) -> None:
         self._core.set_held_rotation(np.asarray(R, dtype=np.float64).reshape(9))
 
     @property
@@ -296,29 +297,13 @@ class CartesianImpedance:
         (initially the start's, fk(q0)). The core checks the target as a step
         would (a rotation that is not one, a value not finite or beyond its
         ceiling: MeasurementError); only a good R is kept as the last one."""
-        out = self._target((p, dp, ddp, R, w, dw))
+        out = flat_target(self, (p, dp, ddp, R, w, dw))
         try:
             self._core.check_target(out)
         except MeasurementError as e:
             raise as_given(e, _POSE_NAMES) from None
-        self._commit(out, R)
+        commit_rotation(self, out, R)
         return out
-
-    def _target(
-        self, values: Sequence[ArrayLike | None], names: Sequence[str] = _POSE_NAMES
-    ) -> FloatArray:
-        """The flat target of (p, dp, ddp, R, w, dw), R the last commanded one if
-        None; nothing kept (see :meth:`_commit`)."""
-        v = list(values)
-        if v[3] is None:
-            v[3] = self._R
-        return _pose(v, names)
-
-    def _commit(self, target: FloatArray | None, R: object) -> None:
-        """After the core accepted ``target``: its rotation is the last commanded
-        one if it set one (``R`` given, or a path's 6-tuple)."""
-        if target is not None and R is not None:
-            self._R = target[9:18].reshape(3, 3).copy()
 
     def step(
         self,
@@ -341,9 +326,9 @@ class CartesianImpedance:
             if p is not None:
                 raise TypeError("give the commanded pose as p=… or as target=…, not both")
             p, dp, ddp, R, w, dw = target.p, target.dp, target.ddp, target.R, target.w, target.dw
-        flat = None if p is None else self._target((p, dp, ddp, R, w, dw))
+        flat = None if p is None else flat_target(self, (p, dp, ddp, R, w, dw))
         q, dq, ddq = self._core.reference(flat, wrench_of(wrench))
-        self._commit(flat, R)
+        commit_rotation(self, flat, R)
         return q, dq, ddq
 
     def last(self, what: str) -> FloatArray:
@@ -363,7 +348,7 @@ class CartesianImpedance:
         start = self.q0 if q0 is None else np.array(q0, dtype=np.float64)
         self._core.reset(start)
         self.q0 = start
-        self._R = self.chain.fk(self.q0)[:3, :3].copy()
+        self.held_rotation = self.chain.fk(self.q0)[:3, :3].copy()
 
     def set_stiffness(self, Kd: ArrayLike, Kd_rot: ArrayLike | None = None) -> None:
         """Ask for the stiffness ``Kd`` (N/m) and ``Kd_rot`` (N m/rad; default
@@ -428,3 +413,23 @@ class CartesianImpedance:
         table = tabulate(path, steps, self.Ts, self.chain.fk(start)[:3, :3])
         q, dq, ddq = self._core.orbit(start, table, samples)
         return tuple(np.asarray(a, dtype=np.float64) for a in (q, dq, ddq))  # type: ignore[return-value]
+
+
+def flat_target(
+    outer: CartesianImpedance,
+    values: Sequence[ArrayLike | None],
+    names: Sequence[str] = _POSE_NAMES,
+) -> FloatArray:
+    """The flat target (24,) of (p, dp, ddp, R, w, dw), R the outer loop's held
+    rotation if None; nothing kept (see :func:`commit_rotation`)."""
+    v = list(values)
+    if v[3] is None:
+        v[3] = outer.held_rotation
+    return _pose(v, names)
+
+
+def commit_rotation(outer: CartesianImpedance, target: FloatArray | None, R: object) -> None:
+    """After the core accepted ``target``: its rotation is the one the outer
+    loop holds if it set one (``R`` given, or a path's 6-tuple)."""
+    if target is not None and R is not None:
+        outer.held_rotation = target[9:18].reshape(3, 3).copy()

@@ -250,7 +250,7 @@ def _pose_table(
     pc = np.asarray(log["pc"], dtype=np.float64)
     table = np.zeros((len(pc) * every, 24))
     table[:, 0:3] = np.repeat(pc, every, axis=0)
-    table[:, 9:18] = np.asarray(ctrl.outer._R, dtype=np.float64).reshape(9)
+    table[:, 9:18] = np.asarray(ctrl.outer.held_rotation, dtype=np.float64).reshape(9)
     return table
 
 

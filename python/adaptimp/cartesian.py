@@ -49,7 +49,9 @@ from ._cartesian_impedance import (
     FloatArray,
     Path,
     as_given,
+    commit_rotation,
     finite_pose,
+    flat_target,
     measured_of,
     pose_of,
     wrench_of,
@@ -543,7 +545,7 @@ class CartesianController:
         given: FloatArray | None = None
         if xc is not None:
             # Read here, each part named as given (the core reads p_c, R_c, …).
-            given = self.outer._target((xc, dxc, ddxc, R, w, dw), names)
+            given = flat_target(self.outer, (xc, dxc, ddxc, R, w, dw), names)
             finite_pose(given, names)
             sample: Any = given
         elif self.path is not None:
@@ -574,7 +576,7 @@ class CartesianController:
         if given is not None:
             flat, turned = given, R
         elif sample is not None:
-            flat = pose_of(sample, self.outer._R)
+            flat = pose_of(sample, self.outer.held_rotation)
             turned = True
         core = self.outer.core
         try:
@@ -584,7 +586,7 @@ class CartesianController:
                 raise
             raise as_given(e, names) from None
         self._tau = np.asarray(getattr(self.inner, "tau", out), dtype=np.float64)
-        self.outer._commit(flat, turned)
+        commit_rotation(self.outer, flat, turned)
         if self.record:
             for key, v in zip(
                 _LOG,
@@ -629,14 +631,16 @@ class CartesianController:
             return None
         if reference is not None and not callable(reference):
             out = np.zeros((steps, 24))
-            out[:, 9:18] = self.outer._R.ravel()
+            out[:, 9:18] = self.outer.held_rotation.ravel()
             for i in range(3):
                 out[:, 3 * i : 3 * i + 3] = reference[i][:steps]
             return out
         if reference is not None:
-            return tabulate(reference, steps, self.Ts, self.outer._R, what="reference(t)")
+            return tabulate(
+                reference, steps, self.Ts, self.outer.held_rotation, what="reference(t)"
+            )
         assert path is not None
-        return tabulate(path, steps, self.Ts, self.outer._R, start=self._k)
+        return tabulate(path, steps, self.Ts, self.outer.held_rotation, start=self._k)
 
     def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None, k0: int) -> None:
         """After a run of the core's loop (:func:`adaptimp.mujoco.simulate`) along
@@ -645,7 +649,7 @@ class CartesianController:
         extended by the run's kept rows ``task`` (None: none); ``k0`` the steps
         taken before it."""
         if self._k > k0 and targets is not None and self.path is not None:
-            self.outer._R = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
+            self.outer.held_rotation = targets[self._k - k0 - 1, 9:18].reshape(3, 3).copy()
         if self.record and task is not None and len(task["pc"]):
             log = self.log
             for key in _LOG:

@@ -273,12 +273,12 @@ def simulate(
         core_params = {k: v for k, v in p.items() if k in BY_NAME}
         out = _adaptimp.simulate(
             core,
-            arm._core,
+            arm.core,
             core_params,
             every,
             callback,
             _weights_or_none(weights),
-            None if fault is None else fault._core(n),
+            None if fault is None else fault.core(n),
         )
     finally:
         if bar is not None:

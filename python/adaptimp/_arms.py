@@ -52,6 +52,11 @@ class TwoLinkArm:
         return (_two_link_arm, (self._params,))
 
     @property
+    def core(self) -> Any:
+        """The compiled arm (``adaptimp._adaptimp.TwoLinkArm``) the core's runs simulate."""
+        return self._core
+
+    @property
     def params(self) -> dict[str, Any]:
         """The arm's parameters (a copy), derived ones included."""
         return dict(self._params)
@@ -195,6 +200,11 @@ class PlanarArm:
     def __reduce__(self) -> tuple[Any, ...]:
         p = self._params
         return (PlanarArm, (p["n"], p["masses"], p["lengths"], p["coms"], p["inertias"], p["g"]))
+
+    @property
+    def core(self) -> Any:
+        """The compiled arm (``adaptimp._adaptimp.PlanarArm``) the core's runs simulate."""
+        return self._core
 
     @property
     def n(self) -> int:

@@ -61,7 +61,7 @@ class Fault:
         number("Fault start", self.start)
         positive("Fault duration", self.duration)
 
-    def _core(self, n: int) -> CoreFault:
+    def core(self, n: int) -> CoreFault:
         """The form the compiled core takes, for n joints."""
         bias = None
         if self.bias is not None:

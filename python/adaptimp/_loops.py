@@ -264,11 +264,11 @@ def _computed_loop(
     if run.reference is not None:
         refs = tabulate(run.reference, run.steps, Ts, run.plant.n)
     else:
-        if ctrl._trajectory is None:
+        if ctrl.trajectory is None:
             raise ValueError("no setpoint given and no trajectory to follow")
-        k0 = int(ctrl._core.steps)
-        refs = tabulate(lambda t: ctrl._trajectory(t), run.steps, Ts, run.plant.n, k0)
-    out: dict[str, Any] = ctrl._core.simulate_mujoco(
+        k0 = int(ctrl.core.steps)
+        refs = tabulate(ctrl.trajectory, run.steps, Ts, run.plant.n, k0)
+    out: dict[str, Any] = ctrl.core.simulate_mujoco(
         run.plant.model, run.plant.data, run.spec, run.dist, run.T, run.settle, refs,
         run.every, progress, fault,
     )  # fmt: skip

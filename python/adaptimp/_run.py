@@ -362,7 +362,7 @@ def simulate(
     from ._api import _progress
 
     callback, bar = _progress(progress, "mujoco.simulate")
-    core_fault = None if fault is None else fault._core(run.plant.n)
+    core_fault = None if fault is None else fault.core(run.plant.n)
     try:
         out = LOOPS[run.kind](run, callback, core_fault)
     finally:

@@ -272,7 +272,7 @@ def _rerun(
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             core = _core_controller(case, p, n, None, None)
-            out = _adaptimp.simulate(core, arm._core, p, record_every, None, None, None)
+            out = _adaptimp.simulate(core, arm.core, p, record_every, None, None, None)
     except (TypeError, ValueError, KeyError, ArithmeticError) as e:
         if why is not None:
             why.append(f"{type(e).__name__}: {e}")

@@ -223,7 +223,7 @@ def _run_batch(
 ) -> list[dict[str, Any] | str]:
     """Run ``jobs`` (case, params, arm) in this process on ``threads`` threads: the
     task an executor runs, and the batches of ``executor=None``."""
-    core_jobs = [(c, p, None if a is None else a._core) for c, p, a in jobs]
+    core_jobs = [(c, p, None if a is None else a.core) for c, p, a in jobs]
     return list(_adaptimp.simulate_many(core_jobs, threads, progress))
 
 

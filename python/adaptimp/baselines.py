@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, overload
 
@@ -570,6 +570,17 @@ class ComputedTorque:
     def reset(self) -> None:
         """Back to t = 0; the reference starts at the next setpoint."""
         self._core.reset()
+
+    @property
+    def core(self) -> Any:
+        """The compiled controller (``adaptimp._adaptimp.ComputedTorque``) the
+        core's loops step."""
+        return self._core
+
+    @property
+    def trajectory(self) -> Callable[[float], Any] | None:
+        """The built-in reference t -> (xc, dxc, ddxc) (rad, rad/s, rad/s²), or None."""
+        return self._trajectory
 
     @property
     def _core_joint(self) -> Any:

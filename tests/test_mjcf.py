@@ -163,32 +163,37 @@ def test_the_chain_to_a_body_or_a_site_is_mujocos() -> None:
 
 def test_the_default_tip_is_the_cores(tmp_path: Path) -> None:
     """Without tip=, the plant's end effector, the chain's tip and the Cartesian
-    task's chain are the core's reduction's (SPEC (21.2) rule 7): a site on the
-    last arm joint's body that no force sensor measures at is not the tip (the
-    body's origin is); a force sensor's site a hinge of the arm moves is."""
+    task's chain are the core's reduction's (SPEC (21.2) rules 2 and 7): the
+    last arm joint's body's origin; the first site on that body (the tool
+    point the file's author named there); a force sensor's site a hinge of
+    the arm moves, before either."""
     spec = mujoco.MjSpec.from_file(str(UR5))
-    spec.body("wrist_3_link").add_site(name="marker", pos=[0.0, 0.05, 0.0])
     path = tmp_path / "ur5_marker.xml"
+    core = _mjcf.arm_of(mujoco.MjModel.from_xml_path(str(UR5)))
+    assert core["tip"] == "wrist_3_link"
+    spec.body("wrist_3_link").add_site(name="marker", pos=[0.0, 0.05, 0.0])
+    spec.body("wrist_3_link").add_site(name="second", pos=[0.0, 0.0, 0.05])
+    spec.body("shoulder_link").add_site(name="elsewhere", pos=[0.0, 0.0, 0.05])
     path.write_text(spec.to_xml())
     with pytest.warns(adaptimp.PlantWarning):
         plant = amj.Plant(str(path))
     core = _mjcf.arm_of(mujoco.MjModel.from_xml_path(str(path)))
-    assert core["tip"] == "wrist_3_link"
-    assert plant.notes["tip"] == "wrist_3_link"
-    assert plant.ee_site == -1
+    assert core["tip"] == "marker"
+    assert plant.notes["tip"] == "marker"
+    assert plant.ee_site == plant.model.site("marker").id
     assert plant.ee_body == plant.model.body("wrist_3_link").id
-    assert adaptimp.Chain.from_mujoco(str(path)).source == "MuJoCo model to body 'wrist_3_link'"
-    assert amj.chain_of(plant).source == "MuJoCo model to body 'wrist_3_link'"
-    # A force sensor at the site makes it the tool frame, the tip.
+    assert adaptimp.Chain.from_mujoco(str(path)).source == "MuJoCo model to site 'marker'"
+    assert amj.chain_of(plant).source == "MuJoCo model to site 'marker'"
+    # A force sensor's site comes first, wherever the arm moves it.
     spec.add_sensor(
-        type=mujoco.mjtSensor.mjSENS_FORCE, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="marker"
+        type=mujoco.mjtSensor.mjSENS_FORCE, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="second"
     )
     path.write_text(spec.to_xml())
     with pytest.warns(adaptimp.PlantWarning):
         plant = amj.Plant(str(path))
-    assert plant.notes["tip"] == "marker"
-    assert plant.ee_site == plant.model.site("marker").id
-    assert amj.chain_of(plant).source == "MuJoCo model to site 'marker'"
+    assert plant.notes["tip"] == "second"
+    assert plant.ee_site == plant.model.site("second").id
+    assert amj.chain_of(plant).source == "MuJoCo model to site 'second'"
 
 
 def test_a_compiled_model_is_refused_where_only_the_file_can_be_edited() -> None:

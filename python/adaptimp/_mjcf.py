@@ -115,9 +115,9 @@ def arm_of(m: mujoco.MjModel, tip: str | None = None, fix: Sequence[str] = ()) -
     §21, :func:`adaptimp._description.read_arm`; the rule of a URDF's arm on
     MuJoCo's body tree): the arm's hinges, the tip (``tip``, a site or a
     body, a site first; without it the site of a force sensor a hinge moves,
-    else the body of the last arm joint), and why every other joint is not
-    the arm's (asked, mimic or coupled, a gripper's drive or jaw, in a hand,
-    prismatic, off the chain).
+    else the first site on the last arm joint's body, else that body), and
+    why every other joint is not the arm's (asked, mimic or coupled, a
+    gripper's drive or jaw, in a hand, prismatic, off the chain).
 
     Returns a dict: ``joints`` (names, base to tip), ``joint_ids`` (MuJoCo
     ids), ``fixed`` ({name: reason}), ``tip`` (its name), ``tip_kind``
@@ -709,7 +709,7 @@ def end_effector(m: mujoco.MjModel, tip: str) -> tuple[int, int]:
     origin; a link of the core's tree, :func:`_body_of`). ``tip`` is the one
     asked for, or the one the core's reduction found (:func:`arm_of`'s
     ``"tip"``: the site of a force sensor a hinge of the arm moves, else the
-    body of the last arm joint; SPEC (21.2)).
+    first site on the last arm joint's body, else that body; SPEC (21.2)).
 
     Raises
     ------

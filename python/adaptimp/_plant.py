@@ -118,7 +118,8 @@ class Plant:
         The end effector, a site or a body (its origin; a site if both have
         the name): the arm is the hinges on the way to it. Default: the core's
         rule (SPEC (21.2)), the site of a force sensor that a hinge of the arm
-        moves, else the origin of the last arm joint's body. A URDF's ``tip``
+        moves, else the first site on the last arm joint's body, else that
+        body's origin. A URDF's ``tip``
         is a link.
     fix : tuple of str
         Joints to lock as well (at their reference position), by name.

@@ -169,7 +169,8 @@ class Chain(_adaptimp.Chain):
         it), or a site id; ``site=`` is the earlier keyword for a site. By
         default the plant's end effector (:class:`adaptimp.mujoco.Plant`), the
         core's rule (SPEC (21.2)): the site of a force sensor that a hinge of
-        the arm moves, else the last arm joint's body. The chain's joints are the arm's
+        the arm moves, else the first site on the last arm joint's body, else
+        that body. The chain's joints are the arm's
         (the core's one reduction, SPEC §21: the hinges and slides on the way
         to the tip that it does not hold, a gripper's coupled joints and those
         named in ``fix``); any other joint on the way is held at its

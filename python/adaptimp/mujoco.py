@@ -17,21 +17,22 @@ rest of adaptimp never imports it.
   :func:`panda` (the Franka Emika Panda of ``example-robot-data``, arm only, on a
   table), :func:`from_urdf` (any URDF arm, with motors from its effort limits).
 
-The measured wrench. If the model has a ``force`` sensor, its site is the end
-effector and F_e is read from it (with the ``torque`` sensor on the same site,
-if any, for the moment; without one the moment is taken as zero). MuJoCo's
-force/torque sensors measure the wrench between the site's body and its parent,
-so the site should sit on a massless body welded to the last link, holding the
-contact geometry: then the reading is exactly the contact wrench (the packaged
-models do this). Without a force sensor, F_e is the net force of the active
-contacts between the end-effector body's subtree and anything outside it,
-with the moment about the end-effector point (the plant's ``tip``, by
-default the last arm joint's body's origin): for a model :class:`Plant` loads from a
-file and in which no contact can arise inside that subtree, from a contact
-sensor it adds (the net contact wrench on the subtree, ``reduce="netforce"``;
-it changes no dynamics); otherwise from the external forces MuJoCo sums from
-its contact list on each body of the subtree (``cfrc_ext``: a contact inside
-the subtree cancels). :attr:`Plant.wrench_source` says which is used.
+The measured wrench. If the model has a ``force`` sensor, its site is the
+end effector and F_e is read from it (with the ``torque`` sensor on the same
+site, if any, for the moment; without one the moment is taken as zero).
+MuJoCo's force/torque sensors measure the wrench between the site's body and
+its parent, so the site should sit on a massless body welded to the last
+link, holding the contact geometry: then the reading is exactly the contact
+wrench (the packaged models do this). Without a force sensor, F_e is the net
+force of the active contacts between the end-effector body's subtree and
+anything outside it, with the moment about the end-effector point (the
+plant's ``tip``, by default a site on the last arm joint's body, else its
+origin): for a model :class:`Plant` loads from a file and in which no
+contact can arise inside that subtree, from a contact sensor it adds (the
+net contact wrench on the subtree, ``reduce="netforce"``; it changes no
+dynamics); otherwise from the external forces MuJoCo sums from its contact
+list on each body of the subtree (``cfrc_ext``: a contact inside the subtree
+cancels). :attr:`Plant.wrench_source` says which is used.
 
 Units: rad, rad/s, rad/s², N, N m, m, s. Vectors in the world frame.
 

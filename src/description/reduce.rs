@@ -145,12 +145,19 @@ pub fn reduce(tree: &Tree, tip: Option<&str>, fix: &[&str]) -> Result<Arm, Descr
             let arm = find_chain(&mut r, root)?;
             let last = arm[arm.len() - 1];
             let end = tree.joint_links(last).1;
-            let tip_name = tree.links()[end].name.clone();
+            let link_name = tree.links()[end].name.clone();
             // The joints the rule passes on its way are the arm's business
             // too (a floating one was held silently here, refused with the
             // same tip given).
-            on_the_way(tree, &tree.path_to(end), &tip_name, fix)?;
-            (root, arm, tip_name)
+            on_the_way(tree, &tree.path_to(end), &link_name, fix)?;
+            // Rule 7: a frame the file's author put on that link (a MuJoCo
+            // site: `grasp`, `end_effector`) is the tool point, the first
+            // in file order; else the link itself.
+            if let Some(f) = tree.frames().iter().position(|f| f.link == link_name) {
+                let tip_name = tree.frames()[f].name.clone();
+                return build(&r, root, arm, tip_name, Some(end), Some(f));
+            }
+            (root, arm, link_name)
         }
     };
     build(&r, base, arm, tip_name, tip_link, tip_frame)

@@ -533,6 +533,16 @@ fn a_mujoco_model_is_the_same_kind_of_tree() {
     assert_eq!(arm.chain[0].offset, 0.4);
     let mass: f64 = arm.inertials.iter().map(|i| i.mass).sum();
     assert_eq!(mass, 3.0);
+    // Without tip=, rule 7 of SPEC (21.2): the site on the last arm joint's
+    // body (b) is the tip; the slide is not the rule's arm.
+    let arm = reduce(&tree, None, &[]).unwrap();
+    assert_eq!((arm.tip.as_str(), arm.tip_is_frame), ("tip", true));
+    assert_eq!(names(&arm), ["j1", "j3"]);
+    // Without a site there, the body's origin.
+    let mut m = mujoco_arrays();
+    m.site_bodyid = std::vec![1];
+    let arm = reduce(&m.tree("MJCF 'm.xml'").unwrap(), None, &[]).unwrap();
+    assert_eq!((arm.tip.as_str(), arm.tip_is_frame), ("b", false));
 }
 
 #[test]

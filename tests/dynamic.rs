@@ -1375,3 +1375,30 @@ fn a_model_arm_gives_each_quantity_of_its_dynamics() {
             .to_string()
     );
 }
+
+/// Whether the run-time disturbances have friction, and its torque: the
+/// const-generic ones'.
+#[test]
+fn run_time_disturbances_have_the_friction_of_their_scenario() {
+    let none = dy::Scenario::new(3, Preset::Robot, Law::StateFeedback)
+        .unwrap()
+        .disturbances()
+        .unwrap();
+    assert_eq!(none.n(), 3);
+    assert!(!none.has_friction());
+    let b = [0.5, 0.25, 0.125];
+    let mut s = Scenario::<3>::preset(Preset::Robot, Law::StateFeedback);
+    s.set("friction_viscous", Value::Vec(&b)).unwrap();
+    let mut d = dy::Scenario::new(3, Preset::Robot, Law::StateFeedback).unwrap();
+    d.set("friction_viscous", Value::Vec(&b)).unwrap();
+    let run_time = d.disturbances().unwrap();
+    assert!(run_time.has_friction());
+    let dq = [0.3, -0.2, 0.1];
+    let mut out = [0.0; 3];
+    assert!(run_time.friction_torque(&dq, &mut out).unwrap());
+    let typed = s.disturbances().unwrap();
+    let want = typed
+        .friction()
+        .torque(&Vector::<3>::from_column_slice(&dq));
+    same("friction", &out, want.as_slice());
+}

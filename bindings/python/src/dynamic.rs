@@ -729,7 +729,12 @@ where
     let own = Cell::new(false);
     let stop = on.abort.unwrap_or(&own);
     let mut tick = |done: u64, total: u64| hooks.borrow_mut().tick(done, total);
-    let mut plant = MjPlant::<N>::new(on.sim, spec, ts, *dist.friction())?;
+    let mut run_time = adaptimp::dynamic::Scenario::new(N, Preset::Robot, on.law)?;
+    for (name, v) in on.items {
+        run_time.set(name, v.value())?;
+    }
+    let friction = run_time.disturbances()?;
+    let mut plant = MjPlant::new(on.sim, spec, ts, &friction)?;
     plant.watch(&mut tick, total);
     plant.abort_on(stop);
     if let Err(e) = plant.start() {

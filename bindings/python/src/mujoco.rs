@@ -1,4 +1,5 @@
-//! MuJoCo as a [`Plant`] of the core's closed loop: [`MjPlant`] drives a
+//! MuJoCo as a [`Plant`] of the core's closed loop (the run-time
+//! [`adaptimp::dynamic::Plant`] of n joints): [`MjPlant`] drives a
 //! model through [`adaptimp_mujoco::Sim`] (the engine's C library, no Python
 //! in the loop) with the semantics of `adaptimp.mujoco` (SPEC §13.1):
 //!
@@ -25,9 +26,8 @@
 //!
 //! Nothing here is `unsafe`: the FFI lives in the `adaptimp-mujoco` crate.
 
+use adaptimp::dynamic::{Disturbances, Plant};
 use adaptimp::error::Error;
-use adaptimp::sim::disturb::Friction;
-use adaptimp::sim::plant::Plant;
 use adaptimp::types::Vector;
 use adaptimp_mujoco::{Sim, MAX_WARNINGS};
 
@@ -107,19 +107,17 @@ pub type Tick<'a> = dyn FnMut(u64, u64) -> bool + 'a;
 /// MuJoCo steps between two calls of the run's hook.
 const TICK_STEPS: u32 = 64;
 
-/// MuJoCo as a [`Plant`] of N joints.
-pub struct MjPlant<'a, const N: usize> {
+/// MuJoCo as a [`Plant`] of n joints (n = the spec's joints).
+pub struct MjPlant<'a> {
     sim: &'a mut Sim,
     spec: &'a MujocoSpec,
-    qadr: [usize; N],
-    dofs: [usize; N],
-    act: [usize; N],
-    gear: Vector<N>,
-    tau_max: Vector<N>,
-    friction: Friction<N>,
+    /// The joint friction (SPEC §17), if the plant has any.
+    friction: Option<Disturbances>,
+    /// n values of scratch: the velocities, then the friction torque.
+    scratch: [Vec<f64>; 2],
     ts: f64,
     rows: u64,
-    tau_e: Vector<N>,
+    tau_e: Vec<f64>,
     wrench: [f64; 6],
     x_ee: [f64; 3],
     failure: Option<Failure>,
@@ -148,18 +146,14 @@ fn invalid(what: &'static str, reason: &'static str) -> Error {
     Error::Invalid { what, reason }
 }
 
-fn indices<const N: usize>(
-    v: &[usize],
-    bound: usize,
-    what: &'static str,
-) -> Result<[usize; N], Error> {
-    let a: [usize; N] = v
-        .try_into()
-        .map_err(|_| invalid(what, "need one per joint"))?;
-    if a.iter().any(|&i| i >= bound) {
+fn indices(v: &[usize], n: usize, bound: usize, what: &'static str) -> Result<(), Error> {
+    if v.len() != n {
+        return Err(invalid(what, "need one per joint"));
+    }
+    if v.iter().any(|&i| i >= bound) {
         return Err(invalid(what, "out of the model's range"));
     }
-    Ok(a)
+    Ok(())
 }
 
 /// The wrench [f; t + (c − p) × f] of the force f and the moment t about c
@@ -229,45 +223,47 @@ fn check_wrench(spec: &MujocoSpec, sim: &Sim) -> Result<(), Error> {
     }
 }
 
-impl<'a, const N: usize> MjPlant<'a, N> {
-    /// The plant of `sim` as `spec` describes it, at the period `ts` (s),
-    /// with the joint `friction` of SPEC §17 applied through `qfrc_applied`
-    /// (held over each MuJoCo step). Reads the state MuJoCo's last forward
-    /// computation left (the caller has run one, e.g. a reset).
+impl<'a> MjPlant<'a> {
+    /// The plant of `sim` as `spec` describes it (n = its joints), at the
+    /// period `ts` (s), with the joint friction of `disturbances` (SPEC
+    /// §17, n joints) applied through `qfrc_applied` (held over each MuJoCo
+    /// step). Reads the state MuJoCo's last forward computation left (the
+    /// caller has run one, e.g. a reset).
     pub fn new(
         sim: &'a mut Sim,
         spec: &'a MujocoSpec,
         ts: f64,
-        friction: Friction<N>,
+        disturbances: &Disturbances,
     ) -> Result<Self, Error> {
+        let n = spec.qadr.len();
+        if n == 0 || disturbances.n() != n {
+            return Err(invalid(
+                "qadr",
+                "need one per joint of the disturbances, at least one",
+            ));
+        }
         let nv = sim.nv();
-        let qadr = indices::<N>(&spec.qadr, sim.qpos().len(), "qadr")?;
-        let dofs = indices::<N>(&spec.dofs, nv, "dofs")?;
-        let act = indices::<N>(&spec.act, sim.ctrl_mut().len(), "act")?;
-        let vec = |v: &[f64], what| -> Result<Vector<N>, Error> {
-            if v.len() != N || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+        indices(&spec.qadr, n, sim.qpos().len(), "qadr")?;
+        indices(&spec.dofs, n, nv, "dofs")?;
+        indices(&spec.act, n, sim.ctrl_mut().len(), "act")?;
+        for (v, what) in [(&spec.gear, "gear"), (&spec.tau_max, "tau_max")] {
+            if v.len() != n || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
                 return Err(invalid(what, "need one finite value > 0 per joint"));
             }
-            Ok(Vector::from_column_slice(v))
-        };
-        let gear = vec(&spec.gear, "gear")?;
-        let tau_max = vec(&spec.tau_max, "tau_max")?;
+        }
         check_wrench(spec, sim)?;
         if spec.substeps == 0 || !(spec.timestep > 0.0 && spec.timestep.is_finite()) {
             return Err(invalid("substeps", "need substeps ≥ 1 and a timestep > 0"));
         }
+        let friction = disturbances.has_friction().then(|| disturbances.clone());
         Ok(Self {
             sim,
             spec,
-            qadr,
-            dofs,
-            act,
-            gear,
-            tau_max,
             friction,
+            scratch: [std::vec![0.0; n], std::vec![0.0; n]],
             ts,
             rows: 0,
-            tau_e: Vector::zeros(),
+            tau_e: std::vec![0.0; n],
             wrench: [0.0; 6],
             x_ee: [0.0; 3],
             failure: None,
@@ -394,9 +390,9 @@ impl<'a, const N: usize> MjPlant<'a, N> {
             [0.0; 6]
         };
         self.wrench = w;
-        self.tau_e = Vector::zeros();
+        self.tau_e.fill(0.0);
         if w.iter().any(|x| *x != 0.0) {
-            self.tau_e = self.joint_torque(&w)?;
+            self.joint_torque(&w)?;
         }
         Ok(())
     }
@@ -473,10 +469,11 @@ impl<'a, const N: usize> MjPlant<'a, N> {
         Ok(w.map(|x| 0.0 - x))
     }
 
-    /// τe = Jᵀ F_e (J = [Jp; Jr], 6 × n) at the current forward computation.
-    fn joint_torque(&mut self, w: &[f64; 6]) -> Result<Vector<N>, Error> {
+    /// τe = Jᵀ F_e (J = [Jp; Jr], 6 × n) at the current forward computation,
+    /// into `tau_e`.
+    fn joint_torque(&mut self, w: &[f64; 6]) -> Result<(), Error> {
         let nv = self.sim.nv();
-        let dofs = self.dofs;
+        let dofs = &self.spec.dofs;
         let (by_site, id) = match self.spec.site {
             Some(s) => (true, s),
             None => (false, self.spec.ee_body),
@@ -485,8 +482,7 @@ impl<'a, const N: usize> MjPlant<'a, N> {
             Ok(j) => j,
             Err(e) => return Err(self.fatal(e)),
         };
-        let mut te = Vector::<N>::zeros();
-        for (i, &d) in dofs.iter().enumerate() {
+        for (te, &d) in self.tau_e.iter_mut().zip(dofs) {
             let mut acc = 0.0;
             for r in 0..3 {
                 acc += jp[r * nv + d] * w[r];
@@ -494,9 +490,9 @@ impl<'a, const N: usize> MjPlant<'a, N> {
             for r in 0..3 {
                 acc += jr[r * nv + d] * w[3 + r];
             }
-            te[i] = acc;
+            *te = acc;
         }
-        Ok(te)
+        Ok(())
     }
 
     /// The period's end: MuJoCo's warnings, the time, the state.
@@ -512,8 +508,10 @@ impl<'a, const N: usize> MjPlant<'a, N> {
         self.time = Some(time);
         let warned = (0..count).find(|&i| after[i].0 != before[i].0);
         let nonfinite = {
-            let (x, dx) = self.state();
-            x.iter().chain(dx.iter()).any(|v| !v.is_finite())
+            let (qpos, qvel) = (self.sim.qpos(), self.sim.qvel());
+            let x = self.spec.qadr.iter().map(|&a| qpos[a]);
+            let dx = self.spec.dofs.iter().map(|&d| qvel[d]);
+            x.chain(dx).any(|v| !v.is_finite())
         };
         // A reset puts the time back to 0: half a timestep tells it from rounding.
         let reset = (time - expected).abs() > 0.5 * self.spec.timestep;
@@ -564,21 +562,29 @@ impl<'a, const N: usize> MjPlant<'a, N> {
     }
 }
 
-impl<const N: usize> Plant<N> for MjPlant<'_, N> {
-    fn state(&self) -> (Vector<N>, Vector<N>) {
+impl Plant for MjPlant<'_> {
+    fn n(&self) -> usize {
+        self.spec.qadr.len()
+    }
+
+    fn state(&self, x: &mut [f64], dx: &mut [f64]) {
         let (qpos, qvel) = (self.sim.qpos(), self.sim.qvel());
-        (
-            Vector::from_fn(|i, _| qpos[self.qadr[i]]),
-            Vector::from_fn(|i, _| qvel[self.dofs[i]]),
-        )
+        for (x, &a) in x.iter_mut().zip(&self.spec.qadr) {
+            *x = qpos[a];
+        }
+        for (dx, &d) in dx.iter_mut().zip(&self.spec.dofs) {
+            *dx = qvel[d];
+        }
     }
 
-    fn contact(&self) -> Vector<N> {
-        self.tau_e
+    fn contact(&self, tau_e: &mut [f64]) {
+        tau_e.copy_from_slice(&self.tau_e);
     }
 
-    fn actuate(&self, tau: &Vector<N>) -> Vector<N> {
-        tau.zip_map(&self.tau_max, |t, m| t.max(-m).min(m))
+    fn actuate(&self, tau: &[f64], out: &mut [f64]) {
+        for ((o, t), m) in out.iter_mut().zip(tau).zip(&self.spec.tau_max) {
+            *o = t.max(-m).min(*m);
+        }
     }
 
     fn wrench(&self) -> [f64; 6] {
@@ -589,7 +595,7 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
         self.x_ee
     }
 
-    fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
+    fn advance(&mut self, tau: &[f64], h: f64, ddx: &mut [f64]) -> Result<(), Error> {
         if self.abort.is_some_and(Cell::get) {
             self.stopped = true;
             return Err(invalid("run", "stopped by the controller"));
@@ -600,46 +606,46 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
                 "the MuJoCo plant advances by Ts exactly (its timestep is fixed for a run)",
             ));
         }
-        let tau = self.actuate(tau);
-        let (act, gear) = (self.act, self.gear);
+        let spec = self.spec;
         let ctrl = self.sim.ctrl_mut();
-        for i in 0..N {
-            ctrl[act[i]] = tau[i] / gear[i];
+        for (((&a, &g), t), m) in spec.act.iter().zip(&spec.gear).zip(tau).zip(&spec.tau_max) {
+            ctrl[a] = t.max(-m).min(*m) / g;
         }
         if let Err(e) = self.sim.forward_acceleration() {
             return Err(self.fatal(e));
         }
         let qacc = self.sim.qacc();
-        let ddq = Vector::from_fn(|i, _| qacc[self.dofs[i]]);
+        for (a, &d) in ddx.iter_mut().zip(&spec.dofs) {
+            *a = qacc[d];
+        }
         let (before, _) = self.sim.warnings();
         let t0 = self.period_start();
-        for sub in 0..self.spec.substeps {
-            if sub == 0 && self.friction.is_none() {
+        for sub in 0..spec.substeps {
+            let Some(friction) = &self.friction else {
                 // The forward computation at x_k with these controls is the
                 // one just done for the row's q̈: `mj_step` without it.
-                if let Err(e) = self.sim.step_computed(self.spec.integrator) {
+                let stepped = if sub == 0 {
+                    self.sim.step_computed(spec.integrator)
+                } else {
+                    self.inner_step()
+                };
+                if let Err(e) = stepped {
                     return Err(self.fatal(e));
                 }
                 self.stepped()?;
                 continue;
-            }
-            if !self.friction.is_none() {
-                let (_, dq) = self.state();
-                let f = self.friction.torque(&dq);
-                let dofs = self.dofs;
-                let applied = self.sim.qfrc_applied_mut();
-                for i in 0..N {
-                    applied[dofs[i]] = f[i];
-                }
-            }
-            // A step inside the period: its sensors are not read (the
-            // period's last forward computation is sensed).
-            let stepped = if self.spec.pure_sensors {
-                self.sim.step_without_sensors(self.spec.integrator)
-            } else {
-                self.sim.step()
             };
-            if let Err(e) = stepped {
+            let [dq, f] = &mut self.scratch;
+            let qvel = self.sim.qvel();
+            for (v, &d) in dq.iter_mut().zip(&spec.dofs) {
+                *v = qvel[d];
+            }
+            friction.friction_torque(dq, f)?;
+            let applied = self.sim.qfrc_applied_mut();
+            for (&d, &t) in spec.dofs.iter().zip(f.iter()) {
+                applied[d] = t;
+            }
+            if let Err(e) = self.inner_step() {
                 return Err(self.fatal(e));
             }
             self.stepped()?;
@@ -654,6 +660,52 @@ impl<const N: usize> Plant<N> for MjPlant<'_, N> {
         if self.rows == self.total {
             self.ask(self.rows)?;
         }
-        Ok(ddq)
+        Ok(())
+    }
+}
+
+impl MjPlant<'_> {
+    /// A MuJoCo step inside the period: its sensors are not read (the
+    /// period's last forward computation is sensed).
+    fn inner_step(&mut self) -> Result<(), adaptimp_mujoco::Error> {
+        if self.spec.pure_sensors {
+            self.sim.step_without_sensors(self.spec.integrator)
+        } else {
+            self.sim.step()
+        }
+    }
+}
+
+/// The plant for the const-generic loop of N joints (N = n), through the
+/// run-time face.
+impl<const N: usize> adaptimp::sim::plant::Plant<N> for MjPlant<'_> {
+    fn state(&self) -> (Vector<N>, Vector<N>) {
+        let (mut x, mut dx) = (Vector::<N>::zeros(), Vector::<N>::zeros());
+        Plant::state(self, x.as_mut_slice(), dx.as_mut_slice());
+        (x, dx)
+    }
+
+    fn contact(&self) -> Vector<N> {
+        Vector::from_column_slice(&self.tau_e)
+    }
+
+    fn actuate(&self, tau: &Vector<N>) -> Vector<N> {
+        let mut out = Vector::<N>::zeros();
+        Plant::actuate(self, tau.as_slice(), out.as_mut_slice());
+        out
+    }
+
+    fn wrench(&self) -> [f64; 6] {
+        self.wrench
+    }
+
+    fn end_effector(&self) -> [f64; 3] {
+        self.x_ee
+    }
+
+    fn advance(&mut self, tau: &Vector<N>, h: f64) -> Result<Vector<N>, Error> {
+        let mut a = Vector::<N>::zeros();
+        Plant::advance(self, tau.as_slice(), h, a.as_mut_slice())?;
+        Ok(a)
     }
 }

@@ -371,6 +371,11 @@ impl Disturbances {
         self.inner.n()
     }
 
+    /// Whether the plant's joints have friction (SPEC §17).
+    pub fn has_friction(&self) -> bool {
+        each!(&self.inner, d, N => !d.friction().is_none())
+    }
+
     /// The payload (kg): the plant's.
     pub fn payload(&self) -> f64 {
         each!(&self.inner, d, N => d.payload())

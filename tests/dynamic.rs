@@ -684,6 +684,44 @@ fn the_closed_loop_is_the_const_generic_one_bit_for_bit() {
     same_rows(&out.rows, &drows);
     assert!(out.task.is_none());
     same_metrics(&out.ended.expect("typed run"), &dmetrics);
+    // The rows fed back, as a loop in another language gives them: the
+    // same metrics, whole tables or row by row.
+    let r = &drows;
+    let recorded = dy::Recorded {
+        n: 2,
+        m: 2,
+        t: &r.t,
+        x: [&r.x, &r.dx, &r.ddx],
+        c: [&r.xc, &r.dxc, &r.ddxc],
+        z1: &r.z1,
+        tau: [&r.tau, &r.tau_sat, &r.tau_e],
+    };
+    let target = dc.impedance();
+    let target = [&target[0][..], &target[1][..], &target[2][..]];
+    let tables = dy::metrics_of(&recorded, settle, target, None).expect("metrics of rows");
+    same_metrics(&tables, &dmetrics);
+    let mut by_row = dy::RowMetrics::new(2, 2, true, settle, target).expect("row metrics");
+    for k in 0..r.len() {
+        let at = |v: &[f64]| v[2 * k..2 * k + 2].to_vec();
+        let (x, dx, ddx) = (at(&r.x), at(&r.dx), at(&r.ddx));
+        let (xc, dxc, ddxc, z1) = (at(&r.xc), at(&r.dxc), at(&r.ddxc), at(&r.z1));
+        let (tau, tau_sat, tau_e) = (at(&r.tau), at(&r.tau_sat), at(&r.tau_e));
+        by_row
+            .push(
+                r.t[k],
+                [&x, &dx, &ddx],
+                [&xc, &dxc, &ddxc],
+                &z1,
+                [&tau, &tau_sat, &tau_e],
+            )
+            .expect("row");
+    }
+    same_metrics(&by_row.finish(), &dmetrics);
+    let short = by_row.push(0.0, [&[0.0]; 3], [&[0.0; 2]; 3], &[0.0; 2], [&[0.0; 2]; 3]);
+    assert_eq!(
+        short.unwrap_err().to_string(),
+        "rows: a row needs n values per joint quantity, m per reference one"
+    );
 }
 
 /// Every metric of two runs, bit for bit (NaN included).
@@ -1401,4 +1439,48 @@ fn run_time_disturbances_have_the_friction_of_their_scenario() {
         .friction()
         .torque(&Vector::<3>::from_column_slice(&dq));
     same("friction", &out, want.as_slice());
+}
+
+/// The one builder feeds forward a nominal model's gravity (SPEC (20.10)):
+/// the same torques as the const-generic controller given the same model,
+/// other than without it; a model of another n is refused by name.
+#[test]
+fn the_one_builder_feeds_forward_the_gravity_of_a_model() {
+    const N: usize = 3;
+    let (mut d, s) = scenario::<N>(Law::StateFeedback, false);
+    let js = joints::<N>();
+    let inertials: Vec<Inertial> = (0..=N)
+        .map(|i| Inertial::point(1.0 + 0.1 * i as f64, [0.02, 0.01, 0.06]))
+        .collect();
+    let g = [0.0, 0.0, -9.81];
+    let plain = d.controller().expect("without");
+    d.feedforward(dy::Dynamics::new(&js, &inertials, g).expect("model"));
+    let dc = d.controller().expect("with the model");
+    let (cc, traj) = core_controller(&s);
+    let model = Dynamics::<N>::new(&js, &inertials, g).expect("typed model");
+    let cc = cc.with_feedforward(std::sync::Arc::new(model));
+    let (mut ds, mut ps, mut cs) = (dc.new_state(), plain.new_state(), cc.new_state());
+    for k in 0..50 {
+        let m = measurement(&traj, k, usize::MAX);
+        let dm = dy::Measurement {
+            x: m.x.as_slice(),
+            dx: m.dx.as_ref().map(|v| v.as_slice()),
+            tau_e: m.tau_e.as_slice(),
+        };
+        let own = traj.sample(cc.time(&cs));
+        let a = dc.step(&mut ds, &dm, None).expect("run-time step");
+        let b = cc.step(&mut cs, &m, &own).expect("typed step");
+        same_command(&a, &b);
+        let p = plain.step(&mut ps, &dm, None).expect("plain step");
+        assert_ne!(
+            bits(&p.tau),
+            bits(&a.tau),
+            "step {k}: the gravity is fed forward"
+        );
+    }
+    d.feedforward(dy::Dynamics::new(&joints::<2>(), &inertials[..3], g).expect("model"));
+    assert_eq!(
+        d.controller().unwrap_err().to_string(),
+        "feedforward: was made for another number of joints"
+    );
 }

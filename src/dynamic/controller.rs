@@ -3,6 +3,7 @@
 //! controller with its own trajectory) and [`State`] (on the heap or in the
 //! caller's buffer), over the const-generic [`Controller`](crate::Controller).
 
+use super::model::Dynamics;
 use super::sized::{each, make, map, pair, ByJoints, Family};
 use super::values::{mismatch, too_many, Command, Joints, Measurement, Setpoint};
 use crate::cartesian::CartesianConfig;
@@ -103,6 +104,7 @@ pub struct Scenario {
     inner: ByJoints<ScenarioF>,
     law: Law,
     basis: Basis,
+    feedforward: Option<Dynamics>,
 }
 
 impl Scenario {
@@ -116,6 +118,7 @@ impl Scenario {
             inner,
             law,
             basis: Basis::Default,
+            feedforward: None,
         })
     }
 
@@ -133,6 +136,15 @@ impl Scenario {
         self
     }
 
+    /// Feed forward the gravity torque G(q) of the nominal `model` (n
+    /// joints), SPEC (20.10): for a robot that does not compensate gravity
+    /// itself ([`with_feedforward`](crate::Controller::with_feedforward));
+    /// none (the default) for one that does.
+    pub fn feedforward(&mut self, model: Dynamics) -> &mut Self {
+        self.feedforward = Some(model);
+        self
+    }
+
     /// The centres of the caller's (or of the rule's, [`Tuning::suggest`](super::Tuning::suggest)),
     /// if the basis is made of them.
     pub fn centres(&self) -> Option<&Centres> {
@@ -144,7 +156,12 @@ impl Scenario {
 
     /// The scenario of N joints `inner` for `law` with `basis`.
     pub(super) fn of(inner: ByJoints<ScenarioF>, law: Law, basis: Basis) -> Self {
-        Self { inner, law, basis }
+        Self {
+            inner,
+            law,
+            basis,
+            feedforward: None,
+        }
     }
 
     /// The number of joints n.
@@ -179,13 +196,23 @@ impl Scenario {
     /// commanded sinusoid as its own trajectory: validated (SPEC §10, every
     /// condition named), built once for n.
     pub fn controller(&self) -> Result<Controller, Error> {
-        let inner = map!(&self.inner, s, N => build::<N>(s, &self.basis))?;
+        let inner = map!(&self.inner, s, N => {
+            let model = match &self.feedforward {
+                Some(m) => Some(m.inner.get::<N>().ok_or(mismatch("feedforward"))?),
+                None => None,
+            };
+            build::<N>(s, &self.basis, model.map(|m| &**m))
+        })?;
         Ok(Controller { inner })
     }
 }
 
 /// The controller of N joints of `s` with `basis`.
-fn build<const N: usize>(s: &schema::Scenario<N>, basis: &Basis) -> Result<Box<Ctl<N>>, Error> {
+fn build<const N: usize>(
+    s: &schema::Scenario<N>,
+    basis: &Basis,
+    feedforward: Option<&crate::cartesian::Dynamics<N>>,
+) -> Result<Box<Ctl<N>>, Error> {
     let traj = s.trajectory()?;
     let basis = match basis {
         Basis::Default if N > GRID_MAX_JOINTS => {
@@ -208,7 +235,10 @@ fn build<const N: usize>(s: &schema::Scenario<N>, basis: &Basis) -> Result<Box<C
             AnyBasis::Centers(Centers::new(c.rows.clone(), widths2)?)
         }
     };
-    let ctrl = controller::Controller::for_trajectory(s.config, basis, &traj)?;
+    let mut ctrl = controller::Controller::for_trajectory(s.config, basis, &traj)?;
+    if let Some(model) = feedforward {
+        ctrl = ctrl.with_feedforward(alloc::sync::Arc::new(*model));
+    }
     Ok(Box::new(Ctl { ctrl, traj }))
 }
 
@@ -271,6 +301,14 @@ impl Controller {
     /// The actuators' limits τmax (N m).
     pub fn tau_max(&self) -> Joints {
         each!(&self.inner, c, N => Joints::of(&c.ctrl.config().tau_max))
+    }
+
+    /// The target impedance's Dd, Cd, Gd (n values each) it realises.
+    pub fn impedance(&self) -> [Joints; 3] {
+        each!(&self.inner, c, N => {
+            let t = c.ctrl.impedance();
+            [Joints::of(t.dd()), Joints::of(t.cd()), Joints::of(t.gd())]
+        })
     }
 
     /// The resolved weight bounds (‖ŴD‖, ‖ŴC‖, ‖ŴG‖), if any.

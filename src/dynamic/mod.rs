@@ -412,7 +412,7 @@ pub use model::{
 pub use run::{
     metrics_of, run, simulate, simulate_cartesian, Arm as ModelArm, Control, Controlled,
     Disturbances, Hooks, Injected, Injection, Jacobian3, Loop, Metrics, Output, Plant, Recorded,
-    Reference, RigidBody, Rows, Run, RunError, Spec, Table, TaskRows, TaskStep,
+    Reference, RigidBody, RowMetrics, Rows, Run, RunError, Spec, Table, TaskRows, TaskStep,
 };
 #[cfg(feature = "alloc")]
 pub use tuning::{Inertia, TaskPath, Tuning};

@@ -30,7 +30,8 @@
 
 use super::cartesian_loop::reads_the_wrench;
 use super::dynamic::{
-    drive_mujoco, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError, TaskMetrics,
+    drive_mujoco, FaultSpec, Hooks, Items, Metrics, OnMujoco, RowMetrics, Rows as JointRows,
+    RunError,
 };
 use super::measurement::PyMeasurement;
 use super::mujoco::MujocoSpec;
@@ -514,9 +515,12 @@ pub const REFERENCE: [&str; 5] = ["xc", "dxc", "ddxc", "xd", "z1"];
 struct Rows<'a, const N: usize, const M: usize> {
     run: &'a CallbackRun<'a>,
     report: &'a Cell<Report>,
-    joint: Records,
+    joint: JointRows,
+    every: u64,
     reference: RefRows,
-    metrics: TaskMetrics<M>,
+    metrics: RowMetrics,
+    /// A row the metrics refused (none: every row fits by construction).
+    refused: Option<Error>,
     seen: u64,
 }
 
@@ -580,7 +584,7 @@ impl<const N: usize, const M: usize> Recorder<N> for Rows<'_, N, M> {
             ..*r
         };
         self.joint.record(&row);
-        if self.seen.is_multiple_of(self.joint.every) {
+        if self.seen.is_multiple_of(self.every) {
             for (out, v) in self.reference.iter_mut().zip([xc, dxc, ddxc, xd, z1]) {
                 out.extend_from_slice(&v[..w]);
             }
@@ -592,13 +596,16 @@ impl<const N: usize, const M: usize> Recorder<N> for Rows<'_, N, M> {
         } else {
             Vector::<N>::from_fn(|i, _| rep.sat[i])
         };
-        self.metrics.push(
+        let pushed = self.metrics.push(
             r.t,
             [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
             [&xc[..w], &dxc[..w], &ddxc[..w]],
             &z1[..w],
             [tau.as_slice(), sat.as_slice(), r.tau_e.as_slice()],
         );
+        if let Err(e) = pushed {
+            self.refused.get_or_insert(e);
+        }
     }
 }
 
@@ -607,7 +614,7 @@ impl<const N: usize, const M: usize> Recorder<N> for Rows<'_, N, M> {
 /// which ended it.
 pub struct RunOut {
     /// The rows and metrics, or the run's error.
-    pub rows: Result<(Records, RefRows, MetricsOut), RunError>,
+    pub rows: Result<(JointRows, RefRows, Metrics), RunError>,
     /// The controller's exception.
     pub raised: Option<PyErr>,
 }
@@ -624,9 +631,9 @@ impl From<RunError> for RunOut {
 /// A run's records, metrics and target, made before it starts: the table
 /// and the disturbances checked, the rows allocated.
 struct Prepared<const N: usize, const M: usize> {
-    joint: Records,
+    joint: JointRows,
     reference: RefRows,
-    metrics: TaskMetrics<M>,
+    metrics: RowMetrics,
     target: TargetImpedance<N>,
 }
 
@@ -646,7 +653,7 @@ fn prepare<const N: usize, const M: usize>(
     }
     let every = run.every.max(1);
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-    let joint = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let joint = JointRows::new(N, kept, every)?;
     let mut reference = RefRows::default();
     for v in &mut reference {
         let room = kept.checked_mul(w).ok_or(RunError::Memory(kept))?;
@@ -694,8 +701,10 @@ fn run_m<const N: usize, const M: usize>(
         run,
         report: &report,
         joint: p.joint,
+        every: run.every.max(1),
         reference: p.reference,
         metrics: p.metrics,
+        refused: None,
         seen: 0,
     };
     let on = OnMujoco {
@@ -710,7 +719,10 @@ fn run_m<const N: usize, const M: usize>(
     };
     let result = drive_mujoco(&mut step, &Clock(&clock), on, hooks, &mut rows);
     RunOut {
-        rows: result.map(|()| (rows.joint, rows.reference, rows.metrics.finish())),
+        rows: result.and_then(|()| match rows.refused {
+            Some(e) => Err(RunError::Core(e, None)),
+            None => Ok((rows.joint, rows.reference, rows.metrics.finish())),
+        }),
         raised: step.error,
     }
 }
@@ -724,8 +736,8 @@ fn invalid(what: &'static str, reason: &'static str) -> RunError {
 fn metrics_and_target<const N: usize, const M: usize>(
     run: &CallbackRun<'_>,
     joint_space: bool,
-) -> Result<(TaskMetrics<M>, TargetImpedance<N>), Error> {
-    let metrics = TaskMetrics::<M>::new(N, run.m, joint_space, run.settle, run.target)?;
+) -> Result<(RowMetrics, TargetImpedance<N>), Error> {
+    let metrics = RowMetrics::new(N, run.m, joint_space, run.settle, run.target)?;
     let t = |v: &[f64]| Vector::<N>::from_fn(|i, _| v.get(i).copied().unwrap_or(1.0));
     let target = match TargetImpedance::new(t(run.target[0]), t(run.target[1]), t(run.target[2])) {
         Ok(tgt) => tgt,
@@ -850,8 +862,8 @@ pub fn simulate_mujoco_callback<'py>(
         return Err(raised);
     }
     let (rec, reference, metrics) = result.rows.map_err(|e| super::run_error(e, &mut hooks))?;
-    let k = rec.rows();
-    let out = super::records_dict(py, rec, metrics)?;
+    let k = rec.len();
+    let out = super::records_dict(py, rec, metrics, true)?;
     for (name, rows) in REFERENCE.iter().zip(reference) {
         out.set_item(*name, super::array(py, rows, (k, m))?)?;
     }

@@ -1749,8 +1749,8 @@ impl PyCartesian {
                 return Err(err);
             }
         };
-        let k = rec.rows();
-        let out = super::records_dict(py, rec, metrics)?;
+        let k = rec.len();
+        let out = super::records_dict(py, rec, metrics, true)?;
         for (name, v) in [
             ("xc", &task.pc[0]),
             ("dxc", &task.pc[1]),

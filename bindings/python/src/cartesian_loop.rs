@@ -22,8 +22,8 @@
 
 use super::computed::Computed;
 use super::dynamic::{
-    drive_mujoco, FaultKind, FaultSpec, Hooks, Items, MetricsOut, OnMujoco, Records, RunError,
-    TaskMetrics, Typed, View,
+    drive_mujoco, FaultKind, FaultSpec, Hooks, Items, Metrics, OnMujoco, RowMetrics, Rows,
+    RunError, Typed, View,
 };
 use super::mujoco::MujocoSpec;
 use adaptimp::cartesian::{
@@ -385,9 +385,12 @@ impl<const N: usize, J: JointStep<N> + ?Sized> WrenchControl<N> for Cartesian<'_
 
 /// The joint rows, the task rows and the task-space metrics of every row.
 struct TaskRecorder<'a, const N: usize, const M: usize> {
-    joint: &'a mut Records,
+    joint: &'a mut Rows,
     task: &'a mut TaskRecords,
-    metrics: &'a mut TaskMetrics<M>,
+    metrics: &'a mut RowMetrics,
+    /// A row the metrics refused (none: every row fits by construction).
+    refused: Option<Error>,
+    width: core::marker::PhantomData<[(); M]>,
     last: &'a RefCell<Option<LastStep<N>>>,
     pending: &'a Cell<bool>,
 }
@@ -403,19 +406,22 @@ impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
             None => (&nan, nan[0]),
         };
         self.task.record(slot.as_ref(), &z1);
-        self.metrics.push(
+        let pushed = self.metrics.push(
             r.t,
             [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
             [pc[0].as_slice(), pc[1].as_slice(), pc[2].as_slice()],
             z1.as_slice(),
             [r.tau.as_slice(), r.tau_sat.as_slice(), r.tau_e.as_slice()],
         );
+        if let Err(e) = pushed {
+            self.refused.get_or_insert(e);
+        }
     }
 }
 
 /// What a Cartesian run gives back: the joint rows, the task rows and the
 /// SPEC §12 metrics of task space (z1 = p_d − p, m = 3).
-pub type CartesianOut = (Records, TaskRecords, MetricsOut);
+pub type CartesianOut = (Rows, TaskRecords, Metrics);
 
 fn invalid(what: &'static str, reason: &'static str) -> RunError {
     RunError::Core(Error::Invalid { what, reason }, None)
@@ -470,10 +476,10 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     let total = checked(outer, &*joint, run)?;
     let every = run.every.max(1);
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-    let mut rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let mut rec = Rows::new(N, kept, every)?;
     let mut task = TaskRecords::with_rows(N, kept, every).ok_or(RunError::Memory(kept))?;
     let ones = [1.0; N];
-    let mut metrics = TaskMetrics::<M>::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
+    let mut metrics = RowMetrics::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
     let clock = Cell::new(0.0);
     // This run's steps (the previous run's last step is kept until one is taken).
     let steps = RefCell::new(None);
@@ -503,10 +509,16 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
         joint: &mut rec,
         task: &mut task,
         metrics: &mut metrics,
+        refused: None,
+        width: core::marker::PhantomData::<[(); M]>,
         last: &steps,
         pending: &pending,
     };
     let result = drive_mujoco(&mut ctrl, &Clock(&clock), on, hooks, &mut recorder);
+    let result = match recorder.refused {
+        Some(e) => result.and(Err(RunError::Core(e, None))),
+        None => result,
+    };
     let taken = steps.into_inner();
     if taken.is_some() {
         *last = taken;

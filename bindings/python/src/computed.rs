@@ -7,8 +7,7 @@
 //! ([`DynComputed::simulate_mujoco`]) along its setpoint of every row.
 
 use super::dynamic::{
-    drive_mujoco, Hooks, MetricsOut, MujocoRun, OnMujoco, Records, RunError, TaskMetrics, View,
-    MAX_JOINTS,
+    drive_mujoco, Hooks, Metrics, MujocoRun, OnMujoco, RowMetrics, Rows, RunError, View, MAX_JOINTS,
 };
 use super::frames::{inertial, joint};
 use super::measurement::JointCall;
@@ -85,7 +84,7 @@ pub trait DynComputed: Send + Sync {
         spec: &MujocoSpec,
         run: &MujocoRun<'_>,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Records, MetricsOut), RunError>;
+    ) -> Result<(Rows, Metrics), RunError>;
     /// As [`Any`], for the typed paths.
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
@@ -192,7 +191,7 @@ impl<const N: usize> DynComputed for Computed<N> {
         spec: &MujocoSpec,
         run: &MujocoRun<'_>,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Records, MetricsOut), RunError> {
+    ) -> Result<(Rows, Metrics), RunError> {
         run_mujoco(self, sim, spec, run, hooks)
     }
     fn as_any_mut(&mut self) -> &mut dyn Any {
@@ -278,8 +277,10 @@ impl<const N: usize> Control<N> for Stepped<'_, N> {
 /// controller gives within the actuators' limits, before a disturbance
 /// weakens it (a refused row: none).
 struct JointRows<'a, const N: usize> {
-    rec: Records,
-    metrics: TaskMetrics<N>,
+    rec: Rows,
+    metrics: RowMetrics,
+    /// A row the metrics refused (none: every row fits by construction).
+    refused: Option<Error>,
     applied: &'a Cell<Vector<N>>,
     tau_max: Vector<N>,
 }
@@ -294,13 +295,16 @@ impl<const N: usize> Recorder<N> for JointRows<'_, N> {
                 .get()
                 .zip_map(&self.tau_max, |t, m| t.max(-m).min(m))
         };
-        self.metrics.push(
+        let pushed = self.metrics.push(
             r.t,
             [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
             [r.xc.as_slice(), r.dxc.as_slice(), r.ddxc.as_slice()],
             r.z1.as_slice(),
             [r.tau.as_slice(), sat.as_slice(), r.tau_e.as_slice()],
         );
+        if let Err(e) = pushed {
+            self.refused.get_or_insert(e);
+        }
     }
 }
 
@@ -310,7 +314,7 @@ fn run_mujoco<const N: usize>(
     spec: &MujocoSpec,
     run: &MujocoRun<'_>,
     hooks: &mut dyn Hooks,
-) -> Result<(Records, MetricsOut), RunError> {
+) -> Result<(Rows, Metrics), RunError> {
     let ts = c.ctrl.period();
     let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
     let need = usize::try_from(total)
@@ -330,20 +334,21 @@ fn run_mujoco<const N: usize>(
     };
     let every = run.every.max(1);
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-    let rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let rec = Rows::new(N, kept, every)?;
     let imp = *c.ctrl.impedance();
     let target = [
         imp.dd().as_slice(),
         imp.cd().as_slice(),
         imp.gd().as_slice(),
     ];
-    let metrics = TaskMetrics::<N>::new(N, N, true, run.settle, target)?;
+    let metrics = RowMetrics::new(N, N, true, run.settle, target)?;
     let applied = Cell::new(Vector::<N>::zeros());
     let tau_max =
         Vector::<N>::from_fn(|i, _| spec.tau_max.get(i).copied().unwrap_or(f64::INFINITY));
     let mut out = JointRows {
         rec,
         metrics,
+        refused: None,
         applied: &applied,
         tau_max,
     };
@@ -362,7 +367,10 @@ fn run_mujoco<const N: usize>(
         applied: &applied,
     };
     drive_mujoco(&mut stepped, &Table::<N> { rows, ts }, on, hooks, &mut out)?;
-    Ok((out.rec, out.metrics.finish()))
+    match out.refused {
+        Some(e) => Err(RunError::Core(e, None)),
+        None => Ok((out.rec, out.metrics.finish())),
+    }
 }
 
 /// The parameters of a [`DynComputed`], as reals per joint.
@@ -890,6 +898,6 @@ impl PyComputedTorque {
         drop(guard);
         drop(sim);
         let (rec, metrics) = result.map_err(|e| super::run_error(e, &mut hooks))?;
-        super::records_dict(py, rec, metrics)
+        super::records_dict(py, rec, metrics, true)
     }
 }

@@ -24,7 +24,7 @@ use adaptimp::sim::inject::{Injected, Injection};
 use adaptimp::sim::metrics::MetricsAccumulator;
 use adaptimp::sim::model::{Link, PlanarArm, TwoLinkArm};
 use adaptimp::sim::plant::{Plant, RigidBody};
-use adaptimp::sim::record::{Recorder, Row};
+use adaptimp::sim::record::Recorder;
 use adaptimp::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapter};
 use adaptimp::trajectory::{Setpoint, Sinusoid, Trajectory};
 use adaptimp::types::Vector;
@@ -338,100 +338,7 @@ impl<const N: usize, C: Control<N> + View + ?Sized> Control<N> for Reporting<'_,
     }
 }
 
-/// Every recorded row (every `every`-th step), one flat row-major buffer per
-/// quantity; `n` values per row for the per-joint ones, 3 for `w_norms`.
-#[derive(Clone, Debug, Default)]
-pub struct Records {
-    /// Joints.
-    pub n: usize,
-    /// Keep every `every`-th row (≥ 1).
-    pub every: u64,
-    seen: u64,
-    /// t (s).
-    pub t: Vec<f64>,
-    /// The per-joint quantities by name, in this order: q, dq, ddq, xc, dxc,
-    /// ddxc, xd, dq_hat, tau, tau_sat, tau_e, zeta, z1.
-    pub joint: [Vec<f64>; 13],
-    /// ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ before the step's update.
-    pub w_norms: Vec<f64>,
-    /// The rows the controller refused (fallback applied).
-    pub refused: Vec<bool>,
-    /// Whether the end effector is recorded (`x_ee`, `wrench`).
-    pub ee: bool,
-    /// End-effector position (m), 3 per row (if `ee`).
-    pub x_ee: Vec<f64>,
-    /// End-effector wrench [f; m] (N, N m), 6 per row (if `ee`).
-    pub wrench: Vec<f64>,
-}
-
-/// The names of [`Records::joint`], in order.
-pub const JOINT_RECORDS: [&str; 13] = [
-    "q", "dq", "ddq", "xc", "dxc", "ddxc", "xd", "dq_hat", "tau", "tau_sat", "tau_e", "zeta", "z1",
-];
-
-impl Records {
-    /// Room for `rows` kept rows of `n` joints (and of the end effector, with
-    /// `ee`); `None` if it cannot be had.
-    pub fn with_rows(n: usize, rows: usize, every: u64, ee: bool) -> Option<Self> {
-        let mut r = Self {
-            n,
-            every: every.max(1),
-            ee,
-            ..Self::default()
-        };
-        if ee {
-            r.x_ee.try_reserve_exact(rows.checked_mul(3)?).ok()?;
-            r.wrench.try_reserve_exact(rows.checked_mul(6)?).ok()?;
-        }
-        r.t.try_reserve_exact(rows).ok()?;
-        r.refused.try_reserve_exact(rows).ok()?;
-        for v in &mut r.joint {
-            v.try_reserve_exact(rows.checked_mul(n)?).ok()?;
-        }
-        r.w_norms.try_reserve_exact(rows.checked_mul(3)?).ok()?;
-        Some(r)
-    }
-
-    /// Rows kept.
-    pub fn rows(&self) -> usize {
-        self.t.len()
-    }
-}
-
-impl<const N: usize> Recorder<N> for Records {
-    fn record(&mut self, r: &Row<N>) {
-        let keep = self.seen.is_multiple_of(self.every);
-        self.seen += 1;
-        if !keep {
-            return;
-        }
-        self.t.push(r.t);
-        let rows = [
-            &r.x, &r.dx, &r.ddx, &r.xc, &r.dxc, &r.ddxc, &r.xd, &r.dx_hat, &r.tau, &r.tau_sat,
-            &r.tau_e, &r.zeta, &r.z1,
-        ];
-        for (v, x) in self.joint.iter_mut().zip(rows) {
-            v.extend_from_slice(x.as_slice());
-        }
-        self.w_norms.extend_from_slice(&r.w_norms);
-        self.refused.push(r.refused);
-        if self.ee {
-            self.x_ee.extend_from_slice(&r.x_ee);
-            self.wrench.extend_from_slice(&r.wrench);
-        }
-    }
-}
-
-/// The SPEC §12 metrics with per-joint values as vectors.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MetricsOut {
-    /// Scalars by name, in SPEC §12 order.
-    pub scalars: Vec<(&'static str, f64)>,
-    /// Counts by name.
-    pub counts: Vec<(&'static str, usize)>,
-    /// Per-joint values by name.
-    pub joint: Vec<(&'static str, Vec<f64>)>,
-}
+pub use adaptimp::dynamic::{Metrics, RowMetrics, Rows};
 
 /// How a run ended when it did not finish.
 #[derive(Clone, Debug)]
@@ -450,6 +357,16 @@ pub enum RunError {
 impl From<Error> for RunError {
     fn from(e: Error) -> Self {
         RunError::Core(e, None)
+    }
+}
+
+impl From<adaptimp::dynamic::RunError> for RunError {
+    fn from(e: adaptimp::dynamic::RunError) -> Self {
+        match e {
+            adaptimp::dynamic::RunError::Core(e, k) => RunError::Core(e, k),
+            adaptimp::dynamic::RunError::Stopped => RunError::Stopped,
+            adaptimp::dynamic::RunError::Memory(rows) => RunError::Memory(rows),
+        }
     }
 }
 
@@ -551,7 +468,7 @@ pub trait DynTracker: Send + Sync {
         fault: Option<&FaultSpec>,
         every: u64,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Records, MetricsOut), RunError>;
+    ) -> Result<(Rows, Metrics), RunError>;
     /// The closed loop on MuJoCo (`sim` as `spec` describes it) from the
     /// controller's current state (not reset: a used controller goes on),
     /// with the disturbances of `run.items` (SPEC §17; payload and jitter are
@@ -563,7 +480,7 @@ pub trait DynTracker: Send + Sync {
         spec: &MujocoSpec,
         run: &MujocoRun<'_>,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Records, MetricsOut), RunError>;
+    ) -> Result<(Rows, Metrics), RunError>;
     /// As [`Any`], for the typed paths.
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
@@ -598,7 +515,7 @@ fn run_mujoco<const N: usize>(
     spec: &MujocoSpec,
     run: &MujocoRun<'_>,
     hooks: &mut dyn Hooks,
-) -> Result<(Records, MetricsOut), RunError> {
+) -> Result<(Rows, Metrics), RunError> {
     let ts = t.controller().period();
     let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
     if let Some(rows) = run.reference {
@@ -617,7 +534,7 @@ fn run_mujoco<const N: usize>(
     }
     let every = run.every.max(1);
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-    let mut rec = Records::with_rows(N, kept, every, true).ok_or(RunError::Memory(kept))?;
+    let mut rec = Rows::new(N, kept, every)?;
     let mut metrics = MetricsAccumulator::new(run.settle, *t.controller().impedance());
     let k0 = t.steps();
     let own = Continued {
@@ -641,7 +558,7 @@ fn run_mujoco<const N: usize>(
         Some(rows) => drive_mujoco(t, &Table::<N> { rows, ts }, on, hooks, rec2),
         None => drive_mujoco(t, &own, on, hooks, rec2),
     }?;
-    Ok((rec, metrics_out(&metrics.finish())))
+    Ok((rec, metrics_out(&metrics.finish())?))
 }
 
 /// A run's plant on MuJoCo and the settings of its loop ([`drive_mujoco`]).
@@ -857,24 +774,22 @@ fn setpoint<const N: usize>(s: [&[f64]; 3]) -> Setpoint<N> {
     }
 }
 
-fn metrics_out<const N: usize>(m: &adaptimp::sim::metrics::Metrics<N>) -> MetricsOut {
-    let v = |x: &Vector<N>| x.as_slice().to_vec();
-    MetricsOut {
-        scalars: Vec::from([
-            ("rms_z1", m.rms_z1),
-            ("rms_z1_after2", m.rms_z1_after2),
-            ("sat_duty", m.sat_duty),
-            ("peak_contact_after2", m.peak_contact_after2),
-            ("mean_contact", m.mean_contact),
-            ("imp_err_rms_after2", m.imp_err_rms_after2),
-        ]),
-        counts: Vec::from([("rows", m.rows), ("steps_in_contact", m.steps_in_contact)]),
-        joint: Vec::from([
-            ("rms_z1_joint_after2", v(&m.rms_z1_joint_after2)),
-            ("max_abs_z1_joint_after2", v(&m.max_abs_z1_joint_after2)),
-            ("peak_abs_tau", v(&m.peak_abs_tau)),
-        ]),
-    }
+/// The const-generic loop's metrics as the run-time ones.
+fn metrics_out<const N: usize>(m: &adaptimp::sim::metrics::Metrics<N>) -> Result<Metrics, Error> {
+    let v = |x: &Vector<N>| adaptimp::dynamic::Joints::from_slice(x.as_slice());
+    Ok(Metrics {
+        rows: m.rows,
+        rms_z1: m.rms_z1,
+        rms_z1_after2: m.rms_z1_after2,
+        rms_z1_joint_after2: v(&m.rms_z1_joint_after2)?,
+        max_abs_z1_joint_after2: v(&m.max_abs_z1_joint_after2)?,
+        sat_duty: m.sat_duty,
+        steps_in_contact: m.steps_in_contact,
+        peak_contact_after2: m.peak_contact_after2,
+        mean_contact: m.mean_contact,
+        peak_abs_tau: v(&m.peak_abs_tau)?,
+        imp_err_rms_after2: m.imp_err_rms_after2,
+    })
 }
 
 /// The adapter that asks the hook every [`HOOK_EVERY`] periods whether to go
@@ -952,7 +867,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     fault: Option<&FaultSpec>,
     every: u64,
     hooks: &mut dyn Hooks,
-) -> Result<(Records, MetricsOut), RunError> {
+) -> Result<(Rows, Metrics), RunError> {
     let cfg = &s.sim;
     let inj = fault
         .map(|f| injection::<N>(f, &t.controller().config().tau_max))
@@ -960,7 +875,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     let ts = t.controller().period();
     let total = adaptimp::sim::simulator::steps(cfg.t_final, ts)?;
     let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
-    let mut rec = Records::with_rows(N, kept, every, false).ok_or(RunError::Memory(kept))?;
+    let mut rec = Rows::new(N, kept, every)?;
     t.reset();
     if let Some(w) = weights {
         DynTracker::load_weights(t, w)?;
@@ -1015,7 +930,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
     if !t.finish() {
         return Err(RunError::Stopped);
     }
-    Ok((rec, metrics_out(&metrics)))
+    Ok((rec, metrics_out(&metrics)?))
 }
 
 impl<const N: usize> DynTracker for Typed<N> {
@@ -1187,7 +1102,7 @@ impl<const N: usize> DynTracker for Typed<N> {
         fault: Option<&FaultSpec>,
         every: u64,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Records, MetricsOut), RunError> {
+    ) -> Result<(Rows, Metrics), RunError> {
         let preset = Preset::Paper;
         let s =
             scenario::<N>(preset, self.law(), items).map_err(|e| RunError::Core(e.error, None))?;
@@ -1229,208 +1144,11 @@ impl<const N: usize> DynTracker for Typed<N> {
         spec: &MujocoSpec,
         run: &MujocoRun<'_>,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Records, MetricsOut), RunError> {
+    ) -> Result<(Rows, Metrics), RunError> {
         run_mujoco(self, sim, spec, run, hooks)
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
     }
-}
-
-/// Recorded rows of a run whose loop ran elsewhere (a Python controller's):
-/// row-major tables of K rows, `n` values per row for the plant's
-/// quantities, `m` for the reference's (xc, ẋc, ẍc, z1: m = n in joint
-/// space, m ≠ n in task space).
-pub struct RowTables<'a> {
-    /// Joints n.
-    pub n: usize,
-    /// Width m of the reference and of z1.
-    pub m: usize,
-    /// t (K).
-    pub t: &'a [f64],
-    /// q, q̇, q̈ (K × n each).
-    pub x: [&'a [f64]; 3],
-    /// xc, ẋc, ẍc (K × m each).
-    pub c: [&'a [f64]; 3],
-    /// z1 (K × m).
-    pub z1: &'a [f64],
-    /// τ, sat(τ), τe (K × n each).
-    pub tau: [&'a [f64]; 3],
-}
-
-/// The SPEC §12 metrics of recorded rows by the core's [`MetricsAccumulator`]
-/// (the one implementation of the metrics): the rows are fed to an
-/// accumulator of max(n, m) joints with the narrower quantities padded with
-/// zeros (which change no norm, peak or count), and the per-joint figures cut
-/// back to z1's m or τ's n ([`TaskMetrics`]). `joint_space`: whether the
-/// reference and z1 are in joint space (then m = n, and the impedance
-/// residual is computed with the target (Dd, Cd, Gd), n values each); none:
-/// whether m = n. In task space the impedance residual is NaN.
-pub fn metrics_of(
-    rows: &RowTables<'_>,
-    settle: f64,
-    target: [&[f64]; 3],
-    joint_space: Option<bool>,
-) -> Result<MetricsOut, Error> {
-    adaptimp::with_joints!(
-        rows.n.max(rows.m),
-        K => metrics_n::<K>(rows, settle, target, joint_space),
-        _ => Err(Error::Invalid {
-            what: "rows",
-            reason: "the joints and the reference's width must be between 1 and 7",
-        }),
-    )
-}
-
-/// The SPEC §12 metrics of a run's rows given one at a time as slices: n
-/// joints (q, q̇, q̈, τ, sat(τ), τe) and a reference of width m (xc, ẋc, ẍc,
-/// z1), in an accumulator of M ≥ max(n, m) slots with the narrower
-/// quantities padded with zeros. [`metrics_of`] (rows recorded elsewhere)
-/// and the Cartesian loop on MuJoCo (rows as they come) both go through it:
-/// the same rows give the same bits.
-pub struct TaskMetrics<const M: usize> {
-    acc: MetricsAccumulator<M>,
-    n: usize,
-    m: usize,
-    joint: bool,
-}
-
-impl<const M: usize> TaskMetrics<M> {
-    /// For n joints and a reference of width m (1 ≤ n, m ≤ M), with the
-    /// window after `settle` (s); `joint`: the reference is in joint space
-    /// (needs m = n; the impedance residual with `target` = (Dd, Cd, Gd), n
-    /// values each).
-    pub fn new(
-        n: usize,
-        m: usize,
-        joint: bool,
-        settle: f64,
-        target: [&[f64]; 3],
-    ) -> Result<Self, Error> {
-        let bad = |reason| Error::Invalid {
-            what: "rows",
-            reason,
-        };
-        if n == 0 || m == 0 || n > M || m > M {
-            return Err(bad("need at least one joint and one reference coordinate"));
-        }
-        if joint && m != n {
-            return Err(bad(
-                "a joint-space reference needs one coordinate per joint (m = n)",
-            ));
-        }
-        if target.iter().any(|v| v.len() != n) {
-            return Err(bad("the target impedance needs n values per matrix"));
-        }
-        let ones = Vector::<M>::from_element(1.0);
-        let tgt = if joint {
-            let t = |v: &[f64]| {
-                let mut o = ones;
-                o.as_mut_slice()[..n].copy_from_slice(v);
-                o
-            };
-            TargetImpedance::new(t(target[0]), t(target[1]), t(target[2]))?
-        } else {
-            TargetImpedance::new(ones, ones, ones)?
-        };
-        Ok(Self {
-            acc: MetricsAccumulator::new(settle, tgt),
-            n,
-            m,
-            joint,
-        })
-    }
-
-    /// One row: t (s); q, q̇, q̈ (n each); xc, ẋc, ẍc (m each); z1 (m); τ,
-    /// sat(τ), τe (n each).
-    pub fn push(&mut self, t: f64, x: [&[f64]; 3], c: [&[f64]; 3], z1: &[f64], tau: [&[f64]; 3]) {
-        let (n, m) = (self.n, self.m);
-        let pad = |v: &[f64], w: usize| {
-            let mut out = Vector::<M>::zeros();
-            out.as_mut_slice()[..w].copy_from_slice(&v[..w]);
-            out
-        };
-        let zero = Vector::<M>::zeros();
-        let (tau_m, tau_sat) = (pad(tau[0], n), pad(tau[1], n));
-        let joint = self.joint;
-        self.acc.push(&Row {
-            t,
-            x: pad(x[0], n),
-            dx: pad(x[1], n),
-            ddx: pad(x[2], n),
-            xc: if joint { pad(c[0], m) } else { zero },
-            dxc: if joint { pad(c[1], m) } else { zero },
-            ddxc: if joint { pad(c[2], m) } else { zero },
-            xd: zero,
-            dx_hat: zero,
-            tau: tau_m,
-            tau_sat,
-            dtau: tau_sat - tau_m,
-            tau_e: pad(tau[2], n),
-            zeta: zero,
-            z1: pad(z1, m),
-            w_norms: [0.0; 3],
-            x_ee: [0.0; 3],
-            wrench: [0.0; 6],
-            refused: false,
-        });
-    }
-
-    /// The metrics: per-joint figures of z1 cut to m, of τ to n; the
-    /// impedance residual NaN in task space.
-    pub fn finish(&self) -> MetricsOut {
-        let mut out = metrics_out(&self.acc.finish());
-        for (name, v) in &mut out.joint {
-            v.truncate(if *name == "peak_abs_tau" {
-                self.n
-            } else {
-                self.m
-            });
-        }
-        if !self.joint {
-            for (name, v) in &mut out.scalars {
-                if *name == "imp_err_rms_after2" {
-                    *v = f64::NAN;
-                }
-            }
-        }
-        out
-    }
-}
-
-fn metrics_n<const N: usize>(
-    r: &RowTables<'_>,
-    settle: f64,
-    target: [&[f64]; 3],
-    joint_space: Option<bool>,
-) -> Result<MetricsOut, Error> {
-    let (n, m, k) = (r.n, r.m, r.t.len());
-    if r.x.iter().chain(r.tau.iter()).any(|v| v.len() != k * n)
-        || r.c.iter().chain([&r.z1]).any(|v| v.len() != k * m)
-    {
-        return Err(Error::Invalid {
-            what: "rows",
-            reason: "every table needs K rows of its width",
-        });
-    }
-    let joint = joint_space.unwrap_or(m == n);
-    let mut acc = TaskMetrics::<N>::new(n, m, joint, settle, target)?;
-    fn row(v: &[f64], w: usize, i: usize) -> &[f64] {
-        &v[i * w..(i + 1) * w]
-    }
-    for i in 0..k {
-        acc.push(
-            r.t[i],
-            [row(r.x[0], n, i), row(r.x[1], n, i), row(r.x[2], n, i)],
-            [row(r.c[0], m, i), row(r.c[1], m, i), row(r.c[2], m, i)],
-            row(r.z1, m, i),
-            [
-                row(r.tau[0], n, i),
-                row(r.tau[1], n, i),
-                row(r.tau[2], n, i),
-            ],
-        );
-    }
-    Ok(acc.finish())
 }

@@ -1,6 +1,6 @@
 //! `simulate`, `metrics`, `simulate_mujoco`: one closed run, with the GIL released, and its SPEC §12 metrics.
 
-use super::dynamic::{ArmSpec, DynTracker, JOINT_RECORDS};
+use super::dynamic::{ArmSpec, DynTracker};
 use super::{arrays::*, controller::*, errors::*, hooks::*, models::*, params::*};
 use super::{dynamic, mujoco};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -65,7 +65,7 @@ pub(super) fn simulate<'py>(
     });
     drop(guard);
     let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
-    records_dict(py, rec, metrics)
+    records_dict(py, rec, metrics, false)
 }
 
 /// A run's records and metrics as the dict `simulate` returns: "t" (K,),
@@ -74,19 +74,35 @@ pub(super) fn simulate<'py>(
 /// "metrics".
 pub(super) fn records_dict<'py>(
     py: Python<'py>,
-    rec: dynamic::Records,
-    metrics: dynamic::MetricsOut,
+    rec: dynamic::Rows,
+    metrics: dynamic::Metrics,
+    ee: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let k = rec.rows();
-    let n = rec.n;
+    let k = rec.len();
+    let n = rec.n();
     let out = PyDict::new(py);
     out.set_item("t", rec.t.into_pyarray(py))?;
-    for (name, data) in JOINT_RECORDS.iter().zip(rec.joint) {
-        out.set_item(*name, array(py, data, (k, n))?)?;
+    let joint = [
+        ("q", rec.x),
+        ("dq", rec.dx),
+        ("ddq", rec.ddx),
+        ("xc", rec.xc),
+        ("dxc", rec.dxc),
+        ("ddxc", rec.ddxc),
+        ("xd", rec.xd),
+        ("dq_hat", rec.dx_hat),
+        ("tau", rec.tau),
+        ("tau_sat", rec.tau_sat),
+        ("tau_e", rec.tau_e),
+        ("zeta", rec.zeta),
+        ("z1", rec.z1),
+    ];
+    for (name, data) in joint {
+        out.set_item(name, array(py, data, (k, n))?)?;
     }
     out.set_item("w_norms", array(py, rec.w_norms, (k, 3))?)?;
     out.set_item("refused", PyArray1::from_vec(py, rec.refused))?;
-    if rec.ee {
+    if ee {
         out.set_item("x_ee", array(py, rec.x_ee, (k, 3))?)?;
         out.set_item("wrench_ee", array(py, rec.wrench, (k, 6))?)?;
     }
@@ -138,7 +154,7 @@ pub(super) fn metrics<'py>(
         tab("tau_e", &tau_e, n)?,
     ];
     let ts: Vec<f64> = t.as_array().iter().copied().collect();
-    let rows = dynamic::RowTables {
+    let rows = adaptimp::dynamic::Recorded {
         n,
         m,
         t: &ts,
@@ -147,7 +163,7 @@ pub(super) fn metrics<'py>(
         z1: &z,
         tau: [&tq[0], &tq[1], &tq[2]],
     };
-    let out = dynamic::metrics_of(
+    let out = adaptimp::dynamic::metrics_of(
         &rows,
         settle,
         [&target.0, &target.1, &target.2],
@@ -289,23 +305,33 @@ pub(super) fn simulate_mujoco<'py>(
     drop(guard);
     drop(sim);
     let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
-    records_dict(py, rec, metrics)
+    records_dict(py, rec, metrics, true)
 }
 
 /// The SPEC §12 metrics of a run as a dict of numbers and per-joint lists.
 pub(super) fn metrics_to_dict<'py>(
     py: Python<'py>,
-    metrics: dynamic::MetricsOut,
+    metrics: dynamic::Metrics,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = PyDict::new(py);
-    for (name, v) in metrics.counts {
+    m.set_item("rows", metrics.rows)?;
+    m.set_item("steps_in_contact", metrics.steps_in_contact)?;
+    for (name, v) in [
+        ("rms_z1", metrics.rms_z1),
+        ("rms_z1_after2", metrics.rms_z1_after2),
+        ("sat_duty", metrics.sat_duty),
+        ("peak_contact_after2", metrics.peak_contact_after2),
+        ("mean_contact", metrics.mean_contact),
+        ("imp_err_rms_after2", metrics.imp_err_rms_after2),
+    ] {
         m.set_item(name, v)?;
     }
-    for (name, v) in metrics.scalars {
-        m.set_item(name, v)?;
-    }
-    for (name, v) in metrics.joint {
-        m.set_item(name, v)?;
+    for (name, v) in [
+        ("rms_z1_joint_after2", metrics.rms_z1_joint_after2),
+        ("max_abs_z1_joint_after2", metrics.max_abs_z1_joint_after2),
+        ("peak_abs_tau", metrics.peak_abs_tau),
+    ] {
+        m.set_item(name, v.as_slice())?;
     }
     Ok(m)
 }

@@ -42,7 +42,7 @@ impl Hooks for StopHooks<'_> {
 pub(super) fn run_job(
     job: &Result<Job, String>,
     stop: &std::sync::atomic::AtomicBool,
-) -> Result<dynamic::MetricsOut, String> {
+) -> Result<dynamic::Metrics, String> {
     let job = job.as_ref().map_err(Clone::clone)?;
     let mut tracker =
         dynamic::build(2, Preset::Paper, job.law, &job.items, None, None).map_err(param_message)?;
@@ -128,8 +128,8 @@ pub(super) fn in_parallel<J: Sync>(
     jobs: &[J],
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
-    run: impl Fn(&J, &std::sync::atomic::AtomicBool) -> Result<dynamic::MetricsOut, String> + Sync,
-) -> PyResult<Vec<Result<dynamic::MetricsOut, String>>> {
+    run: impl Fn(&J, &std::sync::atomic::AtomicBool) -> Result<dynamic::Metrics, String> + Sync,
+) -> PyResult<Vec<Result<dynamic::Metrics, String>>> {
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let pool = rayon::ThreadPoolBuilder::new()

@@ -18,7 +18,7 @@ mod spec;
 
 pub use cartesian::simulate_cartesian;
 pub use plant::{Arm, Disturbances, Injected, Injection, Jacobian3, Plant, RigidBody};
-pub use rows::{metrics_of, Metrics, Recorded, Rows, TaskRows, TaskStep};
+pub use rows::{metrics_of, Metrics, Recorded, RowMetrics, Rows, TaskRows, TaskStep};
 pub use spec::{run, Loop, Output, Spec};
 
 use super::cartesian::Joint;

@@ -3,6 +3,7 @@
 //! core's one accumulator (also of rows recorded elsewhere: [`metrics_of`]).
 
 use super::super::cartesian::CartesianCommand;
+use super::super::sized::{each, make, ByJoints, Family};
 use super::super::values::Joints;
 use super::{Run, RunError};
 use crate::cartesian::{self, PoseTarget};
@@ -320,6 +321,87 @@ impl<const M: usize> TaskMetrics<M> {
     }
 }
 
+struct RowMetricsF;
+impl Family for RowMetricsF {
+    type Of<const N: usize> = TaskMetrics<N>;
+}
+
+/// The SPEC §12 metrics of rows given one at a time as slices (a loop that
+/// runs in another language, row by row): n joints (q, q̇, q̈, τ, sat(τ),
+/// τe) and a reference of width m (xc, ẋc, ẍc, z1), by the core's one
+/// accumulator, sized once for max(n, m) (the narrower quantities padded
+/// with zeros, which change no norm, peak or count). [`metrics_of`] is it
+/// over tables.
+pub struct RowMetrics {
+    inner: ByJoints<RowMetricsF>,
+}
+
+impl RowMetrics {
+    /// For n joints and a reference of width m (1 ≤ n, m ≤ 7), the window
+    /// after `settle` (s); `joint`: the reference is in joint space (m = n;
+    /// the impedance residual against `target` = (Dd, Cd, Gd), n values
+    /// each), else the impedance residual is NaN.
+    pub fn new(
+        n: usize,
+        m: usize,
+        joint: bool,
+        settle: f64,
+        target: [&[f64]; 3],
+    ) -> Result<Self, Error> {
+        let inner = make!(
+            n.max(m),
+            K => TaskMetrics::<K>::new(n, m, joint, settle, target),
+            _ => Error::Invalid {
+                what: "rows",
+                reason: "the joints and the reference's width must be between 1 and 7",
+            }
+        )?;
+        Ok(Self { inner })
+    }
+
+    /// One row: t (s); q, q̇, q̈ (n each); xc, ẋc, ẍc (m each); z1 (m); τ,
+    /// sat(τ), τe (n each). A slice shorter than its width is an error.
+    pub fn push(
+        &mut self,
+        t: f64,
+        x: [&[f64]; 3],
+        c: [&[f64]; 3],
+        z1: &[f64],
+        tau: [&[f64]; 3],
+    ) -> Result<(), Error> {
+        each!(&mut self.inner, a, K => {
+            let (n, m) = (a.n, a.m);
+            if x.iter().chain(tau.iter()).any(|v| v.len() < n)
+                || c.iter().chain([&z1]).any(|v| v.len() < m)
+            {
+                return Err(Error::Invalid {
+                    what: "rows",
+                    reason: "a row needs n values per joint quantity, m per reference one",
+                });
+            }
+            a.push(t, x, c, z1, tau);
+            Ok(())
+        })
+    }
+
+    /// The metrics of the rows so far: per-coordinate figures of z1 cut to
+    /// m, of τ to n.
+    pub fn finish(&self) -> Metrics {
+        each!(&self.inner, a, K => a.finish())
+    }
+}
+
+impl core::fmt::Debug for RowMetrics {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        each!(&self.inner, a, K => f
+            .debug_struct("RowMetrics")
+            .field("n", &a.n)
+            .field("m", &a.m)
+            .field("joint", &a.joint)
+            .finish())
+    }
+}
+
 /// Rows recorded elsewhere (a loop that ran in another language), K of
 /// them, row-major: n values per row for the plant's quantities, m for the
 /// reference's (m = n in joint space, else the task's width).
@@ -347,22 +429,6 @@ pub struct Recorded<'a> {
 /// Gd), n values each; none: whether m = n). In task space the impedance
 /// residual is NaN.
 pub fn metrics_of(
-    rows: &Recorded<'_>,
-    settle: f64,
-    target: [&[f64]; 3],
-    joint_space: Option<bool>,
-) -> Result<Metrics, Error> {
-    crate::with_joints!(
-        rows.n.max(rows.m),
-        K => metrics_n::<K>(rows, settle, target, joint_space),
-        _ => Err(Error::Invalid {
-            what: "rows",
-            reason: "the joints and the reference's width must be between 1 and 7",
-        }),
-    )
-}
-
-fn metrics_n<const N: usize>(
     r: &Recorded<'_>,
     settle: f64,
     target: [&[f64]; 3],
@@ -378,7 +444,7 @@ fn metrics_n<const N: usize>(
         });
     }
     let joint = joint_space.unwrap_or(m == n);
-    let mut acc = TaskMetrics::<N>::new(n, m, joint, settle, target)?;
+    let mut acc = RowMetrics::new(n, m, joint, settle, target)?;
     fn row(v: &[f64], w: usize, i: usize) -> &[f64] {
         &v[i * w..(i + 1) * w]
     }
@@ -393,7 +459,7 @@ fn metrics_n<const N: usize>(
                 row(r.tau[1], n, i),
                 row(r.tau[2], n, i),
             ],
-        );
+        )?;
     }
     Ok(acc.finish())
 }

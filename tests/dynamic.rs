@@ -1484,3 +1484,85 @@ fn the_one_builder_feeds_forward_the_gravity_of_a_model() {
         "feedforward: was made for another number of joints"
     );
 }
+
+/// A replay of recorded rows is the controller's steps, one per row, bit for
+/// bit: with its own trajectory and with the rows' setpoints; the caller sees
+/// the state every 64 rows and after the last, and can stop it.
+#[test]
+fn a_replay_is_the_steps_of_its_rows() {
+    const N: usize = 3;
+    const K: usize = 150;
+    let (d, s) = scenario::<N>(Law::StateFeedback, false);
+    let dc = d.controller().expect("controller");
+    let (_, traj) = core_controller(&s);
+    let mut tables: [Vec<f64>; 6] = Default::default();
+    for k in 0..K {
+        let m = measurement(&traj, k, usize::MAX);
+        let c = traj.sample(k as f64 * 1e-3 + 2e-4);
+        for (t, v) in tables
+            .iter_mut()
+            .zip([m.x, m.dx.expect("dx"), m.tau_e, c.x, c.dx, c.ddx])
+        {
+            t.extend_from_slice(v.as_slice());
+        }
+    }
+    let [x, dx, tau_e, xc, dxc, ddxc] = &tables;
+    for setpoint in [None, Some([&xc[..], &dxc[..], &ddxc[..]])] {
+        let rows = dy::Replay {
+            x,
+            dx: Some(dx),
+            tau_e,
+            setpoint,
+        };
+        let mut by_step = dc.new_state();
+        let mut want = Vec::new();
+        for k in 0..K {
+            let r = |v: &[f64]| v[k * N..(k + 1) * N].to_vec();
+            let (q, v, f) = (r(x), r(dx), r(tau_e));
+            let m = dy::Measurement {
+                x: &q,
+                dx: Some(&v),
+                tau_e: &f,
+            };
+            let (a, b, c) = (r(xc), r(dxc), r(ddxc));
+            let sp = dy::Setpoint {
+                x: &a[..],
+                dx: &b[..],
+                ddx: &c[..],
+            };
+            let cmd = dc
+                .step(&mut by_step, &m, setpoint.map(|_| &sp))
+                .expect("step");
+            want.extend_from_slice(&cmd.tau_sat);
+        }
+        let mut state = dc.new_state();
+        let mut out = vec![0.0; K * N];
+        let mut calls = Vec::new();
+        dc.replay(&mut state, &rows, &mut out, |k, total, st| {
+            calls.push((k, total, st.steps()));
+            true
+        })
+        .expect("replay");
+        same("sat(τ)", &out, &want);
+        assert_eq!(calls, [(64, 150, 64), (128, 150, 128), (150, 150, 150)]);
+        same("zeta", state.zeta(), by_step.zeta());
+        // Stopped at the first look: 64 rows taken.
+        let mut again = dc.new_state();
+        let stopped = dc.replay(&mut again, &rows, &mut out, |_, _, _| false);
+        assert_eq!(stopped, Err(dy::RunError::Stopped));
+        assert_eq!(again.steps(), 64);
+    }
+    // Tables of another length are refused by name.
+    let short = dy::Replay {
+        x: &tables[0],
+        dx: None,
+        tau_e: &tables[2][..3],
+        setpoint: None,
+    };
+    let mut state = dc.new_state();
+    let e = dc.replay(&mut state, &short, &mut [0.0; K * N], |_, _, _| true);
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "rows: every table needs K rows of n values"
+    );
+}

@@ -412,7 +412,8 @@ pub use model::{
 pub use run::{
     metrics_of, run, simulate, simulate_cartesian, Arm as ModelArm, Control, Controlled,
     Disturbances, Hooks, Injected, Injection, Jacobian3, Loop, Metrics, Output, Plant, Recorded,
-    Reference, RigidBody, RowMetrics, Rows, Run, RunError, Spec, Table, TaskRows, TaskStep,
+    Reference, Replay, RigidBody, RowMetrics, Rows, Run, RunError, Spec, Table, TaskRows, TaskStep,
+    HOOK_EVERY,
 };
 #[cfg(feature = "alloc")]
 pub use tuning::{Inertia, TaskPath, Tuning};

@@ -13,11 +13,13 @@
 
 mod cartesian;
 mod plant;
+mod replay;
 mod rows;
 mod spec;
 
 pub use cartesian::simulate_cartesian;
 pub use plant::{Arm, Disturbances, Injected, Injection, Jacobian3, Plant, RigidBody};
+pub use replay::Replay;
 pub use rows::{metrics_of, Metrics, Recorded, RowMetrics, Rows, TaskRows, TaskStep};
 pub use spec::{run, Loop, Output, Spec};
 
@@ -125,7 +127,7 @@ impl Hooks for () {
 }
 
 /// Periods between two calls of [`Hooks::tick`].
-const HOOK_EVERY: u64 = 64;
+pub const HOOK_EVERY: u64 = 64;
 
 /// How a run ended when it did not finish.
 #[derive(Copy, Clone, Debug, PartialEq)]

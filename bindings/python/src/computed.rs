@@ -6,12 +6,10 @@
 //! joint space, it is a [`Control`] of the core's loop on MuJoCo
 //! ([`DynComputed::simulate_mujoco`]) along its setpoint of every row.
 
-use super::dynamic::{
-    drive_mujoco, Hooks, Metrics, MujocoRun, OnMujoco, RowMetrics, Rows, RunError, View, MAX_JOINTS,
-};
+use super::dynamic::{Hooks, Metrics, MujocoRun, Rows, RunError, View, MAX_JOINTS};
 use super::frames::{inertial, joint};
 use super::measurement::JointCall;
-use super::mujoco::{MujocoSpec, Table};
+use super::mujoco::MujocoSpec;
 use super::shared::{Read, Shared, Slot, Write};
 use super::{array, array1, vector, vector_into, ConfigError, MeasurementError};
 use adaptimp::cartesian::chain::JointKind;
@@ -20,15 +18,12 @@ use adaptimp::cartesian::{
     ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
     SampledDrive, Spring,
 };
-use adaptimp::control::config::Law;
 use adaptimp::control::impedance::{ImpedanceMode, TargetImpedance};
 use adaptimp::control::io::{Command, Control, Measurement};
 use adaptimp::error::Error;
-use adaptimp::sim::record::{Recorder, Row};
 use adaptimp::trajectory::Setpoint;
 use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
-use core::cell::Cell;
 use numpy::PyArray1;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -192,7 +187,7 @@ impl<const N: usize> DynComputed for Computed<N> {
         run: &MujocoRun<'_>,
         hooks: &mut dyn Hooks,
     ) -> Result<(Rows, Metrics), RunError> {
-        run_mujoco(self, sim, spec, run, hooks)
+        super::drive::run_computed(self, sim, spec, run, hooks)
     }
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
@@ -234,142 +229,6 @@ impl<const N: usize> View for Computed<N> {
         (part == TypeId::of::<Box<dyn DynComputed>>()).then(|| {
             Box::new(Box::new(self.clone()) as Box<dyn DynComputed>) as Box<dyn Any + Send>
         })
-    }
-}
-
-impl<const N: usize> View for Stepped<'_, N> {
-    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
-        self.c.copy(part)
-    }
-}
-
-/// Computed torque as the loop steps it, keeping the torque it gives to
-/// apply (its sat(τ), or the torque it holds on a refusal).
-struct Stepped<'a, const N: usize> {
-    c: &'a mut Computed<N>,
-    applied: &'a Cell<Vector<N>>,
-}
-
-impl<const N: usize> Control<N> for Stepped<'_, N> {
-    fn period(&self) -> f64 {
-        self.c.period()
-    }
-    fn target(&self) -> &TargetImpedance<N> {
-        Control::target(self.c)
-    }
-    fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
-        Control::step(self.c, m, c)
-    }
-    fn step_or_fallback(
-        &mut self,
-        m: &Measurement<N>,
-        c: &Setpoint<N>,
-    ) -> (Vector<N>, Result<Command<N>, Error>) {
-        let (tau, result) = self.c.step_or_fallback(m, c);
-        self.applied.set(tau);
-        (tau, result)
-    }
-}
-
-/// The rows of a joint-space run and the SPEC §12 metrics of every row (the
-/// accumulator of `_adaptimp.metrics`, as the Python loop measured computed
-/// torque), with the saturation the metrics count: the torque the
-/// controller gives within the actuators' limits, before a disturbance
-/// weakens it (a refused row: none).
-struct JointRows<'a, const N: usize> {
-    rec: Rows,
-    metrics: RowMetrics,
-    /// A row the metrics refused (none: every row fits by construction).
-    refused: Option<Error>,
-    applied: &'a Cell<Vector<N>>,
-    tau_max: Vector<N>,
-}
-
-impl<const N: usize> Recorder<N> for JointRows<'_, N> {
-    fn record(&mut self, r: &Row<N>) {
-        self.rec.record(r);
-        let sat = if r.refused {
-            r.tau
-        } else {
-            self.applied
-                .get()
-                .zip_map(&self.tau_max, |t, m| t.max(-m).min(m))
-        };
-        let pushed = self.metrics.push(
-            r.t,
-            [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
-            [r.xc.as_slice(), r.dxc.as_slice(), r.ddxc.as_slice()],
-            r.z1.as_slice(),
-            [r.tau.as_slice(), sat.as_slice(), r.tau_e.as_slice()],
-        );
-        if let Err(e) = pushed {
-            self.refused.get_or_insert(e);
-        }
-    }
-}
-
-fn run_mujoco<const N: usize>(
-    c: &mut Computed<N>,
-    sim: &mut Sim,
-    spec: &MujocoSpec,
-    run: &MujocoRun<'_>,
-    hooks: &mut dyn Hooks,
-) -> Result<(Rows, Metrics), RunError> {
-    let ts = c.ctrl.period();
-    let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
-    let need = usize::try_from(total)
-        .unwrap_or(usize::MAX)
-        .saturating_mul(N);
-    let rows = match run.reference {
-        Some(rows) if rows.iter().all(|r| r.len() >= need) => rows,
-        _ => {
-            return Err(RunError::Core(
-                Error::Invalid {
-                    what: "reference",
-                    reason: "computed torque needs its setpoint of every step",
-                },
-                None,
-            ))
-        }
-    };
-    let every = run.every.max(1);
-    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-    let rec = Rows::new(N, kept, every)?;
-    let imp = *c.ctrl.impedance();
-    let target = [
-        imp.dd().as_slice(),
-        imp.cd().as_slice(),
-        imp.gd().as_slice(),
-    ];
-    let metrics = RowMetrics::new(N, N, true, run.settle, target)?;
-    let applied = Cell::new(Vector::<N>::zeros());
-    let tau_max =
-        Vector::<N>::from_fn(|i, _| spec.tau_max.get(i).copied().unwrap_or(f64::INFINITY));
-    let mut out = JointRows {
-        rec,
-        metrics,
-        refused: None,
-        applied: &applied,
-        tau_max,
-    };
-    let on = OnMujoco {
-        sim,
-        spec,
-        t_final: run.t_final,
-        settle: run.settle,
-        items: run.items,
-        law: Law::Pd,
-        fault: run.fault,
-        abort: None,
-    };
-    let mut stepped = Stepped {
-        c,
-        applied: &applied,
-    };
-    drive_mujoco(&mut stepped, &Table::<N> { rows, ts }, on, hooks, &mut out)?;
-    match out.refused {
-        Some(e) => Err(RunError::Core(e, None)),
-        None => Ok((out.rec, out.metrics.finish())),
     }
 }
 

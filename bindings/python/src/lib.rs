@@ -33,23 +33,30 @@
 //! calls), `controller`, `models` (the simulation's arms), `runs`
 //! (`simulate`, `metrics`, `simulate_mujoco`), `sweeps` (`simulate_many`,
 //! `simulate_mujoco_many`), `export` (the schema's table); the task-space
-//! classes (`cartesian`, `computed`, `description`, `tuning`) and the loops
-//! (`dynamic`, `mujoco`, `cartesian_loop`, `callback`). The joint count is
-//! dispatched by the core's `with_joints!` (src/dynamic.rs) for every front.
+//! classes (`cartesian`, `computed`, `description`, `tuning`), what builds a
+//! controller (`items`), and the loops (`dynamic`, `drive`, `mujoco`,
+//! `cartesian_loop`, `callback`, `callback_loop`): the MuJoCo plant is the
+//! core's run-time `adaptimp::dynamic::Plant`, the rows and metrics the
+//! core's `adaptimp::dynamic::{Rows, Metrics, RowMetrics}`. The joint count
+//! is dispatched by the core's `with_joints!` (src/dynamic.rs) for every
+//! front.
 
 mod arrays;
 mod callback;
+mod callback_loop;
 mod cartesian;
 mod cartesian_loop;
 mod cartesian_step;
 mod computed;
 mod controller;
 mod description;
+mod drive;
 mod dynamic;
 mod errors;
 mod export;
 mod frames;
 mod hooks;
+mod items;
 mod measurement;
 mod models;
 mod module;

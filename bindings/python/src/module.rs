@@ -23,7 +23,7 @@ mod adaptimp_module {
     };
 
     #[pymodule_export]
-    use crate::callback::simulate_mujoco_callback;
+    use crate::callback_loop::simulate_mujoco_callback;
     #[pymodule_export]
     use crate::cartesian::{centres_along, PyCartesian, PyChain};
     #[pymodule_export]

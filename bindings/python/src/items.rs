@@ -1,0 +1,191 @@
+//! What a front gives to build a joint controller and its runs, as plain
+//! values: parameter items by schema name, user centres, the nominal model
+//! of the gravity fed forward, the arm of a run's plant, a fault to inject
+//! (nothing here knows Python).
+
+use adaptimp::control::config::Law;
+use adaptimp::control::tracker::Tracker;
+use adaptimp::error::Error;
+use adaptimp::networks::rbf::AnyBasis;
+use adaptimp::schema::{Preset, Scenario, Value};
+use adaptimp::sim::inject::{Injected, Injection};
+use adaptimp::sim::model::{Link, TwoLinkArm};
+use adaptimp::trajectory::Sinusoid;
+use adaptimp::types::Vector;
+use std::vec::Vec;
+
+/// A parameter value, owned (the schema's [`Value`] borrows).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Owned {
+    /// A number.
+    Real(f64),
+    /// An integer.
+    Int(i64),
+    /// One number per joint or network.
+    Vec(Vec<f64>),
+    /// A name.
+    Str(String),
+    /// A flag.
+    Bool(bool),
+    /// None.
+    None,
+}
+
+impl Owned {
+    pub(crate) fn value(&self) -> Value<'_> {
+        match self {
+            Owned::Real(x) => Value::Real(*x),
+            Owned::Int(i) => Value::Int(*i),
+            Owned::Vec(v) => Value::Vec(v),
+            Owned::Str(s) => Value::Str(s),
+            Owned::Bool(b) => Value::Bool(*b),
+            Owned::None => Value::None,
+        }
+    }
+}
+
+/// Parameter items by schema name.
+pub type Items = [(String, Owned)];
+
+/// An error of the scenario, with the parameter it came from (if any).
+#[derive(Clone, Debug)]
+pub struct ParamError {
+    /// The parameter's name, when one parameter was at fault.
+    pub name: Option<String>,
+    /// The core's error.
+    pub error: Error,
+}
+
+impl From<Error> for ParamError {
+    fn from(error: Error) -> Self {
+        Self { name: None, error }
+    }
+}
+
+/// `preset` for `law` with every item applied, for N joints.
+pub fn scenario<const N: usize>(
+    preset: Preset,
+    law: Law,
+    items: &Items,
+) -> Result<Scenario<N>, ParamError> {
+    let mut s = Scenario::<N>::preset(preset, law);
+    for (name, v) in items {
+        s.set(name, v.value()).map_err(|error| ParamError {
+            name: Some(name.clone()),
+            error,
+        })?;
+    }
+    Ok(s)
+}
+
+/// User RBF centres: L rows of 4n coordinates (x, v, α1, α̇1) and the
+/// squared widths η_d² per input dimension (4n).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CentersSpec {
+    /// Row-major, L × 4n.
+    pub centers: Vec<f64>,
+    /// 4n squared widths, block-major (x, v, α1, α̇1), joint-minor.
+    pub widths2: Vec<f64>,
+}
+
+/// The nominal model whose gravity a joint controller feeds forward, SPEC
+/// (20.10): a chain's joints and inertials and the gravity vector, as
+/// computed torque takes them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GravitySpec {
+    /// The chain's joints (fixed ones too).
+    pub joints: Vec<adaptimp::cartesian::chain::Joint>,
+    /// One inertial per joint.
+    pub inertials: Vec<adaptimp::cartesian::dynamics::Inertial>,
+    /// Gravity (m/s², base frame).
+    pub gravity: [f64; 3],
+}
+
+/// The arm a run's plant is built from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ArmSpec {
+    /// The paper's 2-link arm (55)–(63).
+    Paper(TwoLinkArm),
+    /// A planar arm of n links.
+    Planar {
+        /// The links, joint 1 first.
+        links: Vec<Link>,
+        /// Gravity (m/s²).
+        g: f64,
+    },
+}
+
+/// A fault to inject into a run (`src/sim/inject.rs`), for any number of joints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaultSpec {
+    /// What goes wrong.
+    pub kind: FaultKind,
+    /// Start of the window (s).
+    pub start: f64,
+    /// Length of the window (s).
+    pub duration: f64,
+}
+
+/// The kinds of [`Injected`] faults.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FaultKind {
+    /// The sensors repeat their last sample.
+    Stale,
+    /// The position sensor reads NaN.
+    NanBurst,
+    /// The force sensor reads τe + bias (N m, one per joint).
+    ForceBias(Vec<f64>),
+    /// The actuators deliver at most this fraction of τmax.
+    ActuatorDrop(f64),
+    /// No control step runs: the last applied torque is held.
+    Skipped,
+}
+
+/// The core's injection of `f`, with the actuators' limits `tau_max` (N m).
+pub(crate) fn injection<const N: usize>(
+    f: &FaultSpec,
+    tau_max: &Vector<N>,
+) -> Result<Injection<N>, Error> {
+    adaptimp::error::check::nonnegative("fault start ≥ 0", "start", f.start)?;
+    adaptimp::error::check::positive("fault duration > 0", "duration", f.duration)?;
+    let fault = match &f.kind {
+        FaultKind::Stale => Injected::Stale,
+        FaultKind::NanBurst => Injected::NanBurst,
+        FaultKind::Skipped => Injected::Skipped,
+        FaultKind::ForceBias(b) => {
+            if b.len() != N {
+                return Err(Error::Invalid {
+                    what: "bias",
+                    reason: "needs one value per joint (N m)",
+                });
+            }
+            adaptimp::error::check::finite_slice("bias", b)?;
+            Injected::ForceBias {
+                bias: Vector::from_column_slice(b),
+            }
+        }
+        FaultKind::ActuatorDrop(fraction) => {
+            if !(0.0..=1.0).contains(fraction) {
+                return Err(Error::Condition {
+                    condition: "0 ≤ fraction ≤ 1",
+                    lhs: "fraction",
+                    index: None,
+                    value: *fraction,
+                });
+            }
+            Injected::ActuatorDrop {
+                tau_max: *tau_max,
+                fraction: *fraction,
+            }
+        }
+    };
+    Ok(Injection {
+        fault,
+        start: f.start,
+        duration: f.duration,
+    })
+}
+
+/// The typed controller behind a [`DynTracker`] of N joints (the Cartesian
+/// bindings step it directly, `bindings/python/src/cartesian.rs`).
+pub(crate) type Typed<const N: usize> = Tracker<N, AnyBasis<N>, Sinusoid<N>>;

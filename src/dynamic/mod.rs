@@ -17,6 +17,7 @@
 //! | [`ComputedTorque`], [`ComputedState`] | [`ComputedTorque`](crate::ComputedTorque) | the model-based baseline (SPEC §20) |
 //! | [`CartesianImpedance`], [`CartesianController`] | [`CartesianImpedance`](crate::CartesianImpedance), [`CartesianController`](crate::CartesianController) | the 6-D outer loop, alone or with the joint controller it drives (SPEC §16) |
 //! | [`simulate`], [`simulate_cartesian`], [`Plant`] (feature `sim`) | [`simulate_disturbed`](crate::sim::simulator::simulate_disturbed), [`Plant`](crate::Plant) | the closed loop over a plant of n joints, its rows and SPEC §12 metrics |
+//! | [`Replay`], [`RowMetrics`] (feature `sim`) | a loop of [`Controller::step`](crate::Controller::step), [`MetricsAccumulator`](crate::sim::metrics::MetricsAccumulator) | the controller along recorded rows; the metrics of rows given one at a time |
 //!
 //! The Python bindings and the C ABI convert to and from these types; the
 //! list of sizes a front is built for is [`MAX_JOINTS`], dispatched here

@@ -215,8 +215,15 @@ SCENE = """
 """
 
 
-def test_the_scene_wrench_is_the_push_on_fixed_bodies_only():
-    m = mujoco.MjModel.from_xml_string(SCENE)
+def scene(cone: str = "pyramidal", condim: int = 3) -> mujoco.MjModel:
+    """SCENE with the friction cone and the contacts' dimension given."""
+    option = f'<option timestep="0.002" cone="{cone}"/><default><geom condim="{condim}"/></default>'
+    return mujoco.MjModel.from_xml_string(SCENE.replace('<option timestep="0.002"/>', option))
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])  # elliptic: robosuite's
+def test_the_scene_wrench_is_the_push_on_fixed_bodies_only(cone):
+    m = scene(cone)
     d = mujoco.MjData(m)
     for _ in range(1500):  # settle: the pad on the table, the box on the pad
         mujoco.mj_step(m, d)
@@ -232,6 +239,56 @@ def test_the_scene_wrench_is_the_push_on_fixed_bodies_only():
     assert w[:3] == pytest.approx([0.0, 0.0, -weight], abs=1e-3)
     # About the tip, 0.1 m beside the pad's centre: the moment of that force.
     assert w[3:] == pytest.approx([0.0, weight * 0.1, 0.0], abs=1e-3)
+
+
+def test_the_scene_wrench_solves_no_contact_and_reads_the_last_solve():
+    """SPEC (23.4): between mj_step1 and mj_step2 the wrench is the contact
+    forces at the acceleration MuJoCo's last solve left (qacc_warmstart), on
+    the timestep's contacts: no constraint solve (qacc, the solver's output,
+    untouched), and at the acceleration of that solve, the forces it solved."""
+    m = scene("elliptic")
+    d = mujoco.MjData(m)
+    for _ in range(1500):
+        mujoco.mj_step(m, d)
+    hinge = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "hinge")
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "tip")
+    wrench = ars.SceneWrench(m, d, hinge, site)
+    mujoco.mj_step1(m, d)
+    d.qacc[:] = np.nan  # what a solve would overwrite
+    w = wrench().copy()
+    assert np.all(np.isnan(d.qacc))
+    # The same state solved by MuJoCo (mj_forward): its qacc is the warm
+    # start's, and its contact forces are the wrench's, to the solver's tolerance.
+    solved = mujoco.MjData(m)
+    solved.qpos[:], solved.qvel[:], solved.act[:] = d.qpos, d.qvel, d.act
+    solved.qacc_warmstart[:] = d.qacc_warmstart
+    mujoco.mj_forward(m, solved)
+    again = ars.SceneWrench(m, solved, hinge, site)
+    solved.qacc_warmstart[:] = solved.qacc  # the acceleration of this solve
+    mujoco.mj_forward(m, solved)
+    assert w == pytest.approx(again().copy(), abs=1e-6)
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+@pytest.mark.parametrize("condim", [1, 3, 4, 6])
+def test_the_scene_wrench_decodes_the_contact_forces_as_mujoco_does(cone, condim):
+    """The contacts' forces in their frames are ``mj_contactForce``'s, read
+    for all contacts at once (an elliptic cone's rows; a pyramid's edges)."""
+    m = scene(cone, condim)
+    d = mujoco.MjData(m)
+    for _ in range(300):
+        mujoco.mj_step(m, d)
+    assert d.ncon > 0
+    wrench = ars.SceneWrench(m, d, 0, 0)
+    hits = np.arange(d.ncon)
+    f = np.zeros(6)
+    want = np.empty((d.ncon, 3))
+    for i in hits:
+        mujoco.mj_contactForce(m, d, int(i), f)
+        want[i] = f[:3]
+    # (to rounding: a pyramid's normal is a sum of its edges, in numpy's order)
+    got = wrench._local(d.contact, hits, d.efc_force)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
 
 
 PAGE = Path(__file__).resolve().parents[1] / "docs" / "robosuite.md"

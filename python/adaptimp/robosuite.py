@@ -258,6 +258,11 @@ def _subtree(model: Any, top: int) -> NDArray[np.bool_]:
     return inside
 
 
+_PAIR = np.array([3, 1])  # a contact's (code1, code2) · _PAIR (SceneWrench)
+# (r × f)_i = r_{i+1} f_{i+2} − r_{i+2} f_{i+1}, for i = 0, 1, 2
+_NEXT, _LAST = np.array([1, 2, 0]), np.array([2, 0, 1])
+
+
 class SceneWrench:
     """The wrench F_e = [f; m] (N, N m), (6,), that the end effector exerts on
     the fixed scene, world frame, the moment about the grip site (SPEC
@@ -268,19 +273,52 @@ class SceneWrench:
     which the networks learn, not a wrench to comply with.
 
     robosuite runs its controllers between ``mj_step1`` and ``mj_step2``: the
-    contacts are the timestep's, their forces not yet solved. When the end
-    effector touches the fixed scene, this solves them (``mj_fwdActuation``,
-    ``mj_fwdAcceleration``, ``mj_fwdConstraint``, with the torque of the last
-    timestep still applied); ``mj_step2`` solves them again with the new one."""
+    contacts are the timestep's (their Jacobian and reference acceleration
+    made by ``mj_step1``), their forces not yet solved. This does not solve
+    them: it evaluates them (``mj_constraintUpdate``) at the acceleration
+    MuJoCo solved at the last timestep and keeps for its warm start
+    (``qacc_warmstart``), the forces the last solve's acceleration gives the
+    timestep's contacts; ``mj_step2`` solves them once, as without ADAPTIMP."""
 
     def __init__(self, model: Any, data: Any, last_joint: int, site: int) -> None:
         self._m, self._d, self._site = model, data, site
         body = np.asarray(model.geom_bodyid)
-        self._ee = _subtree(model, int(model.jnt_bodyid[last_joint]))[body]
-        self._fixed = (np.asarray(model.body_weldid) == 0)[body]
-        self._f = np.zeros(6)
+        ee = _subtree(model, int(model.jnt_bodyid[last_joint]))[body]
+        fixed = (np.asarray(model.body_weldid) == 0)[body]
+        # Per geom: 1 on the end effector, 2 welded to the world, 0 else; a
+        # contact's pair (geom1, geom2) is 3 code1 + code2: 5 the end effector
+        # first, 7 second.
+        self._code = np.where(ee, 1, np.where(fixed, 2, 0)).astype(np.intp)
+        self._elliptic = int(model.opt.cone) == int(mujoco.mjtCone.mjCONE_ELLIPTIC)
         self.wrench = np.zeros(6)
         """The last wrench (N, N m), (6,): read it, do not keep it (overwritten)."""
+
+    def _local(self, contact: Any, hits: NDArray[np.intp], force: FloatArray) -> FloatArray:
+        """The contacts' forces (N), (k, 3), in their frames: normal, tangents
+        (``mj_contactForce``'s, read from ``force``, MuJoCo's efc_force, for
+        the contacts ``hits`` at once: an elliptic cone's rows are the force,
+        a pyramid's edges decode as ``mju_decodePyramid`` does)."""
+        adr = np.asarray(contact.efc_address[hits], dtype=np.intp)
+        dim = np.asarray(contact.dim[hits], dtype=np.intp)
+        on = adr >= 0  # a contact without constraint rows exerts nothing
+        last = force.size - 1
+        out = np.zeros((hits.size, 3))
+        if self._elliptic:
+            rows = np.minimum(adr[:, None] + np.arange(3), last)
+            out[:] = np.where(np.arange(3) < np.minimum(dim, 3)[:, None], force[rows], 0.0)
+        else:
+            edges = 2 * (dim - 1)
+            width = max(int(edges.max()), 1)
+            rows = np.minimum(adr[:, None] + np.arange(width), last)
+            p = np.where(np.arange(width) < edges[:, None], force[rows], 0.0)
+            out[:, 0] = np.where(dim == 1, force[np.minimum(adr, last)], p.sum(axis=1))
+            if width >= 2:
+                mu = np.asarray(contact.friction[hits], dtype=np.float64)
+                out[:, 1] = (p[:, 0] - p[:, 1]) * mu[:, 0]
+                if width >= 4:
+                    out[:, 2] = (p[:, 2] - p[:, 3]) * mu[:, 1]
+        out[~on] = 0.0
+        return out
 
     def __call__(self) -> FloatArray:
         """F_e now (N, N m), (6,)."""
@@ -289,26 +327,24 @@ class SceneWrench:
         if d.ncon == 0:
             return w
         contact = d.contact
-        g = contact.geom
-        first = self._ee[g[:, 0]] & self._fixed[g[:, 1]]
-        second = self._ee[g[:, 1]] & self._fixed[g[:, 0]]
-        hits = np.flatnonzero(first | second)
+        pair = self._code[contact.geom] @ _PAIR
+        hits = np.flatnonzero((pair == 5) | (pair == 7))
         if hits.size == 0:
             return w
-        mujoco.mj_fwdActuation(m, d)
-        mujoco.mj_fwdAcceleration(m, d)
-        mujoco.mj_fwdConstraint(m, d)
-        local = np.empty((hits.size, 3))
-        for j, i in enumerate(hits):
-            mujoco.mj_contactForce(m, d, int(i), self._f)
-            local[j] = self._f[:3]
+        # jar = J a − a_ref at the last solve's acceleration a (SPEC (23.4)).
+        jar = np.empty(d.nefc)
+        mujoco.mj_mulJacVec(m, d, jar, d.qacc_warmstart)
+        jar -= d.efc_aref
+        mujoco.mj_constraintUpdate(m, d, jar, None, 0)
+        local = self._local(contact, hits, d.efc_force)
         # The force on geom2 in the world frame (the frame's rows are the
         # contact's axes, the normal from geom1 to geom2): what the end
         # effector exerts when it is geom1, the opposite when it is geom2.
         f = np.einsum("kji,kj->ki", contact.frame[hits].reshape(-1, 3, 3), local)
-        f[second[hits]] *= -1.0
+        f[pair[hits] == 7] *= -1.0
         w[:3] = f.sum(axis=0)
-        w[3:] = np.cross(contact.pos[hits] - d.site_xpos[self._site], f).sum(axis=0)
+        r = contact.pos[hits] - d.site_xpos[self._site]
+        w[3:] = (r[:, _NEXT] * f[:, _LAST] - r[:, _LAST] * f[:, _NEXT]).sum(axis=0)  # Σ r × f
         return w
 
 

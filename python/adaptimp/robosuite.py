@@ -259,6 +259,8 @@ def _subtree(model: Any, top: int) -> NDArray[np.bool_]:
 
 
 _PAIR = np.array([3, 1])  # a contact's (code1, code2) · _PAIR (SceneWrench)
+_SIDE = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, -1.0, 0.0])  # +1 at 5, −1 at 7
+_XYZ = np.arange(3)
 # (r × f)_i = r_{i+1} f_{i+2} − r_{i+2} f_{i+1}, for i = 0, 1, 2
 _NEXT, _LAST = np.array([1, 2, 0]), np.array([2, 0, 1])
 
@@ -300,6 +302,8 @@ class SceneWrench:
         a pyramid's edges decode as ``mju_decodePyramid`` does)."""
         adr = np.asarray(contact.efc_address[hits], dtype=np.intp)
         dim = np.asarray(contact.dim[hits], dtype=np.intp)
+        if self._elliptic and dim.min() >= 3 and adr.min() >= 0:
+            return force[adr[:, None] + _XYZ]  # the common case: its first three rows
         on = adr >= 0  # a contact without constraint rows exerts nothing
         last = force.size - 1
         out = np.zeros((hits.size, 3))
@@ -327,8 +331,8 @@ class SceneWrench:
         if d.ncon == 0:
             return w
         contact = d.contact
-        pair = self._code[contact.geom] @ _PAIR
-        hits = np.flatnonzero((pair == 5) | (pair == 7))
+        side = _SIDE[self._code[contact.geom] @ _PAIR]
+        hits = np.flatnonzero(side)
         if hits.size == 0:
             return w
         # jar = J a − a_ref at the last solve's acceleration a (SPEC (23.4)).
@@ -340,11 +344,11 @@ class SceneWrench:
         # The force on geom2 in the world frame (the frame's rows are the
         # contact's axes, the normal from geom1 to geom2): what the end
         # effector exerts when it is geom1, the opposite when it is geom2.
-        f = np.einsum("kji,kj->ki", contact.frame[hits].reshape(-1, 3, 3), local)
-        f[pair[hits] == 7] *= -1.0
+        f = np.einsum("kji,kj,k->ki", contact.frame[hits].reshape(-1, 3, 3), local, side[hits])
         w[:3] = f.sum(axis=0)
         r = contact.pos[hits] - d.site_xpos[self._site]
-        w[3:] = (r[:, _NEXT] * f[:, _LAST] - r[:, _LAST] * f[:, _NEXT]).sum(axis=0)  # Σ r × f
+        rf = r.T @ f  # Σ r × f = (S_12 − S_21, S_20 − S_02, S_01 − S_10), S = Σ r fᵀ
+        w[3:] = rf[_NEXT, _LAST] - rf[_LAST, _NEXT]
         return w
 
 

@@ -33,7 +33,7 @@ timestep, when the torque is computed), the task's successes, and the
 median ``env.step`` time (ms, one policy step: 25 model timesteps).
 
     python benches/osc.py [--json] [--arms Panda Sawyer ...] [--tasks square lift wipe]
-        [--errors none cube payload friction] [--seeds 10]
+        [--errors none cube payload friction] [--seeds 10] [--update FILE]
     python benches/osc.py --phases [--json] [--arms ...] [--errors ...]   # the lift's phases
     python benches/osc.py --markdown FILE   # the tables of docs/robosuite.md from a --json FILE
 """
@@ -556,19 +556,24 @@ def markdown(results: list[dict[str, Any]]) -> str:
         seeds = rows[0]["OSC_POSE"]["seeds"]
         out.append(f"#### {TASK_TITLES[task]}, {seeds} seeds\n")
         wipe = task == "wipe"
-        extra = " along the table (mm) | ÷ | wiped (%) | peak force (N) |" if wipe else ""
+        extra = (
+            " along the table (mm) | ÷ | vertical (mm) | ADAPTIMP's vertical ÷ OSC's position "
+            "| wiped (%) | peak force (N) |"
+            if wipe
+            else ""
+        )
         out.append(
             "| arm | model error | position (mm) | ADAPTIMP ÷ OSC | orientation (mrad) "
             f"| successes | env.step (ms) |{extra}"
         )
-        out.append("|---|---|---:|---:|---:|---:|---:|" + ("---:|" * 4 if wipe else ""))
+        out.append("|---|---|---:|---:|---:|---:|---:|" + ("---:|" * 6 if wipe else ""))
         for r in rows:
             o, a = r["OSC_POSE"], r["ADAPTIMP"]
             if _cut_short(r):
                 out.append(
                     f"| {r['arm']} | {ERROR_NAMES[r['error']]} | robosuite ends every "
                     "episode before the script does, under either controller | — | — | "
-                    f"{o['success']} → {a['success']} | — |" + (" — |" * 4 if wipe else "")
+                    f"{o['success']} → {a['success']} | — |" + (" — |" * 6 if wipe else "")
                 )
                 continue
             ratio = "—" if r["pos_ratio"] is None else f"**{r['pos_ratio']:.3f}**"
@@ -582,6 +587,8 @@ def markdown(results: list[dict[str, Any]]) -> str:
                 ho, ha = _horizontal(o), _horizontal(a)
                 line += (
                     f" {_pair(ho, ha)} | {ha / ho:.3f} | "
+                    f"{_pair(o['rms_vertical_mm'], a['rms_vertical_mm'])} | "
+                    f"{a['rms_vertical_mm'] / o['rms_pos_mm']:.3f} | "
                     f"{_pair(100 * o['wiped'], 100 * a['wiped'], 0)} | "
                     f"{_pair(o['force_max_N'], a['force_max_N'], 1)} |"
                 )
@@ -626,6 +633,21 @@ def targets_markdown(results: list[dict[str, Any]]) -> str:
     return "\n".join(out) + "\n"
 
 
+def update(path: str, rows: list[dict[str, Any]]) -> None:
+    """Replace the rows of the ``--json`` results in ``path`` that ``rows``
+    measured again (the same arm, task and model error), keep the others in
+    their order, and write ``path`` back."""
+    with open(path, encoding="utf-8") as f:
+        data = json.load(f)
+    new = {(r["arm"], r["task"], r["error"]): r for r in rows}
+    kept = data["results"]
+    data["results"] = [new.pop((r["arm"], r["task"], r["error"]), r) for r in kept]
+    data["results"] += list(new.values())
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(data, f, indent=1)
+        f.write("\n")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object")
@@ -640,6 +662,11 @@ def main() -> None:
         "--phases",
         action="store_true",
         help="the lift's error per phase of its script, one seed (JSON with --json)",
+    )
+    ap.add_argument(
+        "--update",
+        metavar="FILE",
+        help="measure, then replace those rows of a --json output FILE (the others kept)",
     )
     ap.add_argument("--params", type=json.loads, default={}, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -677,6 +704,8 @@ def main() -> None:
                         f"{o['step_ms']:.2f} → {a['step_ms']:.2f} ms",
                         flush=True,
                     )
+    if args.update:
+        update(args.update, results)
     if args.json:
         json.dump({"results": results}, sys.stdout, indent=1)
         print()

@@ -303,7 +303,7 @@ class SceneWrench:
         adr = np.asarray(contact.efc_address[hits], dtype=np.intp)
         dim = np.asarray(contact.dim[hits], dtype=np.intp)
         if self._elliptic and dim.min() >= 3 and adr.min() >= 0:
-            return force[adr[:, None] + _XYZ]  # the common case: its first three rows
+            return np.asarray(force[adr[:, None] + _XYZ], dtype=np.float64)  # its first 3 rows
         on = adr >= 0  # a contact without constraint rows exerts nothing
         last = force.size - 1
         out = np.zeros((hits.size, 3))

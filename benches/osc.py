@@ -692,8 +692,12 @@ def main() -> None:
                 got = measure(robot, task, error, args.seeds, args.params)
                 row = {"arm": robot, "task": task, "error": error, **got}
                 results.append(row)
+                if args.update:  # row by row: a run cut short keeps what it measured
+                    update(args.update, [row])
                 if args.json:
                     print(f"{robot} {task} {error}: {got['pos_ratio']}", file=sys.stderr)
+                elif _cut_short(row):
+                    print(f"{robot:8s} {task:6s} {error:8s} cut short by robosuite", flush=True)
                 else:
                     a, o = got["ADAPTIMP"], got["OSC_POSE"]
                     print(
@@ -704,8 +708,6 @@ def main() -> None:
                         f"{o['step_ms']:.2f} → {a['step_ms']:.2f} ms",
                         flush=True,
                     )
-    if args.update:
-        update(args.update, results)
     if args.json:
         json.dump({"results": results}, sys.stdout, indent=1)
         print()

@@ -343,6 +343,27 @@ def test_the_pages_tables_are_the_benches_output(script, results):
     assert block.group(1).strip() == want.strip()
 
 
+def test_the_pages_wipe_ranges_are_the_results():
+    """The ranges docs/robosuite.md's prose gives for the wipe (the vertical
+    error's share, the error along the table, the env.step ratio) are the
+    committed results' (the Sawyer's rows, cut short by robosuite, left out)."""
+    page = " ".join(PAGE.read_text(encoding="utf-8").split())
+    data = json.loads((BENCHES / "results" / "osc.json").read_text(encoding="utf-8"))
+    rows = [r for r in data["results"] if r["task"] == "wipe" and r["arm"] != "Sawyer"]
+
+    def along(c: dict) -> float:
+        return float(np.sqrt(max(c["rms_pos_mm"] ** 2 - c["rms_vertical_mm"] ** 2, 0.0)))
+
+    def span(values: list[float]) -> str:
+        return f"{min(values):.2f}–{max(values):.2f}"
+
+    o, a = "OSC_POSE", "ADAPTIMP"
+    vertical = span([r[a]["rms_vertical_mm"] / r[o]["rms_pos_mm"] for r in rows])
+    assert f"vertical error alone is {vertical}× OSC_POSE's whole" in page
+    assert f"where its error is {span([along(r[a]) / along(r[o]) for r in rows])}× OSC's" in page
+    assert f"its env.step is {span([r['step_ratio'] for r in rows])}× OSC_POSE's" in page
+
+
 def test_the_benchs_square_with_a_payload_osc_lacks():
     """benches/osc.py's square on the Panda, a payload of 10 % of the arm on the
     hand that neither controller is told of, one seed: ADAPTIMP reaches every

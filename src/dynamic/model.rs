@@ -4,16 +4,19 @@
 //! [`ComputedTorque`] with its [`ComputedState`] (SPEC §20).
 
 use super::sized::{each, make, map, pair, ByJoints, Family};
-use super::values::{mismatch, vector, Command, Joints, Measurement, Setpoint};
+use super::values::{length, mismatch, vector, Command, Joints, Measurement, Setpoint};
 use super::MAX_JOINTS;
-use crate::cartesian::{self, Inertial, Joint, JointKind, Kinematics, Transform};
+use crate::cartesian::{
+    self, Assessment, Inertial, Joint, JointKind, Kinematics, PostureRule, TaskRows, Transform,
+};
 use crate::control::impedance::{ImpedanceMode, TargetImpedance};
 use crate::control::safety::{Fault, CEILING_POSITION};
 use crate::description::{Arm, DescriptionError, ErrorKind};
 use crate::error::{check, Error};
-use crate::types::Vector;
+use crate::types::{Matrix, Vector};
 use alloc::boxed::Box;
 use alloc::format;
+use alloc::vec::Vec;
 use core::convert::Infallible;
 use nalgebra::{Const, Dyn, MatrixView, Rotation3, SMatrix};
 
@@ -226,6 +229,111 @@ impl Chain {
                 Err(TIP_DIVERGED)
             }
         })
+    }
+}
+
+impl Chain {
+    /// The tip's pose at q unchecked (errors only for a length other than
+    /// n): for postures a run recorded, whatever they are.
+    pub fn pose_unchecked(&self, q: &[f64]) -> Result<(Vector<3>, Rotation3<f64>), Error> {
+        each!(&self.inner, c, N => Ok(c.pose(&vector::<N>("q", q)?)))
+    }
+
+    /// The tip's twist V = J(q) q̇ = [ṗ; ω] (m/s, rad/s) and acceleration
+    /// A = J(q) q̈ + J̇ q̇ = [p̈; ω̇] (m/s², rad/s²) at one row (q, q̇, q̈),
+    /// (q, q̇) checked as [`tip`](Self::tip) checks them.
+    pub fn motion(
+        &self,
+        q: &[f64],
+        dq: &[f64],
+        ddq: &[f64],
+    ) -> Result<(Vector<6>, Vector<6>), Error> {
+        each!(&self.inner, c, N => {
+            let (dq, ddq) = (vector::<N>("dq", dq)?, vector::<N>("ddq", ddq)?);
+            let t = c.tip_checked(&vector::<N>("q", q)?, &dq)?;
+            let dot = |i: usize, x: &Vector<N>| (0..N).map(|j| t.jacobian[(i, j)] * x[j]).sum::<f64>();
+            Ok((
+                Vector::<6>::from_fn(|i, _| dot(i, &dq)),
+                Vector::<6>::from_fn(|i, _| dot(i, &ddq) + t.bias[i]),
+            ))
+        })
+    }
+
+    /// The posture rule's assessment of SPEC (16.9) on this chain
+    /// ([`PostureRule::assess`](crate::cartesian::PostureRule::assess)):
+    /// the orbit's postures q (K × n, rad), the tip's targets p (K × 3, m),
+    /// the gravity torque along it (K × n, N m), the inertia matrix at its
+    /// start `d0` (n × n, kg m²), the limits (n each, rad) and τmax (n, N m),
+    /// all row-major. Errors name a table of another width.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assess_posture(
+        &self,
+        rule: &PostureRule,
+        task: TaskRows,
+        (orbit, targets, gravity): (&[f64], &[f64], &[f64]),
+        d0: &[f64],
+        (lo, hi): (&[f64], &[f64]),
+        tau_max: &[f64],
+    ) -> Result<Assessment, Error> {
+        each!(&self.inner, c, N => {
+            let rows = |what: &'static str, v: &[f64]| -> Result<Vec<Vector<N>>, Error> {
+                if !v.len().is_multiple_of(N) {
+                    return Err(length(what));
+                }
+                Ok(v.chunks_exact(N).map(Vector::<N>::from_column_slice).collect())
+            };
+            if !targets.len().is_multiple_of(3) {
+                return Err(Error::Invalid {
+                    what: "targets",
+                    reason: "needs 3 values (a position) per row",
+                });
+            }
+            if d0.len() != N * N {
+                return Err(length("d0"));
+            }
+            let targets: Vec<Vector<3>> = targets
+                .chunks_exact(3)
+                .map(Vector::<3>::from_column_slice)
+                .collect();
+            rule.assess(
+                &**c,
+                task,
+                &rows("orbit", orbit)?,
+                &targets,
+                &rows("gravity", gravity)?,
+                &Matrix::<N>::from_row_slice(d0),
+                (&vector::<N>("lo", lo)?, &vector::<N>("hi", hi)?),
+                &vector::<N>("tau_max", tau_max)?,
+            )
+        })
+    }
+}
+
+impl Jacobian {
+    /// A 6 × n Jacobian from its rows (6 × n values, row-major,
+    /// 1 ≤ n ≤ [`MAX_JOINTS`]).
+    pub fn from_rows(rows: &[f64]) -> Result<Self, Error> {
+        let n = rows.len() / 6;
+        if rows.len() != 6 * n || !(1..=MAX_JOINTS).contains(&n) {
+            return Err(Error::Invalid {
+                what: "jacobian",
+                reason: "needs 6 rows of n values, 1 ≤ n ≤ 7",
+            });
+        }
+        let mut m = SMatrix::<f64, 6, MAX_JOINTS>::zeros();
+        for (k, v) in rows.iter().enumerate() {
+            m[(k / n, k % n)] = *v;
+        }
+        Ok(Self { n, m })
+    }
+
+    /// The normal of a planar arm's plane, SPEC (16.8)
+    /// ([`plane_normal`](crate::cartesian::rule::plane_normal)), or `None`
+    /// for an arm that is not planar.
+    pub fn plane_normal(&self) -> Option<Vector<3>> {
+        crate::with_joints!(self.n, N => {
+            crate::cartesian::rule::plane_normal(&self.m.fixed_columns::<N>(0).into_owned())
+        }, _ => None)
     }
 }
 

@@ -29,8 +29,8 @@ use adaptimp::cartesian::{
 };
 use adaptimp::control::config::Law;
 use adaptimp::control::io::Command;
+use adaptimp::dynamic::{Centres, Joints};
 use adaptimp::error::Error;
-use adaptimp::networks::rbf::Centers;
 use adaptimp::schema::Preset;
 use adaptimp::trajectory::Setpoint;
 use adaptimp::types::Vector;
@@ -46,35 +46,9 @@ use std::vec::Vec;
 // The object-safe faces.
 // ---------------------------------------------------------------------------
 
-/// The tip's motion at (q, q̇): Jacobian (6 × n row-major), J̇ q̇ (6).
-pub struct TipOut {
-    /// [J_v; J_ω], 6 × n row-major.
-    pub jacobian: Vec<f64>,
-    /// J̇ q̇.
-    pub bias: [f64; 6],
-}
-
-/// A [`Chain`] of any n ≤ 7, over slices.
+/// The chain's typed outer loop: what [`PyCartesian`] is built on until
+/// the outer loop is the core's run-time one.
 pub trait DynChain: Send + Sync {
-    /// Movable joints n.
-    fn n(&self) -> usize;
-    /// Which joints are prismatic.
-    fn prismatic(&self) -> Vec<bool>;
-    /// The tip at (q, q̇) (n values each), both finite and within their
-    /// ceilings (`Chain::tip_checked`).
-    fn tip(&self, q: &[f64], dq: &[f64]) -> Result<TipOut, Error>;
-    /// The tip's pose at q: the homogeneous transform, row-major (4 × 4);
-    /// q checked as by `tip`.
-    fn pose(&self, q: &[f64]) -> Result<Vec<f64>, Error>;
-    /// The Jacobian at q, 6 × n row-major; q checked as by `tip`.
-    fn jacobian(&self, q: &[f64]) -> Result<Vec<f64>, Error>;
-    /// J̇ q̇ at (q, q̇), checked as by `tip` (finite, or an error).
-    fn bias(&self, q: &[f64], dq: &[f64]) -> Result<[f64; 6], Error>;
-    /// The tip (Jacobian, J̇ q̇) and the pose (4 × 4 row-major) unchecked: for
-    /// the core's rules, which hand in their own postures.
-    fn tip_pose_unchecked(&self, q: &[f64], dq: &[f64]) -> (TipOut, Vec<f64>);
-    /// The pose (4 × 4 row-major) unchecked (a run's recorded postures).
-    fn pose_unchecked(&self, q: &[f64]) -> Vec<f64>;
     /// The outer loop of `cfg` over this chain at period `ts`, started at `q0`.
     fn outer(
         &self,
@@ -85,83 +59,11 @@ pub trait DynChain: Send + Sync {
     ) -> Result<Box<dyn DynOuter>, Error>;
 }
 
-/// `v` if every value is finite, else the error `tip_checked` gives.
-fn finite_out(v: Vec<f64>) -> Result<Vec<f64>, Error> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(v)
-    } else {
-        Err(Error::Diverged {
-            what: "the chain's tip (pose, Jacobian or J̇ q̇)",
-        })
-    }
-}
-
 fn vector_of<const N: usize>(v: &[f64]) -> Vector<N> {
     Vector::from_column_slice(&v[..N])
 }
 
 impl<const N: usize> DynChain for Chain<N> {
-    fn n(&self) -> usize {
-        N
-    }
-    fn prismatic(&self) -> Vec<bool> {
-        (0..N).map(|i| self.is_prismatic(i)).collect()
-    }
-    fn tip(&self, q: &[f64], dq: &[f64]) -> Result<TipOut, Error> {
-        let t = self.tip_checked(&vector_of(q), &vector_of(dq))?;
-        Ok(TipOut {
-            jacobian: t.jacobian.transpose().as_slice().to_vec(),
-            bias: t.bias.into(),
-        })
-    }
-    fn tip_pose_unchecked(&self, q: &[f64], dq: &[f64]) -> (TipOut, Vec<f64>) {
-        let t = Kinematics::tip(self, &vector_of(q), &vector_of(dq));
-        let tip = TipOut {
-            jacobian: t.jacobian.transpose().as_slice().to_vec(),
-            bias: t.bias.into(),
-        };
-        (tip, self.pose_unchecked(q))
-    }
-    fn pose(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
-        self.check_motion(&vector_of(q), None)?;
-        finite_out(self.pose_unchecked(q))
-    }
-    fn pose_unchecked(&self, q: &[f64]) -> Vec<f64> {
-        let (p, r) = Chain::pose(self, &vector_of(q));
-        let mut m = std::vec![0.0; 16];
-        for i in 0..3 {
-            for j in 0..3 {
-                m[4 * i + j] = r[(i, j)];
-            }
-            m[4 * i + 3] = p[i];
-        }
-        m[15] = 1.0;
-        m
-    }
-    fn jacobian(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
-        let q = vector_of::<N>(q);
-        self.check_motion(&q, None)?;
-        // Column-major 6 × N storage of Jᵀ: J row-major.
-        finite_out(
-            self.pose_jacobian(&q)
-                .jacobian
-                .transpose()
-                .as_slice()
-                .to_vec(),
-        )
-    }
-    fn bias(&self, q: &[f64], dq: &[f64]) -> Result<[f64; 6], Error> {
-        let (q, dq) = (vector_of::<N>(q), vector_of::<N>(dq));
-        self.check_motion(&q, Some(&dq))?;
-        let b: [f64; 6] = Chain::bias(self, &q, &dq).into();
-        if b.iter().all(|x| x.is_finite()) {
-            Ok(b)
-        } else {
-            Err(Error::Diverged {
-                what: "the chain's tip (pose, Jacobian or J̇ q̇)",
-            })
-        }
-    }
     fn outer(
         &self,
         cfg: CartesianConfig,
@@ -1112,7 +1014,8 @@ fn rows(n: usize, what: &str, a: &PyReadonlyArray2<'_, f64>, width: usize) -> Py
 /// Use `adaptimp.Chain`, which reads URDF files and MuJoCo models.
 #[pyclass(name = "Chain", module = "adaptimp._adaptimp", frozen, subclass)]
 pub struct PyChain {
-    inner: Box<dyn DynChain>,
+    inner: adaptimp::dynamic::Chain,
+    typed: Box<dyn DynChain>,
 }
 
 impl PyChain {
@@ -1121,27 +1024,8 @@ impl PyChain {
     }
 
     /// The chain behind the object.
-    pub(super) fn dyn_chain(&self) -> &dyn DynChain {
-        &*self.inner
-    }
-}
-
-/// A [`DynChain`] of `N` joints as the core's [`Kinematics`] (for the rules
-/// that take an arm's kinematics, SPEC §16).
-pub(super) struct TypedChain<'a, const N: usize>(pub(super) &'a dyn DynChain);
-
-impl<const N: usize> Kinematics<N> for TypedChain<'_, N> {
-    fn tip(&self, q: &Vector<N>, dq: &Vector<N>) -> adaptimp::cartesian::Tip<N> {
-        // The pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
-        let (t, pose) = self.0.tip_pose_unchecked(q.as_slice(), dq.as_slice());
-        adaptimp::cartesian::Tip {
-            position: Vector::<3>::new(pose[3], pose[7], pose[11]),
-            rotation: nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::new(
-                pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
-            )),
-            jacobian: adaptimp::cartesian::Jacobian6::<N>::from_row_slice(&t.jacobian),
-            bias: Vector::<6>::from(t.bias),
-        }
+    pub(super) fn chain(&self) -> &adaptimp::dynamic::Chain {
+        &self.inner
     }
 }
 
@@ -1160,8 +1044,10 @@ impl PyChain {
             Some(t) => transform(&t)?,
             None => Transform::IDENTITY,
         };
-        let inner = chain(&js, &tip).map_err(|e| ConfigError::new_err(e.to_string()))?;
-        Ok(Self { inner })
+        let err = |e: Error| ConfigError::new_err(e.to_string());
+        let inner = adaptimp::dynamic::Chain::new(&js, &tip).map_err(err)?;
+        let typed = chain(&js, &tip).map_err(err)?;
+        Ok(Self { inner, typed })
     }
 
     /// Movable joints n.
@@ -1173,7 +1059,9 @@ impl PyChain {
     /// Whether each joint is prismatic (else revolute), (n,).
     #[getter]
     fn prismatic(&self) -> Vec<bool> {
-        self.inner.prismatic()
+        (0..self.inner.n())
+            .map(|i| self.inner.is_prismatic(i))
+            .collect()
     }
 
     /// The tip's pose at q: the homogeneous transform (4, 4), world ← tip (m).
@@ -1184,7 +1072,13 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        let pose = self.inner.pose(&q[..n]).map_err(cartesian_error)?;
+        let (p, r) = self.inner.pose(&q[..n]).map_err(cartesian_error)?;
+        let mut pose = std::vec![0.0; 16];
+        for i in 0..3 {
+            pose[4 * i..4 * i + 3].copy_from_slice(&[r[(i, 0)], r[(i, 1)], r[(i, 2)]]);
+            pose[4 * i + 3] = p[i];
+        }
+        pose[15] = 1.0;
         array(py, pose, (4, 4))
     }
 
@@ -1219,16 +1113,11 @@ impl PyChain {
                 let (mut v, mut a) = (std::vec![0.0; 6 * k], std::vec![0.0; 6 * k]);
                 for r in 0..k {
                     let rows = r * n..(r + 1) * n;
-                    let t = inner
-                        .tip(&q[rows.clone()], &dq[rows.clone()])
+                    let (tv, ta) = inner
+                        .motion(&q[rows.clone()], &dq[rows.clone()], &ddq[rows])
                         .map_err(|e| (r, e))?;
-                    // TipOut's Jacobian is row-major 6 × n.
-                    for i in 0..6 {
-                        let row = &t.jacobian[i * n..(i + 1) * n];
-                        let dot = |x: &[f64]| row.iter().zip(x).map(|(j, x)| j * x).sum::<f64>();
-                        v[6 * r + i] = dot(&dq[rows.clone()]);
-                        a[6 * r + i] = dot(&ddq[rows.clone()]) + t.bias[i];
-                    }
+                    v[6 * r..6 * r + 6].copy_from_slice(tv.as_slice());
+                    a[6 * r..6 * r + 6].copy_from_slice(ta.as_slice());
                 }
                 Ok((v, a))
             })
@@ -1247,8 +1136,9 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        let jacobian = self.inner.jacobian(&q[..n]).map_err(cartesian_error)?;
-        array(py, jacobian, (6, n))
+        let j = self.inner.jacobian(&q[..n]).map_err(cartesian_error)?;
+        let rows = (0..6).flat_map(|i| (0..n).map(move |c| (i, c)));
+        array(py, rows.map(|ij| j[ij]).collect(), (6, n))
     }
 
     /// J̇ q̇ at (q, q̇), (6,): the tip's classical acceleration at q̈ = 0,
@@ -1265,7 +1155,7 @@ impl PyChain {
             .inner
             .bias(&q[..n], &dq[..n])
             .map_err(cartesian_error)?;
-        Ok(array1(py, &bias))
+        Ok(array1(py, bias.as_slice()))
     }
 }
 
@@ -1338,7 +1228,7 @@ impl PyCartesian {
         let q0 = vector("q0", n, q0)?;
         let posture = posture.map(|p| vector("posture", n, p)).transpose()?;
         let inner = chain
-            .inner
+            .typed
             .outer(cfg, ts, &q0[..n], posture.as_ref().map(|p| &p[..n]))
             .map_err(|e| ConfigError::new_err(e.to_string()))?;
         Ok(Self {
@@ -1892,36 +1782,20 @@ pub fn centres_along<'py>(
     }
     let qs = rows(l, "q", &q, n)?;
     let dqs = rows(l, "dq", &dq, n)?;
-    fn along<const N: usize>(
-        qs: &[f64],
-        dqs: &[f64],
-        tube: [f64; 2],
-        periodic: bool,
-    ) -> Result<(Vec<f64>, Vec<f64>), Error> {
-        let samples: Vec<Setpoint<N>> = qs
-            .chunks(N)
-            .zip(dqs.chunks(N))
-            .map(|(x, dx)| Setpoint {
-                x: vector_of(x),
-                dx: vector_of(dx),
-                ddx: Vector::zeros(),
+    let samples = qs
+        .chunks(n)
+        .zip(dqs.chunks(n))
+        .map(|(x, dx)| {
+            Ok(adaptimp::dynamic::Setpoint {
+                x: Joints::from_slice(x)?,
+                dx: Joints::from_slice(dx)?,
+                ddx: Joints::zeros(n)?,
             })
-            .collect();
-        let c = if periodic {
-            Centers::along_periodic(&samples, tube)?
-        } else {
-            Centers::along(&samples, tube)?
-        };
-        let w = c.widths2();
-        let widths = w.iter().flat_map(|b| b.iter().copied()).collect();
-        Ok((c.centers().to_vec(), widths))
-    }
-    let tube = [tube.0, tube.1];
-    let (c, w) = adaptimp::with_joints!(
-        n,
-        K => along::<K>(&qs, &dqs, tube, periodic),
-        _ => unreachable!("n is checked above"),
-    )
-    .map_err(|e| ConfigError::new_err(e.to_string()))?;
+        })
+        .collect::<Result<Vec<_>, Error>>();
+    let c = samples
+        .and_then(|s| Centres::along(&s, [tube.0, tube.1], periodic))
+        .map_err(|e| ConfigError::new_err(e.to_string()))?;
+    let (c, w) = (c.rows, c.widths2.unwrap_or_default());
     Ok((array(py, c, (l, 4 * n))?, array1(py, &w)))
 }

@@ -1,7 +1,7 @@
 //! The gain and basis rule of SPEC §18 for Python (`adaptimp.tuning`), a thin
 //! face of [`adaptimp::control::tuning`]: arrays in, the schema's names out.
 
-use super::cartesian::{PyChain, TypedChain};
+use super::cartesian::PyChain;
 use super::cartesian_loop::TARGET_LEN;
 use super::{array, config_error, law_of, py_value, ConfigError};
 use adaptimp::cartesian::rule::{PoseCircle, PostureRule, TaskRows};
@@ -9,7 +9,7 @@ use adaptimp::control::tuning::{default_task as core_default_task, Rule};
 use adaptimp::dynamic::{Inertia, TaskPath, Tuning};
 use adaptimp::error::Error;
 use adaptimp::schema::{Group, PARAMS};
-use adaptimp::types::{Matrix, Vector};
+use adaptimp::types::Vector;
 use numpy::{
     PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArrayDyn,
     PyUntypedArrayMethods,
@@ -318,19 +318,18 @@ pub fn assess_posture<'py>(
             ))
         }
     };
-    let kin = chain.dyn_chain();
+    let kin = chain.chain();
     let n = kin.n();
     check_posture_shapes((&q, &p, &gravity, &d0), (&lo, &hi, &tau_max), n)?;
     let flat = |a: &PyReadonlyArray2<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
     let flat1 = |a: &PyReadonlyArray1<'py, f64>| a.as_array().iter().copied().collect::<Vec<_>>();
     let (q, p, g, d) = (flat(&q), flat(&p), flat(&gravity), flat(&d0));
     let (lo, hi, tau) = (flat1(&lo), flat1(&hi), flat1(&tau_max));
-    let (a, score, error) = adaptimp::with_joints!(
-        n,
-        K => assess_typed::<K>(&rule, kin, (&q, &p, &g, &d), (&lo, &hi, &tau), task),
-        _ => unreachable!("a chain has 1 to 7 joints"),
-    )
-    .map_err(|e| config_error(e.into()))?;
+    let a = kin
+        .assess_posture(&rule, task, (&q, &p, &g), &d, (&lo, &hi), &tau)
+        .map_err(|e| config_error(e.into()))?;
+    let error = rule.check(&a).err().map(|e| e.to_string());
+    let score = rule.score(&a);
     let out = assessment_dict(py, &a, score, error)?;
     let needs = PyDict::new(py);
     needs.set_item("sigma_min", rule.sigma_min)?;
@@ -395,16 +394,9 @@ pub fn plane_normal(jacobian: PyReadonlyArray2<'_, f64>) -> PyResult<Option<[f64
     if shape.len() != 2 || shape[0] != 6 || !(1..=super::MAX_JOINTS).contains(&shape[1]) {
         return Err(shape_error("jacobian", "(6, n), 1 ≤ n ≤ 7".into(), shape));
     }
-    let n = shape[1];
     let j: Vec<f64> = jacobian.as_array().iter().copied().collect();
-    Ok(adaptimp::with_joints!(
-        n,
-        K => {
-            let m = adaptimp::cartesian::kinematics::Jacobian6::<K>::from_row_slice(&j);
-            adaptimp::cartesian::rule::plane_normal(&m).map(|v| [v[0], v[1], v[2]])
-        },
-        _ => unreachable!("n checked above"),
-    ))
+    let j = adaptimp::dynamic::Jacobian::from_rows(&j).map_err(|e| config_error(e.into()))?;
+    Ok(j.plane_normal().map(|v| [v[0], v[1], v[2]]))
 }
 
 /// [`assess_posture`]'s shapes, SPEC (16.9): q (K, n), p (K, 3), gravity
@@ -443,38 +435,6 @@ fn check_posture_shapes(
         )));
     }
     Ok(())
-}
-
-/// [`assess_posture`]'s assessment at N joints, SPEC (16.9): the flat
-/// rows (q, p, gravity, d0) and the limits (lo, hi, τmax) as the rule's
-/// vectors, the rule's assessment, its score and its first violated
-/// condition (None: none).
-fn assess_typed<const N: usize>(
-    rule: &PostureRule,
-    kin: &dyn super::cartesian::DynChain,
-    (q, p, g, d): (&[f64], &[f64], &[f64], &[f64]),
-    (lo, hi, tau): (&[f64], &[f64], &[f64]),
-    task: TaskRows,
-) -> Result<(adaptimp::cartesian::Assessment, f64, Option<String>), Error> {
-    let v = Vector::<N>::from_column_slice;
-    let orbit: Vec<Vector<N>> = q.chunks_exact(N).map(v).collect();
-    let targets: Vec<Vector<3>> = p
-        .chunks_exact(3)
-        .map(Vector::<3>::from_column_slice)
-        .collect();
-    let gravity: Vec<Vector<N>> = g.chunks_exact(N).map(v).collect();
-    let a = rule.assess(
-        &TypedChain::<N>(kin),
-        task,
-        &orbit,
-        &targets,
-        &gravity,
-        &Matrix::<N>::from_row_slice(d),
-        (&v(lo), &v(hi)),
-        &v(tau),
-    )?;
-    let error = rule.check(&a).err().map(|e| e.to_string());
-    Ok((a, rule.score(&a), error))
 }
 
 /// [`assess_posture`]'s result, SPEC (16.9): the assessment's figures,
@@ -517,7 +477,7 @@ pub fn pose_metrics<'py>(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyDict>,
 )> {
-    let kin = chain.dyn_chain();
+    let kin = chain.chain();
     let n = kin.n();
     let k = q.shape()[0];
     if q.shape() != [k, n] || targets.shape() != [k, TARGET_LEN] || t.shape() != [k] {
@@ -531,34 +491,27 @@ pub fn pose_metrics<'py>(
     let q: Vec<f64> = q.as_array().iter().copied().collect();
     let tg: Vec<f64> = targets.as_array().iter().copied().collect();
     let t: Vec<f64> = t.as_array().iter().copied().collect();
-    let (pos, rot) = py.detach(|| {
-        let (mut pos, mut rot) = (Vec::with_capacity(k), Vec::with_capacity(k));
-        for r in 0..k {
-            // The tip's pose, 4 × 4 row-major: R in rows 0..3, p in column 3.
-            let pose = kin.pose_unchecked(&q[r * n..(r + 1) * n]);
-            let position = [pose[3], pose[7], pose[11]];
-            let rotation = [
-                pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
-            ];
-            let row = &tg[r * TARGET_LEN..(r + 1) * TARGET_LEN];
-            let quat = |m: &[f64]| {
-                nalgebra::UnitQuaternion::from_rotation_matrix(
-                    &nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::from_row_slice(
-                        m,
-                    )),
-                )
-            };
-            let (ep, eo) = adaptimp::sim::metrics::pose_error(
-                &Vector::<3>::from(position),
-                &quat(&rotation),
-                &Vector::<3>::from_column_slice(&row[..3]),
-                &quat(&row[9..18]),
-            );
-            pos.push(ep);
-            rot.push(eo);
-        }
-        (pos, rot)
-    });
+    let (pos, rot) = py
+        .detach(|| -> Result<_, Error> {
+            let (mut pos, mut rot) = (Vec::with_capacity(k), Vec::with_capacity(k));
+            for r in 0..k {
+                let (position, rotation) = kin.pose_unchecked(&q[r * n..(r + 1) * n])?;
+                let row = &tg[r * TARGET_LEN..(r + 1) * TARGET_LEN];
+                let target = nalgebra::Rotation3::from_matrix_unchecked(
+                    nalgebra::Matrix3::from_row_slice(&row[9..18]),
+                );
+                let (ep, eo) = adaptimp::sim::metrics::pose_error(
+                    &position,
+                    &nalgebra::UnitQuaternion::from_rotation_matrix(&rotation),
+                    &Vector::<3>::from_column_slice(&row[..3]),
+                    &nalgebra::UnitQuaternion::from_rotation_matrix(&target),
+                );
+                pos.push(ep);
+                rot.push(eo);
+            }
+            Ok((pos, rot))
+        })
+        .map_err(|e| config_error(e.into()))?;
     let m = adaptimp::sim::metrics::pose_metrics(&t, &pos, &rot, settle, ts);
     let out = PyDict::new(py);
     for (name, v) in [

@@ -16,6 +16,7 @@
 //! | [`Chain`], [`Dynamics`] | [`Chain`](crate::Chain), [`Dynamics`](crate::Dynamics) | kinematics and rigid-body dynamics, from joint data or an [`Arm`](crate::description::Arm) read from a URDF or an MJCF |
 //! | [`ComputedTorque`], [`ComputedState`] | [`ComputedTorque`](crate::ComputedTorque) | the model-based baseline (SPEC §20) |
 //! | [`CartesianImpedance`], [`CartesianController`] | [`CartesianImpedance`](crate::CartesianImpedance), [`CartesianController`](crate::CartesianController) | the 6-D outer loop, alone or with the joint controller it drives (SPEC §16) |
+//! | [`pose_target`], [`HeldRotation`] | [`PoseTarget`](crate::PoseTarget) | a commanded pose from its flat layout, and the rotation a target without one keeps |
 //! | [`simulate`], [`simulate_cartesian`], [`Plant`] (feature `sim`) | [`simulate_disturbed`](crate::sim::simulator::simulate_disturbed), [`Plant`](crate::Plant) | the closed loop over a plant of n joints, its rows and SPEC §12 metrics |
 //! | [`Replay`], [`RowMetrics`] (feature `sim`) | a loop of [`Controller::step`](crate::Controller::step), [`MetricsAccumulator`](crate::sim::metrics::MetricsAccumulator) | the controller along recorded rows; the metrics of rows given one at a time |
 //!
@@ -390,6 +391,8 @@ mod model;
 #[cfg(all(feature = "alloc", feature = "sim"))]
 mod run;
 #[cfg(feature = "alloc")]
+mod target;
+#[cfg(feature = "alloc")]
 mod tuning;
 
 #[cfg(feature = "alloc")]
@@ -416,6 +419,8 @@ pub use run::{
     Reference, Replay, RigidBody, RowMetrics, Rows, Run, RunError, Spec, Table, TaskRows, TaskStep,
     HOOK_EVERY,
 };
+#[cfg(feature = "alloc")]
+pub use target::{pose_target, HeldRotation, TARGET_LEN};
 #[cfg(feature = "alloc")]
 pub use tuning::{Inertia, TaskPath, Tuning};
 #[cfg(feature = "alloc")]

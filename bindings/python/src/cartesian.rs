@@ -29,13 +29,14 @@ use adaptimp::cartesian::{
 };
 use adaptimp::control::config::Law;
 use adaptimp::control::io::Command;
-use adaptimp::dynamic::{Centres, Joints};
+use adaptimp::dynamic::{Centres, HeldRotation, Joints};
 use adaptimp::error::Error;
 use adaptimp::schema::Preset;
 use adaptimp::trajectory::Setpoint;
 use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::any::{Any, TypeId};
+use nalgebra::Matrix3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -82,7 +83,7 @@ impl<const N: usize> DynChain for Chain<N> {
             q0,
             posture,
             last: None,
-            held: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            held: HeldRotation::default(),
             log: Vec::new(),
             rows: 0,
         }))
@@ -179,10 +180,10 @@ pub trait DynOuter: Send + Sync {
     /// before a step): `last("tau_sat")` without its name's lookup or a
     /// vector made.
     fn applied(&self) -> [f64; MAX_JOINTS];
-    /// The commanded rotation held when a target gives none (row-major).
-    fn held(&self) -> [f64; 9];
-    /// Hold `r` (row-major) from now on.
-    fn set_held(&mut self, r: [f64; 9]);
+    /// The commanded rotation held when a target gives none.
+    fn held(&self) -> &HeldRotation;
+    /// The same, to change.
+    fn held_mut(&mut self) -> &mut HeldRotation;
     /// Keep the last step's row of `CartesianController.log` (p_c, ṗ_c, p̈_c,
     /// p_d, ṗ_d, p̈_d, q_d, F_e, the error: [`LOG_WIDTH`] + n values).
     fn record(&mut self);
@@ -259,8 +260,8 @@ struct Outer<const N: usize> {
     q0: Vector<N>,
     posture: Vector<N>,
     last: Option<LastStep<N>>,
-    /// The commanded rotation a target without one keeps (row-major).
-    held: [f64; 9],
+    /// The commanded rotation a target without one keeps.
+    held: HeldRotation,
     /// Kept rows of the log, flat ([`LOG_WIDTH`] + N each), and their number.
     log: Vec<f64>,
     rows: usize,
@@ -331,11 +332,11 @@ impl<const N: usize> DynOuter for Outer<N> {
         self.rows = 0;
         Ok(())
     }
-    fn held(&self) -> [f64; 9] {
-        self.held
+    fn held(&self) -> &HeldRotation {
+        &self.held
     }
-    fn set_held(&mut self, r: [f64; 9]) {
-        self.held = r;
+    fn held_mut(&mut self) -> &mut HeldRotation {
+        &mut self.held
     }
     fn record(&mut self) {
         let Some(last) = &self.last else {
@@ -787,12 +788,10 @@ fn wrench_sample(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
 }
 
 /// The commanded pose of a step: a path's (p, ṗ, p̈) or (p, ṗ, p̈, R, ω, ω̇)
-/// (rates None: 0; R None: `held`; a given R becomes `held`), or a flat
-/// target (24,).
-fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTarget> {
+/// (rates None: 0; R None: the rotation `held`), or a flat target (24,).
+fn sample_target(obj: &Bound<'_, PyAny>, held: &HeldRotation) -> PyResult<PoseTarget> {
     if let Ok(a) = obj.cast::<PyArray1<f64>>() {
         let v = flat("target", TARGET_LEN, a.as_any())?;
-        held.copy_from_slice(&v[9..18]);
         return Ok(pose_target(&v));
     }
     // A tuple (a path's return) is read in place; any other iterable is
@@ -836,14 +835,14 @@ fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTa
             ))
         }
     };
-    let mut v = [0.0; TARGET_LEN];
-    v[..3].copy_from_slice(&p);
-    v[3..6].copy_from_slice(&reals::<3>("dp_c", get(1).as_ref())?);
-    v[6..9].copy_from_slice(&reals::<3>("ddp_c", get(2).as_ref())?);
-    if let Some(r) = get(3) {
-        let r = match r.cast::<PyArray2<f64>>() {
+    let v3 =
+        |what: &'static str, i: usize| reals::<3>(what, get(i).as_ref()).map(Vector::<3>::from);
+    let rates = [v3("dp_c", 1)?, v3("ddp_c", 2)?];
+    let r = match get(3) {
+        None => None,
+        Some(r) => Some(match r.cast::<PyArray2<f64>>() {
             Ok(a) if a.shape() == [3, 3] => {
-                core::array::from_fn(|k| a.get_owned([k / 3, k % 3]).unwrap_or(f64::NAN))
+                Matrix3::from_fn(|i, j| a.get_owned([i, j]).unwrap_or(f64::NAN))
             }
             _ => {
                 if let Some(shape) = shape_other_than(&r, &[&[3, 3]]) {
@@ -851,16 +850,12 @@ fn sample_target(obj: &Bound<'_, PyAny>, held: &mut [f64; 9]) -> PyResult<PoseTa
                         "R_c must have shape (3, 3), got shape {shape}"
                     )));
                 }
-                let f = flat_any("R_c", 9, &r)?;
-                core::array::from_fn(|k| f[k])
+                Matrix3::from_row_slice(&flat_any("R_c", 9, &r)?)
             }
-        };
-        *held = r;
-    }
-    v[9..18].copy_from_slice(held);
-    v[18..21].copy_from_slice(&reals::<3>("w_c", get(4).as_ref())?);
-    v[21..24].copy_from_slice(&reals::<3>("dw_c", get(5).as_ref())?);
-    Ok(pose_target(&v))
+        }),
+    };
+    let w = [v3("w_c", 4)?, v3("dw_c", 5)?];
+    Ok(held.target(Vector::<3>::from(p), rates, r, w))
 }
 
 /// As [`flat`], without the finiteness check (the core's), of any length
@@ -1411,14 +1406,15 @@ impl PyCartesian {
         let mut g = self.lock(py)?;
         // The rotation a sample sets is held only once the core accepted the
         // step: a refused one (a rotation that is not one) keeps nothing.
-        let mut held = g.held();
         let target = match sample {
             None => None,
-            Some(s) => Some(sample_target(s, &mut held)?),
+            Some(s) => Some(sample_target(s, g.held())?),
         };
         let m = self.measurement(&qb, measured_dq.then_some(&dqb), f, target);
         g.step_tracker(joint.joint(), &m).map_err(cartesian_error)?;
-        g.set_held(held);
+        if let Some(t) = &target {
+            g.held_mut().hold(t.r);
+        }
         if record {
             g.record();
         }
@@ -1427,13 +1423,14 @@ impl PyCartesian {
 
     /// The commanded rotation a target without one keeps, (3, 3).
     fn held_rotation<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        array(py, self.read(py)?.held().to_vec(), (3, 3))
+        let r = *self.read(py)?.held().rotation();
+        array(py, r.transpose().as_slice().to_vec(), (3, 3))
     }
 
     /// Hold the commanded rotation `r` (3, 3) from now on.
     fn set_held_rotation(&self, py: Python<'_>, r: &Bound<'_, PyAny>) -> PyResult<()> {
         let v = flat("R", 9, r)?;
-        self.lock(py)?.set_held(core::array::from_fn(|i| v[i]));
+        self.lock(py)?.held_mut().hold(Matrix3::from_row_slice(&v));
         Ok(())
     }
 

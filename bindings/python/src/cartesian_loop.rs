@@ -40,11 +40,9 @@ use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::any::{Any, TypeId};
 use core::cell::{Cell, RefCell};
-use nalgebra::Matrix3;
 use std::vec::Vec;
 
-/// Length of a flat pose target: p, ṗ, p̈ (3 each), R row-major (9), ω, ω̇ (3 each).
-pub const TARGET_LEN: usize = 24;
+pub use adaptimp::dynamic::TARGET_LEN;
 
 /// A Cartesian run on MuJoCo ([`simulate_mujoco`]).
 pub struct CartesianRun<'a> {
@@ -279,17 +277,11 @@ pub(crate) fn cartesian_step<const N: usize, J: JointStep<N> + ?Sized>(
     result
 }
 
-/// A pose target from its flat layout (see [`TARGET_LEN`]).
-pub(crate) fn pose_target(v: &[f64]) -> PoseTarget {
-    let v3 = |i: usize| Vector::<3>::new(v[i], v[i + 1], v[i + 2]);
-    PoseTarget {
-        p: v3(0),
-        dp: v3(3),
-        ddp: v3(6),
-        r: Matrix3::from_fn(|i, j| v[9 + 3 * i + j]),
-        w: v3(18),
-        dw: v3(21),
-    }
+/// A row of a flat table as the core's pose target
+/// ([`adaptimp::dynamic::pose_target`]); a short row is NaN, which the
+/// step refuses.
+pub(crate) fn pose_target(row: &[f64]) -> PoseTarget {
+    adaptimp::dynamic::pose_target(row.first_chunk().unwrap_or(&[f64::NAN; TARGET_LEN]))
 }
 
 /// How a run copies its outer loop for the Python code it calls (a

@@ -33,7 +33,8 @@
 //! calls), `controller`, `models` (the simulation's arms), `runs`
 //! (`simulate`, `metrics`, `simulate_mujoco`), `sweeps` (`simulate_many`,
 //! `simulate_mujoco_many`), `export` (the schema's table); the task-space
-//! classes (`cartesian`, `computed`, `description`, `tuning`), what builds a
+//! classes (`chain`, `cartesian` with `cartesian_outer` and
+//! `cartesian_args`, `computed`, `description`, `tuning`), what builds a
 //! controller (`items`), and the loops (`dynamic`, `drive`, `mujoco`,
 //! `cartesian_loop`, `callback`, `callback_loop`): the MuJoCo plant is the
 //! core's run-time `adaptimp::dynamic::Plant`, the rows and metrics the
@@ -45,8 +46,11 @@ mod arrays;
 mod callback;
 mod callback_loop;
 mod cartesian;
+mod cartesian_args;
 mod cartesian_loop;
+mod cartesian_outer;
 mod cartesian_step;
+mod chain;
 mod computed;
 mod controller;
 mod description;

@@ -1,8 +1,8 @@
 //! The gain and basis rule of SPEC §18 for Python (`adaptimp.tuning`), a thin
 //! face of [`adaptimp::control::tuning`]: arrays in, the schema's names out.
 
-use super::cartesian::PyChain;
 use super::cartesian_loop::TARGET_LEN;
+use super::chain::PyChain;
 use super::{array, config_error, law_of, py_value, ConfigError};
 use adaptimp::cartesian::rule::{PoseCircle, PostureRule, TaskRows};
 use adaptimp::control::tuning::{default_task as core_default_task, Rule};

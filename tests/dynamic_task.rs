@@ -59,6 +59,14 @@ fn task_queries<const N: usize>() {
         let want_a: Vec<f64> = (0..6).map(|i| row(i, &ddq) + t.bias[i]).collect();
         assert_eq!(bits(v.as_slice()), bits(&want_v), "twist, n = {N}");
         assert_eq!(bits(a.as_slice()), bits(&want_a), "acceleration, n = {N}");
+        // The Jacobian row-major, as a front's array holds it.
+        let mut rows = vec![0.0; 6 * N];
+        dc.jacobian_rows(q.as_slice(), &mut rows).expect("rows");
+        assert_eq!(
+            bits(&rows),
+            bits(cc.pose_jacobian(&q).jacobian.transpose().as_slice())
+        );
+        assert!(dc.jacobian_rows(q.as_slice(), &mut [0.0; 5]).is_err());
         // A recorded posture's pose, unchecked.
         let (p, r) = dc.pose_unchecked(q.as_slice()).expect("pose");
         let (p2, r2) = cc.pose(&q);

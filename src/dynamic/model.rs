@@ -217,6 +217,25 @@ impl Chain {
         })
     }
 
+    /// The Jacobian at q written row-major into `out` (6 × n values, as
+    /// a front's array holds it), checked as [`jacobian`](Self::jacobian).
+    pub fn jacobian_rows(&self, q: &[f64], out: &mut [f64]) -> Result<(), Error> {
+        each!(&self.inner, c, N => {
+            let q = vector::<N>("q", q)?;
+            if out.len() != 6 * N {
+                return Err(length("out"));
+            }
+            c.check_motion(&q, None)?;
+            // Jᵀ's column-major storage is J row-major.
+            let jt = c.pose_jacobian(&q).jacobian.transpose();
+            if !jt.iter().all(|x| x.is_finite()) {
+                return Err(TIP_DIVERGED);
+            }
+            out.copy_from_slice(jt.as_slice());
+            Ok(())
+        })
+    }
+
     /// J̇ q̇ at (q, q̇): [(m/s²); (rad/s²)].
     pub fn bias(&self, q: &[f64], dq: &[f64]) -> Result<Vector<6>, Error> {
         each!(&self.inner, c, N => {

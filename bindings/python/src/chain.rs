@@ -148,9 +148,11 @@ impl PyChain {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let n = self.inner.n();
         let q = self.qv("q", q)?;
-        let j = self.inner.jacobian(&q[..n]).map_err(cartesian_error)?;
-        let rows = (0..6).flat_map(|i| (0..n).map(move |c| (i, c)));
-        array(py, rows.map(|ij| j[ij]).collect(), (6, n))
+        let mut rows = std::vec![0.0; 6 * n];
+        self.inner
+            .jacobian_rows(&q[..n], &mut rows)
+            .map_err(cartesian_error)?;
+        array(py, rows, (6, n))
     }
 
     /// J̇ q̇ at (q, q̇), (6,): the tip's classical acceleration at q̈ = 0,

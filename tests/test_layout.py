@@ -110,3 +110,43 @@ def test_the_package_takes_no_name_from_its_parent() -> None:
     into = sorted(m for m, to in edges.items() if "adaptimp" in to)
     assert into == []
     assert "adaptimp.mujoco" not in edges["adaptimp._result"]
+
+
+# The names each module split by responsibility had (its top-level definitions
+# and the package names it imported), before the split: a user's
+# ``from adaptimp.mujoco import X`` keeps working.
+BEFORE_THE_SPLIT = {
+    "adaptimp.mujoco": "ARRAYS CartesianTask ConfigError ControllerLike DISTURBANCES "
+    "EFFORT_ACCEL Fault FloatArray HOME_CLEARANCE HOME_LOAD HOME_SAMPLES MAX_JOINTS "
+    "MAX_SUBSTEPS MUJOCO_FIGURES MUJOCO_PLOT_KINDS ModelSource MujocoResult PLOT_KINDS "
+    "Plant PlantWarning RUN_CONTACT_EVERY RUN_PEAK RUN_SATURATED RUN_SETTLE RUN_TRACKING "
+    "Reference SWING_SAMPLES SimResult TASK_AMPLITUDE Task add_table add_tool call_shape "
+    "cartesian_task chain_of collision default_task estimate_effort from_urdf "
+    "holding_controls home_posture loop_delay measure mocap_welds moving_mass needs_extra "
+    "no_file panda paper_circle reals rule_keywords scene_contact_findings self_collision "
+    "simulate sinusoid task_of task_space torque_findings two_link with_payload",
+    "adaptimp.cartesian": "BY_NAME CartesianController CartesianImpedance CartesianStep "
+    "Chain ConfigError FloatArray Measurement MeasurementError PoseTarget call_shape "
+    "check_scenario describe inner_params period_alias pose_target reals resolve tabulate",
+    "adaptimp.franka": "AdaptimpError BLEND BLEND_SPEED COLLISION CartesianTask Chain "
+    "ConfigError DELAY FloatArray LIBFRANKA_ERRORS Measurement PERIOD READY RobotError "
+    "SERVER SETTLE SETTLED SETTLE_WAIT Setup Simulator TAU_MAX TORQUE_RATE chain_of "
+    "move_to needs_extra plant run setup",
+    "adaptimp.scenarios.contact": "ADMITTANCE_SHARE_OF_PERIOD AXIS_SHARE CLEARANCE "
+    "CONTACT_IMPEDANCE CONTACT_K1 Chain ConfigError DEFAULT_MD FloatArray HOME_CANDIDATES "
+    "LEARN_KEYS MAX_PATH_STEPS MIN_REACH_SHARE NORMAL_SAMPLES OUTWARD PandaTable "
+    "REACH_SHARE REFUSAL_ROWS RINGING ROBUST_SLOPE SAG_MARGIN SHARE SLIP_SHARE TABLE_MASS "
+    "TABLE_OFFSET_MARGIN TABLE_ROWS TABLE_TIMECONST THROUGH_TABLE T_APPROACH T_HOLD "
+    "T_PRESS arm_model arm_table contact_impedance contact_metrics normal_inertia "
+    "placement placements refusal_of row_controller rule_keywords run_row sag "
+    "sliding_timeconst table_metrics velocity_loop_radius",
+}
+
+
+@pytest.mark.parametrize("module", sorted(BEFORE_THE_SPLIT))
+def test_a_split_module_keeps_every_name_it_had(module: str) -> None:
+    pytest.importorskip("mujoco")
+    if module == "adaptimp.franka":
+        pytest.importorskip("pylibfranka")
+    mod = importlib.import_module(module)
+    assert [n for n in BEFORE_THE_SPLIT[module].split() if not hasattr(mod, n)] == []

@@ -269,6 +269,35 @@ def test_the_scene_wrench_solves_no_contact_and_reads_the_last_solve():
     assert w == pytest.approx(again().copy(), abs=1e-6)
 
 
+def test_the_scene_wrench_after_a_reset_reads_the_resets_solve():
+    """SPEC (23.4'): after a reset, before any step, the warm start is zeros;
+    the wrench is the forces at the reset's mj_forward's acceleration (qacc),
+    the forces MuJoCo solves for that state (here while the pad still
+    settles, its acceleration far from zero)."""
+    m = scene("elliptic")
+    d = mujoco.MjData(m)
+    for _ in range(100):  # the pad has just met the table
+        mujoco.mj_step(m, d)
+    assert d.ncon > 0
+    qpos, qvel = d.qpos.copy(), d.qvel.copy()
+    mujoco.mj_resetData(m, d)
+    d.qpos[:], d.qvel[:] = qpos, qvel
+    mujoco.mj_forward(m, d)  # as robosuite's reset does
+    assert not d.qacc_warmstart.any()
+    assert np.abs(d.qacc).max() > 1.0
+    hinge = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "hinge")
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "tip")
+    mujoco.mj_step1(m, d)
+    w = ars.SceneWrench(m, d, hinge, site)().copy()
+    solved = mujoco.MjData(m)
+    solved.qpos[:], solved.qvel[:] = qpos, qvel
+    mujoco.mj_forward(m, solved)
+    solved.qacc_warmstart[:] = solved.qacc
+    mujoco.mj_forward(m, solved)
+    want = ars.SceneWrench(m, solved, hinge, site)().copy()
+    assert w == pytest.approx(want, abs=1e-3)
+
+
 @pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
 @pytest.mark.parametrize("condim", [1, 3, 4, 6])
 def test_the_scene_wrench_decodes_the_contact_forces_as_mujoco_does(cone, condim):

@@ -34,7 +34,7 @@ def test_the_old_scenario_modules_warn_and_forward(name: str) -> None:
     old = sys.modules[f"adaptimp.{name}"]
     assert str(caught[0].message) == (
         f"adaptimp.{name} is deprecated: import adaptimp.scenarios.{name} instead "
-        "(the same names; this alias goes away in the next release)"
+        "(the same names; this alias goes away in 0.3)"
     )
     assert caught[0].filename == __file__
     assert old.__all__ == new.__all__

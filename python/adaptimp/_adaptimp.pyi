@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 from typing_extensions import deprecated, disjoint_base
 
 __all__ = [
+    "EFFORT_ACCEL",
     "MAX_JOINTS",
     "N_NODES",
     "CartesianImpedance",
@@ -51,6 +52,7 @@ __all__ = [
 
 __version__: str
 MAX_JOINTS: int
+EFFORT_ACCEL: float
 N_NODES: int
 
 _F = NDArray[np.float64]

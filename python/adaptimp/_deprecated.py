@@ -88,8 +88,7 @@ def moved_module(old: str, new: str) -> None:
     """Warn that the alias module ``old`` was imported: ``new`` replaces it
     (removed in 0.3). Called from the alias module's body."""
     warnings.warn(
-        f"{old} is deprecated: import {new} instead "
-        "(the same names; this alias goes away in the next release)",
+        f"{old} is deprecated: import {new} instead (the same names; this alias goes away in 0.3)",
         DeprecationWarning,
         stacklevel=3,
     )

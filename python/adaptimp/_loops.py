@@ -100,11 +100,9 @@ def table_reference(reference: Any, n: int, Ts: float, steps: int) -> Reference:
     return _Table((xc, dxc, ddxc), Ts)
 
 
-# ---------------------------------------------------------------------------
-# The result of a run.
-
-
 def period_of_controller(ctrl: Any) -> float:
+    """The period Ts (s) of a controller: its ``.Ts``, else the deprecated
+    earlier name (warning); TypeError if it has neither."""
     value = getattr(ctrl, "Ts", None)
     if value is not None:
         return float(value)

@@ -60,7 +60,9 @@ from ._cartesian_impedance import pose_target as pose_target
 from ._cartesian_impedance import tabulate as tabulate
 from ._deprecated import period_alias
 from ._errors import ConfigError, MeasurementError
+from ._inputs import reals as reals  # (importable from here before the split)
 from ._params import BY_NAME, check_scenario, describe
+from ._params import resolve as resolve  # (importable from here before the split)
 from ._pose import CartesianStep, PoseTarget, call_shape
 from .chain import Chain
 

@@ -62,6 +62,12 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.franka", "pylibfranka>=0.21", "franka") from e
 
 from . import mujoco as amj
+
+# Names importable from this module before it was split, kept so.
+from ._adaptimp import Measurement as Measurement
+from ._cartesian_task import CartesianTask as CartesianTask
+from ._cartesian_task import chain_of as chain_of
+from ._errors import AdaptimpError as AdaptimpError
 from ._franka_loop import (
     BLEND,
     BLEND_SPEED,
@@ -83,7 +89,10 @@ from ._franka_loop import (
 )
 from ._franka_loop import READY as READY
 from ._franka_loop import TAU_MAX as TAU_MAX
+from ._franka_loop import FloatArray as FloatArray
+from ._franka_sim import SERVER as SERVER
 from ._franka_sim import Simulator as Simulator
+from .chain import Chain as Chain
 
 __all__ = [
     "BLEND",

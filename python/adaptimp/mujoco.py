@@ -55,6 +55,9 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 
 # Every name this module had, re-exported from where it now lives (explicitly:
 # ``X as X``), so that nothing a user imports from adaptimp.mujoco moves.
+# Names importable from this module before it was split (its own imports),
+# kept so; EFFORT_ACCEL is the core's (SPEC §18, the effort estimate).
+from ._adaptimp import EFFORT_ACCEL as EFFORT_ACCEL
 from ._cartesian_task import (
     CartesianTask as CartesianTask,
 )
@@ -73,9 +76,13 @@ from ._cartesian_task import (
 from ._cartesian_task import (
     task_of as task_of,
 )
+from ._errors import ConfigError as ConfigError
 from ._errors import (
     PlantWarning as PlantWarning,
 )
+from ._errors import no_file as no_file
+from ._faults import Fault as Fault
+from ._inputs import reals as reals
 from ._loops import (
     DISTURBANCES as DISTURBANCES,
 )
@@ -88,6 +95,7 @@ from ._mujoco_result import (
 from ._mujoco_result import (
     MujocoResult as MujocoResult,
 )
+from ._params import loop_delay as loop_delay
 from ._plant import (
     Plant as Plant,
 )
@@ -124,6 +132,11 @@ from ._plant_models import (
 from ._plant_models import (
     with_payload as with_payload,
 )
+from ._plot import MUJOCO_FIGURES as MUJOCO_FIGURES
+from ._plot import MUJOCO_PLOT_KINDS as MUJOCO_PLOT_KINDS
+from ._pose import call_shape as call_shape
+from ._pose import task_space as task_space
+from ._result import SimResult as SimResult
 from ._run import (
     MAX_SUBSTEPS as MAX_SUBSTEPS,
 )
@@ -184,6 +197,8 @@ from ._tasks import (
 from ._tasks import (
     rule_keywords as rule_keywords,
 )
+from ._tooling import add_table as add_table
+from ._tooling import add_tool as add_tool
 from ._trajectory import (
     Reference as Reference,
 )

@@ -279,8 +279,9 @@ class SceneWrench:
     made by ``mj_step1``), their forces not yet solved. This does not solve
     them: it evaluates them (``mj_constraintUpdate``) at the acceleration
     MuJoCo solved at the last timestep and keeps for its warm start
-    (``qacc_warmstart``), the forces the last solve's acceleration gives the
-    timestep's contacts; ``mj_step2`` solves them once, as without ADAPTIMP."""
+    (``qacc_warmstart``; after a reset, before any step, the reset's
+    ``mj_forward``'s ``qacc``), the forces the last solve's acceleration
+    gives the timestep's contacts; ``mj_step2`` solves them once, as without ADAPTIMP."""
 
     def __init__(self, model: Any, data: Any, last_joint: int, site: int) -> None:
         self._m, self._d, self._site = model, data, site
@@ -305,6 +306,8 @@ class SceneWrench:
         if self._elliptic and dim.min() >= 3 and adr.min() >= 0:
             return np.asarray(force[adr[:, None] + _XYZ], dtype=np.float64)  # its first 3 rows
         on = adr >= 0  # a contact without constraint rows exerts nothing
+        if force.size == 0:
+            return np.zeros((hits.size, 3))
         last = force.size - 1
         out = np.zeros((hits.size, 3))
         if self._elliptic:
@@ -335,9 +338,12 @@ class SceneWrench:
         hits = np.flatnonzero(side)
         if hits.size == 0:
             return w
-        # jar = J a − a_ref at the last solve's acceleration a (SPEC (23.4)).
+        # jar = J a − a_ref at the last solve's acceleration a (SPEC (23.4')):
+        # mj_step2's, kept for the warm start; before the first step after a
+        # reset (a warm start of zeros), the reset's mj_forward's (qacc).
+        acc = d.qacc_warmstart if d.qacc_warmstart.any() else d.qacc
         jar = np.empty(d.nefc)
-        mujoco.mj_mulJacVec(m, d, jar, d.qacc_warmstart)
+        mujoco.mj_mulJacVec(m, d, jar, acc)
         jar -= d.efc_aref
         mujoco.mj_constraintUpdate(m, d, jar, None, 0)
         local = self._local(contact, hits, d.efc_force)

@@ -41,6 +41,7 @@ mod adaptimp_module {
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("MAX_JOINTS", crate::MAX_JOINTS)?;
+        m.add("EFFORT_ACCEL", adaptimp::dynamic::EFFORT_ACCEL)?;
         m.add("N_NODES", adaptimp::types::grid_nodes(2))?;
         // Load NumPy's C API now, at import: loading it lazily inside a call
         // can meet a pending KeyboardInterrupt and fail with a panic.

@@ -237,7 +237,7 @@ def _sag(chain: Chain, model: Any, q: FloatArray, tau_max: ArrayLike, Ts: float)
 
 
 def rule_keywords(sc: PandaTable, case: str = "sf") -> dict[str, Any]:
-    """Keywords of :func:`adaptimp.cartesian.panda_controller` for the joint
+    """Keywords of :func:`adaptimp.scenarios.panda_table.panda_controller` for the joint
     controller ``case`` on the scenario ``sc``, from the core's rule (SPEC §18,
     :func:`adaptimp.tuning.suggest`): gains (18.1)–(18.4) from D(q0), the RBF
     centres (18.5) and the learning (18.6)–(18.8) along the scenario's whole

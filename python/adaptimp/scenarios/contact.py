@@ -73,6 +73,7 @@ from ._contact_model import TABLE_TIMECONST as TABLE_TIMECONST
 from ._contact_model import contact_impedance as contact_impedance
 from ._contact_model import sliding_timeconst as sliding_timeconst
 from .panda_table import PandaTable
+from .panda_table import table_metrics as table_metrics  # (importable from here before)
 
 __all__ = [
     "ADMITTANCE_SHARE_OF_PERIOD",

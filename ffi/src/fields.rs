@@ -259,6 +259,53 @@ mod tests {
         coverage(&mut cartesian_fields(&mut c), Group::Cartesian);
     }
 
+    /// The fields of `pub struct <name>` in `source`, in order.
+    fn struct_fields<'s>(source: &'s str, name: &str) -> Vec<&'s str> {
+        let head = format!("pub struct {name} {{");
+        let body = source.split(&head).nth(1).unwrap_or_default();
+        let body = body.split("\n}").next().unwrap_or_default();
+        body.lines()
+            .filter_map(|l| l.trim().strip_prefix("pub "))
+            .filter_map(|l| l.split(':').next())
+            .collect()
+    }
+
+    /// Every field of a parameter struct is in its table, or is one of the
+    /// few that hold no parameter of their own name (the joint count, the
+    /// law, the centres, a composite's parts): a field added to the struct
+    /// and not to the table is named here, not dropped.
+    #[test]
+    fn each_struct_field_is_a_parameter_or_named_as_not_one() {
+        fn unmapped(fields: Vec<&str>, table: &Table<'_>) -> Vec<String> {
+            assert!(!fields.is_empty());
+            fields
+                .into_iter()
+                .filter(|f| !table.iter().any(|(n, _)| n == f))
+                .map(str::to_string)
+                .collect()
+        }
+        let mut p = crate::params::BLANK;
+        let fields = struct_fields(include_str!("params.rs"), "AdaptimpParams");
+        assert_eq!(
+            unmapped(fields, &controller_fields(&mut p)),
+            [
+                "n",
+                "law",
+                "k_remark1",
+                "weight_bound_mode",
+                "centers",
+                "nodes",
+                "widths2"
+            ]
+        );
+        let mut c = AdaptimpCartesianParams::default();
+        let fields = struct_fields(include_str!("cartesian.rs"), "AdaptimpCartesianParams");
+        assert_eq!(
+            unmapped(fields, &cartesian_fields(&mut c)),
+            ["bd", "bd_critical", "bd_rot", "bd_rot_critical"]
+        );
+    }
+
     #[test]
     fn the_c_enums_follow_the_schemas_choice_order() {
         fn check<E: CEnum>(name: &str) {

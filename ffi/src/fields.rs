@@ -26,11 +26,12 @@ pub(crate) enum Field<'a> {
     /// A C bool.
     Flag(&'a mut AdaptimpBoolRaw),
     /// An enum's integer: its position in the enum (INVALID_CONFIG naming
-    /// the field if it is none of its values), and the integer at a position.
+    /// the field if it is none of its values), and the integer at a position
+    /// (none past the enum's end).
     Choice(
         &'a mut u32,
         fn(u32, &str) -> Result<usize, AdaptimpStatus>,
-        fn(usize) -> u32,
+        fn(usize) -> Option<u32>,
     ),
     /// The weight bound: its mode (`<name>_mode`) and its three bounds.
     Bound(&'a mut AdaptimpWeightBoundRaw, &'a mut [f64; 3]),
@@ -42,7 +43,7 @@ impl<'a> Field<'a> {
         Field::Choice(
             raw,
             |v, field| Ok(decode::<E>(E::from_raw(v), field)?.index()),
-            |i| E::ALL.get(i).unwrap_or(&E::ALL[0]).value(),
+            |i| E::ALL.get(i).map(|e| e.value()),
         )
     }
 }
@@ -65,10 +66,27 @@ from_places! {
     AdaptimpBoolRaw => Flag
 }
 
-/// `v` into the first of `dst`.
-fn copy(dst: &mut [f64], v: &[f64]) {
-    let k = v.len().min(dst.len());
-    dst[..k].copy_from_slice(&v[..k]);
+/// `v` into the first `len` of `dst`, or INTERNAL naming `field` if `v`
+/// has another length or `dst` is shorter: a value the struct cannot hold
+/// is never cut or dropped.
+fn copy(dst: &mut [f64], len: usize, v: &[f64], field: &str) -> Result<(), AdaptimpStatus> {
+    match dst.get_mut(..len) {
+        Some(dst) if v.len() == len => {
+            dst.copy_from_slice(v);
+            Ok(())
+        }
+        _ => Err(internal(&format_args!(
+            "{field}: the core gave {} values, the field takes {len} (of its {})",
+            v.len(),
+            dst.len()
+        ))),
+    }
+}
+
+/// INTERNAL, with `what` recorded: the schema and a struct's table disagree
+/// (a bug of this crate, not of the caller's values).
+fn internal(what: &dyn std::fmt::Display) -> AdaptimpStatus {
+    fail(AdaptimpStatus::Internal, what)
 }
 
 /// The names of a choice parameter's values (none for another kind).
@@ -117,37 +135,58 @@ impl Field<'_> {
         })
     }
 
-    /// Set from the schema's value `v` of a parameter of `kind`.
-    fn put(&mut self, kind: Kind, v: Value<'_>) {
+    /// Set from the schema's value `v` of a parameter of `kind` (`n`
+    /// values of a per-joint one), or INTERNAL naming `field` if the field
+    /// cannot hold `v` as it is: another kind, another length, a choice the
+    /// C enum lacks, a negative count.
+    fn put(
+        &mut self,
+        kind: Kind,
+        n: usize,
+        v: Value<'_>,
+        field: &str,
+    ) -> Result<(), AdaptimpStatus> {
         match (self, v) {
             (Field::Real(x), Value::Real(y)) => **x = y,
-            (Field::Real(x), Value::None) => **x = f64::INFINITY,
-            (Field::Count(d), Value::Int(i)) => **d = usize::try_from(i).unwrap_or(0),
-            (Field::Joint(dst), Value::Vec(v)) => copy(&mut dst[..], v),
-            (Field::Joint(dst), Value::None) => dst.fill(f64::INFINITY),
-            (Field::Three(dst), Value::Vec(v)) => copy(&mut dst[..], v),
+            (Field::Real(x), Value::None) if kind == Kind::Optional => **x = f64::INFINITY,
+            (Field::Count(d), Value::Int(i)) => {
+                **d = usize::try_from(i)
+                    .map_err(|_| internal(&format_args!("{field}: the count {i} is negative")))?;
+            }
+            (Field::Joint(dst), Value::Vec(v)) => copy(&mut dst[..], n, v, field)?,
+            (Field::Joint(dst), Value::None) if kind == Kind::Limit => dst.fill(f64::INFINITY),
+            (Field::Three(dst), Value::Vec(v)) => copy(&mut dst[..], 3, v, field)?,
             (Field::Derived(dst, critical), Value::None) => {
                 **dst = [0.0; 3];
                 **critical = true.into();
             }
             (Field::Derived(dst, critical), Value::Vec(v)) => {
-                copy(&mut dst[..], v);
+                copy(&mut dst[..], 3, v, field)?;
                 **critical = false.into();
             }
             (Field::Flag(b), Value::Bool(x)) => **b = x.into(),
             (Field::Choice(raw, _, int), Value::Str(s)) => {
-                if let Some(i) = names(kind).iter().position(|n| *n == s) {
-                    **raw = int(i);
-                }
+                let i = names(kind).iter().position(|n| *n == s);
+                **raw = i.and_then(int).ok_or_else(|| {
+                    internal(&format_args!("{field}: the C enum has no value \"{s}\""))
+                })?;
             }
             (Field::Bound(mode, _), Value::None) => **mode = AdaptimpWeightBound::None.raw(),
-            (Field::Bound(mode, _), Value::Str(_)) => **mode = AdaptimpWeightBound::Auto.raw(),
-            (Field::Bound(mode, dst), Value::Vec(v)) => {
-                **mode = AdaptimpWeightBound::Fixed.raw();
-                copy(&mut dst[..], v);
+            (Field::Bound(mode, _), Value::Str("auto")) => {
+                **mode = AdaptimpWeightBound::Auto.raw();
             }
-            _ => {}
+            (Field::Bound(mode, dst), Value::Vec(v)) => {
+                copy(&mut dst[..], 3, v, field)?;
+                **mode = AdaptimpWeightBound::Fixed.raw();
+            }
+            (_, v) => {
+                return Err(internal(&format_args!(
+                    "{field}: the field cannot hold the {} value {v:?}",
+                    kind.name()
+                )))
+            }
         }
+        Ok(())
     }
 }
 
@@ -187,16 +226,37 @@ pub(crate) fn read_into(
     Ok(())
 }
 
-/// Each field of `table` from the value of its parameter (of `group`) in `s`.
-pub(crate) fn write_from(s: &Scenario, group: Group, mut table: Table<'_>) {
+/// Each field of `table` from the value of its parameter (of `group`) in
+/// `s` (the first `s.n()` of a per-joint one), or INTERNAL naming the first
+/// parameter of `group` that has no field or whose value its field cannot
+/// hold (`owner` names the struct, as in [`read_into`]): nothing is skipped.
+pub(crate) fn write_from(
+    s: &Scenario,
+    group: Group,
+    mut table: Table<'_>,
+    owner: &str,
+) -> Result<(), AdaptimpStatus> {
+    let mut out = Ok(());
     s.visit(|name, v| {
-        let Some(p) = param(name).filter(|p| p.group == group) else {
+        if out.is_err() {
+            return;
+        }
+        let Some(p) = param(name) else {
+            out = Err(internal(&format_args!(
+                "the schema has no parameter {name}"
+            )));
             return;
         };
-        if let Some(f) = field_of(&mut table, p) {
-            f.put(p.kind, v);
+        if p.group != group {
+            return;
         }
+        let field = &format!("{owner}.{}", p.name.to_lowercase());
+        out = match field_of(&mut table, p) {
+            Some(f) => f.put(p.kind, s.n(), v, field),
+            None => Err(internal(&format_args!("no {field}"))),
+        };
     });
+    out
 }
 
 /// The table of `$p`: each named field by its own name, then the others.
@@ -304,6 +364,71 @@ mod tests {
             unmapped(fields, &cartesian_fields(&mut c)),
             ["bd", "bd_critical", "bd_rot", "bd_rot_critical"]
         );
+    }
+
+    /// This thread's last error message.
+    fn last_error() -> String {
+        // SAFETY: the library's NUL-terminated buffer.
+        unsafe { std::ffi::CStr::from_ptr(crate::adaptimp_last_error()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    /// The Cartesian table of `c` with parameter Md's field replaced by
+    /// `md` (none: left out).
+    fn with_md<'a>(c: &'a mut AdaptimpCartesianParams, md: Option<Field<'a>>) -> Table<'a> {
+        let mut table: Table<'a> = cartesian_fields(c)
+            .into_iter()
+            .filter(|(name, _)| *name != "md")
+            .collect();
+        table.extend(md.map(|f| ("md", f)));
+        table
+    }
+
+    /// A value its field cannot hold (another length, another kind) and a
+    /// parameter without a field are INTERNAL errors naming the field, never
+    /// cut to fit or skipped: the three values of Md in a per-joint field of
+    /// a 2-joint scenario were once cut to the first two, and a field of
+    /// another kind or none at all left the struct's value as it was.
+    #[test]
+    fn a_value_its_field_cannot_hold_is_an_error_naming_the_field() {
+        let s = Scenario::new(2, adaptimp::schema::Preset::Robot, adaptimp::Law::Pd).unwrap();
+        let mut c = AdaptimpCartesianParams::default();
+        let mut joint = [-1.0; ADAPTIMP_MAX_JOINTS];
+        let table = with_md(&mut c, Some(Field::Joint(&mut joint)));
+        let out = write_from(&s, Group::Cartesian, table, "cart");
+        assert_eq!(out, Err(AdaptimpStatus::Internal));
+        assert_eq!(
+            last_error(),
+            "cart.md: the core gave 3 values, the field takes 2 (of its 7)"
+        );
+        assert_eq!(joint, [-1.0; ADAPTIMP_MAX_JOINTS]);
+
+        let mut c = AdaptimpCartesianParams::default();
+        let mut real = -1.0;
+        let table = with_md(&mut c, Some(Field::Real(&mut real)));
+        let out = write_from(&s, Group::Cartesian, table, "cart");
+        assert_eq!(out, Err(AdaptimpStatus::Internal));
+        assert_eq!(
+            last_error(),
+            "cart.md: the field cannot hold the axes value Vec([2.0, 2.0, 2.0])"
+        );
+        assert_eq!(real, -1.0);
+
+        let mut c = AdaptimpCartesianParams::default();
+        let out = write_from(&s, Group::Cartesian, with_md(&mut c, None), "cart");
+        assert_eq!(out, Err(AdaptimpStatus::Internal));
+        assert_eq!(last_error(), "no cart.md");
+
+        // Each struct's own table holds every default of every size.
+        for n in 1..=ADAPTIMP_MAX_JOINTS {
+            let s = Scenario::new(n, adaptimp::schema::Preset::Robot, adaptimp::Law::Pd).unwrap();
+            let mut c = AdaptimpCartesianParams::default();
+            assert_eq!(
+                write_from(&s, Group::Cartesian, cartesian_fields(&mut c), "cart"),
+                Ok(())
+            );
+        }
     }
 
     #[test]

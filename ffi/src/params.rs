@@ -206,15 +206,16 @@ pub(crate) unsafe fn controller_of(p: &AdaptimpParams) -> Result<Controller, Ada
 // pointer, for each of which all-zero bytes are a value (NULL for a pointer).
 pub(crate) const BLANK: AdaptimpParams = unsafe { std::mem::zeroed() };
 
-/// The controller parameters of scenario `s` (centres: none).
-pub(crate) fn params_of(s: &Scenario) -> AdaptimpParams {
+/// The controller parameters of scenario `s` (centres: none); INTERNAL if
+/// a value does not fit its field ([`write_from`]).
+pub(crate) fn params_of(s: &Scenario) -> Result<AdaptimpParams, AdaptimpStatus> {
     let mut p = AdaptimpParams {
         n: s.n(),
         law: law_raw(s.law()),
         ..BLANK
     };
-    write_from(s, Group::Controller, controller_fields(&mut p));
-    p
+    write_from(s, Group::Controller, controller_fields(&mut p), "params")?;
+    Ok(p)
 }
 
 /// Fill `out` with the defaults of `preset` for controller `law` and `n`
@@ -240,7 +241,7 @@ pub unsafe extern "C" fn adaptimp_params_default(
         let preset = preset_of(decode::<AdaptimpPreset>(preset, "preset")?);
         // The one error of a scenario's defaults is its n.
         let s = Scenario::new(n, preset, law).map_err(|_| bad_n(n))?;
-        *out = params_of(&s);
+        *out = params_of(&s)?;
         Ok(())
     })
 }
@@ -307,7 +308,7 @@ pub unsafe extern "C" fn adaptimp_params_suggest(
             rule.gravity = Some(unsafe { slice(gravity, n, "gravity") }?);
         }
         let s = rule.suggest().map_err(|e| core_error(e, Context::Config))?;
-        let mut filled = params_of(&s);
+        let mut filled = params_of(&s)?;
         if let Some(c) = s.centres() {
             // SAFETY (in `slice_mut`): the caller gives ADAPTIMP_SUGGEST_MAX_NODES
             // rows of 4n reals and 4n reals, L ≤ that.
@@ -345,7 +346,7 @@ mod tests {
             for preset in Preset::ALL {
                 for law in [Law::Pd, Law::StateFeedback, Law::OutputFeedback] {
                     let expect = Scenario::new(n, preset, law).unwrap();
-                    let s = scenario_of(&params_of(&expect)).unwrap();
+                    let s = scenario_of(&params_of(&expect).unwrap()).unwrap();
                     let controller = |s: &Scenario| {
                         let mut out = Vec::new();
                         s.visit(|name, v| {

@@ -231,7 +231,7 @@ pub unsafe extern "C" fn adaptimp_cartesian_params_default(
         let s =
             Scenario::new(1, Preset::Robot, Law::Pd).map_err(|e| core_error(e, Context::Config))?;
         let mut p = AdaptimpCartesianParams::default();
-        write_from(&s, Group::Cartesian, cartesian_fields(&mut p));
+        write_from(&s, Group::Cartesian, cartesian_fields(&mut p), "cart")?;
         *out = p;
         Ok(())
     })

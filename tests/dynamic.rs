@@ -3,6 +3,7 @@
 //! controller, the Cartesian controller, the chain, the dynamics, computed
 //! torque, the closed loop), and the same errors.
 
+mod common;
 use adaptimp::control::tuning::Rule;
 use adaptimp::dynamic as dy;
 use adaptimp::schema::{Preset, Scenario, Value};
@@ -12,10 +13,7 @@ use adaptimp::{
     ImpedanceMode, Inertial, Joint, Kinematics, Law, Measurement, PoseTarget, Setpoint, Sinusoid,
     Trajectory, Transform, Vector,
 };
-
-fn bits(v: &[f64]) -> Vec<u64> {
-    v.iter().map(|x| x.to_bits()).collect()
-}
+use common::{bits, joints, q_of};
 
 /// `a` and `b` hold the same bits.
 #[track_caller]
@@ -224,33 +222,6 @@ fn one_builder_gives_both_fronts_the_same_basis() {
         d.controller().unwrap_err().to_string(),
         "widths: need one width per input dimension (4n: x, v, α1, α̇1)"
     );
-}
-
-/// A chain of N revolute joints about alternating axes, a fixed joint and
-/// a tip offset.
-fn joints<const N: usize>() -> Vec<Joint> {
-    let mut js: Vec<Joint> = (0..N)
-        .map(|i| {
-            let axis = if i % 2 == 0 {
-                [0.0, 0.0, 1.0]
-            } else {
-                [0.0, 1.0, 0.0]
-            };
-            Joint::revolute(
-                Transform::from_xyz_rpy([0.05 * i as f64, 0.0, 0.12], [0.1 * i as f64, 0.0, 0.0]),
-                axis,
-            )
-        })
-        .collect();
-    js.push(Joint::fixed(Transform::from_xyz_rpy(
-        [0.0, 0.0, 0.1],
-        [0.0; 3],
-    )));
-    js
-}
-
-fn q_of<const N: usize>(k: usize) -> Vector<N> {
-    Vector::from_fn(|i, _| 0.3 * ((k + 1) as f64 * 0.7 + i as f64).sin())
 }
 
 fn chain_and_dynamics<const N: usize>() {

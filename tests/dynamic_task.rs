@@ -3,40 +3,13 @@
 //! (16.9), a planar arm's normal) against the const-generic core: the same
 //! bits for every n = 1 … 7, and the same errors.
 
+mod common;
 use adaptimp::cartesian::rule::plane_normal;
 use adaptimp::cartesian::{PostureRule, TaskRows};
 use adaptimp::control::tuning::Rule;
 use adaptimp::dynamic as dy;
-use adaptimp::{Chain, Error, Joint, Kinematics, Transform, Vector};
-
-fn bits(v: &[f64]) -> Vec<u64> {
-    v.iter().map(|x| x.to_bits()).collect()
-}
-
-fn joints<const N: usize>() -> Vec<Joint> {
-    let mut js: Vec<Joint> = (0..N)
-        .map(|i| {
-            let axis = if i % 2 == 0 {
-                [0.0, 0.0, 1.0]
-            } else {
-                [0.0, 1.0, 0.0]
-            };
-            Joint::revolute(
-                Transform::from_xyz_rpy([0.05 * i as f64, 0.0, 0.12], [0.1 * i as f64, 0.0, 0.0]),
-                axis,
-            )
-        })
-        .collect();
-    js.push(Joint::fixed(Transform::from_xyz_rpy(
-        [0.0, 0.0, 0.1],
-        [0.0; 3],
-    )));
-    js
-}
-
-fn q_of<const N: usize>(k: usize) -> Vector<N> {
-    Vector::from_fn(|i, _| 0.3 * ((k + 1) as f64 * 0.7 + i as f64).sin())
-}
+use adaptimp::{Chain, Error, Kinematics, Transform, Vector};
+use common::{bits, joints, q_of};
 
 fn task_queries<const N: usize>() {
     let (js, tip) = (

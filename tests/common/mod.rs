@@ -157,3 +157,37 @@ pub fn circle(tip: &adaptimp::Tip<7>, t: f64) -> adaptimp::PoseTarget {
         ..PoseTarget::at(tip.position, *tip.rotation.matrix())
     }
 }
+
+/// The bits of each of `v` (to compare two computations exactly).
+pub fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// A chain of N revolute joints about alternating axes, a fixed joint and
+/// a tip offset (the run-time API's tests against the const-generic core).
+pub fn joints<const N: usize>() -> Vec<adaptimp::Joint> {
+    use adaptimp::{Joint, Transform};
+    let mut js: Vec<Joint> = (0..N)
+        .map(|i| {
+            let axis = if i % 2 == 0 {
+                [0.0, 0.0, 1.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            Joint::revolute(
+                Transform::from_xyz_rpy([0.05 * i as f64, 0.0, 0.12], [0.1 * i as f64, 0.0, 0.0]),
+                axis,
+            )
+        })
+        .collect();
+    js.push(Joint::fixed(Transform::from_xyz_rpy(
+        [0.0, 0.0, 0.1],
+        [0.0; 3],
+    )));
+    js
+}
+
+/// A posture of N joints, the k-th of a smooth sequence (rad).
+pub fn q_of<const N: usize>(k: usize) -> adaptimp::Vector<N> {
+    adaptimp::Vector::from_fn(|i, _| 0.3 * ((k + 1) as f64 * 0.7 + i as f64).sin())
+}

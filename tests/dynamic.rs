@@ -519,6 +519,76 @@ fn the_cartesian_step_is_the_const_generic_one_bit_for_bit_for_every_n() {
     cartesian::<7>();
 }
 
+/// Task rows a loop of its own records from the const-generic outer loop's
+/// steps (as the Python front's MuJoCo loop does): a row before any step is
+/// NaN, a step's row holds its commanded, compliant and joint references,
+/// its error, wrench and z1 bit for bit, and only every `every`-th row is
+/// kept.
+fn task_rows<const N: usize>() {
+    let js = joints::<N>();
+    let (_, s) = scenario::<N>(Law::StateFeedback, true);
+    let (cc, _) = core_controller(&s);
+    let chain = Chain::<N>::new(&js, &Transform::IDENTITY).expect("chain");
+    let outer = CartesianImpedance::new(s.cartesian, chain, cc.period()).expect("outer");
+    let pair = CartesianController::new(outer, cc).expect("pair");
+    let q0 = q_of::<N>(0);
+    let (mut ost, mut ist) = (pair.start(&q0).expect("start"), pair.inner().new_state());
+    let t0 = chain.tip(&q0, &Vector::zeros());
+    let mut rows = dy::TaskRows::new(N, 3, 2).expect("rows");
+    assert_eq!((rows.n(), rows.len()), (N, 0));
+    rows.record(None, &Vector::<3>::from_element(f64::NAN));
+    let mut steps = Vec::new();
+    for k in 0..4 {
+        let m = CartesianMeasurement {
+            q: q0 + Vector::<N>::from_element(1e-3 * k as f64),
+            dq: Some(Vector::from_element(1e-3)),
+            wrench: Vector::<6>::new(1.0, -0.5, 0.2, 0.0, 0.05, 0.0),
+        };
+        let c = target(&t0.position, t0.rotation.matrix(), k);
+        let cmd = pair.step(&mut ost, &mut ist, &m, Some(&c)).expect("step");
+        let step = dy::TaskStep {
+            command: dy::CartesianCommand::of(&cmd),
+            commanded: [c.p, c.dp, c.ddp],
+            wrench: m.wrench.into(),
+        };
+        same("q_d", &step.command.reference.x, cmd.reference.x.as_slice());
+        let z1 = cmd.compliant.p - cmd.p;
+        same("z1", step.z1().as_slice(), z1.as_slice());
+        rows.record(Some(&step), &step.z1());
+        steps.push(step);
+    }
+    // Rows 0 (before any step), 2 and 4 of five, every second kept.
+    assert_eq!(rows.len(), 3);
+    assert!(rows.pc.iter().chain(&rows.pd).all(|v| v.len() == 9));
+    assert_eq!((rows.qd.len(), rows.error.len()), (3 * N, 18));
+    let nan = |v: &[f64]| v.iter().all(|x| x.is_nan());
+    assert!(nan(&rows.pc[0][..3]) && nan(&rows.pd[2][..3]) && nan(&rows.z1[..3]));
+    assert!(nan(&rows.qd[..N]) && nan(&rows.error[..6]) && nan(&rows.wrench[..6]));
+    for (row, s) in [(1, &steps[1]), (2, &steps[3])] {
+        let (c, cp) = (&s.command, &s.command.compliant);
+        for (i, v) in s.commanded.iter().enumerate() {
+            same("p_c", &rows.pc[i][3 * row..3 * row + 3], v.as_slice());
+        }
+        for (i, v) in [&cp.p, &cp.dp, &cp.ddp].into_iter().enumerate() {
+            same("p_d", &rows.pd[i][3 * row..3 * row + 3], v.as_slice());
+        }
+        same("q_d", &rows.qd[N * row..N * row + N], &c.reference.x);
+        same(
+            "error",
+            &rows.error[6 * row..6 * row + 6],
+            c.error.as_slice(),
+        );
+        same("wrench", &rows.wrench[6 * row..6 * row + 6], &s.wrench);
+        same("z1", &rows.z1[3 * row..3 * row + 3], s.z1().as_slice());
+    }
+}
+
+#[test]
+fn task_rows_record_the_steps_of_a_loop_of_its_own() {
+    task_rows::<2>();
+    task_rows::<7>();
+}
+
 /// The closed loop of the paper's arm and wall with disturbances and a
 /// fault, through the run-time plant and loop, against the core's
 /// `run_disturbed_with`: the same rows and metrics.

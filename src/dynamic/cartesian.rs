@@ -95,7 +95,10 @@ pub struct CartesianCommand {
 }
 
 impl CartesianCommand {
-    pub(crate) fn of<const N: usize>(c: &cartesian::CartesianCommand<N>) -> Self {
+    /// The run-time command of the const-generic outer loop's `c`, its
+    /// values copied bit for bit (a loop that steps the const-generic
+    /// controller and records its steps in [`TaskRows`](crate::dynamic::TaskRows)).
+    pub fn of<const N: usize>(c: &cartesian::CartesianCommand<N>) -> Self {
         Self {
             joint: Command::of(&c.joint),
             reference: Setpoint::of(&c.reference),

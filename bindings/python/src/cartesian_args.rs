@@ -2,11 +2,11 @@
 //! sample, a flat pose target, tables of rows, counts) and its errors to
 //! the exceptions of `adaptimp._errors`.
 
-use super::cartesian_loop::{pose_target, TaskRecords, TARGET_LEN};
+use super::cartesian_loop::{pose_target, TARGET_LEN};
 use super::{array, python_shape, ConfigError};
 use super::{DivergedError, MeasurementError};
 use adaptimp::cartesian::PoseTarget;
-use adaptimp::dynamic::HeldRotation;
+use adaptimp::dynamic::{HeldRotation, TaskRows};
 use adaptimp::error::Error;
 use adaptimp::types::Vector;
 use nalgebra::Matrix3;
@@ -281,12 +281,8 @@ pub(super) fn wrench_of(obj: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
 
 /// A Cartesian run's task rows (`k` of them) as the dict of
 /// `CartesianController.arrays()`'s keys.
-pub(super) fn task_dict(
-    py: Python<'_>,
-    task: TaskRecords,
-    k: usize,
-) -> PyResult<Bound<'_, PyDict>> {
-    let n = task.n;
+pub(super) fn task_dict(py: Python<'_>, task: TaskRows, k: usize) -> PyResult<Bound<'_, PyDict>> {
+    let n = task.n();
     let [pc, dpc, ddpc] = task.pc;
     let [pd, dpd, ddpd] = task.pd;
     let d = PyDict::new(py);

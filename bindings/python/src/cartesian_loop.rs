@@ -16,7 +16,7 @@
 //! filtered target p_t when held), ẋc, ẍc (ṗ_c, p̈_c; zero when held), xd =
 //! p_d (the compliant reference), z1 = p_d − p(q) (m, with p(q) the chain's
 //! tip at the measured q), and beside them ṗ_d, p̈_d, q_d, the impedance's
-//! error and the wrench the controller was given ([`TaskRecords`]). The
+//! error and the wrench the controller was given (the core's [`TaskRows`]). The
 //! joint quantities (q, τ, sat(τ), τe, ζ, the velocity used) are the joint
 //! controller's, as for a joint-space run.
 
@@ -33,6 +33,7 @@ use adaptimp::control::config::Law;
 use adaptimp::control::impedance::TargetImpedance;
 use adaptimp::control::io::TaskTorque;
 use adaptimp::control::io::{Command, Measurement, WrenchControl};
+use adaptimp::dynamic::{self as dy, TaskRows, TaskStep};
 use adaptimp::error::Error;
 use adaptimp::sim::record::{Recorder, Row};
 use adaptimp::trajectory::{Clock, Setpoint};
@@ -146,75 +147,6 @@ impl<const N: usize> JointStep<N> for Computed<N> {
     }
 }
 
-/// Every kept row's task-space quantities, one flat row-major buffer each.
-#[derive(Clone, Debug, Default)]
-pub struct TaskRecords {
-    /// Joints n (the width of `qd`).
-    pub n: usize,
-    every: u64,
-    seen: u64,
-    /// p_c, ṗ_c, p̈_c (m, m/s, m/s²), 3 per row each.
-    pub pc: [Vec<f64>; 3],
-    /// p_d, ṗ_d, p̈_d (m, m/s, m/s²), 3 per row each.
-    pub pd: [Vec<f64>; 3],
-    /// q_d (rad), n per row.
-    pub qd: Vec<f64>,
-    /// The impedance's error [e_p; e_o] (m, rad), 6 per row.
-    pub error: Vec<f64>,
-    /// The wrench the controller was given (N, N m), 6 per row.
-    pub wrench: Vec<f64>,
-    /// z1 = p_d − p(q) (m), 3 per row.
-    pub z1: Vec<f64>,
-}
-
-impl TaskRecords {
-    fn with_rows(n: usize, rows: usize, every: u64) -> Option<Self> {
-        let mut r = Self {
-            n,
-            every: every.max(1),
-            ..Self::default()
-        };
-        for v in r.pc.iter_mut().chain(r.pd.iter_mut()).chain([&mut r.z1]) {
-            v.try_reserve_exact(rows.checked_mul(3)?).ok()?;
-        }
-        r.qd.try_reserve_exact(rows.checked_mul(n)?).ok()?;
-        r.error.try_reserve_exact(rows.checked_mul(6)?).ok()?;
-        r.wrench.try_reserve_exact(rows.checked_mul(6)?).ok()?;
-        Some(r)
-    }
-
-    /// The row of the step `last` (its z1 = p_d − p(q) given); none: a row
-    /// before any step, NaN.
-    fn record<const N: usize>(&mut self, last: Option<&LastStep<N>>, z1: &Vector<3>) {
-        let keep = self.seen.is_multiple_of(self.every);
-        self.seen += 1;
-        if !keep {
-            return;
-        }
-        let Some(last) = last else {
-            for out in self.pc.iter_mut().chain(self.pd.iter_mut()) {
-                out.extend_from_slice(&[f64::NAN; 3]);
-            }
-            self.qd.extend((0..N).map(|_| f64::NAN));
-            self.error.extend_from_slice(&[f64::NAN; 6]);
-            self.wrench.extend_from_slice(&[f64::NAN; 6]);
-            self.z1.extend_from_slice(z1.as_slice());
-            return;
-        };
-        let (cmd, c) = (&last.cmd, &last.cmd.compliant);
-        for (out, v) in self.pc.iter_mut().zip(&last.commanded) {
-            out.extend_from_slice(v.as_slice());
-        }
-        for (out, v) in self.pd.iter_mut().zip([&c.p, &c.dp, &c.ddp]) {
-            out.extend_from_slice(v.as_slice());
-        }
-        self.qd.extend_from_slice(cmd.reference.x.as_slice());
-        self.error.extend_from_slice(cmd.error.as_slice());
-        self.wrench.extend_from_slice(&last.wrench);
-        self.z1.extend_from_slice(z1.as_slice());
-    }
-}
-
 /// The row of a table for t_k = k·Ts.
 fn row_of(t: f64, ts: f64) -> usize {
     libm::round(t / ts) as usize
@@ -244,6 +176,15 @@ impl<const N: usize> LastStep<N> {
             cmd,
             commanded,
             wrench,
+        }
+    }
+
+    /// The step as the core's task rows record it.
+    fn task_step(&self) -> TaskStep {
+        TaskStep {
+            command: dy::CartesianCommand::of(&self.cmd),
+            commanded: self.commanded,
+            wrench: self.wrench,
         }
     }
 }
@@ -378,7 +319,7 @@ impl<const N: usize, J: JointStep<N> + ?Sized> WrenchControl<N> for Cartesian<'_
 /// The joint rows, the task rows and the task-space metrics of every row.
 struct TaskRecorder<'a, const N: usize, const M: usize> {
     joint: &'a mut Rows,
-    task: &'a mut TaskRecords,
+    task: &'a mut TaskRows,
     metrics: &'a mut RowMetrics,
     /// A row the metrics refused (none: every row fits by construction).
     refused: Option<Error>,
@@ -391,13 +332,13 @@ impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
     fn record(&mut self, r: &Row<N>) {
         self.pending.set(false);
         self.joint.record(r);
-        let slot = self.last.borrow();
+        let step = self.last.borrow().as_ref().map(LastStep::task_step);
         let nan = [Vector::<3>::from_element(f64::NAN); 3];
-        let (pc, z1) = match slot.as_ref() {
-            Some(l) => (&l.commanded, l.cmd.compliant.p - l.cmd.p),
+        let (pc, z1) = match &step {
+            Some(s) => (&s.commanded, s.z1()),
             None => (&nan, nan[0]),
         };
-        self.task.record(slot.as_ref(), &z1);
+        self.task.record(step.as_ref(), &z1);
         let pushed = self.metrics.push(
             r.t,
             [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
@@ -413,7 +354,7 @@ impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
 
 /// What a Cartesian run gives back: the joint rows, the task rows and the
 /// SPEC §12 metrics of task space (z1 = p_d − p, m = 3).
-pub type CartesianOut = (Rows, TaskRecords, Metrics);
+pub type CartesianOut = (Rows, TaskRows, Metrics);
 
 fn invalid(what: &'static str, reason: &'static str) -> RunError {
     RunError::Core(Error::Invalid { what, reason }, None)
@@ -436,7 +377,7 @@ pub(crate) fn simulate_mujoco<const N: usize, J: JointStep<N> + ?Sized>(
     spec: &MujocoSpec,
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
-    partial: &mut Option<TaskRecords>,
+    partial: &mut Option<TaskRows>,
     copy: &OuterCopy<'_, N>,
 ) -> Result<CartesianOut, RunError> {
     if N <= 3 {
@@ -462,14 +403,14 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     spec: &MujocoSpec,
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
-    partial: &mut Option<TaskRecords>,
+    partial: &mut Option<TaskRows>,
     copy: &OuterCopy<'_, N>,
 ) -> Result<CartesianOut, RunError> {
     let total = checked(outer, &*joint, run)?;
     let every = run.every.max(1);
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
     let mut rec = Rows::new(N, kept, every)?;
-    let mut task = TaskRecords::with_rows(N, kept, every).ok_or(RunError::Memory(kept))?;
+    let mut task = TaskRows::new(N, kept, every)?;
     let ones = [1.0; N];
     let mut metrics = RowMetrics::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
     let clock = Cell::new(0.0);
@@ -513,14 +454,15 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     };
     let taken = steps.into_inner();
     if taken.is_some() {
+        task.last = taken.as_ref().map(LastStep::task_step);
         *last = taken;
     }
     if let Err(e) = result {
         // A step taken in the period the error stopped: its task row too
         // (the controller's clock counts it).
         if pending.get() {
-            if let Some(l) = last.as_ref() {
-                task.record(Some(l), &(l.cmd.compliant.p - l.cmd.p));
+            if let Some(s) = task.last {
+                task.record(Some(&s), &s.z1());
             }
         }
         *partial = Some(task);

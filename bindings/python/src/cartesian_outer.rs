@@ -3,7 +3,7 @@
 //! until the bindings' joint controllers are the core's run-time ones and
 //! the outer loop can be the core's `dynamic::CartesianImpedance`.
 
-use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep, LastStep, TaskRecords};
+use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep, LastStep};
 use super::computed::{Computed, DynComputed};
 use super::dynamic::{DynTracker, Hooks, RunError, Typed, MAX_JOINTS};
 use super::mujoco::MujocoSpec;
@@ -13,6 +13,7 @@ use adaptimp::cartesian::{
 };
 use adaptimp::control::io::Command;
 use adaptimp::dynamic::HeldRotation;
+use adaptimp::dynamic::TaskRows;
 use adaptimp::error::Error;
 use adaptimp::trajectory::Setpoint;
 use adaptimp::types::Vector;
@@ -185,7 +186,7 @@ pub trait DynOuter: Send + Sync {
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
         hooks: &mut dyn Hooks,
-        partial: &mut Option<TaskRecords>,
+        partial: &mut Option<TaskRows>,
     ) -> Result<CartesianOut, RunError>;
     /// Steps over recorded rows, the core's alone ([`cartesian_loop::replay`]).
     fn replay(
@@ -520,7 +521,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         spec: &MujocoSpec,
         run: &CartesianRun<'_>,
         hooks: &mut dyn Hooks,
-        partial: &mut Option<TaskRecords>,
+        partial: &mut Option<TaskRows>,
     ) -> Result<CartesianOut, RunError> {
         let joint = typed::<N>(joint)?;
         let before = self.at(&self.state, None);

@@ -495,7 +495,7 @@ impl TaskStep {
     }
 
     /// z1 = p_d − p(q) (m).
-    pub(crate) fn z1(&self) -> Vector<3> {
+    pub fn z1(&self) -> Vector<3> {
         self.command.compliant.p - self.command.p
     }
 }
@@ -553,6 +553,11 @@ impl TaskRows {
         Self::new(n, kept, every)
     }
 
+    /// The number of joints n (the width of `qd`).
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
     /// The number of rows kept.
     pub fn len(&self) -> usize {
         self.z1.len() / 3
@@ -563,8 +568,10 @@ impl TaskRows {
         self.z1.is_empty()
     }
 
-    /// The row of `step` (its z1 given); none: a row before any step, NaN.
-    pub(crate) fn record(&mut self, step: Option<&TaskStep>, z1: &Vector<3>) {
+    /// The row of `step` (its z1 given), kept if it is an `every`-th;
+    /// none: a row before any step, NaN (z1 as given). A loop of its own (a
+    /// front's) records its steps here as the run-time loop does.
+    pub fn record(&mut self, step: Option<&TaskStep>, z1: &Vector<3>) {
         let keep = self.seen.is_multiple_of(self.every);
         self.seen += 1;
         if !keep {

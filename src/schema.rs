@@ -88,12 +88,14 @@ pub enum Kind {
     DerivedAxes,
     /// True or false.
     Flag,
+    /// None, or n × n numbers (row-major; symmetric).
+    Matrix,
 }
 
 impl Kind {
     /// The kind's name in Python ("real", "int", "joint", "network",
     /// "choice", "optional", "derived", "bound", "limit", "axes",
-    /// "derived_axes", "flag").
+    /// "derived_axes", "flag", "matrix").
     pub fn name(self) -> &'static str {
         match self {
             Kind::Real => "real",
@@ -108,6 +110,7 @@ impl Kind {
             Kind::Axes => "axes",
             Kind::DerivedAxes => "derived_axes",
             Kind::Flag => "flag",
+            Kind::Matrix => "matrix",
         }
     }
 }
@@ -219,7 +222,9 @@ const fn robot(param: Param, value: Value<'static>) -> Param {
 }
 
 use Group::{Arm, Cartesian as Cart, Controller as Ctrl, Env, Sim};
-use Kind::{Axes, Bound, Derived, DerivedAxes, Flag, Int, Joint, Limit, Network, Optional, Real};
+use Kind::{
+    Axes, Bound, Derived, DerivedAxes, Flag, Int, Joint, Limit, Matrix, Network, Optional, Real,
+};
 use Value::{Bool as B, Int as I, None as Nil, Real as R, Str as S, Vec as V};
 
 const PI: f64 = core::f64::consts::PI;
@@ -322,6 +327,16 @@ pub const PARAMS: &[Param] = &[
         "inertia scale d of each joint: the auxiliary system takes Δτ/d, the z1 term d·z1, the learning error d·z2 (SPEC §10)",
         "1e-9 ≤ d ≤ 1e9",
         R(1.0),
+    ),
+    // SPEC (18.12): the scales as a matrix, and the gains shaped by it.
+    p(
+        "inertia_matrix",
+        Ctrl,
+        Matrix,
+        "kg m²",
+        "inertia-shaped gains: Dₛ (n × n, row-major) in place of diag(d) in the z1 term and the learning error, and Kp = R^½ Dₛ R^½ with R = diag(Kp/d) (SPEC (18.12); None: diagonal)",
+        "symmetric positive definite",
+        Nil,
     ),
     p("rho", Ctrl, Real, "1/s", "Young weight ρ of ζᵀΔτ in the auxiliary system's β (SPEC §10)", "1e-9 ≤ ρ ≤ 1e9", R(1.0)),
     robot(

@@ -9,7 +9,7 @@ use crate::control::observer::Hold;
 use crate::control::robust::RobustKind;
 use crate::control::safety::{Fallback, FaultPolicy, Limits};
 use crate::networks::learning::{LearningStep, SaturationLearning};
-use crate::types::{choices, Vector};
+use crate::types::{choices, Matrix, Vector};
 
 /// Which of the paper's controllers, SPEC §7.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -114,6 +114,12 @@ pub struct Config<const N: usize> {
     /// auxiliary system (Δτ_i/d_i), the z1 term (d_i z1_i) and the learning
     /// error (d_i z2_i). Paper: 1.
     pub inertia: Vector<N>,
+    /// Dₛ (kg m², symmetric positive definite), SPEC (18.12): the inertia
+    /// scales as a matrix, in place of diag([`inertia`](Self::inertia)) in
+    /// the z1 term and the learning error, and the feedback gain Kp = R^½
+    /// Dₛ R^½, R = diag(Kp_i/d_i) (the auxiliary system keeps d). None
+    /// (paper, robot): the diagonal law.
+    pub inertia_matrix: Option<Matrix<N>>,
     /// Young weight ρ (1/s) of ζᵀΔτ in the auxiliary system's β, SPEC §10. Paper: 1.
     pub rho: f64,
     /// Which stability conditions construction checks, SPEC §10.
@@ -189,6 +195,7 @@ impl<const N: usize> Config<N> {
             kzeta: z,
             mu: 0.0,
             inertia: z,
+            inertia_matrix: None,
             rho: 0.0,
             conditions: Conditions::Paper,
             aux_law: AuxLaw::Leaky,

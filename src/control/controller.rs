@@ -16,6 +16,7 @@
 
 use crate::control::auxiliary::Auxiliary;
 use crate::control::config::{Conditions, Config, Law, ObserverInit, WeightBound, MAX_DELAY};
+use crate::control::coupling::{inertia_times, kp_times, Coupling};
 use crate::control::impedance::{ImpedanceMode, Reference, TargetImpedance};
 #[cfg(feature = "alloc")]
 use crate::control::io::Feedforward;
@@ -60,6 +61,8 @@ pub struct Controller<const N: usize, B = Grid<N>> {
     /// model's gravity, SPEC (20.10)); none by default.
     #[cfg(feature = "alloc")]
     feedforward: Option<alloc::sync::Arc<dyn Feedforward<N>>>,
+    /// The inertia-shaped gains, SPEC (18.12) (none: diagonal).
+    coupling: Option<Coupling<N>>,
 }
 
 /// The errors of one step at t_k, SPEC §5, from the reference and the velocity used.
@@ -118,17 +121,17 @@ impl<const N: usize> Task<N> {
     /// n α1 + (1 − n) q̇_c and the paper's z2 of `e` (on the compliant
     /// reference: the networks learn what the impedance leaves undone, never
     /// the contact force it prescribes), weighted d∘z2 by the inertia scales
-    /// as (10.2). The acceleration regressor takes the commanded q̈_c in place
+    /// as (10.2) (`z2`: Dₛ z2 with the coupled gains of (18.12)). The acceleration regressor takes the commanded q̈_c in place
     /// of the compliant ẍd, which carries this sample's wrench (ẍd ∋ J⁺F_e/M_d):
     /// through D̂ that closed the admittance's algebraic loop with the learnt
     /// inertia's gain, and the unified step rang on a rigid table once D̂ had
     /// learnt (SPEC (19.2)).
-    fn signals(&self, e: &Errors<N>, inertia: &Vector<N>) -> Signals<N> {
+    fn signals(&self, e: &Errors<N>, z2: Vector<N>) -> Signals<N> {
         let n = self.share;
         Signals {
             dalpha1: self.commanded.ddx + n * (e.dalpha1 - e.ddxd),
             alpha1: n * e.alpha1 + (1.0 - n) * self.commanded.dx,
-            z2: e.z2.component_mul(inertia),
+            z2,
         }
     }
 
@@ -363,7 +366,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             if self.cfg.law.learns() {
                 self.learning.check_bounded(
                     &st.norms,
-                    &t.signals(&e, &self.cfg.inertia),
+                    &t.signals(&e, self.weighted(&e.z2)),
                     self.basis.nodes(),
                 )?;
             }
@@ -399,11 +402,8 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             check::within(what, x.as_slice(), BOUND)?;
         }
         if self.cfg.law.learns() {
-            self.learning.check_bounded(
-                &st.norms,
-                &e.signals_scaled(&self.cfg.inertia),
-                self.basis.nodes(),
-            )?;
+            self.learning
+                .check_bounded(&st.norms, &self.joint_signals(e), self.basis.nodes())?;
         }
         Ok(())
     }
@@ -423,26 +423,26 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         task: Option<&Task<N>>,
     ) -> Result<Command<N>, Error> {
         let learns = self.cfg.law.learns();
-        let d = &self.cfg.inertia;
+        let (k, cfg) = (self.coupling.as_ref(), &self.cfg);
         let (sig, mut tau) = match task {
-            None => (e.signals_scaled(d), self.feedback(e, &st.zeta)),
+            None => (self.joint_signals(e), self.feedback(e, &st.zeta)),
             Some(t) => {
                 // (19.2): the admittance's share and the torque-level part.
                 let n = t.share;
-                let mut adm = self.cfg.kp.component_mul(&e.z2)
-                    + self.robust.eval(&e.z2, &e.alpha1, &e.dalpha1);
+                let mut adm =
+                    kp_times(k, cfg, &e.z2) + self.robust.eval(&e.z2, &e.alpha1, &e.dalpha1);
                 if learns {
-                    adm += e.z1.component_mul(d) + m.tau_e;
+                    adm += inertia_times(k, cfg, &e.z1) + m.tau_e;
                 }
-                let tau = n * adm + (1.0 - n) * t.torque + self.cfg.kp.component_mul(&st.zeta);
-                (t.signals(e, d), tau)
+                let tau = n * adm + (1.0 - n) * t.torque + kp_times(k, cfg, &st.zeta);
+                (t.signals(e, self.weighted(&e.z2)), tau)
             }
         };
         let w_norms = if learns {
             let before = st.norms;
             if task.is_none() {
                 // (14), (35) with +z1 (erratum, SPEC §7), weighted d∘z1 (SPEC (10.2)).
-                tau += e.z1.component_mul(d) + self.networks(st, &m.x, v, &sig) + m.tau_e;
+                tau += inertia_times(k, cfg, &e.z1) + self.networks(st, &m.x, v, &sig) + m.tau_e;
             } else {
                 let (x, v) = task.map_or((m.x, *v), |t| t.input(&m.x, v));
                 tau += self.networks(st, &x, &v, &sig);
@@ -648,13 +648,17 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         let force = t.force(v);
         // (19.3) the joint law's feedback without its task part:
         // Π τ = τ − Jᵀ (J Kp⁻¹ Jᵀ + k̄ Λ²)⁻¹ J Kp⁻¹ τ, so Π Kp = Kp − Jᵀ Λ_K J ≼ Kp.
-        let null = t.null_space(&self.cfg.kp);
-        let mut inner = self.cfg.kp.component_mul(&errors.z2)
+        let (c, cfg) = (self.coupling.as_ref(), &self.cfg);
+        let null = match c {
+            Some(c) => t.null_space_of(c.kp_inv()),
+            None => t.null_space(&cfg.kp),
+        };
+        let mut inner = kp_times(c, cfg, &errors.z2)
             + self
                 .robust
                 .eval(&errors.z2, &errors.alpha1, &errors.dalpha1);
         if self.cfg.law.learns() {
-            inner += errors.z1.component_mul(&self.cfg.inertia);
+            inner += inertia_times(c, cfg, &errors.z1);
         }
         let torque = j.transpose() * force + null.apply(&inner);
         check::within("tau_task", torque.as_slice(), BOUND)?;
@@ -666,10 +670,24 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         })
     }
 
+    /// Dₛ v: d∘v, or the coupled inertia's product (SPEC (10.2), (18.12)).
+    fn weighted(&self, v: &Vector<N>) -> Vector<N> {
+        inertia_times(self.coupling.as_ref(), &self.cfg, v)
+    }
+
+    /// The joint law's learning signals, with the error Dₛ z2 (SPEC (10.2), (18.12)).
+    fn joint_signals(&self, e: &Errors<N>) -> Signals<N> {
+        Signals {
+            z2: self.weighted(&e.z2),
+            ..e.signals()
+        }
+    }
+
     /// Stage "robust term" with the feedback it adds to: `Kp (z2 + ζ) + r(z2)`
     /// (N m), SPEC §7.
     pub fn feedback(&self, e: &Errors<N>, zeta: &Vector<N>) -> Vector<N> {
-        self.cfg.kp.component_mul(&(e.z2 + zeta)) + self.robust.eval(&e.z2, &e.alpha1, &e.dalpha1)
+        kp_times(self.coupling.as_ref(), &self.cfg, &(e.z2 + zeta))
+            + self.robust.eval(&e.z2, &e.alpha1, &e.dalpha1)
     }
 
     /// Stages "basis" and "networks": S(Z) at Z = [x; v; α1; α̇1] into the

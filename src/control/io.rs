@@ -71,6 +71,22 @@ impl<const N: usize> TaskTorque<N> {
             ch: a.cholesky(),
         }
     }
+
+    /// Π of (19.3) for a joint law of full stiffness Kp, given `kp_inv` =
+    /// Kp⁻¹ (SPEC (18.12)): J Kp⁻¹ Jᵀ + k̄ Λ², k̄ = tr(Kp⁻¹)/N (the
+    /// diagonal's mean of 1/Kp_i).
+    pub fn null_space_of(&self, kp_inv: &crate::types::Matrix<N>) -> NullSpace<N> {
+        let j = self.jacobian;
+        let kbar = kp_inv.trace() / N as f64;
+        let jk = j * kp_inv;
+        let a = jk * j.transpose()
+            + nalgebra::SMatrix::<f64, 6, 6>::from_diagonal(&(kbar * self.lambda2));
+        NullSpace {
+            j,
+            jk,
+            ch: a.cholesky(),
+        }
+    }
 }
 
 /// The projection Π of (19.3) onto the null space of a task Jacobian J,

@@ -7,6 +7,7 @@
 pub mod auxiliary;
 pub mod config;
 pub mod controller;
+pub mod coupling;
 pub mod impedance;
 pub mod io;
 pub mod observer;

@@ -281,7 +281,7 @@ pub fn damped_scales<const N: usize>(
 /// An upper bound on the largest eigenvalue of a symmetric positive definite
 /// `m`, within 1 % of it: λmax ≤ (tr m^(2^k))^(2^−k) ≤ N^(2^−k) λmax, k = 8
 /// (repeated squaring, each power scaled to unit trace).
-fn largest_eigenvalue<const N: usize>(m: &Matrix<N>) -> f64 {
+pub fn largest_eigenvalue<const N: usize>(m: &Matrix<N>) -> f64 {
     const K: i32 = 8;
     let t = m.trace();
     let mut a = m / t;

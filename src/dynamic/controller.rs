@@ -288,6 +288,12 @@ impl Controller {
         each!(&self.inner, c, N => c.ctrl.basis().nodes())
     }
 
+    /// Dₛ of SPEC (18.12) (kg m², n × n row-major), if the gains are
+    /// inertia-shaped (the parameter `inertia_matrix`).
+    pub fn inertia_matrix(&self) -> Option<Vec<f64>> {
+        each!(&self.inner, c, N => c.ctrl.coupling().map(|k| k.inertia().transpose().as_slice().to_vec()))
+    }
+
     /// The law.
     pub fn law(&self) -> Law {
         each!(&self.inner, c, N => c.ctrl.config().law)

@@ -15,7 +15,7 @@ use super::values::{length, too_many, vector};
 use crate::cartesian::rule::resolving;
 use crate::control::config::Law;
 use crate::control::tuning::{
-    damped_scales, inertia_scales, inertia_scales_along, loop_bound, Rule,
+    damped_scales, inertia_scales, inertia_scales_along, largest_eigenvalue, loop_bound, Rule,
 };
 use crate::error::{check, Error};
 use crate::schema::{self, Preset};
@@ -80,6 +80,10 @@ pub struct Tuning<'a> {
     /// The arm bears no gravity the controller must hold (a robot that
     /// compensates it itself): D̂ and Ĉ learn at Ĝ's bandwidth, SPEC (22.2).
     pub weightless: bool,
+    /// The inertia-shaped gains of SPEC (18.12): Dₛ the harmonic mean of D
+    /// along the path (the parameter `inertia_matrix`),
+    /// the margin of (18.11) at the largest mode of Dₛ^½ D⁻¹ Dₛ^½.
+    pub coupled: bool,
 }
 
 impl<'a> Tuning<'a> {
@@ -99,6 +103,7 @@ impl<'a> Tuning<'a> {
             resolve: false,
             critical: false,
             weightless: false,
+            coupled: false,
         }
     }
 
@@ -120,6 +125,29 @@ const INERTIA_SHAPE: Error = Error::Invalid {
     what: "inertia",
     reason: "needs n × n values (n: tau_max's), or K ≥ 1 matrices of n × n along a path",
 };
+
+/// The inertia-shaped scale of SPEC (18.12) along `ds`: Dₛ = (mean D⁻¹)⁻¹,
+/// and λmax of Dₛ^½ D⁻¹ Dₛ^½ over the samples (as Lᵀ D⁻¹ L, Dₛ = L Lᵀ:
+/// the same eigenvalues), bounded from above within 1 %.
+fn coupled_scale<const N: usize>(ds: &[Matrix<N>]) -> Result<(Matrix<N>, f64), Error> {
+    let spd = Error::Invalid {
+        what: "inertia matrix",
+        reason: "must be positive definite",
+    };
+    let inverses = ds
+        .iter()
+        .map(|d| d.cholesky().map(|c| c.inverse()).ok_or(spd))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mean = inverses.iter().fold(Matrix::<N>::zeros(), |a, b| a + b) / inverses.len() as f64;
+    let scale = mean.cholesky().ok_or(spd)?.inverse();
+    let l = scale.cholesky().ok_or(spd)?.l();
+    let mut largest = 0.0f64;
+    for inv in &inverses {
+        let m = l.transpose() * inv * l;
+        largest = largest.max(largest_eigenvalue(&((m + m.transpose()) * 0.5)));
+    }
+    Ok((scale, largest))
+}
 
 /// [`Tuning::suggest`] for N joints: the scenario, and the centres into `centres`.
 fn typed<const N: usize>(
@@ -152,12 +180,25 @@ fn typed<const N: usize>(
     } else {
         inertia_scales(&ds[0])
     }?;
-    // SPEC (18.11): the margin at the largest mode of the undamped scales.
-    rule = rule.bounded(loop_bound(&ds, &scales)?);
+    // SPEC (18.11): the margin at the largest mode of the undamped scales;
+    // (18.12): of the inertia-shaped scale's, when coupled.
+    let shaped = t.coupled.then(|| coupled_scale(&ds)).transpose()?;
+    rule = rule.bounded(match &shaped {
+        Some((_, lmax)) => *lmax,
+        None => loop_bound(&ds, &scales)?,
+    });
+    let undamped = scales;
     let scales = match t.damping {
         None => scales,
         Some(b) => damped_scales(&scales, &vector::<N>("damping", b)?, t.ts)?,
     };
+    // (18.12): the damping's reduction of (18.9) per joint, as a congruence.
+    let shaped = shaped.map(|(m, _)| {
+        let c = Matrix::<N>::from_diagonal(&scales.zip_map(&undamped, |a, b| libm::sqrt(a / b)));
+        let m = c * m * c;
+        // Exactly symmetric: its row-major and column-major layouts agree.
+        (m + m.transpose()) * 0.5
+    });
     let tau = vector::<N>("tau_max", t.tau_max)?;
     let mut s = schema::Scenario::<N>::preset(Preset::Robot, t.law);
     match &t.path {
@@ -197,5 +238,6 @@ fn typed<const N: usize>(
             *centres = Some(Centres::of(&sug.centers));
         }
     }
+    s.config.inertia_matrix = shaped;
     Ok(Box::new(s))
 }

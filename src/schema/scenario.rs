@@ -160,6 +160,7 @@ impl<const N: usize> Scenario<N> {
             "Kp" => c.kp = joint(n, value)?,
             "Kzeta" => c.kzeta = joint(n, value)?,
             "inertia" => c.inertia = joint(n, value)?,
+            "inertia_matrix" => c.inertia_matrix = matrix(n, value)?,
             "rho" => c.rho = real(n, value)?,
             "conditions" => c.conditions = choice(p, value, &Conditions::ALL)?,
             "mu" => c.mu = real(n, value)?,
@@ -320,6 +321,7 @@ impl<const N: usize> Scenario<N> {
             kzeta,
             mu,
             inertia,
+            inertia_matrix,
             rho,
             conditions,
             aux_law,
@@ -386,6 +388,14 @@ impl<const N: usize> Scenario<N> {
         f("Kp", V(kp.as_slice()));
         f("Kzeta", V(kzeta.as_slice()));
         f("inertia", V(inertia.as_slice()));
+        // Column-major: the row-major layout of a symmetric matrix (the
+        // controller refuses another).
+        f(
+            "inertia_matrix",
+            inertia_matrix
+                .as_ref()
+                .map_or(Value::None, |m| V(m.as_slice())),
+        );
         f("rho", R(*rho));
         f("conditions", S(conditions.name()));
         f("mu", R(*mu));
@@ -644,6 +654,22 @@ pub(super) fn array<const M: usize>(name: &'static str, v: Value<'_>) -> Result<
 
 pub(super) fn joint<const N: usize>(name: &'static str, v: Value<'_>) -> Result<Vector<N>, Error> {
     array::<N>(name, v).map(Vector::from)
+}
+
+/// None, or N × N values, row-major.
+pub(super) fn matrix<const N: usize>(
+    name: &'static str,
+    v: Value<'_>,
+) -> Result<Option<crate::types::Matrix<N>>, Error> {
+    match v {
+        Value::None => Ok(None),
+        Value::Vec(s) if s.len() == N * N => Ok(Some(crate::types::Matrix::<N>::from_row_slice(s))),
+        Value::Vec(_) => Err(Error::Invalid {
+            what: name,
+            reason: "wrong length: n × n values, row-major",
+        }),
+        _ => Err(kind_error(name)),
+    }
 }
 
 pub(super) fn limit<const N: usize>(name: &'static str, v: Value<'_>) -> Result<Vector<N>, Error> {

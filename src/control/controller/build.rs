@@ -44,6 +44,11 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         };
         let obs = HighGainObserver::new(cfg.eps, cfg.lam1, cfg.ts, cfg.observer_hold)?;
         let lead = (cfg.law == Law::OutputFeedback && cfg.observer_lead).then(|| *obs.lag());
+        // SPEC (18.12): the inertia-shaped gains, checked and made once.
+        let coupling = match &cfg.inertia_matrix {
+            Some(m) => Some(Coupling::new(m, &cfg)?),
+            None => None,
+        };
         Ok(Self {
             sat: Saturation::new(cfg.tau_max)?,
             imp: TargetImpedance::new(cfg.dd, cfg.cd, cfg.gd)?,
@@ -67,7 +72,14 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
             simd: SimdPath::detect(),
             #[cfg(feature = "alloc")]
             feedforward: None,
+            coupling,
         })
+    }
+
+    /// The inertia-shaped gains of SPEC (18.12), if
+    /// [`Config::inertia_matrix`] is set.
+    pub fn coupling(&self) -> Option<&Coupling<N>> {
+        self.coupling.as_ref()
     }
 
     /// This controller with `feedforward`'s torque added to the law's at

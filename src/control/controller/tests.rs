@@ -79,8 +79,12 @@ fn the_unified_regressors_do_not_carry_the_compliant_acceleration() {
         dalpha1: ddxd + Vector::<2>::new(0.5, -0.25), // ẍd + K1 (ẋd − v)
     };
     let d = Vector::<2>::new(2.0, 0.5);
-    let quiet = task.signals(&errors(Vector::<2>::new(0.1, -0.2)), &d);
-    let pushed = task.signals(&errors(Vector::<2>::new(50.0, -80.0)), &d);
+    let (e_quiet, e_pushed) = (
+        errors(Vector::<2>::new(0.1, -0.2)),
+        errors(Vector::<2>::new(50.0, -80.0)),
+    );
+    let quiet = task.signals(&e_quiet, e_quiet.z2.component_mul(&d));
+    let pushed = task.signals(&e_pushed, e_pushed.z2.component_mul(&d));
     assert_eq!(quiet.dalpha1, pushed.dalpha1);
     // q̈_c + n K1 (ẋd − v): the commanded acceleration and the share's feedback.
     let expected = commanded.ddx + 0.3 * Vector::<2>::new(0.5, -0.25);

@@ -15,6 +15,10 @@
 // The largest number of joints (the arrays of the structs below have this many entries).
 #define ADAPTIMP_MAX_JOINTS 7
 
+// The entries of a parameter that is an n × n matrix (row-major in the
+// first n² of them): `ADAPTIMP_MAX_JOINTS`².
+#define ADAPTIMP_MAX_MATRIX 49
+
 // How many handles can live at once, of every kind together (a freed one
 // does not count): making one more is refused with TOO_MANY_HANDLES.
 #define ADAPTIMP_MAX_HANDLES 16384
@@ -341,6 +345,10 @@ typedef struct AdaptimpParams {
   double kzeta[ADAPTIMP_MAX_JOINTS];
   // Inertia scale d of each joint (kg m²), SPEC §10.
   double inertia[ADAPTIMP_MAX_JOINTS];
+  // Dₛ (kg m²), SPEC (18.12): the inertia-shaped gains, n × n row-major
+  // in the first n² values (symmetric positive definite); INFINITY in the
+  // first value: none, the diagonal law of `inertia` (the default).
+  double inertia_matrix[ADAPTIMP_MAX_MATRIX];
   // Young weight ρ (1/s) of the auxiliary system, SPEC §10.
   double rho;
   // The stability conditions checked.

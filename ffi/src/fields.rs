@@ -18,6 +18,8 @@ pub(crate) enum Field<'a> {
     Count(&'a mut usize),
     /// One real per joint, of which the first n are read.
     Joint(&'a mut [f64; ADAPTIMP_MAX_JOINTS]),
+    /// n × n row-major in the first n² values; INFINITY first: none.
+    Matrix(&'a mut [f64; ADAPTIMP_MAX_MATRIX]),
     /// Three reals (per network, per axis).
     Three(&'a mut [f64; 3]),
     /// Three reals, or the schema's none (derived: critical damping) when
@@ -62,6 +64,7 @@ from_places! {
     f64 => Real,
     usize => Count,
     [f64; ADAPTIMP_MAX_JOINTS] => Joint,
+    [f64; ADAPTIMP_MAX_MATRIX] => Matrix,
     [f64; 3] => Three,
     AdaptimpBoolRaw => Flag
 }
@@ -108,6 +111,8 @@ impl Field<'_> {
             // usize → i64: a count beyond i64 is refused by the schema's check (≤ 64).
             Field::Count(d) => Value::Int(i64::try_from(**d).unwrap_or(i64::MAX)),
             Field::Joint(v) => Value::Vec(&v[..n]),
+            Field::Matrix(v) if v[0] == f64::INFINITY => Value::None,
+            Field::Matrix(v) => Value::Vec(&v[..n * n]),
             Field::Three(v) => Value::Vec(&v[..]),
             Field::Derived(v, critical) => {
                 match decode_bool(**critical, &format!("{field}_critical"))? {
@@ -155,6 +160,8 @@ impl Field<'_> {
             }
             (Field::Joint(dst), Value::Vec(v)) => copy(&mut dst[..], n, v, field)?,
             (Field::Joint(dst), Value::None) if kind == Kind::Limit => dst.fill(f64::INFINITY),
+            (Field::Matrix(dst), Value::Vec(v)) => copy(&mut dst[..], n * n, v, field)?,
+            (Field::Matrix(dst), Value::None) => dst.fill(f64::INFINITY),
             (Field::Three(dst), Value::Vec(v)) => copy(&mut dst[..], 3, v, field)?,
             (Field::Derived(dst, critical), Value::None) => {
                 **dst = [0.0; 3];
@@ -270,7 +277,7 @@ macro_rules! table {
 /// and the centres are not parameters).
 pub(crate) fn controller_fields(p: &mut AdaptimpParams) -> Table<'_> {
     let [kd, kc, kg] = &mut p.k_remark1;
-    table!(p: ts, delay, k1, kp, kzeta, inertia, rho, conditions, mu, aux_law, robust, kr,
+    table!(p: ts, delay, k1, kp, kzeta, inertia, inertia_matrix, rho, conditions, mu, aux_law, robust, kr,
         phi, learning_step, kappa, saturation_learning, gamma, sigma, eps, lam1,
         observer_init, observer_hold, observer_lead, tau_max, dd, cd, gd, impedance, eta2,
         xc_offset, xc_sin, xc_cos, xc_omega, fallback, fallback_damping, fault_policy, q_max,

@@ -36,6 +36,12 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// The largest number of joints (the arrays of the structs below have this many entries).
 pub const ADAPTIMP_MAX_JOINTS: usize = 7;
+
+/// The entries of a parameter that is an n × n matrix (row-major in the
+/// first n² of them): `ADAPTIMP_MAX_JOINTS`².
+pub const ADAPTIMP_MAX_MATRIX: usize = 49;
+
+const _: () = assert!(ADAPTIMP_MAX_MATRIX == ADAPTIMP_MAX_JOINTS * ADAPTIMP_MAX_JOINTS);
 // A literal for the header's generator; the core's list of sizes is the truth.
 const _: () = assert!(ADAPTIMP_MAX_JOINTS == adaptimp::dynamic::MAX_JOINTS);
 

@@ -35,6 +35,10 @@ pub struct AdaptimpParams {
     pub kzeta: [f64; ADAPTIMP_MAX_JOINTS],
     /// Inertia scale d of each joint (kg m²), SPEC §10.
     pub inertia: [f64; ADAPTIMP_MAX_JOINTS],
+    /// Dₛ (kg m²), SPEC (18.12): the inertia-shaped gains, n × n row-major
+    /// in the first n² values (symmetric positive definite); INFINITY in the
+    /// first value: none, the diagonal law of `inertia` (the default).
+    pub inertia_matrix: [f64; ADAPTIMP_MAX_MATRIX],
     /// Young weight ρ (1/s) of the auxiliary system, SPEC §10.
     pub rho: f64,
     /// The stability conditions checked.
@@ -359,7 +363,7 @@ mod tests {
                         });
                         out
                     };
-                    assert_eq!(controller(&s).len(), 45);
+                    assert_eq!(controller(&s).len(), 46);
                     assert_eq!(
                         controller(&s),
                         controller(&expect),
@@ -368,5 +372,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_inertia_matrix_is_none_by_default_and_read_row_major() {
+        let expect = Scenario::new(2, Preset::Robot, Law::StateFeedback).unwrap();
+        let mut p = params_of(&expect).unwrap();
+        assert!(p.inertia_matrix.iter().all(|x| *x == f64::INFINITY));
+        assert_eq!(
+            scenario_of(&p)
+                .unwrap()
+                .controller()
+                .unwrap()
+                .inertia_matrix(),
+            None
+        );
+        p.inertia_matrix[..4].copy_from_slice(&[2.0, 0.6, 0.6, 0.5]);
+        let s = scenario_of(&p).unwrap();
+        assert_eq!(
+            s.controller().unwrap().inertia_matrix(),
+            Some(std::vec![2.0, 0.6, 0.6, 0.5])
+        );
+        assert_eq!(
+            params_of(&s).unwrap().inertia_matrix[..4],
+            [2.0, 0.6, 0.6, 0.5]
+        );
     }
 }

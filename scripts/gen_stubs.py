@@ -33,6 +33,7 @@ TYPES = {
     "axes": "float | Sequence[float]",
     "derived_axes": "float | Sequence[float] | None",
     "flag": "bool",
+    "matrix": "Sequence[float] | Sequence[Sequence[float]] | None",
 }
 
 CLASSES = (

@@ -81,6 +81,10 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     ("docs/your_arm.md", 4): "the delay tables on robot files of packages CI does not "
     "install (robosuite, gymnasium, dm_control, metaworld, franky-sim, pybullet): "
     "tests/test_delay.py makes the same simulate calls on the Panda",
+    ("docs/your_arm.md", 5): "on a file of the reader's (FILE): tests/test_coupling.py makes "
+    "the same calls on the Panda",
+    ("docs/your_arm.md", 6): "the coupled delay tables on the same files as block 4, which "
+    "CI does not install: tests/test_coupling.py runs the Panda's joint rows",
 }
 
 # Shell blocks run here as written (each line, from the checkout's root).

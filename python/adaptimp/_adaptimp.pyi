@@ -79,6 +79,10 @@ class ControllerParams(TypedDict, total=False):
     inertia: float | _Joint
     """inertia scale d of each joint: the auxiliary system takes Δτ/d, the z1 term d·z1, the
     learning error d·z2 (SPEC §10) (kg m²)."""
+    inertia_matrix: Sequence[float] | Sequence[Sequence[float]] | None
+    """inertia-shaped gains: Dₛ (n × n, row-major) in place of diag(d) in the z1 term and the
+    learning error, and Kp = R^½ Dₛ R^½ with R = diag(Kp/d) (SPEC (18.12); None: diagonal)
+    (kg m²)."""
     rho: float
     """Young weight ρ of ζᵀΔτ in the auxiliary system's β (SPEC §10) (1/s)."""
     conditions: Literal["paper", "scaled"]
@@ -743,6 +747,7 @@ def suggest(
     orbit: NDArray[np.float64] | None = None,
     delay: int = 0,
     weightless: bool = False,
+    coupled: bool = False,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every
@@ -752,7 +757,8 @@ def suggest(
     (n,): the joints' viscous damping, the scales as the sampled loop sees them,
     SPEC (18.9); ``orbit`` (K', n): one period of the joint positions that repeat,
     the widths in q at least its diameter, SPEC (19.11); ``weightless``: D̂ and Ĉ
-    learning at Ĝ's bandwidth, an arm without gravity, SPEC (22.2)."""
+    learning at Ĝ's bandwidth, an arm without gravity, SPEC (22.2); ``coupled``: the
+    inertia-shaped gains of SPEC (18.12) (the keyword ``inertia_matrix``)."""
 
 def pose_circle(
     p0: NDArray[np.float64],

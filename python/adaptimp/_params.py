@@ -67,7 +67,8 @@ class Param:
     (``None`` for no limit, or a number > 0 per joint), ``"axes"`` (a number
     broadcast to the task axes x, y, z, or one value per axis),
     ``"derived_axes"`` (the same, or ``None`` for the value derived from other
-    parameters), ``"flag"`` (``True`` or ``False``).
+    parameters), ``"flag"`` (``True`` or ``False``), ``"matrix"`` (``None``,
+    or an (n, n) array, also given as n² values row-major).
     ``condition`` is the validity condition the core checks (SPEC §10 style).
     """
 
@@ -243,6 +244,22 @@ def _choice(p: Param, value: object) -> str:
     return value
 
 
+def _matrix(p: Param, value: object, n: int) -> list[float]:
+    """An n × n matrix, given (n, n) or as n² values row-major: n² finite
+    floats, row-major (symmetry is the core's check)."""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(
+            f"{p.name} must be an ({n}, {n}) array of numbers, got {_type_name(value)}"
+        ) from None
+    if a.shape not in ((n, n), (n * n,)):
+        raise ConfigError(f"{p.name} must have shape ({n}, {n}), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ConfigError(f"{p.name} must be finite, got {a.tolist()}")
+    return [float(x) for x in a.reshape(-1)]
+
+
 def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
     """``value`` of parameter ``name`` in its normal form (float, int, str, list of
     floats or None) for ``n`` joints; raises ``TypeError``/``ValueError`` naming
@@ -270,6 +287,8 @@ def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
         return _vector(p, value, 3, "one value per axis x, y, z")
     if p.kind == "derived_axes":
         return None if value is None else _vector(p, value, 3, "one value per axis x, y, z")
+    if p.kind == "matrix":
+        return None if value is None else _matrix(p, value, n)
     if p.kind == "flag":
         if isinstance(value, (bool, np.bool_)):
             return bool(value)

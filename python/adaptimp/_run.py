@@ -122,6 +122,7 @@ def _rule_setup(
     T: float,
     home: ArrayLike | None = None,
     delay: int = 0,
+    coupled: bool = False,
 ) -> tuple[Task | None, Any, dict[str, Any]]:
     """The task and the rule's keywords for a case name on ``plant`` (SPEC §18):
     the default task unless a reference or the controller's own trajectory
@@ -133,7 +134,7 @@ def _rule_setup(
         )
     if reference is None and not own:
         task = default_task(plant, home)
-        kw = rule_keywords(plant, task, Ts=Ts, case=case, delay=delay)
+        kw = rule_keywords(plant, task, Ts=Ts, case=case, delay=delay, coupled=coupled)
         kw.pop("n")
         return task, task.reference, kw
     from . import tuning
@@ -152,8 +153,9 @@ def _rule_setup(
     home = np.asarray(path(0.0)[0], dtype=np.float64)
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
     kw = tuning.suggest(
-        plant, home, plant.tau_max, Ts=Ts, path=path, period=period, case=case, delay=delay
-    )
+        plant, home, plant.tau_max, Ts=Ts, path=path, period=period, case=case, delay=delay,
+        coupled=coupled,
+    )  # fmt: skip
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(plant.model, plant.data)
     kw.pop("n")
@@ -286,7 +288,8 @@ def simulate(
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
         them), for any controller; and, for a case name, controller parameters
-        (``Kp``, ``gamma``, …).
+        (``Kp``, ``gamma``, …) and ``coupled=True``: the rule's
+        inertia-shaped gains of SPEC (18.12) (:func:`adaptimp.tuning.suggest`).
 
     Notes
     -----
@@ -463,6 +466,8 @@ def _setup(
     task: Task | None = None
     params = dict(params)
     delay = loop_delay(params)
+    # SPEC (18.12): a rule option of a case name, not a parameter.
+    coupled = bool(params.pop("coupled", False)) if isinstance(controller, str) else False
     disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
     if home is not None and not (isinstance(controller, str) and uses_rule(nominal)):
         raise ValueError(
@@ -473,7 +478,7 @@ def _setup(
         if uses_rule(nominal):
             task, reference, rule = _rule_setup(
                 nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
-                float(defaults["T"]) if T is None else float(T), home, delay,
+                float(defaults["T"]) if T is None else float(T), home, delay, coupled,
             )  # fmt: skip
             kwargs = {**rule, **kwargs}
             if q0 is None and task is not None:
@@ -564,6 +569,16 @@ def _controller_delay(ctrl: Any) -> int | None:
     return None
 
 
+def _controller_param(ctrl: Any, name: str) -> Any:
+    """Parameter ``name`` of ``ctrl`` (an ``adaptimp.Controller``) or of a
+    Cartesian controller's joint controller; None for one that does not say."""
+    for c in (ctrl, getattr(ctrl, "inner", None)):
+        params = getattr(c, "params", None)
+        if isinstance(params, Mapping) and params.get(name) is not None:
+            return params[name]
+    return None
+
+
 def _result(run: Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
     plant, ctrl = run.plant, run.ctrl
     name = plant.model.names[: plant.model.names.find(b"\0")].decode()
@@ -587,6 +602,10 @@ def _result(run: Run, out: dict[str, Any], m: dict[str, Any]) -> MujocoResult:
     # SPEC (18.11): the delay the controller was made for, beside the plant's
     # (``plant_delay``); they differ only for a controller the caller made.
     params["delay"] = _controller_delay(ctrl)
+    # SPEC (18.12): the inertia-shaped gains, when the controller has them.
+    shaped = _controller_param(ctrl, "inertia_matrix")
+    if shaped is not None:
+        params["inertia_matrix"] = shaped
     if run.task is not None:
         params["task"] = {"home": run.task.home.tolist(), **run.task.keywords}
     case = getattr(ctrl, "case", None)

@@ -181,11 +181,13 @@ def rule_keywords(
     Ts: float = 1e-3,
     case: str = "sf",
     delay: int = 0,
+    coupled: bool = False,
 ) -> dict[str, Any]:
     """The rule's controller keywords for ``plant`` on ``task`` (default
     :func:`default_task`) at period ``Ts`` (s) for a loop of ``delay``
     periods, SPEC §18 (:func:`adaptimp.tuning.suggest` with D at the task's
-    home, the plant's τmax and the task's path; (18.11) for the delay), with
+    home, the plant's τmax and the task's path; (18.11) for the delay;
+    ``coupled``: the inertia-shaped gains of (18.12)), with
     ``impedance="external"`` (in free space the controller tracks the
     reference as given). The plant's own model: give it the nominal plant (no
     payload)."""
@@ -195,7 +197,7 @@ def rule_keywords(
     saved = (np.array(plant.data.qpos), np.array(plant.data.qvel))
     kw = tuning.suggest(
         plant, task.home, plant.tau_max, Ts=Ts, path=task.reference, period=task.period,
-        case=case, delay=delay,
+        case=case, delay=delay, coupled=coupled,
     )  # fmt: skip
     plant.data.qpos[:], plant.data.qvel[:] = saved
     mujoco.mj_forward(plant.model, plant.data)

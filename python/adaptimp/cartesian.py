@@ -269,6 +269,7 @@ class CartesianController:
         span: float | None = None,
         Ts: float = 1e-3,
         delay: int = 0,
+        coupled: bool = False,
         **params: Any,
     ) -> CartesianController:
         """The Cartesian controller of a case name built by the core's rule
@@ -317,6 +318,9 @@ class CartesianController:
         delay : int
             The loop's delay (periods) the rule sizes the joint gains for,
             SPEC (18.11) (libfranka: 1); the joint controller's ``delay``.
+        coupled : bool
+            The joint controller's inertia-shaped gains, SPEC (18.12)
+            (:func:`adaptimp.tuning.suggest`'s ``coupled``).
         **params
             Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
             and the joint controller's, e.g. ``gamma``). ``gravity="model"``:
@@ -384,7 +388,7 @@ class CartesianController:
                 raise ConfigError(f"q0 cannot run the path: {a['error']}")
             kw = tuning.suggest(
                 model, q0, limits, Ts=Ts, path=np.hstack([q, dq, ddq]), period=steps * Ts,
-                case=controller, resolve=True, delay=delay,
+                case=controller, resolve=True, delay=delay, coupled=coupled,
             )  # fmt: skip
         kw.pop("n")
         joint = {k: v for k, v in params.items() if k not in cart}

@@ -59,7 +59,7 @@ class CliError(Exception):
 def _parse_value(name: str, text: str) -> Any:
     p = BY_NAME[name]
     try:
-        if p.kind in ("optional", "derived", "bound", "limit", "derived_axes") and (
+        if p.kind in ("optional", "derived", "bound", "limit", "derived_axes", "matrix") and (
             text.lower() == "none"
         ):
             return None
@@ -72,7 +72,7 @@ def _parse_value(name: str, text: str) -> Any:
             return int(text)
         if p.kind in ("real", "optional", "derived"):
             return float(text)
-        if p.kind in ("joint", "network", "limit", "axes", "derived_axes"):
+        if p.kind in ("joint", "network", "limit", "axes", "derived_axes", "matrix"):
             parts = [float(x) for x in text.split(",")]
             return parts[0] if len(parts) == 1 else parts
         if p.kind == "flag":
@@ -97,6 +97,7 @@ def _expected(kind: str) -> str:
         "axes": "a number or comma-separated numbers, one per axis (x, y, z)",
         "derived_axes": "'none', or a number or comma-separated numbers, one per axis (x, y, z)",
         "flag": "'true' or 'false'",
+        "matrix": "'none', or n × n comma-separated numbers, row-major",
     }.get(kind, "a value")
 
 

@@ -171,6 +171,7 @@ def suggest(
     orbit: ArrayLike | None = None,
     delay: int = 0,
     weightless: bool | None = None,
+    coupled: bool = False,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
     the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
@@ -224,12 +225,21 @@ def suggest(
         or an arm in a horizontal plane): D̂ and Ĉ learn at Ĝ's bandwidth,
         SPEC (22.2). Default: whether the model has no gravity at all
         (:func:`is_weightless`).
+    coupled : bool
+        The inertia-shaped gains of SPEC (18.12): Dₛ (kg m²) the harmonic
+        mean of D along the path, (mean D⁻¹)⁻¹ (D(q0) without one), in place
+        of the diagonal scales in Kp, the z1 term and the learning error, and
+        the margin of (18.11) at the largest mode of Dₛ^½ D⁻¹ Dₛ^½: the
+        delayed loop's modes stay together where the diagonal's spread (the
+        keyword ``inertia_matrix``, n × n values row-major). Default False:
+        the diagonal rule.
 
     Returns
     -------
     dict
-        ``n`` and the keywords of :data:`RULE_KEYS` and, with a path,
-        ``centers`` (L, 4n) and ``widths`` (4n,): keywords of
+        ``n`` and the keywords of :data:`RULE_KEYS`, ``inertia_matrix`` when
+        ``coupled`` and, with a path, ``centers`` (L, 4n) and ``widths``
+        (4n,): keywords of
         ``adaptimp.Controller(case, "robot", **kw)``, which construction accepts.
 
     Raises
@@ -278,10 +288,12 @@ def suggest(
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
         critical=critical, damping=b_arr, orbit=orbit, delay=loop_delay({'delay': delay}),
-        weightless=light,
+        weightless=light, coupled=bool(coupled),
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})
+    if out["params"]["inertia_matrix"] is not None:
+        kw["inertia_matrix"] = out["params"]["inertia_matrix"]
     if "centers" in out:
         kw["centers"], kw["widths"] = out["centers"], out["widths"]
     return kw

@@ -38,8 +38,10 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// q at least its diameter, SPEC (19.11) (the table scenario's).
 /// `weightless`: the arm bears no gravity the controller must hold (a robot
 /// that compensates it itself): D̂ and Ĉ learn at Ĝ's bandwidth, SPEC (22.2).
+/// `coupled`: the inertia-shaped gains of SPEC (18.12) (the parameter
+/// `inertia_matrix`, n × n values row-major).
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0, weightless=false))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0, weightless=false, coupled=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -56,6 +58,7 @@ pub fn suggest<'py>(
     orbit: Option<PyReadonlyArray2<'py, f64>>,
     delay: usize,
     weightless: bool,
+    coupled: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();
@@ -134,6 +137,7 @@ pub fn suggest<'py>(
     rule.damping = damping.as_deref();
     rule.orbit = orbit.as_deref();
     (rule.resolve, rule.critical, rule.weightless) = (resolve, critical, weightless);
+    rule.coupled = coupled;
     let s = rule.suggest().map_err(|e| config_error(e.into()))?;
     let out = PyDict::new(py);
     let params = PyDict::new(py);

@@ -4,7 +4,8 @@ torque acting d periods after its sample, the controllers made by the rule for
 that delay, nothing set per arm.
 
     python scripts/delay_targets.py FILE [FILE ...] [--delays 0,1,2] [--T 8]
-                                    [--cartesian] [--tip NAME] [--json out.json]
+                                    [--cartesian] [--coupled] [--tip NAME]
+                                    [--json out.json]
 
 For each file and delay d: ``amj.simulate(case, FILE, T=T, delay=d)`` for PD,
 SF and OF (RMS ‖z1‖ over t ≥ 2 s, the plant's true q), SF's drift (RMS over the
@@ -12,7 +13,8 @@ last 2 s against [2, 4) s), the peak commanded |τ_i|/τmax_i after 0.1 s and
 the share of rows at a limit; with ``--cartesian`` also ``amj.cartesian_task``
 and SF/PD in position and orientation over t ≥ 2 s (T = 12 s). Prints one
 Markdown table per part; the targets of the issue are SF/PD and OF/PD ≤ 0.2,
-no drift, peak ≤ 2 τmax.
+no drift, peak ≤ 2 τmax. ``--coupled``: every controller (PD too) made by the
+rule with the inertia-shaped gains of SPEC (18.12) (``coupled=True``).
 """
 
 from __future__ import annotations
@@ -28,11 +30,15 @@ from typing import Any
 import numpy as np
 
 
-def joint_row(path: str, d: int, T: float, tip: str | None) -> dict[str, Any]:
+def joint_row(
+    path: str, d: int, T: float, tip: str | None, coupled: bool = False
+) -> dict[str, Any]:
     """PD, SF, OF of the default joint task at delay ``d``."""
     from adaptimp import mujoco as amj
 
-    runs = {c: amj.simulate(c, path, T=T, delay=d, tip=tip) for c in ("pd", "sf", "of")}
+    runs = {
+        c: amj.simulate(c, path, T=T, delay=d, tip=tip, coupled=coupled) for c in ("pd", "sf", "of")
+    }
     rms = {c: float(r.metrics["rms_z1_after2"]) for c, r in runs.items()}
     sf = runs["sf"]
     t = sf.t
@@ -57,13 +63,15 @@ def joint_row(path: str, d: int, T: float, tip: str | None) -> dict[str, Any]:
     }
 
 
-def cartesian_row(path: str, d: int, tip: str | None) -> dict[str, Any]:
+def cartesian_row(path: str, d: int, tip: str | None, coupled: bool = False) -> dict[str, Any]:
     """PD and SF of the default Cartesian task at delay ``d`` (T = 12 s)."""
     from adaptimp import mujoco as amj
 
     plant = amj.Plant(path, tip=tip, contact=False)
     task = amj.cartesian_task(plant)
-    runs = {c: amj.simulate(c, plant, T=12.0, task=task, delay=d) for c in ("pd", "sf")}
+    runs = {
+        c: amj.simulate(c, plant, T=12.0, task=task, delay=d, coupled=coupled) for c in ("pd", "sf")
+    }
     pos = {c: float(r.metrics["rms_pos_after2"]) for c, r in runs.items()}
     rot = {c: float(r.metrics["rms_rot_after2"]) for c, r in runs.items()}
     tau_max = np.asarray(runs["sf"].params["tau_max"])
@@ -86,6 +94,9 @@ def main() -> None:
     parser.add_argument("--delays", default="0,1,2", help="delays in periods, comma-separated")
     parser.add_argument("--T", type=float, default=8.0, help="joint runs' duration (s)")
     parser.add_argument("--cartesian", action="store_true", help="also the Cartesian task")
+    parser.add_argument(
+        "--coupled", action="store_true", help="the inertia-shaped gains of SPEC (18.12)"
+    )
     parser.add_argument("--tip", default=None, help="the end effector, for every file")
     parser.add_argument("--json", type=Path, default=None, help="write the numbers")
     args = parser.parse_args()
@@ -102,7 +113,7 @@ def main() -> None:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 try:
-                    r = joint_row(path, d, args.T, args.tip)
+                    r = joint_row(path, d, args.T, args.tip, args.coupled)
                 except Exception as e:  # a file the library refuses: the refusal is the row
                     print(f"| {name} | {d} | {type(e).__name__}: {str(e)[:120]} |||||||")
                     continue
@@ -123,7 +134,7 @@ def main() -> None:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     try:
-                        c = cartesian_row(path, d, args.tip)
+                        c = cartesian_row(path, d, args.tip, args.coupled)
                     except Exception as e:
                         print(f"| {name} | {d} | {type(e).__name__}: {str(e)[:120]} ||||")
                         continue

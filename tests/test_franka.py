@@ -68,6 +68,16 @@ def test_the_controller_is_the_rule_a_simulate_user_gets() -> None:
     ctask = amj.cartesian_task(plant, q0=READY)
     assert c.controller.params == ctask.controller("sf", plant, delay=franka.DELAY, **limits).params
     assert s.controller.params["delay"] == 1
+    assert s.controller.params["inertia_matrix"] is None
+    # SPEC (18.12): the rule's option, the same on the robot as in simulate.
+    shaped = franka.setup("sf", plant, READY, coupled=True)
+    coupled = amj.rule_keywords(plant, task, Ts=1e-3, case="sf", delay=franka.DELAY, coupled=True)
+    assert shaped.controller.params["inertia_matrix"] == coupled["inertia_matrix"]
+    c = franka.setup("sf", plant, READY, task="cartesian", coupled=True)
+    want = ctask.controller("sf", plant, delay=franka.DELAY, coupled=True, **limits)
+    assert c.controller.params == want.params
+    assert c.controller.inner.params == want.inner.params
+    assert want.inner.params["inertia_matrix"] is not None
 
 
 @pytest.mark.parametrize("task", ["joint", "cartesian"])

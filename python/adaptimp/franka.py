@@ -137,6 +137,7 @@ def setup(
     home: ArrayLike | None = None,
     blend: float = BLEND,
     tip: str | None = None,
+    coupled: bool = False,
     **params: Any,
 ) -> Setup:
     """The controller and task :func:`run` drives for an arm standing at ``q``
@@ -159,7 +160,8 @@ def setup(
     (``delay`` = :data:`DELAY`, SPEC (18.11)); it gets the Franka's torque
     limits (:data:`TAU_MAX`, at most the URDF's effort) and libfranka's
     torque rate (``tau_rate_max`` = :data:`TORQUE_RATE` × 1 ms); ``params``
-    replace the rule's keywords. ``gravity=`` is refused: the robot
+    replace the rule's keywords. ``coupled``: the rule's inertia-shaped gains,
+    SPEC (18.12) (:func:`adaptimp.tuning.suggest`). ``gravity=`` is refused: the robot
     compensates gravity itself (SPEC (20.10)).
     """
     if controller not in ("pd", "sf", "of"):
@@ -185,11 +187,13 @@ def setup(
                 f"the arm stands at q = {np.round(q, 4).tolist()} rad, where {e}: move it "
                 "first (run(..., start=franka.READY), or franka.move_to)"
             ) from e
-        ctrl = ctask.controller(controller, arm, Ts=PERIOD, delay=DELAY, **keywords)
+        ctrl = ctask.controller(
+            controller, arm, Ts=PERIOD, delay=DELAY, coupled=coupled, **keywords
+        )
         return Setup(ctrl, "cartesian", arm, q, ctask, 0.0)
     h = q if home is None else posture_of("home", home)
     jtask = amj.default_task(arm, h)
-    kw = amj.rule_keywords(arm, jtask, Ts=PERIOD, case=controller, delay=DELAY)
+    kw = amj.rule_keywords(arm, jtask, Ts=PERIOD, case=controller, delay=DELAY, coupled=coupled)
     kw.pop("n")
     kw.update(keywords)
     ctrl = _adaptimp_controller(controller, kw)

@@ -8,12 +8,15 @@ use nalgebra::SMatrix;
 
 type Matrix<const N: usize> = SMatrix<f64, N, N>;
 
-/// The robot preset's state feedback for 2 joints with unequal scales and rates.
+/// The robot preset's state feedback for 2 joints with unequal scales, the
+/// rate Kp/d 250 /s on both, and actuators that saturate (the auxiliary
+/// system acts).
 fn config() -> Config<2> {
     let mut cfg = Config::robot(Law::StateFeedback);
     cfg.inertia = Vector::<2>::new(2.0, 0.5);
-    cfg.kp = Vector::<2>::new(500.0, 60.0);
+    cfg.kp = Vector::<2>::new(500.0, 125.0);
     cfg.kzeta = Vector::<2>::new(400.0, 400.0);
+    cfg.tau_max = Vector::<2>::new(20.0, 5.0);
     cfg
 }
 
@@ -42,6 +45,8 @@ fn torques(cfg: Config<2>) -> Vec<Vector<2>> {
 #[test]
 fn a_diagonal_inertia_matrix_is_the_diagonal_law() {
     let diagonal = torques(config());
+    // The run saturates: the auxiliary system's weighting is exercised too.
+    assert!(diagonal.iter().any(|t| t[1].abs() > 5.0));
     let mut cfg = config();
     cfg.inertia_matrix = Some(Matrix::<2>::from_diagonal(&cfg.inertia));
     let shaped = torques(cfg);
@@ -64,8 +69,8 @@ fn the_coupled_gain_is_made_once_from_the_rates() {
     let c =
         Controller::for_trajectory(cfg, adaptimp::rbf::Grid::paper(), &Sinusoid::paper()).unwrap();
     let k = c.coupling().expect("coupled");
-    // Kp = R^½ Dₛ R^½, R = diag(Kp_i/d_i) = diag(250, 120).
-    let r = [250.0f64, 120.0];
+    // Kp = R^½ Dₛ R^½, R = diag(Kp_i/d_i) = 250 /s on both joints.
+    let r = [250.0f64, 250.0];
     for i in 0..2 {
         for j in 0..2 {
             let want = r[i].sqrt() * ds[(i, j)] * r[j].sqrt();
@@ -73,6 +78,7 @@ fn the_coupled_gain_is_made_once_from_the_rates() {
         }
     }
     assert!((k.kp() * k.kp_inv() - Matrix::<2>::identity()).amax() < 1e-12);
+    assert!((k.inertia() * k.inertia_inv() - Matrix::<2>::identity()).amax() < 1e-12);
     assert_eq!(k.inertia(), &ds);
 }
 
@@ -91,6 +97,33 @@ fn an_inertia_matrix_that_is_not_one_is_refused_by_name() {
     assert_eq!(
         build(Matrix::<2>::new(f64::NAN, 0.0, 0.0, 1.0)),
         "inertia_matrix[0] is not finite (NaN or infinite)"
+    ); // Opposite signs within 1e-9 of the largest entry: not symmetric.
+    assert_eq!(build(Matrix::<2>::new(1e6, 5e-4, -5e-4, 1.0)), not);
+    // (λmin from the bound on λmax(Dₛ⁻¹), within 1 % of it.)
+    assert_eq!(
+        build(Matrix::<2>::identity() * 1e-12),
+        "condition λmin(inertia_matrix) ≥ 1e-9 is violated: λmin(inertia_matrix) = 0.0000000000009972960560854704 (SPEC §10)"
+    );
+    let with = |f: &dyn Fn(&mut Config<2>)| {
+        let mut cfg = config();
+        cfg.inertia_matrix = Some(Matrix::<2>::new(2.0, 0.6, 0.6, 0.5));
+        f(&mut cfg);
+        Controller::for_trajectory(cfg, adaptimp::rbf::Grid::paper(), &Sinusoid::paper())
+            .unwrap_err()
+            .to_string()
+    };
+    let uniform =
+        "inertia_matrix: needs K1, Kzeta and Kp/inertia the same on every joint (SPEC (18.12))";
+    assert_eq!(with(&|c| c.k1 = Vector::<2>::new(1.0, 100.0)), uniform);
+    assert_eq!(with(&|c| c.kzeta = Vector::<2>::new(400.0, 500.0)), uniform);
+    assert_eq!(with(&|c| c.kp = Vector::<2>::new(500.0, 60.0)), uniform);
+    assert_eq!(
+        with(&|c| {
+            // The paper's unit weights, for which (13) holds diagonal.
+            c.conditions = adaptimp::Conditions::Paper;
+            (c.inertia, c.kp, c.rho) = (Vector::<2>::repeat(1.0), Vector::<2>::repeat(5.0), 1.0);
+        }),
+        "inertia_matrix: needs conditions = scaled (SPEC (18.12))"
     );
 }
 
@@ -199,4 +232,37 @@ fn the_rule_takes_the_harmonic_mean_and_sizes_the_margin_at_its_modes() {
     ));
     assert!(diagonal_rate <= g / (diagonal_lmax * 1e-3) * 1.000_001);
     assert!(coupled_rate > diagonal_rate);
+}
+
+#[test]
+fn the_null_space_of_a_diagonal_kp_is_the_diagonal_one() {
+    use adaptimp::TaskTorque;
+    let jacobian = nalgebra::SMatrix::<f64, 6, 3>::from_fn(|r, c| {
+        ((r * 3 + c) as f64 * 0.37).sin() + if r == c { 1.0 } else { 0.0 }
+    });
+    let t = TaskTorque::<3> {
+        commanded: adaptimp::trajectory::Setpoint {
+            x: Vector::<3>::zeros(),
+            dx: Vector::<3>::zeros(),
+            ddx: Vector::<3>::zeros(),
+        },
+        jacobian,
+        spring: nalgebra::Vector6::zeros(),
+        damping: nalgebra::Vector6::zeros(),
+        twist: nalgebra::Vector6::zeros(),
+        lambda2: nalgebra::Vector6::from_element(1e-3),
+        share: 0.0,
+    };
+    let kp = Vector::<3>::new(300.0, 40.0, 5.0);
+    let tau = Vector::<3>::new(1.0, -2.0, 0.5);
+    let diagonal = t.null_space(&kp).apply(&tau);
+    let full = t
+        .null_space_of(&Matrix::<3>::from_diagonal(&kp.map(|k| 1.0 / k)))
+        .apply(&tau);
+    assert!(
+        (diagonal - full).amax() <= 1e-12 * diagonal.amax(),
+        "{diagonal} vs {full}"
+    );
+    // Π Kp ≼ Kp: the projection removes the task's part of the torque.
+    assert!(diagonal.norm() < tau.norm());
 }

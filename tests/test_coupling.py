@@ -64,7 +64,28 @@ def test_the_coupled_rule_holds_the_panda_two_periods_late(panda: amj.Plant) -> 
     assert out["of"] < 0.12 * out["pd"]
 
 
-def test_coupled_is_a_rule_option_of_a_case_name_only(panda: amj.Plant) -> None:
+def test_coupled_is_a_rule_option_of_a_case_name_on_an_arm(panda: amj.Plant) -> None:
     ctrl = adaptimp.Controller("sf", "robot", n=7)
-    with pytest.raises(TypeError, match="apply to a case name only"):
+    with pytest.raises(TypeError, match=r"^coupled= is an option of the rule that builds"):
         amj.simulate(ctrl, panda, T=0.01, coupled=True)
+    with pytest.raises(ValueError, match=r"^coupled= shapes the rule's gains on an arm"):
+        amj.simulate("sf", "two_link", T=0.01, coupled=True)
+    # A flag: "false" is not taken for True.
+    with pytest.raises(TypeError, match=r"^coupled must be True or False, got str$"):
+        amj.simulate("sf", panda, T=0.01, coupled="false")
+    with pytest.raises(TypeError, match=r"^coupled must be True or False, got int$"):
+        adaptimp.tuning.suggest(panda, panda.q, panda.tau_max, coupled=1)
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        (True, r"^inertia_matrix must be an \(2, 2\) array of real numbers \(kg m²\), got bool$"),
+        ([["1", "0"], ["0", "1"]], r"got list of dtype <U1$"),
+        (np.eye(2, dtype=bool), r"got ndarray of dtype bool$"),
+        (np.eye(2) * (1 + 1j), r"got ndarray of dtype complex128$"),
+    ],
+)
+def test_the_keyword_takes_real_numbers_only(value: object, message: str) -> None:
+    with pytest.raises(TypeError, match=message):
+        adaptimp.Controller("sf", "robot", inertia_matrix=value)

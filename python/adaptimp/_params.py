@@ -246,18 +246,37 @@ def _choice(p: Param, value: object) -> str:
 
 def _matrix(p: Param, value: object, n: int) -> list[float]:
     """An n × n matrix, given (n, n) or as n² values row-major: n² finite
-    floats, row-major (symmetry is the core's check)."""
+    floats, row-major (symmetry is the core's check). Booleans, strings and
+    complex numbers are refused, as for the other kinds."""
+    what = (
+        f"{p.name} must be an ({n}, {n}) array of real numbers{_unit(p)}, got {_type_name(value)}"
+    )
+    if isinstance(value, (str, bytes, bool)):
+        raise TypeError(what)
     try:
-        a = np.asarray(value, dtype=np.float64)
+        a = np.asarray(value)
+        if a.dtype == object:
+            a = np.asarray(value, dtype=np.float64)
+    except OverflowError:
+        raise ConfigError(f"{p.name} holds a number too large for a float") from None
     except (TypeError, ValueError):
-        raise TypeError(
-            f"{p.name} must be an ({n}, {n}) array of numbers, got {_type_name(value)}"
-        ) from None
+        raise TypeError(what) from None
+    if a.dtype.kind not in "iuf":
+        raise TypeError(what + (f" of dtype {a.dtype}" if a.ndim else ""))
+    a = a.astype(np.float64)
     if a.shape not in ((n, n), (n * n,)):
         raise ConfigError(f"{p.name} must have shape ({n}, {n}), got {a.shape}")
     if not np.all(np.isfinite(a)):
         raise ConfigError(f"{p.name} must be finite, got {a.tolist()}")
     return [float(x) for x in a.reshape(-1)]
+
+
+def flag(name: str, value: object) -> bool:
+    """``value`` of the option ``name`` if it is ``True`` or ``False``; else
+    ``TypeError`` naming it (a string such as "false" is not taken for True)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{name} must be True or False, got {_type_name(value)}")
 
 
 def validate(name: str, value: object, n: int = N_JOINTS) -> Any:

@@ -32,7 +32,7 @@ from ._loops import (
     tabulate,
 )
 from ._mujoco_result import MujocoResult
-from ._params import loop_delay
+from ._params import flag, loop_delay
 from ._plant import Plant, uses_rule
 from ._plant_models import ModelSource, with_payload
 from ._pose import task_space
@@ -467,11 +467,21 @@ def _setup(
     params = dict(params)
     delay = loop_delay(params)
     # SPEC (18.12): a rule option of a case name, not a parameter.
-    coupled = bool(params.pop("coupled", False)) if isinstance(controller, str) else False
+    coupled = flag("coupled", params.pop("coupled")) if "coupled" in params else False
+    if coupled and not isinstance(controller, str):
+        raise TypeError(
+            "coupled= is an option of the rule that builds a case name's controller: "
+            "build your controller with it (tuning.suggest(coupled=True))"
+        )
     disturb = {k: params.pop(k) for k in DISTURBANCES if k in params}
     if home is not None and not (isinstance(controller, str) and uses_rule(nominal)):
         raise ValueError(
             "home= sets the default task of a case name on an arm (not the paper's two_link)"
+        )
+    if coupled and not uses_rule(nominal):
+        raise ValueError(
+            "coupled= shapes the rule's gains on an arm: the paper's two_link runs the paper's "
+            "controller, not the rule's"
         )
     if isinstance(controller, str):
         kwargs = dict(params)

@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _adaptimp
 from ._errors import ConfigError
 from ._inputs import positive, reals
-from ._params import loop_delay
+from ._params import flag, loop_delay
 
 FloatArray = NDArray[np.float64]
 Path = Callable[[float], tuple[ArrayLike, ArrayLike, ArrayLike]]
@@ -288,7 +288,7 @@ def suggest(
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
         critical=critical, damping=b_arr, orbit=orbit, delay=loop_delay({'delay': delay}),
-        weightless=light, coupled=bool(coupled),
+        weightless=light, coupled=flag("coupled", coupled),
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

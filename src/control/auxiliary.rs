@@ -136,6 +136,35 @@ impl<const N: usize> Auxiliary<N> {
                 / (1.0 + ts * (self.kzeta[i] + beta));
         }
     }
+    /// [`advance`](Self::advance) with the scales as the matrix Dₛ (kg m²) of
+    /// SPEC (18.12), `inv` = Dₛ⁻¹: β = (|z2ᵀΔτ| + ΔτᵀDₛ⁻¹Δτ/(2ρ))/(ζᵀDₛζ)
+    /// and the input Dₛ⁻¹Δτ, per component as there.
+    #[inline]
+    pub fn advance_coupled(
+        &self,
+        zeta: &mut Vector<N>,
+        z2: &Vector<N>,
+        dtau: &Vector<N>,
+        ts: f64,
+        inertia: &crate::types::Matrix<N>,
+        inv: &crate::types::Matrix<N>,
+    ) {
+        let n2 = zeta.norm_squared();
+        let energy = zeta.dot(&(inertia * *zeta));
+        let input = inv * dtau;
+        let beta = if self.law == AuxLaw::Linear {
+            0.0
+        } else if n2 >= self.mu * self.mu && energy > 0.0 {
+            (z2.dot(dtau).abs() + input.dot(dtau) * self.half_inv_rho) / energy
+        } else if self.law == AuxLaw::Printed {
+            return;
+        } else {
+            0.0
+        };
+        for i in 0..N {
+            zeta[i] = (zeta[i] + ts * input[i]) / (1.0 + ts * (self.kzeta[i] + beta));
+        }
+    }
 }
 
 #[cfg(test)]

@@ -494,7 +494,17 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         cmd: &Command<N>,
     ) {
         let ts = self.cfg.ts;
-        self.aux.advance(&mut st.zeta, &e.z2, &cmd.dtau, ts);
+        match &self.coupling {
+            Some(k) => self.aux.advance_coupled(
+                &mut st.zeta,
+                &e.z2,
+                &cmd.dtau,
+                ts,
+                k.inertia(),
+                k.inertia_inv(),
+            ),
+            None => self.aux.advance(&mut st.zeta, &e.z2, &cmd.dtau, ts),
+        }
         if self.cfg.law == Law::OutputFeedback {
             self.obs.finish(&mut staged.observer, &m.x);
         }

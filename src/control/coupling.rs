@@ -10,7 +10,6 @@
 const MIN_SCALE: f64 = 1e-9;
 
 use crate::control::config::{Conditions, Config};
-use crate::control::tuning::largest_eigenvalue;
 use crate::error::{check, Error, PARAM_BOUND};
 use crate::types::{Matrix, Vector};
 
@@ -147,4 +146,21 @@ pub(crate) fn inertia_times<const N: usize>(
         Some(c) => c.inertia * v,
         None => cfg.inertia.component_mul(v),
     }
+}
+
+/// An upper bound on the largest eigenvalue of a symmetric positive definite
+/// `m`, within 1 % of it: λmax ≤ (tr m^(2^k))^(2^−k) ≤ N^(2^−k) λmax, k = 8
+/// (repeated squaring, each power scaled to unit trace).
+pub fn largest_eigenvalue<const N: usize>(m: &Matrix<N>) -> f64 {
+    const K: i32 = 8;
+    let t = m.trace();
+    let mut a = m / t;
+    let mut log_c = libm::log(t);
+    for _ in 0..K {
+        let sq = a * a;
+        let t = sq.trace();
+        a = sq / t;
+        log_c = 2.0 * log_c + libm::log(t);
+    }
+    libm::exp(log_c / f64::from(1 << K))
 }

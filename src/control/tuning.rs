@@ -278,22 +278,7 @@ pub fn damped_scales<const N: usize>(
     Ok(out)
 }
 
-/// An upper bound on the largest eigenvalue of a symmetric positive definite
-/// `m`, within 1 % of it: λmax ≤ (tr m^(2^k))^(2^−k) ≤ N^(2^−k) λmax, k = 8
-/// (repeated squaring, each power scaled to unit trace).
-pub fn largest_eigenvalue<const N: usize>(m: &Matrix<N>) -> f64 {
-    const K: i32 = 8;
-    let t = m.trace();
-    let mut a = m / t;
-    let mut log_c = libm::log(t);
-    for _ in 0..K {
-        let sq = a * a;
-        let t = sq.trace();
-        a = sq / t;
-        log_c = 2.0 * log_c + libm::log(t);
-    }
-    libm::exp(log_c / f64::from(1 << K))
-}
+pub use crate::control::coupling::largest_eigenvalue;
 
 impl Rule {
     /// The rule with its tube widened to hold the sag of the arm under the

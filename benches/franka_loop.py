@@ -59,10 +59,12 @@ def one(args: argparse.Namespace, case: str, task: str, load: float) -> dict[str
     hook = stretch if args.stretch else None
     if args.ip:
         res = franka.run(case, args.urdf, args.ip, T=args.T, task=task, start=franka.READY,
-                         on_cycle=hook)  # fmt: skip
+                         on_cycle=hook, coupled=args.coupled)  # fmt: skip
     else:
         with franka.Simulator(q0=franka.READY, load=load) as sim:
-            res = franka.run(case, args.urdf, sim.ip, T=args.T, task=task, on_cycle=hook)
+            res = franka.run(
+                case, args.urdf, sim.ip, T=args.T, task=task, on_cycle=hook, coupled=args.coupled
+            )
     m, p = res.metrics, res.params
     gaps = np.round(np.diff(res.t) / franka.PERIOD).astype(int)
     return {
@@ -150,6 +152,9 @@ def main() -> None:
         "--load", type=float, help="also runs with a load on the hand: this share of the arm's mass"
     )
     parser.add_argument("--stretch", action="store_true", help="1 %% of the cycles 2–3 ms")
+    parser.add_argument(
+        "--coupled", action="store_true", help="the rule's inertia-shaped gains, SPEC (18.12)"
+    )
     parser.add_argument("--simulate", action="store_true", help="also the library's own loop")
     parser.add_argument("--ip", help="a robot's address instead of a simulator (it moves!)")
     parser.add_argument("--urdf", help="the arm's URDF (default: franky-sim's FR3)")

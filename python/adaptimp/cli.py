@@ -216,8 +216,8 @@ def cmd_simulate(args: argparse.Namespace, params: dict[str, Any]) -> int:
         _figure_format(args.plot)
     if args.model is None:
         mujoco_only = [
-            f"--{k}" for k in ("tip", "fix", "task", "payload", "home", "gravity")
-            if getattr(args, k) not in (None, "", "joint")
+            f"--{k}" for k in ("tip", "fix", "task", "payload", "home", "gravity", "coupled")
+            if getattr(args, k) not in (None, "", "joint", False)
         ]  # fmt: skip
         if mujoco_only:
             verb = "applies" if len(mujoco_only) == 1 else "apply"
@@ -303,6 +303,8 @@ def _run_model(args: argparse.Namespace, params: dict[str, Any]) -> tuple[Any, f
     where: dict[str, Any] = {"tip": args.tip, "fix": _fix(args.fix)}
     scenario = args.scenario or "robot"
     extra: dict[str, Any] = {"gravity": args.gravity, "payload": args.payload or 0.0}
+    if args.coupled:
+        extra["coupled"] = True
     try:
         if args.task == "cartesian":
             plant = amj.Plant(args.model, **where)
@@ -520,6 +522,12 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="with --model: feed the nominal model's gravity forward, SPEC (20.10) (for a "
         "robot that does not compensate it)",
+    )
+    sim.add_argument(
+        "--coupled",
+        action="store_true",
+        help="with --model: the rule's inertia-shaped gains, SPEC (18.12) (for a loop with "
+        "delay, --delay 1 or 2)",
     )
     sim.add_argument("--plot", metavar="FILE", help="write a figure (PNG, PDF, SVG, …)")
     sim.add_argument(

@@ -309,9 +309,7 @@ def validate(name: str, value: object, n: int = N_JOINTS) -> Any:
     if p.kind == "matrix":
         return None if value is None else _matrix(p, value, n)
     if p.kind == "flag":
-        if isinstance(value, (bool, np.bool_)):
-            return bool(value)
-        raise TypeError(f"{p.name} must be True or False, got {_type_name(value)}")
+        return flag(p.name, value)
     if p.kind == "bound":
         if value is None or (isinstance(value, str) and value == "auto"):
             return value

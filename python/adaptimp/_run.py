@@ -572,20 +572,20 @@ def _controller_delay(ctrl: Any) -> int | None:
     """The loop's delay (periods) ``ctrl`` was made for, SPEC (18.11): an
     ``adaptimp.Controller``'s ``delay``, a Cartesian controller's joint
     controller's; None for a controller that does not say."""
-    for c in (ctrl, getattr(ctrl, "inner", None)):
-        params = getattr(c, "params", None)
-        if isinstance(params, Mapping) and isinstance(params.get("delay"), int):
-            return int(params["delay"])
-    return None
+    delay = _controller_param(ctrl, "delay", int)
+    return None if delay is None else int(delay)
 
 
-def _controller_param(ctrl: Any, name: str) -> Any:
+def _controller_param(ctrl: Any, name: str, kind: type = object) -> Any:
     """Parameter ``name`` of ``ctrl`` (an ``adaptimp.Controller``) or of a
-    Cartesian controller's joint controller; None for one that does not say."""
+    Cartesian controller's joint controller, the first that is a ``kind``;
+    None for one that does not say."""
     for c in (ctrl, getattr(ctrl, "inner", None)):
         params = getattr(c, "params", None)
-        if isinstance(params, Mapping) and params.get(name) is not None:
-            return params[name]
+        if isinstance(params, Mapping):
+            value = params.get(name)
+            if value is not None and isinstance(value, kind):
+                return value
     return None
 
 

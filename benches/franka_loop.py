@@ -153,7 +153,11 @@ def main() -> None:
     )
     parser.add_argument("--stretch", action="store_true", help="1 %% of the cycles 2–3 ms")
     parser.add_argument(
-        "--coupled", action="store_true", help="the rule's inertia-shaped gains, SPEC (18.12)"
+        "--coupled",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the rule's inertia-shaped gains, SPEC (18.12) (the joint task's default, "
+        "libfranka's loop having a delay); --no-coupled: the diagonal gains of (18.1)",
     )
     parser.add_argument("--simulate", action="store_true", help="also the library's own loop")
     parser.add_argument("--ip", help="a robot's address instead of a simulator (it moves!)")

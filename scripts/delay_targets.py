@@ -4,7 +4,7 @@ torque acting d periods after its sample, the controllers made by the rule for
 that delay, nothing set per arm.
 
     python scripts/delay_targets.py FILE [FILE ...] [--delays 0,1,2] [--T 8]
-                                    [--cartesian] [--coupled] [--tip NAME]
+                                    [--cartesian] [--[no-]coupled] [--tip NAME]
                                     [--json out.json]
 
 For each file and delay d: ``amj.simulate(case, FILE, T=T, delay=d)`` for PD,
@@ -13,8 +13,11 @@ last 2 s against [2, 4) s), the peak commanded |τ_i|/τmax_i after 0.1 s and
 the share of rows at a limit; with ``--cartesian`` also ``amj.cartesian_task``
 and SF/PD in position and orientation over t ≥ 2 s (T = 12 s). Prints one
 Markdown table per part; the targets of the issue are SF/PD and OF/PD ≤ 0.2,
-no drift, peak ≤ 2 τmax. ``--coupled``: every controller (PD too) made by the
-rule with the inertia-shaped gains of SPEC (18.12) (``coupled=True``).
+no drift, peak ≤ 2 τmax. Every controller (PD too) is made by the rule with
+its default: the inertia-shaped gains of SPEC (18.12) on the joint task for
+d ≥ 1, the diagonal gains of (18.1) for d = 0 and on the Cartesian task;
+``--coupled`` / ``--no-coupled``: the one or the other everywhere
+(``coupled=True`` / ``False``).
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ import numpy as np
 
 
 def joint_row(
-    path: str, d: int, T: float, tip: str | None, coupled: bool = False
+    path: str, d: int, T: float, tip: str | None, coupled: bool | None = None
 ) -> dict[str, Any]:
     """PD, SF, OF of the default joint task at delay ``d``."""
     from adaptimp import mujoco as amj
@@ -63,7 +66,9 @@ def joint_row(
     }
 
 
-def cartesian_row(path: str, d: int, tip: str | None, coupled: bool = False) -> dict[str, Any]:
+def cartesian_row(
+    path: str, d: int, tip: str | None, coupled: bool | None = None
+) -> dict[str, Any]:
     """PD and SF of the default Cartesian task at delay ``d`` (T = 12 s)."""
     from adaptimp import mujoco as amj
 
@@ -95,7 +100,11 @@ def main() -> None:
     parser.add_argument("--T", type=float, default=8.0, help="joint runs' duration (s)")
     parser.add_argument("--cartesian", action="store_true", help="also the Cartesian task")
     parser.add_argument(
-        "--coupled", action="store_true", help="the inertia-shaped gains of SPEC (18.12)"
+        "--coupled",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the inertia-shaped gains of SPEC (18.12) (the rule's default: joint task, d ≥ 1); "
+        "--no-coupled: the diagonal gains of (18.1) at every d; --coupled: at every d",
     )
     parser.add_argument("--tip", default=None, help="the end effector, for every file")
     parser.add_argument("--json", type=Path, default=None, help="write the numbers")

@@ -172,11 +172,25 @@ fn the_rule_takes_the_harmonic_mean_and_sizes_the_margin_at_its_modes() {
         .collect();
     let tau = [50.0, 50.0];
     let mut t = dy::Tuning::new(Law::StateFeedback, dy::Inertia::Along(&flat), &tau, 1e-3);
+    // By default the rule shapes the gains for a loop with a delay, and
+    // keeps the diagonal scales without one (SPEC (18.12)).
+    assert!(!t.coupled());
+    let undelayed = t.suggest().unwrap();
+    assert_eq!(undelayed.controller().unwrap().inertia_matrix(), None);
     t.delay = 2;
+    assert!(t.coupled());
+    // Not on a Cartesian task's orbit (the rule of (16.10)).
+    t.resolve = true;
+    assert!(!t.coupled());
+    t.resolve = false;
+    let coupled = t.suggest().unwrap();
+    t.coupled = Some(false);
     let diagonal = t.suggest().unwrap();
     assert_eq!(diagonal.controller().unwrap().inertia_matrix(), None);
-    t.coupled = true;
-    let coupled = t.suggest().unwrap();
+    t.delay = 0;
+    t.coupled = Some(true);
+    let asked = t.suggest().unwrap();
+    assert!(asked.controller().unwrap().inertia_matrix().is_some());
     let got = coupled.controller().unwrap().inertia_matrix().unwrap();
     // (mean D⁻¹)⁻¹, computed here independently.
     let mean = ds

@@ -1192,6 +1192,10 @@ fn rule<const N: usize>() {
     {
         let ts = 1e-3;
         let mut t = dy::Tuning::new(law, dy::Inertia::At(&at), &tau, ts);
+        // The const-generic rule is the diagonal one of (18.1)–(18.11); the
+        // shaping of (18.12), the run-time rule's default with a delay, is
+        // tested in tests/coupling.rs.
+        t.coupled = Some(false);
         if case >= 1 {
             t.delay = case;
             t.path = Some(dy::TaskPath {

@@ -191,12 +191,14 @@ def test_table_runs_an_arm_at_a_home_given(tmp_path: Path) -> None:
 
 
 def test_simulate_takes_the_rules_inertia_shaped_gains() -> None:
-    """``--coupled`` is simulate's ``coupled=True`` (SPEC (18.12)): two periods
-    late, PD with the coupled gains holds the servo arm far closer than the
-    diagonal rule's PD (docs/your_arm.md: 0.018 against 0.123 rad, T = 8 s)."""
+    """The rule's inertia-shaped gains (SPEC (18.12)) are simulate's default
+    with a delay, ``--no-coupled`` is ``coupled=False``: two periods late, PD
+    with the coupled gains holds the servo arm far closer than the diagonal
+    rule's PD (docs/your_arm.md: 0.018 against 0.123 rad, T = 8 s)."""
     rms = {}
-    for flag in ((), ("--coupled",)):
+    for flag in ((), ("--coupled",), ("--no-coupled",)):
         proc = run("simulate", "--model", HOBBY, "--case", "pd", "--T", "4", "--delay", "2",
                    *flag, "--json")  # fmt: skip
-        rms[bool(flag)] = json.loads(proc.stdout)["rms_z1_after2"]
-    assert rms[True] < 0.5 * rms[False]
+        rms[flag] = json.loads(proc.stdout)["rms_z1_after2"]
+    assert rms[()] == rms[("--coupled",)]
+    assert rms[()] < 0.5 * rms[("--no-coupled",)]

@@ -35,9 +35,14 @@ def panda() -> amj.Plant:
 
 def test_the_rule_shapes_the_gains_by_the_paths_inertia(panda: amj.Plant) -> None:
     task = amj.default_task(panda)
-    diagonal = amj.rule_keywords(panda, task, delay=2)
-    coupled = amj.rule_keywords(panda, task, delay=2, coupled=True)
+    diagonal = amj.rule_keywords(panda, task, delay=2, coupled=False)
+    coupled = amj.rule_keywords(panda, task, delay=2)
     assert "inertia_matrix" not in diagonal
+    # The default for a loop with a delay; without one, the diagonal rule's
+    # unless asked (SPEC (18.12)).
+    assert "inertia_matrix" not in amj.rule_keywords(panda, task)
+    asked = amj.rule_keywords(panda, task, coupled=True)
+    np.testing.assert_array_equal(asked["inertia_matrix"], coupled["inertia_matrix"])
     m = np.asarray(coupled["inertia_matrix"]).reshape(7, 7)
     np.testing.assert_array_equal(m, m.T)
     assert np.linalg.eigvalsh(m).min() > 0.0
@@ -53,13 +58,14 @@ def test_the_coupled_rule_holds_the_panda_two_periods_late(panda: amj.Plant) -> 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", adaptimp.PlantWarning)
         for case in ("pd", "sf", "of"):
-            res = amj.simulate(case, panda, T=8.0, delay=2, coupled=True)
+            res = amj.simulate(case, panda, T=8.0, delay=2)
             out[case] = float(res.metrics["rms_z1_after2"])
             assert res.params["inertia_matrix"] is not None
-        diagonal = float(amj.simulate("pd", panda, T=8.0, delay=2).metrics["rms_z1_after2"])
+        diagonal = amj.simulate("pd", panda, T=8.0, delay=2, coupled=False)
+        assert diagonal.params.get("inertia_matrix") is None
     # Measured: PD 0.0379 rad diagonal, 0.0088 coupled; SF/PD and OF/PD 0.076
     # (docs/your_arm.md, "Inertia-shaped gains").
-    assert out["pd"] < 0.3 * diagonal
+    assert out["pd"] < 0.3 * float(diagonal.metrics["rms_z1_after2"])
     assert out["sf"] < 0.12 * out["pd"]
     assert out["of"] < 0.12 * out["pd"]
 
@@ -89,3 +95,16 @@ def test_coupled_is_a_rule_option_of_a_case_name_on_an_arm(panda: amj.Plant) -> 
 def test_the_keyword_takes_real_numbers_only(value: object, message: str) -> None:
     with pytest.raises(TypeError, match=message):
         adaptimp.Controller("sf", "robot", inertia_matrix=value)
+
+
+def test_the_cartesian_task_keeps_the_diagonal_gains_unless_asked() -> None:
+    """SPEC (18.12): on a Cartesian task's orbit the rule's default is the
+    diagonal gains at any delay; ``coupled=True`` asks for the shaped ones
+    (docs/your_arm.md's block, on the Panda)."""
+    plant = amj.Plant(adaptimp._models.panda_urdf_path(), contact=False)
+    task = amj.cartesian_task(plant)
+    default = amj.simulate("sf", plant, T=0.05, task=task, delay=2)
+    asked = amj.simulate("sf", plant, T=0.05, task=task, delay=2, coupled=True)
+    assert default.params.get("inertia_matrix") is None
+    m = np.asarray(asked.params["inertia_matrix"]).reshape(7, 7)
+    np.testing.assert_array_equal(m, m.T)

@@ -59,7 +59,7 @@ def test_the_rule_without_delay_is_the_rule_as_it_was() -> None:
     assert same.keys() == zero.keys()
     for key, value in same.items():
         np.testing.assert_array_equal(np.asarray(value), np.asarray(zero[key]), err_msg=key)
-    late = amj.rule_keywords(plant, task, delay=1)
+    late = amj.rule_keywords(plant, task, delay=1, coupled=False)
     assert (zero["delay"], late["delay"]) == (0, 1)
     # (18.11): every gain of the velocity loop by one factor f < 1, K1 with it
     # (the position loop 5× inside), the robust term off.

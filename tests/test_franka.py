@@ -67,12 +67,18 @@ def test_the_controller_is_the_rule_a_simulate_user_gets() -> None:
     c = franka.setup("sf", plant, READY, task="cartesian")
     ctask = amj.cartesian_task(plant, q0=READY)
     assert c.controller.params == ctask.controller("sf", plant, delay=franka.DELAY, **limits).params
+    # The Cartesian task's orbit keeps the diagonal gains by default (SPEC (18.12)).
+    assert c.controller.inner.params.get("inertia_matrix") is None
     assert s.controller.params["delay"] == 1
-    assert s.controller.params["inertia_matrix"] is None
-    # SPEC (18.12): the rule's option, the same on the robot as in simulate.
-    shaped = franka.setup("sf", plant, READY, coupled=True)
-    coupled = amj.rule_keywords(plant, task, Ts=1e-3, case="sf", delay=franka.DELAY, coupled=True)
-    assert shaped.controller.params["inertia_matrix"] == coupled["inertia_matrix"]
+    # SPEC (18.12): the rule's default for libfranka's delay, the same on
+    # the robot as in simulate; coupled=False the diagonal rule's.
+    assert s.controller.params["inertia_matrix"] is not None
+    diagonal = franka.setup("sf", plant, READY, coupled=False)
+    assert diagonal.controller.params["inertia_matrix"] is None
+    kw = amj.rule_keywords(plant, task, Ts=1e-3, case="sf", delay=franka.DELAY, coupled=False)
+    kw.pop("n")
+    same = adaptimp.Controller("sf", scenario="robot", n=7, **{**kw, **limits})
+    assert diagonal.controller.params == same.params
     c = franka.setup("sf", plant, READY, task="cartesian", coupled=True)
     want = ctask.controller("sf", plant, delay=franka.DELAY, coupled=True, **limits)
     assert c.controller.params == want.params

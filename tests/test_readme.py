@@ -83,8 +83,9 @@ ELSEWHERE: dict[tuple[str, int], str] = {
     "tests/test_delay.py makes the same simulate calls on the Panda",
     ("docs/your_arm.md", 5): "on a file of the reader's (FILE): tests/test_coupling.py makes "
     "the same calls on the Panda",
-    ("docs/your_arm.md", 6): "the coupled delay tables on the same files as block 4, which "
-    "CI does not install: tests/test_coupling.py runs the Panda's joint rows",
+    ("docs/your_arm.md", 6): "the comparison tables (the joint task's diagonal gains, the "
+    "Cartesian task's shaped ones) on the same files as block 4, which CI does not install: "
+    "tests/test_coupling.py runs the Panda's joint rows both ways",
 }
 
 # Shell blocks run here as written (each line, from the checkout's root).

@@ -266,7 +266,10 @@ pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = adaptimp::tuning::NODES.1;
 /// `centers` (room for [`ADAPTIMP_SUGGEST_MAX_NODES`] × 4n reals) and their
 /// squared widths to `widths2` (4n), and `out->centers`, `out->nodes`,
 /// `out->widths2` point at them. `gravity` (n, N m, G at the path's start)
-/// may be NULL. `adaptimp_controller_new(out, …)` then builds the
+/// may be NULL. With a delay (≥ 1) the gains are shaped by the inertia,
+/// SPEC (18.12): `out->inertia_matrix` gets `inertia` (the only sample, so
+/// Dₛ = D at the start); without one it is INFINITY first (the diagonal
+/// gains of (18.1)). `adaptimp_controller_new(out, …)` then builds the
 /// controller. `law` outside its enum is INVALID_CONFIG; a NaN or a bad
 /// value is INVALID_CONFIG naming it. On an error `*out` is left unchanged.
 ///

@@ -427,3 +427,51 @@ fn the_rule_through_the_abi_is_the_cores() {
         last_error()
     );
 }
+
+/// SPEC (18.12) through the C ABI: with a delay the rule shapes the gains by
+/// the inertia given (its only sample: Dₛ = D), without one it leaves
+/// `inertia_matrix` empty (INFINITY first), as the core's `Tuning` does.
+#[test]
+fn the_rule_through_the_abi_shapes_the_gains_with_a_delay() {
+    let d = [2.0, 0.5, 0.1, 0.5, 1.0, 0.2, 0.1, 0.2, 0.05];
+    let tau = [50.0, 20.0, 5.0];
+    let suggest = |delay: usize| {
+        let mut p = defaults(3, AdaptimpLaw::Pd, AdaptimpPreset::Robot);
+        // SAFETY: valid pointers with the documented lengths; no path.
+        let s = unsafe {
+            adaptimp_params_suggest(
+                &mut p,
+                3,
+                AdaptimpLaw::Pd.into(),
+                d.as_ptr(),
+                tau.as_ptr(),
+                1e-3,
+                delay,
+                ptr::null(),
+                0,
+                0.0,
+                ptr::null(),
+                ptr::null_mut(),
+                ptr::null_mut(),
+            )
+        };
+        assert_eq!(s, AdaptimpStatus::Ok, "{}", last_error());
+        p
+    };
+    assert_eq!(suggest(0).inertia_matrix[0], f64::INFINITY);
+    let p = suggest(1);
+    for (got, want) in p.inertia_matrix[..9].iter().zip(d) {
+        assert!(
+            (got - want).abs() <= 1e-12 * want,
+            "{:?}",
+            &p.inertia_matrix[..9]
+        );
+    }
+    // The rate Kp/d is the same on every joint (SPEC (18.12)), and the
+    // controller builds from what the ABI filled.
+    let rate = p.kp[0] / p.inertia[0];
+    for i in 1..3 {
+        assert!((p.kp[i] / p.inertia[i] - rate).abs() <= 1e-12 * rate);
+    }
+    Handles::new(&p).expect("the shaped rule builds through the ABI");
+}

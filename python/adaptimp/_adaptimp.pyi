@@ -747,7 +747,7 @@ def suggest(
     orbit: NDArray[np.float64] | None = None,
     delay: int = 0,
     weightless: bool = False,
-    coupled: bool = False,
+    coupled: bool | None = None,
 ) -> dict[str, Any]:
     """The gain and basis rule of SPEC §18 for ``inertia`` (n, n), or (K, n, n)
     samples along the path (SPEC (18.1)'s scales along it): "params" (every
@@ -758,7 +758,8 @@ def suggest(
     SPEC (18.9); ``orbit`` (K', n): one period of the joint positions that repeat,
     the widths in q at least its diameter, SPEC (19.11); ``weightless``: D̂ and Ĉ
     learning at Ĝ's bandwidth, an arm without gravity, SPEC (22.2); ``coupled``: the
-    inertia-shaped gains of SPEC (18.12) (the keyword ``inertia_matrix``)."""
+    inertia-shaped gains of SPEC (18.12) (the keyword ``inertia_matrix``; None:
+    the core's default, on for a delay ≥ 1 unless ``resolve``)."""
 
 def pose_circle(
     p0: NDArray[np.float64],

@@ -122,7 +122,7 @@ def _rule_setup(
     T: float,
     home: ArrayLike | None = None,
     delay: int = 0,
-    coupled: bool = False,
+    coupled: bool | None = None,
 ) -> tuple[Task | None, Any, dict[str, Any]]:
     """The task and the rule's keywords for a case name on ``plant`` (SPEC §18):
     the default task unless a reference or the controller's own trajectory
@@ -288,8 +288,11 @@ def simulate(
         The disturbances of SPEC §17 (:data:`DISTURBANCES`: sensor noise,
         delay, joint friction, weak actuators; the controller is told none of
         them), for any controller; and, for a case name, controller parameters
-        (``Kp``, ``gamma``, …) and ``coupled=True``: the rule's
-        inertia-shaped gains of SPEC (18.12) (:func:`adaptimp.tuning.suggest`).
+        (``Kp``, ``gamma``, …) and ``coupled``: the rule's inertia-shaped
+        gains of SPEC (18.12) (default: on the joint task with a delay,
+        ``delay`` ≥ 1; ``coupled=False``: the diagonal gains of (18.1)
+        always, ``True``: the shaped ones always; see
+        :func:`adaptimp.tuning.suggest`).
 
     Notes
     -----
@@ -466,9 +469,11 @@ def _setup(
     task: Task | None = None
     params = dict(params)
     delay = loop_delay(params)
-    # SPEC (18.12): a rule option of a case name, not a parameter.
-    coupled = flag("coupled", params.pop("coupled")) if "coupled" in params else False
-    if coupled and not isinstance(controller, str):
+    # SPEC (18.12): a rule option of a case name, not a parameter; the rule's
+    # default (None) shapes the gains for a loop with a delay.
+    asked = params.pop("coupled", None)
+    asked = None if asked is None else flag("coupled", asked)
+    if asked and not isinstance(controller, str):
         raise TypeError(
             "coupled= is an option of the rule that builds a case name's controller: "
             "build your controller with it (tuning.suggest(coupled=True))"
@@ -478,7 +483,7 @@ def _setup(
         raise ValueError(
             "home= sets the default task of a case name on an arm (not the paper's two_link)"
         )
-    if coupled and not uses_rule(nominal):
+    if asked and not uses_rule(nominal):
         raise ValueError(
             "coupled= shapes the rule's gains on an arm: the paper's two_link runs the paper's "
             "controller, not the rule's"
@@ -488,7 +493,7 @@ def _setup(
         if uses_rule(nominal):
             task, reference, rule = _rule_setup(
                 nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
-                float(defaults["T"]) if T is None else float(T), home, delay, coupled,
+                float(defaults["T"]) if T is None else float(T), home, delay, asked,
             )  # fmt: skip
             kwargs = {**rule, **kwargs}
             if q0 is None and task is not None:

@@ -181,13 +181,14 @@ def rule_keywords(
     Ts: float = 1e-3,
     case: str = "sf",
     delay: int = 0,
-    coupled: bool = False,
+    coupled: bool | None = None,
 ) -> dict[str, Any]:
     """The rule's controller keywords for ``plant`` on ``task`` (default
     :func:`default_task`) at period ``Ts`` (s) for a loop of ``delay``
     periods, SPEC §18 (:func:`adaptimp.tuning.suggest` with D at the task's
     home, the plant's τmax and the task's path; (18.11) for the delay;
-    ``coupled``: the inertia-shaped gains of (18.12)), with
+    ``coupled``: the inertia-shaped gains of (18.12), by default for a
+    ``delay`` ≥ 1 on the joint task), with
     ``impedance="external"`` (in free space the controller tracks the
     reference as given). The plant's own model: give it the nominal plant (no
     payload)."""

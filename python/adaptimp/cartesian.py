@@ -269,7 +269,7 @@ class CartesianController:
         span: float | None = None,
         Ts: float = 1e-3,
         delay: int = 0,
-        coupled: bool = False,
+        coupled: bool | None = None,
         **params: Any,
     ) -> CartesianController:
         """The Cartesian controller of a case name built by the core's rule
@@ -318,9 +318,11 @@ class CartesianController:
         delay : int
             The loop's delay (periods) the rule sizes the joint gains for,
             SPEC (18.11) (libfranka: 1); the joint controller's ``delay``.
-        coupled : bool
+        coupled : bool or None
             The joint controller's inertia-shaped gains, SPEC (18.12)
-            (:func:`adaptimp.tuning.suggest`'s ``coupled``).
+            (:func:`adaptimp.tuning.suggest`'s ``coupled``; default: the
+            diagonal gains of (18.1), which hold a Cartesian task better at
+            every delay measured; True: the shaped ones).
         **params
             Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
             and the joint controller's, e.g. ``gamma``). ``gravity="model"``:

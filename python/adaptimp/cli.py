@@ -303,8 +303,8 @@ def _run_model(args: argparse.Namespace, params: dict[str, Any]) -> tuple[Any, f
     where: dict[str, Any] = {"tip": args.tip, "fix": _fix(args.fix)}
     scenario = args.scenario or "robot"
     extra: dict[str, Any] = {"gravity": args.gravity, "payload": args.payload or 0.0}
-    if args.coupled:
-        extra["coupled"] = True
+    if args.coupled is not None:
+        extra["coupled"] = args.coupled
     try:
         if args.task == "cartesian":
             plant = amj.Plant(args.model, **where)
@@ -525,9 +525,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sim.add_argument(
         "--coupled",
-        action="store_true",
-        help="with --model: the rule's inertia-shaped gains, SPEC (18.12) (for a loop with "
-        "delay, --delay 1 or 2)",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="with --model: the rule's inertia-shaped gains, SPEC (18.12) (the joint task's "
+        "default with --delay 1 or 2); --no-coupled: the diagonal gains of (18.1)",
     )
     sim.add_argument("--plot", metavar="FILE", help="write a figure (PNG, PDF, SVG, …)")
     sim.add_argument(

@@ -137,7 +137,7 @@ def setup(
     home: ArrayLike | None = None,
     blend: float = BLEND,
     tip: str | None = None,
-    coupled: bool = False,
+    coupled: bool | None = None,
     **params: Any,
 ) -> Setup:
     """The controller and task :func:`run` drives for an arm standing at ``q``
@@ -161,7 +161,10 @@ def setup(
     limits (:data:`TAU_MAX`, at most the URDF's effort) and libfranka's
     torque rate (``tau_rate_max`` = :data:`TORQUE_RATE` × 1 ms); ``params``
     replace the rule's keywords. ``coupled``: the rule's inertia-shaped gains,
-    SPEC (18.12) (:func:`adaptimp.tuning.suggest`). ``gravity=`` is refused: the robot
+    SPEC (18.12) (the joint task's default, for libfranka's delay of one
+    period; False: the diagonal gains of (18.1), the Cartesian task's
+    default; see
+    :func:`adaptimp.tuning.suggest`). ``gravity=`` is refused: the robot
     compensates gravity itself (SPEC (20.10)).
     """
     if controller not in ("pd", "sf", "of"):

@@ -171,7 +171,7 @@ def suggest(
     orbit: ArrayLike | None = None,
     delay: int = 0,
     weightless: bool | None = None,
-    coupled: bool = False,
+    coupled: bool | None = None,
 ) -> dict[str, Any]:
     """Controller keywords for an arm from its inertia (at ``q0`` (rad), or along
     the task's joint path if given: :data:`INERTIA_SAMPLES` postures of it), its
@@ -225,14 +225,16 @@ def suggest(
         or an arm in a horizontal plane): D̂ and Ĉ learn at Ĝ's bandwidth,
         SPEC (22.2). Default: whether the model has no gravity at all
         (:func:`is_weightless`).
-    coupled : bool
+    coupled : bool or None
         The inertia-shaped gains of SPEC (18.12): Dₛ (kg m²) the harmonic
         mean of D along the path, (mean D⁻¹)⁻¹ (D(q0) without one), in place
         of the diagonal scales in Kp, the z1 term and the learning error, and
         the margin of (18.11) at the largest mode of Dₛ^½ D⁻¹ Dₛ^½: the
         delayed loop's modes stay together where the diagonal's spread (the
-        keyword ``inertia_matrix``, n × n values row-major). Default False:
-        the diagonal rule.
+        keyword ``inertia_matrix``, n × n values row-major). Default None:
+        for a loop with a delay (``delay`` ≥ 1), where (18.11)'s margin
+        bounds the gains, unless ``resolve`` (a Cartesian task's orbit);
+        False: the diagonal rule of (18.1), per-joint gains.
 
     Returns
     -------
@@ -288,7 +290,7 @@ def suggest(
     out = _adaptimp.suggest(
         case, np.ascontiguousarray(d), tau, float(Ts), rows, period, g, resolve=resolve,
         critical=critical, damping=b_arr, orbit=orbit, delay=loop_delay({'delay': delay}),
-        weightless=light, coupled=flag("coupled", coupled),
+        weightless=light, coupled=None if coupled is None else flag("coupled", coupled),
     )  # fmt: skip
     kw: dict[str, Any] = {"n": n}
     kw.update({k: out["params"][k] for k in RULE_KEYS})

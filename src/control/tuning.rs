@@ -124,7 +124,10 @@ pub const NODES: (usize, usize) = (16, 256);
 /// Samples of one period of a [`Trajectory`] the alloc conveniences take.
 pub const PATH_SAMPLES: usize = 1000;
 
-/// The constants of the rule, SPEC §18 ([`Rule::default`] is the SPEC's).
+/// The constants of the rule, SPEC §18 ([`Rule::default`] is the SPEC's):
+/// the diagonal gains of (18.1)–(18.11). The inertia-shaped gains of (18.12),
+/// the default of the run-time rule for a joint task with a delay, are
+/// `dynamic::Tuning`'s.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Rule {
     /// m of Kp_i = m d_i/Ts: each joint's sampled velocity loop keeps its

@@ -83,7 +83,11 @@ pub struct Tuning<'a> {
     /// The inertia-shaped gains of SPEC (18.12): Dₛ the harmonic mean of D
     /// along the path (the parameter `inertia_matrix`),
     /// the margin of (18.11) at the largest mode of Dₛ^½ D⁻¹ Dₛ^½.
-    pub coupled: bool,
+    /// `None` (the default): on for a loop with a delay (δ ≥ 1), where
+    /// (18.11)'s margin bounds the gain, but not on a Cartesian task's orbit
+    /// (`resolve`), where the diagonal's tables hold better (SPEC (18.12));
+    /// off, the diagonal scales of (18.1).
+    pub coupled: Option<bool>,
 }
 
 impl<'a> Tuning<'a> {
@@ -103,8 +107,14 @@ impl<'a> Tuning<'a> {
             resolve: false,
             critical: false,
             weightless: false,
-            coupled: false,
+            coupled: None,
         }
+    }
+
+    /// Whether the rule shapes the gains by the inertia, SPEC (18.12):
+    /// as asked, else for a loop with a delay (δ ≥ 1) on a joint task.
+    pub fn coupled(&self) -> bool {
+        self.coupled.unwrap_or(self.delay >= 1 && !self.resolve)
     }
 
     /// The robot scenario's parameters for `law` with the rule's gains and
@@ -182,7 +192,7 @@ fn typed<const N: usize>(
     }?;
     // SPEC (18.11): the margin at the largest mode of the undamped scales;
     // (18.12): of the inertia-shaped scale's, when coupled.
-    let shaped = t.coupled.then(|| coupled_scale(&ds)).transpose()?;
+    let shaped = t.coupled().then(|| coupled_scale(&ds)).transpose()?;
     rule = rule.bounded(match &shaped {
         Some((_, lmax)) => *lmax,
         None => loop_bound(&ds, &scales)?,

@@ -39,9 +39,10 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// `weightless`: the arm bears no gravity the controller must hold (a robot
 /// that compensates it itself): D̂ and Ĉ learn at Ĝ's bandwidth, SPEC (22.2).
 /// `coupled`: the inertia-shaped gains of SPEC (18.12) (the parameter
-/// `inertia_matrix`, n × n values row-major).
+/// `inertia_matrix`, n × n values row-major); None: the core's default, on
+/// for a loop with a delay (δ ≥ 1) unless `resolve`.
 #[pyfunction]
-#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0, weightless=false, coupled=false))]
+#[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0, weightless=false, coupled=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn suggest<'py>(
     py: Python<'py>,
@@ -58,7 +59,7 @@ pub fn suggest<'py>(
     orbit: Option<PyReadonlyArray2<'py, f64>>,
     delay: usize,
     weightless: bool,
-    coupled: bool,
+    coupled: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let law = law_of(case)?;
     let shape = inertia.shape();

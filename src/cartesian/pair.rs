@@ -303,6 +303,34 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
 }
 
 impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
+    /// The outer loop alone, one committed step (F_e = `wrench`): the joint
+    /// reference of t_k for a joint controller stepped elsewhere, in a
+    /// command whose joint part and τe are zero and whose measured tip is
+    /// fk(q_d). Errors as [`stage`](Self::stage), changing nothing.
+    pub fn reference(
+        &self,
+        outer: &mut CartesianState<N>,
+        target: Option<&PoseTarget>,
+        wrench: &Vector<6>,
+    ) -> Result<CartesianCommand<N>, Error> {
+        let staged = self.stage(outer, target, wrench)?;
+        let tip = self.kinematics().tip(&staged.reference.x, &Vector::zeros());
+        *outer = staged.next;
+        Ok(CartesianCommand {
+            joint: Command::zeros(),
+            reference: staged.reference,
+            commanded: staged.commanded,
+            compliant: staged.compliant,
+            target: staged.target,
+            error: staged.error,
+            p: tip.position,
+            r: tip.rotation,
+            tau_e: Vector::zeros(),
+        })
+    }
+}
+
+impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
     /// The Cartesian step with any joint controller `joint` (C5): stage the
     /// outer loop, call `joint(measurement, reference, task)` with the joint
     /// reference (q_d, q̇_d, q̈_d), τe = Jᵀ(q) F_e (zero without
@@ -409,6 +437,35 @@ mod tests {
         assert_eq!(tau, Vector::<2>::zeros());
         assert_eq!(*ist.applied(), Vector::<2>::zeros());
         assert_eq!(ist.steps(), 1);
+    }
+
+    #[test]
+    fn the_outer_loop_alone_commits_its_staged_step_with_the_tip_at_q_d() {
+        let outer =
+            CartesianImpedance::new(CartesianConfig::default(), TwoLinkArm::paper(), 1e-3).unwrap();
+        let q = Vector::<2>::new(0.5, 1.0);
+        let mut st = outer.start(q);
+        let p = outer.kinematics().fk(&q) + Vector::<3>::new(0.01, 0.0, 0.0);
+        let target = PoseTarget::at(p, nalgebra::Matrix3::identity());
+        let wrench = Vector::<6>::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let staged = outer.stage(&st, Some(&target), &wrench).unwrap();
+        let cmd = outer.reference(&mut st, Some(&target), &wrench).unwrap();
+        assert_eq!(st, staged.next);
+        assert_eq!(
+            (cmd.reference, cmd.commanded),
+            (staged.reference, staged.commanded)
+        );
+        let tip = outer
+            .kinematics()
+            .tip(&staged.reference.x, &Vector::zeros());
+        assert_eq!((cmd.p, cmd.r), (tip.position, tip.rotation));
+        assert_eq!(cmd.joint, Command::zeros());
+        assert_eq!(cmd.tau_e, Vector::<2>::zeros());
+        let before = st;
+        let nan = Vector::<6>::from_element(f64::NAN);
+        let e = outer.reference(&mut st, None, &nan).unwrap_err();
+        assert!(e.to_string().contains("wrench"), "{e}");
+        assert_eq!(st, before);
     }
 
     #[test]

@@ -10,8 +10,7 @@ use super::model::{Chain, ComputedState, ComputedTorque, Jacobian};
 use super::sized::{each, map, pair, ByJoints, Family};
 use super::values::{mismatch, vector, Command, Joints, Measurement, Setpoint};
 use crate::cartesian::{
-    self, check_joint, set_pair_posture, start_pair, CartesianConfig, CompliantPose, Kinematics,
-    PoseTarget,
+    self, check_joint, set_pair_posture, start_pair, CartesianConfig, CompliantPose, PoseTarget,
 };
 use crate::control::io;
 use crate::error::{check, Error};
@@ -263,20 +262,7 @@ impl CartesianImpedance {
         wrench: &Vector<6>,
     ) -> Result<CartesianCommand, Error> {
         pair!(&self.inner, &mut state.inner, o, s, N => {
-            let staged = o.stage(s, target, wrench)?;
-            let tip = Kinematics::tip(o.kinematics(), &staged.reference.x, &Vector::zeros());
-            *s = staged.next;
-            Ok(CartesianCommand::of(&cartesian::CartesianCommand {
-                joint: io::Command::zeros(),
-                reference: staged.reference,
-                commanded: staged.commanded,
-                compliant: staged.compliant,
-                target: staged.target,
-                error: staged.error,
-                p: tip.position,
-                r: tip.rotation,
-                tau_e: Vector::<N>::zeros(),
-            }))
+            o.reference(s, target, wrench).map(|cmd| CartesianCommand::of(&cmd))
         }, _ => Err(mismatch("state")))
     }
 

@@ -8,8 +8,8 @@ use super::computed::{Computed, DynComputed};
 use super::dynamic::{DynTracker, Hooks, RunError, Typed, MAX_JOINTS};
 use super::mujoco::MujocoSpec;
 use adaptimp::cartesian::{
-    CartesianCommand, CartesianConfig, CartesianImpedance, CartesianMeasurement, CartesianState,
-    Chain, Joint, JointKind, Kinematics, PoseTarget, Transform,
+    CartesianConfig, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, Joint,
+    JointKind, PoseTarget, Transform,
 };
 use adaptimp::control::io::Command;
 use adaptimp::dynamic::HeldRotation;
@@ -353,24 +353,9 @@ impl<const N: usize> DynOuter for Outer<N> {
         self.outer.check_target(target)
     }
     fn reference(&mut self, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Result<(), Error> {
-        let staged = self.outer.stage(&self.state, target, &wrench.into())?;
-        let tip = Kinematics::tip(
-            self.outer.kinematics(),
-            &staged.reference.x,
-            &Vector::zeros(),
-        );
-        self.state = staged.next;
-        let cmd = CartesianCommand {
-            joint: Command::zeros(),
-            reference: staged.reference,
-            commanded: staged.commanded,
-            compliant: staged.compliant,
-            target: staged.target,
-            error: staged.error,
-            p: tip.position,
-            r: tip.rotation,
-            tau_e: Vector::zeros(),
-        };
+        let cmd = self
+            .outer
+            .reference(&mut self.state, target, &wrench.into())?;
         self.last = Some(LastStep::new(cmd, target, wrench));
         Ok(())
     }

@@ -1,46 +1,43 @@
 //! The Cartesian controller in the core's closed loop on MuJoCo (SPEC §13.1,
-//! §16): the core's outer loop over a [`Chain`] and the joint controller
-//! behind it ([`Typed`]) as one [`Control`], stepped by the core's loop
-//! ([`drive_mujoco`]) with the measured end-effector wrench
-//! ([`Control::step_with_wrench`]), recorded in task space and measured by
-//! the one implementation of the SPEC §12 metrics ([`TaskMetrics`]).
+//! §16): the core's Cartesian loop ([`drive_cartesian`]: the outer loop over a
+//! [`Chain`] and the joint controller behind it, recorded in task space,
+//! measured by the one implementation of the SPEC §12 metrics), driven on
+//! the MuJoCo plant by [`drive_mujoco`], with the copies of the controllers
+//! the Python code a run calls reads ([`View`]).
 //!
 //! The commanded pose of row k is the k-th of a table (tabulated by the
 //! caller from a path or a reference at t_k = k·Ts), or none: the last
-//! target held. The loop's clock reaches the controller through the
-//! trajectory it samples at every row ([`Clock`]): a fault that skips rows
-//! does not shift the path.
+//! target held.
 //!
-//! What each row records, as the Python loop records it for
-//! `adaptimp.CartesianController`: xc = p_c (the commanded position; the
-//! filtered target p_t when held), ẋc, ẍc (ṗ_c, p̈_c; zero when held), xd =
-//! p_d (the compliant reference), z1 = p_d − p(q) (m, with p(q) the chain's
-//! tip at the measured q), and beside them ṗ_d, p̈_d, q_d, the impedance's
-//! error and the wrench the controller was given (the core's [`TaskRows`]). The
-//! joint quantities (q, τ, sat(τ), τe, ζ, the velocity used) are the joint
-//! controller's, as for a joint-space run.
+//! What each row records is the core's [`TaskRows`]: xc = p_c (the
+//! commanded position; the filtered target p_t when held), ẋc, ẍc (ṗ_c, p̈_c;
+//! zero when held), xd = p_d, z1 = p_d − p(q), ṗ_d, p̈_d, q_d, the
+//! impedance's error and the wrench. The joint quantities (q, τ, sat(τ), τe,
+//! ζ, the velocity used) are the joint controller's, as for a joint-space run.
 
 use super::computed::Computed;
 use super::dynamic::{
-    drive_mujoco, FaultKind, FaultSpec, Hooks, Items, Metrics, OnMujoco, RowMetrics, Rows,
-    RunError, Typed, View,
+    drive_mujoco, FaultKind, FaultSpec, Hooks, Items, Metrics, OnMujoco, Rows, RunError, Typed,
+    View,
 };
 use super::mujoco::MujocoSpec;
 use adaptimp::cartesian::{
-    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, PoseTarget,
+    CartesianCommand, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, JointLaw,
+    PoseTarget,
 };
 use adaptimp::control::config::Law;
 use adaptimp::control::impedance::TargetImpedance;
 use adaptimp::control::io::TaskTorque;
 use adaptimp::control::io::{Command, Measurement, WrenchControl};
-use adaptimp::dynamic::{self as dy, TaskRows, TaskStep};
+use adaptimp::dynamic::{
+    drive_cartesian, CartesianDriver, CartesianLoop, LoopJoint, TaskRows, TypedTaskStep,
+};
 use adaptimp::error::Error;
-use adaptimp::sim::record::{Recorder, Row};
+use adaptimp::sim::record::Recorder;
 use adaptimp::trajectory::{Clock, Setpoint};
 use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::any::{Any, TypeId};
-use core::cell::{Cell, RefCell};
 use std::vec::Vec;
 
 pub use adaptimp::dynamic::TARGET_LEN;
@@ -147,54 +144,41 @@ impl<const N: usize> JointStep<N> for Computed<N> {
     }
 }
 
-/// The row of a table for t_k = k·Ts.
-fn row_of(t: f64, ts: f64) -> usize {
-    libm::round(t / ts) as usize
-}
+/// A joint controller of the bindings as the core's Cartesian step drives
+/// it ([`JointLaw`], [`LoopJoint`]). A step the outer loop refuses before
+/// the joint step runs is recorded as the bindings' refused step
+/// ([`JointStep::refuse`]: without the measurement, as before).
+pub(crate) struct Joint<'a, J: ?Sized>(pub &'a mut J);
 
-/// The last step of an outer loop, with what it was given: the command,
-/// the commanded position and rates p_c, ṗ_c, p̈_c (the target's; without
-/// one, the held target after its filter, p_t, at rest) and the wrench.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub(crate) struct LastStep<const N: usize> {
-    /// The step's command.
-    pub cmd: CartesianCommand<N>,
-    /// p_c, ṗ_c, p̈_c (m, m/s, m/s²).
-    pub commanded: [Vector<3>; 3],
-    /// F_e (N, N m).
-    pub wrench: [f64; 6],
-}
-
-impl<const N: usize> LastStep<N> {
-    /// The step of `cmd` with its `target` and `wrench`.
-    pub fn new(cmd: CartesianCommand<N>, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Self {
-        let commanded = match target {
-            Some(t) => [t.p, t.dp, t.ddp],
-            None => [cmd.target.0, Vector::zeros(), Vector::zeros()],
-        };
-        Self {
-            cmd,
-            commanded,
-            wrench,
-        }
+impl<const N: usize, J: JointStep<N> + ?Sized> JointLaw<N> for Joint<'_, J> {
+    fn step(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error> {
+        self.0.step_with(m, r)
     }
+    fn step_task(
+        &mut self,
+        m: &Measurement<N>,
+        r: &Setpoint<N>,
+        task: &TaskTorque<N>,
+    ) -> Result<Command<N>, Error> {
+        self.0.step_task(m, r, task)
+    }
+    fn refuse(&mut self, _m: &Measurement<N>, error: Error) {
+        self.0.refuse(error);
+    }
+}
 
-    /// The step as the core's task rows record it.
-    fn task_step(&self) -> TaskStep {
-        TaskStep {
-            command: dy::CartesianCommand::of(&self.cmd),
-            commanded: self.commanded,
-            wrench: self.wrench,
-        }
+impl<const N: usize, J: JointStep<N> + ?Sized> LoopJoint<N> for Joint<'_, J> {
+    fn target(&self) -> &TargetImpedance<N> {
+        self.0.impedance()
+    }
+    fn applied(&self) -> Vector<N> {
+        self.0.applied()
     }
 }
 
 /// One Cartesian step of `outer` (its state `state`) with the core's joint
 /// controller `joint` (SPEC §16, (C0)–(C5)), under the fault semantics of
-/// every step: a step the joint controller refuses is recorded there (the
-/// fault, its fallback as the applied torque); so is one the outer loop
-/// refuses before the joint step runs (a non-finite q, wrench or target), as
-/// a front's refused call is ([`Tracker::refuse`](adaptimp::control::tracker::Tracker::refuse)).
+/// every step ([`CartesianImpedance::step_joint`]).
 pub(crate) fn cartesian_step<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
@@ -202,20 +186,7 @@ pub(crate) fn cartesian_step<const N: usize, J: JointStep<N> + ?Sized>(
     m: &CartesianMeasurement<N>,
     target: Option<&PoseTarget>,
 ) -> Result<CartesianCommand<N>, Error> {
-    let mut ran = false;
-    let result = outer.step_with(state, m, target, |jm, r, task| {
-        ran = true;
-        match task {
-            Some(t) => joint.step_task(jm, r, t),
-            None => joint.step_with(jm, r),
-        }
-    });
-    if let Err(e) = result {
-        if !ran {
-            joint.refuse(e);
-        }
-    }
-    result
+    outer.step_joint(state, &mut Joint(joint), m, target)
 }
 
 /// A row of a flat table as the core's pose target
@@ -229,37 +200,13 @@ pub(crate) fn pose_target(row: &[f64]) -> PoseTarget {
 /// progress callback): the copy a binding keeps as the type `part` (None:
 /// another type), from the outer loop's state and the run's last step (None:
 /// none taken yet). The binding that starts the run knows the rest of it.
-pub(crate) type OuterCopy<'a, const N: usize> =
-    dyn Fn(TypeId, &CartesianState<N>, Option<&LastStep<N>>) -> Option<Box<dyn Any + Send>> + 'a;
-
-/// The outer loop and the joint controller behind it as the loop's
-/// [`Control`]: [`Control::step_with_wrench`] runs
-/// [`CartesianImpedance::step_with`] with the measured wrench and the
-/// joint controller's step, the commanded pose of the row from the table.
-/// The step is kept in `last`, where the recorder reads the row's task
-/// quantities (no copy of them per row).
-struct Cartesian<'a, const N: usize, J: ?Sized> {
-    outer: &'a CartesianImpedance<N, Chain<N>>,
-    state: &'a mut CartesianState<N>,
-    joint: &'a mut J,
-    targets: Option<&'a [f64]>,
-    clock: &'a Cell<f64>,
-    last: &'a RefCell<Option<LastStep<N>>>,
-    /// Whether `last` holds a step the recorder has not recorded yet.
-    pending: &'a Cell<bool>,
-    copy: &'a OuterCopy<'a, N>,
-}
-
-impl<const N: usize, J: JointStep<N> + ?Sized> View for Cartesian<'_, N, J> {
-    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
-        (self.copy)(part, self.state, self.last.borrow().as_ref()).or_else(|| self.joint.copy(part))
-    }
-}
+pub(crate) type OuterCopy<'a, const N: usize> = dyn Fn(TypeId, &CartesianState<N>, Option<&TypedTaskStep<N>>) -> Option<Box<dyn Any + Send>>
+    + 'a;
 
 /// The state of a replay between two rows, as a [`View`].
 struct Replayed<'a, const N: usize, J: ?Sized> {
     state: &'a CartesianState<N>,
-    last: Option<&'a LastStep<N>>,
+    last: Option<&'a TypedTaskStep<N>>,
     joint: &'a J,
     copy: &'a OuterCopy<'a, N>,
 }
@@ -270,85 +217,62 @@ impl<const N: usize, J: JointStep<N> + ?Sized> View for Replayed<'_, N, J> {
     }
 }
 
-impl<const N: usize, J: JointStep<N> + ?Sized> Cartesian<'_, N, J> {
-    fn step_cartesian(
-        &mut self,
-        m: &Measurement<N>,
-        wrench: &[f64; 6],
-    ) -> Result<Command<N>, Error> {
-        let target = self.targets.map(|tab| {
-            let k = row_of(self.clock.get(), self.outer.period());
-            pose_target(&tab[k * TARGET_LEN..(k + 1) * TARGET_LEN])
-        });
-        let meas = CartesianMeasurement {
-            q: m.x,
-            dq: m.dx,
-            wrench: Vector::<6>::from(*wrench),
-        };
-        let cmd = cartesian_step(self.outer, self.state, self.joint, &meas, target.as_ref())?;
-        let mut slot = self.last.borrow_mut();
-        let last = slot.insert(LastStep::new(cmd, target.as_ref(), *wrench));
-        self.pending.set(true);
-        Ok(last.cmd.joint)
+/// The core's Cartesian loop as the MuJoCo loop steps it: its step, and
+/// between two steps a copy of both controllers for the Python code the
+/// run calls.
+struct Shown<'c, 'l, 'j, const N: usize, J: ?Sized> {
+    ctrl: &'c mut CartesianLoop<'l, N, Joint<'j, J>>,
+    copy: &'c OuterCopy<'c, N>,
+}
+
+impl<const N: usize, J: JointStep<N> + ?Sized> View for Shown<'_, '_, '_, N, J> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        let last = self.ctrl.last();
+        (self.copy)(part, self.ctrl.state(), last.as_ref())
+            .or_else(|| self.ctrl.joint().0.copy(part))
     }
 }
 
-impl<const N: usize, J: JointStep<N> + ?Sized> WrenchControl<N> for Cartesian<'_, N, J> {
+impl<const N: usize, J: JointStep<N> + ?Sized> WrenchControl<N> for Shown<'_, '_, '_, N, J> {
     fn period(&self) -> f64 {
-        self.outer.period()
+        WrenchControl::period(self.ctrl)
     }
     fn target(&self) -> &TargetImpedance<N> {
-        self.joint.impedance()
+        WrenchControl::target(self.ctrl)
     }
-    /// The Cartesian step; on an error (of the outer loop or of the joint
-    /// step, recorded in the joint controller: [`cartesian_step`]) its
-    /// fallback, the torque it now applies.
     fn step_with_wrench(
         &mut self,
         m: &Measurement<N>,
         wrench: &[f64; 6],
-        _c: &Setpoint<N>,
+        c: &Setpoint<N>,
     ) -> (Vector<N>, Result<Command<N>, Error>) {
-        match self.step_cartesian(m, wrench) {
-            Ok(cmd) => (cmd.tau_sat, Ok(cmd)),
-            Err(e) => (self.joint.applied(), Err(e)),
-        }
+        self.ctrl.step_with_wrench(m, wrench, c)
     }
 }
 
-/// The joint rows, the task rows and the task-space metrics of every row.
-struct TaskRecorder<'a, const N: usize, const M: usize> {
-    joint: &'a mut Rows,
-    task: &'a mut TaskRows,
-    metrics: &'a mut RowMetrics,
-    /// A row the metrics refused (none: every row fits by construction).
-    refused: Option<Error>,
-    width: core::marker::PhantomData<[(); M]>,
-    last: &'a RefCell<Option<LastStep<N>>>,
-    pending: &'a Cell<bool>,
+/// The MuJoCo plant, its run and hooks as the driver of the core's
+/// Cartesian loop.
+struct OnSim<'a, 'c, const N: usize> {
+    on: OnMujoco<'a>,
+    hooks: &'a mut dyn Hooks,
+    copy: &'a OuterCopy<'c, N>,
 }
 
-impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
-    fn record(&mut self, r: &Row<N>) {
-        self.pending.set(false);
-        self.joint.record(r);
-        let step = self.last.borrow().as_ref().map(LastStep::task_step);
-        let nan = [Vector::<3>::from_element(f64::NAN); 3];
-        let (pc, z1) = match &step {
-            Some(s) => (&s.commanded, s.z1()),
-            None => (&nan, nan[0]),
+impl<'j, const N: usize, J: JointStep<N> + ?Sized> CartesianDriver<N, Joint<'j, J>>
+    for OnSim<'_, '_, N>
+{
+    type Error = RunError;
+    fn drive<R: Recorder<N>>(
+        self,
+        ctrl: &mut CartesianLoop<'_, N, Joint<'j, J>>,
+        clock: &Clock<'_>,
+        rec: &mut R,
+    ) -> Result<(), RunError> {
+        let mut shown = Shown {
+            ctrl,
+            copy: self.copy,
         };
-        self.task.record(step.as_ref(), &z1);
-        let pushed = self.metrics.push(
-            r.t,
-            [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
-            [pc[0].as_slice(), pc[1].as_slice(), pc[2].as_slice()],
-            z1.as_slice(),
-            [r.tau.as_slice(), r.tau_sat.as_slice(), r.tau_e.as_slice()],
-        );
-        if let Err(e) = pushed {
-            self.refused.get_or_insert(e);
-        }
+        drive_mujoco(&mut shown, clock, self.on, self.hooks, rec)
     }
 }
 
@@ -363,42 +287,17 @@ fn invalid(what: &'static str, reason: &'static str) -> RunError {
 /// The closed loop of the outer loop `outer` (its state `state`) in front of
 /// the joint controller `joint` on MuJoCo (`sim` as `spec` describes it),
 /// from both controllers' current states (not reset: a used controller goes
-/// on). Returns the records and the task-space metrics, and leaves the last
-/// step taken in `last` (also when the run ends with an error); when it ends
-/// with an error (Ctrl-C, a diverged plant), the task rows of the steps it
-/// took in `partial` (the controller's log keeps them).
+/// on): the core's Cartesian loop ([`drive_cartesian`]). Returns the records
+/// and the task-space metrics, and leaves the last step taken in `last`
+/// (also when the run ends with an error); when it ends with an error
+/// (Ctrl-C, a diverged plant), the task rows of the steps it took in
+/// `partial` (the controller's log keeps them).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn simulate_mujoco<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
     joint: &mut J,
-    last: &mut Option<LastStep<N>>,
-    sim: &mut Sim,
-    spec: &MujocoSpec,
-    run: &CartesianRun<'_>,
-    hooks: &mut dyn Hooks,
-    partial: &mut Option<TaskRows>,
-    copy: &OuterCopy<'_, N>,
-) -> Result<CartesianOut, RunError> {
-    if N <= 3 {
-        run_m::<N, 3, J>(
-            outer, state, joint, last, sim, spec, run, hooks, partial, copy,
-        )
-    } else {
-        run_m::<N, N, J>(
-            outer, state, joint, last, sim, spec, run, hooks, partial, copy,
-        )
-    }
-}
-
-/// [`simulate_mujoco`] with the metrics' accumulator of M = max(N, 3) slots
-/// (as [`metrics_of`](super::dynamic::metrics_of) takes for the same rows).
-#[allow(clippy::too_many_arguments)]
-fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
-    outer: &CartesianImpedance<N, Chain<N>>,
-    state: &mut CartesianState<N>,
-    joint: &mut J,
-    last: &mut Option<LastStep<N>>,
+    last: &mut Option<TypedTaskStep<N>>,
     sim: &mut Sim,
     spec: &MujocoSpec,
     run: &CartesianRun<'_>,
@@ -411,64 +310,43 @@ fn run_m<const N: usize, const M: usize, J: JointStep<N> + ?Sized>(
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
     let mut rec = Rows::new(N, kept, every)?;
     let mut task = TaskRows::new(N, kept, every)?;
-    let ones = [1.0; N];
-    let mut metrics = RowMetrics::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
-    let clock = Cell::new(0.0);
-    // This run's steps (the previous run's last step is kept until one is taken).
-    let steps = RefCell::new(None);
-    let pending = Cell::new(false);
-    let mut ctrl = Cartesian {
-        outer,
-        state,
-        joint,
-        targets: run.targets,
-        clock: &clock,
-        last: &steps,
-        pending: &pending,
-        copy,
-    };
-    let law = ctrl.joint.law();
+    // The table's rows as the core's pose targets (checked: one per step).
+    let steps = usize::try_from(total).unwrap_or(usize::MAX);
+    let targets: Option<Vec<PoseTarget>> = run.targets.map(|tab| {
+        tab.chunks(TARGET_LEN)
+            .take(steps)
+            .map(pose_target)
+            .collect()
+    });
     let on = OnMujoco {
         sim,
         spec,
         t_final: run.t_final,
         settle: run.settle,
         items: run.items,
-        law,
+        law: joint.law(),
         fault: run.fault,
         abort: None,
     };
-    let mut recorder = TaskRecorder {
-        joint: &mut rec,
-        task: &mut task,
-        metrics: &mut metrics,
-        refused: None,
-        width: core::marker::PhantomData::<[(); M]>,
-        last: &steps,
-        pending: &pending,
-    };
-    let result = drive_mujoco(&mut ctrl, &Clock(&clock), on, hooks, &mut recorder);
-    let result = match recorder.refused {
-        Some(e) => result.and(Err(RunError::Core(e, None))),
-        None => result,
-    };
-    let taken = steps.into_inner();
-    if taken.is_some() {
-        task.last = taken.as_ref().map(LastStep::task_step);
-        *last = taken;
-    }
-    if let Err(e) = result {
-        // A step taken in the period the error stopped: its task row too
-        // (the controller's clock counts it).
-        if pending.get() {
-            if let Some(s) = task.last {
-                task.record(Some(&s), &s.z1());
-            }
+    let driver = OnSim { on, hooks, copy };
+    let result = drive_cartesian(
+        driver,
+        outer,
+        state,
+        Joint(joint),
+        targets.as_deref(),
+        run.settle,
+        &mut rec,
+        &mut task,
+        last,
+    );
+    match result {
+        Ok(metrics) => Ok((rec, task, metrics)),
+        Err(e) => {
+            *partial = Some(task);
+            Err(e)
         }
-        *partial = Some(task);
-        return Err(e);
     }
-    Ok((rec, task, metrics.finish()))
 }
 
 /// The steps of `run`, checked before it starts: the joint controller at the
@@ -542,7 +420,7 @@ pub(crate) fn replay<const N: usize, J: JointStep<N> + ?Sized>(
     outer: &CartesianImpedance<N, Chain<N>>,
     state: &mut CartesianState<N>,
     joint: &mut J,
-    last: &mut Option<LastStep<N>>,
+    last: &mut Option<TypedTaskStep<N>>,
     rows: usize,
     tables: [&[f64]; 3],
     targets: Option<&[f64]>,
@@ -578,7 +456,7 @@ pub(crate) fn replay<const N: usize, J: JointStep<N> + ?Sized>(
         let cmd = cartesian_step(outer, state, joint, &m, target.as_ref())
             .map_err(|e| RunError::Core(e, Some(k as u64)))?;
         out.extend_from_slice(cmd.joint.tau_sat.as_slice());
-        *last = Some(LastStep::new(cmd, target.as_ref(), m.wrench.into()));
+        *last = Some(TypedTaskStep::new(cmd, target.as_ref(), m.wrench.into()));
     }
     // The last row reported too (a progress bar ends at 100 %).
     let view = Replayed {

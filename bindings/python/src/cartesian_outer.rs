@@ -3,7 +3,7 @@
 //! until the bindings' joint controllers are the core's run-time ones and
 //! the outer loop can be the core's `dynamic::CartesianImpedance`.
 
-use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep, LastStep};
+use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep};
 use super::computed::{Computed, DynComputed};
 use super::dynamic::{DynTracker, Hooks, RunError, Typed, MAX_JOINTS};
 use super::mujoco::MujocoSpec;
@@ -13,7 +13,7 @@ use adaptimp::cartesian::{
 };
 use adaptimp::control::io::Command;
 use adaptimp::dynamic::HeldRotation;
-use adaptimp::dynamic::TaskRows;
+use adaptimp::dynamic::{TaskRows, TypedTaskStep};
 use adaptimp::error::Error;
 use adaptimp::trajectory::Setpoint;
 use adaptimp::types::Vector;
@@ -239,7 +239,7 @@ pub(super) struct Outer<const N: usize> {
     state: CartesianState<N>,
     q0: Vector<N>,
     posture: Vector<N>,
-    last: Option<LastStep<N>>,
+    last: Option<TypedTaskStep<N>>,
     /// The commanded rotation a target without one keeps.
     held: HeldRotation,
     /// Kept rows of the log, flat ([`LOG_WIDTH`] + N each), and their number.
@@ -254,7 +254,7 @@ pub const LOG_WIDTH: usize = 30;
 impl<const N: usize> Outer<N> {
     /// This loop at `state`, after `last` (None: the last step kept), without
     /// its log: a copy for the Python code a run calls.
-    fn at(&self, state: &CartesianState<N>, last: Option<&LastStep<N>>) -> Self {
+    fn at(&self, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>) -> Self {
         Self {
             state: *state,
             last: last.copied().or(self.last),
@@ -270,7 +270,7 @@ impl<const N: usize> Outer<N> {
         &self,
         part: TypeId,
         state: &CartesianState<N>,
-        last: Option<&LastStep<N>>,
+        last: Option<&TypedTaskStep<N>>,
     ) -> Option<Box<dyn Any + Send>> {
         (part == TypeId::of::<Box<dyn DynOuter>>()).then(|| {
             Box::new(Box::new(self.at(state, last)) as Box<dyn DynOuter>) as Box<dyn Any + Send>
@@ -322,7 +322,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         let Some(last) = &self.last else {
             return;
         };
-        let c = &last.cmd;
+        let c = &last.command;
         for v in last
             .commanded
             .iter()
@@ -356,7 +356,7 @@ impl<const N: usize> DynOuter for Outer<N> {
         let cmd = self
             .outer
             .reference(&mut self.state, target, &wrench.into())?;
-        self.last = Some(LastStep::new(cmd, target, wrench));
+        self.last = Some(TypedTaskStep::new(cmd, target, wrench));
         Ok(())
     }
     fn step_tracker(&mut self, joint: JointRef<'_>, m: &StepIn<'_>) -> Result<(), Error> {
@@ -369,7 +369,7 @@ impl<const N: usize> DynOuter for Outer<N> {
             &meas,
             m.target.as_ref(),
         )?;
-        self.last = Some(LastStep::new(cmd, m.target.as_ref(), m.wrench));
+        self.last = Some(TypedTaskStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
     }
     fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error> {
@@ -411,13 +411,13 @@ impl<const N: usize> DynOuter for Outer<N> {
                         ..Command::zeros()
                     })
                 })?;
-        self.last = Some(LastStep::new(cmd, m.target.as_ref(), m.wrench));
+        self.last = Some(TypedTaskStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
     }
     fn applied(&self) -> [f64; MAX_JOINTS] {
         let mut out = [f64::NAN; MAX_JOINTS];
         if let Some(last) = &self.last {
-            out[..N].copy_from_slice(last.cmd.joint.tau_sat.as_slice());
+            out[..N].copy_from_slice(last.command.joint.tau_sat.as_slice());
         }
         out
     }
@@ -431,7 +431,7 @@ impl<const N: usize> DynOuter for Outer<N> {
             };
             return std::vec![f64::NAN; width];
         };
-        let c = &last.cmd;
+        let c = &last.command;
         let v3 = |v: &Vector<3>| v.as_slice().to_vec();
         let vn = |v: &Vector<N>| v.as_slice().to_vec();
         match LAST[what] {
@@ -510,7 +510,7 @@ impl<const N: usize> DynOuter for Outer<N> {
     ) -> Result<CartesianOut, RunError> {
         let joint = typed::<N>(joint)?;
         let before = self.at(&self.state, None);
-        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&LastStep<N>>| {
+        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>| {
             before.copy_as(part, state, last)
         };
         cartesian_loop::simulate_mujoco(
@@ -537,7 +537,7 @@ impl<const N: usize> DynOuter for Outer<N> {
     ) -> Result<(), RunError> {
         let joint = typed::<N>(joint)?;
         let before = self.at(&self.state, None);
-        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&LastStep<N>>| {
+        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>| {
             before.copy_as(part, state, last)
         };
         cartesian_loop::replay(

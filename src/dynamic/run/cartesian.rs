@@ -6,10 +6,9 @@
 use super::super::cartesian::{CartesianImpedance, CartesianState, Joint};
 use super::super::sized::each;
 use super::super::values::mismatch;
-use super::rows::{TaskMetrics, TaskStep};
+use super::rows::{TaskMetrics, TypedTaskStep};
 use super::{
-    drive, Disturbances, Hooks, Injected, Injection, Metrics, On, Plant, Rows, Run, RunError,
-    TaskRows,
+    drive, Disturbances, Hooks, Injected, Injection, Metrics, Plant, Rows, Run, RunError, TaskRows,
 };
 use crate::cartesian::{self, PoseTarget};
 use crate::control::impedance::TargetImpedance;
@@ -21,54 +20,81 @@ use crate::trajectory::{self, Clock};
 use crate::types::Vector;
 use core::cell::{Cell, RefCell};
 
-/// The joint controller behind the outer loop, typed: the paper's laws or
-/// computed torque.
-trait JointLoop<const N: usize>: cartesian::JointLaw<N> {
+/// The joint controller behind a typed outer loop in the closed loop
+/// ([`drive_cartesian`]): a [`JointLaw`](cartesian::JointLaw) that gives
+/// the target impedance it realises and the torque it applies now. The
+/// paper's laws and computed torque are two; a front may wrap its own.
+pub trait LoopJoint<const N: usize>: cartesian::JointLaw<N> {
+    /// The target impedance (3) (for the impedance residual of SPEC §12).
+    fn target(&self) -> &TargetImpedance<N>;
+    /// The torque it applies now (N m): the last step's, or its fallback.
     fn applied(&self) -> Vector<N>;
 }
 
-impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> JointLoop<N>
+impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> LoopJoint<N>
     for (
         &crate::control::controller::Controller<N, crate::networks::rbf::AnyBasis<N>>,
         &mut crate::control::state::State<N, S>,
     )
 {
+    fn target(&self) -> &TargetImpedance<N> {
+        self.0.impedance()
+    }
     fn applied(&self) -> Vector<N> {
         *self.1.applied()
     }
 }
 
-impl<const N: usize> JointLoop<N>
+impl<const N: usize> LoopJoint<N>
     for (
         &cartesian::ComputedTorque<N>,
         &mut cartesian::ComputedState<N>,
     )
 {
+    fn target(&self) -> &TargetImpedance<N> {
+        self.0.impedance()
+    }
     fn applied(&self) -> Vector<N> {
         self.1.applied
     }
 }
 
-/// The outer loop and the joint controller behind it as the loop's
-/// controller: the Cartesian step with the measured wrench, the row's pose
-/// target, the step kept for the recorder.
-struct CartesianLoop<'a, const N: usize, J> {
+/// The typed outer loop and the joint controller behind it as the loop's
+/// controller ([`WrenchControl`]): the Cartesian step with the measured
+/// wrench and the row's pose target, the step kept for the recorder (and
+/// for a front's copy of the state between two steps: [`state`](Self::state),
+/// [`last`](Self::last), [`joint`](Self::joint)).
+pub struct CartesianLoop<'a, const N: usize, J> {
     outer: &'a cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
     state: &'a mut cartesian::CartesianState<N>,
     joint: J,
-    target: TargetImpedance<N>,
     targets: Option<&'a [PoseTarget]>,
     clock: &'a Cell<f64>,
-    last: &'a RefCell<Option<TaskStep>>,
+    last: &'a RefCell<Option<TypedTaskStep<N>>>,
     pending: &'a Cell<bool>,
 }
 
-impl<const N: usize, J: JointLoop<N>> WrenchControl<N> for CartesianLoop<'_, N, J> {
+impl<const N: usize, J> CartesianLoop<'_, N, J> {
+    /// The outer loop's state now.
+    pub fn state(&self) -> &cartesian::CartesianState<N> {
+        self.state
+    }
+    /// The joint controller.
+    pub fn joint(&self) -> &J {
+        &self.joint
+    }
+    /// The last step this run took (none yet: `None`).
+    pub fn last(&self) -> Option<TypedTaskStep<N>> {
+        *self.last.borrow()
+    }
+}
+
+impl<const N: usize, J: LoopJoint<N>> WrenchControl<N> for CartesianLoop<'_, N, J> {
     fn period(&self) -> f64 {
         self.outer.period()
     }
     fn target(&self) -> &TargetImpedance<N> {
-        &self.target
+        self.joint.target()
     }
     fn step_with_wrench(
         &mut self,
@@ -90,7 +116,7 @@ impl<const N: usize, J: JointLoop<N>> WrenchControl<N> for CartesianLoop<'_, N, 
             .step_joint(self.state, &mut self.joint, &meas, target.as_ref())
         {
             Ok(cmd) => {
-                *self.last.borrow_mut() = Some(TaskStep::new(&cmd, target.as_ref(), *wrench));
+                *self.last.borrow_mut() = Some(TypedTaskStep::new(cmd, target.as_ref(), *wrench));
                 self.pending.set(true);
                 (cmd.joint.tau_sat, Ok(cmd.joint))
             }
@@ -100,25 +126,25 @@ impl<const N: usize, J: JointLoop<N>> WrenchControl<N> for CartesianLoop<'_, N, 
 }
 
 /// The joint rows, the task rows and the task-space metrics of every row.
-struct TaskRecorder<'a, const M: usize> {
+struct TaskRecorder<'a, const N: usize, const M: usize> {
     joint: &'a mut Rows,
     task: &'a mut TaskRows,
     metrics: &'a mut TaskMetrics<M>,
-    last: &'a RefCell<Option<TaskStep>>,
+    last: &'a RefCell<Option<TypedTaskStep<N>>>,
     pending: &'a Cell<bool>,
 }
 
-impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, M> {
+impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, N, M> {
     fn record(&mut self, r: &Row<N>) {
         self.pending.set(false);
         self.joint.record(r);
-        let slot = self.last.borrow();
+        let step = self.last.borrow().as_ref().map(TypedTaskStep::run_time);
         let nan = [Vector::<3>::from_element(f64::NAN); 3];
-        let (pc, z1) = match slot.as_ref() {
+        let (pc, z1) = match step.as_ref() {
             Some(s) => (&s.commanded, s.z1()),
             None => (&nan, nan[0]),
         };
-        self.task.record(slot.as_ref(), &z1);
+        self.task.record(step.as_ref(), &z1);
         self.metrics.push(
             r.t,
             [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
@@ -127,6 +153,109 @@ impl<const N: usize, const M: usize> Recorder<N> for TaskRecorder<'_, M> {
             [r.tau.as_slice(), r.tau_sat.as_slice(), r.tau_e.as_slice()],
         );
     }
+}
+
+/// How a Cartesian loop of the typed outer loop runs: the plant, its
+/// disturbances and faults, the hooks. The run-time loop's own plant
+/// ([`simulate_cartesian`]), or a front's (a physics engine it steps, with
+/// the copies of the controllers it shows its callbacks).
+pub trait CartesianDriver<const N: usize, J> {
+    /// How a run ends when it does not finish.
+    type Error: From<Error>;
+    /// The core's loop ([`simulate_disturbed`](crate::sim::simulator::simulate_disturbed))
+    /// of `ctrl` along `clock` (the loop's time into the cell the controller
+    /// reads its row from), every row to `rec`.
+    fn drive<R: Recorder<N>>(
+        self,
+        ctrl: &mut CartesianLoop<'_, N, J>,
+        clock: &Clock<'_>,
+        rec: &mut R,
+    ) -> Result<(), Self::Error>;
+}
+
+/// The closed loop of the typed outer loop `outer` (its state `state`) in
+/// front of `joint`, run by `driver`, from both controllers' current
+/// states: the commanded pose of row k the k-th of `targets` (checked
+/// against the run's length by the caller; none: the last target held),
+/// the joint rows to `rows`, the task rows to `task` and the last step
+/// taken to `last` (also those before an error; the step of the period an
+/// error stopped recorded too); returns the SPEC §12 metrics in task space
+/// (z1 = p_d − p, m = 3; the impedance residual NaN) after `settle` (s).
+/// What [`simulate_cartesian`] runs for N joints; a front with its own
+/// plant gives its own `driver`.
+#[allow(clippy::too_many_arguments)]
+pub fn drive_cartesian<const N: usize, J: LoopJoint<N>, D: CartesianDriver<N, J>>(
+    driver: D,
+    outer: &cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
+    state: &mut cartesian::CartesianState<N>,
+    joint: J,
+    targets: Option<&[PoseTarget]>,
+    settle: f64,
+    rows: &mut Rows,
+    task: &mut TaskRows,
+    last: &mut Option<TypedTaskStep<N>>,
+) -> Result<Metrics, D::Error> {
+    if N <= 3 {
+        cartesian_m::<N, 3, J, D>(
+            driver, outer, state, joint, targets, settle, rows, task, last,
+        )
+    } else {
+        cartesian_m::<N, N, J, D>(
+            driver, outer, state, joint, targets, settle, rows, task, last,
+        )
+    }
+}
+
+/// [`drive_cartesian`] with the metrics in M = max(N, 3) slots.
+#[allow(clippy::too_many_arguments)]
+fn cartesian_m<const N: usize, const M: usize, J: LoopJoint<N>, D: CartesianDriver<N, J>>(
+    driver: D,
+    outer: &cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
+    state: &mut cartesian::CartesianState<N>,
+    joint: J,
+    targets: Option<&[PoseTarget]>,
+    settle: f64,
+    rows: &mut Rows,
+    task: &mut TaskRows,
+    last: &mut Option<TypedTaskStep<N>>,
+) -> Result<Metrics, D::Error> {
+    let ones = [1.0; N];
+    let mut metrics = TaskMetrics::<M>::new(N, 3, false, settle, [&ones, &ones, &ones])?;
+    let clock = Cell::new(0.0);
+    // This run's steps (the previous run's last step is kept until one is taken).
+    let steps = RefCell::new(None);
+    let pending = Cell::new(false);
+    let mut ctrl = CartesianLoop {
+        outer,
+        state,
+        joint,
+        targets,
+        clock: &clock,
+        last: &steps,
+        pending: &pending,
+    };
+    let mut recorder = TaskRecorder {
+        joint: rows,
+        task,
+        metrics: &mut metrics,
+        last: &steps,
+        pending: &pending,
+    };
+    let result = driver.drive(&mut ctrl, &Clock(&clock), &mut recorder);
+    let taken = steps.into_inner();
+    if taken.is_some() {
+        task.last = taken.as_ref().map(TypedTaskStep::run_time);
+        *last = taken;
+    }
+    if result.is_err() && pending.get() {
+        // A step taken in the period the error stopped: its task row too
+        // (the controller's clock counts it).
+        if let Some(s) = task.last {
+            task.record(Some(&s), &s.z1());
+        }
+    }
+    result?;
+    Ok(metrics.finish())
 }
 
 /// The closed loop of the Cartesian controller (SPEC §13.1, §16): the
@@ -196,100 +325,42 @@ pub fn simulate_cartesian<S: AsRef<[f64]> + AsMut<[f64]>>(
             Some(d) => Some(d.inner.get::<N>().ok_or(mismatch("disturbances"))?),
             None => None,
         };
-        let on = On { plant, dist, run, hooks, rows };
+        let on = OnPlant { plant, dist, run, hooks };
+        let mut last = None;
         match joint {
             Joint::Adaptive(c, s) => {
                 let c = c.inner.get::<N>().ok_or(mismatch("joint controller"))?;
                 let s = s.inner.get_mut::<N>().ok_or(mismatch("joint state"))?;
-                let target = *c.ctrl.impedance();
-                cartesian_n(on, o, st, (&c.ctrl, s), target, targets, task)
+                drive_cartesian(on, o, st, (&c.ctrl, s), targets, run.settle, rows, task, &mut last)
             }
             Joint::Computed(c, s) => {
                 let c = c.inner.get::<N>().ok_or(mismatch("joint controller"))?;
                 let s = s.inner.get_mut::<N>().ok_or(mismatch("joint state"))?;
-                let target = *c.impedance();
-                cartesian_n(on, o, st, (&**c, s), target, targets, task)
+                drive_cartesian(on, o, st, (&**c, s), targets, run.settle, rows, task, &mut last)
             }
         }
     })
 }
 
-/// [`simulate_cartesian`] for N joints, the metrics in M = max(N, 3) slots.
-#[allow(clippy::too_many_arguments)]
-fn cartesian_n<const N: usize, J: JointLoop<N>>(
-    on: On<'_, '_, N>,
-    outer: &cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
-    state: &mut cartesian::CartesianState<N>,
-    joint: J,
-    target: TargetImpedance<N>,
-    targets: Option<&[PoseTarget]>,
-    task: &mut TaskRows,
-) -> Result<Metrics, RunError> {
-    if N <= 3 {
-        cartesian_m::<N, 3, J>(on, outer, state, joint, target, targets, task)
-    } else {
-        cartesian_m::<N, N, J>(on, outer, state, joint, target, targets, task)
-    }
+/// The run-time loop's plant, disturbances, run and hooks as the driver of
+/// [`drive_cartesian`].
+struct OnPlant<'a, 'b, const N: usize> {
+    plant: &'a mut dyn Plant,
+    dist: Option<&'a crate::sim::disturb::Disturbances<N>>,
+    run: &'a Run<'b>,
+    hooks: &'a mut dyn Hooks,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn cartesian_m<const N: usize, const M: usize, J: JointLoop<N>>(
-    on: On<'_, '_, N>,
-    outer: &cartesian::CartesianImpedance<N, cartesian::Chain<N>>,
-    state: &mut cartesian::CartesianState<N>,
-    joint: J,
-    target: TargetImpedance<N>,
-    targets: Option<&[PoseTarget]>,
-    task: &mut TaskRows,
-) -> Result<Metrics, RunError> {
-    let On {
-        plant,
-        dist,
-        run,
-        hooks,
-        rows,
-    } = on;
-    let ones = [1.0; N];
-    let mut metrics = TaskMetrics::<M>::new(N, 3, false, run.settle, [&ones, &ones, &ones])?;
-    let clock = Cell::new(0.0);
-    let steps = RefCell::new(None);
-    let pending = Cell::new(false);
-    let mut ctrl = CartesianLoop {
-        outer,
-        state,
-        joint,
-        target,
-        targets,
-        clock: &clock,
-        last: &steps,
-        pending: &pending,
-    };
-    let mut recorder = TaskRecorder {
-        joint: rows,
-        task,
-        metrics: &mut metrics,
-        last: &steps,
-        pending: &pending,
-    };
-    let result = drive(
-        plant,
-        &mut ctrl,
-        &Clock(&clock),
-        dist,
-        run,
-        hooks,
-        &mut recorder,
-    );
-    let taken = steps.into_inner();
-    if taken.is_some() {
-        task.last = taken;
+impl<const N: usize, J: LoopJoint<N>> CartesianDriver<N, J> for OnPlant<'_, '_, N> {
+    type Error = RunError;
+    fn drive<R: Recorder<N>>(
+        self,
+        ctrl: &mut CartesianLoop<'_, N, J>,
+        clock: &Clock<'_>,
+        rec: &mut R,
+    ) -> Result<(), RunError> {
+        drive(
+            self.plant, ctrl, clock, self.dist, self.run, self.hooks, rec,
+        )
     }
-    if result.is_err() && pending.get() {
-        // A step taken in the period the error stopped: its task row too.
-        if let Some(s) = task.last {
-            task.record(Some(&s), &s.z1());
-        }
-    }
-    result?;
-    Ok(metrics.finish())
 }

@@ -17,10 +17,14 @@ mod replay;
 mod rows;
 mod spec;
 
-pub use cartesian::simulate_cartesian;
+pub use cartesian::{
+    drive_cartesian, simulate_cartesian, CartesianDriver, CartesianLoop, LoopJoint,
+};
 pub use plant::{Arm, Disturbances, Injected, Injection, Jacobian3, Plant, RigidBody};
 pub use replay::Replay;
-pub use rows::{metrics_of, Metrics, Recorded, RowMetrics, Rows, TaskRows, TaskStep};
+pub use rows::{
+    metrics_of, Metrics, Recorded, RowMetrics, Rows, TaskRows, TaskStep, TypedTaskStep,
+};
 pub use spec::{run, Loop, Output, Spec};
 
 use super::cartesian::Joint;

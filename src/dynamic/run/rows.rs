@@ -478,25 +478,50 @@ pub struct TaskStep {
 }
 
 impl TaskStep {
-    pub(crate) fn new<const N: usize>(
-        cmd: &cartesian::CartesianCommand<N>,
+    /// z1 = p_d − p(q) (m).
+    pub fn z1(&self) -> Vector<3> {
+        self.command.compliant.p - self.command.p
+    }
+}
+
+/// [`TaskStep`] for the typed outer loop of N joints: what a loop over
+/// [`CartesianImpedance`](crate::CartesianImpedance) keeps of its last step.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct TypedTaskStep<const N: usize> {
+    /// The step's command.
+    pub command: cartesian::CartesianCommand<N>,
+    /// p_c, ṗ_c, p̈_c (m, m/s, m/s²).
+    pub commanded: [Vector<3>; 3],
+    /// F_e (N, N m).
+    pub wrench: [f64; 6],
+}
+
+impl<const N: usize> TypedTaskStep<N> {
+    /// The step of `command`, given the commanded pose `target` (none: the
+    /// held target, p_c = p_t at rest) and the wrench F_e.
+    pub fn new(
+        command: cartesian::CartesianCommand<N>,
         target: Option<&PoseTarget>,
         wrench: [f64; 6],
     ) -> Self {
         let commanded = match target {
             Some(t) => [t.p, t.dp, t.ddp],
-            None => [cmd.target.0, Vector::zeros(), Vector::zeros()],
+            None => [command.target.0, Vector::zeros(), Vector::zeros()],
         };
         Self {
-            command: CartesianCommand::of(cmd),
+            command,
             commanded,
             wrench,
         }
     }
 
-    /// z1 = p_d − p(q) (m).
-    pub fn z1(&self) -> Vector<3> {
-        self.command.compliant.p - self.command.p
+    /// The step at run time, its values copied bit for bit.
+    pub fn run_time(&self) -> TaskStep {
+        TaskStep {
+            command: CartesianCommand::of(&self.command),
+            commanded: self.commanded,
+            wrench: self.wrench,
+        }
     }
 }
 

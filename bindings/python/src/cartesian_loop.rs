@@ -203,6 +203,17 @@ pub(crate) fn pose_target(row: &[f64]) -> PoseTarget {
 pub(crate) type OuterCopy<'a, const N: usize> = dyn Fn(TypeId, &CartesianState<N>, Option<&TypedTaskStep<N>>) -> Option<Box<dyn Any + Send>>
     + 'a;
 
+/// What a run ([`simulate_mujoco`], [`replay`]) goes on: the outer loop,
+/// its state and last step, the joint controller behind it, and how the
+/// run copies the outer loop for the Python code it calls.
+pub(crate) struct OuterRun<'a, const N: usize> {
+    pub outer: &'a CartesianImpedance<N, Chain<N>>,
+    pub state: &'a mut CartesianState<N>,
+    pub joint: &'a mut dyn JointStep<N>,
+    pub last: &'a mut Option<TypedTaskStep<N>>,
+    pub copy: &'a OuterCopy<'a, N>,
+}
+
 /// The state of a replay between two rows, as a [`View`].
 struct Replayed<'a, const N: usize, J: ?Sized> {
     state: &'a CartesianState<N>,
@@ -292,19 +303,21 @@ fn invalid(what: &'static str, reason: &'static str) -> RunError {
 /// (also when the run ends with an error); when it ends with an error
 /// (Ctrl-C, a diverged plant), the task rows of the steps it took in
 /// `partial` (the controller's log keeps them).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn simulate_mujoco<const N: usize, J: JointStep<N> + ?Sized>(
-    outer: &CartesianImpedance<N, Chain<N>>,
-    state: &mut CartesianState<N>,
-    joint: &mut J,
-    last: &mut Option<TypedTaskStep<N>>,
+pub(crate) fn simulate_mujoco<const N: usize>(
+    o: OuterRun<'_, N>,
     sim: &mut Sim,
     spec: &MujocoSpec,
     run: &CartesianRun<'_>,
     hooks: &mut dyn Hooks,
     partial: &mut Option<TaskRows>,
-    copy: &OuterCopy<'_, N>,
 ) -> Result<CartesianOut, RunError> {
+    let OuterRun {
+        outer,
+        state,
+        joint,
+        last,
+        copy,
+    } = o;
     let total = checked(outer, &*joint, run)?;
     let every = run.every.max(1);
     let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
@@ -415,19 +428,21 @@ pub(crate) fn reads_the_wrench<const N: usize>(
 /// cost of the controller without a plant): q, q̇ (K × n), the wrench (K ×
 /// 6), the pose targets (K × [`TARGET_LEN`], or none: held). Writes sat(τ)
 /// rows into `out`. Errors name the row.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn replay<const N: usize, J: JointStep<N> + ?Sized>(
-    outer: &CartesianImpedance<N, Chain<N>>,
-    state: &mut CartesianState<N>,
-    joint: &mut J,
-    last: &mut Option<TypedTaskStep<N>>,
+pub(crate) fn replay<const N: usize>(
+    o: OuterRun<'_, N>,
     rows: usize,
     tables: [&[f64]; 3],
     targets: Option<&[f64]>,
     out: &mut Vec<f64>,
     hooks: &mut dyn Hooks,
-    copy: &OuterCopy<'_, N>,
 ) -> Result<(), RunError> {
+    let OuterRun {
+        outer,
+        state,
+        joint,
+        last,
+        copy,
+    } = o;
     let [q, dq, wrench] = tables;
     if q.len() < rows * N || dq.len() < rows * N || wrench.len() < rows * 6 {
         return Err(invalid("rows", "every table needs K rows of its width"));

@@ -3,7 +3,7 @@
 //! until the bindings' joint controllers are the core's run-time ones and
 //! the outer loop can be the core's `dynamic::CartesianImpedance`.
 
-use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep};
+use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep, OuterRun};
 use super::computed::{Computed, DynComputed};
 use super::dynamic::{DynTracker, Hooks, RunError, Typed, MAX_JOINTS};
 use super::mujoco::MujocoSpec;
@@ -277,6 +277,29 @@ impl<const N: usize> Outer<N> {
         })
     }
 
+    /// A run of this loop in front of `joint` (a MuJoCo run, a replay):
+    /// `run` gets the loop's parts, the typed joint controller and how the
+    /// run copies this loop for the Python code it calls (the loop as
+    /// before the run, at the run's state and last step).
+    fn run_with<R>(
+        &mut self,
+        joint: JointRef<'_>,
+        run: impl FnOnce(OuterRun<'_, N>) -> Result<R, RunError>,
+    ) -> Result<R, RunError> {
+        let joint = typed::<N>(joint)?;
+        let before = self.at(&self.state, None);
+        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>| {
+            before.copy_as(part, state, last)
+        };
+        run(OuterRun {
+            outer: &self.outer,
+            state: &mut self.state,
+            joint,
+            last: &mut self.last,
+            copy: &copy,
+        })
+    }
+
     fn measurement(m: &StepIn<'_>) -> CartesianMeasurement<N> {
         CartesianMeasurement {
             q: vector_of(m.q),
@@ -508,23 +531,9 @@ impl<const N: usize> DynOuter for Outer<N> {
         hooks: &mut dyn Hooks,
         partial: &mut Option<TaskRows>,
     ) -> Result<CartesianOut, RunError> {
-        let joint = typed::<N>(joint)?;
-        let before = self.at(&self.state, None);
-        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>| {
-            before.copy_as(part, state, last)
-        };
-        cartesian_loop::simulate_mujoco(
-            &self.outer,
-            &mut self.state,
-            joint,
-            &mut self.last,
-            sim,
-            spec,
-            run,
-            hooks,
-            partial,
-            &copy,
-        )
+        self.run_with(joint, |o| {
+            cartesian_loop::simulate_mujoco(o, sim, spec, run, hooks, partial)
+        })
     }
     fn replay(
         &mut self,
@@ -535,23 +544,9 @@ impl<const N: usize> DynOuter for Outer<N> {
         out: &mut Vec<f64>,
         hooks: &mut dyn Hooks,
     ) -> Result<(), RunError> {
-        let joint = typed::<N>(joint)?;
-        let before = self.at(&self.state, None);
-        let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>| {
-            before.copy_as(part, state, last)
-        };
-        cartesian_loop::replay(
-            &self.outer,
-            &mut self.state,
-            joint,
-            &mut self.last,
-            rows,
-            tables,
-            targets,
-            out,
-            hooks,
-            &copy,
-        )
+        self.run_with(joint, |o| {
+            cartesian_loop::replay(o, rows, tables, targets, out, hooks)
+        })
     }
     fn view(&self) -> Box<dyn DynOuter> {
         Box::new(self.at(&self.state, None))

@@ -414,10 +414,11 @@ pub use model::{
 };
 #[cfg(all(feature = "alloc", feature = "sim"))]
 pub use run::{
-    drive_cartesian, metrics_of, run, simulate, simulate_cartesian, Arm as ModelArm,
-    CartesianDriver, CartesianLoop, Control, Controlled, Disturbances, Hooks, Injected, Injection,
-    Jacobian3, Loop, LoopJoint, Metrics, Output, Plant, Recorded, Reference, Replay, RigidBody,
-    RowMetrics, Rows, Run, RunError, Spec, Table, TaskRows, TaskStep, TypedTaskStep, HOOK_EVERY,
+    cartesian_steps, drive_cartesian, metrics_of, reads_the_wrench, run, simulate,
+    simulate_cartesian, Arm as ModelArm, CartesianDriver, CartesianLoop, Control, Controlled,
+    Disturbances, Hooks, Injected, Injection, Jacobian3, Loop, LoopJoint, Metrics, Output, Plant,
+    Recorded, Reference, Replay, RigidBody, RowMetrics, Rows, Run, RunError, Spec, Table, TaskRows,
+    TaskStep, TypedTaskStep, HOOK_EVERY,
 };
 #[cfg(feature = "alloc")]
 pub use target::{pose_target, HeldRotation, TARGET_LEN};

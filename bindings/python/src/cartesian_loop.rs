@@ -30,7 +30,7 @@ use adaptimp::control::impedance::TargetImpedance;
 use adaptimp::control::io::TaskTorque;
 use adaptimp::control::io::{Command, Measurement, WrenchControl};
 use adaptimp::dynamic::{
-    drive_cartesian, CartesianDriver, CartesianLoop, LoopJoint, TaskRows, TypedTaskStep,
+    self as dy, drive_cartesian, CartesianDriver, CartesianLoop, LoopJoint, TaskRows, TypedTaskStep,
 };
 use adaptimp::error::Error;
 use adaptimp::sim::record::Recorder;
@@ -369,22 +369,8 @@ fn checked<const N: usize, J: JointStep<N> + ?Sized>(
     joint: &J,
     run: &CartesianRun<'_>,
 ) -> Result<u64, RunError> {
-    let ts = outer.period();
-    if joint.period() != ts {
-        return Err(invalid(
-            "joint controller of a Cartesian impedance",
-            "needs the same Ts as the Cartesian impedance",
-        ));
-    }
-    let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
-    if let Some(tab) = run.targets {
-        let need = usize::try_from(total)
-            .unwrap_or(usize::MAX)
-            .saturating_mul(TARGET_LEN);
-        if tab.len() < need {
-            return Err(invalid("targets", "needs one pose target per step"));
-        }
-    }
+    let targets = run.targets.map(|tab| tab.len() / TARGET_LEN);
+    let total = dy::cartesian_steps(outer.period(), joint.period(), run.t_final, targets)?;
     reads_the_wrench::<N>(joint.law(), run.items, run.fault)?;
     Ok(total)
 }
@@ -392,7 +378,7 @@ fn checked<const N: usize, J: JointStep<N> + ?Sized>(
 /// A Cartesian controller (the core's, or one written in Python with the
 /// wrench hook) reads the wrench, not τe: the disturbances of `items` (for
 /// `law`'s scenario) and the `fault` must not act on τe alone, which would
-/// act on nothing.
+/// act on nothing ([`dy::reads_the_wrench`]).
 pub(crate) fn reads_the_wrench<const N: usize>(
     law: Law,
     items: &Items,
@@ -400,28 +386,20 @@ pub(crate) fn reads_the_wrench<const N: usize>(
 ) -> Result<(), RunError> {
     let s = super::dynamic::scenario::<N>(adaptimp::schema::Preset::Robot, law, items)
         .map_err(|e| RunError::Core(e.error, None))?;
-    if s.disturbances()?
+    let noise = s
+        .disturbances()?
         .params()
         .noise_tau_e
         .iter()
-        .any(|v| *v != 0.0)
-    {
-        return Err(invalid(
-            "noise_tau_e",
-            "a Cartesian controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
-        ));
-    }
-    if let Some(FaultSpec {
-        kind: FaultKind::ForceBias(_),
-        ..
-    }) = fault
-    {
-        return Err(invalid(
-            "force_bias",
-            "a Cartesian controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
-        ));
-    }
-    Ok(())
+        .any(|v| *v != 0.0);
+    let bias = matches!(
+        fault,
+        Some(FaultSpec {
+            kind: FaultKind::ForceBias(_),
+            ..
+        })
+    );
+    Ok(dy::reads_the_wrench(noise, bias)?)
 }
 
 /// A Cartesian step per row of recorded tables, the core's alone (for the

@@ -258,6 +258,51 @@ fn cartesian_m<const N: usize, const M: usize, J: LoopJoint<N>, D: CartesianDriv
     Ok(metrics.finish())
 }
 
+/// The steps of a Cartesian run of `t_final` (s) at the outer loop's
+/// period `ts` (s), checked before it starts: the joint controller at the
+/// same period (`joint_ts`), a pose target per step (`targets`: how many
+/// the run has, none: the last target held).
+pub fn cartesian_steps(
+    ts: f64,
+    joint_ts: f64,
+    t_final: f64,
+    targets: Option<usize>,
+) -> Result<u64, Error> {
+    if joint_ts != ts {
+        return Err(Error::Invalid {
+            what: "joint controller of a Cartesian impedance",
+            reason: "needs the same Ts as the Cartesian impedance",
+        });
+    }
+    let total = simulator::steps(t_final, ts)?;
+    if targets.is_some_and(|t| (t as u64) < total) {
+        return Err(Error::Invalid {
+            what: "targets",
+            reason: "needs one pose target per step",
+        });
+    }
+    Ok(total)
+}
+
+/// A Cartesian controller reads the wrench F_e, not τe: a run that puts
+/// sensor noise on τe (`noise_on_tau_e`) or a bias on it (`force_bias`)
+/// would disturb nothing, and is refused.
+pub fn reads_the_wrench(noise_on_tau_e: bool, force_bias: bool) -> Result<(), Error> {
+    if noise_on_tau_e {
+        return Err(Error::Invalid {
+            what: "noise_tau_e",
+            reason: "a Cartesian controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
+        });
+    }
+    if force_bias {
+        return Err(Error::Invalid {
+            what: "force_bias",
+            reason: "a Cartesian controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
+        });
+    }
+    Ok(())
+}
+
 /// The closed loop of the Cartesian controller (SPEC §13.1, §16): the
 /// outer loop `outer` (its state `state`) in front of `joint` on `plant`,
 /// with the measured wrench, the commanded pose of row k the k-th of
@@ -286,39 +331,23 @@ pub fn simulate_cartesian<S: AsRef<[f64]> + AsMut<[f64]>>(
     if rows.n() != n || task.n != n {
         return Err(mismatch("rows").into());
     }
-    if joint.period() != outer.period() {
-        return Err(Error::Invalid {
-            what: "joint controller of a Cartesian impedance",
-            reason: "needs the same Ts as the Cartesian impedance",
-        }
-        .into());
-    }
-    let total = simulator::steps(run.t_final, outer.period())?;
-    if targets.is_some_and(|t| (t.len() as u64) < total) {
-        return Err(Error::Invalid {
-            what: "targets",
-            reason: "needs one pose target per step",
-        }
-        .into());
-    }
-    if run.disturbances.is_some_and(Disturbances::noise_on_tau_e) {
-        return Err(Error::Invalid {
-            what: "noise_tau_e",
-            reason: "a Cartesian controller reads the wrench F_e, not τe: sensor noise on τe would act on nothing",
-        }
-        .into());
-    }
-    if let Some(Injection {
-        fault: Injected::ForceBias(_),
-        ..
-    }) = run.injection
-    {
-        return Err(Error::Invalid {
-            what: "force_bias",
-            reason: "a Cartesian controller reads the wrench F_e, not τe: a bias on τe would act on nothing",
-        }
-        .into());
-    }
+    cartesian_steps(
+        outer.period(),
+        joint.period(),
+        run.t_final,
+        targets.map(<[PoseTarget]>::len),
+    )?;
+    let force_bias = matches!(
+        run.injection,
+        Some(Injection {
+            fault: Injected::ForceBias(_),
+            ..
+        })
+    );
+    reads_the_wrench(
+        run.disturbances.is_some_and(Disturbances::noise_on_tau_e),
+        force_bias,
+    )?;
     each!(&outer.inner, o, N => {
         let st = state.inner.get_mut::<N>().ok_or(mismatch("state"))?;
         let dist = match run.disturbances {
@@ -362,5 +391,28 @@ impl<const N: usize, J: LoopJoint<N>> CartesianDriver<N, J> for OnPlant<'_, '_, 
         drive(
             self.plant, ctrl, clock, self.dist, self.run, self.hooks, rec,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cartesian_run_is_checked_before_it_starts() {
+        assert_eq!(cartesian_steps(1e-3, 1e-3, 0.01, None), Ok(10));
+        assert_eq!(cartesian_steps(1e-3, 1e-3, 0.01, Some(10)), Ok(10));
+        let msg = |r: Result<_, Error>| r.map(|_: u64| ()).unwrap_err().to_string();
+        assert_eq!(
+            msg(cartesian_steps(1e-3, 1e-3, 0.01, Some(9))),
+            "targets: needs one pose target per step"
+        );
+        assert!(msg(cartesian_steps(1e-3, 2e-3, 0.01, None)).contains("same Ts"));
+        assert_eq!(reads_the_wrench(false, false), Ok(()));
+        for (noise, bias, what) in [(true, false, "noise_tau_e"), (false, true, "force_bias")] {
+            let e = reads_the_wrench(noise, bias).unwrap_err().to_string();
+            assert!(e.starts_with(what), "{e}");
+            assert!(e.contains("reads the wrench F_e, not τe"), "{e}");
+        }
     }
 }

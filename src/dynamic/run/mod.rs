@@ -18,7 +18,8 @@ mod rows;
 mod spec;
 
 pub use cartesian::{
-    drive_cartesian, simulate_cartesian, CartesianDriver, CartesianLoop, LoopJoint,
+    cartesian_steps, drive_cartesian, reads_the_wrench, simulate_cartesian, CartesianDriver,
+    CartesianLoop, LoopJoint,
 };
 pub use plant::{Arm, Disturbances, Injected, Injection, Jacobian3, Plant, RigidBody};
 pub use replay::Replay;

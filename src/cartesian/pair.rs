@@ -3,7 +3,7 @@
 //! wrench, an optional pose target), transactional, allocation-free.
 
 use crate::cartesian::computed::{ComputedState, ComputedTorque};
-use crate::cartesian::kinematics::Kinematics;
+use crate::cartesian::kinematics::{Jacobian6, Kinematics};
 use crate::cartesian::outer::Formulation;
 use crate::cartesian::outer::{CartesianImpedance, CartesianState, CompliantPose, PoseTarget};
 use crate::control::controller::Controller;
@@ -326,6 +326,54 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
             p: tip.position,
             r: tip.rotation,
             tau_e: Vector::zeros(),
+        })
+    }
+}
+
+impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
+    /// [`step_with`](Self::step_with) for a joint law that gives only its
+    /// torque (a controller written in another language): `joint` gets the
+    /// measurement (τe = Jᵀ(q) F_e, zero without `force_feedforward`), the
+    /// joint reference to track (the compliant q_d, q̇_d, q̈_d; for the
+    /// torque-level formulations, SPEC §19, the commanded q_c, q̇_c, q̈_c)
+    /// and, for those, the task torque Jᵀ(K̃e + B(ṗ_c − J q̇)) (N m) at the
+    /// measured q̇ with the task Jacobian J (6 × n), and returns the torque
+    /// to apply (N m). The command's joint part is that torque (τ = sat(τ))
+    /// with z1 = q_d − q and xc = xd = q_d.
+    pub fn step_with_torque<F>(
+        &self,
+        outer: &mut CartesianState<N>,
+        m: &CartesianMeasurement<N>,
+        target: Option<&PoseTarget>,
+        joint: F,
+    ) -> Result<CartesianCommand<N>, Error>
+    where
+        F: FnOnce(
+            &Measurement<N>,
+            &Setpoint<N>,
+            Option<(&Vector<N>, &Jacobian6<N>)>,
+        ) -> Result<Vector<N>, Error>,
+    {
+        self.step_with(outer, m, target, |jm, r, task| {
+            let (reference, torque) = match task {
+                // The torque-level formulations (SPEC §19): the commanded
+                // reference and the task torque at the measured q̇.
+                Some(t) if t.share < 1.0 => {
+                    let dq = jm.dx.ok_or(Error::MissingVelocity)?;
+                    let torque = t.jacobian.transpose() * t.force(&dq);
+                    (t.commanded, Some((torque, &t.jacobian)))
+                }
+                _ => (*r, None),
+            };
+            let t = joint(jm, &reference, torque.as_ref().map(|(tau, j)| (tau, *j)))?;
+            Ok(Command {
+                tau_sat: t,
+                tau: t,
+                z1: r.x - jm.x,
+                xc: r.x,
+                xd: r.x,
+                ..Command::zeros()
+            })
         })
     }
 }

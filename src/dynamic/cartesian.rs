@@ -12,7 +12,6 @@ use super::values::{mismatch, vector, Command, Joints, Measurement, Setpoint};
 use crate::cartesian::{
     self, check_joint, set_pair_posture, start_pair, CartesianConfig, CompliantPose, PoseTarget,
 };
-use crate::control::io;
 use crate::error::{check, Error};
 use crate::types::Vector;
 use alloc::boxed::Box;
@@ -331,22 +330,12 @@ impl CartesianImpedance {
     {
         pair!(&self.inner, &mut state.inner, o, s, N => {
             let m = m.typed::<N>()?;
-            o.step_with(s, &m, target, |jm, r, task| {
-                let (reference, extra) = match task {
-                    // The torque-level formulations (SPEC §19): the commanded
-                    // reference and the task torque at the measured q̇.
-                    Some(t) if t.share < 1.0 => {
-                        let dq = jm.dx.ok_or(Error::MissingVelocity)?;
-                        let torque = t.jacobian.transpose() * t.force(&dq);
-                        (t.commanded, Some((Joints::of(&torque), Jacobian::of(&t.jacobian))))
-                    }
-                    _ => (*r, None),
-                };
-                let dx = jm.dx.as_ref().map(|d| d.as_slice());
+            o.step_with_torque(s, &m, target, |jm, reference, task| {
+                let task = task.map(|(torque, j)| (Joints::of(torque), Jacobian::of(j)));
                 let input = JointInput {
                     measurement: Measurement {
                         x: jm.x.as_slice(),
-                        dx,
+                        dx: jm.dx.as_ref().map(|d| d.as_slice()),
                         tau_e: jm.tau_e.as_slice(),
                     },
                     reference: Setpoint {
@@ -354,21 +343,12 @@ impl CartesianImpedance {
                         dx: reference.dx.as_slice(),
                         ddx: reference.ddx.as_slice(),
                     },
-                    task: extra.as_ref().map(|(torque, jacobian)| TaskInput {
+                    task: task.as_ref().map(|(torque, jacobian)| TaskInput {
                         torque: torque.as_slice(),
                         jacobian,
                     }),
                 };
-                let tau = joint(&input)?;
-                let t = vector::<N>("the joint controller's torque", &tau)?;
-                Ok(io::Command {
-                    tau_sat: t,
-                    tau: t,
-                    z1: r.x - jm.x,
-                    xc: r.x,
-                    xd: r.x,
-                    ..io::Command::zeros()
-                })
+                vector::<N>("the joint controller's torque", &joint(&input)?)
             })
             .map(|cmd| CartesianCommand::of(&cmd))
         }, _ => Err(mismatch("state")))

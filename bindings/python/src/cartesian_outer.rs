@@ -11,7 +11,6 @@ use adaptimp::cartesian::{
     CartesianConfig, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, Joint,
     JointKind, PoseTarget, Transform,
 };
-use adaptimp::control::io::Command;
 use adaptimp::dynamic::HeldRotation;
 use adaptimp::dynamic::{TaskRows, TypedTaskStep};
 use adaptimp::error::Error;
@@ -397,43 +396,23 @@ impl<const N: usize> DynOuter for Outer<N> {
     }
     fn step_joint(&mut self, m: &StepIn<'_>, joint: &mut JointFn<'_>) -> Result<(), Error> {
         let meas = Self::measurement(m);
-        let cmd =
-            self.outer
-                .step_with(&mut self.state, &meas, m.target.as_ref(), |jm, r, task| {
-                    let mut tau = [0.0; MAX_JOINTS];
-                    let (reference, extra) = match task {
-                        // The torque-level formulations (SPEC §19): the commanded
-                        // reference and the task torque at the measured q̇.
-                        Some(t) if t.share < 1.0 => {
-                            let dq = jm.dx.ok_or(Error::MissingVelocity)?;
-                            let torque = t.jacobian.transpose() * t.force(&dq);
-                            let rows = t.jacobian.transpose();
-                            (t.commanded, Some((torque, rows)))
-                        }
-                        _ => (*r, None),
-                    };
-                    joint(
-                        jm.x.as_slice(),
-                        jm.dx.as_ref().map(|d| d.as_slice()),
-                        jm.tau_e.as_slice(),
-                        [
-                            reference.x.as_slice(),
-                            reference.dx.as_slice(),
-                            reference.ddx.as_slice(),
-                        ],
-                        extra.as_ref().map(|(t, j)| (t.as_slice(), j.as_slice())),
-                        &mut tau[..N],
-                    )?;
-                    let t = vector_of::<N>(&tau);
-                    Ok(Command {
-                        tau_sat: t,
-                        tau: t,
-                        z1: r.x - jm.x,
-                        xc: r.x,
-                        xd: r.x,
-                        ..Command::zeros()
-                    })
-                })?;
+        let target = m.target.as_ref();
+        let cmd = self
+            .outer
+            .step_with_torque(&mut self.state, &meas, target, |jm, r, task| {
+                let mut tau = [0.0; MAX_JOINTS];
+                // Jᵀ (n × 6) column-major: J (6 × n) row-major.
+                let rows = task.map(|(torque, j)| (torque, j.transpose()));
+                joint(
+                    jm.x.as_slice(),
+                    jm.dx.as_ref().map(|d| d.as_slice()),
+                    jm.tau_e.as_slice(),
+                    [r.x.as_slice(), r.dx.as_slice(), r.ddx.as_slice()],
+                    rows.as_ref().map(|(t, j)| (t.as_slice(), j.as_slice())),
+                    &mut tau[..N],
+                )?;
+                Ok(vector_of::<N>(&tau))
+            })?;
         self.last = Some(TypedTaskStep::new(cmd, m.target.as_ref(), m.wrench));
         Ok(())
     }

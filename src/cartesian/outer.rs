@@ -728,6 +728,30 @@ impl<const N: usize, K: Kinematics<N>> CartesianImpedance<N, K> {
         }
         Ok(written)
     }
+
+    /// [`orbit`](Self::orbit) from `q0` (rad, checked finite) into a buffer
+    /// it sizes for L = min(`nodes`, `steps`) samples (at least one: one a
+    /// step at most, so a huge `nodes` allocates no more); the samples
+    /// written.
+    #[cfg(feature = "alloc")]
+    pub fn orbit_samples<F: FnMut(usize) -> PoseTarget>(
+        &self,
+        q0: Vector<N>,
+        steps: usize,
+        path: F,
+        nodes: usize,
+    ) -> Result<alloc::vec::Vec<Setpoint<N>>, Error> {
+        check::finite_slice("q0", q0.as_slice())?;
+        let zero = Setpoint {
+            x: Vector::<N>::zeros(),
+            dx: Vector::zeros(),
+            ddx: Vector::zeros(),
+        };
+        let mut out = alloc::vec![zero; nodes.min(steps).max(1)];
+        let k = self.orbit(q0, steps, path, &mut out)?;
+        out.truncate(k);
+        Ok(out)
+    }
 }
 
 #[cfg(test)]

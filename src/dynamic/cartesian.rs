@@ -12,7 +12,7 @@ use super::values::{mismatch, vector, Command, Joints, Measurement, Setpoint};
 use crate::cartesian::{
     self, check_joint, set_pair_posture, start_pair, CartesianConfig, CompliantPose, PoseTarget,
 };
-use crate::error::{check, Error};
+use crate::error::Error;
 use crate::types::Vector;
 use alloc::boxed::Box;
 use alloc::vec::Vec;
@@ -368,16 +368,8 @@ impl CartesianImpedance {
     ) -> Result<Vec<Setpoint>, Error> {
         each!(&self.inner, o, N => {
             let q0 = vector::<N>("q0", q0)?;
-            check::finite_slice("q0", q0.as_slice())?;
-            let zero = crate::trajectory::Setpoint {
-                x: Vector::<N>::zeros(),
-                dx: Vector::zeros(),
-                ddx: Vector::zeros(),
-            };
-            // At most one sample a step: a huge `nodes` allocates no more.
-            let mut out = alloc::vec![zero; nodes.min(steps).max(1)];
-            let k = o.orbit(q0, steps, path, &mut out)?;
-            Ok(out[..k].iter().map(Setpoint::of).collect())
+            let out = o.orbit_samples(q0, steps, path, nodes)?;
+            Ok(out.iter().map(Setpoint::of).collect())
         })
     }
 }

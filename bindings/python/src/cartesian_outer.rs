@@ -14,7 +14,6 @@ use adaptimp::cartesian::{
 use adaptimp::dynamic::HeldRotation;
 use adaptimp::dynamic::{TaskRows, TypedTaskStep};
 use adaptimp::error::Error;
-use adaptimp::trajectory::Setpoint;
 use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::any::{Any, TypeId};
@@ -482,23 +481,12 @@ impl<const N: usize> DynOuter for Outer<N> {
         nodes: usize,
     ) -> Result<[Vec<f64>; 3], Error> {
         let q0 = vector_of::<N>(q0);
-        adaptimp::error::check::finite_slice("q0", q0.as_slice())?;
-        let zero = Setpoint {
-            x: Vector::<N>::zeros(),
-            dx: Vector::zeros(),
-            ddx: Vector::zeros(),
-        };
-        // At most one sample a step: a huge `nodes` allocates no more.
-        let mut out = std::vec![zero; nodes.min(targets.len()).max(1)];
-        let k = self
+        let out = self
             .outer
-            .orbit(q0, targets.len(), |k| targets[k], &mut out)?;
-        let q = out[..k].iter().flat_map(|s| s.x.iter().copied()).collect();
-        let dq = out[..k].iter().flat_map(|s| s.dx.iter().copied()).collect();
-        let ddq = out[..k]
-            .iter()
-            .flat_map(|s| s.ddx.iter().copied())
-            .collect();
+            .orbit_samples(q0, targets.len(), |k| targets[k], nodes)?;
+        let q = out.iter().flat_map(|s| s.x.iter().copied()).collect();
+        let dq = out.iter().flat_map(|s| s.dx.iter().copied()).collect();
+        let ddq = out.iter().flat_map(|s| s.ddx.iter().copied()).collect();
         Ok([q, dq, ddq])
     }
     fn simulate_mujoco(

@@ -333,8 +333,11 @@ def main() -> None:
             try:
                 r = cartesian(model_of(arm, found[arm.label]), args.T)
             except Exception as e:  # a row per arm, whatever happens
-                print(f"| {arm.label} | refused or failed: {type(e).__name__}: {e} |")
+                row = f"| {arm.label} | refused or failed: {type(e).__name__}: {e} |"
+                print(row)
                 out["cartesian"][arm.label] = {"error": f"{type(e).__name__}: {e}"}
+                if args.check and documented.get(arm.label) != row:
+                    differ.append(f"documented: {documented.get(arm.label)}\nmeasured:   {row}")
                 continue
             r["time_s"] = time.perf_counter() - t0
             out["cartesian"][arm.label] = r

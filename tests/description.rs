@@ -649,6 +649,56 @@ fn an_inertia_no_rigid_body_has_refuses_the_arms_dynamics_by_name() {
     assert!(arm.to_dynamics::<2>(GRAVITY).is_ok());
 }
 
+/// SPEC (21.5): a file of the kinematics alone (no link the arm moves states
+/// a mass) and a last joint whose link has its mass on the axis and no
+/// inertia refuse the arm's dynamics by name; the kinematics reads.
+#[test]
+fn a_description_with_nothing_to_move_refuses_the_arms_dynamics_by_name() {
+    let two = [
+        ("j1", "revolute", "root", "a", ""),
+        ("j2", "revolute", "a", "b", ""),
+    ];
+    let arm = reduce(
+        &urdf::read_str(&robot(&two, &["a", "b"])).unwrap(),
+        None,
+        &[],
+    )
+    .unwrap();
+    assert!(arm.to_chain::<2>().is_ok());
+    let e = arm.to_dynamics::<2>(GRAVITY).expect_err("massless");
+    assert_eq!(e.kind(), ErrorKind::Value);
+    assert_eq!(
+        e.to_string(),
+        "URDF text: no link the arm moves states a mass (<inertial>): the file describes the \
+         arm's kinematics alone, and its dynamics (the plant, the rule's gains, computed \
+         torque) needs each link's mass and inertia: use a description of the arm with its \
+         links' <inertial> (the maker's, or example-robot-data's)"
+    );
+    // A point mass on j2's axis (y, through the link's origin): nothing to turn.
+    let point = robot(&two, &[]).replacen(
+        "<link name='b'><inertial><mass value='1'/>\
+         <inertia ixx='0.01' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.01'/>",
+        "<link name='b'><inertial><origin xyz='0 0.2 0'/><mass value='1'/>\
+         <inertia ixx='0' ixy='0' ixz='0' iyy='0' iyz='0' izz='0'/>",
+        1,
+    );
+    let arm = reduce(&urdf::read_str(&point).unwrap(), None, &[]).unwrap();
+    let e = arm
+        .to_dynamics::<2>(GRAVITY)
+        .expect_err("nothing about the axis");
+    assert_eq!(
+        e.to_string(),
+        "URDF text: the last arm joint 'j2' moves 0e0 kg m² about its axis (less than 1e-9): \
+         its link states no inertia there, so no torque controls it: give the link its \
+         <inertial>, or hold the joint (fix=['j2'])"
+    );
+    // The same mass 0.1 m off the axis moves m r² = 0.01 kg m².
+    let off = point.replace("<origin xyz='0 0.2 0'/>", "<origin xyz='0.1 0.2 0'/>");
+    let arm = reduce(&urdf::read_str(&off).unwrap(), None, &[]).unwrap();
+    assert!(arm.inertia_error.is_none());
+    assert!(arm.to_dynamics::<2>(GRAVITY).is_ok());
+}
+
 /// A mimic joint whose master is not another joint of the file was held
 /// silently (on the arm's way: the arm one joint short), in every front.
 /// On the way it is refused by name; off the arm it is held and said

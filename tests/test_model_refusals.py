@@ -190,3 +190,24 @@ def test_an_inertia_no_rigid_body_has_is_refused_by_link_and_file(
         assert message.startswith("URDF 'bad_inertia.urdf': link 'shoulder' has the inertia ")
         assert f"its principal moments are {moments} kg m², one negative" in message
     assert adaptimp.Chain.from_urdf(path).n == 5
+
+
+def test_a_file_of_the_kinematics_alone_is_refused_by_every_front(tmp_path: Path) -> None:
+    """SPEC (21.5): a URDF without one ``<inertial>`` on the arm (as
+    robotics-toolbox-python's xacro ABB IRB140 and Puma 560 ship) compiled with
+    MuJoCo's bounds into a 1e-6 kg arm that the rule tuned and the Cartesian
+    task ran on. The plant, computed torque and the dynamics refuse it by
+    name; its kinematics reads."""
+    from adaptimp import mujoco as amj
+
+    hobby = Path(__file__).parent / "data" / "hobby_arm.urdf"
+    path = tmp_path / "kinematic.urdf"
+    path.write_text(re.sub(r"<inertial>.*?</inertial>", "", hobby.read_text(), flags=re.S))
+    for read in (ComputedTorque, amj.from_urdf, amj.Plant):
+        with pytest.raises(
+            adaptimp.ConfigError,
+            match=r"^URDF 'kinematic\.urdf': no link the arm moves states a mass "
+            r"\(<inertial>\): the file describes the arm's kinematics alone",
+        ):
+            read(path)
+    assert adaptimp.Chain.from_urdf(path).n == 5

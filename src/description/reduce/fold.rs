@@ -252,6 +252,58 @@ pub(super) fn arm_joint(tree: &Tree, j: usize) -> ArmJoint {
 /// The [`Arm`] of the reduction `r` (the end of SPEC (21.2)): the arm
 /// joints `arm` from `base` to the tip, their chain and bodies, and every
 /// held joint with its value and reason.
+/// SPEC (21.5): a description whose dynamics has nothing to move — no link
+/// the arm moves states a mass, or the last arm joint moves less than 1e-9
+/// kg m² about its axis (1e-9 kg along it) — named with the file, the joint
+/// and what to do.
+fn unmovable(
+    tree: &Tree,
+    arm: &[usize],
+    chain: &[Joint],
+    inertials: &[Inertial],
+) -> Option<DescriptionError> {
+    const FLOOR: f64 = 1e-9;
+    if inertials.iter().all(|i| i.mass == 0.0) {
+        return Some(DescriptionError::new(
+            ErrorKind::Value,
+            format!(
+                "{}: no link the arm moves states a mass (<inertial>): the file describes \
+                 the arm's kinematics alone, and its dynamics (the plant, the rule's gains, \
+                 computed torque) needs each link's mass and inertia: use a description of \
+                 the arm with its links' <inertial> (the maker's, or example-robot-data's)",
+                tree.source()
+            ),
+        ));
+    }
+    let (&j, joint, body) = (arm.last()?, chain.last()?, inertials.last()?);
+    let name = &tree.joints()[j].name;
+    let a = Vector3::from(joint.axis).normalize();
+    let (moved, unit, what) = if tree.joints()[j].kind == JointType::Prismatic {
+        (body.mass, "kg", "along")
+    } else {
+        let r = Matrix3::from_fn(|i, k| body.origin.rotation[i][k]);
+        let ic = Matrix3::from_fn(|i, k| body.inertia[i][k]);
+        let c = Vector3::from(body.origin.translation);
+        let axial = a.dot(&(r * ic * r.transpose() * a));
+        (
+            axial + body.mass * (c.norm_squared() - a.dot(&c).powi(2)),
+            "kg m²",
+            "about",
+        )
+    };
+    (moved < FLOOR).then(|| {
+        DescriptionError::new(
+            ErrorKind::Value,
+            format!(
+                "{}: the last arm joint '{name}' moves {moved:e} {unit} {what} its axis \
+                 (less than {FLOOR:e}): its link states no inertia there, so no torque \
+                 controls it: give the link its <inertial>, or hold the joint (fix=['{name}'])",
+                tree.source()
+            ),
+        )
+    })
+}
+
 pub(super) fn build(
     r: &Reduction<'_>,
     base: usize,
@@ -272,6 +324,9 @@ pub(super) fn build(
         .iter()
         .map(|&a| fold.body(a))
         .collect::<Result<(Vec<_>, Vec<_>), _>>()?;
+    if let Some(e) = unmovable(tree, &arm, &chain, &inertials) {
+        fold.unphysical.borrow_mut().get_or_insert(e);
+    }
     let held = r
         .held
         .iter()

@@ -113,7 +113,9 @@ fn an_inertia_matrix_that_is_not_one_is_refused_by_name() {
             .to_string()
     };
     let uniform =
-        "inertia_matrix: needs K1, Kzeta and Kp/inertia the same on every joint (SPEC (18.12))";
+        "inertia_matrix: needs K1, Kzeta and Kp/inertia the same on every joint (SPEC (18.12)); \
+         gains that differ by joint take the diagonal law (no inertia_matrix: the rule's \
+         coupled = false)";
     assert_eq!(with(&|c| c.k1 = Vector::<2>::new(1.0, 100.0)), uniform);
     assert_eq!(with(&|c| c.kzeta = Vector::<2>::new(400.0, 500.0)), uniform);
     assert_eq!(with(&|c| c.kp = Vector::<2>::new(500.0, 60.0)), uniform);

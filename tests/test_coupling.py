@@ -108,3 +108,21 @@ def test_the_cartesian_task_keeps_the_diagonal_gains_unless_asked() -> None:
     assert default.params.get("inertia_matrix") is None
     m = np.asarray(asked.params["inertia_matrix"]).reshape(7, 7)
     np.testing.assert_array_equal(m, m.T)
+
+
+def test_gains_that_differ_by_joint_say_how_to_take_the_diagonal_law(panda: amj.Plant) -> None:
+    """With a delay the rule's default shapes the gains (SPEC (18.12)); a user's
+    Kp that changes the rate Kp/d on some joints is refused with the way out,
+    and runs with ``coupled=False``."""
+    kw = amj.rule_keywords(panda, amj.default_task(panda), delay=1)
+    kp = (np.asarray(kw["Kp"]) * np.array([1, 1, 1, 1, 0.5, 0.5, 0.5])).tolist()
+    with pytest.raises(
+        adaptimp.ConfigError,
+        match=r"^inertia_matrix: needs K1, Kzeta and Kp/inertia the same on every joint "
+        r"\(SPEC \(18\.12\)\); gains that differ by joint take the diagonal law \(no "
+        r"inertia_matrix: the rule's coupled = false\)$",
+    ):
+        amj.simulate("sf", panda, T=0.01, delay=1, Kp=kp)
+    res = amj.simulate("sf", panda, T=0.01, delay=1, Kp=kp, coupled=False)
+    assert res.params.get("inertia_matrix") is None
+    assert res.rows == 10

@@ -73,7 +73,9 @@ impl<const N: usize> Coupling<N> {
         if !(uniform(&cfg.k1) && uniform(&cfg.kzeta) && uniform(&rates)) {
             return Err(Error::Invalid {
                 what: "inertia_matrix",
-                reason: "needs K1, Kzeta and Kp/inertia the same on every joint (SPEC (18.12))",
+                reason: "needs K1, Kzeta and Kp/inertia the same on every joint (SPEC (18.12)); \
+                         gains that differ by joint take the diagonal law (no inertia_matrix: \
+                         the rule's coupled = false)",
             });
         }
         let inertia = (inertia + inertia.transpose()) * 0.5;

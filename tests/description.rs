@@ -688,9 +688,10 @@ fn a_description_with_nothing_to_move_refuses_the_arms_dynamics_by_name() {
         .expect_err("nothing about the axis");
     assert_eq!(
         e.to_string(),
-        "URDF text: the last arm joint 'j2' moves 0e0 kg m² about its axis (less than 1e-9): \
-         its link states no inertia there, so no torque controls it: give the link its \
-         <inertial>, or hold the joint (fix=['j2'])"
+        "URDF text: the last arm joint 'j2' moves 0e0 kg m² about its axis (less than 1e-9, \
+         its armature included): its link states no inertia there, so no torque controls it: \
+         give the link its <inertial> or the joint an armature, or hold the joint \
+         (fix=['j2'])"
     );
     // The same mass 0.1 m off the axis moves m r² = 0.01 kg m².
     let off = point.replace("<origin xyz='0 0.2 0'/>", "<origin xyz='0.1 0.2 0'/>");

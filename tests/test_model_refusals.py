@@ -211,3 +211,39 @@ def test_a_file_of_the_kinematics_alone_is_refused_by_every_front(tmp_path: Path
         ):
             read(path)
     assert adaptimp.Chain.from_urdf(path).n == 5
+
+
+ARMATURE_ARM = """<mujoco model="wrist">
+  <worldbody>
+    <body name="upper">
+      <joint name="j1" type="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+      <body name="hand" pos="0.3 0 0">
+        <joint name="j2" type="hinge" axis="1 0 0"{armature}/>
+        <inertial pos="0 0 0" mass="1e-9" diaginertia="1e-13 1e-13 1e-13"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="j1" ctrlrange="-10 10"/>
+    <motor joint="j2" ctrlrange="-10 10"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_a_last_joint_is_moved_by_its_armature_too(tmp_path: Path) -> None:
+    """SPEC (21.5) counts the joint's armature (rotor inertia) with its link:
+    dm_control's Jaco ends in a 1e-9 kg ring with ``armature="2"``, which
+    MuJoCo's mass matrix and the core's dynamics both carry. Without the
+    armature the same wrist moves nothing about its axis and is refused."""
+    path = tmp_path / "wrist.xml"
+    path.write_text(ARMATURE_ARM.format(armature=' armature="2"'))
+    assert ComputedTorque(path).n == 2
+    path.write_text(ARMATURE_ARM.format(armature=""))
+    with pytest.raises(
+        adaptimp.ConfigError,
+        match=r"^MJCF 'wrist\.xml': the last arm joint 'j2' moves 1e-13 kg m² about its axis "
+        r"\(less than 1e-9, its armature included\)",
+    ):
+        ComputedTorque(path)

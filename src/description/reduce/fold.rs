@@ -254,8 +254,8 @@ pub(super) fn arm_joint(tree: &Tree, j: usize) -> ArmJoint {
 /// held joint with its value and reason.
 /// SPEC (21.5): a description whose dynamics has nothing to move — no link
 /// the arm moves states a mass, or the last arm joint moves less than 1e-9
-/// kg m² about its axis (1e-9 kg along it) — named with the file, the joint
-/// and what to do.
+/// kg m² about its axis (1e-9 kg along it), its armature (rotor inertia)
+/// included — named with the file, the joint and what to do.
 fn unmovable(
     tree: &Tree,
     arm: &[usize],
@@ -278,26 +278,29 @@ fn unmovable(
     let (&j, joint, body) = (arm.last()?, chain.last()?, inertials.last()?);
     let name = &tree.joints()[j].name;
     let a = Vector3::from(joint.axis).normalize();
+    let armature = tree.joints()[j].armature;
     let (moved, unit, what) = if tree.joints()[j].kind == JointType::Prismatic {
-        (body.mass, "kg", "along")
+        (body.mass + armature, "kg", "along")
     } else {
         let r = Matrix3::from_fn(|i, k| body.origin.rotation[i][k]);
         let ic = Matrix3::from_fn(|i, k| body.inertia[i][k]);
         let c = Vector3::from(body.origin.translation);
         let axial = a.dot(&(r * ic * r.transpose() * a));
         (
-            axial + body.mass * (c.norm_squared() - a.dot(&c).powi(2)),
+            axial + body.mass * (c.norm_squared() - a.dot(&c).powi(2)) + armature,
             "kg m²",
             "about",
         )
     };
-    (moved < FLOOR).then(|| {
+    // A NaN is refused too.
+    (moved.is_nan() || moved < FLOOR).then(|| {
         DescriptionError::new(
             ErrorKind::Value,
             format!(
                 "{}: the last arm joint '{name}' moves {moved:e} {unit} {what} its axis \
-                 (less than {FLOOR:e}): its link states no inertia there, so no torque \
-                 controls it: give the link its <inertial>, or hold the joint (fix=['{name}'])",
+                 (less than {FLOOR:e}, its armature included): its link states no inertia \
+                 there, so no torque controls it: give the link its <inertial> or the joint \
+                 an armature, or hold the joint (fix=['{name}'])",
                 tree.source()
             ),
         )

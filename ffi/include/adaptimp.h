@@ -205,6 +205,17 @@ typedef enum AdaptimpFormulation {
   ADAPTIMP_FORMULATION_UNIFIED = 1502,
 } AdaptimpFormulation;
 
+// Which gains the rule of SPEC §18 makes ([`adaptimp_params_suggest_coupling`]).
+typedef enum AdaptimpCoupling {
+  // The rule's default: the inertia-shaped gains of SPEC (18.12) with a
+  // delay (≥ 1), the diagonal ones without.
+  ADAPTIMP_COUPLING_DEFAULT = 1600,
+  // The diagonal gains of (18.1) at any delay (per-joint scales).
+  ADAPTIMP_COUPLING_DIAGONAL = 1601,
+  // The inertia-shaped gains of (18.12) at any delay.
+  ADAPTIMP_COUPLING_SHAPED = 1602,
+} AdaptimpCoupling;
+
 // The 6-D Cartesian impedance over a chain and the joint controller it
 // drives (opaque: a handle; immutable: share it between threads).
 typedef struct AdaptimpCartesian AdaptimpCartesian;
@@ -1095,7 +1106,8 @@ enum AdaptimpStatus adaptimp_params_default(struct AdaptimpParams *out,
 // may be NULL. With a delay (≥ 1) the gains are shaped by the inertia,
 // SPEC (18.12): `out->inertia_matrix` gets `inertia` (the only sample, so
 // Dₛ = D at the start); without one it is INFINITY first (the diagonal
-// gains of (18.1)). `adaptimp_controller_new(out, …)` then builds the
+// gains of (18.1)); [`adaptimp_params_suggest_coupling`] chooses either at
+// any delay. `adaptimp_controller_new(out, …)` then builds the
 // controller. `law` outside its enum is INVALID_CONFIG; a NaN or a bad
 // value is INVALID_CONFIG naming it. On an error `*out` is left unchanged.
 //
@@ -1115,6 +1127,28 @@ enum AdaptimpStatus adaptimp_params_suggest(struct AdaptimpParams *out,
                                             const double *gravity,
                                             double *centers,
                                             double *widths2);
+
+// [`adaptimp_params_suggest`] with the choice of gains (`Python:
+// tuning.suggest(coupled=…)`): `coupling` the rule's default, the diagonal
+// gains of SPEC (18.1) or the inertia-shaped ones of (18.12) at any delay.
+// A `coupling` outside its enum is INVALID_CONFIG naming it.
+//
+// # Safety
+// As [`adaptimp_params_suggest`].
+enum AdaptimpStatus adaptimp_params_suggest_coupling(struct AdaptimpParams *out,
+                                                     size_t n,
+                                                     AdaptimpLaw law,
+                                                     const double *inertia,
+                                                     const double *tau_max,
+                                                     double ts,
+                                                     size_t delay,
+                                                     AdaptimpCoupling coupling,
+                                                     const double *path,
+                                                     size_t rows,
+                                                     double period,
+                                                     const double *gravity,
+                                                     double *centers,
+                                                     double *widths2);
 
 // The chain of the arm of a URDF into `*out` (free it with
 // `adaptimp_chain_free`), read and reduced by

@@ -156,6 +156,19 @@ pub enum AdaptimpFormulation {
     Unified = 1502,
 }
 
+/// Which gains the rule of SPEC §18 makes ([`adaptimp_params_suggest_coupling`]).
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AdaptimpCoupling {
+    /// The rule's default: the inertia-shaped gains of SPEC (18.12) with a
+    /// delay (≥ 1), the diagonal ones without.
+    Default = 1600,
+    /// The diagonal gains of (18.1) at any delay (per-joint scales).
+    Diagonal = 1601,
+    /// The inertia-shaped gains of (18.12) at any delay.
+    Shaped = 1602,
+}
+
 /// The robust term r(z2) (SPEC §7), in the order of `RobustKind::NAMES`.
 #[repr(C)]
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -272,6 +285,10 @@ pub enum AdaptimpJointKind {
 #[repr(transparent)]
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct AdaptimpLawRaw(pub u32);
+/// An [`AdaptimpCoupling`] as the caller passed it.
+#[repr(transparent)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct AdaptimpCouplingRaw(pub u32);
 /// An [`AdaptimpPreset`] as the caller passed it.
 #[repr(transparent)]
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
@@ -416,6 +433,7 @@ c_enums! {
     AdaptimpFaultPolicy / AdaptimpFaultPolicyRaw: Report, Latch;
     AdaptimpJointKind / AdaptimpJointKindRaw: Fixed, Revolute, Prismatic;
     AdaptimpFormulation / AdaptimpFormulationRaw: Admittance, Impedance, Unified;
+    AdaptimpCoupling / AdaptimpCouplingRaw: Default, Diagonal, Shaped;
 }
 
 /// The C name of a value: "AdaptimpLaw", "StateFeedback" → "ADAPTIMP_LAW_STATE_FEEDBACK".

@@ -269,7 +269,8 @@ pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = adaptimp::tuning::NODES.1;
 /// may be NULL. With a delay (≥ 1) the gains are shaped by the inertia,
 /// SPEC (18.12): `out->inertia_matrix` gets `inertia` (the only sample, so
 /// Dₛ = D at the start); without one it is INFINITY first (the diagonal
-/// gains of (18.1)). `adaptimp_controller_new(out, …)` then builds the
+/// gains of (18.1)); [`adaptimp_params_suggest_coupling`] chooses either at
+/// any delay. `adaptimp_controller_new(out, …)` then builds the
 /// controller. `law` outside its enum is INVALID_CONFIG; a NaN or a bad
 /// value is INVALID_CONFIG naming it. On an error `*out` is left unchanged.
 ///
@@ -293,6 +294,52 @@ pub unsafe extern "C" fn adaptimp_params_suggest(
     centers: *mut f64,
     widths2: *mut f64,
 ) -> AdaptimpStatus {
+    // SAFETY: the caller's contract, the same as the function's below.
+    unsafe {
+        adaptimp_params_suggest_coupling(
+            out,
+            n,
+            law,
+            inertia,
+            tau_max,
+            ts,
+            delay,
+            AdaptimpCouplingRaw(AdaptimpCoupling::Default as u32),
+            path,
+            rows,
+            period,
+            gravity,
+            centers,
+            widths2,
+        )
+    }
+}
+
+/// [`adaptimp_params_suggest`] with the choice of gains (`Python:
+/// tuning.suggest(coupled=…)`): `coupling` the rule's default, the diagonal
+/// gains of SPEC (18.1) or the inertia-shaped ones of (18.12) at any delay.
+/// A `coupling` outside its enum is INVALID_CONFIG naming it.
+///
+/// # Safety
+/// As [`adaptimp_params_suggest`].
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn adaptimp_params_suggest_coupling(
+    out: *mut AdaptimpParams,
+    n: usize,
+    law: AdaptimpLawRaw,
+    inertia: *const f64,
+    tau_max: *const f64,
+    ts: f64,
+    delay: usize,
+    coupling: AdaptimpCouplingRaw,
+    path: *const f64,
+    rows: usize,
+    period: f64,
+    gravity: *const f64,
+    centers: *mut f64,
+    widths2: *mut f64,
+) -> AdaptimpStatus {
     guard(|| {
         if !(1..=ADAPTIMP_MAX_JOINTS).contains(&n) {
             return Err(bad_n(n));
@@ -304,6 +351,11 @@ pub unsafe extern "C" fn adaptimp_params_suggest(
         let tau_max = unsafe { slice(tau_max, n, "tau_max") }?;
         let mut rule = Tuning::new(law, Inertia::At(inertia), tau_max, ts);
         rule.delay = delay;
+        rule.coupled = match decode::<AdaptimpCoupling>(coupling, "coupling")? {
+            AdaptimpCoupling::Default => None,
+            AdaptimpCoupling::Diagonal => Some(false),
+            AdaptimpCoupling::Shaped => Some(true),
+        };
         if !path.is_null() {
             let len = rows
                 .checked_mul(3 * n)

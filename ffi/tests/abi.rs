@@ -435,11 +435,11 @@ fn the_rule_through_the_abi_is_the_cores() {
 fn the_rule_through_the_abi_shapes_the_gains_with_a_delay() {
     let d = [2.0, 0.5, 0.1, 0.5, 1.0, 0.2, 0.1, 0.2, 0.05];
     let tau = [50.0, 20.0, 5.0];
-    let suggest = |delay: usize| {
+    let suggest = |delay: usize, coupling: u32| {
         let mut p = defaults(3, AdaptimpLaw::Pd, AdaptimpPreset::Robot);
         // SAFETY: valid pointers with the documented lengths; no path.
         let s = unsafe {
-            adaptimp_params_suggest(
+            adaptimp_params_suggest_coupling(
                 &mut p,
                 3,
                 AdaptimpLaw::Pd.into(),
@@ -447,6 +447,7 @@ fn the_rule_through_the_abi_shapes_the_gains_with_a_delay() {
                 tau.as_ptr(),
                 1e-3,
                 delay,
+                AdaptimpCouplingRaw(coupling),
                 ptr::null(),
                 0,
                 0.0,
@@ -455,18 +456,58 @@ fn the_rule_through_the_abi_shapes_the_gains_with_a_delay() {
                 ptr::null_mut(),
             )
         };
+        (s, p)
+    };
+    let ok = |delay: usize, coupling: AdaptimpCoupling| {
+        let (s, p) = suggest(delay, coupling as u32);
         assert_eq!(s, AdaptimpStatus::Ok, "{}", last_error());
         p
     };
-    assert_eq!(suggest(0).inertia_matrix[0], f64::INFINITY);
-    let p = suggest(1);
-    for (got, want) in p.inertia_matrix[..9].iter().zip(d) {
-        assert!(
-            (got - want).abs() <= 1e-12 * want,
-            "{:?}",
-            &p.inertia_matrix[..9]
-        );
-    }
+    let shaped = |p: &AdaptimpParams| {
+        for (got, want) in p.inertia_matrix[..9].iter().zip(d) {
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "{:?}",
+                &p.inertia_matrix[..9]
+            );
+        }
+    };
+    // The rule's default, as adaptimp_params_suggest gives it: shaped with
+    // a delay, diagonal without.
+    assert_eq!(
+        ok(0, AdaptimpCoupling::Default).inertia_matrix[0],
+        f64::INFINITY
+    );
+    let p = ok(1, AdaptimpCoupling::Default);
+    shaped(&p);
+    let mut q = defaults(3, AdaptimpLaw::Pd, AdaptimpPreset::Robot);
+    // SAFETY: valid pointers with the documented lengths; no path.
+    let s = unsafe {
+        adaptimp_params_suggest(
+            &mut q,
+            3,
+            AdaptimpLaw::Pd.into(),
+            d.as_ptr(),
+            tau.as_ptr(),
+            1e-3,
+            1,
+            ptr::null(),
+            0,
+            0.0,
+            ptr::null(),
+            ptr::null_mut(),
+            ptr::null_mut(),
+        )
+    };
+    assert_eq!(s, AdaptimpStatus::Ok, "{}", last_error());
+    assert_eq!(q.inertia_matrix, p.inertia_matrix);
+    assert_eq!(q.kp, p.kp);
+    // Either at any delay, as asked.
+    assert_eq!(
+        ok(1, AdaptimpCoupling::Diagonal).inertia_matrix[0],
+        f64::INFINITY
+    );
+    shaped(&ok(0, AdaptimpCoupling::Shaped));
     // The rate Kp/d is the same on every joint (SPEC (18.12)), and the
     // controller builds from what the ABI filled.
     let rate = p.kp[0] / p.inertia[0];
@@ -474,4 +515,8 @@ fn the_rule_through_the_abi_shapes_the_gains_with_a_delay() {
         assert!((p.kp[i] / p.inertia[i] - rate).abs() <= 1e-12 * rate);
     }
     Handles::new(&p).expect("the shaped rule builds through the ABI");
+    // A value outside the enum is refused by name.
+    let (s, _) = suggest(1, 7);
+    assert_eq!(s, AdaptimpStatus::InvalidConfig);
+    assert!(last_error().contains("coupling"), "{}", last_error());
 }

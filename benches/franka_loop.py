@@ -105,7 +105,7 @@ def franky_plant() -> amj.Plant:
     return plant
 
 
-def twin(urdf: str, T: float) -> list[dict[str, Any]]:
+def twin(urdf: str, T: float, coupled: bool | None = None) -> list[dict[str, Any]]:
     """franka.setup's controllers (from the URDF, as the robot route builds them)
     on franky-sim's MuJoCo FR3 in the library's loop, one period of delay, from
     the ready posture: the robot route without the network and the wall clock."""
@@ -113,7 +113,7 @@ def twin(urdf: str, T: float) -> list[dict[str, Any]]:
     for task in ("joint", "cartesian"):
         row: dict[str, Any] = {"loop": f"franky-sim's MJCF FR3, delay=1, {task}"}
         for case in ("pd", "sf") if task == "cartesian" else ("pd", "sf", "of"):
-            s = franka.setup(case, urdf, franka.READY, task=task)
+            s = franka.setup(case, urdf, franka.READY, task=task, coupled=coupled)
             q0 = np.array(franka.READY)
             if task == "joint":
                 ref = s.reference(round(T / franka.PERIOD))
@@ -127,7 +127,7 @@ def twin(urdf: str, T: float) -> list[dict[str, Any]]:
     return out
 
 
-def simulated(urdf: str, T: float) -> list[dict[str, Any]]:
+def simulated(urdf: str, T: float, coupled: bool | None = None) -> list[dict[str, Any]]:
     """The library's own loop on the same arm: delay 1, with and without gravity."""
     out = []
     for label, model in (("URDF, delay=1", urdf), ("franka.plant(URDF), delay=1", None)):
@@ -136,7 +136,7 @@ def simulated(urdf: str, T: float) -> list[dict[str, Any]]:
             plant = franka.plant(urdf) if model is None else model
             with warnings.catch_warnings():  # kept in the result, printed below
                 warnings.simplefilter("ignore", PlantWarning)
-                res = amj.simulate(case, plant, T=T, delay=1)
+                res = amj.simulate(case, plant, T=T, delay=1, coupled=coupled)
             row[case] = res.metrics["rms_z1_after2"]
             row["warnings"] += [f"{case}: {w}" for w in res.params["warnings"]]
         out.append(row)
@@ -177,8 +177,8 @@ def main() -> None:
         if not (task == "cartesian" and case == "of")
     ]
     load_after = os.getloadavg()
-    sim = simulated(args.urdf, 8.0) if args.simulate else []
-    twins = twin(args.urdf, args.T) if args.simulate and not args.ip else []
+    sim = simulated(args.urdf, 8.0, args.coupled) if args.simulate else []
+    twins = twin(args.urdf, args.T, args.coupled) if args.simulate and not args.ip else []
     machine = {
         "cpus": os.cpu_count(),
         "machine": platform.machine(),

@@ -76,6 +76,11 @@ def test_coupled_is_a_rule_option_of_a_case_name_on_an_arm(panda: amj.Plant) -> 
         amj.simulate(ctrl, panda, T=0.01, coupled=True)
     with pytest.raises(ValueError, match=r"^coupled= shapes the rule's gains on an arm"):
         amj.simulate("sf", "two_link", T=0.01, coupled=True)
+    # Told either way where no rule runs, it is refused, not dropped.
+    with pytest.raises(TypeError, match=r"^coupled= is an option of the rule that builds"):
+        amj.simulate(ctrl, panda, T=0.01, coupled=False)
+    with pytest.raises(ValueError, match=r"^coupled= shapes the rule's gains on an arm"):
+        amj.simulate("sf", "two_link", T=0.01, coupled=False)
     # A flag: "false" is not taken for True.
     with pytest.raises(TypeError, match=r"^coupled must be True or False, got str$"):
         amj.simulate("sf", panda, T=0.01, coupled="false")
@@ -110,19 +115,24 @@ def test_the_cartesian_task_keeps_the_diagonal_gains_unless_asked() -> None:
     np.testing.assert_array_equal(m, m.T)
 
 
-def test_gains_that_differ_by_joint_say_how_to_take_the_diagonal_law(panda: amj.Plant) -> None:
-    """With a delay the rule's default shapes the gains (SPEC (18.12)); a user's
-    Kp that changes the rate Kp/d on some joints is refused with the way out,
-    and runs with ``coupled=False``."""
-    kw = amj.rule_keywords(panda, amj.default_task(panda), delay=1)
+def test_gains_of_the_users_own_take_the_diagonal_law_unless_asked(panda: amj.Plant) -> None:
+    """With a delay the rule's default shapes the gains (SPEC (18.12)); a user
+    who sets Kp, inertia, K1 or Kzeta gets the diagonal law their per-joint
+    gains ran with before (``rule_coupled``); asked for the shaped law, gains
+    that differ by joint are refused with the way out."""
+    kw = amj.rule_keywords(panda, amj.default_task(panda), delay=1, coupled=False)
     kp = (np.asarray(kw["Kp"]) * np.array([1, 1, 1, 1, 0.5, 0.5, 0.5])).tolist()
+    res = amj.simulate("sf", panda, T=0.01, delay=1, Kp=kp)
+    assert res.params.get("inertia_matrix") is None
+    same = amj.simulate("sf", panda, T=0.01, delay=1, Kp=kp, coupled=False)
+    np.testing.assert_array_equal(res.tau, same.tau)
+    assert amj.rule_coupled(None, {"K1": 5.0}) is False
+    assert amj.rule_coupled(True, {"K1": 5.0}) is True
+    assert amj.rule_coupled(None, {"gamma": 1.0}) is None
     with pytest.raises(
         adaptimp.ConfigError,
         match=r"^inertia_matrix: needs K1, Kzeta and Kp/inertia the same on every joint "
         r"\(SPEC \(18\.12\)\); gains that differ by joint take the diagonal law \(no "
         r"inertia_matrix: the rule's coupled = false\)$",
     ):
-        amj.simulate("sf", panda, T=0.01, delay=1, Kp=kp)
-    res = amj.simulate("sf", panda, T=0.01, delay=1, Kp=kp, coupled=False)
-    assert res.params.get("inertia_matrix") is None
-    assert res.rows == 10
+        amj.simulate("sf", panda, T=0.01, delay=1, Kp=kp, coupled=True)

@@ -37,7 +37,7 @@ from ._plant import Plant, uses_rule
 from ._plant_models import ModelSource, with_payload
 from ._pose import task_space
 from ._run_checks import check_delay, check_refused, check_run, check_tracking
-from ._tasks import Task, default_task, rule_keywords
+from ._tasks import Task, default_task, rule_coupled, rule_keywords
 from ._trajectory import Reference, sinusoid
 
 FloatArray = NDArray[np.float64]
@@ -473,7 +473,7 @@ def _setup(
     # default (None) shapes the gains for a loop with a delay.
     asked = params.pop("coupled", None)
     asked = None if asked is None else flag("coupled", asked)
-    if asked and not isinstance(controller, str):
+    if asked is not None and not isinstance(controller, str):
         raise TypeError(
             "coupled= is an option of the rule that builds a case name's controller: "
             "build your controller with it (tuning.suggest(coupled=True))"
@@ -483,7 +483,7 @@ def _setup(
         raise ValueError(
             "home= sets the default task of a case name on an arm (not the paper's two_link)"
         )
-    if asked and not uses_rule(nominal):
+    if asked is not None and not uses_rule(nominal):
         raise ValueError(
             "coupled= shapes the rule's gains on an arm: the paper's two_link runs the paper's "
             "controller, not the rule's"
@@ -493,7 +493,8 @@ def _setup(
         if uses_rule(nominal):
             task, reference, rule = _rule_setup(
                 nominal, controller, kwargs, reference, Ts or float(defaults["Ts"]),
-                float(defaults["T"]) if T is None else float(T), home, delay, asked,
+                float(defaults["T"]) if T is None else float(T), home, delay,
+                rule_coupled(asked, kwargs),
             )  # fmt: skip
             kwargs = {**rule, **kwargs}
             if q0 is None and task is not None:

@@ -8,7 +8,7 @@ Re-exported by :mod:`adaptimp.mujoco`. Units: rad, rad/s, N m, m, s."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -172,6 +172,21 @@ def default_task(plant: Plant, home: ArrayLike | None = None) -> Task:
     kw = tuning.default_task(h, lo, hi)
     q0 = np.asarray(kw["xc_offset"]) + np.asarray(kw["xc_cos"])
     return Task(home=h, q0=q0, keywords=kw, period=2 * math.pi / kw["xc_omega"][0])
+
+
+#: The keywords whose per-joint values the inertia-shaped gains of SPEC
+#: (18.12) tie together (K1, Kζ and the rate Kp/d the same on every joint).
+SHAPED_KEYS = ("Kp", "inertia", "K1", "Kzeta")
+
+
+def rule_coupled(coupled: bool | None, params: Mapping[str, Any]) -> bool | None:
+    """The rule's ``coupled`` (SPEC (18.12)) for a caller's keywords ``params``:
+    as asked; else, where they set any of :data:`SHAPED_KEYS` (gains of their
+    own, which may differ by joint), the diagonal law (False); else the
+    rule's default (None: shaped on a joint task with a delay)."""
+    if coupled is None and any(k in params for k in SHAPED_KEYS):
+        return False
+    return coupled
 
 
 def rule_keywords(

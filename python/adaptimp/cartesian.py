@@ -321,8 +321,8 @@ class CartesianController:
         coupled : bool or None
             The joint controller's inertia-shaped gains, SPEC (18.12)
             (:func:`adaptimp.tuning.suggest`'s ``coupled``; default: the
-            diagonal gains of (18.1), which hold a Cartesian task better at
-            every delay measured; True: the shaped ones).
+            diagonal gains of (18.1), which miss fewer of the Cartesian
+            targets measured (docs/your_arm.md); True: the shaped ones).
         **params
             Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
             and the joint controller's, e.g. ``gamma``). ``gravity="model"``:

@@ -216,9 +216,9 @@ def cmd_simulate(args: argparse.Namespace, params: dict[str, Any]) -> int:
         _figure_format(args.plot)
     if args.model is None:
         mujoco_only = [
-            f"--{k}" for k in ("tip", "fix", "task", "payload", "home", "gravity", "coupled")
+            f"--{k}" for k in ("tip", "fix", "task", "payload", "home", "gravity")
             if getattr(args, k) not in (None, "", "joint", False)
-        ]  # fmt: skip
+        ] + (["--[no-]coupled"] if args.coupled is not None else [])  # fmt: skip
         if mujoco_only:
             verb = "applies" if len(mujoco_only) == 1 else "apply"
             raise CliError(f"{', '.join(mujoco_only)} {verb} to an arm given with --model FILE")

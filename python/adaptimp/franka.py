@@ -92,6 +92,7 @@ from ._franka_loop import TAU_MAX as TAU_MAX
 from ._franka_loop import FloatArray as FloatArray
 from ._franka_sim import SERVER as SERVER
 from ._franka_sim import Simulator as Simulator
+from ._tasks import rule_coupled
 from .chain import Chain as Chain
 
 __all__ = [
@@ -196,7 +197,8 @@ def setup(
         return Setup(ctrl, "cartesian", arm, q, ctask, 0.0)
     h = q if home is None else posture_of("home", home)
     jtask = amj.default_task(arm, h)
-    kw = amj.rule_keywords(arm, jtask, Ts=PERIOD, case=controller, delay=DELAY, coupled=coupled)
+    shaped = rule_coupled(coupled, params)
+    kw = amj.rule_keywords(arm, jtask, Ts=PERIOD, case=controller, delay=DELAY, coupled=shaped)
     kw.pop("n")
     kw.update(keywords)
     ctrl = _adaptimp_controller(controller, kw)

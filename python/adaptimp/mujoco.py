@@ -195,6 +195,9 @@ from ._tasks import (
     home_posture as home_posture,
 )
 from ._tasks import (
+    rule_coupled as rule_coupled,
+)
+from ._tasks import (
     rule_keywords as rule_keywords,
 )
 from ._tooling import add_table as add_table
@@ -227,6 +230,7 @@ __all__ = [
     "moving_mass",
     "panda",
     "paper_circle",
+    "rule_coupled",
     "rule_keywords",
     "self_collision",
     "simulate",

@@ -240,7 +240,8 @@ def suggest(
     -------
     dict
         ``n`` and the keywords of :data:`RULE_KEYS`, ``inertia_matrix`` when
-        ``coupled`` and, with a path, ``centers`` (L, 4n) and ``widths``
+        the gains are shaped (``coupled`` True, or None with a ``delay`` and
+        no ``resolve``) and, with a path, ``centers`` (L, 4n) and ``widths``
         (4n,): keywords of
         ``adaptimp.Controller(case, "robot", **kw)``, which construction accepts.
 

@@ -286,8 +286,9 @@ fn unmovable(
         let ic = Matrix3::from_fn(|i, k| body.inertia[i][k]);
         let c = Vector3::from(body.origin.translation);
         let axial = a.dot(&(r * ic * r.transpose() * a));
+        let along = a.dot(&c);
         (
-            axial + body.mass * (c.norm_squared() - a.dot(&c).powi(2)) + armature,
+            axial + body.mass * (c.norm_squared() - along * along) + armature,
             "kg m²",
             "about",
         )

@@ -11,7 +11,7 @@ For each file and delay d: ``amj.simulate(case, FILE, T=T, delay=d)`` for PD,
 SF and OF (RMS ‖z1‖ over t ≥ 2 s, the plant's true q), SF's drift (RMS over the
 last 2 s against [2, 4) s), the peak commanded |τ_i|/τmax_i after 0.1 s and
 the share of rows at a limit; with ``--cartesian`` also ``amj.cartesian_task``
-and SF/PD in position and orientation over t ≥ 2 s (T = 12 s). Prints one
+and SF/PD in position and orientation over t ≥ 2 s (T = 12 s, ``--cartesian-T``). Prints one
 Markdown table per part; the targets of the issue are SF/PD and OF/PD ≤ 0.2,
 no drift, peak ≤ 2 τmax. Every controller (PD too) is made by the rule with
 its default: the inertia-shaped gains of SPEC (18.12) on the joint task for
@@ -67,15 +67,15 @@ def joint_row(
 
 
 def cartesian_row(
-    path: str, d: int, tip: str | None, coupled: bool | None = None
+    path: str, d: int, tip: str | None, coupled: bool | None = None, T: float = 12.0
 ) -> dict[str, Any]:
-    """PD and SF of the default Cartesian task at delay ``d`` (T = 12 s)."""
+    """PD and SF of the default Cartesian task at delay ``d`` (T s, 12 by default)."""
     from adaptimp import mujoco as amj
 
     plant = amj.Plant(path, tip=tip, contact=False)
     task = amj.cartesian_task(plant)
     runs = {
-        c: amj.simulate(c, plant, T=12.0, task=task, delay=d, coupled=coupled) for c in ("pd", "sf")
+        c: amj.simulate(c, plant, T=T, task=task, delay=d, coupled=coupled) for c in ("pd", "sf")
     }
     pos = {c: float(r.metrics["rms_pos_after2"]) for c, r in runs.items()}
     rot = {c: float(r.metrics["rms_rot_after2"]) for c, r in runs.items()}
@@ -99,6 +99,9 @@ def main() -> None:
     parser.add_argument("--delays", default="0,1,2", help="delays in periods, comma-separated")
     parser.add_argument("--T", type=float, default=8.0, help="joint runs' duration (s)")
     parser.add_argument("--cartesian", action="store_true", help="also the Cartesian task")
+    parser.add_argument(
+        "--cartesian-T", type=float, default=12.0, help="Cartesian runs' duration (s)"
+    )
     parser.add_argument(
         "--coupled",
         action=argparse.BooleanOptionalAction,
@@ -143,7 +146,7 @@ def main() -> None:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     try:
-                        c = cartesian_row(path, d, args.tip, args.coupled)
+                        c = cartesian_row(path, d, args.tip, args.coupled, args.cartesian_T)
                     except Exception as e:
                         print(f"| {name} | {d} | {type(e).__name__}: {str(e)[:120]} ||||")
                         continue

@@ -532,12 +532,26 @@ class Plant:
         controls, activations, time) as it is now, put back when the block
         ends, whatever it did (a rule that reads D(q) and G(q) at postures of
         its own, :meth:`adaptimp.CartesianController.from_rule`)."""
-        saved = mujoco.MjData(self.model)
-        mujoco.mj_copyData(saved, self.model, self.data)
+        m, d = self.model, self.data
+        copy_data = getattr(mujoco, "mj_copyData", None)
+        if copy_data is not None:
+            saved = mujoco.MjData(m)
+            copy_data(saved, m, d)
+            try:
+                yield
+            finally:
+                copy_data(d, m, saved)
+            return
+        # MuJoCo bindings without mj_copyData (robosuite's 3.3): the
+        # state that integration reads, and the rest recomputed from it.
+        spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        state = np.empty(mujoco.mj_stateSize(m, spec))
+        mujoco.mj_getState(m, d, state, spec)
         try:
             yield
         finally:
-            mujoco.mj_copyData(self.data, self.model, saved)
+            mujoco.mj_setState(m, d, state, spec)
+            mujoco.mj_forward(m, d)
 
     def _vector(self, name: str, value: ArrayLike) -> FloatArray:
         v = reals(name, value, finite=False)

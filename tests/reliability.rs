@@ -350,6 +350,50 @@ fn the_rate_limit_bounds_the_change_of_torque_and_shows_in_dtau() {
     assert!(limited, "the rate limit acted below the saturation limits");
 }
 
+#[test]
+fn a_controller_takes_over_the_torque_it_is_handed() {
+    // The first step's rate limit moves from the torque taken over (what a
+    // robot's own controller held the arm with), not from zero.
+    let mut cfg = robot(Law::StateFeedback);
+    cfg.limits.tau_rate = Vector::from_element(0.5);
+    let c = build(cfg).unwrap();
+    let held = Vector::<2>::new(6.0, -4.0);
+    let mut cold = c.new_state();
+    let mut st = c.new_state();
+    c.take_over(&mut st, &held).unwrap();
+    assert_eq!(st.applied(), &held);
+    let first = step(&c, &mut st, &measurement(0)).unwrap();
+    assert!(
+        (first.tau_sat - held).amax() <= 0.5 + 1e-12,
+        "{}",
+        first.tau_sat
+    );
+    let from_zero = step(&c, &mut cold, &measurement(0)).unwrap();
+    assert!(from_zero.tau_sat.amax() <= 0.5 + 1e-12);
+    // Only before the first step; finite; within τmax. Nothing changes on an error.
+    let e = c.take_over(&mut st, &held).unwrap_err();
+    assert_eq!(e.to_string(), "take_over: only before the first step");
+    let mut fresh = c.new_state();
+    let e = c
+        .take_over(&mut fresh, &Vector::<2>::new(f64::NAN, 0.0))
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "torque taken over[0] is not finite (NaN or infinite)"
+    );
+    let e = c
+        .take_over(&mut fresh, &Vector::<2>::new(0.0, 1e3))
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "torque taken over[1] = 1e3 is beyond its limit ±1.5e1; the state was left unchanged"
+    );
+    assert_eq!(fresh.applied(), &Vector::<2>::zeros());
+    // reset: back to zero.
+    st.reset();
+    assert_eq!(st.applied(), &Vector::<2>::zeros());
+}
+
 /// The URDF reader (SPEC §21) on documents no robot file is: nested 100 000
 /// deep (the XML reader builds and drops elements recursively: this
 /// overflowed the stack, and 10⁶ deep took minutes), a device that never

@@ -170,3 +170,32 @@ def test_reading_a_large_urdf_stops_on_a_signal() -> None:
     # Raised inside the reading, not after it ended (then with its context).
     assert stopped.value.__context__ is None
     assert spent < 0.5 * whole, (spent, whole)
+
+
+def test_a_controller_takes_over_a_robots_torque() -> None:
+    """take_over(tau): the first step's rate limit moves from the torque a
+    robot's own controller held the arm with (libfranka's limitRate from
+    tau_J_d), not from zero; only before the first step, finite, within τmax,
+    each refused by name with nothing changed."""
+    c = adaptimp.Controller("sf", "robot", n=2, tau_rate_max=0.5)
+    cold = adaptimp.Controller("sf", "robot", n=2, tau_rate_max=0.5)
+    with pytest.raises(
+        adaptimp.MeasurementError, match=r"^tau\[0\] is not finite \(NaN or infinite\)$"
+    ):
+        c.take_over([np.nan, 0.0])
+    with pytest.raises(
+        adaptimp.ConfigError,
+        match=r"^torque taken over\[1\] = 1e3 is beyond its limit ±1\.5e1; "
+        r"the state was left unchanged$",
+    ):
+        c.take_over([0.0, 1e3])
+    np.testing.assert_array_equal(c.applied, [0.0, 0.0])
+    c.take_over([6.0, -4.0])
+    np.testing.assert_array_equal(c.applied, [6.0, -4.0])
+    m = adaptimp.Measurement([0.1, 0.2], [0.0, 0.0])
+    np.testing.assert_array_equal(c.step(m), [5.5, -3.5])
+    np.testing.assert_array_equal(cold.step(m), [-0.5, 0.5])
+    with pytest.raises(adaptimp.ConfigError, match=r"^take_over: only before the first step$"):
+        c.take_over([0.0, 0.0])
+    c.reset()
+    np.testing.assert_array_equal(c.applied, [0.0, 0.0])

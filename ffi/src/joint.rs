@@ -432,6 +432,37 @@ pub unsafe extern "C" fn adaptimp_state_restore(
     })
 }
 
+/// Take over the actuators from a controller that was applying `tau` (`n`
+/// reals, N m) until now (a robot's own, holding the arm where it stands:
+/// libfranka's `tau_J_d` read before the torque loop starts): the first
+/// step's torque rate limit moves from it, so the first command continues
+/// it, as Rust's `Controller::take_over` and Python's `Controller.take_over`.
+/// Before the first step only. On an error the state is unchanged:
+/// BAD_SIZE (`n`), INVALID_CONFIG (after the first step, a torque not finite
+/// or beyond τmax, named), WRONG_STATE (a state of another controller).
+///
+/// # Safety
+/// `ctrl` and `state` are NULL or valid; `tau` is NULL or holds `n` reals.
+#[no_mangle]
+pub unsafe extern "C" fn adaptimp_state_take_over(
+    ctrl: *const AdaptimpController,
+    state: *mut AdaptimpState,
+    tau: *const f64,
+    n: usize,
+) -> AdaptimpStatus {
+    guard(|| {
+        // SAFETY (in the helpers): checked for NULL; the caller's contract.
+        let c = unsafe { handle(ctrl, "ctrl") }?;
+        let s = unsafe { handle_mut(state, "state") }?;
+        check_n(n, c.ctrl.n(), "controller")?;
+        let tau = unsafe { slice(tau, n, "tau") }?;
+        same_joints(c.ctrl.n(), s.state.n(), "controller")?;
+        c.ctrl
+            .take_over(&mut s.state, tau)
+            .map_err(|e| core_error(e, Context::Config))
+    })
+}
+
 /// One controller step at t_k = k·Ts. `q` (rad), `tau_e` (N m) and `dq`
 /// (rad/s; required by PD and state feedback, may be NULL for output
 /// feedback) hold `n` reals, the controller's number of joints. `setpoint` is

@@ -299,6 +299,40 @@ fn a_snapshot_restored_continues_bit_identically_and_a_bad_one_changes_nothing()
 }
 
 #[test]
+fn a_state_takes_over_a_robots_torque_before_its_first_step() {
+    let mut p = defaults(2, AdaptimpLaw::StateFeedback, AdaptimpPreset::Robot);
+    p.tau_rate_max[..2].copy_from_slice(&[0.5, 0.5]);
+    let (a, cold) = (Handles::new(&p).unwrap(), Handles::new(&p).unwrap());
+    let held = [6.0, -4.0];
+    // SAFETY: valid handles; slices of the stated lengths.
+    unsafe {
+        assert_eq!(
+            adaptimp_state_take_over(a.ctrl, a.state, held.as_ptr(), 3),
+            AdaptimpStatus::BadSize
+        );
+        assert_eq!(
+            adaptimp_state_take_over(a.ctrl, a.state, held.as_ptr(), 2),
+            AdaptimpStatus::Ok
+        );
+    }
+    let (q, dq, te) = inputs(0);
+    let first = a.step(&q, Some(&dq), &te).unwrap();
+    let from_zero = cold.step(&q, Some(&dq), &te).unwrap();
+    for (i, h) in held.iter().enumerate() {
+        assert!((first.tau_sat[i] - h).abs() <= 0.5 + 1e-12);
+        assert!(from_zero.tau_sat[i].abs() <= 0.5 + 1e-12);
+    }
+    // SAFETY: as above.
+    unsafe {
+        assert_eq!(
+            adaptimp_state_take_over(a.ctrl, a.state, held.as_ptr(), 2),
+            AdaptimpStatus::InvalidConfig
+        );
+    }
+    assert_eq!(last_error(), "take_over: only before the first step");
+}
+
+#[test]
 fn the_circle_of_the_preset_is_the_default_setpoint() {
     // A NULL setpoint tracks the controller's own trajectory, as Tracker does.
     let c = Handles::new(&defaults(

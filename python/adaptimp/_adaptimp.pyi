@@ -391,6 +391,10 @@ class Controller:
     def snapshot(self) -> _F: ...
     def restore(self, data: _F) -> None: ...
     def load_weights(self, weights: dict[str, _F]) -> None: ...
+    def take_over(self, tau: ArrayLike) -> None:
+        """Take over from a controller that was applying ``tau`` (n,) (N m): the
+        first step's torque rate limit moves from it (libfranka's ``limitRate``
+        from ``tau_J_d``). Before the first step only; finite, within τmax."""
     @property
     def case(self) -> str: ...
     @property
@@ -759,7 +763,8 @@ def suggest(
     the widths in q at least its diameter, SPEC (19.11); ``weightless``: D̂ and Ĉ
     learning at Ĝ's bandwidth, an arm without gravity, SPEC (22.2); ``coupled``: the
     inertia-shaped gains of SPEC (18.12) (the keyword ``inertia_matrix``; None:
-    the core's default, on for a delay ≥ 1 unless ``resolve``)."""
+    the core's default, on for a delay ≥ 1; with ``resolve``, Ĝ then learns at
+    least at (m/Ts) K1)."""
 
 def pose_circle(
     p0: NDArray[np.float64],

@@ -265,6 +265,36 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         Ok(())
     }
 
+    /// Take over the actuators from a controller that was applying `tau`
+    /// (N m) until now (a robot's own, holding the arm where it stands): the
+    /// first step's torque rate limit moves from it, as libfranka's
+    /// `limitRate` moves from the torque the robot last commanded
+    /// (`tau_J_d`), and a refused first step holds it. Without it the first
+    /// step's rate limit moves from zero, a step in torque of what held the
+    /// arm. Only before the first step (refused after it: "take_over: only
+    /// before the first step"); `tau` finite and within τmax, each refused
+    /// by name. On an error `st` is as before.
+    pub fn take_over<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        st: &mut State<N, S>,
+        tau: &Vector<N>,
+    ) -> Result<(), Error> {
+        if st.steps() != 0 {
+            return Err(Error::Invalid {
+                what: "take_over",
+                reason: "only before the first step",
+            });
+        }
+        check::finite_slice("torque taken over", tau.as_slice())?;
+        check::within_each(
+            "torque taken over",
+            tau.as_slice(),
+            self.sat.limits().as_slice(),
+        )?;
+        st.applied = *tau;
+        Ok(())
+    }
+
     /// Replace the weights of `st` (a warm start), checked as
     /// [`State::load_weights`] checks them and against the projection bounds.
     pub fn load_weights<S: AsRef<[f64]> + AsMut<[f64]>>(

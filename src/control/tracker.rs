@@ -80,6 +80,12 @@ impl<const N: usize, B: Basis<N>, T: Trajectory<N>> Tracker<N, B, T> {
         self.ctrl.restore(&mut self.state, data)
     }
 
+    /// Take over from a controller that was applying `tau` (N m), checked
+    /// ([`Controller::take_over`]); on an error nothing changes.
+    pub fn take_over(&mut self, tau: &crate::types::Vector<N>) -> Result<(), Error> {
+        self.ctrl.take_over(&mut self.state, tau)
+    }
+
     /// Replace the weights, checked against the controller
     /// ([`Controller::load_weights`]); on an error nothing changes.
     pub fn load_weights(

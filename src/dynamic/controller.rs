@@ -415,6 +415,22 @@ impl Controller {
         pair!(&self.inner, &mut state.inner, c, s, N => c.ctrl.restore(s, data), _ => Err(mismatch("state")))
     }
 
+    /// Take over the actuators from a controller that was applying `tau`
+    /// (N m, n values) until now: the first step's torque rate limit moves
+    /// from it ([`Controller::take_over`](crate::Controller::take_over)).
+    pub fn take_over<S: AsRef<[f64]> + AsMut<[f64]>>(
+        &self,
+        state: &mut State<S>,
+        tau: &[f64],
+    ) -> Result<(), Error> {
+        pair!(&self.inner, &mut state.inner, c, s, N => {
+            if tau.len() != N {
+                return Err(super::values::length("torque taken over"));
+            }
+            c.ctrl.take_over(s, &Vector::<N>::from_column_slice(tau))
+        }, _ => Err(mismatch("state")))
+    }
+
     /// Replace the weights of `state` (a warm start) with `rows`: the
     /// `2n² + n` rows ŴD\[k\]\[j\], ŴC\[k\]\[j\], ŴG\[k\] of L values each
     /// ([`Weights::from_rows`]), checked as

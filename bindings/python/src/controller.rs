@@ -405,6 +405,17 @@ impl PyController {
         self.lock(py)?.load_weights(&rows).map_err(state_error)
     }
 
+    /// Take over the actuators from a controller that was applying ``tau``
+    /// (n,) (N m) until now (a robot's own, holding the arm): the first
+    /// step's torque rate limit moves from it, as libfranka's ``limitRate``
+    /// moves from the torque the robot last commanded (``tau_J_d``). Before
+    /// the first step only; ``tau`` finite and within τmax (ConfigError
+    /// naming what is wrong; on an error nothing changes).
+    fn take_over(&self, py: Python<'_>, tau: &Bound<'_, PyAny>) -> PyResult<()> {
+        let t = vector("tau", self.n, tau)?;
+        self.lock(py)?.take_over(&t[..self.n]).map_err(state_error)
+    }
+
     /// "pd", "sf" or "of".
     #[getter]
     fn case(&self) -> &'static str {

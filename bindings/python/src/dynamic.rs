@@ -107,6 +107,8 @@ pub trait DynTracker: Send + Sync {
     fn weights(&self) -> Vec<f64>;
     /// Replace the weights (same layout as [`weights`](Self::weights)).
     fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error>;
+    /// Take over from a controller that was applying `tau` (n values, N m).
+    fn take_over(&mut self, tau: &[f64]) -> Result<(), Error>;
     /// The whole state as reals ([`State::save`](adaptimp::control::state::State::save)).
     fn snapshot(&self) -> Vec<f64>;
     /// Restore a [`snapshot`](Self::snapshot).
@@ -333,6 +335,10 @@ impl<const N: usize> DynTracker for Typed<N> {
     fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error> {
         let w = Weights::<N>::from_rows(rows, self.nodes())?;
         Tracker::load_weights(self, &w)
+    }
+
+    fn take_over(&mut self, tau: &[f64]) -> Result<(), Error> {
+        Tracker::take_over(self, &Vector::<N>::from_column_slice(tau))
     }
 
     fn snapshot(&self) -> Vec<f64> {

@@ -101,6 +101,11 @@ int main(int argc, char** argv) {
         AdaptimpState* s = nullptr;
         check(adaptimp_state_new(ctrl.get(), &s), "its state");
         std::unique_ptr<AdaptimpState, FreeState> state(s);
+        // What the robot holds the arm with now (gravity aside): the first command
+        // continues it, and the rate limit moves from it (no step in torque).
+        const franka::RobotState held = robot.readOnce();
+        check(adaptimp_state_take_over(ctrl.get(), state.get(), held.tau_J_d.data(), kJoints),
+              "taking over the robot's torque");
 
         AdaptimpSetpoint hold{};
         for (std::size_t i = 0; i < kJoints; ++i) hold.x[i] = start.q[i];

@@ -76,6 +76,35 @@ def test_the_default_path_holds_then_draws_a_circle(panda_task: amj.CartesianTas
     assert path.span == 4.0
 
 
+def test_the_task_moves_to_where_the_arm_stands(panda_task: amj.CartesianTask) -> None:
+    """moved_to(q): the same circle about the pose at q (a robot's arm that
+    sagged between the set-up and the first cycle starts where it stands)."""
+    q = panda_task.q0 + np.array([0.0, 5e-4, 0.0, -1e-3, 0.0, -3e-4, 0.0])
+    moved = panda_task.moved_to(q)
+    np.testing.assert_array_equal(moved.q0, q)
+    p, r = moved.pose0
+    table = moved.targets(4000, 1e-3)
+    assert np.array_equal(table[0, :3], p)
+    assert np.array_equal(table[999, :3], p)
+    assert np.allclose(table[:, 9:18], r.reshape(9), atol=0.0)
+    assert moved.path.radius == panda_task.path.radius
+    shift = p - panda_task.pose0[0]
+    assert 1e-4 < np.linalg.norm(shift) < 1e-2
+    np.testing.assert_allclose(
+        table[2500:, :3] - panda_task.targets(4000, 1e-3)[2500:, :3],
+        np.broadcast_to(shift, (1500, 3)),
+        atol=1e-4,
+    )
+    assert moved.span == panda_task.span
+    assert moved.orients == panda_task.orients
+    assert moved.source.endswith(", moved to where the arm stands")
+    odd = amj.CartesianTask(panda_task.q0, panda_task.chain, lambda t: None, 4.0, True)
+    with pytest.raises(
+        adaptimp.ConfigError, match=r"^moved_to moves the default CirclePath, not function$"
+    ):
+        odd.moved_to(q)
+
+
 def test_from_rule_is_the_task_s_controller(panda_task: amj.CartesianTask) -> None:
     """simulate(case, model, task=) is CartesianController.from_rule in the
     loop: the same rows to the bit."""

@@ -85,7 +85,13 @@ def runs(request: pytest.FixtureRequest) -> dict[str, Any]:
 
 @pytest.fixture(scope="module")
 def loaded() -> dict[str, Any]:
-    return {case: run(case, load=LOAD) for case in ("pd", "sf")}
+    """Both tasks with the load: the arm sags under it while the robot holds
+    it before the start (the robot's model lacks it)."""
+    return {
+        f"{case} {task}": run(case, task, load=LOAD)
+        for case in ("pd", "sf")
+        for task in ("joint", "cartesian")
+    }
 
 
 def test_the_joint_task_tracks_within_a_fifth_of_pd(runs: dict[str, Any]) -> None:
@@ -133,10 +139,25 @@ def test_late_cycles_advance_the_clock(runs: dict[str, Any]) -> None:
 
 
 def test_an_unknown_load_on_the_hand_is_learnt(loaded: dict[str, Any]) -> None:
-    pd, sf = loaded["pd"].metrics, loaded["sf"].metrics
+    """Both tasks learn the load (the Cartesian task's shaped gains went
+    unstable on it, SF 2000× PD, while the first command dropped the torque
+    that held the load and the reference started where the arm stood when the
+    set-up read it: the run now takes the robot's torque over and starts the
+    task where the arm stands at the first cycle)."""
+    pd, sf = loaded["pd joint"].metrics, loaded["sf joint"].metrics
     assert sf["rms_z1_after2"] <= RATIO * pd["rms_z1_after2"], (sf, pd)
-    late = loaded["sf"].t >= 0.5
-    assert np.all(np.abs(loaded["sf"].tau_sat[late]) < np.asarray(franka.TAU_MAX))
+    pd, sf = loaded["pd cartesian"].metrics, loaded["sf cartesian"].metrics
+    for key in ("rms_pos_after2", "rms_rot_after2"):
+        assert sf[key] <= RATIO * pd[key], (key, sf[key], pd[key])
+    for name, res in loaded.items():
+        # No step in torque at the start: the robot's holding torque (the
+        # load's weight in it, grown since the test read "holding" as the arm
+        # sagged) taken over, and moved from at 1 N m a cycle.
+        held = np.asarray(res.params["taken_over"])
+        assert np.max(np.abs(res.tau_sat[0] - held)) <= 1.0 + 1e-9, name
+        assert np.max(np.abs(held)) > 2.0, name  # the load's weight is in it
+        late = res.t >= 0.5
+        assert np.all(np.abs(res.tau_sat[late]) < np.asarray(franka.TAU_MAX)), name
 
 
 def test_move_to_and_ctrl_c_on_the_server() -> None:

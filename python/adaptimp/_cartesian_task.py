@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import mujoco
@@ -279,6 +279,22 @@ class CartesianTask:
     def pose0(self) -> tuple[FloatArray, FloatArray]:
         """The start pose: p (m), R (3, 3)."""
         return self.chain.pose(self.q0)
+
+    def moved_to(self, q: ArrayLike) -> CartesianTask:
+        """The same task from posture ``q`` (rad): a :class:`CirclePath` about
+        the pose the arm has at ``q``, the same radius and plane (a robot's
+        arm that moved between the task's set-up and its first cycle starts
+        where it stands, without a step in the reference). Other paths are
+        not moved (ConfigError)."""
+        path = self.path
+        if not isinstance(path, CirclePath):
+            raise ConfigError(f"moved_to moves the default CirclePath, not {type(path).__name__}")
+        q = np.array(q, dtype=np.float64).reshape(self.q0.shape)
+        p, r = self.chain.pose(q)
+        moved = CirclePath(p, r, radius=path.radius, normal=path.normal)
+        return replace(
+            self, q0=q, path=moved, source=f"{self.source}, moved to where the arm stands"
+        )
 
     def targets(self, steps: int, Ts: float) -> FloatArray:
         """The path at t_k = k·Ts, (steps, 24) (:func:`adaptimp.cartesian.tabulate`)."""

@@ -29,7 +29,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 from . import _adaptimp
 from . import mujoco as amj
 from ._adaptimp import Measurement
-from ._cartesian_task import CartesianTask, chain_of
+from ._cartesian_task import CartesianTask, CirclePath, chain_of
 from ._description import model_name
 from .chain import Chain
 
@@ -246,6 +246,7 @@ class Loop:
         self.chain: Chain = s.controller.chain if self.cartesian else chain_of(s.plant)
         self.source = s.controller.inner if self.cartesian else s.controller
         self.tables = s.reference(self.steps)
+        self.task = s.task  # the Cartesian task as run (moved to the first cycle's pose)
         if not self.cartesian:
             # The path itself, for the blend from where the arm stands at the first cycle.
             t = np.arange(self.steps, dtype=np.float64)[:, None] * PERIOD
@@ -272,6 +273,18 @@ class Loop:
         for table, rows_ in zip(self.tables, blended):
             table[: len(rows_)] = rows_
 
+    def start_from(self, q: Sequence[float]) -> tuple[FloatArray, ...]:
+        """The Cartesian task from the pose the arm stands in at the first
+        cycle (:meth:`CartesianTask.moved_to`; the set-up read the posture
+        earlier, and an arm holding a load the robot's model lacks sags in
+        between): the outer loop restarted at ``q``, the pose rows anew."""
+        task = self.s.task
+        if isinstance(task, CartesianTask) and isinstance(task.path, CirclePath):
+            self.task = task.moved_to(q)
+            self.ctrl.outer.reset(self.task.q0)
+            self.tables = (np.ascontiguousarray(self.task.targets(self.steps, PERIOD)),)
+        return self.tables
+
     def measurement(self, state: Any) -> Any:
         """The step's measurement from the state: q, q̇ and the wrench (moved
         from the stiffness frame K to the chain's tip), or τe = Jᵀ F_e."""
@@ -295,11 +308,17 @@ class Loop:
         ctrl, steps = self.ctrl, self.steps
         tables = self.tables
         core = ctrl.outer.core if self.cartesian else None
-        joint = ctrl._joint if self.cartesian else None
+        joint = ctrl._joint if self.cartesian else ctrl  # the joint controller
         record = ctrl.record if self.cartesian else False
         last = -1  # the row of the last step
         Torques = pylibfranka.Torques
         clock = time.perf_counter_ns
+        # The torque the robot holds the arm with now (gravity aside; with a
+        # load its model lacks, the load's weight too): the controller takes it
+        # over, so the first command continues it (the first cycle's tau_J_d
+        # is the torque controller's own, zero).
+        held = list(r.read_once().tau_J_d)
+        self.params["taken_over"] = held
         ctl = r.start_torque_control()
         collecting = gc.isenabled()
         gc.disable()  # no collection pause inside a 1 ms cycle
@@ -315,10 +334,15 @@ class Loop:
                 if k >= steps:
                     self.finish(ctl)
                     return
-                if not self.K and not self.cartesian:
-                    self.blend_from(state.q)
+                if not self.K:
+                    if self.cartesian:
+                        tables = self.start_from(state.q)
+                    else:
+                        self.blend_from(state.q)
                 m, tau_e = self.measurement(state)
                 try:
+                    if not self.K:
+                        joint.take_over(held)
                     if core is not None:
                         # A late cycle: the outer loop's joint reference is
                         # integrated over the cycles missed too (its clock
@@ -474,7 +498,7 @@ class Loop:
             "controller": f"adaptimp.franka.setup({case!r}, task={self.s.kind!r})",
             "loop": "libfranka",
             "payload": 0.0,
-            "q0": self.s.q.tolist(),
+            "q0": np.asarray(self.task.q0 if self.cartesian else self.s.q).tolist(),
             "task": self.s.kind,
             "blend": self.s.blend,
             "cycles": {
@@ -513,8 +537,8 @@ class Loop:
             wrench_ee=np.ascontiguousarray(wrench_ee),
             task=task,
         )
-        if self.cartesian and isinstance(self.s.task, CartesianTask):
-            self.s.task.measure(res)
+        if self.cartesian and isinstance(self.task, CartesianTask):
+            self.task.measure(res)
         return res
 
 

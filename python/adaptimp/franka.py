@@ -162,9 +162,8 @@ def setup(
     limits (:data:`TAU_MAX`, at most the URDF's effort) and libfranka's
     torque rate (``tau_rate_max`` = :data:`TORQUE_RATE` × 1 ms); ``params``
     replace the rule's keywords. ``coupled``: the rule's inertia-shaped gains,
-    SPEC (18.12) (the joint task's default, for libfranka's delay of one
-    period; False: the diagonal gains of (18.1), the Cartesian task's
-    default; see
+    SPEC (18.12) (the default of both tasks, for libfranka's delay of one
+    period; False: the diagonal gains of (18.1); see
     :func:`adaptimp.tuning.suggest`). ``gravity=`` is refused: the robot
     compensates gravity itself (SPEC (20.10)).
     """
@@ -294,7 +293,11 @@ def run(
     :class:`adaptimp.mujoco.MujocoResult` (``simulate``'s metrics, plots and
     ``save``).
 
-    Every cycle: ``readOnce()`` gives the state and the time since the last
+    The start (SPEC (22.4)): the controller takes over the torque the robot
+    holds the arm with (``tau_J_d`` just before the loop, N m, gravity
+    aside; ``res.params["taken_over"]``), so the first command is within
+    1 N m of it, and the task starts where the arm stands at the first
+    cycle. Every cycle: ``readOnce()`` gives the state and the time since the last
     one (1 ms; more after a missed cycle); the controller's clock advances by
     it, so each step is given the setpoint at the time its state was
     measured (a missed cycle skips the rows it missed); the step's torque

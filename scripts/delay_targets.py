@@ -14,8 +14,8 @@ the share of rows at a limit; with ``--cartesian`` also ``amj.cartesian_task``
 and SF/PD in position and orientation over t ≥ 2 s (T = 12 s, ``--cartesian-T``). Prints one
 Markdown table per part; the targets of the issue are SF/PD and OF/PD ≤ 0.2,
 no drift, peak ≤ 2 τmax. Every controller (PD too) is made by the rule with
-its default: the inertia-shaped gains of SPEC (18.12) on the joint task for
-d ≥ 1, the diagonal gains of (18.1) for d = 0 and on the Cartesian task;
+its default: the inertia-shaped gains of SPEC (18.12) for d ≥ 1, the
+diagonal gains of (18.1) for d = 0;
 ``--coupled`` / ``--no-coupled``: the one or the other everywhere
 (``coupled=True`` / ``False``).
 """

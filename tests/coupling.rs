@@ -181,9 +181,9 @@ fn the_rule_takes_the_harmonic_mean_and_sizes_the_margin_at_its_modes() {
     assert_eq!(undelayed.controller().unwrap().inertia_matrix(), None);
     t.delay = 2;
     assert!(t.coupled());
-    // Not on a Cartesian task's orbit (the rule of (16.10)).
+    // On a Cartesian task's orbit too (the rule of (16.10)).
     t.resolve = true;
-    assert!(!t.coupled());
+    assert!(t.coupled());
     t.resolve = false;
     let coupled = t.suggest().unwrap();
     t.coupled = Some(false);

@@ -102,17 +102,26 @@ def test_the_keyword_takes_real_numbers_only(value: object, message: str) -> Non
         adaptimp.Controller("sf", "robot", inertia_matrix=value)
 
 
-def test_the_cartesian_task_keeps_the_diagonal_gains_unless_asked() -> None:
+def test_the_cartesian_task_takes_the_shaped_gains_with_a_delay() -> None:
     """SPEC (18.12): on a Cartesian task's orbit the rule's default is the
-    diagonal gains at any delay; ``coupled=True`` asks for the shaped ones
-    (docs/your_arm.md's block, on the Panda)."""
+    shaped gains for a delay ≥ 1 and the diagonal ones without;
+    ``coupled=False`` asks for the diagonal ones (on the Panda)."""
     plant = amj.Plant(adaptimp._models.panda_urdf_path(), contact=False)
     task = amj.cartesian_task(plant)
     default = amj.simulate("sf", plant, T=0.05, task=task, delay=2)
-    asked = amj.simulate("sf", plant, T=0.05, task=task, delay=2, coupled=True)
-    assert default.params.get("inertia_matrix") is None
-    m = np.asarray(asked.params["inertia_matrix"]).reshape(7, 7)
+    undelayed = amj.simulate("sf", plant, T=0.05, task=task, delay=0)
+    diagonal = amj.simulate("sf", plant, T=0.05, task=task, delay=2, coupled=False)
+    assert undelayed.params.get("inertia_matrix") is None
+    assert diagonal.params.get("inertia_matrix") is None
+    m = np.asarray(default.params["inertia_matrix"]).reshape(7, 7)
     np.testing.assert_array_equal(m, m.T)
+    # Ĝ on the shaped gains' orbit at least at (m/Ts) K1: twice (18.6)'s ω_G²
+    # (δ = 0: the same rates Kp/d, K1 and basis), so twice the learning rates
+    # (D̂'s and Ĉ's go with ω_G, SPEC (18.6)).
+    shaped = task.controller("sf", plant, delay=0, coupled=True).inner.params
+    plain = task.controller("sf", plant, delay=0, coupled=False).inner.params
+    np.testing.assert_array_equal(shaped["K1"], plain["K1"])
+    np.testing.assert_allclose(shaped["gamma"], 2.0 * np.asarray(plain["gamma"]), rtol=1e-12)
 
 
 def test_gains_of_the_users_own_take_the_diagonal_law_unless_asked(panda: amj.Plant) -> None:

@@ -67,8 +67,8 @@ def test_the_controller_is_the_rule_a_simulate_user_gets() -> None:
     c = franka.setup("sf", plant, READY, task="cartesian")
     ctask = amj.cartesian_task(plant, q0=READY)
     assert c.controller.params == ctask.controller("sf", plant, delay=franka.DELAY, **limits).params
-    # The Cartesian task's orbit keeps the diagonal gains by default (SPEC (18.12)).
-    assert c.controller.inner.params.get("inertia_matrix") is None
+    # The Cartesian task's orbit takes the shaped gains too (SPEC (18.12)).
+    assert c.controller.inner.params.get("inertia_matrix") is not None
     assert s.controller.params["delay"] == 1
     # SPEC (18.12): the rule's default for libfranka's delay, the same on
     # the robot as in simulate; coupled=False the diagonal rule's.

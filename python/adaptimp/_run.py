@@ -289,8 +289,8 @@ def simulate(
         delay, joint friction, weak actuators; the controller is told none of
         them), for any controller; and, for a case name, controller parameters
         (``Kp``, ``gamma``, …) and ``coupled``: the rule's inertia-shaped
-        gains of SPEC (18.12) (default: on the joint task with a delay,
-        ``delay`` ≥ 1; ``coupled=False``: the diagonal gains of (18.1)
+        gains of SPEC (18.12) (default: on with a delay, ``delay`` ≥ 1, on
+        the joint task and the Cartesian one; ``coupled=False``: the diagonal gains of (18.1)
         always, ``True``: the shaped ones always; see
         :func:`adaptimp.tuning.suggest`).
 

@@ -183,7 +183,7 @@ def rule_coupled(coupled: bool | None, params: Mapping[str, Any]) -> bool | None
     """The rule's ``coupled`` (SPEC (18.12)) for a caller's keywords ``params``:
     as asked; else, where they set any of :data:`SHAPED_KEYS` (gains of their
     own, which may differ by joint), the diagonal law (False); else the
-    rule's default (None: shaped on a joint task with a delay)."""
+    rule's default (None: shaped with a delay)."""
     if coupled is None and any(k in params for k in SHAPED_KEYS):
         return False
     return coupled

@@ -321,8 +321,9 @@ class CartesianController:
         coupled : bool or None
             The joint controller's inertia-shaped gains, SPEC (18.12)
             (:func:`adaptimp.tuning.suggest`'s ``coupled``; default: the
-            diagonal gains of (18.1), which miss fewer of the Cartesian
-            targets measured (docs/your_arm.md); True: the shaped ones).
+            shaped gains for a ``delay`` ≥ 1, with Ĝ learning at least at
+            (m/Ts) K1 on the orbit, the diagonal ones of (18.1) without a
+            delay; False: the diagonal ones at any delay).
         **params
             Replace the rule's keywords (Cartesian parameters, e.g. ``Kd``,
             and the joint controller's, e.g. ``gamma``). ``gravity="model"``:

@@ -527,8 +527,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--coupled",
         action=argparse.BooleanOptionalAction,
         default=None,
-        help="with --model: the rule's inertia-shaped gains, SPEC (18.12) (the joint task's "
-        "default with --delay 1 or 2); --no-coupled: the diagonal gains of (18.1)",
+        help="with --model: the rule's inertia-shaped gains, SPEC (18.12) (the default "
+        "with --delay 1 or 2); --no-coupled: the diagonal gains of (18.1)",
     )
     sim.add_argument("--plot", metavar="FILE", help="write a figure (PNG, PDF, SVG, …)")
     sim.add_argument(

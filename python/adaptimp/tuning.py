@@ -233,16 +233,17 @@ def suggest(
         delayed loop's modes stay together where the diagonal's spread (the
         keyword ``inertia_matrix``, n × n values row-major). Default None:
         for a loop with a delay (``delay`` ≥ 1), where (18.11)'s margin
-        bounds the gains, unless ``resolve`` (a Cartesian task's orbit);
-        False: the diagonal rule of (18.1), per-joint gains.
+        bounds the gains (with ``resolve``, a Cartesian task's orbit, Ĝ then
+        learns at ω_G² at least (m/Ts) K1: the joints' Coulomb friction,
+        SPEC (18.12) "On an orbit"); False: the diagonal rule of (18.1),
+        per-joint gains.
 
     Returns
     -------
     dict
         ``n`` and the keywords of :data:`RULE_KEYS`, ``inertia_matrix`` when
-        the gains are shaped (``coupled`` True, or None with a ``delay`` and
-        no ``resolve``) and, with a path, ``centers`` (L, 4n) and ``widths``
-        (4n,): keywords of
+        the gains are shaped (``coupled`` True, or None with a ``delay``)
+        and, with a path, ``centers`` (L, 4n) and ``widths`` (4n,): keywords of
         ``adaptimp.Controller(case, "robot", **kw)``, which construction accepts.
 
     Raises

@@ -796,5 +796,24 @@ pub fn resolving<const N: usize>(rule: &Rule, path: &[Setpoint<N>]) -> Rule {
 /// ℓ_b / tube_b of [`resolving`]: the orbit's length in tube widths (10).
 pub const RESOLUTION: f64 = 10.0;
 
+/// The rule of the inertia-shaped gains on a Cartesian task's orbit, SPEC
+/// (18.12), "On an orbit": [`resolving`]'s, with Ĝ learning at ω_G² at least
+/// (m/Ts) K1 ([`Rule::learn`] at least [`SHAPED_ORBIT_LEARN`]; twice (18.6)'s
+/// ½, the critical rule's 1.03 kept). The joints that hold the hand's
+/// orientation barely move on the orbit; their Coulomb friction flips with
+/// the sign of their small velocity, and Ĝ(q) learns that step at ω_G: at
+/// (18.6)'s ω_G the error it leaves was the orientation's floor. The
+/// diagonal gains keep (18.6)'s ω_G (at 2× two arms rang at δ = 1).
+pub fn shaped_orbit(rule: &Rule) -> Rule {
+    Rule {
+        learn: rule.learn.max(SHAPED_ORBIT_LEARN),
+        ..*rule
+    }
+}
+
+/// The least [`Rule::learn`] of [`shaped_orbit`]: ω_G² = (m/Ts) K1, the
+/// geometric mean of the velocity and position loops' rates squared.
+pub const SHAPED_ORBIT_LEARN: f64 = 1.0;
+
 #[cfg(test)]
 mod tests;

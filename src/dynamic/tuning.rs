@@ -12,7 +12,7 @@
 use super::controller::{Basis, Centres, Scenario};
 use super::sized::make;
 use super::values::{length, too_many, vector};
-use crate::cartesian::rule::resolving;
+use crate::cartesian::rule::{resolving, shaped_orbit};
 use crate::control::config::Law;
 use crate::control::tuning::{
     damped_scales, inertia_scales, inertia_scales_along, largest_eigenvalue, loop_bound, Rule,
@@ -84,9 +84,9 @@ pub struct Tuning<'a> {
     /// along the path (the parameter `inertia_matrix`),
     /// the margin of (18.11) at the largest mode of Dₛ^½ D⁻¹ Dₛ^½.
     /// `None` (the default): on for a loop with a delay (δ ≥ 1), where
-    /// (18.11)'s margin bounds the gain, but not on a Cartesian task's orbit
-    /// (`resolve`), where the diagonal's tables hold better (SPEC (18.12));
-    /// off, the diagonal scales of (18.1).
+    /// (18.11)'s margin bounds the gain, on a joint task and on a Cartesian
+    /// task's orbit (`resolve`, where Ĝ then learns faster:
+    /// [`shaped_orbit`]); off, the diagonal scales of (18.1).
     pub coupled: Option<bool>,
 }
 
@@ -112,9 +112,9 @@ impl<'a> Tuning<'a> {
     }
 
     /// Whether the rule shapes the gains by the inertia, SPEC (18.12):
-    /// as asked, else for a loop with a delay (δ ≥ 1) on a joint task.
+    /// as asked, else for a loop with a delay (δ ≥ 1).
     pub fn coupled(&self) -> bool {
-        self.coupled.unwrap_or(self.delay >= 1 && !self.resolve)
+        self.coupled.unwrap_or(self.delay >= 1)
     }
 
     /// The robot scenario's parameters for `law` with the rule's gains and
@@ -229,6 +229,9 @@ fn typed<const N: usize>(
             if t.resolve && !samples.is_empty() {
                 let learn_dc = rule.learn_dc;
                 rule = resolving(&rule, &samples);
+                if shaped.is_some() {
+                    rule = shaped_orbit(&rule);
+                }
                 if t.weightless {
                     // (22.2): D̂ and Ĉ at Ĝ's bandwidth, whatever the orbit.
                     rule.learn_dc = learn_dc;

@@ -29,6 +29,25 @@ fn an_orbit_of_a_delayed_loop_slows_d_and_c_only() {
 }
 
 #[test]
+fn the_shaped_gains_orbit_learns_g_at_least_at_the_loops_geometric_mean() {
+    // (18.6)'s ½ doubled; the critical rule's, faster already, kept.
+    let rule = Rule::default();
+    assert_eq!(rule.learn, 0.5);
+    let shaped = shaped_orbit(&rule);
+    assert_eq!(shaped.learn, 1.0);
+    assert_eq!(
+        Rule {
+            learn: 0.5,
+            ..shaped
+        },
+        rule
+    );
+    let critical = rule.critical(1e-3);
+    assert!(critical.learn > 1.0);
+    assert_eq!(shaped_orbit(&critical), critical);
+}
+
+#[test]
 fn sigma_min_is_the_smallest_singular_value() {
     let mut j = Jacobian6::<7>::zeros();
     for (i, s) in [3.0, 2.0, 1.5, 1.0, 0.5, 0.25].iter().enumerate() {

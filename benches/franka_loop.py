@@ -156,7 +156,7 @@ def main() -> None:
         "--coupled",
         action=argparse.BooleanOptionalAction,
         default=None,
-        help="the rule's inertia-shaped gains, SPEC (18.12) (the joint task's default, "
+        help="the rule's inertia-shaped gains, SPEC (18.12) (the default of both tasks, "
         "libfranka's loop having a delay); --no-coupled: the diagonal gains of (18.1)",
     )
     parser.add_argument("--simulate", action="store_true", help="also the library's own loop")

@@ -283,3 +283,29 @@ def test_move_to_uses_the_robots_own_controller() -> None:
     assert np.max(steps) <= 0.5 * 1e-3 + 1e-12
     # 375 ms from rest to rest (1.875 × 0.1 rad / 0.5 rad/s), at least 0.5 s.
     assert len(robot.sent) == 501
+
+
+@pytest.mark.parametrize("task", ["joint", "cartesian"])
+def test_the_robots_torque_is_taken_over_before_anything_moves(task: str) -> None:
+    """SPEC (22.4): the torque the robot holds the arm with when the loop
+    starts (tau_J_d) is the one the first command moves from, at most 1 N m
+    a cycle; one beyond the controller's τmax is refused before the motion,
+    by name, and nothing is sent."""
+    held = [0.0, -4.0, 0.0, 6.5, 0.0, 1.0, 0.0]
+    robot = FakeRobot(FR3)
+    robot.applied = np.array(held)
+    res = franka.run("sf", FR3, robot, T=0.02, task=task)
+    assert res.params["taken_over"] == held
+    first = np.asarray(robot.sent[0][0])
+    assert np.max(np.abs(first - held)) <= 1.0 + 1e-9
+    assert np.max(np.abs(first - held)) > 0.0
+    beyond = FakeRobot(FR3)
+    beyond.applied = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 20.0])
+    with pytest.raises(
+        adaptimp.ConfigError,
+        match=r"^the torque the robot holds the arm with, \[0\.0, 0\.0, 0\.0, 0\.0, 0\.0, 0\.0, "
+        r"20\.0\] N m, cannot be taken over: torque taken over\[6\] = 2e1 is beyond its limit "
+        r"±1\.2e1; the state was left unchanged$",
+    ):
+        franka.run("sf", FR3, beyond, T=0.02, task=task)
+    assert beyond.sent == []

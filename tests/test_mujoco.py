@@ -676,3 +676,31 @@ def test_disturbances_act_on_the_mujoco_plant() -> None:
         amj.simulate("sf", "two_link", T=0.1, jitter=0.1)
     with pytest.raises(ValueError, match="0 ≤ delay ≤ 64"):
         amj.simulate("sf", "two_link", T=0.1, delay=65)
+
+
+@pytest.mark.parametrize("copy_data", [True, False], ids=["mj_copyData", "mj_setState"])
+def test_state_kept_puts_the_plants_state_back(
+    monkeypatch: pytest.MonkeyPatch, copy_data: bool
+) -> None:
+    """Plant.state_kept: what a rule does to the plant inside the block (D and G
+    read at postures of its own) is undone, with MuJoCo's mj_copyData or, on
+    bindings without it (robosuite's MuJoCo 3.3), the integration state."""
+    if not copy_data:
+        monkeypatch.delattr(mujoco, "mj_copyData", raising=False)
+    plant = amj.Plant(adaptimp._models.panda_urdf_path(), contact=False)
+    d = plant.data
+    d.qpos[:] += 0.1
+    d.qvel[:] = 0.3
+    d.ctrl[:] = 0.5
+    d.time = 1.25
+    mujoco.mj_forward(plant.model, d)
+    before = {k: np.array(getattr(d, k)) for k in ("qpos", "qvel", "ctrl", "xpos")}
+    with plant.state_kept():
+        d.qpos[:] = 0.0
+        d.qvel[:] = 0.0
+        d.ctrl[:] = 0.0
+        d.time = 9.0
+        mujoco.mj_forward(plant.model, d)
+    for k, v in before.items():
+        np.testing.assert_array_equal(getattr(d, k), v, err_msg=k)
+    assert d.time == 1.25

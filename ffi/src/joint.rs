@@ -434,9 +434,10 @@ pub unsafe extern "C" fn adaptimp_state_restore(
 
 /// Take over the actuators from a controller that was applying `tau` (`n`
 /// reals, N m) until now (a robot's own, holding the arm where it stands:
-/// libfranka's `tau_J_d` read before the torque loop starts): the first
-/// step's torque rate limit moves from it, so the first command continues
-/// it, as Rust's `Controller::take_over` and Python's `Controller.take_over`.
+/// libfranka's `tau_J_d` read before the torque loop starts, with libfranka's
+/// own `limitRate` off): the first step's torque rate limit moves from it,
+/// so the first command continues it, as Rust's `Controller::take_over` and
+/// Python's `Controller.take_over`.
 /// Before the first step only. On an error the state is unchanged:
 /// BAD_SIZE (`n`), INVALID_CONFIG (after the first step, a torque not finite
 /// or beyond τmax, named), WRONG_STATE (a state of another controller).

@@ -1390,6 +1390,7 @@ static const Entry ENTRIES[] = {
     {"adaptimp_state_snapshot_len", {KIND_STATE, -1}},
     {"adaptimp_state_save", {KIND_STATE, -1}},
     {"adaptimp_state_restore", {KIND_CTRL, KIND_STATE}},
+    {"adaptimp_state_take_over", {KIND_CTRL, KIND_STATE}},
     {"adaptimp_step", {KIND_CTRL, KIND_STATE}},
     {"adaptimp_chain_joints", {KIND_CHAIN, -1}},
     {"adaptimp_chain_tip", {KIND_CHAIN, -1}},
@@ -1475,6 +1476,10 @@ static int call_entry(int e, void *h[NKINDS], AdaptimpStatus *status) {
         ok = REFUSED(s) && written == 7 && buf[0] == 0;
     } else if (!strcmp(name, "adaptimp_state_restore")) {
         s = adaptimp_state_restore(ctrl, state, buf, 16);
+        ok = REFUSED(s);
+    } else if (!strcmp(name, "adaptimp_state_take_over")) {
+        double tau[2] = {0, 0};
+        s = adaptimp_state_take_over(ctrl, state, tau, 2);
         ok = REFUSED(s);
     } else if (!strcmp(name, "adaptimp_step")) {
         AdaptimpCommand c;

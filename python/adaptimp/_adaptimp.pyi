@@ -393,8 +393,8 @@ class Controller:
     def load_weights(self, weights: dict[str, _F]) -> None: ...
     def take_over(self, tau: ArrayLike) -> None:
         """Take over from a controller that was applying ``tau`` (n,) (N m): the
-        first step's torque rate limit moves from it (libfranka's ``limitRate``
-        from ``tau_J_d``). Before the first step only; finite, within τmax."""
+        first step's torque rate limit moves from it (SPEC (22.4)). Before the
+        first step only; finite, within τmax."""
     @property
     def case(self) -> str: ...
     @property

@@ -424,7 +424,9 @@ class Controller(_adaptimp.Controller):
     with a ``DeprecationWarning``. ``step_or_fallback`` never raises for a refused
     measurement and returns (torque, error message or None). ``replay`` runs K
     steps from (K, n) tables without the GIL. ``reset()``, ``snapshot()``,
-    ``restore(data)``, ``load_weights(dict)``; the read-only ``t``, ``steps``,
+    ``restore(data)``, ``load_weights(dict)``, ``take_over(tau)`` (before the
+    first step: the torque a robot's own controller held the arm with, from
+    which the first step's rate limit moves, SPEC (22.4)); the read-only ``t``, ``steps``,
     ``Ts``, ``n``, ``nodes``, ``zeta``, ``tau``, ``tau_sat``, ``applied`` (the
     torque to apply now: after a refused step, the fallback), ``dtau``, ``z1``,
     ``xc``, ``xd``, ``dq_hat``, ``weights``, ``weight_bound``, ``fault``.

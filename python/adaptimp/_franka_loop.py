@@ -273,15 +273,33 @@ class Loop:
         for table, rows_ in zip(self.tables, blended):
             table[: len(rows_)] = rows_
 
-    def start_from(self, q: Sequence[float]) -> tuple[FloatArray, ...]:
-        """The Cartesian task from the pose the arm stands in at the first
-        cycle (:meth:`CartesianTask.moved_to`; the set-up read the posture
-        earlier, and an arm holding a load the robot's model lacks sags in
-        between): the outer loop restarted at ``q``, the pose rows anew."""
+    def take_over(self, state: Any) -> tuple[FloatArray, ...]:
+        """Just before the torque loop starts, from the robot's ``state`` then
+        (SPEC (22.4)), every check before anything moves: the controller takes
+        over the torque the robot holds the arm with (``tau_J_d``, gravity
+        aside; with a load its model lacks, the load's weight too: the set-up
+        read the posture earlier, and the arm sags under the robot's own
+        controller in between), so the first command continues it; the
+        Cartesian task starts from the pose the arm stands in
+        (:meth:`CartesianTask.moved_to`, the outer loop restarted there, its
+        null-space posture too if it was the set-up's). Returns the rows."""
+        held = [float(x) for x in state.tau_J_d]
+        try:
+            self.ctrl.take_over(held)
+        except ConfigError as e:
+            raise ConfigError(
+                f"the torque the robot holds the arm with, {np.round(held, 3).tolist()} N m, "
+                f"cannot be taken over: {e}"
+            ) from e
+        self.params["taken_over"] = held
         task = self.s.task
-        if isinstance(task, CartesianTask) and isinstance(task.path, CirclePath):
-            self.task = task.moved_to(q)
-            self.ctrl.outer.reset(self.task.q0)
+        if self.cartesian and isinstance(task, CartesianTask) and isinstance(task.path, CirclePath):
+            outer = self.ctrl.outer
+            default = np.array_equal(outer.core.state("posture"), self.s.q)
+            self.task = task.moved_to(state.q)
+            outer.reset(self.task.q0)
+            if default:
+                outer.set_posture(self.task.q0)
             self.tables = (np.ascontiguousarray(self.task.targets(self.steps, PERIOD)),)
         return self.tables
 
@@ -306,19 +324,13 @@ class Loop:
     def drive(self, r: Any, on_cycle: Callable[[int, float, Any], object] | None) -> None:
         """The torque loop until T, Ctrl-C, a refused step or a libfranka exception."""
         ctrl, steps = self.ctrl, self.steps
-        tables = self.tables
         core = ctrl.outer.core if self.cartesian else None
-        joint = ctrl._joint if self.cartesian else ctrl  # the joint controller
+        joint = ctrl._joint if self.cartesian else None
         record = ctrl.record if self.cartesian else False
         last = -1  # the row of the last step
         Torques = pylibfranka.Torques
         clock = time.perf_counter_ns
-        # The torque the robot holds the arm with now (gravity aside; with a
-        # load its model lacks, the load's weight too): the controller takes it
-        # over, so the first command continues it (the first cycle's tau_J_d
-        # is the torque controller's own, zero).
-        held = list(r.read_once().tau_J_d)
-        self.params["taken_over"] = held
+        tables = self.take_over(r.read_once())
         ctl = r.start_torque_control()
         collecting = gc.isenabled()
         gc.disable()  # no collection pause inside a 1 ms cycle
@@ -334,15 +346,10 @@ class Loop:
                 if k >= steps:
                     self.finish(ctl)
                     return
-                if not self.K:
-                    if self.cartesian:
-                        tables = self.start_from(state.q)
-                    else:
-                        self.blend_from(state.q)
+                if not self.K and not self.cartesian:
+                    self.blend_from(state.q)
                 m, tau_e = self.measurement(state)
                 try:
-                    if not self.K:
-                        joint.take_over(held)
                     if core is not None:
                         # A late cycle: the outer loop's joint reference is
                         # integrated over the cycles missed too (its clock
@@ -405,7 +412,8 @@ class Loop:
 
     def finish(self, ctl: Any) -> None:
         """End the motion: the last torque sent, again, with ``motion_finished``."""
-        last = self.last_sent if self.last_sent is not None else [0.0] * 7
+        # Nothing sent yet: the torque taken over (no step from what held the arm).
+        last = self.last_sent if self.last_sent is not None else self.params["taken_over"]
         command = pylibfranka.Torques(last)
         command.motion_finished = True
         ctl.writeOnce(command)

@@ -499,6 +499,18 @@ class CartesianController:
         p = inner_params(self.inner)
         return {**self.outer.params, "inner": dict(p)}
 
+    def take_over(self, tau: ArrayLike) -> None:
+        """The joint controller takes over from a controller that was applying
+        ``tau`` (n,) (N m) until now (:meth:`adaptimp.Controller.take_over`:
+        the first step's torque rate limit moves from it). TypeError if the
+        joint controller has no ``take_over``."""
+        take = getattr(self._joint, "take_over", None)
+        if not callable(take):
+            raise TypeError(
+                f"the joint controller {type(self._joint).__name__} cannot take over a torque"
+            )
+        take(tau)
+
     def reset(self) -> None:
         """Back to t = 0: the outer loop at its start, the joint controller reset
         (if it has ``reset``), the log emptied."""

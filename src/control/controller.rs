@@ -266,12 +266,11 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
     }
 
     /// Take over the actuators from a controller that was applying `tau`
-    /// (N m) until now (a robot's own, holding the arm where it stands): the
-    /// first step's torque rate limit moves from it, as libfranka's
-    /// `limitRate` moves from the torque the robot last commanded
-    /// (`tau_J_d`), and a refused first step holds it. Without it the first
-    /// step's rate limit moves from zero, a step in torque of what held the
-    /// arm. Only before the first step (refused after it: "take_over: only
+    /// (N m) until now (a robot's own, holding the arm where it stands:
+    /// libfranka's `tau_J_d` read before the torque loop starts): the first
+    /// step's torque rate limit moves from it, and a refused first step
+    /// holds it, SPEC (22.4). Without it the first step's rate limit moves
+    /// from zero, a step in torque of what held the arm. Only before the first step (refused after it: "take_over: only
     /// before the first step"); `tau` finite and within τmax, each refused
     /// by name. On an error `st` is as before.
     pub fn take_over<S: AsRef<[f64]> + AsMut<[f64]>>(
@@ -279,6 +278,7 @@ impl<const N: usize, B: Basis<N>> Controller<N, B> {
         st: &mut State<N, S>,
         tau: &Vector<N>,
     ) -> Result<(), Error> {
+        self.check_nodes(st)?;
         if st.steps() != 0 {
             return Err(Error::Invalid {
                 what: "take_over",

@@ -10,7 +10,7 @@
 //! | here | the const-generic core | what |
 //! |---|---|---|
 //! | [`Scenario`] | [`schema::Scenario`](crate::schema::Scenario) | every parameter by name, and the one builder of the joint controller (feature `alloc`) |
-//! | [`Tuning`] | [`tuning::Rule`](crate::tuning::Rule) | the gain and basis rule of SPEC §18: an arm's inertia, limits and period (and its task's path) to a [`Scenario`]; with a delay on a joint task, the inertia-shaped gains of (18.12) |
+//! | [`Tuning`] | [`tuning::Rule`](crate::tuning::Rule) | the gain and basis rule of SPEC §18: an arm's inertia, limits and period (and its task's path) to a [`Scenario`]; with a delay, the inertia-shaped gains of (18.12) |
 //! | [`Controller`], [`State`] | [`Controller`](crate::Controller), [`State`](crate::State) | the joint controller, its own trajectory, its state (heap or the caller's buffer) |
 //! | [`Measurement`], [`Setpoint`], [`Command`], [`Joints`] | [`Measurement`](crate::Measurement), … | a step's typed input and output: n values per joint quantity |
 //! | [`Chain`], [`Dynamics`] | [`Chain`](crate::Chain), [`Dynamics`](crate::Dynamics) | kinematics and rigid-body dynamics, from joint data or an [`Arm`](crate::description::Arm) read from a URDF or an MJCF |

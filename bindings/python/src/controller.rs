@@ -406,9 +406,9 @@ impl PyController {
     }
 
     /// Take over the actuators from a controller that was applying ``tau``
-    /// (n,) (N m) until now (a robot's own, holding the arm): the first
-    /// step's torque rate limit moves from it, as libfranka's ``limitRate``
-    /// moves from the torque the robot last commanded (``tau_J_d``). Before
+    /// (n,) (N m) until now (a robot's own, holding the arm: libfranka's
+    /// ``tau_J_d`` read before the torque loop starts): the first step's
+    /// torque rate limit moves from it, SPEC (22.4). Before
     /// the first step only; ``tau`` finite and within τmax (ConfigError
     /// naming what is wrong; on an error nothing changes).
     fn take_over(&self, py: Python<'_>, tau: &Bound<'_, PyAny>) -> PyResult<()> {

@@ -40,7 +40,7 @@ fn shape_error(what: &str, want: String, got: &[usize]) -> PyErr {
 /// that compensates it itself): D̂ and Ĉ learn at Ĝ's bandwidth, SPEC (22.2).
 /// `coupled`: the inertia-shaped gains of SPEC (18.12) (the parameter
 /// `inertia_matrix`, n × n values row-major); None: the core's default, on
-/// for a loop with a delay (δ ≥ 1) unless `resolve`.
+/// for a loop with a delay (δ ≥ 1; with `resolve`, Ĝ then learns faster).
 #[pyfunction]
 #[pyo3(signature = (case, inertia, tau_max, ts, path=None, period=None, gravity=None, resolve=false, critical=false, damping=None, orbit=None, delay=0, weightless=false, coupled=None))]
 #[allow(clippy::too_many_arguments)]

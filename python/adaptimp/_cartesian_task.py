@@ -284,8 +284,9 @@ class CartesianTask:
         """The same task from posture ``q`` (rad): a :class:`CirclePath` about
         the pose the arm has at ``q``, the same radius and plane (a robot's
         arm that moved between the task's set-up and its first cycle starts
-        where it stands, without a step in the reference). Other paths are
-        not moved (ConfigError)."""
+        where it stands, without a step in the reference); its
+        ``assessment`` stays the original start's figures (the move is small:
+        the rule's checks ran there). Other paths are not moved (ConfigError)."""
         path = self.path
         if not isinstance(path, CirclePath):
             raise ConfigError(f"moved_to moves the default CirclePath, not {type(path).__name__}")

@@ -247,6 +247,7 @@ class Loop:
         self.source = s.controller.inner if self.cartesian else s.controller
         self.tables = s.reference(self.steps)
         self.task = s.task  # the Cartesian task as run (moved to the first cycle's pose)
+        self.q0 = np.array(s.q, dtype=np.float64)  # the joint task's blend start, as run
         if not self.cartesian:
             # The path itself, for the blend from where the arm stands at the first cycle.
             t = np.arange(self.steps, dtype=np.float64)[:, None] * PERIOD
@@ -269,7 +270,8 @@ class Loop:
         rows = min(self.steps, math.ceil(self.s.blend / PERIOD) + 1)
         t = np.arange(rows, dtype=np.float64) * PERIOD
         path = (self.path[0][:rows], self.path[1][:rows], self.path[2][:rows])
-        blended = _blend(t, path, np.asarray(q, dtype=np.float64), self.s.blend)
+        self.q0 = np.array(q, dtype=np.float64)
+        blended = _blend(t, path, self.q0, self.s.blend)
         for table, rows_ in zip(self.tables, blended):
             table[: len(rows_)] = rows_
 
@@ -506,7 +508,9 @@ class Loop:
             "controller": f"adaptimp.franka.setup({case!r}, task={self.s.kind!r})",
             "loop": "libfranka",
             "payload": 0.0,
-            "q0": np.asarray(self.task.q0 if self.cartesian else self.s.q).tolist(),
+            # Where the run started: the first cycle's posture (the joint task's
+            # blend), or the Cartesian task's as moved there.
+            "q0": np.asarray(self.task.q0 if self.cartesian else self.q0).tolist(),
             "task": self.s.kind,
             "blend": self.s.blend,
             "cycles": {

@@ -12,7 +12,7 @@ import gc
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -246,8 +246,6 @@ class Loop:
         self.chain: Chain = s.controller.chain if self.cartesian else chain_of(s.plant)
         self.source = s.controller.inner if self.cartesian else s.controller
         self.tables = s.reference(self.steps)
-        self.task = s.task  # the Cartesian task as run (moved to the first cycle's pose)
-        self.q0 = np.array(s.q, dtype=np.float64)  # the joint task's blend start, as run
         if not self.cartesian:
             # The path itself, for the blend from where the arm stands at the first cycle.
             t = np.arange(self.steps, dtype=np.float64)[:, None] * PERIOD
@@ -270,8 +268,9 @@ class Loop:
         rows = min(self.steps, math.ceil(self.s.blend / PERIOD) + 1)
         t = np.arange(rows, dtype=np.float64) * PERIOD
         path = (self.path[0][:rows], self.path[1][:rows], self.path[2][:rows])
-        self.q0 = np.array(q, dtype=np.float64)
-        blended = _blend(t, path, self.q0, self.s.blend)
+        # The set-up as run: from the first cycle's posture.
+        self.s = replace(self.s, q=np.array(q, dtype=np.float64))
+        blended = _blend(t, path, self.s.q, self.s.blend)
         for table, rows_ in zip(self.tables, blended):
             table[: len(rows_)] = rows_
 
@@ -298,11 +297,13 @@ class Loop:
         if self.cartesian and isinstance(task, CartesianTask) and isinstance(task.path, CirclePath):
             outer = self.ctrl.outer
             default = np.array_equal(outer.core.state("posture"), self.s.q)
-            self.task = task.moved_to(state.q)
-            outer.reset(self.task.q0)
+            moved = task.moved_to(state.q)
+            # The set-up as run: the task moved to where the arm stands.
+            self.s = replace(self.s, q=moved.q0, task=moved)
+            outer.reset(moved.q0)
             if default:
-                outer.set_posture(self.task.q0)
-            self.tables = (np.ascontiguousarray(self.task.targets(self.steps, PERIOD)),)
+                outer.set_posture(moved.q0)
+            self.tables = self.s.reference(self.steps)
         return self.tables
 
     def measurement(self, state: Any) -> Any:
@@ -509,8 +510,8 @@ class Loop:
             "loop": "libfranka",
             "payload": 0.0,
             # Where the run started: the first cycle's posture (the joint task's
-            # blend), or the Cartesian task's as moved there.
-            "q0": np.asarray(self.task.q0 if self.cartesian else self.q0).tolist(),
+            # blend, the Cartesian task moved there).
+            "q0": self.s.q.tolist(),
             "task": self.s.kind,
             "blend": self.s.blend,
             "cycles": {
@@ -549,8 +550,8 @@ class Loop:
             wrench_ee=np.ascontiguousarray(wrench_ee),
             task=task,
         )
-        if self.cartesian and isinstance(self.task, CartesianTask):
-            self.task.measure(res)
+        if self.cartesian and isinstance(self.s.task, CartesianTask):
+            self.s.task.measure(res)
         return res
 
 

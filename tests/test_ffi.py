@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import adaptimp
-from adaptimp import Measurement
+from adaptimp import Measurement, tuning
 
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "target" / "ffi-examples"
@@ -141,6 +141,79 @@ def test_c_and_python_build_the_same_controller_on_user_centres(examples: Path) 
     c = _c_controller(examples, n, "sf", "robot", params, x)
     ctrl = adaptimp.Controller("sf", scenario="robot", n=n, centers=centers, widths=widths)
     np.testing.assert_array_equal(c, _python_controller(ctrl, n, x))
+
+
+class _Arm:
+    """A made-up arm of n joints: D(q) symmetric positive definite and G(q),
+    smooth in q (kg m², N m)."""
+
+    def __init__(self, n: int) -> None:
+        rng = np.random.default_rng(n)
+        a = rng.uniform(-0.3, 0.3, size=(n, n))
+        self.base = a @ a.T + np.diag(np.linspace(2.0, 0.2, n))
+        self.n = n
+
+    def D(self, q: np.ndarray) -> np.ndarray:
+        c = np.cos(q)
+        return self.base + 0.1 * np.outer(c, c) + np.diag(0.05 * np.sin(q) ** 2)
+
+    def G(self, q: np.ndarray) -> np.ndarray:
+        return 5.0 * np.sin(q + 0.3) * np.linspace(1.0, 0.2, self.n)
+
+
+# The rule's inputs given to both fronts: (n, case, delay, path, keywords of
+# tuning.suggest); every field of AdaptimpTuning is set by one of them.
+RULE = [
+    (2, "sf", 0, False, {}),
+    (3, "pd", 0, True, {"coupled": True}),
+    (4, "of", 1, True, {"resolve": True}),
+    (6, "sf", 2, True, {"damping": 0.5, "orbit": True, "critical": True, "weightless": True}),
+    (7, "sf", 1, True, {"coupled": False, "damping": [0.1, 0.2, 0.3, 0.4, 0.3, 0.2, 0.1]}),
+]
+
+
+@pytest.mark.parametrize(("n", "case", "delay", "with_path", "kw"), RULE)
+def test_c_and_python_build_the_same_controller_from_the_same_rule_inputs(
+    examples: Path, n: int, case: str, delay: int, with_path: bool, kw: dict[str, Any]
+) -> None:
+    """The rule of SPEC §18 given the same inputs through C
+    (adaptimp_params_suggest_tuning, every field of AdaptimpTuning) and
+    through Python (tuning.suggest): the same controller, its torques bit for
+    bit; with a path, the inertia along it, the gravity, the damping, the
+    orbit and the flags as Python reads them from its model."""
+    arm = _Arm(n)
+    period, k = 4.0, 40
+    t = np.arange(k)[:, None] * period / k
+    w = 2 * np.pi / period
+    amp = np.linspace(0.4, 0.1, n)[None, :]
+    q = 0.2 + amp * np.sin(w * t)
+    rows = np.hstack([q, amp * w * np.cos(w * t), -amp * w * w * np.sin(w * t)])
+    q0 = rows[0, :n]
+    tau = np.linspace(60.0, 10.0, n)
+    fields: dict[str, Any] = {"tau_max": tau, "Ts": 1e-3, "delay": delay}
+    py_kw = dict(kw)
+    if with_path:
+        py_kw.update(path=rows, period=period)
+        fields.update(path=rows.ravel(), period=period, gravity=arm.G(q0), inertia_samples=k)
+        fields["inertia"] = np.concatenate([arm.D(r).ravel() for r in q])
+    else:
+        fields["inertia"] = arm.D(q0).ravel()
+    if kw.get("orbit"):
+        py_kw["orbit"] = q[::4]
+        fields["orbit"] = q[::4].ravel()
+    if "damping" in kw:
+        fields["damping"] = np.broadcast_to(kw["damping"], (n,))
+    for flag in ("resolve", "critical", "weightless"):
+        fields[flag] = float(kw.get(flag, False))
+    fields["coupling"] = {None: 0, False: 1, True: 2}[kw.get("coupled")]
+    sug = tuning.suggest(arm, q0, tau, Ts=1e-3, case=case, delay=delay, **py_kw)
+    x = _inputs(n, 40)
+    c = _c_controller(examples, n, case, "rule", fields, x)
+    ctrl = adaptimp.Controller(case, scenario="robot", **sug)
+    assert ("centers" in sug) == with_path
+    assert ("inertia_matrix" in sug) == kw.get("coupled", delay >= 1)
+    np.testing.assert_array_equal(c, _python_controller(ctrl, n, x))
+    assert np.abs(c[:, n:]).max() > 0.0
 
 
 def test_the_c_paper_example_prints_the_rust_examples_metrics(examples: Path) -> None:

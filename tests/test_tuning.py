@@ -88,7 +88,8 @@ def test_centres_that_span_the_orbit() -> None:
         tuning.suggest(*args, **opts, orbit=orbit[:, :2])
     bad = orbit.copy()
     bad[3, 1] = np.nan
-    with pytest.raises(adaptimp.ConfigError, match="orbit must be finite"):
+    # Row-major: row 3, joint 1 of three is element 10.
+    with pytest.raises(adaptimp.ConfigError, match=r"^orbit\[10\] is not finite"):
         tuning.suggest(*args, **opts, orbit=bad)
 
 

@@ -23,6 +23,12 @@
 // does not count): making one more is refused with TOO_MANY_HANDLES.
 #define ADAPTIMP_MAX_HANDLES 16384
 
+// The most centres [`adaptimp_params_suggest`] places (its `centers`
+// buffer holds this many rows of 4n reals).
+// (A literal, which the header can state; the core's bound it must equal is
+// checked when this crate compiles.)
+#define ADAPTIMP_SUGGEST_MAX_NODES 256
+
 // The outcome of a call.
 typedef enum AdaptimpStatus {
   // Success.
@@ -558,6 +564,57 @@ typedef struct AdaptimpCommand {
   // ‖ŴD‖, ‖ŴC‖, ‖ŴG‖ before the step's update.
   double w_norms[3];
 } AdaptimpCommand;
+
+// Everything the rule of SPEC §18 is given, as Python's `tuning.suggest`
+// takes it (the core's `adaptimp::dynamic::Tuning`): fill it with
+// [`adaptimp_tuning_init`], set what you know, then
+// [`adaptimp_params_suggest_tuning`]. Pointers are NULL when not given;
+// the lengths are in n, the count given to the suggest call.
+typedef struct AdaptimpTuning {
+  // The controller's law.
+  AdaptimpLaw law;
+  // The arm's inertia (kg m², row-major): one n × n matrix D at the
+  // task's start when `inertia_samples` is 0 (SPEC (18.1)'s scales at
+  // it); K = `inertia_samples` ≥ 1 matrices of n × n at postures along
+  // the task's path (the scales along it, and (18.11)'s margin at the
+  // largest mode of them all).
+  const double *inertia;
+  // 0, or the number K of matrices at `inertia` (see there).
+  size_t inertia_samples;
+  // The actuators' limits τmax (N m, n values).
+  const double *tau_max;
+  // The sampling period Ts (s).
+  double ts;
+  // The loop's delay δ (periods, 0 … 64), SPEC (18.11).
+  size_t delay;
+  // Which gains: the rule's default, diagonal or shaped (SPEC (18.12)).
+  AdaptimpCoupling coupling;
+  // The task's path: `rows` rows of 3n reals (q, q̇, q̈) over one period
+  // of `period` s, evenly spaced in time; NULL: the gains only.
+  const double *path;
+  // The path's number of rows.
+  size_t rows;
+  // The period the path spans (s).
+  double period;
+  // The gravity torque G at the path's start (N m, n values), or NULL;
+  // read with a path only.
+  const double *gravity;
+  // The joints' viscous damping (N m s/rad, n values), or NULL, SPEC (18.9).
+  const double *damping;
+  // The joint positions (rad) of one period of the motion that repeats,
+  // `orbit_rows` rows of n, or NULL, SPEC (19.11); read with a path only.
+  const double *orbit;
+  // The orbit's number of rows.
+  size_t orbit_rows;
+  // The tube narrowed to the path's own size, SPEC (16.10) (the
+  // Cartesian rule's); read with a path only.
+  bool resolve;
+  // Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6).
+  bool critical;
+  // The arm bears no gravity the controller must hold (a robot that
+  // compensates it itself), SPEC (22.2).
+  bool weightless;
+} AdaptimpTuning;
 
 // What the core read of the arm beside its chain (SPEC §21), per arm joint
 // in the order of q (base to tip); entries from `n` on are 0.
@@ -1166,6 +1223,36 @@ enum AdaptimpStatus adaptimp_params_suggest_coupling(struct AdaptimpParams *out,
                                                      const double *gravity,
                                                      double *centers,
                                                      double *widths2);
+
+// `*out` gets the rule's inputs `law`, `inertia` (one n × n matrix at the
+// start), `tau_max` and `ts`, and nothing else: no delay, the default
+// gains, no path, no gravity, damping or orbit, every flag off (the core's
+// `Tuning::new`). The pointers are stored, not read.
+//
+// # Safety
+// `out` is NULL or valid for writing one [`AdaptimpTuning`].
+enum AdaptimpStatus adaptimp_tuning_init(struct AdaptimpTuning *out,
+                                         AdaptimpLaw law,
+                                         const double *inertia,
+                                         const double *tau_max,
+                                         double ts);
+
+// The rule of SPEC §18 on everything `tuning` gives, for an arm of `n`
+// joints: `*out` as [`adaptimp_params_suggest`] fills it, and the centres
+// and their squared widths into `centers` and `widths2` with a path. The
+// same inputs give the same parameters as Python's `tuning.suggest` (the
+// core's one `Tuning`). A field's enum or flag outside its values is
+// INVALID_CONFIG naming it; a NULL pointer that must be given, NULL_POINTER
+// naming it; a length that overflows, BAD_SIZE.
+//
+// # Safety
+// `tuning` is NULL or valid; its pointers are NULL or valid for the lengths
+// its fields document; `centers` and `widths2` as [`adaptimp_params_suggest`]'s.
+enum AdaptimpStatus adaptimp_params_suggest_tuning(struct AdaptimpParams *out,
+                                                   size_t n,
+                                                   const struct AdaptimpTuning *tuning,
+                                                   double *centers,
+                                                   double *widths2);
 
 // The chain of the arm of a URDF into `*out` (free it with
 // `adaptimp_chain_free`), read and reduced by

@@ -252,7 +252,10 @@ pub unsafe extern "C" fn adaptimp_params_default(
 
 /// The most centres [`adaptimp_params_suggest`] places (its `centers`
 /// buffer holds this many rows of 4n reals).
-pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = adaptimp::tuning::NODES.1;
+/// (A literal, which the header can state; the core's bound it must equal is
+/// checked when this crate compiles.)
+pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = 256;
+const _: () = assert!(ADAPTIMP_SUGGEST_MAX_NODES == adaptimp::tuning::NODES.1);
 
 /// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
 /// the robot scenario's parameters for `law` with the rule's gains from the
@@ -340,32 +343,183 @@ pub unsafe extern "C" fn adaptimp_params_suggest_coupling(
     centers: *mut f64,
     widths2: *mut f64,
 ) -> AdaptimpStatus {
+    let mut t = tuning_of(law, inertia, tau_max, ts);
+    (t.delay, t.coupling) = (delay, coupling);
+    (t.path, t.rows, t.period, t.gravity) = (path, rows, period, gravity);
+    // SAFETY: the caller's contract, the same as the function's below.
+    unsafe { adaptimp_params_suggest_tuning(out, n, &t, centers, widths2) }
+}
+
+/// Everything the rule of SPEC §18 is given, as Python's `tuning.suggest`
+/// takes it (the core's `adaptimp::dynamic::Tuning`): fill it with
+/// [`adaptimp_tuning_init`], set what you know, then
+/// [`adaptimp_params_suggest_tuning`]. Pointers are NULL when not given;
+/// the lengths are in n, the count given to the suggest call.
+#[repr(C)]
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct AdaptimpTuning {
+    /// The controller's law.
+    pub law: AdaptimpLawRaw,
+    /// The arm's inertia (kg m², row-major): one n × n matrix D at the
+    /// task's start when `inertia_samples` is 0 (SPEC (18.1)'s scales at
+    /// it); K = `inertia_samples` ≥ 1 matrices of n × n at postures along
+    /// the task's path (the scales along it, and (18.11)'s margin at the
+    /// largest mode of them all).
+    pub inertia: *const f64,
+    /// 0, or the number K of matrices at `inertia` (see there).
+    pub inertia_samples: usize,
+    /// The actuators' limits τmax (N m, n values).
+    pub tau_max: *const f64,
+    /// The sampling period Ts (s).
+    pub ts: f64,
+    /// The loop's delay δ (periods, 0 … 64), SPEC (18.11).
+    pub delay: usize,
+    /// Which gains: the rule's default, diagonal or shaped (SPEC (18.12)).
+    pub coupling: AdaptimpCouplingRaw,
+    /// The task's path: `rows` rows of 3n reals (q, q̇, q̈) over one period
+    /// of `period` s, evenly spaced in time; NULL: the gains only.
+    pub path: *const f64,
+    /// The path's number of rows.
+    pub rows: usize,
+    /// The period the path spans (s).
+    pub period: f64,
+    /// The gravity torque G at the path's start (N m, n values), or NULL;
+    /// read with a path only.
+    pub gravity: *const f64,
+    /// The joints' viscous damping (N m s/rad, n values), or NULL, SPEC (18.9).
+    pub damping: *const f64,
+    /// The joint positions (rad) of one period of the motion that repeats,
+    /// `orbit_rows` rows of n, or NULL, SPEC (19.11); read with a path only.
+    pub orbit: *const f64,
+    /// The orbit's number of rows.
+    pub orbit_rows: usize,
+    /// The tube narrowed to the path's own size, SPEC (16.10) (the
+    /// Cartesian rule's); read with a path only.
+    pub resolve: AdaptimpBoolRaw,
+    /// Ĝ learning at the velocity loop's critical bandwidth, SPEC (19.6).
+    pub critical: AdaptimpBoolRaw,
+    /// The arm bears no gravity the controller must hold (a robot that
+    /// compensates it itself), SPEC (22.2).
+    pub weightless: AdaptimpBoolRaw,
+}
+
+/// The rule's inputs with nothing but the law, the inertia at the start, the
+/// limits and the period: [`adaptimp_tuning_init`]'s.
+fn tuning_of(
+    law: AdaptimpLawRaw,
+    inertia: *const f64,
+    tau_max: *const f64,
+    ts: f64,
+) -> AdaptimpTuning {
+    AdaptimpTuning {
+        law,
+        inertia,
+        inertia_samples: 0,
+        tau_max,
+        ts,
+        delay: 0,
+        coupling: AdaptimpCoupling::Default.into(),
+        path: std::ptr::null(),
+        rows: 0,
+        period: 0.0,
+        gravity: std::ptr::null(),
+        damping: std::ptr::null(),
+        orbit: std::ptr::null(),
+        orbit_rows: 0,
+        resolve: false.into(),
+        critical: false.into(),
+        weightless: false.into(),
+    }
+}
+
+/// `*out` gets the rule's inputs `law`, `inertia` (one n × n matrix at the
+/// start), `tau_max` and `ts`, and nothing else: no delay, the default
+/// gains, no path, no gravity, damping or orbit, every flag off (the core's
+/// `Tuning::new`). The pointers are stored, not read.
+///
+/// # Safety
+/// `out` is NULL or valid for writing one [`AdaptimpTuning`].
+#[no_mangle]
+pub unsafe extern "C" fn adaptimp_tuning_init(
+    out: *mut AdaptimpTuning,
+    law: AdaptimpLawRaw,
+    inertia: *const f64,
+    tau_max: *const f64,
+    ts: f64,
+) -> AdaptimpStatus {
+    guard(|| {
+        // SAFETY (in `out`): checked for NULL; the caller's contract.
+        *unsafe { crate::out(out, "out") }? = tuning_of(law, inertia, tau_max, ts);
+        Ok(())
+    })
+}
+
+/// The rule of SPEC §18 on everything `tuning` gives, for an arm of `n`
+/// joints: `*out` as [`adaptimp_params_suggest`] fills it, and the centres
+/// and their squared widths into `centers` and `widths2` with a path. The
+/// same inputs give the same parameters as Python's `tuning.suggest` (the
+/// core's one `Tuning`). A field's enum or flag outside its values is
+/// INVALID_CONFIG naming it; a NULL pointer that must be given, NULL_POINTER
+/// naming it; a length that overflows, BAD_SIZE.
+///
+/// # Safety
+/// `tuning` is NULL or valid; its pointers are NULL or valid for the lengths
+/// its fields document; `centers` and `widths2` as [`adaptimp_params_suggest`]'s.
+#[no_mangle]
+pub unsafe extern "C" fn adaptimp_params_suggest_tuning(
+    out: *mut AdaptimpParams,
+    n: usize,
+    tuning: *const AdaptimpTuning,
+    centers: *mut f64,
+    widths2: *mut f64,
+) -> AdaptimpStatus {
     guard(|| {
         if !(1..=ADAPTIMP_MAX_JOINTS).contains(&n) {
             return Err(bad_n(n));
         }
         // SAFETY (in `out`, `slice`): checked for NULL; the caller's contract.
         let out = unsafe { crate::out(out, "out") }?;
-        let law = law_of(decode::<AdaptimpLaw>(law, "law")?);
-        let inertia = unsafe { slice(inertia, n * n, "inertia") }?;
-        let tau_max = unsafe { slice(tau_max, n, "tau_max") }?;
-        let mut rule = Tuning::new(law, Inertia::At(inertia), tau_max, ts);
-        rule.delay = delay;
-        rule.coupled = match decode::<AdaptimpCoupling>(coupling, "coupling")? {
+        let t = unsafe { tuning.as_ref() }.ok_or_else(|| null("tuning"))?;
+        let law = law_of(decode::<AdaptimpLaw>(t.law, "law")?);
+        let times = |k: usize, per: usize, what: &str| {
+            k.checked_mul(per)
+                .ok_or_else(|| fail(AdaptimpStatus::BadSize, &format_args!("{what} overflows")))
+        };
+        let inertia = match t.inertia_samples {
+            0 => Inertia::At(unsafe { slice(t.inertia, n * n, "inertia") }?),
+            k => Inertia::Along(unsafe {
+                slice(
+                    t.inertia,
+                    times(k, n * n, "inertia_samples × n²")?,
+                    "inertia",
+                )
+            }?),
+        };
+        let tau_max = unsafe { slice(t.tau_max, n, "tau_max") }?;
+        let mut rule = Tuning::new(law, inertia, tau_max, t.ts);
+        rule.delay = t.delay;
+        rule.coupled = match decode::<AdaptimpCoupling>(t.coupling, "coupling")? {
             AdaptimpCoupling::Default => None,
             AdaptimpCoupling::Diagonal => Some(false),
             AdaptimpCoupling::Shaped => Some(true),
         };
-        if !path.is_null() {
-            let len = rows
-                .checked_mul(3 * n)
-                .ok_or_else(|| fail(AdaptimpStatus::BadSize, &"rows × 3n overflows"))?;
-            let rows = unsafe { slice(path, len, "path") }?;
-            rule.path = Some(TaskPath { rows, period });
+        rule.resolve = decode_bool(t.resolve, "resolve")?;
+        rule.critical = decode_bool(t.critical, "critical")?;
+        rule.weightless = decode_bool(t.weightless, "weightless")?;
+        let given = |p: *const f64, len: usize, what: &str| match p.is_null() {
+            true => Ok(None),
+            false => unsafe { slice(p, len, what) }.map(Some),
+        };
+        if !t.path.is_null() {
+            let rows = unsafe { slice(t.path, times(t.rows, 3 * n, "rows × 3n")?, "path") }?;
+            rule.path = Some(TaskPath {
+                rows,
+                period: t.period,
+            });
         }
-        if !gravity.is_null() {
-            rule.gravity = Some(unsafe { slice(gravity, n, "gravity") }?);
-        }
+        rule.gravity = given(t.gravity, n, "gravity")?;
+        rule.damping = given(t.damping, n, "damping")?;
+        rule.orbit = given(t.orbit, times(t.orbit_rows, n, "orbit_rows × n")?, "orbit")?;
         let s = rule.suggest().map_err(|e| core_error(e, Context::Config))?;
         let mut filled = params_of(&s)?;
         if let Some(c) = s.centres() {

@@ -554,3 +554,81 @@ fn the_rule_through_the_abi_shapes_the_gains_with_a_delay() {
     assert_eq!(s, AdaptimpStatus::InvalidConfig);
     assert!(last_error().contains("coupling"), "{}", last_error());
 }
+
+/// The rule's inputs in one struct (`AdaptimpTuning`): misuse is a status
+/// naming the field, and `*out` is left as it was.
+#[test]
+fn the_rule_struct_refuses_by_name() {
+    let d = [2.0, 0.5, 0.5, 1.0];
+    let tau = [50.0, 20.0];
+    let orbit = [0.1, 0.2, f64::NAN, 0.3];
+    // One period of 2 s, 400 rows of q, q̇, q̈.
+    let path: Vec<f64> = (0..400)
+        .flat_map(|k| {
+            let (w, t) = (std::f64::consts::PI, k as f64 * 0.005);
+            let (s, c) = (0.3 * (w * t).sin(), 0.3 * (w * t).cos());
+            [s, 0.5 * s, w * c, 0.5 * w * c, -w * w * s, -0.5 * w * w * s]
+        })
+        .collect();
+    let call = |edit: &dyn Fn(&mut AdaptimpTuning)| {
+        let mut t = std::mem::MaybeUninit::<AdaptimpTuning>::uninit();
+        // SAFETY: a valid out pointer; the inputs are stored, not read.
+        let s = unsafe {
+            adaptimp_tuning_init(
+                t.as_mut_ptr(),
+                AdaptimpLaw::StateFeedback.into(),
+                d.as_ptr(),
+                tau.as_ptr(),
+                1e-3,
+            )
+        };
+        assert_eq!(s, AdaptimpStatus::Ok);
+        // SAFETY: initialised by the call above.
+        let mut t = unsafe { t.assume_init() };
+        edit(&mut t);
+        let mut p = defaults(2, AdaptimpLaw::Pd, AdaptimpPreset::Paper);
+        let before = p;
+        let mut centers = vec![0.0; ADAPTIMP_SUGGEST_MAX_NODES * 8];
+        let mut widths2 = [0.0; 8];
+        // SAFETY: valid pointers with the documented lengths.
+        let s = unsafe {
+            adaptimp_params_suggest_tuning(
+                &mut p,
+                2,
+                &t,
+                centers.as_mut_ptr(),
+                widths2.as_mut_ptr(),
+            )
+        };
+        if s != AdaptimpStatus::Ok {
+            assert_eq!(p, before, "*out changed on {s:?}");
+        }
+        (s, last_error())
+    };
+    assert_eq!(call(&|_| {}).0, AdaptimpStatus::Ok);
+    let (s, e) = call(&|t| t.resolve = AdaptimpBoolRaw(2));
+    assert_eq!(s, AdaptimpStatus::InvalidConfig);
+    assert_eq!(e, "resolve = 2 is not a bool (0 or 1)");
+    let (s, e) = call(&|t| t.coupling = AdaptimpCouplingRaw(3));
+    assert_eq!(s, AdaptimpStatus::InvalidConfig);
+    assert!(e.contains("coupling"), "{e}");
+    let (s, e) = call(&|t| t.inertia_samples = usize::MAX);
+    assert_eq!(s, AdaptimpStatus::BadSize);
+    assert!(e.contains("inertia_samples × n² overflows"), "{e}");
+    let (s, e) = call(&|t| {
+        t.path = path.as_ptr();
+        t.rows = 400;
+        t.period = 2.0;
+        t.orbit = orbit.as_ptr();
+        t.orbit_rows = 2;
+    });
+    assert_eq!(s, AdaptimpStatus::InvalidConfig, "{e}");
+    assert!(e.contains("orbit"), "{e}");
+    let mut p = defaults(2, AdaptimpLaw::Pd, AdaptimpPreset::Paper);
+    // SAFETY: a NULL struct is refused before anything is read.
+    let s = unsafe {
+        adaptimp_params_suggest_tuning(&mut p, 2, ptr::null(), ptr::null_mut(), ptr::null_mut())
+    };
+    assert_eq!(s, AdaptimpStatus::NullPointer);
+    assert!(last_error().contains("tuning"), "{}", last_error());
+}

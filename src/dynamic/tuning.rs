@@ -241,6 +241,8 @@ fn typed<const N: usize>(
                 if !o.len().is_multiple_of(N) {
                     return Err(length("orbit"));
                 }
+                // Row-major K' × n: the element (row, joint) is o[n row + joint].
+                check::finite_slice("orbit", o)?;
                 let qs: Vec<Vector<N>> = o.chunks_exact(N).map(Vector::from_column_slice).collect();
                 rule = rule.spanning(&qs);
             }

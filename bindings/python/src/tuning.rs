@@ -93,18 +93,7 @@ pub fn suggest<'py>(
     };
     let orbit: Option<Vec<f64>> = match orbit {
         None => None,
-        Some(o) if o.shape()[1] == n => {
-            let v: Vec<f64> = o.as_array().iter().copied().collect();
-            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-                return Err(ConfigError::new_err(format!(
-                    "orbit must be finite (rad), got {} at row {}, joint {}",
-                    v[i],
-                    i / n,
-                    i % n
-                )));
-            }
-            Some(v)
-        }
+        Some(o) if o.shape()[1] == n => Some(o.as_array().iter().copied().collect()),
         Some(o) => return Err(shape_error("orbit", format!("(K, {n})"), o.shape())),
     };
     let path: Option<(Vec<f64>, f64)> = match (path, period) {

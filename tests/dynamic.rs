@@ -1611,3 +1611,50 @@ fn a_replay_is_the_steps_of_its_rows() {
         "rows: every table needs K rows of n values"
     );
 }
+
+/// The default task of SPEC §18 at run time: the core's sinusoid for every
+/// n, and its errors (a home outside the swing's room, lo or hi of another
+/// length, n beyond 7).
+#[test]
+fn the_default_task_is_the_cores() {
+    fn check<const N: usize>() {
+        let home = Vector::<N>::from_fn(|i, _| 0.1 * i as f64 - 0.2);
+        let lo = Vector::<N>::from_fn(|i, _| -1.0 - 0.5 * i as f64);
+        let hi = Vector::<N>::from_fn(|i, _| if i == 0 { f64::INFINITY } else { 0.9 });
+        let t = adaptimp::control::tuning::default_task(&home, &lo, &hi).expect("the core's");
+        let d = dy::default_task(home.as_slice(), lo.as_slice(), hi.as_slice()).expect("run time");
+        for (what, a, b) in [
+            ("offset", &d[0], t.offset()),
+            ("sin", &d[1], t.sin_amplitude()),
+            ("cos", &d[2], t.cos_amplitude()),
+            ("omega", &d[3], t.omega()),
+        ] {
+            same(what, a, b.as_slice());
+        }
+    }
+    check::<1>();
+    check::<2>();
+    check::<3>();
+    check::<4>();
+    check::<5>();
+    check::<6>();
+    check::<7>();
+    let e = dy::default_task(&[0.0, 0.0], &[-1.0], &[1.0, 1.0]).expect_err("lo of one");
+    assert_eq!(
+        e.to_string(),
+        dy::default_task(&[0.0, 0.0], &[-1.0, -1.0], &[1.0])
+            .expect_err("hi of one")
+            .to_string()
+            .replace("hi", "lo")
+    );
+    assert!(e.to_string().starts_with("lo"), "{e}");
+    let outside = dy::default_task(&[0.95], &[-1.0], &[1.0]).expect_err("no room");
+    let core = adaptimp::control::tuning::default_task(
+        &Vector::<1>::new(0.95),
+        &Vector::<1>::new(-1.0),
+        &Vector::<1>::new(1.0),
+    )
+    .expect_err("no room");
+    assert_eq!(outside, core);
+    assert!(dy::default_task(&[0.0; 8], &[-1.0; 8], &[1.0; 8]).is_err());
+}

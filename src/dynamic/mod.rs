@@ -423,7 +423,7 @@ pub use run::{
 #[cfg(feature = "alloc")]
 pub use target::{pose_target, HeldRotation, TARGET_LEN};
 #[cfg(feature = "alloc")]
-pub use tuning::{Inertia, TaskPath, Tuning};
+pub use tuning::{default_task, Inertia, TaskPath, Tuning};
 #[cfg(feature = "alloc")]
 pub use values::{Command, Joints, Measurement, Setpoint};
 

@@ -11,7 +11,7 @@
 
 use super::controller::{Basis, Centres, Scenario};
 use super::sized::make;
-use super::values::{length, too_many, vector};
+use super::values::{length, too_many, vector, Joints};
 use crate::cartesian::rule::{resolving, shaped_orbit};
 use crate::control::config::Law;
 use crate::control::tuning::{
@@ -255,4 +255,22 @@ fn typed<const N: usize>(
     }
     s.config.inertia_matrix = shaped;
     Ok(Box::new(s))
+}
+
+/// The default task of SPEC §18 about `home` within [`lo`, `hi`] (rad, n
+/// values each; ±∞ for a continuous joint): the const-generic
+/// [`default_task`](crate::control::tuning::default_task)'s sinusoid as its
+/// offset, sine and cosine amplitudes (rad) and angular frequencies
+/// (rad/s), the controller's `xc_*` parameters. Its errors, and one naming
+/// `lo` or `hi` of another length than `home`.
+pub fn default_task(home: &[f64], lo: &[f64], hi: &[f64]) -> Result<[Joints; 4], Error> {
+    let n = home.len();
+    crate::with_joints!(n, N => {
+        let t = crate::control::tuning::default_task(
+            &vector::<N>("home", home)?,
+            &vector::<N>("lo", lo)?,
+            &vector::<N>("hi", hi)?,
+        )?;
+        Ok([t.offset(), t.sin_amplitude(), t.cos_amplitude(), t.omega()].map(Joints::of))
+    }, _ => Err(too_many(n)))
 }

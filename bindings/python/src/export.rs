@@ -1,8 +1,9 @@
 //! The schema's table and a scenario's defaults, for the Python layer's docs and keyword parameters.
 
+use super::errors::config_error;
 use super::params::*;
 use adaptimp::control::config::Law;
-use adaptimp::schema::{Kind, Preset, Scenario, Value, PARAMS};
+use adaptimp::schema::{Kind, Preset, Value, PARAMS};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
@@ -61,15 +62,13 @@ pub(super) fn defaults<'py>(
     let preset = preset_of(scenario)?;
     let d = PyDict::new(py);
     let mut err = Ok(());
-    adaptimp::with_joints!(
-        check_n(n)?,
-        K => Scenario::<K>::preset(preset, Law::StateFeedback).visit(|name, v| {
+    adaptimp::dynamic::Scenario::new(check_n(n)?, preset, Law::StateFeedback)
+        .map_err(|e| config_error(e.into()))?
+        .visit(|name, v| {
             if err.is_ok() {
                 err = py_value(py, v).and_then(|v| d.set_item(name, v));
             }
-        }),
-        _ => {}
-    );
+        });
     err?;
     Ok(d)
 }

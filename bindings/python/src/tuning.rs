@@ -5,7 +5,7 @@ use super::cartesian_loop::TARGET_LEN;
 use super::chain::PyChain;
 use super::{array, config_error, law_of, py_value, ConfigError};
 use adaptimp::cartesian::rule::{PoseCircle, PostureRule, TaskRows};
-use adaptimp::control::tuning::{default_task as core_default_task, Rule};
+use adaptimp::control::tuning::Rule;
 use adaptimp::dynamic::{Inertia, TaskPath, Tuning};
 use adaptimp::error::Error;
 use adaptimp::schema::{Group, PARAMS};
@@ -171,21 +171,10 @@ pub fn default_task(
         )));
     }
     let [h, l, u] = [home, lo, hi].map(|a| a.as_array().iter().copied().collect::<Vec<f64>>());
-    adaptimp::with_joints!(
-        n,
-        K => {
-            let v = |x: &[f64]| Vector::<K>::from_column_slice(x);
-            let t = core_default_task(&v(&h), &v(&l), &v(&u))
-                .map_err(|e| config_error(e.into()))?;
-            Ok((
-                t.offset().as_slice().to_vec(),
-                t.sin_amplitude().as_slice().to_vec(),
-                t.cos_amplitude().as_slice().to_vec(),
-                t.omega().as_slice().to_vec(),
-            ))
-        },
-        _ => unreachable!("n checked above"),
-    )
+    let [offset, sin, cos, omega] = adaptimp::dynamic::default_task(&h, &l, &u)
+        .map_err(|e| config_error(e.into()))?
+        .map(|v| v.to_vec());
+    Ok((offset, sin, cos, omega))
 }
 
 /// The default Cartesian task of SPEC (16.8) about the start pose `p0` (3,;

@@ -1,5 +1,6 @@
 use super::*;
 use crate::cartesian::chain::{Chain, Joint, Transform};
+use crate::cartesian::kinematics::Jacobian6;
 
 #[test]
 fn an_orbit_of_a_delayed_loop_slows_d_and_c_only() {

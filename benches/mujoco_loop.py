@@ -269,7 +269,7 @@ def cartesian_timers(
     assert log.params["loop"] == "native"
     assert log.task is not None
     ctrl.reset()
-    targets = ctrl._targets(steps, reference)
+    targets = ctrl.commanded_poses(steps, reference)
     controls = np.repeat(log.tau_sat / plant._gear, substeps, axis=0)
     m, d = plant.model, plant.data
     plant.reset(q0)

@@ -209,7 +209,7 @@ def cartesian_timers(
     log = amj.simulate(ctrl, plant, T=calls * 1e-3, q0=q0)
     assert log.task is not None
     ctrl.reset()
-    targets = ctrl._targets(calls, None)
+    targets = ctrl.commanded_poses(calls, None)
     wrenches = log.task["wrench"]
     rows = list(zip(log.q, log.dq, wrenches))
 

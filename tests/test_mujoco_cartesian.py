@@ -237,7 +237,7 @@ def test_the_replay_gives_the_runs_torques(sc: apt.PandaTable, basis: Any) -> No
     """CartesianImpedance.replay: the core's steps over a run's rows give its
     torques again (the controller's cost without a plant, benches/mujoco_loop.py)."""
     ctrl = apt.panda_controller("of", sc, basis=basis)
-    targets = ctrl._targets(400, None)
+    targets = ctrl.commanded_poses(400, None)
     res = amj.simulate(ctrl, amj.Plant(sc.model), T=0.4, q0=sc.q0)
     assert res.task is not None
     again = apt.panda_controller("of", sc, basis=basis)

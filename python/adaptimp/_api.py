@@ -350,7 +350,7 @@ def gravity_model(source: Any, n: int) -> Gravity | None:
     from ._description import read_arm
 
     plant_model = getattr(source, "model", None)
-    arm = read_arm(plant_model if hasattr(source, "_qadr") else source)
+    arm = read_arm(plant_model if hasattr(source, "qpos_adr") else source)
     if arm.n != n:
         raise ConfigError(
             f"gravity's model has {arm.n} movable joints ({', '.join(arm.joints)}), the "

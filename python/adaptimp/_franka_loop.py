@@ -328,7 +328,7 @@ class Loop:
         """The torque loop until T, Ctrl-C, a refused step or a libfranka exception."""
         ctrl, steps = self.ctrl, self.steps
         core = ctrl.outer.core if self.cartesian else None
-        joint = ctrl._joint if self.cartesian else None
+        joint = ctrl.core_joint if self.cartesian else None
         record = ctrl.record if self.cartesian else False
         last = -1  # the row of the last step
         Torques = pylibfranka.Torques

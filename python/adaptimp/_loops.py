@@ -151,7 +151,7 @@ def native_computed(ctrl: Any) -> bool:
     return (
         baselines is not None
         and isinstance(ctrl, baselines.ComputedTorque)
-        and isinstance(ctrl._core_joint, _adaptimp.ComputedTorque)
+        and isinstance(ctrl.core_joint, _adaptimp.ComputedTorque)
     )
 
 
@@ -164,8 +164,8 @@ def native_cartesian(ctrl: Any) -> bool:
     return (
         isinstance(ctrl, CartesianController)
         and type(ctrl).step is CartesianController.step
-        and ctrl._core_inner
-        and (native(ctrl.inner) or isinstance(ctrl._joint, _adaptimp.ComputedTorque))
+        and ctrl.core_joint is not None
+        and (native(ctrl.inner) or isinstance(ctrl.core_joint, _adaptimp.ComputedTorque))
     )
 
 
@@ -209,27 +209,20 @@ def _cartesian_loop(
     run: Run, progress: Callable[[int, int], object] | None, fault: Any
 ) -> dict[str, Any]:
     """The native loop of an :class:`adaptimp.CartesianController` whose joint
-    controller the core steps: its commanded pose tabulated for every row
-    (the reference at t_k, else its path on its own clock), then the core's
-    loop; the controller's Python side brought up to date, whatever happens."""
+    controller the core steps (:meth:`~adaptimp.CartesianController.run_core`),
+    along the reference at t_k, else its path on its own clock."""
     ctrl, reference = run.ctrl, run.reference
     table = reference.arrays if isinstance(reference, _Table) else reference
-    targets = ctrl._targets(run.steps, table)
-    k0 = ctrl._k
-    task: dict[str, Any] | None = None
-    try:
+
+    def loop(joint: Any, targets: FloatArray | None) -> dict[str, Any]:
         out: dict[str, Any] = ctrl.outer.core.simulate_mujoco(
-            ctrl._joint, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
+            joint, run.plant.model, run.plant.data, run.spec, run.dist, run.T,
             run.settle, run.every, progress, targets, fault,
         )  # fmt: skip
-        task = out["task"]
-    except BaseException as e:
-        # Stopped (Ctrl-C, a diverged plant): the rows of the steps it took
-        # (the exception's `partial`), which the log keeps as the clock does.
-        task = getattr(e, "partial", None)
-        raise
-    finally:
-        ctrl._ran(targets, task, k0)
+        return out
+
+    ran: tuple[dict[str, Any], FloatArray | None] = ctrl.run_core(run.steps, table, loop)
+    out, targets = ran
     out["targets"] = _pose_table(ctrl, targets, out.get("task"), run.every)
     return out
 
@@ -303,11 +296,12 @@ def _callback_loop(
     # An adaptimp.CartesianController's commanded pose of every step (or that of
     # one behind an object of the user's), for its pose errors: taken before it
     # steps (its path on its own clock).
-    cartesian = in_task and hasattr(ctrl, "chain") and callable(getattr(ctrl, "_targets", None))
+    poses_of: Any = getattr(ctrl, "commanded_poses", None)
+    cartesian = in_task and hasattr(ctrl, "chain") and callable(poses_of)
     poses = None
     if cartesian:
         given = reference.arrays if isinstance(reference, _Table) else reference
-        poses = ctrl._targets(steps, given)
+        poses = poses_of(steps, given)
     cparams = getattr(ctrl, "params", None)
     cparams = cparams if isinstance(cparams, Mapping) else {}
     target = tuple(

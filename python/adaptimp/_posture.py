@@ -51,7 +51,7 @@ def plane(chain: Any) -> list[float] | None:
 
 
 def _is_plant(model: Any) -> bool:
-    return hasattr(model, "_qadr") and hasattr(model, "model") and hasattr(model, "tau_max")
+    return hasattr(model, "qpos_adr") and hasattr(model, "model") and hasattr(model, "tau_max")
 
 
 def limits_of(model: Any, n: int) -> tuple[FloatArray, FloatArray]:

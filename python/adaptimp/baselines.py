@@ -583,7 +583,7 @@ class ComputedTorque:
         return self._trajectory
 
     @property
-    def _core_joint(self) -> Any:
+    def core_joint(self) -> Any:
         """The core's controller, which a Cartesian controller steps itself
         (None for a subclass with a ``step`` of its own)."""
         return self._core if type(self).step is ComputedTorque.step else None

@@ -183,8 +183,7 @@ class CartesianController:
                 widths=widths,
                 **joint,
             )
-            self._core_inner = True
-            self._joint: Any = inner
+            self._core: Any = inner
         else:
             if joint or centers is not None or widths is not None:
                 raise TypeError(
@@ -200,11 +199,12 @@ class CartesianController:
                 )
             inner = controller
             # A joint controller the core steps (computed torque, SPEC §20).
-            core_joint = getattr(controller, "_core_joint", None)
-            self._core_inner = isinstance(core_joint, _adaptimp.ComputedTorque)
-            self._joint = core_joint if self._core_inner else controller
+            core_joint = getattr(controller, "core_joint", None)
+            self._core = core_joint if isinstance(core_joint, _adaptimp.ComputedTorque) else None
             # A joint controller written in Python: called as the protocol says.
-            self._inner_measurement = self._core_inner or call_shape(controller) == "measurement"
+            self._inner_measurement = (
+                self._core is not None or call_shape(controller) == "measurement"
+            )
         Ts = getattr(inner, "Ts", None)
         if Ts is None:
             raise TypeError(f"the joint controller {inner!r} has no period .Ts (s)")
@@ -224,7 +224,7 @@ class CartesianController:
         is left as it is."""
         if type(self).step is not CartesianController.step:
             return
-        joint = self._joint if self._core_inner else None
+        joint = self._core
         # Any call but step(m) goes on to the method below, as written in Python.
         other = types.MethodType(CartesianController.step, self)
         bound = _adaptimp.CartesianStep(self.outer.core, joint, self._path, other, self._record)
@@ -340,7 +340,7 @@ class CartesianController:
         from . import _posture, tuning
 
         if params.get("gravity") == "model":
-            if not hasattr(model, "_qadr"):
+            if not hasattr(model, "qpos_adr"):
                 raise ConfigError(
                     "gravity='model' reads the model's description from an "
                     "adaptimp.mujoco.Plant: give the arm's file itself, gravity=PATH"
@@ -478,9 +478,17 @@ class CartesianController:
         return self.outer.q0.copy() if np.isnan(q).all() else q
 
     @property
+    def core_joint(self) -> Any:
+        """The joint controller the core steps itself behind this one (an
+        :class:`adaptimp.Controller`, or the core's computed torque of an
+        :class:`adaptimp.baselines.ComputedTorque`); None for a joint controller
+        written in Python, which each step calls."""
+        return self._core
+
+    @property
     def tau(self) -> FloatArray:
         """The last step's commanded τ of the joint controller (N m), (n,)."""
-        return self._last("tau") if self._core_inner else self._tau
+        return self._last("tau") if self._core is not None else self._tau
 
     @property
     def log(self) -> dict[str, list[FloatArray]]:
@@ -504,10 +512,11 @@ class CartesianController:
         ``tau`` (n,) (N m) until now (:meth:`adaptimp.Controller.take_over`:
         the first step's torque rate limit moves from it). TypeError if the
         joint controller has no ``take_over``."""
-        take = getattr(self._joint, "take_over", None)
+        joint = self.inner if self._core is None else self._core
+        take = getattr(joint, "take_over", None)
         if not callable(take):
             raise TypeError(
-                f"the joint controller {type(self._joint).__name__} cannot take over a torque"
+                f"the joint controller {type(joint).__name__} cannot take over a torque"
             )
         take(tau)
 
@@ -550,7 +559,7 @@ class CartesianController:
         ``DeprecationWarning``.
         """
         measured: Any
-        if self._core_inner and type(m) is Measurement and dq is wrench is q is None:
+        if self._core is not None and type(m) is Measurement and dq is wrench is q is None:
             measured = m  # the core reads it itself: no arrays made here
         else:
             q, dq, wrench = measured_of(self.chain.n, m, dq, wrench, q)
@@ -578,12 +587,12 @@ class CartesianController:
                 )
         else:
             sample = None
-        if self._core_inner:
+        if self._core is not None:
             # One call of the core: the pose and wrench read, the step, the row kept.
             core = self.outer.core
             try:
                 out: FloatArray = core.step_sample(
-                    self._joint, measured, dq, wrench, sample, self.record
+                    self._core, measured, dq, wrench, sample, self.record
                 )
             except MeasurementError as e:
                 if given is None:
@@ -637,13 +646,44 @@ class CartesianController:
             k: np.vstack(v) if v else np.zeros((0, width.get(k, 3))) for k, v in self.log.items()
         }
 
-    def _targets(
+    def run_core(
         self,
         steps: int,
         reference: Callable[[float], Sequence[ArrayLike]] | Sequence[FloatArray] | None,
+        loop: Callable[[Any, FloatArray | None], dict[str, Any]],
+    ) -> tuple[dict[str, Any], FloatArray | None]:
+        """``steps`` steps of the core's closed loop from this controller's state
+        (:func:`adaptimp.mujoco.simulate`'s): its commanded pose tabulated for
+        every row (``reference`` at t_k, or its rows (xc, dxc, ddxc), else the
+        path on this controller's clock), then ``loop(core_joint, targets)``,
+        which runs the core's loop and returns its dict; the controller brought
+        up to date (clock, held rotation, log) whatever happens. Returns that
+        dict and the targets (steps, 24), or None where the last target is held."""
+        if self._core is None:
+            raise TypeError("the core steps a Cartesian controller whose joint controller it steps")
+        targets = self.commanded_poses(steps, reference)
+        k0 = self._k
+        task: dict[str, Any] | None = None
+        try:
+            out = loop(self._core, targets)
+            task = out["task"]
+        except BaseException as e:
+            # Stopped (Ctrl-C, a diverged plant): the rows of the steps it took
+            # (the exception's `partial`), which the log keeps as the clock does.
+            task = getattr(e, "partial", None)
+            raise
+        finally:
+            self._ran(targets, task, k0)
+        return out, targets
+
+    def commanded_poses(
+        self,
+        steps: int,
+        reference: Callable[[float], Sequence[ArrayLike]] | Sequence[FloatArray] | None = None,
     ) -> FloatArray | None:
         """The commanded pose of the next ``steps`` steps at t_k = k·Ts of a loop,
-        (steps, 24), as :meth:`step` would take them one by one: ``reference(t_k)``
+        (steps, 24) (p (m), ṗ (m/s), p̈ (m/s²), R row-major, ω (rad/s), ω̇
+        (rad/s²)), as :meth:`step` would take them one by one: ``reference(t_k)``
         or the row k of a tabulated reference (xc, dxc, ddxc) (position, rates;
         the rotation held), else the path on this controller's clock, else None
         (the last target held)."""
@@ -665,7 +705,7 @@ class CartesianController:
 
     def _ran(self, targets: FloatArray | None, task: dict[str, FloatArray] | None, k0: int) -> None:
         """After a run of the core's loop (:func:`adaptimp.mujoco.simulate`) along
-        ``targets`` (of :meth:`_targets`), whole or stopped by an error: the clock,
+        ``targets`` (of :meth:`commanded_poses`), whole or stopped by an error: the clock,
         the held rotation and the attributes as after the steps it took; the log
         extended by the run's kept rows ``task`` (None: none); ``k0`` the steps
         taken before it."""

@@ -135,7 +135,7 @@ def joint_damping(model: Any) -> FloatArray | None:
     (a Pinocchio ``Model`` or a URDF compiled without its drive terms carries
     none), or if every joint's is zero."""
     m = getattr(model, "model", None)
-    dofs = getattr(model, "_dofs", None)
+    dofs = getattr(model, "dof_adr", None)
     if m is None or dofs is None or not hasattr(m, "dof_damping"):
         return None
     b = np.asarray(m.dof_damping[np.asarray(dofs)], dtype=np.float64)

@@ -281,70 +281,6 @@ pub enum AdaptimpJointKind {
     Prismatic = 1302,
 }
 
-/// An [`AdaptimpLaw`] as the caller passed it: an integer, checked when read.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpLawRaw(pub u32);
-/// An [`AdaptimpCoupling`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpCouplingRaw(pub u32);
-/// An [`AdaptimpPreset`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpPresetRaw(pub u32);
-/// An [`AdaptimpAuxLaw`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpAuxLawRaw(pub u32);
-/// An [`AdaptimpConditions`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpConditionsRaw(pub u32);
-/// An [`AdaptimpFormulation`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpFormulationRaw(pub u32);
-/// An [`AdaptimpRobust`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpRobustRaw(pub u32);
-/// An [`AdaptimpLearningStep`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpLearningStepRaw(pub u32);
-/// An [`AdaptimpSaturationLearning`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpSaturationLearningRaw(pub u32);
-/// An [`AdaptimpWeightBound`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpWeightBoundRaw(pub u32);
-/// An [`AdaptimpObserverInit`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpObserverInitRaw(pub u32);
-/// An [`AdaptimpObserverHold`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpObserverHoldRaw(pub u32);
-/// An [`AdaptimpImpedance`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpImpedanceRaw(pub u32);
-/// An [`AdaptimpFallback`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpFallbackRaw(pub u32);
-/// An [`AdaptimpFaultPolicy`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpFaultPolicyRaw(pub u32);
-/// An [`AdaptimpJointKind`] as the caller passed it.
-#[repr(transparent)]
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct AdaptimpJointKindRaw(pub u32);
 /// A C `bool` as the caller passed it: a byte, 0 or 1 (anything else is refused).
 #[repr(transparent)]
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
@@ -375,6 +311,11 @@ pub trait CEnum: Copy + std::fmt::Debug + PartialEq + 'static {
 macro_rules! c_enums {
     ($($e:ident / $raw:ident: $($v:ident),+;)+) => {
         $(
+            #[doc = concat!("An [`", stringify!($e), "`] as the caller passed it: an integer, checked when read.")]
+            #[repr(transparent)]
+            #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+            pub struct $raw(pub u32);
+
             impl CEnum for $e {
                 const NAME: &'static str = stringify!($e);
                 const ALL: &'static [Self] = &[$($e::$v),+];

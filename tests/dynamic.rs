@@ -274,7 +274,15 @@ fn chain_and_dynamics<const N: usize>() {
         .collect();
     let g = adaptimp::GRAVITY;
     let drive = [0.1; N];
+    // Gravity compensation (SPEC (20.1')): a share of each link lifted.
+    let lifted: Vec<adaptimp::cartesian::Lifted> = (0..=N)
+        .map(|i| adaptimp::cartesian::Lifted {
+            mass: 0.3 + 0.05 * i as f64,
+            moment: [0.01, -0.02, 0.03 * i as f64],
+        })
+        .collect();
     let dd = dy::Dynamics::new(&js, &inertials, g)
+        .and_then(|d| d.with_gravity_compensation(&js, &lifted))
         .and_then(|d| {
             d.with_drive(&dy::Drive {
                 armature: &drive,
@@ -284,6 +292,7 @@ fn chain_and_dynamics<const N: usize>() {
         })
         .expect("run-time dynamics");
     let cd = Dynamics::<N>::new(&js, &inertials, g)
+        .and_then(|d| d.with_gravity_compensation(&js, &lifted))
         .and_then(|d| {
             d.with_drive(adaptimp::Drive {
                 armature: Vector::from(drive),
@@ -310,6 +319,17 @@ fn chain_and_dynamics<const N: usize>() {
             "gravity",
             &dd.gravity_torque(q.as_slice()).expect("G"),
             cd.gravity_torque(&q).as_slice(),
+        );
+    }
+    // The compensation is there: the lifted share's weight is off G (where
+    // the arm bears any: a first joint about the vertical bears none).
+    let plain = dy::Dynamics::new(&js, &inertials, g).expect("plain");
+    let q = q_of::<N>(1);
+    let bare = plain.gravity_torque(q.as_slice()).expect("G");
+    if bare.iter().any(|x| x.abs() > 1e-9) {
+        assert_ne!(
+            bits(&bare),
+            bits(&dd.gravity_torque(q.as_slice()).expect("G"))
         );
     }
     // Computed torque on that model (SPEC §20).

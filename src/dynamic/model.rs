@@ -458,6 +458,20 @@ impl Dynamics {
         Chain { inner }
     }
 
+    /// The model with gravity compensation, SPEC (20.1'): `lifted[k]` what is
+    /// lifted in the link of entry k of `joints` (as [`new`](Self::new) took
+    /// them, fixed ones too)
+    /// ([`Dynamics::with_gravity_compensation`](crate::Dynamics::with_gravity_compensation)).
+    pub fn with_gravity_compensation(
+        self,
+        joints: &[Joint],
+        lifted: &[cartesian::Lifted],
+    ) -> Result<Self, Error> {
+        let inner =
+            map!(self.inner, d, N => d.with_gravity_compensation(joints, lifted).map(Box::new))?;
+        Ok(Self { inner })
+    }
+
     /// Every mass and inertia times `factor` ([`Dynamics::scaled`](crate::Dynamics::scaled)).
     pub fn scaled(self, factor: f64) -> Result<Self, Error> {
         let inner = map!(self.inner, d, N => d.scaled(factor).map(Box::new))?;

@@ -163,7 +163,7 @@ def timers(name: str, T: float) -> tuple[dict[str, Callable[[], float]], int, in
         states, _ = rollout.rollout(m, d, initial, controls)
         seconds = time.perf_counter() - start
         # The same motion as (a), to MuJoCo's rounding (not a diverged run).
-        q_end = states[0, -1, 1 : 1 + m.nq][plant._qadr]
+        q_end = states[0, -1, 1 : 1 + m.nq][plant.qpos_adr]
         assert np.allclose(q_end, log.q[-1], atol=1e-3), (q_end, log.q[-1])
         return seconds / steps
 
@@ -287,7 +287,7 @@ def cartesian_timers(
         start = time.perf_counter()
         states, _ = rollout.rollout(m, d, initial, controls)
         seconds = time.perf_counter() - start
-        q_end = states[0, -1, 1 : 1 + m.nq][plant._qadr]
+        q_end = states[0, -1, 1 : 1 + m.nq][plant.qpos_adr]
         assert np.allclose(q_end, log.q[-1], atol=1e-3), (q_end, log.q[-1])
         return seconds / steps
 

@@ -216,3 +216,22 @@ def test_the_rules_keywords_drive_a_cartesian_controller_under_gravity() -> None
     )  # fmt: skip
     res = amj.simulate(ctrl, plant, T=5.0, q0=HOME)
     assert np.linalg.norm(PANDA.pose(res.q[-1])[0] - path(5.0)[0]) < 1e-3
+
+
+def test_run_core_is_refused_for_a_joint_controller_stepped_from_python() -> None:
+    """CartesianController.run_core runs the core's loop only where the core
+    steps the joint controller: a Python one is refused by name."""
+
+    class Joint:
+        Ts = 1e-3
+        impedance = "external"
+
+        def step(self, m: Measurement, **kw: object) -> np.ndarray:
+            return np.zeros(7)
+
+    ctrl = adaptimp.CartesianController(PANDA, Joint(), q0=HOME)
+    assert ctrl.core_joint is None
+    with pytest.raises(TypeError, match=r"^run_core: .* this one's joint controller is a Joint$"):
+        ctrl.run_core(10, None, lambda joint, targets: {})
+    native = adaptimp.CartesianController(PANDA, "pd", q0=HOME, tau_max=87.0, **ONE)
+    assert isinstance(native.core_joint, adaptimp.Controller)

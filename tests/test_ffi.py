@@ -147,29 +147,41 @@ class _Arm:
     """A made-up arm of n joints: D(q) symmetric positive definite and G(q),
     smooth in q (kg m², N m)."""
 
-    def __init__(self, n: int) -> None:
+    def __init__(self, n: int, heavy: float = 1.0) -> None:
         rng = np.random.default_rng(n)
         a = rng.uniform(-0.3, 0.3, size=(n, n))
         self.base = a @ a.T + np.diag(np.linspace(2.0, 0.2, n))
-        self.n = n
+        self.n, self.heavy = n, heavy
 
     def D(self, q: np.ndarray) -> np.ndarray:
         c = np.cos(q)
         return self.base + 0.1 * np.outer(c, c) + np.diag(0.05 * np.sin(q) ** 2)
 
     def G(self, q: np.ndarray) -> np.ndarray:
-        return 5.0 * np.sin(q + 0.3) * np.linspace(1.0, 0.2, self.n)
+        return self.heavy * 5.0 * np.sin(q + 0.3) * np.linspace(1.0, 0.2, self.n)
 
 
 # The rule's inputs given to both fronts: (n, case, delay, path, keywords of
-# tuning.suggest); every field of AdaptimpTuning is set by one of them.
+# tuning.suggest); every field of AdaptimpTuning is set by one of them, and
+# the gravity ("heavy": the arm's G scaled, the tube then holding its sag)
+# and `resolve` (on a path small enough for (16.10) to narrow the tube,
+# "small": its amplitude scaled) each change the controller where given.
 RULE = [
     (2, "sf", 0, False, {}),
     (3, "pd", 0, True, {"coupled": True}),
+    (3, "sf", 0, True, {"heavy": 1000.0}),
     (4, "of", 1, True, {"resolve": True}),
+    (4, "sf", 0, True, {"resolve": True, "small": 0.05}),
     (6, "sf", 2, True, {"damping": 0.5, "orbit": True, "critical": True, "weightless": True}),
     (7, "sf", 1, True, {"coupled": False, "damping": [0.1, 0.2, 0.3, 0.4, 0.3, 0.2, 0.1]}),
 ]
+
+
+def _differ(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Whether two suggestions differ in any keyword."""
+    return a.keys() != b.keys() or any(
+        not np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in a
+    )
 
 
 @pytest.mark.parametrize(("n", "case", "delay", "with_path", "kw"), RULE)
@@ -181,11 +193,13 @@ def test_c_and_python_build_the_same_controller_from_the_same_rule_inputs(
     through Python (tuning.suggest): the same controller, its torques bit for
     bit; with a path, the inertia along it, the gravity, the damping, the
     orbit and the flags as Python reads them from its model."""
-    arm = _Arm(n)
+    kw = dict(kw)
+    heavy, small = kw.pop("heavy", 1.0), kw.pop("small", 1.0)
+    arm = _Arm(n, heavy)
     period, k = 4.0, 40
     t = np.arange(k)[:, None] * period / k
     w = 2 * np.pi / period
-    amp = np.linspace(0.4, 0.1, n)[None, :]
+    amp = small * np.linspace(0.4, 0.1, n)[None, :]
     q = 0.2 + amp * np.sin(w * t)
     rows = np.hstack([q, amp * w * np.cos(w * t), -amp * w * w * np.sin(w * t)])
     q0 = rows[0, :n]
@@ -207,6 +221,13 @@ def test_c_and_python_build_the_same_controller_from_the_same_rule_inputs(
         fields[flag] = float(kw.get(flag, False))
     fields["coupling"] = {None: 0, False: 1, True: 2}[kw.get("coupled")]
     sug = tuning.suggest(arm, q0, tau, Ts=1e-3, case=case, delay=delay, **py_kw)
+    # The row's gravity and resolve change the controller (so C must pass them).
+    if heavy != 1.0:
+        light = tuning.suggest(_Arm(n), q0, tau, Ts=1e-3, case=case, delay=delay, **py_kw)
+        assert _differ(sug, light)
+    if small != 1.0:
+        coarse = {**py_kw, "resolve": False}
+        assert _differ(sug, tuning.suggest(arm, q0, tau, Ts=1e-3, case=case, delay=delay, **coarse))
     x = _inputs(n, 40)
     c = _c_controller(examples, n, case, "rule", fields, x)
     ctrl = adaptimp.Controller(case, scenario="robot", **sug)

@@ -88,8 +88,9 @@ def test_centres_that_span_the_orbit() -> None:
         tuning.suggest(*args, **opts, orbit=orbit[:, :2])
     bad = orbit.copy()
     bad[3, 1] = np.nan
-    # Row-major: row 3, joint 1 of three is element 10.
-    with pytest.raises(adaptimp.ConfigError, match=r"^orbit\[10\] is not finite"):
+    with pytest.raises(
+        adaptimp.ConfigError, match=r"^orbit must be finite \(rad\), got NaN at row 3, joint 1$"
+    ):
         tuning.suggest(*args, **opts, orbit=bad)
 
 
@@ -97,6 +98,11 @@ def test_gains_alone_without_a_path() -> None:
     kw = tuning.suggest(np.diag([2.0, 0.5]), [0.0, 0.0], 10.0, Ts=2e-3)
     np.testing.assert_allclose(kw["Kp"], [250.0, 62.5], rtol=1e-15)
     assert kw["K1"] == [25.0, 25.0]
+    # An orbit is read with the path only: without one it is refused, not ignored.
+    with pytest.raises(
+        adaptimp.ConfigError, match=r"^orbit: is read with the task's path only: give the path too"
+    ):
+        tuning.suggest(np.diag([2.0, 0.5]), [0.0, 0.0], 10.0, Ts=2e-3, orbit=np.zeros((4, 2)))
     assert "centers" not in kw
     adaptimp.Controller("sf", "robot", **kw)
 

@@ -23,10 +23,9 @@
 // does not count): making one more is refused with TOO_MANY_HANDLES.
 #define ADAPTIMP_MAX_HANDLES 16384
 
-// The most centres [`adaptimp_params_suggest`] places (its `centers`
-// buffer holds this many rows of 4n reals).
-// (A literal, which the header can state; the core's bound it must equal is
-// checked when this crate compiles.)
+// The most centres the rule places ([`adaptimp_params_suggest`],
+// [`adaptimp_params_suggest_tuning`]): their `centers` buffer holds this
+// many rows of 4n reals.
 #define ADAPTIMP_SUGGEST_MAX_NODES 256
 
 // The outcome of a call.
@@ -1241,9 +1240,13 @@ enum AdaptimpStatus adaptimp_tuning_init(struct AdaptimpTuning *out,
 // joints: `*out` as [`adaptimp_params_suggest`] fills it, and the centres
 // and their squared widths into `centers` and `widths2` with a path. The
 // same inputs give the same parameters as Python's `tuning.suggest` (the
-// core's one `Tuning`). A field's enum or flag outside its values is
-// INVALID_CONFIG naming it; a NULL pointer that must be given, NULL_POINTER
-// naming it; a length that overflows, BAD_SIZE.
+// core's one `Tuning`); Python reads them from its model: D at the path's
+// rows `0, s, 2s, …` (s = max(1, rows / 50)), G at the path's start, the
+// damping of the plant's joints, `weightless` when the model has no
+// gravity. A field's enum or flag outside its values is INVALID_CONFIG
+// naming it, as is an orbit or a gravity given without a path; a NULL
+// pointer that must be given, NULL_POINTER naming it; a length that
+// overflows, BAD_SIZE. On an error `*out` is left unchanged.
 //
 // # Safety
 // `tuning` is NULL or valid; its pointers are NULL or valid for the lengths

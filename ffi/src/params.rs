@@ -250,11 +250,11 @@ pub unsafe extern "C" fn adaptimp_params_default(
     })
 }
 
-/// The most centres [`adaptimp_params_suggest`] places (its `centers`
-/// buffer holds this many rows of 4n reals).
-/// (A literal, which the header can state; the core's bound it must equal is
-/// checked when this crate compiles.)
+/// The most centres the rule places ([`adaptimp_params_suggest`],
+/// [`adaptimp_params_suggest_tuning`]): their `centers` buffer holds this
+/// many rows of 4n reals.
 pub const ADAPTIMP_SUGGEST_MAX_NODES: usize = 256;
+// A literal, which the header can state; the core's bound it must equal.
 const _: () = assert!(ADAPTIMP_SUGGEST_MAX_NODES == adaptimp::tuning::NODES.1);
 
 /// The gain and basis rule of SPEC §18 for an arm of `n` joints: `*out` gets
@@ -458,9 +458,13 @@ pub unsafe extern "C" fn adaptimp_tuning_init(
 /// joints: `*out` as [`adaptimp_params_suggest`] fills it, and the centres
 /// and their squared widths into `centers` and `widths2` with a path. The
 /// same inputs give the same parameters as Python's `tuning.suggest` (the
-/// core's one `Tuning`). A field's enum or flag outside its values is
-/// INVALID_CONFIG naming it; a NULL pointer that must be given, NULL_POINTER
-/// naming it; a length that overflows, BAD_SIZE.
+/// core's one `Tuning`); Python reads them from its model: D at the path's
+/// rows `0, s, 2s, …` (s = max(1, rows / 50)), G at the path's start, the
+/// damping of the plant's joints, `weightless` when the model has no
+/// gravity. A field's enum or flag outside its values is INVALID_CONFIG
+/// naming it, as is an orbit or a gravity given without a path; a NULL
+/// pointer that must be given, NULL_POINTER naming it; a length that
+/// overflows, BAD_SIZE. On an error `*out` is left unchanged.
 ///
 /// # Safety
 /// `tuning` is NULL or valid; its pointers are NULL or valid for the lengths

@@ -624,6 +624,24 @@ fn the_rule_struct_refuses_by_name() {
     });
     assert_eq!(s, AdaptimpStatus::InvalidConfig, "{e}");
     assert!(e.contains("orbit"), "{e}");
+    // What is read with a path only is refused without one, by name.
+    let g = [1.0, 2.0];
+    let with_orbit = |t: &mut AdaptimpTuning| {
+        t.orbit = orbit.as_ptr();
+        t.orbit_rows = 1;
+    };
+    let with_gravity = |t: &mut AdaptimpTuning| t.gravity = g.as_ptr();
+    for (what, edit) in [
+        ("orbit", &with_orbit as &dyn Fn(&mut AdaptimpTuning)),
+        ("gravity", &with_gravity),
+    ] {
+        let (s, e) = call(edit);
+        assert_eq!(s, AdaptimpStatus::InvalidConfig, "{e}");
+        assert!(
+            e.contains(&format!("{what}: is read with the task's path only")),
+            "{e}"
+        );
+    }
     let mut p = defaults(2, AdaptimpLaw::Pd, AdaptimpPreset::Paper);
     // SAFETY: a NULL struct is refused before anything is read.
     let s = unsafe {

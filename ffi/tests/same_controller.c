@@ -198,7 +198,7 @@ static int suggest(AdaptimpParams *p, size_t n, AdaptimpLaw law, int argc, char 
         } else if (strcmp(name, "coupling") == 0) {
             const AdaptimpCoupling c[] = {ADAPTIMP_COUPLING_DEFAULT, ADAPTIMP_COUPLING_DIAGONAL,
                                           ADAPTIMP_COUPLING_SHAPED};
-            t.coupling = c[(int)v[0] % 3];
+            t.coupling = c[(unsigned)v[0] % 3u];
         } else if (strcmp(name, "resolve") == 0) {
             t.resolve = v[0] != 0.0;
         } else if (strcmp(name, "critical") == 0) {

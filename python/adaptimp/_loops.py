@@ -296,7 +296,7 @@ def _callback_loop(
     # An adaptimp.CartesianController's commanded pose of every step (or that of
     # one behind an object of the user's), for its pose errors: taken before it
     # steps (its path on its own clock).
-    poses_of: Any = getattr(ctrl, "commanded_poses", None)
+    poses_of: Any = getattr(ctrl, "commanded_poses", None) if in_task else None
     cartesian = in_task and hasattr(ctrl, "chain") and callable(poses_of)
     poses = None
     if cartesian:

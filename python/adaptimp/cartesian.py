@@ -659,8 +659,13 @@ class CartesianController:
         which runs the core's loop and returns its dict; the controller brought
         up to date (clock, held rotation, log) whatever happens. Returns that
         dict and the targets (steps, 24), or None where the last target is held."""
-        if self._core is None:
-            raise TypeError("the core steps a Cartesian controller whose joint controller it steps")
+        if self._core is None or type(self).step is not CartesianController.step:
+            raise TypeError(
+                "run_core: the core runs a CartesianController whose step is its own and whose "
+                "joint controller it steps (an adaptimp.Controller or a baselines.ComputedTorque); "
+                f"this one's joint controller is a {type(self.inner).__name__}"
+                + ("" if type(self).step is CartesianController.step else ", its step overridden")
+            )
         targets = self.commanded_poses(steps, reference)
         k0 = self._k
         task: dict[str, Any] | None = None

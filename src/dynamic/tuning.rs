@@ -210,6 +210,30 @@ fn typed<const N: usize>(
         (m + m.transpose()) * 0.5
     });
     let tau = vector::<N>("tau_max", t.tau_max)?;
+    // What is read with a path only is refused without one, not ignored.
+    if t.path.is_none() {
+        for (what, given) in [
+            ("orbit", t.orbit.is_some()),
+            ("gravity", t.gravity.is_some()),
+        ] {
+            if given {
+                return Err(Error::Invalid {
+                    what,
+                    reason: "is read with the task's path only: give the path too",
+                });
+            }
+        }
+    }
+    if let Some(o) = t.orbit {
+        if o.is_empty() || !o.len().is_multiple_of(N) {
+            return Err(Error::Invalid {
+                what: "orbit",
+                reason: "needs one row of n joint positions or more",
+            });
+        }
+        // Row-major K' × n: the element (row, joint) is o[n row + joint].
+        check::finite_slice("orbit", o)?;
+    }
     let mut s = schema::Scenario::<N>::preset(Preset::Robot, t.law);
     match &t.path {
         None => s.config = rule.gains_scaled(t.law, &scales, &tau, t.ts)?,
@@ -238,11 +262,6 @@ fn typed<const N: usize>(
                 }
             }
             if let Some(o) = t.orbit {
-                if !o.len().is_multiple_of(N) {
-                    return Err(length("orbit"));
-                }
-                // Row-major K' × n: the element (row, joint) is o[n row + joint].
-                check::finite_slice("orbit", o)?;
                 let qs: Vec<Vector<N>> = o.chunks_exact(N).map(Vector::from_column_slice).collect();
                 rule = rule.spanning(&qs);
             }

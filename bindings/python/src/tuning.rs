@@ -128,7 +128,22 @@ pub fn suggest<'py>(
     rule.orbit = orbit.as_deref();
     (rule.resolve, rule.critical, rule.weightless) = (resolve, critical, weightless);
     rule.coupled = coupled;
-    let s = rule.suggest().map_err(|e| config_error(e.into()))?;
+    let s = rule.suggest().map_err(|e| match (e, orbit.as_deref()) {
+        // The core's flat index as the array's row and joint.
+        (
+            Error::NonFinite {
+                what: "orbit",
+                index,
+            },
+            Some(o),
+        ) => ConfigError::new_err(format!(
+            "orbit must be finite (rad), got {} at row {}, joint {}",
+            o[index],
+            index / n,
+            index % n
+        )),
+        (e, _) => config_error(e.into()),
+    })?;
     let out = PyDict::new(py);
     let params = PyDict::new(py);
     let mut res = Ok(());

@@ -88,6 +88,22 @@ macro_rules! with_joints {
     };
 }
 
+/// A computation over the const-generic core for one number of joints N,
+/// which a caller holding run-time values ([`ComputedTorque::typed`], …)
+/// runs through [`for_joints`]: the one dispatch of a run-time n to a const
+/// N, here, for code that must be generic over N (a typed loop).
+pub trait ForJoints {
+    /// What it gives.
+    type Output;
+    /// The computation for N joints.
+    fn call<const N: usize>(self) -> Self::Output;
+}
+
+/// `f` for N = `n`, or `None` outside 1 … [`MAX_JOINTS`].
+pub fn for_joints<F: ForJoints>(n: usize, f: F) -> Option<F::Output> {
+    with_joints!(n, N => Some(f.call::<N>()), _ => None)
+}
+
 /// `$m! { J1 => 1, J2 => 2, …, J7 => 7 }`: a macro that defines one item
 /// per joint count (the run-time types' impls for each N) gets the same
 /// sizes as [`with_joints!`](crate::with_joints).

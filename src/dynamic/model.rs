@@ -643,6 +643,12 @@ impl ComputedTorque {
         self.inner.n()
     }
 
+    /// The const-generic controller, if made for N joints: for a caller
+    /// generic over N (a typed loop, [`for_joints`](super::for_joints)).
+    pub fn typed<const N: usize>(&self) -> Option<&cartesian::ComputedTorque<N>> {
+        each!(&self.inner, c, M => (&**c as &dyn core::any::Any).downcast_ref())
+    }
+
     /// Sampling period Ts (s).
     pub fn period(&self) -> f64 {
         each!(&self.inner, c, N => c.period())
@@ -711,6 +717,17 @@ impl ComputedState {
     /// The number of joints n.
     pub fn n(&self) -> usize {
         self.inner.n()
+    }
+
+    /// The const-generic state, if made for N joints: for a caller generic
+    /// over N (a typed loop, [`for_joints`](super::for_joints)).
+    pub fn typed<const N: usize>(&self) -> Option<&cartesian::ComputedState<N>> {
+        each!(&self.inner, s, M => (s as &dyn core::any::Any).downcast_ref())
+    }
+
+    /// [`typed`](Self::typed), to change.
+    pub fn typed_mut<const N: usize>(&mut self) -> Option<&mut cartesian::ComputedState<N>> {
+        each!(&mut self.inner, s, M => (s as &mut dyn core::any::Any).downcast_mut())
     }
 
     /// Steps taken k.

@@ -6,7 +6,7 @@
 //! `cartesian_args`; errors become the exceptions of `adaptimp._errors`.
 
 use super::cartesian_loop::{pose_target, CartesianRun, TARGET_LEN};
-use super::computed::{DynComputed, PyComputedTorque};
+use super::computed::{ComputedCore, PyComputedTorque};
 use super::dynamic::{scenario, DynTracker, Owned, MAX_JOINTS};
 use super::measurement::PyMeasurement;
 use super::shared::{Read, Shared, Slot, Write};
@@ -32,14 +32,14 @@ pub use super::chain::{centres_along, PyChain};
 /// where a run publishes its copy.
 enum Locked<'a> {
     Adaptive(Write<'a, dyn DynTracker>, &'a dyn Slot),
-    Computed(Write<'a, dyn DynComputed>, &'a dyn Slot),
+    Computed(Write<'a, ComputedCore>, &'a dyn Slot),
 }
 
 impl<'a> Locked<'a> {
     fn joint(&mut self) -> JointRef<'_> {
         match self {
             Locked::Adaptive(g, _) => JointRef::Adaptive(&mut ***g),
-            Locked::Computed(g, _) => JointRef::Computed(&mut ***g),
+            Locked::Computed(g, _) => JointRef::Computed(g),
         }
     }
 

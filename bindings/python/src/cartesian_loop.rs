@@ -15,7 +15,7 @@
 //! impedance's error and the wrench. The joint quantities (q, τ, sat(τ), τe,
 //! ζ, the velocity used) are the joint controller's, as for a joint-space run.
 
-use super::computed::Computed;
+use super::computed::ComputedStep;
 use super::dynamic::{
     drive_mujoco, FaultKind, FaultSpec, Hooks, Items, Metrics, OnMujoco, Rows, RunError, Typed,
     View,
@@ -60,7 +60,7 @@ pub struct CartesianRun<'a> {
 }
 
 /// A joint controller of the core behind a Cartesian impedance: the
-/// paper's laws ([`Typed`]) or computed torque ([`Computed`]), as the
+/// paper's laws ([`Typed`]) or computed torque ([`ComputedStep`]), as the
 /// Cartesian step and the native loop drive it; copied for the Python code
 /// a run calls ([`View`]).
 pub(crate) trait JointStep<const N: usize>: View {
@@ -114,7 +114,7 @@ impl<const N: usize> JointStep<N> for Typed<N> {
     }
 }
 
-impl<const N: usize> JointStep<N> for Computed<N> {
+impl<const N: usize> JointStep<N> for ComputedStep<'_, N> {
     fn period(&self) -> f64 {
         self.ctrl.period()
     }
@@ -126,7 +126,7 @@ impl<const N: usize> JointStep<N> for Computed<N> {
         Law::Pd
     }
     fn step_with(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error> {
-        self.ctrl.step(&mut self.state, m, r)
+        self.ctrl.step(self.state, m, r)
     }
     fn step_task(
         &mut self,
@@ -134,10 +134,10 @@ impl<const N: usize> JointStep<N> for Computed<N> {
         r: &Setpoint<N>,
         t: &TaskTorque<N>,
     ) -> Result<Command<N>, Error> {
-        self.ctrl.step_task(&mut self.state, m, r, t)
+        self.ctrl.step_task(self.state, m, r, t)
     }
     fn refuse(&mut self, e: Error) {
-        self.ctrl.refuse(&mut self.state, e);
+        self.ctrl.refuse(self.state, e);
     }
     fn applied(&self) -> Vector<N> {
         self.state.applied

@@ -4,7 +4,7 @@
 //! the outer loop can be the core's `dynamic::CartesianImpedance`.
 
 use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep, OuterRun};
-use super::computed::{Computed, DynComputed};
+use super::computed::{ComputedCore, ComputedStep};
 use super::dynamic::{DynTracker, Hooks, RunError, Typed, MAX_JOINTS};
 use super::mujoco::MujocoSpec;
 use adaptimp::cartesian::{
@@ -207,28 +207,43 @@ pub enum JointRef<'a> {
     /// An `adaptimp.Controller`.
     Adaptive(&'a mut dyn DynTracker),
     /// An `adaptimp.baselines.ComputedTorque`.
-    Computed(&'a mut dyn DynComputed),
+    Computed(&'a mut ComputedCore),
 }
 
-/// The typed joint controller of N joints behind `joint`.
-pub(super) fn typed<'a, const N: usize>(
-    joint: JointRef<'a>,
-) -> Result<&'a mut dyn JointStep<N>, Error> {
-    let other = Error::Invalid {
-        what: "controller",
-        reason: "has another number of joints than the chain",
-    };
+/// The typed joint controller of N joints behind a [`JointRef`].
+pub(super) enum TypedJoint<'a, const N: usize> {
+    /// The paper's laws.
+    Adaptive(&'a mut Typed<N>),
+    /// Computed torque.
+    Computed(ComputedStep<'a, N>),
+}
+
+impl<const N: usize> TypedJoint<'_, N> {
+    /// As the Cartesian loop steps it.
+    pub(super) fn step(&mut self) -> &mut dyn JointStep<N> {
+        match self {
+            TypedJoint::Adaptive(t) => *t,
+            TypedJoint::Computed(c) => c,
+        }
+    }
+}
+
+/// The typed joint controller of N joints behind `joint`; `run`: for a run,
+/// which publishes copies of it for the Python code it calls.
+pub(super) fn typed<const N: usize>(
+    joint: JointRef<'_>,
+    run: bool,
+) -> Result<TypedJoint<'_, N>, Error> {
     match joint {
         JointRef::Adaptive(t) => t
             .as_any_mut()
             .downcast_mut::<Typed<N>>()
-            .map(|t| t as &mut dyn JointStep<N>)
-            .ok_or(other),
-        JointRef::Computed(c) => c
-            .as_any_mut()
-            .downcast_mut::<Computed<N>>()
-            .map(|c| c as &mut dyn JointStep<N>)
-            .ok_or(other),
+            .map(TypedJoint::Adaptive)
+            .ok_or(Error::Invalid {
+                what: "controller",
+                reason: "has another number of joints than the chain",
+            }),
+        JointRef::Computed(c) => ComputedStep::of(c, run).map(TypedJoint::Computed),
     }
 }
 
@@ -284,7 +299,7 @@ impl<const N: usize> Outer<N> {
         joint: JointRef<'_>,
         run: impl FnOnce(OuterRun<'_, N>) -> Result<R, RunError>,
     ) -> Result<R, RunError> {
-        let joint = typed::<N>(joint)?;
+        let mut joint = typed::<N>(joint, true)?;
         let before = self.at(&self.state, None);
         let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>| {
             before.copy_as(part, state, last)
@@ -292,7 +307,7 @@ impl<const N: usize> Outer<N> {
         run(OuterRun {
             outer: &self.outer,
             state: &mut self.state,
-            joint,
+            joint: joint.step(),
             last: &mut self.last,
             copy: &copy,
         })
@@ -381,12 +396,12 @@ impl<const N: usize> DynOuter for Outer<N> {
         Ok(())
     }
     fn step_tracker(&mut self, joint: JointRef<'_>, m: &StepIn<'_>) -> Result<(), Error> {
-        let typed = typed::<N>(joint)?;
+        let mut typed = typed::<N>(joint, false)?;
         let meas = Self::measurement(m);
         let cmd = cartesian_loop::cartesian_step(
             &self.outer,
             &mut self.state,
-            typed,
+            typed.step(),
             &meas,
             m.target.as_ref(),
         )?;

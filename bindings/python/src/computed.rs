@@ -1,10 +1,11 @@
 //! Python bindings of the core's rigid-body dynamics and computed torque
-//! (SPEC §20): `ComputedTorque`, one monomorphised core per n behind an
-//! object-safe face ([`DynComputed`]); `adaptimp.baselines.ComputedTorque`
-//! is its front. As a joint controller behind `CartesianImpedance` it steps
-//! in the core's Cartesian step and native loop like `Controller`; alone, in
-//! joint space, it is a [`Control`] of the core's loop on MuJoCo
-//! ([`DynComputed::simulate_mujoco`]) along its setpoint of every row.
+//! (SPEC §20): `ComputedTorque`, the core's run-time controller and its
+//! state ([`ComputedCore`]); `adaptimp.baselines.ComputedTorque` is its
+//! front. As a joint controller behind `CartesianImpedance` it steps in the
+//! core's Cartesian step and native loop like `Controller`, through the
+//! const-generic controller of its n ([`ComputedStep`]); alone, in joint
+//! space, it is a [`Control`] of the core's loop on MuJoCo along its
+//! setpoint of every row.
 
 use super::dynamic::{Hooks, Metrics, MujocoRun, Rows, RunError, View, MAX_JOINTS};
 use super::frames::{inertial, joint};
@@ -12,14 +13,11 @@ use super::measurement::JointCall;
 use super::mujoco::MujocoSpec;
 use super::shared::{Read, Shared, Slot, Write};
 use super::{array, array1, vector, vector_into, ConfigError, MeasurementError};
-use adaptimp::cartesian::chain::JointKind;
 use adaptimp::cartesian::dynamics::Lifted;
-use adaptimp::cartesian::{
-    ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Inertial, Joint,
-    SampledDrive, Spring,
-};
+use adaptimp::cartesian::{ComputedState, ComputedTorque};
 use adaptimp::control::impedance::{ImpedanceMode, TargetImpedance};
 use adaptimp::control::io::{Command, Control, Measurement};
+use adaptimp::dynamic::{self as dy, for_joints, ForJoints};
 use adaptimp::error::Error;
 use adaptimp::trajectory::Setpoint;
 use adaptimp::types::Vector;
@@ -32,56 +30,13 @@ use std::any::{Any, TypeId};
 use std::sync::Mutex;
 use std::vec::Vec;
 
-/// A computed-torque controller of any n ≤ 7 with its state, over slices.
-pub trait DynComputed: Send + Sync {
-    /// Joints n.
-    fn n(&self) -> usize;
-    /// Ts (s).
-    fn ts(&self) -> f64;
-    /// Steps taken.
-    fn steps(&self) -> u64;
-    /// Back to t = 0.
-    fn reset(&mut self);
-    /// One step (20.3) on the setpoint `c` (xc, ẋc, ẍc); writes sat(τ).
-    fn step(
-        &mut self,
-        q: &[f64],
-        dq: Option<&[f64]>,
-        tau_e: &[f64],
-        c: [&[f64]; 3],
-        out: &mut [f64],
-    ) -> Result<(), Error>;
-    /// ID(q, q̇, q̈) of the controller's model (SPEC (20.5)) into `out`: inputs
-    /// within their ceilings, the torque finite (else an error naming them).
-    fn inverse_dynamics(
-        &self,
-        q: &[f64],
-        dq: &[f64],
-        ddq: &[f64],
-        out: &mut [f64],
-    ) -> Result<(), Error>;
-    /// M(q), row-major.
-    fn mass_matrix(&self, q: &[f64]) -> Result<Vec<f64>, Error>;
-    /// The last step's τ, sat(τ), xc, xd, z1 (by index).
-    fn last(&self, what: usize) -> Vec<f64>;
-    /// The last refused step: (error, step).
-    fn fault(&self) -> Option<(Error, u64)>;
-    /// The controller's total moving mass (kg).
-    fn mass(&self) -> f64;
-    /// The closed loop on MuJoCo (`sim` as `spec` describes it) in joint
-    /// space along `run.reference` (needed: the setpoint of every row), from
-    /// the controller's current state, with the disturbances and the fault
-    /// of `run` (SPEC §17). Records every `run.every`-th row with the end
-    /// effector, and the SPEC §12 metrics of every row.
-    fn simulate_mujoco(
-        &mut self,
-        sim: &mut Sim,
-        spec: &MujocoSpec,
-        run: &MujocoRun<'_>,
-        hooks: &mut dyn Hooks,
-    ) -> Result<(Rows, Metrics), RunError>;
-    /// As [`Any`], for the typed paths.
-    fn as_any_mut(&mut self) -> &mut dyn Any;
+/// The core's computed-torque controller of any n ≤ 7 with its state.
+#[derive(Clone, Debug)]
+pub struct ComputedCore {
+    /// The controller.
+    pub ctrl: dy::ComputedTorque,
+    /// Its state.
+    pub state: dy::ComputedState,
 }
 
 /// An input of a model query refused (MeasurementError, named), or a result
@@ -95,109 +50,44 @@ fn input_error(e: Error) -> pyo3::PyErr {
     }
 }
 
-/// Computed torque (SPEC §20) with its state.
-#[derive(Clone, Debug)]
-pub struct Computed<const N: usize> {
+/// The error of a controller and a state of other numbers of joints than a
+/// typed caller's (not reachable: both are made together).
+const OTHER_N: Error = Error::Invalid {
+    what: "controller",
+    reason: "has another number of joints than the chain",
+};
+
+/// [`ComputedCore`] as its const-generic controller of N joints, with its
+/// state, for a typed loop; `copy_of`: the whole controller, whose copy with
+/// this state the Python code a run calls reads ([`View`]).
+pub struct ComputedStep<'a, const N: usize> {
     /// The controller.
-    pub ctrl: ComputedTorque<N>,
+    pub ctrl: &'a ComputedTorque<N>,
     /// Its state.
-    pub state: ComputedState<N>,
+    pub state: &'a mut ComputedState<N>,
+    copy_of: Option<Box<ComputedCore>>,
 }
 
-fn vector_of<const N: usize>(v: &[f64]) -> Vector<N> {
-    Vector::from_column_slice(&v[..N])
-}
-
-impl<const N: usize> DynComputed for Computed<N> {
-    fn n(&self) -> usize {
-        N
-    }
-    fn ts(&self) -> f64 {
-        self.ctrl.period()
-    }
-    fn steps(&self) -> u64 {
-        self.state.k
-    }
-    fn reset(&mut self) {
-        self.state = ComputedState::default();
-    }
-    fn step(
-        &mut self,
-        q: &[f64],
-        dq: Option<&[f64]>,
-        tau_e: &[f64],
-        c: [&[f64]; 3],
-        out: &mut [f64],
-    ) -> Result<(), Error> {
-        let m = Measurement {
-            x: vector_of(q),
-            dx: dq.map(vector_of),
-            tau_e: vector_of(tau_e),
-        };
-        let s = Setpoint {
-            x: vector_of(c[0]),
-            dx: vector_of(c[1]),
-            ddx: vector_of(c[2]),
-        };
-        let cmd = self.ctrl.step(&mut self.state, &m, &s)?;
-        out[..N].copy_from_slice(cmd.tau_sat.as_slice());
-        Ok(())
-    }
-    fn inverse_dynamics(
-        &self,
-        q: &[f64],
-        dq: &[f64],
-        ddq: &[f64],
-        out: &mut [f64],
-    ) -> Result<(), Error> {
-        let tau = self.ctrl.model().inverse_dynamics_checked(
-            &vector_of(q),
-            &vector_of(dq),
-            &vector_of(ddq),
-        )?;
-        out[..N].copy_from_slice(tau.as_slice());
-        Ok(())
-    }
-    fn mass_matrix(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
-        let m = self.ctrl.model().mass_matrix_checked(&vector_of(q))?;
-        // Column-major storage of a symmetric matrix: its rows.
-        Ok(m.as_slice().to_vec())
-    }
-    fn last(&self, what: usize) -> Vec<f64> {
-        let c = &self.state.last;
-        let v = match what {
-            0 => c.tau,
-            1 => c.tau_sat,
-            2 => c.xc,
-            3 => c.xd,
-            _ => c.z1,
-        };
-        v.as_slice().to_vec()
-    }
-    fn fault(&self) -> Option<(Error, u64)> {
-        self.state.fault.map(|f| (f.error, f.step))
-    }
-    fn mass(&self) -> f64 {
-        self.ctrl.model().mass()
-    }
-    fn simulate_mujoco(
-        &mut self,
-        sim: &mut Sim,
-        spec: &MujocoSpec,
-        run: &MujocoRun<'_>,
-        hooks: &mut dyn Hooks,
-    ) -> Result<(Rows, Metrics), RunError> {
-        super::drive::run_computed(self, sim, spec, run, hooks)
-    }
-    fn as_any_mut(&mut self) -> &mut dyn Any {
-        self
+impl<'a, const N: usize> ComputedStep<'a, N> {
+    /// `core` for N joints (an error if it was made for another n); `run`:
+    /// for a run, which publishes copies of it (a step alone allocates
+    /// nothing).
+    pub fn of(core: &'a mut ComputedCore, run: bool) -> Result<Self, Error> {
+        let copy_of = run.then(|| Box::new(core.clone()));
+        let ctrl = core.ctrl.typed::<N>().ok_or(OTHER_N)?;
+        let state = core.state.typed_mut::<N>().ok_or(OTHER_N)?;
+        Ok(Self {
+            ctrl,
+            state,
+            copy_of,
+        })
     }
 }
 
 /// Computed torque as a joint controller of the core's loop: its step on
 /// the loop's setpoint; a refused step holds the torque last applied. It
 /// has no weights: their norms are NaN in the rows.
-impl<const N: usize> Control<N> for Computed<N> {
+impl<const N: usize> Control<N> for ComputedStep<'_, N> {
     fn period(&self) -> f64 {
         self.ctrl.period()
     }
@@ -205,7 +95,7 @@ impl<const N: usize> Control<N> for Computed<N> {
         self.ctrl.impedance()
     }
     fn step(&mut self, m: &Measurement<N>, c: &Setpoint<N>) -> Result<Command<N>, Error> {
-        let cmd = self.ctrl.step(&mut self.state, m, c)?;
+        let cmd = self.ctrl.step(self.state, m, c)?;
         Ok(Command {
             w_norms: [f64::NAN; 3],
             ..cmd
@@ -223,16 +113,39 @@ impl<const N: usize> Control<N> for Computed<N> {
     }
 }
 
-/// The copy of computed torque as the bindings keep it.
-impl<const N: usize> View for Computed<N> {
+/// The copy of computed torque as the bindings keep it: the controller with
+/// the state as it is now.
+impl<const N: usize> View for ComputedStep<'_, N> {
     fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
-        (part == TypeId::of::<Box<dyn DynComputed>>()).then(|| {
-            Box::new(Box::new(self.clone()) as Box<dyn DynComputed>) as Box<dyn Any + Send>
+        let base = self.copy_of.as_ref()?;
+        (part == TypeId::of::<Box<ComputedCore>>()).then(|| {
+            let mut copy = (**base).clone();
+            if let Some(s) = copy.state.typed_mut::<N>() {
+                *s = *self.state;
+            }
+            Box::new(Box::new(copy)) as Box<dyn Any + Send>
         })
     }
 }
 
-/// The parameters of a [`DynComputed`], as reals per joint.
+/// The closed loop of [`ComputedCore`] on MuJoCo for its N.
+struct OnMujoco<'a, H> {
+    core: &'a mut ComputedCore,
+    sim: &'a mut Sim,
+    spec: &'a MujocoSpec,
+    run: &'a MujocoRun<'a>,
+    hooks: &'a mut H,
+}
+
+impl<H: Hooks> ForJoints for OnMujoco<'_, H> {
+    type Output = Result<(Rows, Metrics), RunError>;
+    fn call<const N: usize>(self) -> Self::Output {
+        let mut step = ComputedStep::<N>::of(self.core, true)?;
+        super::drive::run_computed(&mut step, self.sim, self.spec, self.run, self.hooks)
+    }
+}
+
+/// The parameters of a [`ComputedCore`], as reals per joint.
 struct Params<'a> {
     ts: f64,
     kp: &'a [f64],
@@ -244,39 +157,24 @@ struct Params<'a> {
     mode: ImpedanceMode,
     mass_scale: f64,
     payload: f64,
-    armature: &'a [f64],
-    damping: &'a [f64],
-    friction: &'a [f64],
+    drive: dy::Drive<'a>,
     /// SPEC (20.9), if given.
-    sampled: Option<Sampled<'a>>,
-    /// SPEC (20.5'): (k, q_s), if any stiffness is given.
-    spring: Option<(&'a [f64], &'a [f64])>,
+    sampled: Option<dy::SampledDrive<'a>>,
+    /// SPEC (20.5'), if any stiffness is given.
+    spring: Option<dy::Spring<'a>>,
     /// What gravity compensation lifts, one per joint entry (SPEC (20.1')).
     lifted: Option<&'a [Lifted]>,
 }
 
-/// SPEC (20.9)'s terms, as reals per joint: h, s, implicit damping, R, b_r.
-struct Sampled<'a> {
-    substep: f64,
-    substeps: u32,
-    implicit_damping: bool,
-    semi_implicit: bool,
-    regularisation: &'a [f64],
-    rate: &'a [f64],
-}
-
-fn build<const N: usize>(
-    joints: &[Joint],
-    inertials: &[Inertial],
+/// The core's controller of `p` on the model of `joints`, `inertials`
+/// and `gravity`, composed as SPEC §20 states it.
+fn computed(
+    joints: &[adaptimp::cartesian::Joint],
+    inertials: &[adaptimp::cartesian::Inertial],
     gravity: [f64; 3],
     p: &Params<'_>,
-) -> Result<Box<dyn DynComputed>, Error> {
-    let drive = Drive {
-        armature: vector_of(p.armature),
-        damping: vector_of(p.damping),
-        friction: vector_of(p.friction),
-    };
-    let model = Dynamics::<N>::new(joints, inertials, gravity)?;
+) -> Result<ComputedCore, Error> {
+    let model = dy::Dynamics::new(joints, inertials, gravity)?;
     let model = match p.lifted {
         Some(lifted) => model.with_gravity_compensation(joints, lifted)?,
         None => model,
@@ -284,56 +182,28 @@ fn build<const N: usize>(
     let model = model
         .scaled(p.mass_scale)?
         .with_payload(p.payload)?
-        .with_drive(drive)?;
+        .with_drive(&p.drive)?;
     let model = match &p.sampled {
         None => model,
-        Some(sp) => model.with_sampled_drive(SampledDrive {
-            substep: sp.substep,
-            substeps: sp.substeps,
-            implicit_damping: sp.implicit_damping,
-            semi_implicit: sp.semi_implicit,
-            regularisation: vector_of(sp.regularisation),
-            rate: vector_of(sp.rate),
-        })?,
+        Some(s) => model.with_sampled_drive(s)?,
     };
-    let model = match p.spring {
+    let model = match &p.spring {
         None => model,
-        Some((k, qs)) => model.with_spring(Spring {
-            stiffness: vector_of(k),
-            reference: vector_of(qs),
-        })?,
+        Some(s) => model.with_spring(s)?,
     };
-    let cfg = ComputedTorqueConfig {
+    let cfg = dy::ComputedTorqueConfig {
         ts: p.ts,
-        kp: vector_of(p.kp),
-        kd: vector_of(p.kd),
-        tau_max: vector_of(p.tau_max),
-        impedance: TargetImpedance::new(vector_of(p.dd), vector_of(p.cd), vector_of(p.gd))?,
+        kp: p.kp,
+        kd: p.kd,
+        tau_max: p.tau_max,
+        dd: p.dd,
+        cd: p.cd,
+        gd: p.gd,
         mode: p.mode,
     };
-    Ok(Box::new(Computed {
-        ctrl: ComputedTorque::new(cfg, model)?,
-        state: ComputedState::default(),
-    }))
-}
-
-fn computed(
-    joints: &[Joint],
-    inertials: &[Inertial],
-    gravity: [f64; 3],
-    p: &Params<'_>,
-) -> Result<Box<dyn DynComputed>, Error> {
-    let n = joints.iter().filter(|j| j.kind != JointKind::Fixed).count();
-    adaptimp::with_joints!(
-        n,
-        K => build::<K>(joints, inertials, gravity, p),
-        _ => Err(Error::Condition {
-            condition: "1 ≤ n ≤ 7 movable joints",
-            lhs: "movable joints",
-            index: None,
-            value: n as f64,
-        }),
-    )
+    let ctrl = dy::ComputedTorque::new(&cfg, model)?;
+    let state = ctrl.new_state();
+    Ok(ComputedCore { ctrl, state })
 }
 
 /// What gravity compensation lifts of one link: {"mass" (kg), "moment" (kg m, 3)}.
@@ -376,7 +246,7 @@ const LAST: [&str; 5] = ["tau", "tau_sat", "xc", "xd", "z1"];
     subclass
 )]
 pub struct PyComputedTorque {
-    inner: Shared<dyn DynComputed>,
+    inner: Shared<ComputedCore>,
     /// Joints n.
     pub n: usize,
     /// `trajectory(t) -> (xc, dxc, ddxc)` for a step given no setpoint.
@@ -405,7 +275,7 @@ impl PyComputedTorque {
         };
         let t = {
             let g = self.read(py)?;
-            g.steps() as f64 * g.ts()
+            g.state.steps() as f64 * g.ctrl.period()
         };
         let out = traj.call1(py, (t,))?;
         let out = out.bind(py);
@@ -417,13 +287,13 @@ impl PyComputedTorque {
 
     /// The controller for a call that may change it, waiting (with the GIL
     /// released) while another thread uses it.
-    pub(super) fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, dyn DynComputed>> {
+    pub(super) fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, ComputedCore>> {
         self.inner.write(py)
     }
 
     /// The controller to read (during a run of its own, the copy the run
     /// publishes for the Python code it calls).
-    pub(super) fn read(&self, py: Python<'_>) -> PyResult<Read<'_, dyn DynComputed>> {
+    pub(super) fn read(&self, py: Python<'_>) -> PyResult<Read<'_, ComputedCore>> {
         self.inner.read(py)
     }
 
@@ -495,7 +365,10 @@ impl PyComputedTorque {
             .iter()
             .map(inertial)
             .collect::<PyResult<Vec<_>>>()?;
-        let n = js.iter().filter(|j| j.kind != JointKind::Fixed).count();
+        let n = js
+            .iter()
+            .filter(|j| j.kind != adaptimp::cartesian::chain::JointKind::Fixed)
+            .count();
         let mode = match impedance {
             "joint" => ImpedanceMode::Joint,
             "external" => ImpedanceMode::External,
@@ -543,10 +416,12 @@ impl PyComputedTorque {
             mode,
             mass_scale,
             payload,
-            armature: &armature,
-            damping: &damping,
-            friction: &friction,
-            sampled: substep.map(|substep| Sampled {
+            drive: dy::Drive {
+                armature: &armature,
+                damping: &damping,
+                friction: &friction,
+            },
+            sampled: substep.map(|substep| dy::SampledDrive {
                 substep,
                 substeps,
                 implicit_damping,
@@ -554,13 +429,16 @@ impl PyComputedTorque {
                 regularisation: &regularisation,
                 rate: &rate,
             }),
-            spring: stiffness.map(|_| (&k[..], &qs[..])),
+            spring: stiffness.map(|_| dy::Spring {
+                stiffness: &k,
+                reference: &qs,
+            }),
             lifted: lifted.as_deref(),
         };
         let inner = computed(&js, &ins, gravity, &p).map_err(config_err)?;
         Ok(Self {
-            n: inner.n(),
-            inner: Shared::new(inner, "ComputedTorque"),
+            n: inner.ctrl.n(),
+            inner: Shared::new(Box::new(inner), "ComputedTorque"),
             trajectory: Mutex::new(None),
         })
     }
@@ -582,24 +460,24 @@ impl PyComputedTorque {
     #[getter]
     #[allow(non_snake_case)]
     fn Ts(&self, py: Python<'_>) -> PyResult<f64> {
-        Ok(self.read(py)?.ts())
+        Ok(self.read(py)?.ctrl.period())
     }
 
     /// Steps taken k (the next step is at t_k = k·Ts).
     #[getter]
     fn steps(&self, py: Python<'_>) -> PyResult<u64> {
-        Ok(self.read(py)?.steps())
+        Ok(self.read(py)?.state.steps())
     }
 
     /// Total mass of the model's moving links (kg).
     #[getter]
     fn mass(&self, py: Python<'_>) -> PyResult<f64> {
-        Ok(self.read(py)?.mass())
+        Ok(self.read(py)?.ctrl.mass())
     }
 
     /// Back to t = 0 (the reference starts at the next setpoint).
     fn reset(&self, py: Python<'_>) -> PyResult<()> {
-        self.lock(py)?.reset();
+        self.lock(py)?.state.reset();
         Ok(())
     }
 
@@ -648,17 +526,23 @@ impl PyComputedTorque {
             }
             None => self.setpoint_of_trajectory(py, dxc.is_some() || ddxc.is_some(), &mut b)?,
         }
-        let mut out = [0.0; MAX_JOINTS];
-        self.lock(py)?
-            .step(
-                &b[0][..n],
-                Some(&b[2][..n]),
-                &b[1][..n],
-                [&b[3][..n], &b[4][..n], &b[5][..n]],
-                &mut out[..n],
-            )
+        let mut guard = self.lock(py)?;
+        let core = &mut **guard;
+        let m = dy::Measurement {
+            x: &b[0][..n],
+            dx: Some(&b[2][..n]),
+            tau_e: &b[1][..n],
+        };
+        let c = dy::Setpoint {
+            x: &b[3][..n],
+            dx: &b[4][..n],
+            ddx: &b[5][..n],
+        };
+        let cmd = core
+            .ctrl
+            .step(&mut core.state, &m, &c)
             .map_err(input_error)?;
-        Ok(array1(py, &out[..n]))
+        Ok(array1(py, &cmd.tau_sat))
     }
 
     /// RNEA(q, q̇, q̈) = M q̈ + C q̇ + G of the controller's model (N m), (n,).
@@ -675,11 +559,12 @@ impl PyComputedTorque {
             vector("dq", n, dq)?,
             vector("ddq", n, ddq)?,
         );
-        let mut out = [0.0; MAX_JOINTS];
-        self.read(py)?
-            .inverse_dynamics(&q[..n], &dq[..n], &ddq[..n], &mut out[..n])
+        let tau = self
+            .read(py)?
+            .ctrl
+            .inverse_dynamics(&q[..n], &dq[..n], &ddq[..n])
             .map_err(input_error)?;
-        Ok(array1(py, &out[..n]))
+        Ok(array1(py, &tau))
     }
 
     /// M(q) of the controller's model (kg m²), (n, n).
@@ -690,8 +575,13 @@ impl PyComputedTorque {
     ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
         let n = self.n;
         let q = vector("q", n, q)?;
-        let m = self.read(py)?.mass_matrix(&q[..n]).map_err(input_error)?;
-        array(py, m, (n, n))
+        let m = self
+            .read(py)?
+            .ctrl
+            .mass_matrix(&q[..n])
+            .map_err(input_error)?;
+        // Column-major storage of a symmetric matrix: its rows.
+        array(py, m.matrix().iter().copied().collect(), (n, n))
     }
 
     /// A quantity of the last step by name: "tau", "tau_sat", "xc", "xd",
@@ -701,13 +591,18 @@ impl PyComputedTorque {
             .iter()
             .position(|w| *w == what)
             .ok_or_else(|| ConfigError::new_err(format!("last() knows {LAST:?}, got {what:?}")))?;
-        Ok(array1(py, &self.read(py)?.last(i)))
+        let c = self.read(py)?.state.last();
+        Ok(array1(py, [&c.tau, &c.tau_sat, &c.xc, &c.xd, &c.z1][i]))
     }
 
     /// The last refused step as (message, step), or None.
     #[getter]
     fn fault(&self, py: Python<'_>) -> PyResult<Option<(String, u64)>> {
-        Ok(self.read(py)?.fault().map(|(e, k)| (e.to_string(), k)))
+        Ok(self
+            .read(py)?
+            .state
+            .fault()
+            .map(|f| (f.error.to_string(), f.step)))
     }
 
     /// The closed loop on MuJoCo in joint space, from the controller's
@@ -752,8 +647,18 @@ impl PyComputedTorque {
         };
         let mut hooks = super::PyHooks::holding(progress, vec![self.slot()]);
         let mut guard = self.lock(py)?;
-        let ctrl: &mut dyn DynComputed = &mut **guard;
-        let result = py.detach(|| ctrl.simulate_mujoco(&mut sim, &spec, &run, &mut hooks));
+        let core: &mut ComputedCore = &mut guard;
+        let n = self.n;
+        let result = py.detach(|| {
+            let on = OnMujoco {
+                core,
+                sim: &mut sim,
+                spec: &spec,
+                run: &run,
+                hooks: &mut hooks,
+            };
+            for_joints(n, on).unwrap_or(Err(RunError::Core(OTHER_N, None)))
+        });
         drop(guard);
         drop(sim);
         let (rec, metrics) = result.map_err(|e| super::run_error(e, &mut hooks))?;

@@ -175,6 +175,84 @@ def test_reset_builds_a_fresh_controller_and_reset_goal_holds_the_pose():
     assert all(np.count_nonzero(w) == 0 for w in second.ctrl.inner.weights.values())
 
 
+def test_the_osc_stiffness_is_osc_poses_own_at_the_start_held_at_the_rules_bandwidth():
+    """``stiffness="osc"`` (SPEC (23.6)): per world axis, the target stiffness
+    is diag(Λ) k_p as robosuite's own OSC computes Λ (its ``opspace_matrices``
+    on its mass matrix and Jacobians) at the start posture, and the target
+    inertia M_d = K_d / K1²: the bandwidth is the rule's, only the press differs."""
+    from robosuite.utils.control_utils import opspace_matrices
+
+    env = make(ars.controller_config("Panda", stiffness="osc"), seed=4)
+    env.reset()
+    # Built on the state now (robosuite's Robot.reset sets the fingers after
+    # it builds the controllers, and the rule reads the model as it stands).
+    part = ars.ArmController(arm(env).osc, {"stiffness": "osc"})
+    osc = part.osc
+    osc.update(force=True)
+    _, lam_pos, lam_ori, _ = opspace_matrices(osc.mass_matrix, osc.J_full, osc.J_pos, osc.J_ori)
+    want = np.concatenate([np.diag(lam_pos), np.diag(lam_ori)]) * osc.kp
+    assert part.stiffness == pytest.approx(want, rel=1e-9)
+    p = part.ctrl.params
+    k1 = min(p["inner"]["K1"])
+    assert p["Kd"] + p["Kd_rot"] == part.stiffness.tolist()
+    assert np.asarray(p["Md"] + p["Md_rot"]) * k1 * k1 == pytest.approx(part.stiffness, rel=1e-12)
+    # The default keeps (23.1): no matched stiffness.
+    default = make(ars.controller_config("Panda"), seed=4)
+    default.reset()
+    assert arm(default).stiffness is None
+    assert arm(default).ctrl.params["Kd"] == [2.0 * k1 * k1] * 3
+
+
+def test_the_osc_stiffness_leaves_free_space_as_the_rule_has_it():
+    """In free space the admittance's motion depends on K_d / M_d and B_d / M_d
+    only (B_d critical, 2 √(K_d M_d)): with ``stiffness="osc"`` the arm moves
+    as with the rule's, to rounding."""
+    poses = []
+    for options in ({}, {"stiffness": "osc"}):
+        env = make(ars.controller_config("Panda", **options), seed=6)
+        env.reset()
+        for k in range(20):
+            obs, *_ = env.step(np.array([0.5, -0.3, 0.4 - 0.04 * k, 0.2, 0.0, -0.1, -1.0]))
+        assert arm(env).wrench.wrench.tolist() == [0.0] * 6  # no contact with the scene
+        poses.append(obs["robot0_joint_pos"])
+    assert np.abs(poses[0] - poses[1]).max() < 1e-9
+
+
+def test_osc_stiffness_is_diag_lambda_times_kp():
+    # D = diag(1..6) and J = I: Λ_v = diag(1, 2, 3), Λ_ω = diag(4, 5, 6), coupled or not.
+    D = np.diag(np.arange(1.0, 7.0))
+    for uncoupled in (True, False):
+        got = ars.osc_stiffness(np.eye(6), D, 150.0, uncoupled=uncoupled)
+        assert got == pytest.approx(150.0 * np.arange(1.0, 7.0), rel=1e-12)
+    # A coupling between translation and rotation: the uncoupled blocks ignore it.
+    J = np.eye(6)
+    J[0, 3] = 1.0
+    assert ars.osc_stiffness(J, np.eye(6), 1.0)[0] == pytest.approx(0.5)
+    assert ars.osc_stiffness(J, np.eye(6), 1.0, uncoupled=False)[0] == pytest.approx(1.0)
+
+
+def test_impedance_with_a_stiffness_keeps_the_bandwidth():
+    p = ars.impedance(25.0, 0.05, [2500.0, 1250.0, 5000.0, 100.0, 50.0, 25.0])
+    assert p["Kd"] == [2500.0, 1250.0, 5000.0]
+    assert p["Md"] == [4.0, 2.0, 8.0]
+    assert p["Kd_rot"] == [100.0, 50.0, 25.0]
+    assert p["Md_rot"] == [0.16, 0.08, 0.04]
+    assert "Md" not in ars.impedance(25.0, 0.05)
+    with pytest.raises(ConfigError, match=r"ADAPTIMP: stiffness must be 6 positive numbers"):
+        ars.impedance(25.0, 0.05, [1.0] * 3)
+
+
+def test_an_unknown_or_zero_stiffness_is_refused_by_name():
+    with pytest.raises(ConfigError, match=r"stiffness must be one of 'rule', 'osc', got 'stiff'"):
+        make(ars.controller_config("Panda", stiffness="stiff")).reset()
+    env = make(ars.controller_config("Panda"), seed=4)
+    env.reset()
+    osc = arm(env).osc
+    osc.kp = np.array([150.0, 150.0, 0.0, 150.0, 150.0, 150.0])
+    with pytest.raises(ConfigError, match=r"not positive on every axis .* give stiffness='rule'"):
+        ars.ArmController(osc, {"stiffness": "osc"})
+
+
 @pytest.mark.parametrize(
     ("key", "value", "message"),
     [

@@ -49,7 +49,10 @@ robot, ``load_composite_controller_config(robot=robot)``, with ``"type":
   they learnt).
 
 Per-arm options (the ``"adaptimp"`` entry of the arm's part configuration,
-:func:`controller_config`'s keywords): ``case`` ("sf", "pd", "of"), and any
+:func:`controller_config`'s keywords): ``case`` ("sf", "pd", "of"),
+``stiffness`` ("rule", the default: K_d = M_d K1² with the schema's M_d;
+"osc": OSC_POSE's stiffness per axis at the start posture, diag(Λ) k_p, at
+the same bandwidth K1, :func:`osc_stiffness`, SPEC (23.6)), and any
 parameter of :class:`adaptimp.CartesianController` (``Kd``, ``Md``,
 ``force_filter``, ``gamma``, …), which replaces the rule's.
 
@@ -96,6 +99,7 @@ __all__ = [
     "controller_config",
     "held_joints",
     "impedance",
+    "osc_stiffness",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -105,6 +109,11 @@ NAME = "ADAPTIMP"
 
 ARM_TYPES = ("OSC_POSE", "OSC_POSITION")
 """The arm part types whose actions ADAPTIMP takes."""
+
+STIFFNESS = ("rule", "osc")
+"""The option ``stiffness``: ``"rule"`` the target at the joint loop's
+bandwidth with the schema's target inertia (SPEC (23.1)); ``"osc"`` OSC_POSE's
+stiffness per axis at the start posture, at that same bandwidth (SPEC (23.6))."""
 
 
 def controller_config(robot: str, **params: Any) -> dict[str, Any]:
@@ -123,28 +132,57 @@ def controller_config(robot: str, **params: Any) -> dict[str, Any]:
     return config
 
 
-def impedance(k1: float, policy_period: float) -> dict[str, Any]:
+def impedance(
+    k1: float, policy_period: float, stiffness: ArrayLike | None = None
+) -> dict[str, Any]:
     """The Cartesian parameters ADAPTIMP gives the rule (SPEC (23.1)–(23.3)),
     for a joint loop whose position gain is ``k1`` (1/s, the rule's K1) under
     a policy that sets a goal every ``policy_period`` (s):
 
     - the target impedance at the joint loop's bandwidth, critically damped:
       K_d = M_d K1², K_d,rot = M_d,rot K1² (N/m, N m/rad; M_d, M_d,rot the
-      schema's, B_d, B_d,rot critical);
+      schema's, B_d, B_d,rot critical); with ``stiffness`` (6,), the target
+      stiffness per world axis [K_d (N/m) ×3, K_d,rot (N m/rad) ×3] at that
+      same bandwidth: M_d = K_d / K1², M_d,rot = K_d,rot / K1² (SPEC (23.6));
     - no filter on the commanded pose (``target_filter = 0``): robosuite's goal
       jumps at every action by design, and OSC takes it as it jumps;
     - the measured wrench filtered over one policy period, and not fed
       forward to the joint law (``force_filter``, ``force_feedforward``)."""
-    d = defaults("robot")
-    md = np.asarray(d["Md"], dtype=np.float64)
-    mr = np.asarray(d["Md_rot"], dtype=np.float64)
-    return {
-        "Kd": (md * k1 * k1).tolist(),
-        "Kd_rot": (mr * k1 * k1).tolist(),
-        "target_filter": 0.0,
-        "force_filter": float(policy_period),
-        "force_feedforward": False,
-    }
+    if stiffness is None:
+        d = defaults("robot")
+        md = np.asarray(d["Md"], dtype=np.float64)
+        mr = np.asarray(d["Md_rot"], dtype=np.float64)
+        kd, kr = md * k1 * k1, mr * k1 * k1
+    else:
+        k = np.asarray(stiffness, dtype=np.float64)
+        if k.shape != (6,) or not np.all(np.isfinite(k)) or np.any(k <= 0.0):
+            raise ConfigError(f"{NAME}: stiffness must be 6 positive numbers, got {stiffness!r}")
+        kd, kr = k[:3], k[3:]
+        md, mr = kd / (k1 * k1), kr / (k1 * k1)
+    out: dict[str, Any] = {"Kd": kd.tolist(), "Kd_rot": kr.tolist()}
+    if stiffness is not None:
+        out.update(Md=md.tolist(), Md_rot=mr.tolist())
+    out.update(target_filter=0.0, force_filter=float(policy_period), force_feedforward=False)
+    return out
+
+
+def osc_stiffness(
+    jacobian: ArrayLike, inertia: ArrayLike, kp: ArrayLike, *, uncoupled: bool = True
+) -> FloatArray:
+    """The stiffness per world axis (N/m ×3, N m/rad ×3), (6,), of robosuite's
+    operational-space controller OSC_POSE at a posture (SPEC (23.6)):
+    diag(Λ) k_p, Λ its operational-space inertia on the arm's inertia D(q)
+    (kg m², (n, n)) and the grip site's geometric Jacobian [J_v; J_ω] (6, n):
+    Λ_v = (J_v D⁻¹ J_vᵀ)⁻¹ and Λ_ω = (J_ω D⁻¹ J_ωᵀ)⁻¹ when ``uncoupled`` (OSC's
+    ``uncouple_pos_ori``, its default), Λ = (J D⁻¹ Jᵀ)⁻¹ otherwise; ``kp``
+    OSC's stiffness gains (1/s², a number or 6)."""
+    J = np.asarray(jacobian, dtype=np.float64)
+    Dinv = np.linalg.inv(np.asarray(inertia, dtype=np.float64))
+    # pinv as robosuite's opspace_matrices takes it (small singular values zeroed).
+    blocks = (J[:3], J[3:]) if uncoupled else (J,)
+    lam = np.concatenate([np.diag(np.linalg.pinv(j @ Dinv @ j.T)) for j in blocks])
+    gains = np.broadcast_to(np.asarray(kp, dtype=np.float64), (6,))
+    return np.asarray(lam * gains, dtype=np.float64)
 
 
 class _ArmModel:
@@ -426,9 +464,29 @@ class ArmController:
         Ts = float(m.opt.timestep)
         kw = dict(self.params)
         case = kw.pop("case", "sf")
+        stiffness = kw.pop("stiffness", "rule")
+        if not (isinstance(stiffness, str) and stiffness in STIFFNESS):
+            raise ConfigError(
+                f"{NAME}: stiffness must be one of {', '.join(map(repr, STIFFNESS))}, "
+                f"got {stiffness!r}"
+            )
         # The rule's position gain K1 (one value for every joint, SPEC (18.2)).
         k1 = float(np.min(tuning.suggest(model, q0, tau_max, Ts=Ts, case=case)["K1"]))
-        rule = impedance(k1, 1.0 / float(osc.control_freq))
+        k = None
+        if stiffness == "osc":  # OSC_POSE's at the start posture, SPEC (23.6)
+            k = osc_stiffness(
+                chain.jacobian(q0), model.D(q0), osc.kp, uncoupled=bool(osc.uncoupling)
+            )
+            if not np.all(k > 0.0):
+                raise ConfigError(
+                    f"{NAME}: OSC_POSE's stiffness at the start posture is {k.tolist()} "
+                    "(N/m, N m/rad): not positive on every axis (a singular posture, or a "
+                    "kp of 0); give stiffness='rule' or Kd, Md"
+                )
+        self.stiffness = None if k is None else k.copy()
+        """The matched stiffness per world axis (N/m ×3, N m/rad ×3), (6,),
+        with ``stiffness="osc"``; None with the rule's."""
+        rule = impedance(k1, 1.0 / float(osc.control_freq), k)
         rule.update(kw)
         ctrl = CartesianController.from_rule(
             chain, case, CirclePath(*chain.pose(q0)), q0, model=model, tau_max=tau_max, Ts=Ts,

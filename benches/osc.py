@@ -34,6 +34,7 @@ median ``env.step`` time (ms, one policy step: 25 model timesteps).
 
     python benches/osc.py [--json] [--arms Panda Sawyer ...] [--tasks square lift wipe]
         [--errors none cube payload friction] [--seeds 10] [--update FILE]
+        [--params '{"stiffness": "osc"}']   # ADAPTIMP's options
     python benches/osc.py --phases [--json] [--arms ...] [--errors ...]   # the lift's phases
     python benches/osc.py --markdown FILE   # the tables of docs/robosuite.md from a --json FILE
 """
@@ -668,7 +669,13 @@ def main() -> None:
         metavar="FILE",
         help="measure, then replace those rows of a --json output FILE (the others kept)",
     )
-    ap.add_argument("--params", type=json.loads, default={}, help=argparse.SUPPRESS)
+    ap.add_argument(
+        "--params",
+        type=json.loads,
+        default={},
+        help="ADAPTIMP's options, a JSON object (controller_config's keywords), "
+        'e.g. \'{"stiffness": "osc"}\'',
+    )
     args = ap.parse_args()
     if args.markdown:
         with open(args.markdown, encoding="utf-8") as f:

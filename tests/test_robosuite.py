@@ -89,11 +89,13 @@ def test_the_arm_runs_the_rules_cartesian_controller(pair):
     assert ctrl.Ts == ours.sim.model.opt.timestep == 0.002
     assert inner["delay"] == 0
     assert inner["tau_max"] == [80.0] * 5 + [12.0] * 2
-    # The target impedance at the rule's K1, critically damped (SPEC (23.1)).
+    # The target impedance at the rule's K1, critically damped, with
+    # OSC_POSE's stiffness (SPEC (23.1), (23.6)).
     k1 = min(inner["K1"])
     assert k1 == pytest.approx(25.0)
-    assert ctrl.params["Kd"] == [2.0 * k1 * k1] * 3
-    assert ctrl.params["Kd_rot"] == [0.08 * k1 * k1] * 3
+    assert ctrl.params["Kd"] + ctrl.params["Kd_rot"] == part.stiffness.tolist()
+    md = np.asarray(ctrl.params["Md"] + ctrl.params["Md_rot"])
+    assert md * k1 * k1 == pytest.approx(part.stiffness, rel=1e-12)
     assert ctrl.params["target_filter"] == 0.0
     assert ctrl.params["force_filter"] == 1.0 / ours.control_freq
     assert ctrl.params["force_feedforward"] is False
@@ -176,17 +178,17 @@ def test_reset_builds_a_fresh_controller_and_reset_goal_holds_the_pose():
 
 
 def test_the_osc_stiffness_is_osc_poses_own_at_the_start_held_at_the_rules_bandwidth():
-    """``stiffness="osc"`` (SPEC (23.6)): per world axis, the target stiffness
+    """The default ``stiffness="osc"`` (SPEC (23.6)): per world axis, the target stiffness
     is diag(Λ) k_p as robosuite's own OSC computes Λ (its ``opspace_matrices``
     on its mass matrix and Jacobians) at the start posture, and the target
     inertia M_d = K_d / K1²: the bandwidth is the rule's, only the press differs."""
     from robosuite.utils.control_utils import opspace_matrices
 
-    env = make(ars.controller_config("Panda", stiffness="osc"), seed=4)
+    env = make(ars.controller_config("Panda"), seed=4)
     env.reset()
     # Built on the state now (robosuite's Robot.reset sets the fingers after
     # it builds the controllers, and the rule reads the model as it stands).
-    part = ars.ArmController(arm(env).osc, {"stiffness": "osc"})
+    part = ars.ArmController(arm(env).osc, {})
     osc = part.osc
     osc.update(force=True)
     _, lam_pos, lam_ori, _ = opspace_matrices(osc.mass_matrix, osc.J_full, osc.J_pos, osc.J_ori)
@@ -196,11 +198,11 @@ def test_the_osc_stiffness_is_osc_poses_own_at_the_start_held_at_the_rules_bandw
     k1 = min(p["inner"]["K1"])
     assert p["Kd"] + p["Kd_rot"] == part.stiffness.tolist()
     assert np.asarray(p["Md"] + p["Md_rot"]) * k1 * k1 == pytest.approx(part.stiffness, rel=1e-12)
-    # The default keeps (23.1): no matched stiffness.
-    default = make(ars.controller_config("Panda"), seed=4)
-    default.reset()
-    assert arm(default).stiffness is None
-    assert arm(default).ctrl.params["Kd"] == [2.0 * k1 * k1] * 3
+    # stiffness="rule" keeps (23.1)'s target inertia: no matched stiffness.
+    rule = make(ars.controller_config("Panda", stiffness="rule"), seed=4)
+    rule.reset()
+    assert arm(rule).stiffness is None
+    assert arm(rule).ctrl.params["Kd"] == [2.0 * k1 * k1] * 3
 
 
 def test_the_osc_stiffness_leaves_free_space_as_the_rule_has_it():
@@ -208,7 +210,7 @@ def test_the_osc_stiffness_leaves_free_space_as_the_rule_has_it():
     only (B_d critical, 2 √(K_d M_d)): with ``stiffness="osc"`` the arm moves
     as with the rule's, to rounding."""
     poses = []
-    for options in ({}, {"stiffness": "osc"}):
+    for options in ({"stiffness": "rule"}, {}):
         env = make(ars.controller_config("Panda", **options), seed=6)
         env.reset()
         for k in range(20):
@@ -243,7 +245,7 @@ def test_impedance_with_a_stiffness_keeps_the_bandwidth():
 
 
 def test_an_unknown_or_zero_stiffness_is_refused_by_name():
-    with pytest.raises(ConfigError, match=r"stiffness must be one of 'rule', 'osc', got 'stiff'"):
+    with pytest.raises(ConfigError, match=r"stiffness must be one of 'osc', 'rule', got 'stiff'"):
         make(ars.controller_config("Panda", stiffness="stiff")).reset()
     env = make(ars.controller_config("Panda"), seed=4)
     env.reset()

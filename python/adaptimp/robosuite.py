@@ -50,9 +50,10 @@ robot, ``load_composite_controller_config(robot=robot)``, with ``"type":
 
 Per-arm options (the ``"adaptimp"`` entry of the arm's part configuration,
 :func:`controller_config`'s keywords): ``case`` ("sf", "pd", "of"),
-``stiffness`` ("rule", the default: K_d = M_d K1² with the schema's M_d;
-"osc": OSC_POSE's stiffness per axis at the start posture, diag(Λ) k_p, at
-the same bandwidth K1, :func:`osc_stiffness`, SPEC (23.6)), and any
+``stiffness`` ("osc", the default: OSC_POSE's stiffness per axis at the
+start posture, diag(Λ) k_p, at the joint loop's bandwidth K1,
+:func:`osc_stiffness`, SPEC (23.1), (23.6); "rule": K_d = M_d K1² with the
+schema's M_d), and any
 parameter of :class:`adaptimp.CartesianController` (``Kd``, ``Md``,
 ``force_filter``, ``gamma``, …), which replaces the rule's.
 
@@ -110,10 +111,10 @@ NAME = "ADAPTIMP"
 ARM_TYPES = ("OSC_POSE", "OSC_POSITION")
 """The arm part types whose actions ADAPTIMP takes."""
 
-STIFFNESS = ("rule", "osc")
-"""The option ``stiffness``: ``"rule"`` the target at the joint loop's
-bandwidth with the schema's target inertia (SPEC (23.1)); ``"osc"`` OSC_POSE's
-stiffness per axis at the start posture, at that same bandwidth (SPEC (23.6))."""
+STIFFNESS = ("osc", "rule")
+"""The option ``stiffness``: ``"osc"`` (the default) OSC_POSE's stiffness per
+axis at the start posture, at the joint loop's bandwidth (SPEC (23.6));
+``"rule"`` that bandwidth with the schema's target inertia (SPEC (23.1))."""
 
 
 def controller_config(robot: str, **params: Any) -> dict[str, Any]:
@@ -464,7 +465,7 @@ class ArmController:
         Ts = float(m.opt.timestep)
         kw = dict(self.params)
         case = kw.pop("case", "sf")
-        stiffness = kw.pop("stiffness", "rule")
+        stiffness = kw.pop("stiffness", "osc")
         if not (isinstance(stiffness, str) and stiffness in STIFFNESS):
             raise ConfigError(
                 f"{NAME}: stiffness must be one of {', '.join(map(repr, STIFFNESS))}, "

@@ -144,6 +144,26 @@ fn joint_controller<const N: usize>(law: Law) {
     let mut dsnap = vec![0.0; ds.snapshot_len()];
     ds.save(&mut dsnap).expect("save");
     same("snapshot", &dsnap, &snap);
+    // The typed accessors reach this very controller and state: a typed
+    // step from them is the run-time step, bit for bit, and another N is none.
+    let (tc, tt) = dc.typed::<N>().expect("typed for its own N");
+    assert_eq!(tt.sample(0.37).x, traj.sample(0.37).x);
+    let other = if N == 1 {
+        dc.typed::<2>().is_none() && ds.typed::<2>().is_none()
+    } else {
+        dc.typed::<1>().is_none() && ds.typed::<1>().is_none()
+    };
+    assert!(other, "no typed view for another N");
+    let mut copy = ds.clone();
+    let m = measurement(&traj, 7, usize::MAX);
+    let own = traj.sample(cc.time(&cs));
+    let typed = tc
+        .step(copy.typed_mut::<N>().expect("typed state"), &m, &own)
+        .expect("typed step");
+    let reference = cc.step(&mut cs, &m, &own).expect("const-generic step");
+    same("typed tau", typed.tau.as_slice(), reference.tau.as_slice());
+    let back = copy.typed::<N>().expect("typed state");
+    same("typed zeta", back.zeta().as_slice(), cs.zeta().as_slice());
 }
 
 #[test]

@@ -299,6 +299,16 @@ impl Controller {
         each!(&self.inner, c, N => c.ctrl.config().law)
     }
 
+    /// The const-generic controller and its own trajectory, if made for N
+    /// joints: for a caller generic over N (a typed loop,
+    /// [`for_joints`](super::for_joints)).
+    pub fn typed<const N: usize>(
+        &self,
+    ) -> Option<(&controller::Controller<N, AnyBasis<N>>, &Sinusoid<N>)> {
+        let c: &Ctl<N> = each!(&self.inner, c, M => (&**c as &dyn core::any::Any).downcast_ref())?;
+        Some((&c.ctrl, &c.traj))
+    }
+
     /// Sampling period Ts (s).
     pub fn period(&self) -> f64 {
         each!(&self.inner, c, N => c.ctrl.period())
@@ -484,6 +494,19 @@ fn inputs<const N: usize, S>(
         None => ctl.traj.sample(ctl.ctrl.time(s)),
     };
     Ok((meas, sp))
+}
+
+impl<S: 'static> State<S> {
+    /// The const-generic state, if made for N joints: for a caller generic
+    /// over N (a typed loop, [`for_joints`](super::for_joints)).
+    pub fn typed<const N: usize>(&self) -> Option<&state::State<N, S>> {
+        each!(&self.inner, s, M => (s as &dyn core::any::Any).downcast_ref())
+    }
+
+    /// [`typed`](Self::typed), to change.
+    pub fn typed_mut<const N: usize>(&mut self) -> Option<&mut state::State<N, S>> {
+        each!(&mut self.inner, s, M => (s as &mut dyn core::any::Any).downcast_mut())
+    }
 }
 
 impl<S: AsRef<[f64]> + AsMut<[f64]>> State<S> {

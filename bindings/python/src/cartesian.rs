@@ -7,7 +7,7 @@
 
 use super::cartesian_loop::{pose_target, CartesianRun, TARGET_LEN};
 use super::computed::{ComputedCore, PyComputedTorque};
-use super::dynamic::{scenario, DynTracker, Owned, MAX_JOINTS};
+use super::dynamic::{scenario, JointCore, Owned, MAX_JOINTS};
 use super::measurement::PyMeasurement;
 use super::shared::{Read, Shared, Slot, Write};
 use super::{array, array1, config_error, items, shape_error, vector, ConfigError, PyController};
@@ -31,14 +31,14 @@ pub use super::chain::{centres_along, PyChain};
 /// `adaptimp.Controller` or a `ComputedTorque` (SPEC §20) of n joints, with
 /// where a run publishes its copy.
 enum Locked<'a> {
-    Adaptive(Write<'a, dyn DynTracker>, &'a dyn Slot),
+    Adaptive(Write<'a, JointCore>, &'a dyn Slot),
     Computed(Write<'a, ComputedCore>, &'a dyn Slot),
 }
 
 impl<'a> Locked<'a> {
     fn joint(&mut self) -> JointRef<'_> {
         match self {
-            Locked::Adaptive(g, _) => JointRef::Adaptive(&mut ***g),
+            Locked::Adaptive(g, _) => JointRef::Adaptive(g),
             Locked::Computed(g, _) => JointRef::Computed(g),
         }
     }

@@ -17,8 +17,8 @@
 
 use super::computed::ComputedStep;
 use super::dynamic::{
-    drive_mujoco, FaultKind, FaultSpec, Hooks, Items, Metrics, OnMujoco, Rows, RunError, Typed,
-    View,
+    drive_mujoco, AdaptiveStep, FaultKind, FaultSpec, Hooks, Items, Metrics, OnMujoco, Rows,
+    RunError, View,
 };
 use super::mujoco::MujocoSpec;
 use adaptimp::cartesian::{
@@ -60,7 +60,7 @@ pub struct CartesianRun<'a> {
 }
 
 /// A joint controller of the core behind a Cartesian impedance: the
-/// paper's laws ([`Typed`]) or computed torque ([`ComputedStep`]), as the
+/// paper's laws ([`AdaptiveStep`]) or computed torque ([`ComputedStep`]), as the
 /// Cartesian step and the native loop drive it; copied for the Python code
 /// a run calls ([`View`]).
 pub(crate) trait JointStep<const N: usize>: View {
@@ -85,18 +85,18 @@ pub(crate) trait JointStep<const N: usize>: View {
     fn applied(&self) -> Vector<N>;
 }
 
-impl<const N: usize> JointStep<N> for Typed<N> {
+impl<const N: usize> JointStep<N> for AdaptiveStep<'_, N> {
     fn period(&self) -> f64 {
-        self.controller().period()
+        self.ctrl.period()
     }
     fn impedance(&self) -> &TargetImpedance<N> {
-        self.controller().impedance()
+        self.ctrl.impedance()
     }
     fn law(&self) -> Law {
-        self.controller().config().law
+        self.ctrl.config().law
     }
     fn step_with(&mut self, m: &Measurement<N>, r: &Setpoint<N>) -> Result<Command<N>, Error> {
-        Typed::step_with(self, m, r)
+        self.ctrl.step(self.state, m, r)
     }
     fn step_task(
         &mut self,
@@ -104,13 +104,13 @@ impl<const N: usize> JointStep<N> for Typed<N> {
         r: &Setpoint<N>,
         t: &TaskTorque<N>,
     ) -> Result<Command<N>, Error> {
-        Typed::step_task(self, m, r, t)
+        AdaptiveStep::step_task(self, m, r, t)
     }
     fn refuse(&mut self, e: Error) {
-        Typed::refuse(self, e);
+        self.ctrl.refuse(self.state, e);
     }
     fn applied(&self) -> Vector<N> {
-        *self.state().applied()
+        *self.state.applied()
     }
 }
 

@@ -5,7 +5,7 @@
 
 use super::cartesian_loop::{self, CartesianOut, CartesianRun, JointStep, OuterRun};
 use super::computed::{ComputedCore, ComputedStep};
-use super::dynamic::{DynTracker, Hooks, RunError, Typed, MAX_JOINTS};
+use super::dynamic::{AdaptiveStep, Hooks, JointCore, RunError, MAX_JOINTS};
 use super::mujoco::MujocoSpec;
 use adaptimp::cartesian::{
     CartesianConfig, CartesianImpedance, CartesianMeasurement, CartesianState, Chain, Joint,
@@ -205,7 +205,7 @@ pub trait DynOuter: Send + Sync {
 /// torque (SPEC §20).
 pub enum JointRef<'a> {
     /// An `adaptimp.Controller`.
-    Adaptive(&'a mut dyn DynTracker),
+    Adaptive(&'a mut JointCore),
     /// An `adaptimp.baselines.ComputedTorque`.
     Computed(&'a mut ComputedCore),
 }
@@ -213,7 +213,7 @@ pub enum JointRef<'a> {
 /// The typed joint controller of N joints behind a [`JointRef`].
 pub(super) enum TypedJoint<'a, const N: usize> {
     /// The paper's laws.
-    Adaptive(&'a mut Typed<N>),
+    Adaptive(AdaptiveStep<'a, N>),
     /// Computed torque.
     Computed(ComputedStep<'a, N>),
 }
@@ -222,7 +222,7 @@ impl<const N: usize> TypedJoint<'_, N> {
     /// As the Cartesian loop steps it.
     pub(super) fn step(&mut self) -> &mut dyn JointStep<N> {
         match self {
-            TypedJoint::Adaptive(t) => *t,
+            TypedJoint::Adaptive(t) => t,
             TypedJoint::Computed(c) => c,
         }
     }
@@ -235,14 +235,7 @@ pub(super) fn typed<const N: usize>(
     run: bool,
 ) -> Result<TypedJoint<'_, N>, Error> {
     match joint {
-        JointRef::Adaptive(t) => t
-            .as_any_mut()
-            .downcast_mut::<Typed<N>>()
-            .map(TypedJoint::Adaptive)
-            .ok_or(Error::Invalid {
-                what: "controller",
-                reason: "has another number of joints than the chain",
-            }),
+        JointRef::Adaptive(c) => AdaptiveStep::of(c, run).map(TypedJoint::Adaptive),
         JointRef::Computed(c) => ComputedStep::of(c, run).map(TypedJoint::Computed),
     }
 }

@@ -7,7 +7,7 @@
 //! space, it is a [`Control`] of the core's loop on MuJoCo along its
 //! setpoint of every row.
 
-use super::dynamic::{Hooks, Metrics, MujocoRun, Rows, RunError, View, MAX_JOINTS};
+use super::dynamic::{Hooks, Metrics, MujocoRun, Rows, RunError, View, MAX_JOINTS, OTHER_N};
 use super::frames::{inertial, joint};
 use super::measurement::JointCall;
 use super::mujoco::MujocoSpec;
@@ -49,13 +49,6 @@ fn input_error(e: Error) -> pyo3::PyErr {
         _ => super::MeasurementError::new_err(e.to_string()),
     }
 }
-
-/// The error of a controller and a state of other numbers of joints than a
-/// typed caller's (not reachable: both are made together).
-const OTHER_N: Error = Error::Invalid {
-    what: "controller",
-    reason: "has another number of joints than the chain",
-};
 
 /// [`ComputedCore`] as its const-generic controller of N joints, with its
 /// state, for a typed loop; `copy_of`: the whole controller, whose copy with

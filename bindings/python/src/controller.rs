@@ -3,7 +3,7 @@
 //! ([`super::shared`]).
 
 use super::dynamic;
-use super::dynamic::{CentersSpec, DynTracker, Inputs, Last, Tables, MAX_JOINTS};
+use super::dynamic::{CentersSpec, Inputs, JointCore, Last, Tables, MAX_JOINTS};
 use super::measurement::JointCall;
 use super::shared::{Read, Shared, Slot, Write};
 use super::{arrays::*, errors::*, hooks::*, params::*};
@@ -33,15 +33,17 @@ impl Given {
     };
 
     pub(super) fn inputs(&self, n: usize) -> Inputs<'_> {
-        Inputs {
+        let m = adaptimp::dynamic::Measurement {
             x: &self.x[..n],
             dx: self.dx.as_ref().map(|d| &d[..n]),
             tau_e: &self.tau_e[..n],
-            setpoint: self
-                .setpoint
-                .as_ref()
-                .map(|s| [&s[0][..n], &s[1][..n], &s[2][..n]]),
-        }
+        };
+        let c = self.setpoint.as_ref().map(|s| adaptimp::dynamic::Setpoint {
+            x: &s[0][..n],
+            dx: &s[1][..n],
+            ddx: &s[2][..n],
+        });
+        (m, c)
     }
 }
 
@@ -57,7 +59,7 @@ type GravityModel<'py> = (Vec<Bound<'py, PyDict>>, Vec<Bound<'py, PyDict>>, [f64
 /// fills in the defaults and checks the keywords.
 #[pyclass(name = "Controller", module = "adaptimp._adaptimp", frozen, subclass)]
 pub(super) struct PyController {
-    pub(super) inner: Shared<dyn DynTracker>,
+    pub(super) inner: Shared<JointCore>,
     pub(super) n: usize,
     pub(super) law: Law,
 }
@@ -65,13 +67,13 @@ pub(super) struct PyController {
 impl PyController {
     /// The controller for a call that may change it, waiting (with the GIL
     /// released) while another thread uses it.
-    pub(super) fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, dyn DynTracker>> {
+    pub(super) fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, JointCore>> {
         self.inner.write(py)
     }
 
     /// The controller to read (during a run of its own, the copy the run
     /// publishes for the Python code it calls).
-    pub(super) fn read(&self, py: Python<'_>) -> PyResult<Read<'_, dyn DynTracker>> {
+    pub(super) fn read(&self, py: Python<'_>) -> PyResult<Read<'_, JointCore>> {
         self.inner.read(py)
     }
 
@@ -80,11 +82,11 @@ impl PyController {
         &self.inner
     }
 
-    pub(super) fn wrap(inner: Box<dyn DynTracker>) -> Self {
+    pub(super) fn wrap(inner: JointCore) -> Self {
         Self {
             n: inner.n(),
             law: inner.law(),
-            inner: Shared::new(inner, "Controller"),
+            inner: Shared::new(Box::new(inner), "Controller"),
         }
     }
 
@@ -93,7 +95,7 @@ impl PyController {
         py: Python<'py>,
         what: Last,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(array1(py, self.read(py)?.last(what)))
+        Ok(array1(py, &self.read(py)?.last(what)))
     }
 
     /// A step's arguments, converted into `given` (shapes and types checked;
@@ -139,7 +141,7 @@ impl PyController {
 /// warning turned into an error (the deprecated call shape under
 /// `-W error`): the call was not made, nothing was wrong with the
 /// measurement.
-fn refused_arguments(py: Python<'_>, e: &PyErr, g: &mut Write<'_, dyn DynTracker>) {
+fn refused_arguments(py: Python<'_>, e: &PyErr, g: &mut Write<'_, JointCore>) {
     if !e.is_instance_of::<pyo3::exceptions::PyWarning>(py) {
         g.refuse(BAD_ARGUMENTS);
     }
@@ -300,7 +302,7 @@ impl PyController {
     /// Clear the recorded fault; nothing else changes (the learned state,
     /// the torque last applied and the jump anchors are kept).
     fn clear_fault(&self, py: Python<'_>) -> PyResult<()> {
-        self.lock(py)?.clear_fault();
+        self.lock(py)?.state.clear_fault();
         Ok(())
     }
 
@@ -363,8 +365,8 @@ impl PyController {
             tau_e: &te,
             setpoint: sp.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
         };
-        let tracker: &mut dyn DynTracker = &mut **guard;
-        let result = py.detach(|| tracker.replay(rows, &tables, &mut out, &mut hooks));
+        let core: &mut JointCore = &mut guard;
+        let result = py.detach(|| core.replay(rows, &tables, &mut out, &mut hooks));
         drop(guard);
         result.map_err(|e| run_error(e, &mut hooks))?;
         array(py, out, (rows, n))
@@ -393,7 +395,8 @@ impl PyController {
     /// norms those of the weights). Clears a recorded fault.
     fn restore(&self, py: Python<'_>, data: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let data: Vec<f64> = data.as_array().iter().copied().collect();
-        self.lock(py)?.restore(&data).map_err(state_error)
+        let g = &mut *self.lock(py)?;
+        g.ctrl.restore(&mut g.state, &data).map_err(state_error)
     }
 
     /// Replace the network weights: "D" (n, n, L), "C" (n, n, L), "G" (n, L)
@@ -402,7 +405,10 @@ impl PyController {
     fn load_weights(&self, py: Python<'_>, weights: &Bound<'_, PyDict>) -> PyResult<()> {
         let l = self.read(py)?.nodes();
         let rows = weight_rows(self.n, l, weights)?;
-        self.lock(py)?.load_weights(&rows).map_err(state_error)
+        let g = &mut *self.lock(py)?;
+        g.ctrl
+            .load_weights(&mut g.state, &rows)
+            .map_err(state_error)
     }
 
     /// Take over the actuators from a controller that was applying ``tau``
@@ -413,7 +419,10 @@ impl PyController {
     /// naming what is wrong; on an error nothing changes).
     fn take_over(&self, py: Python<'_>, tau: &Bound<'_, PyAny>) -> PyResult<()> {
         let t = vector("tau", self.n, tau)?;
-        self.lock(py)?.take_over(&t[..self.n]).map_err(state_error)
+        let g = &mut *self.lock(py)?;
+        g.ctrl
+            .take_over(&mut g.state, &t[..self.n])
+            .map_err(state_error)
     }
 
     /// "pd", "sf" or "of".
@@ -455,7 +464,7 @@ impl PyController {
     /// Auxiliary state ζ (N m) now, i.e. what the next step uses, (11).
     #[getter]
     fn zeta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(array1(py, self.read(py)?.zeta()))
+        Ok(array1(py, self.read(py)?.state.zeta()))
     }
 
     /// Velocity the last step used (rad/s): dq, or the observer's estimate for "of".
@@ -515,7 +524,7 @@ impl PyController {
     fn weights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let (mut w, l) = {
             let g = self.read(py)?;
-            (g.weights(), g.nodes())
+            (g.state.weights(), g.nodes())
         };
         let n = self.n;
         let g = w.split_off(2 * n * n * l);
@@ -531,7 +540,7 @@ impl PyController {
     /// or None.
     #[getter]
     fn weight_bound(&self, py: Python<'_>) -> PyResult<Option<[f64; 3]>> {
-        Ok(self.read(py)?.weight_bound())
+        Ok(self.read(py)?.ctrl.weight_bound())
     }
 
     /// (g, min Kp): the per-step gain of the explicit-Euler learning step at
@@ -539,7 +548,7 @@ impl PyController {
     /// learning loop is stable for g < Kp (docs/robot.md).
     #[getter]
     fn learning_gain(&self, py: Python<'_>) -> PyResult<(f64, f64)> {
-        Ok(self.read(py)?.learning_gain())
+        Ok(self.read(py)?.ctrl.learning_gain())
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {

@@ -1,21 +1,19 @@
 //! The closed loops the bindings still run over the typed controllers: the
 //! run's hooks (signals, progress, a copy of the controller for the Python
 //! code it calls), the loop on MuJoCo ([`drive_mujoco`], over the plant of
-//! `mujoco.rs`) and on the core's rigid bodies, and how a run ended.
+//! `mujoco.rs`), computed torque's run on it, and how a run ended; the
+//! joint controller's loops are `dynamic`'s.
 
-use super::items::{injection, scenario, FaultSpec, Items, Typed};
-use super::mujoco::{Continued, Failure, MjPlant, MujocoSpec, Table};
+use super::items::{injection, scenario, FaultSpec, Items};
+use super::mujoco::{Failure, MjPlant, MujocoSpec, Table};
 use adaptimp::control::config::Law;
 use adaptimp::control::impedance::TargetImpedance;
 use adaptimp::control::io::{Command, Control, Measurement};
 use adaptimp::error::Error;
-use adaptimp::schema::{Preset, Scenario};
-use adaptimp::sim::disturb::TipPayload;
-use adaptimp::sim::environment::{FreeSpace, Wall};
-use adaptimp::sim::metrics::MetricsAccumulator;
-use adaptimp::sim::plant::{Plant, RigidBody};
+use adaptimp::schema::Preset;
+use adaptimp::sim::plant::Plant;
 use adaptimp::sim::record::{Recorder, Row};
-use adaptimp::sim::simulator::{run_disturbed_with, simulate_disturbed, Adapter};
+use adaptimp::sim::simulator::{simulate_disturbed, Adapter};
 use adaptimp::trajectory::{Setpoint, Trajectory};
 use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
@@ -43,7 +41,7 @@ pub trait Hooks {
 /// What a run's controllers are at a [`Hooks::report`], copied on demand.
 pub trait View {
     /// A copy of the part of the run's state that a binding keeps as the
-    /// type `part` (the `TypeId` of a `Box<dyn DynTracker>`, of a
+    /// type `part` (the `TypeId` of a `Box<JointCore>`, of a
     /// `Box<dyn DynOuter>`, …), boxed as `Any`; None if the run has no such
     /// part.
     fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>>;
@@ -180,7 +178,7 @@ impl From<adaptimp::dynamic::RunError> for RunError {
     }
 }
 
-/// A run of [`DynTracker::simulate_mujoco`].
+/// A run of [`JointCore::simulate_mujoco`](super::dynamic::JointCore::simulate_mujoco).
 pub struct MujocoRun<'a> {
     /// Duration T (s).
     pub t_final: f64,
@@ -202,58 +200,6 @@ fn invalid_tau_max() -> Error {
         what: "tau_max",
         reason: "the plant needs one limit per joint",
     }
-}
-
-pub(crate) fn run_mujoco<const N: usize>(
-    t: &mut Typed<N>,
-    sim: &mut Sim,
-    spec: &MujocoSpec,
-    run: &MujocoRun<'_>,
-    hooks: &mut dyn Hooks,
-) -> Result<(Rows, Metrics), RunError> {
-    let ts = t.controller().period();
-    let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
-    if let Some(rows) = run.reference {
-        let need = usize::try_from(total)
-            .unwrap_or(usize::MAX)
-            .saturating_mul(N);
-        if rows.iter().any(|r| r.len() < need) {
-            return Err(RunError::Core(
-                Error::Invalid {
-                    what: "reference",
-                    reason: "needs one row per step",
-                },
-                None,
-            ));
-        }
-    }
-    let every = run.every.max(1);
-    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-    let mut rec = Rows::new(N, kept, every)?;
-    let mut metrics = MetricsAccumulator::new(run.settle, *t.controller().impedance());
-    let k0 = t.state().steps();
-    let own = Continued {
-        traj: *t.trajectory(),
-        k0,
-        ts,
-    };
-    let law = t.controller().config().law;
-    let on = OnMujoco {
-        sim,
-        spec,
-        t_final: run.t_final,
-        settle: run.settle,
-        items: run.items,
-        law,
-        fault: run.fault,
-        abort: None,
-    };
-    let rec2 = &mut (&mut metrics, &mut rec);
-    match run.reference {
-        Some(rows) => drive_mujoco(t, &Table::<N> { rows, ts }, on, hooks, rec2),
-        None => drive_mujoco(t, &own, on, hooks, rec2),
-    }?;
-    Ok((rec, metrics_out(&metrics.finish())?))
 }
 
 /// A run's plant on MuJoCo and the settings of its loop ([`drive_mujoco`]).
@@ -461,86 +407,6 @@ impl<const N: usize> Adapter<N> for Watch<'_, '_> {
         }
         Ok(a)
     }
-}
-
-pub(crate) fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
-    t: &mut Typed<N>,
-    arm: &M,
-    s: &Scenario<N>,
-    weights: Option<&[f64]>,
-    fault: Option<&FaultSpec>,
-    every: u64,
-    hooks: &mut dyn Hooks,
-) -> Result<(Rows, Metrics), RunError> {
-    let cfg = &s.sim;
-    let inj = fault
-        .map(|f| injection::<N>(f, &t.controller().config().tau_max))
-        .transpose()?;
-    let ts = t.controller().period();
-    let total = adaptimp::sim::simulator::steps(cfg.t_final, ts)?;
-    let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
-    let mut rec = Rows::new(N, kept, every)?;
-    t.reset();
-    if let Some(w) = weights {
-        adaptimp::control::tracker::Tracker::load_weights(
-            t,
-            &adaptimp::networks::network::Weights::<N>::from_rows(
-                w,
-                adaptimp::networks::rbf::Basis::nodes(t.controller().basis()),
-            )?,
-        )?;
-    }
-    let traj = *t.trajectory();
-    // The plant the controller does not know (SPEC §17): payload and friction.
-    let dist = s.disturbances()?;
-    // The set-up's errors name no row: check what the run builds first.
-    adaptimp::error::check::nonnegative("settle ≥ 0", "settle", cfg.settle)?;
-    RigidBody::new(
-        arm.with_payload(dist.payload())?,
-        FreeSpace,
-        cfg.q0,
-        cfg.dq0,
-        cfg.substeps,
-    )?;
-    let hooks = RefCell::new(hooks);
-    let stop = Cell::new(false);
-    let mut watch = Watch::new(&hooks, &stop, total);
-    let mut t = Reporting::new(t, &hooks, &stop, total);
-    let metrics = match s.wall {
-        Some(w) => {
-            let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
-            run_disturbed_with(
-                arm,
-                &wall,
-                &mut t,
-                &traj,
-                cfg,
-                &dist,
-                inj.as_ref(),
-                &mut watch,
-                &mut rec,
-            )
-        }
-        None => {
-            let env = FreeSpace;
-            run_disturbed_with(
-                arm,
-                &env,
-                &mut t,
-                &traj,
-                cfg,
-                &dist,
-                inj.as_ref(),
-                &mut watch,
-                &mut rec,
-            )
-        }
-    }
-    .map_err(|e| watch.error(e))?;
-    if !t.finish() {
-        return Err(RunError::Stopped);
-    }
-    Ok((rec, metrics_out(&metrics)?))
 }
 
 // ---------------------------------------------------------------------------

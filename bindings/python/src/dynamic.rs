@@ -1,53 +1,57 @@
-//! The controller behind a run-time number of joints: [`DynTracker`], an
-//! object-safe face of [`Tracker<N, AnyBasis<N>, Sinusoid<N>>`] for every
-//! N = 1 … [`MAX_JOINTS`], taking and giving slices, built from the schema's
-//! parameter items ([`super::items`]); its closed loops are in
-//! [`super::drive`], recording into the core's rows and metrics.
+//! The joint controller behind a run-time number of joints: [`JointCore`],
+//! the core's run-time [`Controller`](dy::Controller) and
+//! [`State`](dy::State), built by the core's one builder
+//! ([`dy::Scenario`]) from the schema's parameter items
+//! ([`super::items`]); for a typed loop, [`AdaptiveStep`] is the
+//! const-generic controller of its N, reached through the core's accessors
+//! and [`for_joints`]; its closed loops are in [`super::drive`], recording
+//! into the core's rows and metrics.
 //!
 //! Nothing here knows Python: the bindings (`mod.rs`) convert arrays to
 //! slices and errors to exceptions.
 
-use super::mujoco::MujocoSpec;
+use super::items::injection;
+use super::mujoco::{Continued, MujocoSpec, Table};
 use adaptimp::control::config::Law;
 use adaptimp::control::controller::Controller;
-use adaptimp::control::io::{Command, Measurement};
-use adaptimp::control::tracker::Tracker;
-use adaptimp::control::tuning::Rule;
+use adaptimp::control::impedance::TargetImpedance;
+use adaptimp::control::io::{self, Control, TaskTorque};
+use adaptimp::control::state::HeapState;
+use adaptimp::dynamic::{self as dy, for_joints, ForJoints};
 use adaptimp::error::Error;
-use adaptimp::networks::network::{Weights, C, D, G};
-use adaptimp::networks::rbf::{AnyBasis, Basis, Centers, GRID_MAX_JOINTS};
+use adaptimp::networks::network::Weights;
+use adaptimp::networks::rbf::{AnyBasis, Basis as _};
 use adaptimp::schema::Preset;
+use adaptimp::schema::Scenario;
+use adaptimp::sim::disturb::TipPayload;
+use adaptimp::sim::environment::{FreeSpace, Wall};
+use adaptimp::sim::metrics::MetricsAccumulator;
 use adaptimp::sim::model::{Link, PlanarArm};
-use adaptimp::trajectory::{Setpoint, Trajectory};
+use adaptimp::sim::plant::RigidBody;
+use adaptimp::sim::simulator::run_disturbed_with;
+use adaptimp::trajectory::{Setpoint, Sinusoid};
 use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
+use core::cell::{Cell, RefCell};
 use std::any::Any;
+use std::boxed::Box;
 use std::vec::Vec;
 
 pub use adaptimp::dynamic::MAX_JOINTS;
 
 pub(crate) use super::drive::{drive_mujoco, Hooks, MujocoRun, OnMujoco, RunError, View};
-use super::drive::{run_arm, run_mujoco, HOOK_EVERY};
+use super::drive::{metrics_out, Reporting, Watch, HOOK_EVERY};
 use std::any::TypeId;
 
-pub(crate) use super::items::Typed;
 pub use super::items::{
     scenario, ArmSpec, CentersSpec, FaultKind, FaultSpec, GravitySpec, Items, Owned, ParamError,
 };
 
 pub use adaptimp::dynamic::{Metrics, RowMetrics, Rows};
 
-/// A step's inputs as slices of n values.
-pub struct Inputs<'a> {
-    /// Joint positions (rad).
-    pub x: &'a [f64],
-    /// Joint velocities (rad/s), if measured.
-    pub dx: Option<&'a [f64]>,
-    /// Force on the environment (N m).
-    pub tau_e: &'a [f64],
-    /// An external setpoint (xc, ẋc, ẍc) instead of the trajectory's.
-    pub setpoint: Option<[&'a [f64]; 3]>,
-}
+/// A step's inputs as slices of n values: the measurement, and an external
+/// setpoint (xc, ẋc, ẍc) instead of the trajectory's.
+pub type Inputs<'a> = (dy::Measurement<'a>, Option<dy::Setpoint<&'a [f64]>>);
 
 /// The quantities of the last step, by name.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -70,66 +74,183 @@ pub enum Last {
     Applied,
 }
 
-/// A controller with its trajectory and state, for any N ≤ [`MAX_JOINTS`].
-pub trait DynTracker: Send + Sync {
+/// The core's joint controller (the paper's laws) of any n ≤ 7, with its
+/// own trajectory, and its state.
+#[derive(Clone, Debug)]
+pub struct JointCore {
+    /// The controller.
+    pub ctrl: dy::Controller,
+    /// Its state.
+    pub state: dy::State,
+}
+
+/// The error of a controller and a state of other numbers of joints than a
+/// typed caller's (not reachable: both are made together).
+pub(crate) const OTHER_N: Error = Error::Invalid {
+    what: "controller",
+    reason: "has another number of joints than the chain",
+};
+
+/// Build the controller `law` for n joints from `preset` and `items` by the
+/// core's one builder ([`dy::Scenario::controller`], which C's builds by
+/// too), with the paper's grid (n ≤ 3), the rule's default centres beyond
+/// (SPEC §18), or `centers`, feeding forward `gravity`'s G(q) if given
+/// (SPEC (20.10)).
+pub fn build(
+    n: usize,
+    preset: Preset,
+    law: Law,
+    items: &Items,
+    centers: Option<&CentersSpec>,
+    gravity: Option<&GravitySpec>,
+) -> Result<JointCore, ParamError> {
+    let mut s = dy::Scenario::new(n, preset, law)?;
+    for (name, v) in items {
+        s.set(name, v.value()).map_err(|error| ParamError {
+            name: Some(name.clone()),
+            error,
+        })?;
+    }
+    if let Some(c) = centers {
+        s.basis(dy::Basis::Centres(dy::Centres {
+            rows: c.centers.clone(),
+            widths2: Some(c.widths2.clone()),
+        }));
+    }
+    if let Some(g) = gravity {
+        s.feedforward(dy::Dynamics::new(&g.joints, &g.inertials, g.gravity)?);
+    }
+    let ctrl = s.controller()?;
+    let state = ctrl.new_state();
+    Ok(JointCore { ctrl, state })
+}
+
+impl JointCore {
     /// Joints n.
-    fn n(&self) -> usize;
+    pub fn n(&self) -> usize {
+        self.ctrl.n()
+    }
     /// RBF nodes L.
-    fn nodes(&self) -> usize;
+    pub fn nodes(&self) -> usize {
+        self.ctrl.nodes()
+    }
     /// The law.
-    fn law(&self) -> Law;
+    pub fn law(&self) -> Law {
+        self.ctrl.law()
+    }
     /// Ts (s).
-    fn ts(&self) -> f64;
+    pub fn ts(&self) -> f64 {
+        self.ctrl.period()
+    }
     /// t_k (s) of the next step.
-    fn time(&self) -> f64;
+    pub fn time(&self) -> f64 {
+        self.ctrl.time(&self.state)
+    }
     /// Steps taken.
-    fn steps(&self) -> u64;
+    pub fn steps(&self) -> u64 {
+        self.state.steps()
+    }
     /// Back to t = 0.
-    fn reset(&mut self);
+    pub fn reset(&mut self) {
+        self.state.reset()
+    }
+
     /// One step; writes sat(τ) into `out` (n values).
-    fn step(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
+    pub fn step(&mut self, (m, c): &Inputs<'_>, out: &mut [f64]) -> Result<(), Error> {
+        let cmd = self.ctrl.step(&mut self.state, m, c.as_ref())?;
+        out.copy_from_slice(&cmd.tau_sat);
+        Ok(())
+    }
+
     /// One step that always writes a torque to apply into `out`.
-    fn step_or_fallback(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error>;
+    pub fn step_or_fallback(&mut self, (m, c): &Inputs<'_>, out: &mut [f64]) -> Result<(), Error> {
+        let (tau, result) = self.ctrl.step_or_fallback(&mut self.state, m, c.as_ref());
+        out.copy_from_slice(&tau.ok_or(OTHER_N)?);
+        result.map(|_| ())
+    }
+
     /// A step call refused by the front (its arguments' shapes or types):
-    /// recorded as a refused step ([`Controller::refuse`](adaptimp::Controller::refuse)).
-    fn refuse(&mut self, error: Error);
+    /// recorded as a refused step ([`dy::Controller::refuse`]).
+    pub fn refuse(&mut self, error: Error) {
+        self.ctrl.refuse(&mut self.state, error);
+    }
+
     /// A quantity of the last step.
-    fn last(&self, what: Last) -> &[f64];
-    /// ζ now.
-    fn zeta(&self) -> &[f64];
+    pub fn last(&self, what: Last) -> dy::Joints {
+        let c = self.state.last();
+        match what {
+            Last::Tau => c.tau,
+            Last::TauSat => c.tau_sat,
+            Last::Dtau => c.dtau,
+            Last::Z1 => c.z1,
+            Last::Xc => c.xc,
+            Last::Xd => c.xd,
+            Last::V => c.v,
+            Last::Applied => self.state.applied(),
+        }
+    }
+
     /// The recorded fault: (error, step).
-    fn fault(&self) -> Option<(Error, u64)>;
-    /// Forget the recorded fault.
-    fn clear_fault(&mut self);
-    /// The resolved weight bounds.
-    fn weight_bound(&self) -> Option<[f64; 3]>;
-    /// The weights, row-major over ŴD[k][j], ŴC[k][j], ŴG[k], each over L nodes.
-    fn weights(&self) -> Vec<f64>;
-    /// Replace the weights (same layout as [`weights`](Self::weights)).
-    fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error>;
-    /// Take over from a controller that was applying `tau` (n values, N m).
-    fn take_over(&mut self, tau: &[f64]) -> Result<(), Error>;
+    pub fn fault(&self) -> Option<(Error, u64)> {
+        self.state.fault().map(|f| (f.error, f.step))
+    }
+
     /// The whole state as reals ([`State::save`](adaptimp::control::state::State::save)).
-    fn snapshot(&self) -> Vec<f64>;
-    /// Restore a [`snapshot`](Self::snapshot).
-    fn restore(&mut self, data: &[f64]) -> Result<(), Error>;
-    /// The per-step learning gain of the explicit-Euler step at the start of
-    /// the trajectory, Ts ‖S(Z0)‖² (ΓD ‖ẍc(0)‖² + ΓC ‖ẋc(0)‖² + ΓG) (N m per
-    /// rad/s), and min Kp: the Jury condition of `docs/robot.md` is gain < Kp.
-    fn learning_gain(&self) -> (f64, f64);
+    pub fn snapshot(&self) -> Vec<f64> {
+        let mut out = std::vec![0.0; self.state.snapshot_len()];
+        // The buffer has exactly the length save needs.
+        let _ = self.state.save(&mut out);
+        out
+    }
+
     /// `rows` steps from row-major tables; writes sat(τ) rows into `out`.
     /// Errors name the row.
-    fn replay(
+    pub fn replay(
         &mut self,
         rows: usize,
-        tables: &Tables<'_>,
+        t: &Tables<'_>,
         out: &mut Vec<f64>,
         hooks: &mut dyn Hooks,
-    ) -> Result<(), RunError>;
+    ) -> Result<(), RunError> {
+        let n = self.n();
+        fn at(v: &[f64], k: usize, n: usize) -> &[f64] {
+            &v[k * n..(k + 1) * n]
+        }
+        let row = |v, k| at(v, k, n);
+        for k in 0..rows {
+            if k > 0
+                && (k as u64).is_multiple_of(HOOK_EVERY)
+                && !hooks.report(k as u64, rows as u64, &*self)
+            {
+                return Err(RunError::Stopped);
+            }
+            let m = dy::Measurement {
+                x: row(t.x, k),
+                dx: t.dx.map(|d| row(d, k)),
+                tau_e: row(t.tau_e, k),
+            };
+            let c = t.setpoint.map(|[x, dx, ddx]| dy::Setpoint {
+                x: row(x, k),
+                dx: row(dx, k),
+                ddx: row(ddx, k),
+            });
+            let cmd = self
+                .ctrl
+                .step(&mut self.state, &m, c.as_ref())
+                .map_err(|e| RunError::Core(e, Some(k as u64)))?;
+            out.extend_from_slice(&cmd.tau_sat);
+        }
+        // The last row reported too (a progress bar ends at 100 %).
+        if rows > 0 && !hooks.report(rows as u64, rows as u64, &*self) {
+            return Err(RunError::Stopped);
+        }
+        Ok(())
+    }
+
     /// The closed loop of SPEC §11 against `arm` with the scenario of
     /// `items` (its run and wall parameters), from t = 0 (reset first) with
-    /// the initial `weights` (rows as for [`load_weights`](Self::load_weights)).
-    fn simulate(
+    /// the initial `weights` (rows as for [`dy::Controller::load_weights`]).
+    pub fn simulate(
         &mut self,
         arm: &ArmSpec,
         items: &Items,
@@ -137,21 +258,219 @@ pub trait DynTracker: Send + Sync {
         fault: Option<&FaultSpec>,
         every: u64,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Rows, Metrics), RunError>;
+    ) -> Result<(Rows, Metrics), RunError> {
+        let n = self.n();
+        let on = OnArm {
+            core: self,
+            arm,
+            items,
+            weights,
+            fault,
+            every,
+            hooks,
+        };
+        for_joints(n, on).unwrap_or(Err(RunError::Core(OTHER_N, None)))
+    }
+
     /// The closed loop on MuJoCo (`sim` as `spec` describes it) from the
     /// controller's current state (not reset: a used controller goes on),
     /// with the disturbances of `run.items` (SPEC §17; payload and jitter are
     /// refused: the first is a change of the model, the second of its
     /// timestep). Records every `run.every`-th row with the end effector.
-    fn simulate_mujoco(
+    pub fn simulate_mujoco(
         &mut self,
         sim: &mut Sim,
         spec: &MujocoSpec,
         run: &MujocoRun<'_>,
         hooks: &mut dyn Hooks,
-    ) -> Result<(Rows, Metrics), RunError>;
-    /// As [`Any`], for the typed paths.
-    fn as_any_mut(&mut self) -> &mut dyn Any;
+    ) -> Result<(Rows, Metrics), RunError> {
+        let n = self.n();
+        let on = OnMujocoRun {
+            core: self,
+            sim,
+            spec,
+            run,
+            hooks,
+        };
+        for_joints(n, on).unwrap_or(Err(RunError::Core(OTHER_N, None)))
+    }
+}
+
+/// The copy of a joint controller as the bindings keep it.
+impl View for JointCore {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        (part == TypeId::of::<Box<JointCore>>())
+            .then(|| Box::new(Box::new(self.clone())) as Box<dyn Any + Send>)
+    }
+}
+
+/// [`JointCore`] as its const-generic controller of N joints, with its own
+/// trajectory and its state, for a typed loop; `copy_of`: the whole
+/// controller, whose copy with this state the Python code a run calls reads
+/// ([`View`]).
+pub struct AdaptiveStep<'a, const N: usize> {
+    /// The controller.
+    pub ctrl: &'a Controller<N, AnyBasis<N>>,
+    /// The trajectory it tracks by default.
+    pub traj: &'a Sinusoid<N>,
+    /// Its state.
+    pub state: &'a mut HeapState<N>,
+    copy_of: Option<Box<JointCore>>,
+}
+
+impl<'a, const N: usize> AdaptiveStep<'a, N> {
+    /// `core` for N joints (an error if it was made for another n); `run`:
+    /// for a run, which publishes copies of it (a step alone allocates
+    /// nothing).
+    pub fn of(core: &'a mut JointCore, run: bool) -> Result<Self, Error> {
+        let copy_of = run.then(|| Box::new(core.clone()));
+        let (ctrl, traj) = core.ctrl.typed::<N>().ok_or(OTHER_N)?;
+        let state = core.state.typed_mut::<N>().ok_or(OTHER_N)?;
+        Ok(Self {
+            ctrl,
+            traj,
+            state,
+            copy_of,
+        })
+    }
+
+    /// One step of the torque-level formulations (SPEC §19).
+    pub fn step_task(
+        &mut self,
+        m: &io::Measurement<N>,
+        c: &Setpoint<N>,
+        t: &TaskTorque<N>,
+    ) -> Result<io::Command<N>, Error> {
+        self.ctrl.step_task(self.state, m, c, t)
+    }
+
+    /// Back to t = 0, and the initial `weights` if given (rows as for
+    /// [`dy::Controller::load_weights`]).
+    pub fn restart(&mut self, weights: Option<&[f64]>) -> Result<(), Error> {
+        self.state.reset();
+        if let Some(w) = weights {
+            let w = Weights::<N>::from_rows(w, self.ctrl.basis().nodes())?;
+            self.ctrl.load_weights(self.state, &w)?;
+        }
+        Ok(())
+    }
+}
+
+impl<const N: usize> Control<N> for AdaptiveStep<'_, N> {
+    fn period(&self) -> f64 {
+        self.ctrl.period()
+    }
+    fn target(&self) -> &TargetImpedance<N> {
+        self.ctrl.impedance()
+    }
+    fn step(&mut self, m: &io::Measurement<N>, c: &Setpoint<N>) -> Result<io::Command<N>, Error> {
+        self.ctrl.step(self.state, m, c)
+    }
+    fn step_or_fallback(
+        &mut self,
+        m: &io::Measurement<N>,
+        c: &Setpoint<N>,
+    ) -> (Vector<N>, Result<io::Command<N>, Error>) {
+        self.ctrl.step_or_fallback(self.state, m, c)
+    }
+}
+
+/// The copy of the joint controller as the bindings keep it: the controller
+/// with the state as it is now.
+impl<const N: usize> View for AdaptiveStep<'_, N> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        let base = self.copy_of.as_ref()?;
+        (part == TypeId::of::<Box<JointCore>>()).then(|| {
+            let mut copy = (**base).clone();
+            if let Some(s) = copy.state.typed_mut::<N>() {
+                s.clone_from(self.state);
+            }
+            Box::new(Box::new(copy)) as Box<dyn Any + Send>
+        })
+    }
+}
+
+/// The closed loop of a [`JointCore`] against an arm of the core, for its N.
+struct OnArm<'a> {
+    core: &'a mut JointCore,
+    arm: &'a ArmSpec,
+    items: &'a Items,
+    weights: Option<&'a [f64]>,
+    fault: Option<&'a FaultSpec>,
+    every: u64,
+    hooks: &'a mut dyn Hooks,
+}
+
+impl ForJoints for OnArm<'_> {
+    type Output = Result<(Rows, Metrics), RunError>;
+    fn call<const N: usize>(self) -> Self::Output {
+        let law = self.core.law();
+        let s = scenario::<N>(Preset::Paper, law, self.items)
+            .map_err(|e| RunError::Core(e.error, None))?;
+        match self.arm {
+            ArmSpec::Paper(two) => {
+                let mut t = AdaptiveStep::<2>::of(self.core, true).map_err(|_| {
+                    RunError::Core(
+                        Error::Invalid {
+                            what: "arm",
+                            reason: "TwoLinkArm has 2 joints: the controller has another number",
+                        },
+                        None,
+                    )
+                })?;
+                let s2 = scenario::<2>(Preset::Paper, law, self.items)
+                    .map_err(|e| RunError::Core(e.error, None))?;
+                run_arm(
+                    &mut t,
+                    two,
+                    &s2,
+                    self.weights,
+                    self.fault,
+                    self.every,
+                    self.hooks,
+                )
+            }
+            ArmSpec::Planar { links, g } => {
+                let links: [Link; N] = links.as_slice().try_into().map_err(|_| {
+                    RunError::Core(
+                        Error::Invalid {
+                            what: "arm",
+                            reason: "the arm and the controller have different numbers of joints",
+                        },
+                        None,
+                    )
+                })?;
+                let arm = PlanarArm::new(links, *g)?;
+                let mut t = AdaptiveStep::<N>::of(self.core, true)?;
+                run_arm(
+                    &mut t,
+                    &arm,
+                    &s,
+                    self.weights,
+                    self.fault,
+                    self.every,
+                    self.hooks,
+                )
+            }
+        }
+    }
+}
+
+/// The closed loop of a [`JointCore`] on MuJoCo, for its N.
+struct OnMujocoRun<'a, 'b> {
+    core: &'a mut JointCore,
+    sim: &'a mut Sim,
+    spec: &'a MujocoSpec,
+    run: &'a MujocoRun<'b>,
+    hooks: &'a mut dyn Hooks,
+}
+
+impl ForJoints for OnMujocoRun<'_, '_> {
+    type Output = Result<(Rows, Metrics), RunError>;
+    fn call<const N: usize>(self) -> Self::Output {
+        let mut t = AdaptiveStep::<N>::of(self.core, true)?;
+        run_mujoco(&mut t, self.sim, self.spec, self.run, self.hooks)
+    }
 }
 
 /// Row-major tables of a replay: K × n each.
@@ -166,311 +485,133 @@ pub struct Tables<'a> {
     pub setpoint: Option<[&'a [f64]; 3]>,
 }
 
-/// Build the controller `law` for n joints from `preset` and `items`, with the
-/// paper's grid (n ≤ 3) or `centers`, feeding forward `gravity`'s G(q) if
-/// given (SPEC (20.10)).
-pub fn build(
-    n: usize,
-    preset: Preset,
-    law: Law,
-    items: &Items,
-    centers: Option<&CentersSpec>,
-    gravity: Option<&GravitySpec>,
-) -> Result<Box<dyn DynTracker>, ParamError> {
-    adaptimp::with_joints!(
-        n,
-        K => Ok(Box::new(build_n::<K>(preset, law, items, centers, gravity)?)),
-        _ => Err(Error::Invalid {
-            what: "n",
-            reason: "the number of joints must be between 1 and 7",
-        }
-        .into()),
-    )
-}
+// ---------------------------------------------------------------------------
+// The joint controller's closed loops, typed.
+// ---------------------------------------------------------------------------
 
-fn build_n<const N: usize>(
-    preset: Preset,
-    law: Law,
-    items: &Items,
-    centers: Option<&CentersSpec>,
-    gravity: Option<&GravitySpec>,
-) -> Result<Typed<N>, ParamError> {
-    let s = scenario::<N>(preset, law, items)?;
-    let traj = s.trajectory()?;
-    let basis = match centers {
-        // Beyond the vertex grid: the rule's default basis, SPEC §18.
-        None if N > GRID_MAX_JOINTS => AnyBasis::Centers(Rule::default().default_basis(&traj)?),
-        None => AnyBasis::Grid(s.grid()?),
-        Some(c) => {
-            if c.widths2.len() != 4 * N {
-                return Err(Error::Invalid {
-                    what: "widths",
-                    reason: "need one width per input dimension (4n: x, v, α1, α̇1)",
-                }
-                .into());
-            }
-            let w: [Vector<N>; 4] =
-                core::array::from_fn(|b| Vector::from_column_slice(&c.widths2[b * N..][..N]));
-            AnyBasis::Centers(Centers::new(c.centers.clone(), w)?)
+/// The closed loop of the joint controller on MuJoCo ([`drive_mujoco`]),
+/// along its own trajectory from its clock on, or along `run.reference`.
+fn run_mujoco<const N: usize>(
+    t: &mut AdaptiveStep<'_, N>,
+    sim: &mut Sim,
+    spec: &MujocoSpec,
+    run: &MujocoRun<'_>,
+    hooks: &mut dyn Hooks,
+) -> Result<(Rows, Metrics), RunError> {
+    let ts = t.ctrl.period();
+    let total = adaptimp::sim::simulator::steps(run.t_final, ts)?;
+    if let Some(rows) = run.reference {
+        let need = usize::try_from(total)
+            .unwrap_or(usize::MAX)
+            .saturating_mul(N);
+        if rows.iter().any(|r| r.len() < need) {
+            return Err(RunError::Core(
+                Error::Invalid {
+                    what: "reference",
+                    reason: "needs one row per step",
+                },
+                None,
+            ));
         }
+    }
+    let every = run.every.max(1);
+    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let mut rec = Rows::new(N, kept, every)?;
+    let mut metrics = MetricsAccumulator::new(run.settle, *t.ctrl.impedance());
+    let k0 = t.state.steps();
+    let own = Continued {
+        traj: *t.traj,
+        k0,
+        ts,
     };
-    let mut ctrl = Controller::for_trajectory(s.config, basis, &traj)?;
-    if let Some(g) = gravity {
-        let model =
-            adaptimp::cartesian::dynamics::Dynamics::<N>::new(&g.joints, &g.inertials, g.gravity)?;
-        ctrl = ctrl.with_feedforward(std::sync::Arc::new(model));
-    }
-    Ok(Tracker::new(ctrl, traj))
+    let law = t.ctrl.config().law;
+    let on = OnMujoco {
+        sim,
+        spec,
+        t_final: run.t_final,
+        settle: run.settle,
+        items: run.items,
+        law,
+        fault: run.fault,
+        abort: None,
+    };
+    let rec2 = &mut (&mut metrics, &mut rec);
+    match run.reference {
+        Some(rows) => drive_mujoco(t, &Table::<N> { rows, ts }, on, hooks, rec2),
+        None => drive_mujoco(t, &own, on, hooks, rec2),
+    }?;
+    Ok((rec, metrics_out(&metrics.finish())?))
 }
 
-fn vector<const N: usize>(v: &[f64]) -> Vector<N> {
-    Vector::from_column_slice(v)
-}
-
-fn measurement<const N: usize>(m: &Inputs<'_>) -> Measurement<N> {
-    Measurement {
-        x: vector(m.x),
-        dx: m.dx.map(vector),
-        tau_e: vector(m.tau_e),
-    }
-}
-
-fn setpoint<const N: usize>(s: [&[f64]; 3]) -> Setpoint<N> {
-    Setpoint {
-        x: vector(s[0]),
-        dx: vector(s[1]),
-        ddx: vector(s[2]),
-    }
-}
-
-impl<const N: usize> DynTracker for Typed<N> {
-    fn n(&self) -> usize {
-        N
-    }
-    fn nodes(&self) -> usize {
-        self.controller().basis().nodes()
-    }
-    fn law(&self) -> Law {
-        self.controller().config().law
-    }
-    fn ts(&self) -> f64 {
-        self.controller().period()
-    }
-    fn time(&self) -> f64 {
-        Tracker::time(self)
-    }
-    fn steps(&self) -> u64 {
-        self.state().steps()
-    }
-    fn reset(&mut self) {
-        Tracker::reset(self)
-    }
-
-    fn step(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error> {
-        let meas = measurement::<N>(m);
-        let cmd = match m.setpoint {
-            Some(s) => self.step_with(&meas, &setpoint(s))?,
-            None => Tracker::step(self, &meas)?,
-        };
-        out.copy_from_slice(cmd.tau_sat.as_slice());
-        Ok(())
-    }
-
-    fn step_or_fallback(&mut self, m: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error> {
-        let meas = measurement::<N>(m);
-        let c = match m.setpoint {
-            Some(s) => setpoint(s),
-            None => self.trajectory().sample(Tracker::time(self)),
-        };
-        let (tau, result) = adaptimp::control::io::Control::step_or_fallback(self, &meas, &c);
-        out.copy_from_slice(tau.as_slice());
-        result.map(|_| ())
-    }
-
-    fn refuse(&mut self, error: Error) {
-        Tracker::refuse(self, error);
-    }
-
-    fn last(&self, what: Last) -> &[f64] {
-        let c: &Command<N> = self.state().last();
-        match what {
-            Last::Tau => c.tau.as_slice(),
-            Last::TauSat => c.tau_sat.as_slice(),
-            Last::Dtau => c.dtau.as_slice(),
-            Last::Z1 => c.z1.as_slice(),
-            Last::Xc => c.xc.as_slice(),
-            Last::Xd => c.xd.as_slice(),
-            Last::V => c.v.as_slice(),
-            Last::Applied => self.state().applied().as_slice(),
+/// The closed loop of SPEC §11 of the joint controller against a rigid-body
+/// arm of the core, from t = 0 with the initial `weights`.
+fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
+    t: &mut AdaptiveStep<'_, N>,
+    arm: &M,
+    s: &Scenario<N>,
+    weights: Option<&[f64]>,
+    fault: Option<&FaultSpec>,
+    every: u64,
+    hooks: &mut dyn Hooks,
+) -> Result<(Rows, Metrics), RunError> {
+    let cfg = &s.sim;
+    let inj = fault
+        .map(|f| injection::<N>(f, &t.ctrl.config().tau_max))
+        .transpose()?;
+    let ts = t.ctrl.period();
+    let total = adaptimp::sim::simulator::steps(cfg.t_final, ts)?;
+    let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
+    let mut rec = Rows::new(N, kept, every)?;
+    t.restart(weights)?;
+    let traj = *t.traj;
+    // The plant the controller does not know (SPEC §17): payload and friction.
+    let dist = s.disturbances()?;
+    // The set-up's errors name no row: check what the run builds first.
+    adaptimp::error::check::nonnegative("settle ≥ 0", "settle", cfg.settle)?;
+    RigidBody::new(
+        arm.with_payload(dist.payload())?,
+        FreeSpace,
+        cfg.q0,
+        cfg.dq0,
+        cfg.substeps,
+    )?;
+    let hooks = RefCell::new(hooks);
+    let stop = Cell::new(false);
+    let mut watch = Watch::new(&hooks, &stop, total);
+    let mut t = Reporting::new(t, &hooks, &stop, total);
+    let metrics = match s.wall {
+        Some(w) => {
+            let wall = Wall::<N>::new(0, w, s.ke_be[0], s.ke_be[1])?;
+            run_disturbed_with(
+                arm,
+                &wall,
+                &mut t,
+                &traj,
+                cfg,
+                &dist,
+                inj.as_ref(),
+                &mut watch,
+                &mut rec,
+            )
+        }
+        None => {
+            let env = FreeSpace;
+            run_disturbed_with(
+                arm,
+                &env,
+                &mut t,
+                &traj,
+                cfg,
+                &dist,
+                inj.as_ref(),
+                &mut watch,
+                &mut rec,
+            )
         }
     }
-
-    fn zeta(&self) -> &[f64] {
-        self.state().zeta().as_slice()
+    .map_err(|e| watch.error(e))?;
+    if !t.finish() {
+        return Err(RunError::Stopped);
     }
-
-    fn fault(&self) -> Option<(Error, u64)> {
-        self.state().fault().map(|f| (f.error, f.step))
-    }
-
-    fn clear_fault(&mut self) {
-        self.state_mut().clear_fault()
-    }
-
-    fn weight_bound(&self) -> Option<[f64; 3]> {
-        self.controller().learning().bound()
-    }
-
-    fn weights(&self) -> Vec<f64> {
-        let w = self.state().weights();
-        let mut out = Vec::with_capacity((2 * N * N + N) * self.nodes());
-        for net in [D, C, G] {
-            for row in w.network(net) {
-                out.extend_from_slice(row);
-            }
-        }
-        out
-    }
-
-    fn load_weights(&mut self, rows: &[f64]) -> Result<(), Error> {
-        let w = Weights::<N>::from_rows(rows, self.nodes())?;
-        Tracker::load_weights(self, &w)
-    }
-
-    fn take_over(&mut self, tau: &[f64]) -> Result<(), Error> {
-        Tracker::take_over(self, &Vector::<N>::from_column_slice(tau))
-    }
-
-    fn snapshot(&self) -> Vec<f64> {
-        let st = self.state();
-        let mut out = std::vec![0.0; st.snapshot_len()];
-        // The buffer has exactly the length save needs.
-        let _ = st.save(&mut out);
-        out
-    }
-
-    fn restore(&mut self, data: &[f64]) -> Result<(), Error> {
-        Tracker::restore(self, data)
-    }
-
-    fn learning_gain(&self) -> (f64, f64) {
-        let ctrl = self.controller();
-        let cfg = ctrl.config();
-        let c = self.trajectory().sample(0.0);
-        let mut s = std::vec![0.0; self.nodes()];
-        ctrl.basis().eval(&[c.x, c.dx, c.dx, c.ddx], &mut s);
-        let s2: f64 = s.iter().map(|x| x * x).sum();
-        let [gd, gc, gg] = cfg.gamma;
-        let gain = cfg.ts * s2 * (gd * c.ddx.norm_squared() + gc * c.dx.norm_squared() + gg);
-        // Per unit inertia scale, SPEC (10.2): joint k's rows learn at Γ d_k
-        // against Kp_k (Kp for the paper's d = 1).
-        (gain, cfg.kp.component_div(&cfg.inertia).min())
-    }
-
-    fn replay(
-        &mut self,
-        rows: usize,
-        t: &Tables<'_>,
-        out: &mut Vec<f64>,
-        hooks: &mut dyn Hooks,
-    ) -> Result<(), RunError> {
-        let row = |v: &[f64], k: usize| Vector::<N>::from_column_slice(&v[k * N..(k + 1) * N]);
-        for k in 0..rows {
-            if k > 0
-                && (k as u64).is_multiple_of(HOOK_EVERY)
-                && !hooks.report(k as u64, rows as u64, &*self)
-            {
-                return Err(RunError::Stopped);
-            }
-            let m = Measurement {
-                x: row(t.x, k),
-                dx: t.dx.map(|d| row(d, k)),
-                tau_e: row(t.tau_e, k),
-            };
-            let cmd = match t.setpoint {
-                Some([x, dx, ddx]) => {
-                    let c = Setpoint {
-                        x: row(x, k),
-                        dx: row(dx, k),
-                        ddx: row(ddx, k),
-                    };
-                    self.step_with(&m, &c)
-                }
-                None => Tracker::step(self, &m),
-            }
-            .map_err(|e| RunError::Core(e, Some(k as u64)))?;
-            out.extend_from_slice(cmd.tau_sat.as_slice());
-        }
-        // The last row reported too (a progress bar ends at 100 %).
-        if rows > 0 && !hooks.report(rows as u64, rows as u64, &*self) {
-            return Err(RunError::Stopped);
-        }
-        Ok(())
-    }
-
-    fn simulate(
-        &mut self,
-        arm: &ArmSpec,
-        items: &Items,
-        weights: Option<&[f64]>,
-        fault: Option<&FaultSpec>,
-        every: u64,
-        hooks: &mut dyn Hooks,
-    ) -> Result<(Rows, Metrics), RunError> {
-        let preset = Preset::Paper;
-        let s =
-            scenario::<N>(preset, self.law(), items).map_err(|e| RunError::Core(e.error, None))?;
-        match arm {
-            ArmSpec::Paper(two) => {
-                let typed = self
-                    .as_any_mut()
-                    .downcast_mut::<Typed<2>>()
-                    .ok_or(RunError::Core(
-                        Error::Invalid {
-                            what: "arm",
-                            reason: "TwoLinkArm has 2 joints: the controller has another number",
-                        },
-                        None,
-                    ))?;
-                let s2 = scenario::<2>(preset, typed.law(), items)
-                    .map_err(|e| RunError::Core(e.error, None))?;
-                run_arm(typed, two, &s2, weights, fault, every, hooks)
-            }
-            ArmSpec::Planar { links, g } => {
-                let links: [Link; N] = links.as_slice().try_into().map_err(|_| {
-                    RunError::Core(
-                        Error::Invalid {
-                            what: "arm",
-                            reason: "the arm and the controller have different numbers of joints",
-                        },
-                        None,
-                    )
-                })?;
-                let arm = PlanarArm::new(links, *g)?;
-                run_arm(self, &arm, &s, weights, fault, every, hooks)
-            }
-        }
-    }
-
-    fn simulate_mujoco(
-        &mut self,
-        sim: &mut Sim,
-        spec: &MujocoSpec,
-        run: &MujocoRun<'_>,
-        hooks: &mut dyn Hooks,
-    ) -> Result<(Rows, Metrics), RunError> {
-        run_mujoco(self, sim, spec, run, hooks)
-    }
-
-    fn as_any_mut(&mut self) -> &mut dyn Any {
-        self
-    }
-}
-
-/// The copy of a joint controller as the bindings keep it.
-impl<const N: usize> View for Typed<N> {
-    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
-        (part == TypeId::of::<Box<dyn DynTracker>>())
-            .then(|| Box::new(Box::new(self.clone()) as Box<dyn DynTracker>) as Box<dyn Any + Send>)
-    }
+    Ok((rec, metrics_out(&metrics)?))
 }

@@ -4,13 +4,10 @@
 //! (nothing here knows Python).
 
 use adaptimp::control::config::Law;
-use adaptimp::control::tracker::Tracker;
 use adaptimp::error::Error;
-use adaptimp::networks::rbf::AnyBasis;
 use adaptimp::schema::{Preset, Scenario, Value};
 use adaptimp::sim::inject::{Injected, Injection};
 use adaptimp::sim::model::{Link, TwoLinkArm};
-use adaptimp::trajectory::Sinusoid;
 use adaptimp::types::Vector;
 use std::vec::Vec;
 
@@ -185,7 +182,3 @@ pub(crate) fn injection<const N: usize>(
         duration: f.duration,
     })
 }
-
-/// The typed controller behind a [`DynTracker`] of N joints (the Cartesian
-/// bindings step it directly, `bindings/python/src/cartesian.rs`).
-pub(crate) type Typed<const N: usize> = Tracker<N, AnyBasis<N>, Sinusoid<N>>;

@@ -8,9 +8,10 @@
 //! pure Python in `python/adaptimp/`; it hands this module complete parameter
 //! dicts whose keys are the schema's names (`Ts`, `Kp`, `Kzeta`, …).
 //!
-//! - The controller of n joints is a `dynamic::DynTracker` (one
-//!   monomorphised core per n behind one object-safe face), the arms are
-//!   the core's run-time `adaptimp::dynamic::ModelArm`s.
+//! - The controller of n joints is the core's run-time
+//!   `adaptimp::dynamic::Controller` and `State` (`dynamic::JointCore`),
+//!   built by the core's one builder (`adaptimp::dynamic::Scenario`), as
+//!   C's is; the arms are the core's run-time `adaptimp::dynamic::ModelArm`s.
 //! - Errors become the exception classes of `adaptimp._errors` in one place
 //!   each: `config_error` (construction: `ConfigError`) and `step_error`
 //!   (a step: `MeasurementError`, `DivergedError`, `FaultError`), with the
@@ -39,8 +40,8 @@
 //! `cartesian_loop`, `callback`, `callback_loop`): the MuJoCo plant is the
 //! core's run-time `adaptimp::dynamic::Plant`, the rows and metrics the
 //! core's `adaptimp::dynamic::{Rows, Metrics, RowMetrics}`. The joint count
-//! is dispatched by the core's `with_joints!` (src/dynamic.rs) for every
-//! front.
+//! is dispatched by the core's `for_joints` (src/dynamic/mod.rs) for every
+//! typed loop.
 
 mod arrays;
 mod callback;

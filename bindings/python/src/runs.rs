@@ -1,6 +1,6 @@
 //! `simulate`, `metrics`, `simulate_mujoco`: one closed run, with the GIL released, and its SPEC §12 metrics.
 
-use super::dynamic::{ArmSpec, DynTracker};
+use super::dynamic::{ArmSpec, JointCore};
 use super::{arrays::*, controller::*, errors::*, hooks::*, models::*, params::*};
 use super::{dynamic, mujoco};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -58,10 +58,10 @@ pub(super) fn simulate<'py>(
     };
     let mut hooks = PyHooks::holding(progress, vec![ctrl.slot()]);
     let mut guard = ctrl.lock(py)?;
-    let tracker: &mut dyn DynTracker = &mut **guard;
+    let core: &mut JointCore = &mut guard;
     let result = py.detach(|| {
         let w = weights.as_deref();
-        tracker.simulate(&spec, &items, w, fault.as_ref(), record_every, &mut hooks)
+        core.simulate(&spec, &items, w, fault.as_ref(), record_every, &mut hooks)
     });
     drop(guard);
     let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;
@@ -300,8 +300,8 @@ pub(super) fn simulate_mujoco<'py>(
     };
     let mut hooks = PyHooks::holding(progress, vec![ctrl.slot()]);
     let mut guard = ctrl.lock(py)?;
-    let tracker: &mut dyn DynTracker = &mut **guard;
-    let result = py.detach(|| tracker.simulate_mujoco(&mut sim, &spec, &run, &mut hooks));
+    let core: &mut JointCore = &mut guard;
+    let result = py.detach(|| core.simulate_mujoco(&mut sim, &spec, &run, &mut hooks));
     drop(guard);
     drop(sim);
     let (rec, metrics) = result.map_err(|e| run_error(e, &mut hooks))?;

@@ -44,11 +44,10 @@ pub(super) fn run_job(
     stop: &std::sync::atomic::AtomicBool,
 ) -> Result<dynamic::Metrics, String> {
     let job = job.as_ref().map_err(Clone::clone)?;
-    let mut tracker =
+    let mut core =
         dynamic::build(2, Preset::Paper, job.law, &job.items, None, None).map_err(param_message)?;
     let mut hooks = StopHooks(stop);
-    tracker
-        .simulate(&job.arm, &job.items, None, None, u64::MAX, &mut hooks)
+    core.simulate(&job.arm, &job.items, None, None, u64::MAX, &mut hooks)
         .map(|(_, m)| m)
         .map_err(run_message)
 }

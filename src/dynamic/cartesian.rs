@@ -199,6 +199,14 @@ impl CartesianImpedance {
         each!(&self.inner, o, N => o.period())
     }
 
+    /// The const-generic outer loop, if made for N joints: for a caller
+    /// generic over N (a typed loop, [`for_joints`](super::for_joints)).
+    pub fn typed<const N: usize>(
+        &self,
+    ) -> Option<&cartesian::CartesianImpedance<N, cartesian::Chain<N>>> {
+        each!(&self.inner, o, M => (&**o as &dyn core::any::Any).downcast_ref())
+    }
+
     /// Whether the orientation is a task (Kd_rot > 0).
     pub fn orients(&self) -> bool {
         each!(&self.inner, o, N => o.orients())
@@ -378,6 +386,17 @@ impl CartesianState {
     /// The number of joints n.
     pub fn n(&self) -> usize {
         self.inner.n()
+    }
+
+    /// The const-generic state, if made for N joints: for a caller generic
+    /// over N (a typed loop, [`for_joints`](super::for_joints)).
+    pub fn typed<const N: usize>(&self) -> Option<&cartesian::CartesianState<N>> {
+        each!(&self.inner, s, M => (s as &dyn core::any::Any).downcast_ref())
+    }
+
+    /// [`typed`](Self::typed), to change.
+    pub fn typed_mut<const N: usize>(&mut self) -> Option<&mut cartesian::CartesianState<N>> {
+        each!(&mut self.inner, s, M => (s as &mut dyn core::any::Any).downcast_mut())
     }
 
     /// Steps taken k.

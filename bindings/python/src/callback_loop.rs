@@ -294,11 +294,31 @@ pub fn simulate(
     run: &CallbackRun<'_>,
     hooks: &mut dyn Hooks,
 ) -> RunOut {
-    adaptimp::with_joints!(
-        n,
-        K => run_n::<K>(ctrl, sim, spec, run, hooks),
-        _ => invalid("n", "the number of joints must be between 1 and 7").into(),
-    )
+    let on = OnJoints {
+        ctrl,
+        sim,
+        spec,
+        run,
+        hooks,
+    };
+    adaptimp::dynamic::for_joints(n, on)
+        .unwrap_or_else(|| invalid("n", "the number of joints must be between 1 and 7").into())
+}
+
+/// [`simulate`] for N joints.
+struct OnJoints<'a, 'b> {
+    ctrl: &'a Py<PyAny>,
+    sim: &'a mut Sim,
+    spec: &'a MujocoSpec,
+    run: &'a CallbackRun<'b>,
+    hooks: &'a mut dyn Hooks,
+}
+
+impl adaptimp::dynamic::ForJoints for OnJoints<'_, '_> {
+    type Output = RunOut;
+    fn call<const N: usize>(self) -> RunOut {
+        run_n::<N>(self.ctrl, self.sim, self.spec, self.run, self.hooks)
+    }
 }
 
 /// Close the loop of `controller`, a controller written in Python (the

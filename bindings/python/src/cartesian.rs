@@ -84,18 +84,18 @@ fn lock_joint<'a>(
 /// written in Python (`step_python`). Use `adaptimp.CartesianController`.
 #[pyclass(name = "CartesianImpedance", module = "adaptimp._adaptimp", frozen)]
 pub struct PyCartesian {
-    inner: Shared<dyn DynOuter>,
+    inner: Shared<OuterCore>,
     n: usize,
 }
 
 impl PyCartesian {
     /// The outer loop for a call that may change it ([`Shared::write`]).
-    fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, dyn DynOuter>> {
+    fn lock(&self, py: Python<'_>) -> PyResult<Write<'_, OuterCore>> {
         self.inner.write(py)
     }
 
     /// The outer loop to read ([`Shared::read`]).
-    fn read(&self, py: Python<'_>) -> PyResult<Read<'_, dyn DynOuter>> {
+    fn read(&self, py: Python<'_>) -> PyResult<Read<'_, OuterCore>> {
         self.inner.read(py)
     }
 
@@ -142,12 +142,16 @@ impl PyCartesian {
             .cartesian;
         let q0 = vector("q0", n, q0)?;
         let posture = posture.map(|p| vector("posture", n, p)).transpose()?;
-        let inner = chain
-            .typed
-            .outer(cfg, ts, &q0[..n], posture.as_ref().map(|p| &p[..n]))
-            .map_err(|e| ConfigError::new_err(e.to_string()))?;
+        let inner = OuterCore::new(
+            &chain.inner,
+            cfg,
+            ts,
+            &q0[..n],
+            posture.as_ref().map(|p| &p[..n]),
+        )
+        .map_err(|e| ConfigError::new_err(e.to_string()))?;
         Ok(Self {
-            inner: Shared::new(inner, "CartesianController"),
+            inner: Shared::new(Box::new(inner), "CartesianController"),
             n,
         })
     }
@@ -536,7 +540,7 @@ impl PyCartesian {
         let mut outer = self.lock(py)?;
         let mut partial = None;
         let result = {
-            let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
+            let (t, o): (JointRef<'_>, &mut OuterCore) = (joint.joint(), &mut outer);
             py.detach(|| o.simulate_mujoco(t, &mut sim, &spec, &run, &mut hooks, &mut partial))
         };
         drop(outer);
@@ -603,7 +607,7 @@ impl PyCartesian {
         let mut hooks = super::PyHooks::holding(progress, vec![&self.inner, joint.slot()]);
         let mut outer = self.lock(py)?;
         let result = {
-            let (t, o): (JointRef<'_>, &mut dyn DynOuter) = (joint.joint(), &mut **outer);
+            let (t, o): (JointRef<'_>, &mut OuterCore) = (joint.joint(), &mut outer);
             py.detach(|| {
                 o.replay(
                     t,

@@ -3,7 +3,6 @@
 //! rule, the core's `dynamic::Centres::along`).
 
 use super::cartesian_args::*;
-use super::cartesian_outer::*;
 use super::dynamic::MAX_JOINTS;
 use super::frames::{joint, transform};
 use super::MeasurementError;
@@ -27,7 +26,6 @@ use std::vec::Vec;
 #[pyclass(name = "Chain", module = "adaptimp._adaptimp", frozen, subclass)]
 pub struct PyChain {
     pub(super) inner: adaptimp::dynamic::Chain,
-    pub(super) typed: Box<dyn DynChain>,
 }
 
 impl PyChain {
@@ -58,8 +56,7 @@ impl PyChain {
         };
         let err = |e: Error| ConfigError::new_err(e.to_string());
         let inner = adaptimp::dynamic::Chain::new(&js, &tip).map_err(err)?;
-        let typed = chain(&js, &tip).map_err(err)?;
-        Ok(Self { inner, typed })
+        Ok(Self { inner })
     }
 
     /// Movable joints n.

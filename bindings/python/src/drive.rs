@@ -42,7 +42,7 @@ pub trait Hooks {
 pub trait View {
     /// A copy of the part of the run's state that a binding keeps as the
     /// type `part` (the `TypeId` of a `Box<JointCore>`, of a
-    /// `Box<dyn DynOuter>`, …), boxed as `Any`; None if the run has no such
+    /// `Box<OuterCore>`, …), boxed as `Any`; None if the run has no such
     /// part.
     fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>>;
 }

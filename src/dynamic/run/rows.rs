@@ -478,6 +478,21 @@ pub struct TaskStep {
 }
 
 impl TaskStep {
+    /// The step of `command`, given the commanded pose `target` (none: the
+    /// held target, p_c = p_t at rest) and the wrench F_e: as
+    /// [`TypedTaskStep::new`], at run time.
+    pub fn new(command: CartesianCommand, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Self {
+        let commanded = match target {
+            Some(t) => [t.p, t.dp, t.ddp],
+            None => [command.target.0, Vector::zeros(), Vector::zeros()],
+        };
+        Self {
+            command,
+            commanded,
+            wrench,
+        }
+    }
+
     /// z1 = p_d − p(q) (m).
     pub fn z1(&self) -> Vector<3> {
         self.command.compliant.p - self.command.p

@@ -27,9 +27,9 @@ mod adaptimp_module {
     #[pymodule_export]
     use crate::cartesian::{centres_along, PyCartesian, PyChain};
     #[pymodule_export]
-    use crate::chain::operational_inertia;
-    #[pymodule_export]
     use crate::cartesian_step::PyCartesianStep;
+    #[pymodule_export]
+    use crate::chain::operational_inertia;
     #[pymodule_export]
     use crate::computed::PyComputedTorque;
     #[pymodule_export]

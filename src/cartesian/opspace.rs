@@ -43,9 +43,9 @@ const NOT_SPD: Error = Error::Invalid {
 /// not move at all is zero.
 ///
 /// Errors: a non-finite entry of `j` or `d` ([`Error::NonFinite`], `index`
-/// column-major), `d` not symmetric or not positive definite, or
-/// J D⁻¹ Jᵀ beyond f64 (`d` too near singular) ([`Error::Invalid`], named
-/// `inertia`).
+/// column-major); `d` not symmetric or not positive definite
+/// ([`Error::Invalid`] named `inertia`); J D⁻¹ Jᵀ or Λ beyond f64
+/// ([`Error::Invalid`] named `J D⁻¹ Jᵀ` or `Λ`): never a NaN or an infinity.
 pub fn operational_inertia<const N: usize>(
     j: &Jacobian6<N>,
     d: &Matrix<N>,
@@ -68,17 +68,26 @@ pub fn operational_inertia<const N: usize>(
     let a = x.transpose() * x;
     if a.iter().any(|v| !v.is_finite()) {
         return Err(Error::Invalid {
-            what: "inertia",
-            reason: "J D⁻¹ Jᵀ is beyond f64: D is too near singular",
+            what: "J D⁻¹ Jᵀ",
+            reason: "beyond f64 (a jacobian too large, or an inertia too near singular)",
         });
     }
-    if !uncoupled {
-        return pinv(a);
-    }
-    let mut lam = Matrix::<6>::zeros();
-    for k in [0, 3] {
-        let block = pinv(a.fixed_view::<3, 3>(k, k).into_owned())?;
-        lam.fixed_view_mut::<3, 3>(k, k).copy_from(&block);
+    let lam = if uncoupled {
+        let mut lam = Matrix::<6>::zeros();
+        for k in [0, 3] {
+            let block = pinv(a.fixed_view::<3, 3>(k, k).into_owned())?;
+            lam.fixed_view_mut::<3, 3>(k, k).copy_from(&block);
+        }
+        lam
+    } else {
+        pinv(a)?
+    };
+    if lam.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Invalid {
+            what: "Λ",
+            reason: "beyond f64 (J D⁻¹ Jᵀ too near zero: a jacobian near 0, or an inertia \
+                     too large)",
+        });
     }
     Ok(lam)
 }

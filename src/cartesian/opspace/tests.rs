@@ -95,7 +95,18 @@ fn the_refusals_name_the_input() {
     let e = operational_inertia(&j, &tiny, true).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "inertia: J D⁻¹ Jᵀ is beyond f64: D is too near singular"
+        "J D⁻¹ Jᵀ: beyond f64 (a jacobian too large, or an inertia too near singular)"
+    );
+    let mut huge = j;
+    huge[(0, 0)] = 1e300;
+    let e = operational_inertia(&huge, &d, false).unwrap_err();
+    assert!(e.to_string().starts_with("J D⁻¹ Jᵀ: beyond f64"), "{e}");
+    // Λ = 1/(J D⁻¹ Jᵀ) beyond f64: a one-joint arm that barely moves its tip.
+    let jt = Jacobian6::<1>::from_column_slice(&[1e-160, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    let e = operational_inertia(&jt, &Matrix::<1>::new(1.0), true).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "Λ: beyond f64 (J D⁻¹ Jᵀ too near zero: a jacobian near 0, or an inertia too large)"
     );
 }
 

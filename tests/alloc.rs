@@ -435,6 +435,17 @@ fn no_heap_allocation_in_the_run_time_api() {
         }
     });
     assert_eq!(n, 0, "run-time computed torque or dynamics allocated");
+    // OSC_POSE's Λ (SPEC (23.7)) on the chain's Jacobian and the model's D.
+    let mut jr = [0.0; 6 * N];
+    chain.jacobian_rows(&q, &mut jr).expect("J");
+    let d = model.mass_matrix(&q).expect("D");
+    let dr: [f64; N * N] = std::array::from_fn(|k| d[(k / N, k % N)]);
+    let (n, ()) = allocations_in(|| {
+        for uncoupled in [true, false] {
+            dy::operational_inertia(&jr, &dr, uncoupled).expect("Λ");
+        }
+    });
+    assert_eq!(n, 0, "the operational inertia allocated");
     // The closed loop: a planar arm of three links, its rows sized before.
     let mut s = dy::Scenario::new(3, Preset::Paper, Law::StateFeedback).expect("n");
     s.set("q0", Value::Vec(&[0.1, 0.2, 0.3])).expect("q0");

@@ -725,6 +725,25 @@ enum AdaptimpStatus adaptimp_chain_tip(const struct AdaptimpChain *chain,
 // `out` is NULL or points to an `AdaptimpCartesianParams`.
 enum AdaptimpStatus adaptimp_cartesian_params_default(struct AdaptimpCartesianParams *out);
 
+// The operational-space inertia Λ of robosuite's OSC_POSE, SPEC (23.7), the
+// core's `dynamic::operational_inertia`: `jacobian` the tip's 6 × n
+// geometric Jacobian [J_v; J_ω] (6 n reals, row-major, world-aligned),
+// `inertia` the joint-space inertia D (n² reals, row-major, kg m²),
+// `uncoupled` OSC_POSE's `uncouple_pos_ori` (Λ block-diagonal). Writes Λ
+// (36 reals, row-major, symmetric; kg, kg m², kg m across) to `out`.
+// BAD_SIZE for n outside 1 … 7; INVALID_CONFIG, with the core's message,
+// for a non-finite entry or D not symmetric or not positive definite
+// (`out` then untouched).
+//
+// # Safety
+// `jacobian` is NULL or holds 6 n reals, `inertia` n², `out` 36 writable
+// reals that nothing else accesses during the call.
+enum AdaptimpStatus adaptimp_operational_inertia(size_t n,
+                                                 const double *jacobian,
+                                                 const double *inertia,
+                                                 bool uncoupled,
+                                                 double *out);
+
 // The 6-D Cartesian impedance of `cart` over `chain` (copied), driving the
 // joint controller of `joint` (its `n` the chain's, `impedance` =
 // `ADAPTIMP_IMPEDANCE_EXTERNAL`: the Cartesian impedance is the only one),

@@ -758,6 +758,46 @@ static void chains(void) {
         const double want = b % 4 == 3 ? 1.0 : 0.0;
         outcome(what, fabs(BAD[b] - want) <= 1e-6 ? ACCEPT : REFUSE, s, 1);
     }
+    /* The operational-space inertia (SPEC (23.7)) of a planar two-link arm:
+       each entry of J (6 × 2) and D (2 × 2) bad in turn; a result is finite,
+       a refusal leaves `out` as it was. */
+    for (int e = 0; e < 16; e++) {
+        for (int b = 0; b < NBAD; b++) {
+            double jac[12] = {-1, -1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1}, inertia[4] = {2, 0, 0, 1};
+            double *field = e < 12 ? &jac[e] : &inertia[e - 12];
+            *field = BAD[b];
+            double out[36];
+            for (int i = 0; i < 36; i++) out[i] = 7.0;
+            for (int coupled = 0; coupled < 2; coupled++) {
+                AdaptimpStatus s = adaptimp_operational_inertia(2, jac, inertia, !coupled, out);
+                int untouched = 1;
+                for (int i = 0; i < 36; i++) untouched = untouched && out[i] == 7.0;
+                const int ok = s == ADAPTIMP_STATUS_OK ? finite_all(out, 36) : untouched;
+                snprintf(what, sizeof what, "operational inertia, %s[%d] = %g%s",
+                         e < 12 ? "jacobian" : "inertia", e < 12 ? e : e - 12, BAD[b],
+                         coupled ? ", coupled" : "");
+                outcome(what, isfinite(BAD[b]) ? EITHER : REFUSE, s, ok);
+                for (int i = 0; i < 36; i++) out[i] = 7.0;
+            }
+        }
+    }
+    /* Its numbers of joints and NULL pointers. */
+    static const double jac9[6 * 9] = {1, 1, 1, 1, 1, 1, 1, 1, 1};
+    double out[36], eye[9 * 9];
+    for (size_t n = 0; n < 10; n++) {
+        for (size_t i = 0; i < n * n; i++) eye[i] = i % (n + 1) == 0; /* I_n, row-major */
+        AdaptimpStatus s = adaptimp_operational_inertia(n, jac9, eye, 1, out);
+        snprintf(what, sizeof what, "operational inertia, n = %zu", n);
+        outcome(what, n >= 1 && n <= 7 ? EITHER : REFUSE, s,
+                s == ADAPTIMP_STATUS_OK ? finite_all(out, 36) : s == ADAPTIMP_STATUS_BAD_SIZE);
+    }
+    const double eye2[4] = {1, 0, 0, 1};
+    outcome("operational inertia, jacobian NULL", REFUSE,
+            adaptimp_operational_inertia(2, NULL, eye2, 1, out), 1);
+    outcome("operational inertia, inertia NULL", REFUSE,
+            adaptimp_operational_inertia(2, jac9, NULL, 1, out), 1);
+    outcome("operational inertia, out NULL", REFUSE,
+            adaptimp_operational_inertia(2, jac9, eye2, 1, NULL), 1);
 }
 
 typedef struct {

@@ -927,3 +927,67 @@ fn a_urdf_arm_of_eight_joints_is_refused_by_name_and_read_with_one_held() {
         adaptimp_chain_free(chain);
     }
 }
+
+/// SPEC (23.7) through the C ABI: the core's Λ bit for bit, row-major; the
+/// refusals are statuses naming the input, `out` untouched.
+#[test]
+fn the_operational_inertia_is_the_cores_and_refuses_by_name() {
+    // A planar arm of two unit links at (0, π/2), D = diag(2, 1) kg m².
+    let j = [
+        -1.0, -1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, //
+    ];
+    let d = [2.0, 0.0, 0.0, 1.0];
+    let call = |n: usize, j: *const f64, d: *const f64, out: *mut f64| {
+        // SAFETY: the pointers are NULL or hold what `n` asks for.
+        unsafe { adaptimp_operational_inertia(n, j, d, false, out) }
+    };
+    let mut out = [7.0; 36];
+    assert_eq!(
+        call(2, j.as_ptr(), d.as_ptr(), out.as_mut_ptr()),
+        AdaptimpStatus::Ok
+    );
+    let core = adaptimp::dynamic::operational_inertia(&j, &d, false).unwrap();
+    assert_eq!(out, core);
+    assert!(
+        (out[7] - 3.0).abs() < 1e-14,
+        "Λ_yy = {} (hand-computed: 3)",
+        out[7]
+    );
+    let mut out = [7.0; 36];
+    assert_eq!(
+        call(0, j.as_ptr(), d.as_ptr(), out.as_mut_ptr()),
+        AdaptimpStatus::BadSize
+    );
+    assert_eq!(last_error(), "n = 0: the number of joints must be 1 … 7");
+    assert_eq!(
+        call(2, ptr::null(), d.as_ptr(), out.as_mut_ptr()),
+        AdaptimpStatus::NullPointer
+    );
+    assert!(last_error().contains("jacobian"), "{}", last_error());
+    assert_eq!(
+        call(2, j.as_ptr(), ptr::null(), out.as_mut_ptr()),
+        AdaptimpStatus::NullPointer
+    );
+    assert!(last_error().contains("inertia"), "{}", last_error());
+    assert_eq!(
+        call(2, j.as_ptr(), d.as_ptr(), ptr::null_mut()),
+        AdaptimpStatus::NullPointer
+    );
+    assert!(last_error().contains("out"), "{}", last_error());
+    let skew = [2.0, 0.5, 0.0, 1.0];
+    assert_eq!(
+        call(2, j.as_ptr(), skew.as_ptr(), out.as_mut_ptr()),
+        AdaptimpStatus::InvalidConfig
+    );
+    assert_eq!(
+        last_error(),
+        "inertia: must be symmetric (D_ij = D_ji to 1e-12 relative)"
+    );
+    let nan = [2.0, 0.0, 0.0, f64::NAN];
+    assert_eq!(
+        call(2, j.as_ptr(), nan.as_ptr(), out.as_mut_ptr()),
+        AdaptimpStatus::InvalidConfig
+    );
+    assert_eq!(last_error(), "inertia[3] is not finite (NaN or infinite)");
+    assert_eq!(out, [7.0; 36]);
+}

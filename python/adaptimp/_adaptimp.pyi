@@ -33,6 +33,7 @@ __all__ = [
     "description_kind",
     "estimate_effort",
     "metrics",
+    "operational_inertia",
     "plane_normal",
     "pose_circle",
     "pose_metrics",
@@ -604,6 +605,14 @@ def estimate_effort(
     """Effort limits (N m per joint) where a description states none: 2 (max |G_i| +
     10 rad/s² · max Σ_j |D_ij| + b_i · 1 rad/s + F_i) over the sampled postures
     (``gravity`` (K, n), ``inertia`` (K, n, n))."""
+
+def operational_inertia(
+    jacobian: NDArray[np.float64], inertia: NDArray[np.float64], uncoupled: bool = True
+) -> NDArray[np.float64]:
+    """The operational-space inertia Λ (6, 6) of robosuite's OSC_POSE (SPEC (23.7)):
+    kg on the translation rows, kg m² on the rotation rows, kg m across;
+    ``jacobian`` [J_v; J_ω] (6, n), ``inertia`` D (n, n; kg m²), ``uncoupled``
+    OSC's ``uncouple_pos_ori`` (Λ block-diagonal)."""
 
 @disjoint_base
 class Chain:

@@ -82,7 +82,7 @@ try:
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise needs_extra("adaptimp.robosuite", "robosuite>=1.5", "robosuite") from e
 
-from . import tuning
+from . import _adaptimp, tuning
 from ._adaptimp import Measurement
 from ._cartesian_task import CirclePath
 from ._description import read_arm
@@ -176,12 +176,13 @@ def osc_stiffness(
     (kg m², (n, n)) and the grip site's geometric Jacobian [J_v; J_ω] (6, n):
     Λ_v = (J_v D⁻¹ J_vᵀ)⁻¹ and Λ_ω = (J_ω D⁻¹ J_ωᵀ)⁻¹ when ``uncoupled`` (OSC's
     ``uncouple_pos_ori``, its default), Λ = (J D⁻¹ Jᵀ)⁻¹ otherwise; ``kp``
-    OSC's stiffness gains (1/s², a number or 6)."""
+    OSC's stiffness gains (1/s², a number or 6). The inverses are
+    pseudo-inverses as robosuite's ``opspace_matrices`` takes them, in the
+    core (SPEC (23.7)); a D that is not finite, symmetric and positive
+    definite raises ConfigError."""
     J = np.asarray(jacobian, dtype=np.float64)
-    Dinv = np.linalg.inv(np.asarray(inertia, dtype=np.float64))
-    # pinv as robosuite's opspace_matrices takes it (small singular values zeroed).
-    blocks = (J[:3], J[3:]) if uncoupled else (J,)
-    lam = np.concatenate([np.diag(np.linalg.pinv(j @ Dinv @ j.T)) for j in blocks])
+    D = np.asarray(inertia, dtype=np.float64)
+    lam = np.diag(_adaptimp.operational_inertia(J, D, uncoupled))
     gains = np.broadcast_to(np.asarray(kp, dtype=np.float64), (6,))
     return np.asarray(lam * gains, dtype=np.float64)
 

@@ -7,6 +7,7 @@ pub mod computed;
 pub mod dynamics;
 pub mod impedance_torque;
 pub mod kinematics;
+pub mod opspace;
 mod outer;
 mod pair;
 pub mod rotation;

@@ -16,6 +16,7 @@
 //! | [`Chain`], [`Dynamics`] | [`Chain`](crate::Chain), [`Dynamics`](crate::Dynamics) | kinematics and rigid-body dynamics, from joint data or an [`Arm`](crate::description::Arm) read from a URDF or an MJCF |
 //! | [`ComputedTorque`], [`ComputedState`] | [`ComputedTorque`](crate::ComputedTorque) | the model-based baseline (SPEC §20) |
 //! | [`CartesianImpedance`], [`CartesianController`] | [`CartesianImpedance`](crate::CartesianImpedance), [`CartesianController`](crate::CartesianController) | the 6-D outer loop, alone or with the joint controller it drives (SPEC §16) |
+//! | [`operational_inertia`] | [`operational_inertia`](crate::cartesian::opspace::operational_inertia) | the operational-space inertia Λ of robosuite's OSC_POSE, SPEC (23.7) |
 //! | [`pose_target`], [`HeldRotation`] | [`PoseTarget`](crate::PoseTarget) | a commanded pose from its flat layout, and the rotation a target without one keeps |
 //! | [`simulate`], [`simulate_cartesian`], [`Plant`] (feature `sim`) | [`simulate_disturbed`](crate::sim::simulator::simulate_disturbed), [`Plant`](crate::Plant) | the closed loop over a plant of n joints, its rows and SPEC §12 metrics |
 //! | [`Replay`], [`RowMetrics`] (feature `sim`) | a loop of [`Controller::step`](crate::Controller::step), [`MetricsAccumulator`](crate::sim::metrics::MetricsAccumulator) | the controller along recorded rows; the metrics of rows given one at a time |
@@ -404,6 +405,7 @@ mod controller;
 mod effort;
 #[cfg(feature = "alloc")]
 mod model;
+mod opspace;
 #[cfg(all(feature = "alloc", feature = "sim"))]
 mod run;
 #[cfg(feature = "alloc")]
@@ -428,6 +430,7 @@ pub use model::{
     Chain, ComputedState, ComputedTorque, ComputedTorqueConfig, Drive, Dynamics, Jacobian,
     JointMatrix, SampledDrive, Spring, Tip,
 };
+pub use opspace::operational_inertia;
 #[cfg(all(feature = "alloc", feature = "sim"))]
 pub use run::{
     cartesian_steps, drive_cartesian, metrics_of, reads_the_wrench, run, simulate,

@@ -210,3 +210,36 @@ pub fn centres_along<'py>(
     let (c, w) = (c.rows, c.widths2.unwrap_or_default());
     Ok((array(py, c, (l, 4 * n))?, array1(py, &w)))
 }
+
+/// The operational-space inertia Λ (6, 6) of robosuite's OSC_POSE, SPEC
+/// (23.7), the core's `dynamic::operational_inertia`: kg on the translation
+/// rows, kg m² on the rotation rows, kg m across; `jacobian` the tip's
+/// geometric Jacobian [J_v; J_ω] (6, n), `inertia` the joint-space inertia D
+/// (n, n; kg m²), `uncoupled` OSC's `uncouple_pos_ori` (Λ block-diagonal).
+#[pyfunction]
+#[pyo3(signature = (jacobian, inertia, uncoupled=true))]
+pub fn operational_inertia<'py>(
+    py: Python<'py>,
+    jacobian: PyReadonlyArray2<'py, f64>,
+    inertia: PyReadonlyArray2<'py, f64>,
+    uncoupled: bool,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = jacobian.shape()[1];
+    if jacobian.shape()[0] != 6 {
+        return Err(ConfigError::new_err(format!(
+            "jacobian must have shape (6, n), got {}",
+            python_shape(jacobian.shape())
+        )));
+    }
+    if inertia.shape() != [n, n] {
+        return Err(ConfigError::new_err(format!(
+            "inertia must have shape ({n}, {n}) (n: the jacobian's columns), got {}",
+            python_shape(inertia.shape())
+        )));
+    }
+    let j: Vec<f64> = jacobian.as_array().iter().copied().collect();
+    let d: Vec<f64> = inertia.as_array().iter().copied().collect();
+    let lam = adaptimp::dynamic::operational_inertia(&j, &d, uncoupled)
+        .map_err(|e| ConfigError::new_err(e.to_string()))?;
+    array(py, lam.to_vec(), (6, 6))
+}

@@ -29,6 +29,8 @@ mod adaptimp_module {
     #[pymodule_export]
     use crate::cartesian_step::PyCartesianStep;
     #[pymodule_export]
+    use crate::chain::operational_inertia;
+    #[pymodule_export]
     use crate::computed::PyComputedTorque;
     #[pymodule_export]
     use crate::description::{arm_from_mujoco, description_kind, estimate_effort, read_arm};

@@ -236,3 +236,39 @@ pub unsafe extern "C" fn adaptimp_cartesian_params_default(
         Ok(())
     })
 }
+
+/// The operational-space inertia Λ of robosuite's OSC_POSE, SPEC (23.7), the
+/// core's `dynamic::operational_inertia`: `jacobian` the tip's 6 × n
+/// geometric Jacobian [J_v; J_ω] (6 n reals, row-major, world-aligned),
+/// `inertia` the joint-space inertia D (n² reals, row-major, kg m²),
+/// `uncoupled` OSC_POSE's `uncouple_pos_ori` (Λ block-diagonal). Writes Λ
+/// (36 reals, row-major, symmetric; kg, kg m², kg m across) to `out`.
+/// BAD_SIZE for n outside 1 … 7; INVALID_CONFIG, with the core's message,
+/// for a non-finite entry or D not symmetric or not positive definite
+/// (`out` then untouched).
+///
+/// # Safety
+/// `jacobian` is NULL or holds 6 n reals, `inertia` n², `out` 36 writable
+/// reals that nothing else accesses during the call.
+#[no_mangle]
+pub unsafe extern "C" fn adaptimp_operational_inertia(
+    n: usize,
+    jacobian: *const f64,
+    inertia: *const f64,
+    uncoupled: bool,
+    out: *mut f64,
+) -> AdaptimpStatus {
+    guard(|| {
+        if !(1..=ADAPTIMP_MAX_JOINTS).contains(&n) {
+            return Err(crate::params::bad_n(n));
+        }
+        // SAFETY (in the helpers): checked for NULL; the caller's contract.
+        let j = unsafe { slice(jacobian, 6 * n, "jacobian") }?;
+        let d = unsafe { slice(inertia, n * n, "inertia") }?;
+        let out = unsafe { slice_mut(out, 36, "out") }?;
+        let lam = adaptimp::dynamic::operational_inertia(j, d, uncoupled)
+            .map_err(|e| core_error(e, Context::Config))?;
+        out.copy_from_slice(&lam);
+        Ok(())
+    })
+}

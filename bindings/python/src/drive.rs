@@ -273,10 +273,7 @@ where
             if spec.tau_max.len() != N {
                 return Err(RunError::Core(invalid_tau_max(), None));
             }
-            Some(injection::<N>(
-                f,
-                &Vector::from_column_slice(&spec.tau_max),
-            )?)
+            Some(injection::<N>(f, &spec.tau_max)?)
         }
         None => None,
     };

@@ -556,7 +556,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
 ) -> Result<(Rows, Metrics), RunError> {
     let cfg = &s.sim;
     let inj = fault
-        .map(|f| injection::<N>(f, &t.ctrl.config().tau_max))
+        .map(|f| injection::<N>(f, t.ctrl.config().tau_max.as_slice()))
         .transpose()?;
     let ts = t.ctrl.period();
     let total = adaptimp::sim::simulator::steps(cfg.t_final, ts)?;

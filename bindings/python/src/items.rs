@@ -4,11 +4,11 @@
 //! (nothing here knows Python).
 
 use adaptimp::control::config::Law;
+use adaptimp::dynamic as dy;
 use adaptimp::error::Error;
 use adaptimp::schema::{Preset, Scenario, Value};
-use adaptimp::sim::inject::{Injected, Injection};
+use adaptimp::sim::inject::Injection;
 use adaptimp::sim::model::{Link, TwoLinkArm};
-use adaptimp::types::Vector;
 use std::vec::Vec;
 
 /// A parameter value, owned (the schema's [`Value`] borrows).
@@ -138,47 +138,29 @@ pub enum FaultKind {
     Skipped,
 }
 
-/// The core's injection of `f`, with the actuators' limits `tau_max` (N m).
+/// The core's injection of `f` for N joints, with the actuators' limits
+/// `tau_max` (N m), checked by the core ([`dy::Injection::typed`]).
 pub(crate) fn injection<const N: usize>(
     f: &FaultSpec,
-    tau_max: &Vector<N>,
+    tau_max: &[f64],
 ) -> Result<Injection<N>, Error> {
-    adaptimp::error::check::nonnegative("fault start ≥ 0", "start", f.start)?;
-    adaptimp::error::check::positive("fault duration > 0", "duration", f.duration)?;
     let fault = match &f.kind {
-        FaultKind::Stale => Injected::Stale,
-        FaultKind::NanBurst => Injected::NanBurst,
-        FaultKind::Skipped => Injected::Skipped,
+        FaultKind::Stale => dy::Injected::Stale,
+        FaultKind::NanBurst => dy::Injected::NanBurst,
+        FaultKind::Skipped => dy::Injected::Skipped,
+        // More than 7 values: the core's refusal of a bias of another length.
         FaultKind::ForceBias(b) => {
-            if b.len() != N {
-                return Err(Error::Invalid {
-                    what: "bias",
-                    reason: "needs one value per joint (N m)",
-                });
-            }
-            adaptimp::error::check::finite_slice("bias", b)?;
-            Injected::ForceBias {
-                bias: Vector::from_column_slice(b),
-            }
+            dy::Injected::ForceBias(dy::Joints::from_slice(b).unwrap_or(dy::Joints::zeros(0)?))
         }
-        FaultKind::ActuatorDrop(fraction) => {
-            if !(0.0..=1.0).contains(fraction) {
-                return Err(Error::Condition {
-                    condition: "0 ≤ fraction ≤ 1",
-                    lhs: "fraction",
-                    index: None,
-                    value: *fraction,
-                });
-            }
-            Injected::ActuatorDrop {
-                tau_max: *tau_max,
-                fraction: *fraction,
-            }
-        }
+        FaultKind::ActuatorDrop(fraction) => dy::Injected::ActuatorDrop {
+            tau_max: dy::Joints::from_slice(tau_max)?,
+            fraction: *fraction,
+        },
     };
-    Ok(Injection {
+    dy::Injection {
         fault,
         start: f.start,
         duration: f.duration,
-    })
+    }
+    .typed::<N>()
 }

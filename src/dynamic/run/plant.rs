@@ -456,8 +456,9 @@ pub struct Injection {
 
 impl Injection {
     /// The core's injection of N joints, checked: the window, the bias
-    /// finite with one value per joint, 0 ≤ fraction ≤ 1.
-    pub(crate) fn typed<const N: usize>(&self) -> Result<inject::Injection<N>, Error> {
+    /// finite with one value per joint, 0 ≤ fraction ≤ 1, τmax of N values
+    /// (for a caller generic over N, a typed loop).
+    pub fn typed<const N: usize>(&self) -> Result<inject::Injection<N>, Error> {
         check::nonnegative("fault start ≥ 0", "start", self.start)?;
         check::positive("fault duration > 0", "duration", self.duration)?;
         let fault = match &self.fault {

@@ -400,3 +400,29 @@ def test_an_interrupted_native_cartesian_run_keeps_its_rows_in_the_log() -> None
     rows = ctrl.arrays()
     assert {len(v) for v in rows.values()} == {k}, {n: len(v) for n, v in rows.items()}
     np.testing.assert_array_equal(rows["qd"][-1], ctrl.q_d)
+
+
+def test_a_step_the_outer_loop_refuses_falls_back_on_its_own_measurement() -> None:
+    """A step the outer loop refuses before the joint step runs (a rotation
+    that is not one) is recorded with its measurement, as the core's and C's
+    Cartesian steps record it: the damping fallback is −Kd q̇ of that step's
+    q̇, for a single step and within a run (a replay) alike."""
+    dq = np.array([0.5, -0.4, 0.3])
+    bad = R0.copy()
+    bad[0, 0] += 0.21
+    alone = _ctrl(fallback="damping", fallback_damping=3.0)
+    _steps(alone, Q0, 3)
+    with pytest.raises(adaptimp.MeasurementError, match="orthonormal"):
+        alone.step(Measurement(Q0, dq, wrench=np.zeros(6)), xc=P0, R=bad)
+    np.testing.assert_array_equal(alone.inner.applied, -3.0 * dq)
+
+    run = _ctrl(fallback="damping", fallback_damping=3.0)
+    good = np.concatenate([P0, np.zeros(6), R0.ravel(), np.zeros(6)])
+    targets = np.tile(good, (4, 1))
+    targets[3, 9:18] = bad.ravel()
+    q = np.tile(Q0, (4, 1))
+    dqs = np.zeros((4, 3))
+    dqs[3] = dq
+    with pytest.raises(adaptimp.ConfigError, match=r"^row 3: condition RᵀR = I"):
+        run.outer.core.replay(run.inner, q, dqs, np.zeros((4, 6)), targets, None)
+    np.testing.assert_array_equal(run.inner.applied, -3.0 * dq)

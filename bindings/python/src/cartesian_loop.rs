@@ -79,8 +79,9 @@ pub(crate) trait JointStep<const N: usize>: View {
         r: &Setpoint<N>,
         t: &TaskTorque<N>,
     ) -> Result<Command<N>, Error>;
-    /// A step refused before it reached the controller, recorded.
-    fn refuse(&mut self, e: Error);
+    /// A step refused before it reached the controller (the outer loop's
+    /// refusal of measurement `m`), recorded as the core's pairs record it.
+    fn refuse(&mut self, m: &Measurement<N>, e: Error);
     /// The torque it applies now (N m): the last step's, or its fallback.
     fn applied(&self) -> Vector<N>;
 }
@@ -106,8 +107,8 @@ impl<const N: usize> JointStep<N> for AdaptiveStep<'_, N> {
     ) -> Result<Command<N>, Error> {
         AdaptiveStep::step_task(self, m, r, t)
     }
-    fn refuse(&mut self, e: Error) {
-        self.ctrl.refuse(self.state, e);
+    fn refuse(&mut self, m: &Measurement<N>, e: Error) {
+        self.ctrl.refuse_measured(self.state, m, e);
     }
     fn applied(&self) -> Vector<N> {
         *self.state.applied()
@@ -136,7 +137,7 @@ impl<const N: usize> JointStep<N> for ComputedStep<'_, N> {
     ) -> Result<Command<N>, Error> {
         self.ctrl.step_task(self.state, m, r, t)
     }
-    fn refuse(&mut self, e: Error) {
+    fn refuse(&mut self, _m: &Measurement<N>, e: Error) {
         self.ctrl.refuse(self.state, e);
     }
     fn applied(&self) -> Vector<N> {
@@ -146,8 +147,8 @@ impl<const N: usize> JointStep<N> for ComputedStep<'_, N> {
 
 /// A joint controller of the bindings as the core's Cartesian step drives
 /// it ([`JointLaw`], [`LoopJoint`]). A step the outer loop refuses before
-/// the joint step runs is recorded as the bindings' refused step
-/// ([`JointStep::refuse`]: without the measurement, as before).
+/// the joint step runs is recorded with its measurement
+/// ([`JointStep::refuse`]), as the core's run-time step records it.
 pub(crate) struct Joint<'a, J: ?Sized>(pub &'a mut J);
 
 impl<const N: usize, J: JointStep<N> + ?Sized> JointLaw<N> for Joint<'_, J> {
@@ -162,8 +163,8 @@ impl<const N: usize, J: JointStep<N> + ?Sized> JointLaw<N> for Joint<'_, J> {
     ) -> Result<Command<N>, Error> {
         self.0.step_task(m, r, task)
     }
-    fn refuse(&mut self, _m: &Measurement<N>, error: Error) {
-        self.0.refuse(error);
+    fn refuse(&mut self, m: &Measurement<N>, error: Error) {
+        self.0.refuse(m, error);
     }
 }
 

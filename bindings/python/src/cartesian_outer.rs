@@ -63,15 +63,15 @@ pub type JointFn<'a> = dyn FnMut(
     ) -> Result<(), Error>
     + 'a;
 
-/// The outer loop over a chain of any n ≤ 7 with its state, the start and
-/// posture it was given, its last step, the rotation a target without one
-/// keeps, and the rows `CartesianController.log` has not taken yet.
+/// The outer loop over a chain of any n ≤ 7 with its state (the null-space
+/// posture in it), the start it was given, its last step, the rotation a
+/// target without one keeps, and the rows `CartesianController.log` has not
+/// taken yet.
 #[derive(Clone, Debug)]
 pub struct OuterCore {
     outer: dy::CartesianImpedance,
     state: dy::CartesianState,
     q0: dy::Joints,
-    posture: dy::Joints,
     last: Option<TaskStep>,
     /// The commanded rotation a target without one keeps.
     held: HeldRotation,
@@ -92,13 +92,11 @@ impl OuterCore {
     ) -> Result<Self, Error> {
         let outer = dy::CartesianImpedance::new(cfg, chain, ts)?;
         let mut state = outer.start(q0)?;
-        let posture = dy::Joints::from_slice(posture.unwrap_or(q0))?;
-        outer.set_posture(&mut state, &posture)?;
+        outer.set_posture(&mut state, posture.unwrap_or(q0))?;
         Ok(Self {
             outer,
             state,
             q0: dy::Joints::from_slice(q0)?,
-            posture,
             last: None,
             held: HeldRotation::default(),
             log: Vec::new(),
@@ -170,10 +168,7 @@ impl OuterCore {
 
     /// The null-space posture (rad).
     pub fn set_posture(&mut self, posture: &[f64]) -> Result<(), Error> {
-        let p = dy::Joints::from_slice(posture)?;
-        self.outer.set_posture(&mut self.state, &p)?;
-        self.posture = p;
-        Ok(())
+        self.outer.set_posture(&mut self.state, posture)
     }
 
     /// The stiffness asked for (N/m, N m/rad).
@@ -383,9 +378,13 @@ impl OuterCore {
     /// step or a run calls reads meanwhile.
     pub fn view(&self) -> Box<OuterCore> {
         Box::new(Self {
+            outer: self.outer.clone(),
+            state: self.state.clone(),
+            q0: self.q0,
+            last: self.last,
+            held: self.held,
             log: Vec::new(),
             rows: 0,
-            ..self.clone()
         })
     }
 
@@ -421,7 +420,7 @@ fn run_typed<const N: usize, R>(
     joint: JointRef<'_>,
     run: impl FnOnce(OuterRun<'_, N>) -> Result<R, RunError>,
 ) -> Result<R, RunError> {
-    let mut joint = typed::<N>(joint, true)?;
+    let mut joint = typed::<N>(joint)?;
     let before = core.view();
     let copy = |part: TypeId, state: &CartesianState<N>, last: Option<&TypedTaskStep<N>>| {
         before.copy_as(part, state, last)
@@ -527,15 +526,12 @@ impl<const N: usize> TypedJoint<'_, N> {
     }
 }
 
-/// The typed joint controller of N joints behind `joint`; `run`: for a run,
-/// which publishes copies of it for the Python code it calls.
-pub(super) fn typed<const N: usize>(
-    joint: JointRef<'_>,
-    run: bool,
-) -> Result<TypedJoint<'_, N>, Error> {
+/// The typed joint controller of N joints behind `joint`, for a run (which
+/// publishes copies of it for the Python code it calls).
+pub(super) fn typed<const N: usize>(joint: JointRef<'_>) -> Result<TypedJoint<'_, N>, Error> {
     match joint {
-        JointRef::Adaptive(c) => AdaptiveStep::of(c, run).map(TypedJoint::Adaptive),
-        JointRef::Computed(c) => ComputedStep::of(c, run).map(TypedJoint::Computed),
+        JointRef::Adaptive(c) => AdaptiveStep::of(c).map(TypedJoint::Adaptive),
+        JointRef::Computed(c) => ComputedStep::of(c).map(TypedJoint::Computed),
     }
 }
 

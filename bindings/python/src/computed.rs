@@ -51,29 +51,24 @@ fn input_error(e: Error) -> pyo3::PyErr {
 }
 
 /// [`ComputedCore`] as its const-generic controller of N joints, with its
-/// state, for a typed loop; `copy_of`: the whole controller, whose copy with
-/// this state the Python code a run calls reads ([`View`]).
+/// state, for a typed loop; `whole`: the run-time controller, of which a run
+/// copies the controller at this state for the Python code it calls
+/// ([`View`]: made only when asked for).
 pub struct ComputedStep<'a, const N: usize> {
     /// The controller.
     pub ctrl: &'a ComputedTorque<N>,
     /// Its state.
     pub state: &'a mut ComputedState<N>,
-    copy_of: Option<Box<ComputedCore>>,
+    whole: &'a dy::ComputedTorque,
 }
 
 impl<'a, const N: usize> ComputedStep<'a, N> {
-    /// `core` for N joints (an error if it was made for another n); `run`:
-    /// for a run, which publishes copies of it (a step alone allocates
-    /// nothing).
-    pub fn of(core: &'a mut ComputedCore, run: bool) -> Result<Self, Error> {
-        let copy_of = run.then(|| Box::new(core.clone()));
-        let ctrl = core.ctrl.typed::<N>().ok_or(OTHER_N)?;
-        let state = core.state.typed_mut::<N>().ok_or(OTHER_N)?;
-        Ok(Self {
-            ctrl,
-            state,
-            copy_of,
-        })
+    /// `core` for N joints (an error if it was made for another n).
+    pub fn of(core: &'a mut ComputedCore) -> Result<Self, Error> {
+        let ComputedCore { ctrl: whole, state } = core;
+        let ctrl = whole.typed::<N>().ok_or(OTHER_N)?;
+        let state = state.typed_mut::<N>().ok_or(OTHER_N)?;
+        Ok(Self { ctrl, state, whole })
     }
 }
 
@@ -110,12 +105,15 @@ impl<const N: usize> Control<N> for ComputedStep<'_, N> {
 /// the state as it is now.
 impl<const N: usize> View for ComputedStep<'_, N> {
     fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
-        let base = self.copy_of.as_ref()?;
         (part == TypeId::of::<Box<ComputedCore>>()).then(|| {
-            let mut copy = (**base).clone();
-            if let Some(s) = copy.state.typed_mut::<N>() {
+            let mut state = self.whole.new_state();
+            if let Some(s) = state.typed_mut::<N>() {
                 *s = *self.state;
             }
+            let copy = ComputedCore {
+                ctrl: self.whole.clone(),
+                state,
+            };
             Box::new(Box::new(copy)) as Box<dyn Any + Send>
         })
     }
@@ -133,7 +131,7 @@ struct OnMujoco<'a, H> {
 impl<H: Hooks> ForJoints for OnMujoco<'_, H> {
     type Output = Result<(Rows, Metrics), RunError>;
     fn call<const N: usize>(self) -> Self::Output {
-        let mut step = ComputedStep::<N>::of(self.core, true)?;
+        let mut step = ComputedStep::<N>::of(self.core)?;
         super::drive::run_computed(&mut step, self.sim, self.spec, self.run, self.hooks)
     }
 }

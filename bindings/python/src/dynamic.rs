@@ -4,13 +4,14 @@
 //! ([`dy::Scenario`]) from the schema's parameter items
 //! ([`super::items`]); for a typed loop, [`AdaptiveStep`] is the
 //! const-generic controller of its N, reached through the core's accessors
-//! and [`for_joints`]; its closed loops are in [`super::drive`], recording
-//! into the core's rows and metrics.
+//! and [`for_joints`]; its closed loops (on MuJoCo, over
+//! [`super::drive`]'s loop, and on the core's rigid bodies) are here,
+//! recording into the core's rows and metrics.
 //!
-//! Nothing here knows Python: the bindings (`mod.rs`) convert arrays to
-//! slices and errors to exceptions.
+//! Nothing here knows Python: the bindings (`controller.rs`, `runs.rs`)
+//! convert arrays to slices and errors to exceptions.
 
-use super::items::injection;
+use super::items::{apply, injection};
 use super::mujoco::{Continued, MujocoSpec, Table};
 use adaptimp::control::config::Law;
 use adaptimp::control::controller::Controller;
@@ -29,7 +30,7 @@ use adaptimp::sim::metrics::MetricsAccumulator;
 use adaptimp::sim::model::{Link, PlanarArm};
 use adaptimp::sim::plant::RigidBody;
 use adaptimp::sim::simulator::run_disturbed_with;
-use adaptimp::trajectory::{Setpoint, Sinusoid};
+use adaptimp::trajectory::{Setpoint, Sinusoid, Trajectory};
 use adaptimp::types::Vector;
 use adaptimp_mujoco::Sim;
 use core::cell::{Cell, RefCell};
@@ -105,12 +106,7 @@ pub fn build(
     gravity: Option<&GravitySpec>,
 ) -> Result<JointCore, ParamError> {
     let mut s = dy::Scenario::new(n, preset, law)?;
-    for (name, v) in items {
-        s.set(name, v.value()).map_err(|error| ParamError {
-            name: Some(name.clone()),
-            error,
-        })?;
-    }
+    apply(items, |name, v| s.set(name, v).map(|_| ()))?;
     if let Some(c) = centers {
         s.basis(dy::Basis::Centres(dy::Centres {
             rows: c.centers.clone(),
@@ -156,16 +152,22 @@ impl JointCore {
     }
 
     /// One step; writes sat(τ) into `out` (n values).
-    pub fn step(&mut self, (m, c): &Inputs<'_>, out: &mut [f64]) -> Result<(), Error> {
-        let cmd = self.ctrl.step(&mut self.state, m, c.as_ref())?;
-        out.copy_from_slice(&cmd.tau_sat);
-        Ok(())
+    pub fn step(&mut self, inputs: &Inputs<'_>, out: &mut [f64]) -> Result<(), Error> {
+        let n = self.n();
+        let on = OnceTyped {
+            core: self,
+            inputs,
+            out,
+        };
+        for_joints(n, on).unwrap_or(Err(OTHER_N))
     }
 
     /// One step that always writes a torque to apply into `out`.
     pub fn step_or_fallback(&mut self, (m, c): &Inputs<'_>, out: &mut [f64]) -> Result<(), Error> {
         let (tau, result) = self.ctrl.step_or_fallback(&mut self.state, m, c.as_ref());
-        out.copy_from_slice(&tau.ok_or(OTHER_N)?);
+        if let Some(t) = tau {
+            out.copy_from_slice(&t);
+        }
         result.map(|_| ())
     }
 
@@ -208,43 +210,19 @@ impl JointCore {
     pub fn replay(
         &mut self,
         rows: usize,
-        t: &Tables<'_>,
+        tables: &Tables<'_>,
         out: &mut Vec<f64>,
         hooks: &mut dyn Hooks,
     ) -> Result<(), RunError> {
         let n = self.n();
-        fn at(v: &[f64], k: usize, n: usize) -> &[f64] {
-            &v[k * n..(k + 1) * n]
-        }
-        let row = |v, k| at(v, k, n);
-        for k in 0..rows {
-            if k > 0
-                && (k as u64).is_multiple_of(HOOK_EVERY)
-                && !hooks.report(k as u64, rows as u64, &*self)
-            {
-                return Err(RunError::Stopped);
-            }
-            let m = dy::Measurement {
-                x: row(t.x, k),
-                dx: t.dx.map(|d| row(d, k)),
-                tau_e: row(t.tau_e, k),
-            };
-            let c = t.setpoint.map(|[x, dx, ddx]| dy::Setpoint {
-                x: row(x, k),
-                dx: row(dx, k),
-                ddx: row(ddx, k),
-            });
-            let cmd = self
-                .ctrl
-                .step(&mut self.state, &m, c.as_ref())
-                .map_err(|e| RunError::Core(e, Some(k as u64)))?;
-            out.extend_from_slice(&cmd.tau_sat);
-        }
-        // The last row reported too (a progress bar ends at 100 %).
-        if rows > 0 && !hooks.report(rows as u64, rows as u64, &*self) {
-            return Err(RunError::Stopped);
-        }
-        Ok(())
+        let on = OnTables {
+            core: self,
+            rows,
+            tables,
+            out,
+            hooks,
+        };
+        for_joints(n, on).unwrap_or(Err(RunError::Core(OTHER_N, None)))
     }
 
     /// The closed loop of SPEC §11 against `arm` with the scenario of
@@ -305,9 +283,9 @@ impl View for JointCore {
 }
 
 /// [`JointCore`] as its const-generic controller of N joints, with its own
-/// trajectory and its state, for a typed loop; `copy_of`: the whole
-/// controller, whose copy with this state the Python code a run calls reads
-/// ([`View`]).
+/// trajectory and its state, for a typed loop; `whole`: the run-time
+/// controller, of which a run copies the controller at this state for the
+/// Python code it calls ([`View`]: made only when asked for).
 pub struct AdaptiveStep<'a, const N: usize> {
     /// The controller.
     pub ctrl: &'a Controller<N, AnyBasis<N>>,
@@ -315,22 +293,20 @@ pub struct AdaptiveStep<'a, const N: usize> {
     pub traj: &'a Sinusoid<N>,
     /// Its state.
     pub state: &'a mut HeapState<N>,
-    copy_of: Option<Box<JointCore>>,
+    whole: &'a dy::Controller,
 }
 
 impl<'a, const N: usize> AdaptiveStep<'a, N> {
-    /// `core` for N joints (an error if it was made for another n); `run`:
-    /// for a run, which publishes copies of it (a step alone allocates
-    /// nothing).
-    pub fn of(core: &'a mut JointCore, run: bool) -> Result<Self, Error> {
-        let copy_of = run.then(|| Box::new(core.clone()));
-        let (ctrl, traj) = core.ctrl.typed::<N>().ok_or(OTHER_N)?;
-        let state = core.state.typed_mut::<N>().ok_or(OTHER_N)?;
+    /// `core` for N joints (an error if it was made for another n).
+    pub fn of(core: &'a mut JointCore) -> Result<Self, Error> {
+        let JointCore { ctrl: whole, state } = core;
+        let (ctrl, traj) = whole.typed::<N>().ok_or(OTHER_N)?;
+        let state = state.typed_mut::<N>().ok_or(OTHER_N)?;
         Ok(Self {
             ctrl,
             traj,
             state,
-            copy_of,
+            whole,
         })
     }
 
@@ -342,6 +318,51 @@ impl<'a, const N: usize> AdaptiveStep<'a, N> {
         t: &TaskTorque<N>,
     ) -> Result<io::Command<N>, Error> {
         self.ctrl.step_task(self.state, m, c, t)
+    }
+
+    /// `rows` steps from row-major tables (a monomorphic loop: the rows
+    /// read as the core's vectors); writes sat(τ) rows into `out`, reports
+    /// every [`HOOK_EVERY`] rows and after the last, this controller
+    /// readable then. Errors name the row.
+    fn replay(
+        &mut self,
+        rows: usize,
+        t: &Tables<'_>,
+        out: &mut Vec<f64>,
+        hooks: &mut dyn Hooks,
+    ) -> Result<(), RunError> {
+        let row = |v: &[f64], k: usize| Vector::<N>::from_column_slice(&v[k * N..(k + 1) * N]);
+        for k in 0..rows {
+            if k > 0
+                && (k as u64).is_multiple_of(HOOK_EVERY)
+                && !hooks.report(k as u64, rows as u64, &*self)
+            {
+                return Err(RunError::Stopped);
+            }
+            let m = io::Measurement {
+                x: row(t.x, k),
+                dx: t.dx.map(|d| row(d, k)),
+                tau_e: row(t.tau_e, k),
+            };
+            let c = match t.setpoint {
+                Some([x, dx, ddx]) => Setpoint {
+                    x: row(x, k),
+                    dx: row(dx, k),
+                    ddx: row(ddx, k),
+                },
+                None => self.traj.sample(self.ctrl.time(self.state)),
+            };
+            let cmd = self
+                .ctrl
+                .step(self.state, &m, &c)
+                .map_err(|e| RunError::Core(e, Some(k as u64)))?;
+            out.extend_from_slice(cmd.tau_sat.as_slice());
+        }
+        // The last row reported too (a progress bar ends at 100 %).
+        if rows > 0 && !hooks.report(rows as u64, rows as u64, &*self) {
+            return Err(RunError::Stopped);
+        }
+        Ok(())
     }
 
     /// Back to t = 0, and the initial `weights` if given (rows as for
@@ -379,12 +400,15 @@ impl<const N: usize> Control<N> for AdaptiveStep<'_, N> {
 /// with the state as it is now.
 impl<const N: usize> View for AdaptiveStep<'_, N> {
     fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
-        let base = self.copy_of.as_ref()?;
         (part == TypeId::of::<Box<JointCore>>()).then(|| {
-            let mut copy = (**base).clone();
-            if let Some(s) = copy.state.typed_mut::<N>() {
+            let mut state = self.whole.new_state();
+            if let Some(s) = state.typed_mut::<N>() {
                 s.clone_from(self.state);
             }
+            let copy = JointCore {
+                ctrl: self.whole.clone(),
+                state,
+            };
             Box::new(Box::new(copy)) as Box<dyn Any + Send>
         })
     }
@@ -409,7 +433,7 @@ impl ForJoints for OnArm<'_> {
             .map_err(|e| RunError::Core(e.error, None))?;
         match self.arm {
             ArmSpec::Paper(two) => {
-                let mut t = AdaptiveStep::<2>::of(self.core, true).map_err(|_| {
+                let mut t = AdaptiveStep::<2>::of(self.core).map_err(|_| {
                     RunError::Core(
                         Error::Invalid {
                             what: "arm",
@@ -441,7 +465,7 @@ impl ForJoints for OnArm<'_> {
                     )
                 })?;
                 let arm = PlanarArm::new(links, *g)?;
-                let mut t = AdaptiveStep::<N>::of(self.core, true)?;
+                let mut t = AdaptiveStep::<N>::of(self.core)?;
                 run_arm(
                     &mut t,
                     &arm,
@@ -453,6 +477,55 @@ impl ForJoints for OnArm<'_> {
                 )
             }
         }
+    }
+}
+
+/// [`JointCore::step`] for its N: the rows read as the core's vectors.
+struct OnceTyped<'a, 'b> {
+    core: &'a mut JointCore,
+    inputs: &'a Inputs<'b>,
+    out: &'a mut [f64],
+}
+
+impl ForJoints for OnceTyped<'_, '_> {
+    type Output = Result<(), Error>;
+    fn call<const N: usize>(self) -> Self::Output {
+        let t = AdaptiveStep::<N>::of(self.core)?;
+        let (m, c) = self.inputs;
+        let v = |x: &[f64]| Vector::<N>::from_column_slice(x);
+        let m = io::Measurement {
+            x: v(m.x),
+            dx: m.dx.map(v),
+            tau_e: v(m.tau_e),
+        };
+        let c = match c {
+            Some(c) => Setpoint {
+                x: v(c.x),
+                dx: v(c.dx),
+                ddx: v(c.ddx),
+            },
+            None => t.traj.sample(t.ctrl.time(t.state)),
+        };
+        let cmd = t.ctrl.step(t.state, &m, &c)?;
+        self.out.copy_from_slice(cmd.tau_sat.as_slice());
+        Ok(())
+    }
+}
+
+/// [`JointCore::replay`] for its N.
+struct OnTables<'a, 'b> {
+    core: &'a mut JointCore,
+    rows: usize,
+    tables: &'a Tables<'b>,
+    out: &'a mut Vec<f64>,
+    hooks: &'a mut dyn Hooks,
+}
+
+impl ForJoints for OnTables<'_, '_> {
+    type Output = Result<(), RunError>;
+    fn call<const N: usize>(self) -> Self::Output {
+        let mut t = AdaptiveStep::<N>::of(self.core)?;
+        t.replay(self.rows, self.tables, self.out, self.hooks)
     }
 }
 
@@ -468,7 +541,7 @@ struct OnMujocoRun<'a, 'b> {
 impl ForJoints for OnMujocoRun<'_, '_> {
     type Output = Result<(Rows, Metrics), RunError>;
     fn call<const N: usize>(self) -> Self::Output {
-        let mut t = AdaptiveStep::<N>::of(self.core, true)?;
+        let mut t = AdaptiveStep::<N>::of(self.core)?;
         run_mujoco(&mut t, self.sim, self.spec, self.run, self.hooks)
     }
 }

@@ -59,6 +59,21 @@ impl From<Error> for ParamError {
     }
 }
 
+/// Every item given to `set` in turn, by name; the first refusal names its
+/// parameter.
+pub(crate) fn apply<T>(
+    items: &Items,
+    mut set: impl FnMut(&str, Value<'_>) -> Result<T, Error>,
+) -> Result<(), ParamError> {
+    for (name, v) in items {
+        set(name, v.value()).map_err(|error| ParamError {
+            name: Some(name.clone()),
+            error,
+        })?;
+    }
+    Ok(())
+}
+
 /// `preset` for `law` with every item applied, for N joints.
 pub fn scenario<const N: usize>(
     preset: Preset,
@@ -66,12 +81,7 @@ pub fn scenario<const N: usize>(
     items: &Items,
 ) -> Result<Scenario<N>, ParamError> {
     let mut s = Scenario::<N>::preset(preset, law);
-    for (name, v) in items {
-        s.set(name, v.value()).map_err(|error| ParamError {
-            name: Some(name.clone()),
-            error,
-        })?;
-    }
+    apply(items, |name, v| s.set(name, v))?;
     Ok(s)
 }
 
@@ -150,7 +160,7 @@ pub(crate) fn injection<const N: usize>(
         FaultKind::Skipped => dy::Injected::Skipped,
         // More than 7 values: the core's refusal of a bias of another length.
         FaultKind::ForceBias(b) => {
-            dy::Injected::ForceBias(dy::Joints::from_slice(b).unwrap_or(dy::Joints::zeros(0)?))
+            dy::Injected::ForceBias(dy::Joints::from_slice(b).or_else(|_| dy::Joints::zeros(0))?)
         }
         FaultKind::ActuatorDrop(fraction) => dy::Injected::ActuatorDrop {
             tau_max: dy::Joints::from_slice(tau_max)?,

@@ -477,15 +477,21 @@ pub struct TaskStep {
     pub wrench: [f64; 6],
 }
 
+/// p_c, ṗ_c, p̈_c of a step given the commanded pose `target`; none: the
+/// held target `held` (the filtered p_t) at rest.
+fn commanded(target: Option<&PoseTarget>, held: &Vector<3>) -> [Vector<3>; 3] {
+    match target {
+        Some(t) => [t.p, t.dp, t.ddp],
+        None => [*held, Vector::zeros(), Vector::zeros()],
+    }
+}
+
 impl TaskStep {
     /// The step of `command`, given the commanded pose `target` (none: the
     /// held target, p_c = p_t at rest) and the wrench F_e: as
     /// [`TypedTaskStep::new`], at run time.
     pub fn new(command: CartesianCommand, target: Option<&PoseTarget>, wrench: [f64; 6]) -> Self {
-        let commanded = match target {
-            Some(t) => [t.p, t.dp, t.ddp],
-            None => [command.target.0, Vector::zeros(), Vector::zeros()],
-        };
+        let commanded = commanded(target, &command.target.0);
         Self {
             command,
             commanded,
@@ -519,10 +525,7 @@ impl<const N: usize> TypedTaskStep<N> {
         target: Option<&PoseTarget>,
         wrench: [f64; 6],
     ) -> Self {
-        let commanded = match target {
-            Some(t) => [t.p, t.dp, t.ddp],
-            None => [command.target.0, Vector::zeros(), Vector::zeros()],
-        };
+        let commanded = commanded(target, &command.target.0);
         Self {
             command,
             commanded,

@@ -203,3 +203,22 @@ def test_a_failing_mujoco_run_never_sinks_the_sweep() -> None:
     assert df["error"].isna().tolist() == [True, False, False, False]
     assert "jitter" in df["error"][1]
     assert "Kp" in df["error"][2]
+
+
+def test_a_batch_starts_no_more_threads_than_jobs_and_refuses_fewer_than_one() -> None:
+    """More threads than jobs would start only to idle (10⁶ of them used to
+    take minutes to start): a batch runs on at most one thread per job, with
+    the results of one thread; fewer than one thread is refused by name."""
+    from adaptimp import _adaptimp
+
+    jobs = [("sf", adaptimp.Controller("sf").params, None)]
+    one = _adaptimp.simulate_many(jobs, 1, None)
+    many = _adaptimp.simulate_many(jobs, 10**6, None)
+    assert isinstance(one[0], dict)
+    assert one == many
+    for bad in (0, -1):
+        with pytest.raises(
+            adaptimp.ConfigError,
+            match=rf"^threads must be ≥ 1 \(None: every core\), got {bad}$",
+        ):
+            _adaptimp.simulate_many(jobs, bad, None)

@@ -32,6 +32,13 @@ const NOT_SPD: Error = Error::Invalid {
     reason: "must be positive definite (its Cholesky factorisation failed: D is singular)",
 };
 
+/// The error of a Λ beyond f64: J D⁻¹ Jᵀ too near zero (whole, or a block
+/// the joints move, underflowed to zero).
+const TOO_NEAR_ZERO: Error = Error::Invalid {
+    what: "Λ",
+    reason: "beyond f64 (J D⁻¹ Jᵀ too near zero: a jacobian near 0, or an inertia too large)",
+};
+
 /// Λ of SPEC (23.7), 6 × 6, symmetric (kg on the translation rows, kg m² on
 /// the rotation rows, kg m across): robosuite's `opspace_matrices`
 /// (`lambda_full`, or `lambda_pos` and `lambda_ori` on the diagonal blocks
@@ -45,7 +52,9 @@ const NOT_SPD: Error = Error::Invalid {
 /// Errors: a non-finite entry of `j` or `d` ([`Error::NonFinite`], `index`
 /// column-major); `d` not symmetric or not positive definite
 /// ([`Error::Invalid`] named `inertia`); J D⁻¹ Jᵀ or Λ beyond f64
-/// ([`Error::Invalid`] named `J D⁻¹ Jᵀ` or `Λ`): never a NaN or an infinity.
+/// ([`Error::Invalid`] named `J D⁻¹ Jᵀ` or `Λ`; a block whose J D⁻¹ Jᵀ
+/// underflows to zero while its rows of J do not, too): never a NaN, an
+/// infinity or a spurious zero.
 pub fn operational_inertia<const N: usize>(
     j: &Jacobian6<N>,
     d: &Matrix<N>,
@@ -72,22 +81,30 @@ pub fn operational_inertia<const N: usize>(
             reason: "beyond f64 (a jacobian too large, or an inertia too near singular)",
         });
     }
+    // Rows of J that move the tip but whose J D⁻¹ Jᵀ underflowed to zero:
+    // Λ there is beyond f64, not a direction the joints cannot move.
+    let underflow = |rows: core::ops::Range<usize>| {
+        let moved = rows.clone().any(|r| j.row(r).iter().any(|v| *v != 0.0));
+        moved && rows.clone().all(|r| rows.clone().all(|c| a[(r, c)] == 0.0))
+    };
     let lam = if uncoupled {
         let mut lam = Matrix::<6>::zeros();
         for k in [0, 3] {
+            if underflow(k..k + 3) {
+                return Err(TOO_NEAR_ZERO);
+            }
             let block = pinv(a.fixed_view::<3, 3>(k, k).into_owned())?;
             lam.fixed_view_mut::<3, 3>(k, k).copy_from(&block);
         }
         lam
     } else {
+        if underflow(0..6) {
+            return Err(TOO_NEAR_ZERO);
+        }
         pinv(a)?
     };
     if lam.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Invalid {
-            what: "Λ",
-            reason: "beyond f64 (J D⁻¹ Jᵀ too near zero: a jacobian near 0, or an inertia \
-                     too large)",
-        });
+        return Err(TOO_NEAR_ZERO);
     }
     Ok(lam)
 }

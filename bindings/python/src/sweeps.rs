@@ -66,7 +66,7 @@ pub(super) fn run_job(
 pub(super) fn simulate_many<'py>(
     py: Python<'py>,
     jobs: &Bound<'py, PyList>,
-    threads: Option<usize>,
+    threads: Option<i64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
     let mut parsed = Vec::with_capacity(jobs.len());
@@ -118,21 +118,34 @@ pub(super) fn simulate_many<'py>(
     Ok(out)
 }
 
-/// Run `run` on every job on `threads` threads (all cores if None) with the
-/// GIL released, in order of the results; this thread watches for signals
+/// Run `run` on every job on `threads` threads (all cores if None; at most
+/// one per job; fewer than one refused by name) with the GIL released, in order of the results; this thread watches for signals
 /// and reports progress every 50 ms (Ctrl-C stops the remaining runs and
 /// raises `KeyboardInterrupt`).
 pub(super) fn in_parallel<J: Sync>(
     py: Python<'_>,
     jobs: &[J],
-    threads: Option<usize>,
+    threads: Option<i64>,
     progress: Option<Py<PyAny>>,
     run: impl Fn(&J, &std::sync::atomic::AtomicBool) -> Result<dynamic::Metrics, String> + Sync,
 ) -> PyResult<Vec<Result<dynamic::Metrics, String>>> {
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    // More threads than jobs would only be started to idle (10⁴ of them
+    // take seconds to start): at most one per job. 0: rayon's every core.
+    let threads = match threads {
+        None => 0,
+        Some(t) if t >= 1 => usize::try_from(t)
+            .unwrap_or(usize::MAX)
+            .min(jobs.len().max(1)),
+        Some(t) => {
+            return Err(ConfigError::new_err(format!(
+                "threads must be ≥ 1 (None: every core), got {t}"
+            )))
+        }
+    };
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
+        .num_threads(threads)
         .build()
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start the thread pool: {e}")))?;
     let stop = AtomicBool::new(false);
@@ -232,7 +245,7 @@ pub(super) fn run_message(e: RunError) -> String {
 pub(super) fn simulate_mujoco_many<'py>(
     py: Python<'py>,
     jobs: &Bound<'py, PyList>,
-    threads: Option<usize>,
+    threads: Option<i64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
     let mut parsed = Vec::with_capacity(jobs.len());

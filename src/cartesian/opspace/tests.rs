@@ -104,10 +104,27 @@ fn the_refusals_name_the_input() {
     // Λ = 1/(J D⁻¹ Jᵀ) beyond f64: a one-joint arm that barely moves its tip.
     let jt = Jacobian6::<1>::from_column_slice(&[1e-160, 0.0, 0.0, 0.0, 0.0, 0.0]);
     let e = operational_inertia(&jt, &Matrix::<1>::new(1.0), true).unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "Λ: beyond f64 (J D⁻¹ Jᵀ too near zero: a jacobian near 0, or an inertia too large)"
-    );
+    let near_zero =
+        "Λ: beyond f64 (J D⁻¹ Jᵀ too near zero: a jacobian near 0, or an inertia too large)";
+    assert_eq!(e.to_string(), near_zero);
+    // Smaller still, J D⁻¹ Jᵀ underflows to exactly zero: refused as well,
+    // not taken for a direction the joints cannot move (whose Λ is 0), in
+    // either form and in a rotation block alone.
+    for scale in [1e-162, 1e-200, f64::MIN_POSITIVE] {
+        let jt = Jacobian6::<1>::from_column_slice(&[scale, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        for uncoupled in [true, false] {
+            let e = operational_inertia(&jt, &Matrix::<1>::new(1.0), uncoupled).unwrap_err();
+            assert_eq!(e.to_string(), near_zero, "scale {scale:e}");
+        }
+    }
+    let mut rot = j;
+    for r in 3..6 {
+        for c in 0..2 {
+            rot[(r, c)] *= 1e-200;
+        }
+    }
+    let e = operational_inertia(&rot, &d, true).unwrap_err();
+    assert_eq!(e.to_string(), near_zero);
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! ([`super::shared`]).
 
 use super::dynamic;
-use super::dynamic::{CentersSpec, Inputs, JointCore, Last, Tables, MAX_JOINTS};
+use super::dynamic::{CentersSpec, Inputs, JointCore, Last, MAX_JOINTS};
 use super::measurement::JointCall;
 use super::shared::{Read, Shared, Slot, Write};
 use super::{arrays::*, errors::*, hooks::*, params::*};
@@ -357,16 +357,17 @@ impl PyController {
                 "cannot allocate the torques of {rows} rows"
             )));
         }
+        out.resize(rows * n, 0.0);
         let mut hooks = PyHooks::holding(progress, vec![self.slot()]);
         let mut guard = self.lock(py)?;
-        let tables = Tables {
+        let tables = adaptimp::dynamic::Replay {
             x: &x,
             dx: dx.as_deref(),
             tau_e: &te,
             setpoint: sp.as_ref().map(|[a, b, c]| [&a[..], &b[..], &c[..]]),
         };
         let core: &mut JointCore = &mut guard;
-        let result = py.detach(|| core.replay(rows, &tables, &mut out, &mut hooks));
+        let result = py.detach(|| core.replay(&tables, &mut out, &mut hooks));
         drop(guard);
         result.map_err(|e| run_error(e, &mut hooks))?;
         array(py, out, (rows, n))

@@ -41,7 +41,7 @@ use std::vec::Vec;
 pub use adaptimp::dynamic::MAX_JOINTS;
 
 pub(crate) use super::drive::{drive_mujoco, Hooks, MujocoRun, OnMujoco, RunError, View};
-use super::drive::{metrics_out, Reporting, Watch, HOOK_EVERY};
+use super::drive::{metrics_out, Reporting, Watch};
 use std::any::TypeId;
 
 pub use super::items::{
@@ -205,24 +205,27 @@ impl JointCore {
         out
     }
 
-    /// `rows` steps from row-major tables; writes sat(τ) rows into `out`.
-    /// Errors name the row.
+    /// The K steps of `rows` (the core's [`dy::Controller::replay`]); sat(τ)
+    /// into `out` (K × n), the hooks told every [`dy::HOOK_EVERY`] rows and
+    /// after the last, this controller readable then. Errors name the row.
     pub fn replay(
         &mut self,
-        rows: usize,
-        tables: &Tables<'_>,
-        out: &mut Vec<f64>,
+        rows: &dy::Replay<'_>,
+        out: &mut [f64],
         hooks: &mut dyn Hooks,
     ) -> Result<(), RunError> {
-        let n = self.n();
-        let on = OnTables {
-            core: self,
-            rows,
-            tables,
-            out,
-            hooks,
+        let JointCore { ctrl, state } = self;
+        let seen = |done, total, state: &dy::State| {
+            hooks.report(
+                done,
+                total,
+                &Seen {
+                    ctrl: &*ctrl,
+                    state,
+                },
+            )
         };
-        for_joints(n, on).unwrap_or(Err(RunError::Core(OTHER_N, None)))
+        Ok(ctrl.replay(state, rows, out, seen)?)
     }
 
     /// The closed loop of SPEC §11 against `arm` with the scenario of
@@ -282,6 +285,25 @@ impl View for JointCore {
     }
 }
 
+/// A replay's controller between two rows, as a [`View`]: a copy made when
+/// asked for.
+struct Seen<'a> {
+    ctrl: &'a dy::Controller,
+    state: &'a dy::State,
+}
+
+impl View for Seen<'_> {
+    fn copy(&self, part: TypeId) -> Option<Box<dyn Any + Send>> {
+        (part == TypeId::of::<Box<JointCore>>()).then(|| {
+            let copy = JointCore {
+                ctrl: self.ctrl.clone(),
+                state: self.state.clone(),
+            };
+            Box::new(Box::new(copy)) as Box<dyn Any + Send>
+        })
+    }
+}
+
 /// [`JointCore`] as its const-generic controller of N joints, with its own
 /// trajectory and its state, for a typed loop; `whole`: the run-time
 /// controller, of which a run copies the controller at this state for the
@@ -318,51 +340,6 @@ impl<'a, const N: usize> AdaptiveStep<'a, N> {
         t: &TaskTorque<N>,
     ) -> Result<io::Command<N>, Error> {
         self.ctrl.step_task(self.state, m, c, t)
-    }
-
-    /// `rows` steps from row-major tables (a monomorphic loop: the rows
-    /// read as the core's vectors); writes sat(τ) rows into `out`, reports
-    /// every [`HOOK_EVERY`] rows and after the last, this controller
-    /// readable then. Errors name the row.
-    fn replay(
-        &mut self,
-        rows: usize,
-        t: &Tables<'_>,
-        out: &mut Vec<f64>,
-        hooks: &mut dyn Hooks,
-    ) -> Result<(), RunError> {
-        let row = |v: &[f64], k: usize| Vector::<N>::from_column_slice(&v[k * N..(k + 1) * N]);
-        for k in 0..rows {
-            if k > 0
-                && (k as u64).is_multiple_of(HOOK_EVERY)
-                && !hooks.report(k as u64, rows as u64, &*self)
-            {
-                return Err(RunError::Stopped);
-            }
-            let m = io::Measurement {
-                x: row(t.x, k),
-                dx: t.dx.map(|d| row(d, k)),
-                tau_e: row(t.tau_e, k),
-            };
-            let c = match t.setpoint {
-                Some([x, dx, ddx]) => Setpoint {
-                    x: row(x, k),
-                    dx: row(dx, k),
-                    ddx: row(ddx, k),
-                },
-                None => self.traj.sample(self.ctrl.time(self.state)),
-            };
-            let cmd = self
-                .ctrl
-                .step(self.state, &m, &c)
-                .map_err(|e| RunError::Core(e, Some(k as u64)))?;
-            out.extend_from_slice(cmd.tau_sat.as_slice());
-        }
-        // The last row reported too (a progress bar ends at 100 %).
-        if rows > 0 && !hooks.report(rows as u64, rows as u64, &*self) {
-            return Err(RunError::Stopped);
-        }
-        Ok(())
     }
 
     /// Back to t = 0, and the initial `weights` if given (rows as for
@@ -512,23 +489,6 @@ impl ForJoints for OnceTyped<'_, '_> {
     }
 }
 
-/// [`JointCore::replay`] for its N.
-struct OnTables<'a, 'b> {
-    core: &'a mut JointCore,
-    rows: usize,
-    tables: &'a Tables<'b>,
-    out: &'a mut Vec<f64>,
-    hooks: &'a mut dyn Hooks,
-}
-
-impl ForJoints for OnTables<'_, '_> {
-    type Output = Result<(), RunError>;
-    fn call<const N: usize>(self) -> Self::Output {
-        let mut t = AdaptiveStep::<N>::of(self.core)?;
-        t.replay(self.rows, self.tables, self.out, self.hooks)
-    }
-}
-
 /// The closed loop of a [`JointCore`] on MuJoCo, for its N.
 struct OnMujocoRun<'a, 'b> {
     core: &'a mut JointCore,
@@ -544,18 +504,6 @@ impl ForJoints for OnMujocoRun<'_, '_> {
         let mut t = AdaptiveStep::<N>::of(self.core)?;
         run_mujoco(&mut t, self.sim, self.spec, self.run, self.hooks)
     }
-}
-
-/// Row-major tables of a replay: K × n each.
-pub struct Tables<'a> {
-    /// Positions.
-    pub x: &'a [f64],
-    /// Velocities.
-    pub dx: Option<&'a [f64]>,
-    /// Forces.
-    pub tau_e: &'a [f64],
-    /// Setpoints (xc, ẋc, ẍc).
-    pub setpoint: Option<[&'a [f64]; 3]>,
 }
 
 // ---------------------------------------------------------------------------

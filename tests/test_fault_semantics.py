@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import pickle
+import re
 
 import numpy as np
 import pytest
@@ -231,6 +232,31 @@ def test_an_edited_or_corrupt_snapshot_is_refused_and_changes_nothing() -> None:
     np.testing.assert_array_equal(target.snapshot(), before)
     target.restore(snap)
     np.testing.assert_array_equal(target.snapshot(), snap)
+    # Truncated or extended: named as what it is, not by the Rust call it fails.
+    for bad in (snap[:-1], np.append(snap, 0.0)):
+        with pytest.raises(
+            ConfigError,
+            match=r"truncated or too long: not the length of a snapshot of this n and L",
+        ):
+            target.restore(bad)
+    np.testing.assert_array_equal(target.snapshot(), snap)
+
+
+def test_a_raw_fault_of_no_kind_is_named_in_pythons_words() -> None:
+    from adaptimp import _adaptimp
+
+    ctrl = adaptimp.Controller("sf")
+    arm = adaptimp.TwoLinkArm()
+    with pytest.raises(
+        ConfigError,
+        match=re.escape(
+            "fault 'stale' with bias [1.0, 2.0] and fraction 0.5: the kinds are 'stale', "
+        ),
+    ):
+        _adaptimp.simulate(ctrl, arm.core, {}, fault=("stale", 0.0, 1.0, [1.0, 2.0], 0.5))
+    gone = "fault 'gone' with bias None and fraction None"
+    with pytest.raises(ConfigError, match=re.escape(gone)):
+        _adaptimp.simulate(ctrl, arm.core, {}, fault=("gone", 0.0, 1.0, None, None))
 
 
 def test_weights_no_step_could_use_are_refused() -> None:

@@ -341,7 +341,9 @@ impl<const N: usize, S: AsRef<[f64]> + AsMut<[f64]>> State<N, S> {
             return Err(bad("made for another number of joints or nodes"));
         }
         if data.len() != self.snapshot_len() {
-            return Err(bad("its length is not State::snapshot_len() of this state"));
+            return Err(bad(
+                "truncated or too long: not the length of a snapshot of this n and L",
+            ));
         }
         let k = data[4];
         if !(0.0..=9.007_199_254_740_992e15).contains(&k) || (k as u64) as f64 != k {

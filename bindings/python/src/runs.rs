@@ -190,10 +190,13 @@ pub(super) fn fault_spec(f: Option<PyFault>) -> PyResult<Option<dynamic::FaultSp
         ("force_bias", Some(b), None) => K::ForceBias(b),
         ("actuator_drop", None, Some(x)) => K::ActuatorDrop(x),
         (other, b, x) => {
+            // As Python writes them: None, [1.0, 2.0], 0.5.
+            let b = b.map_or("None".to_string(), |v| format!("{v:?}"));
+            let x = x.map_or("None".to_string(), |v| format!("{v:?}"));
             return Err(ConfigError::new_err(format!(
-                "fault {other:?} with bias {b:?} and fraction {x:?}: the kinds are 'stale', \
+                "fault '{other}' with bias {b} and fraction {x}: the kinds are 'stale', \
                  'nan_burst', 'skipped', 'force_bias' (with bias) and 'actuator_drop' (with fraction)"
-            )))
+            )));
         }
     };
     Ok(Some(dynamic::FaultSpec {

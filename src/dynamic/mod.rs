@@ -433,7 +433,7 @@ pub use model::{
 pub use opspace::operational_inertia;
 #[cfg(all(feature = "alloc", feature = "sim"))]
 pub use run::{
-    cartesian_steps, drive_cartesian, metrics_of, reads_the_wrench, run, simulate,
+    cartesian_steps, drive_cartesian, kept_rows, metrics_of, reads_the_wrench, run, simulate,
     simulate_cartesian, Arm as ModelArm, CartesianDriver, CartesianLoop, Control, Controlled,
     Disturbances, Hooks, Injected, Injection, Jacobian3, Loop, LoopJoint, Metrics, Output, Plant,
     Recorded, Reference, Replay, RigidBody, RowMetrics, Rows, Run, RunError, Spec, Table, TaskRows,

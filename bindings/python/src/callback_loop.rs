@@ -171,7 +171,7 @@ fn prepare<const N: usize, const M: usize>(
         reads_the_wrench::<N>(Law::Pd, run.items, run.fault)?;
     }
     let every = run.every.max(1);
-    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let kept = adaptimp::dynamic::kept_rows(total, every);
     let joint = JointRows::new(N, kept, every)?;
     let mut reference = RefRows::default();
     for v in &mut reference {

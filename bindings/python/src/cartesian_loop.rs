@@ -321,7 +321,7 @@ pub(crate) fn simulate_mujoco<const N: usize>(
     } = o;
     let total = checked(outer, &*joint, run)?;
     let every = run.every.max(1);
-    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let kept = adaptimp::dynamic::kept_rows(total, every);
     let mut rec = Rows::new(N, kept, every)?;
     let mut task = TaskRows::new(N, kept, every)?;
     // The table's rows as the core's pose targets (checked: one per step).

@@ -506,7 +506,7 @@ pub(crate) fn run_computed<const N: usize, C: Control<N> + View>(
         }
     };
     let every = run.every.max(1);
-    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let kept = adaptimp::dynamic::kept_rows(total, every);
     let rec = Rows::new(N, kept, every)?;
     let imp = *Control::target(c);
     let target = [

@@ -536,7 +536,7 @@ fn run_mujoco<const N: usize>(
         }
     }
     let every = run.every.max(1);
-    let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
+    let kept = adaptimp::dynamic::kept_rows(total, every);
     let mut rec = Rows::new(N, kept, every)?;
     let mut metrics = MetricsAccumulator::new(run.settle, *t.ctrl.impedance());
     let k0 = t.state.steps();
@@ -581,7 +581,7 @@ fn run_arm<const N: usize, M: TipPayload<N> + Clone>(
         .transpose()?;
     let ts = t.ctrl.period();
     let total = adaptimp::sim::simulator::steps(cfg.t_final, ts)?;
-    let kept = usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX);
+    let kept = adaptimp::dynamic::kept_rows(total, every);
     let mut rec = Rows::new(N, kept, every)?;
     t.restart(weights)?;
     let traj = *t.traj;

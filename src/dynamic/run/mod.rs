@@ -24,7 +24,7 @@ pub use cartesian::{
 pub use plant::{Arm, Disturbances, Injected, Injection, Jacobian3, Plant, RigidBody};
 pub use replay::Replay;
 pub use rows::{
-    metrics_of, Metrics, Recorded, RowMetrics, Rows, TaskRows, TaskStep, TypedTaskStep,
+    kept_rows, metrics_of, Metrics, Recorded, RowMetrics, Rows, TaskRows, TaskStep, TypedTaskStep,
 };
 pub use spec::{run, Loop, Output, Spec};
 

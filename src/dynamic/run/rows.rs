@@ -61,6 +61,13 @@ pub struct Rows {
     pub wrench: Vec<f64>,
 }
 
+/// The rows a run of `total` periods keeps when it keeps every `every`-th
+/// (0 is taken as 1): ⌈total / every⌉, what [`Rows::new`] and
+/// [`TaskRows::new`] are sized for.
+pub fn kept_rows(total: u64, every: u64) -> usize {
+    usize::try_from(total.div_ceil(every.max(1))).unwrap_or(usize::MAX)
+}
+
 impl Rows {
     /// Room for `rows` kept rows of n joints, keeping every `every`-th
     /// (≥ 1); [`RunError::Memory`] if it cannot be had.
@@ -104,9 +111,7 @@ impl Rows {
     /// every `run.every`-th of its round(T/Ts) periods.
     pub fn for_run(n: usize, run: &Run<'_>, ts: f64) -> Result<Self, RunError> {
         let total = simulator::steps(run.t_final, ts)?;
-        let every = run.every.max(1);
-        let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-        Self::new(n, kept, every)
+        Self::new(n, kept_rows(total, run.every), run.every)
     }
 
     /// The number of joints n.
@@ -591,9 +596,7 @@ impl TaskRows {
     /// Rows for the run `run` at the period `ts` (s), as [`Rows::for_run`].
     pub fn for_run(n: usize, run: &Run<'_>, ts: f64) -> Result<Self, RunError> {
         let total = simulator::steps(run.t_final, ts)?;
-        let every = run.every.max(1);
-        let kept = usize::try_from(total.div_ceil(every)).unwrap_or(usize::MAX);
-        Self::new(n, kept, every)
+        Self::new(n, kept_rows(total, run.every), run.every)
     }
 
     /// The number of joints n (the width of `qd`).
